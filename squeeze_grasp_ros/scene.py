@@ -1,0 +1,474 @@
+# Copyright 2026 squeeze_grasp_ros developers
+# SPDX-License-Identifier: Apache-2.0
+"""YAML scene files -> typed, validated, frozen configuration.
+
+A scene names the object (shape, material, mesh or ring model), the fingers (tip radius,
+placement, device), the squeeze (type, depth), friction, optional sections for later effects,
+and an explicit ``effects:`` list. Parsing is strict: unknown keys, wrong types, values out of
+range and contradictions raise :class:`SceneError` naming the field (``fingers.F1.tip_radius``).
+
+Each section is a frozen dataclass; its fields carry their documentation, unit and range in
+``metadata`` so the parser, the error messages and ``squeeze-grasp scene-help`` share one
+source of truth. Adding a section = adding a dataclass and a field of :class:`Scene`.
+"""
+from __future__ import annotations
+
+import dataclasses
+import types
+import typing
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Optional
+
+import numpy as np
+import yaml
+
+from .mechanics import shapes
+from .mechanics.errors import MechanicsError
+from .mechanics.material import Material
+from .mechanics.mesh import Mesh, generate_mesh, target_max_area
+
+
+class SceneError(ValueError):
+    """A scene entry is unknown, of the wrong type, out of range or contradictory."""
+
+
+def spec(doc: str, unit: str = "", lo: float | None = None, hi: float | None = None,
+         lo_open: bool = False, choices: tuple = (), **kw) -> Any:
+    """A dataclass field with documentation, unit, range and allowed choices for the parser."""
+    meta = {"doc": doc, "unit": unit, "lo": lo, "hi": hi, "lo_open": lo_open, "choices": choices}
+    return field(metadata=meta, **kw)
+
+
+EFFECTS: dict[str, str] = {
+    "friction": "Coulomb friction at the fingertips (needs friction.mu)",
+    "strain_limit": "stop at the proportional limit (needs strain_limit.epsilon)",
+    "pickup": "stop when friction can lift the object's weight (needs pickup.weight)",
+    "adversary": "a third finger pushes after the squeeze (needs adversary)",
+    "force_sensing": "fingertip wrench sensors",
+    "tactile_sensing": "fingertip tactile arrays",
+    "sensor_noise": "Gaussian noise on sensor readings (needs sensors.noise_std, sensors.seed)",
+    "actuator_lag": "first-order lag of the finger actuators (needs actuators.time_constant)",
+    "sensor_dropout": "sensor messages dropped at random (needs sensors.dropout)",
+}
+"""Every effect a scene may declare, with what it requires."""
+
+SHAPES: dict[str, tuple[str, ...]] = {
+    "rectangle": ("width", "height"),
+    "square": ("side",),
+    "disk": ("radius",),
+    "ellipse": ("a", "b"),
+    "superellipse": ("a", "b", "exponent"),
+    "fourier_blob": ("radius", "cos", "sin"),
+    "polygon": ("points",),
+    "spline": ("points",),
+    "file": ("path",),
+    "annulus": ("outer_radius", "inner_radius"),
+}
+"""Shape types and their parameters (lengths in m; fourier coefficients relative)."""
+
+
+@dataclass(frozen=True)
+class MeshSpec:
+    """Triangulation controls: the accuracy knobs of the solid model."""
+
+    max_area: Optional[float] = spec("largest element area", "m^2", lo=0.0, lo_open=True, default=None)
+    nodes: Optional[int] = spec("approximate node count (instead of max_area)", lo=10, default=None)
+    min_angle: float = spec("smallest element angle", "deg", lo=0.0, hi=34.0, lo_open=True, default=30.0)
+
+
+@dataclass(frozen=True)
+class MaterialSpec:
+    """Material of the object (plane stress)."""
+
+    E: float = spec("Young's modulus", "Pa", lo=0.0, lo_open=True)
+    nu: float = spec("Poisson's ratio", "", lo=-1.0, hi=0.5, lo_open=True)
+    thickness: float = spec("out-of-plane thickness h (ring: width w)", "m", lo=0.0, lo_open=True)
+
+
+@dataclass(frozen=True)
+class RingSpec:
+    """Curved-beam model of a hollow object (Sec. 7): the shape is the middle curve."""
+
+    wall_thickness: float = spec("in-plane wall thickness h", "m", lo=0.0, lo_open=True)
+    elements: int = spec("number of beam elements along the middle curve", lo=8, default=200)
+
+
+@dataclass(frozen=True)
+class ObjectSpec:
+    """The grasped object."""
+
+    shape: dict = spec("outline: {type: <one of SHAPES>, <its parameters>}")
+    material: MaterialSpec = spec("material")
+    model: str = spec("mechanical model", choices=("solid", "ring"), default="solid")
+    mesh: MeshSpec = spec("solid-model triangulation", default_factory=MeshSpec)
+    ring: Optional[RingSpec] = spec("ring-model parameters (model: ring)", default=None)
+
+
+@dataclass(frozen=True)
+class PlacementSpec:
+    """Where a finger first touches the boundary: exactly one of point, angle_deg, node."""
+
+    point: Optional[tuple[float, float]] = spec("nearest boundary node to this point", "m", default=None)
+    angle_deg: Optional[float] = spec("boundary node in this polar direction from the centroid", "deg",
+                                      default=None)
+    node: Optional[int] = spec("mesh node index on the outer boundary", lo=0, default=None)
+
+
+@dataclass(frozen=True)
+class FingerSpec:
+    """One finger."""
+
+    placement: PlacementSpec = spec("initial contact")
+    tip_radius: float = spec("fingertip radius (0 = point finger)", "m", lo=0.0, default=0.0)
+    device: str = spec("device driving this finger", default="")
+
+
+@dataclass(frozen=True)
+class SqueezeSpec:
+    """The squeeze to perform."""
+
+    type: str = spec("squeeze type", choices=("stable", "pure"), default="stable")
+    depth: Optional[float] = spec("squeeze depth rho", "m", lo=0.0, default=None)
+    relative_depth: Optional[float] = spec("finger approach / initial contact distance", "",
+                                           lo=0.0, hi=1.0, default=None)
+    step: float = spec("depth step of the event-driven squeeze, relative to the object size", "",
+                       lo=0.0, lo_open=True, default=1e-3)
+    event_tol: float = spec("event location tolerance, relative to the object size", "",
+                            lo=0.0, lo_open=True, default=1e-9)
+
+
+@dataclass(frozen=True)
+class FrictionSpec:
+    """Coulomb friction between fingertips and object."""
+
+    mu: float = spec("friction coefficient", "", lo=0.0)
+
+
+@dataclass(frozen=True)
+class StrainLimitSpec:
+    """Proportional limit (eq. 45)."""
+
+    epsilon: float = spec("strain limit epsilon*", "", lo=0.0, lo_open=True)
+    criterion: str = spec("principal: max |eps_1|,|eps_2|; componentwise: |eps_x|,|eps_y| (literal eq. 45)",
+                          choices=("principal", "componentwise"), default="principal")
+
+
+@dataclass(frozen=True)
+class PickupSpec:
+    """Lift the object against gravity."""
+
+    weight: float = spec("object weight", "N", lo=0.0, lo_open=True)
+
+
+@dataclass(frozen=True)
+class AdversarySpec:
+    """A third finger A that pushes the grasped object (Sec. 6)."""
+
+    placement: PlacementSpec = spec("initial contact of A")
+    a: tuple[float, float] = spec("translation of A", "m")
+    tip_radius: float = spec("fingertip radius of A", "m", lo=0.0, default=0.0)
+    mode: str = spec("resistance type", choices=("stable", "pure"), default="stable")
+    contacts: str = spec("contact model", choices=("point", "segment", "friction"), default="point")
+    device: str = spec("device driving A", default="")
+
+
+@dataclass(frozen=True)
+class Scene:
+    """A validated scene. Build it with :func:`load_scene` or :func:`parse_scene`."""
+
+    object: ObjectSpec = spec("the object")
+    fingers: dict = spec("F1, F2: finger specs")
+    name: str = spec("scene name", default="")
+    description: str = spec("free text", default="")
+    squeeze: SqueezeSpec = spec("the squeeze", default_factory=SqueezeSpec)
+    friction: Optional[FrictionSpec] = spec("friction (effect: friction)", default=None)
+    strain_limit: Optional[StrainLimitSpec] = spec("strain limit (effect: strain_limit)", default=None)
+    pickup: Optional[PickupSpec] = spec("pickup (effect: pickup)", default=None)
+    adversary: Optional[AdversarySpec] = spec("adversary finger (effect: adversary)", default=None)
+    effects: tuple[str, ...] = spec("declared effects, see EFFECTS", default=())
+
+    @property
+    def mu(self) -> float:
+        """Friction coefficient (0 without the friction effect)."""
+        return self.friction.mu if self.friction is not None else 0.0
+
+    def has(self, effect: str) -> bool:
+        """True if the scene declares ``effect``."""
+        return effect in self.effects
+
+
+SECTION_EFFECT = {"friction": "friction", "strain_limit": "strain_limit", "pickup": "pickup",
+                  "adversary": "adversary"}
+
+
+def _describe(meta: dict) -> str:
+    lo, hi = meta.get("lo"), meta.get("hi")
+    if lo is not None and hi is not None:
+        return f"in {'(' if meta.get('lo_open') else '['}{lo}, {hi}]"
+    if lo is not None:
+        return f"{'>' if meta.get('lo_open') else '>='} {lo}"
+    return ""
+
+
+def _check_range(value: float, meta: dict, where: str) -> None:
+    lo, hi = meta.get("lo"), meta.get("hi")
+    bad = (lo is not None and (value < lo or (meta.get("lo_open") and value == lo))) or (
+        hi is not None and value > hi)
+    if bad or not np.isfinite(value):
+        unit = f" {meta['unit']}" if meta.get("unit") else ""
+        raise SceneError(f"{where} must be {_describe(meta)}{unit}, got {value!r}")
+
+
+def _yaml11_float(text: str, where: str) -> float:
+    """Accept exponents such as ``5.0e4`` that YAML 1.1 (PyYAML) leaves as strings."""
+    try:
+        return float(text)
+    except ValueError:
+        raise SceneError(f"{where} must be a number, got {text!r}") from None
+
+
+def _convert(tp: Any, value: Any, meta: dict, where: str) -> Any:
+    origin = typing.get_origin(tp)
+    if origin in (typing.Union, types.UnionType):
+        args = [a for a in typing.get_args(tp) if a is not type(None)]
+        return None if value is None else _convert(args[0], value, meta, where)
+    if dataclasses.is_dataclass(tp):
+        return parse_section(tp, value, where)
+    if origin is tuple:
+        args = typing.get_args(tp)
+        if not isinstance(value, (list, tuple)):
+            raise SceneError(f"{where} must be a list, got {value!r}")
+        if args[-1] is not Ellipsis and len(value) != len(args):
+            raise SceneError(f"{where} must have {len(args)} entries, got {len(value)}")
+        inner = args[0]
+        return tuple(_convert(inner, v, meta, f"{where}[{k}]") for k, v in enumerate(value))
+    if tp is float:
+        if isinstance(value, str):
+            value = _yaml11_float(value, where)
+        if isinstance(value, bool) or not isinstance(value, (int, float)):
+            raise SceneError(f"{where} must be a number, got {value!r}")
+        value = float(value)
+        _check_range(value, meta, where)
+        return value
+    if tp is int:
+        if isinstance(value, bool) or not isinstance(value, int):
+            raise SceneError(f"{where} must be an integer, got {value!r}")
+        _check_range(value, meta, where)
+        return value
+    if tp is str:
+        if not isinstance(value, str):
+            raise SceneError(f"{where} must be a string, got {value!r}")
+        if meta.get("choices") and value not in meta["choices"]:
+            raise SceneError(f"{where} must be one of {list(meta['choices'])}, got {value!r}")
+        return value
+    if tp is bool:
+        if not isinstance(value, bool):
+            raise SceneError(f"{where} must be true or false, got {value!r}")
+        return value
+    if tp is dict:
+        if not isinstance(value, dict):
+            raise SceneError(f"{where} must be a mapping, got {value!r}")
+        return value
+    raise TypeError(f"unsupported scene field type {tp!r} at {where}")
+
+
+def parse_section(cls: type, data: Any, where: str) -> Any:
+    """Parse mapping ``data`` into dataclass ``cls``; errors name ``where.<field>``."""
+    if not isinstance(data, dict):
+        raise SceneError(f"{where} must be a mapping, got {data!r}")
+    hints = typing.get_type_hints(cls)
+    fields = {f.name: f for f in dataclasses.fields(cls)}
+    unknown = sorted(set(data) - set(fields))
+    if unknown:
+        raise SceneError(f"unknown key {where}.{unknown[0]} (allowed: {sorted(fields)})")
+    kwargs = {}
+    for name, f in fields.items():
+        path = f"{where}.{name}" if where else name
+        if name not in data:
+            if f.default is dataclasses.MISSING and f.default_factory is dataclasses.MISSING:
+                raise SceneError(f"missing required key {path}")
+            continue
+        kwargs[name] = _convert(hints[name], data[name], dict(f.metadata), path)
+    return cls(**kwargs)
+
+
+def _validate_shape(shape: dict) -> None:
+    kind = shape.get("type")
+    if kind not in SHAPES:
+        raise SceneError(f"object.shape.type must be one of {sorted(SHAPES)}, got {kind!r}")
+    allowed = set(SHAPES[kind]) | {"type"}
+    unknown = sorted(set(shape) - allowed)
+    if unknown:
+        raise SceneError(f"unknown key object.shape.{unknown[0]} for type {kind} "
+                         f"(allowed: {sorted(allowed - {'type'})})")
+    optional = {"cos", "sin"}
+    for key in SHAPES[kind]:
+        if key not in shape and key not in optional:
+            raise SceneError(f"missing required key object.shape.{key} for type {kind}")
+
+
+def _validate(scene: Scene) -> Scene:
+    _validate_shape(scene.object.shape)
+    for name in scene.fingers:
+        if name not in ("F1", "F2"):
+            raise SceneError(f"unknown finger fingers.{name} (allowed: F1, F2; the adversary is "
+                             "the 'adversary' section)")
+    if set(scene.fingers) != {"F1", "F2"}:
+        raise SceneError("fingers must define both F1 and F2")
+    placements = [(f"fingers.{k}", v.placement) for k, v in scene.fingers.items()]
+    if scene.adversary is not None:
+        placements.append(("adversary", scene.adversary.placement))
+    for where, p in placements:
+        given = [k for k in ("point", "angle_deg", "node") if getattr(p, k) is not None]
+        if len(given) != 1:
+            raise SceneError(f"{where}.placement needs exactly one of point, angle_deg, node; "
+                             f"got {given or 'none'}")
+    sq = scene.squeeze
+    if sq.depth is not None and sq.relative_depth is not None:
+        raise SceneError("squeeze.depth and squeeze.relative_depth are exclusive; give one")
+    for effect in scene.effects:
+        if effect not in EFFECTS:
+            raise SceneError(f"unknown effect {effect!r} in effects (allowed: {sorted(EFFECTS)})")
+    if len(set(scene.effects)) != len(scene.effects):
+        raise SceneError("effects lists an effect twice")
+    for section, effect in SECTION_EFFECT.items():
+        present = getattr(scene, section) is not None
+        if present and not scene.has(effect):
+            raise SceneError(f"section {section} is given but effect {effect!r} is not declared "
+                             "in effects")
+        if scene.has(effect) and not present:
+            raise SceneError(f"effect {effect!r} is declared but section {section} is missing")
+    obj = scene.object
+    if obj.model == "ring" and obj.ring is None:
+        raise SceneError("object.model is ring but object.ring is missing")
+    if obj.model == "solid" and obj.ring is not None:
+        raise SceneError("object.ring is given but object.model is solid")
+    if obj.model == "solid" and obj.mesh.max_area is not None and obj.mesh.nodes is not None:
+        raise SceneError("object.mesh.max_area and object.mesh.nodes are exclusive; give one")
+    try:
+        Material(obj.material.E, obj.material.nu, obj.material.thickness)
+    except MechanicsError as exc:
+        raise SceneError(f"object.{exc}") from None
+    return scene
+
+
+def parse_scene(data: Any, base_dir: Path | None = None) -> Scene:
+    """Validate a scene given as a mapping (e.g. from YAML); relative file paths use ``base_dir``."""
+    if not isinstance(data, dict):
+        raise SceneError("a scene must be a YAML mapping")
+    if isinstance(data.get("fingers"), dict):
+        data = dict(data)
+        data["fingers"] = {k: parse_section(FingerSpec, v, f"fingers.{k}")
+                           for k, v in data["fingers"].items()}
+    scene = _validate(parse_section(Scene, data, ""))
+    shape = scene.object.shape
+    if shape["type"] == "file" and base_dir is not None and not Path(shape["path"]).is_absolute():
+        shape = {**shape, "path": str(Path(base_dir) / shape["path"])}
+        scene = dataclasses.replace(scene, object=dataclasses.replace(scene.object, shape=shape))
+    return scene
+
+
+def load_scene(path: str | Path) -> Scene:
+    """Read and validate a YAML scene file."""
+    path = Path(path)
+    if not path.is_file():
+        raise SceneError(f"scene file not found: {path}")
+    try:
+        data = yaml.safe_load(path.read_text())
+    except yaml.YAMLError as exc:
+        raise SceneError(f"{path}: invalid YAML: {exc}") from None
+    return parse_scene(data, base_dir=path.parent)
+
+
+def build_outline(shape: dict) -> shapes.Outline:
+    """The :class:`~squeeze_grasp_ros.mechanics.shapes.Outline` of a validated shape mapping."""
+    kind = shape["type"]
+    try:
+        if kind == "square":
+            return shapes.rectangle(shape["side"], shape["side"])
+        if kind == "file":
+            return shapes.load_outline(shape["path"])
+        builder = getattr(shapes, kind)
+        return builder(**{k: v for k, v in shape.items() if k != "type"})
+    except MechanicsError as exc:
+        raise SceneError(f"object.shape: {exc}") from None
+    except TypeError as exc:
+        raise SceneError(f"object.shape ({kind}): {exc}") from None
+
+
+def scene_material(scene: Scene) -> Material:
+    """The object's :class:`Material`."""
+    m = scene.object.material
+    return Material(m.E, m.nu, m.thickness)
+
+
+def build_mesh(scene: Scene) -> Mesh:
+    """Triangulate the scene's solid object with its mesh settings."""
+    outline = build_outline(scene.object.shape)
+    ms = scene.object.mesh
+    if ms.max_area is not None:
+        area = ms.max_area
+    else:
+        area = target_max_area(outline, ms.nodes if ms.nodes is not None else 600)
+    try:
+        return generate_mesh(outline, area, ms.min_angle)
+    except MechanicsError as exc:
+        raise SceneError(f"object.mesh: {exc}") from None
+
+
+def placement_node(mesh: Mesh, placement: PlacementSpec, where: str,
+                   positions: np.ndarray | None = None) -> int:
+    """Mesh node index of a finger placement on the outer boundary (or ``positions`` loop)."""
+    loop = mesh.boundary
+    pts = mesh.nodes[loop] if positions is None else positions
+    if placement.node is not None:
+        if placement.node >= mesh.n or placement.node not in set(loop.tolist()):
+            raise SceneError(f"{where}.placement.node {placement.node} is not an outer-boundary "
+                             f"node (boundary has {len(loop)} nodes; see `squeeze-grasp mesh`)")
+        return int(placement.node)
+    if placement.point is not None:
+        k = np.argmin(np.linalg.norm(pts - np.asarray(placement.point), axis=1))
+        return int(loop[k])
+    c = mesh.centroid
+    ang = np.arctan2(pts[:, 1] - c[1], pts[:, 0] - c[0])
+    target = np.radians(placement.angle_deg)
+    k = np.argmin(np.abs(np.angle(np.exp(1j * (ang - target)))))
+    return int(loop[k])
+
+
+def finger_nodes(scene: Scene, mesh: Mesh) -> tuple[int, int]:
+    """Initial contact nodes (F1, F2) of the scene's fingers on ``mesh``."""
+    i = placement_node(mesh, scene.fingers["F1"].placement, "fingers.F1")
+    j = placement_node(mesh, scene.fingers["F2"].placement, "fingers.F2")
+    if i == j:
+        raise SceneError("fingers.F1 and fingers.F2 are placed on the same boundary node")
+    return i, j
+
+
+def scene_help() -> str:
+    """Human-readable reference of every scene key, unit and range."""
+    lines: list[str] = []
+
+    def walk(cls: type, prefix: str) -> None:
+        hints = typing.get_type_hints(cls)
+        for f in dataclasses.fields(cls):
+            meta = f.metadata
+            tp = hints[f.name]
+            args = [a for a in typing.get_args(tp) if a is not type(None)] or [tp]
+            inner = args[0]
+            path = f"{prefix}{f.name}"
+            req = f.default is dataclasses.MISSING and f.default_factory is dataclasses.MISSING
+            extra = [x for x in (meta.get("unit"), _describe(dict(meta)),
+                                 "one of " + "/".join(meta["choices"]) if meta.get("choices") else "",
+                                 "required" if req else "") if x]
+            lines.append(f"{path:38s} {meta.get('doc', '')}" + (f" [{', '.join(extra)}]" if extra else ""))
+            if dataclasses.is_dataclass(inner):
+                walk(inner, path + ".")
+            if path == "fingers":
+                walk(FingerSpec, "fingers.F1|F2.")
+    walk(Scene, "")
+    lines.append("")
+    lines.append("shape types: " + "; ".join(f"{k}({', '.join(v)})" for k, v in SHAPES.items()))
+    lines.append("effects: " + "; ".join(f"{k}: {v}" for k, v in EFFECTS.items()))
+    return "\n".join(lines)

@@ -1,0 +1,81 @@
+# Copyright 2026 squeeze_grasp_ros developers
+# SPDX-License-Identifier: Apache-2.0
+"""Session-wide test set-up: DDS isolation, the ``slow`` marker and an isolated rclpy context.
+
+Every test session claims its own ``ROS_DOMAIN_ID`` (1-101, held by a file lock so concurrent
+sessions on one machine never share one) and restricts discovery to localhost, before any test
+module is imported, so no run sees another run or the network.
+"""
+from __future__ import annotations
+
+import fcntl
+import os
+import tempfile
+from collections.abc import Iterator
+from pathlib import Path
+from typing import IO, TYPE_CHECKING
+
+import pytest
+
+if TYPE_CHECKING:
+    from rclpy.context import Context
+
+DOMAIN_IDS = range(1, 102)
+DOMAIN_LOCK = pytest.StashKey[IO[str]]()
+
+
+def claim_domain_id() -> tuple[int, IO[str]]:
+    """Lock a ROS domain id no other test session on this machine holds.
+
+    Returns
+    -------
+    tuple of (int, file)
+        The domain id and the open lock file; the id is held while the file stays open.
+    """
+    lock_dir = Path(tempfile.gettempdir()) / "squeeze_grasp_ros-domains"
+    lock_dir.mkdir(exist_ok=True)
+    start = os.getpid() % len(DOMAIN_IDS)
+    for offset in range(len(DOMAIN_IDS)):
+        domain_id = DOMAIN_IDS[(start + offset) % len(DOMAIN_IDS)]
+        handle = (lock_dir / f"{domain_id}.lock").open("w")
+        try:
+            fcntl.flock(handle, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except BlockingIOError:
+            handle.close()
+            continue
+        return domain_id, handle
+    raise RuntimeError(f"every ROS domain id in {DOMAIN_IDS} is held by another test session")
+
+
+def pytest_configure(config: pytest.Config) -> None:
+    """Isolate DDS for this session and register the ``slow`` marker."""
+    domain_id, config.stash[DOMAIN_LOCK] = claim_domain_id()
+    os.environ["ROS_DOMAIN_ID"] = str(domain_id)
+    os.environ["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "LOCALHOST"
+    config.addinivalue_line(
+        "markers", "slow: long-running test, excluded by default (select with -m slow)"
+    )
+
+
+def pytest_unconfigure(config: pytest.Config) -> None:
+    """Release this session's domain id."""
+    if DOMAIN_LOCK in config.stash:
+        config.stash[DOMAIN_LOCK].close()
+
+
+@pytest.fixture
+def ros_context() -> Iterator[Context]:
+    """Yield an initialised rclpy context of its own; shut it down after the test.
+
+    No signal handlers are installed, so Ctrl-C still stops pytest.
+    """
+    import rclpy
+    from rclpy.context import Context
+    from rclpy.signals import SignalHandlerOptions
+
+    context = Context()
+    rclpy.init(context=context, signal_handler_options=SignalHandlerOptions.NO)
+    try:
+        yield context
+    finally:
+        context.try_shutdown()

@@ -1,0 +1,284 @@
+# Copyright 2026 squeeze_grasp_ros developers
+# SPDX-License-Identifier: Apache-2.0
+"""Real ROS 2 from PyPI: rclpy and our interfaces work with nothing sourced; ros-setup is safe.
+
+These tests need the ``ros`` extra and ``python -m squeeze_grasp_ros.ros_setup`` to have run
+(CI does both); they fail rather than skip without them.
+"""
+from __future__ import annotations
+
+import os
+import shutil
+import sys
+import time
+from collections.abc import Callable
+from pathlib import Path
+
+import pytest
+
+from squeeze_grasp_ros import ros_setup
+
+WAIT_S = 10.0
+CMAKE_TEMPLATE = """\
+set_target_properties(pkg__rosidl_generator_py PROPERTIES
+  INTERFACE_INCLUDE_DIRECTORIES "{python};{numpy};${{_IMPORT_PREFIX}}/include"
+)
+"""
+WHEEL_PYTHON = "/opt/python/cp312-cp312/include/python3.12"
+WHEEL_NUMPY = "/opt/python/cp312-cp312/lib/python3.12/site-packages/numpy/_core/include"
+
+
+def spin_until(executor, condition: Callable[[], bool], timeout: float = WAIT_S) -> bool:
+    """Spin ``executor`` one callback at a time until ``condition()`` holds or time runs out."""
+    deadline = time.monotonic() + timeout
+    while not condition():
+        if time.monotonic() > deadline:
+            return False
+        executor.spin_once(timeout_sec=0.05)
+    return True
+
+
+# --------------------------------------------------------------------------- real rclpy
+
+
+def test_rclpy_and_interfaces_import_from_this_environment() -> None:
+    import rclpy
+    import squeeze_grasp_interfaces.msg
+    import squeeze_grasp_interfaces.srv
+
+    prefix = Path(sys.prefix).resolve()
+    for module in (rclpy, squeeze_grasp_interfaces.msg, squeeze_grasp_interfaces.srv):
+        assert Path(module.__file__).resolve().is_relative_to(prefix)
+
+
+def test_session_is_isolated(ros_context) -> None:
+    domain_id = int(os.environ["ROS_DOMAIN_ID"])
+    assert 1 <= domain_id <= 101
+    assert os.environ["ROS_AUTOMATIC_DISCOVERY_RANGE"] == "LOCALHOST"
+    assert ros_context.get_domain_id() == domain_id
+
+
+def test_interface_constants() -> None:
+    from squeeze_grasp_interfaces.msg import ContactEvent, ContactNode
+    from squeeze_grasp_interfaces.srv import LoadObject, PlanSqueeze
+
+    assert (ContactNode.STICK, ContactNode.SLIP) == (0, 1)
+    assert ContactEvent.NEW_CONTACT == "A" and ContactEvent.SLIP_TO_STICK == "D"
+    codes = ("OK", "INVALID_ARGUMENT", "UNKNOWN_OBJECT", "NOT_FEASIBLE", "INTERNAL_ERROR",
+             "CANCELLED")
+    for response in (LoadObject.Response, PlanSqueeze.Response):
+        assert [getattr(response, name) for name in codes] == list(range(6))
+        assert {"success", "error_code", "message"} <= set(response.get_fields_and_field_types())
+
+
+def test_nested_message_serialization_round_trip() -> None:
+    from geometry_msgs.msg import Vector3
+    from rclpy.serialization import deserialize_message, serialize_message
+    from squeeze_grasp_interfaces.msg import ContactNode, ContactState
+
+    state = ContactState(depth=2e-3, relative_depth=0.04)
+    state.header.frame_id = "object"
+    state.nodes = [
+        ContactNode(finger="F1", node=3, polar_angle=0.1, mode=ContactNode.STICK,
+                    force=Vector3(x=1.5, y=-0.25)),
+        ContactNode(finger="F2", node=17, polar_angle=-0.2, mode=ContactNode.SLIP),
+    ]
+    assert deserialize_message(serialize_message(state), ContactState) == state
+
+
+def test_contact_event_publish_subscribe(ros_context) -> None:
+    import rclpy
+    from rclpy.executors import SingleThreadedExecutor
+    from squeeze_grasp_interfaces.msg import ContactEvent
+
+    node = rclpy.create_node("test_contact_events", context=ros_context)
+    executor = SingleThreadedExecutor(context=ros_context)
+    executor.add_node(node)
+    received: list[ContactEvent] = []
+    node.create_subscription(ContactEvent, "contact_events", received.append, 10)
+    publisher = node.create_publisher(ContactEvent, "contact_events", 10)
+    assert spin_until(executor, lambda: publisher.get_subscription_count() == 1)
+
+    sent = ContactEvent(type=ContactEvent.STICK_TO_SLIP, node=7, finger="F2", depth=1.25e-3,
+                        relative_depth=0.05)
+    sent.header.frame_id = "object"
+    sent.header.stamp.sec = 3
+    publisher.publish(sent)
+    assert spin_until(executor, lambda: len(received) == 1)
+    assert received == [sent]
+    executor.shutdown()
+    node.destroy_node()
+
+
+def test_plan_squeeze_service_round_trip(ros_context) -> None:
+    import rclpy
+    from rclpy.executors import SingleThreadedExecutor
+    from squeeze_grasp_interfaces.srv import PlanSqueeze
+
+    def reject(request: PlanSqueeze.Request, response: PlanSqueeze.Response):
+        response.success = False
+        response.error_code = PlanSqueeze.Response.UNKNOWN_OBJECT
+        response.message = f"no object {request.object_id!r}"
+        return response
+
+    node = rclpy.create_node("test_plan_squeeze", context=ros_context)
+    executor = SingleThreadedExecutor(context=ros_context)
+    executor.add_node(node)
+    node.create_service(PlanSqueeze, "plan_squeeze", reject)
+    client = node.create_client(PlanSqueeze, "plan_squeeze")
+    assert spin_until(executor, client.service_is_ready)
+
+    request = PlanSqueeze.Request(object_id="disk", contacts=[0, 12],
+                                  squeeze_type=PlanSqueeze.Request.STABLE)
+    future = client.call_async(request)
+    assert spin_until(executor, future.done)
+    response = future.result()
+    assert (response.success, response.error_code) == (False, PlanSqueeze.Response.UNKNOWN_OBJECT)
+    assert response.message == "no object 'disk'"
+    executor.shutdown()
+    node.destroy_node()
+
+
+# --------------------------------------------------------------------------- CMake path repair
+
+
+def make_prefix(root: Path) -> dict[str, Path]:
+    """Create a fake environment with broken, clean, non-CMake and out-of-prefix files."""
+    broken = CMAKE_TEMPLATE.format(python=WHEEL_PYTHON, numpy=WHEEL_NUMPY)
+    cmake_dir = root / "env" / "share" / "pkg" / "cmake"
+    cmake_dir.mkdir(parents=True)
+    files = {
+        "broken": cmake_dir / "export_pkg__rosidl_generator_pyExport.cmake",
+        "clean": cmake_dir / "pkgConfig.cmake",
+        "not_cmake": cmake_dir / "notes.txt",
+        "outside": root / "elsewhere" / "foreign.cmake",
+        "link": cmake_dir / "link.cmake",
+    }
+    files["broken"].write_text(broken)
+    files["clean"].write_text("set(pkg_FOUND TRUE)\n")
+    files["not_cmake"].write_text(broken)
+    files["outside"].parent.mkdir()
+    files["outside"].write_text(broken)
+    files["link"].symlink_to(files["outside"])
+    return files
+
+
+def test_repair_rewrites_only_cmake_files_inside_the_prefix(tmp_path: Path) -> None:
+    files = make_prefix(tmp_path)
+    before = {name: path.read_text() for name, path in files.items()}
+    prefix = (tmp_path / "env").resolve()
+
+    changed = ros_setup.repair_cmake_paths(prefix, "/env/include/py", "/env/numpy/include")
+
+    assert changed == [files["broken"].resolve()]
+    assert files["broken"].read_text() == CMAKE_TEMPLATE.format(
+        python="/env/include/py", numpy="/env/numpy/include")
+    for name in ("clean", "not_cmake", "outside"):
+        assert files[name].read_text() == before[name]
+
+
+def test_repair_is_idempotent_and_dry_run_writes_nothing(tmp_path: Path) -> None:
+    files = make_prefix(tmp_path)
+    prefix = (tmp_path / "env").resolve()
+    broken = files["broken"].read_text()
+
+    assert ros_setup.repair_cmake_paths(prefix, "/a", "/b", dry_run=True) == [
+        files["broken"].resolve()]
+    assert files["broken"].read_text() == broken
+    assert len(ros_setup.repair_cmake_paths(prefix, "/a", "/b")) == 1
+    repaired = files["broken"].read_text()
+    assert ros_setup.repair_cmake_paths(prefix, "/a", "/b") == []
+    assert files["broken"].read_text() == repaired
+
+
+def test_this_environment_needs_no_repair() -> None:
+    prefix = Path(sys.prefix)
+    assert ros_setup.repair_cmake_paths(
+        prefix, ros_setup.python_include_dir(), ros_setup.numpy_include_dir(), dry_run=True
+    ) == []
+
+
+# --------------------------------------------------------------------------- prerequisites
+
+
+def test_prerequisites_of_this_environment_hold() -> None:
+    assert ros_setup.find_problems(Path(sys.prefix)) == []
+
+
+def test_missing_prerequisites_are_named(tmp_path: Path, monkeypatch) -> None:
+    monkeypatch.setattr(sys, "prefix", sys.base_prefix)
+    monkeypatch.setattr(shutil, "which", lambda name: None)
+    monkeypatch.delenv("CC", raising=False)
+    monkeypatch.delenv("CXX", raising=False)
+
+    problems = "\n".join(ros_setup.find_problems(tmp_path))
+
+    for needle in ("virtual environment", "cmake", "C compiler", "C++ compiler",
+                   "rosidl_default_generators", "pip install -e '.[ros]'"):
+        assert needle in problems
+
+
+def test_main_fails_clearly_outside_a_venv(monkeypatch, capsys) -> None:
+    monkeypatch.setattr(sys, "prefix", sys.base_prefix)
+    assert ros_setup.main(["--check"]) == 1
+    assert "not running in a virtual environment" in capsys.readouterr().err
+
+
+# --------------------------------------------------------------------------- idempotence
+
+
+def test_second_run_is_a_no_op(capsys) -> None:
+    assert ros_setup.main([]) == 0
+    layout = ros_setup.Layout.for_prefix(Path(sys.prefix))
+    import squeeze_grasp_interfaces.msg
+
+    watched = [layout.stamp_file, Path(squeeze_grasp_interfaces.msg.__file__)]
+    mtimes = [path.stat().st_mtime_ns for path in watched]
+    capsys.readouterr()
+
+    assert ros_setup.main([]) == 0
+    assert "is up to date" in capsys.readouterr().out
+    assert [path.stat().st_mtime_ns for path in watched] == mtimes
+    assert ros_setup.main(["--check"]) == 0
+
+
+def test_changed_interface_sources_are_detected(tmp_path: Path, capsys) -> None:
+    source = ros_setup.default_source()
+    copy = tmp_path / "msg_defs"
+    shutil.copytree(source, copy)
+    layout = ros_setup.Layout.for_prefix(Path(sys.prefix))
+    settings = ros_setup.build_settings(layout, source)
+    stamp = {"settings": settings, "sources": ros_setup.source_digest(source)}
+
+    assert ros_setup.source_digest(copy) == stamp["sources"]
+    assert ros_setup.rebuild_reason(stamp, settings, stamp["sources"], True) is None
+    assert "missing" in ros_setup.rebuild_reason(stamp, settings, stamp["sources"], False)
+    assert "not built" in ros_setup.rebuild_reason(None, settings, stamp["sources"], True)
+
+    with (copy / "msg" / "ContactEvent.msg").open("a") as handle:
+        handle.write("float64 extra\n")
+    changed = ros_setup.source_digest(copy)
+    assert changed != stamp["sources"]
+    assert "sources changed" in ros_setup.rebuild_reason(stamp, settings, changed, True)
+    other_folder = ros_setup.build_settings(layout, copy)
+    assert "settings changed" in ros_setup.rebuild_reason(stamp, other_folder, changed, True)
+
+    assert ros_setup.main(["--check", "--source", str(copy)]) == 1
+    assert "settings changed" in capsys.readouterr().out
+
+
+def test_hidden_files_do_not_change_the_digest(tmp_path: Path) -> None:
+    copy = tmp_path / "msg_defs"
+    shutil.copytree(ros_setup.default_source(), copy)
+    digest = ros_setup.source_digest(copy)
+    (copy / "msg" / ".ContactEvent.msg.swp").write_text("editor state")
+    assert ros_setup.source_digest(copy) == digest
+
+
+@pytest.mark.parametrize("missing", ["package.xml", "CMakeLists.txt"])
+def test_source_without_package_files_is_rejected(tmp_path: Path, missing: str) -> None:
+    for name in ("package.xml", "CMakeLists.txt"):
+        if name != missing:
+            (tmp_path / name).write_text("")
+    with pytest.raises(ros_setup.SetupError, match=missing):
+        ros_setup.resolve_source(tmp_path)

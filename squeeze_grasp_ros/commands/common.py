@@ -1,0 +1,44 @@
+# Copyright 2026 squeeze_grasp_ros developers
+# SPDX-License-Identifier: Apache-2.0
+"""Argument and loading helpers shared by the verbs."""
+from __future__ import annotations
+
+import argparse
+from dataclasses import dataclass
+
+from ..mechanics.compliance import ROUTES, ElasticObject
+from ..scene import Scene, build_mesh, finger_nodes, load_scene, scene_material
+
+
+def add_scene_argument(parser: argparse.ArgumentParser) -> None:
+    """The positional SCENE argument (a YAML file, see `squeeze-grasp scene-help`)."""
+    parser.add_argument("scene", metavar="SCENE", help="scene YAML file (e.g. config/scenes/disk.yaml)")
+
+
+def add_solver_argument(parser: argparse.ArgumentParser) -> None:
+    """``--solver``: the K+ route (factorized default, spectral = the paper's dense reference)."""
+    parser.add_argument("--solver", choices=ROUTES, default="factorized",
+                        help="contact-compliance route (default: factorized; spectral is the "
+                             "paper's O(n^3) eigendecomposition, for cross-checks)")
+
+
+def add_plot_argument(parser: argparse.ArgumentParser) -> None:
+    """``--plot FILE.png``."""
+    parser.add_argument("--plot", metavar="FILE.png", help="write a figure to this PNG file")
+
+
+@dataclass(frozen=True)
+class LoadedScene:
+    """A scene with its meshed elastic object and initial finger contact nodes."""
+
+    scene: Scene
+    obj: ElasticObject
+    contacts: tuple[int, int]
+
+
+def load_solid(path: str, solver: str = "factorized") -> LoadedScene:
+    """Load a solid-model scene, mesh it and locate the fingers' initial contact nodes."""
+    scene = load_scene(path)
+    mesh = build_mesh(scene)
+    obj = ElasticObject(mesh, scene_material(scene), solver)
+    return LoadedScene(scene, obj, finger_nodes(scene, mesh))

@@ -1,0 +1,63 @@
+# Copyright 2026 squeeze_grasp_ros developers
+# SPDX-License-Identifier: Apache-2.0
+"""``squeeze-grasp graspmap``: stable-squeeze quality of every pair of boundary placements."""
+from __future__ import annotations
+
+import argparse
+
+import numpy as np
+
+from .. import plots
+from ..mechanics.graspmap import GraspMap, grasp_map
+from .common import add_plot_argument, add_scene_argument, add_solver_argument, load_solid
+
+HELP = "all-pairs grasp map: stiffness, inwardness and force closure of every placement"
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    """SCENE, --pairs, --solver, --plot."""
+    add_scene_argument(parser)
+    parser.add_argument("--pairs", action="store_true",
+                        help="include the full b x b matrices in the JSON")
+    add_solver_argument(parser)
+    add_plot_argument(parser)
+
+
+def run(args: argparse.Namespace) -> dict:
+    """Map every placement pair of the scene's object."""
+    loaded = load_solid(args.scene, args.solver)
+    gmap = grasp_map(loaded.obj, loaded.scene.mu)
+    if args.plot:
+        plot(loaded.obj, gmap, args.plot)
+    return {**gmap.to_json(pairs=args.pairs), "model": "solid",
+            "note": "point-contact stiffness is mesh dependent: compare placements on one mesh"}
+
+
+def plot(obj, gmap: GraspMap, path: str) -> None:
+    """Stiffness over (i, j) with infeasible placements greyed, and the best placements."""
+    fig, (ax0, ax1) = plots.figure(2, size=5.0)
+    k = np.where(gmap.feasible, gmap.stiffness, np.nan)
+    im = ax0.imshow(k, origin="lower", cmap="viridis")
+    ax0.set_aspect("equal")
+    ax0.set_xlabel("boundary position j")
+    ax0.set_ylabel("boundary position i")
+    ax0.set_title(f"stable stiffness [N/m] (feasible at mu={gmap.mu})")
+    fig.colorbar(im, ax=ax0, shrink=0.8)
+    plots.draw_outline(ax1, obj.mesh)
+    for rank, (i, j, _) in enumerate(gmap.best()):
+        p = obj.mesh.nodes[[i, j]]
+        ax1.plot(p[:, 0], p[:, 1], "-o", color=f"C{rank}", ms=4, label=f"#{rank + 1}")
+    ax1.legend(fontsize=8)
+    ax1.set_title("stiffest feasible placements")
+    plots.save(fig, path)
+
+
+def summary(result: dict) -> str:
+    """Counts and the best placements."""
+    lines = [f"{result['pairs']} placements: {result['inward_pairs']} inward, "
+             f"{result['force_closure_pairs']} force closure (mu={result['mu']}), "
+             f"{result['feasible_pairs']} both",
+             "stiffest feasible placements (nodes, N/m):"]
+    lines += [f"  {b['contacts'][0]:5d} {b['contacts'][1]:5d}  {b['stiffness']:.5g}" for b in result["best"]]
+    lines.append(result["note"])
+    return "\n".join(lines)

@@ -1,0 +1,61 @@
+# Copyright 2026 squeeze_grasp_ros developers
+# SPDX-License-Identifier: Apache-2.0
+"""Matplotlib drawing primitives shared by the CLI verbs (Agg backend, PNG output)."""
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Sequence
+
+import numpy as np
+
+from .mechanics.mesh import Mesh
+
+
+def figure(ncols: int = 1, nrows: int = 1, size: float = 4.2):
+    """A new figure with ``nrows x ncols`` equal-aspect axes (Agg backend, no display)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, axes = plt.subplots(nrows, ncols, figsize=(size * ncols, size * nrows), squeeze=False)
+    return fig, axes.ravel()
+
+
+def save(fig, path: str | Path) -> str:
+    """Write ``fig`` to ``path`` (PNG, 150 dpi), close it and return the path."""
+    import matplotlib.pyplot as plt
+
+    fig.tight_layout()
+    fig.savefig(path, dpi=150)
+    plt.close(fig)
+    return str(path)
+
+
+def draw_outline(ax, mesh: Mesh, displacement: np.ndarray | None = None, **style) -> None:
+    """Draw the outer and inner boundary loops, displaced by ``displacement`` (n, 2) m if given."""
+    pts = mesh.nodes if displacement is None else mesh.nodes + displacement
+    for loop in (mesh.boundary, *mesh.inner_boundaries):
+        closed = np.append(loop, loop[0])
+        ax.plot(pts[closed, 0], pts[closed, 1], **({"color": "k", "lw": 1.2} | style))
+    ax.set_aspect("equal")
+    ax.set_xlabel("x [m]")
+    ax.set_ylabel("y [m]")
+
+
+def draw_arrows(ax, points: np.ndarray, vectors: np.ndarray, length: float, color: str,
+                label: str | None = None) -> None:
+    """Arrows from ``points`` (k, 2) along ``vectors`` (k, 2), the longest drawn ``length`` m long."""
+    vmax = max(float(np.linalg.norm(vectors, axis=1).max()), 1e-300)
+    v = vectors * (length / vmax)
+    ax.quiver(points[:, 0], points[:, 1], v[:, 0], v[:, 1], angles="xy", scale_units="xy",
+              scale=1.0, color=color, width=0.006, label=label)
+
+
+def mark_nodes(ax, points: np.ndarray, filled: Sequence[bool] | None = None, color: str = "C3",
+               size: float = 28.0, label: str | None = None) -> None:
+    """Scatter contact nodes: filled markers where ``filled`` (sticking), hollow elsewhere."""
+    filled = np.ones(len(points), bool) if filled is None else np.asarray(filled, bool)
+    ax.scatter(points[filled, 0], points[filled, 1], s=size, color=color, zorder=5, label=label)
+    ax.scatter(points[~filled, 0], points[~filled, 1], s=size, facecolors="white",
+               edgecolors=color, zorder=5)

@@ -1,0 +1,112 @@
+# Copyright 2026 squeeze_grasp_ros developers
+# SPDX-License-Identifier: Apache-2.0
+"""Scene validation (errors name the field) and the foundation CLI verbs' JSON."""
+import copy
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+import yaml
+
+from squeeze_grasp_ros import cli
+from squeeze_grasp_ros.scene import SceneError, load_scene, parse_scene
+
+SCENES = sorted((Path(__file__).parents[1] / "config" / "scenes").glob("*.yaml"))
+FOAM = Path(__file__).parents[1] / "config" / "scenes" / "foam_square.yaml"
+BASE = yaml.safe_load(FOAM.read_text())
+
+
+def test_every_shipped_scene_validates():
+    assert len(SCENES) >= 5
+    for path in SCENES:
+        scene = load_scene(path)
+        assert scene.name, path
+
+
+def mutate(path: str, value):
+    data = copy.deepcopy(BASE)
+    keys = path.split(".")
+    node = data
+    for k in keys[:-1]:
+        node = node.setdefault(k, {})
+    if value is KeyError:
+        del node[keys[-1]]
+    else:
+        node[keys[-1]] = value
+    return data
+
+
+@pytest.mark.parametrize("path,value,message", [
+    ("object.material.E", -5.0, "object.material.E must be > 0"),
+    ("object.material.nu", 0.7, "object.material.nu must be in"),
+    ("object.material.colour", "red", "unknown key object.material.colour"),
+    ("object.mesh.min_angle", 40, "object.mesh.min_angle must be in"),
+    ("object.shape.type", "hexagon", "object.shape.type must be one of"),
+    ("object.shape.radius", 0.1, "unknown key object.shape.radius"),
+    ("fingers.F1.tip_radius", -0.01, "fingers.F1.tip_radius must be >= 0"),
+    ("fingers.F1.placement", {"point": [0, 0], "node": 3}, "exactly one of"),
+    ("fingers.F3", {"placement": {"node": 1}}, "unknown finger fingers.F3"),
+    ("squeeze.depth", 0.01, "exclusive"),
+    ("squeeze.type", "gentle", "squeeze.type must be one of"),
+    ("friction", KeyError, "effect 'friction' is declared but section friction is missing"),
+    ("effects", ["friction", "levitation"], "unknown effect 'levitation'"),
+    ("strain_limit", {"epsilon": 0.1}, "section strain_limit is given but effect"),
+    ("object.material.E", "soft", "object.material.E must be a number"),
+    ("object.material", KeyError, "missing required key object.material"),
+])
+def test_scene_errors_name_the_field(path, value, message):
+    with pytest.raises(SceneError, match=message.replace("(", r"\(")):
+        parse_scene(mutate(path, value))
+
+
+def run_json(capsys, *argv):
+    assert cli.main([*argv, "--json"]) == 0
+    return json.loads(capsys.readouterr().out)
+
+
+def test_mesh_verb_json(capsys):
+    out = run_json(capsys, "mesh", str(SCENES[0]))
+    nodes, tris, boundary = np.array(out["nodes"]), np.array(out["triangles"]), out["boundary"]
+    assert nodes.shape[1] == 2 and tris.shape[1] == 3
+    assert tris.min() == 0 and tris.max() == len(nodes) - 1
+    p = nodes[boundary]
+    area = 0.5 * np.sum(p[:, 0] * np.roll(p[:, 1], -1) - np.roll(p[:, 0], -1) * p[:, 1])
+    assert area > 0  # counter-clockwise
+    assert set(out["material"]) == {"E", "nu", "thickness"}
+
+
+def test_plan_verb_json_is_consistent_with_theorem10(capsys, tmp_path):
+    png = tmp_path / "plan.png"
+    out = run_json(capsys, "plan", str(FOAM), "--plot", str(png))
+    assert png.stat().st_size > 0
+    i, j = out["contacts"]
+    s, p = out["stable"], out["pure"]
+    for block in (s, p):
+        assert len(block["displacement"]) == 4 and len(block["forces"]) == 4
+        assert np.isclose(np.linalg.norm(block["displacement"]), 1.0)
+    ratio = np.linalg.norm(p["forces"]) / np.linalg.norm(s["forces"])
+    assert np.isclose(np.dot(s["displacement"], p["displacement"]), ratio, rtol=1e-9)
+    # the requested 12 % relative squeeze of a stable squeeze: sqrt(2) rho / |p_i - p_j|
+    pts = np.array(out["contact_points"])
+    assert np.isclose(np.sqrt(2) * out["depth"] / np.linalg.norm(pts[0] - pts[1]), 0.12)
+    mesh = run_json(capsys, "mesh", str(FOAM))
+    assert len(out["boundary_displacement"]["stable"]) == len(mesh["boundary"])
+    k_i = mesh["boundary"].index(i)
+    assert np.allclose(out["boundary_displacement"]["stable"][k_i],
+                       out["depth"] * np.array(s["displacement"][:2]), atol=1e-12)
+
+
+def test_graspmap_verb_json(capsys):
+    out = run_json(capsys, "graspmap", str(FOAM))
+    b = len(out["boundary"])
+    assert out["pairs"] == b * (b - 1) // 2
+    assert 0 < out["feasible_pairs"] <= out["force_closure_pairs"]
+    assert out["best"][0]["stiffness"] >= out["best"][-1]["stiffness"]
+
+
+def test_cli_reports_bad_scene_with_exit_code_2(tmp_path, capsys):
+    bad = tmp_path / "bad.yaml"
+    bad.write_text(yaml.safe_dump(mutate("object.material.nu", 0.9)))
+    assert cli.main(["plan", str(bad)]) == 2
+    assert "object.material.nu" in capsys.readouterr().err

@@ -11,6 +11,7 @@ VERBS: tuple[str, ...] = (
     "mesh",
     "plan",
     "graspmap",
+    "bench",
     "scene_help",
 )
 """Module names of the verbs, in the order ``--help`` lists them (CLI name: '_' -> '-')."""

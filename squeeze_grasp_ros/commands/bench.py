@@ -1,0 +1,49 @@
+# Copyright 2026 squeeze_grasp_ros developers
+# SPDX-License-Identifier: Apache-2.0
+"""``squeeze-grasp bench``: what accuracy costs in time, as tables, a report and plots."""
+from __future__ import annotations
+
+import argparse
+import importlib
+import platform
+import sys
+from pathlib import Path
+
+from ..bench import SECTIONS
+
+HELP = "run the benchmarks; print tables and write a Markdown report with plots"
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    """--quick, --only, --out."""
+    parser.add_argument("--quick", action="store_true", help="smaller sizes (about 2 minutes)")
+    parser.add_argument("--only", nargs="+", choices=SECTIONS, metavar="SECTION",
+                        help=f"run only these sections ({', '.join(SECTIONS)})")
+    parser.add_argument("--out", default="bench_out", help="report directory (default: bench_out)")
+
+
+def _progress(message: str) -> None:
+    print(f"[bench] {message}", file=sys.stderr, flush=True)
+
+
+def run(args: argparse.Namespace) -> dict:
+    """Run the sections; write OUT/report.md and the plots."""
+    out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    tables = []
+    for name in args.only or SECTIONS:
+        module = importlib.import_module(f"..bench.{name}", __package__)
+        tables += module.run(args.quick, out, _progress)
+    header = (f"# squeeze_grasp_ros benchmark ({'quick' if args.quick else 'full'})\n\n"
+              f"Python {platform.python_version()}, {platform.machine()}, "
+              f"{platform.processor() or 'cpu'}; times are best-of wall times in one run.\n")
+    report = out / "report.md"
+    report.write_text(header + "\n" + "\n".join(t.markdown() for t in tables))
+    return {"report": str(report),
+            "tables": [{"title": t.title, "columns": list(t.columns), "rows": t.rows,
+                        "notes": t.notes, "plots": list(t.plots)} for t in tables]}
+
+
+def summary(result: dict) -> str:
+    """The tables as Markdown, and where the report is."""
+    return Path(result["report"]).read_text() + f"\nreport: {result['report']}"

@@ -327,6 +327,11 @@ def rebuild_reason(
         Current `source_digest` of the interface folder.
     installed : bool
         Whether the package is importable from the environment.
+
+    Returns
+    -------
+    str or None
+        The reason for a build, None when the installed interfaces are current.
     """
     if stamp is None:
         return "not built in this environment yet"
@@ -399,24 +404,15 @@ def run_command(command: Sequence[str], layout: Layout, verbose: bool) -> None:
         )
 
 
-def remove_previous_install(layout: Layout) -> int:
-    """Delete the files the previous build installed (only those inside the prefix).
-
-    Returns
-    -------
-    int
-        Number of files removed.
-    """
+def remove_previous_install(layout: Layout) -> None:
+    """Delete the files the previous build installed (only those inside the prefix)."""
     if not layout.manifest_file.is_file():
-        return 0
+        return
     root = layout.prefix.resolve()
-    removed = 0
     for line in layout.manifest_file.read_text(encoding="utf-8").splitlines():
         path = Path(line)
         if line and path.is_file() and path.resolve().is_relative_to(root):
             path.unlink()
-            removed += 1
-    return removed
 
 
 def build_and_install(layout: Layout, source: Path, verbose: bool) -> None:

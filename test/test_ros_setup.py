@@ -198,6 +198,22 @@ def test_this_environment_needs_no_repair() -> None:
     ) == []
 
 
+def test_previous_install_is_removed_only_inside_the_prefix(tmp_path: Path) -> None:
+    layout = ros_setup.Layout.for_prefix(tmp_path / "env")
+    inside = layout.prefix / "share" / "pkg" / "msg" / "Old.msg"
+    outside = tmp_path / "elsewhere" / "Old.msg"
+    for path in (inside, outside):
+        path.parent.mkdir(parents=True)
+        path.write_text("float64 old\n")
+    layout.state_dir.mkdir(parents=True)
+    layout.manifest_file.write_text(f"{inside}\n{outside}\n{layout.prefix / 'gone.txt'}\n")
+
+    ros_setup.remove_previous_install(layout)
+
+    assert not inside.exists()
+    assert outside.exists()
+
+
 # --------------------------------------------------------------------------- prerequisites
 
 

@@ -288,11 +288,18 @@ def source_digest(source: Path) -> str:
     return digest.hexdigest()
 
 
+def venv_python() -> str:
+    """The environment's ``bin/python``: the same whether we run as ``python -m`` or as a
+    console script (whose ``sys.executable`` is ``bin/python3``)."""
+    candidate = Path(sys.prefix) / "bin" / "python"
+    return str(candidate) if candidate.exists() else sys.executable
+
+
 def build_settings(layout: Layout, source: Path) -> dict[str, object]:
     """Return everything besides the sources that determines the build's result."""
     return {
         "python": sys.version,
-        "executable": sys.executable,
+        "executable": venv_python(),
         "source": str(source),
         "cmake_args": cmake_configure_args(layout, source),
     }
@@ -363,7 +370,7 @@ def cmake_configure_args(layout: Layout, source: Path) -> list[str]:
         "-B", str(layout.build_dir),
         f"-DCMAKE_INSTALL_PREFIX={layout.prefix}",
         f"-DCMAKE_PREFIX_PATH={layout.prefix}",
-        f"-DPython3_EXECUTABLE={sys.executable}",
+        f"-DPython3_EXECUTABLE={venv_python()}",
         f"-DPYTHON_INSTALL_DIR={purelib.relative_to(layout.prefix).as_posix()}",
         "-DBUILD_TESTING=OFF",
     ]
@@ -468,15 +475,14 @@ def default_source() -> Path:
     return candidates[-1]
 
 
-def parse_args(argv: Sequence[str] | None) -> argparse.Namespace:
-    """Parse the command line."""
-    parser = argparse.ArgumentParser(
-        prog="squeeze-grasp ros-setup",
-        description=(
-            "Repair the ROS 2 wheels' CMake files and build the interface package "
-            f"{INTERFACE_PACKAGE} (msg_defs/) into the active virtual environment."
-        ),
-    )
+DESCRIPTION = (
+    "Repair the ROS 2 wheels' CMake files and build the interface package "
+    f"{INTERFACE_PACKAGE} (msg_defs/) into the active virtual environment."
+)
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    """Options of ``ros-setup`` (shared by this module's CLI and the ``squeeze-grasp`` verb)."""
     parser.add_argument(
         "--source",
         type=Path,
@@ -489,6 +495,12 @@ def parse_args(argv: Sequence[str] | None) -> argparse.Namespace:
     parser.add_argument(
         "--check", action="store_true", help="only report the state; exit 1 if work is due"
     )
+
+
+def parse_args(argv: Sequence[str] | None) -> argparse.Namespace:
+    """Parse the command line."""
+    parser = argparse.ArgumentParser(prog="squeeze-grasp ros-setup", description=DESCRIPTION)
+    add_arguments(parser)
     return parser.parse_args(argv)
 
 
@@ -552,7 +564,11 @@ def setup(layout: Layout, source: Path, force: bool, verbose: bool) -> None:
 
 def main(argv: list[str] | None = None) -> int:
     """Run ``ros-setup``; return the process exit code."""
-    args = parse_args(argv)
+    return run(parse_args(argv))
+
+
+def run(args: argparse.Namespace) -> int:
+    """Run ``ros-setup`` with parsed options; return the process exit code."""
     layout = Layout.for_prefix(Path(sys.prefix))
     problems = find_problems(layout.prefix)
     say(f"environment {layout.prefix} (Python {sys.version.split()[0]})")

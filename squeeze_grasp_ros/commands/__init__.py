@@ -11,7 +11,9 @@ VERBS: tuple[str, ...] = (
     "mesh",
     "plan",
     "graspmap",
+    "resist",
     "bench",
     "scene_help",
+    "ros_setup",
 )
 """Module names of the verbs, in the order ``--help`` lists them (CLI name: '_' -> '-')."""

@@ -171,6 +171,14 @@ class AdversarySpec:
     mode: str = spec("resistance type", choices=("stable", "pure"), default="stable")
     contacts: str = spec("contact model", choices=("point", "segment", "friction"), default="point")
     device: str = spec("device driving A", default="")
+    segment_half_width: Optional[float] = spec(
+        "contacts: segment: each finger's fixed segment is the boundary nodes within this arc "
+        "length of its contact node (default: the node and its two neighbours)", "m", lo=0.0,
+        default=None)
+    compare_direction: Optional[tuple[float, float]] = spec(
+        "line of F1's translation d1 of a user-given resistance to compare with the optimum "
+        "(Table 4); d2 and the length of d1 follow from the resistance constraints", "",
+        default=None)
 
 
 @dataclass(frozen=True)
@@ -324,6 +332,12 @@ def _validate(scene: Scene) -> Scene:
         if len(given) != 1:
             raise SceneError(f"{where}.placement needs exactly one of point, angle_deg, node; "
                              f"got {given or 'none'}")
+    adv = scene.adversary
+    if adv is not None:
+        for name in ("a", "compare_direction"):
+            value = getattr(adv, name)
+            if value is not None and not np.hypot(*value) > 0:
+                raise SceneError(f"adversary.{name} must be a nonzero vector, got {list(value)}")
     sq = scene.squeeze
     if sq.depth is not None and sq.relative_depth is not None:
         raise SceneError("squeeze.depth and squeeze.relative_depth are exclusive; give one")

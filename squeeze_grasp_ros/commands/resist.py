@@ -1,0 +1,158 @@
+# Copyright 2026 squeeze_grasp_ros developers
+# SPDX-License-Identifier: Apache-2.0
+"""``squeeze-grasp resist``: optimal resistance to the scene's adversary finger (Sec. 6)."""
+from __future__ import annotations
+
+import argparse
+import time
+
+import numpy as np
+
+from .. import plots
+from ..mechanics.errors import MechanicsError
+from ..mechanics.reduced import displacement_field
+from ..mechanics.resistance import (FINGERS, MODES, Resistance, ResistanceGrasp,
+                                    ResistanceSweep, compare_resistances, contact_segments,
+                                    expansion_matrix, optimal_resistance, resistance_along,
+                                    resistance_grasp, sweep_directions)
+from ..scene import SceneError, placement_node
+from .common import add_plot_argument, add_scene_argument, add_solver_argument, load_solid
+
+HELP = "optimal stable/pure resistance of F1, F2 to the scene's adversary finger A (Sec. 6)"
+CONTACT_MODELS = ("point", "segment", "friction")
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    """SCENE, --mode, --contacts, --directions, --segment-half-width, --compare-direction."""
+    add_scene_argument(parser)
+    parser.add_argument("--mode", choices=MODES, help="resistance type (default: the scene's)")
+    parser.add_argument("--contacts", choices=CONTACT_MODELS,
+                        help="contact model (default: the scene's adversary.contacts)")
+    parser.add_argument("--directions", type=int, metavar="N",
+                        help="also sweep N adversary push directions (grasp quality, polar plot)")
+    parser.add_argument("--segment-half-width", type=float, metavar="M",
+                        help="segment contacts: arc length, m, on each side of a contact node")
+    parser.add_argument("--compare-direction", type=float, nargs=2, metavar=("X", "Y"),
+                        help="compare with the resistance whose d1 lies along (X, Y) (Table 4)")
+    add_solver_argument(parser)
+    add_plot_argument(parser)
+
+
+def build_grasp(loaded, contact_model: str, half_width: float | None) -> ResistanceGrasp:
+    """The fixed-contact problem of the scene's F1, F2 and adversary placements."""
+    scene, obj = loaded.scene, loaded.obj
+    k = placement_node(obj.mesh, scene.adversary.placement, "adversary")
+    if k in loaded.contacts:
+        raise SceneError("adversary.placement is on the same boundary node as F1 or F2")
+    nodes = [*loaded.contacts, k]
+    if contact_model == "point":
+        sets = [[n] for n in nodes]
+    else:
+        sets = contact_segments(obj.mesh, nodes, half_width)
+    return resistance_grasp(obj, dict(zip(FINGERS, sets)))
+
+
+def run(args: argparse.Namespace) -> dict:
+    """Optimal resistance (and sweep / comparison when asked); see docs/resistance.md."""
+    loaded = load_solid(args.scene, args.solver)
+    adv = loaded.scene.adversary
+    if adv is None:
+        raise SceneError("the scene has no adversary section (declare effect 'adversary'); "
+                         "see config/scenes/resist_fig9.yaml")
+    mode = args.mode or adv.mode
+    contact_model = args.contacts or adv.contacts
+    if contact_model == "friction":
+        raise MechanicsError("--contacts friction (Algorithm 2) needs the event-driven stepper, "
+                             "which is not available yet; use --contacts point or segment")
+    if args.directions is not None and args.directions < 1:
+        raise MechanicsError(f"--directions must be >= 1, got {args.directions}")
+    half_width = args.segment_half_width
+    half_width = adv.segment_half_width if half_width is None else half_width
+    start = time.perf_counter()
+    loaded.obj.precompute()
+    t_pre = time.perf_counter() - start
+    start = time.perf_counter()
+    grasp = build_grasp(loaded, contact_model, half_width)
+    res = optimal_resistance(grasp, adv.a, mode)
+    timing = {"precompute_s": t_pre, "resistance_s": time.perf_counter() - start}
+    out = {"scene": loaded.scene.name, **res.to_json(),
+           "contact_points": loaded.obj.mesh.nodes[res.contacts].tolist()}
+    direction = args.compare_direction or adv.compare_direction
+    if direction is not None and res.success:
+        out["comparison"] = compare_resistances(res, resistance_along(grasp, adv.a, direction, mode))
+    sweep = None
+    if args.directions:
+        start = time.perf_counter()
+        sweep = sweep_directions(grasp, mode, args.directions)
+        timing["sweep_s"] = time.perf_counter() - start
+        out["sweep"] = sweep.to_json()
+    out["timing"] = timing
+    out["diagnostics"] = {**out["diagnostics"], **loaded.obj.diagnostics()}
+    if args.plot:
+        plot(grasp, res, sweep, args.plot)
+    return out
+
+
+def plot(grasp: ResistanceGrasp, res: Resistance, sweep: ResistanceSweep | None, path: str) -> None:
+    """Fig. 9: undeformed shape with the translations; deformed shape with the contact forces;
+    with a sweep, the polar plot of W*_F per unit push over the push directions."""
+    obj = grasp.obj
+    mesh, L = obj.mesh, obj.scale
+    fig, axes = plots.figure(3 if sweep is not None else 2)
+    pts = mesh.nodes[grasp.red.contacts]
+    heads = mesh.nodes[res.contacts]
+    plots.draw_outline(axes[0], mesh)
+    plots.mark_nodes(axes[0], pts)
+    axes[0].set_title(f"{res.mode} resistance ({res.contact_model} contacts)")
+    if res.success:
+        moves = np.array([res.d1, res.d2, res.a])
+        for p, v, color, name in zip(heads, moves, ("C0", "C1", "C3"), ("d1 (F1)", "d2 (F2)", "a (A)")):
+            plots.draw_arrows(axes[0], p[None], v[None], 0.25 * L * np.linalg.norm(v)
+                              / np.abs(moves).max(), color, name)
+        axes[0].legend(loc="lower right", fontsize=8)
+        delta = expansion_matrix(grasp.counts) @ np.concatenate([res.d1, res.d2, res.a])
+        field = displacement_field(obj, grasp.red, delta)
+        plots.draw_outline(axes[1], mesh, color="0.75", lw=0.8)
+        plots.draw_outline(axes[1], mesh, field)
+        moved = pts + field[grasp.red.contacts]
+        plots.draw_arrows(axes[1], moved, res.node_forces, 0.25 * L, "C3", "force")
+        axes[1].set_title(f"deformed, W*_F = {res.work['total']:.4g} J")
+    else:
+        axes[1].set_title(res.reason, fontsize=7)
+    for ax in axes[:2]:
+        ax.margins(0.3)
+    if sweep is not None:
+        axes[2].remove()
+        ax = fig.add_subplot(1, 3, 3, projection="polar")
+        ok = sweep.feasible
+        ax.plot(np.append(sweep.angles[ok], sweep.angles[ok][:1]),
+                np.append(sweep.unit_work[ok], sweep.unit_work[ok][:1]), "C0.-", ms=2)
+        ax.set_title("W*_F per unit push [J/m^2] vs push direction", fontsize=9)
+    plots.save(fig, path)
+
+
+def summary(result: dict) -> str:
+    """Human-readable resistance report."""
+    i, j, k = result["contacts"]
+    head = (f"{result['mode']} resistance, {result['contact_model']} contacts at nodes "
+            f"F1 {i}, F2 {j}, A {k}; a = {np.round(result['a'], 6).tolist()} m")
+    if not result["success"]:
+        return f"{head}\n{result['reason']}"
+    w = result["work"]
+    lines = [head,
+             f"d1 = {np.round(result['d1'], 6).tolist()} m, d2 = {np.round(result['d2'], 6).tolist()} m",
+             f"work [J]: F1 {w['F1']:.5g}, F2 {w['F2']:.5g}, total W*_F {w['total']:.5g} "
+             f"(A {w['A']:.5g}); per unit push {result['unit_work']:.5g} J/m^2"]
+    lines += [f"force {f} [N]: {np.round(result['forces'][f], 4).tolist()}" for f in FINGERS]
+    cmp = result.get("comparison")
+    if cmp is not None:
+        other = cmp["resistance"]
+        ratio = f", {cmp['ratio']:.3g} x the optimum" if cmp["ratio"] is not None else ""
+        lines.append(f"compared: {other['reason']}: W_F {other['work']['total']:.5g} J{ratio}"
+                     if other["success"] else f"compared: {other['reason']}")
+    sweep = result.get("sweep")
+    if sweep is not None and sweep["min"] is not None:
+        lines.append(f"sweep of {len(sweep['angles_deg'])} directions: W*_F per unit push "
+                     f"{sweep['min']['unit_work']:.4g} J/m^2 at {sweep['min']['angle_deg']:.1f} deg "
+                     f"to {sweep['max']['unit_work']:.4g} J/m^2 at {sweep['max']['angle_deg']:.1f} deg")
+    return "\n".join(lines)

@@ -263,6 +263,8 @@ class ResistanceGrasp:
         Dimensionless P^T C_hat P: the fingers' resultant forces for x = (d1, d2, a).
     points : (m, 2) ndarray
         Dimensionless contact node positions (object frame / L), in the order of ``red.contacts``.
+    scale : float
+        The object size L, m.
     """
 
     obj: ElasticObject
@@ -270,6 +272,7 @@ class ResistanceGrasp:
     red: ReducedStiffness
     G: np.ndarray
     points: np.ndarray
+    scale: float
 
     @property
     def counts(self) -> np.ndarray:
@@ -337,13 +340,14 @@ def resistance_grasp(obj: ElasticObject, segments: Mapping[str, Sequence[int]]) 
     if len(np.unique(nodes)) != len(nodes):
         listed = {f: sets[f].tolist() for f in FINGERS}
         raise MechanicsError(f"contact sets of F1, F2 and A must be disjoint, got {listed}")
-    if np.any(obj.boundary_positions(nodes) < 0):
-        raise MechanicsError("contact nodes must lie on the outer boundary, got "
-                             f"{nodes[obj.boundary_positions(nodes) < 0].tolist()}")
+    off = nodes[obj.boundary_positions(nodes) < 0]
+    if len(off):
+        raise MechanicsError(f"contact nodes must lie on the outer boundary, got {off.tolist()}")
     red = reduced_stiffness(obj, nodes)
     P = expansion_matrix([len(sets[f]) for f in FINGERS])
     G = P.T @ (red.C / obj.material.force_scale) @ P
-    return ResistanceGrasp(obj, sets, red, 0.5 * (G + G.T), obj.mesh.nodes[nodes] / obj.scale)
+    L = obj.scale
+    return ResistanceGrasp(obj, sets, red, 0.5 * (G + G.T), obj.mesh.nodes[nodes] / L, L)
 
 
 def contact_segments(mesh: Mesh, contacts: Sequence[int],
@@ -507,7 +511,7 @@ def _pure_diagnostics(form: PureForm, a_hat: np.ndarray) -> dict:
 
 def _cannot_resist(grasp: ResistanceGrasp, a: np.ndarray) -> Resistance:
     form = grasp.pure
-    a_hat = a / grasp.obj.scale
+    a_hat = a / grasp.scale
     reason = (f"cannot be resisted: rank Q = {form.rank} and a is not in col(Q), so no pure "
               "contact displacement moves A by a (Sec. 6.1.2)")
     return _unresisted(grasp, "pure", a, reason, _pure_diagnostics(form, a_hat))
@@ -596,7 +600,7 @@ def evaluate_resistance(grasp: ResistanceGrasp, d1, d2, a, mode: ResistanceMode 
         diagnostics["b2"] = form.b2 * obj.material.force_scale
     else:
         violation = form.violation(x)
-        diagnostics.update(_pure_diagnostics(form, a / obj.scale))
+        diagnostics.update(_pure_diagnostics(form, a / grasp.scale))
     success = violation <= FEASIBILITY_TOL
     if not success:
         reason = (f"{reason} is not a {mode} resistance: constraint residual {violation:.3g} > "
@@ -631,7 +635,7 @@ def optimal_resistance(grasp: ResistanceGrasp, a, mode: ResistanceMode = "stable
     """
     a = _translation(a)
     form = grasp.form(mode)
-    L = grasp.obj.scale
+    L = grasp.scale
     a_hat = a[None] / L
     if isinstance(form, PureForm) and form.outside(a_hat)[0] > FEASIBILITY_TOL:
         return _cannot_resist(grasp, a)
@@ -667,7 +671,7 @@ def resistance_along(grasp: ResistanceGrasp, a, direction, mode: ResistanceMode 
     a = _translation(a)
     e = _translation(direction, "d1 direction")
     form = grasp.form(mode)
-    L = grasp.obj.scale
+    L = grasp.scale
     a_hat = a[None] / L
     if isinstance(form, PureForm) and form.outside(a_hat)[0] > FEASIBILITY_TOL:
         return _cannot_resist(grasp, a)

@@ -122,6 +122,9 @@ class FingerSpec:
     placement: PlacementSpec = spec("initial contact")
     tip_radius: float = spec("fingertip radius (0 = point finger)", "m", lo=0.0, default=0.0)
     device: str = spec("device driving this finger", default="")
+    direction: Optional[tuple[float, float]] = spec(
+        "translation direction for the event-driven squeeze (both F1 and F2 or neither; "
+        "overrides squeeze.type; normalised)", "", default=None)
 
 
 @dataclass(frozen=True)
@@ -136,6 +139,9 @@ class SqueezeSpec:
                        lo=0.0, lo_open=True, default=1e-3)
     event_tol: float = spec("event location tolerance, relative to the object size", "",
                             lo=0.0, lo_open=True, default=1e-9)
+    max_events_per_depth: int = spec("chattering bound: most events of one contact node within "
+                                     "one depth step; more freeze its mode for a step (reported)",
+                                     lo=1, default=4)
 
 
 @dataclass(frozen=True)
@@ -338,6 +344,10 @@ def _validate(scene: Scene) -> Scene:
             value = getattr(adv, name)
             if value is not None and not np.hypot(*value) > 0:
                 raise SceneError(f"adversary.{name} must be a nonzero vector, got {list(value)}")
+    given = [k for k, v in scene.fingers.items() if v.direction is not None]
+    if given and len(given) != len(scene.fingers):
+        raise SceneError(f"fingers.{given[0]}.direction is given: give direction for every finger "
+                         "or for none")
     sq = scene.squeeze
     if sq.depth is not None and sq.relative_depth is not None:
         raise SceneError("squeeze.depth and squeeze.relative_depth are exclusive; give one")

@@ -1,0 +1,181 @@
+# Copyright 2026 squeeze_grasp_ros developers
+# SPDX-License-Identifier: Apache-2.0
+"""Hard cases that must stay finite and accurate (or fail with a clear message).
+
+Each case asserts finite results, equilibrium residuals below a stated tolerance, and
+agreement with a reference or an exact scaling law.
+"""
+import warnings
+
+import numpy as np
+import pytest
+
+from squeeze_grasp_ros.mechanics import shapes
+from squeeze_grasp_ros.mechanics.compliance import ElasticObject
+from squeeze_grasp_ros.mechanics.errors import ConditioningWarning, MechanicsError
+from squeeze_grasp_ros.mechanics.graspmap import grasp_map
+from squeeze_grasp_ros.mechanics.material import Material
+from squeeze_grasp_ros.mechanics.mesh import Mesh, generate_mesh, mesh_from_triangles, target_max_area
+from squeeze_grasp_ros.mechanics.reduced import displacement_field, reduced_stiffness
+from squeeze_grasp_ros.mechanics.squeeze import plan_squeeze
+
+EQUILIBRIUM_TOL = 1e-9
+"""Force/torque residual relative to the largest contact force (and object size for torque)."""
+
+
+def blob(nodes: int = 400, size: float = 0.05) -> Mesh:
+    outline = shapes.fourier_blob(size, cos=[0.0, 0.12, 0.04], sin=[0.05, 0.0, 0.02])
+    return generate_mesh(outline, outline.area / nodes * 0.8)
+
+
+def check_squeeze(obj: ElasticObject, contacts) -> None:
+    """Finite outputs, equilibrium, and agreement with the spectral-free identities."""
+    red = reduced_stiffness(obj, contacts)
+    sq = plan_squeeze(obj, contacts, "stable", red)
+    pure = plan_squeeze(obj, contacts, "pure", red)
+    for s in (sq, pure):
+        assert np.all(np.isfinite(s.forces)) and np.isfinite(s.energy_per_unit_depth2)
+        F = s.forces.reshape(-1, 2)
+        p = obj.mesh.nodes[list(contacts)]
+        fmax = np.abs(F).max()
+        assert np.abs(F.sum(axis=0)).max() <= EQUILIBRIUM_TOL * fmax
+        torque = np.sum(p[:, 0] * F[:, 1] - p[:, 1] * F[:, 0])
+        assert abs(torque) <= EQUILIBRIUM_TOL * fmax * obj.scale
+    assert np.isclose(sq.displacement @ pure.displacement, pure.stiffness / sq.stiffness, rtol=1e-8)
+    assert obj.diagnostics()["rigid_mode_residual"] < 1e-12
+
+
+@pytest.mark.parametrize("nu", [0.499, 0.5, -0.9, -0.99])
+def test_extreme_poisson_ratios(nu):
+    mesh = blob()
+    obj = ElasticObject(mesh, Material(1e5, nu, 0.01))
+    c = [mesh.boundary[2], mesh.boundary[len(mesh.boundary) // 2]]
+    check_squeeze(obj, c)
+    ref = ElasticObject(mesh, Material(1e5, nu, 0.01), "spectral")
+    a, b = obj.compliance_block(c), ref.compliance_block(c)
+    assert np.abs(a - b).max() <= 1e-9 * np.abs(b).max()
+
+
+def test_poisson_ratio_outside_range_is_a_clear_error():
+    with pytest.raises(MechanicsError, match=r"nu must be in \(-1, 0.5\]"):
+        Material(1e5, 0.5000001, 0.01)
+
+
+def test_E_from_foam_to_steel_scales_exactly():
+    mesh = blob()
+    c = [mesh.boundary[5], mesh.boundary[30]]
+    base = plan_squeeze(ElasticObject(mesh, Material(1e3, 0.3, 0.01)), c)
+    for E in np.logspace(3, np.log10(2e11), 6):
+        obj = ElasticObject(mesh, Material(E, 0.3, 0.01))
+        check_squeeze(obj, c)
+        sq = plan_squeeze(obj, c)
+        assert np.allclose(sq.displacement, base.displacement, atol=1e-13)
+        assert np.allclose(sq.forces, base.forces * E / 1e3, rtol=1e-9)
+        # the internal (dimensionless) stiffness, hence its conditioning, does not depend on E
+        assert (obj.stiffness != ElasticObject(mesh, Material(1e3, 0.3, 0.01)).stiffness).nnz == 0
+
+
+@pytest.mark.parametrize("size", [1e-3, 10.0])
+def test_object_size_from_a_millimetre_to_ten_metres(size):
+    ref = blob(size=0.05)
+    scaled = Mesh(ref.nodes * (size / 0.05), ref.triangles, ref.boundary, ref.inner_boundaries,
+                  ref.normals)
+    c = [ref.boundary[4], ref.boundary[27]]
+    mat = Material(2e9, 0.3, 0.003)
+    o_ref, o = ElasticObject(ref, mat), ElasticObject(scaled, mat)
+    check_squeeze(o, c)
+    s_ref, s = plan_squeeze(o_ref, c), plan_squeeze(o, c)
+    # 2-D CST stiffness is scale-free: forces per unit depth do not change with size, so at a
+    # fixed relative depth (depth ~ size) forces scale with size and energies with size^2
+    k = size / 0.05
+    assert np.allclose(s.forces, s_ref.forces, rtol=1e-9)
+    rel = 0.1
+    assert np.isclose(s.depth_for_relative(rel) ** 2 * s.energy_per_unit_depth2,
+                      k**2 * s_ref.depth_for_relative(rel) ** 2 * s_ref.energy_per_unit_depth2, rtol=1e-9)
+    assert np.isclose(s.rigid_rotation, s_ref.rigid_rotation / k, rtol=1e-9)
+    field = displacement_field(o, reduced_stiffness(o, c), 1e-3 * size * s.displacement)
+    assert np.all(np.isfinite(field))
+    # a freshly meshed object of that size (not a scaled copy) is fine too
+    outline = shapes.disk(size)
+    mesh = generate_mesh(outline, outline.area / 300)
+    check_squeeze(ElasticObject(mesh, mat), [mesh.boundary[0], mesh.boundary[len(mesh.boundary) // 2]])
+
+
+def test_very_small_element_angles_warn_or_stay_accurate():
+    """A sliver mesh (angles ~0.5 degrees) still gives equilibrium and matches the spectral route."""
+    x = np.linspace(0, 1, 41)
+    y = np.array([0.0, 0.0002, 0.0004])
+    X, Y = np.meshgrid(x, y)
+    nodes = np.column_stack([X.ravel(), Y.ravel()])
+    tris = []
+    nx = len(x)
+    for j in range(len(y) - 1):
+        for i in range(nx - 1):
+            a, b, c, d = j * nx + i, j * nx + i + 1, (j + 1) * nx + i, (j + 1) * nx + i + 1
+            tris += [[a, b, d], [a, d, c]]
+    mesh = mesh_from_triangles(nodes, np.array(tris))
+    assert mesh.min_angle_deg() < 1.0
+    mat = Material(1e6, 0.3, 0.01)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", ConditioningWarning)
+        obj = ElasticObject(mesh, mat)
+        left, right = np.argmin(nodes[:, 0] + nodes[:, 1]), np.argmax(nodes[:, 0] - nodes[:, 1])
+        check_squeeze(obj, [left, right])
+        ref = ElasticObject(mesh, mat, "spectral")
+        a, b = obj.compliance_block([left, right]), ref.compliance_block([left, right])
+    cond = obj.diagnostics()["condition_estimate"]
+    print(f"sliver mesh: condition estimate {cond:.3g}, route difference "
+          f"{np.abs(a - b).max() / np.abs(b).max():.3g}")
+    # both routes lose digits in proportion to the conditioning, no more
+    assert np.abs(a - b).max() <= 10 * cond * np.finfo(float).eps * np.abs(b).max()
+
+
+def test_two_adjacent_contact_nodes():
+    mesh = blob()
+    c = [mesh.boundary[10], mesh.boundary[11]]
+    obj = ElasticObject(mesh, Material(5e4, 0.3, 0.0254))
+    check_squeeze(obj, c)
+    assert reduced_stiffness(obj, c).condition < 1e6
+
+
+@pytest.mark.parametrize("mu", [0.0, 1e-9, 50.0, 1e9])
+def test_friction_extremes_in_the_grasp_map(mu):
+    mesh = blob(300)
+    gm = grasp_map(ElasticObject(mesh, Material(5e4, 0.3, 0.0254)), mu)
+    iu = np.triu_indices(len(mesh.boundary), 1)
+    assert np.all(np.isfinite(gm.stiffness[iu])) and np.all(gm.stiffness[iu] > 0)
+    if mu >= 50:
+        # wide cones: every inward placement with no sharp corner between is force closure
+        assert gm.force_closure[iu].mean() > 0.9
+    if mu == 0.0:
+        # only exactly antipodal normals could close; a smooth blob has (almost) none
+        assert gm.force_closure[iu].mean() < 0.01
+
+
+def test_nonconvex_object_and_inward_check():
+    pts = [[0.06, 0.0], [0.045, 0.04], [0.0, 0.05], [-0.045, 0.04], [-0.06, 0.0],
+           [-0.04, -0.035], [0.0, -0.012], [0.04, -0.035]]
+    outline = shapes.spline(pts)
+    mesh = generate_mesh(outline, outline.area / 600)
+    obj = ElasticObject(mesh, Material(5e4, 0.3, 0.0254))
+    b = mesh.boundary
+    top = b[np.argmax(mesh.nodes[b, 1])]
+    dent = b[np.argmin(np.abs(mesh.nodes[b, 0]) + 10 * (mesh.nodes[b, 1] > 0))]
+    check_squeeze(obj, [top, dent])
+    gm = grasp_map(obj, 0.5)
+    assert 0 < gm.feasible.sum() < gm.feasible.size
+
+
+@pytest.mark.slow
+def test_mesh_with_fifty_thousand_nodes():
+    outline = shapes.ellipse(0.1, 0.06)
+    mesh = generate_mesh(outline, target_max_area(outline, 52000))
+    assert mesh.n >= 50000
+    obj = ElasticObject(mesh, Material(5e4, 0.3, 0.0254)).precompute()
+    c = [mesh.boundary[0], mesh.boundary[len(mesh.boundary) // 2]]
+    check_squeeze(obj, c)
+    red = reduced_stiffness(obj, c)
+    sq = plan_squeeze(obj, c, red=red)
+    field = displacement_field(obj, red, 1e-3 * sq.displacement)
+    assert np.all(np.isfinite(field))
+    assert obj.diagnostics()["last_solve_relative_residual"] < 1e-10

@@ -4,9 +4,9 @@
 exact scaling laws, solver routes and the vectorised grasp map."""
 import numpy as np
 import pytest
-from scipy.integrate import quad
 
 from squeeze_grasp_ros.mechanics import shapes
+from squeeze_grasp_ros.mechanics.analytic import disk_diameter_change_across
 from squeeze_grasp_ros.mechanics.compliance import ElasticObject, node_dofs
 from squeeze_grasp_ros.mechanics.errors import MechanicsError
 from squeeze_grasp_ros.mechanics.fem import element_strains, stiffness_matrix
@@ -74,27 +74,9 @@ def test_stiffness_matches_scikit_fem_plane_stress():
     assert np.abs(K - K_ref).max() <= 1e-12 * np.abs(K_ref).max()
 
 
-def disk_perpendicular_diameter_change(E: float, nu: float, h: float, R: float, P: float) -> float:
-    """Increase of the horizontal diameter of a disk under vertical diametral loads P (N).
-
-    Integrates eps_x = (sigma_x - nu sigma_y) / E along y = 0 of the classical plane-stress
-    disk solution (Timoshenko & Goodier, Sec. 41).
-    """
-    D = 2 * R
-    c = 2 * P / (np.pi * h * D)
-
-    def eps_x(x):
-        q = D * D + 4 * x * x
-        sx = c * ((D * D - 4 * x * x) / q) ** 2
-        sy = -c * (4 * D**4 / q**2 - 1)
-        return (sx - nu * sy) / E
-
-    return quad(eps_x, -R, R, epsabs=1e-16, epsrel=1e-12)[0]
-
-
 def test_disk_far_field_converges_to_the_analytic_solution():
     R, P = 0.05, 1.0
-    exact = disk_perpendicular_diameter_change(MAT.E, MAT.nu, MAT.thickness, R, P)
+    exact = disk_diameter_change_across(MAT.E, MAT.nu, MAT.thickness, R, P)
     errors = []
     for nodes in (300, 1200, 4800):
         outline = shapes.disk(R)

@@ -7,6 +7,7 @@ A section module defines ``TITLE`` and ``run(quick: bool, out_dir: Path, progres
 """
 
 SECTIONS: tuple[str, ...] = (
+    "convergence",
     "solvers",
 )
 """Module names of the benchmark sections, in report order."""

@@ -10,8 +10,10 @@ A verb module defines ``HELP`` (one line), ``add_arguments(parser)``, ``run(args
 VERBS: tuple[str, ...] = (
     "mesh",
     "plan",
+    "squeeze",
     "graspmap",
     "resist",
+    "ring",
     "bench",
     "scene_help",
     "ros_setup",

@@ -358,7 +358,10 @@ class _Run:
                 stick[k], slip[k] = st, sl
             if len(idx) > 3:
                 stick, slip = self._greedy(idx, options, stick, slip)
-            sol = self.solve(self.s, stick=stick, slip=slip)
+            try:
+                sol = self.solve(self.s, stick=stick, slip=slip)
+            except MechanicsError:
+                continue
             bad = sum(self.consistent(sol, k, stick[k], slip[k]) for k in idx)
             if best is None or bad < best[0]:
                 best = (bad, stick, slip, sol.theta)
@@ -380,7 +383,11 @@ class _Run:
             for k in idx:
                 for st, sl in options:
                     stick[k], slip[k] = st, sl
-                    if self.consistent(self.solve(self.s, stick=stick, slip=slip), k, st, sl) == 0:
+                    try:
+                        sol = self.solve(self.s, stick=stick, slip=slip)
+                    except MechanicsError:
+                        continue
+                    if self.consistent(sol, k, st, sl) == 0:
                         break
         return stick, slip
 

@@ -1,0 +1,51 @@
+# Copyright 2026 squeeze_grasp_ros developers
+# SPDX-License-Identifier: Apache-2.0
+"""Scene -> event-driven squeeze: friction, fingertips, limits and depth from a validated scene."""
+from __future__ import annotations
+
+from collections.abc import Callable
+
+from .mechanics.compliance import ElasticObject
+from .mechanics.contact_model import Limits
+from .mechanics.squeeze_events import EventSqueeze, event_squeeze
+from .scene import Scene, SceneError
+
+
+def scene_limits(scene: Scene) -> Limits:
+    """Strain limit (effect ``strain_limit``) and pickup weight (effect ``pickup``) of a scene."""
+    strain = scene.strain_limit if scene.has("strain_limit") else None
+    return Limits(strain.epsilon if strain else None,
+                  strain.criterion if strain else "principal",
+                  scene.pickup.weight if scene.has("pickup") else None)
+
+
+def event_squeeze_scene(scene: Scene, obj: ElasticObject, contacts: tuple[int, int],
+                        depth: float | None = None, relative_depth: float | None = None,
+                        step: float | None = None, event_tol: float | None = None,
+                        reference: bool = False,
+                        progress: Callable[[float], None] | None = None) -> EventSqueeze:
+    """Run the scene's squeeze with rounded fingertips; arguments override the scene's values.
+
+    Raises
+    ------
+    SceneError
+        If a fingertip radius is 0 (point fingers have no polar angle) or no depth is given.
+    """
+    for name, finger in scene.fingers.items():
+        if not finger.tip_radius > 0:
+            raise SceneError(f"fingers.{name}.tip_radius must be > 0 m for the event-driven "
+                             "squeeze (rounded fingertips)")
+    sq = scene.squeeze
+    if depth is None and relative_depth is None:
+        depth, relative_depth = sq.depth, sq.relative_depth
+    if depth is None and relative_depth is None:
+        raise SceneError("no squeeze depth: give squeeze.depth or squeeze.relative_depth in the "
+                         "scene, or --depth / --relative-depth")
+    directions = None
+    if scene.fingers["F1"].direction is not None:
+        directions = {n: scene.fingers[n].direction for n in ("F1", "F2")}
+    return event_squeeze(
+        obj, contacts, {n: scene.fingers[n].tip_radius for n in ("F1", "F2")}, scene.mu,
+        sq.type, depth, relative_depth, scene_limits(scene),
+        sq.step if step is None else step, sq.event_tol if event_tol is None else event_tol,
+        reference, sq.max_events_per_depth, directions, progress)

@@ -13,7 +13,6 @@ VERBS: tuple[str, ...] = (
     "squeeze",
     "graspmap",
     "resist",
-    "ring",
     "bench",
     "scene_help",
     "ros_setup",

@@ -27,6 +27,7 @@ from .mechanics import shapes
 from .mechanics.errors import MechanicsError
 from .mechanics.material import Material
 from .mechanics.mesh import Mesh, generate_mesh, target_max_area
+from .mechanics.ring_model import RingModel, ring_from_outline
 
 
 class SceneError(ValueError):
@@ -439,6 +440,21 @@ def build_mesh(scene: Scene) -> Mesh:
         return generate_mesh(outline, area, ms.min_angle)
     except MechanicsError as exc:
         raise SceneError(f"object.mesh: {exc}") from None
+
+
+def build_ring(scene: Scene) -> RingModel:
+    """The curved-beam model of a ring scene (``object.model: ring``): the shape is the middle
+    curve, ``material.thickness`` the out-of-plane width w, ``ring.wall_thickness`` the wall h.
+
+    Its nodes act as boundary nodes, so :func:`finger_nodes` places fingers on it."""
+    obj = scene.object
+    if obj.model != "ring":
+        raise SceneError(f"object.model must be ring for the ring model, got {obj.model!r}")
+    try:
+        return ring_from_outline(build_outline(obj.shape), scene_material(scene),
+                                 obj.ring.wall_thickness, obj.ring.elements)
+    except MechanicsError as exc:
+        raise SceneError(f"object.ring: {exc}") from None
 
 
 def placement_node(mesh: Mesh, placement: PlacementSpec, where: str,

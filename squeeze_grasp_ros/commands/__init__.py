@@ -13,6 +13,7 @@ VERBS: tuple[str, ...] = (
     "squeeze",
     "graspmap",
     "resist",
+    "ring",
     "bench",
     "scene_help",
     "ros_setup",

@@ -25,7 +25,7 @@ import numpy as np
 
 from .errors import MechanicsError
 from .ring_model import RingModel
-from .ring_squeeze import (LIMITS, RingSqueezeKind, _check_limits, cone_depths, initially_feasible,
+from .ring_squeeze import (LIMITS, RingSqueezeKind, check_limits, cone_depths, initially_feasible,
                            neighbours, resolve_limits, ring_grasp)
 
 CHUNK = 512
@@ -215,7 +215,7 @@ def ring_grasp_map(ring: RingModel, mu: float, epsilon: float | None = None,
     """
     if kind not in ("stable", "pure"):
         raise MechanicsError(f"squeeze type must be 'stable' or 'pure', got {kind!r}")
-    _check_limits(mu, epsilon)
+    check_limits(mu, epsilon)
     if requested_relative_depth is not None and not 0 < requested_relative_depth <= 1:
         raise MechanicsError(f"requested relative depth must be in (0, 1], got {requested_relative_depth}")
     L = ring.scale
@@ -240,31 +240,29 @@ def ring_grasp_map(ring: RingModel, mu: float, epsilon: float | None = None,
                         requested_relative_depth=requested_relative_depth)
 
 
-def bench_ring(elements: int = 400, mu: float = 0.5, epsilon: float | None = 0.03,
-               single: int = 200, seed: int = 0) -> dict[str, float]:
-    """Time the precompute, the all-pairs map and single placements on an elliptic ring.
+def bench_ring(ring: RingModel, mu: float, epsilon: float | None = None,
+               kind: RingSqueezeKind = "stable", single: int = 200, seed: int = 0) -> dict:
+    """Wall-clock timings of the mechanics on ``ring``, seconds.
 
-    Returns wall-clock seconds: ``precompute``, ``map`` (all pairs), ``single_mean`` and
-    ``single_min`` (one :func:`~.ring_squeeze.ring_grasp`), plus ``pairs`` and ``elements``.
+    Returns ``precompute`` (stiffness, factor, compliance, strain influence; from a fresh copy of
+    the ring), ``map`` (all pairs), ``single_mean`` / ``single_min`` over ``single`` random
+    placements (:func:`~.ring_squeeze.ring_grasp`), with ``elements``, ``pairs`` and
+    ``initially_feasible_pairs``.
     """
-    from .material import Material
-    from .ring_model import ring_from_outline
-    from .shapes import ellipse
-
-    ring = ring_from_outline(ellipse(0.05, 0.03), Material(2e9, 0.0, 0.01), 0.003, elements)
+    fresh = RingModel(ring.points, ring.material, ring.wall_thickness)
     t0 = time.perf_counter()
-    ring.precompute()
+    fresh.precompute()
     t1 = time.perf_counter()
-    gmap = ring_grasp_map(ring, mu, epsilon)
+    gmap = ring_grasp_map(fresh, mu, epsilon, kind)
     t2 = time.perf_counter()
     rng = np.random.default_rng(seed)
     times = []
     for _ in range(single):
-        i, j = rng.choice(ring.n, size=2, replace=False)
+        i, j = rng.choice(fresh.n, size=2, replace=False)
         s = time.perf_counter()
-        ring_grasp(ring, (i, j), mu, epsilon)
+        ring_grasp(fresh, (i, j), mu, epsilon, kind)
         times.append(time.perf_counter() - s)
-    return {"elements": ring.n, "pairs": int(len(gmap.pairs)),
+    return {"elements": fresh.n, "pairs": int(len(gmap.pairs)),
             "initially_feasible_pairs": int(gmap.initially_feasible.sum()),
             "precompute": t1 - t0, "map": t2 - t1,
             "single_mean": float(np.mean(times)), "single_min": float(np.min(times))}

@@ -334,7 +334,7 @@ def _check_contacts(ring: RingModel, contacts) -> np.ndarray:
     return c
 
 
-def _check_limits(mu: float, epsilon: float | None) -> None:
+def check_limits(mu: float, epsilon: float | None) -> None:
     require_finite("mu", mu)
     if mu < 0:
         raise MechanicsError(f"friction coefficient mu must be >= 0, got {mu}")
@@ -376,7 +376,7 @@ def ring_grasp(ring: RingModel, contacts, mu: float, epsilon: float | None = Non
     if kind not in ("stable", "pure"):
         raise MechanicsError(f"squeeze type must be 'stable' or 'pure', got {kind!r}")
     c = _check_contacts(ring, contacts)
-    _check_limits(mu, epsilon)
+    check_limits(mu, epsilon)
     L = ring.scale
     p = ring.points[c]
     dofs = node_dofs(c)

@@ -3,6 +3,8 @@
 """Ring-like objects (Sec. 7): curved-beam model, point-contact squeeze limits, grasp map."""
 from __future__ import annotations
 
+from functools import cache
+
 import numpy as np
 import pytest
 
@@ -20,14 +22,23 @@ from squeeze_grasp_ros.mechanics.ring_squeeze import (LIMITS, first_root, inward
 E, W, H = 2.0e9, 0.01, 0.003
 
 
-def make_ring(outline=None, elements=120, E=E, w=W, h=H) -> RingModel:
-    outline = shapes.ellipse(0.05, 0.03) if outline is None else outline
-    return ring_from_outline(outline, Material(E, 0.0, w), h, elements)
+@cache
+def outline(kind: str) -> shapes.Outline:
+    """Shared outlines (building and validating a dense outline takes a noticeable time)."""
+    if kind == "ellipse":
+        return shapes.ellipse(0.05, 0.03)
+    if kind == "peanut":
+        return shapes.fourier_blob(0.04, cos=[0.0, 0.3])
+    return shapes.disk(0.04)
 
 
-def circle_diametral(elements: int, radius=0.04, h=0.004, load=10.0):
-    """FE diameter changes (along, across) and max fibre strain of a circle under +-load."""
-    ring = make_ring(shapes.disk(radius), elements, h=h)
+def make_ring(kind="ellipse", elements=120, E=E, w=W, h=H) -> RingModel:
+    return ring_from_outline(outline(kind), Material(E, 0.0, w), h, elements)
+
+
+def circle_diametral(elements: int, h=0.004, load=10.0):
+    """FE diameter changes (along, across) and max fibre strain of the 0.04 m circle under +-load."""
+    ring = make_ring("disk", elements, h=h)
     ang = np.arctan2(ring.points[:, 1], ring.points[:, 0])
     top, bottom, left, right = (int(np.argmin(np.abs(np.angle(np.exp(1j * (ang - a))))))
                                 for a in (np.pi / 2, -np.pi / 2, np.pi, 0.0))
@@ -52,7 +63,7 @@ def test_circle_converges_to_closed_form_at_second_order():
     print("\nring under diametral loads: FE vs closed form (extension + bending, eq. 71)")
     print(f"{'elements':>8} {'along (m)':>13} {'across (m)':>13} {'err along':>10} {'err across':>10} {'order':>6}")
     for k, n in enumerate(sizes):
-        along, across, _ = circle_diametral(n, R, h, P)
+        along, across, _ = circle_diametral(n, h, P)
         err = np.abs(np.array([along, across]) / exact - 1)
         errors.append(err)
         order = "" if k == 0 else f"{np.log2(errors[-2][0] / err[0]):6.2f}"
@@ -80,13 +91,13 @@ def test_closed_form_limits_and_extension_term():
 
 def test_strain_recovery_matches_load_point_moment():
     R, h, P = 0.04, 0.004, 10.0
-    _, _, strain = circle_diametral(512, R, h, P)
+    _, _, strain = circle_diametral(512, h, P)
     EI = E * W * h ** 3 / 12
     assert strain == pytest.approx(P * R / np.pi * h / (2 * EI), rel=0.01)
 
 
 def test_exactly_three_rigid_modes():
-    ring = make_ring(shapes.fourier_blob(0.04, cos=[0.0, 0.3]), 80)
+    ring = make_ring("peanut", 80)
     K = ring.stiffness.toarray()
     assert np.abs(K @ ring.rigid).max() <= 1e-12 * np.abs(K).max()
     lam = np.linalg.eigvalsh(K)
@@ -117,7 +128,7 @@ def test_reduced_stiffness_matches_dense_pinv_route():
 
 
 def test_rigid_motion_invariance():
-    ring = make_ring(shapes.fourier_blob(0.04, cos=[0.0, 0.3]), 60)
+    ring = make_ring("peanut", 60)
     th = 0.7
     Rot = np.array([[np.cos(th), -np.sin(th)], [np.sin(th), np.cos(th)]])
     moved = RingModel(ring.points @ Rot.T + [0.3, -0.2], ring.material, ring.wall_thickness)
@@ -130,15 +141,15 @@ def test_rigid_motion_invariance():
 
 
 def test_scaling_with_E_w_and_h_cubed():
-    base = make_ring(shapes.disk(0.04), 90, h=4e-4)
+    base = make_ring("disk", 90, h=4e-4)
     ref = ring_grasp(base, (0, 45), 0.3, 0.01)
-    for scaled, factor in ((make_ring(shapes.disk(0.04), 90, E=3 * E, h=4e-4), 3.0),
-                           (make_ring(shapes.disk(0.04), 90, w=2 * W, h=4e-4), 2.0)):
+    for scaled, factor in ((make_ring("disk", 90, E=3 * E, h=4e-4), 3.0),
+                           (make_ring("disk", 90, w=2 * W, h=4e-4), 2.0)):
         g = ring_grasp(scaled, (0, 45), 0.3, 0.01)
         assert g.stiffness == pytest.approx(factor * ref.stiffness, rel=1e-10)
         assert g.max_depth == pytest.approx(ref.max_depth, rel=1e-10)
         assert np.allclose(g.field, ref.field, atol=1e-12)
-    thin = ring_grasp(make_ring(shapes.disk(0.04), 90, h=2e-4), (0, 45), 0.3, 0.01)
+    thin = ring_grasp(make_ring("disk", 90, h=2e-4), (0, 45), 0.3, 0.01)
     assert thin.stiffness / ref.stiffness == pytest.approx(1 / 8, rel=2e-3)
 
 
@@ -213,7 +224,7 @@ def test_cone_depth_equals_brute_force_scan():
 
 
 def test_strain_depth_is_where_strain_reaches_epsilon():
-    ring = make_ring(shapes.disk(0.04), 120)
+    ring = make_ring("disk", 120)
     g = ring_grasp(ring, (0, 60), 0.3, 0.004)
     assert g.limit == "strain"
     assert g.max_strain_at(g.max_depth) == pytest.approx(0.004, rel=1e-12)
@@ -264,7 +275,7 @@ def test_fig15_cones_rotating_toward_each_other_strengthen_the_grasp():
 
 @pytest.mark.parametrize("kind", ["stable", "pure"])
 def test_all_pairs_map_equals_single_placements(kind):
-    ring = make_ring(shapes.fourier_blob(0.04, cos=[0.0, 0.3]), 40)
+    ring = make_ring("peanut", 40)
     gmap = ring_grasp_map(ring, 0.4, 0.02, kind, requested_relative_depth=0.1)
     assert len(gmap.pairs) == 40 * 39 // 2
     for k in range(len(gmap.pairs)):
@@ -287,9 +298,9 @@ def test_bad_inputs_raise():
     with pytest.raises(MechanicsError):
         ring_grasp(ring, (3, 20), -0.1)
     with pytest.raises(MechanicsError):
-        ring_from_outline(shapes.disk(0.04), Material(E, 0.3, W), H, 40)
+        ring_from_outline(outline("disk"), Material(E, 0.3, W), H, 40)
     with pytest.raises(MechanicsError):
-        ring_from_outline(shapes.disk(0.04), Material(E, 0.0, W), 0.05, 40)
+        ring_from_outline(outline("disk"), Material(E, 0.0, W), 0.05, 40)
     with pytest.raises(MechanicsError):
         ring.solve_loads(np.ones((ring.n, 2)))
 
@@ -299,7 +310,8 @@ def _write_scene(tmp_path, relative_depth=0.05, effects="[friction, strain_limit
     path.write_text(f"""
 object:
   model: ring
-  shape: {{type: ellipse, a: 0.045, b: 0.03}}
+  shape: {{type: polygon, points: [[0.045, 0], [0.032, 0.021], [0, 0.03], [-0.032, 0.021],
+                                   [-0.045, 0], [-0.032, -0.021], [0, -0.03], [0.032, -0.021]]}}
   material: {{E: 3.0e9, nu: 0.0, thickness: 0.01}}
   ring: {{wall_thickness: 0.003, elements: 48}}
 fingers:

@@ -78,10 +78,7 @@ def run(args: argparse.Namespace) -> dict:
         if depth is not None:
             raise SceneError("the grasp map compares placements at a relative depth: give "
                              "squeeze.relative_depth or --relative-depth, not a depth in m")
-        gmap = ring_grasp_map(ring, mu, eps, kind, relative)
-        if args.plot:
-            plot_map(ring, gmap, args.plot)
-        return {"model": "ring", **gmap.to_json(best=args.best)}
+        return map_result(scene, ring, relative, args.plot, args.best)
     if depth is None and relative is None:
         raise SceneError("give squeeze.depth or squeeze.relative_depth (or --depth/--relative-depth)")
     grasp = ring_grasp(ring, finger_nodes(scene, ring), mu, eps, kind)
@@ -89,6 +86,15 @@ def run(args: argparse.Namespace) -> dict:
     if args.plot:
         plot_grasp(ring, grasp, rho, args.plot)
     return grasp_json(ring, grasp, rho)
+
+
+def map_result(scene: Scene, ring: RingModel, relative_depth: float | None,
+               plot: str | None = None, best: int = 10) -> dict:
+    """The all-pairs map of a ring scene as JSON (``graspmap`` serves ring scenes with this)."""
+    gmap = ring_grasp_map(ring, scene.mu, strain_limit(scene), scene.squeeze.type, relative_depth)
+    if plot:
+        plot_map(ring, gmap, plot)
+    return {"model": "ring", **gmap.to_json(best=best)}
 
 
 def force_angles(grasp: RingGrasp, depth: float) -> np.ndarray:
@@ -224,7 +230,9 @@ def summary(result: dict) -> str:
                  f"epsilon={result['epsilon']}; limits: {result['limits']}"]
         if "feasible_pairs" in result:
             lines.append(f"{result['feasible_pairs']} succeed at relative depth "
-                         f"{result['requested_relative_depth']}; failures: {result['failure_modes']}")
+                         f"{result['requested_relative_depth']}; {result['initially_infeasible_pairs']} "
+                         f"start outside a cone; failures during the squeeze: "
+                         f"{result['failure_modes_during_squeeze']}")
         lines.append("deepest placements (F1, F2, max relative depth, limit):")
         lines += [f"  {b['contacts'][0]:5d} {b['contacts'][1]:5d}  {b['max_relative_depth']:.4g}  {b['limit']}"
                   for b in result["best"]]

@@ -93,9 +93,12 @@ class RingGraspMap:
             raise MechanicsError(f"no placement ({i}, {j}) on a ring of {self.n} nodes")
         return int(a * self.n - a * (a + 1) // 2 + (b - a - 1))
 
-    def failure_modes(self, relative_depth: float) -> dict[str, int]:
-        """Counts, by limit name, of the placements that fail before ``relative_depth``."""
+    def failure_modes(self, relative_depth: float, started: bool = False) -> dict[str, int]:
+        """Counts, by limit name, of the placements that fail before ``relative_depth``; with
+        ``started`` only those that start inside both cones (they fail during the squeeze)."""
         fail = ~self.succeeds(relative_depth)
+        if started:
+            fail &= self.initially_feasible
         codes = self.limit_code[fail]
         return {name: int(np.sum(codes == k)) for k, name in enumerate(LIMITS)}
 
@@ -127,7 +130,8 @@ class RingGraspMap:
             ok = self.succeeds(r)
             out.update({"requested_relative_depth": r, "feasible_pairs": int(ok.sum()),
                         "failure_modes": self.failure_modes(r),
-                        "initially_infeasible_pairs": int((~self.initially_feasible).sum())})
+                        "initially_infeasible_pairs": int((~self.initially_feasible).sum()),
+                        "failure_modes_during_squeeze": self.failure_modes(r, started=True)})
         return out
 
 

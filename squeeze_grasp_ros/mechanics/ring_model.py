@@ -124,7 +124,7 @@ class RingModel:
         cross = x * yn - xn * y
         return np.array([np.sum((x + xn) * cross), np.sum((y + yn) * cross)]) / (3.0 * np.sum(cross))
 
-    @property
+    @cached_property
     def scale(self) -> float:
         """Length scale L, m: the larger side of the bounding box."""
         return float(np.ptp(np.asarray(self.points, float), axis=0).max())

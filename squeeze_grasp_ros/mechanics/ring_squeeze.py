@@ -51,12 +51,11 @@ RingSqueezeKind = Literal["stable", "pure"]
 
 def poly_mul(p: np.ndarray, q: np.ndarray) -> np.ndarray:
     """Product of polynomials with ascending coefficients along the last axis (broadcasting)."""
-    shape = np.broadcast_shapes(p.shape[:-1], q.shape[:-1])
-    out = np.zeros(shape + (p.shape[-1] + q.shape[-1] - 1,))
-    for a in range(p.shape[-1]):
-        for b in range(q.shape[-1]):
-            out[..., a + b] += p[..., a] * q[..., b]
-    return out
+    a, b = p.shape[-1], q.shape[-1]
+    conv = np.zeros((a * b, a + b - 1))
+    conv[np.arange(a * b), np.add.outer(np.arange(a), np.arange(b)).ravel()] = 1.0
+    outer = p[..., :, None] * q[..., None, :]
+    return outer.reshape(outer.shape[:-2] + (a * b,)) @ conv
 
 
 def polyval(coeffs: np.ndarray, x: np.ndarray) -> np.ndarray:
@@ -183,10 +182,13 @@ def cone_depths(base: np.ndarray, rate: np.ndarray, force: np.ndarray, mu: float
     (previous, contact, next) node; ``force`` (k, 2, 2); ``cap`` (k,): roots beyond it are not
     sought (inf returned). Fingers not inside their cone at rho = 0+ get depth 0.
     """
-    g = cone_polynomials(normal_polynomial(base, rate), force, mu)
-    k = len(base)
-    roots = first_root(g.reshape(-1, g.shape[-1]), np.repeat(cap, 4)).reshape(k, 2, 2).min(axis=2)
-    return np.where(initially_feasible(base, force, mu), roots, 0.0)
+    inside = initially_feasible(base, force, mu)
+    out = np.zeros(inside.shape)
+    k, f = np.nonzero(inside)
+    g = cone_polynomials(normal_polynomial(base[k, f], rate[k, f]), force[k, f], mu)
+    roots = first_root(g.reshape(-1, g.shape[-1]), np.repeat(cap[k], 2))
+    out[k, f] = roots.reshape(-1, 2).min(axis=1)
+    return out
 
 
 def resolve_limits(cones: np.ndarray, strain: np.ndarray, cap: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -318,7 +320,8 @@ class RingGrasp:
         return cones_ok and strain_ok
 
     def limit_depths(self) -> dict[str, float | None]:
-        """Candidate depths (m) by limit name; None where the limit is never reached."""
+        """Candidate depths (m) by limit name; None where the limit is not reached before the
+        smaller of the strain depth and ``depth_cap`` (cone roots are not sought beyond)."""
         vals = [*self.cone_depths, self.strain_depth]
         return {name: (float(v) if np.isfinite(v) else None) for name, v in zip(LIMITS, vals)}
 

@@ -38,8 +38,10 @@ from .reduced import reduce_blocks
 
 STRAIN_CRITERIA: tuple[str, ...] = ("principal", "componentwise")
 NEWTON_MAX_ITERATIONS = 50
+NEWTON_BACKTRACKS = 30
 NEWTON_TOL = 1e-14
-"""Newton stops when the largest angle update is below this (rad)."""
+"""Newton stops when the cone residual is below this times the force scale |C| r, or when the
+largest angle update (rad) falls below it."""
 
 
 @dataclass(frozen=True)
@@ -203,20 +205,28 @@ def solve_fixed_set(C: np.ndarray, cfg: Configuration, centers: np.ndarray, dirs
     P = np.flatnonzero(~cfg.stick)
     r = cfg.radius
     Cb = C.reshape(m, 2, m, 2)
+    force_scale = max(float(np.abs(C).max()) * float(r.max()), 1e-300)
+
+    def forces(th: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        delta = centers + r[:, None] * unit(th) - cfg.p0
+        return delta, (C @ delta.reshape(-1)).reshape(m, 2)
+
+    def cone_residual(th: np.ndarray, F: np.ndarray) -> np.ndarray:
+        return cross(F[P], unit(th[P] - cfg.slip[P] * phi))
+
+    delta, F = forces(theta)
     it, residual, cond = 0, 0.0, 1.0
     J = np.zeros((0, 0))
-    while True:
-        delta = centers + r[:, None] * unit(theta) - cfg.p0
-        F = (C @ delta.reshape(-1)).reshape(m, 2)
-        if len(P) == 0:
-            break
-        alpha = theta[P] - cfg.slip[P] * phi
-        ea = unit(alpha)
-        R = cross(F[P], ea)
+    R = cone_residual(theta, F)
+    while len(P):
+        ea = unit(theta[P] - cfg.slip[P] * phi)
         # dF_k / d theta_j = C_kj r_j t(theta_j): (m, 2, |P|)
         G = np.einsum("kajb,jb->kaj", Cb[:, :, P, :], r[P, None] * tangent(theta[P]))
         J = cross(np.moveaxis(G[P], 2, 1), ea[:, None, :]) + np.diag(np.einsum("ij,ij->i", F[P], ea))
         residual = float(np.abs(R).max())
+        if residual <= NEWTON_TOL * force_scale:
+            cond = float(np.linalg.cond(J))
+            break
         if it >= NEWTON_MAX_ITERATIONS:
             raise MechanicsError(f"Newton on the sliding angles did not converge in {it} "
                                  f"iterations (residual {residual:.3g})")
@@ -224,12 +234,18 @@ def solve_fixed_set(C: np.ndarray, cfg: Configuration, centers: np.ndarray, dirs
             step = np.linalg.solve(J, R)
         except np.linalg.LinAlgError:
             raise MechanicsError("singular Jacobian of the sliding constraints (eq. 47)") from None
-        theta[P] -= step
         it += 1
+        for _ in range(NEWTON_BACKTRACKS):
+            trial = theta.copy()
+            trial[P] -= step
+            t_delta, t_F = forces(trial)
+            t_R = cone_residual(trial, t_F)
+            if np.abs(t_R).max() < residual or np.abs(step).max() < NEWTON_TOL:
+                break
+            step = 0.5 * step
+        theta, delta, F, R = trial, t_delta, t_F, t_R
         if np.abs(step).max() < NEWTON_TOL:
-            delta = centers + r[:, None] * unit(theta) - cfg.p0
-            F = (C @ delta.reshape(-1)).reshape(m, 2)
-            residual = float(np.abs(cross(F[P], unit(theta[P] - cfg.slip[P] * phi))).max())
+            residual = float(np.abs(R).max())
             cond = float(np.linalg.cond(J))
             break
     dF0 = (C @ dirs.reshape(-1)).reshape(m, 2)

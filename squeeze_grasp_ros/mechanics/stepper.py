@@ -67,6 +67,10 @@ EVENT_ORDER = {"B": 0, "D": 1, "C+": 2, "C-": 2, "A": 3}
 """Processing order of simultaneous events (C+ and C- never coexist on one node)."""
 TERMINATION_ORDER: tuple[str, ...] = ("strain_limit", "finger_slip", "picked_up")
 MAX_SUBSTEP_HALVINGS = 12
+CONTINUATION_ITERATIONS = 12
+MAX_ANGLE_JUMP = 0.05
+"""Continuation safeguards: Newton iterations and distance (rad) from the predicted angles
+beyond which a substep is halved."""
 MAX_ROOT_ITERATIONS = 200
 
 
@@ -335,50 +339,81 @@ class _Run:
         return sorted(out, key=lambda k: (EVENT_ORDER[k[0]],
                                           k[2] if k[0] == "A" else finger_of[k[1]], k[1]))
 
-    def consistent(self, sol: Solution, k: int, stick: bool, slip: int) -> int:
-        """Number of violated hypothesis conditions for contact k (0 = consistent)."""
-        fn_r, ft_r = sol.normal_rate()[k], sol.tangential_rate()[k]
-        bad = int(fn_r <= 0)
+    def zero_keys(self) -> set:
+        """Functions zero by construction now: the fresh ones and each sliding node's cone
+        margin on its slip side (its force lies on that cone edge)."""
+        zero = set(self.fresh)
+        for node, stick, slip in zip(self.nodes.tolist(), self.stick, self.slip):
+            if not stick and slip:
+                zero.add(("C+" if slip > 0 else "C-", node))
+        return zero
+
+    def violations(self, sol: Solution, k: int, stick: bool, slip: int, zero: set) -> int:
+        """Violated conditions of a mode hypothesis for contact k (0 = consistent).
+
+        A function in ``zero`` must grow along the motion; any other must be positive. Stick:
+        normal force and both cone margins; slip: normal force and slip rate of the assumed
+        sign (Algorithm 1's hypothesis-and-test)."""
+        node = int(self.nodes[k])
+        mu = self.model.mu
+        fn, ft = float(sol.normal()[k]), float(sol.tangential()[k])
+        fn_r, ft_r = float(sol.normal_rate()[k]), float(sol.tangential_rate()[k])
+
+        def ok(kind: str, value: float, rate: float) -> bool:
+            return rate > 0 if (kind, node) in zero else value > 0
+
+        bad = int(not ok("B", fn, fn_r))
         if stick:
-            bad += int(self.model.mu * fn_r < abs(ft_r))
+            bad += int(not ok("C+", mu * fn + ft, mu * fn_r + ft_r))
+            bad += int(not ok("C-", mu * fn - ft, mu * fn_r - ft_r))
         elif not self.frictionless:
             bad += int(slip * sol.dtheta[k] <= 0)
         return bad
 
-    def decide(self) -> None:
-        """Hypothesis-and-test for the undetermined contacts (Algorithm 1 lines 2 and 13)."""
-        idx = [int(np.searchsorted(self.nodes, n)) for n in sorted(self.undetermined)]
+    def decide(self, nodes: list[int]) -> None:
+        """Joint hypothesis-and-test for the modes of ``nodes`` (Algorithm 1 lines 2 and 13).
+
+        Options per node in the order stick, slip +1, slip -1; every combination for up to
+        three nodes (the first consistent one wins, else the one with fewest violations),
+        node by node in two passes for more."""
+        idx = [int(np.searchsorted(self.nodes, n)) for n in sorted(nodes)]
+        zero = self.zero_keys()
         options = [(False, 0)] if self.frictionless else [(True, 0), (False, 1), (False, -1)]
-        combos = (itertools.product(options, repeat=len(idx)) if len(idx) <= 3 else
-                  [tuple(options[0] for _ in idx)])
+        if len(idx) <= 3:
+            candidates = itertools.product(options, repeat=len(idx))
+        else:
+            candidates = [self._greedy(idx, options, zero)]
         best = None
-        for combo in combos:
+        for combo in candidates:
             stick, slip = self.stick.copy(), self.slip.copy()
             for k, (st, sl) in zip(idx, combo):
                 stick[k], slip[k] = st, sl
-            if len(idx) > 3:
-                stick, slip = self._greedy(idx, options, stick, slip)
             try:
                 sol = self.solve(self.s, stick=stick, slip=slip)
             except MechanicsError:
                 continue
-            bad = sum(self.consistent(sol, k, stick[k], slip[k]) for k in idx)
+            bad = sum(self.violations(sol, k, stick[k], slip[k], zero) for k in idx)
             if best is None or bad < best[0]:
                 best = (bad, stick, slip, sol.theta)
             if bad == 0:
                 break
+        if best is None:
+            raise MechanicsError(f"no contact mode of nodes {sorted(nodes)} can be solved")
         if best[0] > 0:
             self.diag["ambiguous_modes"] += 1
         _, self.stick, self.slip, self.theta = best
         for k in idx:
             node = int(self.nodes[k])
-            if not self.stick[k]:
-                self.fresh.discard(("C+", node))
-                self.fresh.discard(("C-", node))
-        self.undetermined.clear()
+            if self.stick[k]:
+                self.fresh |= {key for key in (("C+", node), ("C-", node)) if key in zero}
+            else:
+                self.fresh -= {("C+", node), ("C-", node)}
+        self.undetermined -= set(nodes)
 
-    def _greedy(self, idx, options, stick, slip):
+    def _greedy(self, idx: list[int], options: list, zero: set) -> tuple:
         """Node-by-node hypothesis-and-test (two passes) for many undecided nodes."""
+        stick, slip = self.stick.copy(), self.slip.copy()
+        choice = {k: options[0] for k in idx}
         for _ in range(2):
             for k in idx:
                 for st, sl in options:
@@ -387,53 +422,71 @@ class _Run:
                         sol = self.solve(self.s, stick=stick, slip=slip)
                     except MechanicsError:
                         continue
-                    if self.consistent(sol, k, st, sl) == 0:
+                    if self.violations(sol, k, st, sl, zero) == 0:
+                        choice[k] = (st, sl)
                         break
-        return stick, slip
+                stick[k], slip[k] = choice[k]
+        return tuple(choice[k] for k in idx)
 
     def _chatters(self, node: int, finger: int) -> bool:
-        """Apply the chattering bound to an event of ``node``; True if it is frozen instead."""
+        """Count an event of ``node`` in the depth window; True if the bound froze it instead."""
         depth = self.depth_at(self.s)
         window = self.step * self.model.length
         self.history = [(n, d) for n, d in self.history if d > depth - window]
         if sum(1 for n, _ in self.history if n == node) < self.model.max_events_per_depth:
             self.history.append((node, depth))
             return False
-        self.holds[node] = depth + window
-        self.chatter.append(Chatter(node, self.names[finger], depth, depth + window))
+        self.hold(node, finger)
         return True
 
-    def apply(self, key: tuple, sol: Solution) -> None:
-        """Process one pending event (updates modes, the contact set and the fresh keys)."""
-        kind, node = key[0], key[1]
+    def hold(self, node: int, finger: int) -> None:
+        """Freeze the contact state of ``node`` for one depth step (chattering bound)."""
         depth = self.depth_at(self.s)
-        rel = depth * self.relative_per_depth
-        if kind == "A":
-            f = key[2]
+        until = depth + self.step * self.model.length
+        self.holds[node] = until
+        self.chatter.append(Chatter(node, self.names[finger], depth, until))
+
+    def log(self, kind: str, k: int) -> None:
+        """Append an event of contact k (mode and slip after the event)."""
+        depth = self.depth_at(self.s)
+        mode = "stick" if self.stick[k] else "slip"
+        self.events.append(Event(kind, int(self.nodes[k]), self.names[self.fidx[k]], depth,
+                                 depth * self.relative_per_depth, mode, int(self.slip[k])))
+
+    def add_contacts(self, keys: list[tuple], sol: Solution) -> None:
+        """Event A for every key (one per node): put the nodes on their tips, decide jointly."""
+        added = []
+        self.theta = sol.theta.copy()
+        for _, node, f in keys:
             if self._chatters(node, f):
-                return
+                continue
             row = self.model.obj.boundary_positions([node])
             x = self.p_b[row[0]] + self.model.boundary_displacement(self.sd, sol.delta, sol.F, row)[0]
             rel_x = x - (self.c0[f] + self.s * self.D[f])
             theta = float(np.arctan2(rel_x[1], rel_x[0]))
             same = self.fidx == f
             if same.any():
-                ref = float(np.mean(sol.theta[same]))
+                ref = float(np.mean(self.theta[same]))
                 theta = ref + float(np.angle(np.exp(1j * (theta - ref))))
-            self.theta = sol.theta.copy()
             self.nodes = np.append(self.nodes, node)
             self.fidx = np.append(self.fidx, f)
             self.stick = np.append(self.stick, True)
             self.slip = np.append(self.slip, 0)
             self.theta = np.append(self.theta, theta)
-            self._refresh_set()
-            self.undetermined.add(node)
-            self.fresh |= {("B", node), ("C+", node), ("C-", node)}
-            self.decide()
-            k = int(np.searchsorted(self.nodes, node))
-            mode = "stick" if self.stick[k] else "slip"
-            self.events.append(Event("A", node, self.names[f], depth, rel, mode, int(self.slip[k])))
+            self.fresh = ({k for k in self.fresh if k[1] != node}
+                          | {("B", node), ("C+", node), ("C-", node)})
+            added.append(node)
+        if not added:
             return
+        self._refresh_set()
+        self.undetermined |= set(added)
+        self.decide(added)
+        for node in sorted(added):
+            self.log("A", int(np.searchsorted(self.nodes, node)))
+
+    def apply(self, key: tuple, sol: Solution) -> None:
+        """Process one B, C or D event (updates modes, the contact set and the fresh keys)."""
+        kind, node = key[0], key[1]
         k = int(np.searchsorted(self.nodes, node))
         f = int(self.fidx[k])
         if self._chatters(node, f):
@@ -442,29 +495,68 @@ class _Run:
         if kind == "B" and np.count_nonzero(self.fidx == f) == 1:
             self.lost = self.names[f]
         elif kind == "B":
+            self.log("B", k)
+            self.events[-1] = Event("B", node, self.names[f], self.events[-1].depth,
+                                    self.events[-1].relative_depth, "none", 0)
             keep = np.arange(len(self.nodes)) != k
             for name in ("nodes", "fidx", "stick", "slip", "theta"):
                 setattr(self, name, getattr(self, name)[keep])
             self._refresh_set()
             self.fresh = {fk for fk in self.fresh if fk[1] != node} | {("A", node)}
-            self.events.append(Event("B", node, self.names[f], depth, rel, "none", 0))
         elif kind in ("C+", "C-"):
             self.stick[k] = False
             self.slip[k] = 1 if kind == "C+" else -1
             self.fresh -= {("C+", node), ("C-", node)}
-            self.events.append(Event("C", node, self.names[f], depth, rel, "slip", int(self.slip[k])))
+            self.log("C", k)
         else:
             side = "C+" if self.slip[k] > 0 else "C-"
             self.stick[k], self.slip[k] = True, 0
             self.fresh.add((side, node))
-            self.events.append(Event("D", node, self.names[f], depth, rel, "stick", 0))
+            self.log("D", k)
+
+    def resettle(self, nodes: set, before: dict, first_event: int) -> None:
+        """Joint hypothesis-and-test for nodes whose C/D events at this point flip back.
+
+        Their C/D events at this point are replaced by the net mode change from the start of
+        the point (C for stick -> slip, D for slip -> stick, D then C for a slip reversal)."""
+        self.decide(sorted(nodes))
+        kept = [e for e in self.events[first_event:] if not (e.node in nodes and e.type in "CD")]
+        self.events[first_event:] = kept
+        for node in sorted(nodes):
+            k = int(np.searchsorted(self.nodes, node))
+            old_stick, old_slip = before.get(node, (True, 0))
+            new = (bool(self.stick[k]), int(self.slip[k]))
+            if new == (old_stick, old_slip):
+                continue
+            if not old_stick:
+                self.stick[k], self.slip[k] = True, 0
+                self.log("D", k)
+                self.stick[k], self.slip[k] = new
+            if not new[0]:
+                self.log("C", k)
+        for i, e in enumerate(self.events[first_event:], first_event):
+            if e.type == "A" and e.node in nodes:
+                k = int(np.searchsorted(self.nodes, e.node))
+                self.events[i] = Event("A", e.node, e.finger, e.depth, e.relative_depth,
+                                       "stick" if self.stick[k] else "slip", int(self.slip[k]))
 
     def resolve(self) -> Solution:
-        """Process every pending event at the current point; returns the final solution."""
+        """Process every pending event at the current point; returns the final solution.
+
+        New contacts pending together are added as one batch with a joint mode decision. A
+        node whose C/D event would flip back at the same point triggers a joint decision over
+        the nodes with C/D events here; a node that flips again after that, or has a second
+        A/B event here, is frozen by the chattering bound."""
         if self.rate == 0:
             return self.solve(self.s)
         if self.undetermined:
-            self.decide()
+            self.decide(sorted(self.undetermined))
+        before = {int(n): (bool(st), int(sl))
+                  for n, st, sl in zip(self.nodes, self.stick, self.slip)}
+        first_event = len(self.events)
+        mode_events: set = set()
+        contact_events: set = set()
+        settled: set = set()
         limit = 4 * (len(self.nodes) + 8) * self.model.max_events_per_depth
         for _ in range(limit):
             sol = self.solve(self.s)
@@ -473,7 +565,25 @@ class _Run:
             todo = self.pending(sol)
             if not todo:
                 return sol
-            self.apply(todo[0], sol)
+            key = todo[0]
+            kind, node = key[0], key[1]
+            finger = key[2] if kind == "A" else int(self.fidx[np.searchsorted(self.nodes, node)])
+            if node in settled or (kind in ("A", "B") and node in contact_events):
+                self.hold(node, finger)
+            elif kind == "A":
+                batch = {}
+                for k in todo:
+                    if k[0] == "A" and k[1] not in contact_events:
+                        batch.setdefault(k[1], k)
+                self.add_contacts(sorted(batch.values(), key=lambda k: (k[2], k[1])), sol)
+                contact_events |= set(batch)
+            elif kind != "B" and node in mode_events:
+                group = mode_events | {node}
+                self.resettle(group, before, first_event)
+                settled |= group
+            else:
+                (contact_events if kind == "B" else mode_events).add(node)
+                self.apply(key, sol)
         raise MechanicsError("event processing at one point did not settle (chattering bound "
                              "exceeded); lower squeeze.max_events_per_depth")
 
@@ -540,11 +650,22 @@ class _Run:
                 out.append(key)
         return out
 
+    def continue_to(self, sol_a: Solution, a: float, b: float) -> Solution:
+        """Solve at b by continuation from the solution at a (predictor theta + dtheta/ds (b-a)).
+
+        Raises MechanicsError if Newton needs more than CONTINUATION_ITERATIONS iterations or
+        lands more than MAX_ANGLE_JUMP (rad) from the prediction (another solution branch)."""
+        guess = sol_a.theta + sol_a.dtheta * (b - a)
+        sol = self.solve(b, theta=guess)
+        if sol.iterations > CONTINUATION_ITERATIONS or np.abs(sol.theta - guess).max() > MAX_ANGLE_JUMP:
+            raise MechanicsError(f"continuation from s = {a:.6g} to {b:.6g} left the solution branch")
+        return sol
+
     def substep(self, sol_a: Solution, a: float, b: float) -> tuple[float, Solution]:
-        """(b, solution at b) from the angles at a, halving the substep while Newton fails."""
+        """(b, solution at b) by continuation from a, halving the substep while it fails."""
         for _ in range(MAX_SUBSTEP_HALVINGS):
             try:
-                return b, self.solve(b, theta=sol_a.theta)
+                return b, self.continue_to(sol_a, a, b)
             except MechanicsError:
                 self.diag["substep_halvings"] += 1
                 b = a + 0.5 * (b - a)
@@ -585,12 +706,20 @@ class _Run:
 
     def earliest(self, crossed, sol_a, sol_b, a, b, tol_s, va, vb):
         """Locate every crossed function; return the earliest bracket end and its solution."""
-        theta_a = sol_a.theta
+        solved = [(a, sol_a), (b, sol_b)]
         best = None
         finger_of = dict(zip(self.nodes.tolist(), self.fidx.tolist()))
+
+        def solve_near(s: float) -> Solution:
+            """Solve at s by continuation from the nearest point solved so far."""
+            near, sol_near = min(solved, key=lambda p: abs(p[0] - s))
+            sol = self.continue_to(sol_near, near, s)
+            solved.append((s, sol))
+            return sol
+
         for key in crossed:
             def g(s, key=key):
-                return self._key_value(key, self.solve(s, theta=theta_a), s)
+                return self._key_value(key, solve_near(s), s)
             lo, glo = a, va[key]
             if key[:2] in self.fresh or not glo > 0:
                 lo = min(a + tol_s, b)
@@ -605,7 +734,7 @@ class _Run:
             rank = (hi, EVENT_ORDER.get(key[0], 4), fidx, key[1])
             best = rank if best is None or rank < best else best
         s_e = best[0]
-        return s_e, self.solve(s_e, theta=theta_a)
+        return s_e, solve_near(s_e)
 
     def to_state(self) -> ContactState:
         """The frozen SI state at the current point."""

@@ -1,0 +1,305 @@
+# Copyright 2026 squeeze_grasp_ros developers
+# SPDX-License-Identifier: Apache-2.0
+"""Event-driven squeeze (Sec. 5): physical invariants at every event, the one-shot invariant by
+an independent sparse solve, convergence in the tolerance, symmetry and path independence."""
+from __future__ import annotations
+
+import functools
+
+import numpy as np
+import pytest
+
+from squeeze_grasp_ros.mechanics import shapes
+from squeeze_grasp_ros.mechanics.compliance import ElasticObject
+from squeeze_grasp_ros.mechanics.contact_model import ContactModel
+from squeeze_grasp_ros.mechanics.contact_state import ContactState, initial_state
+from squeeze_grasp_ros.mechanics.fingertips import place_fingertip, tip_gaps
+from squeeze_grasp_ros.mechanics.material import Material
+from squeeze_grasp_ros.mechanics.mesh import generate_mesh, mesh_from_triangles, target_max_area
+from squeeze_grasp_ros.mechanics.oneshot import one_shot_solve
+from squeeze_grasp_ros.mechanics.squeeze import plan_squeeze
+from squeeze_grasp_ros.mechanics.squeeze_events import event_squeeze
+from squeeze_grasp_ros.mechanics.stepper import advance
+
+FOAM = Material(5e4, 0.3, 0.0254)
+RADIUS = 0.02
+
+
+@functools.lru_cache(maxsize=None)
+def foam_square(nodes: int = 2000) -> tuple[ElasticObject, tuple[int, int]]:
+    """The Sec. 5.5 square and the boundary nodes nearest (-0.05, 0) and (0.05, 0)."""
+    outline = shapes.rectangle(0.1, 0.1)
+    obj = ElasticObject(generate_mesh(outline, target_max_area(outline, nodes)), FOAM).precompute()
+    b = obj.mesh.boundary
+    pts = obj.mesh.nodes[b]
+    ends = tuple(int(b[np.argmin(np.linalg.norm(pts - p, axis=1))]) for p in ([-0.05, 0], [0.05, 0]))
+    return obj, ends
+
+
+@functools.lru_cache(maxsize=None)
+def symmetric_square(cells: int = 16) -> tuple[ElasticObject, tuple[int, int]]:
+    """A structured square mesh symmetric about both axes (each cell split at its centre)."""
+    h = 0.1 / cells
+    g = np.linspace(-0.05, 0.05, cells + 1)
+    X, Y = np.meshgrid(g, g, indexing="ij")
+    corners = np.column_stack([X.ravel(), Y.ravel()])
+    cx, cy = np.meshgrid(g[:-1] + h / 2, g[:-1] + h / 2, indexing="ij")
+    centres = np.column_stack([cx.ravel(), cy.ravel()])
+    nodes = np.vstack([corners, centres])
+    tris = []
+    for i in range(cells):
+        for j in range(cells):
+            a, b = i * (cells + 1) + j, (i + 1) * (cells + 1) + j
+            c = len(corners) + i * cells + j
+            for p, q in ((a, b), (b, b + 1), (b + 1, a + 1), (a + 1, a)):
+                tris.append((p, q, c))
+    mesh = mesh_from_triangles(nodes, np.array(tris))
+    obj = ElasticObject(mesh, FOAM).precompute()
+    mid = cells // 2
+    return obj, (mid, cells * (cells + 1) + mid)
+
+
+def squeeze_directions(obj, contacts) -> dict:
+    u = plan_squeeze(obj, list(contacts)).displacement.reshape(2, 2)
+    return {"F1": u[0], "F2": u[1]}
+
+
+def start(obj, contacts, rel_per_depth: float = 0.0) -> ContactState:
+    tips = [place_fingertip(obj.mesh, n, c, RADIUS) for n, c in zip(("F1", "F2"), contacts)]
+    return initial_state(tips, rel_per_depth)
+
+
+def walk(model: ContactModel, state: ContactState, dirs: dict, depth: float, **kw):
+    """States after every event point of a squeeze to ``depth`` (Algorithm 1, one call per event)."""
+    out, done = [], 0.0
+    while done < depth * (1 - 1e-12):
+        r = advance(model, state, {k: (depth - done) * v for k, v in dirs.items()},
+                    stop_on_event=True, **kw)
+        done += r.state.depth - state.depth
+        state = r.state
+        out.append((r, state))
+        if r.termination:
+            break
+    return out
+
+
+def forces_and_field(model: ContactModel, state: ContactState):
+    obj = model.obj
+    L, fu = model.length, model.force_unit
+    sd = model.set_data(tuple(c.node for c in state.contacts))
+    delta = np.array([c.displacement for c in state.contacts]) / L
+    F = np.array([c.force for c in state.contacts]) / fu
+    return F * fu, model.full_displacement(sd, delta, F).reshape(-1, 2) * L
+
+
+def check_state(model: ContactModel, state: ContactState, tol: float = 1e-9) -> None:
+    """Equilibrium, friction cones and no penetration, from the full displacement field."""
+    obj = model.obj
+    mesh = obj.mesh
+    F, u = forces_and_field(model, state)
+    scale = np.abs(F).max()
+    nodes = np.array([c.node for c in state.contacts])
+    # equilibrium of the external forces and of the full FEM problem K u = f
+    assert np.abs(F.sum(axis=0)).max() < 1e-10 * scale
+    p = mesh.nodes[nodes]
+    assert abs(np.sum(p[:, 0] * F[:, 1] - p[:, 1] * F[:, 0])) < 1e-10 * scale * obj.scale
+    f_full = np.zeros(2 * mesh.n)
+    f_full[np.stack([2 * nodes, 2 * nodes + 1], 1).ravel()] = F.ravel()
+    K = obj.stiffness * obj.material.force_scale
+    assert np.abs(K @ u.ravel() - f_full).max() < 1e-8 * scale
+    # contact nodes lie on their tip circle; forces inside / on the friction cone
+    mu = model.mu
+    for c, f in zip(state.contacts, F):
+        tip = state.finger(c.finger)
+        x = mesh.nodes[c.node] + u[c.node]
+        assert abs(np.linalg.norm(x - tip.center) - tip.radius) < 1e-12
+        fn, ft = c.normal_force(), c.tangential_force()
+        assert np.allclose(f, c.force)
+        assert fn > -1e-6 * scale
+        if c.mode == "stick":
+            assert abs(ft) <= mu * fn + 1e-6 * scale
+        else:
+            assert abs(mu * fn - abs(ft)) < 1e-9 * scale
+            assert ft * c.slip <= 1e-9 * scale  # friction opposes the slip
+    # no non-contact boundary node inside a fingertip beyond the tolerance
+    free = np.setdiff1d(mesh.boundary, nodes)
+    centers = np.array([f.center for f in state.fingers])
+    radii = np.array([f.radius for f in state.fingers])
+    gaps = tip_gaps(mesh.nodes[free] + u[free], centers, radii)
+    assert gaps.min() > -10 * tol * obj.scale
+
+
+@pytest.mark.parametrize("mu", [0.4, 0.05])
+def test_invariants_hold_at_every_event(mu):
+    obj, contacts = foam_square()
+    model = ContactModel(obj, mu)
+    dirs = squeeze_directions(obj, contacts)
+    states = walk(model, start(obj, contacts), dirs, 0.0085)
+    events = [e for r, _ in states for e in r.events]
+    assert len(events) >= 12 and {e.type for e in events} >= {"A"}
+    if mu < 0.1:
+        assert {"C", "D"} <= {e.type for e in events}
+    for _, state in states:
+        check_state(model, state)
+    sizes = {f: len(states[-1][1].segment(f)) for f in ("F1", "F2")}
+    assert min(sizes.values()) >= 4
+
+
+@pytest.mark.parametrize("mu", [0.4, 0.05])
+def test_one_shot_invariant_by_independent_sparse_solve(mu):
+    obj, contacts = foam_square()
+    res = event_squeeze(obj, contacts, RADIUS, mu, relative_depth=0.12)
+    assert any(c.mode == "slip" for c in res.state.contacts) == (mu < 0.1)
+    shot = one_shot_solve(obj, res.state, mu)
+    F = np.array([c.force for c in res.state.contacts])
+    theta = np.array([c.theta for c in res.state.contacts])
+    sliding = any(c.mode == "slip" for c in res.state.contacts)
+    assert shot.iterations >= (2 if sliding else 1)  # sliding angles start perturbed
+    assert np.abs(shot.forces - F).max() < 1e-9 * np.abs(F).max()
+    assert np.abs(shot.theta - theta).max() < 1e-10
+    assert np.abs(shot.displacement - res.displacement).max() < 1e-9 * np.abs(res.displacement).max()
+
+
+def test_events_converge_as_the_tolerance_shrinks():
+    obj, contacts = foam_square()
+    runs = {tol: event_squeeze(obj, contacts, RADIUS, 0.05, relative_depth=0.12, event_tol=tol)
+            for tol in (1e-3, 1e-5, 1e-7, 1e-9)}
+    fine = runs[1e-9]
+    fine_events = [(e.type, e.node) for e in fine.events]
+    F_fine = np.array([c.force for c in fine.state.contacts])
+    errors = {}
+    for tol in (1e-5, 1e-7):
+        r = runs[tol]
+        assert [(e.type, e.node) for e in r.events] == fine_events
+        depth_err = max(abs(a.depth - b.depth) for a, b in zip(r.events, fine.events))
+        assert depth_err <= 2 * tol * obj.scale
+        F = np.array([c.force for c in r.state.contacts])
+        errors[tol] = np.abs(F - F_fine).max()
+    assert errors[1e-7] < errors[1e-5] or errors[1e-5] < 1e-12 * np.abs(F_fine).max()
+    assert errors[1e-7] < 1e-4 * np.abs(F_fine).max()
+
+
+def test_results_do_not_depend_on_the_step_beyond_the_tolerance():
+    obj, contacts = foam_square()
+    a = event_squeeze(obj, contacts, RADIUS, 0.05, relative_depth=0.12, step=1e-3)
+    b = event_squeeze(obj, contacts, RADIUS, 0.05, relative_depth=0.12, step=2.7e-4)
+    assert [(e.type, e.node) for e in a.events] == [(e.type, e.node) for e in b.events]
+    assert max(abs(x.depth - y.depth) for x, y in zip(a.events, b.events)) < 3e-9 * obj.scale
+    Fa = np.array([c.force for c in a.state.contacts])
+    Fb = np.array([c.force for c in b.state.contacts])
+    assert np.abs(Fa - Fb).max() < 1e-6 * np.abs(Fa).max()
+
+
+@pytest.mark.parametrize("mu", [0.4, 0.05])
+def test_symmetric_scene_gives_symmetric_results(mu):
+    obj, contacts = symmetric_square()
+    mesh = obj.mesh
+    res = event_squeeze(obj, contacts, RADIUS, mu, relative_depth=0.12)
+    assert res.event_counts["A"] >= 4
+
+    def mirror(node, axis):
+        p = mesh.nodes[node] * (np.array([-1, 1]) if axis == 0 else np.array([1, -1]))
+        return int(np.argmin(np.linalg.norm(mesh.nodes - p, axis=1)))
+
+    forces = {c.node: c for c in res.state.contacts}
+    scale = max(np.abs(c.force).max() for c in res.state.contacts)
+    for c in res.state.contacts:
+        lr = forces[mirror(c.node, 0)]  # F1 <-> F2: x -> -x
+        ud = forces[mirror(c.node, 1)]  # within a segment: y -> -y
+        assert lr.mode == c.mode and ud.mode == c.mode
+        assert np.allclose(lr.force, c.force * [-1, 1], atol=1e-8 * scale)
+        assert np.allclose(ud.force, c.force * [1, -1], atol=1e-8 * scale)
+        assert ud.slip == -c.slip and lr.slip == -c.slip
+    by_node = {}
+    for e in res.events:
+        by_node.setdefault((e.type, e.node), e.depth)
+    for (kind, node), depth in by_node.items():
+        for axis in (0, 1):
+            assert abs(by_node[(kind, mirror(node, axis))] - depth) < 1e-8 * obj.scale
+    assert res.work["F1"] == pytest.approx(res.work["F2"], rel=1e-8)
+
+
+def test_path_with_direction_changes_equals_one_step_when_no_event_occurs():
+    obj, contacts = foam_square()
+    model = ContactModel(obj, 0.05)
+    dirs = squeeze_directions(obj, contacts)
+    state = walk(model, start(obj, contacts), dirs, 0.004)[-1][1]
+    sliding = [c for c in state.contacts if c.mode == "slip"]
+    assert sliding, "the test needs sliding nodes to be meaningful"
+    total = {k: 2e-5 * v for k, v in dirs.items()}
+    one = advance(model, state, total)
+    kink = np.array([0.0, 4e-6])
+    pieces = [{"F1": 0.3 * total["F1"] + kink, "F2": 0.5 * total["F2"]},
+              {"F1": 0.2 * total["F1"] - 2 * kink, "F2": 0.5 * total["F2"] + kink},
+              {"F1": 0.5 * total["F1"] + kink, "F2": -kink}]
+    s = state
+    for piece in pieces:
+        r = advance(model, s, piece)
+        assert not r.events
+        s = r.state
+    assert not one.events
+    for a, b in zip(one.state.contacts, s.contacts):
+        assert a.node == b.node and a.mode == b.mode
+        assert np.allclose(a.force, b.force, rtol=0, atol=1e-12 * np.abs(a.force).max())
+        assert a.theta == pytest.approx(b.theta, abs=1e-13)
+
+
+def test_reference_mode_reproduces_the_located_events():
+    obj, contacts = foam_square(800)
+    fast = event_squeeze(obj, contacts, RADIUS, 0.05, relative_depth=0.12)
+    ref = event_squeeze(obj, contacts, RADIUS, 0.05, relative_depth=0.12, step=1e-4,
+                        reference=True)
+    assert [(e.type, e.node) for e in ref.events] == [(e.type, e.node) for e in fast.events]
+    for e_ref, e_fast in zip(ref.events, fast.events):
+        assert 0 <= e_ref.depth - e_fast.depth <= 2e-4 * obj.scale
+    Ff = np.array([c.force for c in fast.state.contacts])
+    Fr = np.array([c.force for c in ref.state.contacts])
+    assert np.abs(Ff - Fr).max() < 1e-2 * np.abs(Ff).max()
+
+
+def test_all_stick_work_equals_strain_energy_and_slip_dissipates():
+    obj, contacts = foam_square()
+    stuck = event_squeeze(obj, contacts, RADIUS, 1.0, relative_depth=0.12)
+    assert all(c.mode == "stick" for c in stuck.state.contacts)
+    assert sum(stuck.work.values()) == pytest.approx(stuck.energy, rel=1e-6)
+    slippery = event_squeeze(obj, contacts, RADIUS, 0.05, relative_depth=0.12)
+    assert sum(slippery.work.values()) >= slippery.energy * (1 - 1e-9)
+
+
+def test_non_force_closure_placement_slips_at_once():
+    obj, contacts = foam_square()
+    tilt = abs(np.diff(obj.mesh.nodes[list(contacts), 1])[0]) / 0.1
+    res = event_squeeze(obj, contacts, RADIUS, 0.5 * tilt, relative_depth=0.12)
+    assert res.termination == "finger_slip" and res.depth == 0.0
+
+
+def test_chattering_bound_freezes_modes_and_terminates():
+    obj, contacts = foam_square()
+    free = event_squeeze(obj, contacts, RADIUS, 0.05, relative_depth=0.12)
+    capped = event_squeeze(obj, contacts, RADIUS, 0.05, relative_depth=0.12,
+                           max_events_per_depth=1, step=0.02)
+    assert capped.termination == "depth_reached"
+    assert capped.chatter and len(capped.events) <= len(free.events)
+    window = 0.02 * obj.scale
+    for e in capped.events:
+        same = [x for x in capped.events if x.node == e.node and 0 <= e.depth - x.depth < window]
+        assert len(same) <= 1
+
+
+def test_three_fingers_and_arbitrary_translations():
+    obj, contacts = foam_square(800)
+    mesh = obj.mesh
+    b = mesh.boundary
+    top = int(b[np.argmin(np.linalg.norm(mesh.nodes[b] - [0.0, 0.05], axis=1))])
+    tips = [place_fingertip(mesh, n, c, RADIUS) for n, c in zip(("F1", "F2", "A"), (*contacts, top))]
+    model = ContactModel(obj, 0.8)
+    state = initial_state(tips)
+    r = advance(model, state, {"F1": (0.002, 0.0), "F2": (-0.002, 0.0), "A": (0.0, -0.0016)})
+    assert r.termination is None and r.fraction == 1.0
+    assert {e.finger for e in r.events} == {"F1", "F2", "A"}
+    check_state(model, r.state)
+    r2 = advance(model, r.state, {"A": (0.0003, -0.0002)})
+    assert r2.fraction == 1.0
+    assert r2.state.finger("F1").translation == pytest.approx([0.002, 0.0])
+    assert r2.state.finger("A").translation == pytest.approx([0.0003, -0.0018])
+    check_state(model, r2.state)

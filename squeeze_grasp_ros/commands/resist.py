@@ -9,14 +9,20 @@ import time
 import numpy as np
 
 from .. import plots
+from ..mechanics.contact_model import ContactModel
 from ..mechanics.errors import MechanicsError
 from ..mechanics.reduced import displacement_field
 from ..mechanics.resistance import (FINGERS, MODES, Resistance, ResistanceGrasp,
                                     ResistanceSweep, compare_resistances, contact_segments,
                                     expansion_matrix, optimal_resistance, resistance_along,
                                     resistance_grasp, sweep_directions)
+from ..mechanics.resistance_friction import (FrictionalResistance, add_adversary,
+                                             frictional_resistance)
+from ..mechanics.squeeze_events import grasp_health
 from ..scene import SceneError, placement_node
-from .common import add_plot_argument, add_scene_argument, add_solver_argument, load_solid
+from ..scene_events import event_squeeze_scene
+from .common import (LoadedScene, add_plot_argument, add_scene_argument, add_solver_argument,
+                     load_solid)
 
 HELP = "optimal stable/pure resistance of F1, F2 to the scene's adversary finger A (Sec. 6)"
 CONTACT_MODELS = ("point", "segment", "friction")
@@ -38,18 +44,51 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     add_plot_argument(parser)
 
 
-def build_grasp(loaded, contact_model: str, half_width: float | None) -> ResistanceGrasp:
-    """The fixed-contact problem of the scene's F1, F2 and adversary placements."""
-    scene, obj = loaded.scene, loaded.obj
-    k = placement_node(obj.mesh, scene.adversary.placement, "adversary")
+def adversary_node(loaded: LoadedScene) -> int:
+    """The adversary's initial contact node (distinct from F1's and F2's)."""
+    k = placement_node(loaded.obj.mesh, loaded.scene.adversary.placement, "adversary")
     if k in loaded.contacts:
         raise SceneError("adversary.placement is on the same boundary node as F1 or F2")
-    nodes = [*loaded.contacts, k]
+    return k
+
+
+def build_grasp(loaded: LoadedScene, contact_model: str, half_width: float | None) -> ResistanceGrasp:
+    """The fixed-contact problem of the scene's F1, F2 and adversary placements."""
+    nodes = [*loaded.contacts, adversary_node(loaded)]
     if contact_model == "point":
         sets = [[n] for n in nodes]
     else:
-        sets = contact_segments(obj.mesh, nodes, half_width)
-    return resistance_grasp(obj, dict(zip(FINGERS, sets)))
+        sets = contact_segments(loaded.obj.mesh, nodes, half_width)
+    return resistance_grasp(loaded.obj, dict(zip(FINGERS, sets)))
+
+
+def run_friction(loaded: LoadedScene, mode: str, plot_path: str | None) -> dict:
+    """Algorithm 2 after the scene's event-driven squeeze (frictional segment contacts)."""
+    scene, obj = loaded.scene, loaded.obj
+    adv = scene.adversary
+    k = adversary_node(loaded)
+    start = time.perf_counter()
+    obj.precompute()
+    t_pre = time.perf_counter() - start
+    start = time.perf_counter()
+    squeeze = event_squeeze_scene(scene, obj, loaded.contacts)
+    t_squeeze = time.perf_counter() - start
+    model = ContactModel(obj, scene.mu, max_events_per_depth=scene.squeeze.max_events_per_depth)
+    start = time.perf_counter()
+    state = add_adversary(squeeze.state, model, squeeze.displacement, k, adv.tip_radius)
+    res = frictional_resistance(model, state, adv.a, mode, squeeze.step, squeeze.event_tol,
+                                contacts=[*loaded.contacts, k])
+    timing = {"precompute_s": t_pre, "squeeze_s": t_squeeze,
+              "resistance_s": time.perf_counter() - start}
+    out = {"scene": scene.name, **res.to_json(),
+           "contact_points": obj.mesh.nodes[res.contacts].tolist(),
+           "squeeze": {"termination": squeeze.termination, "depth": squeeze.depth,
+                       "event_counts": squeeze.event_counts,
+                       "work": dict(squeeze.work)},
+           "timing": timing}
+    if plot_path:
+        plot_friction(model, squeeze.displacement, res, plot_path)
+    return out
 
 
 def run(args: argparse.Namespace) -> dict:
@@ -62,8 +101,7 @@ def run(args: argparse.Namespace) -> dict:
     mode = args.mode or adv.mode
     contact_model = args.contacts or adv.contacts
     if contact_model == "friction":
-        raise MechanicsError("--contacts friction (Algorithm 2) needs the event-driven stepper, "
-                             "which is not available yet; use --contacts point or segment")
+        return run_friction(loaded, mode, args.plot)
     if args.directions is not None and args.directions < 1:
         raise MechanicsError(f"--directions must be >= 1, got {args.directions}")
     half_width = args.segment_half_width
@@ -131,11 +169,50 @@ def plot(grasp: ResistanceGrasp, res: Resistance, sweep: ResistanceSweep | None,
     plots.save(fig, path)
 
 
+def draw_tips(ax, mesh, res: FrictionalResistance, which: str, displacement) -> None:
+    """Deformed outline with the fingertips and contact nodes (solid: stick, hollow: slip)."""
+    state = res.start_state if which == "start" else res.state
+    plots.draw_outline(ax, mesh, color="0.75", lw=0.8)
+    plots.draw_outline(ax, mesh, displacement)
+    for color, f in zip(("C0", "C1", "C3"), FINGERS):
+        tip = state.finger(f)
+        circle = tip.center + tip.radius * np.column_stack([np.cos(np.linspace(0, 2 * np.pi, 121)),
+                                                            np.sin(np.linspace(0, 2 * np.pi, 121))])
+        ax.plot(circle[:, 0], circle[:, 1], color=color, lw=1.0)
+        nodes = state.segment(f)
+        plots.mark_nodes(ax, np.array([mesh.nodes[c.node] + c.displacement for c in nodes]),
+                         [c.mode == "stick" for c in nodes], color, 14, f"{f} ({len(nodes)})")
+    ax.legend(loc="lower right", fontsize=7)
+
+
+def plot_friction(model: ContactModel, squeezed: np.ndarray, res: FrictionalResistance,
+                  path: str) -> None:
+    """Fig. 10: (a) after the squeeze with A touching; (b) at the end of the resistance;
+    (c) the fingers' trajectories from a common origin."""
+    mesh = model.obj.mesh
+    fig, axes = plots.figure(3)
+    draw_tips(axes[0], mesh, res, "start", squeezed)
+    axes[0].set_title("squeezed, A touching", fontsize=9)
+    draw_tips(axes[1], mesh, res, "end", grasp_health(model, res.state)[1])
+    axes[1].set_title(f"{res.reason} after {1e3 * res.travelled:.3f} mm", fontsize=9)
+    ax = axes[2]
+    for color, f in zip(("C0", "C1", "C3"), FINGERS):
+        ax.plot(*(1e3 * res.trajectories[f]).T, ".-", color=color, ms=3, label=f)
+    ax.set_aspect("equal")
+    ax.set_xlabel("x [mm]")
+    ax.set_ylabel("y [mm]")
+    ax.legend(fontsize=7)
+    ax.set_title(f"trajectories, W_F = {res.work['total']:.3g} J", fontsize=9)
+    plots.save(fig, path)
+
+
 def summary(result: dict) -> str:
     """Human-readable resistance report."""
     i, j, k = result["contacts"]
     head = (f"{result['mode']} resistance, {result['contact_model']} contacts at nodes "
             f"F1 {i}, F2 {j}, A {k}; a = {np.round(result['a'], 6).tolist()} m")
+    if result["contact_model"] == "friction":
+        return friction_summary(head, result)
     if not result["success"]:
         return f"{head}\n{result['reason']}"
     w = result["work"]
@@ -155,4 +232,19 @@ def summary(result: dict) -> str:
         lines.append(f"sweep of {len(sweep['angles_deg'])} directions: W*_F per unit push "
                      f"{sweep['min']['unit_work']:.4g} J/m^2 at {sweep['min']['angle_deg']:.1f} deg "
                      f"to {sweep['max']['unit_work']:.4g} J/m^2 at {sweep['max']['angle_deg']:.1f} deg")
+    return "\n".join(lines)
+
+
+def friction_summary(head: str, result: dict) -> str:
+    """Human-readable Algorithm 2 report (Table 3 style)."""
+    w, along = result["work"], result["force_along"]
+    counts = ", ".join(f"{k} {v}" for k, v in result["event_counts"].items())
+    lines = [head,
+             f"{'success' if result['success'] else 'failure'}: {result['reason']} after A "
+             f"travelled {1e3 * result['travelled']:.4g} mm in {len(result['stages'])} stages; "
+             f"events {counts}",
+             f"d1 = {np.round(result['d1'], 6).tolist()} m, d2 = {np.round(result['d2'], 6).tolist()} m",
+             f"{'':4s}{'force start [N]':>17s}{'force end [N]':>15s}{'work [J]':>12s}"]
+    lines += [f"{f:4s}{along[f]['start']:17.4g}{along[f]['end']:15.4g}{w[f]:12.4g}" for f in FINGERS]
+    lines.append(f"W_F = {w['total']:.5g} J (forces along each finger's motion, Table 3)")
     return "\n".join(lines)

@@ -54,6 +54,19 @@ EFFECTS: dict[str, str] = {
 }
 """Every effect a scene may declare, with what it requires."""
 
+DEVICES: dict[str, str] = {
+    "barrett_f1": "finger 1 of the Barrett BH8 hand",
+    "barrett_f2": "finger 2 of the Barrett BH8 hand",
+    "barrett_f3": "finger 3 (the thumb) of the Barrett BH8 hand",
+    "cobra": "Cobra-style arm carrying a rounded fingertip",
+    "pusher": "linear pusher carrying the adversary fingertip",
+}
+"""Devices a finger may be mapped to (``fingers.<F>.device``, ``adversary.device``)."""
+
+DEFAULT_DEVICES: dict[str, str] = {"F1": "barrett_f1", "F2": "barrett_f3", "A": "pusher"}
+"""Device of a finger whose scene entry leaves ``device`` empty (Sec. 5.5: both squeezing
+fingers on the Barrett hand; Sec. 6.4: the adversary on the pusher)."""
+
 SHAPES: dict[str, tuple[str, ...]] = {
     "rectangle": ("width", "height"),
     "square": ("side",),
@@ -122,7 +135,8 @@ class FingerSpec:
 
     placement: PlacementSpec = spec("initial contact")
     tip_radius: float = spec("fingertip radius (0 = point finger)", "m", lo=0.0, default=0.0)
-    device: str = spec("device driving this finger", default="")
+    device: str = spec("device driving this finger (empty: DEFAULT_DEVICES)",
+                       choices=("",) + tuple(DEVICES), default="")
     direction: Optional[tuple[float, float]] = spec(
         "translation direction for the event-driven squeeze (both F1 and F2 or neither; "
         "overrides squeeze.type; normalised)", "", default=None)
@@ -177,7 +191,8 @@ class AdversarySpec:
     tip_radius: float = spec("fingertip radius of A", "m", lo=0.0, default=0.0)
     mode: str = spec("resistance type", choices=("stable", "pure"), default="stable")
     contacts: str = spec("contact model", choices=("point", "segment", "friction"), default="point")
-    device: str = spec("device driving A", default="")
+    device: str = spec("device driving A (empty: DEFAULT_DEVICES)", choices=("",) + tuple(DEVICES),
+                       default="")
     segment_half_width: Optional[float] = spec(
         "contacts: segment: each finger's fixed segment is the boundary nodes within this arc "
         "length of its contact node (default: the node and its two neighbours)", "m", lo=0.0,
@@ -186,6 +201,43 @@ class AdversarySpec:
         "line of F1's translation d1 of a user-given resistance to compare with the optimum "
         "(Table 4); d2 and the length of d1 follow from the resistance constraints", "",
         default=None)
+
+
+@dataclass(frozen=True)
+class SensorsSpec:
+    """Fingertip sensors of the simulated hardware (effects: force_sensing, tactile_sensing,
+    sensor_noise, sensor_dropout)."""
+
+    noise_std: Optional[float] = spec("std of the Gaussian noise on every force reading (wrench "
+                                      "force components and taxel forces; torques get "
+                                      "noise_std * tip radius) (effect: sensor_noise)", "N",
+                                      lo=0.0, lo_open=True, default=None)
+    dropout: Optional[float] = spec("probability that a wrench or tactile message of a tick is "
+                                    "dropped (effect: sensor_dropout)", "", lo=0.0, hi=1.0,
+                                    default=None)
+    seed: Optional[int] = spec("seed of the noise and dropout draws (required with either)", "",
+                               lo=0, default=None)
+    taxels: int = spec("taxels per fingertip tactile array (effect: tactile_sensing)", "", lo=2,
+                       default=64)
+    taxel_span_deg: float = spec("arc of the fingertip covered by the tactile array, centred on "
+                                 "the initial contact", "deg", lo=0.0, hi=360.0, lo_open=True,
+                                 default=150.0)
+
+
+@dataclass(frozen=True)
+class ActuatorsSpec:
+    """Dynamics of the finger actuators (effect: actuator_lag)."""
+
+    time_constant: float = spec("first-order lag time constant of every finger actuator", "s",
+                                lo=0.0, lo_open=True)
+
+
+@dataclass(frozen=True)
+class SimSpec:
+    """The simulated world's clock (no effect needed)."""
+
+    dt: float = spec("lockstep tick: sim-time step of the simulated hardware", "s", lo=0.0,
+                     hi=1.0, lo_open=True, default=1e-3)
 
 
 @dataclass(frozen=True)
@@ -202,6 +254,11 @@ class Scene:
     pickup: Optional[PickupSpec] = spec("pickup (effect: pickup)", default=None)
     adversary: Optional[AdversarySpec] = spec("adversary finger (effect: adversary)", default=None)
     effects: tuple[str, ...] = spec("declared effects, see EFFECTS", default=())
+    sensors: Optional[SensorsSpec] = spec("fingertip sensors (effects: sensor_noise, sensor_dropout;"
+                                          " taxel layout with tactile_sensing)", default=None)
+    actuators: Optional[ActuatorsSpec] = spec("actuator dynamics (effect: actuator_lag)",
+                                              default=None)
+    sim: SimSpec = spec("simulated clock", default_factory=SimSpec)
 
     @property
     def mu(self) -> float:
@@ -214,7 +271,11 @@ class Scene:
 
 
 SECTION_EFFECT = {"friction": "friction", "strain_limit": "strain_limit", "pickup": "pickup",
-                  "adversary": "adversary"}
+                  "adversary": "adversary", "actuators": "actuator_lag"}
+
+SENSOR_FIELD_EFFECT = {"noise_std": "sensor_noise", "dropout": "sensor_dropout"}
+"""Fields of the ``sensors`` section that exist exactly when their effect is declared."""
+SENSING_EFFECTS = ("force_sensing", "tactile_sensing")
 
 
 def _describe(meta: dict) -> str:
@@ -364,6 +425,8 @@ def _validate(scene: Scene) -> Scene:
                              "in effects")
         if scene.has(effect) and not present:
             raise SceneError(f"effect {effect!r} is declared but section {section} is missing")
+    _validate_sensors(scene)
+    _validate_devices(scene)
     obj = scene.object
     if obj.model == "ring" and obj.ring is None:
         raise SceneError("object.model is ring but object.ring is missing")
@@ -376,6 +439,54 @@ def _validate(scene: Scene) -> Scene:
     except MechanicsError as exc:
         raise SceneError(f"object.{exc}") from None
     return scene
+
+
+def _validate_sensors(scene: Scene) -> None:
+    """``sensors`` fields exist exactly with their effects; noise and dropout need a sensor."""
+    sensors = scene.sensors
+    for name, effect in SENSOR_FIELD_EFFECT.items():
+        present = sensors is not None and getattr(sensors, name) is not None
+        if present and not scene.has(effect):
+            raise SceneError(f"sensors.{name} is given but effect {effect!r} is not declared in "
+                             "effects")
+        if scene.has(effect) and not present:
+            raise SceneError(f"effect {effect!r} is declared but sensors.{name} is missing")
+        if scene.has(effect) and not any(scene.has(e) for e in SENSING_EFFECTS):
+            raise SceneError(f"effect {effect!r} needs a sensor to act on: declare "
+                             "force_sensing or tactile_sensing")
+    if sensors is None:
+        return
+    randomised = any(getattr(sensors, name) is not None for name in SENSOR_FIELD_EFFECT)
+    if randomised and sensors.seed is None:
+        raise SceneError("sensors.seed is required with sensors.noise_std or sensors.dropout "
+                         "(runs must be reproducible)")
+    if sensors.seed is not None and not randomised:
+        raise SceneError("sensors.seed is given but there is no sensor_noise or sensor_dropout")
+    defaults = SensorsSpec()
+    changed = [f for f in ("taxels", "taxel_span_deg") if getattr(sensors, f) != getattr(defaults, f)]
+    if changed and not scene.has("tactile_sensing"):
+        raise SceneError(f"sensors.{changed[0]} is given but effect 'tactile_sensing' is not "
+                         "declared in effects")
+    if not randomised and not changed:
+        raise SceneError("section sensors is given but sets nothing the declared effects use")
+
+
+def finger_devices(scene: Scene) -> dict[str, str]:
+    """Finger name -> device name (``DEVICES``) of every finger of the scene, adversary included."""
+    given = {name: spec_.device for name, spec_ in scene.fingers.items()}
+    if scene.adversary is not None:
+        given["A"] = scene.adversary.device
+    return {name: device or DEFAULT_DEVICES[name] for name, device in sorted(given.items())}
+
+
+def _validate_devices(scene: Scene) -> None:
+    """No two fingers on one device."""
+    seen: dict[str, str] = {}
+    for name, device in finger_devices(scene).items():
+        if device in seen:
+            raise SceneError(f"fingers {seen[device]} and {name} are both mapped to device "
+                             f"{device!r}; give each finger its own device")
+        seen[device] = name
 
 
 def parse_scene(data: Any, base_dir: Path | None = None) -> Scene:

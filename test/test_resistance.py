@@ -21,8 +21,8 @@ from squeeze_grasp_ros.mechanics.mesh import generate_mesh, mesh_from_triangles
 from squeeze_grasp_ros.mechanics.reduced import displacement_field
 from squeeze_grasp_ros.mechanics.resistance import (
     FINGERS, ResistanceGrasp, compare_resistances, contact_segments, evaluate_resistance,
-    expansion_matrix, optimal_resistance, pure_form, resistance_along, resistance_grasp,
-    sweep_directions)
+    optimal_resistance, resistance_along, resistance_grasp, sweep_directions)
+from squeeze_grasp_ros.mechanics.resistance_forms import expansion_matrix, pure_form
 
 SCENES = "config/scenes"
 

@@ -14,8 +14,9 @@ from ..mechanics.errors import MechanicsError
 from ..mechanics.reduced import displacement_field
 from ..mechanics.resistance import (FINGERS, MODES, Resistance, ResistanceGrasp,
                                     ResistanceSweep, compare_resistances, contact_segments,
-                                    expansion_matrix, optimal_resistance, resistance_along,
-                                    resistance_grasp, sweep_directions)
+                                    optimal_resistance, resistance_along, resistance_grasp,
+                                    sweep_directions)
+from ..mechanics.resistance_forms import expansion_matrix
 from ..mechanics.resistance_friction import (FrictionalResistance, add_adversary,
                                              frictional_resistance)
 from ..mechanics.squeeze_events import grasp_health

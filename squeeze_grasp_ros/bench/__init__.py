@@ -9,5 +9,6 @@ A section module defines ``TITLE`` and ``run(quick: bool, out_dir: Path, progres
 SECTIONS: tuple[str, ...] = (
     "convergence",
     "solvers",
+    "events",
 )
 """Module names of the benchmark sections, in report order."""

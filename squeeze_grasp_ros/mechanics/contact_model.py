@@ -303,13 +303,15 @@ class ContactModel:
 
     @property
     def length(self) -> float:
-        """L, m."""
-        return self.obj.scale
+        """L, m (cached: the object's scale is recomputed from the mesh on every access)."""
+        if "length" not in self._cache:
+            self._cache["length"] = self.obj.scale
+        return self._cache["length"]
 
     @property
     def force_unit(self) -> float:
         """E h L, N: the force unit inside."""
-        return self.obj.material.force_scale * self.obj.scale
+        return self.obj.material.force_scale * self.length
 
     @property
     def boundary_nodes(self) -> np.ndarray:

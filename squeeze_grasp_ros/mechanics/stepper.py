@@ -681,17 +681,21 @@ class _Run:
             return term
         hs = self.step / self.rate
         tol_s = self.tol / self.rate
+        rows, va = None, None
         while self.s < 1.0:
             a = self.s
             depth_a = self.depth_at(a)
-            rows = self.free_rows(depth_a)
-            va = self.entries(self.values(sol, a, rows), rows, depth_a)
+            free = self.free_rows(depth_a)
+            if va is None or not np.array_equal(free, rows):
+                rows = free
+                va = self.entries(self.values(sol, a, rows), rows, depth_a)
             b, sol_b = self.substep(sol, a, min(a + hs, 1.0))
             self.diag["substeps"] += 1
             vb = self.entries(self.values(sol_b, b, rows), rows, depth_a)
             crossed = self.crossings(va, vb, self.fresh)
             if crossed and not self.model.reference:
                 b, sol_b = self.earliest(crossed, sol, sol_b, a, b, tol_s, dict(va), dict(vb))
+            va = None if crossed else vb
             self.integrate_work(sol, sol_b, a, b)
             self.s = 1.0 if b >= 1.0 else b
             self.fresh = set()

@@ -11,6 +11,8 @@ VERBS: tuple[str, ...] = (
     "mesh",
     "plan",
     "squeeze",
+    "match",
+    "calibrate",
     "graspmap",
     "resist",
     "ring",

@@ -15,13 +15,15 @@ from ..mechanics.fingertips import unit
 from ..mechanics.squeeze_events import EventSqueeze
 from ..scene_events import event_squeeze_scene
 from .common import add_plot_argument, add_scene_argument, add_solver_argument, load_solid
+from .csv_io import write_points
 
 HELP = "event-driven squeeze with rounded fingertips under Coulomb friction (Sec. 5, Algorithm 1)"
 BAR_WIDTH = 30
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    """SCENE, --depth | --relative-depth, --step, --event-tol, --reference, --solver, --plot."""
+    """SCENE, --depth | --relative-depth, --step, --event-tol, --reference, --save-boundary,
+    --solver, --plot."""
     add_scene_argument(parser)
     depth = parser.add_mutually_exclusive_group()
     depth.add_argument("--depth", type=float, metavar="RHO",
@@ -36,6 +38,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--reference", action="store_true",
                         help="the paper's literal route: fixed step H, a full solve per step, "
                              "events at step ends (for cross-checks and timing)")
+    parser.add_argument("--save-boundary", metavar="FILE.csv",
+                        help="write the deformed outer boundary (x,y per node, m, loop order), "
+                             "e.g. for `squeeze-grasp match`")
     add_solver_argument(parser)
     add_plot_argument(parser)
 
@@ -81,6 +86,10 @@ def run(args: argparse.Namespace) -> dict:
            "timing": {"precompute_s": t_pre, "squeeze_s": t_run}}
     if args.plot:
         out["plot"] = plot(loaded.obj, res, args.plot)
+    if args.save_boundary:
+        loop = loaded.obj.mesh.boundary
+        out["boundary_csv"] = write_points(args.save_boundary,
+                                           loaded.obj.mesh.nodes[loop] + res.displacement[loop])
     return out
 
 
@@ -150,6 +159,7 @@ def summary(result: dict) -> str:
         lines.append(f"chattering bound froze {len(result['chatter'])} node mode(s)")
     t = result["timing"]
     lines.append(f"time: precompute {t['precompute_s']:.3f} s, squeeze {t['squeeze_s']:.3f} s")
-    if "plot" in result:
-        lines.append(f"plot: {result['plot']}")
+    for key in ("plot", "boundary_csv"):
+        if key in result:
+            lines.append(f"{key.replace('_', ' ')}: {result[key]}")
     return "\n".join(lines)

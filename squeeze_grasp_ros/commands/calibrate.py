@@ -1,0 +1,76 @@
+# Copyright 2026 squeeze_grasp_ros developers
+# SPDX-License-Identifier: Apache-2.0
+"""``squeeze-grasp calibrate``: E, nu from cuboid compressions and mu from a slope (App. B)."""
+from __future__ import annotations
+
+import argparse
+
+import numpy as np
+
+from ..mechanics.calibration import (Cuboid, calibrate_elasticity, friction_from_angle,
+                                     friction_from_trials)
+from ..mechanics.errors import MechanicsError
+from .csv_io import read_columns
+
+HELP = "Young's modulus, Poisson's ratio from cuboid compressions; mu from the slope angle (App. B)"
+CUBOID_COLUMNS = ("force", "length", "width", "height", "dl", "dw")
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    """--cuboids CSV, --slope-angle DEG | --slope-trials CSV."""
+    parser.add_argument("--cuboids", metavar="CUBOIDS.csv",
+                        help="compression measurements, columns force,length,width,height,dl,dw"
+                             "[,dh] (N, m; dl < 0 when shortened, dw, dh > 0 when bulging)")
+    slope = parser.add_mutually_exclusive_group()
+    slope.add_argument("--slope-angle", type=float, metavar="DEG",
+                       help="critical slope angle alpha0, degrees: mu = tan(alpha0)")
+    slope.add_argument("--slope-trials", metavar="TRIALS.csv",
+                       help="slope trials, columns angle_deg,slid (slid: 1/0 or true/false)")
+
+
+def _truth(cell: str) -> bool:
+    value = cell.strip().lower()
+    if value not in ("1", "0", "true", "false", "yes", "no"):
+        raise MechanicsError(f"slid must be 1/0, true/false or yes/no, got {cell!r}")
+    return value in ("1", "true", "yes")
+
+
+def run(args: argparse.Namespace) -> dict:
+    """The calibrated values."""
+    if not (args.cuboids or args.slope_angle is not None or args.slope_trials):
+        raise MechanicsError("give --cuboids and/or --slope-angle / --slope-trials")
+    out: dict = {}
+    if args.cuboids:
+        rows = read_columns(args.cuboids, CUBOID_COLUMNS, ("dh",))
+        try:
+            cuboids = [Cuboid(*(float(r[c]) for c in CUBOID_COLUMNS),
+                              float(r["dh"]) if r.get("dh") else None) for r in rows]
+        except ValueError as exc:
+            raise MechanicsError(f"{args.cuboids}: {exc}") from None
+        out["elasticity"] = calibrate_elasticity(cuboids).to_json()
+    if args.slope_angle is not None:
+        out["friction"] = friction_from_angle(np.radians(args.slope_angle)).to_json()
+    if args.slope_trials:
+        rows = read_columns(args.slope_trials, ("angle_deg", "slid"))
+        try:
+            trials = [(np.radians(float(r["angle_deg"])), _truth(r["slid"])) for r in rows]
+        except ValueError as exc:
+            raise MechanicsError(f"{args.slope_trials}: {exc}") from None
+        out["friction"] = friction_from_trials(trials).to_json()
+    return out
+
+
+def summary(result: dict) -> str:
+    """Human-readable calibration."""
+    lines = []
+    el = result.get("elasticity")
+    if el:
+        lines.append(f"E = {el['E']:.5g} Pa, nu = {el['nu']:.4g} from {len(el['per_cuboid'])} "
+                     f"cuboid(s) (relative rms residuals {el['E_residual']:.2g}, "
+                     f"{el['nu_residual']:.2g})")
+    fr = result.get("friction")
+    if fr:
+        lo, hi = fr["bracket_deg"]
+        lines.append(f"mu = {fr['mu']:.4g} (alpha0 = {fr['alpha0_deg']:.4g} deg"
+                     + (f", bracket {lo:.4g}-{hi:.4g} deg" if hi > lo else "") + ")")
+    return "\n".join(lines)

@@ -1,0 +1,66 @@
+# Copyright 2026 squeeze_grasp_ros developers
+# SPDX-License-Identifier: Apache-2.0
+"""Small CSV readers and writers for measured data (points, cuboids, slope trials).
+
+Lines starting with ``#`` and blank lines are ignored; a first line that is not numeric is a
+header naming the columns.
+"""
+from __future__ import annotations
+
+import csv
+from pathlib import Path
+
+import numpy as np
+
+from ..mechanics.errors import MechanicsError
+
+
+def read_table(path: str | Path) -> tuple[list[str] | None, list[list[str]]]:
+    """(header or None, rows of cells) of a CSV file."""
+    path = Path(path)
+    if not path.is_file():
+        raise MechanicsError(f"CSV file not found: {path}")
+    with path.open(newline="") as fh:
+        rows = [[c.strip() for c in row] for row in csv.reader(fh)
+                if row and not row[0].lstrip().startswith("#") and any(c.strip() for c in row)]
+    if not rows:
+        raise MechanicsError(f"{path}: no data rows")
+    try:
+        float(rows[0][0])
+    except ValueError:
+        return [c.lower() for c in rows[0]], rows[1:]
+    return None, rows
+
+
+def read_points(path: str | Path) -> np.ndarray:
+    """Points (n, 2), m, from ``x,y`` rows."""
+    header, rows = read_table(path)
+    try:
+        pts = np.array([[float(r[0]), float(r[1])] for r in rows])
+    except (ValueError, IndexError):
+        raise MechanicsError(f"{path}: every row must be 'x,y' (metres)") from None
+    if header is not None and header[:2] != ["x", "y"]:
+        raise MechanicsError(f"{path}: point columns must be x,y, got {header}")
+    return pts
+
+
+def read_columns(path: str | Path, required: tuple[str, ...],
+                 optional: tuple[str, ...] = ()) -> list[dict[str, str]]:
+    """Rows as {column: cell} of a CSV whose header has the ``required`` columns."""
+    header, rows = read_table(path)
+    if header is None:
+        raise MechanicsError(f"{path}: needs a header line with columns {', '.join(required)}")
+    missing = [c for c in required if c not in header]
+    unknown = [c for c in header if c not in required + optional]
+    if missing or unknown:
+        raise MechanicsError(f"{path}: columns must be {', '.join(required)}"
+                             f"{' [, ' + ', '.join(optional) + ']' if optional else ''}, got "
+                             f"{', '.join(header)}")
+    return [dict(zip(header, r)) for r in rows]
+
+
+def write_points(path: str | Path, points: np.ndarray) -> str:
+    """Write ``x,y`` rows (m) with a header; returns the path."""
+    np.savetxt(path, np.asarray(points, float), delimiter=",", header="x,y", comments="",
+               fmt="%.10g")
+    return str(path)

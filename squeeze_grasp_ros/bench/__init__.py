@@ -9,6 +9,7 @@ A section module defines ``TITLE`` and ``run(quick: bool, out_dir: Path, progres
 SECTIONS: tuple[str, ...] = (
     "convergence",
     "solvers",
+    "resistance",
     "events",
 )
 """Module names of the benchmark sections, in report order."""

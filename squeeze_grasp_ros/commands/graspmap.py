@@ -9,9 +9,12 @@ import numpy as np
 
 from .. import plots
 from ..mechanics.graspmap import GraspMap, grasp_map
+from ..scene import build_ring, load_scene
+from . import ring
 from .common import add_plot_argument, add_scene_argument, add_solver_argument, load_solid
 
-HELP = "all-pairs grasp map: stiffness, inwardness and force closure of every placement"
+HELP = ("all-pairs grasp map: stiffness, inwardness and force closure of every placement "
+        "(ring scenes: feasibility and maximum depth, Sec. 7)")
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -24,7 +27,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> dict:
-    """Map every placement pair of the scene's object."""
+    """Map every placement pair of the scene's object (solid or ring model)."""
+    scene = load_scene(args.scene)
+    if scene.object.model == "ring":
+        return ring.map_result(scene, build_ring(scene), scene.squeeze.relative_depth, args.plot)
     loaded = load_solid(args.scene, args.solver)
     gmap = grasp_map(loaded.obj, loaded.scene.mu)
     if args.plot:
@@ -54,6 +60,8 @@ def plot(obj, gmap: GraspMap, path: str) -> None:
 
 def summary(result: dict) -> str:
     """Counts and the best placements."""
+    if result["model"] == "ring":
+        return ring.summary(result)
     lines = [f"{result['pairs']} placements: {result['inward_pairs']} inward, "
              f"{result['force_closure_pairs']} force closure (mu={result['mu']}), "
              f"{result['feasible_pairs']} both",

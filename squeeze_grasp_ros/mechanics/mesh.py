@@ -10,6 +10,7 @@ counter-clockwise triangles of a planar straight-line graph can replace it.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 from typing import Protocol
 
 import numpy as np
@@ -74,12 +75,12 @@ class Mesh:
         """Number of nodes."""
         return len(self.nodes)
 
-    @property
+    @cached_property
     def size(self) -> float:
         """Characteristic length L, m: the larger side of the bounding box."""
         return float(np.ptp(self.nodes, axis=0).max())
 
-    @property
+    @cached_property
     def centroid(self) -> np.ndarray:
         """Area centroid of the object, m."""
         p = self.nodes[self.triangles]

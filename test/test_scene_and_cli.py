@@ -110,3 +110,11 @@ def test_cli_reports_bad_scene_with_exit_code_2(tmp_path, capsys):
     bad.write_text(yaml.safe_dump(mutate("object.material.nu", 0.9)))
     assert cli.main(["plan", str(bad)]) == 2
     assert "object.material.nu" in capsys.readouterr().err
+
+
+def test_graspmap_verb_serves_ring_scenes(capsys):
+    ring_scene = next(p for p in SCENES if p.name == "ring_ellipse.yaml")
+    out = run_json(capsys, "graspmap", str(ring_scene))
+    assert out["model"] == "ring"
+    assert out["pairs"] == out["elements"] * (out["elements"] - 1) // 2
+    assert sum(out["limits"].values()) == out["pairs"]

@@ -217,3 +217,29 @@ def test_degenerate_triangle_is_rejected():
 
 def test_contact_dofs_are_interleaved():
     assert node_dofs([3, 7]).tolist() == [6, 7, 14, 15]
+
+
+def _brute_force_crossing(p: np.ndarray) -> bool:
+    """Reference: every pair of non-adjacent edges, orientation tests."""
+    n, a, b = len(p), p, np.roll(p, -1, axis=0)
+
+    def orient(o, q, r):
+        return np.sign((q[0] - o[0]) * (r[1] - o[1]) - (q[1] - o[1]) * (r[0] - o[0]))
+
+    for i in range(n):
+        for j in range(i + 2, n):
+            if (i, j) == (0, n - 1):
+                continue
+            if (orient(a[i], b[i], a[j]) * orient(a[i], b[i], b[j]) < 0
+                    and orient(a[j], b[j], a[i]) * orient(a[j], b[j], b[i]) < 0):
+                return True
+    return False
+
+
+def test_sweep_self_intersection_check_equals_brute_force():
+    from squeeze_grasp_ros.mechanics.shapes import _segments_intersect
+
+    rng = np.random.default_rng(7)
+    for _ in range(400):
+        p = rng.random((rng.integers(4, 14), 2))
+        assert _segments_intersect(p) == _brute_force_crossing(p)

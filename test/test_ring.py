@@ -14,7 +14,8 @@ from squeeze_grasp_ros.mechanics.errors import MechanicsError
 from squeeze_grasp_ros.mechanics.material import Material
 from squeeze_grasp_ros.mechanics.reduced import reduce_blocks
 from squeeze_grasp_ros.mechanics.ring_map import ring_grasp_map
-from squeeze_grasp_ros.mechanics.ring_model import (RingModel, ring_diameter_changes,
+from squeeze_grasp_ros.mechanics.ring_model import (RingModel, circle_diametral_response,
+                                                    ring_diameter_changes,
                                                     ring_from_outline)
 from squeeze_grasp_ros.mechanics.ring_squeeze import (LIMITS, first_root, inward_normal,
                                                       normal_polynomial, polyval, ring_grasp)
@@ -38,21 +39,7 @@ def make_ring(kind="ellipse", elements=120, E=E, w=W, h=H) -> RingModel:
 
 def circle_diametral(elements: int, h=0.004, load=10.0):
     """FE diameter changes (along, across) and max fibre strain of the 0.04 m circle under +-load."""
-    ring = make_ring("disk", elements, h=h)
-    ang = np.arctan2(ring.points[:, 1], ring.points[:, 0])
-    top, bottom, left, right = (int(np.argmin(np.abs(np.angle(np.exp(1j * (ang - a))))))
-                                for a in (np.pi / 2, -np.pi / 2, np.pi, 0.0))
-    f = np.zeros((ring.n, 2))
-    f[top], f[bottom] = (0.0, -load), (0.0, load)
-    d, rot = ring.solve_loads(f)
-    q = ring.points + d
-    p = ring.points
-    along = np.linalg.norm(q[top] - q[bottom]) - np.linalg.norm(p[top] - p[bottom])
-    across = np.linalg.norm(q[left] - q[right]) - np.linalg.norm(p[left] - p[right])
-    field = np.zeros(3 * ring.n)
-    field[ring.translation_dofs] = d.reshape(-1) / ring.scale
-    field[2::3] = rot
-    return along, across, ring.fibre_strains(field).max()
+    return circle_diametral_response(elements, 0.04, E, W, h, load)
 
 
 def test_circle_converges_to_closed_form_at_second_order():

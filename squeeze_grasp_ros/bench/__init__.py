@@ -10,6 +10,7 @@ SECTIONS: tuple[str, ...] = (
     "convergence",
     "solvers",
     "resistance",
+    "ring",
     "events",
 )
 """Module names of the benchmark sections, in report order."""

@@ -55,7 +55,7 @@ import scipy.sparse as sp
 from .errors import MechanicsError, require_finite
 from .fem import rigid_modes, rotation_mode_norm
 from .material import Material
-from .shapes import Outline, resample, signed_area
+from .shapes import Outline, disk, resample, signed_area
 
 BANDWIDTH = 5
 """Upper bandwidth of the clamped stiffness (two nodes of three DOFs per element)."""
@@ -387,3 +387,26 @@ def ring_diameter_changes(radius: float, E: float, width: float, wall_thickness:
     along = -(bend * (np.pi / 4 - 2 / np.pi) + np.pi * load * radius / (4 * EA))
     across = bend * (2 / np.pi - 0.5) - load * radius / (2 * EA)
     return float(along), float(across)
+
+
+def circle_diametral_response(elements: int, radius: float, E: float, width: float,
+                              wall_thickness: float, load: float) -> tuple[float, float, float]:
+    """FE counterpart of :func:`ring_diameter_changes` on a circle of ``elements`` elements.
+
+    Returns the changes (m) of the diameter along and across two opposite diametral loads
+    ``load`` (N, a squeeze) and the largest fibre strain (dimensionless).
+    """
+    ring = ring_from_outline(disk(radius), Material(E, 0.0, width), wall_thickness, elements)
+    ang = np.arctan2(ring.points[:, 1], ring.points[:, 0])
+    top, bottom, left, right = (int(np.argmin(np.abs(np.angle(np.exp(1j * (ang - a))))))
+                                for a in (np.pi / 2, -np.pi / 2, np.pi, 0.0))
+    f = np.zeros((ring.n, 2))
+    f[top], f[bottom] = (0.0, -load), (0.0, load)
+    d, rot = ring.solve_loads(f)
+    p, q = ring.points, ring.points + d
+    along = np.linalg.norm(q[top] - q[bottom]) - np.linalg.norm(p[top] - p[bottom])
+    across = np.linalg.norm(q[left] - q[right]) - np.linalg.norm(p[left] - p[right])
+    field = np.zeros(3 * ring.n)
+    field[ring.translation_dofs] = d.reshape(-1) / ring.scale
+    field[2::3] = rot
+    return float(along), float(across), float(ring.fibre_strains(field).max())

@@ -59,28 +59,34 @@ def signed_area(points: np.ndarray) -> float:
 
 
 def _segments_intersect(p: np.ndarray) -> bool:
-    """True if any two non-adjacent edges of the closed polyline ``p`` intersect or touch."""
+    """True if any two non-adjacent edges of the closed polyline ``p`` properly cross.
+
+    Broad phase: edges sorted by their left end; each edge is only paired with the following
+    edges whose x-range starts before its own ends (a sweep over x), then with bounding-box
+    overlap in y; narrow phase: orientation tests on the surviving pairs.
+    """
     a, b = p, np.roll(p, -1, axis=0)
     n = len(p)
-    idx = np.arange(n)
-    for start in range(0, n, 256):
-        sl = slice(start, min(n, start + 256))
-        a1, b1 = a[sl, None, :], b[sl, None, :]
-        a2, b2 = a[None, :, :], b[None, :, :]
+    lo, hi = np.minimum(a, b), np.maximum(a, b)
+    order = np.argsort(lo[:, 0], kind="stable")
+    reach = np.searchsorted(lo[order, 0], hi[order, 0], side="right")
+    counts = reach - np.arange(n) - 1
+    first = np.repeat(np.arange(n), np.maximum(counts, 0))
+    second = first + 1 + (np.arange(len(first)) - np.repeat(np.cumsum(np.maximum(counts, 0))
+                                                             - np.maximum(counts, 0), np.maximum(counts, 0)))
+    i, j = order[first], order[second]
+    keep = (lo[i, 1] <= hi[j, 1]) & (lo[j, 1] <= hi[i, 1])
+    gap = np.abs(i - j)
+    keep &= (gap > 1) & (gap != n - 1)
+    i, j = i[keep], j[keep]
 
-        def orient(o, q, r):
-            return np.sign((q[..., 0] - o[..., 0]) * (r[..., 1] - o[..., 1])
-                           - (q[..., 1] - o[..., 1]) * (r[..., 0] - o[..., 0]))
+    def orient(o, q, r):
+        return np.sign((q[:, 0] - o[:, 0]) * (r[:, 1] - o[:, 1])
+                       - (q[:, 1] - o[:, 1]) * (r[:, 0] - o[:, 0]))
 
-        d1, d2 = orient(a1, b1, a2), orient(a1, b1, b2)
-        d3, d4 = orient(a2, b2, a1), orient(a2, b2, b1)
-        cross = (d1 * d2 < 0) & (d3 * d4 < 0)
-        i = idx[sl, None]
-        gap = np.abs(i - idx[None, :])
-        adjacent = (gap <= 1) | (gap == n - 1)
-        if np.any(cross & ~adjacent):
-            return True
-    return False
+    d1, d2 = orient(a[i], b[i], a[j]), orient(a[i], b[i], b[j])
+    d3, d4 = orient(a[j], b[j], a[i]), orient(a[j], b[j], b[i])
+    return bool(np.any((d1 * d2 < 0) & (d3 * d4 < 0)))
 
 
 def validate_polyline(points, name: str = "outline") -> np.ndarray:

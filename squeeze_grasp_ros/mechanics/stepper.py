@@ -31,23 +31,36 @@ the location: events are taken at the end of the fixed step, as in the paper.
 
 Processing at an event point (deterministic). Pending events are those whose function is
 <= 0, or, for functions that are zero by construction at that point (a new contact's force and
-cone margins, a freed node's gap, a just-stuck node's cone margin), whose derivative along the
-motion is negative. They are processed one at a time in the order
+cone margins, a freed node's gap, a just-stuck node's cone margin: the ``fresh`` keys of the
+state), whose derivative along the motion is negative. They are processed in the order
 
     B (break)  <  D (slip -> stick)  <  C (stick -> slip)  <  A (new contact),
 
-then by finger (F1, F2, A) and node index, re-solving after each. A new contact's mode (and
-the initial contacts' modes) is decided by hypothesis-and-test along the motion: stick if the
-force rate lies inside the cone, else slide in the direction whose slip rate and normal-force
-rate are consistent (options tried in the order stick, slip +1, slip -1; all combinations for
-up to three undecided nodes). After the contact events, terminations are checked in the order
-strain_limit < finger_slip < picked_up. A finger slips when all its contact nodes slide the
-same way (Sec. 5.1).
+then by finger (F1, F2, A) and node index, re-solving after each:
+
+* all new contacts pending at the point are added together and their modes decided jointly
+  by hypothesis-and-test along the motion (Algorithm 1 lines 2 and 13): stick if the force
+  rate stays inside the cone, else slide in the direction whose slip rate and normal-force
+  rate are consistent; options stick, slip +1, slip -1 in that order, every combination for up
+  to three nodes (the first consistent wins, else the fewest violations), node by node beyond;
+* a node whose C/D event would flip back at the same point has no consistent mode on its
+  own: the nodes with C/D events at the point are then decided jointly the same way, and
+  their events at the point are replaced by the net mode change;
+* finger slip (all contact nodes of a finger sliding the same way, Sec. 5.1) is checked after
+  every event and stops the processing; a break that would leave a finger without contact is
+  not applied and ends the call as ``contact_lost``.
+
+Then the terminations are checked in the order strain_limit < finger_slip < picked_up.
 
 Chattering bound: a node that would exceed ``model.max_events_per_depth`` events within one
-depth step is frozen in its current mode for one depth step (its events are not processed
-and it is reported as :class:`~.contact_state.Chatter`). Every loop advances s strictly, so a
-call always ends.
+depth step, flips again after a joint decision, or has a second A/B event at one point, is
+frozen in its current state for one depth step (its events are not processed; reported as
+:class:`~.contact_state.Chatter`). Every loop advances s strictly or processes a bounded
+number of events, so a call always ends.
+
+Between substeps the sliding angles are continued from the previous point (predictor
+theta + dtheta/ds ds, Newton with line search); a substep whose Newton solve is slow or lands
+off the predicted branch is halved.
 """
 from __future__ import annotations
 
@@ -61,7 +74,7 @@ from .contact_model import Configuration, ContactModel, Solution, solve_fixed_se
 from .contact_state import (Chatter, ContactNode, ContactState, Event, FingerState, Sample,
                             StepResult)
 from .errors import MechanicsError, require_finite
-from .fingertips import tip_gaps, unit
+from .fingertips import tip_gaps
 
 EVENT_ORDER = {"B": 0, "D": 1, "C+": 2, "C-": 2, "A": 3}
 """Processing order of simultaneous events (C+ and C- never coexist on one node)."""
@@ -124,10 +137,9 @@ def _locate(g: Callable[[float], float], a: float, b: float, ga: float, gb: floa
 
 @dataclass
 class _Values:
-    """Event-function values (and, where needed, derivatives) at one solution."""
+    """Event-function values at one solution (see the module table)."""
 
     fn: np.ndarray
-    ft: np.ndarray
     c_plus: np.ndarray
     c_minus: np.ndarray
     d: np.ndarray
@@ -230,46 +242,37 @@ class _Run:
         u = self.model.boundary_displacement(self.sd, sol.delta, sol.F, rows)
         return tip_gaps(self.p_b[rows] + u, self.c0 + s * self.D, self.radius_f)
 
-    def values(self, sol: Solution, s: float, rows: np.ndarray) -> _Values:
-        """All event and termination functions at ``sol``."""
-        fn, ft = sol.normal(), sol.tangential()
-        mu = self.model.mu
-        rate = self.rate if self.rate > 0 else 1.0
-        d = self.slip * sol.dtheta * self.radius_f[self.fidx] / rate
+    def termination_values(self, sol: Solution) -> tuple[float, float]:
+        """(eps* - max strain, pickup margin); inf for criteria not declared or not enabled."""
         lim = self.model.limits
-        strain = np.inf
+        strain = pickup = np.inf
         if lim.strain is not None and "strain_limit" in self.terminate_on:
             strain = lim.strain - self.model.strain_measure(self.sd, sol.delta, sol.F)[0]
-        pickup = np.inf
         if lim.weight is not None and "picked_up" in self.terminate_on:
-            fingers = sorted(set(self.fidx.tolist()))
-            pickup = pickup_margin(mu, fn, ft, self.stick, self.fidx, fingers,
+            pickup = pickup_margin(self.model.mu, sol.normal(), sol.tangential(), self.stick,
+                                   self.fidx, sorted(set(self.fidx.tolist())),
                                    lim.weight / self.model.force_unit)
-        return _Values(fn, ft, mu * fn + ft, mu * fn - ft, d, self.gaps(sol, s, rows),
-                       strain, pickup)
+        return strain, pickup
+
+    def values(self, sol: Solution, s: float, rows: np.ndarray,
+               terminations: bool = True) -> _Values:
+        """All event functions at ``sol`` (and the termination functions if asked)."""
+        fn, ft = sol.normal(), sol.tangential()
+        mu = self.model.mu
+        d = self.slip * sol.dtheta * self.radius_f[self.fidx] / (self.rate if self.rate > 0 else 1.0)
+        strain, pickup = self.termination_values(sol) if terminations else (np.inf, np.inf)
+        return _Values(fn, mu * fn + ft, mu * fn - ft, d, self.gaps(sol, s, rows), strain, pickup)
 
     def _key_value(self, key: tuple, sol: Solution, s: float) -> float:
         """Value of one event function (for root location)."""
         kind, node = key[0], key[1]
-        if kind == "strain":
-            return self.model.limits.strain - self.model.strain_measure(self.sd, sol.delta, sol.F)[0]
-        if kind == "pickup":
-            return self.values(sol, s, np.zeros(0, int)).pickup
+        if kind in ("strain", "pickup"):
+            return self.termination_values(sol)[0 if kind == "strain" else 1]
         if kind == "A":
-            row = self.model.obj.boundary_positions([node])
-            return float(self.gaps(sol, s, row)[0, key[2]])
+            return float(self.gaps(sol, s, self.model.obj.boundary_positions([node]))[0, key[2]])
+        v = self.values(sol, s, np.zeros(0, int), terminations=False)
         k = int(np.searchsorted(self.nodes, node))
-        fn = float(sol.F[k] @ unit(sol.theta[k]))
-        ft = float(sol.F[k] @ np.array([-np.sin(sol.theta[k]), np.cos(sol.theta[k])]))
-        mu = self.model.mu
-        if kind == "B":
-            return fn
-        if kind == "C+":
-            return mu * fn + ft
-        if kind == "C-":
-            return mu * fn - ft
-        return float(self.slip[k] * sol.dtheta[k] * self.radius_f[self.fidx[k]]
-                     / max(self.rate, 1e-300))
+        return float({"B": v.fn, "C+": v.c_plus, "C-": v.c_minus, "D": v.d}[kind][k])
 
     def entries(self, v: _Values, rows: np.ndarray, depth: float):
         """Active (key, value) pairs of the contact and termination functions, in order."""
@@ -323,12 +326,10 @@ class _Run:
         """Pending contact events at the current point, in processing order."""
         depth = self.depth_at(self.s)
         rows = self.free_rows(depth)
-        v = self.values(sol, self.s, rows)
+        v = self.values(sol, self.s, rows, terminations=False)
         rates = self._fresh_rates(sol, rows)
         out = []
         for key, value in self.entries(v, rows, depth):
-            if key[0] in ("strain", "pickup"):
-                continue
             fresh_key = key[:2]
             if fresh_key in self.fresh and key in rates:
                 if rates[key] < 0:
@@ -591,14 +592,14 @@ class _Run:
         """First termination that holds at the current point (TERMINATION_ORDER)."""
         if self.rate == 0:
             return None
-        v = self.values(sol, self.s, np.zeros(0, int))
-        if "strain_limit" in self.terminate_on and v.strain <= 0:
+        strain, pickup = self.termination_values(sol)
+        if strain <= 0:
             return "strain_limit"
         if self.lost is not None:
             return "contact_lost"
         if "finger_slip" in self.terminate_on and self.slipping_finger(sol) is not None:
             return "finger_slip"
-        if "picked_up" in self.terminate_on and v.pickup <= 0:
+        if pickup <= 0:
             return "picked_up"
         return None
 

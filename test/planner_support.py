@@ -1,0 +1,204 @@
+# Copyright 2026 squeeze_grasp_ros developers
+# SPDX-License-Identifier: Apache-2.0
+"""Shared pieces of the planner node tests: scenes, an in-process harness, waiting helpers.
+
+Nothing here sleeps: waiting is a ``spin_once`` loop with a deadline on the test's own executor,
+and results arrive through futures and done-callbacks.
+"""
+from __future__ import annotations
+
+import threading
+import time
+from collections.abc import Callable
+from typing import Any
+
+import numpy as np
+import rclpy
+import yaml
+from rclpy.action import ActionClient
+from rclpy.client import Client
+from rclpy.context import Context
+from rclpy.executors import Executor, SingleThreadedExecutor
+from rclpy.node import Node
+from rclpy.task import Future
+
+from squeeze_grasp_interfaces.srv import LoadObject
+from squeeze_grasp_ros.mechanics.compliance import ElasticObject
+from squeeze_grasp_ros.nodes.planner import PlannerNode
+from squeeze_grasp_ros.scene import Scene, build_mesh, parse_scene, scene_material
+
+BLOB = """
+name: blob
+object:
+  shape: {type: fourier_blob, radius: 0.055, cos: [0.0, 0.08, 0.0], sin: [0.04, 0.0, 0.01]}
+  material: {E: 5.0e4, nu: 0.3, thickness: 0.0254}
+  mesh: {nodes: 300}
+fingers:
+  F1: {tip_radius: 0.015, placement: {angle_deg: 235}}
+  F2: {tip_radius: 0.015, placement: {angle_deg: 75}}
+squeeze: {type: stable, relative_depth: 0.05}
+friction: {mu: 0.4}
+effects: [friction]
+"""
+"""A small solid with rounded fingertips: squeezes, maps, resistance and event squeezes."""
+
+RING = """
+name: ring
+object:
+  model: ring
+  shape: {type: ellipse, a: 0.045, b: 0.03}
+  material: {E: 3.0e9, nu: 0.0, thickness: 0.01}
+  ring: {wall_thickness: 0.003, elements: 80}
+fingers:
+  F1: {placement: {point: [0.013, 0.0287]}}
+  F2: {placement: {point: [-0.0199, -0.0269]}}
+squeeze: {type: stable, relative_depth: 0.15}
+friction: {mu: 0.5}
+strain_limit: {epsilon: 0.03}
+effects: [friction, strain_limit]
+"""
+"""A small ring (curved-beam model, Sec. 7)."""
+
+
+def big_disk(nodes: int) -> str:
+    """A foam disk of about ``nodes`` nodes: its precompute takes a noticeable time."""
+    return f"""
+name: big_disk
+object:
+  shape: {{type: disk, radius: 0.05}}
+  material: {{E: 5.0e4, nu: 0.3, thickness: 0.0254}}
+  mesh: {{nodes: {nodes}}}
+fingers:
+  F1: {{placement: {{angle_deg: 180}}}}
+  F2: {{placement: {{angle_deg: 0}}}}
+"""
+
+
+def scene_of(text: str) -> Scene:
+    """The validated scene of a YAML text."""
+    return parse_scene(yaml.safe_load(text))
+
+
+def solid_of(text: str) -> ElasticObject:
+    """The mechanics API's own object of a scene: what the planner's numbers must equal."""
+    scene = scene_of(text)
+    return ElasticObject(build_mesh(scene), scene_material(scene))
+
+
+def spin_until(executor: Executor, done: Callable[[], bool], timeout: float = 60.0) -> None:
+    """Spin ``executor`` in this thread until ``done()``; TimeoutError after ``timeout`` s."""
+    deadline = time.monotonic() + timeout
+    while not done():
+        if time.monotonic() > deadline:
+            raise TimeoutError(f"not done within {timeout} s")
+        executor.spin_once(timeout_sec=0.1)
+
+
+class Harness:
+    """A client node on the test thread's executor, optionally with a planner node on it too.
+
+    Parameters
+    ----------
+    context : Context
+        An initialised rclpy context of the test.
+    with_planner : bool
+        Put a :class:`PlannerNode` on the same executor (in-process tests).
+    **planner_kwargs
+        Passed to :class:`PlannerNode` (e.g. ``parameter_overrides``).
+    """
+
+    def __init__(self, context: Context, with_planner: bool = True, **planner_kwargs: Any) -> None:
+        self.executor = SingleThreadedExecutor(context=context)
+        self.planner = PlannerNode(context=context, **planner_kwargs) if with_planner else None
+        self.node: Node = rclpy.create_node("planner_test_client", context=context)
+        for node in (self.planner, self.node):
+            if node is not None:
+                self.executor.add_node(node)
+        self._clients: dict[str, Client] = {}
+        self._actions: dict[str, ActionClient] = {}
+
+    def client(self, srv_type: Any, name: str) -> Client:
+        """A (cached) client of service ``/planner/<name>`` that has found its server."""
+        if name not in self._clients:
+            client = self.node.create_client(srv_type, f"/planner/{name}")
+            if not client.wait_for_service(timeout_sec=30.0):
+                raise TimeoutError(f"service /planner/{name} not available")
+            self._clients[name] = client
+        return self._clients[name]
+
+    def action(self, action_type: Any, name: str) -> ActionClient:
+        """A (cached) client of action ``/planner/<name>`` that has found its server."""
+        if name not in self._actions:
+            client = ActionClient(self.node, action_type, f"/planner/{name}")
+            if not client.wait_for_server(timeout_sec=30.0):
+                raise TimeoutError(f"action /planner/{name} not available")
+            self._actions[name] = client
+        return self._actions[name]
+
+    def call(self, srv_type: Any, name: str, request: Any, timeout: float = 60.0,
+             attempts: int = 1) -> Any:
+        """Call a service and return its response.
+
+        With ``attempts`` > 1 a request without an answer after ``timeout`` s is re-sent
+        (the cross-process first-message loss of ROS_CONVENTIONS §0); the planner's requests
+        are idempotent.
+        """
+        client = self.client(srv_type, name)
+        for attempt in range(attempts):
+            future = client.call_async(request)
+            try:
+                spin_until(self.executor, future.done, timeout)
+            except TimeoutError:
+                client.remove_pending_request(future)
+                if attempt == attempts - 1:
+                    raise
+                continue
+            return future.result()
+        raise AssertionError("unreachable")
+
+    def load(self, text: str, object_id: str = "", **fields: Any) -> LoadObject.Response:
+        """Load a scene given as YAML text; assert it succeeded."""
+        response = self.call(LoadObject, "load_object",
+                             LoadObject.Request(scene_yaml=text, object_id=object_id, **fields))
+        assert response.success, response.message
+        return response
+
+    def goal(self, action_type: Any, name: str, goal: Any,
+             on_feedback: Callable[[Any], None] | None = None) -> tuple[Future, Future]:
+        """Send a goal; return the futures of its goal handle and of its result response.
+
+        The result is requested from a done-callback as soon as the goal is accepted.
+        """
+        accepted, outcome = Future(), Future()
+        sent = self.action(action_type, name).send_goal_async(goal, feedback_callback=on_feedback)
+
+        def on_accepted(future: Future) -> None:
+            handle = future.result()
+            accepted.set_result(handle)
+            handle.get_result_async().add_done_callback(
+                lambda result: outcome.set_result(result.result()))
+        sent.add_done_callback(on_accepted)
+        return accepted, outcome
+
+    def spin_until(self, done: Callable[[], bool], timeout: float = 60.0) -> None:
+        """Spin this harness's executor until ``done()``."""
+        spin_until(self.executor, done, timeout)
+
+    def close(self) -> None:
+        """Destroy the nodes (the planner joins its workers) and the executor."""
+        for client in self._actions.values():
+            client.destroy()
+        if self.planner is not None:
+            self.planner.destroy_node()
+        self.node.destroy_node()
+        self.executor.shutdown()
+
+
+def planner_threads() -> list[threading.Thread]:
+    """Live worker threads of any planner (none after a clean shutdown)."""
+    return [t for t in threading.enumerate() if t.name.startswith("planner-worker")]
+
+
+def flat(values: Any) -> np.ndarray:
+    """A message array field as a flat float ndarray."""
+    return np.asarray(values, dtype=float).reshape(-1)

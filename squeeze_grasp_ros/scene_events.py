@@ -29,8 +29,12 @@ def event_squeeze_scene(scene: Scene, obj: ElasticObject, contacts: tuple[int, i
     Raises
     ------
     SceneError
-        If a fingertip radius is 0 (point fingers have no polar angle) or no depth is given.
+        If the object is not a solid, a fingertip radius is 0 (point fingers have no polar
+        angle) or no depth is given.
     """
+    if scene.object.model != "solid":
+        raise SceneError(f"object.model is {scene.object.model}: the event-driven squeeze needs "
+                         "a solid object (rings: `squeeze-grasp ring`)")
     for name, finger in scene.fingers.items():
         if not finger.tip_radius > 0:
             raise SceneError(f"fingers.{name}.tip_radius must be > 0 m for the event-driven "

@@ -121,6 +121,10 @@ def test_user_given_directions_and_validation():
     scene = parse_scene(data)
     with pytest.raises(SceneError, match="tip_radius"):
         event_squeeze_scene(scene, None, (0, 1))
+    ring = dict(data, object={**data["object"], "model": "ring",
+                              "ring": {"wall_thickness": 0.005}})
+    with pytest.raises(SceneError, match="solid"):
+        event_squeeze_scene(parse_scene(ring), None, (0, 1))
 
 
 def run_cli(args, capsys) -> dict:

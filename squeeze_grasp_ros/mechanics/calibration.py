@@ -185,7 +185,8 @@ def friction_from_angle(alpha0: float) -> Friction:
     """mu = tan(alpha0) for a critical slope angle ``alpha0`` in rad, in [0, pi/2)."""
     require_finite("slope angle", alpha0)
     if not 0 <= alpha0 < np.pi / 2:
-        raise MechanicsError(f"critical slope angle must be in [0, 90) deg, got {np.degrees(alpha0)} deg")
+        raise MechanicsError("critical slope angle must be in [0, 90) deg, got "
+                             f"{np.degrees(alpha0)} deg")
     mu = float(np.tan(alpha0))
     return Friction(mu, float(alpha0), (float(alpha0), float(alpha0)), (mu, mu))
 

@@ -32,7 +32,7 @@ import numpy as np
 
 from .compliance import ElasticObject, node_dofs
 from .errors import MechanicsError
-from .fem import principal_strains, strain_displacement
+from .fem import element_dofs, principal_strains, strain_displacement
 from .fingertips import cross, tangent, unit
 from .reduced import reduce_blocks
 
@@ -334,9 +334,7 @@ class ContactModel:
         idx = np.array(key)
         dofs = node_dofs(idx)
         if self.reference:
-            unit_loads = np.zeros((2 * self.obj.mesh.n, len(dofs)))
-            unit_loads[dofs, np.arange(len(dofs))] = 1.0
-            A_hat = self.obj.pinv_apply(unit_loads)[dofs]
+            A_hat = self.unit_responses(dofs)[dofs]
             A_hat = 0.5 * (A_hat + A_hat.T)
             A_bc = None
             sets.clear()
@@ -348,7 +346,9 @@ class ContactModel:
             A_bc = self.obj.boundary_compliance[:, node_dofs(pos)]
             A_hat = A_bc[node_dofs(pos)]
         C, E, _, condition = reduce_blocks(A_hat, self.obj.rigid[dofs])
-        strain_map = self._strain_map(dofs) if self.limits.strain is not None and not self.reference else None
+        strain_map = None
+        if self.limits.strain is not None and not self.reference:
+            strain_map = self.element_strains(self.unit_responses(dofs))
         data = SetData(idx, C, E, A_bc, strain_map, condition)
         sets[key] = data
         self._cache["max_condition"] = max(self._cache.get("max_condition", 0.0), condition)
@@ -362,17 +362,14 @@ class ContactModel:
             self._cache["strain_b"] = B
         return self._cache["strain_b"]
 
-    def _strain_map(self, dofs: np.ndarray) -> np.ndarray:
-        """Element strains (3t, 2m) per unit dimensionless contact force: B K+ at the contact DOFs."""
+    def unit_responses(self, dofs: np.ndarray) -> np.ndarray:
+        """K+ applied to unit loads at ``dofs``: (2n, len(dofs)), by direct sparse solves."""
         unit_loads = np.zeros((2 * self.obj.mesh.n, len(dofs)))
         unit_loads[dofs, np.arange(len(dofs))] = 1.0
-        X = self.obj.pinv_apply(unit_loads)
-        return self.element_strains(X)
+        return self.obj.pinv_apply(unit_loads)
 
     def element_strains(self, u_hat: np.ndarray) -> np.ndarray:
         """Engineering strains (t*3,) or (t*3, k) of dimensionless nodal displacements (2n[, k])."""
-        from .fem import element_dofs
-
         B = self._strain_b()
         de = u_hat[element_dofs(self.obj.mesh.triangles)]
         return np.einsum("tij,tj...->ti...", B, de).reshape((-1,) + u_hat.shape[1:])

@@ -150,7 +150,7 @@ class SegmentNode:
     theta: float
 
     def to_json(self) -> dict:
-        """``{"node", "mode", "slip", "force", "normal_force", "tangential_force", "slip_margin", "theta"}``."""
+        """All fields as a JSON-able dict (force as [fx, fy])."""
         return {"node": self.node, "mode": self.mode, "slip": self.slip,
                 "force": self.force.tolist(), "normal_force": self.normal_force,
                 "tangential_force": self.tangential_force, "slip_margin": self.slip_margin,
@@ -345,9 +345,10 @@ def polar_trajectories(samples: tuple[Sample, ...], relative_per_depth: float) -
     return {k: tuple(v) for k, v in out.items()}
 
 
-def event_squeeze(obj: ElasticObject, contacts: tuple[int, int], tip_radius: float | Mapping[str, float],
-                  mu: float, kind: str = "stable", depth: float | None = None,
-                  relative_depth: float | None = None, limits: Limits | None = None,
+def event_squeeze(obj: ElasticObject, contacts: tuple[int, int],
+                  tip_radius: float | Mapping[str, float], mu: float, kind: str = "stable",
+                  depth: float | None = None, relative_depth: float | None = None,
+                  limits: Limits | None = None,
                   step: float = 1e-3, event_tol: float = 1e-9, reference: bool = False,
                   max_events_per_depth: int = 4,
                   directions: Mapping[str, tuple[float, float]] | None = None,

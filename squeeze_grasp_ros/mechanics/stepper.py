@@ -658,8 +658,10 @@ class _Run:
         lands more than MAX_ANGLE_JUMP (rad) from the prediction (another solution branch)."""
         guess = sol_a.theta + sol_a.dtheta * (b - a)
         sol = self.solve(b, theta=guess)
-        if sol.iterations > CONTINUATION_ITERATIONS or np.abs(sol.theta - guess).max() > MAX_ANGLE_JUMP:
-            raise MechanicsError(f"continuation from s = {a:.6g} to {b:.6g} left the solution branch")
+        jump = np.abs(sol.theta - guess).max()
+        if sol.iterations > CONTINUATION_ITERATIONS or jump > MAX_ANGLE_JUMP:
+            raise MechanicsError(f"continuation from s = {a:.6g} to {b:.6g} left the solution "
+                                 "branch")
         return sol
 
     def substep(self, sol_a: Solution, a: float, b: float) -> tuple[float, Solution]:

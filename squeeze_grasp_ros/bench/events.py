@@ -125,10 +125,10 @@ def reference_rows(nodes: int, mu: float, accuracy: float, steps: Sequence[float
         if needed is None and same_r and err_r <= accuracy:
             needed = (h, t_ref / t_fast)
     if needed is None:
-        note = (f"no reference step in {list(steps)} reached {accuracy:g} L event accuracy; the "
+        note = (f"No reference step in {list(steps)} reached {accuracy:g} L event accuracy; the "
                 f"finest was {rows[-1][6] / t_fast:.0f}x slower than the located engine")
     else:
-        note = (f"the reference needed h = {needed[0]:g} L for {accuracy:g} L event accuracy: "
+        note = (f"The reference needed h = {needed[0]:g} L for {accuracy:g} L event accuracy: "
                 f"{needed[1]:.0f}x slower than the located engine (n = {obj.mesh.n})")
     return rows, note
 

@@ -31,11 +31,14 @@ import numpy as np
 import yaml
 
 from .mechanics.compliance import ROUTES, ElasticObject
+from .mechanics.contact_model import ContactModel
 from .mechanics.errors import InfeasibleError, MechanicsError
 from .mechanics.graspmap import GraspMap, grasp_map
 from .mechanics.reduced import boundary_displacement, reduced_stiffness
 from .mechanics.resistance import (FINGERS, MODES, Resistance, ResistanceSweep, contact_segments,
                                    optimal_resistance, resistance_grasp, sweep_directions)
+from .mechanics.resistance_friction import (FrictionalResistance, add_adversary,
+                                            frictional_resistance)
 from .mechanics.ring_map import RingGraspMap, ring_grasp_map
 from .mechanics.ring_model import RingModel
 from .mechanics.ring_squeeze import RingGrasp, ring_grasp
@@ -46,7 +49,7 @@ from .scene import (Scene, SceneError, build_mesh, build_outline, build_ring, fi
 from .scene_events import event_squeeze_scene
 
 SQUEEZE_TYPES: tuple[str, ...] = ("stable", "pure")
-CONTACT_MODELS: tuple[str, ...] = ("point", "segment")
+CONTACT_MODELS: tuple[str, ...] = ("point", "segment", "friction")
 MAX_DIRECTIONS = 100_000
 """Most push directions one resistance sweep may ask for."""
 MAX_BEST_COUNT = 100_000
@@ -435,6 +438,14 @@ def check_number(name: str, value: float, low: float = -math.inf, high: float = 
     return float(value)
 
 
+def check_step(step: float, limits: Limits) -> float:
+    """An event-squeeze substep no smaller than the node's ``min_step``."""
+    if step < limits.min_step:
+        raise invalid(f"step {step} is below the planner's min_step {limits.min_step} "
+                      "(parameter): the squeeze would take too long")
+    return step
+
+
 def best_count(requested: int, limits: Limits) -> int:
     """Placements a map returns: ``requested`` in [1, MAX_BEST_COUNT], or the default for 0."""
     return int(check_number("best_count", requested, 0, MAX_BEST_COUNT)) or limits.best_count
@@ -546,18 +557,19 @@ class ResistancePlan:
 
     Attributes
     ----------
-    resistance : Resistance
+    resistance : Resistance or FrictionalResistance
+        Fixed contacts (Sec. 6.1-6.2) or Algorithm 2 under friction (Sec. 6.3).
     sweep : ResistanceSweep or None
     """
 
-    resistance: Resistance
+    resistance: Resistance | FrictionalResistance
     sweep: ResistanceSweep | None
 
 
 def resistance_plan(loaded: LoadedObject, contacts: Sequence[int], a: Sequence[float],
-                    mode: str, contact_model: str, half_width: float,
-                    directions: int) -> ResistancePlan:
-    """Optimal resistance to the adversary translation ``a`` (Sec. 6.1-6.2).
+                    mode: str, contact_model: str, half_width: float, directions: int,
+                    tip_radius: float, limits: Limits) -> ResistancePlan:
+    """Optimal resistance to the adversary translation ``a`` (Sec. 6).
 
     Parameters
     ----------
@@ -568,11 +580,15 @@ def resistance_plan(loaded: LoadedObject, contacts: Sequence[int], a: Sequence[f
     a : (x, y, z)
         Adversary translation, m; z must be 0.
     mode : {"stable", "pure"}
-    contact_model : {"point", "segment"}
+    contact_model : {"point", "segment", "friction"}
     half_width : float
         Segment half width, m (>= 0; 0 = the node and its two neighbours).
     directions : int
-        Push directions to sweep (0 = none).
+        Push directions to sweep (0 = none; fixed contacts only).
+    tip_radius : float
+        Friction: A's fingertip radius, m (0 = the scene's adversary tip radius).
+    limits : Limits
+        Friction: the scene's squeeze step must be >= ``limits.min_step``.
     """
     obj = loaded.solid()
     mode = choice("mode", mode, MODES)
@@ -583,6 +599,11 @@ def resistance_plan(loaded: LoadedObject, contacts: Sequence[int], a: Sequence[f
     width = check_number("segment_half_width", half_width, 0.0)
     count = int(check_number("directions", directions, 0, MAX_DIRECTIONS))
     nodes = contact_nodes(loaded, contacts, count=3)
+    if contact_model == "friction":
+        if count:
+            raise invalid("directions: the sweep needs point or segment contacts")
+        return ResistancePlan(friction_resistance(loaded, nodes, (x, y), mode, tip_radius,
+                                                  limits), None)
     if contact_model == "point":
         sets = [[int(n)] for n in nodes]
     else:
@@ -590,6 +611,25 @@ def resistance_plan(loaded: LoadedObject, contacts: Sequence[int], a: Sequence[f
     grasp = resistance_grasp(obj, dict(zip(FINGERS, sets)))
     sweep = sweep_directions(grasp, mode, count) if count else None
     return ResistancePlan(optimal_resistance(grasp, (x, y), mode), sweep)
+
+
+def friction_resistance(loaded: LoadedObject, nodes: np.ndarray, a: tuple[float, float],
+                        mode: str, tip_radius: float, limits: Limits) -> FrictionalResistance:
+    """Algorithm 2 after the scene's event-driven squeeze at F1, F2 (Sec. 6.3)."""
+    scene = loaded.scene
+    radius = check_number("adversary_tip_radius", tip_radius, 0.0)
+    radius = radius or (scene.adversary.tip_radius if scene.adversary is not None else 0.0)
+    if not radius > 0:
+        raise invalid("adversary_tip_radius must be > 0 m for friction contacts (the scene "
+                      "gives no adversary tip radius)")
+    check_step(scene.squeeze.step, limits)
+    obj = loaded.solid()
+    i, j, k = (int(n) for n in nodes)
+    squeeze = event_squeeze_scene(scene, obj, (i, j))
+    model = ContactModel(obj, scene.mu, max_events_per_depth=scene.squeeze.max_events_per_depth)
+    state = add_adversary(squeeze.state, model, squeeze.displacement, k, radius)
+    return frictional_resistance(model, state, a, mode, squeeze.step, squeeze.event_tol,
+                                 contacts=[i, j, k])
 
 
 @dataclass(frozen=True)
@@ -672,11 +712,8 @@ def event_squeeze_run(loaded: LoadedObject, contacts: Sequence[int], kind: str, 
     relative_depth = check_number("relative_depth", relative_depth, 0.0, 1.0)
     if depth and relative_depth:
         raise invalid("give at most one of depth and relative_depth (0 = the scene's)")
-    step = check_number("step", step, 0.0) or scene.squeeze.step
+    step = check_step(check_number("step", step, 0.0) or scene.squeeze.step, limits)
     event_tol = check_number("event_tol", event_tol, 0.0) or scene.squeeze.event_tol
-    if step < limits.min_step:
-        raise invalid(f"step {step} is below the planner's min_step {limits.min_step} "
-                      "(parameter): the squeeze would take too long")
     nodes = contact_nodes(loaded, contacts, count=2, default=loaded.finger_nodes)
     scene = dataclasses.replace(scene, squeeze=dataclasses.replace(scene.squeeze, type=kind))
     return event_squeeze_scene(scene, obj, (int(nodes[0]), int(nodes[1])), depth or None,

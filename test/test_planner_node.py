@@ -24,18 +24,21 @@ from squeeze_grasp_interfaces.action import EventSqueeze as EventSqueezeAction
 from squeeze_grasp_interfaces.action import GraspMap as GraspMapAction
 from squeeze_grasp_interfaces.srv import (EventSqueeze, GraspMap, LoadObject, PlanResistance,
                                           PlanSqueeze, RingGraspTest)
+from squeeze_grasp_ros.mechanics.contact_model import ContactModel
 from squeeze_grasp_ros.mechanics.graspmap import grasp_map
 from squeeze_grasp_ros.mechanics.reduced import boundary_displacement, reduced_stiffness
 from squeeze_grasp_ros.mechanics.resistance import (contact_segments, optimal_resistance,
                                                     resistance_grasp, sweep_directions)
+from squeeze_grasp_ros.mechanics.resistance_friction import add_adversary, frictional_resistance
 from squeeze_grasp_ros.mechanics.ring_squeeze import ring_grasp
 from squeeze_grasp_ros.mechanics.squeeze import plan_squeeze
 from squeeze_grasp_ros.nodes.planner import PARAMETERS
 from squeeze_grasp_ros.planning import ErrorCode
-from squeeze_grasp_ros.scene import build_ring, finger_nodes
+from squeeze_grasp_ros.scene import build_ring, finger_nodes, placement_node
 from squeeze_grasp_ros.scene_events import event_squeeze_scene
 
 REPO = Path(__file__).resolve().parents[1]
+RESIST_FIG10 = (REPO / "config" / "scenes" / "resist_fig10.yaml").read_text()
 
 
 @pytest.fixture
@@ -170,6 +173,37 @@ def test_plan_resistance_equals_the_mechanics(planner: Harness, model: str, mode
     assert np.array_equal([[n.force.x, n.force.y] for n in response.nodes], res.node_forces)
     assert np.array_equal(flat(response.sweep_angles), sweep.angles)
     assert np.array_equal(flat(response.sweep_unit_work), sweep.unit_work, equal_nan=True)
+
+
+def test_frictional_resistance_equals_the_mechanics(planner: Harness) -> None:
+    """Algorithm 2 after the scene's event-driven squeeze (Sec. 6.3), as in the resist verb."""
+    scene = scene_of(RESIST_FIG10)
+    i, j = planner.load(RESIST_FIG10).finger_nodes
+    obj = solid_of(RESIST_FIG10)
+    k = placement_node(obj.mesh, scene.adversary.placement, "adversary")
+    squeeze = event_squeeze_scene(scene, obj, (i, j))
+    model = ContactModel(obj, scene.mu, max_events_per_depth=scene.squeeze.max_events_per_depth)
+    state = add_adversary(squeeze.state, model, squeeze.displacement, k, 0.02)
+    expected = frictional_resistance(model, state, scene.adversary.a, "stable", squeeze.step,
+                                     squeeze.event_tol, contacts=[i, j, k])
+    response = planner.call(PlanResistance, "plan_resistance", PlanResistance.Request(
+        object_id="resist_fig10", contacts=[i, j, k], a=Vector3(x=0.0024, y=0.0044),
+        mode="stable", contact_model="friction"))
+    assert response.success == expected.success and response.message in ("", expected.reason)
+    assert response.error_code == (ErrorCode.OK if expected.success else ErrorCode.NOT_FEASIBLE)
+    assert [response.d1.x, response.d1.y, response.d2.x, response.d2.y] == [
+        *expected.d1, *expected.d2]
+    assert (response.work_total, response.travelled) == (expected.work["total"],
+                                                         expected.travelled)
+    assert [(e.type, e.node, e.finger) for e in response.events] == [
+        (e.type, e.node, e.finger) for e in expected.events]
+    assert [(n.finger, n.node, n.polar_angle) for n in response.nodes] == [
+        (f, c.node, c.theta) for f in ("F1", "F2", "A") for c in expected.state.segment(f)]
+    assert np.isnan(response.energy)
+    refused = planner.call(PlanResistance, "plan_resistance", PlanResistance.Request(
+        object_id="resist_fig10", contacts=[i, j, k], a=Vector3(x=0.0024, y=0.0044),
+        mode="stable", contact_model="friction", directions=8))
+    assert refused.error_code == ErrorCode.INVALID_ARGUMENT and "directions" in refused.message
 
 
 @pytest.mark.parametrize("kind", ["stable", "pure"])

@@ -140,7 +140,8 @@ BAD_SCENE_FIELDS = {
 def load_object_cases(draw: st.DrawFn) -> Case:
     kind = draw(st.sampled_from(["cached", "small", "bad scene", "bad yaml", "neither"]))
     if kind == "cached":
-        return Case("load_object", LoadObject, LoadObject.Request(scene_yaml=BLOB, object_id="blob"))
+        return Case("load_object", LoadObject,
+                    LoadObject.Request(scene_yaml=BLOB, object_id="blob"))
     data = yaml.safe_load(BLOB)
     object_id = draw(st.sampled_from(["fuzz1", "fuzz2"]))
     if kind == "small":

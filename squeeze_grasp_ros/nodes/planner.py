@@ -11,7 +11,7 @@ name                       kind     computation
 ``~/load_object``          service  mesh, factor and cache a scene's object (worker)
 ``~/plan_squeeze``         service  stable / pure squeeze at point contacts (inline)
 ``~/grasp_map``            service  all-pairs grasp map of a loaded solid (worker)
-``~/plan_resistance``      service  optimal resistance to an adversary finger (inline)
+``~/plan_resistance``      service  optimal resistance to an adversary finger (worker)
 ``~/ring_grasp_test``      service  ring grasp test and ring grasp map (worker)
 ``~/event_squeeze``        service  event-driven squeeze, Algorithm 1 (worker)
 ``~/grasp_map``            action   load + precompute + map with progress and cancel
@@ -145,14 +145,16 @@ class PlannerNode(Node):
                 request.full_matrices))
         return await self._in_worker(GraspMap.Response, compute)
 
-    def _plan_resistance(self, request: PlanResistance.Request,
-                         response: PlanResistance.Response) -> PlanResistance.Response:
-        """Optimal resistance at fixed contacts, inline (milliseconds)."""
+    async def _plan_resistance(self, request: PlanResistance.Request,
+                               response: PlanResistance.Response) -> PlanResistance.Response:
+        """Optimal resistance on a worker (fixed contacts: milliseconds; friction: a squeeze
+        and Algorithm 2)."""
         a = request.a
-        return self._answer(PlanResistance.Response, lambda: messages.plan_resistance_response(
-            planning.resistance_plan(self.cache.get(request.object_id), request.contacts,
-                                     (a.x, a.y, a.z), request.mode, request.contact_model,
-                                     request.segment_half_width, request.directions)))
+        return await self._in_worker(PlanResistance.Response, lambda: (
+            messages.plan_resistance_response(planning.resistance_plan(
+                self.cache.get(request.object_id), request.contacts, (a.x, a.y, a.z),
+                request.mode, request.contact_model, request.segment_half_width,
+                request.directions, request.adversary_tip_radius, self.limits))))
 
     async def _ring_grasp_test(self, request: RingGraspTest.Request,
                                response: RingGraspTest.Response) -> RingGraspTest.Response:
@@ -197,8 +199,9 @@ class PlannerNode(Node):
             loaded = self.cache.get(object_id)
             report("grasp map", stages - 1, stages, loaded.num_nodes)
             gmap = planning.object_grasp_map(loaded, goal.mu)
+            best = planning.best_count(goal.best_count, self.limits)
             return messages.success(GraspMapAction.Result, map=messages.grasp_map_data(
-                gmap, object_id, planning.best_count(goal.best_count, self.limits), goal.full_matrices))
+                gmap, object_id, best, goal.full_matrices))
         return self._finish(goal_handle, await self._in_worker(GraspMapAction.Result, compute))
 
     async def _execute_event_squeeze(self,

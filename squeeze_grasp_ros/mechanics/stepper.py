@@ -332,6 +332,8 @@ class _Run:
         for key, value in self.entries(v, rows, depth):
             fresh_key = key[:2]
             if fresh_key in self.fresh and key in rates:
+                if key[0] == "A" and value > self.tol:
+                    continue  # a freed node is at zero gap only to the finger that released it
                 if rates[key] < 0:
                     out.append(key)
             elif value <= 0:

@@ -12,5 +12,6 @@ SECTIONS: tuple[str, ...] = (
     "resistance",
     "ring",
     "events",
+    "pareto",
 )
 """Module names of the benchmark sections, in report order."""

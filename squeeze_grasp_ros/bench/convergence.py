@@ -19,6 +19,7 @@ from ..mechanics.compliance import ElasticObject
 from ..mechanics.material import Material
 from ..mechanics.mesh import generate_mesh, target_max_area
 from ..mechanics.squeeze_events import EventSqueeze, event_squeeze
+from .events import foam_square
 from .table import Table, timed
 
 TITLE = "Mesh resolution: error and time"
@@ -62,20 +63,14 @@ def half_width(sq: EventSqueeze, finger: str) -> float:
 
 def _foam_square_squeeze(target: int) -> tuple[int, float, EventSqueeze, float]:
     """(nodes, element size h [m], squeeze, seconds) of the 12 % foam-square squeeze."""
-    side = 0.1
-    outline = shapes.rectangle(side, side)
-    area = target_max_area(outline, target)
-
     def solve():
-        mesh = generate_mesh(outline, area, 30.0)
-        obj = ElasticObject(mesh, MATERIAL).precompute()
-        b = mesh.nodes[mesh.boundary]
-        i = mesh.boundary[np.argmin(np.linalg.norm(b - (-side / 2, 0.0), axis=1))]
-        j = mesh.boundary[np.argmin(np.linalg.norm(b - (side / 2, 0.0), axis=1))]
-        return mesh.n, event_squeeze(obj, (int(i), int(j)), 0.02, 0.4, relative_depth=0.12)
+        obj, contacts = foam_square(target)
+        obj.precompute()
+        return obj, event_squeeze(obj, contacts, 0.02, 0.4, relative_depth=0.12)
 
-    (n, sq), seconds = timed(solve)
-    return n, float(np.sqrt(4 * area / np.sqrt(3))), sq, seconds
+    (obj, sq), seconds = timed(solve)
+    area = target_max_area(shapes.rectangle(0.1, 0.1), target)
+    return obj.mesh.n, float(np.sqrt(4 * area / np.sqrt(3))), sq, seconds
 
 
 def rounded_tip_table(quick: bool, progress) -> Table:

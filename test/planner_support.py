@@ -1,6 +1,6 @@
 # Copyright 2026 squeeze_grasp_ros developers
 # SPDX-License-Identifier: Apache-2.0
-"""Shared pieces of the planner node tests: scenes, an in-process harness, waiting helpers.
+"""Shared pieces of the planner node tests: scenes and an in-process harness.
 
 Nothing here sleeps: waiting is a ``spin_once`` loop with a deadline on the test's own executor,
 and results arrive through futures and done-callbacks.
@@ -8,7 +8,6 @@ and results arrive through futures and done-callbacks.
 from __future__ import annotations
 
 import threading
-import time
 from collections.abc import Callable
 from typing import Any
 
@@ -16,15 +15,14 @@ import numpy as np
 import rclpy
 import yaml
 from rclpy.action import ActionClient
-from rclpy.client import Client
 from rclpy.context import Context
-from rclpy.executors import Executor, SingleThreadedExecutor
-from rclpy.node import Node
+from rclpy.executors import SingleThreadedExecutor
 from rclpy.task import Future
 
 from squeeze_grasp_interfaces.srv import LoadObject
 from squeeze_grasp_ros.mechanics.compliance import ElasticObject
 from squeeze_grasp_ros.nodes.planner import PlannerNode
+from squeeze_grasp_ros.nodes.planner_client import PlannerClient
 from squeeze_grasp_ros.scene import Scene, build_mesh, parse_scene, scene_material
 
 BLOB = """
@@ -85,16 +83,7 @@ def solid_of(text: str) -> ElasticObject:
     return ElasticObject(build_mesh(scene), scene_material(scene))
 
 
-def spin_until(executor: Executor, done: Callable[[], bool], timeout: float = 60.0) -> None:
-    """Spin ``executor`` in this thread until ``done()``; TimeoutError after ``timeout`` s."""
-    deadline = time.monotonic() + timeout
-    while not done():
-        if time.monotonic() > deadline:
-            raise TimeoutError(f"not done within {timeout} s")
-        executor.spin_once(timeout_sec=0.1)
-
-
-class Harness:
+class Harness(PlannerClient):
     """A client node on the test thread's executor, optionally with a planner node on it too.
 
     Parameters
@@ -108,53 +97,22 @@ class Harness:
     """
 
     def __init__(self, context: Context, with_planner: bool = True, **planner_kwargs: Any) -> None:
-        self.executor = SingleThreadedExecutor(context=context)
+        executor = SingleThreadedExecutor(context=context)
         self.planner = PlannerNode(context=context, **planner_kwargs) if with_planner else None
-        self.node: Node = rclpy.create_node("planner_test_client", context=context)
+        super().__init__(rclpy.create_node("planner_test_client", context=context), executor)
         for node in (self.planner, self.node):
             if node is not None:
-                self.executor.add_node(node)
-        self._clients: dict[str, Client] = {}
+                executor.add_node(node)
         self._actions: dict[str, ActionClient] = {}
 
-    def client(self, srv_type: Any, name: str) -> Client:
-        """A (cached) client of service ``/planner/<name>`` that has found its server."""
-        if name not in self._clients:
-            client = self.node.create_client(srv_type, f"/planner/{name}")
-            if not client.wait_for_service(timeout_sec=30.0):
-                raise TimeoutError(f"service /planner/{name} not available")
-            self._clients[name] = client
-        return self._clients[name]
-
     def action(self, action_type: Any, name: str) -> ActionClient:
-        """A (cached) client of action ``/planner/<name>`` that has found its server."""
+        """A (cached) client of action ``<planner>/<name>`` that has found its server."""
         if name not in self._actions:
-            client = ActionClient(self.node, action_type, f"/planner/{name}")
+            client = ActionClient(self.node, action_type, f"{self.planner_name}/{name}")
             if not client.wait_for_server(timeout_sec=30.0):
-                raise TimeoutError(f"action /planner/{name} not available")
+                raise TimeoutError(f"action {self.planner_name}/{name} not available")
             self._actions[name] = client
         return self._actions[name]
-
-    def call(self, srv_type: Any, name: str, request: Any, timeout: float = 60.0,
-             attempts: int = 1) -> Any:
-        """Call a service and return its response.
-
-        With ``attempts`` > 1 a request without an answer after ``timeout`` s is re-sent
-        (the cross-process first-message loss of ROS_CONVENTIONS §0); the planner's requests
-        are idempotent.
-        """
-        client = self.client(srv_type, name)
-        for attempt in range(attempts):
-            future = client.call_async(request)
-            try:
-                spin_until(self.executor, future.done, timeout)
-            except TimeoutError:
-                client.remove_pending_request(future)
-                if attempt == attempts - 1:
-                    raise
-                continue
-            return future.result()
-        raise AssertionError("unreachable")
 
     def load(self, text: str, object_id: str = "", **fields: Any) -> LoadObject.Response:
         """Load a scene given as YAML text; assert it succeeded."""
@@ -179,10 +137,6 @@ class Harness:
                 lambda result: outcome.set_result(result.result()))
         sent.add_done_callback(on_accepted)
         return accepted, outcome
-
-    def spin_until(self, done: Callable[[], bool], timeout: float = 60.0) -> None:
-        """Spin this harness's executor until ``done()``."""
-        spin_until(self.executor, done, timeout)
 
     def close(self) -> None:
         """Destroy the nodes (the planner joins its workers) and the executor."""

@@ -12,6 +12,7 @@ SECTIONS: tuple[str, ...] = (
     "resistance",
     "ring",
     "events",
+    "ros_services",
     "pareto",
 )
 """Module names of the benchmark sections, in report order."""

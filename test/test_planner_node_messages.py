@@ -1,0 +1,125 @@
+# Copyright 2026 squeeze_grasp_ros developers
+# SPDX-License-Identifier: Apache-2.0
+"""The planner's conversions in messages.py (pure functions) and the request layer's caches."""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from planner_support import BLOB, RING, scene_of, solid_of
+from squeeze_grasp_interfaces.action import EventSqueeze as EventSqueezeAction
+from squeeze_grasp_interfaces.action import GraspMap as GraspMapAction
+from squeeze_grasp_interfaces.msg import ContactNode, TactileArray
+from squeeze_grasp_interfaces.srv import (EventSqueeze, GraspMap, LoadObject, PlanResistance,
+                                          PlanSqueeze, RingGraspTest)
+from squeeze_grasp_ros import messages, planning
+from squeeze_grasp_ros.mechanics.contact_state import ContactState, Event, FingerState
+from squeeze_grasp_ros.mechanics.contact_state import ContactNode as MechanicsContactNode
+from squeeze_grasp_ros.mechanics.graspmap import grasp_map
+from squeeze_grasp_ros.planning import ErrorCode
+from squeeze_grasp_ros.scene import build_mesh
+
+RESPONSES = [LoadObject.Response, PlanSqueeze.Response, GraspMap.Response,
+             PlanResistance.Response, RingGraspTest.Response, EventSqueeze.Response,
+             GraspMapAction.Result, EventSqueezeAction.Result]
+
+
+@pytest.mark.parametrize("response_type", RESPONSES, ids=lambda t: t.__qualname__)
+def test_error_codes_match_every_interface(response_type: type) -> None:
+    for code in ErrorCode:
+        assert getattr(response_type, code.name) == code.value
+    failed = messages.failure(response_type, ErrorCode.UNKNOWN_OBJECT, "why")
+    assert (failed.success, failed.error_code, failed.message) == (False, 2, "why")
+    assert messages.success(response_type).success
+
+
+@settings(max_examples=50, deadline=None)
+@given(st.lists(st.floats(allow_nan=False), max_size=40))
+def test_arrays_round_trip_bit_for_bit(values: list[float]) -> None:
+    data = np.array(values)
+    assert np.array_equal(np.asarray(messages.float64_array(data.reshape(-1, 1))), data)
+    ints = np.arange(len(values), dtype=np.int64) - 7
+    assert np.asarray(messages.int32_array(ints)).tolist() == ints.tolist()
+
+
+def test_tactile_readings_round_trip() -> None:
+    readings = messages.TactileReadings("F2", np.linspace(-0.5, 0.5, 7), np.arange(7.0),
+                                        -np.arange(7.0) / 3)
+    message = messages.tactile_array_msg(readings)
+    assert isinstance(message, TactileArray) and message.finger == "F2"
+    back = messages.tactile_readings(message)
+    for name in ("angles", "normal", "tangential"):
+        assert np.array_equal(getattr(back, name), getattr(readings, name))
+    with pytest.raises(ValueError, match="differ in length"):
+        messages.tactile_array_msg(messages.TactileReadings("F1", np.zeros(3), np.zeros(2),
+                                                            np.zeros(3)))
+
+
+def test_contact_state_and_events_keep_units_and_modes() -> None:
+    nodes = (MechanicsContactNode(4, "F1", "stick", 0, 0.25, np.zeros(2), np.array([1.5, -2.0])),
+             MechanicsContactNode(9, "F2", "slip", -1, -3.0, np.ones(2), np.array([0.0, 0.5])))
+    fingers = tuple(FingerState(f, np.zeros(2), 0.02, np.zeros(2)) for f in ("F1", "F2"))
+    state = ContactState(fingers, nodes, depth=0.003, relative_per_depth=10.0)
+    message = messages.contact_state_msg(state)
+    assert (message.depth, message.relative_depth) == (0.003, 0.03)
+    assert [(n.node, n.finger, n.mode, n.polar_angle, n.force.x, n.force.y, n.force.z)
+            for n in message.nodes] == [(4, "F1", ContactNode.STICK, 0.25, 1.5, -2.0, 0.0),
+                                        (9, "F2", ContactNode.SLIP, -3.0, 0.0, 0.5, 0.0)]
+    event = messages.contact_event_msg(Event("C", 9, "F2", 0.002, 0.02, "slip", -1))
+    assert (event.type, event.node, event.finger, event.depth, event.relative_depth) == (
+        "C", 9, "F2", 0.002, 0.02)
+
+
+def test_grasp_map_data_best_and_matrices() -> None:
+    gmap = grasp_map(solid_of(BLOB), 0.5)
+    data = messages.grasp_map_data(gmap, "blob", 3, full_matrices=False)
+    assert [list(c.contacts) for c in data.best] == [[i, j] for i, j, _ in gmap.best(3)]
+    assert len(data.stiffness) == len(data.inward) == len(data.force_closure) == 0
+    full = messages.grasp_map_data(gmap, "blob", 3, full_matrices=True)
+    b = len(gmap.boundary)
+    assert len(full.stiffness) == len(full.inward) == len(full.force_closure) == b * b
+
+
+def test_object_cache_evicts_the_least_recently_used() -> None:
+    limits = planning.Limits()
+    source = planning.read_scene(BLOB, "")
+    cache = planning.ObjectCache(2)
+    for object_id in ("a", "b"):
+        cache.put(planning.load_object(source, planning.object_key(source, object_id, "", limits),
+                                       limits))
+    cache.get("a")
+    loaded, cached = planning.load_cached(cache, source, "c", "", limits)
+    assert not cached and cache.ids() == ["a", "c"]
+    again, cached = planning.load_cached(cache, source, "c", "", limits)
+    assert cached and again is loaded
+    with pytest.raises(planning.PlannerError, match="unknown object_id 'b'"):
+        cache.get("b")
+
+
+def test_requested_nodes_are_known_before_meshing() -> None:
+    assert planning.requested_nodes(scene_of(BLOB)) == 300
+    assert planning.requested_nodes(scene_of(RING)) == 80
+    scene = scene_of(BLOB.replace("nodes: 300", "max_area: 1.0e-6"))
+    estimate = planning.requested_nodes(scene)
+    mesh_nodes = build_mesh(scene).n
+    assert 0.7 * mesh_nodes < estimate < 1.3 * mesh_nodes
+
+
+def test_progress_can_cancel_a_load() -> None:
+    stages: list[str] = []
+
+    def progress(stage: str, index: int, count: int, num_nodes: int) -> None:
+        stages.append(stage)
+        if stage == "factorisation":
+            raise planning.Cancelled()
+
+    source = planning.read_scene(BLOB, "")
+    limits = planning.Limits()
+    with pytest.raises(planning.Cancelled):
+        planning.load_object(source, planning.object_key(source, "", "", limits), limits,
+                             progress)
+    assert stages == ["mesh", "stiffness", "factorisation"]
+    assert planning.classify(planning.Cancelled())[0] == ErrorCode.CANCELLED
+    assert planning.classify(RuntimeError("boom"))[0] == ErrorCode.INTERNAL_ERROR

@@ -179,3 +179,125 @@ def test_mesh_with_fifty_thousand_nodes():
     field = displacement_field(obj, red, 1e-3 * sq.displacement)
     assert np.all(np.isfinite(field))
     assert obj.diagnostics()["last_solve_relative_residual"] < 1e-10
+
+
+# --------------------------------------------------------------------------- event-driven squeeze
+def foam(nodes: int = 800, size: float = 0.1, E: float = 5e4, h: float = 0.0254):
+    """Square of side ``size`` (m), fingertips r = size / 5 at the side midpoints."""
+    from squeeze_grasp_ros.bench.events import foam_square
+
+    obj, contacts = foam_square(nodes)
+    k = size / 0.1
+    mesh = obj.mesh
+    scaled = Mesh(mesh.nodes * k, mesh.triangles, mesh.boundary, mesh.inner_boundaries, mesh.normals)
+    return ElasticObject(scaled, Material(E, 0.3, h)), contacts
+
+
+def squeeze(obj, contacts, mu=0.05, **kw):
+    from squeeze_grasp_ros.mechanics.squeeze_events import event_squeeze
+
+    if "depth" not in kw:
+        kw.setdefault("relative_depth", 0.12)
+    return event_squeeze(obj, contacts, 0.2 * obj.scale, mu, **kw)
+
+
+def check_event_result(res, obj) -> None:
+    """Finite forces, total force equilibrium (the fingers balance), consistent energy."""
+    F = np.array([c.force for c in res.state.contacts])
+    assert np.all(np.isfinite(F)) and np.isfinite(res.energy)
+    assert np.abs(F.sum(axis=0)).max() <= 1e-8 * np.abs(F).max()
+    assert sum(res.work.values()) >= res.energy * (1 - 1e-6)
+
+
+def test_event_squeeze_E_from_foam_to_steel_changes_forces_only():
+    obj, contacts = foam()
+    base = squeeze(obj, contacts)
+    for E in (1e3, 2e11):
+        o, _ = foam(E=E)
+        res = squeeze(o, contacts)
+        check_event_result(res, o)
+        assert [(e.type, e.node) for e in res.events] == [(e.type, e.node) for e in base.events]
+        assert np.allclose([e.depth for e in res.events], [e.depth for e in base.events],
+                           atol=1e-9 * obj.scale)
+        assert res.energy == pytest.approx(base.energy * E / 5e4, rel=1e-6)
+
+
+@pytest.mark.parametrize("size", [1e-3, 10.0])
+def test_event_squeeze_object_size_scales_depths_and_forces(size):
+    obj, contacts = foam()
+    base = squeeze(obj, contacts)
+    o, _ = foam(size=size)
+    res = squeeze(o, contacts)
+    check_event_result(res, o)
+    k = size / 0.1
+    assert [(e.type, e.node) for e in res.events] == [(e.type, e.node) for e in base.events]
+    assert np.allclose([e.depth for e in res.events], [k * e.depth for e in base.events],
+                       atol=1e-8 * o.scale)
+    assert res.finger_force["F1"][1] == pytest.approx(k * base.finger_force["F1"][1], rel=1e-6)
+    assert res.energy == pytest.approx(k * k * base.energy, rel=1e-6)
+
+
+@pytest.mark.parametrize("mu", [1e-6, 1e3])
+def test_event_squeeze_friction_extremes(mu):
+    """A squeeze line exactly along both normals (structured symmetric mesh) needs no friction
+    at first; as the segments grow, a nearly frictionless tip lets nodes slide."""
+    from test_events import symmetric_square
+
+    obj, contacts = symmetric_square()
+    res = squeeze(obj, contacts, mu=mu)
+    assert res.termination == "depth_reached"
+    check_event_result(res, obj)
+    modes = {c.mode for c in res.state.contacts}
+    if mu > 1:
+        assert modes == {"stick"}
+        assert sum(res.work.values()) == pytest.approx(res.energy, rel=1e-6)
+    else:
+        assert "slip" in modes
+
+
+def test_frictionless_single_node_contacts_are_a_clear_error():
+    """With mu = 0 and one node per finger the object can slide along the tips: the problem is
+    indeterminate, and the engine says so instead of returning garbage."""
+    from test_events import symmetric_square
+
+    obj, contacts = symmetric_square()
+    with pytest.raises(MechanicsError, match="use mu > 0|can be solved"):
+        squeeze(obj, contacts, mu=0.0)
+
+
+def test_event_squeeze_from_a_nanometre_depth():
+    obj, contacts = foam()
+    tiny = squeeze(obj, contacts, depth=1e-9 * obj.scale)
+    check_event_result(tiny, obj)
+    assert tiny.termination == "depth_reached" and not tiny.events
+    plan = plan_squeeze(obj, list(contacts))
+    # before any new contact, the rounded-tip squeeze is the point-contact squeeze
+    rho = 1e-9 * obj.scale
+    assert tiny.energy == pytest.approx(rho**2 * plan.energy_per_unit_depth2, rel=1e-6)
+
+
+def test_event_squeeze_on_a_nonconvex_object():
+    pts = [[0.06, 0.0], [0.045, 0.04], [0.0, 0.05], [-0.045, 0.04], [-0.06, 0.0],
+           [-0.04, -0.035], [0.0, -0.012], [0.04, -0.035]]
+    outline = shapes.spline(pts)
+    obj = ElasticObject(generate_mesh(outline, target_max_area(outline, 1200)),
+                        Material(5e4, 0.3, 0.0254))
+    b = obj.mesh.boundary
+    p = obj.mesh.nodes[b]
+    contacts = (int(b[np.argmin(p[:, 0])]), int(b[np.argmax(p[:, 0])]))
+    res = squeeze(obj, contacts, mu=0.5, relative_depth=0.05)
+    check_event_result(res, obj)
+    assert res.event_counts["A"] > 0
+
+
+@pytest.mark.parametrize("ratio", [1e-3, 1e-1])
+def test_thin_and_thick_rings_stay_accurate(ratio):
+    from squeeze_grasp_ros.mechanics.ring_model import (circle_diametral_response,
+                                                        ring_diameter_changes)
+
+    R, E, w = 0.04, 2e9, 0.01
+    P = 1e-4 * R / abs(ring_diameter_changes(R, E, w, ratio * R, 1.0)[0])  # small displacement
+    exact = np.array(ring_diameter_changes(R, E, w, ratio * R, P))
+    fe = np.array(circle_diametral_response(256, R, E, w, ratio * R, P)[:2])
+    assert np.all(np.isfinite(fe))
+    assert np.abs(fe / exact - 1).max() < 1e-3

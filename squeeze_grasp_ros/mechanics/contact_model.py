@@ -39,6 +39,9 @@ from .reduced import reduce_blocks
 STRAIN_CRITERIA: tuple[str, ...] = ("principal", "componentwise")
 NEWTON_MAX_ITERATIONS = 50
 NEWTON_BACKTRACKS = 30
+SINGULAR_SLIDING = ("singular Jacobian of the sliding constraints (eq. 47): the sliding contacts "
+                    "do not fix the object's position (e.g. a frictionless finger touching at one "
+                    "node lets the object slide along the tip); use mu > 0")
 NEWTON_TOL = 1e-14
 """Newton stops when the cone residual is below this times the force scale |C| r, or when the
 largest angle update (rad) falls below it."""
@@ -233,7 +236,7 @@ def solve_fixed_set(C: np.ndarray, cfg: Configuration, centers: np.ndarray, dirs
         try:
             step = np.linalg.solve(J, R)
         except np.linalg.LinAlgError:
-            raise MechanicsError("singular Jacobian of the sliding constraints (eq. 47)") from None
+            raise MechanicsError(SINGULAR_SLIDING) from None
         it += 1
         for _ in range(NEWTON_BACKTRACKS):
             trial = theta.copy()
@@ -253,7 +256,10 @@ def solve_fixed_set(C: np.ndarray, cfg: Configuration, centers: np.ndarray, dirs
     if len(P):
         ea = unit(theta[P] - cfg.slip[P] * phi)
         G = np.einsum("kajb,jb->kaj", Cb[:, :, P, :], r[P, None] * tangent(theta[P]))
-        dtheta[P] = -np.linalg.solve(J, cross(dF0[P], ea))
+        try:
+            dtheta[P] = -np.linalg.solve(J, cross(dF0[P], ea))
+        except np.linalg.LinAlgError:
+            raise MechanicsError(SINGULAR_SLIDING) from None
         dF = dF0 + G @ dtheta[P]
     else:
         dF = dF0

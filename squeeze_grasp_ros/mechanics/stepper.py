@@ -79,6 +79,9 @@ from .fingertips import tip_gaps
 EVENT_ORDER = {"B": 0, "D": 1, "C+": 2, "C-": 2, "A": 3}
 """Processing order of simultaneous events (C+ and C- never coexist on one node)."""
 TERMINATION_ORDER: tuple[str, ...] = ("strain_limit", "finger_slip", "picked_up")
+SLIP_RATE_ZERO = 1e-10
+"""Frictionless contacts: polar-angle rates (rad per unit motion) below this have no slip
+direction, so round-off in a symmetric contact cannot fake a one-way finger slip."""
 MAX_SUBSTEP_HALVINGS = 12
 CONTINUATION_ITERATIONS = 12
 MAX_ANGLE_JUMP = 0.05
@@ -619,7 +622,8 @@ class _Run:
     def _slip_signs(self, sol: Solution) -> np.ndarray:
         """Slip direction of each contact (from the slip rate when frictionless)."""
         if self.frictionless:
-            return np.sign(sol.dtheta).astype(int)
+            rate = np.where(np.abs(sol.dtheta) > SLIP_RATE_ZERO, sol.dtheta, 0.0)
+            return np.sign(rate).astype(int)
         return self.slip
 
     # ----------------------------------------------------------------- motion

@@ -301,3 +301,17 @@ def test_thin_and_thick_rings_stay_accurate(ratio):
     fe = np.array(circle_diametral_response(256, R, E, w, ratio * R, P)[:2])
     assert np.all(np.isfinite(fe))
     assert np.abs(fe / exact - 1).max() < 1e-3
+
+
+def test_degraded_conditioning_warns_instead_of_crashing():
+    x = np.linspace(0, 1, 21)
+    y = np.array([0.0, 1e-6])
+    X, Y = np.meshgrid(x, y)
+    nodes = np.column_stack([X.ravel(), Y.ravel()])
+    nx = len(x)
+    tris = [[i, i + 1, nx + i + 1] for i in range(nx - 1)] + [[i, nx + i + 1, nx + i] for i in range(nx - 1)]
+    mesh = mesh_from_triangles(nodes, np.array(tris))
+    obj = ElasticObject(mesh, Material(1e6, 0.3, 0.01))
+    with pytest.warns(ConditioningWarning, match="condition estimate"):
+        cond = obj.diagnostics()["condition_estimate"]
+    assert np.isfinite(cond) and cond > 1e12

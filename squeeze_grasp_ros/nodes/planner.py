@@ -33,11 +33,10 @@ from collections.abc import Callable
 from concurrent.futures import ThreadPoolExecutor
 from typing import Any, TypeVar
 
-import rclpy
 from rcl_interfaces.msg import ParameterDescriptor
 from rclpy.action import ActionServer, CancelResponse
 from rclpy.action.server import ServerGoalHandle
-from rclpy.executors import ExternalShutdownException, SingleThreadedExecutor
+from rclpy.executors import SingleThreadedExecutor
 from rclpy.node import Node
 from rclpy.task import Future
 
@@ -48,6 +47,7 @@ from squeeze_grasp_interfaces.srv import (EventSqueeze, GraspMap, LoadObject, Pl
 
 from .. import messages, planning
 from ..planning import Cancelled, ErrorCode, Limits
+from . import run_node
 
 Response = TypeVar("Response")
 
@@ -299,19 +299,8 @@ class PlannerNode(Node):
 
 
 def main(args: list[str] | None = None) -> None:
-    """Run the planner until Ctrl-C or shutdown: init, spin in the main thread, clean up."""
-    rclpy.init(args=args)
-    node = PlannerNode()
-    executor = SingleThreadedExecutor()
-    executor.add_node(node)
-    try:
-        executor.spin()
-    except (KeyboardInterrupt, ExternalShutdownException):
-        pass
-    finally:
-        node.destroy_node()
-        executor.shutdown()
-        rclpy.try_shutdown()
+    """Run the planner on a SingleThreadedExecutor in the main thread until Ctrl-C or shutdown."""
+    run_node(PlannerNode, SingleThreadedExecutor, args)
 
 
 if __name__ == "__main__":

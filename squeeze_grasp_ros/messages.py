@@ -20,22 +20,30 @@ from dataclasses import dataclass
 from typing import Any, TypeVar
 
 import numpy as np
-from geometry_msgs.msg import Vector3
+from builtin_interfaces.msg import Time
+from geometry_msgs.msg import Point, PoseStamped, Vector3, WrenchStamped
+from rosgraph_msgs.msg import Clock
 from std_msgs.msg import Header
+from visualization_msgs.msg import Marker, MarkerArray
 
 from squeeze_grasp_interfaces.action import EventSqueeze as EventSqueezeAction
+from squeeze_grasp_interfaces.action import ExecuteGrasp
 from squeeze_grasp_interfaces.action import GraspMap as GraspMapAction
-from squeeze_grasp_interfaces.msg import (ContactEvent, ContactNode, ContactState,
-                                          EventSqueezeData, GraspCandidate, GraspMapData,
-                                          ObjectModel, TactileArray)
+from squeeze_grasp_interfaces.msg import (Alarm, ContactEvent, ContactEventArray, ContactNode,
+                                          ContactState, EventSqueezeData, ExecutorStatus,
+                                          GraspCandidate, GraspMapData, MonitorStatus,
+                                          ObjectModel, SimState, TactileArray, Tick)
 from squeeze_grasp_interfaces.srv import LoadObject, PlanResistance, PlanSqueeze, RingGraspTest
 
+from .control.motion import Command, GraspGoal, GraspProgram, Observation
+from .control.tracker import PredictedEvent, TrackedAlarm, TrackedEvent, TrackerOutput
 from .mechanics import contact_state
 from .mechanics.graspmap import GraspMap
 from .mechanics.resistance import FINGERS
 from .mechanics.resistance_friction import FrictionalResistance
 from .mechanics.squeeze_events import EventSqueeze
 from .planning import (ErrorCode, LoadedObject, ResistancePlan, RingTest, SqueezePlan)
+from .sim.world import WorldView
 
 Response = TypeVar("Response")
 
@@ -337,3 +345,295 @@ def tactile_readings(msg: TactileArray) -> TactileReadings:
     return TactileReadings(msg.finger, np.asarray(msg.taxel_angles, dtype=float),
                            np.asarray(msg.normal_forces, dtype=float),
                            np.asarray(msg.tangential_forces, dtype=float))
+
+
+# --------------------------------------------------------------------------- pipeline: time
+
+
+def stamp(ns: int) -> Time:
+    """A ``builtin_interfaces/Time`` of ``ns`` nanoseconds (sim or wall time)."""
+    return Time(sec=int(ns // 1_000_000_000), nanosec=int(ns % 1_000_000_000))
+
+
+def stamp_ns(time: Time) -> int:
+    """Nanoseconds of a ``builtin_interfaces/Time`` (inverse of :func:`stamp`)."""
+    return int(time.sec) * 1_000_000_000 + int(time.nanosec)
+
+
+def header(ns: int, frame_id: str = "") -> Header:
+    """A ``Header`` stamped ``ns`` nanoseconds in ``frame_id``."""
+    return Header(stamp=stamp(ns), frame_id=frame_id)
+
+
+def clock_msg(ns: int) -> Clock:
+    """The ``/clock`` message of sim time ``ns``."""
+    return Clock(clock=stamp(ns))
+
+
+# --------------------------------------------------------------------------- pipeline: devices
+
+
+def pose_msg(position: Sequence[float] | np.ndarray, ns: int, frame_id: str) -> PoseStamped:
+    """A fingertip centre (x, y), m, as ``PoseStamped`` (z = 0, identity orientation)."""
+    msg = PoseStamped(header=header(ns, frame_id))
+    msg.pose.position.x = float(position[0])
+    msg.pose.position.y = float(position[1])
+    msg.pose.orientation.w = 1.0
+    return msg
+
+
+def pose_position(msg: PoseStamped) -> np.ndarray:
+    """The planar position (x, y), m, of a ``PoseStamped``."""
+    return np.array([msg.pose.position.x, msg.pose.position.y])
+
+
+def pose_in_base(values: Sequence[float], frame_id: str) -> PoseStamped:
+    """``PoseStamped`` of [x, y, z, qx, qy, qz, qw] (m, unit quaternion) in ``frame_id``."""
+    msg = PoseStamped(header=Header(frame_id=frame_id))
+    p, q = msg.pose.position, msg.pose.orientation
+    p.x, p.y, p.z, q.x, q.y, q.z, q.w = (float(v) for v in values)
+    return msg
+
+
+def wrench_msg(force: np.ndarray, torque: np.ndarray, ns: int, frame_id: str) -> WrenchStamped:
+    """``WrenchStamped`` of a force (3,), N, and torque (3,), N m, in ``frame_id``."""
+    msg = WrenchStamped(header=header(ns, frame_id))
+    w = msg.wrench
+    w.force.x, w.force.y, w.force.z = (float(v) for v in force)
+    w.torque.x, w.torque.y, w.torque.z = (float(v) for v in torque)
+    return msg
+
+
+def wrench_force(msg: WrenchStamped) -> np.ndarray:
+    """The force (3,), N, of a ``WrenchStamped``."""
+    f = msg.wrench.force
+    return np.array([f.x, f.y, f.z])
+
+
+def tick_msg(index: int, ns: int, readings: Sequence[str]) -> Tick:
+    """The end-of-tick message of lockstep tick ``index`` at sim time ``ns`` (readings as
+    "<device>/<stream>")."""
+    return Tick(header=header(ns), index=int(index), readings=list(readings))
+
+
+# --------------------------------------------------------------------------- pipeline: ground truth
+
+
+def sim_state_msg(state: contact_state.ContactState, fingers: Sequence[str],
+                  termination: str | None, ns: int, frame_id: str) -> SimState:
+    """Ground truth of the simulated world as ``SimState`` (fingers without a tip: zeros)."""
+    present = {f.name: f for f in state.fingers}
+    positions, forces, work = [], [], []
+    for name in fingers:
+        f = present.get(name)
+        positions.append(Point(x=float(f.center[0]), y=float(f.center[1])) if f else Point())
+        forces.append(vector3(state.finger_force(name)))
+        work.append(f.work if f else 0.0)
+    return SimState(header=header(ns, frame_id), fingers=list(fingers), positions=positions,
+                    forces=forces, work=float64_array(work),
+                    nodes=[contact_node_msg(c) for c in state.contacts], depth=float(state.depth),
+                    relative_depth=float(state.relative_depth), termination=termination or "")
+
+
+def sim_events_msg(events: Sequence[contact_state.Event], termination: str,
+                   state: contact_state.ContactState, ns: int) -> ContactEventArray:
+    """The ground-truth events of one tick as ``ContactEventArray``; ``termination`` (e.g.
+    "finger_slip", or "") is set at the tick the world ends, with the depth it ended at."""
+    head = header(ns)
+    return ContactEventArray(header=head, events=[contact_event_msg(e, head) for e in events],
+                             termination=termination,
+                             depth=float(state.depth) if termination else 0.0)
+
+
+def event_record(msg: ContactEvent) -> dict:
+    """A ``ContactEvent`` as a JSON-able dict (stamp in ns)."""
+    return {"stamp_ns": stamp_ns(msg.header.stamp), "type": msg.type, "node": int(msg.node),
+            "finger": msg.finger, "depth": float(msg.depth),
+            "relative_depth": float(msg.relative_depth)}
+
+
+MARKER_COLOURS: dict[str, tuple[float, float, float]] = {
+    "outline": (0.2, 0.4, 0.9), "tip": (0.5, 0.5, 0.5), "stick": (0.1, 0.75, 0.2),
+    "slip": (0.9, 0.2, 0.1), "force": (0.95, 0.7, 0.1)}
+"""RGB of the visualisation markers (contacts: sticking green, sliding red)."""
+
+
+def _marker(ns: int, frame_id: str, namespace: str, ident: int, kind: int, colour: str,
+            points: np.ndarray, width: float) -> Marker:
+    r, g, b = MARKER_COLOURS[colour]
+    m = Marker(header=header(ns, frame_id), ns=namespace, id=ident, type=kind,
+               action=Marker.ADD)
+    m.pose.orientation.w = 1.0
+    m.scale.x = m.scale.y = m.scale.z = width
+    m.color.r, m.color.g, m.color.b, m.color.a = r, g, b, 1.0
+    m.points = [Point(x=float(x), y=float(y)) for x, y in points]
+    return m
+
+
+def world_markers(view: WorldView, ns: int, frame_id: str, force_scale: float = 0.002) -> MarkerArray:
+    """``MarkerArray`` of the deformed outline, fingertip circles, contact nodes (sticking green,
+    sliding red) and contact force arrows (``force_scale`` m per N), object frame."""
+    markers = [_marker(ns, frame_id, "outline", 0, Marker.LINE_STRIP, "outline",
+                       np.vstack([view.outline, view.outline[:1]]), 0.0005)]
+    circle = np.linspace(0.0, 2.0 * np.pi, 49)
+    for k, (_, centre, radius) in enumerate(view.tips):
+        pts = centre + radius * np.stack([np.cos(circle), np.sin(circle)], axis=1)
+        markers.append(_marker(ns, frame_id, "fingertips", k, Marker.LINE_STRIP, "tip", pts, 0.0005))
+    for k, (_, point, mode, force) in enumerate(view.contacts):
+        markers.append(_marker(ns, frame_id, "contacts", k, Marker.SPHERE, mode, np.zeros((0, 2)),
+                               0.002))
+        markers[-1].pose.position.x, markers[-1].pose.position.y = float(point[0]), float(point[1])
+        arrow = np.array([point - force_scale * np.asarray(force), point])
+        markers.append(_marker(ns, frame_id, "forces", k, Marker.ARROW, "force", arrow, 0.0005))
+    clear = Marker(header=header(ns, frame_id), action=Marker.DELETEALL)
+    return MarkerArray(markers=[clear] + markers)
+
+
+# --------------------------------------------------------------------------- pipeline: monitor
+
+
+def _point(xy: np.ndarray) -> Point:
+    return Point(x=float(xy[0]), y=float(xy[1]))
+
+
+def tracked_event_msg(event: TrackedEvent, ns: int) -> ContactEvent:
+    """A monitor event as ``ContactEvent`` (node -1: taxel patches are not mesh nodes)."""
+    return ContactEvent(header=header(ns), type=event.type, node=-1, finger=event.finger,
+                        depth=float(event.depth), relative_depth=float(event.relative_depth))
+
+
+def tracked_events_msg(out: TrackerOutput) -> ContactEventArray:
+    """The events of one monitor tick as one ``ContactEventArray``."""
+    return ContactEventArray(header=header(out.stamp_ns),
+                             events=[tracked_event_msg(e, out.stamp_ns) for e in out.events])
+
+
+def alarm_msg(alarm: TrackedAlarm, ns: int) -> Alarm:
+    """A monitor alarm as ``Alarm``."""
+    return Alarm(header=header(ns), type=alarm.type, finger=alarm.finger,
+                 value=float(alarm.value), message=alarm.message)
+
+
+def patches_state_msg(out: TrackerOutput, frame_id: str) -> ContactState:
+    """The monitor's reconstructed contact patches as ``ContactState`` (node = -1, polar angle
+    = the patch's mean taxel angle, force = the patch force on the object, N)."""
+    nodes = []
+    for p in out.patches:
+        c, s = np.cos(p.angle), np.sin(p.angle)
+        force = (p.normal * c - p.tangential * s, p.normal * s + p.tangential * c)
+        nodes.append(ContactNode(finger=p.finger, node=-1, polar_angle=p.angle,
+                                 mode=CONTACT_MODES[p.mode], force=vector3(force)))
+    return ContactState(header=header(out.stamp_ns, frame_id), nodes=nodes, depth=out.depth,
+                        relative_depth=out.relative_depth)
+
+
+def monitor_status_msg(out: TrackerOutput, frame_id: str) -> MonitorStatus:
+    """The monitor's per-tick ``MonitorStatus`` (fingers without a pose report the origin)."""
+    zero = np.zeros(2)
+    return MonitorStatus(
+        header=header(out.stamp_ns, frame_id), fingers=list(out.fingers),
+        positions=[_point(out.positions.get(f, zero)) for f in out.fingers],
+        forces=[vector3(out.forces[f]) for f in out.fingers],
+        normals=[vector3(out.normals[f]) for f in out.fingers],
+        sensor_age=float64_array([min(out.ages[f], 1e300) for f in out.fingers]),
+        depth=out.depth, relative_depth=out.relative_depth,
+        events=[tracked_event_msg(e, out.stamp_ns) for e in out.events],
+        alarms=[alarm_msg(a, out.stamp_ns) for a in out.alarms])
+
+
+def prediction_msg(events: Sequence[ContactEvent], termination: str, depth: float) -> ContactEventArray:
+    """The planner's predicted events as ``ContactEventArray``."""
+    return ContactEventArray(events=list(events), termination=termination, depth=float(depth))
+
+
+def predicted_events(msg: ContactEventArray) -> list[PredictedEvent]:
+    """The A-D events of a prediction for the tracker."""
+    return [PredictedEvent(e.type, e.finger, float(e.depth)) for e in msg.events]
+
+
+# --------------------------------------------------------------------------- pipeline: executor
+
+
+def observation(msg: MonitorStatus) -> Observation:
+    """The executor's :class:`Observation` of a ``MonitorStatus``."""
+    fingers = list(msg.fingers)
+    return Observation(
+        stamp_ns(msg.header.stamp),
+        {f: np.array([p.x, p.y]) for f, p in zip(fingers, msg.positions)},
+        {f: np.array([v.x, v.y]) for f, v in zip(fingers, msg.forces)},
+        {f: np.array([v.x, v.y]) for f, v in zip(fingers, msg.normals)},
+        tuple((a.type, a.finger) for a in msg.alarms), tuple(e.type for e in msg.events),
+        float(msg.depth))
+
+
+def _planar(vectors: Sequence[Vector3]) -> np.ndarray:
+    return np.array([[v.x, v.y] for v in vectors], float).reshape(-1, 2)
+
+
+def grasp_goal(msg: ExecuteGrasp.Goal) -> GraspGoal:
+    """The :class:`GraspGoal` of an ``ExecuteGrasp`` goal (shapes are checked by
+    :func:`..control.motion.goal_problem`)."""
+    fingers = tuple(msg.fingers)
+    waypoints = _planar(msg.resist_waypoints)
+    k = len(msg.resist_travel)
+    shaped = waypoints.reshape(k, len(fingers), 2) if k and len(waypoints) == k * len(fingers) \
+        else waypoints.reshape(1, -1, 2)
+    return GraspGoal(fingers, _planar(msg.directions), float(msg.depth),
+                     float(msg.relative_per_depth), msg.on_slip_alarm or "hold",
+                     _planar(msg.pure_directions) if msg.pure_directions else None,
+                     msg.adversary if msg.resist else "",
+                     np.array([msg.adversary_translation.x, msg.adversary_translation.y]),
+                     np.asarray(msg.resist_travel, float), shaped)
+
+
+def grasp_goal_msg(goal: GraspGoal) -> ExecuteGrasp.Goal:
+    """The ``ExecuteGrasp`` goal of a :class:`GraspGoal`."""
+    msg = ExecuteGrasp.Goal(fingers=list(goal.fingers),
+                            directions=[vector3(d) for d in goal.directions],
+                            depth=float(goal.depth),
+                            relative_per_depth=float(goal.relative_per_depth),
+                            on_slip_alarm=goal.on_slip_alarm, resist=goal.resist,
+                            adversary=goal.adversary,
+                            adversary_translation=vector3(goal.adversary_translation),
+                            resist_travel=float64_array(goal.resist_travel),
+                            resist_waypoints=[vector3(w) for w in goal.resist_waypoints.reshape(-1, 2)])
+    if goal.pure_directions is not None:
+        msg.pure_directions = [vector3(d) for d in goal.pure_directions]
+    return msg
+
+
+def grasp_feedback(state: str, obs: Observation, fingers: Sequence[str],
+                   events: Sequence[ContactEvent], relative_per_depth: float) -> ExecuteGrasp.Feedback:
+    """``ExecuteGrasp`` feedback: measured depth and forces, events since the last feedback."""
+    return ExecuteGrasp.Feedback(state=state, depth=obs.depth,
+                                 relative_depth=obs.depth * relative_per_depth,
+                                 fingers=list(fingers),
+                                 forces=[vector3(obs.forces.get(f, np.zeros(2))) for f in fingers],
+                                 latest_events=list(events))
+
+
+def grasp_result(program: GraspProgram, command: Command, obs: Observation | None,
+                 events: Sequence[ContactEvent], duration: float,
+                 success_terminations: Sequence[str]) -> ExecuteGrasp.Result:
+    """``ExecuteGrasp`` result of a finished :class:`GraspProgram` (measured numbers)."""
+    fingers = list(program.fingers)
+    forces = obs.forces if obs is not None else {}
+    return ExecuteGrasp.Result(
+        success=command.termination in success_terminations, termination=command.termination,
+        message=command.message, depth=obs.depth if obs is not None else 0.0,
+        relative_depth=(obs.depth if obs is not None else 0.0) * program.goal.relative_per_depth,
+        ticks=program.ticks, duration=float(duration), hold_ticks=program.hold_ticks,
+        redirected=program.redirected, fingers=fingers,
+        forces=[vector3(forces.get(f, np.zeros(2))) for f in fingers],
+        work=float64_array([program.work[f] for f in fingers]), events=list(events))
+
+
+def invalid_goal_result(message: str) -> ExecuteGrasp.Result:
+    """The result of a goal that cannot be executed."""
+    return ExecuteGrasp.Result(success=False, termination=ExecuteGrasp.Result.INVALID_GOAL,
+                               message=message)
+
+
+def executor_status_msg(state: str, depth: float, message: str, ns: int) -> ExecutorStatus:
+    """``ExecutorStatus`` of the executor (depth: commanded or measured, m)."""
+    return ExecutorStatus(header=header(ns), state=state, depth=float(depth), message=message)

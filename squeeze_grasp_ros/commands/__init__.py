@@ -16,6 +16,8 @@ VERBS: tuple[str, ...] = (
     "graspmap",
     "resist",
     "ring",
+    "run",
+    "replay",
     "bench",
     "scene_help",
     "ros_setup",

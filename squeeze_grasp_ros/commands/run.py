@@ -1,0 +1,92 @@
+# Copyright 2026 squeeze_grasp_ros developers
+# SPDX-License-Identifier: Apache-2.0
+"""``squeeze-grasp run SCENE``: a whole scene through the real rclpy nodes, in lockstep sim time."""
+from __future__ import annotations
+
+import argparse
+import sys
+
+from ..nodes.runner import EXECUTORS, PipelineRunner, RunOptions
+from .common import add_scene_argument
+
+HELP = ("run a scene through the planner, executor, simulated hardware, monitor and recorder "
+        "nodes (lockstep sim time) and summarise it")
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    """SCENE, --record DIR, --processes, --executor, --on-slip-alarm, --no-resist, --no-planner."""
+    add_scene_argument(parser)
+    parser.add_argument("--record", metavar="DIR",
+                        help="record every topic into this rosbag2 folder (MCAP storage)")
+    parser.add_argument("--processes", action="store_true",
+                        help="one process per node, as `ros2 launch` starts them (default: "
+                             "every node on one executor in this process)")
+    parser.add_argument("--executor", choices=EXECUTORS, default="events",
+                        help="rclpy executor of the one-process mode (default: events, "
+                             "rclpy.experimental.EventsExecutor)")
+    parser.add_argument("--on-slip-alarm", choices=("hold", "pure", "normals"), default="hold",
+                        help="executor reaction to an imminent-slip alarm: hold (default), or "
+                             "change the squeeze direction once to the pure squeeze or along the "
+                             "measured contact normals")
+    parser.add_argument("--no-resist", action="store_true",
+                        help="skip the resistance phase of a scene with a frictional adversary")
+    parser.add_argument("--no-planner", action="store_true",
+                        help="plan with the mechanics API instead of the planner node")
+    parser.add_argument("--quiet", action="store_true", help="no progress line")
+
+
+def _progress_line(update: dict) -> None:
+    forces = " ".join(f"{f} {(v[0] ** 2 + v[1] ** 2) ** 0.5:6.3f} N"
+                      for f, v in update["forces"].items())
+    sys.stderr.write(f"\r{update['state']:>10}  depth {update['depth'] * 1e3:7.3f} mm "
+                     f"({update['relative_depth'] * 100:5.2f} %)  {forces}  "
+                     f"monitor events {update['events']:3d}")
+    sys.stderr.flush()
+
+
+def run(args: argparse.Namespace) -> dict:
+    """Run the pipeline; the JSON summary (see :meth:`PipelineRunner.summary`)."""
+    options = RunOptions(args.scene, record=args.record, processes=args.processes,
+                         executor=args.executor, on_slip_alarm=args.on_slip_alarm,
+                         resist=not args.no_resist, planner=not args.no_planner)
+    show = not (args.quiet or args.json) and sys.stderr.isatty()
+    try:
+        result = PipelineRunner(options, _progress_line if show else None).run()
+    finally:
+        if show:
+            sys.stderr.write("\n")
+    return result
+
+
+def _vector(v: list) -> str:
+    return f"({v[0]:+.4f}, {v[1]:+.4f})"
+
+
+def summary(result: dict) -> str:
+    """Human-readable report of a run."""
+    counts = " ".join(f"{k} {v}" for k, v in result["event_counts"].items())
+    monitor = " ".join(f"{k} {v}" for k, v in sorted(result["monitor_event_counts"].items()))
+    alarms = ", ".join(f"{k} x{v}" for k, v in sorted(result["alarms"].items())) or "none"
+    timing = result["timing"]
+    lines = [
+        f"{result['scene']}: {result['termination']} ({result['message']}) after "
+        f"{result['ticks']} ticks = {result['sim_time']:.3f} s sim time; {result['mode']}, "
+        f"plan from the {result['plan_source']}",
+        f"depth {result['depth'] * 1e3:.4f} mm = {result['relative_depth'] * 100:.2f} % "
+        f"(target {result['target_depth'] * 1e3:.4f} mm; measured "
+        f"{result['measured_depth'] * 1e3:.4f} mm); held {result['hold_ticks']} ticks for stale "
+        f"data{'; redirected on a slip alarm' if result['redirected'] else ''}",
+        f"world (ground truth): termination {result['world_termination']}; events {counts}",
+        f"monitor: events {monitor or 'none'}; alarms {alarms}",
+        f"planner prediction: {result['prediction']['termination']} at "
+        f"{result['prediction']['depth'] * 1e3:.4f} mm, {len(result['prediction']['events'])} events",
+        "forces on the object [N]: " + "  ".join(f"{f} {_vector(v)}"
+                                                for f, v in result["forces"].items()),
+        "work [J]: " + "  ".join(f"{f} {w:.5f} (measured {result['measured_work'].get(f, 0.0):.5f})"
+                                 for f, w in result["work"].items()),
+        f"wall time {timing['total']:.2f} s (plan {timing['plan']:.2f} s, nodes "
+        f"{timing['start_nodes']:.2f} s, lockstep loop {timing['loop']:.2f} s)",
+    ]
+    if result["recording"]:
+        lines.append(f"recording: {result['recording']}")
+    return "\n".join(lines)

@@ -1,0 +1,393 @@
+# Copyright 2026 squeeze_grasp_ros developers
+# SPDX-License-Identifier: Apache-2.0
+"""The executor's logic: a grasp goal -> rate-limited fingertip setpoints, one observation at a time.
+
+A goal is a squeeze (each squeezing finger f moves along d_f per unit depth rho, to depth rho*)
+and optionally a resistance (the adversary moves by a along a straight line while the squeezing
+fingers follow piecewise-linear waypoints in the adversary's travel). Each phase is a path
+p_f(s) in a progress variable s (depth, or the adversary's travel). Every control cycle the
+progress speed v follows an online trapezoid: v <- min(v + a_s dt, v_s, sqrt(2 a_s (s* - s)))
+with v_s = v_max / g and a_s = a_max / g, where g = max over fingers and segments of |dp_f/ds|,
+so no fingertip exceeds ``max_velocity`` (m/s) or ``max_acceleration`` (m/s^2); the last step
+lands exactly on the end. A phase ends when the progress is at its end and every moving
+fingertip is measured within ``position_tolerance`` of its setpoint (devices may lag).
+
+Reactions (checked in this order every cycle):
+
+1. cancel -> hold the measured positions, end ``canceled``;
+2. ``picked_up`` event -> hold, end ``picked_up``; ``contact_lost`` alarm of a moving finger ->
+   hold, end ``contact_lost``;
+3. ``slip_imminent`` alarm of a squeezing finger -> with ``on_slip_alarm`` = "hold": hold, end
+   ``slip_alarm``; with "pure" / "normals": once, continue the remaining depth from the current
+   setpoints along the pure-squeeze directions / along each finger's measured contact normal
+   (scaled so the stacked direction has unit norm), ignoring the alarm for ``redirect_grace``
+   cycles; an alarm after that ends the goal as with "hold". In the resistance phase an alarm of
+   the adversary ends it successfully (the adversary slips, as in Algorithm 2);
+4. ``stale_sensor`` alarm of a moving finger -> hold the current setpoints (v = 0) until fresh.
+
+Fingers the goal does not move hold the positions measured at the start. Work is integrated
+from measurements: W_f += (F_prev + F_cur)/2 . (x_cur - x_prev), forces of the finger on the
+object (N), positions in m.
+"""
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+
+import numpy as np
+
+REACTIONS: tuple[str, ...] = ("hold", "pure", "normals")
+
+
+@dataclass(frozen=True)
+class MotionLimits:
+    """Limits and tolerances of the executor.
+
+    Attributes
+    ----------
+    max_velocity : float
+        Largest fingertip speed, m/s.
+    max_acceleration : float
+        Largest fingertip acceleration, m/s^2.
+    position_tolerance : float
+        A phase ends when every moving tip is measured this close to its setpoint, m.
+    redirect_grace : int
+        Cycles after a redirection during which the slip alarm is ignored.
+    """
+
+    max_velocity: float = 0.01
+    max_acceleration: float = 0.1
+    position_tolerance: float = 1e-7
+    redirect_grace: int = 20
+
+
+@dataclass(frozen=True)
+class GraspGoal:
+    """A squeeze and an optional resistance (object frame, SI).
+
+    Attributes
+    ----------
+    fingers : tuple of str
+        Squeezing fingers.
+    directions : (f, 2) ndarray
+        Translation of each squeezing finger per unit depth, m/m.
+    depth : float
+        Squeeze depth to reach, m.
+    relative_per_depth : float
+        1/m, for reports.
+    on_slip_alarm : {"hold", "pure", "normals"}
+    pure_directions : (f, 2) ndarray or None
+        For "pure".
+    adversary : str
+        Adversary finger of the resistance ("" = no resistance).
+    adversary_translation : (2,) ndarray
+        Total translation a of the adversary, m.
+    resist_travel : (k,) ndarray
+        Adversary travel at each waypoint, m, increasing, last = |a|.
+    resist_waypoints : (k, f, 2) ndarray
+        Translation of each squeezing finger since the resistance start at each waypoint, m.
+    """
+
+    fingers: tuple[str, ...]
+    directions: np.ndarray
+    depth: float
+    relative_per_depth: float = 0.0
+    on_slip_alarm: str = "hold"
+    pure_directions: np.ndarray | None = None
+    adversary: str = ""
+    adversary_translation: np.ndarray = field(default_factory=lambda: np.zeros(2))
+    resist_travel: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    resist_waypoints: np.ndarray = field(default_factory=lambda: np.zeros((0, 0, 2)))
+
+    @property
+    def resist(self) -> bool:
+        """True if the goal has a resistance phase."""
+        return bool(self.adversary)
+
+
+def goal_problem(goal: GraspGoal, known: Sequence[str]) -> str | None:
+    """Why ``goal`` cannot be executed with fingers ``known``, or None if it can."""
+    f = len(goal.fingers)
+    if f == 0 or len(set(goal.fingers)) != f:
+        return "fingers must be non-empty and distinct"
+    unknown = sorted(set(goal.fingers) - set(known))
+    if unknown:
+        return f"finger {unknown[0]!r} is not mapped to a device (known: {sorted(known)})"
+    if goal.directions.shape != (f, 2) or not np.all(np.isfinite(goal.directions)):
+        return f"directions must be {f} finite vectors"
+    if not np.any(goal.directions):
+        return "directions are all zero"
+    if not (np.isfinite(goal.depth) and goal.depth >= 0):
+        return f"depth must be finite and >= 0, got {goal.depth}"
+    if goal.on_slip_alarm not in REACTIONS:
+        return f"on_slip_alarm must be one of {REACTIONS}, got {goal.on_slip_alarm!r}"
+    if goal.on_slip_alarm == "pure" and (
+            goal.pure_directions is None or goal.pure_directions.shape != (f, 2)
+            or not np.all(np.isfinite(goal.pure_directions)) or not np.any(goal.pure_directions)):
+        return f"on_slip_alarm 'pure' needs {f} finite, not all zero pure_directions"
+    if goal.resist:
+        return _resistance_problem(goal, known)
+    return None
+
+
+def _resistance_problem(goal: GraspGoal, known: Sequence[str]) -> str | None:
+    f = len(goal.fingers)
+    if goal.adversary not in known or goal.adversary in goal.fingers:
+        return f"adversary {goal.adversary!r} must be a mapped finger other than the squeezing ones"
+    a = goal.adversary_translation
+    travel = goal.resist_travel
+    k = len(travel)
+    if a.shape != (2,) or not np.all(np.isfinite(a)) or not np.hypot(*a) > 0:
+        return "adversary_translation must be a finite nonzero vector"
+    if k == 0 or np.any(np.diff(travel) <= 0) or travel[0] <= 0 or \
+            not np.isclose(travel[-1], np.hypot(*a), rtol=1e-9, atol=0.0):
+        return "resist_travel must increase from > 0 to |adversary_translation|"
+    if goal.resist_waypoints.shape != (k, f, 2) or not np.all(np.isfinite(goal.resist_waypoints)):
+        return f"resist_waypoints must hold {k} x {f} finite vectors"
+    return None
+
+
+@dataclass(frozen=True)
+class Observation:
+    """What the executor knows at a control cycle (the monitor's status; object frame, SI).
+
+    Attributes
+    ----------
+    stamp_ns : int
+    positions, forces, normals : mapping of str to (2,) ndarray
+        Measured tip centres (m), forces on the object (N), unit contact normals.
+    alarms : tuple of (str, str)
+        Active (type, finger) alarms.
+    events : tuple of str
+        Types of the events detected at this cycle.
+    depth : float
+        Measured depth, m.
+    """
+
+    stamp_ns: int
+    positions: Mapping[str, np.ndarray]
+    forces: Mapping[str, np.ndarray]
+    normals: Mapping[str, np.ndarray]
+    alarms: tuple[tuple[str, str], ...] = ()
+    events: tuple[str, ...] = ()
+    depth: float = 0.0
+
+
+@dataclass(frozen=True)
+class Command:
+    """The executor's output for one cycle.
+
+    Attributes
+    ----------
+    setpoints : dict of str to (2,) ndarray
+        Tip-centre setpoint of every finger, m, object frame.
+    state : str
+        ExecutorStatus state ("squeezing", "resisting", "holding").
+    termination : str or None
+        Set on the last cycle of the goal.
+    message : str
+    """
+
+    setpoints: dict
+    state: str
+    termination: str | None = None
+    message: str = ""
+
+
+@dataclass(frozen=True)
+class PolylinePath:
+    """p_f(s) = start_f + piecewise-linear offsets through knots (s_k, offsets_k)."""
+
+    knots: np.ndarray        # (K+1,), s_0 = 0
+    offsets: np.ndarray      # (K+1, f, 2)
+    start: np.ndarray        # (f, 2)
+
+    @property
+    def end(self) -> float:
+        """Progress at the end of the path."""
+        return float(self.knots[-1])
+
+    @property
+    def gain(self) -> float:
+        """Largest fingertip speed per unit progress speed, max |dp_f/ds|."""
+        if self.end == 0.0:
+            return 1.0
+        slopes = np.diff(self.offsets, axis=0) / np.diff(self.knots)[:, None, None]
+        return max(float(np.linalg.norm(slopes, axis=2).max()), 1e-300)
+
+    def at(self, s: float) -> np.ndarray:
+        """Positions (f, 2) at progress s."""
+        if self.end == 0.0:
+            return self.start.copy()
+        k = int(np.clip(np.searchsorted(self.knots, s, side="right") - 1, 0, len(self.knots) - 2))
+        w = (s - self.knots[k]) / (self.knots[k + 1] - self.knots[k])
+        return self.start + self.offsets[k] + w * (self.offsets[k + 1] - self.offsets[k])
+
+
+def straight_path(start: np.ndarray, directions: np.ndarray, length: float) -> PolylinePath:
+    """Every finger from ``start`` (f, 2) along ``directions`` (f, 2) per unit s, s in [0, length]."""
+    return PolylinePath(np.array([0.0, length]), np.stack([np.zeros_like(directions),
+                                                           directions * length]), start)
+
+
+class GraspProgram:
+    """Online execution of one :class:`GraspGoal`.
+
+    Parameters
+    ----------
+    goal : GraspGoal
+        A goal for which :func:`goal_problem` returned None.
+    limits : MotionLimits
+    fingers : sequence of str
+        Every finger with a device; those the goal does not move hold still.
+    """
+
+    def __init__(self, goal: GraspGoal, limits: MotionLimits, fingers: Sequence[str]) -> None:
+        self.goal = goal
+        self.limits = limits
+        self.fingers = tuple(fingers)
+        self.phase = "squeeze"
+        self.moving: tuple[str, ...] = goal.fingers
+        self.path: PolylinePath | None = None
+        self.s = 0.0
+        self.v = 0.0
+        self.commanded: dict[str, np.ndarray] = {}
+        self.redirected = False
+        self.grace = 0
+        self.hold_ticks = 0
+        self.ticks = 0
+        self.cancel_requested = False
+        self.work = {f: 0.0 for f in self.fingers}
+        self._last: Observation | None = None
+
+    def cancel(self) -> None:
+        """Request a cancel: the next cycle holds the measured positions and ends the goal."""
+        self.cancel_requested = True
+
+    # ----------------------------------------------------------------- the cycle
+    def step(self, obs: Observation, dt: float) -> Command:
+        """One control cycle of ``dt`` s from observation ``obs``."""
+        self.ticks += 1
+        self._integrate_work(obs)
+        if self.path is None:
+            self.commanded = {f: np.asarray(obs.positions[f], float) for f in self.fingers}
+            self._start_squeeze(self.goal.directions)
+        terminal = self._terminal(obs)
+        if terminal is not None:
+            return terminal
+        alarmed = {finger for kind, finger in obs.alarms if kind == "slip_imminent"}
+        if self.grace > 0:
+            self.grace -= 1
+        elif self.phase == "resist" and self.goal.adversary in alarmed:
+            return self._finish(obs, "resisted", "the adversary slips", measured=True)
+        elif alarmed & set(self.goal.fingers):
+            if self.goal.on_slip_alarm == "hold" or self.redirected or self.phase != "squeeze":
+                return self._finish(obs, "slip_alarm", "imminent slip of "
+                                    + ", ".join(sorted(alarmed & set(self.goal.fingers))),
+                                    measured=True)
+            self._redirect(obs)
+        stale = {finger for kind, finger in obs.alarms if kind == "stale_sensor"}
+        if stale & set(self.moving):
+            self.v = 0.0
+            self.hold_ticks += 1
+            return Command(self._setpoints(), "holding", None,
+                           "stale sensor data: " + ", ".join(sorted(stale & set(self.moving))))
+        if self.s >= self.path.end and self._settled(obs):
+            done = self._phase_done(obs)
+            if done is not None:
+                return done
+        self._advance(dt)
+        return Command(self._setpoints(), "squeezing" if self.phase == "squeeze" else "resisting")
+
+    # ----------------------------------------------------------------- pieces
+    def _terminal(self, obs: Observation) -> Command | None:
+        if self.cancel_requested:
+            return self._finish(obs, "canceled", "goal canceled", measured=True)
+        if "picked_up" in obs.events and self.phase == "squeeze":
+            return self._finish(obs, "picked_up", "friction can lift the object", measured=True)
+        lost = {finger for kind, finger in obs.alarms if kind == "contact_lost"} & set(self.moving)
+        if lost:
+            return self._finish(obs, "contact_lost", "no contact on " + ", ".join(sorted(lost)),
+                                measured=True)
+        return None
+
+    def _start_squeeze(self, directions: np.ndarray) -> None:
+        start = np.array([self.commanded[f] for f in self.goal.fingers])
+        self.path = straight_path(start, np.asarray(directions, float), self.goal.depth)
+        self.s, self.v = 0.0, 0.0
+
+    def _redirect(self, obs: Observation) -> None:
+        """Continue the remaining depth along the pure directions or the contact normals."""
+        goal = self.goal
+        if goal.on_slip_alarm == "pure":
+            directions = np.asarray(goal.pure_directions, float)
+        else:
+            old = self.path.offsets[-1] / max(self.path.end, 1e-300)
+            directions = np.array([obs.normals[f] if np.any(obs.normals.get(f, 0.0)) else old[k]
+                                   for k, f in enumerate(goal.fingers)], float)
+            directions /= np.linalg.norm(directions)
+        remaining = self.path.end - self.s
+        start = np.array([self.commanded[f] for f in goal.fingers])
+        self.path = straight_path(start, directions, remaining)
+        self.s, self.v = 0.0, 0.0
+        self.redirected = True
+        self.grace = self.limits.redirect_grace
+
+    def _settled(self, obs: Observation) -> bool:
+        tol = self.limits.position_tolerance
+        return all(np.linalg.norm(np.asarray(obs.positions[f]) - self.commanded[f]) <= tol
+                   for f in self.moving)
+
+    def _phase_done(self, obs: Observation) -> Command | None:
+        if self.phase == "resist":
+            return self._finish(obs, "resisted", "the adversary completed its translation")
+        if not self.goal.resist:
+            return self._finish(obs, "depth_reached", "squeeze depth reached")
+        goal = self.goal
+        self.phase = "resist"
+        self.moving = goal.fingers + (goal.adversary,)
+        a = goal.adversary_translation
+        knots = np.concatenate([[0.0], goal.resist_travel])
+        unit_a = a / np.hypot(*a)
+        adv = knots[:, None] * unit_a[None, :]
+        offsets = np.concatenate([np.concatenate([np.zeros((1, len(goal.fingers), 2)),
+                                                  goal.resist_waypoints]), adv[:, None, :]], axis=1)
+        start = np.array([self.commanded[f] for f in self.moving])
+        self.path = PolylinePath(knots, offsets, start)
+        self.s, self.v = 0.0, 0.0
+        return None
+
+    def _advance(self, dt: float) -> None:
+        path = self.path
+        gain = path.gain
+        speed = self.limits.max_velocity / gain
+        accel = self.limits.max_acceleration / gain
+        remaining = path.end - self.s
+        if remaining <= 0.0:
+            return
+        self.v = min(self.v + accel * dt, speed, float(np.sqrt(2.0 * accel * remaining)))
+        self.s = min(self.s + self.v * dt, path.end)
+        for f, p in zip(self.moving, path.at(self.s)):
+            self.commanded[f] = p
+
+    def _setpoints(self) -> dict:
+        return {f: self.commanded[f].copy() for f in self.fingers}
+
+    def _finish(self, obs: Observation, termination: str, message: str,
+                measured: bool = False) -> Command:
+        """End the goal holding the measured (or the commanded) positions."""
+        if measured:
+            self.commanded = {f: np.asarray(obs.positions[f], float) for f in self.fingers}
+        self.phase = "done"
+        return Command(self._setpoints(), "holding", termination, message)
+
+    def _integrate_work(self, obs: Observation) -> None:
+        last = self._last
+        if last is not None:
+            for f in self.fingers:
+                if f in obs.positions and f in last.positions:
+                    force = 0.5 * (np.asarray(obs.forces.get(f, np.zeros(2)))
+                                   + np.asarray(last.forces.get(f, np.zeros(2))))
+                    self.work[f] += float(force @ (np.asarray(obs.positions[f])
+                                                   - np.asarray(last.positions[f])))
+        self._last = obs

@@ -1,0 +1,457 @@
+# Copyright 2026 squeeze_grasp_ros developers
+# SPDX-License-Identifier: Apache-2.0
+"""The monitor's contact tracker: contact configuration and events from taxels and wrenches.
+
+Taxels are not mesh nodes: a contact node between two taxels loads both, and sliding nodes move
+across taxels. The tracker therefore reconstructs *contact patches*: maximal runs of
+neighbouring loaded taxels (normal force above ``load_threshold``). A patch has the summed
+normal force F_n and tangential force F_t of its taxels and their F_n-weighted mean angle. With
+taxels finer than half the node spacing on the fingertip, every contact node forms its own patch
+(the shipped scenes are built so); coarser arrays merge neighbouring nodes into one patch.
+
+Per tick and finger, patches are matched to the previous tick's by angle (greedy, nearest first,
+within ``match_spacings`` taxel spacings), which gives the events (types as in the paper):
+
+- A (new contact): a patch with no predecessor, on a finger already in contact (the first
+  patches of a finger are its initial contact, not an event, as in the paper);
+- B (contact break): a predecessor with no patch;
+- C (stick -> slip): a matched patch whose cone usage |F_t| / (mu F_n) reached
+  1 - ``edge_tolerance``;
+- D (slip -> stick): a matched patch whose cone usage fell below it again.
+
+Events of one tick are ordered by finger (F1, F2, A), then B < D < C < A (the stepper's
+order), then angle. Alarms (active while their condition holds):
+
+- ``slip_imminent``: every loaded taxel of the finger uses at least ``alarm_ratio`` of its
+  friction cone, all pushing the same way (a finger slips when all its contact nodes slide the
+  same way, Sec. 5.1; the alarm comes first because alarm_ratio < 1). Off without friction.
+- ``stale_sensor``: a sensor stream of the finger has no reading newer than ``stale_after`` s.
+- ``contact_lost``: the finger had loaded taxels and has none now.
+- ``prediction_mismatch`` (at the tick it is found): an observed event of a type and finger the
+  planner did not predict within ``prediction_tolerance`` of depth, or a predicted one that
+  the depth passed without being observed.
+
+Pickup (effect ``pickup``): the tracker reports a ``picked_up`` event when every finger in
+contact can supply its share w / n_f of vertical friction, sum over its sticking taxels of
+sqrt(mu^2 f_n^2 - f_t^2) (the stepper's criterion, on taxels instead of nodes).
+
+Depth is the path length of the stacked measured fingertip translations (the stepper's depth).
+Forces are those of the fingers *on the object* (the negated wrench, else the taxel sum).
+"""
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..mechanics.fingertips import FINGER_NAMES
+
+ORDER = {"B": 0, "D": 1, "C": 2, "A": 3}
+"""Processing order of the events of one tick and finger."""
+
+
+@dataclass(frozen=True)
+class TrackerConfig:
+    """Monitor parameters.
+
+    Attributes
+    ----------
+    mu : float
+        Friction coefficient of the fingertips (0: frictionless, no slip alarm).
+    load_threshold : float
+        A taxel is loaded above this normal force, N.
+    edge_tolerance : float
+        A patch slides when its cone usage is at least 1 - edge_tolerance.
+    alarm_ratio : float
+        Cone usage of every loaded taxel that raises ``slip_imminent`` (< 1).
+    match_spacings : float
+        Largest angle between a patch and its predecessor, in taxel spacings.
+    stale_after : float
+        Age of a finger's newest reading that makes it stale, s.
+    weight : float or None
+        Object weight for the pickup test, N (None: no pickup test).
+    prediction_tolerance : float
+        Depth tolerance when matching observed events to the prediction, m.
+    relative_per_depth : float
+        Relative depth per unit depth, 1/m (for reports).
+    """
+
+    mu: float
+    load_threshold: float = 0.005
+    edge_tolerance: float = 0.02
+    alarm_ratio: float = 0.9
+    match_spacings: float = 1.5
+    stale_after: float = 0.0025
+    weight: float | None = None
+    prediction_tolerance: float = 5e-4
+    relative_per_depth: float = 0.0
+
+
+@dataclass(frozen=True)
+class FingerSample:
+    """The newest readings of one finger at a tick (object frame for positions and forces).
+
+    Attributes
+    ----------
+    position : (2,) ndarray or None
+        Measured fingertip centre, m.
+    force : (3,) ndarray or None
+        Wrench force the object applies to the fingertip, N.
+    force_stamp_ns : int or None
+        Stamp of that wrench.
+    angles, normal, tangential : (n,) ndarray or None
+        Taxel angles (rad, fingertip frame) and forces (N).
+    tactile_stamp_ns : int or None
+        Stamp of those taxels.
+    """
+
+    position: np.ndarray | None = None
+    force: np.ndarray | None = None
+    force_stamp_ns: int | None = None
+    angles: np.ndarray | None = None
+    normal: np.ndarray | None = None
+    tangential: np.ndarray | None = None
+    tactile_stamp_ns: int | None = None
+
+
+@dataclass(frozen=True)
+class Patch:
+    """A contact patch: a run of neighbouring loaded taxels (first..last, inclusive).
+
+    Attributes
+    ----------
+    finger : str
+    angle : float
+        F_n-weighted mean taxel angle, rad.
+    normal, tangential : float
+        Summed taxel forces, N.
+    mode : {"stick", "slip"}
+    slip : int
+        +1 / -1: direction of sliding in polar angle (-sign F_t); 0 while sticking.
+    """
+
+    finger: str
+    angle: float
+    normal: float
+    tangential: float
+    mode: str
+    slip: int
+
+
+@dataclass(frozen=True)
+class TrackedEvent:
+    """An event found by the tracker (``type`` A, B, C, D or picked_up)."""
+
+    type: str
+    finger: str
+    depth: float
+    relative_depth: float
+    angle: float
+
+
+@dataclass(frozen=True)
+class TrackedAlarm:
+    """An alarm active at a tick."""
+
+    type: str
+    finger: str
+    value: float
+    message: str
+
+
+@dataclass(frozen=True)
+class PredictedEvent:
+    """An event of the planner's prediction."""
+
+    type: str
+    finger: str
+    depth: float
+
+
+@dataclass(frozen=True)
+class TrackerOutput:
+    """The tracker's result for one tick (SI, object frame).
+
+    Attributes
+    ----------
+    stamp_ns : int
+    fingers : tuple of str
+    positions, forces, normals : dict of str to (2,) ndarray
+        Measured tip centres, forces on the object, unit contact normals (into the object;
+        zero without loaded taxels).
+    ages : dict of str to float
+        Age of the stalest sensor stream of each finger, s.
+    patches : tuple of Patch
+    events : tuple of TrackedEvent
+    alarms : tuple of TrackedAlarm
+    depth, relative_depth : float
+    """
+
+    stamp_ns: int
+    fingers: tuple[str, ...]
+    positions: dict
+    forces: dict
+    normals: dict
+    ages: dict
+    patches: tuple[Patch, ...]
+    events: tuple[TrackedEvent, ...]
+    alarms: tuple[TrackedAlarm, ...]
+    depth: float
+    relative_depth: float
+
+
+def loaded_runs(normal: np.ndarray, threshold: float) -> list[tuple[int, int]]:
+    """(first, last) taxel indices of every maximal run of loaded taxels."""
+    loaded = np.concatenate([[False], normal > threshold, [False]])
+    edges = np.flatnonzero(np.diff(loaded.astype(np.int8)))
+    return [(int(a), int(b) - 1) for a, b in zip(edges[::2], edges[1::2])]
+
+
+def patches_of(finger: str, sample: FingerSample, config: TrackerConfig) -> list[Patch]:
+    """Contact patches of one finger's taxels."""
+    if sample.normal is None:
+        return []
+    out = []
+    mu = config.mu
+    for first, last in loaded_runs(sample.normal, config.load_threshold):
+        fn = sample.normal[first:last + 1]
+        normal = float(fn.sum())
+        tangential = float(sample.tangential[first:last + 1].sum())
+        angle = float(fn @ sample.angles[first:last + 1] / normal)
+        sliding = mu == 0.0 or abs(tangential) >= (1.0 - config.edge_tolerance) * mu * normal
+        slip = -int(np.sign(tangential)) if sliding and mu > 0.0 else 0
+        out.append(Patch(finger, angle, normal, tangential, "slip" if sliding else "stick", slip))
+    return out
+
+
+def match_patches(previous: Sequence[Patch], current: Sequence[Patch],
+                  radius: float) -> list[tuple[int, int]]:
+    """Greedy nearest-angle matching (i into previous, j into current) within ``radius`` rad."""
+    pairs = sorted((abs(p.angle - c.angle), i, j) for i, p in enumerate(previous)
+                   for j, c in enumerate(current) if abs(p.angle - c.angle) <= radius)
+    used_i, used_j, out = set(), set(), []
+    for _, i, j in pairs:
+        if i not in used_i and j not in used_j:
+            used_i.add(i)
+            used_j.add(j)
+            out.append((i, j))
+    return out
+
+
+@dataclass
+class _FingerTrack:
+    """Mutable per-finger memory of the tracker."""
+
+    patches: list = field(default_factory=list)
+    position: np.ndarray | None = None
+    force: np.ndarray = field(default_factory=lambda: np.zeros(2))
+    normal: np.ndarray = field(default_factory=lambda: np.zeros(2))
+    had_contact: bool = False
+    stamps: dict = field(default_factory=dict)
+
+
+class ContactTracker:
+    """Event tracker over ticks of tactile and wrench readings (the monitor's logic).
+
+    Parameters
+    ----------
+    config : TrackerConfig
+    fingers : sequence of str
+        Fingers to track, in their canonical order.
+    streams : sequence of str
+        Sensor streams expected per finger ("wrench", "tactile") for the staleness test.
+    prediction : sequence of PredictedEvent
+        The planner's predicted events (may be empty).
+    """
+
+    def __init__(self, config: TrackerConfig, fingers: Sequence[str],
+                 streams: Sequence[str] = ("wrench", "tactile"),
+                 prediction: Sequence[PredictedEvent] = ()) -> None:
+        order = {n: k for k, n in enumerate(FINGER_NAMES)}
+        self.config = config
+        self.fingers = tuple(sorted(fingers, key=lambda n: order.get(n, len(order))))
+        self.streams = tuple(streams)
+        self.tracks = {f: _FingerTrack() for f in self.fingers}
+        self.depth = 0.0
+        self.picked_up = False
+        self.set_prediction(prediction)
+
+    def set_prediction(self, prediction: Sequence[PredictedEvent]) -> None:
+        """Replace the prediction the observed events are compared with."""
+        self.prediction = list(prediction)
+        self.unmatched = list(range(len(self.prediction)))
+
+    def update(self, stamp_ns: int, samples: Mapping[str, FingerSample]) -> TrackerOutput:
+        """Process the readings of one tick (newest reading per finger and stream)."""
+        cfg = self.config
+        self._advance_depth(samples)
+        relative = self.depth * cfg.relative_per_depth
+        events: list[TrackedEvent] = []
+        alarms: list[TrackedAlarm] = []
+        patches: list[Patch] = []
+        for name in self.fingers:
+            sample = samples.get(name, FingerSample())
+            track = self.tracks[name]
+            self._note_stamps(track, sample)
+            current = patches_of(name, sample, cfg)
+            if sample.normal is not None:
+                events += self._events(name, track.patches, current, sample, relative)
+                track.patches = current
+                track.had_contact = track.had_contact or bool(current)
+            patches += track.patches
+            track.force = self._force(sample, track.force)
+            track.normal = self._normal(sample, track.normal)
+            alarms += self._alarms(name, track, sample, stamp_ns)
+        if cfg.weight is not None and not self.picked_up and self._can_lift(samples):
+            self.picked_up = True
+            events.append(TrackedEvent("picked_up", "", self.depth, relative, 0.0))
+        alarms += self._compare(events)
+        return TrackerOutput(
+            stamp_ns, self.fingers,
+            {f: self.tracks[f].position for f in self.fingers if self.tracks[f].position is not None},
+            {f: self.tracks[f].force.copy() for f in self.fingers},
+            {f: self.tracks[f].normal.copy() for f in self.fingers},
+            {f: self._age(self.tracks[f], stamp_ns) for f in self.fingers},
+            tuple(patches), tuple(events), tuple(alarms), self.depth, relative)
+
+    # ----------------------------------------------------------------- pieces
+    def _advance_depth(self, samples: Mapping[str, FingerSample]) -> None:
+        step = 0.0
+        for name in self.fingers:
+            sample = samples.get(name)
+            if sample is None or sample.position is None:
+                continue
+            track = self.tracks[name]
+            position = np.asarray(sample.position, float)
+            if track.position is not None:
+                d = position - track.position
+                step += float(d @ d)
+            track.position = position
+        self.depth += float(np.sqrt(step))
+
+    @staticmethod
+    def _note_stamps(track: _FingerTrack, sample: FingerSample) -> None:
+        if sample.force_stamp_ns is not None:
+            track.stamps["wrench"] = sample.force_stamp_ns
+        if sample.tactile_stamp_ns is not None:
+            track.stamps["tactile"] = sample.tactile_stamp_ns
+
+    def _age(self, track: _FingerTrack, stamp_ns: int) -> float:
+        """Age of the stalest expected stream, s (inf before its first reading)."""
+        ages = [(stamp_ns - track.stamps[s]) * 1e-9 if s in track.stamps else float("inf")
+                for s in self.streams]
+        return max(ages, default=0.0)
+
+    def _events(self, name: str, previous: list[Patch], current: list[Patch],
+                sample: FingerSample, relative: float) -> list[TrackedEvent]:
+        spacing = float(sample.angles[1] - sample.angles[0]) if len(sample.angles) > 1 else 1.0
+        pairs = match_patches(previous, current, self.config.match_spacings * spacing)
+        matched_prev = {i for i, _ in pairs}
+        matched_cur = {j for _, j in pairs}
+        found = [("B", p.angle) for i, p in enumerate(previous) if i not in matched_prev]
+        if self.tracks[name].had_contact:
+            found += [("A", c.angle) for j, c in enumerate(current) if j not in matched_cur]
+        for i, j in pairs:
+            before, after = previous[i].mode, current[j].mode
+            if before == "stick" and after == "slip":
+                found.append(("C", current[j].angle))
+            elif before == "slip" and after == "stick":
+                found.append(("D", current[j].angle))
+        found.sort(key=lambda e: (ORDER[e[0]], e[1]))
+        return [TrackedEvent(kind, name, self.depth, relative, angle) for kind, angle in found]
+
+    @staticmethod
+    def _force(sample: FingerSample, previous: np.ndarray) -> np.ndarray:
+        """Force of the finger on the object (2,), N: -wrench force, else the taxel sum."""
+        if sample.force is not None:
+            return -np.asarray(sample.force[:2], float)
+        if sample.normal is not None:
+            c, s = np.cos(sample.angles), np.sin(sample.angles)
+            return np.array([sample.normal @ c - sample.tangential @ s,
+                             sample.normal @ s + sample.tangential @ c])
+        return previous
+
+    def _normal(self, sample: FingerSample, previous: np.ndarray) -> np.ndarray:
+        """Unit contact normal into the object from the loaded taxels (zero without any)."""
+        if sample.normal is None:
+            return previous
+        loaded = sample.normal > self.config.load_threshold
+        if not loaded.any():
+            return np.zeros(2)
+        w = sample.normal[loaded]
+        v = np.array([w @ np.cos(sample.angles[loaded]), w @ np.sin(sample.angles[loaded])])
+        return v / np.linalg.norm(v)
+
+    def _alarms(self, name: str, track: _FingerTrack, sample: FingerSample,
+                stamp_ns: int) -> list[TrackedAlarm]:
+        cfg = self.config
+        out = []
+        age = self._age(track, stamp_ns)
+        if age > cfg.stale_after:
+            out.append(TrackedAlarm("stale_sensor", name, age,
+                                    f"newest {name} reading is {age * 1e3:.3g} ms old"))
+        if track.had_contact and not track.patches:
+            out.append(TrackedAlarm("contact_lost", name, 0.0, f"{name} has no loaded taxel"))
+        usage = self._cone_usage(sample)
+        if usage is not None:
+            out.append(TrackedAlarm("slip_imminent", name, usage,
+                                    f"every loaded taxel of {name} uses >= {usage:.3f} of its "
+                                    "friction cone in one direction"))
+        return out
+
+    def _cone_usage(self, sample: FingerSample) -> float | None:
+        """Smallest cone usage if every loaded taxel is past alarm_ratio one way, else None."""
+        cfg = self.config
+        if cfg.mu == 0.0 or sample.normal is None:
+            return None
+        loaded = sample.normal > cfg.load_threshold
+        if not loaded.any():
+            return None
+        usage = -sample.tangential[loaded] / (cfg.mu * sample.normal[loaded])
+        if np.all(usage >= cfg.alarm_ratio) or np.all(usage <= -cfg.alarm_ratio):
+            return float(np.abs(usage).min())
+        return None
+
+    def _can_lift(self, samples: Mapping[str, FingerSample]) -> bool:
+        """Every finger with loaded taxels can supply w / n_f of vertical friction."""
+        cfg = self.config
+        supply = []
+        for name in self.fingers:
+            sample = samples.get(name)
+            if sample is None or sample.normal is None:
+                continue
+            fn, ft = sample.normal, sample.tangential
+            loaded = fn > cfg.load_threshold
+            if not loaded.any():
+                continue
+            sticking = loaded & (np.abs(ft) < (1.0 - cfg.edge_tolerance) * cfg.mu * fn)
+            supply.append(float(np.sqrt(np.maximum(cfg.mu ** 2 * fn[sticking] ** 2
+                                                   - ft[sticking] ** 2, 0.0)).sum()))
+        return bool(supply) and min(supply) >= cfg.weight / len(supply)
+
+    def _compare(self, events: list[TrackedEvent]) -> list[TrackedAlarm]:
+        """Match observed events to the prediction; mismatch alarms for surprises and misses."""
+        if not self.prediction:
+            return []
+        tol = self.config.prediction_tolerance
+        out = []
+        for e in events:
+            if e.type not in ORDER:
+                continue
+            hit = next((k for k in self.unmatched if self.prediction[k].type == e.type
+                        and self.prediction[k].finger == e.finger
+                        and abs(self.prediction[k].depth - e.depth) <= tol), None)
+            if hit is None:
+                out.append(TrackedAlarm("prediction_mismatch", e.finger, e.depth,
+                                        f"event {e.type} on {e.finger} at depth {e.depth:.6g} m "
+                                        "was not predicted"))
+            else:
+                self.unmatched.remove(hit)
+        for k in [k for k in self.unmatched if self.prediction[k].depth + tol < self.depth]:
+            p = self.prediction[k]
+            self.unmatched.remove(k)
+            out.append(TrackedAlarm("prediction_mismatch", p.finger, p.depth,
+                                    f"predicted event {p.type} on {p.finger} at depth "
+                                    f"{p.depth:.6g} m was not observed"))
+        return out

@@ -1,0 +1,251 @@
+# Copyright 2026 squeeze_grasp_ros developers
+# SPDX-License-Identifier: Apache-2.0
+"""Topics, QoS, parameters and the lockstep handshake shared by the pipeline nodes.
+
+Topic names are relative (so a namespace or a remap moves them); devices get
+``devices/<device>/{setpoint,pose,wrench,tactile}``. QoS (ROS_CONVENTIONS.md): commands,
+states and events reliable; sensor streams reliable in simulation (the lockstep loop must not
+lose a reading) and ``sensor_data`` (best effort) on hardware, chosen by the ``sensor_qos``
+parameter; latched data (the prediction, the object pose) transient-local.
+
+Lockstep start-up (ARCHITECTURE.md §9): a publisher that reports its subscriber as matched can
+still lose the first messages across processes. So the driver (``sim_hardware``, or the
+replayer) repeats ``sim/hello`` on a wall-clock timer and starts tick 0 only when every
+participant it waits for has answered on ``sim/ready``; a participant answers each hello once
+its own lockstep publishers and subscriptions see their peers. Lost ticks are re-sent by the
+driver and handled idempotently by stamp in every node.
+"""
+from __future__ import annotations
+
+import importlib
+from collections.abc import Callable, Iterable, Mapping, Sequence
+from typing import Any
+
+import rclpy
+from rcl_interfaces.msg import ParameterDescriptor
+from rclpy.clock import Clock, ClockType
+from rclpy.executors import ExternalShutdownException
+from rclpy.experimental import EventsExecutor
+from rclpy.node import Node
+from rclpy.qos import (DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy,
+                       qos_profile_sensor_data)
+from rclpy.signals import SignalHandlerOptions
+from std_msgs.msg import String
+
+FRAME = "object"
+"""Default object frame: x right, y up, the scene's coordinates (m)."""
+STREAMS: tuple[str, ...] = ("pose", "wrench", "tactile")
+"""Readings a device publishes per tick."""
+CLOCK = "/clock"
+TICK = "sim/tick"
+HELLO = "sim/hello"
+READY = "sim/ready"
+SIM_STATE = "sim/state"
+SIM_EVENTS = "sim/events"
+MARKERS = "sim/markers"
+RECORDER_PROGRESS = "recorder/progress"
+STATUS = "monitor/status"
+CONTACT_STATE = "monitor/contact_state"
+EVENTS = "monitor/events"
+ALARMS = "monitor/alarms"
+PREDICTION = "planner/predicted_events"
+EXECUTOR_STATUS = "executor/status"
+OBJECT_POSE = "object_pose"
+ACTION = "executor/execute_grasp"
+
+
+def device_topic(device: str, stream: str) -> str:
+    """``devices/<device>/<stream>`` (stream: setpoint, pose, wrench, tactile)."""
+    return f"devices/{device}/{stream}"
+
+
+def pipeline_topics(devices: Iterable[str]) -> dict[str, str]:
+    """Topic (fully qualified) -> type of every topic of a run with ``devices``."""
+    types = {
+        CLOCK: "rosgraph_msgs/msg/Clock",
+        TICK: "squeeze_grasp_interfaces/msg/Tick",
+        SIM_STATE: "squeeze_grasp_interfaces/msg/SimState",
+        SIM_EVENTS: "squeeze_grasp_interfaces/msg/ContactEventArray",
+        MARKERS: "visualization_msgs/msg/MarkerArray",
+        STATUS: "squeeze_grasp_interfaces/msg/MonitorStatus",
+        CONTACT_STATE: "squeeze_grasp_interfaces/msg/ContactState",
+        EVENTS: "squeeze_grasp_interfaces/msg/ContactEventArray",
+        ALARMS: "squeeze_grasp_interfaces/msg/Alarm",
+        PREDICTION: "squeeze_grasp_interfaces/msg/ContactEventArray",
+        EXECUTOR_STATUS: "squeeze_grasp_interfaces/msg/ExecutorStatus",
+        OBJECT_POSE: "geometry_msgs/msg/PoseStamped",
+        f"{ACTION}/_action/feedback": "squeeze_grasp_interfaces/action/ExecuteGrasp_FeedbackMessage",
+        f"{ACTION}/_action/status": "action_msgs/msg/GoalStatusArray",
+    }
+    stream_types = {"setpoint": "geometry_msgs/msg/PoseStamped",
+                    "pose": "geometry_msgs/msg/PoseStamped",
+                    "wrench": "geometry_msgs/msg/WrenchStamped",
+                    "tactile": "squeeze_grasp_interfaces/msg/TactileArray"}
+    for device in devices:
+        for stream, type_name in stream_types.items():
+            types[device_topic(device, stream)] = type_name
+    return {("/" + k).replace("//", "/"): v for k, v in types.items()}
+
+
+def message_type(type_name: str) -> type:
+    """The Python class of 'pkg/msg/Type' or of an action's 'pkg/action/Name_Suffix' message."""
+    package, kind, name = type_name.split("/")
+    module = importlib.import_module(f"{package}.{kind}")
+    if kind == "action" and "_" in name:
+        action, _, part = name.partition("_")
+        return getattr(getattr(module, action).Impl, part)
+    return getattr(module, name)
+
+
+def parse_mapping(entries: Sequence[str], what: str) -> dict[str, str]:
+    """``["F1:barrett_f1", ...]`` -> {"F1": "barrett_f1", ...}.
+
+    Raises
+    ------
+    ValueError
+        For an entry without exactly one ':' or a repeated key.
+    """
+    out: dict[str, str] = {}
+    for entry in entries:
+        key, sep, value = entry.partition(":")
+        if not sep or not key or not value or ":" in value or key in out:
+            raise ValueError(f"{what}: expected distinct 'finger:device' entries, got {entry!r}")
+        out[key] = value
+    return out
+
+
+def loop_qos(depth: int) -> QoSProfile:
+    """Reliable, keep-last ``depth``, volatile: commands, states, events, lockstep ticks."""
+    return QoSProfile(depth=depth, reliability=ReliabilityPolicy.RELIABLE,
+                      history=HistoryPolicy.KEEP_LAST, durability=DurabilityPolicy.VOLATILE)
+
+
+def sensor_qos(kind: str, depth: int) -> QoSProfile:
+    """QoS of the sensor streams: "reliable" (simulation) or "sensor_data" (hardware)."""
+    if kind == "reliable":
+        return loop_qos(depth)
+    if kind == "sensor_data":
+        return qos_profile_sensor_data
+    raise ValueError(f"sensor_qos must be 'reliable' or 'sensor_data', got {kind!r}")
+
+
+LATCHED = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE,
+                     history=HistoryPolicy.KEEP_LAST, durability=DurabilityPolicy.TRANSIENT_LOCAL)
+"""Transient-local: late subscribers get the last message (prediction, object pose)."""
+
+
+def declare(node: Node, parameters: Mapping[str, tuple[Any, str]]) -> dict[str, Any]:
+    """Declare typed parameters (float ones also accept YAML integers); return their values."""
+    values = {}
+    for name, (default, description) in parameters.items():
+        node.declare_parameter(name, default, ParameterDescriptor(
+            description=description, dynamic_typing=isinstance(default, float)))
+        value = node.get_parameter(name).value
+        values[name] = float(value) if isinstance(default, float) else value
+    return values
+
+
+def wall_timer(node: Node, period: float, callback: Callable[[], None]):
+    """A timer on the steady (wall) clock, whatever ``use_sim_time`` says."""
+    return node.create_timer(period, callback, clock=Clock(clock_type=ClockType.STEADY_TIME))
+
+
+class Participant:
+    """A node's side of the lockstep handshake: answer ``sim/hello`` once its peers are there.
+
+    Parameters
+    ----------
+    node : Node
+    name : str
+        Name reported on ``sim/ready`` (the driver's ``participants`` parameter lists it).
+    inputs : sequence of str
+        Topics this node needs publishers on before it is ready.
+    outputs : sequence of Publisher
+        Publishers that need a subscriber before it is ready.
+    """
+
+    def __init__(self, node: Node, name: str, inputs: Sequence[str], outputs: Sequence) -> None:
+        self.node = node
+        self.name = name
+        self.inputs = list(inputs)
+        self.outputs = list(outputs)
+        self._ready = node.create_publisher(String, READY, loop_qos(10))
+        node.create_subscription(String, HELLO, self._hello, loop_qos(10))
+
+    def ready(self) -> bool:
+        """True when every input has a publisher and every output a subscriber."""
+        return (all(self.node.count_publishers(t) > 0 for t in self.inputs)
+                and all(p.get_subscription_count() > 0 for p in self.outputs))
+
+    def _hello(self, _: String) -> None:
+        if self.ready():
+            self._ready.publish(String(data=self.name))
+
+
+class Handshake:
+    """The driver's side: repeat ``sim/hello`` until every participant answered, then start.
+
+    Parameters
+    ----------
+    node : Node
+    participants : sequence of str
+    period : float
+        Wall-clock seconds between hellos.
+    on_complete : callable
+        Called once, when the last participant answered.
+    """
+
+    def __init__(self, node: Node, participants: Sequence[str], period: float,
+                 on_complete: Callable[[], None]) -> None:
+        self.waiting = set(participants)
+        self.on_complete = on_complete
+        self._hello = node.create_publisher(String, HELLO, loop_qos(10))
+        node.create_subscription(String, READY, self._answer, loop_qos(10))
+        self._timer = wall_timer(node, period, self._say_hello)
+        self.done = False
+
+    def _say_hello(self) -> None:
+        if self.waiting:
+            self._hello.publish(String(data="hello"))
+        else:
+            self._finish()
+
+    def _answer(self, msg: String) -> None:
+        self.waiting.discard(msg.data)
+        if not self.waiting:
+            self._finish()
+
+    def _finish(self) -> None:
+        if not self.done:
+            self.done = True
+            self._timer.cancel()
+            self.on_complete()
+
+
+def run_node(factory: Callable[[], Node], args: list[str] | None = None) -> None:
+    """The ``main()`` of a pipeline node: init, spin in the main thread, clean up.
+
+    The node is spun by ``EventsExecutor.spin_once`` in a loop: in rclpy 7.1.6
+    ``EventsExecutor.spin()`` holds the GIL at 100 % CPU once a node has a timer (measured: no
+    callback runs, no other thread gets the GIL) and does not return after shutdown. Ctrl-C
+    (SIGINT, also what ``ros2 launch`` sends) ends the loop; a node with ``drain(executor)``
+    may first process what has already arrived, and ``close()`` is called in any case.
+    """
+    rclpy.init(args=args, signal_handler_options=SignalHandlerOptions.NO)
+    executor = EventsExecutor()
+    node = factory()
+    executor.add_node(node)
+    try:
+        while rclpy.ok():
+            executor.spin_once(0.1)
+    except KeyboardInterrupt:
+        if hasattr(node, "drain"):
+            node.drain(executor)
+    except ExternalShutdownException:
+        pass
+    finally:
+        if hasattr(node, "close"):
+            node.close()
+        executor.shutdown()
+        node.destroy_node()
+        rclpy.try_shutdown()

@@ -1,0 +1,127 @@
+# Copyright 2026 squeeze_grasp_ros developers
+# SPDX-License-Identifier: Apache-2.0
+"""Fingertip force/torque sensors, tactile arrays, sensor noise and dropout.
+
+Frames and signs (object frame: x right, y up; fingertips only translate, so each fingertip
+frame ``<finger>_tip`` is the object frame moved to the tip centre):
+
+- **Wrench** (geometry_msgs/WrenchStamped convention): the force and torque the object applies
+  *to the fingertip*, at the tip centre, N and N m: f = -sum_k f_k, tau_z = sum_k
+  (r e(theta_k)) x (-f_k), where f_k is the stepper's force of the finger on contact node k at
+  polar angle theta_k (:mod:`..mechanics.fingertips`).
+- **Tactile array**: taxels at fixed polar angles alpha_j (rad, fingertip frame) spaced
+  ``delta`` apart. Each contact node spreads its normal force f_n = f_k . e(theta_k) (> 0 while
+  pressing) and tangential force f_t = f_k . t(theta_k) (+ counter-clockwise) over the two
+  taxels that bracket it with hat weights max(0, 1 - |theta_k - alpha_j| / delta), which sum to 1
+  inside the array: the total force is preserved, but taxels are not mesh nodes (a node between
+  two taxels loads both; nodes beyond the array's ends are not sensed).
+- **Noise**: independent Gaussian noise of std sigma on every force reading (three wrench force
+  components, every taxel's normal and tangential force) and sigma * r on the torques.
+- **Dropout**: each wrench and each tactile message of a tick is dropped with probability p.
+Noise and dropout draw from two independent streams of one seed, so declaring dropout does not
+change the noise values of the messages that are delivered.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..mechanics.contact_state import ContactNode
+from ..mechanics.fingertips import tangent, unit
+
+
+@dataclass(frozen=True)
+class TactileLayout:
+    """Taxel angles of one fingertip's tactile array.
+
+    Attributes
+    ----------
+    angles : (n,) ndarray
+        Polar angles of the taxel centres, rad, fingertip frame, increasing.
+    """
+
+    angles: np.ndarray
+
+    @property
+    def spacing(self) -> float:
+        """Angle between neighbouring taxels, rad."""
+        return float(self.angles[1] - self.angles[0])
+
+
+def tactile_layout(center: float, taxels: int, span: float) -> TactileLayout:
+    """``taxels`` taxels evenly over ``span`` rad centred on polar angle ``center`` rad."""
+    return TactileLayout(center + np.linspace(-0.5 * span, 0.5 * span, taxels))
+
+
+def taxel_weights(layout: TactileLayout, thetas: np.ndarray) -> np.ndarray:
+    """Hat weights (k, n) of contact angles ``thetas`` (k,) rad on the taxels."""
+    offset = np.angle(np.exp(1j * (np.asarray(thetas, float)[:, None] - layout.angles[None, :])))
+    return np.maximum(0.0, 1.0 - np.abs(offset) / layout.spacing)
+
+
+def contact_components(contacts: list[ContactNode]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(thetas, normal forces, tangential forces) (k,) of contact nodes (rad, N, N)."""
+    thetas = np.array([c.theta for c in contacts], float)
+    forces = np.array([c.force for c in contacts], float).reshape(-1, 2)
+    return (thetas, np.einsum("ij,ij->i", forces, unit(thetas)),
+            np.einsum("ij,ij->i", forces, tangent(thetas)))
+
+
+def render_tactile(layout: TactileLayout, contacts: list[ContactNode]) -> tuple[np.ndarray, np.ndarray]:
+    """(normal, tangential) taxel forces (n,), N, of one finger's contact nodes."""
+    if not contacts:
+        return np.zeros(len(layout.angles)), np.zeros(len(layout.angles))
+    thetas, fn, ft = contact_components(contacts)
+    w = taxel_weights(layout, thetas)
+    return fn @ w, ft @ w
+
+
+def fingertip_wrench(contacts: list[ContactNode], radius: float) -> tuple[np.ndarray, np.ndarray]:
+    """(force (3,), torque (3,)) the object applies to the fingertip at its centre, N and N m."""
+    if not contacts:
+        return np.zeros(3), np.zeros(3)
+    thetas = np.array([c.theta for c in contacts], float)
+    forces = -np.array([c.force for c in contacts], float).reshape(-1, 2)
+    arms = radius * unit(thetas)
+    torque_z = float(np.sum(arms[:, 0] * forces[:, 1] - arms[:, 1] * forces[:, 0]))
+    total = forces.sum(axis=0)
+    return np.array([total[0], total[1], 0.0]), np.array([0.0, 0.0, torque_z])
+
+
+class SensorRandomness:
+    """Seeded noise and dropout draws, in a fixed order per tick (deterministic).
+
+    Parameters
+    ----------
+    seed : int
+        Seed of both streams.
+    noise_std : float or None
+        Force noise std, N (None: no noise effect, nothing is drawn).
+    dropout : float or None
+        Drop probability per message (None: no dropout effect, nothing is drawn).
+    draws : collections.Counter
+        Work counter; "noise_draws" and "dropout_draws" count the random numbers drawn.
+    """
+
+    def __init__(self, seed: int, noise_std: float | None, dropout: float | None, draws) -> None:
+        noise_seq, dropout_seq = np.random.SeedSequence(seed).spawn(2)
+        self.noise_std = noise_std
+        self.dropout = dropout
+        self._noise = np.random.default_rng(noise_seq)
+        self._dropout = np.random.default_rng(dropout_seq)
+        self._draws = draws
+
+    def dropped(self) -> bool:
+        """True if the next message is dropped (False without the dropout effect)."""
+        if self.dropout is None:
+            return False
+        self._draws["dropout_draws"] += 1
+        return bool(self._dropout.random() < self.dropout)
+
+    def perturb(self, values: np.ndarray, scale: float = 1.0) -> np.ndarray:
+        """``values`` plus noise of std ``noise_std * scale`` (unchanged without the noise effect)."""
+        if self.noise_std is None:
+            return values
+        self._draws["noise_draws"] += values.size
+        return values + self._noise.normal(0.0, self.noise_std * scale, values.shape)

@@ -1,0 +1,322 @@
+# Copyright 2026 squeeze_grasp_ros developers
+# SPDX-License-Identifier: Apache-2.0
+"""The simulated world: devices follow setpoints, the stepper moves the contact, sensors read it.
+
+One :meth:`SimWorld.step` is one lockstep tick of ``scene.sim.dt`` seconds:
+
+1. every device moves its fingertip toward its setpoint (:func:`.devices.follow`);
+2. the per-tick translations of the fingertips in contact go to the incremental stepper
+   (:func:`..mechanics.stepper.advance`), which locates the contact events on the way
+   (ground truth);
+3. the declared sensors read the new contact state (:mod:`.sensors`).
+
+Only declared effects are composed (``scene.effects``): ``friction`` sets mu (else 0),
+``strain_limit`` and ``pickup`` set the stepper's termination limits, ``adversary`` adds the
+third fingertip and its pusher, ``force_sensing``/``tactile_sensing`` render wrenches/taxels,
+``sensor_noise``/``sensor_dropout`` draw random numbers, ``actuator_lag`` lags the devices. Every
+piece of optional work increments a counter of :attr:`SimWorld.work`.
+
+When the stepper reports a termination (a finger slips, the strain limit, pickup, a lost
+contact) the object's motion can no longer be simulated: the world *ends*, the contact state
+freezes (the sensors keep reading it) and the devices still follow their setpoints.
+
+The adversary's pusher waits at its home (its fingertip touching the undeformed object at its
+placement) until its setpoint first moves; then a guarded move places its fingertip on the
+*deformed* boundary (:func:`..mechanics.resistance_friction.add_adversary`). The pusher's
+position readings and setpoints stay in its own frame (its encoder counts from home), so
+commands and measurements stay consistent; the ground truth (:class:`TickOutput` ``state``) has
+the true tip centre.
+"""
+from __future__ import annotations
+
+from collections import Counter
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..mechanics.compliance import ElasticObject
+from ..mechanics.contact_model import ContactModel
+from ..mechanics.contact_state import ContactState, Event, initial_state
+from ..mechanics.fingertips import place_fingertip
+from ..mechanics.resistance_friction import add_adversary
+from ..mechanics.squeeze import plan_squeeze
+from ..mechanics.stepper import advance
+from ..scene import (Scene, build_mesh, finger_devices, finger_nodes, placement_node,
+                     scene_material)
+from ..scene_events import scene_limits
+from .devices import DeviceModel, device_model, follow
+from .sensors import (SensorRandomness, TactileLayout, fingertip_wrench, render_tactile,
+                      tactile_layout)
+
+TERMINATE_ON: tuple[str, ...] = ("strain_limit", "finger_slip", "picked_up")
+"""Stepper terminations that end the simulated world (as in Algorithm 1)."""
+
+
+def squeeze_geometry(scene: Scene, obj: ElasticObject,
+                     contacts: tuple[int, int]) -> tuple[dict[str, np.ndarray], float]:
+    """(finger -> translation per unit depth (m/m), relative depth per unit depth (1/m)).
+
+    The scene's stable or pure squeeze (:func:`..mechanics.squeeze.plan_squeeze`; approach
+    ||u_1 - u_2|| per unit depth, DEFINITIONS.md), or its user-given ``fingers.<F>.direction``
+    scaled to a unit stacked vector (approach along the chord of the contacts), as the
+    event-driven squeeze sets them up.
+    """
+    chord = np.diff(obj.mesh.nodes[list(contacts)], axis=0)[0]
+    distance = float(np.linalg.norm(chord))
+    if scene.fingers["F1"].direction is None:
+        plan = plan_squeeze(obj, list(contacts), scene.squeeze.type)
+        u = plan.displacement.reshape(2, 2)
+        return {"F1": u[0], "F2": u[1]}, plan.approach_per_unit_depth / distance
+    u = np.array([scene.fingers[n].direction for n in ("F1", "F2")], float)
+    u = u / np.linalg.norm(u)
+    return {"F1": u[0], "F2": u[1]}, float((u[0] - u[1]) @ chord) / distance ** 2
+
+
+@dataclass(frozen=True)
+class CountingContactModel(ContactModel):
+    """A :class:`ContactModel` that counts its strain-field work in ``counter``."""
+
+    counter: Counter = field(default_factory=Counter, repr=False, compare=False)
+
+    def strain_measure(self, sd, delta, F):
+        """Largest strain of a configuration (counted as ``strain_evaluations``)."""
+        self.counter["strain_evaluations"] += 1
+        return super().strain_measure(sd, delta, F)
+
+    def _strain_map(self, dofs):
+        self.counter["strain_maps"] += 1
+        return super()._strain_map(dofs)
+
+
+@dataclass(frozen=True)
+class FingerReading:
+    """What one fingertip's devices and sensors report at a tick (SI, fingertip frame).
+
+    Attributes
+    ----------
+    finger : str
+    device : str
+    position : (2,) ndarray
+        Measured fingertip centre, m, object frame (the pusher's from its home, see the module).
+    force, torque : (3,) ndarray or None
+        Wrench the object applies to the fingertip (N, N m); None without force sensing or
+        when the message was dropped.
+    normal, tangential : (n,) ndarray or None
+        Taxel forces, N; None without tactile sensing or when the message was dropped.
+    """
+
+    finger: str
+    device: str
+    position: np.ndarray
+    force: np.ndarray | None = None
+    torque: np.ndarray | None = None
+    normal: np.ndarray | None = None
+    tangential: np.ndarray | None = None
+
+
+@dataclass(frozen=True)
+class TickOutput:
+    """Everything the world reports for one tick.
+
+    Attributes
+    ----------
+    index : int
+        Tick number (0 = the initial state).
+    stamp_ns : int
+        Sim time of the tick, ns (index * dt).
+    readings : tuple of FingerReading
+        One per finger, in finger order.
+    events : tuple of Event
+        Ground-truth events located during the motion into this tick, in processing order.
+    termination : str or None
+        Set from the tick at which the world ended on.
+    state : ContactState
+        Ground-truth contact state.
+    """
+
+    index: int
+    stamp_ns: int
+    readings: tuple[FingerReading, ...]
+    events: tuple[Event, ...]
+    termination: str | None
+    state: ContactState
+
+
+@dataclass(frozen=True)
+class WorldView:
+    """Geometry for visualisation (object frame, m, N).
+
+    Attributes
+    ----------
+    outline : (b, 2) ndarray
+        Deformed outer boundary, counter-clockwise.
+    tips : tuple of (str, (2,) ndarray, float)
+        (finger, centre, radius) of every fingertip.
+    contacts : tuple of (str, (2,) ndarray, str, (2,) ndarray)
+        (finger, deformed node position, mode, force on the object) of every contact node.
+    """
+
+    outline: np.ndarray
+    tips: tuple
+    contacts: tuple
+
+
+class SimWorld:
+    """The simulated hardware's world for one scene (ROS-free, deterministic).
+
+    Parameters
+    ----------
+    scene : Scene
+        A solid-model scene with rounded fingertips.
+    obj : ElasticObject, optional
+        The meshed object (built from the scene if omitted).
+    """
+
+    def __init__(self, scene: Scene, obj: ElasticObject | None = None) -> None:
+        self.scene = scene
+        self.work: Counter = Counter()
+        if obj is None:
+            obj = ElasticObject(build_mesh(scene), scene_material(scene))
+        self.obj = obj.precompute()
+        self.model = CountingContactModel(
+            obj, scene.mu, scene_limits(scene),
+            max_events_per_depth=scene.squeeze.max_events_per_depth, counter=self.work)
+        mesh = obj.mesh
+        self.contacts = finger_nodes(scene, mesh)
+        tips = [place_fingertip(mesh, name, node, scene.fingers[name].tip_radius)
+                for name, node in zip(("F1", "F2"), self.contacts)]
+        self.directions, self.relative_per_depth = squeeze_geometry(scene, obj, self.contacts)
+        self.state = initial_state(tips, self.relative_per_depth)
+        self.adversary = None
+        if scene.has("adversary"):
+            adv = scene.adversary
+            node = placement_node(mesh, adv.placement, "adversary")
+            self.adversary = place_fingertip(mesh, "A", node, adv.tip_radius)
+            tips.append(self.adversary)
+        lag = scene.actuators.time_constant if scene.has("actuator_lag") else 0.0
+        devices = finger_devices(scene)
+        self.fingers: tuple[str, ...] = tuple(t.name for t in tips)
+        self.devices: dict[str, DeviceModel] = {t.name: device_model(devices[t.name], lag)
+                                                for t in tips}
+        self.radii = {t.name: t.radius for t in tips}
+        self.positions = {t.name: np.asarray(t.center, float) for t in tips}
+        self.offsets = {t.name: np.zeros(2) for t in tips}
+        sensors = scene.sensors
+        self.layouts: dict[str, TactileLayout] = {}
+        if scene.has("tactile_sensing"):
+            taxels = sensors.taxels if sensors is not None else 64
+            span = np.radians(sensors.taxel_span_deg if sensors is not None else 150.0)
+            self.layouts = {t.name: tactile_layout(t.theta, taxels, span) for t in tips}
+        self.randomness = SensorRandomness(
+            sensors.seed if sensors is not None and sensors.seed is not None else 0,
+            sensors.noise_std if scene.has("sensor_noise") else None,
+            sensors.dropout if scene.has("sensor_dropout") else None, self.work)
+        self.dt = scene.sim.dt
+        self.dt_ns = int(round(scene.sim.dt * 1e9))
+        self.index = 0
+        self.termination: str | None = None
+        self.step_size = scene.squeeze.step
+        self.event_tol = scene.squeeze.event_tol
+
+    # ----------------------------------------------------------------- ticks
+    def start(self) -> TickOutput:
+        """The readings of tick 0 (initial placement, no motion)."""
+        return self._output(())
+
+    def step(self, setpoints: Mapping[str, np.ndarray]) -> TickOutput:
+        """Advance one tick toward ``setpoints`` (finger -> tip centre (2,), m, object frame).
+
+        Fingers without a setpoint hold their position.
+        """
+        moves: dict[str, np.ndarray] = {}
+        for name in self.fingers:
+            if name not in setpoints:
+                continue
+            target = np.asarray(setpoints[name], float) + self.offsets[name]
+            if name == "A" and not self._adversary_touching() and np.any(target != self.positions[name]):
+                target = self._touch_adversary(target)
+            device = self.devices[name]
+            if device.lagged:
+                self.work["lag_updates"] += 1
+            new = follow(device, self.positions[name], target, self.dt)
+            moves[name] = new - self.positions[name]
+            self.positions[name] = new
+        self.index += 1
+        events: tuple[Event, ...] = ()
+        touching = {f.name for f in self.state.fingers}
+        translations = {k: tuple(v) for k, v in moves.items() if k in touching and np.any(v != 0.0)}
+        if translations and self.termination is None:
+            self.work["stepper_calls"] += 1
+            result = advance(self.model, self.state, translations, self.step_size, self.event_tol,
+                             terminate_on=TERMINATE_ON)
+            self.state, events = result.state, result.events
+            self.termination = result.termination
+        return self._output(events)
+
+    def _adversary_touching(self) -> bool:
+        return any(f.name == "A" for f in self.state.fingers)
+
+    def _touch_adversary(self, target: np.ndarray) -> np.ndarray:
+        """Place A on the deformed boundary; return its setpoint shifted by the same offset."""
+        self.work["adversary_placements"] += 1
+        field_ = self.displacement_field()
+        self.state = add_adversary(self.state, self.model, field_, self.adversary.node,
+                                   self.adversary.radius)
+        touched = np.asarray(self.state.finger("A").center, float)
+        offset = touched - self.positions["A"]
+        self.offsets["A"] = self.offsets["A"] + offset
+        self.positions["A"] = touched
+        return target + offset
+
+    def _output(self, events: tuple[Event, ...]) -> TickOutput:
+        readings = tuple(self._read(name) for name in self.fingers)
+        return TickOutput(self.index, self.index * self.dt_ns, readings, events, self.termination,
+                          self.state)
+
+    def _read(self, name: str) -> FingerReading:
+        """Sensor readings of finger ``name`` (dropout decided before noise is drawn)."""
+        contacts = [c for c in self.state.contacts if c.finger == name]
+        device = self.devices[name].name
+        reading = {"finger": name, "device": device,
+                   "position": self.positions[name] - self.offsets[name]}
+        rnd = self.randomness
+        if self.scene.has("force_sensing") and not rnd.dropped():
+            self.work["wrench_evaluations"] += 1
+            force, torque = fingertip_wrench(contacts, self.radii[name])
+            reading["force"] = rnd.perturb(force)
+            reading["torque"] = rnd.perturb(torque, self.radii[name])
+        if name in self.layouts and not rnd.dropped():
+            self.work["tactile_renderings"] += 1
+            normal, tangential = render_tactile(self.layouts[name], contacts)
+            reading["normal"] = rnd.perturb(normal)
+            reading["tangential"] = rnd.perturb(tangential)
+        return FingerReading(**reading)
+
+    # ----------------------------------------------------------------- geometry
+    def _contact_solution(self) -> tuple:
+        """(set data, dimensionless displacements, dimensionless forces) of the current contacts."""
+        contacts = self.state.contacts
+        sd = self.model.set_data(tuple(c.node for c in contacts))
+        delta = np.array([c.displacement for c in contacts]) / self.model.length
+        forces = np.array([c.force for c in contacts]) / self.model.force_unit
+        return sd, delta, forces
+
+    def displacement_field(self) -> np.ndarray:
+        """Displacement (n, 2) of every mesh node, m (one sparse solve; counted)."""
+        self.work["displacement_fields"] += 1
+        sd, delta, forces = self._contact_solution()
+        return self.model.full_displacement(sd, delta, forces).reshape(-1, 2) * self.model.length
+
+    def view(self) -> WorldView:
+        """Deformed outline, fingertips and contacts for display (counted as ``views``)."""
+        self.work["views"] += 1
+        sd, delta, forces = self._contact_solution()
+        mesh = self.obj.mesh
+        outline = mesh.nodes[mesh.boundary] + self.model.boundary_displacement(sd, delta, forces) \
+            * self.model.length
+        tips = tuple((f.name, np.asarray(f.center, float), float(f.radius))
+                     for f in self.state.fingers)
+        contacts = tuple((c.finger, mesh.nodes[c.node] + c.displacement, c.mode, c.force)
+                         for c in self.state.contacts)
+        return WorldView(outline, tips, contacts)

@@ -6,11 +6,13 @@ from __future__ import annotations
 import argparse
 import sys
 
-from ..nodes.runner import EXECUTORS, PipelineRunner, RunOptions
 from .common import add_scene_argument
 
 HELP = ("run a scene through the planner, executor, simulated hardware, monitor and recorder "
         "nodes (lockstep sim time) and summarise it")
+EXECUTOR_CHOICES: tuple[str, ...] = ("events", "single")
+"""``--executor`` values (equal to ``nodes.runner.EXECUTORS``; kept here so that building the CLI
+parser never imports rclpy: ``squeeze-grasp ros-setup`` must run before the interfaces exist)."""
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -21,7 +23,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--processes", action="store_true",
                         help="one process per node, as `ros2 launch` starts them (default: "
                              "every node on one executor in this process)")
-    parser.add_argument("--executor", choices=EXECUTORS, default="events",
+    parser.add_argument("--executor", choices=EXECUTOR_CHOICES, default="events",
                         help="rclpy executor of the one-process mode (default: events, "
                              "rclpy.experimental.EventsExecutor)")
     parser.add_argument("--on-slip-alarm", choices=("hold", "pure", "normals"), default="hold",
@@ -46,6 +48,8 @@ def _progress_line(update: dict) -> None:
 
 def run(args: argparse.Namespace) -> dict:
     """Run the pipeline; the JSON summary (see :meth:`PipelineRunner.summary`)."""
+    from ..nodes.runner import PipelineRunner, RunOptions
+
     options = RunOptions(args.scene, record=args.record, processes=args.processes,
                          executor=args.executor, on_slip_alarm=args.on_slip_alarm,
                          resist=not args.no_resist, planner=not args.no_planner)

@@ -218,7 +218,7 @@ class SensorsSpec:
     seed: Optional[int] = spec("seed of the noise and dropout draws (required with either)", "",
                                lo=0, default=None)
     taxels: int = spec("taxels per fingertip tactile array (effect: tactile_sensing)", "", lo=2,
-                       default=64)
+                       default=96)
     taxel_span_deg: float = spec("arc of the fingertip covered by the tactile array, centred on "
                                  "the initial contact", "deg", lo=0.0, hi=360.0, lo_open=True,
                                  default=150.0)

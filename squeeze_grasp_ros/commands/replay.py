@@ -4,6 +4,9 @@
 from __future__ import annotations
 
 import argparse
+import sys
+
+import yaml
 
 HELP = ("replay a recording's sensor topics on its sim time into a fresh monitor and check that "
         "it reproduces the recorded event sequence")
@@ -12,18 +15,23 @@ HELP = ("replay a recording's sensor topics on its sim time into a fresh monitor
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     """DIR and monitor parameter overrides for recordings made by other tools."""
     parser.add_argument("bag", metavar="DIR", help="rosbag2 folder (MCAP or SQLite3) or .mcap file")
-    parser.add_argument("--mu", type=float,
-                        help="friction coefficient for the monitor (default: the recording's)")
-    parser.add_argument("--load-threshold", type=float,
-                        help="taxel load threshold, N (default: the recording's)")
+    parser.add_argument("--param", metavar="NAME=VALUE", action="append", default=[],
+                        help="monitor parameter for the replay (repeatable; YAML value), e.g. "
+                             "mu=0.4 for a recording made by another tool (default: the "
+                             "recording's parameters, else config/monitor.yaml)")
 
 
 def run(args: argparse.Namespace) -> dict | int:
     """Replay; exit code 1 when the recorded event sequence is not reproduced."""
     from ..recording.replay import replay
 
-    overrides = {k: v for k, v in (("mu", args.mu), ("load_threshold", args.load_threshold))
-                 if v is not None}
+    overrides = {}
+    for entry in args.param:
+        name, sep, value = entry.partition("=")
+        if not sep or not name:
+            print(f"squeeze-grasp replay: --param needs NAME=VALUE, got {entry!r}", file=sys.stderr)
+            return 2
+        overrides[name] = yaml.safe_load(value)
     result = replay(args.bag, overrides)
     if result["reproduced"] is False and not args.json:
         print(summary(result))

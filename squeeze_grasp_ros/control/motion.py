@@ -6,9 +6,11 @@ A goal is a squeeze (each squeezing finger f moves along d_f per unit depth rho,
 and optionally a resistance (the adversary moves by a along a straight line while the squeezing
 fingers follow piecewise-linear waypoints in the adversary's travel). Each phase is a path
 p_f(s) in a progress variable s (depth, or the adversary's travel). Every control cycle the
-progress speed v follows an online trapezoid: v <- min(v + a_s dt, v_s, sqrt(2 a_s (s* - s)))
-with v_s = v_max / g and a_s = a_max / g, where g = max over fingers and segments of |dp_f/ds|,
-so no fingertip exceeds ``max_velocity`` (m/s) or ``max_acceleration`` (m/s^2); the last step
+progress speed v follows an online trapezoid: v <- min(v + a_s dt, v_s, v_b(s* - s)) with
+v_s = v_max / g and a_s = a_max / g, where g = max over fingers and segments of |dp_f/ds|, and
+v_b(R) the largest speed from which the remaining progress R can still be covered exactly while
+slowing by at most a_s dt per cycle (:func:`braking_speed`); so no fingertip exceeds
+``max_velocity`` (m/s) or ``max_acceleration`` (m/s^2), also in discrete time, and the last step
 lands exactly on the end. A phase ends when the progress is at its end and every moving
 fingertip is measured within ``position_tolerance`` of its setpoint (devices may lag).
 
@@ -194,6 +196,21 @@ class Command:
     message: str = ""
 
 
+def braking_speed(remaining: float, accel: float, dt: float) -> float:
+    """Largest speed v for this cycle after which ``remaining`` progress can still be covered
+    exactly, slowing by at most ``accel * dt`` per cycle.
+
+    With m later cycles, each slower by accel dt, the progress covered from speed v is
+    g(v) = dt ((m + 1) v - accel dt m (m + 1) / 2) for v in (m accel dt, (m + 1) accel dt];
+    g is continuous and increasing, and v_b = g^-1(remaining).
+    """
+    if remaining <= 0.0:
+        return 0.0
+    x = remaining / (accel * dt * dt)
+    m = max(int(np.ceil((np.sqrt(1.0 + 8.0 * x) - 1.0) / 2.0)) - 1, 0)
+    return (remaining / dt + accel * dt * m * (m + 1) / 2.0) / (m + 1)
+
+
 @dataclass(frozen=True)
 class PolylinePath:
     """p_f(s) = start_f + piecewise-linear offsets through knots (s_k, offsets_k)."""
@@ -365,7 +382,7 @@ class GraspProgram:
         remaining = path.end - self.s
         if remaining <= 0.0:
             return
-        self.v = min(self.v + accel * dt, speed, float(np.sqrt(2.0 * accel * remaining)))
+        self.v = min(self.v + accel * dt, speed, braking_speed(remaining, accel, dt))
         self.s = min(self.s + self.v * dt, path.end)
         for f, p in zip(self.moving, path.at(self.s)):
             self.commanded[f] = p

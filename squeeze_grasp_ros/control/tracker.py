@@ -9,15 +9,19 @@ normal force F_n and tangential force F_t of its taxels and their F_n-weighted m
 taxels finer than half the node spacing on the fingertip, every contact node forms its own patch
 (the shipped scenes are built so); coarser arrays merge neighbouring nodes into one patch.
 
-Per tick and finger, patches are matched to the previous tick's by angle (greedy, nearest first,
-within ``match_spacings`` taxel spacings), which gives the events (types as in the paper):
+Per tick and finger, a patch and a patch of the previous tick are *connected* when their taxel
+ranges overlap (widened by ``match_margin`` taxels on each side); the connected groups give the
+events (types as in the paper):
 
-- A (new contact): a patch with no predecessor, on a finger already in contact (the first
-  patches of a finger are its initial contact, not an event, as in the paper);
-- B (contact break): a predecessor with no patch;
-- C (stick -> slip): a matched patch whose cone usage |F_t| / (mu F_n) reached
+- A (new contact): a patch connected to no previous patch, on a finger already in contact (the
+  first patches of a finger are its initial contact, not an event, as in the paper);
+- B (contact break): a previous patch connected to no patch;
+- C (stick -> slip): a one-to-one connected patch whose cone usage |F_t| / (mu F_n) reached
   1 - ``edge_tolerance``;
-- D (slip -> stick): a matched patch whose cone usage fell below it again.
+- D (slip -> stick): a one-to-one connected patch whose cone usage fell below it again.
+
+Patches that merge or split (sliding nodes moving across the taxels) are connected groups of
+several patches and raise no event.
 
 Events of one tick are ordered by finger (F1, F2, A), then B < D < C < A (the stepper's
 order), then angle. Alarms (active while their condition holds):
@@ -65,8 +69,8 @@ class TrackerConfig:
         A patch slides when its cone usage is at least 1 - edge_tolerance.
     alarm_ratio : float
         Cone usage of every loaded taxel that raises ``slip_imminent`` (< 1).
-    match_spacings : float
-        Largest angle between a patch and its predecessor, in taxel spacings.
+    match_margin : int
+        Taxels by which patch ranges are widened before testing them for overlap.
     stale_after : float
         Age of a finger's newest reading that makes it stale, s.
     weight : float or None
@@ -78,10 +82,10 @@ class TrackerConfig:
     """
 
     mu: float
-    load_threshold: float = 0.005
-    edge_tolerance: float = 0.02
+    load_threshold: float = 0.002
+    edge_tolerance: float = 1e-4
     alarm_ratio: float = 0.9
-    match_spacings: float = 1.5
+    match_margin: int = 0
     stale_after: float = 0.0025
     weight: float | None = None
     prediction_tolerance: float = 5e-4
@@ -117,7 +121,7 @@ class FingerSample:
 
 @dataclass(frozen=True)
 class Patch:
-    """A contact patch: a run of neighbouring loaded taxels (first..last, inclusive).
+    """A contact patch: a run of neighbouring loaded taxels.
 
     Attributes
     ----------
@@ -129,6 +133,8 @@ class Patch:
     mode : {"stick", "slip"}
     slip : int
         +1 / -1: direction of sliding in polar angle (-sign F_t); 0 while sticking.
+    first, last : int
+        Its taxels (inclusive).
     """
 
     finger: str
@@ -137,6 +143,8 @@ class Patch:
     tangential: float
     mode: str
     slip: int
+    first: int = 0
+    last: int = 0
 
 
 @dataclass(frozen=True)
@@ -221,22 +229,34 @@ def patches_of(finger: str, sample: FingerSample, config: TrackerConfig) -> list
         angle = float(fn @ sample.angles[first:last + 1] / normal)
         sliding = mu == 0.0 or abs(tangential) >= (1.0 - config.edge_tolerance) * mu * normal
         slip = -int(np.sign(tangential)) if sliding and mu > 0.0 else 0
-        out.append(Patch(finger, angle, normal, tangential, "slip" if sliding else "stick", slip))
+        out.append(Patch(finger, angle, normal, tangential, "slip" if sliding else "stick", slip,
+                         first, last))
     return out
 
 
-def match_patches(previous: Sequence[Patch], current: Sequence[Patch],
-                  radius: float) -> list[tuple[int, int]]:
-    """Greedy nearest-angle matching (i into previous, j into current) within ``radius`` rad."""
-    pairs = sorted((abs(p.angle - c.angle), i, j) for i, p in enumerate(previous)
-                   for j, c in enumerate(current) if abs(p.angle - c.angle) <= radius)
-    used_i, used_j, out = set(), set(), []
-    for _, i, j in pairs:
-        if i not in used_i and j not in used_j:
-            used_i.add(i)
-            used_j.add(j)
-            out.append((i, j))
-    return out
+def connected_groups(previous: Sequence[Patch], current: Sequence[Patch],
+                     margin: int) -> list[tuple[list[int], list[int]]]:
+    """Groups (previous indices, current indices) of patches linked by overlapping taxel ranges."""
+    parent = list(range(len(previous) + len(current)))
+
+    def root(k: int) -> int:
+        while parent[k] != k:
+            parent[k] = parent[parent[k]]
+            k = parent[k]
+        return k
+
+    for i, p in enumerate(previous):
+        for j, c in enumerate(current):
+            if p.first - margin <= c.last + margin and c.first - margin <= p.last + margin:
+                parent[root(i)] = root(len(previous) + j)
+    groups: dict[int, tuple[list[int], list[int]]] = {}
+    for k in range(len(parent)):
+        group = groups.setdefault(root(k), ([], []))
+        if k < len(previous):
+            group[0].append(k)
+        else:
+            group[1].append(k - len(previous))
+    return list(groups.values())
 
 
 @dataclass
@@ -296,7 +316,7 @@ class ContactTracker:
             self._note_stamps(track, sample)
             current = patches_of(name, sample, cfg)
             if sample.normal is not None:
-                events += self._events(name, track.patches, current, sample, relative)
+                events += self._events(name, track.patches, current, relative)
                 track.patches = current
                 track.had_contact = track.had_contact or bool(current)
             patches += track.patches
@@ -344,20 +364,20 @@ class ContactTracker:
         return max(ages, default=0.0)
 
     def _events(self, name: str, previous: list[Patch], current: list[Patch],
-                sample: FingerSample, relative: float) -> list[TrackedEvent]:
-        spacing = float(sample.angles[1] - sample.angles[0]) if len(sample.angles) > 1 else 1.0
-        pairs = match_patches(previous, current, self.config.match_spacings * spacing)
-        matched_prev = {i for i, _ in pairs}
-        matched_cur = {j for _, j in pairs}
-        found = [("B", p.angle) for i, p in enumerate(previous) if i not in matched_prev]
-        if self.tracks[name].had_contact:
-            found += [("A", c.angle) for j, c in enumerate(current) if j not in matched_cur]
-        for i, j in pairs:
-            before, after = previous[i].mode, current[j].mode
-            if before == "stick" and after == "slip":
-                found.append(("C", current[j].angle))
-            elif before == "slip" and after == "stick":
-                found.append(("D", current[j].angle))
+                relative: float) -> list[TrackedEvent]:
+        found = []
+        for before, after in connected_groups(previous, current, self.config.match_margin):
+            if not after:
+                found += [("B", previous[i].angle) for i in before]
+            elif not before:
+                if self.tracks[name].had_contact:
+                    found += [("A", current[j].angle) for j in after]
+            elif len(before) == len(after) == 1:
+                old, new = previous[before[0]], current[after[0]]
+                if old.mode == "stick" and new.mode == "slip":
+                    found.append(("C", new.angle))
+                elif old.mode == "slip" and new.mode == "stick":
+                    found.append(("D", new.angle))
         found.sort(key=lambda e: (ORDER[e[0]], e[1]))
         return [TrackedEvent(kind, name, self.depth, relative, angle) for kind, angle in found]
 

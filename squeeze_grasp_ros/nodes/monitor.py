@@ -35,10 +35,10 @@ PARAMETERS: dict[str, tuple[Any, str]] = {
     "finger_devices": (["F1:barrett_f1", "F2:barrett_f3"], "finger:device of every fingertip"),
     "streams": (["wrench", "tactile"], "sensor streams each finger has (staleness test)"),
     "mu": (0.4, "friction coefficient of the fingertips"),
-    "load_threshold": (0.005, "a taxel is loaded above this normal force, N"),
-    "edge_tolerance": (0.02, "a patch slides at cone usage >= 1 - edge_tolerance"),
+    "load_threshold": (0.002, "a taxel is loaded above this normal force, N"),
+    "edge_tolerance": (1e-4, "a patch slides at cone usage >= 1 - edge_tolerance"),
     "alarm_ratio": (0.9, "cone usage of every loaded taxel that raises slip_imminent"),
-    "match_spacings": (1.5, "largest patch motion between ticks, taxel spacings"),
+    "match_margin": (0, "taxels by which patch ranges are widened to connect them over ticks"),
     "stale_after": (0.0025, "age of a finger's newest reading that makes it stale, s"),
     "weight": (0.0, "object weight for the pickup test, N (0: no pickup test)"),
     "prediction_tolerance": (5e-4, "depth tolerance of the prediction comparison, m"),
@@ -61,7 +61,7 @@ class MonitorNode(Node):
         self.fingers = pipeline.parse_mapping(p["finger_devices"], "finger_devices")
         self.tracker = ContactTracker(TrackerConfig(
             p["mu"], p["load_threshold"], p["edge_tolerance"], p["alarm_ratio"],
-            p["match_spacings"], p["stale_after"], p["weight"] or None,
+            p["match_margin"], p["stale_after"], p["weight"] or None,
             p["prediction_tolerance"], p["relative_per_depth"]), list(self.fingers), p["streams"])
         loop = pipeline.loop_qos(p["qos_depth"])
         sensors = pipeline.sensor_qos(p["sensor_qos"], p["qos_depth"])

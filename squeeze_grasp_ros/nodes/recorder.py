@@ -56,10 +56,14 @@ PARAMETERS: dict[str, tuple[Any, str]] = {
 
 DUPLICATE_WINDOW = 16
 """Stamps per topic remembered to drop re-sent copies."""
-POLICY_NAMES = {HistoryPolicy.KEEP_LAST: "keep_last", HistoryPolicy.KEEP_ALL: "keep_all",
-                ReliabilityPolicy.RELIABLE: "reliable", ReliabilityPolicy.BEST_EFFORT: "best_effort",
-                DurabilityPolicy.VOLATILE: "volatile",
-                DurabilityPolicy.TRANSIENT_LOCAL: "transient_local"}
+POLICY_NAMES = {
+    "history": {HistoryPolicy.KEEP_LAST: "keep_last", HistoryPolicy.KEEP_ALL: "keep_all"},
+    "reliability": {ReliabilityPolicy.RELIABLE: "reliable",
+                    ReliabilityPolicy.BEST_EFFORT: "best_effort"},
+    "durability": {DurabilityPolicy.VOLATILE: "volatile",
+                   DurabilityPolicy.TRANSIENT_LOCAL: "transient_local"},
+}
+"""rclpy QoS policies -> the names rosbag2 v9 writes (per policy: their integer values overlap)."""
 
 
 def cdr_stamp_ns(data: bytes) -> int:
@@ -110,9 +114,10 @@ class RecorderNode(Node):
             pipeline.wall_timer(self, 0.05, self._report)
 
     def _offered_qos(self, topic: str) -> list[dict]:
-        return [qos_dict(POLICY_NAMES.get(q.history, "unknown"), q.depth,
-                         POLICY_NAMES.get(q.reliability, "unknown"),
-                         POLICY_NAMES.get(q.durability, "unknown"))
+        def name(policy: str, value) -> str:
+            return POLICY_NAMES[policy].get(value, "unknown")
+        return [qos_dict(name("history", q.history), q.depth, name("reliability", q.reliability),
+                         name("durability", q.durability))
                 for q in (i.qos_profile for i in self.get_publishers_info_by_topic(topic))]
 
     def _record(self, topic: str, data: bytes) -> None:

@@ -142,7 +142,7 @@ def node_parameters(scene: Scene, scene_path: str, options: RunOptions,
     monitor.update(finger_devices=mapping, streams=streams or [""], mu=float(scene.mu),
                    weight=float(scene.pickup.weight) if scene.has("pickup") else 0.0,
                    relative_per_depth=float(relative_per_depth),
-                   load_threshold=max(float(monitor.get("load_threshold", 0.005)), 5.0 * noise))
+                   load_threshold=max(float(monitor.get("load_threshold", 0.005)), 6.0 * noise))
     params["executor"].update(finger_devices=mapping, period=float(scene.sim.dt))
     custom = {"scene": Path(scene_path).read_text(), "scene_path": str(scene_path)}
     params["recorder"].update(output=str(options.record or ""), devices=list(devices.values()))
@@ -204,6 +204,7 @@ class PipelineRunner:
         self.alarms: Counter = Counter()
         self.first_alarm: dict[str, dict] = {}
         self.sim_state: SimState | None = None
+        self.sim_states: list[SimState] = []
         self.recorder_ns = -1
         self.feedback: list[ExecuteGrasp.Feedback] = []
         loop = pipeline.loop_qos(1000)
@@ -236,6 +237,7 @@ class PipelineRunner:
 
     def _state(self, msg: SimState) -> None:
         self.sim_state = msg
+        self.sim_states.append(msg)
 
     def _recorder_progress(self, msg: Header) -> None:
         self.recorder_ns = max(self.recorder_ns, messages.stamp_ns(msg.stamp))

@@ -90,7 +90,8 @@ def monitor_parameters(bag: BagContents) -> dict[str, Any]:
             fingers.setdefault(match.group(1), deserialize_message(m.data, TactileArray).finger)
     free = [f for f in FINGER_ORDER if f not in fingers.values()]
     for device in devices:
-        fingers.setdefault(device, free.pop(0))
+        if device not in fingers:
+            fingers[device] = free.pop(0)
     params["finger_devices"] = [f"{f}:{d}" for d, f in fingers.items()]
     streams = {READING.match(m.topic).group(2) for m in bag.messages if READING.match(m.topic)}
     params["streams"] = sorted(streams - {"pose"}) or [""]

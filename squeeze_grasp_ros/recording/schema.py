@@ -76,8 +76,8 @@ def own_text(type_name: str) -> str:
     for suffix, index in ACTION_PARTS.items():
         if name.endswith(suffix):
             text = interface_file(package, "action", name[: -len(suffix)], ".action").read_text()
-            sections = re.split(r"^---\s*$", text, flags=re.MULTILINE)
-            return sections[index].strip("\n") + "\n"
+            section = re.split(r"^---\s*$", text, flags=re.MULTILINE)[index].strip("\n") + "\n"
+            return qualify(section, package)
     raise SchemaError(f"no definition for {type_name!r}")
 
 
@@ -89,6 +89,23 @@ def _fields(text: str) -> list[list[str]]:
         if line and not CONSTANT.match(line):
             out.append(line.split())
     return out
+
+
+def qualify(text: str, package: str) -> str:
+    """An action section's text with same-package field types written ``package/Type``.
+
+    Inside an ``.action`` file a bare ``Type`` names ``package/msg/Type``; readers that resolve
+    bare names against the enclosing type's namespace (``package/action``) need it spelled out.
+    """
+    out = []
+    for line in text.splitlines(keepends=True):
+        code = line.split("#", 1)[0]
+        tokens = code.split()
+        base = re.split(r"[\[<]", tokens[0], maxsplit=1)[0] if tokens else ""
+        if tokens and not CONSTANT.match(code.strip()) and base not in PRIMITIVES and "/" not in base:
+            line = line.replace(tokens[0], f"{package}/{tokens[0]}", 1)
+        out.append(line)
+    return "".join(out)
 
 
 def field_types(text: str, package: str) -> list[str]:

@@ -42,8 +42,8 @@ from ..mechanics.fingertips import place_fingertip
 from ..mechanics.resistance_friction import add_adversary
 from ..mechanics.squeeze import plan_squeeze
 from ..mechanics.stepper import advance
-from ..scene import (Scene, build_mesh, finger_devices, finger_nodes, placement_node,
-                     scene_material)
+from ..scene import (Scene, SensorsSpec, build_mesh, finger_devices, finger_nodes,
+                     placement_node, scene_material)
 from ..scene_events import scene_limits
 from .devices import DeviceModel, device_model, follow
 from .sensors import (SensorRandomness, TactileLayout, fingertip_wrench, render_tactile,
@@ -205,8 +205,8 @@ class SimWorld:
         sensors = scene.sensors
         self.layouts: dict[str, TactileLayout] = {}
         if scene.has("tactile_sensing"):
-            taxels = sensors.taxels if sensors is not None else 64
-            span = np.radians(sensors.taxel_span_deg if sensors is not None else 150.0)
+            layout = sensors if sensors is not None else SensorsSpec()
+            taxels, span = layout.taxels, np.radians(layout.taxel_span_deg)
             self.layouts = {t.name: tactile_layout(t.theta, taxels, span) for t in tips}
         self.randomness = SensorRandomness(
             sensors.seed if sensors is not None and sensors.seed is not None else 0,

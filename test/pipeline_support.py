@@ -1,0 +1,83 @@
+# Copyright 2026 squeeze_grasp_ros developers
+# SPDX-License-Identifier: Apache-2.0
+"""Scenes and comparisons shared by the simulated-world and pipeline tests."""
+from __future__ import annotations
+
+import copy
+from pathlib import Path
+
+import yaml
+
+EVENT_TOLERANCE_TICKS = 8
+"""Monitor events vs ground truth: type and finger exact, tick within this many ticks."""
+
+SMALL_SQUARE = {
+    "name": "small_square",
+    "object": {"shape": {"type": "square", "side": 0.1},
+               "material": {"E": 5.0e4, "nu": 0.3, "thickness": 0.0254},
+               "mesh": {"nodes": 1000, "min_angle": 30}},
+    "fingers": {"F1": {"tip_radius": 0.02, "placement": {"point": [-0.05, 0.0]}},
+                "F2": {"tip_radius": 0.02, "placement": {"point": [0.05, 0.0]}}},
+    "squeeze": {"type": "stable", "relative_depth": 0.08},
+    "friction": {"mu": 0.05},
+    "effects": ["friction", "force_sensing", "tactile_sensing"],
+}
+"""A 1000-node foam square squeezed 8 % at mu = 0.05: contact growth, sticking and sliding
+(events A, C, D)."""
+
+SLIPPING_SQUARE = {**copy.deepcopy(SMALL_SQUARE), "name": "slipping_square",
+                   "object": {**SMALL_SQUARE["object"], "mesh": {"nodes": 800, "min_angle": 30}},
+                   "squeeze": {"type": "stable", "relative_depth": 0.10}}
+"""An 800-node square at mu = 0.05 whose squeeze ends with a finger slipping (Sec. 5.1)."""
+
+
+def scene_data(base: dict, **changes) -> dict:
+    """A deep copy of ``base`` with top-level keys replaced (None deletes a key)."""
+    data = copy.deepcopy(base)
+    for key, value in changes.items():
+        if value is None:
+            data.pop(key, None)
+        else:
+            data[key] = value
+    return data
+
+
+def write_scene(directory: Path, data: dict) -> str:
+    """Write a scene mapping to ``directory/<name>.yaml``; returns the path."""
+    path = Path(directory) / f"{data['name']}.yaml"
+    path.write_text(yaml.safe_dump(data))
+    return str(path)
+
+
+def net_events(states) -> list[tuple[int, str, str]]:
+    """(tick, type, finger) of the net contact changes between consecutive ground-truth states.
+
+    ``states`` are, in tick order, mappings contact node -> (finger, "stick" | "slip"). Several
+    located events of one node within one tick (slip -> stick -> slip) are one net change or
+    none: what any sensor sampled once per tick can see.
+    """
+    out = []
+    for tick, (prev, cur) in enumerate(zip(states, states[1:]), start=1):
+        out += [(tick, "A", cur[n][0]) for n in sorted(cur.keys() - prev.keys())]
+        out += [(tick, "B", prev[n][0]) for n in sorted(prev.keys() - cur.keys())]
+        out += [(tick, "C" if cur[n][1] == "slip" else "D", cur[n][0])
+                for n in sorted(cur.keys() & prev.keys()) if cur[n][1] != prev[n][1]]
+    return out
+
+
+def contact_modes(state) -> dict:
+    """node -> (finger, mode) of a stepper ``ContactState`` or a ``SimState`` message."""
+    if hasattr(state, "contacts"):
+        return {c.node: (c.finger, c.mode) for c in state.contacts}
+    return {n.node: (n.finger, "stick" if n.mode == n.STICK else "slip") for n in state.nodes}
+
+
+def match_within(expected, observed, ticks: int) -> list[str]:
+    """Problems matching (tick, type, finger) events one to one per (type, finger) within ticks."""
+    problems = []
+    for key in sorted({e[1:] for e in expected} | {e[1:] for e in observed}):
+        a = sorted(e[0] for e in expected if e[1:] == key)
+        b = sorted(e[0] for e in observed if e[1:] == key)
+        if len(a) != len(b) or any(abs(x - y) > ticks for x, y in zip(a, b)):
+            problems.append(f"{key}: ground truth at ticks {a}, monitor at {b}")
+    return problems

@@ -1,0 +1,262 @@
+# Copyright 2026 squeeze_grasp_ros developers
+# SPDX-License-Identifier: Apache-2.0
+"""The pipeline on real rclpy nodes in one process: ground truth against the mechanics API,
+monitor events against the ground truth, the recording read back by independent readers,
+replay, dropout holds, slip alarms, the reactive redirection and cancel."""
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+import yaml
+from rclpy.serialization import deserialize_message
+
+from squeeze_grasp_ros.mechanics.compliance import ElasticObject
+from squeeze_grasp_ros.nodes import pipeline
+from squeeze_grasp_ros.nodes.runner import PipelineRunner, RunOptions
+from squeeze_grasp_ros.recording.bag import read_bag
+from squeeze_grasp_ros.recording.replay import replay
+from squeeze_grasp_ros.recording.schema import own_text
+from squeeze_grasp_ros.scene import build_mesh, finger_nodes, load_scene, scene_material
+from squeeze_grasp_ros.scene_events import event_squeeze_scene
+
+from pipeline_support import (EVENT_TOLERANCE_TICKS, SLIPPING_SQUARE, SMALL_SQUARE,
+                              contact_modes, match_within, net_events, scene_data, write_scene)
+
+SCENES = Path(__file__).resolve().parents[1] / "config" / "scenes"
+
+
+def mechanics(scene_path: str):
+    """(event tolerance in m, the mechanics API's event-driven squeeze) of a scene."""
+    scene = load_scene(scene_path)
+    obj = ElasticObject(build_mesh(scene), scene_material(scene))
+    return (scene.squeeze.event_tol * obj.scale,
+            event_squeeze_scene(scene, obj, finger_nodes(scene, obj.mesh)))
+
+
+def messages_of(bag, topic: str) -> list:
+    """Deserialized messages of one topic of a :func:`read_bag` result."""
+    cls = pipeline.message_type(bag.types[topic])
+    return [deserialize_message(m.data, cls) for m in bag.messages if m.topic == topic]
+
+
+@pytest.fixture(scope="module")
+def foam(tmp_path_factory):
+    """The shipped foam-square scene, recorded, through every node in one process."""
+    record = tmp_path_factory.mktemp("foam") / "bag"
+    path = str(SCENES / "foam_square.yaml")
+    return {"path": path, "bag": record,
+            "run": PipelineRunner(RunOptions(path, record=str(record))).run()}
+
+
+@pytest.fixture(scope="module")
+def small(tmp_path_factory):
+    """The small mu = 0.05 square (A, C, D events), recorded, no slip alarm."""
+    directory = tmp_path_factory.mktemp("small")
+    path = write_scene(directory, SMALL_SQUARE)
+    options = RunOptions(path, record=str(directory / "bag"),
+                         overrides={"monitor": {"alarm_ratio": 2.0}})
+    return {"path": path, "bag": directory / "bag", "run": PipelineRunner(options).run()}
+
+
+def assert_ground_truth_is_the_mechanics(run: dict, path: str) -> None:
+    event_tol, api = mechanics(path)
+    tol = 2 * event_tol + 1e-12
+    print(f"ground truth vs mechanics: events (type, node, finger) equal, depths within {tol:.2g} m")
+    truth = run["events"]
+    assert [(e["type"], e["node"], e["finger"]) for e in truth] == \
+        [(e.type, e.node, e.finger) for e in api.events]
+    assert all(abs(e["depth"] - a.depth) <= tol for e, a in zip(truth, api.events))
+    expected = api.termination
+    world = run["world_termination"]
+    assert (world if world != "none" else "depth_reached") == expected
+    assert run["depth"] == pytest.approx(api.depth, rel=1e-9, abs=tol)
+    for finger in ("F1", "F2"):
+        assert np.allclose(run["forces"][finger], api.state.finger_force(finger), rtol=1e-7,
+                           atol=1e-9)
+        assert run["work"][finger] == pytest.approx(api.work[finger], rel=1e-6)
+    assert sorted((c["node"], c["mode"]) for c in run["contacts"]) == \
+        sorted((c.node, c.mode) for c in api.state.contacts)
+
+
+def test_foam_square_ground_truth_equals_the_mechanics(foam):
+    run = foam["run"]
+    assert run["termination"] == "depth_reached" and run["success"]
+    assert run["plan_source"] == "planner"
+    assert_ground_truth_is_the_mechanics(run, foam["path"])
+    assert run["measured_depth"] == pytest.approx(run["target_depth"], rel=1e-9)
+
+
+def test_small_square_ground_truth_equals_the_mechanics(small):
+    assert_ground_truth_is_the_mechanics(small["run"], small["path"])
+    assert {"C", "D"} <= {e["type"] for e in small["run"]["events"]}
+
+
+@pytest.mark.parametrize("case", ["foam", "small"])
+def test_monitor_events_match_the_ground_truth(case, foam, small):
+    fixture = {"foam": foam, "small": small}[case]
+    bag = read_bag(fixture["bag"])
+    states = [contact_modes(s) for s in messages_of(bag, "/sim/state")]
+    dt_ns = load_scene(fixture["path"]).sim.dt * 1e9
+    truth = net_events(states)
+    seen = [(round(pipeline_stamp(e) / dt_ns), e.type, e.finger)
+            for msg in messages_of(bag, "/monitor/events") for e in msg.events]
+    print(f"{case}: tolerance: type and finger exact, tick within {EVENT_TOLERANCE_TICKS} ticks "
+          f"({EVENT_TOLERANCE_TICKS * dt_ns * 1e-6:.0f} ms of sim time); {len(truth)} ground-truth "
+          f"net events, {len(seen)} monitor events")
+    assert truth and match_within(truth, seen, EVENT_TOLERANCE_TICKS) == []
+
+
+def pipeline_stamp(msg) -> int:
+    """Stamp of a message with a header, ns."""
+    return msg.header.stamp.sec * 1_000_000_000 + msg.header.stamp.nanosec
+
+
+def test_recording_reads_back_with_rosbags(foam):
+    from rosbags.highlevel import AnyReader
+
+    run = foam["run"]
+    ticks = run["ticks"] + 1
+    expected = pipeline.pipeline_topics(["barrett_f1", "barrett_f3"])
+    with AnyReader([foam["bag"]]) as reader:
+        connections = {c.topic: c for c in reader.connections}
+        assert set(connections) <= set(expected)
+        for topic in ("/clock", "/sim/tick", "/sim/state", "/monitor/status",
+                      "/devices/barrett_f1/tactile", "/devices/barrett_f3/wrench"):
+            assert connections[topic].msgtype == expected[topic]
+            assert connections[topic].msgcount == ticks
+        assert connections["/devices/barrett_f1/setpoint"].msgcount == ticks - 1
+        assert connections["/sim/events"].msgtype == expected["/sim/events"]
+        last: dict[str, int] = {}
+        decoded = set()
+        for connection, timestamp, raw in reader.messages():
+            assert timestamp >= last.get(connection.topic, 0)
+            last[connection.topic] = timestamp
+            if connection.topic not in decoded:
+                reader.deserialize(raw, connection.msgtype)
+                decoded.add(connection.topic)
+        assert decoded == set(connections)
+    qos = connections["/sim/tick"].ext.offered_qos_profiles[0]
+    assert qos.reliability.name == "RELIABLE"
+    assert (foam["bag"] / "metadata.yaml").is_file()
+
+
+def test_recording_reads_back_with_the_mcap_library(foam):
+    from mcap.reader import make_reader
+
+    files = list(Path(foam["bag"]).glob("*.mcap"))
+    with open(files[0], "rb") as f:
+        reader = make_reader(f)
+        header = reader.get_header()
+        summary = reader.get_summary()
+        metadata = {m.name: m.metadata for m in reader.iter_metadata()}
+    assert header.profile == "ros2"
+    assert {s.encoding for s in summary.schemas.values()} == {"ros2msg"}
+    assert {c.message_encoding for c in summary.channels.values()} == {"cdr"}
+    assert all("offered_qos_profiles" in c.metadata for c in summary.channels.values())
+    assert summary.statistics.message_count == sum(read_bag(foam["bag"]).counts().values())
+    assert "serialized_metadata" in metadata["rosbag2"]
+
+
+def test_replay_reproduces_the_recorded_events(foam):
+    first = replay(str(foam["bag"]))
+    assert first["reproduced"] is True and first["events"]
+    second = replay(str(foam["bag"]))
+    assert second["events"] == first["events"]
+
+
+def test_recording_of_another_tool_replays(small, tmp_path):
+    """A bag rewritten by rosbags (SQLite3, no ticks, no custom data) replays the same."""
+    from rosbags.rosbag2 import StoragePlugin, Writer
+    from rosbags.typesys import Stores, get_types_from_msg, get_typestore
+
+    bag = read_bag(small["bag"])
+    store = get_typestore(Stores.ROS2_JAZZY)
+    for name in ("ContactNode", "ContactEvent", "ContactEventArray", "TactileArray"):
+        type_name = f"squeeze_grasp_interfaces/msg/{name}"
+        store.register(get_types_from_msg(own_text(type_name), type_name))
+    keep = [t for t in bag.types if replay_topic(t)]
+    out = tmp_path / "other"
+    with Writer(out, version=9, storage_plugin=StoragePlugin.SQLITE3) as writer:
+        connections = {t: writer.add_connection(t, bag.types[t], typestore=store) for t in keep}
+        for m in bag.messages:
+            if m.topic in connections:
+                writer.write(connections[m.topic], m.log_time_ns, m.data)
+    params = {"mu": 0.05, "alarm_ratio": 2.0,
+              "relative_per_depth": load_relative_per_depth(small["bag"])}
+    result = replay(str(out), params)
+    assert result["reproduced"] is True
+
+
+def replay_topic(topic: str) -> bool:
+    """Readings and the monitor's events: what another recorder would have."""
+    return topic.endswith(("/pose", "/wrench", "/tactile")) or topic == "/monitor/events"
+
+
+def load_relative_per_depth(bag_path) -> float:
+    """The relative depth per unit depth the run's monitor used (from its custom data)."""
+    return yaml.safe_load(read_bag(bag_path).custom_data["monitor_parameters"])["relative_per_depth"]
+
+
+def test_sensor_dropout_makes_the_executor_hold(tmp_path):
+    data = scene_data(SMALL_SQUARE, name="dropout_square",
+                      squeeze={"type": "stable", "relative_depth": 0.03},
+                      sensors={"dropout": 0.3, "seed": 4},
+                      effects=["friction", "force_sensing", "tactile_sensing", "sensor_dropout"])
+    runner = PipelineRunner(RunOptions(write_scene(tmp_path, data),
+                                       overrides={"monitor": {"alarm_ratio": 2.0}}))
+    run = runner.run()
+    assert run["termination"] == "depth_reached"
+    assert run["hold_ticks"] > 0 and run["alarms"]["stale_sensor"] >= run["hold_ticks"]
+    positions = [np.array([[p.x, p.y] for p in s.positions]) for s in runner.sim_states]
+    moves = [np.abs(b - a).max() for a, b in zip(positions, positions[1:])]
+    assert sum(1 for m in moves if m == 0.0) >= run["hold_ticks"]
+
+
+def test_slip_alarm_comes_before_the_finger_slips(tmp_path):
+    path = write_scene(tmp_path, SLIPPING_SQUARE)
+    _, api = mechanics(path)
+    assert api.termination == "finger_slip"
+    run = PipelineRunner(RunOptions(path)).run()
+    assert run["termination"] == "slip_alarm"
+    alarm_depth = run["measured_depth"]
+    print(f"slip alarm at depth {alarm_depth * 1e3:.4f} mm; the finger slips at "
+          f"{api.depth * 1e3:.4f} mm")
+    assert alarm_depth < api.depth
+    assert run["world_termination"] == "none"
+
+
+def test_reactive_redirection_instead_of_stopping(tmp_path):
+    path = write_scene(tmp_path, SLIPPING_SQUARE)
+    held = PipelineRunner(RunOptions(path)).run()
+    redirected = PipelineRunner(RunOptions(path, on_slip_alarm="normals")).run()
+    assert redirected["redirected"]
+    assert redirected["measured_depth"] > held["measured_depth"]
+
+
+def test_cancel_holds_position(tmp_path):
+    path = write_scene(tmp_path, SMALL_SQUARE)
+    runner = PipelineRunner(RunOptions(path, overrides={"monitor": {"alarm_ratio": 2.0}}))
+    try:
+        runner.start()
+        runner.send_goal()
+        runner.spin_until(lambda: runner.feedback and runner.feedback[-1].depth > 1e-3, 120,
+                          "1 mm of depth")
+        runner.cancel()
+        result = runner.wait_result()
+    finally:
+        runner.shutdown()
+    assert result.termination == "canceled" and not result.success
+    assert 1e-3 < result.depth < runner.plan.goal.depth
+    last, before = runner.sim_states[-1], runner.sim_states[-2]
+    assert [(p.x, p.y) for p in last.positions] == [(p.x, p.y) for p in before.positions]
+
+
+def test_single_threaded_executor_gives_the_same_run(small, tmp_path):
+    path = write_scene(tmp_path, SMALL_SQUARE)
+    run = PipelineRunner(RunOptions(path, executor="single",
+                                    overrides={"monitor": {"alarm_ratio": 2.0}})).run()
+    assert run["mode"].endswith("SingleThreadedExecutor")
+    for key in ("events", "monitor_events", "forces", "work", "ticks"):
+        assert run[key] == small["run"][key], key

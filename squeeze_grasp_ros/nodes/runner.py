@@ -315,7 +315,8 @@ class PipelineRunner:
             self.executor.add_node(node)
 
     def _spawn(self, params: dict[str, dict]) -> None:
-        handle, path = tempfile.mkstemp(prefix="squeeze_grasp_run_", suffix=".yaml")
+        handle, path = tempfile.mkstemp(prefix=f"squeeze_grasp_run_{os.getpid()}_",
+                                        suffix=".yaml")
         os.close(handle)
         self.params_file = Path(path)
         self.params_file.write_text(plain_yaml(

@@ -1,0 +1,115 @@
+# Copyright 2026 squeeze_grasp_ros developers
+# SPDX-License-Identifier: Apache-2.0
+"""The pipeline across processes and under SIGINT: the same run as in one process, and an
+interrupted run leaves a readable recording."""
+from __future__ import annotations
+
+import json
+import signal
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+from rclpy.serialization import deserialize_message
+
+from squeeze_grasp_ros.nodes import pipeline
+from squeeze_grasp_ros.nodes.runner import PipelineRunner, RunOptions
+from squeeze_grasp_ros.recording.bag import read_bag
+
+from pipeline_support import SMALL_SQUARE, scene_data, write_scene
+
+QUICK = scene_data(SMALL_SQUARE, name="quick_square",
+                   squeeze={"type": "stable", "relative_depth": 0.04})
+"""The small square squeezed 4 %: a few hundred ticks with A and D events."""
+DETERMINISTIC = ("/clock", "/sim/tick", "/sim/state", "/sim/events", "/monitor/status",
+                 "/monitor/events", "/monitor/contact_state", "/devices/barrett_f1/setpoint",
+                 "/devices/barrett_f3/setpoint", "/devices/barrett_f1/tactile",
+                 "/devices/barrett_f3/wrench")
+"""Topics whose messages (content and log time) do not depend on how the nodes ran (the
+action's goal ids are random; markers are logged at the recorder's clock)."""
+
+
+def contents(bag_path) -> dict:
+    """Topic -> [(log time, message)] of the deterministic topics of a bag."""
+    bag = read_bag(bag_path)
+    out = {}
+    for topic in DETERMINISTIC:
+        cls = pipeline.message_type(bag.types[topic])
+        out[topic] = [(m.log_time_ns, deserialize_message(m.data, cls)) for m in bag.messages
+                      if m.topic == topic]
+    return out
+
+
+def test_one_process_and_processes_give_the_same_run_and_recording(tmp_path):
+    path = write_scene(tmp_path, QUICK)
+    overrides = {"monitor": {"alarm_ratio": 2.0}}
+    one = PipelineRunner(RunOptions(path, record=str(tmp_path / "one"),
+                                    overrides=overrides)).run()
+    many = PipelineRunner(RunOptions(path, record=str(tmp_path / "many"), processes=True,
+                                     overrides=overrides)).run()
+    assert many["mode"] == "processes" and one["mode"].startswith("one process")
+    for key in ("events", "monitor_events", "termination", "ticks", "forces", "work",
+                "measured_work", "alarms"):
+        assert one[key] == many[key], key
+    assert {e["type"] for e in one["events"]} >= {"A", "D"}
+    a, b = contents(tmp_path / "one"), contents(tmp_path / "many")
+    for topic in DETERMINISTIC:
+        assert a[topic] == b[topic], topic
+
+
+def run_command(*args: str) -> list[str]:
+    """``squeeze-grasp`` as the user types it, in this interpreter."""
+    return [sys.executable, "-m", "squeeze_grasp_ros.cli", *args]
+
+
+@pytest.mark.parametrize("processes", [False, True], ids=["one_process", "processes"])
+def test_sigint_leaves_a_readable_recording(tmp_path, processes):
+    from rosbags.highlevel import AnyReader
+
+    path = write_scene(tmp_path, scene_data(SMALL_SQUARE, name="long_square",
+                                            squeeze={"type": "stable", "relative_depth": 0.2}))
+    bag = tmp_path / "bag"
+    extra = ["--processes"] if processes else []
+    proc = subprocess.Popen(run_command("run", path, "--record", str(bag), "--quiet", *extra),
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    data = bag / "bag_0.mcap"
+    try:
+        for _ in range(3000):
+            if data.is_file() and data.stat().st_size > 64 * 1024:
+                break
+            try:
+                proc.wait(0.05)
+            except subprocess.TimeoutExpired:
+                continue
+            pytest.fail(f"the run ended before it was interrupted: {proc.stderr.read()[-2000:]}")
+        else:
+            pytest.fail("the recording did not grow within 150 s")
+        proc.send_signal(signal.SIGINT)
+        proc.wait(120)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.wait()
+    assert (bag / "metadata.yaml").is_file()
+    with AnyReader([bag]) as reader:
+        counts = {c.topic: c.msgcount for c in reader.connections}
+        stamps = [t for c, t, _ in reader.messages(
+            connections=[c for c in reader.connections if c.topic == "/sim/tick"])]
+    assert counts["/sim/tick"] > 10 and stamps == sorted(stamps)
+    nodes = subprocess.run(["pgrep", "-f", f"squeeze_grasp_run_{proc.pid}_"],
+                           capture_output=True, text=True)
+    assert nodes.stdout.strip() == "", "node processes outlived the run"
+
+
+def test_run_verb_prints_json(tmp_path):
+    path = write_scene(tmp_path, QUICK)
+    done = subprocess.run(run_command("run", path, "--json", "--no-planner"),
+                          capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0, done.stderr[-2000:]
+    result = json.loads(done.stdout)
+    assert result["termination"] in ("depth_reached", "slip_alarm")
+    assert result["plan_source"] == "mechanics" and result["events"]
+    replayed = subprocess.run(run_command("replay", "--help"), capture_output=True, text=True)
+    assert replayed.returncode == 0 and "--param" in replayed.stdout
+    assert Path(path).is_file()

@@ -13,6 +13,7 @@ SECTIONS: tuple[str, ...] = (
     "ring",
     "events",
     "ros_services",
+    "pipeline",
     "pareto",
 )
 """Module names of the benchmark sections, in report order."""

@@ -46,8 +46,9 @@ def _progress_line(update: dict) -> None:
     sys.stderr.flush()
 
 
-def run(args: argparse.Namespace) -> dict:
-    """Run the pipeline; the JSON summary (see :meth:`PipelineRunner.summary`)."""
+def run(args: argparse.Namespace) -> dict | int:
+    """Run the pipeline; the JSON summary (see :meth:`PipelineRunner.summary`), or exit code
+    130 after Ctrl-C (the recording is finished first)."""
     from ..nodes.runner import PipelineRunner, RunOptions
 
     options = RunOptions(args.scene, record=args.record, processes=args.processes,
@@ -56,6 +57,10 @@ def run(args: argparse.Namespace) -> dict:
     show = not (args.quiet or args.json) and sys.stderr.isatty()
     try:
         result = PipelineRunner(options, _progress_line if show else None).run()
+    except KeyboardInterrupt:
+        where = f"; the recording is complete up to here: {args.record}" if args.record else ""
+        print(f"\nsqueeze-grasp run: interrupted{where}", file=sys.stderr)
+        return 130
     finally:
         if show:
             sys.stderr.write("\n")

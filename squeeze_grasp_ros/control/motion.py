@@ -35,6 +35,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
+from functools import cached_property
 
 import numpy as np
 
@@ -224,7 +225,7 @@ class PolylinePath:
         """Progress at the end of the path."""
         return float(self.knots[-1])
 
-    @property
+    @cached_property
     def gain(self) -> float:
         """Largest fingertip speed per unit progress speed, max |dp_f/ds|."""
         if self.end == 0.0:

@@ -236,27 +236,22 @@ def patches_of(finger: str, sample: FingerSample, config: TrackerConfig) -> list
 
 def connected_groups(previous: Sequence[Patch], current: Sequence[Patch],
                      margin: int) -> list[tuple[list[int], list[int]]]:
-    """Groups (previous indices, current indices) of patches linked by overlapping taxel ranges."""
-    parent = list(range(len(previous) + len(current)))
+    """Groups (previous indices, current indices) of patches linked by overlapping taxel ranges.
 
-    def root(k: int) -> int:
-        while parent[k] != k:
-            parent[k] = parent[parent[k]]
-            k = parent[k]
-        return k
-
-    for i, p in enumerate(previous):
-        for j, c in enumerate(current):
-            if p.first - margin <= c.last + margin and c.first - margin <= p.last + margin:
-                parent[root(i)] = root(len(previous) + j)
-    groups: dict[int, tuple[list[int], list[int]]] = {}
-    for k in range(len(parent)):
-        group = groups.setdefault(root(k), ([], []))
-        if k < len(previous):
-            group[0].append(k)
-        else:
-            group[1].append(k - len(previous))
-    return list(groups.values())
+    Patches of one tick never overlap each other, so the groups are the runs of the union of
+    all (widened) ranges: one sweep in order of the first taxel.
+    """
+    spans = sorted([(p.first - margin, p.last + margin, 0, i) for i, p in enumerate(previous)]
+                   + [(c.first - margin, c.last + margin, 1, j) for j, c in enumerate(current)])
+    groups: list[tuple[list[int], list[int]]] = []
+    end = None
+    for first, last, side, index in spans:
+        if end is None or first > end:
+            groups.append(([], []))
+            end = last
+        end = max(end, last)
+        groups[-1][side].append(index)
+    return groups
 
 
 @dataclass

@@ -62,7 +62,8 @@ class MonitorNode(Node):
         self.tracker = ContactTracker(TrackerConfig(
             p["mu"], p["load_threshold"], p["edge_tolerance"], p["alarm_ratio"],
             p["match_margin"], p["stale_after"], p["weight"] or None,
-            p["prediction_tolerance"], p["relative_per_depth"]), list(self.fingers), p["streams"])
+            p["prediction_tolerance"], p["relative_per_depth"]), list(self.fingers),
+            [s for s in p["streams"] if s])
         loop = pipeline.loop_qos(p["qos_depth"])
         sensors = pipeline.sensor_qos(p["sensor_qos"], p["qos_depth"])
         types = {"pose": PoseStamped, "wrench": WrenchStamped, "tactile": TactileArray}

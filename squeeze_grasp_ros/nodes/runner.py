@@ -189,6 +189,7 @@ class PipelineRunner:
                                  "hardware tracks rounded fingertips (Sec. 5)")
         self.t0 = time.perf_counter()
         self.timing: dict[str, float] = {}
+        self.interrupted = threading.Event()
         self.context = Context()
         rclpy.init(context=self.context, signal_handler_options=SignalHandlerOptions.NO)
         self.executor = (EventsExecutor(context=self.context) if options.executor == "events"
@@ -256,6 +257,8 @@ class PipelineRunner:
         """Spin the executor until ``done()`` or ``timeout`` wall-clock seconds (then raise)."""
         deadline = time.monotonic() + timeout
         while not done():
+            if self.interrupted.is_set():
+                raise KeyboardInterrupt
             if time.monotonic() > deadline:
                 raise RunError(f"timed out after {timeout:.0f} s waiting for {what}")
             self._check_processes()
@@ -490,13 +493,20 @@ class PipelineRunner:
 
     # ----------------------------------------------------------------- the whole run
     def run(self) -> dict:
-        """Start, execute the goal, collect the summary, shut down; returns the JSON summary."""
+        """Start, execute the goal, collect the summary, shut down; returns the JSON summary.
+
+        SIGINT (Ctrl-C) sets a flag that the waiting loop turns into ``KeyboardInterrupt``
+        between callbacks, so no callback (a recorder write) is cut in half; the shutdown still
+        finishes the recording.
+        """
+        previous = signal.signal(signal.SIGINT, lambda *_: self.interrupted.set())
         try:
             self.start()
             self.send_goal()
             result = self.wait_result()
             return self.summary(result)
         finally:
+            signal.signal(signal.SIGINT, previous)
             self.shutdown()
 
     def summary(self, result: ExecuteGrasp.Result) -> dict:
@@ -530,8 +540,14 @@ class PipelineRunner:
                           "mode": "stick" if n.mode == n.STICK else "slip",
                           "force": [n.force.x, n.force.y]} for n in state.nodes],
             "recording": self.options.record,
-            "timing": {**self.timing, "total": time.perf_counter() - self.t0},
+            "timing": {**self.timing, "total": time.perf_counter() - self.t0,
+                       **self._node_timing()},
         }
+
+    def _node_timing(self) -> dict:
+        """Mechanics time inside the in-process simulated hardware (absent with processes)."""
+        sims = [n for n in self.nodes if n.get_name() == "sim_hardware"]
+        return {"mechanics": sims[0].world.stepper_seconds} if sims else {}
 
     def mode(self) -> str:
         """How the nodes ran."""

@@ -56,7 +56,8 @@ def tactile_layout(center: float, taxels: int, span: float) -> TactileLayout:
 
 def taxel_weights(layout: TactileLayout, thetas: np.ndarray) -> np.ndarray:
     """Hat weights (k, n) of contact angles ``thetas`` (k,) rad on the taxels."""
-    offset = np.angle(np.exp(1j * (np.asarray(thetas, float)[:, None] - layout.angles[None, :])))
+    offset = np.asarray(thetas, float)[:, None] - layout.angles[None, :]
+    offset = (offset + np.pi) % (2.0 * np.pi) - np.pi
     return np.maximum(0.0, 1.0 - np.abs(offset) / layout.spacing)
 
 

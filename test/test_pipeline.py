@@ -134,9 +134,13 @@ def test_recording_reads_back_with_rosbags(foam):
             assert timestamp >= last.get(connection.topic, 0)
             last[connection.topic] = timestamp
             if connection.topic not in decoded:
-                reader.deserialize(raw, connection.msgtype)
+                msg = reader.deserialize(raw, connection.msgtype)
                 decoded.add(connection.topic)
+                if connection.topic == "/sim/markers":
+                    namespaces = {m.ns for m in msg.markers}
         assert decoded == set(connections)
+        assert namespaces >= {"outline", "fingertips", "contacts", "forces"}
+        assert 0 < connections["/sim/markers"].msgcount < ticks / 10
     qos = connections["/sim/tick"].ext.offered_qos_profiles[0]
     assert qos.reliability.name == "RELIABLE"
     assert (foam["bag"] / "metadata.yaml").is_file()
@@ -260,3 +264,30 @@ def test_single_threaded_executor_gives_the_same_run(small, tmp_path):
     assert run["mode"].endswith("SingleThreadedExecutor")
     for key in ("events", "monitor_events", "forces", "work", "ticks"):
         assert run[key] == small["run"][key], key
+
+
+def test_resistance_ground_truth_equals_algorithm_2():
+    """Sec. 6.4 set-up (F1 on a Barrett finger, F2 on the Cobra arm, A on the pusher): the
+    squeeze, then the executor streams Algorithm 2's waypoints; the simulated world's events,
+    termination and work are those of the mechanics API."""
+    from squeeze_grasp_ros.mechanics.contact_model import ContactModel
+    from squeeze_grasp_ros.mechanics.resistance_friction import add_adversary, frictional_resistance
+    from squeeze_grasp_ros.scene import placement_node
+
+    path = str(SCENES / "resist_fig10.yaml")
+    scene = load_scene(path)
+    obj = ElasticObject(build_mesh(scene), scene_material(scene))
+    squeeze = event_squeeze_scene(scene, obj, finger_nodes(scene, obj.mesh))
+    model = ContactModel(obj, scene.mu, max_events_per_depth=scene.squeeze.max_events_per_depth)
+    adv = scene.adversary
+    start = add_adversary(squeeze.state, model, squeeze.displacement,
+                          placement_node(obj.mesh, adv.placement, "adversary"), adv.tip_radius)
+    plan = frictional_resistance(model, start, adv.a, adv.mode, squeeze.step, squeeze.event_tol)
+    run = PipelineRunner(RunOptions(path, planner=False)).run()
+    assert run["termination"] == "resisted"
+    assert [(e["type"], e["node"], e["finger"]) for e in run["events"]] == \
+        [(e.type, e.node, e.finger) for e in squeeze.events + plan.events]
+    assert (run["world_termination"], plan.reason) == ("finger_slip", "F2 slips")
+    for finger in ("F1", "F2", "A"):
+        total = squeeze.work.get(finger, 0.0) + plan.work[finger]
+        assert run["work"][finger] == pytest.approx(total, rel=1e-5)

@@ -4,6 +4,7 @@
 from __future__ import annotations
 
 import argparse
+import json
 import sys
 
 import yaml
@@ -22,7 +23,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> dict | int:
-    """Replay; exit code 1 when the recorded event sequence is not reproduced."""
+    """Replay; exit code 1 (after printing the result) when the recorded event sequence is not
+    reproduced."""
     from ..recording.replay import replay
 
     overrides = {}
@@ -33,8 +35,8 @@ def run(args: argparse.Namespace) -> dict | int:
             return 2
         overrides[name] = yaml.safe_load(value)
     result = replay(args.bag, overrides)
-    if result["reproduced"] is False and not args.json:
-        print(summary(result))
+    if result["reproduced"] is False:
+        print(json.dumps(result) if args.json else summary(result))
         return 1
     return result
 

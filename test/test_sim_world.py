@@ -23,8 +23,8 @@ from squeeze_grasp_ros.sim.sensors import (SensorRandomness, fingertip_wrench, r
                                            tactile_layout, taxel_weights)
 from squeeze_grasp_ros.sim.world import SimWorld, squeeze_geometry
 
-from pipeline_support import (EVENT_TOLERANCE_TICKS, SMALL_SQUARE, contact_modes, match_within, net_events,
-                              scene_data)
+from pipeline_support import (EVENT_TOLERANCE_TICKS, SMALL_SQUARE, contact_modes, match_within,
+                              net_events, scene_data)
 
 
 def scene_with(**changes):

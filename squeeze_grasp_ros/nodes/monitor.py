@@ -13,8 +13,9 @@ and runs :class:`..control.tracker.ContactTracker` once per tick:
 
 Each tick it publishes the tick's events as one ``monitor/events`` array (when there are
 any), one ``monitor/alarms`` message per active alarm, the reconstructed
-``monitor/contact_state`` and, last, the ``monitor/status`` the executor acts on. A repeated ``sim/tick`` (a re-sent tick) gets the same status again, nothing else. The
-planner's prediction (``planner/predicted_events``, latched) is compared with the observed
+``monitor/contact_state`` and, last, the ``monitor/status`` the executor acts on. A repeated
+``sim/tick`` (a re-sent tick) gets the same status again, nothing else. The planner's
+prediction (``planner/predicted_events``, latched) is compared with the observed
 events.
 """
 from __future__ import annotations

@@ -144,8 +144,9 @@ class SimHardwareNode(Node):
             if r.normal is not None:
                 reading = messages.TactileReadings(r.finger, self.world.layouts[r.finger].angles,
                                                    r.normal, r.tangential)
+                tip = messages.header(ns, f"{r.finger}_tip")
                 batch.append((self.tactile_pubs[r.finger],
-                              messages.tactile_array_msg(reading, messages.header(ns, f"{r.finger}_tip"))))
+                              messages.tactile_array_msg(reading, tip)))
                 readings.append(f"{device}/tactile")
         ending = out.termination is not None and not self.ended
         self.ended = self.ended or ending

@@ -139,7 +139,8 @@ class BagWriter:
              "topic_type_hash": type_hash(type_name)})
         self.topics[name] = _Topic(name, type_name, channel, qos)
 
-    def write(self, topic: str, data: bytes, log_time_ns: int, publish_time_ns: int | None = None) -> None:
+    def write(self, topic: str, data: bytes, log_time_ns: int,
+              publish_time_ns: int | None = None) -> None:
         """Append one serialized (CDR) message of a declared topic."""
         t = self.topics[topic]
         self._writer.add_message(t.channel, log_time_ns, bytes(data),

@@ -29,7 +29,8 @@ CONSTANT = re.compile(r"^\S+\s+\w+\s*=")
 ACTION_PARTS = {"_Goal": 0, "_Result": 1, "_Feedback": 2}
 """Message of an action -> its section of the ``.action`` file."""
 ACTION_WRAPPERS = {
-    "_FeedbackMessage": "unique_identifier_msgs/UUID goal_id\n{package}/action/{action}_Feedback feedback\n",
+    "_FeedbackMessage":
+        "unique_identifier_msgs/UUID goal_id\n{package}/action/{action}_Feedback feedback\n",
 }
 """Messages rosidl wraps around an action's sections (their definition, formatted)."""
 

@@ -237,7 +237,8 @@ class SimWorld:
             if name not in setpoints:
                 continue
             target = np.asarray(setpoints[name], float) + self.offsets[name]
-            if name == "A" and not self._adversary_touching() and np.any(target != self.positions[name]):
+            waiting = name == "A" and not self._adversary_touching()
+            if waiting and np.any(target != self.positions[name]):
                 target = self._touch_adversary(target)
             device = self.devices[name]
             if device.lagged:

@@ -25,7 +25,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                              "every node on one executor in this process)")
     parser.add_argument("--executor", choices=EXECUTOR_CHOICES, default="events",
                         help="rclpy executor of the one-process mode (default: events, "
-                             "rclpy.experimental.EventsExecutor)")
+                             "rclpy.experimental.EventsExecutor; single = SingleThreadedExecutor)")
     parser.add_argument("--on-slip-alarm", choices=("hold", "pure", "normals"), default="hold",
                         help="executor reaction to an imminent-slip alarm: hold (default), or "
                              "change the squeeze direction once to the pure squeeze or along the "

@@ -68,7 +68,8 @@ def run_command(*args: str) -> list[str]:
     return [sys.executable, "-m", "squeeze_grasp_ros.cli", *args]
 
 
-@pytest.mark.parametrize("processes", [False, True], ids=["one_process", "processes"])
+@pytest.mark.parametrize("processes", [False, pytest.param(True, marks=pytest.mark.slow)],
+                         ids=["one_process", "processes"])
 def test_sigint_leaves_a_readable_recording(tmp_path, processes):
     from rosbags.highlevel import AnyReader
 

@@ -108,6 +108,13 @@ class ExecutorNode(Node):
             self.create_timer(p["period"], self._timer)
 
     # ----------------------------------------------------------------- action
+    def destroy_node(self) -> None:
+        """Destroy the action server too: rclpy's ``destroy_node`` leaves waitables to the garbage
+        collector, and a still-referenced server keeps answering goals of a later run in the same
+        process ("more than one action server")."""
+        self.server.destroy()
+        super().destroy_node()
+
     def _accept_goal(self, _: ExecuteGrasp.Goal) -> GoalResponse:
         return GoalResponse.REJECT if self.goal is not None else GoalResponse.ACCEPT
 

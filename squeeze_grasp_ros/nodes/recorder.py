@@ -20,7 +20,8 @@ message can differ.)
 In lockstep it takes part in the start-up handshake and reports on ``recorder/progress`` the
 newest tick it has written, every ``progress_every`` ticks, so ``sim_hardware`` never runs more
 than its ``recorder_window`` ahead (no message is lost to a full history); a wall-clock timer
-also reports the newest tick when the run pauses. On Ctrl-C / SIGINT it first writes what has
+repeats the newest tick 20 times a second, so the report of the last tick of a run arrives even
+if one copy is lost. On Ctrl-C / SIGINT it first writes what has
 already arrived, then ``close`` writes the MCAP summary and ``metadata.yaml``.
 """
 from __future__ import annotations
@@ -111,7 +112,7 @@ class RecorderNode(Node):
         if p["lockstep"]:
             self.participant = pipeline.Participant(self, "recorder", [pipeline.TICK],
                                                     [self.progress_pub])
-            pipeline.wall_timer(self, 0.05, self._report)
+            pipeline.wall_timer(self, 0.05, self._repeat_report)
 
     def _offered_qos(self, topic: str) -> list[dict]:
         def name(policy: str, value) -> str:
@@ -139,6 +140,11 @@ class RecorderNode(Node):
     def _report(self) -> None:
         """Publish the newest tick written, if not reported yet."""
         if self.newest_tick_ns > self.reported_ns:
+            self._repeat_report()
+
+    def _repeat_report(self) -> None:
+        """Publish the newest tick written (again: a lost report is repeated by the timer)."""
+        if self.newest_tick_ns >= 0:
             self.reported_ns = self.newest_tick_ns
             self.progress_pub.publish(messages.header(self.newest_tick_ns))
 

@@ -31,6 +31,7 @@ import sys
 import tempfile
 import threading
 import time
+import uuid
 from collections import Counter
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -40,7 +41,9 @@ from typing import Any
 import numpy as np
 import rclpy
 import yaml
+from action_msgs.msg import GoalStatus, GoalStatusArray
 from rclpy.action import ActionClient
+from rclpy.action.client import ClientGoalHandle
 from rclpy.context import Context
 from rclpy.executors import SingleThreadedExecutor
 from rclpy.experimental import EventsExecutor
@@ -51,6 +54,7 @@ from std_msgs.msg import Header
 
 from squeeze_grasp_interfaces.action import ExecuteGrasp
 from squeeze_grasp_interfaces.msg import Alarm, ContactEvent, ContactEventArray, SimState
+from unique_identifier_msgs.msg import UUID
 
 from .. import messages
 from ..control.motion import GraspGoal
@@ -67,6 +71,10 @@ from . import pipeline
 NODES: tuple[str, ...] = ("sim_hardware", "monitor", "executor", "recorder")
 EXECUTORS: tuple[str, ...] = ("events", "single")
 PLANNER_MODULE = "squeeze_grasp_ros.nodes.planner"
+GOAL_RESPONSE_TIMEOUT = 5.0
+"""Wall-clock seconds to wait for a goal (or result) response before checking the status."""
+SERVICE_RETRY = 30.0
+"""Wall-clock seconds after which an unanswered planner request is sent again."""
 
 
 class RunError(RuntimeError):
@@ -219,6 +227,9 @@ class PipelineRunner:
         self.prediction_pub = c.create_publisher(ContactEventArray, pipeline.PREDICTION,
                                                  pipeline.LATCHED)
         self.action = ActionClient(c, ExecuteGrasp, pipeline.ACTION)
+        self.goal_statuses: dict[bytes, int] = {}
+        c.create_subscription(GoalStatusArray, f"{pipeline.ACTION}/_action/status",
+                              self._goal_status, pipeline.LATCHED)
         self.goal_handle = None
         self.result_future = None
         self.plan: Plan | None = None
@@ -268,10 +279,6 @@ class PipelineRunner:
         for proc in self.processes:
             if proc.poll() is not None:
                 raise RunError(f"node process {proc.args[2]} exited with code {proc.returncode}")
-
-    def _wait_future(self, future, what: str):
-        self.spin_until(future.done, self.options.timeout, what)
-        return future.result()
 
     # ----------------------------------------------------------------- start-up
     def start(self) -> None:
@@ -360,9 +367,21 @@ class PipelineRunner:
         return stop_thread
 
     def _call(self, srv_type: Any, name: str, request: Any) -> Any:
+        """Call a planner service; the request is repeated if its response is lost (the
+        planner's requests are idempotent)."""
         client = self.client.create_client(srv_type, f"planner/{name}")
         self.spin_until(client.service_is_ready, self.options.timeout, f"planner/{name}")
-        response = self._wait_future(client.call_async(request), f"planner/{name}")
+        deadline = time.monotonic() + self.options.timeout
+        while True:
+            future = client.call_async(request)
+            retry = min(time.monotonic() + SERVICE_RETRY, deadline)
+            self.spin_until(lambda: future.done() or time.monotonic() > retry,
+                            self.options.timeout, f"planner/{name}")
+            if future.done():
+                break
+            if time.monotonic() > deadline:
+                raise RunError(f"planner/{name} did not answer")
+        response = future.result()
         self.client.destroy_client(client)
         if not response.success:
             raise RunError(f"planner/{name}: {response.message}")
@@ -436,24 +455,86 @@ class PipelineRunner:
 
     # ----------------------------------------------------------------- the goal
     def send_goal(self) -> None:
-        """Send the plan's goal and wait until it is accepted."""
+        """Send the plan's goal and wait until it is accepted.
+
+        Across processes a service response can be lost while discovery is still settling
+        (ROS_CONVENTIONS §0: the first messages after matching). The goal ids are ours, so a
+        goal whose acceptance shows on the action's status topic counts as accepted even if the
+        response never came; after ``GOAL_RESPONSE_TIMEOUT`` without either the request is sent
+        again with a new id, and whichever request is accepted first is the goal (the executor
+        rejects the others while it runs one).
+        """
         msg = messages.grasp_goal_msg(self.plan.goal)
-        handle = self._wait_future(self.action.send_goal_async(msg, self._feedback),
-                                   "the goal to be accepted")
+        deadline = time.monotonic() + self.options.timeout
+        sent: list = []
+        handle = None
+        while handle is None:
+            goal_id = UUID(uuid=list(uuid.uuid4().bytes))
+            sent.append((goal_id, self.action.send_goal_async(msg, self._feedback,
+                                                              goal_uuid=goal_id)))
+            retry = min(time.monotonic() + GOAL_RESPONSE_TIMEOUT, deadline)
+            self.spin_until(lambda: self._accepted(sent) is not None
+                            or all(f.done() for _, f in sent) or time.monotonic() > retry,
+                            self.options.timeout, "the goal to be accepted")
+            handle = self._accepted(sent)
+            if handle is None and all(f.done() for _, f in sent):
+                settle = time.monotonic() + GOAL_RESPONSE_TIMEOUT
+                self.spin_until(lambda: self._accepted(sent) is not None
+                                or time.monotonic() > settle, self.options.timeout,
+                                "the status of the goal requests")
+                handle = self._accepted(sent) or sent[-1][1].result()
+            if handle is None and time.monotonic() > deadline:
+                raise RunError("the executor never answered the goal request")
         if not handle.accepted:
             raise RunError("the executor rejected the goal")
         self.goal_handle = handle
         self.result_future = handle.get_result_async()
         self.loop_started = time.perf_counter()
+        self.loop_cpu_started = time.process_time()
+
+    def _accepted(self, sent: list):
+        """The goal handle of the first request known to be accepted (by its response or by
+        the status topic), or None."""
+        for goal_id, future in sent:
+            if future.done() and future.result().accepted:
+                return future.result()
+            if self._status_of(goal_id) is not None:
+                return ClientGoalHandle(self.action, goal_id,
+                                        ExecuteGrasp.Impl.SendGoalService.Response(accepted=True))
+        return None
+
+    def _goal_status(self, msg: GoalStatusArray) -> None:
+        for status in msg.status_list:
+            self.goal_statuses[bytes(status.goal_info.goal_id.uuid)] = status.status
+
+    def _status_of(self, goal_id: UUID) -> int | None:
+        return self.goal_statuses.get(bytes(goal_id.uuid))
 
     def cancel(self) -> None:
         """Ask the executor to cancel the goal (it holds position)."""
         self.goal_handle.cancel_goal_async()
 
     def wait_result(self) -> ExecuteGrasp.Result:
-        """Spin until the goal's result, then until the ground truth of its last tick arrived."""
-        result = self._wait_future(self.result_future, "the goal's result").result
+        """Spin until the goal's result, then until the ground truth of its last tick arrived.
+
+        If the status topic reports the goal finished but the result response does not come
+        within a few seconds (lost across processes), the result is requested again.
+        """
+        finished = (GoalStatus.STATUS_SUCCEEDED, GoalStatus.STATUS_ABORTED,
+                    GoalStatus.STATUS_CANCELED)
+        deadline = time.monotonic() + self.options.timeout
+        while not self.result_future.done():
+            ended = [time.monotonic()] if self._status_of(self.goal_handle.goal_id) in finished \
+                else []
+            self.spin_until(lambda: self.result_future.done() or (
+                ended and time.monotonic() > ended[0] + GOAL_RESPONSE_TIMEOUT) or (
+                not ended and self._status_of(self.goal_handle.goal_id) in finished),
+                max(deadline - time.monotonic(), 0.0), "the goal's result")
+            if not self.result_future.done() and ended:
+                self.result_future = self.goal_handle.get_result_async()
+        result = self.result_future.result().result
         self.timing["loop"] = time.perf_counter() - self.loop_started
+        self.timing["loop_cpu"] = time.process_time() - self.loop_cpu_started
         final = self.start_ns + result.ticks * self._dt_ns()
         self.spin_until(lambda: messages.stamp_ns(self.sim_state.header.stamp) >= final,
                         self.options.timeout, "the ground truth of the last tick")
@@ -545,9 +626,13 @@ class PipelineRunner:
         }
 
     def _node_timing(self) -> dict:
-        """Mechanics time inside the in-process simulated hardware (absent with processes)."""
+        """Wall and CPU time of the stepper inside the in-process simulated hardware (absent
+        with processes; ``loop_cpu`` is then only this process's CPU time)."""
         sims = [n for n in self.nodes if n.get_name() == "sim_hardware"]
-        return {"mechanics": sims[0].world.stepper_seconds} if sims else {}
+        if not sims:
+            return {}
+        return {"mechanics": sims[0].world.stepper_seconds,
+                "mechanics_cpu": sims[0].world.stepper_cpu_seconds}
 
     def mode(self) -> str:
         """How the nodes ran."""

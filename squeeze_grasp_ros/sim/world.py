@@ -14,8 +14,9 @@ Only declared effects are composed (``scene.effects``): ``friction`` sets mu (el
 ``strain_limit`` and ``pickup`` set the stepper's termination limits, ``adversary`` adds the
 third fingertip and its pusher, ``force_sensing``/``tactile_sensing`` render wrenches/taxels,
 ``sensor_noise``/``sensor_dropout`` draw random numbers, ``actuator_lag`` lags the devices. Every
-piece of optional work increments a counter of :attr:`SimWorld.work`; the wall time spent in
-the stepper is :attr:`SimWorld.stepper_seconds` (benchmarks subtract it).
+piece of optional work increments a counter of :attr:`SimWorld.work`; the wall and CPU time spent
+in the stepper are :attr:`SimWorld.stepper_seconds` and ``stepper_cpu_seconds`` (benchmarks
+subtract them).
 
 When the stepper reports a termination (a finger slips, the strain limit, pickup, a lost
 contact) the object's motion can no longer be simulated: the world *ends*, the contact state
@@ -219,6 +220,7 @@ class SimWorld:
         self.index = 0
         self.termination: str | None = None
         self.stepper_seconds = 0.0
+        self.stepper_cpu_seconds = 0.0
         self.step_size = scene.squeeze.step
         self.event_tol = scene.squeeze.event_tol
 
@@ -252,10 +254,11 @@ class SimWorld:
         translations = {k: tuple(v) for k, v in moves.items() if k in touching and np.any(v != 0.0)}
         if translations and self.termination is None:
             self.work["stepper_calls"] += 1
-            started = time.perf_counter()
+            started, cpu = time.perf_counter(), time.thread_time()
             result = advance(self.model, self.state, translations, self.step_size, self.event_tol,
                              terminate_on=TERMINATE_ON)
             self.stepper_seconds += time.perf_counter() - started
+            self.stepper_cpu_seconds += time.thread_time() - cpu
             self.state, events = result.state, result.events
             self.termination = result.termination
         return self._output(events)

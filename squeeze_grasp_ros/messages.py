@@ -3,7 +3,9 @@
 """Conversion between mechanics results and ROS messages: the one place where both meet.
 
 Every function is pure: it builds and returns a new message (or numpy arrays) and never keeps
-state. Units are SI; positions, displacements, forces and directions are in the object frame
+state, except the ``fill_*`` functions of the lockstep loop, which refill a node's own
+per-tick message in place (rclpy serialises a message when it is published, so a publisher can
+reuse one object; building a fresh ``PoseStamped`` costs about 15 times as much). Units are SI; positions, displacements, forces and directions are in the object frame
 (x right, y up, the scene's coordinates), planar vectors travel as ``geometry_msgs/Vector3``
 with z = 0. Arrays are flattened row-major: a list of contact displacements (m, 2) becomes
 ``[x0, y0, x1, y1, ...]`` and a b x b matrix its rows one after the other.
@@ -48,7 +50,7 @@ from .sim.world import WorldView
 Response = TypeVar("Response")
 
 CONTACT_MODES: dict[str, int] = {"stick": ContactNode.STICK, "slip": ContactNode.SLIP}
-"""Mechanics contact mode -> ``ContactNode.mode`` constant."""
+"""Mechanics contact mode -> ``ContactNode.mode`` (= ``ContactState.modes``) constant."""
 
 
 # --------------------------------------------------------------------------- building blocks
@@ -260,9 +262,32 @@ def contact_node_msg(node: contact_state.ContactNode) -> ContactNode:
 def contact_state_msg(state: contact_state.ContactState,
                       header: Header | None = None) -> ContactState:
     """The contact set of a stepper state as ``ContactState`` (depth rho in m)."""
-    return ContactState(header=header or Header(),
-                        nodes=[contact_node_msg(c) for c in state.contacts],
-                        depth=float(state.depth), relative_depth=float(state.relative_depth))
+    contacts = state.contacts
+    forces = np.array([c.force for c in contacts], float).reshape(-1, 2)
+    return contact_arrays_msg(
+        [c.finger for c in contacts], [c.node for c in contacts], [c.theta for c in contacts],
+        [CONTACT_MODES[c.mode] for c in contacts], forces, float(state.depth),
+        float(state.relative_depth), header)
+
+
+def contact_arrays_msg(fingers: Sequence[str], nodes: Sequence[int], angles: Sequence[float],
+                       modes: Sequence[int], forces: np.ndarray, depth: float,
+                       relative_depth: float, header: Header | None = None) -> ContactState:
+    """``ContactState`` of parallel per-contact values (forces (k, 2), N; depth m)."""
+    forces = np.asarray(forces, float).reshape(-1, 2)
+    return ContactState(header=header or Header(), fingers=list(fingers),
+                        nodes=int32_array(nodes), polar_angles=float64_array(angles),
+                        modes=array.array("B", modes), forces_x=float64_array(forces[:, 0]),
+                        forces_y=float64_array(forces[:, 1]), depth=depth,
+                        relative_depth=relative_depth)
+
+
+def contact_records(msg: ContactState) -> list[dict]:
+    """The contacts of a ``ContactState`` as JSON-able dicts (node, finger, mode, force N)."""
+    return [{"node": int(n), "finger": f, "mode": "stick" if m == ContactState.STICK else "slip",
+             "polar_angle": float(a), "force": [float(x), float(y)]}
+            for f, n, a, m, x, y in zip(msg.fingers, msg.nodes, msg.polar_angles, msg.modes,
+                                        msg.forces_x, msg.forces_y)]
 
 
 def contact_event_msg(event: contact_state.Event, header: Header | None = None) -> ContactEvent:
@@ -340,6 +365,26 @@ def tactile_array_msg(readings: TactileReadings, header: Header | None = None) -
                         tangential_forces=float64_array(readings.tangential))
 
 
+def fill_tactile(msg: TactileArray, normal: np.ndarray, tangential: np.ndarray,
+                 ns: int) -> TactileArray:
+    """Refill a :func:`tactile_array_msg` in place with new taxel forces, N, and stamp (the
+    taxel angles stay).
+
+    Raises
+    ------
+    ValueError
+        If the force arrays do not have one entry per taxel.
+    """
+    if not len(normal) == len(tangential) == len(msg.taxel_angles):
+        raise ValueError(f"tactile arrays of {msg.finger} differ in length: "
+                         f"{len(msg.taxel_angles)} taxels, {len(normal)} normal and "
+                         f"{len(tangential)} tangential forces")
+    set_stamp(msg.header.stamp, ns)
+    msg.normal_forces = float64_array(normal)
+    msg.tangential_forces = float64_array(tangential)
+    return msg
+
+
 def tactile_readings(msg: TactileArray) -> TactileReadings:
     """The readings of a ``TactileArray`` as numpy arrays (inverse of :func:`tactile_array_msg`)."""
     return TactileReadings(msg.finger, np.asarray(msg.taxel_angles, dtype=float),
@@ -370,6 +415,11 @@ def clock_msg(ns: int) -> Clock:
     return Clock(clock=stamp(ns))
 
 
+def set_stamp(time: Time, ns: int) -> None:
+    """Set a ``builtin_interfaces/Time`` to ``ns`` nanoseconds in place."""
+    time.sec, time.nanosec = divmod(int(ns), 1_000_000_000)
+
+
 # --------------------------------------------------------------------------- pipeline: devices
 
 
@@ -379,6 +429,14 @@ def pose_msg(position: Sequence[float] | np.ndarray, ns: int, frame_id: str) -> 
     msg.pose.position.x = float(position[0])
     msg.pose.position.y = float(position[1])
     msg.pose.orientation.w = 1.0
+    return msg
+
+
+def fill_pose(msg: PoseStamped, position: Sequence[float] | np.ndarray, ns: int) -> PoseStamped:
+    """Refill a :func:`pose_msg` in place with a new position (x, y), m, and stamp; returns it."""
+    set_stamp(msg.header.stamp, ns)
+    point = msg.pose.position
+    point.x, point.y = float(position[0]), float(position[1])
     return msg
 
 
@@ -401,6 +459,15 @@ def wrench_msg(force: np.ndarray, torque: np.ndarray, ns: int, frame_id: str) ->
     w = msg.wrench
     w.force.x, w.force.y, w.force.z = (float(v) for v in force)
     w.torque.x, w.torque.y, w.torque.z = (float(v) for v in torque)
+    return msg
+
+
+def fill_wrench(msg: WrenchStamped, force: np.ndarray, torque: np.ndarray, ns: int) -> WrenchStamped:
+    """Refill a :func:`wrench_msg` in place with a new force, N, torque, N m, and stamp."""
+    set_stamp(msg.header.stamp, ns)
+    f, t = msg.wrench.force, msg.wrench.torque
+    f.x, f.y, f.z = (float(v) for v in force)
+    t.x, t.y, t.z = (float(v) for v in torque)
     return msg
 
 
@@ -429,10 +496,11 @@ def sim_state_msg(state: contact_state.ContactState, fingers: Sequence[str],
         positions.append(Point(x=float(f.center[0]), y=float(f.center[1])) if f else Point())
         forces.append(vector3(state.finger_force(name)))
         work.append(f.work if f else 0.0)
-    return SimState(header=header(ns, frame_id), fingers=list(fingers), positions=positions,
+    stamp_header = header(ns, frame_id)
+    return SimState(header=stamp_header, fingers=list(fingers), positions=positions,
                     forces=forces, work=float64_array(work),
-                    nodes=[contact_node_msg(c) for c in state.contacts], depth=float(state.depth),
-                    relative_depth=float(state.relative_depth), termination=termination or "")
+                    contacts=contact_state_msg(state, stamp_header),
+                    termination=termination or "")
 
 
 def sim_events_msg(events: Sequence[contact_state.Event], termination: str,
@@ -517,14 +585,15 @@ def alarm_msg(alarm: TrackedAlarm, ns: int) -> Alarm:
 def patches_state_msg(out: TrackerOutput, frame_id: str) -> ContactState:
     """The monitor's reconstructed contact patches as ``ContactState`` (node = -1, polar angle
     = the patch's mean taxel angle, force = the patch force on the object, N)."""
-    nodes = []
-    for p in out.patches:
-        c, s = np.cos(p.angle), np.sin(p.angle)
-        force = (p.normal * c - p.tangential * s, p.normal * s + p.tangential * c)
-        nodes.append(ContactNode(finger=p.finger, node=-1, polar_angle=p.angle,
-                                 mode=CONTACT_MODES[p.mode], force=vector3(force)))
-    return ContactState(header=header(out.stamp_ns, frame_id), nodes=nodes, depth=out.depth,
-                        relative_depth=out.relative_depth)
+    patches = out.patches
+    angles = np.array([p.angle for p in patches], float)
+    normal = np.array([p.normal for p in patches], float)
+    tangential = np.array([p.tangential for p in patches], float)
+    c, s = np.cos(angles), np.sin(angles)
+    forces = np.column_stack([normal * c - tangential * s, normal * s + tangential * c])
+    return contact_arrays_msg([p.finger for p in patches], [-1] * len(patches), angles,
+                              [CONTACT_MODES[p.mode] for p in patches], forces, out.depth,
+                              out.relative_depth, header(out.stamp_ns, frame_id))
 
 
 def monitor_status_msg(out: TrackerOutput, frame_id: str) -> MonitorStatus:

@@ -67,9 +67,10 @@ def net_events(states) -> list[tuple[int, str, str]]:
 
 def contact_modes(state) -> dict:
     """node -> (finger, mode) of a stepper ``ContactState`` or a ``SimState`` message."""
-    if hasattr(state, "contacts"):
+    if not hasattr(state, "header"):
         return {c.node: (c.finger, c.mode) for c in state.contacts}
-    return {n.node: (n.finger, "stick" if n.mode == n.STICK else "slip") for n in state.nodes}
+    from squeeze_grasp_ros.messages import contact_records
+    return {c["node"]: (c["finger"], c["mode"]) for c in contact_records(state.contacts)}
 
 
 def match_within(expected, observed, ticks: int) -> list[str]:

@@ -245,8 +245,9 @@ def test_event_squeeze_service_and_action_equal_the_mechanics(planner: Harness) 
             expected.depth, expected.relative_depth, expected.energy)
         assert [(e.type, e.node, e.finger, e.depth) for e in data.events] == [
             (e.type, e.node, e.finger, e.depth) for e in expected.events]
-        assert [(c.node, c.finger, c.polar_angle, c.force.x, c.force.y)
-                for c in data.final_state.nodes] == [
+        final = data.final_state
+        assert list(zip(final.nodes, final.fingers, final.polar_angles, final.forces_x,
+                        final.forces_y)) == [
             (c.node, c.finger, c.theta, *c.force) for c in expected.state.contacts]
         assert (data.work_f1, data.work_f2) == (expected.work["F1"], expected.work["F2"])
         assert data.max_strain == expected.health.max_strain

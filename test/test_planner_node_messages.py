@@ -64,9 +64,11 @@ def test_contact_state_and_events_keep_units_and_modes() -> None:
     state = ContactState(fingers, nodes, depth=0.003, relative_per_depth=10.0)
     message = messages.contact_state_msg(state)
     assert (message.depth, message.relative_depth) == (0.003, 0.03)
-    assert [(n.node, n.finger, n.mode, n.polar_angle, n.force.x, n.force.y, n.force.z)
-            for n in message.nodes] == [(4, "F1", ContactNode.STICK, 0.25, 1.5, -2.0, 0.0),
-                                        (9, "F2", ContactNode.SLIP, -3.0, 0.0, 0.5, 0.0)]
+    assert list(zip(message.nodes, message.fingers, message.modes, message.polar_angles,
+                    message.forces_x, message.forces_y)) == [
+        (4, "F1", ContactNode.STICK, 0.25, 1.5, -2.0), (9, "F2", ContactNode.SLIP, -3.0, 0.0, 0.5)]
+    assert messages.contact_records(message)[1] == {
+        "node": 9, "finger": "F2", "mode": "slip", "polar_angle": -3.0, "force": [0.0, 0.5]}
     event = messages.contact_event_msg(Event("C", 9, "F2", 0.002, 0.02, "slip", -1))
     assert (event.type, event.node, event.finger, event.depth, event.relative_depth) == (
         "C", 9, "F2", 0.002, 0.02)

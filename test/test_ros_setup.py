@@ -100,16 +100,17 @@ def test_interface_constants() -> None:
 def test_nested_message_serialization_round_trip() -> None:
     from geometry_msgs.msg import Vector3
     from rclpy.serialization import deserialize_message, serialize_message
-    from squeeze_grasp_interfaces.msg import ContactNode, ContactState
+    from squeeze_grasp_interfaces.msg import ContactNode, SimState
 
-    state = ContactState(depth=2e-3, relative_depth=0.04)
+    state = SimState(fingers=["F1", "F2"], termination="finger_slip")
     state.header.frame_id = "object"
-    state.nodes = [
-        ContactNode(finger="F1", node=3, polar_angle=0.1, mode=ContactNode.STICK,
-                    force=Vector3(x=1.5, y=-0.25)),
-        ContactNode(finger="F2", node=17, polar_angle=-0.2, mode=ContactNode.SLIP),
-    ]
-    assert deserialize_message(serialize_message(state), ContactState) == state
+    state.forces = [Vector3(x=1.5, y=-0.25), Vector3(x=-1.5, y=0.25)]
+    contacts = state.contacts
+    contacts.depth, contacts.relative_depth = 2e-3, 0.04
+    contacts.fingers, contacts.nodes, contacts.modes = ["F1", "F2"], [3, 17], [0, 1]
+    contacts.forces_x = [1.5, 0.0]
+    assert list(contacts.modes) == [ContactNode.STICK, ContactNode.SLIP]
+    assert deserialize_message(serialize_message(state), SimState) == state
 
 
 def test_contact_event_publish_subscribe(ros_context) -> None:

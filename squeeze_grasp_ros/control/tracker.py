@@ -209,28 +209,37 @@ class TrackerOutput:
     relative_depth: float
 
 
-def loaded_runs(normal: np.ndarray, threshold: float) -> list[tuple[int, int]]:
-    """(first, last) taxel indices of every maximal run of loaded taxels."""
-    loaded = np.concatenate([[False], normal > threshold, [False]])
-    edges = np.flatnonzero(np.diff(loaded.astype(np.int8)))
-    return [(int(a), int(b) - 1) for a, b in zip(edges[::2], edges[1::2])]
+def loaded_runs(normal: np.ndarray, threshold: float) -> tuple[np.ndarray, np.ndarray]:
+    """First and last taxel indices (inclusive) of every maximal run of loaded taxels."""
+    loaded = np.empty(len(normal) + 2, np.int8)
+    loaded[0] = loaded[-1] = 0
+    np.greater(normal, threshold, out=loaded[1:-1], casting="unsafe")
+    edges = np.flatnonzero(np.diff(loaded))
+    return edges[::2], edges[1::2] - 1
 
 
 def patches_of(finger: str, sample: FingerSample, config: TrackerConfig) -> list[Patch]:
-    """Contact patches of one finger's taxels."""
+    """Contact patches of one finger's taxels (all runs summed in one pass each)."""
     if sample.normal is None:
         return []
+    firsts, lasts = loaded_runs(sample.normal, config.load_threshold)
+    if not len(firsts):
+        return []
+    loaded = np.zeros(len(sample.normal), bool)
+    for first, last in zip(firsts, lasts):
+        loaded[first:last + 1] = True
+    fn = np.where(loaded, sample.normal, 0.0)
+    sums = np.add.reduceat(np.stack([fn, np.where(loaded, sample.tangential, 0.0),
+                                     fn * sample.angles]), firsts, axis=1)
+    mu, edge = config.mu, 1.0 - config.edge_tolerance
     out = []
-    mu = config.mu
-    for first, last in loaded_runs(sample.normal, config.load_threshold):
-        fn = sample.normal[first:last + 1]
-        normal = float(fn.sum())
-        tangential = float(sample.tangential[first:last + 1].sum())
-        angle = float(fn @ sample.angles[first:last + 1] / normal)
-        sliding = mu == 0.0 or abs(tangential) >= (1.0 - config.edge_tolerance) * mu * normal
-        slip = -int(np.sign(tangential)) if sliding and mu > 0.0 else 0
-        out.append(Patch(finger, angle, normal, tangential, "slip" if sliding else "stick", slip,
-                         first, last))
+    for first, last, normal, tangential, moment in zip(firsts.tolist(), lasts.tolist(),
+                                                       *sums.tolist()):
+        sliding = mu == 0.0 or abs(tangential) >= edge * mu * normal
+        slip = (-1 if tangential > 0.0 else 1 if tangential < 0.0 else 0) \
+            if sliding and mu > 0.0 else 0
+        out.append(Patch(finger, moment / normal, normal, tangential,
+                         "slip" if sliding else "stick", slip, first, last))
     return out
 
 

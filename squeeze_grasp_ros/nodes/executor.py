@@ -100,6 +100,8 @@ class ExecutorNode(Node):
         self.latest: MonitorStatus | None = None
         self.answered_ns = -1
         self.last_setpoints: list = []
+        self.setpoints = {f: messages.pose_msg((0.0, 0.0), 0, self.p["frame_id"])
+                          for f in self.setpoint_pubs}
         self.state = ExecutorStatus.IDLE
         if p["lockstep"]:
             self.participant = pipeline.Participant(self, "executor", [pipeline.STATUS],
@@ -167,7 +169,8 @@ class ExecutorNode(Node):
         obs = messages.observation(msg)
         command = goal.program.step(obs, self.p["period"])
         stamp = ns + self.period_ns if now_ns is None else now_ns
-        self.last_setpoints = [(self.setpoint_pubs[f], messages.pose_msg(xy, stamp, self.p["frame_id"]))
+        self.last_setpoints = [(self.setpoint_pubs[f],
+                                messages.fill_pose(self.setpoints[f], xy, stamp))
                                for f, xy in command.setpoints.items()]
         self.answered_ns = ns
         for publisher, setpoint in self.last_setpoints:

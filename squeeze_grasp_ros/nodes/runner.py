@@ -600,7 +600,8 @@ class PipelineRunner:
             "scene": self.scene.name, "mode": self.mode(), "plan_source": plan.source,
             "termination": result.termination, "success": bool(result.success),
             "message": result.message, "world_termination": state.termination or "none",
-            "depth": float(state.depth), "relative_depth": float(state.relative_depth),
+            "depth": float(state.contacts.depth),
+            "relative_depth": float(state.contacts.relative_depth),
             "target_depth": float(plan.goal.depth), "measured_depth": float(result.depth),
             "ticks": int(result.ticks), "sim_time": float(result.duration),
             "hold_ticks": int(result.hold_ticks), "redirected": bool(result.redirected),
@@ -617,22 +618,22 @@ class PipelineRunner:
             "work": dict(zip(fingers, (float(w) for w in state.work))),
             "measured_forces": {f: [v.x, v.y] for f, v in zip(result.fingers, result.forces)},
             "measured_work": dict(zip(result.fingers, (float(w) for w in result.work))),
-            "contacts": [{"node": int(n.node), "finger": n.finger,
-                          "mode": "stick" if n.mode == n.STICK else "slip",
-                          "force": [n.force.x, n.force.y]} for n in state.nodes],
+            "contacts": messages.contact_records(state.contacts),
             "recording": self.options.record,
             "timing": {**self.timing, "total": time.perf_counter() - self.t0,
                        **self._node_timing()},
         }
 
     def _node_timing(self) -> dict:
-        """Wall and CPU time of the stepper inside the in-process simulated hardware (absent
-        with processes; ``loop_cpu`` is then only this process's CPU time)."""
+        """Wall and CPU time of the stepper (``mechanics``) and of whole world ticks (``world``:
+        devices, stepper, sensors) inside the in-process simulated hardware (absent with
+        processes; ``loop_cpu`` is then only this process's CPU time)."""
         sims = [n for n in self.nodes if n.get_name() == "sim_hardware"]
         if not sims:
             return {}
-        return {"mechanics": sims[0].world.stepper_seconds,
-                "mechanics_cpu": sims[0].world.stepper_cpu_seconds}
+        world = sims[0].world
+        return {"mechanics": world.stepper_seconds, "mechanics_cpu": world.stepper_cpu_seconds,
+                "world": world.step_seconds, "world_cpu": world.step_cpu_seconds}
 
     def mode(self) -> str:
         """How the nodes ran."""

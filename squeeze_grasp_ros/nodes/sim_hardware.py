@@ -25,6 +25,7 @@ from __future__ import annotations
 import time
 from typing import Any
 
+import numpy as np
 from geometry_msgs.msg import PoseStamped, WrenchStamped
 from rclpy.node import Node
 from rosgraph_msgs.msg import Clock
@@ -83,6 +84,7 @@ class SimHardwareNode(Node):
                             for f, d in self.devices.items() if world.scene.has("force_sensing")}
         self.tactile_pubs = {f: pub(TactileArray, pipeline.device_topic(d, "tactile"), sensors)
                              for f, d in self.devices.items() if f in world.layouts}
+        self.msgs = {f: self._reading_messages(f) for f in self.devices}
         self.tick_pub = pub(Tick, pipeline.TICK, loop)
         self.state_pub = pub(SimState, pipeline.SIM_STATE, loop)
         self.event_pub = pub(ContactEventArray, pipeline.SIM_EVENTS, loop)
@@ -103,6 +105,19 @@ class SimHardwareNode(Node):
         self.handshake = pipeline.Handshake(self, self.p["participants"],
                                             self.p["handshake_period"], self._start)
         pipeline.wall_timer(self, max(self.p["resend_timeout"] / 2.0, 1e-3), self._check_stalled)
+
+    def _reading_messages(self, finger: str) -> dict[str, Any]:
+        """One message per reading of ``finger``, refilled every tick (frames and taxel
+        angles set once)."""
+        tip = f"{finger}_tip"
+        out: dict[str, Any] = {"pose": messages.pose_msg((0.0, 0.0), 0, self.frame),
+                               "wrench": messages.wrench_msg(np.zeros(3), np.zeros(3), 0, tip)}
+        if finger in self.world.layouts:
+            angles = self.world.layouts[finger].angles
+            out["tactile"] = messages.tactile_array_msg(messages.TactileReadings(
+                finger, angles, np.zeros_like(angles), np.zeros_like(angles)),
+                messages.header(0, tip))
+        return out
 
     # ----------------------------------------------------------------- the loop
     def _start(self) -> None:
@@ -129,24 +144,26 @@ class SimHardwareNode(Node):
         self._publish(self.world.step(setpoints))
 
     def _publish(self, out: TickOutput) -> None:
-        """Publish tick ``out`` (clock first, sim/tick last) and keep it for a re-send."""
+        """Publish tick ``out`` (clock first, sim/tick last) and keep it for a re-send.
+
+        The per-device readings are refilled in place (one message object per publisher);
+        markers are built only at the display rate and only while somebody subscribes.
+        """
         ns, frame = out.stamp_ns, self.frame
         batch = [(self.clock_pub, messages.clock_msg(ns))]
         readings = []
         for r in out.readings:
-            device = self.devices[r.finger]
-            batch.append((self.pose_pubs[r.finger], messages.pose_msg(r.position, ns, frame)))
+            device, msgs = self.devices[r.finger], self.msgs[r.finger]
+            batch.append((self.pose_pubs[r.finger],
+                          messages.fill_pose(msgs["pose"], r.position, ns)))
             readings.append(f"{device}/pose")
             if r.force is not None:
                 batch.append((self.wrench_pubs[r.finger],
-                              messages.wrench_msg(r.force, r.torque, ns, f"{r.finger}_tip")))
+                              messages.fill_wrench(msgs["wrench"], r.force, r.torque, ns)))
                 readings.append(f"{device}/wrench")
             if r.normal is not None:
-                reading = messages.TactileReadings(r.finger, self.world.layouts[r.finger].angles,
-                                                   r.normal, r.tangential)
-                tip = messages.header(ns, f"{r.finger}_tip")
                 batch.append((self.tactile_pubs[r.finger],
-                              messages.tactile_array_msg(reading, tip)))
+                              messages.fill_tactile(msgs["tactile"], r.normal, r.tangential, ns)))
                 readings.append(f"{device}/tactile")
         ending = out.termination is not None and not self.ended
         self.ended = self.ended or ending
@@ -157,7 +174,7 @@ class SimHardwareNode(Node):
                                                              out.termination, ns, frame)))
         tick = (self.tick_pub, messages.tick_msg(out.index, ns, readings))
         self.current, self.now_ns = batch + [tick], ns
-        if self._display_due(out.index):
+        if self._display_due(out.index) and self.marker_pub.get_subscription_count() > 0:
             batch.append((self.marker_pub, messages.world_markers(self.world.view(), ns, frame)))
         self.last_progress = time.monotonic()
         self.ticks_published += 1

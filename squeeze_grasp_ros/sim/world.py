@@ -15,8 +15,9 @@ Only declared effects are composed (``scene.effects``): ``friction`` sets mu (el
 third fingertip and its pusher, ``force_sensing``/``tactile_sensing`` render wrenches/taxels,
 ``sensor_noise``/``sensor_dropout`` draw random numbers, ``actuator_lag`` lags the devices. Every
 piece of optional work increments a counter of :attr:`SimWorld.work`; the wall and CPU time spent
-in the stepper are :attr:`SimWorld.stepper_seconds` and ``stepper_cpu_seconds`` (benchmarks
-subtract them).
+in the stepper are :attr:`SimWorld.stepper_seconds` and ``stepper_cpu_seconds``, those of whole
+ticks (devices, stepper, sensors) ``step_seconds`` and ``step_cpu_seconds`` (benchmarks subtract
+them to measure what the nodes and their messages cost).
 
 When the stepper reports a termination (a finger slips, the strain limit, pickup, a lost
 contact) the object's motion can no longer be simulated: the world *ends*, the contact state
@@ -221,6 +222,8 @@ class SimWorld:
         self.termination: str | None = None
         self.stepper_seconds = 0.0
         self.stepper_cpu_seconds = 0.0
+        self.step_seconds = 0.0
+        self.step_cpu_seconds = 0.0
         self.step_size = scene.squeeze.step
         self.event_tol = scene.squeeze.event_tol
 
@@ -234,6 +237,13 @@ class SimWorld:
 
         Fingers without a setpoint hold their position.
         """
+        started, cpu = time.perf_counter(), time.thread_time()
+        out = self._step(setpoints)
+        self.step_seconds += time.perf_counter() - started
+        self.step_cpu_seconds += time.thread_time() - cpu
+        return out
+
+    def _step(self, setpoints: Mapping[str, np.ndarray]) -> TickOutput:
         moves: dict[str, np.ndarray] = {}
         for name in self.fingers:
             if name not in setpoints:

@@ -46,6 +46,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
+from typing import NamedTuple
 
 import numpy as np
 
@@ -119,9 +120,9 @@ class FingerSample:
     tactile_stamp_ns: int | None = None
 
 
-@dataclass(frozen=True)
-class Patch:
-    """A contact patch: a run of neighbouring loaded taxels.
+class Patch(NamedTuple):
+    """A contact patch: a run of neighbouring loaded taxels (a named tuple: a few are built
+    per finger and tick).
 
     Attributes
     ----------
@@ -209,31 +210,52 @@ class TrackerOutput:
     relative_depth: float
 
 
-def loaded_runs(normal: np.ndarray, threshold: float) -> tuple[np.ndarray, np.ndarray]:
-    """First and last taxel indices (inclusive) of every maximal run of loaded taxels."""
-    loaded = np.empty(len(normal) + 2, np.int8)
-    loaded[0] = loaded[-1] = 0
-    np.greater(normal, threshold, out=loaded[1:-1], casting="unsafe")
-    edges = np.flatnonzero(np.diff(loaded))
-    return edges[::2], edges[1::2] - 1
+@dataclass(frozen=True)
+class LoadedTaxels:
+    """The loaded taxels (normal force above the threshold) of one finger's reading.
+
+    Attributes
+    ----------
+    index : (k,) ndarray of int
+        Their indices, increasing.
+    normal, tangential : (k,) ndarray
+        Their forces, N.
+    angles, cos, sin : (k,) ndarray
+        Their polar angles (rad) and its cosine and sine.
+    """
+
+    index: np.ndarray
+    normal: np.ndarray
+    tangential: np.ndarray
+    angles: np.ndarray
+    cos: np.ndarray
+    sin: np.ndarray
 
 
-def patches_of(finger: str, sample: FingerSample, config: TrackerConfig) -> list[Patch]:
-    """Contact patches of one finger's taxels (all runs summed in one pass each)."""
-    if sample.normal is None:
+def loaded_taxels(sample: FingerSample, threshold: float,
+                  trig: tuple[np.ndarray, np.ndarray] | None = None) -> LoadedTaxels:
+    """The loaded taxels of a reading with tactile data (``trig``: cos and sin of all its
+    taxel angles, if already known)."""
+    index = np.flatnonzero(sample.normal > threshold)
+    cos, sin = trig if trig is not None else (np.cos(sample.angles), np.sin(sample.angles))
+    return LoadedTaxels(index, sample.normal[index], sample.tangential[index],
+                        sample.angles[index], cos[index], sin[index])
+
+
+def patches_of(finger: str, taxels: LoadedTaxels, config: TrackerConfig) -> list[Patch]:
+    """Contact patches of one finger: its maximal runs of neighbouring loaded taxels, each
+    summed in one ``reduceat`` pass."""
+    index = taxels.index
+    if not len(index):
         return []
-    firsts, lasts = loaded_runs(sample.normal, config.load_threshold)
-    if not len(firsts):
-        return []
-    loaded = np.zeros(len(sample.normal), bool)
-    for first, last in zip(firsts, lasts):
-        loaded[first:last + 1] = True
-    fn = np.where(loaded, sample.normal, 0.0)
-    sums = np.add.reduceat(np.stack([fn, np.where(loaded, sample.tangential, 0.0),
-                                     fn * sample.angles]), firsts, axis=1)
+    breaks = np.flatnonzero(np.diff(index) > 1) + 1
+    starts = np.concatenate([[0], breaks])
+    sums = np.add.reduceat(np.stack([taxels.normal, taxels.tangential,
+                                     taxels.normal * taxels.angles]), starts, axis=1)
+    lasts = np.concatenate([index[breaks - 1], index[-1:]])
     mu, edge = config.mu, 1.0 - config.edge_tolerance
     out = []
-    for first, last, normal, tangential, moment in zip(firsts.tolist(), lasts.tolist(),
+    for first, last, normal, tangential, moment in zip(index[starts].tolist(), lasts.tolist(),
                                                        *sums.tolist()):
         sliding = mu == 0.0 or abs(tangential) >= edge * mu * normal
         slip = (-1 if tangential > 0.0 else 1 if tangential < 0.0 else 0) \
@@ -273,6 +295,8 @@ class _FingerTrack:
     normal: np.ndarray = field(default_factory=lambda: np.zeros(2))
     had_contact: bool = False
     stamps: dict = field(default_factory=dict)
+    trig_key: bytes = b""
+    trig: tuple = ()
 
 
 class ContactTracker:
@@ -314,20 +338,24 @@ class ContactTracker:
         events: list[TrackedEvent] = []
         alarms: list[TrackedAlarm] = []
         patches: list[Patch] = []
+        loaded: dict[str, LoadedTaxels] = {}
         for name in self.fingers:
             sample = samples.get(name, FingerSample())
             track = self.tracks[name]
             self._note_stamps(track, sample)
-            current = patches_of(name, sample, cfg)
+            taxels = None
             if sample.normal is not None:
+                taxels = loaded_taxels(sample, cfg.load_threshold, self._trig(track, sample))
+                current = patches_of(name, taxels, cfg)
                 events += self._events(name, track.patches, current, relative)
                 track.patches = current
                 track.had_contact = track.had_contact or bool(current)
+                loaded[name] = taxels
             patches += track.patches
             track.force = self._force(sample, track.force)
-            track.normal = self._normal(sample, track.normal)
-            alarms += self._alarms(name, track, sample, stamp_ns)
-        if cfg.weight is not None and not self.picked_up and self._can_lift(samples):
+            track.normal = self._normal(taxels, track.normal)
+            alarms += self._alarms(name, track, taxels, stamp_ns)
+        if cfg.weight is not None and not self.picked_up and self._can_lift(loaded):
             self.picked_up = True
             events.append(TrackedEvent("picked_up", "", self.depth, relative, 0.0))
         alarms += self._compare(events)
@@ -353,6 +381,14 @@ class ContactTracker:
                 step += float(d @ d)
             track.position = position
         self.depth += float(np.sqrt(step))
+
+    @staticmethod
+    def _trig(track: _FingerTrack, sample: FingerSample) -> tuple[np.ndarray, np.ndarray]:
+        """cos and sin of the finger's taxel angles, recomputed only when the angles change."""
+        key = sample.angles.tobytes()
+        if track.trig_key != key:
+            track.trig_key, track.trig = key, (np.cos(sample.angles), np.sin(sample.angles))
+        return track.trig
 
     @staticmethod
     def _note_stamps(track: _FingerTrack, sample: FingerSample) -> None:
@@ -396,18 +432,18 @@ class ContactTracker:
                              sample.normal @ s + sample.tangential @ c])
         return previous
 
-    def _normal(self, sample: FingerSample, previous: np.ndarray) -> np.ndarray:
+    @staticmethod
+    def _normal(taxels: LoadedTaxels | None, previous: np.ndarray) -> np.ndarray:
         """Unit contact normal into the object from the loaded taxels (zero without any)."""
-        if sample.normal is None:
+        if taxels is None:
             return previous
-        loaded = sample.normal > self.config.load_threshold
-        if not loaded.any():
+        if not len(taxels.index):
             return np.zeros(2)
-        w = sample.normal[loaded]
-        v = np.array([w @ np.cos(sample.angles[loaded]), w @ np.sin(sample.angles[loaded])])
+        w = taxels.normal
+        v = np.array([w @ taxels.cos, w @ taxels.sin])
         return v / np.linalg.norm(v)
 
-    def _alarms(self, name: str, track: _FingerTrack, sample: FingerSample,
+    def _alarms(self, name: str, track: _FingerTrack, taxels: LoadedTaxels | None,
                 stamp_ns: int) -> list[TrackedAlarm]:
         cfg = self.config
         out = []
@@ -417,39 +453,33 @@ class ContactTracker:
                                     f"newest {name} reading is {age * 1e3:.3g} ms old"))
         if track.had_contact and not track.patches:
             out.append(TrackedAlarm("contact_lost", name, 0.0, f"{name} has no loaded taxel"))
-        usage = self._cone_usage(sample)
+        usage = self._cone_usage(taxels)
         if usage is not None:
             out.append(TrackedAlarm("slip_imminent", name, usage,
                                     f"every loaded taxel of {name} uses >= {usage:.3f} of its "
                                     "friction cone in one direction"))
         return out
 
-    def _cone_usage(self, sample: FingerSample) -> float | None:
+    def _cone_usage(self, taxels: LoadedTaxels | None) -> float | None:
         """Smallest cone usage if every loaded taxel is past alarm_ratio one way, else None."""
         cfg = self.config
-        if cfg.mu == 0.0 or sample.normal is None:
+        if cfg.mu == 0.0 or taxels is None or not len(taxels.index):
             return None
-        loaded = sample.normal > cfg.load_threshold
-        if not loaded.any():
-            return None
-        usage = -sample.tangential[loaded] / (cfg.mu * sample.normal[loaded])
-        if np.all(usage >= cfg.alarm_ratio) or np.all(usage <= -cfg.alarm_ratio):
-            return float(np.abs(usage).min())
+        usage = -taxels.tangential / (cfg.mu * taxels.normal)
+        low, high = float(usage.min()), float(usage.max())
+        if low >= cfg.alarm_ratio or high <= -cfg.alarm_ratio:
+            return min(abs(low), abs(high))
         return None
 
-    def _can_lift(self, samples: Mapping[str, FingerSample]) -> bool:
+    def _can_lift(self, loaded: Mapping[str, LoadedTaxels]) -> bool:
         """Every finger with loaded taxels can supply w / n_f of vertical friction."""
         cfg = self.config
         supply = []
-        for name in self.fingers:
-            sample = samples.get(name)
-            if sample is None or sample.normal is None:
+        for taxels in loaded.values():
+            if not len(taxels.index):
                 continue
-            fn, ft = sample.normal, sample.tangential
-            loaded = fn > cfg.load_threshold
-            if not loaded.any():
-                continue
-            sticking = loaded & (np.abs(ft) < (1.0 - cfg.edge_tolerance) * cfg.mu * fn)
+            fn, ft = taxels.normal, taxels.tangential
+            sticking = np.abs(ft) < (1.0 - cfg.edge_tolerance) * cfg.mu * fn
             supply.append(float(np.sqrt(np.maximum(cfg.mu ** 2 * fn[sticking] ** 2
                                                    - ft[sticking] ** 2, 0.0)).sum()))
         return bool(supply) and min(supply) >= cfg.weight / len(supply)

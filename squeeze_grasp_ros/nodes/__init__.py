@@ -3,36 +3,57 @@
 """The ROS 2 nodes: thin rclpy wiring around the mechanics, one console script each."""
 from __future__ import annotations
 
+import signal
+import threading
 from collections.abc import Callable
 
 import rclpy
 from rclpy.executors import Executor, ExternalShutdownException
+from rclpy.experimental import EventsExecutor
 from rclpy.node import Node
+from rclpy.signals import SignalHandlerOptions
 
 
-def run_node(node_type: Callable[[], Node], executor_type: Callable[[], Executor],
-             args: list[str] | None = None) -> None:
-    """A node's ``main``: init rclpy, spin one node in the main thread until Ctrl-C or
-    shutdown, then destroy the node (joining any workers), the executor and the context.
+def run_node(factory: Callable[[], Node], args: list[str] | None = None,
+             executor_type: Callable[[], Executor] = EventsExecutor) -> None:
+    """A node's ``main``: init rclpy, spin the node in the main thread until SIGINT, SIGTERM or
+    shutdown, then clean up.
+
+    The executor (default ``rclpy.experimental.EventsExecutor``; the planner, whose worker
+    threads hand results back through futures, uses ``SingleThreadedExecutor``) is spun with
+    ``spin_once`` in a loop: in rclpy 7.1.6 ``EventsExecutor.spin()`` holds the GIL at 100 % CPU
+    once a node has a timer (measured: no callback runs, no other thread gets the GIL) and does
+    not return after shutdown. SIGINT (Ctrl-C, also what ``ros2 launch`` sends first) and
+    SIGTERM only set a flag, so no callback is interrupted halfway; the loop then ends, a node
+    with ``drain(executor)`` processes what has already arrived, its ``close()`` is called, and
+    the node is destroyed (the planner joins its workers there).
 
     Parameters
     ----------
-    node_type : callable
+    factory : callable
         Builds the node (after ``rclpy.init``).
-    executor_type : callable
-        Builds the executor, e.g. ``SingleThreadedExecutor``.
     args : list of str, optional
         Command-line arguments for ``rclpy.init`` (``--ros-args ...``); None = ``sys.argv``.
+    executor_type : callable
+        Builds the executor.
     """
-    rclpy.init(args=args)
-    node = node_type()
+    stop = threading.Event()
+    for signum in (signal.SIGINT, signal.SIGTERM):
+        signal.signal(signum, lambda *_: stop.set())
+    rclpy.init(args=args, signal_handler_options=SignalHandlerOptions.NO)
     executor = executor_type()
+    node = factory()
     executor.add_node(node)
     try:
-        executor.spin()
-    except (KeyboardInterrupt, ExternalShutdownException):
+        while rclpy.ok() and not stop.is_set():
+            executor.spin_once(0.1)
+        if stop.is_set() and hasattr(node, "drain"):
+            node.drain(executor)
+    except ExternalShutdownException:
         pass
     finally:
-        node.destroy_node()
+        if hasattr(node, "close"):
+            node.close()
         executor.shutdown()
+        node.destroy_node()
         rclpy.try_shutdown()

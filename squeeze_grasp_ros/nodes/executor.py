@@ -37,7 +37,7 @@ from squeeze_grasp_interfaces.msg import ExecutorStatus, MonitorStatus
 
 from .. import messages
 from ..control.motion import Command, GraspProgram, MotionLimits, goal_problem
-from . import pipeline
+from . import pipeline, run_node
 
 PARAMETERS: dict[str, tuple[Any, str]] = {
     "finger_devices": (["F1:barrett_f1", "F2:barrett_f3"], "finger:device of every fingertip"),
@@ -203,7 +203,7 @@ class ExecutorNode(Node):
 
 def main(args: list[str] | None = None) -> None:
     """Run the executor until Ctrl-C or shutdown."""
-    pipeline.run_node(ExecutorNode, args)
+    run_node(ExecutorNode, args)
 
 
 if __name__ == "__main__":

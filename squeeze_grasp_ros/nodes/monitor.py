@@ -30,7 +30,7 @@ from squeeze_grasp_interfaces.msg import (Alarm, ContactEventArray, ContactState
 
 from .. import messages
 from ..control.tracker import ContactTracker, FingerSample, TrackerConfig
-from . import pipeline
+from . import pipeline, run_node
 
 PARAMETERS: dict[str, tuple[Any, str]] = {
     "finger_devices": (["F1:barrett_f1", "F2:barrett_f3"], "finger:device of every fingertip"),
@@ -159,7 +159,7 @@ class MonitorNode(Node):
 
 def main(args: list[str] | None = None) -> None:
     """Run the monitor until Ctrl-C or shutdown."""
-    pipeline.run_node(MonitorNode, args)
+    run_node(MonitorNode, args)
 
 
 if __name__ == "__main__":

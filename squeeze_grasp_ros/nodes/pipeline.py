@@ -18,20 +18,14 @@ driver and handled idempotently by stamp in every node.
 from __future__ import annotations
 
 import importlib
-import signal
-import threading
 from collections.abc import Callable, Iterable, Mapping, Sequence
 from typing import Any
 
-import rclpy
 from rcl_interfaces.msg import ParameterDescriptor
 from rclpy.clock import Clock, ClockType
-from rclpy.executors import ExternalShutdownException
-from rclpy.experimental import EventsExecutor
 from rclpy.node import Node
 from rclpy.qos import (DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy,
                        qos_profile_sensor_data)
-from rclpy.signals import SignalHandlerOptions
 from std_msgs.msg import String
 
 FRAME = "object"
@@ -222,35 +216,3 @@ class Handshake:
             self.done = True
             self._timer.cancel()
             self.on_complete()
-
-
-def run_node(factory: Callable[[], Node], args: list[str] | None = None) -> None:
-    """The ``main()`` of a pipeline node: init, spin in the main thread, clean up.
-
-    The node is spun by ``EventsExecutor.spin_once`` in a loop: in rclpy 7.1.6
-    ``EventsExecutor.spin()`` holds the GIL at 100 % CPU once a node has a timer (measured: no
-    callback runs, no other thread gets the GIL) and does not return after shutdown. SIGINT
-    (Ctrl-C, also what ``ros2 launch`` sends first) and SIGTERM only set a flag, so no callback
-    is interrupted halfway; the loop then ends, a node with ``drain(executor)`` processes what
-    has already arrived, and ``close()`` is called in any case.
-    """
-    stop = threading.Event()
-    for signum in (signal.SIGINT, signal.SIGTERM):
-        signal.signal(signum, lambda *_: stop.set())
-    rclpy.init(args=args, signal_handler_options=SignalHandlerOptions.NO)
-    executor = EventsExecutor()
-    node = factory()
-    executor.add_node(node)
-    try:
-        while rclpy.ok() and not stop.is_set():
-            executor.spin_once(0.1)
-        if stop.is_set() and hasattr(node, "drain"):
-            node.drain(executor)
-    except ExternalShutdownException:
-        pass
-    finally:
-        if hasattr(node, "close"):
-            node.close()
-        executor.shutdown()
-        node.destroy_node()
-        rclpy.try_shutdown()

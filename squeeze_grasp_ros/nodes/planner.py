@@ -300,7 +300,7 @@ class PlannerNode(Node):
 
 def main(args: list[str] | None = None) -> None:
     """Run the planner on a SingleThreadedExecutor in the main thread until Ctrl-C or shutdown."""
-    run_node(PlannerNode, SingleThreadedExecutor, args)
+    run_node(PlannerNode, args, SingleThreadedExecutor)
 
 
 if __name__ == "__main__":

@@ -39,7 +39,7 @@ from std_msgs.msg import Header
 from .. import messages
 from ..recording.bag import BagWriter, qos_dict
 from ..recording.schema import starts_with_stamp
-from . import pipeline
+from . import pipeline, run_node
 
 PARAMETERS: dict[str, tuple[Any, str]] = {
     "output": ("", "bag folder to create (required; must not exist or be empty)"),
@@ -163,7 +163,7 @@ class RecorderNode(Node):
 
 def main(args: list[str] | None = None) -> None:
     """Record until Ctrl-C or shutdown, then finish the bag."""
-    pipeline.run_node(RecorderNode, args)
+    run_node(RecorderNode, args)
 
 
 if __name__ == "__main__":

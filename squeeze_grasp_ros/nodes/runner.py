@@ -49,6 +49,7 @@ from rclpy.executors import SingleThreadedExecutor
 from rclpy.experimental import EventsExecutor
 from rclpy.node import Node
 from rclpy.parameter import Parameter
+from rclpy.serialization import deserialize_message
 from rclpy.signals import SignalHandlerOptions
 from std_msgs.msg import Header
 
@@ -67,6 +68,7 @@ from ..scene import (Scene, SceneError, build_mesh, finger_devices, finger_nodes
                      placement_node, scene_material)
 from ..scene_events import event_squeeze_scene
 from . import pipeline
+from .recorder import cdr_stamp_ns
 
 NODES: tuple[str, ...] = ("sim_hardware", "monitor", "executor", "recorder")
 EXECUTORS: tuple[str, ...] = ("events", "single")
@@ -212,8 +214,8 @@ class PipelineRunner:
         self.monitor_events: list[ContactEvent] = []
         self.alarms: Counter = Counter()
         self.first_alarm: dict[str, dict] = {}
-        self.sim_state: SimState | None = None
-        self.sim_states: list[SimState] = []
+        self.sim_state_data: list[bytes] = []
+        self.sim_state_ns = -1
         self.recorder_ns = -1
         self.feedback: list[ExecuteGrasp.Feedback] = []
         loop = pipeline.loop_qos(1000)
@@ -222,7 +224,7 @@ class PipelineRunner:
         c.create_subscription(ContactEventArray, pipeline.EVENTS,
                               lambda msg: self.monitor_events.extend(msg.events), loop)
         c.create_subscription(Alarm, pipeline.ALARMS, self._alarm, loop)
-        c.create_subscription(SimState, pipeline.SIM_STATE, self._state, loop)
+        c.create_subscription(SimState, pipeline.SIM_STATE, self._state, loop, raw=True)
         c.create_subscription(Header, pipeline.RECORDER_PROGRESS, self._recorder_progress, loop)
         self.prediction_pub = c.create_publisher(ContactEventArray, pipeline.PREDICTION,
                                                  pipeline.LATCHED)
@@ -247,9 +249,20 @@ class PipelineRunner:
         self.first_alarm.setdefault(msg.type, {"stamp_ns": messages.stamp_ns(msg.header.stamp),
                                                "finger": msg.finger, "message": msg.message})
 
-    def _state(self, msg: SimState) -> None:
-        self.sim_state = msg
-        self.sim_states.append(msg)
+    def _state(self, data: bytes) -> None:
+        self.sim_state_data.append(data)
+        self.sim_state_ns = cdr_stamp_ns(data)
+
+    @property
+    def sim_state(self) -> SimState | None:
+        """The newest ground-truth state (kept serialised; decoded on demand)."""
+        return deserialize_message(self.sim_state_data[-1], SimState) \
+            if self.sim_state_data else None
+
+    @property
+    def sim_states(self) -> list[SimState]:
+        """Every ground-truth state received, in order (one per tick, re-sent ticks repeated)."""
+        return [deserialize_message(data, SimState) for data in self.sim_state_data]
 
     def _recorder_progress(self, msg: Header) -> None:
         self.recorder_ns = max(self.recorder_ns, messages.stamp_ns(msg.stamp))
@@ -303,8 +316,8 @@ class PipelineRunner:
             self._construct(params)
         self.spin_until(lambda: self.action.server_is_ready(), self.options.timeout,
                         "the executor's action server")
-        self.spin_until(lambda: self.sim_state is not None, self.options.timeout, "tick 0")
-        self.start_ns = messages.stamp_ns(self.sim_state.header.stamp)
+        self.spin_until(lambda: self.sim_state_ns >= 0, self.options.timeout, "tick 0")
+        self.start_ns = self.sim_state_ns
         self.timing["start_nodes"] = time.perf_counter() - started
 
     def _use_planner(self) -> bool:
@@ -536,7 +549,7 @@ class PipelineRunner:
         self.timing["loop"] = time.perf_counter() - self.loop_started
         self.timing["loop_cpu"] = time.process_time() - self.loop_cpu_started
         final = self.start_ns + result.ticks * self._dt_ns()
-        self.spin_until(lambda: messages.stamp_ns(self.sim_state.header.stamp) >= final,
+        self.spin_until(lambda: self.sim_state_ns >= final,
                         self.options.timeout, "the ground truth of the last tick")
         if self.options.record and self.options.processes:
             self.spin_until(lambda: self.recorder_ns >= final, self.options.timeout,

@@ -37,7 +37,7 @@ from squeeze_grasp_interfaces.msg import ContactEventArray, SimState, TactileArr
 from .. import messages
 from ..scene import load_scene
 from ..sim.world import SimWorld, TickOutput
-from . import pipeline
+from . import pipeline, run_node
 
 PARAMETERS: dict[str, tuple[Any, str]] = {
     "scene": ("", "scene YAML file the world is built from (required)"),
@@ -199,7 +199,7 @@ class SimHardwareNode(Node):
 
 def main(args: list[str] | None = None) -> None:
     """Run the simulated hardware until Ctrl-C or shutdown."""
-    pipeline.run_node(SimHardwareNode, args)
+    run_node(SimHardwareNode, args)
 
 
 if __name__ == "__main__":

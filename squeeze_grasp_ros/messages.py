@@ -263,22 +263,22 @@ def contact_state_msg(state: contact_state.ContactState,
                       header: Header | None = None) -> ContactState:
     """The contact set of a stepper state as ``ContactState`` (depth rho in m)."""
     contacts = state.contacts
-    forces = np.array([c.force for c in contacts], float).reshape(-1, 2)
     return contact_arrays_msg(
-        [c.finger for c in contacts], [c.node for c in contacts], [c.theta for c in contacts],
-        [CONTACT_MODES[c.mode] for c in contacts], forces, float(state.depth),
-        float(state.relative_depth), header)
+        [c.finger for c in contacts], [int(c.node) for c in contacts],
+        [float(c.theta) for c in contacts], [CONTACT_MODES[c.mode] for c in contacts],
+        [float(c.force[0]) for c in contacts], [float(c.force[1]) for c in contacts],
+        float(state.depth), float(state.relative_depth), header)
 
 
-def contact_arrays_msg(fingers: Sequence[str], nodes: Sequence[int], angles: Sequence[float],
-                       modes: Sequence[int], forces: np.ndarray, depth: float,
-                       relative_depth: float, header: Header | None = None) -> ContactState:
-    """``ContactState`` of parallel per-contact values (forces (k, 2), N; depth m)."""
-    forces = np.asarray(forces, float).reshape(-1, 2)
-    return ContactState(header=header or Header(), fingers=list(fingers),
-                        nodes=int32_array(nodes), polar_angles=float64_array(angles),
-                        modes=array.array("B", modes), forces_x=float64_array(forces[:, 0]),
-                        forces_y=float64_array(forces[:, 1]), depth=depth,
+def contact_arrays_msg(fingers: list[str], nodes: list[int], angles: list[float],
+                       modes: list[int], forces_x: list[float], forces_y: list[float],
+                       depth: float, relative_depth: float,
+                       header: Header | None = None) -> ContactState:
+    """``ContactState`` of parallel per-contact lists (angles rad, forces N, depth m)."""
+    return ContactState(header=header or Header(), fingers=fingers,
+                        nodes=array.array("i", nodes), polar_angles=array.array("d", angles),
+                        modes=array.array("B", modes), forces_x=array.array("d", forces_x),
+                        forces_y=array.array("d", forces_y), depth=depth,
                         relative_depth=relative_depth)
 
 
@@ -586,14 +586,13 @@ def patches_state_msg(out: TrackerOutput, frame_id: str) -> ContactState:
     """The monitor's reconstructed contact patches as ``ContactState`` (node = -1, polar angle
     = the patch's mean taxel angle, force = the patch force on the object, N)."""
     patches = out.patches
-    angles = np.array([p.angle for p in patches], float)
-    normal = np.array([p.normal for p in patches], float)
-    tangential = np.array([p.tangential for p in patches], float)
-    c, s = np.cos(angles), np.sin(angles)
-    forces = np.column_stack([normal * c - tangential * s, normal * s + tangential * c])
-    return contact_arrays_msg([p.finger for p in patches], [-1] * len(patches), angles,
-                              [CONTACT_MODES[p.mode] for p in patches], forces, out.depth,
-                              out.relative_depth, header(out.stamp_ns, frame_id))
+    trig = [(math.cos(p.angle), math.sin(p.angle)) for p in patches]
+    return contact_arrays_msg(
+        [p.finger for p in patches], [-1] * len(patches), [p.angle for p in patches],
+        [CONTACT_MODES[p.mode] for p in patches],
+        [p.normal * c - p.tangential * s for p, (c, s) in zip(patches, trig)],
+        [p.normal * s + p.tangential * c for p, (c, s) in zip(patches, trig)],
+        out.depth, out.relative_depth, header(out.stamp_ns, frame_id))
 
 
 def monitor_status_msg(out: TrackerOutput, frame_id: str) -> MonitorStatus:

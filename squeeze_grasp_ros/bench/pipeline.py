@@ -158,7 +158,7 @@ def run(quick: bool, out_dir: Path, progress) -> list[Table]:
     if not quick:
         configs += [("processes (ros2 launch layout)", True, {"processes": True}),
                     ("processes (ros2 launch layout)", False, {"processes": True})]
-    repeats = 1 if quick else 3
+    repeats = 1 if quick else 5
     runs = [(mode, record, [work / f"foam_{k}_{r}" if record else None for r in range(repeats)],
              []) for k, (mode, record, _) in enumerate(configs)]
     for r in range(repeats):

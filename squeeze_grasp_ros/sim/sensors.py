@@ -28,7 +28,6 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..mechanics.contact_state import ContactNode
-from ..mechanics.fingertips import tangent, unit
 
 
 @dataclass(frozen=True)
@@ -62,11 +61,13 @@ def taxel_weights(layout: TactileLayout, thetas: np.ndarray) -> np.ndarray:
 
 
 def contact_components(contacts: list[ContactNode]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """(thetas, normal forces, tangential forces) (k,) of contact nodes (rad, N, N)."""
+    """(thetas, normal forces, tangential forces) (k,) of contact nodes (rad, N, N): the force
+    on the object projected on e(theta) and t(theta)."""
     thetas = np.array([c.theta for c in contacts], float)
     forces = np.array([c.force for c in contacts], float).reshape(-1, 2)
-    return (thetas, np.einsum("ij,ij->i", forces, unit(thetas)),
-            np.einsum("ij,ij->i", forces, tangent(thetas)))
+    cos, sin = np.cos(thetas), np.sin(thetas)
+    return (thetas, forces[:, 0] * cos + forces[:, 1] * sin,
+            forces[:, 1] * cos - forces[:, 0] * sin)
 
 
 def render_tactile(layout: TactileLayout, contacts: list[ContactNode]) -> tuple[np.ndarray, np.ndarray]:
@@ -84,8 +85,7 @@ def fingertip_wrench(contacts: list[ContactNode], radius: float) -> tuple[np.nda
         return np.zeros(3), np.zeros(3)
     thetas = np.array([c.theta for c in contacts], float)
     forces = -np.array([c.force for c in contacts], float).reshape(-1, 2)
-    arms = radius * unit(thetas)
-    torque_z = float(np.sum(arms[:, 0] * forces[:, 1] - arms[:, 1] * forces[:, 0]))
+    torque_z = radius * float(np.cos(thetas) @ forces[:, 1] - np.sin(thetas) @ forces[:, 0])
     total = forces.sum(axis=0)
     return np.array([total[0], total[1], 0.0]), np.array([0.0, 0.0, torque_z])
 

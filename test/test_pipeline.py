@@ -257,13 +257,20 @@ def test_cancel_holds_position(tmp_path):
     assert [(p.x, p.y) for p in last.positions] == [(p.x, p.y) for p in before.positions]
 
 
-def test_single_threaded_executor_gives_the_same_run(small, tmp_path):
+def test_single_threaded_executor_gives_the_same_run_and_recording(small, tmp_path):
+    """Also covers the recorder's drain at shutdown on this executor (its progress timer and
+    the re-sent last tick once kept it from ever seeing the executor idle)."""
     path = write_scene(tmp_path, SMALL_SQUARE)
-    run = PipelineRunner(RunOptions(path, executor="single",
-                                    overrides={"monitor": {"alarm_ratio": 2.0}})).run()
+    run = PipelineRunner(RunOptions(path, executor="single", record=str(tmp_path / "bag"),
+                                    overrides={"monitor": {"alarm_ratio": 2.0}},
+                                    timeout=120.0)).run()
     assert run["mode"].endswith("SingleThreadedExecutor")
     for key in ("events", "monitor_events", "forces", "work", "ticks"):
         assert run[key] == small["run"][key], key
+    ours, reference = read_bag(tmp_path / "bag"), read_bag(small["bag"])
+    for topic in ("/sim/tick", "/sim/state", "/monitor/status", "/devices/barrett_f1/tactile"):
+        assert [m.log_time_ns for m in ours.messages if m.topic == topic] == [
+            m.log_time_ns for m in reference.messages if m.topic == topic], topic
 
 
 def test_resistance_ground_truth_equals_algorithm_2():

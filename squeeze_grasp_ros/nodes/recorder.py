@@ -95,6 +95,7 @@ class RecorderNode(Node):
                        if stamped and name != "/" + pipeline.ALARMS}
         self.recent = {name: deque(maxlen=DUPLICATE_WINDOW) for name in self.unique}
         self.duplicates = 0
+        self.written = 0
         self.ticks = 0
         self.newest_tick_ns = -1
         self.reported_ns = -1
@@ -131,6 +132,7 @@ class RecorderNode(Node):
         if topic not in self.writer.topics:
             self.writer.add_topic(topic, self.types[topic], self._offered_qos(topic))
         self.writer.write(topic, data, ns)
+        self.written += 1
         if topic == "/" + pipeline.TICK:
             self.ticks += 1
             self.newest_tick_ns = ns
@@ -149,11 +151,19 @@ class RecorderNode(Node):
             self.progress_pub.publish(messages.header(self.newest_tick_ns))
 
     def drain(self, executor, idle: float = 0.05) -> None:
-        """Write what has already arrived: spin ``executor`` until ``idle`` s pass without work."""
+        """Write what has already arrived: spin ``executor`` until ``idle`` wall-clock seconds
+        pass without a new message written.
+
+        Idleness is judged by what is written, not by the executor returning early: timers
+        (this node's progress timer has a period of ``idle``) and re-sent ticks (dropped as
+        duplicates) keep an executor busy forever. The executor is always spun with the same
+        timeout (``SingleThreadedExecutor`` discards its ready entities when it changes).
+        """
         while True:
-            before = time.monotonic()
-            executor.spin_once(idle)
-            if time.monotonic() - before >= idle:
+            written, until = self.written, time.monotonic() + idle
+            while time.monotonic() < until:
+                executor.spin_once(idle / 5.0)
+            if self.written == written:
                 return
 
     def close(self) -> None:

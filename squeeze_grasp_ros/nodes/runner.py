@@ -206,6 +206,7 @@ class PipelineRunner:
         rclpy.init(context=self.context, signal_handler_options=SignalHandlerOptions.NO)
         self.executor = (EventsExecutor(context=self.context) if options.executor == "events"
                          else SingleThreadedExecutor(context=self.context))
+        self.events_per_check = EVENTS_PER_CHECK if options.executor == "events" else 0
         self.client = Node("run", context=self.context)
         self.executor.add_node(self.client)
         self.nodes: list[Node] = []
@@ -282,9 +283,12 @@ class PipelineRunner:
     def spin_until(self, done: Callable[[], bool], timeout: float, what: str) -> None:
         """Spin the executor until ``done()`` or ``timeout`` wall-clock seconds (then raise).
 
-        After waiting (at most 50 ms) for one event, up to ``EVENTS_PER_CHECK`` more events that
-        are already queued are executed before the conditions are checked again (a tick is
-        about 13 events; checking after each cost about 5 % of the loop).
+        On ``EventsExecutor``, after waiting (at most 50 ms) for one event, up to
+        ``EVENTS_PER_CHECK`` more events that are already queued are executed before the
+        conditions are checked again (a tick is about 13 events; checking after each cost about
+        5 % of the loop). Not on ``SingleThreadedExecutor``: its ``spin_once`` keeps a generator
+        of ready entities per timeout argument, and alternating timeouts discard it together
+        with triggers it has already taken (a run then waits forever for a lost result).
         """
         deadline = time.monotonic() + timeout
         while not done():
@@ -294,7 +298,7 @@ class PipelineRunner:
                 raise RunError(f"timed out after {timeout:.0f} s waiting for {what}")
             self._check_processes()
             self.executor.spin_once(0.05)
-            for _ in range(EVENTS_PER_CHECK):
+            for _ in range(self.events_per_check):
                 self.executor.spin_once(0.0)
 
     def _check_processes(self) -> None:

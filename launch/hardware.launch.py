@@ -5,8 +5,9 @@
     ros2 launch squeeze_grasp_ros hardware.launch.py mu:=0.4 record:=/data/run1
 
 The drivers (Barrett hand, Cobra arm, pusher, fingertip F/T and tactile sensors) provide and
-accept the topics of the hardware contract (README.md, "Hardware contract"): ``devices/<device>/pose``,
-``wrench``, ``tactile`` with sensor-data QoS and ``devices/<device>/setpoint`` (reliable). The
+accept the topics of the hardware contract (README.md, "Hardware contract"):
+``devices/<device>/pose``, ``wrench``, ``tactile`` with sensor-data QoS and
+``devices/<device>/setpoint`` (reliable). The
 nodes run on wall-clock timers (``lockstep: false``) on the newest readings; there is no
 ``/clock`` and no simulated hardware. Finger-device mapping, limits and the object pose in the
 robot base frame come from ``config/executor.yaml`` and ``config/monitor.yaml``.

@@ -5,7 +5,9 @@
 Every function is pure: it builds and returns a new message (or numpy arrays) and never keeps
 state, except the ``fill_*`` functions of the lockstep loop, which refill a node's own
 per-tick message in place (rclpy serialises a message when it is published, so a publisher can
-reuse one object; building a fresh ``PoseStamped`` costs about 15 times as much). Units are SI; positions, displacements, forces and directions are in the object frame
+reuse one object; building a fresh ``PoseStamped`` costs about 15 times as much).
+
+Units are SI; positions, displacements, forces and directions are in the object frame
 (x right, y up, the scene's coordinates), planar vectors travel as ``geometry_msgs/Vector3``
 with z = 0. Arrays are flattened row-major: a list of contact displacements (m, 2) becomes
 ``[x0, y0, x1, y1, ...]`` and a b x b matrix its rows one after the other.
@@ -462,7 +464,8 @@ def wrench_msg(force: np.ndarray, torque: np.ndarray, ns: int, frame_id: str) ->
     return msg
 
 
-def fill_wrench(msg: WrenchStamped, force: np.ndarray, torque: np.ndarray, ns: int) -> WrenchStamped:
+def fill_wrench(msg: WrenchStamped, force: np.ndarray, torque: np.ndarray,
+                ns: int) -> WrenchStamped:
     """Refill a :func:`wrench_msg` in place with a new force, N, torque, N m, and stamp."""
     set_stamp(msg.header.stamp, ns)
     f, t = msg.wrench.force, msg.wrench.torque

@@ -350,6 +350,13 @@ class TactileReadings:
     tangential: np.ndarray
 
 
+def _check_taxels(finger: str, *arrays: Sequence[float]) -> None:
+    """Raise ValueError unless the tactile arrays of ``finger`` have one entry per taxel."""
+    sizes = {len(a) for a in arrays}
+    if len(sizes) != 1:
+        raise ValueError(f"tactile arrays of {finger} differ in length: {sorted(sizes)}")
+
+
 def tactile_array_msg(readings: TactileReadings, header: Header | None = None) -> TactileArray:
     """``TactileArray`` of a fingertip's readings; the three arrays must have one entry per taxel.
 
@@ -358,9 +365,7 @@ def tactile_array_msg(readings: TactileReadings, header: Header | None = None) -
     ValueError
         If the arrays differ in length.
     """
-    sizes = {len(readings.angles), len(readings.normal), len(readings.tangential)}
-    if len(sizes) != 1:
-        raise ValueError(f"tactile arrays of {readings.finger} differ in length: {sorted(sizes)}")
+    _check_taxels(readings.finger, readings.angles, readings.normal, readings.tangential)
     return TactileArray(header=header or Header(), finger=readings.finger,
                         taxel_angles=float64_array(readings.angles),
                         normal_forces=float64_array(readings.normal),
@@ -377,10 +382,7 @@ def fill_tactile(msg: TactileArray, normal: np.ndarray, tangential: np.ndarray,
     ValueError
         If the force arrays do not have one entry per taxel.
     """
-    if not len(normal) == len(tangential) == len(msg.taxel_angles):
-        raise ValueError(f"tactile arrays of {msg.finger} differ in length: "
-                         f"{len(msg.taxel_angles)} taxels, {len(normal)} normal and "
-                         f"{len(tangential)} tangential forces")
+    _check_taxels(msg.finger, msg.taxel_angles, normal, tangential)
     set_stamp(msg.header.stamp, ns)
     msg.normal_forces = float64_array(normal)
     msg.tangential_forces = float64_array(tangential)

@@ -233,11 +233,11 @@ class LoadedTaxels:
 
 
 def loaded_taxels(sample: FingerSample, threshold: float,
-                  trig: tuple[np.ndarray, np.ndarray] | None = None) -> LoadedTaxels:
+                  trig: tuple[np.ndarray, np.ndarray]) -> LoadedTaxels:
     """The loaded taxels of a reading with tactile data (``trig``: cos and sin of all its
-    taxel angles, if already known)."""
+    taxel angles)."""
     index = np.flatnonzero(sample.normal > threshold)
-    cos, sin = trig if trig is not None else (np.cos(sample.angles), np.sin(sample.angles))
+    cos, sin = trig
     return LoadedTaxels(index, sample.normal[index], sample.tangential[index],
                         sample.angles[index], cos[index], sin[index])
 
@@ -343,16 +343,17 @@ class ContactTracker:
             sample = samples.get(name, FingerSample())
             track = self.tracks[name]
             self._note_stamps(track, sample)
-            taxels = None
+            taxels, trig = None, None
             if sample.normal is not None:
-                taxels = loaded_taxels(sample, cfg.load_threshold, self._trig(track, sample))
+                trig = self._trig(track, sample)
+                taxels = loaded_taxels(sample, cfg.load_threshold, trig)
                 current = patches_of(name, taxels, cfg)
                 events += self._events(name, track.patches, current, relative)
                 track.patches = current
                 track.had_contact = track.had_contact or bool(current)
                 loaded[name] = taxels
             patches += track.patches
-            track.force = self._force(sample, track.force)
+            track.force = self._force(sample, trig, track.force)
             track.normal = self._normal(taxels, track.normal)
             alarms += self._alarms(name, track, taxels, stamp_ns)
         if cfg.weight is not None and not self.picked_up and self._can_lift(loaded):
@@ -422,12 +423,14 @@ class ContactTracker:
         return [TrackedEvent(kind, name, self.depth, relative, angle) for kind, angle in found]
 
     @staticmethod
-    def _force(sample: FingerSample, previous: np.ndarray) -> np.ndarray:
-        """Force of the finger on the object (2,), N: -wrench force, else the taxel sum."""
+    def _force(sample: FingerSample, trig: tuple[np.ndarray, np.ndarray] | None,
+               previous: np.ndarray) -> np.ndarray:
+        """Force of the finger on the object (2,), N: -wrench force, else the taxel sum
+        (``trig``: cos and sin of the taxel angles, given with tactile data)."""
         if sample.force is not None:
             return -np.asarray(sample.force[:2], float)
         if sample.normal is not None:
-            c, s = np.cos(sample.angles), np.sin(sample.angles)
+            c, s = trig
             return np.array([sample.normal @ c - sample.tangential @ s,
                              sample.normal @ s + sample.tangential @ c])
         return previous

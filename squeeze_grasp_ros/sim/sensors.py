@@ -60,11 +60,16 @@ def taxel_weights(layout: TactileLayout, thetas: np.ndarray) -> np.ndarray:
     return np.maximum(0.0, 1.0 - np.abs(offset) / layout.spacing)
 
 
+def contact_arrays(contacts: list[ContactNode]) -> tuple[np.ndarray, np.ndarray]:
+    """(thetas (k,), rad; forces on the object (k, 2), N) of contact nodes."""
+    return (np.array([c.theta for c in contacts], float),
+            np.array([c.force for c in contacts], float).reshape(-1, 2))
+
+
 def contact_components(contacts: list[ContactNode]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """(thetas, normal forces, tangential forces) (k,) of contact nodes (rad, N, N): the force
     on the object projected on e(theta) and t(theta)."""
-    thetas = np.array([c.theta for c in contacts], float)
-    forces = np.array([c.force for c in contacts], float).reshape(-1, 2)
+    thetas, forces = contact_arrays(contacts)
     cos, sin = np.cos(thetas), np.sin(thetas)
     return (thetas, forces[:, 0] * cos + forces[:, 1] * sin,
             forces[:, 1] * cos - forces[:, 0] * sin)
@@ -83,8 +88,8 @@ def fingertip_wrench(contacts: list[ContactNode], radius: float) -> tuple[np.nda
     """(force (3,), torque (3,)) the object applies to the fingertip at its centre, N and N m."""
     if not contacts:
         return np.zeros(3), np.zeros(3)
-    thetas = np.array([c.theta for c in contacts], float)
-    forces = -np.array([c.force for c in contacts], float).reshape(-1, 2)
+    thetas, on_object = contact_arrays(contacts)
+    forces = -on_object
     torque_z = radius * float(np.cos(thetas) @ forces[:, 1] - np.sin(thetas) @ forces[:, 0])
     total = forces.sum(axis=0)
     return np.array([total[0], total[1], 0.0]), np.array([0.0, 0.0, torque_z])

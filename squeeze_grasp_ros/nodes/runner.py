@@ -223,11 +223,12 @@ class PipelineRunner:
         self.feedback: list[ExecuteGrasp.Feedback] = []
         loop = pipeline.loop_qos(1000)
         c = self.client
-        c.create_subscription(ContactEventArray, pipeline.SIM_EVENTS, self._sim_events, loop)
-        c.create_subscription(ContactEventArray, pipeline.EVENTS,
-                              lambda msg: self.monitor_events.extend(msg.events), loop)
-        c.create_subscription(Alarm, pipeline.ALARMS, self._alarm, loop)
-        c.create_subscription(SimState, pipeline.SIM_STATE, self._state, loop, raw=True)
+        self.outcome_subscriptions = [
+            c.create_subscription(ContactEventArray, pipeline.SIM_EVENTS, self._sim_events, loop),
+            c.create_subscription(ContactEventArray, pipeline.EVENTS,
+                                  lambda msg: self.monitor_events.extend(msg.events), loop),
+            c.create_subscription(Alarm, pipeline.ALARMS, self._alarm, loop),
+            c.create_subscription(SimState, pipeline.SIM_STATE, self._state, loop, raw=True)]
         c.create_subscription(Header, pipeline.RECORDER_PROGRESS, self._recorder_progress, loop)
         self.prediction_pub = c.create_publisher(ContactEventArray, pipeline.PREDICTION,
                                                  pipeline.LATCHED)
@@ -308,7 +309,16 @@ class PipelineRunner:
 
     # ----------------------------------------------------------------- start-up
     def start(self) -> None:
-        """Plan, start the nodes and wait until the loop stands at tick 0 and the executor serves."""
+        """Plan, start the nodes and wait until the loop stands at tick 0, the executor serves
+        and this client's subscriptions to the outcome (ground-truth state and events, monitor
+        events and alarms) have matched their publishers.
+
+        The last wait matters across processes: those publishers are not part of the lockstep
+        handshake, and simulated time only moves once the goal is sent, so waiting here loses
+        nothing; without it a fast loop could publish its first events before discovery
+        between this process and the monitor had settled (seen: a run whose 7 monitor events
+        never reached the client).
+        """
         plan_source = self._use_planner()
         planner = self._start_planner() if plan_source else None
         try:
@@ -330,6 +340,9 @@ class PipelineRunner:
         self.spin_until(lambda: self.action.server_is_ready(), self.options.timeout,
                         "the executor's action server")
         self.spin_until(lambda: self.sim_state_ns >= 0, self.options.timeout, "tick 0")
+        self.spin_until(lambda: all(s.get_publisher_count() > 0
+                                    for s in self.outcome_subscriptions),
+                        self.options.timeout, "the publishers of the run's outcome topics")
         self.start_ns = self.sim_state_ns
         self.timing["start_nodes"] = time.perf_counter() - started
 

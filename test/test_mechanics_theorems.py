@@ -60,6 +60,8 @@ def test_theorem7_against_spectral_saddle_inverse(case):
     scale = np.abs(C_ref).max()
     assert np.abs(red.C - C_ref).max() <= 1e-7 * scale
     assert np.abs(red.E - E_ref).max() <= 1e-7 * max(np.abs(E_ref).max(), 1.0)
+    assert np.abs(red.H - H_ref).max() <= 1e-7 * np.abs(H_ref).max()  # eq. (29), H block
+    assert np.allclose(red.H, red.H.T, atol=1e-12 * np.abs(H_ref).max())
     # (i) C symmetric PSD with null(C) = col(B)
     assert np.allclose(red.C, red.C.T, atol=1e-12 * scale)
     eig = np.linalg.eigvalsh(red.C)

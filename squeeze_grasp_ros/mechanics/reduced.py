@@ -40,7 +40,7 @@ class ReducedStiffness:
     E : (2m, 3) ndarray
         Rigid-component map: g = E^T * contact displacements, m (eq. 31).
     H : (3, 3) ndarray
-        Lower-right block of M^-1, N/m.
+        Lower-right block of M^-1, m/N (A E + B H = 0 gives H the units of A).
     condition : float
         2-norm condition number of Z^T A Z (the only matrix inverted).
     """
@@ -118,7 +118,7 @@ def reduced_stiffness(obj: ElasticObject, contacts) -> ReducedStiffness:
     B = obj.rigid[node_dofs(contacts)]
     C_hat, E, H_hat, condition = reduce_blocks(A_hat, B)
     eh = obj.material.force_scale
-    red = ReducedStiffness(contacts, A_hat / eh, B, C_hat * eh, E, H_hat * eh, condition)
+    red = ReducedStiffness(contacts, A_hat / eh, B, C_hat * eh, E, H_hat / eh, condition)
     require_finite("reduced stiffness", red.C)
     return red
 

@@ -19,7 +19,10 @@ VERBS: tuple[str, ...] = (
     "run",
     "replay",
     "bench",
+    "sweep",
+    "sweep_report",
     "scene_help",
+    "sweep_help",
     "ros_setup",
 )
 """Module names of the verbs, in the order ``--help`` lists them (CLI name: '_' -> '-')."""

@@ -1,0 +1,80 @@
+# Copyright 2026 squeeze_grasp_ros developers
+# SPDX-License-Identifier: Apache-2.0
+"""``squeeze-grasp sweep``: a grasp dataset on Dask, resumable and deterministic (docs/sweep.md)."""
+from __future__ import annotations
+
+import argparse
+import sys
+
+from ..exit_codes import ExitCode
+from ..sweep.engine import dry_run, require_extra, run_sweep
+from ..sweep.spec import SweepError, load_sweep_spec
+
+HELP = ("evaluate a sweep spec (objects x materials x friction x tips x squeezes x depths x "
+        "placements) on Dask into a Parquet dataset; re-run to resume")
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    """SPEC, --out, --scheduler, --workers, --dry-run, --no-progress."""
+    parser.add_argument("spec", metavar="SPEC.yaml", help="sweep spec (keys: squeeze-grasp sweep-help)")
+    parser.add_argument("--out", metavar="DIR",
+                        help="output directory: parts/*.parquet and manifest.json (required "
+                             "unless --dry-run); re-running into it resumes")
+    parser.add_argument("--scheduler", metavar="ADDRESS",
+                        help="address of a running Dask scheduler, e.g. tcp://10.0.0.5:8786 "
+                             "(default: a local cluster, one worker process per core)")
+    parser.add_argument("--workers", type=int, metavar="N",
+                        help="local cluster size (default: one per core)")
+    parser.add_argument("--dry-run", action="store_true",
+                        help="print task and evaluation counts and an estimated time from a "
+                             "small timed sample; run nothing on Dask")
+    parser.add_argument("--no-progress", action="store_true", help="no progress line on stderr")
+
+
+def run(args: argparse.Namespace) -> dict | int:
+    """Run or resume the sweep; returns its counts (exit 130 when interrupted)."""
+    if args.workers is not None and args.workers < 1:
+        raise SweepError(f"--workers must be >= 1, got {args.workers}")
+    if args.workers is not None and args.scheduler:
+        raise SweepError("--workers sizes the local cluster; it cannot be used with --scheduler")
+    loaded = load_sweep_spec(args.spec)
+    if args.dry_run:
+        return {"dry_run": True, "spec": args.spec, "spec_hash": loaded.hash,
+                **dry_run(loaded, workers=args.workers, scheduler=args.scheduler)}
+    if not args.out:
+        raise SweepError("--out DIR is required (or use --dry-run)")
+    require_extra()
+    outcome = run_sweep(loaded, args.out, scheduler=args.scheduler, workers=args.workers,
+                        progress=not args.no_progress)
+    result = {"dry_run": False, "out": args.out, "spec_hash": loaded.hash, **vars(outcome)}
+    if outcome.interrupted:
+        print(f"squeeze-grasp sweep: interrupted; {outcome.done} task(s) written this run. "
+              "Re-run the same command to resume.", file=sys.stderr)
+        return int(ExitCode.INTERRUPTED)
+    return result
+
+
+def summary(result: dict) -> str:
+    """Human-readable counts."""
+    if result["dry_run"]:
+        s = result["sample"]
+        lines = [f"{result['spec']}: {result['objects']} objects, {result['groups']} groups "
+                 f"(object x material), {result['tasks']} tasks, {result['evaluations']} "
+                 f"evaluations ({result['parameters']} parameter sets per placement)",
+                 f"sample ({s['group']}): prepare {s['prepare_s']:.2f} s, "
+                 f"{s['evaluations']} evaluations at {s['mean_evaluation_s']:.3f} s each"]
+        if "estimate_s" in result:
+            lines.append(f"estimated time on {result['workers']} worker(s): "
+                         f"{result['estimate_s'] / 60:.1f} min")
+        return "\n".join(lines)
+    lines = [f"{result['out']}: {result['tasks']} tasks, {result['skipped']} already done, "
+             f"{result['done']} written now ({result['evaluations']} evaluations, "
+             f"{result['errors']} with an error), {result['failed']} failed",
+             f"time {result['seconds']:.1f} s on {result['workers']} worker(s)"]
+    if result["evaluations"]:
+        lines[-1] += (f"; {result['evaluations'] / result['seconds'] / max(result['workers'], 1):.2f}"
+                      " evaluations/s per worker")
+    if result["failed"]:
+        lines.append("failed tasks are listed in manifest.json; re-run to retry them")
+    lines.append(f"summary: squeeze-grasp sweep-report {result['out']}")
+    return "\n".join(lines)

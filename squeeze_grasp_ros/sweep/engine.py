@@ -1,0 +1,238 @@
+# Copyright 2026 squeeze_grasp_ros developers
+# SPDX-License-Identifier: Apache-2.0
+"""Run a sweep on Dask distributed: a local cluster by default, any cluster by address.
+
+The client plans the tasks, skips those whose Parquet part exists, submits the rest with
+deterministic keys and writes each part as its task finishes (:class:`~.store.Store`). Workers
+only compute (:func:`~.evaluate.run_task`) and need not share a file system with the client.
+Local default: one worker process per core, one thread each (Dask's nannies start workers with
+``OMP_NUM_THREADS=MKL_NUM_THREADS=OPENBLAS_NUM_THREADS=1``, so BLAS does not oversubscribe).
+A worker that dies mid-task has its task rescheduled by Dask; a client that dies loses only the
+tasks in flight.
+"""
+from __future__ import annotations
+
+import importlib.util
+import logging
+import os
+import sys
+import time
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Callable, Optional
+
+from .evaluate import prepare, run_task
+from .plan import Task, plan_tasks
+from .spec import LoadedSpec, SweepError
+
+INSTALL_HINT = ("squeeze-grasp sweep needs the 'sweep' extra (Dask distributed and pyarrow): "
+                "pip install '.[sweep]' in the repository (or pip install 'dask[distributed]' "
+                "pyarrow)")
+DRY_RUN_SAMPLE = 4
+"""Evaluations timed by ``--dry-run``."""
+
+
+def require_extra() -> None:
+    """Raise :class:`SweepError` with the install command if Dask or pyarrow is missing."""
+    try:
+        import distributed  # noqa: F401
+        import pyarrow  # noqa: F401
+    except ImportError as exc:
+        raise SweepError(f"{INSTALL_HINT} ({exc})") from None
+
+
+class Progress:
+    """One stderr line: evaluations done/total, rate, ETA and the dashboard address.
+
+    Redrawn in place on a terminal; otherwise printed at most every ``interval`` seconds."""
+
+    def __init__(self, total: int, dashboard: Optional[str], enabled: bool = True,
+                 interval: float = 10.0, stream=None) -> None:
+        self.total, self.done, self.dashboard = total, 0, dashboard
+        self.stream = stream or sys.stderr
+        self.tty = self.stream.isatty()
+        self.enabled, self.interval = enabled, interval
+        self.start = time.perf_counter()
+        self.last = -float("inf")
+
+    def line(self) -> str:
+        """The progress text."""
+        elapsed = time.perf_counter() - self.start
+        rate = self.done / elapsed if elapsed > 0 else 0.0
+        left = (self.total - self.done) / rate if rate > 0 else float("nan")
+        eta = time.strftime("%H:%M:%S", time.gmtime(left)) if left == left else "--:--:--"
+        pct = 100.0 * self.done / self.total if self.total else 100.0
+        text = (f"sweep {self.done}/{self.total} evaluations ({pct:.0f} %), {rate:.2f} eval/s, "
+                f"ETA {eta}")
+        return text + (f", dashboard {self.dashboard}" if self.dashboard else "")
+
+    def update(self, count: int, final: bool = False) -> None:
+        """Add ``count`` finished evaluations and redraw when due."""
+        self.done += count
+        if not self.enabled:
+            return
+        now = time.perf_counter()
+        if self.tty:
+            self.stream.write("\r" + self.line() + ("\n" if final else ""))
+        elif final or now - self.last >= self.interval:
+            self.stream.write(self.line() + "\n")
+            self.last = now
+        self.stream.flush()
+
+
+@dataclass
+class Outcome:
+    """What a sweep run did (counts of tasks and evaluations, seconds)."""
+
+    tasks: int
+    skipped: int
+    done: int
+    failed: int
+    evaluations: int
+    errors: int
+    seconds: float
+    workers: int
+    dashboard: Optional[str]
+    interrupted: bool
+    prepare_s: float
+    evaluate_s: float
+
+
+def _cluster(scheduler: Optional[str], workers: Optional[int]):
+    from distributed import Client, LocalCluster
+    if scheduler is not None:
+        try:
+            client = Client(scheduler, timeout="20s")
+        except (OSError, TimeoutError) as exc:
+            raise SweepError(f"--scheduler {scheduler}: cannot connect ({exc})") from None
+        return client, None
+    n = workers or os.cpu_count() or 1
+    dashboard = "127.0.0.1:0" if importlib.util.find_spec("bokeh") else None
+    cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True, host="127.0.0.1",
+                           dashboard_address=dashboard, silence_logs=logging.ERROR)
+    return Client(cluster), cluster
+
+
+def _dashboard(client) -> Optional[str]:
+    """The dashboard address, if the scheduler serves one (locally: only with bokeh)."""
+    if "dashboard" not in client.scheduler_info().get("services", {}):
+        return None
+    return client.dashboard_link
+
+
+def _check_workers(client) -> int:
+    from .store import package_version
+    versions = client.run(package_version)
+    mine = package_version()
+    bad = {w: v for w, v in versions.items() if v != mine}
+    if bad:
+        worker, version = sorted(bad.items())[0]
+        raise SweepError(f"worker {worker} runs squeeze_grasp_ros {version}, this client {mine}: "
+                         "install the same version on every worker")
+    if not versions:
+        raise SweepError("the Dask cluster has no workers")
+    return len(versions)
+
+
+def run_sweep(loaded: LoadedSpec, out: str | Path, *, scheduler: Optional[str] = None,
+              workers: Optional[int] = None, progress: bool = True,
+              on_task: Optional[Callable[[Task], None]] = None) -> Outcome:
+    """Run (or resume) a sweep into ``out``; returns what was done.
+
+    Parameters
+    ----------
+    loaded : LoadedSpec
+    out : path
+        Output directory (created; must be empty or hold this spec's sweep).
+    scheduler : str, optional
+        Address of an existing Dask scheduler (``tcp://host:8786``); default: a local cluster.
+    workers : int, optional
+        Local cluster size (default: one worker per core).
+    progress : bool
+        Draw the progress line on stderr.
+    on_task : callable, optional
+        Called after each part is written (tests use it to kill the client at a known point).
+    """
+    require_extra()
+    from .store import Store
+    start = time.perf_counter()
+    tasks = plan_tasks(loaded)
+    store = Store(out, loaded, tasks)
+    todo = [t for t in tasks if not store.done(t.id)]
+    outcome = Outcome(len(tasks), len(tasks) - len(todo), 0, 0, 0, 0, 0.0, 0, None, False,
+                      0.0, 0.0)
+    if not todo:
+        outcome.seconds = time.perf_counter() - start
+        return outcome
+    from distributed import as_completed
+    client, cluster = _cluster(scheduler, workers)
+    try:
+        outcome.workers = _check_workers(client)
+        outcome.dashboard = _dashboard(client)
+        bar = Progress(sum(t.evaluations for t in todo), outcome.dashboard, progress)
+        bar.update(0)
+        futures = {client.submit(run_task, t, key=f"sweep-{loaded.hash[:12]}-{t.id}",
+                                 pure=False): t for t in todo}
+        try:
+            for future in as_completed(futures):
+                task = futures.pop(future)
+                try:
+                    result = future.result()
+                except Exception as exc:  # noqa: BLE001 - a task that raises is recorded
+                    store.fail(task, f"{type(exc).__name__}: {exc}")
+                    outcome.failed += 1
+                    bar.total -= task.evaluations
+                    bar.update(0)
+                    continue
+                rows = result["rows"]
+                store.write(task, rows)
+                outcome.done += 1
+                outcome.evaluations += len(rows)
+                outcome.errors += sum(1 for r in rows if r.get("error"))
+                outcome.prepare_s += result["prepare_s"]
+                outcome.evaluate_s += result["evaluate_s"]
+                bar.total -= task.evaluations - len(rows)
+                bar.update(len(rows))
+                if on_task is not None:
+                    on_task(task)
+        except KeyboardInterrupt:
+            outcome.interrupted = True
+            client.cancel(list(futures))
+        bar.update(0, final=True)
+    finally:
+        client.close()
+        if cluster is not None:
+            cluster.close()
+    outcome.seconds = time.perf_counter() - start
+    return outcome
+
+
+def dry_run(loaded: LoadedSpec, *, workers: Optional[int] = None,
+            scheduler: Optional[str] = None) -> dict:
+    """Task and evaluation counts and an estimated time from a small timed sample.
+
+    The sample runs in this process: the first task's group is prepared (mesh, factorisation,
+    grasp map) and up to :data:`DRY_RUN_SAMPLE` of its evaluations are timed; the estimate is
+    groups x prepare + evaluations x mean evaluation time / workers (each worker prepares a
+    group at most once)."""
+    from .evaluate import evaluate
+    tasks = plan_tasks(loaded)
+    groups = sorted({t.group for t in tasks})
+    total = sum(t.evaluations for t in tasks)
+    n = workers or (None if scheduler else os.cpu_count() or 1)
+    first = tasks[0]
+    group = prepare(first)
+    times, resist = [], {}
+    for index in range(first.start, min(first.stop, len(group.placements))):
+        for params in first.params:
+            if len(times) < DRY_RUN_SAMPLE:
+                times.append(evaluate(first, group, index, params, resist)["time_s"])
+    per_eval = sum(times) / max(len(times), 1)
+    out = {"tasks": len(tasks), "groups": len(groups), "evaluations": total,
+           "objects": len({t.obj.id for t in tasks}), "parameters": len(first.params),
+           "sample": {"evaluations": len(times), "mean_evaluation_s": per_eval,
+                      "prepare_s": group.prepare_s, "group": first.group}}
+    if n:
+        out["workers"] = n
+        out["estimate_s"] = len(groups) * group.prepare_s + total * per_eval / n
+    return out

@@ -1,0 +1,232 @@
+# Copyright 2026 squeeze_grasp_ros developers
+# SPDX-License-Identifier: Apache-2.0
+"""A sweep spec -> objects, parameter grid and Dask tasks, with seeds derived from ids.
+
+Grouping. The costly shared step of an evaluation is meshing, assembling and factorising the
+object and computing its boundary compliance (0.3-1 s for 1-2k nodes, against 0.05-0.5 s for a
+squeeze); it depends on the object, its mesh settings and its material only. Evaluations are
+therefore grouped by (object, mesh, material); a group's placements are chosen on the worker
+from its mesh (the grasp map needs the factorised object). Groups are cut into tasks of at most
+``chunk`` evaluations (whole placements) so that two workers share the work of a sweep with
+few objects, a killed task loses little and the progress bar moves; each worker process keeps
+the prepared groups it has seen (:mod:`.evaluate`), so a group is meshed and factorised once per
+worker, not once per task.
+
+Determinism. Every random draw takes its generator from ``SeedSequence(seed, spawn_key=...)``
+whose spawn key is derived from the id of what is drawn (object id, group id and repeat), never
+from a worker, an order of execution or Python's salted ``hash``.
+"""
+from __future__ import annotations
+
+import dataclasses
+import hashlib
+import itertools
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Optional
+
+import numpy as np
+
+from ..mechanics.contact_model import Limits
+from ..mechanics.mesh import generate_mesh, target_max_area
+from ..scene import MeshSpec, build_outline, load_scene
+from ..scene_events import scene_limits
+from .spec import LoadedSpec, ObjectEntry, SweepError
+
+
+def id_key(*parts: str | int) -> tuple[int, ...]:
+    """A stable SeedSequence spawn key (four 32-bit words of BLAKE2b) of an id."""
+    digest = hashlib.blake2b("/".join(str(p) for p in parts).encode(), digest_size=16).digest()
+    return tuple(int.from_bytes(digest[i:i + 4], "little") for i in range(0, 16, 4))
+
+
+def rng_for(seed: int, *parts: str | int) -> np.random.Generator:
+    """The generator of the draw identified by ``parts`` under root ``seed``."""
+    return np.random.default_rng(np.random.SeedSequence(seed, spawn_key=id_key(*parts)))
+
+
+@dataclass(frozen=True)
+class ObjectItem:
+    """One object of the sweep.
+
+    Attributes
+    ----------
+    id : str
+        ``NN-name`` (NN: entry index; families ``NN-name-KKK``).
+    shape : dict
+        Scene-style shape mapping (``build_outline``).
+    mesh : MeshSpec
+    """
+
+    id: str
+    shape: dict
+    mesh: MeshSpec
+
+
+@dataclass(frozen=True)
+class Params:
+    """One point of the parameter grid (ids ``qNNNN`` in grid order)."""
+
+    id: str
+    mu: float
+    tip_radius: float
+    kind: str
+    depth: Optional[float]
+    relative_depth: Optional[float]
+
+
+@dataclass(frozen=True)
+class Task:
+    """One Dask task: placements [start, stop) of a group, every parameter for each.
+
+    Attributes
+    ----------
+    id : str
+        ``<object id>~<material>~cNNNN``; also the Parquet part name.
+    group : str
+        ``<object id>~<material>``.
+    spec_hash : str
+        Hash of the sweep (workers cache prepared groups under it).
+    obj : ObjectItem
+    material : tuple of (str, float, float, float)
+        (name, E Pa, nu, thickness m).
+    placement_mode : str
+    placement_count : int
+    placement_filters : tuple of str
+    placement_mu : float
+    seed, repeat : int
+    start, stop : int
+        Placement index range of this task.
+    params : tuple of Params
+    limits : Limits
+    step, event_tol : float
+    max_events_per_depth : int
+    adversary : tuple or None
+        (position, mode, contacts, directions).
+    """
+
+    id: str
+    group: str
+    spec_hash: str
+    obj: ObjectItem
+    material: tuple
+    placement_mode: str
+    placement_count: int
+    placement_filters: tuple
+    placement_mu: float
+    seed: int
+    repeat: int
+    start: int
+    stop: int
+    params: tuple
+    limits: Limits
+    step: float
+    event_tol: float
+    max_events_per_depth: int
+    adversary: Optional[tuple]
+
+    @property
+    def evaluations(self) -> int:
+        """Upper bound of the evaluations of the task (graspmap may find fewer pairs)."""
+        return (self.stop - self.start) * len(self.params)
+
+
+def _family_shapes(entry: ObjectEntry, seed: int, name: str) -> list[tuple[str, dict]]:
+    fam = entry.family
+    out = []
+    for k in range(fam.count):
+        oid = f"{name}-{k:03d}"
+        rng = rng_for(seed, "shape", oid)
+        if fam.type == "superellipse":
+            shape = {"type": "superellipse", "a": float(rng.uniform(*fam.a)),
+                     "b": float(rng.uniform(*fam.b)),
+                     "exponent": float(rng.uniform(*fam.exponent))}
+        else:
+            h = np.arange(1, fam.harmonics + 1)
+            bound = fam.amplitude / h
+            shape = {"type": "fourier_blob", "radius": float(rng.uniform(*fam.radius)),
+                     "cos": rng.uniform(-bound, bound).tolist(),
+                     "sin": rng.uniform(-bound, bound).tolist()}
+        out.append((oid, shape))
+    return out
+
+
+def objects(loaded: LoadedSpec) -> list[ObjectItem]:
+    """Every object of the sweep, in spec order."""
+    sw = loaded.spec
+    if sw.objects is None:
+        name = loaded.base.name or "base"
+        return [ObjectItem(f"00-{name}", loaded.base.object.shape, loaded.mesh)]
+    items = []
+    for k, entry in enumerate(sw.objects):
+        mesh = entry.mesh or loaded.mesh
+        if entry.scene is not None:
+            scene = load_scene(entry.scene)
+            name = entry.name or Path(entry.scene).stem
+            pairs = [(name, scene.object.shape)]
+            mesh = entry.mesh or scene.object.mesh
+        elif entry.outline is not None:
+            pairs = [(entry.name or Path(entry.outline).stem,
+                      {"type": "file", "path": entry.outline})]
+        elif entry.shape is not None:
+            pairs = [(entry.name or entry.shape["type"], entry.shape)]
+        else:
+            pairs = _family_shapes(entry, sw.seed, entry.name or entry.family.type)
+        items += [ObjectItem(f"{k:02d}-{oid}", shape, mesh) for oid, shape in pairs]
+    return items
+
+
+def parameter_grid(loaded: LoadedSpec) -> tuple[Params, ...]:
+    """friction x tip_radius x squeeze x depth, ids in that order."""
+    grid = itertools.product(loaded.friction, loaded.tip_radius, loaded.squeeze, loaded.depths)
+    return tuple(Params(f"q{k:04d}", float(mu), float(r), kind, d, rel)
+                 for k, (mu, r, kind, (d, rel)) in enumerate(grid))
+
+
+def build_group_mesh(item: ObjectItem):
+    """The mesh of an object (deterministic: the same on every machine with the same Triangle)."""
+    outline = build_outline(item.shape)
+    ms = item.mesh
+    area = ms.max_area if ms.max_area is not None else target_max_area(
+        outline, ms.nodes if ms.nodes is not None else 600)
+    return generate_mesh(outline, area, ms.min_angle)
+
+
+def placement_total(loaded: LoadedSpec, item: ObjectItem) -> int:
+    """Number of placement indices of an object (meshes it for placements.mode: all)."""
+    pl = loaded.spec.placements
+    if pl.mode == "all":
+        try:
+            b = len(build_group_mesh(item).boundary)
+        except Exception as exc:
+            raise SweepError(f"object {item.id}: meshing failed: {exc}") from None
+        return b * (b - 1) // 2
+    return pl.count * (loaded.spec.repeat if pl.mode == "sample" else 1)
+
+
+def plan_tasks(loaded: LoadedSpec) -> list[Task]:
+    """Every task of the sweep, sorted by id."""
+    sw = loaded.spec
+    params = parameter_grid(loaded)
+    per_task = max(1, sw.chunk // len(params))
+    limits = scene_limits(loaded.base)
+    limits = dataclasses.replace(limits, weight=loaded.weight)
+    sq = loaded.base.squeeze
+    adversary = None
+    if sw.adversary is not None:
+        a = sw.adversary
+        adversary = (a.position, a.mode, a.contacts, a.directions)
+    pl = sw.placements
+    mu_filter = pl.mu if pl.mu is not None else min(loaded.friction)
+    tasks = []
+    for item in objects(loaded):
+        total = placement_total(loaded, item)
+        for mat_name, m in loaded.materials.items():
+            group = f"{item.id}~{mat_name}"
+            for c, start in enumerate(range(0, total, per_task)):
+                tasks.append(Task(
+                    f"{group}~c{c:04d}", group, loaded.hash, item,
+                    (mat_name, m.E, m.nu, m.thickness), pl.mode, pl.count, tuple(pl.require),
+                    float(mu_filter), sw.seed, sw.repeat, start, min(start + per_task, total),
+                    params, limits, sq.step, sq.event_tol, sq.max_events_per_depth, adversary))
+    return sorted(tasks, key=lambda t: t.id)

@@ -15,5 +15,6 @@ SECTIONS: tuple[str, ...] = (
     "ros_services",
     "pipeline",
     "pareto",
+    "sweep",
 )
 """Module names of the benchmark sections, in report order."""

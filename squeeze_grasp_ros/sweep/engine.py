@@ -113,8 +113,10 @@ def _cluster(scheduler: Optional[str], workers: Optional[int]):
     return Client(cluster), cluster
 
 
-def _dashboard(client) -> Optional[str]:
+def _dashboard(client, local: bool) -> Optional[str]:
     """The dashboard address, if the scheduler serves one (locally: only with bokeh)."""
+    if local and importlib.util.find_spec("bokeh") is None:
+        return None
     if "dashboard" not in client.scheduler_info().get("services", {}):
         return None
     return client.dashboard_link
@@ -168,7 +170,7 @@ def run_sweep(loaded: LoadedSpec, out: str | Path, *, scheduler: Optional[str] =
     client, cluster = _cluster(scheduler, workers)
     try:
         outcome.workers = _check_workers(client)
-        outcome.dashboard = _dashboard(client)
+        outcome.dashboard = _dashboard(client, cluster is not None)
         bar = Progress(sum(t.evaluations for t in todo), outcome.dashboard, progress)
         bar.update(0)
         futures = {client.submit(run_task, t, key=f"sweep-{loaded.hash[:12]}-{t.id}",

@@ -85,6 +85,11 @@ class Group:
 _CACHE: "OrderedDict[tuple, Group]" = OrderedDict()
 
 
+def clear_cache() -> None:
+    """Forget the prepared groups of this process (benchmarks start cold)."""
+    _CACHE.clear()
+
+
 def select_placements(task: Task, mesh: Mesh, gmap: GraspMap) -> list[tuple[int, int, int]]:
     """(repeat, F1 node, F2 node) of every placement index of the task's group."""
     loop = mesh.boundary
@@ -157,7 +162,8 @@ def evaluate(task: Task, group: Group, index: int, params, resist: dict) -> dict
     repeat, i, j = group.placements[index]
     mesh = group.obj.mesh
     gpos = mesh.boundary_position(i), mesh.boundary_position(j)
-    row = {"eval_id": f"{task.group}/p{index:05d}/{params.id}", "task_id": task.id,
+    row = dict.fromkeys(COLUMNS)
+    row.update({"eval_id": f"{task.group}/p{index:05d}/{params.id}", "task_id": task.id,
            "object_id": task.obj.id, "material_id": task.material[0],
            "placement_id": f"p{index:05d}", "param_id": params.id, "repeat": repeat,
            "node_F1": i, "node_F2": j,
@@ -166,7 +172,7 @@ def evaluate(task: Task, group: Group, index: int, params, resist: dict) -> dict
            "mu": params.mu, "tip_radius": params.tip_radius, "squeeze": params.kind,
            "target_depth": params.depth, "target_relative_depth": params.relative_depth,
            "mesh_nodes": mesh.n, "boundary_nodes": len(mesh.boundary),
-           "stiffness": float(group.gmap.stiffness[gpos])}
+           "stiffness": float(group.gmap.stiffness[gpos])})
     start = time.perf_counter()
     try:
         res = event_squeeze(group.obj, (i, j), params.tip_radius, params.mu, params.kind,

@@ -235,7 +235,8 @@ def parse_sweep_spec(data: Any, base_dir: Path) -> LoadedSpec:
     except SweepError:
         raise
     except SceneError as exc:
-        raise SweepError(str(exc)) from None
+        # the scene parser prefixes top-level unknown keys with "." (empty section path)
+        raise SweepError(str(exc).replace("unknown key .", "unknown key ", 1)) from None
     sw = dataclasses.replace(sw, base=_absolute(sw.base, base_dir))
     files = {"base": _file_digest(sw.base, "base")}
     try:

@@ -597,28 +597,38 @@ def finger_nodes(scene: Scene, mesh: Mesh) -> tuple[int, int]:
     return i, j
 
 
+def key_reference(cls: type, prefix: str = "", width: int = 38,
+                  nested: dict[str, tuple[type, str]] | None = None) -> list[str]:
+    """One line per key of dataclass ``cls`` (and its sections): path, doc, unit, range.
+
+    Lists of sections (``tuple[Section, ...]``) are shown as ``key[]``; ``nested`` maps a key
+    path to (section class, prefix) for mappings whose values are sections."""
+    nested = nested or {}
+    lines: list[str] = []
+    hints = typing.get_type_hints(cls)
+    for f in dataclasses.fields(cls):
+        meta = f.metadata
+        tp = hints[f.name]
+        inner = ([a for a in typing.get_args(tp) if a is not type(None)] or [tp])[0]
+        path = f"{prefix}{f.name}"
+        if typing.get_origin(inner) is tuple and dataclasses.is_dataclass(typing.get_args(inner)[0]):
+            inner, path = typing.get_args(inner)[0], path + "[]"
+        req = f.default is dataclasses.MISSING and f.default_factory is dataclasses.MISSING
+        extra = [x for x in (meta.get("unit"), _describe(dict(meta)),
+                             "one of " + "/".join(meta["choices"]) if meta.get("choices") else "",
+                             "required" if req else "") if x]
+        lines.append(f"{path:{width}s} {meta.get('doc', '')}"
+                     + (f" [{', '.join(extra)}]" if extra else ""))
+        if dataclasses.is_dataclass(inner):
+            lines += key_reference(inner, path + ".", width, nested)
+        if path in nested:
+            lines += key_reference(nested[path][0], nested[path][1], width, nested)
+    return lines
+
+
 def scene_help() -> str:
     """Human-readable reference of every scene key, unit and range."""
-    lines: list[str] = []
-
-    def walk(cls: type, prefix: str) -> None:
-        hints = typing.get_type_hints(cls)
-        for f in dataclasses.fields(cls):
-            meta = f.metadata
-            tp = hints[f.name]
-            args = [a for a in typing.get_args(tp) if a is not type(None)] or [tp]
-            inner = args[0]
-            path = f"{prefix}{f.name}"
-            req = f.default is dataclasses.MISSING and f.default_factory is dataclasses.MISSING
-            extra = [x for x in (meta.get("unit"), _describe(dict(meta)),
-                                 "one of " + "/".join(meta["choices"]) if meta.get("choices") else "",
-                                 "required" if req else "") if x]
-            lines.append(f"{path:38s} {meta.get('doc', '')}" + (f" [{', '.join(extra)}]" if extra else ""))
-            if dataclasses.is_dataclass(inner):
-                walk(inner, path + ".")
-            if path == "fingers":
-                walk(FingerSpec, "fingers.F1|F2.")
-    walk(Scene, "")
+    lines = key_reference(Scene, nested={"fingers": (FingerSpec, "fingers.F1|F2.")})
     lines.append("")
     lines.append("shape types: " + "; ".join(f"{k}({', '.join(v)})" for k, v in SHAPES.items()))
     lines.append("effects: " + "; ".join(f"{k}: {v}" for k, v in EFFECTS.items()))

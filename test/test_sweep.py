@@ -346,3 +346,23 @@ def test_dry_run_and_report(tmp_path, capsys):
     for obj, best in rep["best"].items():
         assert best[0]["success_rate"] >= best[-1]["success_rate"]
     assert all(Path(p).stat().st_size > 10_000 for p in rep["plots"])
+
+
+def test_outline_file_objects_travel_with_the_task(tmp_path):
+    """An outline file is read by the client: a worker without the file computes the same rows."""
+    t = np.linspace(0, 2 * np.pi, 40, endpoint=False)
+    csv = tmp_path / "blob.csv"
+    np.savetxt(csv, np.column_stack([0.05 * np.cos(t), 0.03 * np.sin(t) * (1 + 0.2 * np.cos(t))]),
+               delimiter=",")
+    loaded = parse_sweep_spec({**SMALL, "objects": [{"outline": "blob.csv"}],
+                               "friction": [0.5]}, tmp_path)
+    task = plan_tasks(loaded)[0]
+    assert task.obj.id == "00-blob"
+    first = run_task(task)["rows"]
+    csv.unlink()
+    from squeeze_grasp_ros.sweep.evaluate import clear_cache
+    clear_cache()
+    again = run_task(task)["rows"]
+    strip = [{k: v for k, v in r.items() if k != "time_s"} for r in first]
+    assert strip == [{k: v for k, v in r.items() if k != "time_s"} for r in again]
+    assert all(r["error"] is None for r in first)

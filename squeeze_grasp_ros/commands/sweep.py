@@ -67,6 +67,9 @@ def summary(result: dict) -> str:
             lines.append(f"estimated time on {result['workers']} worker(s): "
                          f"{result['estimate_s'] / 60:.1f} min")
         return "\n".join(lines)
+    if result["skipped"] == result["tasks"]:
+        return (f"{result['out']}: all {result['tasks']} tasks already done "
+                f"({result['seconds']:.2f} s); summary: squeeze-grasp sweep-report {result['out']}")
     lines = [f"{result['out']}: {result['tasks']} tasks, {result['skipped']} already done, "
              f"{result['done']} written now ({result['evaluations']} evaluations, "
              f"{result['errors']} with an error), {result['failed']} failed",

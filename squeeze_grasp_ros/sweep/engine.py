@@ -28,6 +28,7 @@ from .spec import LoadedSpec, SweepError
 INSTALL_HINT = ("squeeze-grasp sweep needs the 'sweep' extra (Dask distributed and pyarrow): "
                 "pip install '.[sweep]' in the repository (or pip install 'dask[distributed]' "
                 "pyarrow)")
+BAR_WIDTH = 24
 DRY_RUN_SAMPLE = 4
 """Evaluations timed by ``--dry-run``."""
 
@@ -62,8 +63,9 @@ class Progress:
         left = (self.total - self.done) / rate if rate > 0 else float("nan")
         eta = time.strftime("%H:%M:%S", time.gmtime(left)) if left == left else "--:--:--"
         pct = 100.0 * self.done / self.total if self.total else 100.0
-        text = (f"sweep {self.done}/{self.total} evaluations ({pct:.0f} %), {rate:.2f} eval/s, "
-                f"ETA {eta}")
+        filled = int(BAR_WIDTH * pct / 100)
+        text = (f"sweep [{'#' * filled}{'.' * (BAR_WIDTH - filled)}] {self.done}/{self.total} "
+                f"evaluations ({pct:.0f} %), {rate:.2f} eval/s, ETA {eta}")
         return text + (f", dashboard {self.dashboard}" if self.dashboard else "")
 
     def update(self, count: int, final: bool = False) -> None:
@@ -82,7 +84,8 @@ class Progress:
 
 @dataclass
 class Outcome:
-    """What a sweep run did (counts of tasks and evaluations, seconds)."""
+    """What a sweep run did: counts of tasks and evaluations; seconds in all, summed over the
+    tasks for preparing groups and evaluating, and until the cluster was ready."""
 
     tasks: int
     skipped: int
@@ -96,6 +99,7 @@ class Outcome:
     interrupted: bool
     prepare_s: float
     evaluate_s: float
+    startup_s: float = 0.0
 
 
 def _cluster(scheduler: Optional[str], workers: Optional[int]):
@@ -171,6 +175,7 @@ def run_sweep(loaded: LoadedSpec, out: str | Path, *, scheduler: Optional[str] =
     try:
         outcome.workers = _check_workers(client)
         outcome.dashboard = _dashboard(client, cluster is not None)
+        outcome.startup_s = time.perf_counter() - start
         bar = Progress(sum(t.evaluations for t in todo), outcome.dashboard, progress)
         bar.update(0)
         futures = {client.submit(run_task, t, key=f"sweep-{loaded.hash[:12]}-{t.id}",

@@ -29,6 +29,7 @@ import numpy as np
 
 from ..mechanics.contact_model import Limits
 from ..mechanics.mesh import generate_mesh, target_max_area
+from ..mechanics.shapes import Outline
 from ..scene import MeshSpec, build_outline, load_scene
 from ..scene_events import scene_limits
 from .spec import LoadedSpec, ObjectEntry, SweepError
@@ -56,11 +57,15 @@ class ObjectItem:
     shape : dict
         Scene-style shape mapping (``build_outline``).
     mesh : MeshSpec
+    outline : Outline or None
+        Outline read from a file by the client (``shape.type: file``), so that workers need
+        no access to the spec's files.
     """
 
     id: str
     shape: dict
     mesh: MeshSpec
+    outline: Optional[Outline] = None
 
 
 @dataclass(frozen=True)
@@ -156,7 +161,9 @@ def objects(loaded: LoadedSpec) -> list[ObjectItem]:
     sw = loaded.spec
     if sw.objects is None:
         name = loaded.base.name or "base"
-        return [ObjectItem(f"00-{name}", loaded.base.object.shape, loaded.mesh)]
+        shape = loaded.base.object.shape
+        return [ObjectItem(f"00-{name}", shape, loaded.mesh,
+                           build_outline(shape) if shape["type"] == "file" else None)]
     items = []
     for k, entry in enumerate(sw.objects):
         mesh = entry.mesh or loaded.mesh
@@ -172,7 +179,9 @@ def objects(loaded: LoadedSpec) -> list[ObjectItem]:
             pairs = [(entry.name or entry.shape["type"], entry.shape)]
         else:
             pairs = _family_shapes(entry, sw.seed, entry.name or entry.family.type)
-        items += [ObjectItem(f"{k:02d}-{oid}", shape, mesh) for oid, shape in pairs]
+        items += [ObjectItem(f"{k:02d}-{oid}", shape, mesh,
+                             build_outline(shape) if shape["type"] == "file" else None)
+                  for oid, shape in pairs]
     return items
 
 
@@ -185,7 +194,7 @@ def parameter_grid(loaded: LoadedSpec) -> tuple[Params, ...]:
 
 def build_group_mesh(item: ObjectItem):
     """The mesh of an object (deterministic: the same on every machine with the same Triangle)."""
-    outline = build_outline(item.shape)
+    outline = item.outline if item.outline is not None else build_outline(item.shape)
     ms = item.mesh
     area = ms.max_area if ms.max_area is not None else target_max_area(
         outline, ms.nodes if ms.nodes is not None else 600)

@@ -19,8 +19,8 @@ from typing import Any, Optional
 
 import yaml
 
-from ..scene import (MaterialSpec, MeshSpec, Scene, SceneError, _describe, build_outline,
-                     load_scene, parse_section, spec)
+from ..scene import (MaterialSpec, MeshSpec, Scene, SceneError, _validate_shape, build_outline,
+                     key_reference, load_scene, parse_section, spec)
 
 
 class SweepError(SceneError):
@@ -154,7 +154,8 @@ class LoadedSpec:
         (depth m, relative depth) pairs, exactly one of each pair set.
     weight : float or None
     hash : str
-        SHA-256 of the parsed spec and the bytes of every file it reads.
+        SHA-256 of the spec as written and the bytes of every file it reads (not of where
+        they are, so a moved checkout resumes its sweeps).
     raw : dict
         The YAML mapping as given.
     """
@@ -202,7 +203,6 @@ def _check_entry(entry: ObjectEntry, where: str) -> None:
                              f"(allowed: {list(FAMILIES[fam.type])})")
     if entry.shape is not None:
         try:
-            from ..scene import _validate_shape
             _validate_shape(entry.shape)
             build_outline(entry.shape)
         except SceneError as exc:
@@ -300,13 +300,15 @@ def parse_sweep_spec(data: Any, base_dir: Path) -> LoadedSpec:
     else:
         raise SweepError("no squeeze depth: give depth or relative_depth (or squeeze.depth / "
                          "squeeze.relative_depth in the base scene)")
+    if sw.adversary is not None and sw.adversary.position >= 1.0:
+        raise SweepError("adversary.position must be < 1 (1 is F2's node)")
     if sw.repeat > 1 and sw.placements.mode != "sample":
         raise SweepError(f"repeat is {sw.repeat} but placements.mode is {sw.placements.mode}: "
                          "only sampled placements are random (placements.mode: sample)")
     if sw.placements.mode == "graspmap" and len(set(sw.placements.require)) != len(sw.placements.require):
         raise SweepError("placements.require lists a filter twice")
     weight = sw.weight if sw.weight is not None else (base.pickup.weight if base.has("pickup") else None)
-    ident = {"spec": dataclasses.asdict(sw), "files": files}
+    ident = {"spec": data, "files": files}
     digest = hashlib.sha256(json.dumps(ident, sort_keys=True, default=str).encode()).hexdigest()
     return LoadedSpec(
         spec=sw, base=base, materials=materials, mesh=sw.mesh or base.object.mesh,
@@ -330,31 +332,8 @@ def load_sweep_spec(path: str | Path) -> LoadedSpec:
 
 def sweep_help() -> str:
     """Human-readable reference of every sweep key, unit and range."""
-    import typing
-    lines: list[str] = []
-
-    def walk(cls: type, prefix: str) -> None:
-        hints = typing.get_type_hints(cls)
-        for f in dataclasses.fields(cls):
-            meta = f.metadata
-            tp = hints[f.name]
-            args = [a for a in typing.get_args(tp) if a is not type(None)] or [tp]
-            inner = args[0]
-            if typing.get_origin(inner) is tuple and dataclasses.is_dataclass(typing.get_args(inner)[0]):
-                inner = typing.get_args(inner)[0]
-                path = f"{prefix}{f.name}[]"
-            else:
-                path = f"{prefix}{f.name}"
-            req = f.default is dataclasses.MISSING and f.default_factory is dataclasses.MISSING
-            extra = [x for x in (meta.get("unit"), _describe(dict(meta)),
-                                 "one of " + "/".join(meta["choices"]) if meta.get("choices") else "",
-                                 "required" if req else "") if x]
-            lines.append(f"{path:30s} {meta.get('doc', '')}" + (f" [{', '.join(extra)}]" if extra else ""))
-            if dataclasses.is_dataclass(inner):
-                walk(inner, path + ".")
-            if path == "materials":
-                walk(MaterialSpec, "materials.<name>.")
-    walk(SweepSpec, "")
+    lines = key_reference(SweepSpec, width=30,
+                          nested={"materials": (MaterialSpec, "materials.<name>.")})
     lines += ["", "Axes not given take the base scene's value; the evaluations of an object are "
               "placements x materials x friction x tip_radius x squeeze x depth.",
               "families: " + "; ".join(f"{k}({', '.join(v)})" for k, v in FAMILIES.items()),

@@ -20,6 +20,11 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     add_scene_argument(parser)
     parser.add_argument("--record", metavar="DIR",
                         help="record every topic into this rosbag2 folder (MCAP storage)")
+    parser.add_argument("--include-hidden-topics", action="store_true",
+                        help="with --record: also record the executor action's hidden topics "
+                             "(_action/feedback, _action/status); like rosbag2, off by default. Foxglove "
+                             "and rosbags decode them; mcap_ros2 cannot (it rejects rosidl's "
+                             "action message names, e.g. ExecuteGrasp_FeedbackMessage)")
     parser.add_argument("--processes", action="store_true",
                         help="one process per node, as `ros2 launch` starts them (default: "
                              "every node on one executor in this process)")
@@ -51,7 +56,9 @@ def run(args: argparse.Namespace) -> dict | int:
     130 after Ctrl-C (the recording is finished first)."""
     from ..nodes.runner import PipelineRunner, RunOptions
 
-    options = RunOptions(args.scene, record=args.record, processes=args.processes,
+    options = RunOptions(args.scene, record=args.record,
+                         include_hidden_topics=args.include_hidden_topics,
+                         processes=args.processes,
                          executor=args.executor, on_slip_alarm=args.on_slip_alarm,
                          resist=not args.no_resist, planner=not args.no_planner)
     show = not (args.quiet or args.json) and sys.stderr.isatty()

@@ -55,8 +55,12 @@ def device_topic(device: str, stream: str) -> str:
     return f"devices/{device}/{stream}"
 
 
-def pipeline_topics(devices: Iterable[str]) -> dict[str, str]:
-    """Topic (fully qualified) -> type of every topic of a run with ``devices``."""
+def pipeline_topics(devices: Iterable[str], *, hidden: bool = False) -> dict[str, str]:
+    """Topic (fully qualified) -> type of every topic of a run with ``devices``.
+
+    ``hidden`` adds the executor action's hidden topics (``.../_action/feedback`` and
+    ``.../_action/status``), which rosbag2 too records only when asked.
+    """
     types = {
         CLOCK: "rosgraph_msgs/msg/Clock",
         TICK: "squeeze_grasp_interfaces/msg/Tick",
@@ -70,9 +74,11 @@ def pipeline_topics(devices: Iterable[str]) -> dict[str, str]:
         PREDICTION: "squeeze_grasp_interfaces/msg/ContactEventArray",
         EXECUTOR_STATUS: "squeeze_grasp_interfaces/msg/ExecutorStatus",
         OBJECT_POSE: "geometry_msgs/msg/PoseStamped",
-        f"{ACTION}/_action/feedback": "squeeze_grasp_interfaces/action/ExecuteGrasp_FeedbackMessage",
-        f"{ACTION}/_action/status": "action_msgs/msg/GoalStatusArray",
     }
+    if hidden:
+        types[f"{ACTION}/_action/feedback"] = \
+            "squeeze_grasp_interfaces/action/ExecuteGrasp_FeedbackMessage"
+        types[f"{ACTION}/_action/status"] = "action_msgs/msg/GoalStatusArray"
     stream_types = {"setpoint": "geometry_msgs/msg/PoseStamped",
                     "pose": "geometry_msgs/msg/PoseStamped",
                     "wrench": "geometry_msgs/msg/WrenchStamped",

@@ -45,6 +45,9 @@ PARAMETERS: dict[str, tuple[Any, str]] = {
     "output": ("", "bag folder to create (required; must not exist or be empty)"),
     "devices": (["barrett_f1", "barrett_f3"], "devices whose topics are recorded"),
     "extra_topics": ([""], "more topics to record, as 'name pkg/msg/Type' ('' = none)"),
+    "include_hidden_topics": (False, "also record the executor action's hidden topics "
+                                     "(_action/feedback, _action/status), as rosbag2 does only "
+                                     "with --include-hidden-topics"),
     "compression": ("zstd", "chunk compression: zstd, lz4 or none"),
     "chunk_size": (262144, "uncompressed chunk size written out when full, bytes"),
     "custom_data": ("{}", "YAML mapping of strings stored in metadata.yaml custom_data"),
@@ -84,7 +87,7 @@ class RecorderNode(Node):
         custom = yaml.safe_load(p["custom_data"]) or {}
         self.writer = BagWriter(p["output"], p["compression"], p["chunk_size"],
                                 {str(k): str(v) for k, v in custom.items()})
-        topics = pipeline.pipeline_topics(p["devices"])
+        topics = pipeline.pipeline_topics(p["devices"], hidden=p["include_hidden_topics"])
         for entry in p["extra_topics"]:
             if entry.strip():
                 name, type_name = entry.split()

@@ -111,6 +111,8 @@ class RunOptions:
     scene_path : str
     record : str or None
         Bag folder to record into.
+    include_hidden_topics : bool
+        Record the executor action's hidden ``_action/`` topics too.
     processes : bool
         One process per node instead of one executor in this process.
     executor : {"events", "single"}
@@ -129,6 +131,7 @@ class RunOptions:
 
     scene_path: str
     record: str | None = None
+    include_hidden_topics: bool = False
     processes: bool = False
     executor: str = "events"
     on_slip_alarm: str = "hold"
@@ -157,7 +160,8 @@ def node_parameters(scene: Scene, scene_path: str, options: RunOptions,
                    load_threshold=max(float(monitor.get("load_threshold", 0.005)), 6.0 * noise))
     params["executor"].update(finger_devices=mapping, period=float(scene.sim.dt))
     custom = {"scene": Path(scene_path).read_text(), "scene_path": str(scene_path)}
-    params["recorder"].update(output=str(options.record or ""), devices=list(devices.values()))
+    params["recorder"].update(output=str(options.record or ""), devices=list(devices.values()),
+                              include_hidden_topics=options.include_hidden_topics)
     for name, values in options.overrides.items():
         params[name].update(values)
     custom["monitor_parameters"] = yaml.safe_dump(params["monitor"], sort_keys=True)

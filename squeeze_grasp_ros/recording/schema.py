@@ -2,14 +2,28 @@
 # SPDX-License-Identifier: Apache-2.0
 """Complete ``ros2msg`` message definitions and RIHS01 type hashes from installed interfaces.
 
-rosbag2 stores a *complete message definition* per type in the MCAP schema record: the type's
-``.msg`` text first, then every type it uses (recursively, each once, in order of first use),
-each preceded by a line of 80 ``=`` and a line ``MSG: <package>/msg/<Type>``
-(ros2/rosbag2 docs/message_definition_encoding.md). The texts come from the ``.msg`` files
-every interface package installs under ``share/<package>/msg`` (and ``.action`` files for the
-messages an action generates); the type hash from the generated ``.json`` type description.
-Install prefixes are searched in ``AMENT_PREFIX_PATH`` order, then ``sys.prefix`` (the pip
-route installs everything there).
+The MCAP schema record of a type holds its *complete message definition*, written exactly as
+rosbag2 (Jazzy, ``rosbag2_cpp::LocalMessageDefinitionSource``) writes it, so that every reader
+that understands rosbag2's bags (Foxglove, ``mcap_ros2``, rosbags) understands ours:
+
+* the root type's ``.msg`` file, verbatim (comments and constants included);
+* then, depth first, each type it uses, once: a newline, a line of 80 ``=``, a line
+  ``MSG: <package>/<Type>`` (the name as the field spells it; a bare ``Type`` becomes
+  ``<package>/<Type>`` of the enclosing package, never ``<package>/msg/<Type>``) and that
+  type's ``.msg`` file verbatim. The types a definition uses are visited in sorted order.
+
+The texts come from the ``.msg`` files every interface package installs under
+``share/<package>/msg``. rosbag2 writes no definition for the messages an action generates
+(``_action/feedback``), and does not record those hidden topics unless asked; when asked, we
+compose their definitions from the ``.action`` file, naming them as rosidl does
+(``<package>/action/<Action>_Feedback``) so that the type hashes readers recompute from the
+text match the recorded ones. Foxglove and rosbags decode them; ``mcap_ros2`` (0.6) cannot,
+because it accepts only message names matching ``[A-Z][A-Za-z0-9]*`` and rosidl's action
+messages have an underscore. Install prefixes are searched in ``AMENT_PREFIX_PATH``
+order, then ``sys.prefix`` (the pip route installs everything there).
+
+>>> print(message_definition("std_msgs/msg/Header").split(SEPARATOR)[1].splitlines()[1])
+MSG: builtin_interfaces/Time
 """
 from __future__ import annotations
 
@@ -24,6 +38,8 @@ PRIMITIVES = frozenset({
     "bool", "byte", "char", "float32", "float64", "int8", "uint8", "int16", "uint16", "int32",
     "uint32", "int64", "uint64", "string", "wstring"})
 SEPARATOR = "=" * 80
+FIELD_TYPE = re.compile(r"(?:^|\n)\s*([a-zA-Z0-9_/]+)(?:\[[^\]]*\])?\s+")
+"""The type token at the start of a line, as rosbag2's dependency scan reads it."""
 CONSTANT = re.compile(r"^\S+\s+\w+\s*=")
 """A constant line: ``<type> NAME=value``."""
 ACTION_PARTS = {"_Goal": 0, "_Result": 1, "_Feedback": 2}
@@ -67,10 +83,15 @@ def split_type(type_name: str) -> tuple[str, str, str]:
 
 @functools.lru_cache(maxsize=None)
 def own_text(type_name: str) -> str:
-    """The ``.msg`` text of one type (no dependencies)."""
+    """The definition text of one type (no dependencies): its ``.msg`` file, or the section of
+    the ``.action`` file (or rosidl's wrapper) for a message an action generates."""
     package, kind, name = split_type(type_name)
     if kind == "msg":
-        return interface_file(package, "msg", name, ".msg").read_text()
+        try:
+            return interface_file(package, "msg", name, ".msg").read_text()
+        except SchemaError:
+            if not name.endswith((*ACTION_WRAPPERS, *ACTION_PARTS)):
+                raise
     for suffix, template in ACTION_WRAPPERS.items():
         if name.endswith(suffix):
             return template.format(package=package, action=name[: -len(suffix)])
@@ -109,37 +130,31 @@ def qualify(text: str, package: str) -> str:
     return "".join(out)
 
 
-def field_types(text: str, package: str) -> list[str]:
-    """Full names 'pkg/msg/Type' of the non-primitive field types of a ``.msg`` text, in order."""
-    out = []
-    for tokens in _fields(text):
-        base = re.split(r"[\[<]", tokens[0], maxsplit=1)[0]
+def dependencies(text: str, package: str) -> list[str]:
+    """Types a definition text uses, as rosbag2 names them ('pkg/Type'), sorted, each once."""
+    found = set()
+    for match in FIELD_TYPE.finditer(text):
+        base = match.group(1)
         if base in PRIMITIVES:
             continue
-        if "/" not in base:
-            base = f"{package}/{base}"
-        pkg, _, name = base.rpartition("/")
-        kind = "action" if pkg.endswith("/action") else "msg"
-        out.append(f"{pkg.split('/')[0]}/{kind}/{name}")
-    return out
+        found.add(base if "/" in base else f"{package}/{base}")
+    return sorted(found)
 
 
 def message_definition(type_name: str) -> str:
-    """The complete ``ros2msg`` definition of ``type_name`` ('pkg/msg/Type')."""
-    seen: list[str] = []
+    """The complete ``ros2msg`` definition of ``type_name`` ('pkg/msg/Type'), as rosbag2 writes it."""
+    seen: set[str] = set()
 
-    def visit(name: str) -> None:
-        for dep in field_types(own_text(name), split_type(name)[0]):
-            if dep not in seen and dep != type_name:
-                seen.append(dep)
-                visit(dep)
+    def text_with_dependencies(name: str) -> str:
+        own = own_text(name)
+        parts = [own]
+        for dep in dependencies(own, split_type(name)[0]):
+            if dep not in seen:
+                seen.add(dep)
+                parts.append(f"\n{SEPARATOR}\nMSG: {dep}\n{text_with_dependencies(dep)}")
+        return "".join(parts)
 
-    visit(type_name)
-    parts = [own_text(type_name).rstrip("\n")]
-    for dep in seen:
-        package, kind, name = split_type(dep)
-        parts.append(f"{SEPARATOR}\nMSG: {package}/{kind}/{name}\n{own_text(dep).rstrip(chr(10))}")
-    return "\n".join(parts) + "\n"
+    return text_with_dependencies(type_name)
 
 
 @functools.lru_cache(maxsize=None)

@@ -1,0 +1,149 @@
+# Copyright 2026 squeeze_grasp_ros developers
+# SPDX-License-Identifier: Apache-2.0
+"""Recordings decode completely in the standard readers users open them with.
+
+Foxglove (its own TypeScript libraries, run under node), ``mcap_ros2`` (Foxglove's Python
+decoder) and rosbags each decode every message of every channel of a fresh recording. The
+schema text is checked against rosbag2's own writer, byte for byte.
+"""
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+from mcap.reader import make_reader
+
+from squeeze_grasp_ros.nodes.runner import PipelineRunner, RunOptions
+from squeeze_grasp_ros.recording.schema import SEPARATOR, message_definition, own_text
+
+from foxglove_support import foxglove_decode
+from pipeline_support import SMALL_SQUARE, write_scene
+
+ACTION_TOPICS = {"/executor/execute_grasp/_action/feedback",
+                 "/executor/execute_grasp/_action/status"}
+
+
+def record(directory: Path, *, hidden: bool) -> Path:
+    """The small square through every node in one process, recorded; the ``.mcap`` file."""
+    path = write_scene(directory, SMALL_SQUARE)
+    PipelineRunner(RunOptions(path, record=str(directory / "bag"),
+                              include_hidden_topics=hidden)).run()
+    return next((directory / "bag").glob("*.mcap"))
+
+
+@pytest.fixture(scope="module")
+def default_bag(tmp_path_factory) -> Path:
+    return record(tmp_path_factory.mktemp("default"), hidden=False)
+
+
+@pytest.fixture(scope="module")
+def hidden_bag(tmp_path_factory) -> Path:
+    return record(tmp_path_factory.mktemp("hidden"), hidden=True)
+
+
+def channel_counts(mcap_file: Path) -> dict[str, int]:
+    """Topic -> message count from the file's own statistics record."""
+    with open(mcap_file, "rb") as f:
+        summary = make_reader(f).get_summary()
+    return {summary.channels[c].topic: n
+            for c, n in summary.statistics.channel_message_counts.items()}
+
+
+def mcap_ros2_counts(mcap_file: Path, topics=None) -> dict[str, int]:
+    from mcap_ros2.decoder import DecoderFactory
+
+    counts: dict[str, int] = {}
+    with open(mcap_file, "rb") as f:
+        reader = make_reader(f, decoder_factories=[DecoderFactory()])
+        for _, channel, _, decoded in reader.iter_decoded_messages(topics=topics):
+            assert decoded is not None
+            counts[channel.topic] = counts.get(channel.topic, 0) + 1
+    return counts
+
+
+def rosbags_counts(bag: Path) -> dict[str, int]:
+    from rosbags.highlevel import AnyReader
+
+    counts: dict[str, int] = {}
+    with AnyReader([bag]) as reader:
+        for connection, _, raw in reader.messages():
+            reader.deserialize(raw, connection.msgtype)
+            counts[connection.topic] = counts.get(connection.topic, 0) + 1
+    return counts
+
+
+def test_hidden_action_topics_are_recorded_only_when_asked(default_bag, hidden_bag):
+    assert not ACTION_TOPICS & set(channel_counts(default_bag))
+    assert ACTION_TOPICS <= set(channel_counts(hidden_bag))
+
+
+def test_foxglove_libraries_decode_every_message(default_bag, hidden_bag):
+    for mcap_file in (default_bag, hidden_bag):
+        expected = channel_counts(mcap_file)
+        report = foxglove_decode(mcap_file)
+        assert {t: r["decoded"] for t, r in report.items()} == expected
+        assert all(r["error"] is None for r in report.values()), report
+    report = foxglove_decode(default_bag)
+    assert report["/sim/markers"]["frame_ids"] == ["object"]
+    assert report["/sim/markers"]["schema"] == "visualization_msgs/msg/MarkerArray"
+
+
+def test_mcap_ros2_decodes_every_message(default_bag):
+    assert mcap_ros2_counts(default_bag) == channel_counts(default_bag)
+
+
+def test_mcap_ros2_rejects_only_the_action_feedback(hidden_bag):
+    """mcap_ros2 0.6 accepts message names matching [A-Z][A-Za-z0-9]* only, so it cannot parse
+    rosidl's action messages (``ExecuteGrasp_FeedbackMessage``); every other channel decodes.
+    The ``--include-hidden-topics`` help says so."""
+    expected = channel_counts(hidden_bag)
+    feedback = "/executor/execute_grasp/_action/feedback"
+    others = [t for t in expected if t != feedback]
+    assert mcap_ros2_counts(hidden_bag, topics=others) == {t: expected[t] for t in others}
+    with pytest.raises(Exception, match="ExecuteGrasp_") as info:
+        mcap_ros2_counts(hidden_bag, topics=[feedback])
+    assert info.typename == "InvalidResourceName"
+
+
+def test_rosbags_decodes_every_message(default_bag, hidden_bag):
+    for mcap_file in (default_bag, hidden_bag):
+        assert rosbags_counts(mcap_file.parent) == channel_counts(mcap_file)
+
+
+def test_schema_text_is_rosbag2s_for_standard_types(default_bag):
+    """rosbag2's layout: the root .msg verbatim, then depth first and in sorted order each used
+    type once, after a blank line, 80 '=' and 'MSG: pkg/Type' (no '/msg/')."""
+    def msg(name: str) -> str:
+        return own_text(name.replace("/", "/msg/"))
+
+    def section(name: str) -> str:
+        return f"\n{SEPARATOR}\nMSG: {name}\n{msg(name)}"
+
+    expected = (msg("geometry_msgs/PoseStamped") + section("geometry_msgs/Pose")
+                + section("geometry_msgs/Point") + section("geometry_msgs/Quaternion")
+                + section("std_msgs/Header") + section("builtin_interfaces/Time"))
+    with open(default_bag, "rb") as f:
+        schemas = {s.name: s.data.decode() for s in make_reader(f).get_summary().schemas.values()}
+    assert schemas["geometry_msgs/msg/PoseStamped"] == expected
+    assert "MSG: std_msgs/Header\n" in schemas["visualization_msgs/msg/MarkerArray"]
+    assert all("/msg/" not in line for text in schemas.values()
+               for line in text.splitlines() if line.startswith("MSG: "))
+
+
+def test_schema_text_matches_rosbag2s_own_unit_test(tmp_path, monkeypatch):
+    """rosbag2_cpp's test_local_message_definition_source (can_find_msg_deps), ported."""
+    share = tmp_path / "share" / "rosbag2_test_msgdefs" / "msg"
+    share.mkdir(parents=True)
+    (share / "ComplexMsg.msg").write_text("rosbag2_test_msgdefs/BasicMsg b\n")
+    (share / "BasicMsg.msg").write_text("float32 c\n")
+    monkeypatch.setenv("AMENT_PREFIX_PATH", str(tmp_path))
+    own_text.cache_clear()
+    try:
+        text = message_definition("rosbag2_test_msgdefs/ComplexMsg")
+    finally:
+        own_text.cache_clear()
+    assert text == ("rosbag2_test_msgdefs/BasicMsg b\n"
+                    "\n"
+                    f"{'=' * 80}\n"
+                    "MSG: rosbag2_test_msgdefs/BasicMsg\n"
+                    "float32 c\n")

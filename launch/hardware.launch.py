@@ -18,7 +18,7 @@ from launch.conditions import IfCondition
 from launch.substitutions import LaunchConfiguration, PythonExpression
 from launch_ros.actions import Node
 
-from squeeze_grasp_ros.nodes.runner import config_dir
+from squeeze_grasp_ros.resources import config_dir
 
 HARDWARE = {"use_sim_time": False, "lockstep": False, "sensor_qos": "sensor_data"}
 """Overrides of the simulation defaults in config/*.yaml."""

@@ -147,3 +147,56 @@ def test_schema_text_matches_rosbag2s_own_unit_test(tmp_path, monkeypatch):
                     f"{'=' * 80}\n"
                     "MSG: rosbag2_test_msgdefs/BasicMsg\n"
                     "float32 c\n")
+
+
+def resolve(message, path: str):
+    """The value of a Foxglove message path below the topic ('forces[0].x') in a message."""
+    value = message
+    for part in path.split("."):
+        name, _, index = part.partition("[")
+        value = getattr(value, name)
+        if index:
+            value = value[int(index.rstrip("]"))]
+    return value
+
+
+def first_messages(bag: Path) -> dict:
+    from rosbags.highlevel import AnyReader
+
+    out = {}
+    with AnyReader([bag]) as reader:
+        for connection, _, raw in reader.messages():
+            if connection.topic not in out:
+                out[connection.topic] = reader.deserialize(raw, connection.msgtype)
+    return out
+
+
+def test_shipped_viewers_show_what_a_recording_holds(default_bag):
+    """Every topic and message path of the Foxglove layout, and the RViz2 display topic and fixed
+    frame, exist in a fresh recording; the force-vs-depth plot reads numbers."""
+    import json
+
+    import yaml
+
+    from squeeze_grasp_ros.resources import viewer_file
+
+    messages = first_messages(default_bag.parent)
+    layout = json.loads(viewer_file("foxglove_layout.json").read_text())
+    panels = layout["configById"]
+    paths = [p["value"] for c in panels.values() for p in c.get("paths", [])]
+    paths += [c["xAxisPath"]["value"] for c in panels.values() if "xAxisPath" in c]
+    assert paths
+    for value in paths:
+        topic, _, field = value.partition(".")
+        assert isinstance(resolve(messages[topic], field), float), value
+    topics = [t for c in panels.values() for t in c.get("topics", {})]
+    topics += [c["topicPath"] for c in panels.values() if "topicPath" in c]
+    assert set(topics) <= set(messages)
+    frame = panels["3D!squeeze"]["followTf"]
+    assert {m.header.frame_id for m in messages["/sim/markers"].markers} == {frame}
+
+    rviz = yaml.safe_load(viewer_file("squeeze_grasp.rviz").read_text())["Visualization Manager"]
+    markers = next(d for d in rviz["Displays"] if d["Class"].endswith("/MarkerArray"))
+    assert markers["Topic"]["Value"] in messages
+    assert rviz["Global Options"]["Fixed Frame"] == frame
+    assert set(markers["Namespaces"]) == {m.ns for m in messages["/sim/markers"].markers if m.ns}

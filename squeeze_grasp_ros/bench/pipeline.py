@@ -14,14 +14,13 @@ from ..mechanics.compliance import ElasticObject
 from ..nodes import pipeline
 from ..nodes.runner import PipelineRunner, RunOptions
 from ..recording.bag import read_bag
+from ..resources import scene_file
 from ..scene import build_mesh, finger_nodes, load_scene, scene_material
 from ..scene_events import event_squeeze_scene
 from ..sim.world import SimWorld
 from .table import Table, best_time, timed
 
 TITLE = "Pipeline on real rclpy nodes: end to end, lockstep rate, recording, effects"
-SCENES = Path(__file__).resolve().parents[2] / "config" / "scenes"
-FOAM = SCENES / "foam_square.yaml"
 EFFECT_SCENE = {
     "name": "effects", "object": {"shape": {"type": "square", "side": 0.1},
                                   "material": {"E": 5.0e4, "nu": 0.3, "thickness": 0.0254},
@@ -130,7 +129,7 @@ def effect_rows(out_dir: Path, progress, repeats: int) -> list:
                                                "effects": list(effects)}))
     world: dict[str, float] = {name: float("inf") for name in paths}
     loop: dict[str, float] = {name: float("inf") for name in paths}
-    world_loop(FOAM)
+    world_loop(scene_file("foam_square"))
     for r in range(repeats):
         for name, path in paths.items():
             progress(f"pipeline: effect {name}, run {r + 1} of {repeats}")
@@ -149,8 +148,9 @@ def run(quick: bool, out_dir: Path, progress) -> list[Table]:
     out_dir.mkdir(parents=True, exist_ok=True)
     work = Path(tempfile.mkdtemp(prefix="bench_pipeline_", dir=out_dir))
     progress("pipeline: bare mechanics (and a warm-up run)")
-    bare = min(bare_mechanics(FOAM) for _ in range(2))
-    run_once(FOAM)
+    foam = scene_file("foam_square")
+    bare = min(bare_mechanics(foam) for _ in range(2))
+    run_once(foam)
     configs = [("one process, EventsExecutor", True, {}),
                ("one process, EventsExecutor", False, {}),
                ("one process, SingleThreadedExecutor", True, {"executor": "single"}),
@@ -165,7 +165,7 @@ def run(quick: bool, out_dir: Path, progress) -> list[Table]:
         for (mode, record, bags, results), (_, _, options) in zip(runs, configs):
             progress(f"pipeline: foam square, {mode}, recording {'on' if record else 'off'}, "
                      f"run {r + 1} of {repeats}")
-            results.append(run_once(FOAM, bags[r], **options))
+            results.append(run_once(foam, bags[r], **options))
     rows, rate_rows = [], []
     for mode, record, bags, results in runs:
         best = min(range(repeats), key=lambda r: results[r]["timing"]["total"])

@@ -18,6 +18,7 @@ from pathlib import Path
 
 import yaml
 
+from ..resources import scene_file
 from ..sweep.engine import run_sweep
 from ..sweep.evaluate import clear_cache, run_task
 from ..sweep.plan import plan_tasks
@@ -25,7 +26,6 @@ from ..sweep.spec import parse_sweep_spec
 from .table import Table
 
 TITLE = "Grasp-dataset sweep on Dask"
-BASE = Path(__file__).resolve().parents[2] / "config" / "scenes" / "foam_square.yaml"
 OBJECTS = [
     {"shape": {"type": "square", "side": 0.1}},
     {"shape": {"type": "disk", "radius": 0.05}},
@@ -44,7 +44,7 @@ OBJECTS = [
 def bench_spec(nodes: int, placements: int) -> dict:
     """The benchmark sweep: 12 objects x ``placements`` grasp-map placements x 3 friction x
     2 tip radii x 2 depths, with pickup weight and adversary (every field recorded)."""
-    return {"name": "bench", "base": str(BASE), "seed": 19, "objects": OBJECTS,
+    return {"name": "bench", "base": str(scene_file("foam_square")), "seed": 19, "objects": OBJECTS,
             "mesh": {"nodes": nodes}, "friction": [0.3, 0.6, 0.9], "tip_radius": [0.01, 0.02],
             "relative_depth": [0.04, 0.08],
             "placements": {"mode": "graspmap", "count": placements},

@@ -64,6 +64,7 @@ from ..mechanics.contact_model import ContactModel
 from ..mechanics.resistance_friction import add_adversary, frictional_resistance
 from ..mechanics.squeeze import plan_squeeze
 from ..recording.bag import plain_yaml
+from ..resources import config_dir
 from ..scene import (Scene, SceneError, build_mesh, finger_devices, finger_nodes, load_scene,
                      placement_node, scene_material)
 from ..scene_events import event_squeeze_scene
@@ -83,16 +84,6 @@ SERVICE_RETRY = 30.0
 
 class RunError(RuntimeError):
     """The pipeline could not be started or did not finish in time."""
-
-
-def config_dir() -> Path:
-    """``config/`` of the repository (editable install) or ``share/squeeze_grasp_ros/config``."""
-    candidates = [Path(__file__).resolve().parents[2] / "config",
-                  Path(sys.prefix) / "share" / "squeeze_grasp_ros" / "config"]
-    for path in candidates:
-        if (path / "executor.yaml").is_file():
-            return path
-    raise RunError(f"no node configuration found in {[str(p) for p in candidates]}")
 
 
 def config_parameters(node: str) -> dict[str, Any]:

@@ -9,6 +9,8 @@ import json
 import sys
 
 from .commands import VERBS
+from .exit_codes import ExitCode
+from .extras import install_hint
 from .mechanics.errors import MechanicsError
 from .scene import SceneError
 
@@ -37,7 +39,14 @@ def main(argv: list[str] | None = None) -> int:
         result = args._module.run(args)
     except (SceneError, MechanicsError) as exc:
         print(f"squeeze-grasp {args.verb}: error: {exc}", file=sys.stderr)
-        return 2
+        return ExitCode.USAGE
+    except ModuleNotFoundError as exc:
+        hint = install_hint(exc.name or "")
+        if hint is None:
+            raise
+        print(f"squeeze-grasp {args.verb}: error: needs {exc.name.split('.')[0]}, which is not "
+              f"installed: {hint}", file=sys.stderr)
+        return ExitCode.INTERNAL
     if isinstance(result, int):
         return result
     if args.json:

@@ -4,7 +4,12 @@
 
 A section module defines ``TITLE`` and ``run(quick: bool, out_dir: Path, progress) -> list[Table]``;
 ``squeeze-grasp bench`` runs the sections listed in ``SECTIONS`` and writes a Markdown report.
+A section whose modules are not installed (``REQUIREMENTS``) is skipped with a line saying why,
+and the report lists it, so the mechanics sections run on a plain ``pip install .``.
 """
+from __future__ import annotations
+
+from ..extras import EXTRAS, installed
 
 SECTIONS: tuple[str, ...] = (
     "convergence",
@@ -18,3 +23,16 @@ SECTIONS: tuple[str, ...] = (
     "sweep",
 )
 """Module names of the benchmark sections, in report order."""
+
+REQUIREMENTS: dict[str, tuple[tuple[str, ...], str]] = {
+    "ros_services": (("rclpy", "squeeze_grasp_interfaces"), EXTRAS["ros"][1]),
+    "pipeline": (("rclpy", "squeeze_grasp_interfaces", "mcap"), EXTRAS["ros"][1]),
+    "sweep": EXTRAS["sweep"],
+}
+"""Section -> (modules it imports beyond the mechanics, how to install them)."""
+
+
+def missing(section: str) -> tuple[list[str], str]:
+    """Modules ``section`` needs that are not installed, and how to install them."""
+    modules, how = REQUIREMENTS.get(section, ((), ""))
+    return [m for m in modules if not installed(m)], how

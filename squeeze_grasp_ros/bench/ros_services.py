@@ -19,22 +19,16 @@ squeeze request < 10 ms end to end. Without rclpy and the interfaces (``pip inst
 """
 from __future__ import annotations
 
-import importlib.util
 from collections.abc import Callable
 from pathlib import Path
 
 from .table import Table
 
 TITLE = "ROS services: round trip over the bare mechanics call"
-REQUIRED = ("rclpy", "squeeze_grasp_interfaces")
 
 
 def run(quick: bool, out_dir: Path, progress: Callable[[str], None]) -> list[Table]:
     """Measure the three tables in one run."""
-    missing = [name for name in REQUIRED if importlib.util.find_spec(name) is None]
-    if missing:
-        return [Table(TITLE, ["skipped"], [[f"not installed: {', '.join(missing)}"]],
-                      "ROS 2 from PyPI: pip install -e '.[ros]' && squeeze-grasp ros-setup")]
     from .ros_measure import localhost_only, long_request_rows, overhead_rows
 
     sizes = (500, 2000) if quick else (500, 2000, 8000, 20000)

@@ -9,7 +9,8 @@ import platform
 import sys
 from pathlib import Path
 
-from ..bench import SECTIONS
+from ..bench import SECTIONS, missing
+from ..bench.table import Table
 
 HELP = "run the benchmarks; print tables and write a Markdown report with plots"
 
@@ -30,10 +31,18 @@ def run(args: argparse.Namespace) -> dict:
     """Run the sections; write OUT/report.md and the plots."""
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
-    tables = []
+    tables, skipped = [], []
     for name in args.only or SECTIONS:
+        absent, how = missing(name)
+        if absent:
+            _progress(f"skipped {name}: {', '.join(absent)} not installed ({how})")
+            skipped.append([name, ", ".join(absent), how])
+            continue
         module = importlib.import_module(f"..bench.{name}", __package__)
         tables += module.run(args.quick, out, _progress)
+    if skipped:
+        tables.append(Table("Skipped sections", ["section", "not installed", "to run it"],
+                            skipped, "These sections need modules this environment lacks."))
     header = (f"# squeeze_grasp_ros benchmark ({'quick' if args.quick else 'full'})\n\n"
               f"Python {platform.python_version()}, {platform.machine()}, "
               f"{platform.processor() or 'cpu'}; times are best-of wall times in one run.\n")

@@ -1,0 +1,42 @@
+# Copyright 2026 squeeze_grasp_ros developers
+# SPDX-License-Identifier: Apache-2.0
+"""Optional parts of the package and how to install them.
+
+``pip install .`` gives the mechanics; ROS 2 (nodes, ``run``, ``replay``, recordings) and the
+Dask sweeps come with extras. Code that needs an extra asks here, so that a missing one ends
+in a sentence saying what to install, never a traceback.
+
+>>> install_hint("rclpy").startswith("pip install '.[ros]'")
+True
+>>> install_hint("numpy") is None
+True
+"""
+from __future__ import annotations
+
+import importlib.util
+
+__all__ = ["EXTRAS", "install_hint", "installed"]
+
+EXTRAS: dict[str, tuple[tuple[str, ...], str]] = {
+    "ros": (("rclpy", "squeeze_grasp_interfaces", "mcap", "ament_index_python", "std_msgs",
+             "geometry_msgs", "sensor_msgs", "visualization_msgs", "rosgraph_msgs",
+             "action_msgs", "builtin_interfaces", "unique_identifier_msgs"),
+            "pip install '.[ros]' && squeeze-grasp ros-setup (or source a ROS 2 Jazzy "
+            "workspace with squeeze_grasp_interfaces built)"),
+    "sweep": (("dask", "distributed", "pyarrow"), "pip install '.[sweep]'"),
+}
+"""Extra -> (top-level modules it provides, how to install it)."""
+
+
+def installed(module: str) -> bool:
+    """True if ``module`` can be found (without importing it)."""
+    try:
+        return importlib.util.find_spec(module) is not None
+    except ImportError:
+        return False
+
+
+def install_hint(module: str) -> str | None:
+    """How to install the extra that provides top-level ``module`` (None: not an extra's)."""
+    root = module.split(".")[0]
+    return next((how for modules, how in EXTRAS.values() if root in modules), None)

@@ -328,9 +328,14 @@ def test_dry_run_and_report(tmp_path, capsys):
     store = Store(tmp_path / "o", loaded, tasks)
     rows = []
     for task in tasks:
-        part = run_task(task)["rows"]
-        store.write(task, part)
-        rows += part
+        res = run_task(task)
+        store.write(task, res["rows"], res["outline"])
+        rows += res["rows"]
+    from squeeze_grasp_ros.sweep.store import read_outlines
+    outlines = read_outlines(tmp_path / "o")
+    assert sorted(outlines) == sorted({t.obj.id for t in tasks})
+    xy = np.array(outlines[tasks[0].obj.id])
+    assert np.allclose(np.hypot(xy[:, 0] / 0.05, xy[:, 1] / 0.035), 1.0, atol=1e-3)
     assert main(["sweep-report", str(tmp_path / "o"), "--json", "--plot",
                  str(tmp_path / "plots")]) == 0
     rep = json.loads(capsys.readouterr().out)

@@ -24,14 +24,14 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 def run(args: argparse.Namespace) -> dict:
     """Read the dataset and summarise it."""
     require_extra()
-    from ..sweep.store import read_dataset, read_manifest
+    from ..sweep.store import read_dataset, read_manifest, read_outlines
     manifest = read_manifest(args.out)
     rows = read_dataset(args.out).to_pylist()
     out = {"out": args.out, "manifest": {k: manifest[k] for k in
                                          ("name", "spec_hash", "package_version", "counts")},
            **summarise(rows, args.best)}
     if args.plot and rows:
-        out["plots"] = plot(rows, args.plot)
+        out["plots"] = plot(rows, args.plot, read_outlines(args.out))
     return out
 
 

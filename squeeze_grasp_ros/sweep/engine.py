@@ -192,7 +192,7 @@ def run_sweep(loaded: LoadedSpec, out: str | Path, *, scheduler: Optional[str] =
                     bar.update(0)
                     continue
                 rows = result["rows"]
-                store.write(task, rows)
+                store.write(task, rows, result["outline"])
                 outcome.done += 1
                 outcome.evaluations += len(rows)
                 outcome.errors += sum(1 for r in rows if r.get("error"))

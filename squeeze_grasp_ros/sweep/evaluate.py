@@ -214,8 +214,9 @@ def evaluate(task: Task, group: Group, index: int, params, resist: dict) -> dict
 
 
 def run_task(task: Task) -> dict:
-    """Evaluate a task; returns ``{"rows": [...], "prepare_s": s, "cached": bool,
-    "evaluate_s": s}`` (rows sorted by ``eval_id``)."""
+    """Evaluate a task; returns ``{"rows": [...], "outline": [[x, y], ...], "prepare_s": s,
+    "cached": bool, "evaluate_s": s}`` (rows sorted by ``eval_id``; the outline is the mesh's
+    outer boundary loop, m, for the report's pictures)."""
     cached = (task.spec_hash, task.group) in _CACHE
     group = prepare(task)
     start = time.perf_counter()
@@ -223,6 +224,8 @@ def run_task(task: Task) -> dict:
     for index in range(task.start, min(task.stop, len(group.placements))):
         for params in task.params:
             rows.append(evaluate(task, group, index, params, resist))
+    mesh = group.obj.mesh
     return {"rows": sorted(rows, key=lambda r: r["eval_id"]),
+            "outline": mesh.nodes[mesh.boundary].tolist(),
             "prepare_s": 0.0 if cached else group.prepare_s, "cached": cached,
             "evaluate_s": time.perf_counter() - start}

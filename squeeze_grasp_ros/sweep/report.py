@@ -103,9 +103,10 @@ def text(summary: dict, manifest: dict) -> str:
     return "\n".join(lines)
 
 
-def plot(rows: list[dict], directory: str | Path) -> list[str]:
-    """Quality map over placements per object (chords between the contact points coloured by
-    quality, failures grey) and success rate against friction and depth; PNG paths."""
+def plot(rows: list[dict], directory: str | Path, outlines: dict | None = None) -> list[str]:
+    """Quality map over placements per object (its outline, chords between the contact points
+    coloured by quality, failures grey) and success rate against friction and depth; PNG
+    paths. ``outlines``: object id -> boundary loop [[x, y], ...], m."""
     from matplotlib import colormaps
 
     from .. import plots
@@ -117,6 +118,10 @@ def plot(rows: list[dict], directory: str | Path) -> list[str]:
     cmap = colormaps["viridis"]
     for ax, obj in zip(axes, objects):
         mine = [r for r in rows if r["object_id"] == obj]
+        if outlines and obj in outlines:
+            loop = np.array(outlines[obj] + outlines[obj][:1])
+            ax.plot(loop[:, 0], loop[:, 1], color="0.4", lw=0.8)
+        ax.set_aspect("equal")
         good = [r for r in mine if r[qkey] is not None and success(r)]
         for r in mine:
             if not success(r):

@@ -6,6 +6,7 @@ Layout::
 
     DIR/manifest.json           spec, spec hash, package version, per-task status
     DIR/parts/<task id>.parquet one file per finished task (rows sorted by eval_id)
+    DIR/outlines/<object id>.json  the object's meshed outer boundary, m (for pictures)
 
 Parts are written to a temporary file in ``parts/``, flushed to disk and renamed into place,
 so a part either exists complete or not at all, whatever kills the process. A part's existence
@@ -92,8 +93,15 @@ class Store:
         """The task's part exists (it is complete: parts appear by rename)."""
         return self.part(task_id).exists()
 
-    def write(self, task: Task, rows: list[dict]) -> int:
-        """Write a task's rows atomically and update the manifest; returns the row count."""
+    def write(self, task: Task, rows: list[dict], outline: list | None = None) -> int:
+        """Write a task's rows (and its object's outline, once) atomically and update the
+        manifest; returns the row count."""
+        if outline is not None:
+            path = self.out / "outlines" / f"{task.obj.id}.json"
+            if not path.exists():
+                path.parent.mkdir(exist_ok=True)
+                text = json.dumps({"object_id": task.obj.id, "outline": outline})
+                _atomic_write(path, lambda p: p.write_text(text))
         table = pa.Table.from_pylist(rows, schema=SCHEMA)
         _atomic_write(self.part(task.id), lambda p: pq.write_table(table, p))
         self.errors.pop(task.id, None)
@@ -136,6 +144,12 @@ def read_dataset(out: str | Path) -> pa.Table:
         return SCHEMA.empty_table()
     table = pa.concat_tables([pq.read_table(f, schema=SCHEMA) for f in files])
     return table.sort_by("eval_id")
+
+
+def read_outlines(out: str | Path) -> dict[str, list]:
+    """Object id -> outer boundary loop [[x, y], ...], m, of the objects written so far."""
+    return {p.stem: json.loads(p.read_text())["outline"]
+            for p in sorted((Path(out) / "outlines").glob("*.json"))}
 
 
 def read_manifest(out: str | Path) -> dict:

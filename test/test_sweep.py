@@ -371,3 +371,20 @@ def test_outline_file_objects_travel_with_the_task(tmp_path):
     strip = [{k: v for k, v in r.items() if k != "time_s"} for r in first]
     assert strip == [{k: v for k, v in r.items() if k != "time_s"} for r in again]
     assert all(r["error"] is None for r in first)
+
+
+def test_a_failed_task_is_recorded_and_redone(tmp_path):
+    from squeeze_grasp_ros.sweep.store import Store
+    loaded = parse_sweep_spec(SMALL, tmp_path)
+    tasks = plan_tasks(loaded)
+    store = Store(tmp_path / "o", loaded, tasks)
+    store.fail(tasks[0], "MechanicsError: boom")
+    manifest = json.loads((tmp_path / "o" / "manifest.json").read_text())
+    assert manifest["tasks"][tasks[0].id] == {"status": "failed", "error": "MechanicsError: boom"}
+    assert manifest["counts"] == {"done": 0, "failed": 1, "pending": len(tasks) - 1}
+    again = Store(tmp_path / "o", loaded, tasks)
+    assert not again.done(tasks[0].id)
+    res = run_task(tasks[0])
+    again.write(tasks[0], res["rows"], res["outline"])
+    manifest = json.loads((tmp_path / "o" / "manifest.json").read_text())
+    assert manifest["tasks"][tasks[0].id]["status"] == "done"

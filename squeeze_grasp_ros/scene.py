@@ -505,16 +505,20 @@ def parse_scene(data: Any, base_dir: Path | None = None) -> Scene:
     return scene
 
 
-def load_scene(path: str | Path) -> Scene:
-    """Read and validate a YAML scene file."""
+def read_yaml(path: str | Path, what: str = "scene") -> Any:
+    """The YAML document of a ``what`` file; SceneError if it is missing or not YAML."""
     path = Path(path)
     if not path.is_file():
-        raise SceneError(f"scene file not found: {path}")
+        raise SceneError(f"{what} file not found: {path}")
     try:
-        data = yaml.safe_load(path.read_text())
+        return yaml.safe_load(path.read_text())
     except yaml.YAMLError as exc:
         raise SceneError(f"{path}: invalid YAML: {exc}") from None
-    return parse_scene(data, base_dir=path.parent)
+
+
+def load_scene(path: str | Path) -> Scene:
+    """Read and validate a YAML scene file."""
+    return parse_scene(read_yaml(path), base_dir=Path(path).parent)
 
 
 def build_outline(shape: dict) -> shapes.Outline:

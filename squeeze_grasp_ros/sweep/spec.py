@@ -17,10 +17,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Optional
 
-import yaml
-
 from ..scene import (MaterialSpec, MeshSpec, Scene, SceneError, _validate_shape, build_outline,
-                     key_reference, load_scene, parse_section, spec)
+                     key_reference, load_scene, parse_section, read_yaml, spec)
 
 
 class SweepError(SceneError):
@@ -320,14 +318,11 @@ def parse_sweep_spec(data: Any, base_dir: Path) -> LoadedSpec:
 
 def load_sweep_spec(path: str | Path) -> LoadedSpec:
     """Read and validate a sweep YAML file."""
-    path = Path(path)
-    if not path.is_file():
-        raise SweepError(f"sweep spec not found: {path}")
     try:
-        data = yaml.safe_load(path.read_text())
-    except yaml.YAMLError as exc:
-        raise SweepError(f"{path}: invalid YAML: {exc}") from None
-    return parse_sweep_spec(data, path.parent)
+        data = read_yaml(path, "sweep spec")
+    except SceneError as exc:
+        raise SweepError(str(exc)) from None
+    return parse_sweep_spec(data, Path(path).parent)
 
 
 def sweep_help() -> str:

@@ -58,7 +58,7 @@ setup(
         # squeeze-grasp sweep: Dask distributed runs the tasks, pyarrow writes the Parquet dataset
         "sweep": ["dask[distributed]>=2024.1", "pyarrow>=14"],
         "test": ["pytest>=7", "hypothesis>=6", "scikit-fem>=9", "rosbags>=0.10", "mcap>=1.1",
-                 "mcap-ros2-support>=0.5"],
+                 "mcap-ros2-support>=0.5", "colcon-common-extensions>=0.3"],
     },
     zip_safe=True,
     maintainer="squeeze_grasp_ros developers",

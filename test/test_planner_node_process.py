@@ -2,8 +2,8 @@
 # SPDX-License-Identifier: Apache-2.0
 """The planner as its own process (console script and ``python -m``), called from this one.
 
-Across processes the first request can be lost even after ``wait_for_service`` (ROS_CONVENTIONS
-§0), so requests are re-sent when no answer comes: the planner's requests are idempotent.
+Across processes the first request can be lost even after ``wait_for_service`` (docs/design.md
+§5), so requests are re-sent when no answer comes: the planner's requests are idempotent.
 """
 from __future__ import annotations
 

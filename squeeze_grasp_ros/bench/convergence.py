@@ -3,8 +3,9 @@
 """Mesh resolution -> error and time for a converging quantity, and the drift of one that does not.
 
 Converging: the disk's perpendicular diameter change per unit diametral force (far field), against
-the closed form. Not converging (DEFINITIONS.md): the point-contact stable stiffness 1/(u^T A u),
-whose displacement under the load grows like log(1/h); it is shown as drift, not error.
+the closed form. Not converging (docs/design.md §2): the point-contact stable stiffness
+1/(u^T A u), whose displacement under the load grows like log(1/h); it is shown as drift, not
+error.
 """
 from __future__ import annotations
 

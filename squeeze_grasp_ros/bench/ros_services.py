@@ -13,9 +13,9 @@ Three questions, each answered in one run:
    planner's worker, first alone (the executor thread's CPU time shows whether the executor
    waits or spins), then while ``plan_squeeze`` requests keep arriving.
 
-Targets (issue 12): overhead < 2 ms in one process, < 5 ms across processes, a cached stable
-squeeze request < 10 ms end to end. Without rclpy and the interfaces (``pip install -e
-'.[ros]' && squeeze-grasp ros-setup``) the section reports that it was skipped.
+Targets: overhead < 2 ms in one process, < 5 ms across processes, a cached stable
+squeeze request < 10 ms end to end. Without rclpy and the interfaces ``squeeze-grasp bench``
+skips this section and says what to install (``bench.REQUIREMENTS``).
 """
 from __future__ import annotations
 

@@ -65,7 +65,7 @@ class ProgressBar:
 
 
 def run(args: argparse.Namespace) -> dict:
-    """Run the squeeze; JSON keys per DEFINITIONS.md (see docs/events.md)."""
+    """Run the squeeze; JSON keys per docs/design.md §2 (see docs/events.md)."""
     loaded = load_solid(args.scene, args.solver)
     start = time.perf_counter()
     if not args.reference:

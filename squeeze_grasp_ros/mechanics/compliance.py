@@ -1,6 +1,6 @@
 # Copyright 2026 squeeze_grasp_ros developers
 # SPDX-License-Identifier: Apache-2.0
-"""Contact compliance: the pseudo-inverse K+ applied by sparse factorisation (ARCHITECTURE §4).
+"""Contact compliance: the pseudo-inverse K+ applied by sparse factorisation (docs/design.md §3).
 
 The paper's A (eq. 23) is the contact block of K+. Two routes compute K+ b for equilibrated
 loads:

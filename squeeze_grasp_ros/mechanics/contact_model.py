@@ -13,7 +13,7 @@ solved by Newton on the sliding angles. Totals, not increments, are used: F = C 
 for the final contact set with total displacements (the one-shot invariant of Sec. 5.3), so
 the state between events is a function of the finger positions alone and does not drift.
 
-Costs (ARCHITECTURE §4): per contact set a gather of the cached boundary compliance (O(m^2)) and
+Costs (docs/design.md §3): per contact set a gather of the cached boundary compliance (O(m^2)) and
 a null-space reduction (O(m^3)), cached by the set; per evaluation O(m^2 |P|) for Newton and
 O(b m) for the boundary displacements used by Event A. The element strain map (2m sparse
 solves per set) is built only when a strain limit is declared.

@@ -104,7 +104,7 @@ class ContactState:
         Sorted by node index.
     depth : float
         Accumulated squeeze depth, m: the sum over steps of the norm of the stacked finger
-        translations (rho of DEFINITIONS.md for a unit squeeze direction).
+        translations (rho of docs/design.md §2 for a unit squeeze direction).
     relative_per_depth : float
         Relative depth per unit depth, 1/m (approach per depth / initial contact distance);
         0 when the motion is not a squeeze.

@@ -23,7 +23,7 @@ from .errors import MechanicsError
 from .mesh import Mesh
 
 FINGER_NAMES: tuple[str, ...] = ("F1", "F2", "A")
-"""Finger names in their canonical order (DEFINITIONS.md): the two squeezing fingers, then
+"""Finger names in their canonical order (docs/design.md §2): the two squeezing fingers, then
 the adversary."""
 
 

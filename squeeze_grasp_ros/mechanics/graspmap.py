@@ -8,7 +8,7 @@ friction coefficient mu. Vectorised over all b^2 pairs from the cached boundary 
 no solve per pair.
 
 Point-contact stiffnesses depend on the mesh (a 2-D point load has unbounded displacement
-under it; DEFINITIONS.md): compare placements on one mesh, never across meshes.
+under it; docs/design.md §2): compare placements on one mesh, never across meshes.
 """
 from __future__ import annotations
 

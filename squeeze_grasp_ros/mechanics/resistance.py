@@ -16,7 +16,7 @@ minimised over (d1, d2) for a given adversary translation a, under one of two co
   d1 = tau t + eta n, t the unit vector of p - q (contact centroids of F1, F2), (55)/(66) fixes
   eta (eq. 59) and W_F = 1/2 b2 tau^2 + b1 tau + b0 (eq. 60). b2 = t^T H t > 0 always
   (Theorem 11, Proposition 12), so tau* = -b1/b2 is the unique optimum for every p_k, including
-  the midpoint of p_i p_j (DEFINITIONS.md: the null space of H matters only without (55)).
+  the midpoint of p_i p_j (docs/design.md §2: the null space of H matters only without (55)).
 * **pure** (Delta in col(AC) = null(E^T), Theorem 7): x = U tau with U an orthonormal basis of
   null(E^T P) (App. D; for point contacts U spans col(AC)) and a = Q tau, Q = (0, I2) U
   (eq. 62). If a is outside col(Q) (possible only when rank Q < 2) the adversary cannot be

@@ -5,7 +5,7 @@
 A *stable* squeeze is the unit contact displacement maximising the strain energy: the top
 eigenvector of C (Sec. 3.5); for two contacts it is u of eq. (40) and C = u u^T / (u^T A u)
 (Theorem 10). A *pure* squeeze deforms without rigid motion: v = A C u / ||A C u|| (eq. 44;
-col(AC) are the pure contact displacements, Theorem 8). Depths follow DEFINITIONS.md.
+col(AC) are the pure contact displacements, Theorem 8). Depths follow docs/design.md §2.
 """
 from __future__ import annotations
 

@@ -78,7 +78,7 @@ def squeeze_to_depth(model: ContactModel, state: ContactState,
         Start state (its ``depth`` is the start depth).
     directions : mapping
         Finger name -> translation per unit depth (m/m); the stacked vector should have norm 1
-        so that depth is rho of DEFINITIONS.md.
+        so that depth is rho of docs/design.md §2.
     depth : float
         Depth to add, m (>= 0).
     step, event_tol : float
@@ -271,7 +271,7 @@ class EventSqueeze:
         return {t: sum(1 for e in self.events if e.type == t) for t in EVENT_TYPES}
 
     def to_json(self) -> dict:
-        """JSON-able dict with the keys of DEFINITIONS.md and issue 10."""
+        """JSON-able dict with the keys and names of docs/design.md §2 and docs/events.md."""
         radii = list(self.tip_radius.values())
         return {
             "termination": self.termination,
@@ -368,7 +368,7 @@ def event_squeeze(obj: ElasticObject, contacts: tuple[int, int],
         Squeeze directions from :func:`plan_squeeze` (ignored when ``directions`` is given).
     depth, relative_depth : float
         Exactly one: squeeze depth rho, m, or the finger approach over the initial contact
-        distance (DEFINITIONS.md).
+        distance (docs/design.md §2).
     limits : Limits, optional
         Strain limit and pickup weight.
     step, event_tol : float

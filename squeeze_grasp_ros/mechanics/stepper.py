@@ -1,6 +1,6 @@
 # Copyright 2026 squeeze_grasp_ros developers
 # SPDX-License-Identifier: Apache-2.0
-"""The incremental event stepper (paper Sec. 5.2-5.4, Algorithm 1 lines 4-15; DEFINITIONS.md).
+"""The incremental event stepper (paper Sec. 5.2-5.4, Algorithm 1 lines 4-15; docs/design.md §2).
 
 :func:`advance` moves any number of fingertips by given translations from a frozen
 :class:`~.contact_state.ContactState` and returns the new state with the events it located.

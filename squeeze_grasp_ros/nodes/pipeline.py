@@ -3,12 +3,12 @@
 """Topics, QoS, parameters and the lockstep handshake shared by the pipeline nodes.
 
 Topic names are relative (so a namespace or a remap moves them); devices get
-``devices/<device>/{setpoint,pose,wrench,tactile}``. QoS (ROS_CONVENTIONS.md): commands,
+``devices/<device>/{setpoint,pose,wrench,tactile}``. QoS (docs/design.md §5): commands,
 states and events reliable; sensor streams reliable in simulation (the lockstep loop must not
 lose a reading) and ``sensor_data`` (best effort) on hardware, chosen by the ``sensor_qos``
 parameter; latched data (the prediction, the object pose) transient-local.
 
-Lockstep start-up (ARCHITECTURE.md §9): a publisher that reports its subscriber as matched can
+Lockstep start-up (docs/design.md §4): a publisher that reports its subscriber as matched can
 still lose the first messages across processes. So the driver (``sim_hardware``, or the
 replayer) repeats ``sim/hello`` on a wall-clock timer and starts tick 0 only when every
 participant it waits for has answered on ``sim/ready``; a participant answers each hello once

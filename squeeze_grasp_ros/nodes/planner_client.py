@@ -4,7 +4,7 @@
 
 :class:`PlannerClient` spins the given executor in the calling thread until a response
 arrives (a ``spin_once`` loop with a deadline: rclpy 7.1.6's ``spin_until_future_complete``
-leaves tasks behind when used in a loop, ROS_CONVENTIONS §0). Across processes the first
+leaves tasks behind when used in a loop, docs/design.md §5). Across processes the first
 request can be lost even after ``wait_for_service``; ``attempts`` re-sends it (the planner's
 requests are idempotent).
 """

@@ -492,7 +492,7 @@ class PipelineRunner:
         """Send the plan's goal and wait until it is accepted.
 
         Across processes a service response can be lost while discovery is still settling
-        (ROS_CONVENTIONS §0: the first messages after matching). The goal ids are ours, so a
+        (docs/design.md §5: the first messages after matching). The goal ids are ours, so a
         goal whose acceptance shows on the action's status topic counts as accepted even if the
         response never came; after ``GOAL_RESPONSE_TIMEOUT`` without either the request is sent
         again with a new id, and whichever request is accepted first is the goal (the executor

@@ -4,7 +4,7 @@
 
 Run it with ``ros2 run squeeze_grasp_ros sim_hardware --ros-args --params-file
 config/sim_hardware.yaml -p scene:=config/scenes/foam_square.yaml``. It owns ``/clock`` and
-advances it in lockstep (ARCHITECTURE.md §9), driven by messages, never by timers:
+advances it in lockstep (docs/design.md §4), driven by messages, never by timers:
 
 1. after the start-up handshake (``sim/hello`` / ``sim/ready``) it publishes tick 0;
 2. a tick k is ``/clock`` = t_k, every device's ``pose``, ``wrench`` and ``tactile`` reading

@@ -62,7 +62,7 @@ def squeeze_geometry(scene: Scene, obj: ElasticObject,
     """(finger -> translation per unit depth (m/m), relative depth per unit depth (1/m)).
 
     The scene's stable or pure squeeze (:func:`..mechanics.squeeze.plan_squeeze`; approach
-    ||u_1 - u_2|| per unit depth, DEFINITIONS.md), or its user-given ``fingers.<F>.direction``
+    ||u_1 - u_2|| per unit depth, docs/design.md §2), or its user-given ``fingers.<F>.direction``
     scaled to a unit stacked vector (approach along the chord of the contacts), as the
     event-driven squeeze sets them up.
     """

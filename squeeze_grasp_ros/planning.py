@@ -28,8 +28,8 @@ from enum import IntEnum
 from pathlib import Path
 
 import numpy as np
-import yaml
 
+from .inputs import InputError, confine, load_yaml, read_text
 from .mechanics.compliance import ROUTES, ElasticObject
 from .mechanics.contact_model import ContactModel
 from .mechanics.errors import InfeasibleError, MechanicsError
@@ -45,7 +45,7 @@ from .mechanics.ring_squeeze import RingGrasp, ring_grasp
 from .mechanics.squeeze import Squeeze, force_closure, plan_squeeze
 from .mechanics.squeeze_events import EventSqueeze
 from .scene import (Scene, SceneError, build_mesh, build_outline, build_ring, finger_nodes,
-                    load_scene, parse_scene, scene_material)
+                    parse_scene, scene_material)
 from .scene_events import event_squeeze_scene
 
 SQUEEZE_TYPES: tuple[str, ...] = ("stable", "pure")
@@ -219,25 +219,43 @@ class SceneSource:
     text: str
 
 
-def read_scene(scene_yaml: str, scene_path: str) -> SceneSource:
+def read_scene(scene_yaml: str, scene_path: str, roots: Sequence[str | Path] | None = None
+               ) -> SceneSource:
     """Parse the scene of a request: exactly one of YAML text and a file path.
+
+    Parameters
+    ----------
+    scene_yaml, scene_path : str
+        The request's fields; exactly one is non-empty.
+    roots : sequence of path-like, optional
+        Folders that ``scene_path`` and an outline file named by the scene must lie in (after
+        following symlinks and ``..``); None allows any path.
 
     Raises
     ------
     PlannerError
-        INVALID_ARGUMENT for neither or both, unreadable files, bad YAML or a bad scene (the
-        message names the field).
+        INVALID_ARGUMENT for neither or both, paths outside ``roots``, unreadable or oversized
+        files, YAML aliases, bad YAML or a bad scene (the message names the field and never
+        quotes a file's contents).
     """
     if bool(scene_yaml) == bool(scene_path):
         raise invalid("give exactly one of scene_yaml and scene_path")
-    if scene_path:
-        scene = load_scene(scene_path)
-        return SceneSource(scene, Path(scene_path).read_text())
     try:
-        data = yaml.safe_load(scene_yaml)
-    except yaml.YAMLError as exc:
-        raise invalid(f"scene_yaml: invalid YAML: {exc}") from None
-    return SceneSource(parse_scene(data), scene_yaml)
+        if scene_path:
+            path = confine(scene_path, roots, what="scene_path") if roots is not None \
+                else Path(scene_path)
+            text = read_text(path, what="scene_path")
+            data, base_dir = load_yaml(text, what="scene_path"), path.parent
+        else:
+            text = scene_yaml
+            data, base_dir = load_yaml(scene_yaml, what="scene_yaml"), None
+        scene = parse_scene(data, base_dir=base_dir)
+        shape = scene.object.shape
+        if roots is not None and shape["type"] == "file":
+            confine(shape["path"], roots, what="object.shape.path")
+    except InputError as exc:
+        raise invalid(str(exc)) from None
+    return SceneSource(scene, text)
 
 
 def requested_nodes(scene: Scene) -> int | None:

@@ -21,8 +21,8 @@ from pathlib import Path
 from typing import Any, Optional
 
 import numpy as np
-import yaml
 
+from .inputs import InputError, load_yaml, read_text
 from .mechanics import shapes
 from .mechanics.errors import MechanicsError
 from .mechanics.material import Material
@@ -507,13 +507,10 @@ def parse_scene(data: Any, base_dir: Path | None = None) -> Scene:
 
 def read_yaml(path: str | Path, what: str = "scene") -> Any:
     """The YAML document of a ``what`` file; SceneError if it is missing or not YAML."""
-    path = Path(path)
-    if not path.is_file():
-        raise SceneError(f"{what} file not found: {path}")
     try:
-        return yaml.safe_load(path.read_text())
-    except yaml.YAMLError as exc:
-        raise SceneError(f"{path}: invalid YAML: {exc}") from None
+        return load_yaml(read_text(path, what=what), what=f"{what} {path}")
+    except InputError as exc:
+        raise SceneError(str(exc)) from None
 
 
 def load_scene(path: str | Path) -> Scene:

@@ -16,6 +16,7 @@ from typing import Sequence
 import numpy as np
 from scipy.interpolate import CubicSpline
 
+from ..inputs import InputError, read_text
 from .errors import MechanicsError
 
 DENSE = 2048
@@ -59,21 +60,30 @@ def signed_area(points: np.ndarray) -> float:
 
 
 def _segments_intersect(p: np.ndarray) -> bool:
-    """True if any two non-adjacent edges of the closed polyline ``p`` properly cross.
+    """True if the closed polyline ``p`` is not simple: two non-adjacent edges cross or touch
+    (a repeated vertex, a vertex on another edge, overlapping edges), or two adjacent edges fold
+    back onto each other (a zero-width spike).
 
     Broad phase: edges sorted by their left end; each edge is only paired with the following
     edges whose x-range starts before its own ends (a sweep over x), then with bounding-box
-    overlap in y; narrow phase: orientation tests on the surviving pairs.
+    overlap in y; narrow phase: orientation tests on the surviving pairs, with collinearity
+    judged to 1e-12 of the squared size.
     """
     a, b = p, np.roll(p, -1, axis=0)
     n = len(p)
-    lo, hi = np.minimum(a, b), np.maximum(a, b)
+    size = max(float(np.ptp(p, axis=0).max()), 1e-300)
+    tol = 1e-12 * size
+    edge = b - a
+    cross_turn = np.roll(edge, 1, axis=0)[:, 0] * edge[:, 1] - np.roll(edge, 1, axis=0)[:, 1] * edge[:, 0]
+    dot_turn = np.einsum("ij,ij->i", np.roll(edge, 1, axis=0), edge)
+    if np.any((np.abs(cross_turn) <= tol * size) & (dot_turn < 0)):
+        return True
+    lo, hi = np.minimum(a, b) - tol, np.maximum(a, b) + tol
     order = np.argsort(lo[:, 0], kind="stable")
     reach = np.searchsorted(lo[order, 0], hi[order, 0], side="right")
-    counts = reach - np.arange(n) - 1
-    first = np.repeat(np.arange(n), np.maximum(counts, 0))
-    second = first + 1 + (np.arange(len(first)) - np.repeat(np.cumsum(np.maximum(counts, 0))
-                                                             - np.maximum(counts, 0), np.maximum(counts, 0)))
+    counts = np.maximum(reach - np.arange(n) - 1, 0)
+    first = np.repeat(np.arange(n), counts)
+    second = first + 1 + (np.arange(len(first)) - np.repeat(np.cumsum(counts) - counts, counts))
     i, j = order[first], order[second]
     keep = (lo[i, 1] <= hi[j, 1]) & (lo[j, 1] <= hi[i, 1])
     gap = np.abs(i - j)
@@ -81,19 +91,27 @@ def _segments_intersect(p: np.ndarray) -> bool:
     i, j = i[keep], j[keep]
 
     def orient(o, q, r):
-        return np.sign((q[:, 0] - o[:, 0]) * (r[:, 1] - o[:, 1])
-                       - (q[:, 1] - o[:, 1]) * (r[:, 0] - o[:, 0]))
+        value = (q[:, 0] - o[:, 0]) * (r[:, 1] - o[:, 1]) - (q[:, 1] - o[:, 1]) * (r[:, 0] - o[:, 0])
+        return np.where(np.abs(value) <= tol * size, 0.0, np.sign(value))
+
+    def on_segment(o, q, r, side):
+        inside = np.all((np.minimum(o, q) - tol <= r) & (r <= np.maximum(o, q) + tol), axis=1)
+        return (side == 0) & inside
 
     d1, d2 = orient(a[i], b[i], a[j]), orient(a[i], b[i], b[j])
     d3, d4 = orient(a[j], b[j], a[i]), orient(a[j], b[j], b[i])
-    return bool(np.any((d1 * d2 < 0) & (d3 * d4 < 0)))
+    proper = (d1 * d2 < 0) & (d3 * d4 < 0)
+    touch = (on_segment(a[i], b[i], a[j], d1) | on_segment(a[i], b[i], b[j], d2)
+             | on_segment(a[j], b[j], a[i], d3) | on_segment(a[j], b[j], b[i], d4))
+    return bool(np.any(proper | touch))
 
 
 def validate_polyline(points, name: str = "outline") -> np.ndarray:
     """Return ``points`` as a counter-clockwise (N, 2) array, or raise a clear error.
 
-    Rejects fewer than 3 distinct vertices, non-finite values, zero area and
-    self-intersections. Repeated consecutive vertices (and a repeated closing vertex) are dropped.
+    Rejects fewer than 3 distinct vertices, non-finite values, zero area and curves that are
+    not simple (edges that cross or touch, repeated vertices, zero-width spikes): the mesher
+    crashes on those. Repeated consecutive vertices (and a repeated closing vertex) are dropped.
     """
     p = np.asarray(points, dtype=float)
     if p.ndim != 2 or p.shape[1] != 2:
@@ -111,7 +129,9 @@ def validate_polyline(points, name: str = "outline") -> np.ndarray:
     if area < 0:
         p = p[::-1].copy()
     if _segments_intersect(p):
-        raise MechanicsError(f"{name} is self-intersecting; give a simple closed curve")
+        raise MechanicsError(f"{name} is self-intersecting: two edges cross or touch (a "
+                             "repeated vertex, a vertex on another edge or a zero-width spike); "
+                             "give a simple closed curve")
     return p
 
 
@@ -201,26 +221,60 @@ def annulus(outer_radius: float, inner_radius: float) -> Outline:
     return Outline(disk(outer_radius).points, holes=(hole,))
 
 
+MAX_OUTLINE_POINTS = 100_000
+"""Vertices an outline file may have at most."""
+
+
+def _csv_points(text: str, name: str) -> list[list[float]]:
+    """``x,y`` rows of a CSV outline (``#`` comments and blank lines skipped)."""
+    pts = []
+    for number, line in enumerate(text.splitlines(), start=1):
+        line = line.split("#", 1)[0].strip()
+        if not line:
+            continue
+        cells = line.split(",")
+        try:
+            if len(cells) != 2:
+                raise ValueError
+            pts.append([float(cells[0]), float(cells[1])])
+        except ValueError:
+            raise MechanicsError(f"{name}: line {number} is not 'x,y' (two numbers, metres)") from None
+        if len(pts) > MAX_OUTLINE_POINTS:
+            raise MechanicsError(f"{name}: more than {MAX_OUTLINE_POINTS} points")
+    return pts
+
+
 def load_outline(path: str | Path) -> Outline:
     """Read an outline from CSV (``x,y`` per line, m) or JSON (``{"outline": [[x, y], ...]}``).
 
     The points are the vertices of a polygon; vertices where it turns by more than 20 degrees
-    are kept as corners when the outline is resampled.
+    are kept as corners when the outline is resampled. The file is read up to
+    :data:`~squeeze_grasp_ros.inputs.MAX_FILE_BYTES` and errors never quote its contents.
     """
     path = Path(path)
-    if not path.is_file():
-        raise MechanicsError(f"outline file not found: {path}")
+    name = f"outline file {path.name}"
+    try:
+        text = read_text(path, what="outline")
+    except InputError as exc:
+        raise MechanicsError(str(exc)) from None
     if path.suffix.lower() == ".json":
-        data = json.loads(path.read_text())
-        if not isinstance(data, dict) or "outline" not in data:
-            raise MechanicsError(f'{path}: JSON outline must be {{"outline": [[x, y], ...]}}')
-        pts = data["outline"]
-    else:
         try:
-            pts = np.loadtxt(path, delimiter=",", ndmin=2, comments="#")
-        except ValueError as exc:
-            raise MechanicsError(f"{path}: expected 'x,y' per line: {exc}") from None
-    p = validate_polyline(pts, f"outline file {path.name}")
+            data = json.loads(text)
+        except json.JSONDecodeError as exc:
+            raise MechanicsError(f"{name}: invalid JSON at line {exc.lineno}, column "
+                                 f"{exc.colno}") from None
+        if not isinstance(data, dict) or "outline" not in data:
+            raise MechanicsError(f'{name}: JSON outline must be {{"outline": [[x, y], ...]}}')
+        pts = data["outline"]
+        if not isinstance(pts, list) or len(pts) > MAX_OUTLINE_POINTS or not all(
+                isinstance(q, list) and len(q) == 2
+                and all(isinstance(c, (int, float)) and not isinstance(c, bool) for c in q)
+                for q in pts):
+            raise MechanicsError(f"{name}: 'outline' must be a list of at most "
+                                 f"{MAX_OUTLINE_POINTS} [x, y] number pairs")
+    else:
+        pts = _csv_points(text, name)
+    p = validate_polyline(pts, name)
     return Outline(p, corners=_turning_corners(p))
 
 

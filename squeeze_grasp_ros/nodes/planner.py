@@ -31,6 +31,7 @@ import queue
 import threading
 from collections.abc import Callable
 from concurrent.futures import ThreadPoolExecutor
+from pathlib import Path
 from typing import Any, TypeVar
 
 from rcl_interfaces.msg import ParameterDescriptor
@@ -47,6 +48,7 @@ from squeeze_grasp_interfaces.srv import (EventSqueeze, GraspMap, LoadObject, Pl
 
 from .. import messages, planning
 from ..planning import Cancelled, ErrorCode, Limits
+from ..resources import share_dir
 from . import run_node
 
 Response = TypeVar("Response")
@@ -62,6 +64,9 @@ PARAMETERS: dict[str, tuple[Any, str]] = {
     "worker_threads": (2, "threads computing long requests (loads, maps, event squeezes)"),
     "best_count": (10, "placements a grasp map returns when a request asks for 0"),
     "min_step": (1e-5, "smallest event-squeeze substep, relative to the object size"),
+    "allowed_roots": ([""], "folders whose files scene_path and a scene's outline file may "
+                            "name (symlinks and '..' resolved first); [''] = the package share "
+                            "folder and the node's working directory"),
 }
 """Parameter name -> (typed default, description); config/planner.yaml sets the same names."""
 
@@ -92,6 +97,8 @@ class PlannerNode(Node):
                              default_route=planning.solver_route(value("default_solver_route"),
                                                                  Limits()),
                              best_count=value("best_count"), min_step=float(value("min_step")))
+        roots = [Path(r) for r in value("allowed_roots") if r] or [share_dir(), Path.cwd()]
+        self.roots = list(dict.fromkeys(r.resolve() for r in roots))
         self.cache = planning.ObjectCache(value("cache_size"))
         self._pool = ThreadPoolExecutor(max_workers=value("worker_threads"),
                                         thread_name_prefix="planner-worker")
@@ -110,7 +117,8 @@ class PlannerNode(Node):
             ActionServer(self, EventSqueezeAction, "~/event_squeeze",
                          self._execute_event_squeeze, cancel_callback=self._accept_cancel),
         ]
-        self.get_logger().info(f"planner ready: {self.limits}")
+        self.get_logger().info(f"planner ready: {self.limits}; files from "
+                               f"{[str(r) for r in self.roots]}")
 
     def _parameter(self, name: str) -> Any:
         """The value of a declared parameter (an int given for a float is accepted)."""
@@ -122,7 +130,7 @@ class PlannerNode(Node):
                            response: LoadObject.Response) -> LoadObject.Response:
         """Mesh, factor and cache the scene's object on a worker."""
         def load() -> LoadObject.Response:
-            source = planning.read_scene(request.scene_yaml, request.scene_path)
+            source = planning.read_scene(request.scene_yaml, request.scene_path, self.roots)
             loaded, cached = planning.load_cached(self.cache, source, request.object_id,
                                                   request.solver_route, self.limits)
             return messages.load_object_response(loaded, cached, request.return_model)
@@ -189,7 +197,7 @@ class PlannerNode(Node):
             object_id = goal.object_id
             stages = 1
             if goal.scene_yaml or goal.scene_path:
-                source = planning.read_scene(goal.scene_yaml, goal.scene_path)
+                source = planning.read_scene(goal.scene_yaml, goal.scene_path, self.roots)
                 stages += len(planning.RING_STAGES if source.scene.object.model == "ring"
                               else planning.SOLID_STAGES)
                 loaded, _ = planning.load_cached(

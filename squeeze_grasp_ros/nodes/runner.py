@@ -24,6 +24,7 @@ Every wait spins the executor with a wall-clock timeout; nothing sleeps to synch
 from __future__ import annotations
 
 import importlib.util
+import json
 import os
 import signal
 import subprocess
@@ -64,7 +65,7 @@ from ..mechanics.contact_model import ContactModel
 from ..mechanics.resistance_friction import add_adversary, frictional_resistance
 from ..mechanics.squeeze import plan_squeeze
 from ..recording.bag import plain_yaml
-from ..resources import config_dir
+from ..resources import config_dir, share_dir
 from ..scene import (Scene, SceneError, build_mesh, finger_devices, finger_nodes, load_scene,
                      placement_node, scene_material)
 from ..scene_events import event_squeeze_scene
@@ -375,11 +376,22 @@ class PipelineRunner:
         return next(n for n in self.nodes if n.get_name() == name)
 
     # ----------------------------------------------------------------- planning
+    def _planner_roots(self) -> list[str]:
+        """Folders the run's own planner may read: the scene's (and its outline file's), the
+        package share folder and the working directory."""
+        folders = [Path(self.options.scene_path).resolve().parent, share_dir(), Path.cwd()]
+        shape = self.scene.object.shape
+        if shape["type"] == "file":
+            folders.append(Path(shape["path"]).resolve().parent)
+        return [str(f) for f in folders]
+
     def _start_planner(self) -> Callable[[], None]:
         """Start the planner (thread or process); return the function that stops it."""
+        roots = self._planner_roots()
         if self.options.processes:
             proc = subprocess.Popen([sys.executable, "-m", PLANNER_MODULE, "--ros-args",
-                                     "--params-file", str(config_dir() / "planner.yaml")],
+                                     "--params-file", str(config_dir() / "planner.yaml"),
+                                     "-p", f"allowed_roots:={json.dumps(roots)}"],
                                     stdin=subprocess.DEVNULL)
 
             def stop_process() -> None:
@@ -388,7 +400,8 @@ class PipelineRunner:
             return stop_process
         from .planner import PlannerNode
 
-        node = PlannerNode(context=self.context)
+        node = PlannerNode(context=self.context,
+                           parameter_overrides=[Parameter("allowed_roots", value=roots)])
         spinner = SingleThreadedExecutor(context=self.context)
         spinner.add_node(node)
         thread = threading.Thread(target=spinner.spin, name="planner", daemon=True)

@@ -1,0 +1,195 @@
+# Copyright 2026 squeeze_grasp_ros developers
+# SPDX-License-Identifier: Apache-2.0
+"""Hostile and careless inputs: each case ends in a clean error (or the right outcome), the node
+stays up, and no error message quotes a file's contents.
+
+Cases: polygons that are not simple (they crashed the mesher), paths outside the planner's
+allowed folders, files whose contents must not leak, YAML alias bombs, oversized and non-UTF-8
+files.
+"""
+from __future__ import annotations
+
+import subprocess
+import sys
+import time
+from collections.abc import Iterator
+from pathlib import Path
+
+import pytest
+import yaml
+from rclpy.context import Context
+
+from planner_support import BLOB, Harness
+from squeeze_grasp_ros.cli import main
+from squeeze_grasp_ros.inputs import MAX_FILE_BYTES
+from squeeze_grasp_ros.planning import ErrorCode
+from squeeze_grasp_ros.scene import SceneError, build_mesh, parse_scene
+from squeeze_grasp_interfaces.srv import LoadObject
+
+SPIKE = [[-0.05, -0.05], [0.05, -0.05], [0.05, 0.05], [0.0, 0.0], [-0.05, 0.05], [0.0, 0.0]]
+"""A square with a vertex repeated at a non-adjacent position: a zero-width spike that made the
+``triangle`` mesher segfault in about half the calls."""
+SECRET = "SECRET-MARKER-7f3a9c"
+"""Text planted in files that must never appear in an error message."""
+ALIAS_BOMB = "a: &a [x, x, x, x, x, x, x, x, x]\n" + "".join(
+    f"{chr(98 + k)}: &{chr(98 + k)} [*{chr(97 + k)}, *{chr(97 + k)}, *{chr(97 + k)}, "
+    f"*{chr(97 + k)}, *{chr(97 + k)}, *{chr(97 + k)}, *{chr(97 + k)}, *{chr(97 + k)}, "
+    f"*{chr(97 + k)}]\n" for k in range(8))
+"""Nine levels of nine-fold aliases: 9^9 strings once expanded, under 1 kB of text."""
+
+
+def scene_with_shape(shape: dict) -> dict:
+    data = yaml.safe_load(BLOB)
+    data["object"]["shape"] = shape
+    return data
+
+
+@pytest.fixture()
+def planner(ros_context: Context, tmp_path: Path) -> Iterator[Harness]:
+    """A planner whose allowed folder is ``tmp_path/allowed``."""
+    from rclpy.parameter import Parameter
+
+    (tmp_path / "allowed").mkdir()
+    harness = Harness(ros_context, parameter_overrides=[
+        Parameter("allowed_roots", value=[str(tmp_path / "allowed")])])
+    try:
+        yield harness
+    finally:
+        harness.close()
+
+
+def load(harness: Harness, **fields) -> LoadObject.Response:
+    return harness.call(LoadObject, "load_object", LoadObject.Request(**fields))
+
+
+def assert_alive(harness: Harness) -> None:
+    response = load(harness, scene_yaml=BLOB, object_id="alive")
+    assert response.success, response.message
+
+
+def test_spike_polygon_is_refused_before_meshing():
+    with pytest.raises(SceneError, match="self-intersecting"):
+        build_mesh(parse_scene(scene_with_shape({"type": "polygon", "points": SPIKE})))
+
+
+def test_random_grid_polygons_never_crash_the_mesher():
+    """300 random polygons on a coarse grid (repeated vertices, collinear runs and touching
+    edges are frequent) are either refused or meshed, in a child process that must not die."""
+    child = """
+import numpy as np
+from squeeze_grasp_ros.mechanics import shapes
+from squeeze_grasp_ros.mechanics.errors import MechanicsError
+from squeeze_grasp_ros.mechanics.mesh import generate_mesh
+rng = np.random.default_rng(2014)
+meshed = refused = 0
+for _ in range(300):
+    pts = rng.integers(0, 5, size=(rng.integers(3, 9), 2)) * 0.01
+    try:
+        outline = shapes.polygon(pts.tolist())
+    except MechanicsError:
+        refused += 1
+        continue
+    mesh = generate_mesh(outline, outline.area / 40, 25.0)
+    assert mesh.n >= 3
+    meshed += 1
+print(meshed, refused)
+"""
+    done = subprocess.run([sys.executable, "-c", child], capture_output=True, text=True,
+                          timeout=300)
+    assert done.returncode == 0, done.stderr[-2000:]
+    meshed, refused = map(int, done.stdout.split())
+    assert meshed > 20 and refused > 20
+
+
+def test_planner_survives_spike_polygons_and_answers(planner):
+    text = yaml.safe_dump(scene_with_shape({"type": "polygon", "points": SPIKE}))
+    for _ in range(20):
+        response = load(planner, scene_yaml=text)
+        assert response.error_code == ErrorCode.INVALID_ARGUMENT
+        assert "self-intersecting" in response.message
+    assert_alive(planner)
+
+
+def test_planner_refuses_paths_outside_its_folders(planner, tmp_path):
+    secret = tmp_path / "secret.csv"
+    secret.write_text(f"{SECRET},1\n")
+    inside = tmp_path / "allowed" / "scene.yaml"
+    inside.write_text(yaml.safe_dump(scene_with_shape({"type": "file", "path": str(secret)})))
+    escape = tmp_path / "allowed" / "link.yaml"
+    escape.symlink_to(secret)
+    cases = [dict(scene_path=str(secret)), dict(scene_path=str(escape)),
+             dict(scene_path=str(tmp_path / "allowed" / ".." / "secret.csv")),
+             dict(scene_path="/proc/self/environ"), dict(scene_path=str(inside)),
+             dict(scene_yaml=yaml.safe_dump(scene_with_shape({"type": "file",
+                                                              "path": str(secret)})))]
+    for fields in cases:
+        response = load(planner, **fields)
+        assert response.error_code == ErrorCode.INVALID_ARGUMENT, fields
+        assert "outside the allowed folders" in response.message, response.message
+        assert SECRET not in response.message
+    assert_alive(planner)
+
+
+def test_no_error_quotes_a_files_contents(planner, tmp_path):
+    allowed = tmp_path / "allowed"
+    (allowed / "bad_yaml.yaml").write_text(f"object: [{SECRET}: {{\n")
+    (allowed / "not_scene.yaml").write_text(f"{SECRET}\n")
+    (allowed / "bad_outline.csv").write_text(f"0,0\n{SECRET},1\n1,1\n")
+    (allowed / "bad_outline.json").write_text(f'{{"outline": [[0, 0], "{SECRET}"]}}')
+    (allowed / "binary.yaml").write_bytes(b"object:\n  " + SECRET.encode() + b"\xff\xfe\n")
+    outline_scenes = []
+    for name in ("bad_outline.csv", "bad_outline.json"):
+        path = allowed / f"scene_{name}.yaml"
+        path.write_text(yaml.safe_dump(scene_with_shape({"type": "file",
+                                                         "path": str(allowed / name)})))
+        outline_scenes.append(path)
+    paths = [allowed / "bad_yaml.yaml", allowed / "not_scene.yaml", allowed / "binary.yaml",
+             *outline_scenes]
+    for path in paths:
+        response = load(planner, scene_path=str(path))
+        assert response.error_code == ErrorCode.INVALID_ARGUMENT, path
+        assert SECRET not in response.message, response.message
+    for path in paths:
+        code = main(["mesh", str(path)])
+        assert code == 2, path
+    assert_alive(planner)
+
+
+def test_cli_errors_do_not_quote_contents(tmp_path, capsys):
+    bad = tmp_path / "bad.yaml"
+    bad.write_text(f"object: [{SECRET}: {{\n")
+    outline = tmp_path / "o.csv"
+    outline.write_text(f"0,0\n{SECRET},1\n")
+    scene = tmp_path / "scene.yaml"
+    scene.write_text(yaml.safe_dump(scene_with_shape({"type": "file", "path": str(outline)})))
+    for path in (bad, scene):
+        assert main(["mesh", str(path)]) == 2
+        err = capsys.readouterr().err
+        assert SECRET not in err and "error" in err
+
+
+def test_yaml_alias_bomb_is_refused_quickly(planner, tmp_path):
+    start = time.perf_counter()
+    response = load(planner, scene_yaml=ALIAS_BOMB)
+    assert response.error_code == ErrorCode.INVALID_ARGUMENT
+    assert "aliases" in response.message and len(response.message) < 300
+    path = tmp_path / "allowed" / "bomb.yaml"
+    path.write_text(ALIAS_BOMB)
+    assert "aliases" in load(planner, scene_path=str(path)).message
+    assert main(["plan", str(path)]) == 2
+    assert time.perf_counter() - start < 30  # the expanded document would take minutes
+    assert_alive(planner)
+
+
+def test_oversized_and_huge_text_inputs_are_refused(planner, tmp_path):
+    big = tmp_path / "allowed" / "big.yaml"
+    with open(big, "wb") as fh:
+        fh.truncate(MAX_FILE_BYTES + 1)
+    response = load(planner, scene_path=str(big))
+    assert response.error_code == ErrorCode.INVALID_ARGUMENT
+    assert "larger than" in response.message
+    response = load(planner, scene_yaml="# " + "x" * (2 * 1024 * 1024))
+    assert response.error_code == ErrorCode.INVALID_ARGUMENT
+    assert "larger than" in response.message
+    assert main(["mesh", str(big)]) == 2
+    assert_alive(planner)

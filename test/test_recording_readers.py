@@ -200,3 +200,56 @@ def test_shipped_viewers_show_what_a_recording_holds(default_bag):
     assert markers["Topic"]["Value"] in messages
     assert rviz["Global Options"]["Fixed Frame"] == frame
     assert set(markers["Namespaces"]) == {m.ns for m in messages["/sim/markers"].markers if m.ns}
+
+
+def test_corrupt_recordings_are_refused_never_misread(default_bag, tmp_path):
+    """Single-bit flips anywhere in the file (60 seeded positions plus one in every chunk's
+    data): read_bag either refuses the file or returns exactly the original messages."""
+    import numpy as np
+    from mcap.reader import make_reader as reader_of
+
+    from squeeze_grasp_ros.recording.bag import BagError, read_bag
+
+    original = read_bag(default_bag).messages
+    data = default_bag.read_bytes()
+    with open(default_bag, "rb") as f:
+        chunks = reader_of(f).get_summary().chunk_indexes
+    positions = [c.chunk_start_offset + c.chunk_length - 1 - c.compressed_size // 2
+                 for c in chunks]
+    positions += np.random.default_rng(7).integers(8, len(data) - 8, 60).tolist()
+    refused = 0
+    for k, position in enumerate(positions):
+        flipped = bytearray(data)
+        flipped[position] ^= 1 << (k % 8)
+        path = tmp_path / f"flip_{k}.mcap"
+        path.write_bytes(bytes(flipped))
+        try:
+            assert read_bag(path).messages == original, position
+        except BagError as exc:
+            assert "corrupt" in str(exc)
+            refused += 1
+    assert refused >= len(chunks)
+
+
+def test_replay_of_a_bare_mcap_and_odd_metadata_reproduces(default_bag, tmp_path):
+    import shutil
+
+    from squeeze_grasp_ros.cli import main
+
+    folder = default_bag.parent
+    bare_folder = tmp_path / "no_metadata"
+    bare_folder.mkdir()
+    shutil.copy(default_bag, bare_folder)
+    twice = tmp_path / "twice"
+    shutil.copytree(folder, twice)
+    meta = (twice / "metadata.yaml").read_text()
+    name = default_bag.name
+    (twice / "metadata.yaml").write_text(meta.replace(f"- {name}", f"- {name}\n  - {name}", 1))
+    assert meta != (twice / "metadata.yaml").read_text()
+    for target in (default_bag, bare_folder, twice):
+        assert main(["replay", str(target)]) == 0, target
+    corrupt = tmp_path / "corrupt.mcap"
+    data = bytearray(default_bag.read_bytes())
+    data[len(data) // 3] ^= 0x10
+    corrupt.write_bytes(bytes(data))
+    assert main(["replay", str(corrupt)]) == 2

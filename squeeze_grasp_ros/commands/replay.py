@@ -9,6 +9,8 @@ import sys
 
 import yaml
 
+from ..exit_codes import ExitCode
+
 HELP = ("replay a recording's sensor topics on its sim time into a fresh monitor and check that "
         "it reproduces the recorded event sequence")
 
@@ -24,7 +26,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 def run(args: argparse.Namespace) -> dict | int:
     """Replay; exit code 1 (after printing the result) when the recorded event sequence is not
-    reproduced."""
+    reproduced, 2 for a missing or corrupt bag, 4 when the replay does not finish."""
+    from ..recording.bag import BagError
     from ..recording.replay import replay
 
     overrides = {}
@@ -32,12 +35,19 @@ def run(args: argparse.Namespace) -> dict | int:
         name, sep, value = entry.partition("=")
         if not sep or not name:
             print(f"squeeze-grasp replay: --param needs NAME=VALUE, got {entry!r}", file=sys.stderr)
-            return 2
+            return ExitCode.USAGE
         overrides[name] = yaml.safe_load(value)
-    result = replay(args.bag, overrides)
+    try:
+        result = replay(args.bag, overrides)
+    except BagError as exc:
+        print(f"squeeze-grasp replay: error: {exc}", file=sys.stderr)
+        return ExitCode.USAGE
+    except TimeoutError as exc:
+        print(f"squeeze-grasp replay: error: {exc}", file=sys.stderr)
+        return ExitCode.INTERNAL
     if result["reproduced"] is False:
         print(json.dumps(result) if args.json else summary(result))
-        return 1
+        return ExitCode.OUTCOME
     return result
 
 

@@ -25,9 +25,13 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import yaml
+from mcap.exceptions import McapError
 from mcap.reader import make_reader
+from mcap.records import Channel, Message, Schema
+from mcap.stream_reader import StreamReader
 from mcap.writer import CompressionType, Writer
 
+from ..inputs import InputError, load_yaml, read_text
 from .schema import message_definition, type_hash
 
 METADATA_VERSION = 9
@@ -116,7 +120,7 @@ class BagWriter:
         self.file_name = f"{self.path.name}_0.mcap"
         self._stream = _Direct(self.path / self.file_name)
         self._writer = Writer(self._stream, chunk_size=chunk_size,
-                              compression=COMPRESSION[compression])
+                              compression=COMPRESSION[compression], enable_data_crcs=True)
         self._writer.start(profile="ros2", library="squeeze_grasp_ros")
         self._schemas: dict[str, int] = {}
         self.topics: dict[str, _Topic] = {}
@@ -228,24 +232,76 @@ class BagContents:
 
 
 def _storage_files(path: Path) -> tuple[list[Path], dict]:
-    """(storage files, metadata mapping or {}) of a bag folder or a bare storage file."""
+    """(storage files, metadata mapping or {}) of a bag folder or a bare storage file.
+
+    Without ``metadata.yaml`` the metadata comes from the ``rosbag2`` record inside the MCAP
+    file, which holds the same YAML.
+    """
     if path.is_file():
-        return [path], {}
+        return [path], _embedded_info(path)
     meta_path = path / "metadata.yaml"
     if not meta_path.is_file():
         files = sorted(path.glob("*.mcap")) + sorted(path.glob("*.db3"))
         if not files:
             raise BagError(f"{path} has no metadata.yaml and no .mcap/.db3 file")
-        return files, {}
-    info = yaml.safe_load(meta_path.read_text()).get("rosbag2_bagfile_information", {})
-    return [path / f for f in info.get("relative_file_paths", [])], info
+        return files, _embedded_info(files[0])
+    try:
+        data = load_yaml(read_text(meta_path, what="metadata.yaml"), what=str(meta_path))
+        info = data["rosbag2_bagfile_information"]
+        names = list(dict.fromkeys(info.get("relative_file_paths") or []))
+    except (InputError, KeyError, TypeError, AttributeError) as exc:
+        raise BagError(f"{meta_path} is not rosbag2 metadata: {exc}") from None
+    files = []
+    for name in names:
+        file = (path / str(name)).resolve()
+        if file.parent != path.resolve() or not file.is_file():
+            raise BagError(f"{meta_path} lists {name!r}, which is not a file of this bag")
+        files.append(file)
+    return files, info
+
+
+def _embedded_info(path: Path) -> dict:
+    """The bag information of the ``rosbag2`` metadata record of an MCAP file ({} if none)."""
+    if path.suffix != ".mcap":
+        return {}
+    try:
+        with open(path, "rb") as f:
+            for record in make_reader(f).iter_metadata():
+                if record.name == "rosbag2":
+                    data = load_yaml(record.metadata.get("serialized_metadata", ""),
+                                     what=f"{path} rosbag2 metadata")
+                    return dict((data or {}).get("rosbag2_bagfile_information", data or {}))
+    except (McapError, InputError, OSError, ValueError):
+        return {}
+    return {}
 
 
 def _read_mcap(path: Path) -> Iterator[BagMessage]:
-    with open(path, "rb") as f:
-        for schema, channel, message in make_reader(f).iter_messages(log_time_order=True):
-            yield BagMessage(channel.topic, schema.name if schema else "", message.log_time,
-                             bytes(message.data))
+    """Every message of an MCAP file, with its chunk and data-section CRCs checked.
+
+    Raises
+    ------
+    BagError
+        A CRC does not match or a record cannot be parsed: the file is corrupt.
+    """
+    schemas: dict[int, str] = {}
+    topics: dict[int, tuple[str, str]] = {}
+    out: list[BagMessage] = []
+    try:
+        with open(path, "rb") as f:
+            for record in StreamReader(f, validate_crcs=True).records:
+                if isinstance(record, Schema):
+                    schemas[record.id] = record.name
+                elif isinstance(record, Channel):
+                    topics[record.id] = (record.topic, schemas.get(record.schema_id, ""))
+                elif isinstance(record, Message):
+                    topic, type_name = topics[record.channel_id]
+                    out.append(BagMessage(topic, type_name, record.log_time, bytes(record.data)))
+    except Exception as exc:  # noqa: BLE001 (any failure to parse these bytes means corruption)
+        raise BagError(f"{path} is corrupt ({type(exc).__name__}: {exc}); it cannot be "
+                       "trusted, not even in part") from None
+    out.sort(key=lambda m: m.log_time_ns)
+    yield from out
 
 
 def _read_sqlite(path: Path) -> Iterator[BagMessage]:

@@ -4,8 +4,10 @@
 from __future__ import annotations
 
 import argparse
+import json
 import sys
 
+from ..exit_codes import ExitCode
 from .common import add_scene_argument
 
 HELP = ("run a scene through the planner, executor, simulated hardware, monitor and recorder "
@@ -54,7 +56,7 @@ def _progress_line(update: dict) -> None:
 def run(args: argparse.Namespace) -> dict | int:
     """Run the pipeline; the JSON summary (see :meth:`PipelineRunner.summary`), or exit code
     130 after Ctrl-C (the recording is finished first)."""
-    from ..nodes.runner import PipelineRunner, RunOptions
+    from ..nodes.runner import PipelineRunner, RunError, RunOptions
 
     options = RunOptions(args.scene, record=args.record,
                          include_hidden_topics=args.include_hidden_topics,
@@ -67,10 +69,16 @@ def run(args: argparse.Namespace) -> dict | int:
     except KeyboardInterrupt:
         where = f"; the recording is complete up to here: {args.record}" if args.record else ""
         print(f"\nsqueeze-grasp run: interrupted{where}", file=sys.stderr)
-        return 130
+        return ExitCode.INTERRUPTED
+    except RunError as exc:
+        print(f"squeeze-grasp run: error: {exc}", file=sys.stderr)
+        return ExitCode.INTERNAL
     finally:
         if show:
             sys.stderr.write("\n")
+    if not result["success"]:
+        print(json.dumps(result) if args.json else summary(result))
+        return ExitCode.OUTCOME
     return result
 
 
@@ -85,7 +93,8 @@ def summary(result: dict) -> str:
     alarms = ", ".join(f"{k} x{v}" for k, v in sorted(result["alarms"].items())) or "none"
     timing = result["timing"]
     lines = [
-        f"{result['scene']}: {result['termination']} ({result['message']}) after "
+        f"{result['scene']}: {result['outcome']}",
+        f"executor: {result['termination']} ({result['message']}) after "
         f"{result['ticks']} ticks = {result['sim_time']:.3f} s sim time; {result['mode']}, "
         f"plan from the {result['plan_source']}",
         f"depth {result['depth'] * 1e3:.4f} mm = {result['relative_depth'] * 100:.2f} % "

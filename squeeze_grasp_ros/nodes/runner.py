@@ -83,6 +83,10 @@ SERVICE_RETRY = 30.0
 """Wall-clock seconds after which an unanswered planner request is sent again."""
 
 
+GRASP_HELD: tuple[str, ...] = ("none", "picked_up")
+"""World terminations after which the grasp holds ("none": the world never ended)."""
+
+
 class RunError(RuntimeError):
     """The pipeline could not be started or did not finish in time."""
 
@@ -561,21 +565,32 @@ class PipelineRunner:
         """Ask the executor to cancel the goal (it holds position)."""
         self.goal_handle.cancel_goal_async()
 
+    def _world_failed(self) -> bool:
+        """True once the simulated world has ended with a termination that loses the grasp."""
+        return self.world_end is not None and self.world_end["termination"] not in GRASP_HELD
+
     def wait_result(self) -> ExecuteGrasp.Result:
         """Spin until the goal's result, then until the ground truth of its last tick arrived.
 
-        If the status topic reports the goal finished but the result response does not come
-        within a few seconds (lost across processes), the result is requested again.
+        When the simulated world ends with a lost grasp (a finger slipped, the strain limit), the
+        goal is cancelled, so the executor holds instead of driving fingers that no longer move
+        the object. If the status topic reports the goal finished but the result response does
+        not come within a few seconds (lost across processes), the result is requested again.
         """
         finished = (GoalStatus.STATUS_SUCCEEDED, GoalStatus.STATUS_ABORTED,
                     GoalStatus.STATUS_CANCELED)
         deadline = time.monotonic() + self.options.timeout
+        cancelled = False
         while not self.result_future.done():
+            if not cancelled and self._world_failed():
+                cancelled = True
+                self.cancel()
             ended = [time.monotonic()] if self._status_of(self.goal_handle.goal_id) in finished \
                 else []
             self.spin_until(lambda: self.result_future.done() or (
                 ended and time.monotonic() > ended[0] + GOAL_RESPONSE_TIMEOUT) or (
-                not ended and self._status_of(self.goal_handle.goal_id) in finished),
+                not ended and self._status_of(self.goal_handle.goal_id) in finished) or (
+                not cancelled and self._world_failed()),
                 max(deadline - time.monotonic(), 0.0), "the goal's result")
             if not self.result_future.done() and ended:
                 self.result_future = self.goal_handle.get_result_async()
@@ -645,7 +660,9 @@ class PipelineRunner:
         plan = self.plan
         return {
             "scene": self.scene.name, "mode": self.mode(), "plan_source": plan.source,
-            "termination": result.termination, "success": bool(result.success),
+            "termination": result.termination,
+            "success": bool(result.success) and (state.termination or "none") in GRASP_HELD,
+            "executor_success": bool(result.success), "outcome": self.outcome(result),
             "message": result.message, "world_termination": state.termination or "none",
             "depth": float(state.contacts.depth),
             "relative_depth": float(state.contacts.relative_depth),
@@ -681,6 +698,17 @@ class PipelineRunner:
         world = sims[0].world
         return {"mechanics": world.stepper_seconds, "mechanics_cpu": world.stepper_cpu_seconds,
                 "world": world.step_seconds, "world_cpu": world.step_cpu_seconds}
+
+    def outcome(self, result: ExecuteGrasp.Result) -> str:
+        """One sentence: did the grasp hold in the simulated world, and if not, why."""
+        world = self.sim_state.termination or "none"
+        if world in GRASP_HELD and result.success:
+            return "grasp held" if world == "none" else "object picked up"
+        if world not in GRASP_HELD:
+            depth = self.world_end["depth"] if self.world_end else float("nan")
+            return (f"grasp failed in the world: {world} at depth {depth * 1e3:.4f} mm; the "
+                    "executor was stopped")
+        return f"executor did not finish: {result.termination} ({result.message})"
 
     def mode(self) -> str:
         """How the nodes ran."""

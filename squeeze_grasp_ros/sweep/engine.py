@@ -15,8 +15,10 @@ from __future__ import annotations
 import importlib.util
 import logging
 import os
+import signal
 import sys
 import time
+import urllib.request
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Callable, Optional
@@ -118,12 +120,23 @@ def _cluster(scheduler: Optional[str], workers: Optional[int]):
 
 
 def _dashboard(client, local: bool) -> Optional[str]:
-    """The dashboard address, if the scheduler serves one (locally: only with bokeh)."""
+    """The dashboard address if the scheduler serves one that answers from here (Dask serves
+    a stub page without bokeh, and its HTTP server also runs with ``--no-dashboard``)."""
     if local and importlib.util.find_spec("bokeh") is None:
         return None
-    if "dashboard" not in client.scheduler_info().get("services", {}):
+    link = client.dashboard_link
+    try:
+        with urllib.request.urlopen(link, timeout=2) as reply:
+            page = reply.read(4096)
+    except (OSError, ValueError):
         return None
-    return client.dashboard_link
+    return link if b"needs bokeh" not in page else None
+
+
+def ignore_sigint() -> None:
+    """Run in a local worker process: Ctrl-C reaches the whole process group, and the client
+    alone handles it (it cancels the tasks and closes the cluster)."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
 
 
 def _check_workers(client) -> int:
@@ -175,6 +188,8 @@ def run_sweep(loaded: LoadedSpec, out: str | Path, *, scheduler: Optional[str] =
     try:
         outcome.workers = _check_workers(client)
         outcome.dashboard = _dashboard(client, cluster is not None)
+        if cluster is not None:
+            client.run(ignore_sigint)
         outcome.startup_s = time.perf_counter() - start
         bar = Progress(sum(t.evaluations for t in todo), outcome.dashboard, progress)
         bar.update(0)

@@ -7,18 +7,25 @@ starts, with the same parameters.
     ros2 launch squeeze_grasp_ros sim_pipeline.launch.py scene:=/path/to/scene.yaml \\
         record:=/tmp/foam_run rviz:=true
 
-The nodes wait for a goal: send the executor its goal with ``ros2 action send_goal
-/executor/execute_grasp squeeze_grasp_interfaces/action/ExecuteGrasp '{...}'`` (docs/pipeline.md),
-or run the whole scene with ``squeeze-grasp run``. Arguments: ``scene`` (default: the shipped
-foam square), ``record`` (bag folder; empty: no recorder), ``include_hidden_topics`` (record the
-action's hidden topics too), ``rviz`` (start RViz2 with the shipped configuration).
+By default a client (``squeeze-grasp run --attach``) plans the scene with the launched planner,
+sends the executor its goal, prints the summary and ends the launch with the run.
+``run:=false`` only starts the nodes, which then wait for a goal (``ros2 action send_goal
+/executor/execute_grasp squeeze_grasp_interfaces/action/ExecuteGrasp '{...}'``, see
+docs/pipeline.md). Arguments: ``scene`` (default: the shipped foam square), ``record`` (bag
+folder; empty: no recorder), ``include_hidden_topics`` (record the action's hidden topics too),
+``rviz`` (start RViz2 with the shipped configuration), ``run``.
 """
 import shutil
+from pathlib import Path
 
 from launch import LaunchDescription
-from launch.actions import DeclareLaunchArgument, ExecuteProcess, LogInfo, OpaqueFunction
+from launch.actions import (DeclareLaunchArgument, EmitEvent, ExecuteProcess, LogInfo,
+                            OpaqueFunction, RegisterEventHandler)
+from launch.event_handlers import OnProcessExit
+from launch.events import Shutdown
 from launch.substitutions import LaunchConfiguration
 from launch_ros.actions import Node
+from launch_ros.substitutions import ExecutableInPackage
 
 from squeeze_grasp_ros.mechanics.compliance import ElasticObject
 from squeeze_grasp_ros.nodes.runner import RunOptions, node_parameters
@@ -54,17 +61,27 @@ def nodes(context, *args, **kwargs):
     params = node_parameters(scene, scene_path, options, relative_per_depth)
     if not record:
         del params["recorder"]
+    roots = [str(Path(scene_path).resolve().parent), str(config_dir().parent), str(Path.cwd())]
     actions = [LogInfo(msg=f"scene {scene_path}"),
                Node(package="squeeze_grasp_ros", executable="planner", name="planner",
-                    parameters=[str(config_dir() / "planner.yaml")], output="screen")]
+                    parameters=[str(config_dir() / "planner.yaml"), {"allowed_roots": roots}],
+                    output="screen")]
     for name, values in params.items():
         actions.append(Node(package="squeeze_grasp_ros", executable=name, name=name,
                             parameters=[values], output="screen"))
+    if LaunchConfiguration("run").perform(context).lower() in TRUE:
+        client = ExecuteProcess(
+            cmd=[ExecutableInPackage("squeeze-grasp", "squeeze_grasp_ros"), "run", scene_path,
+                 "--attach"], output="screen", name="run")
+        actions += [client, RegisterEventHandler(OnProcessExit(
+            target_action=client,
+            on_exit=[LogInfo(msg="the run has ended; shutting the pipeline down"),
+                     EmitEvent(event=Shutdown(reason="run finished"))]))]
     return actions + rviz(LaunchConfiguration("rviz").perform(context))
 
 
 def generate_launch_description() -> LaunchDescription:
-    """[scene:=FILE] [record:=DIR] [include_hidden_topics:=true] [rviz:=true]."""
+    """[scene:=FILE] [record:=DIR] [include_hidden_topics:=true] [rviz:=true] [run:=false]."""
     return LaunchDescription([
         DeclareLaunchArgument("scene", default_value="",
                               description="scene YAML file (empty: the shipped foam square)"),
@@ -72,6 +89,10 @@ def generate_launch_description() -> LaunchDescription:
                               description="rosbag2 folder to record into (empty: no recording)"),
         DeclareLaunchArgument("include_hidden_topics", default_value="false",
                               description="also record the action's _action/ topics"),
+        DeclareLaunchArgument("run", default_value="true",
+                              description="run the scene (plan, send the goal, print the "
+                                          "summary, then shut down); false: only start the "
+                                          "nodes"),
         DeclareLaunchArgument("rviz", default_value="false",
                               description="start RViz2 with share/squeeze_grasp_ros/config/"
                                           "viewers/squeeze_grasp.rviz"),

@@ -27,6 +27,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                              "(_action/feedback, _action/status); like rosbag2, off by default. Foxglove "
                              "and rosbags decode them; mcap_ros2 cannot (it rejects rosidl's "
                              "action message names, e.g. ExecuteGrasp_FeedbackMessage)")
+    parser.add_argument("--attach", action="store_true",
+                        help="use the pipeline nodes already running on this ROS domain (as "
+                             "sim_pipeline.launch.py starts them): plan with their planner, send "
+                             "the goal and summarise; starts and records nothing itself")
     parser.add_argument("--processes", action="store_true",
                         help="one process per node, as `ros2 launch` starts them (default: "
                              "every node on one executor in this process)")
@@ -59,7 +63,7 @@ def run(args: argparse.Namespace) -> dict | int:
     from ..nodes.runner import PipelineRunner, RunError, RunOptions
 
     options = RunOptions(args.scene, record=args.record,
-                         include_hidden_topics=args.include_hidden_topics,
+                         include_hidden_topics=args.include_hidden_topics, attach=args.attach,
                          processes=args.processes,
                          executor=args.executor, on_slip_alarm=args.on_slip_alarm,
                          resist=not args.no_resist, planner=not args.no_planner)

@@ -109,6 +109,10 @@ class RunOptions:
         Bag folder to record into.
     include_hidden_topics : bool
         Record the executor action's hidden ``_action/`` topics too.
+    attach : bool
+        Use the nodes already running on this ROS domain (started by ``ros2 launch
+        squeeze_grasp_ros sim_pipeline.launch.py``) instead of starting them: plan with the
+        running planner, send the goal, summarise. Recording is then the launched recorder's.
     processes : bool
         One process per node instead of one executor in this process.
     executor : {"events", "single"}
@@ -128,6 +132,7 @@ class RunOptions:
     scene_path: str
     record: str | None = None
     include_hidden_topics: bool = False
+    attach: bool = False
     processes: bool = False
     executor: str = "events"
     on_slip_alarm: str = "hold"
@@ -192,6 +197,9 @@ class PipelineRunner:
     def __init__(self, options: RunOptions, progress: Callable[[dict], None] | None = None) -> None:
         if options.executor not in EXECUTORS:
             raise RunError(f"executor must be one of {EXECUTORS}, got {options.executor!r}")
+        if options.attach and (options.processes or options.record):
+            raise RunError("attach uses the nodes already running: it starts no processes and "
+                           "records nothing itself (record with the launch file's record:=)")
         self.options = options
         self.progress = progress
         self.scene = load_scene(options.scene_path)
@@ -320,7 +328,7 @@ class PipelineRunner:
         never reached the client).
         """
         plan_source = self._use_planner()
-        planner = self._start_planner() if plan_source else None
+        planner = self._start_planner() if plan_source and not self.options.attach else None
         try:
             self.plan = self._plan_with_planner() if plan_source else self._plan_with_mechanics()
         finally:
@@ -335,7 +343,7 @@ class PipelineRunner:
         started = time.perf_counter()
         if self.options.processes:
             self._spawn(params)
-        else:
+        elif not self.options.attach:
             self._construct(params)
         self.spin_until(lambda: self.action.server_is_ready(), self.options.timeout,
                         "the executor's action server")
@@ -347,7 +355,8 @@ class PipelineRunner:
         self.timing["start_nodes"] = time.perf_counter() - started
 
     def _use_planner(self) -> bool:
-        return self.options.planner and importlib.util.find_spec(PLANNER_MODULE) is not None
+        return self.options.attach or (self.options.planner
+                                       and importlib.util.find_spec(PLANNER_MODULE) is not None)
 
     def _construct(self, params: dict[str, dict]) -> None:
         from .executor import ExecutorNode
@@ -712,6 +721,8 @@ class PipelineRunner:
 
     def mode(self) -> str:
         """How the nodes ran."""
+        if self.options.attach:
+            return "attached to running nodes"
         if self.options.processes:
             return "processes"
         return "one process, " + ("EventsExecutor" if self.options.executor == "events"

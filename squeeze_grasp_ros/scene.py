@@ -26,7 +26,7 @@ from .inputs import InputError, load_yaml, read_text
 from .mechanics import shapes
 from .mechanics.errors import MechanicsError
 from .mechanics.material import Material
-from .mechanics.mesh import Mesh, generate_mesh, target_max_area
+from .mechanics.mesh import MAX_MESH_NODES, Mesh, generate_mesh, target_max_area
 from .mechanics.ring_model import RingModel, ring_from_outline
 
 
@@ -87,7 +87,8 @@ class MeshSpec:
     """Triangulation controls: the accuracy knobs of the solid model."""
 
     max_area: Optional[float] = spec("largest element area", "m^2", lo=0.0, lo_open=True, default=None)
-    nodes: Optional[int] = spec("approximate node count (instead of max_area)", lo=10, default=None)
+    nodes: Optional[int] = spec("approximate node count (instead of max_area)", lo=10,
+                                hi=MAX_MESH_NODES, default=None)
     min_angle: float = spec("smallest element angle", "deg", lo=0.0, hi=34.0, lo_open=True, default=30.0)
 
 
@@ -284,15 +285,25 @@ def _describe(meta: dict) -> str:
         return f"in {'(' if meta.get('lo_open') else '['}{lo}, {hi}]"
     if lo is not None:
         return f"{'>' if meta.get('lo_open') else '>='} {lo}"
-    return ""
+    if hi is not None:
+        return f"<= {hi}"
+    return "a finite number"
+
+
+MAX_INT = 2 ** 53
+"""Largest integer a scene entry may hold (exactly representable as a float)."""
 
 
 def _check_range(value: float, meta: dict, where: str) -> None:
     lo, hi = meta.get("lo"), meta.get("hi")
+    unit = f" {meta['unit']}" if meta.get("unit") else ""
+    if abs(value) > MAX_INT and isinstance(value, int):
+        raise SceneError(f"{where} must be an integer of at most {MAX_INT}, got {value!r}")
+    if not np.isfinite(float(value)):
+        raise SceneError(f"{where} must be a finite number{unit}, got {value!r}")
     bad = (lo is not None and (value < lo or (meta.get("lo_open") and value == lo))) or (
         hi is not None and value > hi)
-    if bad or not np.isfinite(value):
-        unit = f" {meta['unit']}" if meta.get("unit") else ""
+    if bad:
         raise SceneError(f"{where} must be {_describe(meta)}{unit}, got {value!r}")
 
 
@@ -382,6 +393,32 @@ def _validate_shape(shape: dict) -> None:
     for key in SHAPES[kind]:
         if key not in shape and key not in optional:
             raise SceneError(f"missing required key object.shape.{key} for type {kind}")
+        if key in shape:
+            _check_shape_value(key, shape[key], f"object.shape.{key}")
+
+
+def _is_number(value: Any) -> bool:
+    return isinstance(value, (int, float)) and not isinstance(value, bool) and \
+        abs(value) <= MAX_INT and bool(np.isfinite(float(value)))
+
+
+def _check_shape_value(key: str, value: Any, where: str) -> None:
+    """Types of the shape parameters: lengths are positive numbers (m), ``points`` a list of
+    [x, y] number pairs, ``cos``/``sin`` lists of numbers, ``path`` a non-empty string."""
+    if key == "path":
+        if not isinstance(value, str) or not value:
+            raise SceneError(f"{where} must be a file path (a non-empty string), got {value!r}")
+    elif key == "points":
+        if not isinstance(value, list) or not all(
+                isinstance(p, (list, tuple)) and len(p) == 2 and all(map(_is_number, p))
+                for p in value):
+            raise SceneError(f"{where} must be a list of [x, y] number pairs (m)")
+    elif key in ("cos", "sin"):
+        if not isinstance(value, list) or not all(map(_is_number, value)):
+            raise SceneError(f"{where} must be a list of numbers (relative to the radius)")
+    elif not _is_number(value) or value <= 0:
+        unit = "" if key == "exponent" else " (m)"
+        raise SceneError(f"{where} must be a positive number{unit}, got {value!r}")
 
 
 def _validate(scene: Scene) -> Scene:

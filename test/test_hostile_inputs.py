@@ -193,3 +193,55 @@ def test_oversized_and_huge_text_inputs_are_refused(planner, tmp_path):
     assert "larger than" in response.message
     assert main(["mesh", str(big)]) == 2
     assert_alive(planner)
+
+
+def scene_variant(tmp_path: Path, name: str, change) -> str:
+    data = yaml.safe_load((SCENES / "foam_square.yaml").read_text())
+    change(data)
+    path = tmp_path / f"{name}.yaml"
+    path.write_text(yaml.safe_dump(data))
+    return str(path)
+
+
+SCENES = Path(__file__).resolve().parents[1] / "config" / "scenes"
+CARELESS = {
+    "side: true": (lambda d: d["object"]["shape"].__setitem__("side", True),
+                   "object.shape.side must be a positive number"),
+    "path: null": (lambda d: d["object"].__setitem__("shape", {"type": "file", "path": None}),
+                   "object.shape.path must be a file path"),
+    "path: 5": (lambda d: d["object"].__setitem__("shape", {"type": "file", "path": 5}),
+                "object.shape.path must be a file path"),
+    "ragged points": (lambda d: d["object"].__setitem__(
+        "shape", {"type": "polygon", "points": [[0, 0], [1], [1, 1]]}),
+        "object.shape.points must be a list of [x, y] number pairs"),
+    "huge integer": (lambda d: d["squeeze"].__setitem__("max_events_per_depth", 10 ** 30),
+                     "squeeze.max_events_per_depth must be an integer of at most"),
+    "10 million nodes": (lambda d: d["object"]["mesh"].__setitem__("nodes", 10 ** 7),
+                         "mesh.nodes must be in [10, 250000]"),
+    "max_area 1e-12": (lambda d: d["object"].__setitem__("mesh", {"max_area": 1e-12}),
+                       "at most 250000 are allowed"),
+}
+
+
+@pytest.mark.parametrize("case", sorted(CARELESS))
+def test_careless_scenes_end_in_a_clean_error(case, tmp_path, capfd):
+    change, message = CARELESS[case]
+    start = time.perf_counter()
+    assert main(["squeeze", scene_variant(tmp_path, case.replace(" ", "_"), change)]) == 2
+    err = capfd.readouterr().err
+    assert message in err and "Traceback" not in err
+    assert time.perf_counter() - start < 20
+
+
+@pytest.mark.parametrize("argv, message", [
+    (["squeeze", "{foam}", "--save-boundary", "{tmp}"], "is a folder"),
+    (["squeeze", "{foam}", "--plot", "/nonexistent/x.png"], "does not exist"),
+    (["run", "{foam}", "--record", ""], "needs a folder name"),
+    (["run", "{foam}", "--record", "{foam}"], "is a file"),
+])
+def test_bad_output_paths_are_refused_before_any_work(argv, message, tmp_path, capfd):
+    argv = [a.format(foam=SCENES / "foam_square.yaml", tmp=tmp_path) for a in argv]
+    with pytest.raises(SystemExit) as exit_info:
+        main(argv)
+    assert exit_info.value.code == 2
+    assert message in capfd.readouterr().err

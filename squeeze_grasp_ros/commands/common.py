@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import argparse
 from dataclasses import dataclass
+from pathlib import Path
 
 from ..mechanics.compliance import ROUTES, ElasticObject
 from ..scene import Scene, build_mesh, finger_nodes, load_scene, scene_material
@@ -22,9 +23,35 @@ def add_solver_argument(parser: argparse.ArgumentParser) -> None:
                              "paper's O(n^3) eigendecomposition, for cross-checks)")
 
 
+def output_file(text: str) -> str:
+    """argparse type of an output file: a path whose folder exists and that is not a folder."""
+    path = Path(text)
+    if not text:
+        raise argparse.ArgumentTypeError("needs a file name")
+    if path.is_dir():
+        raise argparse.ArgumentTypeError(f"{text} is a folder; give a file name in it")
+    if not path.resolve().parent.is_dir():
+        raise argparse.ArgumentTypeError(f"the folder of {text} does not exist")
+    return text
+
+
+def new_folder(text: str) -> str:
+    """argparse type of a folder to create (a recording): not empty, not a file, not a folder
+    that already holds something."""
+    path = Path(text)
+    if not text.strip():
+        raise argparse.ArgumentTypeError("needs a folder name")
+    if path.is_file():
+        raise argparse.ArgumentTypeError(f"{text} is a file; give a new folder")
+    if path.is_dir() and any(path.iterdir()):
+        raise argparse.ArgumentTypeError(f"{text} exists and is not empty")
+    return text
+
+
 def add_plot_argument(parser: argparse.ArgumentParser) -> None:
     """``--plot FILE.png``."""
-    parser.add_argument("--plot", metavar="FILE.png", help="write a figure to this PNG file")
+    parser.add_argument("--plot", metavar="FILE.png", type=output_file,
+                        help="write a figure to this PNG file")
 
 
 @dataclass(frozen=True)

@@ -8,7 +8,7 @@ import json
 import sys
 
 from ..exit_codes import ExitCode
-from .common import add_scene_argument
+from .common import add_scene_argument, new_folder
 
 HELP = ("run a scene through the planner, executor, simulated hardware, monitor and recorder "
         "nodes (lockstep sim time) and summarise it")
@@ -20,7 +20,7 @@ parser never imports rclpy: ``squeeze-grasp ros-setup`` must run before the inte
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     """SCENE, --record DIR, --processes, --executor, --on-slip-alarm, --no-resist, --no-planner."""
     add_scene_argument(parser)
-    parser.add_argument("--record", metavar="DIR",
+    parser.add_argument("--record", metavar="DIR", type=new_folder,
                         help="record every topic into this rosbag2 folder (MCAP storage)")
     parser.add_argument("--include-hidden-topics", action="store_true",
                         help="with --record: also record the executor action's hidden topics "

@@ -14,7 +14,8 @@ from ..mechanics.contact_state import EVENT_TYPES
 from ..mechanics.fingertips import unit
 from ..mechanics.squeeze_events import EventSqueeze
 from ..scene_events import event_squeeze_scene
-from .common import add_plot_argument, add_scene_argument, add_solver_argument, load_solid
+from .common import (add_plot_argument, add_scene_argument, add_solver_argument, load_solid,
+                     output_file)
 from .csv_io import write_points
 
 HELP = "event-driven squeeze with rounded fingertips under Coulomb friction (Sec. 5, Algorithm 1)"
@@ -38,7 +39,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--reference", action="store_true",
                         help="the paper's literal route: fixed step H, a full solve per step, "
                              "events at step ends (for cross-checks and timing)")
-    parser.add_argument("--save-boundary", metavar="FILE.csv",
+    parser.add_argument("--save-boundary", metavar="FILE.csv", type=output_file,
                         help="write the deformed outer boundary (x,y per node, m, loop order), "
                              "e.g. for `squeeze-grasp match`")
     add_solver_argument(parser)

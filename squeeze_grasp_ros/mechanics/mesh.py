@@ -151,10 +151,15 @@ def vertex_normals(points: np.ndarray) -> np.ndarray:
     return nrm / np.linalg.norm(nrm, axis=1, keepdims=True)
 
 
+MAX_MESH_NODES = 250_000
+"""Largest mesh the mesher is asked for (about 0.8 area / max_area nodes); beyond it a solve
+takes minutes and gigabytes, so the request is refused before meshing."""
+
+
 def target_max_area(outline: Outline, nodes: int) -> float:
     """The ``max_area`` (m^2) that gives roughly ``nodes`` mesh nodes for ``outline``."""
-    if nodes < 10:
-        raise MechanicsError(f"mesh.nodes must be >= 10, got {nodes}")
+    if not 10 <= nodes <= MAX_MESH_NODES:
+        raise MechanicsError(f"mesh.nodes must be in [10, {MAX_MESH_NODES}], got {nodes}")
     return 1.6 * outline.area / (2.0 * nodes)
 
 
@@ -177,6 +182,11 @@ def generate_mesh(outline: Outline, max_area: float, min_angle: float = 30.0,
         raise MechanicsError(f"mesh.min_angle must be in (0, 34] degrees, got {min_angle}")
     if max_area > outline.area:
         max_area = outline.area / 4.0
+    if 0.8 * outline.area / max_area > MAX_MESH_NODES:
+        raise MechanicsError(f"mesh.max_area {max_area:.3g} m^2 would give about "
+                             f"{0.8 * outline.area / max_area:.3g} nodes on this "
+                             f"{outline.area:.3g} m^2 object; at most {MAX_MESH_NODES} are "
+                             f"allowed (max_area >= {0.8 * outline.area / MAX_MESH_NODES:.3g} m^2)")
     spacing = np.sqrt(4.0 * max_area / np.sqrt(3.0))
     loops = [resample(outline.points, spacing, outline.corners)]
     loops += [resample(h if signed_area(h) > 0 else h[::-1], spacing) for h in outline.holes]

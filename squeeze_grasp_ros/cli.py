@@ -6,9 +6,12 @@ from __future__ import annotations
 import argparse
 import importlib
 import json
+import math
 import sys
+from typing import Any
 
 from .commands import VERBS
+from .commands.common import fail
 from .exit_codes import ExitCode
 from .extras import install_hint
 from .mechanics.errors import MechanicsError
@@ -35,29 +38,49 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+def finite_json(value: Any, path: str = "", bad: list[str] | None = None) -> Any:
+    """``value`` with every non-finite float replaced by None; their paths appended to ``bad``."""
+    if isinstance(value, float) and not math.isfinite(value):
+        if bad is not None:
+            bad.append(path or "(result)")
+        return None
+    if isinstance(value, dict):
+        return {k: finite_json(v, f"{path}.{k}" if path else str(k), bad)
+                for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [finite_json(v, f"{path}[{k}]", bad) for k, v in enumerate(value)]
+    return value
+
+
 def main(argv: list[str] | None = None) -> int:
-    """Entry point; returns the process exit code (2 for invalid input)."""
+    """Entry point; returns the process exit code (:class:`~.exit_codes.ExitCode`).
+
+    With ``--json`` a result is printed as one JSON object (non-finite numbers become null and
+    are listed under ``non_finite``), and an error as ``{"error", "field", "code",
+    "code_name"}``.
+    """
     args = build_parser().parse_args(argv)
     try:
         result = args._module.run(args)
     except (SceneError, MechanicsError) as exc:
-        print(f"squeeze-grasp {args.verb}: error: {exc}", file=sys.stderr)
-        return ExitCode.USAGE
+        return fail(args, str(exc), ExitCode.USAGE)
     except ModuleNotFoundError as exc:
         hint = install_hint(exc.name or "")
         if hint is None:
             raise
-        print(f"squeeze-grasp {args.verb}: error: needs {exc.name.split('.')[0]}, which is not "
-              f"installed: {hint}", file=sys.stderr)
-        return ExitCode.INTERNAL
+        return fail(args, f"needs {exc.name.split('.')[0]}, which is not installed: {hint}",
+                    ExitCode.INTERNAL)
     if isinstance(result, int):
         return result
     if args.json:
-        json.dump(result, sys.stdout, allow_nan=False)
-        sys.stdout.write("\n")
+        bad: list[str] = []
+        clean = finite_json(result, "", bad)
+        if bad:
+            clean["non_finite"] = bad
+        sys.stdout.write(json.dumps(clean, allow_nan=False) + "\n")
     else:
         print(args._module.summary(result))
-    return 0
+    return ExitCode.OK
 
 
 if __name__ == "__main__":

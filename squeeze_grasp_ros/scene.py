@@ -450,6 +450,9 @@ def _validate(scene: Scene) -> Scene:
     sq = scene.squeeze
     if sq.depth is not None and sq.relative_depth is not None:
         raise SceneError("squeeze.depth and squeeze.relative_depth are exclusive; give one")
+    if sq.relative_depth is not None and not sq.relative_depth < 1:
+        raise SceneError(f"squeeze.relative_depth must be < 1 (at 1 the fingers would meet), "
+                         f"got {sq.relative_depth}")
     for effect in scene.effects:
         if effect not in EFFECTS:
             raise SceneError(f"unknown effect {effect!r} in effects (allowed: {sorted(EFFECTS)})")

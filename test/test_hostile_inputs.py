@@ -245,3 +245,52 @@ def test_bad_output_paths_are_refused_before_any_work(argv, message, tmp_path, c
         main(argv)
     assert exit_info.value.code == 2
     assert message in capfd.readouterr().err
+
+
+def test_numbers_that_would_be_silently_wrong_are_refused(tmp_path, capfd):
+    trials = tmp_path / "trials.csv"
+    trials.write_text("angle_deg,slid\n60,0\n95,1\n")
+    assert main(["calibrate", "--slope-trials", str(trials)]) == 2
+    assert "[0, 90) deg" in capfd.readouterr().err
+    same = tmp_path / "same.csv"
+    same.write_text("x,y\n1,1\n1,1\n1,1\n")
+    assert main(["match", str(same), str(same)]) == 2
+    foam = str(SCENES / "foam_square.yaml")
+    for argv in (["plan", foam, "--depth", "1e308"], ["squeeze", foam, "--depth", "1e308"],
+                 ["plan", foam, "--relative-depth", "1.0"]):
+        assert main(argv) == 2, argv
+        assert "fingers would meet" in capfd.readouterr().err
+    for name, change, message in (
+            ("rel1", lambda d: d["squeeze"].__setitem__("relative_depth", 1.0), "must be < 1"),
+            ("step", lambda d: d["squeeze"].__setitem__("step", 1e-12), "step must be >= 1e-06")):
+        path = scene_variant(tmp_path, name, change)
+        assert main(["squeeze", path]) == 2
+        assert message in capfd.readouterr().err
+        assert main(["run", path, "--no-planner", "--quiet"]) == 2
+        assert message in capfd.readouterr().err
+
+
+def test_plan_squeeze_service_refuses_an_absurd_depth(planner):
+    from squeeze_grasp_interfaces.srv import PlanSqueeze
+
+    load(planner, scene_yaml=BLOB, object_id="blob")
+    response = planner.call(PlanSqueeze, "plan_squeeze", PlanSqueeze.Request(
+        object_id="blob", squeeze_type="stable", depth=1e308))
+    assert response.error_code == ErrorCode.INVALID_ARGUMENT
+    assert "fingers would meet" in response.message
+
+
+def test_json_errors_and_non_finite_results_are_valid_json(tmp_path, capfd):
+    import json
+
+    from squeeze_grasp_ros.cli import finite_json
+
+    path = scene_variant(tmp_path, "side", lambda d: d["object"]["shape"].__setitem__("side", True))
+    assert main(["mesh", path, "--json"]) == 2
+    error = json.loads(capfd.readouterr().out)
+    assert error["field"] == "object.shape.side" and error["code"] == 2
+    assert "positive number" in error["error"]
+    bad: list[str] = []
+    clean = finite_json({"a": [1.0, float("inf")], "b": {"c": float("nan")}, "d": "x"}, "", bad)
+    assert clean == {"a": [1.0, None], "b": {"c": None}, "d": "x"}
+    assert bad == ["a[1]", "b.c"]

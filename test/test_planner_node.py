@@ -282,7 +282,9 @@ BAD_SCENES = [
      "self-intersecting"),
     ("nu out of range", ("object", "material", "nu"), 0.7, "object.material.nu"),
     ("NaN modulus", ("object", "material", "E"), float("nan"), "object.material.E"),
-    ("oversized mesh", ("object", "mesh"), {"nodes": 10_000_000}, "oversized"),
+    ("oversized mesh", ("object", "mesh"), {"nodes": 100_000}, "oversized"),
+    ("mesh beyond the core limit", ("object", "mesh"), {"nodes": 10_000_000},
+     "mesh.nodes must be in [10, 250000]"),
     ("oversized by max_area", ("object", "mesh"), {"max_area": 1e-12}, "oversized"),
     ("unknown key", ("object", "colour"), "red", "object.colour"),
 ]

@@ -10,6 +10,7 @@ produce INTERNAL_ERROR, and afterwards the node still answers with the mechanics
 """
 from __future__ import annotations
 
+import functools
 import math
 import re
 from collections import Counter
@@ -25,12 +26,13 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from rclpy.context import Context
 
-from planner_support import BLOB, RING, Harness, flat, planner_threads, solid_of
+from planner_support import BLOB, RING, Harness, flat, planner_threads, scene_of, solid_of
 from squeeze_grasp_interfaces.srv import (EventSqueeze, GraspMap, LoadObject, PlanResistance,
                                           PlanSqueeze, RingGraspTest)
 from squeeze_grasp_ros.mechanics.graspmap import grasp_map
 from squeeze_grasp_ros.mechanics.squeeze import plan_squeeze
 from squeeze_grasp_ros.planning import ErrorCode
+from squeeze_grasp_ros.scene import finger_nodes
 
 SOLID = solid_of(BLOB)
 BOUNDARY = SOLID.mesh.boundary.tolist()
@@ -112,7 +114,17 @@ def plan_squeeze_cases(draw: st.DrawFn) -> Case:
                          ErrorCode.INVALID_ARGUMENT, "squeeze_type"),
         "depth": (st.one_of(NON_FINITE, NEGATIVE), ErrorCode.INVALID_ARGUMENT, "depth"),
     })
+    if not reason and fields["depth"] > 0 and relative_depth(
+            tuple(fields["contacts"]), fields["squeeze_type"], fields["depth"]) >= 1:
+        reason, code = "fingers would meet", ErrorCode.INVALID_ARGUMENT
     return Case("plan_squeeze", PlanSqueeze, PlanSqueeze.Request(**fields), reason, code)
+
+
+@functools.lru_cache(maxsize=None)
+def relative_depth(contacts: tuple[int, ...], kind: str, depth: float) -> float:
+    """The finger approach over the contacts' distance at ``depth`` (the planner's check)."""
+    nodes = list(contacts) or list(finger_nodes(scene_of(BLOB), SOLID.mesh))
+    return plan_squeeze(SOLID, nodes, kind).relative_depth(depth)
 
 
 def scene_text(data: dict) -> str:
@@ -130,7 +142,7 @@ BAD_SCENE_FIELDS = {
                           "shape"),
     ("object", "mesh"): (st.one_of(st.integers(70_000, 10**9).map(lambda n: {"nodes": n}),
                                    floats(1e-15, 1e-9).map(lambda a: {"max_area": a})),
-                         "oversized"),
+                         "oversized|mesh.nodes must be in|at most 250000"),
     ("squeeze", "depth"): (NEGATIVE, "squeeze.depth"),
     ("friction", "mu"): (NEGATIVE, "friction.mu"),
 }
@@ -138,7 +150,8 @@ BAD_SCENE_FIELDS = {
 
 @st.composite
 def load_object_cases(draw: st.DrawFn) -> Case:
-    kind = draw(st.sampled_from(["cached", "small", "bad scene", "bad yaml", "neither"]))
+    kind = draw(st.sampled_from(["cached", "small", "bad scene", "bad yaml", "neither",
+                                 "hostile"]))
     if kind == "cached":
         return Case("load_object", LoadObject,
                     LoadObject.Request(scene_yaml=BLOB, object_id="blob"))
@@ -160,7 +173,29 @@ def load_object_cases(draw: st.DrawFn) -> Case:
     if kind == "bad yaml":
         text = draw(st.sampled_from(["object: [", "{", ":\n- - ]", "a: b: c"]))
         return Case("load_object", LoadObject, LoadObject.Request(scene_yaml=text), "invalid YAML")
+    if kind == "hostile":
+        return draw(st.sampled_from(HOSTILE_LOADS))
     return Case("load_object", LoadObject, LoadObject.Request(), "exactly one of")
+
+
+HOSTILE_LOADS = [
+    Case("load_object", LoadObject, LoadObject.Request(scene_path=path),
+         "outside the allowed folders")
+    for path in ("/etc/shadow", "/proc/self/environ", "../../../../etc/passwd", "/dev/zero")
+] + [
+    Case("load_object", LoadObject, LoadObject.Request(scene_yaml=text), reason)
+    for text, reason in (
+        ("a: &a [x, x, x]\nb: &b [*a, *a, *a]\nc: [*b, *b, *b]\n", "aliases"),
+        (scene_text({**yaml.safe_load(BLOB), "object": {**yaml.safe_load(BLOB)["object"],
+                     "shape": {"type": "polygon", "points": [[-0.05, -0.05], [0.05, -0.05],
+                                                             [0.05, 0.05], [0, 0],
+                                                             [-0.05, 0.05], [0, 0]]}}}),
+         "self-intersecting"),
+        ("# " + "x" * (2 * 1024 * 1024), "larger than"),
+    )
+]
+"""Loads a careless or hostile client sends: paths outside the planner's folders, a YAML alias
+bomb, a polygon that crashed the mesher, an oversized request."""
 
 
 @st.composite

@@ -4,11 +4,29 @@
 from __future__ import annotations
 
 import argparse
+import json
+import re
+import sys
 from dataclasses import dataclass
 from pathlib import Path
 
+from ..exit_codes import ExitCode
 from ..mechanics.compliance import ROUTES, ElasticObject
 from ..scene import Scene, build_mesh, finger_nodes, load_scene, scene_material
+
+
+FIELD = re.compile(r"^([A-Za-z_][\w.\[\]]*) (?:must|is|needs|has)\b")
+"""A message that starts with the name of the offending field ("object.shape.side must ...")."""
+
+
+def fail(args: argparse.Namespace, message: str, code: ExitCode) -> int:
+    """Report an error: one line on stderr, and with ``--json`` a JSON object on stdout."""
+    print(f"squeeze-grasp {args.verb}: error: {message}", file=sys.stderr)
+    if getattr(args, "json", False):
+        match = FIELD.match(message)
+        print(json.dumps({"error": message, "field": match.group(1) if match else None,
+                          "code": int(code), "code_name": code.name}))
+    return code
 
 
 def add_scene_argument(parser: argparse.ArgumentParser) -> None:

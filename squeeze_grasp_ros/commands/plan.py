@@ -49,10 +49,15 @@ def requested_depth(args: argparse.Namespace, scene_squeeze, sq: Squeeze) -> flo
         if depth is not None:
             if not (np.isfinite(depth) and depth >= 0):
                 raise MechanicsError(f"depth must be >= 0 m, got {depth}")
+            rel = sq.relative_depth(depth)
+            if not rel < 1:
+                raise MechanicsError(f"depth {depth:.6g} m is a relative depth of {rel:.6g}: it "
+                                     "must be below 1 (at 1 the fingers would meet)")
             return depth
         if rel is not None:
-            if not (np.isfinite(rel) and 0 <= rel <= 1):
-                raise MechanicsError(f"relative depth must be in [0, 1], got {rel}")
+            if not (np.isfinite(rel) and 0 <= rel < 1):
+                raise MechanicsError(f"relative depth must be in [0, 1) (at 1 the fingers would "
+                                     f"meet), got {rel}")
             return sq.depth_for_relative(rel)
     return sq.depth_for_relative(DEFAULT_RELATIVE_DEPTH)
 

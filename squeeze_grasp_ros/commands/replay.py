@@ -10,6 +10,7 @@ import sys
 import yaml
 
 from ..exit_codes import ExitCode
+from .common import fail
 
 HELP = ("replay a recording's sensor topics on its sim time into a fresh monitor and check that "
         "it reproduces the recorded event sequence")
@@ -40,11 +41,9 @@ def run(args: argparse.Namespace) -> dict | int:
     try:
         result = replay(args.bag, overrides)
     except BagError as exc:
-        print(f"squeeze-grasp replay: error: {exc}", file=sys.stderr)
-        return ExitCode.USAGE
+        return fail(args, str(exc), ExitCode.USAGE)
     except TimeoutError as exc:
-        print(f"squeeze-grasp replay: error: {exc}", file=sys.stderr)
-        return ExitCode.INTERNAL
+        return fail(args, str(exc), ExitCode.INTERNAL)
     if result["reproduced"] is False:
         print(json.dumps(result) if args.json else summary(result))
         return ExitCode.OUTCOME

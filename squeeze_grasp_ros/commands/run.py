@@ -8,7 +8,7 @@ import json
 import sys
 
 from ..exit_codes import ExitCode
-from .common import add_scene_argument, new_folder
+from .common import add_scene_argument, fail, new_folder
 
 HELP = ("run a scene through the planner, executor, simulated hardware, monitor and recorder "
         "nodes (lockstep sim time) and summarise it")
@@ -75,8 +75,7 @@ def run(args: argparse.Namespace) -> dict | int:
         print(f"\nsqueeze-grasp run: interrupted{where}", file=sys.stderr)
         return ExitCode.INTERRUPTED
     except RunError as exc:
-        print(f"squeeze-grasp run: error: {exc}", file=sys.stderr)
-        return ExitCode.INTERNAL
+        return fail(args, str(exc), ExitCode.INTERNAL)
     finally:
         if show:
             sys.stderr.write("\n")

@@ -406,6 +406,11 @@ def event_squeeze(obj: ElasticObject, contacts: tuple[int, int],
         if not relative_per_depth > 0:
             raise MechanicsError("the fingers do not approach each other: relative depth undefined")
         depth = relative_depth / relative_per_depth
+    require_finite("depth", depth)
+    if depth < 0 or depth * relative_per_depth >= 1.0:
+        raise MechanicsError(f"depth {depth:.6g} m is a relative depth of "
+                             f"{depth * relative_per_depth:.6g}: it must be in [0, 1) (at 1 the "
+                             "fingers would meet)")
     tips = [place_fingertip(obj.mesh, n, int(c), radii[n]) for n, c in zip(names, contacts)]
     model = ContactModel(obj, mu, limits or Limits(), reference, max_events_per_depth)
     run = squeeze_to_depth(model, initial_state(tips, relative_per_depth), dirs, depth, step,

@@ -771,6 +771,13 @@ class _Run:
                             tuple(sorted((n, u) for n, u in self.holds.items() if u > depth)))
 
 
+MIN_STEP = 1e-6
+"""Smallest substep, relative to the object size: below it a squeeze to a usual depth needs
+millions of steps (``squeeze.step: 1e-12`` ran for ever)."""
+MIN_EVENT_TOL = 1e-15
+"""Smallest event tolerance, relative to the object size (near the float resolution)."""
+
+
 def advance(model: ContactModel, state: ContactState,
             translations: Mapping[str, tuple[float, float]], step: float = 1e-3,
             event_tol: float = 1e-9, stop_on_event: bool = False,
@@ -808,9 +815,12 @@ def advance(model: ContactModel, state: ContactState,
     MechanicsError
         For bad arguments, a lost grasp (fewer than 2 contacts) or a solve that fails.
     """
-    for name, value in (("step", step), ("event_tol", event_tol)):
-        if not (np.isfinite(value) and value > 0):
-            raise MechanicsError(f"{name} must be > 0 (relative to the object size), got {value}")
+    if not (np.isfinite(step) and step >= MIN_STEP):
+        raise MechanicsError(f"step must be >= {MIN_STEP} (relative to the object size), got "
+                             f"{step}")
+    if not (np.isfinite(event_tol) and event_tol >= MIN_EVENT_TOL):
+        raise MechanicsError(f"event_tol must be >= {MIN_EVENT_TOL} (relative to the object "
+                             f"size), got {event_tol}")
     bad = sorted(set(terminate_on) - set(TERMINATION_ORDER))
     if bad:
         raise MechanicsError(f"unknown termination {bad[0]!r} (allowed: {TERMINATION_ORDER})")

@@ -275,10 +275,13 @@ def test_sigkill_of_the_client_loses_nothing_finished_and_resume_completes(tmp_p
     assert json.loads(again.stdout)["skipped"] == total
 
 
-def test_ctrl_c_stops_cleanly_with_exit_130_and_resumes(tmp_path):
-    """SIGINT to the whole process group, as Ctrl-C in a terminal: exit 130, one message and
-    no traceback (workers leave SIGINT to the client), and the re-run completes the table."""
-    data = {**SMALL, "chunk": 2}
+@pytest.mark.parametrize("signum, code", [
+    (signal.SIGINT, 130), pytest.param(signal.SIGTERM, 143, marks=pytest.mark.slow)])
+def test_ctrl_c_stops_cleanly_and_resumes(tmp_path, signum, code):
+    """SIGINT (or SIGTERM) to the whole process group, as Ctrl-C in a terminal: exit 130 (143),
+    one message and no traceback, the manifest agrees with the parts, and the re-run completes
+    the table."""
+    data = {**SMALL, "chunk": 2, "mesh": {"nodes": 600}, "relative_depth": [0.04, 0.08]}
     spec = write_spec(tmp_path, data)
     out = tmp_path / "out"
     cmd = [str(BIN / "squeeze-grasp"), "sweep", str(spec), "--out", str(out), "--workers", "1"]
@@ -288,14 +291,14 @@ def test_ctrl_c_stops_cleanly_with_exit_130_and_resumes(tmp_path):
         while len(list((out / "parts").glob("*.parquet"))) < 1:
             assert proc.poll() is None
             time.sleep(0.05)
-        os.killpg(proc.pid, signal.SIGINT)
-        assert proc.wait(timeout=60) == 130
+        os.killpg(proc.pid, signum)
+        assert proc.wait(timeout=60) == code
         err = proc.stderr.read().decode()
         assert "Re-run the same command to resume" in err and "Traceback" not in err
     finally:
         stop([proc])
     manifest = json.loads((out / "manifest.json").read_text())
-    assert manifest["counts"]["done"] >= 1
+    assert manifest["counts"]["done"] == len(list((out / "parts").glob("*.parquet"))) >= 1
     assert subprocess.run(cmd + ["--no-progress"], capture_output=True).returncode == 0
     loaded = parse_sweep_spec(data, tmp_path)
     assert table_without_time(out).to_pylist() == bare_rows(loaded)

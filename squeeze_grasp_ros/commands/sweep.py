@@ -4,6 +4,7 @@
 from __future__ import annotations
 
 import argparse
+import signal
 import sys
 
 from ..exit_codes import ExitCode
@@ -32,7 +33,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> dict | int:
-    """Run or resume the sweep; returns its counts (exit 130 when interrupted)."""
+    """Run or resume the sweep; returns its counts (exit 130 on SIGINT, 143 on SIGTERM)."""
     if args.workers is not None and args.workers < 1:
         raise SweepError(f"--workers must be >= 1, got {args.workers}")
     if args.workers is not None and args.scheduler:
@@ -47,10 +48,12 @@ def run(args: argparse.Namespace) -> dict | int:
     outcome = run_sweep(loaded, args.out, scheduler=args.scheduler, workers=args.workers,
                         progress=not args.no_progress)
     result = {"dry_run": False, "out": args.out, "spec_hash": loaded.hash, **vars(outcome)}
-    if outcome.interrupted:
-        print(f"squeeze-grasp sweep: interrupted; {outcome.done} task(s) written this run. "
+    if outcome.interrupted is not None:
+        name = signal.Signals(outcome.interrupted).name
+        print(f"squeeze-grasp sweep: stopped by {name}; {outcome.done} task(s) written this run. "
               "Re-run the same command to resume.", file=sys.stderr)
-        return int(ExitCode.INTERRUPTED)
+        return int(ExitCode.INTERRUPTED if outcome.interrupted == signal.SIGINT
+                   else ExitCode.TERMINATED)
     return result
 
 

@@ -16,6 +16,7 @@ import importlib.util
 import logging
 import os
 import signal
+import threading
 import sys
 import time
 import urllib.request
@@ -31,6 +32,8 @@ INSTALL_HINT = ("squeeze-grasp sweep needs the 'sweep' extra (Dask distributed a
                 "pip install '.[sweep]' in the repository (or pip install 'dask[distributed]' "
                 "pyarrow)")
 BAR_WIDTH = 24
+POLL_S = 0.05
+"""Seconds between checks for finished tasks and stop signals."""
 DRY_RUN_SAMPLE = 4
 """Evaluations timed by ``--dry-run``."""
 
@@ -87,7 +90,8 @@ class Progress:
 @dataclass
 class Outcome:
     """What a sweep run did: counts of tasks and evaluations; seconds in all, summed over the
-    tasks for preparing groups and evaluating, and until the cluster was ready."""
+    tasks for preparing groups and evaluating, and until the cluster was ready; the signal
+    (SIGINT, SIGTERM) that stopped it, or None."""
 
     tasks: int
     skipped: int
@@ -98,7 +102,7 @@ class Outcome:
     seconds: float
     workers: int
     dashboard: Optional[str]
-    interrupted: bool
+    interrupted: Optional[int]
     prepare_s: float
     evaluate_s: float
     startup_s: float = 0.0
@@ -153,6 +157,55 @@ def _check_workers(client) -> int:
     return len(versions)
 
 
+class StopSignals:
+    """Within ``with``: SIGINT and SIGTERM set :attr:`signal` instead of raising, so that a
+    part and its manifest update are never cut in half (main thread only; elsewhere a no-op)."""
+
+    def __init__(self) -> None:
+        self.signal: Optional[int] = None
+        self._event = threading.Event()
+        self._old: dict = {}
+
+    def _handle(self, signum, _frame) -> None:
+        self.signal = signum
+        self._event.set()
+
+    def wait(self, seconds: float) -> None:
+        """Sleep up to ``seconds``, waking at a signal."""
+        self._event.wait(seconds)
+
+    def __enter__(self) -> "StopSignals":
+        if threading.current_thread() is threading.main_thread():
+            for signum in (signal.SIGINT, signal.SIGTERM):
+                self._old[signum] = signal.signal(signum, self._handle)
+        return self
+
+    def __exit__(self, *exc) -> None:
+        for signum, old in self._old.items():
+            signal.signal(signum, old)
+
+
+def _collect(future, task: Task, store, outcome: "Outcome", bar: Progress) -> None:
+    """Write a finished task's part (or record its failure) and count it."""
+    try:
+        result = future.result()
+    except Exception as exc:  # noqa: BLE001 - a task that raises is recorded
+        store.fail(task, f"{type(exc).__name__}: {exc}")
+        outcome.failed += 1
+        bar.total -= task.evaluations
+        bar.update(0)
+        return
+    rows = result["rows"]
+    store.write(task, rows, result["outline"])
+    outcome.done += 1
+    outcome.evaluations += len(rows)
+    outcome.errors += sum(1 for r in rows if r.get("error"))
+    outcome.prepare_s += result["prepare_s"]
+    outcome.evaluate_s += result["evaluate_s"]
+    bar.total -= task.evaluations - len(rows)
+    bar.update(len(rows))
+
+
 def run_sweep(loaded: LoadedSpec, out: str | Path, *, scheduler: Optional[str] = None,
               workers: Optional[int] = None, progress: bool = True,
               on_task: Optional[Callable[[Task], None]] = None) -> Outcome:
@@ -178,7 +231,7 @@ def run_sweep(loaded: LoadedSpec, out: str | Path, *, scheduler: Optional[str] =
     tasks = plan_tasks(loaded)
     store = Store(out, loaded, tasks)
     todo = [t for t in tasks if not store.done(t.id)]
-    outcome = Outcome(len(tasks), len(tasks) - len(todo), 0, 0, 0, 0, 0.0, 0, None, False,
+    outcome = Outcome(len(tasks), len(tasks) - len(todo), 0, 0, 0, 0, 0.0, 0, None, None,
                       0.0, 0.0)
     if not todo:
         outcome.seconds = time.perf_counter() - start
@@ -195,30 +248,19 @@ def run_sweep(loaded: LoadedSpec, out: str | Path, *, scheduler: Optional[str] =
         bar.update(0)
         futures = {client.submit(run_task, t, key=f"sweep-{loaded.hash[:12]}-{t.id}",
                                  pure=False): t for t in todo}
-        try:
-            for future in as_completed(futures):
-                task = futures.pop(future)
-                try:
-                    result = future.result()
-                except Exception as exc:  # noqa: BLE001 - a task that raises is recorded
-                    store.fail(task, f"{type(exc).__name__}: {exc}")
-                    outcome.failed += 1
-                    bar.total -= task.evaluations
-                    bar.update(0)
-                    continue
-                rows = result["rows"]
-                store.write(task, rows, result["outline"])
-                outcome.done += 1
-                outcome.evaluations += len(rows)
-                outcome.errors += sum(1 for r in rows if r.get("error"))
-                outcome.prepare_s += result["prepare_s"]
-                outcome.evaluate_s += result["evaluate_s"]
-                bar.total -= task.evaluations - len(rows)
-                bar.update(len(rows))
-                if on_task is not None:
-                    on_task(task)
-        except KeyboardInterrupt:
-            outcome.interrupted = True
+        pending = as_completed(futures)
+        with StopSignals() as stop:
+            while not pending.is_empty() and stop.signal is None:
+                batch = pending.next_batch(block=False)
+                if not batch:
+                    stop.wait(POLL_S)
+                for future in batch:
+                    task = futures.pop(future)
+                    _collect(future, task, store, outcome, bar)
+                    if on_task is not None:
+                        on_task(task)
+        if stop.signal is not None:
+            outcome.interrupted = stop.signal
             client.cancel(list(futures))
         bar.update(0, final=True)
     finally:

@@ -655,7 +655,8 @@ def key_reference(cls: type, prefix: str = "", width: int = 38,
         if typing.get_origin(inner) is tuple and dataclasses.is_dataclass(typing.get_args(inner)[0]):
             inner, path = typing.get_args(inner)[0], path + "[]"
         req = f.default is dataclasses.MISSING and f.default_factory is dataclasses.MISSING
-        extra = [x for x in (meta.get("unit"), _describe(dict(meta)),
+        ranged = meta.get("lo") is not None or meta.get("hi") is not None
+        extra = [x for x in (meta.get("unit"), _describe(dict(meta)) if ranged else "",
                              "one of " + "/".join(meta["choices"]) if meta.get("choices") else "",
                              "required" if req else "") if x]
         lines.append(f"{path:{width}s} {meta.get('doc', '')}"

@@ -112,6 +112,9 @@ def test_sweep_help_lists_every_key():
     for key in ("objects[].family.exponent", "placements.require", "adversary.directions",
                 "materials.<name>.E", "mesh.nodes"):
         assert key in text
+    lines = {line.split()[0]: line for line in text.splitlines() if line.strip()}
+    assert lines["base"].endswith("[required]") and lines["name"].endswith("sweep name")
+    assert lines["friction"].endswith("[>= 0.0]")
 
 
 def test_seeds_come_from_ids_not_from_order(tmp_path):

@@ -251,7 +251,7 @@ def test_numbers_that_would_be_silently_wrong_are_refused(tmp_path, capfd):
     trials = tmp_path / "trials.csv"
     trials.write_text("angle_deg,slid\n60,0\n95,1\n")
     assert main(["calibrate", "--slope-trials", str(trials)]) == 2
-    assert "[0, 90) deg" in capfd.readouterr().err
+    assert "[0, 90] deg" in capfd.readouterr().err
     same = tmp_path / "same.csv"
     same.write_text("x,y\n1,1\n1,1\n1,1\n")
     assert main(["match", str(same), str(same)]) == 2

@@ -7,10 +7,21 @@ failed (the executor is stopped), 2 user error, 4 internal error.
 """
 from __future__ import annotations
 
+import contextlib
 import json
+import os
+import signal
+import subprocess
+import sys
+import time
 from pathlib import Path
 
+import pytest
+import yaml
+
+from pipeline_support import SMALL_SQUARE
 from squeeze_grasp_ros.cli import main
+from squeeze_grasp_ros.recording.bag import read_bag
 
 SCENES = Path(__file__).resolve().parents[1] / "config" / "scenes"
 
@@ -34,3 +45,87 @@ def test_a_held_grasp_exits_0(capfd):
     assert main(["run", str(SCENES / "foam_square.yaml"), "--json", "--quiet"]) == 0
     out = json.loads(capfd.readouterr().out)
     assert out["success"] is True and out["outcome"] == "grasp held"
+
+
+def long_scene(tmp_path: Path, **changes) -> str:
+    """The foam square at a 0.1 ms tick: about 7,000 ticks, long enough to interrupt."""
+    data = yaml.safe_load((SCENES / "foam_square.yaml").read_text())
+    data["sim"] = {"dt": 1e-4}
+    data.update(changes)
+    path = tmp_path / "long_square.yaml"
+    path.write_text(yaml.safe_dump(data))
+    return str(path)
+
+
+def start_run(tmp_path: Path, *extra: str) -> tuple[subprocess.Popen, Path]:
+    bag = tmp_path / "bag"
+    proc = subprocess.Popen([sys.executable, "-m", "squeeze_grasp_ros.cli", "run",
+                             long_scene(tmp_path), "--record", str(bag), "--quiet", *extra],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    deadline = time.monotonic() + 120
+    while not any(bag.glob("*.mcap")) or next(bag.glob("*.mcap")).stat().st_size < 300_000:
+        assert proc.poll() is None, proc.communicate()
+        assert time.monotonic() < deadline, "the run never started recording"
+        time.sleep(0.2)
+    return proc, bag
+
+
+@pytest.mark.parametrize("signum", [signal.SIGINT, signal.SIGTERM])
+def test_a_signal_stops_a_one_process_run_at_once_with_a_readable_bag(tmp_path, signum):
+    proc, bag = start_run(tmp_path)
+    sent = time.monotonic()
+    proc.send_signal(signum)
+    _, err = proc.communicate(timeout=60)
+    stopped_after = time.monotonic() - sent
+    assert proc.returncode == 128 + signum
+    assert stopped_after < 10, stopped_after  # the whole squeeze takes several times longer
+    messages = read_bag(bag).messages
+    assert f"recording in {bag} is complete up to here ({len(messages)} messages)" in err
+    ticks = [m for m in messages if m.topic == "/sim/tick"]
+    assert 0 < len(ticks) < 7000
+
+
+@pytest.mark.slow
+def test_sigterm_to_the_processes_parent_takes_the_children_down(tmp_path):
+    proc, bag = start_run(tmp_path, "--processes")
+    children = subprocess.run(["pgrep", "-P", str(proc.pid)], capture_output=True,
+                              text=True).stdout.split()
+    assert len(children) >= 4
+    proc.send_signal(signal.SIGTERM)
+    _, err = proc.communicate(timeout=90)
+    assert proc.returncode == 143, err
+    for pid in children:
+        assert not Path(f"/proc/{pid}").exists() or \
+            Path(f"/proc/{pid}/stat").read_text().split()[2] == "Z", pid
+    assert read_bag(bag).messages
+
+
+@pytest.mark.slow
+def test_a_hung_node_ends_the_run_with_a_clear_error(tmp_path):
+    proc, _ = start_run(tmp_path, "--processes", "--timeout", "20")
+    monitor = subprocess.run(["pgrep", "-P", str(proc.pid), "-f", "nodes.monitor"],
+                             capture_output=True, text=True).stdout.split()
+    assert monitor
+    os.kill(int(monitor[0]), signal.SIGSTOP)
+    try:
+        _, err = proc.communicate(timeout=120)
+    finally:
+        with contextlib.suppress(ProcessLookupError):
+            os.kill(int(monitor[0]), signal.SIGCONT)
+    assert proc.returncode == 4, err
+    assert "timed out after 20 s" in err and "Traceback" not in err
+
+
+def test_sensor_dropout_1_ends_the_goal_after_the_stale_budget(tmp_path, capfd):
+    data = yaml.safe_load(yaml.safe_dump(SMALL_SQUARE))
+    data["effects"] = data["effects"] + ["sensor_dropout"]
+    data["sensors"] = {"dropout": 1.0, "seed": 3}
+    path = tmp_path / "dropout.yaml"
+    path.write_text(yaml.safe_dump(data))
+    start = time.monotonic()
+    code = main(["run", str(path), "--json"])
+    out = json.loads(capfd.readouterr().out)
+    assert time.monotonic() - start < 60
+    assert code == 1 and out["termination"] == "stale_data"
+    assert out["sim_time"] < 0.2 + 0.05
+    assert sum(out["alarms"].values()) <= 4  # one per alarm episode and finger, not per tick

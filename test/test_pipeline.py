@@ -212,7 +212,8 @@ def test_sensor_dropout_makes_the_executor_hold(tmp_path):
                                        overrides={"monitor": {"alarm_ratio": 2.0}}))
     run = runner.run()
     assert run["termination"] == "depth_reached"
-    assert run["hold_ticks"] > 0 and run["alarms"]["stale_sensor"] >= run["hold_ticks"]
+    # one alarm message per stale episode; the executor holds on every stale tick
+    assert run["hold_ticks"] > 0 and 1 <= run["alarms"]["stale_sensor"] <= run["hold_ticks"]
     positions = [np.array([[p.x, p.y] for p in s.positions]) for s in runner.sim_states]
     moves = [np.abs(b - a).max() for a, b in zip(positions, positions[1:])]
     assert sum(1 for m in moves if m == 0.0) >= run["hold_ticks"]

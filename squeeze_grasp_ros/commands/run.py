@@ -5,7 +5,9 @@ from __future__ import annotations
 
 import argparse
 import json
+import signal
 import sys
+from pathlib import Path
 
 from ..exit_codes import ExitCode
 from .common import add_scene_argument, fail, new_folder
@@ -46,6 +48,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--no-planner", action="store_true",
                         help="plan with the mechanics API instead of the planner node")
     parser.add_argument("--quiet", action="store_true", help="no progress line")
+    parser.add_argument("--timeout", type=float, default=300.0, metavar="SECONDS",
+                        help="wall-clock seconds to wait for any step of the run (a node that "
+                             "hangs or dies ends the run with exit 4; default: 300)")
 
 
 def _progress_line(update: dict) -> None:
@@ -62,18 +67,23 @@ def run(args: argparse.Namespace) -> dict | int:
     130 after Ctrl-C (the recording is finished first)."""
     from ..nodes.runner import PipelineRunner, RunError, RunOptions
 
+    if not (args.timeout > 0 and args.timeout < float("inf")):
+        return fail(args, f"--timeout must be > 0 s, got {args.timeout}", ExitCode.USAGE)
+
     options = RunOptions(args.scene, record=args.record,
                          include_hidden_topics=args.include_hidden_topics, attach=args.attach,
                          processes=args.processes,
                          executor=args.executor, on_slip_alarm=args.on_slip_alarm,
-                         resist=not args.no_resist, planner=not args.no_planner)
+                         resist=not args.no_resist, planner=not args.no_planner,
+                         timeout=args.timeout)
     show = not (args.quiet or args.json) and sys.stderr.isatty()
     try:
         result = PipelineRunner(options, _progress_line if show else None).run()
-    except KeyboardInterrupt:
-        where = f"; the recording is complete up to here: {args.record}" if args.record else ""
-        print(f"\nsqueeze-grasp run: interrupted{where}", file=sys.stderr)
-        return ExitCode.INTERRUPTED
+    except KeyboardInterrupt as exc:
+        signum = getattr(exc, "signum", signal.SIGINT)
+        print(f"\nsqueeze-grasp run: stopped by {signal.Signals(signum).name}; "
+              f"{recording_state(args.record)}", file=sys.stderr)
+        return 128 + signum
     except RunError as exc:
         return fail(args, str(exc), ExitCode.INTERNAL)
     finally:
@@ -83,6 +93,21 @@ def run(args: argparse.Namespace) -> dict | int:
         print(json.dumps(result) if args.json else summary(result))
         return ExitCode.OUTCOME
     return result
+
+
+def recording_state(record: str | None) -> str:
+    """What an interrupted run left behind, checked, not assumed."""
+    if not record:
+        return "nothing was recorded"
+    from ..recording.bag import BagError, read_bag
+
+    if not (Path(record) / "metadata.yaml").is_file():
+        return f"no recording was written ({record} has no bag)"
+    try:
+        count = len(read_bag(record).messages)
+    except BagError as exc:
+        return f"the recording in {record} is not readable: {exc}"
+    return f"the recording in {record} is complete up to here ({count} messages)"
 
 
 def _vector(v: list) -> str:

@@ -56,12 +56,16 @@ class MotionLimits:
         A phase ends when every moving tip is measured this close to its setpoint, m.
     redirect_grace : int
         Cycles after a redirection during which the slip alarm is ignored.
+    stale_budget : float
+        Longest uninterrupted hold for stale sensor data, s of (sim) time; past it the goal
+        ends ``stale_data`` holding position.
     """
 
     max_velocity: float = 0.01
     max_acceleration: float = 0.1
     position_tolerance: float = 1e-7
     redirect_grace: int = 20
+    stale_budget: float = 0.1
 
 
 @dataclass(frozen=True)
@@ -273,6 +277,7 @@ class GraspProgram:
         self.redirected = False
         self.grace = 0
         self.hold_ticks = 0
+        self.stale_time = 0.0
         self.ticks = 0
         self.cancel_requested = False
         self.work = {f: 0.0 for f in self.fingers}
@@ -308,8 +313,15 @@ class GraspProgram:
         if stale & set(self.moving):
             self.v = 0.0
             self.hold_ticks += 1
+            self.stale_time += dt
+            if self.stale_time > self.limits.stale_budget:
+                return self._finish(obs, "stale_data", f"sensor data of "
+                                    f"{', '.join(sorted(stale & set(self.moving)))} stale for "
+                                    f"{self.stale_time:.3f} s (stale_budget "
+                                    f"{self.limits.stale_budget} s)")
             return Command(self._setpoints(), "holding", None,
                            "stale sensor data: " + ", ".join(sorted(stale & set(self.moving))))
+        self.stale_time = 0.0
         if self.s >= self.path.end and self._settled(obs):
             done = self._phase_done(obs)
             if done is not None:

@@ -204,8 +204,8 @@ def friction_from_trials(trials: list[tuple[float, bool]]) -> Friction:
     """
     for angle, _ in trials:
         require_finite("slope trial angle", angle)
-        if not 0 <= angle < np.pi / 2:
-            raise MechanicsError(f"slope trial angles must be in [0, 90) deg, got "
+        if not 0 <= angle <= np.pi / 2:
+            raise MechanicsError(f"slope trial angles must be in [0, 90] deg, got "
                                  f"{np.degrees(angle):.6g} deg")
     held = [a for a, slid in trials if not slid]
     slid = [a for a, s in trials if s]

@@ -49,6 +49,8 @@ PARAMETERS: dict[str, tuple[Any, str]] = {
     "max_acceleration": (0.1, "largest fingertip acceleration, m/s^2"),
     "position_tolerance": (1e-7, "a phase ends when every moving tip is this close, m"),
     "redirect_grace": (20, "cycles the slip alarm is ignored after a redirection"),
+    "stale_budget": (0.1, "longest hold for stale sensor data, s; past it the goal ends "
+                          "stale_data"),
     "period": (0.001, "control cycle, s (lockstep: the simulated tick)"),
     "feedback_every": (10, "cycles between action feedback messages"),
     "lockstep": (True, "cycle on each monitor status (simulation) or on a wall-clock timer"),
@@ -59,7 +61,8 @@ PARAMETERS: dict[str, tuple[Any, str]] = {
 SUCCESS = (ExecuteGrasp.Result.DEPTH_REACHED, ExecuteGrasp.Result.RESISTED,
            ExecuteGrasp.Result.PICKED_UP)
 """Terminations that count as success."""
-HOLDS = (ExecuteGrasp.Result.CANCELED, ExecuteGrasp.Result.SLIP_ALARM)
+HOLDS = (ExecuteGrasp.Result.CANCELED, ExecuteGrasp.Result.SLIP_ALARM,
+         ExecuteGrasp.Result.STALE_DATA)
 """Terminations after which the executor reports that it holds position."""
 
 
@@ -83,7 +86,8 @@ class ExecutorNode(Node):
         self.p = p = pipeline.declare(self, PARAMETERS)
         self.devices = pipeline.parse_mapping(p["finger_devices"], "finger_devices")
         self.limits = MotionLimits(p["max_velocity"], p["max_acceleration"],
-                                   p["position_tolerance"], p["redirect_grace"])
+                                   p["position_tolerance"], p["redirect_grace"],
+                                   float(p["stale_budget"]))
         self.period_ns = int(round(p["period"] * 1e9))
         loop = pipeline.loop_qos(p["qos_depth"])
         self.setpoint_pubs = {f: self.create_publisher(PoseStamped,

@@ -12,7 +12,8 @@ and runs :class:`..control.tracker.ContactTracker` once per tick:
 - hardware (``lockstep: false``): a wall-clock timer at ``rate`` Hz uses the newest readings.
 
 Each tick it publishes the tick's events as one ``monitor/events`` array (when there are
-any), one ``monitor/alarms`` message per active alarm, the reconstructed
+any), one ``monitor/alarms`` message per alarm episode (when an alarm of a type and finger
+becomes active; ``monitor/status`` lists the alarms active at every tick), the reconstructed
 ``monitor/contact_state`` and, last, the ``monitor/status`` the executor acts on. A repeated
 ``sim/tick`` (a re-sent tick) gets the same status again, nothing else. The planner's
 prediction (``planner/predicted_events``, latched) is compared with the observed
@@ -85,6 +86,7 @@ class MonitorNode(Node):
         self.buffer: dict[int, dict[str, Any]] = {}
         self.expected: dict[int, set[str]] = {}
         self.last_ns = -1
+        self.active_alarms: set[tuple[str, str]] = set()
         self.last_status: MonitorStatus | None = None
         if p["lockstep"]:
             self.create_subscription(Tick, pipeline.TICK, self._tick, loop)
@@ -148,7 +150,10 @@ class MonitorNode(Node):
         out = self.tracker.update(ns, self._samples())
         frame = self.p["frame_id"]
         batch = [(self.event_pub, messages.tracked_events_msg(out))] if out.events else []
-        batch += [(self.alarm_pub, messages.alarm_msg(a, ns)) for a in out.alarms]
+        active = {(a.type, a.finger) for a in out.alarms}
+        batch += [(self.alarm_pub, messages.alarm_msg(a, ns)) for a in out.alarms
+                  if (a.type, a.finger) not in self.active_alarms]
+        self.active_alarms = active
         batch.append((self.state_pub, messages.patches_state_msg(out, frame)))
         self.last_status = messages.monitor_status_msg(out, frame)
         batch.append((self.status_pub, self.last_status))

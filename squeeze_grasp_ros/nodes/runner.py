@@ -87,6 +87,18 @@ GRASP_HELD: tuple[str, ...] = ("none", "picked_up")
 """World terminations after which the grasp holds ("none": the world never ended)."""
 
 
+STOP_SIGNALS = (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)
+"""Signals that stop a run cleanly (the recording is finished, node processes are stopped)."""
+
+
+class Interrupted(KeyboardInterrupt):
+    """A run stopped by a signal; ``signum`` says which (exit status 128 + signum)."""
+
+    def __init__(self, signum: int) -> None:
+        super().__init__(signal.Signals(signum).name)
+        self.signum = int(signum)
+
+
 class RunError(RuntimeError):
     """The pipeline could not be started or did not finish in time."""
 
@@ -210,6 +222,7 @@ class PipelineRunner:
         self.t0 = time.perf_counter()
         self.timing: dict[str, float] = {}
         self.interrupted = threading.Event()
+        self.signal = signal.SIGINT
         self.context = Context()
         rclpy.init(context=self.context, signal_handler_options=SignalHandlerOptions.NO)
         self.executor = (EventsExecutor(context=self.context) if options.executor == "events"
@@ -302,7 +315,7 @@ class PipelineRunner:
         deadline = time.monotonic() + timeout
         while not done():
             if self.interrupted.is_set():
-                raise KeyboardInterrupt
+                raise Interrupted(self.signal)
             if time.monotonic() > deadline:
                 raise RunError(f"timed out after {timeout:.0f} s waiting for {what}")
             self._check_processes()
@@ -619,8 +632,16 @@ class PipelineRunner:
 
     # ----------------------------------------------------------------- shutdown
     def shutdown(self) -> None:
-        """Stop every node (the recorder finishes its bag) and the rclpy context."""
+        """Stop every node (the recorder finishes its bag) and the rclpy context.
+
+        After an interruption the simulated hardware leaves the executor first, so the lockstep
+        loop stops at once and the recorder drains only what it has already received.
+        """
         try:
+            if self.interrupted.is_set():
+                for node in self.nodes:
+                    if node.get_name() == "sim_hardware":
+                        self.executor.remove_node(node)
             for node in self.nodes:
                 if hasattr(node, "drain"):
                     node.drain(self.executor)
@@ -636,7 +657,8 @@ class PipelineRunner:
                     proc.wait()
         finally:
             for node in self.nodes + [self.client]:
-                self.executor.remove_node(node)
+                if node in self.executor.get_nodes():
+                    self.executor.remove_node(node)
                 node.destroy_node()
             self.executor.shutdown()
             self.context.try_shutdown()
@@ -647,19 +669,26 @@ class PipelineRunner:
     def run(self) -> dict:
         """Start, execute the goal, collect the summary, shut down; returns the JSON summary.
 
-        SIGINT (Ctrl-C) sets a flag that the waiting loop turns into ``KeyboardInterrupt``
-        between callbacks, so no callback (a recorder write) is cut in half; the shutdown still
-        finishes the recording.
+        SIGINT (Ctrl-C), SIGTERM and SIGHUP set a flag that the waiting loop turns into
+        :class:`Interrupted` between callbacks, so no callback (a recorder write) is cut in half;
+        the shutdown then stops the simulated world first (no new ticks), lets the recorder
+        write what it has received and finishes the recording, and stops every node process.
         """
-        previous = signal.signal(signal.SIGINT, lambda *_: self.interrupted.set())
+        def on_signal(signum: int, _frame: Any) -> None:
+            self.signal = signum
+            self.interrupted.set()
+        previous = {s: signal.signal(s, on_signal) for s in STOP_SIGNALS}
         try:
             self.start()
             self.send_goal()
             result = self.wait_result()
             return self.summary(result)
         finally:
-            signal.signal(signal.SIGINT, previous)
-            self.shutdown()
+            try:
+                self.shutdown()
+            finally:
+                for signum, handler in previous.items():
+                    signal.signal(signum, handler)
 
     def summary(self, result: ExecuteGrasp.Result) -> dict:
         """JSON-able summary of a finished goal (ground truth and measured)."""

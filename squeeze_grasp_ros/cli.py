@@ -7,6 +7,7 @@ import argparse
 import importlib
 import json
 import math
+import os
 import sys
 from typing import Any
 
@@ -72,14 +73,18 @@ def main(argv: list[str] | None = None) -> int:
                     ExitCode.INTERNAL)
     if isinstance(result, int):
         return result
-    if args.json:
-        bad: list[str] = []
-        clean = finite_json(result, "", bad)
-        if bad:
-            clean["non_finite"] = bad
-        sys.stdout.write(json.dumps(clean, allow_nan=False) + "\n")
-    else:
-        print(args._module.summary(result))
+    try:
+        if args.json:
+            bad: list[str] = []
+            clean = finite_json(result, "", bad)
+            if bad:
+                clean["non_finite"] = bad
+            sys.stdout.write(json.dumps(clean, allow_nan=False) + "\n")
+        else:
+            print(args._module.summary(result))
+        sys.stdout.flush()
+    except BrokenPipeError:  # the reader (e.g. `| head`) closed the pipe: not an error
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
     return ExitCode.OK
 
 

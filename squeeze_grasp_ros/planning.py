@@ -71,6 +71,7 @@ class ErrorCode(IntEnum):
     NOT_FEASIBLE = 3
     INTERNAL_ERROR = 4
     CANCELLED = 5
+    BUSY = 6
 
 
 class PlannerError(Exception):

@@ -294,3 +294,53 @@ def test_json_errors_and_non_finite_results_are_valid_json(tmp_path, capfd):
     clean = finite_json({"a": [1.0, float("inf")], "b": {"c": float("nan")}, "d": "x"}, "", bad)
     assert clean == {"a": [1.0, None], "b": {"c": None}, "d": "x"}
     assert bad == ["a[1]", "b.c"]
+
+
+def send_and_wait(harness: Harness, calls: list, timeout: float = 120.0) -> list:
+    """Send every (client, request) at once; spin until all are answered; the responses."""
+    deadline = time.monotonic() + 30
+    while not all(c.service_is_ready() for c, _ in calls):
+        assert time.monotonic() < deadline
+        harness.executor.spin_once(0.05)
+    futures = [c.call_async(r) for c, r in calls]
+    deadline = time.monotonic() + timeout
+    while not all(f.done() for f in futures):
+        assert time.monotonic() < deadline, sum(f.done() for f in futures)
+        harness.executor.spin_once(0.05)
+    return [f.result() for f in futures]
+
+
+def test_thirty_concurrent_requests_all_get_an_answer(planner):
+    """30 clients send one load each at once. A service runs one long request at a time, so the
+    others wait in its queue: with the default depth of 10, 20 of them were dropped unanswered;
+    the queue depth is now the service_queue_depth parameter (100)."""
+    def scene(k: int) -> str:  # distinct meshes: no request is a cache hit
+        data = yaml.safe_load(BLOB)
+        data["object"]["mesh"] = {"nodes": 300 + 10 * k}
+        return yaml.safe_dump(data)
+    calls = [(planner.node.create_client(LoadObject, f"{planner.planner_name}/load_object"),
+              LoadObject.Request(scene_yaml=scene(k), object_id=f"o{k}")) for k in range(30)]
+    responses = send_and_wait(planner, calls)
+    assert [r.error_code for r in responses] == [ErrorCode.OK] * 30
+    assert_alive(planner)
+
+
+def test_long_requests_beyond_max_pending_are_answered_busy(ros_context: Context):
+    """With max_pending 0 every long request is refused BUSY at once, with the reason; quick
+    requests (plan_squeeze on a cached object) are still served."""
+    from rclpy.parameter import Parameter
+
+    from squeeze_grasp_interfaces.srv import GraspMap, PlanSqueeze
+
+    harness = Harness(ros_context, parameter_overrides=[Parameter("max_pending", value=0)])
+    try:
+        for request in (LoadObject.Request(scene_yaml=BLOB, object_id="blob"),):
+            response = harness.call(LoadObject, "load_object", request)
+            assert response.error_code == ErrorCode.BUSY and "max_pending" in response.message
+        response = harness.call(GraspMap, "grasp_map", GraspMap.Request(object_id="x", mu=0.4))
+        assert response.error_code == ErrorCode.BUSY
+        response = harness.call(PlanSqueeze, "plan_squeeze", PlanSqueeze.Request(
+            object_id="nope", squeeze_type="stable"))
+        assert response.error_code == ErrorCode.UNKNOWN_OBJECT  # quick path, not queued
+    finally:
+        harness.close()

@@ -39,6 +39,7 @@ from rclpy.action import ActionServer, CancelResponse
 from rclpy.action.server import ServerGoalHandle
 from rclpy.executors import SingleThreadedExecutor
 from rclpy.node import Node
+from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
 from rclpy.task import Future
 
 from squeeze_grasp_interfaces.action import EventSqueeze as EventSqueezeAction
@@ -64,6 +65,9 @@ PARAMETERS: dict[str, tuple[Any, str]] = {
     "worker_threads": (2, "threads computing long requests (loads, maps, event squeezes)"),
     "best_count": (10, "placements a grasp map returns when a request asks for 0"),
     "min_step": (1e-5, "smallest event-squeeze substep, relative to the object size"),
+    "service_queue_depth": (100, "requests each service queues before DDS drops them"),
+    "max_pending": (16, "long requests (loads, maps, event squeezes) queued or running at "
+                        "once; more are answered BUSY at once"),
     "allowed_roots": ([""], "folders whose files scene_path and a scene's outline file may "
                             "name (symlinks and '..' resolved first); [''] = the package share "
                             "folder and the node's working directory"),
@@ -105,12 +109,24 @@ class PlannerNode(Node):
         self._stopping = threading.Event()
         self._feedback: queue.SimpleQueue[tuple[ServerGoalHandle, Any]] = queue.SimpleQueue()
 
-        self.create_service(LoadObject, "~/load_object", self._load_object)
-        self.create_service(PlanSqueeze, "~/plan_squeeze", self._plan_squeeze)
-        self.create_service(GraspMap, "~/grasp_map", self._grasp_map)
-        self.create_service(PlanResistance, "~/plan_resistance", self._plan_resistance)
-        self.create_service(RingGraspTest, "~/ring_grasp_test", self._ring_grasp_test)
-        self.create_service(EventSqueeze, "~/event_squeeze", self._event_squeeze)
+        services = QoSProfile(history=HistoryPolicy.KEEP_LAST,
+                              depth=value("service_queue_depth"),
+                              reliability=ReliabilityPolicy.RELIABLE,
+                              durability=DurabilityPolicy.VOLATILE)
+        self._pending = 0
+        self._pending_lock = threading.Lock()
+        self.create_service(LoadObject, "~/load_object", self._load_object,
+                            qos_profile=services)
+        self.create_service(PlanSqueeze, "~/plan_squeeze", self._plan_squeeze,
+                            qos_profile=services)
+        self.create_service(GraspMap, "~/grasp_map", self._grasp_map,
+                            qos_profile=services)
+        self.create_service(PlanResistance, "~/plan_resistance", self._plan_resistance,
+                            qos_profile=services)
+        self.create_service(RingGraspTest, "~/ring_grasp_test", self._ring_grasp_test,
+                            qos_profile=services)
+        self.create_service(EventSqueeze, "~/event_squeeze", self._event_squeeze,
+                            qos_profile=services)
         self._actions = [
             ActionServer(self, GraspMapAction, "~/grasp_map", self._execute_grasp_map,
                          cancel_callback=self._accept_cancel),
@@ -255,11 +271,26 @@ class PlannerNode(Node):
         schedules that callback as a task, which wakes the executor at once (measured: the
         response follows the worker within a millisecond, with no busy loop).
         """
+        with self._pending_lock:
+            if self._pending >= self._parameter("max_pending"):
+                return messages.failure(response_type, ErrorCode.BUSY,
+                                        f"planner busy: {self._pending} long requests queued or "
+                                        f"running (max_pending); retry later")
+            self._pending += 1
+
+        def work() -> None:
+            try:
+                future.set_result(self._answer(response_type, compute))
+            finally:
+                with self._pending_lock:
+                    self._pending -= 1
         future = Future(executor=self.executor)
         future.add_done_callback(_resume)
         try:
-            self._pool.submit(lambda: future.set_result(self._answer(response_type, compute)))
+            self._pool.submit(work)
         except RuntimeError:
+            with self._pending_lock:
+                self._pending -= 1
             return messages.failure(response_type, ErrorCode.CANCELLED,
                                     "the planner is shutting down")
         return await future

@@ -115,18 +115,14 @@ class PlannerNode(Node):
                               durability=DurabilityPolicy.VOLATILE)
         self._pending = 0
         self._pending_lock = threading.Lock()
-        self.create_service(LoadObject, "~/load_object", self._load_object,
-                            qos_profile=services)
-        self.create_service(PlanSqueeze, "~/plan_squeeze", self._plan_squeeze,
-                            qos_profile=services)
-        self.create_service(GraspMap, "~/grasp_map", self._grasp_map,
-                            qos_profile=services)
-        self.create_service(PlanResistance, "~/plan_resistance", self._plan_resistance,
-                            qos_profile=services)
-        self.create_service(RingGraspTest, "~/ring_grasp_test", self._ring_grasp_test,
-                            qos_profile=services)
-        self.create_service(EventSqueeze, "~/event_squeeze", self._event_squeeze,
-                            qos_profile=services)
+        for srv_type, name, callback in (
+                (LoadObject, "load_object", self._load_object),
+                (PlanSqueeze, "plan_squeeze", self._plan_squeeze),
+                (GraspMap, "grasp_map", self._grasp_map),
+                (PlanResistance, "plan_resistance", self._plan_resistance),
+                (RingGraspTest, "ring_grasp_test", self._ring_grasp_test),
+                (EventSqueeze, "event_squeeze", self._event_squeeze)):
+            self.create_service(srv_type, f"~/{name}", callback, qos_profile=services)
         self._actions = [
             ActionServer(self, GraspMapAction, "~/grasp_map", self._execute_grasp_map,
                          cancel_callback=self._accept_cancel),

@@ -129,3 +129,21 @@ def test_sensor_dropout_1_ends_the_goal_after_the_stale_budget(tmp_path, capfd):
     assert code == 1 and out["termination"] == "stale_data"
     assert out["sim_time"] < 0.2 + 0.05
     assert sum(out["alarms"].values()) <= 4  # one per alarm episode and finger, not per tick
+
+
+def test_a_second_run_on_the_same_domain_is_refused(tmp_path):
+    first, first_bag = start_run(tmp_path)
+    try:
+        second = subprocess.run([sys.executable, "-m", "squeeze_grasp_ros.cli", "run",
+                                 str(SCENES / "foam_square.yaml"), "--record",
+                                 str(tmp_path / "second_bag"), "--quiet",
+                                 "--discovery-wait", "3"],
+                                capture_output=True, text=True, timeout=120)
+    finally:
+        first.send_signal(signal.SIGINT)
+        first.communicate(timeout=60)
+    assert second.returncode == 4
+    assert "another simulated pipeline is running on ROS_DOMAIN_ID" in second.stderr
+    assert not (tmp_path / "second_bag").exists()
+    topics = {m.topic for m in read_bag(first_bag).messages}
+    assert "/sim/tick" in topics

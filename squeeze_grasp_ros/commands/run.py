@@ -48,6 +48,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--no-planner", action="store_true",
                         help="plan with the mechanics API instead of the planner node")
     parser.add_argument("--quiet", action="store_true", help="no progress line")
+    parser.add_argument("--discovery-wait", type=float, default=1.0, metavar="SECONDS",
+                        help="least time to discover another simulation on this ROS domain "
+                             "before refusing to run beside it (default: 1; overlaps planning)")
     parser.add_argument("--timeout", type=float, default=300.0, metavar="SECONDS",
                         help="wall-clock seconds to wait for any step of the run (a node that "
                              "hangs or dies ends the run with exit 4; default: 300)")
@@ -75,7 +78,7 @@ def run(args: argparse.Namespace) -> dict | int:
                          processes=args.processes,
                          executor=args.executor, on_slip_alarm=args.on_slip_alarm,
                          resist=not args.no_resist, planner=not args.no_planner,
-                         timeout=args.timeout)
+                         timeout=args.timeout, discovery_wait=args.discovery_wait)
     show = not (args.quiet or args.json) and sys.stderr.isatty()
     try:
         result = PipelineRunner(options, _progress_line if show else None).run()

@@ -139,6 +139,9 @@ class RunOptions:
         Node name -> parameter overrides (applied last).
     timeout : float
         Wall-clock seconds a run may take.
+    discovery_wait : float
+        Least wall-clock seconds of DDS discovery before the run checks that no other
+        simulation uses its ROS domain (it overlaps the planning).
     """
 
     scene_path: str
@@ -152,6 +155,7 @@ class RunOptions:
     planner: bool = True
     overrides: dict = field(default_factory=dict)
     timeout: float = 300.0
+    discovery_wait: float = 1.0
 
 
 def node_parameters(scene: Scene, scene_path: str, options: RunOptions,
@@ -340,6 +344,7 @@ class PipelineRunner:
         between this process and the monitor had settled (seen: a run whose 7 monitor events
         never reached the client).
         """
+        discovery_ends = time.monotonic() + self.options.discovery_wait
         plan_source = self._use_planner()
         planner = self._start_planner() if plan_source and not self.options.attach else None
         try:
@@ -347,6 +352,8 @@ class PipelineRunner:
         finally:
             if planner is not None:
                 planner()
+        if not self.options.attach:
+            self._refuse_if_domain_busy(discovery_ends)
         self.timing["plan"] = self.plan.seconds
         self.prediction_pub.publish(self.plan.prediction)
         params = node_parameters(self.scene, self.options.scene_path, self.options,
@@ -366,6 +373,25 @@ class PipelineRunner:
                         self.options.timeout, "the publishers of the run's outcome topics")
         self.start_ns = self.sim_state_ns
         self.timing["start_nodes"] = time.perf_counter() - started
+
+    def _refuse_if_domain_busy(self, deadline: float) -> None:
+        """Refuse to start the nodes when another simulated pipeline runs on this ROS domain.
+
+        Two lockstep loops on one domain answer each other's ticks and record each other's
+        messages. Discovery runs while the run plans, for at least ``discovery_wait`` s; then a
+        publisher of ``sim/tick`` means another simulation is running. Two runs started within
+        that time of each other are not told apart: give concurrent runs their own
+        ROS_DOMAIN_ID.
+        """
+        while time.monotonic() < deadline:
+            self.executor.spin_once(0.02)
+        others = self.client.count_publishers("/" + pipeline.TICK)
+        if others:
+            domain = os.environ.get("ROS_DOMAIN_ID", "0")
+            raise RunError(f"another simulated pipeline is running on ROS_DOMAIN_ID {domain} "
+                           f"({others} publisher(s) of /{pipeline.TICK}); a second run would "
+                           "corrupt both. Stop it, or give this run its own domain, e.g. "
+                           "ROS_DOMAIN_ID=42 squeeze-grasp run ...")
 
     def _use_planner(self) -> bool:
         return self.options.attach or (self.options.planner

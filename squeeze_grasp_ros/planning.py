@@ -390,14 +390,15 @@ class ObjectCache:
         Raises
         ------
         PlannerError
-            UNKNOWN_OBJECT, listing the loaded ids.
+            UNKNOWN_OBJECT. The message does not list the loaded ids: they belong to other
+            clients.
         """
         with self._lock:
             loaded = self._objects.get(object_id)
             if loaded is None:
                 raise PlannerError(ErrorCode.UNKNOWN_OBJECT,
-                                   f"unknown object_id {object_id!r}: load it first "
-                                   f"(loaded: {list(self._objects)})")
+                                   f"unknown object_id {object_id!r}: load it first with "
+                                   "load_object (objects are evicted when the cache is full)")
             self._objects.move_to_end(object_id)
             return loaded
 

@@ -344,3 +344,14 @@ def test_long_requests_beyond_max_pending_are_answered_busy(ros_context: Context
         assert response.error_code == ErrorCode.UNKNOWN_OBJECT  # quick path, not queued
     finally:
         harness.close()
+
+
+def test_unknown_object_error_does_not_list_other_clients_objects(planner):
+    from squeeze_grasp_interfaces.srv import PlanSqueeze
+
+    load(planner, scene_yaml=BLOB, object_id="someone_elses_secret_object")
+    response = planner.call(PlanSqueeze, "plan_squeeze", PlanSqueeze.Request(
+        object_id="nope", squeeze_type="stable"))
+    assert response.error_code == ErrorCode.UNKNOWN_OBJECT
+    assert "unknown object_id 'nope'" in response.message
+    assert "someone_elses_secret_object" not in response.message

@@ -557,9 +557,10 @@ def squeeze_plan(loaded: LoadedObject, contacts: Sequence[int], kind: str,
     nodes = contact_nodes(loaded, contacts, default=loaded.finger_nodes)
     red = reduced_stiffness(obj, nodes)
     sq = plan_squeeze(obj, nodes, kind, red)
-    if depth and len(nodes) == 2 and not sq.relative_depth(scale) < 1.0:
-        raise invalid(f"depth {depth:.6g} m is a relative depth of {sq.relative_depth(scale):.6g}: "
-                      "it must be below 1 (at 1 the fingers would meet)")
+    relative = sq.relative_depth(scale)
+    if depth and len(nodes) == 2 and not relative < 1.0:
+        raise invalid(f"depth {depth:.6g} m is a relative depth of {relative:.6g}: it must be "
+                      "below 1 (at 1 the fingers would meet)")
     closure = False
     if len(nodes) == 2:
         mesh = obj.mesh

@@ -26,9 +26,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="record every topic into this rosbag2 folder (MCAP storage)")
     parser.add_argument("--include-hidden-topics", action="store_true",
                         help="with --record: also record the executor action's hidden topics "
-                             "(_action/feedback, _action/status); like rosbag2, off by default. Foxglove "
-                             "and rosbags decode them; mcap_ros2 cannot (it rejects rosidl's "
-                             "action message names, e.g. ExecuteGrasp_FeedbackMessage)")
+                             "(_action/feedback, _action/status); like rosbag2, off by default. "
+                             "Foxglove and rosbags decode them; mcap_ros2 cannot (it rejects "
+                             "rosidl's action message names, e.g. ExecuteGrasp_FeedbackMessage)")
     parser.add_argument("--attach", action="store_true",
                         help="use the pipeline nodes already running on this ROS domain (as "
                              "sim_pipeline.launch.py starts them): plan with their planner, send "

@@ -183,10 +183,11 @@ def generate_mesh(outline: Outline, max_area: float, min_angle: float = 30.0,
     if max_area > outline.area:
         max_area = outline.area / 4.0
     if 0.8 * outline.area / max_area > MAX_MESH_NODES:
+        smallest = 0.8 * outline.area / MAX_MESH_NODES
         raise MechanicsError(f"mesh.max_area {max_area:.3g} m^2 would give about "
                              f"{0.8 * outline.area / max_area:.3g} nodes on this "
                              f"{outline.area:.3g} m^2 object; at most {MAX_MESH_NODES} are "
-                             f"allowed (max_area >= {0.8 * outline.area / MAX_MESH_NODES:.3g} m^2)")
+                             f"allowed (max_area >= {smallest:.3g} m^2)")
     spacing = np.sqrt(4.0 * max_area / np.sqrt(3.0))
     loops = [resample(outline.points, spacing, outline.corners)]
     loops += [resample(h if signed_area(h) > 0 else h[::-1], spacing) for h in outline.holes]

@@ -74,8 +74,9 @@ def _segments_intersect(p: np.ndarray) -> bool:
     size = max(float(np.ptp(p, axis=0).max()), 1e-300)
     tol = 1e-12 * size
     edge = b - a
-    cross_turn = np.roll(edge, 1, axis=0)[:, 0] * edge[:, 1] - np.roll(edge, 1, axis=0)[:, 1] * edge[:, 0]
-    dot_turn = np.einsum("ij,ij->i", np.roll(edge, 1, axis=0), edge)
+    before = np.roll(edge, 1, axis=0)
+    cross_turn = before[:, 0] * edge[:, 1] - before[:, 1] * edge[:, 0]
+    dot_turn = np.einsum("ij,ij->i", before, edge)
     if np.any((np.abs(cross_turn) <= tol * size) & (dot_turn < 0)):
         return True
     lo, hi = np.minimum(a, b) - tol, np.maximum(a, b) + tol
@@ -91,7 +92,8 @@ def _segments_intersect(p: np.ndarray) -> bool:
     i, j = i[keep], j[keep]
 
     def orient(o, q, r):
-        value = (q[:, 0] - o[:, 0]) * (r[:, 1] - o[:, 1]) - (q[:, 1] - o[:, 1]) * (r[:, 0] - o[:, 0])
+        oq, o_r = q - o, r - o
+        value = oq[:, 0] * o_r[:, 1] - oq[:, 1] * o_r[:, 0]
         return np.where(np.abs(value) <= tol * size, 0.0, np.sign(value))
 
     def on_segment(o, q, r, side):
@@ -238,7 +240,8 @@ def _csv_points(text: str, name: str) -> list[list[float]]:
                 raise ValueError
             pts.append([float(cells[0]), float(cells[1])])
         except ValueError:
-            raise MechanicsError(f"{name}: line {number} is not 'x,y' (two numbers, metres)") from None
+            raise MechanicsError(f"{name}: line {number} is not 'x,y' (two numbers, "
+                                 "metres)") from None
         if len(pts) > MAX_OUTLINE_POINTS:
             raise MechanicsError(f"{name}: more than {MAX_OUTLINE_POINTS} points")
     return pts

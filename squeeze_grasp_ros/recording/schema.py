@@ -142,7 +142,8 @@ def dependencies(text: str, package: str) -> list[str]:
 
 
 def message_definition(type_name: str) -> str:
-    """The complete ``ros2msg`` definition of ``type_name`` ('pkg/msg/Type'), as rosbag2 writes it."""
+    """The complete ``ros2msg`` definition of ``type_name`` ('pkg/msg/Type'), as rosbag2 writes
+    it."""
     seen: set[str] = set()
 
     def text_with_dependencies(name: str) -> str:

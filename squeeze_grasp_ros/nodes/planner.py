@@ -38,6 +38,7 @@ from rcl_interfaces.msg import ParameterDescriptor
 from rclpy.action import ActionServer, CancelResponse
 from rclpy.action.server import ServerGoalHandle
 from rclpy.executors import SingleThreadedExecutor
+from rclpy.callback_groups import ReentrantCallbackGroup
 from rclpy.node import Node
 from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
 from rclpy.task import Future
@@ -115,6 +116,10 @@ class PlannerNode(Node):
                               durability=DurabilityPolicy.VOLATILE)
         self._pending = 0
         self._pending_lock = threading.Lock()
+        # Reentrant: a long request awaiting its worker must not hold the node's default
+        # (mutually exclusive) group, or every other request waits for it (measured: a
+        # plan_squeeze waited the whole 7 s of an event_squeeze).
+        self._group = ReentrantCallbackGroup()
         for srv_type, name, callback in (
                 (LoadObject, "load_object", self._load_object),
                 (PlanSqueeze, "plan_squeeze", self._plan_squeeze),
@@ -122,12 +127,14 @@ class PlannerNode(Node):
                 (PlanResistance, "plan_resistance", self._plan_resistance),
                 (RingGraspTest, "ring_grasp_test", self._ring_grasp_test),
                 (EventSqueeze, "event_squeeze", self._event_squeeze)):
-            self.create_service(srv_type, f"~/{name}", callback, qos_profile=services)
+            self.create_service(srv_type, f"~/{name}", callback, qos_profile=services,
+                                callback_group=self._group)
         self._actions = [
             ActionServer(self, GraspMapAction, "~/grasp_map", self._execute_grasp_map,
-                         cancel_callback=self._accept_cancel),
+                         cancel_callback=self._accept_cancel, callback_group=self._group),
             ActionServer(self, EventSqueezeAction, "~/event_squeeze",
-                         self._execute_event_squeeze, cancel_callback=self._accept_cancel),
+                         self._execute_event_squeeze, cancel_callback=self._accept_cancel,
+                         callback_group=self._group),
         ]
         self.get_logger().info(f"planner ready: {self.limits}; files from "
                                f"{[str(r) for r in self.roots]}")

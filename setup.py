@@ -69,11 +69,11 @@ setup(
     entry_points={
         "console_scripts": [
             "squeeze-grasp = squeeze_grasp_ros.cli:main",
-            "planner = squeeze_grasp_ros.nodes.planner:main",
-            "executor = squeeze_grasp_ros.nodes.executor:main",
-            "monitor = squeeze_grasp_ros.nodes.monitor:main",
-            "sim_hardware = squeeze_grasp_ros.nodes.sim_hardware:main",
-            "recorder = squeeze_grasp_ros.nodes.recorder:main",
+            "planner = squeeze_grasp_ros.ros.nodes.planner:main",
+            "executor = squeeze_grasp_ros.ros.nodes.executor:main",
+            "monitor = squeeze_grasp_ros.ros.nodes.monitor:main",
+            "sim_hardware = squeeze_grasp_ros.ros.nodes.sim_hardware:main",
+            "recorder = squeeze_grasp_ros.ros.nodes.recorder:main",
         ],
     },
 )

@@ -27,8 +27,8 @@ from launch.substitutions import LaunchConfiguration
 from launch_ros.actions import Node
 from launch_ros.substitutions import ExecutableInPackage
 
-from squeeze_grasp_ros.mechanics.compliance import ElasticObject
-from squeeze_grasp_ros.nodes.runner import RunOptions, node_parameters
+from squeeze_grasp_ros.mechanics.elastic.compliance import ElasticObject
+from squeeze_grasp_ros.ros.run.runner import RunOptions, node_parameters
 from squeeze_grasp_ros.resources import config_dir, scene_file, viewer_file
 from squeeze_grasp_ros.scene import build_mesh, finger_nodes, load_scene, scene_material
 from squeeze_grasp_ros.sim.world import squeeze_geometry

@@ -11,12 +11,12 @@ import os
 import sys
 from typing import Any
 
-from .commands import VERBS
-from .commands.common import fail
-from .exit_codes import ExitCode
-from .extras import install_hint
-from .mechanics.errors import MechanicsError
-from .scene import SceneError
+from squeeze_grasp_ros.commands import VERBS
+from squeeze_grasp_ros.commands.common import fail
+from squeeze_grasp_ros.exit_codes import ExitCode
+from squeeze_grasp_ros.extras import install_hint
+from squeeze_grasp_ros.mechanics.errors import MechanicsError
+from squeeze_grasp_ros.scene import SceneError
 
 
 def build_parser() -> argparse.ArgumentParser:

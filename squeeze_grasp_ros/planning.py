@@ -2,8 +2,8 @@
 # SPDX-License-Identifier: Apache-2.0
 """The planner's requests without ROS: validation, the object cache and one call per computation.
 
-The planner node (:mod:`squeeze_grasp_ros.nodes.planner`) turns each service request into one
-call of this module and the result into a response with :mod:`squeeze_grasp_ros.messages`.
+The planner node (:mod:`squeeze_grasp_ros.ros.nodes.planner`) turns each service request into one
+call of this module and the result into a response with :mod:`squeeze_grasp_ros.ros.messages`.
 Everything here is plain Python and numpy, so it is tested without ROS and shared by the
 node's services and actions.
 
@@ -29,24 +29,24 @@ from pathlib import Path
 
 import numpy as np
 
-from .inputs import InputError, confine, load_yaml, read_text
-from .mechanics.compliance import ROUTES, ElasticObject
-from .mechanics.contact_model import ContactModel
-from .mechanics.errors import InfeasibleError, MechanicsError
-from .mechanics.graspmap import GraspMap, grasp_map
-from .mechanics.reduced import boundary_displacement, reduced_stiffness
-from .mechanics.resistance import (FINGERS, MODES, Resistance, ResistanceSweep, contact_segments,
+from squeeze_grasp_ros.inputs import InputError, confine, load_yaml, read_text
+from squeeze_grasp_ros.mechanics.elastic.compliance import ROUTES, ElasticObject
+from squeeze_grasp_ros.mechanics.squeeze.contact_model import ContactModel
+from squeeze_grasp_ros.mechanics.errors import InfeasibleError, MechanicsError
+from squeeze_grasp_ros.mechanics.squeeze.graspmap import GraspMap, grasp_map
+from squeeze_grasp_ros.mechanics.elastic.reduced import boundary_displacement, reduced_stiffness
+from squeeze_grasp_ros.mechanics.resistance.optimal import (FINGERS, MODES, Resistance, ResistanceSweep, contact_segments,
                                    optimal_resistance, resistance_grasp, sweep_directions)
-from .mechanics.resistance_friction import (FrictionalResistance, add_adversary,
+from squeeze_grasp_ros.mechanics.resistance.frictional import (FrictionalResistance, add_adversary,
                                             frictional_resistance)
-from .mechanics.ring_map import RingGraspMap, ring_grasp_map
-from .mechanics.ring_model import RingModel
-from .mechanics.ring_squeeze import RingGrasp, ring_grasp
-from .mechanics.squeeze import Squeeze, force_closure, plan_squeeze
-from .mechanics.squeeze_events import EventSqueeze
-from .scene import (Scene, SceneError, build_mesh, build_outline, build_ring, finger_nodes,
+from squeeze_grasp_ros.mechanics.ring.grasp_map import RingGraspMap, ring_grasp_map
+from squeeze_grasp_ros.mechanics.ring.model import RingModel
+from squeeze_grasp_ros.mechanics.ring.squeeze import RingGrasp, ring_grasp
+from squeeze_grasp_ros.mechanics.squeeze.stable_pure import Squeeze, force_closure, plan_squeeze
+from squeeze_grasp_ros.mechanics.squeeze.events import EventSqueeze
+from squeeze_grasp_ros.scene import (Scene, SceneError, build_mesh, build_outline, build_ring, finger_nodes,
                     parse_scene, scene_material)
-from .scene_events import event_squeeze_scene
+from squeeze_grasp_ros.scene_events import event_squeeze_scene
 
 SQUEEZE_TYPES: tuple[str, ...] = ("stable", "pure")
 CONTACT_MODELS: tuple[str, ...] = ("point", "segment", "friction")

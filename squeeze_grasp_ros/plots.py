@@ -8,7 +8,7 @@ from typing import Sequence
 
 import numpy as np
 
-from .mechanics.mesh import Mesh
+from squeeze_grasp_ros.mechanics.elastic.mesh import Mesh
 
 
 def figure(ncols: int = 1, nrows: int = 1, size: float = 4.2):

@@ -22,12 +22,12 @@ from typing import Any, Optional
 
 import numpy as np
 
-from .inputs import InputError, load_yaml, read_text
-from .mechanics import shapes
-from .mechanics.errors import MechanicsError
-from .mechanics.material import Material
-from .mechanics.mesh import MAX_MESH_NODES, Mesh, generate_mesh, target_max_area
-from .mechanics.ring_model import RingModel, ring_from_outline
+from squeeze_grasp_ros.inputs import InputError, load_yaml, read_text
+from squeeze_grasp_ros.mechanics.elastic import shapes
+from squeeze_grasp_ros.mechanics.errors import MechanicsError
+from squeeze_grasp_ros.mechanics.elastic.material import Material
+from squeeze_grasp_ros.mechanics.elastic.mesh import MAX_MESH_NODES, Mesh, generate_mesh, target_max_area
+from squeeze_grasp_ros.mechanics.ring.model import RingModel, ring_from_outline
 
 
 class SceneError(ValueError):
@@ -559,7 +559,7 @@ def load_scene(path: str | Path) -> Scene:
 
 
 def build_outline(shape: dict) -> shapes.Outline:
-    """The :class:`~squeeze_grasp_ros.mechanics.shapes.Outline` of a validated shape mapping."""
+    """The :class:`~squeeze_grasp_ros.mechanics.elastic.shapes.Outline` of a validated shape mapping."""
     kind = shape["type"]
     try:
         if kind == "square":

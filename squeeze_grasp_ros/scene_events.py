@@ -5,10 +5,10 @@ from __future__ import annotations
 
 from collections.abc import Callable
 
-from .mechanics.compliance import ElasticObject
-from .mechanics.contact_model import Limits
-from .mechanics.squeeze_events import EventSqueeze, event_squeeze
-from .scene import Scene, SceneError
+from squeeze_grasp_ros.mechanics.elastic.compliance import ElasticObject
+from squeeze_grasp_ros.mechanics.squeeze.contact_model import Limits
+from squeeze_grasp_ros.mechanics.squeeze.events import EventSqueeze, event_squeeze
+from squeeze_grasp_ros.scene import Scene, SceneError
 
 
 def scene_limits(scene: Scene) -> Limits:

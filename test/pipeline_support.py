@@ -69,7 +69,7 @@ def contact_modes(state) -> dict:
     """node -> (finger, mode) of a stepper ``ContactState`` or a ``SimState`` message."""
     if not hasattr(state, "header"):
         return {c.node: (c.finger, c.mode) for c in state.contacts}
-    from squeeze_grasp_ros.messages import contact_records
+    from squeeze_grasp_ros.ros.messages import contact_records
     return {c["node"]: (c["finger"], c["mode"]) for c in contact_records(state.contacts)}
 
 

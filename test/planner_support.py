@@ -20,9 +20,9 @@ from rclpy.executors import SingleThreadedExecutor
 from rclpy.task import Future
 
 from squeeze_grasp_interfaces.srv import LoadObject
-from squeeze_grasp_ros.mechanics.compliance import ElasticObject
-from squeeze_grasp_ros.nodes.planner import PlannerNode
-from squeeze_grasp_ros.nodes.planner_client import PlannerClient
+from squeeze_grasp_ros.mechanics.elastic.compliance import ElasticObject
+from squeeze_grasp_ros.ros.nodes.planner import PlannerNode
+from squeeze_grasp_ros.ros.nodes.planner_client import PlannerClient
 from squeeze_grasp_ros.scene import Scene, build_mesh, parse_scene, scene_material
 
 BLOB = """

@@ -9,17 +9,17 @@ import functools
 import numpy as np
 import pytest
 
-from squeeze_grasp_ros.mechanics import shapes
-from squeeze_grasp_ros.mechanics.compliance import ElasticObject
-from squeeze_grasp_ros.mechanics.contact_model import ContactModel
-from squeeze_grasp_ros.mechanics.contact_state import ContactState, initial_state
-from squeeze_grasp_ros.mechanics.fingertips import place_fingertip, tip_gaps
-from squeeze_grasp_ros.mechanics.material import Material
-from squeeze_grasp_ros.mechanics.mesh import generate_mesh, mesh_from_triangles, target_max_area
-from squeeze_grasp_ros.mechanics.oneshot import one_shot_solve
-from squeeze_grasp_ros.mechanics.squeeze import plan_squeeze
-from squeeze_grasp_ros.mechanics.squeeze_events import event_squeeze
-from squeeze_grasp_ros.mechanics.stepper import advance
+from squeeze_grasp_ros.mechanics.elastic import shapes
+from squeeze_grasp_ros.mechanics.elastic.compliance import ElasticObject
+from squeeze_grasp_ros.mechanics.squeeze.contact_model import ContactModel
+from squeeze_grasp_ros.mechanics.squeeze.contact_state import ContactState, initial_state
+from squeeze_grasp_ros.mechanics.squeeze.fingertips import place_fingertip, tip_gaps
+from squeeze_grasp_ros.mechanics.elastic.material import Material
+from squeeze_grasp_ros.mechanics.elastic.mesh import generate_mesh, mesh_from_triangles, target_max_area
+from squeeze_grasp_ros.mechanics.squeeze.oneshot import one_shot_solve
+from squeeze_grasp_ros.mechanics.squeeze.stable_pure import plan_squeeze
+from squeeze_grasp_ros.mechanics.squeeze.events import event_squeeze
+from squeeze_grasp_ros.mechanics.squeeze.stepper import advance
 
 FOAM = Material(5e4, 0.3, 0.0254)
 RADIUS = 0.02

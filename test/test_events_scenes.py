@@ -14,9 +14,9 @@ import yaml
 
 from squeeze_grasp_ros import cli
 from squeeze_grasp_ros.commands.common import load_solid
-from squeeze_grasp_ros.mechanics.contact_model import Limits
-from squeeze_grasp_ros.mechanics.fem import element_strains, principal_strains
-from squeeze_grasp_ros.mechanics.squeeze_events import event_squeeze
+from squeeze_grasp_ros.mechanics.squeeze.contact_model import Limits
+from squeeze_grasp_ros.mechanics.elastic.fem import element_strains, principal_strains
+from squeeze_grasp_ros.mechanics.squeeze.events import event_squeeze
 from squeeze_grasp_ros.scene import SceneError, parse_scene
 from squeeze_grasp_ros.scene_events import event_squeeze_scene
 
@@ -107,7 +107,7 @@ def test_user_given_directions_and_validation():
         parse_scene(data)
     data["fingers"]["F2"]["direction"] = [-1.0, 0.0]
     scene = parse_scene(data)
-    from squeeze_grasp_ros.mechanics.compliance import ElasticObject
+    from squeeze_grasp_ros.mechanics.elastic.compliance import ElasticObject
     from squeeze_grasp_ros.scene import build_mesh, finger_nodes, scene_material
     mesh = build_mesh(scene)
     res = event_squeeze_scene(scene, ElasticObject(mesh, scene_material(scene)),

@@ -10,8 +10,8 @@ import pytest
 
 from squeeze_grasp_ros.bench.events import event_error, foam_square
 from squeeze_grasp_ros.commands.common import load_solid
-from squeeze_grasp_ros.mechanics.oneshot import one_shot_solve
-from squeeze_grasp_ros.mechanics.squeeze_events import event_squeeze
+from squeeze_grasp_ros.mechanics.squeeze.oneshot import one_shot_solve
+from squeeze_grasp_ros.mechanics.squeeze.events import event_squeeze
 from squeeze_grasp_ros.scene_events import event_squeeze_scene
 
 SCENES = Path(__file__).resolve().parents[1] / "config" / "scenes"

@@ -10,14 +10,14 @@ import warnings
 import numpy as np
 import pytest
 
-from squeeze_grasp_ros.mechanics import shapes
-from squeeze_grasp_ros.mechanics.compliance import ElasticObject
+from squeeze_grasp_ros.mechanics.elastic import shapes
+from squeeze_grasp_ros.mechanics.elastic.compliance import ElasticObject
 from squeeze_grasp_ros.mechanics.errors import ConditioningWarning, MechanicsError
-from squeeze_grasp_ros.mechanics.graspmap import grasp_map
-from squeeze_grasp_ros.mechanics.material import Material
-from squeeze_grasp_ros.mechanics.mesh import Mesh, generate_mesh, mesh_from_triangles, target_max_area
-from squeeze_grasp_ros.mechanics.reduced import displacement_field, reduced_stiffness
-from squeeze_grasp_ros.mechanics.squeeze import plan_squeeze
+from squeeze_grasp_ros.mechanics.squeeze.graspmap import grasp_map
+from squeeze_grasp_ros.mechanics.elastic.material import Material
+from squeeze_grasp_ros.mechanics.elastic.mesh import Mesh, generate_mesh, mesh_from_triangles, target_max_area
+from squeeze_grasp_ros.mechanics.elastic.reduced import displacement_field, reduced_stiffness
+from squeeze_grasp_ros.mechanics.squeeze.stable_pure import plan_squeeze
 
 EQUILIBRIUM_TOL = 1e-9
 """Force/torque residual relative to the largest contact force (and object size for torque)."""
@@ -194,7 +194,7 @@ def foam(nodes: int = 800, size: float = 0.1, E: float = 5e4, h: float = 0.0254)
 
 
 def squeeze(obj, contacts, mu=0.05, **kw):
-    from squeeze_grasp_ros.mechanics.squeeze_events import event_squeeze
+    from squeeze_grasp_ros.mechanics.squeeze.events import event_squeeze
 
     if "depth" not in kw:
         kw.setdefault("relative_depth", 0.12)
@@ -292,7 +292,7 @@ def test_event_squeeze_on_a_nonconvex_object():
 
 @pytest.mark.parametrize("ratio", [1e-3, 1e-1])
 def test_thin_and_thick_rings_stay_accurate(ratio):
-    from squeeze_grasp_ros.mechanics.ring_model import (circle_diametral_response,
+    from squeeze_grasp_ros.mechanics.ring.model import (circle_diametral_response,
                                                         ring_diameter_changes)
 
     R, E, w = 0.04, 2e9, 0.01

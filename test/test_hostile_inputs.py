@@ -77,9 +77,9 @@ def test_random_grid_polygons_never_crash_the_mesher():
     edges are frequent) are either refused or meshed, in a child process that must not die."""
     child = """
 import numpy as np
-from squeeze_grasp_ros.mechanics import shapes
+from squeeze_grasp_ros.mechanics.elastic import shapes
 from squeeze_grasp_ros.mechanics.errors import MechanicsError
-from squeeze_grasp_ros.mechanics.mesh import generate_mesh
+from squeeze_grasp_ros.mechanics.elastic.mesh import generate_mesh
 rng = np.random.default_rng(2014)
 meshed = refused = 0
 for _ in range(300):

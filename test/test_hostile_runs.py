@@ -21,7 +21,7 @@ import yaml
 
 from pipeline_support import SMALL_SQUARE
 from squeeze_grasp_ros.cli import main
-from squeeze_grasp_ros.recording.bag import read_bag
+from squeeze_grasp_ros.ros.recording.bag import read_bag
 
 SCENES = Path(__file__).resolve().parents[1] / "config" / "scenes"
 

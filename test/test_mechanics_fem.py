@@ -5,16 +5,16 @@ exact scaling laws, solver routes and the vectorised grasp map."""
 import numpy as np
 import pytest
 
-from squeeze_grasp_ros.mechanics import shapes
-from squeeze_grasp_ros.mechanics.analytic import disk_diameter_change_across
-from squeeze_grasp_ros.mechanics.compliance import ElasticObject, node_dofs
+from squeeze_grasp_ros.mechanics.elastic import shapes
+from squeeze_grasp_ros.mechanics.elastic.analytic import disk_diameter_change_across
+from squeeze_grasp_ros.mechanics.elastic.compliance import ElasticObject, node_dofs
 from squeeze_grasp_ros.mechanics.errors import MechanicsError
-from squeeze_grasp_ros.mechanics.fem import element_strains, stiffness_matrix
-from squeeze_grasp_ros.mechanics.graspmap import grasp_map
-from squeeze_grasp_ros.mechanics.material import Material
-from squeeze_grasp_ros.mechanics.mesh import Mesh, element_areas, generate_mesh, mesh_from_triangles
-from squeeze_grasp_ros.mechanics.reduced import displacement_field, reduced_stiffness
-from squeeze_grasp_ros.mechanics.squeeze import plan_squeeze
+from squeeze_grasp_ros.mechanics.elastic.fem import element_strains, stiffness_matrix
+from squeeze_grasp_ros.mechanics.squeeze.graspmap import grasp_map
+from squeeze_grasp_ros.mechanics.elastic.material import Material
+from squeeze_grasp_ros.mechanics.elastic.mesh import Mesh, element_areas, generate_mesh, mesh_from_triangles
+from squeeze_grasp_ros.mechanics.elastic.reduced import displacement_field, reduced_stiffness
+from squeeze_grasp_ros.mechanics.squeeze.stable_pure import plan_squeeze
 
 MAT = Material(5e4, 0.3, 0.0254)
 
@@ -237,7 +237,7 @@ def _brute_force_crossing(p: np.ndarray) -> bool:
 
 
 def test_sweep_self_intersection_check_equals_brute_force():
-    from squeeze_grasp_ros.mechanics.shapes import _segments_intersect
+    from squeeze_grasp_ros.mechanics.elastic.shapes import _segments_intersect
 
     rng = np.random.default_rng(7)
     for _ in range(400):

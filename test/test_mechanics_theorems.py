@@ -10,13 +10,13 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from squeeze_grasp_ros.mechanics import shapes
-from squeeze_grasp_ros.mechanics.compliance import ElasticObject, node_dofs
-from squeeze_grasp_ros.mechanics.material import Material
-from squeeze_grasp_ros.mechanics.mesh import generate_mesh
-from squeeze_grasp_ros.mechanics.reduced import (displacement_field, reduced_stiffness,
+from squeeze_grasp_ros.mechanics.elastic import shapes
+from squeeze_grasp_ros.mechanics.elastic.compliance import ElasticObject, node_dofs
+from squeeze_grasp_ros.mechanics.elastic.material import Material
+from squeeze_grasp_ros.mechanics.elastic.mesh import generate_mesh
+from squeeze_grasp_ros.mechanics.elastic.reduced import (displacement_field, reduced_stiffness,
                                                  rotation_angle)
-from squeeze_grasp_ros.mechanics.squeeze import plan_squeeze, two_contact_direction
+from squeeze_grasp_ros.mechanics.squeeze.stable_pure import plan_squeeze, two_contact_direction
 
 SETTINGS = settings(max_examples=12, deadline=None,
                     suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large])

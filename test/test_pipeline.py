@@ -12,12 +12,12 @@ import pytest
 import yaml
 from rclpy.serialization import deserialize_message
 
-from squeeze_grasp_ros.mechanics.compliance import ElasticObject
-from squeeze_grasp_ros.nodes import pipeline
-from squeeze_grasp_ros.nodes.runner import PipelineRunner, RunOptions
-from squeeze_grasp_ros.recording.bag import read_bag
-from squeeze_grasp_ros.recording.replay import replay
-from squeeze_grasp_ros.recording.schema import own_text
+from squeeze_grasp_ros.mechanics.elastic.compliance import ElasticObject
+from squeeze_grasp_ros.ros.nodes import pipeline
+from squeeze_grasp_ros.ros.run.runner import PipelineRunner, RunOptions
+from squeeze_grasp_ros.ros.recording.bag import read_bag
+from squeeze_grasp_ros.ros.recording.replay import replay
+from squeeze_grasp_ros.ros.recording.schema import own_text
 from squeeze_grasp_ros.scene import build_mesh, finger_nodes, load_scene, scene_material
 from squeeze_grasp_ros.scene_events import event_squeeze_scene
 
@@ -278,8 +278,8 @@ def test_resistance_ground_truth_equals_algorithm_2():
     """Sec. 6.4 set-up (F1 on a Barrett finger, F2 on the Cobra arm, A on the pusher): the
     squeeze, then the executor streams Algorithm 2's waypoints; the simulated world's events,
     termination and work are those of the mechanics API."""
-    from squeeze_grasp_ros.mechanics.contact_model import ContactModel
-    from squeeze_grasp_ros.mechanics.resistance_friction import add_adversary, frictional_resistance
+    from squeeze_grasp_ros.mechanics.squeeze.contact_model import ContactModel
+    from squeeze_grasp_ros.mechanics.resistance.frictional import add_adversary, frictional_resistance
     from squeeze_grasp_ros.scene import placement_node
 
     path = str(SCENES / "resist_fig10.yaml")

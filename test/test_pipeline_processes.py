@@ -13,9 +13,9 @@ from pathlib import Path
 import pytest
 from rclpy.serialization import deserialize_message
 
-from squeeze_grasp_ros.nodes import pipeline
-from squeeze_grasp_ros.nodes.runner import PipelineRunner, RunOptions
-from squeeze_grasp_ros.recording.bag import read_bag
+from squeeze_grasp_ros.ros.nodes import pipeline
+from squeeze_grasp_ros.ros.run.runner import PipelineRunner, RunOptions
+from squeeze_grasp_ros.ros.recording.bag import read_bag
 
 from pipeline_support import SMALL_SQUARE, scene_data, write_scene
 

@@ -24,15 +24,15 @@ from squeeze_grasp_interfaces.action import EventSqueeze as EventSqueezeAction
 from squeeze_grasp_interfaces.action import GraspMap as GraspMapAction
 from squeeze_grasp_interfaces.srv import (EventSqueeze, GraspMap, LoadObject, PlanResistance,
                                           PlanSqueeze, RingGraspTest)
-from squeeze_grasp_ros.mechanics.contact_model import ContactModel
-from squeeze_grasp_ros.mechanics.graspmap import grasp_map
-from squeeze_grasp_ros.mechanics.reduced import boundary_displacement, reduced_stiffness
-from squeeze_grasp_ros.mechanics.resistance import (contact_segments, optimal_resistance,
+from squeeze_grasp_ros.mechanics.squeeze.contact_model import ContactModel
+from squeeze_grasp_ros.mechanics.squeeze.graspmap import grasp_map
+from squeeze_grasp_ros.mechanics.elastic.reduced import boundary_displacement, reduced_stiffness
+from squeeze_grasp_ros.mechanics.resistance.optimal import (contact_segments, optimal_resistance,
                                                     resistance_grasp, sweep_directions)
-from squeeze_grasp_ros.mechanics.resistance_friction import add_adversary, frictional_resistance
-from squeeze_grasp_ros.mechanics.ring_squeeze import ring_grasp
-from squeeze_grasp_ros.mechanics.squeeze import plan_squeeze
-from squeeze_grasp_ros.nodes.planner import PARAMETERS
+from squeeze_grasp_ros.mechanics.resistance.frictional import add_adversary, frictional_resistance
+from squeeze_grasp_ros.mechanics.ring.squeeze import ring_grasp
+from squeeze_grasp_ros.mechanics.squeeze.stable_pure import plan_squeeze
+from squeeze_grasp_ros.ros.nodes.planner import PARAMETERS
 from squeeze_grasp_ros.planning import ErrorCode
 from squeeze_grasp_ros.scene import build_ring, finger_nodes, placement_node
 from squeeze_grasp_ros.scene_events import event_squeeze_scene

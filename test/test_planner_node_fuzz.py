@@ -29,8 +29,8 @@ from rclpy.context import Context
 from planner_support import BLOB, RING, Harness, flat, planner_threads, scene_of, solid_of
 from squeeze_grasp_interfaces.srv import (EventSqueeze, GraspMap, LoadObject, PlanResistance,
                                           PlanSqueeze, RingGraspTest)
-from squeeze_grasp_ros.mechanics.graspmap import grasp_map
-from squeeze_grasp_ros.mechanics.squeeze import plan_squeeze
+from squeeze_grasp_ros.mechanics.squeeze.graspmap import grasp_map
+from squeeze_grasp_ros.mechanics.squeeze.stable_pure import plan_squeeze
 from squeeze_grasp_ros.planning import ErrorCode
 from squeeze_grasp_ros.scene import finger_nodes
 

@@ -1,6 +1,6 @@
 # Copyright 2026 squeeze_grasp_ros developers
 # SPDX-License-Identifier: Apache-2.0
-"""The planner's conversions in messages.py (pure functions) and the request layer's caches."""
+"""The planner's conversions in ros/messages.py (pure functions) and the request layer's caches."""
 from __future__ import annotations
 
 import numpy as np
@@ -14,10 +14,11 @@ from squeeze_grasp_interfaces.action import GraspMap as GraspMapAction
 from squeeze_grasp_interfaces.msg import ContactNode, TactileArray
 from squeeze_grasp_interfaces.srv import (EventSqueeze, GraspMap, LoadObject, PlanResistance,
                                           PlanSqueeze, RingGraspTest)
-from squeeze_grasp_ros import messages, planning
-from squeeze_grasp_ros.mechanics.contact_state import ContactState, Event, FingerState
-from squeeze_grasp_ros.mechanics.contact_state import ContactNode as MechanicsContactNode
-from squeeze_grasp_ros.mechanics.graspmap import grasp_map
+from squeeze_grasp_ros import planning
+from squeeze_grasp_ros.ros import messages
+from squeeze_grasp_ros.mechanics.squeeze.contact_state import ContactState, Event, FingerState
+from squeeze_grasp_ros.mechanics.squeeze.contact_state import ContactNode as MechanicsContactNode
+from squeeze_grasp_ros.mechanics.squeeze.graspmap import grasp_map
 from squeeze_grasp_ros.planning import ErrorCode
 from squeeze_grasp_ros.scene import build_mesh
 

@@ -23,12 +23,12 @@ from rclpy.parameter import parameter_value_to_python
 
 from planner_support import BLOB, Harness, flat, solid_of
 from squeeze_grasp_interfaces.srv import LoadObject, PlanSqueeze
-from squeeze_grasp_ros.mechanics.squeeze import plan_squeeze
+from squeeze_grasp_ros.mechanics.squeeze.stable_pure import plan_squeeze
 
 REPO = Path(__file__).resolve().parents[1]
 COMMANDS = {
     "console script": [str(Path(sys.executable).parent / "planner")],
-    "python -m": [sys.executable, "-m", "squeeze_grasp_ros.nodes.planner"],
+    "python -m": [sys.executable, "-m", "squeeze_grasp_ros.ros.nodes.planner"],
 }
 ATTEMPTS, TIMEOUT = 3, 20.0
 

@@ -13,8 +13,8 @@ from pathlib import Path
 import pytest
 from mcap.reader import make_reader
 
-from squeeze_grasp_ros.nodes.runner import PipelineRunner, RunOptions
-from squeeze_grasp_ros.recording.schema import SEPARATOR, message_definition, own_text
+from squeeze_grasp_ros.ros.run.runner import PipelineRunner, RunOptions
+from squeeze_grasp_ros.ros.recording.schema import SEPARATOR, message_definition, own_text
 
 from foxglove_support import foxglove_decode
 from pipeline_support import SMALL_SQUARE, write_scene
@@ -208,7 +208,7 @@ def test_corrupt_recordings_are_refused_never_misread(default_bag, tmp_path):
     import numpy as np
     from mcap.reader import make_reader as reader_of
 
-    from squeeze_grasp_ros.recording.bag import BagError, read_bag
+    from squeeze_grasp_ros.ros.recording.bag import BagError, read_bag
 
     original = read_bag(default_bag).messages
     data = default_bag.read_bytes()

@@ -13,16 +13,16 @@ import pytest
 from scipy.optimize import minimize
 
 from squeeze_grasp_ros.cli import main
-from squeeze_grasp_ros.mechanics import shapes
-from squeeze_grasp_ros.mechanics.compliance import ElasticObject
+from squeeze_grasp_ros.mechanics.elastic import shapes
+from squeeze_grasp_ros.mechanics.elastic.compliance import ElasticObject
 from squeeze_grasp_ros.mechanics.errors import MechanicsError
-from squeeze_grasp_ros.mechanics.material import Material
-from squeeze_grasp_ros.mechanics.mesh import generate_mesh, mesh_from_triangles
-from squeeze_grasp_ros.mechanics.reduced import displacement_field
-from squeeze_grasp_ros.mechanics.resistance import (
+from squeeze_grasp_ros.mechanics.elastic.material import Material
+from squeeze_grasp_ros.mechanics.elastic.mesh import generate_mesh, mesh_from_triangles
+from squeeze_grasp_ros.mechanics.elastic.reduced import displacement_field
+from squeeze_grasp_ros.mechanics.resistance.optimal import (
     FINGERS, ResistanceGrasp, compare_resistances, contact_segments, evaluate_resistance,
     optimal_resistance, resistance_along, resistance_grasp, sweep_directions)
-from squeeze_grasp_ros.mechanics.resistance_forms import expansion_matrix, pure_form
+from squeeze_grasp_ros.mechanics.resistance.forms import expansion_matrix, pure_form
 
 SCENES = "config/scenes"
 

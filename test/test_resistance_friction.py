@@ -12,16 +12,16 @@ import numpy as np
 import pytest
 
 from squeeze_grasp_ros.cli import main
-from squeeze_grasp_ros.mechanics import shapes
-from squeeze_grasp_ros.mechanics.compliance import ElasticObject
-from squeeze_grasp_ros.mechanics.contact_model import ContactModel
+from squeeze_grasp_ros.mechanics.elastic import shapes
+from squeeze_grasp_ros.mechanics.elastic.compliance import ElasticObject
+from squeeze_grasp_ros.mechanics.squeeze.contact_model import ContactModel
 from squeeze_grasp_ros.mechanics.errors import MechanicsError
-from squeeze_grasp_ros.mechanics.material import Material
-from squeeze_grasp_ros.mechanics.mesh import generate_mesh
-from squeeze_grasp_ros.mechanics.resistance import FINGERS, evaluate_resistance, resistance_grasp
-from squeeze_grasp_ros.mechanics.resistance_friction import (add_adversary, frictional_resistance,
+from squeeze_grasp_ros.mechanics.elastic.material import Material
+from squeeze_grasp_ros.mechanics.elastic.mesh import generate_mesh
+from squeeze_grasp_ros.mechanics.resistance.optimal import FINGERS, evaluate_resistance, resistance_grasp
+from squeeze_grasp_ros.mechanics.resistance.frictional import (add_adversary, frictional_resistance,
                                                              slipping_fingers)
-from squeeze_grasp_ros.mechanics.squeeze_events import event_squeeze
+from squeeze_grasp_ros.mechanics.squeeze.events import event_squeeze
 
 
 @pytest.fixture(scope="module")

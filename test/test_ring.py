@@ -8,16 +8,16 @@ from functools import cache
 import numpy as np
 import pytest
 
-from squeeze_grasp_ros.mechanics import shapes
-from squeeze_grasp_ros.mechanics.compliance import node_dofs
+from squeeze_grasp_ros.mechanics.elastic import shapes
+from squeeze_grasp_ros.mechanics.elastic.compliance import node_dofs
 from squeeze_grasp_ros.mechanics.errors import MechanicsError
-from squeeze_grasp_ros.mechanics.material import Material
-from squeeze_grasp_ros.mechanics.reduced import reduce_blocks
-from squeeze_grasp_ros.mechanics.ring_map import ring_grasp_map
-from squeeze_grasp_ros.mechanics.ring_model import (RingModel, circle_diametral_response,
+from squeeze_grasp_ros.mechanics.elastic.material import Material
+from squeeze_grasp_ros.mechanics.elastic.reduced import reduce_blocks
+from squeeze_grasp_ros.mechanics.ring.grasp_map import ring_grasp_map
+from squeeze_grasp_ros.mechanics.ring.model import (RingModel, circle_diametral_response,
                                                     ring_diameter_changes,
                                                     ring_from_outline)
-from squeeze_grasp_ros.mechanics.ring_squeeze import (LIMITS, first_root, inward_normal,
+from squeeze_grasp_ros.mechanics.ring.squeeze import (LIMITS, first_root, inward_normal,
                                                       normal_polynomial, polyval, ring_grasp)
 
 E, W, H = 2.0e9, 0.01, 0.003

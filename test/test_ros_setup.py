@@ -2,7 +2,7 @@
 # SPDX-License-Identifier: Apache-2.0
 """Real ROS 2 from PyPI: rclpy and our interfaces work with nothing sourced; ros-setup is safe.
 
-These tests need the ``ros`` extra and ``python -m squeeze_grasp_ros.ros_setup`` to have run
+These tests need the ``ros`` extra and ``python -m squeeze_grasp_ros.ros.interfaces`` to have run
 (CI does both); they fail rather than skip without them. Under the colcon route
 (``colcon test`` in a workspace whose overlay provides ``squeeze_grasp_interfaces``) the tests
 about *this environment's* ros-setup build are skipped: there the interfaces come from the
@@ -19,7 +19,7 @@ from pathlib import Path
 
 import pytest
 
-from squeeze_grasp_ros import ros_setup
+from squeeze_grasp_ros.ros import interfaces as ros_setup
 
 WAIT_S = 10.0
 CMAKE_TEMPLATE = """\

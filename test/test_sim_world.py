@@ -14,9 +14,9 @@ import yaml
 from squeeze_grasp_ros.control.motion import (GraspGoal, GraspProgram, MotionLimits,
                                               Observation, goal_problem)
 from squeeze_grasp_ros.control.tracker import ContactTracker, FingerSample, TrackerConfig
-from squeeze_grasp_ros.mechanics.contact_state import initial_state
-from squeeze_grasp_ros.mechanics.fingertips import place_fingertip
-from squeeze_grasp_ros.mechanics.stepper import advance
+from squeeze_grasp_ros.mechanics.squeeze.contact_state import initial_state
+from squeeze_grasp_ros.mechanics.squeeze.fingertips import place_fingertip
+from squeeze_grasp_ros.mechanics.squeeze.stepper import advance
 from squeeze_grasp_ros.scene import SceneError, parse_scene
 from squeeze_grasp_ros.sim.devices import device_model, follow
 from squeeze_grasp_ros.sim.sensors import (SensorRandomness, fingertip_wrench, render_tactile,

@@ -156,8 +156,8 @@ def test_failing_evaluation_is_a_row_not_a_crash(tmp_path):
 
 def test_rows_match_the_event_squeeze_and_grasp_map(tmp_path):
     """A row is the event engine's own result for that placement (cross-check in one process)."""
-    from squeeze_grasp_ros.mechanics.contact_model import Limits
-    from squeeze_grasp_ros.mechanics.squeeze_events import event_squeeze
+    from squeeze_grasp_ros.mechanics.squeeze.contact_model import Limits
+    from squeeze_grasp_ros.mechanics.squeeze.events import event_squeeze
     from squeeze_grasp_ros.sweep.evaluate import prepare
     loaded = parse_sweep_spec({**SMALL, "objects": SMALL["objects"][:1]}, tmp_path)
     task = plan_tasks(loaded)[0]

@@ -9,7 +9,7 @@ and the report lists it, so the mechanics sections run on a plain ``pip install 
 """
 from __future__ import annotations
 
-from ..extras import EXTRAS, installed
+from squeeze_grasp_ros.extras import EXTRAS, installed
 
 SECTIONS: tuple[str, ...] = (
     "convergence",

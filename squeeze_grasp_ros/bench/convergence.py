@@ -13,15 +13,15 @@ from pathlib import Path
 
 import numpy as np
 
-from .. import plots
-from ..mechanics import shapes
-from ..mechanics.analytic import disk_diameter_change_across
-from ..mechanics.compliance import ElasticObject
-from ..mechanics.material import Material
-from ..mechanics.mesh import generate_mesh, target_max_area
-from ..mechanics.squeeze_events import EventSqueeze, event_squeeze
-from .events import foam_square
-from .table import Table, timed
+from squeeze_grasp_ros import plots
+from squeeze_grasp_ros.mechanics.elastic import shapes
+from squeeze_grasp_ros.mechanics.elastic.analytic import disk_diameter_change_across
+from squeeze_grasp_ros.mechanics.elastic.compliance import ElasticObject
+from squeeze_grasp_ros.mechanics.elastic.material import Material
+from squeeze_grasp_ros.mechanics.elastic.mesh import generate_mesh, target_max_area
+from squeeze_grasp_ros.mechanics.squeeze.events import EventSqueeze, event_squeeze
+from squeeze_grasp_ros.bench.events import foam_square
+from squeeze_grasp_ros.bench.table import Table, timed
 
 TITLE = "Mesh resolution: error and time"
 RADIUS = 0.05

@@ -16,11 +16,11 @@ from pathlib import Path
 
 import numpy as np
 
-from .. import plots
-from ..mechanics.errors import MechanicsError
-from ..mechanics.squeeze_events import event_squeeze
-from .events import foam_square
-from .table import Table
+from squeeze_grasp_ros import plots
+from squeeze_grasp_ros.mechanics.errors import MechanicsError
+from squeeze_grasp_ros.mechanics.squeeze.events import event_squeeze
+from squeeze_grasp_ros.bench.events import foam_square
+from squeeze_grasp_ros.bench.table import Table
 
 TITLE = "Accuracy vs time: Pareto front of the squeeze settings"
 MU, RADIUS, RELATIVE = 0.05, 0.02, 0.12

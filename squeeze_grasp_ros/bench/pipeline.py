@@ -10,15 +10,15 @@ from pathlib import Path
 import yaml
 from rclpy.serialization import deserialize_message, serialize_message
 
-from ..mechanics.compliance import ElasticObject
-from ..nodes import pipeline
-from ..nodes.runner import PipelineRunner, RunOptions
-from ..recording.bag import read_bag
-from ..resources import scene_file
-from ..scene import build_mesh, finger_nodes, load_scene, scene_material
-from ..scene_events import event_squeeze_scene
-from ..sim.world import SimWorld
-from .table import Table, best_time, timed
+from squeeze_grasp_ros.mechanics.elastic.compliance import ElasticObject
+from squeeze_grasp_ros.ros.nodes import pipeline
+from squeeze_grasp_ros.ros.run.runner import PipelineRunner, RunOptions
+from squeeze_grasp_ros.ros.recording.bag import read_bag
+from squeeze_grasp_ros.resources import scene_file
+from squeeze_grasp_ros.scene import build_mesh, finger_nodes, load_scene, scene_material
+from squeeze_grasp_ros.scene_events import event_squeeze_scene
+from squeeze_grasp_ros.sim.world import SimWorld
+from squeeze_grasp_ros.bench.table import Table, best_time, timed
 
 TITLE = "Pipeline on real rclpy nodes: end to end, lockstep rate, recording, effects"
 EFFECT_SCENE = {

@@ -8,13 +8,13 @@ from typing import Callable, Sequence
 
 import numpy as np
 
-from ..mechanics import shapes
-from ..mechanics.compliance import ElasticObject
-from ..mechanics.material import Material
-from ..mechanics.mesh import generate_mesh, target_max_area
-from ..mechanics.resistance import (FINGERS, MODES, contact_segments, optimal_resistance,
+from squeeze_grasp_ros.mechanics.elastic import shapes
+from squeeze_grasp_ros.mechanics.elastic.compliance import ElasticObject
+from squeeze_grasp_ros.mechanics.elastic.material import Material
+from squeeze_grasp_ros.mechanics.elastic.mesh import generate_mesh, target_max_area
+from squeeze_grasp_ros.mechanics.resistance.optimal import (FINGERS, MODES, contact_segments, optimal_resistance,
                                     resistance_grasp, sweep_directions)
-from .table import Table, best_time, timed
+from squeeze_grasp_ros.bench.table import Table, best_time, timed
 
 TITLE = "Optimal resistance (Sec. 6.1-6.2): time per adversary direction"
 MATERIAL = Material(5e4, 0.3, 0.0254)

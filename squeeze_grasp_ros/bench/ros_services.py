@@ -22,14 +22,14 @@ from __future__ import annotations
 from collections.abc import Callable
 from pathlib import Path
 
-from .table import Table
+from squeeze_grasp_ros.bench.table import Table
 
 TITLE = "ROS services: round trip over the bare mechanics call"
 
 
 def run(quick: bool, out_dir: Path, progress: Callable[[str], None]) -> list[Table]:
     """Measure the three tables in one run."""
-    from .ros_measure import localhost_only, long_request_rows, overhead_rows
+    from squeeze_grasp_ros.ros.service_latency import localhost_only, long_request_rows, overhead_rows
 
     sizes = (500, 2000) if quick else (500, 2000, 8000, 20000)
     count = 200 if quick else 1000

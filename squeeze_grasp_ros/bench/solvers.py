@@ -7,14 +7,14 @@ from pathlib import Path
 
 import numpy as np
 
-from ..mechanics import shapes
-from ..mechanics.compliance import ElasticObject
-from ..mechanics.graspmap import grasp_map
-from ..mechanics.material import Material
-from ..mechanics.mesh import generate_mesh, target_max_area
-from ..mechanics.reduced import boundary_displacement, reduced_stiffness
-from ..mechanics.squeeze import plan_squeeze
-from .table import Table, best_time, timed
+from squeeze_grasp_ros.mechanics.elastic import shapes
+from squeeze_grasp_ros.mechanics.elastic.compliance import ElasticObject
+from squeeze_grasp_ros.mechanics.squeeze.graspmap import grasp_map
+from squeeze_grasp_ros.mechanics.elastic.material import Material
+from squeeze_grasp_ros.mechanics.elastic.mesh import generate_mesh, target_max_area
+from squeeze_grasp_ros.mechanics.elastic.reduced import boundary_displacement, reduced_stiffness
+from squeeze_grasp_ros.mechanics.squeeze.stable_pure import plan_squeeze
+from squeeze_grasp_ros.bench.table import Table, best_time, timed
 
 TITLE = "Solver routes: precompute and squeeze time vs mesh size"
 MATERIAL = Material(5e4, 0.3, 0.0254)

@@ -21,12 +21,12 @@ from pathlib import Path
 
 import yaml
 
-from ..resources import scene_file
-from ..sweep.engine import run_sweep
-from ..sweep.evaluate import clear_cache, run_task
-from ..sweep.plan import plan_tasks
-from ..sweep.spec import parse_sweep_spec
-from .table import Table
+from squeeze_grasp_ros.resources import scene_file
+from squeeze_grasp_ros.sweep.engine import run_sweep
+from squeeze_grasp_ros.sweep.evaluate import clear_cache, run_task
+from squeeze_grasp_ros.sweep.plan import plan_tasks
+from squeeze_grasp_ros.sweep.spec import parse_sweep_spec
+from squeeze_grasp_ros.bench.table import Table
 
 TITLE = "Grasp-dataset sweep on Dask"
 OBJECTS = [
@@ -107,7 +107,7 @@ def parallel_ceiling(workers: int) -> float:
 
 def mechanics_seconds(out: Path) -> float:
     """Sum of the evaluations' own times (``time_s``) in a sweep directory."""
-    from ..sweep.store import read_dataset
+    from squeeze_grasp_ros.sweep.store import read_dataset
     return float(sum(read_dataset(out).column("time_s").to_pylist()))
 
 

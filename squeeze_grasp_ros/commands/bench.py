@@ -9,8 +9,8 @@ import platform
 import sys
 from pathlib import Path
 
-from ..bench import SECTIONS, missing
-from ..bench.table import Table
+from squeeze_grasp_ros.bench import SECTIONS, missing
+from squeeze_grasp_ros.bench.table import Table
 
 HELP = "run the benchmarks; print tables and write a Markdown report with plots"
 

@@ -7,10 +7,10 @@ import argparse
 
 import numpy as np
 
-from ..mechanics.calibration import (Cuboid, calibrate_elasticity, friction_from_angle,
+from squeeze_grasp_ros.mechanics.calibration.material_fit import (Cuboid, calibrate_elasticity, friction_from_angle,
                                      friction_from_trials)
-from ..mechanics.errors import MechanicsError
-from .csv_io import read_columns
+from squeeze_grasp_ros.mechanics.errors import MechanicsError
+from squeeze_grasp_ros.commands.csv_io import read_columns
 
 HELP = "Young's modulus, Poisson's ratio from cuboid compressions; mu from the slope angle (App. B)"
 CUBOID_COLUMNS = ("force", "length", "width", "height", "dl", "dw")

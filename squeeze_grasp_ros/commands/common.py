@@ -10,9 +10,9 @@ import sys
 from dataclasses import dataclass
 from pathlib import Path
 
-from ..exit_codes import ExitCode
-from ..mechanics.compliance import ROUTES, ElasticObject
-from ..scene import Scene, build_mesh, finger_nodes, load_scene, scene_material
+from squeeze_grasp_ros.exit_codes import ExitCode
+from squeeze_grasp_ros.mechanics.elastic.compliance import ROUTES, ElasticObject
+from squeeze_grasp_ros.scene import Scene, build_mesh, finger_nodes, load_scene, scene_material
 
 
 FIELD = re.compile(r"^([A-Za-z_][\w.\[\]]*) (?:must|is|needs|has)\b")

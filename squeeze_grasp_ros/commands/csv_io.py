@@ -12,7 +12,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..mechanics.errors import MechanicsError
+from squeeze_grasp_ros.mechanics.errors import MechanicsError
 
 
 def read_table(path: str | Path) -> tuple[list[str] | None, list[list[str]]]:

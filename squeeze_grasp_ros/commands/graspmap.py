@@ -7,11 +7,11 @@ import argparse
 
 import numpy as np
 
-from .. import plots
-from ..mechanics.graspmap import GraspMap, grasp_map
-from ..scene import build_ring, load_scene
-from . import ring
-from .common import add_plot_argument, add_scene_argument, add_solver_argument, load_solid
+from squeeze_grasp_ros import plots
+from squeeze_grasp_ros.mechanics.squeeze.graspmap import GraspMap, grasp_map
+from squeeze_grasp_ros.scene import build_ring, load_scene
+from squeeze_grasp_ros.commands import ring
+from squeeze_grasp_ros.commands.common import add_plot_argument, add_scene_argument, add_solver_argument, load_solid
 
 HELP = ("all-pairs grasp map: stiffness, inwardness and force closure of every placement "
         "(ring scenes: feasibility and maximum depth, Sec. 7)")

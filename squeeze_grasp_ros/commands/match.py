@@ -7,10 +7,10 @@ import argparse
 
 import numpy as np
 
-from .. import plots
-from ..mechanics.matching import Match, match_similarity
-from .common import add_plot_argument
-from .csv_io import read_points
+from squeeze_grasp_ros import plots
+from squeeze_grasp_ros.mechanics.calibration.matching import Match, match_similarity
+from squeeze_grasp_ros.commands.common import add_plot_argument
+from squeeze_grasp_ros.commands.csv_io import read_points
 
 HELP = "least-squares scale/rotation/translation of measured onto simulated points (App. C)"
 

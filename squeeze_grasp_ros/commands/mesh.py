@@ -5,9 +5,9 @@ from __future__ import annotations
 
 import argparse
 
-from .. import plots
-from ..scene import build_mesh, load_scene, scene_material
-from .common import add_plot_argument, add_scene_argument
+from squeeze_grasp_ros import plots
+from squeeze_grasp_ros.scene import build_mesh, load_scene, scene_material
+from squeeze_grasp_ros.commands.common import add_plot_argument, add_scene_argument
 
 HELP = "triangulate the scene's object (nodes, triangles, boundary loop, material)"
 

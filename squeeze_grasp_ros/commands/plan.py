@@ -7,11 +7,11 @@ import argparse
 
 import numpy as np
 
-from .. import plots
-from ..mechanics.errors import MechanicsError
-from ..mechanics.reduced import boundary_displacement, reduced_stiffness
-from ..mechanics.squeeze import Squeeze, force_closure, plan_squeeze
-from .common import add_plot_argument, add_scene_argument, add_solver_argument, load_solid
+from squeeze_grasp_ros import plots
+from squeeze_grasp_ros.mechanics.errors import MechanicsError
+from squeeze_grasp_ros.mechanics.elastic.reduced import boundary_displacement, reduced_stiffness
+from squeeze_grasp_ros.mechanics.squeeze.stable_pure import Squeeze, force_closure, plan_squeeze
+from squeeze_grasp_ros.commands.common import add_plot_argument, add_scene_argument, add_solver_argument, load_solid
 
 HELP = "stable and pure squeezes at the scene's finger placements (point contacts, Sec. 3-4)"
 DEFAULT_RELATIVE_DEPTH = 0.05

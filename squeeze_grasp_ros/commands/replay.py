@@ -9,8 +9,8 @@ import sys
 
 import yaml
 
-from ..exit_codes import ExitCode
-from .common import fail
+from squeeze_grasp_ros.exit_codes import ExitCode
+from squeeze_grasp_ros.commands.common import fail
 
 HELP = ("replay a recording's sensor topics on its sim time into a fresh monitor and check that "
         "it reproduces the recorded event sequence")
@@ -28,8 +28,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 def run(args: argparse.Namespace) -> dict | int:
     """Replay; exit code 1 (after printing the result) when the recorded event sequence is not
     reproduced, 2 for a missing or corrupt bag, 4 when the replay does not finish."""
-    from ..recording.bag import BagError
-    from ..recording.replay import replay
+    from squeeze_grasp_ros.ros.recording.bag import BagError
+    from squeeze_grasp_ros.ros.recording.replay import replay
 
     overrides = {}
     for entry in args.param:

@@ -8,21 +8,21 @@ import time
 
 import numpy as np
 
-from .. import plots
-from ..mechanics.contact_model import ContactModel
-from ..mechanics.errors import MechanicsError
-from ..mechanics.reduced import displacement_field
-from ..mechanics.resistance import (FINGERS, MODES, Resistance, ResistanceGrasp,
+from squeeze_grasp_ros import plots
+from squeeze_grasp_ros.mechanics.squeeze.contact_model import ContactModel
+from squeeze_grasp_ros.mechanics.errors import MechanicsError
+from squeeze_grasp_ros.mechanics.elastic.reduced import displacement_field
+from squeeze_grasp_ros.mechanics.resistance.optimal import (FINGERS, MODES, Resistance, ResistanceGrasp,
                                     ResistanceSweep, compare_resistances, contact_segments,
                                     optimal_resistance, resistance_along, resistance_grasp,
                                     sweep_directions)
-from ..mechanics.resistance_forms import expansion_matrix
-from ..mechanics.resistance_friction import (FrictionalResistance, add_adversary,
+from squeeze_grasp_ros.mechanics.resistance.forms import expansion_matrix
+from squeeze_grasp_ros.mechanics.resistance.frictional import (FrictionalResistance, add_adversary,
                                              frictional_resistance)
-from ..mechanics.squeeze_events import grasp_health
-from ..scene import SceneError, placement_node
-from ..scene_events import event_squeeze_scene
-from .common import (LoadedScene, add_plot_argument, add_scene_argument, add_solver_argument,
+from squeeze_grasp_ros.mechanics.squeeze.events import grasp_health
+from squeeze_grasp_ros.scene import SceneError, placement_node
+from squeeze_grasp_ros.scene_events import event_squeeze_scene
+from squeeze_grasp_ros.commands.common import (LoadedScene, add_plot_argument, add_scene_argument, add_solver_argument,
                      load_solid)
 
 HELP = "optimal stable/pure resistance of F1, F2 to the scene's adversary finger A (Sec. 6)"

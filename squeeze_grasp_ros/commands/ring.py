@@ -14,12 +14,12 @@ import dataclasses
 
 import numpy as np
 
-from .. import plots
-from ..mechanics.ring_map import RingGraspMap, bench_ring, ring_grasp_map
-from ..mechanics.ring_model import RingModel
-from ..mechanics.ring_squeeze import FINGERS, LIMITS, RingGrasp, ring_grasp
-from ..scene import Scene, SceneError, build_ring, finger_nodes, load_scene
-from .common import add_plot_argument, add_scene_argument
+from squeeze_grasp_ros import plots
+from squeeze_grasp_ros.mechanics.ring.grasp_map import RingGraspMap, bench_ring, ring_grasp_map
+from squeeze_grasp_ros.mechanics.ring.model import RingModel
+from squeeze_grasp_ros.mechanics.ring.squeeze import FINGERS, LIMITS, RingGrasp, ring_grasp
+from squeeze_grasp_ros.scene import Scene, SceneError, build_ring, finger_nodes, load_scene
+from squeeze_grasp_ros.commands.common import add_plot_argument, add_scene_argument
 
 HELP = "ring-like object, two point fingers (Sec. 7): max squeeze depth, limit, all-pairs map"
 

@@ -9,8 +9,8 @@ import signal
 import sys
 from pathlib import Path
 
-from ..exit_codes import ExitCode
-from .common import add_scene_argument, fail, new_folder
+from squeeze_grasp_ros.exit_codes import ExitCode
+from squeeze_grasp_ros.commands.common import add_scene_argument, fail, new_folder
 
 HELP = ("run a scene through the planner, executor, simulated hardware, monitor and recorder "
         "nodes (lockstep sim time) and summarise it")
@@ -68,7 +68,7 @@ def _progress_line(update: dict) -> None:
 def run(args: argparse.Namespace) -> dict | int:
     """Run the pipeline; the JSON summary (see :meth:`PipelineRunner.summary`), or exit code
     130 after Ctrl-C (the recording is finished first)."""
-    from ..nodes.runner import PipelineRunner, RunError, RunOptions
+    from squeeze_grasp_ros.ros.run.runner import PipelineRunner, RunError, RunOptions
 
     if not (args.timeout > 0 and args.timeout < float("inf")):
         return fail(args, f"--timeout must be > 0 s, got {args.timeout}", ExitCode.USAGE)
@@ -102,7 +102,7 @@ def recording_state(record: str | None) -> str:
     """What an interrupted run left behind, checked, not assumed."""
     if not record:
         return "nothing was recorded"
-    from ..recording.bag import BagError, read_bag
+    from squeeze_grasp_ros.ros.recording.bag import BagError, read_bag
 
     if not (Path(record) / "metadata.yaml").is_file():
         return f"no recording was written ({record} has no bag)"

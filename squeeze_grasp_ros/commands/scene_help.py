@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import argparse
 
-from ..scene import scene_help
+from squeeze_grasp_ros.scene import scene_help
 
 HELP = "list every scene key, unit, range, shape type and effect"
 

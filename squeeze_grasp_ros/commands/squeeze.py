@@ -9,14 +9,14 @@ import time
 
 import numpy as np
 
-from .. import plots
-from ..mechanics.contact_state import EVENT_TYPES
-from ..mechanics.fingertips import unit
-from ..mechanics.squeeze_events import EventSqueeze
-from ..scene_events import event_squeeze_scene
-from .common import (add_plot_argument, add_scene_argument, add_solver_argument, load_solid,
+from squeeze_grasp_ros import plots
+from squeeze_grasp_ros.mechanics.squeeze.contact_state import EVENT_TYPES
+from squeeze_grasp_ros.mechanics.squeeze.fingertips import unit
+from squeeze_grasp_ros.mechanics.squeeze.events import EventSqueeze
+from squeeze_grasp_ros.scene_events import event_squeeze_scene
+from squeeze_grasp_ros.commands.common import (add_plot_argument, add_scene_argument, add_solver_argument, load_solid,
                      output_file)
-from .csv_io import write_points
+from squeeze_grasp_ros.commands.csv_io import write_points
 
 HELP = "event-driven squeeze with rounded fingertips under Coulomb friction (Sec. 5, Algorithm 1)"
 BAR_WIDTH = 30

@@ -7,9 +7,9 @@ import argparse
 import signal
 import sys
 
-from ..exit_codes import ExitCode
-from ..sweep.engine import dry_run, require_extra, run_sweep
-from ..sweep.spec import SweepError, load_sweep_spec
+from squeeze_grasp_ros.exit_codes import ExitCode
+from squeeze_grasp_ros.sweep.engine import dry_run, require_extra, run_sweep
+from squeeze_grasp_ros.sweep.spec import SweepError, load_sweep_spec
 
 HELP = ("evaluate a sweep spec (objects x materials x friction x tips x squeezes x depths x "
         "placements) on Dask into a Parquet dataset; re-run to resume")

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import argparse
 
-from ..sweep.spec import sweep_help
+from squeeze_grasp_ros.sweep.spec import sweep_help
 
 HELP = "list every sweep-spec key, unit, range and shape family"
 

@@ -5,8 +5,8 @@ from __future__ import annotations
 
 import argparse
 
-from ..sweep.engine import require_extra
-from ..sweep.report import plot, summarise, text
+from squeeze_grasp_ros.sweep.engine import require_extra
+from squeeze_grasp_ros.sweep.report import plot, summarise, text
 
 HELP = ("summarise a sweep directory: success rate by object and material, quality "
         "distributions, best placements per object; --plot writes pictures")
@@ -24,7 +24,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 def run(args: argparse.Namespace) -> dict:
     """Read the dataset and summarise it."""
     require_extra()
-    from ..sweep.store import read_dataset, read_manifest, read_outlines
+    from squeeze_grasp_ros.sweep.store import read_dataset, read_manifest, read_outlines
     manifest = read_manifest(args.out)
     rows = read_dataset(args.out).to_pylist()
     out = {"out": args.out, "manifest": {k: manifest[k] for k in

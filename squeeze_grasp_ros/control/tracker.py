@@ -50,7 +50,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from ..mechanics.fingertips import FINGER_NAMES
+from squeeze_grasp_ros.mechanics.squeeze.fingertips import FINGER_NAMES
 
 ORDER = {"B": 0, "D": 1, "C": 2, "A": 3}
 """Processing order of the events of one tick and finger."""

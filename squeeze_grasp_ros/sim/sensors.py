@@ -27,7 +27,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..mechanics.contact_state import ContactNode
+from squeeze_grasp_ros.mechanics.squeeze.contact_state import ContactNode
 
 
 @dataclass(frozen=True)

@@ -39,18 +39,18 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..mechanics.compliance import ElasticObject
-from ..mechanics.contact_model import ContactModel
-from ..mechanics.contact_state import ContactState, Event, initial_state
-from ..mechanics.fingertips import place_fingertip
-from ..mechanics.resistance_friction import add_adversary
-from ..mechanics.squeeze import plan_squeeze
-from ..mechanics.stepper import advance
-from ..scene import (Scene, SensorsSpec, build_mesh, finger_devices, finger_nodes,
+from squeeze_grasp_ros.mechanics.elastic.compliance import ElasticObject
+from squeeze_grasp_ros.mechanics.squeeze.contact_model import ContactModel
+from squeeze_grasp_ros.mechanics.squeeze.contact_state import ContactState, Event, initial_state
+from squeeze_grasp_ros.mechanics.squeeze.fingertips import place_fingertip
+from squeeze_grasp_ros.mechanics.resistance.frictional import add_adversary
+from squeeze_grasp_ros.mechanics.squeeze.stable_pure import plan_squeeze
+from squeeze_grasp_ros.mechanics.squeeze.stepper import advance
+from squeeze_grasp_ros.scene import (Scene, SensorsSpec, build_mesh, finger_devices, finger_nodes,
                      placement_node, scene_material)
-from ..scene_events import scene_limits
-from .devices import DeviceModel, device_model, follow
-from .sensors import (SensorRandomness, TactileLayout, fingertip_wrench, render_tactile,
+from squeeze_grasp_ros.scene_events import scene_limits
+from squeeze_grasp_ros.sim.devices import DeviceModel, device_model, follow
+from squeeze_grasp_ros.sim.sensors import (SensorRandomness, TactileLayout, fingertip_wrench, render_tactile,
                       tactile_layout)
 
 TERMINATE_ON: tuple[str, ...] = ("strain_limit", "finger_slip", "picked_up")

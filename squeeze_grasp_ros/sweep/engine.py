@@ -24,9 +24,9 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Callable, Optional
 
-from .evaluate import prepare, run_task
-from .plan import Task, plan_tasks
-from .spec import LoadedSpec, SweepError
+from squeeze_grasp_ros.sweep.evaluate import prepare, run_task
+from squeeze_grasp_ros.sweep.plan import Task, plan_tasks
+from squeeze_grasp_ros.sweep.spec import LoadedSpec, SweepError
 
 INSTALL_HINT = ("squeeze-grasp sweep needs the 'sweep' extra (Dask distributed and pyarrow): "
                 "pip install '.[sweep]' in the repository (or pip install 'dask[distributed]' "
@@ -144,7 +144,7 @@ def ignore_sigint() -> None:
 
 
 def _check_workers(client) -> int:
-    from .store import package_version
+    from squeeze_grasp_ros.sweep.store import package_version
     versions = client.run(package_version)
     mine = package_version()
     bad = {w: v for w, v in versions.items() if v != mine}
@@ -226,7 +226,7 @@ def run_sweep(loaded: LoadedSpec, out: str | Path, *, scheduler: Optional[str] =
         Called after each part is written (tests use it to kill the client at a known point).
     """
     require_extra()
-    from .store import Store
+    from squeeze_grasp_ros.sweep.store import Store
     start = time.perf_counter()
     tasks = plan_tasks(loaded)
     store = Store(out, loaded, tasks)
@@ -279,7 +279,7 @@ def dry_run(loaded: LoadedSpec, *, workers: Optional[int] = None,
     grasp map) and up to :data:`DRY_RUN_SAMPLE` of its evaluations are timed; the estimate is
     groups x prepare + evaluations x mean evaluation time / workers (each worker prepares a
     group at most once)."""
-    from .evaluate import evaluate
+    from squeeze_grasp_ros.sweep.evaluate import evaluate
     tasks = plan_tasks(loaded)
     groups = sorted({t.group for t in tasks})
     total = sum(t.evaluations for t in tasks)

@@ -5,7 +5,7 @@
 :func:`run_task` is what Dask calls. It prepares the task's group (mesh, stiffness,
 factorisation, boundary compliance, point-contact grasp map, placements) or takes it from the
 process's cache, then runs every (placement, parameter) evaluation of the task with
-:func:`~squeeze_grasp_ros.mechanics.squeeze_events.event_squeeze` (Algorithm 1) and returns one
+:func:`~squeeze_grasp_ros.mechanics.squeeze.events.event_squeeze` (Algorithm 1) and returns one
 row per evaluation (:data:`COLUMNS`). An evaluation that raises becomes a row with its
 ``error``; the record of a squeeze is what the event engine reports (termination, events,
 finger forces, work, energy, grasp health, slip margins); this module adds only the locations
@@ -20,14 +20,14 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..mechanics.compliance import ElasticObject
-from ..mechanics.graspmap import GraspMap, grasp_map
-from ..mechanics.material import Material
-from ..mechanics.mesh import Mesh
-from ..mechanics.resistance import (FINGERS, contact_segments, resistance_grasp,
+from squeeze_grasp_ros.mechanics.elastic.compliance import ElasticObject
+from squeeze_grasp_ros.mechanics.squeeze.graspmap import GraspMap, grasp_map
+from squeeze_grasp_ros.mechanics.elastic.material import Material
+from squeeze_grasp_ros.mechanics.elastic.mesh import Mesh
+from squeeze_grasp_ros.mechanics.resistance.optimal import (FINGERS, contact_segments, resistance_grasp,
                                     sweep_directions)
-from ..mechanics.squeeze_events import event_squeeze
-from .plan import Task, build_group_mesh, rng_for
+from squeeze_grasp_ros.mechanics.squeeze.events import event_squeeze
+from squeeze_grasp_ros.sweep.plan import Task, build_group_mesh, rng_for
 
 CACHE_GROUPS = 4
 """Prepared groups kept per worker process (a 2k-node group holds a few MB)."""

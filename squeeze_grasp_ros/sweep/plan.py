@@ -27,12 +27,12 @@ from typing import Optional
 
 import numpy as np
 
-from ..mechanics.contact_model import Limits
-from ..mechanics.mesh import generate_mesh, target_max_area
-from ..mechanics.shapes import Outline
-from ..scene import MeshSpec, build_outline, load_scene
-from ..scene_events import scene_limits
-from .spec import LoadedSpec, ObjectEntry, SweepError
+from squeeze_grasp_ros.mechanics.squeeze.contact_model import Limits
+from squeeze_grasp_ros.mechanics.elastic.mesh import generate_mesh, target_max_area
+from squeeze_grasp_ros.mechanics.elastic.shapes import Outline
+from squeeze_grasp_ros.scene import MeshSpec, build_outline, load_scene
+from squeeze_grasp_ros.scene_events import scene_limits
+from squeeze_grasp_ros.sweep.spec import LoadedSpec, ObjectEntry, SweepError
 
 
 def id_key(*parts: str | int) -> tuple[int, ...]:

@@ -109,7 +109,7 @@ def plot(rows: list[dict], directory: str | Path, outlines: dict | None = None) 
     paths. ``outlines``: object id -> boundary loop [[x, y], ...], m."""
     from matplotlib import colormaps
 
-    from .. import plots
+    from squeeze_grasp_ros import plots
     directory = Path(directory)
     directory.mkdir(parents=True, exist_ok=True)
     qkey = quality_key(rows)

@@ -17,7 +17,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Optional
 
-from ..scene import (MaterialSpec, MeshSpec, Scene, SceneError, _validate_shape, build_outline,
+from squeeze_grasp_ros.scene import (MaterialSpec, MeshSpec, Scene, SceneError, _validate_shape, build_outline,
                      key_reference, load_scene, parse_section, read_yaml, spec)
 
 

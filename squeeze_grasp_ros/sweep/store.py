@@ -25,9 +25,9 @@ from pathlib import Path
 import pyarrow as pa
 import pyarrow.parquet as pq
 
-from .evaluate import COLUMNS
-from .plan import Task
-from .spec import LoadedSpec, SweepError
+from squeeze_grasp_ros.sweep.evaluate import COLUMNS
+from squeeze_grasp_ros.sweep.plan import Task
+from squeeze_grasp_ros.sweep.spec import LoadedSpec, SweepError
 
 ARROW_TYPES = {"string": pa.string(), "int32": pa.int32(), "float64": pa.float64(),
                "bool": pa.bool_()}
@@ -41,7 +41,7 @@ def package_version() -> str:
     try:
         return metadata.version("squeeze_grasp_ros")
     except metadata.PackageNotFoundError:
-        from .. import __version__
+        from squeeze_grasp_ros import __version__
         return __version__
 
 

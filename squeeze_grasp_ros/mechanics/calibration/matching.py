@@ -1,0 +1,123 @@
+# Copyright 2026 squeeze_grasp_ros developers
+# SPDX-License-Identifier: Apache-2.0
+"""Least-squares similarity matching of corresponding planar point sets (paper App. C).
+
+Given simulated points P = {p_i} and measured points Q = {q_i} (same count and order), find
+the scale s, rotation theta and translation t = (t_x, t_y) that applied to Q minimise
+
+    E = sum_i || p_i - (s R(theta) q_i + t) ||^2                       (eqs. 72-73)
+
+in closed form. With p_i = (x_i, y_i), q_i = (u_i, v_i) and the means
+
+    (c1, ..., c10) = mean(x, y, u, v, x u, x v, y u, y v, u^2, v^2),   D = c9 + c10 - c3^2 - c4^2,
+
+the minimiser is (eqs. 82-85; the text extraction of eq. 84 lost its square root)
+
+    t_x   = (c4 (c7 - c6) - c3 (c5 + c8) + c1 (c9 + c10)) / D
+    t_y   = (c2 (c9 + c10) - c4 (c5 + c8) - c3 (c7 - c6)) / D
+    s     = sqrt((c1 c3 + c2 c4 - (c5 + c8))^2 + (c1 c4 - c2 c3 + (c7 - c6))^2) / D
+    theta = atan2(c7 - c6 + c1 c4 - c2 c3, c5 + c8 - (c1 c3 + c2 c4)).
+
+The paper derives these assuming c3^2 + c4^2 != 0 and shows that the special case
+c3 = c4 = 0 (measured points centred at the origin) gives the same expressions, reduced to
+t = (c1, c2), s = sqrt((c7 - c6)^2 + (c5 + c8)^2) / (c9 + c10), theta = atan2(c7 - c6, c5 + c8);
+so one formula serves both. D > 0 unless all measured points coincide. Units: P and Q in m,
+t in m (the frame of P), theta in rad, s dimensionless.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from squeeze_grasp_ros.mechanics.errors import MechanicsError, require_finite
+
+
+@dataclass(frozen=True)
+class Match:
+    """A similarity transform from the measured frame to the simulated one.
+
+    Attributes
+    ----------
+    scale : float
+        s (dimensionless).
+    rotation : float
+        theta, rad (counter-clockwise).
+    translation : (2,) ndarray
+        t, m.
+    matched : (n, 2) ndarray
+        s R q_i + t: the measured points in the simulated frame, m.
+    errors : (n,) ndarray
+        ||p_i - (s R q_i + t)||, m.
+    """
+
+    scale: float
+    rotation: float
+    translation: np.ndarray
+    matched: np.ndarray
+    errors: np.ndarray
+
+    @property
+    def mean_error(self) -> float:
+        """Mean error per node, m (the paper reports 1.3 mm for Table 1)."""
+        return float(self.errors.mean())
+
+    @property
+    def rms_error(self) -> float:
+        """sqrt(E / n), m."""
+        return float(np.sqrt(np.mean(self.errors ** 2)))
+
+    def apply(self, points: np.ndarray) -> np.ndarray:
+        """Map points (k, 2) from the measured frame to the simulated frame."""
+        c, s = np.cos(self.rotation), np.sin(self.rotation)
+        R = np.array([[c, -s], [s, c]])
+        return self.scale * np.asarray(points, float) @ R.T + self.translation
+
+    def to_json(self) -> dict:
+        """``{"scale", "rotation", "rotation_deg", "translation", "mean_error", "rms_error",
+        "max_error", "errors"}``."""
+        return {"scale": self.scale, "rotation": self.rotation,
+                "rotation_deg": float(np.degrees(self.rotation)),
+                "translation": self.translation.tolist(), "mean_error": self.mean_error,
+                "rms_error": self.rms_error, "max_error": float(self.errors.max()),
+                "errors": self.errors.tolist()}
+
+
+def match_similarity(simulated, measured) -> Match:
+    """Closed-form least-squares similarity transform of ``measured`` onto ``simulated``.
+
+    Parameters
+    ----------
+    simulated, measured : (n, 2) array_like
+        Corresponding points P and Q, m, n >= 2.
+
+    Raises
+    ------
+    MechanicsError
+        For mismatched shapes, fewer than two points, non-finite input or coincident measured
+        points (D = 0).
+    """
+    P = np.asarray(simulated, float)
+    Q = np.asarray(measured, float)
+    if P.ndim != 2 or P.shape[1] != 2 or P.shape != Q.shape:
+        raise MechanicsError(f"simulated and measured points must both be (n, 2) arrays of the "
+                             f"same n, got {P.shape} and {Q.shape}")
+    if len(P) < 2:
+        raise MechanicsError(f"matching needs at least 2 corresponding points, got {len(P)}")
+    require_finite("simulated points", P)
+    require_finite("measured points", Q)
+    x, y = P[:, 0], P[:, 1]
+    u, v = Q[:, 0], Q[:, 1]
+    c1, c2, c3, c4, c5, c6, c7, c8, c9, c10 = (
+        np.mean(a) for a in (x, y, u, v, x * u, x * v, y * u, y * v, u * u, v * v))
+    D = c9 + c10 - (c3 * c3 + c4 * c4)
+    if not D > 1e-30 * max(c9 + c10, 1e-300):
+        raise MechanicsError("the measured points coincide: the similarity transform is undefined")
+    tx = (c4 * (c7 - c6) - c3 * (c5 + c8) + c1 * (c9 + c10)) / D
+    ty = (c2 * (c9 + c10) - c4 * (c5 + c8) - c3 * (c7 - c6)) / D
+    s = np.hypot(c1 * c3 + c2 * c4 - (c5 + c8), c1 * c4 - c2 * c3 + (c7 - c6)) / D
+    theta = np.arctan2(c7 - c6 + c1 * c4 - c2 * c3, c5 + c8 - (c1 * c3 + c2 * c4))
+    partial = Match(float(s), float(theta), np.array([tx, ty]), np.zeros((0, 2)), np.zeros(0))
+    matched = partial.apply(Q)
+    return Match(partial.scale, partial.rotation, partial.translation, matched,
+                 np.linalg.norm(P - matched, axis=1))

@@ -1,0 +1,231 @@
+# Copyright 2026 squeeze_grasp_ros developers
+# SPDX-License-Identifier: Apache-2.0
+"""Quality triangular meshes of planar outlines, with ordered boundary loops and normals.
+
+The mesher sits behind the small :class:`Mesher` protocol. The default,
+:class:`TriangleMesher`, uses the ``triangle`` package (J. R. Shewchuk's Triangle), which is
+robust and fast but **not free for commercial use**; any mesher returning nodes and
+counter-clockwise triangles of a planar straight-line graph can replace it.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from functools import cached_property
+from typing import Protocol
+
+import numpy as np
+
+from squeeze_grasp_ros.mechanics.errors import MechanicsError
+from squeeze_grasp_ros.mechanics.elastic.shapes import Outline, resample, signed_area
+
+
+class Mesher(Protocol):
+    """Triangulates a planar straight-line graph with quality controls."""
+
+    def triangulate(self, vertices: np.ndarray, segments: np.ndarray, holes: np.ndarray,
+                    max_area: float, min_angle: float) -> tuple[np.ndarray, np.ndarray]:
+        """Return ``(nodes (n, 2), triangles (t, 3))`` covering the region.
+
+        ``segments`` are index pairs into ``vertices`` that must stay edges (possibly split);
+        ``holes`` are points inside holes; ``max_area`` (m^2) and ``min_angle`` (degrees) are the
+        quality bounds.
+        """
+
+
+class TriangleMesher:
+    """Mesher backed by the ``triangle`` package (Shewchuk's Triangle; non-commercial licence)."""
+
+    def triangulate(self, vertices, segments, holes, max_area, min_angle):
+        import triangle
+
+        data = {"vertices": vertices, "segments": segments}
+        if len(holes):
+            data["holes"] = holes
+        area = np.format_float_positional(max_area, trim="-")  # Triangle cannot parse 1e-5
+        out = triangle.triangulate(data, f"pq{min_angle:.6g}a{area}Q")
+        return np.asarray(out["vertices"], float), np.asarray(out["triangles"], int)
+
+
+@dataclass(frozen=True)
+class Mesh:
+    """A triangulated planar object.
+
+    Attributes
+    ----------
+    nodes : (n, 2) ndarray
+        Node coordinates, m, in the object frame.
+    triangles : (t, 3) ndarray of int
+        Counter-clockwise node indices of each element.
+    boundary : (b,) ndarray of int
+        The outer boundary loop, counter-clockwise (the nodes fingers can touch).
+    inner_boundaries : tuple of ndarray
+        Loops around holes (clockwise as seen from the object).
+    normals : (b, 2) ndarray
+        Outward unit normals at the ``boundary`` nodes (mean of the adjacent edge normals).
+    """
+
+    nodes: np.ndarray
+    triangles: np.ndarray
+    boundary: np.ndarray
+    inner_boundaries: tuple[np.ndarray, ...]
+    normals: np.ndarray
+
+    @property
+    def n(self) -> int:
+        """Number of nodes."""
+        return len(self.nodes)
+
+    @cached_property
+    def size(self) -> float:
+        """Characteristic length L, m: the larger side of the bounding box."""
+        return float(np.ptp(self.nodes, axis=0).max())
+
+    @cached_property
+    def centroid(self) -> np.ndarray:
+        """Area centroid of the object, m."""
+        p = self.nodes[self.triangles]
+        a = element_areas(self.nodes, self.triangles)
+        return (a[:, None] * p.mean(axis=1)).sum(axis=0) / a.sum()
+
+    def boundary_position(self, node: int) -> int:
+        """Position of mesh ``node`` in the ``boundary`` loop; error if it is not on it."""
+        pos = np.flatnonzero(self.boundary == node)
+        if len(pos) == 0:
+            raise MechanicsError(f"node {node} is not on the outer boundary")
+        return int(pos[0])
+
+    def normal_at(self, node: int) -> np.ndarray:
+        """Outward unit normal (2,) at boundary ``node``."""
+        return self.normals[self.boundary_position(node)]
+
+    def min_angle_deg(self) -> float:
+        """Smallest interior angle over all elements, degrees."""
+        p = self.nodes[self.triangles]
+        angles = []
+        for k in range(3):
+            u = p[:, (k + 1) % 3] - p[:, k]
+            v = p[:, (k + 2) % 3] - p[:, k]
+            cos = np.einsum("ij,ij->i", u, v) / (np.linalg.norm(u, axis=1) * np.linalg.norm(v, axis=1))
+            angles.append(np.degrees(np.arccos(np.clip(cos, -1, 1))))
+        return float(np.min(angles))
+
+
+def element_areas(nodes: np.ndarray, triangles: np.ndarray) -> np.ndarray:
+    """Signed areas (t,) of the triangles, m^2 (> 0 when counter-clockwise)."""
+    p = nodes[triangles]
+    e1, e2 = p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]
+    return 0.5 * (e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0])
+
+
+def boundary_loops(triangles: np.ndarray) -> list[np.ndarray]:
+    """Closed loops of edges that belong to exactly one triangle, in the triangles' orientation."""
+    edges = np.concatenate([triangles[:, [0, 1]], triangles[:, [1, 2]], triangles[:, [2, 0]]])
+    key = np.sort(edges, axis=1)
+    _, inverse, counts = np.unique(key, axis=0, return_inverse=True, return_counts=True)
+    free = edges[counts[inverse.ravel()] == 1]
+    successor = dict(zip(free[:, 0].tolist(), free[:, 1].tolist()))
+    if len(successor) != len(free):
+        raise MechanicsError("mesh boundary is not manifold (a node has two outgoing edges)")
+    loops = []
+    while successor:
+        start = next(iter(successor))
+        loop = [start]
+        node = successor.pop(start)
+        while node != start:
+            loop.append(node)
+            node = successor.pop(node)
+        loops.append(np.array(loop, dtype=int))
+    return loops
+
+
+def vertex_normals(points: np.ndarray) -> np.ndarray:
+    """Outward unit normals at the vertices of a counter-clockwise closed polyline."""
+    e_out = np.roll(points, -1, axis=0) - points
+    e_in = points - np.roll(points, 1, axis=0)
+
+    def edge_normal(e):
+        nrm = np.column_stack([e[:, 1], -e[:, 0]])
+        return nrm / np.linalg.norm(nrm, axis=1, keepdims=True)
+
+    nrm = edge_normal(e_out) + edge_normal(e_in)
+    return nrm / np.linalg.norm(nrm, axis=1, keepdims=True)
+
+
+MAX_MESH_NODES = 250_000
+"""Largest mesh the mesher is asked for (about 0.8 area / max_area nodes); beyond it a solve
+takes minutes and gigabytes, so the request is refused before meshing."""
+
+
+def target_max_area(outline: Outline, nodes: int) -> float:
+    """The ``max_area`` (m^2) that gives roughly ``nodes`` mesh nodes for ``outline``."""
+    if not 10 <= nodes <= MAX_MESH_NODES:
+        raise MechanicsError(f"mesh.nodes must be in [10, {MAX_MESH_NODES}], got {nodes}")
+    return 1.6 * outline.area / (2.0 * nodes)
+
+
+def generate_mesh(outline: Outline, max_area: float, min_angle: float = 30.0,
+                  mesher: Mesher | None = None) -> Mesh:
+    """Mesh ``outline`` with elements of area <= ``max_area`` m^2 and angles >= ``min_angle``.
+
+    The boundary is first resampled to the edge length of an equilateral element of the target
+    area, so boundary nodes are evenly spaced and corners are kept.
+
+    Raises
+    ------
+    MechanicsError
+        If ``max_area`` is not positive or ``min_angle`` is outside (0, 34] degrees (Triangle's
+        guaranteed-termination range), or if the mesher fails.
+    """
+    if not (np.isfinite(max_area) and max_area > 0):
+        raise MechanicsError(f"mesh.max_area must be > 0 m^2, got {max_area}")
+    if not 0 < min_angle <= 34:
+        raise MechanicsError(f"mesh.min_angle must be in (0, 34] degrees, got {min_angle}")
+    if max_area > outline.area:
+        max_area = outline.area / 4.0
+    if 0.8 * outline.area / max_area > MAX_MESH_NODES:
+        smallest = 0.8 * outline.area / MAX_MESH_NODES
+        raise MechanicsError(f"mesh.max_area {max_area:.3g} m^2 would give about "
+                             f"{0.8 * outline.area / max_area:.3g} nodes on this "
+                             f"{outline.area:.3g} m^2 object; at most {MAX_MESH_NODES} are "
+                             f"allowed (max_area >= {smallest:.3g} m^2)")
+    spacing = np.sqrt(4.0 * max_area / np.sqrt(3.0))
+    loops = [resample(outline.points, spacing, outline.corners)]
+    loops += [resample(h if signed_area(h) > 0 else h[::-1], spacing) for h in outline.holes]
+    vertices = np.concatenate(loops)
+    segments, offset = [], 0
+    for loop in loops:
+        k = np.arange(len(loop)) + offset
+        segments.append(np.column_stack([k, np.roll(k, -1)]))
+        offset += len(loop)
+    holes = np.array([h.mean(axis=0) for h in outline.holes]).reshape(-1, 2)
+    nodes, tris = (mesher or TriangleMesher()).triangulate(
+        vertices, np.concatenate(segments), holes, max_area, min_angle)
+    return mesh_from_triangles(nodes, tris)
+
+
+def mesh_from_triangles(nodes: np.ndarray, triangles: np.ndarray) -> Mesh:
+    """Build a :class:`Mesh` (boundary loops, normals) from raw nodes and triangles.
+
+    Unused nodes are dropped, triangles are oriented counter-clockwise, and degenerate (zero
+    area) elements are rejected.
+    """
+    nodes = np.asarray(nodes, float)
+    triangles = np.asarray(triangles, int)
+    if triangles.ndim != 2 or triangles.shape[1] != 3 or len(triangles) == 0:
+        raise MechanicsError("mesh needs at least one triangle given as [i, j, k]")
+    used = np.unique(triangles)
+    remap = -np.ones(len(nodes), dtype=int)
+    remap[used] = np.arange(len(used))
+    nodes, triangles = nodes[used], remap[triangles]
+    area = element_areas(nodes, triangles)
+    scale = float(np.ptp(nodes, axis=0).max()) ** 2
+    if np.any(np.abs(area) <= 1e-14 * scale):
+        raise MechanicsError("mesh has degenerate (zero-area) elements")
+    flip = area < 0
+    triangles[flip] = triangles[flip][:, [0, 2, 1]]
+    loops = boundary_loops(triangles)
+    areas = [signed_area(nodes[loop]) for loop in loops]
+    outer = int(np.argmax(areas))
+    boundary = loops[outer]
+    inner = tuple(loop for i, loop in enumerate(loops) if i != outer)
+    return Mesh(nodes, triangles, boundary, inner, vertex_normals(nodes[boundary]))

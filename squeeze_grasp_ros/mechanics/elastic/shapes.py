@@ -1,0 +1,314 @@
+# Copyright 2026 squeeze_grasp_ros developers
+# SPDX-License-Identifier: Apache-2.0
+"""Closed planar outlines: the shape library shared by solid meshes and ring middle curves.
+
+Every outline is a counter-clockwise polyline of vertices in metres (the closing edge is
+implicit). Smooth shapes are sampled densely; :func:`resample` turns any outline into evenly
+spaced vertices while keeping its corners.
+"""
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Sequence
+
+import numpy as np
+from scipy.interpolate import CubicSpline
+
+from squeeze_grasp_ros.inputs import InputError, read_text
+from squeeze_grasp_ros.mechanics.errors import MechanicsError
+
+DENSE = 2048
+"""Number of samples of a smooth outline before resampling."""
+
+
+@dataclass(frozen=True)
+class Outline:
+    """A closed simple outline, optionally with holes.
+
+    Parameters
+    ----------
+    points : (N, 2) ndarray
+        Vertices of the outer curve, m, counter-clockwise, without repeating the first one.
+    holes : tuple of (M, 2) ndarray
+        Vertices of each hole, m (orientation free).
+    corners : (K,) ndarray of int
+        Indices into ``points`` of vertices that resampling must keep (polygon corners).
+    """
+
+    points: np.ndarray
+    holes: tuple[np.ndarray, ...] = ()
+    corners: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=int))
+
+    @property
+    def area(self) -> float:
+        """Enclosed area, m^2 (holes subtracted)."""
+        return signed_area(self.points) - sum(abs(signed_area(h)) for h in self.holes)
+
+    @property
+    def size(self) -> float:
+        """Characteristic length, m: the larger side of the bounding box."""
+        span = self.points.max(axis=0) - self.points.min(axis=0)
+        return float(span.max())
+
+
+def signed_area(points: np.ndarray) -> float:
+    """Shoelace signed area of a closed polyline, m^2 (> 0 when counter-clockwise)."""
+    x, y = points[:, 0], points[:, 1]
+    return 0.5 * float(np.dot(x, np.roll(y, -1)) - np.dot(np.roll(x, -1), y))
+
+
+def _segments_intersect(p: np.ndarray) -> bool:
+    """True if the closed polyline ``p`` is not simple: two non-adjacent edges cross or touch
+    (a repeated vertex, a vertex on another edge, overlapping edges), or two adjacent edges fold
+    back onto each other (a zero-width spike).
+
+    Broad phase: edges sorted by their left end; each edge is only paired with the following
+    edges whose x-range starts before its own ends (a sweep over x), then with bounding-box
+    overlap in y; narrow phase: orientation tests on the surviving pairs, with collinearity
+    judged to 1e-12 of the squared size.
+    """
+    a, b = p, np.roll(p, -1, axis=0)
+    n = len(p)
+    size = max(float(np.ptp(p, axis=0).max()), 1e-300)
+    tol = 1e-12 * size
+    edge = b - a
+    before = np.roll(edge, 1, axis=0)
+    cross_turn = before[:, 0] * edge[:, 1] - before[:, 1] * edge[:, 0]
+    dot_turn = np.einsum("ij,ij->i", before, edge)
+    if np.any((np.abs(cross_turn) <= tol * size) & (dot_turn < 0)):
+        return True
+    lo, hi = np.minimum(a, b) - tol, np.maximum(a, b) + tol
+    order = np.argsort(lo[:, 0], kind="stable")
+    reach = np.searchsorted(lo[order, 0], hi[order, 0], side="right")
+    counts = np.maximum(reach - np.arange(n) - 1, 0)
+    first = np.repeat(np.arange(n), counts)
+    second = first + 1 + (np.arange(len(first)) - np.repeat(np.cumsum(counts) - counts, counts))
+    i, j = order[first], order[second]
+    keep = (lo[i, 1] <= hi[j, 1]) & (lo[j, 1] <= hi[i, 1])
+    gap = np.abs(i - j)
+    keep &= (gap > 1) & (gap != n - 1)
+    i, j = i[keep], j[keep]
+
+    def orient(o, q, r):
+        oq, o_r = q - o, r - o
+        value = oq[:, 0] * o_r[:, 1] - oq[:, 1] * o_r[:, 0]
+        return np.where(np.abs(value) <= tol * size, 0.0, np.sign(value))
+
+    def on_segment(o, q, r, side):
+        inside = np.all((np.minimum(o, q) - tol <= r) & (r <= np.maximum(o, q) + tol), axis=1)
+        return (side == 0) & inside
+
+    d1, d2 = orient(a[i], b[i], a[j]), orient(a[i], b[i], b[j])
+    d3, d4 = orient(a[j], b[j], a[i]), orient(a[j], b[j], b[i])
+    proper = (d1 * d2 < 0) & (d3 * d4 < 0)
+    touch = (on_segment(a[i], b[i], a[j], d1) | on_segment(a[i], b[i], b[j], d2)
+             | on_segment(a[j], b[j], a[i], d3) | on_segment(a[j], b[j], b[i], d4))
+    return bool(np.any(proper | touch))
+
+
+def validate_polyline(points, name: str = "outline") -> np.ndarray:
+    """Return ``points`` as a counter-clockwise (N, 2) array, or raise a clear error.
+
+    Rejects fewer than 3 distinct vertices, non-finite values, zero area and curves that are
+    not simple (edges that cross or touch, repeated vertices, zero-width spikes): the mesher
+    crashes on those. Repeated consecutive vertices (and a repeated closing vertex) are dropped.
+    """
+    p = np.asarray(points, dtype=float)
+    if p.ndim != 2 or p.shape[1] != 2:
+        raise MechanicsError(f"{name} must be a list of [x, y] pairs, got shape {p.shape}")
+    if not np.all(np.isfinite(p)):
+        raise MechanicsError(f"{name} has non-finite coordinates")
+    step = np.linalg.norm(np.diff(np.vstack([p, p[:1]]), axis=0), axis=1)
+    scale = max(float(np.ptp(p, axis=0).max()), 1e-300)
+    p = p[step > 1e-12 * scale]
+    if len(p) < 3:
+        raise MechanicsError(f"{name} needs at least 3 distinct vertices, got {len(p)}")
+    area = signed_area(p)
+    if abs(area) <= 1e-12 * scale * scale:
+        raise MechanicsError(f"{name} is degenerate (zero enclosed area)")
+    if area < 0:
+        p = p[::-1].copy()
+    if _segments_intersect(p):
+        raise MechanicsError(f"{name} is self-intersecting: two edges cross or touch (a "
+                             "repeated vertex, a vertex on another edge or a zero-width spike); "
+                             "give a simple closed curve")
+    return p
+
+
+def _turning_corners(p: np.ndarray, threshold_deg: float = 20.0) -> np.ndarray:
+    """Indices of vertices where the polyline turns by more than ``threshold_deg``."""
+    e_in = p - np.roll(p, 1, axis=0)
+    e_out = np.roll(p, -1, axis=0) - p
+    cross = e_in[:, 0] * e_out[:, 1] - e_in[:, 1] * e_out[:, 0]
+    turn = np.abs(np.arctan2(cross, np.einsum("ij,ij->i", e_in, e_out)))
+    return np.flatnonzero(turn > np.radians(threshold_deg))
+
+
+def polygon(points: Sequence[Sequence[float]]) -> Outline:
+    """A closed simple polygon through ``points`` (m); its vertices are kept as corners."""
+    p = validate_polyline(points, "polygon")
+    return Outline(p, corners=np.arange(len(p)))
+
+
+def rectangle(width: float, height: float) -> Outline:
+    """Axis-aligned rectangle of ``width`` x ``height`` m centred at the origin."""
+    _positive(width=width, height=height)
+    w, h = 0.5 * width, 0.5 * height
+    return polygon([[-w, -h], [w, -h], [w, h], [-w, h]])
+
+
+def _smooth(x: np.ndarray, y: np.ndarray, name: str) -> Outline:
+    return Outline(validate_polyline(np.column_stack([x, y]), name))
+
+
+def ellipse(a: float, b: float) -> Outline:
+    """Ellipse with semi-axes ``a`` (x) and ``b`` (y), m, centred at the origin."""
+    _positive(a=a, b=b)
+    t = np.linspace(0.0, 2 * np.pi, DENSE, endpoint=False)
+    return _smooth(a * np.cos(t), b * np.sin(t), "ellipse")
+
+
+def disk(radius: float) -> Outline:
+    """Circle of ``radius`` m centred at the origin."""
+    return ellipse(radius, radius)
+
+
+def superellipse(a: float, b: float, exponent: float) -> Outline:
+    """Rounded rectangle |x/a|^p + |y/b|^p = 1 (p = ``exponent`` >= 2; large p -> sharp)."""
+    _positive(a=a, b=b)
+    if not exponent >= 2.0:
+        raise MechanicsError(f"superellipse.exponent must be >= 2, got {exponent}")
+    t = np.linspace(0.0, 2 * np.pi, DENSE, endpoint=False)
+    c, s = np.cos(t), np.sin(t)
+    x = a * np.sign(c) * np.abs(c) ** (2.0 / exponent)
+    y = b * np.sign(s) * np.abs(s) ** (2.0 / exponent)
+    return _smooth(x, y, "superellipse")
+
+
+def fourier_blob(radius: float, cos: Sequence[float] = (), sin: Sequence[float] = ()) -> Outline:
+    """Star-shaped blob r(t) = radius * (1 + sum_k cos[k-1] cos(k t) + sin[k-1] sin(k t)).
+
+    Coefficients are relative (dimensionless); r(t) must stay positive.
+    """
+    _positive(radius=radius)
+    t = np.linspace(0.0, 2 * np.pi, DENSE, endpoint=False)
+    r = np.ones_like(t)
+    for k, ck in enumerate(cos, start=1):
+        r += ck * np.cos(k * t)
+    for k, sk in enumerate(sin, start=1):
+        r += sk * np.sin(k * t)
+    if np.min(r) <= 0.05:
+        raise MechanicsError("fourier_blob coefficients make the radius vanish; reduce them")
+    return _smooth(radius * r * np.cos(t), radius * r * np.sin(t), "fourier_blob")
+
+
+def spline(points: Sequence[Sequence[float]]) -> Outline:
+    """Closed periodic cubic spline through the user's ``points`` (m), by chord length."""
+    p = validate_polyline(points, "spline.points")
+    closed = np.vstack([p, p[:1]])
+    s = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(closed, axis=0), axis=1))])
+    cs = CubicSpline(s, closed, bc_type="periodic")
+    dense = cs(np.linspace(0.0, s[-1], DENSE, endpoint=False))
+    return Outline(validate_polyline(dense, "spline"))
+
+
+def annulus(outer_radius: float, inner_radius: float) -> Outline:
+    """Solid ring (disk with a concentric circular hole), radii in m."""
+    _positive(outer_radius=outer_radius, inner_radius=inner_radius)
+    if not inner_radius < outer_radius:
+        raise MechanicsError("annulus.inner_radius must be smaller than outer_radius")
+    hole = disk(inner_radius).points
+    return Outline(disk(outer_radius).points, holes=(hole,))
+
+
+MAX_OUTLINE_POINTS = 100_000
+"""Vertices an outline file may have at most."""
+
+
+def _csv_points(text: str, name: str) -> list[list[float]]:
+    """``x,y`` rows of a CSV outline (``#`` comments and blank lines skipped)."""
+    pts = []
+    for number, line in enumerate(text.splitlines(), start=1):
+        line = line.split("#", 1)[0].strip()
+        if not line:
+            continue
+        cells = line.split(",")
+        try:
+            if len(cells) != 2:
+                raise ValueError
+            pts.append([float(cells[0]), float(cells[1])])
+        except ValueError:
+            raise MechanicsError(f"{name}: line {number} is not 'x,y' (two numbers, "
+                                 "metres)") from None
+        if len(pts) > MAX_OUTLINE_POINTS:
+            raise MechanicsError(f"{name}: more than {MAX_OUTLINE_POINTS} points")
+    return pts
+
+
+def load_outline(path: str | Path) -> Outline:
+    """Read an outline from CSV (``x,y`` per line, m) or JSON (``{"outline": [[x, y], ...]}``).
+
+    The points are the vertices of a polygon; vertices where it turns by more than 20 degrees
+    are kept as corners when the outline is resampled. The file is read up to
+    :data:`~squeeze_grasp_ros.inputs.MAX_FILE_BYTES` and errors never quote its contents.
+    """
+    path = Path(path)
+    name = f"outline file {path.name}"
+    try:
+        text = read_text(path, what="outline")
+    except InputError as exc:
+        raise MechanicsError(str(exc)) from None
+    if path.suffix.lower() == ".json":
+        try:
+            data = json.loads(text)
+        except json.JSONDecodeError as exc:
+            raise MechanicsError(f"{name}: invalid JSON at line {exc.lineno}, column "
+                                 f"{exc.colno}") from None
+        if not isinstance(data, dict) or "outline" not in data:
+            raise MechanicsError(f'{name}: JSON outline must be {{"outline": [[x, y], ...]}}')
+        pts = data["outline"]
+        if not isinstance(pts, list) or len(pts) > MAX_OUTLINE_POINTS or not all(
+                isinstance(q, list) and len(q) == 2
+                and all(isinstance(c, (int, float)) and not isinstance(c, bool) for c in q)
+                for q in pts):
+            raise MechanicsError(f"{name}: 'outline' must be a list of at most "
+                                 f"{MAX_OUTLINE_POINTS} [x, y] number pairs")
+    else:
+        pts = _csv_points(text, name)
+    p = validate_polyline(pts, name)
+    return Outline(p, corners=_turning_corners(p))
+
+
+def resample(outline_points: np.ndarray, spacing: float, corners: np.ndarray | None = None) -> np.ndarray:
+    """Evenly spaced vertices (about ``spacing`` m apart) along a closed polyline.
+
+    Vertices listed in ``corners`` (and sharp turns) are kept exactly; each piece between two
+    kept vertices is split into equal arc-length parts.
+    """
+    p = np.asarray(outline_points, dtype=float)
+    keep = np.union1d(_turning_corners(p), [] if corners is None else corners).astype(int)
+    closed = np.vstack([p, p[:1]])
+    seg = np.linalg.norm(np.diff(closed, axis=0), axis=1)
+    s = np.concatenate([[0.0], np.cumsum(seg)])
+    total = s[-1]
+    anchors = s[keep] if len(keep) else np.array([0.0])
+    anchors = np.append(anchors, anchors[0] + total)
+    samples = []
+    for s0, s1 in zip(anchors[:-1], anchors[1:]):
+        k = max(1, int(round((s1 - s0) / spacing)))
+        samples.append(s0 + (s1 - s0) * np.arange(k) / k)
+    t = np.mod(np.concatenate(samples), total)
+    x = np.interp(t, s, closed[:, 0])
+    y = np.interp(t, s, closed[:, 1])
+    out = np.column_stack([x, y])
+    if len(out) < 3:
+        raise MechanicsError(f"spacing {spacing} m is too coarse for this outline")
+    return out
+
+
+def _positive(**values: float) -> None:
+    for name, value in values.items():
+        if not (np.isfinite(value) and value > 0):
+            raise MechanicsError(f"{name} must be a positive length in m, got {value}")

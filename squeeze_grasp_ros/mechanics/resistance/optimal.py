@@ -1,0 +1,572 @@
+# Copyright 2026 squeeze_grasp_ros developers
+# SPDX-License-Identifier: Apache-2.0
+"""Optimal resistance to a translating adversary finger at fixed contacts (paper Sec. 6.1-6.2).
+
+Three fingers F1, F2 (grasping) and A (adversary) touch the object at fixed contact node sets
+I, J, K: one node each for point contacts (Sec. 6.1), segments for Sec. 6.2. Every node of a set
+moves with its finger (eq. 64), so the contact displacement is Delta = P x with x = (d1, d2, a)
+and the 2m x 6 expansion P of App. D. The grasping fingers' work (eqs. 53, 94) is
+
+    W_F = 1/2 (d1, d2, 0)^T G (d1, d2, a),   G = P^T C P   (6 x 6),
+
+minimised over (d1, d2) for a given adversary translation a, under one of two constraints:
+
+* **stable** (Delta in col(C)): eqs. (54)-(55), or (66) for segments. Eliminating d2 by (54)
+  gives W_F = 1/2 d1^T H d1 + c^T d1 + omega (eq. 57; App. D eqs. 86-88, 92-93). With
+  d1 = tau t + eta n, t the unit vector of p - q (contact centroids of F1, F2), (55)/(66) fixes
+  eta (eq. 59) and W_F = 1/2 b2 tau^2 + b1 tau + b0 (eq. 60). b2 = t^T H t > 0 always
+  (Theorem 11, Proposition 12), so tau* = -b1/b2 is the unique optimum for every p_k, including
+  the midpoint of p_i p_j (docs/design.md §2: the null space of H matters only without (55)).
+* **pure** (Delta in col(AC) = null(E^T), Theorem 7): x = U tau with U an orthonormal basis of
+  null(E^T P) (App. D; for point contacts U spans col(AC)) and a = Q tau, Q = (0, I2) U
+  (eq. 62). If a is outside col(Q) (possible only when rank Q < 2) the adversary cannot be
+  resisted purely. Otherwise the feasible tau form the affine set Q^+ a + null(Q), on which W_F
+  has a positive definite Hessian (a pure Delta with a = 0 is never rigid, since E^T B = I), so
+  the minimiser is unique: eq. (63) with tau*_1 of App. D eq. (91) when rank Q = 2. For
+  rank Q = 1 the paper sets tau2 = tau3 = 0, which is feasible but not minimal in general; here
+  the minimum over the whole feasible plane is taken.
+
+The optimum is linear in a: d* = ||a|| psi(a / ||a||) (eq. 61) and W*_F = ||a||^2 W*_F(a_hat), so
+a sweep of adversary directions is one vectorised evaluation. Internals are dimensionless
+(lengths by the object size L, forces by E h L, work by E h L^2); the API is SI. The closed
+forms themselves are in :mod:`.resistance_forms`.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field, replace
+from functools import cached_property
+from typing import Literal, Mapping, Sequence
+
+import numpy as np
+
+from squeeze_grasp_ros.mechanics.elastic.compliance import ElasticObject
+from squeeze_grasp_ros.mechanics.squeeze.contact_state import EVENT_TYPES
+from squeeze_grasp_ros.mechanics.errors import MechanicsError, require_finite
+from squeeze_grasp_ros.mechanics.squeeze.fingertips import FINGER_NAMES as FINGERS
+from squeeze_grasp_ros.mechanics.elastic.mesh import Mesh
+from squeeze_grasp_ros.mechanics.elastic.reduced import ReducedStiffness, reduced_stiffness, rotation_angle
+from squeeze_grasp_ros.mechanics.resistance.forms import (PureForm, StableForm, expansion_matrix, null_basis, perp,
+                               pure_form, stable_form)
+
+ResistanceMode = Literal["stable", "pure"]
+MODES: tuple[str, ...] = ("stable", "pure")
+FEASIBILITY_TOL = 1e-7
+"""Relative constraint residual above which a resistance is reported as infeasible."""
+
+
+@dataclass(frozen=True)
+class ResistanceGrasp:
+    """The fixed-contact resistance problem of one placement of F1, F2 and A.
+
+    Build it with :func:`resistance_grasp`. It caches everything that does not depend on the
+    adversary translation a, so each direction then costs a few 2x2 and 6x6 products.
+
+    Attributes
+    ----------
+    obj : ElasticObject
+        The object (its cached compliance is reused, never recomputed).
+    segments : dict of str to (k,) ndarray of int
+        Mesh node indices of the contact sets I, J, K keyed "F1", "F2", "A"; the first node of
+        each set is the finger's initial contact node.
+    red : ReducedStiffness
+        Reduced stiffness (SI) of the nodes of I, J, K concatenated in that order.
+    G : (6, 6) ndarray
+        Dimensionless P^T C_hat P: the fingers' resultant forces for x = (d1, d2, a).
+    points : (m, 2) ndarray
+        Dimensionless contact node positions (object frame / L), in the order of ``red.contacts``.
+    scale : float
+        The object size L, m.
+    """
+
+    obj: ElasticObject
+    segments: dict
+    red: ReducedStiffness
+    G: np.ndarray
+    points: np.ndarray
+    scale: float
+
+    @property
+    def counts(self) -> np.ndarray:
+        """|I|, |J|, |K| (3,) int."""
+        return np.array([len(self.segments[f]) for f in FINGERS])
+
+    @property
+    def kind(self) -> str:
+        """"point" if every finger touches one node, else "segment"."""
+        return "point" if np.all(self.counts == 1) else "segment"
+
+    @property
+    def contacts(self) -> list[int]:
+        """Initial contact nodes [i, j, k] of F1, F2, A."""
+        return [int(self.segments[f][0]) for f in FINGERS]
+
+    @property
+    def centroids(self) -> np.ndarray:
+        """Dimensionless contact centroids p, q, r (3, 2) of F1, F2, A (Sec. 6.2)."""
+        finger = np.repeat(np.arange(3), self.counts)
+        return np.array([self.points[finger == f].mean(axis=0) for f in range(3)])
+
+    @cached_property
+    def stable(self) -> StableForm:
+        """The quadratic form (57) and the line (59) of the stable resistances."""
+        return stable_form(self.G, self.counts, self.centroids)
+
+    @cached_property
+    def pure(self) -> PureForm:
+        """The pure resistances and their minimiser."""
+        E_fingers = expansion_matrix(self.counts).T @ self.red.E
+        return pure_form(self.G, null_basis(E_fingers.T))
+
+    def form(self, mode: str) -> StableForm | PureForm:
+        """The :class:`StableForm` or :class:`PureForm` of ``mode``."""
+        if mode not in MODES:
+            raise MechanicsError(f"resistance mode must be one of {list(MODES)}, got {mode!r}")
+        return self.stable if mode == "stable" else self.pure
+
+
+def resistance_grasp(obj: ElasticObject, segments: Mapping[str, Sequence[int]]) -> ResistanceGrasp:
+    """The resistance problem for contact sets ``segments`` = {"F1": I, "F2": J, "A": K}.
+
+    Parameters
+    ----------
+    obj : ElasticObject
+        The meshed object; its cached boundary compliance gives the contact block.
+    segments : mapping of str to sequence of int
+        Non-empty, pairwise disjoint sets of outer-boundary mesh nodes of F1, F2 and A; the first
+        node of each is reported as the finger's initial contact node.
+
+    Raises
+    ------
+    MechanicsError
+        For missing or unknown fingers, empty or overlapping sets, or nodes off the boundary.
+    """
+    if set(segments) != set(FINGERS):
+        raise MechanicsError(f"segments must have exactly the keys {list(FINGERS)}, "
+                             f"got {sorted(segments)}")
+    sets = {f: np.asarray(segments[f], dtype=int).reshape(-1) for f in FINGERS}
+    empty = [f for f in FINGERS if len(sets[f]) == 0]
+    if empty:
+        raise MechanicsError(f"contact set of {empty[0]} is empty")
+    nodes = np.concatenate([sets[f] for f in FINGERS])
+    if len(np.unique(nodes)) != len(nodes):
+        listed = {f: sets[f].tolist() for f in FINGERS}
+        raise MechanicsError(f"contact sets of F1, F2 and A must be disjoint, got {listed}")
+    off = nodes[obj.boundary_positions(nodes) < 0]
+    if len(off):
+        raise MechanicsError(f"contact nodes must lie on the outer boundary, got {off.tolist()}")
+    red = reduced_stiffness(obj, nodes)
+    P = expansion_matrix([len(sets[f]) for f in FINGERS])
+    G = P.T @ (red.C / obj.material.force_scale) @ P
+    L = obj.scale
+    return ResistanceGrasp(obj, sets, red, 0.5 * (G + G.T), obj.mesh.nodes[nodes] / L, L)
+
+
+def contact_segments(mesh: Mesh, contacts: Sequence[int],
+                     half_width: float | None = None) -> list[np.ndarray]:
+    """Fixed contact segments around initial contact nodes (Sec. 6.2).
+
+    Parameters
+    ----------
+    mesh : Mesh
+        The object mesh.
+    contacts : sequence of int
+        Initial contact nodes on the outer boundary, one per finger.
+    half_width : float, optional
+        Arc length, m, along the undeformed boundary on each side of a contact node whose nodes
+        join its segment. None: the node and its two boundary neighbours.
+
+    Returns
+    -------
+    list of (k,) ndarray of int
+        One segment per contact, the contact node first, then by arc distance.
+    """
+    loop = mesh.boundary
+    edge = np.linalg.norm(np.roll(mesh.nodes[loop], -1, axis=0) - mesh.nodes[loop], axis=1)
+    s = np.concatenate([[0.0], np.cumsum(edge)[:-1]])
+    perimeter = float(edge.sum())
+    if half_width is not None and not (np.isfinite(half_width) and half_width >= 0):
+        raise MechanicsError(f"segment half width must be >= 0 m, got {half_width}")
+    out = []
+    for c in contacts:
+        k = mesh.boundary_position(int(c))
+        gap = np.abs(s - s[k])
+        dist = np.minimum(gap, perimeter - gap)
+        if half_width is None:
+            near = np.argsort(dist, kind="stable")[:3]
+        else:
+            near = np.flatnonzero(dist <= half_width * (1 + 1e-12))
+            near = near[np.argsort(dist[near], kind="stable")]
+        out.append(loop[near])
+    return out
+
+
+@dataclass(frozen=True)
+class Resistance:
+    """A resistance (d1, d2) of F1, F2 to the adversary translation a at fixed contacts.
+
+    Attributes
+    ----------
+    mode : {"stable", "pure"}
+    contact_model : {"point", "segment"}
+    success : bool
+        False when the adversary cannot be resisted in this mode, or a user-given resistance
+        violates the mode's constraints.
+    reason : str
+        Why (human-readable).
+    contacts : list of int
+        Initial contact nodes [i, j, k] of F1, F2, A.
+    segments : dict of str to list of int
+        Contact node sets of F1, F2, A.
+    a : (2,) ndarray
+        Adversary translation, m, object frame.
+    d1, d2 : (2,) ndarray or None
+        Translations of F1 and F2, m (None if there is no resistance).
+    work : dict of str to float or None
+        Work of each finger, J; "total" = F1 + F2 = W_F (eq. 53).
+    forces : dict of str to (2,) ndarray or None
+        Resultant force of each finger on the object, N.
+    node_forces : (m, 2) ndarray or None
+        Force at each contact node, N, in the order of the segments F1, F2, A.
+    energy : float or None
+        Strain energy 1/2 Delta^T C Delta, J (= W_F + work of A).
+    rigid_rotation : float or None
+        Rigid-rotation angle of the displacement field, rad (zero for a pure resistance).
+    unit_work : float or None
+        W_F / ||a||^2, J/m^2: the work to resist a unit push in this direction.
+    event_counts : dict of str to int
+        Contact events A, B, C, D (all zero at fixed contacts).
+    diagnostics : dict
+        Residuals and condition numbers (see :func:`optimal_resistance`).
+    """
+
+    mode: str
+    contact_model: str
+    success: bool
+    reason: str
+    contacts: list
+    segments: dict
+    a: np.ndarray
+    d1: np.ndarray | None = None
+    d2: np.ndarray | None = None
+    work: dict = field(default_factory=lambda: {k: None for k in ("F1", "F2", "A", "total")})
+    forces: dict = field(default_factory=lambda: {f: None for f in FINGERS})
+    node_forces: np.ndarray | None = None
+    energy: float | None = None
+    rigid_rotation: float | None = None
+    unit_work: float | None = None
+    event_counts: dict = field(default_factory=lambda: dict.fromkeys(EVENT_TYPES, 0))
+    diagnostics: dict = field(default_factory=dict)
+
+    def psi(self) -> tuple[np.ndarray, np.ndarray] | None:
+        """(psi1, psi2) of eq. (61): d1 / ||a||, d2 / ||a|| (dimensionless), or None."""
+        if self.d1 is None:
+            return None
+        norm = float(np.linalg.norm(self.a))
+        return self.d1 / norm, self.d2 / norm
+
+    def to_json(self) -> dict:
+        """JSON-able dict (SI); missing quantities are null."""
+        def vec(v):
+            return None if v is None else [float(x) for x in v]
+
+        per_node = None
+        if self.node_forces is not None:
+            bounds = np.cumsum([0] + [len(self.segments[f]) for f in FINGERS])
+            per_node = {f: [{"node": int(n), "mode": "stick", "force": vec(fv)}
+                            for n, fv in zip(self.segments[f], self.node_forces[lo:hi])]
+                        for f, lo, hi in zip(FINGERS, bounds[:-1], bounds[1:])}
+        psi = self.psi()
+        return {
+            "success": self.success,
+            "reason": self.reason,
+            "mode": self.mode,
+            "contact_model": self.contact_model,
+            "contacts": list(self.contacts),
+            "segments": per_node or {f: [{"node": int(n)} for n in self.segments[f]] for f in FINGERS},
+            "a": vec(self.a),
+            "d1": vec(self.d1),
+            "d2": vec(self.d2),
+            "psi": None if psi is None else {"F1": vec(psi[0]), "F2": vec(psi[1])},
+            "work": dict(self.work),
+            "unit_work": self.unit_work,
+            "energy": self.energy,
+            "forces": {f: vec(v) for f, v in self.forces.items()},
+            "rigid_rotation": self.rigid_rotation,
+            "event_counts": dict(self.event_counts),
+            "diagnostics": dict(self.diagnostics),
+        }
+
+
+def _translation(a, name: str = "adversary translation a") -> np.ndarray:
+    a = np.asarray(a, dtype=float).reshape(-1)
+    if a.shape != (2,):
+        raise MechanicsError(f"{name} must be [x, y] in m, got shape {a.shape}")
+    require_finite(name, a)
+    if not np.linalg.norm(a) > 0:
+        raise MechanicsError(f"{name} must be nonzero")
+    return a
+
+
+def _unresisted(grasp: ResistanceGrasp, mode: str, a: np.ndarray, reason: str,
+                diagnostics: dict) -> Resistance:
+    segments = {f: grasp.segments[f].tolist() for f in FINGERS}
+    return Resistance(mode, grasp.kind, False, reason, grasp.contacts, segments, a,
+                      diagnostics=diagnostics)
+
+
+def _pure_diagnostics(form: PureForm, a_hat: np.ndarray) -> dict:
+    return {"rank_Q": form.rank, "Q_singular_values": form.singular_values.tolist(),
+            "outside_col_Q": float(form.outside(a_hat[None])[0]),
+            "hessian_condition": form.hessian_condition}
+
+
+def _cannot_resist(grasp: ResistanceGrasp, a: np.ndarray) -> Resistance:
+    form = grasp.pure
+    a_hat = a / grasp.scale
+    reason = (f"cannot be resisted: rank Q = {form.rank} and a is not in col(Q), so no pure "
+              "contact displacement moves A by a (Sec. 6.1.2)")
+    return _unresisted(grasp, "pure", a, reason, _pure_diagnostics(form, a_hat))
+
+
+def finger_work(G: np.ndarray, x: np.ndarray, a: np.ndarray) -> np.ndarray:
+    """Work (N, 3) of F1, F2, A for rows x = (d1, d2) (N, 4) and a (N, 2): 1/2 d_f . (G x6)_f."""
+    x6 = np.hstack([x, a])
+    return 0.5 * (x6 * (x6 @ G)).reshape(-1, 3, 2).sum(axis=2)
+
+
+def optimum_batch(grasp: ResistanceGrasp, mode: ResistanceMode,
+                  a_hat: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Optimal (d1, d2) for many dimensionless adversary translations at once.
+
+    Parameters
+    ----------
+    grasp : ResistanceGrasp
+    mode : {"stable", "pure"}
+    a_hat : (N, 2) ndarray
+        Adversary translations divided by the object size L.
+
+    Returns
+    -------
+    x : (N, 4) ndarray
+        Dimensionless (d1, d2) per row (multiply by L for metres); rows that cannot be resisted
+        hold the least-squares point and are flagged in ``feasible``.
+    work : (N,) ndarray
+        Dimensionless W*_F (multiply by E h L^2 for J); for "stable" from the parabola (60).
+    feasible : (N,) ndarray of bool
+        False where a pure resistance does not exist (a outside col(Q)).
+    """
+    form = grasp.form(mode)
+    if isinstance(form, StableForm):
+        x, work = form.optimum(a_hat)
+        return x, work, np.ones(len(a_hat), bool)
+    x = a_hat @ form.gain.T
+    work = finger_work(grasp.G, x, a_hat)[:, :2].sum(axis=1)
+    return x, work, form.outside(a_hat) <= FEASIBILITY_TOL
+
+
+def evaluate_resistance(grasp: ResistanceGrasp, d1, d2, a, mode: ResistanceMode = "stable",
+                        reason: str = "user-given resistance") -> Resistance:
+    """Forces, work and constraint residuals of a given resistance (d1, d2) to a, all in m.
+
+    ``success`` is False (the residual is in ``reason``) when (d1, d2, a) violates the mode's
+    constraints by more than :data:`FEASIBILITY_TOL`: eqs. (54)-(55) (segments: their Sec. 6.2
+    form) for "stable", (d1, d2, a) in null(E^T P) (i.e. E^T Delta = 0) for "pure".
+
+    Diagnostics, all dimensionless: ``sum_delta_residual`` |sum delta_t| / sum |delta_t|
+    (eq. 54); ``moment_delta_residual`` |sum p_t x delta_t| / (L sum |delta_t|) (eq. 55);
+    ``rigid_residual`` |E^T Delta| / |Delta|; ``force_residual`` |sum f_t| / sum |f_t| and
+    ``moment_residual`` |sum p_t x f_t| / (L sum |f_t|) (equilibrium); ``reduced_condition``
+    (of Z^T A Z); ``pulling``, the fingers whose resultant force points out of the object at
+    their initial contact (fixed contacts act as if glued, Sec. 6.1); plus ``b2`` (N/m,
+    eq. 60) for "stable" and the rank of Q, its singular values, the distance of a from col(Q)
+    and the Hessian condition for "pure".
+    """
+    form = grasp.form(mode)
+    a = _translation(a)
+    x = np.concatenate([np.asarray(d1, float).reshape(2), np.asarray(d2, float).reshape(2), a])
+    require_finite("d1, d2", x)
+    red, obj = grasp.red, grasp.obj
+    P = expansion_matrix(grasp.counts)
+    delta = P @ x
+    node_forces = red.forces(delta).reshape(-1, 2)
+    resultant = (P.T @ node_forces.reshape(-1)).reshape(3, 2)
+    work = {f: 0.5 * float(x[2 * k:2 * k + 2] @ resultant[k]) for k, f in enumerate(FINGERS)}
+    work["total"] = work["F1"] + work["F2"]
+    g = red.rigid_coefficients(delta)
+    pts = grasp.points - grasp.points.mean(axis=0)
+    dl = delta.reshape(-1, 2)
+    d_size = max(float(np.linalg.norm(dl, axis=1).sum()), 1e-300)
+    f_size = max(float(np.linalg.norm(node_forces, axis=1).sum()), 1e-300)
+    diagnostics = {
+        "sum_delta_residual": float(np.linalg.norm(dl.sum(axis=0))) / d_size,
+        "moment_delta_residual": abs(float(np.sum(perp(pts) * dl))) / d_size,
+        "rigid_residual": float(np.linalg.norm(g) / max(float(np.linalg.norm(delta)), 1e-300)),
+        "force_residual": float(np.linalg.norm(node_forces.sum(axis=0))) / f_size,
+        "moment_residual": abs(float(np.sum(perp(pts) * node_forces))) / f_size,
+        "reduced_condition": red.condition,
+        "pulling": [f for k, f in enumerate(FINGERS)
+                    if resultant[k] @ obj.mesh.normal_at(grasp.contacts[k]) > 0],
+    }
+    if isinstance(form, StableForm):
+        violation = max(diagnostics["sum_delta_residual"], diagnostics["moment_delta_residual"])
+        diagnostics["b2"] = form.b2 * obj.material.force_scale
+    else:
+        violation = form.violation(x)
+        diagnostics.update(_pure_diagnostics(form, a / grasp.scale))
+    success = violation <= FEASIBILITY_TOL
+    if not success:
+        reason = (f"{reason} is not a {mode} resistance: constraint residual {violation:.3g} > "
+                  f"{FEASIBILITY_TOL:g}")
+    return Resistance(
+        mode=mode, contact_model=grasp.kind, success=success, reason=reason,
+        contacts=grasp.contacts, segments={f: grasp.segments[f].tolist() for f in FINGERS},
+        a=a, d1=x[:2], d2=x[2:4], work=work,
+        forces={f: resultant[k] for k, f in enumerate(FINGERS)}, node_forces=node_forces,
+        energy=red.energy(delta), rigid_rotation=rotation_angle(obj, g),
+        unit_work=work["total"] / float(a @ a), diagnostics=diagnostics)
+
+
+def optimal_resistance(grasp: ResistanceGrasp, a, mode: ResistanceMode = "stable") -> Resistance:
+    """The resistance (d1, d2) minimising the grasping fingers' work W_F (Sec. 6.1-6.2).
+
+    Parameters
+    ----------
+    grasp : ResistanceGrasp
+        Fixed contact sets of F1, F2, A (:func:`resistance_grasp`).
+    a : (2,) array_like
+        Adversary translation, m, object frame (nonzero).
+    mode : {"stable", "pure"}
+        Stable: Delta in col(C) (eqs. 54-61, 66); pure: Delta in col(AC) (eqs. 62-63, 91, 94).
+
+    Returns
+    -------
+    Resistance
+        ``success`` False with a "cannot be resisted" reason when no pure resistance exists.
+        Diagnostics as in :func:`evaluate_resistance`, plus ``work_identity_residual``: the
+        closed-form W*_F against the work of the assembled forces, relative.
+    """
+    a = _translation(a)
+    form = grasp.form(mode)
+    L = grasp.scale
+    a_hat = a[None] / L
+    if isinstance(form, PureForm) and form.outside(a_hat)[0] > FEASIBILITY_TOL:
+        return _cannot_resist(grasp, a)
+    x, w, _ = optimum_batch(grasp, mode, a_hat)
+    res = evaluate_resistance(grasp, x[0, :2] * L, x[0, 2:] * L, a, mode,
+                              reason=f"optimal {mode} resistance")
+    closed = float(w[0]) * grasp.obj.material.force_scale * L * L
+    scale = max(abs(res.work["total"]), abs(res.energy), 1e-300)
+    identity = abs(closed - res.work["total"]) / scale
+    return replace(res, diagnostics={**res.diagnostics, "work_identity_residual": identity})
+
+
+def resistance_along(grasp: ResistanceGrasp, a, direction, mode: ResistanceMode = "stable") -> Resistance:
+    """The resistance of ``mode`` to a whose d1 lies on the line of ``direction`` (Table 4).
+
+    The feasible resistances to a form a line (stable; pure with rank Q = 2) or a plane; fixing
+    the line of d1 picks one of them, as the paper's "arbitrary" resistance of Table 4 does.
+
+    Parameters
+    ----------
+    grasp : ResistanceGrasp
+    a : (2,) array_like
+        Adversary translation, m.
+    direction : (2,) array_like
+        Direction of F1's translation (any length; d1 may come out antiparallel).
+    mode : {"stable", "pure"}
+
+    Returns
+    -------
+    Resistance
+        ``success`` False when no resistance of this mode moves F1 along that line.
+    """
+    a = _translation(a)
+    e = _translation(direction, "d1 direction")
+    form = grasp.form(mode)
+    L = grasp.scale
+    a_hat = a[None] / L
+    if isinstance(form, PureForm) and form.outside(a_hat)[0] > FEASIBILITY_TOL:
+        return _cannot_resist(grasp, a)
+    x0, Z = form.line(a_hat)
+    e = e / np.linalg.norm(e)
+    coef = perp(e) @ Z[:2]
+    rhs = -float(perp(e) @ x0[0, :2])
+    if float(np.linalg.norm(coef)) <= 1e-12:
+        if abs(rhs) > FEASIBILITY_TOL * max(float(np.linalg.norm(x0)), 1e-300):
+            return _unresisted(grasp, mode, a, f"no {mode} resistance moves F1 along "
+                               f"{e.round(6).tolist()}", {})
+        coef = np.zeros_like(coef)
+    s = coef * rhs / max(float(coef @ coef), 1e-300)
+    x = (x0[0] + Z @ s) * L
+    return evaluate_resistance(grasp, x[:2], x[2:], a, mode,
+                               reason=f"{mode} resistance with d1 along {e.round(6).tolist()}")
+
+
+def compare_resistances(optimum: Resistance, other: Resistance) -> dict:
+    """Table-4-style comparison of a resistance with the optimum to the same a (J)."""
+    base = optimum.work["total"]
+    total = other.work["total"]
+    return {
+        "resistance": other.to_json(),
+        "optimal_work": base,
+        "excess_work": None if total is None or base is None else total - base,
+        "ratio": total / base if total is not None and base is not None and base > 0 else None,
+    }
+
+
+@dataclass(frozen=True)
+class ResistanceSweep:
+    """Grasp quality over adversary push directions: W*_F of a unit push per direction.
+
+    Attributes
+    ----------
+    mode : {"stable", "pure"}
+    angles : (N,) ndarray
+        Push directions, rad from the object-frame x axis.
+    unit_work : (N,) ndarray
+        W*_F for a 1 m push, J/m^2 (W*_F scales with ||a||^2); NaN where ``feasible`` is False.
+    psi : (N, 4) ndarray
+        Optimal (d1, d2) per unit push (eq. 61), dimensionless; NaN where not feasible.
+    feasible : (N,) ndarray of bool
+        The push can be resisted in this mode.
+    """
+
+    mode: str
+    angles: np.ndarray
+    unit_work: np.ndarray
+    psi: np.ndarray
+    feasible: np.ndarray
+
+    def extremes(self) -> dict:
+        """Easiest and hardest feasible push directions with their W*_F (J/m^2), and the mean."""
+        if not np.any(self.feasible):
+            return {"min": None, "max": None, "mean": None}
+        w = np.where(self.feasible, self.unit_work, np.nan)
+        lo, hi = int(np.nanargmin(w)), int(np.nanargmax(w))
+        return {"min": {"angle_deg": float(np.degrees(self.angles[lo])), "unit_work": float(w[lo])},
+                "max": {"angle_deg": float(np.degrees(self.angles[hi])), "unit_work": float(w[hi])},
+                "mean": float(np.nanmean(w))}
+
+    def to_json(self) -> dict:
+        """JSON-able dict; infeasible directions carry null work and psi."""
+        ok = self.feasible
+        return {
+            "mode": self.mode,
+            "angles_deg": np.degrees(self.angles).tolist(),
+            "unit_work": [float(w) if f else None for w, f in zip(self.unit_work, ok)],
+            "psi": [p.tolist() if f else None for p, f in zip(self.psi, ok)],
+            "feasible": ok.tolist(),
+            **self.extremes(),
+        }
+
+
+def sweep_directions(grasp: ResistanceGrasp, mode: ResistanceMode = "stable",
+                     count: int = 360) -> ResistanceSweep:
+    """W*_F of a unit push in ``count`` evenly spaced directions, vectorised (eq. 61)."""
+    if count < 1:
+        raise MechanicsError(f"number of directions must be >= 1, got {count}")
+    angles = 2.0 * np.pi * np.arange(count) / count
+    units = np.column_stack([np.cos(angles), np.sin(angles)])
+    x, w, ok = optimum_batch(grasp, mode, units)
+    unit_work = np.where(ok, w * grasp.obj.material.force_scale, np.nan)
+    return ResistanceSweep(mode, angles, unit_work, np.where(ok[:, None], x, np.nan), ok)

@@ -1,0 +1,421 @@
+# Copyright 2026 squeeze_grasp_ros developers
+# SPDX-License-Identifier: Apache-2.0
+"""Mechanics of one fixed contact set under rounded fingertips (paper Sec. 5.2, eqs. 46-47).
+
+Between events the contact set S = T u P (sticking, sliding) is fixed. Every contact node k
+lies on its fingertip circle, x_k = o_f + r_f e(theta_k), so its displacement is
+delta_k = o_f + r_f e(theta_k) - p_k (eq. 46 summed over steps); sticking nodes keep their
+polar angle, sliding nodes have the force on a friction-cone edge (eq. 47):
+
+    f_k x e(theta_k - slip_k phi) = 0,   phi = atan(mu),   F = C delta   (eq. 31)
+
+solved by Newton on the sliding angles. Totals, not increments, are used: F = C delta holds
+for the final contact set with total displacements (the one-shot invariant of Sec. 5.3), so
+the state between events is a function of the finger positions alone and does not drift.
+
+Costs (docs/design.md §3): per contact set a gather of the cached boundary compliance (O(m^2)) and
+a null-space reduction (O(m^3)), cached by the set; per evaluation O(m^2 |P|) for Newton and
+O(b m) for the boundary displacements used by Event A. The element strain map (2m sparse
+solves per set) is built only when a strain limit is declared.
+
+The *reference* model follows the paper literally for cross-checks and timing: no boundary
+compliance and no per-set cache (C from 2m direct solves whenever the set changes) and a full
+displacement solve at every evaluation.
+
+Everything here is dimensionless: lengths by L = obj.scale, forces by E h L.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from squeeze_grasp_ros.mechanics.elastic.compliance import ElasticObject, node_dofs
+from squeeze_grasp_ros.mechanics.errors import MechanicsError
+from squeeze_grasp_ros.mechanics.elastic.fem import element_dofs, principal_strains, strain_displacement
+from squeeze_grasp_ros.mechanics.squeeze.fingertips import cross, tangent, unit
+from squeeze_grasp_ros.mechanics.elastic.reduced import reduce_blocks
+
+STRAIN_CRITERIA: tuple[str, ...] = ("principal", "componentwise")
+NEWTON_MAX_ITERATIONS = 50
+NEWTON_BACKTRACKS = 30
+SINGULAR_SLIDING = ("singular Jacobian of the sliding constraints (eq. 47): the sliding contacts "
+                    "do not fix the object's position (e.g. a frictionless finger touching at one "
+                    "node lets the object slide along the tip); use mu > 0")
+NEWTON_TOL = 1e-14
+"""Newton stops when the cone residual is below this times the force scale |C| r, or when the
+largest angle update (rad) falls below it."""
+
+
+@dataclass(frozen=True)
+class Limits:
+    """Termination criteria a scene declares (paper Sec. 5.1).
+
+    Attributes
+    ----------
+    strain : float or None
+        Proportional-limit strain epsilon* (eq. 45); None = not checked (no strain field).
+    criterion : {"principal", "componentwise"}
+        "principal": max(|eps_1|, |eps_2|) <= eps* per element (frame invariant, default);
+        "componentwise": |eps_x|, |eps_y| <= eps* in the object frame (eq. 45 literally).
+    weight : float or None
+        Object weight w, N, for the pickup criterion; None = not checked.
+    """
+
+    strain: float | None = None
+    criterion: str = "principal"
+    weight: float | None = None
+
+    def __post_init__(self) -> None:
+        if self.criterion not in STRAIN_CRITERIA:
+            raise MechanicsError(f"strain_limit.criterion must be one of {STRAIN_CRITERIA}, "
+                                 f"got {self.criterion!r}")
+        if self.strain is not None and not (np.isfinite(self.strain) and self.strain > 0):
+            raise MechanicsError(f"strain_limit.epsilon must be > 0, got {self.strain}")
+        if self.weight is not None and not (np.isfinite(self.weight) and self.weight > 0):
+            raise MechanicsError(f"pickup.weight must be > 0 N, got {self.weight}")
+
+
+@dataclass(frozen=True)
+class SetData:
+    """Dimensionless data of one contact set (nodes sorted).
+
+    Attributes
+    ----------
+    nodes : (m,) ndarray of int
+    C : (2m, 2m) ndarray
+        Reduced stiffness C_hat (forces / (E h L) per displacement / L).
+    E : (2m, 3) ndarray
+        Rigid-coefficient map g_hat = E^T delta_hat.
+    A_bc : (2b, 2m) ndarray or None
+        Boundary compliance columns of the contact DOFs (None in the reference model).
+    strain_map : (3t, 2m) ndarray or None
+        Element engineering strains per contact force (built only with a strain limit).
+    condition : float
+        Condition number of Z^T A Z.
+    """
+
+    nodes: np.ndarray
+    C: np.ndarray
+    E: np.ndarray
+    A_bc: np.ndarray | None
+    strain_map: np.ndarray | None
+    condition: float
+
+
+@dataclass(frozen=True)
+class Solution:
+    """The configuration of a contact set at one set of finger positions (dimensionless).
+
+    Attributes
+    ----------
+    theta : (m,) ndarray
+        Polar angles, rad.
+    delta : (m, 2) ndarray
+        Contact-node displacements / L.
+    F : (m, 2) ndarray
+        Contact forces / (E h L).
+    dtheta : (m,) ndarray
+        d theta / ds along the current finger motion (zero for sticking nodes).
+    dF : (m, 2) ndarray
+        dF / ds.
+    ddelta : (m, 2) ndarray
+        d delta / ds.
+    iterations : int
+        Newton iterations used.
+    residual : float
+        Largest |f_k x e(alpha_k)| over sliding nodes, dimensionless force.
+    jacobian_condition : float
+        Condition number of the Newton Jacobian (1 without sliding nodes).
+    """
+
+    theta: np.ndarray
+    delta: np.ndarray
+    F: np.ndarray
+    dtheta: np.ndarray
+    dF: np.ndarray
+    ddelta: np.ndarray
+    iterations: int
+    residual: float
+    jacobian_condition: float
+
+    def normal(self) -> np.ndarray:
+        """f_n = F . e(theta) (m,)."""
+        return np.einsum("ij,ij->i", self.F, unit(self.theta))
+
+    def tangential(self) -> np.ndarray:
+        """f_t = F . t(theta) (m,)."""
+        return np.einsum("ij,ij->i", self.F, tangent(self.theta))
+
+    def normal_rate(self) -> np.ndarray:
+        """d f_n / ds (m,)."""
+        return (np.einsum("ij,ij->i", self.dF, unit(self.theta))
+                + self.dtheta * np.einsum("ij,ij->i", self.F, tangent(self.theta)))
+
+    def tangential_rate(self) -> np.ndarray:
+        """d f_t / ds (m,)."""
+        return (np.einsum("ij,ij->i", self.dF, tangent(self.theta))
+                - self.dtheta * np.einsum("ij,ij->i", self.F, unit(self.theta)))
+
+
+@dataclass(frozen=True)
+class Configuration:
+    """Contact modes and finger motion that define the fixed-set problem (dimensionless).
+
+    Attributes
+    ----------
+    p0 : (m, 2) ndarray
+        Undeformed contact-node positions / L.
+    stick : (m,) ndarray of bool
+    slip : (m,) ndarray of int
+        Slip direction of sliding nodes (+1/-1), 0 for sticking ones.
+    radius : (m,) ndarray
+        Tip radius of each node's finger / L.
+    """
+
+    p0: np.ndarray
+    stick: np.ndarray
+    slip: np.ndarray
+    radius: np.ndarray
+
+
+def solve_fixed_set(C: np.ndarray, cfg: Configuration, centers: np.ndarray, dirs: np.ndarray,
+                    theta0: np.ndarray, phi: float) -> Solution:
+    """Solve the sliding constraints (eq. 47) for one contact set at given tip centres.
+
+    Parameters
+    ----------
+    C : (2m, 2m) ndarray
+        Reduced stiffness of the set.
+    cfg : Configuration
+        Modes and geometry.
+    centers : (m, 2) ndarray
+        Tip centre of each node's finger / L.
+    dirs : (m, 2) ndarray
+        Translation of each node's finger per unit step parameter s / L (for the rates).
+    theta0 : (m,) ndarray
+        Polar angles: exact for sticking nodes, Newton's initial guess for sliding ones.
+    phi : float
+        Friction angle atan(mu), rad.
+
+    Raises
+    ------
+    MechanicsError
+        If Newton does not converge or produces non-finite values.
+    """
+    m = len(theta0)
+    theta = np.array(theta0, float)
+    P = np.flatnonzero(~cfg.stick)
+    r = cfg.radius
+    Cb = C.reshape(m, 2, m, 2)
+    force_scale = max(float(np.abs(C).max()) * float(r.max()), 1e-300)
+
+    def forces(th: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        delta = centers + r[:, None] * unit(th) - cfg.p0
+        return delta, (C @ delta.reshape(-1)).reshape(m, 2)
+
+    def cone_residual(th: np.ndarray, F: np.ndarray) -> np.ndarray:
+        return cross(F[P], unit(th[P] - cfg.slip[P] * phi))
+
+    delta, F = forces(theta)
+    it, residual, cond = 0, 0.0, 1.0
+    J = np.zeros((0, 0))
+    R = cone_residual(theta, F)
+    while len(P):
+        ea = unit(theta[P] - cfg.slip[P] * phi)
+        # dF_k / d theta_j = C_kj r_j t(theta_j): (m, 2, |P|)
+        G = np.einsum("kajb,jb->kaj", Cb[:, :, P, :], r[P, None] * tangent(theta[P]))
+        J = cross(np.moveaxis(G[P], 2, 1), ea[:, None, :]) + np.diag(np.einsum("ij,ij->i", F[P], ea))
+        residual = float(np.abs(R).max())
+        if residual <= NEWTON_TOL * force_scale:
+            cond = float(np.linalg.cond(J))
+            break
+        if it >= NEWTON_MAX_ITERATIONS:
+            raise MechanicsError(f"Newton on the sliding angles did not converge in {it} "
+                                 f"iterations (residual {residual:.3g})")
+        try:
+            step = np.linalg.solve(J, R)
+        except np.linalg.LinAlgError:
+            raise MechanicsError(SINGULAR_SLIDING) from None
+        it += 1
+        for _ in range(NEWTON_BACKTRACKS):
+            trial = theta.copy()
+            trial[P] -= step
+            t_delta, t_F = forces(trial)
+            t_R = cone_residual(trial, t_F)
+            if np.abs(t_R).max() < residual or np.abs(step).max() < NEWTON_TOL:
+                break
+            step = 0.5 * step
+        theta, delta, F, R = trial, t_delta, t_F, t_R
+        if np.abs(step).max() < NEWTON_TOL:
+            residual = float(np.abs(R).max())
+            cond = float(np.linalg.cond(J))
+            break
+    dF0 = (C @ dirs.reshape(-1)).reshape(m, 2)
+    dtheta = np.zeros(m)
+    if len(P):
+        ea = unit(theta[P] - cfg.slip[P] * phi)
+        G = np.einsum("kajb,jb->kaj", Cb[:, :, P, :], r[P, None] * tangent(theta[P]))
+        try:
+            dtheta[P] = -np.linalg.solve(J, cross(dF0[P], ea))
+        except np.linalg.LinAlgError:
+            raise MechanicsError(SINGULAR_SLIDING) from None
+        dF = dF0 + G @ dtheta[P]
+    else:
+        dF = dF0
+    ddelta = dirs + (r * dtheta)[:, None] * tangent(theta)
+    if not (np.all(np.isfinite(F)) and np.all(np.isfinite(dF)) and np.all(np.isfinite(theta))):
+        raise MechanicsError("non-finite contact forces or angles in the fixed-set solve")
+    return Solution(theta, delta, F, dtheta, dF, ddelta, it, residual, cond)
+
+
+@dataclass(frozen=True)
+class ContactModel:
+    """An elastic object under frictional rounded-fingertip contact.
+
+    Parameters
+    ----------
+    obj : ElasticObject
+        The meshed object (its cached boundary compliance is used unless ``reference``).
+    mu : float
+        Coulomb friction coefficient (>= 0; 0 = frictionless, every contact slides).
+    limits : Limits
+        Strain and pickup criteria (only what the scene declares is computed).
+    reference : bool
+        The paper's literal route: no cached compliance, a full solve per evaluation.
+    max_events_per_depth : int
+        Chattering bound: a node with more events than this within one depth step is frozen in
+        its mode for one depth step (reported).
+    """
+
+    obj: ElasticObject
+    mu: float
+    limits: Limits = field(default_factory=Limits)
+    reference: bool = False
+    max_events_per_depth: int = 4
+    _cache: dict = field(default_factory=dict, repr=False, compare=False)
+
+    def __post_init__(self) -> None:
+        if not (np.isfinite(self.mu) and self.mu >= 0):
+            raise MechanicsError(f"friction.mu must be >= 0, got {self.mu}")
+        if self.max_events_per_depth < 1:
+            raise MechanicsError("squeeze.max_events_per_depth must be >= 1, got "
+                                 f"{self.max_events_per_depth}")
+
+    @property
+    def phi(self) -> float:
+        """Friction angle atan(mu), rad."""
+        return float(np.arctan(self.mu))
+
+    @property
+    def length(self) -> float:
+        """L, m (cached: the object's scale is recomputed from the mesh on every access)."""
+        if "length" not in self._cache:
+            self._cache["length"] = self.obj.scale
+        return self._cache["length"]
+
+    @property
+    def force_unit(self) -> float:
+        """E h L, N: the force unit inside."""
+        return self.obj.material.force_scale * self.length
+
+    @property
+    def boundary_nodes(self) -> np.ndarray:
+        """Outer boundary loop (b,)."""
+        return self.obj.mesh.boundary
+
+    def positions(self, nodes) -> np.ndarray:
+        """Undeformed positions / L (k, 2)."""
+        return self.obj.mesh.nodes[np.asarray(nodes, int)] / self.length
+
+    def set_data(self, nodes: tuple[int, ...]) -> SetData:
+        """Reduced data of the contact set ``nodes`` (sorted), cached per set (fast model)."""
+        key = tuple(int(k) for k in nodes)
+        sets = self._cache.setdefault("sets", {})
+        if key in sets:
+            return sets[key]
+        if len(key) < 2:
+            raise MechanicsError(f"the object lost contact: {len(key)} contact node(s) left; at "
+                                 "least 2 are needed to hold it (Lemma 2)")
+        idx = np.array(key)
+        dofs = node_dofs(idx)
+        if self.reference:
+            A_hat = self.unit_responses(dofs)[dofs]
+            A_hat = 0.5 * (A_hat + A_hat.T)
+            A_bc = None
+            sets.clear()
+        else:
+            pos = self.obj.boundary_positions(idx)
+            if np.any(pos < 0):
+                raise MechanicsError(f"contact nodes {idx[pos < 0].tolist()} are not on the outer "
+                                     "boundary")
+            A_bc = self.obj.boundary_compliance[:, node_dofs(pos)]
+            A_hat = A_bc[node_dofs(pos)]
+        C, E, _, condition = reduce_blocks(A_hat, self.obj.rigid[dofs])
+        strain_map = None
+        if self.limits.strain is not None and not self.reference:
+            strain_map = self.element_strains(self.unit_responses(dofs))
+        data = SetData(idx, C, E, A_bc, strain_map, condition)
+        sets[key] = data
+        self._cache["max_condition"] = max(self._cache.get("max_condition", 0.0), condition)
+        self._cache["sets_factored"] = self._cache.get("sets_factored", 0) + 1
+        return data
+
+    def _strain_b(self) -> np.ndarray:
+        """Element strain-displacement matrices with coordinates / L, (t, 3, 6)."""
+        if "strain_b" not in self._cache:
+            B, _ = strain_displacement(self.obj.mesh.nodes / self.length, self.obj.mesh.triangles)
+            self._cache["strain_b"] = B
+        return self._cache["strain_b"]
+
+    def unit_responses(self, dofs: np.ndarray) -> np.ndarray:
+        """K+ applied to unit loads at ``dofs``: (2n, len(dofs)), by direct sparse solves."""
+        unit_loads = np.zeros((2 * self.obj.mesh.n, len(dofs)))
+        unit_loads[dofs, np.arange(len(dofs))] = 1.0
+        return self.obj.pinv_apply(unit_loads)
+
+    def element_strains(self, u_hat: np.ndarray) -> np.ndarray:
+        """Engineering strains (t*3,) or (t*3, k) of dimensionless nodal displacements (2n[, k])."""
+        B = self._strain_b()
+        de = u_hat[element_dofs(self.obj.mesh.triangles)]
+        return np.einsum("tij,tj...->ti...", B, de).reshape((-1,) + u_hat.shape[1:])
+
+    def full_displacement(self, sd: SetData, delta: np.ndarray, F: np.ndarray) -> np.ndarray:
+        """Dimensionless displacement of every node (2n,): K+ F + R g (one sparse solve)."""
+        rhs = np.zeros(2 * self.obj.mesh.n)
+        rhs[node_dofs(sd.nodes)] = F.reshape(-1)
+        return self.obj.pinv_apply(rhs) + self.obj.rigid @ (sd.E.T @ delta.reshape(-1))
+
+    def boundary_displacement(self, sd: SetData, delta: np.ndarray, F: np.ndarray,
+                              rows: np.ndarray | None = None) -> np.ndarray:
+        """Dimensionless displacement (k, 2) of boundary loop positions ``rows`` (all if None).
+
+        Fast model: A_bc F + R_b g, O(k m). Reference model: a full solve.
+        """
+        b = self.boundary_nodes
+        rows = np.arange(len(b)) if rows is None else np.asarray(rows, int)
+        g = sd.E.T @ delta.reshape(-1)
+        if sd.A_bc is None:
+            u = self.full_displacement(sd, delta, F).reshape(-1, 2)
+            return u[b[rows]]
+        d = node_dofs(rows)
+        u = sd.A_bc[d] @ F.reshape(-1) + self.obj.rigid[node_dofs(b[rows])] @ g
+        return u.reshape(-1, 2)
+
+    def strain_measure(self, sd: SetData, delta: np.ndarray, F: np.ndarray) -> tuple[float, int]:
+        """(largest strain by the limit's criterion, element index) of the configuration."""
+        if sd.strain_map is not None:
+            eps = (sd.strain_map @ F.reshape(-1)).reshape(-1, 3)
+        else:
+            eps = self.element_strains(self.full_displacement(sd, delta, F)).reshape(-1, 3)
+        return strain_criterion(eps, self.limits.criterion)
+
+
+def strain_criterion(eps: np.ndarray, criterion: str) -> tuple[float, int]:
+    """(max strain, element) from engineering strains (t, 3) by ``criterion`` (eq. 45)."""
+    if criterion == "componentwise":
+        per_element = np.abs(eps[:, :2]).max(axis=1)
+    else:
+        per_element = np.abs(principal_strains(eps)).max(axis=1)
+    k = int(np.argmax(per_element))
+    return float(per_element[k]), k

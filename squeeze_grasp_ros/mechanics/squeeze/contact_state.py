@@ -1,0 +1,282 @@
+# Copyright 2026 squeeze_grasp_ros developers
+# SPDX-License-Identifier: Apache-2.0
+"""Frozen contact state, events and samples of the incremental stepper (paper Sec. 5.2-5.3).
+
+All quantities are SI in the object frame (x right, y up, origin of the mesh coordinates):
+positions and displacements in m, forces in N (applied by the finger on the object), work and
+energy in J, polar angles in rad about the fingertip centre (see :mod:`.fingertips`).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from squeeze_grasp_ros.mechanics.squeeze.fingertips import FINGER_NAMES, Fingertip, unit
+
+EVENT_TYPES: tuple[str, ...] = ("A", "B", "C", "D")
+"""A: new contact (eq. 48); B: contact break (eq. 49); C: stick -> slip (eq. 50);
+D: slip -> stick (eq. 51)."""
+
+TERMINATIONS: tuple[str, ...] = ("depth_reached", "strain_limit", "finger_slip", "picked_up",
+                                 "contact_lost")
+"""Termination reasons of a squeeze: Sec. 5.1's four, plus ``contact_lost`` when a contact
+break (Event B) would leave a finger with no contact node (the grasp is lost; the event is not
+applied)."""
+
+
+@dataclass(frozen=True)
+class FingerState:
+    """One rigid fingertip during the squeeze.
+
+    Attributes
+    ----------
+    name : str
+        "F1", "F2" or "A".
+    center : (2,) ndarray
+        Current tip centre, m.
+    radius : float
+        Tip radius, m.
+    translation : (2,) ndarray
+        Accumulated translation since the initial placement, m.
+    work : float
+        Work done by this finger on the object, J (integral of its total contact force along
+        its path).
+    """
+
+    name: str
+    center: np.ndarray
+    radius: float
+    translation: np.ndarray
+    work: float = 0.0
+
+
+@dataclass(frozen=True)
+class ContactNode:
+    """A boundary node in contact with a fingertip.
+
+    Attributes
+    ----------
+    node : int
+        Mesh node index.
+    finger : str
+        Name of the finger it touches.
+    mode : {"stick", "slip"}
+        Sticking (moves with the finger, eq. 46) or sliding (force on a cone edge, eq. 47).
+    slip : int
+        Slip direction for sliding nodes: +1 if its polar angle increases relative to the tip,
+        -1 if it decreases (the friction force opposes it: the force lies on edge
+        e(theta - slip*phi)); 0 for sticking nodes.
+    theta : float
+        Polar angle about the tip centre, rad.
+    displacement : (2,) ndarray
+        Node displacement from the undeformed configuration, m.
+    force : (2,) ndarray
+        Contact force of the finger on the node, N.
+    """
+
+    node: int
+    finger: str
+    mode: str
+    slip: int
+    theta: float
+    displacement: np.ndarray
+    force: np.ndarray
+
+    def normal_force(self) -> float:
+        """f . e(theta), N (> 0 while pressing)."""
+        return float(self.force @ unit(self.theta))
+
+    def tangential_force(self) -> float:
+        """f . t(theta), N."""
+        return float(self.force[1] * np.cos(self.theta) - self.force[0] * np.sin(self.theta))
+
+
+@dataclass(frozen=True)
+class ContactState:
+    """Everything the stepper needs to continue a squeeze; immutable.
+
+    Attributes
+    ----------
+    fingers : tuple of FingerState
+        In canonical finger order (F1, F2, A).
+    contacts : tuple of ContactNode
+        Sorted by node index.
+    depth : float
+        Accumulated squeeze depth, m: the sum over steps of the norm of the stacked finger
+        translations (rho of docs/design.md §2 for a unit squeeze direction).
+    relative_per_depth : float
+        Relative depth per unit depth, 1/m (approach per depth / initial contact distance);
+        0 when the motion is not a squeeze.
+    undetermined : tuple of int
+        Contact nodes whose mode is decided by hypothesis-and-test at the next motion (initial
+        contacts have zero force, so their mode depends on the direction of motion).
+    fresh : tuple of (str, int)
+        Event functions that are zero by construction at this state (e.g. the cone margin of a
+        node that just stuck); their sign is judged by their derivative along the next motion.
+    history : tuple of (int, float)
+        Recent (node, depth in m) events, kept for the chattering bound.
+    holds : tuple of (int, float)
+        (node, depth in m until which its contact mode is frozen after chattering).
+    """
+
+    fingers: tuple[FingerState, ...]
+    contacts: tuple[ContactNode, ...]
+    depth: float = 0.0
+    relative_per_depth: float = 0.0
+    undetermined: tuple[int, ...] = ()
+    fresh: tuple[tuple[str, int], ...] = ()
+    history: tuple[tuple[int, float], ...] = ()
+    holds: tuple[tuple[int, float], ...] = ()
+
+    def finger(self, name: str) -> FingerState:
+        """The finger called ``name``."""
+        for f in self.fingers:
+            if f.name == name:
+                return f
+        raise KeyError(f"no finger {name!r} in the state (have {[f.name for f in self.fingers]})")
+
+    def segment(self, name: str) -> tuple[ContactNode, ...]:
+        """Contact nodes of finger ``name``, ordered by polar angle."""
+        return tuple(sorted((c for c in self.contacts if c.finger == name), key=lambda c: c.theta))
+
+    def finger_force(self, name: str) -> np.ndarray:
+        """Total force (2,) of finger ``name`` on the object, N."""
+        forces = [c.force for c in self.contacts if c.finger == name]
+        return np.sum(forces, axis=0) if forces else np.zeros(2)
+
+    @property
+    def relative_depth(self) -> float:
+        """depth * relative_per_depth (fraction)."""
+        return self.depth * self.relative_per_depth
+
+
+def initial_state(tips: list[Fingertip], relative_per_depth: float = 0.0) -> ContactState:
+    """The state at depth 0: each fingertip touching its initial node with zero force.
+
+    Initial modes are undetermined: the stepper decides them by hypothesis-and-test along the
+    first motion (Algorithm 1, line 2).
+    """
+    order = {name: k for k, name in enumerate(FINGER_NAMES)}
+    tips = sorted(tips, key=lambda t: order[t.name])
+    fingers = tuple(FingerState(t.name, np.asarray(t.center, float), t.radius, np.zeros(2))
+                    for t in tips)
+    contacts = tuple(sorted((ContactNode(t.node, t.name, "stick", 0, t.theta, np.zeros(2),
+                                         np.zeros(2)) for t in tips), key=lambda c: c.node))
+    fresh = tuple((kind, t.node) for t in tips for kind in ("B", "C+", "C-"))
+    return ContactState(fingers, contacts, 0.0, relative_per_depth,
+                        tuple(sorted(t.node for t in tips)), fresh)
+
+
+@dataclass(frozen=True)
+class Event:
+    """A located contact event.
+
+    Attributes
+    ----------
+    type : {"A", "B", "C", "D"}
+    node : int
+        Mesh node index.
+    finger : str
+        The finger involved.
+    depth : float
+        Squeeze depth at the event, m.
+    relative_depth : float
+        Relative squeeze depth at the event (fraction; 0 when not a squeeze).
+    mode : str
+        Contact mode of the node after the event ("stick", "slip" or "none" after B).
+    slip : int
+        Slip direction after the event (see :class:`ContactNode`).
+    """
+
+    type: str
+    node: int
+    finger: str
+    depth: float
+    relative_depth: float
+    mode: str
+    slip: int = 0
+
+    def to_json(self) -> dict:
+        """``{"type", "node", "finger", "depth", "relative_depth", "mode", "slip"}``."""
+        return {"type": self.type, "node": self.node, "finger": self.finger,
+                "depth": self.depth, "relative_depth": self.relative_depth,
+                "mode": self.mode, "slip": self.slip}
+
+
+@dataclass(frozen=True)
+class Sample:
+    """The configuration at one accepted point of the stepper (substep end or event).
+
+    Attributes
+    ----------
+    depth : float
+        Squeeze depth, m.
+    nodes : tuple of int
+        Contact nodes.
+    thetas : tuple of float
+        Their polar angles, rad.
+    finger_forces : dict
+        Finger name -> total force (fx, fy) on the object, N.
+    """
+
+    depth: float
+    nodes: tuple[int, ...]
+    thetas: tuple[float, ...]
+    finger_forces: dict = field(default_factory=dict)
+
+
+@dataclass(frozen=True)
+class Chatter:
+    """A node whose contact mode was frozen by the chattering bound.
+
+    Attributes
+    ----------
+    node : int
+    finger : str
+    depth : float
+        Depth at which it was frozen, m.
+    until : float
+        Depth until which its mode stays frozen, m.
+    """
+
+    node: int
+    finger: str
+    depth: float
+    until: float
+
+    def to_json(self) -> dict:
+        """``{"node", "finger", "depth", "until"}``."""
+        return {"node": self.node, "finger": self.finger, "depth": self.depth, "until": self.until}
+
+
+@dataclass(frozen=True)
+class StepResult:
+    """Outcome of one :func:`~.stepper.advance` call.
+
+    Attributes
+    ----------
+    state : ContactState
+        The state reached.
+    events : tuple of Event
+        Events located during the call, in processing order.
+    fraction : float
+        Fraction of the requested translations applied (< 1 after a termination or when
+        stopping at the first event).
+    termination : str or None
+        "strain_limit", "finger_slip", "picked_up" or "contact_lost" if one ended the motion.
+    samples : tuple of Sample
+        Accepted points (substep ends and event points), for trajectories.
+    chatter : tuple of Chatter
+        Nodes frozen by the chattering bound during the call.
+    diagnostics : dict
+        Newton iterations and residuals, root-finding evaluations, condition numbers.
+    """
+
+    state: ContactState
+    events: tuple[Event, ...]
+    fraction: float
+    termination: str | None
+    samples: tuple[Sample, ...]
+    chatter: tuple[Chatter, ...]
+    diagnostics: dict

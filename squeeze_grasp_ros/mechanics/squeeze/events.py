@@ -1,0 +1,440 @@
+# Copyright 2026 squeeze_grasp_ros developers
+# SPDX-License-Identifier: Apache-2.0
+"""Event-driven squeeze to a depth with rounded fingertips under Coulomb friction (Algorithm 1).
+
+:func:`squeeze_to_depth` is Algorithm 1 as a loop over the incremental stepper
+(:func:`~.stepper.advance`, one call per event point); :func:`event_squeeze` sets it up from
+initial contact nodes (fingertips on the outward normals, stable/pure squeeze directions from
+:func:`~.squeeze.plan_squeeze` or user-given directions) and collects the output: event log,
+final segments, forces, energy, work, polar-angle trajectories and grasp-health numbers.
+SI units at the interface, object frame.
+"""
+from __future__ import annotations
+
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from squeeze_grasp_ros.mechanics.elastic.compliance import ElasticObject
+from squeeze_grasp_ros.mechanics.squeeze.contact_model import ContactModel, Limits, strain_criterion
+from squeeze_grasp_ros.mechanics.squeeze.contact_state import (EVENT_TYPES, Chatter, ContactNode, ContactState, Event, Sample,
+                            initial_state)
+from squeeze_grasp_ros.mechanics.errors import MechanicsError, require_finite
+from squeeze_grasp_ros.mechanics.elastic.fem import element_strains, von_mises_stress
+from squeeze_grasp_ros.mechanics.squeeze.fingertips import place_fingertip
+from squeeze_grasp_ros.mechanics.squeeze.stable_pure import plan_squeeze
+from squeeze_grasp_ros.mechanics.squeeze.stepper import TERMINATION_ORDER, advance
+
+MAX_STALLED_CALLS = 3
+
+
+@dataclass(frozen=True)
+class SqueezeRun:
+    """Raw outcome of :func:`squeeze_to_depth`.
+
+    Attributes
+    ----------
+    state : ContactState
+        Final state.
+    events : tuple of Event
+    samples : tuple of Sample
+        Accepted points (substep ends and event points), including the start.
+    chatter : tuple of Chatter
+    termination : str
+        "depth_reached" or the stepper's termination.
+    diagnostics : dict
+        Merged stepper diagnostics (maxima and sums) plus ``advance_calls``.
+    """
+
+    state: ContactState
+    events: tuple[Event, ...]
+    samples: tuple[Sample, ...]
+    chatter: tuple[Chatter, ...]
+    termination: str
+    diagnostics: dict
+
+
+def _merge(total: dict, new: dict) -> None:
+    """Merge stepper diagnostics: counts add up, maxima stay maxima."""
+    for key, value in new.items():
+        if key in ("root_evaluations", "substeps", "substep_halvings", "ambiguous_modes"):
+            total[key] = total.get(key, 0) + value
+        else:
+            total[key] = max(total.get(key, value), value)
+
+
+def squeeze_to_depth(model: ContactModel, state: ContactState,
+                     directions: Mapping[str, tuple[float, float]], depth: float,
+                     step: float = 1e-3, event_tol: float = 1e-9,
+                     progress: Callable[[float], None] | None = None,
+                     terminate_on: tuple[str, ...] = TERMINATION_ORDER) -> SqueezeRun:
+    """Algorithm 1: advance the fingers along ``directions`` until ``depth`` or a termination.
+
+    Parameters
+    ----------
+    model : ContactModel
+    state : ContactState
+        Start state (its ``depth`` is the start depth).
+    directions : mapping
+        Finger name -> translation per unit depth (m/m); the stacked vector should have norm 1
+        so that depth is rho of docs/design.md §2.
+    depth : float
+        Depth to add, m (>= 0).
+    step, event_tol : float
+        Substep and event tolerance relative to the object size (see :func:`advance`).
+    progress : callable, optional
+        Called with the completed fraction after every stepper call.
+    terminate_on : tuple of str
+        Terminations that end the squeeze besides the depth.
+    """
+    if not (np.isfinite(depth) and depth >= 0):
+        raise MechanicsError(f"squeeze depth must be >= 0 m, got {depth}")
+    dirs = {k: np.asarray(v, float) for k, v in directions.items()}
+    start = state.depth
+    events: list[Event] = []
+    samples: list[Sample] = []
+    chatter: list[Chatter] = []
+    diag: dict = {"advance_calls": 0}
+    termination, stalled = "depth_reached", 0
+    while True:
+        remaining = depth - (state.depth - start)
+        result = advance(model, state, {k: remaining * v for k, v in dirs.items()}, step,
+                         event_tol, stop_on_event=True, terminate_on=terminate_on)
+        diag["advance_calls"] += 1
+        _merge(diag, result.diagnostics)
+        events += result.events
+        samples += result.samples
+        chatter += result.chatter
+        state = result.state
+        if progress is not None:
+            progress(min(1.0, (state.depth - start) / depth) if depth > 0 else 1.0)
+        if result.termination is not None:
+            termination = result.termination
+            break
+        if result.fraction >= 1.0 or remaining <= 0:
+            break
+        stalled = stalled + 1 if result.fraction == 0 and not result.events else 0
+        if stalled >= MAX_STALLED_CALLS:
+            raise MechanicsError(f"the squeeze stalled at depth {state.depth:.6g} m")
+    return SqueezeRun(state, tuple(events), tuple(samples), tuple(chatter), termination, diag)
+
+
+@dataclass(frozen=True)
+class SegmentNode:
+    """A contact node of a final segment.
+
+    Attributes
+    ----------
+    node : int
+    mode : {"stick", "slip"}
+    slip : int
+        Slip direction (see :class:`~.contact_state.ContactNode`).
+    force : (2,) ndarray
+        Contact force on the object, N.
+    normal_force, tangential_force : float
+        f . e(theta) and f . t(theta), N.
+    slip_margin : float
+        mu f_n - |f_t|, N (0 on the cone edge).
+    theta : float
+        Polar angle, rad.
+    """
+
+    node: int
+    mode: str
+    slip: int
+    force: np.ndarray
+    normal_force: float
+    tangential_force: float
+    slip_margin: float
+    theta: float
+
+    def to_json(self) -> dict:
+        """All fields as a JSON-able dict (force as [fx, fy])."""
+        return {"node": self.node, "mode": self.mode, "slip": self.slip,
+                "force": self.force.tolist(), "normal_force": self.normal_force,
+                "tangential_force": self.tangential_force, "slip_margin": self.slip_margin,
+                "theta": self.theta}
+
+
+@dataclass(frozen=True)
+class GraspHealth:
+    """Grasp-health numbers of the final configuration.
+
+    Attributes
+    ----------
+    max_strain : float
+        Largest element strain by ``criterion`` (principal: max |eps_1|, |eps_2|).
+    max_strain_element : int
+    criterion : str
+    max_von_mises : float
+        Largest plane-stress von Mises stress, Pa.
+    max_von_mises_element : int
+    max_displacement : float
+        Largest nodal displacement magnitude, m.
+    max_displacement_node : int
+    slip_margin : dict
+        Finger -> min over its contacts of mu f_n - |f_t|, N.
+    """
+
+    max_strain: float
+    max_strain_element: int
+    criterion: str
+    max_von_mises: float
+    max_von_mises_element: int
+    max_displacement: float
+    max_displacement_node: int
+    slip_margin: dict
+
+    def to_json(self) -> dict:
+        """All fields as a JSON-able dict."""
+        return {"max_strain": self.max_strain, "max_strain_element": self.max_strain_element,
+                "criterion": self.criterion, "max_von_mises": self.max_von_mises,
+                "max_von_mises_element": self.max_von_mises_element,
+                "max_displacement": self.max_displacement,
+                "max_displacement_node": self.max_displacement_node,
+                "slip_margin": dict(self.slip_margin)}
+
+
+@dataclass(frozen=True)
+class EventSqueeze:
+    """Result of :func:`event_squeeze` (SI, object frame).
+
+    Attributes
+    ----------
+    termination : str
+        "depth_reached", "finger_slip", "strain_limit", "picked_up" or "contact_lost".
+    depth, relative_depth : float
+        Depth reached, m, and relative depth (fraction).
+    target_depth : float
+        Requested depth, m.
+    kind : str
+        "stable", "pure" or "custom" (user-given directions).
+    contacts : tuple of int
+        Initial contact nodes (F1, F2).
+    directions : dict
+        Finger -> unit translation per depth (m/m).
+    mu : float
+    tip_radius : dict
+        Finger -> tip radius, m.
+    events : tuple of Event
+    segments : dict
+        Finger -> tuple of SegmentNode, ordered by polar angle.
+    energy : float
+        Strain energy 1/2 delta . F, J.
+    work : dict
+        Finger -> work done on the object, J (sum = energy + frictional dissipation).
+    finger_force : dict
+        Finger -> (start, end) force along its motion direction, N.
+    trajectories : dict
+        Node -> ((relative depth, theta rad), ...) while in contact.
+    health : GraspHealth
+    chatter : tuple of Chatter
+    displacement : (n, 2) ndarray
+        Final displacement field, m.
+    state : ContactState
+        Final state (to continue with the stepper).
+    step, event_tol : float
+        Substep and event tolerance used, relative to the object size.
+    reference : bool
+        Computed by the paper's literal fixed-step route.
+    diagnostics : dict
+    """
+
+    termination: str
+    depth: float
+    relative_depth: float
+    target_depth: float
+    kind: str
+    contacts: tuple[int, ...]
+    directions: dict
+    mu: float
+    tip_radius: dict
+    events: tuple[Event, ...]
+    segments: dict
+    energy: float
+    work: dict
+    finger_force: dict
+    trajectories: dict
+    health: GraspHealth
+    chatter: tuple[Chatter, ...]
+    displacement: np.ndarray = field(repr=False)
+    state: ContactState = field(repr=False)
+    step: float = 1e-3
+    event_tol: float = 1e-9
+    reference: bool = False
+    diagnostics: dict = field(default_factory=dict)
+
+    @property
+    def event_counts(self) -> dict:
+        """{"A": n, "B": n, "C": n, "D": n}."""
+        return {t: sum(1 for e in self.events if e.type == t) for t in EVENT_TYPES}
+
+    def to_json(self) -> dict:
+        """JSON-able dict with the keys and names of docs/design.md §2 and docs/events.md."""
+        radii = list(self.tip_radius.values())
+        return {
+            "termination": self.termination,
+            "depth": self.depth,
+            "relative_depth": self.relative_depth,
+            "target_depth": self.target_depth,
+            "squeeze": self.kind,
+            "contacts": list(self.contacts),
+            "directions": {k: v.tolist() for k, v in self.directions.items()},
+            "events": [e.to_json() for e in self.events],
+            "event_counts": self.event_counts,
+            "segments": {k: [s.to_json() for s in v] for k, v in self.segments.items()},
+            "energy": self.energy,
+            "work": dict(self.work),
+            "finger_force": {k: {"start": v[0], "end": v[1]} for k, v in self.finger_force.items()},
+            "mu": self.mu,
+            "tip_radius": radii[0] if len(set(radii)) == 1 else max(radii),
+            "tip_radii": dict(self.tip_radius),
+            "health": self.health.to_json(),
+            "chatter": [c.to_json() for c in self.chatter],
+            "trajectories": {str(k): [list(p) for p in v] for k, v in self.trajectories.items()},
+            "step": self.step,
+            "event_tol": self.event_tol,
+            "reference": self.reference,
+            "diagnostics": self.diagnostics,
+        }
+
+
+def segment_node(c: ContactNode, mu: float) -> SegmentNode:
+    """Summary of a contact node (forces in N)."""
+    fn, ft = c.normal_force(), c.tangential_force()
+    return SegmentNode(c.node, c.mode, c.slip, np.asarray(c.force, float), fn, ft,
+                       mu * fn - abs(ft), c.theta)
+
+
+def grasp_health(model: ContactModel, state: ContactState) -> tuple[GraspHealth, np.ndarray]:
+    """Grasp-health numbers and the full displacement field (n, 2), m, of ``state``.
+
+    One sparse solve (K+ F + R g) for the field; strains and von Mises stresses per element.
+    """
+    obj = model.obj
+    L, fu = model.length, model.force_unit
+    nodes = tuple(c.node for c in state.contacts)
+    sd = model.set_data(nodes)
+    delta = np.array([c.displacement for c in state.contacts]) / L
+    F = np.array([c.force for c in state.contacts]) / fu
+    u = model.full_displacement(sd, delta, F).reshape(-1, 2) * L
+    eps = element_strains(obj.mesh, u)
+    criterion = model.limits.criterion
+    strain, element = strain_criterion(eps, criterion)
+    vm = von_mises_stress(eps, obj.material.E, obj.material.nu)
+    norms = np.linalg.norm(u, axis=1)
+    margins = {}
+    for f in state.fingers:
+        seg = [segment_node(c, model.mu).slip_margin for c in state.contacts if c.finger == f.name]
+        if seg:
+            margins[f.name] = float(min(seg))
+    health = GraspHealth(strain, element, criterion, float(vm.max()), int(np.argmax(vm)),
+                         float(norms.max()), int(np.argmax(norms)), margins)
+    require_finite("grasp health", [strain, health.max_von_mises, health.max_displacement])
+    return health, u
+
+
+def polar_trajectories(samples: tuple[Sample, ...], relative_per_depth: float) -> dict:
+    """Node -> ((relative depth, theta), ...) from the stepper samples."""
+    out: dict[int, list] = {}
+    for s in samples:
+        rel = s.depth * relative_per_depth
+        for node, theta in zip(s.nodes, s.thetas):
+            out.setdefault(node, []).append((rel, theta))
+    return {k: tuple(v) for k, v in out.items()}
+
+
+def event_squeeze(obj: ElasticObject, contacts: tuple[int, int],
+                  tip_radius: float | Mapping[str, float], mu: float, kind: str = "stable",
+                  depth: float | None = None, relative_depth: float | None = None,
+                  limits: Limits | None = None,
+                  step: float = 1e-3, event_tol: float = 1e-9, reference: bool = False,
+                  max_events_per_depth: int = 4,
+                  directions: Mapping[str, tuple[float, float]] | None = None,
+                  progress: Callable[[float], None] | None = None) -> EventSqueeze:
+    """Event-driven two-finger squeeze of ``obj`` from initial contact nodes (F1, F2).
+
+    Parameters
+    ----------
+    obj : ElasticObject
+    contacts : (int, int)
+        Initial contact nodes of F1 and F2 on the outer boundary.
+    tip_radius : float or mapping
+        Fingertip radius, m (one for both, or per finger).
+    mu : float
+        Friction coefficient.
+    kind : {"stable", "pure"}
+        Squeeze directions from :func:`plan_squeeze` (ignored when ``directions`` is given).
+    depth, relative_depth : float
+        Exactly one: squeeze depth rho, m, or the finger approach over the initial contact
+        distance (docs/design.md §2).
+    limits : Limits, optional
+        Strain limit and pickup weight.
+    step, event_tol : float
+        Substep and event tolerance relative to the object size.
+    reference : bool
+        Use the paper's literal route (fixed step, events at step ends, full solves).
+    max_events_per_depth : int
+        Chattering bound (see :mod:`.stepper`).
+    directions : mapping, optional
+        User-given finger translation directions (normalised so the stacked vector has norm 1).
+    progress : callable, optional
+        Called with the completed fraction.
+    """
+    if (depth is None) == (relative_depth is None):
+        raise MechanicsError("give exactly one of depth (m) and relative_depth")
+    names = ("F1", "F2")
+    radii = dict(tip_radius) if isinstance(tip_radius, Mapping) else dict.fromkeys(names, tip_radius)
+    plan = plan_squeeze(obj, list(contacts), kind)
+    p = obj.mesh.nodes[list(contacts)]
+    distance = float(np.linalg.norm(p[1] - p[0]))
+    if directions is None:
+        u = plan.displacement.reshape(2, 2)
+        dirs = {"F1": u[0], "F2": u[1]}
+        approach = plan.approach_per_unit_depth
+    else:
+        stacked = np.array([directions[n] for n in names], float)
+        norm = float(np.linalg.norm(stacked))
+        if not norm > 0:
+            raise MechanicsError("squeeze directions must not all be zero")
+        dirs = {n: stacked[k] / norm for k, n in enumerate(names)}
+        approach = float((dirs["F1"] - dirs["F2"]) @ (p[1] - p[0]) / distance)
+        kind = "custom"
+    relative_per_depth = approach / distance
+    if depth is None:
+        if not relative_per_depth > 0:
+            raise MechanicsError("the fingers do not approach each other: relative depth undefined")
+        depth = relative_depth / relative_per_depth
+    require_finite("depth", depth)
+    if depth < 0 or depth * relative_per_depth >= 1.0:
+        raise MechanicsError(f"depth {depth:.6g} m is a relative depth of "
+                             f"{depth * relative_per_depth:.6g}: it must be in [0, 1) (at 1 the "
+                             "fingers would meet)")
+    tips = [place_fingertip(obj.mesh, n, int(c), radii[n]) for n, c in zip(names, contacts)]
+    model = ContactModel(obj, mu, limits or Limits(), reference, max_events_per_depth)
+    run = squeeze_to_depth(model, initial_state(tips, relative_per_depth), dirs, depth, step,
+                           event_tol, progress)
+    state = run.state
+    health, u_field = grasp_health(model, state)
+    delta = np.array([c.displacement for c in state.contacts])
+    F = np.array([c.force for c in state.contacts])
+    energy = 0.5 * float(np.sum(delta * F))
+    forces_along = {}
+    for name in names:
+        d = dirs[name] / max(np.linalg.norm(dirs[name]), 1e-300)
+        forces_along[name] = (float(np.asarray(run.samples[0].finger_forces[name]) @ d),
+                              float(state.finger_force(name) @ d))
+    diag = dict(run.diagnostics)
+    diag["compliance"] = obj.diagnostics()
+    diag["work_minus_energy"] = sum(f.work for f in state.fingers) - energy
+    return EventSqueeze(
+        termination=run.termination, depth=state.depth,
+        relative_depth=state.depth * relative_per_depth, target_depth=float(depth), kind=kind,
+        contacts=tuple(int(c) for c in contacts), directions=dirs, mu=float(mu),
+        tip_radius=radii, events=run.events,
+        segments={n: tuple(segment_node(c, mu) for c in state.segment(n)) for n in names},
+        energy=energy, work={f.name: f.work for f in state.fingers}, finger_force=forces_along,
+        trajectories=polar_trajectories(run.samples, relative_per_depth), health=health,
+        chatter=run.chatter, displacement=u_field, state=state, step=step, event_tol=event_tol,
+        reference=reference, diagnostics=diag)

@@ -1,0 +1,834 @@
+# Copyright 2026 squeeze_grasp_ros developers
+# SPDX-License-Identifier: Apache-2.0
+"""The incremental event stepper (paper Sec. 5.2-5.4, Algorithm 1 lines 4-15; docs/design.md §2).
+
+:func:`advance` moves any number of fingertips by given translations from a frozen
+:class:`~.contact_state.ContactState` and returns the new state with the events it located.
+Squeezes, resistance and the simulated hardware are loops over it.
+
+Within one call the motion is parametrised by s in [0, 1] (finger f at o_f + s d_f). The
+interval is cut into substeps of at most ``step`` (depth, relative to the object size L); at
+each substep end the fixed-set problem is solved (:func:`~.contact_model.solve_fixed_set`) and
+the event functions are evaluated:
+
+=====  ===========================================  ===============  =====================
+type   function (positive = no event)               nodes            paper
+=====  ===========================================  ===============  =====================
+A      gap |x_k - o_f| - r_f                         non-contact      eq. 48
+B      normal force f_n = f . e(theta)               contact          eq. 49 (|f| -> 0)
+C      cone margin mu f_n -/+ f_t                    sticking         eq. 50
+D      slip . d theta / ds (slip rate)               sliding          eq. 51
+=====  ===========================================  ===============  =====================
+
+plus the termination functions eps* - max strain (eq. 45; only with a strain limit) and
+w/n_f - min_f sum_k c_k (pickup; see :func:`pickup_margin`). A function that changes sign in a
+substep is located by a safeguarded Illinois (regula falsi) iteration to a bracket
+[a, b] of depth width <= ``event_tol`` * L; the earliest bracket end b wins, so the state at an
+event has the condition just met (a new contact penetrates by at most the tolerance). Results
+therefore depend on ``step`` only through missed double roots inside one substep, and on
+``event_tol`` to within the tolerance. The reference model (``ContactModel.reference``) skips
+the location: events are taken at the end of the fixed step, as in the paper.
+
+Processing at an event point (deterministic). Pending events are those whose function is
+<= 0, or, for functions that are zero by construction at that point (a new contact's force and
+cone margins, a freed node's gap, a just-stuck node's cone margin: the ``fresh`` keys of the
+state), whose derivative along the motion is negative. They are processed in the order
+
+    B (break)  <  D (slip -> stick)  <  C (stick -> slip)  <  A (new contact),
+
+then by finger (F1, F2, A) and node index, re-solving after each:
+
+* all new contacts pending at the point are added together and their modes decided jointly
+  by hypothesis-and-test along the motion (Algorithm 1 lines 2 and 13): stick if the force
+  rate stays inside the cone, else slide in the direction whose slip rate and normal-force
+  rate are consistent; options stick, slip +1, slip -1 in that order, every combination for up
+  to three nodes (the first consistent wins, else the fewest violations), node by node beyond;
+* a node whose C/D event would flip back at the same point has no consistent mode on its
+  own: the nodes with C/D events at the point are then decided jointly the same way, and
+  their events at the point are replaced by the net mode change;
+* finger slip (all contact nodes of a finger sliding the same way, Sec. 5.1) is checked after
+  every event and stops the processing; a break that would leave a finger without contact is
+  not applied and ends the call as ``contact_lost``.
+
+Then the terminations are checked in the order strain_limit < finger_slip < picked_up.
+
+Chattering bound: a node that would exceed ``model.max_events_per_depth`` events within one
+depth step, flips again after a joint decision, or has a second A/B event at one point, is
+frozen in its current state for one depth step (its events are not processed; reported as
+:class:`~.contact_state.Chatter`). Every loop advances s strictly or processes a bounded
+number of events, so a call always ends.
+
+Between substeps the sliding angles are continued from the previous point (predictor
+theta + dtheta/ds ds, Newton with line search); a substep whose Newton solve is slow or lands
+off the predicted branch is halved.
+"""
+from __future__ import annotations
+
+import itertools
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass
+
+import numpy as np
+
+from squeeze_grasp_ros.mechanics.squeeze.contact_model import Configuration, ContactModel, Solution, solve_fixed_set
+from squeeze_grasp_ros.mechanics.squeeze.contact_state import (Chatter, ContactNode, ContactState, Event, FingerState, Sample,
+                            StepResult)
+from squeeze_grasp_ros.mechanics.errors import MechanicsError, require_finite
+from squeeze_grasp_ros.mechanics.squeeze.fingertips import tip_gaps
+
+EVENT_ORDER = {"B": 0, "D": 1, "C+": 2, "C-": 2, "A": 3}
+"""Processing order of simultaneous events (C+ and C- never coexist on one node)."""
+TERMINATION_ORDER: tuple[str, ...] = ("strain_limit", "finger_slip", "picked_up")
+SLIP_RATE_ZERO = 1e-10
+"""Frictionless contacts: polar-angle rates (rad per unit motion) below this have no slip
+direction, so round-off in a symmetric contact cannot fake a one-way finger slip."""
+MAX_SUBSTEP_HALVINGS = 12
+CONTINUATION_ITERATIONS = 12
+MAX_ANGLE_JUMP = 0.05
+"""Continuation safeguards: Newton iterations and distance (rad) from the predicted angles
+beyond which a substep is halved."""
+MAX_ROOT_ITERATIONS = 200
+
+
+def pickup_margin(mu: float, fn: np.ndarray, ft: np.ndarray, stick: np.ndarray,
+                  finger: np.ndarray, fingers: list[int], weight: float) -> float:
+    """How far the grasp is from lifting the object, in force units (> 0: cannot lift yet).
+
+    The object lies on a horizontal plane and is lifted out of it. A contact node with normal
+    force f_n and in-plane tangential force f_t can supply at most
+    c_k = sqrt(mu^2 f_n^2 - f_t^2) of vertical friction (Sec. 5.1); a sliding node (force on the
+    cone edge) supplies none. The object is picked up when every finger with contacts can
+    supply its share: min over those fingers of sum_k c_k >= w / (number of such fingers)
+    (torque balance by friction assumed, as in the paper). Returns w / n_f - min_f sum_k c_k.
+    """
+    c = np.where(stick, np.sqrt(np.maximum(mu * mu * fn * fn - ft * ft, 0.0)), 0.0)
+    totals = [c[finger == f].sum() for f in fingers]
+    return float(weight / len(fingers) - min(totals))
+
+
+def _locate(g: Callable[[float], float], a: float, b: float, ga: float, gb: float,
+            tol: float) -> tuple[float, float, int]:
+    """Bracket [a, b] of width <= tol around the first sign change (ga > 0 >= gb).
+
+    Illinois regula falsi with a bisection safeguard; returns (a, b, evaluations).
+    """
+    evaluations, retained, width = 0, 0, b - a
+    while b - a > tol:
+        if evaluations >= MAX_ROOT_ITERATIONS:
+            raise MechanicsError(f"event location did not converge (bracket {b - a:.3g} > {tol:.3g})")
+        if evaluations % 3 == 2 and b - a > 0.5 * width:
+            c = 0.5 * (a + b)
+        else:
+            c = (a * gb - b * ga) / (gb - ga) if gb != ga else 0.5 * (a + b)
+        c = min(max(c, a + 0.49 * tol), b - 0.49 * tol)
+        if evaluations % 3 == 2:
+            width = b - a
+        gc = g(c)
+        evaluations += 1
+        if gc > 0:
+            a, ga = c, gc
+            if retained == 1:
+                gb *= 0.5
+            retained = 1
+        else:
+            b, gb = c, gc
+            if retained == -1:
+                ga *= 0.5
+            retained = -1
+    return a, b, evaluations
+
+
+@dataclass
+class _Values:
+    """Event-function values at one solution (see the module table)."""
+
+    fn: np.ndarray
+    c_plus: np.ndarray
+    c_minus: np.ndarray
+    d: np.ndarray
+    gaps: np.ndarray
+    strain: float
+    pickup: float
+
+
+class _Run:
+    """Mutable working copy of a state during one :func:`advance` call (dimensionless)."""
+
+    def __init__(self, model: ContactModel, state: ContactState,
+                 translations: Mapping[str, tuple[float, float]], step: float, event_tol: float,
+                 terminate_on: tuple[str, ...]) -> None:
+        self.model = model
+        L = model.length
+        self.names = [f.name for f in state.fingers]
+        unknown = sorted(set(translations) - set(self.names))
+        if unknown:
+            raise MechanicsError(f"translation given for unknown finger {unknown[0]!r} "
+                                 f"(state has {self.names})")
+        self.c0 = np.array([f.center for f in state.fingers], float) / L
+        self.D = np.array([translations.get(n, (0.0, 0.0)) for n in self.names], float) / L
+        require_finite("finger translations", self.D)
+        self.radius_f = np.array([f.radius for f in state.fingers], float) / L
+        self.t0 = np.array([f.translation for f in state.fingers], float) / L
+        self.work = np.array([f.work for f in state.fingers], float) / (model.force_unit * L)
+        self.rate = float(np.linalg.norm(self.D))
+        self.depth0 = state.depth
+        self.relative_per_depth = state.relative_per_depth
+        self.step, self.tol = step, event_tol
+        self.terminate_on = terminate_on
+        order = {n: k for k, n in enumerate(self.names)}
+        self.nodes = np.array([c.node for c in state.contacts], int)
+        self.fidx = np.array([order[c.finger] for c in state.contacts], int)
+        self.stick = np.array([c.mode == "stick" for c in state.contacts], bool)
+        self.slip = np.array([c.slip for c in state.contacts], int)
+        self.theta = np.array([c.theta for c in state.contacts], float)
+        self.undetermined = set(state.undetermined)
+        self.fresh = set(state.fresh)
+        self.history = list(state.history)
+        self.holds = dict(state.holds)
+        self.frictionless = model.mu == 0.0
+        self.boundary = model.boundary_nodes
+        self.p_b = model.positions(self.boundary)
+        self.s = 0.0
+        self.lost: str | None = None
+        self.events: list[Event] = []
+        self.chatter: list[Chatter] = []
+        self.samples: list[Sample] = []
+        self.diag = {"newton_max_iterations": 0, "newton_max_residual": 0.0,
+                     "jacobian_max_condition": 1.0, "root_evaluations": 0, "substeps": 0,
+                     "substep_halvings": 0, "ambiguous_modes": 0}
+        self._refresh_set()
+
+    # ----------------------------------------------------------------- contact set and solve
+    def _refresh_set(self) -> None:
+        order = np.argsort(self.nodes, kind="stable")
+        for name in ("nodes", "fidx", "stick", "slip", "theta"):
+            setattr(self, name, getattr(self, name)[order])
+        self.sd = self.model.set_data(tuple(self.nodes.tolist()))
+        self.p0 = self.model.positions(self.nodes)
+        self.contact_rows = self.model.obj.boundary_positions(self.nodes)
+
+    def depth_at(self, s: float) -> float:
+        """Depth (m) at step parameter s."""
+        return self.depth0 + s * self.rate * self.model.length
+
+    def solve(self, s: float, theta: np.ndarray | None = None,
+              stick: np.ndarray | None = None, slip: np.ndarray | None = None) -> Solution:
+        """Fixed-set solution at parameter s (modes default to the current ones)."""
+        stick = self.stick if stick is None else stick
+        slip = self.slip if slip is None else slip
+        cfg = Configuration(self.p0, stick, slip, self.radius_f[self.fidx])
+        centers = self.c0[self.fidx] + s * self.D[self.fidx]
+        sol = solve_fixed_set(self.sd.C, cfg, centers, self.D[self.fidx],
+                              self.theta if theta is None else theta, self.model.phi)
+        d = self.diag
+        d["newton_max_iterations"] = max(d["newton_max_iterations"], sol.iterations)
+        d["newton_max_residual"] = max(d["newton_max_residual"], sol.residual)
+        d["jacobian_max_condition"] = max(d["jacobian_max_condition"], sol.jacobian_condition)
+        return sol
+
+    # ----------------------------------------------------------------- event functions
+    def held(self, depth: float) -> np.ndarray:
+        """Boolean mask over contacts of nodes whose mode is frozen at ``depth``."""
+        return np.array([self.holds.get(int(k), -np.inf) > depth for k in self.nodes], bool)
+
+    def free_rows(self, depth: float) -> np.ndarray:
+        """Boundary loop positions checked for Event A (not in contact, not held)."""
+        mask = np.ones(len(self.boundary), bool)
+        mask[self.contact_rows] = False
+        for node, until in self.holds.items():
+            if until > depth:
+                mask[self.model.obj.boundary_positions([node])[0]] = False
+        return np.flatnonzero(mask)
+
+    def gaps(self, sol: Solution, s: float, rows: np.ndarray) -> np.ndarray:
+        """Gaps (k, f) of boundary positions ``rows`` to every fingertip."""
+        u = self.model.boundary_displacement(self.sd, sol.delta, sol.F, rows)
+        return tip_gaps(self.p_b[rows] + u, self.c0 + s * self.D, self.radius_f)
+
+    def termination_values(self, sol: Solution) -> tuple[float, float]:
+        """(eps* - max strain, pickup margin); inf for criteria not declared or not enabled."""
+        lim = self.model.limits
+        strain = pickup = np.inf
+        if lim.strain is not None and "strain_limit" in self.terminate_on:
+            strain = lim.strain - self.model.strain_measure(self.sd, sol.delta, sol.F)[0]
+        if lim.weight is not None and "picked_up" in self.terminate_on:
+            pickup = pickup_margin(self.model.mu, sol.normal(), sol.tangential(), self.stick,
+                                   self.fidx, sorted(set(self.fidx.tolist())),
+                                   lim.weight / self.model.force_unit)
+        return strain, pickup
+
+    def values(self, sol: Solution, s: float, rows: np.ndarray,
+               terminations: bool = True) -> _Values:
+        """All event functions at ``sol`` (and the termination functions if asked)."""
+        fn, ft = sol.normal(), sol.tangential()
+        mu = self.model.mu
+        d = self.slip * sol.dtheta * self.radius_f[self.fidx] / (self.rate if self.rate > 0 else 1.0)
+        strain, pickup = self.termination_values(sol) if terminations else (np.inf, np.inf)
+        return _Values(fn, mu * fn + ft, mu * fn - ft, d, self.gaps(sol, s, rows), strain, pickup)
+
+    def _key_value(self, key: tuple, sol: Solution, s: float) -> float:
+        """Value of one event function (for root location)."""
+        kind, node = key[0], key[1]
+        if kind in ("strain", "pickup"):
+            return self.termination_values(sol)[0 if kind == "strain" else 1]
+        if kind == "A":
+            return float(self.gaps(sol, s, self.model.obj.boundary_positions([node]))[0, key[2]])
+        v = self.values(sol, s, np.zeros(0, int), terminations=False)
+        k = int(np.searchsorted(self.nodes, node))
+        return float({"B": v.fn, "C+": v.c_plus, "C-": v.c_minus, "D": v.d}[kind][k])
+
+    def entries(self, v: _Values, rows: np.ndarray, depth: float):
+        """Active (key, value) pairs of the contact and termination functions, in order."""
+        held = self.held(depth)
+        out = []
+        for k, node in enumerate(self.nodes.tolist()):
+            if held[k]:
+                continue
+            out.append((("B", node), v.fn[k]))
+            if self.frictionless:
+                continue
+            if self.stick[k]:
+                out.append((("C+", node), v.c_plus[k]))
+                out.append((("C-", node), v.c_minus[k]))
+            else:
+                out.append((("D", node), v.d[k]))
+        for r, node in enumerate(self.boundary[rows].tolist()):
+            for f in range(len(self.names)):
+                out.append((("A", node, f), v.gaps[r, f]))
+        if np.isfinite(v.strain):
+            out.append((("strain", -1), v.strain))
+        if np.isfinite(v.pickup):
+            out.append((("pickup", -1), v.pickup))
+        return out
+
+    # ----------------------------------------------------------------- processing at a point
+    def _fresh_rates(self, sol: Solution, rows: np.ndarray) -> dict:
+        """Derivatives d/ds of the fresh functions at the current point."""
+        fn_r, ft_r = sol.normal_rate(), sol.tangential_rate()
+        mu = self.model.mu
+        rates = {}
+        a_nodes = [node for kind, node in self.fresh if kind == "A"]
+        if a_nodes:
+            arows = self.model.obj.boundary_positions(a_nodes)
+            x = self.p_b[arows] + self.model.boundary_displacement(self.sd, sol.delta, sol.F, arows)
+            dx = self.model.boundary_displacement(self.sd, sol.ddelta, sol.dF, arows)
+            centers = self.c0 + self.s * self.D
+            for j, node in enumerate(a_nodes):
+                rel = x[j] - centers
+                rel_rate = dx[j] - self.D
+                g_rate = np.einsum("fi,fi->f", rel, rel_rate) / np.linalg.norm(rel, axis=1)
+                for f in range(len(self.names)):
+                    rates[("A", node, f)] = g_rate[f]
+        for k, node in enumerate(self.nodes.tolist()):
+            rates[("B", node)] = fn_r[k]
+            rates[("C+", node)] = mu * fn_r[k] + ft_r[k]
+            rates[("C-", node)] = mu * fn_r[k] - ft_r[k]
+        return rates
+
+    def pending(self, sol: Solution) -> list[tuple]:
+        """Pending contact events at the current point, in processing order."""
+        depth = self.depth_at(self.s)
+        rows = self.free_rows(depth)
+        v = self.values(sol, self.s, rows, terminations=False)
+        rates = self._fresh_rates(sol, rows)
+        out = []
+        for key, value in self.entries(v, rows, depth):
+            fresh_key = key[:2]
+            if fresh_key in self.fresh and key in rates:
+                if key[0] == "A" and value > self.tol:
+                    continue  # a freed node is at zero gap only to the finger that released it
+                if rates[key] < 0:
+                    out.append(key)
+            elif value <= 0:
+                out.append(key)
+        finger_of = dict(zip(self.nodes.tolist(), self.fidx.tolist()))
+        return sorted(out, key=lambda k: (EVENT_ORDER[k[0]],
+                                          k[2] if k[0] == "A" else finger_of[k[1]], k[1]))
+
+    def zero_keys(self) -> set:
+        """Functions zero by construction now: the fresh ones and each sliding node's cone
+        margin on its slip side (its force lies on that cone edge)."""
+        zero = set(self.fresh)
+        for node, stick, slip in zip(self.nodes.tolist(), self.stick, self.slip):
+            if not stick and slip:
+                zero.add(("C+" if slip > 0 else "C-", node))
+        return zero
+
+    def violations(self, sol: Solution, k: int, stick: bool, slip: int, zero: set) -> int:
+        """Violated conditions of a mode hypothesis for contact k (0 = consistent).
+
+        A function in ``zero`` must grow along the motion; any other must be positive. Stick:
+        normal force and both cone margins; slip: normal force and slip rate of the assumed
+        sign (Algorithm 1's hypothesis-and-test)."""
+        node = int(self.nodes[k])
+        mu = self.model.mu
+        fn, ft = float(sol.normal()[k]), float(sol.tangential()[k])
+        fn_r, ft_r = float(sol.normal_rate()[k]), float(sol.tangential_rate()[k])
+
+        def ok(kind: str, value: float, rate: float) -> bool:
+            return rate > 0 if (kind, node) in zero else value > 0
+
+        bad = int(not ok("B", fn, fn_r))
+        if stick:
+            bad += int(not ok("C+", mu * fn + ft, mu * fn_r + ft_r))
+            bad += int(not ok("C-", mu * fn - ft, mu * fn_r - ft_r))
+        elif not self.frictionless:
+            bad += int(slip * sol.dtheta[k] <= 0)
+        return bad
+
+    def decide(self, nodes: list[int]) -> None:
+        """Joint hypothesis-and-test for the modes of ``nodes`` (Algorithm 1 lines 2 and 13).
+
+        Options per node in the order stick, slip +1, slip -1; every combination for up to
+        three nodes (the first consistent one wins, else the one with fewest violations),
+        node by node in two passes for more."""
+        idx = [int(np.searchsorted(self.nodes, n)) for n in sorted(nodes)]
+        zero = self.zero_keys()
+        options = [(False, 0)] if self.frictionless else [(True, 0), (False, 1), (False, -1)]
+        if len(idx) <= 3:
+            candidates = itertools.product(options, repeat=len(idx))
+        else:
+            candidates = [self._greedy(idx, options, zero)]
+        best = None
+        for combo in candidates:
+            stick, slip = self.stick.copy(), self.slip.copy()
+            for k, (st, sl) in zip(idx, combo):
+                stick[k], slip[k] = st, sl
+            try:
+                sol = self.solve(self.s, stick=stick, slip=slip)
+            except MechanicsError:
+                continue
+            bad = sum(self.violations(sol, k, stick[k], slip[k], zero) for k in idx)
+            if best is None or bad < best[0]:
+                best = (bad, stick, slip, sol.theta)
+            if bad == 0:
+                break
+        if best is None:
+            raise MechanicsError(f"no contact mode of nodes {sorted(nodes)} can be solved")
+        if best[0] > 0:
+            self.diag["ambiguous_modes"] += 1
+        _, self.stick, self.slip, self.theta = best
+        for k in idx:
+            node = int(self.nodes[k])
+            if self.stick[k]:
+                self.fresh |= {key for key in (("C+", node), ("C-", node)) if key in zero}
+            else:
+                self.fresh -= {("C+", node), ("C-", node)}
+        self.undetermined -= set(nodes)
+
+    def _greedy(self, idx: list[int], options: list, zero: set) -> tuple:
+        """Node-by-node hypothesis-and-test (two passes) for many undecided nodes."""
+        stick, slip = self.stick.copy(), self.slip.copy()
+        choice = {k: options[0] for k in idx}
+        for _ in range(2):
+            for k in idx:
+                for st, sl in options:
+                    stick[k], slip[k] = st, sl
+                    try:
+                        sol = self.solve(self.s, stick=stick, slip=slip)
+                    except MechanicsError:
+                        continue
+                    if self.violations(sol, k, st, sl, zero) == 0:
+                        choice[k] = (st, sl)
+                        break
+                stick[k], slip[k] = choice[k]
+        return tuple(choice[k] for k in idx)
+
+    def _chatters(self, node: int, finger: int) -> bool:
+        """Count an event of ``node`` in the depth window; True if the bound froze it instead."""
+        depth = self.depth_at(self.s)
+        window = self.step * self.model.length
+        self.history = [(n, d) for n, d in self.history if d > depth - window]
+        if sum(1 for n, _ in self.history if n == node) < self.model.max_events_per_depth:
+            self.history.append((node, depth))
+            return False
+        self.hold(node, finger)
+        return True
+
+    def hold(self, node: int, finger: int) -> None:
+        """Freeze the contact state of ``node`` for one depth step (chattering bound)."""
+        depth = self.depth_at(self.s)
+        until = depth + self.step * self.model.length
+        self.holds[node] = until
+        self.chatter.append(Chatter(node, self.names[finger], depth, until))
+
+    def log(self, kind: str, k: int) -> None:
+        """Append an event of contact k (mode and slip after the event)."""
+        depth = self.depth_at(self.s)
+        mode = "stick" if self.stick[k] else "slip"
+        self.events.append(Event(kind, int(self.nodes[k]), self.names[self.fidx[k]], depth,
+                                 depth * self.relative_per_depth, mode, int(self.slip[k])))
+
+    def add_contacts(self, keys: list[tuple], sol: Solution) -> None:
+        """Event A for every key (one per node): put the nodes on their tips, decide jointly."""
+        added = []
+        self.theta = sol.theta.copy()
+        for _, node, f in keys:
+            if self._chatters(node, f):
+                continue
+            row = self.model.obj.boundary_positions([node])
+            x = self.p_b[row[0]] + self.model.boundary_displacement(self.sd, sol.delta, sol.F, row)[0]
+            rel_x = x - (self.c0[f] + self.s * self.D[f])
+            theta = float(np.arctan2(rel_x[1], rel_x[0]))
+            same = self.fidx == f
+            if same.any():
+                ref = float(np.mean(self.theta[same]))
+                theta = ref + float(np.angle(np.exp(1j * (theta - ref))))
+            self.nodes = np.append(self.nodes, node)
+            self.fidx = np.append(self.fidx, f)
+            self.stick = np.append(self.stick, True)
+            self.slip = np.append(self.slip, 0)
+            self.theta = np.append(self.theta, theta)
+            self.fresh = ({k for k in self.fresh if k[1] != node}
+                          | {("B", node), ("C+", node), ("C-", node)})
+            added.append(node)
+        if not added:
+            return
+        self._refresh_set()
+        self.undetermined |= set(added)
+        self.decide(added)
+        for node in sorted(added):
+            self.log("A", int(np.searchsorted(self.nodes, node)))
+
+    def apply(self, key: tuple, sol: Solution) -> None:
+        """Process one B, C or D event (updates modes, the contact set and the fresh keys)."""
+        kind, node = key[0], key[1]
+        k = int(np.searchsorted(self.nodes, node))
+        f = int(self.fidx[k])
+        if self._chatters(node, f):
+            return
+        self.theta = sol.theta.copy()
+        if kind == "B" and np.count_nonzero(self.fidx == f) == 1:
+            self.lost = self.names[f]
+        elif kind == "B":
+            self.log("B", k)
+            self.events[-1] = Event("B", node, self.names[f], self.events[-1].depth,
+                                    self.events[-1].relative_depth, "none", 0)
+            keep = np.arange(len(self.nodes)) != k
+            for name in ("nodes", "fidx", "stick", "slip", "theta"):
+                setattr(self, name, getattr(self, name)[keep])
+            self._refresh_set()
+            self.fresh = {fk for fk in self.fresh if fk[1] != node} | {("A", node)}
+        elif kind in ("C+", "C-"):
+            self.stick[k] = False
+            self.slip[k] = 1 if kind == "C+" else -1
+            self.fresh -= {("C+", node), ("C-", node)}
+            self.log("C", k)
+        else:
+            side = "C+" if self.slip[k] > 0 else "C-"
+            self.stick[k], self.slip[k] = True, 0
+            self.fresh.add((side, node))
+            self.log("D", k)
+
+    def resettle(self, nodes: set, before: dict, first_event: int) -> None:
+        """Joint hypothesis-and-test for nodes whose C/D events at this point flip back.
+
+        Their C/D events at this point are replaced by the net mode change from the start of
+        the point (C for stick -> slip, D for slip -> stick, D then C for a slip reversal)."""
+        self.decide(sorted(nodes))
+        kept = [e for e in self.events[first_event:] if not (e.node in nodes and e.type in "CD")]
+        self.events[first_event:] = kept
+        for node in sorted(nodes):
+            k = int(np.searchsorted(self.nodes, node))
+            old_stick, old_slip = before.get(node, (True, 0))
+            new = (bool(self.stick[k]), int(self.slip[k]))
+            if new == (old_stick, old_slip):
+                continue
+            if not old_stick:
+                self.stick[k], self.slip[k] = True, 0
+                self.log("D", k)
+                self.stick[k], self.slip[k] = new
+            if not new[0]:
+                self.log("C", k)
+        for i, e in enumerate(self.events[first_event:], first_event):
+            if e.type == "A" and e.node in nodes:
+                k = int(np.searchsorted(self.nodes, e.node))
+                self.events[i] = Event("A", e.node, e.finger, e.depth, e.relative_depth,
+                                       "stick" if self.stick[k] else "slip", int(self.slip[k]))
+
+    def resolve(self) -> Solution:
+        """Process every pending event at the current point; returns the final solution.
+
+        New contacts pending together are added as one batch with a joint mode decision. A
+        node whose C/D event would flip back at the same point triggers a joint decision over
+        the nodes with C/D events here; a node that flips again after that, or has a second
+        A/B event here, is frozen by the chattering bound."""
+        if self.rate == 0:
+            return self.solve(self.s)
+        if self.undetermined:
+            self.decide(sorted(self.undetermined))
+        before = {int(n): (bool(st), int(sl))
+                  for n, st, sl in zip(self.nodes, self.stick, self.slip)}
+        first_event = len(self.events)
+        mode_events: set = set()
+        contact_events: set = set()
+        settled: set = set()
+        limit = 4 * (len(self.nodes) + 8) * self.model.max_events_per_depth
+        for _ in range(limit):
+            sol = self.solve(self.s)
+            if self.lost is not None or self.slipping_finger(sol) is not None:
+                return sol
+            todo = self.pending(sol)
+            if not todo:
+                return sol
+            key = todo[0]
+            kind, node = key[0], key[1]
+            finger = key[2] if kind == "A" else int(self.fidx[np.searchsorted(self.nodes, node)])
+            if node in settled or (kind in ("A", "B") and node in contact_events):
+                self.hold(node, finger)
+            elif kind == "A":
+                batch = {}
+                for k in todo:
+                    if k[0] == "A" and k[1] not in contact_events:
+                        batch.setdefault(k[1], k)
+                self.add_contacts(sorted(batch.values(), key=lambda k: (k[2], k[1])), sol)
+                contact_events |= set(batch)
+            elif kind != "B" and node in mode_events:
+                group = mode_events | {node}
+                self.resettle(group, before, first_event)
+                settled |= group
+            else:
+                (contact_events if kind == "B" else mode_events).add(node)
+                self.apply(key, sol)
+        raise MechanicsError("event processing at one point did not settle (chattering bound "
+                             "exceeded); lower squeeze.max_events_per_depth")
+
+    def termination(self, sol: Solution) -> str | None:
+        """First termination that holds at the current point (TERMINATION_ORDER)."""
+        if self.rate == 0:
+            return None
+        strain, pickup = self.termination_values(sol)
+        if strain <= 0:
+            return "strain_limit"
+        if self.lost is not None:
+            return "contact_lost"
+        if "finger_slip" in self.terminate_on and self.slipping_finger(sol) is not None:
+            return "finger_slip"
+        if pickup <= 0:
+            return "picked_up"
+        return None
+
+    def slipping_finger(self, sol: Solution) -> str | None:
+        """A finger whose contact nodes all slide the same way (Sec. 5.1), or None."""
+        if "finger_slip" not in self.terminate_on:
+            return None
+        signs = self._slip_signs(sol)
+        for f in sorted(set(self.fidx.tolist())):
+            mine = self.fidx == f
+            if not self.stick[mine].any() and (np.all(signs[mine] > 0) or np.all(signs[mine] < 0)):
+                return self.names[f]
+        return None
+
+    def _slip_signs(self, sol: Solution) -> np.ndarray:
+        """Slip direction of each contact (from the slip rate when frictionless)."""
+        if self.frictionless:
+            rate = np.where(np.abs(sol.dtheta) > SLIP_RATE_ZERO, sol.dtheta, 0.0)
+            return np.sign(rate).astype(int)
+        return self.slip
+
+    # ----------------------------------------------------------------- motion
+    def integrate_work(self, sa: Solution, sb: Solution, a: float, b: float) -> None:
+        """Add the work of every finger over [a, b] (cubic Hermite in s)."""
+        h = b - a
+        for f in range(len(self.names)):
+            mine = self.fidx == f
+            if not mine.any():
+                continue
+            ya, yb = sa.F[mine].sum(axis=0) @ self.D[f], sb.F[mine].sum(axis=0) @ self.D[f]
+            ra, rb = sa.dF[mine].sum(axis=0) @ self.D[f], sb.dF[mine].sum(axis=0) @ self.D[f]
+            self.work[f] += 0.5 * h * (ya + yb) + h * h / 12.0 * (ra - rb)
+
+    def record(self, sol: Solution) -> None:
+        """Append a trajectory sample at the current point."""
+        unit_force = self.model.force_unit
+        forces = {name: tuple((sol.F[self.fidx == f].sum(axis=0) * unit_force).tolist())
+                  for f, name in enumerate(self.names)}
+        self.samples.append(Sample(self.depth_at(self.s), tuple(self.nodes.tolist()),
+                                   tuple(sol.theta.tolist()), forces))
+
+    def crossings(self, va: list, vb: list, fresh_at_a: set) -> list[tuple]:
+        """Keys whose function went from > 0 (or fresh zero) at a to <= 0 at b."""
+        before = dict(va)
+        out = []
+        for key, value in vb:
+            if value > 0 or key not in before:
+                continue
+            if before[key] > 0 or key[:2] in fresh_at_a:
+                out.append(key)
+        return out
+
+    def continue_to(self, sol_a: Solution, a: float, b: float) -> Solution:
+        """Solve at b by continuation from the solution at a (predictor theta + dtheta/ds (b-a)).
+
+        Raises MechanicsError if Newton needs more than CONTINUATION_ITERATIONS iterations or
+        lands more than MAX_ANGLE_JUMP (rad) from the prediction (another solution branch)."""
+        guess = sol_a.theta + sol_a.dtheta * (b - a)
+        sol = self.solve(b, theta=guess)
+        jump = np.abs(sol.theta - guess).max()
+        if sol.iterations > CONTINUATION_ITERATIONS or jump > MAX_ANGLE_JUMP:
+            raise MechanicsError(f"continuation from s = {a:.6g} to {b:.6g} left the solution "
+                                 "branch")
+        return sol
+
+    def substep(self, sol_a: Solution, a: float, b: float) -> tuple[float, Solution]:
+        """(b, solution at b) by continuation from a, halving the substep while it fails."""
+        for _ in range(MAX_SUBSTEP_HALVINGS):
+            try:
+                return b, self.continue_to(sol_a, a, b)
+            except MechanicsError:
+                self.diag["substep_halvings"] += 1
+                b = a + 0.5 * (b - a)
+        raise MechanicsError(f"the fixed-set solve failed near depth {self.depth_at(a):.6g} m")
+
+    def run(self, stop_on_event: bool) -> str | None:
+        """Advance s from 0 to 1 (or to a termination / first event); returns the termination."""
+        sol = self.resolve()
+        self.record(sol)
+        term = self.termination(sol)
+        if term or self.rate == 0 or (stop_on_event and self.events):
+            self.final = sol
+            return term
+        hs = self.step / self.rate
+        tol_s = self.tol / self.rate
+        rows, va = None, None
+        while self.s < 1.0:
+            a = self.s
+            depth_a = self.depth_at(a)
+            free = self.free_rows(depth_a)
+            if va is None or not np.array_equal(free, rows):
+                rows = free
+                va = self.entries(self.values(sol, a, rows), rows, depth_a)
+            b, sol_b = self.substep(sol, a, min(a + hs, 1.0))
+            self.diag["substeps"] += 1
+            vb = self.entries(self.values(sol_b, b, rows), rows, depth_a)
+            crossed = self.crossings(va, vb, self.fresh)
+            if crossed and not self.model.reference:
+                b, sol_b = self.earliest(crossed, sol, sol_b, a, b, tol_s, dict(va), dict(vb))
+            va = None if crossed else vb
+            self.integrate_work(sol, sol_b, a, b)
+            self.s = 1.0 if b >= 1.0 else b
+            self.fresh = set()
+            self.theta = sol_b.theta.copy()
+            sol = self.resolve() if crossed else sol_b
+            self.record(sol)
+            term = self.termination(sol) if crossed else None
+            if term or (stop_on_event and self.events):
+                break
+        self.final = sol
+        return term
+
+    def earliest(self, crossed, sol_a, sol_b, a, b, tol_s, va, vb):
+        """Locate every crossed function; return the earliest bracket end and its solution."""
+        solved = [(a, sol_a), (b, sol_b)]
+        best = None
+        finger_of = dict(zip(self.nodes.tolist(), self.fidx.tolist()))
+
+        def solve_near(s: float) -> Solution:
+            """Solve at s by continuation from the nearest point solved so far."""
+            near, sol_near = min(solved, key=lambda p: abs(p[0] - s))
+            sol = self.continue_to(sol_near, near, s)
+            solved.append((s, sol))
+            return sol
+
+        for key in crossed:
+            def g(s, key=key):
+                return self._key_value(key, solve_near(s), s)
+            lo, glo = a, va[key]
+            if key[:2] in self.fresh or not glo > 0:
+                lo = min(a + tol_s, b)
+                glo = g(lo)
+                self.diag["root_evaluations"] += 1
+            if glo <= 0:
+                hi = lo
+            else:
+                _, hi, n = _locate(g, lo, b, glo, vb[key], tol_s)
+                self.diag["root_evaluations"] += n
+            fidx = key[2] if key[0] == "A" else finger_of.get(key[1], 0)
+            rank = (hi, EVENT_ORDER.get(key[0], 4), fidx, key[1])
+            best = rank if best is None or rank < best else best
+        s_e = best[0]
+        return s_e, solve_near(s_e)
+
+    def to_state(self) -> ContactState:
+        """The frozen SI state at the current point."""
+        L, fu = self.model.length, self.model.force_unit
+        sol = self.final
+        s = self.s
+        fingers = tuple(FingerState(n, (self.c0[f] + s * self.D[f]) * L, self.radius_f[f] * L,
+                                    (self.t0[f] + s * self.D[f]) * L, float(self.work[f] * fu * L))
+                        for f, n in enumerate(self.names))
+        signs = self._slip_signs(sol)
+        contacts = tuple(
+            ContactNode(int(node), self.names[self.fidx[k]],
+                        "stick" if self.stick[k] else "slip",
+                        0 if self.stick[k] else int(signs[k]), float(sol.theta[k]),
+                        sol.delta[k] * L, sol.F[k] * fu)
+            for k, node in enumerate(self.nodes.tolist()))
+        depth = self.depth_at(s)
+        return ContactState(fingers, contacts, depth, self.relative_per_depth,
+                            tuple(sorted(self.undetermined)), tuple(sorted(self.fresh)),
+                            tuple(self.history),
+                            tuple(sorted((n, u) for n, u in self.holds.items() if u > depth)))
+
+
+MIN_STEP = 1e-6
+"""Smallest substep, relative to the object size: below it a squeeze to a usual depth needs
+millions of steps (``squeeze.step: 1e-12`` ran for ever)."""
+MIN_EVENT_TOL = 1e-15
+"""Smallest event tolerance, relative to the object size (near the float resolution)."""
+
+
+def advance(model: ContactModel, state: ContactState,
+            translations: Mapping[str, tuple[float, float]], step: float = 1e-3,
+            event_tol: float = 1e-9, stop_on_event: bool = False,
+            terminate_on: tuple[str, ...] = TERMINATION_ORDER) -> StepResult:
+    """Translate fingertips from ``state`` and locate the contact events on the way.
+
+    Parameters
+    ----------
+    model : ContactModel
+        Object, friction and termination criteria.
+    state : ContactState
+        Start state (e.g. :func:`~.contact_state.initial_state`).
+    translations : mapping
+        Finger name -> translation (dx, dy), m, object frame, for this call; fingers not named
+        stay still. Any number of fingers.
+    step : float
+        Largest depth substep, relative to the object size L (the bracketing grid: events
+        closer than this to each other in one function can be missed).
+    event_tol : float
+        Event location tolerance in depth, relative to L.
+    stop_on_event : bool
+        Return right after the first point at which events were processed.
+    terminate_on : tuple of str
+        Which of "strain_limit", "finger_slip", "picked_up" end the motion (strain and pickup
+        are only evaluated if the model's limits declare them).
+
+    Returns
+    -------
+    StepResult
+        New state, events, fraction of the translations applied, termination (or None),
+        trajectory samples, chattering record and diagnostics.
+
+    Raises
+    ------
+    MechanicsError
+        For bad arguments, a lost grasp (fewer than 2 contacts) or a solve that fails.
+    """
+    if not (np.isfinite(step) and step >= MIN_STEP):
+        raise MechanicsError(f"step must be >= {MIN_STEP} (relative to the object size), got "
+                             f"{step}")
+    if not (np.isfinite(event_tol) and event_tol >= MIN_EVENT_TOL):
+        raise MechanicsError(f"event_tol must be >= {MIN_EVENT_TOL} (relative to the object "
+                             f"size), got {event_tol}")
+    bad = sorted(set(terminate_on) - set(TERMINATION_ORDER))
+    if bad:
+        raise MechanicsError(f"unknown termination {bad[0]!r} (allowed: {TERMINATION_ORDER})")
+    run = _Run(model, state, translations, step, min(event_tol, step), tuple(terminate_on))
+    termination = run.run(stop_on_event)
+    new_state = run.to_state()
+    diag = dict(run.diag)
+    diag["sets_factored"] = model._cache.get("sets_factored", 0)
+    diag["reduced_max_condition"] = model._cache.get("max_condition", 1.0)
+    return StepResult(new_state, tuple(run.events), float(run.s), termination,
+                      tuple(run.samples), tuple(run.chatter), diag)

@@ -1,0 +1,102 @@
+# Copyright 2026 squeeze_grasp_ros developers
+# SPDX-License-Identifier: Apache-2.0
+"""The domain vocabulary: one string enum per kind of name.
+
+Each member *is* its string (``Finger.F1 == "F1"``, same hash), so JSON, YAML scenes, CSV
+columns and ROS messages keep the exact strings they always had, and code that receives a
+plain string from a file works unchanged. ``str(member)`` and f-strings give the bare value.
+
+>>> from squeeze_grasp_ros.mechanics.vocabulary import Finger, Termination
+>>> Finger.F1 == "F1", f"{Termination.STRAIN_LIMIT}"
+(True, 'strain_limit')
+>>> Finger("F2") is Finger.F2
+True
+"""
+from __future__ import annotations
+
+from enum import Enum
+
+__all__ = ["ContactMode", "EventType", "Finger", "MaterialModel", "SQUEEZING_FINGERS",
+           "SqueezeKind", "StrainCriterion", "Termination"]
+
+
+class _Name(str, Enum):
+    """A string enum whose ``str()`` and format are the bare value."""
+
+    __str__ = str.__str__
+    __format__ = str.__format__
+
+    @classmethod
+    def values(cls) -> tuple[str, ...]:
+        """All values, in declaration order."""
+        return tuple(m.value for m in cls)
+
+
+class Finger(_Name):
+    """Finger names: the two squeezing fingers and the adversary (paper Sec. 6)."""
+
+    F1 = "F1"
+    F2 = "F2"
+    A = "A"
+
+
+SQUEEZING_FINGERS: tuple[Finger, Finger] = (Finger.F1, Finger.F2)
+"""The two fingers of a squeeze, in canonical order."""
+
+
+class EventType(_Name):
+    """Contact events of the event-driven squeeze (paper Sec. 5.3)."""
+
+    A = "A"
+    """New contact: a boundary node reaches a fingertip (eq. 48)."""
+    B = "B"
+    """Contact break: the normal force of a contact node reaches zero (eq. 49)."""
+    C = "C"
+    """Stick to slip: the force of a sticking node reaches a friction-cone edge (eq. 50)."""
+    D = "D"
+    """Slip to stick: a sliding node's slip rate reaches zero (eq. 51)."""
+
+
+class ContactMode(_Name):
+    """Mode of a contact node under Coulomb friction."""
+
+    STICK = "stick"
+    SLIP = "slip"
+
+
+class Termination(_Name):
+    """Why a squeeze ended: the paper's four criteria (Sec. 5.1) and a lost grasp."""
+
+    DEPTH_REACHED = "depth_reached"
+    STRAIN_LIMIT = "strain_limit"
+    FINGER_SLIP = "finger_slip"
+    PICKED_UP = "picked_up"
+    CONTACT_LOST = "contact_lost"
+    """A contact break (Event B) would leave a finger with no contact node; not applied."""
+
+
+class SqueezeKind(_Name):
+    """Stable or pure: the squeeze (paper Sec. 2.4) and the resistance built on it (Sec. 6.1)."""
+
+    STABLE = "stable"
+    PURE = "pure"
+
+
+class StrainCriterion(_Name):
+    """How the strain limit eps* is tested per element (eq. 45)."""
+
+    PRINCIPAL = "principal"
+    """max(|eps_1|, |eps_2|) <= eps* (frame invariant; the default)."""
+    COMPONENTWISE = "componentwise"
+    """|eps_x|, |eps_y| <= eps* in the object frame (eq. 45 literally)."""
+
+
+class MaterialModel(_Name):
+    """Constitutive model of a solid object."""
+
+    LINEAR = "linear"
+    """Small-strain linear elasticity (the paper's model)."""
+    COROTATIONAL = "corotational"
+    """Linear stress in the element's rotated frame: exact under rigid rotation."""
+    NEO_HOOKEAN = "neo_hookean"
+    """Compressible neo-Hookean hyperelasticity in exact plane stress."""

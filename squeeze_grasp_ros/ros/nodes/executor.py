@@ -1,0 +1,214 @@
+# Copyright 2026 squeeze_grasp_ros developers
+# SPDX-License-Identifier: Apache-2.0
+"""The executor: an ``ExecuteGrasp`` action server streaming fingertip setpoints to the devices.
+
+Run it with ``ros2 run squeeze_grasp_ros executor --ros-args --params-file config/executor.yaml``.
+A goal (a squeeze, then optionally a resistance) becomes a
+:class:`..control.motion.GraspProgram`; every control cycle turns the monitor's
+``monitor/status`` into one ``geometry_msgs/PoseStamped`` setpoint per device
+(``devices/<device>/setpoint``: fingertip centre in the object frame ``frame_id``; the object
+frame's pose in ``base_frame`` is the ``object_pose`` parameter, published latched on
+``object_pose`` for the drivers), with the velocity and acceleration limits, the holds on stale
+data and slip alarms, and the reactive redirection of the program.
+
+- Lockstep (simulation): a cycle runs when the status of tick t arrives; the setpoints are
+  stamped t + ``period``. While no goal runs the executor does not answer, so simulated time
+  waits for the next goal (a run does not depend on when the goal arrived). A repeated status
+  (a re-sent tick) gets the same setpoints again.
+- Hardware (``lockstep: false``): a wall-clock timer at 1 / ``period`` runs the cycle on the
+  newest status.
+
+Feedback (every ``feedback_every`` cycles): state, measured depth and forces, events since the
+previous feedback. Cancel: the next cycle holds the measured positions and the goal ends
+``canceled``. Only one goal runs at a time; others are rejected.
+"""
+from __future__ import annotations
+
+from typing import Any
+
+from geometry_msgs.msg import PoseStamped
+from rclpy.action import ActionServer, CancelResponse, GoalResponse
+from rclpy.action.server import ServerGoalHandle
+from rclpy.node import Node
+from rclpy.task import Future
+
+from squeeze_grasp_interfaces.action import ExecuteGrasp
+from squeeze_grasp_interfaces.msg import ExecutorStatus, MonitorStatus
+
+from squeeze_grasp_ros.ros import messages
+from squeeze_grasp_ros.control.motion import Command, GraspProgram, MotionLimits, goal_problem
+from squeeze_grasp_ros.ros.nodes import pipeline, run_node
+
+PARAMETERS: dict[str, tuple[Any, str]] = {
+    "finger_devices": (["F1:barrett_f1", "F2:barrett_f3"], "finger:device of every fingertip"),
+    "frame_id": (pipeline.FRAME, "object frame of the setpoints"),
+    "base_frame": ("base_link", "robot base frame"),
+    "object_pose": ([0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0],
+                    "pose of the object frame in base_frame: x y z (m) qx qy qz qw"),
+    "max_velocity": (0.01, "largest fingertip speed, m/s"),
+    "max_acceleration": (0.1, "largest fingertip acceleration, m/s^2"),
+    "position_tolerance": (1e-7, "a phase ends when every moving tip is this close, m"),
+    "redirect_grace": (20, "cycles the slip alarm is ignored after a redirection"),
+    "stale_budget": (0.1, "longest hold for stale sensor data, s; past it the goal ends "
+                          "stale_data"),
+    "period": (0.001, "control cycle, s (lockstep: the simulated tick)"),
+    "feedback_every": (10, "cycles between action feedback messages"),
+    "lockstep": (True, "cycle on each monitor status (simulation) or on a wall-clock timer"),
+    "qos_depth": (100, "history depth of the reliable topics"),
+}
+"""Parameter name -> (typed default, description); config/executor.yaml sets them."""
+
+SUCCESS = (ExecuteGrasp.Result.DEPTH_REACHED, ExecuteGrasp.Result.RESISTED,
+           ExecuteGrasp.Result.PICKED_UP)
+"""Terminations that count as success."""
+HOLDS = (ExecuteGrasp.Result.CANCELED, ExecuteGrasp.Result.SLIP_ALARM,
+         ExecuteGrasp.Result.STALE_DATA)
+"""Terminations after which the executor reports that it holds position."""
+
+
+class _Goal:
+    """The running goal: program, handle, completion future and the events seen."""
+
+    def __init__(self, program: GraspProgram, handle: ServerGoalHandle) -> None:
+        self.program = program
+        self.handle = handle
+        self.done = Future()
+        self.events: list = []
+        self.since_feedback: list = []
+        self.start_ns: int | None = None
+
+
+class ExecutorNode(Node):
+    """Grasp executor action server."""
+
+    def __init__(self, **kwargs: Any) -> None:
+        super().__init__("executor", **kwargs)
+        self.p = p = pipeline.declare(self, PARAMETERS)
+        self.devices = pipeline.parse_mapping(p["finger_devices"], "finger_devices")
+        self.limits = MotionLimits(p["max_velocity"], p["max_acceleration"],
+                                   p["position_tolerance"], p["redirect_grace"],
+                                   float(p["stale_budget"]))
+        self.period_ns = int(round(p["period"] * 1e9))
+        loop = pipeline.loop_qos(p["qos_depth"])
+        self.setpoint_pubs = {f: self.create_publisher(PoseStamped,
+                                                       pipeline.device_topic(d, "setpoint"), loop)
+                              for f, d in self.devices.items()}
+        self.status_pub = self.create_publisher(ExecutorStatus, pipeline.EXECUTOR_STATUS, loop)
+        pose_pub = self.create_publisher(PoseStamped, pipeline.OBJECT_POSE, pipeline.LATCHED)
+        pose_pub.publish(messages.pose_in_base(p["object_pose"], p["base_frame"]))
+        self.create_subscription(MonitorStatus, pipeline.STATUS, self._status, loop)
+        self.server = ActionServer(self, ExecuteGrasp, pipeline.ACTION, self._execute,
+                                   goal_callback=self._accept_goal,
+                                   cancel_callback=lambda _: CancelResponse.ACCEPT)
+        self.goal: _Goal | None = None
+        self.latest: MonitorStatus | None = None
+        self.answered_ns = -1
+        self.last_setpoints: list = []
+        self.setpoints = {f: messages.pose_msg((0.0, 0.0), 0, self.p["frame_id"])
+                          for f in self.setpoint_pubs}
+        self.state = ExecutorStatus.IDLE
+        if p["lockstep"]:
+            self.participant = pipeline.Participant(self, "executor", [pipeline.STATUS],
+                                                    list(self.setpoint_pubs.values()))
+        else:
+            self.create_timer(p["period"], self._timer)
+
+    # ----------------------------------------------------------------- action
+    def destroy_node(self) -> None:
+        """Destroy the action server too: rclpy's ``destroy_node`` leaves waitables to the garbage
+        collector, and a still-referenced server keeps answering goals of a later run in the same
+        process ("more than one action server")."""
+        self.server.destroy()
+        super().destroy_node()
+
+    def _accept_goal(self, _: ExecuteGrasp.Goal) -> GoalResponse:
+        return GoalResponse.REJECT if self.goal is not None else GoalResponse.ACCEPT
+
+    async def _execute(self, handle: ServerGoalHandle) -> ExecuteGrasp.Result:
+        goal = messages.grasp_goal(handle.request)
+        problem = goal_problem(goal, list(self.devices))
+        if problem is not None:
+            handle.abort()
+            return messages.invalid_goal_result(problem)
+        self.goal = _Goal(GraspProgram(goal, self.limits, list(self.devices)), handle)
+        done = self.goal.done
+        if self.p["lockstep"] and self.latest is not None and \
+                messages.stamp_ns(self.latest.header.stamp) > self.answered_ns:
+            self._cycle(self.latest)
+        result = await done
+        if result.termination == ExecuteGrasp.Result.CANCELED:
+            handle.canceled()
+        elif result.success:
+            handle.succeed()
+        else:
+            handle.abort()
+        return result
+
+    # ----------------------------------------------------------------- cycles
+    def _status(self, msg: MonitorStatus) -> None:
+        ns = messages.stamp_ns(msg.header.stamp)
+        if ns == self.answered_ns:
+            for publisher, setpoint in self.last_setpoints:
+                publisher.publish(setpoint)
+        if ns <= self.answered_ns:
+            return
+        self.latest = msg
+        if self.p["lockstep"] and self.goal is not None:
+            self._cycle(msg)
+
+    def _timer(self) -> None:
+        if self.goal is not None and self.latest is not None:
+            self._cycle(self.latest, self.get_clock().now().nanoseconds)
+
+    def _cycle(self, msg: MonitorStatus, now_ns: int | None = None) -> None:
+        """One control cycle on status ``msg``; publish the setpoints, finish the goal if done."""
+        goal = self.goal
+        ns = messages.stamp_ns(msg.header.stamp)
+        if goal.start_ns is None:
+            goal.start_ns = ns
+        goal.events += msg.events
+        goal.since_feedback += msg.events
+        if goal.handle.is_cancel_requested:
+            goal.program.cancel()
+        obs = messages.observation(msg)
+        command = goal.program.step(obs, self.p["period"])
+        stamp = ns + self.period_ns if now_ns is None else now_ns
+        self.last_setpoints = [(self.setpoint_pubs[f],
+                                messages.fill_pose(self.setpoints[f], xy, stamp))
+                               for f, xy in command.setpoints.items()]
+        self.answered_ns = ns
+        for publisher, setpoint in self.last_setpoints:
+            publisher.publish(setpoint)
+        self._report(command, obs, ns)
+        if command.termination is not None:
+            self.goal = None
+            goal.done.set_result(messages.grasp_result(
+                goal.program, command, obs, goal.events, (ns - goal.start_ns) * 1e-9, SUCCESS))
+
+    def _report(self, command: Command, obs, ns: int) -> None:
+        """Executor status on state changes; action feedback every ``feedback_every`` cycles."""
+        goal = self.goal
+        state = command.state
+        if command.termination in SUCCESS:
+            state = ExecutorStatus.IDLE
+        elif command.termination not in (None, *HOLDS):
+            state = ExecutorStatus.ABORTED
+        if state != self.state:
+            self.state = state
+            self.status_pub.publish(messages.executor_status_msg(state, obs.depth,
+                                                                 command.message, ns))
+        program = goal.program
+        if program.ticks % self.p["feedback_every"] == 0 or command.termination is not None:
+            goal.handle.publish_feedback(messages.grasp_feedback(
+                command.state, obs, program.fingers, goal.since_feedback,
+                program.goal.relative_per_depth))
+            goal.since_feedback = []
+
+
+def main(args: list[str] | None = None) -> None:
+    """Run the executor until Ctrl-C or shutdown."""
+    run_node(ExecutorNode, args)
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,171 @@
+# Copyright 2026 squeeze_grasp_ros developers
+# SPDX-License-Identifier: Apache-2.0
+"""The monitor: contact configuration, events and alarms from fingertip wrenches and taxels.
+
+Run it with ``ros2 run squeeze_grasp_ros monitor --ros-args --params-file config/monitor.yaml``.
+Per finger (``finger_devices``) it subscribes to ``devices/<device>/{pose,wrench,tactile}``
+and runs :class:`..control.tracker.ContactTracker` once per tick:
+
+- lockstep (simulation): a tick closes when its ``sim/tick`` has arrived together with every
+  reading it lists (readings are matched by stamp, whatever order they arrive in); a reading
+  that was dropped is simply not listed, and the tracker judges staleness by stamps;
+- hardware (``lockstep: false``): a wall-clock timer at ``rate`` Hz uses the newest readings.
+
+Each tick it publishes the tick's events as one ``monitor/events`` array (when there are
+any), one ``monitor/alarms`` message per alarm episode (when an alarm of a type and finger
+becomes active; ``monitor/status`` lists the alarms active at every tick), the reconstructed
+``monitor/contact_state`` and, last, the ``monitor/status`` the executor acts on. A repeated
+``sim/tick`` (a re-sent tick) gets the same status again, nothing else. The planner's
+prediction (``planner/predicted_events``, latched) is compared with the observed
+events.
+"""
+from __future__ import annotations
+
+from typing import Any
+
+from geometry_msgs.msg import PoseStamped, WrenchStamped
+from rclpy.node import Node
+
+from squeeze_grasp_interfaces.msg import (Alarm, ContactEventArray, ContactState, MonitorStatus,
+                                          TactileArray, Tick)
+
+from squeeze_grasp_ros.ros import messages
+from squeeze_grasp_ros.control.tracker import ContactTracker, FingerSample, TrackerConfig
+from squeeze_grasp_ros.ros.nodes import pipeline, run_node
+
+PARAMETERS: dict[str, tuple[Any, str]] = {
+    "finger_devices": (["F1:barrett_f1", "F2:barrett_f3"], "finger:device of every fingertip"),
+    "streams": (["wrench", "tactile"], "sensor streams each finger has (staleness test)"),
+    "mu": (0.4, "friction coefficient of the fingertips"),
+    "load_threshold": (0.002, "a taxel is loaded above this normal force, N"),
+    "edge_tolerance": (1e-4, "a patch slides at cone usage >= 1 - edge_tolerance"),
+    "alarm_ratio": (0.9, "cone usage of every loaded taxel that raises slip_imminent"),
+    "match_margin": (0, "taxels by which patch ranges are widened to connect them over ticks"),
+    "stale_after": (0.0025, "age of a finger's newest reading that makes it stale, s"),
+    "weight": (0.0, "object weight for the pickup test, N (0: no pickup test)"),
+    "prediction_tolerance": (5e-4, "depth tolerance of the prediction comparison, m"),
+    "relative_per_depth": (0.0, "relative depth per unit depth, 1/m (reports)"),
+    "lockstep": (True, "close ticks on sim/tick (simulation) or on a wall-clock timer"),
+    "rate": (100.0, "hardware mode: status rate, Hz"),
+    "frame_id": (pipeline.FRAME, "object frame"),
+    "sensor_qos": ("reliable", "QoS of the readings: reliable (lockstep) or sensor_data"),
+    "qos_depth": (100, "history depth of the reliable topics"),
+}
+"""Parameter name -> (typed default, description); config/monitor.yaml sets them."""
+
+
+class MonitorNode(Node):
+    """Reactive contact-event tracker on fingertip sensors."""
+
+    def __init__(self, **kwargs: Any) -> None:
+        super().__init__("monitor", **kwargs)
+        self.p = p = pipeline.declare(self, PARAMETERS)
+        self.fingers = pipeline.parse_mapping(p["finger_devices"], "finger_devices")
+        self.tracker = ContactTracker(TrackerConfig(
+            p["mu"], p["load_threshold"], p["edge_tolerance"], p["alarm_ratio"],
+            p["match_margin"], p["stale_after"], p["weight"] or None,
+            p["prediction_tolerance"], p["relative_per_depth"]), list(self.fingers),
+            [s for s in p["streams"] if s])
+        loop = pipeline.loop_qos(p["qos_depth"])
+        sensors = pipeline.sensor_qos(p["sensor_qos"], p["qos_depth"])
+        types = {"pose": PoseStamped, "wrench": WrenchStamped, "tactile": TactileArray}
+        self.keys: dict[str, tuple[str, str]] = {}
+        for finger, device in self.fingers.items():
+            for stream, msg_type in types.items():
+                key = f"{device}/{stream}"
+                self.keys[key] = (finger, stream)
+                self.create_subscription(msg_type, pipeline.device_topic(device, stream),
+                                         lambda msg, k=key: self._reading(k, msg), sensors)
+        self.create_subscription(ContactEventArray, pipeline.PREDICTION, self._prediction,
+                                 pipeline.LATCHED)
+        self.event_pub = self.create_publisher(ContactEventArray, pipeline.EVENTS, loop)
+        self.alarm_pub = self.create_publisher(Alarm, pipeline.ALARMS, loop)
+        self.state_pub = self.create_publisher(ContactState, pipeline.CONTACT_STATE, loop)
+        self.status_pub = self.create_publisher(MonitorStatus, pipeline.STATUS, loop)
+        self.latest: dict[str, Any] = {}
+        self.buffer: dict[int, dict[str, Any]] = {}
+        self.expected: dict[int, set[str]] = {}
+        self.last_ns = -1
+        self.active_alarms: set[tuple[str, str]] = set()
+        self.last_status: MonitorStatus | None = None
+        if p["lockstep"]:
+            self.create_subscription(Tick, pipeline.TICK, self._tick, loop)
+            self.participant = pipeline.Participant(self, "monitor", [pipeline.TICK],
+                                                    [self.status_pub])
+        else:
+            self.create_timer(1.0 / p["rate"], self._timer)
+
+    # ----------------------------------------------------------------- inputs
+    def _prediction(self, msg: ContactEventArray) -> None:
+        self.tracker.set_prediction(messages.predicted_events(msg))
+
+    def _reading(self, key: str, msg: Any) -> None:
+        ns = messages.stamp_ns(msg.header.stamp)
+        if not self.p["lockstep"]:
+            self.latest[key] = msg
+            return
+        if ns <= self.last_ns:
+            return
+        self.buffer.setdefault(ns, {})[key] = msg
+        self._try_close(ns)
+
+    def _tick(self, msg: Tick) -> None:
+        ns = messages.stamp_ns(msg.header.stamp)
+        if ns == self.last_ns:
+            self.status_pub.publish(self.last_status)
+        if ns <= self.last_ns:
+            return
+        self.expected[ns] = set(msg.readings)
+        self._try_close(ns)
+
+    def _try_close(self, ns: int) -> None:
+        expected = self.expected.get(ns)
+        if expected is None or not expected <= self.buffer.get(ns, {}).keys():
+            return
+        self.latest.update(self.buffer.pop(ns, {}))
+        del self.expected[ns]
+        self._process(ns)
+
+    def _timer(self) -> None:
+        self._process(self.get_clock().now().nanoseconds)
+
+    # ----------------------------------------------------------------- one tick
+    def _samples(self) -> dict[str, FingerSample]:
+        """The newest reading of every finger and stream as tracker samples."""
+        fields: dict[str, dict[str, Any]] = {f: {} for f in self.fingers}
+        for key, msg in self.latest.items():
+            finger, stream = self.keys[key]
+            ns = messages.stamp_ns(msg.header.stamp)
+            if stream == "pose":
+                fields[finger]["position"] = messages.pose_position(msg)
+            elif stream == "wrench":
+                fields[finger].update(force=messages.wrench_force(msg), force_stamp_ns=ns)
+            else:
+                taxels = messages.tactile_readings(msg)
+                fields[finger].update(angles=taxels.angles, normal=taxels.normal,
+                                      tangential=taxels.tangential, tactile_stamp_ns=ns)
+        return {f: FingerSample(**v) for f, v in fields.items()}
+
+    def _process(self, ns: int) -> None:
+        out = self.tracker.update(ns, self._samples())
+        frame = self.p["frame_id"]
+        batch = [(self.event_pub, messages.tracked_events_msg(out))] if out.events else []
+        active = {(a.type, a.finger) for a in out.alarms}
+        batch += [(self.alarm_pub, messages.alarm_msg(a, ns)) for a in out.alarms
+                  if (a.type, a.finger) not in self.active_alarms]
+        self.active_alarms = active
+        batch.append((self.state_pub, messages.patches_state_msg(out, frame)))
+        self.last_status = messages.monitor_status_msg(out, frame)
+        batch.append((self.status_pub, self.last_status))
+        self.last_ns = ns
+        for publisher, msg in batch:
+            publisher.publish(msg)
+
+
+def main(args: list[str] | None = None) -> None:
+    """Run the monitor until Ctrl-C or shutdown."""
+    run_node(MonitorNode, args)
+
+
+if __name__ == "__main__":
+    main()

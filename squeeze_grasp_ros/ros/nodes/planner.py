@@ -1,0 +1,350 @@
+# Copyright 2026 squeeze_grasp_ros developers
+# SPDX-License-Identifier: Apache-2.0
+"""The planner node: squeezes, grasp maps, resistance and ring tests as ROS 2 services and actions.
+
+Run it with ``ros2 run squeeze_grasp_ros planner --ros-args --params-file config/planner.yaml``
+(or the ``planner`` console script). Services and actions live under the node's name:
+
+=========================  =======  ====================================================
+name                       kind     computation
+=========================  =======  ====================================================
+``~/load_object``          service  mesh, factor and cache a scene's object (worker)
+``~/plan_squeeze``         service  stable / pure squeeze at point contacts (inline)
+``~/grasp_map``            service  all-pairs grasp map of a loaded solid (worker)
+``~/plan_resistance``      service  optimal resistance to an adversary finger (worker)
+``~/ring_grasp_test``      service  ring grasp test and ring grasp map (worker)
+``~/event_squeeze``        service  event-driven squeeze, Algorithm 1 (worker)
+``~/grasp_map``            action   load + precompute + map with progress and cancel
+``~/event_squeeze``        action   event-driven squeeze with progress and cancel
+=========================  =======  ====================================================
+
+Threading (measured in docs/ros.md): the node is spun by a ``SingleThreadedExecutor`` in the
+main thread. Quick requests run inline in their callback. Long ones run on a worker pool: the
+service or action callback is a coroutine that awaits an rclpy future which the worker
+completes, so the executor keeps serving other requests meanwhile. Workers never touch rclpy
+objects except to complete their future; action feedback is queued and published from the
+executor thread.
+"""
+from __future__ import annotations
+
+import queue
+import threading
+from collections.abc import Callable
+from concurrent.futures import ThreadPoolExecutor
+from pathlib import Path
+from typing import Any, TypeVar
+
+from rcl_interfaces.msg import ParameterDescriptor
+from rclpy.action import ActionServer, CancelResponse
+from rclpy.action.server import ServerGoalHandle
+from rclpy.executors import SingleThreadedExecutor
+from rclpy.callback_groups import ReentrantCallbackGroup
+from rclpy.node import Node
+from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
+from rclpy.task import Future
+
+from squeeze_grasp_interfaces.action import EventSqueeze as EventSqueezeAction
+from squeeze_grasp_interfaces.action import GraspMap as GraspMapAction
+from squeeze_grasp_interfaces.srv import (EventSqueeze, GraspMap, LoadObject, PlanResistance,
+                                          PlanSqueeze, RingGraspTest)
+
+from squeeze_grasp_ros import planning
+from squeeze_grasp_ros.ros import messages
+from squeeze_grasp_ros.planning import Cancelled, ErrorCode, Limits
+from squeeze_grasp_ros.resources import share_dir
+from squeeze_grasp_ros.ros.nodes import run_node
+
+Response = TypeVar("Response")
+
+PARAMETERS: dict[str, tuple[Any, str]] = {
+    "max_nodes": (60_000, "largest solid mesh (nodes) the planner builds; larger scenes are "
+                          "refused as oversized"),
+    "max_spectral_nodes": (3_000, "largest mesh for the dense spectral solver route"),
+    "max_ring_elements": (1_000, "largest ring model (elements); its compliance is dense"),
+    "default_solver_route": ("factorized", "solver route when a request leaves it empty: "
+                                           "factorized or spectral"),
+    "cache_size": (8, "objects kept in the cache; the least recently used is evicted"),
+    "worker_threads": (2, "threads computing long requests (loads, maps, event squeezes)"),
+    "best_count": (10, "placements a grasp map returns when a request asks for 0"),
+    "min_step": (1e-5, "smallest event-squeeze substep, relative to the object size"),
+    "service_queue_depth": (100, "requests each service queues before DDS drops them"),
+    "max_pending": (16, "long requests (loads, maps, event squeezes) queued or running at "
+                        "once; more are answered BUSY at once"),
+    "allowed_roots": ([""], "folders whose files scene_path and a scene's outline file may "
+                            "name (symlinks and '..' resolved first); [''] = the package share "
+                            "folder and the node's working directory"),
+}
+"""Parameter name -> (typed default, description); config/planner.yaml sets the same names."""
+
+
+def _resume(_: Future) -> None:
+    """Done-callback of worker futures: scheduling it wakes the executor (see PlannerNode)."""
+
+
+class PlannerNode(Node):
+    """Planner services and actions backed by :mod:`squeeze_grasp_ros.planning`.
+
+    Parameters
+    ----------
+    **kwargs
+        Passed to :class:`rclpy.node.Node` (e.g. ``context``, ``parameter_overrides``).
+    """
+
+    def __init__(self, **kwargs: Any) -> None:
+        super().__init__("planner", **kwargs)
+        for name, (default, description) in PARAMETERS.items():
+            # float parameters also take YAML integers (``min_step: 1`` is an int in YAML)
+            self.declare_parameter(name, default, ParameterDescriptor(
+                description=description, dynamic_typing=isinstance(default, float)))
+        value = self._parameter
+        self.limits = Limits(max_nodes=value("max_nodes"),
+                             max_spectral_nodes=value("max_spectral_nodes"),
+                             max_ring_elements=value("max_ring_elements"),
+                             default_route=planning.solver_route(value("default_solver_route"),
+                                                                 Limits()),
+                             best_count=value("best_count"), min_step=float(value("min_step")))
+        roots = [Path(r) for r in value("allowed_roots") if r] or [share_dir(), Path.cwd()]
+        self.roots = list(dict.fromkeys(r.resolve() for r in roots))
+        self.cache = planning.ObjectCache(value("cache_size"))
+        self._pool = ThreadPoolExecutor(max_workers=value("worker_threads"),
+                                        thread_name_prefix="planner-worker")
+        self._stopping = threading.Event()
+        self._feedback: queue.SimpleQueue[tuple[ServerGoalHandle, Any]] = queue.SimpleQueue()
+
+        services = QoSProfile(history=HistoryPolicy.KEEP_LAST,
+                              depth=value("service_queue_depth"),
+                              reliability=ReliabilityPolicy.RELIABLE,
+                              durability=DurabilityPolicy.VOLATILE)
+        self._pending = 0
+        self._pending_lock = threading.Lock()
+        # Reentrant: a long request awaiting its worker must not hold the node's default
+        # (mutually exclusive) group, or every other request waits for it (measured: a
+        # plan_squeeze waited the whole 7 s of an event_squeeze).
+        self._group = ReentrantCallbackGroup()
+        for srv_type, name, callback in (
+                (LoadObject, "load_object", self._load_object),
+                (PlanSqueeze, "plan_squeeze", self._plan_squeeze),
+                (GraspMap, "grasp_map", self._grasp_map),
+                (PlanResistance, "plan_resistance", self._plan_resistance),
+                (RingGraspTest, "ring_grasp_test", self._ring_grasp_test),
+                (EventSqueeze, "event_squeeze", self._event_squeeze)):
+            self.create_service(srv_type, f"~/{name}", callback, qos_profile=services,
+                                callback_group=self._group)
+        self._actions = [
+            ActionServer(self, GraspMapAction, "~/grasp_map", self._execute_grasp_map,
+                         cancel_callback=self._accept_cancel, callback_group=self._group),
+            ActionServer(self, EventSqueezeAction, "~/event_squeeze",
+                         self._execute_event_squeeze, cancel_callback=self._accept_cancel,
+                         callback_group=self._group),
+        ]
+        self.get_logger().info(f"planner ready: {self.limits}; files from "
+                               f"{[str(r) for r in self.roots]}")
+
+    def _parameter(self, name: str) -> Any:
+        """The value of a declared parameter (an int given for a float is accepted)."""
+        return self.get_parameter(name).value
+
+    # ------------------------------------------------------------------ services
+
+    async def _load_object(self, request: LoadObject.Request,
+                           response: LoadObject.Response) -> LoadObject.Response:
+        """Mesh, factor and cache the scene's object on a worker."""
+        def load() -> LoadObject.Response:
+            source = planning.read_scene(request.scene_yaml, request.scene_path, self.roots)
+            loaded, cached = planning.load_cached(self.cache, source, request.object_id,
+                                                  request.solver_route, self.limits)
+            return messages.load_object_response(loaded, cached, request.return_model)
+        return await self._in_worker(LoadObject.Response, load)
+
+    def _plan_squeeze(self, request: PlanSqueeze.Request,
+                      response: PlanSqueeze.Response) -> PlanSqueeze.Response:
+        """Stable or pure squeeze of a cached object, inline (milliseconds)."""
+        return self._answer(PlanSqueeze.Response, lambda: messages.plan_squeeze_response(
+            planning.squeeze_plan(self.cache.get(request.object_id), request.contacts,
+                                  request.squeeze_type, request.depth)))
+
+    async def _grasp_map(self, request: GraspMap.Request,
+                         response: GraspMap.Response) -> GraspMap.Response:
+        """All-pairs grasp map of a cached object on a worker."""
+        def compute() -> GraspMap.Response:
+            gmap = planning.object_grasp_map(self.cache.get(request.object_id), request.mu)
+            return messages.success(GraspMap.Response, map=messages.grasp_map_data(
+                gmap, request.object_id, planning.best_count(request.best_count, self.limits),
+                request.full_matrices))
+        return await self._in_worker(GraspMap.Response, compute)
+
+    async def _plan_resistance(self, request: PlanResistance.Request,
+                               response: PlanResistance.Response) -> PlanResistance.Response:
+        """Optimal resistance on a worker (fixed contacts: milliseconds; friction: a squeeze
+        and Algorithm 2)."""
+        a = request.a
+        return await self._in_worker(PlanResistance.Response, lambda: (
+            messages.plan_resistance_response(planning.resistance_plan(
+                self.cache.get(request.object_id), request.contacts, (a.x, a.y, a.z),
+                request.mode, request.contact_model, request.segment_half_width,
+                request.directions, request.adversary_tip_radius, self.limits))))
+
+    async def _ring_grasp_test(self, request: RingGraspTest.Request,
+                               response: RingGraspTest.Response) -> RingGraspTest.Response:
+        """Ring grasp test (and all-pairs map) on a worker."""
+        def compute() -> RingGraspTest.Response:
+            test = planning.ring_grasp_test(
+                self.cache.get(request.object_id), request.contacts, request.squeeze_type,
+                request.mu, request.strain_limit, request.relative_depth, request.all_pairs)
+            return messages.ring_grasp_test_response(
+                test, planning.best_count(request.best_count, self.limits))
+        return await self._in_worker(RingGraspTest.Response, compute)
+
+    async def _event_squeeze(self, request: EventSqueeze.Request,
+                             response: EventSqueeze.Response) -> EventSqueeze.Response:
+        """Event-driven squeeze on a worker."""
+        return await self._in_worker(EventSqueeze.Response,
+                                     lambda: self._event_squeeze_result(EventSqueeze.Response,
+                                                                        request))
+
+    # ------------------------------------------------------------------ actions
+
+    def _accept_cancel(self, goal_handle: ServerGoalHandle) -> CancelResponse:
+        """Accept every cancel request; the worker stops at its next stage."""
+        return CancelResponse.ACCEPT
+
+    async def _execute_grasp_map(self, goal_handle: ServerGoalHandle) -> GraspMapAction.Result:
+        """Load (when the goal has a scene), precompute and map, with a feedback per stage."""
+        goal = goal_handle.request
+        report = self._reporter(goal_handle, messages.grasp_map_feedback)
+
+        def compute() -> GraspMapAction.Result:
+            object_id = goal.object_id
+            stages = 1
+            if goal.scene_yaml or goal.scene_path:
+                source = planning.read_scene(goal.scene_yaml, goal.scene_path, self.roots)
+                stages += len(planning.RING_STAGES if source.scene.object.model == "ring"
+                              else planning.SOLID_STAGES)
+                loaded, _ = planning.load_cached(
+                    self.cache, source, object_id, goal.solver_route, self.limits,
+                    lambda stage, index, count, nodes: report(stage, index, stages, nodes))
+                object_id = loaded.object_id
+            loaded = self.cache.get(object_id)
+            report("grasp map", stages - 1, stages, loaded.num_nodes)
+            gmap = planning.object_grasp_map(loaded, goal.mu)
+            best = planning.best_count(goal.best_count, self.limits)
+            return messages.success(GraspMapAction.Result, map=messages.grasp_map_data(
+                gmap, object_id, best, goal.full_matrices))
+        return self._finish(goal_handle, await self._in_worker(GraspMapAction.Result, compute))
+
+    async def _execute_event_squeeze(self,
+                                     goal_handle: ServerGoalHandle) -> EventSqueezeAction.Result:
+        """Event-driven squeeze with the completed fraction as feedback."""
+        report = self._reporter(goal_handle, messages.event_squeeze_feedback)
+        result = await self._in_worker(
+            EventSqueezeAction.Result,
+            lambda: self._event_squeeze_result(EventSqueezeAction.Result, goal_handle.request,
+                                               report))
+        return self._finish(goal_handle, result)
+
+    # ------------------------------------------------------------------ plumbing
+
+    def _event_squeeze_result(self, response_type: type[Response], request: Any,
+                              progress: Callable[[float], None] | None = None) -> Response:
+        """The event squeeze of a service request or action goal as ``response_type``."""
+        loaded = self.cache.get(request.object_id)
+        result = planning.event_squeeze_run(
+            loaded, request.contacts, request.squeeze_type, request.depth,
+            request.relative_depth, request.step, request.event_tol, self.limits, progress)
+        return messages.success(response_type,
+                                squeeze=messages.event_squeeze_data(result, loaded.object_id))
+
+    def _answer(self, response_type: type[Response], compute: Callable[[], Response]) -> Response:
+        """``compute()``, or a failure response naming the reason; never raises for a request."""
+        try:
+            return compute()
+        except Exception as exc:
+            code, message = planning.classify(exc)
+            if code == ErrorCode.INTERNAL_ERROR:
+                self.get_logger().error(f"{response_type.__name__}: {message}")
+            else:
+                self.get_logger().info(f"refused ({code.name}): {message}")
+            return messages.failure(response_type, code, message)
+
+    async def _in_worker(self, response_type: type[Response],
+                         compute: Callable[[], Response]) -> Response:
+        """Run ``compute`` on the worker pool; the executor serves other requests meanwhile.
+
+        The worker completes an rclpy future. In rclpy 7.1.6 a coroutine awaiting a future is
+        resumed only when the executor wakes up; completing a future that has a done-callback
+        schedules that callback as a task, which wakes the executor at once (measured: the
+        response follows the worker within a millisecond, with no busy loop).
+        """
+        with self._pending_lock:
+            if self._pending >= self._parameter("max_pending"):
+                return messages.failure(response_type, ErrorCode.BUSY,
+                                        f"planner busy: {self._pending} long requests queued or "
+                                        f"running (max_pending); retry later")
+            self._pending += 1
+
+        def work() -> None:
+            try:
+                future.set_result(self._answer(response_type, compute))
+            finally:
+                with self._pending_lock:
+                    self._pending -= 1
+        future = Future(executor=self.executor)
+        future.add_done_callback(_resume)
+        try:
+            self._pool.submit(work)
+        except RuntimeError:
+            with self._pending_lock:
+                self._pending -= 1
+            return messages.failure(response_type, ErrorCode.CANCELLED,
+                                    "the planner is shutting down")
+        return await future
+
+    def _reporter(self, goal_handle: ServerGoalHandle,
+                  feedback: Callable[..., Any]) -> Callable[..., None]:
+        """A progress callback for a worker: queues ``feedback(*args)`` for the goal, or raises
+        :class:`Cancelled` when the goal is being cancelled or the node is shutting down."""
+        def report(*args: Any) -> None:
+            if goal_handle.is_cancel_requested or self._stopping.is_set():
+                raise Cancelled("cancelled by the client" if goal_handle.is_cancel_requested
+                                else "the planner is shutting down")
+            self._feedback.put((goal_handle, feedback(*args)))
+            self.executor.create_task(self._publish_feedback)
+        return report
+
+    def _publish_feedback(self) -> None:
+        """Publish queued feedback in order (runs on the executor thread)."""
+        while True:
+            try:
+                goal_handle, message = self._feedback.get_nowait()
+            except queue.Empty:
+                return
+            if goal_handle.is_active:
+                goal_handle.publish_feedback(message)
+
+    def _finish(self, goal_handle: ServerGoalHandle, result: Response) -> Response:
+        """Publish pending feedback, then end the goal as succeeded, canceled or aborted."""
+        self._publish_feedback()
+        if result.success:
+            goal_handle.succeed()
+        elif result.error_code == ErrorCode.CANCELLED and goal_handle.is_cancel_requested:
+            goal_handle.canceled()
+        else:
+            goal_handle.abort()
+        return result
+
+    def destroy_node(self) -> None:
+        """Stop the workers (running computations stop at their next stage), then the node."""
+        self._stopping.set()
+        self._pool.shutdown(wait=True, cancel_futures=True)
+        for server in self._actions:
+            server.destroy()
+        super().destroy_node()
+
+
+def main(args: list[str] | None = None) -> None:
+    """Run the planner on a SingleThreadedExecutor in the main thread until Ctrl-C or shutdown."""
+    run_node(PlannerNode, args, SingleThreadedExecutor)
+
+
+if __name__ == "__main__":
+    main()

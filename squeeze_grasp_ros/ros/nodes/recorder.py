@@ -1,0 +1,183 @@
+# Copyright 2026 squeeze_grasp_ros developers
+# SPDX-License-Identifier: Apache-2.0
+"""The recorder: every topic of a run, as raw CDR, into a rosbag2 bag with MCAP storage.
+
+Run it with ``ros2 run squeeze_grasp_ros recorder --ros-args --params-file config/recorder.yaml
+-p output:=runs/foam``. It subscribes with ``raw=True`` to the pipeline topics of its
+``devices`` (:func:`.pipeline.pipeline_topics`) plus ``extra_topics`` and writes the bytes DDS
+delivered with :class:`..recording.bag.BagWriter`; each topic's channel is created at its first
+message with the QoS its publishers offer.
+
+Log times: a message whose type starts with a header or a time (nearly all of them) is logged
+at its own stamp, the sim time of its tick, so the same run gives the same recording whatever
+the arrival order; others (action feedback and status, markers) at the recorder's clock.
+Every stamped topic but ``monitor/alarms`` carries at most one message per stamp, so a message
+whose stamp is among the last few of its topic is a re-sent copy (a lost tick re-sent by
+``sim_hardware``, the status or setpoints answering it) and is not written again. (Comparing
+bytes would not do: the CDR alignment padding is not zeroed, so two serialisations of one
+message can differ.)
+
+In lockstep it takes part in the start-up handshake and reports on ``recorder/progress`` the
+newest tick it has written, every ``progress_every`` ticks, so ``sim_hardware`` never runs more
+than its ``recorder_window`` ahead (no message is lost to a full history); a wall-clock timer
+repeats the newest tick 20 times a second, so the report of the last tick of a run arrives even
+if one copy is lost. On Ctrl-C / SIGINT it first writes what has
+already arrived, then ``close`` writes the MCAP summary and ``metadata.yaml``.
+"""
+from __future__ import annotations
+
+import struct
+import time
+from collections import deque
+from typing import Any
+
+import yaml
+from rclpy.node import Node
+from rclpy.qos import DurabilityPolicy, HistoryPolicy, ReliabilityPolicy
+from std_msgs.msg import Header
+
+from squeeze_grasp_ros.ros import messages
+from squeeze_grasp_ros.ros.recording.bag import BagWriter, qos_dict
+from squeeze_grasp_ros.ros.recording.schema import starts_with_stamp
+from squeeze_grasp_ros.ros.nodes import pipeline, run_node
+
+PARAMETERS: dict[str, tuple[Any, str]] = {
+    "output": ("", "bag folder to create (required; must not exist or be empty)"),
+    "devices": (["barrett_f1", "barrett_f3"], "devices whose topics are recorded"),
+    "extra_topics": ([""], "more topics to record, as 'name pkg/msg/Type' ('' = none)"),
+    "include_hidden_topics": (False, "also record the executor action's hidden topics "
+                                     "(_action/feedback, _action/status), as rosbag2 does only "
+                                     "with --include-hidden-topics"),
+    "compression": ("zstd", "chunk compression: zstd, lz4 or none"),
+    "chunk_size": (262144, "uncompressed chunk size written out when full, bytes"),
+    "custom_data": ("{}", "YAML mapping of strings stored in metadata.yaml custom_data"),
+    "lockstep": (True, "take part in the start-up handshake and report progress"),
+    "progress_every": (10, "ticks between recorder/progress reports"),
+    "sensor_qos": ("reliable", "QoS of the readings: reliable (lockstep) or sensor_data"),
+    "qos_depth": (1000, "history depth of the subscriptions"),
+}
+"""Parameter name -> (typed default, description); config/recorder.yaml sets them."""
+
+DUPLICATE_WINDOW = 16
+"""Stamps per topic remembered to drop re-sent copies."""
+POLICY_NAMES = {
+    "history": {HistoryPolicy.KEEP_LAST: "keep_last", HistoryPolicy.KEEP_ALL: "keep_all"},
+    "reliability": {ReliabilityPolicy.RELIABLE: "reliable",
+                    ReliabilityPolicy.BEST_EFFORT: "best_effort"},
+    "durability": {DurabilityPolicy.VOLATILE: "volatile",
+                   DurabilityPolicy.TRANSIENT_LOCAL: "transient_local"},
+}
+"""rclpy QoS policies -> the names rosbag2 v9 writes (per policy: their integer values overlap)."""
+
+
+def cdr_stamp_ns(data: bytes) -> int:
+    """Stamp (ns) at the start of a CDR message whose first field is a header or a time."""
+    sec, nanosec = struct.unpack_from("<iI" if data[1] & 1 else ">iI", data, 4)
+    return sec * 1_000_000_000 + nanosec
+
+
+class RecorderNode(Node):
+    """Raw-subscription recorder writing a rosbag2 MCAP bag."""
+
+    def __init__(self, **kwargs: Any) -> None:
+        super().__init__("recorder", **kwargs)
+        self.p = p = pipeline.declare(self, PARAMETERS)
+        if not p["output"]:
+            raise ValueError("parameter 'output' (the bag folder) is required")
+        custom = yaml.safe_load(p["custom_data"]) or {}
+        self.writer = BagWriter(p["output"], p["compression"], p["chunk_size"],
+                                {str(k): str(v) for k, v in custom.items()})
+        topics = pipeline.pipeline_topics(p["devices"], hidden=p["include_hidden_topics"])
+        for entry in p["extra_topics"]:
+            if entry.strip():
+                name, type_name = entry.split()
+                topics[name] = type_name
+        self.types = topics
+        self.stamped = {name: starts_with_stamp(t) for name, t in topics.items()}
+        self.unique = {name for name, stamped in self.stamped.items()
+                       if stamped and name != "/" + pipeline.ALARMS}
+        self.recent = {name: deque(maxlen=DUPLICATE_WINDOW) for name in self.unique}
+        self.duplicates = 0
+        self.written = 0
+        self.ticks = 0
+        self.newest_tick_ns = -1
+        self.reported_ns = -1
+        latched = {"/" + pipeline.PREDICTION, "/" + pipeline.OBJECT_POSE,
+                   f"/{pipeline.ACTION}/_action/status"}
+        sensors = {name for name in topics if name.rsplit("/", 1)[-1] in pipeline.STREAMS}
+        for name, type_name in topics.items():
+            qos = pipeline.LATCHED if name in latched else (
+                pipeline.sensor_qos(p["sensor_qos"], p["qos_depth"]) if name in sensors
+                else pipeline.loop_qos(p["qos_depth"]))
+            self.create_subscription(pipeline.message_type(type_name), name,
+                                     lambda data, n=name: self._record(n, data), qos, raw=True)
+        self.progress_pub = self.create_publisher(Header, pipeline.RECORDER_PROGRESS,
+                                                  pipeline.loop_qos(10))
+        if p["lockstep"]:
+            self.participant = pipeline.Participant(self, "recorder", [pipeline.TICK],
+                                                    [self.progress_pub])
+            pipeline.wall_timer(self, 0.05, self._repeat_report)
+
+    def _offered_qos(self, topic: str) -> list[dict]:
+        def name(policy: str, value) -> str:
+            return POLICY_NAMES[policy].get(value, "unknown")
+        return [qos_dict(name("history", q.history), q.depth, name("reliability", q.reliability),
+                         name("durability", q.durability))
+                for q in (i.qos_profile for i in self.get_publishers_info_by_topic(topic))]
+
+    def _record(self, topic: str, data: bytes) -> None:
+        ns = cdr_stamp_ns(data) if self.stamped[topic] else self.get_clock().now().nanoseconds
+        if topic in self.unique:
+            if ns in self.recent[topic]:
+                self.duplicates += 1
+                return
+            self.recent[topic].append(ns)
+        if topic not in self.writer.topics:
+            self.writer.add_topic(topic, self.types[topic], self._offered_qos(topic))
+        self.writer.write(topic, data, ns)
+        self.written += 1
+        if topic == "/" + pipeline.TICK:
+            self.ticks += 1
+            self.newest_tick_ns = ns
+            if self.ticks % self.p["progress_every"] == 0:
+                self._report()
+
+    def _report(self) -> None:
+        """Publish the newest tick written, if not reported yet."""
+        if self.newest_tick_ns > self.reported_ns:
+            self._repeat_report()
+
+    def _repeat_report(self) -> None:
+        """Publish the newest tick written (again: a lost report is repeated by the timer)."""
+        if self.newest_tick_ns >= 0:
+            self.reported_ns = self.newest_tick_ns
+            self.progress_pub.publish(messages.header(self.newest_tick_ns))
+
+    def drain(self, executor, idle: float = 0.05) -> None:
+        """Write what has already arrived: spin ``executor`` until ``idle`` wall-clock seconds
+        pass without a new message written.
+
+        Idleness is judged by what is written, not by the executor returning early: timers
+        (this node's progress timer has a period of ``idle``) and re-sent ticks (dropped as
+        duplicates) keep an executor busy forever. The executor is always spun with the same
+        timeout (``SingleThreadedExecutor`` discards its ready entities when it changes).
+        """
+        while True:
+            written, until = self.written, time.monotonic() + idle
+            while time.monotonic() < until:
+                executor.spin_once(idle / 5.0)
+            if self.written == written:
+                return
+
+    def close(self) -> None:
+        """Finish the recording (summary and metadata.yaml); safe to call twice."""
+        self.writer.close()
+
+
+def main(args: list[str] | None = None) -> None:
+    """Record until Ctrl-C or shutdown, then finish the bag."""
+    run_node(RecorderNode, args)
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,206 @@
+# Copyright 2026 squeeze_grasp_ros developers
+# SPDX-License-Identifier: Apache-2.0
+"""The simulated hardware: Barrett fingers, Cobra arm, pusher and fingertip sensors in lockstep.
+
+Run it with ``ros2 run squeeze_grasp_ros sim_hardware --ros-args --params-file
+config/sim_hardware.yaml -p scene:=config/scenes/foam_square.yaml``. It owns ``/clock`` and
+advances it in lockstep (docs/design.md §4), driven by messages, never by timers:
+
+1. after the start-up handshake (``sim/hello`` / ``sim/ready``) it publishes tick 0;
+2. a tick k is ``/clock`` = t_k, every device's ``pose``, ``wrench`` and ``tactile`` reading
+   stamped t_k (a reading dropped by the sensor_dropout effect is skipped), the ground-truth
+   events of the tick as one ``sim/events`` array (with the termination reason at the tick the
+   world ends), the ground-truth state (``sim/state``), markers at ``display_rate``, and last
+   ``sim/tick`` listing the readings it published;
+3. when every device's setpoint stamped after t_k has arrived (and the recorder is no more than
+   ``recorder_window`` ticks behind), the world steps (:class:`..sim.world.SimWorld`) and
+   tick k+1 follows.
+
+If the loop does not close within ``resend_timeout`` wall-clock seconds, tick k is published
+again, message for message except the markers (receivers act on stamps, so this is idempotent;
+every re-sent topic carries one message per stamp, which is how the recorder drops the copies).
+"""
+from __future__ import annotations
+
+import time
+from typing import Any
+
+import numpy as np
+from geometry_msgs.msg import PoseStamped, WrenchStamped
+from rclpy.node import Node
+from rosgraph_msgs.msg import Clock
+from std_msgs.msg import Header
+from visualization_msgs.msg import MarkerArray
+
+from squeeze_grasp_interfaces.msg import ContactEventArray, SimState, TactileArray, Tick
+
+from squeeze_grasp_ros.ros import messages
+from squeeze_grasp_ros.scene import load_scene
+from squeeze_grasp_ros.sim.world import SimWorld, TickOutput
+from squeeze_grasp_ros.ros.nodes import pipeline, run_node
+
+PARAMETERS: dict[str, tuple[Any, str]] = {
+    "scene": ("", "scene YAML file the world is built from (required)"),
+    "frame_id": (pipeline.FRAME, "object frame of poses and markers"),
+    "sensor_qos": ("reliable", "QoS of the readings: reliable (lockstep) or sensor_data"),
+    "qos_depth": (100, "history depth of the reliable topics"),
+    "display_rate": (30.0, "MarkerArray rate in Hz of sim time (0: no markers)"),
+    "participants": (["monitor", "executor"], "nodes whose sim/ready starts tick 0"),
+    "handshake_period": (0.05, "wall-clock seconds between start-up hellos"),
+    "resend_timeout": (1.0, "wall-clock seconds without progress before a tick is re-sent"),
+    "recorder_window": (50, "ticks the recorder may lag behind (if 'recorder' participates)"),
+}
+"""Parameter name -> (typed default, description); config/sim_hardware.yaml sets them."""
+
+
+class SimHardwareNode(Node):
+    """Lockstep simulated hardware backed by :class:`..sim.world.SimWorld`.
+
+    Parameters
+    ----------
+    world : SimWorld, optional
+        A prebuilt world (default: built from the ``scene`` parameter).
+    **kwargs
+        Passed to :class:`rclpy.node.Node`.
+    """
+
+    def __init__(self, world: SimWorld | None = None, **kwargs: Any) -> None:
+        super().__init__("sim_hardware", **kwargs)
+        self.p = pipeline.declare(self, PARAMETERS)
+        if world is None:
+            if not self.p["scene"]:
+                raise ValueError("parameter 'scene' (a scene YAML file) is required")
+            world = SimWorld(load_scene(self.p["scene"]))
+        self.world = world
+        self.frame = self.p["frame_id"]
+        loop = pipeline.loop_qos(self.p["qos_depth"])
+        sensors = pipeline.sensor_qos(self.p["sensor_qos"], self.p["qos_depth"])
+        self.devices = {f: world.devices[f].name for f in world.fingers}
+        pub = self.create_publisher
+        self.clock_pub = pub(Clock, pipeline.CLOCK, loop)
+        self.pose_pubs = {f: pub(PoseStamped, pipeline.device_topic(d, "pose"), sensors)
+                          for f, d in self.devices.items()}
+        self.wrench_pubs = {f: pub(WrenchStamped, pipeline.device_topic(d, "wrench"), sensors)
+                            for f, d in self.devices.items() if world.scene.has("force_sensing")}
+        self.tactile_pubs = {f: pub(TactileArray, pipeline.device_topic(d, "tactile"), sensors)
+                             for f, d in self.devices.items() if f in world.layouts}
+        self.msgs = {f: self._reading_messages(f) for f in self.devices}
+        self.tick_pub = pub(Tick, pipeline.TICK, loop)
+        self.state_pub = pub(SimState, pipeline.SIM_STATE, loop)
+        self.event_pub = pub(ContactEventArray, pipeline.SIM_EVENTS, loop)
+        self.marker_pub = pub(MarkerArray, pipeline.MARKERS, loop)
+        for finger, device in self.devices.items():
+            self.create_subscription(PoseStamped, pipeline.device_topic(device, "setpoint"),
+                                     lambda msg, f=finger: self._setpoint(f, msg), loop)
+        self.flow_control = "recorder" in self.p["participants"]
+        self.recorder_ns = -1
+        self.create_subscription(Header, pipeline.RECORDER_PROGRESS, self._progress, loop)
+        self.pending: dict = {}
+        self.current: list = []
+        self.now_ns = -1
+        self.ended = False
+        self.last_progress = time.monotonic()
+        self.ticks_published = 0
+        self.resends = 0
+        self.handshake = pipeline.Handshake(self, self.p["participants"],
+                                            self.p["handshake_period"], self._start)
+        pipeline.wall_timer(self, max(self.p["resend_timeout"] / 2.0, 1e-3), self._check_stalled)
+
+    def _reading_messages(self, finger: str) -> dict[str, Any]:
+        """One message per reading of ``finger``, refilled every tick (frames and taxel
+        angles set once)."""
+        tip = f"{finger}_tip"
+        out: dict[str, Any] = {"pose": messages.pose_msg((0.0, 0.0), 0, self.frame),
+                               "wrench": messages.wrench_msg(np.zeros(3), np.zeros(3), 0, tip)}
+        if finger in self.world.layouts:
+            angles = self.world.layouts[finger].angles
+            out["tactile"] = messages.tactile_array_msg(messages.TactileReadings(
+                finger, angles, np.zeros_like(angles), np.zeros_like(angles)),
+                messages.header(0, tip))
+        return out
+
+    # ----------------------------------------------------------------- the loop
+    def _start(self) -> None:
+        self.get_logger().info(f"lockstep start: fingers {self.devices}, dt {self.world.dt} s")
+        self._publish(self.world.start())
+
+    def _setpoint(self, finger: str, msg: PoseStamped) -> None:
+        if self.now_ns < 0 or messages.stamp_ns(msg.header.stamp) <= self.now_ns:
+            return
+        self.pending[finger] = messages.pose_position(msg)
+        self._try_step()
+
+    def _progress(self, msg: Header) -> None:
+        self.recorder_ns = max(self.recorder_ns, messages.stamp_ns(msg.stamp))
+        self._try_step()
+
+    def _try_step(self) -> None:
+        if len(self.pending) < len(self.devices):
+            return
+        window = self.p["recorder_window"] * self.world.dt_ns
+        if self.flow_control and self.recorder_ns < self.now_ns - window:
+            return
+        setpoints, self.pending = self.pending, {}
+        self._publish(self.world.step(setpoints))
+
+    def _publish(self, out: TickOutput) -> None:
+        """Publish tick ``out`` (clock first, sim/tick last) and keep it for a re-send.
+
+        The per-device readings are refilled in place (one message object per publisher);
+        markers are built only at the display rate and only while somebody subscribes.
+        """
+        ns, frame = out.stamp_ns, self.frame
+        batch = [(self.clock_pub, messages.clock_msg(ns))]
+        readings = []
+        for r in out.readings:
+            device, msgs = self.devices[r.finger], self.msgs[r.finger]
+            batch.append((self.pose_pubs[r.finger],
+                          messages.fill_pose(msgs["pose"], r.position, ns)))
+            readings.append(f"{device}/pose")
+            if r.force is not None:
+                batch.append((self.wrench_pubs[r.finger],
+                              messages.fill_wrench(msgs["wrench"], r.force, r.torque, ns)))
+                readings.append(f"{device}/wrench")
+            if r.normal is not None:
+                batch.append((self.tactile_pubs[r.finger],
+                              messages.fill_tactile(msgs["tactile"], r.normal, r.tangential, ns)))
+                readings.append(f"{device}/tactile")
+        ending = out.termination is not None and not self.ended
+        self.ended = self.ended or ending
+        if out.events or ending:
+            batch.append((self.event_pub, messages.sim_events_msg(
+                out.events, out.termination if ending else "", out.state, ns)))
+        batch.append((self.state_pub, messages.sim_state_msg(out.state, self.world.fingers,
+                                                             out.termination, ns, frame)))
+        tick = (self.tick_pub, messages.tick_msg(out.index, ns, readings))
+        self.current, self.now_ns = batch + [tick], ns
+        if self._display_due(out.index) and self.marker_pub.get_subscription_count() > 0:
+            batch.append((self.marker_pub, messages.world_markers(self.world.view(), ns, frame)))
+        self.last_progress = time.monotonic()
+        self.ticks_published += 1
+        for publisher, msg in batch + [tick]:
+            publisher.publish(msg)
+
+    def _display_due(self, index: int) -> bool:
+        rate = self.p["display_rate"]
+        if rate <= 0.0:
+            return False
+        frames = (index * self.world.dt * rate, (index - 1) * self.world.dt * rate)
+        return index == 0 or int(frames[0]) > int(frames[1])
+
+    def _check_stalled(self) -> None:
+        """Re-send the current tick if the loop has not closed for ``resend_timeout`` s."""
+        if self.current and time.monotonic() - self.last_progress > self.p["resend_timeout"]:
+            self.resends += 1
+            self.last_progress = time.monotonic()
+            for publisher, msg in self.current:
+                publisher.publish(msg)
+
+
+def main(args: list[str] | None = None) -> None:
+    """Run the simulated hardware until Ctrl-C or shutdown."""
+    run_node(SimHardwareNode, args)
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,347 @@
+# Copyright 2026 squeeze_grasp_ros developers
+# SPDX-License-Identifier: Apache-2.0
+"""rosbag2 bags with MCAP storage: written from raw CDR with the ``mcap`` library, and read back.
+
+A bag is a folder with ``metadata.yaml`` (rosbag2 metadata version 9, Jazzy) and one
+``<folder name>_0.mcap``. Inside the MCAP (profile ``ros2``): one schema per type (encoding
+``ros2msg``, the complete message definition of :mod:`.schema`), one channel per topic
+(message encoding ``cdr``; metadata ``offered_qos_profiles`` as YAML and ``topic_type_hash``),
+messages with log and publish times in ns, chunks (compressed with zstd, lz4 or not at all)
+written to the file as soon as they fill, a ``rosbag2`` metadata record whose
+``serialized_metadata`` is the YAML of ``metadata.yaml``, and the summary with statistics.
+:meth:`BagWriter.close` writes the summary and ``metadata.yaml``; call it from a ``finally`` (or
+a SIGINT handler) and an interrupted run leaves a complete recording.
+
+:func:`read_bag` reads our bags and those of other tools with the same layout: a folder with
+``metadata.yaml`` and MCAP or SQLite3 (``.db3``) storage, or a bare ``.mcap`` file.
+"""
+from __future__ import annotations
+
+import io
+import sqlite3
+from collections import Counter
+from collections.abc import Iterator, Mapping, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+
+import yaml
+from mcap.exceptions import McapError
+from mcap.reader import make_reader
+from mcap.records import Channel, Message, Schema
+from mcap.stream_reader import StreamReader
+from mcap.writer import CompressionType, Writer
+
+from squeeze_grasp_ros.inputs import InputError, load_yaml, read_text
+from squeeze_grasp_ros.ros.recording.schema import message_definition, type_hash
+
+METADATA_VERSION = 9
+COMPRESSION = {"zstd": CompressionType.ZSTD, "lz4": CompressionType.LZ4,
+               "none": CompressionType.NONE}
+INFINITE = {"sec": 9223372036, "nsec": 854775807}
+"""rosbag2's rendering of an unset (infinite) QoS duration."""
+
+
+class _PlainDumper(yaml.SafeDumper):
+    """YAML without anchors and aliases (rosbag2's parser expects plain mappings)."""
+
+    def ignore_aliases(self, data) -> bool:
+        return True
+
+
+def plain_yaml(data) -> str:
+    """YAML text of ``data`` without anchors and aliases (rcl and rosbag2 refuse them)."""
+    return yaml.dump(data, Dumper=_PlainDumper, sort_keys=False)
+
+
+class BagError(ValueError):
+    """A path is not a readable bag."""
+
+
+def qos_dict(history: str, depth: int, reliability: str, durability: str) -> dict:
+    """One offered QoS profile as rosbag2 v9 writes it (names lower case, durations infinite)."""
+    return {"history": history, "depth": int(depth), "reliability": reliability,
+            "durability": durability, "deadline": dict(INFINITE), "lifespan": dict(INFINITE),
+            "liveliness": "automatic", "liveliness_lease_duration": dict(INFINITE),
+            "avoid_ros_namespace_conventions": False}
+
+
+class _Direct(io.IOBase):
+    """A write-through file for the MCAP writer: every record goes to the OS at once."""
+
+    def __init__(self, path: Path) -> None:
+        self._file = open(path, "wb", buffering=0)  # noqa: SIM115 - closed by close()
+
+    def write(self, data: bytes) -> int:
+        view = memoryview(data)
+        while view:
+            view = view[self._file.write(view):]
+        return len(data)
+
+    def tell(self) -> int:
+        return self._file.tell()
+
+    def close(self) -> None:
+        self._file.close()
+        super().close()
+
+
+@dataclass
+class _Topic:
+    name: str
+    type: str
+    channel: int
+    qos: list
+    count: int = 0
+
+
+class BagWriter:
+    """Write a rosbag2 bag (MCAP storage) from serialized messages.
+
+    Parameters
+    ----------
+    path : path-like
+        Bag folder to create (must not exist or be empty).
+    compression : {"zstd", "lz4", "none"}
+        Chunk compression.
+    chunk_size : int
+        Uncompressed chunk size, bytes, at which a chunk is written out.
+    custom_data : mapping of str to str
+        Stored in ``metadata.yaml`` ``custom_data`` (e.g. the scene and node parameters).
+    """
+
+    def __init__(self, path: str | Path, compression: str = "zstd", chunk_size: int = 256 * 1024,
+                 custom_data: Mapping[str, str] | None = None) -> None:
+        self.path = Path(path)
+        if self.path.exists() and any(self.path.iterdir()):
+            raise BagError(f"{self.path} exists and is not empty")
+        if compression not in COMPRESSION:
+            raise BagError(f"compression must be one of {sorted(COMPRESSION)}, got {compression!r}")
+        self.path.mkdir(parents=True, exist_ok=True)
+        self.file_name = f"{self.path.name}_0.mcap"
+        self._stream = _Direct(self.path / self.file_name)
+        self._writer = Writer(self._stream, chunk_size=chunk_size,
+                              compression=COMPRESSION[compression], enable_data_crcs=True)
+        self._writer.start(profile="ros2", library="squeeze_grasp_ros")
+        self._schemas: dict[str, int] = {}
+        self.topics: dict[str, _Topic] = {}
+        self.custom_data = dict(custom_data or {})
+        self.start_ns: int | None = None
+        self.end_ns: int | None = None
+        self.closed = False
+
+    def add_topic(self, name: str, type_name: str, offered_qos: Sequence[dict] = ()) -> None:
+        """Declare topic ``name`` of type ``type_name`` ('pkg/msg/Type') with its offered QoS."""
+        if name in self.topics:
+            return
+        if type_name not in self._schemas:
+            self._schemas[type_name] = self._writer.register_schema(
+                type_name, "ros2msg", message_definition(type_name).encode())
+        qos = list(offered_qos)
+        channel = self._writer.register_channel(
+            name, "cdr", self._schemas[type_name],
+            {"offered_qos_profiles": plain_yaml(qos) if qos else "",
+             "topic_type_hash": type_hash(type_name)})
+        self.topics[name] = _Topic(name, type_name, channel, qos)
+
+    def write(self, topic: str, data: bytes, log_time_ns: int,
+              publish_time_ns: int | None = None) -> None:
+        """Append one serialized (CDR) message of a declared topic."""
+        t = self.topics[topic]
+        self._writer.add_message(t.channel, log_time_ns, bytes(data),
+                                 log_time_ns if publish_time_ns is None else publish_time_ns,
+                                 sequence=t.count)
+        t.count += 1
+        self.start_ns = log_time_ns if self.start_ns is None else min(self.start_ns, log_time_ns)
+        self.end_ns = log_time_ns if self.end_ns is None else max(self.end_ns, log_time_ns)
+
+    def metadata(self) -> dict:
+        """The ``rosbag2_bagfile_information`` mapping of the bag so far."""
+        start = self.start_ns or 0
+        duration = (self.end_ns or 0) - start
+        count = sum(t.count for t in self.topics.values())
+        return {
+            "version": METADATA_VERSION, "storage_identifier": "mcap",
+            "duration": {"nanoseconds": duration},
+            "starting_time": {"nanoseconds_since_epoch": start}, "message_count": count,
+            "topics_with_message_count": [
+                {"topic_metadata": {"name": t.name, "type": t.type, "serialization_format": "cdr",
+                                    "offered_qos_profiles": t.qos,
+                                    "type_description_hash": type_hash(t.type)},
+                 "message_count": t.count} for t in self.topics.values()],
+            "compression_format": "", "compression_mode": "",
+            "relative_file_paths": [self.file_name],
+            "files": [{"path": self.file_name, "starting_time": {"nanoseconds_since_epoch": start},
+                       "duration": {"nanoseconds": duration}, "message_count": count}],
+            "custom_data": dict(self.custom_data), "ros_distro": "jazzy"}
+
+    def close(self) -> None:
+        """Write the rosbag2 metadata record, the MCAP summary and ``metadata.yaml`` (idempotent)."""
+        if self.closed:
+            return
+        self.closed = True
+        info = self.metadata()
+        self._writer.add_metadata("rosbag2", {"serialized_metadata": plain_yaml(info)})
+        self._writer.finish()
+        self._stream.close()
+        text = plain_yaml({"rosbag2_bagfile_information": info})
+        tmp = self.path / "metadata.yaml.tmp"
+        tmp.write_text(text)
+        tmp.replace(self.path / "metadata.yaml")
+
+
+@dataclass(frozen=True)
+class BagMessage:
+    """One recorded message.
+
+    Attributes
+    ----------
+    topic : str
+    type : str
+        'pkg/msg/Type'.
+    log_time_ns : int
+    data : bytes
+        Serialized (CDR) message.
+    """
+
+    topic: str
+    type: str
+    log_time_ns: int
+    data: bytes
+
+
+@dataclass(frozen=True)
+class BagContents:
+    """Everything :func:`read_bag` found.
+
+    Attributes
+    ----------
+    messages : tuple of BagMessage
+        In log-time order (ties in storage order).
+    types : dict of str to str
+        Topic -> type.
+    custom_data : dict of str to str
+    """
+
+    messages: tuple[BagMessage, ...]
+    types: dict
+    custom_data: dict
+
+    def counts(self) -> Counter:
+        """Messages per topic."""
+        return Counter(m.topic for m in self.messages)
+
+
+def _storage_files(path: Path) -> tuple[list[Path], dict]:
+    """(storage files, metadata mapping or {}) of a bag folder or a bare storage file.
+
+    Without ``metadata.yaml`` the metadata comes from the ``rosbag2`` record inside the MCAP
+    file, which holds the same YAML.
+    """
+    if path.is_file():
+        return [path], _embedded_info(path)
+    meta_path = path / "metadata.yaml"
+    if not meta_path.is_file():
+        files = sorted(path.glob("*.mcap")) + sorted(path.glob("*.db3"))
+        if not files:
+            raise BagError(f"{path} has no metadata.yaml and no .mcap/.db3 file")
+        return files, _embedded_info(files[0])
+    try:
+        data = load_yaml(read_text(meta_path, what="metadata.yaml"), what=str(meta_path))
+        info = data["rosbag2_bagfile_information"]
+        names = list(dict.fromkeys(info.get("relative_file_paths") or []))
+    except (InputError, KeyError, TypeError, AttributeError) as exc:
+        raise BagError(f"{meta_path} is not rosbag2 metadata: {exc}") from None
+    files = []
+    for name in names:
+        file = (path / str(name)).resolve()
+        if file.parent != path.resolve() or not file.is_file():
+            raise BagError(f"{meta_path} lists {name!r}, which is not a file of this bag")
+        files.append(file)
+    return files, info
+
+
+def _embedded_info(path: Path) -> dict:
+    """The bag information of the ``rosbag2`` metadata record of an MCAP file ({} if none)."""
+    if path.suffix != ".mcap":
+        return {}
+    try:
+        with open(path, "rb") as f:
+            for record in make_reader(f).iter_metadata():
+                if record.name == "rosbag2":
+                    data = load_yaml(record.metadata.get("serialized_metadata", ""),
+                                     what=f"{path} rosbag2 metadata")
+                    return dict((data or {}).get("rosbag2_bagfile_information", data or {}))
+    except (McapError, InputError, OSError, ValueError):
+        return {}
+    return {}
+
+
+def _read_mcap(path: Path) -> Iterator[BagMessage]:
+    """Every message of an MCAP file, with its chunk and data-section CRCs checked.
+
+    Raises
+    ------
+    BagError
+        A CRC does not match or a record cannot be parsed: the file is corrupt.
+    """
+    schemas: dict[int, str] = {}
+    topics: dict[int, tuple[str, str]] = {}
+    out: list[BagMessage] = []
+    try:
+        with open(path, "rb") as f:
+            for record in StreamReader(f, validate_crcs=True).records:
+                if isinstance(record, Schema):
+                    schemas[record.id] = record.name
+                elif isinstance(record, Channel):
+                    topics[record.id] = (record.topic, schemas.get(record.schema_id, ""))
+                elif isinstance(record, Message):
+                    topic, type_name = topics[record.channel_id]
+                    out.append(BagMessage(topic, type_name, record.log_time, bytes(record.data)))
+    except Exception as exc:  # noqa: BLE001 (any failure to parse these bytes means corruption)
+        raise BagError(f"{path} is corrupt ({type(exc).__name__}: {exc}); it cannot be "
+                       "trusted, not even in part") from None
+    out.sort(key=lambda m: m.log_time_ns)
+    yield from out
+
+
+def _read_sqlite(path: Path) -> Iterator[BagMessage]:
+    db = sqlite3.connect(f"file:{path}?mode=ro", uri=True)
+    try:
+        rows = db.execute("SELECT topics.name, topics.type, messages.timestamp, messages.data "
+                          "FROM messages JOIN topics ON messages.topic_id = topics.id "
+                          "ORDER BY messages.timestamp, messages.id")
+        for name, type_name, timestamp, data in rows:
+            yield BagMessage(name, type_name, int(timestamp), bytes(data))
+    finally:
+        db.close()
+
+
+def read_bag(path: str | Path, topics: Sequence[str] | None = None) -> BagContents:
+    """Read a rosbag2 bag (MCAP or SQLite3 storage) or a bare ``.mcap`` file.
+
+    Parameters
+    ----------
+    path : path-like
+    topics : sequence of str, optional
+        Only these topics.
+
+    Raises
+    ------
+    BagError
+        If ``path`` is not a bag.
+    """
+    path = Path(path)
+    if not path.exists():
+        raise BagError(f"no bag at {path}")
+    files, info = _storage_files(path)
+    wanted = set(topics) if topics is not None else None
+    messages: list[BagMessage] = []
+    for file in files:
+        reader = _read_sqlite if file.suffix == ".db3" else _read_mcap
+        messages += [m for m in reader(file) if wanted is None or m.topic in wanted]
+    messages.sort(key=lambda m: m.log_time_ns)
+    types = {m.topic: m.type for m in messages}
+    for entry in info.get("topics_with_message_count", []):
+        meta = entry["topic_metadata"]
+        types.setdefault(meta["name"], meta["type"])
+    return BagContents(tuple(messages), types, dict(info.get("custom_data") or {}))

@@ -1,0 +1,784 @@
+# Copyright 2026 squeeze_grasp_ros developers
+# SPDX-License-Identifier: Apache-2.0
+"""Run a scene through the real nodes: all on one rclpy executor, or one process per node.
+
+:class:`PipelineRunner` is what ``squeeze-grasp run`` does, step by step (tests and benchmarks
+drive the steps themselves):
+
+1. node parameters from ``config/*.yaml`` plus what the scene decides (devices, sensors, mu,
+   tick, recording);
+2. the nodes: ``sim_hardware``, ``monitor``, ``executor``, ``recorder`` (with ``record``) as
+   real rclpy nodes, by default on one executor in this process (``EventsExecutor`` in the main
+   thread, or ``SingleThreadedExecutor``), with ``processes`` each as its own Python process
+   (``python -m squeeze_grasp_ros.ros.nodes.<node> --ros-args --params-file ...``, as ``ros2
+   launch`` would start them);
+3. the plan: the planner node's services when the planner exists (``load_object``,
+   ``event_squeeze`` for the directions and the predicted events, ``plan_squeeze`` for the pure
+   directions), else the same mechanics API directly; the resistance waypoints (scenes with a
+   frictional adversary) from Algorithm 2 (:mod:`..mechanics.resistance_friction`);
+4. the prediction latched on ``planner/predicted_events``, the ``ExecuteGrasp`` goal, progress
+   from its feedback, the result; ground truth from ``sim/events`` and ``sim/state``.
+
+Every wait spins the executor with a wall-clock timeout; nothing sleeps to synchronise.
+"""
+from __future__ import annotations
+
+import importlib.util
+import json
+import os
+import signal
+import subprocess
+import sys
+import tempfile
+import threading
+import time
+import uuid
+from collections import Counter
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import rclpy
+import yaml
+from action_msgs.msg import GoalStatus, GoalStatusArray
+from rclpy.action import ActionClient
+from rclpy.action.client import ClientGoalHandle
+from rclpy.context import Context
+from rclpy.executors import SingleThreadedExecutor
+from rclpy.experimental import EventsExecutor
+from rclpy.node import Node
+from rclpy.parameter import Parameter
+from rclpy.serialization import deserialize_message
+from rclpy.signals import SignalHandlerOptions
+from std_msgs.msg import Header
+
+from squeeze_grasp_interfaces.action import ExecuteGrasp
+from squeeze_grasp_interfaces.msg import Alarm, ContactEvent, ContactEventArray, SimState
+from unique_identifier_msgs.msg import UUID
+
+from squeeze_grasp_ros.ros import messages
+from squeeze_grasp_ros.control.motion import GraspGoal
+from squeeze_grasp_ros.mechanics.elastic.compliance import ElasticObject
+from squeeze_grasp_ros.mechanics.squeeze.contact_model import ContactModel
+from squeeze_grasp_ros.mechanics.resistance.frictional import add_adversary, frictional_resistance
+from squeeze_grasp_ros.mechanics.squeeze.stable_pure import plan_squeeze
+from squeeze_grasp_ros.ros.recording.bag import plain_yaml
+from squeeze_grasp_ros.resources import config_dir, share_dir
+from squeeze_grasp_ros.scene import (Scene, SceneError, build_mesh, finger_devices, finger_nodes, load_scene,
+                     placement_node, scene_material)
+from squeeze_grasp_ros.scene_events import event_squeeze_scene
+from squeeze_grasp_ros.ros.nodes import pipeline
+from squeeze_grasp_ros.ros.nodes.recorder import cdr_stamp_ns
+
+NODES: tuple[str, ...] = ("sim_hardware", "monitor", "executor", "recorder")
+EXECUTORS: tuple[str, ...] = ("events", "single")
+PLANNER_MODULE = "squeeze_grasp_ros.ros.nodes.planner"
+GOAL_RESPONSE_TIMEOUT = 5.0
+"""Wall-clock seconds to wait for a goal (or result) response before checking the status."""
+EVENTS_PER_CHECK = 16
+"""Queued events :meth:`PipelineRunner.spin_until` executes between two checks of its condition."""
+SERVICE_RETRY = 30.0
+"""Wall-clock seconds after which an unanswered planner request is sent again."""
+
+
+GRASP_HELD: tuple[str, ...] = ("none", "picked_up")
+"""World terminations after which the grasp holds ("none": the world never ended)."""
+
+
+STOP_SIGNALS = (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)
+"""Signals that stop a run cleanly (the recording is finished, node processes are stopped)."""
+
+
+class Interrupted(KeyboardInterrupt):
+    """A run stopped by a signal; ``signum`` says which (exit status 128 + signum)."""
+
+    def __init__(self, signum: int) -> None:
+        super().__init__(signal.Signals(signum).name)
+        self.signum = int(signum)
+
+
+class RunError(RuntimeError):
+    """The pipeline could not be started or did not finish in time."""
+
+
+def config_parameters(node: str) -> dict[str, Any]:
+    """The ``ros__parameters`` of ``config/<node>.yaml``."""
+    data = yaml.safe_load((config_dir() / f"{node}.yaml").read_text())
+    section = data.get(node) or data.get("/**") or {}
+    return dict(section.get("ros__parameters", {}))
+
+
+@dataclass(frozen=True)
+class RunOptions:
+    """What to run and how.
+
+    Attributes
+    ----------
+    scene_path : str
+    record : str or None
+        Bag folder to record into.
+    include_hidden_topics : bool
+        Record the executor action's hidden ``_action/`` topics too.
+    attach : bool
+        Use the nodes already running on this ROS domain (started by ``ros2 launch
+        squeeze_grasp_ros sim_pipeline.launch.py``) instead of starting them: plan with the
+        running planner, send the goal, summarise. Recording is then the launched recorder's.
+    processes : bool
+        One process per node instead of one executor in this process.
+    executor : {"events", "single"}
+        rclpy executor of the one-process mode.
+    on_slip_alarm : {"hold", "pure", "normals"}
+        The executor's reaction to an imminent-slip alarm.
+    resist : bool
+        Run the resistance phase when the scene has a frictional adversary.
+    planner : bool
+        Plan with the planner node if it exists (else with the mechanics API).
+    overrides : dict
+        Node name -> parameter overrides (applied last).
+    timeout : float
+        Wall-clock seconds a run may take.
+    discovery_wait : float
+        Least wall-clock seconds of DDS discovery before the run checks that no other
+        simulation uses its ROS domain (it overlaps the planning).
+    """
+
+    scene_path: str
+    record: str | None = None
+    include_hidden_topics: bool = False
+    attach: bool = False
+    processes: bool = False
+    executor: str = "events"
+    on_slip_alarm: str = "hold"
+    resist: bool = True
+    planner: bool = True
+    overrides: dict = field(default_factory=dict)
+    timeout: float = 300.0
+    discovery_wait: float = 1.0
+
+
+def node_parameters(scene: Scene, scene_path: str, options: RunOptions,
+                    relative_per_depth: float) -> dict[str, dict[str, Any]]:
+    """Parameters of every node: the config files, then the scene's values, then overrides."""
+    params = {name: config_parameters(name) for name in NODES}
+    devices = finger_devices(scene)
+    mapping = [f"{f}:{d}" for f, d in devices.items()]
+    streams = [s for s, effect in (("wrench", "force_sensing"), ("tactile", "tactile_sensing"))
+               if scene.has(effect)]
+    noise = scene.sensors.noise_std if scene.has("sensor_noise") else 0.0
+    params["sim_hardware"].update(
+        scene=str(Path(scene_path).resolve()),
+        participants=["monitor", "executor"] + (["recorder"] if options.record else []))
+    monitor = params["monitor"]
+    monitor.update(finger_devices=mapping, streams=streams or [""], mu=float(scene.mu),
+                   weight=float(scene.pickup.weight) if scene.has("pickup") else 0.0,
+                   relative_per_depth=float(relative_per_depth),
+                   load_threshold=max(float(monitor.get("load_threshold", 0.005)), 6.0 * noise))
+    params["executor"].update(finger_devices=mapping, period=float(scene.sim.dt))
+    custom = {"scene": Path(scene_path).read_text(), "scene_path": str(scene_path)}
+    params["recorder"].update(output=str(options.record or ""), devices=list(devices.values()),
+                              include_hidden_topics=options.include_hidden_topics)
+    for name, values in options.overrides.items():
+        params[name].update(values)
+    custom["monitor_parameters"] = yaml.safe_dump(params["monitor"], sort_keys=True)
+    params["recorder"]["custom_data"] = yaml.safe_dump(custom)
+    return params
+
+
+@dataclass(frozen=True)
+class Plan:
+    """What the executor is asked to do and what the planner predicts."""
+
+    goal: GraspGoal
+    prediction: ContactEventArray
+    source: str
+    seconds: float
+
+
+def _event_list(events: list[ContactEvent]) -> list[dict]:
+    return [messages.event_record(e) for e in events]
+
+
+class PipelineRunner:
+    """The pipeline of one scene on real rclpy nodes (see the module docstring).
+
+    Parameters
+    ----------
+    options : RunOptions
+    progress : callable, optional
+        Called with a dict (state, depth, relative_depth, forces, events) at every feedback.
+    """
+
+    def __init__(self, options: RunOptions, progress: Callable[[dict], None] | None = None) -> None:
+        if options.executor not in EXECUTORS:
+            raise RunError(f"executor must be one of {EXECUTORS}, got {options.executor!r}")
+        if options.attach and (options.processes or options.record):
+            raise RunError("attach uses the nodes already running: it starts no processes and "
+                           "records nothing itself (record with the launch file's record:=)")
+        self.options = options
+        self.progress = progress
+        self.scene = load_scene(options.scene_path)
+        for name, finger in self.scene.fingers.items():
+            if not finger.tip_radius > 0:
+                raise SceneError(f"fingers.{name}.tip_radius must be > 0 m: the simulated "
+                                 "hardware tracks rounded fingertips (Sec. 5)")
+        self.t0 = time.perf_counter()
+        self.timing: dict[str, float] = {}
+        self.interrupted = threading.Event()
+        self.signal = signal.SIGINT
+        self.context = Context()
+        rclpy.init(context=self.context, signal_handler_options=SignalHandlerOptions.NO)
+        self.executor = (EventsExecutor(context=self.context) if options.executor == "events"
+                         else SingleThreadedExecutor(context=self.context))
+        self.events_per_check = EVENTS_PER_CHECK if options.executor == "events" else 0
+        self.client = Node("run", context=self.context)
+        self.executor.add_node(self.client)
+        self.nodes: list[Node] = []
+        self.processes: list[subprocess.Popen] = []
+        self.params_file: Path | None = None
+        self.sim_events: list[ContactEvent] = []
+        self.world_end: dict | None = None
+        self.monitor_events: list[ContactEvent] = []
+        self.alarms: Counter = Counter()
+        self.first_alarm: dict[str, dict] = {}
+        self.sim_state_data: list[bytes] = []
+        self.sim_state_ns = -1
+        self.recorder_ns = -1
+        self.feedback: list[ExecuteGrasp.Feedback] = []
+        loop = pipeline.loop_qos(1000)
+        c = self.client
+        self.outcome_subscriptions = [
+            c.create_subscription(ContactEventArray, pipeline.SIM_EVENTS, self._sim_events, loop),
+            c.create_subscription(ContactEventArray, pipeline.EVENTS,
+                                  lambda msg: self.monitor_events.extend(msg.events), loop),
+            c.create_subscription(Alarm, pipeline.ALARMS, self._alarm, loop),
+            c.create_subscription(SimState, pipeline.SIM_STATE, self._state, loop, raw=True)]
+        c.create_subscription(Header, pipeline.RECORDER_PROGRESS, self._recorder_progress, loop)
+        self.prediction_pub = c.create_publisher(ContactEventArray, pipeline.PREDICTION,
+                                                 pipeline.LATCHED)
+        self.action = ActionClient(c, ExecuteGrasp, pipeline.ACTION)
+        self.goal_statuses: dict[bytes, int] = {}
+        c.create_subscription(GoalStatusArray, f"{pipeline.ACTION}/_action/status",
+                              self._goal_status, pipeline.LATCHED)
+        self.goal_handle = None
+        self.result_future = None
+        self.plan: Plan | None = None
+        self.start_ns = 0
+
+    # ----------------------------------------------------------------- callbacks
+    def _sim_events(self, msg: ContactEventArray) -> None:
+        self.sim_events += msg.events
+        if msg.termination:
+            self.world_end = {"termination": msg.termination, "depth": float(msg.depth),
+                              "stamp_ns": messages.stamp_ns(msg.header.stamp)}
+
+    def _alarm(self, msg: Alarm) -> None:
+        self.alarms[msg.type] += 1
+        self.first_alarm.setdefault(msg.type, {"stamp_ns": messages.stamp_ns(msg.header.stamp),
+                                               "finger": msg.finger, "message": msg.message})
+
+    def _state(self, data: bytes) -> None:
+        self.sim_state_data.append(data)
+        self.sim_state_ns = cdr_stamp_ns(data)
+
+    @property
+    def sim_state(self) -> SimState | None:
+        """The newest ground-truth state (kept serialised; decoded on demand)."""
+        return deserialize_message(self.sim_state_data[-1], SimState) \
+            if self.sim_state_data else None
+
+    @property
+    def sim_states(self) -> list[SimState]:
+        """Every ground-truth state received, in order (one per tick, re-sent ticks repeated)."""
+        return [deserialize_message(data, SimState) for data in self.sim_state_data]
+
+    def _recorder_progress(self, msg: Header) -> None:
+        self.recorder_ns = max(self.recorder_ns, messages.stamp_ns(msg.stamp))
+
+    def _feedback(self, msg: Any) -> None:
+        fb = msg.feedback
+        self.feedback.append(fb)
+        if self.progress is not None:
+            self.progress({"state": fb.state, "depth": fb.depth,
+                           "relative_depth": fb.relative_depth,
+                           "forces": {f: [v.x, v.y] for f, v in zip(fb.fingers, fb.forces)},
+                           "events": len(self.monitor_events)})
+
+    # ----------------------------------------------------------------- waiting
+    def spin_until(self, done: Callable[[], bool], timeout: float, what: str) -> None:
+        """Spin the executor until ``done()`` or ``timeout`` wall-clock seconds (then raise).
+
+        On ``EventsExecutor``, after waiting (at most 50 ms) for one event, up to
+        ``EVENTS_PER_CHECK`` more events that are already queued are executed before the
+        conditions are checked again (a tick is about 13 events; checking after each cost about
+        5 % of the loop). Not on ``SingleThreadedExecutor``: its ``spin_once`` keeps a generator
+        of ready entities per timeout argument, and alternating timeouts discard it together
+        with triggers it has already taken (a run then waits forever for a lost result).
+        """
+        deadline = time.monotonic() + timeout
+        while not done():
+            if self.interrupted.is_set():
+                raise Interrupted(self.signal)
+            if time.monotonic() > deadline:
+                raise RunError(f"timed out after {timeout:.0f} s waiting for {what}")
+            self._check_processes()
+            self.executor.spin_once(0.05)
+            for _ in range(self.events_per_check):
+                self.executor.spin_once(0.0)
+
+    def _check_processes(self) -> None:
+        for proc in self.processes:
+            if proc.poll() is not None:
+                raise RunError(f"node process {proc.args[2]} exited with code {proc.returncode}")
+
+    # ----------------------------------------------------------------- start-up
+    def start(self) -> None:
+        """Plan, start the nodes and wait until the loop stands at tick 0, the executor serves
+        and this client's subscriptions to the outcome (ground-truth state and events, monitor
+        events and alarms) have matched their publishers.
+
+        The last wait matters across processes: those publishers are not part of the lockstep
+        handshake, and simulated time only moves once the goal is sent, so waiting here loses
+        nothing; without it a fast loop could publish its first events before discovery
+        between this process and the monitor had settled (seen: a run whose 7 monitor events
+        never reached the client).
+        """
+        discovery_ends = time.monotonic() + self.options.discovery_wait
+        plan_source = self._use_planner()
+        planner = self._start_planner() if plan_source and not self.options.attach else None
+        try:
+            self.plan = self._plan_with_planner() if plan_source else self._plan_with_mechanics()
+        finally:
+            if planner is not None:
+                planner()
+        if not self.options.attach:
+            self._refuse_if_domain_busy(discovery_ends)
+        self.timing["plan"] = self.plan.seconds
+        self.prediction_pub.publish(self.plan.prediction)
+        params = node_parameters(self.scene, self.options.scene_path, self.options,
+                                 self.plan.goal.relative_per_depth)
+        if not self.options.record:
+            del params["recorder"]
+        started = time.perf_counter()
+        if self.options.processes:
+            self._spawn(params)
+        elif not self.options.attach:
+            self._construct(params)
+        self.spin_until(lambda: self.action.server_is_ready(), self.options.timeout,
+                        "the executor's action server")
+        self.spin_until(lambda: self.sim_state_ns >= 0, self.options.timeout, "tick 0")
+        self.spin_until(lambda: all(s.get_publisher_count() > 0
+                                    for s in self.outcome_subscriptions),
+                        self.options.timeout, "the publishers of the run's outcome topics")
+        self.start_ns = self.sim_state_ns
+        self.timing["start_nodes"] = time.perf_counter() - started
+
+    def _refuse_if_domain_busy(self, deadline: float) -> None:
+        """Refuse to start the nodes when another simulated pipeline runs on this ROS domain.
+
+        Two lockstep loops on one domain answer each other's ticks and record each other's
+        messages. Discovery runs while the run plans, for at least ``discovery_wait`` s; then a
+        publisher of ``sim/tick`` means another simulation is running. Two runs started within
+        that time of each other are not told apart: give concurrent runs their own
+        ROS_DOMAIN_ID.
+        """
+        while time.monotonic() < deadline:
+            self.executor.spin_once(0.02)
+        others = self.client.count_publishers("/" + pipeline.TICK)
+        if others:
+            domain = os.environ.get("ROS_DOMAIN_ID", "0")
+            raise RunError(f"another simulated pipeline is running on ROS_DOMAIN_ID {domain} "
+                           f"({others} publisher(s) of /{pipeline.TICK}); a second run would "
+                           "corrupt both. Stop it, or give this run its own domain, e.g. "
+                           "ROS_DOMAIN_ID=42 squeeze-grasp run ...")
+
+    def _use_planner(self) -> bool:
+        return self.options.attach or (self.options.planner
+                                       and importlib.util.find_spec(PLANNER_MODULE) is not None)
+
+    def _construct(self, params: dict[str, dict]) -> None:
+        from squeeze_grasp_ros.ros.nodes.executor import ExecutorNode
+        from squeeze_grasp_ros.ros.nodes.monitor import MonitorNode
+        from squeeze_grasp_ros.ros.nodes.recorder import RecorderNode
+        from squeeze_grasp_ros.ros.nodes.sim_hardware import SimHardwareNode
+
+        classes = {"sim_hardware": SimHardwareNode, "monitor": MonitorNode,
+                   "executor": ExecutorNode, "recorder": RecorderNode}
+        for name, values in params.items():
+            overrides = [Parameter(k, value=v) for k, v in values.items()]
+            node = classes[name](context=self.context, parameter_overrides=overrides)
+            self.nodes.append(node)
+            self.executor.add_node(node)
+
+    def _spawn(self, params: dict[str, dict]) -> None:
+        handle, path = tempfile.mkstemp(prefix=f"squeeze_grasp_run_{os.getpid()}_",
+                                        suffix=".yaml")
+        os.close(handle)
+        self.params_file = Path(path)
+        self.params_file.write_text(plain_yaml(
+            {name: {"ros__parameters": values} for name, values in params.items()}))
+        for name in params:
+            self.processes.append(subprocess.Popen(
+                [sys.executable, "-m", f"squeeze_grasp_ros.ros.nodes.{name}", "--ros-args",
+                 "--params-file", str(self.params_file)], stdin=subprocess.DEVNULL))
+
+    def node(self, name: str) -> Node:
+        """The in-process node called ``name``."""
+        return next(n for n in self.nodes if n.get_name() == name)
+
+    # ----------------------------------------------------------------- planning
+    def _planner_roots(self) -> list[str]:
+        """Folders the run's own planner may read: the scene's (and its outline file's), the
+        package share folder and the working directory."""
+        folders = [Path(self.options.scene_path).resolve().parent, share_dir(), Path.cwd()]
+        shape = self.scene.object.shape
+        if shape["type"] == "file":
+            folders.append(Path(shape["path"]).resolve().parent)
+        return [str(f) for f in folders]
+
+    def _start_planner(self) -> Callable[[], None]:
+        """Start the planner (thread or process); return the function that stops it."""
+        roots = self._planner_roots()
+        if self.options.processes:
+            proc = subprocess.Popen([sys.executable, "-m", PLANNER_MODULE, "--ros-args",
+                                     "--params-file", str(config_dir() / "planner.yaml"),
+                                     "-p", f"allowed_roots:={json.dumps(roots)}"],
+                                    stdin=subprocess.DEVNULL)
+
+            def stop_process() -> None:
+                proc.send_signal(signal.SIGINT)
+                proc.wait(30)
+            return stop_process
+        from squeeze_grasp_ros.ros.nodes.planner import PlannerNode
+
+        node = PlannerNode(context=self.context,
+                           parameter_overrides=[Parameter("allowed_roots", value=roots)])
+        spinner = SingleThreadedExecutor(context=self.context)
+        spinner.add_node(node)
+        thread = threading.Thread(target=spinner.spin, name="planner", daemon=True)
+        thread.start()
+
+        def stop_thread() -> None:
+            spinner.shutdown()
+            thread.join(30)
+            node.destroy_node()
+        return stop_thread
+
+    def _call(self, srv_type: Any, name: str, request: Any) -> Any:
+        """Call a planner service; the request is repeated if its response is lost (the
+        planner's requests are idempotent)."""
+        client = self.client.create_client(srv_type, f"planner/{name}")
+        self.spin_until(client.service_is_ready, self.options.timeout, f"planner/{name}")
+        deadline = time.monotonic() + self.options.timeout
+        while True:
+            future = client.call_async(request)
+            retry = min(time.monotonic() + SERVICE_RETRY, deadline)
+            self.spin_until(lambda: future.done() or time.monotonic() > retry,
+                            self.options.timeout, f"planner/{name}")
+            if future.done():
+                break
+            if time.monotonic() > deadline:
+                raise RunError(f"planner/{name} did not answer")
+        response = future.result()
+        self.client.destroy_client(client)
+        if not response.success:
+            raise RunError(f"planner/{name}: {response.message}")
+        return response
+
+    def _plan_with_planner(self) -> Plan:
+        from squeeze_grasp_interfaces.srv import EventSqueeze, LoadObject, PlanSqueeze
+
+        t0 = time.perf_counter()
+        path = str(Path(self.options.scene_path).resolve())
+        loaded = self._call(LoadObject, "load_object", LoadObject.Request(scene_path=path))
+        squeeze = self._call(EventSqueeze, "event_squeeze",
+                             EventSqueeze.Request(object_id=loaded.object_id)).squeeze
+        pure = self._call(PlanSqueeze, "plan_squeeze", PlanSqueeze.Request(
+            object_id=loaded.object_id, contacts=list(loaded.finger_nodes), squeeze_type="pure"))
+        directions = np.array([[squeeze.direction_f1.x, squeeze.direction_f1.y],
+                               [squeeze.direction_f2.x, squeeze.direction_f2.y]])
+        rpd = squeeze.relative_depth / squeeze.depth if squeeze.depth > 0 else 0.0
+        resistance = self._resistance_plan() if self._resists() else {}
+        goal = GraspGoal(("F1", "F2"), directions, squeeze.target_depth, rpd,
+                         self.options.on_slip_alarm,
+                         np.asarray(pure.displacement, float).reshape(2, 2), **resistance)
+        prediction = messages.prediction_msg(list(squeeze.events), squeeze.termination,
+                                             squeeze.depth)
+        return Plan(goal, prediction, "planner", time.perf_counter() - t0)
+
+    def _plan_with_mechanics(self) -> Plan:
+        t0 = time.perf_counter()
+        scene = self.scene
+        obj = ElasticObject(build_mesh(scene), scene_material(scene))
+        contacts = finger_nodes(scene, obj.mesh)
+        result = event_squeeze_scene(scene, obj, contacts)
+        directions = np.array([result.directions["F1"], result.directions["F2"]])
+        rpd = result.relative_depth / result.depth if result.depth > 0 else 0.0
+        pure = plan_squeeze(obj, list(contacts), "pure").displacement.reshape(2, 2)
+        resistance = self._resistance_plan(obj, contacts, result) if self._resists() else {}
+        goal = GraspGoal(("F1", "F2"), directions, result.target_depth, rpd,
+                         self.options.on_slip_alarm, pure, **resistance)
+        prediction = messages.prediction_msg(
+            [messages.contact_event_msg(e) for e in result.events], result.termination,
+            result.depth)
+        return Plan(goal, prediction, "mechanics", time.perf_counter() - t0)
+
+    def _resists(self) -> bool:
+        adv = self.scene.adversary
+        return self.options.resist and adv is not None and adv.contacts == "friction"
+
+    def _resistance_plan(self, obj: ElasticObject | None = None, contacts=None,
+                         squeeze=None) -> dict:
+        """Waypoints of Algorithm 2 (Sec. 6.3) after the scene's squeeze, for the goal.
+
+        The adversary is sent as far as Algorithm 2 got (all of a, or until it slipped).
+        """
+        scene, adv = self.scene, self.scene.adversary
+        if obj is None:
+            obj = ElasticObject(build_mesh(scene), scene_material(scene))
+            contacts = finger_nodes(scene, obj.mesh)
+            squeeze = event_squeeze_scene(scene, obj, contacts)
+        model = ContactModel(obj, scene.mu, max_events_per_depth=scene.squeeze.max_events_per_depth)
+        node = placement_node(obj.mesh, adv.placement, "adversary")
+        state = add_adversary(squeeze.state, model, squeeze.displacement, node, adv.tip_radius)
+        plan = frictional_resistance(model, state, adv.a, adv.mode, squeeze.step,
+                                     squeeze.event_tol)
+        travel = np.array([s.end for s in plan.stages])
+        keep = np.concatenate([[True], np.diff(travel) > 0]) & (travel > 0)
+        waypoints = np.stack([plan.trajectories[f][1:] for f in ("F1", "F2")], axis=1)
+        a = np.asarray(adv.a, float)
+        travel = travel[keep]
+        return {"adversary": "A", "adversary_translation": a * (travel[-1] / np.hypot(*a)),
+                "resist_travel": travel, "resist_waypoints": waypoints[keep]}
+
+    # ----------------------------------------------------------------- the goal
+    def send_goal(self) -> None:
+        """Send the plan's goal and wait until it is accepted.
+
+        Across processes a service response can be lost while discovery is still settling
+        (docs/design.md §5: the first messages after matching). The goal ids are ours, so a
+        goal whose acceptance shows on the action's status topic counts as accepted even if the
+        response never came; after ``GOAL_RESPONSE_TIMEOUT`` without either the request is sent
+        again with a new id, and whichever request is accepted first is the goal (the executor
+        rejects the others while it runs one).
+        """
+        msg = messages.grasp_goal_msg(self.plan.goal)
+        deadline = time.monotonic() + self.options.timeout
+        sent: list = []
+        handle = None
+        while handle is None:
+            goal_id = UUID(uuid=list(uuid.uuid4().bytes))
+            sent.append((goal_id, self.action.send_goal_async(msg, self._feedback,
+                                                              goal_uuid=goal_id)))
+            retry = min(time.monotonic() + GOAL_RESPONSE_TIMEOUT, deadline)
+            self.spin_until(lambda: self._accepted(sent) is not None
+                            or all(f.done() for _, f in sent) or time.monotonic() > retry,
+                            self.options.timeout, "the goal to be accepted")
+            handle = self._accepted(sent)
+            if handle is None and all(f.done() for _, f in sent):
+                settle = time.monotonic() + GOAL_RESPONSE_TIMEOUT
+                self.spin_until(lambda: self._accepted(sent) is not None
+                                or time.monotonic() > settle, self.options.timeout,
+                                "the status of the goal requests")
+                handle = self._accepted(sent) or sent[-1][1].result()
+            if handle is None and time.monotonic() > deadline:
+                raise RunError("the executor never answered the goal request")
+        if not handle.accepted:
+            raise RunError("the executor rejected the goal")
+        self.goal_handle = handle
+        self.result_future = handle.get_result_async()
+        self.loop_started = time.perf_counter()
+        self.loop_cpu_started = time.process_time()
+
+    def _accepted(self, sent: list):
+        """The goal handle of the first request known to be accepted (by its response or by
+        the status topic), or None."""
+        for goal_id, future in sent:
+            if future.done() and future.result().accepted:
+                return future.result()
+            if self._status_of(goal_id) is not None:
+                return ClientGoalHandle(self.action, goal_id,
+                                        ExecuteGrasp.Impl.SendGoalService.Response(accepted=True))
+        return None
+
+    def _goal_status(self, msg: GoalStatusArray) -> None:
+        for status in msg.status_list:
+            self.goal_statuses[bytes(status.goal_info.goal_id.uuid)] = status.status
+
+    def _status_of(self, goal_id: UUID) -> int | None:
+        return self.goal_statuses.get(bytes(goal_id.uuid))
+
+    def cancel(self) -> None:
+        """Ask the executor to cancel the goal (it holds position)."""
+        self.goal_handle.cancel_goal_async()
+
+    def _world_failed(self) -> bool:
+        """True once the simulated world has ended with a termination that loses the grasp."""
+        return self.world_end is not None and self.world_end["termination"] not in GRASP_HELD
+
+    def wait_result(self) -> ExecuteGrasp.Result:
+        """Spin until the goal's result, then until the ground truth of its last tick arrived.
+
+        When the simulated world ends with a lost grasp (a finger slipped, the strain limit), the
+        goal is cancelled, so the executor holds instead of driving fingers that no longer move
+        the object. If the status topic reports the goal finished but the result response does
+        not come within a few seconds (lost across processes), the result is requested again.
+        """
+        finished = (GoalStatus.STATUS_SUCCEEDED, GoalStatus.STATUS_ABORTED,
+                    GoalStatus.STATUS_CANCELED)
+        deadline = time.monotonic() + self.options.timeout
+        cancelled = False
+        while not self.result_future.done():
+            if not cancelled and self._world_failed():
+                cancelled = True
+                self.cancel()
+            ended = [time.monotonic()] if self._status_of(self.goal_handle.goal_id) in finished \
+                else []
+            self.spin_until(lambda: self.result_future.done() or (
+                ended and time.monotonic() > ended[0] + GOAL_RESPONSE_TIMEOUT) or (
+                not ended and self._status_of(self.goal_handle.goal_id) in finished) or (
+                not cancelled and self._world_failed()),
+                max(deadline - time.monotonic(), 0.0), "the goal's result")
+            if not self.result_future.done() and ended:
+                self.result_future = self.goal_handle.get_result_async()
+        result = self.result_future.result().result
+        self.timing["loop"] = time.perf_counter() - self.loop_started
+        self.timing["loop_cpu"] = time.process_time() - self.loop_cpu_started
+        final = self.start_ns + result.ticks * self._dt_ns()
+        self.spin_until(lambda: self.sim_state_ns >= final,
+                        self.options.timeout, "the ground truth of the last tick")
+        if self.options.record and self.options.processes:
+            self.spin_until(lambda: self.recorder_ns >= final, self.options.timeout,
+                            "the recorder to reach the last tick")
+        return result
+
+    def _dt_ns(self) -> int:
+        return int(round(self.scene.sim.dt * 1e9))
+
+    # ----------------------------------------------------------------- shutdown
+    def shutdown(self) -> None:
+        """Stop every node (the recorder finishes its bag) and the rclpy context.
+
+        After an interruption the simulated hardware leaves the executor first, so the lockstep
+        loop stops at once and the recorder drains only what it has already received.
+        """
+        try:
+            if self.interrupted.is_set():
+                for node in self.nodes:
+                    if node.get_name() == "sim_hardware":
+                        self.executor.remove_node(node)
+            for node in self.nodes:
+                if hasattr(node, "drain"):
+                    node.drain(self.executor)
+                    node.close()
+            for proc in self.processes:
+                if proc.poll() is None:
+                    proc.send_signal(signal.SIGINT)
+            for proc in self.processes:
+                try:
+                    proc.wait(30)
+                except subprocess.TimeoutExpired:
+                    proc.kill()
+                    proc.wait()
+        finally:
+            for node in self.nodes + [self.client]:
+                if node in self.executor.get_nodes():
+                    self.executor.remove_node(node)
+                node.destroy_node()
+            self.executor.shutdown()
+            self.context.try_shutdown()
+            if self.params_file is not None:
+                self.params_file.unlink(missing_ok=True)
+
+    # ----------------------------------------------------------------- the whole run
+    def run(self) -> dict:
+        """Start, execute the goal, collect the summary, shut down; returns the JSON summary.
+
+        SIGINT (Ctrl-C), SIGTERM and SIGHUP set a flag that the waiting loop turns into
+        :class:`Interrupted` between callbacks, so no callback (a recorder write) is cut in half;
+        the shutdown then stops the simulated world first (no new ticks), lets the recorder
+        write what it has received and finishes the recording, and stops every node process.
+        """
+        def on_signal(signum: int, _frame: Any) -> None:
+            self.signal = signum
+            self.interrupted.set()
+        previous = {s: signal.signal(s, on_signal) for s in STOP_SIGNALS}
+        try:
+            self.start()
+            self.send_goal()
+            result = self.wait_result()
+            return self.summary(result)
+        finally:
+            try:
+                self.shutdown()
+            finally:
+                for signum, handler in previous.items():
+                    signal.signal(signum, handler)
+
+    def summary(self, result: ExecuteGrasp.Result) -> dict:
+        """JSON-able summary of a finished goal (ground truth and measured)."""
+        state = self.sim_state
+        fingers = list(state.fingers)
+        gt_events = list(self.sim_events)
+        plan = self.plan
+        return {
+            "scene": self.scene.name, "mode": self.mode(), "plan_source": plan.source,
+            "termination": result.termination,
+            "success": bool(result.success) and (state.termination or "none") in GRASP_HELD,
+            "executor_success": bool(result.success), "outcome": self.outcome(result),
+            "message": result.message, "world_termination": state.termination or "none",
+            "depth": float(state.contacts.depth),
+            "relative_depth": float(state.contacts.relative_depth),
+            "target_depth": float(plan.goal.depth), "measured_depth": float(result.depth),
+            "ticks": int(result.ticks), "sim_time": float(result.duration),
+            "hold_ticks": int(result.hold_ticks), "redirected": bool(result.redirected),
+            "events": _event_list(gt_events),
+            "event_counts": {t: sum(1 for e in gt_events if e.type == t) for t in "ABCD"},
+            "world_end": self.world_end,
+            "monitor_events": _event_list(list(self.monitor_events)),
+            "monitor_event_counts": dict(Counter(e.type for e in self.monitor_events)),
+            "alarms": dict(self.alarms), "first_alarms": self.first_alarm,
+            "prediction": {"termination": plan.prediction.termination,
+                           "depth": float(plan.prediction.depth),
+                           "events": _event_list(list(plan.prediction.events))},
+            "forces": {f: [v.x, v.y] for f, v in zip(fingers, state.forces)},
+            "work": dict(zip(fingers, (float(w) for w in state.work))),
+            "measured_forces": {f: [v.x, v.y] for f, v in zip(result.fingers, result.forces)},
+            "measured_work": dict(zip(result.fingers, (float(w) for w in result.work))),
+            "contacts": messages.contact_records(state.contacts),
+            "recording": self.options.record,
+            "timing": {**self.timing, "total": time.perf_counter() - self.t0,
+                       **self._node_timing()},
+        }
+
+    def _node_timing(self) -> dict:
+        """Wall and CPU time of the stepper (``mechanics``) and of whole world ticks (``world``:
+        devices, stepper, sensors) inside the in-process simulated hardware (absent with
+        processes; ``loop_cpu`` is then only this process's CPU time)."""
+        sims = [n for n in self.nodes if n.get_name() == "sim_hardware"]
+        if not sims:
+            return {}
+        world = sims[0].world
+        return {"mechanics": world.stepper_seconds, "mechanics_cpu": world.stepper_cpu_seconds,
+                "world": world.step_seconds, "world_cpu": world.step_cpu_seconds}
+
+    def outcome(self, result: ExecuteGrasp.Result) -> str:
+        """One sentence: did the grasp hold in the simulated world, and if not, why."""
+        world = self.sim_state.termination or "none"
+        if world in GRASP_HELD and result.success:
+            return "grasp held" if world == "none" else "object picked up"
+        if world not in GRASP_HELD:
+            depth = self.world_end["depth"] if self.world_end else float("nan")
+            return (f"grasp failed in the world: {world} at depth {depth * 1e3:.4f} mm; the "
+                    "executor was stopped")
+        return f"executor did not finish: {result.termination} ({result.message})"
+
+    def mode(self) -> str:
+        """How the nodes ran."""
+        if self.options.attach:
+            return "attached to running nodes"
+        if self.options.processes:
+            return "processes"
+        return "one process, " + ("EventsExecutor" if self.options.executor == "events"
+                                  else "SingleThreadedExecutor")

@@ -57,23 +57,33 @@ setup(
         "ros": ROS_WHEELS + ["mcap>=1.1"],
         # squeeze-grasp sweep: Dask distributed runs the tasks, pyarrow writes the Parquet dataset
         "sweep": ["dask[distributed]>=2024.1", "pyarrow>=14"],
-        "test": ["pytest>=7", "hypothesis>=6", "scikit-fem>=9", "rosbags>=0.10", "mcap>=1.1",
-                 "mcap-ros2-support>=0.5", "colcon-common-extensions>=0.3"],
+        "test": [
+            "pytest>=7",
+            "hypothesis>=6",
+            "scikit-fem>=9",
+            "rosbags>=0.10",
+            "mcap>=1.1",
+            "mcap-ros2-support>=0.5",
+            "colcon-common-extensions>=0.3",
+            # the linter test (test/test_lint.py): flake8 and pep257 checks in one tool
+            "ruff>=0.5",
+        ],
     },
     zip_safe=True,
     maintainer="squeeze_grasp_ros developers",
     maintainer_email="maintainers@squeeze-grasp.invalid",
-    description="Two-finger squeeze grasps of deformable planar objects (Jia, Guo, Lin 2014) on ROS 2 Jazzy.",
+    description="Two-finger squeeze grasps of deformable planar objects (Jia, Guo, Lin 2014) on "
+                "ROS 2 Jazzy.",
     license="Apache-2.0",
     tests_require=["pytest"],
     entry_points={
         "console_scripts": [
-            "squeeze-grasp = squeeze_grasp_ros.cli:main",
-            "planner = squeeze_grasp_ros.ros.nodes.planner:main",
-            "executor = squeeze_grasp_ros.ros.nodes.executor:main",
-            "monitor = squeeze_grasp_ros.ros.nodes.monitor:main",
-            "sim_hardware = squeeze_grasp_ros.ros.nodes.sim_hardware:main",
-            "recorder = squeeze_grasp_ros.ros.nodes.recorder:main",
+            "squeeze-grasp = squeeze_grasp_ros.entry:cli",
+            "planner = squeeze_grasp_ros.entry:planner",
+            "executor = squeeze_grasp_ros.entry:executor",
+            "monitor = squeeze_grasp_ros.entry:monitor",
+            "sim_hardware = squeeze_grasp_ros.entry:sim_hardware",
+            "recorder = squeeze_grasp_ros.entry:recorder",
         ],
     },
 )

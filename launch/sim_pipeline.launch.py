@@ -1,10 +1,10 @@
 # Copyright 2026 squeeze_grasp_ros developers
 # SPDX-License-Identifier: Apache-2.0
-"""The simulated pipeline under a ROS 2 installation: the nodes ``squeeze-grasp run --processes``
+r"""The simulated pipeline under a ROS 2 installation: the nodes ``squeeze-grasp run --processes``
 starts, with the same parameters.
 
     ros2 launch squeeze_grasp_ros sim_pipeline.launch.py            # the shipped foam square
-    ros2 launch squeeze_grasp_ros sim_pipeline.launch.py scene:=/path/to/scene.yaml \\
+    ros2 launch squeeze_grasp_ros sim_pipeline.launch.py scene:=/path/to/scene.yaml \
         record:=/tmp/foam_run rviz:=true
 
 By default a client (``squeeze-grasp run --attach``) plans the scene with the launched planner,

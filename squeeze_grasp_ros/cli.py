@@ -15,8 +15,8 @@ from squeeze_grasp_ros.commands import VERBS
 from squeeze_grasp_ros.commands.common import fail
 from squeeze_grasp_ros.exit_codes import ExitCode
 from squeeze_grasp_ros.extras import install_hint
-from squeeze_grasp_ros.mechanics.errors import MechanicsError
-from squeeze_grasp_ros.scene import SceneError
+from squeeze_grasp_ros.mechanics.errors import (InfeasibleError, InternalError, InvalidInputError,
+                                               NumericalError, SqueezeGraspError)
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -53,6 +53,16 @@ def finite_json(value: Any, path: str = "", bad: list[str] | None = None) -> Any
     return value
 
 
+EXIT_CODES: dict[type[SqueezeGraspError], ExitCode] = {
+    InvalidInputError: ExitCode.USAGE,
+    InfeasibleError: ExitCode.OUTCOME,
+    NumericalError: ExitCode.NUMERICAL,
+    InternalError: ExitCode.INTERNAL,
+    SqueezeGraspError: ExitCode.INTERNAL,
+}
+"""The exit code of each error kind (first match wins)."""
+
+
 def main(argv: list[str] | None = None) -> int:
     """Entry point; returns the process exit code (:class:`~.exit_codes.ExitCode`).
 
@@ -63,8 +73,9 @@ def main(argv: list[str] | None = None) -> int:
     args = build_parser().parse_args(argv)
     try:
         result = args._module.run(args)
-    except (SceneError, MechanicsError) as exc:
-        return fail(args, str(exc), ExitCode.USAGE)
+    except SqueezeGraspError as exc:
+        return fail(args, str(exc), next(code for kind, code in EXIT_CODES.items()
+                                         if isinstance(exc, kind)))
     except ModuleNotFoundError as exc:
         hint = install_hint(exc.name or "")
         if hint is None:

@@ -1,6 +1,6 @@
 # Copyright 2026 squeeze_grasp_ros developers
 # SPDX-License-Identifier: Apache-2.0
-"""Reading untrusted input: bounded file reads, YAML without aliases, confined paths.
+r"""Reading untrusted input: bounded file reads, YAML without aliases, confined paths.
 
 Scenes, outlines and sweep specs come from users and, through the planner's services, from any
 ROS client. Reading them must not exhaust memory (a file is read up to a byte limit, YAML
@@ -10,7 +10,7 @@ must not reach outside the folders the operator allows.
 
 >>> load_yaml("a: 1", what="scene")
 {'a': 1}
->>> load_yaml("a: &x [1]\\nb: *x", what="scene")  # doctest: +IGNORE_EXCEPTION_DETAIL
+>>> load_yaml("a: &x [1]\nb: *x", what="scene")  # doctest: +IGNORE_EXCEPTION_DETAIL
 Traceback (most recent call last):
 InputError: scene: YAML aliases (*name) are not accepted (line 2, column 4)
 """

@@ -14,6 +14,7 @@ raise :class:`Cancelled`.
 
 Units are SI and coordinates are in the object frame of the scene (x right, y up).
 """
+
 from __future__ import annotations
 
 import dataclasses
@@ -32,23 +33,45 @@ import numpy as np
 from squeeze_grasp_ros.inputs import InputError, confine, load_yaml, read_text
 from squeeze_grasp_ros.mechanics.elastic.compliance import ROUTES, ElasticObject
 from squeeze_grasp_ros.mechanics.squeeze.contact_model import ContactModel
-from squeeze_grasp_ros.mechanics.errors import InfeasibleError, MechanicsError
+from squeeze_grasp_ros.mechanics.errors import (
+    InfeasibleError,
+    InternalError,
+    InvalidInputError,
+    NumericalError,
+    SqueezeGraspError,
+)
 from squeeze_grasp_ros.mechanics.squeeze.graspmap import GraspMap, grasp_map
 from squeeze_grasp_ros.mechanics.elastic.reduced import boundary_displacement, reduced_stiffness
-from squeeze_grasp_ros.mechanics.resistance.optimal import (FINGERS, MODES, Resistance, ResistanceSweep, contact_segments,
-                                   optimal_resistance, resistance_grasp, sweep_directions)
-from squeeze_grasp_ros.mechanics.resistance.frictional import (FrictionalResistance, add_adversary,
-                                            frictional_resistance)
+from squeeze_grasp_ros.mechanics.resistance.optimal import (
+    Resistance,
+    ResistanceSweep,
+    contact_segments,
+    optimal_resistance,
+    resistance_grasp,
+    sweep_directions,
+)
+from squeeze_grasp_ros.mechanics.resistance.frictional import (
+    FrictionalResistance,
+    add_adversary,
+    frictional_resistance,
+)
 from squeeze_grasp_ros.mechanics.ring.grasp_map import RingGraspMap, ring_grasp_map
 from squeeze_grasp_ros.mechanics.ring.model import RingModel
 from squeeze_grasp_ros.mechanics.ring.squeeze import RingGrasp, ring_grasp
 from squeeze_grasp_ros.mechanics.squeeze.stable_pure import Squeeze, force_closure, plan_squeeze
 from squeeze_grasp_ros.mechanics.squeeze.events import EventSqueeze
-from squeeze_grasp_ros.scene import (Scene, SceneError, build_mesh, build_outline, build_ring, finger_nodes,
-                    parse_scene, scene_material)
+from squeeze_grasp_ros.scene import (
+    Scene,
+    build_mesh,
+    build_outline,
+    build_ring,
+    finger_nodes,
+    parse_scene,
+    scene_material,
+)
 from squeeze_grasp_ros.scene_events import event_squeeze_scene
+from squeeze_grasp_ros.mechanics.vocabulary import Finger, SqueezeKind
 
-SQUEEZE_TYPES: tuple[str, ...] = ("stable", "pure")
 CONTACT_MODELS: tuple[str, ...] = ("point", "segment", "friction")
 MAX_DIRECTIONS = 100_000
 """Most push directions one resistance sweep may ask for."""
@@ -72,6 +95,7 @@ class ErrorCode(IntEnum):
     INTERNAL_ERROR = 4
     CANCELLED = 5
     BUSY = 6
+    NUMERICAL_FAILURE = 7
 
 
 class PlannerError(Exception):
@@ -94,6 +118,15 @@ def invalid(message: str) -> PlannerError:
     return PlannerError(ErrorCode.INVALID_ARGUMENT, message)
 
 
+ERROR_CODES: dict[type[SqueezeGraspError], ErrorCode] = {
+    InvalidInputError: ErrorCode.INVALID_ARGUMENT,
+    InfeasibleError: ErrorCode.NOT_FEASIBLE,
+    NumericalError: ErrorCode.NUMERICAL_FAILURE,
+    InternalError: ErrorCode.INTERNAL_ERROR,
+}
+"""The service error code of each error kind."""
+
+
 def classify(exc: Exception) -> tuple[ErrorCode, str]:
     """The error code and message of a failed request.
 
@@ -105,16 +138,16 @@ def classify(exc: Exception) -> tuple[ErrorCode, str]:
     Returns
     -------
     (ErrorCode, str)
-        :class:`PlannerError` keeps its code; :class:`InfeasibleError` is NOT_FEASIBLE; the
-        scene parser's and the mechanics' input errors are INVALID_ARGUMENT; anything else is
-        INTERNAL_ERROR (a bug: its type is named in the message).
+        :class:`PlannerError` keeps its code; the error kinds of
+        :mod:`squeeze_grasp_ros.mechanics.errors` map to INVALID_ARGUMENT, NOT_FEASIBLE,
+        NUMERICAL_FAILURE and INTERNAL_ERROR; anything else is INTERNAL_ERROR too (a bug: its
+        type is named in the message).
     """
     if isinstance(exc, PlannerError):
         return exc.code, str(exc)
-    if isinstance(exc, InfeasibleError):
-        return ErrorCode.NOT_FEASIBLE, str(exc)
-    if isinstance(exc, (SceneError, MechanicsError)):
-        return ErrorCode.INVALID_ARGUMENT, str(exc)
+    for kind, code in ERROR_CODES.items():
+        if isinstance(exc, kind):
+            return code, str(exc)
     return ErrorCode.INTERNAL_ERROR, f"internal error ({type(exc).__name__}): {exc}"
 
 
@@ -177,7 +210,7 @@ class LoadedObject:
 
     @property
     def model(self) -> str:
-        """"solid" (FEM mesh) or "ring" (curved beam)."""
+        """Body model: "solid" (FEM mesh) or "ring" (curved beam)."""
         return "ring" if isinstance(self.body, RingModel) else "solid"
 
     @property
@@ -193,15 +226,18 @@ class LoadedObject:
     def solid(self) -> ElasticObject:
         """The FEM object; a ring raises INVALID_ARGUMENT naming the service to use."""
         if not isinstance(self.body, ElasticObject):
-            raise invalid(f"object {self.object_id!r} is a ring model (Sec. 7): use the "
-                          "ring_grasp_test service")
+            raise invalid(
+                f"object {self.object_id!r} is a ring model (Sec. 7): use the "
+                "ring_grasp_test service"
+            )
         return self.body
 
     def ring(self) -> RingModel:
         """The ring model; a solid raises INVALID_ARGUMENT."""
         if not isinstance(self.body, RingModel):
-            raise invalid(f"object {self.object_id!r} is a solid (object.model: solid), not a "
-                          "ring")
+            raise invalid(
+                f"object {self.object_id!r} is a solid (object.model: solid), not a ring"
+            )
         return self.body
 
 
@@ -220,8 +256,9 @@ class SceneSource:
     text: str
 
 
-def read_scene(scene_yaml: str, scene_path: str, roots: Sequence[str | Path] | None = None
-               ) -> SceneSource:
+def read_scene(
+    scene_yaml: str, scene_path: str, roots: Sequence[str | Path] | None = None
+) -> SceneSource:
     """Parse the scene of a request: exactly one of YAML text and a file path.
 
     Parameters
@@ -243,8 +280,11 @@ def read_scene(scene_yaml: str, scene_path: str, roots: Sequence[str | Path] | N
         raise invalid("give exactly one of scene_yaml and scene_path")
     try:
         if scene_path:
-            path = confine(scene_path, roots, what="scene_path") if roots is not None \
+            path = (
+                confine(scene_path, roots, what="scene_path")
+                if roots is not None
                 else Path(scene_path)
+            )
             text = read_text(path, what="scene_path")
             data, base_dir = load_yaml(text, what="scene_path"), path.parent
         else:
@@ -280,8 +320,10 @@ def requested_nodes(scene: Scene) -> int | None:
 def check_size(count: int | None, limit: int, what: str) -> None:
     """Refuse a model with more than ``limit`` nodes (INVALID_ARGUMENT, oversized)."""
     if count is not None and count > limit:
-        raise invalid(f"oversized {what}: {count} nodes, more than the planner's limit of "
-                      f"{limit} (parameter); coarsen object.mesh or object.ring")
+        raise invalid(
+            f"oversized {what}: {count} nodes, more than the planner's limit of "
+            f"{limit} (parameter); coarsen object.mesh or object.ring"
+        )
 
 
 def solver_route(route: str, limits: Limits) -> str:
@@ -322,8 +364,9 @@ def object_key(source: SceneSource, object_id: str, route: str, limits: Limits) 
     return ObjectKey(object_id or source.scene.name or f"object-{digest[:12]}", route, digest)
 
 
-def load_object(source: SceneSource, key: ObjectKey, limits: Limits,
-                progress: Progress = no_progress) -> LoadedObject:
+def load_object(
+    source: SceneSource, key: ObjectKey, limits: Limits, progress: Progress = no_progress
+) -> LoadedObject:
     """Build and precompute the object of a scene, stage by stage.
 
     Parameters
@@ -364,8 +407,7 @@ def load_object(source: SceneSource, key: ObjectKey, limits: Limits,
         progress(SOLID_STAGES[3], 3, len(SOLID_STAGES), mesh.n)
         body.precompute()
         nodes = finger_nodes(scene, mesh)
-    return LoadedObject(key.object_id, scene, body, nodes, key.digest,
-                        time.perf_counter() - start)
+    return LoadedObject(key.object_id, scene, body, nodes, key.digest, time.perf_counter() - start)
 
 
 class ObjectCache:
@@ -396,9 +438,11 @@ class ObjectCache:
         with self._lock:
             loaded = self._objects.get(object_id)
             if loaded is None:
-                raise PlannerError(ErrorCode.UNKNOWN_OBJECT,
-                                   f"unknown object_id {object_id!r}: load it first with "
-                                   "load_object (objects are evicted when the cache is full)")
+                raise PlannerError(
+                    ErrorCode.UNKNOWN_OBJECT,
+                    f"unknown object_id {object_id!r}: load it first with "
+                    "load_object (objects are evicted when the cache is full)",
+                )
             self._objects.move_to_end(object_id)
             return loaded
 
@@ -427,8 +471,14 @@ class ObjectCache:
             return list(self._objects)
 
 
-def load_cached(cache: ObjectCache, source: SceneSource, object_id: str, route: str,
-                limits: Limits, progress: Progress = no_progress) -> tuple[LoadedObject, bool]:
+def load_cached(
+    cache: ObjectCache,
+    source: SceneSource,
+    object_id: str,
+    route: str,
+    limits: Limits,
+    progress: Progress = no_progress,
+) -> tuple[LoadedObject, bool]:
     """The cached object of the same id, scene and route, or a freshly loaded and cached one.
 
     Returns
@@ -461,8 +511,10 @@ def check_number(name: str, value: float, low: float = -math.inf, high: float = 
 def check_step(step: float, limits: Limits) -> float:
     """An event-squeeze substep no smaller than the node's ``min_step``."""
     if step < limits.min_step:
-        raise invalid(f"step {step} is below the planner's min_step {limits.min_step} "
-                      "(parameter): the squeeze would take too long")
+        raise invalid(
+            f"step {step} is below the planner's min_step {limits.min_step} "
+            "(parameter): the squeeze would take too long"
+        )
     return step
 
 
@@ -480,8 +532,12 @@ def choice(name: str, value: str, allowed: Sequence[str], default: str | None = 
     return value
 
 
-def contact_nodes(loaded: LoadedObject, contacts: Sequence[int], count: int | None = None,
-                  default: Sequence[int] | None = None) -> np.ndarray:
+def contact_nodes(
+    loaded: LoadedObject,
+    contacts: Sequence[int],
+    count: int | None = None,
+    default: Sequence[int] | None = None,
+) -> np.ndarray:
     """Validated contact nodes: distinct nodes of the outer boundary (every node of a ring).
 
     Parameters
@@ -505,9 +561,11 @@ def contact_nodes(loaded: LoadedObject, contacts: Sequence[int], count: int | No
         raise invalid(f"contacts must be distinct nodes, got {nodes.tolist()}")
     off = nodes[~np.isin(nodes, loaded.boundary)]
     if len(off):
-        raise invalid(f"contact node {int(off[0])} is not on the outer boundary of object "
-                      f"{loaded.object_id!r} ({len(loaded.boundary)} boundary nodes; "
-                      "LoadObject with return_model lists them)")
+        raise invalid(
+            f"contact node {int(off[0])} is not on the outer boundary of object "
+            f"{loaded.object_id!r} ({len(loaded.boundary)} boundary nodes; "
+            "LoadObject with return_model lists them)"
+        )
     return nodes
 
 
@@ -537,8 +595,9 @@ class SqueezePlan:
     force_closure: bool
 
 
-def squeeze_plan(loaded: LoadedObject, contacts: Sequence[int], kind: str,
-                 depth: float) -> SqueezePlan:
+def squeeze_plan(
+    loaded: LoadedObject, contacts: Sequence[int], kind: str, depth: float
+) -> SqueezePlan:
     """Plan a stable or pure squeeze (:func:`~.mechanics.squeeze.plan_squeeze`).
 
     Parameters
@@ -552,22 +611,27 @@ def squeeze_plan(loaded: LoadedObject, contacts: Sequence[int], kind: str,
         rho, m, >= 0; 0 = unit squeeze.
     """
     obj = loaded.solid()
-    kind = choice("squeeze_type", kind, SQUEEZE_TYPES)
+    kind = choice("squeeze_type", kind, SqueezeKind.values())
     scale = check_number("depth", depth, 0.0) or 1.0
     nodes = contact_nodes(loaded, contacts, default=loaded.finger_nodes)
     red = reduced_stiffness(obj, nodes)
-    sq = plan_squeeze(obj, nodes, kind, red)
+    sq = plan_squeeze(obj, nodes, kind=kind, red=red)
     relative = sq.relative_depth(scale)
     if depth and len(nodes) == 2 and not relative < 1.0:
-        raise invalid(f"depth {depth:.6g} m is a relative depth of {relative:.6g}: it must be "
-                      "below 1 (at 1 the fingers would meet)")
+        raise invalid(
+            f"depth {depth:.6g} m is a relative depth of {relative:.6g}: it must be "
+            "below 1 (at 1 the fingers would meet)"
+        )
     closure = False
     if len(nodes) == 2:
         mesh = obj.mesh
         i, j = (int(n) for n in nodes)
-        closure = force_closure(mesh.nodes[i], mesh.normal_at(i), mesh.nodes[j], mesh.normal_at(j),
-                                loaded.scene.mu)
-    return SqueezePlan(sq, scale, boundary_displacement(obj, red, scale * sq.displacement), closure)
+        closure = force_closure(
+            mesh.nodes[i], mesh.normal_at(i), mesh.nodes[j], mesh.normal_at(j), loaded.scene.mu
+        )
+    return SqueezePlan(
+        sq, scale, boundary_displacement(obj, red, scale * sq.displacement), closure
+    )
 
 
 def object_grasp_map(loaded: LoadedObject, mu: float) -> GraspMap:
@@ -590,9 +654,17 @@ class ResistancePlan:
     sweep: ResistanceSweep | None
 
 
-def resistance_plan(loaded: LoadedObject, contacts: Sequence[int], a: Sequence[float],
-                    mode: str, contact_model: str, half_width: float, directions: int,
-                    tip_radius: float, limits: Limits) -> ResistancePlan:
+def resistance_plan(
+    loaded: LoadedObject,
+    contacts: Sequence[int],
+    a: Sequence[float],
+    mode: str,
+    contact_model: str,
+    half_width: float,
+    directions: int,
+    tip_radius: float,
+    limits: Limits,
+) -> ResistancePlan:
     """Optimal resistance to the adversary translation ``a`` (Sec. 6).
 
     Parameters
@@ -615,7 +687,7 @@ def resistance_plan(loaded: LoadedObject, contacts: Sequence[int], a: Sequence[f
         Friction: the scene's squeeze step must be >= ``limits.min_step``.
     """
     obj = loaded.solid()
-    mode = choice("mode", mode, MODES)
+    mode = choice("mode", mode, SqueezeKind.values())
     contact_model = choice("contact_model", contact_model, CONTACT_MODELS)
     x, y, z = (check_number(f"a.{k}", v) for k, v in zip("xyz", a))
     if z != 0.0:
@@ -626,34 +698,50 @@ def resistance_plan(loaded: LoadedObject, contacts: Sequence[int], a: Sequence[f
     if contact_model == "friction":
         if count:
             raise invalid("directions: the sweep needs point or segment contacts")
-        return ResistancePlan(friction_resistance(loaded, nodes, (x, y), mode, tip_radius,
-                                                  limits), None)
+        return ResistancePlan(
+            friction_resistance(loaded, nodes, (x, y), mode, tip_radius, limits), None
+        )
     if contact_model == "point":
         sets = [[int(n)] for n in nodes]
     else:
         sets = contact_segments(obj.mesh, nodes.tolist(), width or None)
-    grasp = resistance_grasp(obj, dict(zip(FINGERS, sets)))
+    grasp = resistance_grasp(obj, dict(zip(tuple(Finger), sets)))
     sweep = sweep_directions(grasp, mode, count) if count else None
-    return ResistancePlan(optimal_resistance(grasp, (x, y), mode), sweep)
+    return ResistancePlan(optimal_resistance(grasp, (x, y), mode=mode), sweep)
 
 
-def friction_resistance(loaded: LoadedObject, nodes: np.ndarray, a: tuple[float, float],
-                        mode: str, tip_radius: float, limits: Limits) -> FrictionalResistance:
+def friction_resistance(
+    loaded: LoadedObject,
+    nodes: np.ndarray,
+    a: tuple[float, float],
+    mode: str,
+    tip_radius: float,
+    limits: Limits,
+) -> FrictionalResistance:
     """Algorithm 2 after the scene's event-driven squeeze at F1, F2 (Sec. 6.3)."""
     scene = loaded.scene
     radius = check_number("adversary_tip_radius", tip_radius, 0.0)
     radius = radius or (scene.adversary.tip_radius if scene.adversary is not None else 0.0)
     if not radius > 0:
-        raise invalid("adversary_tip_radius must be > 0 m for friction contacts (the scene "
-                      "gives no adversary tip radius)")
+        raise invalid(
+            "adversary_tip_radius must be > 0 m for friction contacts (the scene "
+            "gives no adversary tip radius)"
+        )
     check_step(scene.squeeze.step, limits)
     obj = loaded.solid()
     i, j, k = (int(n) for n in nodes)
     squeeze = event_squeeze_scene(scene, obj, (i, j))
     model = ContactModel(obj, scene.mu, max_events_per_depth=scene.squeeze.max_events_per_depth)
     state = add_adversary(squeeze.state, model, squeeze.displacement, k, radius)
-    return frictional_resistance(model, state, a, mode, squeeze.step, squeeze.event_tol,
-                                 contacts=[i, j, k])
+    return frictional_resistance(
+        model,
+        state,
+        a,
+        mode=mode,
+        step=squeeze.step,
+        event_tol=squeeze.event_tol,
+        contacts=[i, j, k],
+    )
 
 
 @dataclass(frozen=True)
@@ -676,8 +764,15 @@ class RingTest:
     map: RingGraspMap | None
 
 
-def ring_grasp_test(loaded: LoadedObject, contacts: Sequence[int], kind: str, mu: float,
-                    strain_limit: float, relative_depth: float, all_pairs: bool) -> RingTest:
+def ring_grasp_test(
+    loaded: LoadedObject,
+    contacts: Sequence[int],
+    kind: str,
+    mu: float,
+    strain_limit: float,
+    relative_depth: float,
+    all_pairs: bool,
+) -> RingTest:
     """Grasp test of a ring (:func:`~.mechanics.ring_squeeze.ring_grasp`, Sec. 7).
 
     Parameters
@@ -697,20 +792,34 @@ def ring_grasp_test(loaded: LoadedObject, contacts: Sequence[int], kind: str, mu
         Also map every placement (:func:`~.mechanics.ring_map.ring_grasp_map`).
     """
     ring = loaded.ring()
-    kind = choice("squeeze_type", kind, SQUEEZE_TYPES)
+    kind = choice("squeeze_type", kind, SqueezeKind.values())
     mu = check_number("mu", mu, 0.0)
     epsilon = check_number("strain_limit", strain_limit, 0.0) or None
     relative = check_number("relative_depth", relative_depth, 0.0, 1.0)
     nodes = contact_nodes(loaded, contacts, count=2, default=loaded.finger_nodes)
-    grasp = ring_grasp(ring, nodes, mu, epsilon, kind)
+    grasp = ring_grasp(ring, nodes, mu, epsilon=epsilon, kind=kind)
     depth = grasp.depth_for_relative(relative)
-    gmap = ring_grasp_map(ring, mu, epsilon, kind, relative or None) if all_pairs else None
+    gmap = (
+        ring_grasp_map(
+            ring, mu, epsilon=epsilon, kind=kind, requested_relative_depth=relative or None
+        )
+        if all_pairs
+        else None
+    )
     return RingTest(grasp, depth, grasp.feasible_at(depth), gmap)
 
 
-def event_squeeze_run(loaded: LoadedObject, contacts: Sequence[int], kind: str, depth: float,
-                      relative_depth: float, step: float, event_tol: float, limits: Limits,
-                      progress: Callable[[float], None] | None = None) -> EventSqueeze:
+def event_squeeze_run(
+    loaded: LoadedObject,
+    contacts: Sequence[int],
+    kind: str,
+    depth: float,
+    relative_depth: float,
+    step: float,
+    event_tol: float,
+    limits: Limits,
+    progress: Callable[[float], None] | None = None,
+) -> EventSqueeze:
     """The scene's event-driven squeeze (Algorithm 1) with the request's overrides.
 
     Parameters
@@ -731,7 +840,7 @@ def event_squeeze_run(loaded: LoadedObject, contacts: Sequence[int], kind: str, 
     """
     obj = loaded.solid()
     scene = loaded.scene
-    kind = choice("squeeze_type", kind, SQUEEZE_TYPES, scene.squeeze.type)
+    kind = choice("squeeze_type", kind, SqueezeKind.values(), scene.squeeze.type)
     depth = check_number("depth", depth, 0.0)
     relative_depth = check_number("relative_depth", relative_depth, 0.0, 1.0)
     if depth and relative_depth:
@@ -740,5 +849,13 @@ def event_squeeze_run(loaded: LoadedObject, contacts: Sequence[int], kind: str, 
     event_tol = check_number("event_tol", event_tol, 0.0) or scene.squeeze.event_tol
     nodes = contact_nodes(loaded, contacts, count=2, default=loaded.finger_nodes)
     scene = dataclasses.replace(scene, squeeze=dataclasses.replace(scene.squeeze, type=kind))
-    return event_squeeze_scene(scene, obj, (int(nodes[0]), int(nodes[1])), depth or None,
-                               relative_depth or None, step, event_tol, progress=progress)
+    return event_squeeze_scene(
+        scene,
+        obj,
+        (int(nodes[0]), int(nodes[1])),
+        depth=depth or None,
+        relative_depth=relative_depth or None,
+        step=step,
+        event_tol=event_tol,
+        progress=progress,
+    )

@@ -45,7 +45,9 @@ def draw_outline(ax, mesh: Mesh, displacement: np.ndarray | None = None, **style
 
 def draw_arrows(ax, points: np.ndarray, vectors: np.ndarray, length: float, color: str,
                 label: str | None = None) -> None:
-    """Arrows from ``points`` (k, 2) along ``vectors`` (k, 2), the longest drawn ``length`` m long."""
+    """Arrows from ``points`` (k, 2) along ``vectors`` (k, 2), the longest drawn ``length`` m
+    long.
+    """
     vmax = max(float(np.linalg.norm(vectors, axis=1).max()), 1e-300)
     v = vectors * (length / vmax)
     ax.quiver(points[:, 0], points[:, 1], v[:, 0], v[:, 1], angles="xy", scale_units="xy",

@@ -11,6 +11,7 @@ Each section is a frozen dataclass; its fields carry their documentation, unit a
 ``metadata`` so the parser, the error messages and ``squeeze-grasp scene-help`` share one
 source of truth. Adding a section = adding a dataclass and a field of :class:`Scene`.
 """
+
 from __future__ import annotations
 
 import dataclasses
@@ -24,18 +25,32 @@ import numpy as np
 
 from squeeze_grasp_ros.inputs import InputError, load_yaml, read_text
 from squeeze_grasp_ros.mechanics.elastic import shapes
-from squeeze_grasp_ros.mechanics.errors import MechanicsError
+from squeeze_grasp_ros.mechanics.elastic.compliance import ElasticObject
+from squeeze_grasp_ros.mechanics.errors import InvalidInputError
 from squeeze_grasp_ros.mechanics.elastic.material import Material
-from squeeze_grasp_ros.mechanics.elastic.mesh import MAX_MESH_NODES, Mesh, generate_mesh, target_max_area
+from squeeze_grasp_ros.mechanics.elastic.mesh import (
+    MAX_MESH_NODES,
+    Mesh,
+    generate_mesh,
+    target_max_area,
+)
 from squeeze_grasp_ros.mechanics.ring.model import RingModel, ring_from_outline
+from squeeze_grasp_ros.mechanics.vocabulary import Finger, SQUEEZING_FINGERS
 
 
-class SceneError(ValueError):
+class SceneError(InvalidInputError):
     """A scene entry is unknown, of the wrong type, out of range or contradictory."""
 
 
-def spec(doc: str, unit: str = "", lo: float | None = None, hi: float | None = None,
-         lo_open: bool = False, choices: tuple = (), **kw) -> Any:
+def spec(
+    doc: str,
+    unit: str = "",
+    lo: float | None = None,
+    hi: float | None = None,
+    lo_open: bool = False,
+    choices: tuple = (),
+    **kw,
+) -> Any:
     """A dataclass field with documentation, unit, range and allowed choices for the parser."""
     meta = {"doc": doc, "unit": unit, "lo": lo, "hi": hi, "lo_open": lo_open, "choices": choices}
     return field(metadata=meta, **kw)
@@ -86,10 +101,15 @@ SHAPES: dict[str, tuple[str, ...]] = {
 class MeshSpec:
     """Triangulation controls: the accuracy knobs of the solid model."""
 
-    max_area: Optional[float] = spec("largest element area", "m^2", lo=0.0, lo_open=True, default=None)
-    nodes: Optional[int] = spec("approximate node count (instead of max_area)", lo=10,
-                                hi=MAX_MESH_NODES, default=None)
-    min_angle: float = spec("smallest element angle", "deg", lo=0.0, hi=34.0, lo_open=True, default=30.0)
+    max_area: Optional[float] = spec(
+        "largest element area", "m^2", lo=0.0, lo_open=True, default=None
+    )
+    nodes: Optional[int] = spec(
+        "approximate node count (instead of max_area)", lo=10, hi=MAX_MESH_NODES, default=None
+    )
+    min_angle: float = spec(
+        "smallest element angle", "deg", lo=0.0, hi=34.0, lo_open=True, default=30.0
+    )
 
 
 @dataclass(frozen=True)
@@ -124,9 +144,12 @@ class ObjectSpec:
 class PlacementSpec:
     """Where a finger first touches the boundary: exactly one of point, angle_deg, node."""
 
-    point: Optional[tuple[float, float]] = spec("nearest boundary node to this point", "m", default=None)
-    angle_deg: Optional[float] = spec("boundary node in this polar direction from the centroid", "deg",
-                                      default=None)
+    point: Optional[tuple[float, float]] = spec(
+        "nearest boundary node to this point", "m", default=None
+    )
+    angle_deg: Optional[float] = spec(
+        "boundary node in this polar direction from the centroid", "deg", default=None
+    )
     node: Optional[int] = spec("mesh node index on the outer boundary", lo=0, default=None)
 
 
@@ -136,11 +159,17 @@ class FingerSpec:
 
     placement: PlacementSpec = spec("initial contact")
     tip_radius: float = spec("fingertip radius (0 = point finger)", "m", lo=0.0, default=0.0)
-    device: str = spec("device driving this finger (empty: DEFAULT_DEVICES)",
-                       choices=("",) + tuple(DEVICES), default="")
+    device: str = spec(
+        "device driving this finger (empty: DEFAULT_DEVICES)",
+        choices=("",) + tuple(DEVICES),
+        default="",
+    )
     direction: Optional[tuple[float, float]] = spec(
         "translation direction for the event-driven squeeze (both F1 and F2 or neither; "
-        "overrides squeeze.type; normalised)", "", default=None)
+        "overrides squeeze.type; normalised)",
+        "",
+        default=None,
+    )
 
 
 @dataclass(frozen=True)
@@ -149,15 +178,29 @@ class SqueezeSpec:
 
     type: str = spec("squeeze type", choices=("stable", "pure"), default="stable")
     depth: Optional[float] = spec("squeeze depth rho", "m", lo=0.0, default=None)
-    relative_depth: Optional[float] = spec("finger approach / initial contact distance", "",
-                                           lo=0.0, hi=1.0, default=None)
-    step: float = spec("depth step of the event-driven squeeze, relative to the object size", "",
-                       lo=0.0, lo_open=True, default=1e-3)
-    event_tol: float = spec("event location tolerance, relative to the object size", "",
-                            lo=0.0, lo_open=True, default=1e-9)
-    max_events_per_depth: int = spec("chattering bound: most events of one contact node within "
-                                     "one depth step; more freeze its mode for a step (reported)",
-                                     lo=1, default=4)
+    relative_depth: Optional[float] = spec(
+        "finger approach / initial contact distance", "", lo=0.0, hi=1.0, default=None
+    )
+    step: float = spec(
+        "depth step of the event-driven squeeze, relative to the object size",
+        "",
+        lo=0.0,
+        lo_open=True,
+        default=1e-3,
+    )
+    event_tol: float = spec(
+        "event location tolerance, relative to the object size",
+        "",
+        lo=0.0,
+        lo_open=True,
+        default=1e-9,
+    )
+    max_events_per_depth: int = spec(
+        "chattering bound: most events of one contact node within "
+        "one depth step; more freeze its mode for a step (reported)",
+        lo=1,
+        default=4,
+    )
 
 
 @dataclass(frozen=True)
@@ -172,8 +215,11 @@ class StrainLimitSpec:
     """Proportional limit (eq. 45)."""
 
     epsilon: float = spec("strain limit epsilon*", "", lo=0.0, lo_open=True)
-    criterion: str = spec("principal: max |eps_1|,|eps_2|; componentwise: |eps_x|,|eps_y| (literal eq. 45)",
-                          choices=("principal", "componentwise"), default="principal")
+    criterion: str = spec(
+        "principal: max |eps_1|,|eps_2|; componentwise: |eps_x|,|eps_y| (literal eq. 45)",
+        choices=("principal", "componentwise"),
+        default="principal",
+    )
 
 
 @dataclass(frozen=True)
@@ -191,54 +237,87 @@ class AdversarySpec:
     a: tuple[float, float] = spec("translation of A", "m")
     tip_radius: float = spec("fingertip radius of A", "m", lo=0.0, default=0.0)
     mode: str = spec("resistance type", choices=("stable", "pure"), default="stable")
-    contacts: str = spec("contact model", choices=("point", "segment", "friction"), default="point")
-    device: str = spec("device driving A (empty: DEFAULT_DEVICES)", choices=("",) + tuple(DEVICES),
-                       default="")
+    contacts: str = spec(
+        "contact model", choices=("point", "segment", "friction"), default="point"
+    )
+    device: str = spec(
+        "device driving A (empty: DEFAULT_DEVICES)", choices=("",) + tuple(DEVICES), default=""
+    )
     segment_half_width: Optional[float] = spec(
         "contacts: segment: each finger's fixed segment is the boundary nodes within this arc "
-        "length of its contact node (default: the node and its two neighbours)", "m", lo=0.0,
-        default=None)
+        "length of its contact node (default: the node and its two neighbours)",
+        "m",
+        lo=0.0,
+        default=None,
+    )
     compare_direction: Optional[tuple[float, float]] = spec(
         "line of F1's translation d1 of a user-given resistance to compare with the optimum "
-        "(Table 4); d2 and the length of d1 follow from the resistance constraints", "",
-        default=None)
+        "(Table 4); d2 and the length of d1 follow from the resistance constraints",
+        "",
+        default=None,
+    )
 
 
 @dataclass(frozen=True)
 class SensorsSpec:
     """Fingertip sensors of the simulated hardware (effects: force_sensing, tactile_sensing,
-    sensor_noise, sensor_dropout)."""
+    sensor_noise, sensor_dropout).
+    """
 
-    noise_std: Optional[float] = spec("std of the Gaussian noise on every force reading (wrench "
-                                      "force components and taxel forces; torques get "
-                                      "noise_std * tip radius) (effect: sensor_noise)", "N",
-                                      lo=0.0, lo_open=True, default=None)
-    dropout: Optional[float] = spec("probability that a wrench or tactile message of a tick is "
-                                    "dropped (effect: sensor_dropout)", "", lo=0.0, hi=1.0,
-                                    default=None)
-    seed: Optional[int] = spec("seed of the noise and dropout draws (required with either)", "",
-                               lo=0, default=None)
-    taxels: int = spec("taxels per fingertip tactile array (effect: tactile_sensing)", "", lo=2,
-                       default=96)
-    taxel_span_deg: float = spec("arc of the fingertip covered by the tactile array, centred on "
-                                 "the initial contact", "deg", lo=0.0, hi=360.0, lo_open=True,
-                                 default=150.0)
+    noise_std: Optional[float] = spec(
+        "std of the Gaussian noise on every force reading (wrench "
+        "force components and taxel forces; torques get "
+        "noise_std * tip radius) (effect: sensor_noise)",
+        "N",
+        lo=0.0,
+        lo_open=True,
+        default=None,
+    )
+    dropout: Optional[float] = spec(
+        "probability that a wrench or tactile message of a tick is "
+        "dropped (effect: sensor_dropout)",
+        "",
+        lo=0.0,
+        hi=1.0,
+        default=None,
+    )
+    seed: Optional[int] = spec(
+        "seed of the noise and dropout draws (required with either)", "", lo=0, default=None
+    )
+    taxels: int = spec(
+        "taxels per fingertip tactile array (effect: tactile_sensing)", "", lo=2, default=96
+    )
+    taxel_span_deg: float = spec(
+        "arc of the fingertip covered by the tactile array, centred on the initial contact",
+        "deg",
+        lo=0.0,
+        hi=360.0,
+        lo_open=True,
+        default=150.0,
+    )
 
 
 @dataclass(frozen=True)
 class ActuatorsSpec:
     """Dynamics of the finger actuators (effect: actuator_lag)."""
 
-    time_constant: float = spec("first-order lag time constant of every finger actuator", "s",
-                                lo=0.0, lo_open=True)
+    time_constant: float = spec(
+        "first-order lag time constant of every finger actuator", "s", lo=0.0, lo_open=True
+    )
 
 
 @dataclass(frozen=True)
 class SimSpec:
     """The simulated world's clock (no effect needed)."""
 
-    dt: float = spec("lockstep tick: sim-time step of the simulated hardware", "s", lo=0.0,
-                     hi=1.0, lo_open=True, default=1e-3)
+    dt: float = spec(
+        "lockstep tick: sim-time step of the simulated hardware",
+        "s",
+        lo=0.0,
+        hi=1.0,
+        lo_open=True,
+        default=1e-3,
+    )
 
 
 @dataclass(frozen=True)
@@ -251,14 +330,21 @@ class Scene:
     description: str = spec("free text", default="")
     squeeze: SqueezeSpec = spec("the squeeze", default_factory=SqueezeSpec)
     friction: Optional[FrictionSpec] = spec("friction (effect: friction)", default=None)
-    strain_limit: Optional[StrainLimitSpec] = spec("strain limit (effect: strain_limit)", default=None)
+    strain_limit: Optional[StrainLimitSpec] = spec(
+        "strain limit (effect: strain_limit)", default=None
+    )
     pickup: Optional[PickupSpec] = spec("pickup (effect: pickup)", default=None)
     adversary: Optional[AdversarySpec] = spec("adversary finger (effect: adversary)", default=None)
     effects: tuple[str, ...] = spec("declared effects, see EFFECTS", default=())
-    sensors: Optional[SensorsSpec] = spec("fingertip sensors (effects: sensor_noise, sensor_dropout;"
-                                          " taxel layout with tactile_sensing)", default=None)
-    actuators: Optional[ActuatorsSpec] = spec("actuator dynamics (effect: actuator_lag)",
-                                              default=None)
+    sensors: Optional[SensorsSpec] = spec(
+        "fingertip sensors (effects: sensor_noise, "
+        "sensor_dropout;"
+        " taxel layout with tactile_sensing)",
+        default=None,
+    )
+    actuators: Optional[ActuatorsSpec] = spec(
+        "actuator dynamics (effect: actuator_lag)", default=None
+    )
     sim: SimSpec = spec("simulated clock", default_factory=SimSpec)
 
     @property
@@ -271,8 +357,13 @@ class Scene:
         return effect in self.effects
 
 
-SECTION_EFFECT = {"friction": "friction", "strain_limit": "strain_limit", "pickup": "pickup",
-                  "adversary": "adversary", "actuators": "actuator_lag"}
+SECTION_EFFECT = {
+    "friction": "friction",
+    "strain_limit": "strain_limit",
+    "pickup": "pickup",
+    "adversary": "adversary",
+    "actuators": "actuator_lag",
+}
 
 SENSOR_FIELD_EFFECT = {"noise_std": "sensor_noise", "dropout": "sensor_dropout"}
 """Fields of the ``sensors`` section that exist exactly when their effect is declared."""
@@ -290,7 +381,7 @@ def _describe(meta: dict) -> str:
     return "a finite number"
 
 
-MAX_INT = 2 ** 53
+MAX_INT = 2**53
 """Largest integer a scene entry may hold (exactly representable as a float)."""
 
 
@@ -302,7 +393,8 @@ def _check_range(value: float, meta: dict, where: str) -> None:
     if not np.isfinite(float(value)):
         raise SceneError(f"{where} must be a finite number{unit}, got {value!r}")
     bad = (lo is not None and (value < lo or (meta.get("lo_open") and value == lo))) or (
-        hi is not None and value > hi)
+        hi is not None and value > hi
+    )
     if bad:
         raise SceneError(f"{where} must be {_describe(meta)}{unit}, got {value!r}")
 
@@ -387,8 +479,10 @@ def _validate_shape(shape: dict) -> None:
     allowed = set(SHAPES[kind]) | {"type"}
     unknown = sorted(set(shape) - allowed)
     if unknown:
-        raise SceneError(f"unknown key object.shape.{unknown[0]} for type {kind} "
-                         f"(allowed: {sorted(allowed - {'type'})})")
+        raise SceneError(
+            f"unknown key object.shape.{unknown[0]} for type {kind} "
+            f"(allowed: {sorted(allowed - {'type'})})"
+        )
     optional = {"cos", "sin"}
     for key in SHAPES[kind]:
         if key not in shape and key not in optional:
@@ -398,20 +492,25 @@ def _validate_shape(shape: dict) -> None:
 
 
 def _is_number(value: Any) -> bool:
-    return isinstance(value, (int, float)) and not isinstance(value, bool) and \
-        abs(value) <= MAX_INT and bool(np.isfinite(float(value)))
+    return (
+        isinstance(value, (int, float))
+        and not isinstance(value, bool)
+        and abs(value) <= MAX_INT
+        and bool(np.isfinite(float(value)))
+    )
 
 
 def _check_shape_value(key: str, value: Any, where: str) -> None:
     """Types of the shape parameters: lengths are positive numbers (m), ``points`` a list of
-    [x, y] number pairs, ``cos``/``sin`` lists of numbers, ``path`` a non-empty string."""
+    [x, y] number pairs, ``cos``/``sin`` lists of numbers, ``path`` a non-empty string.
+    """
     if key == "path":
         if not isinstance(value, str) or not value:
             raise SceneError(f"{where} must be a file path (a non-empty string), got {value!r}")
     elif key == "points":
         if not isinstance(value, list) or not all(
-                isinstance(p, (list, tuple)) and len(p) == 2 and all(map(_is_number, p))
-                for p in value):
+            isinstance(p, (list, tuple)) and len(p) == 2 and all(map(_is_number, p)) for p in value
+        ):
             raise SceneError(f"{where} must be a list of [x, y] number pairs (m)")
     elif key in ("cos", "sin"):
         if not isinstance(value, list) or not all(map(_is_number, value)):
@@ -424,10 +523,12 @@ def _check_shape_value(key: str, value: Any, where: str) -> None:
 def _validate(scene: Scene) -> Scene:
     _validate_shape(scene.object.shape)
     for name in scene.fingers:
-        if name not in ("F1", "F2"):
-            raise SceneError(f"unknown finger fingers.{name} (allowed: F1, F2; the adversary is "
-                             "the 'adversary' section)")
-    if set(scene.fingers) != {"F1", "F2"}:
+        if name not in SQUEEZING_FINGERS:
+            raise SceneError(
+                f"unknown finger fingers.{name} (allowed: F1, F2; the adversary is "
+                "the 'adversary' section)"
+            )
+    if set(scene.fingers) != {Finger.F1, Finger.F2}:
         raise SceneError("fingers must define both F1 and F2")
     placements = [(f"fingers.{k}", v.placement) for k, v in scene.fingers.items()]
     if scene.adversary is not None:
@@ -435,8 +536,10 @@ def _validate(scene: Scene) -> Scene:
     for where, p in placements:
         given = [k for k in ("point", "angle_deg", "node") if getattr(p, k) is not None]
         if len(given) != 1:
-            raise SceneError(f"{where}.placement needs exactly one of point, angle_deg, node; "
-                             f"got {given or 'none'}")
+            raise SceneError(
+                f"{where}.placement needs exactly one of point, angle_deg, node; "
+                f"got {given or 'none'}"
+            )
     adv = scene.adversary
     if adv is not None:
         for name in ("a", "compare_direction"):
@@ -445,14 +548,17 @@ def _validate(scene: Scene) -> Scene:
                 raise SceneError(f"adversary.{name} must be a nonzero vector, got {list(value)}")
     given = [k for k, v in scene.fingers.items() if v.direction is not None]
     if given and len(given) != len(scene.fingers):
-        raise SceneError(f"fingers.{given[0]}.direction is given: give direction for every finger "
-                         "or for none")
+        raise SceneError(
+            f"fingers.{given[0]}.direction is given: give direction for every finger or for none"
+        )
     sq = scene.squeeze
     if sq.depth is not None and sq.relative_depth is not None:
         raise SceneError("squeeze.depth and squeeze.relative_depth are exclusive; give one")
     if sq.relative_depth is not None and not sq.relative_depth < 1:
-        raise SceneError(f"squeeze.relative_depth must be < 1 (at 1 the fingers would meet), "
-                         f"got {sq.relative_depth}")
+        raise SceneError(
+            f"squeeze.relative_depth must be < 1 (at 1 the fingers would meet), "
+            f"got {sq.relative_depth}"
+        )
     for effect in scene.effects:
         if effect not in EFFECTS:
             raise SceneError(f"unknown effect {effect!r} in effects (allowed: {sorted(EFFECTS)})")
@@ -461,8 +567,9 @@ def _validate(scene: Scene) -> Scene:
     for section, effect in SECTION_EFFECT.items():
         present = getattr(scene, section) is not None
         if present and not scene.has(effect):
-            raise SceneError(f"section {section} is given but effect {effect!r} is not declared "
-                             "in effects")
+            raise SceneError(
+                f"section {section} is given but effect {effect!r} is not declared in effects"
+            )
         if scene.has(effect) and not present:
             raise SceneError(f"effect {effect!r} is declared but section {section} is missing")
     _validate_sensors(scene)
@@ -476,7 +583,7 @@ def _validate(scene: Scene) -> Scene:
         raise SceneError("object.mesh.max_area and object.mesh.nodes are exclusive; give one")
     try:
         Material(obj.material.E, obj.material.nu, obj.material.thickness)
-    except MechanicsError as exc:
+    except InvalidInputError as exc:
         raise SceneError(f"object.{exc}") from None
     return scene
 
@@ -487,32 +594,43 @@ def _validate_sensors(scene: Scene) -> None:
     for name, effect in SENSOR_FIELD_EFFECT.items():
         present = sensors is not None and getattr(sensors, name) is not None
         if present and not scene.has(effect):
-            raise SceneError(f"sensors.{name} is given but effect {effect!r} is not declared in "
-                             "effects")
+            raise SceneError(
+                f"sensors.{name} is given but effect {effect!r} is not declared in effects"
+            )
         if scene.has(effect) and not present:
             raise SceneError(f"effect {effect!r} is declared but sensors.{name} is missing")
         if scene.has(effect) and not any(scene.has(e) for e in SENSING_EFFECTS):
-            raise SceneError(f"effect {effect!r} needs a sensor to act on: declare "
-                             "force_sensing or tactile_sensing")
+            raise SceneError(
+                f"effect {effect!r} needs a sensor to act on: declare "
+                "force_sensing or tactile_sensing"
+            )
     if sensors is None:
         return
     randomised = any(getattr(sensors, name) is not None for name in SENSOR_FIELD_EFFECT)
     if randomised and sensors.seed is None:
-        raise SceneError("sensors.seed is required with sensors.noise_std or sensors.dropout "
-                         "(runs must be reproducible)")
+        raise SceneError(
+            "sensors.seed is required with sensors.noise_std or sensors.dropout "
+            "(runs must be reproducible)"
+        )
     if sensors.seed is not None and not randomised:
         raise SceneError("sensors.seed is given but there is no sensor_noise or sensor_dropout")
     defaults = SensorsSpec()
-    changed = [f for f in ("taxels", "taxel_span_deg") if getattr(sensors, f) != getattr(defaults, f)]
+    changed = [
+        f for f in ("taxels", "taxel_span_deg") if getattr(sensors, f) != getattr(defaults, f)
+    ]
     if changed and not scene.has("tactile_sensing"):
-        raise SceneError(f"sensors.{changed[0]} is given but effect 'tactile_sensing' is not "
-                         "declared in effects")
+        raise SceneError(
+            f"sensors.{changed[0]} is given but effect 'tactile_sensing' is not "
+            "declared in effects"
+        )
     if not randomised and not changed:
         raise SceneError("section sensors is given but sets nothing the declared effects use")
 
 
 def finger_devices(scene: Scene) -> dict[str, str]:
-    """Finger name -> device name (``DEVICES``) of every finger of the scene, adversary included."""
+    """Finger name -> device name (``DEVICES``) of every finger of the scene, adversary
+    included.
+    """
     given = {name: spec_.device for name, spec_ in scene.fingers.items()}
     if scene.adversary is not None:
         given["A"] = scene.adversary.device
@@ -524,19 +642,24 @@ def _validate_devices(scene: Scene) -> None:
     seen: dict[str, str] = {}
     for name, device in finger_devices(scene).items():
         if device in seen:
-            raise SceneError(f"fingers {seen[device]} and {name} are both mapped to device "
-                             f"{device!r}; give each finger its own device")
+            raise SceneError(
+                f"fingers {seen[device]} and {name} are both mapped to device "
+                f"{device!r}; give each finger its own device"
+            )
         seen[device] = name
 
 
 def parse_scene(data: Any, base_dir: Path | None = None) -> Scene:
-    """Validate a scene given as a mapping (e.g. from YAML); relative file paths use ``base_dir``."""
+    """Validate a scene given as a mapping (e.g. from YAML); relative file paths use
+    ``base_dir``.
+    """
     if not isinstance(data, dict):
         raise SceneError("a scene must be a YAML mapping")
     if isinstance(data.get("fingers"), dict):
         data = dict(data)
-        data["fingers"] = {k: parse_section(FingerSpec, v, f"fingers.{k}")
-                           for k, v in data["fingers"].items()}
+        data["fingers"] = {
+            k: parse_section(FingerSpec, v, f"fingers.{k}") for k, v in data["fingers"].items()
+        }
     scene = _validate(parse_section(Scene, data, ""))
     shape = scene.object.shape
     if shape["type"] == "file" and base_dir is not None and not Path(shape["path"]).is_absolute():
@@ -559,7 +682,9 @@ def load_scene(path: str | Path) -> Scene:
 
 
 def build_outline(shape: dict) -> shapes.Outline:
-    """The :class:`~squeeze_grasp_ros.mechanics.elastic.shapes.Outline` of a validated shape mapping."""
+    """The :class:`~squeeze_grasp_ros.mechanics.elastic.shapes.Outline` of a validated shape
+    mapping.
+    """
     kind = shape["type"]
     try:
         if kind == "square":
@@ -568,7 +693,7 @@ def build_outline(shape: dict) -> shapes.Outline:
             return shapes.load_outline(shape["path"])
         builder = getattr(shapes, kind)
         return builder(**{k: v for k, v in shape.items() if k != "type"})
-    except MechanicsError as exc:
+    except InvalidInputError as exc:
         raise SceneError(f"object.shape: {exc}") from None
     except TypeError as exc:
         raise SceneError(f"object.shape ({kind}): {exc}") from None
@@ -589,35 +714,48 @@ def build_mesh(scene: Scene) -> Mesh:
     else:
         area = target_max_area(outline, ms.nodes if ms.nodes is not None else 600)
     try:
-        return generate_mesh(outline, area, ms.min_angle)
-    except MechanicsError as exc:
+        return generate_mesh(outline, area, min_angle=ms.min_angle)
+    except InvalidInputError as exc:
         raise SceneError(f"object.mesh: {exc}") from None
+
+
+def scene_solid(scene: Scene) -> ElasticObject:
+    """The scene's solid object: its mesh (:func:`build_mesh`) and plane-stress material."""
+    return ElasticObject(build_mesh(scene), scene_material(scene))
 
 
 def build_ring(scene: Scene) -> RingModel:
     """The curved-beam model of a ring scene (``object.model: ring``): the shape is the middle
     curve, ``material.thickness`` the out-of-plane width w, ``ring.wall_thickness`` the wall h.
 
-    Its nodes act as boundary nodes, so :func:`finger_nodes` places fingers on it."""
+    Its nodes act as boundary nodes, so :func:`finger_nodes` places fingers on it.
+    """
     obj = scene.object
     if obj.model != "ring":
         raise SceneError(f"object.model must be ring for the ring model, got {obj.model!r}")
     try:
-        return ring_from_outline(build_outline(obj.shape), scene_material(scene),
-                                 obj.ring.wall_thickness, obj.ring.elements)
-    except MechanicsError as exc:
+        return ring_from_outline(
+            build_outline(obj.shape),
+            scene_material(scene),
+            obj.ring.wall_thickness,
+            obj.ring.elements,
+        )
+    except InvalidInputError as exc:
         raise SceneError(f"object.ring: {exc}") from None
 
 
-def placement_node(mesh: Mesh, placement: PlacementSpec, where: str,
-                   positions: np.ndarray | None = None) -> int:
+def placement_node(
+    mesh: Mesh, placement: PlacementSpec, where: str, positions: np.ndarray | None = None
+) -> int:
     """Mesh node index of a finger placement on the outer boundary (or ``positions`` loop)."""
     loop = mesh.boundary
     pts = mesh.nodes[loop] if positions is None else positions
     if placement.node is not None:
         if placement.node >= mesh.n or placement.node not in set(loop.tolist()):
-            raise SceneError(f"{where}.placement.node {placement.node} is not an outer-boundary "
-                             f"node (boundary has {len(loop)} nodes; see `squeeze-grasp mesh`)")
+            raise SceneError(
+                f"{where}.placement.node {placement.node} is not an outer-boundary "
+                f"node (boundary has {len(loop)} nodes; see `squeeze-grasp mesh`)"
+            )
         return int(placement.node)
     if placement.point is not None:
         k = np.argmin(np.linalg.norm(pts - np.asarray(placement.point), axis=1))
@@ -631,19 +769,21 @@ def placement_node(mesh: Mesh, placement: PlacementSpec, where: str,
 
 def finger_nodes(scene: Scene, mesh: Mesh) -> tuple[int, int]:
     """Initial contact nodes (F1, F2) of the scene's fingers on ``mesh``."""
-    i = placement_node(mesh, scene.fingers["F1"].placement, "fingers.F1")
-    j = placement_node(mesh, scene.fingers["F2"].placement, "fingers.F2")
+    i = placement_node(mesh, scene.fingers[Finger.F1].placement, "fingers.F1")
+    j = placement_node(mesh, scene.fingers[Finger.F2].placement, "fingers.F2")
     if i == j:
         raise SceneError("fingers.F1 and fingers.F2 are placed on the same boundary node")
     return i, j
 
 
-def key_reference(cls: type, prefix: str = "", width: int = 38,
-                  nested: dict[str, tuple[type, str]] | None = None) -> list[str]:
+def key_reference(
+    cls: type, prefix: str = "", width: int = 38, nested: dict[str, tuple[type, str]] | None = None
+) -> list[str]:
     """One line per key of dataclass ``cls`` (and its sections): path, doc, unit, range.
 
     Lists of sections (``tuple[Section, ...]``) are shown as ``key[]``; ``nested`` maps a key
-    path to (section class, prefix) for mappings whose values are sections."""
+    path to (section class, prefix) for mappings whose values are sections.
+    """
     nested = nested or {}
     lines: list[str] = []
     hints = typing.get_type_hints(cls)
@@ -652,15 +792,25 @@ def key_reference(cls: type, prefix: str = "", width: int = 38,
         tp = hints[f.name]
         inner = ([a for a in typing.get_args(tp) if a is not type(None)] or [tp])[0]
         path = f"{prefix}{f.name}"
-        if typing.get_origin(inner) is tuple and dataclasses.is_dataclass(typing.get_args(inner)[0]):
+        if typing.get_origin(inner) is tuple and dataclasses.is_dataclass(
+            typing.get_args(inner)[0]
+        ):
             inner, path = typing.get_args(inner)[0], path + "[]"
         req = f.default is dataclasses.MISSING and f.default_factory is dataclasses.MISSING
         ranged = meta.get("lo") is not None or meta.get("hi") is not None
-        extra = [x for x in (meta.get("unit"), _describe(dict(meta)) if ranged else "",
-                             "one of " + "/".join(meta["choices"]) if meta.get("choices") else "",
-                             "required" if req else "") if x]
-        lines.append(f"{path:{width}s} {meta.get('doc', '')}"
-                     + (f" [{', '.join(extra)}]" if extra else ""))
+        extra = [
+            x
+            for x in (
+                meta.get("unit"),
+                _describe(dict(meta)) if ranged else "",
+                "one of " + "/".join(meta["choices"]) if meta.get("choices") else "",
+                "required" if req else "",
+            )
+            if x
+        ]
+        lines.append(
+            f"{path:{width}s} {meta.get('doc', '')}" + (f" [{', '.join(extra)}]" if extra else "")
+        )
         if dataclasses.is_dataclass(inner):
             lines += key_reference(inner, path + ".", width, nested)
         if path in nested:

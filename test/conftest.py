@@ -17,6 +17,10 @@ from typing import IO, TYPE_CHECKING
 
 import pytest
 
+from squeeze_grasp_ros.threads import single_thread_blas
+
+single_thread_blas()  # as the installed executables do, before any test imports numpy
+
 if TYPE_CHECKING:
     from rclpy.context import Context
 

@@ -66,7 +66,7 @@ def net_events(states) -> list[tuple[int, str, str]]:
 
 
 def contact_modes(state) -> dict:
-    """node -> (finger, mode) of a stepper ``ContactState`` or a ``SimState`` message."""
+    """Node -> (finger, mode) of a stepper ``ContactState`` or a ``SimState`` message."""
     if not hasattr(state, "header"):
         return {c.node: (c.finger, c.mode) for c in state.contacts}
     from squeeze_grasp_ros.ros.messages import contact_records

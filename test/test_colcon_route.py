@@ -10,6 +10,7 @@ ROS installation would be); this package is built into a fresh install base on e
 overlay). The environment is exactly what sourcing both ``setup.bash`` files gives; the test
 checks that the package, its interfaces and its data files are the installed ones.
 """
+
 from __future__ import annotations
 
 import fcntl
@@ -25,22 +26,49 @@ from pathlib import Path
 import pytest
 
 REPO = Path(__file__).resolve().parents[1]
-CACHE = Path(os.environ.get("SQUEEZE_GRASP_COLCON_CACHE",
-                            Path.home() / ".cache" / "squeeze_grasp_ros" / "colcon-interfaces"))
+CACHE = Path(
+    os.environ.get(
+        "SQUEEZE_GRASP_COLCON_CACHE",
+        Path.home() / ".cache" / "squeeze_grasp_ros" / "colcon-interfaces",
+    )
+)
 
 
 def colcon_build(paths: list[Path], base: Path, env: dict[str, str]) -> None:
     """``colcon build --paths PATHS`` with build, install and log folders under ``base``."""
-    colcon = shutil.which("colcon", path=str(Path(sys.executable).parent)) or shutil.which("colcon")
+    colcon = shutil.which("colcon", path=str(Path(sys.executable).parent)) or shutil.which(
+        "colcon"
+    )
     assert colcon, "colcon is not installed (pip install -e '.[test]' brings it)"
     prefix = sys.prefix
-    env = {**env, "CMAKE_PREFIX_PATH": os.pathsep.join(filter(None, [
-        env.get("CMAKE_PREFIX_PATH", ""), prefix]))}
+    env = {
+        **env,
+        "CMAKE_PREFIX_PATH": os.pathsep.join(
+            filter(None, [env.get("CMAKE_PREFIX_PATH", ""), prefix])
+        ),
+    }
     done = subprocess.run(
-        [colcon, "--log-base", str(base / "log"), "build", "--paths", *map(str, paths),
-         "--build-base", str(base / "build"), "--install-base", str(base / "install"),
-         "--cmake-args", "-DBUILD_TESTING=OFF", f"-DPython3_EXECUTABLE={sys.executable}"],
-        cwd=base, env=env, capture_output=True, text=True, timeout=1200)
+        [
+            colcon,
+            "--log-base",
+            str(base / "log"),
+            "build",
+            "--paths",
+            *map(str, paths),
+            "--build-base",
+            str(base / "build"),
+            "--install-base",
+            str(base / "install"),
+            "--cmake-args",
+            "-DBUILD_TESTING=OFF",
+            f"-DPython3_EXECUTABLE={sys.executable}",
+        ],
+        cwd=base,
+        env=env,
+        capture_output=True,
+        text=True,
+        timeout=1200,
+    )
     assert done.returncode == 0, done.stdout[-4000:] + done.stderr[-4000:]
 
 
@@ -80,23 +108,40 @@ def workspace(tmp_path_factory) -> dict:
     overlay_env = sourced([underlay], env)
     colcon_build([REPO], base, overlay_env)
     install = base / "install" / "squeeze_grasp_ros"
-    return {"env": sourced([underlay, base / "install" / "setup.bash"], env),
-            "install": install, "bin": install / "lib" / "squeeze_grasp_ros",
-            "outside": tmp_path_factory.mktemp("user_folder")}
+    return {
+        "env": sourced([underlay, base / "install" / "setup.bash"], env),
+        "install": install,
+        "bin": install / "lib" / "squeeze_grasp_ros",
+        "outside": tmp_path_factory.mktemp("user_folder"),
+    }
 
 
 def run_installed(ws: dict, *args: str, timeout: float = 300) -> subprocess.CompletedProcess:
-    return subprocess.run([str(ws["bin"] / args[0]), *args[1:]], cwd=ws["outside"],
-                          env=ws["env"], capture_output=True, text=True, timeout=timeout)
+    return subprocess.run(
+        [str(ws["bin"] / args[0]), *args[1:]],
+        cwd=ws["outside"],
+        env=ws["env"],
+        capture_output=True,
+        text=True,
+        timeout=timeout,
+    )
 
 
 def test_installed_package_is_the_one_that_runs(workspace):
-    probe = ("import json, squeeze_grasp_ros, squeeze_grasp_interfaces; "
-             "from squeeze_grasp_ros.resources import share_dir; "
-             "print(json.dumps([squeeze_grasp_ros.__file__, squeeze_grasp_interfaces.__file__, "
-             "str(share_dir())]))")
-    done = subprocess.run([sys.executable, "-c", probe], cwd=workspace["outside"],
-                          env=workspace["env"], capture_output=True, text=True, check=True)
+    probe = (
+        "import json, squeeze_grasp_ros, squeeze_grasp_interfaces; "
+        "from squeeze_grasp_ros.resources import share_dir; "
+        "print(json.dumps([squeeze_grasp_ros.__file__, squeeze_grasp_interfaces.__file__, "
+        "str(share_dir())]))"
+    )
+    done = subprocess.run(
+        [sys.executable, "-c", probe],
+        cwd=workspace["outside"],
+        env=workspace["env"],
+        capture_output=True,
+        text=True,
+        check=True,
+    )
     package, interfaces, share = json.loads(done.stdout.splitlines()[-1])
     assert Path(package).is_relative_to(workspace["install"])
     assert not Path(interfaces).is_relative_to(REPO)
@@ -112,9 +157,15 @@ def test_installed_package_is_the_one_that_runs(workspace):
 def test_run_and_replay_from_the_install(workspace):
     share = workspace["install"] / "share" / "squeeze_grasp_ros"
     bag = workspace["outside"] / "foam_run"
-    run = run_installed(workspace, "squeeze-grasp", "run",
-                        str(share / "config" / "scenes" / "foam_square.yaml"),
-                        "--record", str(bag), "--json")
+    run = run_installed(
+        workspace,
+        "squeeze-grasp",
+        "run",
+        str(share / "config" / "scenes" / "foam_square.yaml"),
+        "--record",
+        str(bag),
+        "--json",
+    )
     assert run.returncode == 0, run.stderr[-3000:]
     summary = json.loads(run.stdout)
     assert summary["success"] is True and summary["recording"] == str(bag)

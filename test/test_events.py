@@ -1,7 +1,9 @@
 # Copyright 2026 squeeze_grasp_ros developers
 # SPDX-License-Identifier: Apache-2.0
 """Event-driven squeeze (Sec. 5): physical invariants at every event, the one-shot invariant by
-an independent sparse solve, convergence in the tolerance, symmetry and path independence."""
+an independent sparse solve, convergence in the tolerance, symmetry and path independence.
+"""
+
 from __future__ import annotations
 
 import functools
@@ -15,7 +17,11 @@ from squeeze_grasp_ros.mechanics.squeeze.contact_model import ContactModel
 from squeeze_grasp_ros.mechanics.squeeze.contact_state import ContactState, initial_state
 from squeeze_grasp_ros.mechanics.squeeze.fingertips import place_fingertip, tip_gaps
 from squeeze_grasp_ros.mechanics.elastic.material import Material
-from squeeze_grasp_ros.mechanics.elastic.mesh import generate_mesh, mesh_from_triangles, target_max_area
+from squeeze_grasp_ros.mechanics.elastic.mesh import (
+    generate_mesh,
+    mesh_from_triangles,
+    target_max_area,
+)
 from squeeze_grasp_ros.mechanics.squeeze.oneshot import one_shot_solve
 from squeeze_grasp_ros.mechanics.squeeze.stable_pure import plan_squeeze
 from squeeze_grasp_ros.mechanics.squeeze.events import event_squeeze
@@ -32,7 +38,9 @@ def foam_square(nodes: int = 2000) -> tuple[ElasticObject, tuple[int, int]]:
     obj = ElasticObject(generate_mesh(outline, target_max_area(outline, nodes)), FOAM).precompute()
     b = obj.mesh.boundary
     pts = obj.mesh.nodes[b]
-    ends = tuple(int(b[np.argmin(np.linalg.norm(pts - p, axis=1))]) for p in ([-0.05, 0], [0.05, 0]))
+    ends = tuple(
+        int(b[np.argmin(np.linalg.norm(pts - p, axis=1))]) for p in ([-0.05, 0], [0.05, 0])
+    )
     return obj, ends
 
 
@@ -70,11 +78,18 @@ def start(obj, contacts, rel_per_depth: float = 0.0) -> ContactState:
 
 
 def walk(model: ContactModel, state: ContactState, dirs: dict, depth: float, **kw):
-    """States after every event point of a squeeze to ``depth`` (Algorithm 1, one call per event)."""
+    """States after every event point of a squeeze to ``depth`` (Algorithm 1, one call per
+    event).
+    """
     out, done = [], 0.0
     while done < depth * (1 - 1e-12):
-        r = advance(model, state, {k: (depth - done) * v for k, v in dirs.items()},
-                    stop_on_event=True, **kw)
+        r = advance(
+            model,
+            state,
+            {k: (depth - done) * v for k, v in dirs.items()},
+            stop_on_event=True,
+            **kw,
+        )
         done += r.state.depth - state.depth
         state = r.state
         out.append((r, state))
@@ -84,7 +99,6 @@ def walk(model: ContactModel, state: ContactState, dirs: dict, depth: float, **k
 
 
 def forces_and_field(model: ContactModel, state: ContactState):
-    obj = model.obj
     L, fu = model.length, model.force_unit
     sd = model.set_data(tuple(c.node for c in state.contacts))
     delta = np.array([c.displacement for c in state.contacts]) / L
@@ -157,13 +171,17 @@ def test_one_shot_invariant_by_independent_sparse_solve(mu):
     assert shot.iterations >= (2 if sliding else 1)  # sliding angles start perturbed
     assert np.abs(shot.forces - F).max() < 1e-9 * np.abs(F).max()
     assert np.abs(shot.theta - theta).max() < 1e-10
-    assert np.abs(shot.displacement - res.displacement).max() < 1e-9 * np.abs(res.displacement).max()
+    assert (
+        np.abs(shot.displacement - res.displacement).max() < 1e-9 * np.abs(res.displacement).max()
+    )
 
 
 def test_events_converge_as_the_tolerance_shrinks():
     obj, contacts = foam_square()
-    runs = {tol: event_squeeze(obj, contacts, RADIUS, 0.05, relative_depth=0.12, event_tol=tol)
-            for tol in (1e-3, 1e-5, 1e-7, 1e-9)}
+    runs = {
+        tol: event_squeeze(obj, contacts, RADIUS, 0.05, relative_depth=0.12, event_tol=tol)
+        for tol in (1e-3, 1e-5, 1e-7, 1e-9)
+    }
     fine = runs[1e-9]
     fine_events = [(e.type, e.node) for e in fine.events]
     F_fine = np.array([c.force for c in fine.state.contacts])
@@ -229,9 +247,11 @@ def test_path_with_direction_changes_equals_one_step_when_no_event_occurs():
     total = {k: 2e-5 * v for k, v in dirs.items()}
     one = advance(model, state, total)
     kink = np.array([0.0, 4e-6])
-    pieces = [{"F1": 0.3 * total["F1"] + kink, "F2": 0.5 * total["F2"]},
-              {"F1": 0.2 * total["F1"] - 2 * kink, "F2": 0.5 * total["F2"] + kink},
-              {"F1": 0.5 * total["F1"] + kink, "F2": -kink}]
+    pieces = [
+        {"F1": 0.3 * total["F1"] + kink, "F2": 0.5 * total["F2"]},
+        {"F1": 0.2 * total["F1"] - 2 * kink, "F2": 0.5 * total["F2"] + kink},
+        {"F1": 0.5 * total["F1"] + kink, "F2": -kink},
+    ]
     s = state
     for piece in pieces:
         r = advance(model, s, piece)
@@ -247,8 +267,9 @@ def test_path_with_direction_changes_equals_one_step_when_no_event_occurs():
 def test_reference_mode_reproduces_the_located_events():
     obj, contacts = foam_square(800)
     fast = event_squeeze(obj, contacts, RADIUS, 0.05, relative_depth=0.12)
-    ref = event_squeeze(obj, contacts, RADIUS, 0.05, relative_depth=0.12, step=1e-4,
-                        reference=True)
+    ref = event_squeeze(
+        obj, contacts, RADIUS, 0.05, relative_depth=0.12, step=1e-4, reference=True
+    )
     assert [(e.type, e.node) for e in ref.events] == [(e.type, e.node) for e in fast.events]
     for e_ref, e_fast in zip(ref.events, fast.events):
         assert 0 <= e_ref.depth - e_fast.depth <= 2e-4 * obj.scale
@@ -276,8 +297,9 @@ def test_non_force_closure_placement_slips_at_once():
 def test_chattering_bound_freezes_modes_and_terminates():
     obj, contacts = foam_square()
     free = event_squeeze(obj, contacts, RADIUS, 0.05, relative_depth=0.12)
-    capped = event_squeeze(obj, contacts, RADIUS, 0.05, relative_depth=0.12,
-                           max_events_per_depth=1, step=0.02)
+    capped = event_squeeze(
+        obj, contacts, RADIUS, 0.05, relative_depth=0.12, max_events_per_depth=1, step=0.02
+    )
     assert capped.termination == "depth_reached"
     assert capped.chatter and len(capped.events) <= len(free.events)
     window = 0.02 * obj.scale
@@ -291,7 +313,9 @@ def test_three_fingers_and_arbitrary_translations():
     mesh = obj.mesh
     b = mesh.boundary
     top = int(b[np.argmin(np.linalg.norm(mesh.nodes[b] - [0.0, 0.05], axis=1))])
-    tips = [place_fingertip(mesh, n, c, RADIUS) for n, c in zip(("F1", "F2", "A"), (*contacts, top))]
+    tips = [
+        place_fingertip(mesh, n, c, RADIUS) for n, c in zip(("F1", "F2", "A"), (*contacts, top))
+    ]
     model = ContactModel(obj, 0.8)
     state = initial_state(tips)
     r = advance(model, state, {"F1": (0.002, 0.0), "F2": (-0.002, 0.0), "A": (0.0, -0.0016)})

@@ -1,7 +1,8 @@
 # Copyright 2026 squeeze_grasp_ros developers
 # SPDX-License-Identifier: Apache-2.0
 """App. C similarity matching and App. B calibration: exact recovery of known transforms and
-materials, the special case c3 = c4 = 0, an FEM round trip, and the match/calibrate verbs."""
+materials, the special case c3 = c4 = 0, an FEM round trip, and the match/calibrate verbs.
+"""
 from __future__ import annotations
 
 import json
@@ -12,10 +13,15 @@ import pytest
 
 from squeeze_grasp_ros import cli
 from squeeze_grasp_ros.mechanics.elastic import shapes
-from squeeze_grasp_ros.mechanics.calibration.material_fit import (Cuboid, bisect_slope, calibrate_elasticity,
-                                                     friction_from_angle, friction_from_trials)
+from squeeze_grasp_ros.mechanics.calibration.material_fit import (
+    Cuboid,
+    bisect_slope,
+    calibrate_elasticity,
+    friction_from_angle,
+    friction_from_trials,
+)
 from squeeze_grasp_ros.mechanics.elastic.compliance import ElasticObject
-from squeeze_grasp_ros.mechanics.errors import MechanicsError
+from squeeze_grasp_ros.mechanics.errors import InvalidInputError
 from squeeze_grasp_ros.mechanics.calibration.matching import match_similarity
 from squeeze_grasp_ros.mechanics.elastic.material import Material
 from squeeze_grasp_ros.mechanics.elastic.mesh import generate_mesh
@@ -68,9 +74,9 @@ def test_match_is_the_least_squares_optimum_with_noise():
         d = 1e-3 * rng.normal(size=4)
         trial = similarity(Q, m.scale + d[0], m.rotation + d[1], m.translation + d[2:])
         assert np.sum((P - trial) ** 2) >= best
-    with pytest.raises(MechanicsError, match="coincide"):
+    with pytest.raises(InvalidInputError, match="coincide"):
         match_similarity(P[:3], np.ones((3, 2)))
-    with pytest.raises(MechanicsError, match="same n"):
+    with pytest.raises(InvalidInputError, match="same n"):
         match_similarity(P[:3], P[:4])
 
 
@@ -87,7 +93,7 @@ def test_calibration_round_trips_known_material():
     fr = friction_from_trials(trials)
     assert fr.mu_range[0] <= 0.4 <= fr.mu_range[1]
     assert fr.mu == pytest.approx(0.4, abs=1e-8)
-    with pytest.raises(MechanicsError, match="inconsistent"):
+    with pytest.raises(InvalidInputError, match="inconsistent"):
         friction_from_trials([(0.5, False), (0.3, True)])
 
 

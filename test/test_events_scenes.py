@@ -1,7 +1,8 @@
 # Copyright 2026 squeeze_grasp_ros developers
 # SPDX-License-Identifier: Apache-2.0
 """Event-driven squeeze on the shipped scenes: each termination in the scene built for it, the
-strain and pickup criteria checked independently, the squeeze verb's JSON and plot."""
+strain and pickup criteria checked independently, the squeeze verb's JSON and plot.
+"""
 from __future__ import annotations
 
 import functools

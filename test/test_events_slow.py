@@ -1,6 +1,7 @@
 # Copyright 2026 squeeze_grasp_ros developers
 # SPDX-License-Identifier: Apache-2.0
 """Slow cross-checks of the event-driven squeeze (run with ``-m slow``)."""
+
 from __future__ import annotations
 
 from pathlib import Path
@@ -24,16 +25,23 @@ def test_literal_fixed_step_route_converges_to_the_located_events():
     truth = event_squeeze(obj, contacts, 0.02, 0.05, relative_depth=0.12, event_tol=1e-12)
     errors = []
     for h in (1e-4, 1e-5):
-        ref = event_squeeze(obj, contacts, 0.02, 0.05, relative_depth=0.12, step=h,
-                            reference=True)
+        ref = event_squeeze(obj, contacts, 0.02, 0.05, relative_depth=0.12, step=h, reference=True)
         same, err = event_error(ref, truth, obj.scale)
         assert same and err <= 3 * h  # a late event also shifts the slip history after it
         errors.append(err)
     assert errors[1] < 0.25 * errors[0]
 
 
-@pytest.mark.parametrize("name", ["foam_square", "foam_square_low_friction", "disk_finger_slip",
-                                  "foam_square_strain_limit", "foam_square_pickup"])
+@pytest.mark.parametrize(
+    "name",
+    [
+        "foam_square",
+        "foam_square_low_friction",
+        "disk_finger_slip",
+        "foam_square_strain_limit",
+        "foam_square_pickup",
+    ],
+)
 def test_one_shot_invariant_on_every_event_scene(name):
     loaded = load_solid(str(SCENES / f"{name}.yaml"))
     loaded.obj.precompute()
@@ -41,7 +49,9 @@ def test_one_shot_invariant_on_every_event_scene(name):
     shot = one_shot_solve(loaded.obj, res.state, res.mu)
     F = np.array([c.force for c in res.state.contacts])
     assert np.abs(shot.forces - F).max() < 1e-8 * np.abs(F).max()
-    assert np.abs(shot.displacement - res.displacement).max() < 1e-8 * np.abs(res.displacement).max()
+    assert (
+        np.abs(shot.displacement - res.displacement).max() < 1e-8 * np.abs(res.displacement).max()
+    )
 
 
 def test_large_mesh_squeeze_stays_consistent():

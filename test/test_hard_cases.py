@@ -5,6 +5,7 @@
 Each case asserts finite results, equilibrium residuals below a stated tolerance, and
 agreement with a reference or an exact scaling law.
 """
+
 import warnings
 
 import numpy as np
@@ -12,10 +13,15 @@ import pytest
 
 from squeeze_grasp_ros.mechanics.elastic import shapes
 from squeeze_grasp_ros.mechanics.elastic.compliance import ElasticObject
-from squeeze_grasp_ros.mechanics.errors import ConditioningWarning, MechanicsError
+from squeeze_grasp_ros.mechanics.errors import ConditioningWarning, InvalidInputError
 from squeeze_grasp_ros.mechanics.squeeze.graspmap import grasp_map
 from squeeze_grasp_ros.mechanics.elastic.material import Material
-from squeeze_grasp_ros.mechanics.elastic.mesh import Mesh, generate_mesh, mesh_from_triangles, target_max_area
+from squeeze_grasp_ros.mechanics.elastic.mesh import (
+    Mesh,
+    generate_mesh,
+    mesh_from_triangles,
+    target_max_area,
+)
 from squeeze_grasp_ros.mechanics.elastic.reduced import displacement_field, reduced_stiffness
 from squeeze_grasp_ros.mechanics.squeeze.stable_pure import plan_squeeze
 
@@ -31,8 +37,8 @@ def blob(nodes: int = 400, size: float = 0.05) -> Mesh:
 def check_squeeze(obj: ElasticObject, contacts) -> None:
     """Finite outputs, equilibrium, and agreement with the spectral-free identities."""
     red = reduced_stiffness(obj, contacts)
-    sq = plan_squeeze(obj, contacts, "stable", red)
-    pure = plan_squeeze(obj, contacts, "pure", red)
+    sq = plan_squeeze(obj, contacts, kind="stable", red=red)
+    pure = plan_squeeze(obj, contacts, kind="pure", red=red)
     for s in (sq, pure):
         assert np.all(np.isfinite(s.forces)) and np.isfinite(s.energy_per_unit_depth2)
         F = s.forces.reshape(-1, 2)
@@ -41,7 +47,9 @@ def check_squeeze(obj: ElasticObject, contacts) -> None:
         assert np.abs(F.sum(axis=0)).max() <= EQUILIBRIUM_TOL * fmax
         torque = np.sum(p[:, 0] * F[:, 1] - p[:, 1] * F[:, 0])
         assert abs(torque) <= EQUILIBRIUM_TOL * fmax * obj.scale
-    assert np.isclose(sq.displacement @ pure.displacement, pure.stiffness / sq.stiffness, rtol=1e-8)
+    assert np.isclose(
+        sq.displacement @ pure.displacement, pure.stiffness / sq.stiffness, rtol=1e-8
+    )
     assert obj.diagnostics()["rigid_mode_residual"] < 1e-12
 
 
@@ -57,7 +65,7 @@ def test_extreme_poisson_ratios(nu):
 
 
 def test_poisson_ratio_outside_range_is_a_clear_error():
-    with pytest.raises(MechanicsError, match=r"nu must be in \(-1, 0.5\]"):
+    with pytest.raises(InvalidInputError, match=r"nu must be in \(-1, 0.5\]"):
         Material(1e5, 0.5000001, 0.01)
 
 
@@ -78,8 +86,9 @@ def test_E_from_foam_to_steel_scales_exactly():
 @pytest.mark.parametrize("size", [1e-3, 10.0])
 def test_object_size_from_a_millimetre_to_ten_metres(size):
     ref = blob(size=0.05)
-    scaled = Mesh(ref.nodes * (size / 0.05), ref.triangles, ref.boundary, ref.inner_boundaries,
-                  ref.normals)
+    scaled = Mesh(
+        ref.nodes * (size / 0.05), ref.triangles, ref.boundary, ref.inner_boundaries, ref.normals
+    )
     c = [ref.boundary[4], ref.boundary[27]]
     mat = Material(2e9, 0.3, 0.003)
     o_ref, o = ElasticObject(ref, mat), ElasticObject(scaled, mat)
@@ -90,19 +99,26 @@ def test_object_size_from_a_millimetre_to_ten_metres(size):
     k = size / 0.05
     assert np.allclose(s.forces, s_ref.forces, rtol=1e-9)
     rel = 0.1
-    assert np.isclose(s.depth_for_relative(rel) ** 2 * s.energy_per_unit_depth2,
-                      k**2 * s_ref.depth_for_relative(rel) ** 2 * s_ref.energy_per_unit_depth2, rtol=1e-9)
+    assert np.isclose(
+        s.depth_for_relative(rel) ** 2 * s.energy_per_unit_depth2,
+        k**2 * s_ref.depth_for_relative(rel) ** 2 * s_ref.energy_per_unit_depth2,
+        rtol=1e-9,
+    )
     assert np.isclose(s.rigid_rotation, s_ref.rigid_rotation / k, rtol=1e-9)
     field = displacement_field(o, reduced_stiffness(o, c), 1e-3 * size * s.displacement)
     assert np.all(np.isfinite(field))
     # a freshly meshed object of that size (not a scaled copy) is fine too
     outline = shapes.disk(size)
     mesh = generate_mesh(outline, outline.area / 300)
-    check_squeeze(ElasticObject(mesh, mat), [mesh.boundary[0], mesh.boundary[len(mesh.boundary) // 2]])
+    check_squeeze(
+        ElasticObject(mesh, mat), [mesh.boundary[0], mesh.boundary[len(mesh.boundary) // 2]]
+    )
 
 
 def test_very_small_element_angles_warn_or_stay_accurate():
-    """A sliver mesh (angles ~0.5 degrees) still gives equilibrium and matches the spectral route."""
+    """A sliver mesh (angles ~0.5 degrees) still gives equilibrium and matches the spectral
+    route.
+    """
     x = np.linspace(0, 1, 41)
     y = np.array([0.0, 0.0002, 0.0004])
     X, Y = np.meshgrid(x, y)
@@ -124,8 +140,10 @@ def test_very_small_element_angles_warn_or_stay_accurate():
         ref = ElasticObject(mesh, mat, "spectral")
         a, b = obj.compliance_block([left, right]), ref.compliance_block([left, right])
     cond = obj.diagnostics()["condition_estimate"]
-    print(f"sliver mesh: condition estimate {cond:.3g}, route difference "
-          f"{np.abs(a - b).max() / np.abs(b).max():.3g}")
+    print(
+        f"sliver mesh: condition estimate {cond:.3g}, route difference "
+        f"{np.abs(a - b).max() / np.abs(b).max():.3g}"
+    )
     # both routes lose digits in proportion to the conditioning, no more
     assert np.abs(a - b).max() <= 10 * cond * np.finfo(float).eps * np.abs(b).max()
 
@@ -153,8 +171,16 @@ def test_friction_extremes_in_the_grasp_map(mu):
 
 
 def test_nonconvex_object_and_inward_check():
-    pts = [[0.06, 0.0], [0.045, 0.04], [0.0, 0.05], [-0.045, 0.04], [-0.06, 0.0],
-           [-0.04, -0.035], [0.0, -0.012], [0.04, -0.035]]
+    pts = [
+        [0.06, 0.0],
+        [0.045, 0.04],
+        [0.0, 0.05],
+        [-0.045, 0.04],
+        [-0.06, 0.0],
+        [-0.04, -0.035],
+        [0.0, -0.012],
+        [0.04, -0.035],
+    ]
     outline = shapes.spline(pts)
     mesh = generate_mesh(outline, outline.area / 600)
     obj = ElasticObject(mesh, Material(5e4, 0.3, 0.0254))
@@ -189,7 +215,9 @@ def foam(nodes: int = 800, size: float = 0.1, E: float = 5e4, h: float = 0.0254)
     obj, contacts = foam_square(nodes)
     k = size / 0.1
     mesh = obj.mesh
-    scaled = Mesh(mesh.nodes * k, mesh.triangles, mesh.boundary, mesh.inner_boundaries, mesh.normals)
+    scaled = Mesh(
+        mesh.nodes * k, mesh.triangles, mesh.boundary, mesh.inner_boundaries, mesh.normals
+    )
     return ElasticObject(scaled, Material(E, 0.3, h)), contacts
 
 
@@ -217,8 +245,9 @@ def test_event_squeeze_E_from_foam_to_steel_changes_forces_only():
         res = squeeze(o, contacts)
         check_event_result(res, o)
         assert [(e.type, e.node) for e in res.events] == [(e.type, e.node) for e in base.events]
-        assert np.allclose([e.depth for e in res.events], [e.depth for e in base.events],
-                           atol=1e-9 * obj.scale)
+        assert np.allclose(
+            [e.depth for e in res.events], [e.depth for e in base.events], atol=1e-9 * obj.scale
+        )
         assert res.energy == pytest.approx(base.energy * E / 5e4, rel=1e-6)
 
 
@@ -231,8 +260,9 @@ def test_event_squeeze_object_size_scales_depths_and_forces(size):
     check_event_result(res, o)
     k = size / 0.1
     assert [(e.type, e.node) for e in res.events] == [(e.type, e.node) for e in base.events]
-    assert np.allclose([e.depth for e in res.events], [k * e.depth for e in base.events],
-                       atol=1e-8 * o.scale)
+    assert np.allclose(
+        [e.depth for e in res.events], [k * e.depth for e in base.events], atol=1e-8 * o.scale
+    )
     assert res.finger_force["F1"][1] == pytest.approx(k * base.finger_force["F1"][1], rel=1e-6)
     assert res.energy == pytest.approx(k * k * base.energy, rel=1e-6)
 
@@ -240,7 +270,8 @@ def test_event_squeeze_object_size_scales_depths_and_forces(size):
 @pytest.mark.parametrize("mu", [1e-6, 1e3])
 def test_event_squeeze_friction_extremes(mu):
     """A squeeze line exactly along both normals (structured symmetric mesh) needs no friction
-    at first; as the segments grow, a nearly frictionless tip lets nodes slide."""
+    at first; as the segments grow, a nearly frictionless tip lets nodes slide.
+    """
     from test_events import symmetric_square
 
     obj, contacts = symmetric_square()
@@ -257,11 +288,12 @@ def test_event_squeeze_friction_extremes(mu):
 
 def test_frictionless_single_node_contacts_are_a_clear_error():
     """With mu = 0 and one node per finger the object can slide along the tips: the problem is
-    indeterminate, and the engine says so instead of returning garbage."""
+    indeterminate, and the engine says so instead of returning garbage.
+    """
     from test_events import symmetric_square
 
     obj, contacts = symmetric_square()
-    with pytest.raises(MechanicsError, match="use mu > 0|can be solved"):
+    with pytest.raises(InvalidInputError, match="use mu > 0|can be solved"):
         squeeze(obj, contacts, mu=0.0)
 
 
@@ -277,11 +309,20 @@ def test_event_squeeze_from_a_nanometre_depth():
 
 
 def test_event_squeeze_on_a_nonconvex_object():
-    pts = [[0.06, 0.0], [0.045, 0.04], [0.0, 0.05], [-0.045, 0.04], [-0.06, 0.0],
-           [-0.04, -0.035], [0.0, -0.012], [0.04, -0.035]]
+    pts = [
+        [0.06, 0.0],
+        [0.045, 0.04],
+        [0.0, 0.05],
+        [-0.045, 0.04],
+        [-0.06, 0.0],
+        [-0.04, -0.035],
+        [0.0, -0.012],
+        [0.04, -0.035],
+    ]
     outline = shapes.spline(pts)
-    obj = ElasticObject(generate_mesh(outline, target_max_area(outline, 1200)),
-                        Material(5e4, 0.3, 0.0254))
+    obj = ElasticObject(
+        generate_mesh(outline, target_max_area(outline, 1200)), Material(5e4, 0.3, 0.0254)
+    )
     b = obj.mesh.boundary
     p = obj.mesh.nodes[b]
     contacts = (int(b[np.argmin(p[:, 0])]), int(b[np.argmax(p[:, 0])]))
@@ -292,8 +333,10 @@ def test_event_squeeze_on_a_nonconvex_object():
 
 @pytest.mark.parametrize("ratio", [1e-3, 1e-1])
 def test_thin_and_thick_rings_stay_accurate(ratio):
-    from squeeze_grasp_ros.mechanics.ring.model import (circle_diametral_response,
-                                                        ring_diameter_changes)
+    from squeeze_grasp_ros.mechanics.ring.model import (
+        circle_diametral_response,
+        ring_diameter_changes,
+    )
 
     R, E, w = 0.04, 2e9, 0.01
     P = 1e-4 * R / abs(ring_diameter_changes(R, E, w, ratio * R, 1.0)[0])  # small displacement
@@ -309,7 +352,9 @@ def test_degraded_conditioning_warns_instead_of_crashing():
     X, Y = np.meshgrid(x, y)
     nodes = np.column_stack([X.ravel(), Y.ravel()])
     nx = len(x)
-    tris = [[i, i + 1, nx + i + 1] for i in range(nx - 1)] + [[i, nx + i + 1, nx + i] for i in range(nx - 1)]
+    tris = [[i, i + 1, nx + i + 1] for i in range(nx - 1)] + [
+        [i, nx + i + 1, nx + i] for i in range(nx - 1)
+    ]
     mesh = mesh_from_triangles(nodes, np.array(tris))
     obj = ElasticObject(mesh, Material(1e6, 0.3, 0.01))
     with pytest.warns(ConditioningWarning, match="condition estimate"):

@@ -1,18 +1,25 @@
 # Copyright 2026 squeeze_grasp_ros developers
 # SPDX-License-Identifier: Apache-2.0
 """FEM cross-checks: patch test, an independent assembler, an analytic elasticity case,
-exact scaling laws, solver routes and the vectorised grasp map."""
+exact scaling laws, solver routes and the vectorised grasp map.
+"""
+
 import numpy as np
 import pytest
 
 from squeeze_grasp_ros.mechanics.elastic import shapes
 from squeeze_grasp_ros.mechanics.elastic.analytic import disk_diameter_change_across
 from squeeze_grasp_ros.mechanics.elastic.compliance import ElasticObject, node_dofs
-from squeeze_grasp_ros.mechanics.errors import MechanicsError
+from squeeze_grasp_ros.mechanics.errors import InvalidInputError
 from squeeze_grasp_ros.mechanics.elastic.fem import element_strains, stiffness_matrix
 from squeeze_grasp_ros.mechanics.squeeze.graspmap import grasp_map
 from squeeze_grasp_ros.mechanics.elastic.material import Material
-from squeeze_grasp_ros.mechanics.elastic.mesh import Mesh, element_areas, generate_mesh, mesh_from_triangles
+from squeeze_grasp_ros.mechanics.elastic.mesh import (
+    Mesh,
+    element_areas,
+    generate_mesh,
+    mesh_from_triangles,
+)
 from squeeze_grasp_ros.mechanics.elastic.reduced import displacement_field, reduced_stiffness
 from squeeze_grasp_ros.mechanics.squeeze.stable_pure import plan_squeeze
 
@@ -84,8 +91,10 @@ def test_disk_far_field_converges_to_the_analytic_solution():
         obj = ElasticObject(mesh, MAT)
         b = mesh.boundary
         angle = np.arctan2(mesh.nodes[b, 1], mesh.nodes[b, 0])
-        pick = [b[np.argmin(np.abs(np.angle(np.exp(1j * (angle - a)))))]
-                for a in (np.pi / 2, -np.pi / 2, np.pi, 0.0)]
+        pick = [
+            b[np.argmin(np.abs(np.angle(np.exp(1j * (angle - a)))))]
+            for a in (np.pi / 2, -np.pi / 2, np.pi, 0.0)
+        ]
         A = obj.compliance_block(pick) / MAT.force_scale
         F = np.array([0, -P, 0, P, 0, 0, 0, 0])
         d = (A @ F).reshape(-1, 2)
@@ -120,8 +129,9 @@ def test_exact_scaling_with_object_size(s):
     rho1, rho2 = s1.depth_for_relative(rel), s2.depth_for_relative(rel)
     assert np.isclose(rho2, s * rho1, rtol=1e-12)
     assert np.allclose(rho2 * s2.forces, s * rho1 * s1.forces, rtol=1e-9)
-    assert np.isclose(rho2**2 * s2.energy_per_unit_depth2, s**2 * rho1**2 * s1.energy_per_unit_depth2,
-                      rtol=1e-9)
+    assert np.isclose(
+        rho2**2 * s2.energy_per_unit_depth2, s**2 * rho1**2 * s1.energy_per_unit_depth2, rtol=1e-9
+    )
     r1 = reduced_stiffness(o1, c)
     r2 = reduced_stiffness(o2, c)
     f1 = displacement_field(o1, r1, rho1 * s1.displacement)
@@ -136,8 +146,9 @@ def test_factorized_and_spectral_routes_agree():
     assert np.abs(A1 - A2).max() <= 1e-10 * np.abs(A2).max()
     interior = np.setdiff1d(np.arange(mesh.n), mesh.boundary)[:3]
     nodes = np.concatenate([mesh.boundary[:2], interior])
-    assert np.allclose(fact.compliance_block(nodes), spec.compliance_block(nodes),
-                       atol=1e-10 * np.abs(A2).max())
+    assert np.allclose(
+        fact.compliance_block(nodes), spec.compliance_block(nodes), atol=1e-10 * np.abs(A2).max()
+    )
     d = fact.diagnostics()
     assert d["rigid_mode_residual"] < 1e-13 and d["condition_estimate"] > 1
 
@@ -163,7 +174,7 @@ def test_grasp_map_equals_per_pair_squeezes():
 
 def test_mesh_quality_controls_and_boundary_loop():
     outline = shapes.rectangle(0.1, 0.05)
-    mesh = generate_mesh(outline, 2e-5, 30.0)
+    mesh = generate_mesh(outline, 2e-5, min_angle=30.0)
     assert mesh.min_angle_deg() >= 30.0 - 1e-9
     areas = element_areas(mesh.nodes, mesh.triangles)
     assert areas.min() > 0
@@ -187,32 +198,40 @@ def test_annulus_has_hole_and_inner_loop():
     assert sq.inward and np.all(np.isfinite(sq.forces))
 
 
-@pytest.mark.parametrize("points,match", [
-    ([[0, 0], [2, 1], [2, 0], [0, 1.5]], "self-intersecting"),
-    ([[0, 0], [1, 0], [2, 0]], "degenerate"),
-    ([[0, 0], [1, 0]], "at least 3"),
-    ([[0, 0], [1, np.nan], [0, 1]], "non-finite"),
-])
+@pytest.mark.parametrize(
+    "points,match",
+    [
+        ([[0, 0], [2, 1], [2, 0], [0, 1.5]], "self-intersecting"),
+        ([[0, 0], [1, 0], [2, 0]], "degenerate"),
+        ([[0, 0], [1, 0]], "at least 3"),
+        ([[0, 0], [1, np.nan], [0, 1]], "non-finite"),
+    ],
+)
 def test_bad_outlines_are_rejected(points, match):
-    with pytest.raises(MechanicsError, match=match):
+    with pytest.raises(InvalidInputError, match=match):
         shapes.polygon(points)
 
 
-@pytest.mark.parametrize("kw,match", [
-    (dict(E=0, nu=0.3, thickness=1), "E must be > 0"),
-    (dict(E=1, nu=0.6, thickness=1), "nu must be in"),
-    (dict(E=1, nu=-1.0, thickness=1), "nu must be in"),
-    (dict(E=1, nu=0.3, thickness=-1), "thickness must be > 0"),
-    (dict(E=np.inf, nu=0.3, thickness=1), "finite"),
-])
+@pytest.mark.parametrize(
+    "kw,match",
+    [
+        (dict(E=0, nu=0.3, thickness=1), "E must be > 0"),
+        (dict(E=1, nu=0.6, thickness=1), "nu must be in"),
+        (dict(E=1, nu=-1.0, thickness=1), "nu must be in"),
+        (dict(E=1, nu=0.3, thickness=-1), "thickness must be > 0"),
+        (dict(E=np.inf, nu=0.3, thickness=1), "finite"),
+    ],
+)
 def test_bad_materials_are_rejected(kw, match):
-    with pytest.raises(MechanicsError, match=match):
+    with pytest.raises(InvalidInputError, match=match):
         Material(**kw)
 
 
 def test_degenerate_triangle_is_rejected():
-    with pytest.raises(MechanicsError, match="degenerate"):
-        mesh_from_triangles(np.array([[0, 0], [1, 0], [2, 0], [0, 1]]), np.array([[0, 1, 2], [0, 1, 3]]))
+    with pytest.raises(InvalidInputError, match="degenerate"):
+        mesh_from_triangles(
+            np.array([[0, 0], [1, 0], [2, 0], [0, 1]]), np.array([[0, 1, 2], [0, 1, 3]])
+        )
 
 
 def test_contact_dofs_are_interleaved():
@@ -230,8 +249,10 @@ def _brute_force_crossing(p: np.ndarray) -> bool:
         for j in range(i + 2, n):
             if (i, j) == (0, n - 1):
                 continue
-            if (orient(a[i], b[i], a[j]) * orient(a[i], b[i], b[j]) < 0
-                    and orient(a[j], b[j], a[i]) * orient(a[j], b[j], b[i]) < 0):
+            if (
+                orient(a[i], b[i], a[j]) * orient(a[i], b[i], b[j]) < 0
+                and orient(a[j], b[j], a[i]) * orient(a[j], b[j], b[i]) < 0
+            ):
                 return True
     return False
 

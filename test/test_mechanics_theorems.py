@@ -5,6 +5,7 @@
 The null-space C is checked against an independent route: the paper's spectral A (dense
 eigendecomposition) with M of eq. (27) inverted directly.
 """
+
 import numpy as np
 import pytest
 from hypothesis import HealthCheck, given, settings
@@ -14,12 +15,18 @@ from squeeze_grasp_ros.mechanics.elastic import shapes
 from squeeze_grasp_ros.mechanics.elastic.compliance import ElasticObject, node_dofs
 from squeeze_grasp_ros.mechanics.elastic.material import Material
 from squeeze_grasp_ros.mechanics.elastic.mesh import generate_mesh
-from squeeze_grasp_ros.mechanics.elastic.reduced import (displacement_field, reduced_stiffness,
-                                                 rotation_angle)
+from squeeze_grasp_ros.mechanics.elastic.reduced import (
+    displacement_field,
+    reduced_stiffness,
+    rotation_angle,
+)
 from squeeze_grasp_ros.mechanics.squeeze.stable_pure import plan_squeeze, two_contact_direction
 
-SETTINGS = settings(max_examples=12, deadline=None,
-                    suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large])
+SETTINGS = settings(
+    max_examples=12,
+    deadline=None,
+    suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large],
+)
 
 
 @st.composite
@@ -28,8 +35,10 @@ def objects(draw):
     c = [draw(st.floats(-0.15, 0.15)) for _ in range(3)]
     s = [draw(st.floats(-0.15, 0.15)) for _ in range(3)]
     outline = shapes.fourier_blob(draw(st.floats(0.01, 1.0)), cos=c, sin=s)
-    mesh = generate_mesh(outline, outline.area / draw(st.integers(80, 250)), 28.0)
-    mat = Material(draw(st.floats(1e3, 1e9)), draw(st.floats(-0.5, 0.49)), draw(st.floats(1e-3, 0.1)))
+    mesh = generate_mesh(outline, outline.area / draw(st.integers(80, 250)), min_angle=28.0)
+    mat = Material(
+        draw(st.floats(1e3, 1e9)), draw(st.floats(-0.5, 0.49)), draw(st.floats(1e-3, 0.1))
+    )
     return ElasticObject(mesh, mat), ElasticObject(mesh, mat, "spectral")
 
 
@@ -130,8 +139,8 @@ def test_theorem10_and_stable_pure_identities(pair, seed):
     u = two_contact_direction(obj.mesh.nodes[i], obj.mesh.nodes[j])
     uAu = u @ red.A @ u
     assert np.allclose(red.C, np.outer(u, u) / uAu, atol=1e-9 * np.abs(red.C).max())
-    stable = plan_squeeze(obj, [i, j], "stable", red)
-    pure = plan_squeeze(obj, [i, j], "pure", red)
+    stable = plan_squeeze(obj, [i, j], kind="stable", red=red)
+    pure = plan_squeeze(obj, [i, j], kind="pure", red=red)
     sign = np.sign(stable.displacement @ u)
     Au = red.A @ u
     assert np.allclose(stable.forces, sign * u / uAu, rtol=1e-9, atol=1e-12 / uAu)
@@ -154,7 +163,7 @@ def test_stable_squeeze_of_three_contacts_is_top_eigenvector():
     b = obj.mesh.boundary
     contacts = b[[0, len(b) // 3, 2 * len(b) // 3]]
     red = reduced_stiffness(obj, contacts)
-    sq = plan_squeeze(obj, contacts, "stable", red)
+    sq = plan_squeeze(obj, contacts, kind="stable", red=red)
     lam, U = np.linalg.eigh(red.C)
     assert np.isclose(abs(U[:, -1] @ sq.displacement), 1.0)
     assert np.isclose(sq.energy_per_unit_depth2, 0.5 * lam[-1])

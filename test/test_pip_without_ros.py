@@ -15,10 +15,27 @@ import sys
 from pathlib import Path
 
 SCENES = Path(__file__).resolve().parents[1] / "config" / "scenes"
-ABSENT = ("rclpy", "rosidl", "rpyutils", "rcl_interfaces", "std_msgs", "geometry_msgs",
-          "sensor_msgs", "visualization_msgs", "rosgraph_msgs", "action_msgs", "builtin_interfaces",
-          "unique_identifier_msgs", "squeeze_grasp_interfaces", "ament_index_python", "mcap",
-          "mcap_ros2", "dask", "distributed", "pyarrow")
+ABSENT = (
+    "rclpy",
+    "rosidl",
+    "rpyutils",
+    "rcl_interfaces",
+    "std_msgs",
+    "geometry_msgs",
+    "sensor_msgs",
+    "visualization_msgs",
+    "rosgraph_msgs",
+    "action_msgs",
+    "builtin_interfaces",
+    "unique_identifier_msgs",
+    "squeeze_grasp_interfaces",
+    "ament_index_python",
+    "mcap",
+    "mcap_ros2",
+    "dask",
+    "distributed",
+    "pyarrow",
+)
 """Top-level modules of the ros and sweep extras (and what they pull in)."""
 
 CHILD = """

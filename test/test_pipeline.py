@@ -2,7 +2,9 @@
 # SPDX-License-Identifier: Apache-2.0
 """The pipeline on real rclpy nodes in one process: ground truth against the mechanics API,
 monitor events against the ground truth, the recording read back by independent readers,
-replay, dropout holds, slip alarms, the reactive redirection and cancel."""
+replay, dropout holds, slip alarms, the reactive redirection and cancel.
+"""
+
 from __future__ import annotations
 
 from pathlib import Path
@@ -21,8 +23,16 @@ from squeeze_grasp_ros.ros.recording.schema import own_text
 from squeeze_grasp_ros.scene import build_mesh, finger_nodes, load_scene, scene_material
 from squeeze_grasp_ros.scene_events import event_squeeze_scene
 
-from pipeline_support import (EVENT_TOLERANCE_TICKS, SLIPPING_SQUARE, SMALL_SQUARE,
-                              contact_modes, match_within, net_events, scene_data, write_scene)
+from pipeline_support import (
+    EVENT_TOLERANCE_TICKS,
+    SLIPPING_SQUARE,
+    SMALL_SQUARE,
+    contact_modes,
+    match_within,
+    net_events,
+    scene_data,
+    write_scene,
+)
 
 SCENES = Path(__file__).resolve().parents[1] / "config" / "scenes"
 
@@ -31,8 +41,10 @@ def mechanics(scene_path: str):
     """(event tolerance in m, the mechanics API's event-driven squeeze) of a scene."""
     scene = load_scene(scene_path)
     obj = ElasticObject(build_mesh(scene), scene_material(scene))
-    return (scene.squeeze.event_tol * obj.scale,
-            event_squeeze_scene(scene, obj, finger_nodes(scene, obj.mesh)))
+    return (
+        scene.squeeze.event_tol * obj.scale,
+        event_squeeze_scene(scene, obj, finger_nodes(scene, obj.mesh)),
+    )
 
 
 def messages_of(bag, topic: str) -> list:
@@ -46,8 +58,11 @@ def foam(tmp_path_factory):
     """The shipped foam-square scene, recorded, through every node in one process."""
     record = tmp_path_factory.mktemp("foam") / "bag"
     path = str(SCENES / "foam_square.yaml")
-    return {"path": path, "bag": record,
-            "run": PipelineRunner(RunOptions(path, record=str(record))).run()}
+    return {
+        "path": path,
+        "bag": record,
+        "run": PipelineRunner(RunOptions(path, record=str(record))).run(),
+    }
 
 
 @pytest.fixture(scope="module")
@@ -55,29 +70,35 @@ def small(tmp_path_factory):
     """The small mu = 0.05 square (A, C, D events), recorded, no slip alarm."""
     directory = tmp_path_factory.mktemp("small")
     path = write_scene(directory, SMALL_SQUARE)
-    options = RunOptions(path, record=str(directory / "bag"),
-                         overrides={"monitor": {"alarm_ratio": 2.0}})
+    options = RunOptions(
+        path, record=str(directory / "bag"), overrides={"monitor": {"alarm_ratio": 2.0}}
+    )
     return {"path": path, "bag": directory / "bag", "run": PipelineRunner(options).run()}
 
 
 def assert_ground_truth_is_the_mechanics(run: dict, path: str) -> None:
     event_tol, api = mechanics(path)
     tol = 2 * event_tol + 1e-12
-    print(f"ground truth vs mechanics: events (type, node, finger) equal, depths within {tol:.2g} m")
+    print(
+        f"ground truth vs mechanics: events (type, node, finger) equal, depths within {tol:.2g} m"
+    )
     truth = run["events"]
-    assert [(e["type"], e["node"], e["finger"]) for e in truth] == \
-        [(e.type, e.node, e.finger) for e in api.events]
+    assert [(e["type"], e["node"], e["finger"]) for e in truth] == [
+        (e.type, e.node, e.finger) for e in api.events
+    ]
     assert all(abs(e["depth"] - a.depth) <= tol for e, a in zip(truth, api.events))
     expected = api.termination
     world = run["world_termination"]
     assert (world if world != "none" else "depth_reached") == expected
     assert run["depth"] == pytest.approx(api.depth, rel=1e-9, abs=tol)
     for finger in ("F1", "F2"):
-        assert np.allclose(run["forces"][finger], api.state.finger_force(finger), rtol=1e-7,
-                           atol=1e-9)
+        assert np.allclose(
+            run["forces"][finger], api.state.finger_force(finger), rtol=1e-7, atol=1e-9
+        )
         assert run["work"][finger] == pytest.approx(api.work[finger], rel=1e-6)
-    assert sorted((c["node"], c["mode"]) for c in run["contacts"]) == \
-        sorted((c.node, c.mode) for c in api.state.contacts)
+    assert sorted((c["node"], c["mode"]) for c in run["contacts"]) == sorted(
+        (c.node, c.mode) for c in api.state.contacts
+    )
 
 
 def test_foam_square_ground_truth_equals_the_mechanics(foam):
@@ -100,11 +121,16 @@ def test_monitor_events_match_the_ground_truth(case, foam, small):
     states = [contact_modes(s) for s in messages_of(bag, "/sim/state")]
     dt_ns = load_scene(fixture["path"]).sim.dt * 1e9
     truth = net_events(states)
-    seen = [(round(pipeline_stamp(e) / dt_ns), e.type, e.finger)
-            for msg in messages_of(bag, "/monitor/events") for e in msg.events]
-    print(f"{case}: tolerance: type and finger exact, tick within {EVENT_TOLERANCE_TICKS} ticks "
-          f"({EVENT_TOLERANCE_TICKS * dt_ns * 1e-6:.0f} ms of sim time); {len(truth)} ground-truth "
-          f"net events, {len(seen)} monitor events")
+    seen = [
+        (round(pipeline_stamp(e) / dt_ns), e.type, e.finger)
+        for msg in messages_of(bag, "/monitor/events")
+        for e in msg.events
+    ]
+    print(
+        f"{case}: tolerance: type and finger exact, tick within {EVENT_TOLERANCE_TICKS} ticks "
+        f"({EVENT_TOLERANCE_TICKS * dt_ns * 1e-6:.0f} ms of sim time); {len(truth)} ground-truth "
+        f"net events, {len(seen)} monitor events"
+    )
     assert truth and match_within(truth, seen, EVENT_TOLERANCE_TICKS) == []
 
 
@@ -122,8 +148,14 @@ def test_recording_reads_back_with_rosbags(foam):
     with AnyReader([foam["bag"]]) as reader:
         connections = {c.topic: c for c in reader.connections}
         assert set(connections) <= set(expected)
-        for topic in ("/clock", "/sim/tick", "/sim/state", "/monitor/status",
-                      "/devices/barrett_f1/tactile", "/devices/barrett_f3/wrench"):
+        for topic in (
+            "/clock",
+            "/sim/tick",
+            "/sim/state",
+            "/monitor/status",
+            "/devices/barrett_f1/tactile",
+            "/devices/barrett_f3/wrench",
+        ):
             assert connections[topic].msgtype == expected[topic]
             assert connections[topic].msgcount == ticks
         assert connections["/devices/barrett_f1/setpoint"].msgcount == ticks - 1
@@ -187,8 +219,11 @@ def test_recording_of_another_tool_replays(small, tmp_path):
         for m in bag.messages:
             if m.topic in connections:
                 writer.write(connections[m.topic], m.log_time_ns, m.data)
-    params = {"mu": 0.05, "alarm_ratio": 2.0,
-              "relative_per_depth": load_relative_per_depth(small["bag"])}
+    params = {
+        "mu": 0.05,
+        "alarm_ratio": 2.0,
+        "relative_per_depth": load_relative_per_depth(small["bag"]),
+    }
     result = replay(str(out), params)
     assert result["reproduced"] is True
 
@@ -200,16 +235,22 @@ def replay_topic(topic: str) -> bool:
 
 def load_relative_per_depth(bag_path) -> float:
     """The relative depth per unit depth the run's monitor used (from its custom data)."""
-    return yaml.safe_load(read_bag(bag_path).custom_data["monitor_parameters"])["relative_per_depth"]
+    return yaml.safe_load(read_bag(bag_path).custom_data["monitor_parameters"])[
+        "relative_per_depth"
+    ]
 
 
 def test_sensor_dropout_makes_the_executor_hold(tmp_path):
-    data = scene_data(SMALL_SQUARE, name="dropout_square",
-                      squeeze={"type": "stable", "relative_depth": 0.03},
-                      sensors={"dropout": 0.3, "seed": 4},
-                      effects=["friction", "force_sensing", "tactile_sensing", "sensor_dropout"])
-    runner = PipelineRunner(RunOptions(write_scene(tmp_path, data),
-                                       overrides={"monitor": {"alarm_ratio": 2.0}}))
+    data = scene_data(
+        SMALL_SQUARE,
+        name="dropout_square",
+        squeeze={"type": "stable", "relative_depth": 0.03},
+        sensors={"dropout": 0.3, "seed": 4},
+        effects=["friction", "force_sensing", "tactile_sensing", "sensor_dropout"],
+    )
+    runner = PipelineRunner(
+        RunOptions(write_scene(tmp_path, data), overrides={"monitor": {"alarm_ratio": 2.0}})
+    )
     run = runner.run()
     assert run["termination"] == "depth_reached"
     # one alarm message per stale episode; the executor holds on every stale tick
@@ -226,8 +267,10 @@ def test_slip_alarm_comes_before_the_finger_slips(tmp_path):
     run = PipelineRunner(RunOptions(path)).run()
     assert run["termination"] == "slip_alarm"
     alarm_depth = run["measured_depth"]
-    print(f"slip alarm at depth {alarm_depth * 1e3:.4f} mm; the finger slips at "
-          f"{api.depth * 1e3:.4f} mm")
+    print(
+        f"slip alarm at depth {alarm_depth * 1e3:.4f} mm; the finger slips at "
+        f"{api.depth * 1e3:.4f} mm"
+    )
     assert alarm_depth < api.depth
     assert run["world_termination"] == "none"
 
@@ -246,8 +289,9 @@ def test_cancel_holds_position(tmp_path):
     try:
         runner.start()
         runner.send_goal()
-        runner.spin_until(lambda: runner.feedback and runner.feedback[-1].depth > 1e-3, 120,
-                          "1 mm of depth")
+        runner.spin_until(
+            lambda: runner.feedback and runner.feedback[-1].depth > 1e-3, 120, "1 mm of depth"
+        )
         runner.cancel()
         result = runner.wait_result()
     finally:
@@ -260,26 +304,38 @@ def test_cancel_holds_position(tmp_path):
 
 def test_single_threaded_executor_gives_the_same_run_and_recording(small, tmp_path):
     """Also covers the recorder's drain at shutdown on this executor (its progress timer and
-    the re-sent last tick once kept it from ever seeing the executor idle)."""
+    the re-sent last tick once kept it from ever seeing the executor idle).
+    """
     path = write_scene(tmp_path, SMALL_SQUARE)
-    run = PipelineRunner(RunOptions(path, executor="single", record=str(tmp_path / "bag"),
-                                    overrides={"monitor": {"alarm_ratio": 2.0}},
-                                    timeout=120.0)).run()
+    run = PipelineRunner(
+        RunOptions(
+            path,
+            executor="single",
+            record=str(tmp_path / "bag"),
+            overrides={"monitor": {"alarm_ratio": 2.0}},
+            timeout=120.0,
+        )
+    ).run()
     assert run["mode"].endswith("SingleThreadedExecutor")
     for key in ("events", "monitor_events", "forces", "work", "ticks"):
         assert run[key] == small["run"][key], key
     ours, reference = read_bag(tmp_path / "bag"), read_bag(small["bag"])
     for topic in ("/sim/tick", "/sim/state", "/monitor/status", "/devices/barrett_f1/tactile"):
         assert [m.log_time_ns for m in ours.messages if m.topic == topic] == [
-            m.log_time_ns for m in reference.messages if m.topic == topic], topic
+            m.log_time_ns for m in reference.messages if m.topic == topic
+        ], topic
 
 
 def test_resistance_ground_truth_equals_algorithm_2():
     """Sec. 6.4 set-up (F1 on a Barrett finger, F2 on the Cobra arm, A on the pusher): the
     squeeze, then the executor streams Algorithm 2's waypoints; the simulated world's events,
-    termination and work are those of the mechanics API."""
+    termination and work are those of the mechanics API.
+    """
     from squeeze_grasp_ros.mechanics.squeeze.contact_model import ContactModel
-    from squeeze_grasp_ros.mechanics.resistance.frictional import add_adversary, frictional_resistance
+    from squeeze_grasp_ros.mechanics.resistance.frictional import (
+        add_adversary,
+        frictional_resistance,
+    )
     from squeeze_grasp_ros.scene import placement_node
 
     path = str(SCENES / "resist_fig10.yaml")
@@ -288,13 +344,21 @@ def test_resistance_ground_truth_equals_algorithm_2():
     squeeze = event_squeeze_scene(scene, obj, finger_nodes(scene, obj.mesh))
     model = ContactModel(obj, scene.mu, max_events_per_depth=scene.squeeze.max_events_per_depth)
     adv = scene.adversary
-    start = add_adversary(squeeze.state, model, squeeze.displacement,
-                          placement_node(obj.mesh, adv.placement, "adversary"), adv.tip_radius)
-    plan = frictional_resistance(model, start, adv.a, adv.mode, squeeze.step, squeeze.event_tol)
+    start = add_adversary(
+        squeeze.state,
+        model,
+        squeeze.displacement,
+        placement_node(obj.mesh, adv.placement, "adversary"),
+        adv.tip_radius,
+    )
+    plan = frictional_resistance(
+        model, start, adv.a, mode=adv.mode, step=squeeze.step, event_tol=squeeze.event_tol
+    )
     run = PipelineRunner(RunOptions(path, planner=False)).run()
     assert run["termination"] == "resisted"
-    assert [(e["type"], e["node"], e["finger"]) for e in run["events"]] == \
-        [(e.type, e.node, e.finger) for e in squeeze.events + plan.events]
+    assert [(e["type"], e["node"], e["finger"]) for e in run["events"]] == [
+        (e.type, e.node, e.finger) for e in squeeze.events + plan.events
+    ]
     assert (run["world_termination"], plan.reason) == ("finger_slip", "F2 slips")
     for finger in ("F1", "F2", "A"):
         total = squeeze.work.get(finger, 0.0) + plan.work[finger]

@@ -1,7 +1,8 @@
 # Copyright 2026 squeeze_grasp_ros developers
 # SPDX-License-Identifier: Apache-2.0
 """The pipeline across processes and under SIGINT: the same run as in one process, and an
-interrupted run leaves a readable recording."""
+interrupted run leaves a readable recording.
+"""
 from __future__ import annotations
 
 import json

@@ -124,7 +124,7 @@ def plan_squeeze_cases(draw: st.DrawFn) -> Case:
 def relative_depth(contacts: tuple[int, ...], kind: str, depth: float) -> float:
     """The finger approach over the contacts' distance at ``depth`` (the planner's check)."""
     nodes = list(contacts) or list(finger_nodes(scene_of(BLOB), SOLID.mesh))
-    return plan_squeeze(SOLID, nodes, kind).relative_depth(depth)
+    return plan_squeeze(SOLID, nodes, kind=kind).relative_depth(depth)
 
 
 def scene_text(data: dict) -> str:
@@ -325,7 +325,7 @@ def still_correct(planner: Harness) -> None:
     response = planner.call(PlanSqueeze, "plan_squeeze", PlanSqueeze.Request(
         object_id="blob", squeeze_type="pure", depth=0.002))
     assert np.array_equal(flat(response.forces),
-                          0.002 * plan_squeeze(SOLID, fingers, "pure").forces)
+                          0.002 * plan_squeeze(SOLID, fingers, kind="pure").forces)
     gmap = planner.call(GraspMap, "grasp_map", GraspMap.Request(
         object_id="blob", mu=0.4, full_matrices=True))
     assert np.array_equal(flat(gmap.map.stiffness), grasp_map(SOLID, 0.4).stiffness.reshape(-1))

@@ -5,6 +5,7 @@
 Across processes the first request can be lost even after ``wait_for_service`` (docs/design.md
 §5), so requests are re-sent when no answer comes: the planner's requests are idempotent.
 """
+
 from __future__ import annotations
 
 import os
@@ -42,8 +43,12 @@ def planner_process(request: pytest.FixtureRequest, tmp_path: Path) -> Iterator[
     path = tmp_path / "planner.yaml"
     path.write_text(yaml.safe_dump(params))
     log = (tmp_path / "planner.log").open("w")
-    process = subprocess.Popen([*COMMANDS[request.param], "--ros-args", "--params-file", str(path)],
-                               stdout=log, stderr=subprocess.STDOUT, env=dict(os.environ))
+    process = subprocess.Popen(
+        [*COMMANDS[request.param], "--ros-args", "--params-file", str(path)],
+        stdout=log,
+        stderr=subprocess.STDOUT,
+        env=dict(os.environ),
+    )
     try:
         yield values
     finally:
@@ -55,25 +60,39 @@ def planner_process(request: pytest.FixtureRequest, tmp_path: Path) -> Iterator[
 
 
 def test_the_planner_process_answers_and_loads_its_parameters(
-        ros_context: Context, planner_process: dict) -> None:
+    ros_context: Context, planner_process: dict
+) -> None:
     harness = Harness(ros_context, with_planner=False)
     try:
         names = sorted(planner_process)
-        answer = harness.call(GetParameters, "get_parameters", GetParameters.Request(names=names),
-                              TIMEOUT, ATTEMPTS)
+        answer = harness.call(
+            GetParameters, "get_parameters", GetParameters.Request(names=names), TIMEOUT, ATTEMPTS
+        )
         assert {n: parameter_value_to_python(v) for n, v in zip(names, answer.values)} == (
-            planner_process)
-        loaded = harness.call(LoadObject, "load_object", LoadObject.Request(scene_yaml=BLOB),
-                              TIMEOUT, ATTEMPTS)
+            planner_process
+        )
+        loaded = harness.call(
+            LoadObject, "load_object", LoadObject.Request(scene_yaml=BLOB), TIMEOUT, ATTEMPTS
+        )
         assert loaded.success, loaded.message
         fingers = list(loaded.finger_nodes)
-        response = harness.call(PlanSqueeze, "plan_squeeze", PlanSqueeze.Request(
-            object_id="blob", squeeze_type="stable", depth=0.002), TIMEOUT, ATTEMPTS)
+        response = harness.call(
+            PlanSqueeze,
+            "plan_squeeze",
+            PlanSqueeze.Request(object_id="blob", squeeze_type="stable", depth=0.002),
+            TIMEOUT,
+            ATTEMPTS,
+        )
         assert response.success, response.message
-        expected = plan_squeeze(solid_of(BLOB), fingers, "stable")
+        expected = plan_squeeze(solid_of(BLOB), fingers, kind="stable")
         assert np.array_equal(flat(response.forces), 0.002 * expected.forces)
-        refused = harness.call(LoadObject, "load_object", LoadObject.Request(
-            scene_yaml=BLOB.replace("nodes: 300", "nodes: 9000")), TIMEOUT, ATTEMPTS)
+        refused = harness.call(
+            LoadObject,
+            "load_object",
+            LoadObject.Request(scene_yaml=BLOB.replace("nodes: 300", "nodes: 9000")),
+            TIMEOUT,
+            ATTEMPTS,
+        )
         assert not refused.success and "limit of 5000" in refused.message
     finally:
         harness.close()

@@ -95,7 +95,8 @@ def test_mcap_ros2_decodes_every_message(default_bag):
 def test_mcap_ros2_rejects_only_the_action_feedback(hidden_bag):
     """mcap_ros2 0.6 accepts message names matching [A-Z][A-Za-z0-9]* only, so it cannot parse
     rosidl's action messages (``ExecuteGrasp_FeedbackMessage``); every other channel decodes.
-    The ``--include-hidden-topics`` help says so."""
+    The ``--include-hidden-topics`` help says so.
+    """
     expected = channel_counts(hidden_bag)
     feedback = "/executor/execute_grasp/_action/feedback"
     others = [t for t in expected if t != feedback]
@@ -112,7 +113,8 @@ def test_rosbags_decodes_every_message(default_bag, hidden_bag):
 
 def test_schema_text_is_rosbag2s_for_standard_types(default_bag):
     """rosbag2's layout: the root .msg verbatim, then depth first and in sorted order each used
-    type once, after a blank line, 80 '=' and 'MSG: pkg/Type' (no '/msg/')."""
+    type once, after a blank line, 80 '=' and 'MSG: pkg/Type' (no '/msg/').
+    """
     def msg(name: str) -> str:
         return own_text(name.replace("/", "/msg/"))
 
@@ -173,7 +175,8 @@ def first_messages(bag: Path) -> dict:
 
 def test_shipped_viewers_show_what_a_recording_holds(default_bag):
     """Every topic and message path of the Foxglove layout, and the RViz2 display topic and fixed
-    frame, exist in a fresh recording; the force-vs-depth plot reads numbers."""
+    frame, exist in a fresh recording; the force-vs-depth plot reads numbers.
+    """
     import json
 
     import yaml
@@ -204,7 +207,8 @@ def test_shipped_viewers_show_what_a_recording_holds(default_bag):
 
 def test_corrupt_recordings_are_refused_never_misread(default_bag, tmp_path):
     """Single-bit flips anywhere in the file (60 seeded positions plus one in every chunk's
-    data): read_bag either refuses the file or returns exactly the original messages."""
+    data): read_bag either refuses the file or returns exactly the original messages.
+    """
     import numpy as np
     from mcap.reader import make_reader as reader_of
 

@@ -6,6 +6,7 @@ The closed forms are checked against a generic constrained minimiser (SLSQP) of 
 written straight from the reduced stiffness C, with the constraints written from the node
 positions (stable) or from col(AC) (pure), never from the forms under test.
 """
+
 import json
 
 import numpy as np
@@ -15,14 +16,22 @@ from scipy.optimize import minimize
 from squeeze_grasp_ros.cli import main
 from squeeze_grasp_ros.mechanics.elastic import shapes
 from squeeze_grasp_ros.mechanics.elastic.compliance import ElasticObject
-from squeeze_grasp_ros.mechanics.errors import MechanicsError
+from squeeze_grasp_ros.mechanics.errors import InvalidInputError
 from squeeze_grasp_ros.mechanics.elastic.material import Material
 from squeeze_grasp_ros.mechanics.elastic.mesh import generate_mesh, mesh_from_triangles
 from squeeze_grasp_ros.mechanics.elastic.reduced import displacement_field
 from squeeze_grasp_ros.mechanics.resistance.optimal import (
-    FINGERS, ResistanceGrasp, compare_resistances, contact_segments, evaluate_resistance,
-    optimal_resistance, resistance_along, resistance_grasp, sweep_directions)
+    ResistanceGrasp,
+    compare_resistances,
+    contact_segments,
+    evaluate_resistance,
+    optimal_resistance,
+    resistance_along,
+    resistance_grasp,
+    sweep_directions,
+)
 from squeeze_grasp_ros.mechanics.resistance.forms import expansion_matrix, pure_form
+from squeeze_grasp_ros.mechanics.vocabulary import Finger
 
 SCENES = "config/scenes"
 
@@ -30,7 +39,7 @@ SCENES = "config/scenes"
 @pytest.fixture(scope="module")
 def blob():
     outline = shapes.fourier_blob(0.05, cos=[0.02, 0.06, 0.0], sin=[0.03, 0.0, 0.02])
-    mesh = generate_mesh(outline, outline.area / 160, 28.0)
+    mesh = generate_mesh(outline, outline.area / 160, min_angle=28.0)
     return ElasticObject(mesh, Material(5e4, 0.3, 0.0254)).precompute()
 
 
@@ -63,7 +72,7 @@ def random_placement(obj, rng, segment=False):
         sets = contact_segments(obj.mesh, nodes, half_width=float(rng.uniform(0.002, 0.012)))
     else:
         sets = [[n] for n in nodes]
-    return dict(zip(FINGERS, sets))
+    return dict(zip(tuple(Finger), sets))
 
 
 def reference_work(grasp, x, a):
@@ -75,11 +84,12 @@ def reference_work(grasp, x, a):
 
 
 def stable_constraints(grasp, a):
-    """sum delta = 0 and sum p x delta = 0 over all contact nodes, from the node positions."""
+    """Sum delta = 0 and sum p x delta = 0 over all contact nodes, from the node positions."""
     P = expansion_matrix(grasp.counts)
     p = grasp.obj.mesh.nodes[grasp.red.contacts]
-    rows = np.vstack([np.tile(np.eye(2), len(p)),
-                      np.column_stack([-p[:, 1], p[:, 0]]).reshape(1, -1)])
+    rows = np.vstack(
+        [np.tile(np.eye(2), len(p)), np.column_stack([-p[:, 1], p[:, 0]]).reshape(1, -1)]
+    )
     M = rows @ P
     return M[:, :4], -M[:, 4:] @ a
 
@@ -89,7 +99,7 @@ def pure_constraints(grasp, a):
     P = expansion_matrix(grasp.counts)
     AC = grasp.red.A @ grasp.red.C
     U, s, _ = np.linalg.svd(AC)
-    N = U[:, np.count_nonzero(s > 1e-9 * s[0]):]
+    N = U[:, np.count_nonzero(s > 1e-9 * s[0]) :]
     M = N.T @ P
     return M[:, :4], -M[:, 4:] @ a
 
@@ -103,21 +113,28 @@ def numerical_optimum(grasp, a, constraints):
     def fun(y):
         return reference_work(grasp, y * L, a) / scale
 
-    res = minimize(fun, np.zeros(4), method="SLSQP", tol=1e-14, options={"maxiter": 500},
-                   constraints=[{"type": "eq", "fun": lambda y: (M @ (y * L) - rhs) / L}])
+    res = minimize(
+        fun,
+        np.zeros(4),
+        method="SLSQP",
+        tol=1e-14,
+        options={"maxiter": 500},
+        constraints=[{"type": "eq", "fun": lambda y: (M @ (y * L) - rhs) / L}],
+    )
     assert res.success, res.message
     return res.x * L, res.fun * scale
 
 
-@pytest.mark.parametrize("mode,constraints", [("stable", stable_constraints),
-                                              ("pure", pure_constraints)])
+@pytest.mark.parametrize(
+    "mode,constraints", [("stable", stable_constraints), ("pure", pure_constraints)]
+)
 @pytest.mark.parametrize("segment", [False, True])
 @pytest.mark.parametrize("seed", range(4))
 def test_closed_form_equals_numerical_minimiser(blob, mode, constraints, segment, seed):
     rng = np.random.default_rng(seed)
     grasp = resistance_grasp(blob, random_placement(blob, rng, segment))
     a = rng.normal(size=2) * 0.004
-    res = optimal_resistance(grasp, a, mode)
+    res = optimal_resistance(grasp, a, mode=mode)
     assert res.success, res.reason
     x_num, w_num = numerical_optimum(grasp, a, constraints)
     assert res.work["total"] == pytest.approx(w_num, rel=1e-6, abs=1e-9 * abs(res.energy))
@@ -131,12 +148,12 @@ def test_stable_constraints_and_equilibrium(blob, seed):
     rng = np.random.default_rng(10 + seed)
     grasp = resistance_grasp(blob, random_placement(blob, rng))
     a = rng.normal(size=2) * 0.003
-    res = optimal_resistance(grasp, a, "stable")
+    res = optimal_resistance(grasp, a, mode="stable")
     p = blob.mesh.nodes[res.contacts]
     delta = np.array([res.d1, res.d2, a])
-    assert np.allclose(delta.sum(axis=0), 0, atol=1e-15)                        # eq. (54)
+    assert np.allclose(delta.sum(axis=0), 0, atol=1e-15)  # eq. (54)
     assert abs(np.sum(cross2(p, delta))) < 1e-12 * np.linalg.norm(a) * blob.scale  # eq. (55)
-    f = np.array([res.forces[k] for k in FINGERS])
+    f = np.array([res.forces[k] for k in tuple(Finger)])
     fmax = np.abs(f).max()
     assert np.allclose(f.sum(axis=0), 0, atol=1e-10 * fmax)
     assert abs(np.sum(cross2(p, f))) < 1e-10 * fmax * blob.scale
@@ -148,14 +165,16 @@ def test_pure_resistance_has_no_rigid_component(blob, segment):
     rng = np.random.default_rng(3)
     grasp = resistance_grasp(blob, random_placement(blob, rng, segment))
     a = np.array([0.002, -0.003])
-    res = optimal_resistance(grasp, a, "pure")
+    res = optimal_resistance(grasp, a, mode="pure")
     delta = expansion_matrix(grasp.counts) @ np.concatenate([res.d1, res.d2, a])
     field = displacement_field(blob, grasp.red, delta).reshape(-1) / blob.scale
     rigid = blob.rigid.T @ field
     assert np.linalg.norm(rigid) < 1e-9 * np.linalg.norm(field)
     assert abs(res.rigid_rotation) < 1e-12
-    stable = optimal_resistance(grasp, a, "stable")
-    assert stable.work["total"] <= res.work["total"] * (1 + 1e-12) or abs(stable.rigid_rotation) > 0
+    stable = optimal_resistance(grasp, a, mode="stable")
+    assert (
+        stable.work["total"] <= res.work["total"] * (1 + 1e-12) or abs(stable.rigid_rotation) > 0
+    )
 
 
 def test_scaling_with_push_and_material(blob):
@@ -167,13 +186,13 @@ def test_scaling_with_push_and_material(blob):
     eh_ratio = 2e9 * 0.003 / (5e4 * 0.0254)
     a = np.array([-0.003, 0.001])
     for mode in ("stable", "pure"):
-        base = optimal_resistance(grasp, a, mode)
+        base = optimal_resistance(grasp, a, mode=mode)
         for s in (0.1, 3.0):
-            scaled = optimal_resistance(grasp, s * a, mode)
+            scaled = optimal_resistance(grasp, s * a, mode=mode)
             assert scaled.work["total"] == pytest.approx(s * s * base.work["total"], rel=1e-10)
             assert np.allclose(scaled.psi()[0], base.psi()[0], atol=1e-12)
             assert np.allclose(scaled.d2, s * base.d2, rtol=1e-10, atol=1e-15)
-        other = optimal_resistance(grasp2, a, mode)
+        other = optimal_resistance(grasp2, a, mode=mode)
         assert other.work["total"] == pytest.approx(eh_ratio * base.work["total"], rel=1e-8)
         assert np.allclose(other.d1, base.d1, rtol=1e-8, atol=1e-14)
 
@@ -195,12 +214,12 @@ def test_theorem11_null_space_at_midpoint_and_unique_optimum(square):
     grasp = resistance_grasp(square, edge_placement(square, 0))
     form = grasp.stable
     lam, vec = np.linalg.eigh(form.H)
-    assert lam[0] < 1e-9 * lam[1]                               # H singular at the midpoint
-    assert abs(vec[:, 0] @ form.t) < 1e-6                       # null(H) is normal to p_i - p_j
-    assert form.b2 > 0.1 * lam[1]                               # yet b2 = t^T H t > 0
+    assert lam[0] < 1e-9 * lam[1]  # H singular at the midpoint
+    assert abs(vec[:, 0] @ form.t) < 1e-6  # null(H) is normal to p_i - p_j
+    assert form.b2 > 0.1 * lam[1]  # yet b2 = t^T H t > 0
     off = resistance_grasp(square, edge_placement(square, 2)).stable
     assert np.linalg.eigvalsh(off.H)[0] > 1e-3 * lam[1]
-    res = optimal_resistance(grasp, [0.001, 0.002], "stable")
+    res = optimal_resistance(grasp, [0.001, 0.002], mode="stable")
     x_num, w_num = numerical_optimum(grasp, np.array([0.001, 0.002]), stable_constraints)
     assert res.work["total"] == pytest.approx(w_num, rel=1e-6)
     assert np.allclose(np.concatenate([res.d1, res.d2]), x_num, atol=1e-5 * np.linalg.norm(x_num))
@@ -210,8 +229,10 @@ def test_optimum_is_continuous_as_pk_crosses_the_midpoint(square):
     """The optimum at the midpoint node agrees with the quadratic through its neighbours."""
     a = np.array([0.001, 0.002])
     offsets = np.array([-2, -1, 0, 1, 2])
-    runs = [optimal_resistance(resistance_grasp(square, edge_placement(square, off)), a, "stable")
-            for off in offsets]
+    runs = [
+        optimal_resistance(resistance_grasp(square, edge_placement(square, off)), a, mode="stable")
+        for off in offsets
+    ]
     values = np.array([[*r.d1, *r.d2, r.work["total"]] for r in runs])
     assert np.all(np.isfinite(values))
     side = offsets != 0
@@ -223,11 +244,11 @@ def test_optimum_is_continuous_as_pk_crosses_the_midpoint(square):
 
 def test_segments_make_H_definite_at_the_midpoint(square):
     point = edge_placement(square, 0)
-    nodes = [point[f][0] for f in FINGERS]
-    sets = dict(zip(FINGERS, contact_segments(square.mesh, nodes)))
+    nodes = [point[f][0] for f in tuple(Finger)]
+    sets = dict(zip(tuple(Finger), contact_segments(square.mesh, nodes)))
     H = resistance_grasp(square, sets).stable.H
     lam = np.linalg.eigvalsh(H)
-    assert lam[0] > 1e-3 * lam[1]                               # Proposition 12
+    assert lam[0] > 1e-3 * lam[1]  # Proposition 12
 
 
 def synthetic_grasp(blob, U):
@@ -247,8 +268,13 @@ def minimise_over_span(grasp, U, a):
         x = U @ tau
         return reference_work(grasp, x[:4] * L, x[4:] * L) / grasp.obj.material.force_scale / L**2
 
-    res = minimize(fun, np.linalg.lstsq(U[4:], a / L, rcond=None)[0], method="SLSQP", tol=1e-14,
-                   constraints=[{"type": "eq", "fun": lambda tau: rows @ (U[4:] @ tau - a / L)}])
+    res = minimize(
+        fun,
+        np.linalg.lstsq(U[4:], a / L, rcond=None)[0],
+        method="SLSQP",
+        tol=1e-14,
+        constraints=[{"type": "eq", "fun": lambda tau: rows @ (U[4:] @ tau - a / L)}],
+    )
     assert res.success
     return (U @ res.x)[:4] * L
 
@@ -268,12 +294,15 @@ def test_rank_cases_of_Q(blob, rank):
     inside = 0.004 * v
     outside = 0.004 * np.array([v[1], -v[0]])
     if rank >= 1:
-        res = optimal_resistance(grasp, inside, "pure")
+        res = optimal_resistance(grasp, inside, mode="pure")
         assert res.success and res.reason == "optimal pure resistance"
-        assert np.allclose(np.concatenate([res.d1, res.d2]), minimise_over_span(grasp, U, inside),
-                           atol=1e-6 * np.linalg.norm(res.d1) + 1e-12)
+        assert np.allclose(
+            np.concatenate([res.d1, res.d2]),
+            minimise_over_span(grasp, U, inside),
+            atol=1e-6 * np.linalg.norm(res.d1) + 1e-12,
+        )
     if rank < 2:
-        res = optimal_resistance(grasp, outside, "pure")
+        res = optimal_resistance(grasp, outside, mode="pure")
         assert not res.success and res.reason.startswith("cannot be resisted")
         out = res.to_json()
         json.dumps(out, allow_nan=False)
@@ -290,7 +319,7 @@ def test_sweep_matches_single_directions(blob, mode):
     sweep = sweep_directions(grasp, mode, 12)
     for k in (0, 5, 11):
         u = np.array([np.cos(sweep.angles[k]), np.sin(sweep.angles[k])])
-        res = optimal_resistance(grasp, 0.002 * u, mode)
+        res = optimal_resistance(grasp, 0.002 * u, mode=mode)
         assert sweep.unit_work[k] == pytest.approx(res.unit_work, rel=1e-10)
         assert np.allclose(sweep.psi[k], np.concatenate(res.psi()), atol=1e-12)
 
@@ -298,7 +327,7 @@ def test_sweep_matches_single_directions(blob, mode):
 def test_user_given_resistance_against_the_optimum(blob):
     grasp = resistance_grasp(blob, random_placement(blob, np.random.default_rng(8)))
     a = np.array([0.0024, 0.0044])
-    best = optimal_resistance(grasp, a, "stable")
+    best = optimal_resistance(grasp, a, mode="stable")
     same = resistance_along(grasp, a, best.d1, "stable")
     assert np.allclose(same.d1, best.d1, atol=1e-12) and same.success
     other = resistance_along(grasp, a, [0.447, -0.894], "stable")
@@ -313,30 +342,54 @@ def test_user_given_resistance_against_the_optimum(blob):
 
 def test_invalid_inputs(blob):
     b = blob.mesh.boundary
-    with pytest.raises(MechanicsError, match="disjoint"):
+    with pytest.raises(InvalidInputError, match="disjoint"):
         resistance_grasp(blob, {"F1": [b[0], b[1]], "F2": [b[1]], "A": [b[9]]})
-    with pytest.raises(MechanicsError, match="keys"):
+    with pytest.raises(InvalidInputError, match="keys"):
         resistance_grasp(blob, {"F1": [b[0]], "F2": [b[5]]})
     grasp = resistance_grasp(blob, {"F1": [b[0]], "F2": [b[12]], "A": [b[25]]})
-    with pytest.raises(MechanicsError, match="nonzero"):
+    with pytest.raises(InvalidInputError, match="nonzero"):
         optimal_resistance(grasp, [0.0, 0.0])
-    with pytest.raises(MechanicsError, match="mode"):
-        optimal_resistance(grasp, [0.001, 0.0], "rigid")
+    with pytest.raises(InvalidInputError, match="mode"):
+        optimal_resistance(grasp, [0.001, 0.0], mode="rigid")
     assert isinstance(grasp, ResistanceGrasp)
 
 
 def test_cli_resist_point_segment_and_sweep(tmp_path, capsys):
     plot = tmp_path / "fig9.png"
-    assert main(["resist", f"{SCENES}/resist_fig9.yaml", "--json", "--directions", "36",
-                 "--plot", str(plot)]) == 0
+    assert (
+        main(
+            [
+                "resist",
+                f"{SCENES}/resist_fig9.yaml",
+                "--json",
+                "--directions",
+                "36",
+                "--plot",
+                str(plot),
+            ]
+        )
+        == 0
+    )
     out = json.loads(capsys.readouterr().out)
     for key in ("success", "reason", "d1", "d2", "a", "work", "forces", "event_counts"):
         assert key in out
     assert out["success"] and set(out["work"]) >= {"F1", "F2", "total"}
     assert np.allclose(np.add(np.add(out["d1"], out["d2"]), out["a"]), 0, atol=1e-15)
     assert len(out["sweep"]["unit_work"]) == 36 and plot.stat().st_size > 0
-    assert main(["resist", f"{SCENES}/resist_fig10.yaml", "--contacts", "segment",
-                 "--mode", "pure", "--json"]) == 0
+    assert (
+        main(
+            [
+                "resist",
+                f"{SCENES}/resist_fig10.yaml",
+                "--contacts",
+                "segment",
+                "--mode",
+                "pure",
+                "--json",
+            ]
+        )
+        == 0
+    )
     out = json.loads(capsys.readouterr().out)
     assert out["contact_model"] == "segment" and out["mode"] == "pure"
-    assert all(len(out["segments"][f]) >= 2 for f in FINGERS)
+    assert all(len(out["segments"][f]) >= 2 for f in tuple(Finger))

@@ -1,6 +1,7 @@
 # Copyright 2026 squeeze_grasp_ros developers
 # SPDX-License-Identifier: Apache-2.0
 """Ring-like objects (Sec. 7): curved-beam model, point-contact squeeze limits, grasp map."""
+
 from __future__ import annotations
 
 from functools import cache
@@ -10,15 +11,24 @@ import pytest
 
 from squeeze_grasp_ros.mechanics.elastic import shapes
 from squeeze_grasp_ros.mechanics.elastic.compliance import node_dofs
-from squeeze_grasp_ros.mechanics.errors import MechanicsError
+from squeeze_grasp_ros.mechanics.errors import InvalidInputError
 from squeeze_grasp_ros.mechanics.elastic.material import Material
 from squeeze_grasp_ros.mechanics.elastic.reduced import reduce_blocks
 from squeeze_grasp_ros.mechanics.ring.grasp_map import ring_grasp_map
-from squeeze_grasp_ros.mechanics.ring.model import (RingModel, circle_diametral_response,
-                                                    ring_diameter_changes,
-                                                    ring_from_outline)
-from squeeze_grasp_ros.mechanics.ring.squeeze import (LIMITS, first_root, inward_normal,
-                                                      normal_polynomial, polyval, ring_grasp)
+from squeeze_grasp_ros.mechanics.ring.model import (
+    RingModel,
+    circle_diametral_response,
+    ring_diameter_changes,
+    ring_from_outline,
+)
+from squeeze_grasp_ros.mechanics.ring.squeeze import (
+    LIMITS,
+    first_root,
+    inward_normal,
+    normal_polynomial,
+    polyval,
+    ring_grasp,
+)
 
 E, W, H = 2.0e9, 0.01, 0.003
 
@@ -38,7 +48,9 @@ def make_ring(kind="ellipse", elements=120, E=E, w=W, h=H) -> RingModel:
 
 
 def circle_diametral(elements: int, h=0.004, load=10.0):
-    """FE diameter changes (along, across) and max fibre strain of the 0.04 m circle under +-load."""
+    """FE diameter changes (along, across) and max fibre strain of the 0.04 m circle under
+    +-load.
+    """
     return circle_diametral_response(elements, 0.04, E, W, h, load)
 
 
@@ -48,7 +60,10 @@ def test_circle_converges_to_closed_form_at_second_order():
     sizes = [16, 32, 64, 128, 256, 512]
     errors = []
     print("\nring under diametral loads: FE vs closed form (extension + bending, eq. 71)")
-    print(f"{'elements':>8} {'along (m)':>13} {'across (m)':>13} {'err along':>10} {'err across':>10} {'order':>6}")
+    print(
+        f"{'elements':>8} {'along (m)':>13} {'across (m)':>13} {'err along':>10} "
+        f"{'err across':>10} {'order':>6}"
+    )
     for k, n in enumerate(sizes):
         along, across, _ = circle_diametral(n, h, P)
         err = np.abs(np.array([along, across]) / exact - 1)
@@ -64,22 +79,22 @@ def test_circle_converges_to_closed_form_at_second_order():
 
 def test_closed_form_limits_and_extension_term():
     R, P = 0.04, 10.0
-    EI = E * W * H ** 3 / 12
+    EI = E * W * H**3 / 12
     along, across = ring_diameter_changes(R, E, W, H, P)
     assert along < 0 < across
     thin_along, thin_across = ring_diameter_changes(R, E, W, 1e-5, P)
     EI_thin = E * W * 1e-15 / 12
-    assert thin_along * EI_thin / (P * R ** 3) == pytest.approx(-(np.pi / 4 - 2 / np.pi), rel=1e-6)
-    assert thin_across * EI_thin / (P * R ** 3) == pytest.approx(2 / np.pi - 0.5, rel=1e-6)
-    assert abs(along * EI / (P * R ** 3)) > np.pi / 4 - 2 / np.pi
-    with pytest.raises(MechanicsError):
+    assert thin_along * EI_thin / (P * R**3) == pytest.approx(-(np.pi / 4 - 2 / np.pi), rel=1e-6)
+    assert thin_across * EI_thin / (P * R**3) == pytest.approx(2 / np.pi - 0.5, rel=1e-6)
+    assert abs(along * EI / (P * R**3)) > np.pi / 4 - 2 / np.pi
+    with pytest.raises(InvalidInputError):
         ring_diameter_changes(R, -E, W, H, P)
 
 
 def test_strain_recovery_matches_load_point_moment():
     R, h, P = 0.04, 0.004, 10.0
     _, _, strain = circle_diametral(512, h, P)
-    EI = E * W * h ** 3 / 12
+    EI = E * W * h**3 / 12
     assert strain == pytest.approx(P * R / np.pi * h / (2 * EI), rel=0.01)
 
 
@@ -119,8 +134,8 @@ def test_rigid_motion_invariance():
     th = 0.7
     Rot = np.array([[np.cos(th), -np.sin(th)], [np.sin(th), np.cos(th)]])
     moved = RingModel(ring.points @ Rot.T + [0.3, -0.2], ring.material, ring.wall_thickness)
-    a = ring_grasp(ring, (5, 37), 0.4, 0.02)
-    b = ring_grasp(moved, (5, 37), 0.4, 0.02)
+    a = ring_grasp(ring, (5, 37), 0.4, epsilon=0.02)
+    b = ring_grasp(moved, (5, 37), 0.4, epsilon=0.02)
     assert b.max_depth == pytest.approx(a.max_depth, rel=1e-9)
     assert b.limit == a.limit
     assert np.allclose(b.forces, a.forces @ Rot.T, rtol=1e-9, atol=1e-9 * np.abs(a.forces).max())
@@ -129,14 +144,16 @@ def test_rigid_motion_invariance():
 
 def test_scaling_with_E_w_and_h_cubed():
     base = make_ring("disk", 90, h=4e-4)
-    ref = ring_grasp(base, (0, 45), 0.3, 0.01)
-    for scaled, factor in ((make_ring("disk", 90, E=3 * E, h=4e-4), 3.0),
-                           (make_ring("disk", 90, w=2 * W, h=4e-4), 2.0)):
-        g = ring_grasp(scaled, (0, 45), 0.3, 0.01)
+    ref = ring_grasp(base, (0, 45), 0.3, epsilon=0.01)
+    for scaled, factor in (
+        (make_ring("disk", 90, E=3 * E, h=4e-4), 3.0),
+        (make_ring("disk", 90, w=2 * W, h=4e-4), 2.0),
+    ):
+        g = ring_grasp(scaled, (0, 45), 0.3, epsilon=0.01)
         assert g.stiffness == pytest.approx(factor * ref.stiffness, rel=1e-10)
         assert g.max_depth == pytest.approx(ref.max_depth, rel=1e-10)
         assert np.allclose(g.field, ref.field, atol=1e-12)
-    thin = ring_grasp(make_ring("disk", 90, h=2e-4), (0, 45), 0.3, 0.01)
+    thin = ring_grasp(make_ring("disk", 90, h=2e-4), (0, 45), 0.3, epsilon=0.01)
     assert thin.stiffness / ref.stiffness == pytest.approx(1 / 8, rel=2e-3)
 
 
@@ -145,7 +162,9 @@ def test_stable_squeeze_forces_follow_theorem_10():
     g = ring_grasp(ring, (7, 33), 0.5)
     d = ring.points[33] - ring.points[7]
     assert np.allclose(g.forces[0], -g.forces[1])
-    assert abs(g.forces[0, 0] * d[1] - g.forces[0, 1] * d[0]) < 1e-10 * np.linalg.norm(g.forces[0]) * np.linalg.norm(d)
+    assert abs(g.forces[0, 0] * d[1] - g.forces[0, 1] * d[0]) < 1e-10 * np.linalg.norm(
+        g.forces[0]
+    ) * np.linalg.norm(d)
     assert g.forces[0] @ d > 0
     ends = g.field[[7, 33]].reshape(-1)
     assert np.allclose(ends, g.displacement, atol=1e-12)
@@ -212,7 +231,7 @@ def test_cone_depth_equals_brute_force_scan():
 
 def test_strain_depth_is_where_strain_reaches_epsilon():
     ring = make_ring("disk", 120)
-    g = ring_grasp(ring, (0, 60), 0.3, 0.004)
+    g = ring_grasp(ring, (0, 60), 0.3, epsilon=0.004)
     assert g.limit == "strain"
     assert g.max_strain_at(g.max_depth) == pytest.approx(0.004, rel=1e-12)
     F = np.zeros((ring.n, 2))
@@ -253,7 +272,7 @@ def test_fig15_cones_rotating_toward_each_other_strengthen_the_grasp():
     depth = probe.depth_for_relative(0.3)
     assert np.all(_angles(probe, depth) < psi0)
     mu = np.tan(np.radians(psi0.max() + 0.2))
-    g = ring_grasp(ring, pair, mu, 0.03)
+    g = ring_grasp(ring, pair, mu, epsilon=0.03)
     assert g.limit in ("strain", "none")
     assert np.all(g.cone_depths >= g.max_depth)
     worst = g.cone_margins_at(0.0).min(axis=1)
@@ -263,11 +282,11 @@ def test_fig15_cones_rotating_toward_each_other_strengthen_the_grasp():
 @pytest.mark.parametrize("kind", ["stable", "pure"])
 def test_all_pairs_map_equals_single_placements(kind):
     ring = make_ring("peanut", 40)
-    gmap = ring_grasp_map(ring, 0.4, 0.02, kind, requested_relative_depth=0.1)
+    gmap = ring_grasp_map(ring, 0.4, epsilon=0.02, kind=kind, requested_relative_depth=0.1)
     assert len(gmap.pairs) == 40 * 39 // 2
     for k in range(len(gmap.pairs)):
         i, j = gmap.pairs[k]
-        g = ring_grasp(ring, (i, j), 0.4, 0.02, kind)
+        g = ring_grasp(ring, (i, j), 0.4, epsilon=0.02, kind=kind)
         assert gmap.max_depth[k] == pytest.approx(g.max_depth, rel=1e-7, abs=1e-13)
         assert LIMITS[gmap.limit_code[k]] == g.limit
         assert gmap.lookup(j, i) == k
@@ -278,17 +297,17 @@ def test_all_pairs_map_equals_single_placements(kind):
 
 def test_bad_inputs_raise():
     ring = make_ring(elements=40)
-    with pytest.raises(MechanicsError):
+    with pytest.raises(InvalidInputError):
         ring_grasp(ring, (3, 3), 0.3)
-    with pytest.raises(MechanicsError):
+    with pytest.raises(InvalidInputError):
         ring_grasp(ring, (3, 50), 0.3)
-    with pytest.raises(MechanicsError):
+    with pytest.raises(InvalidInputError):
         ring_grasp(ring, (3, 20), -0.1)
-    with pytest.raises(MechanicsError):
+    with pytest.raises(InvalidInputError):
         ring_from_outline(outline("disk"), Material(E, 0.3, W), H, 40)
-    with pytest.raises(MechanicsError):
+    with pytest.raises(InvalidInputError):
         ring_from_outline(outline("disk"), Material(E, 0.0, W), 0.05, 40)
-    with pytest.raises(MechanicsError):
+    with pytest.raises(InvalidInputError):
         ring.solve_loads(np.ones((ring.n, 2)))
 
 
@@ -325,7 +344,7 @@ def test_cli_single_placement_and_map(tmp_path, capsys):
     scene = load_scene(scene_path)
     ring = build_ring(scene)
     contacts = finger_nodes(scene, ring)
-    g = ring_grasp(ring, contacts, 0.5, 0.03)
+    g = ring_grasp(ring, contacts, 0.5, epsilon=0.03)
     assert out["contacts"] == list(contacts)
     assert out["max_depth"] == pytest.approx(g.max_depth)
     assert out["limit"] == g.limit

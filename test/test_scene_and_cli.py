@@ -122,7 +122,8 @@ def test_graspmap_verb_serves_ring_scenes(capsys):
 
 def test_cli_builds_and_runs_mechanics_verbs_without_ros(tmp_path):
     """`squeeze-grasp ros-setup` runs before the interfaces exist, and the mechanics verbs work
-    with `pip install .` alone: building the parser must not import rclpy or our interfaces."""
+    with `pip install .` alone: building the parser must not import rclpy or our interfaces.
+    """
     import subprocess
     import sys
 

@@ -1,7 +1,8 @@
 # Copyright 2026 squeeze_grasp_ros developers
 # SPDX-License-Identifier: Apache-2.0
 """The simulated world without ROS: devices, sensors, effects that cost nothing when undeclared,
-the stepper loop, the monitor's tracker against the ground truth, the executor's motion logic."""
+the stepper loop, the monitor's tracker against the ground truth, the executor's motion logic.
+"""
 from __future__ import annotations
 
 import copy
@@ -35,7 +36,8 @@ def scene_with(**changes):
 @pytest.fixture(scope="module")
 def world_run():
     """The small square through world + tracker + motion program, tick by tick (no slip alarm:
-    at mu = 0.05 every contact of a finger comes close to its cone edge)."""
+    at mu = 0.05 every contact of a finger comes close to its cone edge).
+    """
     return closed_loop(scene_with(), TrackerConfig(mu=SMALL_SQUARE["friction"]["mu"],
                                                    alarm_ratio=2.0))
 

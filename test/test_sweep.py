@@ -2,7 +2,9 @@
 # SPDX-License-Identifier: Apache-2.0
 """``squeeze-grasp sweep``: spec validation, seeds from ids, failures as rows, and real Dask runs
 (a scheduler and two workers as separate processes on 127.0.0.1, a local cluster, SIGKILL of
-the client and of a worker, resume) that must give the same table bit for bit."""
+the client and of a worker, resume) that must give the same table bit for bit.
+"""
+
 from __future__ import annotations
 
 import dataclasses
@@ -21,8 +23,7 @@ import yaml
 from squeeze_grasp_ros.cli import main
 from squeeze_grasp_ros.sweep.evaluate import COLUMNS, run_task
 from squeeze_grasp_ros.sweep.plan import objects, plan_tasks
-from squeeze_grasp_ros.sweep.spec import (SweepError, SweepSpec, parse_sweep_spec,
-                                          sweep_help)
+from squeeze_grasp_ros.sweep.spec import SweepError, SweepSpec, parse_sweep_spec, sweep_help
 
 pa = pytest.importorskip("pyarrow")
 pytest.importorskip("distributed")
@@ -32,15 +33,30 @@ BASE = str(ROOT / "config" / "scenes" / "foam_square.yaml")
 BIN = Path(sys.executable).parent
 
 SMALL = {
-    "name": "small", "base": BASE, "seed": 11,
-    "objects": [{"shape": {"type": "ellipse", "a": 0.05, "b": 0.035}},
-                {"family": {"type": "superellipse", "count": 2, "a": [0.04, 0.05],
-                            "b": [0.03, 0.04], "exponent": [2.5, 5.0]}},
-                {"family": {"type": "fourier_blob", "count": 1, "radius": [0.04, 0.05]}}],
+    "name": "small",
+    "base": BASE,
+    "seed": 11,
+    "objects": [
+        {"shape": {"type": "ellipse", "a": 0.05, "b": 0.035}},
+        {
+            "family": {
+                "type": "superellipse",
+                "count": 2,
+                "a": [0.04, 0.05],
+                "b": [0.03, 0.04],
+                "exponent": [2.5, 5.0],
+            }
+        },
+        {"family": {"type": "fourier_blob", "count": 1, "radius": [0.04, 0.05]}},
+    ],
     "mesh": {"nodes": 250},
-    "friction": [0.3, 0.8], "tip_radius": [0.01], "relative_depth": [0.04],
+    "friction": [0.3, 0.8],
+    "tip_radius": [0.01],
+    "relative_depth": [0.04],
     "placements": {"mode": "graspmap", "count": 4},
-    "weight": 0.3, "adversary": {"directions": 24}, "chunk": 4,
+    "weight": 0.3,
+    "adversary": {"directions": 24},
+    "chunk": 4,
 }
 
 
@@ -52,6 +68,7 @@ def write_spec(tmp_path: Path, data: dict, name: str = "spec.yaml") -> Path:
 
 def table_without_time(out: Path):
     from squeeze_grasp_ros.sweep.store import read_dataset
+
     return read_dataset(out).drop_columns(["time_s"])
 
 
@@ -68,30 +85,61 @@ def bare_rows(loaded) -> list[dict]:
 # ----------------------------------------------------------------- spec
 
 
-@pytest.mark.parametrize("patch, message", [
-    ({"frictoin": [0.2]}, "unknown key frictoin"),
-    ({"friction": [-0.1]}, "friction[0] must be >= 0.0"),
-    ({"friction": [0.2, 0.2]}, "friction lists a value twice"),
-    ({"relative_depth": [1.5]}, "relative_depth[0] must be in (0.0, 1.0]"),
-    ({"depth": [0.01]}, "depth and relative_depth are exclusive"),
-    ({"chunk": 0}, "chunk must be >= 1"),
-    ({"placements": {"mode": "random"}}, "placements.mode must be one of"),
-    ({"repeat": 2}, "only sampled placements are random"),
-    ({"objects": [{"family": {"type": "superellipse", "count": 2, "a": [0.05, 0.04],
-                              "b": [0.03, 0.04], "exponent": [3, 4]}}]},
-     "objects[0].family.a must be [low, high] with low <= high"),
-    ({"objects": [{"family": {"type": "fourier_blob", "count": 1, "radius": [0.04, 0.05],
-                              "exponent": [3, 4]}}]},
-     "objects[0].family.exponent does not apply to type fourier_blob"),
-    ({"objects": [{"shape": {"type": "ellipse", "a": 0.05}}]},
-     "missing required key shape.b"),
-    ({"objects": [{"outline": "nowhere.csv"}]}, "objects[0].outline: file not found"),
-    ({"objects": [{"shape": {"type": "disk", "radius": 0.05}, "outline": "x.csv"}]},
-     "objects[0] needs exactly one of scene, outline, shape, family"),
-    ({"materials": {"foam": {"E": 5e4, "nu": 0.7, "thickness": 0.01}}},
-     "materials.foam.nu must be in (-1.0, 0.5]"),
-    ({"adversary": {"position": 0.0}}, "adversary.position must be in (0.0, 1.0]"),
-])
+@pytest.mark.parametrize(
+    "patch, message",
+    [
+        ({"frictoin": [0.2]}, "unknown key frictoin"),
+        ({"friction": [-0.1]}, "friction[0] must be >= 0.0"),
+        ({"friction": [0.2, 0.2]}, "friction lists a value twice"),
+        ({"relative_depth": [1.5]}, "relative_depth[0] must be in (0.0, 1.0]"),
+        ({"depth": [0.01]}, "depth and relative_depth are exclusive"),
+        ({"chunk": 0}, "chunk must be >= 1"),
+        ({"placements": {"mode": "random"}}, "placements.mode must be one of"),
+        ({"repeat": 2}, "only sampled placements are random"),
+        (
+            {
+                "objects": [
+                    {
+                        "family": {
+                            "type": "superellipse",
+                            "count": 2,
+                            "a": [0.05, 0.04],
+                            "b": [0.03, 0.04],
+                            "exponent": [3, 4],
+                        }
+                    }
+                ]
+            },
+            "objects[0].family.a must be [low, high] with low <= high",
+        ),
+        (
+            {
+                "objects": [
+                    {
+                        "family": {
+                            "type": "fourier_blob",
+                            "count": 1,
+                            "radius": [0.04, 0.05],
+                            "exponent": [3, 4],
+                        }
+                    }
+                ]
+            },
+            "objects[0].family.exponent does not apply to type fourier_blob",
+        ),
+        ({"objects": [{"shape": {"type": "ellipse", "a": 0.05}}]}, "missing required key shape.b"),
+        ({"objects": [{"outline": "nowhere.csv"}]}, "objects[0].outline: file not found"),
+        (
+            {"objects": [{"shape": {"type": "disk", "radius": 0.05}, "outline": "x.csv"}]},
+            "objects[0] needs exactly one of scene, outline, shape, family",
+        ),
+        (
+            {"materials": {"foam": {"E": 5e4, "nu": 0.7, "thickness": 0.01}}},
+            "materials.foam.nu must be in (-1.0, 0.5]",
+        ),
+        ({"adversary": {"position": 0.0}}, "adversary.position must be in (0.0, 1.0]"),
+    ],
+)
 def test_spec_errors_name_the_key(tmp_path, patch, message):
     with pytest.raises(SweepError) as err:
         parse_sweep_spec({**SMALL, **patch}, tmp_path)
@@ -107,10 +155,18 @@ def test_cli_reports_spec_errors_without_traceback(tmp_path, capsys):
 def test_sweep_help_lists_every_key():
     text = sweep_help()
     for f in dataclasses.fields(SweepSpec):
-        assert any(line.split()[0] in (f.name, f.name + "[]") for line in text.splitlines()
-                   if line.strip()), f.name
-    for key in ("objects[].family.exponent", "placements.require", "adversary.directions",
-                "materials.<name>.E", "mesh.nodes"):
+        assert any(
+            line.split()[0] in (f.name, f.name + "[]")
+            for line in text.splitlines()
+            if line.strip()
+        ), f.name
+    for key in (
+        "objects[].family.exponent",
+        "placements.require",
+        "adversary.directions",
+        "materials.<name>.E",
+        "mesh.nodes",
+    ):
         assert key in text
     lines = {line.split()[0]: line for line in text.splitlines() if line.strip()}
     assert lines["base"].endswith("[required]") and lines["name"].endswith("sweep name")
@@ -119,11 +175,18 @@ def test_sweep_help_lists_every_key():
 
 def test_seeds_come_from_ids_not_from_order(tmp_path):
     """Reordering the parameter axes or adding an object leaves each drawn shape and each
-    sampled placement set unchanged; another seed changes them."""
+    sampled placement set unchanged; another seed changes them.
+    """
     data = {**SMALL, "placements": {"mode": "sample", "count": 3}, "repeat": 2}
     one = parse_sweep_spec(data, tmp_path)
-    more = parse_sweep_spec({**data, "objects": SMALL["objects"] + [
-        {"shape": {"type": "disk", "radius": 0.04}}], "friction": [0.8, 0.3]}, tmp_path)
+    more = parse_sweep_spec(
+        {
+            **data,
+            "objects": SMALL["objects"] + [{"shape": {"type": "disk", "radius": 0.04}}],
+            "friction": [0.8, 0.3],
+        },
+        tmp_path,
+    )
     other = parse_sweep_spec({**data, "seed": 12}, tmp_path)
     shapes = {o.id: o.shape for o in objects(one)}
     assert all(shapes[o.id] == o.shape for o in objects(more) if o.id in shapes)
@@ -132,7 +195,9 @@ def test_seeds_come_from_ids_not_from_order(tmp_path):
     def placements(loaded):
         task = next(t for t in plan_tasks(loaded) if t.group.startswith("01-"))
         from squeeze_grasp_ros.sweep.evaluate import prepare
+
         return prepare(task).placements
+
     first = placements(one)
     assert first == placements(more)
     assert len(first) == 6 and {r for r, _, _ in first} == {0, 1}
@@ -141,14 +206,23 @@ def test_seeds_come_from_ids_not_from_order(tmp_path):
 
 def test_failing_evaluation_is_a_row_not_a_crash(tmp_path):
     """An adversary on F1's own node raises inside the evaluation: the row carries the error,
-    the other rows of the task are complete."""
-    loaded = parse_sweep_spec({**SMALL, "objects": SMALL["objects"][:1],
-                               "adversary": {"position": 1e-6}, "friction": [0.3]}, tmp_path)
+    the other rows of the task are complete.
+    """
+    loaded = parse_sweep_spec(
+        {
+            **SMALL,
+            "objects": SMALL["objects"][:1],
+            "adversary": {"position": 1e-6},
+            "friction": [0.3],
+        },
+        tmp_path,
+    )
     rows = run_task(plan_tasks(loaded)[0])["rows"]
     assert rows and all("puts A on F1's or F2's node" in r["error"] for r in rows)
     assert all(r["termination"] is None and r["stiffness"] > 0 for r in rows)
-    loaded = parse_sweep_spec({**SMALL, "objects": SMALL["objects"][:1], "friction": [0.3]},
-                              tmp_path)
+    loaded = parse_sweep_spec(
+        {**SMALL, "objects": SMALL["objects"][:1], "friction": [0.3]}, tmp_path
+    )
     rows = run_task(plan_tasks(loaded)[0])["rows"]
     assert all(r.get("error") is None and r["termination"] for r in rows)
     assert set(rows[0]) == set(COLUMNS)
@@ -159,18 +233,27 @@ def test_rows_match_the_event_squeeze_and_grasp_map(tmp_path):
     from squeeze_grasp_ros.mechanics.squeeze.contact_model import Limits
     from squeeze_grasp_ros.mechanics.squeeze.events import event_squeeze
     from squeeze_grasp_ros.sweep.evaluate import prepare
+
     loaded = parse_sweep_spec({**SMALL, "objects": SMALL["objects"][:1]}, tmp_path)
     task = plan_tasks(loaded)[0]
     row = run_task(task)["rows"][-1]
     group = prepare(task)
-    res = event_squeeze(group.obj, (row["node_F1"], row["node_F2"]), 0.01, row["mu"],
-                        relative_depth=0.04, limits=Limits(weight=0.3))
+    res = event_squeeze(
+        group.obj,
+        (row["node_F1"], row["node_F2"]),
+        0.01,
+        row["mu"],
+        relative_depth=0.04,
+        limits=Limits(weight=0.3),
+    )
     assert row["termination"] == res.termination and row["depth"] == res.depth
     assert row["energy"] == res.energy and row["work_F1"] == res.work["F1"]
     assert row["events_A"] == res.event_counts["A"]
     assert row["picked_up"] == (res.termination == "picked_up")
     b = list(group.obj.mesh.boundary)
-    assert row["stiffness"] == group.gmap.stiffness[b.index(row["node_F1"]), b.index(row["node_F2"])]
+    assert (
+        row["stiffness"] == group.gmap.stiffness[b.index(row["node_F1"]), b.index(row["node_F2"])]
+    )
     assert row["resist_min"] <= row["resist_max"]
 
 
@@ -179,24 +262,59 @@ def test_rows_match_the_event_squeeze_and_grasp_map(tmp_path):
 
 def start_cluster(tmp_path: Path, workers: int = 2):
     """A `dask scheduler` and `dask worker` processes on 127.0.0.1 (own session each)."""
-    env = {**os.environ, "OMP_NUM_THREADS": "1", "OPENBLAS_NUM_THREADS": "1",
-           "MKL_NUM_THREADS": "1"}
+    env = {
+        **os.environ,
+        "OMP_NUM_THREADS": "1",
+        "OPENBLAS_NUM_THREADS": "1",
+        "MKL_NUM_THREADS": "1",
+    }
     file = tmp_path / "scheduler.json"
-    procs = [subprocess.Popen([str(BIN / "dask"), "scheduler", "--host", "127.0.0.1",
-                               "--port", "0", "--no-dashboard", "--scheduler-file", str(file)],
-                              env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
-                              start_new_session=True)]
+    procs = [
+        subprocess.Popen(
+            [
+                str(BIN / "dask"),
+                "scheduler",
+                "--host",
+                "127.0.0.1",
+                "--port",
+                "0",
+                "--no-dashboard",
+                "--scheduler-file",
+                str(file),
+            ],
+            env=env,
+            stdout=subprocess.DEVNULL,
+            stderr=subprocess.DEVNULL,
+            start_new_session=True,
+        )
+    ]
     deadline = time.monotonic() + 60
     while not file.exists():
         assert time.monotonic() < deadline, "scheduler did not start"
         time.sleep(0.1)
     address = json.loads(file.read_text())["address"]
     for _ in range(workers):
-        procs.append(subprocess.Popen(
-            [str(BIN / "dask"), "worker", address, "--nthreads", "1", "--no-nanny",
-             "--host", "127.0.0.1", "--no-dashboard"], env=env, stdout=subprocess.DEVNULL,
-            stderr=subprocess.DEVNULL, start_new_session=True))
+        procs.append(
+            subprocess.Popen(
+                [
+                    str(BIN / "dask"),
+                    "worker",
+                    address,
+                    "--nthreads",
+                    "1",
+                    "--no-nanny",
+                    "--host",
+                    "127.0.0.1",
+                    "--no-dashboard",
+                ],
+                env=env,
+                stdout=subprocess.DEVNULL,
+                stderr=subprocess.DEVNULL,
+                start_new_session=True,
+            )
+        )
     from distributed import Client
+
     with Client(address, timeout="30s") as client:
         client.wait_for_workers(workers, timeout=60)
     return address, procs
@@ -211,8 +329,10 @@ def stop(procs) -> None:
 
 def test_remote_cluster_local_cluster_and_bare_loop_agree_bit_for_bit(tmp_path):
     """Two `dask worker` processes (one SIGKILLed after the first part is written), a local
-    cluster of one worker and the in-process loop give the same table, row for row."""
+    cluster of one worker and the in-process loop give the same table, row for row.
+    """
     from squeeze_grasp_ros.sweep.engine import run_sweep
+
     loaded = parse_sweep_spec(SMALL, tmp_path)
     address, procs = start_cluster(tmp_path)
     killed = []
@@ -221,9 +341,11 @@ def test_remote_cluster_local_cluster_and_bare_loop_agree_bit_for_bit(tmp_path):
         if not killed:
             os.killpg(procs[1].pid, signal.SIGKILL)
             killed.append(task.id)
+
     try:
-        remote = run_sweep(loaded, tmp_path / "remote", scheduler=address, progress=False,
-                           on_task=kill_worker)
+        remote = run_sweep(
+            loaded, tmp_path / "remote", scheduler=address, progress=False, on_task=kill_worker
+        )
     finally:
         stop(procs)
     assert killed and remote.done == remote.tasks == len(plan_tasks(loaded))
@@ -244,15 +366,25 @@ def test_remote_cluster_local_cluster_and_bare_loop_agree_bit_for_bit(tmp_path):
 def test_sigkill_of_the_client_loses_nothing_finished_and_resume_completes(tmp_path):
     """A real `squeeze-grasp sweep` process is SIGKILLed once parts exist; the parts it wrote
     stay byte-identical, the re-run writes only the rest, and the table equals a clean run's
-    (the in-process loop)."""
+    (the in-process loop).
+    """
     data = {**SMALL, "chunk": 2}
     spec = write_spec(tmp_path, data)
     loaded = parse_sweep_spec(data, tmp_path)
     out = tmp_path / "out"
-    cmd = [str(BIN / "squeeze-grasp"), "sweep", str(spec), "--out", str(out), "--workers", "1",
-           "--no-progress"]
-    proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
-                            start_new_session=True)
+    cmd = [
+        str(BIN / "squeeze-grasp"),
+        "sweep",
+        str(spec),
+        "--out",
+        str(out),
+        "--workers",
+        "1",
+        "--no-progress",
+    ]
+    proc = subprocess.Popen(
+        cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, start_new_session=True
+    )
     parts = out / "parts"
     deadline = time.monotonic() + 120
     try:
@@ -278,18 +410,22 @@ def test_sigkill_of_the_client_loses_nothing_finished_and_resume_completes(tmp_p
     assert json.loads(again.stdout)["skipped"] == total
 
 
-@pytest.mark.parametrize("signum, code", [
-    (signal.SIGINT, 130), pytest.param(signal.SIGTERM, 143, marks=pytest.mark.slow)])
+@pytest.mark.parametrize(
+    "signum, code",
+    [(signal.SIGINT, 130), pytest.param(signal.SIGTERM, 143, marks=pytest.mark.slow)],
+)
 def test_ctrl_c_stops_cleanly_and_resumes(tmp_path, signum, code):
     """SIGINT (or SIGTERM) to the whole process group, as Ctrl-C in a terminal: exit 130 (143),
     one message and no traceback, the manifest agrees with the parts, and the re-run completes
-    the table."""
+    the table.
+    """
     data = {**SMALL, "chunk": 2, "mesh": {"nodes": 600}, "relative_depth": [0.04, 0.08]}
     spec = write_spec(tmp_path, data)
     out = tmp_path / "out"
     cmd = [str(BIN / "squeeze-grasp"), "sweep", str(spec), "--out", str(out), "--workers", "1"]
-    proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
-                            start_new_session=True)
+    proc = subprocess.Popen(
+        cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, start_new_session=True
+    )
     try:
         while len(list((out / "parts").glob("*.parquet"))) < 1:
             assert proc.poll() is None
@@ -310,6 +446,7 @@ def test_ctrl_c_stops_cleanly_and_resumes(tmp_path, signum, code):
 def test_other_spec_in_the_same_directory_is_refused(tmp_path):
     from squeeze_grasp_ros.sweep.plan import plan_tasks as plan
     from squeeze_grasp_ros.sweep.store import Store
+
     one = parse_sweep_spec(SMALL, tmp_path)
     Store(tmp_path / "o", one, plan(one))
     two = parse_sweep_spec({**SMALL, "seed": 5}, tmp_path)
@@ -333,6 +470,7 @@ def test_dry_run_and_report(tmp_path, capsys):
     assert dry["tasks"] == len(tasks) and dry["evaluations"] == sum(t.evaluations for t in tasks)
     assert dry["objects"] == 4 and dry["parameters"] == 2 and dry["estimate_s"] > 0
     from squeeze_grasp_ros.sweep.store import Store
+
     store = Store(tmp_path / "o", loaded, tasks)
     rows = []
     for task in tasks:
@@ -340,12 +478,15 @@ def test_dry_run_and_report(tmp_path, capsys):
         store.write(task, res["rows"], res["outline"])
         rows += res["rows"]
     from squeeze_grasp_ros.sweep.store import read_outlines
+
     outlines = read_outlines(tmp_path / "o")
     assert sorted(outlines) == sorted({t.obj.id for t in tasks})
     xy = np.array(outlines[tasks[0].obj.id])
     assert np.allclose(np.hypot(xy[:, 0] / 0.05, xy[:, 1] / 0.035), 1.0, atol=1e-3)
-    assert main(["sweep-report", str(tmp_path / "o"), "--json", "--plot",
-                 str(tmp_path / "plots")]) == 0
+    assert (
+        main(["sweep-report", str(tmp_path / "o"), "--json", "--plot", str(tmp_path / "plots")])
+        == 0
+    )
     rep = json.loads(capsys.readouterr().out)
     assert rep["evaluations"] == len(rows)
     per = {(c["object"], c["material"]): c for c in rep["by_object_material"]}
@@ -365,15 +506,20 @@ def test_outline_file_objects_travel_with_the_task(tmp_path):
     """An outline file is read by the client: a worker without the file computes the same rows."""
     t = np.linspace(0, 2 * np.pi, 40, endpoint=False)
     csv = tmp_path / "blob.csv"
-    np.savetxt(csv, np.column_stack([0.05 * np.cos(t), 0.03 * np.sin(t) * (1 + 0.2 * np.cos(t))]),
-               delimiter=",")
-    loaded = parse_sweep_spec({**SMALL, "objects": [{"outline": "blob.csv"}],
-                               "friction": [0.5]}, tmp_path)
+    np.savetxt(
+        csv,
+        np.column_stack([0.05 * np.cos(t), 0.03 * np.sin(t) * (1 + 0.2 * np.cos(t))]),
+        delimiter=",",
+    )
+    loaded = parse_sweep_spec(
+        {**SMALL, "objects": [{"outline": "blob.csv"}], "friction": [0.5]}, tmp_path
+    )
     task = plan_tasks(loaded)[0]
     assert task.obj.id == "00-blob"
     first = run_task(task)["rows"]
     csv.unlink()
     from squeeze_grasp_ros.sweep.evaluate import clear_cache
+
     clear_cache()
     again = run_task(task)["rows"]
     strip = [{k: v for k, v in r.items() if k != "time_s"} for r in first]
@@ -383,12 +529,16 @@ def test_outline_file_objects_travel_with_the_task(tmp_path):
 
 def test_a_failed_task_is_recorded_and_redone(tmp_path):
     from squeeze_grasp_ros.sweep.store import Store
+
     loaded = parse_sweep_spec(SMALL, tmp_path)
     tasks = plan_tasks(loaded)
     store = Store(tmp_path / "o", loaded, tasks)
-    store.fail(tasks[0], "MechanicsError: boom")
+    store.fail(tasks[0], "InvalidInputError: boom")
     manifest = json.loads((tmp_path / "o" / "manifest.json").read_text())
-    assert manifest["tasks"][tasks[0].id] == {"status": "failed", "error": "MechanicsError: boom"}
+    assert manifest["tasks"][tasks[0].id] == {
+        "status": "failed",
+        "error": "InvalidInputError: boom",
+    }
     assert manifest["counts"] == {"done": 0, "failed": 1, "pending": len(tasks) - 1}
     again = Store(tmp_path / "o", loaded, tasks)
     assert not again.done(tasks[0].id)

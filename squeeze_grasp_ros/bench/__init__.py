@@ -2,7 +2,8 @@
 # SPDX-License-Identifier: Apache-2.0
 """Benchmarks: accuracy and time, measured in one run and printed as tables (never asserted).
 
-A section module defines ``TITLE`` and ``run(quick: bool, out_dir: Path, progress) -> list[Table]``;
+A section module defines ``TITLE`` and ``run(quick: bool, out_dir: Path, progress) ->
+list[Table]``;
 ``squeeze-grasp bench`` runs the sections listed in ``SECTIONS`` and writes a Markdown report.
 A section whose modules are not installed (``REQUIREMENTS``) is skipped with a line saying why,
 and the report lists it, so the mechanics sections run on a plain ``pip install .``.

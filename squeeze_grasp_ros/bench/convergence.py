@@ -22,6 +22,7 @@ from squeeze_grasp_ros.mechanics.elastic.mesh import generate_mesh, target_max_a
 from squeeze_grasp_ros.mechanics.squeeze.events import EventSqueeze, event_squeeze
 from squeeze_grasp_ros.bench.events import foam_square
 from squeeze_grasp_ros.bench.table import Table, timed
+from squeeze_grasp_ros.mechanics.vocabulary import Finger
 
 TITLE = "Mesh resolution: error and time"
 RADIUS = 0.05
@@ -80,8 +81,8 @@ def rounded_tip_table(quick: bool, progress) -> Table:
     reference = 16000 if quick else 64000
     progress(f"convergence: rounded-tip reference, n ~ {reference}")
     n_ref, _, ref, t_ref = _foam_square_squeeze(reference)
-    keys = {"force": lambda q: q.finger_force["F1"][1], "energy": lambda q: q.energy,
-            "half_width": lambda q: half_width(q, "F1")}
+    keys = {"force": lambda q: q.finger_force[Finger.F1][1], "energy": lambda q: q.energy,
+            "half_width": lambda q: half_width(q, Finger.F1)}
     exact = {k: f(ref) for k, f in keys.items()}
     hs, rows, errors = [], [], {k: [] for k in keys}
     for target in targets:
@@ -89,28 +90,54 @@ def rounded_tip_table(quick: bool, progress) -> Table:
         n, h, sq, seconds = _foam_square_squeeze(target)
         hs.append(h)
         row = [n, seconds, keys["force"](sq), keys["energy"](sq), 1e3 * keys["half_width"](sq),
-               len(sq.segments["F1"]), sum(sq.event_counts.values())]
+               len(sq.segments[Finger.F1]), sum(sq.event_counts.values())]
         for k, f in keys.items():
             errors[k].append(abs(f(sq) - exact[k]) / abs(exact[k]))
             row.append(errors[k][-1])
         rows.append(row)
-    rows.append([n_ref, t_ref, exact["force"], exact["energy"], 1e3 * exact["half_width"],
-                 len(ref.segments["F1"]), sum(ref.event_counts.values()), "ref", "ref", "ref"])
+    rows.append(
+        [
+            n_ref,
+            t_ref,
+            exact["force"],
+            exact["energy"],
+            1e3 * exact["half_width"],
+            len(ref.segments[Finger.F1]),
+            sum(ref.event_counts.values()),
+            "ref",
+            "ref",
+            "ref",
+        ]
+    )
     orders = ", ".join(f"{k} {fitted_order(hs, errors[k]):.2f}" for k in keys)
     return Table(
         "Rounded-tip squeeze (foam square, 12 %): mesh resolution -> error and time",
-        ["nodes n", "time [s]", "F1 force [N]", "energy [J]", "F1 half-width [mm]",
-         "F1 contact nodes", "events", "force rel. err", "energy rel. err", "half-width rel. err"],
+        [
+            "nodes n",
+            "time [s]",
+            "F1 force [N]",
+            "energy [J]",
+            "F1 half-width [mm]",
+            "F1 contact nodes",
+            "events",
+            "force rel. err",
+            "energy rel. err",
+            "half-width rel. err",
+        ],
         rows,
-        f"Errors against the last row, a much finer reference mesh. Observed orders (least-squares "
+        f"Errors against the last row, a much finer reference mesh. Observed orders "
+        "(least-squares "
         f"slope in the element size): {orders}. Time = mesh + precompute + event-driven squeeze "
-        "(events located to 1e-9 L). Contact quantities are quantised by the boundary node spacing "
-        "(the contact edge jumps from node to node), so their errors oscillate while decreasing.")
+        "(events located to 1e-9 L). Contact quantities are quantised by the boundary node "
+        "spacing "
+        "(the contact edge jumps from node to node), so their errors oscillate while decreasing.",
+    )
 
 
 def run(quick: bool, out_dir: Path, progress) -> list[Table]:
     """Refine a disk mesh; tabulate far-field error (with order) and point-stiffness drift;
-    refine the foam square under a rounded-tip squeeze."""
+    refine the foam square under a rounded-tip squeeze.
+    """
     targets = (250, 1000, 4000, 16000) if quick else (250, 1000, 4000, 16000, 64000)
     exact = disk_diameter_change_across(MATERIAL.E, MATERIAL.nu, MATERIAL.thickness, RADIUS, 1.0)
     outline = shapes.disk(RADIUS)
@@ -120,7 +147,7 @@ def run(quick: bool, out_dir: Path, progress) -> list[Table]:
         area = target_max_area(outline, target)
 
         def solve():
-            mesh = generate_mesh(outline, area, 30.0)
+            mesh = generate_mesh(outline, area, min_angle=30.0)
             obj = ElasticObject(mesh, MATERIAL).precompute()
             nodes = _diametral_nodes(mesh)
             A = obj.compliance_block(nodes) / MATERIAL.force_scale
@@ -152,14 +179,29 @@ def run(quick: bool, out_dir: Path, progress) -> list[Table]:
     ax1.set_title("point contact: drifts, does not converge")
     ax1.set_aspect("auto")
     plots.save(fig, out_dir / png)
-    return [rounded_tip_table(quick, progress), Table(
-        TITLE,
-        ["nodes n", "max area [m^2]", "min angle [deg]", "time [s]", "dD/P [m/N]",
-         "rel. error", "observed order", "point stiffness [N/m]", "drift vs finest"],
-        rows,
-        f"Disk R = {RADIUS} m, E = {MATERIAL.E:g} Pa, nu = {MATERIAL.nu}, h = {MATERIAL.thickness} m; "
-        f"exact dD/P = {exact:.6g} m/N (closed form). The observed order is in the element size "
-        "h ~ sqrt(max area) (expected 2 for a smooth far-field quantity of linear triangles, "
-        "reduced by the point-load singularity). The point-contact stiffness keeps drifting "
-        "(about 1/log(1/h)): it is mesh dependent by nature and is not given an error.",
-        (png,))]
+    return [
+        rounded_tip_table(quick, progress),
+        Table(
+            TITLE,
+            [
+                "nodes n",
+                "max area [m^2]",
+                "min angle [deg]",
+                "time [s]",
+                "dD/P [m/N]",
+                "rel. error",
+                "observed order",
+                "point stiffness [N/m]",
+                "drift vs finest",
+            ],
+            rows,
+            f"Disk R = {RADIUS} m, E = {MATERIAL.E:g} Pa, nu = {MATERIAL.nu}, h = "
+            f"{MATERIAL.thickness} m; "
+            f"exact dD/P = {exact:.6g} m/N (closed form). The observed order is in the element "
+            "size "
+            "h ~ sqrt(max area) (expected 2 for a smooth far-field quantity of linear triangles, "
+            "reduced by the point-load singularity). The point-contact stiffness keeps drifting "
+            "(about 1/log(1/h)): it is mesh dependent by nature and is not given an error.",
+            (png,),
+        ),
+    ]

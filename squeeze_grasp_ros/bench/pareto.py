@@ -17,10 +17,11 @@ from pathlib import Path
 import numpy as np
 
 from squeeze_grasp_ros import plots
-from squeeze_grasp_ros.mechanics.errors import MechanicsError
+from squeeze_grasp_ros.mechanics.errors import InvalidInputError, NumericalError
 from squeeze_grasp_ros.mechanics.squeeze.events import event_squeeze
 from squeeze_grasp_ros.bench.events import foam_square
 from squeeze_grasp_ros.bench.table import Table
+from squeeze_grasp_ros.mechanics.vocabulary import Finger
 
 TITLE = "Accuracy vs time: Pareto front of the squeeze settings"
 MU, RADIUS, RELATIVE = 0.05, 0.02, 0.12
@@ -38,7 +39,7 @@ def _measure(nodes: int, repeat: int = 2, **kw) -> tuple[float, float, float]:
         obj.precompute()
         sq = event_squeeze(obj, contacts, RADIUS, MU, relative_depth=RELATIVE, **kw)
         best = min(best, time.perf_counter() - start)
-    return sq.finger_force["F1"][1], sq.energy, best
+    return sq.finger_force[Finger.F1][1], sq.energy, best
 
 
 def pareto_front(points: list[tuple[float, float]]) -> list[int]:
@@ -69,7 +70,7 @@ def run(quick: bool, out_dir: Path, progress) -> list[Table]:
                                                                            "reference": True}
         try:
             f, e, seconds = _measure(n, **kw)
-        except MechanicsError as exc:
+        except (InvalidInputError, NumericalError) as exc:
             failed.append(f"n ~ {n}, {route}, step {step:g}: {exc}")
             continue
         err = max(abs(f - f_ref) / abs(f_ref), abs(e - e_ref) / abs(e_ref))

@@ -8,7 +8,6 @@ import time
 from pathlib import Path
 
 import yaml
-from rclpy.serialization import deserialize_message, serialize_message
 
 from squeeze_grasp_ros.mechanics.elastic.compliance import ElasticObject
 from squeeze_grasp_ros.ros.nodes import pipeline
@@ -19,6 +18,7 @@ from squeeze_grasp_ros.scene import build_mesh, finger_nodes, load_scene, scene_
 from squeeze_grasp_ros.scene_events import event_squeeze_scene
 from squeeze_grasp_ros.sim.world import SimWorld
 from squeeze_grasp_ros.bench.table import Table, best_time, timed
+from squeeze_grasp_ros.mechanics.vocabulary import SQUEEZING_FINGERS
 
 TITLE = "Pipeline on real rclpy nodes: end to end, lockstep rate, recording, effects"
 EFFECT_SCENE = {
@@ -53,7 +53,8 @@ never lifts, so every run makes the same motion and only the checks cost."""
 
 def bare_mechanics(path: Path) -> float:
     """Seconds of the mechanics API's event-driven squeeze of the scene (mesh and precompute
-    included, as the pipeline builds them too)."""
+    included, as the pipeline builds them too).
+    """
     def squeeze():
         scene = load_scene(path)
         obj = ElasticObject(build_mesh(scene), scene_material(scene))
@@ -82,12 +83,8 @@ def serialization_per_tick(bag_path: Path) -> tuple[float, float, float]:
     markers = [m for m in bag.messages if m.topic == "/sim/markers"]
 
     def cost(batch) -> float:
-        decoded = [(pipeline.message_type(bag.types[m.topic]), m.data) for m in batch]
-
-        def round_trip():
-            for cls, data in decoded:
-                serialize_message(deserialize_message(data, cls))
-        return best_time(round_trip, repeat=3, min_time=0.1)
+        convert = pipeline.round_trip([(bag.types[m.topic], m.data) for m in batch])
+        return best_time(convert, repeat=3, min_time=0.1)
     per_tick = cost(sample) + cost(markers[-1:]) * len(markers) / ticks
     return count / ticks, size / ticks, 1e6 * per_tick
 
@@ -96,7 +93,8 @@ def loop_rate(runs: list[dict], excluded: str = "mechanics", clock: str = "") ->
     """Best lockstep ticks per second over ``runs`` with the time of ``excluded`` taken out
     ("mechanics": the stepper; "world": whole world ticks, i.e. devices, stepper and sensor
     rendering), in wall time or, with ``clock="_cpu"``, CPU time of the whole one-process
-    pipeline. NaN with processes (the world runs in another process)."""
+    pipeline. NaN with processes (the world runs in another process).
+    """
     rates = [r["ticks"] / (r["timing"]["loop" + clock] - r["timing"][excluded + clock])
              for r in runs if excluded in r["timing"]]
     return max(rates, default=float("nan"))
@@ -104,10 +102,11 @@ def loop_rate(runs: list[dict], excluded: str = "mechanics", clock: str = "") ->
 
 def world_loop(scene_path: Path, ticks: int = 700) -> float:
     """CPU seconds of the ROS-free simulated world driven along the scene's squeeze for
-    ``ticks`` ticks (devices, stepper, sensors; no messages)."""
+    ``ticks`` ticks (devices, stepper, sensors; no messages).
+    """
     world = SimWorld(load_scene(scene_path))
     depth = world.scene.squeeze.relative_depth / world.relative_per_depth
-    start = {f: world.positions[f].copy() for f in ("F1", "F2")}
+    start = {f: world.positions[f].copy() for f in SQUEEZING_FINGERS}
     world.start()
 
     def drive():
@@ -121,7 +120,8 @@ def world_loop(scene_path: Path, ticks: int = 700) -> float:
 def effect_rows(out_dir: Path, progress, repeats: int) -> list:
     """Marginal time of each effect on the foam square: with it minus its base, per tick, for
     the ROS-free world and for the whole pipeline (best of ``repeats`` each, the effects
-    interleaved so that slow phases of a shared machine hit them alike)."""
+    interleaved so that slow phases of a shared machine hit them alike).
+    """
     paths = {}
     for k, (name, effects, sections, _) in enumerate(EFFECTS):
         paths[name] = out_dir / f"effect_{k}.yaml"
@@ -188,16 +188,27 @@ def run(quick: bool, out_dir: Path, progress) -> list[Table]:
                               per_tick, size, cost])
     end_to_end = Table(
         "Foam square (Sec. 5.5) through every node: end to end",
-        ["mode", "recording", "total [s]", "plan [s]", "nodes up [s]", "lockstep loop [s]",
-         "ticks", "total / bare mechanics", "recording overhead [% of total]"],
+        [
+            "mode",
+            "recording",
+            "total [s]",
+            "plan [s]",
+            "nodes up [s]",
+            "lockstep loop [s]",
+            "ticks",
+            "total / bare mechanics",
+            "recording overhead [% of total]",
+        ],
         rows,
         f"`squeeze-grasp run config/scenes/foam_square.yaml [--record DIR] [--processes] "
         f"[--executor single]`, best of {repeats} runs by total time (the configurations "
         f"interleaved, so slow phases of a shared machine hit them alike); plan = the planner "
-        f"node's load_object + event_squeeze + plan_squeeze services. Bare mechanics: the same scene's event-driven squeeze through "
+        f"node's load_object + event_squeeze + plan_squeeze services. Bare mechanics: the same "
+        "scene's event-driven squeeze through "
         f"the mechanics API (mesh, precompute, Algorithm 1) took {bare:.3f} s. Recording "
         f"overhead = (best loop with - best loop without recording) / best total with "
-        f"recording.")
+        f"recording.",
+    )
     rate = Table(
         "Lockstep loop with the real nodes, mechanics step excluded",
         ["mode", "ticks", "loop [s]", "stepper [s]", "world step [s]",

@@ -1,6 +1,9 @@
 # Copyright 2026 squeeze_grasp_ros developers
 # SPDX-License-Identifier: Apache-2.0
-"""Optimal resistance at fixed contacts: time per adversary direction and per 360-direction sweep."""
+"""Optimal resistance at fixed contacts: time per adversary direction and per 360-direction
+sweep.
+"""
+
 from __future__ import annotations
 
 from pathlib import Path
@@ -12,9 +15,14 @@ from squeeze_grasp_ros.mechanics.elastic import shapes
 from squeeze_grasp_ros.mechanics.elastic.compliance import ElasticObject
 from squeeze_grasp_ros.mechanics.elastic.material import Material
 from squeeze_grasp_ros.mechanics.elastic.mesh import generate_mesh, target_max_area
-from squeeze_grasp_ros.mechanics.resistance.optimal import (FINGERS, MODES, contact_segments, optimal_resistance,
-                                    resistance_grasp, sweep_directions)
+from squeeze_grasp_ros.mechanics.resistance.optimal import (
+    contact_segments,
+    optimal_resistance,
+    resistance_grasp,
+    sweep_directions,
+)
 from squeeze_grasp_ros.bench.table import Table, best_time, timed
+from squeeze_grasp_ros.mechanics.vocabulary import Finger, SqueezeKind
 
 TITLE = "Optimal resistance (Sec. 6.1-6.2): time per adversary direction"
 MATERIAL = Material(5e4, 0.3, 0.0254)
@@ -27,13 +35,22 @@ PUSH = np.array([-0.01, 0.0])
 SEGMENT_HALF_WIDTH = 0.004
 """Half width of the fixed contact segments, m."""
 DIRECTIONS = 360
-COLUMNS = ["nodes n", "boundary b", "contacts", "mode", "precompute [s]",
-           "per direction, grasp cached [ms]", "per direction incl. grasp build [ms]",
-           f"{DIRECTIONS}-direction sweep incl. build [ms]"]
+COLUMNS = [
+    "nodes n",
+    "boundary b",
+    "contacts",
+    "mode",
+    "precompute [s]",
+    "per direction, grasp cached [ms]",
+    "per direction incl. grasp build [ms]",
+    f"{DIRECTIONS}-direction sweep incl. build [ms]",
+]
 
 
-def resistance_rows(sizes: Sequence[int], progress: Callable[[str], None] = lambda _: None,
-                    ) -> list[list]:
+def resistance_rows(
+    sizes: Sequence[int],
+    progress: Callable[[str], None] = lambda _: None,
+) -> list[list]:
     """One row per mesh size, contact model and mode (columns: :data:`COLUMNS`).
 
     Times are best-of wall times after the object's compliance is cached ("precompute" is
@@ -49,27 +66,40 @@ def resistance_rows(sizes: Sequence[int], progress: Callable[[str], None] = lamb
         obj = ElasticObject(mesh, MATERIAL)
         _, t_pre = timed(obj.precompute)
         b = mesh.boundary
-        nodes = b[np.argmin(np.linalg.norm(mesh.nodes[b][None] - PLACEMENT[:, None], axis=2), axis=1)]
-        models = {"point": [[n] for n in nodes],
-                  "segment": contact_segments(mesh, nodes, SEGMENT_HALF_WIDTH)}
+        nodes = b[
+            np.argmin(np.linalg.norm(mesh.nodes[b][None] - PLACEMENT[:, None], axis=2), axis=1)
+        ]
+        models = {
+            "point": [[n] for n in nodes],
+            "segment": contact_segments(mesh, nodes, SEGMENT_HALF_WIDTH),
+        }
         for model, sets in models.items():
-            segments = dict(zip(FINGERS, sets))
-            for mode in MODES:
+            segments = dict(zip(tuple(Finger), sets))
+            for mode in SqueezeKind.values():
                 grasp = resistance_grasp(obj, segments)
-                t_warm = best_time(lambda: optimal_resistance(grasp, PUSH, mode))
-                t_cold = best_time(lambda: optimal_resistance(resistance_grasp(obj, segments),
-                                                              PUSH, mode))
-                t_sweep = best_time(lambda: sweep_directions(resistance_grasp(obj, segments),
-                                                             mode, DIRECTIONS))
-                rows.append([mesh.n, len(b), model, mode, t_pre, 1e3 * t_warm, 1e3 * t_cold,
-                             1e3 * t_sweep])
+                t_warm = best_time(lambda: optimal_resistance(grasp, PUSH, mode=mode))
+                t_cold = best_time(
+                    lambda: optimal_resistance(resistance_grasp(obj, segments), PUSH, mode=mode)
+                )
+                t_sweep = best_time(
+                    lambda: sweep_directions(resistance_grasp(obj, segments), mode, DIRECTIONS)
+                )
+                rows.append(
+                    [mesh.n, len(b), model, mode, t_pre, 1e3 * t_warm, 1e3 * t_cold, 1e3 * t_sweep]
+                )
     return rows
 
 
 def run(quick: bool, out_dir: Path, progress) -> list[Table]:
     """The resistance timing table (quick: up to 5,000 nodes; full: up to 20,000)."""
     sizes = (517, 2000, 5000) if quick else (517, 2000, 5000, 20000)
-    return [Table(TITLE, COLUMNS, resistance_rows(sizes, progress),
-                  "Fig. 9 placement and push on a Fig. 9-like blob. Targets: under 1 ms per "
-                  "adversary direction after the compliance is cached, and a 360-direction "
-                  "sweep (grasp-quality polar plot) under 0.5 s.")]
+    return [
+        Table(
+            TITLE,
+            COLUMNS,
+            resistance_rows(sizes, progress),
+            "Fig. 9 placement and push on a Fig. 9-like blob. Targets: under 1 ms per "
+            "adversary direction after the compliance is cached, and a 360-direction "
+            "sweep (grasp-quality polar plot) under 0.5 s.",
+        )
+    ]

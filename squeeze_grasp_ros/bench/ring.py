@@ -1,6 +1,7 @@
 # Copyright 2026 squeeze_grasp_ros developers
 # SPDX-License-Identifier: Apache-2.0
 """Ring discretisation -> error against the closed-form circle -> time; all-pairs map time."""
+
 from __future__ import annotations
 
 from pathlib import Path
@@ -10,10 +11,15 @@ import numpy as np
 from squeeze_grasp_ros import plots
 from squeeze_grasp_ros.mechanics.elastic.material import Material
 from squeeze_grasp_ros.mechanics.ring.grasp_map import ring_grasp_map
-from squeeze_grasp_ros.mechanics.ring.model import circle_diametral_response, ring_diameter_changes, ring_from_outline
+from squeeze_grasp_ros.mechanics.ring.model import (
+    circle_diametral_response,
+    ring_diameter_changes,
+    ring_from_outline,
+)
 from squeeze_grasp_ros.mechanics.elastic.shapes import ellipse
 from squeeze_grasp_ros.bench.convergence import observed_orders
 from squeeze_grasp_ros.bench.table import Table, best_time, timed
+from squeeze_grasp_ros.mechanics.vocabulary import SqueezeKind
 
 TITLE = "Ring discretisation: error against the closed form and time"
 RADIUS, E, WIDTH, WALL, LOAD = 0.04, 2e9, 0.01, 0.004, 10.0
@@ -45,18 +51,36 @@ def run(quick: bool, out_dir: Path, progress) -> list[Table]:
     ax.set_title("ring: accuracy vs time (labels: elements)")
     plots.save(fig, out_dir / png)
     map_rows = []
-    for n in ((100, 200, 400) if quick else (100, 200, 400, 800)):
+    for n in (100, 200, 400) if quick else (100, 200, 400, 800):
         ring = ring_from_outline(ellipse(0.045, 0.03), Material(3e9, 0.0, 0.01), 0.003, n)
         _, t_pre = timed(ring.precompute)
-        gm, t_map = timed(lambda: ring_grasp_map(ring, 0.5, 0.03, "stable", 0.15))
+        gm, t_map = timed(
+            lambda: ring_grasp_map(
+                ring, 0.5, epsilon=0.03, kind=SqueezeKind.STABLE, requested_relative_depth=0.15
+            )
+        )
         map_rows.append([ring.n, n * (n - 1) // 2, 1e3 * t_pre, t_map])
     return [
-        Table(TITLE, ["elements", "time [ms]", "along [m]", "across [m]", "max rel. error",
-                      "observed order"], rows,
-              f"Circle R = {RADIUS} m, h = {WALL} m, w = {WIDTH} m, E = {E:g} Pa, diametral loads "
-              f"{LOAD} N; closed form with extension and bending (eq. 71). Second order is expected "
-              "(straight elements on a curved middle line).", (png,)),
-        Table("Ring all-pairs grasp map (ellipse, mu 0.5, eps* 0.03, 15 %)",
-              ["elements", "placements", "precompute [ms]", "map [s]"], map_rows,
-              "Feasibility, maximum depth and limit of every placement, vectorised."),
+        Table(
+            TITLE,
+            [
+                "elements",
+                "time [ms]",
+                "along [m]",
+                "across [m]",
+                "max rel. error",
+                "observed order",
+            ],
+            rows,
+            f"Circle R = {RADIUS} m, h = {WALL} m, w = {WIDTH} m, E = {E:g} Pa, diametral loads "
+            f"{LOAD} N; closed form with extension and bending (eq. 71). Second order is expected "
+            "(straight elements on a curved middle line).",
+            (png,),
+        ),
+        Table(
+            "Ring all-pairs grasp map (ellipse, mu 0.5, eps* 0.03, 15 %)",
+            ["elements", "placements", "precompute [ms]", "map [s]"],
+            map_rows,
+            "Feasibility, maximum depth and limit of every placement, vectorised.",
+        ),
     ]

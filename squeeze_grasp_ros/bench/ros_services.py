@@ -17,6 +17,7 @@ Targets: overhead < 2 ms in one process, < 5 ms across processes, a cached stabl
 squeeze request < 10 ms end to end. Without rclpy and the interfaces ``squeeze-grasp bench``
 skips this section and says what to install (``bench.REQUIREMENTS``).
 """
+
 from __future__ import annotations
 
 from collections.abc import Callable
@@ -29,7 +30,11 @@ TITLE = "ROS services: round trip over the bare mechanics call"
 
 def run(quick: bool, out_dir: Path, progress: Callable[[str], None]) -> list[Table]:
     """Measure the three tables in one run."""
-    from squeeze_grasp_ros.ros.service_latency import localhost_only, long_request_rows, overhead_rows
+    from squeeze_grasp_ros.ros.service_latency import (
+        localhost_only,
+        long_request_rows,
+        overhead_rows,
+    )
 
     sizes = (500, 2000) if quick else (500, 2000, 8000, 20000)
     count = 200 if quick else 1000
@@ -37,32 +42,60 @@ def run(quick: bool, out_dir: Path, progress: Callable[[str], None]) -> list[Tab
         overhead, by_size = overhead_rows(namespace, sizes, count, progress)
         long_rows = long_request_rows(namespace, 8000 if quick else 20000, progress)
     return [
-        Table(TITLE,
-              ["route", "executor", "error reply [ms]", "stable squeeze reply [ms]",
-               "callback work [ms]", "mechanics [ms]", "overhead over mechanics [ms]",
-               "reply / mechanics"],
-              overhead,
-              f"Medians of {count} calls of ~/plan_squeeze on a cached {sizes[0]}-node object "
-              "(two point contacts, rho = 4 mm). Error reply = a request for an unknown object: "
-              "the service overhead alone. Mechanics = reduced stiffness + stable squeeze + "
-              "boundary displacement; callback work adds validation and message building. "
-              "Targets: overhead < 2 ms in one process, < 5 ms across processes."),
-        Table("ROS services: cached-object stable squeeze end to end vs mesh size",
-              ["nodes n", "boundary b", "mechanics [ms]", "one process [ms]",
-               "two processes [ms]", "two processes < 10 ms"],
-              by_size,
-              "Medians of the ~/plan_squeeze round trip (SingleThreadedExecutor) after the "
-              "object is loaded: the cached boundary compliance makes it independent of n."),
-        Table("ROS services: quick requests beside a long goal",
-              ["executor", "goal mesh nodes", "goal time [s]", "executor CPU during goal [s/s]",
-               "spin_once returns during goal [1/s]", "replies during a second goal",
-               "median reply [ms]", "p99 reply [ms]", "max reply [ms]",
-               "median reply, idle [ms]", "p99 < 10 ms"],
-              long_rows,
-              "A GraspMap goal that loads (mesh, factorisation, boundary compliance) and maps a "
-              "large object runs on the planner's worker. First alone: executor CPU = CPU time "
-              "of the thread spinning the executor per wall second (0 = it waits; 1 = it "
-              "spins); then again while ~/plan_squeeze requests are sent back to back from the "
-              "same process (client and planner share the executor). Target: p99 of the quick "
-              "replies under 10 ms while the goal runs."),
+        Table(
+            TITLE,
+            [
+                "route",
+                "executor",
+                "error reply [ms]",
+                "stable squeeze reply [ms]",
+                "callback work [ms]",
+                "mechanics [ms]",
+                "overhead over mechanics [ms]",
+                "reply / mechanics",
+            ],
+            overhead,
+            f"Medians of {count} calls of ~/plan_squeeze on a cached {sizes[0]}-node object "
+            "(two point contacts, rho = 4 mm). Error reply = a request for an unknown object: "
+            "the service overhead alone. Mechanics = reduced stiffness + stable squeeze + "
+            "boundary displacement; callback work adds validation and message building. "
+            "Targets: overhead < 2 ms in one process, < 5 ms across processes.",
+        ),
+        Table(
+            "ROS services: cached-object stable squeeze end to end vs mesh size",
+            [
+                "nodes n",
+                "boundary b",
+                "mechanics [ms]",
+                "one process [ms]",
+                "two processes [ms]",
+                "two processes < 10 ms",
+            ],
+            by_size,
+            "Medians of the ~/plan_squeeze round trip (SingleThreadedExecutor) after the "
+            "object is loaded: the cached boundary compliance makes it independent of n.",
+        ),
+        Table(
+            "ROS services: quick requests beside a long goal",
+            [
+                "executor",
+                "goal mesh nodes",
+                "goal time [s]",
+                "executor CPU during goal [s/s]",
+                "spin_once returns during goal [1/s]",
+                "replies during a second goal",
+                "median reply [ms]",
+                "p99 reply [ms]",
+                "max reply [ms]",
+                "median reply, idle [ms]",
+                "p99 < 10 ms",
+            ],
+            long_rows,
+            "A GraspMap goal that loads (mesh, factorisation, boundary compliance) and maps a "
+            "large object runs on the planner's worker. First alone: executor CPU = CPU time "
+            "of the thread spinning the executor per wall second (0 = it waits; 1 = it "
+            "spins); then again while ~/plan_squeeze requests are sent back to back from the "
+            "same process (client and planner share the executor). Target: p99 of the quick "
+            "replies under 10 ms while the goal runs.",
+        ),
     ]

@@ -15,6 +15,7 @@ from squeeze_grasp_ros.mechanics.elastic.mesh import generate_mesh, target_max_a
 from squeeze_grasp_ros.mechanics.elastic.reduced import boundary_displacement, reduced_stiffness
 from squeeze_grasp_ros.mechanics.squeeze.stable_pure import plan_squeeze
 from squeeze_grasp_ros.bench.table import Table, best_time, timed
+from squeeze_grasp_ros.mechanics.vocabulary import SqueezeKind
 
 TITLE = "Solver routes: precompute and squeeze time vs mesh size"
 MATERIAL = Material(5e4, 0.3, 0.0254)
@@ -24,7 +25,7 @@ OUTLINE = shapes.fourier_blob(0.06, cos=[0.0, 0.15, 0.05], sin=[0.05])
 def _squeeze(obj: ElasticObject, contacts) -> np.ndarray:
     """One two-contact stable squeeze: reduced stiffness, plan, boundary displacement."""
     red = reduced_stiffness(obj, contacts)
-    sq = plan_squeeze(obj, contacts, "stable", red)
+    sq = plan_squeeze(obj, contacts, kind=SqueezeKind.STABLE, red=red)
     return boundary_displacement(obj, red, 1e-3 * sq.displacement)
 
 
@@ -54,11 +55,20 @@ def run(quick: bool, out_dir: Path, progress) -> list[Table]:
         gm_rows.append([mesh.n, len(b), len(b) * (len(b) - 1) // 2, t_map])
     table = Table(
         TITLE,
-        ["nodes n", "boundary b", "mesh [s]", "factorised precompute [s]", "factorised squeeze [ms]",
-         "spectral precompute [s]", "spectral squeeze [ms]", "precompute ratio spectral/factorised"],
+        [
+            "nodes n",
+            "boundary b",
+            "mesh [s]",
+            "factorised precompute [s]",
+            "factorised squeeze [ms]",
+            "spectral precompute [s]",
+            "spectral squeeze [ms]",
+            "precompute ratio spectral/factorised",
+        ],
         rows,
         "Precompute = assembly + factorisation (+ eigendecomposition for the spectral route) + "
-        "boundary compliance. Squeeze = reduced stiffness + stable squeeze + boundary displacement "
+        "boundary compliance. Squeeze = reduced stiffness + stable squeeze + boundary "
+        "displacement "
         "for two contacts. Both routes on the same mesh in the same run.",
     )
     gm = Table("All-pairs grasp map (after precompute)",

@@ -7,12 +7,18 @@ import argparse
 
 import numpy as np
 
-from squeeze_grasp_ros.mechanics.calibration.material_fit import (Cuboid, calibrate_elasticity, friction_from_angle,
-                                     friction_from_trials)
-from squeeze_grasp_ros.mechanics.errors import MechanicsError
+from squeeze_grasp_ros.mechanics.calibration.material_fit import (
+    Cuboid,
+    calibrate_elasticity,
+    friction_from_angle,
+    friction_from_trials,
+)
+from squeeze_grasp_ros.mechanics.errors import InvalidInputError
 from squeeze_grasp_ros.commands.csv_io import read_columns
 
-HELP = "Young's modulus, Poisson's ratio from cuboid compressions; mu from the slope angle (App. B)"
+HELP = (
+    "Young's modulus, Poisson's ratio from cuboid compressions; mu from the slope angle (App. B)"
+)
 CUBOID_COLUMNS = ("force", "length", "width", "height", "dl", "dw")
 
 
@@ -31,14 +37,14 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 def _truth(cell: str) -> bool:
     value = cell.strip().lower()
     if value not in ("1", "0", "true", "false", "yes", "no"):
-        raise MechanicsError(f"slid must be 1/0, true/false or yes/no, got {cell!r}")
+        raise InvalidInputError(f"slid must be 1/0, true/false or yes/no, got {cell!r}")
     return value in ("1", "true", "yes")
 
 
 def run(args: argparse.Namespace) -> dict:
     """The calibrated values."""
     if not (args.cuboids or args.slope_angle is not None or args.slope_trials):
-        raise MechanicsError("give --cuboids and/or --slope-angle / --slope-trials")
+        raise InvalidInputError("give --cuboids and/or --slope-angle / --slope-trials")
     out: dict = {}
     if args.cuboids:
         rows = read_columns(args.cuboids, CUBOID_COLUMNS, ("dh",))
@@ -46,7 +52,7 @@ def run(args: argparse.Namespace) -> dict:
             cuboids = [Cuboid(*(float(r[c]) for c in CUBOID_COLUMNS),
                               float(r["dh"]) if r.get("dh") else None) for r in rows]
         except ValueError as exc:
-            raise MechanicsError(f"{args.cuboids}: {exc}") from None
+            raise InvalidInputError(f"{args.cuboids}: {exc}") from None
         out["elasticity"] = calibrate_elasticity(cuboids).to_json()
     if args.slope_angle is not None:
         out["friction"] = friction_from_angle(np.radians(args.slope_angle)).to_json()
@@ -55,7 +61,7 @@ def run(args: argparse.Namespace) -> dict:
         try:
             trials = [(np.radians(float(r["angle_deg"])), _truth(r["slid"])) for r in rows]
         except ValueError as exc:
-            raise MechanicsError(f"{args.slope_trials}: {exc}") from None
+            raise InvalidInputError(f"{args.slope_trials}: {exc}") from None
         out["friction"] = friction_from_trials(trials).to_json()
     return out
 

@@ -31,7 +31,8 @@ def fail(args: argparse.Namespace, message: str, code: ExitCode) -> int:
 
 def add_scene_argument(parser: argparse.ArgumentParser) -> None:
     """The positional SCENE argument (a YAML file, see `squeeze-grasp scene-help`)."""
-    parser.add_argument("scene", metavar="SCENE", help="scene YAML file (e.g. config/scenes/disk.yaml)")
+    parser.add_argument("scene", metavar="SCENE", help="scene YAML file (e.g. "
+                                                       "config/scenes/disk.yaml)")
 
 
 def add_solver_argument(parser: argparse.ArgumentParser) -> None:
@@ -42,7 +43,7 @@ def add_solver_argument(parser: argparse.ArgumentParser) -> None:
 
 
 def output_file(text: str) -> str:
-    """argparse type of an output file: a path whose folder exists and that is not a folder."""
+    """Argparse type of an output file: a path whose folder exists and that is not a folder."""
     path = Path(text)
     if not text:
         raise argparse.ArgumentTypeError("needs a file name")
@@ -54,8 +55,9 @@ def output_file(text: str) -> str:
 
 
 def new_folder(text: str) -> str:
-    """argparse type of a folder to create (a recording): not empty, not a file, not a folder
-    that already holds something."""
+    """Argparse type of a folder to create (a recording): not empty, not a file, not a folder
+    that already holds something.
+    """
     path = Path(text)
     if not text.strip():
         raise argparse.ArgumentTypeError("needs a folder name")

@@ -12,19 +12,19 @@ from pathlib import Path
 
 import numpy as np
 
-from squeeze_grasp_ros.mechanics.errors import MechanicsError
+from squeeze_grasp_ros.mechanics.errors import InvalidInputError
 
 
 def read_table(path: str | Path) -> tuple[list[str] | None, list[list[str]]]:
     """(header or None, rows of cells) of a CSV file."""
     path = Path(path)
     if not path.is_file():
-        raise MechanicsError(f"CSV file not found: {path}")
+        raise InvalidInputError(f"CSV file not found: {path}")
     with path.open(newline="") as fh:
         rows = [[c.strip() for c in row] for row in csv.reader(fh)
                 if row and not row[0].lstrip().startswith("#") and any(c.strip() for c in row)]
     if not rows:
-        raise MechanicsError(f"{path}: no data rows")
+        raise InvalidInputError(f"{path}: no data rows")
     try:
         float(rows[0][0])
     except ValueError:
@@ -38,9 +38,9 @@ def read_points(path: str | Path) -> np.ndarray:
     try:
         pts = np.array([[float(r[0]), float(r[1])] for r in rows])
     except (ValueError, IndexError):
-        raise MechanicsError(f"{path}: every row must be 'x,y' (metres)") from None
+        raise InvalidInputError(f"{path}: every row must be 'x,y' (metres)") from None
     if header is not None and header[:2] != ["x", "y"]:
-        raise MechanicsError(f"{path}: point columns must be x,y, got {header}")
+        raise InvalidInputError(f"{path}: point columns must be x,y, got {header}")
     return pts
 
 
@@ -49,11 +49,11 @@ def read_columns(path: str | Path, required: tuple[str, ...],
     """Rows as {column: cell} of a CSV whose header has the ``required`` columns."""
     header, rows = read_table(path)
     if header is None:
-        raise MechanicsError(f"{path}: needs a header line with columns {', '.join(required)}")
+        raise InvalidInputError(f"{path}: needs a header line with columns {', '.join(required)}")
     missing = [c for c in required if c not in header]
     unknown = [c for c in header if c not in required + optional]
     if missing or unknown:
-        raise MechanicsError(f"{path}: columns must be {', '.join(required)}"
+        raise InvalidInputError(f"{path}: columns must be {', '.join(required)}"
                              f"{' [, ' + ', '.join(optional) + ']' if optional else ''}, got "
                              f"{', '.join(header)}")
     return [dict(zip(header, r)) for r in rows]

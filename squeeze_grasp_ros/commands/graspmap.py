@@ -1,6 +1,7 @@
 # Copyright 2026 squeeze_grasp_ros developers
 # SPDX-License-Identifier: Apache-2.0
 """``squeeze-grasp graspmap``: stable-squeeze quality of every pair of boundary placements."""
+
 from __future__ import annotations
 
 import argparse
@@ -11,17 +12,25 @@ from squeeze_grasp_ros import plots
 from squeeze_grasp_ros.mechanics.squeeze.graspmap import GraspMap, grasp_map
 from squeeze_grasp_ros.scene import build_ring, load_scene
 from squeeze_grasp_ros.commands import ring
-from squeeze_grasp_ros.commands.common import add_plot_argument, add_scene_argument, add_solver_argument, load_solid
+from squeeze_grasp_ros.commands.common import (
+    add_plot_argument,
+    add_scene_argument,
+    add_solver_argument,
+    load_solid,
+)
 
-HELP = ("all-pairs grasp map: stiffness, inwardness and force closure of every placement "
-        "(ring scenes: feasibility and maximum depth, Sec. 7)")
+HELP = (
+    "all-pairs grasp map: stiffness, inwardness and force closure of every placement "
+    "(ring scenes: feasibility and maximum depth, Sec. 7)"
+)
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     """SCENE, --pairs, --solver, --plot."""
     add_scene_argument(parser)
-    parser.add_argument("--pairs", action="store_true",
-                        help="include the full b x b matrices in the JSON")
+    parser.add_argument(
+        "--pairs", action="store_true", help="include the full b x b matrices in the JSON"
+    )
     add_solver_argument(parser)
     add_plot_argument(parser)
 
@@ -35,8 +44,11 @@ def run(args: argparse.Namespace) -> dict:
     gmap = grasp_map(loaded.obj, loaded.scene.mu)
     if args.plot:
         plot(loaded.obj, gmap, args.plot)
-    return {**gmap.to_json(pairs=args.pairs), "model": "solid",
-            "note": "point-contact stiffness is mesh dependent: compare placements on one mesh"}
+    return {
+        **gmap.to_json(pairs=args.pairs),
+        "model": "solid",
+        "note": "point-contact stiffness is mesh dependent: compare placements on one mesh",
+    }
 
 
 def plot(obj, gmap: GraspMap, path: str) -> None:
@@ -62,10 +74,15 @@ def summary(result: dict) -> str:
     """Counts and the best placements."""
     if result["model"] == "ring":
         return ring.summary(result)
-    lines = [f"{result['pairs']} placements: {result['inward_pairs']} inward, "
-             f"{result['force_closure_pairs']} force closure (mu={result['mu']}), "
-             f"{result['feasible_pairs']} both",
-             "stiffest feasible placements (nodes, N/m):"]
-    lines += [f"  {b['contacts'][0]:5d} {b['contacts'][1]:5d}  {b['stiffness']:.5g}" for b in result["best"]]
+    lines = [
+        f"{result['pairs']} placements: {result['inward_pairs']} inward, "
+        f"{result['force_closure_pairs']} force closure (mu={result['mu']}), "
+        f"{result['feasible_pairs']} both",
+        "stiffest feasible placements (nodes, N/m):",
+    ]
+    lines += [
+        f"  {b['contacts'][0]:5d} {b['contacts'][1]:5d}  {b['stiffness']:.5g}"
+        for b in result["best"]
+    ]
     lines.append(result["note"])
     return "\n".join(lines)

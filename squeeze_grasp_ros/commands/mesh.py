@@ -40,5 +40,7 @@ def run(args: argparse.Namespace) -> dict:
 
 def summary(result: dict) -> str:
     """Counts and quality."""
-    return (f"{len(result['nodes'])} nodes, {len(result['triangles'])} triangles, "
-            f"{len(result['boundary'])} boundary nodes, min angle {result['min_angle_deg']:.1f} deg")
+    return (
+        f"{len(result['nodes'])} nodes, {len(result['triangles'])} triangles, "
+        f"{len(result['boundary'])} boundary nodes, min angle {result['min_angle_deg']:.1f} deg"
+    )

@@ -1,6 +1,7 @@
 # Copyright 2026 squeeze_grasp_ros developers
 # SPDX-License-Identifier: Apache-2.0
 """``squeeze-grasp plan``: unit stable and pure squeezes at the scene's two contacts (Sec. 4)."""
+
 from __future__ import annotations
 
 import argparse
@@ -8,10 +9,16 @@ import argparse
 import numpy as np
 
 from squeeze_grasp_ros import plots
-from squeeze_grasp_ros.mechanics.errors import MechanicsError
+from squeeze_grasp_ros.mechanics.errors import InvalidInputError
 from squeeze_grasp_ros.mechanics.elastic.reduced import boundary_displacement, reduced_stiffness
 from squeeze_grasp_ros.mechanics.squeeze.stable_pure import Squeeze, force_closure, plan_squeeze
-from squeeze_grasp_ros.commands.common import add_plot_argument, add_scene_argument, add_solver_argument, load_solid
+from squeeze_grasp_ros.commands.common import (
+    add_plot_argument,
+    add_scene_argument,
+    add_solver_argument,
+    load_solid,
+)
+from squeeze_grasp_ros.mechanics.vocabulary import SqueezeKind
 
 HELP = "stable and pure squeezes at the scene's finger placements (point contacts, Sec. 3-4)"
 DEFAULT_RELATIVE_DEPTH = 0.05
@@ -23,8 +30,11 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     add_scene_argument(parser)
     depth = parser.add_mutually_exclusive_group()
     depth.add_argument("--depth", type=float, help="squeeze depth rho, m (overrides the scene)")
-    depth.add_argument("--relative-depth", type=float,
-                       help="finger approach / initial contact distance (overrides the scene)")
+    depth.add_argument(
+        "--relative-depth",
+        type=float,
+        help="finger approach / initial contact distance (overrides the scene)",
+    )
     add_solver_argument(parser)
     add_plot_argument(parser)
 
@@ -44,20 +54,26 @@ def squeeze_json(sq: Squeeze) -> dict:
 
 def requested_depth(args: argparse.Namespace, scene_squeeze, sq: Squeeze) -> float:
     """Depth rho (m) from the command line, else the scene, else DEFAULT_RELATIVE_DEPTH."""
-    for depth, rel in ((args.depth, args.relative_depth),
-                       (scene_squeeze.depth, scene_squeeze.relative_depth)):
+    for depth, rel in (
+        (args.depth, args.relative_depth),
+        (scene_squeeze.depth, scene_squeeze.relative_depth),
+    ):
         if depth is not None:
             if not (np.isfinite(depth) and depth >= 0):
-                raise MechanicsError(f"depth must be >= 0 m, got {depth}")
+                raise InvalidInputError(f"depth must be >= 0 m, got {depth}")
             rel = sq.relative_depth(depth)
             if not rel < 1:
-                raise MechanicsError(f"depth {depth:.6g} m is a relative depth of {rel:.6g}: it "
-                                     "must be below 1 (at 1 the fingers would meet)")
+                raise InvalidInputError(
+                    f"depth {depth:.6g} m is a relative depth of {rel:.6g}: "
+                    "it "
+                    "must be below 1 (at 1 the fingers would meet)"
+                )
             return depth
         if rel is not None:
             if not (np.isfinite(rel) and 0 <= rel < 1):
-                raise MechanicsError(f"relative depth must be in [0, 1) (at 1 the fingers would "
-                                     f"meet), got {rel}")
+                raise InvalidInputError(
+                    f"relative depth must be in [0, 1) (at 1 the fingers would meet), got {rel}"
+                )
             return sq.depth_for_relative(rel)
     return sq.depth_for_relative(DEFAULT_RELATIVE_DEPTH)
 
@@ -67,12 +83,14 @@ def run(args: argparse.Namespace) -> dict:
     loaded = load_solid(args.scene, args.solver)
     obj, (i, j) = loaded.obj, loaded.contacts
     red = reduced_stiffness(obj, [i, j])
-    stable = plan_squeeze(obj, [i, j], "stable", red)
-    pure = plan_squeeze(obj, [i, j], "pure", red)
-    chosen = stable if loaded.scene.squeeze.type == "stable" else pure
+    stable = plan_squeeze(obj, [i, j], kind=SqueezeKind.STABLE, red=red)
+    pure = plan_squeeze(obj, [i, j], kind=SqueezeKind.PURE, red=red)
+    chosen = stable if loaded.scene.squeeze.type == SqueezeKind.STABLE else pure
     rho = requested_depth(args, loaded.scene.squeeze, chosen)
-    disp = {k: boundary_displacement(obj, red, rho * sq.displacement)
-            for k, sq in (("stable", stable), ("pure", pure))}
+    disp = {
+        k: boundary_displacement(obj, red, rho * sq.displacement)
+        for k, sq in ((SqueezeKind.STABLE, stable), (SqueezeKind.PURE, pure))
+    }
     mesh = obj.mesh
     result = {
         "contacts": [i, j],
@@ -83,11 +101,14 @@ def run(args: argparse.Namespace) -> dict:
         "squeeze_type": chosen.kind,
         "depth": rho,
         "relative_depth": chosen.relative_depth(rho),
-        "rigid_rotation_at_depth": {"stable": rho * stable.rigid_rotation,
-                                    "pure": rho * pure.rigid_rotation},
+        "rigid_rotation_at_depth": {
+            "stable": rho * stable.rigid_rotation,
+            "pure": rho * pure.rigid_rotation,
+        },
         "boundary_displacement": {k: v.tolist() for k, v in disp.items()},
-        "force_closure": force_closure(mesh.nodes[i], mesh.normal_at(i), mesh.nodes[j],
-                                       mesh.normal_at(j), loaded.scene.mu),
+        "force_closure": force_closure(
+            mesh.nodes[i], mesh.normal_at(i), mesh.nodes[j], mesh.normal_at(j), loaded.scene.mu
+        ),
         "mu": loaded.scene.mu,
         "diagnostics": {**obj.diagnostics(), "reduced_condition": red.condition},
     }
@@ -107,7 +128,7 @@ def plot(obj, stable: Squeeze, pure: Squeeze, rho: float, disp: dict, path: str)
     plots.draw_arrows(axes[0], pts, pure.displacement.reshape(-1, 2), 0.2 * L, "C1", "pure v")
     axes[0].legend(loc="lower right", fontsize=8)
     axes[0].set_title("unit squeezes")
-    for ax, sq, key in ((axes[1], stable, "stable"), (axes[2], pure, "pure")):
+    for ax, sq, key in ((axes[1], stable, SqueezeKind.STABLE), (axes[2], pure, SqueezeKind.PURE)):
         full = np.zeros_like(mesh.nodes)
         full[mesh.boundary] = disp[key]
         plots.draw_outline(ax, mesh, color="0.75", lw=0.8)
@@ -121,15 +142,24 @@ def plot(obj, stable: Squeeze, pure: Squeeze, rho: float, disp: dict, path: str)
 
 def summary(result: dict) -> str:
     """Human-readable comparison of the two squeezes."""
-    s, p = result["stable"], result["pure"]
+    s, p = result[SqueezeKind.STABLE], result[SqueezeKind.PURE]
     i, j = result["contacts"]
-    lines = [f"contacts: nodes {i}, {j}; force closure at mu={result['mu']}: {result['force_closure']}",
-             f"{'':8s}{'|F|/rho [N/m]':>15s}{'U/rho^2 [J/m^2]':>17s}{'rotation [rad/m]':>18s}{'inward':>8s}"]
-    for name, b in (("stable", s), ("pure", p)):
-        lines.append(f"{name:8s}{b['stiffness']:15.5g}{b['energy_per_unit_depth2']:17.5g}"
-                     f"{b['rigid_rotation']:18.3g}{str(b['inward']):>8s}")
-    lines.append(f"u.v = {np.dot(s['displacement'], p['displacement']):.5f} "
-                 f"(= |F(v)|/|F(u)| = {p['stiffness'] / s['stiffness']:.5f}, Theorem 10)")
-    lines.append(f"{result['squeeze_type']} squeeze to depth {result['depth'] * 1e3:.3f} mm "
-                 f"= {100 * result['relative_depth']:.2f} % of the finger distance")
+    lines = [
+        f"contacts: nodes {i}, {j}; force closure at mu={result['mu']}: {result['force_closure']}",
+        f"{'':8s}{'|F|/rho [N/m]':>15s}{'U/rho^2 [J/m^2]':>17s}"
+        f"{'rotation [rad/m]':>18s}{'inward':>8s}",
+    ]
+    for name, b in ((SqueezeKind.STABLE, s), (SqueezeKind.PURE, p)):
+        lines.append(
+            f"{name:8s}{b['stiffness']:15.5g}{b['energy_per_unit_depth2']:17.5g}"
+            f"{b['rigid_rotation']:18.3g}{str(b['inward']):>8s}"
+        )
+    lines.append(
+        f"u.v = {np.dot(s['displacement'], p['displacement']):.5f} "
+        f"(= |F(v)|/|F(u)| = {p['stiffness'] / s['stiffness']:.5f}, Theorem 10)"
+    )
+    lines.append(
+        f"{result['squeeze_type']} squeeze to depth {result['depth'] * 1e3:.3f} mm "
+        f"= {100 * result['relative_depth']:.2f} % of the finger distance"
+    )
     return "\n".join(lines)

@@ -1,6 +1,7 @@
 # Copyright 2026 squeeze_grasp_ros developers
 # SPDX-License-Identifier: Apache-2.0
 """``squeeze-grasp replay DIR``: a recording's sensor topics into a fresh monitor."""
+
 from __future__ import annotations
 
 import argparse
@@ -12,22 +13,32 @@ import yaml
 from squeeze_grasp_ros.exit_codes import ExitCode
 from squeeze_grasp_ros.commands.common import fail
 
-HELP = ("replay a recording's sensor topics on its sim time into a fresh monitor and check that "
-        "it reproduces the recorded event sequence")
+HELP = (
+    "replay a recording's sensor topics on its sim time into a fresh monitor and check that "
+    "it reproduces the recorded event sequence"
+)
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     """DIR and monitor parameter overrides for recordings made by other tools."""
-    parser.add_argument("bag", metavar="DIR", help="rosbag2 folder (MCAP or SQLite3) or .mcap file")
-    parser.add_argument("--param", metavar="NAME=VALUE", action="append", default=[],
-                        help="monitor parameter for the replay (repeatable; YAML value), e.g. "
-                             "mu=0.4 for a recording made by another tool (default: the "
-                             "recording's parameters, else config/monitor.yaml)")
+    parser.add_argument(
+        "bag", metavar="DIR", help="rosbag2 folder (MCAP or SQLite3) or .mcap file"
+    )
+    parser.add_argument(
+        "--param",
+        metavar="NAME=VALUE",
+        action="append",
+        default=[],
+        help="monitor parameter for the replay (repeatable; YAML value), e.g. "
+        "mu=0.4 for a recording made by another tool (default: the "
+        "recording's parameters, else config/monitor.yaml)",
+    )
 
 
 def run(args: argparse.Namespace) -> dict | int:
     """Replay; exit code 1 (after printing the result) when the recorded event sequence is not
-    reproduced, 2 for a missing or corrupt bag, 4 when the replay does not finish."""
+    reproduced, 2 for a missing or corrupt bag, 4 when the replay does not finish.
+    """
     from squeeze_grasp_ros.ros.recording.bag import BagError
     from squeeze_grasp_ros.ros.recording.replay import replay
 
@@ -35,7 +46,9 @@ def run(args: argparse.Namespace) -> dict | int:
     for entry in args.param:
         name, sep, value = entry.partition("=")
         if not sep or not name:
-            print(f"squeeze-grasp replay: --param needs NAME=VALUE, got {entry!r}", file=sys.stderr)
+            print(
+                f"squeeze-grasp replay: --param needs NAME=VALUE, got {entry!r}", file=sys.stderr
+            )
             return ExitCode.USAGE
         overrides[name] = yaml.safe_load(value)
     try:
@@ -52,15 +65,22 @@ def run(args: argparse.Namespace) -> dict | int:
 
 def summary(result: dict) -> str:
     """Human-readable report of a replay."""
-    lines = [f"{result['bag']}: {result['ticks']} ticks replayed into a fresh monitor in "
-             f"{result['seconds']:.2f} s; {len(result['events'])} events, {result['alarms']} "
-             "alarm reports"]
+    lines = [
+        f"{result['bag']}: {result['ticks']} ticks replayed into a fresh monitor in "
+        f"{result['seconds']:.2f} s; {len(result['events'])} events, {result['alarms']} "
+        "alarm reports"
+    ]
     for e in result["events"]:
-        lines.append(f"  t={e['stamp_ns'] * 1e-9:9.4f} s  {e['type']:>9} {e['finger'] or '-':>2}  "
-                     f"depth {e['depth'] * 1e3:.4f} mm")
+        lines.append(
+            f"  t={e['stamp_ns'] * 1e-9:9.4f} s  {e['type']:>9} {e['finger'] or '-':>2}  "
+            f"depth {e['depth'] * 1e3:.4f} mm"
+        )
     if result["reproduced"] is None:
         lines.append("the recording has no monitor/events to compare with")
     else:
-        lines.append("recorded event sequence reproduced exactly" if result["reproduced"] else
-                     f"DIFFERENT from the {len(result['recorded_events'])} recorded events")
+        lines.append(
+            "recorded event sequence reproduced exactly"
+            if result["reproduced"]
+            else f"DIFFERENT from the {len(result['recorded_events'])} recorded events"
+        )
     return "\n".join(lines)

@@ -1,6 +1,7 @@
 # Copyright 2026 squeeze_grasp_ros developers
 # SPDX-License-Identifier: Apache-2.0
 """``squeeze-grasp resist``: optimal resistance to the scene's adversary finger (Sec. 6)."""
+
 from __future__ import annotations
 
 import argparse
@@ -10,20 +11,36 @@ import numpy as np
 
 from squeeze_grasp_ros import plots
 from squeeze_grasp_ros.mechanics.squeeze.contact_model import ContactModel
-from squeeze_grasp_ros.mechanics.errors import MechanicsError
+from squeeze_grasp_ros.mechanics.errors import InvalidInputError
 from squeeze_grasp_ros.mechanics.elastic.reduced import displacement_field
-from squeeze_grasp_ros.mechanics.resistance.optimal import (FINGERS, MODES, Resistance, ResistanceGrasp,
-                                    ResistanceSweep, compare_resistances, contact_segments,
-                                    optimal_resistance, resistance_along, resistance_grasp,
-                                    sweep_directions)
+from squeeze_grasp_ros.mechanics.resistance.optimal import (
+    Resistance,
+    ResistanceGrasp,
+    ResistanceSweep,
+    compare_resistances,
+    contact_segments,
+    optimal_resistance,
+    resistance_along,
+    resistance_grasp,
+    sweep_directions,
+)
 from squeeze_grasp_ros.mechanics.resistance.forms import expansion_matrix
-from squeeze_grasp_ros.mechanics.resistance.frictional import (FrictionalResistance, add_adversary,
-                                             frictional_resistance)
+from squeeze_grasp_ros.mechanics.resistance.frictional import (
+    FrictionalResistance,
+    add_adversary,
+    frictional_resistance,
+)
 from squeeze_grasp_ros.mechanics.squeeze.events import grasp_health
 from squeeze_grasp_ros.scene import SceneError, placement_node
 from squeeze_grasp_ros.scene_events import event_squeeze_scene
-from squeeze_grasp_ros.commands.common import (LoadedScene, add_plot_argument, add_scene_argument, add_solver_argument,
-                     load_solid)
+from squeeze_grasp_ros.commands.common import (
+    LoadedScene,
+    add_plot_argument,
+    add_scene_argument,
+    add_solver_argument,
+    load_solid,
+)
+from squeeze_grasp_ros.mechanics.vocabulary import ContactMode, Finger, SqueezeKind
 
 HELP = "optimal stable/pure resistance of F1, F2 to the scene's adversary finger A (Sec. 6)"
 CONTACT_MODELS = ("point", "segment", "friction")
@@ -32,15 +49,33 @@ CONTACT_MODELS = ("point", "segment", "friction")
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     """SCENE, --mode, --contacts, --directions, --segment-half-width, --compare-direction."""
     add_scene_argument(parser)
-    parser.add_argument("--mode", choices=MODES, help="resistance type (default: the scene's)")
-    parser.add_argument("--contacts", choices=CONTACT_MODELS,
-                        help="contact model (default: the scene's adversary.contacts)")
-    parser.add_argument("--directions", type=int, metavar="N",
-                        help="also sweep N adversary push directions (grasp quality, polar plot)")
-    parser.add_argument("--segment-half-width", type=float, metavar="M",
-                        help="segment contacts: arc length, m, on each side of a contact node")
-    parser.add_argument("--compare-direction", type=float, nargs=2, metavar=("X", "Y"),
-                        help="compare with the resistance whose d1 lies along (X, Y) (Table 4)")
+    parser.add_argument(
+        "--mode", choices=SqueezeKind.values(), help="resistance type (default: the scene's)"
+    )
+    parser.add_argument(
+        "--contacts",
+        choices=CONTACT_MODELS,
+        help="contact model (default: the scene's adversary.contacts)",
+    )
+    parser.add_argument(
+        "--directions",
+        type=int,
+        metavar="N",
+        help="also sweep N adversary push directions (grasp quality, polar plot)",
+    )
+    parser.add_argument(
+        "--segment-half-width",
+        type=float,
+        metavar="M",
+        help="segment contacts: arc length, m, on each side of a contact node",
+    )
+    parser.add_argument(
+        "--compare-direction",
+        type=float,
+        nargs=2,
+        metavar=("X", "Y"),
+        help="compare with the resistance whose d1 lies along (X, Y) (Table 4)",
+    )
     add_solver_argument(parser)
     add_plot_argument(parser)
 
@@ -53,14 +88,16 @@ def adversary_node(loaded: LoadedScene) -> int:
     return k
 
 
-def build_grasp(loaded: LoadedScene, contact_model: str, half_width: float | None) -> ResistanceGrasp:
+def build_grasp(
+    loaded: LoadedScene, contact_model: str, half_width: float | None
+) -> ResistanceGrasp:
     """The fixed-contact problem of the scene's F1, F2 and adversary placements."""
     nodes = [*loaded.contacts, adversary_node(loaded)]
     if contact_model == "point":
         sets = [[n] for n in nodes]
     else:
         sets = contact_segments(loaded.obj.mesh, nodes, half_width)
-    return resistance_grasp(loaded.obj, dict(zip(FINGERS, sets)))
+    return resistance_grasp(loaded.obj, dict(zip(tuple(Finger), sets)))
 
 
 def run_friction(loaded: LoadedScene, mode: str, plot_path: str | None) -> dict:
@@ -77,16 +114,32 @@ def run_friction(loaded: LoadedScene, mode: str, plot_path: str | None) -> dict:
     model = ContactModel(obj, scene.mu, max_events_per_depth=scene.squeeze.max_events_per_depth)
     start = time.perf_counter()
     state = add_adversary(squeeze.state, model, squeeze.displacement, k, adv.tip_radius)
-    res = frictional_resistance(model, state, adv.a, mode, squeeze.step, squeeze.event_tol,
-                                contacts=[*loaded.contacts, k])
-    timing = {"precompute_s": t_pre, "squeeze_s": t_squeeze,
-              "resistance_s": time.perf_counter() - start}
-    out = {"scene": scene.name, **res.to_json(),
-           "contact_points": obj.mesh.nodes[res.contacts].tolist(),
-           "squeeze": {"termination": squeeze.termination, "depth": squeeze.depth,
-                       "event_counts": squeeze.event_counts,
-                       "work": dict(squeeze.work)},
-           "timing": timing}
+    res = frictional_resistance(
+        model,
+        state,
+        adv.a,
+        mode=mode,
+        step=squeeze.step,
+        event_tol=squeeze.event_tol,
+        contacts=[*loaded.contacts, k],
+    )
+    timing = {
+        "precompute_s": t_pre,
+        "squeeze_s": t_squeeze,
+        "resistance_s": time.perf_counter() - start,
+    }
+    out = {
+        "scene": scene.name,
+        **res.to_json(),
+        "contact_points": obj.mesh.nodes[res.contacts].tolist(),
+        "squeeze": {
+            "termination": squeeze.termination,
+            "depth": squeeze.depth,
+            "event_counts": squeeze.event_counts,
+            "work": dict(squeeze.work),
+        },
+        "timing": timing,
+    }
     if plot_path:
         plot_friction(model, squeeze.displacement, res, plot_path)
     return out
@@ -97,14 +150,16 @@ def run(args: argparse.Namespace) -> dict:
     loaded = load_solid(args.scene, args.solver)
     adv = loaded.scene.adversary
     if adv is None:
-        raise SceneError("the scene has no adversary section (declare effect 'adversary'); "
-                         "see config/scenes/resist_fig9.yaml")
+        raise SceneError(
+            "the scene has no adversary section (declare effect 'adversary'); "
+            "see config/scenes/resist_fig9.yaml"
+        )
     mode = args.mode or adv.mode
     contact_model = args.contacts or adv.contacts
     if contact_model == "friction":
         return run_friction(loaded, mode, args.plot)
     if args.directions is not None and args.directions < 1:
-        raise MechanicsError(f"--directions must be >= 1, got {args.directions}")
+        raise InvalidInputError(f"--directions must be >= 1, got {args.directions}")
     half_width = args.segment_half_width
     half_width = adv.segment_half_width if half_width is None else half_width
     start = time.perf_counter()
@@ -112,13 +167,18 @@ def run(args: argparse.Namespace) -> dict:
     t_pre = time.perf_counter() - start
     start = time.perf_counter()
     grasp = build_grasp(loaded, contact_model, half_width)
-    res = optimal_resistance(grasp, adv.a, mode)
+    res = optimal_resistance(grasp, adv.a, mode=mode)
     timing = {"precompute_s": t_pre, "resistance_s": time.perf_counter() - start}
-    out = {"scene": loaded.scene.name, **res.to_json(),
-           "contact_points": loaded.obj.mesh.nodes[res.contacts].tolist()}
+    out = {
+        "scene": loaded.scene.name,
+        **res.to_json(),
+        "contact_points": loaded.obj.mesh.nodes[res.contacts].tolist(),
+    }
     direction = args.compare_direction or adv.compare_direction
     if direction is not None and res.success:
-        out["comparison"] = compare_resistances(res, resistance_along(grasp, adv.a, direction, mode))
+        out["comparison"] = compare_resistances(
+            res, resistance_along(grasp, adv.a, direction, mode)
+        )
     sweep = None
     if args.directions:
         start = time.perf_counter()
@@ -132,9 +192,12 @@ def run(args: argparse.Namespace) -> dict:
     return out
 
 
-def plot(grasp: ResistanceGrasp, res: Resistance, sweep: ResistanceSweep | None, path: str) -> None:
+def plot(
+    grasp: ResistanceGrasp, res: Resistance, sweep: ResistanceSweep | None, path: str
+) -> None:
     """Fig. 9: undeformed shape with the translations; deformed shape with the contact forces;
-    with a sweep, the polar plot of W*_F per unit push over the push directions."""
+    with a sweep, the polar plot of W*_F per unit push over the push directions.
+    """
     obj = grasp.obj
     mesh, L = obj.mesh, obj.scale
     fig, axes = plots.figure(3 if sweep is not None else 2)
@@ -145,9 +208,17 @@ def plot(grasp: ResistanceGrasp, res: Resistance, sweep: ResistanceSweep | None,
     axes[0].set_title(f"{res.mode} resistance ({res.contact_model} contacts)")
     if res.success:
         moves = np.array([res.d1, res.d2, res.a])
-        for p, v, color, name in zip(heads, moves, ("C0", "C1", "C3"), ("d1 (F1)", "d2 (F2)", "a (A)")):
-            plots.draw_arrows(axes[0], p[None], v[None], 0.25 * L * np.linalg.norm(v)
-                              / np.abs(moves).max(), color, name)
+        for p, v, color, name in zip(
+            heads, moves, ("C0", "C1", "C3"), ("d1 (F1)", "d2 (F2)", "a (A)")
+        ):
+            plots.draw_arrows(
+                axes[0],
+                p[None],
+                v[None],
+                0.25 * L * np.linalg.norm(v) / np.abs(moves).max(),
+                color,
+                name,
+            )
         axes[0].legend(loc="lower right", fontsize=8)
         delta = expansion_matrix(grasp.counts) @ np.concatenate([res.d1, res.d2, res.a])
         field = displacement_field(obj, grasp.red, delta)
@@ -164,8 +235,12 @@ def plot(grasp: ResistanceGrasp, res: Resistance, sweep: ResistanceSweep | None,
         axes[2].remove()
         ax = fig.add_subplot(1, 3, 3, projection="polar")
         ok = sweep.feasible
-        ax.plot(np.append(sweep.angles[ok], sweep.angles[ok][:1]),
-                np.append(sweep.unit_work[ok], sweep.unit_work[ok][:1]), "C0.-", ms=2)
+        ax.plot(
+            np.append(sweep.angles[ok], sweep.angles[ok][:1]),
+            np.append(sweep.unit_work[ok], sweep.unit_work[ok][:1]),
+            "C0.-",
+            ms=2,
+        )
         ax.set_title("W*_F per unit push [J/m^2] vs push direction", fontsize=9)
     plots.save(fig, path)
 
@@ -175,21 +250,30 @@ def draw_tips(ax, mesh, res: FrictionalResistance, which: str, displacement) -> 
     state = res.start_state if which == "start" else res.state
     plots.draw_outline(ax, mesh, color="0.75", lw=0.8)
     plots.draw_outline(ax, mesh, displacement)
-    for color, f in zip(("C0", "C1", "C3"), FINGERS):
+    for color, f in zip(("C0", "C1", "C3"), tuple(Finger)):
         tip = state.finger(f)
-        circle = tip.center + tip.radius * np.column_stack([np.cos(np.linspace(0, 2 * np.pi, 121)),
-                                                            np.sin(np.linspace(0, 2 * np.pi, 121))])
+        circle = tip.center + tip.radius * np.column_stack(
+            [np.cos(np.linspace(0, 2 * np.pi, 121)), np.sin(np.linspace(0, 2 * np.pi, 121))]
+        )
         ax.plot(circle[:, 0], circle[:, 1], color=color, lw=1.0)
         nodes = state.segment(f)
-        plots.mark_nodes(ax, np.array([mesh.nodes[c.node] + c.displacement for c in nodes]),
-                         [c.mode == "stick" for c in nodes], color, 14, f"{f} ({len(nodes)})")
+        plots.mark_nodes(
+            ax,
+            np.array([mesh.nodes[c.node] + c.displacement for c in nodes]),
+            [c.mode == ContactMode.STICK for c in nodes],
+            color,
+            14,
+            f"{f} ({len(nodes)})",
+        )
     ax.legend(loc="lower right", fontsize=7)
 
 
-def plot_friction(model: ContactModel, squeezed: np.ndarray, res: FrictionalResistance,
-                  path: str) -> None:
+def plot_friction(
+    model: ContactModel, squeezed: np.ndarray, res: FrictionalResistance, path: str
+) -> None:
     """Fig. 10: (a) after the squeeze with A touching; (b) at the end of the resistance;
-    (c) the fingers' trajectories from a common origin."""
+    (c) the fingers' trajectories from a common origin.
+    """
     mesh = model.obj.mesh
     fig, axes = plots.figure(3)
     draw_tips(axes[0], mesh, res, "start", squeezed)
@@ -197,7 +281,7 @@ def plot_friction(model: ContactModel, squeezed: np.ndarray, res: FrictionalResi
     draw_tips(axes[1], mesh, res, "end", grasp_health(model, res.state)[1])
     axes[1].set_title(f"{res.reason} after {1e3 * res.travelled:.3f} mm", fontsize=9)
     ax = axes[2]
-    for color, f in zip(("C0", "C1", "C3"), FINGERS):
+    for color, f in zip(("C0", "C1", "C3"), tuple(Finger)):
         ax.plot(*(1e3 * res.trajectories[f]).T, ".-", color=color, ms=3, label=f)
     ax.set_aspect("equal")
     ax.set_xlabel("x [mm]")
@@ -210,29 +294,39 @@ def plot_friction(model: ContactModel, squeezed: np.ndarray, res: FrictionalResi
 def summary(result: dict) -> str:
     """Human-readable resistance report."""
     i, j, k = result["contacts"]
-    head = (f"{result['mode']} resistance, {result['contact_model']} contacts at nodes "
-            f"F1 {i}, F2 {j}, A {k}; a = {np.round(result['a'], 6).tolist()} m")
+    head = (
+        f"{result['mode']} resistance, {result['contact_model']} contacts at nodes "
+        f"F1 {i}, F2 {j}, A {k}; a = {np.round(result['a'], 6).tolist()} m"
+    )
     if result["contact_model"] == "friction":
         return friction_summary(head, result)
     if not result["success"]:
         return f"{head}\n{result['reason']}"
     w = result["work"]
-    lines = [head,
-             f"d1 = {np.round(result['d1'], 6).tolist()} m, d2 = {np.round(result['d2'], 6).tolist()} m",
-             f"work [J]: F1 {w['F1']:.5g}, F2 {w['F2']:.5g}, total W*_F {w['total']:.5g} "
-             f"(A {w['A']:.5g}); per unit push {result['unit_work']:.5g} J/m^2"]
-    lines += [f"force {f} [N]: {np.round(result['forces'][f], 4).tolist()}" for f in FINGERS]
+    lines = [
+        head,
+        f"d1 = {np.round(result['d1'], 6).tolist()} m, d2 = "
+        f"{np.round(result['d2'], 6).tolist()} m",
+        f"work [J]: F1 {w['F1']:.5g}, F2 {w['F2']:.5g}, total W*_F {w['total']:.5g} "
+        f"(A {w['A']:.5g}); per unit push {result['unit_work']:.5g} J/m^2",
+    ]
+    lines += [f"force {f} [N]: {np.round(result['forces'][f], 4).tolist()}" for f in tuple(Finger)]
     cmp = result.get("comparison")
     if cmp is not None:
         other = cmp["resistance"]
         ratio = f", {cmp['ratio']:.3g} x the optimum" if cmp["ratio"] is not None else ""
-        lines.append(f"compared: {other['reason']}: W_F {other['work']['total']:.5g} J{ratio}"
-                     if other["success"] else f"compared: {other['reason']}")
+        lines.append(
+            f"compared: {other['reason']}: W_F {other['work']['total']:.5g} J{ratio}"
+            if other["success"]
+            else f"compared: {other['reason']}"
+        )
     sweep = result.get("sweep")
     if sweep is not None and sweep["min"] is not None:
-        lines.append(f"sweep of {len(sweep['angles_deg'])} directions: W*_F per unit push "
-                     f"{sweep['min']['unit_work']:.4g} J/m^2 at {sweep['min']['angle_deg']:.1f} deg "
-                     f"to {sweep['max']['unit_work']:.4g} J/m^2 at {sweep['max']['angle_deg']:.1f} deg")
+        lines.append(
+            f"sweep of {len(sweep['angles_deg'])} directions: W*_F per unit push "
+            f"{sweep['min']['unit_work']:.4g} J/m^2 at {sweep['min']['angle_deg']:.1f} deg "
+            f"to {sweep['max']['unit_work']:.4g} J/m^2 at {sweep['max']['angle_deg']:.1f} deg"
+        )
     return "\n".join(lines)
 
 
@@ -240,12 +334,18 @@ def friction_summary(head: str, result: dict) -> str:
     """Human-readable Algorithm 2 report (Table 3 style)."""
     w, along = result["work"], result["force_along"]
     counts = ", ".join(f"{k} {v}" for k, v in result["event_counts"].items())
-    lines = [head,
-             f"{'success' if result['success'] else 'failure'}: {result['reason']} after A "
-             f"travelled {1e3 * result['travelled']:.4g} mm in {len(result['stages'])} stages; "
-             f"events {counts}",
-             f"d1 = {np.round(result['d1'], 6).tolist()} m, d2 = {np.round(result['d2'], 6).tolist()} m",
-             f"{'':4s}{'force start [N]':>17s}{'force end [N]':>15s}{'work [J]':>12s}"]
-    lines += [f"{f:4s}{along[f]['start']:17.4g}{along[f]['end']:15.4g}{w[f]:12.4g}" for f in FINGERS]
+    lines = [
+        head,
+        f"{'success' if result['success'] else 'failure'}: {result['reason']} after A "
+        f"travelled {1e3 * result['travelled']:.4g} mm in {len(result['stages'])} stages; "
+        f"events {counts}",
+        f"d1 = {np.round(result['d1'], 6).tolist()} m, d2 = "
+        f"{np.round(result['d2'], 6).tolist()} m",
+        f"{'':4s}{'force start [N]':>17s}{'force end [N]':>15s}{'work [J]':>12s}",
+    ]
+    lines += [
+        f"{f:4s}{along[f]['start']:17.4g}{along[f]['end']:15.4g}{w[f]:12.4g}"
+        for f in tuple(Finger)
+    ]
     lines.append(f"W_F = {w['total']:.5g} J (forces along each finger's motion, Table 3)")
     return "\n".join(lines)

@@ -1,6 +1,8 @@
 # Copyright 2026 squeeze_grasp_ros developers
 # SPDX-License-Identifier: Apache-2.0
-"""``squeeze-grasp run SCENE``: a whole scene through the real rclpy nodes, in lockstep sim time."""
+"""``squeeze-grasp run SCENE``: a whole scene through the real rclpy nodes, in lockstep sim
+time.
+"""
 from __future__ import annotations
 
 import argparse
@@ -67,7 +69,8 @@ def _progress_line(update: dict) -> None:
 
 def run(args: argparse.Namespace) -> dict | int:
     """Run the pipeline; the JSON summary (see :meth:`PipelineRunner.summary`), or exit code
-    130 after Ctrl-C (the recording is finished first)."""
+    130 after Ctrl-C (the recording is finished first).
+    """
     from squeeze_grasp_ros.ros.run.runner import PipelineRunner, RunError, RunOptions
 
     if not (args.timeout > 0 and args.timeout < float("inf")):
@@ -135,11 +138,15 @@ def summary(result: dict) -> str:
         f"world (ground truth): termination {result['world_termination']}; events {counts}",
         f"monitor: events {monitor or 'none'}; alarms {alarms}",
         f"planner prediction: {result['prediction']['termination']} at "
-        f"{result['prediction']['depth'] * 1e3:.4f} mm, {len(result['prediction']['events'])} events",
-        "forces on the object [N]: " + "  ".join(f"{f} {_vector(v)}"
-                                                for f, v in result["forces"].items()),
-        "work [J]: " + "  ".join(f"{f} {w:.5f} (measured {result['measured_work'].get(f, 0.0):.5f})"
-                                 for f, w in result["work"].items()),
+        f"{result['prediction']['depth'] * 1e3:.4f} mm, {len(result['prediction']['events'])} "
+        "events",
+        "forces on the object [N]: "
+        + "  ".join(f"{f} {_vector(v)}" for f, v in result["forces"].items()),
+        "work [J]: "
+        + "  ".join(
+            f"{f} {w:.5f} (measured {result['measured_work'].get(f, 0.0):.5f})"
+            for f, w in result["work"].items()
+        ),
         f"wall time {timing['total']:.2f} s (plan {timing['plan']:.2f} s, nodes "
         f"{timing['start_nodes']:.2f} s, lockstep loop {timing['loop']:.2f} s)",
     ]

@@ -1,6 +1,9 @@
 # Copyright 2026 squeeze_grasp_ros developers
 # SPDX-License-Identifier: Apache-2.0
-"""``squeeze-grasp squeeze``: event-driven squeeze with rounded fingertips (Sec. 5, Algorithm 1)."""
+"""``squeeze-grasp squeeze``: event-driven squeeze with rounded fingertips (Sec. 5, Algorithm
+1).
+"""
+
 from __future__ import annotations
 
 import argparse
@@ -10,13 +13,19 @@ import time
 import numpy as np
 
 from squeeze_grasp_ros import plots
-from squeeze_grasp_ros.mechanics.squeeze.contact_state import EVENT_TYPES
+
 from squeeze_grasp_ros.mechanics.squeeze.fingertips import unit
 from squeeze_grasp_ros.mechanics.squeeze.events import EventSqueeze
 from squeeze_grasp_ros.scene_events import event_squeeze_scene
-from squeeze_grasp_ros.commands.common import (add_plot_argument, add_scene_argument, add_solver_argument, load_solid,
-                     output_file)
+from squeeze_grasp_ros.commands.common import (
+    add_plot_argument,
+    add_scene_argument,
+    add_solver_argument,
+    load_solid,
+    output_file,
+)
 from squeeze_grasp_ros.commands.csv_io import write_points
+from squeeze_grasp_ros.mechanics.vocabulary import ContactMode, EventType, Finger
 
 HELP = "event-driven squeeze with rounded fingertips under Coulomb friction (Sec. 5, Algorithm 1)"
 BAR_WIDTH = 30
@@ -24,24 +33,44 @@ BAR_WIDTH = 30
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     """SCENE, --depth | --relative-depth, --step, --event-tol, --reference, --save-boundary,
-    --solver, --plot."""
+    --solver, --plot.
+    """
     add_scene_argument(parser)
     depth = parser.add_mutually_exclusive_group()
-    depth.add_argument("--depth", type=float, metavar="RHO",
-                       help="squeeze depth rho, m (default: the scene's)")
-    depth.add_argument("--relative-depth", type=float, metavar="R",
-                       help="finger approach / initial contact distance (default: the scene's)")
-    parser.add_argument("--step", type=float, metavar="H",
-                        help="depth substep relative to the object size (default: the scene's)")
-    parser.add_argument("--event-tol", type=float, metavar="T",
-                        help="event location tolerance relative to the object size "
-                             "(default: the scene's)")
-    parser.add_argument("--reference", action="store_true",
-                        help="the paper's literal route: fixed step H, a full solve per step, "
-                             "events at step ends (for cross-checks and timing)")
-    parser.add_argument("--save-boundary", metavar="FILE.csv", type=output_file,
-                        help="write the deformed outer boundary (x,y per node, m, loop order), "
-                             "e.g. for `squeeze-grasp match`")
+    depth.add_argument(
+        "--depth", type=float, metavar="RHO", help="squeeze depth rho, m (default: the scene's)"
+    )
+    depth.add_argument(
+        "--relative-depth",
+        type=float,
+        metavar="R",
+        help="finger approach / initial contact distance (default: the scene's)",
+    )
+    parser.add_argument(
+        "--step",
+        type=float,
+        metavar="H",
+        help="depth substep relative to the object size (default: the scene's)",
+    )
+    parser.add_argument(
+        "--event-tol",
+        type=float,
+        metavar="T",
+        help="event location tolerance relative to the object size (default: the scene's)",
+    )
+    parser.add_argument(
+        "--reference",
+        action="store_true",
+        help="the paper's literal route: fixed step H, a full solve per step, "
+        "events at step ends (for cross-checks and timing)",
+    )
+    parser.add_argument(
+        "--save-boundary",
+        metavar="FILE.csv",
+        type=output_file,
+        help="write the deformed outer boundary (x,y per node, m, loop order), "
+        "e.g. for `squeeze-grasp match`",
+    )
     add_solver_argument(parser)
     add_plot_argument(parser)
 
@@ -55,8 +84,9 @@ class ProgressBar:
     def __call__(self, fraction: float) -> None:
         if self.enabled:
             done = int(round(BAR_WIDTH * fraction))
-            sys.stderr.write(f"\rsqueeze [{'#' * done}{'.' * (BAR_WIDTH - done)}] "
-                             f"{100 * fraction:5.1f} %")
+            sys.stderr.write(
+                f"\rsqueeze [{'#' * done}{'.' * (BAR_WIDTH - done)}] {100 * fraction:5.1f} %"
+            )
             sys.stderr.flush()
 
     def close(self) -> None:
@@ -75,44 +105,64 @@ def run(args: argparse.Namespace) -> dict:
     bar = ProgressBar()
     start = time.perf_counter()
     try:
-        res = event_squeeze_scene(loaded.scene, loaded.obj, loaded.contacts, args.depth,
-                                  args.relative_depth, args.step, args.event_tol, args.reference,
-                                  bar)
+        res = event_squeeze_scene(
+            loaded.scene,
+            loaded.obj,
+            loaded.contacts,
+            depth=args.depth,
+            relative_depth=args.relative_depth,
+            step=args.step,
+            event_tol=args.event_tol,
+            reference=args.reference,
+            progress=bar,
+        )
     finally:
         bar.close()
     t_run = time.perf_counter() - start
-    out = {"scene": loaded.scene.name, **res.to_json(),
-           "contact_points": loaded.obj.mesh.nodes[list(res.contacts)].tolist(),
-           "mesh": {"nodes": loaded.obj.mesh.n, "boundary": len(loaded.obj.mesh.boundary)},
-           "timing": {"precompute_s": t_pre, "squeeze_s": t_run}}
+    out = {
+        "scene": loaded.scene.name,
+        **res.to_json(),
+        "contact_points": loaded.obj.mesh.nodes[list(res.contacts)].tolist(),
+        "mesh": {"nodes": loaded.obj.mesh.n, "boundary": len(loaded.obj.mesh.boundary)},
+        "timing": {"precompute_s": t_pre, "squeeze_s": t_run},
+    }
     if args.plot:
         out["plot"] = plot(loaded.obj, res, args.plot)
     if args.save_boundary:
         loop = loaded.obj.mesh.boundary
-        out["boundary_csv"] = write_points(args.save_boundary,
-                                           loaded.obj.mesh.nodes[loop] + res.displacement[loop])
+        out["boundary_csv"] = write_points(
+            args.save_boundary, loaded.obj.mesh.nodes[loop] + res.displacement[loop]
+        )
     return out
 
 
 def plot(obj, res: EventSqueeze, path: str) -> str:
     """Deformed shape with sticking (solid) / sliding (hollow) nodes and fingertips (Table 1),
-    polar-angle changes vs relative depth (Fig. 6), and the event timeline; one PNG."""
+    polar-angle changes vs relative depth (Fig. 6), and the event timeline; one PNG.
+    """
     mesh = obj.mesh
     fig, axes = plots.figure(3)
     ax = axes[0]
     plots.draw_outline(ax, mesh, color="0.75", lw=0.8)
     plots.draw_outline(ax, mesh, res.displacement)
-    for name, color in (("F1", "C0"), ("F2", "C1")):
+    for name, color in ((Finger.F1, "C0"), (Finger.F2, "C1")):
         finger = res.state.finger(name)
         arc = finger.center + finger.radius * unit(np.linspace(0, 2 * np.pi, 181))
         ax.plot(arc[:, 0], arc[:, 1], color=color, lw=1.0)
         seg = res.state.segment(name)
         pts = np.array([mesh.nodes[c.node] + c.displacement for c in seg])
-        plots.mark_nodes(ax, pts, [c.mode == "stick" for c in seg], color=color, size=14,
-                         label=f"{name} ({len(seg)} nodes)")
+        plots.mark_nodes(
+            ax,
+            pts,
+            [c.mode == ContactMode.STICK for c in seg],
+            color=color,
+            size=14,
+            label=f"{name} ({len(seg)} nodes)",
+        )
     ax.legend(loc="lower right", fontsize=7)
-    ax.set_title(f"{res.termination} at {100 * res.relative_depth:.2f} % "
-                 f"(mu = {res.mu:g})", fontsize=9)
+    ax.set_title(
+        f"{res.termination} at {100 * res.relative_depth:.2f} % (mu = {res.mu:g})", fontsize=9
+    )
     ax = axes[1]
     ax.set_aspect("auto")
     order = sorted(res.trajectories, key=lambda k: (res.trajectories[k][0][0], k))
@@ -127,11 +177,19 @@ def plot(obj, res: EventSqueeze, path: str) -> str:
     ax.set_title("polar angles of the contact nodes (Fig. 6)", fontsize=9)
     ax = axes[2]
     ax.set_aspect("auto")
-    for row, kind in enumerate(EVENT_TYPES):
+    for row, kind in enumerate(EventType.values()):
         evs = [e for e in res.events if e.type == kind]
-        ax.scatter([e.relative_depth for e in evs], [row] * len(evs),
-                   c=["C0" if e.finger == "F1" else "C1" for e in evs], s=18, marker="|")
-    ax.set_yticks(range(len(EVENT_TYPES)), [f"{k} ({res.event_counts[k]})" for k in EVENT_TYPES])
+        ax.scatter(
+            [e.relative_depth for e in evs],
+            [row] * len(evs),
+            c=["C0" if e.finger == Finger.F1 else "C1" for e in evs],
+            s=18,
+            marker="|",
+        )
+    ax.set_yticks(
+        range(len(EventType.values())),
+        [f"{k} ({res.event_counts[k]})" for k in EventType.values()],
+    )
     ax.set_xlim(0, max(res.relative_depth, 1e-9) * 1.02)
     ax.set_xlabel("relative squeeze depth")
     ax.set_title("event timeline (F1 blue, F2 orange)", fontsize=9)
@@ -141,21 +199,27 @@ def plot(obj, res: EventSqueeze, path: str) -> str:
 def summary(result: dict) -> str:
     """Human-readable squeeze report."""
     c = result["event_counts"]
-    lines = [f"{result['scene']}: {result['squeeze']} squeeze, mu = {result['mu']:g}, "
-             f"tip radius {result['tip_radius']:g} m, initial contacts {result['contacts']}",
-             f"termination: {result['termination']} at depth {result['depth']:.6g} m "
-             f"(relative {100 * result['relative_depth']:.3f} %)",
-             "events: " + ", ".join(f"{k} {c[k]}" for k in EVENT_TYPES)]
+    lines = [
+        f"{result['scene']}: {result['squeeze']} squeeze, mu = {result['mu']:g}, "
+        f"tip radius {result['tip_radius']:g} m, initial contacts {result['contacts']}",
+        f"termination: {result['termination']} at depth {result['depth']:.6g} m "
+        f"(relative {100 * result['relative_depth']:.3f} %)",
+        "events: " + ", ".join(f"{k} {c[k]}" for k in EventType.values()),
+    ]
     for name, seg in result["segments"].items():
         modes = " ".join(f"{s['node']}{'' if s['mode'] == 'stick' else '~'}" for s in seg)
         ff = result["finger_force"][name]
-        lines.append(f"{name}: {len(seg)} nodes [{modes}] (~ = sliding); force along motion "
-                     f"{ff['start']:.4g} -> {ff['end']:.4g} N, work {result['work'][name]:.4g} J")
+        lines.append(
+            f"{name}: {len(seg)} nodes [{modes}] (~ = sliding); force along motion "
+            f"{ff['start']:.4g} -> {ff['end']:.4g} N, work {result['work'][name]:.4g} J"
+        )
     h = result["health"]
-    lines.append(f"energy {result['energy']:.5g} J; max strain {h['max_strain']:.4g} "
-                 f"({h['criterion']}, element {h['max_strain_element']}); max von Mises "
-                 f"{h['max_von_mises']:.4g} Pa; max displacement {h['max_displacement']:.4g} m; "
-                 "slip margin " + ", ".join(f"{k} {v:.4g} N" for k, v in h["slip_margin"].items()))
+    lines.append(
+        f"energy {result['energy']:.5g} J; max strain {h['max_strain']:.4g} "
+        f"({h['criterion']}, element {h['max_strain_element']}); max von Mises "
+        f"{h['max_von_mises']:.4g} Pa; max displacement {h['max_displacement']:.4g} m; "
+        "slip margin " + ", ".join(f"{k} {v:.4g} N" for k, v in h["slip_margin"].items())
+    )
     if result["chatter"]:
         lines.append(f"chattering bound froze {len(result['chatter'])} node mode(s)")
     t = result["timing"]

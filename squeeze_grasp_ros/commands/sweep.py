@@ -1,6 +1,8 @@
 # Copyright 2026 squeeze_grasp_ros developers
 # SPDX-License-Identifier: Apache-2.0
-"""``squeeze-grasp sweep``: a grasp dataset on Dask, resumable and deterministic (docs/sweep.md)."""
+"""``squeeze-grasp sweep``: a grasp dataset on Dask, resumable and deterministic
+(docs/sweep.md).
+"""
 from __future__ import annotations
 
 import argparse
@@ -17,7 +19,8 @@ HELP = ("evaluate a sweep spec (objects x materials x friction x tips x squeezes
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     """SPEC, --out, --scheduler, --workers, --dry-run, --no-progress."""
-    parser.add_argument("spec", metavar="SPEC.yaml", help="sweep spec (keys: squeeze-grasp sweep-help)")
+    parser.add_argument("spec", metavar="SPEC.yaml", help="sweep spec (keys: squeeze-grasp "
+                                                          "sweep-help)")
     parser.add_argument("--out", metavar="DIR",
                         help="output directory: parts/*.parquet and manifest.json (required "
                              "unless --dry-run); re-running into it resumes")
@@ -71,15 +74,20 @@ def summary(result: dict) -> str:
                          f"{result['estimate_s'] / 60:.1f} min")
         return "\n".join(lines)
     if result["skipped"] == result["tasks"]:
-        return (f"{result['out']}: all {result['tasks']} tasks already done "
-                f"({result['seconds']:.2f} s); summary: squeeze-grasp sweep-report {result['out']}")
+        return (
+            f"{result['out']}: all {result['tasks']} tasks already done "
+            f"({result['seconds']:.2f} s); summary: squeeze-grasp sweep-report {result['out']}"
+        )
     lines = [f"{result['out']}: {result['tasks']} tasks, {result['skipped']} already done, "
              f"{result['done']} written now ({result['evaluations']} evaluations, "
              f"{result['errors']} with an error), {result['failed']} failed",
              f"time {result['seconds']:.1f} s on {result['workers']} worker(s)"]
     if result["evaluations"]:
-        lines[-1] += (f"; {result['evaluations'] / result['seconds'] / max(result['workers'], 1):.2f}"
-                      " evaluations/s per worker")
+        lines[-1] += (
+            f"; "
+            f"{result['evaluations'] / result['seconds'] / max(result['workers'], 1):.2f}"
+            " evaluations/s per worker"
+        )
     if result["failed"]:
         lines.append("failed tasks are listed in manifest.json; re-run to retry them")
     lines.append(f"summary: squeeze-grasp sweep-report {result['out']}")

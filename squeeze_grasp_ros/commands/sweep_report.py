@@ -14,7 +14,8 @@ HELP = ("summarise a sweep directory: success rate by object and material, quali
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     """DIR, --best, --plot."""
-    parser.add_argument("out", metavar="DIR", help="sweep output directory (squeeze-grasp sweep --out)")
+    parser.add_argument("out", metavar="DIR", help="sweep output directory (squeeze-grasp sweep "
+                                                   "--out)")
     parser.add_argument("--best", type=int, default=3, metavar="N",
                         help="best placements listed per object (default 3)")
     parser.add_argument("--plot", metavar="DIR",

@@ -1,6 +1,7 @@
 # Copyright 2026 squeeze_grasp_ros developers
 # SPDX-License-Identifier: Apache-2.0
-"""The executor's logic: a grasp goal -> rate-limited fingertip setpoints, one observation at a time.
+"""The executor's logic: a grasp goal -> rate-limited fingertip setpoints, one observation at a
+time.
 
 A goal is a squeeze (each squeezing finger f moves along d_f per unit depth rho, to depth rho*)
 and optionally a resistance (the adversary moves by a along a straight line while the squeezing
@@ -31,6 +32,7 @@ Fingers the goal does not move hold the positions measured at the start. Work is
 from measurements: W_f += (F_prev + F_cur)/2 . (x_cur - x_prev), forces of the finger on the
 object (N), positions in m.
 """
+
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
@@ -38,6 +40,7 @@ from dataclasses import dataclass, field
 from functools import cached_property
 
 import numpy as np
+from squeeze_grasp_ros.mechanics.vocabulary import SqueezeKind, Termination
 
 REACTIONS: tuple[str, ...] = ("hold", "pure", "normals")
 
@@ -128,9 +131,12 @@ def goal_problem(goal: GraspGoal, known: Sequence[str]) -> str | None:
         return f"depth must be finite and >= 0, got {goal.depth}"
     if goal.on_slip_alarm not in REACTIONS:
         return f"on_slip_alarm must be one of {REACTIONS}, got {goal.on_slip_alarm!r}"
-    if goal.on_slip_alarm == "pure" and (
-            goal.pure_directions is None or goal.pure_directions.shape != (f, 2)
-            or not np.all(np.isfinite(goal.pure_directions)) or not np.any(goal.pure_directions)):
+    if goal.on_slip_alarm == SqueezeKind.PURE and (
+        goal.pure_directions is None
+        or goal.pure_directions.shape != (f, 2)
+        or not np.all(np.isfinite(goal.pure_directions))
+        or not np.any(goal.pure_directions)
+    ):
         return f"on_slip_alarm 'pure' needs {f} finite, not all zero pure_directions"
     if goal.resist:
         return _resistance_problem(goal, known)
@@ -140,14 +146,20 @@ def goal_problem(goal: GraspGoal, known: Sequence[str]) -> str | None:
 def _resistance_problem(goal: GraspGoal, known: Sequence[str]) -> str | None:
     f = len(goal.fingers)
     if goal.adversary not in known or goal.adversary in goal.fingers:
-        return f"adversary {goal.adversary!r} must be a mapped finger other than the squeezing ones"
+        return (
+            f"adversary {goal.adversary!r} must be a mapped finger other than the squeezing ones"
+        )
     a = goal.adversary_translation
     travel = goal.resist_travel
     k = len(travel)
     if a.shape != (2,) or not np.all(np.isfinite(a)) or not np.hypot(*a) > 0:
         return "adversary_translation must be a finite nonzero vector"
-    if k == 0 or np.any(np.diff(travel) <= 0) or travel[0] <= 0 or \
-            not np.isclose(travel[-1], np.hypot(*a), rtol=1e-9, atol=0.0):
+    if (
+        k == 0
+        or np.any(np.diff(travel) <= 0)
+        or travel[0] <= 0
+        or not np.isclose(travel[-1], np.hypot(*a), rtol=1e-9, atol=0.0)
+    ):
         return "resist_travel must increase from > 0 to |adversary_translation|"
     if goal.resist_waypoints.shape != (k, f, 2) or not np.all(np.isfinite(goal.resist_waypoints)):
         return f"resist_waypoints must hold {k} x {f} finite vectors"
@@ -220,9 +232,9 @@ def braking_speed(remaining: float, accel: float, dt: float) -> float:
 class PolylinePath:
     """p_f(s) = start_f + piecewise-linear offsets through knots (s_k, offsets_k)."""
 
-    knots: np.ndarray        # (K+1,), s_0 = 0
-    offsets: np.ndarray      # (K+1, f, 2)
-    start: np.ndarray        # (f, 2)
+    knots: np.ndarray  # (K+1,), s_0 = 0
+    offsets: np.ndarray  # (K+1, f, 2)
+    start: np.ndarray  # (f, 2)
 
     @property
     def end(self) -> float:
@@ -247,9 +259,12 @@ class PolylinePath:
 
 
 def straight_path(start: np.ndarray, directions: np.ndarray, length: float) -> PolylinePath:
-    """Every finger from ``start`` (f, 2) along ``directions`` (f, 2) per unit s, s in [0, length]."""
-    return PolylinePath(np.array([0.0, length]), np.stack([np.zeros_like(directions),
-                                                           directions * length]), start)
+    """Every finger from ``start`` (f, 2) along ``directions`` (f, 2) per unit s, s in [0,
+    length].
+    """
+    return PolylinePath(
+        np.array([0.0, length]), np.stack([np.zeros_like(directions), directions * length]), start
+    )
 
 
 class GraspProgram:
@@ -305,9 +320,12 @@ class GraspProgram:
             return self._finish(obs, "resisted", "the adversary slips", measured=True)
         elif alarmed & set(self.goal.fingers):
             if self.goal.on_slip_alarm == "hold" or self.redirected or self.phase != "squeeze":
-                return self._finish(obs, "slip_alarm", "imminent slip of "
-                                    + ", ".join(sorted(alarmed & set(self.goal.fingers))),
-                                    measured=True)
+                return self._finish(
+                    obs,
+                    "slip_alarm",
+                    "imminent slip of " + ", ".join(sorted(alarmed & set(self.goal.fingers))),
+                    measured=True,
+                )
             self._redirect(obs)
         stale = {finger for kind, finger in obs.alarms if kind == "stale_sensor"}
         if stale & set(self.moving):
@@ -315,12 +333,20 @@ class GraspProgram:
             self.hold_ticks += 1
             self.stale_time += dt
             if self.stale_time > self.limits.stale_budget:
-                return self._finish(obs, "stale_data", f"sensor data of "
-                                    f"{', '.join(sorted(stale & set(self.moving)))} stale for "
-                                    f"{self.stale_time:.3f} s (stale_budget "
-                                    f"{self.limits.stale_budget} s)")
-            return Command(self._setpoints(), "holding", None,
-                           "stale sensor data: " + ", ".join(sorted(stale & set(self.moving))))
+                return self._finish(
+                    obs,
+                    "stale_data",
+                    f"sensor data of "
+                    f"{', '.join(sorted(stale & set(self.moving)))} stale for "
+                    f"{self.stale_time:.3f} s (stale_budget "
+                    f"{self.limits.stale_budget} s)",
+                )
+            return Command(
+                self._setpoints(),
+                "holding",
+                None,
+                "stale sensor data: " + ", ".join(sorted(stale & set(self.moving))),
+            )
         self.stale_time = 0.0
         if self.s >= self.path.end and self._settled(obs):
             done = self._phase_done(obs)
@@ -333,12 +359,20 @@ class GraspProgram:
     def _terminal(self, obs: Observation) -> Command | None:
         if self.cancel_requested:
             return self._finish(obs, "canceled", "goal canceled", measured=True)
-        if "picked_up" in obs.events and self.phase == "squeeze":
-            return self._finish(obs, "picked_up", "friction can lift the object", measured=True)
-        lost = {finger for kind, finger in obs.alarms if kind == "contact_lost"} & set(self.moving)
+        if Termination.PICKED_UP in obs.events and self.phase == "squeeze":
+            return self._finish(
+                obs, Termination.PICKED_UP, "friction can lift the object", measured=True
+            )
+        lost = {finger for kind, finger in obs.alarms if kind == Termination.CONTACT_LOST} & set(
+            self.moving
+        )
         if lost:
-            return self._finish(obs, "contact_lost", "no contact on " + ", ".join(sorted(lost)),
-                                measured=True)
+            return self._finish(
+                obs,
+                Termination.CONTACT_LOST,
+                "no contact on " + ", ".join(sorted(lost)),
+                measured=True,
+            )
         return None
 
     def _start_squeeze(self, directions: np.ndarray) -> None:
@@ -349,12 +383,17 @@ class GraspProgram:
     def _redirect(self, obs: Observation) -> None:
         """Continue the remaining depth along the pure directions or the contact normals."""
         goal = self.goal
-        if goal.on_slip_alarm == "pure":
+        if goal.on_slip_alarm == SqueezeKind.PURE:
             directions = np.asarray(goal.pure_directions, float)
         else:
             old = self.path.offsets[-1] / max(self.path.end, 1e-300)
-            directions = np.array([obs.normals[f] if np.any(obs.normals.get(f, 0.0)) else old[k]
-                                   for k, f in enumerate(goal.fingers)], float)
+            directions = np.array(
+                [
+                    obs.normals[f] if np.any(obs.normals.get(f, 0.0)) else old[k]
+                    for k, f in enumerate(goal.fingers)
+                ],
+                float,
+            )
             directions /= np.linalg.norm(directions)
         remaining = self.path.end - self.s
         start = np.array([self.commanded[f] for f in goal.fingers])
@@ -365,14 +404,16 @@ class GraspProgram:
 
     def _settled(self, obs: Observation) -> bool:
         tol = self.limits.position_tolerance
-        return all(np.linalg.norm(np.asarray(obs.positions[f]) - self.commanded[f]) <= tol
-                   for f in self.moving)
+        return all(
+            np.linalg.norm(np.asarray(obs.positions[f]) - self.commanded[f]) <= tol
+            for f in self.moving
+        )
 
     def _phase_done(self, obs: Observation) -> Command | None:
         if self.phase == "resist":
             return self._finish(obs, "resisted", "the adversary completed its translation")
         if not self.goal.resist:
-            return self._finish(obs, "depth_reached", "squeeze depth reached")
+            return self._finish(obs, Termination.DEPTH_REACHED, "squeeze depth reached")
         goal = self.goal
         self.phase = "resist"
         self.moving = goal.fingers + (goal.adversary,)
@@ -380,8 +421,13 @@ class GraspProgram:
         knots = np.concatenate([[0.0], goal.resist_travel])
         unit_a = a / np.hypot(*a)
         adv = knots[:, None] * unit_a[None, :]
-        offsets = np.concatenate([np.concatenate([np.zeros((1, len(goal.fingers), 2)),
-                                                  goal.resist_waypoints]), adv[:, None, :]], axis=1)
+        offsets = np.concatenate(
+            [
+                np.concatenate([np.zeros((1, len(goal.fingers), 2)), goal.resist_waypoints]),
+                adv[:, None, :],
+            ],
+            axis=1,
+        )
         start = np.array([self.commanded[f] for f in self.moving])
         self.path = PolylinePath(knots, offsets, start)
         self.s, self.v = 0.0, 0.0
@@ -403,8 +449,9 @@ class GraspProgram:
     def _setpoints(self) -> dict:
         return {f: self.commanded[f].copy() for f in self.fingers}
 
-    def _finish(self, obs: Observation, termination: str, message: str,
-                measured: bool = False) -> Command:
+    def _finish(
+        self, obs: Observation, termination: str, message: str, measured: bool = False
+    ) -> Command:
         """End the goal holding the measured (or the commanded) positions."""
         if measured:
             self.commanded = {f: np.asarray(obs.positions[f], float) for f in self.fingers}
@@ -416,8 +463,11 @@ class GraspProgram:
         if last is not None:
             for f in self.fingers:
                 if f in obs.positions and f in last.positions:
-                    force = 0.5 * (np.asarray(obs.forces.get(f, np.zeros(2)))
-                                   + np.asarray(last.forces.get(f, np.zeros(2))))
-                    self.work[f] += float(force @ (np.asarray(obs.positions[f])
-                                                   - np.asarray(last.positions[f])))
+                    force = 0.5 * (
+                        np.asarray(obs.forces.get(f, np.zeros(2)))
+                        + np.asarray(last.forces.get(f, np.zeros(2)))
+                    )
+                    self.work[f] += float(
+                        force @ (np.asarray(obs.positions[f]) - np.asarray(last.positions[f]))
+                    )
         self._last = obs

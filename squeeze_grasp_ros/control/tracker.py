@@ -50,7 +50,8 @@ from typing import NamedTuple
 
 import numpy as np
 
-from squeeze_grasp_ros.mechanics.squeeze.fingertips import FINGER_NAMES
+
+from squeeze_grasp_ros.mechanics.vocabulary import ContactMode, Finger, Termination
 
 ORDER = {"B": 0, "D": 1, "C": 2, "A": 3}
 """Processing order of the events of one tick and finger."""
@@ -235,7 +236,8 @@ class LoadedTaxels:
 def loaded_taxels(sample: FingerSample, threshold: float,
                   trig: tuple[np.ndarray, np.ndarray]) -> LoadedTaxels:
     """The loaded taxels of a reading with tactile data (``trig``: cos and sin of all its
-    taxel angles)."""
+    taxel angles).
+    """
     index = np.flatnonzero(sample.normal > threshold)
     cos, sin = trig
     return LoadedTaxels(index, sample.normal[index], sample.tangential[index],
@@ -244,7 +246,8 @@ def loaded_taxels(sample: FingerSample, threshold: float,
 
 def patches_of(finger: str, taxels: LoadedTaxels, config: TrackerConfig) -> list[Patch]:
     """Contact patches of one finger: its maximal runs of neighbouring loaded taxels, each
-    summed in one ``reduceat`` pass."""
+    summed in one ``reduceat`` pass.
+    """
     index = taxels.index
     if not len(index):
         return []
@@ -261,7 +264,7 @@ def patches_of(finger: str, taxels: LoadedTaxels, config: TrackerConfig) -> list
         slip = (-1 if tangential > 0.0 else 1 if tangential < 0.0 else 0) \
             if sliding and mu > 0.0 else 0
         out.append(Patch(finger, moment / normal, normal, tangential,
-                         "slip" if sliding else "stick", slip, first, last))
+                         ContactMode.SLIP if sliding else ContactMode.STICK, slip, first, last))
     return out
 
 
@@ -316,7 +319,7 @@ class ContactTracker:
     def __init__(self, config: TrackerConfig, fingers: Sequence[str],
                  streams: Sequence[str] = ("wrench", "tactile"),
                  prediction: Sequence[PredictedEvent] = ()) -> None:
-        order = {n: k for k, n in enumerate(FINGER_NAMES)}
+        order = {n: k for k, n in enumerate(Finger.values())}
         self.config = config
         self.fingers = tuple(sorted(fingers, key=lambda n: order.get(n, len(order))))
         self.streams = tuple(streams)
@@ -358,15 +361,25 @@ class ContactTracker:
             alarms += self._alarms(name, track, taxels, stamp_ns)
         if cfg.weight is not None and not self.picked_up and self._can_lift(loaded):
             self.picked_up = True
-            events.append(TrackedEvent("picked_up", "", self.depth, relative, 0.0))
+            events.append(TrackedEvent(Termination.PICKED_UP, "", self.depth, relative, 0.0))
         alarms += self._compare(events)
         return TrackerOutput(
-            stamp_ns, self.fingers,
-            {f: self.tracks[f].position for f in self.fingers if self.tracks[f].position is not None},
+            stamp_ns,
+            self.fingers,
+            {
+                f: self.tracks[f].position
+                for f in self.fingers
+                if self.tracks[f].position is not None
+            },
             {f: self.tracks[f].force.copy() for f in self.fingers},
             {f: self.tracks[f].normal.copy() for f in self.fingers},
             {f: self._age(self.tracks[f], stamp_ns) for f in self.fingers},
-            tuple(patches), tuple(events), tuple(alarms), self.depth, relative)
+            tuple(patches),
+            tuple(events),
+            tuple(alarms),
+            self.depth,
+            relative,
+        )
 
     # ----------------------------------------------------------------- pieces
     def _advance_depth(self, samples: Mapping[str, FingerSample]) -> None:
@@ -385,7 +398,7 @@ class ContactTracker:
 
     @staticmethod
     def _trig(track: _FingerTrack, sample: FingerSample) -> tuple[np.ndarray, np.ndarray]:
-        """cos and sin of the finger's taxel angles, recomputed only when the angles change."""
+        """Cos and sin of the finger's taxel angles, recomputed only when the angles change."""
         key = sample.angles.tobytes()
         if track.trig_key != key:
             track.trig_key, track.trig = key, (np.cos(sample.angles), np.sin(sample.angles))
@@ -415,9 +428,9 @@ class ContactTracker:
                     found += [("A", current[j].angle) for j in after]
             elif len(before) == len(after) == 1:
                 old, new = previous[before[0]], current[after[0]]
-                if old.mode == "stick" and new.mode == "slip":
+                if old.mode == ContactMode.STICK and new.mode == ContactMode.SLIP:
                     found.append(("C", new.angle))
-                elif old.mode == "slip" and new.mode == "stick":
+                elif old.mode == ContactMode.SLIP and new.mode == ContactMode.STICK:
                     found.append(("D", new.angle))
         found.sort(key=lambda e: (ORDER[e[0]], e[1]))
         return [TrackedEvent(kind, name, self.depth, relative, angle) for kind, angle in found]
@@ -426,7 +439,8 @@ class ContactTracker:
     def _force(sample: FingerSample, trig: tuple[np.ndarray, np.ndarray] | None,
                previous: np.ndarray) -> np.ndarray:
         """Force of the finger on the object (2,), N: -wrench force, else the taxel sum
-        (``trig``: cos and sin of the taxel angles, given with tactile data)."""
+        (``trig``: cos and sin of the taxel angles, given with tactile data).
+        """
         if sample.force is not None:
             return -np.asarray(sample.force[:2], float)
         if sample.normal is not None:
@@ -455,7 +469,8 @@ class ContactTracker:
             out.append(TrackedAlarm("stale_sensor", name, age,
                                     f"newest {name} reading is {age * 1e3:.3g} ms old"))
         if track.had_contact and not track.patches:
-            out.append(TrackedAlarm("contact_lost", name, 0.0, f"{name} has no loaded taxel"))
+            out.append(TrackedAlarm(Termination.CONTACT_LOST, name, 0.0, f"{name} has no loaded "
+                                                                         "taxel"))
         usage = self._cone_usage(taxels)
         if usage is not None:
             out.append(TrackedAlarm("slip_imminent", name, usage,

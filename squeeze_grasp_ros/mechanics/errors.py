@@ -1,24 +1,78 @@
 # Copyright 2026 squeeze_grasp_ros developers
 # SPDX-License-Identifier: Apache-2.0
-"""Exceptions and warnings raised by the mechanics core."""
+"""Errors by meaning, and the warning of a poorly conditioned solve.
+
+Every error the package raises on purpose is a :class:`SqueezeGraspError`, of one of four kinds
+that say who has to act:
+
+============================  ==========================================  ======  ==============
+error                         meaning                                     exit    service code
+============================  ==========================================  ======  ==============
+:class:`InvalidInputError`    the caller's input is wrong; the message    2       INVALID_ARGUMENT
+                              names the field and the allowed range
+:class:`InfeasibleError`      a physical answer: no such grasp exists     1       NOT_FEASIBLE
+:class:`NumericalError`       a solver failed; carries its residuals      3       NUMERICAL_FAILURE
+:class:`InternalError`        a broken invariant (a bug)                  4       INTERNAL_ERROR
+============================  ==========================================  ======  ==============
+
+>>> err = NumericalError("Newton did not converge", residuals={"cone": 2.5e-3})
+>>> str(err), err.residuals["cone"], isinstance(err, SqueezeGraspError)
+('Newton did not converge (residuals: cone 0.0025)', 0.0025, True)
+"""
+from __future__ import annotations
+
+from collections.abc import Mapping
+
+import numpy as np
+
+__all__ = ["ConditioningWarning", "InfeasibleError", "InternalError", "InvalidInputError",
+           "NumericalError", "SqueezeGraspError", "require_finite"]
 
 
-class MechanicsError(ValueError):
-    """Invalid input to a mechanics computation; the message names the field and allowed range."""
+class SqueezeGraspError(Exception):
+    """Base of every error the package raises on purpose."""
 
 
-class InfeasibleError(MechanicsError):
-    """A well-formed request that the mechanics cannot satisfy (e.g. no stable squeeze exists)."""
+class InvalidInputError(SqueezeGraspError, ValueError):
+    """Invalid input to a computation; the message names the field and the allowed range."""
+
+
+class InfeasibleError(SqueezeGraspError):
+    """A well-formed request whose physical answer is "no" (e.g. no stable squeeze exists)."""
+
+
+class NumericalError(SqueezeGraspError, ArithmeticError):
+    """A solver failed (no convergence, a singular system, an inverted element).
+
+    Parameters
+    ----------
+    message : str
+        What failed and where.
+    residuals : mapping of str to float, optional
+        The solver's last residuals by name (dimensionless unless the name says otherwise);
+        they are appended to the message.
+    """
+
+    def __init__(self, message: str, *, residuals: Mapping[str, float] | None = None) -> None:
+        self.residuals: dict[str, float] = {k: float(v) for k, v in (residuals or {}).items()}
+        if self.residuals:
+            listed = ", ".join(f"{k} {v:.3g}" for k, v in self.residuals.items())
+            message = f"{message} (residuals: {listed})"
+        super().__init__(message)
+
+
+class InternalError(SqueezeGraspError, RuntimeError):
+    """A broken invariant: a bug to report, not something the caller can fix."""
 
 
 class ConditioningWarning(RuntimeWarning):
-    """A solve whose condition estimate passed the documented threshold; results may lose digits."""
+    """A solve whose condition estimate passed the documented threshold; results may lose
+    digits.
+    """
 
 
 def require_finite(name: str, value) -> None:
-    """Raise :class:`MechanicsError` if ``value`` (scalar or array) has NaN or inf entries."""
-    import numpy as np
-
+    """Raise :class:`InvalidInputError` if ``value`` (scalar or array) has NaN or inf entries."""
     arr = np.asarray(value, dtype=float)
     if not np.all(np.isfinite(arr)):
-        raise MechanicsError(f"{name} must be finite, got {value!r}")
+        raise InvalidInputError(f"{name} must be finite, got {value!r}")

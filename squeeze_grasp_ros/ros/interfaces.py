@@ -17,6 +17,7 @@ the job without anything sourced:
 It never imports rclpy. Run it as ``python -m squeeze_grasp_ros.ros.interfaces`` (or the
 ``squeeze-grasp ros-setup`` verb).
 """
+
 from __future__ import annotations
 
 import argparse
@@ -179,7 +180,9 @@ def missing_ros_parts(prefix: Path) -> list[str]:
     """Return the Python modules and CMake packages of the ROS wheels that are absent."""
     modules = [name for name in REQUIRED_MODULES if importlib.util.find_spec(name) is None]
     packages = [
-        name for name in REQUIRED_CMAKE_PACKAGES if not (prefix / "share" / name / "cmake").is_dir()
+        name
+        for name in REQUIRED_CMAKE_PACKAGES
+        if not (prefix / "share" / name / "cmake").is_dir()
     ]
     return modules + packages
 
@@ -290,7 +293,8 @@ def source_digest(source: Path) -> str:
 
 def venv_python() -> str:
     """The environment's ``bin/python``: the same whether we run as ``python -m`` or as a
-    console script (whose ``sys.executable`` is ``bin/python3``)."""
+    console script (whose ``sys.executable`` is ``bin/python3``).
+    """
     candidate = Path(sys.prefix) / "bin" / "python"
     return str(candidate) if candidate.exists() else sys.executable
 
@@ -366,8 +370,10 @@ def cmake_configure_args(layout: Layout, source: Path) -> list[str]:
     purelib = Path(sysconfig.get_paths()["purelib"])
     return [
         "cmake",
-        "-S", str(source),
-        "-B", str(layout.build_dir),
+        "-S",
+        str(source),
+        "-B",
+        str(layout.build_dir),
         f"-DCMAKE_INSTALL_PREFIX={layout.prefix}",
         f"-DCMAKE_PREFIX_PATH={layout.prefix}",
         f"-DPython3_EXECUTABLE={venv_python()}",
@@ -402,7 +408,9 @@ def run_command(command: Sequence[str], layout: Layout, verbose: bool) -> None:
     with layout.log_file.open("a", encoding="utf-8") as log:
         log.write(f"$ {' '.join(command)}\n")
         log.flush()
-        result = subprocess.run(command, env=env, stdout=log, stderr=subprocess.STDOUT, check=False)
+        result = subprocess.run(
+            command, env=env, stdout=log, stderr=subprocess.STDOUT, check=False
+        )
     if result.returncode != 0:
         tail = layout.log_file.read_text(encoding="utf-8", errors="replace").splitlines()[-25:]
         raise SetupError(
@@ -521,7 +529,9 @@ def resolve_source(arg: Path | None) -> Path:
     source = (arg if arg is not None else default_source()).resolve()
     for name in ("package.xml", "CMakeLists.txt"):
         if not (source / name).is_file():
-            raise SetupError(f"{source} has no {name}: pass the interface folder with --source DIR")
+            raise SetupError(
+                f"{source} has no {name}: pass the interface folder with --source DIR"
+            )
     return source
 
 

@@ -2,7 +2,9 @@
 # SPDX-License-Identifier: Apache-2.0
 """Measurements of the ``ros_services`` benchmark section on real rclpy (imported only when
 rclpy and the interfaces are installed). Every row is measured in the calling run; processes
-are isolated by a unique node namespace and localhost-only discovery."""
+are isolated by a unique node namespace and localhost-only discovery.
+"""
+
 from __future__ import annotations
 
 import contextlib
@@ -34,6 +36,8 @@ from squeeze_grasp_ros.mechanics.elastic.reduced import boundary_displacement, r
 from squeeze_grasp_ros.mechanics.squeeze.stable_pure import plan_squeeze
 from squeeze_grasp_ros.ros.nodes.planner import PlannerNode
 from squeeze_grasp_ros.ros.nodes.planner_client import PlannerClient
+from squeeze_grasp_ros.threads import single_thread_blas
+from squeeze_grasp_ros.mechanics.vocabulary import SqueezeKind
 
 DEPTH = 0.004
 """Squeeze depth rho of the benchmarked requests, m."""
@@ -108,13 +112,15 @@ class Session:
         Also create the planner node on the same executor.
     """
 
-    def __init__(self, namespace: str, executor_type: Callable[..., Executor],
-                 in_process: bool) -> None:
+    def __init__(
+        self, namespace: str, executor_type: Callable[..., Executor], in_process: bool
+    ) -> None:
         self.context = Context()
         rclpy.init(context=self.context, signal_handler_options=SignalHandlerOptions.NO)
         self.executor = executor_type(context=self.context)
-        self.planner = (PlannerNode(context=self.context, namespace=namespace)
-                        if in_process else None)
+        self.planner = (
+            PlannerNode(context=self.context, namespace=namespace) if in_process else None
+        )
         node = rclpy.create_node("bench_client", namespace=namespace, context=self.context)
         for member in (self.planner, node):
             if member is not None:
@@ -123,8 +129,13 @@ class Session:
 
     def plan(self, object_id: str) -> PlanSqueeze.Response:
         """A stable squeeze of ``object_id`` at :data:`DEPTH` (cross-process: re-sent if lost)."""
-        return self.client.call(PlanSqueeze, "plan_squeeze", PlanSqueeze.Request(
-            object_id=object_id, squeeze_type="stable", depth=DEPTH), 20.0, 3)
+        return self.client.call(
+            PlanSqueeze,
+            "plan_squeeze",
+            PlanSqueeze.Request(object_id=object_id, squeeze_type=SqueezeKind.STABLE, depth=DEPTH),
+            20.0,
+            3,
+        )
 
     def close(self) -> None:
         """Destroy nodes, executor and context."""
@@ -139,13 +150,15 @@ def build_object(nodes: int) -> planning.LoadedObject:
     """The benchmark object of about ``nodes`` nodes, loaded under ``n<nodes>`` in this process."""
     source = planning.read_scene(scene_text(nodes), "")
     limits = planning.Limits()
-    return planning.load_object(source, planning.object_key(source, f"n{nodes}", "", limits),
-                                limits)
+    return planning.load_object(
+        source, planning.object_key(source, f"n{nodes}", "", limits), limits
+    )
 
 
 def load_directly(session: Session, nodes: int) -> planning.LoadedObject:
     """Put the benchmark object into an in-process planner's cache without a service call
-    (EventsExecutor in rclpy 7.1.6 rejects the coroutine callback of ``load_object``)."""
+    (EventsExecutor in rclpy 7.1.6 rejects the coroutine callback of ``load_object``).
+    """
     loaded = build_object(nodes)
     session.planner.cache.put(loaded)
     return loaded
@@ -153,24 +166,32 @@ def load_directly(session: Session, nodes: int) -> planning.LoadedObject:
 
 def load_by_service(session: Session, nodes: int) -> None:
     """Load the benchmark object of about ``nodes`` nodes through ``load_object``."""
-    response = session.client.call(LoadObject, "load_object", LoadObject.Request(
-        scene_yaml=scene_text(nodes), object_id=f"n{nodes}"), 120.0, 3)
+    response = session.client.call(
+        LoadObject,
+        "load_object",
+        LoadObject.Request(scene_yaml=scene_text(nodes), object_id=f"n{nodes}"),
+        120.0,
+        3,
+    )
     if not response.success:
         raise RuntimeError(f"the planner refused the benchmark scene: {response.message}")
 
 
 def bare_times(loaded: planning.LoadedObject, count: int) -> tuple[np.ndarray, np.ndarray]:
     """(mechanics, callback work) per call, s: reduced stiffness + squeeze + boundary
-    displacement; and the planner callback's validation + mechanics + message building."""
+    displacement; and the planner callback's validation + mechanics + message building.
+    """
     obj, contacts = loaded.solid(), list(loaded.finger_nodes)
 
     def mechanics() -> None:
         red = reduced_stiffness(obj, contacts)
-        sq = plan_squeeze(obj, contacts, "stable", red)
+        sq = plan_squeeze(obj, contacts, kind=SqueezeKind.STABLE, red=red)
         boundary_displacement(obj, red, DEPTH * sq.displacement)
 
     def callback() -> None:
-        messages.plan_squeeze_response(planning.squeeze_plan(loaded, [], "stable", DEPTH))
+        messages.plan_squeeze_response(
+            planning.squeeze_plan(loaded, [], SqueezeKind.STABLE, DEPTH)
+        )
 
     return per_call(mechanics, count), per_call(callback, count)
 
@@ -179,10 +200,22 @@ class PlannerProcess:
     """The planner as its own process (``python -m squeeze_grasp_ros.ros.nodes.planner``)."""
 
     def __init__(self, namespace: str) -> None:
-        command = [sys.executable, "-m", "squeeze_grasp_ros.ros.nodes.planner", "--ros-args",
-                   "-r", f"__ns:={namespace}", "--log-level", "warn"]
-        self.process = subprocess.Popen(command, stdout=subprocess.DEVNULL,
-                                        stderr=subprocess.DEVNULL, env=dict(os.environ))
+        command = [
+            sys.executable,
+            "-m",
+            "squeeze_grasp_ros.ros.nodes.planner",
+            "--ros-args",
+            "-r",
+            f"__ns:={namespace}",
+            "--log-level",
+            "warn",
+        ]
+        self.process = subprocess.Popen(
+            command,
+            stdout=subprocess.DEVNULL,
+            stderr=subprocess.DEVNULL,
+            env=single_thread_blas(dict(os.environ)),
+        )
 
     def stop(self) -> None:
         """SIGINT, then wait for a clean exit."""
@@ -190,14 +223,17 @@ class PlannerProcess:
         self.process.wait(timeout=30)
 
 
-def overhead_rows(namespace: str, sizes: tuple[int, ...], count: int,
-                  progress: Progress) -> tuple[list[list[Any]], list[list[Any]]]:
+def overhead_rows(
+    namespace: str, sizes: tuple[int, ...], count: int, progress: Progress
+) -> tuple[list[list[Any]], list[list[Any]]]:
     """Rows of the overhead table and of the per-size table, measured in this run."""
     base = sizes[0]
     overhead: list[list[Any]] = []
     by_size: dict[int, list[Any]] = {}
-    for label, executor_type in (("SingleThreadedExecutor", SingleThreadedExecutor),
-                                 ("EventsExecutor", EventsExecutor)):
+    for label, executor_type in (
+        ("SingleThreadedExecutor", SingleThreadedExecutor),
+        ("EventsExecutor", EventsExecutor),
+    ):
         progress(f"ros_services: one process, {label}")
         session = Session(namespace, executor_type, in_process=True)
         try:
@@ -207,8 +243,18 @@ def overhead_rows(namespace: str, sizes: tuple[int, ...], count: int,
                 reply = per_call(lambda: session.plan(f"n{n}"), count)
                 if n == base:
                     error = per_call(lambda: session.plan("unknown"), count)
-                    overhead.append(["one process", label, ms(error), ms(reply), ms(work),
-                                     ms(mech), ms(reply) - ms(mech), ms(reply) / ms(mech)])
+                    overhead.append(
+                        [
+                            "one process",
+                            label,
+                            ms(error),
+                            ms(reply),
+                            ms(work),
+                            ms(mech),
+                            ms(reply) - ms(mech),
+                            ms(reply) / ms(mech),
+                        ]
+                    )
                 if label == "SingleThreadedExecutor":
                     by_size[n] = [loaded.num_nodes, len(loaded.boundary), ms(mech), ms(reply)]
         finally:
@@ -225,8 +271,18 @@ def overhead_rows(namespace: str, sizes: tuple[int, ...], count: int,
             if n == base:
                 mech, work = bare_times(build_object(n), count)
                 error = per_call(lambda: session.plan("unknown"), count)
-                overhead.append(["two processes", "SingleThreadedExecutor", ms(error), ms(reply),
-                                 ms(work), ms(mech), ms(reply) - ms(mech), ms(reply) / ms(mech)])
+                overhead.append(
+                    [
+                        "two processes",
+                        "SingleThreadedExecutor",
+                        ms(error),
+                        ms(reply),
+                        ms(work),
+                        ms(mech),
+                        ms(reply) - ms(mech),
+                        ms(reply) / ms(mech),
+                    ]
+                )
     finally:
         session.close()
         process.stop()
@@ -236,14 +292,18 @@ def overhead_rows(namespace: str, sizes: tuple[int, ...], count: int,
 def long_request_rows(namespace: str, big: int, progress: Progress) -> list[list[Any]]:
     """Per executor: a GraspMap goal loading a ``big``-node mesh with the executor otherwise
     idle (executor-thread CPU and spin_once returns), then another one while plan_squeeze
-    requests are sent back to back (their round trips)."""
+    requests are sent back to back (their round trips).
+    """
     rows = []
-    for label, executor_type in (("SingleThreadedExecutor", SingleThreadedExecutor),
-                                 ("EventsExecutor", EventsExecutor)):
+    for label, executor_type in (
+        ("SingleThreadedExecutor", SingleThreadedExecutor),
+        ("EventsExecutor", EventsExecutor),
+    ):
         progress(f"ros_services: long goal beside quick requests, {label}")
         session = Session(namespace, executor_type, in_process=True)
-        action = ActionClient(session.client.node, GraspMap,
-                              f"{session.client.planner_name}/grasp_map")
+        action = ActionClient(
+            session.client.node, GraspMap, f"{session.client.planner_name}/grasp_map"
+        )
         try:
             if not action.wait_for_server(timeout_sec=30.0):
                 raise TimeoutError("the GraspMap action server did not appear")
@@ -262,9 +322,21 @@ def long_request_rows(namespace: str, big: int, progress: Progress) -> list[list
                 session.plan("n500")
                 busy.append(time.perf_counter() - start)
             p99 = float(np.percentile(busy, 99) * 1e3) if busy else float("nan")
-            rows.append([label, big, alone, cpu / alone, spins / alone, len(busy),
-                         ms(np.array(busy)), p99, 1e3 * max(busy, default=float("nan")),
-                         ms(idle), "yes" if p99 < 10 else "no"])
+            rows.append(
+                [
+                    label,
+                    big,
+                    alone,
+                    cpu / alone,
+                    spins / alone,
+                    len(busy),
+                    ms(np.array(busy)),
+                    p99,
+                    1e3 * max(busy, default=float("nan")),
+                    ms(idle),
+                    "yes" if p99 < 10 else "no",
+                ]
+            )
         finally:
             action.destroy()
             session.close()
@@ -273,10 +345,12 @@ def long_request_rows(namespace: str, big: int, progress: Progress) -> list[list
 
 def start_goal(session: Session, action: ActionClient, nodes: int, object_id: str) -> Future:
     """Send a GraspMap goal that loads the ``nodes``-node object under ``object_id``; return
-    the future of its result once the first feedback (the worker started) has arrived."""
+    the future of its result once the first feedback (the worker started) has arrived.
+    """
     started: list[bool] = []
-    sent = action.send_goal_async(GraspMap.Goal(scene_yaml=scene_text(nodes), mu=0.4,
-                                                object_id=object_id),
-                                  feedback_callback=lambda _: started.append(True))
+    sent = action.send_goal_async(
+        GraspMap.Goal(scene_yaml=scene_text(nodes), mu=0.4, object_id=object_id),
+        feedback_callback=lambda _: started.append(True),
+    )
     session.client.spin_until(lambda: sent.done() and bool(started), 120.0)
     return sent.result().get_result_async()

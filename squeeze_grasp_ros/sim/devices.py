@@ -60,7 +60,9 @@ def device_model(name: str, time_constant: float = 0.0) -> DeviceModel:
     return DeviceModel(name, kind, KIND_MAX_SPEED[kind], float(time_constant))
 
 
-def follow(device: DeviceModel, position: np.ndarray, setpoint: np.ndarray, dt: float) -> np.ndarray:
+def follow(
+    device: DeviceModel, position: np.ndarray, setpoint: np.ndarray, dt: float
+) -> np.ndarray:
     """Tip centre (2,) after one tick of ``dt`` s from ``position`` toward ``setpoint`` (m)."""
     target = np.asarray(setpoint, float)
     if device.lagged:

@@ -68,14 +68,17 @@ def contact_arrays(contacts: list[ContactNode]) -> tuple[np.ndarray, np.ndarray]
 
 def contact_components(contacts: list[ContactNode]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """(thetas, normal forces, tangential forces) (k,) of contact nodes (rad, N, N): the force
-    on the object projected on e(theta) and t(theta)."""
+    on the object projected on e(theta) and t(theta).
+    """
     thetas, forces = contact_arrays(contacts)
     cos, sin = np.cos(thetas), np.sin(thetas)
     return (thetas, forces[:, 0] * cos + forces[:, 1] * sin,
             forces[:, 1] * cos - forces[:, 0] * sin)
 
 
-def render_tactile(layout: TactileLayout, contacts: list[ContactNode]) -> tuple[np.ndarray, np.ndarray]:
+def render_tactile(
+    layout: TactileLayout, contacts: list[ContactNode]
+) -> tuple[np.ndarray, np.ndarray]:
     """(normal, tangential) taxel forces (n,), N, of one finger's contact nodes."""
     if not contacts:
         return np.zeros(len(layout.angles)), np.zeros(len(layout.angles))
@@ -126,7 +129,9 @@ class SensorRandomness:
         return bool(self._dropout.random() < self.dropout)
 
     def perturb(self, values: np.ndarray, scale: float = 1.0) -> np.ndarray:
-        """``values`` plus noise of std ``noise_std * scale`` (unchanged without the noise effect)."""
+        """``values`` plus noise of std ``noise_std * scale`` (unchanged without the noise
+        effect).
+        """
         if self.noise_std is None:
             return values
         self._draws["noise_draws"] += values.size

@@ -30,6 +30,7 @@ position readings and setpoints stay in its own frame (its encoder counts from h
 commands and measurements stay consistent; the ground truth (:class:`TickOutput` ``state``) has
 the true tip centre.
 """
+
 from __future__ import annotations
 
 import time
@@ -46,19 +47,37 @@ from squeeze_grasp_ros.mechanics.squeeze.fingertips import place_fingertip
 from squeeze_grasp_ros.mechanics.resistance.frictional import add_adversary
 from squeeze_grasp_ros.mechanics.squeeze.stable_pure import plan_squeeze
 from squeeze_grasp_ros.mechanics.squeeze.stepper import advance
-from squeeze_grasp_ros.scene import (Scene, SensorsSpec, build_mesh, finger_devices, finger_nodes,
-                     placement_node, scene_material)
+from squeeze_grasp_ros.scene import (
+    Scene,
+    SensorsSpec,
+    build_mesh,
+    finger_devices,
+    finger_nodes,
+    placement_node,
+    scene_material,
+)
 from squeeze_grasp_ros.scene_events import scene_limits
 from squeeze_grasp_ros.sim.devices import DeviceModel, device_model, follow
-from squeeze_grasp_ros.sim.sensors import (SensorRandomness, TactileLayout, fingertip_wrench, render_tactile,
-                      tactile_layout)
+from squeeze_grasp_ros.sim.sensors import (
+    SensorRandomness,
+    TactileLayout,
+    fingertip_wrench,
+    render_tactile,
+    tactile_layout,
+)
+from squeeze_grasp_ros.mechanics.vocabulary import Finger, SQUEEZING_FINGERS, Termination
 
-TERMINATE_ON: tuple[str, ...] = ("strain_limit", "finger_slip", "picked_up")
+TERMINATE_ON: tuple[str, ...] = (
+    Termination.STRAIN_LIMIT,
+    Termination.FINGER_SLIP,
+    Termination.PICKED_UP,
+)
 """Stepper terminations that end the simulated world (as in Algorithm 1)."""
 
 
-def squeeze_geometry(scene: Scene, obj: ElasticObject,
-                     contacts: tuple[int, int]) -> tuple[dict[str, np.ndarray], float]:
+def squeeze_geometry(
+    scene: Scene, obj: ElasticObject, contacts: tuple[int, int]
+) -> tuple[dict[str, np.ndarray], float]:
     """(finger -> translation per unit depth (m/m), relative depth per unit depth (1/m)).
 
     The scene's stable or pure squeeze (:func:`..mechanics.squeeze.plan_squeeze`; approach
@@ -68,13 +87,13 @@ def squeeze_geometry(scene: Scene, obj: ElasticObject,
     """
     chord = np.diff(obj.mesh.nodes[list(contacts)], axis=0)[0]
     distance = float(np.linalg.norm(chord))
-    if scene.fingers["F1"].direction is None:
-        plan = plan_squeeze(obj, list(contacts), scene.squeeze.type)
+    if scene.fingers[Finger.F1].direction is None:
+        plan = plan_squeeze(obj, list(contacts), kind=scene.squeeze.type)
         u = plan.displacement.reshape(2, 2)
         return {"F1": u[0], "F2": u[1]}, plan.approach_per_unit_depth / distance
-    u = np.array([scene.fingers[n].direction for n in ("F1", "F2")], float)
+    u = np.array([scene.fingers[n].direction for n in SQUEEZING_FINGERS], float)
     u = u / np.linalg.norm(u)
-    return {"F1": u[0], "F2": u[1]}, float((u[0] - u[1]) @ chord) / distance ** 2
+    return {"F1": u[0], "F2": u[1]}, float((u[0] - u[1]) @ chord) / distance**2
 
 
 @dataclass(frozen=True)
@@ -184,12 +203,18 @@ class SimWorld:
             obj = ElasticObject(build_mesh(scene), scene_material(scene))
         self.obj = obj.precompute()
         self.model = CountingContactModel(
-            obj, scene.mu, scene_limits(scene),
-            max_events_per_depth=scene.squeeze.max_events_per_depth, counter=self.work)
+            obj,
+            scene.mu,
+            scene_limits(scene),
+            max_events_per_depth=scene.squeeze.max_events_per_depth,
+            counter=self.work,
+        )
         mesh = obj.mesh
         self.contacts = finger_nodes(scene, mesh)
-        tips = [place_fingertip(mesh, name, node, scene.fingers[name].tip_radius)
-                for name, node in zip(("F1", "F2"), self.contacts)]
+        tips = [
+            place_fingertip(mesh, name, node, scene.fingers[name].tip_radius)
+            for name, node in zip(SQUEEZING_FINGERS, self.contacts)
+        ]
         self.directions, self.relative_per_depth = squeeze_geometry(scene, obj, self.contacts)
         self.state = initial_state(tips, self.relative_per_depth)
         self.adversary = None
@@ -201,8 +226,9 @@ class SimWorld:
         lag = scene.actuators.time_constant if scene.has("actuator_lag") else 0.0
         devices = finger_devices(scene)
         self.fingers: tuple[str, ...] = tuple(t.name for t in tips)
-        self.devices: dict[str, DeviceModel] = {t.name: device_model(devices[t.name], lag)
-                                                for t in tips}
+        self.devices: dict[str, DeviceModel] = {
+            t.name: device_model(devices[t.name], lag) for t in tips
+        }
         self.radii = {t.name: t.radius for t in tips}
         self.positions = {t.name: np.asarray(t.center, float) for t in tips}
         self.offsets = {t.name: np.zeros(2) for t in tips}
@@ -215,7 +241,9 @@ class SimWorld:
         self.randomness = SensorRandomness(
             sensors.seed if sensors is not None and sensors.seed is not None else 0,
             sensors.noise_std if scene.has("sensor_noise") else None,
-            sensors.dropout if scene.has("sensor_dropout") else None, self.work)
+            sensors.dropout if scene.has("sensor_dropout") else None,
+            self.work,
+        )
         self.dt = scene.sim.dt
         self.dt_ns = int(round(scene.sim.dt * 1e9))
         self.index = 0
@@ -261,12 +289,20 @@ class SimWorld:
         self.index += 1
         events: tuple[Event, ...] = ()
         touching = {f.name for f in self.state.fingers}
-        translations = {k: tuple(v) for k, v in moves.items() if k in touching and np.any(v != 0.0)}
+        translations = {
+            k: tuple(v) for k, v in moves.items() if k in touching and np.any(v != 0.0)
+        }
         if translations and self.termination is None:
             self.work["stepper_calls"] += 1
             started, cpu = time.perf_counter(), time.thread_time()
-            result = advance(self.model, self.state, translations, self.step_size, self.event_tol,
-                             terminate_on=TERMINATE_ON)
+            result = advance(
+                self.model,
+                self.state,
+                translations,
+                self.step_size,
+                self.event_tol,
+                terminate_on=TERMINATE_ON,
+            )
             self.stepper_seconds += time.perf_counter() - started
             self.stepper_cpu_seconds += time.thread_time() - cpu
             self.state, events = result.state, result.events
@@ -280,8 +316,9 @@ class SimWorld:
         """Place A on the deformed boundary; return its setpoint shifted by the same offset."""
         self.work["adversary_placements"] += 1
         field_ = self.displacement_field()
-        self.state = add_adversary(self.state, self.model, field_, self.adversary.node,
-                                   self.adversary.radius)
+        self.state = add_adversary(
+            self.state, self.model, field_, self.adversary.node, self.adversary.radius
+        )
         touched = np.asarray(self.state.finger("A").center, float)
         offset = touched - self.positions["A"]
         self.offsets["A"] = self.offsets["A"] + offset
@@ -290,15 +327,19 @@ class SimWorld:
 
     def _output(self, events: tuple[Event, ...]) -> TickOutput:
         readings = tuple(self._read(name) for name in self.fingers)
-        return TickOutput(self.index, self.index * self.dt_ns, readings, events, self.termination,
-                          self.state)
+        return TickOutput(
+            self.index, self.index * self.dt_ns, readings, events, self.termination, self.state
+        )
 
     def _read(self, name: str) -> FingerReading:
         """Sensor readings of finger ``name`` (dropout decided before noise is drawn)."""
         contacts = [c for c in self.state.contacts if c.finger == name]
         device = self.devices[name].name
-        reading = {"finger": name, "device": device,
-                   "position": self.positions[name] - self.offsets[name]}
+        reading = {
+            "finger": name,
+            "device": device,
+            "position": self.positions[name] - self.offsets[name],
+        }
         rnd = self.randomness
         if self.scene.has("force_sensing") and not rnd.dropped():
             self.work["wrench_evaluations"] += 1
@@ -314,7 +355,9 @@ class SimWorld:
 
     # ----------------------------------------------------------------- geometry
     def _contact_solution(self) -> tuple:
-        """(set data, dimensionless displacements, dimensionless forces) of the current contacts."""
+        """(set data, dimensionless displacements, dimensionless forces) of the current
+        contacts.
+        """
         contacts = self.state.contacts
         sd = self.model.set_data(tuple(c.node for c in contacts))
         delta = np.array([c.displacement for c in contacts]) / self.model.length
@@ -332,10 +375,15 @@ class SimWorld:
         self.work["views"] += 1
         sd, delta, forces = self._contact_solution()
         mesh = self.obj.mesh
-        outline = mesh.nodes[mesh.boundary] + self.model.boundary_displacement(sd, delta, forces) \
-            * self.model.length
-        tips = tuple((f.name, np.asarray(f.center, float), float(f.radius))
-                     for f in self.state.fingers)
-        contacts = tuple((c.finger, mesh.nodes[c.node] + c.displacement, c.mode, c.force)
-                         for c in self.state.contacts)
+        outline = (
+            mesh.nodes[mesh.boundary]
+            + self.model.boundary_displacement(sd, delta, forces) * self.model.length
+        )
+        tips = tuple(
+            (f.name, np.asarray(f.center, float), float(f.radius)) for f in self.state.fingers
+        )
+        contacts = tuple(
+            (c.finger, mesh.nodes[c.node] + c.displacement, c.mode, c.force)
+            for c in self.state.contacts
+        )
         return WorldView(outline, tips, contacts)

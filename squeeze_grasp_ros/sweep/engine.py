@@ -50,7 +50,8 @@ def require_extra() -> None:
 class Progress:
     """One stderr line: evaluations done/total, rate, ETA and the dashboard address.
 
-    Redrawn in place on a terminal; otherwise printed at most every ``interval`` seconds."""
+    Redrawn in place on a terminal; otherwise printed at most every ``interval`` seconds.
+    """
 
     def __init__(self, total: int, dashboard: Optional[str], enabled: bool = True,
                  interval: float = 10.0, stream=None) -> None:
@@ -91,7 +92,8 @@ class Progress:
 class Outcome:
     """What a sweep run did: counts of tasks and evaluations; seconds in all, summed over the
     tasks for preparing groups and evaluating, and until the cluster was ready; the signal
-    (SIGINT, SIGTERM) that stopped it, or None."""
+    (SIGINT, SIGTERM) that stopped it, or None.
+    """
 
     tasks: int
     skipped: int
@@ -125,7 +127,8 @@ def _cluster(scheduler: Optional[str], workers: Optional[int]):
 
 def _dashboard(client, local: bool) -> Optional[str]:
     """The dashboard address if the scheduler serves one that answers from here (Dask serves
-    a stub page without bokeh, and its HTTP server also runs with ``--no-dashboard``)."""
+    a stub page without bokeh, and its HTTP server also runs with ``--no-dashboard``).
+    """
     if local and importlib.util.find_spec("bokeh") is None:
         return None
     link = client.dashboard_link
@@ -139,7 +142,8 @@ def _dashboard(client, local: bool) -> Optional[str]:
 
 def ignore_sigint() -> None:
     """Run in a local worker process: Ctrl-C reaches the whole process group, and the client
-    alone handles it (it cancels the tasks and closes the cluster)."""
+    alone handles it (it cancels the tasks and closes the cluster).
+    """
     signal.signal(signal.SIGINT, signal.SIG_IGN)
 
 
@@ -159,7 +163,8 @@ def _check_workers(client) -> int:
 
 class StopSignals:
     """Within ``with``: SIGINT and SIGTERM set :attr:`signal` instead of raising, so that a
-    part and its manifest update are never cut in half (main thread only; elsewhere a no-op)."""
+    part and its manifest update are never cut in half (main thread only; elsewhere a no-op).
+    """
 
     def __init__(self) -> None:
         self.signal: Optional[int] = None
@@ -278,7 +283,8 @@ def dry_run(loaded: LoadedSpec, *, workers: Optional[int] = None,
     The sample runs in this process: the first task's group is prepared (mesh, factorisation,
     grasp map) and up to :data:`DRY_RUN_SAMPLE` of its evaluations are timed; the estimate is
     groups x prepare + evaluations x mean evaluation time / workers (each worker prepares a
-    group at most once)."""
+    group at most once).
+    """
     from squeeze_grasp_ros.sweep.evaluate import evaluate
     tasks = plan_tasks(loaded)
     groups = sorted({t.group for t in tasks})

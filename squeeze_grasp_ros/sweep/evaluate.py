@@ -12,6 +12,7 @@ finger forces, work, energy, grasp health, slip margins); this module adds only 
 of the strain and stress maxima, the pickup outcome, W*_F over push directions and the
 point-contact stiffness. No Dask or pyarrow here: the loop is the bare mechanics loop too.
 """
+
 from __future__ import annotations
 
 import time
@@ -24,37 +25,75 @@ from squeeze_grasp_ros.mechanics.elastic.compliance import ElasticObject
 from squeeze_grasp_ros.mechanics.squeeze.graspmap import GraspMap, grasp_map
 from squeeze_grasp_ros.mechanics.elastic.material import Material
 from squeeze_grasp_ros.mechanics.elastic.mesh import Mesh
-from squeeze_grasp_ros.mechanics.resistance.optimal import (FINGERS, contact_segments, resistance_grasp,
-                                    sweep_directions)
+from squeeze_grasp_ros.mechanics.resistance.optimal import (
+    contact_segments,
+    resistance_grasp,
+    sweep_directions,
+)
 from squeeze_grasp_ros.mechanics.squeeze.events import event_squeeze
 from squeeze_grasp_ros.sweep.plan import Task, build_group_mesh, rng_for
+from squeeze_grasp_ros.mechanics.vocabulary import Finger, Termination
 
 CACHE_GROUPS = 4
 """Prepared groups kept per worker process (a 2k-node group holds a few MB)."""
 
 COLUMNS: dict[str, str] = {
-    "eval_id": "string", "task_id": "string", "object_id": "string", "material_id": "string",
-    "placement_id": "string", "param_id": "string", "repeat": "int32",
-    "node_F1": "int32", "node_F2": "int32", "x_F1": "float64", "y_F1": "float64",
-    "x_F2": "float64", "y_F2": "float64",
-    "mu": "float64", "tip_radius": "float64", "squeeze": "string",
-    "target_depth": "float64", "target_relative_depth": "float64",
-    "mesh_nodes": "int32", "boundary_nodes": "int32",
-    "termination": "string", "depth": "float64", "relative_depth": "float64",
-    "events_A": "int32", "events_B": "int32", "events_C": "int32", "events_D": "int32",
-    "chatter": "int32", "contacts_F1": "int32", "contacts_F2": "int32",
-    "force_F1_start": "float64", "force_F1_end": "float64",
-    "force_F2_start": "float64", "force_F2_end": "float64",
-    "work_F1": "float64", "work_F2": "float64", "energy": "float64",
-    "max_strain": "float64", "max_strain_element": "int32",
-    "max_strain_x": "float64", "max_strain_y": "float64",
-    "max_von_mises": "float64", "max_von_mises_element": "int32",
-    "max_von_mises_x": "float64", "max_von_mises_y": "float64",
-    "slip_margin_F1": "float64", "slip_margin_F2": "float64",
+    "eval_id": "string",
+    "task_id": "string",
+    "object_id": "string",
+    "material_id": "string",
+    "placement_id": "string",
+    "param_id": "string",
+    "repeat": "int32",
+    "node_F1": "int32",
+    "node_F2": "int32",
+    "x_F1": "float64",
+    "y_F1": "float64",
+    "x_F2": "float64",
+    "y_F2": "float64",
+    "mu": "float64",
+    "tip_radius": "float64",
+    "squeeze": "string",
+    "target_depth": "float64",
+    "target_relative_depth": "float64",
+    "mesh_nodes": "int32",
+    "boundary_nodes": "int32",
+    "termination": "string",
+    "depth": "float64",
+    "relative_depth": "float64",
+    "events_A": "int32",
+    "events_B": "int32",
+    "events_C": "int32",
+    "events_D": "int32",
+    "chatter": "int32",
+    "contacts_F1": "int32",
+    "contacts_F2": "int32",
+    "force_F1_start": "float64",
+    "force_F1_end": "float64",
+    "force_F2_start": "float64",
+    "force_F2_end": "float64",
+    "work_F1": "float64",
+    "work_F2": "float64",
+    "energy": "float64",
+    "max_strain": "float64",
+    "max_strain_element": "int32",
+    "max_strain_x": "float64",
+    "max_strain_y": "float64",
+    "max_von_mises": "float64",
+    "max_von_mises_element": "int32",
+    "max_von_mises_x": "float64",
+    "max_von_mises_y": "float64",
+    "slip_margin_F1": "float64",
+    "slip_margin_F2": "float64",
     "picked_up": "bool",
-    "node_A": "int32", "resist_min": "float64", "resist_min_angle_deg": "float64",
-    "resist_max": "float64", "resist_max_angle_deg": "float64",
-    "stiffness": "float64", "time_s": "float64", "error": "string",
+    "node_A": "int32",
+    "resist_min": "float64",
+    "resist_min_angle_deg": "float64",
+    "resist_max": "float64",
+    "resist_max_angle_deg": "float64",
+    "stiffness": "float64",
+    "time_s": "float64",
+    "error": "string",
 }
 """Dataset columns and their Arrow types (SI units; see docs/sweep.md). Every column but
 ``time_s`` is identical, bit for bit, however the sweep is distributed."""
@@ -109,7 +148,7 @@ def select_placements(task: Task, mesh: Mesh, gmap: GraspMap) -> list[tuple[int,
         ok &= getattr(gmap, name)
     ok = ok[rows, cols]
     score = np.where(ok, gmap.stiffness[rows, cols], -np.inf)
-    order = np.lexsort((np.arange(len(rows)), -score))[:task.placement_count]
+    order = np.lexsort((np.arange(len(rows)), -score))[: task.placement_count]
     return [(0, int(loop[rows[k]]), int(loop[cols[k]])) for k in order if ok[k]]
 
 
@@ -143,8 +182,9 @@ def _adversary(group: Group, i: int, j: int, spec: tuple) -> dict:
         raise ValueError(f"adversary.position {position} puts A on F1's or F2's node")
     nodes = [i, j, k]
     sets = [[n] for n in nodes] if contacts == "point" else contact_segments(mesh, nodes)
-    ext = sweep_directions(resistance_grasp(group.obj, dict(zip(FINGERS, sets))), mode,
-                           directions).extremes()
+    ext = sweep_directions(
+        resistance_grasp(group.obj, dict(zip(tuple(Finger), sets))), mode, directions
+    ).extremes()
     for key in ("min", "max"):
         if ext[key] is not None:
             out[f"resist_{key}"] = ext[key]["unit_work"]
@@ -163,21 +203,46 @@ def evaluate(task: Task, group: Group, index: int, params, resist: dict) -> dict
     mesh = group.obj.mesh
     gpos = mesh.boundary_position(i), mesh.boundary_position(j)
     row = dict.fromkeys(COLUMNS)
-    row.update({"eval_id": f"{task.group}/p{index:05d}/{params.id}", "task_id": task.id,
-           "object_id": task.obj.id, "material_id": task.material[0],
-           "placement_id": f"p{index:05d}", "param_id": params.id, "repeat": repeat,
-           "node_F1": i, "node_F2": j,
-           "x_F1": float(mesh.nodes[i, 0]), "y_F1": float(mesh.nodes[i, 1]),
-           "x_F2": float(mesh.nodes[j, 0]), "y_F2": float(mesh.nodes[j, 1]),
-           "mu": params.mu, "tip_radius": params.tip_radius, "squeeze": params.kind,
-           "target_depth": params.depth, "target_relative_depth": params.relative_depth,
-           "mesh_nodes": mesh.n, "boundary_nodes": len(mesh.boundary),
-           "stiffness": float(group.gmap.stiffness[gpos])})
+    row.update(
+        {
+            "eval_id": f"{task.group}/p{index:05d}/{params.id}",
+            "task_id": task.id,
+            "object_id": task.obj.id,
+            "material_id": task.material[0],
+            "placement_id": f"p{index:05d}",
+            "param_id": params.id,
+            "repeat": repeat,
+            "node_F1": i,
+            "node_F2": j,
+            "x_F1": float(mesh.nodes[i, 0]),
+            "y_F1": float(mesh.nodes[i, 1]),
+            "x_F2": float(mesh.nodes[j, 0]),
+            "y_F2": float(mesh.nodes[j, 1]),
+            "mu": params.mu,
+            "tip_radius": params.tip_radius,
+            "squeeze": params.kind,
+            "target_depth": params.depth,
+            "target_relative_depth": params.relative_depth,
+            "mesh_nodes": mesh.n,
+            "boundary_nodes": len(mesh.boundary),
+            "stiffness": float(group.gmap.stiffness[gpos]),
+        }
+    )
     start = time.perf_counter()
     try:
-        res = event_squeeze(group.obj, (i, j), params.tip_radius, params.mu, params.kind,
-                            params.depth, params.relative_depth, task.limits, task.step,
-                            task.event_tol, max_events_per_depth=task.max_events_per_depth)
+        res = event_squeeze(
+            group.obj,
+            (i, j),
+            params.tip_radius,
+            params.mu,
+            kind=params.kind,
+            depth=params.depth,
+            relative_depth=params.relative_depth,
+            limits=task.limits,
+            step=task.step,
+            event_tol=task.event_tol,
+            max_events_per_depth=task.max_events_per_depth,
+        )
         if task.adversary is not None:
             key = (i, j)
             if key not in resist:
@@ -194,19 +259,33 @@ def evaluate(task: Task, group: Group, index: int, params, resist: dict) -> dict
         return row
     counts = res.event_counts
     h = res.health
-    row.update({
-        "termination": res.termination, "depth": res.depth,
-        "relative_depth": res.relative_depth,
-        **{f"events_{k}": counts[k] for k in "ABCD"}, "chatter": len(res.chatter),
-        "contacts_F1": len(res.segments["F1"]), "contacts_F2": len(res.segments["F2"]),
-        "force_F1_start": res.finger_force["F1"][0], "force_F1_end": res.finger_force["F1"][1],
-        "force_F2_start": res.finger_force["F2"][0], "force_F2_end": res.finger_force["F2"][1],
-        "work_F1": res.work["F1"], "work_F2": res.work["F2"], "energy": res.energy,
-        "max_strain": h.max_strain, "max_strain_element": h.max_strain_element,
-        "max_von_mises": h.max_von_mises, "max_von_mises_element": h.max_von_mises_element,
-        "slip_margin_F1": h.slip_margin.get("F1"), "slip_margin_F2": h.slip_margin.get("F2"),
-        "picked_up": (res.termination == "picked_up") if task.limits.weight is not None else None,
-    })
+    row.update(
+        {
+            "termination": res.termination,
+            "depth": res.depth,
+            "relative_depth": res.relative_depth,
+            **{f"events_{k}": counts[k] for k in "ABCD"},
+            "chatter": len(res.chatter),
+            "contacts_F1": len(res.segments[Finger.F1]),
+            "contacts_F2": len(res.segments[Finger.F2]),
+            "force_F1_start": res.finger_force[Finger.F1][0],
+            "force_F1_end": res.finger_force[Finger.F1][1],
+            "force_F2_start": res.finger_force[Finger.F2][0],
+            "force_F2_end": res.finger_force[Finger.F2][1],
+            "work_F1": res.work[Finger.F1],
+            "work_F2": res.work[Finger.F2],
+            "energy": res.energy,
+            "max_strain": h.max_strain,
+            "max_strain_element": h.max_strain_element,
+            "max_von_mises": h.max_von_mises,
+            "max_von_mises_element": h.max_von_mises_element,
+            "slip_margin_F1": h.slip_margin.get(Finger.F1),
+            "slip_margin_F2": h.slip_margin.get(Finger.F2),
+            "picked_up": (res.termination == Termination.PICKED_UP)
+            if task.limits.weight is not None
+            else None,
+        }
+    )
     row["max_strain_x"], row["max_strain_y"] = _centroid(mesh, h.max_strain_element)
     row["max_von_mises_x"], row["max_von_mises_y"] = _centroid(mesh, h.max_von_mises_element)
     row["time_s"] = time.perf_counter() - start
@@ -216,7 +295,8 @@ def evaluate(task: Task, group: Group, index: int, params, resist: dict) -> dict
 def run_task(task: Task) -> dict:
     """Evaluate a task; returns ``{"rows": [...], "outline": [[x, y], ...], "prepare_s": s,
     "cached": bool, "evaluate_s": s}`` (rows sorted by ``eval_id``; the outline is the mesh's
-    outer boundary loop, m, for the report's pictures)."""
+    outer boundary loop, m, for the report's pictures).
+    """
     cached = (task.spec_hash, task.group) in _CACHE
     group = prepare(task)
     start = time.perf_counter()
@@ -225,7 +305,10 @@ def run_task(task: Task) -> dict:
         for params in task.params:
             rows.append(evaluate(task, group, index, params, resist))
     mesh = group.obj.mesh
-    return {"rows": sorted(rows, key=lambda r: r["eval_id"]),
-            "outline": mesh.nodes[mesh.boundary].tolist(),
-            "prepare_s": 0.0 if cached else group.prepare_s, "cached": cached,
-            "evaluate_s": time.perf_counter() - start}
+    return {
+        "rows": sorted(rows, key=lambda r: r["eval_id"]),
+        "outline": mesh.nodes[mesh.boundary].tolist(),
+        "prepare_s": 0.0 if cached else group.prepare_s,
+        "cached": cached,
+        "evaluate_s": time.perf_counter() - start,
+    }

@@ -186,7 +186,7 @@ def objects(loaded: LoadedSpec) -> list[ObjectItem]:
 
 
 def parameter_grid(loaded: LoadedSpec) -> tuple[Params, ...]:
-    """friction x tip_radius x squeeze x depth, ids in that order."""
+    """Friction x tip_radius x squeeze x depth, ids in that order."""
     grid = itertools.product(loaded.friction, loaded.tip_radius, loaded.squeeze, loaded.depths)
     return tuple(Params(f"q{k:04d}", float(mu), float(r), kind, d, rel)
                  for k, (mu, r, kind, (d, rel)) in enumerate(grid))
@@ -198,7 +198,7 @@ def build_group_mesh(item: ObjectItem):
     ms = item.mesh
     area = ms.max_area if ms.max_area is not None else target_max_area(
         outline, ms.nodes if ms.nodes is not None else 600)
-    return generate_mesh(outline, area, ms.min_angle)
+    return generate_mesh(outline, area, min_angle=ms.min_angle)
 
 
 def placement_total(loaded: LoadedSpec, item: ObjectItem) -> int:

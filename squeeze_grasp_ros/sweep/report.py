@@ -7,25 +7,35 @@ Success of an evaluation: no error, and the squeeze held to its depth (terminati
 placement: W*_F per unit push in the hardest direction (``resist_min``, J/m^2) when the sweep
 has an adversary, else the point-contact stiffness (N/m, comparable on one mesh only).
 """
+
 from __future__ import annotations
 
 from collections import defaultdict
 from pathlib import Path
 
 import numpy as np
+from squeeze_grasp_ros.mechanics.vocabulary import Termination
 
-SUCCESS = ("depth_reached", "picked_up")
+SUCCESS = (Termination.DEPTH_REACHED, Termination.PICKED_UP)
 QUANTILES = (0.0, 0.25, 0.5, 0.75, 1.0)
-DISTRIBUTIONS = ("stiffness", "resist_min", "resist_max", "energy", "max_strain",
-                 "max_von_mises", "relative_depth", "time_s")
+DISTRIBUTIONS = (
+    "stiffness",
+    "resist_min",
+    "resist_max",
+    "energy",
+    "max_strain",
+    "max_von_mises",
+    "relative_depth",
+    "time_s",
+)
 
 
 def success(row: dict) -> bool:
     """The evaluation succeeded (see module docstring)."""
     if row["error"]:
         return False
-    if row["picked_up"] is not None:
-        return bool(row["picked_up"])
+    if row[Termination.PICKED_UP] is not None:
+        return bool(row[Termination.PICKED_UP])
     return row["termination"] in SUCCESS
 
 
@@ -47,9 +57,12 @@ def summarise(rows: list[dict], best: int = 3) -> dict:
     for key in DISTRIBUTIONS:
         v = np.array([r[key] for r in rows if r[key] is not None], float)
         if len(v):
-            dist[key] = {"count": int(len(v)),
-                         "quantiles": dict(zip(("min", "q25", "median", "q75", "max"),
-                                               np.quantile(v, QUANTILES).tolist()))}
+            dist[key] = {
+                "count": int(len(v)),
+                "quantiles": dict(
+                    zip(("min", "q25", "median", "q75", "max"), np.quantile(v, QUANTILES).tolist())
+                ),
+            }
     qkey = quality_key(rows)
     placements: dict = defaultdict(lambda: {"ok": 0, "n": 0})
     for r in rows:
@@ -60,56 +73,92 @@ def summarise(rows: list[dict], best: int = 3) -> dict:
     ranked = defaultdict(list)
     for (obj, mat, pid), p in sorted(placements.items()):
         if p["quality"] is not None:
-            ranked[obj].append({"material": mat, "placement": pid, "nodes": p["nodes"],
-                                "quality": p["quality"], "success_rate": p["ok"] / p["n"]})
-    best_of = {obj: sorted(v, key=lambda p: (-p["success_rate"], -p["quality"], p["placement"]))[:best]
-               for obj, v in ranked.items()}
-    return {"evaluations": len(rows), "errors": sum(1 for r in rows if r["error"]),
-            "success_rate": sum(map(success, rows)) / len(rows) if rows else None,
-            "by_object_material": [{"object": o, "material": m, "success": s, "evaluations": n,
-                                    "rate": s / n} for (o, m), (s, n) in sorted(by.items())],
-            "terminations": dict(sorted(terminations.items())), "distributions": dist,
-            "quality": qkey, "best": best_of}
+            ranked[obj].append(
+                {
+                    "material": mat,
+                    "placement": pid,
+                    "nodes": p["nodes"],
+                    "quality": p["quality"],
+                    "success_rate": p["ok"] / p["n"],
+                }
+            )
+    best_of = {
+        obj: sorted(v, key=lambda p: (-p["success_rate"], -p["quality"], p["placement"]))[:best]
+        for obj, v in ranked.items()
+    }
+    return {
+        "evaluations": len(rows),
+        "errors": sum(1 for r in rows if r["error"]),
+        "success_rate": sum(map(success, rows)) / len(rows) if rows else None,
+        "by_object_material": [
+            {"object": o, "material": m, "success": s, "evaluations": n, "rate": s / n}
+            for (o, m), (s, n) in sorted(by.items())
+        ],
+        "terminations": dict(sorted(terminations.items())),
+        "distributions": dist,
+        "quality": qkey,
+        "best": best_of,
+    }
 
 
 def text(summary: dict, manifest: dict) -> str:
     """The summary as plain-text tables."""
     counts = manifest["counts"]
-    lines = [f"sweep {manifest.get('name') or ''} (spec {manifest['spec_hash'][:12]}, package "
-             f"{manifest['package_version']}): tasks done {counts['done']}, failed "
-             f"{counts['failed']}, pending {counts['pending']}; {summary['evaluations']} "
-             f"evaluations, {summary['errors']} with an error"]
+    lines = [
+        f"sweep {manifest.get('name') or ''} (spec {manifest['spec_hash'][:12]}, package "
+        f"{manifest['package_version']}): tasks done {counts['done']}, failed "
+        f"{counts['failed']}, pending {counts['pending']}; {summary['evaluations']} "
+        f"evaluations, {summary['errors']} with an error"
+    ]
     if not summary["evaluations"]:
         return "\n".join(lines)
-    lines += ["", f"success rate {100 * summary['success_rate']:.1f} % (held to depth, or picked "
-              "up when a weight is given)", "",
-              f"{'object':28s} {'material':12s} {'success':>9s} {'rate':>7s}"]
+    lines += [
+        "",
+        f"success rate {100 * summary['success_rate']:.1f} % (held to depth, or picked "
+        "up when a weight is given)",
+        "",
+        f"{'object':28s} {'material':12s} {'success':>9s} {'rate':>7s}",
+    ]
     for c in summary["by_object_material"]:
-        lines.append(f"{c['object']:28s} {c['material']:12s} {c['success']:4d}/{c['evaluations']:<4d}"
-                     f" {100 * c['rate']:6.1f}%")
-    lines += ["", "terminations: " + ", ".join(f"{k} {v}" for k, v in summary["terminations"].items()),
-              "", f"{'quantity':16s} {'count':>6s} {'min':>10s} {'q25':>10s} {'median':>10s} "
-              f"{'q75':>10s} {'max':>10s}"]
+        lines.append(
+            f"{c['object']:28s} {c['material']:12s} "
+            f"{c['success']:4d}/{c['evaluations']:<4d}"
+            f" {100 * c['rate']:6.1f}%"
+        )
+    lines += [
+        "",
+        "terminations: " + ", ".join(f"{k} {v}" for k, v in summary["terminations"].items()),
+        "",
+        f"{'quantity':16s} {'count':>6s} {'min':>10s} {'q25':>10s} {'median':>10s} "
+        f"{'q75':>10s} {'max':>10s}",
+    ]
     for key, d in summary["distributions"].items():
         q = d["quantiles"]
         lines.append(f"{key:16s} {d['count']:6d} " + " ".join(f"{q[k]:10.4g}" for k in q))
     unit = "J/m^2" if summary["quality"] == "resist_min" else "N/m"
-    lines += ["", f"best placements per object (by success rate, then {summary['quality']} {unit}):"]
+    lines += [
+        "",
+        f"best placements per object (by success rate, then {summary['quality']} {unit}):",
+    ]
     for obj, best in summary["best"].items():
         for p in best:
-            lines.append(f"  {obj:26s} {p['material']:10s} {p['placement']} nodes "
-                         f"{p['nodes'][0]:4d},{p['nodes'][1]:4d}  {summary['quality']} "
-                         f"{p['quality']:.4g}  success {100 * p['success_rate']:.0f} %")
+            lines.append(
+                f"  {obj:26s} {p['material']:10s} {p['placement']} nodes "
+                f"{p['nodes'][0]:4d},{p['nodes'][1]:4d}  {summary['quality']} "
+                f"{p['quality']:.4g}  success {100 * p['success_rate']:.0f} %"
+            )
     return "\n".join(lines)
 
 
 def plot(rows: list[dict], directory: str | Path, outlines: dict | None = None) -> list[str]:
     """Quality map over placements per object (its outline, chords between the contact points
     coloured by quality, failures grey) and success rate against friction and depth; PNG
-    paths. ``outlines``: object id -> boundary loop [[x, y], ...], m."""
+    paths. ``outlines``: object id -> boundary loop [[x, y], ...], m.
+    """
     from matplotlib import colormaps
 
     from squeeze_grasp_ros import plots
+
     directory = Path(directory)
     directory.mkdir(parents=True, exist_ok=True)
     qkey = quality_key(rows)
@@ -131,22 +180,32 @@ def plot(rows: list[dict], directory: str | Path, outlines: dict | None = None) 
             norm = (q - q.min()) / max(np.ptp(q), 1e-300)
             for r, v in zip(good, norm):
                 ax.plot([r["x_F1"], r["x_F2"]], [r["y_F1"], r["y_F2"]], color=cmap(v), lw=1.0)
-        pts = np.array([[r[k] for k in ("x_F1", "y_F1")] for r in mine]
-                       + [[r[k] for k in ("x_F2", "y_F2")] for r in mine])
+        pts = np.array(
+            [[r[k] for k in ("x_F1", "y_F1")] for r in mine]
+            + [[r[k] for k in ("x_F2", "y_F2")] for r in mine]
+        )
         ax.scatter(pts[:, 0], pts[:, 1], s=6, color="k")
         ax.set_title(f"{obj}: {qkey} (bright = high)", fontsize=8)
-    for ax in axes[len(objects):]:
+    for ax in axes[len(objects) :]:
         ax.set_visible(False)
     paths = [plots.save(fig, directory / "quality_map.png")]
     fig, axes = plots.figure(2)
-    for ax, key, label in ((axes[0], "mu", "friction coefficient mu"),
-                           (axes[1], "target", "target depth (relative, or m)")):
+    for ax, key, label in (
+        (axes[0], "mu", "friction coefficient mu"),
+        (axes[1], "target", "target depth (relative, or m)"),
+    ):
         ax.set_aspect("auto")
         groups = defaultdict(list)
         for r in rows:
-            x = r["mu"] if key == "mu" else (r["target_relative_depth"]
-                                              if r["target_relative_depth"] is not None
-                                              else r["target_depth"])
+            x = (
+                r["mu"]
+                if key == "mu"
+                else (
+                    r["target_relative_depth"]
+                    if r["target_relative_depth"] is not None
+                    else r["target_depth"]
+                )
+            )
             groups[x].append(success(r))
         xs = sorted(groups)
         ax.plot(xs, [100 * np.mean(groups[x]) for x in xs], "o-")

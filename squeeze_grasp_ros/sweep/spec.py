@@ -5,9 +5,11 @@
 A sweep names a base scene (defaults for everything not swept: material, mesh, friction,
 fingertip, squeeze, strain limit, event tolerances), the objects, the axes (materials, friction,
 fingertip radius, squeeze type, depth), the placements per object, an optional pickup weight and
-an optional adversary. The parser is the scene parser (:func:`~squeeze_grasp_ros.scene.parse_section`):
+an optional adversary. The parser is the scene parser
+(:func:`~squeeze_grasp_ros.scene.parse_section`):
 unknown keys, wrong types and values out of range raise :class:`SweepError` naming the key.
 """
+
 from __future__ import annotations
 
 import dataclasses
@@ -17,13 +19,26 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Optional
 
-from squeeze_grasp_ros.scene import (MaterialSpec, MeshSpec, Scene, SceneError, _validate_shape, build_outline,
-                     key_reference, load_scene, parse_section, read_yaml, spec)
+from squeeze_grasp_ros.scene import (
+    MaterialSpec,
+    MeshSpec,
+    Scene,
+    SceneError,
+    _validate_shape,
+    build_outline,
+    key_reference,
+    load_scene,
+    parse_section,
+    read_yaml,
+    spec,
+)
+from squeeze_grasp_ros.mechanics.vocabulary import Finger
 
 
 class SweepError(SceneError):
     """A sweep spec entry is unknown, of the wrong type, out of range or contradictory, or the
-    sweep cannot run (missing extra, output directory of another spec)."""
+    sweep cannot run (missing extra, output directory of another spec).
+    """
 
 
 FAMILIES: dict[str, tuple[str, ...]] = {
@@ -39,32 +54,44 @@ class FamilySpec:
 
     type: str = spec("shape family", choices=tuple(FAMILIES))
     count: int = spec("number of shapes drawn", lo=1)
-    a: Optional[tuple[float, float]] = spec("superellipse: half-width range [low, high]", "m",
-                                            lo=0.0, lo_open=True, default=None)
-    b: Optional[tuple[float, float]] = spec("superellipse: half-height range [low, high]", "m",
-                                            lo=0.0, lo_open=True, default=None)
-    exponent: Optional[tuple[float, float]] = spec("superellipse: exponent range [low, high]", "",
-                                                   lo=2.0, default=None)
-    radius: Optional[tuple[float, float]] = spec("fourier_blob: mean radius range [low, high]",
-                                                 "m", lo=0.0, lo_open=True, default=None)
+    a: Optional[tuple[float, float]] = spec(
+        "superellipse: half-width range [low, high]", "m", lo=0.0, lo_open=True, default=None
+    )
+    b: Optional[tuple[float, float]] = spec(
+        "superellipse: half-height range [low, high]", "m", lo=0.0, lo_open=True, default=None
+    )
+    exponent: Optional[tuple[float, float]] = spec(
+        "superellipse: exponent range [low, high]", "", lo=2.0, default=None
+    )
+    radius: Optional[tuple[float, float]] = spec(
+        "fourier_blob: mean radius range [low, high]", "m", lo=0.0, lo_open=True, default=None
+    )
     harmonics: int = spec("fourier_blob: number of harmonics k = 1..H", lo=1, default=4)
-    amplitude: float = spec("fourier_blob: coefficients of harmonic k drawn from "
-                            "[-amplitude/k, amplitude/k]", "", lo=0.0, hi=0.3, default=0.1)
+    amplitude: float = spec(
+        "fourier_blob: coefficients of harmonic k drawn from [-amplitude/k, amplitude/k]",
+        "",
+        lo=0.0,
+        hi=0.3,
+        default=0.1,
+    )
 
 
 @dataclass(frozen=True)
 class ObjectEntry:
     """One entry of ``objects``: exactly one of scene, outline, shape, family."""
 
-    name: str = spec("name used in ids (default: file stem, shape type or family type)",
-                     default="")
+    name: str = spec(
+        "name used in ids (default: file stem, shape type or family type)", default=""
+    )
     scene: Optional[str] = spec("scene file: its object's shape and mesh settings", default=None)
-    outline: Optional[str] = spec("outline file: CSV 'x,y' per line or JSON {outline: [...]}",
-                                  "m", default=None)
+    outline: Optional[str] = spec(
+        "outline file: CSV 'x,y' per line or JSON {outline: [...]}", "m", default=None
+    )
     shape: Optional[dict] = spec("shape mapping as in scenes (object.shape)", default=None)
     family: Optional[FamilySpec] = spec("seeded random shapes", default=None)
-    mesh: Optional[MeshSpec] = spec("mesh settings of this entry (default: the sweep's mesh)",
-                                    default=None)
+    mesh: Optional[MeshSpec] = spec(
+        "mesh settings of this entry (default: the sweep's mesh)", default=None
+    )
 
 
 PLACEMENT_FILTERS = ("inward", "force_closure")
@@ -74,28 +101,51 @@ PLACEMENT_FILTERS = ("inward", "force_closure")
 class PlacementsSpec:
     """Initial contact pairs (F1, F2) per object, over outer-boundary nodes."""
 
-    mode: str = spec("all: every boundary-node pair; sample: a seeded sample of `count` pairs "
-                     "(per repeat); graspmap: the `count` stiffest pairs of the point-contact "
-                     "grasp map passing `require`", choices=("all", "sample", "graspmap"),
-                     default="sample")
+    mode: str = spec(
+        "all: every boundary-node pair; sample: a seeded sample of `count` pairs "
+        "(per repeat); graspmap: the `count` stiffest pairs of the point-contact "
+        "grasp map passing `require`",
+        choices=("all", "sample", "graspmap"),
+        default="sample",
+    )
     count: int = spec("pairs per object (sample: per repeat; graspmap: top N)", lo=1, default=20)
-    require: tuple[str, ...] = spec("graspmap: filters the pairs must pass",
-                                    choices=PLACEMENT_FILTERS, default=PLACEMENT_FILTERS)
-    mu: Optional[float] = spec("graspmap: friction coefficient of the force-closure test "
-                               "(default: the smallest of the sweep)", "", lo=0.0, default=None)
+    require: tuple[str, ...] = spec(
+        "graspmap: filters the pairs must pass",
+        choices=PLACEMENT_FILTERS,
+        default=PLACEMENT_FILTERS,
+    )
+    mu: Optional[float] = spec(
+        "graspmap: friction coefficient of the force-closure test "
+        "(default: the smallest of the sweep)",
+        "",
+        lo=0.0,
+        default=None,
+    )
 
 
 @dataclass(frozen=True)
 class SweepAdversarySpec:
     """Optimal resistance W*_F to an adversary finger A at the initial contacts (Sec. 6)."""
 
-    position: float = spec("where A touches: fraction of the boundary loop counter-clockwise "
-                           "from F1 to F2", "", lo=0.0, hi=1.0, lo_open=True, default=0.5)
+    position: float = spec(
+        "where A touches: fraction of the boundary loop counter-clockwise from F1 to F2",
+        "",
+        lo=0.0,
+        hi=1.0,
+        lo_open=True,
+        default=0.5,
+    )
     mode: str = spec("resistance type", choices=("stable", "pure"), default="stable")
-    contacts: str = spec("point: the three nodes; segment: each node and its two neighbours",
-                         choices=("point", "segment"), default="point")
-    directions: int = spec("push directions over which W*_F per unit push is minimised and "
-                           "maximised", lo=1, default=72)
+    contacts: str = spec(
+        "point: the three nodes; segment: each node and its two neighbours",
+        choices=("point", "segment"),
+        default="point",
+    )
+    directions: int = spec(
+        "push directions over which W*_F per unit push is minimised and maximised",
+        lo=1,
+        default=72,
+    )
 
 
 @dataclass(frozen=True)
@@ -105,33 +155,57 @@ class SweepSpec:
     base: str = spec("base scene file (defaults for everything not swept)")
     name: str = spec("sweep name", default="")
     description: str = spec("free text", default="")
-    seed: int = spec("root seed of every random draw (shapes, sampled placements)", lo=0,
-                     default=0)
-    repeat: int = spec("independent draws of the sampled placements (placements.mode: sample)",
-                       lo=1, default=1)
-    objects: Optional[tuple[ObjectEntry, ...]] = spec("objects (default: the base scene's)",
-                                                      default=None)
-    materials: Optional[dict] = spec("name -> {E, nu, thickness} (default: the base scene's, "
-                                     "named 'base')", default=None)
+    seed: int = spec(
+        "root seed of every random draw (shapes, sampled placements)", lo=0, default=0
+    )
+    repeat: int = spec(
+        "independent draws of the sampled placements (placements.mode: sample)", lo=1, default=1
+    )
+    objects: Optional[tuple[ObjectEntry, ...]] = spec(
+        "objects (default: the base scene's)", default=None
+    )
+    materials: Optional[dict] = spec(
+        "name -> {E, nu, thickness} (default: the base scene's, named 'base')", default=None
+    )
     mesh: Optional[MeshSpec] = spec("mesh settings (default: the base scene's)", default=None)
-    friction: Optional[tuple[float, ...]] = spec("friction coefficients mu", "", lo=0.0,
-                                                 default=None)
-    tip_radius: Optional[tuple[float, ...]] = spec("fingertip radii (both fingers)", "m", lo=0.0,
-                                                   lo_open=True, default=None)
-    squeeze: Optional[tuple[str, ...]] = spec("squeeze types", choices=("stable", "pure"),
-                                              default=None)
-    depth: Optional[tuple[float, ...]] = spec("squeeze depths rho", "m", lo=0.0, lo_open=True,
-                                              default=None)
+    friction: Optional[tuple[float, ...]] = spec(
+        "friction coefficients mu", "", lo=0.0, default=None
+    )
+    tip_radius: Optional[tuple[float, ...]] = spec(
+        "fingertip radii (both fingers)", "m", lo=0.0, lo_open=True, default=None
+    )
+    squeeze: Optional[tuple[str, ...]] = spec(
+        "squeeze types", choices=("stable", "pure"), default=None
+    )
+    depth: Optional[tuple[float, ...]] = spec(
+        "squeeze depths rho", "m", lo=0.0, lo_open=True, default=None
+    )
     relative_depth: Optional[tuple[float, ...]] = spec(
-        "relative depths (finger approach / initial contact distance)", "", lo=0.0, hi=1.0,
-        lo_open=True, default=None)
-    weight: Optional[float] = spec("object weight for pickup: the squeeze stops when friction "
-                                   "can lift it (default: the base scene's pickup)", "N",
-                                   lo=0.0, lo_open=True, default=None)
-    adversary: Optional[SweepAdversarySpec] = spec("optimal resistance per placement", default=None)
+        "relative depths (finger approach / initial contact distance)",
+        "",
+        lo=0.0,
+        hi=1.0,
+        lo_open=True,
+        default=None,
+    )
+    weight: Optional[float] = spec(
+        "object weight for pickup: the squeeze stops when friction "
+        "can lift it (default: the base scene's pickup)",
+        "N",
+        lo=0.0,
+        lo_open=True,
+        default=None,
+    )
+    adversary: Optional[SweepAdversarySpec] = spec(
+        "optimal resistance per placement", default=None
+    )
     placements: PlacementsSpec = spec("placements per object", default_factory=PlacementsSpec)
-    chunk: int = spec("most evaluations per Dask task (tasks of one object and material share "
-                      "its mesh and factorisation on each worker)", lo=1, default=64)
+    chunk: int = spec(
+        "most evaluations per Dask task (tasks of one object and material share "
+        "its mesh and factorisation on each worker)",
+        lo=1,
+        default=64,
+    )
 
 
 @dataclass(frozen=True)
@@ -180,11 +254,13 @@ def _absolute(path: Optional[str], base_dir: Path) -> Optional[str]:
 def _check_entry(entry: ObjectEntry, where: str) -> None:
     given = [k for k in ("scene", "outline", "shape", "family") if getattr(entry, k) is not None]
     if len(given) != 1:
-        raise SweepError(f"{where} needs exactly one of scene, outline, shape, family; got "
-                         f"{given or 'none'}")
+        raise SweepError(
+            f"{where} needs exactly one of scene, outline, shape, family; got {given or 'none'}"
+        )
     if entry.name and not all(c.isalnum() or c in "_.-" for c in entry.name):
-        raise SweepError(f"{where}.name must use letters, digits, '_', '.', '-', got "
-                         f"{entry.name!r}")
+        raise SweepError(
+            f"{where}.name must use letters, digits, '_', '.', '-', got {entry.name!r}"
+        )
     fam = entry.family
     if fam is not None:
         for key in FAMILIES[fam.type]:
@@ -192,13 +268,21 @@ def _check_entry(entry: ObjectEntry, where: str) -> None:
             if value is None:
                 raise SweepError(f"missing required key {where}.family.{key} for type {fam.type}")
             if value[0] > value[1]:
-                raise SweepError(f"{where}.family.{key} must be [low, high] with low <= high, "
-                                 f"got {list(value)}")
-        other = [k for f, keys in FAMILIES.items() if f != fam.type for k in keys
-                 if getattr(fam, k) is not None]
+                raise SweepError(
+                    f"{where}.family.{key} must be [low, high] with low <= high, got {list(value)}"
+                )
+        other = [
+            k
+            for f, keys in FAMILIES.items()
+            if f != fam.type
+            for k in keys
+            if getattr(fam, k) is not None
+        ]
         if other:
-            raise SweepError(f"{where}.family.{other[0]} does not apply to type {fam.type} "
-                             f"(allowed: {list(FAMILIES[fam.type])})")
+            raise SweepError(
+                f"{where}.family.{other[0]} does not apply to type {fam.type} "
+                f"(allowed: {list(FAMILIES[fam.type])})"
+            )
     if entry.shape is not None:
         try:
             _validate_shape(entry.shape)
@@ -246,8 +330,11 @@ def parse_sweep_spec(data: Any, base_dir: Path) -> LoadedSpec:
     entries = []
     for k, entry in enumerate(sw.objects or ()):
         where = f"objects[{k}]"
-        entry = dataclasses.replace(entry, scene=_absolute(entry.scene, base_dir),
-                                    outline=_absolute(entry.outline, base_dir))
+        entry = dataclasses.replace(
+            entry,
+            scene=_absolute(entry.scene, base_dir),
+            outline=_absolute(entry.outline, base_dir),
+        )
         _check_entry(entry, where)
         for key in ("scene", "outline"):
             if getattr(entry, key) is not None:
@@ -275,18 +362,26 @@ def parse_sweep_spec(data: Any, base_dir: Path) -> LoadedSpec:
             raise SweepError("materials must name at least one material")
         materials = {}
         for name, value in sw.materials.items():
-            if not isinstance(name, str) or not name or not all(c.isalnum() or c in "_.-" for c in name):
-                raise SweepError(f"materials: name {name!r} must use letters, digits, '_', '.', '-'")
+            if (
+                not isinstance(name, str)
+                or not name
+                or not all(c.isalnum() or c in "_.-" for c in name)
+            ):
+                raise SweepError(
+                    f"materials: name {name!r} must use letters, digits, '_', '.', '-'"
+                )
             try:
                 materials[name] = parse_section(MaterialSpec, value, f"materials.{name}")
             except SceneError as exc:
                 raise SweepError(str(exc)) from None
     fingers = base.fingers
-    tip = fingers["F1"].tip_radius
-    if sw.tip_radius is None and not (tip > 0 and fingers["F2"].tip_radius == tip):
-        raise SweepError("tip_radius is not swept and the base scene's fingertips are not one "
-                         "radius > 0 m: give tip_radius (the event-driven squeeze needs rounded "
-                         "fingertips)")
+    tip = fingers[Finger.F1].tip_radius
+    if sw.tip_radius is None and not (tip > 0 and fingers[Finger.F2].tip_radius == tip):
+        raise SweepError(
+            "tip_radius is not swept and the base scene's fingertips are not one "
+            "radius > 0 m: give tip_radius (the event-driven squeeze needs rounded "
+            "fingertips)"
+        )
     if sw.depth is not None and sw.relative_depth is not None:
         raise SweepError("depth and relative_depth are exclusive; give one")
     if sw.depth is not None:
@@ -296,24 +391,41 @@ def parse_sweep_spec(data: Any, base_dir: Path) -> LoadedSpec:
     elif base.squeeze.depth is not None or base.squeeze.relative_depth is not None:
         depths = ((base.squeeze.depth, base.squeeze.relative_depth),)
     else:
-        raise SweepError("no squeeze depth: give depth or relative_depth (or squeeze.depth / "
-                         "squeeze.relative_depth in the base scene)")
+        raise SweepError(
+            "no squeeze depth: give depth or relative_depth (or squeeze.depth / "
+            "squeeze.relative_depth in the base scene)"
+        )
     if sw.adversary is not None and sw.adversary.position >= 1.0:
         raise SweepError("adversary.position must be < 1 (1 is F2's node)")
     if sw.repeat > 1 and sw.placements.mode != "sample":
-        raise SweepError(f"repeat is {sw.repeat} but placements.mode is {sw.placements.mode}: "
-                         "only sampled placements are random (placements.mode: sample)")
-    if sw.placements.mode == "graspmap" and len(set(sw.placements.require)) != len(sw.placements.require):
+        raise SweepError(
+            f"repeat is {sw.repeat} but placements.mode is {sw.placements.mode}: "
+            "only sampled placements are random (placements.mode: sample)"
+        )
+    if sw.placements.mode == "graspmap" and len(set(sw.placements.require)) != len(
+        sw.placements.require
+    ):
         raise SweepError("placements.require lists a filter twice")
-    weight = sw.weight if sw.weight is not None else (base.pickup.weight if base.has("pickup") else None)
+    weight = (
+        sw.weight
+        if sw.weight is not None
+        else (base.pickup.weight if base.has("pickup") else None)
+    )
     ident = {"spec": data, "files": files}
     digest = hashlib.sha256(json.dumps(ident, sort_keys=True, default=str).encode()).hexdigest()
     return LoadedSpec(
-        spec=sw, base=base, materials=materials, mesh=sw.mesh or base.object.mesh,
+        spec=sw,
+        base=base,
+        materials=materials,
+        mesh=sw.mesh or base.object.mesh,
         friction=_axis(sw.friction, base.mu, "friction"),
         tip_radius=_axis(sw.tip_radius, tip, "tip_radius"),
-        squeeze=_axis(sw.squeeze, base.squeeze.type, "squeeze"), depths=depths, weight=weight,
-        hash=digest, raw=data)
+        squeeze=_axis(sw.squeeze, base.squeeze.type, "squeeze"),
+        depths=depths,
+        weight=weight,
+        hash=digest,
+        raw=data,
+    )
 
 
 def load_sweep_spec(path: str | Path) -> LoadedSpec:
@@ -327,10 +439,14 @@ def load_sweep_spec(path: str | Path) -> LoadedSpec:
 
 def sweep_help() -> str:
     """Human-readable reference of every sweep key, unit and range."""
-    lines = key_reference(SweepSpec, width=30,
-                          nested={"materials": (MaterialSpec, "materials.<name>.")})
-    lines += ["", "Axes not given take the base scene's value; the evaluations of an object are "
-              "placements x materials x friction x tip_radius x squeeze x depth.",
-              "families: " + "; ".join(f"{k}({', '.join(v)})" for k, v in FAMILIES.items()),
-              "Scene keys (base scene, objects[].scene): `squeeze-grasp scene-help`."]
+    lines = key_reference(
+        SweepSpec, width=30, nested={"materials": (MaterialSpec, "materials.<name>.")}
+    )
+    lines += [
+        "",
+        "Axes not given take the base scene's value; the evaluations of an object are "
+        "placements x materials x friction x tip_radius x squeeze x depth.",
+        "families: " + "; ".join(f"{k}({', '.join(v)})" for k, v in FAMILIES.items()),
+        "Scene keys (base scene, objects[].scene): `squeeze-grasp scene-help`.",
+    ]
     return "\n".join(lines)

@@ -14,6 +14,7 @@ is what marks its task done; the manifest (also replaced atomically) repeats the
 people and tools, and records failed tasks with their error. Re-running the same spec into the
 same directory therefore skips exactly the finished tasks.
 """
+
 from __future__ import annotations
 
 import json
@@ -29,8 +30,12 @@ from squeeze_grasp_ros.sweep.evaluate import COLUMNS
 from squeeze_grasp_ros.sweep.plan import Task
 from squeeze_grasp_ros.sweep.spec import LoadedSpec, SweepError
 
-ARROW_TYPES = {"string": pa.string(), "int32": pa.int32(), "float64": pa.float64(),
-               "bool": pa.bool_()}
+ARROW_TYPES = {
+    "string": pa.string(),
+    "int32": pa.int32(),
+    "float64": pa.float64(),
+    "bool": pa.bool_(),
+}
 SCHEMA = pa.schema([(name, ARROW_TYPES[kind]) for name, kind in COLUMNS.items()])
 """Arrow schema of every part."""
 MANIFEST_FORMAT = 1
@@ -42,6 +47,7 @@ def package_version() -> str:
         return metadata.version("squeeze_grasp_ros")
     except metadata.PackageNotFoundError:
         from squeeze_grasp_ros import __version__
+
         return __version__
 
 
@@ -67,15 +73,21 @@ class Store:
             try:
                 old = json.loads(manifest.read_text())
             except ValueError as exc:
-                raise SweepError(f"{manifest}: unreadable manifest ({exc}); use another --out") from None
+                raise SweepError(
+                    f"{manifest}: unreadable manifest ({exc}); use another --out"
+                ) from None
             if old.get("spec_hash") != loaded.hash:
-                raise SweepError(f"{self.out} holds a sweep of another spec (hash "
-                                 f"{str(old.get('spec_hash'))[:12]}, this spec {loaded.hash[:12]}; "
-                                 "a referenced file may have changed): give another --out or "
-                                 "delete it")
+                raise SweepError(
+                    f"{self.out} holds a sweep of another spec (hash "
+                    f"{str(old.get('spec_hash'))[:12]}, this spec {loaded.hash[:12]}; "
+                    "a referenced file may have changed): give another --out or "
+                    "delete it"
+                )
         elif self.out.exists() and any(self.out.iterdir()):
-            raise SweepError(f"--out {self.out} exists, is not empty and has no manifest.json: "
-                             "give a new or empty directory")
+            raise SweepError(
+                f"--out {self.out} exists, is not empty and has no manifest.json: "
+                "give a new or empty directory"
+            )
         self.parts.mkdir(parents=True, exist_ok=True)
         for stale in self.parts.glob(".*.tmp"):
             stale.unlink()
@@ -95,7 +107,8 @@ class Store:
 
     def write(self, task: Task, rows: list[dict], outline: list | None = None) -> int:
         """Write a task's rows (and its object's outline, once) atomically and update the
-        manifest; returns the row count."""
+        manifest; returns the row count.
+        """
         if outline is not None:
             path = self.out / "outlines" / f"{task.obj.id}.json"
             if not path.exists():
@@ -115,21 +128,34 @@ class Store:
 
     def status(self) -> dict[str, str]:
         """Task id -> "done", "failed" or "pending"."""
-        return {tid: "done" if self.done(tid) else "failed" if tid in self.errors else "pending"
-                for tid in sorted(self.tasks)}
+        return {
+            tid: "done" if self.done(tid) else "failed" if tid in self.errors else "pending"
+            for tid in sorted(self.tasks)
+        }
 
     def write_manifest(self) -> None:
         """Replace manifest.json atomically."""
         status = self.status()
-        doc = {"format": MANIFEST_FORMAT, "name": self.loaded.spec.name,
-               "spec": self.loaded.raw, "spec_hash": self.loaded.hash,
-               "package_version": package_version(), "created": self.created,
-               "updated": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime()),
-               "counts": {k: sum(1 for v in status.values() if v == k)
-                          for k in ("done", "failed", "pending")},
-               "tasks": {tid: ({"status": s, "error": self.errors[tid]} if s == "failed"
-                               else {"status": s, "evaluations": self.tasks[tid].evaluations})
-                         for tid, s in status.items()}}
+        doc = {
+            "format": MANIFEST_FORMAT,
+            "name": self.loaded.spec.name,
+            "spec": self.loaded.raw,
+            "spec_hash": self.loaded.hash,
+            "package_version": package_version(),
+            "created": self.created,
+            "updated": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime()),
+            "counts": {
+                k: sum(1 for v in status.values() if v == k) for k in ("done", "failed", "pending")
+            },
+            "tasks": {
+                tid: (
+                    {"status": s, "error": self.errors[tid]}
+                    if s == "failed"
+                    else {"status": s, "evaluations": self.tasks[tid].evaluations}
+                )
+                for tid, s in status.items()
+            },
+        }
         text = json.dumps(doc, indent=1, sort_keys=True, default=str)
         _atomic_write(self.out / "manifest.json", lambda p: p.write_text(text))
 
@@ -148,8 +174,10 @@ def read_dataset(out: str | Path) -> pa.Table:
 
 def read_outlines(out: str | Path) -> dict[str, list]:
     """Object id -> outer boundary loop [[x, y], ...], m, of the objects written so far."""
-    return {p.stem: json.loads(p.read_text())["outline"]
-            for p in sorted((Path(out) / "outlines").glob("*.json"))}
+    return {
+        p.stem: json.loads(p.read_text())["outline"]
+        for p in sorted((Path(out) / "outlines").glob("*.json"))
+    }
 
 
 def read_manifest(out: str | Path) -> dict:

@@ -30,7 +30,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from squeeze_grasp_ros.mechanics.errors import MechanicsError, require_finite
+from squeeze_grasp_ros.mechanics.errors import InvalidInputError, require_finite
 
 
 @dataclass(frozen=True)
@@ -75,7 +75,8 @@ class Match:
 
     def to_json(self) -> dict:
         """``{"scale", "rotation", "rotation_deg", "translation", "mean_error", "rms_error",
-        "max_error", "errors"}``."""
+        "max_error", "errors"}``.
+        """
         return {"scale": self.scale, "rotation": self.rotation,
                 "rotation_deg": float(np.degrees(self.rotation)),
                 "translation": self.translation.tolist(), "mean_error": self.mean_error,
@@ -93,17 +94,28 @@ def match_similarity(simulated, measured) -> Match:
 
     Raises
     ------
-    MechanicsError
+    InvalidInputError
         For mismatched shapes, fewer than two points, non-finite input or coincident measured
         points (D = 0).
+
+    Examples
+    --------
+    Measured points that are the simulated ones scaled by 1/2, turned by -0.3 rad and shifted:
+
+    >>> p = np.array([[0.0, 0.0], [0.1, 0.0], [0.0, 0.05], [0.08, 0.07]])
+    >>> c, s = np.cos(-0.3), np.sin(-0.3)
+    >>> q = 0.5 * p @ np.array([[c, -s], [s, c]]).T + [0.2, -0.1]
+    >>> m = match_similarity(p, q)
+    >>> print(f"scale {m.scale:.4f}, rotation {m.rotation:.4f} rad", bool(m.errors.max() < 1e-12))
+    scale 2.0000, rotation 0.3000 rad True
     """
     P = np.asarray(simulated, float)
     Q = np.asarray(measured, float)
     if P.ndim != 2 or P.shape[1] != 2 or P.shape != Q.shape:
-        raise MechanicsError(f"simulated and measured points must both be (n, 2) arrays of the "
+        raise InvalidInputError(f"simulated and measured points must both be (n, 2) arrays of the "
                              f"same n, got {P.shape} and {Q.shape}")
     if len(P) < 2:
-        raise MechanicsError(f"matching needs at least 2 corresponding points, got {len(P)}")
+        raise InvalidInputError(f"matching needs at least 2 corresponding points, got {len(P)}")
     require_finite("simulated points", P)
     require_finite("measured points", Q)
     x, y = P[:, 0], P[:, 1]
@@ -112,7 +124,8 @@ def match_similarity(simulated, measured) -> Match:
         np.mean(a) for a in (x, y, u, v, x * u, x * v, y * u, y * v, u * u, v * v))
     D = c9 + c10 - (c3 * c3 + c4 * c4)
     if not D > 1e-30 * max(c9 + c10, 1e-300):
-        raise MechanicsError("the measured points coincide: the similarity transform is undefined")
+        raise InvalidInputError("the measured points coincide: the similarity transform is "
+                                "undefined")
     tx = (c4 * (c7 - c6) - c3 * (c5 + c8) + c1 * (c9 + c10)) / D
     ty = (c2 * (c9 + c10) - c4 * (c5 + c8) - c3 * (c7 - c6)) / D
     s = np.hypot(c1 * c3 + c2 * c4 - (c5 + c8), c1 * c4 - c2 * c3 + (c7 - c6)) / D

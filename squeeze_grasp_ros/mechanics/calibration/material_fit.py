@@ -14,13 +14,14 @@ fingertip material starts to slide above the critical angle alpha0, found by bis
 [0, pi/2]; mu = tan(alpha0).
 SI units: N, m, Pa, rad.
 """
+
 from __future__ import annotations
 
 from dataclasses import dataclass
 
 import numpy as np
 
-from squeeze_grasp_ros.mechanics.errors import MechanicsError, require_finite
+from squeeze_grasp_ros.mechanics.errors import InvalidInputError, require_finite
 
 
 @dataclass(frozen=True)
@@ -54,25 +55,27 @@ class Cuboid:
             require_finite(f"cuboid.{name}", getattr(self, name))
         for name in ("force", "length", "width", "height"):
             if not getattr(self, name) > 0:
-                raise MechanicsError(f"cuboid.{name} must be > 0, got {getattr(self, name)}")
+                raise InvalidInputError(f"cuboid.{name} must be > 0, got {getattr(self, name)}")
         if not self.dl < 0:
-            raise MechanicsError(f"cuboid.dl must be < 0 m (the cuboid shortens), got {self.dl}")
+            raise InvalidInputError(
+                f"cuboid.dl must be < 0 m (the cuboid shortens), got {self.dl}"
+            )
         if self.dh is not None:
             require_finite("cuboid.dh", self.dh)
 
     @property
     def axial_strain(self) -> float:
-        """dl / l (< 0)."""
+        """Dl / l (< 0)."""
         return self.dl / self.length
 
     @property
     def stress(self) -> float:
-        """f / (w h), Pa."""
+        """F / (w h), Pa."""
         return self.force / (self.width * self.height)
 
     @property
     def transverse_strains(self) -> list[float]:
-        """dw / w and, if measured, dh / h."""
+        """Dw / w and, if measured, dh / h."""
         out = [self.dw / self.width]
         if self.dh is not None:
             out.append(self.dh / self.height)
@@ -83,17 +86,19 @@ class Cuboid:
         return self.stress / abs(self.axial_strain)
 
     def poisson(self) -> float:
-        """nu of this cuboid alone (mean over the measured transverse sides)."""
+        """Nu of this cuboid alone (mean over the measured transverse sides)."""
         return float(np.mean([-t / self.axial_strain for t in self.transverse_strains]))
 
     @staticmethod
-    def simulate(E: float, nu: float, force: float, length: float, width: float,
-                 height: float) -> "Cuboid":
+    def simulate(
+        E: float, nu: float, force: float, length: float, width: float, height: float
+    ) -> "Cuboid":
         """The measurement a linear-elastic cuboid (E in Pa, nu) would give, for round trips."""
         dl = -force * length / (E * width * height)
         strain = dl / length
-        return Cuboid(force, length, width, height, dl, -nu * strain * width,
-                      -nu * strain * height)
+        return Cuboid(
+            force, length, width, height, dl, -nu * strain * width, -nu * strain * height
+        )
 
 
 @dataclass(frozen=True)
@@ -120,9 +125,13 @@ class Elasticity:
 
     def to_json(self) -> dict:
         """All fields."""
-        return {"E": self.E, "nu": self.nu,
-                "per_cuboid": [{"E": e, "nu": n} for e, n in self.per_cuboid],
-                "E_residual": self.E_residual, "nu_residual": self.nu_residual}
+        return {
+            "E": self.E,
+            "nu": self.nu,
+            "per_cuboid": [{"E": e, "nu": n} for e, n in self.per_cuboid],
+            "E_residual": self.E_residual,
+            "nu_residual": self.nu_residual,
+        }
 
 
 def fit_through_origin(x: np.ndarray, y: np.ndarray) -> tuple[float, float]:
@@ -137,11 +146,22 @@ def calibrate_elasticity(cuboids: list[Cuboid]) -> Elasticity:
 
     Raises
     ------
-    MechanicsError
+    InvalidInputError
         Without measurements or for a fitted nu outside (-1, 0.5].
+
+    Examples
+    --------
+    A 0.1 x 0.05 x 0.02 m cuboid of E = 2e5 Pa, nu = 0.4 under 10 N shortens by
+    f l / (E w h) = 5 mm and widens by nu w |dl| / l:
+
+    >>> cuboid = Cuboid(force=10.0, length=0.1, width=0.05, height=0.02, dl=-0.005,
+    ...                 dw=0.4 * 0.05 * 0.005 / 0.1)
+    >>> fit = calibrate_elasticity([cuboid])
+    >>> print(f"{fit.E:.0f} Pa, nu = {fit.nu:.3f}")
+    200000 Pa, nu = 0.400
     """
     if not cuboids:
-        raise MechanicsError("calibration needs at least one cuboid measurement")
+        raise InvalidInputError("calibration needs at least one cuboid measurement")
     axial = np.array([abs(c.axial_strain) for c in cuboids])
     E, e_res = fit_through_origin(axial, np.array([c.stress for c in cuboids]))
     pairs = [(-c.axial_strain, -t) for c in cuboids for t in c.transverse_strains]
@@ -149,8 +169,10 @@ def calibrate_elasticity(cuboids: list[Cuboid]) -> Elasticity:
     nu, n_res = fit_through_origin(a, np.array([p[1] for p in pairs]))
     nu = -nu
     if not -1.0 < nu <= 0.5:
-        raise MechanicsError(f"fitted Poisson's ratio {nu:.4g} is outside (-1, 0.5]: check the "
-                             "signs of dl (< 0) and dw, dh (> 0 when bulging)")
+        raise InvalidInputError(
+            f"fitted Poisson's ratio {nu:.4g} is outside (-1, 0.5]: check the "
+            "signs of dl (< 0) and dw, dh (> 0 when bulging)"
+        )
     return Elasticity(E, nu, tuple((c.young(), c.poisson()) for c in cuboids), e_res, n_res)
 
 
@@ -176,47 +198,57 @@ class Friction:
 
     def to_json(self) -> dict:
         """All fields, angles also in degrees."""
-        return {"mu": self.mu, "alpha0": self.alpha0, "alpha0_deg": float(np.degrees(self.alpha0)),
-                "bracket_deg": [float(np.degrees(b)) for b in self.bracket],
-                "mu_range": list(self.mu_range)}
+        return {
+            "mu": self.mu,
+            "alpha0": self.alpha0,
+            "alpha0_deg": float(np.degrees(self.alpha0)),
+            "bracket_deg": [float(np.degrees(b)) for b in self.bracket],
+            "mu_range": list(self.mu_range),
+        }
 
 
 def friction_from_angle(alpha0: float) -> Friction:
-    """mu = tan(alpha0) for a critical slope angle ``alpha0`` in rad, in [0, pi/2)."""
+    """Mu = tan(alpha0) for a critical slope angle ``alpha0`` in rad, in [0, pi/2)."""
     require_finite("slope angle", alpha0)
     if not 0 <= alpha0 < np.pi / 2:
-        raise MechanicsError("critical slope angle must be in [0, 90) deg, got "
-                             f"{np.degrees(alpha0)} deg")
+        raise InvalidInputError(
+            f"critical slope angle must be in [0, 90) deg, got {np.degrees(alpha0)} deg"
+        )
     mu = float(np.tan(alpha0))
     return Friction(mu, float(alpha0), (float(alpha0), float(alpha0)), (mu, mu))
 
 
 def friction_from_trials(trials: list[tuple[float, bool]]) -> Friction:
-    """mu from slope trials [(angle rad, slid)], e.g. the steps of the paper's bisection.
+    """Mu from slope trials [(angle rad, slid)], e.g. the steps of the paper's bisection.
 
     The critical angle lies between the largest angle at which the sample held and the
     smallest at which it slid; alpha0 is their midpoint.
 
     Raises
     ------
-    MechanicsError
+    InvalidInputError
         If the trials are inconsistent (a held angle above a slid one) or one side is missing.
     """
     for angle, _ in trials:
         require_finite("slope trial angle", angle)
         if not 0 <= angle <= np.pi / 2:
-            raise MechanicsError(f"slope trial angles must be in [0, 90] deg, got "
-                                 f"{np.degrees(angle):.6g} deg")
+            raise InvalidInputError(
+                f"slope trial angles must be in [0, 90] deg, got {np.degrees(angle):.6g} deg"
+            )
     held = [a for a, slid in trials if not slid]
     slid = [a for a, s in trials if s]
     if not held or not slid:
-        raise MechanicsError("slope trials need at least one angle that held and one that slid")
+        raise InvalidInputError("slope trials need at least one angle that held and one that slid")
     lo, hi = max(held), min(slid)
     if lo > hi:
-        raise MechanicsError(f"inconsistent slope trials: held at {np.degrees(lo):.4g} deg but "
-                             f"slid at {np.degrees(hi):.4g} deg")
+        raise InvalidInputError(
+            f"inconsistent slope trials: held at {np.degrees(lo):.4g} deg but "
+            f"slid at {np.degrees(hi):.4g} deg"
+        )
     alpha0 = 0.5 * (lo + hi)
-    return Friction(float(np.tan(alpha0)), alpha0, (lo, hi), (float(np.tan(lo)), float(np.tan(hi))))
+    return Friction(
+        float(np.tan(alpha0)), alpha0, (lo, hi), (float(np.tan(lo)), float(np.tan(hi)))
+    )
 
 
 def bisect_slope(slides, tol: float = 1e-3) -> list[tuple[float, bool]]:

@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 from scipy.integrate import quad
 
-from squeeze_grasp_ros.mechanics.errors import MechanicsError
+from squeeze_grasp_ros.mechanics.errors import InvalidInputError
 
 
 def disk_diameter_change_across(E: float, nu: float, thickness: float, radius: float,
@@ -20,7 +20,7 @@ def disk_diameter_change_across(E: float, nu: float, thickness: float, radius: f
     each point load does not.
     """
     if not (E > 0 and thickness > 0 and radius > 0 and -1 < nu <= 0.5):
-        raise MechanicsError("disk_diameter_change_across needs E, thickness, radius > 0 and "
+        raise InvalidInputError("disk_diameter_change_across needs E, thickness, radius > 0 and "
                              "nu in (-1, 0.5]")
     D = 2.0 * radius
     c = 2.0 * load / (np.pi * thickness * D)

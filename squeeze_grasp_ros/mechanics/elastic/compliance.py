@@ -28,15 +28,20 @@ import scipy.linalg as la
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from squeeze_grasp_ros.mechanics.errors import ConditioningWarning, MechanicsError
-from squeeze_grasp_ros.mechanics.elastic.fem import rigid_modes, rotation_mode_norm, stiffness_matrix
+from squeeze_grasp_ros.mechanics.errors import ConditioningWarning, InvalidInputError
+from squeeze_grasp_ros.mechanics.elastic.fem import (
+    rigid_modes,
+    rotation_mode_norm,
+    stiffness_matrix,
+)
 from squeeze_grasp_ros.mechanics.elastic.material import Material
 from squeeze_grasp_ros.mechanics.elastic.mesh import Mesh
 
 Route = Literal["factorized", "spectral"]
 ROUTES: tuple[str, ...] = ("factorized", "spectral")
 CONDITION_WARN = 1e12
-"""Condition estimate of a factorised or reduced matrix above which a ConditioningWarning is issued."""
+"""Condition estimate of a factorised or reduced matrix above which a ConditioningWarning is
+issued."""
 
 
 def node_dofs(nodes) -> np.ndarray:
@@ -77,7 +82,8 @@ class FactorizedSolver:
     @staticmethod
     def _pins(nodes: np.ndarray, boundary_dofs: np.ndarray) -> np.ndarray:
         """Three DOFs on the outer boundary that fix the rigid motions: both DOFs of the
-        leftmost node and, at the node farthest from it, the DOF most perpendicular to the line."""
+        leftmost node and, at the node farthest from it, the DOF most perpendicular to the line.
+        """
         bnodes = boundary_dofs[0::2] // 2
         a = int(bnodes[np.argmin(nodes[bnodes, 0] + 1e-3 * nodes[bnodes, 1])])
         b = int(bnodes[np.argmax(np.linalg.norm(nodes[bnodes] - nodes[a], axis=1))])
@@ -133,7 +139,8 @@ class SpectralSolver:
         Kc = Qc.T @ (K @ Qc)
         lam, W = la.eigh(0.5 * (Kc + Kc.T))
         if lam[0] <= 0:
-            raise MechanicsError("stiffness matrix has a non-rigid zero mode (mesh not connected?)")
+            raise InvalidInputError("stiffness matrix has a non-rigid zero mode (mesh not "
+                                    "connected?)")
         self.V = Qc @ W
         self.lam = lam
         self.condition = float(lam[-1] / lam[0])
@@ -180,7 +187,7 @@ class ElasticObject:
 
     def __post_init__(self) -> None:
         if self.route not in ROUTES:
-            raise MechanicsError(f"solver route must be one of {ROUTES}, got {self.route!r}")
+            raise InvalidInputError(f"solver route must be one of {ROUTES}, got {self.route!r}")
 
     @property
     def scale(self) -> float:
@@ -266,7 +273,9 @@ class ElasticObject:
         return self.rigid[node_dofs(self.mesh.boundary)]
 
     def diagnostics(self) -> dict[str, float]:
-        """Condition estimate, rigid-mode residual ||K R||/||K||, last solve residual, asymmetry."""
+        """Condition estimate, rigid-mode residual ||K R||/||K||, last solve residual,
+        asymmetry.
+        """
         _ = self.solver
         return dict(self._diag)
 

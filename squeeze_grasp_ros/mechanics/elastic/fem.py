@@ -58,7 +58,8 @@ def stiffness_matrix(mesh: Mesh, nu: float) -> sp.csr_matrix:
 
 
 def rigid_modes(nodes: np.ndarray, scale: float) -> np.ndarray:
-    """Orthonormal basis (2n, 3) of the rigid motions, the paper's v_{2n-2}, v_{2n-1}, v_{2n} (eq. 14).
+    """Orthonormal basis (2n, 3) of the rigid motions, the paper's v_{2n-2}, v_{2n-1}, v_{2n} (eq.
+    14).
 
     Columns: x translation, y translation, rotation about the node centroid; orthonormal under
     the unweighted nodal inner product (eq. 16). Coordinates are divided by ``scale`` (m) so the
@@ -82,7 +83,9 @@ def rotation_mode_norm(nodes: np.ndarray, scale: float) -> float:
 
 
 def element_strains(mesh: Mesh, displacement: np.ndarray) -> np.ndarray:
-    """Engineering strains (t, 3) = (eps_xx, eps_yy, gamma_xy) for a nodal displacement (n, 2), m."""
+    """Engineering strains (t, 3) = (eps_xx, eps_yy, gamma_xy) for a nodal displacement (n, 2),
+    m.
+    """
     B, _ = strain_displacement(mesh.nodes, mesh.triangles)
     de = np.asarray(displacement, float).reshape(-1)[element_dofs(mesh.triangles)]
     return np.einsum("tij,tj->ti", B, de)

@@ -7,7 +7,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from squeeze_grasp_ros.mechanics.errors import MechanicsError, require_finite
+from squeeze_grasp_ros.mechanics.errors import InvalidInputError, require_finite
 
 
 @dataclass(frozen=True)
@@ -22,6 +22,16 @@ class Material:
         Poisson's ratio, dimensionless, in (-1, 0.5].
     thickness : float
         Out-of-plane thickness h, m (> 0). Forces, energies and stiffnesses scale with E*h.
+
+    Examples
+    --------
+    >>> foam = Material(E=1e5, nu=0.3, thickness=0.01)
+    >>> foam.force_scale
+    1000.0
+    >>> Material(E=1e5, nu=0.6, thickness=0.01)
+    Traceback (most recent call last):
+    ...
+    squeeze_grasp_ros.mechanics.errors.InvalidInputError: material.nu must be in (-1, 0.5], got 0.6
     """
 
     E: float
@@ -32,11 +42,11 @@ class Material:
         for name in ("E", "nu", "thickness"):
             require_finite(f"material.{name}", getattr(self, name))
         if not self.E > 0:
-            raise MechanicsError(f"material.E must be > 0 Pa, got {self.E}")
+            raise InvalidInputError(f"material.E must be > 0 Pa, got {self.E}")
         if not -1.0 < self.nu <= 0.5:
-            raise MechanicsError(f"material.nu must be in (-1, 0.5], got {self.nu}")
+            raise InvalidInputError(f"material.nu must be in (-1, 0.5], got {self.nu}")
         if not self.thickness > 0:
-            raise MechanicsError(f"material.thickness must be > 0 m, got {self.thickness}")
+            raise InvalidInputError(f"material.thickness must be > 0 m, got {self.thickness}")
 
     @property
     def force_scale(self) -> float:

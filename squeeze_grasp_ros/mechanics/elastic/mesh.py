@@ -7,6 +7,7 @@ The mesher sits behind the small :class:`Mesher` protocol. The default,
 robust and fast but **not free for commercial use**; any mesher returning nodes and
 counter-clockwise triangles of a planar straight-line graph can replace it.
 """
+
 from __future__ import annotations
 
 from dataclasses import dataclass
@@ -15,15 +16,21 @@ from typing import Protocol
 
 import numpy as np
 
-from squeeze_grasp_ros.mechanics.errors import MechanicsError
+from squeeze_grasp_ros.mechanics.errors import InvalidInputError
 from squeeze_grasp_ros.mechanics.elastic.shapes import Outline, resample, signed_area
 
 
 class Mesher(Protocol):
     """Triangulates a planar straight-line graph with quality controls."""
 
-    def triangulate(self, vertices: np.ndarray, segments: np.ndarray, holes: np.ndarray,
-                    max_area: float, min_angle: float) -> tuple[np.ndarray, np.ndarray]:
+    def triangulate(
+        self,
+        vertices: np.ndarray,
+        segments: np.ndarray,
+        holes: np.ndarray,
+        max_area: float,
+        min_angle: float,
+    ) -> tuple[np.ndarray, np.ndarray]:
         """Return ``(nodes (n, 2), triangles (t, 3))`` covering the region.
 
         ``segments`` are index pairs into ``vertices`` that must stay edges (possibly split);
@@ -91,7 +98,7 @@ class Mesh:
         """Position of mesh ``node`` in the ``boundary`` loop; error if it is not on it."""
         pos = np.flatnonzero(self.boundary == node)
         if len(pos) == 0:
-            raise MechanicsError(f"node {node} is not on the outer boundary")
+            raise InvalidInputError(f"node {node} is not on the outer boundary")
         return int(pos[0])
 
     def normal_at(self, node: int) -> np.ndarray:
@@ -105,7 +112,9 @@ class Mesh:
         for k in range(3):
             u = p[:, (k + 1) % 3] - p[:, k]
             v = p[:, (k + 2) % 3] - p[:, k]
-            cos = np.einsum("ij,ij->i", u, v) / (np.linalg.norm(u, axis=1) * np.linalg.norm(v, axis=1))
+            cos = np.einsum("ij,ij->i", u, v) / (
+                np.linalg.norm(u, axis=1) * np.linalg.norm(v, axis=1)
+            )
             angles.append(np.degrees(np.arccos(np.clip(cos, -1, 1))))
         return float(np.min(angles))
 
@@ -125,7 +134,7 @@ def boundary_loops(triangles: np.ndarray) -> list[np.ndarray]:
     free = edges[counts[inverse.ravel()] == 1]
     successor = dict(zip(free[:, 0].tolist(), free[:, 1].tolist()))
     if len(successor) != len(free):
-        raise MechanicsError("mesh boundary is not manifold (a node has two outgoing edges)")
+        raise InvalidInputError("mesh boundary is not manifold (a node has two outgoing edges)")
     loops = []
     while successor:
         start = next(iter(successor))
@@ -159,12 +168,13 @@ takes minutes and gigabytes, so the request is refused before meshing."""
 def target_max_area(outline: Outline, nodes: int) -> float:
     """The ``max_area`` (m^2) that gives roughly ``nodes`` mesh nodes for ``outline``."""
     if not 10 <= nodes <= MAX_MESH_NODES:
-        raise MechanicsError(f"mesh.nodes must be in [10, {MAX_MESH_NODES}], got {nodes}")
+        raise InvalidInputError(f"mesh.nodes must be in [10, {MAX_MESH_NODES}], got {nodes}")
     return 1.6 * outline.area / (2.0 * nodes)
 
 
-def generate_mesh(outline: Outline, max_area: float, min_angle: float = 30.0,
-                  mesher: Mesher | None = None) -> Mesh:
+def generate_mesh(
+    outline: Outline, max_area: float, *, min_angle: float = 30.0, mesher: Mesher | None = None
+) -> Mesh:
     """Mesh ``outline`` with elements of area <= ``max_area`` m^2 and angles >= ``min_angle``.
 
     The boundary is first resampled to the edge length of an equilateral element of the target
@@ -172,22 +182,33 @@ def generate_mesh(outline: Outline, max_area: float, min_angle: float = 30.0,
 
     Raises
     ------
-    MechanicsError
+    InvalidInputError
         If ``max_area`` is not positive or ``min_angle`` is outside (0, 34] degrees (Triangle's
         guaranteed-termination range), or if the mesher fails.
+
+    Examples
+    --------
+    >>> from squeeze_grasp_ros.mechanics.elastic import shapes
+    >>> mesh = generate_mesh(shapes.rectangle(0.1, 0.05), 1e-4, min_angle=30.0)
+    >>> bool(element_areas(mesh.nodes, mesh.triangles).max() <= 1e-4)
+    True
+    >>> print(f"{element_areas(mesh.nodes, mesh.triangles).sum():.6f} m^2")
+    0.005000 m^2
     """
     if not (np.isfinite(max_area) and max_area > 0):
-        raise MechanicsError(f"mesh.max_area must be > 0 m^2, got {max_area}")
+        raise InvalidInputError(f"mesh.max_area must be > 0 m^2, got {max_area}")
     if not 0 < min_angle <= 34:
-        raise MechanicsError(f"mesh.min_angle must be in (0, 34] degrees, got {min_angle}")
+        raise InvalidInputError(f"mesh.min_angle must be in (0, 34] degrees, got {min_angle}")
     if max_area > outline.area:
         max_area = outline.area / 4.0
     if 0.8 * outline.area / max_area > MAX_MESH_NODES:
         smallest = 0.8 * outline.area / MAX_MESH_NODES
-        raise MechanicsError(f"mesh.max_area {max_area:.3g} m^2 would give about "
-                             f"{0.8 * outline.area / max_area:.3g} nodes on this "
-                             f"{outline.area:.3g} m^2 object; at most {MAX_MESH_NODES} are "
-                             f"allowed (max_area >= {smallest:.3g} m^2)")
+        raise InvalidInputError(
+            f"mesh.max_area {max_area:.3g} m^2 would give about "
+            f"{0.8 * outline.area / max_area:.3g} nodes on this "
+            f"{outline.area:.3g} m^2 object; at most {MAX_MESH_NODES} are "
+            f"allowed (max_area >= {smallest:.3g} m^2)"
+        )
     spacing = np.sqrt(4.0 * max_area / np.sqrt(3.0))
     loops = [resample(outline.points, spacing, outline.corners)]
     loops += [resample(h if signed_area(h) > 0 else h[::-1], spacing) for h in outline.holes]
@@ -199,7 +220,8 @@ def generate_mesh(outline: Outline, max_area: float, min_angle: float = 30.0,
         offset += len(loop)
     holes = np.array([h.mean(axis=0) for h in outline.holes]).reshape(-1, 2)
     nodes, tris = (mesher or TriangleMesher()).triangulate(
-        vertices, np.concatenate(segments), holes, max_area, min_angle)
+        vertices, np.concatenate(segments), holes, max_area, min_angle
+    )
     return mesh_from_triangles(nodes, tris)
 
 
@@ -212,7 +234,7 @@ def mesh_from_triangles(nodes: np.ndarray, triangles: np.ndarray) -> Mesh:
     nodes = np.asarray(nodes, float)
     triangles = np.asarray(triangles, int)
     if triangles.ndim != 2 or triangles.shape[1] != 3 or len(triangles) == 0:
-        raise MechanicsError("mesh needs at least one triangle given as [i, j, k]")
+        raise InvalidInputError("mesh needs at least one triangle given as [i, j, k]")
     used = np.unique(triangles)
     remap = -np.ones(len(nodes), dtype=int)
     remap[used] = np.arange(len(used))
@@ -220,7 +242,7 @@ def mesh_from_triangles(nodes: np.ndarray, triangles: np.ndarray) -> Mesh:
     area = element_areas(nodes, triangles)
     scale = float(np.ptp(nodes, axis=0).max()) ** 2
     if np.any(np.abs(area) <= 1e-14 * scale):
-        raise MechanicsError("mesh has degenerate (zero-area) elements")
+        raise InvalidInputError("mesh has degenerate (zero-area) elements")
     flip = area < 0
     triangles[flip] = triangles[flip][:, [0, 2, 1]]
     loops = boundary_loops(triangles)

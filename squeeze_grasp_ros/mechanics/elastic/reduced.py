@@ -11,6 +11,7 @@ m >= 2, Lemma 3), the blocks of M^-1 (eq. 29) are
 which satisfy eq. (30) exactly; C is symmetric PSD with null(C) = col(B) by construction
 (Theorem 7). Z^T A Z is SPD by Lemma 4 and is factored by Cholesky.
 """
+
 from __future__ import annotations
 
 import warnings
@@ -20,7 +21,11 @@ import numpy as np
 import scipy.linalg as la
 
 from squeeze_grasp_ros.mechanics.elastic.compliance import CONDITION_WARN, ElasticObject, node_dofs
-from squeeze_grasp_ros.mechanics.errors import ConditioningWarning, MechanicsError, require_finite
+from squeeze_grasp_ros.mechanics.errors import (
+    ConditioningWarning,
+    InvalidInputError,
+    require_finite,
+)
 
 
 @dataclass(frozen=True)
@@ -63,7 +68,7 @@ class ReducedStiffness:
         return self.C @ delta
 
     def rigid_coefficients(self, delta: np.ndarray) -> np.ndarray:
-        """g = E^T delta (3,), m: the displacement field's components on the rigid modes."""
+        """G = E^T delta (3,), m: the displacement field's components on the rigid modes."""
         return self.E.T @ delta
 
     def energy(self, delta: np.ndarray) -> float:
@@ -78,10 +83,12 @@ class ReducedStiffness:
 def null_space_basis(B: np.ndarray) -> np.ndarray:
     """Orthonormal basis Z (2m, 2m-3) of null(B^T) from a complete QR of B."""
     Q, _ = np.linalg.qr(B, mode="complete")
-    return Q[:, B.shape[1]:]
+    return Q[:, B.shape[1] :]
 
 
-def reduce_blocks(A_hat: np.ndarray, B: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, float]:
+def reduce_blocks(
+    A_hat: np.ndarray, B: np.ndarray
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, float]:
     """Dimensionless (C_hat, E, H_hat, condition) from A_hat and B by the null-space form."""
     Z = null_space_basis(B)
     S = Z.T @ A_hat @ Z
@@ -89,13 +96,16 @@ def reduce_blocks(A_hat: np.ndarray, B: np.ndarray) -> tuple[np.ndarray, np.ndar
     try:
         cho = la.cho_factor(S)
     except la.LinAlgError:
-        raise MechanicsError("Z^T A Z is not positive definite: contact nodes coincide or the "
-                             "compliance is corrupt") from None
+        raise InvalidInputError(
+            "Z^T A Z is not positive definite: contact nodes coincide or the compliance is corrupt"
+        ) from None
     eig = np.linalg.eigvalsh(S)
     condition = float(eig[-1] / eig[0])
     if condition > CONDITION_WARN:
-        warnings.warn(f"reduced compliance condition {condition:.3g} exceeds {CONDITION_WARN:.0e}",
-                      ConditioningWarning)
+        warnings.warn(
+            f"reduced compliance condition {condition:.3g} exceeds {CONDITION_WARN:.0e}",
+            ConditioningWarning,
+        )
     C = Z @ la.cho_solve(cho, Z.T)
     C = 0.5 * (C + C.T)
     BtB = B.T @ B
@@ -106,14 +116,26 @@ def reduce_blocks(A_hat: np.ndarray, B: np.ndarray) -> tuple[np.ndarray, np.ndar
 
 
 def reduced_stiffness(obj: ElasticObject, contacts) -> ReducedStiffness:
-    """Reduced stiffness of ``obj`` for contact nodes ``contacts`` (m >= 2 distinct nodes)."""
+    """Reduced stiffness of ``obj`` for contact nodes ``contacts`` (m >= 2 distinct nodes).
+
+    Examples
+    --------
+    >>> from squeeze_grasp_ros.mechanics.elastic import shapes
+    >>> from squeeze_grasp_ros.api import ElasticObject, Material, generate_mesh
+    >>> mesh = generate_mesh(shapes.disk(0.05), 2e-4)
+    >>> obj = ElasticObject(mesh, Material(E=1e5, nu=0.3, thickness=0.01))
+    >>> i, j = (int(mesh.boundary[k]) for k in (0, len(mesh.boundary) // 2))
+    >>> red = reduced_stiffness(obj, [i, j])
+    >>> red.C.shape, bool(np.allclose(red.C, red.C.T, atol=1e-9 * abs(red.C).max()))
+    ((4, 4), True)
+    """
     contacts = np.asarray(contacts, dtype=int).reshape(-1)
     if len(contacts) < 2:
-        raise MechanicsError(f"contacts needs at least 2 nodes (Lemma 2), got {len(contacts)}")
+        raise InvalidInputError(f"contacts needs at least 2 nodes (Lemma 2), got {len(contacts)}")
     if len(np.unique(contacts)) != len(contacts):
-        raise MechanicsError(f"contacts must be distinct nodes, got {contacts.tolist()}")
+        raise InvalidInputError(f"contacts must be distinct nodes, got {contacts.tolist()}")
     if contacts.min() < 0 or contacts.max() >= obj.mesh.n:
-        raise MechanicsError(f"contacts must be node indices in [0, {obj.mesh.n - 1}]")
+        raise InvalidInputError(f"contacts must be node indices in [0, {obj.mesh.n - 1}]")
     A_hat = obj.compliance_block(contacts)
     B = obj.rigid[node_dofs(contacts)]
     C_hat, E, H_hat, condition = reduce_blocks(A_hat, B)
@@ -124,12 +146,16 @@ def reduced_stiffness(obj: ElasticObject, contacts) -> ReducedStiffness:
 
 
 def rotation_angle(obj: ElasticObject, g: np.ndarray) -> float:
-    """Angle (rad) of the rigid-rotation component for rigid coefficients ``g`` (m) (eqs. 13-14)."""
+    """Angle (rad) of the rigid-rotation component for rigid coefficients ``g`` (m) (eqs.
+    13-14).
+    """
     return float(g[2] / (obj.scale * obj.rotation_norm))
 
 
 def nodal_forces(obj: ElasticObject, contacts: np.ndarray, forces: np.ndarray) -> np.ndarray:
-    """Full nodal force vector (2n,), N, with ``forces`` (2m,) at ``contacts`` and zero elsewhere."""
+    """Full nodal force vector (2n,), N, with ``forces`` (2m,) at ``contacts`` and zero
+    elsewhere.
+    """
     F = np.zeros(2 * obj.mesh.n)
     F[node_dofs(contacts)] = forces
     return F
@@ -140,12 +166,16 @@ def displacement_field(obj: ElasticObject, red: ReducedStiffness, delta: np.ndar
 
     One sparse solve: Delta = K+ F + R g with F = C delta, g = E^T delta.
     """
-    F_hat = nodal_forces(obj, red.contacts, red.forces(delta)) / (obj.material.force_scale * obj.scale)
+    F_hat = nodal_forces(obj, red.contacts, red.forces(delta)) / (
+        obj.material.force_scale * obj.scale
+    )
     u_hat = obj.pinv_apply(F_hat) + obj.rigid @ (red.rigid_coefficients(delta) / obj.scale)
     return (u_hat * obj.scale).reshape(-1, 2)
 
 
-def boundary_displacement(obj: ElasticObject, red: ReducedStiffness, delta: np.ndarray) -> np.ndarray:
+def boundary_displacement(
+    obj: ElasticObject, red: ReducedStiffness, delta: np.ndarray
+) -> np.ndarray:
     """Displacement of the outer-boundary nodes (b, 2), m, from the cached boundary compliance.
 
     Costs O(b m) after the precompute: no solve.

@@ -17,7 +17,7 @@ import numpy as np
 from scipy.interpolate import CubicSpline
 
 from squeeze_grasp_ros.inputs import InputError, read_text
-from squeeze_grasp_ros.mechanics.errors import MechanicsError
+from squeeze_grasp_ros.mechanics.errors import InvalidInputError
 
 DENSE = 2048
 """Number of samples of a smooth outline before resampling."""
@@ -117,21 +117,21 @@ def validate_polyline(points, name: str = "outline") -> np.ndarray:
     """
     p = np.asarray(points, dtype=float)
     if p.ndim != 2 or p.shape[1] != 2:
-        raise MechanicsError(f"{name} must be a list of [x, y] pairs, got shape {p.shape}")
+        raise InvalidInputError(f"{name} must be a list of [x, y] pairs, got shape {p.shape}")
     if not np.all(np.isfinite(p)):
-        raise MechanicsError(f"{name} has non-finite coordinates")
+        raise InvalidInputError(f"{name} has non-finite coordinates")
     step = np.linalg.norm(np.diff(np.vstack([p, p[:1]]), axis=0), axis=1)
     scale = max(float(np.ptp(p, axis=0).max()), 1e-300)
     p = p[step > 1e-12 * scale]
     if len(p) < 3:
-        raise MechanicsError(f"{name} needs at least 3 distinct vertices, got {len(p)}")
+        raise InvalidInputError(f"{name} needs at least 3 distinct vertices, got {len(p)}")
     area = signed_area(p)
     if abs(area) <= 1e-12 * scale * scale:
-        raise MechanicsError(f"{name} is degenerate (zero enclosed area)")
+        raise InvalidInputError(f"{name} is degenerate (zero enclosed area)")
     if area < 0:
         p = p[::-1].copy()
     if _segments_intersect(p):
-        raise MechanicsError(f"{name} is self-intersecting: two edges cross or touch (a "
+        raise InvalidInputError(f"{name} is self-intersecting: two edges cross or touch (a "
                              "repeated vertex, a vertex on another edge or a zero-width spike); "
                              "give a simple closed curve")
     return p
@@ -179,7 +179,7 @@ def superellipse(a: float, b: float, exponent: float) -> Outline:
     """Rounded rectangle |x/a|^p + |y/b|^p = 1 (p = ``exponent`` >= 2; large p -> sharp)."""
     _positive(a=a, b=b)
     if not exponent >= 2.0:
-        raise MechanicsError(f"superellipse.exponent must be >= 2, got {exponent}")
+        raise InvalidInputError(f"superellipse.exponent must be >= 2, got {exponent}")
     t = np.linspace(0.0, 2 * np.pi, DENSE, endpoint=False)
     c, s = np.cos(t), np.sin(t)
     x = a * np.sign(c) * np.abs(c) ** (2.0 / exponent)
@@ -200,7 +200,7 @@ def fourier_blob(radius: float, cos: Sequence[float] = (), sin: Sequence[float] 
     for k, sk in enumerate(sin, start=1):
         r += sk * np.sin(k * t)
     if np.min(r) <= 0.05:
-        raise MechanicsError("fourier_blob coefficients make the radius vanish; reduce them")
+        raise InvalidInputError("fourier_blob coefficients make the radius vanish; reduce them")
     return _smooth(radius * r * np.cos(t), radius * r * np.sin(t), "fourier_blob")
 
 
@@ -218,7 +218,7 @@ def annulus(outer_radius: float, inner_radius: float) -> Outline:
     """Solid ring (disk with a concentric circular hole), radii in m."""
     _positive(outer_radius=outer_radius, inner_radius=inner_radius)
     if not inner_radius < outer_radius:
-        raise MechanicsError("annulus.inner_radius must be smaller than outer_radius")
+        raise InvalidInputError("annulus.inner_radius must be smaller than outer_radius")
     hole = disk(inner_radius).points
     return Outline(disk(outer_radius).points, holes=(hole,))
 
@@ -240,10 +240,10 @@ def _csv_points(text: str, name: str) -> list[list[float]]:
                 raise ValueError
             pts.append([float(cells[0]), float(cells[1])])
         except ValueError:
-            raise MechanicsError(f"{name}: line {number} is not 'x,y' (two numbers, "
+            raise InvalidInputError(f"{name}: line {number} is not 'x,y' (two numbers, "
                                  "metres)") from None
         if len(pts) > MAX_OUTLINE_POINTS:
-            raise MechanicsError(f"{name}: more than {MAX_OUTLINE_POINTS} points")
+            raise InvalidInputError(f"{name}: more than {MAX_OUTLINE_POINTS} points")
     return pts
 
 
@@ -259,21 +259,21 @@ def load_outline(path: str | Path) -> Outline:
     try:
         text = read_text(path, what="outline")
     except InputError as exc:
-        raise MechanicsError(str(exc)) from None
+        raise InvalidInputError(str(exc)) from None
     if path.suffix.lower() == ".json":
         try:
             data = json.loads(text)
         except json.JSONDecodeError as exc:
-            raise MechanicsError(f"{name}: invalid JSON at line {exc.lineno}, column "
+            raise InvalidInputError(f"{name}: invalid JSON at line {exc.lineno}, column "
                                  f"{exc.colno}") from None
         if not isinstance(data, dict) or "outline" not in data:
-            raise MechanicsError(f'{name}: JSON outline must be {{"outline": [[x, y], ...]}}')
+            raise InvalidInputError(f'{name}: JSON outline must be {{"outline": [[x, y], ...]}}')
         pts = data["outline"]
         if not isinstance(pts, list) or len(pts) > MAX_OUTLINE_POINTS or not all(
                 isinstance(q, list) and len(q) == 2
                 and all(isinstance(c, (int, float)) and not isinstance(c, bool) for c in q)
                 for q in pts):
-            raise MechanicsError(f"{name}: 'outline' must be a list of at most "
+            raise InvalidInputError(f"{name}: 'outline' must be a list of at most "
                                  f"{MAX_OUTLINE_POINTS} [x, y] number pairs")
     else:
         pts = _csv_points(text, name)
@@ -281,7 +281,9 @@ def load_outline(path: str | Path) -> Outline:
     return Outline(p, corners=_turning_corners(p))
 
 
-def resample(outline_points: np.ndarray, spacing: float, corners: np.ndarray | None = None) -> np.ndarray:
+def resample(
+    outline_points: np.ndarray, spacing: float, corners: np.ndarray | None = None
+) -> np.ndarray:
     """Evenly spaced vertices (about ``spacing`` m apart) along a closed polyline.
 
     Vertices listed in ``corners`` (and sharp turns) are kept exactly; each piece between two
@@ -304,11 +306,11 @@ def resample(outline_points: np.ndarray, spacing: float, corners: np.ndarray | N
     y = np.interp(t, s, closed[:, 1])
     out = np.column_stack([x, y])
     if len(out) < 3:
-        raise MechanicsError(f"spacing {spacing} m is too coarse for this outline")
+        raise InvalidInputError(f"spacing {spacing} m is too coarse for this outline")
     return out
 
 
 def _positive(**values: float) -> None:
     for name, value in values.items():
         if not (np.isfinite(value) and value > 0):
-            raise MechanicsError(f"{name} must be a positive length in m, got {value}")
+            raise InvalidInputError(f"{name} must be a positive length in m, got {value}")

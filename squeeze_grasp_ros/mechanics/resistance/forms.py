@@ -1,6 +1,7 @@
 # Copyright 2026 squeeze_grasp_ros developers
 # SPDX-License-Identifier: Apache-2.0
-"""The closed forms of the fixed-contact resistance (paper Sec. 6.1-6.2, App. D), pure linear algebra.
+"""The closed forms of the fixed-contact resistance (paper Sec. 6.1-6.2, App. D), pure linear
+algebra.
 
 Given the finger stiffness G = P^T C P (6 x 6) of the contact sets I, J, K of F1, F2, A, the
 grasping fingers' work is W_F = 1/2 (d1, d2, 0)^T G (d1, d2, a) (eqs. 53, 94).
@@ -21,7 +22,7 @@ from typing import Sequence
 
 import numpy as np
 
-from squeeze_grasp_ros.mechanics.errors import MechanicsError
+from squeeze_grasp_ros.mechanics.errors import InvalidInputError
 
 RANK_TOL = 1e-9
 """Singular values of Q (at most 1, U is orthonormal) below this count as zero."""
@@ -43,7 +44,9 @@ def expansion_matrix(counts: Sequence[int]) -> np.ndarray:
 
 
 def null_basis(M: np.ndarray, rtol: float = 1e-10) -> np.ndarray:
-    """Orthonormal basis (columns) of null(M) from the SVD, singular values below rtol*max dropped."""
+    """Orthonormal basis (columns) of null(M) from the SVD, singular values below rtol*max
+    dropped.
+    """
     _, s, Vt = np.linalg.svd(M)
     rank = int(np.count_nonzero(s > rtol * max(s.max(initial=0.0), 1e-300)))
     return Vt[rank:].T
@@ -124,7 +127,7 @@ def stable_form(G: np.ndarray, counts: Sequence[int], centroids: np.ndarray) -> 
 
     Raises
     ------
-    MechanicsError
+    InvalidInputError
         If p = q: the direction t of eq. (59) is undefined.
     """
     nI, nJ, nK = (float(c) for c in counts)
@@ -137,7 +140,8 @@ def stable_form(G: np.ndarray, counts: Sequence[int], centroids: np.ndarray) -> 
     p, q, r = np.asarray(centroids, float)
     dist = float(np.linalg.norm(p - q))
     if dist <= 1e-12 * max(float(np.abs(centroids).max()), 1e-300):
-        raise MechanicsError("contact centroids of F1 and F2 coincide: no stable resistance line")
+        raise InvalidInputError("contact centroids of F1 and F2 coincide: no stable resistance "
+                                "line")
     t = (p - q) / dist
     H = S.T @ G @ S
     return StableForm(H=0.5 * (H + H.T), c_map=S.T @ G @ c_side, omega_map=0.5 * (omega + omega.T),

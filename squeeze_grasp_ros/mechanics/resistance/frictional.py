@@ -3,7 +3,8 @@
 """Resistance under frictional segment contacts (paper Sec. 6.3, Algorithm 2).
 
 A loop over the incremental stepper (:func:`~.stepper.advance`) with three fingertips. It
-starts from a squeeze computed by the event-driven squeeze (:func:`~.squeeze_events.event_squeeze`);
+starts from a squeeze computed by the event-driven squeeze
+(:func:`~.squeeze_events.event_squeeze`);
 the adversary A (a rounded tip of its own radius) then touches the *deformed* boundary at its
 contact node on the deformed outward normal, with zero force and its mode decided along its
 first motion. At every stage, with the current contact sets I, J, K:
@@ -24,6 +25,7 @@ slips: failure), as in Algorithm 2 and Sec. 6.3. Only the directions of a stage 
 linearised Sec. 6.2 model; the motion, events, forces and work are the stepper's. SI units at
 the interface, object frame.
 """
+
 from __future__ import annotations
 
 from collections.abc import Sequence
@@ -32,12 +34,19 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from squeeze_grasp_ros.mechanics.squeeze.contact_model import ContactModel
-from squeeze_grasp_ros.mechanics.squeeze.contact_state import EVENT_TYPES, ContactState, Event, initial_state
-from squeeze_grasp_ros.mechanics.errors import MechanicsError, require_finite
+from squeeze_grasp_ros.mechanics.squeeze.contact_state import ContactState, Event, initial_state
+from squeeze_grasp_ros.mechanics.errors import InvalidInputError, require_finite
 from squeeze_grasp_ros.mechanics.squeeze.fingertips import Fingertip
 from squeeze_grasp_ros.mechanics.elastic.mesh import vertex_normals
-from squeeze_grasp_ros.mechanics.resistance.optimal import FINGERS, ResistanceMode, optimal_resistance, resistance_grasp
+from squeeze_grasp_ros.mechanics.resistance.optimal import optimal_resistance, resistance_grasp
 from squeeze_grasp_ros.mechanics.squeeze.stepper import advance
+from squeeze_grasp_ros.mechanics.vocabulary import (
+    ContactMode,
+    EventType,
+    Finger,
+    SqueezeKind,
+    Termination,
+)
 
 MAX_STALLED_CALLS = 3
 """Stepper calls in a row without progress or events after which the loop stops with an error."""
@@ -67,10 +76,13 @@ class ResistanceStage:
 
     def to_json(self) -> dict:
         """``{"start", "end", "psi": {"F1", "F2"}, "segments", "events"}``."""
-        return {"start": self.start, "end": self.end,
-                "psi": {"F1": self.psi[:2].tolist(), "F2": self.psi[2:].tolist()},
-                "segments": {f: list(v) for f, v in self.segments.items()},
-                "events": [e.type for e in self.events]}
+        return {
+            "start": self.start,
+            "end": self.end,
+            "psi": {"F1": self.psi[:2].tolist(), "F2": self.psi[2:].tolist()},
+            "segments": {f: list(v) for f, v in self.segments.items()},
+            "events": [e.type for e in self.events],
+        }
 
 
 @dataclass(frozen=True)
@@ -137,7 +149,7 @@ class FrictionalResistance:
     @property
     def event_counts(self) -> dict:
         """{"A": n, "B": n, "C": n, "D": n} during the resistance."""
-        return {t: sum(1 for e in self.events if e.type == t) for t in EVENT_TYPES}
+        return {t: sum(1 for e in self.events if e.type == t) for t in EventType.values()}
 
     def to_json(self) -> dict:
         """JSON-able dict with the keys of the fixed-contact resistance plus trajectories."""
@@ -147,8 +159,13 @@ class FrictionalResistance:
             "mode": self.mode,
             "contact_model": "friction",
             "contacts": list(self.contacts),
-            "segments": {f: [{"node": c.node, "mode": c.mode, "force": c.force.tolist()}
-                             for c in self.state.segment(f)] for f in FINGERS},
+            "segments": {
+                f: [
+                    {"node": c.node, "mode": c.mode, "force": c.force.tolist()}
+                    for c in self.state.segment(f)
+                ]
+                for f in tuple(Finger)
+            },
             "a": self.a.tolist(),
             "travelled": self.travelled,
             "d1": self.d1.tolist(),
@@ -158,15 +175,18 @@ class FrictionalResistance:
             "forces_start": {f: v[0].tolist() for f, v in self.forces.items()},
             "force_along": {f: {"start": v[0], "end": v[1]} for f, v in self.force_along.items()},
             "trajectories": {f: v.tolist() for f, v in self.trajectories.items()},
-            "events": [{**e.to_json(), "travel": t} for e, t in zip(self.events, self.event_travel)],
+            "events": [
+                {**e.to_json(), "travel": t} for e, t in zip(self.events, self.event_travel)
+            ],
             "event_counts": self.event_counts,
             "stages": [s.to_json() for s in self.stages],
             "diagnostics": dict(self.diagnostics),
         }
 
 
-def add_adversary(state: ContactState, model: ContactModel, displacement: np.ndarray,
-                  node: int, radius: float) -> ContactState:
+def add_adversary(
+    state: ContactState, model: ContactModel, displacement: np.ndarray, node: int, radius: float
+) -> ContactState:
     """``state`` with the adversary tip touching boundary ``node`` of the deformed object.
 
     Parameters
@@ -188,30 +208,40 @@ def add_adversary(state: ContactState, model: ContactModel, displacement: np.nda
         along its first motion) and ``relative_per_depth`` = 0 (the motion is not a squeeze).
     """
     if not (np.isfinite(radius) and radius > 0):
-        raise MechanicsError(f"adversary.tip_radius must be > 0 m for frictional contact, got {radius}")
+        raise InvalidInputError(
+            f"adversary.tip_radius must be > 0 m for frictional contact, got {radius}"
+        )
     if any(c.node == node for c in state.contacts):
-        raise MechanicsError(f"the adversary's node {node} already touches F1 or F2")
+        raise InvalidInputError(f"the adversary's node {node} already touches F1 or F2")
     mesh = model.obj.mesh
     loop = mesh.boundary
     deformed = mesh.nodes[loop] + displacement[loop]
     k = mesh.boundary_position(int(node))
     n = vertex_normals(deformed)[k]
-    tip = Fingertip("A", int(node), deformed[k] + radius * n, float(radius),
-                    float(np.arctan2(-n[1], -n[0])))
+    tip = Fingertip(
+        "A", int(node), deformed[k] + radius * n, float(radius), float(np.arctan2(-n[1], -n[0]))
+    )
     touch = initial_state([tip])
     contact = replace(touch.contacts[0], displacement=np.asarray(displacement[node], float))
-    return replace(state, fingers=state.fingers + touch.fingers,
-                   contacts=tuple(sorted(state.contacts + (contact,), key=lambda c: c.node)),
-                   relative_per_depth=0.0,
-                   undetermined=tuple(sorted(state.undetermined + touch.undetermined)),
-                   fresh=state.fresh + touch.fresh)
+    return replace(
+        state,
+        fingers=state.fingers + touch.fingers,
+        contacts=tuple(sorted(state.contacts + (contact,), key=lambda c: c.node)),
+        relative_per_depth=0.0,
+        undetermined=tuple(sorted(state.undetermined + touch.undetermined)),
+        fresh=state.fresh + touch.fresh,
+    )
 
 
 def slipping_fingers(state: ContactState) -> list[str]:
     """Fingers whose contact nodes all slide the same way (Sec. 5.1)."""
     out = []
     for f in state.fingers:
-        signs = {c.slip if c.mode == "slip" else 0 for c in state.contacts if c.finger == f.name}
+        signs = {
+            c.slip if c.mode == ContactMode.SLIP else 0
+            for c in state.contacts
+            if c.finger == f.name
+        }
         if len(signs) == 1 and 0 not in signs:
             out.append(f.name)
     return out
@@ -219,19 +249,21 @@ def slipping_fingers(state: ContactState) -> list[str]:
 
 def _lost_finger(state: ContactState) -> str:
     """The finger whose last contact lost its normal force (after a contact_lost termination)."""
-    pressing = {f.name: sum(c.normal_force() for c in state.contacts if c.finger == f.name)
-                for f in state.fingers}
+    pressing = {
+        f.name: sum(c.normal_force() for c in state.contacts if c.finger == f.name)
+        for f in state.fingers
+    }
     return min(pressing, key=pressing.get)
 
 
 def _outcome(termination: str | None, state: ContactState) -> tuple[bool, str] | None:
     """(success, reason) if the stepper's termination ends Algorithm 2, else None."""
-    if termination == "finger_slip":
+    if termination == Termination.FINGER_SLIP:
         slipping = slipping_fingers(state)
         if "A" in slipping:
             return True, "adversary slips"
         return False, f"{slipping[0] if slipping else 'a grasping finger'} slips"
-    if termination == "contact_lost":
+    if termination == Termination.CONTACT_LOST:
         finger = _lost_finger(state)
         return finger == "A", f"{finger} lost contact"
     if termination is not None:
@@ -239,10 +271,15 @@ def _outcome(termination: str | None, state: ContactState) -> tuple[bool, str] |
     return None
 
 
-def frictional_resistance(model: ContactModel, state: ContactState, a,
-                          mode: ResistanceMode = "stable", step: float = 1e-3,
-                          event_tol: float = 1e-9,
-                          contacts: Sequence[int] | None = None) -> FrictionalResistance:
+def frictional_resistance(
+    model: ContactModel,
+    state: ContactState,
+    a,
+    *, mode: SqueezeKind = SqueezeKind.STABLE,
+    step: float = 1e-3,
+    event_tol: float = 1e-9,
+    contacts: Sequence[int] | None = None,
+) -> FrictionalResistance:
     """Algorithm 2: F1 and F2 resist A's translation ``a`` from ``state`` (with A touching).
 
     Parameters
@@ -263,77 +300,128 @@ def frictional_resistance(model: ContactModel, state: ContactState, a,
 
     Raises
     ------
-    MechanicsError
+    InvalidInputError
         If the state has no finger A, a is zero, the stepper fails or the loop stalls.
     """
     a = np.asarray(a, float).reshape(-1)
     require_finite("adversary translation a", a)
     length = float(np.linalg.norm(a))
     if a.shape != (2,) or not length > 0:
-        raise MechanicsError(f"adversary translation a must be a nonzero [x, y] in m, got {a.tolist()}")
-    if [f.name for f in state.fingers] != list(FINGERS):
-        raise MechanicsError(f"the state needs fingers {list(FINGERS)}, has "
-                             f"{[f.name for f in state.fingers]}")
+        raise InvalidInputError(
+            f"adversary translation a must be a nonzero [x, y] in m, got {a.tolist()}"
+        )
+    if [f.name for f in state.fingers] != list(tuple(Finger)):
+        raise InvalidInputError(
+            f"the state needs fingers {list(tuple(Finger))}, has {[f.name for f in state.fingers]}"
+        )
     a_hat = a / length
     start_state = state
     if contacts is None:
-        contacts = [state.segment(f)[0].node for f in FINGERS]
+        contacts = [state.segment(f)[0].node for f in tuple(Finger)]
     contacts = [int(c) for c in contacts]
     travelled, stalled = 0.0, 0
     stages, events, travel = [], [], []
-    path = {f: [np.zeros(2)] for f in FINGERS}
+    path = {f: [np.zeros(2)] for f in tuple(Finger)}
     diag = {"advance_calls": 0, "stage_reduced_condition_max": 1.0}
     outcome = None
     while outcome is None:
-        segments = {f: tuple(c.node for c in state.segment(f)) for f in FINGERS}
-        stage = optimal_resistance(resistance_grasp(model.obj, segments), a_hat, mode)
+        segments = {f: tuple(c.node for c in state.segment(f)) for f in tuple(Finger)}
+        stage = optimal_resistance(resistance_grasp(model.obj, segments), a_hat, mode=mode)
         if not stage.success:
             outcome = (False, stage.reason)
             break
-        diag["stage_reduced_condition_max"] = max(diag["stage_reduced_condition_max"],
-                                                  stage.diagnostics["reduced_condition"])
+        diag["stage_reduced_condition_max"] = max(
+            diag["stage_reduced_condition_max"], stage.diagnostics["reduced_condition"]
+        )
         remaining = length - travelled
         moves = {"F1": remaining * stage.d1, "F2": remaining * stage.d2, "A": remaining * a_hat}
         depth0 = state.depth
         rate = float(np.linalg.norm(np.concatenate(list(moves.values()))))
-        result = advance(model, state, moves, step, event_tol, stop_on_event=True,
-                         terminate_on=("finger_slip",))
+        result = advance(
+            model,
+            state,
+            moves,
+            step,
+            event_tol,
+            stop_on_event=True,
+            terminate_on=(Termination.FINGER_SLIP,),
+        )
         diag["advance_calls"] += 1
         state = result.state
         start = travelled
         travelled += result.fraction * remaining
         travel += [start + (e.depth - depth0) / rate * remaining for e in result.events]
         events += result.events
-        stages.append(ResistanceStage(start, travelled, np.concatenate([stage.d1, stage.d2]),
-                                      segments, result.events))
-        for f in FINGERS:
+        stages.append(
+            ResistanceStage(
+                start, travelled, np.concatenate([stage.d1, stage.d2]), segments, result.events
+            )
+        )
+        for f in tuple(Finger):
             path[f].append(state.finger(f).translation - start_state.finger(f).translation)
         outcome = _outcome(result.termination, state)
         if outcome is None and result.fraction >= 1.0:
             outcome = (True, "adversary completed a")
         stalled = stalled + 1 if result.fraction == 0 and not result.events else 0
         if outcome is None and stalled >= MAX_STALLED_CALLS:
-            raise MechanicsError(f"the resistance stalled after A travelled {travelled:.6g} m")
-    return _summary(outcome, mode, contacts, a, travelled, start_state, state, events, travel,
-                    stages, path, diag)
+            raise InvalidInputError(f"the resistance stalled after A travelled {travelled:.6g} m")
+    return _summary(
+        outcome,
+        mode,
+        contacts,
+        a,
+        travelled,
+        start_state,
+        state,
+        events,
+        travel,
+        stages,
+        path,
+        diag,
+    )
 
 
-def _summary(outcome: tuple[bool, str], mode: str, contacts: list, a: np.ndarray,
-             travelled: float, start: ContactState, end: ContactState, events: list,
-             travel: list, stages: list, path: dict, diag: dict) -> FrictionalResistance:
-    moved = {f: end.finger(f).translation - start.finger(f).translation for f in FINGERS}
-    work = {f: end.finger(f).work - start.finger(f).work for f in FINGERS}
-    work["total"] = work["F1"] + work["F2"]
-    forces = {f: (start.finger_force(f), end.finger_force(f)) for f in FINGERS}
+def _summary(
+    outcome: tuple[bool, str],
+    mode: str,
+    contacts: list,
+    a: np.ndarray,
+    travelled: float,
+    start: ContactState,
+    end: ContactState,
+    events: list,
+    travel: list,
+    stages: list,
+    path: dict,
+    diag: dict,
+) -> FrictionalResistance:
+    moved = {f: end.finger(f).translation - start.finger(f).translation for f in tuple(Finger)}
+    work = {f: end.finger(f).work - start.finger(f).work for f in tuple(Finger)}
+    work["total"] = work[Finger.F1] + work[Finger.F2]
+    forces = {f: (start.finger_force(f), end.finger_force(f)) for f in tuple(Finger)}
     along = {}
-    for f in FINGERS:
+    for f in tuple(Finger):
         d = a if f == "A" else moved[f]
         unit = d / max(float(np.linalg.norm(d)), 1e-300)
         along[f] = (float(forces[f][0] @ unit), float(forces[f][1] @ unit))
     success, reason = outcome
     return FrictionalResistance(
-        success=success, reason=reason, mode=mode, contacts=contacts, a=a, travelled=travelled,
-        d1=moved["F1"], d2=moved["F2"], work=work, forces=forces, force_along=along,
-        trajectories={f: np.array(v) for f, v in path.items()}, events=tuple(events),
-        event_travel=tuple(travel), stages=tuple(stages), state=end, start_state=start,
-        diagnostics=diag)
+        success=success,
+        reason=reason,
+        mode=mode,
+        contacts=contacts,
+        a=a,
+        travelled=travelled,
+        d1=moved[Finger.F1],
+        d2=moved[Finger.F2],
+        work=work,
+        forces=forces,
+        force_along=along,
+        trajectories={f: np.array(v) for f, v in path.items()},
+        events=tuple(events),
+        event_travel=tuple(travel),
+        stages=tuple(stages),
+        state=end,
+        start_state=start,
+        diagnostics=diag,
+    )

@@ -31,25 +31,36 @@ a sweep of adversary directions is one vectorised evaluation. Internals are dime
 (lengths by the object size L, forces by E h L, work by E h L^2); the API is SI. The closed
 forms themselves are in :mod:`.resistance_forms`.
 """
+
 from __future__ import annotations
 
 from dataclasses import dataclass, field, replace
 from functools import cached_property
-from typing import Literal, Mapping, Sequence
+from typing import Mapping, Sequence
 
 import numpy as np
 
 from squeeze_grasp_ros.mechanics.elastic.compliance import ElasticObject
-from squeeze_grasp_ros.mechanics.squeeze.contact_state import EVENT_TYPES
-from squeeze_grasp_ros.mechanics.errors import MechanicsError, require_finite
-from squeeze_grasp_ros.mechanics.squeeze.fingertips import FINGER_NAMES as FINGERS
-from squeeze_grasp_ros.mechanics.elastic.mesh import Mesh
-from squeeze_grasp_ros.mechanics.elastic.reduced import ReducedStiffness, reduced_stiffness, rotation_angle
-from squeeze_grasp_ros.mechanics.resistance.forms import (PureForm, StableForm, expansion_matrix, null_basis, perp,
-                               pure_form, stable_form)
 
-ResistanceMode = Literal["stable", "pure"]
-MODES: tuple[str, ...] = ("stable", "pure")
+from squeeze_grasp_ros.mechanics.errors import InvalidInputError, require_finite
+
+from squeeze_grasp_ros.mechanics.elastic.mesh import Mesh
+from squeeze_grasp_ros.mechanics.elastic.reduced import (
+    ReducedStiffness,
+    reduced_stiffness,
+    rotation_angle,
+)
+from squeeze_grasp_ros.mechanics.resistance.forms import (
+    PureForm,
+    StableForm,
+    expansion_matrix,
+    null_basis,
+    perp,
+    pure_form,
+    stable_form,
+)
+from squeeze_grasp_ros.mechanics.vocabulary import ContactMode, EventType, Finger, SqueezeKind
+
 FEASIBILITY_TOL = 1e-7
 """Relative constraint residual above which a resistance is reported as infeasible."""
 
@@ -88,17 +99,17 @@ class ResistanceGrasp:
     @property
     def counts(self) -> np.ndarray:
         """|I|, |J|, |K| (3,) int."""
-        return np.array([len(self.segments[f]) for f in FINGERS])
+        return np.array([len(self.segments[f]) for f in tuple(Finger)])
 
     @property
     def kind(self) -> str:
-        """"point" if every finger touches one node, else "segment"."""
+        """Contact kind: "point" if every finger touches one node, else "segment"."""
         return "point" if np.all(self.counts == 1) else "segment"
 
     @property
     def contacts(self) -> list[int]:
         """Initial contact nodes [i, j, k] of F1, F2, A."""
-        return [int(self.segments[f][0]) for f in FINGERS]
+        return [int(self.segments[f][0]) for f in tuple(Finger)]
 
     @property
     def centroids(self) -> np.ndarray:
@@ -119,9 +130,11 @@ class ResistanceGrasp:
 
     def form(self, mode: str) -> StableForm | PureForm:
         """The :class:`StableForm` or :class:`PureForm` of ``mode``."""
-        if mode not in MODES:
-            raise MechanicsError(f"resistance mode must be one of {list(MODES)}, got {mode!r}")
-        return self.stable if mode == "stable" else self.pure
+        if mode not in SqueezeKind.values():
+            raise InvalidInputError(
+                f"resistance mode must be one of {list(SqueezeKind.values())}, got {mode!r}"
+            )
+        return self.stable if mode == SqueezeKind.STABLE else self.pure
 
 
 def resistance_grasp(obj: ElasticObject, segments: Mapping[str, Sequence[int]]) -> ResistanceGrasp:
@@ -137,32 +150,36 @@ def resistance_grasp(obj: ElasticObject, segments: Mapping[str, Sequence[int]]) 
 
     Raises
     ------
-    MechanicsError
+    InvalidInputError
         For missing or unknown fingers, empty or overlapping sets, or nodes off the boundary.
     """
-    if set(segments) != set(FINGERS):
-        raise MechanicsError(f"segments must have exactly the keys {list(FINGERS)}, "
-                             f"got {sorted(segments)}")
-    sets = {f: np.asarray(segments[f], dtype=int).reshape(-1) for f in FINGERS}
-    empty = [f for f in FINGERS if len(sets[f]) == 0]
+    if set(segments) != set(tuple(Finger)):
+        raise InvalidInputError(
+            f"segments must have exactly the keys {list(tuple(Finger))}, got {sorted(segments)}"
+        )
+    sets = {f: np.asarray(segments[f], dtype=int).reshape(-1) for f in tuple(Finger)}
+    empty = [f for f in tuple(Finger) if len(sets[f]) == 0]
     if empty:
-        raise MechanicsError(f"contact set of {empty[0]} is empty")
-    nodes = np.concatenate([sets[f] for f in FINGERS])
+        raise InvalidInputError(f"contact set of {empty[0]} is empty")
+    nodes = np.concatenate([sets[f] for f in tuple(Finger)])
     if len(np.unique(nodes)) != len(nodes):
-        listed = {f: sets[f].tolist() for f in FINGERS}
-        raise MechanicsError(f"contact sets of F1, F2 and A must be disjoint, got {listed}")
+        listed = {f: sets[f].tolist() for f in tuple(Finger)}
+        raise InvalidInputError(f"contact sets of F1, F2 and A must be disjoint, got {listed}")
     off = nodes[obj.boundary_positions(nodes) < 0]
     if len(off):
-        raise MechanicsError(f"contact nodes must lie on the outer boundary, got {off.tolist()}")
+        raise InvalidInputError(
+            f"contact nodes must lie on the outer boundary, got {off.tolist()}"
+        )
     red = reduced_stiffness(obj, nodes)
-    P = expansion_matrix([len(sets[f]) for f in FINGERS])
+    P = expansion_matrix([len(sets[f]) for f in tuple(Finger)])
     G = P.T @ (red.C / obj.material.force_scale) @ P
     L = obj.scale
     return ResistanceGrasp(obj, sets, red, 0.5 * (G + G.T), obj.mesh.nodes[nodes] / L, L)
 
 
-def contact_segments(mesh: Mesh, contacts: Sequence[int],
-                     half_width: float | None = None) -> list[np.ndarray]:
+def contact_segments(
+    mesh: Mesh, contacts: Sequence[int], half_width: float | None = None
+) -> list[np.ndarray]:
     """Fixed contact segments around initial contact nodes (Sec. 6.2).
 
     Parameters
@@ -185,7 +202,7 @@ def contact_segments(mesh: Mesh, contacts: Sequence[int],
     s = np.concatenate([[0.0], np.cumsum(edge)[:-1]])
     perimeter = float(edge.sum())
     if half_width is not None and not (np.isfinite(half_width) and half_width >= 0):
-        raise MechanicsError(f"segment half width must be >= 0 m, got {half_width}")
+        raise InvalidInputError(f"segment half width must be >= 0 m, got {half_width}")
     out = []
     for c in contacts:
         k = mesh.boundary_position(int(c))
@@ -248,13 +265,15 @@ class Resistance:
     a: np.ndarray
     d1: np.ndarray | None = None
     d2: np.ndarray | None = None
-    work: dict = field(default_factory=lambda: {k: None for k in ("F1", "F2", "A", "total")})
-    forces: dict = field(default_factory=lambda: {f: None for f in FINGERS})
+    work: dict = field(
+        default_factory=lambda: {k: None for k in (Finger.F1, Finger.F2, "A", "total")}
+    )
+    forces: dict = field(default_factory=lambda: {f: None for f in tuple(Finger)})
     node_forces: np.ndarray | None = None
     energy: float | None = None
     rigid_rotation: float | None = None
     unit_work: float | None = None
-    event_counts: dict = field(default_factory=lambda: dict.fromkeys(EVENT_TYPES, 0))
+    event_counts: dict = field(default_factory=lambda: dict.fromkeys(EventType.values(), 0))
     diagnostics: dict = field(default_factory=dict)
 
     def psi(self) -> tuple[np.ndarray, np.ndarray] | None:
@@ -266,15 +285,20 @@ class Resistance:
 
     def to_json(self) -> dict:
         """JSON-able dict (SI); missing quantities are null."""
+
         def vec(v):
             return None if v is None else [float(x) for x in v]
 
         per_node = None
         if self.node_forces is not None:
-            bounds = np.cumsum([0] + [len(self.segments[f]) for f in FINGERS])
-            per_node = {f: [{"node": int(n), "mode": "stick", "force": vec(fv)}
-                            for n, fv in zip(self.segments[f], self.node_forces[lo:hi])]
-                        for f, lo, hi in zip(FINGERS, bounds[:-1], bounds[1:])}
+            bounds = np.cumsum([0] + [len(self.segments[f]) for f in tuple(Finger)])
+            per_node = {
+                f: [
+                    {"node": int(n), "mode": ContactMode.STICK, "force": vec(fv)}
+                    for n, fv in zip(self.segments[f], self.node_forces[lo:hi])
+                ]
+                for f, lo, hi in zip(tuple(Finger), bounds[:-1], bounds[1:])
+            }
         psi = self.psi()
         return {
             "success": self.success,
@@ -282,7 +306,8 @@ class Resistance:
             "mode": self.mode,
             "contact_model": self.contact_model,
             "contacts": list(self.contacts),
-            "segments": per_node or {f: [{"node": int(n)} for n in self.segments[f]] for f in FINGERS},
+            "segments": per_node
+            or {f: [{"node": int(n)} for n in self.segments[f]] for f in tuple(Finger)},
             "a": vec(self.a),
             "d1": vec(self.d1),
             "d2": vec(self.d2),
@@ -300,32 +325,39 @@ class Resistance:
 def _translation(a, name: str = "adversary translation a") -> np.ndarray:
     a = np.asarray(a, dtype=float).reshape(-1)
     if a.shape != (2,):
-        raise MechanicsError(f"{name} must be [x, y] in m, got shape {a.shape}")
+        raise InvalidInputError(f"{name} must be [x, y] in m, got shape {a.shape}")
     require_finite(name, a)
     if not np.linalg.norm(a) > 0:
-        raise MechanicsError(f"{name} must be nonzero")
+        raise InvalidInputError(f"{name} must be nonzero")
     return a
 
 
-def _unresisted(grasp: ResistanceGrasp, mode: str, a: np.ndarray, reason: str,
-                diagnostics: dict) -> Resistance:
-    segments = {f: grasp.segments[f].tolist() for f in FINGERS}
-    return Resistance(mode, grasp.kind, False, reason, grasp.contacts, segments, a,
-                      diagnostics=diagnostics)
+def _unresisted(
+    grasp: ResistanceGrasp, mode: str, a: np.ndarray, reason: str, diagnostics: dict
+) -> Resistance:
+    segments = {f: grasp.segments[f].tolist() for f in tuple(Finger)}
+    return Resistance(
+        mode, grasp.kind, False, reason, grasp.contacts, segments, a, diagnostics=diagnostics
+    )
 
 
 def _pure_diagnostics(form: PureForm, a_hat: np.ndarray) -> dict:
-    return {"rank_Q": form.rank, "Q_singular_values": form.singular_values.tolist(),
-            "outside_col_Q": float(form.outside(a_hat[None])[0]),
-            "hessian_condition": form.hessian_condition}
+    return {
+        "rank_Q": form.rank,
+        "Q_singular_values": form.singular_values.tolist(),
+        "outside_col_Q": float(form.outside(a_hat[None])[0]),
+        "hessian_condition": form.hessian_condition,
+    }
 
 
 def _cannot_resist(grasp: ResistanceGrasp, a: np.ndarray) -> Resistance:
     form = grasp.pure
     a_hat = a / grasp.scale
-    reason = (f"cannot be resisted: rank Q = {form.rank} and a is not in col(Q), so no pure "
-              "contact displacement moves A by a (Sec. 6.1.2)")
-    return _unresisted(grasp, "pure", a, reason, _pure_diagnostics(form, a_hat))
+    reason = (
+        f"cannot be resisted: rank Q = {form.rank} and a is not in col(Q), so no pure "
+        "contact displacement moves A by a (Sec. 6.1.2)"
+    )
+    return _unresisted(grasp, SqueezeKind.PURE, a, reason, _pure_diagnostics(form, a_hat))
 
 
 def finger_work(G: np.ndarray, x: np.ndarray, a: np.ndarray) -> np.ndarray:
@@ -334,8 +366,9 @@ def finger_work(G: np.ndarray, x: np.ndarray, a: np.ndarray) -> np.ndarray:
     return 0.5 * (x6 * (x6 @ G)).reshape(-1, 3, 2).sum(axis=2)
 
 
-def optimum_batch(grasp: ResistanceGrasp, mode: ResistanceMode,
-                  a_hat: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def optimum_batch(
+    grasp: ResistanceGrasp, mode: SqueezeKind, a_hat: np.ndarray
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Optimal (d1, d2) for many dimensionless adversary translations at once.
 
     Parameters
@@ -364,8 +397,14 @@ def optimum_batch(grasp: ResistanceGrasp, mode: ResistanceMode,
     return x, work, form.outside(a_hat) <= FEASIBILITY_TOL
 
 
-def evaluate_resistance(grasp: ResistanceGrasp, d1, d2, a, mode: ResistanceMode = "stable",
-                        reason: str = "user-given resistance") -> Resistance:
+def evaluate_resistance(
+    grasp: ResistanceGrasp,
+    d1,
+    d2,
+    a,
+    mode: SqueezeKind = SqueezeKind.STABLE,
+    reason: str = "user-given resistance",
+) -> Resistance:
     """Forces, work and constraint residuals of a given resistance (d1, d2) to a, all in m.
 
     ``success`` is False (the residual is in ``reason``) when (d1, d2, a) violates the mode's
@@ -390,8 +429,10 @@ def evaluate_resistance(grasp: ResistanceGrasp, d1, d2, a, mode: ResistanceMode 
     delta = P @ x
     node_forces = red.forces(delta).reshape(-1, 2)
     resultant = (P.T @ node_forces.reshape(-1)).reshape(3, 2)
-    work = {f: 0.5 * float(x[2 * k:2 * k + 2] @ resultant[k]) for k, f in enumerate(FINGERS)}
-    work["total"] = work["F1"] + work["F2"]
+    work = {
+        f: 0.5 * float(x[2 * k : 2 * k + 2] @ resultant[k]) for k, f in enumerate(tuple(Finger))
+    }
+    work["total"] = work[Finger.F1] + work[Finger.F2]
     g = red.rigid_coefficients(delta)
     pts = grasp.points - grasp.points.mean(axis=0)
     dl = delta.reshape(-1, 2)
@@ -404,8 +445,11 @@ def evaluate_resistance(grasp: ResistanceGrasp, d1, d2, a, mode: ResistanceMode 
         "force_residual": float(np.linalg.norm(node_forces.sum(axis=0))) / f_size,
         "moment_residual": abs(float(np.sum(perp(pts) * node_forces))) / f_size,
         "reduced_condition": red.condition,
-        "pulling": [f for k, f in enumerate(FINGERS)
-                    if resultant[k] @ obj.mesh.normal_at(grasp.contacts[k]) > 0],
+        "pulling": [
+            f
+            for k, f in enumerate(tuple(Finger))
+            if resultant[k] @ obj.mesh.normal_at(grasp.contacts[k]) > 0
+        ],
     }
     if isinstance(form, StableForm):
         violation = max(diagnostics["sum_delta_residual"], diagnostics["moment_delta_residual"])
@@ -415,18 +459,33 @@ def evaluate_resistance(grasp: ResistanceGrasp, d1, d2, a, mode: ResistanceMode 
         diagnostics.update(_pure_diagnostics(form, a / grasp.scale))
     success = violation <= FEASIBILITY_TOL
     if not success:
-        reason = (f"{reason} is not a {mode} resistance: constraint residual {violation:.3g} > "
-                  f"{FEASIBILITY_TOL:g}")
+        reason = (
+            f"{reason} is not a {mode} resistance: constraint residual {violation:.3g} > "
+            f"{FEASIBILITY_TOL:g}"
+        )
     return Resistance(
-        mode=mode, contact_model=grasp.kind, success=success, reason=reason,
-        contacts=grasp.contacts, segments={f: grasp.segments[f].tolist() for f in FINGERS},
-        a=a, d1=x[:2], d2=x[2:4], work=work,
-        forces={f: resultant[k] for k, f in enumerate(FINGERS)}, node_forces=node_forces,
-        energy=red.energy(delta), rigid_rotation=rotation_angle(obj, g),
-        unit_work=work["total"] / float(a @ a), diagnostics=diagnostics)
+        mode=mode,
+        contact_model=grasp.kind,
+        success=success,
+        reason=reason,
+        contacts=grasp.contacts,
+        segments={f: grasp.segments[f].tolist() for f in tuple(Finger)},
+        a=a,
+        d1=x[:2],
+        d2=x[2:4],
+        work=work,
+        forces={f: resultant[k] for k, f in enumerate(tuple(Finger))},
+        node_forces=node_forces,
+        energy=red.energy(delta),
+        rigid_rotation=rotation_angle(obj, g),
+        unit_work=work["total"] / float(a @ a),
+        diagnostics=diagnostics,
+    )
 
 
-def optimal_resistance(grasp: ResistanceGrasp, a, mode: ResistanceMode = "stable") -> Resistance:
+def optimal_resistance(
+    grasp: ResistanceGrasp, a, *, mode: SqueezeKind = SqueezeKind.STABLE
+) -> Resistance:
     """The resistance (d1, d2) minimising the grasping fingers' work W_F (Sec. 6.1-6.2).
 
     Parameters
@@ -444,6 +503,20 @@ def optimal_resistance(grasp: ResistanceGrasp, a, mode: ResistanceMode = "stable
         ``success`` False with a "cannot be resisted" reason when no pure resistance exists.
         Diagnostics as in :func:`evaluate_resistance`, plus ``work_identity_residual``: the
         closed-form W*_F against the work of the assembled forces, relative.
+
+    Examples
+    --------
+    >>> from squeeze_grasp_ros.mechanics.elastic import shapes
+    >>> from squeeze_grasp_ros.api import ElasticObject, Material, generate_mesh
+    >>> mesh = generate_mesh(shapes.disk(0.05), 2e-4)
+    >>> obj = ElasticObject(mesh, Material(E=1e5, nu=0.3, thickness=0.01))
+    >>> b = [int(k) for k in mesh.boundary]
+    >>> sets = {"F1": [b[0]], "F2": [b[len(b) // 2]], "A": [b[len(b) // 4]]}
+    >>> grasp = resistance_grasp(obj, sets)
+    >>> res = optimal_resistance(grasp, (-0.001, 0.0))
+    >>> w = res.work
+    >>> print(res.mode, res.success, bool(np.isclose(w["total"], w["F1"] + w["F2"])))
+    stable True True
     """
     a = _translation(a)
     form = grasp.form(mode)
@@ -452,15 +525,18 @@ def optimal_resistance(grasp: ResistanceGrasp, a, mode: ResistanceMode = "stable
     if isinstance(form, PureForm) and form.outside(a_hat)[0] > FEASIBILITY_TOL:
         return _cannot_resist(grasp, a)
     x, w, _ = optimum_batch(grasp, mode, a_hat)
-    res = evaluate_resistance(grasp, x[0, :2] * L, x[0, 2:] * L, a, mode,
-                              reason=f"optimal {mode} resistance")
+    res = evaluate_resistance(
+        grasp, x[0, :2] * L, x[0, 2:] * L, a, mode, reason=f"optimal {mode} resistance"
+    )
     closed = float(w[0]) * grasp.obj.material.force_scale * L * L
     scale = max(abs(res.work["total"]), abs(res.energy), 1e-300)
     identity = abs(closed - res.work["total"]) / scale
     return replace(res, diagnostics={**res.diagnostics, "work_identity_residual": identity})
 
 
-def resistance_along(grasp: ResistanceGrasp, a, direction, mode: ResistanceMode = "stable") -> Resistance:
+def resistance_along(
+    grasp: ResistanceGrasp, a, direction, mode: SqueezeKind = SqueezeKind.STABLE
+) -> Resistance:
     """The resistance of ``mode`` to a whose d1 lies on the line of ``direction`` (Table 4).
 
     The feasible resistances to a form a line (stable; pure with rank Q = 2) or a plane; fixing
@@ -493,13 +569,20 @@ def resistance_along(grasp: ResistanceGrasp, a, direction, mode: ResistanceMode 
     rhs = -float(perp(e) @ x0[0, :2])
     if float(np.linalg.norm(coef)) <= 1e-12:
         if abs(rhs) > FEASIBILITY_TOL * max(float(np.linalg.norm(x0)), 1e-300):
-            return _unresisted(grasp, mode, a, f"no {mode} resistance moves F1 along "
-                               f"{e.round(6).tolist()}", {})
+            return _unresisted(
+                grasp, mode, a, f"no {mode} resistance moves F1 along {e.round(6).tolist()}", {}
+            )
         coef = np.zeros_like(coef)
     s = coef * rhs / max(float(coef @ coef), 1e-300)
     x = (x0[0] + Z @ s) * L
-    return evaluate_resistance(grasp, x[:2], x[2:], a, mode,
-                               reason=f"{mode} resistance with d1 along {e.round(6).tolist()}")
+    return evaluate_resistance(
+        grasp,
+        x[:2],
+        x[2:],
+        a,
+        mode,
+        reason=f"{mode} resistance with d1 along {e.round(6).tolist()}",
+    )
 
 
 def compare_resistances(optimum: Resistance, other: Resistance) -> dict:
@@ -543,9 +626,11 @@ class ResistanceSweep:
             return {"min": None, "max": None, "mean": None}
         w = np.where(self.feasible, self.unit_work, np.nan)
         lo, hi = int(np.nanargmin(w)), int(np.nanargmax(w))
-        return {"min": {"angle_deg": float(np.degrees(self.angles[lo])), "unit_work": float(w[lo])},
-                "max": {"angle_deg": float(np.degrees(self.angles[hi])), "unit_work": float(w[hi])},
-                "mean": float(np.nanmean(w))}
+        return {
+            "min": {"angle_deg": float(np.degrees(self.angles[lo])), "unit_work": float(w[lo])},
+            "max": {"angle_deg": float(np.degrees(self.angles[hi])), "unit_work": float(w[hi])},
+            "mean": float(np.nanmean(w)),
+        }
 
     def to_json(self) -> dict:
         """JSON-able dict; infeasible directions carry null work and psi."""
@@ -560,11 +645,12 @@ class ResistanceSweep:
         }
 
 
-def sweep_directions(grasp: ResistanceGrasp, mode: ResistanceMode = "stable",
-                     count: int = 360) -> ResistanceSweep:
+def sweep_directions(
+    grasp: ResistanceGrasp, mode: SqueezeKind = SqueezeKind.STABLE, count: int = 360
+) -> ResistanceSweep:
     """W*_F of a unit push in ``count`` evenly spaced directions, vectorised (eq. 61)."""
     if count < 1:
-        raise MechanicsError(f"number of directions must be >= 1, got {count}")
+        raise InvalidInputError(f"number of directions must be >= 1, got {count}")
     angles = 2.0 * np.pi * np.arange(count) / count
     units = np.column_stack([np.cos(angles), np.sin(angles)])
     x, w, ok = optimum_batch(grasp, mode, units)

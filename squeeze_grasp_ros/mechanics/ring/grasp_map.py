@@ -1,6 +1,7 @@
 # Copyright 2026 squeeze_grasp_ros developers
 # SPDX-License-Identifier: Apache-2.0
-"""Grasp map of a ring: maximum feasible depth and its limit for every pair of nodes (Sec. 7.1-7.2).
+"""Grasp map of a ring: maximum feasible depth and its limit for every pair of nodes (Sec.
+7.1-7.2).
 
 Vectorised over all n (n - 1) / 2 unordered placements (F1 at the lower index). For two
 contacts null(B^T) is spanned by the squeeze direction u, so Theorem 10 gives everything in
@@ -23,13 +24,22 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from squeeze_grasp_ros.mechanics.errors import MechanicsError
+from squeeze_grasp_ros.mechanics.errors import InvalidInputError
 from squeeze_grasp_ros.mechanics.ring.model import RingModel
-from squeeze_grasp_ros.mechanics.ring.squeeze import (LIMITS, RingSqueezeKind, check_limits, cone_depths, initially_feasible,
-                           neighbours, resolve_limits, ring_grasp)
+from squeeze_grasp_ros.mechanics.ring.squeeze import (
+    LIMITS,
+    check_limits,
+    cone_depths,
+    initially_feasible,
+    neighbours,
+    resolve_limits,
+    ring_grasp,
+)
+from squeeze_grasp_ros.mechanics.vocabulary import SqueezeKind
 
 CHUNK = 512
-"""Placements per block in the strain search (bounds the temporary memory to ~CHUNK * 9n floats)."""
+"""Placements per block in the strain search (bounds the temporary memory to ~CHUNK * 9n
+floats)."""
 
 
 @dataclass(frozen=True)
@@ -90,12 +100,13 @@ class RingGraspMap:
         """Row of placement {i, j} in ``pairs`` (F1 at min(i, j))."""
         a, b = min(i, j), max(i, j)
         if a == b or a < 0 or b >= self.n:
-            raise MechanicsError(f"no placement ({i}, {j}) on a ring of {self.n} nodes")
+            raise InvalidInputError(f"no placement ({i}, {j}) on a ring of {self.n} nodes")
         return int(a * self.n - a * (a + 1) // 2 + (b - a - 1))
 
     def failure_modes(self, relative_depth: float, started: bool = False) -> dict[str, int]:
         """Counts, by limit name, of the placements that fail before ``relative_depth``; with
-        ``started`` only those that start inside both cones (they fail during the squeeze)."""
+        ``started`` only those that start inside both cones (they fail during the squeeze).
+        """
         fail = ~self.succeeds(relative_depth)
         if started:
             fail &= self.initially_feasible
@@ -140,7 +151,7 @@ def _all_pairs(n: int) -> np.ndarray:
     return np.column_stack([i, j])
 
 
-def pair_fields(ring: RingModel, pairs: np.ndarray, kind: RingSqueezeKind):
+def pair_fields(ring: RingModel, pairs: np.ndarray, kind: SqueezeKind):
     """Closed-form (Theorem 10) squeeze of each placement, dimensionless.
 
     Returns
@@ -162,7 +173,7 @@ def pair_fields(ring: RingModel, pairs: np.ndarray, kind: RingSqueezeKind):
     Ad_j = np.einsum("pab,pb->pa", A4[J, I] - A4[J, J], d)
     q = 0.5 * np.einsum("pa,pa->p", d, Ad_i - Ad_j)
     Au = np.stack([Ad_i, Ad_j], axis=1) / np.sqrt(2.0)
-    if kind == "stable":
+    if kind == SqueezeKind.STABLE:
         scale = 1.0 / q
         approach = np.full(len(pairs), np.sqrt(2.0))
     else:
@@ -173,7 +184,7 @@ def pair_fields(ring: RingModel, pairs: np.ndarray, kind: RingSqueezeKind):
     force = np.stack([f1, -f1], axis=1)
     nb = neighbours(n, pairs)
     rate = np.einsum("pfkab,pb->pfka", A4[nb, I[:, None, None]] - A4[nb, J[:, None, None]], f1)
-    if kind == "stable":
+    if kind == SqueezeKind.STABLE:
         B = np.concatenate([Rn[I], Rn[J]], axis=1)
         BtB = np.einsum("pra,prb->pab", B, B)
         BtAF = np.einsum("pra,pr->pa", B, (Au * scale[:, None, None]).reshape(-1, 4))
@@ -183,7 +194,9 @@ def pair_fields(ring: RingModel, pairs: np.ndarray, kind: RingSqueezeKind):
 
 
 def strain_rates(ring: RingModel, pairs: np.ndarray, force: np.ndarray) -> np.ndarray:
-    """Largest fibre strain per unit dimensionless depth (P,) of each placement: max over elements."""
+    """Largest fibre strain per unit dimensionless depth (P,) of each placement: max over
+    elements.
+    """
     n = ring.n
     Phi = ring.strain_influence.reshape(n, 2, 3 * n)
     half_h = 0.5 * ring.h_hat
@@ -201,8 +214,8 @@ def strain_rates(ring: RingModel, pairs: np.ndarray, force: np.ndarray) -> np.nd
     return out
 
 
-def ring_grasp_map(ring: RingModel, mu: float, epsilon: float | None = None,
-                   kind: RingSqueezeKind = "stable",
+def ring_grasp_map(ring: RingModel, mu: float, *, epsilon: float | None = None,
+                   kind: SqueezeKind = SqueezeKind.STABLE,
                    requested_relative_depth: float | None = None) -> RingGraspMap:
     """Maximum feasible depth and limit of every placement (i, j), i < j, on ``ring``.
 
@@ -216,12 +229,22 @@ def ring_grasp_map(ring: RingModel, mu: float, epsilon: float | None = None,
     kind : {"stable", "pure"}
     requested_relative_depth : float, optional
         Relative depth to report successes and failure modes at (Table 5).
+
+    Examples
+    --------
+    >>> from squeeze_grasp_ros.api import load_scene, scene_file
+    >>> from squeeze_grasp_ros.scene import build_ring
+    >>> ring = build_ring(load_scene(scene_file("ring_ring")))
+    >>> gmap = ring_grasp_map(ring, 0.4)
+    >>> gmap.n == ring.n, gmap.kind
+    (True, <SqueezeKind.STABLE: 'stable'>)
     """
-    if kind not in ("stable", "pure"):
-        raise MechanicsError(f"squeeze type must be 'stable' or 'pure', got {kind!r}")
+    if kind not in (SqueezeKind.STABLE, SqueezeKind.PURE):
+        raise InvalidInputError(f"squeeze type must be 'stable' or 'pure', got {kind!r}")
     check_limits(mu, epsilon)
     if requested_relative_depth is not None and not 0 < requested_relative_depth <= 1:
-        raise MechanicsError(f"requested relative depth must be in (0, 1], got {requested_relative_depth}")
+        raise InvalidInputError(f"requested relative depth must be in (0, 1], got "
+                                f"{requested_relative_depth}")
     L = ring.scale
     pairs = _all_pairs(ring.n)
     force, rate, approach = pair_fields(ring, pairs, kind)
@@ -245,7 +268,7 @@ def ring_grasp_map(ring: RingModel, mu: float, epsilon: float | None = None,
 
 
 def bench_ring(ring: RingModel, mu: float, epsilon: float | None = None,
-               kind: RingSqueezeKind = "stable", single: int = 200, seed: int = 0) -> dict:
+               kind: SqueezeKind = SqueezeKind.STABLE, single: int = 200, seed: int = 0) -> dict:
     """Wall-clock timings of the mechanics on ``ring``, seconds.
 
     Returns ``precompute`` (stiffness, factor, compliance, strain influence; from a fresh copy of
@@ -257,14 +280,14 @@ def bench_ring(ring: RingModel, mu: float, epsilon: float | None = None,
     t0 = time.perf_counter()
     fresh.precompute()
     t1 = time.perf_counter()
-    gmap = ring_grasp_map(fresh, mu, epsilon, kind)
+    gmap = ring_grasp_map(fresh, mu, epsilon=epsilon, kind=kind)
     t2 = time.perf_counter()
     rng = np.random.default_rng(seed)
     times = []
     for _ in range(single):
         i, j = rng.choice(fresh.n, size=2, replace=False)
         s = time.perf_counter()
-        ring_grasp(fresh, (i, j), mu, epsilon, kind)
+        ring_grasp(fresh, (i, j), mu, epsilon=epsilon, kind=kind)
         times.append(time.perf_counter() - s)
     return {"elements": fresh.n, "pairs": int(len(gmap.pairs)),
             "initially_feasible_pairs": int(gmap.initially_feasible.sum()),

@@ -43,6 +43,7 @@ displacement is A F + B g with B the contact rows of the rigid modes, orthonorma
 Units: SI at the API. Inside, lengths are divided by the ring size L, forces by E w L, so
 K_hat is dimensionless and A = A_hat / (E w) in m/N, like the solid model with thickness -> w.
 """
+
 from __future__ import annotations
 
 from dataclasses import dataclass
@@ -52,7 +53,12 @@ import numpy as np
 import scipy.linalg as la
 import scipy.sparse as sp
 
-from squeeze_grasp_ros.mechanics.errors import MechanicsError, require_finite
+from squeeze_grasp_ros.mechanics.errors import (
+    InternalError,
+    InvalidInputError,
+    NumericalError,
+    require_finite,
+)
 from squeeze_grasp_ros.mechanics.elastic.fem import rigid_modes, rotation_mode_norm
 from squeeze_grasp_ros.mechanics.elastic.material import Material
 from squeeze_grasp_ros.mechanics.elastic.shapes import Outline, disk, resample, signed_area
@@ -87,18 +93,23 @@ class RingModel:
     def __post_init__(self) -> None:
         p = np.asarray(self.points, dtype=float)
         if p.ndim != 2 or p.shape[1] != 2 or len(p) < 8:
-            raise MechanicsError(f"ring.points must be (n, 2) with n >= 8, got shape {p.shape}")
+            raise InvalidInputError(f"ring.points must be (n, 2) with n >= 8, got shape {p.shape}")
         require_finite("ring.points", p)
         if signed_area(p) <= 0:
-            raise MechanicsError("ring.points must be counter-clockwise with positive area")
+            raise InvalidInputError("ring.points must be counter-clockwise with positive area")
         if self.material.nu != 0.0:
-            raise MechanicsError(f"material.nu must be 0 for the ring model (Sec. 7), got {self.material.nu}")
+            raise InvalidInputError(
+                f"material.nu must be 0 for the ring model (Sec. 7), got {self.material.nu}"
+            )
         require_finite("ring.wall_thickness", self.wall_thickness)
         if not 0.0 < self.wall_thickness < 0.25 * self.scale:
-            raise MechanicsError(f"ring.wall_thickness must be in (0, {0.25 * self.scale:.4g}) m "
-                                 f"(a quarter of the ring size), got {self.wall_thickness}")
+            raise InvalidInputError(
+                f"ring.wall_thickness must be in (0, {0.25 * self.scale:.4g}) "
+                "m "
+                f"(a quarter of the ring size), got {self.wall_thickness}"
+            )
         if np.min(self.element_lengths) <= 1e-9 * self.scale:
-            raise MechanicsError("ring.points has coincident consecutive nodes")
+            raise InvalidInputError("ring.points has coincident consecutive nodes")
         object.__setattr__(self, "points", p)
 
     @property
@@ -122,7 +133,9 @@ class RingModel:
         x, y = self.points[:, 0], self.points[:, 1]
         xn, yn = np.roll(x, -1), np.roll(y, -1)
         cross = x * yn - xn * y
-        return np.array([np.sum((x + xn) * cross), np.sum((y + yn) * cross)]) / (3.0 * np.sum(cross))
+        return np.array([np.sum((x + xn) * cross), np.sum((y + yn) * cross)]) / (
+            3.0 * np.sum(cross)
+        )
 
     @cached_property
     def scale(self) -> float:
@@ -172,13 +185,19 @@ class RingModel:
         """
         _, l = self.frames
         h = self.h_hat
-        ea, ei = h, h ** 3 / 12.0
+        ea, ei = h, h**3 / 12.0
         k = np.zeros((self.n, 6, 6))
         ax = ea / l
         k[:, 0, 0] = k[:, 3, 3] = ax
         k[:, 0, 3] = k[:, 3, 0] = -ax
-        bend = np.array([[12.0, 6.0, -12.0, 6.0], [6.0, 4.0, -6.0, 2.0],
-                         [-12.0, -6.0, 12.0, -6.0], [6.0, 2.0, -6.0, 4.0]])
+        bend = np.array(
+            [
+                [12.0, 6.0, -12.0, 6.0],
+                [6.0, 4.0, -6.0, 2.0],
+                [-12.0, -6.0, 12.0, -6.0],
+                [6.0, 2.0, -6.0, 4.0],
+            ]
+        )
         powers = np.array([[3, 2, 3, 2], [2, 1, 2, 1], [3, 2, 3, 2], [2, 1, 2, 1]])
         idx = np.array([1, 2, 4, 5])
         k[np.ix_(np.arange(self.n), idx, idx)] = ei * bend / l[:, None, None] ** powers
@@ -194,14 +213,15 @@ class RingModel:
     @cached_property
     def strain_matrix(self) -> sp.csr_matrix:
         """Sparse (3n, 3n) map from Delta_hat to element strains, rows blocked as
-        [eps (n), zeta_hat at start (n), zeta_hat at end (n)]; zeta_hat = zeta L (Hermite w'')."""
+        [eps (n), zeta_hat at start (n), zeta_hat at end (n)]; zeta_hat = zeta L (Hermite w'').
+        """
         _, l = self.frames
         S = np.zeros((self.n, 3, 6))
         S[:, 0, 0], S[:, 0, 3] = -1.0 / l, 1.0 / l
-        S[:, 1, [1, 2, 4, 5]] = np.column_stack([-6.0 / l ** 2, -4.0 / l, 6.0 / l ** 2, -2.0 / l])
-        S[:, 2, [1, 2, 4, 5]] = np.column_stack([6.0 / l ** 2, 2.0 / l, -6.0 / l ** 2, 4.0 / l])
+        S[:, 1, [1, 2, 4, 5]] = np.column_stack([-6.0 / l**2, -4.0 / l, 6.0 / l**2, -2.0 / l])
+        S[:, 2, [1, 2, 4, 5]] = np.column_stack([6.0 / l**2, 2.0 / l, -6.0 / l**2, 4.0 / l])
         Sg = np.einsum("eqj,ejk->eqk", S, self._rotations())
-        rows = (np.arange(3)[None, :, None] * self.n + np.arange(self.n)[:, None, None])
+        rows = np.arange(3)[None, :, None] * self.n + np.arange(self.n)[:, None, None]
         rows = np.broadcast_to(rows, Sg.shape).ravel()
         cols = np.broadcast_to(self.element_dofs[:, None, :], Sg.shape).ravel()
         return sp.csr_matrix((Sg.ravel(), (rows, cols)), shape=(3 * self.n, 3 * self.n))
@@ -209,7 +229,8 @@ class RingModel:
     @cached_property
     def rigid(self) -> np.ndarray:
         """Rigid modes R (3n, 3): translational rows orthonormal under eq. (16), theta rows the
-        matching rotation (0, 0, 1/||w_perp||)."""
+        matching rotation (0, 0, 1/||w_perp||).
+        """
         R = np.zeros((3 * self.n, 3))
         tr = self.translation_dofs
         R[tr] = rigid_modes(self.points, self.scale)
@@ -229,16 +250,18 @@ class RingModel:
         keep = (K.row >= 3) & (K.col >= 3) & (K.row <= K.col)
         r, c, v = K.row[keep] - 3, K.col[keep] - 3, K.data[keep]
         if np.any(c - r > BANDWIDTH):
-            raise MechanicsError("ring stiffness is not banded: nodes out of order")
+            raise InternalError("ring stiffness is not banded: nodes out of order")
         ab = np.zeros((BANDWIDTH + 1, 3 * self.n - 3))
         np.add.at(ab, (BANDWIDTH + r - c, c), v)
         try:
             return la.cholesky_banded(ab, lower=False)
         except la.LinAlgError:
-            raise MechanicsError("clamped ring stiffness is not positive definite") from None
+            raise NumericalError("clamped ring stiffness is not positive definite") from None
 
     def clamped_solve(self, rhs: np.ndarray) -> np.ndarray:
-        """X rhs: the clamped-at-node-0 solution of K_hat x = rhs (3n,) or (3n, k), zero at node 0."""
+        """X rhs: the clamped-at-node-0 solution of K_hat x = rhs (3n,) or (3n, k), zero at
+        node 0.
+        """
         rhs = np.asarray(rhs, dtype=float)
         x = np.zeros_like(rhs)
         x[3:] = la.cho_solve_banded((self._clamped_factor, False), rhs[3:], check_finite=False)
@@ -251,7 +274,9 @@ class RingModel:
 
     @cached_property
     def _translational_solutions(self) -> np.ndarray:
-        """P_T-projected X T^T: clamped responses (3n, 2n) to unit equilibrated translational loads."""
+        """P_T-projected X T^T: clamped responses (3n, 2n) to unit equilibrated translational
+        loads.
+        """
         tr = self.translation_dofs
         E = np.zeros((3 * self.n, 2 * self.n))
         E[tr, np.arange(2 * self.n)] = 1.0
@@ -271,13 +296,15 @@ class RingModel:
     @cached_property
     def strain_influence(self) -> np.ndarray:
         """(n, 2, 3, n): element strains [eps, zeta_hat start, zeta_hat end] per unit
-        dimensionless force on each node's x and y (rigid parts carry no strain)."""
+        dimensionless force on each node's x and y (rigid parts carry no strain).
+        """
         S = self.strain_matrix @ self._translational_solutions
         return np.ascontiguousarray(S.T.reshape(self.n, 2, 3, self.n))
 
     def field_from_forces(self, forces_hat: np.ndarray) -> np.ndarray:
         """Dimensionless deformation Delta_hat (3n,) with no rigid component for equilibrated
-        dimensionless nodal forces ``forces_hat`` (n, 2)."""
+        dimensionless nodal forces ``forces_hat`` (n, 2).
+        """
         F = np.zeros(3 * self.n)
         F[self.translation_dofs] = np.asarray(forces_hat, float).reshape(-1)
         return self.remove_rigid(self.clamped_solve(F))
@@ -300,16 +327,18 @@ class RingModel:
         f = np.asarray(forces, dtype=float)
         require_finite("forces", f)
         if f.shape != (self.n, 2):
-            raise MechanicsError(f"forces must have shape ({self.n}, 2), got {f.shape}")
+            raise InvalidInputError(f"forces must have shape ({self.n}, 2), got {f.shape}")
         Rt = self.rigid[self.translation_dofs]
         imbalance = np.abs(Rt.T @ f.reshape(-1)).max()
         if imbalance > 1e-9 * max(np.abs(f).max(), 1e-300) * np.sqrt(self.n):
-            raise MechanicsError("forces are not equilibrated (net force or moment is nonzero)")
+            raise InvalidInputError("forces are not equilibrated (net force or moment is nonzero)")
         x = self.field_from_forces(f / (self.material.force_scale * self.scale))
         return x[self.translation_dofs].reshape(-1, 2) * self.scale, x[2::3].copy()
 
     def fibre_strains(self, field_hat: np.ndarray) -> np.ndarray:
-        """Largest fibre strain |eps| + h/2 |zeta| of every element (n,) for a field Delta_hat (3n,)."""
+        """Largest fibre strain |eps| + h/2 |zeta| of every element (n,) for a field Delta_hat
+        (3n,).
+        """
         q = (self.strain_matrix @ field_hat).reshape(3, self.n)
         return np.abs(q[0]) + 0.5 * self.h_hat * np.maximum(np.abs(q[1]), np.abs(q[2]))
 
@@ -319,8 +348,9 @@ class RingModel:
         return self
 
 
-def ring_from_outline(outline: Outline, material: Material, wall_thickness: float,
-                      elements: int) -> RingModel:
+def ring_from_outline(
+    outline: Outline, material: Material, wall_thickness: float, elements: int
+) -> RingModel:
     """A :class:`RingModel` whose middle curve is ``outline`` resampled into ~``elements`` nodes.
 
     Parameters
@@ -335,15 +365,16 @@ def ring_from_outline(outline: Outline, material: Material, wall_thickness: floa
         Target number of elements (exact for smooth curves), >= 8.
     """
     if elements < 8:
-        raise MechanicsError(f"ring.elements must be >= 8, got {elements}")
+        raise InvalidInputError(f"ring.elements must be >= 8, got {elements}")
     p = outline.points
     perimeter = float(np.sum(np.linalg.norm(np.roll(p, -1, axis=0) - p, axis=1)))
     nodes = resample(p, perimeter / elements, outline.corners)
     return RingModel(nodes, material, wall_thickness)
 
 
-def ring_diameter_changes(radius: float, E: float, width: float, wall_thickness: float,
-                          load: float) -> tuple[float, float]:
+def ring_diameter_changes(
+    radius: float, E: float, width: float, wall_thickness: float, load: float
+) -> tuple[float, float]:
     """Closed-form diameter changes of a thin circular ring under two diametral point loads.
 
     Kirchhoff curved beam with extension and bending uncoupled (eq. 71, no shear), by
@@ -375,22 +406,27 @@ def ring_diameter_changes(radius: float, E: float, width: float, wall_thickness:
         Signed changes of the diameter along and across the load line, m (along < 0 < across
         for a squeeze).
     """
-    for name, value in (("radius", radius), ("E", E), ("width", width),
-                        ("wall_thickness", wall_thickness)):
+    for name, value in (
+        ("radius", radius),
+        ("E", E),
+        ("width", width),
+        ("wall_thickness", wall_thickness),
+    ):
         require_finite(name, value)
         if not value > 0:
-            raise MechanicsError(f"{name} must be > 0, got {value}")
+            raise InvalidInputError(f"{name} must be > 0, got {value}")
     require_finite("load", load)
-    EI = E * width * wall_thickness ** 3 / 12.0
+    EI = E * width * wall_thickness**3 / 12.0
     EA = E * width * wall_thickness
-    bend = load * radius ** 3 / EI
+    bend = load * radius**3 / EI
     along = -(bend * (np.pi / 4 - 2 / np.pi) + np.pi * load * radius / (4 * EA))
     across = bend * (2 / np.pi - 0.5) - load * radius / (2 * EA)
     return float(along), float(across)
 
 
-def circle_diametral_response(elements: int, radius: float, E: float, width: float,
-                              wall_thickness: float, load: float) -> tuple[float, float, float]:
+def circle_diametral_response(
+    elements: int, radius: float, E: float, width: float, wall_thickness: float, load: float
+) -> tuple[float, float, float]:
     """FE counterpart of :func:`ring_diameter_changes` on a circle of ``elements`` elements.
 
     Returns the changes (m) of the diameter along and across two opposite diametral loads
@@ -398,8 +434,10 @@ def circle_diametral_response(elements: int, radius: float, E: float, width: flo
     """
     ring = ring_from_outline(disk(radius), Material(E, 0.0, width), wall_thickness, elements)
     ang = np.arctan2(ring.points[:, 1], ring.points[:, 0])
-    top, bottom, left, right = (int(np.argmin(np.abs(np.angle(np.exp(1j * (ang - a))))))
-                                for a in (np.pi / 2, -np.pi / 2, np.pi, 0.0))
+    top, bottom, left, right = (
+        int(np.argmin(np.abs(np.angle(np.exp(1j * (ang - a))))))
+        for a in (np.pi / 2, -np.pi / 2, np.pi, 0.0)
+    )
     f = np.zeros((ring.n, 2))
     f[top], f[bottom] = (0.0, -load), (0.0, load)
     d, rot = ring.solve_loads(f)

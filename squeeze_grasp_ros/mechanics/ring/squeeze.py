@@ -25,28 +25,27 @@ strain per unit depth). The maximum feasible depth is the least of the two cone 
 strain depth and the depth cap (relative depth 1: the fingers would meet); ties resolve in the
 order F1, F2, strain.
 """
+
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Literal
 
 import numpy as np
 
 from squeeze_grasp_ros.mechanics.elastic.compliance import node_dofs
-from squeeze_grasp_ros.mechanics.errors import MechanicsError, require_finite
+from squeeze_grasp_ros.mechanics.errors import InvalidInputError, require_finite
 from squeeze_grasp_ros.mechanics.elastic.reduced import reduce_blocks
 from squeeze_grasp_ros.mechanics.ring.model import RingModel
 from squeeze_grasp_ros.mechanics.squeeze.stable_pure import two_contact_direction
+from squeeze_grasp_ros.mechanics.vocabulary import SqueezeKind
 
 LIMITS: tuple[str, ...] = ("friction_cone_F1", "friction_cone_F2", "strain", "none")
 """Names of what bounds the squeeze depth, indexed by the integer limit codes."""
-FINGERS: tuple[str, str] = ("F1", "F2")
 EDGE_TOL = 1e-9
 """A force within this relative margin (~rad) of a cone edge at rho = 0+ counts as on the edge."""
 ROOT_IMAG_TOL = 1e-7
-"""A companion eigenvalue with |Im| <= ROOT_IMAG_TOL (1 + |Re|) (scaled variable) is a real root."""
-
-RingSqueezeKind = Literal["stable", "pure"]
+"""A companion eigenvalue with |Im| <= ROOT_IMAG_TOL (1 + |Re|) (scaled variable) is a real
+root."""
 
 
 def poly_mul(p: np.ndarray, q: np.ndarray) -> np.ndarray:
@@ -94,7 +93,8 @@ def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
 
 
 def cone_polynomials(normal: np.ndarray, force: np.ndarray, mu: float) -> np.ndarray:
-    """Edge functions (..., 2, d+1) [g_-, g_+] for N coefficients (..., 2, d+1) and a force (..., 2).
+    """Edge functions (..., 2, d+1) [g_-, g_+] for N coefficients (..., 2, d+1) and a force (...,
+    2).
 
     The force is inside the cone of half-angle atan(mu) about N(rho) iff both are >= 0.
     """
@@ -113,13 +113,16 @@ def edge_margins(normal: np.ndarray, force: np.ndarray, mu: float) -> np.ndarray
     """
     alpha = np.arctan(mu)
     scale = np.linalg.norm(normal, axis=-1) * np.linalg.norm(force, axis=-1)
-    g = np.stack([_cross(normal, _rotate(force, alpha)), _cross(_rotate(force, -alpha), normal)], -1)
+    g = np.stack(
+        [_cross(normal, _rotate(force, alpha)), _cross(_rotate(force, -alpha), normal)], -1
+    )
     return g / np.where(scale > 0, scale, 1.0)[..., None]
 
 
 def positive_on_unit_interval(coeffs: np.ndarray) -> np.ndarray:
     """(k,) True where a cubic (k, 4) in t is certified > 0 on [0, 1]: all Bernstein coefficients
-    are positive (the curve lies in their convex hull). False means "may have a root"."""
+    are positive (the curve lies in their convex hull). False means "may have a root".
+    """
     c0, c1, c2, c3 = coeffs.T
     bern = np.stack([c0, c0 + c1 / 3.0, c0 + (2.0 * c1 + c2) / 3.0, c0 + c1 + c2 + c3])
     return np.all(bern > 0, axis=0)
@@ -174,8 +177,9 @@ def initially_feasible(base: np.ndarray, force: np.ndarray, mu: float) -> np.nda
     return np.all(edge_margins(n0, force, mu) > EDGE_TOL, axis=-1)
 
 
-def cone_depths(base: np.ndarray, rate: np.ndarray, force: np.ndarray, mu: float,
-                cap: np.ndarray) -> np.ndarray:
+def cone_depths(
+    base: np.ndarray, rate: np.ndarray, force: np.ndarray, mu: float, cap: np.ndarray
+) -> np.ndarray:
     """(k, 2) depth (scaled like ``base``) at which each finger's force reaches a cone edge.
 
     ``base``, ``rate`` (k, 2, 3, 2): positions and displacements per unit depth of each finger's
@@ -191,9 +195,12 @@ def cone_depths(base: np.ndarray, rate: np.ndarray, force: np.ndarray, mu: float
     return out
 
 
-def resolve_limits(cones: np.ndarray, strain: np.ndarray, cap: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def resolve_limits(
+    cones: np.ndarray, strain: np.ndarray, cap: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
     """Maximum depth (k,) and limit code (k,) (index into :data:`LIMITS`) from the candidate
-    depths: cones (k, 2), strain (k,), cap (k,). Ties go to F1, then F2, then strain."""
+    depths: cones (k, 2), strain (k,), cap (k,). Ties go to F1, then F2, then strain.
+    """
     depths = np.column_stack([cones, strain, cap])
     code = np.argmin(depths, axis=1)
     return depths[np.arange(len(depths)), code], code
@@ -223,7 +230,8 @@ class RingGrasp:
     forces : (2, 2) ndarray
         Contact force on the ring at F1, F2 per unit depth, N/m.
     field : (n, 2) ndarray
-        Displacement of every node per unit depth, m/m (includes the rigid part of a stable squeeze).
+        Displacement of every node per unit depth, m/m (includes the rigid part of a stable
+        squeeze).
     points : (n, 2) ndarray
         Undeformed ring nodes, m.
     strains : (n,) ndarray
@@ -312,7 +320,7 @@ class RingGrasp:
         """
         require_finite("depth", depth)
         if depth < 0:
-            raise MechanicsError(f"depth must be >= 0 m, got {depth}")
+            raise InvalidInputError(f"depth must be >= 0 m, got {depth}")
         if depth > self.depth_cap:
             return False
         cones_ok = bool(np.all(self.cone_margins_at(depth) > EDGE_TOL))
@@ -321,7 +329,8 @@ class RingGrasp:
 
     def limit_depths(self) -> dict[str, float | None]:
         """Candidate depths (m) by limit name; None where the limit is not reached before the
-        smaller of the strain depth and ``depth_cap`` (cone roots are not sought beyond)."""
+        smaller of the strain depth and ``depth_cap`` (cone roots are not sought beyond).
+        """
         vals = [*self.cone_depths, self.strain_depth]
         return {name: (float(v) if np.isfinite(v) else None) for name, v in zip(LIMITS, vals)}
 
@@ -329,22 +338,22 @@ class RingGrasp:
 def _check_contacts(ring: RingModel, contacts) -> np.ndarray:
     c = np.asarray(contacts, dtype=int).reshape(-1)
     if len(c) != 2:
-        raise MechanicsError(f"a ring grasp needs exactly 2 contact nodes, got {len(c)}")
+        raise InvalidInputError(f"a ring grasp needs exactly 2 contact nodes, got {len(c)}")
     if c[0] == c[1]:
-        raise MechanicsError("the two contact nodes coincide")
+        raise InvalidInputError("the two contact nodes coincide")
     if c.min() < 0 or c.max() >= ring.n:
-        raise MechanicsError(f"contact nodes must be in [0, {ring.n - 1}], got {c.tolist()}")
+        raise InvalidInputError(f"contact nodes must be in [0, {ring.n - 1}], got {c.tolist()}")
     return c
 
 
 def check_limits(mu: float, epsilon: float | None) -> None:
     require_finite("mu", mu)
     if mu < 0:
-        raise MechanicsError(f"friction coefficient mu must be >= 0, got {mu}")
+        raise InvalidInputError(f"friction coefficient mu must be >= 0, got {mu}")
     if epsilon is not None:
         require_finite("epsilon", epsilon)
         if not epsilon > 0:
-            raise MechanicsError(f"strain limit epsilon must be > 0, got {epsilon}")
+            raise InvalidInputError(f"strain limit epsilon must be > 0, got {epsilon}")
 
 
 def fibre_strain_rate(ring: RingModel, contacts: np.ndarray, forces_hat: np.ndarray) -> np.ndarray:
@@ -353,8 +362,13 @@ def fibre_strain_rate(ring: RingModel, contacts: np.ndarray, forces_hat: np.ndar
     return np.abs(q[0]) + 0.5 * ring.h_hat * np.maximum(np.abs(q[1]), np.abs(q[2]))
 
 
-def ring_grasp(ring: RingModel, contacts, mu: float, epsilon: float | None = None,
-               kind: RingSqueezeKind = "stable") -> RingGrasp:
+def ring_grasp(
+    ring: RingModel,
+    contacts,
+    mu: float,
+    *, epsilon: float | None = None,
+    kind: SqueezeKind = SqueezeKind.STABLE,
+) -> RingGrasp:
     """Squeeze a ring at two nodes and find its maximum feasible depth in closed form.
 
     The contact displacement and forces come from the Sec. 3 blocks (C, E by
@@ -373,11 +387,20 @@ def ring_grasp(ring: RingModel, contacts, mu: float, epsilon: float | None = Non
 
     Raises
     ------
-    MechanicsError
+    InvalidInputError
         For bad contacts, mu, epsilon or kind.
+
+    Examples
+    --------
+    >>> from squeeze_grasp_ros.api import load_scene, scene_file
+    >>> from squeeze_grasp_ros.scene import build_ring
+    >>> ring = build_ring(load_scene(scene_file("ring_ring")))
+    >>> grasp = ring_grasp(ring, [0, ring.n // 2], 0.4)
+    >>> print(grasp.kind, bool(grasp.max_depth > 0))
+    stable True
     """
-    if kind not in ("stable", "pure"):
-        raise MechanicsError(f"squeeze type must be 'stable' or 'pure', got {kind!r}")
+    if kind not in (SqueezeKind.STABLE, SqueezeKind.PURE):
+        raise InvalidInputError(f"squeeze type must be 'stable' or 'pure', got {kind!r}")
     c = _check_contacts(ring, contacts)
     check_limits(mu, epsilon)
     L = ring.scale
@@ -387,7 +410,7 @@ def ring_grasp(ring: RingModel, contacts, mu: float, epsilon: float | None = Non
     Rt = ring.rigid[ring.translation_dofs]
     C, E, _, condition = reduce_blocks(A_hat, Rt[dofs])
     u = two_contact_direction(p[0], p[1])
-    delta = u if kind == "stable" else A_hat @ C @ u
+    delta = u if kind == SqueezeKind.STABLE else A_hat @ C @ u
     delta = delta / np.linalg.norm(delta)
     F_hat = C @ delta
     field = ring.compliance[:, dofs] @ F_hat + Rt @ (E.T @ delta)
@@ -399,14 +422,27 @@ def ring_grasp(ring: RingModel, contacts, mu: float, epsilon: float | None = Non
     strain_hat = np.inf if epsilon is None else epsilon / strains.max()
     nb = neighbours(ring.n, c)
     base = ring.points[nb][None] / L
-    cones = cone_depths(base, field[nb][None], F_hat.reshape(1, 2, 2), mu,
-                        np.array([min(cap_hat, strain_hat)]))
+    cones = cone_depths(
+        base, field[nb][None], F_hat.reshape(1, 2, 2), mu, np.array([min(cap_hat, strain_hat)])
+    )
     depth, code = resolve_limits(cones, np.array([strain_hat]), np.array([cap_hat]))
     require_finite("ring grasp forces", F_hat)
     return RingGrasp(
-        contacts=c, kind=kind, mu=float(mu), epsilon=epsilon, displacement=delta,
-        forces=F_hat.reshape(2, 2) * ring.material.force_scale, field=field,
-        strains=strains / L, points=ring.points, approach_per_unit_depth=approach,
-        initial_distance=distance, cone_depths=cones[0] * L, strain_depth=strain_hat * L,
-        depth_cap=cap_hat * L, max_depth=float(depth[0] * L), limit=LIMITS[int(code[0])],
-        condition=condition)
+        contacts=c,
+        kind=kind,
+        mu=float(mu),
+        epsilon=epsilon,
+        displacement=delta,
+        forces=F_hat.reshape(2, 2) * ring.material.force_scale,
+        field=field,
+        strains=strains / L,
+        points=ring.points,
+        approach_per_unit_depth=approach,
+        initial_distance=distance,
+        cone_depths=cones[0] * L,
+        strain_depth=strain_hat * L,
+        depth_cap=cap_hat * L,
+        max_depth=float(depth[0] * L),
+        limit=LIMITS[int(code[0])],
+        condition=condition,
+    )

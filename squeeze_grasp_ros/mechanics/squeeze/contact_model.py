@@ -24,6 +24,7 @@ displacement solve at every evaluation.
 
 Everything here is dimensionless: lengths by L = obj.scale, forces by E h L.
 """
+
 from __future__ import annotations
 
 from dataclasses import dataclass, field
@@ -31,17 +32,23 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from squeeze_grasp_ros.mechanics.elastic.compliance import ElasticObject, node_dofs
-from squeeze_grasp_ros.mechanics.errors import MechanicsError
-from squeeze_grasp_ros.mechanics.elastic.fem import element_dofs, principal_strains, strain_displacement
+from squeeze_grasp_ros.mechanics.errors import InvalidInputError, NumericalError
+from squeeze_grasp_ros.mechanics.elastic.fem import (
+    element_dofs,
+    principal_strains,
+    strain_displacement,
+)
 from squeeze_grasp_ros.mechanics.squeeze.fingertips import cross, tangent, unit
 from squeeze_grasp_ros.mechanics.elastic.reduced import reduce_blocks
+from squeeze_grasp_ros.mechanics.vocabulary import StrainCriterion
 
-STRAIN_CRITERIA: tuple[str, ...] = ("principal", "componentwise")
 NEWTON_MAX_ITERATIONS = 50
 NEWTON_BACKTRACKS = 30
-SINGULAR_SLIDING = ("singular Jacobian of the sliding constraints (eq. 47): the sliding contacts "
-                    "do not fix the object's position (e.g. a frictionless finger touching at one "
-                    "node lets the object slide along the tip); use mu > 0")
+SINGULAR_SLIDING = (
+    "singular Jacobian of the sliding constraints (eq. 47): the sliding contacts "
+    "do not fix the object's position (e.g. a frictionless finger touching at one "
+    "node lets the object slide along the tip); use mu > 0"
+)
 NEWTON_TOL = 1e-14
 """Newton stops when the cone residual is below this times the force scale |C| r, or when the
 largest angle update (rad) falls below it."""
@@ -63,17 +70,20 @@ class Limits:
     """
 
     strain: float | None = None
-    criterion: str = "principal"
+    criterion: str = StrainCriterion.PRINCIPAL
     weight: float | None = None
 
     def __post_init__(self) -> None:
-        if self.criterion not in STRAIN_CRITERIA:
-            raise MechanicsError(f"strain_limit.criterion must be one of {STRAIN_CRITERIA}, "
-                                 f"got {self.criterion!r}")
+        if self.criterion not in StrainCriterion.values():
+            raise InvalidInputError(
+                f"strain_limit.criterion must be one of "
+                f"{StrainCriterion.values()}, "
+                f"got {self.criterion!r}"
+            )
         if self.strain is not None and not (np.isfinite(self.strain) and self.strain > 0):
-            raise MechanicsError(f"strain_limit.epsilon must be > 0, got {self.strain}")
+            raise InvalidInputError(f"strain_limit.epsilon must be > 0, got {self.strain}")
         if self.weight is not None and not (np.isfinite(self.weight) and self.weight > 0):
-            raise MechanicsError(f"pickup.weight must be > 0 N, got {self.weight}")
+            raise InvalidInputError(f"pickup.weight must be > 0 N, got {self.weight}")
 
 
 @dataclass(frozen=True)
@@ -148,14 +158,16 @@ class Solution:
         return np.einsum("ij,ij->i", self.F, tangent(self.theta))
 
     def normal_rate(self) -> np.ndarray:
-        """d f_n / ds (m,)."""
-        return (np.einsum("ij,ij->i", self.dF, unit(self.theta))
-                + self.dtheta * np.einsum("ij,ij->i", self.F, tangent(self.theta)))
+        """D f_n / ds (m,)."""
+        return np.einsum("ij,ij->i", self.dF, unit(self.theta)) + self.dtheta * np.einsum(
+            "ij,ij->i", self.F, tangent(self.theta)
+        )
 
     def tangential_rate(self) -> np.ndarray:
-        """d f_t / ds (m,)."""
-        return (np.einsum("ij,ij->i", self.dF, tangent(self.theta))
-                - self.dtheta * np.einsum("ij,ij->i", self.F, unit(self.theta)))
+        """D f_t / ds (m,)."""
+        return np.einsum("ij,ij->i", self.dF, tangent(self.theta)) - self.dtheta * np.einsum(
+            "ij,ij->i", self.F, unit(self.theta)
+        )
 
 
 @dataclass(frozen=True)
@@ -179,8 +191,57 @@ class Configuration:
     radius: np.ndarray
 
 
-def solve_fixed_set(C: np.ndarray, cfg: Configuration, centers: np.ndarray, dirs: np.ndarray,
-                    theta0: np.ndarray, phi: float) -> Solution:
+@dataclass(frozen=True)
+class SolveFailure:
+    """Why a fixed-set solve found no solution: a value, not an exception, because the stepper
+    tries mode hypotheses and substeps that may legitimately fail.
+
+    Attributes
+    ----------
+    reason : str
+        What failed.
+    residual : float
+        Largest cone residual |f_k x e(alpha_k)| at the last iterate (dimensionless force;
+        inf when none was computed).
+    indeterminate : bool
+        The problem itself has no unique solution (the sliding contacts do not fix the
+        object), which the input must change, rather than a solver failure.
+    """
+
+    reason: str
+    residual: float = float("inf")
+    indeterminate: bool = False
+
+    def error(self) -> InvalidInputError | NumericalError:
+        """The failure as an exception, for callers that cannot go on without a solution."""
+        if self.indeterminate:
+            return InvalidInputError(self.reason)
+        return NumericalError(self.reason, residuals={"cone": self.residual})
+
+
+def solve_fixed_set(
+    C: np.ndarray,
+    cfg: Configuration,
+    centers: np.ndarray,
+    dirs: np.ndarray,
+    theta0: np.ndarray,
+    phi: float,
+) -> Solution:
+    """:func:`attempt_fixed_set`, raising :class:`NumericalError` when it fails."""
+    result = attempt_fixed_set(C, cfg, centers, dirs, theta0, phi)
+    if isinstance(result, SolveFailure):
+        raise result.error()
+    return result
+
+
+def attempt_fixed_set(
+    C: np.ndarray,
+    cfg: Configuration,
+    centers: np.ndarray,
+    dirs: np.ndarray,
+    theta0: np.ndarray,
+    phi: float,
+) -> Solution | SolveFailure:
     """Solve the sliding constraints (eq. 47) for one contact set at given tip centres.
 
     Parameters
@@ -198,10 +259,11 @@ def solve_fixed_set(C: np.ndarray, cfg: Configuration, centers: np.ndarray, dirs
     phi : float
         Friction angle atan(mu), rad.
 
-    Raises
-    ------
-    MechanicsError
-        If Newton does not converge or produces non-finite values.
+    Returns
+    -------
+    Solution or SolveFailure
+        The failure when Newton does not converge, its Jacobian is singular or it produces
+        non-finite values.
     """
     m = len(theta0)
     theta = np.array(theta0, float)
@@ -225,18 +287,21 @@ def solve_fixed_set(C: np.ndarray, cfg: Configuration, centers: np.ndarray, dirs
         ea = unit(theta[P] - cfg.slip[P] * phi)
         # dF_k / d theta_j = C_kj r_j t(theta_j): (m, 2, |P|)
         G = np.einsum("kajb,jb->kaj", Cb[:, :, P, :], r[P, None] * tangent(theta[P]))
-        J = cross(np.moveaxis(G[P], 2, 1), ea[:, None, :]) + np.diag(np.einsum("ij,ij->i", F[P], ea))
+        J = cross(np.moveaxis(G[P], 2, 1), ea[:, None, :]) + np.diag(
+            np.einsum("ij,ij->i", F[P], ea)
+        )
         residual = float(np.abs(R).max())
         if residual <= NEWTON_TOL * force_scale:
             cond = float(np.linalg.cond(J))
             break
         if it >= NEWTON_MAX_ITERATIONS:
-            raise MechanicsError(f"Newton on the sliding angles did not converge in {it} "
-                                 f"iterations (residual {residual:.3g})")
+            return SolveFailure(
+                f"Newton on the sliding angles did not converge in {it} iterations", residual
+            )
         try:
             step = np.linalg.solve(J, R)
         except np.linalg.LinAlgError:
-            raise MechanicsError(SINGULAR_SLIDING) from None
+            return SolveFailure(SINGULAR_SLIDING, residual, indeterminate=True)
         it += 1
         for _ in range(NEWTON_BACKTRACKS):
             trial = theta.copy()
@@ -259,13 +324,13 @@ def solve_fixed_set(C: np.ndarray, cfg: Configuration, centers: np.ndarray, dirs
         try:
             dtheta[P] = -np.linalg.solve(J, cross(dF0[P], ea))
         except np.linalg.LinAlgError:
-            raise MechanicsError(SINGULAR_SLIDING) from None
+            return SolveFailure(SINGULAR_SLIDING, residual, indeterminate=True)
         dF = dF0 + G @ dtheta[P]
     else:
         dF = dF0
     ddelta = dirs + (r * dtheta)[:, None] * tangent(theta)
     if not (np.all(np.isfinite(F)) and np.all(np.isfinite(dF)) and np.all(np.isfinite(theta))):
-        raise MechanicsError("non-finite contact forces or angles in the fixed-set solve")
+        return SolveFailure("non-finite contact forces or angles in the fixed-set solve", residual)
     return Solution(theta, delta, F, dtheta, dF, ddelta, it, residual, cond)
 
 
@@ -297,10 +362,11 @@ class ContactModel:
 
     def __post_init__(self) -> None:
         if not (np.isfinite(self.mu) and self.mu >= 0):
-            raise MechanicsError(f"friction.mu must be >= 0, got {self.mu}")
+            raise InvalidInputError(f"friction.mu must be >= 0, got {self.mu}")
         if self.max_events_per_depth < 1:
-            raise MechanicsError("squeeze.max_events_per_depth must be >= 1, got "
-                                 f"{self.max_events_per_depth}")
+            raise InvalidInputError(
+                f"squeeze.max_events_per_depth must be >= 1, got {self.max_events_per_depth}"
+            )
 
     @property
     def phi(self) -> float:
@@ -335,8 +401,11 @@ class ContactModel:
         if key in sets:
             return sets[key]
         if len(key) < 2:
-            raise MechanicsError(f"the object lost contact: {len(key)} contact node(s) left; at "
-                                 "least 2 are needed to hold it (Lemma 2)")
+            raise InvalidInputError(
+                f"the object lost contact: {len(key)} contact node(s) left; "
+                "at "
+                "least 2 are needed to hold it (Lemma 2)"
+            )
         idx = np.array(key)
         dofs = node_dofs(idx)
         if self.reference:
@@ -347,8 +416,9 @@ class ContactModel:
         else:
             pos = self.obj.boundary_positions(idx)
             if np.any(pos < 0):
-                raise MechanicsError(f"contact nodes {idx[pos < 0].tolist()} are not on the outer "
-                                     "boundary")
+                raise InvalidInputError(
+                    f"contact nodes {idx[pos < 0].tolist()} are not on the outer boundary"
+                )
             A_bc = self.obj.boundary_compliance[:, node_dofs(pos)]
             A_hat = A_bc[node_dofs(pos)]
         C, E, _, condition = reduce_blocks(A_hat, self.obj.rigid[dofs])
@@ -375,7 +445,9 @@ class ContactModel:
         return self.obj.pinv_apply(unit_loads)
 
     def element_strains(self, u_hat: np.ndarray) -> np.ndarray:
-        """Engineering strains (t*3,) or (t*3, k) of dimensionless nodal displacements (2n[, k])."""
+        """Engineering strains (t*3,) or (t*3, k) of dimensionless nodal displacements (2n[,
+        k]).
+        """
         B = self._strain_b()
         de = u_hat[element_dofs(self.obj.mesh.triangles)]
         return np.einsum("tij,tj...->ti...", B, de).reshape((-1,) + u_hat.shape[1:])
@@ -386,8 +458,9 @@ class ContactModel:
         rhs[node_dofs(sd.nodes)] = F.reshape(-1)
         return self.obj.pinv_apply(rhs) + self.obj.rigid @ (sd.E.T @ delta.reshape(-1))
 
-    def boundary_displacement(self, sd: SetData, delta: np.ndarray, F: np.ndarray,
-                              rows: np.ndarray | None = None) -> np.ndarray:
+    def boundary_displacement(
+        self, sd: SetData, delta: np.ndarray, F: np.ndarray, rows: np.ndarray | None = None
+    ) -> np.ndarray:
         """Dimensionless displacement (k, 2) of boundary loop positions ``rows`` (all if None).
 
         Fast model: A_bc F + R_b g, O(k m). Reference model: a full solve.
@@ -413,7 +486,7 @@ class ContactModel:
 
 def strain_criterion(eps: np.ndarray, criterion: str) -> tuple[float, int]:
     """(max strain, element) from engineering strains (t, 3) by ``criterion`` (eq. 45)."""
-    if criterion == "componentwise":
+    if criterion == StrainCriterion.COMPONENTWISE:
         per_element = np.abs(eps[:, :2]).max(axis=1)
     else:
         per_element = np.abs(principal_strains(eps)).max(axis=1)

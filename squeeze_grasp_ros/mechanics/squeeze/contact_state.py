@@ -6,23 +6,15 @@ All quantities are SI in the object frame (x right, y up, origin of the mesh coo
 positions and displacements in m, forces in N (applied by the finger on the object), work and
 energy in J, polar angles in rad about the fingertip centre (see :mod:`.fingertips`).
 """
+
 from __future__ import annotations
 
 from dataclasses import dataclass, field
 
 import numpy as np
 
-from squeeze_grasp_ros.mechanics.squeeze.fingertips import FINGER_NAMES, Fingertip, unit
-
-EVENT_TYPES: tuple[str, ...] = ("A", "B", "C", "D")
-"""A: new contact (eq. 48); B: contact break (eq. 49); C: stick -> slip (eq. 50);
-D: slip -> stick (eq. 51)."""
-
-TERMINATIONS: tuple[str, ...] = ("depth_reached", "strain_limit", "finger_slip", "picked_up",
-                                 "contact_lost")
-"""Termination reasons of a squeeze: Sec. 5.1's four, plus ``contact_lost`` when a contact
-break (Event B) would leave a finger with no contact node (the grasp is lost; the event is not
-applied)."""
+from squeeze_grasp_ros.mechanics.squeeze.fingertips import Fingertip, unit
+from squeeze_grasp_ros.mechanics.vocabulary import ContactMode, Finger
 
 
 @dataclass(frozen=True)
@@ -84,11 +76,11 @@ class ContactNode:
     force: np.ndarray
 
     def normal_force(self) -> float:
-        """f . e(theta), N (> 0 while pressing)."""
+        """F . e(theta), N (> 0 while pressing)."""
         return float(self.force @ unit(self.theta))
 
     def tangential_force(self) -> float:
-        """f . t(theta), N."""
+        """F . t(theta), N."""
         return float(self.force[1] * np.cos(self.theta) - self.force[0] * np.sin(self.theta))
 
 
@@ -147,7 +139,7 @@ class ContactState:
 
     @property
     def relative_depth(self) -> float:
-        """depth * relative_per_depth (fraction)."""
+        """Depth * relative_per_depth (fraction)."""
         return self.depth * self.relative_per_depth
 
 
@@ -157,15 +149,26 @@ def initial_state(tips: list[Fingertip], relative_per_depth: float = 0.0) -> Con
     Initial modes are undetermined: the stepper decides them by hypothesis-and-test along the
     first motion (Algorithm 1, line 2).
     """
-    order = {name: k for k, name in enumerate(FINGER_NAMES)}
+    order = {name: k for k, name in enumerate(Finger.values())}
     tips = sorted(tips, key=lambda t: order[t.name])
-    fingers = tuple(FingerState(t.name, np.asarray(t.center, float), t.radius, np.zeros(2))
-                    for t in tips)
-    contacts = tuple(sorted((ContactNode(t.node, t.name, "stick", 0, t.theta, np.zeros(2),
-                                         np.zeros(2)) for t in tips), key=lambda c: c.node))
+    fingers = tuple(
+        FingerState(t.name, np.asarray(t.center, float), t.radius, np.zeros(2)) for t in tips
+    )
+    contacts = tuple(
+        sorted(
+            (
+                ContactNode(
+                    t.node, t.name, ContactMode.STICK, 0, t.theta, np.zeros(2), np.zeros(2)
+                )
+                for t in tips
+            ),
+            key=lambda c: c.node,
+        )
+    )
     fresh = tuple((kind, t.node) for t in tips for kind in ("B", "C+", "C-"))
-    return ContactState(fingers, contacts, 0.0, relative_per_depth,
-                        tuple(sorted(t.node for t in tips)), fresh)
+    return ContactState(
+        fingers, contacts, 0.0, relative_per_depth, tuple(sorted(t.node for t in tips)), fresh
+    )
 
 
 @dataclass(frozen=True)
@@ -199,9 +202,15 @@ class Event:
 
     def to_json(self) -> dict:
         """``{"type", "node", "finger", "depth", "relative_depth", "mode", "slip"}``."""
-        return {"type": self.type, "node": self.node, "finger": self.finger,
-                "depth": self.depth, "relative_depth": self.relative_depth,
-                "mode": self.mode, "slip": self.slip}
+        return {
+            "type": self.type,
+            "node": self.node,
+            "finger": self.finger,
+            "depth": self.depth,
+            "relative_depth": self.relative_depth,
+            "mode": self.mode,
+            "slip": self.slip,
+        }
 
 
 @dataclass(frozen=True)

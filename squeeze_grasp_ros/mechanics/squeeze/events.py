@@ -9,6 +9,7 @@ initial contact nodes (fingertips on the outward normals, stable/pure squeeze di
 final segments, forces, energy, work, polar-angle trajectories and grasp-health numbers.
 SI units at the interface, object frame.
 """
+
 from __future__ import annotations
 
 from collections.abc import Callable, Mapping
@@ -17,14 +18,31 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from squeeze_grasp_ros.mechanics.elastic.compliance import ElasticObject
-from squeeze_grasp_ros.mechanics.squeeze.contact_model import ContactModel, Limits, strain_criterion
-from squeeze_grasp_ros.mechanics.squeeze.contact_state import (EVENT_TYPES, Chatter, ContactNode, ContactState, Event, Sample,
-                            initial_state)
-from squeeze_grasp_ros.mechanics.errors import MechanicsError, require_finite
+from squeeze_grasp_ros.mechanics.squeeze.contact_model import (
+    ContactModel,
+    Limits,
+    strain_criterion,
+)
+from squeeze_grasp_ros.mechanics.squeeze.contact_state import (
+    Chatter,
+    ContactNode,
+    ContactState,
+    Event,
+    Sample,
+    initial_state,
+)
+from squeeze_grasp_ros.mechanics.errors import InvalidInputError, require_finite
 from squeeze_grasp_ros.mechanics.elastic.fem import element_strains, von_mises_stress
 from squeeze_grasp_ros.mechanics.squeeze.fingertips import place_fingertip
 from squeeze_grasp_ros.mechanics.squeeze.stable_pure import plan_squeeze
 from squeeze_grasp_ros.mechanics.squeeze.stepper import TERMINATION_ORDER, advance
+from squeeze_grasp_ros.mechanics.vocabulary import (
+    EventType,
+    Finger,
+    SQUEEZING_FINGERS,
+    SqueezeKind,
+    Termination,
+)
 
 MAX_STALLED_CALLS = 3
 
@@ -64,11 +82,16 @@ def _merge(total: dict, new: dict) -> None:
             total[key] = max(total.get(key, value), value)
 
 
-def squeeze_to_depth(model: ContactModel, state: ContactState,
-                     directions: Mapping[str, tuple[float, float]], depth: float,
-                     step: float = 1e-3, event_tol: float = 1e-9,
-                     progress: Callable[[float], None] | None = None,
-                     terminate_on: tuple[str, ...] = TERMINATION_ORDER) -> SqueezeRun:
+def squeeze_to_depth(
+    model: ContactModel,
+    state: ContactState,
+    directions: Mapping[str, tuple[float, float]],
+    depth: float,
+    step: float = 1e-3,
+    event_tol: float = 1e-9,
+    progress: Callable[[float], None] | None = None,
+    terminate_on: tuple[str, ...] = TERMINATION_ORDER,
+) -> SqueezeRun:
     """Algorithm 1: advance the fingers along ``directions`` until ``depth`` or a termination.
 
     Parameters
@@ -89,18 +112,25 @@ def squeeze_to_depth(model: ContactModel, state: ContactState,
         Terminations that end the squeeze besides the depth.
     """
     if not (np.isfinite(depth) and depth >= 0):
-        raise MechanicsError(f"squeeze depth must be >= 0 m, got {depth}")
+        raise InvalidInputError(f"squeeze depth must be >= 0 m, got {depth}")
     dirs = {k: np.asarray(v, float) for k, v in directions.items()}
     start = state.depth
     events: list[Event] = []
     samples: list[Sample] = []
     chatter: list[Chatter] = []
     diag: dict = {"advance_calls": 0}
-    termination, stalled = "depth_reached", 0
+    termination, stalled = Termination.DEPTH_REACHED, 0
     while True:
         remaining = depth - (state.depth - start)
-        result = advance(model, state, {k: remaining * v for k, v in dirs.items()}, step,
-                         event_tol, stop_on_event=True, terminate_on=terminate_on)
+        result = advance(
+            model,
+            state,
+            {k: remaining * v for k, v in dirs.items()},
+            step,
+            event_tol,
+            stop_on_event=True,
+            terminate_on=terminate_on,
+        )
         diag["advance_calls"] += 1
         _merge(diag, result.diagnostics)
         events += result.events
@@ -116,7 +146,7 @@ def squeeze_to_depth(model: ContactModel, state: ContactState,
             break
         stalled = stalled + 1 if result.fraction == 0 and not result.events else 0
         if stalled >= MAX_STALLED_CALLS:
-            raise MechanicsError(f"the squeeze stalled at depth {state.depth:.6g} m")
+            raise InvalidInputError(f"the squeeze stalled at depth {state.depth:.6g} m")
     return SqueezeRun(state, tuple(events), tuple(samples), tuple(chatter), termination, diag)
 
 
@@ -151,10 +181,16 @@ class SegmentNode:
 
     def to_json(self) -> dict:
         """All fields as a JSON-able dict (force as [fx, fy])."""
-        return {"node": self.node, "mode": self.mode, "slip": self.slip,
-                "force": self.force.tolist(), "normal_force": self.normal_force,
-                "tangential_force": self.tangential_force, "slip_margin": self.slip_margin,
-                "theta": self.theta}
+        return {
+            "node": self.node,
+            "mode": self.mode,
+            "slip": self.slip,
+            "force": self.force.tolist(),
+            "normal_force": self.normal_force,
+            "tangential_force": self.tangential_force,
+            "slip_margin": self.slip_margin,
+            "theta": self.theta,
+        }
 
 
 @dataclass(frozen=True)
@@ -188,12 +224,16 @@ class GraspHealth:
 
     def to_json(self) -> dict:
         """All fields as a JSON-able dict."""
-        return {"max_strain": self.max_strain, "max_strain_element": self.max_strain_element,
-                "criterion": self.criterion, "max_von_mises": self.max_von_mises,
-                "max_von_mises_element": self.max_von_mises_element,
-                "max_displacement": self.max_displacement,
-                "max_displacement_node": self.max_displacement_node,
-                "slip_margin": dict(self.slip_margin)}
+        return {
+            "max_strain": self.max_strain,
+            "max_strain_element": self.max_strain_element,
+            "criterion": self.criterion,
+            "max_von_mises": self.max_von_mises,
+            "max_von_mises_element": self.max_von_mises_element,
+            "max_displacement": self.max_displacement,
+            "max_displacement_node": self.max_displacement_node,
+            "slip_margin": dict(self.slip_margin),
+        }
 
 
 @dataclass(frozen=True)
@@ -268,7 +308,7 @@ class EventSqueeze:
     @property
     def event_counts(self) -> dict:
         """{"A": n, "B": n, "C": n, "D": n}."""
-        return {t: sum(1 for e in self.events if e.type == t) for t in EVENT_TYPES}
+        return {t: sum(1 for e in self.events if e.type == t) for t in EventType.values()}
 
     def to_json(self) -> dict:
         """JSON-able dict with the keys and names of docs/design.md §2 and docs/events.md."""
@@ -286,7 +326,9 @@ class EventSqueeze:
             "segments": {k: [s.to_json() for s in v] for k, v in self.segments.items()},
             "energy": self.energy,
             "work": dict(self.work),
-            "finger_force": {k: {"start": v[0], "end": v[1]} for k, v in self.finger_force.items()},
+            "finger_force": {
+                k: {"start": v[0], "end": v[1]} for k, v in self.finger_force.items()
+            },
             "mu": self.mu,
             "tip_radius": radii[0] if len(set(radii)) == 1 else max(radii),
             "tip_radii": dict(self.tip_radius),
@@ -303,8 +345,9 @@ class EventSqueeze:
 def segment_node(c: ContactNode, mu: float) -> SegmentNode:
     """Summary of a contact node (forces in N)."""
     fn, ft = c.normal_force(), c.tangential_force()
-    return SegmentNode(c.node, c.mode, c.slip, np.asarray(c.force, float), fn, ft,
-                       mu * fn - abs(ft), c.theta)
+    return SegmentNode(
+        c.node, c.mode, c.slip, np.asarray(c.force, float), fn, ft, mu * fn - abs(ft), c.theta
+    )
 
 
 def grasp_health(model: ContactModel, state: ContactState) -> tuple[GraspHealth, np.ndarray]:
@@ -329,8 +372,16 @@ def grasp_health(model: ContactModel, state: ContactState) -> tuple[GraspHealth,
         seg = [segment_node(c, model.mu).slip_margin for c in state.contacts if c.finger == f.name]
         if seg:
             margins[f.name] = float(min(seg))
-    health = GraspHealth(strain, element, criterion, float(vm.max()), int(np.argmax(vm)),
-                         float(norms.max()), int(np.argmax(norms)), margins)
+    health = GraspHealth(
+        strain,
+        element,
+        criterion,
+        float(vm.max()),
+        int(np.argmax(vm)),
+        float(norms.max()),
+        int(np.argmax(norms)),
+        margins,
+    )
     require_finite("grasp health", [strain, health.max_von_mises, health.max_displacement])
     return health, u
 
@@ -345,14 +396,22 @@ def polar_trajectories(samples: tuple[Sample, ...], relative_per_depth: float) -
     return {k: tuple(v) for k, v in out.items()}
 
 
-def event_squeeze(obj: ElasticObject, contacts: tuple[int, int],
-                  tip_radius: float | Mapping[str, float], mu: float, kind: str = "stable",
-                  depth: float | None = None, relative_depth: float | None = None,
-                  limits: Limits | None = None,
-                  step: float = 1e-3, event_tol: float = 1e-9, reference: bool = False,
-                  max_events_per_depth: int = 4,
-                  directions: Mapping[str, tuple[float, float]] | None = None,
-                  progress: Callable[[float], None] | None = None) -> EventSqueeze:
+def event_squeeze(
+    obj: ElasticObject,
+    contacts: tuple[int, int],
+    tip_radius: float | Mapping[str, float],
+    mu: float,
+    *, kind: str = SqueezeKind.STABLE,
+    depth: float | None = None,
+    relative_depth: float | None = None,
+    limits: Limits | None = None,
+    step: float = 1e-3,
+    event_tol: float = 1e-9,
+    reference: bool = False,
+    max_events_per_depth: int = 4,
+    directions: Mapping[str, tuple[float, float]] | None = None,
+    progress: Callable[[float], None] | None = None,
+) -> EventSqueeze:
     """Event-driven two-finger squeeze of ``obj`` from initial contact nodes (F1, F2).
 
     Parameters
@@ -381,12 +440,23 @@ def event_squeeze(obj: ElasticObject, contacts: tuple[int, int],
         User-given finger translation directions (normalised so the stacked vector has norm 1).
     progress : callable, optional
         Called with the completed fraction.
+
+    Examples
+    --------
+    >>> from squeeze_grasp_ros.api import finger_nodes, load_scene, scene_file, scene_solid
+    >>> scene = load_scene(scene_file("foam_square"))
+    >>> obj = scene_solid(scene)
+    >>> res = event_squeeze(obj, finger_nodes(scene, obj.mesh), 0.02, 0.4, relative_depth=0.05)
+    >>> print(res.termination, sorted({e.type for e in res.events}))
+    depth_reached ['A']
     """
     if (depth is None) == (relative_depth is None):
-        raise MechanicsError("give exactly one of depth (m) and relative_depth")
-    names = ("F1", "F2")
-    radii = dict(tip_radius) if isinstance(tip_radius, Mapping) else dict.fromkeys(names, tip_radius)
-    plan = plan_squeeze(obj, list(contacts), kind)
+        raise InvalidInputError("give exactly one of depth (m) and relative_depth")
+    names = SQUEEZING_FINGERS
+    radii = (
+        dict(tip_radius) if isinstance(tip_radius, Mapping) else dict.fromkeys(names, tip_radius)
+    )
+    plan = plan_squeeze(obj, list(contacts), kind=kind)
     p = obj.mesh.nodes[list(contacts)]
     distance = float(np.linalg.norm(p[1] - p[0]))
     if directions is None:
@@ -397,24 +467,29 @@ def event_squeeze(obj: ElasticObject, contacts: tuple[int, int],
         stacked = np.array([directions[n] for n in names], float)
         norm = float(np.linalg.norm(stacked))
         if not norm > 0:
-            raise MechanicsError("squeeze directions must not all be zero")
+            raise InvalidInputError("squeeze directions must not all be zero")
         dirs = {n: stacked[k] / norm for k, n in enumerate(names)}
-        approach = float((dirs["F1"] - dirs["F2"]) @ (p[1] - p[0]) / distance)
+        approach = float((dirs[Finger.F1] - dirs[Finger.F2]) @ (p[1] - p[0]) / distance)
         kind = "custom"
     relative_per_depth = approach / distance
     if depth is None:
         if not relative_per_depth > 0:
-            raise MechanicsError("the fingers do not approach each other: relative depth undefined")
+            raise InvalidInputError(
+                "the fingers do not approach each other: relative depth undefined"
+            )
         depth = relative_depth / relative_per_depth
     require_finite("depth", depth)
     if depth < 0 or depth * relative_per_depth >= 1.0:
-        raise MechanicsError(f"depth {depth:.6g} m is a relative depth of "
-                             f"{depth * relative_per_depth:.6g}: it must be in [0, 1) (at 1 the "
-                             "fingers would meet)")
+        raise InvalidInputError(
+            f"depth {depth:.6g} m is a relative depth of "
+            f"{depth * relative_per_depth:.6g}: it must be in [0, 1) (at 1 the "
+            "fingers would meet)"
+        )
     tips = [place_fingertip(obj.mesh, n, int(c), radii[n]) for n, c in zip(names, contacts)]
     model = ContactModel(obj, mu, limits or Limits(), reference, max_events_per_depth)
-    run = squeeze_to_depth(model, initial_state(tips, relative_per_depth), dirs, depth, step,
-                           event_tol, progress)
+    run = squeeze_to_depth(
+        model, initial_state(tips, relative_per_depth), dirs, depth, step, event_tol, progress
+    )
     state = run.state
     health, u_field = grasp_health(model, state)
     delta = np.array([c.displacement for c in state.contacts])
@@ -423,18 +498,35 @@ def event_squeeze(obj: ElasticObject, contacts: tuple[int, int],
     forces_along = {}
     for name in names:
         d = dirs[name] / max(np.linalg.norm(dirs[name]), 1e-300)
-        forces_along[name] = (float(np.asarray(run.samples[0].finger_forces[name]) @ d),
-                              float(state.finger_force(name) @ d))
+        forces_along[name] = (
+            float(np.asarray(run.samples[0].finger_forces[name]) @ d),
+            float(state.finger_force(name) @ d),
+        )
     diag = dict(run.diagnostics)
     diag["compliance"] = obj.diagnostics()
     diag["work_minus_energy"] = sum(f.work for f in state.fingers) - energy
     return EventSqueeze(
-        termination=run.termination, depth=state.depth,
-        relative_depth=state.depth * relative_per_depth, target_depth=float(depth), kind=kind,
-        contacts=tuple(int(c) for c in contacts), directions=dirs, mu=float(mu),
-        tip_radius=radii, events=run.events,
+        termination=run.termination,
+        depth=state.depth,
+        relative_depth=state.depth * relative_per_depth,
+        target_depth=float(depth),
+        kind=kind,
+        contacts=tuple(int(c) for c in contacts),
+        directions=dirs,
+        mu=float(mu),
+        tip_radius=radii,
+        events=run.events,
         segments={n: tuple(segment_node(c, mu) for c in state.segment(n)) for n in names},
-        energy=energy, work={f.name: f.work for f in state.fingers}, finger_force=forces_along,
-        trajectories=polar_trajectories(run.samples, relative_per_depth), health=health,
-        chatter=run.chatter, displacement=u_field, state=state, step=step, event_tol=event_tol,
-        reference=reference, diagnostics=diag)
+        energy=energy,
+        work={f.name: f.work for f in state.fingers},
+        finger_force=forces_along,
+        trajectories=polar_trajectories(run.samples, relative_per_depth),
+        health=health,
+        chatter=run.chatter,
+        displacement=u_field,
+        state=state,
+        step=step,
+        event_tol=event_tol,
+        reference=reference,
+        diagnostics=diag,
+    )

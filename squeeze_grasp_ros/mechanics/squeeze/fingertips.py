@@ -19,12 +19,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from squeeze_grasp_ros.mechanics.errors import MechanicsError
+from squeeze_grasp_ros.mechanics.errors import InvalidInputError
 from squeeze_grasp_ros.mechanics.elastic.mesh import Mesh
+from squeeze_grasp_ros.mechanics.vocabulary import Finger
 
-FINGER_NAMES: tuple[str, ...] = ("F1", "F2", "A")
-"""Finger names in their canonical order (docs/design.md §2): the two squeezing fingers, then
-the adversary."""
 
 
 def unit(theta) -> np.ndarray:
@@ -70,17 +68,19 @@ class Fingertip:
 
 
 def place_fingertip(mesh: Mesh, name: str, node: int, radius: float) -> Fingertip:
-    """Fingertip ``name`` of radius ``radius`` (m) touching boundary ``node`` on its outward normal.
+    """Fingertip ``name`` of radius ``radius`` (m) touching boundary ``node`` on its outward
+    normal.
 
     Raises
     ------
-    MechanicsError
+    InvalidInputError
         For an unknown finger name, a non-positive radius or a node not on the outer boundary.
     """
-    if name not in FINGER_NAMES:
-        raise MechanicsError(f"finger name must be one of {FINGER_NAMES}, got {name!r}")
+    if name not in Finger.values():
+        raise InvalidInputError(f"finger name must be one of {Finger.values()}, got {name!r}")
     if not (np.isfinite(radius) and radius > 0):
-        raise MechanicsError(f"fingers.{name}.tip_radius must be > 0 m for rounded-tip contact, "
+        raise InvalidInputError(f"fingers.{name}.tip_radius must be > 0 m for rounded-tip "
+                                "contact, "
                              f"got {radius}")
     n = mesh.normal_at(int(node))
     p = mesh.nodes[int(node)]

@@ -10,6 +10,7 @@ no solve per pair.
 Point-contact stiffnesses depend on the mesh (a 2-D point load has unbounded displacement
 under it; docs/design.md §2): compare placements on one mesh, never across meshes.
 """
+
 from __future__ import annotations
 
 from dataclasses import dataclass
@@ -56,8 +57,11 @@ class GraspMap:
         score = np.where(np.triu(self.feasible, 1), self.stiffness, -np.inf)
         flat = np.argsort(score, axis=None)[::-1][:count]
         rows, cols = np.unravel_index(flat, score.shape)
-        return [(int(self.boundary[r]), int(self.boundary[c]), float(self.stiffness[r, c]))
-                for r, c in zip(rows, cols) if np.isfinite(score[r, c])]
+        return [
+            (int(self.boundary[r]), int(self.boundary[c]), float(self.stiffness[r, c]))
+            for r, c in zip(rows, cols)
+            if np.isfinite(score[r, c])
+        ]
 
     def to_json(self, pairs: bool = False) -> dict:
         """Summary (and, with ``pairs``, the full matrices as nested lists)."""
@@ -81,7 +85,21 @@ class GraspMap:
 
 
 def grasp_map(obj: ElasticObject, mu: float) -> GraspMap:
-    """Stable-squeeze stiffness, inwardness and force closure of all boundary-node pairs."""
+    """Stable-squeeze stiffness, inwardness and force closure of all boundary-node pairs.
+
+    Examples
+    --------
+    >>> from squeeze_grasp_ros.mechanics.elastic import shapes
+    >>> from squeeze_grasp_ros.api import ElasticObject, Material, generate_mesh
+    >>> mesh = generate_mesh(shapes.disk(0.05), 2e-4)
+    >>> obj = ElasticObject(mesh, Material(E=1e5, nu=0.3, thickness=0.01))
+    >>> i, j = (int(mesh.boundary[k]) for k in (0, len(mesh.boundary) // 2))
+    >>> gmap = grasp_map(obj, mu=0.4)
+    >>> b = len(mesh.boundary)
+    >>> symmetric = np.allclose(gmap.stiffness, gmap.stiffness.T, equal_nan=True)
+    >>> gmap.stiffness.shape == (b, b), bool(symmetric)
+    (True, True)
+    """
     mesh = obj.mesh
     p = mesh.nodes[mesh.boundary] / obj.scale
     n = mesh.normals
@@ -100,7 +118,8 @@ def grasp_map(obj: ElasticObject, mu: float) -> GraspMap:
     stiffness = obj.material.force_scale / q
     inward = (np.einsum("abi,ai->ab", d, n) < 0) & (np.einsum("abi,bi->ab", d, n) > 0)
     pts = mesh.nodes[mesh.boundary]
-    closure = force_closure_pairs(pts[:, None, :], n[:, None, :], pts[None, :, :],
-                                  n[None, :, :], mu)
+    closure = force_closure_pairs(
+        pts[:, None, :], n[:, None, :], pts[None, :, :], n[None, :, :], mu
+    )
     np.fill_diagonal(inward, False)
     return GraspMap(mesh.boundary.copy(), stiffness, inward, closure, float(mu))

@@ -25,8 +25,9 @@ import scipy.sparse.linalg as spla
 
 from squeeze_grasp_ros.mechanics.elastic.compliance import ElasticObject
 from squeeze_grasp_ros.mechanics.squeeze.contact_state import ContactState
-from squeeze_grasp_ros.mechanics.errors import MechanicsError
+from squeeze_grasp_ros.mechanics.errors import NumericalError
 from squeeze_grasp_ros.mechanics.squeeze.fingertips import tangent, unit
+from squeeze_grasp_ros.mechanics.vocabulary import ContactMode
 
 ONE_SHOT_MAX_ITERATIONS = 30
 
@@ -65,7 +66,7 @@ def one_shot_solve(obj: ElasticObject, state: ContactState, mu: float,
 
     Raises
     ------
-    MechanicsError
+    InvalidInputError
         If Newton does not converge.
     """
     L, fu = obj.scale, obj.material.force_scale * obj.scale
@@ -74,7 +75,7 @@ def one_shot_solve(obj: ElasticObject, state: ContactState, mu: float,
     phi = float(np.arctan(mu))
     contacts = state.contacts
     nodes = np.array([c.node for c in contacts], int)
-    stick = np.array([c.mode == "stick" for c in contacts], bool)
+    stick = np.array([c.mode == ContactMode.STICK for c in contacts], bool)
     slip = np.array([c.slip for c in contacts], float)
     fingers = {f.name: f for f in state.fingers}
     centers = np.array([fingers[c.finger].center for c in contacts]) / L
@@ -108,8 +109,10 @@ def one_shot_solve(obj: ElasticObject, state: ContactState, mu: float,
             break
         # d r_u / d theta_P = -E_P lambda t(alpha); d r_P / d theta_P = -r t(theta)
         cols = np.arange(nP)
-        blk = lambda v: sp.csr_matrix((v.reshape(-1), (np.arange(2 * nP), np.repeat(cols, 2))),
-                                      shape=(2 * nP, nP))
+
+        def blk(v: np.ndarray) -> sp.csr_matrix:
+            return sp.csr_matrix((v.reshape(-1), (np.arange(2 * nP), np.repeat(cols, 2))),
+                                 shape=(2 * nP, nP))
         J = sp.bmat([
             [K, -ET, -EP @ blk(lam[:, None] * ta), -EP @ blk(ea)],
             [ET.T, None, None, None],
@@ -117,14 +120,15 @@ def one_shot_solve(obj: ElasticObject, state: ContactState, mu: float,
         ], format="csc")
         dx = spla.spsolve(J, -r)
         if not np.all(np.isfinite(dx)):
-            raise MechanicsError("one-shot solve: singular saddle-point system (too few "
-                                 "sticking contacts to fix the rigid motion?)")
+            raise NumericalError("one-shot solve: singular saddle-point system (too few "
+                                 "sticking contacts to fix the rigid motion?)",
+                                 residuals={"newton": residual})
         u += dx[:n2]
         fT += dx[n2:n2 + 2 * nT]
         theta[P] += dx[n2 + 2 * nT:n2 + 2 * nT + nP]
         lam += dx[n2 + 2 * nT + nP:]
     else:
-        raise MechanicsError(f"one-shot Newton did not converge (residual {residual:.3g})")
+        raise NumericalError("one-shot Newton did not converge", residuals={"newton": residual})
     forces = np.zeros((len(nodes), 2))
     forces[T] = fT.reshape(-1, 2)
     forces[P] = lam[:, None] * unit(theta[P] - slip[P] * phi)

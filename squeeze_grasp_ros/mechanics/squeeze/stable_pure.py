@@ -10,15 +10,18 @@ col(AC) are the pure contact displacements, Theorem 8). Depths follow docs/desig
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Literal
 
 import numpy as np
 
 from squeeze_grasp_ros.mechanics.elastic.compliance import ElasticObject
-from squeeze_grasp_ros.mechanics.errors import InfeasibleError, MechanicsError
-from squeeze_grasp_ros.mechanics.elastic.reduced import ReducedStiffness, reduced_stiffness, rotation_angle
+from squeeze_grasp_ros.mechanics.errors import InfeasibleError, InvalidInputError
+from squeeze_grasp_ros.mechanics.elastic.reduced import (
+    ReducedStiffness,
+    reduced_stiffness,
+    rotation_angle,
+)
+from squeeze_grasp_ros.mechanics.vocabulary import SqueezeKind
 
-SqueezeKind = Literal["stable", "pure"]
 
 
 @dataclass(frozen=True)
@@ -31,7 +34,8 @@ class Squeeze:
     contacts : (m,) ndarray of int
         Initial contact node indices.
     displacement : (2m,) ndarray
-        Unit contact displacement (||.|| = 1), dimensionless direction; depth rho multiplies it (m).
+        Unit contact displacement (||.|| = 1), dimensionless direction; depth rho multiplies it
+        (m).
     forces : (2m,) ndarray
         Contact forces per unit depth, N/m (forces at depth rho are rho * forces).
     energy_per_unit_depth2 : float
@@ -72,11 +76,11 @@ class Squeeze:
 
 
 def two_contact_direction(p_i: np.ndarray, p_j: np.ndarray) -> np.ndarray:
-    """u of eq. (40): the two nodes move toward each other, ||u|| = 1."""
+    """U of eq. (40): the two nodes move toward each other, ||u|| = 1."""
     d = np.asarray(p_j, float) - np.asarray(p_i, float)
     dist = np.linalg.norm(d)
     if dist == 0:
-        raise MechanicsError("the two contact nodes coincide")
+        raise InvalidInputError("the two contact nodes coincide")
     return np.concatenate([d, -d]) / (np.sqrt(2.0) * dist)
 
 
@@ -110,20 +114,34 @@ def _approach(delta: np.ndarray, points: np.ndarray) -> tuple[float, float]:
     return float(rel.max()), float(dist.max())
 
 
-def plan_squeeze(obj: ElasticObject, contacts, kind: SqueezeKind = "stable",
+def plan_squeeze(obj: ElasticObject, contacts, *, kind: SqueezeKind = SqueezeKind.STABLE,
                  red: ReducedStiffness | None = None) -> Squeeze:
     """Unit stable or pure squeeze at point ``contacts`` (m >= 2 boundary nodes).
 
     Raises
     ------
-    MechanicsError
+    InvalidInputError
         For bad contacts or an unknown ``kind``.
+
+    Examples
+    --------
+    >>> from squeeze_grasp_ros.mechanics.elastic import shapes
+    >>> from squeeze_grasp_ros.api import ElasticObject, Material, generate_mesh
+    >>> mesh = generate_mesh(shapes.disk(0.05), 2e-4)
+    >>> obj = ElasticObject(mesh, Material(E=1e5, nu=0.3, thickness=0.01))
+    >>> i, j = (int(mesh.boundary[k]) for k in (0, len(mesh.boundary) // 2))
+    >>> stable = plan_squeeze(obj, [i, j])
+    >>> print(stable.kind, stable.inward, f"{np.linalg.norm(stable.displacement):.3f}")
+    stable True 1.000
+    >>> pure = plan_squeeze(obj, [i, j], kind="pure")
+    >>> bool(abs(pure.rigid_rotation) < 1e-9)
+    True
     """
-    if kind not in ("stable", "pure"):
-        raise MechanicsError(f"squeeze type must be 'stable' or 'pure', got {kind!r}")
+    if kind not in (SqueezeKind.STABLE, SqueezeKind.PURE):
+        raise InvalidInputError(f"squeeze type must be 'stable' or 'pure', got {kind!r}")
     red = red if red is not None else reduced_stiffness(obj, contacts)
     u = stable_direction(obj, red)
-    if kind == "stable":
+    if kind == SqueezeKind.STABLE:
         delta = u
     else:
         w = red.pure_part(u)
@@ -156,7 +174,7 @@ def force_closure(p_i, n_i, p_j, n_j, mu: float) -> bool:
 def force_closure_pairs(p_i, n_i, p_j, n_j, mu: float) -> np.ndarray:
     """Vectorised :func:`force_closure` over arrays of placements (..., 2) -> bool (...)."""
     if not (np.isfinite(mu) and mu >= 0):
-        raise MechanicsError(f"friction coefficient mu must be >= 0, got {mu}")
+        raise InvalidInputError(f"friction coefficient mu must be >= 0, got {mu}")
     d = p_j - p_i
     dist = np.linalg.norm(d, axis=-1)
     safe = np.where(dist > 0, dist, 1.0)

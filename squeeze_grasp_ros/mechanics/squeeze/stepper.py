@@ -62,6 +62,7 @@ Between substeps the sliding angles are continued from the previous point (predi
 theta + dtheta/ds ds, Newton with line search); a substep whose Newton solve is slow or lands
 off the predicted branch is halved.
 """
+
 from __future__ import annotations
 
 import itertools
@@ -70,15 +71,33 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from squeeze_grasp_ros.mechanics.squeeze.contact_model import Configuration, ContactModel, Solution, solve_fixed_set
-from squeeze_grasp_ros.mechanics.squeeze.contact_state import (Chatter, ContactNode, ContactState, Event, FingerState, Sample,
-                            StepResult)
-from squeeze_grasp_ros.mechanics.errors import MechanicsError, require_finite
+from squeeze_grasp_ros.mechanics.squeeze.contact_model import (
+    Configuration,
+    ContactModel,
+    Solution,
+    SolveFailure,
+    attempt_fixed_set,
+)
+from squeeze_grasp_ros.mechanics.squeeze.contact_state import (
+    Chatter,
+    ContactNode,
+    ContactState,
+    Event,
+    FingerState,
+    Sample,
+    StepResult,
+)
+from squeeze_grasp_ros.mechanics.errors import InvalidInputError, NumericalError, require_finite
 from squeeze_grasp_ros.mechanics.squeeze.fingertips import tip_gaps
+from squeeze_grasp_ros.mechanics.vocabulary import ContactMode, Termination
 
 EVENT_ORDER = {"B": 0, "D": 1, "C+": 2, "C-": 2, "A": 3}
 """Processing order of simultaneous events (C+ and C- never coexist on one node)."""
-TERMINATION_ORDER: tuple[str, ...] = ("strain_limit", "finger_slip", "picked_up")
+TERMINATION_ORDER: tuple[str, ...] = (
+    Termination.STRAIN_LIMIT,
+    Termination.FINGER_SLIP,
+    Termination.PICKED_UP,
+)
 SLIP_RATE_ZERO = 1e-10
 """Frictionless contacts: polar-angle rates (rad per unit motion) below this have no slip
 direction, so round-off in a symmetric contact cannot fake a one-way finger slip."""
@@ -90,8 +109,15 @@ beyond which a substep is halved."""
 MAX_ROOT_ITERATIONS = 200
 
 
-def pickup_margin(mu: float, fn: np.ndarray, ft: np.ndarray, stick: np.ndarray,
-                  finger: np.ndarray, fingers: list[int], weight: float) -> float:
+def pickup_margin(
+    mu: float,
+    fn: np.ndarray,
+    ft: np.ndarray,
+    stick: np.ndarray,
+    finger: np.ndarray,
+    fingers: list[int],
+    weight: float,
+) -> float:
     """How far the grasp is from lifting the object, in force units (> 0: cannot lift yet).
 
     The object lies on a horizontal plane and is lifted out of it. A contact node with normal
@@ -106,8 +132,9 @@ def pickup_margin(mu: float, fn: np.ndarray, ft: np.ndarray, stick: np.ndarray,
     return float(weight / len(fingers) - min(totals))
 
 
-def _locate(g: Callable[[float], float], a: float, b: float, ga: float, gb: float,
-            tol: float) -> tuple[float, float, int]:
+def _locate(
+    g: Callable[[float], float], a: float, b: float, ga: float, gb: float, tol: float
+) -> tuple[float, float, int]:
     """Bracket [a, b] of width <= tol around the first sign change (ga > 0 >= gb).
 
     Illinois regula falsi with a bisection safeguard; returns (a, b, evaluations).
@@ -115,7 +142,10 @@ def _locate(g: Callable[[float], float], a: float, b: float, ga: float, gb: floa
     evaluations, retained, width = 0, 0, b - a
     while b - a > tol:
         if evaluations >= MAX_ROOT_ITERATIONS:
-            raise MechanicsError(f"event location did not converge (bracket {b - a:.3g} > {tol:.3g})")
+            raise NumericalError(
+                f"event location did not converge in {evaluations} evaluations",
+                residuals={"bracket": b - a, "tolerance": tol},
+            )
         if evaluations % 3 == 2 and b - a > 0.5 * width:
             c = 0.5 * (a + b)
         else:
@@ -154,16 +184,23 @@ class _Values:
 class _Run:
     """Mutable working copy of a state during one :func:`advance` call (dimensionless)."""
 
-    def __init__(self, model: ContactModel, state: ContactState,
-                 translations: Mapping[str, tuple[float, float]], step: float, event_tol: float,
-                 terminate_on: tuple[str, ...]) -> None:
+    def __init__(
+        self,
+        model: ContactModel,
+        state: ContactState,
+        translations: Mapping[str, tuple[float, float]],
+        step: float,
+        event_tol: float,
+        terminate_on: tuple[str, ...],
+    ) -> None:
         self.model = model
         L = model.length
         self.names = [f.name for f in state.fingers]
         unknown = sorted(set(translations) - set(self.names))
         if unknown:
-            raise MechanicsError(f"translation given for unknown finger {unknown[0]!r} "
-                                 f"(state has {self.names})")
+            raise InvalidInputError(
+                f"translation given for unknown finger {unknown[0]!r} (state has {self.names})"
+            )
         self.c0 = np.array([f.center for f in state.fingers], float) / L
         self.D = np.array([translations.get(n, (0.0, 0.0)) for n in self.names], float) / L
         require_finite("finger translations", self.D)
@@ -178,7 +215,7 @@ class _Run:
         order = {n: k for k, n in enumerate(self.names)}
         self.nodes = np.array([c.node for c in state.contacts], int)
         self.fidx = np.array([order[c.finger] for c in state.contacts], int)
-        self.stick = np.array([c.mode == "stick" for c in state.contacts], bool)
+        self.stick = np.array([c.mode == ContactMode.STICK for c in state.contacts], bool)
         self.slip = np.array([c.slip for c in state.contacts], int)
         self.theta = np.array([c.theta for c in state.contacts], float)
         self.undetermined = set(state.undetermined)
@@ -193,9 +230,15 @@ class _Run:
         self.events: list[Event] = []
         self.chatter: list[Chatter] = []
         self.samples: list[Sample] = []
-        self.diag = {"newton_max_iterations": 0, "newton_max_residual": 0.0,
-                     "jacobian_max_condition": 1.0, "root_evaluations": 0, "substeps": 0,
-                     "substep_halvings": 0, "ambiguous_modes": 0}
+        self.diag = {
+            "newton_max_iterations": 0,
+            "newton_max_residual": 0.0,
+            "jacobian_max_condition": 1.0,
+            "root_evaluations": 0,
+            "substeps": 0,
+            "substep_halvings": 0,
+            "ambiguous_modes": 0,
+        }
         self._refresh_set()
 
     # ----------------------------------------------------------------- contact set and solve
@@ -211,15 +254,35 @@ class _Run:
         """Depth (m) at step parameter s."""
         return self.depth0 + s * self.rate * self.model.length
 
-    def solve(self, s: float, theta: np.ndarray | None = None,
-              stick: np.ndarray | None = None, slip: np.ndarray | None = None) -> Solution:
-        """Fixed-set solution at parameter s (modes default to the current ones)."""
+    def solve(self, s: float, theta: np.ndarray | None = None) -> Solution:
+        """Fixed-set solution at parameter s with the current modes; NumericalError if none."""
+        sol = self.attempt(s, theta)
+        if isinstance(sol, SolveFailure):
+            raise sol.error()
+        return sol
+
+    def attempt(
+        self,
+        s: float,
+        theta: np.ndarray | None = None,
+        stick: np.ndarray | None = None,
+        slip: np.ndarray | None = None,
+    ) -> Solution | SolveFailure:
+        """Fixed-set solution at parameter s (modes default to the current ones), or why not."""
         stick = self.stick if stick is None else stick
         slip = self.slip if slip is None else slip
         cfg = Configuration(self.p0, stick, slip, self.radius_f[self.fidx])
         centers = self.c0[self.fidx] + s * self.D[self.fidx]
-        sol = solve_fixed_set(self.sd.C, cfg, centers, self.D[self.fidx],
-                              self.theta if theta is None else theta, self.model.phi)
+        sol = attempt_fixed_set(
+            self.sd.C,
+            cfg,
+            centers,
+            self.D[self.fidx],
+            self.theta if theta is None else theta,
+            self.model.phi,
+        )
+        if isinstance(sol, SolveFailure):
+            return sol
         d = self.diag
         d["newton_max_iterations"] = max(d["newton_max_iterations"], sol.iterations)
         d["newton_max_residual"] = max(d["newton_max_residual"], sol.residual)
@@ -249,20 +312,32 @@ class _Run:
         """(eps* - max strain, pickup margin); inf for criteria not declared or not enabled."""
         lim = self.model.limits
         strain = pickup = np.inf
-        if lim.strain is not None and "strain_limit" in self.terminate_on:
+        if lim.strain is not None and Termination.STRAIN_LIMIT in self.terminate_on:
             strain = lim.strain - self.model.strain_measure(self.sd, sol.delta, sol.F)[0]
-        if lim.weight is not None and "picked_up" in self.terminate_on:
-            pickup = pickup_margin(self.model.mu, sol.normal(), sol.tangential(), self.stick,
-                                   self.fidx, sorted(set(self.fidx.tolist())),
-                                   lim.weight / self.model.force_unit)
+        if lim.weight is not None and Termination.PICKED_UP in self.terminate_on:
+            pickup = pickup_margin(
+                self.model.mu,
+                sol.normal(),
+                sol.tangential(),
+                self.stick,
+                self.fidx,
+                sorted(set(self.fidx.tolist())),
+                lim.weight / self.model.force_unit,
+            )
         return strain, pickup
 
-    def values(self, sol: Solution, s: float, rows: np.ndarray,
-               terminations: bool = True) -> _Values:
+    def values(
+        self, sol: Solution, s: float, rows: np.ndarray, terminations: bool = True
+    ) -> _Values:
         """All event functions at ``sol`` (and the termination functions if asked)."""
         fn, ft = sol.normal(), sol.tangential()
         mu = self.model.mu
-        d = self.slip * sol.dtheta * self.radius_f[self.fidx] / (self.rate if self.rate > 0 else 1.0)
+        d = (
+            self.slip
+            * sol.dtheta
+            * self.radius_f[self.fidx]
+            / (self.rate if self.rate > 0 else 1.0)
+        )
         strain, pickup = self.termination_values(sol) if terminations else (np.inf, np.inf)
         return _Values(fn, mu * fn + ft, mu * fn - ft, d, self.gaps(sol, s, rows), strain, pickup)
 
@@ -310,7 +385,9 @@ class _Run:
         a_nodes = [node for kind, node in self.fresh if kind == "A"]
         if a_nodes:
             arows = self.model.obj.boundary_positions(a_nodes)
-            x = self.p_b[arows] + self.model.boundary_displacement(self.sd, sol.delta, sol.F, arows)
+            x = self.p_b[arows] + self.model.boundary_displacement(
+                self.sd, sol.delta, sol.F, arows
+            )
             dx = self.model.boundary_displacement(self.sd, sol.ddelta, sol.dF, arows)
             centers = self.c0 + self.s * self.D
             for j, node in enumerate(a_nodes):
@@ -342,12 +419,14 @@ class _Run:
             elif value <= 0:
                 out.append(key)
         finger_of = dict(zip(self.nodes.tolist(), self.fidx.tolist()))
-        return sorted(out, key=lambda k: (EVENT_ORDER[k[0]],
-                                          k[2] if k[0] == "A" else finger_of[k[1]], k[1]))
+        return sorted(
+            out, key=lambda k: (EVENT_ORDER[k[0]], k[2] if k[0] == "A" else finger_of[k[1]], k[1])
+        )
 
     def zero_keys(self) -> set:
         """Functions zero by construction now: the fresh ones and each sliding node's cone
-        margin on its slip side (its force lies on that cone edge)."""
+        margin on its slip side (its force lies on that cone edge).
+        """
         zero = set(self.fresh)
         for node, stick, slip in zip(self.nodes.tolist(), self.stick, self.slip):
             if not stick and slip:
@@ -359,7 +438,8 @@ class _Run:
 
         A function in ``zero`` must grow along the motion; any other must be positive. Stick:
         normal force and both cone margins; slip: normal force and slip rate of the assumed
-        sign (Algorithm 1's hypothesis-and-test)."""
+        sign (Algorithm 1's hypothesis-and-test).
+        """
         node = int(self.nodes[k])
         mu = self.model.mu
         fn, ft = float(sol.normal()[k]), float(sol.tangential()[k])
@@ -381,7 +461,8 @@ class _Run:
 
         Options per node in the order stick, slip +1, slip -1; every combination for up to
         three nodes (the first consistent one wins, else the one with fewest violations),
-        node by node in two passes for more."""
+        node by node in two passes for more.
+        """
         idx = [int(np.searchsorted(self.nodes, n)) for n in sorted(nodes)]
         zero = self.zero_keys()
         options = [(False, 0)] if self.frictionless else [(True, 0), (False, 1), (False, -1)]
@@ -389,14 +470,14 @@ class _Run:
             candidates = itertools.product(options, repeat=len(idx))
         else:
             candidates = [self._greedy(idx, options, zero)]
-        best = None
+        best, failures = None, []
         for combo in candidates:
             stick, slip = self.stick.copy(), self.slip.copy()
             for k, (st, sl) in zip(idx, combo):
                 stick[k], slip[k] = st, sl
-            try:
-                sol = self.solve(self.s, stick=stick, slip=slip)
-            except MechanicsError:
+            sol = self.attempt(self.s, stick=stick, slip=slip)
+            if isinstance(sol, SolveFailure):
+                failures.append(sol)
                 continue
             bad = sum(self.violations(sol, k, stick[k], slip[k], zero) for k in idx)
             if best is None or bad < best[0]:
@@ -404,7 +485,11 @@ class _Run:
             if bad == 0:
                 break
         if best is None:
-            raise MechanicsError(f"no contact mode of nodes {sorted(nodes)} can be solved")
+            if failures and all(f.indeterminate for f in failures):
+                raise failures[-1].error()
+            residual = min((f.residual for f in failures), default=float("inf"))
+            raise NumericalError(f"no contact mode of nodes {sorted(nodes)} can be solved",
+                                 residuals={"cone": residual})
         if best[0] > 0:
             self.diag["ambiguous_modes"] += 1
         _, self.stick, self.slip, self.theta = best
@@ -424,9 +509,8 @@ class _Run:
             for k in idx:
                 for st, sl in options:
                     stick[k], slip[k] = st, sl
-                    try:
-                        sol = self.solve(self.s, stick=stick, slip=slip)
-                    except MechanicsError:
+                    sol = self.attempt(self.s, stick=stick, slip=slip)
+                    if isinstance(sol, SolveFailure):
                         continue
                     if self.violations(sol, k, st, sl, zero) == 0:
                         choice[k] = (st, sl)
@@ -455,9 +539,18 @@ class _Run:
     def log(self, kind: str, k: int) -> None:
         """Append an event of contact k (mode and slip after the event)."""
         depth = self.depth_at(self.s)
-        mode = "stick" if self.stick[k] else "slip"
-        self.events.append(Event(kind, int(self.nodes[k]), self.names[self.fidx[k]], depth,
-                                 depth * self.relative_per_depth, mode, int(self.slip[k])))
+        mode = ContactMode.STICK if self.stick[k] else ContactMode.SLIP
+        self.events.append(
+            Event(
+                kind,
+                int(self.nodes[k]),
+                self.names[self.fidx[k]],
+                depth,
+                depth * self.relative_per_depth,
+                mode,
+                int(self.slip[k]),
+            )
+        )
 
     def add_contacts(self, keys: list[tuple], sol: Solution) -> None:
         """Event A for every key (one per node): put the nodes on their tips, decide jointly."""
@@ -467,7 +560,10 @@ class _Run:
             if self._chatters(node, f):
                 continue
             row = self.model.obj.boundary_positions([node])
-            x = self.p_b[row[0]] + self.model.boundary_displacement(self.sd, sol.delta, sol.F, row)[0]
+            x = (
+                self.p_b[row[0]]
+                + self.model.boundary_displacement(self.sd, sol.delta, sol.F, row)[0]
+            )
             rel_x = x - (self.c0[f] + self.s * self.D[f])
             theta = float(np.arctan2(rel_x[1], rel_x[0]))
             same = self.fidx == f
@@ -479,8 +575,11 @@ class _Run:
             self.stick = np.append(self.stick, True)
             self.slip = np.append(self.slip, 0)
             self.theta = np.append(self.theta, theta)
-            self.fresh = ({k for k in self.fresh if k[1] != node}
-                          | {("B", node), ("C+", node), ("C-", node)})
+            self.fresh = {k for k in self.fresh if k[1] != node} | {
+                ("B", node),
+                ("C+", node),
+                ("C-", node),
+            }
             added.append(node)
         if not added:
             return
@@ -502,8 +601,15 @@ class _Run:
             self.lost = self.names[f]
         elif kind == "B":
             self.log("B", k)
-            self.events[-1] = Event("B", node, self.names[f], self.events[-1].depth,
-                                    self.events[-1].relative_depth, "none", 0)
+            self.events[-1] = Event(
+                "B",
+                node,
+                self.names[f],
+                self.events[-1].depth,
+                self.events[-1].relative_depth,
+                "none",
+                0,
+            )
             keep = np.arange(len(self.nodes)) != k
             for name in ("nodes", "fidx", "stick", "slip", "theta"):
                 setattr(self, name, getattr(self, name)[keep])
@@ -524,7 +630,8 @@ class _Run:
         """Joint hypothesis-and-test for nodes whose C/D events at this point flip back.
 
         Their C/D events at this point are replaced by the net mode change from the start of
-        the point (C for stick -> slip, D for slip -> stick, D then C for a slip reversal)."""
+        the point (C for stick -> slip, D for slip -> stick, D then C for a slip reversal).
+        """
         self.decide(sorted(nodes))
         kept = [e for e in self.events[first_event:] if not (e.node in nodes and e.type in "CD")]
         self.events[first_event:] = kept
@@ -543,8 +650,15 @@ class _Run:
         for i, e in enumerate(self.events[first_event:], first_event):
             if e.type == "A" and e.node in nodes:
                 k = int(np.searchsorted(self.nodes, e.node))
-                self.events[i] = Event("A", e.node, e.finger, e.depth, e.relative_depth,
-                                       "stick" if self.stick[k] else "slip", int(self.slip[k]))
+                self.events[i] = Event(
+                    "A",
+                    e.node,
+                    e.finger,
+                    e.depth,
+                    e.relative_depth,
+                    ContactMode.STICK if self.stick[k] else ContactMode.SLIP,
+                    int(self.slip[k]),
+                )
 
     def resolve(self) -> Solution:
         """Process every pending event at the current point; returns the final solution.
@@ -552,13 +666,15 @@ class _Run:
         New contacts pending together are added as one batch with a joint mode decision. A
         node whose C/D event would flip back at the same point triggers a joint decision over
         the nodes with C/D events here; a node that flips again after that, or has a second
-        A/B event here, is frozen by the chattering bound."""
+        A/B event here, is frozen by the chattering bound.
+        """
         if self.rate == 0:
             return self.solve(self.s)
         if self.undetermined:
             self.decide(sorted(self.undetermined))
-        before = {int(n): (bool(st), int(sl))
-                  for n, st, sl in zip(self.nodes, self.stick, self.slip)}
+        before = {
+            int(n): (bool(st), int(sl)) for n, st, sl in zip(self.nodes, self.stick, self.slip)
+        }
         first_event = len(self.events)
         mode_events: set = set()
         contact_events: set = set()
@@ -590,8 +706,10 @@ class _Run:
             else:
                 (contact_events if kind == "B" else mode_events).add(node)
                 self.apply(key, sol)
-        raise MechanicsError("event processing at one point did not settle (chattering bound "
-                             "exceeded); lower squeeze.max_events_per_depth")
+        raise NumericalError(
+            "event processing at one point did not settle (chattering bound "
+            "exceeded); lower squeeze.max_events_per_depth"
+        )
 
     def termination(self, sol: Solution) -> str | None:
         """First termination that holds at the current point (TERMINATION_ORDER)."""
@@ -599,18 +717,18 @@ class _Run:
             return None
         strain, pickup = self.termination_values(sol)
         if strain <= 0:
-            return "strain_limit"
+            return Termination.STRAIN_LIMIT
         if self.lost is not None:
-            return "contact_lost"
-        if "finger_slip" in self.terminate_on and self.slipping_finger(sol) is not None:
-            return "finger_slip"
+            return Termination.CONTACT_LOST
+        if Termination.FINGER_SLIP in self.terminate_on and self.slipping_finger(sol) is not None:
+            return Termination.FINGER_SLIP
         if pickup <= 0:
-            return "picked_up"
+            return Termination.PICKED_UP
         return None
 
     def slipping_finger(self, sol: Solution) -> str | None:
         """A finger whose contact nodes all slide the same way (Sec. 5.1), or None."""
-        if "finger_slip" not in self.terminate_on:
+        if Termination.FINGER_SLIP not in self.terminate_on:
             return None
         signs = self._slip_signs(sol)
         for f in sorted(set(self.fidx.tolist())):
@@ -641,10 +759,18 @@ class _Run:
     def record(self, sol: Solution) -> None:
         """Append a trajectory sample at the current point."""
         unit_force = self.model.force_unit
-        forces = {name: tuple((sol.F[self.fidx == f].sum(axis=0) * unit_force).tolist())
-                  for f, name in enumerate(self.names)}
-        self.samples.append(Sample(self.depth_at(self.s), tuple(self.nodes.tolist()),
-                                   tuple(sol.theta.tolist()), forces))
+        forces = {
+            name: tuple((sol.F[self.fidx == f].sum(axis=0) * unit_force).tolist())
+            for f, name in enumerate(self.names)
+        }
+        self.samples.append(
+            Sample(
+                self.depth_at(self.s),
+                tuple(self.nodes.tolist()),
+                tuple(sol.theta.tolist()),
+                forces,
+            )
+        )
 
     def crossings(self, va: list, vb: list, fresh_at_a: set) -> list[tuple]:
         """Keys whose function went from > 0 (or fresh zero) at a to <= 0 at b."""
@@ -657,28 +783,38 @@ class _Run:
                 out.append(key)
         return out
 
-    def continue_to(self, sol_a: Solution, a: float, b: float) -> Solution:
+    def continue_to(self, sol_a: Solution, a: float, b: float) -> Solution | SolveFailure:
         """Solve at b by continuation from the solution at a (predictor theta + dtheta/ds (b-a)).
 
-        Raises MechanicsError if Newton needs more than CONTINUATION_ITERATIONS iterations or
-        lands more than MAX_ANGLE_JUMP (rad) from the prediction (another solution branch)."""
+        Fails if Newton fails, needs more than CONTINUATION_ITERATIONS iterations or lands more
+        than MAX_ANGLE_JUMP (rad) from the prediction (another solution branch).
+        """
         guess = sol_a.theta + sol_a.dtheta * (b - a)
-        sol = self.solve(b, theta=guess)
-        jump = np.abs(sol.theta - guess).max()
-        if sol.iterations > CONTINUATION_ITERATIONS or jump > MAX_ANGLE_JUMP:
-            raise MechanicsError(f"continuation from s = {a:.6g} to {b:.6g} left the solution "
-                                 "branch")
+        sol = self.attempt(b, theta=guess)
+        if isinstance(sol, SolveFailure):
+            return sol
+        if (
+            sol.iterations > CONTINUATION_ITERATIONS
+            or np.abs(sol.theta - guess).max() > MAX_ANGLE_JUMP
+        ):
+            return SolveFailure(
+                f"continuation from s = {a:.6g} to {b:.6g} left the solution branch", sol.residual
+            )
         return sol
 
     def substep(self, sol_a: Solution, a: float, b: float) -> tuple[float, Solution]:
         """(b, solution at b) by continuation from a, halving the substep while it fails."""
         for _ in range(MAX_SUBSTEP_HALVINGS):
-            try:
-                return b, self.continue_to(sol_a, a, b)
-            except MechanicsError:
-                self.diag["substep_halvings"] += 1
-                b = a + 0.5 * (b - a)
-        raise MechanicsError(f"the fixed-set solve failed near depth {self.depth_at(a):.6g} m")
+            sol = self.continue_to(sol_a, a, b)
+            if not isinstance(sol, SolveFailure):
+                return b, sol
+            self.diag["substep_halvings"] += 1
+            b = a + 0.5 * (b - a)
+        raise NumericalError(
+            f"the fixed-set solve failed near depth {self.depth_at(a):.6g} m "
+            f"after {MAX_SUBSTEP_HALVINGS} substep halvings: {sol.reason}",
+            residuals={"cone": sol.residual},
+        )
 
     def run(self, stop_on_event: bool) -> str | None:
         """Advance s from 0 to 1 (or to a termination / first event); returns the termination."""
@@ -727,12 +863,16 @@ class _Run:
             """Solve at s by continuation from the nearest point solved so far."""
             near, sol_near = min(solved, key=lambda p: abs(p[0] - s))
             sol = self.continue_to(sol_near, near, s)
+            if isinstance(sol, SolveFailure):
+                raise sol.error()
             solved.append((s, sol))
             return sol
 
         for key in crossed:
+
             def g(s, key=key):
                 return self._key_value(key, solve_near(s), s)
+
             lo, glo = a, va[key]
             if key[:2] in self.fresh or not glo > 0:
                 lo = min(a + tol_s, b)
@@ -754,21 +894,40 @@ class _Run:
         L, fu = self.model.length, self.model.force_unit
         sol = self.final
         s = self.s
-        fingers = tuple(FingerState(n, (self.c0[f] + s * self.D[f]) * L, self.radius_f[f] * L,
-                                    (self.t0[f] + s * self.D[f]) * L, float(self.work[f] * fu * L))
-                        for f, n in enumerate(self.names))
+        fingers = tuple(
+            FingerState(
+                n,
+                (self.c0[f] + s * self.D[f]) * L,
+                self.radius_f[f] * L,
+                (self.t0[f] + s * self.D[f]) * L,
+                float(self.work[f] * fu * L),
+            )
+            for f, n in enumerate(self.names)
+        )
         signs = self._slip_signs(sol)
         contacts = tuple(
-            ContactNode(int(node), self.names[self.fidx[k]],
-                        "stick" if self.stick[k] else "slip",
-                        0 if self.stick[k] else int(signs[k]), float(sol.theta[k]),
-                        sol.delta[k] * L, sol.F[k] * fu)
-            for k, node in enumerate(self.nodes.tolist()))
+            ContactNode(
+                int(node),
+                self.names[self.fidx[k]],
+                ContactMode.STICK if self.stick[k] else ContactMode.SLIP,
+                0 if self.stick[k] else int(signs[k]),
+                float(sol.theta[k]),
+                sol.delta[k] * L,
+                sol.F[k] * fu,
+            )
+            for k, node in enumerate(self.nodes.tolist())
+        )
         depth = self.depth_at(s)
-        return ContactState(fingers, contacts, depth, self.relative_per_depth,
-                            tuple(sorted(self.undetermined)), tuple(sorted(self.fresh)),
-                            tuple(self.history),
-                            tuple(sorted((n, u) for n, u in self.holds.items() if u > depth)))
+        return ContactState(
+            fingers,
+            contacts,
+            depth,
+            self.relative_per_depth,
+            tuple(sorted(self.undetermined)),
+            tuple(sorted(self.fresh)),
+            tuple(self.history),
+            tuple(sorted((n, u) for n, u in self.holds.items() if u > depth)),
+        )
 
 
 MIN_STEP = 1e-6
@@ -778,10 +937,15 @@ MIN_EVENT_TOL = 1e-15
 """Smallest event tolerance, relative to the object size (near the float resolution)."""
 
 
-def advance(model: ContactModel, state: ContactState,
-            translations: Mapping[str, tuple[float, float]], step: float = 1e-3,
-            event_tol: float = 1e-9, stop_on_event: bool = False,
-            terminate_on: tuple[str, ...] = TERMINATION_ORDER) -> StepResult:
+def advance(
+    model: ContactModel,
+    state: ContactState,
+    translations: Mapping[str, tuple[float, float]],
+    step: float = 1e-3,
+    event_tol: float = 1e-9,
+    stop_on_event: bool = False,
+    terminate_on: tuple[str, ...] = TERMINATION_ORDER,
+) -> StepResult:
     """Translate fingertips from ``state`` and locate the contact events on the way.
 
     Parameters
@@ -812,23 +976,32 @@ def advance(model: ContactModel, state: ContactState,
 
     Raises
     ------
-    MechanicsError
+    InvalidInputError
         For bad arguments, a lost grasp (fewer than 2 contacts) or a solve that fails.
     """
     if not (np.isfinite(step) and step >= MIN_STEP):
-        raise MechanicsError(f"step must be >= {MIN_STEP} (relative to the object size), got "
-                             f"{step}")
+        raise InvalidInputError(
+            f"step must be >= {MIN_STEP} (relative to the object size), got {step}"
+        )
     if not (np.isfinite(event_tol) and event_tol >= MIN_EVENT_TOL):
-        raise MechanicsError(f"event_tol must be >= {MIN_EVENT_TOL} (relative to the object "
-                             f"size), got {event_tol}")
+        raise InvalidInputError(
+            f"event_tol must be >= {MIN_EVENT_TOL} (relative to the object size), got {event_tol}"
+        )
     bad = sorted(set(terminate_on) - set(TERMINATION_ORDER))
     if bad:
-        raise MechanicsError(f"unknown termination {bad[0]!r} (allowed: {TERMINATION_ORDER})")
+        raise InvalidInputError(f"unknown termination {bad[0]!r} (allowed: {TERMINATION_ORDER})")
     run = _Run(model, state, translations, step, min(event_tol, step), tuple(terminate_on))
     termination = run.run(stop_on_event)
     new_state = run.to_state()
     diag = dict(run.diag)
     diag["sets_factored"] = model._cache.get("sets_factored", 0)
     diag["reduced_max_condition"] = model._cache.get("max_condition", 1.0)
-    return StepResult(new_state, tuple(run.events), float(run.s), termination,
-                      tuple(run.samples), tuple(run.chatter), diag)
+    return StepResult(
+        new_state,
+        tuple(run.events),
+        float(run.s),
+        termination,
+        tuple(run.samples),
+        tuple(run.chatter),
+        diag,
+    )

@@ -117,7 +117,8 @@ class ExecutorNode(Node):
     def destroy_node(self) -> None:
         """Destroy the action server too: rclpy's ``destroy_node`` leaves waitables to the garbage
         collector, and a still-referenced server keeps answering goals of a later run in the same
-        process ("more than one action server")."""
+        process ("more than one action server").
+        """
         self.server.destroy()
         super().destroy_node()
 

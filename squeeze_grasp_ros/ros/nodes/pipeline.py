@@ -26,6 +26,7 @@ from rclpy.clock import Clock, ClockType
 from rclpy.node import Node
 from rclpy.qos import (DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy,
                        qos_profile_sensor_data)
+from rclpy.serialization import deserialize_message, serialize_message
 from std_msgs.msg import String
 
 FRAME = "object"
@@ -97,6 +98,18 @@ def message_type(type_name: str) -> type:
         action, _, part = name.partition("_")
         return getattr(getattr(module, action).Impl, part)
     return getattr(module, name)
+
+
+def round_trip(messages: Sequence[tuple[str, bytes]]) -> Callable[[], None]:
+    """A function that deserialises and re-serialises ``messages`` ((type name, CDR bytes)
+    pairs) with rclpy, for timing what rclpy's message conversion costs.
+    """
+    decoded = [(message_type(type_name), data) for type_name, data in messages]
+
+    def convert() -> None:
+        for cls, data in decoded:
+            serialize_message(deserialize_message(data, cls))
+    return convert
 
 
 def parse_mapping(entries: Sequence[str], what: str) -> dict[str, str]:

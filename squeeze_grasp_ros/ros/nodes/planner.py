@@ -176,7 +176,8 @@ class PlannerNode(Node):
     async def _plan_resistance(self, request: PlanResistance.Request,
                                response: PlanResistance.Response) -> PlanResistance.Response:
         """Optimal resistance on a worker (fixed contacts: milliseconds; friction: a squeeze
-        and Algorithm 2)."""
+        and Algorithm 2).
+        """
         a = request.a
         return await self._in_worker(PlanResistance.Response, lambda: (
             messages.plan_resistance_response(planning.resistance_plan(
@@ -302,7 +303,8 @@ class PlannerNode(Node):
     def _reporter(self, goal_handle: ServerGoalHandle,
                   feedback: Callable[..., Any]) -> Callable[..., None]:
         """A progress callback for a worker: queues ``feedback(*args)`` for the goal, or raises
-        :class:`Cancelled` when the goal is being cancelled or the node is shutting down."""
+        :class:`Cancelled` when the goal is being cancelled or the node is shutting down.
+        """
         def report(*args: Any) -> None:
             if goal_handle.is_cancel_requested or self._stopping.is_set():
                 raise Cancelled("cancelled by the client" if goal_handle.is_cancel_requested

@@ -108,7 +108,8 @@ class SimHardwareNode(Node):
 
     def _reading_messages(self, finger: str) -> dict[str, Any]:
         """One message per reading of ``finger``, refilled every tick (frames and taxel
-        angles set once)."""
+        angles set once).
+        """
         tip = f"{finger}_tip"
         out: dict[str, Any] = {"pose": messages.pose_msg((0.0, 0.0), 0, self.frame),
                                "wrench": messages.wrench_msg(np.zeros(3), np.zeros(3), 0, tip)}

@@ -15,6 +15,7 @@ a SIGINT handler) and an interrupted run leaves a complete recording.
 :func:`read_bag` reads our bags and those of other tools with the same layout: a folder with
 ``metadata.yaml`` and MCAP or SQLite3 (``.db3``) storage, or a bare ``.mcap`` file.
 """
+
 from __future__ import annotations
 
 import io
@@ -35,8 +36,11 @@ from squeeze_grasp_ros.inputs import InputError, load_yaml, read_text
 from squeeze_grasp_ros.ros.recording.schema import message_definition, type_hash
 
 METADATA_VERSION = 9
-COMPRESSION = {"zstd": CompressionType.ZSTD, "lz4": CompressionType.LZ4,
-               "none": CompressionType.NONE}
+COMPRESSION = {
+    "zstd": CompressionType.ZSTD,
+    "lz4": CompressionType.LZ4,
+    "none": CompressionType.NONE,
+}
 INFINITE = {"sec": 9223372036, "nsec": 854775807}
 """rosbag2's rendering of an unset (infinite) QoS duration."""
 
@@ -59,10 +63,17 @@ class BagError(ValueError):
 
 def qos_dict(history: str, depth: int, reliability: str, durability: str) -> dict:
     """One offered QoS profile as rosbag2 v9 writes it (names lower case, durations infinite)."""
-    return {"history": history, "depth": int(depth), "reliability": reliability,
-            "durability": durability, "deadline": dict(INFINITE), "lifespan": dict(INFINITE),
-            "liveliness": "automatic", "liveliness_lease_duration": dict(INFINITE),
-            "avoid_ros_namespace_conventions": False}
+    return {
+        "history": history,
+        "depth": int(depth),
+        "reliability": reliability,
+        "durability": durability,
+        "deadline": dict(INFINITE),
+        "lifespan": dict(INFINITE),
+        "liveliness": "automatic",
+        "liveliness_lease_duration": dict(INFINITE),
+        "avoid_ros_namespace_conventions": False,
+    }
 
 
 class _Direct(io.IOBase):
@@ -74,7 +85,7 @@ class _Direct(io.IOBase):
     def write(self, data: bytes) -> int:
         view = memoryview(data)
         while view:
-            view = view[self._file.write(view):]
+            view = view[self._file.write(view) :]
         return len(data)
 
     def tell(self) -> int:
@@ -109,18 +120,29 @@ class BagWriter:
         Stored in ``metadata.yaml`` ``custom_data`` (e.g. the scene and node parameters).
     """
 
-    def __init__(self, path: str | Path, compression: str = "zstd", chunk_size: int = 256 * 1024,
-                 custom_data: Mapping[str, str] | None = None) -> None:
+    def __init__(
+        self,
+        path: str | Path,
+        compression: str = "zstd",
+        chunk_size: int = 256 * 1024,
+        custom_data: Mapping[str, str] | None = None,
+    ) -> None:
         self.path = Path(path)
         if self.path.exists() and any(self.path.iterdir()):
             raise BagError(f"{self.path} exists and is not empty")
         if compression not in COMPRESSION:
-            raise BagError(f"compression must be one of {sorted(COMPRESSION)}, got {compression!r}")
+            raise BagError(
+                f"compression must be one of {sorted(COMPRESSION)}, got {compression!r}"
+            )
         self.path.mkdir(parents=True, exist_ok=True)
         self.file_name = f"{self.path.name}_0.mcap"
         self._stream = _Direct(self.path / self.file_name)
-        self._writer = Writer(self._stream, chunk_size=chunk_size,
-                              compression=COMPRESSION[compression], enable_data_crcs=True)
+        self._writer = Writer(
+            self._stream,
+            chunk_size=chunk_size,
+            compression=COMPRESSION[compression],
+            enable_data_crcs=True,
+        )
         self._writer.start(profile="ros2", library="squeeze_grasp_ros")
         self._schemas: dict[str, int] = {}
         self.topics: dict[str, _Topic] = {}
@@ -135,21 +157,32 @@ class BagWriter:
             return
         if type_name not in self._schemas:
             self._schemas[type_name] = self._writer.register_schema(
-                type_name, "ros2msg", message_definition(type_name).encode())
+                type_name, "ros2msg", message_definition(type_name).encode()
+            )
         qos = list(offered_qos)
         channel = self._writer.register_channel(
-            name, "cdr", self._schemas[type_name],
-            {"offered_qos_profiles": plain_yaml(qos) if qos else "",
-             "topic_type_hash": type_hash(type_name)})
+            name,
+            "cdr",
+            self._schemas[type_name],
+            {
+                "offered_qos_profiles": plain_yaml(qos) if qos else "",
+                "topic_type_hash": type_hash(type_name),
+            },
+        )
         self.topics[name] = _Topic(name, type_name, channel, qos)
 
-    def write(self, topic: str, data: bytes, log_time_ns: int,
-              publish_time_ns: int | None = None) -> None:
+    def write(
+        self, topic: str, data: bytes, log_time_ns: int, publish_time_ns: int | None = None
+    ) -> None:
         """Append one serialized (CDR) message of a declared topic."""
         t = self.topics[topic]
-        self._writer.add_message(t.channel, log_time_ns, bytes(data),
-                                 log_time_ns if publish_time_ns is None else publish_time_ns,
-                                 sequence=t.count)
+        self._writer.add_message(
+            t.channel,
+            log_time_ns,
+            bytes(data),
+            log_time_ns if publish_time_ns is None else publish_time_ns,
+            sequence=t.count,
+        )
         t.count += 1
         self.start_ns = log_time_ns if self.start_ns is None else min(self.start_ns, log_time_ns)
         self.end_ns = log_time_ns if self.end_ns is None else max(self.end_ns, log_time_ns)
@@ -160,22 +193,43 @@ class BagWriter:
         duration = (self.end_ns or 0) - start
         count = sum(t.count for t in self.topics.values())
         return {
-            "version": METADATA_VERSION, "storage_identifier": "mcap",
+            "version": METADATA_VERSION,
+            "storage_identifier": "mcap",
             "duration": {"nanoseconds": duration},
-            "starting_time": {"nanoseconds_since_epoch": start}, "message_count": count,
+            "starting_time": {"nanoseconds_since_epoch": start},
+            "message_count": count,
             "topics_with_message_count": [
-                {"topic_metadata": {"name": t.name, "type": t.type, "serialization_format": "cdr",
-                                    "offered_qos_profiles": t.qos,
-                                    "type_description_hash": type_hash(t.type)},
-                 "message_count": t.count} for t in self.topics.values()],
-            "compression_format": "", "compression_mode": "",
+                {
+                    "topic_metadata": {
+                        "name": t.name,
+                        "type": t.type,
+                        "serialization_format": "cdr",
+                        "offered_qos_profiles": t.qos,
+                        "type_description_hash": type_hash(t.type),
+                    },
+                    "message_count": t.count,
+                }
+                for t in self.topics.values()
+            ],
+            "compression_format": "",
+            "compression_mode": "",
             "relative_file_paths": [self.file_name],
-            "files": [{"path": self.file_name, "starting_time": {"nanoseconds_since_epoch": start},
-                       "duration": {"nanoseconds": duration}, "message_count": count}],
-            "custom_data": dict(self.custom_data), "ros_distro": "jazzy"}
+            "files": [
+                {
+                    "path": self.file_name,
+                    "starting_time": {"nanoseconds_since_epoch": start},
+                    "duration": {"nanoseconds": duration},
+                    "message_count": count,
+                }
+            ],
+            "custom_data": dict(self.custom_data),
+            "ros_distro": "jazzy",
+        }
 
     def close(self) -> None:
-        """Write the rosbag2 metadata record, the MCAP summary and ``metadata.yaml`` (idempotent)."""
+        """Write the rosbag2 metadata record, the MCAP summary and ``metadata.yaml``
+        (idempotent).
+        """
         if self.closed:
             return
         self.closed = True
@@ -268,8 +322,10 @@ def _embedded_info(path: Path) -> dict:
         with open(path, "rb") as f:
             for record in make_reader(f).iter_metadata():
                 if record.name == "rosbag2":
-                    data = load_yaml(record.metadata.get("serialized_metadata", ""),
-                                     what=f"{path} rosbag2 metadata")
+                    data = load_yaml(
+                        record.metadata.get("serialized_metadata", ""),
+                        what=f"{path} rosbag2 metadata",
+                    )
                     return dict((data or {}).get("rosbag2_bagfile_information", data or {}))
     except (McapError, InputError, OSError, ValueError):
         return {}
@@ -298,8 +354,10 @@ def _read_mcap(path: Path) -> Iterator[BagMessage]:
                     topic, type_name = topics[record.channel_id]
                     out.append(BagMessage(topic, type_name, record.log_time, bytes(record.data)))
     except Exception as exc:  # noqa: BLE001 (any failure to parse these bytes means corruption)
-        raise BagError(f"{path} is corrupt ({type(exc).__name__}: {exc}); it cannot be "
-                       "trusted, not even in part") from None
+        raise BagError(
+            f"{path} is corrupt ({type(exc).__name__}: {exc}); it cannot be "
+            "trusted, not even in part"
+        ) from None
     out.sort(key=lambda m: m.log_time_ns)
     yield from out
 
@@ -307,9 +365,11 @@ def _read_mcap(path: Path) -> Iterator[BagMessage]:
 def _read_sqlite(path: Path) -> Iterator[BagMessage]:
     db = sqlite3.connect(f"file:{path}?mode=ro", uri=True)
     try:
-        rows = db.execute("SELECT topics.name, topics.type, messages.timestamp, messages.data "
-                          "FROM messages JOIN topics ON messages.topic_id = topics.id "
-                          "ORDER BY messages.timestamp, messages.id")
+        rows = db.execute(
+            "SELECT topics.name, topics.type, messages.timestamp, messages.data "
+            "FROM messages JOIN topics ON messages.topic_id = topics.id "
+            "ORDER BY messages.timestamp, messages.id"
+        )
         for name, type_name, timestamp, data in rows:
             yield BagMessage(name, type_name, int(timestamp), bytes(data))
     finally:

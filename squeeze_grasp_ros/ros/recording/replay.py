@@ -37,9 +37,9 @@ from squeeze_grasp_ros.ros.nodes.monitor import MonitorNode
 from squeeze_grasp_ros.ros.nodes.recorder import cdr_stamp_ns
 from squeeze_grasp_ros.ros.run.runner import config_parameters
 from squeeze_grasp_ros.ros.recording.bag import BagContents, BagError, read_bag
+from squeeze_grasp_ros.mechanics.vocabulary import Finger
 
 READING = re.compile(r"^/?devices/([^/]+)/(pose|wrench|tactile)$")
-FINGER_ORDER = ("F1", "F2", "A")
 
 
 def event_tuple(e: Any) -> tuple:
@@ -88,7 +88,7 @@ def monitor_parameters(bag: BagContents) -> dict[str, Any]:
         match = READING.match(m.topic)
         if match and match.group(2) == "tactile":
             fingers.setdefault(match.group(1), deserialize_message(m.data, TactileArray).finger)
-    free = [f for f in FINGER_ORDER if f not in fingers.values()]
+    free = [f for f in Finger.values() if f not in fingers.values()]
     for device in devices:
         if device not in fingers:
             fingers[device] = free.pop(0)
@@ -185,9 +185,14 @@ def replay(path: str, overrides: Mapping[str, Any] | None = None, timeout: float
         context.try_shutdown()
     recorded = recorded_events(bag)
     keys = ("stamp_ns", "type", "finger", "node", "depth", "relative_depth")
-    return {"bag": str(path), "ticks": len(ticks), "topics": sorted(bag.types),
-            "events": [dict(zip(keys, e)) for e in replayer.events],
-            "recorded_events": None if recorded is None else [dict(zip(keys, e)) for e in recorded],
-            "reproduced": None if recorded is None else recorded == replayer.events,
-            "alarms": len(replayer.alarms), "monitor_parameters": params,
-            "seconds": time.perf_counter() - t0}
+    return {
+        "bag": str(path),
+        "ticks": len(ticks),
+        "topics": sorted(bag.types),
+        "events": [dict(zip(keys, e)) for e in replayer.events],
+        "recorded_events": None if recorded is None else [dict(zip(keys, e)) for e in recorded],
+        "reproduced": None if recorded is None else recorded == replayer.events,
+        "alarms": len(replayer.alarms),
+        "monitor_parameters": params,
+        "seconds": time.perf_counter() - t0,
+    }

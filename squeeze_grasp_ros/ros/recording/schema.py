@@ -25,6 +25,7 @@ order, then ``sys.prefix`` (the pip route installs everything there).
 >>> print(message_definition("std_msgs/msg/Header").split(SEPARATOR)[1].splitlines()[1])
 MSG: builtin_interfaces/Time
 """
+
 from __future__ import annotations
 
 import functools
@@ -34,9 +35,25 @@ import re
 import sys
 from pathlib import Path
 
-PRIMITIVES = frozenset({
-    "bool", "byte", "char", "float32", "float64", "int8", "uint8", "int16", "uint16", "int32",
-    "uint32", "int64", "uint64", "string", "wstring"})
+PRIMITIVES = frozenset(
+    {
+        "bool",
+        "byte",
+        "char",
+        "float32",
+        "float64",
+        "int8",
+        "uint8",
+        "int16",
+        "uint16",
+        "int32",
+        "uint32",
+        "int64",
+        "uint64",
+        "string",
+        "wstring",
+    }
+)
 SEPARATOR = "=" * 80
 FIELD_TYPE = re.compile(r"(?:^|\n)\s*([a-zA-Z0-9_/]+)(?:\[[^\]]*\])?\s+")
 """The type token at the start of a line, as rosbag2's dependency scan reads it."""
@@ -45,8 +62,8 @@ CONSTANT = re.compile(r"^\S+\s+\w+\s*=")
 ACTION_PARTS = {"_Goal": 0, "_Result": 1, "_Feedback": 2}
 """Message of an action -> its section of the ``.action`` file."""
 ACTION_WRAPPERS = {
-    "_FeedbackMessage":
-        "unique_identifier_msgs/UUID goal_id\n{package}/action/{action}_Feedback feedback\n",
+    "_FeedbackMessage": "unique_identifier_msgs/UUID goal_id\n{package}/action/{action}_Feedback "
+                        "feedback\n",
 }
 """Messages rosidl wraps around an action's sections (their definition, formatted)."""
 
@@ -67,8 +84,9 @@ def interface_file(package: str, kind: str, name: str, suffix: str) -> Path:
         path = prefix / "share" / package / kind / f"{name}{suffix}"
         if path.is_file():
             return path
-    raise SchemaError(f"{package}/{kind}/{name}{suffix} is not installed under "
-                      f"{[str(p) for p in prefixes()]}")
+    raise SchemaError(
+        f"{package}/{kind}/{name}{suffix} is not installed under {[str(p) for p in prefixes()]}"
+    )
 
 
 def split_type(type_name: str) -> tuple[str, str, str]:
@@ -84,7 +102,8 @@ def split_type(type_name: str) -> tuple[str, str, str]:
 @functools.lru_cache(maxsize=None)
 def own_text(type_name: str) -> str:
     """The definition text of one type (no dependencies): its ``.msg`` file, or the section of
-    the ``.action`` file (or rosidl's wrapper) for a message an action generates."""
+    the ``.action`` file (or rosidl's wrapper) for a message an action generates.
+    """
     package, kind, name = split_type(type_name)
     if kind == "msg":
         try:
@@ -124,7 +143,12 @@ def qualify(text: str, package: str) -> str:
         code = line.split("#", 1)[0]
         tokens = code.split()
         base = re.split(r"[\[<]", tokens[0], maxsplit=1)[0] if tokens else ""
-        if tokens and not CONSTANT.match(code.strip()) and base not in PRIMITIVES and "/" not in base:
+        if (
+            tokens
+            and not CONSTANT.match(code.strip())
+            and base not in PRIMITIVES
+            and "/" not in base
+        ):
             line = line.replace(tokens[0], f"{package}/{tokens[0]}", 1)
         out.append(line)
     return "".join(out)
@@ -143,7 +167,8 @@ def dependencies(text: str, package: str) -> list[str]:
 
 def message_definition(type_name: str) -> str:
     """The complete ``ros2msg`` definition of ``type_name`` ('pkg/msg/Type'), as rosbag2 writes
-    it."""
+    it.
+    """
     seen: set[str] = set()
 
     def text_with_dependencies(name: str) -> str:
@@ -164,15 +189,17 @@ def type_hash(type_name: str) -> str:
     package, kind, name = split_type(type_name)
     stem = name
     if kind == "action":
-        stem = next((name[: -len(s)] for s in (*ACTION_WRAPPERS, *ACTION_PARTS)
-                     if name.endswith(s)), name)
+        stem = next(
+            (name[: -len(s)] for s in (*ACTION_WRAPPERS, *ACTION_PARTS) if name.endswith(s)), name
+        )
     try:
         data = json.loads(interface_file(package, kind, stem, ".json").read_text())
     except SchemaError:
         return ""
     wanted = f"{package}/{kind}/{name}"
-    return next((h["hash_string"] for h in data.get("type_hashes", ())
-                 if h["type_name"] == wanted), "")
+    return next(
+        (h["hash_string"] for h in data.get("type_hashes", ()) if h["type_name"] == wanted), ""
+    )
 
 
 def starts_with_stamp(type_name: str) -> bool:

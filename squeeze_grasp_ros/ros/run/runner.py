@@ -21,6 +21,7 @@ drive the steps themselves):
 
 Every wait spins the executor with a wall-clock timeout; nothing sleeps to synchronise.
 """
+
 from __future__ import annotations
 
 import importlib.util
@@ -66,11 +67,26 @@ from squeeze_grasp_ros.mechanics.resistance.frictional import add_adversary, fri
 from squeeze_grasp_ros.mechanics.squeeze.stable_pure import plan_squeeze
 from squeeze_grasp_ros.ros.recording.bag import plain_yaml
 from squeeze_grasp_ros.resources import config_dir, share_dir
-from squeeze_grasp_ros.scene import (Scene, SceneError, build_mesh, finger_devices, finger_nodes, load_scene,
-                     placement_node, scene_material)
+from squeeze_grasp_ros.scene import (
+    Scene,
+    SceneError,
+    build_mesh,
+    finger_devices,
+    finger_nodes,
+    load_scene,
+    placement_node,
+    scene_material,
+)
 from squeeze_grasp_ros.scene_events import event_squeeze_scene
 from squeeze_grasp_ros.ros.nodes import pipeline
 from squeeze_grasp_ros.ros.nodes.recorder import cdr_stamp_ns
+from squeeze_grasp_ros.threads import single_thread_blas
+from squeeze_grasp_ros.mechanics.vocabulary import (
+    Finger,
+    SQUEEZING_FINGERS,
+    SqueezeKind,
+    Termination,
+)
 
 NODES: tuple[str, ...] = ("sim_hardware", "monitor", "executor", "recorder")
 EXECUTORS: tuple[str, ...] = ("events", "single")
@@ -83,7 +99,7 @@ SERVICE_RETRY = 30.0
 """Wall-clock seconds after which an unanswered planner request is sent again."""
 
 
-GRASP_HELD: tuple[str, ...] = ("none", "picked_up")
+GRASP_HELD: tuple[str, ...] = ("none", Termination.PICKED_UP)
 """World terminations after which the grasp holds ("none": the world never ended)."""
 
 
@@ -158,27 +174,39 @@ class RunOptions:
     discovery_wait: float = 1.0
 
 
-def node_parameters(scene: Scene, scene_path: str, options: RunOptions,
-                    relative_per_depth: float) -> dict[str, dict[str, Any]]:
+def node_parameters(
+    scene: Scene, scene_path: str, options: RunOptions, relative_per_depth: float
+) -> dict[str, dict[str, Any]]:
     """Parameters of every node: the config files, then the scene's values, then overrides."""
     params = {name: config_parameters(name) for name in NODES}
     devices = finger_devices(scene)
     mapping = [f"{f}:{d}" for f, d in devices.items()]
-    streams = [s for s, effect in (("wrench", "force_sensing"), ("tactile", "tactile_sensing"))
-               if scene.has(effect)]
+    streams = [
+        s
+        for s, effect in (("wrench", "force_sensing"), ("tactile", "tactile_sensing"))
+        if scene.has(effect)
+    ]
     noise = scene.sensors.noise_std if scene.has("sensor_noise") else 0.0
     params["sim_hardware"].update(
         scene=str(Path(scene_path).resolve()),
-        participants=["monitor", "executor"] + (["recorder"] if options.record else []))
+        participants=["monitor", "executor"] + (["recorder"] if options.record else []),
+    )
     monitor = params["monitor"]
-    monitor.update(finger_devices=mapping, streams=streams or [""], mu=float(scene.mu),
-                   weight=float(scene.pickup.weight) if scene.has("pickup") else 0.0,
-                   relative_per_depth=float(relative_per_depth),
-                   load_threshold=max(float(monitor.get("load_threshold", 0.005)), 6.0 * noise))
+    monitor.update(
+        finger_devices=mapping,
+        streams=streams or [""],
+        mu=float(scene.mu),
+        weight=float(scene.pickup.weight) if scene.has("pickup") else 0.0,
+        relative_per_depth=float(relative_per_depth),
+        load_threshold=max(float(monitor.get("load_threshold", 0.005)), 6.0 * noise),
+    )
     params["executor"].update(finger_devices=mapping, period=float(scene.sim.dt))
     custom = {"scene": Path(scene_path).read_text(), "scene_path": str(scene_path)}
-    params["recorder"].update(output=str(options.record or ""), devices=list(devices.values()),
-                              include_hidden_topics=options.include_hidden_topics)
+    params["recorder"].update(
+        output=str(options.record or ""),
+        devices=list(devices.values()),
+        include_hidden_topics=options.include_hidden_topics,
+    )
     for name, values in options.overrides.items():
         params[name].update(values)
     custom["monitor_parameters"] = yaml.safe_dump(params["monitor"], sort_keys=True)
@@ -210,27 +238,36 @@ class PipelineRunner:
         Called with a dict (state, depth, relative_depth, forces, events) at every feedback.
     """
 
-    def __init__(self, options: RunOptions, progress: Callable[[dict], None] | None = None) -> None:
+    def __init__(
+        self, options: RunOptions, progress: Callable[[dict], None] | None = None
+    ) -> None:
         if options.executor not in EXECUTORS:
             raise RunError(f"executor must be one of {EXECUTORS}, got {options.executor!r}")
         if options.attach and (options.processes or options.record):
-            raise RunError("attach uses the nodes already running: it starts no processes and "
-                           "records nothing itself (record with the launch file's record:=)")
+            raise RunError(
+                "attach uses the nodes already running: it starts no processes and "
+                "records nothing itself (record with the launch file's record:=)"
+            )
         self.options = options
         self.progress = progress
         self.scene = load_scene(options.scene_path)
         for name, finger in self.scene.fingers.items():
             if not finger.tip_radius > 0:
-                raise SceneError(f"fingers.{name}.tip_radius must be > 0 m: the simulated "
-                                 "hardware tracks rounded fingertips (Sec. 5)")
+                raise SceneError(
+                    f"fingers.{name}.tip_radius must be > 0 m: the simulated "
+                    "hardware tracks rounded fingertips (Sec. 5)"
+                )
         self.t0 = time.perf_counter()
         self.timing: dict[str, float] = {}
         self.interrupted = threading.Event()
         self.signal = signal.SIGINT
         self.context = Context()
         rclpy.init(context=self.context, signal_handler_options=SignalHandlerOptions.NO)
-        self.executor = (EventsExecutor(context=self.context) if options.executor == "events"
-                         else SingleThreadedExecutor(context=self.context))
+        self.executor = (
+            EventsExecutor(context=self.context)
+            if options.executor == "events"
+            else SingleThreadedExecutor(context=self.context)
+        )
         self.events_per_check = EVENTS_PER_CHECK if options.executor == "events" else 0
         self.client = Node("run", context=self.context)
         self.executor.add_node(self.client)
@@ -250,17 +287,27 @@ class PipelineRunner:
         c = self.client
         self.outcome_subscriptions = [
             c.create_subscription(ContactEventArray, pipeline.SIM_EVENTS, self._sim_events, loop),
-            c.create_subscription(ContactEventArray, pipeline.EVENTS,
-                                  lambda msg: self.monitor_events.extend(msg.events), loop),
+            c.create_subscription(
+                ContactEventArray,
+                pipeline.EVENTS,
+                lambda msg: self.monitor_events.extend(msg.events),
+                loop,
+            ),
             c.create_subscription(Alarm, pipeline.ALARMS, self._alarm, loop),
-            c.create_subscription(SimState, pipeline.SIM_STATE, self._state, loop, raw=True)]
+            c.create_subscription(SimState, pipeline.SIM_STATE, self._state, loop, raw=True),
+        ]
         c.create_subscription(Header, pipeline.RECORDER_PROGRESS, self._recorder_progress, loop)
-        self.prediction_pub = c.create_publisher(ContactEventArray, pipeline.PREDICTION,
-                                                 pipeline.LATCHED)
+        self.prediction_pub = c.create_publisher(
+            ContactEventArray, pipeline.PREDICTION, pipeline.LATCHED
+        )
         self.action = ActionClient(c, ExecuteGrasp, pipeline.ACTION)
         self.goal_statuses: dict[bytes, int] = {}
-        c.create_subscription(GoalStatusArray, f"{pipeline.ACTION}/_action/status",
-                              self._goal_status, pipeline.LATCHED)
+        c.create_subscription(
+            GoalStatusArray,
+            f"{pipeline.ACTION}/_action/status",
+            self._goal_status,
+            pipeline.LATCHED,
+        )
         self.goal_handle = None
         self.result_future = None
         self.plan: Plan | None = None
@@ -270,13 +317,22 @@ class PipelineRunner:
     def _sim_events(self, msg: ContactEventArray) -> None:
         self.sim_events += msg.events
         if msg.termination:
-            self.world_end = {"termination": msg.termination, "depth": float(msg.depth),
-                              "stamp_ns": messages.stamp_ns(msg.header.stamp)}
+            self.world_end = {
+                "termination": msg.termination,
+                "depth": float(msg.depth),
+                "stamp_ns": messages.stamp_ns(msg.header.stamp),
+            }
 
     def _alarm(self, msg: Alarm) -> None:
         self.alarms[msg.type] += 1
-        self.first_alarm.setdefault(msg.type, {"stamp_ns": messages.stamp_ns(msg.header.stamp),
-                                               "finger": msg.finger, "message": msg.message})
+        self.first_alarm.setdefault(
+            msg.type,
+            {
+                "stamp_ns": messages.stamp_ns(msg.header.stamp),
+                "finger": msg.finger,
+                "message": msg.message,
+            },
+        )
 
     def _state(self, data: bytes) -> None:
         self.sim_state_data.append(data)
@@ -285,8 +341,9 @@ class PipelineRunner:
     @property
     def sim_state(self) -> SimState | None:
         """The newest ground-truth state (kept serialised; decoded on demand)."""
-        return deserialize_message(self.sim_state_data[-1], SimState) \
-            if self.sim_state_data else None
+        return (
+            deserialize_message(self.sim_state_data[-1], SimState) if self.sim_state_data else None
+        )
 
     @property
     def sim_states(self) -> list[SimState]:
@@ -300,10 +357,15 @@ class PipelineRunner:
         fb = msg.feedback
         self.feedback.append(fb)
         if self.progress is not None:
-            self.progress({"state": fb.state, "depth": fb.depth,
-                           "relative_depth": fb.relative_depth,
-                           "forces": {f: [v.x, v.y] for f, v in zip(fb.fingers, fb.forces)},
-                           "events": len(self.monitor_events)})
+            self.progress(
+                {
+                    "state": fb.state,
+                    "depth": fb.depth,
+                    "relative_depth": fb.relative_depth,
+                    "forces": {f: [v.x, v.y] for f, v in zip(fb.fingers, fb.forces)},
+                    "events": len(self.monitor_events),
+                }
+            )
 
     # ----------------------------------------------------------------- waiting
     def spin_until(self, done: Callable[[], bool], timeout: float, what: str) -> None:
@@ -356,8 +418,9 @@ class PipelineRunner:
             self._refuse_if_domain_busy(discovery_ends)
         self.timing["plan"] = self.plan.seconds
         self.prediction_pub.publish(self.plan.prediction)
-        params = node_parameters(self.scene, self.options.scene_path, self.options,
-                                 self.plan.goal.relative_per_depth)
+        params = node_parameters(
+            self.scene, self.options.scene_path, self.options, self.plan.goal.relative_per_depth
+        )
         if not self.options.record:
             del params["recorder"]
         started = time.perf_counter()
@@ -365,12 +428,17 @@ class PipelineRunner:
             self._spawn(params)
         elif not self.options.attach:
             self._construct(params)
-        self.spin_until(lambda: self.action.server_is_ready(), self.options.timeout,
-                        "the executor's action server")
+        self.spin_until(
+            lambda: self.action.server_is_ready(),
+            self.options.timeout,
+            "the executor's action server",
+        )
         self.spin_until(lambda: self.sim_state_ns >= 0, self.options.timeout, "tick 0")
-        self.spin_until(lambda: all(s.get_publisher_count() > 0
-                                    for s in self.outcome_subscriptions),
-                        self.options.timeout, "the publishers of the run's outcome topics")
+        self.spin_until(
+            lambda: all(s.get_publisher_count() > 0 for s in self.outcome_subscriptions),
+            self.options.timeout,
+            "the publishers of the run's outcome topics",
+        )
         self.start_ns = self.sim_state_ns
         self.timing["start_nodes"] = time.perf_counter() - started
 
@@ -388,14 +456,17 @@ class PipelineRunner:
         others = self.client.count_publishers("/" + pipeline.TICK)
         if others:
             domain = os.environ.get("ROS_DOMAIN_ID", "0")
-            raise RunError(f"another simulated pipeline is running on ROS_DOMAIN_ID {domain} "
-                           f"({others} publisher(s) of /{pipeline.TICK}); a second run would "
-                           "corrupt both. Stop it, or give this run its own domain, e.g. "
-                           "ROS_DOMAIN_ID=42 squeeze-grasp run ...")
+            raise RunError(
+                f"another simulated pipeline is running on ROS_DOMAIN_ID {domain} "
+                f"({others} publisher(s) of /{pipeline.TICK}); a second run would "
+                "corrupt both. Stop it, or give this run its own domain, e.g. "
+                "ROS_DOMAIN_ID=42 squeeze-grasp run ..."
+            )
 
     def _use_planner(self) -> bool:
-        return self.options.attach or (self.options.planner
-                                       and importlib.util.find_spec(PLANNER_MODULE) is not None)
+        return self.options.attach or (
+            self.options.planner and importlib.util.find_spec(PLANNER_MODULE) is not None
+        )
 
     def _construct(self, params: dict[str, dict]) -> None:
         from squeeze_grasp_ros.ros.nodes.executor import ExecutorNode
@@ -403,8 +474,12 @@ class PipelineRunner:
         from squeeze_grasp_ros.ros.nodes.recorder import RecorderNode
         from squeeze_grasp_ros.ros.nodes.sim_hardware import SimHardwareNode
 
-        classes = {"sim_hardware": SimHardwareNode, "monitor": MonitorNode,
-                   "executor": ExecutorNode, "recorder": RecorderNode}
+        classes = {
+            "sim_hardware": SimHardwareNode,
+            "monitor": MonitorNode,
+            "executor": ExecutorNode,
+            "recorder": RecorderNode,
+        }
         for name, values in params.items():
             overrides = [Parameter(k, value=v) for k, v in values.items()]
             node = classes[name](context=self.context, parameter_overrides=overrides)
@@ -412,16 +487,27 @@ class PipelineRunner:
             self.executor.add_node(node)
 
     def _spawn(self, params: dict[str, dict]) -> None:
-        handle, path = tempfile.mkstemp(prefix=f"squeeze_grasp_run_{os.getpid()}_",
-                                        suffix=".yaml")
+        handle, path = tempfile.mkstemp(prefix=f"squeeze_grasp_run_{os.getpid()}_", suffix=".yaml")
         os.close(handle)
         self.params_file = Path(path)
-        self.params_file.write_text(plain_yaml(
-            {name: {"ros__parameters": values} for name, values in params.items()}))
+        self.params_file.write_text(
+            plain_yaml({name: {"ros__parameters": values} for name, values in params.items()})
+        )
         for name in params:
-            self.processes.append(subprocess.Popen(
-                [sys.executable, "-m", f"squeeze_grasp_ros.ros.nodes.{name}", "--ros-args",
-                 "--params-file", str(self.params_file)], stdin=subprocess.DEVNULL))
+            self.processes.append(
+                subprocess.Popen(
+                    [
+                        sys.executable,
+                        "-m",
+                        f"squeeze_grasp_ros.ros.nodes.{name}",
+                        "--ros-args",
+                        "--params-file",
+                        str(self.params_file),
+                    ],
+                    stdin=subprocess.DEVNULL,
+                    env=single_thread_blas(dict(os.environ)),
+                )
+            )
 
     def node(self, name: str) -> Node:
         """The in-process node called ``name``."""
@@ -430,7 +516,8 @@ class PipelineRunner:
     # ----------------------------------------------------------------- planning
     def _planner_roots(self) -> list[str]:
         """Folders the run's own planner may read: the scene's (and its outline file's), the
-        package share folder and the working directory."""
+        package share folder and the working directory.
+        """
         folders = [Path(self.options.scene_path).resolve().parent, share_dir(), Path.cwd()]
         shape = self.scene.object.shape
         if shape["type"] == "file":
@@ -441,19 +528,31 @@ class PipelineRunner:
         """Start the planner (thread or process); return the function that stops it."""
         roots = self._planner_roots()
         if self.options.processes:
-            proc = subprocess.Popen([sys.executable, "-m", PLANNER_MODULE, "--ros-args",
-                                     "--params-file", str(config_dir() / "planner.yaml"),
-                                     "-p", f"allowed_roots:={json.dumps(roots)}"],
-                                    stdin=subprocess.DEVNULL)
+            proc = subprocess.Popen(
+                [
+                    sys.executable,
+                    "-m",
+                    PLANNER_MODULE,
+                    "--ros-args",
+                    "--params-file",
+                    str(config_dir() / "planner.yaml"),
+                    "-p",
+                    f"allowed_roots:={json.dumps(roots)}",
+                ],
+                stdin=subprocess.DEVNULL,
+                env=single_thread_blas(dict(os.environ)),
+            )
 
             def stop_process() -> None:
                 proc.send_signal(signal.SIGINT)
                 proc.wait(30)
+
             return stop_process
         from squeeze_grasp_ros.ros.nodes.planner import PlannerNode
 
-        node = PlannerNode(context=self.context,
-                           parameter_overrides=[Parameter("allowed_roots", value=roots)])
+        node = PlannerNode(
+            context=self.context, parameter_overrides=[Parameter("allowed_roots", value=roots)]
+        )
         spinner = SingleThreadedExecutor(context=self.context)
         spinner.add_node(node)
         thread = threading.Thread(target=spinner.spin, name="planner", daemon=True)
@@ -463,19 +562,24 @@ class PipelineRunner:
             spinner.shutdown()
             thread.join(30)
             node.destroy_node()
+
         return stop_thread
 
     def _call(self, srv_type: Any, name: str, request: Any) -> Any:
         """Call a planner service; the request is repeated if its response is lost (the
-        planner's requests are idempotent)."""
+        planner's requests are idempotent).
+        """
         client = self.client.create_client(srv_type, f"planner/{name}")
         self.spin_until(client.service_is_ready, self.options.timeout, f"planner/{name}")
         deadline = time.monotonic() + self.options.timeout
         while True:
             future = client.call_async(request)
             retry = min(time.monotonic() + SERVICE_RETRY, deadline)
-            self.spin_until(lambda: future.done() or time.monotonic() > retry,
-                            self.options.timeout, f"planner/{name}")
+            self.spin_until(
+                lambda: future.done() or time.monotonic() > retry,
+                self.options.timeout,
+                f"planner/{name}",
+            )
             if future.done():
                 break
             if time.monotonic() > deadline:
@@ -492,19 +596,38 @@ class PipelineRunner:
         t0 = time.perf_counter()
         path = str(Path(self.options.scene_path).resolve())
         loaded = self._call(LoadObject, "load_object", LoadObject.Request(scene_path=path))
-        squeeze = self._call(EventSqueeze, "event_squeeze",
-                             EventSqueeze.Request(object_id=loaded.object_id)).squeeze
-        pure = self._call(PlanSqueeze, "plan_squeeze", PlanSqueeze.Request(
-            object_id=loaded.object_id, contacts=list(loaded.finger_nodes), squeeze_type="pure"))
-        directions = np.array([[squeeze.direction_f1.x, squeeze.direction_f1.y],
-                               [squeeze.direction_f2.x, squeeze.direction_f2.y]])
+        squeeze = self._call(
+            EventSqueeze, "event_squeeze", EventSqueeze.Request(object_id=loaded.object_id)
+        ).squeeze
+        pure = self._call(
+            PlanSqueeze,
+            "plan_squeeze",
+            PlanSqueeze.Request(
+                object_id=loaded.object_id,
+                contacts=list(loaded.finger_nodes),
+                squeeze_type=SqueezeKind.PURE,
+            ),
+        )
+        directions = np.array(
+            [
+                [squeeze.direction_f1.x, squeeze.direction_f1.y],
+                [squeeze.direction_f2.x, squeeze.direction_f2.y],
+            ]
+        )
         rpd = squeeze.relative_depth / squeeze.depth if squeeze.depth > 0 else 0.0
         resistance = self._resistance_plan() if self._resists() else {}
-        goal = GraspGoal(("F1", "F2"), directions, squeeze.target_depth, rpd,
-                         self.options.on_slip_alarm,
-                         np.asarray(pure.displacement, float).reshape(2, 2), **resistance)
-        prediction = messages.prediction_msg(list(squeeze.events), squeeze.termination,
-                                             squeeze.depth)
+        goal = GraspGoal(
+            SQUEEZING_FINGERS,
+            directions,
+            squeeze.target_depth,
+            rpd,
+            self.options.on_slip_alarm,
+            np.asarray(pure.displacement, float).reshape(2, 2),
+            **resistance,
+        )
+        prediction = messages.prediction_msg(
+            list(squeeze.events), squeeze.termination, squeeze.depth
+        )
         return Plan(goal, prediction, "planner", time.perf_counter() - t0)
 
     def _plan_with_mechanics(self) -> Plan:
@@ -513,23 +636,33 @@ class PipelineRunner:
         obj = ElasticObject(build_mesh(scene), scene_material(scene))
         contacts = finger_nodes(scene, obj.mesh)
         result = event_squeeze_scene(scene, obj, contacts)
-        directions = np.array([result.directions["F1"], result.directions["F2"]])
+        directions = np.array([result.directions[Finger.F1], result.directions[Finger.F2]])
         rpd = result.relative_depth / result.depth if result.depth > 0 else 0.0
-        pure = plan_squeeze(obj, list(contacts), "pure").displacement.reshape(2, 2)
+        pure = plan_squeeze(obj, list(contacts), kind=SqueezeKind.PURE).displacement.reshape(2, 2)
         resistance = self._resistance_plan(obj, contacts, result) if self._resists() else {}
-        goal = GraspGoal(("F1", "F2"), directions, result.target_depth, rpd,
-                         self.options.on_slip_alarm, pure, **resistance)
+        goal = GraspGoal(
+            SQUEEZING_FINGERS,
+            directions,
+            result.target_depth,
+            rpd,
+            self.options.on_slip_alarm,
+            pure,
+            **resistance,
+        )
         prediction = messages.prediction_msg(
-            [messages.contact_event_msg(e) for e in result.events], result.termination,
-            result.depth)
+            [messages.contact_event_msg(e) for e in result.events],
+            result.termination,
+            result.depth,
+        )
         return Plan(goal, prediction, "mechanics", time.perf_counter() - t0)
 
     def _resists(self) -> bool:
         adv = self.scene.adversary
         return self.options.resist and adv is not None and adv.contacts == "friction"
 
-    def _resistance_plan(self, obj: ElasticObject | None = None, contacts=None,
-                         squeeze=None) -> dict:
+    def _resistance_plan(
+        self, obj: ElasticObject | None = None, contacts=None, squeeze=None
+    ) -> dict:
         """Waypoints of Algorithm 2 (Sec. 6.3) after the scene's squeeze, for the goal.
 
         The adversary is sent as far as Algorithm 2 got (all of a, or until it slipped).
@@ -539,18 +672,25 @@ class PipelineRunner:
             obj = ElasticObject(build_mesh(scene), scene_material(scene))
             contacts = finger_nodes(scene, obj.mesh)
             squeeze = event_squeeze_scene(scene, obj, contacts)
-        model = ContactModel(obj, scene.mu, max_events_per_depth=scene.squeeze.max_events_per_depth)
+        model = ContactModel(
+            obj, scene.mu, max_events_per_depth=scene.squeeze.max_events_per_depth
+        )
         node = placement_node(obj.mesh, adv.placement, "adversary")
         state = add_adversary(squeeze.state, model, squeeze.displacement, node, adv.tip_radius)
-        plan = frictional_resistance(model, state, adv.a, adv.mode, squeeze.step,
-                                     squeeze.event_tol)
+        plan = frictional_resistance(
+            model, state, adv.a, mode=adv.mode, step=squeeze.step, event_tol=squeeze.event_tol
+        )
         travel = np.array([s.end for s in plan.stages])
         keep = np.concatenate([[True], np.diff(travel) > 0]) & (travel > 0)
-        waypoints = np.stack([plan.trajectories[f][1:] for f in ("F1", "F2")], axis=1)
+        waypoints = np.stack([plan.trajectories[f][1:] for f in SQUEEZING_FINGERS], axis=1)
         a = np.asarray(adv.a, float)
         travel = travel[keep]
-        return {"adversary": "A", "adversary_translation": a * (travel[-1] / np.hypot(*a)),
-                "resist_travel": travel, "resist_waypoints": waypoints[keep]}
+        return {
+            "adversary": "A",
+            "adversary_translation": a * (travel[-1] / np.hypot(*a)),
+            "resist_travel": travel,
+            "resist_waypoints": waypoints[keep],
+        }
 
     # ----------------------------------------------------------------- the goal
     def send_goal(self) -> None:
@@ -569,18 +709,27 @@ class PipelineRunner:
         handle = None
         while handle is None:
             goal_id = UUID(uuid=list(uuid.uuid4().bytes))
-            sent.append((goal_id, self.action.send_goal_async(msg, self._feedback,
-                                                              goal_uuid=goal_id)))
+            sent.append(
+                (goal_id, self.action.send_goal_async(msg, self._feedback, goal_uuid=goal_id))
+            )
             retry = min(time.monotonic() + GOAL_RESPONSE_TIMEOUT, deadline)
-            self.spin_until(lambda: self._accepted(sent) is not None
-                            or all(f.done() for _, f in sent) or time.monotonic() > retry,
-                            self.options.timeout, "the goal to be accepted")
+            self.spin_until(
+                lambda: (
+                    self._accepted(sent) is not None
+                    or all(f.done() for _, f in sent)
+                    or time.monotonic() > retry
+                ),
+                self.options.timeout,
+                "the goal to be accepted",
+            )
             handle = self._accepted(sent)
             if handle is None and all(f.done() for _, f in sent):
                 settle = time.monotonic() + GOAL_RESPONSE_TIMEOUT
-                self.spin_until(lambda: self._accepted(sent) is not None
-                                or time.monotonic() > settle, self.options.timeout,
-                                "the status of the goal requests")
+                self.spin_until(
+                    lambda: self._accepted(sent) is not None or time.monotonic() > settle,
+                    self.options.timeout,
+                    "the status of the goal requests",
+                )
                 handle = self._accepted(sent) or sent[-1][1].result()
             if handle is None and time.monotonic() > deadline:
                 raise RunError("the executor never answered the goal request")
@@ -593,13 +742,15 @@ class PipelineRunner:
 
     def _accepted(self, sent: list):
         """The goal handle of the first request known to be accepted (by its response or by
-        the status topic), or None."""
+        the status topic), or None.
+        """
         for goal_id, future in sent:
             if future.done() and future.result().accepted:
                 return future.result()
             if self._status_of(goal_id) is not None:
-                return ClientGoalHandle(self.action, goal_id,
-                                        ExecuteGrasp.Impl.SendGoalService.Response(accepted=True))
+                return ClientGoalHandle(
+                    self.action, goal_id, ExecuteGrasp.Impl.SendGoalService.Response(accepted=True)
+                )
         return None
 
     def _goal_status(self, msg: GoalStatusArray) -> None:
@@ -625,32 +776,47 @@ class PipelineRunner:
         the object. If the status topic reports the goal finished but the result response does
         not come within a few seconds (lost across processes), the result is requested again.
         """
-        finished = (GoalStatus.STATUS_SUCCEEDED, GoalStatus.STATUS_ABORTED,
-                    GoalStatus.STATUS_CANCELED)
+        finished = (
+            GoalStatus.STATUS_SUCCEEDED,
+            GoalStatus.STATUS_ABORTED,
+            GoalStatus.STATUS_CANCELED,
+        )
         deadline = time.monotonic() + self.options.timeout
         cancelled = False
         while not self.result_future.done():
             if not cancelled and self._world_failed():
                 cancelled = True
                 self.cancel()
-            ended = [time.monotonic()] if self._status_of(self.goal_handle.goal_id) in finished \
-                else []
-            self.spin_until(lambda: self.result_future.done() or (
-                ended and time.monotonic() > ended[0] + GOAL_RESPONSE_TIMEOUT) or (
-                not ended and self._status_of(self.goal_handle.goal_id) in finished) or (
-                not cancelled and self._world_failed()),
-                max(deadline - time.monotonic(), 0.0), "the goal's result")
+            ended = (
+                [time.monotonic()] if self._status_of(self.goal_handle.goal_id) in finished else []
+            )
+            self.spin_until(
+                lambda: (
+                    self.result_future.done()
+                    or (ended and time.monotonic() > ended[0] + GOAL_RESPONSE_TIMEOUT)
+                    or (not ended and self._status_of(self.goal_handle.goal_id) in finished)
+                    or (not cancelled and self._world_failed())
+                ),
+                max(deadline - time.monotonic(), 0.0),
+                "the goal's result",
+            )
             if not self.result_future.done() and ended:
                 self.result_future = self.goal_handle.get_result_async()
         result = self.result_future.result().result
         self.timing["loop"] = time.perf_counter() - self.loop_started
         self.timing["loop_cpu"] = time.process_time() - self.loop_cpu_started
         final = self.start_ns + result.ticks * self._dt_ns()
-        self.spin_until(lambda: self.sim_state_ns >= final,
-                        self.options.timeout, "the ground truth of the last tick")
+        self.spin_until(
+            lambda: self.sim_state_ns >= final,
+            self.options.timeout,
+            "the ground truth of the last tick",
+        )
         if self.options.record and self.options.processes:
-            self.spin_until(lambda: self.recorder_ns >= final, self.options.timeout,
-                            "the recorder to reach the last tick")
+            self.spin_until(
+                lambda: self.recorder_ns >= final,
+                self.options.timeout,
+                "the recorder to reach the last tick",
+            )
         return result
 
     def _dt_ns(self) -> int:
@@ -700,9 +866,11 @@ class PipelineRunner:
         the shutdown then stops the simulated world first (no new ticks), lets the recorder
         write what it has received and finishes the recording, and stops every node process.
         """
+
         def on_signal(signum: int, _frame: Any) -> None:
             self.signal = signum
             self.interrupted.set()
+
         previous = {s: signal.signal(s, on_signal) for s in STOP_SIGNALS}
         try:
             self.start()
@@ -723,45 +891,63 @@ class PipelineRunner:
         gt_events = list(self.sim_events)
         plan = self.plan
         return {
-            "scene": self.scene.name, "mode": self.mode(), "plan_source": plan.source,
+            "scene": self.scene.name,
+            "mode": self.mode(),
+            "plan_source": plan.source,
             "termination": result.termination,
             "success": bool(result.success) and (state.termination or "none") in GRASP_HELD,
-            "executor_success": bool(result.success), "outcome": self.outcome(result),
-            "message": result.message, "world_termination": state.termination or "none",
+            "executor_success": bool(result.success),
+            "outcome": self.outcome(result),
+            "message": result.message,
+            "world_termination": state.termination or "none",
             "depth": float(state.contacts.depth),
             "relative_depth": float(state.contacts.relative_depth),
-            "target_depth": float(plan.goal.depth), "measured_depth": float(result.depth),
-            "ticks": int(result.ticks), "sim_time": float(result.duration),
-            "hold_ticks": int(result.hold_ticks), "redirected": bool(result.redirected),
+            "target_depth": float(plan.goal.depth),
+            "measured_depth": float(result.depth),
+            "ticks": int(result.ticks),
+            "sim_time": float(result.duration),
+            "hold_ticks": int(result.hold_ticks),
+            "redirected": bool(result.redirected),
             "events": _event_list(gt_events),
             "event_counts": {t: sum(1 for e in gt_events if e.type == t) for t in "ABCD"},
             "world_end": self.world_end,
             "monitor_events": _event_list(list(self.monitor_events)),
             "monitor_event_counts": dict(Counter(e.type for e in self.monitor_events)),
-            "alarms": dict(self.alarms), "first_alarms": self.first_alarm,
-            "prediction": {"termination": plan.prediction.termination,
-                           "depth": float(plan.prediction.depth),
-                           "events": _event_list(list(plan.prediction.events))},
+            "alarms": dict(self.alarms),
+            "first_alarms": self.first_alarm,
+            "prediction": {
+                "termination": plan.prediction.termination,
+                "depth": float(plan.prediction.depth),
+                "events": _event_list(list(plan.prediction.events)),
+            },
             "forces": {f: [v.x, v.y] for f, v in zip(fingers, state.forces)},
             "work": dict(zip(fingers, (float(w) for w in state.work))),
             "measured_forces": {f: [v.x, v.y] for f, v in zip(result.fingers, result.forces)},
             "measured_work": dict(zip(result.fingers, (float(w) for w in result.work))),
             "contacts": messages.contact_records(state.contacts),
             "recording": self.options.record,
-            "timing": {**self.timing, "total": time.perf_counter() - self.t0,
-                       **self._node_timing()},
+            "timing": {
+                **self.timing,
+                "total": time.perf_counter() - self.t0,
+                **self._node_timing(),
+            },
         }
 
     def _node_timing(self) -> dict:
         """Wall and CPU time of the stepper (``mechanics``) and of whole world ticks (``world``:
         devices, stepper, sensors) inside the in-process simulated hardware (absent with
-        processes; ``loop_cpu`` is then only this process's CPU time)."""
+        processes; ``loop_cpu`` is then only this process's CPU time).
+        """
         sims = [n for n in self.nodes if n.get_name() == "sim_hardware"]
         if not sims:
             return {}
         world = sims[0].world
-        return {"mechanics": world.stepper_seconds, "mechanics_cpu": world.stepper_cpu_seconds,
-                "world": world.step_seconds, "world_cpu": world.step_cpu_seconds}
+        return {
+            "mechanics": world.stepper_seconds,
+            "mechanics_cpu": world.stepper_cpu_seconds,
+            "world": world.step_seconds,
+            "world_cpu": world.step_cpu_seconds,
+        }
 
     def outcome(self, result: ExecuteGrasp.Result) -> str:
         """One sentence: did the grasp hold in the simulated world, and if not, why."""
@@ -770,8 +956,10 @@ class PipelineRunner:
             return "grasp held" if world == "none" else "object picked up"
         if world not in GRASP_HELD:
             depth = self.world_end["depth"] if self.world_end else float("nan")
-            return (f"grasp failed in the world: {world} at depth {depth * 1e3:.4f} mm; the "
-                    "executor was stopped")
+            return (
+                f"grasp failed in the world: {world} at depth {depth * 1e3:.4f} mm; the "
+                "executor was stopped"
+            )
         return f"executor did not finish: {result.termination} ({result.message})"
 
     def mode(self) -> str:
@@ -780,5 +968,6 @@ class PipelineRunner:
             return "attached to running nodes"
         if self.options.processes:
             return "processes"
-        return "one process, " + ("EventsExecutor" if self.options.executor == "events"
-                                  else "SingleThreadedExecutor")
+        return "one process, " + (
+            "EventsExecutor" if self.options.executor == "events" else "SingleThreadedExecutor"
+        )

@@ -1,0 +1,81 @@
+# Copyright 2026 squeeze_grasp_ros developers
+# SPDX-License-Identifier: Apache-2.0
+"""The front door: the public, ROS-free Python API in one import.
+
+Scenes and shipped files, meshes and elastic objects, stable and pure squeezes, the
+event-driven squeeze with rounded fingertips (Algorithm 1), grasp maps, resistance, rings,
+calibration, the domain vocabulary and the error kinds. SI units throughout; lengths in m,
+forces in N, the object frame x right, y up. Everything else in the package is internal and
+may move.
+
+A scene, meshed, squeezed, and its contact events:
+
+>>> from squeeze_grasp_ros.api import event_squeeze_scene, load_scene, scene_file, scene_solid
+>>> scene = load_scene(scene_file("foam_square"))
+>>> result = event_squeeze_scene(scene, scene_solid(scene))
+>>> for event in result.events[:2]:
+...     print(event.type, event.finger, f"{event.relative_depth:.4f}")
+A F2 0.0106
+A F1 0.0107
+>>> print(result.termination, f"{result.relative_depth:.2f}")
+depth_reached 0.12
+
+The same from its parts: the mesh, the fingers' initial contact nodes, the squeeze:
+
+>>> mesh = build_mesh(scene)
+>>> obj = ElasticObject(mesh, Material(E=1e5, nu=0.3, thickness=0.01))
+>>> i, j = finger_nodes(scene, mesh)
+>>> squeeze = event_squeeze(obj, (i, j), 0.02, 0.4, kind=SqueezeKind.PURE, relative_depth=0.02)
+>>> print(squeeze.termination, squeeze.events[0].type)
+depth_reached A
+"""
+from __future__ import annotations
+
+from squeeze_grasp_ros.mechanics.calibration.material_fit import Cuboid, calibrate_elasticity
+from squeeze_grasp_ros.mechanics.calibration.matching import match_similarity
+from squeeze_grasp_ros.mechanics.elastic.compliance import ElasticObject
+from squeeze_grasp_ros.mechanics.elastic.material import Material
+from squeeze_grasp_ros.mechanics.elastic.mesh import Mesh, generate_mesh
+from squeeze_grasp_ros.mechanics.elastic.reduced import ReducedStiffness, reduced_stiffness
+from squeeze_grasp_ros.mechanics.errors import (InfeasibleError, InternalError,
+                                               InvalidInputError, NumericalError,
+                                               SqueezeGraspError)
+from squeeze_grasp_ros.mechanics.resistance.frictional import (FrictionalResistance,
+                                                               frictional_resistance)
+from squeeze_grasp_ros.mechanics.resistance.optimal import optimal_resistance, resistance_grasp
+from squeeze_grasp_ros.mechanics.ring.grasp_map import ring_grasp_map
+from squeeze_grasp_ros.mechanics.ring.model import RingModel
+from squeeze_grasp_ros.mechanics.ring.squeeze import ring_grasp
+from squeeze_grasp_ros.mechanics.squeeze.contact_model import Limits
+from squeeze_grasp_ros.mechanics.squeeze.contact_state import ContactState, Event
+from squeeze_grasp_ros.mechanics.squeeze.events import EventSqueeze, event_squeeze
+from squeeze_grasp_ros.mechanics.squeeze.graspmap import GraspMap, grasp_map
+from squeeze_grasp_ros.mechanics.squeeze.stable_pure import Squeeze, plan_squeeze
+from squeeze_grasp_ros.mechanics.vocabulary import (ContactMode, EventType, Finger,
+                                                    MaterialModel, SqueezeKind,
+                                                    StrainCriterion, Termination)
+from squeeze_grasp_ros.resources import scene_file
+from squeeze_grasp_ros.scene import Scene, build_mesh, finger_nodes, load_scene, scene_solid
+from squeeze_grasp_ros.scene_events import event_squeeze_scene
+
+__all__ = [
+    # scenes
+    "Scene", "load_scene", "scene_file", "build_mesh", "scene_solid", "finger_nodes",
+    "event_squeeze_scene",
+    # elastic objects
+    "Material", "Mesh", "generate_mesh", "ElasticObject", "ReducedStiffness",
+    "reduced_stiffness",
+    # squeezes
+    "Squeeze", "plan_squeeze", "Limits", "EventSqueeze", "Event", "ContactState",
+    "event_squeeze", "GraspMap", "grasp_map",
+    # resistance, rings, calibration
+    "resistance_grasp", "optimal_resistance", "FrictionalResistance", "frictional_resistance",
+    "RingModel", "ring_grasp", "ring_grasp_map", "Cuboid", "calibrate_elasticity",
+    "match_similarity",
+    # vocabulary
+    "Finger", "EventType", "ContactMode", "Termination", "SqueezeKind", "StrainCriterion",
+    "MaterialModel",
+    # errors
+    "SqueezeGraspError", "InvalidInputError", "InfeasibleError", "NumericalError",
+    "InternalError",
+]

@@ -28,7 +28,7 @@ from launch_ros.actions import Node
 from launch_ros.substitutions import ExecutableInPackage
 
 from squeeze_grasp_ros.mechanics.elastic.compliance import ElasticObject
-from squeeze_grasp_ros.ros.run.runner import RunOptions, node_parameters
+from squeeze_grasp_ros.ros.run.options import RunOptions, node_parameters
 from squeeze_grasp_ros.resources import config_dir, scene_file, viewer_file
 from squeeze_grasp_ros.scene import build_mesh, finger_nodes, load_scene, scene_material
 from squeeze_grasp_ros.sim.world import squeeze_geometry

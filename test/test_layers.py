@@ -32,7 +32,8 @@ ROS_MODULES = ("rclpy", "rosidl", "rcl_interfaces", "builtin_interfaces", "std_m
 LAYERS: tuple[tuple[str, ...], ...] = (
     ("inputs", "exit_codes", "extras", "resources", "threads"),
     ("mechanics",),
-    ("scene", "scene_events", "planning", "control", "sim", "plots", "sweep", "api"),
+    ("scene", "scene_events", "scene_plan", "planning", "control", "sim", "plots", "sweep",
+     "api"),
     ("ros",),
     ("commands", "bench", "cli", "entry"),
 )

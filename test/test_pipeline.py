@@ -16,7 +16,8 @@ from rclpy.serialization import deserialize_message
 
 from squeeze_grasp_ros.mechanics.elastic.compliance import ElasticObject
 from squeeze_grasp_ros.ros.nodes import pipeline
-from squeeze_grasp_ros.ros.run.runner import PipelineRunner, RunOptions
+from squeeze_grasp_ros.ros.run.options import RunOptions
+from squeeze_grasp_ros.ros.run.runner import PipelineRunner
 from squeeze_grasp_ros.ros.recording.bag import read_bag
 from squeeze_grasp_ros.ros.recording.replay import replay
 from squeeze_grasp_ros.ros.recording.schema import own_text

@@ -15,7 +15,8 @@ import pytest
 from rclpy.serialization import deserialize_message
 
 from squeeze_grasp_ros.ros.nodes import pipeline
-from squeeze_grasp_ros.ros.run.runner import PipelineRunner, RunOptions
+from squeeze_grasp_ros.ros.run.options import RunOptions
+from squeeze_grasp_ros.ros.run.runner import PipelineRunner
 from squeeze_grasp_ros.ros.recording.bag import read_bag
 
 from pipeline_support import SMALL_SQUARE, scene_data, write_scene

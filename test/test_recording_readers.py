@@ -13,7 +13,8 @@ from pathlib import Path
 import pytest
 from mcap.reader import make_reader
 
-from squeeze_grasp_ros.ros.run.runner import PipelineRunner, RunOptions
+from squeeze_grasp_ros.ros.run.options import RunOptions
+from squeeze_grasp_ros.ros.run.runner import PipelineRunner
 from squeeze_grasp_ros.ros.recording.schema import SEPARATOR, message_definition, own_text
 
 from foxglove_support import foxglove_decode

@@ -11,7 +11,8 @@ import yaml
 
 from squeeze_grasp_ros.mechanics.elastic.compliance import ElasticObject
 from squeeze_grasp_ros.ros.nodes import pipeline
-from squeeze_grasp_ros.ros.run.runner import PipelineRunner, RunOptions
+from squeeze_grasp_ros.ros.run.options import RunOptions
+from squeeze_grasp_ros.ros.run.runner import PipelineRunner
 from squeeze_grasp_ros.ros.recording.bag import read_bag
 from squeeze_grasp_ros.resources import scene_file
 from squeeze_grasp_ros.scene import build_mesh, finger_nodes, load_scene, scene_material

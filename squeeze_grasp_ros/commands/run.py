@@ -71,7 +71,8 @@ def run(args: argparse.Namespace) -> dict | int:
     """Run the pipeline; the JSON summary (see :meth:`PipelineRunner.summary`), or exit code
     130 after Ctrl-C (the recording is finished first).
     """
-    from squeeze_grasp_ros.ros.run.runner import PipelineRunner, RunError, RunOptions
+    from squeeze_grasp_ros.ros.run.options import RunError, RunOptions
+    from squeeze_grasp_ros.ros.run.runner import PipelineRunner
 
     if not (args.timeout > 0 and args.timeout < float("inf")):
         return fail(args, f"--timeout must be > 0 s, got {args.timeout}", ExitCode.USAGE)

@@ -35,7 +35,7 @@ from squeeze_grasp_ros.ros import messages
 from squeeze_grasp_ros.ros.nodes import pipeline
 from squeeze_grasp_ros.ros.nodes.monitor import MonitorNode
 from squeeze_grasp_ros.ros.nodes.recorder import cdr_stamp_ns
-from squeeze_grasp_ros.ros.run.runner import config_parameters
+from squeeze_grasp_ros.ros.run.options import config_parameters
 from squeeze_grasp_ros.ros.recording.bag import BagContents, BagError, read_bag
 from squeeze_grasp_ros.mechanics.vocabulary import Finger
 

@@ -14,12 +14,14 @@ drive the steps themselves):
    launch`` would start them);
 3. the plan: the planner node's services when the planner exists (``load_object``,
    ``event_squeeze`` for the directions and the predicted events, ``plan_squeeze`` for the pure
-   directions), else the same mechanics API directly; the resistance waypoints (scenes with a
-   frictional adversary) from Algorithm 2 (:mod:`..mechanics.resistance_friction`);
+   directions), else :func:`squeeze_grasp_ros.scene_plan.plan_scene` directly; the resistance
+   waypoints (scenes with a frictional adversary) from Algorithm 2
+   (:func:`squeeze_grasp_ros.scene_plan.resistance_goal`);
 4. the prediction latched on ``planner/predicted_events``, the ``ExecuteGrasp`` goal, progress
    from its feedback, the result; ground truth from ``sim/events`` and ``sim/state``.
 
-Every wait spins the executor with a wall-clock timeout; nothing sleeps to synchronise.
+Every wait spins the executor with a wall-clock timeout; nothing sleeps to synchronise. The
+options and node parameters are in :mod:`.options`, the summary in :mod:`.summary`.
 """
 
 from __future__ import annotations
@@ -36,13 +38,11 @@ import time
 import uuid
 from collections import Counter
 from collections.abc import Callable
-from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 import rclpy
-import yaml
 from action_msgs.msg import GoalStatus, GoalStatusArray
 from rclpy.action import ActionClient
 from rclpy.action.client import ClientGoalHandle
@@ -61,46 +61,30 @@ from unique_identifier_msgs.msg import UUID
 
 from squeeze_grasp_ros.ros import messages
 from squeeze_grasp_ros.control.motion import GraspGoal
-from squeeze_grasp_ros.mechanics.elastic.compliance import ElasticObject
-from squeeze_grasp_ros.mechanics.squeeze.contact_model import ContactModel
-from squeeze_grasp_ros.mechanics.resistance.frictional import add_adversary, frictional_resistance
-from squeeze_grasp_ros.mechanics.squeeze.stable_pure import plan_squeeze
 from squeeze_grasp_ros.ros.recording.bag import plain_yaml
 from squeeze_grasp_ros.resources import config_dir, share_dir
 from squeeze_grasp_ros.scene import (
-    Scene,
     SceneError,
-    build_mesh,
-    finger_devices,
-    finger_nodes,
     load_scene,
-    placement_node,
-    scene_material,
 )
-from squeeze_grasp_ros.scene_events import event_squeeze_scene
 from squeeze_grasp_ros.ros.nodes import pipeline
 from squeeze_grasp_ros.ros.nodes.recorder import cdr_stamp_ns
+from squeeze_grasp_ros.ros.run.options import (EXECUTORS, PLANNER_MODULE, RunError,
+                                               RunOptions, node_parameters)
+from squeeze_grasp_ros.ros.run.summary import GRASP_HELD, Observed, Plan, run_summary
+from squeeze_grasp_ros.scene_plan import plan_scene, resistance_goal, resists
 from squeeze_grasp_ros.threads import single_thread_blas
 from squeeze_grasp_ros.mechanics.vocabulary import (
-    Finger,
     SQUEEZING_FINGERS,
     SqueezeKind,
-    Termination,
 )
 
-NODES: tuple[str, ...] = ("sim_hardware", "monitor", "executor", "recorder")
-EXECUTORS: tuple[str, ...] = ("events", "single")
-PLANNER_MODULE = "squeeze_grasp_ros.ros.nodes.planner"
 GOAL_RESPONSE_TIMEOUT = 5.0
 """Wall-clock seconds to wait for a goal (or result) response before checking the status."""
 EVENTS_PER_CHECK = 16
 """Queued events :meth:`PipelineRunner.spin_until` executes between two checks of its condition."""
 SERVICE_RETRY = 30.0
 """Wall-clock seconds after which an unanswered planner request is sent again."""
-
-
-GRASP_HELD: tuple[str, ...] = ("none", Termination.PICKED_UP)
-"""World terminations after which the grasp holds ("none": the world never ended)."""
 
 
 STOP_SIGNALS = (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)
@@ -113,119 +97,6 @@ class Interrupted(KeyboardInterrupt):
     def __init__(self, signum: int) -> None:
         super().__init__(signal.Signals(signum).name)
         self.signum = int(signum)
-
-
-class RunError(RuntimeError):
-    """The pipeline could not be started or did not finish in time."""
-
-
-def config_parameters(node: str) -> dict[str, Any]:
-    """The ``ros__parameters`` of ``config/<node>.yaml``."""
-    data = yaml.safe_load((config_dir() / f"{node}.yaml").read_text())
-    section = data.get(node) or data.get("/**") or {}
-    return dict(section.get("ros__parameters", {}))
-
-
-@dataclass(frozen=True)
-class RunOptions:
-    """What to run and how.
-
-    Attributes
-    ----------
-    scene_path : str
-    record : str or None
-        Bag folder to record into.
-    include_hidden_topics : bool
-        Record the executor action's hidden ``_action/`` topics too.
-    attach : bool
-        Use the nodes already running on this ROS domain (started by ``ros2 launch
-        squeeze_grasp_ros sim_pipeline.launch.py``) instead of starting them: plan with the
-        running planner, send the goal, summarise. Recording is then the launched recorder's.
-    processes : bool
-        One process per node instead of one executor in this process.
-    executor : {"events", "single"}
-        rclpy executor of the one-process mode.
-    on_slip_alarm : {"hold", "pure", "normals"}
-        The executor's reaction to an imminent-slip alarm.
-    resist : bool
-        Run the resistance phase when the scene has a frictional adversary.
-    planner : bool
-        Plan with the planner node if it exists (else with the mechanics API).
-    overrides : dict
-        Node name -> parameter overrides (applied last).
-    timeout : float
-        Wall-clock seconds a run may take.
-    discovery_wait : float
-        Least wall-clock seconds of DDS discovery before the run checks that no other
-        simulation uses its ROS domain (it overlaps the planning).
-    """
-
-    scene_path: str
-    record: str | None = None
-    include_hidden_topics: bool = False
-    attach: bool = False
-    processes: bool = False
-    executor: str = "events"
-    on_slip_alarm: str = "hold"
-    resist: bool = True
-    planner: bool = True
-    overrides: dict = field(default_factory=dict)
-    timeout: float = 300.0
-    discovery_wait: float = 1.0
-
-
-def node_parameters(
-    scene: Scene, scene_path: str, options: RunOptions, relative_per_depth: float
-) -> dict[str, dict[str, Any]]:
-    """Parameters of every node: the config files, then the scene's values, then overrides."""
-    params = {name: config_parameters(name) for name in NODES}
-    devices = finger_devices(scene)
-    mapping = [f"{f}:{d}" for f, d in devices.items()]
-    streams = [
-        s
-        for s, effect in (("wrench", "force_sensing"), ("tactile", "tactile_sensing"))
-        if scene.has(effect)
-    ]
-    noise = scene.sensors.noise_std if scene.has("sensor_noise") else 0.0
-    params["sim_hardware"].update(
-        scene=str(Path(scene_path).resolve()),
-        participants=["monitor", "executor"] + (["recorder"] if options.record else []),
-    )
-    monitor = params["monitor"]
-    monitor.update(
-        finger_devices=mapping,
-        streams=streams or [""],
-        mu=float(scene.mu),
-        weight=float(scene.pickup.weight) if scene.has("pickup") else 0.0,
-        relative_per_depth=float(relative_per_depth),
-        load_threshold=max(float(monitor.get("load_threshold", 0.005)), 6.0 * noise),
-    )
-    params["executor"].update(finger_devices=mapping, period=float(scene.sim.dt))
-    custom = {"scene": Path(scene_path).read_text(), "scene_path": str(scene_path)}
-    params["recorder"].update(
-        output=str(options.record or ""),
-        devices=list(devices.values()),
-        include_hidden_topics=options.include_hidden_topics,
-    )
-    for name, values in options.overrides.items():
-        params[name].update(values)
-    custom["monitor_parameters"] = yaml.safe_dump(params["monitor"], sort_keys=True)
-    params["recorder"]["custom_data"] = yaml.safe_dump(custom)
-    return params
-
-
-@dataclass(frozen=True)
-class Plan:
-    """What the executor is asked to do and what the planner predicts."""
-
-    goal: GraspGoal
-    prediction: ContactEventArray
-    source: str
-    seconds: float
-
-
-def _event_list(events: list[ContactEvent]) -> list[dict]:
-    return [messages.event_record(e) for e in events]
 
 
 class PipelineRunner:
@@ -615,7 +486,8 @@ class PipelineRunner:
             ]
         )
         rpd = squeeze.relative_depth / squeeze.depth if squeeze.depth > 0 else 0.0
-        resistance = self._resistance_plan() if self._resists() else {}
+        resist = resists(self.scene, resist=self.options.resist)
+        resistance = resistance_goal(self.scene) if resist else {}
         goal = GraspGoal(
             SQUEEZING_FINGERS,
             directions,
@@ -631,66 +503,13 @@ class PipelineRunner:
         return Plan(goal, prediction, "planner", time.perf_counter() - t0)
 
     def _plan_with_mechanics(self) -> Plan:
-        t0 = time.perf_counter()
-        scene = self.scene
-        obj = ElasticObject(build_mesh(scene), scene_material(scene))
-        contacts = finger_nodes(scene, obj.mesh)
-        result = event_squeeze_scene(scene, obj, contacts)
-        directions = np.array([result.directions[Finger.F1], result.directions[Finger.F2]])
-        rpd = result.relative_depth / result.depth if result.depth > 0 else 0.0
-        pure = plan_squeeze(obj, list(contacts), kind=SqueezeKind.PURE).displacement.reshape(2, 2)
-        resistance = self._resistance_plan(obj, contacts, result) if self._resists() else {}
-        goal = GraspGoal(
-            SQUEEZING_FINGERS,
-            directions,
-            result.target_depth,
-            rpd,
-            self.options.on_slip_alarm,
-            pure,
-            **resistance,
-        )
+        plan = plan_scene(self.scene, on_slip_alarm=self.options.on_slip_alarm,
+                          resist=self.options.resist)
+        squeeze = plan.squeeze
         prediction = messages.prediction_msg(
-            [messages.contact_event_msg(e) for e in result.events],
-            result.termination,
-            result.depth,
-        )
-        return Plan(goal, prediction, "mechanics", time.perf_counter() - t0)
-
-    def _resists(self) -> bool:
-        adv = self.scene.adversary
-        return self.options.resist and adv is not None and adv.contacts == "friction"
-
-    def _resistance_plan(
-        self, obj: ElasticObject | None = None, contacts=None, squeeze=None
-    ) -> dict:
-        """Waypoints of Algorithm 2 (Sec. 6.3) after the scene's squeeze, for the goal.
-
-        The adversary is sent as far as Algorithm 2 got (all of a, or until it slipped).
-        """
-        scene, adv = self.scene, self.scene.adversary
-        if obj is None:
-            obj = ElasticObject(build_mesh(scene), scene_material(scene))
-            contacts = finger_nodes(scene, obj.mesh)
-            squeeze = event_squeeze_scene(scene, obj, contacts)
-        model = ContactModel(
-            obj, scene.mu, max_events_per_depth=scene.squeeze.max_events_per_depth
-        )
-        node = placement_node(obj.mesh, adv.placement, "adversary")
-        state = add_adversary(squeeze.state, model, squeeze.displacement, node, adv.tip_radius)
-        plan = frictional_resistance(
-            model, state, adv.a, mode=adv.mode, step=squeeze.step, event_tol=squeeze.event_tol
-        )
-        travel = np.array([s.end for s in plan.stages])
-        keep = np.concatenate([[True], np.diff(travel) > 0]) & (travel > 0)
-        waypoints = np.stack([plan.trajectories[f][1:] for f in SQUEEZING_FINGERS], axis=1)
-        a = np.asarray(adv.a, float)
-        travel = travel[keep]
-        return {
-            "adversary": "A",
-            "adversary_translation": a * (travel[-1] / np.hypot(*a)),
-            "resist_travel": travel,
-            "resist_waypoints": waypoints[keep],
-        }
+            [messages.contact_event_msg(e) for e in squeeze.events], squeeze.termination,
+            squeeze.depth)
+        return Plan(plan.goal, prediction, "mechanics", plan.seconds)
 
     # ----------------------------------------------------------------- the goal
     def send_goal(self) -> None:
@@ -885,53 +704,13 @@ class PipelineRunner:
                     signal.signal(signum, handler)
 
     def summary(self, result: ExecuteGrasp.Result) -> dict:
-        """JSON-able summary of a finished goal (ground truth and measured)."""
-        state = self.sim_state
-        fingers = list(state.fingers)
-        gt_events = list(self.sim_events)
-        plan = self.plan
-        return {
-            "scene": self.scene.name,
-            "mode": self.mode(),
-            "plan_source": plan.source,
-            "termination": result.termination,
-            "success": bool(result.success) and (state.termination or "none") in GRASP_HELD,
-            "executor_success": bool(result.success),
-            "outcome": self.outcome(result),
-            "message": result.message,
-            "world_termination": state.termination or "none",
-            "depth": float(state.contacts.depth),
-            "relative_depth": float(state.contacts.relative_depth),
-            "target_depth": float(plan.goal.depth),
-            "measured_depth": float(result.depth),
-            "ticks": int(result.ticks),
-            "sim_time": float(result.duration),
-            "hold_ticks": int(result.hold_ticks),
-            "redirected": bool(result.redirected),
-            "events": _event_list(gt_events),
-            "event_counts": {t: sum(1 for e in gt_events if e.type == t) for t in "ABCD"},
-            "world_end": self.world_end,
-            "monitor_events": _event_list(list(self.monitor_events)),
-            "monitor_event_counts": dict(Counter(e.type for e in self.monitor_events)),
-            "alarms": dict(self.alarms),
-            "first_alarms": self.first_alarm,
-            "prediction": {
-                "termination": plan.prediction.termination,
-                "depth": float(plan.prediction.depth),
-                "events": _event_list(list(plan.prediction.events)),
-            },
-            "forces": {f: [v.x, v.y] for f, v in zip(fingers, state.forces)},
-            "work": dict(zip(fingers, (float(w) for w in state.work))),
-            "measured_forces": {f: [v.x, v.y] for f, v in zip(result.fingers, result.forces)},
-            "measured_work": dict(zip(result.fingers, (float(w) for w in result.work))),
-            "contacts": messages.contact_records(state.contacts),
-            "recording": self.options.record,
-            "timing": {
-                **self.timing,
-                "total": time.perf_counter() - self.t0,
-                **self._node_timing(),
-            },
-        }
+        """JSON-able summary of a finished goal (:func:`.summary.run_summary`)."""
+        observed = Observed(self.sim_state, list(self.sim_events), self.world_end,
+                            list(self.monitor_events), self.alarms, self.first_alarm)
+        timing = {**self.timing, "total": time.perf_counter() - self.t0, **self._node_timing()}
+        return run_summary(scene=self.scene.name, mode=self.mode(), plan=self.plan,
+                           observed=observed, result=result, recording=self.options.record,
+                           timing=timing)
 
     def _node_timing(self) -> dict:
         """Wall and CPU time of the stepper (``mechanics``) and of whole world ticks (``world``:
@@ -948,19 +727,6 @@ class PipelineRunner:
             "world": world.step_seconds,
             "world_cpu": world.step_cpu_seconds,
         }
-
-    def outcome(self, result: ExecuteGrasp.Result) -> str:
-        """One sentence: did the grasp hold in the simulated world, and if not, why."""
-        world = self.sim_state.termination or "none"
-        if world in GRASP_HELD and result.success:
-            return "grasp held" if world == "none" else "object picked up"
-        if world not in GRASP_HELD:
-            depth = self.world_end["depth"] if self.world_end else float("nan")
-            return (
-                f"grasp failed in the world: {world} at depth {depth * 1e3:.4f} mm; the "
-                "executor was stopped"
-            )
-        return f"executor did not finish: {result.termination} ({result.message})"
 
     def mode(self) -> str:
         """How the nodes ran."""

@@ -1,0 +1,125 @@
+# Copyright 2026 squeeze_grasp_ros developers
+# SPDX-License-Identifier: Apache-2.0
+"""What a run is asked to do: its options and every node's parameters (no rclpy).
+
+The parameters of a node are ``config/<node>.yaml``, then what the scene decides (devices,
+sensors, mu, tick, recording), then the user's overrides; ``squeeze-grasp run`` and
+``sim_pipeline.launch.py`` both use :func:`node_parameters`, so the two routes start the same
+nodes.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import yaml
+
+from squeeze_grasp_ros.resources import config_dir
+from squeeze_grasp_ros.scene import Scene, finger_devices
+
+__all__ = ["EXECUTORS", "NODES", "PLANNER_MODULE", "RunError", "RunOptions", "config_parameters",
+           "node_parameters"]
+
+NODES: tuple[str, ...] = ("sim_hardware", "monitor", "executor", "recorder")
+EXECUTORS: tuple[str, ...] = ("events", "single")
+PLANNER_MODULE = "squeeze_grasp_ros.ros.nodes.planner"
+
+
+class RunError(RuntimeError):
+    """The pipeline could not be started or did not finish in time."""
+
+
+def config_parameters(node: str) -> dict[str, Any]:
+    """The ``ros__parameters`` of ``config/<node>.yaml``."""
+    data = yaml.safe_load((config_dir() / f"{node}.yaml").read_text())
+    section = data.get(node) or data.get("/**") or {}
+    return dict(section.get("ros__parameters", {}))
+
+
+@dataclass(frozen=True)
+class RunOptions:
+    """What to run and how.
+
+    Attributes
+    ----------
+    scene_path : str
+    record : str or None
+        Bag folder to record into.
+    include_hidden_topics : bool
+        Record the executor action's hidden ``_action/`` topics too.
+    attach : bool
+        Use the nodes already running on this ROS domain (started by ``ros2 launch
+        squeeze_grasp_ros sim_pipeline.launch.py``) instead of starting them: plan with the
+        running planner, send the goal, summarise. Recording is then the launched recorder's.
+    processes : bool
+        One process per node instead of one executor in this process.
+    executor : {"events", "single"}
+        rclpy executor of the one-process mode.
+    on_slip_alarm : {"hold", "pure", "normals"}
+        The executor's reaction to an imminent-slip alarm.
+    resist : bool
+        Run the resistance phase when the scene has a frictional adversary.
+    planner : bool
+        Plan with the planner node if it exists (else with the mechanics API).
+    overrides : dict
+        Node name -> parameter overrides (applied last).
+    timeout : float
+        Wall-clock seconds a run may take.
+    discovery_wait : float
+        Least wall-clock seconds of DDS discovery before the run checks that no other
+        simulation uses its ROS domain (it overlaps the planning).
+    """
+
+    scene_path: str
+    record: str | None = None
+    include_hidden_topics: bool = False
+    attach: bool = False
+    processes: bool = False
+    executor: str = "events"
+    on_slip_alarm: str = "hold"
+    resist: bool = True
+    planner: bool = True
+    overrides: dict = field(default_factory=dict)
+    timeout: float = 300.0
+    discovery_wait: float = 1.0
+
+
+def node_parameters(
+    scene: Scene, scene_path: str, options: RunOptions, relative_per_depth: float
+) -> dict[str, dict[str, Any]]:
+    """Parameters of every node: the config files, then the scene's values, then overrides."""
+    params = {name: config_parameters(name) for name in NODES}
+    devices = finger_devices(scene)
+    mapping = [f"{f}:{d}" for f, d in devices.items()]
+    streams = [
+        s
+        for s, effect in (("wrench", "force_sensing"), ("tactile", "tactile_sensing"))
+        if scene.has(effect)
+    ]
+    noise = scene.sensors.noise_std if scene.has("sensor_noise") else 0.0
+    params["sim_hardware"].update(
+        scene=str(Path(scene_path).resolve()),
+        participants=["monitor", "executor"] + (["recorder"] if options.record else []),
+    )
+    monitor = params["monitor"]
+    monitor.update(
+        finger_devices=mapping,
+        streams=streams or [""],
+        mu=float(scene.mu),
+        weight=float(scene.pickup.weight) if scene.has("pickup") else 0.0,
+        relative_per_depth=float(relative_per_depth),
+        load_threshold=max(float(monitor.get("load_threshold", 0.005)), 6.0 * noise),
+    )
+    params["executor"].update(finger_devices=mapping, period=float(scene.sim.dt))
+    custom = {"scene": Path(scene_path).read_text(), "scene_path": str(scene_path)}
+    params["recorder"].update(
+        output=str(options.record or ""),
+        devices=list(devices.values()),
+        include_hidden_topics=options.include_hidden_topics,
+    )
+    for name, values in options.overrides.items():
+        params[name].update(values)
+    custom["monitor_parameters"] = yaml.safe_dump(params["monitor"], sort_keys=True)
+    params["recorder"]["custom_data"] = yaml.safe_dump(custom)
+    return params

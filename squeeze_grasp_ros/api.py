@@ -15,8 +15,8 @@ A scene, meshed, squeezed, and its contact events:
 >>> result = event_squeeze_scene(scene, scene_solid(scene))
 >>> for event in result.events[:2]:
 ...     print(event.type, event.finger, f"{event.relative_depth:.4f}")
-A F2 0.0106
-A F1 0.0107
+A F1 0.0110
+A F2 0.0113
 >>> print(result.termination, f"{result.relative_depth:.2f}")
 depth_reached 0.12
 

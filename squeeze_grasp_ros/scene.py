@@ -145,7 +145,7 @@ class PlacementSpec:
     """Where a finger first touches the boundary: exactly one of point, angle_deg, node."""
 
     point: Optional[tuple[float, float]] = spec(
-        "nearest boundary node to this point", "m", default=None
+        "this point's projection on the boundary, made a mesh node", "m", default=None
     )
     angle_deg: Optional[float] = spec(
         "boundary node in this polar direction from the centroid", "deg", default=None
@@ -705,9 +705,22 @@ def scene_material(scene: Scene) -> Material:
     return Material(m.E, m.nu, m.thickness)
 
 
+def placement_points(scene: Scene) -> list[tuple[float, float]]:
+    """The placements given as points (fingers, then the adversary), m."""
+    placements = [f.placement for f in scene.fingers.values()]
+    if scene.adversary is not None:
+        placements.append(scene.adversary.placement)
+    return [p.point for p in placements if p.point is not None]
+
+
 def build_mesh(scene: Scene) -> Mesh:
-    """Triangulate the scene's solid object with its mesh settings."""
-    outline = build_outline(scene.object.shape)
+    """Triangulate the scene's solid object with its mesh settings.
+
+    A placement given as a point becomes a boundary node exactly (its projection on the
+    outline is a kept vertex of the mesh), so the finger touches where the scene says.
+    """
+    outline = shapes.with_boundary_points(build_outline(scene.object.shape),
+                                          placement_points(scene))
     ms = scene.object.mesh
     if ms.max_area is not None:
         area = ms.max_area

@@ -17,13 +17,14 @@ SMALL_SQUARE = {
                "material": {"E": 5.0e4, "nu": 0.3, "thickness": 0.0254},
                "mesh": {"nodes": 1000, "min_angle": 30}},
     "fingers": {"F1": {"tip_radius": 0.02, "placement": {"point": [-0.05, 0.0]}},
-                "F2": {"tip_radius": 0.02, "placement": {"point": [0.05, 0.0]}}},
+                "F2": {"tip_radius": 0.02, "placement": {"point": [0.05, 0.002]}}},
     "squeeze": {"type": "stable", "relative_depth": 0.08},
     "friction": {"mu": 0.05},
     "effects": ["friction", "force_sensing", "tactile_sensing"],
 }
 """A 1000-node foam square squeezed 8 % at mu = 0.05: contact growth, sticking and sliding
-(events A, C, D)."""
+(events A, C, D). F2 sits 2 mm off the axis: on the axis the squeeze is symmetric and no
+contact starts to slide (no event C)."""
 
 SLIPPING_SQUARE = {**copy.deepcopy(SMALL_SQUARE), "name": "slipping_square",
                    "object": {**SMALL_SQUARE["object"], "mesh": {"nodes": 800, "min_angle": 30}},

@@ -22,8 +22,8 @@ from squeeze_grasp_ros.ros.recording.bag import read_bag
 from pipeline_support import SMALL_SQUARE, scene_data, write_scene
 
 QUICK = scene_data(SMALL_SQUARE, name="quick_square",
-                   squeeze={"type": "stable", "relative_depth": 0.04})
-"""The small square squeezed 4 %: a few hundred ticks with A and D events."""
+                   squeeze={"type": "stable", "relative_depth": 0.06})
+"""The small square squeezed 6 %: a few hundred ticks with A, C and D events."""
 DETERMINISTIC = ("/clock", "/sim/tick", "/sim/state", "/sim/events", "/monitor/status",
                  "/monitor/events", "/monitor/contact_state", "/devices/barrett_f1/setpoint",
                  "/devices/barrett_f3/setpoint", "/devices/barrett_f1/tactile",

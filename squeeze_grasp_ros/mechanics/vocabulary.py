@@ -21,10 +21,13 @@ __all__ = ["ContactMode", "EventType", "Finger", "MaterialModel", "SQUEEZING_FIN
 
 
 class _Name(str, Enum):
-    """A string enum whose ``str()`` and format are the bare value."""
+    """A string enum whose ``str()``, format and ``repr()`` are those of the bare value, so
+    logs, reprs of results and JSON read as before.
+    """
 
     __str__ = str.__str__
     __format__ = str.__format__
+    __repr__ = str.__repr__
 
     @classmethod
     def values(cls) -> tuple[str, ...]:

@@ -146,6 +146,37 @@ def _turning_corners(p: np.ndarray, threshold_deg: float = 20.0) -> np.ndarray:
     return np.flatnonzero(turn > np.radians(threshold_deg))
 
 
+def with_boundary_points(outline: Outline, points: Sequence[Sequence[float]]) -> Outline:
+    """``outline`` with the boundary point nearest to each of ``points`` as a kept vertex.
+
+    Each point is projected onto the nearest segment of the outer curve and inserted there as a
+    corner, so meshing keeps it exactly as a boundary node (a finger placed at a point then
+    touches exactly there, not at the nearest node of an evenly resampled boundary). A point
+    within 1e-9 of the outline size of an existing vertex reuses that vertex.
+
+    Examples
+    --------
+    >>> square = with_boundary_points(rectangle(0.1, 0.1), [(-0.06, 0.001)])
+    >>> [round(float(v), 6) for v in square.points[square.corners[-1]]]
+    [-0.05, 0.001]
+    """
+    p = np.asarray(outline.points, float)
+    corners = np.asarray(outline.corners, int)
+    for point in np.asarray(points, float).reshape(-1, 2):
+        a, b = p, np.roll(p, -1, axis=0)
+        ab = b - a
+        t = np.clip(np.einsum("ij,ij->i", point - a, ab) / np.einsum("ij,ij->i", ab, ab), 0, 1)
+        foot = a + t[:, None] * ab
+        k = int(np.argmin(np.linalg.norm(foot - point, axis=1)))
+        near = np.linalg.norm(p - foot[k], axis=1)
+        if near.min() <= 1e-9 * outline.size:
+            corners = np.union1d(corners, [int(np.argmin(near))])
+            continue
+        p = np.insert(p, k + 1, foot[k], axis=0)
+        corners = np.union1d(np.where(corners > k, corners + 1, corners), [k + 1])
+    return Outline(p, outline.holes, corners.astype(int))
+
+
 def polygon(points: Sequence[Sequence[float]]) -> Outline:
     """A closed simple polygon through ``points`` (m); its vertices are kept as corners."""
     p = validate_polyline(points, "polygon")

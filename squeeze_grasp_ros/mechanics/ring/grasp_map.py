@@ -237,7 +237,7 @@ def ring_grasp_map(ring: RingModel, mu: float, *, epsilon: float | None = None,
     >>> ring = build_ring(load_scene(scene_file("ring_ring")))
     >>> gmap = ring_grasp_map(ring, 0.4)
     >>> gmap.n == ring.n, gmap.kind
-    (True, <SqueezeKind.STABLE: 'stable'>)
+    (True, 'stable')
     """
     if kind not in (SqueezeKind.STABLE, SqueezeKind.PURE):
         raise InvalidInputError(f"squeeze type must be 'stable' or 'pure', got {kind!r}")

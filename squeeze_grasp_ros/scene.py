@@ -35,7 +35,7 @@ from squeeze_grasp_ros.mechanics.elastic.mesh import (
     target_max_area,
 )
 from squeeze_grasp_ros.mechanics.ring.model import RingModel, ring_from_outline
-from squeeze_grasp_ros.mechanics.vocabulary import Finger, SQUEEZING_FINGERS
+from squeeze_grasp_ros.mechanics.vocabulary import SQUEEZING_FINGERS, Finger, MaterialModel
 
 
 class SceneError(InvalidInputError):
@@ -119,6 +119,9 @@ class MaterialSpec:
     E: float = spec("Young's modulus", "Pa", lo=0.0, lo_open=True)
     nu: float = spec("Poisson's ratio", "", lo=-1.0, hi=0.5, lo_open=True)
     thickness: float = spec("out-of-plane thickness h (ring: width w)", "m", lo=0.0, lo_open=True)
+    model: str = spec("constitutive model of a solid (event-driven squeeze): linear (the "
+                      "paper's), corotational or neo_hookean (finite deformation)",
+                      choices=MaterialModel.values(), default=MaterialModel.LINEAR.value)
 
 
 @dataclass(frozen=True)

@@ -11,6 +11,7 @@ from squeeze_grasp_ros.mechanics.squeeze.contact_model import Limits
 from squeeze_grasp_ros.mechanics.squeeze.events import EventSqueeze, event_squeeze
 from squeeze_grasp_ros.scene import Scene, SceneError, finger_nodes, scene_solid
 from squeeze_grasp_ros.mechanics.vocabulary import (
+    MaterialModel,
     Finger,
     SQUEEZING_FINGERS,
     StrainCriterion,
@@ -39,6 +40,7 @@ def event_squeeze_scene(
     event_tol: float | None = None,
     reference: bool = False,
     progress: Callable[[float], None] | None = None,
+    material_model: MaterialModel | str | None = None,
 ) -> EventSqueeze:
     """Run the scene's squeeze with rounded fingertips; arguments override the scene's values.
 
@@ -58,6 +60,8 @@ def event_squeeze_scene(
         The paper's literal route (fixed steps, no cached compliance).
     progress : callable, optional
         Called with the completed fraction of the depth.
+    material_model : MaterialModel or str, optional
+        Constitutive model; default the scene's ``object.material.model``.
 
     Raises
     ------
@@ -104,4 +108,5 @@ def event_squeeze_scene(
         max_events_per_depth=sq.max_events_per_depth,
         directions=directions,
         progress=progress,
+        material_model=scene.object.material.model if material_model is None else material_model,
     )

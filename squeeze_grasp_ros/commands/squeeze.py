@@ -25,7 +25,8 @@ from squeeze_grasp_ros.commands.common import (
     output_file,
 )
 from squeeze_grasp_ros.commands.csv_io import write_points
-from squeeze_grasp_ros.mechanics.vocabulary import ContactMode, EventType, Finger
+from squeeze_grasp_ros.mechanics.elastic.hyperelastic import STRAIN_MEASURES
+from squeeze_grasp_ros.mechanics.vocabulary import ContactMode, EventType, Finger, MaterialModel
 
 HELP = "event-driven squeeze with rounded fingertips under Coulomb friction (Sec. 5, Algorithm 1)"
 BAR_WIDTH = 30
@@ -71,6 +72,19 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         help="write the deformed outer boundary (x,y per node, m, loop order), "
         "e.g. for `squeeze-grasp match`",
     )
+    models = parser.add_mutually_exclusive_group()
+    models.add_argument(
+        "--model",
+        choices=MaterialModel.values(),
+        help="constitutive model (default: the scene's object.material.model, else linear)",
+    )
+    models.add_argument(
+        "--compare-models",
+        action="store_true",
+        help="run the scene under every model and print forces, energy, contact widths, max "
+        "strain, events and termination side by side with the differences from linear; with "
+        "--plot, overlay the deformed outlines and the force-depth curves",
+    )
     add_solver_argument(parser)
     add_plot_argument(parser)
 
@@ -97,6 +111,8 @@ class ProgressBar:
 
 def run(args: argparse.Namespace) -> dict:
     """Run the squeeze; JSON keys per docs/design.md §2 (see docs/events.md)."""
+    if args.compare_models:
+        return compare_models(args)
     loaded = load_solid(args.scene, args.solver)
     start = time.perf_counter()
     if not args.reference:
@@ -115,6 +131,7 @@ def run(args: argparse.Namespace) -> dict:
             event_tol=args.event_tol,
             reference=args.reference,
             progress=bar,
+            material_model=args.model,
         )
     finally:
         bar.close()
@@ -196,8 +213,116 @@ def plot(obj, res: EventSqueeze, path: str) -> str:
     return plots.save(fig, path)
 
 
+def _model_row(res: EventSqueeze, model: str, seconds: float) -> dict:
+    segments = {f: [s.node for s in seg] for f, seg in res.segments.items()}
+    widths = {}
+    for f, seg in res.segments.items():
+        thetas = [s.theta for s in seg]
+        widths[f] = 0.5 * res.tip_radius[f] * (max(thetas) - min(thetas)) if thetas else 0.0
+    return {
+        "termination": res.termination,
+        "depth": res.depth,
+        "relative_depth": res.relative_depth,
+        "force": {f: res.finger_force[f][1] for f in res.segments},
+        "energy": res.energy,
+        "contact_half_width": widths,
+        "contact_nodes": {f: len(nodes) for f, nodes in segments.items()},
+        "max_strain": res.health.max_strain,
+        "strain_measure": STRAIN_MEASURES[MaterialModel(model)],
+        "event_counts": res.event_counts,
+        "work_minus_energy": res.diagnostics["work_minus_energy"],
+        "nonlinear": res.diagnostics.get("nonlinear"),
+        "seconds": seconds,
+    }
+
+
+def compare_models(args: argparse.Namespace) -> dict:
+    """The scene under every material model, with relative differences from linear."""
+    loaded = load_solid(args.scene, args.solver)
+    loaded.obj.precompute()
+    rows, results = {}, {}
+    for model in MaterialModel.values():
+        print(f"squeeze: {model} ...", file=sys.stderr, flush=True)
+        start = time.perf_counter()
+        res = event_squeeze_scene(
+            loaded.scene, loaded.obj, loaded.contacts, depth=args.depth,
+            relative_depth=args.relative_depth, step=args.step, event_tol=args.event_tol,
+            material_model=model)
+        rows[model] = _model_row(res, model, time.perf_counter() - start)
+        results[model] = res
+    base = rows[MaterialModel.LINEAR]
+
+    def rel(value: float, ref: float) -> float:
+        return (value - ref) / abs(ref) if ref else float("nan")
+
+    differences = {
+        m: {"force": {f: rel(r["force"][f], base["force"][f]) for f in r["force"]},
+            "energy": rel(r["energy"], base["energy"]),
+            "max_strain": rel(r["max_strain"], base["max_strain"]),
+            "contact_half_width": {f: rel(r["contact_half_width"][f],
+                                          base["contact_half_width"][f])
+                                   for f in r["contact_half_width"]},
+            "seconds_ratio": r["seconds"] / max(base["seconds"], 1e-12)}
+        for m, r in rows.items() if m != MaterialModel.LINEAR}
+    out = {"scene": loaded.scene.name, "compare_models": True, "models": rows,
+           "relative_difference": differences}
+    if args.plot:
+        out["plot"] = plot_models(loaded.obj, results, args.plot)
+    return out
+
+
+def plot_models(obj, results: dict, path: str) -> str:
+    """Deformed outlines and force-depth curves of every model, overlaid."""
+    import matplotlib.pyplot as plt
+
+    fig, (ax0, ax1) = plt.subplots(1, 2, figsize=(11, 4.6))
+    loop = np.append(obj.mesh.boundary, obj.mesh.boundary[0])
+    ax0.plot(*obj.mesh.nodes[loop].T, color="0.75", lw=1, label="undeformed")
+    for (model, res), color in zip(results.items(), ("C0", "C1", "C2")):
+        ax0.plot(*(obj.mesh.nodes + res.displacement)[loop].T, color=color, lw=1.2, label=model)
+        for f, curve in res.force_curve.items():
+            x, y = np.array(curve).T if curve else ([], [])
+            ax1.plot(100 * np.asarray(x), y, color=color,
+                     ls="-" if f == Finger.F1 else "--", label=f"{model} {f}")
+    ax0.set_aspect("equal")
+    ax0.set_title("deformed outlines (m)")
+    ax0.legend(fontsize=8)
+    ax1.set_xlabel("relative depth (%)")
+    ax1.set_ylabel("force along the finger's motion (N)")
+    ax1.set_title("force-depth")
+    ax1.legend(fontsize=8)
+    return plots.save(fig, path)
+
+
+def compare_summary(result: dict) -> str:
+    """The model comparison as a table."""
+    rows, diff = result["models"], result["relative_difference"]
+    lines = [f"{result['scene']}: the same squeeze under every material model "
+             "(differences relative to linear)",
+             f"{'model':<14}{'termination':<15}{'rel. depth':>11}{'F1 force N':>12}"
+             f"{'energy J':>12}{'F1 half-width m':>17}{'max strain':>12}  events  time s"]
+    for model, r in rows.items():
+        counts = " ".join(f"{k}{v}" for k, v in r["event_counts"].items())
+        lines.append(f"{model:<14}{r['termination']:<15}{100 * r['relative_depth']:>10.3f}%"
+                     f"{r['force'][Finger.F1]:>12.5g}{r['energy']:>12.5g}"
+                     f"{r['contact_half_width'][Finger.F1]:>17.4g}{r['max_strain']:>12.4g}"
+                     f"  {counts}  {r['seconds']:.2f}")
+    for model, d in diff.items():
+        lines.append(f"{model} vs linear: force {100 * d['force'][Finger.F1]:+.2f} %, energy "
+                     f"{100 * d['energy']:+.2f} %, max strain {100 * d['max_strain']:+.2f} %, "
+                     f"F1 half-width {100 * d['contact_half_width'][Finger.F1]:+.2f} %, time "
+                     f"x{d['seconds_ratio']:.0f}")
+    lines.append("strain measures: " + "; ".join(f"{m}: {r['strain_measure']}"
+                                                 for m, r in rows.items()))
+    if "plot" in result:
+        lines.append(f"plot: {result['plot']}")
+    return "\n".join(lines)
+
+
 def summary(result: dict) -> str:
     """Human-readable squeeze report."""
+    if result.get("compare_models"):
+        return compare_summary(result)
     c = result["event_counts"]
     lines = [
         f"{result['scene']}: {result['squeeze']} squeeze, mu = {result['mu']:g}, "

@@ -27,6 +27,7 @@ Everything here is dimensionless: lengths by L = obj.scale, forces by E h L.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -191,6 +192,10 @@ class Configuration:
     radius: np.ndarray
 
 
+Response = Callable[[np.ndarray], "tuple[np.ndarray, np.ndarray] | SolveFailure"]
+"""An elastic response of a contact set: delta (m, 2) -> (F (m, 2), dF/d delta (2m, 2m))."""
+
+
 @dataclass(frozen=True)
 class SolveFailure:
     """Why a fixed-set solve found no solution: a value, not an exception, because the stepper
@@ -235,7 +240,7 @@ def solve_fixed_set(
 
 
 def attempt_fixed_set(
-    C: np.ndarray,
+    response: Response,
     cfg: Configuration,
     centers: np.ndarray,
     dirs: np.ndarray,
@@ -246,8 +251,10 @@ def attempt_fixed_set(
 
     Parameters
     ----------
-    C : (2m, 2m) ndarray
-        Reduced stiffness of the set.
+    response : callable
+        The set's elastic response: contact displacements delta (m, 2) -> (forces F (m, 2),
+        tangent dF/d delta (2m, 2m)), or a :class:`SolveFailure` (:meth:`ContactModel.response`).
+        An attribute ``tolerance`` (relative accuracy of F) loosens the cone tolerance to it.
     cfg : Configuration
         Modes and geometry.
     centers : (m, 2) ndarray
@@ -269,29 +276,33 @@ def attempt_fixed_set(
     theta = np.array(theta0, float)
     P = np.flatnonzero(~cfg.stick)
     r = cfg.radius
-    Cb = C.reshape(m, 2, m, 2)
-    force_scale = max(float(np.abs(C).max()) * float(r.max()), 1e-300)
 
-    def forces(th: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    def forces(th: np.ndarray):
         delta = centers + r[:, None] * unit(th) - cfg.p0
-        return delta, (C @ delta.reshape(-1)).reshape(m, 2)
+        out = response(delta)
+        return (delta, out, None) if isinstance(out, SolveFailure) else (delta, *out)
 
     def cone_residual(th: np.ndarray, F: np.ndarray) -> np.ndarray:
         return cross(F[P], unit(th[P] - cfg.slip[P] * phi))
 
-    delta, F = forces(theta)
+    delta, F, C = forces(theta)
+    if isinstance(F, SolveFailure):
+        return F
+    force_scale = max(float(np.abs(C).max()) * float(r.max()), 1e-300)
+    tol = max(NEWTON_TOL, getattr(response, "tolerance", 0.0))
     it, residual, cond = 0, 0.0, 1.0
     J = np.zeros((0, 0))
     R = cone_residual(theta, F)
     while len(P):
         ea = unit(theta[P] - cfg.slip[P] * phi)
         # dF_k / d theta_j = C_kj r_j t(theta_j): (m, 2, |P|)
+        Cb = C.reshape(m, 2, m, 2)
         G = np.einsum("kajb,jb->kaj", Cb[:, :, P, :], r[P, None] * tangent(theta[P]))
         J = cross(np.moveaxis(G[P], 2, 1), ea[:, None, :]) + np.diag(
             np.einsum("ij,ij->i", F[P], ea)
         )
         residual = float(np.abs(R).max())
-        if residual <= NEWTON_TOL * force_scale:
+        if residual <= tol * force_scale:
             cond = float(np.linalg.cond(J))
             break
         if it >= NEWTON_MAX_ITERATIONS:
@@ -306,12 +317,19 @@ def attempt_fixed_set(
         for _ in range(NEWTON_BACKTRACKS):
             trial = theta.copy()
             trial[P] -= step
-            t_delta, t_F = forces(trial)
+            t_delta, t_F, t_C = forces(trial)
+            if isinstance(t_F, SolveFailure):
+                if np.abs(step).max() < NEWTON_TOL:
+                    return t_F
+                step = 0.5 * step
+                continue
             t_R = cone_residual(trial, t_F)
             if np.abs(t_R).max() < residual or np.abs(step).max() < NEWTON_TOL:
                 break
             step = 0.5 * step
-        theta, delta, F, R = trial, t_delta, t_F, t_R
+        if isinstance(t_F, SolveFailure):
+            return t_F
+        theta, delta, F, C, R = trial, t_delta, t_F, t_C, t_R
         if np.abs(step).max() < NEWTON_TOL:
             residual = float(np.abs(R).max())
             cond = float(np.linalg.cond(J))
@@ -320,6 +338,7 @@ def attempt_fixed_set(
     dtheta = np.zeros(m)
     if len(P):
         ea = unit(theta[P] - cfg.slip[P] * phi)
+        Cb = C.reshape(m, 2, m, 2)
         G = np.einsum("kajb,jb->kaj", Cb[:, :, P, :], r[P, None] * tangent(theta[P]))
         try:
             dtheta[P] = -np.linalg.solve(J, cross(dF0[P], ea))
@@ -393,6 +412,15 @@ class ContactModel:
     def positions(self, nodes) -> np.ndarray:
         """Undeformed positions / L (k, 2)."""
         return self.obj.mesh.nodes[np.asarray(nodes, int)] / self.length
+
+    def response(self, sd: SetData) -> Response:
+        """The set's elastic response F = C delta with its constant reduced stiffness."""
+        C = sd.C
+        m = len(sd.nodes)
+
+        def linear(delta: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+            return (C @ delta.reshape(-1)).reshape(m, 2), C
+        return linear
 
     def set_data(self, nodes: tuple[int, ...]) -> SetData:
         """Reduced data of the contact set ``nodes`` (sorted), cached per set (fast model)."""
@@ -482,6 +510,19 @@ class ContactModel:
         else:
             eps = self.element_strains(self.full_displacement(sd, delta, F)).reshape(-1, 3)
         return strain_criterion(eps, self.limits.criterion)
+
+
+    def boundary_rate(self, sd: SetData, sol: Solution, rows: np.ndarray) -> np.ndarray:
+        """d/ds of the displacement (k, 2) of boundary positions ``rows`` at ``sol``."""
+        return self.boundary_displacement(sd, sol.ddelta, sol.dF, rows)
+
+    def strain_energy(self, sd: SetData, delta: np.ndarray, F: np.ndarray) -> float:
+        """Dimensionless strain energy (/ (E h L^2)) of a configuration: 1/2 delta . F."""
+        return 0.5 * float(np.sum(delta * F))
+
+    def field_strain(self, u_hat: np.ndarray) -> tuple[float, int]:
+        """(largest strain by the limit's criterion, element) of a full displacement / L."""
+        return strain_criterion(self.element_strains(u_hat).reshape(-1, 3), self.limits.criterion)
 
 
 def strain_criterion(eps: np.ndarray, criterion: str) -> tuple[float, int]:

@@ -21,7 +21,6 @@ from squeeze_grasp_ros.mechanics.elastic.compliance import ElasticObject
 from squeeze_grasp_ros.mechanics.squeeze.contact_model import (
     ContactModel,
     Limits,
-    strain_criterion,
 )
 from squeeze_grasp_ros.mechanics.squeeze.contact_state import (
     Chatter,
@@ -36,7 +35,10 @@ from squeeze_grasp_ros.mechanics.elastic.fem import element_strains, von_mises_s
 from squeeze_grasp_ros.mechanics.squeeze.fingertips import place_fingertip
 from squeeze_grasp_ros.mechanics.squeeze.stable_pure import plan_squeeze
 from squeeze_grasp_ros.mechanics.squeeze.stepper import TERMINATION_ORDER, advance
+from squeeze_grasp_ros.mechanics.squeeze.nonlinear_model import (NonlinearContactModel,
+                                                                  contact_model)
 from squeeze_grasp_ros.mechanics.vocabulary import (
+    MaterialModel,
     EventType,
     Finger,
     SQUEEZING_FINGERS,
@@ -279,6 +281,8 @@ class EventSqueeze:
     reference : bool
         Computed by the paper's literal fixed-step route.
     diagnostics : dict
+    force_curve : dict
+        Finger -> ((relative depth, force along its motion N), ...) at every accepted point.
     """
 
     termination: str
@@ -304,6 +308,7 @@ class EventSqueeze:
     event_tol: float = 1e-9
     reference: bool = False
     diagnostics: dict = field(default_factory=dict)
+    force_curve: dict = field(default_factory=dict)
 
     @property
     def event_counts(self) -> dict:
@@ -364,7 +369,7 @@ def grasp_health(model: ContactModel, state: ContactState) -> tuple[GraspHealth,
     u = model.full_displacement(sd, delta, F).reshape(-1, 2) * L
     eps = element_strains(obj.mesh, u)
     criterion = model.limits.criterion
-    strain, element = strain_criterion(eps, criterion)
+    strain, element = model.field_strain(u.reshape(-1) / L)
     vm = von_mises_stress(eps, obj.material.E, obj.material.nu)
     norms = np.linalg.norm(u, axis=1)
     margins = {}
@@ -411,6 +416,7 @@ def event_squeeze(
     max_events_per_depth: int = 4,
     directions: Mapping[str, tuple[float, float]] | None = None,
     progress: Callable[[float], None] | None = None,
+    material_model: MaterialModel | str = MaterialModel.LINEAR,
 ) -> EventSqueeze:
     """Event-driven two-finger squeeze of ``obj`` from initial contact nodes (F1, F2).
 
@@ -440,6 +446,9 @@ def event_squeeze(
         User-given finger translation directions (normalised so the stacked vector has norm 1).
     progress : callable, optional
         Called with the completed fraction.
+    material_model : MaterialModel or str
+        ``linear`` (the paper's small-strain model, default), ``corotational`` or
+        ``neo_hookean`` (finite deformation: :mod:`.nonlinear_model`).
 
     Examples
     --------
@@ -486,15 +495,18 @@ def event_squeeze(
             "fingers would meet)"
         )
     tips = [place_fingertip(obj.mesh, n, int(c), radii[n]) for n, c in zip(names, contacts)]
-    model = ContactModel(obj, mu, limits or Limits(), reference, max_events_per_depth)
+    model = contact_model(material_model, obj, mu, limits or Limits(), reference,
+                          max_events_per_depth)
     run = squeeze_to_depth(
         model, initial_state(tips, relative_per_depth), dirs, depth, step, event_tol, progress
     )
     state = run.state
     health, u_field = grasp_health(model, state)
-    delta = np.array([c.displacement for c in state.contacts])
-    F = np.array([c.force for c in state.contacts])
-    energy = 0.5 * float(np.sum(delta * F))
+    L, fu = model.length, model.force_unit
+    delta = np.array([c.displacement for c in state.contacts]) / L
+    F = np.array([c.force for c in state.contacts]) / fu
+    sd = model.set_data(tuple(c.node for c in state.contacts))
+    energy = model.strain_energy(sd, delta, F) * fu * L
     forces_along = {}
     for name in names:
         d = dirs[name] / max(np.linalg.norm(dirs[name]), 1e-300)
@@ -504,6 +516,8 @@ def event_squeeze(
         )
     diag = dict(run.diagnostics)
     diag["compliance"] = obj.diagnostics()
+    if isinstance(model, NonlinearContactModel):
+        diag["nonlinear"] = model.diagnostics()
     diag["work_minus_energy"] = sum(f.work for f in state.fingers) - energy
     return EventSqueeze(
         termination=run.termination,
@@ -521,6 +535,10 @@ def event_squeeze(
         work={f.name: f.work for f in state.fingers},
         finger_force=forces_along,
         trajectories=polar_trajectories(run.samples, relative_per_depth),
+        force_curve={n: tuple((s.depth * relative_per_depth,
+                               float(np.asarray(s.finger_forces[n]) @ dirs[n])
+                               / max(float(np.linalg.norm(dirs[n])), 1e-300))
+                              for s in run.samples) for n in names},
         health=health,
         chatter=run.chatter,
         displacement=u_field,

@@ -274,7 +274,7 @@ class _Run:
         cfg = Configuration(self.p0, stick, slip, self.radius_f[self.fidx])
         centers = self.c0[self.fidx] + s * self.D[self.fidx]
         sol = attempt_fixed_set(
-            self.sd.C,
+            self.model.response(self.sd),
             cfg,
             centers,
             self.D[self.fidx],
@@ -388,7 +388,7 @@ class _Run:
             x = self.p_b[arows] + self.model.boundary_displacement(
                 self.sd, sol.delta, sol.F, arows
             )
-            dx = self.model.boundary_displacement(self.sd, sol.ddelta, sol.dF, arows)
+            dx = self.model.boundary_rate(self.sd, sol, arows)
             centers = self.c0 + self.s * self.D
             for j, node in enumerate(a_nodes):
                 rel = x[j] - centers

@@ -1,0 +1,239 @@
+# Copyright 2026 squeeze_grasp_ros developers
+# SPDX-License-Identifier: Apache-2.0
+"""The nonlinear response of a contact set: contact displacements -> contact forces.
+
+With the displacements delta of the m contact nodes prescribed (they sit on the fingertips), the
+other degrees of freedom are in equilibrium: f_int,free(u) = 0. Newton solves them (tangent of
+:func:`~squeeze_grasp_ros.mechanics.elastic.hyperelastic.assemble`, backtracking on the residual
+norm, never into an inverted element), warm-started from the previous solution of the set; when
+Newton fails the increment of delta since the last converged one is halved and marched (load
+sub-stepping). The contact forces are the internal forces at the contact DOFs, and the tangent
+dF/d delta is the Schur complement K_cc - K_cf K_ff^-1 K_fc of the converged tangent (one sparse
+factorisation, reused for the interior rates).
+
+Factorisations: Newton re-uses the last factorisation of K_ff as long as the residual falls by
+at least REUSE_CONTRACTION per iteration (modified Newton), and refactors otherwise; the
+converged state is always refactored once for the exact Schur complement. ``stats`` counts both.
+
+Everything is dimensionless as in the stepper: coordinates and displacements / L, forces / (E h L),
+energies / (E h L^2).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+import scipy.sparse.linalg as spla
+
+from squeeze_grasp_ros.mechanics.elastic.hyperelastic import assemble, deformation
+from squeeze_grasp_ros.mechanics.errors import InvalidInputError
+from squeeze_grasp_ros.mechanics.vocabulary import MaterialModel
+
+__all__ = ["ContactResponse", "Evaluation", "NEWTON_TOL", "ResponseFailure"]
+
+NEWTON_TOL = 1e-10
+"""Interior Newton stops when ||f_free|| <= NEWTON_TOL * max(||f_contact||, |K| ||delta||)."""
+DISPLACEMENT_FLOOR = 1e-6
+"""Contact displacements (/ L) below this are measured against it in the tolerance above, so
+round-off of an almost undeformed state does not count as a residual."""
+MAX_ITERATIONS = 25
+MAX_SUBSTEPS = 64
+REUSE_CONTRACTION = 0.25
+BACKTRACKS = 30
+
+
+@dataclass(frozen=True)
+class Evaluation:
+    """The equilibrium of a contact set at one delta (dimensionless).
+
+    Attributes
+    ----------
+    F : (m, 2) ndarray
+        Forces the fingers apply on the contact nodes.
+    C : (2m, 2m) ndarray
+        Tangent dF / d delta.
+    u : (2n,) ndarray
+        Displacement of every node.
+    energy : float
+        Strain energy.
+    iterations : int
+        Newton iterations of this evaluation (all sub-steps).
+    residual : float
+        Final relative interior residual.
+    """
+
+    F: np.ndarray
+    C: np.ndarray
+    u: np.ndarray
+    energy: float
+    iterations: int
+    residual: float
+
+
+@dataclass(frozen=True)
+class ResponseFailure:
+    """Why no equilibrium was found (a value: callers try smaller steps)."""
+
+    reason: str
+    residual: float = float("inf")
+
+
+@dataclass
+class ContactResponse:
+    """Nonlinear response of one contact set of one object (mutable: warm starts, counters).
+
+    Parameters
+    ----------
+    model : MaterialModel
+    nodes : (n, 2) ndarray
+        Reference node positions / L.
+    triangles : (t, 3) ndarray of int
+    contacts : (m,) ndarray of int
+        Contact nodes (at least 2 distinct: they fix the rigid motion).
+    nu : float
+        Poisson's ratio.
+    """
+
+    model: MaterialModel
+    nodes: np.ndarray
+    triangles: np.ndarray
+    contacts: np.ndarray
+    nu: float
+    stats: dict = field(default_factory=lambda: {"evaluations": 0, "iterations": 0,
+                                                 "factorizations": 0, "substeps": 0})
+    _u: np.ndarray | None = field(default=None, repr=False)
+    _delta: np.ndarray | None = field(default=None, repr=False)
+    _lu: object = field(default=None, repr=False)
+    _rate_map: np.ndarray | None = field(default=None, repr=False)
+    _energy: float = field(default=0.0, repr=False)
+
+    def __post_init__(self) -> None:
+        self.contacts = np.asarray(self.contacts, int)
+        if len(set(self.contacts.tolist())) < 2:
+            raise InvalidInputError("a contact set needs at least 2 distinct nodes to hold the "
+                                    "object")
+        n2 = 2 * len(self.nodes)
+        self.cdofs = np.stack([2 * self.contacts, 2 * self.contacts + 1], 1).reshape(-1)
+        self.free = np.setdiff1d(np.arange(n2), self.cdofs)
+        if self._u is None:
+            self._u = np.zeros(n2)
+            self._delta = np.zeros((len(self.contacts), 2))
+
+    def warm_start(self, u: np.ndarray) -> None:
+        """Start the next solve from the displacement field ``u`` (2n,) (e.g. the previous
+        contact set's), whose contact displacements become the sub-stepping base.
+        """
+        self._u = np.array(u, float)
+        self._delta = self._u[self.cdofs].reshape(-1, 2)
+        self._lu = None
+        self._rate_map = None
+
+    def at(self, delta: np.ndarray) -> bool:
+        """True if the last evaluated state is at ``delta`` (its field can be read)."""
+        return self._rate_map is not None and np.array_equal(
+            np.asarray(delta, float).reshape(-1, 2), self._delta)
+
+    def state_u(self) -> np.ndarray:
+        """Displacement (2n,) of the last evaluated state."""
+        return self._u
+
+    def state_energy(self) -> float:
+        """Strain energy of the last evaluated state."""
+        return self._energy
+
+    # ------------------------------------------------------------------ helpers
+    def _min_det(self, u: np.ndarray) -> float:
+        F = deformation(self.nodes, self.triangles, u)
+        return float((F[:, 0, 0] * F[:, 1, 1] - F[:, 0, 1] * F[:, 1, 0]).min())
+
+    def _newton(self, u: np.ndarray, delta: np.ndarray):
+        """Equilibrium of the free DOFs with the contact DOFs at ``delta``; (u, assembly, its,
+        residual) or a ResponseFailure.
+        """
+        u = u.copy()
+        u[self.cdofs] = delta.reshape(-1)
+        if self._min_det(u) <= 0:
+            return ResponseFailure("the prescribed contact displacement inverts an element")
+        asm = assemble(self.model, self.nodes, self.triangles, u, nu=self.nu)
+        stiffness = abs(asm.tangent).max()
+        scale = max(np.linalg.norm(asm.force[self.cdofs]),
+                    stiffness * max(np.linalg.norm(delta), DISPLACEMENT_FLOOR))
+        r = asm.force[self.free]
+        norm = np.linalg.norm(r)
+        lu, its = self._lu, 0
+        while norm > NEWTON_TOL * scale:
+            if its >= MAX_ITERATIONS:
+                return ResponseFailure("interior Newton did not converge", norm / scale)
+            if lu is None:
+                lu = spla.splu(asm.tangent[self.free][:, self.free].tocsc())
+                self.stats["factorizations"] += 1
+            step = -lu.solve(r)
+            its += 1
+            for _ in range(BACKTRACKS):
+                trial = u.copy()
+                trial[self.free] += step
+                if self._min_det(trial) > 0:
+                    t_asm = assemble(self.model, self.nodes, self.triangles, trial, nu=self.nu)
+                    t_norm = np.linalg.norm(t_asm.force[self.free])
+                    if t_norm < norm:
+                        break
+                step *= 0.5
+            else:
+                if self._lu is not lu or lu is None:
+                    return ResponseFailure("interior line search found no descent", norm / scale)
+                lu = None
+                continue
+            contraction = t_norm / norm
+            u, asm, r, norm = trial, t_asm, t_asm.force[self.free], t_norm
+            if contraction > REUSE_CONTRACTION:
+                lu = None
+        return u, asm, its, norm / scale
+
+    # ------------------------------------------------------------------ public
+    def evaluate(self, delta: np.ndarray) -> Evaluation | ResponseFailure:
+        """The equilibrium at contact displacements ``delta`` (m, 2), or why none was found."""
+        delta = np.asarray(delta, float).reshape(-1, 2)
+        self.stats["evaluations"] += 1
+        base_u, base_d = self._u, self._delta
+        target, done, its = delta, 0.0, 0
+        fraction = 1.0
+        result = None
+        for _ in range(MAX_SUBSTEPS):
+            goal = base_d + (done + fraction) * (target - base_d)
+            out = self._newton(base_u if result is None else result[0], goal)
+            if isinstance(out, ResponseFailure):
+                fraction *= 0.5
+                self.stats["substeps"] += 1
+                if fraction < 1e-6:
+                    return out
+                continue
+            result = out
+            its += out[2]
+            done += fraction
+            if done >= 1.0 - 1e-12:
+                break
+        else:
+            return ResponseFailure("load sub-stepping did not reach the contact displacement")
+        u, asm, _, residual = result
+        self.stats["iterations"] += its
+        K = asm.tangent
+        lu = spla.splu(K[self.free][:, self.free].tocsc())
+        self.stats["factorizations"] += 1
+        Kfc = K[self.free][:, self.cdofs].toarray()
+        X = lu.solve(Kfc)
+        C = K[self.cdofs][:, self.cdofs].toarray() - Kfc.T @ X
+        C = 0.5 * (C + C.T)
+        self._u, self._delta, self._lu, self._rate_map = u, delta.copy(), lu, -X
+        self._energy = asm.energy
+        F = asm.force[self.cdofs].reshape(-1, 2)
+        return Evaluation(F, C, u, asm.energy, its, residual)
+
+    def rate(self, ddelta: np.ndarray) -> np.ndarray:
+        """Du / ds (2n,) of every node for a contact-displacement rate (m, 2) at the last
+        evaluated state (the interior follows by -K_ff^-1 K_fc).
+        """
+        du = np.zeros(2 * len(self.nodes))
+        d = np.asarray(ddelta, float).reshape(-1)
+        du[self.cdofs] = d
+        du[self.free] = self._rate_map @ d
+        return du

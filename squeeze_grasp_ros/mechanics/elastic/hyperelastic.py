@@ -1,0 +1,274 @@
+# Copyright 2026 squeeze_grasp_ros developers
+# SPDX-License-Identifier: Apache-2.0
+"""Finite-deformation material laws on linear triangles, total Lagrangian, vectorised.
+
+Three laws share one interface, :func:`assemble`, which returns the strain energy, the internal
+force vector and the consistent tangent stiffness of a displacement field, all divided by E*h
+(dimensionless, as :func:`~squeeze_grasp_ros.mechanics.elastic.fem.stiffness_matrix`):
+
+- ``linear``: W = 1/2 eps : C : eps with the small strain eps = sym(F) - I. Its tangent is the
+  CST stiffness exactly; it is not frame indifferent (a rigid rotation stores energy).
+- ``corotational``: F = R U (polar decomposition, R from the single angle
+  atan2(F21 - F12, F11 + F22)), W = 1/2 (U - I) : C : (U - I). For an isotropic C the stress
+  S = C : (U - I) is coaxial with U, so P = R S exactly; the tangent adds the rotation's
+  derivative. Exact under rigid rotation.
+- ``neo_hookean``: the compressible law W = mu/2 (I1 - 3) - mu ln J + lambda/2 (ln J)^2 of the
+  3-D solid with Lame constants of (E, nu), in exact plane stress: the thickness stretch
+  lambda3 of every element solves S33 = 0, i.e. mu (lambda3^2 - 1) + lambda ln(J2 lambda3) = 0,
+  by Newton; the tangent condenses the 33 component. At small strain it is the plane-stress law
+  with the same E and nu. Needs nu < 0.5 (lambda is infinite at 0.5).
+
+C is the plane-stress elasticity of (E, nu); F = I + grad u over the reference (undeformed)
+element. An element whose det F <= 0 is inverted: :func:`assemble` raises
+:class:`InvertedElementError`, never returns NaN.
+
+>>> import numpy as np
+>>> X = np.array([[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]]); tri = np.array([[0, 1, 2]])
+>>> turn = np.array([[0.0, -1.0], [1.0, 0.0]])  # a rigid rotation by 90 degrees
+>>> u = (X @ turn.T - X).reshape(-1)
+>>> [round(assemble(m, X, tri, u, nu=0.3).energy, 12) for m in ("corotational", "neo_hookean")]
+[0.0, 0.0]
+>>> assemble("linear", X, tri, u, nu=0.3).energy > 0
+True
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.sparse as sp
+
+from squeeze_grasp_ros.mechanics.elastic.fem import element_dofs
+from squeeze_grasp_ros.mechanics.errors import InvalidInputError, NumericalError
+from squeeze_grasp_ros.mechanics.vocabulary import MaterialModel
+
+__all__ = ["Assembly", "InvertedElementError", "STRAIN_MEASURES", "assemble", "deformation",
+           "principal_strains", "stress_and_tangent"]
+
+STRAIN_MEASURES: dict[MaterialModel, str] = {
+    MaterialModel.LINEAR: "small strain sym(grad u)",
+    MaterialModel.COROTATIONAL: "Biot strain U - I",
+    MaterialModel.NEO_HOOKEAN: "logarithmic (Hencky) strain ln(stretch)",
+}
+"""The strain each model reports and tests its strain limit on (principal values)."""
+
+_PLANE_STRESS_ITERATIONS = 30
+_SKEW = np.array([[0.0, -1.0], [1.0, 0.0]])
+
+
+class InvertedElementError(NumericalError):
+    """An element turned inside out (det F <= 0): no elastic state exists there."""
+
+
+@dataclass(frozen=True)
+class Assembly:
+    """Energy, internal force and tangent of one displacement field, divided by E*h.
+
+    Attributes
+    ----------
+    energy : float
+        Strain energy / (E h), m^2.
+    force : (2n,) ndarray
+        Internal nodal forces / (E h), m (the forces the nodes exert on the solid, = dW/du).
+    tangent : (2n, 2n) scipy.sparse.csr_matrix
+        d force / d u, dimensionless, symmetric.
+    min_det : float
+        Smallest det F (in-plane) over the elements.
+    """
+
+    energy: float
+    force: np.ndarray
+    tangent: sp.csr_matrix
+    min_det: float
+
+
+def _gradients(nodes: np.ndarray, triangles: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Reference shape-function gradients (t, 3, 2), 1/m, and element areas (t,), m^2."""
+    p = nodes[triangles]
+    d1, d2 = p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]
+    J = np.stack([d1, d2], axis=2)  # columns: dX/dxi, dX/deta
+    det = J[:, 0, 0] * J[:, 1, 1] - J[:, 0, 1] * J[:, 1, 0]
+    inv = np.stack([np.stack([J[:, 1, 1], -J[:, 0, 1]], -1),
+                    np.stack([-J[:, 1, 0], J[:, 0, 0]], -1)], 1) / det[:, None, None]
+    dxi = np.array([[-1.0, -1.0], [1.0, 0.0], [0.0, 1.0]])
+    return np.einsum("ak,tkj->taj", dxi, inv), 0.5 * np.abs(det)
+
+
+def deformation(nodes: np.ndarray, triangles: np.ndarray, u: np.ndarray) -> np.ndarray:
+    """Deformation gradients F (t, 2, 2) of the nodal displacement ``u`` (2n,) or (n, 2), m."""
+    grad, _ = _gradients(np.asarray(nodes, float), np.asarray(triangles, int))
+    ue = np.asarray(u, float).reshape(-1, 2)[triangles]
+    return np.eye(2) + np.einsum("tai,taj->tij", ue, grad)
+
+
+def _plane_stress_tensor(nu: float) -> np.ndarray:
+    """C / E as a (2, 2, 2, 2) tensor for plane stress."""
+    lam, mu2 = nu / (1.0 - nu * nu), 1.0 / (1.0 + nu)
+    eye = np.eye(2)
+    return (lam * np.einsum("ij,kl->ijkl", eye, eye)
+            + 0.5 * mu2 * (np.einsum("ik,jl->ijkl", eye, eye)
+                           + np.einsum("il,jk->ijkl", eye, eye)))
+
+
+def _linear(F: np.ndarray, nu: float):
+    C = _plane_stress_tensor(nu)
+    eps = 0.5 * (F + np.swapaxes(F, 1, 2)) - np.eye(2)
+    P = np.einsum("ijkl,tkl->tij", C, eps)
+    W = 0.5 * np.einsum("tij,tij->t", P, eps)
+    return W, P, np.broadcast_to(C, (len(F), 2, 2, 2, 2))
+
+
+def _rotation(F: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """R (t, 2, 2) of the polar decomposition, and d theta / d F (t, 2, 2)."""
+    s, c = F[:, 1, 0] - F[:, 0, 1], F[:, 0, 0] + F[:, 1, 1]
+    n2 = s * s + c * c
+    theta = np.arctan2(s, c)
+    R = np.stack([np.stack([np.cos(theta), -np.sin(theta)], -1),
+                  np.stack([np.sin(theta), np.cos(theta)], -1)], 1)
+    dtheta = np.stack([np.stack([-s, -c], -1), np.stack([c, -s], -1)], 1) / n2[:, None, None]
+    return R, dtheta, n2
+
+
+def _corotational(F: np.ndarray, nu: float):
+    C = _plane_stress_tensor(nu)
+    R, dtheta, _ = _rotation(F)
+    U = np.einsum("tki,tkj->tij", R, F)
+    E = 0.5 * (U + np.swapaxes(U, 1, 2)) - np.eye(2)
+    S = np.einsum("ijkl,tkl->tij", C, E)
+    W = 0.5 * np.einsum("tij,tij->t", S, E)
+    P = np.einsum("tik,tkj->tij", R, S)
+    A = np.empty((len(F), 2, 2, 2, 2))
+    OS = np.einsum("ik,tkj->tij", _SKEW, S)
+    OU = np.einsum("ik,tkj->tij", _SKEW, U)
+    for k in range(2):
+        for m in range(2):
+            dF = np.zeros((2, 2))
+            dF[k, m] = 1.0
+            dth = dtheta[:, k, m]
+            dU = np.einsum("tji,jk->tik", R, dF) - OU * dth[:, None, None]
+            dS = np.einsum("ijkl,tkl->tij", C, 0.5 * (dU + np.swapaxes(dU, 1, 2)))
+            A[:, :, :, k, m] = np.einsum("tik,tkj->tij", R, OS * dth[:, None, None] + dS)
+    return W, P, A
+
+
+def _lame(nu: float) -> tuple[float, float]:
+    """3-D Lame constants / E."""
+    return nu / ((1.0 + nu) * (1.0 - 2.0 * nu)), 0.5 / (1.0 + nu)
+
+
+def _thickness_stretch(J2: np.ndarray, lam: float, mu: float) -> np.ndarray:
+    """lambda3 with mu (l3^2 - 1) + lam ln(J2 l3) = 0 per element (Newton from l3 = 1)."""
+    l3 = np.ones_like(J2)
+    for _ in range(_PLANE_STRESS_ITERATIONS):
+        g = mu * (l3 * l3 - 1.0) + lam * np.log(J2 * l3)
+        dg = 2.0 * mu * l3 + lam / l3
+        step = g / dg
+        l3 = np.maximum(l3 - step, 0.5 * l3)
+        if np.max(np.abs(step)) < 1e-15:
+            break
+    return l3
+
+
+def _neo_hookean(F: np.ndarray, nu: float):
+    if not nu < 0.5:
+        raise InvalidInputError(f"material.nu must be < 0.5 for the neo_hookean model (its "
+                                f"lambda is infinite at 0.5), got {nu}")
+    lam, mu = _lame(nu)
+    J2 = F[:, 0, 0] * F[:, 1, 1] - F[:, 0, 1] * F[:, 1, 0]
+    l3 = _thickness_stretch(J2, lam, mu)
+    lnJ = np.log(J2 * l3)
+    G = np.linalg.inv(F).transpose(0, 2, 1)  # F^-T
+    I1 = np.einsum("tij,tij->t", F, F) + l3 * l3
+    W = 0.5 * mu * (I1 - 3.0) - mu * lnJ + 0.5 * lam * lnJ * lnJ
+    a = lam * lnJ - mu
+    P = mu * F + a[:, None, None] * G
+    g = G.reshape(-1, 4)
+    outer = g[:, :, None] * g[:, None, :]
+    cross = (G[:, :, None, None, :] * np.swapaxes(G, 1, 2)[:, None, :, :, None]).reshape(-1, 4, 4)
+    w33 = mu + mu / l3 ** 2 + lam * (1.0 - lnJ) / l3 ** 2
+    A = (mu * np.eye(4)[None] + (lam - (lam / l3) ** 2 / w33)[:, None, None] * outer
+         - a[:, None, None] * cross).reshape(-1, 2, 2, 2, 2)
+    return W, P, A
+
+
+_LAWS = {MaterialModel.LINEAR: _linear, MaterialModel.COROTATIONAL: _corotational,
+         MaterialModel.NEO_HOOKEAN: _neo_hookean}
+
+
+def stress_and_tangent(model: MaterialModel | str, F: np.ndarray, *, nu: float):
+    """Energy density W / E (t,), first Piola-Kirchhoff stress P / E (t, 2, 2) and its
+    derivative dP/dF / E (t, 2, 2, 2, 2) of each deformation gradient in ``F`` (t, 2, 2).
+    """
+    try:
+        law = _LAWS[MaterialModel(model)]
+    except ValueError:
+        raise InvalidInputError(f"material.model must be one of {MaterialModel.values()}, got "
+                                f"{model!r}") from None
+    return law(np.asarray(F, float), nu)
+
+
+def assemble(model: MaterialModel | str, nodes: np.ndarray, triangles: np.ndarray,
+             u: np.ndarray, *, nu: float) -> Assembly:
+    """Energy, internal forces and tangent stiffness of the displacement ``u`` (2n,), m.
+
+    Parameters
+    ----------
+    model : MaterialModel or str
+        "linear", "corotational" or "neo_hookean".
+    nodes : (n, 2) ndarray
+        Reference node positions, m.
+    triangles : (t, 3) ndarray of int
+        Counter-clockwise elements.
+    u : (2n,) ndarray
+        Nodal displacements, m, DOF order (x1, y1, x2, y2, ...).
+    nu : float
+        Poisson's ratio.
+
+    Raises
+    ------
+    InvertedElementError
+        If an element has det F <= 0.
+    """
+    nodes = np.asarray(nodes, float)
+    triangles = np.asarray(triangles, int)
+    grad, area = _gradients(nodes, triangles)
+    ue = np.asarray(u, float).reshape(-1, 2)[triangles]
+    F = np.eye(2) + np.einsum("tai,taj->tij", ue, grad)
+    det = F[:, 0, 0] * F[:, 1, 1] - F[:, 0, 1] * F[:, 1, 0]
+    worst = int(np.argmin(det))
+    if not det[worst] > 0:
+        raise InvertedElementError(f"element {worst} inverted (det F = {det[worst]:.3g})",
+                                   residuals={"det_F": det[worst]})
+    W, P, A = stress_and_tangent(model, F, nu=nu)
+    # dF_ij / du_(a, k) = delta_ik grad_aj, as a (t, 4, 6) matrix on (ij) x (a k)
+    G = np.zeros((len(triangles), 2, 2, 3, 2))
+    for i in range(2):
+        G[:, i, :, :, i] = np.swapaxes(grad, 1, 2)
+    G = G.reshape(len(triangles), 4, 6)
+    Gt = np.swapaxes(G, 1, 2)
+    fe = area[:, None] * (Gt @ P.reshape(-1, 4, 1))[..., 0]
+    ke = area[:, None, None] * (Gt @ A.reshape(-1, 4, 4) @ G)
+    ke = 0.5 * (ke + np.swapaxes(ke, 1, 2))
+    dofs = element_dofs(triangles)
+    n2 = 2 * len(nodes)
+    force = np.bincount(dofs.ravel(), weights=fe.reshape(-1), minlength=n2)
+    rows = np.repeat(dofs, 6, axis=1).ravel()
+    cols = np.tile(dofs, (1, 6)).ravel()
+    K = sp.csr_matrix((ke.ravel(), (rows, cols)), shape=(n2, n2))
+    K.sum_duplicates()
+    return Assembly(float(np.dot(W, area)), force, K, float(det[worst]))
+
+
+def principal_strains(model: MaterialModel | str, nodes: np.ndarray, triangles: np.ndarray,
+                      u: np.ndarray) -> np.ndarray:
+    """Principal strains (t, 2), largest first, in the model's measure (STRAIN_MEASURES)."""
+    F = deformation(nodes, triangles, u)
+    model = MaterialModel(model)
+    if model == MaterialModel.LINEAR:
+        eps = 0.5 * (F + np.swapaxes(F, 1, 2)) - np.eye(2)
+        return np.linalg.eigvalsh(eps)[:, ::-1]
+    stretch = np.sqrt(np.maximum(np.linalg.eigvalsh(np.einsum("tki,tkj->tij", F, F)), 0.0))
+    stretch = stretch[:, ::-1]
+    if model == MaterialModel.COROTATIONAL:
+        return stretch - 1.0
+    return np.log(np.maximum(stretch, 1e-300))

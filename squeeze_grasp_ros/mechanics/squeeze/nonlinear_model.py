@@ -1,0 +1,165 @@
+# Copyright 2026 squeeze_grasp_ros developers
+# SPDX-License-Identifier: Apache-2.0
+"""The contact model of a large-deformation solid: the event-driven squeeze, unchanged, on a
+corotational or neo-Hookean object.
+
+The stepper asks a contact model for the response F(delta) of a contact set and its tangent,
+for boundary displacements (gaps of Event A, in the deformed geometry), for the strain of the
+limit and for the strain energy. :class:`ContactModel` answers with the linear reduced
+stiffness; :class:`NonlinearContactModel` solves the finite-deformation equilibrium of the
+whole object with the contact displacements prescribed
+(:class:`~squeeze_grasp_ros.mechanics.elastic.contact_response.ContactResponse`), so contact
+normals, gaps and sliding are those of the current configuration. The strain limit uses the
+model's own measure (:data:`~squeeze_grasp_ros.mechanics.elastic.hyperelastic.STRAIN_MEASURES`).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from squeeze_grasp_ros.mechanics.elastic.compliance import node_dofs
+from squeeze_grasp_ros.mechanics.elastic.contact_response import (NEWTON_TOL, ContactResponse,
+                                                                  Evaluation, ResponseFailure)
+from squeeze_grasp_ros.mechanics.elastic.hyperelastic import principal_strains
+from squeeze_grasp_ros.mechanics.errors import InvalidInputError
+from squeeze_grasp_ros.mechanics.squeeze.contact_model import (ContactModel, Response, SetData,
+                                                               Solution, SolveFailure)
+from squeeze_grasp_ros.mechanics.vocabulary import MaterialModel, StrainCriterion
+
+__all__ = ["NonlinearContactModel", "RESPONSE_ACCURACY", "contact_model"]
+
+RESPONSE_ACCURACY = 100 * NEWTON_TOL
+"""Relative accuracy of the contact forces of an interior solve converged to NEWTON_TOL; the
+Newton on the sliding angles cannot resolve the cone better than this."""
+
+
+@dataclass(frozen=True)
+class NonlinearContactModel(ContactModel):
+    """A :class:`ContactModel` whose object follows a finite-deformation material law.
+
+    Parameters
+    ----------
+    material_model : MaterialModel
+        ``corotational`` or ``neo_hookean`` (``linear`` through this class is the linear law
+        solved by Newton, used to cross-check the two routes).
+    """
+
+    material_model: MaterialModel = MaterialModel.COROTATIONAL
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        if self.reference:
+            raise InvalidInputError("the reference (paper-literal) route is linear only; use "
+                                    "material.model: linear with --reference")
+        if self.limits.criterion == StrainCriterion.COMPONENTWISE:
+            raise InvalidInputError("strain_limit.criterion componentwise is defined for small "
+                                    "strains only; use principal with a nonlinear model")
+
+    # ------------------------------------------------------------------ the response
+    def _response_of(self, sd: SetData) -> ContactResponse:
+        responses = self._cache.setdefault("responses", {})
+        key = tuple(sd.nodes.tolist())
+        if key not in responses:
+            mesh = self.obj.mesh
+            responses[key] = ContactResponse(MaterialModel(self.material_model),
+                                             mesh.nodes / self.length, mesh.triangles,
+                                             sd.nodes, self.obj.material.nu)
+            last = self._cache.get("last")
+            if last is not None:
+                responses[key].warm_start(last.state_u())
+        return responses[key]
+
+    def set_data(self, nodes: tuple[int, ...]) -> SetData:
+        """The set's nodes (its response is solved on demand and cached per set)."""
+        key = tuple(int(k) for k in nodes)
+        if len(key) < 2:
+            raise InvalidInputError(f"the object lost contact: {len(key)} contact node(s) "
+                                    "left; at least 2 are needed to hold it (Lemma 2)")
+        idx = np.array(key)
+        m = len(idx)
+        return SetData(idx, np.zeros((2 * m, 2 * m)), np.zeros((2 * m, 3)), None, None, 1.0)
+
+    def _evaluate(self, sd: SetData, delta: np.ndarray) -> Evaluation | ResponseFailure:
+        response = self._response_of(sd)
+        out = response.evaluate(delta)
+        if isinstance(out, Evaluation):
+            self._cache["last"] = response
+            stats = self._cache.setdefault("nonlinear", {"evaluations": 0, "iterations": 0})
+            stats["evaluations"] += 1
+            stats["iterations"] += out.iterations
+        return out
+
+    def response(self, sd: SetData) -> Response:
+        """F(delta) and dF/d delta from the finite-deformation equilibrium."""
+        def nonlinear(delta: np.ndarray):
+            out = self._evaluate(sd, delta)
+            if isinstance(out, ResponseFailure):
+                return SolveFailure(out.reason, out.residual)
+            return out.F, out.C
+        nonlinear.tolerance = RESPONSE_ACCURACY
+        return nonlinear
+
+    def _field(self, sd: SetData, delta: np.ndarray) -> np.ndarray:
+        response = self._response_of(sd)
+        if not response.at(delta):
+            out = self._evaluate(sd, delta)
+            if isinstance(out, ResponseFailure):
+                raise SolveFailure(out.reason, out.residual).error()
+        return response.state_u()
+
+    # ------------------------------------------------------------------ fields
+    def full_displacement(self, sd: SetData, delta: np.ndarray, F: np.ndarray) -> np.ndarray:
+        """Dimensionless displacement of every node (2n,) at contact displacements ``delta``."""
+        return self._field(sd, delta)
+
+    def boundary_displacement(self, sd: SetData, delta: np.ndarray, F: np.ndarray,
+                              rows: np.ndarray | None = None) -> np.ndarray:
+        """Dimensionless displacement (k, 2) of boundary loop positions ``rows`` (all if None)."""
+        b = self.boundary_nodes
+        rows = np.arange(len(b)) if rows is None else np.asarray(rows, int)
+        return self._field(sd, delta)[node_dofs(b[rows])].reshape(-1, 2)
+
+    def boundary_rate(self, sd: SetData, sol: Solution, rows: np.ndarray) -> np.ndarray:
+        """d/ds of the boundary displacement at ``sol`` (interior follows the tangent)."""
+        self._field(sd, sol.delta)
+        b = self.boundary_nodes
+        du = self._response_of(sd).rate(sol.ddelta)
+        return du[node_dofs(b[np.asarray(rows, int)])].reshape(-1, 2)
+
+    def strain_energy(self, sd: SetData, delta: np.ndarray, F: np.ndarray) -> float:
+        """Dimensionless strain energy of the finite-deformation state."""
+        self._field(sd, delta)
+        return self._response_of(sd).state_energy()
+
+    def field_strain(self, u_hat: np.ndarray) -> tuple[float, int]:
+        """(largest absolute principal strain in the model's measure, element)."""
+        mesh = self.obj.mesh
+        eps = principal_strains(self.material_model, mesh.nodes / self.length, mesh.triangles,
+                                u_hat)
+        per_element = np.abs(eps).max(axis=1)
+        k = int(np.argmax(per_element))
+        return float(per_element[k]), k
+
+    def strain_measure(self, sd: SetData, delta: np.ndarray, F: np.ndarray) -> tuple[float, int]:
+        """(largest strain in the model's measure, element) of the configuration."""
+        return self.field_strain(self._field(sd, delta))
+
+    def diagnostics(self) -> dict:
+        """Newton evaluations, iterations and factorisations of the interior solves."""
+        responses = self._cache.get("responses", {}).values()
+        return {"material_model": str(self.material_model),
+                "evaluations": sum(r.stats["evaluations"] for r in responses),
+                "newton_iterations": sum(r.stats["iterations"] for r in responses),
+                "factorizations": sum(r.stats["factorizations"] for r in responses),
+                "load_substeps": sum(r.stats["substeps"] for r in responses)}
+
+
+def contact_model(material_model: MaterialModel | str, *args, **kwargs) -> ContactModel:
+    """The contact model of ``material_model``: the linear one (reduced stiffness) or the
+    finite-deformation one; arguments as :class:`ContactModel`.
+    """
+    model = MaterialModel(material_model)
+    if model == MaterialModel.LINEAR:
+        return ContactModel(*args, **kwargs)
+    return NonlinearContactModel(*args, material_model=model, **kwargs)

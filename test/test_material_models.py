@@ -1,0 +1,284 @@
+# Copyright 2026 squeeze_grasp_ros developers
+# SPDX-License-Identifier: Apache-2.0
+"""Finite-deformation material models: the laws (derivatives, frame indifference, patch test,
+small-strain limit, inversion), an independent assembly with scikit-fem, and the event-driven
+squeeze on corotational and neo-Hookean objects (agreement with linear as the depth vanishes,
+rotated scenes, work = energy, scaling with E, nu near 0.5).
+"""
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from squeeze_grasp_ros.api import (ElasticObject, Material, NumericalError, event_squeeze,
+                                   load_scene, scene_file)
+from squeeze_grasp_ros.mechanics.elastic import hyperelastic as H
+from squeeze_grasp_ros.mechanics.elastic import shapes
+from squeeze_grasp_ros.mechanics.elastic.fem import stiffness_matrix
+from squeeze_grasp_ros.mechanics.elastic.mesh import generate_mesh, mesh_from_triangles
+from squeeze_grasp_ros.scene import build_mesh, finger_nodes
+
+MODELS = ("linear", "corotational", "neo_hookean")
+NONLINEAR = ("corotational", "neo_hookean")
+
+
+def rotation(angle: float) -> np.ndarray:
+    c, s = np.cos(angle), np.sin(angle)
+    return np.array([[c, -s], [s, c]])
+
+
+@pytest.fixture(scope="module")
+def patch():
+    """An irregular mesh of a 0.1 x 0.06 m rectangle."""
+    return generate_mesh(shapes.rectangle(0.1, 0.06), 2e-4, min_angle=25.0)
+
+
+@pytest.mark.parametrize("model", MODELS)
+def test_forces_and_tangent_are_the_derivatives(model, patch):
+    rng = np.random.default_rng(7)
+    u = 0.003 * rng.standard_normal(2 * patch.n)
+    d = rng.standard_normal(2 * patch.n)
+    a = H.assemble(model, patch.nodes, patch.triangles, u, nu=0.3)
+    h = 1e-7
+    up = H.assemble(model, patch.nodes, patch.triangles, u + h * d, nu=0.3)
+    um = H.assemble(model, patch.nodes, patch.triangles, u - h * d, nu=0.3)
+    assert (up.energy - um.energy) / (2 * h) == pytest.approx(a.force @ d, rel=1e-6)
+    fd = (up.force - um.force) / (2 * h)
+    assert np.linalg.norm(fd - a.tangent @ d) < 1e-6 * np.linalg.norm(fd)
+    assert abs(a.tangent - a.tangent.T).max() < 1e-12 * abs(a.tangent).max()
+
+
+def test_the_linear_law_is_the_cst_stiffness(patch):
+    K = stiffness_matrix(patch, 0.3)
+    u = np.random.default_rng(3).standard_normal(2 * patch.n) * 1e-3
+    a = H.assemble("linear", patch.nodes, patch.triangles, u, nu=0.3)
+    assert abs(a.tangent - K).max() < 1e-12 * abs(K).max()
+    assert np.allclose(a.force, K @ u, rtol=0, atol=1e-12 * np.abs(K @ u).max())
+
+
+@settings(max_examples=30, deadline=None)
+@given(st.floats(-np.pi, np.pi), st.floats(-0.2, 0.2), st.floats(-0.2, 0.2), st.floats(-0.2, 0.2))
+def test_frame_indifference_of_the_laws(angle, a, b, c):
+    """W(QF) = W(F) and P(QF) = Q P(F) for the nonlinear laws; the linear law stores energy
+    under a pure rotation, growing like angle^4 (its strain is 1 - cos(angle)).
+    """
+    F = np.array([[[1 + a, b], [c, 1 - 0.5 * a]]])
+    Q = rotation(angle)[None]
+    for model in NONLINEAR:
+        W, P, _ = H.stress_and_tangent(model, F, nu=0.3)
+        Wq, Pq, _ = H.stress_and_tangent(model, Q @ F, nu=0.3)
+        assert Wq[0] == pytest.approx(W[0], rel=1e-9, abs=1e-14)
+        assert np.allclose(Pq[0], Q[0] @ P[0], rtol=1e-9, atol=1e-12)
+    W_rot, _, _ = H.stress_and_tangent("linear", Q, nu=0.3)
+    eps = 1 - np.cos(angle)
+    assert W_rot[0] == pytest.approx(eps * eps / (1 - 0.3), rel=1e-9, abs=1e-15)
+
+
+@pytest.mark.parametrize("model", MODELS)
+@pytest.mark.parametrize("F", [[[1.1, 0.0], [0.0, 1.0]], [[1.0, 0.2], [0.0, 1.0]],
+                               [[0.9, 0.05], [-0.03, 1.04]]], ids=["stretch", "shear", "mixed"])
+def test_patch_test(model, F, patch):
+    """A homogeneous deformation on an irregular mesh: interior nodes in equilibrium, and the
+    boundary reactions are the traction P N of the law over the boundary.
+    """
+    F = np.array(F)
+    u = (patch.nodes @ (F - np.eye(2)).T).reshape(-1)
+    a = H.assemble(model, patch.nodes, patch.triangles, u, nu=0.3)
+    interior = np.setdiff1d(np.arange(patch.n), patch.boundary)
+    f = a.force.reshape(-1, 2)
+    assert np.abs(f[interior]).max() < 1e-12 * np.abs(f).max()
+    _, P, _ = H.stress_and_tangent(model, F[None], nu=0.3)
+    right = patch.nodes[:, 0] > 0.05 - 1e-12
+    assert f[right].sum(axis=0) == pytest.approx(P[0] @ [1.0, 0.0] * 0.06, rel=1e-9, abs=1e-12)
+
+
+def test_small_strain_limit_of_every_law():
+    F = np.eye(2)[None] + 1e-6 * np.array([[[1.0, 0.4], [-0.2, -0.7]]])
+    _, P_lin, A_lin = H.stress_and_tangent("linear", F, nu=0.3)
+    for model in NONLINEAR:
+        _, P, A = H.stress_and_tangent(model, F, nu=0.3)
+        assert np.allclose(P, P_lin, rtol=1e-4, atol=1e-11)
+        assert np.allclose(A, A_lin, atol=1e-5)
+
+
+def test_an_inverted_element_is_an_error_not_nan(patch):
+    u = np.zeros(2 * patch.n)
+    k = patch.triangles[0]
+    u[2 * k[0]:2 * k[0] + 2] = patch.nodes[k[1]] - patch.nodes[k[0]] + patch.nodes[k[2]] - \
+        patch.nodes[k[0]]
+    for model in MODELS:
+        with pytest.raises(H.InvertedElementError) as info:
+            H.assemble(model, patch.nodes, patch.triangles, u, nu=0.3)
+        assert isinstance(info.value, NumericalError) and "det_F" in info.value.residuals
+
+
+def test_neo_hookean_refuses_nu_one_half():
+    with pytest.raises(ValueError, match="nu must be < 0.5"):
+        H.stress_and_tangent("neo_hookean", np.eye(2)[None], nu=0.5)
+
+
+def test_internal_forces_against_scikit_fem(patch):
+    """The internal force of each law, assembled independently by scikit-fem's P1 basis from the
+    law's stress P(F): the same vector.
+    """
+    skfem = pytest.importorskip("skfem")
+    from skfem.helpers import ddot, grad
+
+    m = skfem.MeshTri(patch.nodes.T.copy(), patch.triangles.T.copy())
+    basis = skfem.Basis(m, skfem.ElementVector(skfem.ElementTriP1()))
+    rng = np.random.default_rng(11)
+    u = 0.001 * rng.standard_normal(2 * patch.n)
+    # skfem orders vector DOFs node-wise (x1, y1, x2, ...) like ours for ElementVector(P1)
+    nodal = basis.nodal_dofs
+    ours_to_sk = np.empty(2 * patch.n, int)
+    ours_to_sk[0::2], ours_to_sk[1::2] = nodal[0], nodal[1]
+    w = np.empty(basis.N)
+    w[ours_to_sk] = u
+    for model in MODELS:
+        @skfem.LinearForm
+        def residual(v, p):
+            Fq = np.eye(2)[:, :, None, None] + p["w"].grad
+            flat = np.moveaxis(Fq, (0, 1), (-2, -1)).reshape(-1, 2, 2)
+            _, P, _ = H.stress_and_tangent(model, flat, nu=0.3)
+            Pq = np.moveaxis(P.reshape(Fq.shape[2:] + (2, 2)), (-2, -1), (0, 1))
+            return ddot(Pq, grad(v))
+
+        sk = residual.assemble(basis, w=basis.interpolate(w))[ours_to_sk]
+        ours = H.assemble(model, patch.nodes, patch.triangles, u, nu=0.3).force
+        assert np.allclose(ours, sk, rtol=1e-10, atol=1e-12 * np.abs(ours).max())
+
+
+# --------------------------------------------------------------------------- the squeeze
+@pytest.fixture(scope="module")
+def square():
+    scene = load_scene(scene_file("foam_square"))
+    scene = dataclasses.replace(scene, object=dataclasses.replace(
+        scene.object, mesh=dataclasses.replace(scene.object.mesh, nodes=500)))
+    mesh = build_mesh(scene)
+    return scene, ElasticObject(mesh, Material(5e4, 0.3, 0.0254)), finger_nodes(scene, mesh)
+
+
+def squeeze(obj, contacts, model, **kw):
+    return event_squeeze(obj, contacts, 0.02, 0.4, material_model=model, **kw)
+
+
+def test_every_model_tends_to_linear_as_the_depth_vanishes(square):
+    """Differences from linear are first order in the depth: at 0.01 % approach they are below
+    0.1 %, and ten times less than at 0.1 %.
+    """
+    _, obj, contacts = square
+    diffs = {}
+    for rel in (1e-4, 1e-3):
+        linear = squeeze(obj, contacts, "linear", relative_depth=rel)
+        for model in NONLINEAR:
+            res = squeeze(obj, contacts, model, relative_depth=rel)
+            f, f0 = res.finger_force["F1"][1], linear.finger_force["F1"][1]
+            diffs[model, rel] = abs(f - f0) / f0
+            assert res.energy == pytest.approx(linear.energy, rel=3 * diffs[model, rel] + 1e-9)
+    for model in NONLINEAR:
+        assert diffs[model, 1e-4] < 1e-3
+        assert 4 < diffs[model, 1e-3] / max(diffs[model, 1e-4], 1e-16) < 25
+
+
+@pytest.mark.parametrize("model", MODELS)
+def test_a_rotated_scene_gives_rotated_results(model, square):
+    """The same squeeze with the whole object turned by 37 and 90 degrees: forces rotate,
+    energy, depths and events are the same (the stable directions are planned in each frame).
+    """
+    _, obj, contacts = square
+    base = squeeze(obj, contacts, model, relative_depth=0.03)
+    for angle in (np.radians(37.0), np.pi / 2):
+        Q = rotation(angle)
+        turned = ElasticObject(mesh_from_triangles(obj.mesh.nodes @ Q.T, obj.mesh.triangles),
+                               obj.material)
+        res = squeeze(turned, contacts, model, relative_depth=0.03)
+        assert res.energy == pytest.approx(base.energy, rel=1e-8)
+        assert [(e.type, e.node) for e in res.events] == [(e.type, e.node) for e in base.events]
+        for c, c0 in zip(res.state.contacts, base.state.contacts):
+            assert np.allclose(c.force, Q @ c0.force, rtol=0, atol=1e-8 * abs(base.energy) /
+                               0.001)
+
+
+@pytest.mark.parametrize("model", NONLINEAR)
+def test_finger_work_equals_the_strain_energy_when_nothing_slides(model, square):
+    _, obj, contacts = square
+    res = squeeze(obj, contacts, model, relative_depth=0.05)
+    assert res.event_counts["C"] == 0
+    work = sum(res.work.values())
+    assert abs(work - res.energy) < 1e-6 * res.energy
+
+
+def test_forces_scale_with_e_for_a_very_soft_object(square):
+    _, obj, contacts = square
+    soft = ElasticObject(obj.mesh, Material(1e3, 0.3, 0.0254))
+    stiff = squeeze(obj, contacts, "neo_hookean", relative_depth=0.03)
+    res = squeeze(soft, contacts, "neo_hookean", relative_depth=0.03)
+    assert res.finger_force["F1"][1] == pytest.approx(stiff.finger_force["F1"][1] * 1e3 / 5e4,
+                                                      rel=1e-7)
+
+
+def test_nearly_incompressible_plane_stress_does_not_lock(square):
+    """Plane stress leaves the thickness free, so nu -> 0.5 is benign for P1 triangles: the force
+    changes smoothly (no locking jump) from nu = 0.45 to 0.499.
+    """
+    _, obj, contacts = square
+    forces = []
+    for nu in (0.45, 0.49, 0.499):
+        o = ElasticObject(obj.mesh, Material(5e4, nu, 0.0254))
+        forces.append(squeeze(o, contacts, "neo_hookean", relative_depth=0.03)
+                      .finger_force["F1"][1])
+    assert abs(forces[2] - forces[1]) < abs(forces[1] - forces[0])
+    assert forces[2] / forces[0] < 1.2
+
+
+def test_the_model_comes_from_the_scene_and_the_cli_compares(tmp_path, capfd):
+    import json
+
+    import yaml
+
+    from squeeze_grasp_ros.cli import main
+
+    data = yaml.safe_load(open(scene_file("foam_square")))
+    data["object"]["mesh"]["nodes"] = 400
+    data["object"]["material"]["model"] = "corotational"
+    path = tmp_path / "square.yaml"
+    path.write_text(yaml.safe_dump(data))
+    assert main(["squeeze", str(path), "--relative-depth", "0.02", "--json"]) == 0
+    one = json.loads(capfd.readouterr().out)
+    assert one["diagnostics"]["nonlinear"]["material_model"] == "corotational"
+    assert main(["squeeze", str(path), "--relative-depth", "0.02", "--compare-models",
+                 "--json"]) == 0
+    both = json.loads(capfd.readouterr().out)
+    assert set(both["models"]) == set(MODELS)
+    assert both["models"]["corotational"]["force"]["F1"] == one["finger_force"]["F1"]["end"]
+    d = both["relative_difference"]["neo_hookean"]["force"]["F1"]
+    rows = both["models"]
+    assert d == pytest.approx(rows["neo_hookean"]["force"]["F1"] / rows["linear"]["force"]["F1"]
+                              - 1)
+    data["object"]["material"]["model"] = "rubber"
+    path.write_text(yaml.safe_dump(data))
+    assert main(["squeeze", str(path)]) == 2
+    assert "object.material.model" in capfd.readouterr().err
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("model", NONLINEAR)
+def test_a_thirty_percent_squeeze_converges(model, square):
+    """30 % relative depth (log strains near 0.5) ends at the depth, with finite results that
+    bracket the physics: the corotational square is softer than the linear one, the
+    neo-Hookean one stiffer. Finger work minus strain energy: within 1e-6 for neo-Hookean;
+    1.1e-6 for the corotational square, the same with substeps of 1e-3 L and 5e-4 L (so not the
+    work quadrature; not explained yet), hence its bound of 2e-6.
+    """
+    _, obj, contacts = square
+    linear = squeeze(obj, contacts, "linear", relative_depth=0.30)
+    res = squeeze(obj, contacts, model, relative_depth=0.30, step=5e-4)
+    assert res.termination == "depth_reached" and np.isfinite(res.energy)
+    ratio = res.finger_force["F1"][1] / linear.finger_force["F1"][1]
+    assert (ratio < 1.0) if model == "corotational" else (ratio > 1.0)
+    bound = 2e-6 if model == "corotational" else 1e-6
+    assert abs(sum(res.work.values()) - res.energy) < bound * res.energy

@@ -506,10 +506,9 @@ def optimal_resistance(
 
     Examples
     --------
-    >>> from squeeze_grasp_ros.mechanics.elastic import shapes
-    >>> from squeeze_grasp_ros.api import ElasticObject, Material, generate_mesh
-    >>> mesh = generate_mesh(shapes.disk(0.05), 2e-4)
-    >>> obj = ElasticObject(mesh, Material(E=1e5, nu=0.3, thickness=0.01))
+    >>> from squeeze_grasp_ros.api import load_scene, scene_file, scene_solid
+    >>> obj = scene_solid(load_scene(scene_file("disk")))
+    >>> mesh = obj.mesh
     >>> b = [int(k) for k in mesh.boundary]
     >>> sets = {"F1": [b[0]], "F2": [b[len(b) // 2]], "A": [b[len(b) // 4]]}
     >>> grasp = resistance_grasp(obj, sets)

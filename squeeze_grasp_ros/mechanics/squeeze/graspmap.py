@@ -89,10 +89,9 @@ def grasp_map(obj: ElasticObject, mu: float) -> GraspMap:
 
     Examples
     --------
-    >>> from squeeze_grasp_ros.mechanics.elastic import shapes
-    >>> from squeeze_grasp_ros.api import ElasticObject, Material, generate_mesh
-    >>> mesh = generate_mesh(shapes.disk(0.05), 2e-4)
-    >>> obj = ElasticObject(mesh, Material(E=1e5, nu=0.3, thickness=0.01))
+    >>> from squeeze_grasp_ros.api import load_scene, scene_file, scene_solid
+    >>> obj = scene_solid(load_scene(scene_file("disk")))
+    >>> mesh = obj.mesh
     >>> i, j = (int(mesh.boundary[k]) for k in (0, len(mesh.boundary) // 2))
     >>> gmap = grasp_map(obj, mu=0.4)
     >>> b = len(mesh.boundary)

@@ -125,10 +125,9 @@ def plan_squeeze(obj: ElasticObject, contacts, *, kind: SqueezeKind = SqueezeKin
 
     Examples
     --------
-    >>> from squeeze_grasp_ros.mechanics.elastic import shapes
-    >>> from squeeze_grasp_ros.api import ElasticObject, Material, generate_mesh
-    >>> mesh = generate_mesh(shapes.disk(0.05), 2e-4)
-    >>> obj = ElasticObject(mesh, Material(E=1e5, nu=0.3, thickness=0.01))
+    >>> from squeeze_grasp_ros.api import load_scene, scene_file, scene_solid
+    >>> obj = scene_solid(load_scene(scene_file("disk")))
+    >>> mesh = obj.mesh
     >>> i, j = (int(mesh.boundary[k]) for k in (0, len(mesh.boundary) // 2))
     >>> stable = plan_squeeze(obj, [i, j])
     >>> print(stable.kind, stable.inward, f"{np.linalg.norm(stable.displacement):.3f}")

@@ -18,6 +18,7 @@ SECTIONS: tuple[str, ...] = (
     "resistance",
     "ring",
     "events",
+    "material_models",
     "ros_services",
     "pipeline",
     "pareto",

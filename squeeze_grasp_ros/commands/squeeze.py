@@ -273,9 +273,7 @@ def compare_models(args: argparse.Namespace) -> dict:
 
 def plot_models(obj, results: dict, path: str) -> str:
     """Deformed outlines and force-depth curves of every model, overlaid."""
-    import matplotlib.pyplot as plt
-
-    fig, (ax0, ax1) = plt.subplots(1, 2, figsize=(11, 4.6))
+    fig, (ax0, ax1) = plots.figure(ncols=2, size=5.2)
     loop = np.append(obj.mesh.boundary, obj.mesh.boundary[0])
     ax0.plot(*obj.mesh.nodes[loop].T, color="0.75", lw=1, label="undeformed")
     for (model, res), color in zip(results.items(), ("C0", "C1", "C2")):
@@ -287,6 +285,7 @@ def plot_models(obj, results: dict, path: str) -> str:
     ax0.set_aspect("equal")
     ax0.set_title("deformed outlines (m)")
     ax0.legend(fontsize=8)
+    ax1.set_aspect("auto")
     ax1.set_xlabel("relative depth (%)")
     ax1.set_ylabel("force along the finger's motion (N)")
     ax1.set_title("force-depth")

@@ -1,0 +1,106 @@
+# Copyright 2026 squeeze_grasp_ros developers
+# SPDX-License-Identifier: Apache-2.0
+"""The linear model's error against the finite-deformation models as the squeeze deepens, and
+what a nonlinear squeeze costs (Newton iterations, factorisations, time against linear).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import time
+from pathlib import Path
+
+from squeeze_grasp_ros import plots
+from squeeze_grasp_ros.bench.table import Table
+from squeeze_grasp_ros.mechanics.vocabulary import MaterialModel
+from squeeze_grasp_ros.resources import scene_file
+from squeeze_grasp_ros.scene import load_scene, scene_solid
+from squeeze_grasp_ros.scene_events import event_squeeze_scene
+
+TITLE = "Large deformation: the linear model's error against squeeze depth, and its cost"
+OBJECTS = ("foam_square", "disk", "nonconvex_blob")
+NONLINEAR = (MaterialModel.COROTATIONAL, MaterialModel.NEO_HOOKEAN)
+
+
+def _scene(name: str, nodes: int):
+    scene = load_scene(scene_file(name))
+    obj = dataclasses.replace(scene.object, mesh=dataclasses.replace(scene.object.mesh,
+                                                                     nodes=nodes))
+    return dataclasses.replace(scene, object=obj)
+
+
+def _run(scene, obj, model: MaterialModel, relative_depth: float):
+    start = time.perf_counter()
+    res = event_squeeze_scene(scene, obj, relative_depth=relative_depth, material_model=model)
+    return res, time.perf_counter() - start
+
+
+def run(quick: bool, out_dir: Path, progress) -> list[Table]:
+    """Force and energy differences from linear at increasing depth; cost of one squeeze."""
+    depths = (0.02, 0.08, 0.16) if quick else (0.02, 0.04, 0.08, 0.12, 0.20, 0.30)
+    nodes = 400 if quick else 1200
+    rows, curves = [], {}
+    for name in OBJECTS:
+        scene = _scene(name, nodes)
+        obj = scene_solid(scene)
+        obj.precompute()
+        for rel in depths:
+            progress(f"material_models: {name} at {100 * rel:g} %")
+            linear, _ = _run(scene, obj, MaterialModel.LINEAR, rel)
+            row = [name, 100 * rel, linear.finger_force["F1"][1], linear.health.max_strain]
+            for model in NONLINEAR:
+                res, _ = _run(scene, obj, model, rel)
+                df = res.finger_force["F1"][1] / linear.finger_force["F1"][1] - 1
+                de = res.energy / linear.energy - 1
+                row += [100 * df, 100 * de, res.health.max_strain, res.termination]
+                curves.setdefault((name, model), []).append((100 * rel, 100 * df))
+            rows.append(row)
+    png = "material_models_error.png"
+    fig, (ax,) = plots.figure(size=5.0)
+    for (name, model), points in curves.items():
+        x, y = zip(*points)
+        ax.plot(x, y, "o-" if model == MaterialModel.NEO_HOOKEAN else "s--",
+                label=f"{name}, {model}")
+    ax.axhline(0.0, color="0.6", lw=0.8)
+    ax.set_aspect("auto")
+    ax.set_xlabel("relative depth [%]")
+    ax.set_ylabel("finger force vs linear [%]")
+    ax.set_title("finite deformation vs linear")
+    ax.legend(fontsize=7)
+    plots.save(fig, out_dir / png)
+    progress("material_models: cost of a 12 % foam-square squeeze")
+    cost = []
+    scene = _scene("foam_square", 800 if quick else 2000)
+    obj = scene_solid(scene)
+    obj.precompute()
+    linear, t_lin = _run(scene, obj, MaterialModel.LINEAR, 0.12)
+    cost.append(["linear", t_lin, 1.0, "-", "-", "-", linear.finger_force["F1"][1]])
+    for model in NONLINEAR:
+        res, t = _run(scene, obj, model, 0.12)
+        nl = res.diagnostics["nonlinear"]
+        cost.append([str(model), t, t / t_lin, nl["evaluations"],
+                     nl["newton_iterations"] / max(nl["evaluations"], 1),
+                     nl["factorizations"], res.finger_force["F1"][1]])
+    return [
+        Table(TITLE, ["object", "rel. depth [%]", "linear F1 [N]", "linear max strain",
+                      "corot. dF [%]", "corot. dE [%]", "corot. max strain", "corot. end",
+                      "neo-H. dF [%]", "neo-H. dE [%]", "neo-H. max strain", "neo-H. end"],
+              rows,
+              f"Shipped scenes re-meshed to about {nodes} nodes; the same event-driven squeeze "
+              "(events to the scene's event_tol) under each model. dF, dE: F1's force along its "
+              "motion and the strain energy relative to linear. Max strain in each model's "
+              "measure (linear: small strain, corotational: Biot, neo-Hookean: logarithmic); "
+              "strain differences are differences of measures, not only of the solution.",
+              (png,)),
+        Table("Cost of a nonlinear squeeze (foam square, 12 %, events to 1e-9 L)",
+              ["model", "time [s]", "x linear", "evaluations", "Newton its / evaluation",
+               "factorisations", "F1 [N]"],
+              cost,
+              "An evaluation is one equilibrium of the contact set at one finger position "
+              "(interior Newton, backtracking, load sub-steps if needed); each ends with one "
+              "factorisation of the converged tangent for the Schur complement dF/d delta, and "
+              "Newton re-uses the previous factorisation while the residual falls by 4x per "
+              "iteration (so factorisations < iterations + evaluations). Target (< 10x linear) "
+              "not met: every evaluation is a sparse solve of the whole object, where the linear "
+              "route gathers a cached boundary compliance."),
+    ]

@@ -32,7 +32,6 @@ import numpy as np
 
 from squeeze_grasp_ros.inputs import InputError, confine, load_yaml, read_text
 from squeeze_grasp_ros.mechanics.elastic.compliance import ROUTES, ElasticObject
-from squeeze_grasp_ros.mechanics.squeeze.contact_model import ContactModel
 from squeeze_grasp_ros.mechanics.errors import (
     InfeasibleError,
     InternalError,
@@ -69,7 +68,7 @@ from squeeze_grasp_ros.scene import (
     parse_scene,
     scene_material,
 )
-from squeeze_grasp_ros.scene_events import event_squeeze_scene
+from squeeze_grasp_ros.scene_events import event_squeeze_scene, scene_contact_model
 from squeeze_grasp_ros.mechanics.vocabulary import Finger, SqueezeKind
 
 CONTACT_MODELS: tuple[str, ...] = ("point", "segment", "friction")
@@ -731,7 +730,7 @@ def friction_resistance(
     obj = loaded.solid()
     i, j, k = (int(n) for n in nodes)
     squeeze = event_squeeze_scene(scene, obj, (i, j))
-    model = ContactModel(obj, scene.mu, max_events_per_depth=scene.squeeze.max_events_per_depth)
+    model = scene_contact_model(scene, obj)
     state = add_adversary(squeeze.state, model, squeeze.displacement, k, radius)
     return frictional_resistance(
         model,

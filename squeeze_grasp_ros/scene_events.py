@@ -7,7 +7,8 @@ from __future__ import annotations
 from collections.abc import Callable
 
 from squeeze_grasp_ros.mechanics.elastic.compliance import ElasticObject
-from squeeze_grasp_ros.mechanics.squeeze.contact_model import Limits
+from squeeze_grasp_ros.mechanics.squeeze.contact_model import ContactModel, Limits
+from squeeze_grasp_ros.mechanics.squeeze.nonlinear_model import contact_model
 from squeeze_grasp_ros.mechanics.squeeze.events import EventSqueeze, event_squeeze
 from squeeze_grasp_ros.scene import Scene, SceneError, finger_nodes, scene_solid
 from squeeze_grasp_ros.mechanics.vocabulary import (
@@ -27,6 +28,14 @@ def scene_limits(scene: Scene) -> Limits:
         strain.criterion if strain else StrainCriterion.PRINCIPAL,
         scene.pickup.weight if scene.has("pickup") else None,
     )
+
+
+def scene_contact_model(scene: Scene, obj: ElasticObject) -> ContactModel:
+    """The contact model of the scene's object, friction and material model (for the stepper
+    outside :func:`event_squeeze_scene`, e.g. the resistance of Algorithm 2).
+    """
+    return contact_model(scene.object.material.model, obj, scene.mu,
+                         max_events_per_depth=scene.squeeze.max_events_per_depth)
 
 
 def event_squeeze_scene(

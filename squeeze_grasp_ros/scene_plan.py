@@ -16,12 +16,11 @@ import numpy as np
 from squeeze_grasp_ros.control.motion import GraspGoal
 from squeeze_grasp_ros.mechanics.elastic.compliance import ElasticObject
 from squeeze_grasp_ros.mechanics.resistance.frictional import add_adversary, frictional_resistance
-from squeeze_grasp_ros.mechanics.squeeze.contact_model import ContactModel
 from squeeze_grasp_ros.mechanics.squeeze.events import EventSqueeze
 from squeeze_grasp_ros.mechanics.squeeze.stable_pure import plan_squeeze
 from squeeze_grasp_ros.mechanics.vocabulary import SQUEEZING_FINGERS, Finger, SqueezeKind
 from squeeze_grasp_ros.scene import Scene, finger_nodes, placement_node, scene_solid
-from squeeze_grasp_ros.scene_events import event_squeeze_scene
+from squeeze_grasp_ros.scene_events import event_squeeze_scene, scene_contact_model
 
 __all__ = ["ScenePlan", "plan_scene", "resistance_goal", "resists"]
 
@@ -66,7 +65,7 @@ def resistance_goal(scene: Scene, obj: ElasticObject | None = None,
         contacts = finger_nodes(scene, obj.mesh)
     if squeeze is None:
         squeeze = event_squeeze_scene(scene, obj, contacts)
-    model = ContactModel(obj, scene.mu, max_events_per_depth=scene.squeeze.max_events_per_depth)
+    model = scene_contact_model(scene, obj)
     node = placement_node(obj.mesh, adv.placement, "adversary")
     state = add_adversary(squeeze.state, model, squeeze.displacement, node, adv.tip_radius)
     plan = frictional_resistance(

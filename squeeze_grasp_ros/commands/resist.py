@@ -32,7 +32,7 @@ from squeeze_grasp_ros.mechanics.resistance.frictional import (
 )
 from squeeze_grasp_ros.mechanics.squeeze.events import grasp_health
 from squeeze_grasp_ros.scene import SceneError, placement_node
-from squeeze_grasp_ros.scene_events import event_squeeze_scene
+from squeeze_grasp_ros.scene_events import event_squeeze_scene, scene_contact_model
 from squeeze_grasp_ros.commands.common import (
     LoadedScene,
     add_plot_argument,
@@ -111,7 +111,7 @@ def run_friction(loaded: LoadedScene, mode: str, plot_path: str | None) -> dict:
     start = time.perf_counter()
     squeeze = event_squeeze_scene(scene, obj, loaded.contacts)
     t_squeeze = time.perf_counter() - start
-    model = ContactModel(obj, scene.mu, max_events_per_depth=scene.squeeze.max_events_per_depth)
+    model = scene_contact_model(scene, obj)
     start = time.perf_counter()
     state = add_adversary(squeeze.state, model, squeeze.displacement, k, adv.tip_radius)
     res = frictional_resistance(

@@ -21,7 +21,8 @@ drive the steps themselves):
    from its feedback, the result; ground truth from ``sim/events`` and ``sim/state``.
 
 Every wait spins the executor with a wall-clock timeout; nothing sleeps to synchronise. The
-options and node parameters are in :mod:`.options`, the summary in :mod:`.summary`.
+options and node parameters are in :mod:`.options`, the action client in
+:mod:`.goal_client`, the summary in :mod:`.summary`.
 """
 
 from __future__ import annotations
@@ -35,7 +36,6 @@ import sys
 import tempfile
 import threading
 import time
-import uuid
 from collections import Counter
 from collections.abc import Callable
 from pathlib import Path
@@ -43,9 +43,6 @@ from typing import Any
 
 import numpy as np
 import rclpy
-from action_msgs.msg import GoalStatus, GoalStatusArray
-from rclpy.action import ActionClient
-from rclpy.action.client import ClientGoalHandle
 from rclpy.context import Context
 from rclpy.executors import SingleThreadedExecutor
 from rclpy.experimental import EventsExecutor
@@ -57,7 +54,6 @@ from std_msgs.msg import Header
 
 from squeeze_grasp_interfaces.action import ExecuteGrasp
 from squeeze_grasp_interfaces.msg import Alarm, ContactEvent, ContactEventArray, SimState
-from unique_identifier_msgs.msg import UUID
 
 from squeeze_grasp_ros.ros import messages
 from squeeze_grasp_ros.control.motion import GraspGoal
@@ -69,6 +65,7 @@ from squeeze_grasp_ros.scene import (
 )
 from squeeze_grasp_ros.ros.nodes import pipeline
 from squeeze_grasp_ros.ros.nodes.recorder import cdr_stamp_ns
+from squeeze_grasp_ros.ros.run.goal_client import GoalClient
 from squeeze_grasp_ros.ros.run.options import (EXECUTORS, PLANNER_MODULE, RunError,
                                                RunOptions, node_parameters)
 from squeeze_grasp_ros.ros.run.summary import GRASP_HELD, Observed, Plan, run_summary
@@ -79,8 +76,6 @@ from squeeze_grasp_ros.mechanics.vocabulary import (
     SqueezeKind,
 )
 
-GOAL_RESPONSE_TIMEOUT = 5.0
-"""Wall-clock seconds to wait for a goal (or result) response before checking the status."""
 EVENTS_PER_CHECK = 16
 """Queued events :meth:`PipelineRunner.spin_until` executes between two checks of its condition."""
 SERVICE_RETRY = 30.0
@@ -171,16 +166,7 @@ class PipelineRunner:
         self.prediction_pub = c.create_publisher(
             ContactEventArray, pipeline.PREDICTION, pipeline.LATCHED
         )
-        self.action = ActionClient(c, ExecuteGrasp, pipeline.ACTION)
-        self.goal_statuses: dict[bytes, int] = {}
-        c.create_subscription(
-            GoalStatusArray,
-            f"{pipeline.ACTION}/_action/status",
-            self._goal_status,
-            pipeline.LATCHED,
-        )
-        self.goal_handle = None
-        self.result_future = None
+        self.goal = GoalClient(c, self._feedback)
         self.plan: Plan | None = None
         self.start_ns = 0
 
@@ -300,7 +286,7 @@ class PipelineRunner:
         elif not self.options.attach:
             self._construct(params)
         self.spin_until(
-            lambda: self.action.server_is_ready(),
+            lambda: self.goal.action.server_is_ready(),
             self.options.timeout,
             "the executor's action server",
         )
@@ -513,75 +499,17 @@ class PipelineRunner:
 
     # ----------------------------------------------------------------- the goal
     def send_goal(self) -> None:
-        """Send the plan's goal and wait until it is accepted.
-
-        Across processes a service response can be lost while discovery is still settling
-        (docs/design.md §5: the first messages after matching). The goal ids are ours, so a
-        goal whose acceptance shows on the action's status topic counts as accepted even if the
-        response never came; after ``GOAL_RESPONSE_TIMEOUT`` without either the request is sent
-        again with a new id, and whichever request is accepted first is the goal (the executor
-        rejects the others while it runs one).
+        """Send the plan's goal and wait until it is accepted (:class:`.goal_client.GoalClient`:
+        across processes a response can be lost while discovery is still settling).
         """
-        msg = messages.grasp_goal_msg(self.plan.goal)
-        deadline = time.monotonic() + self.options.timeout
-        sent: list = []
-        handle = None
-        while handle is None:
-            goal_id = UUID(uuid=list(uuid.uuid4().bytes))
-            sent.append(
-                (goal_id, self.action.send_goal_async(msg, self._feedback, goal_uuid=goal_id))
-            )
-            retry = min(time.monotonic() + GOAL_RESPONSE_TIMEOUT, deadline)
-            self.spin_until(
-                lambda: (
-                    self._accepted(sent) is not None
-                    or all(f.done() for _, f in sent)
-                    or time.monotonic() > retry
-                ),
-                self.options.timeout,
-                "the goal to be accepted",
-            )
-            handle = self._accepted(sent)
-            if handle is None and all(f.done() for _, f in sent):
-                settle = time.monotonic() + GOAL_RESPONSE_TIMEOUT
-                self.spin_until(
-                    lambda: self._accepted(sent) is not None or time.monotonic() > settle,
-                    self.options.timeout,
-                    "the status of the goal requests",
-                )
-                handle = self._accepted(sent) or sent[-1][1].result()
-            if handle is None and time.monotonic() > deadline:
-                raise RunError("the executor never answered the goal request")
-        if not handle.accepted:
-            raise RunError("the executor rejected the goal")
-        self.goal_handle = handle
-        self.result_future = handle.get_result_async()
+        self.goal.send(messages.grasp_goal_msg(self.plan.goal), self.spin_until,
+                       self.options.timeout)
         self.loop_started = time.perf_counter()
         self.loop_cpu_started = time.process_time()
 
-    def _accepted(self, sent: list):
-        """The goal handle of the first request known to be accepted (by its response or by
-        the status topic), or None.
-        """
-        for goal_id, future in sent:
-            if future.done() and future.result().accepted:
-                return future.result()
-            if self._status_of(goal_id) is not None:
-                return ClientGoalHandle(
-                    self.action, goal_id, ExecuteGrasp.Impl.SendGoalService.Response(accepted=True)
-                )
-        return None
-
-    def _goal_status(self, msg: GoalStatusArray) -> None:
-        for status in msg.status_list:
-            self.goal_statuses[bytes(status.goal_info.goal_id.uuid)] = status.status
-
-    def _status_of(self, goal_id: UUID) -> int | None:
-        return self.goal_statuses.get(bytes(goal_id.uuid))
-
     def cancel(self) -> None:
         """Ask the executor to cancel the goal (it holds position)."""
-        self.goal_handle.cancel_goal_async()
+        self.goal.cancel()
 
     def _world_failed(self) -> bool:
         """True once the simulated world has ended with a termination that loses the grasp."""
@@ -595,33 +523,7 @@ class PipelineRunner:
         the object. If the status topic reports the goal finished but the result response does
         not come within a few seconds (lost across processes), the result is requested again.
         """
-        finished = (
-            GoalStatus.STATUS_SUCCEEDED,
-            GoalStatus.STATUS_ABORTED,
-            GoalStatus.STATUS_CANCELED,
-        )
-        deadline = time.monotonic() + self.options.timeout
-        cancelled = False
-        while not self.result_future.done():
-            if not cancelled and self._world_failed():
-                cancelled = True
-                self.cancel()
-            ended = (
-                [time.monotonic()] if self._status_of(self.goal_handle.goal_id) in finished else []
-            )
-            self.spin_until(
-                lambda: (
-                    self.result_future.done()
-                    or (ended and time.monotonic() > ended[0] + GOAL_RESPONSE_TIMEOUT)
-                    or (not ended and self._status_of(self.goal_handle.goal_id) in finished)
-                    or (not cancelled and self._world_failed())
-                ),
-                max(deadline - time.monotonic(), 0.0),
-                "the goal's result",
-            )
-            if not self.result_future.done() and ended:
-                self.result_future = self.goal_handle.get_result_async()
-        result = self.result_future.result().result
+        result = self.goal.result(self.spin_until, self.options.timeout, self._world_failed)
         self.timing["loop"] = time.perf_counter() - self.loop_started
         self.timing["loop_cpu"] = time.process_time() - self.loop_cpu_started
         final = self.start_ns + result.ticks * self._dt_ns()

@@ -66,8 +66,7 @@ off the predicted branch is halved.
 from __future__ import annotations
 
 import itertools
-from collections.abc import Callable, Mapping
-from dataclasses import dataclass
+from collections.abc import Mapping
 
 import numpy as np
 
@@ -88,6 +87,9 @@ from squeeze_grasp_ros.mechanics.squeeze.contact_state import (
     StepResult,
 )
 from squeeze_grasp_ros.mechanics.errors import InvalidInputError, NumericalError, require_finite
+from squeeze_grasp_ros.mechanics.squeeze.event_functions import (EventValues, event_values,
+                                                                  locate_sign_change,
+                                                                  mode_violations, pickup_margin)
 from squeeze_grasp_ros.mechanics.squeeze.fingertips import tip_gaps
 from squeeze_grasp_ros.mechanics.vocabulary import ContactMode, Termination
 
@@ -106,81 +108,6 @@ CONTINUATION_ITERATIONS = 12
 MAX_ANGLE_JUMP = 0.05
 """Continuation safeguards: Newton iterations and distance (rad) from the predicted angles
 beyond which a substep is halved."""
-MAX_ROOT_ITERATIONS = 200
-
-
-def pickup_margin(
-    mu: float,
-    fn: np.ndarray,
-    ft: np.ndarray,
-    stick: np.ndarray,
-    finger: np.ndarray,
-    fingers: list[int],
-    weight: float,
-) -> float:
-    """How far the grasp is from lifting the object, in force units (> 0: cannot lift yet).
-
-    The object lies on a horizontal plane and is lifted out of it. A contact node with normal
-    force f_n and in-plane tangential force f_t can supply at most
-    c_k = sqrt(mu^2 f_n^2 - f_t^2) of vertical friction (Sec. 5.1); a sliding node (force on the
-    cone edge) supplies none. The object is picked up when every finger with contacts can
-    supply its share: min over those fingers of sum_k c_k >= w / (number of such fingers)
-    (torque balance by friction assumed, as in the paper). Returns w / n_f - min_f sum_k c_k.
-    """
-    c = np.where(stick, np.sqrt(np.maximum(mu * mu * fn * fn - ft * ft, 0.0)), 0.0)
-    totals = [c[finger == f].sum() for f in fingers]
-    return float(weight / len(fingers) - min(totals))
-
-
-def _locate(
-    g: Callable[[float], float], a: float, b: float, ga: float, gb: float, tol: float
-) -> tuple[float, float, int]:
-    """Bracket [a, b] of width <= tol around the first sign change (ga > 0 >= gb).
-
-    Illinois regula falsi with a bisection safeguard; returns (a, b, evaluations).
-    """
-    evaluations, retained, width = 0, 0, b - a
-    while b - a > tol:
-        if evaluations >= MAX_ROOT_ITERATIONS:
-            raise NumericalError(
-                f"event location did not converge in {evaluations} evaluations",
-                residuals={"bracket": b - a, "tolerance": tol},
-            )
-        if evaluations % 3 == 2 and b - a > 0.5 * width:
-            c = 0.5 * (a + b)
-        else:
-            c = (a * gb - b * ga) / (gb - ga) if gb != ga else 0.5 * (a + b)
-        c = min(max(c, a + 0.49 * tol), b - 0.49 * tol)
-        if evaluations % 3 == 2:
-            width = b - a
-        gc = g(c)
-        evaluations += 1
-        if gc > 0:
-            a, ga = c, gc
-            if retained == 1:
-                gb *= 0.5
-            retained = 1
-        else:
-            b, gb = c, gc
-            if retained == -1:
-                ga *= 0.5
-            retained = -1
-    return a, b, evaluations
-
-
-@dataclass
-class _Values:
-    """Event-function values at one solution (see the module table)."""
-
-    fn: np.ndarray
-    c_plus: np.ndarray
-    c_minus: np.ndarray
-    d: np.ndarray
-    gaps: np.ndarray
-    strain: float
-    pickup: float
-
-
 class _Run:
     """Mutable working copy of a state during one :func:`advance` call (dimensionless)."""
 
@@ -328,18 +255,13 @@ class _Run:
 
     def values(
         self, sol: Solution, s: float, rows: np.ndarray, terminations: bool = True
-    ) -> _Values:
+    ) -> EventValues:
         """All event functions at ``sol`` (and the termination functions if asked)."""
-        fn, ft = sol.normal(), sol.tangential()
-        mu = self.model.mu
-        d = (
-            self.slip
-            * sol.dtheta
-            * self.radius_f[self.fidx]
-            / (self.rate if self.rate > 0 else 1.0)
-        )
         strain, pickup = self.termination_values(sol) if terminations else (np.inf, np.inf)
-        return _Values(fn, mu * fn + ft, mu * fn - ft, d, self.gaps(sol, s, rows), strain, pickup)
+        return event_values(mu=self.model.mu, fn=sol.normal(), ft=sol.tangential(),
+                            slip=self.slip, dtheta=sol.dtheta, radius=self.radius_f[self.fidx],
+                            rate=self.rate, gaps=self.gaps(sol, s, rows), strain=strain,
+                            pickup=pickup)
 
     def _key_value(self, key: tuple, sol: Solution, s: float) -> float:
         """Value of one event function (for root location)."""
@@ -352,7 +274,7 @@ class _Run:
         k = int(np.searchsorted(self.nodes, node))
         return float({"B": v.fn, "C+": v.c_plus, "C-": v.c_minus, "D": v.d}[kind][k])
 
-    def entries(self, v: _Values, rows: np.ndarray, depth: float):
+    def entries(self, v: EventValues, rows: np.ndarray, depth: float):
         """Active (key, value) pairs of the contact and termination functions, in order."""
         held = self.held(depth)
         out = []
@@ -434,27 +356,13 @@ class _Run:
         return zero
 
     def violations(self, sol: Solution, k: int, stick: bool, slip: int, zero: set) -> int:
-        """Violated conditions of a mode hypothesis for contact k (0 = consistent).
-
-        A function in ``zero`` must grow along the motion; any other must be positive. Stick:
-        normal force and both cone margins; slip: normal force and slip rate of the assumed
-        sign (Algorithm 1's hypothesis-and-test).
-        """
+        """Violated conditions of a mode hypothesis for contact k (:func:`mode_violations`)."""
         node = int(self.nodes[k])
-        mu = self.model.mu
-        fn, ft = float(sol.normal()[k]), float(sol.tangential()[k])
-        fn_r, ft_r = float(sol.normal_rate()[k]), float(sol.tangential_rate()[k])
-
-        def ok(kind: str, value: float, rate: float) -> bool:
-            return rate > 0 if (kind, node) in zero else value > 0
-
-        bad = int(not ok("B", fn, fn_r))
-        if stick:
-            bad += int(not ok("C+", mu * fn + ft, mu * fn_r + ft_r))
-            bad += int(not ok("C-", mu * fn - ft, mu * fn_r - ft_r))
-        elif not self.frictionless:
-            bad += int(slip * sol.dtheta[k] <= 0)
-        return bad
+        return mode_violations(
+            mu=self.model.mu, fn=float(sol.normal()[k]), ft=float(sol.tangential()[k]),
+            fn_rate=float(sol.normal_rate()[k]), ft_rate=float(sol.tangential_rate()[k]),
+            dtheta=float(sol.dtheta[k]), stick=bool(stick), slip=int(slip),
+            frictionless=self.frictionless, zero={kind for kind, n in zero if n == node})
 
     def decide(self, nodes: list[int]) -> None:
         """Joint hypothesis-and-test for the modes of ``nodes`` (Algorithm 1 lines 2 and 13).
@@ -881,7 +789,7 @@ class _Run:
             if glo <= 0:
                 hi = lo
             else:
-                _, hi, n = _locate(g, lo, b, glo, vb[key], tol_s)
+                _, hi, n = locate_sign_change(g, lo, b, glo, vb[key], tol_s)
                 self.diag["root_evaluations"] += n
             fidx = key[2] if key[0] == "A" else finger_of.get(key[1], 0)
             rank = (hi, EVENT_ORDER.get(key[0], 4), fidx, key[1])

@@ -1,6 +1,6 @@
 # Copyright 2026 squeeze_grasp_ros developers
 # SPDX-License-Identifier: Apache-2.0
-"""The planner's conversions in ros/messages.py (pure functions) and the request layer's caches."""
+"""The planner's conversions in ros/messages/ (pure functions) and the request layer's caches."""
 from __future__ import annotations
 
 import numpy as np

@@ -1,0 +1,84 @@
+# Copyright 2026 squeeze_grasp_ros developers
+# SPDX-License-Identifier: Apache-2.0
+"""Device streams: poses, wrenches and the lockstep tick."""
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+from geometry_msgs.msg import PoseStamped, WrenchStamped
+from std_msgs.msg import Header
+
+from squeeze_grasp_interfaces.msg import (
+    Tick,
+)
+
+
+
+from squeeze_grasp_ros.ros.messages.common import (header, set_stamp)
+
+
+# --------------------------------------------------------------------------- pipeline: devices
+
+
+def pose_msg(position: Sequence[float] | np.ndarray, ns: int, frame_id: str) -> PoseStamped:
+    """A fingertip centre (x, y), m, as ``PoseStamped`` (z = 0, identity orientation)."""
+    msg = PoseStamped(header=header(ns, frame_id))
+    msg.pose.position.x = float(position[0])
+    msg.pose.position.y = float(position[1])
+    msg.pose.orientation.w = 1.0
+    return msg
+
+
+def fill_pose(msg: PoseStamped, position: Sequence[float] | np.ndarray, ns: int) -> PoseStamped:
+    """Refill a :func:`pose_msg` in place with a new position (x, y), m, and stamp; returns it."""
+    set_stamp(msg.header.stamp, ns)
+    point = msg.pose.position
+    point.x, point.y = float(position[0]), float(position[1])
+    return msg
+
+
+def pose_position(msg: PoseStamped) -> np.ndarray:
+    """The planar position (x, y), m, of a ``PoseStamped``."""
+    return np.array([msg.pose.position.x, msg.pose.position.y])
+
+
+def pose_in_base(values: Sequence[float], frame_id: str) -> PoseStamped:
+    """``PoseStamped`` of [x, y, z, qx, qy, qz, qw] (m, unit quaternion) in ``frame_id``."""
+    msg = PoseStamped(header=Header(frame_id=frame_id))
+    p, q = msg.pose.position, msg.pose.orientation
+    p.x, p.y, p.z, q.x, q.y, q.z, q.w = (float(v) for v in values)
+    return msg
+
+
+def wrench_msg(force: np.ndarray, torque: np.ndarray, ns: int, frame_id: str) -> WrenchStamped:
+    """``WrenchStamped`` of a force (3,), N, and torque (3,), N m, in ``frame_id``."""
+    msg = WrenchStamped(header=header(ns, frame_id))
+    w = msg.wrench
+    w.force.x, w.force.y, w.force.z = (float(v) for v in force)
+    w.torque.x, w.torque.y, w.torque.z = (float(v) for v in torque)
+    return msg
+
+
+def fill_wrench(
+    msg: WrenchStamped, force: np.ndarray, torque: np.ndarray, ns: int
+) -> WrenchStamped:
+    """Refill a :func:`wrench_msg` in place with a new force, N, torque, N m, and stamp."""
+    set_stamp(msg.header.stamp, ns)
+    f, t = msg.wrench.force, msg.wrench.torque
+    f.x, f.y, f.z = (float(v) for v in force)
+    t.x, t.y, t.z = (float(v) for v in torque)
+    return msg
+
+
+def wrench_force(msg: WrenchStamped) -> np.ndarray:
+    """The force (3,), N, of a ``WrenchStamped``."""
+    f = msg.wrench.force
+    return np.array([f.x, f.y, f.z])
+
+
+def tick_msg(index: int, ns: int, readings: Sequence[str]) -> Tick:
+    """The end-of-tick message of lockstep tick ``index`` at sim time ``ns`` (readings as
+    "<device>/<stream>").
+    """
+    return Tick(header=header(ns), index=int(index), readings=list(readings))

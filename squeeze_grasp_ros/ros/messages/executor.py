@@ -1,0 +1,145 @@
+# Copyright 2026 squeeze_grasp_ros developers
+# SPDX-License-Identifier: Apache-2.0
+"""The executor's goal, feedback, result and status."""
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+from geometry_msgs.msg import Vector3
+
+from squeeze_grasp_interfaces.action import ExecuteGrasp
+from squeeze_grasp_interfaces.msg import (
+    ContactEvent,
+    ExecutorStatus,
+    MonitorStatus,
+)
+
+from squeeze_grasp_ros.control.motion import Command, GraspGoal, GraspProgram, Observation
+
+
+from squeeze_grasp_ros.ros.messages.common import (float64_array, header, stamp_ns, vector3)
+
+
+# --------------------------------------------------------------------------- pipeline: executor
+
+
+def observation(msg: MonitorStatus) -> Observation:
+    """The executor's :class:`Observation` of a ``MonitorStatus``."""
+    fingers = list(msg.fingers)
+    return Observation(
+        stamp_ns(msg.header.stamp),
+        {f: np.array([p.x, p.y]) for f, p in zip(fingers, msg.positions)},
+        {f: np.array([v.x, v.y]) for f, v in zip(fingers, msg.forces)},
+        {f: np.array([v.x, v.y]) for f, v in zip(fingers, msg.normals)},
+        tuple((a.type, a.finger) for a in msg.alarms),
+        tuple(e.type for e in msg.events),
+        float(msg.depth),
+    )
+
+
+def _planar(vectors: Sequence[Vector3]) -> np.ndarray:
+    return np.array([[v.x, v.y] for v in vectors], float).reshape(-1, 2)
+
+
+def grasp_goal(msg: ExecuteGrasp.Goal) -> GraspGoal:
+    """The :class:`GraspGoal` of an ``ExecuteGrasp`` goal (shapes are checked by
+    :func:`..control.motion.goal_problem`).
+    """
+    fingers = tuple(msg.fingers)
+    waypoints = _planar(msg.resist_waypoints)
+    k = len(msg.resist_travel)
+    shaped = (
+        waypoints.reshape(k, len(fingers), 2)
+        if k and len(waypoints) == k * len(fingers)
+        else waypoints.reshape(1, -1, 2)
+    )
+    return GraspGoal(
+        fingers,
+        _planar(msg.directions),
+        float(msg.depth),
+        float(msg.relative_per_depth),
+        msg.on_slip_alarm or "hold",
+        _planar(msg.pure_directions) if msg.pure_directions else None,
+        msg.adversary if msg.resist else "",
+        np.array([msg.adversary_translation.x, msg.adversary_translation.y]),
+        np.asarray(msg.resist_travel, float),
+        shaped,
+    )
+
+
+def grasp_goal_msg(goal: GraspGoal) -> ExecuteGrasp.Goal:
+    """The ``ExecuteGrasp`` goal of a :class:`GraspGoal`."""
+    msg = ExecuteGrasp.Goal(
+        fingers=list(goal.fingers),
+        directions=[vector3(d) for d in goal.directions],
+        depth=float(goal.depth),
+        relative_per_depth=float(goal.relative_per_depth),
+        on_slip_alarm=goal.on_slip_alarm,
+        resist=goal.resist,
+        adversary=goal.adversary,
+        adversary_translation=vector3(goal.adversary_translation),
+        resist_travel=float64_array(goal.resist_travel),
+        resist_waypoints=[vector3(w) for w in goal.resist_waypoints.reshape(-1, 2)],
+    )
+    if goal.pure_directions is not None:
+        msg.pure_directions = [vector3(d) for d in goal.pure_directions]
+    return msg
+
+
+def grasp_feedback(
+    state: str,
+    obs: Observation,
+    fingers: Sequence[str],
+    events: Sequence[ContactEvent],
+    relative_per_depth: float,
+) -> ExecuteGrasp.Feedback:
+    """``ExecuteGrasp`` feedback: measured depth and forces, events since the last feedback."""
+    return ExecuteGrasp.Feedback(
+        state=state,
+        depth=obs.depth,
+        relative_depth=obs.depth * relative_per_depth,
+        fingers=list(fingers),
+        forces=[vector3(obs.forces.get(f, np.zeros(2))) for f in fingers],
+        latest_events=list(events),
+    )
+
+
+def grasp_result(
+    program: GraspProgram,
+    command: Command,
+    obs: Observation | None,
+    events: Sequence[ContactEvent],
+    duration: float,
+    success_terminations: Sequence[str],
+) -> ExecuteGrasp.Result:
+    """``ExecuteGrasp`` result of a finished :class:`GraspProgram` (measured numbers)."""
+    fingers = list(program.fingers)
+    forces = obs.forces if obs is not None else {}
+    return ExecuteGrasp.Result(
+        success=command.termination in success_terminations,
+        termination=command.termination,
+        message=command.message,
+        depth=obs.depth if obs is not None else 0.0,
+        relative_depth=(obs.depth if obs is not None else 0.0) * program.goal.relative_per_depth,
+        ticks=program.ticks,
+        duration=float(duration),
+        hold_ticks=program.hold_ticks,
+        redirected=program.redirected,
+        fingers=fingers,
+        forces=[vector3(forces.get(f, np.zeros(2))) for f in fingers],
+        work=float64_array([program.work[f] for f in fingers]),
+        events=list(events),
+    )
+
+
+def invalid_goal_result(message: str) -> ExecuteGrasp.Result:
+    """The result of a goal that cannot be executed."""
+    return ExecuteGrasp.Result(
+        success=False, termination=ExecuteGrasp.Result.INVALID_GOAL, message=message
+    )
+
+
+def executor_status_msg(state: str, depth: float, message: str, ns: int) -> ExecutorStatus:
+    """``ExecutorStatus`` of the executor (depth: commanded or measured, m)."""
+    return ExecutorStatus(header=header(ns), state=state, depth=float(depth), message=message)

@@ -1,0 +1,115 @@
+# Copyright 2026 squeeze_grasp_ros developers
+# SPDX-License-Identifier: Apache-2.0
+"""The monitor's outputs: tracked events, alarms, patches, status, the prediction."""
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+
+import numpy as np
+from geometry_msgs.msg import Point
+
+from squeeze_grasp_interfaces.msg import (
+    Alarm,
+    ContactEvent,
+    ContactEventArray,
+    ContactState,
+    MonitorStatus,
+)
+
+from squeeze_grasp_ros.control.tracker import (
+    PredictedEvent,
+    TrackedAlarm,
+    TrackedEvent,
+    TrackerOutput,
+)
+
+
+from squeeze_grasp_ros.ros.messages.common import (float64_array, header, vector3)
+from squeeze_grasp_ros.ros.messages.contacts import (CONTACT_MODES, contact_arrays_msg)
+
+
+# --------------------------------------------------------------------------- pipeline: monitor
+
+
+def _point(xy: np.ndarray) -> Point:
+    return Point(x=float(xy[0]), y=float(xy[1]))
+
+
+def tracked_event_msg(event: TrackedEvent, ns: int) -> ContactEvent:
+    """A monitor event as ``ContactEvent`` (node -1: taxel patches are not mesh nodes)."""
+    return ContactEvent(
+        header=header(ns),
+        type=event.type,
+        node=-1,
+        finger=event.finger,
+        depth=float(event.depth),
+        relative_depth=float(event.relative_depth),
+    )
+
+
+def tracked_events_msg(out: TrackerOutput) -> ContactEventArray:
+    """The events of one monitor tick as one ``ContactEventArray``."""
+    return ContactEventArray(
+        header=header(out.stamp_ns),
+        events=[tracked_event_msg(e, out.stamp_ns) for e in out.events],
+    )
+
+
+def alarm_msg(alarm: TrackedAlarm, ns: int) -> Alarm:
+    """A monitor alarm as ``Alarm``."""
+    return Alarm(
+        header=header(ns),
+        type=alarm.type,
+        finger=alarm.finger,
+        value=float(alarm.value),
+        message=alarm.message,
+    )
+
+
+def patches_state_msg(out: TrackerOutput, frame_id: str) -> ContactState:
+    """The monitor's reconstructed contact patches as ``ContactState`` (node = -1, polar angle
+    = the patch's mean taxel angle, force = the patch force on the object, N).
+    """
+    patches = out.patches
+    trig = [(math.cos(p.angle), math.sin(p.angle)) for p in patches]
+    return contact_arrays_msg(
+        [p.finger for p in patches],
+        [-1] * len(patches),
+        [p.angle for p in patches],
+        [CONTACT_MODES[p.mode] for p in patches],
+        [p.normal * c - p.tangential * s for p, (c, s) in zip(patches, trig)],
+        [p.normal * s + p.tangential * c for p, (c, s) in zip(patches, trig)],
+        out.depth,
+        out.relative_depth,
+        header(out.stamp_ns, frame_id),
+    )
+
+
+def monitor_status_msg(out: TrackerOutput, frame_id: str) -> MonitorStatus:
+    """The monitor's per-tick ``MonitorStatus`` (fingers without a pose report the origin)."""
+    zero = np.zeros(2)
+    return MonitorStatus(
+        header=header(out.stamp_ns, frame_id),
+        fingers=list(out.fingers),
+        positions=[_point(out.positions.get(f, zero)) for f in out.fingers],
+        forces=[vector3(out.forces[f]) for f in out.fingers],
+        normals=[vector3(out.normals[f]) for f in out.fingers],
+        sensor_age=float64_array([min(out.ages[f], 1e300) for f in out.fingers]),
+        depth=out.depth,
+        relative_depth=out.relative_depth,
+        events=[tracked_event_msg(e, out.stamp_ns) for e in out.events],
+        alarms=[alarm_msg(a, out.stamp_ns) for a in out.alarms],
+    )
+
+
+def prediction_msg(
+    events: Sequence[ContactEvent], termination: str, depth: float
+) -> ContactEventArray:
+    """The planner's predicted events as ``ContactEventArray``."""
+    return ContactEventArray(events=list(events), termination=termination, depth=float(depth))
+
+
+def predicted_events(msg: ContactEventArray) -> list[PredictedEvent]:
+    """The A-D events of a prediction for the tracker."""
+    return [PredictedEvent(e.type, e.finger, float(e.depth)) for e in msg.events]

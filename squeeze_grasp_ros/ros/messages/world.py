@@ -1,0 +1,147 @@
+# Copyright 2026 squeeze_grasp_ros developers
+# SPDX-License-Identifier: Apache-2.0
+"""The simulated world's ground truth and its markers."""
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+from geometry_msgs.msg import Point
+from visualization_msgs.msg import Marker, MarkerArray
+
+from squeeze_grasp_interfaces.msg import (
+    ContactEvent,
+    ContactEventArray,
+    SimState,
+)
+
+from squeeze_grasp_ros.mechanics.squeeze import contact_state
+
+from squeeze_grasp_ros.sim.world import WorldView
+
+from squeeze_grasp_ros.ros.messages.common import (float64_array, header, stamp_ns, vector3)
+from squeeze_grasp_ros.ros.messages.contacts import (contact_event_msg, contact_state_msg)
+
+
+# --------------------------------------------------------------------------- pipeline: ground trut
+
+
+def sim_state_msg(
+    state: contact_state.ContactState,
+    fingers: Sequence[str],
+    termination: str | None,
+    ns: int,
+    frame_id: str,
+) -> SimState:
+    """Ground truth of the simulated world as ``SimState`` (fingers without a tip: zeros)."""
+    present = {f.name: f for f in state.fingers}
+    positions, forces, work = [], [], []
+    for name in fingers:
+        f = present.get(name)
+        positions.append(Point(x=float(f.center[0]), y=float(f.center[1])) if f else Point())
+        forces.append(vector3(state.finger_force(name)))
+        work.append(f.work if f else 0.0)
+    stamp_header = header(ns, frame_id)
+    return SimState(
+        header=stamp_header,
+        fingers=list(fingers),
+        positions=positions,
+        forces=forces,
+        work=float64_array(work),
+        contacts=contact_state_msg(state, stamp_header),
+        termination=termination or "",
+    )
+
+
+def sim_events_msg(
+    events: Sequence[contact_state.Event],
+    termination: str,
+    state: contact_state.ContactState,
+    ns: int,
+) -> ContactEventArray:
+    """The ground-truth events of one tick as ``ContactEventArray``; ``termination`` (e.g.
+    "finger_slip", or "") is set at the tick the world ends, with the depth it ended at.
+    """
+    head = header(ns)
+    return ContactEventArray(
+        header=head,
+        events=[contact_event_msg(e, head) for e in events],
+        termination=termination,
+        depth=float(state.depth) if termination else 0.0,
+    )
+
+
+def event_record(msg: ContactEvent) -> dict:
+    """A ``ContactEvent`` as a JSON-able dict (stamp in ns)."""
+    return {
+        "stamp_ns": stamp_ns(msg.header.stamp),
+        "type": msg.type,
+        "node": int(msg.node),
+        "finger": msg.finger,
+        "depth": float(msg.depth),
+        "relative_depth": float(msg.relative_depth),
+    }
+
+
+MARKER_COLOURS: dict[str, tuple[float, float, float]] = {
+    "outline": (0.2, 0.4, 0.9),
+    "tip": (0.5, 0.5, 0.5),
+    "stick": (0.1, 0.75, 0.2),
+    "slip": (0.9, 0.2, 0.1),
+    "force": (0.95, 0.7, 0.1),
+}
+"""RGB of the visualisation markers (contacts: sticking green, sliding red)."""
+
+
+def _marker(
+    ns: int,
+    frame_id: str,
+    namespace: str,
+    ident: int,
+    kind: int,
+    colour: str,
+    points: np.ndarray,
+    width: float,
+) -> Marker:
+    r, g, b = MARKER_COLOURS[colour]
+    m = Marker(header=header(ns, frame_id), ns=namespace, id=ident, type=kind, action=Marker.ADD)
+    m.pose.orientation.w = 1.0
+    m.scale.x = m.scale.y = m.scale.z = width
+    m.color.r, m.color.g, m.color.b, m.color.a = r, g, b, 1.0
+    m.points = [Point(x=float(x), y=float(y)) for x, y in points]
+    return m
+
+
+def world_markers(
+    view: WorldView, ns: int, frame_id: str, force_scale: float = 0.002
+) -> MarkerArray:
+    """``MarkerArray`` of the deformed outline, fingertip circles, contact nodes (sticking green,
+    sliding red) and contact force arrows (``force_scale`` m per N), object frame.
+    """
+    markers = [
+        _marker(
+            ns,
+            frame_id,
+            "outline",
+            0,
+            Marker.LINE_STRIP,
+            "outline",
+            np.vstack([view.outline, view.outline[:1]]),
+            0.0005,
+        )
+    ]
+    circle = np.linspace(0.0, 2.0 * np.pi, 49)
+    for k, (_, centre, radius) in enumerate(view.tips):
+        pts = centre + radius * np.stack([np.cos(circle), np.sin(circle)], axis=1)
+        markers.append(
+            _marker(ns, frame_id, "fingertips", k, Marker.LINE_STRIP, "tip", pts, 0.0005)
+        )
+    for k, (_, point, mode, force) in enumerate(view.contacts):
+        markers.append(
+            _marker(ns, frame_id, "contacts", k, Marker.SPHERE, mode, np.zeros((0, 2)), 0.002)
+        )
+        markers[-1].pose.position.x, markers[-1].pose.position.y = float(point[0]), float(point[1])
+        arrow = np.array([point - force_scale * np.asarray(force), point])
+        markers.append(_marker(ns, frame_id, "forces", k, Marker.ARROW, "force", arrow, 0.0005))
+    clear = Marker(header=header(ns, frame_id), action=Marker.DELETEALL)
+    return MarkerArray(markers=[clear] + markers)

@@ -523,8 +523,8 @@ def _check_shape_value(key: str, value: Any, where: str) -> None:
         raise SceneError(f"{where} must be a positive number{unit}, got {value!r}")
 
 
-def _validate(scene: Scene) -> Scene:
-    _validate_shape(scene.object.shape)
+def _validate_fingers(scene: Scene) -> None:
+    """F1 and F2 exactly; directions for every finger or none."""
     for name in scene.fingers:
         if name not in SQUEEZING_FINGERS:
             raise SceneError(
@@ -533,6 +533,15 @@ def _validate(scene: Scene) -> Scene:
             )
     if set(scene.fingers) != {Finger.F1, Finger.F2}:
         raise SceneError("fingers must define both F1 and F2")
+    given = [k for k, v in scene.fingers.items() if v.direction is not None]
+    if given and len(given) != len(scene.fingers):
+        raise SceneError(
+            f"fingers.{given[0]}.direction is given: give direction for every finger or for none"
+        )
+
+
+def _validate_placements(scene: Scene) -> None:
+    """Every placement (fingers, adversary) names exactly one of point, angle_deg, node."""
     placements = [(f"fingers.{k}", v.placement) for k, v in scene.fingers.items()]
     if scene.adversary is not None:
         placements.append(("adversary", scene.adversary.placement))
@@ -543,17 +552,21 @@ def _validate(scene: Scene) -> Scene:
                 f"{where}.placement needs exactly one of point, angle_deg, node; "
                 f"got {given or 'none'}"
             )
+
+
+def _validate_adversary(scene: Scene) -> None:
+    """The adversary's translation and comparison direction are nonzero."""
     adv = scene.adversary
-    if adv is not None:
-        for name in ("a", "compare_direction"):
-            value = getattr(adv, name)
-            if value is not None and not np.hypot(*value) > 0:
-                raise SceneError(f"adversary.{name} must be a nonzero vector, got {list(value)}")
-    given = [k for k, v in scene.fingers.items() if v.direction is not None]
-    if given and len(given) != len(scene.fingers):
-        raise SceneError(
-            f"fingers.{given[0]}.direction is given: give direction for every finger or for none"
-        )
+    if adv is None:
+        return
+    for name in ("a", "compare_direction"):
+        value = getattr(adv, name)
+        if value is not None and not np.hypot(*value) > 0:
+            raise SceneError(f"adversary.{name} must be a nonzero vector, got {list(value)}")
+
+
+def _validate_squeeze(scene: Scene) -> None:
+    """At most one of depth and relative_depth; a relative depth below 1."""
     sq = scene.squeeze
     if sq.depth is not None and sq.relative_depth is not None:
         raise SceneError("squeeze.depth and squeeze.relative_depth are exclusive; give one")
@@ -562,6 +575,10 @@ def _validate(scene: Scene) -> Scene:
             f"squeeze.relative_depth must be < 1 (at 1 the fingers would meet), "
             f"got {sq.relative_depth}"
         )
+
+
+def _validate_effects(scene: Scene) -> None:
+    """Known effects, each once, and a section exactly for each declared effect."""
     for effect in scene.effects:
         if effect not in EFFECTS:
             raise SceneError(f"unknown effect {effect!r} in effects (allowed: {sorted(EFFECTS)})")
@@ -575,8 +592,10 @@ def _validate(scene: Scene) -> Scene:
             )
         if scene.has(effect) and not present:
             raise SceneError(f"effect {effect!r} is declared but section {section} is missing")
-    _validate_sensors(scene)
-    _validate_devices(scene)
+
+
+def _validate_object(scene: Scene) -> None:
+    """Model and its sections agree; the material is valid for its constitutive model."""
     obj = scene.object
     if obj.model == "ring" and obj.ring is None:
         raise SceneError("object.model is ring but object.ring is missing")
@@ -588,6 +607,18 @@ def _validate(scene: Scene) -> Scene:
         Material(obj.material.E, obj.material.nu, obj.material.thickness)
     except InvalidInputError as exc:
         raise SceneError(f"object.{exc}") from None
+    if obj.material.model == MaterialModel.NEO_HOOKEAN and not obj.material.nu < 0.5:
+        raise SceneError(f"object.material.nu must be < 0.5 for the neo_hookean model (its "
+                         f"lambda is infinite at 0.5), got {obj.material.nu}")
+
+
+def _validate(scene: Scene) -> Scene:
+    """Cross-field checks of a parsed scene, one concern per function."""
+    _validate_shape(scene.object.shape)
+    for check in (_validate_fingers, _validate_placements, _validate_adversary,
+                  _validate_squeeze, _validate_effects, _validate_sensors, _validate_devices,
+                  _validate_object):
+        check(scene)
     return scene
 
 

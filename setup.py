@@ -44,6 +44,7 @@ setup(
         (f"share/{PACKAGE}/config/scenes", glob("config/scenes/*.yaml")),
         (f"share/{PACKAGE}/config/sweeps", glob("config/sweeps/*.yaml")),
         (f"share/{PACKAGE}/config/viewers", glob("config/viewers/*")),
+        (f"share/{PACKAGE}/config/examples", glob("config/examples/*")),
     ],
     python_requires=">=3.10",
     install_requires=[

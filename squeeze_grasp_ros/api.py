@@ -31,6 +31,8 @@ depth_reached A
 """
 from __future__ import annotations
 
+from squeeze_grasp_ros.mechanics.calibration.hyperelastic_fit import (CompressionCurve,
+                                                                   fit_compression)
 from squeeze_grasp_ros.mechanics.calibration.material_fit import Cuboid, calibrate_elasticity
 from squeeze_grasp_ros.mechanics.calibration.matching import match_similarity
 from squeeze_grasp_ros.mechanics.elastic.compliance import ElasticObject
@@ -71,7 +73,7 @@ __all__ = [
     # resistance, rings, calibration
     "resistance_grasp", "optimal_resistance", "FrictionalResistance", "frictional_resistance",
     "RingModel", "ring_grasp", "ring_grasp_map", "Cuboid", "calibrate_elasticity",
-    "match_similarity",
+    "match_similarity", "CompressionCurve", "fit_compression",
     # vocabulary
     "Finger", "EventType", "ContactMode", "Termination", "SqueezeKind", "StrainCriterion",
     "MaterialModel",

@@ -1,0 +1,83 @@
+# Copyright 2026 squeeze_grasp_ros developers
+# SPDX-License-Identifier: Apache-2.0
+"""Linear and neo-Hookean fits of a uniaxial compression curve (calibrate --compression)."""
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+from squeeze_grasp_ros.cli import main
+from squeeze_grasp_ros.mechanics.calibration.hyperelastic_fit import (
+    CompressionCurve, MaterialFit, fit_compression, linear_validity, uniaxial_response)
+from squeeze_grasp_ros.mechanics.elastic import hyperelastic
+from squeeze_grasp_ros.mechanics.vocabulary import MaterialModel
+
+SIDES = (0.05, 0.04, 0.02)
+
+
+def curve(strain, *, E=5e4, nu=0.3, lateral=True, noise=0.0, seed=0):
+    P, l2 = uniaxial_response("neo_hookean", 1 - strain, E=E, nu=nu)
+    force = -P * SIDES[1] * SIDES[2]
+    force = force * (1 + noise * np.random.default_rng(seed).standard_normal(len(force)))
+    return CompressionCurve(*SIDES, force, -strain * SIDES[0],
+                            (l2 - 1) * SIDES[1] if lateral else None)
+
+
+def test_uniaxial_neo_hookean_is_the_plane_stress_law_with_free_faces():
+    """The scalar uniaxial response equals the element law's P11 at F = diag(l1, l2) with the
+    lateral stretch that leaves the faces free (P22 = 0): an independent check of both.
+    """
+    l1 = np.array([0.95, 0.8, 0.7])
+    P, l2 = uniaxial_response("neo_hookean", l1, E=5e4, nu=0.3)
+    F = np.zeros((3, 2, 2))
+    F[:, 0, 0], F[:, 1, 1] = l1, l2
+    _, P_el, _ = hyperelastic.stress_and_tangent("neo_hookean", F, nu=0.3)
+    assert np.allclose(P_el[:, 0, 0] * 5e4, P, rtol=1e-10)
+    assert np.abs(P_el[:, 1, 1]).max() < 1e-10
+
+
+def test_exact_data_give_back_the_law():
+    fit = fit_compression(curve(np.linspace(0.01, 0.3, 10)), model="neo_hookean")
+    assert fit.E == pytest.approx(5e4, rel=1e-8) and fit.nu == pytest.approx(0.3, rel=1e-8)
+    assert fit.nu_fitted and fit.residual < 1e-10
+
+
+def test_linear_is_right_at_small_strain_and_wrong_at_large():
+    small = fit_compression(curve(np.linspace(0.001, 0.01, 6)), model="linear")
+    assert small.E == pytest.approx(5e4, rel=0.01)
+    data = curve(np.linspace(0.01, 0.3, 12), lateral=False)
+    linear, neo = (fit_compression(data, model=m) for m in ("linear", "neo_hookean"))
+    assert not linear.nu_fitted and linear.nu == 0.3
+    assert neo.residual < 1e-9 < 0.01 < linear.residual
+
+
+def test_noisy_data_fit_within_the_noise():
+    fit = fit_compression(curve(np.linspace(0.01, 0.3, 40), noise=0.01), model="neo_hookean")
+    assert fit.E == pytest.approx(5e4, rel=0.02) and 0.001 < fit.residual < 0.01
+
+
+def test_the_linear_range_shrinks_with_the_tolerance():
+    fit = MaterialFit(MaterialModel.NEO_HOOKEAN, 5e4, 0.3, 0.0, False)
+    ranges = [linear_validity(fit, tolerance=t) for t in (0.01, 0.05, 0.2)]
+    assert ranges == sorted(ranges) and 0.0 < ranges[0] < ranges[2]
+
+
+def test_the_cli_route(tmp_path, capfd):
+    data = curve(np.linspace(0.01, 0.25, 8))
+    path = tmp_path / "curve.csv"
+    path.write_text("force,dl,dw\n" + "".join(f"{f:.17g},{d:.17g},{w:.17g}\n" for f, d, w in
+                                               zip(data.force, data.dl, data.dw)))
+    args = ["calibrate", "--compression", str(path), "--sample-size", *map(str, SIDES)]
+    assert main(args + ["--json"]) == 0
+    out = json.loads(capfd.readouterr().out)["compression"]
+    assert out["neo_hookean"]["E"] == pytest.approx(5e4, rel=1e-6)
+    assert 0.03 < out["linear_within_5_percent_up_to_strain"] < 0.1
+    assert main(args) == 0
+    assert "within 5 % of the neo-Hookean fit" in capfd.readouterr().out
+    assert main(["calibrate", "--compression", str(path)]) == 2
+    assert "--sample-size" in capfd.readouterr().err
+    path.write_text("force,dl\n1.0,0.001\n2.0,0.002\n")
+    assert main(args) == 2
+    assert "dl must be in" in capfd.readouterr().err

@@ -102,8 +102,7 @@ class ExecutorNode(Node):
                                    cancel_callback=lambda _: CancelResponse.ACCEPT)
         self.goal: _Goal | None = None
         self.latest: MonitorStatus | None = None
-        self.answered_ns = -1
-        self.last_setpoints: list = []
+        self.answered = pipeline.TickAnswer()
         self.setpoints = {f: messages.pose_msg((0.0, 0.0), 0, self.p["frame_id"])
                           for f in self.setpoint_pubs}
         self.state = ExecutorStatus.IDLE
@@ -134,7 +133,7 @@ class ExecutorNode(Node):
         self.goal = _Goal(GraspProgram(goal, self.limits, list(self.devices)), handle)
         done = self.goal.done
         if self.p["lockstep"] and self.latest is not None and \
-                messages.stamp_ns(self.latest.header.stamp) > self.answered_ns:
+                messages.stamp_ns(self.latest.header.stamp) > self.answered.stamp_ns:
             self._cycle(self.latest)
         result = await done
         if result.termination == ExecuteGrasp.Result.CANCELED:
@@ -147,11 +146,7 @@ class ExecutorNode(Node):
 
     # ----------------------------------------------------------------- cycles
     def _status(self, msg: MonitorStatus) -> None:
-        ns = messages.stamp_ns(msg.header.stamp)
-        if ns == self.answered_ns:
-            for publisher, setpoint in self.last_setpoints:
-                publisher.publish(setpoint)
-        if ns <= self.answered_ns:
+        if not self.answered.is_new(messages.stamp_ns(msg.header.stamp)):
             return
         self.latest = msg
         if self.p["lockstep"] and self.goal is not None:
@@ -174,12 +169,9 @@ class ExecutorNode(Node):
         obs = messages.observation(msg)
         command = goal.program.step(obs, self.p["period"])
         stamp = ns + self.period_ns if now_ns is None else now_ns
-        self.last_setpoints = [(self.setpoint_pubs[f],
-                                messages.fill_pose(self.setpoints[f], xy, stamp))
-                               for f, xy in command.setpoints.items()]
-        self.answered_ns = ns
-        for publisher, setpoint in self.last_setpoints:
-            publisher.publish(setpoint)
+        self.answered.answer(ns, [(self.setpoint_pubs[f],
+                                   messages.fill_pose(self.setpoints[f], xy, stamp))
+                                  for f, xy in command.setpoints.items()])
         self._report(command, obs, ns)
         if command.termination is not None:
             self.goal = None

@@ -85,9 +85,8 @@ class MonitorNode(Node):
         self.latest: dict[str, Any] = {}
         self.buffer: dict[int, dict[str, Any]] = {}
         self.expected: dict[int, set[str]] = {}
-        self.last_ns = -1
+        self.answered = pipeline.TickAnswer()
         self.active_alarms: set[tuple[str, str]] = set()
-        self.last_status: MonitorStatus | None = None
         if p["lockstep"]:
             self.create_subscription(Tick, pipeline.TICK, self._tick, loop)
             self.participant = pipeline.Participant(self, "monitor", [pipeline.TICK],
@@ -104,16 +103,14 @@ class MonitorNode(Node):
         if not self.p["lockstep"]:
             self.latest[key] = msg
             return
-        if ns <= self.last_ns:
+        if ns <= self.answered.stamp_ns:
             return
         self.buffer.setdefault(ns, {})[key] = msg
         self._try_close(ns)
 
     def _tick(self, msg: Tick) -> None:
         ns = messages.stamp_ns(msg.header.stamp)
-        if ns == self.last_ns:
-            self.status_pub.publish(self.last_status)
-        if ns <= self.last_ns:
+        if not self.answered.is_new(ns):
             return
         self.expected[ns] = set(msg.readings)
         self._try_close(ns)
@@ -155,11 +152,9 @@ class MonitorNode(Node):
                   if (a.type, a.finger) not in self.active_alarms]
         self.active_alarms = active
         batch.append((self.state_pub, messages.patches_state_msg(out, frame)))
-        self.last_status = messages.monitor_status_msg(out, frame)
-        batch.append((self.status_pub, self.last_status))
-        self.last_ns = ns
         for publisher, msg in batch:
             publisher.publish(msg)
+        self.answered.answer(ns, [(self.status_pub, messages.monitor_status_msg(out, frame))])
 
 
 def main(args: list[str] | None = None) -> None:

@@ -165,6 +165,35 @@ def wall_timer(node: Node, period: float, callback: Callable[[], None]):
     return node.create_timer(period, callback, clock=Clock(clock_type=ClockType.STEADY_TIME))
 
 
+class TickAnswer:
+    """The lockstep bookkeeping of a node that answers each tick once: the stamp it answered
+    last and the messages it answered with.
+
+    Ticks are handled idempotently by stamp: a message of the stamp already answered (the driver
+    re-sent a lost tick) publishes the same answer again, an older one is ignored, and only a
+    newer one is new work (:meth:`is_new`).
+    """
+
+    def __init__(self) -> None:
+        self.stamp_ns = -1
+        self.messages: list[tuple[Any, Any]] = []
+
+    def is_new(self, ns: int) -> bool:
+        """True if ``ns`` is after the last answered tick; re-publish the answer if it is that
+        tick again.
+        """
+        if ns == self.stamp_ns:
+            for publisher, msg in self.messages:
+                publisher.publish(msg)
+        return ns > self.stamp_ns
+
+    def answer(self, ns: int, messages: Sequence[tuple[Any, Any]]) -> None:
+        """Record and publish the answer (publisher, message pairs) to tick ``ns``."""
+        self.stamp_ns, self.messages = ns, list(messages)
+        for publisher, msg in self.messages:
+            publisher.publish(msg)
+
+
 class Participant:
     """A node's side of the lockstep handshake: answer ``sim/hello`` once its peers are there.
 

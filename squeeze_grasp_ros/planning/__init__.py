@@ -1,0 +1,106 @@
+# Copyright 2026 squeeze_grasp_ros developers
+# SPDX-License-Identifier: Apache-2.0
+"""The planner's requests without ROS: validation, the object cache and one call per computation.
+
+The planner node (:mod:`squeeze_grasp_ros.ros.nodes.planner`) turns each service request into one
+call of this module and the result into a response with :mod:`squeeze_grasp_ros.ros.messages`.
+Everything here is plain Python and numpy, so it is tested without ROS and shared by the
+node's services and actions.
+
+Bad requests raise :class:`PlannerError` with an :class:`ErrorCode` and a message naming the
+field; :func:`classify` maps the mechanics' and the scene parser's exceptions onto the same
+codes. Long computations take a :data:`Progress` callback that is called at each stage and may
+raise :class:`Cancelled`.
+
+Units are SI and coordinates are in the object frame of the scene (x right, y up).
+"""
+
+from squeeze_grasp_ros.planning.errors import (
+    ErrorCode,
+    PlannerError,
+    Cancelled,
+    invalid,
+    classify,
+    ERROR_CODES,
+)
+from squeeze_grasp_ros.planning.objects import (
+    Limits,
+    LoadedObject,
+    SceneSource,
+    read_scene,
+    requested_nodes,
+    check_size,
+    solver_route,
+    no_progress,
+    ObjectKey,
+    object_key,
+    load_object,
+    ObjectCache,
+    load_cached,
+    CONTACT_MODELS,
+    MAX_DIRECTIONS,
+    MAX_BEST_COUNT,
+    SOLID_STAGES,
+    RING_STAGES,
+    Progress,
+)
+from squeeze_grasp_ros.planning.checks import (
+    check_number,
+    check_step,
+    best_count,
+    choice,
+    contact_nodes,
+)
+from squeeze_grasp_ros.planning.requests import (
+    SqueezePlan,
+    squeeze_plan,
+    object_grasp_map,
+    ResistancePlan,
+    resistance_plan,
+    friction_resistance,
+    RingTest,
+    ring_grasp_test,
+    event_squeeze_run,
+)
+
+__all__ = [
+    "CONTACT_MODELS",
+    "Cancelled",
+    "ERROR_CODES",
+    "ErrorCode",
+    "Limits",
+    "LoadedObject",
+    "MAX_BEST_COUNT",
+    "MAX_DIRECTIONS",
+    "ObjectCache",
+    "ObjectKey",
+    "PlannerError",
+    "Progress",
+    "RING_STAGES",
+    "ResistancePlan",
+    "RingTest",
+    "SOLID_STAGES",
+    "SceneSource",
+    "SqueezePlan",
+    "best_count",
+    "check_number",
+    "check_size",
+    "check_step",
+    "choice",
+    "classify",
+    "contact_nodes",
+    "event_squeeze_run",
+    "friction_resistance",
+    "invalid",
+    "load_cached",
+    "load_object",
+    "no_progress",
+    "object_grasp_map",
+    "object_key",
+    "read_scene",
+    "requested_nodes",
+    "resistance_plan",
+    "ring_grasp_test",
+    "solver_route",
+    "squeeze_plan",
+]

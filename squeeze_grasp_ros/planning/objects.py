@@ -1,0 +1,387 @@
+# Copyright 2026 squeeze_grasp_ros developers
+# SPDX-License-Identifier: Apache-2.0
+"""Limits of the planner, scene sources and the object cache (a bounded LRU of loaded objects)."""
+
+from __future__ import annotations
+
+import hashlib
+import math
+import threading
+import time
+from collections import OrderedDict
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from squeeze_grasp_ros.inputs import InputError, confine, load_yaml, read_text
+from squeeze_grasp_ros.mechanics.elastic.compliance import ROUTES, ElasticObject
+from squeeze_grasp_ros.mechanics.ring.model import RingModel
+from squeeze_grasp_ros.scene import (
+    Scene,
+    build_mesh,
+    build_outline,
+    build_ring,
+    finger_nodes,
+    parse_scene,
+    scene_material,
+)
+from squeeze_grasp_ros.planning.errors import ErrorCode, PlannerError, invalid
+
+
+CONTACT_MODELS: tuple[str, ...] = ("point", "segment", "friction")
+MAX_DIRECTIONS = 100_000
+"""Most push directions one resistance sweep may ask for."""
+MAX_BEST_COUNT = 100_000
+"""Most placements one grasp map may return as candidates."""
+SOLID_STAGES: tuple[str, ...] = ("mesh", "stiffness", "factorisation", "boundary compliance")
+RING_STAGES: tuple[str, ...] = ("ring model", "compliance")
+
+Progress = Callable[[str, int, int, int], None]
+"""Called as ``progress(stage, index, count, num_nodes)`` when a stage starts; may raise
+:class:`Cancelled` to stop the computation."""
+
+
+# --------------------------------------------------------------------------- limits and objects
+
+
+@dataclass(frozen=True)
+class Limits:
+    """What the node accepts (its parameters).
+
+    Attributes
+    ----------
+    max_nodes : int
+        Largest solid mesh, nodes; larger scenes are refused before and after meshing.
+    max_spectral_nodes : int
+        Largest mesh for the dense spectral route (O(n^3) time, O(n^2) memory).
+    max_ring_elements : int
+        Largest ring model, elements (its compliance is dense).
+    default_route : str
+        Solver route used when a request leaves it empty.
+    best_count : int
+        Placements a grasp map returns when a request asks for 0.
+    min_step : float
+        Smallest event-squeeze substep relative to the object size.
+    """
+
+    max_nodes: int = 60_000
+    max_spectral_nodes: int = 3_000
+    max_ring_elements: int = 1_000
+    default_route: str = "factorized"
+    best_count: int = 10
+    min_step: float = 1e-5
+
+
+@dataclass(frozen=True)
+class LoadedObject:
+    """An object with its precomputed mechanics, as the planner caches it.
+
+    Attributes
+    ----------
+    object_id : str
+    scene : Scene
+        The validated scene it came from (fingers, friction, limits, squeeze defaults).
+    body : ElasticObject or RingModel
+        Precomputed: factorisation and boundary compliance (solid) or compliance (ring).
+    finger_nodes : (int, int)
+        Initial contact nodes of F1, F2 from the scene's placements.
+    digest : str
+        SHA-256 of the scene text and the solver route: same digest, same object.
+    precompute_time : float
+        Wall time of meshing and precompute, s.
+    """
+
+    object_id: str
+    scene: Scene
+    body: ElasticObject | RingModel
+    finger_nodes: tuple[int, int]
+    digest: str
+    precompute_time: float
+
+    @property
+    def model(self) -> str:
+        """Body model: "solid" (FEM mesh) or "ring" (curved beam)."""
+        return "ring" if isinstance(self.body, RingModel) else "solid"
+
+    @property
+    def num_nodes(self) -> int:
+        """Mesh nodes (solid) or ring nodes."""
+        return int(self.body.n) if self.model == "ring" else int(self.body.mesh.n)
+
+    @property
+    def boundary(self) -> np.ndarray:
+        """Nodes a finger can touch: the outer boundary loop (solid) or every ring node."""
+        return self.body.boundary if self.model == "ring" else self.body.mesh.boundary
+
+    def solid(self) -> ElasticObject:
+        """The FEM object; a ring raises INVALID_ARGUMENT naming the service to use."""
+        if not isinstance(self.body, ElasticObject):
+            raise invalid(
+                f"object {self.object_id!r} is a ring model (Sec. 7): use the "
+                "ring_grasp_test service"
+            )
+        return self.body
+
+    def ring(self) -> RingModel:
+        """The ring model; a solid raises INVALID_ARGUMENT."""
+        if not isinstance(self.body, RingModel):
+            raise invalid(
+                f"object {self.object_id!r} is a solid (object.model: solid), not a ring"
+            )
+        return self.body
+
+
+@dataclass(frozen=True)
+class SceneSource:
+    """A validated scene with the text it came from.
+
+    Attributes
+    ----------
+    scene : Scene
+    text : str
+        The YAML text (the file's content for a path).
+    """
+
+    scene: Scene
+    text: str
+
+
+def read_scene(
+    scene_yaml: str, scene_path: str, roots: Sequence[str | Path] | None = None
+) -> SceneSource:
+    """Parse the scene of a request: exactly one of YAML text and a file path.
+
+    Parameters
+    ----------
+    scene_yaml, scene_path : str
+        The request's fields; exactly one is non-empty.
+    roots : sequence of path-like, optional
+        Folders that ``scene_path`` and an outline file named by the scene must lie in (after
+        following symlinks and ``..``); None allows any path.
+
+    Raises
+    ------
+    PlannerError
+        INVALID_ARGUMENT for neither or both, paths outside ``roots``, unreadable or oversized
+        files, YAML aliases, bad YAML or a bad scene (the message names the field and never
+        quotes a file's contents).
+    """
+    if bool(scene_yaml) == bool(scene_path):
+        raise invalid("give exactly one of scene_yaml and scene_path")
+    try:
+        if scene_path:
+            path = (
+                confine(scene_path, roots, what="scene_path")
+                if roots is not None
+                else Path(scene_path)
+            )
+            text = read_text(path, what="scene_path")
+            data, base_dir = load_yaml(text, what="scene_path"), path.parent
+        else:
+            text = scene_yaml
+            data, base_dir = load_yaml(scene_yaml, what="scene_yaml"), None
+        scene = parse_scene(data, base_dir=base_dir)
+        shape = scene.object.shape
+        if roots is not None and shape["type"] == "file":
+            confine(shape["path"], roots, what="object.shape.path")
+    except InputError as exc:
+        raise invalid(str(exc)) from None
+    return SceneSource(scene, text)
+
+
+def requested_nodes(scene: Scene) -> int | None:
+    """Nodes the scene asks for before anything is built; None for the mesher's default size.
+
+    A ring asks for ``object.ring.elements``; a solid for ``object.mesh.nodes``, or about
+    0.8 * area / max_area for ``object.mesh.max_area`` (the inverse of
+    :func:`~.mechanics.mesh.target_max_area`).
+    """
+    obj = scene.object
+    if obj.model == "ring":
+        return obj.ring.elements
+    if obj.mesh.nodes is not None:
+        return obj.mesh.nodes
+    if obj.mesh.max_area is None:
+        return None
+    area = build_outline(obj.shape).area
+    return math.ceil(0.8 * area / min(obj.mesh.max_area, 0.25 * area))
+
+
+def check_size(count: int | None, limit: int, what: str) -> None:
+    """Refuse a model with more than ``limit`` nodes (INVALID_ARGUMENT, oversized)."""
+    if count is not None and count > limit:
+        raise invalid(
+            f"oversized {what}: {count} nodes, more than the planner's limit of "
+            f"{limit} (parameter); coarsen object.mesh or object.ring"
+        )
+
+
+def solver_route(route: str, limits: Limits) -> str:
+    """The request's solver route, or the node's default when empty."""
+    route = route or limits.default_route
+    if route not in ROUTES:
+        raise invalid(f"solver_route must be one of {list(ROUTES)} or empty, got {route!r}")
+    return route
+
+
+def no_progress(stage: str, index: int, count: int, num_nodes: int) -> None:
+    """A :data:`Progress` that ignores every stage."""
+
+
+@dataclass(frozen=True)
+class ObjectKey:
+    """Where and how a scene's object is built.
+
+    Attributes
+    ----------
+    object_id : str
+        The request's id, else the scene's name, else ``object-<digest prefix>``.
+    route : str
+        Solver route (the node's default when the request leaves it empty).
+    digest : str
+        SHA-256 of the route and the scene text: same digest, same object.
+    """
+
+    object_id: str
+    route: str
+    digest: str
+
+
+def object_key(source: SceneSource, object_id: str, route: str, limits: Limits) -> ObjectKey:
+    """The :class:`ObjectKey` of a load request."""
+    route = solver_route(route, limits)
+    digest = hashlib.sha256(f"{route}\0{source.text}".encode()).hexdigest()
+    return ObjectKey(object_id or source.scene.name or f"object-{digest[:12]}", route, digest)
+
+
+def load_object(
+    source: SceneSource, key: ObjectKey, limits: Limits, progress: Progress = no_progress
+) -> LoadedObject:
+    """Build and precompute the object of a scene, stage by stage.
+
+    Parameters
+    ----------
+    source : SceneSource
+        The scene (see :func:`read_scene`).
+    key : ObjectKey
+        Id, solver route (rings ignore it) and digest (see :func:`object_key`).
+    limits : Limits
+    progress : Progress
+        Called with :data:`SOLID_STAGES` or :data:`RING_STAGES` as they start.
+
+    Raises
+    ------
+    PlannerError
+        INVALID_ARGUMENT for an oversized or invalid model, CANCELLED from ``progress``.
+    """
+    scene = source.scene
+    start = time.perf_counter()
+    if scene.object.model == "ring":
+        check_size(requested_nodes(scene), limits.max_ring_elements, "ring model")
+        progress(RING_STAGES[0], 0, len(RING_STAGES), 0)
+        body = build_ring(scene)
+        progress(RING_STAGES[1], 1, len(RING_STAGES), body.n)
+        body.precompute()
+        nodes = finger_nodes(scene, body)
+    else:
+        limit = limits.max_nodes if key.route == "factorized" else limits.max_spectral_nodes
+        check_size(requested_nodes(scene), limit, f"{key.route} mesh")
+        progress(SOLID_STAGES[0], 0, len(SOLID_STAGES), 0)
+        mesh = build_mesh(scene)
+        check_size(mesh.n, limit, f"{key.route} mesh")
+        body = ElasticObject(mesh, scene_material(scene), key.route)
+        progress(SOLID_STAGES[1], 1, len(SOLID_STAGES), mesh.n)
+        _ = body.stiffness
+        progress(SOLID_STAGES[2], 2, len(SOLID_STAGES), mesh.n)
+        _ = body.solver
+        progress(SOLID_STAGES[3], 3, len(SOLID_STAGES), mesh.n)
+        body.precompute()
+        nodes = finger_nodes(scene, mesh)
+    return LoadedObject(key.object_id, scene, body, nodes, key.digest, time.perf_counter() - start)
+
+
+class ObjectCache:
+    """Loaded objects by id, least recently used evicted first; safe to share between threads.
+
+    Parameters
+    ----------
+    capacity : int
+        Most objects kept (>= 1).
+    """
+
+    def __init__(self, capacity: int) -> None:
+        if capacity < 1:
+            raise ValueError(f"cache capacity must be >= 1, got {capacity}")
+        self.capacity = capacity
+        self._objects: OrderedDict[str, LoadedObject] = OrderedDict()
+        self._lock = threading.Lock()
+
+    def get(self, object_id: str) -> LoadedObject:
+        """The object loaded under ``object_id`` (now the most recently used).
+
+        Raises
+        ------
+        PlannerError
+            UNKNOWN_OBJECT. The message does not list the loaded ids: they belong to other
+            clients.
+        """
+        with self._lock:
+            loaded = self._objects.get(object_id)
+            if loaded is None:
+                raise PlannerError(
+                    ErrorCode.UNKNOWN_OBJECT,
+                    f"unknown object_id {object_id!r}: load it first with "
+                    "load_object (objects are evicted when the cache is full)",
+                )
+            self._objects.move_to_end(object_id)
+            return loaded
+
+    def find(self, object_id: str, digest: str) -> LoadedObject | None:
+        """The object under ``object_id`` if it was built from the same scene and route."""
+        with self._lock:
+            loaded = self._objects.get(object_id)
+            if loaded is None or loaded.digest != digest:
+                return None
+            self._objects.move_to_end(object_id)
+            return loaded
+
+    def put(self, loaded: LoadedObject) -> list[str]:
+        """Store ``loaded`` (replacing an object of the same id); return the evicted ids."""
+        with self._lock:
+            self._objects[loaded.object_id] = loaded
+            self._objects.move_to_end(loaded.object_id)
+            evicted = []
+            while len(self._objects) > self.capacity:
+                evicted.append(self._objects.popitem(last=False)[0])
+            return evicted
+
+    def ids(self) -> list[str]:
+        """Loaded ids, least recently used first."""
+        with self._lock:
+            return list(self._objects)
+
+
+def load_cached(
+    cache: ObjectCache,
+    source: SceneSource,
+    object_id: str,
+    route: str,
+    limits: Limits,
+    progress: Progress = no_progress,
+) -> tuple[LoadedObject, bool]:
+    """The cached object of the same id, scene and route, or a freshly loaded and cached one.
+
+    Returns
+    -------
+    (LoadedObject, bool)
+        The object and whether it came from the cache.
+    """
+    key = object_key(source, object_id, route, limits)
+    cached = cache.find(key.object_id, key.digest)
+    if cached is not None:
+        return cached, True
+    loaded = load_object(source, key, limits, progress)
+    cache.put(loaded)
+    return loaded, False

@@ -1,0 +1,328 @@
+# Copyright 2026 squeeze_grasp_ros developers
+# SPDX-License-Identifier: Apache-2.0
+"""One call per computation: squeezes, grasp maps, resistance, ring tests, event squeezes."""
+
+from __future__ import annotations
+
+import dataclasses
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from squeeze_grasp_ros.mechanics.squeeze.graspmap import GraspMap, grasp_map
+from squeeze_grasp_ros.mechanics.elastic.reduced import boundary_displacement, reduced_stiffness
+from squeeze_grasp_ros.mechanics.resistance.optimal import (
+    Resistance,
+    ResistanceSweep,
+    contact_segments,
+    optimal_resistance,
+    resistance_grasp,
+    sweep_directions,
+)
+from squeeze_grasp_ros.mechanics.resistance.frictional import (
+    FrictionalResistance,
+    add_adversary,
+    frictional_resistance,
+)
+from squeeze_grasp_ros.mechanics.ring.grasp_map import RingGraspMap, ring_grasp_map
+from squeeze_grasp_ros.mechanics.ring.squeeze import RingGrasp, ring_grasp
+from squeeze_grasp_ros.mechanics.squeeze.stable_pure import Squeeze, force_closure, plan_squeeze
+from squeeze_grasp_ros.mechanics.squeeze.events import EventSqueeze
+from squeeze_grasp_ros.scene_events import event_squeeze_scene, scene_contact_model
+from squeeze_grasp_ros.mechanics.vocabulary import Finger, SqueezeKind
+from squeeze_grasp_ros.planning.errors import invalid
+from squeeze_grasp_ros.planning.objects import CONTACT_MODELS, Limits, LoadedObject, MAX_DIRECTIONS
+from squeeze_grasp_ros.planning.checks import check_number, check_step, choice, contact_nodes
+
+
+# --------------------------------------------------------------------------- computations
+
+
+@dataclass(frozen=True)
+class SqueezePlan:
+    """A stable or pure squeeze at point contacts, scaled to the requested depth.
+
+    Attributes
+    ----------
+    squeeze : Squeeze
+        The unit squeeze (mechanics API).
+    scale : float
+        rho, m, that multiplies the unit displacement and the forces per unit depth: the
+        requested depth, or 1 for a unit squeeze (depth 0).
+    boundary_displacement : (b, 2) ndarray
+        Displacement of the outer-boundary nodes at ``scale``, m.
+    force_closure : bool
+        Two-finger force closure at the scene's mu (False unless there are 2 contacts).
+    """
+
+    squeeze: Squeeze
+    scale: float
+    boundary_displacement: np.ndarray
+    force_closure: bool
+
+
+def squeeze_plan(
+    loaded: LoadedObject, contacts: Sequence[int], kind: str, depth: float
+) -> SqueezePlan:
+    """Plan a stable or pure squeeze (:func:`~.mechanics.squeeze.plan_squeeze`).
+
+    Parameters
+    ----------
+    loaded : LoadedObject
+        A solid.
+    contacts : sequence of int
+        Contact nodes (2 or more); empty = the scene's F1, F2.
+    kind : {"stable", "pure"}
+    depth : float
+        rho, m, >= 0; 0 = unit squeeze.
+    """
+    obj = loaded.solid()
+    kind = choice("squeeze_type", kind, SqueezeKind.values())
+    scale = check_number("depth", depth, 0.0) or 1.0
+    nodes = contact_nodes(loaded, contacts, default=loaded.finger_nodes)
+    red = reduced_stiffness(obj, nodes)
+    sq = plan_squeeze(obj, nodes, kind=kind, red=red)
+    relative = sq.relative_depth(scale)
+    if depth and len(nodes) == 2 and not relative < 1.0:
+        raise invalid(
+            f"depth {depth:.6g} m is a relative depth of {relative:.6g}: it must be "
+            "below 1 (at 1 the fingers would meet)"
+        )
+    closure = False
+    if len(nodes) == 2:
+        mesh = obj.mesh
+        i, j = (int(n) for n in nodes)
+        closure = force_closure(
+            mesh.nodes[i], mesh.normal_at(i), mesh.nodes[j], mesh.normal_at(j), loaded.scene.mu
+        )
+    return SqueezePlan(
+        sq, scale, boundary_displacement(obj, red, scale * sq.displacement), closure
+    )
+
+
+def object_grasp_map(loaded: LoadedObject, mu: float) -> GraspMap:
+    """All-pairs grasp map of a solid (:func:`~.mechanics.graspmap.grasp_map`); mu >= 0."""
+    return grasp_map(loaded.solid(), check_number("mu", mu, 0.0))
+
+
+@dataclass(frozen=True)
+class ResistancePlan:
+    """An optimal resistance and, when asked, the sweep over push directions.
+
+    Attributes
+    ----------
+    resistance : Resistance or FrictionalResistance
+        Fixed contacts (Sec. 6.1-6.2) or Algorithm 2 under friction (Sec. 6.3).
+    sweep : ResistanceSweep or None
+    """
+
+    resistance: Resistance | FrictionalResistance
+    sweep: ResistanceSweep | None
+
+
+def resistance_plan(
+    loaded: LoadedObject,
+    contacts: Sequence[int],
+    a: Sequence[float],
+    mode: str,
+    contact_model: str,
+    half_width: float,
+    directions: int,
+    tip_radius: float,
+    limits: Limits,
+) -> ResistancePlan:
+    """Optimal resistance to the adversary translation ``a`` (Sec. 6).
+
+    Parameters
+    ----------
+    loaded : LoadedObject
+        A solid.
+    contacts : sequence of int
+        Initial contact nodes of F1, F2, A.
+    a : (x, y, z)
+        Adversary translation, m; z must be 0.
+    mode : {"stable", "pure"}
+    contact_model : {"point", "segment", "friction"}
+    half_width : float
+        Segment half width, m (>= 0; 0 = the node and its two neighbours).
+    directions : int
+        Push directions to sweep (0 = none; fixed contacts only).
+    tip_radius : float
+        Friction: A's fingertip radius, m (0 = the scene's adversary tip radius).
+    limits : Limits
+        Friction: the scene's squeeze step must be >= ``limits.min_step``.
+    """
+    obj = loaded.solid()
+    mode = choice("mode", mode, SqueezeKind.values())
+    contact_model = choice("contact_model", contact_model, CONTACT_MODELS)
+    x, y, z = (check_number(f"a.{k}", v) for k, v in zip("xyz", a))
+    if z != 0.0:
+        raise invalid(f"a.z must be 0 (planar objects), got {z}")
+    width = check_number("segment_half_width", half_width, 0.0)
+    count = int(check_number("directions", directions, 0, MAX_DIRECTIONS))
+    nodes = contact_nodes(loaded, contacts, count=3)
+    if contact_model == "friction":
+        if count:
+            raise invalid("directions: the sweep needs point or segment contacts")
+        return ResistancePlan(
+            friction_resistance(loaded, nodes, (x, y), mode, tip_radius, limits), None
+        )
+    if contact_model == "point":
+        sets = [[int(n)] for n in nodes]
+    else:
+        sets = contact_segments(obj.mesh, nodes.tolist(), width or None)
+    grasp = resistance_grasp(obj, dict(zip(tuple(Finger), sets)))
+    sweep = sweep_directions(grasp, mode, count) if count else None
+    return ResistancePlan(optimal_resistance(grasp, (x, y), mode=mode), sweep)
+
+
+def friction_resistance(
+    loaded: LoadedObject,
+    nodes: np.ndarray,
+    a: tuple[float, float],
+    mode: str,
+    tip_radius: float,
+    limits: Limits,
+) -> FrictionalResistance:
+    """Algorithm 2 after the scene's event-driven squeeze at F1, F2 (Sec. 6.3)."""
+    scene = loaded.scene
+    radius = check_number("adversary_tip_radius", tip_radius, 0.0)
+    radius = radius or (scene.adversary.tip_radius if scene.adversary is not None else 0.0)
+    if not radius > 0:
+        raise invalid(
+            "adversary_tip_radius must be > 0 m for friction contacts (the scene "
+            "gives no adversary tip radius)"
+        )
+    check_step(scene.squeeze.step, limits)
+    obj = loaded.solid()
+    i, j, k = (int(n) for n in nodes)
+    squeeze = event_squeeze_scene(scene, obj, (i, j))
+    model = scene_contact_model(scene, obj)
+    state = add_adversary(squeeze.state, model, squeeze.displacement, k, radius)
+    return frictional_resistance(
+        model,
+        state,
+        a,
+        mode=mode,
+        step=squeeze.step,
+        event_tol=squeeze.event_tol,
+        contacts=[i, j, k],
+    )
+
+
+@dataclass(frozen=True)
+class RingTest:
+    """A ring grasp test at one placement and, when asked, the map of every placement.
+
+    Attributes
+    ----------
+    grasp : RingGrasp
+    depth : float
+        rho at the requested relative depth, m.
+    feasible : bool
+        The squeeze is feasible up to that depth.
+    map : RingGraspMap or None
+    """
+
+    grasp: RingGrasp
+    depth: float
+    feasible: bool
+    map: RingGraspMap | None
+
+
+def ring_grasp_test(
+    loaded: LoadedObject,
+    contacts: Sequence[int],
+    kind: str,
+    mu: float,
+    strain_limit: float,
+    relative_depth: float,
+    all_pairs: bool,
+) -> RingTest:
+    """Grasp test of a ring (:func:`~.mechanics.ring_squeeze.ring_grasp`, Sec. 7).
+
+    Parameters
+    ----------
+    loaded : LoadedObject
+        A ring.
+    contacts : sequence of int
+        Ring nodes of F1, F2; empty = the scene's placements.
+    kind : {"stable", "pure"}
+    mu : float
+        Friction coefficient, >= 0.
+    strain_limit : float
+        epsilon* > 0, or 0 for none.
+    relative_depth : float
+        Requested relative depth in [0, 1].
+    all_pairs : bool
+        Also map every placement (:func:`~.mechanics.ring_map.ring_grasp_map`).
+    """
+    ring = loaded.ring()
+    kind = choice("squeeze_type", kind, SqueezeKind.values())
+    mu = check_number("mu", mu, 0.0)
+    epsilon = check_number("strain_limit", strain_limit, 0.0) or None
+    relative = check_number("relative_depth", relative_depth, 0.0, 1.0)
+    nodes = contact_nodes(loaded, contacts, count=2, default=loaded.finger_nodes)
+    grasp = ring_grasp(ring, nodes, mu, epsilon=epsilon, kind=kind)
+    depth = grasp.depth_for_relative(relative)
+    gmap = (
+        ring_grasp_map(
+            ring, mu, epsilon=epsilon, kind=kind, requested_relative_depth=relative or None
+        )
+        if all_pairs
+        else None
+    )
+    return RingTest(grasp, depth, grasp.feasible_at(depth), gmap)
+
+
+def event_squeeze_run(
+    loaded: LoadedObject,
+    contacts: Sequence[int],
+    kind: str,
+    depth: float,
+    relative_depth: float,
+    step: float,
+    event_tol: float,
+    limits: Limits,
+    progress: Callable[[float], None] | None = None,
+) -> EventSqueeze:
+    """The scene's event-driven squeeze (Algorithm 1) with the request's overrides.
+
+    Parameters
+    ----------
+    loaded : LoadedObject
+        A solid whose scene has rounded fingertips.
+    contacts : sequence of int
+        F1, F2 initial contact nodes; empty = the scene's placements.
+    kind : str
+        "stable", "pure", or "" for the scene's squeeze type.
+    depth, relative_depth : float
+        At most one > 0 (rho in m, or the fraction); both 0 = the scene's depth.
+    step, event_tol : float
+        Relative to the object size; 0 = the scene's. ``step`` must be >= ``limits.min_step``.
+    limits : Limits
+    progress : callable, optional
+        Called with the completed fraction; may raise :class:`Cancelled`.
+    """
+    obj = loaded.solid()
+    scene = loaded.scene
+    kind = choice("squeeze_type", kind, SqueezeKind.values(), scene.squeeze.type)
+    depth = check_number("depth", depth, 0.0)
+    relative_depth = check_number("relative_depth", relative_depth, 0.0, 1.0)
+    if depth and relative_depth:
+        raise invalid("give at most one of depth and relative_depth (0 = the scene's)")
+    step = check_step(check_number("step", step, 0.0) or scene.squeeze.step, limits)
+    event_tol = check_number("event_tol", event_tol, 0.0) or scene.squeeze.event_tol
+    nodes = contact_nodes(loaded, contacts, count=2, default=loaded.finger_nodes)
+    scene = dataclasses.replace(scene, squeeze=dataclasses.replace(scene.squeeze, type=kind))
+    return event_squeeze_scene(
+        scene,
+        obj,
+        (int(nodes[0]), int(nodes[1])),
+        depth=depth or None,
+        relative_depth=relative_depth or None,
+        step=step,
+        event_tol=event_tol,
+        progress=progress,
+    )

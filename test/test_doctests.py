@@ -16,10 +16,7 @@ import pytest
 import squeeze_grasp_ros
 from squeeze_grasp_ros import api
 
-EXEMPT: dict[str, str] = {
-    "frictional_resistance": "needs a whole event-driven squeeze and an adversary as input; "
-                             "covered by test_resistance_friction.py",
-}
+EXEMPT: dict[str, str] = {}
 """Public functions without their own example, and why."""
 
 

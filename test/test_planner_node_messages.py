@@ -101,6 +101,29 @@ def test_object_cache_evicts_the_least_recently_used() -> None:
         cache.get("b")
 
 
+def test_object_cache_is_bounded_by_memory() -> None:
+    """The cache counts the arrays an object holds (its boundary compliance, stiffness and
+    factorisation dominate) and evicts by bytes; one object larger than the bound is refused.
+    """
+    limits = planning.Limits()
+    source = planning.read_scene(BLOB, "")
+    loaded = planning.load_object(source, planning.object_key(source, "a", "", limits), limits)
+    body = loaded.body
+    size = planning.resident_bytes(loaded)
+    known = body.boundary_compliance.nbytes + body.stiffness.data.nbytes + body.mesh.nodes.nbytes
+    assert known <= size < 20 * known
+    assert planning.resident_bytes({"x": body, "y": [body]}) == planning.resident_bytes(body)
+    cache = planning.ObjectCache(8, max_bytes=int(1.5 * size))
+    cache.put(loaded)
+    other = planning.load_object(source, planning.object_key(source, "b", "", limits), limits)
+    assert cache.put(other) == ["a"] and cache.ids() == ["b"]
+    assert cache.bytes == planning.resident_bytes(other.body)
+    tiny = planning.ObjectCache(8, max_bytes=size // 2)
+    with pytest.raises(planning.PlannerError, match="cache_max_megabytes") as info:
+        tiny.put(loaded)
+    assert info.value.code == planning.ErrorCode.INVALID_ARGUMENT and tiny.ids() == []
+
+
 def test_requested_nodes_are_known_before_meshing() -> None:
     assert planning.requested_nodes(scene_of(BLOB)) == 300
     assert planning.requested_nodes(scene_of(RING)) == 80

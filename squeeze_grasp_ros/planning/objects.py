@@ -14,6 +14,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
+import scipy.sparse as sp
 
 from squeeze_grasp_ros.inputs import InputError, confine, load_yaml, read_text
 from squeeze_grasp_ros.mechanics.elastic.compliance import ROUTES, ElasticObject
@@ -302,6 +303,37 @@ def load_object(
     return LoadedObject(key.object_id, scene, body, nodes, key.digest, time.perf_counter() - start)
 
 
+def resident_bytes(value: object) -> int:
+    """Bytes of the arrays an object holds: numpy arrays, scipy sparse matrices and SuperLU
+    factors reached through dataclass fields, instance and cached-property dicts, and
+    containers, each counted once. Python object overhead is not counted (it is small next to
+    a mesh's compliance and factorisation).
+    """
+    seen: set[int] = set()
+    stack, total = [value], 0
+    while stack:
+        item = stack.pop()
+        if id(item) in seen or item is None or isinstance(item, (str, bytes, int, float, bool)):
+            continue
+        seen.add(id(item))
+        if isinstance(item, np.ndarray):
+            total += item.nbytes
+        elif sp.issparse(item):
+            total += sum(getattr(item, a).nbytes for a in ("data", "indices", "indptr", "row",
+                                                           "col") if hasattr(item, a))
+        elif type(item).__name__ == "SuperLU":
+            total += 12 * item.nnz + 8 * 2 * item.shape[0]
+        elif isinstance(item, dict):
+            stack.extend(item.values())
+        elif isinstance(item, (list, tuple, set, frozenset)):
+            stack.extend(item)
+        elif hasattr(item, "__dict__") or hasattr(item, "__slots__"):
+            stack.extend(getattr(item, "__dict__", {}).values())
+            stack.extend(getattr(item, s) for s in getattr(item, "__slots__", ())
+                         if hasattr(item, s))
+    return total
+
+
 class ObjectCache:
     """Loaded objects by id, least recently used evicted first; safe to share between threads.
 
@@ -309,14 +341,27 @@ class ObjectCache:
     ----------
     capacity : int
         Most objects kept (>= 1).
+    max_bytes : int, optional
+        Most bytes of arrays (:func:`resident_bytes`) kept; least recently used objects are
+        evicted until the cache fits, and an object larger than this alone is refused.
     """
 
-    def __init__(self, capacity: int) -> None:
+    def __init__(self, capacity: int, max_bytes: int | None = None) -> None:
         if capacity < 1:
             raise ValueError(f"cache capacity must be >= 1, got {capacity}")
+        if max_bytes is not None and max_bytes < 1:
+            raise ValueError(f"cache max_bytes must be >= 1, got {max_bytes}")
         self.capacity = capacity
+        self.max_bytes = max_bytes
         self._objects: OrderedDict[str, LoadedObject] = OrderedDict()
+        self._bytes: dict[str, int] = {}
         self._lock = threading.Lock()
+
+    @property
+    def bytes(self) -> int:
+        """Bytes of arrays held by the cached objects."""
+        with self._lock:
+            return sum(self._bytes.values())
 
     def get(self, object_id: str) -> LoadedObject:
         """The object loaded under ``object_id`` (now the most recently used).
@@ -348,13 +393,32 @@ class ObjectCache:
             return loaded
 
     def put(self, loaded: LoadedObject) -> list[str]:
-        """Store ``loaded`` (replacing an object of the same id); return the evicted ids."""
+        """Store ``loaded`` (replacing an object of the same id); return the evicted ids.
+
+        Raises
+        ------
+        PlannerError
+            INVALID_ARGUMENT if the object alone needs more than ``max_bytes``.
+        """
+        size = resident_bytes(loaded.body)
+        if self.max_bytes is not None and size > self.max_bytes:
+            raise PlannerError(
+                ErrorCode.INVALID_ARGUMENT,
+                f"object {loaded.object_id!r} needs {size / 2**20:.0f} MiB, more than the "
+                f"cache allows ({self.max_bytes / 2**20:.0f} MiB, planner parameter "
+                "cache_max_megabytes); use a coarser mesh",
+            )
         with self._lock:
             self._objects[loaded.object_id] = loaded
+            self._bytes[loaded.object_id] = size
             self._objects.move_to_end(loaded.object_id)
             evicted = []
-            while len(self._objects) > self.capacity:
-                evicted.append(self._objects.popitem(last=False)[0])
+            while len(self._objects) > self.capacity or (
+                    self.max_bytes is not None and len(self._objects) > 1
+                    and sum(self._bytes.values()) > self.max_bytes):
+                old, _ = self._objects.popitem(last=False)
+                del self._bytes[old]
+                evicted.append(old)
             return evicted
 
     def ids(self) -> list[str]:

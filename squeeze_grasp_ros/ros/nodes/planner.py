@@ -64,6 +64,8 @@ PARAMETERS: dict[str, tuple[Any, str]] = {
     "default_solver_route": ("factorized", "solver route when a request leaves it empty: "
                                            "factorized or spectral"),
     "cache_size": (8, "objects kept in the cache; the least recently used is evicted"),
+    "cache_max_megabytes": (2048, "MiB of arrays (meshes, factorisations, compliances) the "
+                                  "cache keeps; least recently used objects are evicted"),
     "worker_threads": (2, "threads computing long requests (loads, maps, event squeezes)"),
     "best_count": (10, "placements a grasp map returns when a request asks for 0"),
     "min_step": (1e-5, "smallest event-squeeze substep, relative to the object size"),
@@ -105,7 +107,8 @@ class PlannerNode(Node):
                              best_count=value("best_count"), min_step=float(value("min_step")))
         roots = [Path(r) for r in value("allowed_roots") if r] or [share_dir(), Path.cwd()]
         self.roots = list(dict.fromkeys(r.resolve() for r in roots))
-        self.cache = planning.ObjectCache(value("cache_size"))
+        self.cache = planning.ObjectCache(value("cache_size"),
+                                          int(value("cache_max_megabytes")) * 2**20)
         self._pool = ThreadPoolExecutor(max_workers=value("worker_threads"),
                                         thread_name_prefix="planner-worker")
         self._stopping = threading.Event()

@@ -76,6 +76,9 @@ class Termination(_Name):
     PICKED_UP = "picked_up"
     CONTACT_LOST = "contact_lost"
     """A contact break (Event B) would leave a finger with no contact node; not applied."""
+    ELEMENT_INVERTED = "element_inverted"
+    """An element of the object turned inside out (det F <= 0): the material model has left
+    its range, so the squeeze cannot go deeper. Always checked, whatever the scene declares."""
 
 
 class SqueezeKind(_Name):

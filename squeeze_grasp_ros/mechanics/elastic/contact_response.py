@@ -25,7 +25,8 @@ from dataclasses import dataclass, field
 import numpy as np
 import scipy.sparse.linalg as spla
 
-from squeeze_grasp_ros.mechanics.elastic.hyperelastic import assemble, deformation
+from squeeze_grasp_ros.mechanics.elastic.hyperelastic import (area_ratios, assemble,
+                                                                gradient_operator)
 from squeeze_grasp_ros.mechanics.errors import InvalidInputError
 from squeeze_grasp_ros.mechanics.vocabulary import MaterialModel
 
@@ -36,6 +37,9 @@ NEWTON_TOL = 1e-10
 DISPLACEMENT_FLOOR = 1e-6
 """Contact displacements (/ L) below this are measured against it in the tolerance above, so
 round-off of an almost undeformed state does not count as a residual."""
+MIN_AREA_RATIO = 1e-8
+"""States whose smallest element area ratio det F is below this count as inverted: it keeps
+every accepted state clear of the round-off at which assembly would find det F <= 0."""
 MAX_ITERATIONS = 25
 MAX_SUBSTEPS = 64
 REUSE_CONTRACTION = 0.25
@@ -72,10 +76,21 @@ class Evaluation:
 
 @dataclass(frozen=True)
 class ResponseFailure:
-    """Why no equilibrium was found (a value: callers try smaller steps)."""
+    """Why no equilibrium was found (a value: callers try smaller steps).
+
+    Attributes
+    ----------
+    reason : str
+    residual : float
+        Relative interior residual of the last iterate (inf when none was computed).
+    inverted : bool
+        Every state tried had an inverted element (det F <= 0): the contact displacement is
+        beyond what the object can take, not a solver failure.
+    """
 
     reason: str
     residual: float = float("inf")
+    inverted: bool = False
 
 
 @dataclass
@@ -115,6 +130,7 @@ class ContactResponse:
         n2 = 2 * len(self.nodes)
         self.cdofs = np.stack([2 * self.contacts, 2 * self.contacts + 1], 1).reshape(-1)
         self.free = np.setdiff1d(np.arange(n2), self.cdofs)
+        self._gradient = gradient_operator(self.nodes, self.triangles)
         if self._u is None:
             self._u = np.zeros(n2)
             self._delta = np.zeros((len(self.contacts), 2))
@@ -143,8 +159,7 @@ class ContactResponse:
 
     # ------------------------------------------------------------------ helpers
     def _min_det(self, u: np.ndarray) -> float:
-        F = deformation(self.nodes, self.triangles, u)
-        return float((F[:, 0, 0] * F[:, 1, 1] - F[:, 0, 1] * F[:, 1, 0]).min())
+        return float(area_ratios(self._gradient, u).min())
 
     def _newton(self, u: np.ndarray, delta: np.ndarray):
         """Equilibrium of the free DOFs with the contact DOFs at ``delta``; (u, assembly, its,
@@ -152,8 +167,9 @@ class ContactResponse:
         """
         u = u.copy()
         u[self.cdofs] = delta.reshape(-1)
-        if self._min_det(u) <= 0:
-            return ResponseFailure("the prescribed contact displacement inverts an element")
+        if self._min_det(u) <= MIN_AREA_RATIO:
+            return ResponseFailure("the prescribed contact displacement inverts an element",
+                                   inverted=True)
         asm = assemble(self.model, self.nodes, self.triangles, u, nu=self.nu)
         stiffness = abs(asm.tangent).max()
         scale = max(np.linalg.norm(asm.force[self.cdofs]),
@@ -169,10 +185,12 @@ class ContactResponse:
                 self.stats["factorizations"] += 1
             step = -lu.solve(r)
             its += 1
+            inverted = True
             for _ in range(BACKTRACKS):
                 trial = u.copy()
                 trial[self.free] += step
-                if self._min_det(trial) > 0:
+                if self._min_det(trial) > MIN_AREA_RATIO:
+                    inverted = False
                     t_asm = assemble(self.model, self.nodes, self.triangles, trial, nu=self.nu)
                     t_norm = np.linalg.norm(t_asm.force[self.free])
                     if t_norm < norm:
@@ -180,7 +198,10 @@ class ContactResponse:
                 step *= 0.5
             else:
                 if self._lu is not lu or lu is None:
-                    return ResponseFailure("interior line search found no descent", norm / scale)
+                    return ResponseFailure("interior line search found no descent"
+                                           + (" (every trial inverted an element)"
+                                              if inverted else ""), norm / scale,
+                                           inverted=inverted)
                 lu = None
                 continue
             contraction = t_norm / norm

@@ -42,8 +42,9 @@ from squeeze_grasp_ros.mechanics.elastic.fem import element_dofs
 from squeeze_grasp_ros.mechanics.errors import InvalidInputError, NumericalError
 from squeeze_grasp_ros.mechanics.vocabulary import MaterialModel
 
-__all__ = ["Assembly", "InvertedElementError", "STRAIN_MEASURES", "assemble", "deformation",
-           "principal_strains", "stress_and_tangent"]
+__all__ = ["Assembly", "InvertedElementError", "STRAIN_MEASURES", "area_ratios", "assemble",
+           "deformation", "gradient_operator", "principal_strains", "shape_gradients",
+           "stress_and_tangent"]
 
 STRAIN_MEASURES: dict[MaterialModel, str] = {
     MaterialModel.LINEAR: "small strain sym(grad u)",
@@ -82,7 +83,7 @@ class Assembly:
     min_det: float
 
 
-def _gradients(nodes: np.ndarray, triangles: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def shape_gradients(nodes: np.ndarray, triangles: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Reference shape-function gradients (t, 3, 2), 1/m, and element areas (t,), m^2."""
     p = nodes[triangles]
     d1, d2 = p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]
@@ -96,9 +97,49 @@ def _gradients(nodes: np.ndarray, triangles: np.ndarray) -> tuple[np.ndarray, np
 
 def deformation(nodes: np.ndarray, triangles: np.ndarray, u: np.ndarray) -> np.ndarray:
     """Deformation gradients F (t, 2, 2) of the nodal displacement ``u`` (2n,) or (n, 2), m."""
-    grad, _ = _gradients(np.asarray(nodes, float), np.asarray(triangles, int))
+    grad, _ = shape_gradients(np.asarray(nodes, float), np.asarray(triangles, int))
+    return _deformation(grad, triangles, u)
+
+
+def _deformation(grad: np.ndarray, triangles: np.ndarray, u: np.ndarray) -> np.ndarray:
     ue = np.asarray(u, float).reshape(-1, 2)[triangles]
     return np.eye(2) + np.einsum("tai,taj->tij", ue, grad)
+
+
+def gradient_operator(nodes: np.ndarray, triangles: np.ndarray) -> sp.csr_matrix:
+    """Sparse (4t, 2n) map of nodal displacements to displacement gradients: row 4e + 2i + j of
+    ``G @ u`` is du_i/dX_j of element e (dimensionless when nodes and u share a unit).
+    """
+    grad, _ = shape_gradients(np.asarray(nodes, float), np.asarray(triangles, int))
+    t = len(triangles)
+    dofs = element_dofs(triangles).reshape(t, 3, 2)
+    rows = (4 * np.arange(t)[:, None, None, None] + 2 * np.arange(2)[None, None, :, None]
+            + np.arange(2)[None, None, None, :])
+    rows = np.broadcast_to(rows, (t, 3, 2, 2))
+    cols = np.broadcast_to(dofs[:, :, :, None], (t, 3, 2, 2))
+    vals = np.broadcast_to(grad[:, :, None, :], (t, 3, 2, 2))
+    return sp.csr_matrix((vals.ravel(), (rows.ravel(), cols.ravel())),
+                         shape=(4 * t, 2 * len(nodes)))
+
+
+def area_ratios(gradient: sp.csr_matrix, u: np.ndarray) -> np.ndarray:
+    """The area ratio det F (t,) of every element: deformed / reference area (<= 0: inverted).
+
+    Parameters
+    ----------
+    gradient : (4t, 2n) sparse matrix
+        :func:`gradient_operator` of the mesh, in the unit that ``u`` is measured in.
+    u : (2n,) ndarray
+        Nodal displacements.
+
+    >>> import numpy as np
+    >>> X = np.array([[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]]); tri = np.array([[0, 1, 2]])
+    >>> squash = np.array([0.0, 0.0, 0.0, 0.0, 0.0, -1.5])  # apex pushed through the base
+    >>> area_ratios(gradient_operator(X, tri), squash).tolist()
+    [-0.5]
+    """
+    H = (gradient @ np.asarray(u, float).reshape(-1)).reshape(-1, 4)
+    return (1.0 + H[:, 0]) * (1.0 + H[:, 3]) - H[:, 1] * H[:, 2]
 
 
 def _plane_stress_tensor(nu: float) -> np.ndarray:
@@ -231,9 +272,8 @@ def assemble(model: MaterialModel | str, nodes: np.ndarray, triangles: np.ndarra
     """
     nodes = np.asarray(nodes, float)
     triangles = np.asarray(triangles, int)
-    grad, area = _gradients(nodes, triangles)
-    ue = np.asarray(u, float).reshape(-1, 2)[triangles]
-    F = np.eye(2) + np.einsum("tai,taj->tij", ue, grad)
+    grad, area = shape_gradients(nodes, triangles)
+    F = _deformation(grad, triangles, u)
     det = F[:, 0, 0] * F[:, 1, 1] - F[:, 0, 1] * F[:, 1, 0]
     worst = int(np.argmin(det))
     if not det[worst] > 0:

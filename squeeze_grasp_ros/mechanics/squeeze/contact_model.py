@@ -39,6 +39,7 @@ from squeeze_grasp_ros.mechanics.elastic.fem import (
     principal_strains,
     strain_displacement,
 )
+from squeeze_grasp_ros.mechanics.elastic.hyperelastic import area_ratios, gradient_operator
 from squeeze_grasp_ros.mechanics.squeeze.fingertips import cross, tangent, unit
 from squeeze_grasp_ros.mechanics.elastic.reduced import reduce_blocks
 from squeeze_grasp_ros.mechanics.vocabulary import StrainCriterion
@@ -211,11 +212,15 @@ class SolveFailure:
     indeterminate : bool
         The problem itself has no unique solution (the sliding contacts do not fix the
         object), which the input must change, rather than a solver failure.
+    inverted : bool
+        No state without an inverted element exists at these finger positions (nonlinear
+        models): the squeeze ends ``element_inverted`` rather than failing.
     """
 
     reason: str
     residual: float = float("inf")
     indeterminate: bool = False
+    inverted: bool = False
 
     def error(self) -> InvalidInputError | NumericalError:
         """The failure as an exception, for callers that cannot go on without a solution."""
@@ -523,6 +528,21 @@ class ContactModel:
     def field_strain(self, u_hat: np.ndarray) -> tuple[float, int]:
         """(largest strain by the limit's criterion, element) of a full displacement / L."""
         return strain_criterion(self.element_strains(u_hat).reshape(-1, 3), self.limits.criterion)
+
+    def field_area_ratio(self, u_hat: np.ndarray) -> tuple[float, int]:
+        """(smallest det F = deformed / reference element area, element) of a full
+        displacement / L; <= 0 means the deformed mesh x + u folds over.
+        """
+        if "gradient" not in self._cache:
+            mesh = self.obj.mesh
+            self._cache["gradient"] = gradient_operator(mesh.nodes / self.length, mesh.triangles)
+        det = area_ratios(self._cache["gradient"], u_hat)
+        k = int(np.argmin(det))
+        return float(det[k]), k
+
+    def area_ratio(self, sd: SetData, delta: np.ndarray, F: np.ndarray) -> tuple[float, int]:
+        """(smallest det F, element) of the configuration (one sparse solve in this model)."""
+        return self.field_area_ratio(self.full_displacement(sd, delta, F))
 
 
 def strain_criterion(eps: np.ndarray, criterion: str) -> tuple[float, int]:

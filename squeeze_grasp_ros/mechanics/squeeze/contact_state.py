@@ -273,7 +273,8 @@ class StepResult:
         Fraction of the requested translations applied (< 1 after a termination or when
         stopping at the first event).
     termination : str or None
-        "strain_limit", "finger_slip", "picked_up" or "contact_lost" if one ended the motion.
+        "strain_limit", "finger_slip", "picked_up", "contact_lost" or "element_inverted" if one
+        ended the motion.
     samples : tuple of Sample
         Accepted points (substep ends and event points), for trajectories.
     chatter : tuple of Chatter

@@ -102,6 +102,9 @@ class EventValues:
         Gaps of free boundary nodes to every fingertip (Event A at 0).
     strain, pickup : float
         Termination margins (inf when not checked).
+    area : float
+        Smallest element area ratio det F less the inversion threshold (termination at 0; inf
+        when not checked).
     """
 
     fn: np.ndarray
@@ -111,20 +114,20 @@ class EventValues:
     gaps: np.ndarray
     strain: float
     pickup: float
-
-
+    area: float = np.inf
 
 
 def event_values(*, mu: float, fn: np.ndarray, ft: np.ndarray, slip: np.ndarray,
                  dtheta: np.ndarray, radius: np.ndarray, rate: float, gaps: np.ndarray,
-                 strain: float = np.inf, pickup: float = np.inf) -> EventValues:
+                 strain: float = np.inf, pickup: float = np.inf,
+                 area: float = np.inf) -> EventValues:
     """The event functions of one contact set at one solution.
 
     ``slip`` is each node's slip direction (0 when sticking), ``dtheta`` d theta/ds, ``radius``
     the tip radius of its finger, ``rate`` the length of the fingers' motion per unit s.
     """
     d = slip * dtheta * radius / (rate if rate > 0 else 1.0)
-    return EventValues(fn, mu * fn + ft, mu * fn - ft, d, gaps, strain, pickup)
+    return EventValues(fn, mu * fn + ft, mu * fn - ft, d, gaps, strain, pickup, area)
 
 
 def mode_violations(*, mu: float, fn: float, ft: float, fn_rate: float, ft_rate: float,

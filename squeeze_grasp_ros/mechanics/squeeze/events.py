@@ -245,7 +245,8 @@ class EventSqueeze:
     Attributes
     ----------
     termination : str
-        "depth_reached", "finger_slip", "strain_limit", "picked_up" or "contact_lost".
+        "depth_reached", "finger_slip", "strain_limit", "picked_up", "contact_lost" or
+        "element_inverted".
     depth, relative_depth : float
         Depth reached, m, and relative depth (fraction).
     target_depth : float

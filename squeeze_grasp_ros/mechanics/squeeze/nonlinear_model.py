@@ -95,7 +95,7 @@ class NonlinearContactModel(ContactModel):
         def nonlinear(delta: np.ndarray):
             out = self._evaluate(sd, delta)
             if isinstance(out, ResponseFailure):
-                return SolveFailure(out.reason, out.residual)
+                return SolveFailure(out.reason, out.residual, inverted=out.inverted)
             return out.F, out.C
         nonlinear.tolerance = RESPONSE_ACCURACY
         return nonlinear
@@ -144,6 +144,10 @@ class NonlinearContactModel(ContactModel):
     def strain_measure(self, sd: SetData, delta: np.ndarray, F: np.ndarray) -> tuple[float, int]:
         """(largest strain in the model's measure, element) of the configuration."""
         return self.field_strain(self._field(sd, delta))
+
+    def area_ratio(self, sd: SetData, delta: np.ndarray, F: np.ndarray) -> tuple[float, int]:
+        """(smallest det F, element) of the finite-deformation state (no extra solve)."""
+        return self.field_area_ratio(self._field(sd, delta))
 
     def diagnostics(self) -> dict:
         """Newton evaluations, iterations and factorisations of the interior solves."""

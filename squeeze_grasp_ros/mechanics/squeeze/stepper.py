@@ -20,8 +20,12 @@ C      cone margin mu f_n -/+ f_t                    sticking         eq. 50
 D      slip . d theta / ds (slip rate)               sliding          eq. 51
 =====  ===========================================  ===============  =====================
 
-plus the termination functions eps* - max strain (eq. 45; only with a strain limit) and
-w/n_f - min_f sum_k c_k (pickup; see :func:`pickup_margin`). A function that changes sign in a
+plus the termination functions eps* - max strain (eq. 45; only with a strain limit),
+w/n_f - min_f sum_k c_k (pickup; see :func:`pickup_margin`) and min det F - J_min, the
+smallest element area ratio above INVERSION_AREA_RATIO (always checked: an element squashed to
+that fraction of its area is about to turn inside out, and the squeeze ends
+``element_inverted``; a nonlinear model that finds no equilibrium without an inverted element
+ends the same way at the last state it solved). A function that changes sign in a
 substep is located by a safeguarded Illinois (regula falsi) iteration to a bracket
 [a, b] of depth width <= ``event_tol`` * L; the earliest bracket end b wins, so the state at an
 event has the condition just met (a new contact penetrates by at most the tolerance). Results
@@ -50,7 +54,8 @@ then by finger (F1, F2, A) and node index, re-solving after each:
   every event and stops the processing; a break that would leave a finger without contact is
   not applied and ends the call as ``contact_lost``.
 
-Then the terminations are checked in the order strain_limit < finger_slip < picked_up.
+Then the terminations are checked in the order element_inverted < strain_limit < finger_slip <
+picked_up.
 
 Chattering bound: a node that would exceed ``model.max_events_per_depth`` events within one
 depth step, flips again after a joint decision, or has a second A/B event at one point, is
@@ -103,6 +108,11 @@ TERMINATION_ORDER: tuple[str, ...] = (
 SLIP_RATE_ZERO = 1e-10
 """Frictionless contacts: polar-angle rates (rad per unit motion) below this have no slip
 direction, so round-off in a symmetric contact cannot fake a one-way finger slip."""
+INVERSION_AREA_RATIO = 0.01
+"""The squeeze ends ``element_inverted`` when an element's area ratio det F falls to this: the
+element is about to turn inside out (det F <= 0), where no material model means anything and
+the finite-deformation solvers cannot converge (the corotational law has no energy barrier at
+det F = 0)."""
 MAX_SUBSTEP_HALVINGS = 12
 CONTINUATION_ITERATIONS = 12
 MAX_ANGLE_JUMP = 0.05
@@ -253,19 +263,26 @@ class _Run:
             )
         return strain, pickup
 
+    def area_value(self, sol: Solution) -> float:
+        """The smallest area ratio det F less INVERSION_AREA_RATIO (element_inverted at <= 0)."""
+        return self.model.area_ratio(self.sd, sol.delta, sol.F)[0] - INVERSION_AREA_RATIO
+
     def values(
         self, sol: Solution, s: float, rows: np.ndarray, terminations: bool = True
     ) -> EventValues:
         """All event functions at ``sol`` (and the termination functions if asked)."""
         strain, pickup = self.termination_values(sol) if terminations else (np.inf, np.inf)
+        area = self.area_value(sol) if terminations and self.rate > 0 else np.inf
         return event_values(mu=self.model.mu, fn=sol.normal(), ft=sol.tangential(),
                             slip=self.slip, dtheta=sol.dtheta, radius=self.radius_f[self.fidx],
                             rate=self.rate, gaps=self.gaps(sol, s, rows), strain=strain,
-                            pickup=pickup)
+                            pickup=pickup, area=area)
 
     def _key_value(self, key: tuple, sol: Solution, s: float) -> float:
         """Value of one event function (for root location)."""
         kind, node = key[0], key[1]
+        if kind == "inverted":
+            return self.area_value(sol)
         if kind in ("strain", "pickup"):
             return self.termination_values(sol)[0 if kind == "strain" else 1]
         if kind == "A":
@@ -292,6 +309,8 @@ class _Run:
         for r, node in enumerate(self.boundary[rows].tolist()):
             for f in range(len(self.names)):
                 out.append((("A", node, f), v.gaps[r, f]))
+        if np.isfinite(v.area):
+            out.append((("inverted", -1), v.area))
         if np.isfinite(v.strain):
             out.append((("strain", -1), v.strain))
         if np.isfinite(v.pickup):
@@ -623,6 +642,10 @@ class _Run:
         """First termination that holds at the current point (TERMINATION_ORDER)."""
         if self.rate == 0:
             return None
+        det, element = self.model.area_ratio(self.sd, sol.delta, sol.F)
+        if det <= INVERSION_AREA_RATIO:
+            self.diag["min_area_ratio"], self.diag["inverted_element"] = det, element
+            return Termination.ELEMENT_INVERTED
         strain, pickup = self.termination_values(sol)
         if strain <= 0:
             return Termination.STRAIN_LIMIT
@@ -710,14 +733,22 @@ class _Run:
             )
         return sol
 
-    def substep(self, sol_a: Solution, a: float, b: float) -> tuple[float, Solution]:
-        """(b, solution at b) by continuation from a, halving the substep while it fails."""
+    def substep(
+        self, sol_a: Solution, a: float, b: float
+    ) -> tuple[float, Solution | SolveFailure]:
+        """(b, solution at b) by continuation from a, halving the substep while it fails.
+
+        A failure because every state beyond a inverts an element is returned as (a, failure):
+        the squeeze ends there. Any other failure after MAX_SUBSTEP_HALVINGS raises.
+        """
         for _ in range(MAX_SUBSTEP_HALVINGS):
             sol = self.continue_to(sol_a, a, b)
             if not isinstance(sol, SolveFailure):
                 return b, sol
             self.diag["substep_halvings"] += 1
             b = a + 0.5 * (b - a)
+        if sol.inverted:
+            return a, sol
         raise NumericalError(
             f"the fixed-set solve failed near depth {self.depth_at(a):.6g} m "
             f"after {MAX_SUBSTEP_HALVINGS} substep halvings: {sol.reason}",
@@ -743,6 +774,10 @@ class _Run:
                 rows = free
                 va = self.entries(self.values(sol, a, rows), rows, depth_a)
             b, sol_b = self.substep(sol, a, min(a + hs, 1.0))
+            if isinstance(sol_b, SolveFailure):
+                self.diag["inversion"] = sol_b.reason
+                term = Termination.ELEMENT_INVERTED
+                break
             self.diag["substeps"] += 1
             vb = self.entries(self.values(sol_b, b, rows), rows, depth_a)
             crossed = self.crossings(va, vb, self.fresh)

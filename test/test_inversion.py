@@ -1,0 +1,80 @@
+# Copyright 2026 squeeze_grasp_ros developers
+# SPDX-License-Identifier: Apache-2.0
+"""A squeeze deep enough to turn an element inside out ends ``element_inverted``, located,
+with the element named, never NaN and never a solver traceback; the CLI says so.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+
+import numpy as np
+import pytest
+
+from squeeze_grasp_ros.api import ElasticObject, Material, event_squeeze, load_scene, scene_file
+from squeeze_grasp_ros.cli import main
+from squeeze_grasp_ros.mechanics.elastic.hyperelastic import area_ratios, gradient_operator
+from squeeze_grasp_ros.mechanics.squeeze.stepper import INVERSION_AREA_RATIO
+from squeeze_grasp_ros.mechanics.vocabulary import Termination
+from squeeze_grasp_ros.scene import build_mesh, finger_nodes
+
+
+@pytest.fixture(scope="module")
+def coarse_square():
+    scene = load_scene(scene_file("foam_square"))
+    scene = dataclasses.replace(scene, object=dataclasses.replace(
+        scene.object, mesh=dataclasses.replace(scene.object.mesh, nodes=120)))
+    mesh = build_mesh(scene)
+    return ElasticObject(mesh, Material(5e4, 0.3, 0.0254)), finger_nodes(scene, mesh)
+
+
+def min_area_ratio(obj: ElasticObject, displacement: np.ndarray) -> float:
+    """Smallest det F of the final field, computed from the mesh here, not by the stepper."""
+    return float(area_ratios(gradient_operator(obj.mesh.nodes, obj.mesh.triangles),
+                             displacement.reshape(-1)).min())
+
+
+@pytest.mark.parametrize("model", ["linear", "corotational"])
+def test_a_squeeze_through_an_element_ends_element_inverted_at_the_located_point(
+        model, coarse_square):
+    """Both laws without an energy barrier at det F = 0 stop where the smallest area ratio
+    reaches the threshold (to the event tolerance), with finite forces; a squeeze to just
+    short of that depth reaches its depth with every element intact.
+    """
+    obj, contacts = coarse_square
+    res = event_squeeze(obj, contacts, 0.02, 0.4, material_model=model, relative_depth=0.9)
+    assert res.termination == Termination.ELEMENT_INVERTED
+    assert 0.3 < res.relative_depth < 0.9
+    det = min_area_ratio(obj, res.displacement)
+    assert INVERSION_AREA_RATIO - 1e-3 < det <= INVERSION_AREA_RATIO + 1e-9
+    assert res.diagnostics["min_area_ratio"] == pytest.approx(det, abs=1e-9)
+    assert 0 <= res.diagnostics["inverted_element"] < len(obj.mesh.triangles)
+    assert all(np.isfinite(v).all() for v in res.finger_force.values())
+    short = event_squeeze(obj, contacts, 0.02, 0.4, material_model=model,
+                          relative_depth=res.relative_depth - 0.01)
+    assert short.termination == Termination.DEPTH_REACHED
+    assert min_area_ratio(obj, short.displacement) > INVERSION_AREA_RATIO
+
+
+def test_shallow_squeezes_never_report_an_inversion(coarse_square):
+    """At the paper's 12 % the smallest area ratio stays far above the threshold."""
+    obj, contacts = coarse_square
+    res = event_squeeze(obj, contacts, 0.02, 0.4, relative_depth=0.12)
+    assert res.termination == Termination.DEPTH_REACHED
+    assert min_area_ratio(obj, res.displacement) > 0.5
+
+
+def test_the_cli_reports_the_inversion_as_the_termination(tmp_path, capfd):
+    """``squeeze --json`` names the termination and the element; exit 0 (an outcome, not an
+    error), and the text route prints it too.
+    """
+    text = scene_file("foam_square").read_text().replace("nodes: 2000", "nodes: 120")
+    path = tmp_path / "coarse.yaml"
+    path.write_text(text)
+    assert main(["squeeze", str(path), "--relative-depth", "0.9", "--json"]) == 0
+    out = json.loads(capfd.readouterr().out)
+    assert out["termination"] == "element_inverted"
+    assert out["relative_depth"] < 0.9
+    assert main(["squeeze", str(path), "--relative-depth", "0.9"]) == 0
+    assert "element_inverted" in capfd.readouterr().out

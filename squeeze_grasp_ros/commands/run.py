@@ -25,7 +25,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     """SCENE, --record DIR, --processes, --executor, --on-slip-alarm, --no-resist, --no-planner."""
     add_scene_argument(parser)
     parser.add_argument("--record", metavar="DIR", type=new_folder,
-                        help="record every topic into this rosbag2 folder (MCAP storage)")
+                        help="record every topic into this rosbag2 folder (MCAP storage); if "
+                             "the disk fills up, the bag keeps every complete chunk, the run "
+                             "still ends and prints its summary, and exits 4 saying so")
     parser.add_argument("--include-hidden-topics", action="store_true",
                         help="with --record: also record the executor action's hidden topics "
                              "(_action/feedback, _action/status); like rosbag2, off by default. "
@@ -96,10 +98,29 @@ def run(args: argparse.Namespace) -> dict | int:
     finally:
         if show:
             sys.stderr.write("\n")
+    stopped = recording_stopped(args.record)
+    if stopped is not None:
+        result["recording_stopped"] = stopped
+        print(json.dumps(result) if args.json else summary(result))
+        print(f"squeeze-grasp run: the recording in {args.record} stopped early: {stopped}; "
+              "it is readable up to there", file=sys.stderr)
+        return ExitCode.INTERNAL
     if not result["success"]:
         print(json.dumps(result) if args.json else summary(result))
         return ExitCode.OUTCOME
     return result
+
+
+def recording_stopped(record: str | None) -> str | None:
+    """Why the recording of a finished run ended early (a full disk), from its metadata.yaml."""
+    if not record:
+        return None
+    from squeeze_grasp_ros.ros.recording.bag import STOPPED_KEY, BagError, bag_info
+
+    try:
+        return bag_info(record).get("custom_data", {}).get(STOPPED_KEY)
+    except BagError as exc:
+        return f"the recording is not readable: {exc}"
 
 
 def recording_state(record: str | None) -> str:

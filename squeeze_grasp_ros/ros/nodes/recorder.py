@@ -135,7 +135,12 @@ class RecorderNode(Node):
         if topic not in self.writer.topics:
             self.writer.add_topic(topic, self.types[topic], self._offered_qos(topic))
         self.writer.write(topic, data, ns)
-        self.written += 1
+        if self.writer.failure is None:
+            self.written += 1
+        elif self.writer.dropped == 1:
+            self.get_logger().error(
+                f"recording stopped: {self.writer.failure}; {self.p['output']} keeps every "
+                "message up to the last complete chunk and is finished at shutdown")
         if topic == "/" + pipeline.TICK:
             self.ticks += 1
             self.newest_tick_ns = ns

@@ -12,13 +12,23 @@ written to the file as soon as they fill, a ``rosbag2`` metadata record whose
 :meth:`BagWriter.close` writes the summary and ``metadata.yaml``; call it from a ``finally`` (or
 a SIGINT handler) and an interrupted run leaves a complete recording.
 
+A full disk (or a file-size or quota limit) does not cost the recording: the write that failed
+is cut off at the last complete record, the bag stops taking messages (:attr:`BagWriter.failure`
+says why, :attr:`BagWriter.dropped` counts what was refused), and :meth:`BagWriter.close` ends
+the file after its last complete chunk (a metadata record, DataEnd and footer, no summary:
+readers scan it), using the room of a reserve file the writer holds from the start.
+``metadata.yaml`` then counts the messages kept and says in ``custom_data.recording_stopped``
+why the recording ended early.
+
 :func:`read_bag` reads our bags and those of other tools with the same layout: a folder with
 ``metadata.yaml`` and MCAP or SQLite3 (``.db3``) storage, or a bare ``.mcap`` file.
 """
 
 from __future__ import annotations
 
+import errno
 import io
+import os
 import sqlite3
 from collections import Counter
 from collections.abc import Iterator, Mapping, Sequence
@@ -26,11 +36,12 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import yaml
-from mcap.exceptions import McapError
+from mcap.exceptions import EndOfFile, McapError
 from mcap.reader import make_reader
-from mcap.records import Channel, Message, Schema
+from mcap.data_stream import RecordBuilder
+from mcap.records import Channel, DataEnd, Footer, Message, Metadata, Schema
 from mcap.stream_reader import StreamReader
-from mcap.writer import CompressionType, Writer
+from mcap.writer import MCAP0_MAGIC, CompressionType, Writer
 
 from squeeze_grasp_ros.inputs import InputError, load_yaml, read_text
 from squeeze_grasp_ros.ros.recording.schema import message_definition, type_hash
@@ -43,6 +54,14 @@ COMPRESSION = {
 }
 INFINITE = {"sec": 9223372036, "nsec": 854775807}
 """rosbag2's rendering of an unset (infinite) QoS duration."""
+SPACE_ERRORS = frozenset({errno.ENOSPC, errno.EDQUOT, errno.EFBIG})
+"""Write errors that mean 'no more room' (disk full, quota, file-size limit)."""
+RESERVE_BYTES = 256 * 1024
+"""Room a bag holds from its start for the end of its file and metadata.yaml after a full disk
+(both hold the bag information, about 15 kB for a run's 40 topics)."""
+RESERVE_NAME = ".space_reserve"
+STOPPED_KEY = "recording_stopped"
+"""``custom_data`` key of ``metadata.yaml`` saying why a recording ended early."""
 
 
 class _PlainDumper(yaml.SafeDumper):
@@ -77,16 +96,33 @@ def qos_dict(history: str, depth: int, reliability: str, durability: str) -> dic
 
 
 class _Direct(io.IOBase):
-    """A write-through file for the MCAP writer: every record goes to the OS at once."""
+    """A write-through file for the MCAP writer: every record goes to the OS at once.
+
+    ``boundaries`` holds the file offsets at which complete writes ended; a write that fails is
+    cut back to the last of them, so the file always ends on a record boundary.
+    """
 
     def __init__(self, path: Path) -> None:
         self._file = open(path, "wb", buffering=0)  # noqa: SIM115 - closed by close()
+        self.boundaries = [0]
 
     def write(self, data: bytes) -> int:
         view = memoryview(data)
-        while view:
-            view = view[self._file.write(view) :]
+        try:
+            while view:
+                view = view[self._file.write(view) :]
+        except OSError:
+            self.cut(self.boundaries[-1])
+            raise
+        self.boundaries.append(self._file.tell())
         return len(data)
+
+    def cut(self, offset: int) -> None:
+        """Truncate the file to ``offset`` and continue writing there."""
+        self._file.truncate(offset)
+        self._file.seek(offset)
+        while self.boundaries[-1] > offset:
+            self.boundaries.pop()
 
     def tell(self) -> int:
         return self._file.tell()
@@ -136,53 +172,79 @@ class BagWriter:
             )
         self.path.mkdir(parents=True, exist_ok=True)
         self.file_name = f"{self.path.name}_0.mcap"
-        self._stream = _Direct(self.path / self.file_name)
-        self._writer = Writer(
-            self._stream,
-            chunk_size=chunk_size,
-            compression=COMPRESSION[compression],
-            enable_data_crcs=True,
-        )
-        self._writer.start(profile="ros2", library="squeeze_grasp_ros")
+        try:
+            fd = os.open(self.path / RESERVE_NAME, os.O_WRONLY | os.O_CREAT, 0o644)
+            try:
+                os.posix_fallocate(fd, 0, RESERVE_BYTES)
+            finally:
+                os.close(fd)
+            self._stream = _Direct(self.path / self.file_name)
+            self._writer = Writer(
+                self._stream,
+                chunk_size=chunk_size,
+                compression=COMPRESSION[compression],
+                enable_data_crcs=True,
+            )
+            self._writer.start(profile="ros2", library="squeeze_grasp_ros")
+        except OSError as exc:
+            raise BagError(f"cannot start a recording in {self.path}: {exc.strerror}") from None
         self._schemas: dict[str, int] = {}
         self.topics: dict[str, _Topic] = {}
         self.custom_data = dict(custom_data or {})
         self.start_ns: int | None = None
         self.end_ns: int | None = None
         self.closed = False
+        self.failure: str | None = None
+        """Why the bag stopped taking messages (a write failed for lack of room), or None."""
+        self.dropped = 0
+        """Messages given to :meth:`write` that are not in the file (after a failure)."""
 
     def add_topic(self, name: str, type_name: str, offered_qos: Sequence[dict] = ()) -> None:
         """Declare topic ``name`` of type ``type_name`` ('pkg/msg/Type') with its offered QoS."""
         if name in self.topics:
             return
-        if type_name not in self._schemas:
-            self._schemas[type_name] = self._writer.register_schema(
-                type_name, "ros2msg", message_definition(type_name).encode()
-            )
         qos = list(offered_qos)
-        channel = self._writer.register_channel(
-            name,
-            "cdr",
-            self._schemas[type_name],
-            {
-                "offered_qos_profiles": plain_yaml(qos) if qos else "",
-                "topic_type_hash": type_hash(type_name),
-            },
-        )
+        try:
+            if type_name not in self._schemas:
+                self._schemas[type_name] = self._writer.register_schema(
+                    type_name, "ros2msg", message_definition(type_name).encode()
+                )
+            channel = self._writer.register_channel(
+                name,
+                "cdr",
+                self._schemas[type_name],
+                {
+                    "offered_qos_profiles": plain_yaml(qos) if qos else "",
+                    "topic_type_hash": type_hash(type_name),
+                },
+            )
+        except OSError as exc:
+            self._fail(exc)
+            channel = -1
         self.topics[name] = _Topic(name, type_name, channel, qos)
 
     def write(
         self, topic: str, data: bytes, log_time_ns: int, publish_time_ns: int | None = None
     ) -> None:
-        """Append one serialized (CDR) message of a declared topic."""
+        """Append one serialized (CDR) message of a declared topic (dropped, and counted in
+        :attr:`dropped`, once a write has failed for lack of room).
+        """
         t = self.topics[topic]
-        self._writer.add_message(
-            t.channel,
-            log_time_ns,
-            bytes(data),
-            log_time_ns if publish_time_ns is None else publish_time_ns,
-            sequence=t.count,
-        )
+        if self.failure is not None:
+            self.dropped += 1
+            return
+        try:
+            self._writer.add_message(
+                t.channel,
+                log_time_ns,
+                bytes(data),
+                log_time_ns if publish_time_ns is None else publish_time_ns,
+                sequence=t.count,
+            )
+        except OSError as exc:
+            self._fail(exc)
+            self.dropped += 1
+            return
         t.count += 1
         self.start_ns = log_time_ns if self.start_ns is None else min(self.start_ns, log_time_ns)
         self.end_ns = log_time_ns if self.end_ns is None else max(self.end_ns, log_time_ns)
@@ -226,21 +288,82 @@ class BagWriter:
             "ros_distro": "jazzy",
         }
 
+    def _fail(self, exc: OSError) -> None:
+        """Stop taking messages after a write failed (for lack of room: anything else raises)."""
+        if exc.errno not in SPACE_ERRORS:
+            raise exc
+        self.failure = f"{exc.strerror} (errno {errno.errorcode.get(exc.errno, exc.errno)})"
+
     def close(self) -> None:
         """Write the rosbag2 metadata record, the MCAP summary and ``metadata.yaml``
-        (idempotent).
+        (idempotent); after a failed write, end the file after its last complete record.
         """
         if self.closed:
             return
         self.closed = True
-        info = self.metadata()
-        self._writer.add_metadata("rosbag2", {"serialized_metadata": plain_yaml(info)})
-        self._writer.finish()
+        (self.path / RESERVE_NAME).unlink(missing_ok=True)
+        if self.failure is None:
+            info = self.metadata()
+            try:
+                self._writer.add_metadata("rosbag2", {"serialized_metadata": plain_yaml(info)})
+                self._writer.finish()
+            except OSError as exc:
+                self._fail(exc)
+        if self.failure is not None:
+            info = self._end_after_failure()
         self._stream.close()
         text = plain_yaml({"rosbag2_bagfile_information": info})
         tmp = self.path / "metadata.yaml.tmp"
         tmp.write_text(text)
         tmp.replace(self.path / "metadata.yaml")
+
+    def _end_after_failure(self) -> dict:
+        """End the file after the last complete record that leaves room for its end: the kept
+        messages are counted from the file itself; returns the bag information of what is kept.
+        """
+        written = sum(t.count for t in self.topics.values())
+        while len(self._stream.boundaries) > 1:
+            end = self._stream.boundaries[-1]
+            self._count_kept(end)
+            lost = written + self.dropped - sum(t.count for t in self.topics.values())
+            self.custom_data[STOPPED_KEY] = (f"{self.failure}; the last {lost} messages were not "
+                                             "recorded")
+            info = self.metadata()
+            for record in (Metadata("rosbag2", {"serialized_metadata": plain_yaml(info)}), None):
+                builder = RecordBuilder()
+                if record is not None:
+                    record.write(builder)
+                DataEnd(0).write(builder)
+                Footer(0, 0, 0).write(builder)
+                try:
+                    self._stream.write(builder.end() + MCAP0_MAGIC)
+                    return info
+                except OSError:
+                    continue
+            self._stream.cut(self._stream.boundaries[-2])
+        raise BagError(f"{self.path / self.file_name}: no room even for the end of the file")
+
+    def _count_kept(self, end: int) -> None:
+        """Set every topic's count, and the time range, to the messages in the first ``end``
+        bytes of the file.
+        """
+        self._stream.cut(end)
+        with open(self.path / self.file_name, "rb") as f:
+            data = f.read(end)
+        by_channel = {t.channel: t for t in self.topics.values()}
+        for t in self.topics.values():
+            t.count = 0
+        self.start_ns = self.end_ns = None
+        reader = StreamReader(io.BytesIO(data), emit_chunks=False)
+        try:
+            for record in reader.records:
+                if isinstance(record, Message) and record.channel_id in by_channel:
+                    by_channel[record.channel_id].count += 1
+                    ns = record.log_time
+                    self.start_ns = ns if self.start_ns is None else min(self.start_ns, ns)
+                    self.end_ns = ns if self.end_ns is None else max(self.end_ns, ns)
+        except EndOfFile:
+            return  # the data ends on a record boundary, before any footer: all of it is read
 
 
 @dataclass(frozen=True)
@@ -283,6 +406,17 @@ class BagContents:
     def counts(self) -> Counter:
         """Messages per topic."""
         return Counter(m.topic for m in self.messages)
+
+
+def bag_info(path: str | Path) -> dict:
+    """The ``rosbag2_bagfile_information`` of a bag folder or bare MCAP file ({} if it has none).
+
+    Raises
+    ------
+    BagError
+        If the path is no bag or its metadata is not rosbag2 metadata.
+    """
+    return _storage_files(Path(path))[1]
 
 
 def _storage_files(path: Path) -> tuple[list[Path], dict]:

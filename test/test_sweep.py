@@ -10,6 +10,7 @@ from __future__ import annotations
 import dataclasses
 import json
 import os
+import re
 import signal
 import subprocess
 import sys
@@ -441,6 +442,111 @@ def test_ctrl_c_stops_cleanly_and_resumes(tmp_path, signum, code):
     assert subprocess.run(cmd + ["--no-progress"], capture_output=True).returncode == 0
     loaded = parse_sweep_spec(data, tmp_path)
     assert table_without_time(out).to_pylist() == bare_rows(loaded)
+
+
+def sweep_command(spec: Path, out: Path, *options: str) -> list[str]:
+    """The `squeeze-grasp sweep` console script of this environment."""
+    return [str(BIN / "squeeze-grasp"), "sweep", str(spec), "--out", str(out), *options]
+
+
+def worker_processes(pgid: int) -> list[str]:
+    """Live multiprocessing children (a local cluster's Dask workers) in process group
+    ``pgid``: pid and command line of each (zombies have no command line).
+    """
+    found = []
+    for stat in Path("/proc").glob("[0-9]*/stat"):
+        try:
+            state, _ppid, pgrp = stat.read_text().rsplit(")", 1)[1].split()[:3]
+            cmd = (stat.parent / "cmdline").read_bytes().replace(b"\0", b" ").decode()
+        except OSError:
+            continue
+        if int(pgrp) == pgid and state != "Z" and "spawn_main" in cmd:
+            found.append(f"{stat.parent.name} {cmd}")
+    return found
+
+
+@pytest.mark.parametrize(
+    "moment, signum, code",
+    [
+        ("manifest written", signal.SIGINT, 130),
+        ("worker spawned", signal.SIGINT, 130),
+        ("worker spawned + 1 s", signal.SIGINT, 130),
+        ("worker spawned", signal.SIGTERM, 143),
+    ],
+)
+def test_ctrl_c_during_start_up_stops_cleanly(tmp_path, moment, signum, code):
+    """Ctrl-C (SIGINT to the process group, workers included) before the local cluster starts,
+    while its two worker processes import, or while they register and the client connects:
+    exit 130, the one-line stop message and no traceback, and no worker process left. SIGTERM
+    to the group kills the starting workers: exit 143 all the same.
+    """
+    data = {**SMALL, "chunk": 2, "mesh": {"nodes": 600}, "relative_depth": [0.04, 0.08]}
+    out = tmp_path / "out"
+    cmd = sweep_command(write_spec(tmp_path, data), out, "--workers", "2")
+    proc = subprocess.Popen(
+        cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, start_new_session=True
+    )
+    try:
+        deadline = time.monotonic() + 60
+        while not (
+            (out / "manifest.json").exists()
+            if moment == "manifest written"
+            else worker_processes(proc.pid)
+        ):
+            assert proc.poll() is None and time.monotonic() < deadline
+            time.sleep(0.01)
+        if moment.endswith("+ 1 s"):
+            time.sleep(1.0)
+        os.killpg(proc.pid, signum)
+        assert proc.wait(timeout=60) == code
+        left = worker_processes(proc.pid)
+        err = proc.stderr.read().decode()
+    finally:
+        stop([proc])
+        for entry in worker_processes(proc.pid):
+            os.kill(int(entry.split()[0]), signal.SIGKILL)
+    assert "Traceback" not in err, err
+    assert re.fullmatch(
+        rf"squeeze-grasp sweep: stopped by {signum.name}; \d+ task\(s\) written this run\. "
+        r"Re-run the same command to resume\.",
+        err.splitlines()[-1],
+    ), err
+    assert left == []
+
+
+def test_ctrl_c_while_connecting_to_a_scheduler_stops_at_once(tmp_path):
+    """A scheduler address where nothing answers: Client() would wait out its 20 s timeout;
+    Ctrl-C ends the connect at once with exit 130 and the stop message.
+    """
+    import socket
+
+    with socket.socket() as sock:
+        sock.bind(("127.0.0.1", 0))
+        port = sock.getsockname()[1]
+    out = tmp_path / "out"
+    cmd = sweep_command(write_spec(tmp_path, SMALL), out, "--scheduler", f"tcp://127.0.0.1:{port}")
+    proc = subprocess.Popen(
+        cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, start_new_session=True
+    )
+    try:
+        deadline = time.monotonic() + 60
+        while not (out / "manifest.json").exists():
+            assert proc.poll() is None and time.monotonic() < deadline
+            time.sleep(0.01)
+        time.sleep(1.0)
+        assert proc.poll() is None
+        sent = time.monotonic()
+        os.killpg(proc.pid, signal.SIGINT)
+        assert proc.wait(timeout=60) == 130
+        assert time.monotonic() - sent < 5
+        err = proc.stderr.read().decode()
+    finally:
+        stop([proc])
+    assert "Traceback" not in err, err
+    assert err.splitlines()[-1] == (
+        "squeeze-grasp sweep: stopped by SIGINT; 0 task(s) written this run. "
+        "Re-run the same command to resume."
+    )
 
 
 def test_other_spec_in_the_same_directory_is_refused(tmp_path):

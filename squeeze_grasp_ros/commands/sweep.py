@@ -10,7 +10,7 @@ import signal
 import sys
 
 from squeeze_grasp_ros.exit_codes import ExitCode
-from squeeze_grasp_ros.sweep.engine import dry_run, require_extra, run_sweep
+from squeeze_grasp_ros.sweep.engine import dry_run, run_sweep
 from squeeze_grasp_ros.sweep.spec import SweepError, load_sweep_spec
 
 HELP = ("evaluate a sweep spec (objects x materials x friction x tips x squeezes x depths x "
@@ -47,7 +47,6 @@ def run(args: argparse.Namespace) -> dict | int:
                 **dry_run(loaded, workers=args.workers, scheduler=args.scheduler)}
     if not args.out:
         raise SweepError("--out DIR is required (or use --dry-run)")
-    require_extra()
     outcome = run_sweep(loaded, args.out, scheduler=args.scheduler, workers=args.workers,
                         progress=not args.no_progress)
     result = {"dry_run": False, "out": args.out, "spec_hash": loaded.hash, **vars(outcome)}

@@ -465,6 +465,89 @@ def worker_processes(pgid: int) -> list[str]:
     return found
 
 
+TOO_FINE = {"shape": {"type": "disk", "radius": 0.04}, "mesh": {"max_area": 1e-10}}
+"""An object whose mesh the worker refuses (about 4e7 nodes: max_area given in the wrong unit);
+only the client-side plan is cheap, so its task fails as a whole on the worker."""
+
+
+def test_a_task_that_fails_as_a_whole_exits_1_and_is_the_only_one_retried(tmp_path):
+    """A real sweep (one-worker local cluster) with one object that cannot be meshed: the other
+    four tasks are written and equal the in-process loop's rows, the manifest marks the fifth
+    failed with the mesher's message, the command exits 1 naming the count on its last line,
+    and a re-run submits that task alone (and, the input being the same, fails it again).
+    """
+    data = {
+        **SMALL,
+        "objects": SMALL["objects"] + [TOO_FINE],
+        "placements": {"mode": "graspmap", "count": 2},
+    }
+    spec = write_spec(tmp_path, data)
+    loaded = parse_sweep_spec(data, tmp_path)
+    tasks = plan_tasks(loaded)
+    bad = [t.id for t in tasks if t.obj.id == "03-disk"]
+    good = sorted(t.id for t in tasks if t.obj.id != "03-disk")
+    assert len(bad) == 1 and len(good) == 4
+    out = tmp_path / "out"
+    cmd = sweep_command(spec, out, "--workers", "1", "--no-progress")
+    last = (
+        f"squeeze-grasp sweep: 1 of 5 task(s) failed (errors in {out}/manifest.json). "
+        "Re-run the same command to retry them."
+    )
+
+    first = subprocess.run(cmd, capture_output=True, text=True, timeout=300)
+    assert first.returncode == 1, first.stderr
+    assert first.stderr.splitlines()[-1] == last
+    assert "4 written now (16 evaluations, 0 with an error), 1 failed" in first.stdout
+    manifest = json.loads((out / "manifest.json").read_text())
+    assert manifest["counts"] == {"done": 4, "failed": 1, "pending": 0}
+    assert manifest["tasks"][bad[0]]["status"] == "failed"
+    error = manifest["tasks"][bad[0]]["error"]
+    assert error.startswith("InvalidInputError: mesh.max_area 1e-10 m^2 would give about")
+    parts = out / "parts"
+    assert sorted(p.stem for p in parts.glob("*.parquet")) == good
+    clean = parse_sweep_spec({**data, "objects": SMALL["objects"]}, tmp_path)
+    assert table_without_time(out).to_pylist() == bare_rows(clean)
+
+    written = {p.name: (p.read_bytes(), p.stat().st_mtime_ns) for p in parts.glob("*.parquet")}
+    again = subprocess.run(cmd + ["--json"], capture_output=True, text=True, timeout=300)
+    assert again.returncode == 1, again.stderr
+    assert again.stderr.splitlines()[-1] == last
+    result = json.loads(again.stdout)
+    assert (result["tasks"], result["skipped"], result["done"], result["failed"]) == (5, 4, 0, 1)
+    assert result["evaluations"] == 0
+    assert {p.name: (p.read_bytes(), p.stat().st_mtime_ns) for p in parts.glob("*.parquet")} == (
+        written
+    )
+    manifest = json.loads((out / "manifest.json").read_text())
+    assert manifest["tasks"][bad[0]] == {"status": "failed", "error": error}
+    assert manifest["counts"] == {"done": 4, "failed": 1, "pending": 0}
+
+
+def test_sweep_help_lists_the_exit_statuses(capsys):
+    with pytest.raises(SystemExit) as done:
+        main(["sweep", "--help"])
+    assert done.value.code == 0
+    text = " ".join(capsys.readouterr().out.split())
+    assert "exit status: 0 every task written (an evaluation that raised is a row" in text
+    assert "1 some tasks failed as a whole" in text and "retries only the failed ones" in text
+    assert "130 stopped by Ctrl-C (SIGINT), 143 by SIGTERM" in text
+
+
+def test_error_rows_are_results_and_leave_the_exit_status_0(tmp_path, capsys):
+    """Every evaluation raises (the adversary on F1's node) but every task completes: exit 0,
+    and the summary says how many rows carry an error.
+    """
+    data = {**SMALL, "objects": SMALL["objects"][:1], "adversary": {"position": 1e-6},
+            "friction": [0.3]}
+    spec = write_spec(tmp_path, data)
+    out = tmp_path / "out"
+    assert main(["sweep", str(spec), "--out", str(out), "--workers", "1", "--no-progress"]) == 0
+    text = capsys.readouterr().out
+    assert "1 written now (4 evaluations, 4 with an error), 0 failed" in text
+    assert "every task written; 4 evaluation(s) raised and are rows with their error" in text
+    assert table_without_time(out)["error"].null_count == 0
+
+
 @pytest.mark.parametrize(
     "moment, signum, code",
     [

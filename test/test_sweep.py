@@ -10,6 +10,7 @@ from __future__ import annotations
 import dataclasses
 import json
 import os
+import re
 import signal
 import subprocess
 import sys
@@ -441,6 +442,194 @@ def test_ctrl_c_stops_cleanly_and_resumes(tmp_path, signum, code):
     assert subprocess.run(cmd + ["--no-progress"], capture_output=True).returncode == 0
     loaded = parse_sweep_spec(data, tmp_path)
     assert table_without_time(out).to_pylist() == bare_rows(loaded)
+
+
+def sweep_command(spec: Path, out: Path, *options: str) -> list[str]:
+    """The `squeeze-grasp sweep` console script of this environment."""
+    return [str(BIN / "squeeze-grasp"), "sweep", str(spec), "--out", str(out), *options]
+
+
+def worker_processes(pgid: int) -> list[str]:
+    """Live multiprocessing children (a local cluster's Dask workers) in process group
+    ``pgid``: pid and command line of each (zombies have no command line).
+    """
+    found = []
+    for stat in Path("/proc").glob("[0-9]*/stat"):
+        try:
+            state, _ppid, pgrp = stat.read_text().rsplit(")", 1)[1].split()[:3]
+            cmd = (stat.parent / "cmdline").read_bytes().replace(b"\0", b" ").decode()
+        except OSError:
+            continue
+        if int(pgrp) == pgid and state != "Z" and "spawn_main" in cmd:
+            found.append(f"{stat.parent.name} {cmd}")
+    return found
+
+
+TOO_FINE = {"shape": {"type": "disk", "radius": 0.04}, "mesh": {"max_area": 1e-10}}
+"""An object whose mesh the worker refuses (about 4e7 nodes: max_area given in the wrong unit);
+only the client-side plan is cheap, so its task fails as a whole on the worker."""
+
+
+def test_a_task_that_fails_as_a_whole_exits_1_and_is_the_only_one_retried(tmp_path):
+    """A real sweep (one-worker local cluster) with one object that cannot be meshed: the other
+    four tasks are written and equal the in-process loop's rows, the manifest marks the fifth
+    failed with the mesher's message, the command exits 1 naming the count on its last line,
+    and a re-run submits that task alone (and, the input being the same, fails it again).
+    """
+    data = {
+        **SMALL,
+        "objects": SMALL["objects"] + [TOO_FINE],
+        "placements": {"mode": "graspmap", "count": 2},
+    }
+    spec = write_spec(tmp_path, data)
+    loaded = parse_sweep_spec(data, tmp_path)
+    tasks = plan_tasks(loaded)
+    bad = [t.id for t in tasks if t.obj.id == "03-disk"]
+    good = sorted(t.id for t in tasks if t.obj.id != "03-disk")
+    assert len(bad) == 1 and len(good) == 4
+    out = tmp_path / "out"
+    cmd = sweep_command(spec, out, "--workers", "1", "--no-progress")
+    last = (
+        f"squeeze-grasp sweep: 1 of 5 task(s) failed (errors in {out}/manifest.json). "
+        "Re-run the same command to retry them."
+    )
+
+    first = subprocess.run(cmd, capture_output=True, text=True, timeout=300)
+    assert first.returncode == 1, first.stderr
+    assert first.stderr.splitlines()[-1] == last
+    assert "4 written now (16 evaluations, 0 with an error), 1 failed" in first.stdout
+    manifest = json.loads((out / "manifest.json").read_text())
+    assert manifest["counts"] == {"done": 4, "failed": 1, "pending": 0}
+    assert manifest["tasks"][bad[0]]["status"] == "failed"
+    error = manifest["tasks"][bad[0]]["error"]
+    assert error.startswith("InvalidInputError: mesh.max_area 1e-10 m^2 would give about")
+    parts = out / "parts"
+    assert sorted(p.stem for p in parts.glob("*.parquet")) == good
+    clean = parse_sweep_spec({**data, "objects": SMALL["objects"]}, tmp_path)
+    assert table_without_time(out).to_pylist() == bare_rows(clean)
+
+    written = {p.name: (p.read_bytes(), p.stat().st_mtime_ns) for p in parts.glob("*.parquet")}
+    again = subprocess.run(cmd + ["--json"], capture_output=True, text=True, timeout=300)
+    assert again.returncode == 1, again.stderr
+    assert again.stderr.splitlines()[-1] == last
+    result = json.loads(again.stdout)
+    assert (result["tasks"], result["skipped"], result["done"], result["failed"]) == (5, 4, 0, 1)
+    assert result["evaluations"] == 0
+    assert {p.name: (p.read_bytes(), p.stat().st_mtime_ns) for p in parts.glob("*.parquet")} == (
+        written
+    )
+    manifest = json.loads((out / "manifest.json").read_text())
+    assert manifest["tasks"][bad[0]] == {"status": "failed", "error": error}
+    assert manifest["counts"] == {"done": 4, "failed": 1, "pending": 0}
+
+
+def test_sweep_help_lists_the_exit_statuses(capsys):
+    with pytest.raises(SystemExit) as done:
+        main(["sweep", "--help"])
+    assert done.value.code == 0
+    text = " ".join(capsys.readouterr().out.split())
+    assert "exit status: 0 every task written (an evaluation that raised is a row" in text
+    assert "1 some tasks failed as a whole" in text and "retries only the failed ones" in text
+    assert "130 stopped by Ctrl-C (SIGINT), 143 by SIGTERM" in text
+
+
+def test_error_rows_are_results_and_leave_the_exit_status_0(tmp_path, capsys):
+    """Every evaluation raises (the adversary on F1's node) but every task completes: exit 0,
+    and the summary says how many rows carry an error.
+    """
+    data = {**SMALL, "objects": SMALL["objects"][:1], "adversary": {"position": 1e-6},
+            "friction": [0.3]}
+    spec = write_spec(tmp_path, data)
+    out = tmp_path / "out"
+    assert main(["sweep", str(spec), "--out", str(out), "--workers", "1", "--no-progress"]) == 0
+    text = capsys.readouterr().out
+    assert "1 written now (4 evaluations, 4 with an error), 0 failed" in text
+    assert "every task written; 4 evaluation(s) raised and are rows with their error" in text
+    assert table_without_time(out)["error"].null_count == 0
+
+
+@pytest.mark.parametrize(
+    "moment, signum, code",
+    [
+        ("manifest written", signal.SIGINT, 130),
+        ("worker spawned", signal.SIGINT, 130),
+        ("worker spawned + 1 s", signal.SIGINT, 130),
+        ("worker spawned", signal.SIGTERM, 143),
+    ],
+)
+def test_ctrl_c_during_start_up_stops_cleanly(tmp_path, moment, signum, code):
+    """Ctrl-C (SIGINT to the process group, workers included) before the local cluster starts,
+    while its two worker processes import, or while they register and the client connects:
+    exit 130, the one-line stop message and no traceback, and no worker process left. SIGTERM
+    to the group kills the starting workers: exit 143 all the same.
+    """
+    data = {**SMALL, "chunk": 2, "mesh": {"nodes": 600}, "relative_depth": [0.04, 0.08]}
+    out = tmp_path / "out"
+    cmd = sweep_command(write_spec(tmp_path, data), out, "--workers", "2")
+    proc = subprocess.Popen(
+        cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, start_new_session=True
+    )
+    try:
+        deadline = time.monotonic() + 60
+        while not (
+            (out / "manifest.json").exists()
+            if moment == "manifest written"
+            else worker_processes(proc.pid)
+        ):
+            assert proc.poll() is None and time.monotonic() < deadline
+            time.sleep(0.01)
+        if moment.endswith("+ 1 s"):
+            time.sleep(1.0)
+        os.killpg(proc.pid, signum)
+        assert proc.wait(timeout=60) == code
+        left = worker_processes(proc.pid)
+        err = proc.stderr.read().decode()
+    finally:
+        stop([proc])
+        for entry in worker_processes(proc.pid):
+            os.kill(int(entry.split()[0]), signal.SIGKILL)
+    assert "Traceback" not in err, err
+    assert re.fullmatch(
+        rf"squeeze-grasp sweep: stopped by {signum.name}; \d+ task\(s\) written this run\. "
+        r"Re-run the same command to resume\.",
+        err.splitlines()[-1],
+    ), err
+    assert left == []
+
+
+def test_ctrl_c_while_connecting_to_a_scheduler_stops_at_once(tmp_path):
+    """A scheduler address where nothing answers: Client() would wait out its 20 s timeout;
+    Ctrl-C ends the connect at once with exit 130 and the stop message.
+    """
+    import socket
+
+    with socket.socket() as sock:
+        sock.bind(("127.0.0.1", 0))
+        port = sock.getsockname()[1]
+    out = tmp_path / "out"
+    cmd = sweep_command(write_spec(tmp_path, SMALL), out, "--scheduler", f"tcp://127.0.0.1:{port}")
+    proc = subprocess.Popen(
+        cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, start_new_session=True
+    )
+    try:
+        deadline = time.monotonic() + 60
+        while not (out / "manifest.json").exists():
+            assert proc.poll() is None and time.monotonic() < deadline
+            time.sleep(0.01)
+        time.sleep(1.0)
+        assert proc.poll() is None
+        sent = time.monotonic()
+        os.killpg(proc.pid, signal.SIGINT)
+        assert proc.wait(timeout=60) == 130
+        assert time.monotonic() - sent < 5
+        err = proc.stderr.read().decode()
+    finally:
+        stop([proc])
+    assert "Traceback" not in err, err
+    assert err.splitlines()[-1] == (
+        "squeeze-grasp sweep: stopped by SIGINT; 0 task(s) written this run. "
+        "Re-run the same command to resume."
+    )
 
 
 def test_other_spec_in_the_same_directory_is_refused(tmp_path):

@@ -6,19 +6,28 @@
 from __future__ import annotations
 
 import argparse
+import json
 import signal
 import sys
 
 from squeeze_grasp_ros.exit_codes import ExitCode
-from squeeze_grasp_ros.sweep.engine import dry_run, require_extra, run_sweep
+from squeeze_grasp_ros.sweep.engine import dry_run, run_sweep
 from squeeze_grasp_ros.sweep.spec import SweepError, load_sweep_spec
 
 HELP = ("evaluate a sweep spec (objects x materials x friction x tips x squeezes x depths x "
         "placements) on Dask into a Parquet dataset; re-run to resume")
+EPILOG = ("exit status: 0 every task written (an evaluation that raised is a row with its error "
+          "and leaves the status 0; the summary counts them); 1 some tasks failed as a whole "
+          "(listed with their error in DIR/manifest.json; the other tasks are written, and "
+          "re-running the same command retries only the failed ones); 2 invalid spec or option, "
+          "unreachable --scheduler, or the sweep extra missing; 130 stopped by Ctrl-C (SIGINT), "
+          "143 by SIGTERM, at any point from start-up on: finished parts are kept, re-run to "
+          "resume")
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    """SPEC, --out, --scheduler, --workers, --dry-run, --no-progress."""
+    """SPEC, --out, --scheduler, --workers, --dry-run, --no-progress; the exit statuses."""
+    parser.epilog = EPILOG
     parser.add_argument("spec", metavar="SPEC.yaml", help="sweep spec (keys: squeeze-grasp "
                                                           "sweep-help)")
     parser.add_argument("--out", metavar="DIR",
@@ -36,7 +45,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> dict | int:
-    """Run or resume the sweep; returns its counts (exit 130 on SIGINT, 143 on SIGTERM)."""
+    """Run or resume the sweep; returns its counts, or the exit status after printing them
+    (1 if tasks failed) or a stop message (130 on SIGINT, 143 on SIGTERM).
+    """
     if args.workers is not None and args.workers < 1:
         raise SweepError(f"--workers must be >= 1, got {args.workers}")
     if args.workers is not None and args.scheduler:
@@ -47,7 +58,6 @@ def run(args: argparse.Namespace) -> dict | int:
                 **dry_run(loaded, workers=args.workers, scheduler=args.scheduler)}
     if not args.out:
         raise SweepError("--out DIR is required (or use --dry-run)")
-    require_extra()
     outcome = run_sweep(loaded, args.out, scheduler=args.scheduler, workers=args.workers,
                         progress=not args.no_progress)
     result = {"dry_run": False, "out": args.out, "spec_hash": loaded.hash, **vars(outcome)}
@@ -57,6 +67,12 @@ def run(args: argparse.Namespace) -> dict | int:
               "Re-run the same command to resume.", file=sys.stderr)
         return int(ExitCode.INTERRUPTED if outcome.interrupted == signal.SIGINT
                    else ExitCode.TERMINATED)
+    if outcome.failed:
+        print(json.dumps(result) if args.json else summary(result), flush=True)
+        print(f"squeeze-grasp sweep: {outcome.failed} of {outcome.tasks} task(s) failed (errors "
+              f"in {args.out}/manifest.json). Re-run the same command to retry them.",
+              file=sys.stderr)
+        return int(ExitCode.OUTCOME)
     return result
 
 
@@ -88,7 +104,8 @@ def summary(result: dict) -> str:
             f"{result['evaluations'] / result['seconds'] / max(result['workers'], 1):.2f}"
             " evaluations/s per worker"
         )
-    if result["failed"]:
-        lines.append("failed tasks are listed in manifest.json; re-run to retry them")
+    if result["errors"] and not result["failed"]:
+        lines.append(f"every task written; {result['errors']} evaluation(s) raised and are rows "
+                     "with their error (exit status 0; a re-run does not redo them)")
     lines.append(f"summary: squeeze-grasp sweep-report {result['out']}")
     return "\n".join(lines)

@@ -8,10 +8,13 @@ only compute (:func:`~.evaluate.run_task`) and need not share a file system with
 Local default: one worker process per core, one thread each (Dask's nannies start workers with
 ``OMP_NUM_THREADS=MKL_NUM_THREADS=OPENBLAS_NUM_THREADS=1``, so BLAS does not oversubscribe).
 A worker that dies mid-task has its task rescheduled by Dask; a client that dies loses only the
-tasks in flight.
+tasks in flight. SIGINT and SIGTERM are flags from planning to the closing of the cluster
+(:class:`StopSignals`), so an interrupt at any point ends the same way: the cluster closed, no
+traceback, the signal in :attr:`Outcome.interrupted`.
 """
 from __future__ import annotations
 
+import contextlib
 import importlib.util
 import logging
 import os
@@ -110,19 +113,55 @@ class Outcome:
     startup_s: float = 0.0
 
 
-def _cluster(scheduler: Optional[str], workers: Optional[int]):
+@contextlib.contextmanager
+def _sigint_blocked():
+    """SIGINT blocked in this thread while a local cluster starts.
+
+    The threads started meanwhile inherit the mask, and so do the worker processes they spawn,
+    from their first instruction on: Ctrl-C, which the terminal sends to the whole process
+    group, never reaches a local worker (one still importing would print a traceback and fail
+    the cluster's start). A SIGINT that arrives meanwhile waits and reaches the client's
+    handler when the block ends. The multiprocessing resource tracker is started first
+    because its first start unblocks SIGINT in the thread that starts it.
+    """
+    from multiprocessing import resource_tracker
+
+    resource_tracker.ensure_running()
+    old = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
+    try:
+        yield
+    finally:
+        signal.pthread_sigmask(signal.SIG_SETMASK, old)
+
+
+def _start(scheduler: Optional[str], workers: Optional[int], stop: "StopSignals"):
+    """The client and the local cluster it drives (None with ``scheduler``).
+
+    Connecting to a remote scheduler can take its whole timeout, and holds nothing that must be
+    closed, so a stop signal interrupts it at once (:class:`Stopped`); a local cluster is let
+    finish starting, with SIGINT kept from its workers, and is then closed by the caller.
+    """
     from distributed import Client, LocalCluster
     if scheduler is not None:
         try:
-            client = Client(scheduler, timeout="20s")
+            with stop.at_once():
+                return Client(scheduler, timeout="20s"), None
         except (OSError, TimeoutError) as exc:
             raise SweepError(f"--scheduler {scheduler}: cannot connect ({exc})") from None
-        return client, None
     n = workers or os.cpu_count() or 1
     dashboard = "127.0.0.1:0" if importlib.util.find_spec("bokeh") else None
-    cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True, host="127.0.0.1",
-                           dashboard_address=dashboard, silence_logs=logging.ERROR)
-    return Client(cluster), cluster
+    # Dask's own logs stay below CRITICAL: what goes wrong in a task is recorded (manifest,
+    # summary, exit status) and a cluster closed right after its start has workers log
+    # tracebacks of heartbeats cut short.
+    with _sigint_blocked():
+        cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
+                               host="127.0.0.1", dashboard_address=dashboard,
+                               silence_logs=logging.CRITICAL)
+        try:
+            return Client(cluster), cluster
+        except BaseException:
+            cluster.close()
+            raise
 
 
 def _dashboard(client, local: bool) -> Optional[str]:
@@ -140,13 +179,6 @@ def _dashboard(client, local: bool) -> Optional[str]:
     return link if b"needs bokeh" not in page else None
 
 
-def ignore_sigint() -> None:
-    """Run in a local worker process: Ctrl-C reaches the whole process group, and the client
-    alone handles it (it cancels the tasks and closes the cluster).
-    """
-    signal.signal(signal.SIGINT, signal.SIG_IGN)
-
-
 def _check_workers(client) -> int:
     from squeeze_grasp_ros.sweep.store import package_version
     versions = client.run(package_version)
@@ -161,23 +193,44 @@ def _check_workers(client) -> int:
     return len(versions)
 
 
+class Stopped(KeyboardInterrupt):
+    """A stop signal inside :meth:`StopSignals.at_once`."""
+
+
 class StopSignals:
     """Within ``with``: SIGINT and SIGTERM set :attr:`signal` instead of raising, so that a
-    part and its manifest update are never cut in half (main thread only; elsewhere a no-op).
+    part and its manifest update are never cut in half and a cluster that is starting is
+    closed, not abandoned (main thread only; elsewhere a no-op). Within :meth:`at_once` they
+    raise :class:`Stopped` as well, for a step that holds nothing to close.
     """
 
     def __init__(self) -> None:
         self.signal: Optional[int] = None
         self._event = threading.Event()
         self._old: dict = {}
+        self._raise = False
 
     def _handle(self, signum, _frame) -> None:
         self.signal = signum
         self._event.set()
+        if self._raise:
+            self._raise = False
+            raise Stopped(signum)
 
     def wait(self, seconds: float) -> None:
         """Sleep up to ``seconds``, waking at a signal."""
         self._event.wait(seconds)
+
+    @contextlib.contextmanager
+    def at_once(self):
+        """Within: a stop signal (or one already received) raises :class:`Stopped`."""
+        if self.signal is not None:
+            raise Stopped(self.signal)
+        self._raise = True
+        try:
+            yield
+        finally:
+            self._raise = False
 
     def __enter__(self) -> "StopSignals":
         if threading.current_thread() is threading.main_thread():
@@ -230,50 +283,68 @@ def run_sweep(loaded: LoadedSpec, out: str | Path, *, scheduler: Optional[str] =
     on_task : callable, optional
         Called after each part is written (tests use it to kill the client at a known point).
     """
-    require_extra()
-    from squeeze_grasp_ros.sweep.store import Store
     start = time.perf_counter()
-    tasks = plan_tasks(loaded)
-    store = Store(out, loaded, tasks)
-    todo = [t for t in tasks if not store.done(t.id)]
-    outcome = Outcome(len(tasks), len(tasks) - len(todo), 0, 0, 0, 0, 0.0, 0, None, None,
-                      0.0, 0.0)
-    if not todo:
-        outcome.seconds = time.perf_counter() - start
-        return outcome
-    from distributed import as_completed
-    client, cluster = _cluster(scheduler, workers)
-    try:
-        outcome.workers = _check_workers(client)
-        outcome.dashboard = _dashboard(client, cluster is not None)
-        if cluster is not None:
-            client.run(ignore_sigint)
-        outcome.startup_s = time.perf_counter() - start
-        bar = Progress(sum(t.evaluations for t in todo), outcome.dashboard, progress)
-        bar.update(0)
-        futures = {client.submit(run_task, t, key=f"sweep-{loaded.hash[:12]}-{t.id}",
-                                 pure=False): t for t in todo}
-        pending = as_completed(futures)
-        with StopSignals() as stop:
-            while not pending.is_empty() and stop.signal is None:
-                batch = pending.next_batch(block=False)
-                if not batch:
-                    stop.wait(POLL_S)
-                for future in batch:
-                    task = futures.pop(future)
-                    _collect(future, task, store, outcome, bar)
-                    if on_task is not None:
-                        on_task(task)
-        if stop.signal is not None:
-            outcome.interrupted = stop.signal
-            client.cancel(list(futures))
-        bar.update(0, final=True)
-    finally:
-        client.close()
-        if cluster is not None:
-            cluster.close()
+    with StopSignals() as stop:
+        require_extra()
+        from squeeze_grasp_ros.sweep.store import Store
+        tasks = plan_tasks(loaded)
+        store = Store(out, loaded, tasks)
+        todo = [t for t in tasks if not store.done(t.id)]
+        outcome = Outcome(len(tasks), len(tasks) - len(todo), 0, 0, 0, 0, 0.0, 0, None, None,
+                          0.0, 0.0)
+        client = cluster = None
+        try:
+            if todo and stop.signal is None:
+                try:
+                    client, cluster = _start(scheduler, workers, stop)
+                    if stop.signal is None:
+                        outcome.workers = _check_workers(client)
+                        outcome.dashboard = _dashboard(client, cluster is not None)
+                        outcome.startup_s = time.perf_counter() - start
+                except Stopped:
+                    pass
+                except Exception:
+                    # SIGTERM to the process group also kills local workers that are still
+                    # starting, and the cluster fails to start (it closes itself): report the
+                    # stop, not that failure.
+                    if stop.signal is None:
+                        raise
+            if client is not None and stop.signal is None:
+                _run_tasks(loaded, todo, client, store, outcome, stop, progress, on_task)
+        finally:
+            if client is not None:
+                client.close()
+            if cluster is not None:
+                cluster.close()
+    outcome.interrupted = stop.signal
     outcome.seconds = time.perf_counter() - start
     return outcome
+
+
+def _run_tasks(loaded: LoadedSpec, todo: list[Task], client, store, outcome: Outcome,
+               stop: StopSignals, progress: bool,
+               on_task: Optional[Callable[[Task], None]]) -> None:
+    """Submit the tasks, write each part as its task finishes, until done or a stop signal
+    (then cancel the rest).
+    """
+    from distributed import as_completed
+    bar = Progress(sum(t.evaluations for t in todo), outcome.dashboard, progress)
+    bar.update(0)
+    futures = {client.submit(run_task, t, key=f"sweep-{loaded.hash[:12]}-{t.id}",
+                             pure=False): t for t in todo}
+    pending = as_completed(futures)
+    while not pending.is_empty() and stop.signal is None:
+        batch = pending.next_batch(block=False)
+        if not batch:
+            stop.wait(POLL_S)
+        for future in batch:
+            task = futures.pop(future)
+            _collect(future, task, store, outcome, bar)
+            if on_task is not None:
+                on_task(task)
+    if stop.signal is not None:
+        client.cancel(list(futures))
+    bar.update(0, final=True)
 
 
 def dry_run(loaded: LoadedSpec, *, workers: Optional[int] = None,

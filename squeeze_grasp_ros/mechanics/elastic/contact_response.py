@@ -25,8 +25,9 @@ from dataclasses import dataclass, field
 import numpy as np
 import scipy.sparse.linalg as spla
 
-from squeeze_grasp_ros.mechanics.elastic.hyperelastic import (area_ratios, assemble,
-                                                                gradient_operator)
+from squeeze_grasp_ros.mechanics.elastic.hyperelastic import (MeshGeometry, area_ratios,
+                                                                assemble, gradient_operator,
+                                                                mesh_geometry)
 from squeeze_grasp_ros.mechanics.errors import InvalidInputError
 from squeeze_grasp_ros.mechanics.vocabulary import MaterialModel
 
@@ -107,6 +108,9 @@ class ContactResponse:
         Contact nodes (at least 2 distinct: they fix the rigid motion).
     nu : float
         Poisson's ratio.
+    geometry : MeshGeometry, optional
+        :func:`~squeeze_grasp_ros.mechanics.elastic.hyperelastic.mesh_geometry` of the mesh, to
+        share between the contact sets of one object (built here otherwise).
     """
 
     model: MaterialModel
@@ -114,6 +118,7 @@ class ContactResponse:
     triangles: np.ndarray
     contacts: np.ndarray
     nu: float
+    geometry: MeshGeometry | None = field(default=None, repr=False)
     stats: dict = field(default_factory=lambda: {"evaluations": 0, "iterations": 0,
                                                  "factorizations": 0, "substeps": 0})
     _u: np.ndarray | None = field(default=None, repr=False)
@@ -131,6 +136,8 @@ class ContactResponse:
         self.cdofs = np.stack([2 * self.contacts, 2 * self.contacts + 1], 1).reshape(-1)
         self.free = np.setdiff1d(np.arange(n2), self.cdofs)
         self._gradient = gradient_operator(self.nodes, self.triangles)
+        if self.geometry is None:
+            self.geometry = mesh_geometry(self.nodes, self.triangles)
         if self._u is None:
             self._u = np.zeros(n2)
             self._delta = np.zeros((len(self.contacts), 2))
@@ -170,7 +177,8 @@ class ContactResponse:
         if self._min_det(u) <= MIN_AREA_RATIO:
             return ResponseFailure("the prescribed contact displacement inverts an element",
                                    inverted=True)
-        asm = assemble(self.model, self.nodes, self.triangles, u, nu=self.nu)
+        asm = assemble(self.model, self.nodes, self.triangles, u, nu=self.nu,
+                       geometry=self.geometry)
         stiffness = abs(asm.tangent).max()
         scale = max(np.linalg.norm(asm.force[self.cdofs]),
                     stiffness * max(np.linalg.norm(delta), DISPLACEMENT_FLOOR))
@@ -191,7 +199,8 @@ class ContactResponse:
                 trial[self.free] += step
                 if self._min_det(trial) > MIN_AREA_RATIO:
                     inverted = False
-                    t_asm = assemble(self.model, self.nodes, self.triangles, trial, nu=self.nu)
+                    t_asm = assemble(self.model, self.nodes, self.triangles, trial,
+                                     nu=self.nu, geometry=self.geometry)
                     t_norm = np.linalg.norm(t_asm.force[self.free])
                     if t_norm < norm:
                         break

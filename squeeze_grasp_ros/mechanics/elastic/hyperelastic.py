@@ -42,9 +42,9 @@ from squeeze_grasp_ros.mechanics.elastic.fem import element_dofs
 from squeeze_grasp_ros.mechanics.errors import InvalidInputError, NumericalError
 from squeeze_grasp_ros.mechanics.vocabulary import MaterialModel
 
-__all__ = ["Assembly", "InvertedElementError", "STRAIN_MEASURES", "area_ratios", "assemble",
-           "deformation", "gradient_operator", "principal_strains", "shape_gradients",
-           "stress_and_tangent"]
+__all__ = ["Assembly", "InvertedElementError", "MeshGeometry", "STRAIN_MEASURES", "area_ratios",
+           "assemble", "deformation", "gradient_operator", "mesh_geometry", "principal_strains",
+           "shape_gradients", "stress_and_tangent"]
 
 STRAIN_MEASURES: dict[MaterialModel, str] = {
     MaterialModel.LINEAR: "small strain sym(grad u)",
@@ -249,7 +249,7 @@ def stress_and_tangent(model: MaterialModel | str, F: np.ndarray, *, nu: float):
 
 
 def assemble(model: MaterialModel | str, nodes: np.ndarray, triangles: np.ndarray,
-             u: np.ndarray, *, nu: float) -> Assembly:
+             u: np.ndarray, *, nu: float, geometry: MeshGeometry | None = None) -> Assembly:
     """Energy, internal forces and tangent stiffness of the displacement ``u`` (2n,), m.
 
     Parameters
@@ -264,39 +264,73 @@ def assemble(model: MaterialModel | str, nodes: np.ndarray, triangles: np.ndarra
         Nodal displacements, m, DOF order (x1, y1, x2, y2, ...).
     nu : float
         Poisson's ratio.
+    geometry : MeshGeometry, optional
+        :func:`mesh_geometry` of ``nodes`` and ``triangles``, when many states of one mesh are
+        assembled (computed here otherwise).
 
     Raises
     ------
     InvertedElementError
         If an element has det F <= 0.
     """
-    nodes = np.asarray(nodes, float)
-    triangles = np.asarray(triangles, int)
-    grad, area = shape_gradients(nodes, triangles)
-    F = _deformation(grad, triangles, u)
+    geometry = mesh_geometry(nodes, triangles) if geometry is None else geometry
+    F = _deformation(geometry.grad, geometry.triangles, u)
     det = F[:, 0, 0] * F[:, 1, 1] - F[:, 0, 1] * F[:, 1, 0]
     worst = int(np.argmin(det))
     if not det[worst] > 0:
         raise InvertedElementError(f"element {worst} inverted (det F = {det[worst]:.3g})",
                                    residuals={"det_F": det[worst]})
     W, P, A = stress_and_tangent(model, F, nu=nu)
+    area, G, Gt = geometry.area, geometry.G, geometry.Gt
+    fe = area[:, None] * (Gt @ P.reshape(-1, 4, 1))[..., 0]
+    ke = area[:, None, None] * (Gt @ A.reshape(-1, 4, 4) @ G)
+    ke = 0.5 * (ke + np.swapaxes(ke, 1, 2))
+    n2 = geometry.n2
+    force = np.bincount(geometry.dofs.ravel(), weights=fe.reshape(-1), minlength=n2)
+    data = np.bincount(geometry.slots, weights=ke.ravel(), minlength=len(geometry.indices))
+    K = sp.csr_matrix((data, geometry.indices, geometry.indptr), shape=(n2, n2))
+    return Assembly(float(np.dot(W, area)), force, K, float(det[worst]))
+
+
+@dataclass(frozen=True)
+class MeshGeometry:
+    """What :func:`assemble` needs of a mesh that does not change with the displacement:
+    shape-function gradients, areas, the (t, 4, 6) map of element DOFs to dF, and the sparsity
+    pattern of the stiffness (CSR ``indices``/``indptr``; ``slots`` places every element entry).
+    """
+
+    triangles: np.ndarray
+    grad: np.ndarray
+    area: np.ndarray
+    G: np.ndarray
+    Gt: np.ndarray
+    dofs: np.ndarray
+    n2: int
+    slots: np.ndarray
+    indices: np.ndarray
+    indptr: np.ndarray
+
+
+def mesh_geometry(nodes: np.ndarray, triangles: np.ndarray) -> MeshGeometry:
+    """The displacement-independent part of :func:`assemble` for ``nodes`` (n, 2) and
+    ``triangles`` (t, 3); build it once and pass it as ``geometry`` to assemble many states.
+    """
+    nodes = np.asarray(nodes, float)
+    triangles = np.asarray(triangles, int)
+    grad, area = shape_gradients(nodes, triangles)
     # dF_ij / du_(a, k) = delta_ik grad_aj, as a (t, 4, 6) matrix on (ij) x (a k)
     G = np.zeros((len(triangles), 2, 2, 3, 2))
     for i in range(2):
         G[:, i, :, :, i] = np.swapaxes(grad, 1, 2)
     G = G.reshape(len(triangles), 4, 6)
-    Gt = np.swapaxes(G, 1, 2)
-    fe = area[:, None] * (Gt @ P.reshape(-1, 4, 1))[..., 0]
-    ke = area[:, None, None] * (Gt @ A.reshape(-1, 4, 4) @ G)
-    ke = 0.5 * (ke + np.swapaxes(ke, 1, 2))
     dofs = element_dofs(triangles)
     n2 = 2 * len(nodes)
-    force = np.bincount(dofs.ravel(), weights=fe.reshape(-1), minlength=n2)
     rows = np.repeat(dofs, 6, axis=1).ravel()
     cols = np.tile(dofs, (1, 6)).ravel()
-    K = sp.csr_matrix((ke.ravel(), (rows, cols)), shape=(n2, n2))
-    K.sum_duplicates()
-    return Assembly(float(np.dot(W, area)), force, K, float(det[worst]))
+    keys, slots = np.unique(rows * n2 + cols, return_inverse=True)
+    indptr = np.searchsorted(keys // n2, np.arange(n2 + 1))
+    return MeshGeometry(triangles, grad, area, G, np.ascontiguousarray(np.swapaxes(G, 1, 2)),
+                        dofs, n2, slots.ravel(), keys % n2, indptr)
 
 
 def principal_strains(model: MaterialModel | str, nodes: np.ndarray, triangles: np.ndarray,

@@ -21,7 +21,7 @@ import numpy as np
 from squeeze_grasp_ros.mechanics.elastic.compliance import node_dofs
 from squeeze_grasp_ros.mechanics.elastic.contact_response import (NEWTON_TOL, ContactResponse,
                                                                   Evaluation, ResponseFailure)
-from squeeze_grasp_ros.mechanics.elastic.hyperelastic import principal_strains
+from squeeze_grasp_ros.mechanics.elastic.hyperelastic import mesh_geometry, principal_strains
 from squeeze_grasp_ros.mechanics.errors import InvalidInputError
 from squeeze_grasp_ros.mechanics.squeeze.contact_model import (ContactModel, Response, SetData,
                                                                Solution, SolveFailure)
@@ -62,9 +62,12 @@ class NonlinearContactModel(ContactModel):
         key = tuple(sd.nodes.tolist())
         if key not in responses:
             mesh = self.obj.mesh
+            if "geometry" not in self._cache:
+                self._cache["geometry"] = mesh_geometry(mesh.nodes / self.length, mesh.triangles)
             responses[key] = ContactResponse(MaterialModel(self.material_model),
                                              mesh.nodes / self.length, mesh.triangles,
-                                             sd.nodes, self.obj.material.nu)
+                                             sd.nodes, self.obj.material.nu,
+                                             geometry=self._cache["geometry"])
             last = self._cache.get("last")
             if last is not None:
                 responses[key].warm_start(last.state_u())

@@ -364,3 +364,23 @@ def test_resistance_ground_truth_equals_algorithm_2():
     for finger in ("F1", "F2", "A"):
         total = squeeze.work.get(finger, 0.0) + plan.work[finger]
         assert run["work"][finger] == pytest.approx(total, rel=1e-5)
+
+
+def test_a_neo_hookean_world_is_the_neo_hookean_mechanics(tmp_path):
+    """With ``object.material.model: neo_hookean`` the simulated world runs the
+    finite-deformation squeeze: its events, forces and work are those of the mechanics API under
+    the same model, and its forces differ from the linear world's.
+    """
+    data = scene_data(SMALL_SQUARE, name="neo_hookean_square",
+                      object={**SMALL_SQUARE["object"], "mesh": {"nodes": 300, "min_angle": 30},
+                              "material": {**SMALL_SQUARE["object"]["material"],
+                                           "model": "neo_hookean"}},
+                      squeeze={"type": "stable", "relative_depth": 0.06})
+    path = write_scene(tmp_path, data)
+    run = PipelineRunner(RunOptions(path, planner=False)).run()
+    assert run["success"] and run["world_termination"] == "none"
+    assert_ground_truth_is_the_mechanics(run, path)
+    linear = scene_data(data, name="linear_square", object={
+        **data["object"], "material": {**data["object"]["material"], "model": "linear"}})
+    _, api = mechanics(write_scene(tmp_path, linear))
+    assert run["forces"]["F1"][0] / api.state.finger_force("F1")[0] - 1 > 1e-3

@@ -46,6 +46,7 @@ from squeeze_grasp_ros.mechanics.squeeze.contact_state import ContactState, Even
 from squeeze_grasp_ros.mechanics.squeeze.fingertips import place_fingertip
 from squeeze_grasp_ros.mechanics.resistance.frictional import add_adversary
 from squeeze_grasp_ros.mechanics.squeeze.stable_pure import plan_squeeze
+from squeeze_grasp_ros.mechanics.squeeze.nonlinear_model import contact_model
 from squeeze_grasp_ros.mechanics.squeeze.stepper import advance
 from squeeze_grasp_ros.scene import (
     Scene,
@@ -65,7 +66,8 @@ from squeeze_grasp_ros.sim.sensors import (
     render_tactile,
     tactile_layout,
 )
-from squeeze_grasp_ros.mechanics.vocabulary import Finger, SQUEEZING_FINGERS, Termination
+from squeeze_grasp_ros.mechanics.vocabulary import (Finger, MaterialModel, SQUEEZING_FINGERS,
+                                                    Termination)
 
 TERMINATE_ON: tuple[str, ...] = (
     Termination.STRAIN_LIMIT,
@@ -202,12 +204,14 @@ class SimWorld:
         if obj is None:
             obj = ElasticObject(build_mesh(scene), scene_material(scene))
         self.obj = obj.precompute()
-        self.model = CountingContactModel(
-            obj,
-            scene.mu,
-            scene_limits(scene),
-            max_events_per_depth=scene.squeeze.max_events_per_depth,
-            counter=self.work,
+        material = MaterialModel(scene.object.material.model)
+        events_per_depth = scene.squeeze.max_events_per_depth
+        self.model = (
+            CountingContactModel(obj, scene.mu, scene_limits(scene),
+                                 max_events_per_depth=events_per_depth, counter=self.work)
+            if material == MaterialModel.LINEAR
+            else contact_model(material, obj, scene.mu, scene_limits(scene),
+                               max_events_per_depth=events_per_depth)
         )
         mesh = obj.mesh
         self.contacts = finger_nodes(scene, mesh)

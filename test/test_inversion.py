@@ -6,27 +6,22 @@ with the element named, never NaN and never a solver traceback; the CLI says so.
 
 from __future__ import annotations
 
-import dataclasses
 import json
 
 import numpy as np
 import pytest
 
-from squeeze_grasp_ros.api import ElasticObject, Material, event_squeeze, load_scene, scene_file
+from foam_support import foam_square
+from squeeze_grasp_ros.api import ElasticObject, event_squeeze, scene_file
 from squeeze_grasp_ros.cli import main
 from squeeze_grasp_ros.mechanics.elastic.hyperelastic import area_ratios, gradient_operator
 from squeeze_grasp_ros.mechanics.squeeze.stepper import INVERSION_AREA_RATIO
 from squeeze_grasp_ros.mechanics.vocabulary import Termination
-from squeeze_grasp_ros.scene import build_mesh, finger_nodes
 
 
 @pytest.fixture(scope="module")
 def coarse_square():
-    scene = load_scene(scene_file("foam_square"))
-    scene = dataclasses.replace(scene, object=dataclasses.replace(
-        scene.object, mesh=dataclasses.replace(scene.object.mesh, nodes=120)))
-    mesh = build_mesh(scene)
-    return ElasticObject(mesh, Material(5e4, 0.3, 0.0254)), finger_nodes(scene, mesh)
+    return foam_square(120)[1:]
 
 
 def min_area_ratio(obj: ElasticObject, displacement: np.ndarray) -> float:

@@ -7,22 +7,21 @@ rotated scenes, work = energy, scaling with E, nu near 0.5).
 """
 from __future__ import annotations
 
-import dataclasses
 
 import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from foam_support import foam_square
 from squeeze_grasp_ros.api import (ElasticObject, Material, NumericalError, event_squeeze,
-                                   load_scene, scene_file)
+                                   scene_file)
 from squeeze_grasp_ros.mechanics.elastic import hyperelastic as H
 from squeeze_grasp_ros.mechanics.elastic import shapes
 from squeeze_grasp_ros.mechanics.elastic.contact_response import ContactResponse
 from squeeze_grasp_ros.mechanics.elastic.fem import stiffness_matrix
 from squeeze_grasp_ros.mechanics.elastic.mesh import generate_mesh, mesh_from_triangles
 from squeeze_grasp_ros.mechanics.vocabulary import MaterialModel
-from squeeze_grasp_ros.scene import build_mesh, finger_nodes
 
 MODELS = ("linear", "corotational", "neo_hookean")
 NONLINEAR = ("corotational", "neo_hookean")
@@ -157,11 +156,7 @@ def test_internal_forces_against_scikit_fem(patch):
 # --------------------------------------------------------------------------- the squeeze
 @pytest.fixture(scope="module")
 def square():
-    scene = load_scene(scene_file("foam_square"))
-    scene = dataclasses.replace(scene, object=dataclasses.replace(
-        scene.object, mesh=dataclasses.replace(scene.object.mesh, nodes=500)))
-    mesh = build_mesh(scene)
-    return scene, ElasticObject(mesh, Material(5e4, 0.3, 0.0254)), finger_nodes(scene, mesh)
+    return foam_square(500)
 
 
 def squeeze(obj, contacts, model, **kw):
@@ -360,18 +355,14 @@ def test_the_force_converges_under_mesh_refinement_with_its_order_fitted(model):
     assert abs(order - np.log2((linear[0] - linear[1]) / (linear[1] - linear[2]))) < 0.15
 
 
-def test_the_squeeze_force_agrees_on_finer_meshes(square):
+def test_the_squeeze_force_agrees_on_finer_meshes():
     """The foam square's neo-Hookean F1 force at 4 % on meshes of about 800 and 1,600 nodes
     agrees within 0.5 % (contact segments are quantised by the boundary node spacing, so the
     sequence is not monotone and has no clean order; the plate problem above has one).
     """
-    scene, _, _ = square
     forces = []
     for nodes in (800, 1600):
-        fine = dataclasses.replace(scene, object=dataclasses.replace(
-            scene.object, mesh=dataclasses.replace(scene.object.mesh, nodes=nodes)))
-        mesh = build_mesh(fine)
-        obj = ElasticObject(mesh, Material(5e4, 0.3, 0.0254))
-        res = squeeze(obj, finger_nodes(fine, mesh), "neo_hookean", relative_depth=0.04)
+        _, obj, contacts = foam_square(nodes)
+        res = squeeze(obj, contacts, "neo_hookean", relative_depth=0.04)
         forces.append(res.finger_force["F1"][1])
     assert forces[1] == pytest.approx(forces[0], rel=5e-3)

@@ -9,42 +9,52 @@ changes nothing.
 from __future__ import annotations
 
 import importlib
+import sys
 
+from squeeze_grasp_ros.exit_codes import ExitCode
 from squeeze_grasp_ros.threads import single_thread_blas
 
 __all__ = ["cli", "executor", "monitor", "planner", "recorder", "sim_hardware"]
 
 
-def _run(module: str):
+def _run(module: str, name: str):
+    """Run ``module.main()``; a Ctrl-C that nothing inside handled (while the program is still
+    importing numpy, ROS or Dask, say) ends with one line naming ``name`` and exit 130, not a
+    traceback.
+    """
     single_thread_blas()
-    return importlib.import_module(module).main()
+    try:
+        return importlib.import_module(module).main()
+    except KeyboardInterrupt:
+        print(f"\n{name}: interrupted", file=sys.stderr)
+        return int(ExitCode.INTERRUPTED)
 
 
 def cli():
     """``squeeze-grasp``."""
-    return _run("squeeze_grasp_ros.cli")
+    return _run("squeeze_grasp_ros.cli", "squeeze-grasp")
 
 
 def planner():
     """``ros2 run squeeze_grasp_ros planner``."""
-    return _run("squeeze_grasp_ros.ros.nodes.planner")
+    return _run("squeeze_grasp_ros.ros.nodes.planner", "planner")
 
 
 def executor():
     """``ros2 run squeeze_grasp_ros executor``."""
-    return _run("squeeze_grasp_ros.ros.nodes.executor")
+    return _run("squeeze_grasp_ros.ros.nodes.executor", "executor")
 
 
 def monitor():
     """``ros2 run squeeze_grasp_ros monitor``."""
-    return _run("squeeze_grasp_ros.ros.nodes.monitor")
+    return _run("squeeze_grasp_ros.ros.nodes.monitor", "monitor")
 
 
 def sim_hardware():
     """``ros2 run squeeze_grasp_ros sim_hardware``."""
-    return _run("squeeze_grasp_ros.ros.nodes.sim_hardware")
+    return _run("squeeze_grasp_ros.ros.nodes.sim_hardware", "sim_hardware")
 
 
 def recorder():
     """``ros2 run squeeze_grasp_ros recorder``."""
-    return _run("squeeze_grasp_ros.ros.nodes.recorder")
+    return _run("squeeze_grasp_ros.ros.nodes.recorder", "recorder")

@@ -3,6 +3,12 @@
 """Scene validation (errors name the field) and the foundation CLI verbs' JSON."""
 import copy
 import json
+import os
+import shutil
+import signal
+import subprocess
+import sys
+import time
 from pathlib import Path
 
 import numpy as np
@@ -136,3 +142,25 @@ def test_cli_builds_and_runs_mechanics_verbs_without_ros(tmp_path):
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
     assert out.returncode == 0, out.stderr
     assert '"boundary"' in out.stdout
+
+
+@pytest.mark.parametrize("delay", [0.1, 0.25, 0.5])
+def test_ctrl_c_while_the_program_starts_is_one_line_not_a_traceback(delay, tmp_path):
+    """The installed ``squeeze-grasp`` interrupted while it is still importing (numpy, scipy,
+    Dask for ``sweep``) or starting its cluster: exit 130 and one line, at any moment.
+    """
+    script = shutil.which("squeeze-grasp", path=str(Path(sys.executable).parent))
+    proc = subprocess.Popen([script, "sweep", str(cli_sweep_spec()), "--out",
+                             str(tmp_path / "out"), "--workers", "1"], stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, text=True, start_new_session=True)
+    time.sleep(delay)
+    os.killpg(proc.pid, signal.SIGINT)
+    _, err = proc.communicate(timeout=60)
+    assert proc.returncode == 130, err
+    assert "Traceback" not in err
+    assert "interrupted" in err or "stopped by SIGINT" in err
+
+
+def cli_sweep_spec() -> Path:
+    """The shipped example sweep spec."""
+    return Path(__file__).resolve().parents[1] / "config" / "sweeps" / "example.yaml"

@@ -441,3 +441,32 @@ def test_quick_requests_are_answered_while_a_long_one_runs(planner):
     while not long_one.done():
         planner.executor.spin_once(0.05)
     assert long_one.result().success
+
+
+def test_a_long_request_whose_client_leaves_is_stopped(planner):
+    """ROS 2 services have no cancel: a client that gives up and destroys its client leaves
+    the graph, and the planner stops that request's work at its next progress report instead
+    of computing an answer nobody can take; later requests are served as before.
+    """
+    from squeeze_grasp_interfaces.srv import EventSqueeze, PlanSqueeze
+
+    data = yaml.safe_load(BLOB)
+    data["object"]["mesh"] = {"nodes": 3000}
+    load(planner, scene_yaml=yaml.safe_dump(data), object_id="blob")
+    node = planner.node
+    slow = node.create_client(EventSqueeze, f"{planner.planner_name}/event_squeeze")
+    while not slow.service_is_ready():
+        planner.executor.spin_once(0.05)
+    slow.call_async(EventSqueeze.Request(object_id="blob", relative_depth=0.3, step=2e-5))
+    while planner.planner._pending == 0:
+        planner.executor.spin_once(0.01)
+    node.destroy_client(slow)
+    while planner.planner._pending:
+        planner.executor.spin_once(0.05)
+    assert len(planner.planner.abandoned) == 1
+    (fraction,) = planner.planner.abandoned[0]
+    print(f"stopped at {100 * fraction:.1f} % of the squeeze")
+    assert fraction < 1.0
+    quick = planner.call(PlanSqueeze, "plan_squeeze",
+                         PlanSqueeze.Request(object_id="blob", squeeze_type="stable"))
+    assert quick.success

@@ -112,6 +112,9 @@ class PlannerNode(Node):
         self._pool = ThreadPoolExecutor(max_workers=value("worker_threads"),
                                         thread_name_prefix="planner-worker")
         self._stopping = threading.Event()
+        self.abandoned: list[tuple] = []
+        """Progress (the arguments of the last report) of service requests stopped because
+        their client left the graph."""
         self._feedback: queue.SimpleQueue[tuple[ServerGoalHandle, Any]] = queue.SimpleQueue()
 
         services = QoSProfile(history=HistoryPolicy.KEEP_LAST,
@@ -152,10 +155,12 @@ class PlannerNode(Node):
     async def _load_object(self, request: LoadObject.Request,
                            response: LoadObject.Response) -> LoadObject.Response:
         """Mesh, factor and cache the scene's object on a worker."""
+        watch = self._client_watch("load_object")
+
         def load() -> LoadObject.Response:
             source = planning.read_scene(request.scene_yaml, request.scene_path, self.roots)
             loaded, cached = planning.load_cached(self.cache, source, request.object_id,
-                                                  request.solver_route, self.limits)
+                                                  request.solver_route, self.limits, watch)
             return messages.load_object_response(loaded, cached, request.return_model)
         return await self._in_worker(LoadObject.Response, load)
 
@@ -201,10 +206,11 @@ class PlannerNode(Node):
 
     async def _event_squeeze(self, request: EventSqueeze.Request,
                              response: EventSqueeze.Response) -> EventSqueeze.Response:
-        """Event-driven squeeze on a worker."""
+        """Event-driven squeeze on a worker; stopped if its client leaves."""
+        watch = self._client_watch("event_squeeze")
         return await self._in_worker(EventSqueeze.Response,
                                      lambda: self._event_squeeze_result(EventSqueeze.Response,
-                                                                        request))
+                                                                        request, watch))
 
     # ------------------------------------------------------------------ actions
 
@@ -302,6 +308,24 @@ class PlannerNode(Node):
             return messages.failure(response_type, ErrorCode.CANCELLED,
                                     "the planner is shutting down")
         return await future
+
+    def _client_watch(self, service: str) -> Callable[..., None]:
+        """A progress callback for the worker of a ``~/<service>`` request: raises
+        :class:`Cancelled` once no client of the service is left on the graph (the requester
+        has gone, so nobody can take the answer) or the node is shutting down.
+
+        ROS 2 services have no cancel; a client that gives up and destroys its client (or
+        whose process ends) leaves the graph, and its work stops at the next progress report.
+        """
+        name = f"{self.get_fully_qualified_name()}/{service}"
+
+        def check(*progress: Any) -> None:
+            if self._stopping.is_set():
+                raise Cancelled("the planner is shutting down")
+            if self.count_clients(name) == 0:
+                self.abandoned.append(progress)
+                raise Cancelled(f"abandoned: no client of {name} is left to take the answer")
+        return check
 
     def _reporter(self, goal_handle: ServerGoalHandle,
                   feedback: Callable[..., Any]) -> Callable[..., None]:

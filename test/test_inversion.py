@@ -15,7 +15,7 @@ from foam_support import foam_square
 from squeeze_grasp_ros.api import ElasticObject, event_squeeze, scene_file
 from squeeze_grasp_ros.cli import main
 from squeeze_grasp_ros.mechanics.elastic.hyperelastic import area_ratios, gradient_operator
-from squeeze_grasp_ros.mechanics.squeeze.stepper import INVERSION_AREA_RATIO
+from squeeze_grasp_ros.mechanics.squeeze.contact_model import INVERSION_AREA_RATIO, ContactModel
 from squeeze_grasp_ros.mechanics.vocabulary import Termination
 
 
@@ -73,3 +73,31 @@ def test_the_cli_reports_the_inversion_as_the_termination(tmp_path, capfd):
     assert out["relative_depth"] < 0.9
     assert main(["squeeze", str(path), "--relative-depth", "0.9"]) == 0
     assert "element_inverted" in capfd.readouterr().out
+
+
+def test_the_gradient_bound_never_understates_an_element_gradient(coarse_square):
+    """The per-element bound that lets the linear model skip its solve is a bound: for random
+    loads on random boundary nodes, every element's exact displacement gradient (one solve)
+    is below it, and the area ratio the model reports from it is below the exact one.
+    """
+    obj, _ = coarse_square
+    model = ContactModel(obj, 0.4)
+    boundary = model.boundary_nodes
+    rng = np.random.default_rng(7)
+    used_bound = 0
+    for scale in (1e-3, 1e-2, 3e-2):
+        for _ in range(10):
+            nodes = np.sort(rng.choice(boundary, 4, replace=False))
+            forces = scale * rng.normal(size=(4, 2))
+            loads = np.zeros(2 * obj.mesh.n)
+            loads[np.stack([2 * nodes, 2 * nodes + 1], 1).ravel()] = forces.ravel()
+            H = (obj.gradient @ obj.pinv_apply(loads)).reshape(-1, 4)
+            bound = obj.gradient_bounds(nodes) @ np.linalg.norm(forces, axis=1)
+            assert np.all(np.sqrt((H * H).sum(axis=1)) <= bound * (1 + 1e-12) + 1e-15)
+            sd = model.set_data(tuple(nodes.tolist()))
+            delta = np.zeros((4, 2))
+            reported, element = model.area_ratio(sd, delta, forces)
+            exact = model.field_area_ratio(model.full_displacement(sd, delta, forces))[0]
+            assert reported <= exact + 1e-12
+            used_bound += element == -1
+    assert 0 < used_bound < 30

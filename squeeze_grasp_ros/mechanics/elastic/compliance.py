@@ -34,6 +34,7 @@ from squeeze_grasp_ros.mechanics.elastic.fem import (
     rotation_mode_norm,
     stiffness_matrix,
 )
+from squeeze_grasp_ros.mechanics.elastic.hyperelastic import gradient_operator
 from squeeze_grasp_ros.mechanics.elastic.material import Material
 from squeeze_grasp_ros.mechanics.elastic.mesh import Mesh
 
@@ -184,6 +185,7 @@ class ElasticObject:
     material: Material
     route: Route = "factorized"
     _diag: dict = field(default_factory=dict, repr=False, compare=False)
+    _gradient_bounds: dict = field(default_factory=dict, repr=False, compare=False)
 
     def __post_init__(self) -> None:
         if self.route not in ROUTES:
@@ -224,6 +226,38 @@ class ElasticObject:
             warnings.warn(f"stiffness condition estimate {s.condition:.3g} exceeds "
                           f"{CONDITION_WARN:.0e}: expect lost digits", ConditioningWarning)
         return s
+
+    @cached_property
+    def gradient(self) -> sp.csr_matrix:
+        """Sparse (4t, 2n) map of dimensionless displacements to displacement gradients
+        (:func:`~squeeze_grasp_ros.mechanics.elastic.hyperelastic.gradient_operator`, X / L).
+        """
+        return gradient_operator(self.mesh.nodes / self.scale, self.mesh.triangles)
+
+    @cached_property
+    def rigid_gradients(self) -> np.ndarray:
+        """Displacement gradients (4t, 3) of the rigid modes R (a rotation's is uniform)."""
+        return self.gradient @ self.rigid
+
+    def gradient_bounds(self, nodes) -> np.ndarray:
+        """Per element e and node k of ``nodes`` (t, len(nodes)): the Frobenius norm of the
+        displacement gradient of element e per unit dimensionless load at node k (in its worst
+        direction), so that ||grad u_e|| <= sum_k bounds[e, k] ||f_k|| for the field K+ f of
+        loads f_k at those nodes.
+
+        A node's column is computed on its first use (one solve with two right-hand sides) and
+        kept (t floats per node).
+        """
+        nodes = [int(k) for k in nodes]
+        missing = sorted(set(nodes) - set(self._gradient_bounds))
+        if missing:
+            dofs = node_dofs(np.array(missing))
+            loads = np.zeros((2 * self.mesh.n, len(dofs)))
+            loads[dofs, np.arange(len(dofs))] = 1.0
+            H = (self.gradient @ self.pinv_apply(loads)).reshape(-1, 4, len(missing), 2)
+            per_element = np.sqrt((H * H).sum(axis=(1, 3)))
+            self._gradient_bounds.update(zip(missing, per_element.T))
+        return np.column_stack([self._gradient_bounds[k] for k in nodes])
 
     def pinv_apply(self, rhs: np.ndarray) -> np.ndarray:
         """Dimensionless K_hat+ applied to ``rhs`` (2n,) or (2n, k); records the residual."""

@@ -39,11 +39,19 @@ from squeeze_grasp_ros.mechanics.elastic.fem import (
     principal_strains,
     strain_displacement,
 )
-from squeeze_grasp_ros.mechanics.elastic.hyperelastic import area_ratios, gradient_operator
+from squeeze_grasp_ros.mechanics.elastic.hyperelastic import area_ratios
 from squeeze_grasp_ros.mechanics.squeeze.fingertips import cross, tangent, unit
 from squeeze_grasp_ros.mechanics.elastic.reduced import reduce_blocks
 from squeeze_grasp_ros.mechanics.vocabulary import StrainCriterion
 
+INVERSION_AREA_RATIO = 0.01
+"""A squeeze ends ``element_inverted`` when an element's area ratio det F falls to this: the
+element is about to turn inside out (det F <= 0), where no material model means anything and
+the finite-deformation solvers cannot converge (the corotational law has no energy barrier at
+det F = 0)."""
+GRADIENT_BOUND_EXACT = 1.0 - INVERSION_AREA_RATIO**0.5
+"""Below this bound on every element's displacement gradient, det F >= (1 - bound)^2 stays above
+INVERSION_AREA_RATIO and the linear model's area check needs no solve."""
 NEWTON_MAX_ITERATIONS = 50
 NEWTON_BACKTRACKS = 30
 SINGULAR_SLIDING = (
@@ -533,15 +541,25 @@ class ContactModel:
         """(smallest det F = deformed / reference element area, element) of a full
         displacement / L; <= 0 means the deformed mesh x + u folds over.
         """
-        if "gradient" not in self._cache:
-            mesh = self.obj.mesh
-            self._cache["gradient"] = gradient_operator(mesh.nodes / self.length, mesh.triangles)
-        det = area_ratios(self._cache["gradient"], u_hat)
+        det = area_ratios(self.obj.gradient, u_hat)
         k = int(np.argmin(det))
         return float(det[k]), k
 
     def area_ratio(self, sd: SetData, delta: np.ndarray, F: np.ndarray) -> tuple[float, int]:
-        """(smallest det F, element) of the configuration (one sparse solve in this model)."""
+        """(smallest det F, element) of the configuration, or (a lower bound, -1) when the
+        gradient bound proves every element far from inversion.
+
+        Every element's displacement gradient H_e obeys ||H_e|| <= B_e = sum_k b_ek ||F_k|| +
+        ||H_e of the rigid part|| (b_ek: :meth:`ElasticObject.gradient_bounds`), and
+        det(I + H) >= (1 - ||H||)^2; while max_e B_e < GRADIENT_BOUND_EXACT that lower bound
+        is returned without a solve, else the field is solved (one sparse solve) and measured.
+        """
+        g = sd.E.T @ delta.reshape(-1)
+        rigid = np.sqrt(((self.obj.rigid_gradients @ g).reshape(-1, 4) ** 2).sum(axis=1))
+        bound = float((self.obj.gradient_bounds(sd.nodes) @ np.linalg.norm(F, axis=1)
+                       + rigid).max())
+        if bound < GRADIENT_BOUND_EXACT:
+            return (1.0 - bound) ** 2, -1
         return self.field_area_ratio(self.full_displacement(sd, delta, F))
 
 

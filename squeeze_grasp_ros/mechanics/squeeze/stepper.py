@@ -76,6 +76,7 @@ from collections.abc import Mapping
 import numpy as np
 
 from squeeze_grasp_ros.mechanics.squeeze.contact_model import (
+    INVERSION_AREA_RATIO,
     Configuration,
     ContactModel,
     Solution,
@@ -108,11 +109,6 @@ TERMINATION_ORDER: tuple[str, ...] = (
 SLIP_RATE_ZERO = 1e-10
 """Frictionless contacts: polar-angle rates (rad per unit motion) below this have no slip
 direction, so round-off in a symmetric contact cannot fake a one-way finger slip."""
-INVERSION_AREA_RATIO = 0.01
-"""The squeeze ends ``element_inverted`` when an element's area ratio det F falls to this: the
-element is about to turn inside out (det F <= 0), where no material model means anything and
-the finite-deformation solvers cannot converge (the corotational law has no energy barrier at
-det F = 0)."""
 MAX_SUBSTEP_HALVINGS = 12
 CONTINUATION_ITERATIONS = 12
 MAX_ANGLE_JUMP = 0.05

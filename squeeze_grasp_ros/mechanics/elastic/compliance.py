@@ -39,6 +39,8 @@ from squeeze_grasp_ros.mechanics.elastic.material import Material
 from squeeze_grasp_ros.mechanics.elastic.mesh import Mesh
 
 Route = Literal["factorized", "spectral"]
+GRADIENT_BOUND_BYTES = 64 * 2**20
+"""Memory an object keeps for :meth:`ElasticObject.gradient_bounds` (t floats per node)."""
 ROUTES: tuple[str, ...] = ("factorized", "spectral")
 CONDITION_WARN = 1e12
 """Condition estimate of a factorised or reduced matrix above which a ConditioningWarning is
@@ -246,7 +248,8 @@ class ElasticObject:
         loads f_k at those nodes.
 
         A node's column is computed on its first use (one solve with two right-hand sides) and
-        kept (t floats per node).
+        kept (t floats per node), the least recently computed dropped beyond
+        GRADIENT_BOUND_BYTES.
         """
         nodes = [int(k) for k in nodes]
         missing = sorted(set(nodes) - set(self._gradient_bounds))
@@ -257,7 +260,11 @@ class ElasticObject:
             H = (self.gradient @ self.pinv_apply(loads)).reshape(-1, 4, len(missing), 2)
             per_element = np.sqrt((H * H).sum(axis=(1, 3)))
             self._gradient_bounds.update(zip(missing, per_element.T))
-        return np.column_stack([self._gradient_bounds[k] for k in nodes])
+        columns = np.column_stack([self._gradient_bounds[k] for k in nodes])
+        keep = max(len(nodes), GRADIENT_BOUND_BYTES // (8 * len(self.mesh.triangles)))
+        for k in list(self._gradient_bounds)[:max(len(self._gradient_bounds) - keep, 0)]:
+            del self._gradient_bounds[k]
+        return columns
 
     def pinv_apply(self, rhs: np.ndarray) -> np.ndarray:
         """Dimensionless K_hat+ applied to ``rhs`` (2n,) or (2n, k); records the residual."""

@@ -141,6 +141,7 @@ def _start(scheduler: Optional[str], workers: Optional[int], stop: "StopSignals"
     closed, so a stop signal interrupts it at once (:class:`Stopped`); a local cluster is let
     finish starting, with SIGINT kept from its workers, and is then closed by the caller.
     """
+    import dask
     from distributed import Client, LocalCluster
     if scheduler is not None:
         try:
@@ -153,7 +154,9 @@ def _start(scheduler: Optional[str], workers: Optional[int], stop: "StopSignals"
     # Dask's own logs stay below CRITICAL: what goes wrong in a task is recorded (manifest,
     # summary, exit status) and a cluster closed right after its start has workers log
     # tracebacks of heartbeats cut short.
-    with _sigint_blocked():
+    # The workers' statistical profiler samples every thread's stack each 10 ms under the GIL:
+    # CPU taken from the evaluations for a dashboard page nobody may be looking at.
+    with _sigint_blocked(), dask.config.set({"distributed.worker.profile.enabled": False}):
         cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
                                host="127.0.0.1", dashboard_address=dashboard,
                                silence_logs=logging.CRITICAL)

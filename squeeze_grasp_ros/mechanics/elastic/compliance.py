@@ -39,8 +39,8 @@ from squeeze_grasp_ros.mechanics.elastic.material import Material
 from squeeze_grasp_ros.mechanics.elastic.mesh import Mesh
 
 Route = Literal["factorized", "spectral"]
-GRADIENT_BOUND_BYTES = 64 * 2**20
-"""Memory an object keeps for :meth:`ElasticObject.gradient_bounds` (t floats per node)."""
+GRADIENT_BOUND_BYTES = 128 * 2**20
+"""Memory an object keeps for :meth:`ElasticObject.load_gradients` (9 t floats per node)."""
 ROUTES: tuple[str, ...] = ("factorized", "spectral")
 CONDITION_WARN = 1e12
 """Condition estimate of a factorised or reduced matrix above which a ConditioningWarning is
@@ -187,7 +187,7 @@ class ElasticObject:
     material: Material
     route: Route = "factorized"
     _diag: dict = field(default_factory=dict, repr=False, compare=False)
-    _gradient_bounds: dict = field(default_factory=dict, repr=False, compare=False)
+    _load_gradients: dict = field(default_factory=dict, repr=False, compare=False)
 
     def __post_init__(self) -> None:
         if self.route not in ROUTES:
@@ -241,30 +241,40 @@ class ElasticObject:
         """Displacement gradients (4t, 3) of the rigid modes R (a rotation's is uniform)."""
         return self.gradient @ self.rigid
 
-    def gradient_bounds(self, nodes) -> np.ndarray:
-        """Per element e and node k of ``nodes`` (t, len(nodes)): the Frobenius norm of the
-        displacement gradient of element e per unit dimensionless load at node k (in its worst
-        direction), so that ||grad u_e|| <= sum_k bounds[e, k] ||f_k|| for the field K+ f of
-        loads f_k at those nodes.
-
-        A node's column is computed on its first use (one solve with two right-hand sides) and
-        kept (t floats per node), the least recently computed dropped beyond
-        GRADIENT_BOUND_BYTES.
-        """
+    def _gradients_of(self, nodes) -> list[tuple[np.ndarray, np.ndarray]]:
+        """(gradients (t, 4, 2), their per-element Frobenius norms (t,)) per node, cached."""
         nodes = [int(k) for k in nodes]
-        missing = sorted(set(nodes) - set(self._gradient_bounds))
+        missing = sorted(set(nodes) - set(self._load_gradients))
         if missing:
             dofs = node_dofs(np.array(missing))
             loads = np.zeros((2 * self.mesh.n, len(dofs)))
             loads[dofs, np.arange(len(dofs))] = 1.0
             H = (self.gradient @ self.pinv_apply(loads)).reshape(-1, 4, len(missing), 2)
-            per_element = np.sqrt((H * H).sum(axis=(1, 3)))
-            self._gradient_bounds.update(zip(missing, per_element.T))
-        columns = np.column_stack([self._gradient_bounds[k] for k in nodes])
-        keep = max(len(nodes), GRADIENT_BOUND_BYTES // (8 * len(self.mesh.triangles)))
-        for k in list(self._gradient_bounds)[:max(len(self._gradient_bounds) - keep, 0)]:
-            del self._gradient_bounds[k]
-        return columns
+            for i, k in enumerate(missing):
+                g = np.ascontiguousarray(H[:, :, i, :])
+                self._load_gradients[k] = (g, np.sqrt((g * g).sum(axis=(1, 2))))
+        out = [self._load_gradients[k] for k in nodes]
+        keep = max(len(nodes), GRADIENT_BOUND_BYTES // (72 * len(self.mesh.triangles)))
+        for k in list(self._load_gradients)[:max(len(self._load_gradients) - keep, 0)]:
+            del self._load_gradients[k]
+        return out
+
+    def load_gradients(self, nodes) -> list[np.ndarray]:
+        """For each mesh node k of ``nodes``: the displacement gradients (t, 4, 2) of every
+        element per unit dimensionless load at k in x and in y (rows 2i + j: du_i/dX_j), so the
+        field K+ f of loads f_k at those nodes has grad u_e = sum_k G_k[e] @ f_k.
+
+        A node's gradients are computed on its first use (one solve with two right-hand sides)
+        and kept, the least recently computed dropped beyond GRADIENT_BOUND_BYTES.
+        """
+        return [g for g, _ in self._gradients_of(nodes)]
+
+    def gradient_bounds(self, nodes) -> np.ndarray:
+        """Per element e and node k of ``nodes`` (t, len(nodes)): the Frobenius norm of
+        :meth:`load_gradients` of element e per unit load at k in its worst direction, so that
+        ||grad u_e|| <= sum_k bounds[e, k] ||f_k|| for the field K+ f of loads f_k.
+        """
+        return np.column_stack([n for _, n in self._gradients_of(nodes)])
 
     def pinv_apply(self, rhs: np.ndarray) -> np.ndarray:
         """Dimensionless K_hat+ applied to ``rhs`` (2n,) or (2n, k); records the residual."""

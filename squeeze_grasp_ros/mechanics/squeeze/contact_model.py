@@ -546,21 +546,33 @@ class ContactModel:
         return float(det[k]), k
 
     def area_ratio(self, sd: SetData, delta: np.ndarray, F: np.ndarray) -> tuple[float, int]:
-        """(smallest det F, element) of the configuration, or (a lower bound, -1) when the
-        gradient bound proves every element far from inversion.
+        """(smallest det F, element) of the configuration, without solving for the field.
 
-        Every element's displacement gradient H_e obeys ||H_e|| <= B_e = sum_k b_ek ||F_k|| +
+        Every element's displacement gradient obeys ||H_e|| <= B_e = sum_k b_ek ||F_k|| +
         ||H_e of the rigid part|| (b_ek: :meth:`ElasticObject.gradient_bounds`), and
-        det(I + H) >= (1 - ||H||)^2; while max_e B_e < GRADIENT_BOUND_EXACT that lower bound
-        is returned without a solve, else the field is solved (one sparse solve) and measured.
+        det(I + H) >= (1 - ||H||)^2: elements with B_e < GRADIENT_BOUND_EXACT are above
+        INVERSION_AREA_RATIO whatever they are; the others get their exact H_e = sum_k G_k[e] F_k
+        + rigid part (:meth:`ElasticObject.load_gradients`). Returns the smallest exact det F
+        and its element, or, if that is larger, the bound (1 - max B_e)^2 of the rest with
+        element -1 (no element near the threshold).
         """
         g = sd.E.T @ delta.reshape(-1)
-        rigid = np.sqrt(((self.obj.rigid_gradients @ g).reshape(-1, 4) ** 2).sum(axis=1))
-        bound = float((self.obj.gradient_bounds(sd.nodes) @ np.linalg.norm(F, axis=1)
-                       + rigid).max())
-        if bound < GRADIENT_BOUND_EXACT:
-            return (1.0 - bound) ** 2, -1
-        return self.field_area_ratio(self.full_displacement(sd, delta, F))
+        rigid = (self.obj.rigid_gradients @ g).reshape(-1, 4)
+        key = ("gradient_bounds", tuple(sd.nodes.tolist()))
+        if self._cache.get("gradient_bounds_key") != key:
+            self._cache["gradient_bounds_key"] = key
+            self._cache["gradient_bounds"] = self.obj.gradient_bounds(sd.nodes)
+        bound = (self._cache["gradient_bounds"] @ np.linalg.norm(F, axis=1)
+                 + np.sqrt((rigid * rigid).sum(axis=1)))
+        near = np.flatnonzero(bound >= GRADIENT_BOUND_EXACT)
+        rest = np.delete(bound, near)
+        floor = (1.0 - rest.max()) ** 2 if rest.size else np.inf
+        if near.size == 0:
+            return float(floor), -1
+        H = rigid[near] + sum(G[near] @ f for G, f in zip(self.obj.load_gradients(sd.nodes), F))
+        det = (1.0 + H[:, 0]) * (1.0 + H[:, 3]) - H[:, 1] * H[:, 2]
+        k = int(np.argmin(det))
+        return (float(det[k]), int(near[k])) if det[k] <= floor else (float(floor), -1)
 
 
 def strain_criterion(eps: np.ndarray, criterion: str) -> tuple[float, int]:

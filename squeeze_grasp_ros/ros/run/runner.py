@@ -30,6 +30,7 @@ from __future__ import annotations
 import importlib.util
 import json
 import os
+import shutil
 import signal
 import subprocess
 import sys
@@ -148,6 +149,7 @@ class PipelineRunner:
         self.sim_state_data: list[bytes] = []
         self.sim_state_ns = -1
         self.recorder_ns = -1
+        self.discard_recording = False
         self.feedback: list[ExecuteGrasp.Feedback] = []
         loop = pipeline.loop_qos(1000)
         c = self.client
@@ -296,27 +298,34 @@ class PipelineRunner:
             self.options.timeout,
             "the publishers of the run's outcome topics",
         )
+        if not self.options.attach:
+            self._refuse_if_domain_busy(time.monotonic(), own=1)
         self.start_ns = self.sim_state_ns
         self.timing["start_nodes"] = time.perf_counter() - started
 
-    def _refuse_if_domain_busy(self, deadline: float) -> None:
-        """Refuse to start the nodes when another simulated pipeline runs on this ROS domain.
+    def _refuse_if_domain_busy(self, deadline: float, own: int = 0) -> None:
+        """Refuse to run when another simulated pipeline runs on this ROS domain.
 
         Two lockstep loops on one domain answer each other's ticks and record each other's
         messages. Discovery runs while the run plans, for at least ``discovery_wait`` s; then a
-        publisher of ``sim/tick`` means another simulation is running. Two runs started within
-        that time of each other are not told apart: give concurrent runs their own
+        publisher of ``sim/tick`` means another simulation is running. The check is made again
+        once this run's own nodes are up (``own`` = 1 publisher of its own), before the goal,
+        for a machine so loaded that discovery took longer; that refusal removes the recording
+        folder this run had started (it holds the other run's messages only). Two runs started
+        within that time of each other are not told apart: give concurrent runs their own
         ROS_DOMAIN_ID.
         """
         while time.monotonic() < deadline:
             self.executor.spin_once(0.02)
-        others = self.client.count_publishers("/" + pipeline.TICK)
-        if others:
+        others = self.client.count_publishers("/" + pipeline.TICK) - own
+        if others > 0:
+            self.discard_recording = bool(own)
             domain = os.environ.get("ROS_DOMAIN_ID", "0")
             raise RunError(
                 f"another simulated pipeline is running on ROS_DOMAIN_ID {domain} "
-                f"({others} publisher(s) of /{pipeline.TICK}); a second run would "
-                "corrupt both. Stop it, or give this run its own domain, e.g. "
+                f"({others} publisher(s) of /{pipeline.TICK}"
+                f"{', found once this run had started its nodes' if own else ''}); a second "
+                "run would corrupt both. Stop it, or give this run its own domain, e.g. "
                 "ROS_DOMAIN_ID=42 squeeze-grasp run ..."
             )
 
@@ -577,6 +586,8 @@ class PipelineRunner:
             self.context.try_shutdown()
             if self.params_file is not None:
                 self.params_file.unlink(missing_ok=True)
+            if self.discard_recording and self.options.record:
+                shutil.rmtree(self.options.record, ignore_errors=True)
 
     # ----------------------------------------------------------------- the whole run
     def run(self) -> dict:

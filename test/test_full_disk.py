@@ -20,6 +20,7 @@ import textwrap
 from pathlib import Path
 
 from mcap.reader import make_reader
+from rosbags.rosbag2 import Reader
 
 from squeeze_grasp_ros.ros.recording.bag import STOPPED_KEY, bag_info, read_bag
 
@@ -45,8 +46,9 @@ WRITE_UNTIL_FULL = textwrap.dedent("""
 
 
 def test_a_bag_that_runs_out_of_room_keeps_every_complete_chunk(tmp_path):
-    """Messages are kept in order from the first, with nothing missing before the cut; every
-    reader (ours, the mcap library's seeking reader) sees the same count as metadata.yaml.
+    """Messages are kept in order from the first, with nothing missing before the cut; the
+    file ends with a rebuilt summary, so every reader (ours, the mcap library's indexed reader,
+    rosbags, which reads MCAP only through its index) sees the count metadata.yaml states.
     """
     bag = tmp_path / "bag"
     out = subprocess.run([sys.executable, "-c", WRITE_UNTIL_FULL, str(bag)], check=True,
@@ -57,7 +59,11 @@ def test_a_bag_that_runs_out_of_room_keeps_every_complete_chunk(tmp_path):
     assert len(messages) > 1000
     assert [m.log_time_ns for m in messages] == [i * 1_000_000 for i in range(len(messages))]
     with open(bag / "bag_0.mcap", "rb") as f:
-        assert sum(1 for _ in make_reader(f).iter_messages()) == len(messages)
+        reader = make_reader(f, validate_crcs=True)
+        assert reader.get_summary().statistics.message_count == len(messages)
+        assert sum(1 for _ in reader.iter_messages()) == len(messages)
+    with Reader(bag) as indexed:  # rosbags reads MCAP through its index only
+        assert sum(1 for _ in indexed.messages()) == len(messages)
     info = bag_info(bag)
     assert info["message_count"] == len(messages)
     assert "EFBIG" in info["custom_data"][STOPPED_KEY]
@@ -112,6 +118,8 @@ def test_a_run_whose_disk_fills_up_prints_its_summary_and_leaves_a_readable_bag(
     ticks = [m for m in messages if m.topic == "/sim/tick"]
     assert 0 < len(ticks) < 700
     assert len(messages) == info["message_count"]
+    with Reader(kept) as indexed:
+        assert sum(1 for _ in indexed.messages()) == len(messages)
     if argv[0] == "unshare":
         replay = json.loads((tmp_path / "replay.json").read_text())
         assert replay["reproduced"] is True

@@ -15,8 +15,9 @@ a SIGINT handler) and an interrupted run leaves a complete recording.
 A full disk (or a file-size or quota limit) does not cost the recording: the write that failed
 is cut off at the last complete record, the bag stops taking messages (:attr:`BagWriter.failure`
 says why, :attr:`BagWriter.dropped` counts what was refused), and :meth:`BagWriter.close` ends
-the file after its last complete chunk (a metadata record, DataEnd and footer, no summary:
-readers scan it), using the room of a reserve file the writer holds from the start.
+the file after its last complete chunk as a finished writer would (a metadata record,
+DataEnd, a summary rebuilt from the file's own records, the footer:
+:mod:`.mcap_end`), using the room of a reserve file the writer holds from the start.
 ``metadata.yaml`` then counts the messages kept and says in ``custom_data.recording_stopped``
 why the recording ended early.
 
@@ -36,14 +37,14 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import yaml
-from mcap.exceptions import EndOfFile, McapError
+from mcap.exceptions import McapError
 from mcap.reader import make_reader
-from mcap.data_stream import RecordBuilder
-from mcap.records import Channel, DataEnd, Footer, Message, Metadata, Schema
+from mcap.records import Channel, Message, Metadata, Schema
 from mcap.stream_reader import StreamReader
-from mcap.writer import MCAP0_MAGIC, CompressionType, Writer
+from mcap.writer import CompressionType, Writer
 
 from squeeze_grasp_ros.inputs import InputError, load_yaml, read_text
+from squeeze_grasp_ros.ros.recording.mcap_end import DataSection, file_end, read_data_section
 from squeeze_grasp_ros.ros.recording.schema import message_definition, type_hash
 
 METADATA_VERSION = 9
@@ -318,52 +319,50 @@ class BagWriter:
         tmp.replace(self.path / "metadata.yaml")
 
     def _end_after_failure(self) -> dict:
-        """End the file after the last complete record that leaves room for its end: the kept
-        messages are counted from the file itself; returns the bag information of what is kept.
+        """End the file after the last complete record that leaves room for its end (DataEnd,
+        a rebuilt summary, the footer): the kept messages are counted from the file itself;
+        returns the bag information of what is kept.
         """
         written = sum(t.count for t in self.topics.values())
         while len(self._stream.boundaries) > 1:
+            section = self._count_kept(self._stream.boundaries[-1])
             end = self._stream.boundaries[-1]
-            self._count_kept(end)
             lost = written + self.dropped - sum(t.count for t in self.topics.values())
             self.custom_data[STOPPED_KEY] = (f"{self.failure}; the last {lost} messages were not "
                                              "recorded")
             info = self.metadata()
+            tail = b""
             for record in (Metadata("rosbag2", {"serialized_metadata": plain_yaml(info)}), None):
-                builder = RecordBuilder()
-                if record is not None:
-                    record.write(builder)
-                DataEnd(0).write(builder)
-                Footer(0, 0, 0).write(builder)
+                tail = file_end(section, end, record)
                 try:
-                    self._stream.write(builder.end() + MCAP0_MAGIC)
+                    self._stream.write(tail)
                     return info
                 except OSError:
                     continue
-            self._stream.cut(self._stream.boundaries[-2])
+            # no room for the end: give up at least as many bytes of data as it needs
+            earlier = [b for b in self._stream.boundaries if b <= end - len(tail)]
+            self._stream.cut(earlier[-1] if len(earlier) > 1 else 0)
         raise BagError(f"{self.path / self.file_name}: no room even for the end of the file")
 
-    def _count_kept(self, end: int) -> None:
-        """Set every topic's count, and the time range, to the messages in the first ``end``
-        bytes of the file.
+    def _count_kept(self, end: int) -> DataSection:
+        """Index the first ``end`` bytes of the file; set every topic's count, and the time
+        range, to the messages they hold.
         """
         self._stream.cut(end)
         with open(self.path / self.file_name, "rb") as f:
-            data = f.read(end)
-        by_channel = {t.channel: t for t in self.topics.values()}
+            section = read_data_section(f.read(end))
+            last = section.chunk_indexes[-1] if section.chunk_indexes else None
+            if last is not None and not last.message_index_offsets:
+                # the write that failed was this chunk's message indexes: readers that go by
+                # the index would skip it, so it goes too
+                end = last.chunk_start_offset
+                self._stream.cut(end)
+                f.seek(0)
+                section = read_data_section(f.read(end))
         for t in self.topics.values():
-            t.count = 0
-        self.start_ns = self.end_ns = None
-        reader = StreamReader(io.BytesIO(data), emit_chunks=False)
-        try:
-            for record in reader.records:
-                if isinstance(record, Message) and record.channel_id in by_channel:
-                    by_channel[record.channel_id].count += 1
-                    ns = record.log_time
-                    self.start_ns = ns if self.start_ns is None else min(self.start_ns, ns)
-                    self.end_ns = ns if self.end_ns is None else max(self.end_ns, ns)
-        except EndOfFile:
-            return  # the data ends on a record boundary, before any footer: all of it is read
+            t.count = section.counts.get(t.channel, 0)
+        self.start_ns, self.end_ns = section.start, section.end
+        return section
 
 
 @dataclass(frozen=True)

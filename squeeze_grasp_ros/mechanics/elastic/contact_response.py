@@ -28,8 +28,7 @@ import numpy as np
 import scipy.sparse.linalg as spla
 
 from squeeze_grasp_ros.mechanics.elastic.hyperelastic import (MeshGeometry, area_ratios,
-                                                                assemble, gradient_operator,
-                                                                mesh_geometry)
+                                                                assemble, mesh_geometry)
 from squeeze_grasp_ros.mechanics.errors import InvalidInputError
 from squeeze_grasp_ros.mechanics.vocabulary import MaterialModel
 
@@ -42,8 +41,8 @@ DISPLACEMENT_FLOOR = 1e-6
 """Contact displacements (/ L) below this are measured against it in the tolerance above, so
 round-off of an almost undeformed state does not count as a residual."""
 MIN_AREA_RATIO = 1e-8
-"""States whose smallest element area ratio det F is below this count as inverted: it keeps
-every accepted state clear of the round-off at which assembly would find det F <= 0."""
+"""States whose smallest element area ratio det F is below this count as inverted, so every
+accepted state keeps a margin above det F = 0, where assembly refuses the state."""
 MAX_ITERATIONS = 25
 MAX_SUBSTEPS = 64
 REUSE_CONTRACTION = 0.25
@@ -161,7 +160,6 @@ class ContactResponse:
         n2 = 2 * len(self.nodes)
         self.cdofs = np.stack([2 * self.contacts, 2 * self.contacts + 1], 1).reshape(-1)
         self.free = np.setdiff1d(np.arange(n2), self.cdofs)
-        self._gradient = gradient_operator(self.nodes, self.triangles)
         if self.geometry is None:
             self.geometry = mesh_geometry(self.nodes, self.triangles)
         if self._u is None:
@@ -192,7 +190,7 @@ class ContactResponse:
 
     # ------------------------------------------------------------------ helpers
     def _min_det(self, u: np.ndarray) -> float:
-        return float(area_ratios(self._gradient, u).min())
+        return float(area_ratios(self.geometry.gradient, u).min())
 
     def _newton(self, u: np.ndarray, delta: np.ndarray):
         """Equilibrium of the free DOFs with the contact DOFs at ``delta``; (u, assembly, its,

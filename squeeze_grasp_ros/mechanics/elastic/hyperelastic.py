@@ -44,7 +44,7 @@ from squeeze_grasp_ros.mechanics.vocabulary import MaterialModel
 
 __all__ = ["Assembly", "InvertedElementError", "MeshGeometry", "STRAIN_MEASURES", "area_ratios",
            "assemble", "deformation", "gradient_operator", "mesh_geometry", "principal_strains",
-           "shape_gradients", "stress_and_tangent"]
+           "stress_and_tangent"]
 
 STRAIN_MEASURES: dict[MaterialModel, str] = {
     MaterialModel.LINEAR: "small strain sym(grad u)",
@@ -83,7 +83,7 @@ class Assembly:
     min_det: float
 
 
-def shape_gradients(nodes: np.ndarray, triangles: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def _shape_gradients(nodes: np.ndarray, triangles: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Reference shape-function gradients (t, 3, 2), 1/m, and element areas (t,), m^2."""
     p = nodes[triangles]
     d1, d2 = p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]
@@ -97,20 +97,19 @@ def shape_gradients(nodes: np.ndarray, triangles: np.ndarray) -> tuple[np.ndarra
 
 def deformation(nodes: np.ndarray, triangles: np.ndarray, u: np.ndarray) -> np.ndarray:
     """Deformation gradients F (t, 2, 2) of the nodal displacement ``u`` (2n,) or (n, 2), m."""
-    grad, _ = shape_gradients(np.asarray(nodes, float), np.asarray(triangles, int))
-    return _deformation(grad, triangles, u)
+    return _deformation(gradient_operator(nodes, triangles), u)
 
 
-def _deformation(grad: np.ndarray, triangles: np.ndarray, u: np.ndarray) -> np.ndarray:
-    ue = np.asarray(u, float).reshape(-1, 2)[triangles]
-    return np.eye(2) + np.einsum("tai,taj->tij", ue, grad)
+def _deformation(gradient: sp.csr_matrix, u: np.ndarray) -> np.ndarray:
+    """F = I + grad u (t, 2, 2) from the :func:`gradient_operator` of the mesh."""
+    return np.eye(2) + (gradient @ np.asarray(u, float).reshape(-1)).reshape(-1, 2, 2)
 
 
 def gradient_operator(nodes: np.ndarray, triangles: np.ndarray) -> sp.csr_matrix:
     """Sparse (4t, 2n) map of nodal displacements to displacement gradients: row 4e + 2i + j of
     ``G @ u`` is du_i/dX_j of element e (dimensionless when nodes and u share a unit).
     """
-    grad, _ = shape_gradients(np.asarray(nodes, float), np.asarray(triangles, int))
+    grad, _ = _shape_gradients(np.asarray(nodes, float), np.asarray(triangles, int))
     t = len(triangles)
     dofs = element_dofs(triangles).reshape(t, 3, 2)
     rows = (4 * np.arange(t)[:, None, None, None] + 2 * np.arange(2)[None, None, :, None]
@@ -138,8 +137,8 @@ def area_ratios(gradient: sp.csr_matrix, u: np.ndarray) -> np.ndarray:
     >>> area_ratios(gradient_operator(X, tri), squash).tolist()
     [-0.5]
     """
-    H = (gradient @ np.asarray(u, float).reshape(-1)).reshape(-1, 4)
-    return (1.0 + H[:, 0]) * (1.0 + H[:, 3]) - H[:, 1] * H[:, 2]
+    F = _deformation(gradient, u)
+    return F[:, 0, 0] * F[:, 1, 1] - F[:, 0, 1] * F[:, 1, 0]
 
 
 def _plane_stress_tensor(nu: float) -> np.ndarray:
@@ -274,7 +273,7 @@ def assemble(model: MaterialModel | str, nodes: np.ndarray, triangles: np.ndarra
         If an element has det F <= 0.
     """
     geometry = mesh_geometry(nodes, triangles) if geometry is None else geometry
-    F = _deformation(geometry.grad, geometry.triangles, u)
+    F = _deformation(geometry.gradient, u)
     det = F[:, 0, 0] * F[:, 1, 1] - F[:, 0, 1] * F[:, 1, 0]
     worst = int(np.argmin(det))
     if not det[worst] > 0:
@@ -294,13 +293,13 @@ def assemble(model: MaterialModel | str, nodes: np.ndarray, triangles: np.ndarra
 
 @dataclass(frozen=True)
 class MeshGeometry:
-    """What :func:`assemble` needs of a mesh that does not change with the displacement:
-    shape-function gradients, areas, the (t, 4, 6) map of element DOFs to dF, and the sparsity
-    pattern of the stiffness (CSR ``indices``/``indptr``; ``slots`` places every element entry).
+    """What :func:`assemble` needs of a mesh that does not change with the displacement: the
+    :func:`gradient_operator`, element areas, the (t, 4, 6) map of element DOFs to dF, and the
+    sparsity pattern of the stiffness (CSR ``indices``/``indptr``; ``slots`` places every element
+    entry).
     """
 
-    triangles: np.ndarray
-    grad: np.ndarray
+    gradient: sp.csr_matrix
     area: np.ndarray
     G: np.ndarray
     Gt: np.ndarray
@@ -317,7 +316,7 @@ def mesh_geometry(nodes: np.ndarray, triangles: np.ndarray) -> MeshGeometry:
     """
     nodes = np.asarray(nodes, float)
     triangles = np.asarray(triangles, int)
-    grad, area = shape_gradients(nodes, triangles)
+    grad, area = _shape_gradients(nodes, triangles)
     # dF_ij / du_(a, k) = delta_ik grad_aj, as a (t, 4, 6) matrix on (ij) x (a k)
     G = np.zeros((len(triangles), 2, 2, 3, 2))
     for i in range(2):
@@ -329,8 +328,9 @@ def mesh_geometry(nodes: np.ndarray, triangles: np.ndarray) -> MeshGeometry:
     cols = np.tile(dofs, (1, 6)).ravel()
     keys, slots = np.unique(rows * n2 + cols, return_inverse=True)
     indptr = np.searchsorted(keys // n2, np.arange(n2 + 1))
-    return MeshGeometry(triangles, grad, area, G, np.ascontiguousarray(np.swapaxes(G, 1, 2)),
-                        dofs, n2, slots.ravel(), keys % n2, indptr)
+    return MeshGeometry(gradient_operator(nodes, triangles), area, G,
+                        np.ascontiguousarray(np.swapaxes(G, 1, 2)), dofs, n2, slots.ravel(),
+                        keys % n2, indptr)
 
 
 def principal_strains(model: MaterialModel | str, nodes: np.ndarray, triangles: np.ndarray,

@@ -326,42 +326,33 @@ class BagWriter:
         written = sum(t.count for t in self.topics.values())
         while len(self._stream.boundaries) > 1:
             section = self._count_kept(self._stream.boundaries[-1])
-            end = self._stream.boundaries[-1]
             lost = written + self.dropped - sum(t.count for t in self.topics.values())
             self.custom_data[STOPPED_KEY] = (f"{self.failure}; the last {lost} messages were not "
                                              "recorded")
             info = self.metadata()
             tail = b""
             for record in (Metadata("rosbag2", {"serialized_metadata": plain_yaml(info)}), None):
-                tail = file_end(section, end, record)
+                tail = file_end(section, record)
                 try:
                     self._stream.write(tail)
                     return info
                 except OSError:
                     continue
             # no room for the end: give up at least as many bytes of data as it needs
-            earlier = [b for b in self._stream.boundaries if b <= end - len(tail)]
+            earlier = [b for b in self._stream.boundaries if b <= section.end - len(tail)]
             self._stream.cut(earlier[-1] if len(earlier) > 1 else 0)
         raise BagError(f"{self.path / self.file_name}: no room even for the end of the file")
 
     def _count_kept(self, end: int) -> DataSection:
-        """Index the first ``end`` bytes of the file; set every topic's count, and the time
-        range, to the messages they hold.
+        """Index the first ``end`` bytes of the file and cut it where the indexed data ends;
+        set every topic's count, and the time range, to the messages kept.
         """
-        self._stream.cut(end)
         with open(self.path / self.file_name, "rb") as f:
-            section = read_data_section(f.read(end))
-            last = section.chunk_indexes[-1] if section.chunk_indexes else None
-            if last is not None and not last.message_index_offsets:
-                # the write that failed was this chunk's message indexes: readers that go by
-                # the index would skip it, so it goes too
-                end = last.chunk_start_offset
-                self._stream.cut(end)
-                f.seek(0)
-                section = read_data_section(f.read(end))
+            section = read_data_section(f, end)
+        self._stream.cut(section.end)
         for t in self.topics.values():
             t.count = section.counts.get(t.channel, 0)
-        self.start_ns, self.end_ns = section.start, section.end
+        self.start_ns, self.end_ns = section.start_time, section.end_time
         return section
 
 

@@ -15,6 +15,7 @@ import io
 import struct
 from collections import Counter
 from dataclasses import dataclass, field
+from typing import BinaryIO
 
 from mcap.data_stream import ReadDataStream, RecordBuilder
 from mcap.opcode import Opcode
@@ -34,88 +35,95 @@ class DataSection:
 
     Attributes
     ----------
+    end : int
+        Offset of the first byte not indexed: the data section ends here (a chunk whose message
+        indexes are missing is left out, since readers that go by the index would skip it).
     schemas, channels : dict
         Records by id, in the order first seen.
     chunk_indexes : list of ChunkIndex
     metadata_indexes : list of MetadataIndex
     counts : Counter
         Messages per channel id.
-    start, end : int or None
+    start_time, end_time : int or None
         Smallest and largest message log time, ns.
     """
 
+    end: int = len(MCAP0_MAGIC)
     schemas: dict = field(default_factory=dict)
     channels: dict = field(default_factory=dict)
     chunk_indexes: list = field(default_factory=list)
     metadata_indexes: list = field(default_factory=list)
     counts: Counter = field(default_factory=Counter)
-    start: int | None = None
-    end: int | None = None
+    start_time: int | None = None
+    end_time: int | None = None
 
-    def _message(self, message: Message) -> None:
-        self.counts[message.channel_id] += 1
-        t = message.log_time
-        self.start = t if self.start is None else min(self.start, t)
-        self.end = t if self.end is None else max(self.end, t)
+    def _add(self, record) -> None:
+        if isinstance(record, Schema):
+            self.schemas.setdefault(record.id, record)
+        elif isinstance(record, Channel):
+            self.channels.setdefault(record.id, record)
+        elif isinstance(record, Message):
+            self.counts[record.channel_id] += 1
+            t = record.log_time
+            self.start_time = t if self.start_time is None else min(self.start_time, t)
+            self.end_time = t if self.end_time is None else max(self.end_time, t)
 
 
-def read_data_section(data: bytes) -> DataSection:
-    """Index the records of ``data``: an MCAP file's bytes from its magic up to a record
-    boundary (no DataEnd, summary or footer).
+def read_data_section(stream: BinaryIO, size: int) -> DataSection:
+    """Index the records of the first ``size`` bytes of an MCAP file open in ``stream``: its
+    magic and whole records (no DataEnd, summary or footer), read one record at a time. A chunk
+    counts once its message indexes follow it.
     """
     section = DataSection()
-    chunk_index: ChunkIndex | None = None
+    chunk: tuple[ChunkIndex, Chunk] | None = None
     pos = len(MCAP0_MAGIC)
-    while pos + _RECORD_HEAD.size <= len(data):
-        opcode, length = _RECORD_HEAD.unpack_from(data, pos)
-        body = ReadDataStream(io.BytesIO(data[pos + _RECORD_HEAD.size:
-                                              pos + _RECORD_HEAD.size + length]))
-        size = _RECORD_HEAD.size + length
-        if opcode != Opcode.MESSAGE_INDEX:
-            chunk_index = None
-        if opcode == Opcode.CHUNK:
-            chunk = Chunk.read(body)
-            chunk_index = ChunkIndex(chunk_length=size, chunk_start_offset=pos,
-                                     compression=chunk.compression,
-                                     compressed_size=len(chunk.data),
-                                     message_end_time=chunk.message_end_time,
-                                     message_index_length=0, message_index_offsets={},
-                                     message_start_time=chunk.message_start_time,
-                                     uncompressed_size=chunk.uncompressed_size)
-            section.chunk_indexes.append(chunk_index)
-            for record in breakup_chunk(chunk):
-                _collect(section, record)
-        elif opcode == Opcode.MESSAGE_INDEX and section.chunk_indexes:
-            index = section.chunk_indexes[-1]
+    stream.seek(pos)
+    while pos + _RECORD_HEAD.size <= size:
+        opcode, length = _RECORD_HEAD.unpack(stream.read(_RECORD_HEAD.size))
+        record_size = _RECORD_HEAD.size + length
+        if pos + record_size > size:
+            break
+        body = ReadDataStream(io.BytesIO(stream.read(length)))
+        if opcode == Opcode.MESSAGE_INDEX and chunk is not None:
+            index, records = chunk
+            if not index.message_index_offsets:
+                section.chunk_indexes.append(index)
+                for record in breakup_chunk(records):
+                    section._add(record)
             index.message_index_offsets[MessageIndex.read(body).channel_id] = pos
-            index.message_index_length += size
+            index.message_index_length += record_size
+        else:
+            chunk = None
+        if opcode == Opcode.CHUNK:
+            records = Chunk.read(body)
+            chunk = (ChunkIndex(chunk_length=record_size, chunk_start_offset=pos,
+                                compression=records.compression,
+                                compressed_size=len(records.data),
+                                message_end_time=records.message_end_time,
+                                message_index_length=0, message_index_offsets={},
+                                message_start_time=records.message_start_time,
+                                uncompressed_size=records.uncompressed_size), records)
         elif opcode == Opcode.METADATA:
-            section.metadata_indexes.append(MetadataIndex(offset=pos, length=size,
+            section.metadata_indexes.append(MetadataIndex(offset=pos, length=record_size,
                                                           name=Metadata.read(body).name))
         elif opcode == Opcode.SCHEMA:
-            _collect(section, Schema.read(body))
+            section._add(Schema.read(body))
         elif opcode == Opcode.CHANNEL:
-            _collect(section, Channel.read(body))
+            section._add(Channel.read(body))
         elif opcode == Opcode.MESSAGE:
-            section._message(Message.read(body, length))
-        pos += size
+            section._add(Message.read(body, length))
+        pos += record_size
+        if chunk is None or chunk[0].message_index_offsets:
+            section.end = pos
     return section
 
 
-def _collect(section: DataSection, record) -> None:
-    if isinstance(record, Schema):
-        section.schemas.setdefault(record.id, record)
-    elif isinstance(record, Channel):
-        section.channels.setdefault(record.id, record)
-    elif isinstance(record, Message):
-        section._message(record)
-
-
-def file_end(section: DataSection, offset: int, metadata: Metadata | None = None) -> bytes:
-    """The bytes that end a file whose data section (indexed in ``section``) ends at byte
-    ``offset``: ``metadata`` (if given), DataEnd, the summary section, the footer and the magic.
+def file_end(section: DataSection, metadata: Metadata | None = None) -> bytes:
+    """The bytes that end a file at ``section.end``, after the data section it indexes:
+    ``metadata`` (if given), DataEnd, the summary section, the footer and the magic.
     Data-section and summary CRCs are 0 (not computed), as the format allows.
     """
+    offset = section.end
     data = RecordBuilder()
     metadata_indexes = list(section.metadata_indexes)
     if metadata is not None:
@@ -129,8 +137,8 @@ def file_end(section: DataSection, offset: int, metadata: Metadata | None = None
     statistics = Statistics(
         attachment_count=0, channel_count=len(section.channels),
         channel_message_counts=dict(section.counts), chunk_count=len(section.chunk_indexes),
-        message_count=sum(section.counts.values()), message_end_time=section.end or 0,
-        message_start_time=section.start or 0, metadata_count=len(metadata_indexes),
+        message_count=sum(section.counts.values()), message_end_time=section.end_time or 0,
+        message_start_time=section.start_time or 0, metadata_count=len(metadata_indexes),
         schema_count=len(section.schemas))
     for opcode, records in ((Opcode.SCHEMA, section.schemas.values()),
                             (Opcode.CHANNEL, section.channels.values()),

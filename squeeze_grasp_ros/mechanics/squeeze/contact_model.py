@@ -558,11 +558,10 @@ class ContactModel:
         """
         g = sd.E.T @ delta.reshape(-1)
         rigid = (self.obj.rigid_gradients @ g).reshape(-1, 4)
-        key = ("gradient_bounds", tuple(sd.nodes.tolist()))
-        if self._cache.get("gradient_bounds_key") != key:
-            self._cache["gradient_bounds_key"] = key
-            self._cache["gradient_bounds"] = self.obj.gradient_bounds(sd.nodes)
-        bound = (self._cache["gradient_bounds"] @ np.linalg.norm(F, axis=1)
+        nodes = tuple(sd.nodes.tolist())
+        if self._cache.get("gradient_bounds", (None,))[0] != nodes:
+            self._cache["gradient_bounds"] = (nodes, self.obj.gradient_bounds(nodes))
+        bound = (self._cache["gradient_bounds"][1] @ np.linalg.norm(F, axis=1)
                  + np.sqrt((rigid * rigid).sum(axis=1)))
         near = np.flatnonzero(bound >= GRADIENT_BOUND_EXACT)
         rest = np.delete(bound, near)

@@ -632,6 +632,42 @@ def test_ctrl_c_while_connecting_to_a_scheduler_stops_at_once(tmp_path):
     )
 
 
+def test_the_local_cluster_samples_its_housekeeping_every_few_seconds():
+    """The local cluster's workers, nannies and scheduler run Dask's periodic housekeeping at
+    the intervals of LOCAL_HOUSEKEEPING (not Dask's 20-100 ms) and without the profiler, in the
+    worker processes themselves, not only in the client's configuration.
+    """
+    import dask
+
+    from squeeze_grasp_ros.sweep.engine import LOCAL_HOUSEKEEPING, StopSignals, _start
+
+    client, cluster = _start(None, 1, StopSignals())
+    try:
+        workers = client.run(
+            lambda dask_worker: {
+                name: pc.callback_time for name, pc in dask_worker.periodic_callbacks.items()
+            }
+        )
+        profile = client.run(lambda: dask.config.get("distributed.worker.profile.enabled"))
+        nannies = [
+            {name: pc.callback_time for name, pc in nanny.periodic_callbacks.items()}
+            for nanny in cluster.workers.values()
+        ]
+        scheduler = {
+            name: pc.callback_time for name, pc in cluster.scheduler.periodic_callbacks.items()
+        }
+    finally:
+        client.close()
+        cluster.close()
+    assert LOCAL_HOUSEKEEPING["distributed.worker.profile.enabled"] is False
+    assert list(profile.values()) == [False]
+    for callbacks in [*workers.values(), *nannies]:
+        assert callbacks["memory_monitor"] == 2000 and callbacks["tick"] == 1000
+        assert callbacks["monitor"] == 5000
+    assert scheduler["tick"] == 1000 and scheduler["monitor"] == 5000
+    assert dask.config.get("distributed.admin.tick.interval") != "1s"
+
+
 def test_other_spec_in_the_same_directory_is_refused(tmp_path):
     from squeeze_grasp_ros.sweep.plan import plan_tasks as plan
     from squeeze_grasp_ros.sweep.store import Store

@@ -5,11 +5,14 @@
 With the displacements delta of the m contact nodes prescribed (they sit on the fingertips), the
 other degrees of freedom are in equilibrium: f_int,free(u) = 0. Newton solves them (tangent of
 :func:`~squeeze_grasp_ros.mechanics.elastic.hyperelastic.assemble`, backtracking on the residual
-norm, never into an inverted element), warm-started from the previous solution of the set; when
-Newton fails the increment of delta since the last converged one is halved and marched (load
-sub-stepping). The contact forces are the internal forces at the contact DOFs, and the tangent
-dF/d delta is the Schur complement K_cc - K_cf K_ff^-1 K_fc of the converged tangent (one sparse
-factorisation, reused for the interior rates).
+norm, never into an inverted element), warm-started from the previous solution of the set with
+its interior moved along the last rate map (a first-order predictor: Newton then starts from a
+residual of second order in the step); when Newton fails the increment of delta since the last
+converged one is halved and marched (load sub-stepping). The contact forces are the internal
+forces at the contact DOFs, and the tangent dF/d delta is the Schur complement
+K_cc - K_cf K_ff^-1 K_fc of the converged tangent (one sparse factorisation, reused for the
+interior rates). Line-search trials assemble forces only; the tangent is assembled where it is
+factorised.
 
 Factorisations: Newton re-uses the last factorisation of K_ff as long as the residual falls by
 at least REUSE_CONTRACTION per iteration (modified Newton), and refactors otherwise; the
@@ -36,7 +39,8 @@ __all__ = ["ContactResponse", "Evaluation", "NEWTON_TOL", "ResponseFailure",
            "factorization_reuse"]
 
 NEWTON_TOL = 1e-10
-"""Interior Newton stops when ||f_free|| <= NEWTON_TOL * max(||f_contact||, |K| ||delta||)."""
+"""Interior Newton stops when ||f_free|| <= NEWTON_TOL * max(||f_contact||, |K0| ||delta||),
+|K0| the largest entry of the undeformed tangent."""
 DISPLACEMENT_FLOOR = 1e-6
 """Contact displacements (/ L) below this are measured against it in the tolerance above, so
 round-off of an almost undeformed state does not count as a residual."""
@@ -151,6 +155,7 @@ class ContactResponse:
     _lu: object = field(default=None, repr=False)
     _rate_map: np.ndarray | None = field(default=None, repr=False)
     _energy: float = field(default=0.0, repr=False)
+    _reference_stiffness: float | None = field(default=None, repr=False)
 
     def __post_init__(self) -> None:
         self.contacts = np.asarray(self.contacts, int)
@@ -189,30 +194,56 @@ class ContactResponse:
         return self._energy
 
     # ------------------------------------------------------------------ helpers
+    def _assemble(self, u: np.ndarray, *, tangent: bool):
+        return assemble(self.model, self.nodes, self.triangles, u, nu=self.nu,
+                        geometry=self.geometry, tangent=tangent)
+
+    def _stiffness(self) -> float:
+        """Largest entry of the reference (undeformed) tangent: the scale of NEWTON_TOL."""
+        if self._reference_stiffness is None:
+            zero = np.zeros(2 * len(self.nodes))
+            self._reference_stiffness = float(abs(self._assemble(zero, tangent=True).tangent)
+                                              .max())
+        return self._reference_stiffness
+
     def _min_det(self, u: np.ndarray) -> float:
         return float(area_ratios(self.geometry.gradient, u).min())
+
+    def _start(self, u: np.ndarray, delta: np.ndarray) -> np.ndarray | None:
+        """Newton's first iterate for contact displacements ``delta`` from the state ``u``:
+        the interior moved along the last converged rate map (first-order predictor, when one
+        is known and it inverts nothing), else where ``u`` has it; None if the contact
+        displacement itself inverts an element.
+        """
+        plain = u.copy()
+        plain[self.cdofs] = delta.reshape(-1)
+        if self._rate_map is not None:
+            predicted = plain.copy()
+            predicted[self.free] += self._rate_map @ (plain[self.cdofs] - u[self.cdofs])
+            if self._min_det(predicted) > MIN_AREA_RATIO:
+                return predicted
+        return plain if self._min_det(plain) > MIN_AREA_RATIO else None
 
     def _newton(self, u: np.ndarray, delta: np.ndarray):
         """Equilibrium of the free DOFs with the contact DOFs at ``delta``; (u, assembly, its,
         residual) or a ResponseFailure.
         """
-        u = u.copy()
-        u[self.cdofs] = delta.reshape(-1)
-        if self._min_det(u) <= MIN_AREA_RATIO:
+        u = self._start(u, delta)
+        if u is None:
             return ResponseFailure("the prescribed contact displacement inverts an element",
                                    inverted=True)
-        asm = assemble(self.model, self.nodes, self.triangles, u, nu=self.nu,
-                       geometry=self.geometry)
-        stiffness = abs(asm.tangent).max()
+        lu, its = (self._lu if _REUSE[0] else None), 0
+        asm = self._assemble(u, tangent=lu is None)
         scale = max(np.linalg.norm(asm.force[self.cdofs]),
-                    stiffness * max(np.linalg.norm(delta), DISPLACEMENT_FLOOR))
+                    self._stiffness() * max(np.linalg.norm(delta), DISPLACEMENT_FLOOR))
         r = asm.force[self.free]
         norm = np.linalg.norm(r)
-        lu, its = (self._lu if _REUSE[0] else None), 0
         while norm > NEWTON_TOL * scale:
             if its >= MAX_ITERATIONS:
                 return ResponseFailure("interior Newton did not converge", norm / scale)
             if lu is None:
+                if asm.tangent is None:
+                    asm = self._assemble(u, tangent=True)
                 lu = factor(asm.tangent[self.free][:, self.free])
                 self.stats["factorizations"] += 1
             step = -lu.solve(r)
@@ -223,8 +254,7 @@ class ContactResponse:
                 trial[self.free] += step
                 if self._min_det(trial) > MIN_AREA_RATIO:
                     inverted = False
-                    t_asm = assemble(self.model, self.nodes, self.triangles, trial,
-                                     nu=self.nu, geometry=self.geometry)
+                    t_asm = self._assemble(trial, tangent=False)
                     t_norm = np.linalg.norm(t_asm.force[self.free])
                     if t_norm < norm:
                         break
@@ -270,7 +300,7 @@ class ContactResponse:
             return ResponseFailure("load sub-stepping did not reach the contact displacement")
         u, asm, _, residual = result
         self.stats["iterations"] += its
-        K = asm.tangent
+        K = asm.tangent if asm.tangent is not None else self._assemble(u, tangent=True).tangent
         lu = factor(K[self.free][:, self.free])
         self.stats["factorizations"] += 1
         Kfc = K[self.free][:, self.cdofs].toarray()

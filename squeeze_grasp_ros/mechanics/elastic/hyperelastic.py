@@ -71,15 +71,15 @@ class Assembly:
         Strain energy / (E h), m^2.
     force : (2n,) ndarray
         Internal nodal forces / (E h), m (the forces the nodes exert on the solid, = dW/du).
-    tangent : (2n, 2n) scipy.sparse.csr_matrix
-        d force / d u, dimensionless, symmetric.
+    tangent : (2n, 2n) scipy.sparse.csr_matrix or None
+        d force / d u, dimensionless, symmetric (None if not assembled).
     min_det : float
         Smallest det F (in-plane) over the elements.
     """
 
     energy: float
     force: np.ndarray
-    tangent: sp.csr_matrix
+    tangent: sp.csr_matrix | None
     min_det: float
 
 
@@ -150,12 +150,12 @@ def _plane_stress_tensor(nu: float) -> np.ndarray:
                            + np.einsum("il,jk->ijkl", eye, eye)))
 
 
-def _linear(F: np.ndarray, nu: float):
+def _linear(F: np.ndarray, nu: float, tangent: bool):
     C = _plane_stress_tensor(nu)
     eps = 0.5 * (F + np.swapaxes(F, 1, 2)) - np.eye(2)
     P = np.einsum("ijkl,tkl->tij", C, eps)
     W = 0.5 * np.einsum("tij,tij->t", P, eps)
-    return W, P, np.broadcast_to(C, (len(F), 2, 2, 2, 2))
+    return W, P, np.broadcast_to(C, (len(F), 2, 2, 2, 2)) if tangent else None
 
 
 def _rotation(F: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -169,7 +169,7 @@ def _rotation(F: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     return R, dtheta, n2
 
 
-def _corotational(F: np.ndarray, nu: float):
+def _corotational(F: np.ndarray, nu: float, tangent: bool):
     C = _plane_stress_tensor(nu)
     R, dtheta, _ = _rotation(F)
     U = np.einsum("tki,tkj->tij", R, F)
@@ -177,6 +177,8 @@ def _corotational(F: np.ndarray, nu: float):
     S = np.einsum("ijkl,tkl->tij", C, E)
     W = 0.5 * np.einsum("tij,tij->t", S, E)
     P = np.einsum("tik,tkj->tij", R, S)
+    if not tangent:
+        return W, P, None
     A = np.empty((len(F), 2, 2, 2, 2))
     OS = np.einsum("ik,tkj->tij", _SKEW, S)
     OU = np.einsum("ik,tkj->tij", _SKEW, U)
@@ -209,7 +211,7 @@ def _thickness_stretch(J2: np.ndarray, lam: float, mu: float) -> np.ndarray:
     return l3
 
 
-def _neo_hookean(F: np.ndarray, nu: float):
+def _neo_hookean(F: np.ndarray, nu: float, tangent: bool):
     if not nu < 0.5:
         raise InvalidInputError(f"material.nu must be < 0.5 for the neo_hookean model (its "
                                 f"lambda is infinite at 0.5), got {nu}")
@@ -217,11 +219,14 @@ def _neo_hookean(F: np.ndarray, nu: float):
     J2 = F[:, 0, 0] * F[:, 1, 1] - F[:, 0, 1] * F[:, 1, 0]
     l3 = _thickness_stretch(J2, lam, mu)
     lnJ = np.log(J2 * l3)
-    G = np.linalg.inv(F).transpose(0, 2, 1)  # F^-T
+    G = np.stack([np.stack([F[:, 1, 1], -F[:, 1, 0]], -1),
+                  np.stack([-F[:, 0, 1], F[:, 0, 0]], -1)], 1) / J2[:, None, None]  # F^-T
     I1 = np.einsum("tij,tij->t", F, F) + l3 * l3
     W = 0.5 * mu * (I1 - 3.0) - mu * lnJ + 0.5 * lam * lnJ * lnJ
     a = lam * lnJ - mu
     P = mu * F + a[:, None, None] * G
+    if not tangent:
+        return W, P, None
     g = G.reshape(-1, 4)
     outer = g[:, :, None] * g[:, None, :]
     cross = (G[:, :, None, None, :] * np.swapaxes(G, 1, 2)[:, None, :, :, None]).reshape(-1, 4, 4)
@@ -235,20 +240,23 @@ _LAWS = {MaterialModel.LINEAR: _linear, MaterialModel.COROTATIONAL: _corotationa
          MaterialModel.NEO_HOOKEAN: _neo_hookean}
 
 
-def stress_and_tangent(model: MaterialModel | str, F: np.ndarray, *, nu: float):
+def stress_and_tangent(model: MaterialModel | str, F: np.ndarray, *, nu: float,
+                       tangent: bool = True):
     """Energy density W / E (t,), first Piola-Kirchhoff stress P / E (t, 2, 2) and its
-    derivative dP/dF / E (t, 2, 2, 2, 2) of each deformation gradient in ``F`` (t, 2, 2).
+    derivative dP/dF / E (t, 2, 2, 2, 2) (None unless ``tangent``) of each deformation gradient
+    in ``F`` (t, 2, 2).
     """
     try:
         law = _LAWS[MaterialModel(model)]
     except ValueError:
         raise InvalidInputError(f"material.model must be one of {MaterialModel.values()}, got "
                                 f"{model!r}") from None
-    return law(np.asarray(F, float), nu)
+    return law(np.asarray(F, float), nu, tangent)
 
 
 def assemble(model: MaterialModel | str, nodes: np.ndarray, triangles: np.ndarray,
-             u: np.ndarray, *, nu: float, geometry: MeshGeometry | None = None) -> Assembly:
+             u: np.ndarray, *, nu: float, geometry: MeshGeometry | None = None,
+             tangent: bool = True) -> Assembly:
     """Energy, internal forces and tangent stiffness of the displacement ``u`` (2n,), m.
 
     Parameters
@@ -266,6 +274,9 @@ def assemble(model: MaterialModel | str, nodes: np.ndarray, triangles: np.ndarra
     geometry : MeshGeometry, optional
         :func:`mesh_geometry` of ``nodes`` and ``triangles``, when many states of one mesh are
         assembled (computed here otherwise).
+    tangent : bool
+        Assemble the tangent stiffness too (False: energy and forces only, about half the
+        work; ``Assembly.tangent`` is None).
 
     Raises
     ------
@@ -279,15 +290,17 @@ def assemble(model: MaterialModel | str, nodes: np.ndarray, triangles: np.ndarra
     if not det[worst] > 0:
         raise InvertedElementError(f"element {worst} inverted (det F = {det[worst]:.3g})",
                                    residuals={"det_F": det[worst]})
-    W, P, A = stress_and_tangent(model, F, nu=nu)
+    W, P, A = stress_and_tangent(model, F, nu=nu, tangent=tangent)
     area, G, Gt = geometry.area, geometry.G, geometry.Gt
     fe = area[:, None] * (Gt @ P.reshape(-1, 4, 1))[..., 0]
-    ke = area[:, None, None] * (Gt @ A.reshape(-1, 4, 4) @ G)
-    ke = 0.5 * (ke + np.swapaxes(ke, 1, 2))
     n2 = geometry.n2
     force = np.bincount(geometry.dofs.ravel(), weights=fe.reshape(-1), minlength=n2)
-    data = np.bincount(geometry.slots, weights=ke.ravel(), minlength=len(geometry.indices))
-    K = sp.csr_matrix((data, geometry.indices, geometry.indptr), shape=(n2, n2))
+    K = None
+    if tangent:
+        ke = area[:, None, None] * (Gt @ A.reshape(-1, 4, 4) @ G)
+        ke = 0.5 * (ke + np.swapaxes(ke, 1, 2))
+        data = np.bincount(geometry.slots, weights=ke.ravel(), minlength=len(geometry.indices))
+        K = sp.csr_matrix((data, geometry.indices, geometry.indptr), shape=(n2, n2))
     return Assembly(float(np.dot(W, area)), force, K, float(det[worst]))
 
 

@@ -53,6 +53,65 @@ def test_forces_and_tangent_are_the_derivatives(model, patch):
     assert abs(a.tangent - a.tangent.T).max() < 1e-12 * abs(a.tangent).max()
 
 
+@pytest.mark.parametrize("model", MODELS)
+def test_a_forces_only_assembly_is_the_full_one_without_the_tangent(model, patch):
+    u = 0.001 * np.random.default_rng(3).standard_normal(2 * patch.n)
+    full = H.assemble(model, patch.nodes, patch.triangles, u, nu=0.3)
+    lean = H.assemble(model, patch.nodes, patch.triangles, u, nu=0.3, tangent=False)
+    assert lean.tangent is None and full.tangent is not None
+    assert lean.energy == full.energy and np.array_equal(lean.force, full.force)
+
+
+@pytest.mark.parametrize("model", NONLINEAR)
+def test_the_condensed_factorisation_against_direct_sparse_solves(model, patch):
+    """The Schur complement read from the trailing block of one LU of the whole (shifted)
+    tangent, and the interior solves and rates done with it, equal what SciPy's spsolve gives
+    on the interior block, on a stressed state whose whole tangent is singular (the free
+    object's translations).
+    """
+    import scipy.sparse.linalg as spla
+
+    from squeeze_grasp_ros.mechanics.elastic.schur import condense, minimum_degree_order
+
+    rng = np.random.default_rng(5)
+    u = (patch.nodes @ np.array([[-0.08, 0.02], [0.03, 0.05]])).ravel()
+    K = H.assemble(model, patch.nodes, patch.triangles, u, nu=0.3).tangent
+    contacts = np.sort(rng.choice(patch.n, 6, replace=False))
+    cd = np.stack([2 * contacts, 2 * contacts + 1], 1).ravel()
+    free = np.setdiff1d(np.arange(2 * patch.n), cd)
+    Kff, Kfc = K[free][:, free].tocsc(), K[free][:, cd].toarray()
+    lu = condense(K, free, cd, minimum_degree_order(Kff))
+    S = K[cd][:, cd].toarray() - Kfc.T @ spla.spsolve(Kff, Kfc)
+    assert np.abs(lu.schur - S).max() < 1e-12 * np.abs(S).max()
+    assert np.linalg.eigvalsh(S)[0] < 1e-12 * np.abs(S).max()  # K itself is singular
+    r, d = rng.standard_normal(len(free)), rng.standard_normal(len(cd))
+    z, x = spla.spsolve(Kff, r), -spla.spsolve(Kff, Kfc @ d)
+    assert np.abs(lu.interior(r) - z).max() < 1e-12 * np.abs(z).max()
+    assert np.abs(lu.interior_rate(d) - x).max() < 1e-12 * np.abs(x).max()
+
+
+@pytest.mark.parametrize("model", NONLINEAR)
+def test_the_response_tangent_is_the_derivative_of_its_forces(model, patch):
+    """dF/d delta of a contact set's equilibrium against central differences of F."""
+    left = np.argsort(patch.nodes[:, 0])[:2]
+    right = np.argsort(-patch.nodes[:, 0])[:2]
+    contacts = np.r_[left, right]
+    L = 0.1
+    delta = np.zeros((4, 2))
+    delta[:2, 0], delta[2:, 0] = 0.004 / L, -0.004 / L
+    d = np.random.default_rng(2).standard_normal((4, 2)) * 1e-3
+
+    def response():
+        return ContactResponse(MaterialModel(model), patch.nodes / L, patch.triangles, contacts,
+                               0.3)
+
+    at = response().evaluate(delta)
+    h = 1e-5
+    plus, minus = response().evaluate(delta + h * d), response().evaluate(delta - h * d)
+    fd = (plus.F - minus.F).reshape(-1) / (2 * h)
+    assert np.linalg.norm(at.C @ d.reshape(-1) - fd) < 1e-6 * np.linalg.norm(fd)
+
+
 def test_the_linear_law_is_the_cst_stiffness(patch):
     K = stiffness_matrix(patch, 0.3)
     u = np.random.default_rng(3).standard_normal(2 * patch.n) * 1e-3

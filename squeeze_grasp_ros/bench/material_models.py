@@ -100,13 +100,14 @@ def run(quick: bool, out_dir: Path, progress) -> list[Table]:
                "factorisations", "F1 [N]"],
               cost,
               "An evaluation is one equilibrium of the contact set at one finger position "
-              "(interior Newton, backtracking, load sub-steps if needed); each ends with one "
-              "factorisation of the converged tangent for the Schur complement dF/d delta, and "
-              "Newton re-uses the previous factorisation (the last evaluation's, then its own) "
-              "while the residual falls by 4x per iteration; 'full Newton' rows refactor at "
-              "every iteration, so their time against the default row is what the reuse saves "
-              "(same forces to the Newton tolerance). The linear row includes the "
-              "element-inversion check (from cached per-node gradients, no solve). Target (< 10x "
-              "linear) not met: every evaluation is a sparse factorisation and solve of the "
-              "whole object, where the linear route gathers a cached boundary compliance."),
+              "(interior Newton from a first-order predictor, backtracking, load sub-steps if "
+              "needed); each ends with one sparse LU of the converged tangent with the contact "
+              "DOFs ordered last, whose trailing block is dF/d delta, and Newton re-uses the "
+              "previous LU (the last evaluation's, then its own) while the residual falls by 4x "
+              "per iteration; 'full Newton' rows refactor at every iteration, so their time "
+              "against the default row is what the reuse saves (same forces to the Newton "
+              "tolerance). The linear row includes the element-inversion check (from cached "
+              "per-node gradients, no solve). Target (< 10x linear) not met: every evaluation "
+              "is a sparse factorisation of the whole object, where the linear route gathers a "
+              "cached boundary compliance."),
     ]

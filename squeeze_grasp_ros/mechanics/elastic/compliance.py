@@ -37,6 +37,7 @@ from squeeze_grasp_ros.mechanics.elastic.fem import (
 from squeeze_grasp_ros.mechanics.elastic.hyperelastic import gradient_operator
 from squeeze_grasp_ros.mechanics.elastic.material import Material
 from squeeze_grasp_ros.mechanics.elastic.mesh import Mesh
+from squeeze_grasp_ros.mechanics.elastic.schur import minimum_degree_order, trailing_factors
 
 Route = Literal["factorized", "spectral"]
 GRADIENT_BOUND_BYTES = 128 * 2**20
@@ -70,10 +71,7 @@ class FactorizedSolver:
         last = boundary_dofs[~np.isin(boundary_dofs, self.pins)]
         interior = np.setdiff1d(np.arange(n_dof), boundary_dofs)
         if len(interior):
-            K_ii = K[interior][:, interior].tocsc()
-            mmd = spla.splu(K_ii, permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0,
-                            options={"SymmetricMode": True}).perm_c
-            interior = interior[np.argsort(mmd)]
+            interior = interior[minimum_degree_order(K[interior][:, interior])]
         self.order = np.concatenate([interior, last])
         self.n_last = len(last)
         Kp = K[self.order][:, self.order].tocsc()
@@ -119,8 +117,7 @@ class FactorizedSolver:
             E = np.zeros((self.K.shape[0], len(boundary_dofs)))
             E[boundary_dofs, np.arange(len(boundary_dofs))] = 1.0
             return self.solve(E)[boundary_dofs]
-        L = self.lu.L.tocsc()[n_first:, n_first:].toarray()
-        U = self.lu.U.tocsc()[n_first:, n_first:].toarray()
+        L, U = trailing_factors(self.lu, n_first)
         X = np.zeros((len(boundary_dofs), len(boundary_dofs)))
         where = np.full(self.K.shape[0], -1)
         where[boundary_dofs] = np.arange(len(boundary_dofs))

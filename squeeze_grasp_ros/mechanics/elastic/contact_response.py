@@ -10,13 +10,15 @@ its interior moved along the last rate map (a first-order predictor: Newton then
 residual of second order in the step); when Newton fails the increment of delta since the last
 converged one is halved and marched (load sub-stepping). The contact forces are the internal
 forces at the contact DOFs, and the tangent dF/d delta is the Schur complement
-K_cc - K_cf K_ff^-1 K_fc of the converged tangent (one sparse factorisation, reused for the
-interior rates). Line-search trials assemble forces only; the tangent is assembled where it is
-factorised.
+K_cc - K_cf K_ff^-1 K_fc of the converged tangent: the trailing block of one sparse LU of the
+whole tangent with the contact DOFs ordered last (:class:`~.schur.CondensedLU`), which serves the
+interior solves and rates. Line-search trials assemble forces only; the tangent is assembled
+where it is factorised.
 
 Factorisations: Newton re-uses the last factorisation of K_ff as long as the residual falls by
 at least REUSE_CONTRACTION per iteration (modified Newton), and refactors otherwise; the
-converged state is always refactored once for the exact Schur complement. ``stats`` counts both.
+converged state is always refactored once for the exact Schur complement. ``stats`` counts both,
+and the one factorisation of K_ff per contact set that gives the interior's ordering.
 
 Everything is dimensionless as in the stepper: coordinates and displacements / L, forces / (E h L),
 energies / (E h L^2).
@@ -28,10 +30,10 @@ from contextlib import contextmanager
 from dataclasses import dataclass, field
 
 import numpy as np
-import scipy.sparse.linalg as spla
 
 from squeeze_grasp_ros.mechanics.elastic.hyperelastic import (MeshGeometry, area_ratios,
                                                                 assemble, mesh_geometry)
+from squeeze_grasp_ros.mechanics.elastic.schur import CondensedLU, condense, minimum_degree_order
 from squeeze_grasp_ros.mechanics.errors import InvalidInputError
 from squeeze_grasp_ros.mechanics.vocabulary import MaterialModel
 
@@ -64,16 +66,6 @@ def factorization_reuse(enabled: bool) -> Iterator[None]:
         yield
     finally:
         _REUSE[0] = before
-
-
-def factor(K: "spla.spmatrix"):
-    """Sparse LU of a (nearly) symmetric stiffness block: minimum-degree ordering of K + K^T
-    and diagonal pivots preferred (a third less fill and time than SuperLU's default
-    column ordering on the foam square's interior block: 11 instead of 15 ms per factorisation,
-    3.6 instead of 5.4 ms for the 20 right-hand sides of its Schur complement).
-    """
-    return spla.splu(K.tocsc(), permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.1,
-                     options={"SymmetricMode": True})
 
 
 @dataclass(frozen=True)
@@ -152,8 +144,9 @@ class ContactResponse:
                                                  "factorizations": 0, "substeps": 0})
     _u: np.ndarray | None = field(default=None, repr=False)
     _delta: np.ndarray | None = field(default=None, repr=False)
-    _lu: object = field(default=None, repr=False)
-    _rate_map: np.ndarray | None = field(default=None, repr=False)
+    _lu: CondensedLU | None = field(default=None, repr=False)
+    _evaluated: bool = field(default=False, repr=False)
+    _order: np.ndarray | None = field(default=None, repr=False)
     _energy: float = field(default=0.0, repr=False)
     _reference_stiffness: float | None = field(default=None, repr=False)
 
@@ -178,11 +171,11 @@ class ContactResponse:
         self._u = np.array(u, float)
         self._delta = self._u[self.cdofs].reshape(-1, 2)
         self._lu = None
-        self._rate_map = None
+        self._evaluated = False
 
     def at(self, delta: np.ndarray) -> bool:
         """True if the last evaluated state is at ``delta`` (its field can be read)."""
-        return self._rate_map is not None and np.array_equal(
+        return self._evaluated and np.array_equal(
             np.asarray(delta, float).reshape(-1, 2), self._delta)
 
     def state_u(self) -> np.ndarray:
@@ -206,6 +199,16 @@ class ContactResponse:
                                               .max())
         return self._reference_stiffness
 
+    def _condense(self, K) -> CondensedLU | None:
+        """Factorise the tangent ``K`` (:func:`~.schur.condense`); the interior's
+        fill-reducing order is taken once per set from a factorisation of K_ff.
+        """
+        if self._order is None:
+            self._order = minimum_degree_order(K[self.free][:, self.free])
+            self.stats["factorizations"] += 1
+        self.stats["factorizations"] += 1
+        return condense(K, self.free, self.cdofs, self._order)
+
     def _min_det(self, u: np.ndarray) -> float:
         return float(area_ratios(self.geometry.gradient, u).min())
 
@@ -217,9 +220,9 @@ class ContactResponse:
         """
         plain = u.copy()
         plain[self.cdofs] = delta.reshape(-1)
-        if self._rate_map is not None:
+        if self._lu is not None:
             predicted = plain.copy()
-            predicted[self.free] += self._rate_map @ (plain[self.cdofs] - u[self.cdofs])
+            predicted[self.free] += self._lu.interior_rate(plain[self.cdofs] - u[self.cdofs])
             if self._min_det(predicted) > MIN_AREA_RATIO:
                 return predicted
         return plain if self._min_det(plain) > MIN_AREA_RATIO else None
@@ -244,9 +247,10 @@ class ContactResponse:
             if lu is None:
                 if asm.tangent is None:
                     asm = self._assemble(u, tangent=True)
-                lu = factor(asm.tangent[self.free][:, self.free])
-                self.stats["factorizations"] += 1
-            step = -lu.solve(r)
+                lu = self._condense(asm.tangent)
+                if lu is None:
+                    return ResponseFailure("the interior tangent is singular", norm / scale)
+            step = -lu.interior(r)
             its += 1
             inverted = True
             for _ in range(BACKTRACKS):
@@ -301,16 +305,13 @@ class ContactResponse:
         u, asm, _, residual = result
         self.stats["iterations"] += its
         K = asm.tangent if asm.tangent is not None else self._assemble(u, tangent=True).tangent
-        lu = factor(K[self.free][:, self.free])
-        self.stats["factorizations"] += 1
-        Kfc = K[self.free][:, self.cdofs].toarray()
-        X = lu.solve(Kfc)
-        C = K[self.cdofs][:, self.cdofs].toarray() - Kfc.T @ X
-        C = 0.5 * (C + C.T)
-        self._u, self._delta, self._lu, self._rate_map = u, delta.copy(), lu, -X
+        lu = self._condense(K)
+        if lu is None:
+            return ResponseFailure("the interior tangent is singular at equilibrium", residual)
+        self._u, self._delta, self._lu, self._evaluated = u, delta.copy(), lu, True
         self._energy = asm.energy
         F = asm.force[self.cdofs].reshape(-1, 2)
-        return Evaluation(F, C, u, asm.energy, its, residual)
+        return Evaluation(F, lu.schur.copy(), u, asm.energy, its, residual)
 
     def rate(self, ddelta: np.ndarray) -> np.ndarray:
         """Du / ds (2n,) of every node for a contact-displacement rate (m, 2) at the last
@@ -319,5 +320,5 @@ class ContactResponse:
         du = np.zeros(2 * len(self.nodes))
         d = np.asarray(ddelta, float).reshape(-1)
         du[self.cdofs] = d
-        du[self.free] = self._rate_map @ d
+        du[self.free] = self._lu.interior_rate(d)
         return du

@@ -231,6 +231,7 @@ def _model_row(res: EventSqueeze, model: str, seconds: float) -> dict:
         "strain_measure": STRAIN_MEASURES[MaterialModel(model)],
         "event_counts": res.event_counts,
         "work_minus_energy": res.diagnostics["work_minus_energy"],
+        "dissipation": sum(res.dissipation.values()),
         "nonlinear": res.diagnostics.get("nonlinear"),
         "seconds": seconds,
     }
@@ -333,9 +334,11 @@ def summary(result: dict) -> str:
     for name, seg in result["segments"].items():
         modes = " ".join(f"{s['node']}{'' if s['mode'] == 'stick' else '~'}" for s in seg)
         ff = result["finger_force"][name]
+        friction = result["dissipation"][name]
         lines.append(
             f"{name}: {len(seg)} nodes [{modes}] (~ = sliding); force along motion "
             f"{ff['start']:.4g} -> {ff['end']:.4g} N, work {result['work'][name]:.4g} J"
+            + (f" ({friction:.3g} J dissipated by friction)" if friction > 0 else "")
         )
     h = result["health"]
     lines.append(

@@ -34,6 +34,9 @@ class FingerState:
     work : float
         Work done by this finger on the object, J (integral of its total contact force along
         its path).
+    dissipation : float
+        Energy dissipated by friction at this finger's sliding contacts, J (integral of
+        -f_t r d theta over them: the friction force against the slip along the tip).
     """
 
     name: str
@@ -41,6 +44,7 @@ class FingerState:
     radius: float
     translation: np.ndarray
     work: float = 0.0
+    dissipation: float = 0.0
 
 
 @dataclass(frozen=True)

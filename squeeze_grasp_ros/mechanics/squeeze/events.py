@@ -267,6 +267,8 @@ class EventSqueeze:
         Strain energy 1/2 delta . F, J.
     work : dict
         Finger -> work done on the object, J (sum = energy + frictional dissipation).
+    dissipation : dict
+        Finger -> energy dissipated by friction at its sliding contacts, J.
     finger_force : dict
         Finger -> (start, end) force along its motion direction, N.
     trajectories : dict
@@ -310,6 +312,7 @@ class EventSqueeze:
     reference: bool = False
     diagnostics: dict = field(default_factory=dict)
     force_curve: dict = field(default_factory=dict)
+    dissipation: dict = field(default_factory=dict)
 
     @property
     def event_counts(self) -> dict:
@@ -332,6 +335,7 @@ class EventSqueeze:
             "segments": {k: [s.to_json() for s in v] for k, v in self.segments.items()},
             "energy": self.energy,
             "work": dict(self.work),
+            "dissipation": dict(self.dissipation),
             "finger_force": {
                 k: {"start": v[0], "end": v[1]} for k, v in self.finger_force.items()
             },
@@ -520,6 +524,7 @@ def event_squeeze(
     if isinstance(model, NonlinearContactModel):
         diag["nonlinear"] = model.diagnostics()
     diag["work_minus_energy"] = sum(f.work for f in state.fingers) - energy
+    diag["energy_balance"] = diag["work_minus_energy"] - sum(f.dissipation for f in state.fingers)
     return EventSqueeze(
         termination=run.termination,
         depth=state.depth,
@@ -534,6 +539,7 @@ def event_squeeze(
         segments={n: tuple(segment_node(c, mu) for c in state.segment(n)) for n in names},
         energy=energy,
         work={f.name: f.work for f in state.fingers},
+        dissipation={f.name: f.dissipation for f in state.fingers},
         finger_force=forces_along,
         trajectories=polar_trajectories(run.samples, relative_per_depth),
         force_curve={n: tuple((s.depth * relative_per_depth,

@@ -140,6 +140,9 @@ class _Run:
         self.radius_f = np.array([f.radius for f in state.fingers], float) / L
         self.t0 = np.array([f.translation for f in state.fingers], float) / L
         self.work = np.array([f.work for f in state.fingers], float) / (model.force_unit * L)
+        self.dissipation = np.array([f.dissipation for f in state.fingers], float) / (
+            model.force_unit * L
+        )
         self.rate = float(np.linalg.norm(self.D))
         self.depth0 = state.depth
         self.relative_per_depth = state.relative_per_depth
@@ -673,8 +676,17 @@ class _Run:
 
     # ----------------------------------------------------------------- motion
     def integrate_work(self, sa: Solution, sb: Solution, a: float, b: float) -> None:
-        """Add the work of every finger over [a, b] (cubic Hermite in s)."""
+        """Add the work of every finger over [a, b] (cubic Hermite in s) and the frictional
+        dissipation at its contacts (trapezoid in s; modes are fixed within [a, b]).
+
+        A contact node sits on its tip at polar angle theta, so it moves relative to the tip by
+        r d theta: the finger's force does F . dc = F . dx - f_t r d theta, and
+        -f_t r d theta (>= 0 against the slip, 0 while sticking) is what friction dissipates.
+        """
         h = b - a
+        r = self.radius_f[self.fidx]
+        pa = -sa.tangential() * r * sa.dtheta
+        pb = -sb.tangential() * r * sb.dtheta
         for f in range(len(self.names)):
             mine = self.fidx == f
             if not mine.any():
@@ -682,6 +694,7 @@ class _Run:
             ya, yb = sa.F[mine].sum(axis=0) @ self.D[f], sb.F[mine].sum(axis=0) @ self.D[f]
             ra, rb = sa.dF[mine].sum(axis=0) @ self.D[f], sb.dF[mine].sum(axis=0) @ self.D[f]
             self.work[f] += 0.5 * h * (ya + yb) + h * h / 12.0 * (ra - rb)
+            self.dissipation[f] += 0.5 * h * (pa[mine].sum() + pb[mine].sum())
 
     def record(self, sol: Solution) -> None:
         """Append a trajectory sample at the current point."""
@@ -840,6 +853,7 @@ class _Run:
                 self.radius_f[f] * L,
                 (self.t0[f] + s * self.D[f]) * L,
                 float(self.work[f] * fu * L),
+                float(self.dissipation[f] * fu * L),
             )
             for f, n in enumerate(self.names)
         )

@@ -90,6 +90,29 @@ def test_the_condensed_factorisation_against_direct_sparse_solves(model, patch):
     assert np.abs(lu.interior_rate(d) - x).max() < 1e-12 * np.abs(x).max()
 
 
+def test_a_pivot_that_would_cross_into_the_contact_block_is_kept_on_the_diagonal():
+    """A weak interior diagonal coupled strongly to a contact DOF: SuperLU's 0.1 threshold
+    would pivot on the contact row, so condense refactors with diagonal pivots, and the Schur
+    complement and interior solves are still exact (against dense linear algebra).
+    """
+    import scipy.sparse as sp
+
+    from squeeze_grasp_ros.mechanics.elastic.schur import condense
+
+    dense = np.diag([0.01, 1.0, 2.0, 1.5, 3.0, 2.5])
+    dense[0, 4] = dense[4, 0] = 10.0
+    dense[1, 2] = dense[2, 1] = 0.3
+    dense[3, 5] = dense[5, 3] = 0.7
+    free, cd = np.arange(4), np.array([4, 5])
+    lu = condense(sp.csr_matrix(dense), free, cd, np.array([2, 0, 3, 1]))
+    assert lu is not None and lu.lu.perm_r.tolist() == list(range(6))
+    Kff, Kfc = dense[:4, :4], dense[:4, 4:]
+    S = dense[4:, 4:] - Kfc.T @ np.linalg.solve(Kff, Kfc)
+    assert np.allclose(lu.schur, S, rtol=1e-12, atol=1e-9)
+    r = np.array([1.0, -2.0, 0.5, 3.0])
+    assert np.allclose(lu.interior(r), np.linalg.solve(Kff, r), rtol=1e-10)
+
+
 @pytest.mark.parametrize("model", NONLINEAR)
 def test_the_response_tangent_is_the_derivative_of_its_forces(model, patch):
     """dF/d delta of a contact set's equilibrium against central differences of F."""

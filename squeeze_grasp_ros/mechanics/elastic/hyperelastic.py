@@ -170,27 +170,24 @@ def _rotation(F: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
 
 
 def _corotational(F: np.ndarray, nu: float, tangent: bool):
-    C = _plane_stress_tensor(nu)
+    t = len(F)
+    C = _plane_stress_tensor(nu).reshape(4, 4)
     R, dtheta, _ = _rotation(F)
-    U = np.einsum("tki,tkj->tij", R, F)
+    U = np.swapaxes(R, 1, 2) @ F
     E = 0.5 * (U + np.swapaxes(U, 1, 2)) - np.eye(2)
-    S = np.einsum("ijkl,tkl->tij", C, E)
-    W = 0.5 * np.einsum("tij,tij->t", S, E)
-    P = np.einsum("tik,tkj->tij", R, S)
+    S = (E.reshape(t, 4) @ C.T).reshape(t, 2, 2)
+    W = 0.5 * np.sum(S * E, axis=(1, 2))
+    P = R @ S
     if not tangent:
         return W, P, None
-    A = np.empty((len(F), 2, 2, 2, 2))
-    OS = np.einsum("ik,tkj->tij", _SKEW, S)
-    OU = np.einsum("ik,tkj->tij", _SKEW, U)
-    for k in range(2):
-        for m in range(2):
-            dF = np.zeros((2, 2))
-            dF[k, m] = 1.0
-            dth = dtheta[:, k, m]
-            dU = np.einsum("tji,jk->tik", R, dF) - OU * dth[:, None, None]
-            dS = np.einsum("ijkl,tkl->tij", C, 0.5 * (dU + np.swapaxes(dU, 1, 2)))
-            A[:, :, :, k, m] = np.einsum("tik,tkj->tij", R, OS * dth[:, None, None] + dS)
-    return W, P, A
+    # dU/dF_km = R^T e_k e_m^T - Omega U dtheta/dF_km, for the four (k, m) at once:
+    # entry [t, k, m, i, j] of the first term is R[t, k, i] delta_jm.
+    dU = (R[:, :, None, :, None] * np.eye(2)[None, None, :, None, :]
+          - (_SKEW @ U)[:, None, None] * dtheta[:, :, :, None, None]).reshape(t, 4, 2, 2)
+    dS = (0.5 * (dU + np.swapaxes(dU, 2, 3))).reshape(t, 4, 4) @ C.T
+    dP = R[:, None] @ ((_SKEW @ S)[:, None] * dtheta.reshape(t, 4, 1, 1)
+                       + dS.reshape(t, 4, 2, 2))
+    return W, P, dP.reshape(t, 2, 2, 2, 2).transpose(0, 3, 4, 1, 2)
 
 
 def _lame(nu: float) -> tuple[float, float]:

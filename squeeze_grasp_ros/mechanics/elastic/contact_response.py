@@ -15,8 +15,9 @@ whole tangent with the contact DOFs ordered last (:class:`~.schur.CondensedLU`),
 interior solves and rates. Line-search trials assemble forces only; the tangent is assembled
 where it is factorised.
 
-Factorisations: Newton re-uses the last factorisation of K_ff as long as the residual falls by
-at least REUSE_CONTRACTION per iteration (modified Newton), and refactors otherwise; the
+Factorisations: Newton re-uses the last factorisation of the whole tangent (kept with the last
+evaluated state) as long as the residual falls by at least REUSE_CONTRACTION per iteration
+(modified Newton), and refactors otherwise; the
 converged state is always refactored once for the exact Schur complement. ``stats`` counts both,
 and the one factorisation of K_ff per contact set that gives the interior's ordering.
 
@@ -145,7 +146,6 @@ class ContactResponse:
     _u: np.ndarray | None = field(default=None, repr=False)
     _delta: np.ndarray | None = field(default=None, repr=False)
     _lu: CondensedLU | None = field(default=None, repr=False)
-    _evaluated: bool = field(default=False, repr=False)
     _order: np.ndarray | None = field(default=None, repr=False)
     _energy: float = field(default=0.0, repr=False)
     _reference_stiffness: float | None = field(default=None, repr=False)
@@ -171,11 +171,12 @@ class ContactResponse:
         self._u = np.array(u, float)
         self._delta = self._u[self.cdofs].reshape(-1, 2)
         self._lu = None
-        self._evaluated = False
 
     def at(self, delta: np.ndarray) -> bool:
-        """True if the last evaluated state is at ``delta`` (its field can be read)."""
-        return self._evaluated and np.array_equal(
+        """True if the last evaluated state is at ``delta`` (its field can be read); a state
+        was evaluated exactly when its factorisation is kept (none after :meth:`warm_start`).
+        """
+        return self._lu is not None and np.array_equal(
             np.asarray(delta, float).reshape(-1, 2), self._delta)
 
     def state_u(self) -> np.ndarray:
@@ -308,7 +309,7 @@ class ContactResponse:
         lu = self._condense(K)
         if lu is None:
             return ResponseFailure("the interior tangent is singular at equilibrium", residual)
-        self._u, self._delta, self._lu, self._evaluated = u, delta.copy(), lu, True
+        self._u, self._delta, self._lu = u, delta.copy(), lu
         self._energy = asm.energy
         F = asm.force[self.cdofs].reshape(-1, 2)
         return Evaluation(F, lu.schur.copy(), u, asm.energy, its, residual)

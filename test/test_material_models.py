@@ -135,6 +135,53 @@ def test_the_response_tangent_is_the_derivative_of_its_forces(model, patch):
     assert np.linalg.norm(at.C @ d.reshape(-1) - fd) < 1e-6 * np.linalg.norm(fd)
 
 
+def test_a_response_returns_to_a_kept_state_without_solving(patch):
+    """Evaluating again at a delta solved shortly before restores that state (field, energy,
+    tangent) without a Newton iteration or a factorisation; an older one is solved again.
+    """
+    from squeeze_grasp_ros.mechanics.elastic.contact_response import KEPT_STATES
+
+    left, right = np.argsort(patch.nodes[:, 0])[:2], np.argsort(-patch.nodes[:, 0])[:2]
+    response = ContactResponse(MaterialModel.NEO_HOOKEAN, patch.nodes / 0.1, patch.triangles,
+                               np.r_[left, right], 0.3)
+    deltas = [np.zeros((4, 2)) for _ in range(KEPT_STATES + 1)]
+    for k, delta in enumerate(deltas):
+        delta[:2, 0], delta[2:, 0] = 0.01 * (k + 1), -0.01 * (k + 1)
+    first = [response.evaluate(d) for d in deltas]
+    before = dict(response.stats)
+    again = response.evaluate(deltas[1])
+    assert again is first[1] and response.stats["factorizations"] == before["factorizations"]
+    assert response.stats["look_ups"] == before["look_ups"] + 1
+    assert response.state_energy() == first[1].energy
+    assert np.array_equal(response.state_u(), first[1].u)
+    assert response.at(deltas[2]) and np.array_equal(response.state_u(), first[2].u)
+    oldest = response.evaluate(deltas[0])
+    assert response.stats["evaluations"] == before["evaluations"] + 1
+    assert abs(oldest.energy - first[0].energy) < 1e-12 * first[0].energy
+
+
+def test_a_larger_contact_set_inherits_the_interior_order(patch):
+    """A set with one more contact node takes the interior order of the smaller one (no
+    ordering factorisation) and its tangent is that of a set ordered afresh.
+    """
+    left, right = np.argsort(patch.nodes[:, 0])[:3], np.argsort(-patch.nodes[:, 0])[:2]
+    delta = np.zeros((5, 2))
+    delta[:3, 0], delta[3:, 0] = 0.01, -0.01
+
+    def response(contacts):
+        return ContactResponse(MaterialModel.NEO_HOOKEAN, patch.nodes / 0.1, patch.triangles,
+                               contacts, 0.3)
+
+    small = response(np.r_[left[:2], right])
+    small.evaluate(np.delete(delta, 2, axis=0))
+    heir, fresh = response(np.r_[left, right]), response(np.r_[left, right])
+    heir.inherit_order(small)
+    a, b = heir.evaluate(delta), fresh.evaluate(delta)
+    assert heir.stats["factorizations"] == fresh.stats["factorizations"] - 1
+    assert np.abs(a.C - b.C).max() < 1e-10 * np.abs(b.C).max()
+    assert np.abs(a.F - b.F).max() < 1e-10 * np.abs(b.F).max()
+
+
 def test_the_linear_law_is_the_cst_stiffness(patch):
     K = stiffness_matrix(patch, 0.3)
     u = np.random.default_rng(3).standard_normal(2 * patch.n) * 1e-3

@@ -19,7 +19,11 @@ Factorisations: Newton re-uses the last factorisation of the whole tangent (kept
 evaluated state) as long as the residual falls by at least REUSE_CONTRACTION per iteration
 (modified Newton), and refactors otherwise; the
 converged state is always refactored once for the exact Schur complement. ``stats`` counts both,
-and the one factorisation of K_ff per contact set that gives the interior's ordering.
+and the one factorisation of K_ff per contact set that gives the interior's ordering (a set
+grown from another inherits that one's, :meth:`ContactResponse.inherit_order`). The last
+KEPT_STATES evaluated states are kept with their factorisations: an evaluation at one of their
+deltas, as when the stepper returns to a point it solved while locating an event, is a
+look-up.
 
 Everything is dimensionless as in the stepper: coordinates and displacements / L, forces / (E h L),
 energies / (E h L^2).
@@ -52,6 +56,9 @@ MIN_AREA_RATIO = 1e-8
 accepted state keeps a margin above det F = 0, where assembly refuses the state."""
 MAX_ITERATIONS = 25
 MAX_SUBSTEPS = 64
+KEPT_STATES = 4
+"""Evaluated states a response keeps (with their factorisations): the stepper returns to
+points it solved while locating an event, and an evaluation at a kept delta is a look-up."""
 REUSE_CONTRACTION = 0.25
 BACKTRACKS = 30
 _REUSE = [True]
@@ -142,13 +149,15 @@ class ContactResponse:
     nu: float
     geometry: MeshGeometry | None = field(default=None, repr=False)
     stats: dict = field(default_factory=lambda: {"evaluations": 0, "iterations": 0,
-                                                 "factorizations": 0, "substeps": 0})
+                                                 "factorizations": 0, "substeps": 0,
+                                                 "look_ups": 0})
     _u: np.ndarray | None = field(default=None, repr=False)
     _delta: np.ndarray | None = field(default=None, repr=False)
     _lu: CondensedLU | None = field(default=None, repr=False)
     _order: np.ndarray | None = field(default=None, repr=False)
     _energy: float = field(default=0.0, repr=False)
     _reference_stiffness: float | None = field(default=None, repr=False)
+    _kept: list = field(default_factory=list, repr=False)
 
     def __post_init__(self) -> None:
         self.contacts = np.asarray(self.contacts, int)
@@ -172,12 +181,38 @@ class ContactResponse:
         self._delta = self._u[self.cdofs].reshape(-1, 2)
         self._lu = None
 
-    def at(self, delta: np.ndarray) -> bool:
-        """True if the last evaluated state is at ``delta`` (its field can be read); a state
-        was evaluated exactly when its factorisation is kept (none after :meth:`warm_start`).
+    def inherit_order(self, other: "ContactResponse") -> None:
+        """Take the interior's fill-reducing order from ``other``'s (a set of the same object
+        with no more contact nodes), without the DOFs that are contact DOFs here: the
+        eliminations restricted to a subgraph fill no more than the original did, and the
+        new set needs no ordering factorisation of its own.
         """
-        return self._lu is not None and np.array_equal(
-            np.asarray(delta, float).reshape(-1, 2), self._delta)
+        if other._order is None or not np.isin(self.free, other.free).all():
+            return
+        interior = other.free[other._order]
+        self._order = np.searchsorted(self.free, interior[np.isin(interior, self.free)])
+
+    def forget(self) -> None:
+        """Drop the kept states but the current one (their factorisations hold memory)."""
+        self._kept = self._kept[-1:]
+
+    def _recall(self, delta: np.ndarray) -> Evaluation | None:
+        """Make the kept state at exactly ``delta`` the current one; its evaluation or None."""
+        for kept_delta, out, lu in reversed(self._kept):
+            if np.array_equal(kept_delta, delta):
+                self._u, self._delta, self._lu, self._energy = out.u, kept_delta, lu, out.energy
+                return out
+        return None
+
+    def at(self, delta: np.ndarray) -> bool:
+        """True if the response is at ``delta`` or keeps the state there (its field can then
+        be read); a state was evaluated exactly when its factorisation is kept (none after
+        :meth:`warm_start`).
+        """
+        delta = np.asarray(delta, float).reshape(-1, 2)
+        if self._lu is not None and np.array_equal(delta, self._delta):
+            return True
+        return self._recall(delta) is not None
 
     def state_u(self) -> np.ndarray:
         """Displacement (2n,) of the last evaluated state."""
@@ -282,6 +317,10 @@ class ContactResponse:
     def evaluate(self, delta: np.ndarray) -> Evaluation | ResponseFailure:
         """The equilibrium at contact displacements ``delta`` (m, 2), or why none was found."""
         delta = np.asarray(delta, float).reshape(-1, 2)
+        kept = self._recall(delta)
+        if kept is not None:
+            self.stats["look_ups"] += 1
+            return kept
         self.stats["evaluations"] += 1
         base_u, base_d = self._u, self._delta
         target, done, its = delta, 0.0, 0
@@ -312,7 +351,9 @@ class ContactResponse:
         self._u, self._delta, self._lu = u, delta.copy(), lu
         self._energy = asm.energy
         F = asm.force[self.cdofs].reshape(-1, 2)
-        return Evaluation(F, lu.schur.copy(), u, asm.energy, its, residual)
+        out = Evaluation(F, lu.schur.copy(), u, asm.energy, its, residual)
+        self._kept = [*self._kept[1 - KEPT_STATES:], (self._delta, out, lu)]
+        return out
 
     def rate(self, ddelta: np.ndarray) -> np.ndarray:
         """Du / ds (2n,) of every node for a contact-displacement rate (m, 2) at the last

@@ -71,6 +71,7 @@ class NonlinearContactModel(ContactModel):
             last = self._cache.get("last")
             if last is not None:
                 responses[key].warm_start(last.state_u())
+                responses[key].inherit_order(last)
         return responses[key]
 
     def set_data(self, nodes: tuple[int, ...]) -> SetData:
@@ -87,6 +88,9 @@ class NonlinearContactModel(ContactModel):
         response = self._response_of(sd)
         out = response.evaluate(delta)
         if isinstance(out, Evaluation):
+            last = self._cache.get("last")
+            if last is not None and last is not response:
+                last.forget()
             self._cache["last"] = response
             stats = self._cache.setdefault("nonlinear", {"evaluations": 0, "iterations": 0})
             stats["evaluations"] += 1
@@ -153,12 +157,15 @@ class NonlinearContactModel(ContactModel):
         return self.field_area_ratio(self._field(sd, delta))
 
     def diagnostics(self) -> dict:
-        """Newton evaluations, iterations and factorisations of the interior solves."""
+        """Newton evaluations, iterations and factorisations of the interior solves, and the
+        evaluations answered by a kept state (look-ups).
+        """
         responses = self._cache.get("responses", {}).values()
         return {"material_model": str(self.material_model),
                 "evaluations": sum(r.stats["evaluations"] for r in responses),
                 "newton_iterations": sum(r.stats["iterations"] for r in responses),
                 "factorizations": sum(r.stats["factorizations"] for r in responses),
+                "look_ups": sum(r.stats["look_ups"] for r in responses),
                 "load_substeps": sum(r.stats["substeps"] for r in responses)}
 
 

@@ -401,6 +401,14 @@ class ContactModel:
             )
 
     @property
+    def adaptive_steps(self) -> bool:
+        """Whether the stepper adapts its substeps between events (a model whose evaluations
+        are dear) or keeps the ``step`` grid (this one: an evaluation is a small dense
+        product).
+        """
+        return False
+
+    @property
     def phi(self) -> float:
         """Friction angle atan(mu), rad."""
         return float(np.arctan(self.mu))

@@ -21,8 +21,8 @@ import numpy as np
 
 from squeeze_grasp_ros.mechanics.errors import NumericalError
 
-__all__ = ["EventValues", "MAX_ROOT_ITERATIONS", "event_values", "locate_sign_change",
-           "mode_violations", "pickup_margin"]
+__all__ = ["EventValues", "MAX_ROOT_ITERATIONS", "event_values", "hermite_dips",
+           "hermite_root", "locate_sign_change", "mode_violations", "pickup_margin"]
 
 MAX_ROOT_ITERATIONS = 200
 
@@ -50,37 +50,106 @@ def pickup_margin(
     return float(weight / len(fingers) - min(totals))
 
 
+def _hermite_coefficients(ga: float, gb: float, ra: float, rb: float, h: float) -> np.ndarray:
+    """Coefficients (t^3, t^2, t, 1) of the cubic Hermite interpolant on t = (s - a) / h."""
+    return np.array([2 * ga + h * ra - 2 * gb + h * rb, -3 * ga - 2 * h * ra + 3 * gb - h * rb,
+                     h * ra, ga])
+
+
+def hermite_root(a: float, b: float, ga: float, gb: float, ra: float, rb: float) -> float | None:
+    """First root in (a, b) of the cubic that has values ga, gb and slopes ra, rb at a, b.
+
+    >>> round(hermite_root(0.0, 2.0, 1.0, -3.0, -2.0, -2.0), 12)  # 1 - 2 s
+    0.5
+    >>> hermite_root(0.0, 1.0, 1.0, 1.0, -3.0, 3.0) is None  # dips to 0.25 only
+    True
+    """
+    t = np.roots(_hermite_coefficients(ga, gb, ra, rb, b - a))
+    t = np.sort(t[(np.abs(t.imag) < 1e-12) & (t.real > 0) & (t.real < 1)].real)
+    return float(a + t[0] * (b - a)) if len(t) else None
+
+
+def hermite_dips(a: float, b: float, ga, gb, ra, rb) -> np.ndarray:
+    """Whether the cubic Hermite interpolant of each function (values ga, gb > 0 and slopes
+    ra, rb at a, b; arrays) goes to or below zero inside (a, b): a double root (a node grazing
+    a tip, a force touching zero and growing again) that the end values alone would miss.
+
+    >>> hermite_dips(0.0, 1.0, [1.0, 1.0], [1.0, 1.0], [-3.0, -6.0], [3.0, 6.0])
+    array([False,  True])
+    """
+    ga, gb, ra, rb = (np.asarray(x, float) for x in (ga, gb, ra, rb))
+    c3, c2, c1, c0 = _hermite_coefficients(ga, gb, ra, rb, b - a)
+    # stationary points: 3 c3 t^2 + 2 c2 t + c1 = 0
+    qa, qb = 3 * c3, 2 * c2
+    disc = np.maximum(qb * qb - 4 * qa * c1, 0.0)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        roots = np.stack([(-qb + np.sqrt(disc)) / (2 * qa), (-qb - np.sqrt(disc)) / (2 * qa),
+                          -c1 / qb])
+    roots = np.where(np.isfinite(roots) & (roots > 0) & (roots < 1), roots, 0.0)
+    low = ((c3 * roots + c2) * roots + c1) * roots + c0
+    return np.any((low <= 0) & (roots > 0), axis=0)
+
+
 def locate_sign_change(
-    g: Callable[[float], float], a: float, b: float, ga: float, gb: float, tol: float
+    g: Callable[[float], float | tuple[float, float]], a: float, b: float, ga: float,
+    gb: float, tol: float, slopes: tuple[float, float] | None = None,
 ) -> tuple[float, float, int]:
     """Bracket [a, b] of width <= tol around the first sign change (ga > 0 >= gb).
 
-    Illinois regula falsi with a bisection safeguard; returns (a, b, evaluations).
+    Without ``slopes``, Illinois regula falsi; with the slopes (ra, rb) at a and b, ``g``
+    returns (value, slope) and each new point is the root of the cubic Hermite interpolant on
+    the bracket (fourth-order accurate: a smooth function needs two or three evaluations),
+    moved tol / 4 past it, so that the bracket closes with its end b a quarter of the tolerance
+    beyond the root rather than on it, where the signs of other functions that cross at the
+    same point would be round-off. A point is kept 0.49 tol inside the bracket, so a converged
+    estimate closes it from the other side, and every third point bisects a bracket that did
+    not halve. Returns (a, b, evaluations).
+
+    cos s = 1/2 on [0, 2] (root pi/3): 9 evaluations without slopes, 4 with them.
+
+    >>> from math import cos, sin, pi
+    >>> locate_sign_change(lambda s: cos(s) - 0.5, 0.0, 2.0, 0.5, cos(2) - 0.5, 1e-9)[2]
+    9
+    >>> a, b, n = locate_sign_change(lambda s: (cos(s) - 0.5, -sin(s)), 0.0, 2.0, 0.5,
+    ...                              cos(2) - 0.5, 1e-9, slopes=(0.0, -sin(2)))
+    >>> a < pi / 3 <= b, b - a <= 1e-9, n
+    (True, True, 4)
     """
     evaluations, retained, width = 0, 0, b - a
+    ra, rb = slopes if slopes is not None else (0.0, 0.0)
     while b - a > tol:
         if evaluations >= MAX_ROOT_ITERATIONS:
             raise NumericalError(
                 f"event location did not converge in {evaluations} evaluations",
                 residuals={"bracket": b - a, "tolerance": tol},
             )
+        c = None
         if evaluations % 3 == 2 and b - a > 0.5 * width:
             c = 0.5 * (a + b)
-        else:
+        elif slopes is not None:
+            c = hermite_root(a, b, ga, gb, ra, rb)
+            c = None if c is None else c + 0.25 * tol
+        if c is None:
             c = (a * gb - b * ga) / (gb - ga) if gb != ga else 0.5 * (a + b)
         c = min(max(c, a + 0.49 * tol), b - 0.49 * tol)
         if evaluations % 3 == 2:
             width = b - a
         gc = g(c)
         evaluations += 1
+        if slopes is not None:
+            gc, rc = gc
         if gc > 0:
             a, ga = c, gc
-            if retained == 1:
+            if slopes is not None:
+                ra = rc
+            elif retained == 1:
                 gb *= 0.5
             retained = 1
         else:
             b, gb = c, gc
-            if retained == -1:
+            if slopes is not None:
+                rb = rc
+            elif retained == -1:
                 ga *= 0.5
             retained = -1
     return a, b, evaluations

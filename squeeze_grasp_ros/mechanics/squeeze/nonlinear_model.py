@@ -56,6 +56,13 @@ class NonlinearContactModel(ContactModel):
             raise InvalidInputError("strain_limit.criterion componentwise is defined for small "
                                     "strains only; use principal with a nonlinear model")
 
+    @property
+    def adaptive_steps(self) -> bool:
+        """True: every evaluation is a nonlinear solve of the whole object, so the stepper
+        adapts its substeps between events to the curvature of the force path.
+        """
+        return True
+
     # ------------------------------------------------------------------ the response
     def _response_of(self, sd: SetData) -> ContactResponse:
         responses = self._cache.setdefault("responses", {})

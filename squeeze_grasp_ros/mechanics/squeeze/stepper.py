@@ -94,6 +94,7 @@ from squeeze_grasp_ros.mechanics.squeeze.contact_state import (
 )
 from squeeze_grasp_ros.mechanics.errors import InvalidInputError, NumericalError, require_finite
 from squeeze_grasp_ros.mechanics.squeeze.event_functions import (EventValues, event_values,
+                                                                  hermite_dips, hermite_root,
                                                                   locate_sign_change,
                                                                   mode_violations, pickup_margin)
 from squeeze_grasp_ros.mechanics.squeeze.fingertips import tip_gaps
@@ -109,6 +110,12 @@ TERMINATION_ORDER: tuple[str, ...] = (
 SLIP_RATE_ZERO = 1e-10
 """Frictionless contacts: polar-angle rates (rad per unit motion) below this have no slip
 direction, so round-off in a symmetric contact cannot fake a one-way finger slip."""
+ADAPTIVE_GROWTH = 2.0
+ADAPTIVE_SLOPE_CHANGE = 0.1
+ADAPTIVE_MAX_STEPS = 8
+"""Adaptive substeps (models with ``adaptive_steps``, :meth:`_Run.next_step`): growth per
+substep, the relative change of the force slope over one substep they aim at, and their
+largest length in grid steps."""
 MAX_SUBSTEP_HALVINGS = 12
 CONTINUATION_ITERATIONS = 12
 MAX_ANGLE_JUMP = 0.05
@@ -173,6 +180,7 @@ class _Run:
             "root_evaluations": 0,
             "substeps": 0,
             "substep_halvings": 0,
+            "substep_rejections": 0,
             "ambiguous_modes": 0,
         }
         self._refresh_set()
@@ -290,6 +298,12 @@ class _Run:
         k = int(np.searchsorted(self.nodes, node))
         return float({"B": v.fn, "C+": v.c_plus, "C-": v.c_minus, "D": v.d}[kind][k])
 
+    def _key_slope(self, key: tuple, sol: Solution, s: float) -> float:
+        """Derivative d/ds of one event function that has one (A, B, C; see :meth:`rates`)."""
+        if key[0] == "A":
+            return self.rates(sol, s, self.model.obj.boundary_positions([key[1]]))[key]
+        return self.rates(sol, s, np.zeros(0, int))[key]
+
     def entries(self, v: EventValues, rows: np.ndarray, depth: float):
         """Active (key, value) pairs of the contact and termination functions, in order."""
         held = self.held(depth)
@@ -317,37 +331,41 @@ class _Run:
         return out
 
     # ----------------------------------------------------------------- processing at a point
-    def _fresh_rates(self, sol: Solution, rows: np.ndarray) -> dict:
-        """Derivatives d/ds of the fresh functions at the current point."""
+    def rates(self, sol: Solution, s: float, rows: np.ndarray) -> dict:
+        """Derivatives d/ds at ``sol`` of the gaps (Event A) of boundary positions ``rows`` and
+        of every contact's normal force and cone margins (B, C); D and the terminations have
+        none (their derivative needs the second derivative of the sliding angles / the field).
+        """
         fn_r, ft_r = sol.normal_rate(), sol.tangential_rate()
         mu = self.model.mu
-        rates = {}
-        a_nodes = [node for kind, node in self.fresh if kind == "A"]
-        if a_nodes:
-            arows = self.model.obj.boundary_positions(a_nodes)
-            x = self.p_b[arows] + self.model.boundary_displacement(
-                self.sd, sol.delta, sol.F, arows
-            )
-            dx = self.model.boundary_rate(self.sd, sol, arows)
-            centers = self.c0 + self.s * self.D
-            for j, node in enumerate(a_nodes):
-                rel = x[j] - centers
-                rel_rate = dx[j] - self.D
-                g_rate = np.einsum("fi,fi->f", rel, rel_rate) / np.linalg.norm(rel, axis=1)
+        out = {}
+        if len(rows):
+            x = self.p_b[rows] + self.model.boundary_displacement(self.sd, sol.delta, sol.F, rows)
+            dx = self.model.boundary_rate(self.sd, sol, rows)
+            rel = x[:, None, :] - (self.c0 + s * self.D)[None]
+            rel_rate = dx[:, None, :] - self.D[None]
+            g_rate = np.einsum("rfi,rfi->rf", rel, rel_rate) / np.linalg.norm(rel, axis=2)
+            for j, node in enumerate(self.boundary[rows].tolist()):
                 for f in range(len(self.names)):
-                    rates[("A", node, f)] = g_rate[f]
+                    out[("A", node, f)] = float(g_rate[j, f])
         for k, node in enumerate(self.nodes.tolist()):
-            rates[("B", node)] = fn_r[k]
-            rates[("C+", node)] = mu * fn_r[k] + ft_r[k]
-            rates[("C-", node)] = mu * fn_r[k] - ft_r[k]
-        return rates
+            out[("B", node)] = float(fn_r[k])
+            out[("C+", node)] = float(mu * fn_r[k] + ft_r[k])
+            out[("C-", node)] = float(mu * fn_r[k] - ft_r[k])
+        return out
+
+    def _fresh_rates(self, sol: Solution) -> dict:
+        """Derivatives d/ds of the fresh functions at the current point."""
+        a_nodes = [node for kind, node in self.fresh if kind == "A"]
+        return self.rates(sol, self.s, self.model.obj.boundary_positions(a_nodes)
+                          if a_nodes else np.zeros(0, int))
 
     def pending(self, sol: Solution) -> list[tuple]:
         """Pending contact events at the current point, in processing order."""
         depth = self.depth_at(self.s)
         rows = self.free_rows(depth)
         v = self.values(sol, self.s, rows, terminations=False)
-        rates = self._fresh_rates(sol, rows)
+        rates = self._fresh_rates(sol)
         out = []
         for key, value in self.entries(v, rows, depth):
             fresh_key = key[:2]
@@ -712,14 +730,13 @@ class _Run:
             )
         )
 
-    def crossings(self, va: list, vb: list, fresh_at_a: set) -> list[tuple]:
+    def crossings(self, va: dict, vb: dict, fresh_at_a: set) -> list[tuple]:
         """Keys whose function went from > 0 (or fresh zero) at a to <= 0 at b."""
-        before = dict(va)
         out = []
-        for key, value in vb:
-            if value > 0 or key not in before:
+        for key, value in vb.items():
+            if value > 0 or key not in va:
                 continue
-            if before[key] > 0 or key[:2] in fresh_at_a:
+            if va[key] > 0 or key[:2] in fresh_at_a:
                 out.append(key)
         return out
 
@@ -774,25 +791,38 @@ class _Run:
             return term
         hs = self.step / self.rate
         tol_s = self.tol / self.rate
-        rows, va = None, None
+        adaptive = self.model.adaptive_steps and not self.model.reference
+        h, rows, va, rates_a = hs, None, None, None
         while self.s < 1.0:
             a = self.s
             depth_a = self.depth_at(a)
             free = self.free_rows(depth_a)
             if va is None or not np.array_equal(free, rows):
                 rows = free
-                va = self.entries(self.values(sol, a, rows), rows, depth_a)
-            b, sol_b = self.substep(sol, a, min(a + hs, 1.0))
+                va = dict(self.entries(self.values(sol, a, rows), rows, depth_a))
+                rates_a = self.rates(sol, a, rows) if adaptive else None
+            b, sol_b = self.substep(sol, a, min(a + h, 1.0))
             if isinstance(sol_b, SolveFailure):
                 self.diag["inversion"] = sol_b.reason
                 term = Termination.ELEMENT_INVERTED
                 break
-            self.diag["substeps"] += 1
-            vb = self.entries(self.values(sol_b, b, rows), rows, depth_a)
+            vb = dict(self.entries(self.values(sol_b, b, rows), rows, depth_a))
+            rates_b = self.rates(sol_b, b, rows) if adaptive else None
             crossed = self.crossings(va, vb, self.fresh)
+            if adaptive and not crossed and b - a > hs and self.dips(va, vb, rates_a, rates_b,
+                                                                     a, b):
+                self.diag["substep_rejections"] += 1
+                h = max(hs, 0.5 * (b - a))
+                continue
+            self.diag["substeps"] += 1
+            if adaptive:
+                h = self.next_step(sol, sol_b, a, b, h, hs, va, vb)
             if crossed and not self.model.reference:
-                b, sol_b = self.earliest(crossed, sol, sol_b, a, b, tol_s, dict(va), dict(vb))
-            va = None if crossed else vb
+                if not adaptive:
+                    rates_a, rates_b = self.rates(sol, a, rows), self.rates(sol_b, b, rows)
+                b, sol_b = self.earliest(crossed, sol, sol_b, a, b, tol_s, va, vb, rates_a,
+                                         rates_b)
+            va, rates_a = (None, None) if crossed else (vb, rates_b)
             self.integrate_work(sol, sol_b, a, b)
             self.s = 1.0 if b >= 1.0 else b
             self.fresh = set()
@@ -805,14 +835,61 @@ class _Run:
         self.final = sol
         return term
 
-    def earliest(self, crossed, sol_a, sol_b, a, b, tol_s, va, vb):
-        """Locate every crossed function; return the earliest bracket end and its solution."""
+    def dips(self, va: dict, vb: dict, ra: dict, rb: dict, a: float, b: float) -> bool:
+        """Whether a function with slopes, positive at both ends of [a, b] (and not zero by
+        construction at a), goes to zero inside on its cubic Hermite interpolant.
+        """
+        keys = [key for key in rb if key in ra and key in va and key in vb
+                and va[key] > 0 and vb[key] > 0 and key[:2] not in self.fresh]
+        return bool(hermite_dips(a, b, *(np.array([v[key] for key in keys])
+                                         for v in (va, vb, ra, rb))).any())
+
+    def next_step(self, sol_a: Solution, sol_b: Solution, a: float, b: float, h: float,
+                  hs: float, va: dict, vb: dict) -> float:
+        """The next substep of an adaptive run (from ``h``, the last one planned, and the
+        accepted [a, b]).
+
+        It grows by up to ADAPTIVE_GROWTH while the slope of the contact forces changes by less
+        than ADAPTIVE_SLOPE_CHANGE of their change over a substep (so the cubic interpolants
+        of the event functions and of the work stay accurate), shrinks when it changes more,
+        and stays within [hs, ADAPTIVE_MAX_STEPS hs] (hs = the ``step`` grid). It stays on the
+        grid while a contact slides (the slip rates have no slopes; the dissipation is
+        integrated by the trapezoid rule), and within half the distance at which a
+        termination function without slope (strain, inversion, pickup) would reach zero at
+        its last rate of change.
+        """
+        if not self.stick.all():
+            return hs
+        change = np.linalg.norm(sol_b.F - sol_a.F)
+        slope_change = (b - a) * np.linalg.norm(sol_b.dF - sol_a.dF)
+        if slope_change <= ADAPTIVE_SLOPE_CHANGE * change / ADAPTIVE_GROWTH:
+            grow = ADAPTIVE_GROWTH
+        else:
+            grow = max(0.5, ADAPTIVE_SLOPE_CHANGE * change / slope_change)
+        h = min(ADAPTIVE_MAX_STEPS * hs, max(hs, h * grow))
+        for key in ("inverted", -1), ("strain", -1), ("pickup", -1):
+            if key in va and key in vb and vb[key] < va[key]:
+                h = min(h, max(hs, 0.5 * vb[key] * (b - a) / (va[key] - vb[key])))
+        return h
+
+    def earliest(self, crossed, sol_a, sol_b, a, b, tol_s, va, vb, ra, rb):
+        """Locate the earliest crossed function; return its bracket end and the solution there.
+
+        Functions with slopes at both ends (``ra``, ``rb``) are located on their cubic Hermite
+        interpolants, the others by regula falsi. The crossings are taken in the order of their
+        interpolated roots: once one is bracketed in [lo, hi], another that is still positive
+        at lo crosses no earlier than the bracket (it is pending at hi if it has crossed
+        there) and needs no location of its own; one that is not is located in [a, lo].
+        """
         solved = [(a, sol_a), (b, sol_b)]
         best = None
         finger_of = dict(zip(self.nodes.tolist(), self.fidx.tolist()))
 
         def solve_near(s: float) -> Solution:
             """Solve at s by continuation from the nearest point solved so far."""
+            for at, sol in solved:
+                if at == s:
+                    return sol
             near, sol_near = min(solved, key=lambda p: abs(p[0] - s))
             sol = self.continue_to(sol_near, near, s)
             if isinstance(sol, SolveFailure):
@@ -820,23 +897,45 @@ class _Run:
             solved.append((s, sol))
             return sol
 
-        for key in crossed:
+        def estimate(key) -> float:
+            if key in ra and key in rb and va[key] > 0:
+                root = hermite_root(a, b, va[key], vb[key], ra[key], rb[key])
+                if root is not None:
+                    return root
+            return b if not va[key] > vb[key] else a + (b - a) * va[key] / (va[key] - vb[key])
 
-            def g(s, key=key):
-                return self._key_value(key, solve_near(s), s)
+        for key in sorted(crossed, key=estimate):
+            hi_end, g_hi, r_hi = b, vb[key], rb.get(key)
+            if best is not None:
+                lo_best = best[-1]
+                g_hi = self._key_value(key, solve_near(lo_best), lo_best)
+                if g_hi > 0 or lo_best <= a:
+                    continue
+                hi_end = lo_best
+                r_hi = (self._key_slope(key, solve_near(lo_best), lo_best)
+                        if key in rb else None)
+            sloped = key in ra and r_hi is not None
 
-            lo, glo = a, va[key]
+            def g(s, key=key, sloped=sloped):
+                sol = solve_near(s)
+                value = self._key_value(key, sol, s)
+                return (value, self._key_slope(key, sol, s)) if sloped else value
+
+            lo, glo, r_lo = a, va[key], ra.get(key)
             if key[:2] in self.fresh or not glo > 0:
-                lo = min(a + tol_s, b)
+                lo = min(a + tol_s, hi_end)
                 glo = g(lo)
+                if sloped:
+                    glo, r_lo = glo
                 self.diag["root_evaluations"] += 1
             if glo <= 0:
-                hi = lo
+                lo = hi = lo
             else:
-                _, hi, n = locate_sign_change(g, lo, b, glo, vb[key], tol_s)
+                lo, hi, n = locate_sign_change(g, lo, hi_end, glo, g_hi, tol_s,
+                                               slopes=(r_lo, r_hi) if sloped else None)
                 self.diag["root_evaluations"] += n
             fidx = key[2] if key[0] == "A" else finger_of.get(key[1], 0)
-            rank = (hi, EVENT_ORDER.get(key[0], 4), fidx, key[1])
+            rank = (hi, EVENT_ORDER.get(key[0], 4), fidx, key[1], lo)
             best = rank if best is None or rank < best else best
         s_e = best[0]
         return s_e, solve_near(s_e)

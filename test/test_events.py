@@ -330,3 +330,17 @@ def test_three_fingers_and_arbitrary_translations():
     assert r2.state.finger("F1").translation == pytest.approx([0.002, 0.0])
     assert r2.state.finger("A").translation == pytest.approx([0.0003, -0.0018])
     check_state(model, r2.state)
+
+
+# ---------------------------------------------------------------- substeps and event location
+def test_a_linear_call_stays_on_the_grid_and_the_first_substep_is_checked():
+    from squeeze_grasp_ros.mechanics.errors import InvalidInputError
+
+    obj, contacts = symmetric_square()
+    model = ContactModel(obj, 0.4)
+    dirs = {k: 0.002 * v for k, v in squeeze_directions(obj, contacts).items()}
+    result = advance(model, start(obj, contacts), dirs, step=2e-3)
+    assert result.next_substep == 2e-3 and result.diagnostics["substep_rejections"] == 0
+    for bad in (0.0, -1e-3, float("nan")):
+        with pytest.raises(InvalidInputError, match="first_substep must be > 0"):
+            advance(model, start(obj, contacts), dirs, first_substep=bad)

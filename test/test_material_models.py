@@ -358,6 +358,35 @@ def test_finger_work_equals_strain_energy_plus_frictional_dissipation(model, squ
     assert residual[0] < 1e-6 and residual[1] < residual[0]
 
 
+@pytest.mark.parametrize("model", NONLINEAR)
+def test_adaptive_substeps_agree_with_the_step_grid(model, square):
+    """A nonlinear model adapts its substeps between events; against the same squeeze on the
+    fixed grid (12 %, mu = 0.4) it finds the same events (type, node, finger, mode) at the same
+    depths to 4 event tolerances, the same forces and energy to 1e-8, work = energy to 1e-7,
+    and needs at most 2/3 of the grid's evaluations.
+    """
+    from squeeze_grasp_ros.mechanics.squeeze.stepper import substep_adaptation
+
+    _, obj, contacts = square
+    adaptive = squeeze(obj, contacts, model, relative_depth=0.12)
+    with substep_adaptation(False):
+        grid = squeeze(obj, contacts, model, relative_depth=0.12)
+
+    def events(res):
+        return [(e.type, e.node, e.finger, e.mode, e.slip) for e in res.events]
+
+    assert len(grid.events) >= 4 and events(adaptive) == events(grid)
+    shift = max(abs(a.depth - b.depth) for a, b in zip(adaptive.events, grid.events))
+    assert shift < 4e-9 * obj.scale
+    F, F0 = np.array(adaptive.finger_force["F1"]), np.array(grid.finger_force["F1"])
+    assert np.abs(F - F0).max() < 1e-8 * np.abs(F0).max()
+    assert adaptive.energy == pytest.approx(grid.energy, rel=1e-8)
+    assert abs(sum(adaptive.work.values()) - adaptive.energy) < 1e-7 * adaptive.energy
+    cost = [res.diagnostics["nonlinear"]["evaluations"] for res in (adaptive, grid)]
+    assert cost[0] < 2 / 3 * cost[1]
+    assert adaptive.diagnostics["substeps"] < grid.diagnostics["substeps"]
+
+
 def test_forces_scale_with_e_for_a_very_soft_object(square):
     _, obj, contacts = square
     soft = ElasticObject(obj.mesh, Material(1e3, 0.3, 0.0254))

@@ -13,6 +13,7 @@ from pathlib import Path
 from squeeze_grasp_ros import plots
 from squeeze_grasp_ros.bench.table import Table
 from squeeze_grasp_ros.mechanics.elastic.contact_response import factorization_reuse
+from squeeze_grasp_ros.mechanics.squeeze.stepper import substep_adaptation
 from squeeze_grasp_ros.mechanics.vocabulary import MaterialModel
 from squeeze_grasp_ros.resources import scene_file
 from squeeze_grasp_ros.scene import load_scene, scene_solid
@@ -21,6 +22,9 @@ from squeeze_grasp_ros.scene_events import event_squeeze_scene
 TITLE = "Large deformation: the linear model's error against squeeze depth, and its cost"
 OBJECTS = ("foam_square", "disk", "nonconvex_blob")
 NONLINEAR = (MaterialModel.COROTATIONAL, MaterialModel.NEO_HOOKEAN)
+TARGET_RATIO = 10.0
+VARIANTS = (("", True, True), (", full Newton", False, True), (", step grid", True, False))
+"""Nonlinear cost rows: (label suffix, factorisation reuse, adaptive substeps)."""
 LINEAR_REPEATS = 3
 """The linear squeeze's time is the best of this many runs: the first also fills the object's
 per-node gradient cache of the inversion check (about 1 ms per contact node, once per
@@ -38,6 +42,19 @@ def _run(scene, obj, model: MaterialModel, relative_depth: float):
     start = time.perf_counter()
     res = event_squeeze_scene(scene, obj, relative_depth=relative_depth, material_model=model)
     return res, time.perf_counter() - start
+
+
+def _verdict(cost: list, quick: bool) -> str:
+    """The target sentence: neo-Hookean under 10x linear on the scene's 2,000-node mesh."""
+    ratio = next(row[2] for row in cost if row[0] == str(MaterialModel.NEO_HOOKEAN))
+    if quick:
+        return (f"Quick run on about 800 nodes: neo-Hookean at {ratio:.1f}x linear; the target "
+                "(< 10x) is stated for the scene's 2,000-node mesh (full run).")
+    if ratio < TARGET_RATIO:
+        return f"Target (< {TARGET_RATIO:g}x linear) met: neo-Hookean at {ratio:.1f}x."
+    return (f"Target (< {TARGET_RATIO:g}x linear) not met: neo-Hookean at {ratio:.1f}x. Each "
+            "evaluation still ends in a sparse factorisation of the whole object (about 9 ms "
+            "at 2,054 nodes), where the linear route gathers a cached boundary compliance.")
 
 
 def run(quick: bool, out_dir: Path, progress) -> list[Table]:
@@ -80,14 +97,18 @@ def run(quick: bool, out_dir: Path, progress) -> list[Table]:
     obj.precompute()
     runs = [_run(scene, obj, MaterialModel.LINEAR, 0.12) for _ in range(LINEAR_REPEATS)]
     linear, t_lin = runs[0][0], min(t for _, t in runs)
-    cost.append(["linear", t_lin, 1.0, "-", "-", "-", linear.finger_force["F1"][1]])
+    cost.append(["linear", t_lin, 1.0, linear.diagnostics["substeps"],
+                 linear.diagnostics["root_evaluations"], "-", "-", "-",
+                 linear.finger_force["F1"][1]])
     for model in NONLINEAR:
-        for reuse in (True, False):
-            with factorization_reuse(reuse):
+        for variant, reuse, adapt in VARIANTS:
+            with factorization_reuse(reuse), substep_adaptation(adapt):
                 res, t = _run(scene, obj, model, 0.12)
             nl = res.diagnostics["nonlinear"]
-            cost.append([str(model) + ("" if reuse else ", full Newton"), t, t / t_lin,
-                         nl["evaluations"], nl["newton_iterations"] / max(nl["evaluations"], 1),
+            cost.append([str(model) + variant, t, t / t_lin, res.diagnostics["substeps"],
+                         res.diagnostics["root_evaluations"],
+                         f"{nl['evaluations']} ({nl['look_ups']})",
+                         nl["newton_iterations"] / max(nl["evaluations"], 1),
                          nl["factorizations"], res.finger_force["F1"][1]])
     return [
         Table(TITLE, ["object", "rel. depth [%]", "linear F1 [N]", "linear max strain",
@@ -101,19 +122,22 @@ def run(quick: bool, out_dir: Path, progress) -> list[Table]:
               "strain differences are differences of measures, not only of the solution.",
               (png,)),
         Table("Cost of a nonlinear squeeze (foam square, 12 %, events to 1e-9 L)",
-              ["model", "time [s]", "x linear", "evaluations", "Newton its / evaluation",
-               "factorisations", "F1 [N]"],
+              ["model", "time [s]", "x linear", "substeps", "root evaluations",
+               "evaluations (look-ups)", "Newton its / evaluation", "factorisations",
+               "F1 [N]"],
               cost,
               "An evaluation is one equilibrium of the contact set at one finger position "
-              "(interior Newton from a first-order predictor, backtracking, load sub-steps if "
-              "needed); each ends with one sparse LU of the converged tangent with the contact "
-              "DOFs ordered last, whose trailing block is dF/d delta, and Newton re-uses the "
-              "previous LU (the last evaluation's, then its own) while the residual falls by 4x "
-              "per iteration; 'full Newton' rows refactor at every iteration, so their time "
-              "against the default row is what the reuse saves (same forces to the Newton "
-              "tolerance). The linear row is the best of 3 runs and includes the "
-              "element-inversion check (from cached per-node gradients, no solve); the "
-              "nonlinear rows are one run each. Target (< 10x linear) not met: every evaluation "
-              "is a sparse factorisation of the whole object, where the linear route gathers a "
-              "cached boundary compliance."),
+              "(interior Newton from a first-order predictor off the nearest kept state, "
+              "backtracking, load sub-steps if needed); each ends with one sparse LU of the "
+              "converged tangent with the contact DOFs ordered last, whose trailing block is "
+              "dF/d delta. Newton re-uses the kept LU while the residual falls by 4x per "
+              "iteration ('full Newton': refactor at every iteration); a response keeps its last "
+              "4 states, so a return to a solved point is a look-up. The linear model steps on "
+              "the scene's step grid (1e-3 L), where an evaluation is a small dense product; the "
+              "nonlinear models adapt their substeps between events (up to 8 grid steps while "
+              "the force slope changes little; 'step grid': the linear model's grid), and every "
+              "model locates gap, force and cone events on cubic Hermite interpolants. Same "
+              "forces to the Newton tolerance in every row. The linear row is the best of 3 runs "
+              "and includes the element-inversion check; the nonlinear rows are one run each. "
+              + _verdict(cost, quick)),
     ]

@@ -322,6 +322,10 @@ class ContactResponse:
             self.stats["look_ups"] += 1
             return kept
         self.stats["evaluations"] += 1
+        if self._kept and self._lu is not None:
+            nearest = min(self._kept, key=lambda state: np.abs(state[0] - delta).max())
+            if np.abs(nearest[0] - delta).max() < np.abs(self._delta - delta).max():
+                self._recall(nearest[0])
         base_u, base_d = self._u, self._delta
         target, done, its = delta, 0.0, 0
         fraction = 1.0

@@ -285,6 +285,10 @@ class StepResult:
         Nodes frozen by the chattering bound during the call.
     diagnostics : dict
         Newton iterations and residuals, root-finding evaluations, condition numbers.
+    next_substep : float
+        The substep the call would have taken next, relative to the object size (the ``step``
+        grid unless the model adapts its substeps): pass it as ``first_substep`` to the next
+        call.
     """
 
     state: ContactState
@@ -294,3 +298,4 @@ class StepResult:
     samples: tuple[Sample, ...]
     chatter: tuple[Chatter, ...]
     diagnostics: dict
+    next_substep: float

@@ -78,7 +78,8 @@ class SqueezeRun:
 def _merge(total: dict, new: dict) -> None:
     """Merge stepper diagnostics: counts add up, maxima stay maxima."""
     for key, value in new.items():
-        if key in ("root_evaluations", "substeps", "substep_halvings", "ambiguous_modes"):
+        if key in ("root_evaluations", "substeps", "substep_halvings", "substep_rejections",
+                   "ambiguous_modes"):
             total[key] = total.get(key, 0) + value
         else:
             total[key] = max(total.get(key, value), value)
@@ -121,7 +122,7 @@ def squeeze_to_depth(
     samples: list[Sample] = []
     chatter: list[Chatter] = []
     diag: dict = {"advance_calls": 0}
-    termination, stalled = Termination.DEPTH_REACHED, 0
+    termination, stalled, substep = Termination.DEPTH_REACHED, 0, None
     while True:
         remaining = depth - (state.depth - start)
         result = advance(
@@ -132,7 +133,9 @@ def squeeze_to_depth(
             event_tol,
             stop_on_event=True,
             terminate_on=terminate_on,
+            first_substep=substep,
         )
+        substep = result.next_substep
         diag["advance_calls"] += 1
         _merge(diag, result.diagnostics)
         events += result.events

@@ -71,7 +71,8 @@ off the predicted branch is halved.
 from __future__ import annotations
 
 import itertools
-from collections.abc import Mapping
+from collections.abc import Iterator, Mapping
+from contextlib import contextmanager
 
 import numpy as np
 
@@ -116,6 +117,21 @@ ADAPTIVE_MAX_STEPS = 8
 """Adaptive substeps (models with ``adaptive_steps``, :meth:`_Run.next_step`): growth per
 substep, the relative change of the force slope over one substep they aim at, and their
 largest length in grid steps."""
+_ADAPT = [True]
+
+
+@contextmanager
+def substep_adaptation(enabled: bool) -> Iterator[None]:
+    """Within the block, models that adapt their substeps (``adaptive_steps``) keep the
+    ``step`` grid instead: for measuring what the adaptation saves.
+    """
+    before, _ADAPT[0] = _ADAPT[0], enabled
+    try:
+        yield
+    finally:
+        _ADAPT[0] = before
+
+
 MAX_SUBSTEP_HALVINGS = 12
 CONTINUATION_ITERATIONS = 12
 MAX_ANGLE_JUMP = 0.05
@@ -154,6 +170,7 @@ class _Run:
         self.depth0 = state.depth
         self.relative_per_depth = state.relative_per_depth
         self.step, self.tol = step, event_tol
+        self.planned_substep = step
         self.terminate_on = terminate_on
         order = {n: k for k, n in enumerate(self.names)}
         self.nodes = np.array([c.node for c in state.contacts], int)
@@ -791,8 +808,11 @@ class _Run:
             return term
         hs = self.step / self.rate
         tol_s = self.tol / self.rate
-        adaptive = self.model.adaptive_steps and not self.model.reference
-        h, rows, va, rates_a = hs, None, None, None
+        adaptive = self.model.adaptive_steps and not self.model.reference and _ADAPT[0]
+        h = hs
+        if adaptive:
+            h = min(ADAPTIVE_MAX_STEPS * hs, max(hs, self.planned_substep / self.rate))
+        rows, va, rates_a = None, None, None
         while self.s < 1.0:
             a = self.s
             depth_a = self.depth_at(a)
@@ -817,6 +837,7 @@ class _Run:
             self.diag["substeps"] += 1
             if adaptive:
                 h = self.next_step(sol, sol_b, a, b, h, hs, va, vb)
+                self.planned_substep = h * self.rate
             if crossed and not self.model.reference:
                 if not adaptive:
                     rates_a, rates_b = self.rates(sol, a, rows), self.rates(sol_b, b, rows)
@@ -997,6 +1018,7 @@ def advance(
     event_tol: float = 1e-9,
     stop_on_event: bool = False,
     terminate_on: tuple[str, ...] = TERMINATION_ORDER,
+    first_substep: float | None = None,
 ) -> StepResult:
     """Translate fingertips from ``state`` and locate the contact events on the way.
 
@@ -1019,6 +1041,9 @@ def advance(
     terminate_on : tuple of str
         Which of "strain_limit", "finger_slip", "picked_up" end the motion (strain and pickup
         are only evaluated if the model's limits declare them).
+    first_substep : float, optional
+        First substep of a model that adapts its substeps, relative to L (default ``step``):
+        a previous call's ``StepResult.next_substep``, to go on where its adaptation ended.
 
     Returns
     -------
@@ -1042,7 +1067,11 @@ def advance(
     bad = sorted(set(terminate_on) - set(TERMINATION_ORDER))
     if bad:
         raise InvalidInputError(f"unknown termination {bad[0]!r} (allowed: {TERMINATION_ORDER})")
+    if first_substep is not None and not (np.isfinite(first_substep) and first_substep > 0):
+        raise InvalidInputError(f"first_substep must be > 0 (relative to the object size), got "
+                                f"{first_substep}")
     run = _Run(model, state, translations, step, min(event_tol, step), tuple(terminate_on))
+    run.planned_substep = step if first_substep is None else first_substep
     termination = run.run(stop_on_event)
     new_state = run.to_state()
     diag = dict(run.diag)
@@ -1056,4 +1085,5 @@ def advance(
         tuple(run.samples),
         tuple(run.chatter),
         diag,
+        run.planned_substep,
     )

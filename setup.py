@@ -51,6 +51,8 @@ setup(
         "numpy>=1.24",
         "scipy>=1.10",
         "triangle>=20230923",
+        # LDL^T of the interior tangent of the large-deformation models (QDLDL, Apache-2.0)
+        "qdldl>=0.1.7",
         "matplotlib>=3.7",
         "pyyaml>=6",
     ],

@@ -63,15 +63,15 @@ def test_a_forces_only_assembly_is_the_full_one_without_the_tangent(model, patch
 
 
 @pytest.mark.parametrize("model", NONLINEAR)
-def test_the_condensed_factorisation_against_direct_sparse_solves(model, patch):
-    """The Schur complement read from the trailing block of one LU of the whole (shifted)
-    tangent, and the interior solves and rates done with it, equal what SciPy's spsolve gives
-    on the interior block, on a stressed state whose whole tangent is singular (the free
-    object's translations).
+def test_the_contact_stiffness_against_direct_sparse_solves(model, patch):
+    """S = K_cc - K_cf K_ff^-1 K_fc applied through the LDL^T of K_ff, and the interior
+    responses, equal what SciPy's spsolve gives on the interior block, on a stressed state whose
+    whole tangent is singular (the free object's translations); a multiple of a vector already
+    applied costs no solve.
     """
     import scipy.sparse.linalg as spla
 
-    from squeeze_grasp_ros.mechanics.elastic.schur import condense, minimum_degree_order
+    from squeeze_grasp_ros.mechanics.elastic.interior import InteriorBlocks
 
     rng = np.random.default_rng(5)
     u = (patch.nodes @ np.array([[-0.08, 0.02], [0.03, 0.05]])).ravel()
@@ -80,37 +80,51 @@ def test_the_condensed_factorisation_against_direct_sparse_solves(model, patch):
     cd = np.stack([2 * contacts, 2 * contacts + 1], 1).ravel()
     free = np.setdiff1d(np.arange(2 * patch.n), cd)
     Kff, Kfc = K[free][:, free].tocsc(), K[free][:, cd].toarray()
-    lu = condense(K, free, cd, minimum_degree_order(Kff))
-    S = K[cd][:, cd].toarray() - Kfc.T @ spla.spsolve(Kff, Kfc)
-    assert np.abs(lu.schur - S).max() < 1e-12 * np.abs(S).max()
-    assert np.linalg.eigvalsh(S)[0] < 1e-12 * np.abs(S).max()  # K itself is singular
-    r, d = rng.standard_normal(len(free)), rng.standard_normal(len(cd))
-    z, x = spla.spsolve(Kff, r), -spla.spsolve(Kff, Kfc @ d)
-    assert np.abs(lu.interior(r) - z).max() < 1e-12 * np.abs(z).max()
-    assert np.abs(lu.interior_rate(d) - x).max() < 1e-12 * np.abs(x).max()
+    blocks = InteriorBlocks(K, free, cd)
+    solves = []
+    solve = blocks.factor(K)
+    S = blocks.contact_stiffness(K, lambda r: solves.append(1) or solve(r))
+    ref = K[cd][:, cd].toarray() - Kfc.T @ spla.spsolve(Kff, Kfc)
+    dense = S.toarray()
+    assert np.abs(dense - ref).max() < 1e-12 * np.abs(ref).max()
+    assert np.linalg.eigvalsh(0.5 * (dense + dense.T))[0] < 1e-10 * np.abs(ref).max()
+    d = rng.standard_normal(len(cd))
+    x = spla.spsolve(Kff, Kfc @ d)
+    assert np.abs(S.interior_response(d) - x).max() < 1e-12 * np.abs(x).max()
+    before = len(solves)
+    assert np.abs(S @ (-2.5 * d) + 2.5 * (ref @ d)).max() < 1e-11 * np.abs(ref @ d).max()
+    assert len(solves) == before and S.knows(3 * d) and not S.knows(d + 1e-3)
 
 
-def test_a_pivot_that_would_cross_into_the_contact_block_is_kept_on_the_diagonal():
-    """A weak interior diagonal coupled strongly to a contact DOF: SuperLU's 0.1 threshold
-    would pivot on the contact row, so condense refactors with diagonal pivots, and the Schur
-    complement and interior solves are still exact (against dense linear algebra).
+def test_a_kept_state_keeps_its_own_stiffness_after_the_factorisation_moved_on(patch):
+    """The factorisation of K_ff is shared by a response's states and by the contact sets of
+    an object: a kept state's dF/d delta, applied after another state or set was factorised,
+    refactors for its own state and equals that of a fresh response at its delta.
     """
-    import scipy.sparse as sp
+    left, right = np.argsort(patch.nodes[:, 0])[:2], np.argsort(-patch.nodes[:, 0])[:2]
 
-    from squeeze_grasp_ros.mechanics.elastic.schur import condense
+    def response():
+        return ContactResponse(MaterialModel.NEO_HOOKEAN, patch.nodes / 0.1, patch.triangles,
+                               np.r_[left, right], 0.3)
 
-    dense = np.diag([0.01, 1.0, 2.0, 1.5, 3.0, 2.5])
-    dense[0, 4] = dense[4, 0] = 10.0
-    dense[1, 2] = dense[2, 1] = 0.3
-    dense[3, 5] = dense[5, 3] = 0.7
-    free, cd = np.arange(4), np.array([4, 5])
-    lu = condense(sp.csr_matrix(dense), free, cd, np.array([2, 0, 3, 1]))
-    assert lu is not None and lu.lu.perm_r.tolist() == list(range(6))
-    Kff, Kfc = dense[:4, :4], dense[:4, 4:]
-    S = dense[4:, 4:] - Kfc.T @ np.linalg.solve(Kff, Kfc)
-    assert np.allclose(lu.schur, S, rtol=1e-12, atol=1e-9)
-    r = np.array([1.0, -2.0, 0.5, 3.0])
-    assert np.allclose(lu.interior(r), np.linalg.solve(Kff, r), rtol=1e-10)
+    near, far = np.zeros((4, 2)), np.zeros((4, 2))
+    near[:2, 0], near[2:, 0], far[:2, 0], far[2:, 0] = 0.01, -0.01, 0.03, -0.03
+    shared = response()
+    first = shared.evaluate(near)
+    shared.evaluate(far)
+    v = np.random.default_rng(4).standard_normal(8)
+    count = shared.stats["factorizations"]
+    own = first.C @ v
+    assert shared.stats["factorizations"] == count + 1
+    reference = response().evaluate(near).C
+    alone = reference @ v
+    assert np.abs(own - alone).max() < 1e-9 * np.abs(alone).max()
+    # the same across contact sets that share the object's factorisation
+    other = ContactResponse(MaterialModel.NEO_HOOKEAN, patch.nodes / 0.1, patch.triangles,
+                            np.r_[left, right[:1]], 0.3, factorization=shared.factorization)
+    other.evaluate(far[:3])
+    w = v[::-1].copy()
+    assert np.abs(first.C @ w - reference @ w).max() < 1e-9 * np.abs(reference @ w).max()
 
 
 @pytest.mark.parametrize("model", NONLINEAR)
@@ -158,28 +172,6 @@ def test_a_response_returns_to_a_kept_state_without_solving(patch):
     oldest = response.evaluate(deltas[0])
     assert response.stats["evaluations"] == before["evaluations"] + 1
     assert abs(oldest.energy - first[0].energy) < 1e-12 * first[0].energy
-
-
-def test_a_larger_contact_set_inherits_the_interior_order(patch):
-    """A set with one more contact node takes the interior order of the smaller one (no
-    ordering factorisation) and its tangent is that of a set ordered afresh.
-    """
-    left, right = np.argsort(patch.nodes[:, 0])[:3], np.argsort(-patch.nodes[:, 0])[:2]
-    delta = np.zeros((5, 2))
-    delta[:3, 0], delta[3:, 0] = 0.01, -0.01
-
-    def response(contacts):
-        return ContactResponse(MaterialModel.NEO_HOOKEAN, patch.nodes / 0.1, patch.triangles,
-                               contacts, 0.3)
-
-    small = response(np.r_[left[:2], right])
-    small.evaluate(np.delete(delta, 2, axis=0))
-    heir, fresh = response(np.r_[left, right]), response(np.r_[left, right])
-    heir.inherit_order(small)
-    a, b = heir.evaluate(delta), fresh.evaluate(delta)
-    assert heir.stats["factorizations"] == fresh.stats["factorizations"] - 1
-    assert np.abs(a.C - b.C).max() < 1e-10 * np.abs(b.C).max()
-    assert np.abs(a.F - b.F).max() < 1e-10 * np.abs(b.F).max()
 
 
 def test_the_linear_law_is_the_cst_stiffness(patch):

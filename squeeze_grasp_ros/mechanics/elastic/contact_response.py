@@ -5,25 +5,25 @@
 With the displacements delta of the m contact nodes prescribed (they sit on the fingertips), the
 other degrees of freedom are in equilibrium: f_int,free(u) = 0. Newton solves them (tangent of
 :func:`~squeeze_grasp_ros.mechanics.elastic.hyperelastic.assemble`, backtracking on the residual
-norm, never into an inverted element), warm-started from the previous solution of the set with
-its interior moved along the last rate map (a first-order predictor: Newton then starts from a
-residual of second order in the step); when Newton fails the increment of delta since the last
-converged one is halved and marched (load sub-stepping). The contact forces are the internal
-forces at the contact DOFs, and the tangent dF/d delta is the Schur complement
-K_cc - K_cf K_ff^-1 K_fc of the converged tangent: the trailing block of one sparse LU of the
-whole tangent with the contact DOFs ordered last (:class:`~.schur.CondensedLU`), which serves the
-interior solves and rates. Line-search trials assemble forces only; the tangent is assembled
-where it is factorised.
+norm, never into an inverted element), warm-started from the kept state nearest the new delta
+with its interior moved along that state's rate map (a first-order predictor: Newton then
+starts from a residual of second order in the step); when Newton fails the increment of delta
+since the last converged one is halved and marched (load sub-stepping). The contact forces are
+the internal forces at the contact DOFs, and the tangent dF/d delta is the Schur complement
+S = K_cc - K_cf K_ff^-1 K_fc of the converged tangent, returned as an operator
+(:class:`~.interior.ContactStiffness`: S v costs one interior solve, memoised), because the
+stepper applies it to the finger motion and to one vector per sliding contact, never needs all
+of it. Line-search trials assemble forces only; the tangent is assembled where it is
+factorised.
 
-Factorisations: Newton re-uses the last factorisation of the whole tangent (kept with the last
-evaluated state) as long as the residual falls by at least REUSE_CONTRACTION per iteration
-(modified Newton), and refactors otherwise; the
-converged state is always refactored once for the exact Schur complement. ``stats`` counts both,
-and the one factorisation of K_ff per contact set that gives the interior's ordering (a set
-grown from another inherits that one's, :meth:`ContactResponse.inherit_order`). The last
-KEPT_STATES evaluated states are kept with their factorisations: an evaluation at one of their
+Factorisations: K_ff is factorised by LDL^T (:class:`~.interior.InteriorBlocks`, one per
+contact set, refactored in place). Newton re-uses the factorisation held (the last state's) as
+long as the residual falls by at least REUSE_CONTRACTION per iteration (modified Newton) and
+refactors otherwise; the converged state is always factorised once, for its exact S. ``stats``
+counts both. The last KEPT_STATES evaluated states are kept: an evaluation at one of their
 deltas, as when the stepper returns to a point it solved while locating an event, is a
-look-up.
+look-up, and a kept state whose S is applied after the factorisation moved on to another state
+refactors for its own.
 
 Everything is dimensionless as in the stepper: coordinates and displacements / L, forces / (E h L),
 energies / (E h L^2).
@@ -38,7 +38,8 @@ import numpy as np
 
 from squeeze_grasp_ros.mechanics.elastic.hyperelastic import (MeshGeometry, area_ratios,
                                                                 assemble, mesh_geometry)
-from squeeze_grasp_ros.mechanics.elastic.schur import CondensedLU, condense, minimum_degree_order
+from squeeze_grasp_ros.mechanics.elastic.interior import (ContactStiffness, InteriorBlocks,
+                                                          TangentFactor)
 from squeeze_grasp_ros.mechanics.errors import InvalidInputError
 from squeeze_grasp_ros.mechanics.vocabulary import MaterialModel
 
@@ -57,8 +58,15 @@ accepted state keeps a margin above det F = 0, where assembly refuses the state.
 MAX_ITERATIONS = 25
 MAX_SUBSTEPS = 64
 KEPT_STATES = 4
-"""Evaluated states a response keeps (with their factorisations): the stepper returns to
+"""Evaluated states a response keeps (with their tangents): the stepper returns to
 points it solved while locating an event, and an evaluation at a kept delta is a look-up."""
+KNOWN_STATE = 5e-8
+KNOWN_START = 1e-6
+"""A state this close (relative, largest nodal displacement) to the one a contact set was
+continued from takes that state's tangent: as its own (KNOWN_STATE: its dF/d delta then differs
+from the exact one by about 1e-9 of its largest entry, within RESPONSE_ACCURACY of the contact
+model) or for Newton's first factorisation (KNOWN_START). A node that touched a tip within the
+event tolerance moves the field by 1e-10 to 3e-8 of it."""
 REUSE_CONTRACTION = 0.25
 BACKTRACKS = 30
 _REUSE = [True]
@@ -84,8 +92,8 @@ class Evaluation:
     ----------
     F : (m, 2) ndarray
         Forces the fingers apply on the contact nodes.
-    C : (2m, 2m) ndarray
-        Tangent dF / d delta.
+    C : ContactStiffness
+        Tangent dF / d delta as an operator (``C @ v``; ``C.toarray()`` for the matrix).
     u : (2n,) ndarray
         Displacement of every node.
     energy : float
@@ -97,7 +105,7 @@ class Evaluation:
     """
 
     F: np.ndarray
-    C: np.ndarray
+    C: ContactStiffness
     u: np.ndarray
     energy: float
     iterations: int
@@ -140,6 +148,8 @@ class ContactResponse:
     geometry : MeshGeometry, optional
         :func:`~squeeze_grasp_ros.mechanics.elastic.hyperelastic.mesh_geometry` of the mesh, to
         share between the contact sets of one object (built here otherwise).
+    factorization : TangentFactor, optional
+        The object's factorisation, shared between its contact sets (one of its own otherwise).
     """
 
     model: MaterialModel
@@ -148,16 +158,18 @@ class ContactResponse:
     contacts: np.ndarray
     nu: float
     geometry: MeshGeometry | None = field(default=None, repr=False)
+    factorization: TangentFactor = field(default_factory=TangentFactor, repr=False)
     stats: dict = field(default_factory=lambda: {"evaluations": 0, "iterations": 0,
                                                  "factorizations": 0, "substeps": 0,
                                                  "look_ups": 0})
     _u: np.ndarray | None = field(default=None, repr=False)
     _delta: np.ndarray | None = field(default=None, repr=False)
-    _lu: CondensedLU | None = field(default=None, repr=False)
-    _order: np.ndarray | None = field(default=None, repr=False)
+    _current: Evaluation | None = field(default=None, repr=False)
+    _blocks: InteriorBlocks | None = field(default=None, repr=False)
     _energy: float = field(default=0.0, repr=False)
     _reference_stiffness: float | None = field(default=None, repr=False)
     _kept: list = field(default_factory=list, repr=False)
+    _known_tangent: tuple | None = field(default=None, repr=False)
 
     def __post_init__(self) -> None:
         self.contacts = np.asarray(self.contacts, int)
@@ -179,38 +191,38 @@ class ContactResponse:
         """
         self._u = np.array(u, float)
         self._delta = self._u[self.cdofs].reshape(-1, 2)
-        self._lu = None
+        self._current = None
+        self._known_tangent = None
 
-    def inherit_order(self, other: "ContactResponse") -> None:
-        """Take the interior's fill-reducing order from ``other``'s (a set of the same object
-        with no more contact nodes), without the DOFs that are contact DOFs here: the
-        eliminations restricted to a subgraph fill no more than the original did, and the
-        new set needs no ordering factorisation of its own.
+    def continue_from(self, other: "ContactResponse") -> None:
+        """Start from the current state of ``other`` (another contact set of the same object):
+        its field, and its tangent, which the first evaluation takes instead of assembling it
+        when that state is already in equilibrium here (a node that just touched a tip).
         """
-        if other._order is None or not np.isin(self.free, other.free).all():
-            return
-        interior = other.free[other._order]
-        self._order = np.searchsorted(self.free, interior[np.isin(interior, self.free)])
+        self.warm_start(other.state_u())
+        self._reference_stiffness = other._reference_stiffness
+        if other._current is not None:
+            self._known_tangent = (other.state_u(), other._current.C.tangent)
 
     def forget(self) -> None:
-        """Drop the kept states but the current one (their factorisations hold memory)."""
+        """Drop the kept states but the current one (their tangents hold memory)."""
         self._kept = self._kept[-1:]
 
     def _recall(self, delta: np.ndarray) -> Evaluation | None:
         """Make the kept state at exactly ``delta`` the current one; its evaluation or None."""
-        for kept_delta, out, lu in reversed(self._kept):
+        for kept_delta, out in reversed(self._kept):
             if np.array_equal(kept_delta, delta):
-                self._u, self._delta, self._lu, self._energy = out.u, kept_delta, lu, out.energy
+                self._u, self._delta, self._current, self._energy = out.u, kept_delta, out, \
+                    out.energy
                 return out
         return None
 
     def at(self, delta: np.ndarray) -> bool:
         """True if the response is at ``delta`` or keeps the state there (its field can then
-        be read); a state was evaluated exactly when its factorisation is kept (none after
-        :meth:`warm_start`).
+        be read; none is after :meth:`warm_start` until an evaluation).
         """
         delta = np.asarray(delta, float).reshape(-1, 2)
-        if self._lu is not None and np.array_equal(delta, self._delta):
+        if self._current is not None and np.array_equal(delta, self._delta):
             return True
         return self._recall(delta) is not None
 
@@ -235,15 +247,46 @@ class ContactResponse:
                                               .max())
         return self._reference_stiffness
 
-    def _condense(self, K) -> CondensedLU | None:
-        """Factorise the tangent ``K`` (:func:`~.schur.condense`); the interior's
-        fill-reducing order is taken once per set from a factorisation of K_ff.
+    def _factor(self, K, owner: object = None):
+        """Factorise K_ff of the tangent ``K`` (for the state ``owner``; None for a Newton
+        iterate); its solve, or None if K_ff is singular.
         """
-        if self._order is None:
-            self._order = minimum_degree_order(K[self.free][:, self.free])
-            self.stats["factorizations"] += 1
+        if self._blocks is None:
+            self._blocks = InteriorBlocks(K, self.free, self.cdofs, self.factorization)
         self.stats["factorizations"] += 1
-        return condense(K, self.free, self.cdofs, self._order)
+        try:
+            return self._blocks.factor(K, owner)
+        except (ValueError, RuntimeError):
+            return None
+
+    def _stiffness_of(self, K) -> ContactStiffness | None:
+        """dF/d delta of the state whose tangent is ``K``, factorising K_ff for it; its solve
+        refactors whenever the shared factorisation has moved on to another state.
+        """
+        token = object()
+        if self._blocks is not None and self._blocks.factored is K:
+            self._blocks.owner = token
+        elif self._factor(K, token) is None:
+            return None
+        blocks = self._blocks
+
+        def solve(r: np.ndarray) -> np.ndarray:
+            if blocks.owner is not token:
+                self._factor(K, token)
+            return blocks.solve(r)
+
+        return blocks.contact_stiffness(K, solve, token)
+
+    def _known(self, u: np.ndarray, tol: float):
+        """The tangent of the state this set was continued from, if ``u`` is that state to
+        ``tol`` (relative, largest nodal displacement), else None.
+        """
+        if self._known_tangent is None:
+            return None
+        known_u, known_K = self._known_tangent
+        close = np.abs(u - known_u).max() <= tol * max(np.abs(known_u).max(),
+                                                       DISPLACEMENT_FLOOR)
+        return known_K if close else None
 
     def _min_det(self, u: np.ndarray) -> float:
         return float(area_ratios(self.geometry.gradient, u).min())
@@ -256,12 +299,24 @@ class ContactResponse:
         """
         plain = u.copy()
         plain[self.cdofs] = delta.reshape(-1)
-        if self._lu is not None:
+        if self._current is not None:
             predicted = plain.copy()
-            predicted[self.free] += self._lu.interior_rate(plain[self.cdofs] - u[self.cdofs])
+            predicted[self.free] -= self._predictor(plain[self.cdofs] - u[self.cdofs])
             if self._min_det(predicted) > MIN_AREA_RATIO:
                 return predicted
         return plain if self._min_det(plain) > MIN_AREA_RATIO else None
+
+    def _predictor(self, d: np.ndarray) -> np.ndarray:
+        """K_ff^-1 K_fc d at the current state: exact when d is a multiple of a direction the
+        state has answered (the finger motion) or the factorisation held is the state's, else
+        with the factorisation held (a Newton start needs no more), zero if that is of another
+        contact set.
+        """
+        C = self._current.C
+        if C.knows(d) or self._blocks.owner is C.owner:
+            return C.interior_response(d)
+        held = self._blocks.solve
+        return np.zeros(len(self.free)) if held is None else held(C.fc @ d)
 
     def _newton(self, u: np.ndarray, delta: np.ndarray):
         """Equilibrium of the free DOFs with the contact DOFs at ``delta``; (u, assembly, its,
@@ -271,8 +326,9 @@ class ContactResponse:
         if u is None:
             return ResponseFailure("the prescribed contact displacement inverts an element",
                                    inverted=True)
-        lu, its = (self._lu if _REUSE[0] else None), 0
-        asm = self._assemble(u, tangent=lu is None)
+        held = self._blocks.solve if self._blocks is not None else None
+        solve, fresh, its = (held if _REUSE[0] else None), False, 0
+        asm = self._assemble(u, tangent=False)
         scale = max(np.linalg.norm(asm.force[self.cdofs]),
                     self._stiffness() * max(np.linalg.norm(delta), DISPLACEMENT_FLOOR))
         r = asm.force[self.free]
@@ -280,13 +336,17 @@ class ContactResponse:
         while norm > NEWTON_TOL * scale:
             if its >= MAX_ITERATIONS:
                 return ResponseFailure("interior Newton did not converge", norm / scale)
-            if lu is None:
-                if asm.tangent is None:
+            if solve is None:
+                K = asm.tangent if asm.tangent is not None else self._known(u, KNOWN_START)
+                if K is None:
                     asm = self._assemble(u, tangent=True)
-                lu = self._condense(asm.tangent)
-                if lu is None:
+                    K = asm.tangent
+                solve, fresh = self._factor(K), True
+                if solve is None:
                     return ResponseFailure("the interior tangent is singular", norm / scale)
-            step = -lu.interior(r)
+            step = -solve(r)
+            if not np.all(np.isfinite(step)):
+                return ResponseFailure("the interior tangent is singular", norm / scale)
             its += 1
             inverted = True
             for _ in range(BACKTRACKS):
@@ -300,17 +360,17 @@ class ContactResponse:
                         break
                 step *= 0.5
             else:
-                if self._lu is not lu or lu is None:
+                if fresh:
                     return ResponseFailure("interior line search found no descent"
                                            + (" (every trial inverted an element)"
                                               if inverted else ""), norm / scale,
                                            inverted=inverted)
-                lu = None
+                solve = None
                 continue
             contraction = t_norm / norm
             u, asm, r, norm = trial, t_asm, t_asm.force[self.free], t_norm
             if contraction > REUSE_CONTRACTION or not _REUSE[0]:
-                lu = None
+                solve = None
         return u, asm, its, norm / scale
 
     # ------------------------------------------------------------------ public
@@ -322,7 +382,7 @@ class ContactResponse:
             self.stats["look_ups"] += 1
             return kept
         self.stats["evaluations"] += 1
-        if self._kept and self._lu is not None:
+        if self._kept and self._current is not None:
             nearest = min(self._kept, key=lambda state: np.abs(state[0] - delta).max())
             if np.abs(nearest[0] - delta).max() < np.abs(self._delta - delta).max():
                 self._recall(nearest[0])
@@ -348,15 +408,17 @@ class ContactResponse:
             return ResponseFailure("load sub-stepping did not reach the contact displacement")
         u, asm, _, residual = result
         self.stats["iterations"] += its
-        K = asm.tangent if asm.tangent is not None else self._assemble(u, tangent=True).tangent
-        lu = self._condense(K)
-        if lu is None:
+        K = asm.tangent if asm.tangent is not None else self._known(u, KNOWN_STATE)
+        if K is None:
+            K = self._assemble(u, tangent=True).tangent
+        self._known_tangent = None
+        C = self._stiffness_of(K)
+        if C is None:
             return ResponseFailure("the interior tangent is singular at equilibrium", residual)
-        self._u, self._delta, self._lu = u, delta.copy(), lu
-        self._energy = asm.energy
         F = asm.force[self.cdofs].reshape(-1, 2)
-        out = Evaluation(F, lu.schur.copy(), u, asm.energy, its, residual)
-        self._kept = [*self._kept[1 - KEPT_STATES:], (self._delta, out, lu)]
+        out = Evaluation(F, C, u, asm.energy, its, residual)
+        self._u, self._delta, self._current, self._energy = u, delta.copy(), out, asm.energy
+        self._kept = [*self._kept[1 - KEPT_STATES:], (self._delta, out)]
         return out
 
     def rate(self, ddelta: np.ndarray) -> np.ndarray:
@@ -366,5 +428,5 @@ class ContactResponse:
         du = np.zeros(2 * len(self.nodes))
         d = np.asarray(ddelta, float).reshape(-1)
         du[self.cdofs] = d
-        du[self.free] = self._lu.interior_rate(d)
+        du[self.free] = -self._current.C.interior_response(d)
         return du

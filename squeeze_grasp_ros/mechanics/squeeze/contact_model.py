@@ -252,6 +252,24 @@ def solve_fixed_set(
     return result
 
 
+def stiffness_scale(C) -> float:
+    """Largest |entry| of a contact stiffness: a matrix, or an operator with a ``scale``."""
+    scale = getattr(C, "scale", None)
+    return float(np.abs(C).max()) if scale is None else float(scale)
+
+
+def angle_response(C, theta: np.ndarray, r: np.ndarray, P: np.ndarray) -> np.ndarray:
+    """dF_k / d theta_j = C_kj r_j t(theta_j) for the sliding nodes j in P: (m, 2, |P|).
+
+    ``C`` is the (2m, 2m) contact stiffness or an operator that applies it (``C @ V``).
+    """
+    m = len(theta)
+    V = np.zeros((2 * m, len(P)))
+    V[2 * P, np.arange(len(P))] = r[P] * tangent(theta[P])[:, 0]
+    V[2 * P + 1, np.arange(len(P))] = r[P] * tangent(theta[P])[:, 1]
+    return (C @ V).reshape(m, 2, len(P))
+
+
 def attempt_fixed_set(
     response: Response,
     cfg: Configuration,
@@ -301,16 +319,14 @@ def attempt_fixed_set(
     delta, F, C = forces(theta)
     if isinstance(F, SolveFailure):
         return F
-    force_scale = max(float(np.abs(C).max()) * float(r.max()), 1e-300)
+    force_scale = max(stiffness_scale(C) * float(r.max()), 1e-300)
     tol = max(NEWTON_TOL, getattr(response, "tolerance", 0.0))
     it, residual, cond = 0, 0.0, 1.0
     J = np.zeros((0, 0))
     R = cone_residual(theta, F)
     while len(P):
         ea = unit(theta[P] - cfg.slip[P] * phi)
-        # dF_k / d theta_j = C_kj r_j t(theta_j): (m, 2, |P|)
-        Cb = C.reshape(m, 2, m, 2)
-        G = np.einsum("kajb,jb->kaj", Cb[:, :, P, :], r[P, None] * tangent(theta[P]))
+        G = angle_response(C, theta, r, P)
         J = cross(np.moveaxis(G[P], 2, 1), ea[:, None, :]) + np.diag(
             np.einsum("ij,ij->i", F[P], ea)
         )
@@ -351,8 +367,7 @@ def attempt_fixed_set(
     dtheta = np.zeros(m)
     if len(P):
         ea = unit(theta[P] - cfg.slip[P] * phi)
-        Cb = C.reshape(m, 2, m, 2)
-        G = np.einsum("kajb,jb->kaj", Cb[:, :, P, :], r[P, None] * tangent(theta[P]))
+        G = angle_response(C, theta, r, P)
         try:
             dtheta[P] = -np.linalg.solve(J, cross(dF0[P], ea))
         except np.linalg.LinAlgError:

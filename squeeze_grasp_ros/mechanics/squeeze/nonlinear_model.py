@@ -22,6 +22,7 @@ from squeeze_grasp_ros.mechanics.elastic.compliance import node_dofs
 from squeeze_grasp_ros.mechanics.elastic.contact_response import (NEWTON_TOL, ContactResponse,
                                                                   Evaluation, ResponseFailure)
 from squeeze_grasp_ros.mechanics.elastic.hyperelastic import mesh_geometry, principal_strains
+from squeeze_grasp_ros.mechanics.elastic.interior import TangentFactor
 from squeeze_grasp_ros.mechanics.errors import InvalidInputError
 from squeeze_grasp_ros.mechanics.squeeze.contact_model import (ContactModel, Response, SetData,
                                                                Solution, SolveFailure)
@@ -71,14 +72,15 @@ class NonlinearContactModel(ContactModel):
             mesh = self.obj.mesh
             if "geometry" not in self._cache:
                 self._cache["geometry"] = mesh_geometry(mesh.nodes / self.length, mesh.triangles)
+            shared = self._cache.setdefault("factorization", TangentFactor())
             responses[key] = ContactResponse(MaterialModel(self.material_model),
                                              mesh.nodes / self.length, mesh.triangles,
                                              sd.nodes, self.obj.material.nu,
-                                             geometry=self._cache["geometry"])
+                                             geometry=self._cache["geometry"],
+                                             factorization=shared)
             last = self._cache.get("last")
             if last is not None:
-                responses[key].warm_start(last.state_u())
-                responses[key].inherit_order(last)
+                responses[key].continue_from(last)
         return responses[key]
 
     def set_data(self, nodes: tuple[int, ...]) -> SetData:

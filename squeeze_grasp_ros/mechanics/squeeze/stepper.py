@@ -113,7 +113,7 @@ SLIP_RATE_ZERO = 1e-10
 direction, so round-off in a symmetric contact cannot fake a one-way finger slip."""
 ADAPTIVE_GROWTH = 2.0
 ADAPTIVE_SLOPE_CHANGE = 0.1
-ADAPTIVE_MAX_STEPS = 8
+ADAPTIVE_MAX_STEPS = 4
 """Adaptive substeps (models with ``adaptive_steps``, :meth:`_Run.next_step`): growth per
 substep, the relative change of the force slope over one substep they aim at, and their
 largest length in grid steps."""

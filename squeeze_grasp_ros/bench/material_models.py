@@ -53,7 +53,7 @@ def _verdict(cost: list, quick: bool) -> str:
     if ratio < TARGET_RATIO:
         return f"Target (< {TARGET_RATIO:g}x linear) met: neo-Hookean at {ratio:.1f}x."
     return (f"Target (< {TARGET_RATIO:g}x linear) not met: neo-Hookean at {ratio:.1f}x. Each "
-            "evaluation still ends in a sparse factorisation of the whole object (about 9 ms "
+            "evaluation still ends in a sparse factorisation of the whole object (about 4 ms "
             "at 2,054 nodes), where the linear route gathers a cached boundary compliance.")
 
 
@@ -128,13 +128,14 @@ def run(quick: bool, out_dir: Path, progress) -> list[Table]:
               cost,
               "An evaluation is one equilibrium of the contact set at one finger position "
               "(interior Newton from a first-order predictor off the nearest kept state, "
-              "backtracking, load sub-steps if needed); each ends with one sparse LU of the "
-              "converged tangent with the contact DOFs ordered last, whose trailing block is "
-              "dF/d delta. Newton re-uses the kept LU while the residual falls by 4x per "
-              "iteration ('full Newton': refactor at every iteration); a response keeps its last "
-              "4 states, so a return to a solved point is a look-up. The linear model steps on "
-              "the scene's step grid (1e-3 L), where an evaluation is a small dense product; the "
-              "nonlinear models adapt their substeps between events (up to 8 grid steps while "
+              "backtracking, load sub-steps if needed); each ends with one sparse LDL^T of the "
+              "interior tangent (QDLDL, one ordering per object), and dF/d delta is applied to "
+              "the finger motion by one solve with it. Newton re-uses the factorisation held "
+              "while the residual falls by 4x per iteration ('full Newton': refactor at every "
+              "iteration); a response keeps its last 4 states, so a return to a solved point is "
+              "a look-up. The linear model steps on the scene's step grid (1e-3 L), where an "
+              "evaluation is a small dense product; the nonlinear models adapt their substeps "
+              "between events (up to 4 grid steps while "
               "the force slope changes little; 'step grid': the linear model's grid), and every "
               "model locates gap, force and cone events on cubic Hermite interpolants. Same "
               "forces to the Newton tolerance in every row. The linear row is the best of 3 runs "

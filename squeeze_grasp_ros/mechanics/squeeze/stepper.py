@@ -7,9 +7,13 @@
 Squeezes, resistance and the simulated hardware are loops over it.
 
 Within one call the motion is parametrised by s in [0, 1] (finger f at o_f + s d_f). The
-interval is cut into substeps of at most ``step`` (depth, relative to the object size L); at
-each substep end the fixed-set problem is solved (:func:`~.contact_model.solve_fixed_set`) and
-the event functions are evaluated:
+interval is cut into substeps of ``step`` (depth, relative to the object size L), the grid; a
+model whose evaluations are dear (``ContactModel.adaptive_steps``: the large-deformation models)
+adapts them between events instead (:meth:`_Run.next_step`: up to ADAPTIVE_MAX_STEPS grid steps
+while the force slope changes little, the grid while a contact slides; a substep on whose cubic
+Hermite interpolants a gap, force or cone function dips to zero inside is halved, so a double
+root the end values would miss is caught). At each substep end the fixed-set problem is solved
+(:func:`~.contact_model.solve_fixed_set`) and the event functions are evaluated:
 
 =====  ===========================================  ===============  =====================
 type   function (positive = no event)               nodes            paper
@@ -26,11 +30,16 @@ smallest element area ratio above INVERSION_AREA_RATIO (always checked: an eleme
 that fraction of its area is about to turn inside out, and the squeeze ends
 ``element_inverted``; a nonlinear model that finds no equilibrium without an inverted element
 ends the same way at the last state it solved). A function that changes sign in a
-substep is located by a safeguarded Illinois (regula falsi) iteration to a bracket
-[a, b] of depth width <= ``event_tol`` * L; the earliest bracket end b wins, so the state at an
-event has the condition just met (a new contact penetrates by at most the tolerance). Results
-therefore depend on ``step`` only through missed double roots inside one substep, and on
-``event_tol`` to within the tolerance. The reference model (``ContactModel.reference``) skips
+substep is located to a bracket [a, b] of depth width <= ``event_tol`` * L: A, B and C, whose
+slopes d/ds are known at every solution (:meth:`_Run.rates`), on their cubic Hermite
+interpolants (2-3 solves per event), D and the terminations by a safeguarded Illinois (regula
+falsi) iteration. The crossings of a substep are taken in the order of their interpolated
+roots, and one still positive at the start of the earliest bracket needs no location of its
+own. The earliest bracket end b wins, so the state at an event has the condition just met (a
+new contact penetrates by at most the tolerance; b lands about a quarter tolerance past the
+root, never on it, where functions crossing at the same point would have round-off signs).
+Results therefore depend on ``step`` only through missed double roots inside one substep, and
+on ``event_tol`` to within the tolerance. The reference model (``ContactModel.reference``) skips
 the location: events are taken at the end of the fixed step, as in the paper.
 
 Processing at an event point (deterministic). Pending events are those whose function is

@@ -849,7 +849,10 @@ class _Run:
                 self.planned_substep = h * self.rate
             if crossed and not self.model.reference:
                 if not adaptive:
-                    rates_a, rates_b = self.rates(sol, a, rows), self.rates(sol_b, b, rows)
+                    gap_rows = self.model.obj.boundary_positions(
+                        sorted({key[1] for key in crossed if key[0] == "A"}))
+                    rates_a = self.rates(sol, a, gap_rows)
+                    rates_b = self.rates(sol_b, b, gap_rows)
                 b, sol_b = self.earliest(crossed, sol, sol_b, a, b, tol_s, va, vb, rates_a,
                                          rates_b)
             va, rates_a = (None, None) if crossed else (vb, rates_b)

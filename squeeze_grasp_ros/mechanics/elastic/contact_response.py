@@ -16,14 +16,14 @@ stepper applies it to the finger motion and to one vector per sliding contact, n
 of it. Line-search trials assemble forces only; the tangent is assembled where it is
 factorised.
 
-Factorisations: K_ff is factorised by LDL^T (:class:`~.interior.InteriorBlocks`, one per
-contact set, refactored in place). Newton re-uses the factorisation held (the last state's) as
-long as the residual falls by at least REUSE_CONTRACTION per iteration (modified Newton) and
-refactors otherwise; the converged state is always factorised once, for its exact S. ``stats``
-counts both. The last KEPT_STATES evaluated states are kept: an evaluation at one of their
-deltas, as when the stepper returns to a point it solved while locating an event, is a
-look-up, and a kept state whose S is applied after the factorisation moved on to another state
-refactors for its own.
+Factorisations: K_ff is factorised by LDL^T in one :class:`~.interior.TangentFactor` per
+object, refactored in place and shared by its contact sets (``factorization``). Newton re-uses
+the factorisation held (the last state's) as long as the residual falls by at least
+REUSE_CONTRACTION per iteration (modified Newton) and refactors otherwise; the converged state
+is always factorised once, for its exact S. ``stats`` counts both. The last KEPT_STATES
+evaluated states are kept: an evaluation at one of their deltas, as when the stepper returns to
+a point it solved while locating an event, is a look-up, and a kept state whose S is applied
+after the factorisation moved on to another state refactors for its own.
 
 Everything is dimensionless as in the stepper: coordinates and displacements / L, forces / (E h L),
 energies / (E h L^2).

@@ -4,12 +4,14 @@
 stiffness dF/d delta as an operator.
 
 With the contact DOFs c prescribed, the interior (free) DOFs f of the tangent K carry the
-equilibrium. :class:`InteriorBlocks` gathers K_ff (upper triangle), K_fc and K_cc out of the
-assembled tangent through index maps built once per sparsity pattern, and factorises K_ff by
-LDL^T (QDLDL, with its own approximate-minimum-degree order; no pivoting: K_ff of a stable
-state is positive definite). :class:`ContactStiffness` is S = K_cc - K_cf K_ff^-1 K_fc of one
-state applied to vectors, one interior solve per vector (memoised): the stepper needs S times
-the finger motion (and one more vector per sliding contact), never the whole matrix.
+equilibrium. :class:`TangentFactor` factorises K_ff by LDL^T (QDLDL, with its own
+approximate-minimum-degree order; no pivoting: K_ff of a stable state is positive definite),
+holding the contact DOFs as identity rows, so that one pattern, ordering and solver serve every
+contact set of an object. :class:`InteriorBlocks` gathers a set's K_fc and K_cc out of the
+assembled tangent through index maps built once per set. :class:`ContactStiffness` is
+S = K_cc - K_cf K_ff^-1 K_fc of one state applied to vectors, one interior solve per vector
+(memoised): the stepper needs S times the finger motion (and one more vector per sliding
+contact), never the whole matrix.
 
 >>> import numpy as np, scipy.sparse as sp
 >>> K = sp.csr_matrix(np.array([[4.0, 1, 0], [1, 3, 1], [0, 1, 2]]))

@@ -166,7 +166,6 @@ class ContactResponse:
     _delta: np.ndarray | None = field(default=None, repr=False)
     _current: Evaluation | None = field(default=None, repr=False)
     _blocks: InteriorBlocks | None = field(default=None, repr=False)
-    _energy: float = field(default=0.0, repr=False)
     _reference_stiffness: float | None = field(default=None, repr=False)
     _kept: list = field(default_factory=list, repr=False)
     _known_tangent: tuple | None = field(default=None, repr=False)
@@ -212,8 +211,7 @@ class ContactResponse:
         """Make the kept state at exactly ``delta`` the current one; its evaluation or None."""
         for kept_delta, out in reversed(self._kept):
             if np.array_equal(kept_delta, delta):
-                self._u, self._delta, self._current, self._energy = out.u, kept_delta, out, \
-                    out.energy
+                self._u, self._delta, self._current = out.u, kept_delta, out
                 return out
         return None
 
@@ -232,7 +230,7 @@ class ContactResponse:
 
     def state_energy(self) -> float:
         """Strain energy of the last evaluated state."""
-        return self._energy
+        return self._current.energy
 
     # ------------------------------------------------------------------ helpers
     def _assemble(self, u: np.ndarray, *, tangent: bool):
@@ -417,7 +415,7 @@ class ContactResponse:
             return ResponseFailure("the interior tangent is singular at equilibrium", residual)
         F = asm.force[self.cdofs].reshape(-1, 2)
         out = Evaluation(F, C, u, asm.energy, its, residual)
-        self._u, self._delta, self._current, self._energy = u, delta.copy(), out, asm.energy
+        self._u, self._delta, self._current = u, delta.copy(), out
         self._kept = [*self._kept[1 - KEPT_STATES:], (self._delta, out)]
         return out
 

@@ -45,6 +45,13 @@ def _gather(K: sp.csr_matrix, rows: np.ndarray, cols: np.ndarray, *,
     return block, block.data.astype(np.int64) - 1
 
 
+def _values(block: sp.csc_matrix, at: np.ndarray, K: sp.csr_matrix) -> sp.csc_matrix:
+    """The ``block`` pattern from :func:`_gather` filled with the entries of the tangent ``K``."""
+    out = block.copy()
+    out.data = K.data[at]
+    return out
+
+
 @dataclass
 class TangentFactor:
     """LDL^T factorisation of tangents of one mesh with a set of DOFs held: their rows and
@@ -133,13 +140,8 @@ class InteriorBlocks:
 
     def __post_init__(self) -> None:
         self.held = tuple(int(k) for k in self.cdofs)
-        self._fc, self._fc_at = _gather(self.pattern, self.free, self.cdofs)
-        cc, cc_at = _gather(self.pattern, self.cdofs, self.cdofs)
-        coded = cc.copy()
-        coded.data = cc_at + 1.0
-        dense = coded.toarray()
-        self._cc_index = np.nonzero(dense)
-        self._cc_from = dense[self._cc_index].astype(np.int64) - 1
+        self._fc = _gather(self.pattern, self.free, self.cdofs)
+        self._cc = _gather(self.pattern, self.cdofs, self.cdofs)
 
     def _solve(self, r: np.ndarray) -> np.ndarray:
         b = np.zeros(self.pattern.shape[0])
@@ -175,18 +177,11 @@ class InteriorBlocks:
         """
         return self._solve if self.shared.held == self.held else None
 
-    def coupling(self, K: sp.csr_matrix) -> sp.csc_matrix:
-        """K_fc of the tangent ``K``."""
-        out = self._fc.copy()
-        out.data = K.data[self._fc_at]
-        return out
-
     def contact_stiffness(self, K: sp.csr_matrix, solve: Callable[[np.ndarray], np.ndarray],
                           owner: object = None) -> "ContactStiffness":
         """S of the tangent ``K`` whose K_ff ``solve`` factorises (see :meth:`factor`)."""
-        cc = np.zeros((len(self.cdofs), len(self.cdofs)))
-        cc[self._cc_index] = K.data[self._cc_from]
-        return ContactStiffness(cc, self.coupling(K), solve, owner, K)
+        return ContactStiffness(_values(*self._cc, K).toarray(), _values(*self._fc, K), solve,
+                                owner, K)
 
 
 @dataclass
@@ -219,10 +214,6 @@ class ContactStiffness:
     def scale(self) -> float:
         """Largest |entry| of K_cc: the stiffness scale of tolerances."""
         return float(np.abs(self.cc).max())
-
-    @property
-    def shape(self) -> tuple[int, int]:
-        return self.cc.shape
 
     def _known(self, d: np.ndarray) -> np.ndarray | None:
         """K_ff^-1 K_fc d if d is a memoised vector or a multiple of one, else None."""

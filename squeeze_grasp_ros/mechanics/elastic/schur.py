@@ -11,7 +11,6 @@ fill is that of a direct factorisation of K_ff.
 """
 from __future__ import annotations
 
-
 import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla

@@ -263,10 +263,10 @@ def angle_response(C, theta: np.ndarray, r: np.ndarray, P: np.ndarray) -> np.nda
 
     ``C`` is the (2m, 2m) contact stiffness or an operator that applies it (``C @ V``).
     """
-    m = len(theta)
+    m, cols = len(theta), np.arange(len(P))
     V = np.zeros((2 * m, len(P)))
-    V[2 * P, np.arange(len(P))] = r[P] * tangent(theta[P])[:, 0]
-    V[2 * P + 1, np.arange(len(P))] = r[P] * tangent(theta[P])[:, 1]
+    t = r[P, None] * tangent(theta[P])
+    V[2 * P, cols], V[2 * P + 1, cols] = t[:, 0], t[:, 1]
     return (C @ V).reshape(m, 2, len(P))
 
 

@@ -1083,7 +1083,8 @@ def advance(
         raise InvalidInputError(f"first_substep must be > 0 (relative to the object size), got "
                                 f"{first_substep}")
     run = _Run(model, state, translations, step, min(event_tol, step), tuple(terminate_on))
-    run.planned_substep = step if first_substep is None else first_substep
+    if first_substep is not None:
+        run.planned_substep = first_substep
     termination = run.run(stop_on_event)
     new_state = run.to_state()
     diag = dict(run.diag)

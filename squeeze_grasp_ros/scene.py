@@ -185,7 +185,8 @@ class SqueezeSpec:
         "finger approach / initial contact distance", "", lo=0.0, hi=1.0, default=None
     )
     step: float = spec(
-        "depth step of the event-driven squeeze, relative to the object size",
+        "depth step of the event-driven squeeze, relative to the object size (corotational "
+        "and neo-Hookean objects adapt their substeps between events, from one to four steps)",
         "",
         lo=0.0,
         lo_open=True,

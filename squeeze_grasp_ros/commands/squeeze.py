@@ -51,7 +51,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "--step",
         type=float,
         metavar="H",
-        help="depth substep relative to the object size (default: the scene's)",
+        help="depth substep relative to the object size; corotational and neo-Hookean objects "
+        "adapt theirs between events, from one to four of these (default: the scene's)",
     )
     parser.add_argument(
         "--event-tol",

@@ -63,8 +63,14 @@ def hermite_root(a: float, b: float, ga: float, gb: float, ra: float, rb: float)
     0.5
     >>> hermite_root(0.0, 1.0, 1.0, 1.0, -3.0, 3.0) is None  # dips to 0.25 only
     True
+    >>> hermite_root(0.0, 1.0, 1.0, 1.0 + 5e-324, 5e-324, 0.0) is None  # constant to round-off
+    True
     """
-    t = np.roots(_hermite_coefficients(ga, gb, ra, rb, b - a))
+    c = _hermite_coefficients(ga, gb, ra, rb, b - a)
+    # leading coefficients below 1e-14 of the largest only add roots beyond 1e14 (and overflow
+    # np.roots when subnormal): the roots in (0, 1) are those of the rest
+    lead = np.flatnonzero(np.abs(c) > 1e-14 * np.abs(c).max())
+    t = np.roots(c[lead[0]:]) if len(lead) else np.zeros(0)
     t = np.sort(t[(np.abs(t.imag) < 1e-12) & (t.real > 0) & (t.real < 1)].real)
     return float(a + t[0] * (b - a)) if len(t) else None
 

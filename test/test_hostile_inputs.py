@@ -355,7 +355,8 @@ def send_and_wait(harness: Harness, calls: list, timeout: float = 120.0) -> list
 def test_thirty_concurrent_requests_all_get_an_answer(planner):
     """30 clients send one load each at once: every one is answered, loaded or BUSY beyond
     max_pending (16). With rclpy's default queue depth of 10, 20 of them went unanswered; the
-    depth is now the service_queue_depth parameter (100).
+    queues now keep every request (planner parameter service_queue_depth 0; bursts of 200:
+    test_planner_clients.py).
     """
 
     def scene(k: int) -> str:  # distinct meshes: no request is a cache hit

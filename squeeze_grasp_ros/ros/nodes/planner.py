@@ -69,7 +69,10 @@ PARAMETERS: dict[str, tuple[Any, str]] = {
     "worker_threads": (2, "threads computing long requests (loads, maps, event squeezes)"),
     "best_count": (10, "placements a grasp map returns when a request asks for 0"),
     "min_step": (1e-5, "smallest event-squeeze substep, relative to the object size"),
-    "service_queue_depth": (100, "requests each service queues before DDS drops them"),
+    "service_queue_depth": (0, "requests each service and action queues: 0 = all of them (DDS "
+                               "never drops a request; a client beyond the reader's resource "
+                               "limits is held back), N = the last N (older unread requests "
+                               "are dropped)"),
     "max_pending": (16, "long requests (loads, maps, event squeezes) queued or running at "
                         "once; more are answered BUSY at once"),
     "allowed_roots": ([""], "folders whose files scene_path and a scene's outline file may "
@@ -77,6 +80,24 @@ PARAMETERS: dict[str, tuple[Any, str]] = {
                             "folder and the node's working directory"),
 }
 """Parameter name -> (typed default, description); config/planner.yaml sets the same names."""
+
+
+def request_queue(depth: int) -> QoSProfile:
+    """QoS of the planner's request queues: reliable, volatile, keep-all for ``depth`` 0 (no
+    request is ever dropped), else keep-last ``depth``.
+
+    rclpy's default for services (keep-last 10) drops the 11th and later requests of a burst
+    inside DDS before rclpy sees them; with keep-all a burst of 2,000 ``plan_squeeze`` requests
+    was answered in full (``bench ros_services``).
+
+    >>> request_queue(0).history.name, request_queue(100).depth
+    ('KEEP_ALL', 100)
+    """
+    if depth < 0:
+        raise ValueError(f"service_queue_depth must be >= 0 (0 = keep all), got {depth}")
+    return QoSProfile(history=HistoryPolicy.KEEP_ALL if depth == 0 else HistoryPolicy.KEEP_LAST,
+                      depth=depth or 1, reliability=ReliabilityPolicy.RELIABLE,
+                      durability=DurabilityPolicy.VOLATILE)
 
 
 def _resume(_: Future) -> None:
@@ -117,10 +138,7 @@ class PlannerNode(Node):
         their client left the graph."""
         self._feedback: queue.SimpleQueue[tuple[ServerGoalHandle, Any]] = queue.SimpleQueue()
 
-        services = QoSProfile(history=HistoryPolicy.KEEP_LAST,
-                              depth=value("service_queue_depth"),
-                              reliability=ReliabilityPolicy.RELIABLE,
-                              durability=DurabilityPolicy.VOLATILE)
+        services = request_queue(value("service_queue_depth"))
         self._pending = 0
         self._pending_lock = threading.Lock()
         # Reentrant: a long request awaiting its worker must not hold the node's default
@@ -136,12 +154,16 @@ class PlannerNode(Node):
                 (EventSqueeze, "event_squeeze", self._event_squeeze)):
             self.create_service(srv_type, f"~/{name}", callback, qos_profile=services,
                                 callback_group=self._group)
+        # The action servers' goal, cancel and result services default to a queue of 10 too:
+        # 200 goals sent at once got 20 responses (issue 34).
+        queues = {f"{kind}_service_qos_profile": services for kind in ("goal", "cancel", "result")}
         self._actions = [
             ActionServer(self, GraspMapAction, "~/grasp_map", self._execute_grasp_map,
-                         cancel_callback=self._accept_cancel, callback_group=self._group),
+                         cancel_callback=self._accept_cancel, callback_group=self._group,
+                         **queues),
             ActionServer(self, EventSqueezeAction, "~/event_squeeze",
                          self._execute_event_squeeze, cancel_callback=self._accept_cancel,
-                         callback_group=self._group),
+                         callback_group=self._group, **queues),
         ]
         self.get_logger().info(f"planner ready: {self.limits}; files from "
                                f"{[str(r) for r in self.roots]}")

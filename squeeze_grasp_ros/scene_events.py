@@ -50,6 +50,7 @@ def event_squeeze_scene(
     reference: bool = False,
     progress: Callable[[float], None] | None = None,
     material_model: MaterialModel | str | None = None,
+    checkpoint: Callable[[], None] | None = None,
 ) -> EventSqueeze:
     """Run the scene's squeeze with rounded fingertips; arguments override the scene's values.
 
@@ -71,6 +72,8 @@ def event_squeeze_scene(
         Called with the completed fraction of the depth.
     material_model : MaterialModel or str, optional
         Constitutive model; default the scene's ``object.material.model``.
+    checkpoint : callable, optional
+        Called before every substep; may raise to abandon the squeeze (a cancellation).
 
     Raises
     ------
@@ -118,4 +121,5 @@ def event_squeeze_scene(
         directions=directions,
         progress=progress,
         material_model=scene.object.material.model if material_model is None else material_model,
+        checkpoint=checkpoint,
     )

@@ -23,6 +23,12 @@ from squeeze_grasp_ros.planning.errors import (
     classify,
     ERROR_CODES,
 )
+from squeeze_grasp_ros.planning.object_ids import (
+    MAX_ID_CHARS,
+    check_object_id,
+    check_digest,
+    shown,
+)
 from squeeze_grasp_ros.planning.objects import (
     Limits,
     LoadedObject,
@@ -72,6 +78,7 @@ __all__ = [
     "Limits",
     "LoadedObject",
     "MAX_BEST_COUNT",
+    "MAX_ID_CHARS",
     "MAX_DIRECTIONS",
     "ObjectCache",
     "ObjectKey",
@@ -84,7 +91,9 @@ __all__ = [
     "SceneSource",
     "SqueezePlan",
     "best_count",
+    "check_digest",
     "check_number",
+    "check_object_id",
     "check_size",
     "check_step",
     "choice",
@@ -103,6 +112,7 @@ __all__ = [
     "resident_bytes",
     "resistance_plan",
     "ring_grasp_test",
+    "shown",
     "solver_route",
     "squeeze_plan",
 ]

@@ -131,6 +131,7 @@ def resistance_plan(
     directions: int,
     tip_radius: float,
     limits: Limits,
+    checkpoint: Callable[[], None] | None = None,
 ) -> ResistancePlan:
     """Optimal resistance to the adversary translation ``a`` (Sec. 6).
 
@@ -152,6 +153,8 @@ def resistance_plan(
         Friction: A's fingertip radius, m (0 = the scene's adversary tip radius).
     limits : Limits
         Friction: the scene's squeeze step must be >= ``limits.min_step``.
+    checkpoint : callable, optional
+        Friction: called before every stepper substep; may raise :class:`Cancelled`.
     """
     obj = loaded.solid()
     mode = choice("mode", mode, SqueezeKind.values())
@@ -166,7 +169,8 @@ def resistance_plan(
         if count:
             raise invalid("directions: the sweep needs point or segment contacts")
         return ResistancePlan(
-            friction_resistance(loaded, nodes, (x, y), mode, tip_radius, limits), None
+            friction_resistance(loaded, nodes, (x, y), mode, tip_radius, limits, checkpoint),
+            None,
         )
     if contact_model == "point":
         sets = [[int(n)] for n in nodes]
@@ -184,8 +188,11 @@ def friction_resistance(
     mode: str,
     tip_radius: float,
     limits: Limits,
+    checkpoint: Callable[[], None] | None = None,
 ) -> FrictionalResistance:
-    """Algorithm 2 after the scene's event-driven squeeze at F1, F2 (Sec. 6.3)."""
+    """Algorithm 2 after the scene's event-driven squeeze at F1, F2 (Sec. 6.3); ``checkpoint``
+    is called before every stepper substep of both.
+    """
     scene = loaded.scene
     radius = check_number("adversary_tip_radius", tip_radius, 0.0)
     radius = radius or (scene.adversary.tip_radius if scene.adversary is not None else 0.0)
@@ -197,7 +204,7 @@ def friction_resistance(
     check_step(scene.squeeze.step, limits)
     obj = loaded.solid()
     i, j, k = (int(n) for n in nodes)
-    squeeze = event_squeeze_scene(scene, obj, (i, j))
+    squeeze = event_squeeze_scene(scene, obj, (i, j), checkpoint=checkpoint)
     model = scene_contact_model(scene, obj)
     state = add_adversary(squeeze.state, model, squeeze.displacement, k, radius)
     return frictional_resistance(
@@ -208,6 +215,7 @@ def friction_resistance(
         step=squeeze.step,
         event_tol=squeeze.event_tol,
         contacts=[i, j, k],
+        checkpoint=checkpoint,
     )
 
 
@@ -286,6 +294,7 @@ def event_squeeze_run(
     event_tol: float,
     limits: Limits,
     progress: Callable[[float], None] | None = None,
+    checkpoint: Callable[[], None] | None = None,
 ) -> EventSqueeze:
     """The scene's event-driven squeeze (Algorithm 1) with the request's overrides.
 
@@ -304,6 +313,8 @@ def event_squeeze_run(
     limits : Limits
     progress : callable, optional
         Called with the completed fraction; may raise :class:`Cancelled`.
+    checkpoint : callable, optional
+        Called before every stepper substep; may raise :class:`Cancelled`.
     """
     obj = loaded.solid()
     scene = loaded.scene
@@ -325,4 +336,5 @@ def event_squeeze_run(
         step=step,
         event_tol=event_tol,
         progress=progress,
+        checkpoint=checkpoint,
     )

@@ -28,7 +28,7 @@ the interface, object frame.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field, replace
 
 import numpy as np
@@ -279,6 +279,8 @@ def frictional_resistance(
     step: float = 1e-3,
     event_tol: float = 1e-9,
     contacts: Sequence[int] | None = None,
+    progress: Callable[[float], None] | None = None,
+    checkpoint: Callable[[], None] | None = None,
 ) -> FrictionalResistance:
     """Algorithm 2: F1 and F2 resist A's translation ``a`` from ``state`` (with A touching).
 
@@ -297,6 +299,10 @@ def frictional_resistance(
     contacts : sequence of 3 int, optional
         Initial contact nodes of F1, F2 (before the squeeze) and A, for the report; default:
         the first node of each finger's segment in ``state``.
+    progress : callable, optional
+        Called after every stage with the fraction of a travelled by A.
+    checkpoint : callable, optional
+        Called before every stepper substep; may raise to abandon the computation.
 
     Raises
     ------
@@ -362,6 +368,7 @@ def frictional_resistance(
             event_tol,
             stop_on_event=True,
             terminate_on=(Termination.FINGER_SLIP,),
+            checkpoint=checkpoint,
         )
         diag["advance_calls"] += 1
         state = result.state
@@ -376,6 +383,8 @@ def frictional_resistance(
         )
         for f in tuple(Finger):
             path[f].append(state.finger(f).translation - start_state.finger(f).translation)
+        if progress is not None:
+            progress(min(travelled / length, 1.0))
         outcome = _outcome(result.termination, state)
         if outcome is None and result.fraction >= 1.0:
             outcome = (True, "adversary completed a")

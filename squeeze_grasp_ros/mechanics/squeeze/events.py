@@ -94,6 +94,7 @@ def squeeze_to_depth(
     event_tol: float = 1e-9,
     progress: Callable[[float], None] | None = None,
     terminate_on: tuple[str, ...] = TERMINATION_ORDER,
+    checkpoint: Callable[[], None] | None = None,
 ) -> SqueezeRun:
     """Algorithm 1: advance the fingers along ``directions`` until ``depth`` or a termination.
 
@@ -113,6 +114,8 @@ def squeeze_to_depth(
         Called with the completed fraction after every stepper call.
     terminate_on : tuple of str
         Terminations that end the squeeze besides the depth.
+    checkpoint : callable, optional
+        Called before every substep; may raise to abandon the squeeze (see :func:`advance`).
     """
     if not (np.isfinite(depth) and depth >= 0):
         raise InvalidInputError(f"squeeze depth must be >= 0 m, got {depth}")
@@ -134,6 +137,7 @@ def squeeze_to_depth(
             stop_on_event=True,
             terminate_on=terminate_on,
             first_substep=substep,
+            checkpoint=checkpoint,
         )
         substep = result.next_substep
         diag["advance_calls"] += 1
@@ -425,6 +429,7 @@ def event_squeeze(
     directions: Mapping[str, tuple[float, float]] | None = None,
     progress: Callable[[float], None] | None = None,
     material_model: MaterialModel | str = MaterialModel.LINEAR,
+    checkpoint: Callable[[], None] | None = None,
 ) -> EventSqueeze:
     """Event-driven two-finger squeeze of ``obj`` from initial contact nodes (F1, F2).
 
@@ -457,6 +462,8 @@ def event_squeeze(
     material_model : MaterialModel or str
         ``linear`` (the paper's small-strain model, default), ``corotational`` or
         ``neo_hookean`` (finite deformation: :mod:`.nonlinear_model`).
+    checkpoint : callable, optional
+        Called before every substep; may raise to abandon the squeeze (a cancellation).
 
     Examples
     --------
@@ -506,7 +513,8 @@ def event_squeeze(
     model = contact_model(material_model, obj, mu, limits or Limits(), reference,
                           max_events_per_depth)
     run = squeeze_to_depth(
-        model, initial_state(tips, relative_per_depth), dirs, depth, step, event_tol, progress
+        model, initial_state(tips, relative_per_depth), dirs, depth, step, event_tol, progress,
+        checkpoint=checkpoint,
     )
     state = run.state
     health, u_field = grasp_health(model, state)

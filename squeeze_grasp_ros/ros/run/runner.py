@@ -463,13 +463,16 @@ class PipelineRunner:
         path = str(Path(self.options.scene_path).resolve())
         loaded = self._call(LoadObject, "load_object", LoadObject.Request(scene_path=path))
         squeeze = self._call(
-            EventSqueeze, "event_squeeze", EventSqueeze.Request(object_id=loaded.object_id)
+            EventSqueeze,
+            "event_squeeze",
+            EventSqueeze.Request(object_id=loaded.object_id, object_digest=loaded.object_digest),
         ).squeeze
         pure = self._call(
             PlanSqueeze,
             "plan_squeeze",
             PlanSqueeze.Request(
                 object_id=loaded.object_id,
+                object_digest=loaded.object_digest,
                 contacts=list(loaded.finger_nodes),
                 squeeze_type=SqueezeKind.PURE,
             ),

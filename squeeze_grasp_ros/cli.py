@@ -100,4 +100,6 @@ def main(argv: list[str] | None = None) -> int:
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    from squeeze_grasp_ros.entry import cli
+
+    sys.exit(cli())  # as the console script: signals while starting end with one line

@@ -3,15 +3,48 @@
 """The ROS 2 nodes: thin rclpy wiring around the mechanics, one console script each."""
 from __future__ import annotations
 
+import ctypes
+import os
 import signal
+import sys
 import threading
 from collections.abc import Callable
+from pathlib import Path
 
 import rclpy
 from rclpy.executors import Executor, ExternalShutdownException
 from rclpy.experimental import EventsExecutor
 from rclpy.node import Node
 from rclpy.signals import SignalHandlerOptions
+
+from squeeze_grasp_ros.exit_codes import ExitCode
+
+
+PARENT_PID_ENV = "SQUEEZE_GRASP_PARENT_PID"
+"""Environment variable naming the process that started a node (``squeeze-grasp run
+--processes``): the node ends when that process dies."""
+PARAMS_FILE_ENV = "SQUEEZE_GRASP_PARAMS_FILE"
+"""Environment variable naming the parameter file the starting process wrote: a node that
+outlives that process removes it."""
+PR_SET_PDEATHSIG = 1
+"""prctl(2) option: the signal this process gets when the thread that forked it ends."""
+
+
+def parent_watch() -> Callable[[], bool]:
+    """'Has the process that started this node died?', for a node started by a run.
+
+    With :data:`PARENT_PID_ENV` set, asks Linux for SIGTERM when the parent dies
+    (``prctl(PR_SET_PDEATHSIG)``: the parent cannot catch SIGKILL, so only the children can
+    notice), and returns a check of the parent pid that also works where prctl does not (the
+    parent died, so this process was re-parented). Without it, a check that is never true.
+    """
+    text = os.environ.get(PARENT_PID_ENV, "")
+    if not text.isdigit():
+        return lambda: False
+    parent = int(text)
+    if sys.platform.startswith("linux"):
+        ctypes.CDLL(None, use_errno=True).prctl(PR_SET_PDEATHSIG, int(signal.SIGTERM), 0, 0, 0)
+    return lambda: os.getppid() != parent
 
 
 def run_node(factory: Callable[[], Node], args: list[str] | None = None,
@@ -26,7 +59,9 @@ def run_node(factory: Callable[[], Node], args: list[str] | None = None,
     not return after shutdown. SIGINT (Ctrl-C, also what ``ros2 launch`` sends first) and
     SIGTERM only set a flag, so no callback is interrupted halfway; the loop then ends, a node
     with ``drain(executor)`` processes what has already arrived, its ``close()`` is called, and
-    the node is destroyed (the planner joins its workers there).
+    the node is destroyed (the planner joins its workers there). A node started by a run ends
+    the same way when that process dies (:func:`parent_watch`), and removes the run's
+    parameter file.
 
     Parameters
     ----------
@@ -40,14 +75,26 @@ def run_node(factory: Callable[[], Node], args: list[str] | None = None,
     stop = threading.Event()
     for signum in (signal.SIGINT, signal.SIGTERM):
         signal.signal(signum, lambda *_: stop.set())
+    orphaned = parent_watch()
     rclpy.init(args=args, signal_handler_options=SignalHandlerOptions.NO)
     executor = executor_type()
-    node = factory()
+    try:
+        node = factory()
+    except ValueError as exc:  # a bad parameter (e.g. a recorder that cannot start its bag)
+        print(f"{getattr(factory, '__name__', 'node')}: {exc}", file=sys.stderr)
+        rclpy.try_shutdown()
+        raise SystemExit(int(ExitCode.USAGE)) from None
     executor.add_node(node)
     try:
-        while rclpy.ok() and not stop.is_set():
+        while rclpy.ok() and not stop.is_set() and not orphaned():
             executor.spin_once(0.1)
-        if stop.is_set() and hasattr(node, "drain"):
+        if orphaned():
+            node.get_logger().error(f"the process that started this node "
+                                    f"({os.environ[PARENT_PID_ENV]}) has died: shutting down")
+            params = os.environ.get(PARAMS_FILE_ENV)
+            if params:
+                Path(params).unlink(missing_ok=True)
+        if (stop.is_set() or orphaned()) and hasattr(node, "drain"):
             node.drain(executor)
     except ExternalShutdownException:
         pass

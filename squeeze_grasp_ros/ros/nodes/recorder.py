@@ -88,10 +88,15 @@ class RecorderNode(Node):
         self.writer = BagWriter(p["output"], p["compression"], p["chunk_size"],
                                 {str(k): str(v) for k, v in custom.items()})
         topics = pipeline.pipeline_topics(p["devices"], hidden=p["include_hidden_topics"])
+        self.sources = {name: name.lstrip("/") for name in topics}
+        """Recorded name -> the name subscribed to: the pipeline's topics relative to the
+        node's namespace (a run in a namespace records '/sim/tick' from '<ns>/sim/tick'),
+        extra topics as given."""
         for entry in p["extra_topics"]:
             if entry.strip():
                 name, type_name = entry.split()
                 topics[name] = type_name
+                self.sources[name] = name
         self.types = topics
         self.stamped = {name: starts_with_stamp(t) for name, t in topics.items()}
         self.unique = {name for name, stamped in self.stamped.items()
@@ -109,7 +114,7 @@ class RecorderNode(Node):
             qos = pipeline.LATCHED if name in latched else (
                 pipeline.sensor_qos(p["sensor_qos"], p["qos_depth"]) if name in sensors
                 else pipeline.loop_qos(p["qos_depth"]))
-            self.create_subscription(pipeline.message_type(type_name), name,
+            self.create_subscription(pipeline.message_type(type_name), self.sources[name],
                                      lambda data, n=name: self._record(n, data), qos, raw=True)
         self.progress_pub = self.create_publisher(Header, pipeline.RECORDER_PROGRESS,
                                                   pipeline.loop_qos(10))
@@ -123,7 +128,8 @@ class RecorderNode(Node):
             return POLICY_NAMES[policy].get(value, "unknown")
         return [qos_dict(name("history", q.history), q.depth, name("reliability", q.reliability),
                          name("durability", q.durability))
-                for q in (i.qos_profile for i in self.get_publishers_info_by_topic(topic))]
+                for q in (i.qos_profile
+                          for i in self.get_publishers_info_by_topic(self.sources[topic]))]
 
     def _record(self, topic: str, data: bytes) -> None:
         ns = cdr_stamp_ns(data) if self.stamped[topic] else self.get_clock().now().nanoseconds

@@ -7,39 +7,23 @@ from __future__ import annotations
 
 import time
 from collections import Counter
-from collections.abc import Iterator
-from pathlib import Path
 
-import pytest
 import yaml
 from rclpy.action import ActionClient
-from rclpy.context import Context
 from rclpy.qos import HistoryPolicy, QoSProfile, ReliabilityPolicy
 
 from action_msgs.msg import GoalStatus
-from planner_support import BLOB, Harness, planner_threads
+from planner_support import BLOB, Harness
+from test_planner_node import RESIST_FIG10
 from squeeze_grasp_interfaces.action import GraspMap as GraspMapAction
 from squeeze_grasp_interfaces.srv import EventSqueeze, LoadObject, PlanSqueeze
 from squeeze_grasp_ros.planning import ErrorCode
 
-RESIST_FIG10 = (Path(__file__).resolve().parents[1] / "config" / "scenes" /
-                "resist_fig10.yaml").read_text()
 BURST = 200
 """Requests or goals sent at once (the issue's burst)."""
 KEEP_ALL = QoSProfile(history=HistoryPolicy.KEEP_ALL, depth=1,
                       reliability=ReliabilityPolicy.RELIABLE)
 """A burst client's own queue: a client with rclpy's default (keep-last 10) drops responses."""
-
-
-@pytest.fixture
-def planner(ros_context: Context) -> Iterator[Harness]:
-    """A planner and a client on one executor spun by the test thread."""
-    harness = Harness(ros_context)
-    try:
-        yield harness
-    finally:
-        harness.close()
-    assert planner_threads() == []
 
 
 def spin_until_done(harness: Harness, futures: list, timeout: float = 120.0) -> None:

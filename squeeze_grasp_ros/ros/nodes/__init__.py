@@ -28,23 +28,35 @@ PARAMS_FILE_ENV = "SQUEEZE_GRASP_PARAMS_FILE"
 outlives that process removes it."""
 PR_SET_PDEATHSIG = 1
 """prctl(2) option: the signal this process gets when the thread that forked it ends."""
+PARENT_DEATH_SIGNAL = signal.SIGUSR1
+"""The signal a node started by a run asks for when that run dies."""
 
 
-def parent_watch() -> Callable[[], bool]:
+def parent_watch(stop: threading.Event) -> Callable[[], bool]:
     """'Has the process that started this node died?', for a node started by a run.
 
-    With :data:`PARENT_PID_ENV` set, asks Linux for SIGTERM when the parent dies
-    (``prctl(PR_SET_PDEATHSIG)``: the parent cannot catch SIGKILL, so only the children can
-    notice), and returns a check of the parent pid that also works where prctl does not (the
-    parent died, so this process was re-parented). Without it, a check that is never true.
+    With :data:`PARENT_PID_ENV` set, asks Linux for :data:`PARENT_DEATH_SIGNAL` when the parent
+    dies (``prctl(PR_SET_PDEATHSIG)``: the parent cannot catch SIGKILL, so only the children can
+    notice); its handler sets ``stop``. A signal of its own, not SIGTERM: it comes as the
+    forking thread ends, while the dying process's other threads may still be this process's
+    parent, so the parent pid cannot tell it yet. The returned check also compares the parent
+    pid (re-parented: the parent died, also where prctl does not exist). Without the variable,
+    a check that is never true.
     """
     text = os.environ.get(PARENT_PID_ENV, "")
     if not text.isdigit():
         return lambda: False
-    parent = int(text)
+    parent, died = int(text), threading.Event()
+
+    def on_parent_death(*_: object) -> None:
+        died.set()
+        stop.set()
+
     if sys.platform.startswith("linux"):
-        ctypes.CDLL(None, use_errno=True).prctl(PR_SET_PDEATHSIG, int(signal.SIGTERM), 0, 0, 0)
-    return lambda: os.getppid() != parent
+        signal.signal(PARENT_DEATH_SIGNAL, on_parent_death)
+        ctypes.CDLL(None, use_errno=True).prctl(PR_SET_PDEATHSIG, int(PARENT_DEATH_SIGNAL),
+                                                0, 0, 0)
+    return lambda: died.is_set() or os.getppid() != parent
 
 
 def run_node(factory: Callable[[], Node], args: list[str] | None = None,
@@ -75,7 +87,7 @@ def run_node(factory: Callable[[], Node], args: list[str] | None = None,
     stop = threading.Event()
     for signum in (signal.SIGINT, signal.SIGTERM):
         signal.signal(signum, lambda *_: stop.set())
-    orphaned = parent_watch()
+    orphaned = parent_watch(stop)
     rclpy.init(args=args, signal_handler_options=SignalHandlerOptions.NO)
     executor = executor_type()
     try:

@@ -29,11 +29,12 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.ndimage import gaussian_filter
 
+from squeeze_grasp_ros.mechanics.elastic.mesh import vertex_normals
 from squeeze_grasp_ros.mechanics.elastic.shapes import Outline, signed_area
 from squeeze_grasp_ros.mechanics.errors import InvalidInputError
 from squeeze_grasp_ros.perception.camera import CameraModel, CameraPose
 
-__all__ = ["CameraViews", "coverage", "render_views"]
+__all__ = ["CameraViews", "coverage", "render_views", "ring_band"]
 
 MAX_EDGE_PX = 0.5
 """Longest projected edge (px) drawn straight when the camera has distortion."""
@@ -123,6 +124,25 @@ def coverage(loops: list[np.ndarray], shape: tuple[int, int]) -> np.ndarray:
     carry = np.bincount(row * (W + 1) + right, weights=dy, minlength=H * (W + 1))
     total = area.reshape(H, W + 1) + np.cumsum(carry.reshape(H, W + 1), axis=1)
     return np.clip(np.abs(total[:, :W]), 0.0, 1.0)
+
+
+def ring_band(middle: Outline, wall: float) -> Outline:
+    """The band a ring object occupies: its middle curve offset by half the in-plane ``wall``
+    thickness (m) to both sides, as an outline with one hole.
+
+    Raises
+    ------
+    InvalidInputError
+        When the inner offset folds (the wall is thicker than the middle curve's tightest
+        curvature allows).
+    """
+    p = np.asarray(middle.points, float)
+    p = p if signed_area(p) > 0 else p[::-1]
+    normals = vertex_normals(p)
+    outer, inner = p + 0.5 * wall * normals, p - 0.5 * wall * normals
+    if not (signed_area(inner) > 0 and signed_area(outer) > signed_area(inner)):
+        raise InvalidInputError(f"ring_band: wall {wall:g} m is too thick for the middle curve")
+    return Outline(outer, (inner,))
 
 
 def _densify(points: np.ndarray, camera: CameraModel, pose: CameraPose,

@@ -333,7 +333,8 @@ def _csv_points(text: str, name: str) -> list[list[float]]:
 
 
 def load_outline(path: str | Path) -> Outline:
-    """Read an outline from CSV (``x,y`` per line, m) or JSON (``{"outline": [[x, y], ...]}``).
+    """Read an outline from CSV (``x,y`` per line, m) or JSON (``{"outline": [[x, y], ...]}``,
+    optionally ``"holes": [[[x, y], ...], ...]``, as ``squeeze-grasp outline`` writes it).
 
     The points are the vertices of a polygon; vertices where it turns by more than 20 degrees
     are kept as corners when the outline is resampled. The file is read up to
@@ -360,10 +361,18 @@ def load_outline(path: str | Path) -> Outline:
                 for q in pts):
             raise InvalidInputError(f"{name}: 'outline' must be a list of at most "
                                  f"{MAX_OUTLINE_POINTS} [x, y] number pairs")
+        holes = data.get("holes", [])
+        if not isinstance(holes, list) or not all(
+                isinstance(h, list) and all(isinstance(q, list) and len(q) == 2 and all(
+                    isinstance(c, (int, float)) and not isinstance(c, bool) for c in q)
+                    for q in h) for h in holes) or sum(map(len, holes)) > MAX_OUTLINE_POINTS:
+            raise InvalidInputError(f"{name}: 'holes' must be a list of polygons, each a list "
+                                    "of [x, y] number pairs")
     else:
-        pts = _csv_points(text, name)
+        pts, holes = _csv_points(text, name), []
     p = validate_polyline(pts, name)
-    return Outline(p, corners=_turning_corners(p))
+    with_holes = polygon(p, holes) if holes else Outline(p)
+    return Outline(p, with_holes.holes, corners=_turning_corners(p))
 
 
 def resample(

@@ -3,8 +3,9 @@
 """Optional parts of the package and how to install them.
 
 ``pip install .`` gives the mechanics; ROS 2 (nodes, ``run``, ``replay``, recordings), the
-Dask sweeps and outline extraction from images (scikit-image) come with extras. Code that needs an extra asks here, so that a missing one ends
-in a sentence saying what to install, never a traceback.
+Dask sweeps and outline extraction from images (scikit-image) come with extras. Code that needs
+an extra asks here, so that a missing one ends in a sentence saying what to install, never a
+traceback.
 
 >>> install_hint("rclpy").startswith("pip install '.[ros]'")
 True

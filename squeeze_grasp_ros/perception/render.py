@@ -140,7 +140,8 @@ def ring_band(middle: Outline, wall: float) -> Outline:
     p = p if signed_area(p) > 0 else p[::-1]
     normals = vertex_normals(p)
     outer, inner = p + 0.5 * wall * normals, p - 0.5 * wall * normals
-    if not (signed_area(inner) > 0 and signed_area(outer) > signed_area(inner)):
+    along = np.einsum("ij,ij->i", np.roll(p, -1, axis=0) - p, np.roll(inner, -1, axis=0) - inner)
+    if not np.all(along > 0):  # an inner edge turned back: the offset folded
         raise InvalidInputError(f"ring_band: wall {wall:g} m is too thick for the middle curve")
     return Outline(outer, (inner,))
 

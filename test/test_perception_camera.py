@@ -39,7 +39,7 @@ def test_back_projection_inverts_projection_through_distortion(x, y, z, roll, pi
 
 
 def test_looking_down_maps_plane_axes_to_image_axes():
-    """u grows with x and v falls with y; the principal point sees the camera's foot point."""
+    """The image u axis follows x and v follows -y; the principal point sees the foot point."""
     pose = CameraPose.looking_down(0.5, x=0.1, y=-0.2)
     uv = PINHOLE.project(pose, np.array([[0.1, -0.2, 0.0], [0.2, -0.2, 0.0], [0.1, -0.1, 0.0]]))
     assert np.allclose(uv[0], [319.5, 239.5])

@@ -47,7 +47,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--max-tilt", type=float, default=2.0, metavar="DEG",
                         help="depth: largest tilt of the support against the pose (default 2)")
     parser.add_argument("--tolerance", type=float, default=None, metavar="M",
-                        help="simplification tolerance, m (default: a quarter of the pixel "
+                        help="simplification tolerance, m (default: 0.15 of the pixel "
                              "footprint at the object)")
     parser.add_argument("--frame-id", default="plane", help="name of the plane frame "
                                                             "(default plane)")

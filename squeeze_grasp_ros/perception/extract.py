@@ -5,8 +5,9 @@
 The object is the largest blob (:mod:`.blobs`); its boundary is traced to sub-pixel accuracy
 by marching squares (``skimage.measure.find_contours``) at an iso-level, each contour point is
 undistorted and its ray met with the plane of the object's top face, and the curves are
-simplified by Douglas-Peucker (:mod:`.simplify`) to a stated tolerance
-in metres. Closed holes become holes of the outline (a ring or annulus-like object).
+simplified by Douglas-Peucker (:mod:`.simplify`) to a stated tolerance in metres; corners where
+straight stretches meet are rebuilt as the intersection of lines fitted to them (an iso-contour
+cuts a corner short). Closed holes become holes of the outline (a ring or annulus-like object).
 
 - **mask** (``mono8``): 0 is background, larger values object; read as coverage (value / 255,
   or / 1 for a 0/1 mask) with the edge at half coverage, so an anti-aliased mask gives edges
@@ -34,10 +35,30 @@ from squeeze_grasp_ros.mechanics.errors import InvalidInputError
 from squeeze_grasp_ros.mechanics.vocabulary import ImageEncoding
 from squeeze_grasp_ros.perception.blobs import Blob, BlobChoice, choose_object
 from squeeze_grasp_ros.perception.camera import CameraModel, CameraPose
-from squeeze_grasp_ros.perception.simplify import simplify_closed
+from squeeze_grasp_ros.perception.simplify import kept_vertices, sharpen_corners
 from squeeze_grasp_ros.perception.support import SupportPlane, fit_support, floor_grids
 
-__all__ = ["ObjectOutline", "extract_outline"]
+__all__ = ["DEFAULT_TOLERANCE_PX", "ObjectOutline", "extract_outline"]
+
+DEFAULT_TOLERANCE_PX = 0.15
+"""Default simplification tolerance, in pixel footprints at the object."""
+
+CORNER_RADIUS_PX = 2.0
+"""Traced points closer than this (pixel footprints) to a corner are not used to rebuild it."""
+
+CORNER_SPAN_PX = 8.0
+"""Length (pixel footprints) of the straight stretches fitted on each side of a corner."""
+
+CORNER_CUT_PX = 0.6
+"""Largest cut (pixel footprints) of a right-angle corner by the traced curve that is rebuilt
+(:func:`~.simplify.sharpen_corners` scales it by 1 / sin(alpha / 2) for a corner of angle
+alpha): the 0.5 iso-contour of an anti-aliased corner cuts it by about 0.3 px."""
+
+CORNER_STRAIGHT_PX = 0.12
+"""How straight (pixel footprints) both stretches must be. Traced straight edges stray up to
+0.09 px (marching squares on slanted edges); an arc strays span^2 / (16 R) from its best line,
+so only arcs of radius R >= 33 px pass, and those turn far less than 30 degrees between the
+two stretches (12 px apart): smooth bends are never made corners."""
 
 IMAGE_TYPES: dict[ImageEncoding, tuple[type, ...]] = {
     ImageEncoding.MONO8: (np.uint8, np.bool_),
@@ -167,9 +188,13 @@ def _trace(field: np.ndarray, level: float, choice: BlobChoice, min_area_px: int
     return [loops[outer]] + [loops[k] for k in holes], len(loops) - 1 - len(holes)
 
 
-def _simplify(points: np.ndarray, tolerance: float, name: str) -> np.ndarray:
+def _simplify(points: np.ndarray, tolerance: float, pixel: float, name: str) -> np.ndarray:
+    kept = kept_vertices(points, tolerance)
+    vertices = sharpen_corners(points, kept, radius=CORNER_RADIUS_PX * pixel,
+                               span=CORNER_SPAN_PX * pixel, tolerance=CORNER_STRAIGHT_PX * pixel,
+                               max_cut=CORNER_CUT_PX * pixel)
     try:
-        return validate_polyline(simplify_closed(points, tolerance), name)
+        return validate_polyline(vertices, name)
     except InvalidInputError as exc:
         raise InvalidInputError(f"{exc}; the simplified {name} is not a simple curve: lower "
                                 f"tolerance_m (now {tolerance:g} m)") from None
@@ -182,14 +207,14 @@ def _outline(loops: list[np.ndarray], camera: CameraModel, pose: CameraPose,
     """
     centre = camera.back_project(pose, np.array([centroid_px]), plane_height).points[0]
     pixel = camera.ground_pixel_size(pose, np.array([*centre, plane_height]))
-    tolerance = 0.25 * pixel if tolerance_m is None else tolerance_m
+    tolerance = DEFAULT_TOLERANCE_PX * pixel if tolerance_m is None else tolerance_m
     if not (np.isfinite(tolerance) and tolerance > 0):
         raise InvalidInputError(f"tolerance_m must be a positive length in m, got {tolerance_m!r}")
     sizes = [len(loop) for loop in loops]
     plane = camera.back_project(pose, np.concatenate(loops), plane_height)
     metric = np.split(plane.points, np.cumsum(sizes)[:-1])
-    outer = _simplify(metric[0], tolerance, "extracted outline")
-    holes = tuple(_simplify(h, tolerance, f"extracted hole {k + 1}")
+    outer = _simplify(metric[0], tolerance, pixel, "extracted outline")
+    holes = tuple(_simplify(h, tolerance, pixel, f"extracted hole {k + 1}")
                   for k, h in enumerate(metric[1:]))
     boundary = MplPath(outer)
     for k, hole in enumerate(holes):
@@ -223,8 +248,8 @@ def extract_outline(image: np.ndarray, encoding: ImageEncoding | str, camera: Ca
     camera, pose : CameraModel, CameraPose
         Intrinsics and the camera's pose in the plane frame.
     tolerance_m : float, optional
-        Douglas-Peucker tolerance of the simplification, m (default: a quarter of the pixel
-        footprint at the object).
+        Douglas-Peucker tolerance of the simplification, m (default:
+        :data:`DEFAULT_TOLERANCE_PX` of the pixel footprint at the object).
     object_height_m : float
         Mask only: height of the object's top face above the plane (its thickness), m.
     min_height_m : float
@@ -276,7 +301,7 @@ def extract_outline(image: np.ndarray, encoding: ImageEncoding | str, camera: Ca
         choice = choose_object(valid & (field > min_height_m), min_area_px=min_area_px,
                                ambiguous_ratio=ambiguous_ratio, what=what)
         _check_invalid_near(valid, choice)
-        top = float(np.median(field[choice.box][choice.labels[choice.box] == choice.label]))
+        top = _top_height(field, choice)
         level = max(min_height_m, 0.5 * top)
         u, v = choice.blob.centroid_px
         under = support.height_at(fx[int(round(v)), int(round(u))], fy[int(round(v)),
@@ -288,6 +313,17 @@ def extract_outline(image: np.ndarray, encoding: ImageEncoding | str, camera: Ca
     return ObjectOutline(outline, frame_id, encoding, plane_height, level, tolerance, pixel,
                          sum(map(len, loops)), choice.blob, choice.others, choice.specks, small,
                          residual, support)
+
+
+def _top_height(field: np.ndarray, choice: BlobChoice) -> float:
+    """The object's top height above the support, m: the median over its pixels one pixel
+    inside the edge (the edge's mixed pixels would pull a thin wall's median down), or over all
+    its pixels when it is too thin to keep ten.
+    """
+    blob = choice.labels[choice.box] == choice.label
+    inner = ndimage.binary_erosion(blob)
+    heights = field[choice.box][inner if inner.sum() >= 10 else blob]
+    return float(np.median(heights))
 
 
 def _check_invalid_near(valid: np.ndarray, choice: BlobChoice) -> None:

@@ -30,7 +30,7 @@ import numpy as np
 from scipy.ndimage import gaussian_filter
 
 from squeeze_grasp_ros.mechanics.elastic.mesh import vertex_normals
-from squeeze_grasp_ros.mechanics.elastic.shapes import Outline, signed_area
+from squeeze_grasp_ros.mechanics.elastic.shapes import Outline, signed_area, validate_polyline
 from squeeze_grasp_ros.mechanics.errors import InvalidInputError
 from squeeze_grasp_ros.perception.camera import CameraModel, CameraPose
 
@@ -139,11 +139,59 @@ def ring_band(middle: Outline, wall: float) -> Outline:
     p = np.asarray(middle.points, float)
     p = p if signed_area(p) > 0 else p[::-1]
     normals = vertex_normals(p)
-    outer, inner = p + 0.5 * wall * normals, p - 0.5 * wall * normals
-    along = np.einsum("ij,ij->i", np.roll(p, -1, axis=0) - p, np.roll(inner, -1, axis=0) - inner)
-    if not np.all(along > 0):  # an inner edge turned back: the offset folded
-        raise InvalidInputError(f"ring_band: wall {wall:g} m is too thick for the middle curve")
+    outer = _untangled(p + 0.5 * wall * normals, p, wall)
+    inner = _untangled(p - 0.5 * wall * normals, p, wall)
     return Outline(outer, (inner,))
+
+
+def _untangled(offset: np.ndarray, middle: np.ndarray, wall: float) -> np.ndarray:
+    """``offset`` with the small loops cut out that it forms where the middle curve bends more
+    tightly than half the wall (a cusp, such as a heart's): each run of edges that turned back
+    against the middle curve is replaced by the crossing of the edges just around it.
+
+    Raises
+    ------
+    InvalidInputError
+        When a fold cannot be cut this way (the wall is too thick for the curve).
+    """
+    n = len(offset)
+    along = np.einsum("ij,ij->i", np.roll(middle, -1, axis=0) - middle,
+                      np.roll(offset, -1, axis=0) - offset)
+    if np.mean(along <= 0) > 0.25:
+        raise InvalidInputError(f"ring_band: wall {wall:g} m is too thick for the middle curve "
+                                "(its offset turns back along a quarter of it)")
+    drop = np.zeros(n, bool)
+    for start in np.flatnonzero((along <= 0) & (np.roll(along, 1) > 0)):
+        end = start
+        while along[end % n] <= 0 and end - start < n:
+            end += 1
+        reach = max(8, n // 8)  # the edges around the run: all pairs, the tightest loop kept
+        i = (start - 1 - np.arange(reach))[:, None] % n
+        j = (end + np.arange(reach))[None, :] % n
+        a0, da = offset[i], offset[(i + 1) % n] - offset[i]
+        b0, db = offset[j], offset[(j + 1) % n] - offset[j]
+        det = da[..., 0] * db[..., 1] - da[..., 1] * db[..., 0]
+        w = b0 - a0
+        with np.errstate(divide="ignore", invalid="ignore"):
+            t = (w[..., 0] * db[..., 1] - w[..., 1] * db[..., 0]) / det
+            u = (w[..., 0] * da[..., 1] - w[..., 1] * da[..., 0]) / det
+        crossing = (t >= 0) & (t <= 1) & (u >= 0) & (u <= 1)
+        if not crossing.any():
+            raise InvalidInputError(f"ring_band: wall {wall:g} m is too thick for the middle "
+                                    "curve (its offset folds)")
+        ki, kj = np.unravel_index(np.argmin(np.where(crossing, np.add.outer(
+            np.arange(reach), np.arange(reach)), 2 * reach)), crossing.shape)
+        first, last = int(i[ki, 0]), int(j[0, kj])
+        cut = np.arange(first + 1, last + 1 + (n if last < first else 0)) % n
+        offset = offset.copy()
+        offset[cut[0]] = a0[ki, 0] + t[ki, kj] * da[ki, 0]
+        drop[cut[1:]] = True
+    result = offset[~drop]
+    try:
+        return validate_polyline(result, "ring band")
+    except InvalidInputError:
+        raise InvalidInputError(f"ring_band: wall {wall:g} m is too thick for the middle curve "
+                                "(its offset crosses itself)") from None
 
 
 def _densify(points: np.ndarray, camera: CameraModel, pose: CameraPose,

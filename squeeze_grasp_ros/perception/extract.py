@@ -182,6 +182,9 @@ def _trace(field: np.ndarray, level: float, choice: BlobChoice, min_area_px: int
     crop[(labels != 0) & (labels != choice.label)] = 0.0
     crop[~np.isfinite(crop)] = 0.0
     loops = [c[:-1, ::-1] + (c0, r0) for c in find_contours(crop, level) if len(c) > 3]
+    if not loops:
+        raise InvalidInputError(f"the object's blob ({choice.blob.area_px} px) is too small to "
+                                "trace an outline")
     areas = np.array([signed_area(loop) for loop in loops])
     outer = int(np.argmax(np.abs(areas)))
     holes = [k for k in range(len(loops)) if k != outer and abs(areas[k]) >= min_area_px]

@@ -103,6 +103,15 @@ class ShapeMatch:
 def deformed_outline(mesh: Mesh, displacement: np.ndarray) -> Outline:
     """The deformed boundary of ``mesh`` under nodal ``displacement`` (n, 2), m: the outer
     boundary nodes and each hole's loop, moved.
+
+    Examples
+    --------
+    >>> from squeeze_grasp_ros.mechanics.elastic.mesh import generate_mesh
+    >>> from squeeze_grasp_ros.mechanics.elastic.shapes import annulus
+    >>> mesh = generate_mesh(annulus(0.05, 0.02), 2e-5)
+    >>> stretched = deformed_outline(mesh, 0.01 * mesh.nodes)  # 1 % larger everywhere
+    >>> print(f"{stretched.area / deformed_outline(mesh, 0 * mesh.nodes).area:.4f}")
+    1.0201
     """
     moved = mesh.nodes + np.asarray(displacement, float).reshape(-1, 2)
     require_finite("displacement", moved)

@@ -60,10 +60,11 @@ class SupportPlane:
                 "inlier_blocks": self.inlier_blocks, "flatness_m": self.flatness_m}
 
 
-@lru_cache(maxsize=8)
+@lru_cache(maxsize=2)
 def floor_grids(camera: CameraModel, pose: CameraPose) -> tuple[np.ndarray, ...]:
     """Per pixel: the ray's plane-frame z per unit depth, and the x, y where it meets z = 0 (m);
-    cached per camera and pose.
+    cached for the last two cameras and poses (a fixed camera pays once; three float64 grids
+    are 7 MB at 640 x 480).
     """
     gz = camera.ray_grid(pose, 2)
     if not np.all(gz < 0):
@@ -74,7 +75,7 @@ def floor_grids(camera: CameraModel, pose: CameraPose) -> tuple[np.ndarray, ...]
     return gz, t[0] + floor * camera.ray_grid(pose, 0), t[1] + floor * camera.ray_grid(pose, 1)
 
 
-@lru_cache(maxsize=8)
+@lru_cache(maxsize=2)
 def _block_centres(camera: CameraModel, pose: CameraPose) -> tuple[np.ndarray, np.ndarray]:
     """Plane-frame x, y (m) of each block's mean floor point; cached per camera and pose."""
     _, fx, fy = floor_grids(camera, pose)

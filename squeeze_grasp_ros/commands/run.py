@@ -6,10 +6,13 @@ time.
 from __future__ import annotations
 
 import argparse
+import errno
 import json
+import os
 import re
 import signal
 import sys
+import tempfile
 from pathlib import Path
 
 from squeeze_grasp_ros.exit_codes import ExitCode, raise_on_signals
@@ -151,10 +154,6 @@ def prepare_recording(folder: str) -> tuple[str, ExitCode] | None:
     Before, ``--record /proc/x`` and a read-only folder ended in tracebacks, and a disk with
     less than 256 kB free in a BagError traceback with a 0-byte ``.space_reserve`` left.
     """
-    import errno
-    import os
-    import tempfile
-
     from squeeze_grasp_ros.ros.recording.bag import RESERVE_BYTES, SPACE_ERRORS
 
     path = Path(folder)

@@ -27,9 +27,9 @@ options and node parameters are in :mod:`.options`, the action client in
 Isolation: a run's own nodes (its planner, the pipeline nodes, its client) live in a namespace
 of their own (:func:`run_namespace`), and ``/clock`` is remapped into it, so every topic,
 service and action of the run carries the run's identity in its name and two runs on one ROS
-domain never see each other's traffic. The run watches its namespace (:meth:`PipelineRunner.
-check_graph`): a node it did not start, a second node of one of its names, or a publisher from
-outside on one of its topics ends the run with :class:`RunError` (exit 4), never a success.
+domain never see each other's traffic. The run watches its topics (:meth:`PipelineRunner.
+check_graph`): a publisher it did not start on one of them, or a second node with the name of
+one of its nodes, ends the run with :class:`RunError` (exit 4), never a success.
 """
 
 from __future__ import annotations
@@ -69,6 +69,7 @@ from squeeze_grasp_ros.exit_codes import Interrupted
 from squeeze_grasp_ros.ros.recording.bag import plain_yaml
 from squeeze_grasp_ros.resources import config_dir, share_dir
 from squeeze_grasp_ros.scene import (
+    Scene,
     SceneError,
     finger_devices,
     load_scene,
@@ -137,7 +138,7 @@ def run_namespace() -> str:
     return f"/squeeze_grasp/run_{os.getpid()}_{secrets.token_hex(4)}"
 
 
-def run_topics(scene: Any) -> list[str]:
+def run_topics(scene: Scene) -> list[str]:
     """Every topic of a run of ``scene`` (action topics and handshake included), relative
     (``/clock`` as ``clock``: it is remapped into the run's namespace).
     """

@@ -110,7 +110,7 @@ def _run(args: argparse.Namespace) -> dict | int:
 
     if not (args.timeout > 0 and args.timeout < float("inf")):
         return fail(args, f"--timeout must be > 0 s, got {args.timeout}", ExitCode.USAGE)
-    if args.record:
+    if args.record and not args.attach:  # attach records nothing (the runner says so)
         refused = prepare_recording(args.record)
         if refused is not None:
             return fail(args, refused[0], refused[1])

@@ -26,6 +26,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from squeeze_grasp_ros.mechanics.elastic.fem import principal_strains as voigt_principal
 from squeeze_grasp_ros.mechanics.errors import InvalidInputError
 from squeeze_grasp_ros.mechanics.vocabulary import StrainMeasure
 
@@ -35,13 +36,6 @@ __all__ = ["COMMON_STRAIN_MEASURE", "max_principal_strain", "max_principal_strai
 COMMON_STRAIN_MEASURE = StrainMeasure.BIOT
 """The measure in which fields of different material models are compared like for like (the
 nominal strain: what a length change per reference length means, and frame indifferent)."""
-
-
-def _symmetric_eigenvalues(a: np.ndarray, b: np.ndarray, c: np.ndarray) -> np.ndarray:
-    """Eigenvalues (t, 2), largest first, of the symmetric 2x2 matrices [[a, b], [b, c]]."""
-    mean = 0.5 * (a + c)
-    radius = np.hypot(0.5 * (a - c), b)
-    return np.column_stack([mean + radius, mean - radius])
 
 
 def principal_strains(F: np.ndarray, measure: StrainMeasure | str) -> np.ndarray:
@@ -67,12 +61,13 @@ def principal_strains(F: np.ndarray, measure: StrainMeasure | str) -> np.ndarray
         raise InvalidInputError(f"strain measure must be one of {StrainMeasure.values()}, got "
                                 f"{measure!r}") from None
     H = np.asarray(F, float) - np.eye(2)
+    # engineering (Voigt) components (xx, yy, 2 xy) of sym(H) and of (H + H^T + H^T H) / 2
+    small = np.column_stack([H[:, 0, 0], H[:, 1, 1], H[:, 0, 1] + H[:, 1, 0]])
     if measure == StrainMeasure.SMALL:
-        return _symmetric_eigenvalues(H[:, 0, 0], 0.5 * (H[:, 0, 1] + H[:, 1, 0]), H[:, 1, 1])
+        return voigt_principal(small)
     HtH = np.einsum("tki,tkj->tij", H, H)
-    e = _symmetric_eigenvalues(H[:, 0, 0] + 0.5 * HtH[:, 0, 0],
-                               0.5 * (H[:, 0, 1] + H[:, 1, 0] + HtH[:, 0, 1]),
-                               H[:, 1, 1] + 0.5 * HtH[:, 1, 1])
+    e = voigt_principal(small + np.column_stack([0.5 * HtH[:, 0, 0], 0.5 * HtH[:, 1, 1],
+                                                 HtH[:, 0, 1]]))
     if measure == StrainMeasure.GREEN_LAGRANGE:
         return e
     two_e = np.maximum(2.0 * e, -1.0)  # lambda^2 = 1 + 2 e >= 0; clip round-off below it

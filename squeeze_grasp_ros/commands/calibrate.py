@@ -125,8 +125,7 @@ def summary(result: dict) -> str:
         measure = StrainMeasure(cp["strain_measure"]).label
         lines.append("linear elasticity (same E, nu) stays within 5 % of the neo-Hookean fit up "
                      f"to {100 * cp['linear_within_5_percent_up_to_strain']:.1f} % compressive "
-                     "strain: beyond that, use material.model: neo_hookean (strains: "
-                     f"{measure}, -dl / l)")
+                     f"{measure} strain (-dl / l): beyond that, use material.model: neo_hookean")
     fr = result.get("friction")
     if fr:
         lo, hi = fr["bracket_deg"]

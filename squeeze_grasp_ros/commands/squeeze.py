@@ -325,7 +325,7 @@ def compare_summary(result: dict) -> str:
                      f"{r['force'][Finger.F1]:>12.5g}{r['energy']:>12.5g}"
                      f"{r['contact_half_width'][Finger.F1]:>17.4g}{r['max_strain']:>12.4g} "
                      f"{StrainMeasure(r['strain_measure']).label:<8}"
-                     f"{r['max_principal_strain'][common]:>12.4g}{r['max_von_mises']:>14.5g} "
+                     f"{r['max_principal_strain'][common]:>12.4g}{r['max_von_mises']:>14.4g} "
                      f"{StressMeasure(r['stress_measure']).label:<13}{counts}  "
                      f"{r['seconds']:.2f}")
     for model, d in diff.items():

@@ -38,6 +38,32 @@ COMMON_STRAIN_MEASURE = StrainMeasure.BIOT
 nominal strain: what a length change per reference length means, and frame indifferent)."""
 
 
+def _small(H: np.ndarray) -> np.ndarray:
+    """Principal small strains (t, 2) of displacement gradients H (t, 2, 2)."""
+    return voigt_principal(np.column_stack([H[:, 0, 0], H[:, 1, 1], H[:, 0, 1] + H[:, 1, 0]]))
+
+
+def _green_lagrange(H: np.ndarray) -> np.ndarray:
+    """Principal Green-Lagrange strains (t, 2) of H: of (H + H^T + H^T H) / 2, in engineering
+    (Voigt) components (xx, yy, 2 xy).
+    """
+    HtH = np.einsum("tki,tkj->tij", H, H)
+    return voigt_principal(np.column_stack([H[:, 0, 0] + 0.5 * HtH[:, 0, 0],
+                                            H[:, 1, 1] + 0.5 * HtH[:, 1, 1],
+                                            H[:, 0, 1] + H[:, 1, 0] + HtH[:, 0, 1]]))
+
+
+def _of_stretch(e: np.ndarray, measure: StrainMeasure) -> np.ndarray:
+    """Principal strains in a measure of the stretch from the Green-Lagrange ones ``e``."""
+    if measure == StrainMeasure.GREEN_LAGRANGE:
+        return e
+    two_e = np.maximum(2.0 * e, -1.0)  # lambda^2 = 1 + 2 e >= 0; clip round-off below it
+    if measure == StrainMeasure.BIOT:
+        return two_e / (1.0 + np.sqrt(1.0 + two_e))
+    with np.errstate(divide="ignore"):
+        return 0.5 * np.log1p(two_e)
+
+
 def principal_strains(F: np.ndarray, measure: StrainMeasure | str) -> np.ndarray:
     """Principal strains (t, 2), largest first, of deformation gradients ``F`` (t, 2, 2).
 
@@ -61,29 +87,25 @@ def principal_strains(F: np.ndarray, measure: StrainMeasure | str) -> np.ndarray
         raise InvalidInputError(f"strain measure must be one of {StrainMeasure.values()}, got "
                                 f"{measure!r}") from None
     H = np.asarray(F, float) - np.eye(2)
-    # engineering (Voigt) components (xx, yy, 2 xy) of sym(H) and of (H + H^T + H^T H) / 2
-    small = np.column_stack([H[:, 0, 0], H[:, 1, 1], H[:, 0, 1] + H[:, 1, 0]])
     if measure == StrainMeasure.SMALL:
-        return voigt_principal(small)
-    HtH = np.einsum("tki,tkj->tij", H, H)
-    e = voigt_principal(small + np.column_stack([0.5 * HtH[:, 0, 0], 0.5 * HtH[:, 1, 1],
-                                                 HtH[:, 0, 1]]))
-    if measure == StrainMeasure.GREEN_LAGRANGE:
-        return e
-    two_e = np.maximum(2.0 * e, -1.0)  # lambda^2 = 1 + 2 e >= 0; clip round-off below it
-    if measure == StrainMeasure.BIOT:
-        return two_e / (1.0 + np.sqrt(1.0 + two_e))
-    with np.errstate(divide="ignore"):
-        return 0.5 * np.log1p(two_e)
+        return _small(H)
+    return _of_stretch(_green_lagrange(H), measure)
 
 
-def max_principal_strain(F: np.ndarray, measure: StrainMeasure | str) -> tuple[float, int]:
-    """(largest max(|eps_1|, |eps_2|) over the elements, its element) in ``measure``."""
-    per_element = np.abs(principal_strains(F, measure)).max(axis=1)
+def _largest(eps: np.ndarray) -> tuple[float, int]:
+    per_element = np.abs(eps).max(axis=1)
     k = int(np.argmax(per_element))
     return float(per_element[k]), k
 
 
+def max_principal_strain(F: np.ndarray, measure: StrainMeasure | str) -> tuple[float, int]:
+    """(largest max(|eps_1|, |eps_2|) over the elements, its element) in ``measure``."""
+    return _largest(principal_strains(F, measure))
+
+
 def max_principal_strains(F: np.ndarray) -> dict[StrainMeasure, float]:
     """Largest absolute principal strain of the elements in every measure, by measure."""
-    return {m: max_principal_strain(F, m)[0] for m in StrainMeasure}
+    H = np.asarray(F, float) - np.eye(2)
+    e = _green_lagrange(H)
+    return {m: _largest(_small(H) if m == StrainMeasure.SMALL else _of_stretch(e, m))[0]
+            for m in StrainMeasure}

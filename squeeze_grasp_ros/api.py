@@ -20,6 +20,14 @@ A F2 0.0113
 >>> print(result.termination, f"{result.relative_depth:.2f}")
 depth_reached 0.12
 
+Every strain and stress names its measure (the model's own; the peak in every measure too):
+
+>>> h = result.health
+>>> print(f"{h.max_strain:.4f}", h.strain_measure, f"{h.max_von_mises:.0f} Pa", h.stress_measure)
+0.2644 small 12923 Pa small_strain
+>>> print({str(m): round(v, 4) for m, v in h.max_principal_strain.items()})
+{'small': 0.2644, 'biot': 0.2615, 'log': 0.3031, 'green_lagrange': 0.2273}
+
 The same from its parts: the mesh, the fingers' initial contact nodes, the squeeze:
 
 >>> mesh = build_mesh(scene)
@@ -55,7 +63,8 @@ from squeeze_grasp_ros.mechanics.squeeze.graspmap import GraspMap, grasp_map
 from squeeze_grasp_ros.mechanics.squeeze.stable_pure import Squeeze, plan_squeeze
 from squeeze_grasp_ros.mechanics.vocabulary import (ContactMode, EventType, Finger,
                                                     MaterialModel, SqueezeKind,
-                                                    StrainCriterion, Termination)
+                                                    StrainCriterion, StrainMeasure,
+                                                    StressMeasure, Termination)
 from squeeze_grasp_ros.resources import scene_file
 from squeeze_grasp_ros.scene import Scene, build_mesh, finger_nodes, load_scene, scene_solid
 from squeeze_grasp_ros.scene_events import event_squeeze_scene
@@ -76,7 +85,7 @@ __all__ = [
     "match_similarity", "CompressionCurve", "fit_compression",
     # vocabulary
     "Finger", "EventType", "ContactMode", "Termination", "SqueezeKind", "StrainCriterion",
-    "MaterialModel",
+    "MaterialModel", "StrainMeasure", "StressMeasure",
     # errors
     "SqueezeGraspError", "InvalidInputError", "InfeasibleError", "NumericalError",
     "InternalError",

@@ -309,8 +309,6 @@ class EventSqueeze:
     diagnostics : dict
     force_curve : dict
         Finger -> ((relative depth, force along its motion N), ...) at every accepted point.
-    dissipation : dict
-        Finger -> energy dissipated by friction at its sliding contacts, J.
     material_model : MaterialModel
         Constitutive model of the object.
     strain_limit : float or None

@@ -60,6 +60,9 @@ setup(
         "ros": ROS_WHEELS + ["mcap>=1.1"],
         # squeeze-grasp sweep: Dask distributed runs the tasks, pyarrow writes the Parquet dataset
         "sweep": ["dask[distributed]>=2024.1", "pyarrow>=14"],
+        # supernodal Cholesky of the interior tangent (SuiteSparse CHOLMOD through cvxopt,
+        # GPL-3.0): about 5x faster factorisations of large nonlinear objects than QDLDL
+        "cholmod": ["cvxopt>=1.3"],
         "test": [
             "pytest>=7",
             "hypothesis>=6",
@@ -70,6 +73,8 @@ setup(
             "colcon-common-extensions>=0.3",
             # the linter test (test/test_lint.py): flake8 and pep257 checks in one tool
             "ruff>=0.5",
+            # both factorisers of the interior tangent are tested (test/test_tangent_factor.py)
+            "cvxopt>=1.3",
         ],
     },
     zip_safe=True,

@@ -16,8 +16,8 @@ from __future__ import annotations
 
 from enum import Enum
 
-__all__ = ["ContactMode", "EventType", "Finger", "MaterialModel", "SQUEEZING_FINGERS",
-           "SqueezeKind", "StrainCriterion", "Termination"]
+__all__ = ["ContactMode", "EventType", "Factorizer", "Finger", "MaterialModel",
+           "SQUEEZING_FINGERS", "SqueezeKind", "StrainCriterion", "Termination"]
 
 
 class _Name(str, Enum):
@@ -106,3 +106,12 @@ class MaterialModel(_Name):
     """Linear stress in the element's rotated frame: exact under rigid rotation."""
     NEO_HOOKEAN = "neo_hookean"
     """Compressible neo-Hookean hyperelasticity in exact plane stress."""
+
+
+class Factorizer(_Name):
+    """Sparse factorisation of the interior tangent of the large-deformation models."""
+
+    CHOLMOD = "cholmod"
+    """Supernodal Cholesky LL^T (SuiteSparse CHOLMOD through cvxopt: the ``cholmod`` extra)."""
+    QDLDL = "qdldl"
+    """LDL^T without pivoting (QDLDL); also takes the tangents that are not positive definite."""

@@ -75,12 +75,15 @@ class Assembly:
         d force / d u, dimensionless, symmetric (None if not assembled).
     min_det : float
         Smallest det F (in-plane) over the elements.
+    deformation : (t, 2, 2) ndarray
+        The deformation gradients F it was assembled from.
     """
 
     energy: float
     force: np.ndarray
     tangent: sp.csr_matrix | None
     min_det: float
+    deformation: np.ndarray
 
 
 def _shape_gradients(nodes: np.ndarray, triangles: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -253,7 +256,7 @@ def stress_and_tangent(model: MaterialModel | str, F: np.ndarray, *, nu: float,
 
 def assemble(model: MaterialModel | str, nodes: np.ndarray, triangles: np.ndarray,
              u: np.ndarray, *, nu: float, geometry: MeshGeometry | None = None,
-             tangent: bool = True) -> Assembly:
+             tangent: bool = True, deformation: np.ndarray | None = None) -> Assembly:
     """Energy, internal forces and tangent stiffness of the displacement ``u`` (2n,), m.
 
     Parameters
@@ -274,6 +277,9 @@ def assemble(model: MaterialModel | str, nodes: np.ndarray, triangles: np.ndarra
     tangent : bool
         Assemble the tangent stiffness too (False: energy and forces only, about half the
         work; ``Assembly.tangent`` is None).
+    deformation : (t, 2, 2) ndarray, optional
+        F of ``u`` (:meth:`MeshGeometry.deformation`) when the caller has it already, as after
+        testing a state for inverted elements (computed here otherwise).
 
     Raises
     ------
@@ -281,7 +287,7 @@ def assemble(model: MaterialModel | str, nodes: np.ndarray, triangles: np.ndarra
         If an element has det F <= 0.
     """
     geometry = mesh_geometry(nodes, triangles) if geometry is None else geometry
-    F = _deformation(geometry.gradient, u)
+    F = geometry.deformation(u) if deformation is None else deformation
     det = F[:, 0, 0] * F[:, 1, 1] - F[:, 0, 1] * F[:, 1, 0]
     worst = int(np.argmin(det))
     if not det[worst] > 0:
@@ -298,7 +304,7 @@ def assemble(model: MaterialModel | str, nodes: np.ndarray, triangles: np.ndarra
         ke = 0.5 * (ke + np.swapaxes(ke, 1, 2))
         data = np.bincount(geometry.slots, weights=ke.ravel(), minlength=len(geometry.indices))
         K = sp.csr_matrix((data, geometry.indices, geometry.indptr), shape=(n2, n2))
-    return Assembly(float(np.dot(W, area)), force, K, float(det[worst]))
+    return Assembly(float(np.dot(W, area)), force, K, float(det[worst]), F)
 
 
 @dataclass(frozen=True)
@@ -318,6 +324,10 @@ class MeshGeometry:
     slots: np.ndarray
     indices: np.ndarray
     indptr: np.ndarray
+
+    def deformation(self, u: np.ndarray) -> np.ndarray:
+        """Deformation gradients F = I + grad u (t, 2, 2) of the displacement ``u`` (2n,)."""
+        return _deformation(self.gradient, u)
 
 
 def mesh_geometry(nodes: np.ndarray, triangles: np.ndarray) -> MeshGeometry:

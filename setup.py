@@ -61,8 +61,9 @@ setup(
         # squeeze-grasp sweep: Dask distributed runs the tasks, pyarrow writes the Parquet dataset
         "sweep": ["dask[distributed]>=2024.1", "pyarrow>=14"],
         # supernodal Cholesky of the interior tangent (SuiteSparse CHOLMOD through cvxopt,
-        # GPL-3.0): about 5x faster factorisations of large nonlinear objects than QDLDL
-        "cholmod": ["cvxopt>=1.3"],
+        # GPL-3.0): about 5x faster factorisations of large nonlinear objects than QDLDL, in
+        # METIS's nested-dissection order (pymetis, MIT)
+        "cholmod": ["cvxopt>=1.3", "pymetis>=2023.1"],
         "test": [
             "pytest>=7",
             "hypothesis>=6",
@@ -75,6 +76,7 @@ setup(
             "ruff>=0.5",
             # both factorisers of the interior tangent are tested (test/test_tangent_factor.py)
             "cvxopt>=1.3",
+            "pymetis>=2023.1",
         ],
     },
     zip_safe=True,

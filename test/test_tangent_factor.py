@@ -141,3 +141,15 @@ def test_the_cholmod_factoriser_without_cvxopt_names_the_install_line(monkeypatc
         with factorizer("cholmod"):
             pass
     assert interior.default_factorizer() == Factorizer.QDLDL
+
+
+def test_the_nested_dissection_order_keeps_a_node_s_dofs_together(stressed):
+    """METIS's order of the tangent's DOFs is a permutation in which x and y of each node
+    follow each other, and it is the same on every call (METIS's seed is fixed).
+    """
+    pytest.importorskip("pymetis", reason="pip install '.[cholmod]'")
+    K, _ = stressed
+    order = interior.nested_dissection(K)
+    assert sorted(order.tolist()) == list(range(K.shape[0]))
+    assert np.array_equal(order[1::2], order[0::2] + 1) and not (order[0::2] % 2).any()
+    assert np.array_equal(order, interior.nested_dissection(K))

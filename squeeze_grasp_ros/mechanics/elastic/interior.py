@@ -9,10 +9,11 @@ so that one pattern, ordering and symbolic analysis serve every contact set of a
 factorisers (:class:`~squeeze_grasp_ros.mechanics.vocabulary.Factorizer`):
 
 - ``cholmod``: the supernodal Cholesky factorisation LL^T of SuiteSparse CHOLMOD (through
-  cvxopt, the ``cholmod`` extra), with its approximate-minimum-degree order: dense BLAS kernels
-  on the supernodes, about 5x faster than QDLDL on an 8,000-node object, where the
-  factorisation is most of an evaluation's cost. It needs K_ff positive definite (every stable
-  state); a tangent it refuses is factorised by QDLDL.
+  cvxopt, the ``cholmod`` extra), in METIS's nested-dissection order (pymetis, same extra;
+  CHOLMOD's approximate minimum degree without it): dense BLAS kernels on the supernodes,
+  about 5x faster than QDLDL on an 8,000-node object, where the factorisation is most of an
+  evaluation's cost. It needs K_ff positive definite (every stable state); a tangent it
+  refuses is factorised by QDLDL.
 - ``qdldl``: LDL^T without pivoting by QDLDL, with its own AMD order; needs only nonzero pivots.
   The default when cvxopt is not installed.
 
@@ -42,7 +43,7 @@ from squeeze_grasp_ros.extras import install_hint, installed
 from squeeze_grasp_ros.mechanics.vocabulary import Factorizer
 
 __all__ = ["ContactStiffness", "Fill", "InteriorBlocks", "TangentFactor", "default_factorizer",
-           "factorizer"]
+           "factorizer", "nested_dissection"]
 
 _FACTORIZER: list[Factorizer | None] = [None]
 
@@ -94,6 +95,34 @@ def _values(block: sp.csc_matrix, at: np.ndarray, K: sp.csr_matrix) -> sp.csc_ma
     out = block.copy()
     out.data = K.data[at]
     return out
+
+
+def nested_dissection(pattern: sp.spmatrix) -> np.ndarray | None:
+    """METIS's nested-dissection order of the DOFs of a tangent with the sparsity ``pattern``
+    (two DOFs per node, x and y, kept together: the order is that of the node graph), as the
+    permutation p of P K P^T = K[p][:, p]; None if pymetis is not installed.
+
+    On the foam square's interior tangent it needs 19 % (8,038 nodes) and 33 % (20,054) fewer
+    flops than approximate minimum degree, and 7-10 % fewer entries of L.
+
+    >>> import scipy.sparse as sp
+    >>> order = nested_dissection(sp.eye(6, k=2) + sp.eye(6) + sp.eye(6, k=-2))
+    >>> order is None or sorted(order.tolist()) == list(range(6))
+    True
+    """
+    if not installed("pymetis"):
+        return None
+    import pymetis
+
+    structure = sp.csr_matrix(pattern, dtype=bool).astype(np.int8)
+    nodes = sp.csr_matrix((structure + structure.T)[0::2][:, 0::2])
+    nodes.setdiag(0)
+    nodes.eliminate_zeros()
+    if nodes.nnz == 0:
+        return np.arange(pattern.shape[0])
+    perm, _ = pymetis.nested_dissection(pymetis.CSRAdjacency(nodes.indptr, nodes.indices))
+    perm = np.asarray(perm, dtype=np.int64)
+    return np.stack([2 * perm, 2 * perm + 1], 1).reshape(-1)
 
 
 @dataclass(frozen=True)
@@ -178,6 +207,21 @@ class TangentFactor:
         self._upper.data = data
         return self._upper
 
+    def _symbolic(self, upper: sp.csc_matrix) -> tuple:
+        """(cvxopt matrix of the pattern of ``upper``, CHOLMOD's symbolic factorisation of it
+        in the nested-dissection order of :func:`nested_dissection`, or CHOLMOD's AMD order
+        without pymetis).
+        """
+        import cvxopt
+        from cvxopt import cholmod
+
+        matrix = cvxopt.spmatrix(cvxopt.matrix(upper.data), cvxopt.matrix(self._rows),
+                                 cvxopt.matrix(self._cols), upper.shape)
+        order = nested_dissection(upper)
+        if order is None:
+            return matrix, cholmod.symbolic(matrix, uplo="U")
+        return matrix, cholmod.symbolic(matrix, p=cvxopt.matrix(order.tolist(), tc="i"), uplo="U")
+
     def _cholmod(self, upper: sp.csc_matrix) -> Callable[[np.ndarray], np.ndarray] | None:
         """Supernodal LL^T of ``upper`` by CHOLMOD (symbolic analysis once); its solve, or None
         if the matrix is not positive definite.
@@ -186,9 +230,7 @@ class TangentFactor:
         from cvxopt import cholmod
 
         if self._cholesky is None:
-            matrix = cvxopt.spmatrix(cvxopt.matrix(upper.data), cvxopt.matrix(self._rows),
-                                     cvxopt.matrix(self._cols), upper.shape)
-            self._cholesky = (matrix, cholmod.symbolic(matrix, uplo="U"))
+            self._cholesky = self._symbolic(upper)
         matrix, factor = self._cholesky
         matrix.V = cvxopt.matrix(upper.data)
         try:
@@ -246,12 +288,9 @@ class TangentFactor:
         """
         upper = self._held_upper(K, held)
         if self.method == Factorizer.CHOLMOD:
-            import cvxopt
             from cvxopt import cholmod
 
-            matrix = cvxopt.spmatrix(cvxopt.matrix(upper.data), cvxopt.matrix(self._rows),
-                                     cvxopt.matrix(self._cols), upper.shape)
-            factor = cholmod.symbolic(matrix, uplo="U")
+            matrix, factor = self._symbolic(upper)
             cholmod.numeric(matrix, factor)
             L = cholmod.getfactor(factor)
             counts = np.bincount(np.asarray(L.J).reshape(-1), minlength=upper.shape[0])

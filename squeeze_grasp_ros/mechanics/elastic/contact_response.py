@@ -37,7 +37,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from squeeze_grasp_ros.mechanics.elastic.hyperelastic import (MeshGeometry, assemble,
-                                                                mesh_geometry)
+                                                                determinants, mesh_geometry)
 from squeeze_grasp_ros.mechanics.elastic.interior import (ContactStiffness, InteriorBlocks,
                                                           TangentFactor)
 from squeeze_grasp_ros.mechanics.errors import InvalidInputError
@@ -291,8 +291,7 @@ class ContactResponse:
         MIN_AREA_RATIO, else None (an inverted state).
         """
         F = self.geometry.deformation(u)
-        det = F[:, 0, 0] * F[:, 1, 1] - F[:, 0, 1] * F[:, 1, 0]
-        return F if float(det.min()) > MIN_AREA_RATIO else None
+        return F if float(determinants(F).min()) > MIN_AREA_RATIO else None
 
     def _start(self, u: np.ndarray, delta: np.ndarray) -> tuple | None:
         """Newton's first iterate for contact displacements ``delta`` from the state ``u``:

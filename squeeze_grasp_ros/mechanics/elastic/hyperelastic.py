@@ -43,8 +43,8 @@ from squeeze_grasp_ros.mechanics.errors import InvalidInputError, NumericalError
 from squeeze_grasp_ros.mechanics.vocabulary import MaterialModel
 
 __all__ = ["Assembly", "InvertedElementError", "MeshGeometry", "STRAIN_MEASURES", "area_ratios",
-           "assemble", "deformation", "gradient_operator", "mesh_geometry", "principal_strains",
-           "stress_and_tangent"]
+           "assemble", "deformation", "determinants", "gradient_operator", "mesh_geometry",
+           "principal_strains", "stress_and_tangent"]
 
 STRAIN_MEASURES: dict[MaterialModel, str] = {
     MaterialModel.LINEAR: "small strain sym(grad u)",
@@ -153,7 +153,11 @@ def area_ratios(gradient: sp.csr_matrix, u: np.ndarray) -> np.ndarray:
     >>> area_ratios(gradient_operator(X, tri), squash).tolist()
     [-0.5]
     """
-    F = _deformation(gradient, u)
+    return determinants(_deformation(gradient, u))
+
+
+def determinants(F: np.ndarray) -> np.ndarray:
+    """The area ratios det F (t,) of the deformation gradients F (t, 2, 2)."""
     return F[:, 0, 0] * F[:, 1, 1] - F[:, 0, 1] * F[:, 1, 0]
 
 
@@ -229,7 +233,7 @@ def _neo_hookean(F: np.ndarray, nu: float, tangent: bool):
         raise InvalidInputError(f"material.nu must be < 0.5 for the neo_hookean model (its "
                                 f"lambda is infinite at 0.5), got {nu}")
     lam, mu = _lame(nu)
-    J2 = F[:, 0, 0] * F[:, 1, 1] - F[:, 0, 1] * F[:, 1, 0]
+    J2 = determinants(F)
     l3 = _thickness_stretch(J2, lam, mu)
     lnJ = np.log(J2 * l3)
     G = np.empty_like(F)  # F^-T
@@ -307,7 +311,7 @@ def assemble(model: MaterialModel | str, nodes: np.ndarray, triangles: np.ndarra
     """
     geometry = mesh_geometry(nodes, triangles) if geometry is None else geometry
     F = geometry.deformation(u) if deformation is None else deformation
-    det = F[:, 0, 0] * F[:, 1, 1] - F[:, 0, 1] * F[:, 1, 0]
+    det = determinants(F)
     worst = int(np.argmin(det))
     if not det[worst] > 0:
         raise InvertedElementError(f"element {worst} inverted (det F = {det[worst]:.3g})",

@@ -269,11 +269,12 @@ class TangentFactor:
         """
         upper = self._held_upper(K, held)
         self.owner = self.held = self.tangent = self._solve = None
-        solve = self._cholmod(upper) if self.method == Factorizer.CHOLMOD else None
-        if solve is None:
-            self.fallbacks += self.method == Factorizer.CHOLMOD
-            solve = self._qdldl(upper)
-        self._solve = solve
+        solve = None
+        if self.method == Factorizer.CHOLMOD:
+            solve = self._cholmod(upper)
+            if solve is None:
+                self.fallbacks += 1
+        self._solve = self._qdldl(upper) if solve is None else solve
         self.owner, self.held, self.tangent = owner, held, K
 
     def solve(self, b: np.ndarray) -> np.ndarray:

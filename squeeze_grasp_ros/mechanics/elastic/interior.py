@@ -9,10 +9,11 @@ so that one pattern, ordering and symbolic analysis serve every contact set of a
 factorisers (:class:`~squeeze_grasp_ros.mechanics.vocabulary.Factorizer`):
 
 - ``cholmod``: the supernodal Cholesky factorisation LL^T of SuiteSparse CHOLMOD (through
-  cvxopt, the ``cholmod`` extra), in METIS's nested-dissection order (pymetis, same extra;
-  CHOLMOD's approximate minimum degree without it): dense BLAS kernels on the supernodes,
-  about 5x faster than QDLDL on an 8,000-node object, where the factorisation is most of an
-  evaluation's cost. It needs K_ff positive definite (every stable state); a tangent it
+  cvxopt, the ``cholmod`` extra), in METIS's nested-dissection order (pymetis, same extra) or
+  CHOLMOD's approximate minimum degree, whichever fills less (its analysis tries both; AMD
+  on the 2,054-node foam square, METIS on 8,038 nodes and more): dense BLAS kernels on the
+  supernodes, about 5x faster than QDLDL on an 8,000-node object, where the factorisation is
+  most of an evaluation's cost. It needs K_ff positive definite (every stable state); a tangent it
   refuses is factorised by QDLDL.
 - ``qdldl``: LDL^T without pivoting by QDLDL, with its own AMD order; needs only nonzero pivots.
   The default when cvxopt is not installed.
@@ -208,9 +209,9 @@ class TangentFactor:
         return self._upper
 
     def _symbolic(self, upper: sp.csc_matrix) -> tuple:
-        """(cvxopt matrix of the pattern of ``upper``, CHOLMOD's symbolic factorisation of it
-        in the nested-dissection order of :func:`nested_dissection`, or CHOLMOD's AMD order
-        without pymetis).
+        """(cvxopt matrix of the pattern of ``upper``, CHOLMOD's symbolic factorisation of it:
+        in the order of :func:`nested_dissection` or CHOLMOD's AMD order, whichever fills less;
+        AMD without pymetis).
         """
         import cvxopt
         from cvxopt import cholmod

@@ -119,11 +119,10 @@ def nested_dissection(pattern: sp.spmatrix) -> np.ndarray | None:
     nodes = sp.csr_matrix((structure + structure.T)[0::2][:, 0::2])
     nodes.setdiag(0)
     nodes.eliminate_zeros()
-    if nodes.nnz == 0:
-        return np.arange(pattern.shape[0])
     perm, _ = pymetis.nested_dissection(pymetis.CSRAdjacency(nodes.indptr, nodes.indices))
     perm = np.asarray(perm, dtype=np.int64)
-    return np.stack([2 * perm, 2 * perm + 1], 1).reshape(-1)
+    order = np.stack([2 * perm, 2 * perm + 1], 1).reshape(-1)
+    return order[order < pattern.shape[0]]  # an odd size: the last node has x only
 
 
 @dataclass(frozen=True)

@@ -64,6 +64,8 @@ setup(
         # GPL-3.0): about 5x faster factorisations of large nonlinear objects than QDLDL, in
         # METIS's nested-dissection order (pymetis, MIT)
         "cholmod": ["cvxopt>=1.3", "pymetis>=2023.1"],
+        # squeeze-grasp outline: sub-pixel contours (marching squares) of masks and depth images
+        "perception": ["scikit-image>=0.22"],
         "test": [
             "pytest>=7",
             "hypothesis>=6",

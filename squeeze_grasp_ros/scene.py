@@ -541,12 +541,17 @@ def _validate_fingers(scene: Scene) -> None:
         )
 
 
-def _validate_placements(scene: Scene) -> None:
-    """Every placement (fingers, adversary) names exactly one of point, angle_deg, node."""
+def named_placements(scene: Scene) -> list[tuple[str, PlacementSpec]]:
+    """(field, placement) of the fingers, then the adversary: ``("fingers.F1", ...)``."""
     placements = [(f"fingers.{k}", v.placement) for k, v in scene.fingers.items()]
     if scene.adversary is not None:
         placements.append(("adversary", scene.adversary.placement))
-    for where, p in placements:
+    return placements
+
+
+def _validate_placements(scene: Scene) -> None:
+    """Every placement (fingers, adversary) names exactly one of point, angle_deg, node."""
+    for where, p in named_placements(scene):
         given = [k for k in ("point", "angle_deg", "node") if getattr(p, k) is not None]
         if len(given) != 1:
             raise SceneError(
@@ -742,27 +747,36 @@ def scene_material(scene: Scene) -> Material:
 
 def placement_points(scene: Scene) -> list[tuple[float, float]]:
     """The placements given as points (fingers, then the adversary), m."""
-    placements = [f.placement for f in scene.fingers.values()]
-    if scene.adversary is not None:
-        placements.append(scene.adversary.placement)
-    return [p.point for p in placements if p.point is not None]
+    return [p.point for _, p in named_placements(scene) if p.point is not None]
 
 
-def build_mesh(scene: Scene) -> Mesh:
+def _check_reach(points: np.ndarray, placement: PlacementSpec, where: str) -> None:
+    """A placement point must be near the object (:func:`shapes.require_within_reach`)."""
+    if placement.point is not None:
+        try:
+            shapes.require_within_reach(points, placement.point, f"{where}.placement.point")
+        except InvalidInputError as exc:
+            raise SceneError(str(exc)) from None
+
+
+def build_mesh(scene: Scene, *, max_nodes: int = MAX_MESH_NODES) -> Mesh:
     """Triangulate the scene's solid object with its mesh settings.
 
     A placement given as a point becomes a boundary node exactly (its projection on the
-    outline is a kept vertex of the mesh), so the finger touches where the scene says.
+    outline is a kept vertex of the mesh), so the finger touches where the scene says. A mesh
+    that would have more than ``max_nodes`` nodes is refused before meshing.
     """
-    outline = shapes.with_boundary_points(build_outline(scene.object.shape),
-                                          placement_points(scene))
+    outline = build_outline(scene.object.shape)
+    for where, placement in named_placements(scene):
+        _check_reach(outline.points, placement, where)
+    outline = shapes.with_boundary_points(outline, placement_points(scene))
     ms = scene.object.mesh
     if ms.max_area is not None:
         area = ms.max_area
     else:
         area = target_max_area(outline, ms.nodes if ms.nodes is not None else 600)
     try:
-        return generate_mesh(outline, area, min_angle=ms.min_angle)
+        return generate_mesh(outline, area, min_angle=ms.min_angle, max_nodes=max_nodes)
     except InvalidInputError as exc:
         raise SceneError(f"object.mesh: {exc}") from None
 
@@ -806,6 +820,7 @@ def placement_node(
             )
         return int(placement.node)
     if placement.point is not None:
+        _check_reach(pts, placement, where)
         k = np.argmin(np.linalg.norm(pts - np.asarray(placement.point), axis=1))
         return int(loop[k])
     c = mesh.centroid

@@ -34,7 +34,7 @@ from squeeze_grasp_ros.mechanics.elastic.mesh import (
     generate_mesh,
     target_max_area,
 )
-from squeeze_grasp_ros.mechanics.ring.model import RingModel, ring_from_outline
+from squeeze_grasp_ros.mechanics.ring.model import MAX_RING_ELEMENTS, RingModel, ring_from_outline
 from squeeze_grasp_ros.mechanics.vocabulary import SQUEEZING_FINGERS, Finger, MaterialModel
 
 
@@ -129,7 +129,8 @@ class RingSpec:
     """Curved-beam model of a hollow object (Sec. 7): the shape is the middle curve."""
 
     wall_thickness: float = spec("in-plane wall thickness h", "m", lo=0.0, lo_open=True)
-    elements: int = spec("number of beam elements along the middle curve", lo=8, default=200)
+    elements: int = spec("number of beam elements along the middle curve", lo=8,
+                         hi=MAX_RING_ELEMENTS, default=200)
 
 
 @dataclass(frozen=True)

@@ -42,6 +42,23 @@ def add_solver_argument(parser: argparse.ArgumentParser) -> None:
                              "paper's O(n^3) eigendecomposition, for cross-checks)")
 
 
+def int_in(lo: int, hi: int):
+    """Argparse type of an integer in [lo, hi]; the error names the range."""
+
+    def parse(text: str) -> int:
+        try:
+            value = int(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"must be an integer in [{lo}, {hi}], got "
+                                             f"{text[:40]!r}") from None
+        if not lo <= value <= hi:
+            raise argparse.ArgumentTypeError(f"must be in [{lo}, {hi}], got {value}")
+        return value
+
+    parse.__name__ = "integer"
+    return parse
+
+
 def output_file(text: str) -> str:
     """Argparse type of an output file: a path whose folder exists and that is not a folder."""
     path = Path(text)

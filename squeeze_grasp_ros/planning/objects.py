@@ -32,8 +32,6 @@ from squeeze_grasp_ros.planning.errors import ErrorCode, PlannerError, invalid
 
 
 CONTACT_MODELS: tuple[str, ...] = ("point", "segment", "friction")
-MAX_DIRECTIONS = 100_000
-"""Most push directions one resistance sweep may ask for."""
 MAX_BEST_COUNT = 100_000
 """Most placements one grasp map may return as candidates."""
 SOLID_STAGES: tuple[str, ...] = ("mesh", "stiffness", "factorisation", "boundary compliance")

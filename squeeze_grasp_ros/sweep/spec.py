@@ -32,6 +32,7 @@ from squeeze_grasp_ros.scene import (
     read_yaml,
     spec,
 )
+from squeeze_grasp_ros.mechanics.resistance.optimal import MAX_DIRECTIONS
 from squeeze_grasp_ros.mechanics.vocabulary import Finger
 
 
@@ -144,6 +145,7 @@ class SweepAdversarySpec:
     directions: int = spec(
         "push directions over which W*_F per unit push is minimised and maximised",
         lo=1,
+        hi=MAX_DIRECTIONS,
         default=72,
     )
 

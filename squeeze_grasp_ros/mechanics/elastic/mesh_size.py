@@ -261,8 +261,8 @@ def estimate_mesh(outline: Outline, max_area: float, *, max_nodes: int = MAX_MES
 
 def check_mesh_size(estimate: MeshEstimate, max_nodes: int) -> None:
     """Refuse a mesh of more than ``max_nodes`` nodes, or one that thin features would more
-    than double (beyond :data:`THIN_ALLOWANCE` extra nodes): the message names the feature, its width, where it is, the element size and
-    the limit.
+    than double (beyond :data:`THIN_ALLOWANCE` extra nodes): the message names the feature,
+    its width, where it is, the element size and the limit.
     """
     thin = estimate.thinnest
     allowed = max(estimate.area_nodes, THIN_ALLOWANCE)

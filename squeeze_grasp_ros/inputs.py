@@ -17,6 +17,7 @@ InputError: scene: YAML aliases (*name) are not accepted (line 2, column 4)
 from __future__ import annotations
 
 import os
+import stat
 from collections.abc import Iterable
 from pathlib import Path
 from typing import Any
@@ -24,7 +25,7 @@ from typing import Any
 import yaml
 
 __all__ = ["InputError", "MAX_FILE_BYTES", "MAX_TEXT_BYTES", "confine", "load_yaml",
-           "read_text"]
+           "read_bytes", "read_text"]
 
 MAX_FILE_BYTES = 8 * 1024 * 1024
 """Bytes read at most from a scene, spec or outline file (8 MiB)."""
@@ -69,26 +70,51 @@ def load_yaml(text: str, *, what: str, max_bytes: int = MAX_TEXT_BYTES) -> Any:
         raise InputError(f"{what}: invalid YAML") from None
 
 
+def read_bytes(path: str | Path, *, what: str, max_bytes: int = MAX_FILE_BYTES) -> bytes:
+    """The bytes of a regular file, read up to ``max_bytes``.
+
+    The file is opened without blocking and checked on the open descriptor, so a FIFO, a device
+    or a folder is refused at once (a FIFO named like a manifest used to hang the reader in
+    ``open()``), and a sparse file of gigabytes is refused after ``max_bytes + 1`` bytes.
+
+    Raises
+    ------
+    InputError
+        Missing, not a regular file, unreadable or too large.
+    """
+    path = Path(path)
+    try:
+        fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK | getattr(os, "O_CLOEXEC", 0))
+    except FileNotFoundError:
+        raise InputError(f"{what} file not found: {path}") from None
+    except OSError as exc:
+        raise InputError(f"{what} file cannot be read: {path} ({exc.strerror})") from None
+    try:
+        info = os.fstat(fd)
+        if not stat.S_ISREG(info.st_mode):
+            raise InputError(f"{what} path is not a regular file: {path}")
+        if info.st_size > max_bytes:
+            raise InputError(f"{what} file is larger than the {max_bytes}-byte limit: {path}")
+        with os.fdopen(os.dup(fd), "rb") as fh:
+            data = fh.read(max_bytes + 1)
+    except OSError as exc:
+        raise InputError(f"{what} file cannot be read: {path} ({exc.strerror})") from None
+    finally:
+        os.close(fd)
+    if len(data) > max_bytes:
+        raise InputError(f"{what} file is larger than the {max_bytes}-byte limit: {path}")
+    return data
+
+
 def read_text(path: str | Path, *, what: str, max_bytes: int = MAX_FILE_BYTES) -> str:
-    """The UTF-8 text of a regular file, read up to ``max_bytes``.
+    """The UTF-8 text of a regular file, read up to ``max_bytes`` (:func:`read_bytes`).
 
     Raises
     ------
     InputError
         Missing, not a regular file, unreadable, too large or not UTF-8 text.
     """
-    path = Path(path)
-    if not path.exists():
-        raise InputError(f"{what} file not found: {path}")
-    if not path.is_file():
-        raise InputError(f"{what} path is not a regular file: {path}")
-    try:
-        with path.open("rb") as fh:
-            data = fh.read(max_bytes + 1)
-    except OSError as exc:
-        raise InputError(f"{what} file cannot be read: {path} ({exc.strerror})") from None
-    if len(data) > max_bytes:
-        raise InputError(f"{what} file is larger than the {max_bytes}-byte limit: {path}")
+    data = read_bytes(path, what=what, max_bytes=max_bytes)
     try:
         return data.decode("utf-8")
     except UnicodeDecodeError as exc:

@@ -60,6 +60,8 @@ def run(args: argparse.Namespace) -> dict | int:
         raise SweepError("--out DIR is required (or use --dry-run)")
     outcome = run_sweep(loaded, args.out, scheduler=args.scheduler, workers=args.workers,
                         progress=not args.no_progress)
+    for line in outcome.repaired:
+        print(f"squeeze-grasp sweep: {args.out}/{line}", file=sys.stderr)
     result = {"dry_run": False, "out": args.out, "spec_hash": loaded.hash, **vars(outcome)}
     if outcome.interrupted is not None:
         name = signal.Signals(outcome.interrupted).name

@@ -23,7 +23,7 @@ import threading
 import sys
 import time
 import urllib.request
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Callable, Optional
 
@@ -109,7 +109,8 @@ class Progress:
 class Outcome:
     """What a sweep run did: counts of tasks and evaluations; seconds in all, summed over the
     tasks for preparing groups and evaluating, and until the cluster was ready; the signal
-    (SIGINT, SIGTERM) that stopped it, or None.
+    (SIGINT, SIGTERM) that stopped it, or None; one line per bad part found at the start, moved
+    to ``damaged/`` and redone (:attr:`.store.Store.repaired`).
     """
 
     tasks: int
@@ -125,6 +126,7 @@ class Outcome:
     prepare_s: float
     evaluate_s: float
     startup_s: float = 0.0
+    repaired: list = field(default_factory=list)
 
 
 @contextlib.contextmanager
@@ -306,7 +308,7 @@ def run_sweep(loaded: LoadedSpec, out: str | Path, *, scheduler: Optional[str] =
         store = Store(out, loaded, tasks)
         todo = [t for t in tasks if not store.done(t.id)]
         outcome = Outcome(len(tasks), len(tasks) - len(todo), 0, 0, 0, 0, 0.0, 0, None, None,
-                          0.0, 0.0)
+                          0.0, 0.0, repaired=list(store.repaired))
         client = cluster = None
         try:
             if todo and stop.signal is None:

@@ -150,6 +150,37 @@ def _sigint_blocked():
         signal.pthread_sigmask(signal.SIG_SETMASK, old)
 
 
+CONNECT_TIMEOUT_S = 20.0
+"""Seconds a ``--scheduler`` has to accept a connection and answer Dask's handshake."""
+
+
+def probe_scheduler(address: str, timeout: float = CONNECT_TIMEOUT_S) -> None:
+    """Connect to ``address`` and complete Dask's handshake within ``timeout`` seconds, or raise
+    :class:`SweepError` with one line.
+
+    Dask bounds the TCP connect but not the handshake after it, so a port that accepts the
+    connection and never answers in Dask's protocol (the dashboard's HTTP port, a web server)
+    held ``Client()`` for ever; this probe bounds both.
+    """
+    import asyncio
+
+    from distributed.comm import connect
+
+    async def handshake() -> None:
+        comm = await asyncio.wait_for(connect(address, timeout=timeout), timeout)
+        await comm.close()
+
+    try:
+        asyncio.run(handshake())
+    except asyncio.TimeoutError:
+        raise SweepError(
+            f"--scheduler {address}: no Dask scheduler answered within {timeout:g} s (the port "
+            "accepted the connection but did not answer in Dask's protocol: is it the "
+            "dashboard's HTTP port? A scheduler listens on tcp://HOST:8786 by default)") from None
+    except (OSError, ValueError, TypeError) as exc:
+        raise SweepError(f"--scheduler {address}: cannot connect ({exc})") from None
+
+
 def _start(scheduler: Optional[str], workers: Optional[int], stop: "StopSignals"):
     """The client and the local cluster it drives (None with ``scheduler``).
 
@@ -162,7 +193,8 @@ def _start(scheduler: Optional[str], workers: Optional[int], stop: "StopSignals"
     if scheduler is not None:
         try:
             with stop.at_once():
-                return Client(scheduler, timeout="20s"), None
+                probe_scheduler(scheduler)
+                return Client(scheduler, timeout=f"{CONNECT_TIMEOUT_S:g}s"), None
         except (OSError, TimeoutError) as exc:
             raise SweepError(f"--scheduler {scheduler}: cannot connect ({exc})") from None
     n = workers or os.cpu_count() or 1

@@ -68,6 +68,8 @@ def load_yaml(text: str, *, what: str, max_bytes: int = MAX_TEXT_BYTES) -> Any:
         raise InputError(f"{what}: invalid YAML{where}: {exc.problem}") from None
     except yaml.YAMLError:
         raise InputError(f"{what}: invalid YAML") from None
+    except RecursionError:
+        raise InputError(f"{what}: YAML nested too deeply") from None
 
 
 def read_bytes(path: str | Path, *, what: str, max_bytes: int = MAX_FILE_BYTES) -> bytes:

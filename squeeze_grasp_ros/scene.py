@@ -27,7 +27,7 @@ from squeeze_grasp_ros.inputs import InputError, load_yaml, read_text
 from squeeze_grasp_ros.mechanics.elastic import shapes
 from squeeze_grasp_ros.mechanics.elastic.compliance import ElasticObject
 from squeeze_grasp_ros.mechanics.errors import InvalidInputError
-from squeeze_grasp_ros.mechanics.elastic.material import Material
+from squeeze_grasp_ros.mechanics.elastic.material import Material, require_poisson_ratio
 from squeeze_grasp_ros.mechanics.elastic.mesh import (
     MAX_MESH_NODES,
     Mesh,
@@ -116,9 +116,10 @@ class MeshSpec:
 class MaterialSpec:
     """Material of the object (plane stress)."""
 
-    E: float = spec("Young's modulus", "Pa", lo=0.0, lo_open=True)
-    nu: float = spec("Poisson's ratio", "", lo=-1.0, hi=0.5, lo_open=True)
-    thickness: float = spec("out-of-plane thickness h (ring: width w)", "m", lo=0.0, lo_open=True)
+    E: float = spec("Young's modulus (gels to diamond)", "Pa", lo=1e-3, hi=1e13)
+    nu: float = spec("Poisson's ratio (neo_hookean: -0.3 to 0.4999)", "", lo=-0.999, hi=0.5)
+    thickness: float = spec("out-of-plane thickness h (ring: width w)", "m", lo=0.0, hi=1e3,
+                            lo_open=True)
     model: str = spec("constitutive model of a solid (event-driven squeeze): linear (the "
                       "paper's), corotational or neo_hookean (finite deformation)",
                       choices=MaterialModel.values(), default=MaterialModel.LINEAR.value)
@@ -212,7 +213,7 @@ class SqueezeSpec:
 class FrictionSpec:
     """Coulomb friction between fingertips and object."""
 
-    mu: float = spec("friction coefficient", "", lo=0.0)
+    mu: float = spec("friction coefficient", "", lo=0.0, hi=1e3)
 
 
 @dataclass(frozen=True)
@@ -375,8 +376,15 @@ SENSOR_FIELD_EFFECT = {"noise_std": "sensor_noise", "dropout": "sensor_dropout"}
 SENSING_EFFECTS = ("force_sensing", "tactile_sensing")
 
 
+def _number(x: float) -> str:
+    """A bound as messages show it: 0.5, 1e-06, 1e+13 (not 10000000000000.0)."""
+    return repr(x) if x == 0 or 1e-4 <= abs(x) < 1e6 else f"{x:g}"
+
+
 def _describe(meta: dict) -> str:
     lo, hi = meta.get("lo"), meta.get("hi")
+    lo = None if lo is None else _number(lo)
+    hi = None if hi is None else _number(hi)
     if lo is not None and hi is not None:
         return f"in {'(' if meta.get('lo_open') else '['}{lo}, {hi}]"
     if lo is not None:
@@ -479,7 +487,7 @@ def parse_section(cls: type, data: Any, where: str) -> Any:
 
 def _validate_shape(shape: dict) -> None:
     kind = shape.get("type")
-    if kind not in SHAPES:
+    if not isinstance(kind, str) or kind not in SHAPES:
         raise SceneError(f"object.shape.type must be one of {sorted(SHAPES)}, got {kind!r}")
     allowed = set(SHAPES[kind]) | {"type"}
     unknown = sorted(set(shape) - allowed)
@@ -614,9 +622,10 @@ def _validate_object(scene: Scene) -> None:
         Material(obj.material.E, obj.material.nu, obj.material.thickness)
     except InvalidInputError as exc:
         raise SceneError(f"object.{exc}") from None
-    if obj.material.model == MaterialModel.NEO_HOOKEAN and not obj.material.nu < 0.5:
-        raise SceneError(f"object.material.nu must be < 0.5 for the neo_hookean model (its "
-                         f"lambda is infinite at 0.5), got {obj.material.nu}")
+    try:
+        require_poisson_ratio(obj.material.nu, obj.material.model)
+    except InvalidInputError as exc:
+        raise SceneError(f"object.{exc}") from None
 
 
 def _validate(scene: Scene) -> Scene:

@@ -32,6 +32,8 @@ from squeeze_grasp_ros.scene import (
     read_yaml,
     spec,
 )
+from squeeze_grasp_ros.mechanics.elastic.material import require_poisson_ratio
+from squeeze_grasp_ros.mechanics.errors import InvalidInputError
 from squeeze_grasp_ros.mechanics.resistance.optimal import MAX_DIRECTIONS
 from squeeze_grasp_ros.mechanics.vocabulary import Finger
 
@@ -171,7 +173,7 @@ class SweepSpec:
     )
     mesh: Optional[MeshSpec] = spec("mesh settings (default: the base scene's)", default=None)
     friction: Optional[tuple[float, ...]] = spec(
-        "friction coefficients mu", "", lo=0.0, default=None
+        "friction coefficients mu", "", lo=0.0, hi=1e3, default=None
     )
     tip_radius: Optional[tuple[float, ...]] = spec(
         "fingertip radii (both fingers)", "m", lo=0.0, lo_open=True, default=None
@@ -374,8 +376,11 @@ def parse_sweep_spec(data: Any, base_dir: Path) -> LoadedSpec:
                 )
             try:
                 materials[name] = parse_section(MaterialSpec, value, f"materials.{name}")
+                require_poisson_ratio(materials[name].nu, materials[name].model)
             except SceneError as exc:
                 raise SweepError(str(exc)) from None
+            except InvalidInputError as exc:
+                raise SweepError(f"materials.{name}: {exc}") from None
     fingers = base.fingers
     tip = fingers[Finger.F1].tip_radius
     if sw.tip_radius is None and not (tip > 0 and fingers[Finger.F2].tip_radius == tip):

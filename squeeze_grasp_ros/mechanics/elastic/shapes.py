@@ -302,6 +302,16 @@ def _csv_points(text: str, name: str) -> list[list[float]]:
     return pts
 
 
+def _is_coordinate(value) -> bool:
+    """A JSON number that is a finite float (no bool, no integer beyond the float range)."""
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        return False
+    try:
+        return bool(np.isfinite(float(value)))
+    except OverflowError:
+        return False
+
+
 def load_outline(path: str | Path) -> Outline:
     """Read an outline from CSV (``x,y`` per line, m) or JSON (``{"outline": [[x, y], ...]}``).
 
@@ -321,15 +331,18 @@ def load_outline(path: str | Path) -> Outline:
         except json.JSONDecodeError as exc:
             raise InvalidInputError(f"{name}: invalid JSON at line {exc.lineno}, column "
                                  f"{exc.colno}") from None
+        except RecursionError:
+            raise InvalidInputError(f"{name}: JSON nested too deeply") from None
+        except ValueError:  # an integer of more than 4,300 digits
+            raise InvalidInputError(f"{name}: JSON holds a number too long to read") from None
         if not isinstance(data, dict) or "outline" not in data:
             raise InvalidInputError(f'{name}: JSON outline must be {{"outline": [[x, y], ...]}}')
         pts = data["outline"]
         if not isinstance(pts, list) or len(pts) > MAX_OUTLINE_POINTS or not all(
-                isinstance(q, list) and len(q) == 2
-                and all(isinstance(c, (int, float)) and not isinstance(c, bool) for c in q)
+                isinstance(q, list) and len(q) == 2 and all(map(_is_coordinate, q))
                 for q in pts):
             raise InvalidInputError(f"{name}: 'outline' must be a list of at most "
-                                 f"{MAX_OUTLINE_POINTS} [x, y] number pairs")
+                                 f"{MAX_OUTLINE_POINTS} [x, y] pairs of finite numbers (m)")
     else:
         pts = _csv_points(text, name)
     p = validate_polyline(pts, name)

@@ -117,7 +117,7 @@ class MaterialSpec:
     """Material of the object (plane stress)."""
 
     E: float = spec("Young's modulus (gels to diamond)", "Pa", lo=1e-3, hi=1e13)
-    nu: float = spec("Poisson's ratio (neo_hookean: -0.3 to 0.4999)", "", lo=-0.999, hi=0.5)
+    nu: float = spec("Poisson's ratio (neo_hookean: -0.3 to 0.4999)", "", lo=-0.9, hi=0.5)
     thickness: float = spec("out-of-plane thickness h (ring: width w)", "m", lo=0.0, hi=1e3,
                             lo_open=True)
     model: str = spec("constitutive model of a solid (event-driven squeeze): linear (the "

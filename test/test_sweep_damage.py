@@ -20,6 +20,7 @@ from pathlib import Path
 import pytest
 import yaml
 
+from output_support import CLI, private_mount
 from squeeze_grasp_ros.cli import main
 
 pa = pytest.importorskip("pyarrow", reason="pip install -e '.[sweep]'")
@@ -220,21 +221,6 @@ def test_the_report_of_a_folder_without_parts_and_plots_into_a_file(sweep, capfd
     assert "exists and is not a folder" in capfd.readouterr().err
 
 
-def private_mount(target: Path, options: str, command: list[str],
-                  timeout: float = 300) -> subprocess.CompletedProcess:
-    """Run ``command`` with a tmpfs mounted at ``target`` in a private mount namespace."""
-    if shutil.which("unshare") is None or subprocess.run(
-            ["unshare", "-m", "true"], capture_output=True).returncode != 0:
-        pytest.skip("needs `unshare -m` (a private mount namespace) for a real full or "
-                    "read-only file system")
-    target.mkdir(exist_ok=True)
-    script = (f"mount -t tmpfs -o {options} tmpfs '{target}' && exec "
-              + " ".join(f"'{a}'" for a in command))
-    return subprocess.run(["unshare", "-m", "sh", "-c", script], capture_output=True,
-                          text=True, timeout=timeout)
-
-
-CLI = [sys.executable, "-m", "squeeze_grasp_ros.cli"]
 
 
 def test_read_only_folders_are_refused_in_one_line_before_any_work(sweep):

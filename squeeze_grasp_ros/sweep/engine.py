@@ -151,12 +151,16 @@ def _sigint_blocked():
 
 
 CONNECT_TIMEOUT_S = 20.0
-"""Seconds a ``--scheduler`` has to accept a connection and answer Dask's handshake."""
+"""Seconds a ``--scheduler`` has to accept a TCP connection (Dask retries within them)."""
+ANSWER_TIMEOUT_S = 10.0
+"""Seconds more it has to answer Dask's handshake once connected."""
 
 
-def probe_scheduler(address: str, timeout: float = CONNECT_TIMEOUT_S) -> None:
-    """Connect to ``address`` and complete Dask's handshake within ``timeout`` seconds, or raise
-    :class:`SweepError` with one line.
+def probe_scheduler(address: str, connect_timeout: float = CONNECT_TIMEOUT_S,
+                    answer_timeout: float = ANSWER_TIMEOUT_S) -> None:
+    """Connect to ``address`` and complete Dask's handshake, or raise :class:`SweepError`
+    with one line: "cannot connect" after ``connect_timeout`` seconds, "no Dask scheduler
+    answered" after ``answer_timeout`` more.
 
     Dask bounds the TCP connect but not the handshake after it, so a port that accepts the
     connection and never answers in Dask's protocol (the dashboard's HTTP port, a web server)
@@ -166,15 +170,17 @@ def probe_scheduler(address: str, timeout: float = CONNECT_TIMEOUT_S) -> None:
 
     from distributed.comm import connect
 
+    total = connect_timeout + answer_timeout
+
     async def handshake() -> None:
-        comm = await asyncio.wait_for(connect(address, timeout=timeout), timeout)
+        comm = await asyncio.wait_for(connect(address, timeout=connect_timeout), total)
         await comm.close()
 
     try:
         asyncio.run(handshake())
     except asyncio.TimeoutError:
         raise SweepError(
-            f"--scheduler {address}: no Dask scheduler answered within {timeout:g} s (the port "
+            f"--scheduler {address}: no Dask scheduler answered within {total:g} s (the port "
             "accepted the connection but did not answer in Dask's protocol: is it the "
             "dashboard's HTTP port? A scheduler listens on tcp://HOST:8786 by default)") from None
     except (OSError, ValueError, TypeError) as exc:

@@ -290,10 +290,13 @@ def start_cluster(tmp_path: Path, workers: int = 2):
         )
     ]
     deadline = time.monotonic() + 60
-    while not file.exists():
-        assert time.monotonic() < deadline, "scheduler did not start"
-        time.sleep(0.1)
-    address = json.loads(file.read_text())["address"]
+    while True:  # Dask creates the file before it writes it
+        try:
+            address = json.loads(file.read_text())["address"]
+            break
+        except (OSError, ValueError, KeyError):
+            assert time.monotonic() < deadline, "scheduler did not start"
+            time.sleep(0.1)
     for _ in range(workers):
         procs.append(
             subprocess.Popen(

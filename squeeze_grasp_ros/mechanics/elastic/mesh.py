@@ -23,7 +23,7 @@ from squeeze_grasp_ros.mechanics.elastic.mesh_size import (
     check_mesh_size,
     estimate_mesh,
 )
-from squeeze_grasp_ros.mechanics.elastic.shapes import Outline, signed_area
+from squeeze_grasp_ros.mechanics.elastic.shapes import Outline, interior_point, signed_area
 
 
 class Mesher(Protocol):
@@ -232,7 +232,7 @@ def generate_mesh(
         k = np.arange(len(loop)) + offset
         segments.append(np.column_stack([k, np.roll(k, -1)]))
         offset += len(loop)
-    holes = np.array([h.mean(axis=0) for h in outline.holes]).reshape(-1, 2)
+    holes = np.array([interior_point(h) for h in outline.holes]).reshape(-1, 2)
     nodes, tris = (mesher or TriangleMesher()).triangulate(
         vertices, np.concatenate(segments), holes, max_area, min_angle, max_nodes
     )

@@ -42,10 +42,12 @@ MAX_MESH_NODES = 250_000
 """Largest mesh the mesher is asked for (interior and thin-feature nodes together); beyond it a
 solve takes minutes and gigabytes, so the request is refused before meshing."""
 
-MAX_BOUNDARY_NODES = 5_000
+MAX_BOUNDARY_NODES = 3_000
 """Most outer and hole boundary nodes of a mesh. The boundary compliance is a dense
 (2b x 2b) matrix computed from the factorisation; measured on this project's 2-core machine, an
-all-boundary strip took 17 s and 1.1 GB at b = 2,082 and 33 s and 2.1 GB at b = 2,946."""
+all-boundary strip took 17 s and 1.1 GB at b = 2,082 and 33 s and 2.1 GB at b = 2,946. Meshes
+of ordinary shapes stay far below at the node limit (a disk of 250,000 nodes has about 1,300
+boundary nodes, a 10:1 rectangle about 2,600)."""
 
 NODES_PER_AREA = 0.8
 """Mesh nodes per ``max_area`` of object area that Triangle gives with a 30 degree minimum
@@ -54,6 +56,12 @@ angle (the inverse of :func:`~squeeze_grasp_ros.mechanics.elastic.mesh.target_ma
 THIN_ALLOWANCE = 1_000
 """Extra nodes thin features may always add, whatever the mesh asked for (a coarse mesh of a
 polygon with a sliver or a sharp notch); beyond it they may at most double the mesh."""
+
+NEAREST = 32
+"""Boundary vertices near each vertex whose edges are measured against it: the work is bounded
+by vertices x NEAREST (own neighbours are a few, the far side of a thin feature is among the
+nearest), not by the pairs within an element size, which a boundary folded many times within
+one element makes quadratic."""
 
 NEIGHBOURHOOD = 2.0
 """Boundary within this many element sizes along the same loop is a vertex's own neighbourhood,
@@ -152,7 +160,8 @@ def thin_features(loops: list[np.ndarray], spacing: float) -> tuple[float, Optio
 
     ``loops`` are closed polylines (outer boundary first) whose edges are at most 1.5 spacing
     long, as :func:`~squeeze_grasp_ros.mechanics.elastic.shapes.resample` gives. See the module
-    docstring for the measure.
+    docstring for the measure; each vertex is measured against the edges at its
+    :data:`NEAREST` nearest vertices within reach.
     """
     sizes = [len(loop) for loop in loops]
     pts = np.concatenate(loops)
@@ -167,11 +176,14 @@ def thin_features(loops: list[np.ndarray], spacing: float) -> tuple[float, Optio
                           for s, n in zip(np.cumsum([0] + sizes[:-1]), sizes)])
     perimeter = np.repeat([seg_len[loop_of == k].sum() for k in range(len(loops))], sizes)
     radius = spacing + 0.5 * float(seg_len.max())
-    pairs = cKDTree(pts).query_pairs(radius, output_type="ndarray")
-    if len(pairs) == 0:
+    k = min(NEAREST, len(pts))
+    _, near = cKDTree(pts).query(pts, k=k, distance_upper_bound=radius)
+    i = np.repeat(np.arange(len(pts)), k)
+    j = near.ravel()
+    keep = (j < len(pts)) & (j != i)
+    if not np.any(keep):
         return 0.0, None
-    i = np.concatenate([pairs[:, 0], pairs[:, 0], pairs[:, 1], pairs[:, 1]])
-    j = np.concatenate([pairs[:, 1], prev[pairs[:, 1]], pairs[:, 0], prev[pairs[:, 0]]])
+    i, j = np.concatenate([i[keep], i[keep]]), np.concatenate([j[keep], prev[j[keep]]])
     dist, t = _point_segment(pts[i], pts[j], pts[nxt[j]])
     same = loop_of[i] == loop_of[j]
     along = np.abs(arc[i] - (arc[j] + t * seg_len[j]))

@@ -15,10 +15,10 @@ vertex's share ds of the boundary needs about ds (1/width - 1/h) extra nodes; th
 strip or a narrow gap between a hole and the outer edge adds thousands to millions.
 
 >>> from squeeze_grasp_ros.mechanics.elastic import shapes
->>> strip = shapes.rectangle(0.1, 1e-5)
->>> estimate = estimate_mesh(strip, 1.6e-9)
+>>> strip = shapes.rectangle(0.1, 3e-5)
+>>> estimate = estimate_mesh(strip, 4.8e-9)
 >>> print(f"{estimate.thinnest.width:.1e} m thin, about {estimate.thin_nodes:.1e} extra nodes")
-1.0e-05 m thin, about 1.7e+04 extra nodes
+3.0e-05 m thin, about 4.8e+03 extra nodes
 >>> estimate_mesh(shapes.rectangle(0.1, 0.05), 1e-5).thinnest is None
 True
 """

@@ -68,6 +68,11 @@ from squeeze_grasp_ros.mechanics.elastic.shapes import (
     resampled_count,
     signed_area,
 )
+from squeeze_grasp_ros.mechanics.vocabulary import StrainMeasure
+
+FIBRE_STRAIN_MEASURE = StrainMeasure.SMALL
+"""The measure of the ring's fibre strains |eps| + h/2 |zeta| and of its strain limit: the
+curved beam is linear (small strain)."""
 
 BANDWIDTH = 5
 """Upper bandwidth of the clamped stiffness (two nodes of three DOFs per element)."""

@@ -9,6 +9,7 @@ from typing import Sequence
 import numpy as np
 
 from squeeze_grasp_ros.mechanics.elastic.mesh import Mesh
+from squeeze_grasp_ros.outputs import write_atomically
 
 
 def figure(ncols: int = 1, nrows: int = 1, size: float = 4.2):
@@ -23,12 +24,16 @@ def figure(ncols: int = 1, nrows: int = 1, size: float = 4.2):
 
 
 def save(fig, path: str | Path) -> str:
-    """Write ``fig`` to ``path`` (PNG, 150 dpi), close it and return the path."""
+    """Write ``fig`` to ``path`` (PNG, 150 dpi, replaced atomically), close it and return the
+    path; a failed write raises :func:`~squeeze_grasp_ros.outputs.output_error`.
+    """
     import matplotlib.pyplot as plt
 
     fig.tight_layout()
-    fig.savefig(path, dpi=150)
-    plt.close(fig)
+    try:
+        write_atomically(path, lambda tmp: fig.savefig(tmp, dpi=150, format="png"), "plot")
+    finally:
+        plt.close(fig)
     return str(path)
 
 

@@ -260,17 +260,29 @@ def test_a_frictional_resistance_whose_client_leaves_stops_inside_its_squeeze(pl
 
 
 def test_a_load_whose_dense_blocks_exceed_the_memory_bound_is_refused_before_factoring(
-        planner):
+        ros_context):
     """Before: a thin rectangle (height 1e-5 m, every node on the boundary) grew the planner
-    by gigabytes inside SuperLU for minutes and could not be stopped. Its dense boundary blocks
-    are now sized right after meshing and the load is refused before the factorisation.
+    by gigabytes inside SuperLU for minutes and could not be stopped. The mesher now refuses
+    that one before meshing; what it allows is sized right after meshing against the planner's
+    memory bound, before the factorisation: here a 1 mm strip of 2,000 nodes (664 on the
+    boundary; measured: its load peaks at 173 MB and the object holds 86 MB) against a bound
+    of 64 MiB. The refusal is the budget's, not the cache's after the work.
     """
+    from rclpy.parameter import Parameter
+
     data = yaml.safe_load(BLOB)
-    data["object"]["shape"] = {"type": "rectangle", "width": 0.1, "height": 1e-5}
-    del data["object"]["mesh"]
-    response = planner.call(LoadObject, "load_object", LoadObject.Request(
-        scene_yaml=yaml.safe_dump(data), object_id="thin"))
-    assert response.error_code == ErrorCode.INVALID_ARGUMENT, response.message
-    assert "MiB for its dense" in response.message and "cache_max_megabytes" in response.message
-    assert "2 rows per boundary node" in response.message
-    assert planner.planner.cache.ids() == []
+    data["object"]["shape"] = {"type": "rectangle", "width": 0.1, "height": 1e-3}
+    data["object"]["mesh"] = {"nodes": 2000}
+    harness = Harness(ros_context,
+                      parameter_overrides=[Parameter("cache_max_megabytes", value=64)])
+    try:
+        response = harness.call(LoadObject, "load_object", LoadObject.Request(
+            scene_yaml=yaml.safe_dump(data), object_id="strip"))
+        assert response.error_code == ErrorCode.INVALID_ARGUMENT, response.message
+        assert "MiB for its dense" in response.message and "2 rows per boundary node" in \
+            response.message and "cache_max_megabytes" in response.message
+        assert harness.planner.cache.ids() == []
+        data["object"]["mesh"] = {"nodes": 300}  # 64 MiB is plenty for a coarser strip
+        assert harness.load(yaml.safe_dump(data), "strip").success
+    finally:
+        harness.close()

@@ -35,8 +35,6 @@ from squeeze_grasp_ros.planning.object_ids import (check_digest, check_object_id
 
 
 CONTACT_MODELS: tuple[str, ...] = ("point", "segment", "friction")
-MAX_DIRECTIONS = 100_000
-"""Most push directions one resistance sweep may ask for."""
 MAX_BEST_COUNT = 100_000
 """Most placements one grasp map may return as candidates."""
 SOLID_STAGES: tuple[str, ...] = ("mesh", "stiffness", "factorisation", "boundary compliance")
@@ -320,8 +318,8 @@ def load_object(
         nodes = finger_nodes(scene, body)
     else:
         progress(SOLID_STAGES[0], 0, len(SOLID_STAGES), 0)
-        mesh = build_mesh(scene)
-        check_size(mesh.n, node_limit(key.route, limits), f"{key.route} mesh")
+        limit = node_limit(key.route, limits)
+        mesh = build_mesh(scene, max_nodes=limit)
         check_load(boundary_nodes=len(mesh.boundary), nodes=mesh.n, route=key.route,
                    max_bytes=limits.max_bytes)
         body = ElasticObject(mesh, scene_material(scene), key.route)

@@ -64,7 +64,7 @@ def test_the_readme_example_runs_and_imports_only_the_front_door(capsys):
     from pathlib import Path
 
     readme = (Path(__file__).resolve().parents[1] / "README.md").read_text(encoding="utf-8")
-    section = readme[readme.index("### Python API"):]
+    section = readme[readme.index("## Python API"):]
     code = section[section.index("```python\n") + 10:section.index("```\n", 10)]
     imports = [line for line in code.splitlines() if line.startswith(("import ", "from "))]
     assert imports and all(line.startswith("from squeeze_grasp_ros.api import ")

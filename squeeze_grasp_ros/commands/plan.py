@@ -79,7 +79,7 @@ def requested_depth(args: argparse.Namespace, scene_squeeze, sq: Squeeze) -> flo
 
 
 def run(args: argparse.Namespace) -> dict:
-    """Plan both squeezes; see the README for the JSON keys."""
+    """Plan both squeezes; see docs/mechanics.md for the JSON keys."""
     loaded = load_solid(args.scene, args.solver)
     obj, (i, j) = loaded.obj, loaded.contacts
     red = reduced_stiffness(obj, [i, j])

@@ -26,8 +26,9 @@ def build_parser() -> argparse.ArgumentParser:
         description="Squeeze grasps of deformable planar objects (Jia, Guo, Lin, IJRR 2014). "
                     "SI units throughout. Scene format: `squeeze-grasp scene-help`.",
         epilog="exit status: 0 done; 1 negative outcome (grasp failed in the world, replay "
-               "differs); 2 invalid input; 4 pipeline or environment failure (e.g. ROS not "
-               "installed); 130 interrupted (Ctrl-C)")
+               "differs); 2 invalid input; 3 a solver failed (the message carries its "
+               "residuals); 4 pipeline or environment failure (e.g. ROS not installed); 130 "
+               "interrupted (Ctrl-C); 143 terminated (SIGTERM)")
     sub = parser.add_subparsers(dest="verb", metavar="VERB", required=True)
     for name in VERBS:
         module = importlib.import_module(f".commands.{name}", __package__)

@@ -265,8 +265,18 @@ def test_missing_prerequisites_are_named(tmp_path: Path, monkeypatch) -> None:
 
 def test_main_fails_clearly_outside_a_venv(monkeypatch, capsys) -> None:
     monkeypatch.setattr(sys, "prefix", sys.base_prefix)
-    assert ros_setup.main(["--check"]) == 1
+    assert ros_setup.main(["--check"]) == 4  # the environment failed: the exit table's 4
     assert "not running in a virtual environment" in capsys.readouterr().err
+
+
+def test_a_missing_cmake_exits_4_with_the_install_line(monkeypatch, capsys) -> None:
+    real_which = shutil.which
+    monkeypatch.setattr(shutil, "which", lambda name, *a, **k: None if name == "cmake"
+                        else real_which(name, *a, **k))
+    assert ros_setup.main([]) == 4
+    err = capsys.readouterr().err.strip().splitlines()
+    assert err == ["ros-setup: error: cmake not found on PATH: install it (e.g. apt-get install "
+                   "cmake)"]
 
 
 # --------------------------------------------------------------------------- idempotence

@@ -4,8 +4,10 @@
 from __future__ import annotations
 
 import signal
+import sys
 import threading
 from collections.abc import Callable
+from pathlib import Path
 
 import rclpy
 from rclpy.executors import Executor, ExternalShutdownException
@@ -13,9 +15,16 @@ from rclpy.experimental import EventsExecutor
 from rclpy.node import Node
 from rclpy.signals import SignalHandlerOptions
 
+from squeeze_grasp_ros.exit_codes import ExitCode
+from squeeze_grasp_ros.mechanics.errors import InvalidInputError
+
+
+class ParameterError(InvalidInputError):
+    """A node parameter is missing or invalid; the message names it."""
+
 
 def run_node(factory: Callable[[], Node], args: list[str] | None = None,
-             executor_type: Callable[[], Executor] = EventsExecutor) -> None:
+             executor_type: Callable[[], Executor] = EventsExecutor) -> int:
     """A node's ``main``: init rclpy, spin the node in the main thread until SIGINT, SIGTERM or
     shutdown, then clean up.
 
@@ -36,13 +45,28 @@ def run_node(factory: Callable[[], Node], args: list[str] | None = None,
         Command-line arguments for ``rclpy.init`` (``--ros-args ...``); None = ``sys.argv``.
     executor_type : callable
         Builds the executor.
+
+    Returns
+    -------
+    int
+        The exit code: 0, or 2 (:attr:`~.ExitCode.USAGE`) when the node refused its
+        parameters (a missing scene, output folder, ...). That error is one line on stderr,
+        ``<program>: error: <what>``, not a traceback. Once built, the node logs
+        ``<name> ready: <its configuration>``.
     """
     stop = threading.Event()
     for signum in (signal.SIGINT, signal.SIGTERM):
         signal.signal(signum, lambda *_: stop.set())
     rclpy.init(args=args, signal_handler_options=SignalHandlerOptions.NO)
+    try:
+        node = factory()
+    except InvalidInputError as error:
+        print(f"{Path(sys.argv[0]).stem}: error: {error}", file=sys.stderr)
+        rclpy.try_shutdown()
+        return ExitCode.USAGE
+    summary = getattr(node, "ready_summary", lambda: "")()
+    node.get_logger().info(f"{node.get_name()} ready" + (f": {summary}" if summary else ""))
     executor = executor_type()
-    node = factory()
     executor.add_node(node)
     try:
         while rclpy.ok() and not stop.is_set():
@@ -57,3 +81,4 @@ def run_node(factory: Callable[[], Node], args: list[str] | None = None,
         executor.shutdown()
         node.destroy_node()
         rclpy.try_shutdown()
+    return ExitCode.OK

@@ -27,6 +27,8 @@ executor thread.
 """
 from __future__ import annotations
 
+import sys
+
 import queue
 import threading
 from collections.abc import Callable
@@ -143,8 +145,10 @@ class PlannerNode(Node):
                          self._execute_event_squeeze, cancel_callback=self._accept_cancel,
                          callback_group=self._group),
         ]
-        self.get_logger().info(f"planner ready: {self.limits}; files from "
-                               f"{[str(r) for r in self.roots]}")
+
+    def ready_summary(self) -> str:
+        """What the ready line of ``ros2 run`` says: the limits and the readable folders."""
+        return f"{self.limits}; files from {[str(r) for r in self.roots]}"
 
     def _parameter(self, name: str) -> Any:
         """The value of a declared parameter (an int given for a float is accepted)."""
@@ -370,10 +374,12 @@ class PlannerNode(Node):
         super().destroy_node()
 
 
-def main(args: list[str] | None = None) -> None:
-    """Run the planner on a SingleThreadedExecutor in the main thread until Ctrl-C or shutdown."""
-    run_node(PlannerNode, args, SingleThreadedExecutor)
+def main(args: list[str] | None = None) -> int:
+    """Run the planner on a SingleThreadedExecutor in the main thread until Ctrl-C or
+    shutdown; return the exit code.
+    """
+    return run_node(PlannerNode, args, SingleThreadedExecutor)
 
 
 if __name__ == "__main__":
-    main()
+    sys.exit(main())

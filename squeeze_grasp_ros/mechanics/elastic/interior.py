@@ -26,7 +26,6 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
-import qdldl
 import scipy.sparse as sp
 
 __all__ = ["ContactStiffness", "InteriorBlocks", "TangentFactor"]
@@ -72,7 +71,7 @@ class TangentFactor:
     owner: object = None
     held: tuple | None = None
     tangent: sp.csr_matrix | None = field(default=None, repr=False)
-    _solver: "qdldl.Solver | None" = field(default=None, repr=False)
+    _solver: "object | None" = field(default=None, repr=False)
     _masks: dict = field(default_factory=dict, repr=False)
 
     def _layout(self, K: sp.csr_matrix) -> None:
@@ -106,6 +105,8 @@ class TangentFactor:
         data[diagonal] = 1.0
         self._upper.data = data
         if self._solver is None:
+            import qdldl  # only the large-deformation models need it (``pip install qdldl``)
+
             self._solver = qdldl.Solver(self._upper, upper=True)
         else:
             self._solver.update(self._upper, upper=True)

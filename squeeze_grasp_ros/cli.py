@@ -11,6 +11,7 @@ import os
 import sys
 from typing import Any
 
+from squeeze_grasp_ros import plots
 from squeeze_grasp_ros.commands import VERBS
 from squeeze_grasp_ros.commands.common import fail
 from squeeze_grasp_ros.exit_codes import ExitCode
@@ -72,6 +73,7 @@ def main(argv: list[str] | None = None) -> int:
     "code_name"}``.
     """
     args = build_parser().parse_args(argv)
+    written = len(plots.WRITTEN)
     try:
         result = args._module.run(args)
     except SqueezeGraspError as exc:
@@ -93,7 +95,9 @@ def main(argv: list[str] | None = None) -> int:
                 clean["non_finite"] = bad
             sys.stdout.write(json.dumps(clean, allow_nan=False) + "\n")
         else:
-            print(args._module.summary(result))
+            text = args._module.summary(result)
+            pictures = [f"plot: {p}" for p in plots.WRITTEN[written:] if p not in text]
+            print("\n".join([text, *pictures]) if text else "\n".join(pictures))
         sys.stdout.flush()
     except BrokenPipeError:  # the reader (e.g. `| head`) closed the pipe: not an error
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())

@@ -96,7 +96,9 @@ OUTPUTS: dict[str, list[str]] = {}
 def run_command(command: Command, folder: Path) -> list[str]:
     """The output of ``command`` (or its equivalent, see the module docstring) in ``folder``."""
     if command.text not in OUTPUTS:
-        OUTPUTS[command.text] = _run(command.text, folder).splitlines()
+        # a terminal shows what follows the last carriage return of a line (progress lines)
+        OUTPUTS[command.text] = [line.rsplit("\r", 1)[-1]
+                                 for line in _run(command.text, folder).split("\n")]
     return OUTPUTS[command.text]
 
 
@@ -143,10 +145,12 @@ def _in_process(words: list[str], folder: Path) -> str:
 
 
 def _process(argv: list[str], folder: Path) -> str:
-    done = subprocess.run(argv, cwd=folder, capture_output=True, text=True, timeout=900,
-                          stdin=subprocess.DEVNULL)
-    assert done.returncode in (0, 1), f"{argv} exited {done.returncode}:\n{done.stderr}"
-    return done.stdout + done.stderr
+    """stdout and stderr interleaved as on a terminal (unbuffered, one pipe)."""
+    done = subprocess.run(argv, cwd=folder, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
+                          text=True, timeout=900, stdin=subprocess.DEVNULL,
+                          env={**os.environ, "PYTHONUNBUFFERED": "1"})
+    assert done.returncode in (0, 1), f"{argv} exited {done.returncode}:\n{done.stdout}"
+    return done.stdout
 
 
 def executables(package: str) -> str:

@@ -145,7 +145,7 @@ def _in_process(words: list[str], folder: Path) -> str:
 
 
 def _process(argv: list[str], folder: Path) -> str:
-    """stdout and stderr interleaved as on a terminal (unbuffered, one pipe)."""
+    """The output of a process, stdout and stderr interleaved as on a terminal."""
     done = subprocess.run(argv, cwd=folder, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
                           text=True, timeout=900, stdin=subprocess.DEVNULL,
                           env={**os.environ, "PYTHONUNBUFFERED": "1"})

@@ -138,9 +138,8 @@ def run(page: Path, start: str, folder: Path,
     """Run the steps of ``page`` against a planner started in ``folder``; each step's output."""
     plan = steps(page, start)
     script = HELPERS + "\n".join(f"print({SEPARATOR!r}, flush=True)\n{s.source}" for s in plan)
-    bin_dir = Path(sys.executable).parent
     planner = subprocess.Popen(
-        [str(bin_dir / "planner"), "--ros-args", "--params-file", "config/planner.yaml"],
+        [script("planner"), "--ros-args", "--params-file", "config/planner.yaml"],
         cwd=folder, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
         start_new_session=True)
     try:

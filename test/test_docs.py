@@ -39,6 +39,7 @@ from pathlib import Path
 
 import doc_ros_session
 import pytest
+from executables import script
 from doc_transcripts import (MASKS, PAGES, REPO, Command, Transcript, blocks, compare,
                              line_matches, number_matches, transcripts)
 
@@ -106,7 +107,7 @@ def _run(text: str, folder: Path) -> str:
     words = squeeze_grasp_words(text)
     if words is not None:
         if words and words[0] in PROCESS_VERBS:
-            return _process([str(Path(sys.executable).parent / "squeeze-grasp"), *words], folder)
+            return _process([script("squeeze-grasp"), *words], folder)
         return _in_process(words, folder)
     words = shlex.split(text.replace("$SHARE", str(REPO)), comments=True)
     if words[0] == "cat":
@@ -185,7 +186,7 @@ def show_args(launch_file: Path) -> str:
 def launched_run(arguments: dict[str, str], folder: Path) -> str:
     """``sim_pipeline.launch.py``'s run, as the run's own lines prefixed by ``[run-N] ``."""
     scene = arguments.get("scene") or str(REPO / "config" / "scenes" / "foam_square.yaml")
-    argv = [str(Path(sys.executable).parent / "squeeze-grasp"), "run", scene]
+    argv = [script("squeeze-grasp"), "run", scene]
     if arguments.get("record"):
         argv += ["--record", str(folder / Path(arguments["record"]).name)]
     return _process(argv, folder)

@@ -7,19 +7,18 @@ from __future__ import annotations
 
 import signal
 import subprocess
-import sys
 import time
 from pathlib import Path
 
 import pytest
+from executables import script
 
 REPO = Path(__file__).resolve().parents[1]
-BIN = Path(sys.executable).parent
 
 
 @pytest.mark.parametrize("node, parameter", [("sim_hardware", "scene"), ("recorder", "output")])
 def test_a_missing_required_parameter_is_one_line_and_exit_2(node, parameter):
-    done = subprocess.run([str(BIN / node)], capture_output=True, text=True, timeout=120,
+    done = subprocess.run([script(node)], capture_output=True, text=True, timeout=120,
                           stdin=subprocess.DEVNULL)
     assert done.returncode == 2
     lines = done.stderr.strip().splitlines()
@@ -39,7 +38,7 @@ def test_every_node_logs_when_it_is_ready(tmp_path):
         "recorder": ["-p", f"output:={tmp_path / 'bag'}"],
         "planner": [],
     }
-    processes = {name: subprocess.Popen([str(BIN / name), "--ros-args", *extra],
+    processes = {name: subprocess.Popen([script(name), "--ros-args", *extra],
                                         stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
                                         text=True, cwd=tmp_path, stdin=subprocess.DEVNULL)
                  for name, extra in commands.items()}

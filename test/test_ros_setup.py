@@ -298,7 +298,7 @@ def test_second_run_is_a_no_op(capsys) -> None:
     assert ros_setup.main(["--check"]) == 0
 
 
-def test_changed_interface_sources_are_detected(tmp_path: Path, capsys) -> None:
+def test_changed_interface_sources_are_detected(tmp_path: Path) -> None:
     source = ros_setup.default_source()
     copy = tmp_path / "msg_defs"
     shutil.copytree(source, copy)
@@ -319,6 +319,12 @@ def test_changed_interface_sources_are_detected(tmp_path: Path, capsys) -> None:
     other_folder = ros_setup.build_settings(layout, copy)
     assert "settings changed" in ros_setup.rebuild_reason(stamp, other_folder, changed, True)
 
+
+@pip_route_only
+def test_check_reports_a_changed_source_folder_of_this_environment(tmp_path: Path,
+                                                                    capsys) -> None:
+    copy = tmp_path / "msg_defs"
+    shutil.copytree(ros_setup.default_source(), copy)
     assert ros_setup.main(["--check", "--source", str(copy)]) == 1
     assert "settings changed" in capsys.readouterr().out
 

@@ -21,6 +21,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from doc_transcripts import REPO, Block, blocks, parse
+from executables import script
 
 SEPARATOR = "\x1e"
 
@@ -137,13 +138,13 @@ def run(page: Path, start: str, folder: Path,
         timeout: float = 600.0) -> list[tuple[Step, list[str]]]:
     """Run the steps of ``page`` against a planner started in ``folder``; each step's output."""
     plan = steps(page, start)
-    script = HELPERS + "\n".join(f"print({SEPARATOR!r}, flush=True)\n{s.source}" for s in plan)
+    client = HELPERS + "\n".join(f"print({SEPARATOR!r}, flush=True)\n{s.source}" for s in plan)
     planner = subprocess.Popen(
         [script("planner"), "--ros-args", "--params-file", "config/planner.yaml"],
         cwd=folder, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
         start_new_session=True)
     try:
-        done = subprocess.run([sys.executable, "-c", script], cwd=folder, capture_output=True,
+        done = subprocess.run([sys.executable, "-c", client], cwd=folder, capture_output=True,
                               text=True, timeout=timeout, stdin=subprocess.DEVNULL,
                               env={**os.environ, "PYTHONUNBUFFERED": "1"})
     finally:

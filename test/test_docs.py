@@ -18,7 +18,8 @@ its equivalent without ros2cli, which is not on PyPI:
 - ``ros2 launch squeeze_grasp_ros sim_pipeline.launch.py [scene:=F] [record:=D]`` is
   ``squeeze-grasp run F [--record D]``: its ``[run-N]`` lines are the run's summary, compared
   as a subsequence of the transcript's lines (the launch system's own lines need ros2launch);
-- ``ros2 interface show PKG/srv/T`` prints ``msg_defs/srv/T.srv``.
+- ``ros2 interface show PKG/srv/T`` prints ``msg_defs/srv/T.srv``;
+- ``/tmp/user/`` (the docs' folder outside the repository) is a folder in the scratch folder.
 
 Mechanics verbs run in this process (``cli.main``), the ROS verbs (``run``, ``replay``,
 ``sweep``) as processes; each distinct command runs once per session. Transcripts whose
@@ -48,6 +49,8 @@ SLOW_VERBS = ("run", "replay", "sweep", "bench")
 PROCESS_VERBS = ("run", "replay", "sweep", "sweep-report", "bench", "ros-setup")
 SLOW_OPTIONS = ("--compare-models",)
 RUN_LINE = re.compile(r"^\[run-\d+\] ")
+USER_FOLDER = "/tmp/user/"
+"""The transcripts' working folder outside the repository; a scratch folder stands in for it."""
 
 ALL = transcripts()
 PLANNER_COMMANDS = ("ros2 service", "ros2 param", "ros2 action")
@@ -87,6 +90,7 @@ def scratch(tmp_path_factory) -> Path:
     folder = tmp_path_factory.mktemp("docs")
     for name in LINKED:
         (folder / name).symlink_to(REPO / name)
+    (folder / "tmp_user").mkdir()
     return folder
 
 
@@ -104,6 +108,7 @@ def run_command(command: Command, folder: Path) -> list[str]:
 
 
 def _run(text: str, folder: Path) -> str:
+    text = text.replace(USER_FOLDER, f"{folder / 'tmp_user'}/")
     words = squeeze_grasp_words(text)
     if words is not None:
         if words and words[0] in PROCESS_VERBS:
@@ -164,22 +169,29 @@ def executables(package: str) -> str:
 def show_args(launch_file: Path) -> str:
     """``ros2 launch ... --show-args``: every ``DeclareLaunchArgument`` of the file, in order.
 
-    The default shown for a value computed at launch time (not a literal) is the transcript's
-    own, masked as ``...``.
+    A default computed from the package's share folder (``get_package_share_directory``) is
+    evaluated with that folder as ``<install prefix>/share/<package>``.
     """
     tree = ast.parse(launch_file.read_text(encoding="utf-8"))
+    values = {"Path": Path, "str": str,
+              "get_package_share_directory": lambda p: f"<install prefix>/share/{p}"}
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Assign) and len(node.targets) == 1 \
+                and isinstance(node.targets[0], ast.Name):
+            with contextlib.suppress(Exception):
+                values[node.targets[0].id] = eval(  # noqa: S307 (the repository's own file)
+                    compile(ast.Expression(node.value), str(launch_file), "eval"), values)
     lines = ["Arguments (pass arguments as '<name>:=<value>'):"]
     for call in ast.walk(tree):
         if not (isinstance(call, ast.Call) and getattr(call.func, "id", "")
                 == "DeclareLaunchArgument"):
             continue
         keywords = {k.arg: k.value for k in call.keywords}
-        name = ast.literal_eval(call.args[0])
-        default = keywords.get("default_value")
-        shown = (repr(ast.literal_eval(default)) if isinstance(default, ast.Constant)
-                 else "...")
-        lines += ["", f"    {name!r}:", f"        {ast.literal_eval(keywords['description'])}",
-                  f"        (default: {shown})"]
+        default = eval(compile(ast.Expression(keywords["default_value"]), str(launch_file),
+                               "eval"), values)
+        lines += ["", f"    {ast.literal_eval(call.args[0])!r}:",
+                  f"        {ast.literal_eval(keywords['description'])}",
+                  f"        (default: {default!r})"]
     return "\n".join(lines)
 
 
@@ -188,7 +200,7 @@ def launched_run(arguments: dict[str, str], folder: Path) -> str:
     scene = arguments.get("scene") or str(REPO / "config" / "scenes" / "foam_square.yaml")
     argv = [script("squeeze-grasp"), "run", scene]
     if arguments.get("record"):
-        argv += ["--record", str(folder / Path(arguments["record"]).name)]
+        argv += ["--record", arguments["record"]]
     return _process(argv, folder)
 
 
@@ -267,7 +279,7 @@ def test_untested_markers_stand_right_before_a_transcript():
         inside = {k for b in blocks(page) for k in range(b.line, b.line + len(b.lines) + 1)}
         lines = page.read_text(encoding="utf-8").splitlines()
         for k, line in enumerate(lines, start=1):
-            if "<!-- untested:" in line and k not in inside:
+            if line.strip().startswith("<!-- untested:") and k not in inside:
                 fence = next(j for j in range(k + 1, len(lines) + 1) if lines[j - 1].strip())
                 assert (page, fence) in marked, f"{page.name}:{k}: not right before a transcript"
 

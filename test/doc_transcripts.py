@@ -148,6 +148,10 @@ MASKS = (
          "the wall-clock column after the event counts of a --compare-models row"),
     Mask("time_s row", r"^time_s\s.*$", "the wall-clock quantiles of sweep-report"),
     Mask("precompute_time", r"precompute_time=[0-9.e-]+", "a wall-clock duration in a message"),
+    Mask("run mode", r"(?<=sim time; )(?:attached to running nodes|one process, \w+|[\w ]*"
+         r"processes[\w ]*)(?=, plan from)",
+         "how `run` ran the nodes: a launch transcript's run is attached to the launched nodes, "
+         "its equivalent runs them in one process"),
     Mask("pid", r"pid \[\d+\]", "a process id"),
     Mask("log stamp", r"\[\d{9,}\.\d+\]", "the wall-clock stamp of a ROS log line"),
     Mask("log folder", r"/\S*\.ros/log/\S+", "a dated log folder of ros2 launch"),

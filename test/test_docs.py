@@ -98,9 +98,12 @@ OUTPUTS: dict[str, list[str]] = {}
 """Each distinct command's output, run once per session."""
 
 
-def run_command(command: Command, folder: Path) -> list[str]:
-    """The output of ``command`` (or its equivalent, see the module docstring) in ``folder``."""
-    if command.text not in OUTPUTS:
+def run_command(command: Command, folder: Path, again: bool = False) -> list[str]:
+    """The output of ``command`` (or its equivalent, see the module docstring) in ``folder``;
+    ``again``: run it even if it ran before (a transcript repeating a command shows what the
+    repetition does, e.g. a sweep resuming).
+    """
+    if again or command.text not in OUTPUTS:
         # a terminal shows what follows the last carriage return of a line (progress lines)
         OUTPUTS[command.text] = [line.rsplit("\r", 1)[-1]
                                  for line in _run(command.text, folder).split("\n")]
@@ -206,9 +209,10 @@ def launched_run(arguments: dict[str, str], folder: Path) -> str:
 
 def check(transcript: Transcript, folder: Path) -> None:
     """Run every command of ``transcript`` and compare its output."""
-    problems = []
+    problems, seen = [], set()
     for command in transcript.commands:
-        output = run_command(command, folder)
+        output = run_command(command, folder, again=command.text in seen)
+        seen.add(command.text)
         if command.text.startswith("ros2 launch") and "--show-args" not in command.text:
             problem = compare_subsequence(command.output, output)
         else:

@@ -148,6 +148,9 @@ def test_ctrl_c_while_the_program_starts_is_one_line_not_a_traceback(delay, tmp_
     """The installed ``squeeze-grasp`` interrupted while it is still importing (numpy, scipy,
     Dask for ``sweep``) or starting its cluster: exit 130 and one line, at any moment.
     """
+    pytest.importorskip("distributed", reason="the sweep extra is not installed (this test "
+                                              "interrupts a starting sweep): pip install "
+                                              "'.[sweep]'")
     proc = subprocess.Popen([script("squeeze-grasp"), "sweep", str(cli_sweep_spec()), "--out",
                              str(tmp_path / "out"), "--workers", "1"], stdout=subprocess.PIPE,
                             stderr=subprocess.PIPE, text=True, start_new_session=True)

@@ -39,6 +39,7 @@ import sys
 from pathlib import Path
 
 import doc_ros_session
+import numpy as np
 import pytest
 from executables import script
 from doc_transcripts import (MASKS, PAGES, REPO, Command, Transcript, blocks, compare,
@@ -331,3 +332,24 @@ def test_every_relative_link_and_anchor_exists():
                 if anchor[1:] not in headings:
                     broken.append(f"{page.name}: {target}{anchor}")
     assert broken == []
+
+
+def test_the_executor_goal_example_is_the_foam_squares_plan():
+    """docs/pipeline.md's ``ros2 action send_goal`` example is the planned goal of the shipped
+    foam square, to its printed precision.
+    """
+    from squeeze_grasp_ros.api import load_scene, scene_file
+    from squeeze_grasp_ros.scene_plan import plan_scene
+
+    page = REPO / "docs" / "pipeline.md"
+    block = next(b for b in blocks(page) if b.language == "bash"
+                 and "/executor/execute_grasp" in "\n".join(b.lines))
+    text = " ".join(block.lines)
+    printed = [re.search(rf"{key}: ([-0-9.e]+)", text).group(1)
+               for key in ("depth", "relative_per_depth")]
+    printed += re.findall(r"[xy]: ([-0-9.e]+)", text)
+    goal = plan_scene(load_scene(scene_file("foam_square"))).goal
+    actual = [goal.depth, goal.relative_per_depth, *np.asarray(goal.directions).ravel()]
+    assert len(printed) == len(actual) == 6
+    assert all(number_matches(p, repr(float(a))) for p, a in zip(printed, actual)), \
+        (printed, actual)

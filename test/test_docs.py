@@ -3,10 +3,10 @@
 """Every console transcript in README.md and docs/ is run and its output compared.
 
 How a transcript is compared, and the masks: ``test/doc_transcripts.py`` (and docs/ci.md).
-A command runs as the user would type it, from a scratch folder in which ``config``,
-``launch`` and ``msg_defs`` are the repository's (so relative paths in the docs resolve and
-files the commands write land in the scratch folder). A command of the colcon route runs as
-its equivalent without ros2cli, which is not on PyPI:
+A command runs as the user would type it, from a scratch folder in which ``config`` is a copy
+of the repository's and ``launch`` and ``msg_defs`` link to it (so relative paths in the docs
+resolve and files the commands write land in the scratch folder). A command of the colcon
+route runs as its equivalent without ros2cli, which is not on PyPI:
 
 - ``ros2 run squeeze_grasp_ros squeeze-grasp ARGS`` is ``squeeze-grasp ARGS``, and ``$SHARE``
   (the package's share folder) is the repository, which has the same ``config/`` and
@@ -34,6 +34,7 @@ import io
 import os
 import re
 import shlex
+import shutil
 import subprocess
 import sys
 from pathlib import Path
@@ -45,7 +46,7 @@ from executables import script
 from doc_transcripts import (MASKS, PAGES, REPO, Command, Transcript, blocks, compare,
                              line_matches, number_matches, transcripts)
 
-LINKED = ("config", "launch", "msg_defs")
+LINKED = ("launch", "msg_defs")
 SLOW_VERBS = ("run", "replay", "sweep", "bench")
 PROCESS_VERBS = ("run", "replay", "sweep", "sweep-report", "bench", "ros-setup")
 SLOW_OPTIONS = ("--compare-models",)
@@ -89,6 +90,9 @@ def squeeze_grasp_words(text: str) -> list[str] | None:
 def scratch(tmp_path_factory) -> Path:
     """The folder the transcripts run in: config/, launch/, msg_defs/ link to the repository."""
     folder = tmp_path_factory.mktemp("docs")
+    # a copy of config/: a planner reads scene files only inside its share folder and its
+    # working folder, symlinks resolved (on the colcon route the share folder is not REPO)
+    shutil.copytree(REPO / "config", folder / "config")
     for name in LINKED:
         (folder / name).symlink_to(REPO / name)
     (folder / "tmp_user").mkdir()

@@ -17,7 +17,10 @@ import squeeze_grasp_ros
 from squeeze_grasp_ros import api
 from squeeze_grasp_ros.extras import install_hint
 
-EXEMPT: dict[str, str] = {}
+EXEMPT: dict[str, str] = {
+    "extract_outline": "needs the perception extra (scikit-image), which the core suite may "
+                       "lack; docs/perception.md shows it, test_perception_extract.py runs it",
+}
 """Public functions without their own example, and why."""
 
 

@@ -20,7 +20,7 @@ import sys
 from dataclasses import dataclass
 from pathlib import Path
 
-from doc_transcripts import REPO, Block, blocks, parse
+from doc_transcripts import Block, blocks, parse
 from executables import script
 
 SEPARATOR = "\x1e"
@@ -103,7 +103,10 @@ class Step:
 
 
 def _command_source(text: str) -> str:
-    words = shlex.split(text.replace("$SHARE", str(REPO)), comments=True)
+    from squeeze_grasp_ros.resources import share_dir
+
+    # $SHARE is `ros2 pkg prefix --share squeeze_grasp_ros`: the package's share folder
+    words = shlex.split(text.replace("$SHARE", str(share_dir())), comments=True)
     if words[:3] == ["ros2", "service", "call"]:
         return f"_service_call({words[3]!r}, {words[4]!r}, {words[5]!r})"
     if words[:3] == ["ros2", "param", "get"]:

@@ -43,6 +43,9 @@ import doc_ros_session
 import numpy as np
 import pytest
 from executables import script
+
+from squeeze_grasp_ros.exit_codes import ExitCode
+from squeeze_grasp_ros.extras import install_hint
 from doc_transcripts import (MASKS, PAGES, REPO, Command, Transcript, blocks, compare,
                              line_matches, number_matches, transcripts)
 
@@ -154,6 +157,9 @@ def _in_process(words: list[str], folder: Path) -> str:
             code = cli.main(words)
     finally:
         os.chdir(cwd)
+    missing = re.search(r"needs (\S+), which is not installed: (.*)", out.getvalue())
+    if code == ExitCode.INTERNAL and missing and install_hint(missing.group(1)):
+        pytest.skip(f"squeeze-grasp {words[0]} needs {missing.group(1)}: {missing.group(2)}")
     assert code in (0, 1), f"squeeze-grasp {' '.join(words)} exited {code}:\n{out.getvalue()}"
     return out.getvalue()
 

@@ -27,6 +27,8 @@ EXTRAS: dict[str, tuple[tuple[str, ...], str]] = {
             "pip install '.[ros]' && squeeze-grasp ros-setup (or source a ROS 2 Jazzy "
             "workspace with squeeze_grasp_interfaces built)"),
     "sweep": (("dask", "distributed", "pyarrow"), "pip install '.[sweep]'"),
+    "cholmod": (("cvxopt", "pymetis"),
+                "pip install '.[cholmod]' (CHOLMOD through cvxopt, GPL-3.0; METIS: pymetis)"),
     "perception": (("skimage",), "pip install '.[perception]'"),
 }
 """Extra -> (top-level modules it provides, how to install it)."""

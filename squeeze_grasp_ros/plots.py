@@ -9,6 +9,7 @@ from typing import Sequence
 import numpy as np
 
 from squeeze_grasp_ros.mechanics.elastic.mesh import Mesh
+from squeeze_grasp_ros.outputs import write_atomically
 
 
 def figure(ncols: int = 1, nrows: int = 1, size: float = 4.2):
@@ -27,14 +28,18 @@ WRITTEN: list[str] = []
 
 
 def save(fig, path: str | Path) -> str:
-    """Write ``fig`` to ``path`` (PNG, 150 dpi; the bounding box grows to hold legends placed
-    outside the axes), close it and return the path.
+    """Write ``fig`` to ``path`` (PNG, 150 dpi, replaced atomically; the bounding box grows to
+    hold legends placed outside the axes), close it and return the path; a failed write raises
+    :func:`~squeeze_grasp_ros.outputs.output_error`.
     """
     import matplotlib.pyplot as plt
 
     fig.tight_layout()
-    fig.savefig(path, dpi=150, bbox_inches="tight")
-    plt.close(fig)
+    try:
+        write_atomically(path, lambda tmp: fig.savefig(tmp, dpi=150, format="png",
+                                                       bbox_inches="tight"), "plot")
+    finally:
+        plt.close(fig)
     WRITTEN.append(str(path))
     return str(path)
 

@@ -27,14 +27,14 @@ from squeeze_grasp_ros.inputs import InputError, load_yaml, read_text
 from squeeze_grasp_ros.mechanics.elastic import shapes
 from squeeze_grasp_ros.mechanics.elastic.compliance import ElasticObject
 from squeeze_grasp_ros.mechanics.errors import InvalidInputError
-from squeeze_grasp_ros.mechanics.elastic.material import Material
+from squeeze_grasp_ros.mechanics.elastic.material import Material, require_poisson_ratio
 from squeeze_grasp_ros.mechanics.elastic.mesh import (
     MAX_MESH_NODES,
     Mesh,
     generate_mesh,
     target_max_area,
 )
-from squeeze_grasp_ros.mechanics.ring.model import RingModel, ring_from_outline
+from squeeze_grasp_ros.mechanics.ring.model import MAX_RING_ELEMENTS, RingModel, ring_from_outline
 from squeeze_grasp_ros.mechanics.vocabulary import SQUEEZING_FINGERS, Finger, MaterialModel
 
 
@@ -116,9 +116,10 @@ class MeshSpec:
 class MaterialSpec:
     """Material of the object (plane stress)."""
 
-    E: float = spec("Young's modulus", "Pa", lo=0.0, lo_open=True)
-    nu: float = spec("Poisson's ratio", "", lo=-1.0, hi=0.5, lo_open=True)
-    thickness: float = spec("out-of-plane thickness h (ring: width w)", "m", lo=0.0, lo_open=True)
+    E: float = spec("Young's modulus (gels to diamond)", "Pa", lo=1e-3, hi=1e13)
+    nu: float = spec("Poisson's ratio (neo_hookean: -0.3 to 0.4999)", "", lo=-0.9, hi=0.5)
+    thickness: float = spec("out-of-plane thickness h (ring: width w)", "m", lo=0.0, hi=1e3,
+                            lo_open=True)
     model: str = spec("constitutive model of a solid (event-driven squeeze): linear (the "
                       "paper's), corotational or neo_hookean (finite deformation)",
                       choices=MaterialModel.values(), default=MaterialModel.LINEAR.value)
@@ -129,7 +130,8 @@ class RingSpec:
     """Curved-beam model of a hollow object (Sec. 7): the shape is the middle curve."""
 
     wall_thickness: float = spec("in-plane wall thickness h", "m", lo=0.0, lo_open=True)
-    elements: int = spec("number of beam elements along the middle curve", lo=8, default=200)
+    elements: int = spec("number of beam elements along the middle curve", lo=8,
+                         hi=MAX_RING_ELEMENTS, default=200)
 
 
 @dataclass(frozen=True)
@@ -211,7 +213,7 @@ class SqueezeSpec:
 class FrictionSpec:
     """Coulomb friction between fingertips and object."""
 
-    mu: float = spec("friction coefficient", "", lo=0.0)
+    mu: float = spec("friction coefficient", "", lo=0.0, hi=1e3)
 
 
 @dataclass(frozen=True)
@@ -378,8 +380,15 @@ SENSOR_FIELD_EFFECT = {"noise_std": "sensor_noise", "dropout": "sensor_dropout"}
 SENSING_EFFECTS = ("force_sensing", "tactile_sensing")
 
 
+def _number(x: float) -> str:
+    """A bound as messages show it: 0.5, 1e-06, 1e+13 (not 10000000000000.0)."""
+    return repr(x) if x == 0 or 1e-4 <= abs(x) < 1e6 else f"{x:g}"
+
+
 def _describe(meta: dict) -> str:
     lo, hi = meta.get("lo"), meta.get("hi")
+    lo = None if lo is None else _number(lo)
+    hi = None if hi is None else _number(hi)
     if lo is not None and hi is not None:
         return f"in {'(' if meta.get('lo_open') else '['}{lo}, {hi}]"
     if lo is not None:
@@ -482,7 +491,7 @@ def parse_section(cls: type, data: Any, where: str) -> Any:
 
 def _validate_shape(shape: dict) -> None:
     kind = shape.get("type")
-    if kind not in SHAPES:
+    if not isinstance(kind, str) or kind not in SHAPES:
         raise SceneError(f"object.shape.type must be one of {sorted(SHAPES)}, got {kind!r}")
     allowed = set(SHAPES[kind]) | {"type"}
     unknown = sorted(set(shape) - allowed)
@@ -552,12 +561,17 @@ def _validate_fingers(scene: Scene) -> None:
         )
 
 
-def _validate_placements(scene: Scene) -> None:
-    """Every placement (fingers, adversary) names exactly one of point, angle_deg, node."""
+def named_placements(scene: Scene) -> list[tuple[str, PlacementSpec]]:
+    """(field, placement) of the fingers, then the adversary: ``("fingers.F1", ...)``."""
     placements = [(f"fingers.{k}", v.placement) for k, v in scene.fingers.items()]
     if scene.adversary is not None:
         placements.append(("adversary", scene.adversary.placement))
-    for where, p in placements:
+    return placements
+
+
+def _validate_placements(scene: Scene) -> None:
+    """Every placement (fingers, adversary) names exactly one of point, angle_deg, node."""
+    for where, p in named_placements(scene):
         given = [k for k in ("point", "angle_deg", "node") if getattr(p, k) is not None]
         if len(given) != 1:
             raise SceneError(
@@ -619,9 +633,10 @@ def _validate_object(scene: Scene) -> None:
         Material(obj.material.E, obj.material.nu, obj.material.thickness)
     except InvalidInputError as exc:
         raise SceneError(f"object.{exc}") from None
-    if obj.material.model == MaterialModel.NEO_HOOKEAN and not obj.material.nu < 0.5:
-        raise SceneError(f"object.material.nu must be < 0.5 for the neo_hookean model (its "
-                         f"lambda is infinite at 0.5), got {obj.material.nu}")
+    try:
+        require_poisson_ratio(obj.material.nu, obj.material.model)
+    except InvalidInputError as exc:
+        raise SceneError(f"object.{exc}") from None
 
 
 def _validate(scene: Scene) -> Scene:
@@ -753,27 +768,36 @@ def scene_material(scene: Scene) -> Material:
 
 def placement_points(scene: Scene) -> list[tuple[float, float]]:
     """The placements given as points (fingers, then the adversary), m."""
-    placements = [f.placement for f in scene.fingers.values()]
-    if scene.adversary is not None:
-        placements.append(scene.adversary.placement)
-    return [p.point for p in placements if p.point is not None]
+    return [p.point for _, p in named_placements(scene) if p.point is not None]
 
 
-def build_mesh(scene: Scene) -> Mesh:
+def _check_reach(points: np.ndarray, placement: PlacementSpec, where: str) -> None:
+    """A placement point must be near the object (:func:`shapes.require_within_reach`)."""
+    if placement.point is not None:
+        try:
+            shapes.require_within_reach(points, placement.point, f"{where}.placement.point")
+        except InvalidInputError as exc:
+            raise SceneError(str(exc)) from None
+
+
+def build_mesh(scene: Scene, *, max_nodes: int = MAX_MESH_NODES) -> Mesh:
     """Triangulate the scene's solid object with its mesh settings.
 
     A placement given as a point becomes a boundary node exactly (its projection on the
-    outline is a kept vertex of the mesh), so the finger touches where the scene says.
+    outline is a kept vertex of the mesh), so the finger touches where the scene says. A mesh
+    that would have more than ``max_nodes`` nodes is refused before meshing.
     """
-    outline = shapes.with_boundary_points(build_outline(scene.object.shape),
-                                          placement_points(scene))
+    outline = build_outline(scene.object.shape)
+    for where, placement in named_placements(scene):
+        _check_reach(outline.points, placement, where)
+    outline = shapes.with_boundary_points(outline, placement_points(scene))
     ms = scene.object.mesh
     if ms.max_area is not None:
         area = ms.max_area
     else:
         area = target_max_area(outline, ms.nodes if ms.nodes is not None else 600)
     try:
-        return generate_mesh(outline, area, min_angle=ms.min_angle)
+        return generate_mesh(outline, area, min_angle=ms.min_angle, max_nodes=max_nodes)
     except InvalidInputError as exc:
         raise SceneError(f"object.mesh: {exc}") from None
 
@@ -817,6 +841,7 @@ def placement_node(
             )
         return int(placement.node)
     if placement.point is not None:
+        _check_reach(pts, placement, where)
         k = np.argmin(np.linalg.norm(pts - np.asarray(placement.point), axis=1))
         return int(loop[k])
     c = mesh.centroid

@@ -8,8 +8,7 @@ The layers, lowest first, are the ones docs/design.md draws:
 - ``mechanics``: the ROS-free core, inside it ``vocabulary``/``errors`` < ``elastic`` <
   ``squeeze`` < ``resistance``, ``ring``; ``calibration`` stands alone;
 - application: ``scene``, ``scene_events``, ``planning``, ``control``, ``sim``, ``plots``,
-``sweep``, ``perception``
-  and the front door ``api``;
+  ``outputs``, ``sweep``, ``perception`` and the front door ``api``;
 - ``ros``: the only folder that imports rclpy, ROS messages or the interfaces;
 - front ends: ``commands``, ``bench``, ``cli``, ``entry``.
 
@@ -32,8 +31,8 @@ ROS_MODULES = ("rclpy", "rosidl", "rcl_interfaces", "builtin_interfaces", "std_m
 LAYERS: tuple[tuple[str, ...], ...] = (
     ("inputs", "exit_codes", "extras", "resources", "threads"),
     ("mechanics",),
-    ("scene", "scene_events", "scene_plan", "planning", "control", "sim", "plots", "sweep",
-     "perception", "api"),
+    ("scene", "scene_events", "scene_plan", "planning", "control", "sim", "plots", "outputs",
+     "sweep", "perception", "api"),
     ("ros",),
     ("commands", "bench", "cli", "entry"),
 )

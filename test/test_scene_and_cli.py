@@ -44,7 +44,7 @@ def mutate(path: str, value):
 
 
 @pytest.mark.parametrize("path,value,message", [
-    ("object.material.E", -5.0, "object.material.E must be > 0"),
+    ("object.material.E", -5.0, "object.material.E must be in \\[0.001, 1e\\+13\\] Pa"),
     ("object.material.nu", 0.7, "object.material.nu must be in"),
     ("object.material.colour", "red", "unknown key object.material.colour"),
     ("object.mesh.min_angle", 40, "object.mesh.min_angle must be in"),

@@ -9,7 +9,7 @@ import argparse
 import numpy as np
 
 from squeeze_grasp_ros import plots
-from squeeze_grasp_ros.mechanics.errors import InvalidInputError
+from squeeze_grasp_ros.mechanics.errors import require_relative_depth
 from squeeze_grasp_ros.mechanics.elastic.reduced import boundary_displacement, reduced_stiffness
 from squeeze_grasp_ros.mechanics.squeeze.stable_pure import Squeeze, force_closure, plan_squeeze
 from squeeze_grasp_ros.commands.common import (
@@ -59,21 +59,10 @@ def requested_depth(args: argparse.Namespace, scene_squeeze, sq: Squeeze) -> flo
         (scene_squeeze.depth, scene_squeeze.relative_depth),
     ):
         if depth is not None:
-            if not (np.isfinite(depth) and depth >= 0):
-                raise InvalidInputError(f"depth must be >= 0 m, got {depth}")
-            rel = sq.relative_depth(depth)
-            if not rel < 1:
-                raise InvalidInputError(
-                    f"depth {depth:.6g} m is a relative depth of {rel:.6g}: "
-                    "it "
-                    "must be below 1 (at 1 the fingers would meet)"
-                )
+            require_relative_depth(sq.relative_depth(depth), depth)
             return depth
         if rel is not None:
-            if not (np.isfinite(rel) and 0 <= rel < 1):
-                raise InvalidInputError(
-                    f"relative depth must be in [0, 1) (at 1 the fingers would meet), got {rel}"
-                )
+            require_relative_depth(rel)
             return sq.depth_for_relative(rel)
     return sq.depth_for_relative(DEFAULT_RELATIVE_DEPTH)
 

@@ -14,6 +14,7 @@ from squeeze_grasp_ros.mechanics.squeeze.contact_model import ContactModel
 from squeeze_grasp_ros.mechanics.errors import InvalidInputError
 from squeeze_grasp_ros.mechanics.elastic.reduced import displacement_field
 from squeeze_grasp_ros.mechanics.resistance.optimal import (
+    MAX_DIRECTIONS,
     Resistance,
     ResistanceGrasp,
     ResistanceSweep,
@@ -38,6 +39,7 @@ from squeeze_grasp_ros.commands.common import (
     add_plot_argument,
     add_scene_argument,
     add_solver_argument,
+    int_in,
     load_solid,
 )
 from squeeze_grasp_ros.mechanics.vocabulary import ContactMode, Finger, SqueezeKind
@@ -59,7 +61,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     )
     parser.add_argument(
         "--directions",
-        type=int,
+        type=int_in(1, MAX_DIRECTIONS),
         metavar="N",
         help="also sweep N adversary push directions (grasp quality, polar plot)",
     )

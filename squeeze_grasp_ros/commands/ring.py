@@ -17,12 +17,19 @@ import numpy as np
 
 from squeeze_grasp_ros import plots
 from squeeze_grasp_ros.mechanics.ring.grasp_map import RingGraspMap, bench_ring, ring_grasp_map
-from squeeze_grasp_ros.mechanics.ring.model import FIBRE_STRAIN_MEASURE, RingModel
+from squeeze_grasp_ros.mechanics.errors import require_relative_depth
+from squeeze_grasp_ros.mechanics.ring.model import (
+    FIBRE_STRAIN_MEASURE,
+    MAX_RING_ELEMENTS,
+    RingModel,
+)
 from squeeze_grasp_ros.mechanics.ring.squeeze import LIMITS, RingGrasp, ring_grasp
 from squeeze_grasp_ros.scene import Scene, SceneError, build_ring, finger_nodes, load_scene
-from squeeze_grasp_ros.commands.common import add_plot_argument, add_scene_argument
+from squeeze_grasp_ros.commands.common import add_plot_argument, add_scene_argument, int_in
 from squeeze_grasp_ros.mechanics.vocabulary import SQUEEZING_FINGERS, StrainMeasure, Termination
 
+MAX_BEST = 10_000
+"""Most placements ``--map --best`` lists."""
 HELP = "ring-like object, two point fingers (Sec. 7): max squeeze depth, limit, all-pairs map"
 
 
@@ -47,13 +54,14 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         metavar="FRACTION",
         help="requested finger approach / initial contact distance (default: the scene's)",
     )
-    parser.add_argument("--elements", type=int, metavar="N", help="override object.ring.elements")
+    parser.add_argument("--elements", type=int_in(8, MAX_RING_ELEMENTS), metavar="N",
+                        help=f"override object.ring.elements (8 to {MAX_RING_ELEMENTS})")
     parser.add_argument(
         "--best",
-        type=int,
+        type=int_in(1, MAX_BEST),
         default=10,
         metavar="K",
-        help="--map: list the K placements with the largest maximum depth",
+        help=f"--map: list the K placements with the largest maximum depth (1 to {MAX_BEST})",
     )
     parser.add_argument(
         "--bench",
@@ -71,8 +79,6 @@ def load_ring(path: str, elements: int | None = None) -> tuple[Scene, RingModel]
             f"{path}: object.model is {scene.object.model!r}; `ring` needs model: ring"
         )
     if elements is not None:
-        if elements < 8:
-            raise SceneError(f"--elements must be >= 8, got {elements}")
         ring_spec = dataclasses.replace(scene.object.ring, elements=elements)
         scene = dataclasses.replace(
             scene, object=dataclasses.replace(scene.object, ring=ring_spec)
@@ -111,7 +117,12 @@ def run(args: argparse.Namespace) -> dict:
             "give squeeze.depth or squeeze.relative_depth (or --depth/--relative-depth)"
         )
     grasp = ring_grasp(ring, finger_nodes(scene, ring), mu, epsilon=eps, kind=kind)
-    rho = depth if depth is not None else grasp.depth_for_relative(relative)
+    if depth is not None:
+        require_relative_depth(grasp.relative_depth(depth), depth)
+        rho = depth
+    else:
+        require_relative_depth(relative)
+        rho = grasp.depth_for_relative(relative)
     if args.plot:
         plot_grasp(ring, grasp, rho, args.plot)
     return grasp_json(ring, grasp, rho)

@@ -16,9 +16,9 @@ from __future__ import annotations
 
 from enum import Enum
 
-__all__ = ["ContactMode", "DistortionModel", "EventType", "Finger", "ImageEncoding",
-           "MaterialModel", "SQUEEZING_FINGERS", "ShapeFit", "SqueezeKind", "StrainCriterion",
-           "StrainMeasure", "StressMeasure", "Termination"]
+__all__ = ["ContactMode", "DistortionModel", "EventType", "Factorizer", "Finger",
+           "ImageEncoding", "MaterialModel", "SQUEEZING_FINGERS", "ShapeFit", "SqueezeKind",
+           "StrainCriterion", "StrainMeasure", "StressMeasure", "Termination"]
 
 
 class _Name(str, Enum):
@@ -205,3 +205,12 @@ class ShapeFit(_Name):
     """Rotation and translation only (the scale of a calibrated camera is known)."""
     NONE = "none"
     """No transform: both curves are already in the same frame."""
+
+
+class Factorizer(_Name):
+    """Sparse factorisation of the interior tangent of the large-deformation models."""
+
+    CHOLMOD = "cholmod"
+    """Supernodal Cholesky LL^T (SuiteSparse CHOLMOD through cvxopt: the ``cholmod`` extra)."""
+    QDLDL = "qdldl"
+    """LDL^T without pivoting (QDLDL); also takes the tangents that are not positive definite."""

@@ -39,12 +39,12 @@ from squeeze_grasp_ros.planning.objects import (
     resident_bytes,
     load_cached,
     CONTACT_MODELS,
-    MAX_DIRECTIONS,
     MAX_BEST_COUNT,
     SOLID_STAGES,
     RING_STAGES,
     Progress,
 )
+from squeeze_grasp_ros.mechanics.resistance.optimal import MAX_DIRECTIONS
 from squeeze_grasp_ros.planning.checks import (
     check_number,
     check_step,

@@ -32,8 +32,6 @@ from squeeze_grasp_ros.planning.errors import ErrorCode, PlannerError, invalid
 
 
 CONTACT_MODELS: tuple[str, ...] = ("point", "segment", "friction")
-MAX_DIRECTIONS = 100_000
-"""Most push directions one resistance sweep may ask for."""
 MAX_BEST_COUNT = 100_000
 """Most placements one grasp map may return as candidates."""
 SOLID_STAGES: tuple[str, ...] = ("mesh", "stiffness", "factorisation", "boundary compliance")
@@ -290,8 +288,7 @@ def load_object(
         limit = limits.max_nodes if key.route == "factorized" else limits.max_spectral_nodes
         check_size(requested_nodes(scene), limit, f"{key.route} mesh")
         progress(SOLID_STAGES[0], 0, len(SOLID_STAGES), 0)
-        mesh = build_mesh(scene)
-        check_size(mesh.n, limit, f"{key.route} mesh")
+        mesh = build_mesh(scene, max_nodes=limit)
         body = ElasticObject(mesh, scene_material(scene), key.route)
         progress(SOLID_STAGES[1], 1, len(SOLID_STAGES), mesh.n)
         _ = body.stiffness

@@ -13,6 +13,7 @@ import numpy as np
 from squeeze_grasp_ros.mechanics.squeeze.graspmap import GraspMap, grasp_map
 from squeeze_grasp_ros.mechanics.elastic.reduced import boundary_displacement, reduced_stiffness
 from squeeze_grasp_ros.mechanics.resistance.optimal import (
+    MAX_DIRECTIONS,
     Resistance,
     ResistanceSweep,
     contact_segments,
@@ -32,7 +33,7 @@ from squeeze_grasp_ros.mechanics.squeeze.events import EventSqueeze
 from squeeze_grasp_ros.scene_events import event_squeeze_scene, scene_contact_model
 from squeeze_grasp_ros.mechanics.vocabulary import Finger, SqueezeKind
 from squeeze_grasp_ros.planning.errors import invalid
-from squeeze_grasp_ros.planning.objects import CONTACT_MODELS, Limits, LoadedObject, MAX_DIRECTIONS
+from squeeze_grasp_ros.planning.objects import CONTACT_MODELS, Limits, LoadedObject
 from squeeze_grasp_ros.planning.checks import check_number, check_step, choice, contact_nodes
 
 

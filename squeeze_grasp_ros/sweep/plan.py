@@ -32,6 +32,7 @@ from squeeze_grasp_ros.mechanics.elastic.mesh import generate_mesh, target_max_a
 from squeeze_grasp_ros.mechanics.elastic.shapes import Outline
 from squeeze_grasp_ros.scene import MeshSpec, build_outline, load_scene
 from squeeze_grasp_ros.scene_events import scene_limits
+from squeeze_grasp_ros.sweep.limits import check_evaluations, check_objects, check_parameter_sets
 from squeeze_grasp_ros.sweep.spec import LoadedSpec, ObjectEntry, SweepError
 
 
@@ -156,8 +157,17 @@ def _family_shapes(entry: ObjectEntry, seed: int, name: str) -> list[tuple[str, 
     return out
 
 
+def object_count(loaded: LoadedSpec) -> int:
+    """Number of objects of the sweep, counted without drawing the families."""
+    entries = loaded.spec.objects
+    if entries is None:
+        return 1
+    return sum(e.family.count if e.family is not None else 1 for e in entries)
+
+
 def objects(loaded: LoadedSpec) -> list[ObjectItem]:
-    """Every object of the sweep, in spec order."""
+    """Every object of the sweep, in spec order (at most :data:`~.limits.MAX_OBJECTS`)."""
+    check_objects(object_count(loaded))
     sw = loaded.spec
     if sw.objects is None:
         name = loaded.base.name or "base"
@@ -185,8 +195,17 @@ def objects(loaded: LoadedSpec) -> list[ObjectItem]:
     return items
 
 
+def parameter_axes(loaded: LoadedSpec) -> dict[str, int]:
+    """Length of each parameter axis, in grid order."""
+    return {"friction": len(loaded.friction), "tip_radius": len(loaded.tip_radius),
+            "squeeze": len(loaded.squeeze), "depth": len(loaded.depths)}
+
+
 def parameter_grid(loaded: LoadedSpec) -> tuple[Params, ...]:
-    """Friction x tip_radius x squeeze x depth, ids in that order."""
+    """Friction x tip_radius x squeeze x depth, ids in that order (refused beyond
+    :data:`~.limits.MAX_TASK_EVALUATIONS` sets before any is made).
+    """
+    check_parameter_sets(parameter_axes(loaded))
     grid = itertools.product(loaded.friction, loaded.tip_radius, loaded.squeeze, loaded.depths)
     return tuple(Params(f"q{k:04d}", float(mu), float(r), kind, d, rel)
                  for k, (mu, r, kind, (d, rel)) in enumerate(grid))
@@ -214,10 +233,18 @@ def placement_total(loaded: LoadedSpec, item: ObjectItem) -> int:
 
 
 def plan_tasks(loaded: LoadedSpec) -> list[Task]:
-    """Every task of the sweep, sorted by id."""
+    """Every task of the sweep, sorted by id.
+
+    The sweep's size is checked from its counts first (:mod:`~.limits`): parameter sets and
+    objects before they are made, evaluations and tasks before any task is.
+    """
     sw = loaded.spec
     params = parameter_grid(loaded)
     per_task = max(1, sw.chunk // len(params))
+    items = objects(loaded)
+    totals = [placement_total(loaded, item) for item in items]
+    check_evaluations(sum(totals), len(loaded.materials), len(params),
+                      len(loaded.materials) * sum(-(-t // per_task) for t in totals))
     limits = scene_limits(loaded.base)
     limits = dataclasses.replace(limits, weight=loaded.weight)
     sq = loaded.base.squeeze
@@ -228,8 +255,7 @@ def plan_tasks(loaded: LoadedSpec) -> list[Task]:
     pl = sw.placements
     mu_filter = pl.mu if pl.mu is not None else min(loaded.friction)
     tasks = []
-    for item in objects(loaded):
-        total = placement_total(loaded, item)
+    for item, total in zip(items, totals):
         for mat_name, m in loaded.materials.items():
             group = f"{item.id}~{mat_name}"
             for c, start in enumerate(range(0, total, per_task)):

@@ -38,7 +38,11 @@ from squeeze_grasp_ros.mechanics.squeeze.contact_state import ContactState, Even
 from squeeze_grasp_ros.mechanics.errors import InvalidInputError, require_finite
 from squeeze_grasp_ros.mechanics.squeeze.fingertips import Fingertip
 from squeeze_grasp_ros.mechanics.elastic.mesh import vertex_normals
-from squeeze_grasp_ros.mechanics.resistance.optimal import optimal_resistance, resistance_grasp
+from squeeze_grasp_ros.mechanics.resistance.optimal import (
+    optimal_resistance,
+    require_small_push,
+    resistance_grasp,
+)
 from squeeze_grasp_ros.mechanics.squeeze.stepper import advance
 from squeeze_grasp_ros.mechanics.vocabulary import (
     ContactMode,
@@ -327,6 +331,7 @@ def frictional_resistance(
         raise InvalidInputError(
             f"adversary translation a must be a nonzero [x, y] in m, got {a.tolist()}"
         )
+    require_small_push(a, model.obj.scale)
     if [f.name for f in state.fingers] != list(tuple(Finger)):
         raise InvalidInputError(
             f"the state needs fingers {list(tuple(Finger))}, has {[f.name for f in state.fingers]}"
@@ -343,7 +348,8 @@ def frictional_resistance(
     outcome = None
     while outcome is None:
         segments = {f: tuple(c.node for c in state.segment(f)) for f in tuple(Finger)}
-        stage = optimal_resistance(resistance_grasp(model.obj, segments), a_hat, mode=mode)
+        stage = optimal_resistance(resistance_grasp(model.obj, segments), a_hat, mode=mode,
+                                   per_unit_push=True)
         if not stage.success:
             outcome = (False, stage.reason)
             break

@@ -30,7 +30,11 @@ from squeeze_grasp_ros.mechanics.squeeze.contact_state import (
     Sample,
     initial_state,
 )
-from squeeze_grasp_ros.mechanics.errors import InvalidInputError, require_finite
+from squeeze_grasp_ros.mechanics.errors import (
+    InvalidInputError,
+    require_finite,
+    require_relative_depth,
+)
 from squeeze_grasp_ros.mechanics.elastic.strain_measures import max_principal_strains
 from squeeze_grasp_ros.mechanics.elastic.stress_measures import element_stresses, von_mises
 from squeeze_grasp_ros.mechanics.squeeze.fingertips import place_fingertip
@@ -533,13 +537,7 @@ def event_squeeze(
                 "the fingers do not approach each other: relative depth undefined"
             )
         depth = relative_depth / relative_per_depth
-    require_finite("depth", depth)
-    if depth < 0 or depth * relative_per_depth >= 1.0:
-        raise InvalidInputError(
-            f"depth {depth:.6g} m is a relative depth of "
-            f"{depth * relative_per_depth:.6g}: it must be in [0, 1) (at 1 the "
-            "fingers would meet)"
-        )
+    require_relative_depth(depth * relative_per_depth, depth)
     tips = [place_fingertip(obj.mesh, n, int(c), radii[n]) for n, c in zip(names, contacts)]
     model = contact_model(material_model, obj, mu, limits or Limits(), reference,
                           max_events_per_depth)

@@ -172,7 +172,7 @@ class TangentFactor:
     tangent: sp.csr_matrix | None = field(default=None, repr=False)
     fallbacks: int = 0
     _upper: sp.csc_matrix | None = field(default=None, repr=False)
-    _ldlt: "qdldl.Solver | None" = field(default=None, repr=False)
+    _ldlt: "object | None" = field(default=None, repr=False)  # a qdldl.Solver
     _cholesky: tuple | None = field(default=None, repr=False)
     _solve: Callable[[np.ndarray], np.ndarray] | None = field(default=None, repr=False)
     _masks: dict = field(default_factory=dict, repr=False)

@@ -26,8 +26,9 @@ from squeeze_grasp_ros.sweep.evaluate import COLUMNS, run_task
 from squeeze_grasp_ros.sweep.plan import objects, plan_tasks
 from squeeze_grasp_ros.sweep.spec import SweepError, SweepSpec, parse_sweep_spec, sweep_help
 
-pa = pytest.importorskip("pyarrow")
-pytest.importorskip("distributed")
+SWEEP_EXTRA = "the sweep extra is not installed: pip install '.[sweep]' (Dask, pyarrow)"
+pa = pytest.importorskip("pyarrow", reason=SWEEP_EXTRA)
+pytest.importorskip("distributed", reason=SWEEP_EXTRA)
 
 ROOT = Path(__file__).resolve().parents[1]
 BASE = str(ROOT / "config" / "scenes" / "foam_square.yaml")

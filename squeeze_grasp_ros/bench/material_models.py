@@ -218,7 +218,7 @@ def run(quick: bool, out_dir: Path, progress) -> list[Table]:
     ax.set_xlabel("relative depth [%]")
     ax.set_ylabel("finger force vs linear [%]")
     ax.set_title("finite deformation vs linear")
-    ax.legend(fontsize=7)
+    plots.legend(ax, ncol=2, fontsize=7)
     plots.save(fig, out_dir / png)
     progress("material_models: cost of a 12 % foam-square squeeze")
     cost = []

@@ -224,6 +224,7 @@ def plot_grasp(ring: RingModel, grasp: RingGrasp, depth: float, path: str) -> st
             fc="none",
             ec="0.6",
             ls=":",
+            label="friction cone, undeformed" if k == 0 else None,
         )
         _cone(
             ax0,
@@ -233,12 +234,15 @@ def plot_grasp(ring: RingModel, grasp: RingGrasp, depth: float, path: str) -> st
             0.18 * size,
             color="0.5",
             alpha=0.4,
+            label="friction cone, deformed" if k == 0 else None,
         )
-    plots.draw_arrows(ax0, after[grasp.contacts], grasp.forces, 0.25 * size, "purple", "forces")
+    longest = float(np.linalg.norm(grasp.forces, axis=1).max())
+    plots.draw_arrows(ax0, after[grasp.contacts], grasp.forces, 0.25 * size, "purple",
+                      f"finger force on the ring (longest {longest:.3g} N)")
     ax0.set_aspect("equal")
     ax0.set_xlabel("x [m]")
     ax0.set_ylabel("y [m]")
-    ax0.legend(fontsize=7, loc="upper right")
+    plots.legend(ax0, ncol=2)
     ax0.set_title(
         f"nodes {grasp.contacts.tolist()}: {grasp.limit} at {grasp.max_relative_depth:.3g}"
     )
@@ -253,7 +257,7 @@ def plot_grasp(ring: RingModel, grasp: RingGrasp, depth: float, path: str) -> st
     ax1.axvline(grasp.relative_depth(depth), color="k", lw=0.8, ls=":", label="requested")
     ax1.set_xlabel("relative depth")
     ax1.set_ylabel("angle [deg]")
-    ax1.legend(fontsize=7)
+    plots.legend(ax1, ncol=2)
     ax1.set_title("cone rotation: force-to-normal angle")
     return plots.save(fig, path)
 
@@ -297,7 +301,7 @@ def plot_map(ring: RingModel, gmap: RingGraspMap, path: str) -> str:
     )
     for color, name in zip(colors[1:], names):
         ax1.plot([], [], "s", color=color, label=name)
-    ax1.legend(fontsize=6, loc="upper left")
+    plots.legend(ax1, ncol=2)
     target = gmap.requested_relative_depth
     ax1.set_title("limit" + (f" / success at relative depth {target:.3g}" if target else ""))
     for ax in (ax0, ax1):
@@ -315,7 +319,7 @@ def plot_map(ring: RingModel, gmap: RingGraspMap, path: str) -> str:
             label=f"{best['contacts']}: {best['max_relative_depth']:.3g}",
         )
     ax2.set_aspect("equal")
-    ax2.legend(fontsize=6)
+    plots.legend(ax2, ncol=2, title="F1, F2 nodes: max relative depth", title_fontsize=8)
     ax2.set_title("deepest placements")
     return plots.save(fig, path)
 

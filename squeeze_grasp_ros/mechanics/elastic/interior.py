@@ -37,7 +37,6 @@ from contextlib import contextmanager
 from dataclasses import dataclass, field
 
 import numpy as np
-import qdldl
 import scipy.sparse as sp
 
 from squeeze_grasp_ros.extras import install_hint, installed
@@ -173,7 +172,7 @@ class TangentFactor:
     tangent: sp.csr_matrix | None = field(default=None, repr=False)
     fallbacks: int = 0
     _upper: sp.csc_matrix | None = field(default=None, repr=False)
-    _ldlt: "qdldl.Solver | None" = field(default=None, repr=False)
+    _ldlt: "object | None" = field(default=None, repr=False)  # a qdldl.Solver
     _cholesky: tuple | None = field(default=None, repr=False)
     _solve: Callable[[np.ndarray], np.ndarray] | None = field(default=None, repr=False)
     _masks: dict = field(default_factory=dict, repr=False)
@@ -254,6 +253,8 @@ class TangentFactor:
             If QDLDL meets a zero pivot.
         """
         if self._ldlt is None:
+            import qdldl  # only the large-deformation models need it (``pip install qdldl``)
+
             self._ldlt = qdldl.Solver(upper, upper=True)
         else:
             self._ldlt.update(upper, upper=True)
@@ -296,6 +297,8 @@ class TangentFactor:
             L = cholmod.getfactor(factor)
             counts = np.bincount(np.asarray(L.J).reshape(-1), minlength=upper.shape[0])
         else:
+            import qdldl
+
             L = qdldl.Solver(upper, upper=True).factors()[0]
             counts = np.diff(L.indptr) + 1
         return Fill(int(counts.sum()), float(np.sum(counts.astype(float) ** 2)))

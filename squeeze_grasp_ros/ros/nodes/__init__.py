@@ -18,6 +18,7 @@ from rclpy.node import Node
 from rclpy.signals import SignalHandlerOptions
 
 from squeeze_grasp_ros.exit_codes import ExitCode
+from squeeze_grasp_ros.mechanics.errors import InvalidInputError
 
 
 PARENT_PID_ENV = "SQUEEZE_GRASP_PARENT_PID"
@@ -59,8 +60,12 @@ def parent_watch(stop: threading.Event) -> Callable[[], bool]:
     return lambda: died.is_set() or os.getppid() != parent
 
 
+class ParameterError(InvalidInputError):
+    """A node parameter is missing or invalid; the message names it."""
+
+
 def run_node(factory: Callable[[], Node], args: list[str] | None = None,
-             executor_type: Callable[[], Executor] = EventsExecutor) -> None:
+             executor_type: Callable[[], Executor] = EventsExecutor) -> int:
     """A node's ``main``: init rclpy, spin the node in the main thread until SIGINT, SIGTERM or
     shutdown, then clean up.
 
@@ -83,19 +88,29 @@ def run_node(factory: Callable[[], Node], args: list[str] | None = None,
         Command-line arguments for ``rclpy.init`` (``--ros-args ...``); None = ``sys.argv``.
     executor_type : callable
         Builds the executor.
+
+    Returns
+    -------
+    int
+        The exit code: 0, or 2 (:attr:`~.ExitCode.USAGE`) when the node refused its
+        parameters (a missing scene, output folder, ...). That error is one line on stderr,
+        ``<program>: error: <what>``, not a traceback. Once built, the node logs
+        ``<name> ready: <its configuration>``.
     """
     stop = threading.Event()
     for signum in (signal.SIGINT, signal.SIGTERM):
         signal.signal(signum, lambda *_: stop.set())
     orphaned = parent_watch(stop)
     rclpy.init(args=args, signal_handler_options=SignalHandlerOptions.NO)
-    executor = executor_type()
     try:
         node = factory()
-    except ValueError as exc:  # a bad parameter (e.g. a recorder that cannot start its bag)
-        print(f"{getattr(factory, '__name__', 'node')}: {exc}", file=sys.stderr)
+    except ValueError as error:  # InvalidInputError, or a recorder that cannot start its bag
+        print(f"{Path(sys.argv[0]).stem}: error: {error}", file=sys.stderr)
         rclpy.try_shutdown()
-        raise SystemExit(int(ExitCode.USAGE)) from None
+        return ExitCode.USAGE
+    summary = getattr(node, "ready_summary", lambda: "")()
+    node.get_logger().info(f"{node.get_name()} ready" + (f": {summary}" if summary else ""))
+    executor = executor_type()
     executor.add_node(node)
     try:
         while rclpy.ok() and not stop.is_set() and not orphaned():
@@ -116,3 +131,4 @@ def run_node(factory: Callable[[], Node], args: list[str] | None = None,
         executor.shutdown()
         node.destroy_node()
         rclpy.try_shutdown()
+    return ExitCode.OK

@@ -29,6 +29,7 @@ from __future__ import annotations
 
 import math
 import queue
+import sys
 import threading
 import time
 from collections.abc import Callable
@@ -169,8 +170,10 @@ class PlannerNode(Node):
                          self._execute_event_squeeze, cancel_callback=self._accept_cancel,
                          callback_group=self._group, **queues),
         ]
-        self.get_logger().info(f"planner ready: {self.limits}; files from "
-                               f"{[str(r) for r in self.roots]}")
+
+    def ready_summary(self) -> str:
+        """What the ready line of ``ros2 run`` says: the limits and the readable folders."""
+        return f"{self.limits}; files from {[str(r) for r in self.roots]}"
 
     def _parameter(self, name: str) -> Any:
         """The value of a declared parameter (an int given for a float is accepted)."""
@@ -430,10 +433,12 @@ class PlannerNode(Node):
         super().destroy_node()
 
 
-def main(args: list[str] | None = None) -> None:
-    """Run the planner on a SingleThreadedExecutor in the main thread until Ctrl-C or shutdown."""
-    run_node(PlannerNode, args, SingleThreadedExecutor)
+def main(args: list[str] | None = None) -> int:
+    """Run the planner on a SingleThreadedExecutor in the main thread until Ctrl-C or
+    shutdown; return the exit code.
+    """
+    return run_node(PlannerNode, args, SingleThreadedExecutor)
 
 
 if __name__ == "__main__":
-    main()
+    sys.exit(main())

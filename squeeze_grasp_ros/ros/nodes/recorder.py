@@ -26,6 +26,8 @@ already arrived, then ``close`` writes the MCAP summary and ``metadata.yaml``.
 """
 from __future__ import annotations
 
+import sys
+
 import struct
 import time
 from collections import deque
@@ -39,7 +41,7 @@ from std_msgs.msg import Header
 from squeeze_grasp_ros.ros import messages
 from squeeze_grasp_ros.ros.recording.bag import BagWriter, qos_dict
 from squeeze_grasp_ros.ros.recording.schema import starts_with_stamp
-from squeeze_grasp_ros.ros.nodes import pipeline, run_node
+from squeeze_grasp_ros.ros.nodes import ParameterError, pipeline, run_node
 
 PARAMETERS: dict[str, tuple[Any, str]] = {
     "output": ("", "bag folder to create (required; must not exist or be empty)"),
@@ -83,7 +85,8 @@ class RecorderNode(Node):
         super().__init__("recorder", **kwargs)
         self.p = p = pipeline.declare(self, PARAMETERS)
         if not p["output"]:
-            raise ValueError("parameter 'output' (the bag folder) is required")
+            raise ParameterError("parameter 'output' (the bag folder) is required: "
+                                 "--ros-args -p output:=/path/to/bag")
         custom = yaml.safe_load(p["custom_data"]) or {}
         self.writer = BagWriter(p["output"], p["compression"], p["chunk_size"],
                                 {str(k): str(v) for k, v in custom.items()})
@@ -122,6 +125,11 @@ class RecorderNode(Node):
             self.participant = pipeline.Participant(self, "recorder", [pipeline.TICK],
                                                     [self.progress_pub])
             pipeline.wall_timer(self, 0.05, self._repeat_report)
+
+
+    def ready_summary(self) -> str:
+        """What the ready line of ``ros2 run`` says: the bag and how many topics."""
+        return f"recording {len(self.types)} topics into {self.p['output']}"
 
     def _offered_qos(self, topic: str) -> list[dict]:
         def name(policy: str, value) -> str:
@@ -185,10 +193,10 @@ class RecorderNode(Node):
         self.writer.close()
 
 
-def main(args: list[str] | None = None) -> None:
-    """Record until Ctrl-C or shutdown, then finish the bag."""
-    run_node(RecorderNode, args)
+def main(args: list[str] | None = None) -> int:
+    """Record until Ctrl-C or shutdown, then finish the bag; return the exit code."""
+    return run_node(RecorderNode, args)
 
 
 if __name__ == "__main__":
-    main()
+    sys.exit(main())

@@ -3,8 +3,9 @@
 """Console-script entry points: configure the process, then import and run the target.
 
 Each sets single-threaded BLAS (:func:`squeeze_grasp_ros.threads.single_thread_blas`)
-before numpy is loaded, unless the user set the variables; importing the package as a library
-changes nothing.
+before numpy is loaded, unless the user set the variables; ``squeeze-grasp`` also keeps its
+standard output for its results (:func:`squeeze_grasp_ros.stdout.reserve_stdout`: the
+middleware's diagnostics go to stderr). Importing the package as a library changes nothing.
 """
 from __future__ import annotations
 
@@ -13,6 +14,7 @@ import signal
 import sys
 
 from squeeze_grasp_ros.exit_codes import raise_on_signals
+from squeeze_grasp_ros.stdout import reserve_stdout
 from squeeze_grasp_ros.threads import single_thread_blas
 
 __all__ = ["cli", "executor", "monitor", "planner", "recorder", "sim_hardware"]
@@ -35,6 +37,7 @@ def _run(module: str, name: str):
 
 def cli():
     """``squeeze-grasp``."""
+    reserve_stdout()
     return _run("squeeze_grasp_ros.cli", "squeeze-grasp")
 
 

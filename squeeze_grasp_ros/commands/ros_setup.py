@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import argparse
 
-from squeeze_grasp_ros.ros import interfaces as ros_setup
+from squeeze_grasp_ros.buildtool import interfaces as ros_setup
 
 HELP = ros_setup.DESCRIPTION
 

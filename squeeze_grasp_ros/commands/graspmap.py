@@ -19,11 +19,6 @@ from squeeze_grasp_ros.commands.common import (
     load_solid,
 )
 
-HELP = (
-    "all-pairs grasp map: stiffness, inwardness and force closure of every placement "
-    "(ring scenes: feasibility and maximum depth, Sec. 7)"
-)
-
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     """SCENE, --pairs, --solver, --plot."""

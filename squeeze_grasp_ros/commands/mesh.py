@@ -9,8 +9,6 @@ from squeeze_grasp_ros import plots
 from squeeze_grasp_ros.scene import build_mesh, load_scene, scene_material
 from squeeze_grasp_ros.commands.common import add_plot_argument, add_scene_argument
 
-HELP = "triangulate the scene's object (nodes, triangles, boundary loop, material)"
-
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     """SCENE and --plot."""

@@ -20,7 +20,6 @@ from squeeze_grasp_ros.commands.common import (
 )
 from squeeze_grasp_ros.mechanics.vocabulary import SqueezeKind
 
-HELP = "stable and pure squeezes at the scene's finger placements (point contacts, Sec. 3-4)"
 DEFAULT_RELATIVE_DEPTH = 0.05
 """Relative depth used when neither the scene nor the command line gives a depth."""
 

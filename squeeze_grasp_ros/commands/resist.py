@@ -44,7 +44,6 @@ from squeeze_grasp_ros.commands.common import (
 )
 from squeeze_grasp_ros.mechanics.vocabulary import ContactMode, Finger, SqueezeKind
 
-HELP = "optimal stable/pure resistance of F1, F2 to the scene's adversary finger A (Sec. 6)"
 CONTACT_MODELS = ("point", "segment", "friction")
 
 

@@ -30,7 +30,6 @@ from squeeze_grasp_ros.mechanics.vocabulary import SQUEEZING_FINGERS, StrainMeas
 
 MAX_BEST = 10_000
 """Most placements ``--map --best`` lists."""
-HELP = "ring-like object, two point fingers (Sec. 7): max squeeze depth, limit, all-pairs map"
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:

@@ -7,11 +7,10 @@ import argparse
 
 from squeeze_grasp_ros.buildtool import interfaces as ros_setup
 
-HELP = ros_setup.DESCRIPTION
-
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     """--source, --force, --verbose, --check."""
+    parser.description = ros_setup.DESCRIPTION
     ros_setup.add_arguments(parser)
 
 

@@ -18,8 +18,6 @@ from pathlib import Path
 from squeeze_grasp_ros.exit_codes import ExitCode, raise_on_signals
 from squeeze_grasp_ros.commands.common import add_scene_argument, fail, new_folder
 
-HELP = ("run a scene through the planner, executor, simulated hardware, monitor and recorder "
-        "nodes (lockstep sim time) and summarise it")
 EXECUTOR_CHOICES: tuple[str, ...] = ("events", "single")
 """``--executor`` values (equal to ``nodes.runner.EXECUTORS``; kept here so that building the CLI
 parser never imports rclpy: ``squeeze-grasp ros-setup`` must run before the interfaces exist)."""

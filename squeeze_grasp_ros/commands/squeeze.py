@@ -29,7 +29,6 @@ from squeeze_grasp_ros.mechanics.elastic.strain_measures import COMMON_STRAIN_ME
 from squeeze_grasp_ros.mechanics.vocabulary import (ContactMode, EventType, Finger, MaterialModel,
                                                     StrainMeasure, StressMeasure)
 
-HELP = "event-driven squeeze with rounded fingertips under Coulomb friction (Sec. 5, Algorithm 1)"
 BAR_WIDTH = 30
 
 

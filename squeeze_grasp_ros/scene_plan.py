@@ -84,12 +84,14 @@ def resistance_goal(scene: Scene, obj: ElasticObject | None = None,
     }
 
 
-def plan_scene(scene: Scene, *, on_slip_alarm: str = "hold", resist: bool = True) -> ScenePlan:
+def plan_scene(scene: Scene, *, on_slip_alarm: str = "hold", resist: bool = True,
+               obj: ElasticObject | None = None) -> ScenePlan:
     """Plan the scene's grasp with the mechanics: one event-driven squeeze, the pure directions
-    at the same contacts and, for a frictional adversary, the resistance waypoints.
+    at the same contacts and, for a frictional adversary, the resistance waypoints. ``obj`` is
+    the scene's meshed object if it was built already (default: built here).
     """
     t0 = time.perf_counter()
-    obj = scene_solid(scene)
+    obj = scene_solid(scene) if obj is None else obj
     contacts = finger_nodes(scene, obj.mesh)
     result = event_squeeze_scene(scene, obj, contacts)
     directions = np.array([result.directions[f] for f in SQUEEZING_FINGERS])

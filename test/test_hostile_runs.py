@@ -165,7 +165,7 @@ def test_stale_parameter_files_are_removed_at_the_next_start(tmp_path):
     """
     import tempfile
 
-    from squeeze_grasp_ros.ros.run.runner import remove_stale_parameter_files
+    from squeeze_grasp_ros.ros.run.processes import remove_stale_parameter_files
 
     gone = subprocess.run([sys.executable, "-c", "import os; print(os.getpid())"],
                           capture_output=True, text=True).stdout.strip()

@@ -7,7 +7,7 @@ from __future__ import annotations
 from collections.abc import Callable
 
 from squeeze_grasp_ros.mechanics.elastic.compliance import ElasticObject
-from squeeze_grasp_ros.mechanics.squeeze.contact_model import ContactModel, Limits
+from squeeze_grasp_ros.mechanics.squeeze.contact_model import ContactModel, Limits, SolveOptions
 from squeeze_grasp_ros.mechanics.squeeze.nonlinear_model import contact_model
 from squeeze_grasp_ros.mechanics.squeeze.events import EventSqueeze, event_squeeze
 from squeeze_grasp_ros.scene import Scene, SceneError, finger_nodes, scene_solid
@@ -50,6 +50,7 @@ def event_squeeze_scene(
     reference: bool = False,
     progress: Callable[[float], None] | None = None,
     material_model: MaterialModel | str | None = None,
+    options: SolveOptions | None = None,
 ) -> EventSqueeze:
     """Run the scene's squeeze with rounded fingertips; arguments override the scene's values.
 
@@ -71,6 +72,8 @@ def event_squeeze_scene(
         Called with the completed fraction of the depth.
     material_model : MaterialModel or str, optional
         Constitutive model; default the scene's ``object.material.model``.
+    options : SolveOptions, optional
+        Switches of the large-deformation savings (see :func:`event_squeeze`).
 
     Raises
     ------
@@ -118,4 +121,5 @@ def event_squeeze_scene(
         directions=directions,
         progress=progress,
         material_model=scene.object.material.model if material_model is None else material_model,
+        options=options,
     )

@@ -21,6 +21,7 @@ from squeeze_grasp_ros.mechanics.elastic.compliance import ElasticObject
 from squeeze_grasp_ros.mechanics.squeeze.contact_model import (
     ContactModel,
     Limits,
+    SolveOptions,
 )
 from squeeze_grasp_ros.mechanics.squeeze.contact_state import (
     Chatter,
@@ -425,6 +426,7 @@ def event_squeeze(
     directions: Mapping[str, tuple[float, float]] | None = None,
     progress: Callable[[float], None] | None = None,
     material_model: MaterialModel | str = MaterialModel.LINEAR,
+    options: SolveOptions | None = None,
 ) -> EventSqueeze:
     """Event-driven two-finger squeeze of ``obj`` from initial contact nodes (F1, F2).
 
@@ -457,6 +459,9 @@ def event_squeeze(
     material_model : MaterialModel or str
         ``linear`` (the paper's small-strain model, default), ``corotational`` or
         ``neo_hookean`` (finite deformation: :mod:`.nonlinear_model`).
+    options : SolveOptions, optional
+        Switches of the large-deformation savings (adaptive substeps, factorisation reuse),
+        for measuring them; default both on.
 
     Examples
     --------
@@ -504,7 +509,7 @@ def event_squeeze(
         )
     tips = [place_fingertip(obj.mesh, n, int(c), radii[n]) for n, c in zip(names, contacts)]
     model = contact_model(material_model, obj, mu, limits or Limits(), reference,
-                          max_events_per_depth)
+                          max_events_per_depth, options or SolveOptions())
     run = squeeze_to_depth(
         model, initial_state(tips, relative_per_depth), dirs, depth, step, event_tol, progress
     )

@@ -17,13 +17,13 @@ True
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field
 from enum import Enum
 
 from squeeze_grasp_ros.mechanics.vocabulary import EventType, Termination
 
-__all__ = ["ANY_FINGER", "EventFunction", "EventKey", "PROCESSING_ORDER", "WHOLE_OBJECT",
-           "processing_rank"]
+__all__ = ["ANY_FINGER", "EventFunction", "EventKey", "KeyTable", "PROCESSING_ORDER",
+           "WHOLE_OBJECT", "processing_rank"]
 
 PROCESSING_ORDER: tuple[EventType, ...] = (EventType.B, EventType.D, EventType.C, EventType.A)
 """Processing order of simultaneous events: break < slip -> stick < stick -> slip < new
@@ -115,6 +115,14 @@ class EventKey:
     function: EventFunction
     node: int = WHOLE_OBJECT
     finger: int = ANY_FINGER
+    _hash: int = field(init=False, repr=False, compare=False)
+
+    def __post_init__(self) -> None:
+        # keys are hashed in every dict of function values: once here, not at each look-up
+        object.__setattr__(self, "_hash", hash((self.function, self.node, self.finger)))
+
+    def __hash__(self) -> int:
+        return self._hash
 
     @classmethod
     def gap(cls, node: int, finger: int) -> EventKey:
@@ -126,9 +134,44 @@ class EventKey:
         """The key without its finger: the form of :attr:`.ContactState.fresh`, where a freed
         node's gap is zero to whichever tip released it.
         """
-        return replace(self, finger=ANY_FINGER) if self.finger != ANY_FINGER else self
+        return self if self.finger == ANY_FINGER else EventKey(self.function, self.node)
 
     @property
     def rank(self) -> int:
         """Processing rank of its event type (:func:`processing_rank`)."""
         return processing_rank(self.function.event_type)
+
+
+class KeyTable:
+    """Each key made once: the stepper's tables of function values hold hundreds of keys per
+    substep (a gap per free boundary node and finger), and making a frozen dataclass costs
+    about a microsecond, ten times a look-up here. One table per object (its contact model
+    keeps it across stepper calls).
+
+    >>> table = KeyTable()
+    >>> table.get(EventFunction.NORMAL_FORCE, 4) is table.get(EventFunction.NORMAL_FORCE, 4)
+    True
+    >>> table.gaps([7, 9], fingers=2)[1] == (EventKey.gap(9, 0), EventKey.gap(9, 1))
+    True
+    """
+
+    def __init__(self) -> None:
+        self._keys: dict[tuple, EventKey] = {}
+        self._gaps: dict[tuple, list[tuple[EventKey, ...]]] = {}
+
+    def get(self, function: EventFunction, node: int = WHOLE_OBJECT,
+            finger: int = ANY_FINGER) -> EventKey:
+        """The key of (function, node, finger)."""
+        made = self._keys.get((function, node, finger))
+        if made is None:
+            made = self._keys[(function, node, finger)] = EventKey(function, node, finger)
+        return made
+
+    def gaps(self, nodes: list[int], fingers: int) -> list[tuple[EventKey, ...]]:
+        """Per node of ``nodes`` (a boundary loop), its gap keys to fingers 0 .. fingers - 1."""
+        made = self._gaps.get((tuple(nodes), fingers))
+        if made is None:
+            made = [tuple(self.get(EventFunction.GAP, node, f) for f in range(fingers))
+                    for node in nodes]
+            self._gaps[(tuple(nodes), fingers)] = made
+        return made

@@ -37,7 +37,7 @@ import numpy as np
 
 from squeeze_grasp_ros.mechanics.squeeze.contact_model import (INVERSION_AREA_RATIO,
                                                                ContactModel, Solution)
-from squeeze_grasp_ros.mechanics.squeeze.event_key import EventFunction, EventKey
+from squeeze_grasp_ros.mechanics.squeeze.event_key import EventFunction, EventKey, KeyTable
 from squeeze_grasp_ros.mechanics.squeeze.stepper.contact_set import ContactSet
 from squeeze_grasp_ros.mechanics.squeeze.stepper.motion import FingerMotion
 from squeeze_grasp_ros.mechanics.vocabulary import Termination
@@ -155,6 +155,16 @@ class EventFunctions:
         return self.model.obj.boundary_positions(nodes)
 
     @cached_property
+    def keys(self) -> KeyTable:
+        """The object's event keys (kept by its model across calls)."""
+        return self.model._cache.setdefault("event_keys", KeyTable())
+
+    @cached_property
+    def _gap_keys(self) -> list[tuple[EventKey, ...]]:
+        """The gap keys of every boundary loop position, one per finger."""
+        return self.keys.gaps(self.model.boundary_nodes.tolist(), len(self.motion.names))
+
+    @cached_property
     def _boundary(self) -> np.ndarray:
         """Undeformed positions / L (b, 2) of the outer boundary loop."""
         return self.model.positions(self.model.boundary_nodes)
@@ -209,25 +219,25 @@ class EventFunctions:
         (mask) its normal force and its cone margins or slip rate, then every free boundary
         row's gaps, then the terminations that are checked.
         """
-        out = []
+        out, key = [], self.keys.get
         for k, node in enumerate(contacts.nodes.tolist()):
             if held[k]:
                 continue
-            out.append((EventKey(EventFunction.NORMAL_FORCE, node), v.fn[k]))
+            out.append((key(EventFunction.NORMAL_FORCE, node), v.fn[k]))
             if self.frictionless:
                 continue
             if contacts.stick[k]:
-                out.append((EventKey(EventFunction.CONE_PLUS, node), v.c_plus[k]))
-                out.append((EventKey(EventFunction.CONE_MINUS, node), v.c_minus[k]))
+                out.append((key(EventFunction.CONE_PLUS, node), v.c_plus[k]))
+                out.append((key(EventFunction.CONE_MINUS, node), v.c_minus[k]))
             else:
-                out.append((EventKey(EventFunction.SLIP_RATE, node), v.d[k]))
-        for r, node in enumerate(self.model.boundary_nodes[rows].tolist()):
-            for f in range(len(self.motion.names)):
-                out.append((EventKey.gap(node, f), v.gaps[r, f]))
+                out.append((key(EventFunction.SLIP_RATE, node), v.d[k]))
+        gap_keys = self._gap_keys
+        for r, row in enumerate(rows.tolist()):
+            out.extend(zip(gap_keys[row], v.gaps[r]))
         for function, value in ((EventFunction.AREA, v.area), (EventFunction.STRAIN, v.strain),
                                 (EventFunction.PICKUP, v.pickup)):
             if np.isfinite(value):
-                out.append((EventKey(function), value))
+                out.append((key(function), value))
         return out
 
     def slopes(self, contacts: ContactSet, sol: Solution, s: float,
@@ -243,13 +253,14 @@ class EventFunctions:
             points = self._boundary_points(contacts, sol, rows)
             velocities = self.model.boundary_rate(contacts.data, sol, rows)
             g_rate = self.motion.gap_slopes(points, velocities, s)
-            for j, node in enumerate(self.model.boundary_nodes[rows].tolist()):
-                for f in range(len(self.motion.names)):
-                    out[EventKey.gap(node, f)] = float(g_rate[j, f])
+            gap_keys = self._gap_keys
+            for j, row in enumerate(rows.tolist()):
+                out.update(zip(gap_keys[row], g_rate[j].tolist()))
+        key = self.keys.get
         for k, node in enumerate(contacts.nodes.tolist()):
-            out[EventKey(EventFunction.NORMAL_FORCE, node)] = float(fn_r[k])
-            out[EventKey(EventFunction.CONE_PLUS, node)] = float(mu * fn_r[k] + ft_r[k])
-            out[EventKey(EventFunction.CONE_MINUS, node)] = float(mu * fn_r[k] - ft_r[k])
+            out[key(EventFunction.NORMAL_FORCE, node)] = float(fn_r[k])
+            out[key(EventFunction.CONE_PLUS, node)] = float(mu * fn_r[k] + ft_r[k])
+            out[key(EventFunction.CONE_MINUS, node)] = float(mu * fn_r[k] - ft_r[k])
         return out
 
     def value(self, key: EventKey, contacts: ContactSet, sol: Solution, s: float) -> float:

@@ -163,7 +163,7 @@ def dips_inside(a: float, b: float, start: Values, end: Values, start_slopes: Va
     construction at a: ``fresh``), goes to zero inside on its cubic Hermite interpolant.
     """
     keys = [key for key in end_slopes if key in start_slopes and key in start and key in end
-            and start[key] > 0 and end[key] > 0 and key.at_node not in fresh]
+            and start[key] > 0 and end[key] > 0 and (not fresh or key.at_node not in fresh)]
     return bool(hermite_dips(a, b, *(np.array([v[key] for key in keys])
                                      for v in (start, end, start_slopes, end_slopes))).any())
 

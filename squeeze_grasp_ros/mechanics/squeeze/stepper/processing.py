@@ -152,7 +152,7 @@ class EventProcessor:
         out = []
         for key, value in functions.entries(contacts, v, rows,
                                             self.chatter.held(contacts.nodes, depth)):
-            if key.at_node in self.fresh and key in slopes:
+            if key in slopes and key.at_node in self.fresh:
                 if key.function == EventFunction.GAP and value > self.tol:
                     continue  # a freed node is at zero gap only to the finger that released it
                 if slopes[key] < 0:

@@ -4,7 +4,8 @@
 
 Scenes and shipped files, meshes and elastic objects, stable and pure squeezes, the
 event-driven squeeze with rounded fingertips (Algorithm 1), grasp maps, resistance, rings,
-calibration, the domain vocabulary and the error kinds. SI units throughout; lengths in m,
+calibration, objects seen by a camera (outline extraction needs the ``perception`` extra), the
+domain vocabulary and the error kinds. SI units throughout; lengths in m,
 forces in N, the object frame x right, y up. Everything else in the package is internal and
 may move.
 
@@ -54,8 +55,14 @@ from squeeze_grasp_ros.mechanics.squeeze.events import EventSqueeze, event_squee
 from squeeze_grasp_ros.mechanics.squeeze.graspmap import GraspMap, grasp_map
 from squeeze_grasp_ros.mechanics.squeeze.stable_pure import Squeeze, plan_squeeze
 from squeeze_grasp_ros.mechanics.vocabulary import (ContactMode, EventType, Finger,
-                                                    MaterialModel, SqueezeKind,
-                                                    StrainCriterion, Termination)
+                                                    ImageEncoding, MaterialModel, ShapeFit,
+                                                    SqueezeKind, StrainCriterion, Termination)
+from squeeze_grasp_ros.perception.camera import CameraModel, CameraPose
+from squeeze_grasp_ros.perception.camera_info import camera_from_info
+from squeeze_grasp_ros.perception.extract import ObjectOutline, extract_outline
+from squeeze_grasp_ros.perception.render import CameraViews, render_views
+from squeeze_grasp_ros.perception.shape_match import (ShapeMatch, deformed_outline,
+                                                      shape_residual)
 from squeeze_grasp_ros.resources import scene_file
 from squeeze_grasp_ros.scene import Scene, build_mesh, finger_nodes, load_scene, scene_solid
 from squeeze_grasp_ros.scene_events import event_squeeze_scene
@@ -74,9 +81,12 @@ __all__ = [
     "resistance_grasp", "optimal_resistance", "FrictionalResistance", "frictional_resistance",
     "RingModel", "ring_grasp", "ring_grasp_map", "Cuboid", "calibrate_elasticity",
     "match_similarity", "CompressionCurve", "fit_compression",
+    # objects seen by a camera
+    "CameraModel", "CameraPose", "camera_from_info", "CameraViews", "render_views",
+    "ObjectOutline", "extract_outline", "ShapeMatch", "deformed_outline", "shape_residual",
     # vocabulary
     "Finger", "EventType", "ContactMode", "Termination", "SqueezeKind", "StrainCriterion",
-    "MaterialModel",
+    "MaterialModel", "ImageEncoding", "ShapeFit",
     # errors
     "SqueezeGraspError", "InvalidInputError", "InfeasibleError", "NumericalError",
     "InternalError",

@@ -8,7 +8,7 @@ The layers, lowest first, are the ones docs/design.md draws:
 - ``mechanics``: the ROS-free core, inside it ``vocabulary``/``errors`` < ``elastic`` <
   ``squeeze`` < ``resistance``, ``ring``; ``calibration`` stands alone;
 - application: ``scene``, ``scene_events``, ``planning``, ``control``, ``sim``, ``plots``,
-``sweep``
+``sweep``, ``perception``
   and the front door ``api``;
 - ``ros``: the only folder that imports rclpy, ROS messages or the interfaces;
 - front ends: ``commands``, ``bench``, ``cli``, ``entry``.
@@ -33,7 +33,7 @@ LAYERS: tuple[tuple[str, ...], ...] = (
     ("inputs", "exit_codes", "extras", "resources", "threads"),
     ("mechanics",),
     ("scene", "scene_events", "scene_plan", "planning", "control", "sim", "plots", "sweep",
-     "api"),
+     "perception", "api"),
     ("ros",),
     ("commands", "bench", "cli", "entry"),
 )

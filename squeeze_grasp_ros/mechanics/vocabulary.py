@@ -16,8 +16,9 @@ from __future__ import annotations
 
 from enum import Enum
 
-__all__ = ["ContactMode", "EventType", "Finger", "MaterialModel", "SQUEEZING_FINGERS",
-           "SqueezeKind", "StrainCriterion", "Termination"]
+__all__ = ["ContactMode", "DistortionModel", "EventType", "Finger", "ImageEncoding",
+           "MaterialModel", "SQUEEZING_FINGERS", "ShapeFit", "SqueezeKind", "StrainCriterion",
+           "Termination"]
 
 
 class _Name(str, Enum):
@@ -106,3 +107,36 @@ class MaterialModel(_Name):
     """Linear stress in the element's rotated frame: exact under rigid rotation."""
     NEO_HOOKEAN = "neo_hookean"
     """Compressible neo-Hookean hyperelasticity in exact plane stress."""
+
+
+class ImageEncoding(_Name):
+    """``sensor_msgs/Image`` encodings that outline extraction reads (perception)."""
+
+    MONO8 = "mono8"
+    """A segmentation mask: 0 background, > 0 object (0-255 as coverage: 127.5 is the edge)."""
+    DEPTH_16UC1 = "16UC1"
+    """Depth in mm (uint16); 0 marks an invalid pixel."""
+    DEPTH_32FC1 = "32FC1"
+    """Depth in m (float32); NaN or 0 marks an invalid pixel."""
+
+
+class DistortionModel(_Name):
+    """``sensor_msgs/CameraInfo.distortion_model`` values that perception reads."""
+
+    PLUMB_BOB = "plumb_bob"
+    """Radial k1, k2, k3 and tangential p1, p2 (Brown-Conrady, as OpenCV)."""
+    RATIONAL_POLYNOMIAL = "rational_polynomial"
+    """Accepted only when its extra coefficients k4-k6 are zero (it is then plumb-bob)."""
+
+
+class ShapeFit(_Name):
+    """Transform fitted between an observed outline and a predicted boundary before the
+    residual is measured (perception, App. C).
+    """
+
+    SIMILARITY = "similarity"
+    """Scale, rotation and translation: App. C's least squares (eqs. 72-85)."""
+    RIGID = "rigid"
+    """Rotation and translation only (the scale of a calibrated camera is known)."""
+    NONE = "none"
+    """No transform: both curves are already in the same frame."""

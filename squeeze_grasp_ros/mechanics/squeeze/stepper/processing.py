@@ -147,8 +147,7 @@ class EventProcessor:
         rows = functions.free_rows(contacts, self.chatter.held_nodes(depth))
         v = functions.values(contacts, sol, self.s, rows, terminations=False)
         gap_nodes = [key.node for key in self.fresh if key.function == EventFunction.GAP]
-        slopes = functions.slopes(contacts, sol, self.s, functions.rows_of(gap_nodes)
-                                  if gap_nodes else np.zeros(0, int))
+        slopes = functions.slopes(contacts, sol, self.s, functions.rows_of(gap_nodes))
         out = []
         for key, value in functions.entries(contacts, v, rows,
                                             self.chatter.held(contacts.nodes, depth)):

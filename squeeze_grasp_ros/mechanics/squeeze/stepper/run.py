@@ -112,9 +112,9 @@ class _Call:
                 control.reject(a, b)
                 continue
             self.counters.substeps += 1
+            control.accept(sol, sol_b, a, b, start.values, end.values,
+                           bool(ev.contacts.stick.all()))
             if adaptive:
-                control.accept(sol, sol_b, a, b, start.values, end.values,
-                               bool(ev.contacts.stick.all()))
                 planned = control.h * rate
             if crossed and not self.model.reference:
                 b, sol_b = self.locate(crossed, sol, sol_b, a, b, start, end)

@@ -21,6 +21,14 @@ A F2 0.0113
 >>> print(result.termination, f"{result.relative_depth:.2f}")
 depth_reached 0.12
 
+Every strain and stress names its measure (the model's own; the peak in every measure too):
+
+>>> h = result.health
+>>> print(f"{h.max_strain:.4f}", h.strain_measure, f"{h.max_von_mises:.0f} Pa", h.stress_measure)
+0.2644 small 12923 Pa small_strain
+>>> print({str(m): round(v, 4) for m, v in h.max_principal_strain.items()})
+{'small': 0.2644, 'biot': 0.2615, 'log': 0.3031, 'green_lagrange': 0.2273}
+
 The same from its parts: the mesh, the fingers' initial contact nodes, the squeeze:
 
 >>> mesh = build_mesh(scene)
@@ -56,7 +64,8 @@ from squeeze_grasp_ros.mechanics.squeeze.graspmap import GraspMap, grasp_map
 from squeeze_grasp_ros.mechanics.squeeze.stable_pure import Squeeze, plan_squeeze
 from squeeze_grasp_ros.mechanics.vocabulary import (ContactMode, EventType, Finger,
                                                     ImageEncoding, MaterialModel, ShapeFit,
-                                                    SqueezeKind, StrainCriterion, Termination)
+                                                    SqueezeKind, StrainCriterion, StrainMeasure,
+                                                    StressMeasure, Termination)
 from squeeze_grasp_ros.perception.camera import CameraModel, CameraPose
 from squeeze_grasp_ros.perception.camera_info import camera_from_info
 from squeeze_grasp_ros.perception.extract import ObjectOutline, extract_outline
@@ -86,7 +95,7 @@ __all__ = [
     "ObjectOutline", "extract_outline", "ShapeMatch", "deformed_outline", "shape_residual",
     # vocabulary
     "Finger", "EventType", "ContactMode", "Termination", "SqueezeKind", "StrainCriterion",
-    "MaterialModel", "ImageEncoding", "ShapeFit",
+    "MaterialModel", "StrainMeasure", "StressMeasure", "ImageEncoding", "ShapeFit",
     # errors
     "SqueezeGraspError", "InvalidInputError", "InfeasibleError", "NumericalError",
     "InternalError",

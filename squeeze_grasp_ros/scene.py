@@ -216,11 +216,15 @@ class FrictionSpec:
 
 @dataclass(frozen=True)
 class StrainLimitSpec:
-    """Proportional limit (eq. 45)."""
+    """Proportional limit (eq. 45), on the material model's own strain measure."""
 
-    epsilon: float = spec("strain limit epsilon*", "", lo=0.0, lo_open=True)
+    epsilon: float = spec(
+        "strain limit epsilon*, on the material model's own strain: small strain sym(grad u) "
+        "(linear), Biot U - I (corotational), log ln U (neo_hookean); rings: the largest fibre "
+        "strain (small)", "", lo=0.0, lo_open=True)
     criterion: str = spec(
-        "principal: max |eps_1|,|eps_2|; componentwise: |eps_x|,|eps_y| (literal eq. 45)",
+        "principal: max |eps_1|,|eps_2|; componentwise: |eps_x|,|eps_y| (literal eq. 45; "
+        "linear model only)",
         choices=("principal", "componentwise"),
         default="principal",
     )

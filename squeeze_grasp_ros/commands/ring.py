@@ -17,11 +17,11 @@ import numpy as np
 
 from squeeze_grasp_ros import plots
 from squeeze_grasp_ros.mechanics.ring.grasp_map import RingGraspMap, bench_ring, ring_grasp_map
-from squeeze_grasp_ros.mechanics.ring.model import RingModel
+from squeeze_grasp_ros.mechanics.ring.model import FIBRE_STRAIN_MEASURE, RingModel
 from squeeze_grasp_ros.mechanics.ring.squeeze import LIMITS, RingGrasp, ring_grasp
 from squeeze_grasp_ros.scene import Scene, SceneError, build_ring, finger_nodes, load_scene
 from squeeze_grasp_ros.commands.common import add_plot_argument, add_scene_argument
-from squeeze_grasp_ros.mechanics.vocabulary import SQUEEZING_FINGERS, Termination
+from squeeze_grasp_ros.mechanics.vocabulary import SQUEEZING_FINGERS, StrainMeasure, Termination
 
 HELP = "ring-like object, two point fingers (Sec. 7): max squeeze depth, limit, all-pairs map"
 
@@ -154,6 +154,7 @@ def grasp_json(ring: RingModel, grasp: RingGrasp, depth: float) -> dict:
         "squeeze": grasp.kind,
         "mu": grasp.mu,
         "epsilon": grasp.epsilon,
+        "strain_measure": str(FIBRE_STRAIN_MEASURE),
         "contacts": [int(c) for c in grasp.contacts],
         "points": {f: ring.points[c].tolist() for f, c in zip(SQUEEZING_FINGERS, grasp.contacts)},
         "depth": float(depth),
@@ -322,7 +323,8 @@ def summary(result: dict) -> str:
     if "pairs" in result:
         lines = [
             f"{result['pairs']} placements on {result['elements']} nodes, mu={result['mu']}, "
-            f"epsilon={result['epsilon']}; limits: {result['limits']}"
+            f"epsilon={result['epsilon']} (largest fibre strain, "
+            f"{StrainMeasure(result['strain_measure']).label} strain); limits: {result['limits']}"
         ]
         if "feasible_pairs" in result:
             lines.append(
@@ -346,7 +348,8 @@ def summary(result: dict) -> str:
             f"requested depth {result['depth']:.4g} m (relative {result['relative_depth']:.4g}): "
             f"{verdict}",
             f"forces F1 {np.round(result['forces']['F1'], 4).tolist()} N, "
-            f"F2 {np.round(result['forces']['F2'], 4).tolist()} N; max strain "
-            f"{result['max_strain']:.4g}",
+            f"F2 {np.round(result['forces']['F2'], 4).tolist()} N; max fibre strain "
+            f"{result['max_strain']:.4g} ({StrainMeasure(result['strain_measure']).label} "
+            "strain)",
         ]
     )

@@ -25,8 +25,9 @@ from squeeze_grasp_ros.commands.common import (
     output_file,
 )
 from squeeze_grasp_ros.commands.csv_io import write_points
-from squeeze_grasp_ros.mechanics.elastic.hyperelastic import STRAIN_MEASURES
-from squeeze_grasp_ros.mechanics.vocabulary import ContactMode, EventType, Finger, MaterialModel
+from squeeze_grasp_ros.mechanics.elastic.strain_measures import COMMON_STRAIN_MEASURE
+from squeeze_grasp_ros.mechanics.vocabulary import (ContactMode, EventType, Finger, MaterialModel,
+                                                    StrainMeasure, StressMeasure)
 
 HELP = "event-driven squeeze with rounded fingertips under Coulomb friction (Sec. 5, Algorithm 1)"
 BAR_WIDTH = 30
@@ -83,8 +84,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "--compare-models",
         action="store_true",
         help="run the scene under every model and print forces, energy, contact widths, max "
-        "strain, events and termination side by side with the differences from linear; with "
-        "--plot, overlay the deformed outlines and the force-depth curves",
+        "strain (each model's own measure and the common Biot strain), max von Mises stress, "
+        "events and termination side by side with the differences from linear (strains like "
+        "for like, in every measure); with --plot, overlay the deformed outlines and the "
+        "force-depth curves",
     )
     add_solver_argument(parser)
     add_plot_argument(parser)
@@ -214,12 +217,13 @@ def plot(obj, res: EventSqueeze, path: str) -> str:
     return plots.save(fig, path)
 
 
-def _model_row(res: EventSqueeze, model: str, seconds: float) -> dict:
+def _model_row(res: EventSqueeze, seconds: float) -> dict:
     segments = {f: [s.node for s in seg] for f, seg in res.segments.items()}
     widths = {}
     for f, seg in res.segments.items():
         thetas = [s.theta for s in seg]
         widths[f] = 0.5 * res.tip_radius[f] * (max(thetas) - min(thetas)) if thetas else 0.0
+    h = res.health
     return {
         "termination": res.termination,
         "depth": res.depth,
@@ -228,8 +232,11 @@ def _model_row(res: EventSqueeze, model: str, seconds: float) -> dict:
         "energy": res.energy,
         "contact_half_width": widths,
         "contact_nodes": {f: len(nodes) for f, nodes in segments.items()},
-        "max_strain": res.health.max_strain,
-        "strain_measure": STRAIN_MEASURES[MaterialModel(model)],
+        "max_strain": h.max_strain,
+        "strain_measure": str(h.strain_measure),
+        "max_principal_strain": {str(m): v for m, v in h.max_principal_strain.items()},
+        "max_von_mises": h.max_von_mises,
+        "stress_measure": str(h.stress_measure),
         "event_counts": res.event_counts,
         "work_minus_energy": res.diagnostics["work_minus_energy"],
         "dissipation": sum(res.dissipation.values()),
@@ -239,7 +246,13 @@ def _model_row(res: EventSqueeze, model: str, seconds: float) -> dict:
 
 
 def compare_models(args: argparse.Namespace) -> dict:
-    """The scene under every material model, with relative differences from linear."""
+    """The scene under every material model, with relative differences from linear.
+
+    Strains are compared like for like: ``max_principal_strain`` holds every field's largest
+    principal strain in every measure, and its differences are taken measure by measure
+    (``common_strain_measure`` is the one the text shows). A model's own measure
+    (``max_strain``) is never compared with another model's.
+    """
     loaded = load_solid(args.scene, args.solver)
     loaded.obj.precompute()
     rows, results = {}, {}
@@ -250,7 +263,7 @@ def compare_models(args: argparse.Namespace) -> dict:
             loaded.scene, loaded.obj, loaded.contacts, depth=args.depth,
             relative_depth=args.relative_depth, step=args.step, event_tol=args.event_tol,
             material_model=model)
-        rows[model] = _model_row(res, model, time.perf_counter() - start)
+        rows[model] = _model_row(res, time.perf_counter() - start)
         results[model] = res
     base = rows[MaterialModel.LINEAR]
 
@@ -260,13 +273,15 @@ def compare_models(args: argparse.Namespace) -> dict:
     differences = {
         m: {"force": {f: rel(r["force"][f], base["force"][f]) for f in r["force"]},
             "energy": rel(r["energy"], base["energy"]),
-            "max_strain": rel(r["max_strain"], base["max_strain"]),
+            "max_principal_strain": {k: rel(v, base["max_principal_strain"][k])
+                                     for k, v in r["max_principal_strain"].items()},
             "contact_half_width": {f: rel(r["contact_half_width"][f],
                                           base["contact_half_width"][f])
                                    for f in r["contact_half_width"]},
             "seconds_ratio": r["seconds"] / max(base["seconds"], 1e-12)}
         for m, r in rows.items() if m != MaterialModel.LINEAR}
-    out = {"scene": loaded.scene.name, "compare_models": True, "models": rows,
+    out = {"scene": loaded.scene.name, "compare_models": True,
+           "common_strain_measure": str(COMMON_STRAIN_MEASURE), "models": rows,
            "relative_difference": differences}
     if args.plot:
         out["plot"] = plot_models(loaded.obj, results, args.plot)
@@ -298,23 +313,36 @@ def plot_models(obj, results: dict, path: str) -> str:
 def compare_summary(result: dict) -> str:
     """The model comparison as a table."""
     rows, diff = result["models"], result["relative_difference"]
+    common = StrainMeasure(result["common_strain_measure"])
     lines = [f"{result['scene']}: the same squeeze under every material model "
              "(differences relative to linear)",
              f"{'model':<14}{'termination':<15}{'rel. depth':>11}{'F1 force N':>12}"
-             f"{'energy J':>12}{'F1 half-width m':>17}{'max strain':>12}  events  time s"]
+             f"{'energy J':>12}{'F1 half-width m':>17}{'max strain':>12} {'measure':<8}"
+             f"{common.label + ' strain':>12}{'von Mises Pa':>14} {'stress':<13}events  time s"]
     for model, r in rows.items():
         counts = " ".join(f"{k}{v}" for k, v in r["event_counts"].items())
         lines.append(f"{model:<14}{r['termination']:<15}{100 * r['relative_depth']:>10.3f}%"
                      f"{r['force'][Finger.F1]:>12.5g}{r['energy']:>12.5g}"
-                     f"{r['contact_half_width'][Finger.F1]:>17.4g}{r['max_strain']:>12.4g}"
-                     f"  {counts}  {r['seconds']:.2f}")
+                     f"{r['contact_half_width'][Finger.F1]:>17.4g}{r['max_strain']:>12.4g} "
+                     f"{StrainMeasure(r['strain_measure']).label:<8}"
+                     f"{r['max_principal_strain'][common]:>12.4g}{r['max_von_mises']:>14.4g} "
+                     f"{StressMeasure(r['stress_measure']).label:<13}{counts}  "
+                     f"{r['seconds']:.2f}")
     for model, d in diff.items():
         lines.append(f"{model} vs linear: force {100 * d['force'][Finger.F1]:+.2f} %, energy "
-                     f"{100 * d['energy']:+.2f} %, max strain {100 * d['max_strain']:+.2f} %, "
-                     f"F1 half-width {100 * d['contact_half_width'][Finger.F1]:+.2f} %, time "
+                     f"{100 * d['energy']:+.2f} %, max {common.label} strain "
+                     f"{100 * d['max_principal_strain'][common]:+.2f} %, F1 half-width "
+                     f"{100 * d['contact_half_width'][Finger.F1]:+.2f} %, time "
                      f"x{d['seconds_ratio']:.0f}")
-    lines.append("strain measures: " + "; ".join(f"{m}: {r['strain_measure']}"
-                                                 for m, r in rows.items()))
+    lines.append("max principal strain vs linear, like for like (the same measure of both "
+                 "fields):")
+    for model, d in diff.items():
+        lines.append(f"  {model}: " + ", ".join(
+            f"{StrainMeasure(k).label} {100 * v:+.2f} %"
+            for k, v in d["max_principal_strain"].items()))
+    lines.append(f"max strain: in the model's own measure, which its strain limit uses; "
+                 f"{common.label} strain: U - I of every field; von Mises of the model's stress "
+                 "(small-strain: C : eps; Cauchy: true stress)")
     if "plot" in result:
         lines.append(f"plot: {result['plot']}")
     return "\n".join(lines)
@@ -325,11 +353,16 @@ def summary(result: dict) -> str:
     if result.get("compare_models"):
         return compare_summary(result)
     c = result["event_counts"]
+    limit = result["strain_limit"]
     lines = [
-        f"{result['scene']}: {result['squeeze']} squeeze, mu = {result['mu']:g}, "
-        f"tip radius {result['tip_radius']:g} m, initial contacts {result['contacts']}",
+        f"{result['scene']}: {result['squeeze']} squeeze of a {result['material_model']} "
+        f"object, mu = {result['mu']:g}, tip radius {result['tip_radius']:g} m, initial "
+        f"contacts {result['contacts']}",
         f"termination: {result['termination']} at depth {result['depth']:.6g} m "
-        f"(relative {100 * result['relative_depth']:.3f} %)",
+        f"(relative {100 * result['relative_depth']:.3f} %)"
+        + (f"; strain limit {limit['epsilon']:g} on the "
+           f"{StrainMeasure(limit['measure']).label} strain ({limit['criterion']})"
+           if limit else ""),
         "events: " + ", ".join(f"{k} {c[k]}" for k in EventType.values()),
     ]
     for name, seg in result["segments"].items():
@@ -342,11 +375,13 @@ def summary(result: dict) -> str:
             + (f" ({friction:.3g} J dissipated by friction)" if friction > 0 else "")
         )
     h = result["health"]
+    strain = StrainMeasure(h["strain_measure"]).label
     lines.append(
         f"energy {result['energy']:.5g} J; max strain {h['max_strain']:.4g} "
-        f"({h['criterion']}, element {h['max_strain_element']}); max von Mises "
-        f"{h['max_von_mises']:.4g} Pa; max displacement {h['max_displacement']:.4g} m; "
-        "slip margin " + ", ".join(f"{k} {v:.4g} N" for k, v in h["slip_margin"].items())
+        f"({strain} strain, {h['criterion']}, element {h['max_strain_element']}); max von "
+        f"Mises {h['max_von_mises']:.4g} Pa ({StressMeasure(h['stress_measure']).label} "
+        f"stress); max displacement {h['max_displacement']:.4g} m; slip margin "
+        + ", ".join(f"{k} {v:.4g} N" for k, v in h["slip_margin"].items())
     )
     if result["chatter"]:
         lines.append(f"chattering bound froze {len(result['chatter'])} node mode(s)")

@@ -18,7 +18,7 @@ from enum import Enum
 
 __all__ = ["ContactMode", "DistortionModel", "EventType", "Finger", "ImageEncoding",
            "MaterialModel", "SQUEEZING_FINGERS", "ShapeFit", "SqueezeKind", "StrainCriterion",
-           "Termination"]
+           "StrainMeasure", "StressMeasure", "Termination"]
 
 
 class _Name(str, Enum):
@@ -98,8 +98,61 @@ class StrainCriterion(_Name):
     """|eps_x|, |eps_y| <= eps* in the object frame (eq. 45 literally)."""
 
 
+class StrainMeasure(_Name):
+    """Measure of a strain, defined by the deformation gradient F = R U of an element.
+
+    At small strain all four agree to first order; at the peak compression of the foam square
+    (about 25 %) they differ by up to a third, so every reported strain names its measure.
+
+    >>> [m.label for m in StrainMeasure]
+    ['small', 'Biot', 'log', 'Green-Lagrange']
+    """
+
+    SMALL = "small"
+    """Small (infinitesimal) strain sym(F) - I = sym(grad u): the linear model's; not frame
+    indifferent (a rigid rotation by theta shows 1 - cos(theta))."""
+    BIOT = "biot"
+    """Biot (nominal, engineering) strain U - I: change of a fibre's length per reference
+    length along the principal directions; the corotational model's."""
+    LOG = "log"
+    """Logarithmic (Hencky, true) strain ln U: the neo-Hookean model's."""
+    GREEN_LAGRANGE = "green_lagrange"
+    """Green-Lagrange strain (F^T F - I) / 2 = (U^2 - I) / 2."""
+
+    @property
+    def label(self) -> str:
+        """Short human-readable name, for text output."""
+        return {"small": "small", "biot": "Biot", "log": "log",
+                "green_lagrange": "Green-Lagrange"}[self.value]
+
+
+class StressMeasure(_Name):
+    """Measure of a reported stress."""
+
+    SMALL_STRAIN = "small_strain"
+    """C : eps of the small strain: the linear model's stress, in which the reference and the
+    deformed configuration are not told apart (Cauchy, Piola and Kirchhoff stresses
+    coincide to first order)."""
+    CAUCHY = "cauchy"
+    """Cauchy (true) stress: force per deformed area, sigma = P F^T / J with the thickness
+    stretch in J; the corotational and neo-Hookean models'."""
+
+    @property
+    def label(self) -> str:
+        """Short human-readable name, for text output."""
+        return {"small_strain": "small-strain", "cauchy": "Cauchy"}[self.value]
+
+
 class MaterialModel(_Name):
-    """Constitutive model of a solid object."""
+    """Constitutive model of a solid object.
+
+    Each model reports strains and tests its strain limit in its own measure, and reports its
+    own stress:
+
+    >>> [(str(m), str(m.strain_measure), str(m.stress_measure)) for m in MaterialModel]
+    [('linear', 'small', 'small_strain'), ('corotational', 'biot', 'cauchy'), \
+('neo_hookean', 'log', 'cauchy')]
+    """
 
     LINEAR = "linear"
     """Small-strain linear elasticity (the paper's model)."""
@@ -107,6 +160,18 @@ class MaterialModel(_Name):
     """Linear stress in the element's rotated frame: exact under rigid rotation."""
     NEO_HOOKEAN = "neo_hookean"
     """Compressible neo-Hookean hyperelasticity in exact plane stress."""
+
+    @property
+    def strain_measure(self) -> StrainMeasure:
+        """The measure of the model's strain: its reports and its strain limit use it."""
+        return {"linear": StrainMeasure.SMALL, "corotational": StrainMeasure.BIOT,
+                "neo_hookean": StrainMeasure.LOG}[self.value]
+
+    @property
+    def stress_measure(self) -> StressMeasure:
+        """The measure of the model's reported stresses."""
+        return (StressMeasure.SMALL_STRAIN if self is MaterialModel.LINEAR
+                else StressMeasure.CAUCHY)
 
 
 class ImageEncoding(_Name):

@@ -104,10 +104,10 @@ class CountingContactModel(ContactModel):
 
     counter: Counter = field(default_factory=Counter, repr=False, compare=False)
 
-    def strain_measure(self, sd, delta, F):
+    def max_strain(self, sd, delta, F):
         """Largest strain of a configuration (counted as ``strain_evaluations``)."""
         self.counter["strain_evaluations"] += 1
-        return super().strain_measure(sd, delta, F)
+        return super().max_strain(sd, delta, F)
 
     def _strain_map(self, dofs):
         self.counter["strain_maps"] += 1

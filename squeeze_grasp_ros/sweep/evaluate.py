@@ -32,7 +32,7 @@ from squeeze_grasp_ros.mechanics.resistance.optimal import (
 )
 from squeeze_grasp_ros.mechanics.squeeze.events import event_squeeze
 from squeeze_grasp_ros.sweep.plan import Task, build_group_mesh, rng_for
-from squeeze_grasp_ros.mechanics.vocabulary import Finger, Termination
+from squeeze_grasp_ros.mechanics.vocabulary import Finger, StrainMeasure, Termination
 
 CACHE_GROUPS = 4
 """Prepared groups kept per worker process (a 2k-node group holds a few MB)."""
@@ -75,11 +75,15 @@ COLUMNS: dict[str, str] = {
     "work_F1": "float64",
     "work_F2": "float64",
     "energy": "float64",
+    "material_model": "string",
     "max_strain": "float64",
+    "strain_measure": "string",
     "max_strain_element": "int32",
     "max_strain_x": "float64",
     "max_strain_y": "float64",
+    "max_strain_biot": "float64",
     "max_von_mises": "float64",
+    "stress_measure": "string",
     "max_von_mises_element": "int32",
     "max_von_mises_x": "float64",
     "max_von_mises_y": "float64",
@@ -160,7 +164,7 @@ def prepare(task: Task) -> Group:
         return _CACHE[key]
     start = time.perf_counter()
     mesh = build_group_mesh(task.obj)
-    name, E, nu, h = task.material
+    _, E, nu, h, _ = task.material
     obj = ElasticObject(mesh, Material(E, nu, h)).precompute()
     gmap = grasp_map(obj, task.placement_mu)
     group = Group(obj, gmap, select_placements(task, mesh, gmap), time.perf_counter() - start)
@@ -209,6 +213,7 @@ def evaluate(task: Task, group: Group, index: int, params, resist: dict) -> dict
             "task_id": task.id,
             "object_id": task.obj.id,
             "material_id": task.material[0],
+            "material_model": task.material[4],
             "placement_id": f"p{index:05d}",
             "param_id": params.id,
             "repeat": repeat,
@@ -242,6 +247,7 @@ def evaluate(task: Task, group: Group, index: int, params, resist: dict) -> dict
             step=task.step,
             event_tol=task.event_tol,
             max_events_per_depth=task.max_events_per_depth,
+            material_model=task.material[4],
         )
         if task.adversary is not None:
             key = (i, j)
@@ -276,8 +282,11 @@ def evaluate(task: Task, group: Group, index: int, params, resist: dict) -> dict
             "work_F2": res.work[Finger.F2],
             "energy": res.energy,
             "max_strain": h.max_strain,
+            "strain_measure": str(h.strain_measure),
             "max_strain_element": h.max_strain_element,
+            "max_strain_biot": h.max_principal_strain[StrainMeasure.BIOT],
             "max_von_mises": h.max_von_mises,
+            "stress_measure": str(h.stress_measure),
             "max_von_mises_element": h.max_von_mises_element,
             "slip_margin_F1": h.slip_margin.get(Finger.F1),
             "slip_margin_F2": h.slip_margin.get(Finger.F2),

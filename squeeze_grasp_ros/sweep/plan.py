@@ -93,8 +93,8 @@ class Task:
     spec_hash : str
         Hash of the sweep (workers cache prepared groups under it).
     obj : ObjectItem
-    material : tuple of (str, float, float, float)
-        (name, E Pa, nu, thickness m).
+    material : tuple of (str, float, float, float, str)
+        (name, E Pa, nu, thickness m, material model).
     placement_mode : str
     placement_count : int
     placement_filters : tuple of str
@@ -235,7 +235,8 @@ def plan_tasks(loaded: LoadedSpec) -> list[Task]:
             for c, start in enumerate(range(0, total, per_task)):
                 tasks.append(Task(
                     f"{group}~c{c:04d}", group, loaded.hash, item,
-                    (mat_name, m.E, m.nu, m.thickness), pl.mode, pl.count, tuple(pl.require),
-                    float(mu_filter), sw.seed, sw.repeat, start, min(start + per_task, total),
-                    params, limits, sq.step, sq.event_tol, sq.max_events_per_depth, adversary))
+                    (mat_name, m.E, m.nu, m.thickness, m.model), pl.mode, pl.count,
+                    tuple(pl.require), float(mu_filter), sw.seed, sw.repeat, start,
+                    min(start + per_task, total), params, limits, sq.step, sq.event_tol,
+                    sq.max_events_per_depth, adversary))
     return sorted(tasks, key=lambda t: t.id)

@@ -25,7 +25,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from squeeze_grasp_ros.mechanics.errors import InvalidInputError
-from squeeze_grasp_ros.mechanics.ring.model import RingModel
+from squeeze_grasp_ros.mechanics.ring.model import FIBRE_STRAIN_MEASURE, RingModel
 from squeeze_grasp_ros.mechanics.ring.squeeze import (
     LIMITS,
     check_limits,
@@ -129,6 +129,7 @@ class RingGraspMap:
         rel = self.max_relative_depth
         out = {
             "elements": self.n, "squeeze": self.kind, "mu": self.mu, "epsilon": self.epsilon,
+            "strain_measure": str(FIBRE_STRAIN_MEASURE),
             "pairs": int(len(self.pairs)),
             "initially_feasible_pairs": int(self.initially_feasible.sum()),
             "max_relative_depth": {"min": float(rel.min()), "median": float(np.median(rel)),

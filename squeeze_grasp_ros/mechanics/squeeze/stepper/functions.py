@@ -189,7 +189,7 @@ class EventFunctions:
         model, lim = self.model, self.model.limits
         strain = pickup = np.inf
         if lim.strain is not None and Termination.STRAIN_LIMIT in self.terminate_on:
-            strain = lim.strain - model.strain_measure(contacts.data, sol.delta, sol.F)[0]
+            strain = lim.strain - model.max_strain(contacts.data, sol.delta, sol.F)[0]
         if lim.weight is not None and Termination.PICKED_UP in self.terminate_on:
             pickup = pickup_margin(model.mu, sol.normal(), sol.tangential(), contacts.stick,
                                    contacts.finger, sorted(set(contacts.finger.tolist())),

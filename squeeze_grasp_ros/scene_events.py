@@ -7,7 +7,7 @@ from __future__ import annotations
 from collections.abc import Callable
 
 from squeeze_grasp_ros.mechanics.elastic.compliance import ElasticObject
-from squeeze_grasp_ros.mechanics.squeeze.contact_model import ContactModel, Limits
+from squeeze_grasp_ros.mechanics.squeeze.contact_model import ContactModel, Limits, SolveOptions
 from squeeze_grasp_ros.mechanics.squeeze.nonlinear_model import contact_model
 from squeeze_grasp_ros.mechanics.squeeze.events import EventSqueeze, event_squeeze
 from squeeze_grasp_ros.scene import Scene, SceneError, finger_nodes, scene_solid
@@ -51,6 +51,7 @@ def event_squeeze_scene(
     progress: Callable[[float], None] | None = None,
     material_model: MaterialModel | str | None = None,
     checkpoint: Callable[[], None] | None = None,
+    options: SolveOptions | None = None,
 ) -> EventSqueeze:
     """Run the scene's squeeze with rounded fingertips; arguments override the scene's values.
 
@@ -74,6 +75,8 @@ def event_squeeze_scene(
         Constitutive model; default the scene's ``object.material.model``.
     checkpoint : callable, optional
         Called before every substep; may raise to abandon the squeeze (a cancellation).
+    options : SolveOptions, optional
+        Switches of the large-deformation savings (see :func:`event_squeeze`).
 
     Raises
     ------
@@ -122,4 +125,5 @@ def event_squeeze_scene(
         progress=progress,
         material_model=scene.object.material.model if material_model is None else material_model,
         checkpoint=checkpoint,
+        options=options,
     )

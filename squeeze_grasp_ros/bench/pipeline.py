@@ -18,10 +18,12 @@ from squeeze_grasp_ros.resources import scene_file
 from squeeze_grasp_ros.scene import build_mesh, finger_nodes, load_scene, scene_material
 from squeeze_grasp_ros.scene_events import event_squeeze_scene
 from squeeze_grasp_ros.sim.world import SimWorld
+from squeeze_grasp_ros.bench.lockstep import bare_ratio_table, profile_table
 from squeeze_grasp_ros.bench.table import Table, best_time, timed
 from squeeze_grasp_ros.mechanics.vocabulary import SQUEEZING_FINGERS
 
-TITLE = "Pipeline on real rclpy nodes: end to end, lockstep rate, recording, effects"
+TITLE = ("Pipeline on real rclpy nodes: end to end, lockstep rate against the bare loop, one "
+         "tick's profile, recording, effects")
 EFFECT_SCENE = {
     "name": "effects", "object": {"shape": {"type": "square", "side": 0.1},
                                   "material": {"E": 5.0e4, "nu": 0.3, "thickness": 0.0254},
@@ -155,7 +157,7 @@ def run(quick: bool, out_dir: Path, progress) -> list[Table]:
 
 
 def _tables(quick: bool, progress, work: Path) -> list[Table]:
-    """The three tables of :func:`run`, with scratch files in ``work``."""
+    """The tables of :func:`run`, with scratch files in ``work``."""
     progress("pipeline: bare mechanics (and a warm-up run)")
     foam = scene_file("foam_square")
     bare = min(bare_mechanics(foam) for _ in range(2))
@@ -250,4 +252,7 @@ def _tables(quick: bool, progress, work: Path) -> list[Table]:
         "costs nothing during the squeeze (its fingertip joins the stepper when it first moves); "
         "without friction the squeeze is a different motion (every node slides), so friction is "
         "the base.")
-    return [end_to_end, rate, effects]
+    progress("pipeline: one tick's profile")
+    profile = profile_table(foam, work / "profiled")
+    ratio = bare_ratio_table(foam, 2 if quick else repeats, progress)
+    return [end_to_end, rate, ratio, profile, effects]

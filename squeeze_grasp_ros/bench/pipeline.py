@@ -19,11 +19,12 @@ from squeeze_grasp_ros.scene import build_mesh, finger_nodes, load_scene, scene_
 from squeeze_grasp_ros.scene_events import event_squeeze_scene
 from squeeze_grasp_ros.sim.world import SimWorld
 from squeeze_grasp_ros.bench.lockstep import bare_ratio_table, profile_table
+from squeeze_grasp_ros.bench.startup import startup_table
 from squeeze_grasp_ros.bench.table import Table, best_time, timed
 from squeeze_grasp_ros.mechanics.vocabulary import SQUEEZING_FINGERS
 
 TITLE = ("Pipeline on real rclpy nodes: end to end, lockstep rate against the bare loop, one "
-         "tick's profile, recording, effects")
+         "tick's profile, start-up, recording, effects")
 EFFECT_SCENE = {
     "name": "effects", "object": {"shape": {"type": "square", "side": 0.1},
                                   "material": {"E": 5.0e4, "nu": 0.3, "thickness": 0.0254},
@@ -255,4 +256,5 @@ def _tables(quick: bool, progress, work: Path) -> list[Table]:
     progress("pipeline: one tick's profile")
     profile = profile_table(foam, work / "profiled")
     ratio = bare_ratio_table(foam, 2 if quick else repeats, progress)
-    return [end_to_end, rate, ratio, profile, effects]
+    startup = startup_table(2 if quick else repeats, progress)
+    return [end_to_end, rate, ratio, profile, startup, effects]

@@ -6,7 +6,7 @@ A sweep names a base scene (defaults for everything not swept: material, mesh, f
 fingertip, squeeze, strain limit, event tolerances), the objects, the axes (materials, friction,
 fingertip radius, squeeze type, depth), the placements per object, an optional pickup weight and
 an optional adversary. The parser is the scene parser
-(:func:`~squeeze_grasp_ros.scene.parse_section`):
+(:func:`~squeeze_grasp_ros.scene.schema.parse_section`):
 unknown keys, wrong types and values out of range raise :class:`SweepError` naming the key.
 """
 
@@ -24,14 +24,12 @@ from squeeze_grasp_ros.scene import (
     MeshSpec,
     Scene,
     SceneError,
-    _validate_shape,
     build_outline,
-    key_reference,
     load_scene,
-    parse_section,
     read_yaml,
-    spec,
 )
+from squeeze_grasp_ros.scene.checks import check_shape
+from squeeze_grasp_ros.scene.schema import key_reference, parse_section, spec
 from squeeze_grasp_ros.mechanics.vocabulary import Finger
 
 
@@ -285,7 +283,7 @@ def _check_entry(entry: ObjectEntry, where: str) -> None:
             )
     if entry.shape is not None:
         try:
-            _validate_shape(entry.shape)
+            check_shape(entry.shape)
             build_outline(entry.shape)
         except SceneError as exc:
             raise SweepError(f"{where}: {exc}".replace("object.shape", "shape")) from None
@@ -312,13 +310,7 @@ def parse_sweep_spec(data: Any, base_dir: Path) -> LoadedSpec:
     """Validate a sweep given as a mapping; relative paths are relative to ``base_dir``."""
     if not isinstance(data, dict):
         raise SweepError("a sweep spec must be a YAML mapping")
-    try:
-        sw = parse_section(SweepSpec, data, "")
-    except SweepError:
-        raise
-    except SceneError as exc:
-        # the scene parser prefixes top-level unknown keys with "." (empty section path)
-        raise SweepError(str(exc).replace("unknown key .", "unknown key ", 1)) from None
+    sw = parse_section(SweepSpec, data, "", error=SweepError)
     sw = dataclasses.replace(sw, base=_absolute(sw.base, base_dir))
     files = {"base": _file_digest(sw.base, "base")}
     try:
@@ -370,10 +362,8 @@ def parse_sweep_spec(data: Any, base_dir: Path) -> LoadedSpec:
                 raise SweepError(
                     f"materials: name {name!r} must use letters, digits, '_', '.', '-'"
                 )
-            try:
-                materials[name] = parse_section(MaterialSpec, value, f"materials.{name}")
-            except SceneError as exc:
-                raise SweepError(str(exc)) from None
+            materials[name] = parse_section(MaterialSpec, value, f"materials.{name}",
+                                            error=SweepError)
     fingers = base.fingers
     tip = fingers[Finger.F1].tip_radius
     if sw.tip_radius is None and not (tip > 0 and fingers[Finger.F2].tip_radius == tip):

@@ -57,13 +57,13 @@ from squeeze_grasp_ros.mechanics.vocabulary import (ContactMode, EventType, Fing
                                                     MaterialModel, SqueezeKind,
                                                     StrainCriterion, Termination)
 from squeeze_grasp_ros.resources import scene_file
-from squeeze_grasp_ros.scene import Scene, build_mesh, finger_nodes, load_scene, scene_solid
-from squeeze_grasp_ros.scene_events import event_squeeze_scene
+from squeeze_grasp_ros.scene import (GraspSetup, Scene, build_mesh, event_squeeze_scene,
+                                     finger_nodes, load_scene, scene_solid)
 
 __all__ = [
     # scenes
-    "Scene", "load_scene", "scene_file", "build_mesh", "scene_solid", "finger_nodes",
-    "event_squeeze_scene",
+    "Scene", "load_scene", "scene_file", "GraspSetup", "build_mesh", "scene_solid",
+    "finger_nodes", "event_squeeze_scene",
     # elastic objects
     "Material", "Mesh", "generate_mesh", "ElasticObject", "ReducedStiffness",
     "reduced_stiffness",

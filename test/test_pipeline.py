@@ -22,7 +22,7 @@ from squeeze_grasp_ros.ros.recording.bag import read_bag
 from squeeze_grasp_ros.ros.recording.replay import replay
 from squeeze_grasp_ros.ros.recording.schema import own_text
 from squeeze_grasp_ros.scene import build_mesh, finger_nodes, load_scene, scene_material
-from squeeze_grasp_ros.scene_events import event_squeeze_scene
+from squeeze_grasp_ros.scene import event_squeeze_scene
 
 from pipeline_support import (
     EVENT_TOLERANCE_TICKS,

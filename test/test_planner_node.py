@@ -55,7 +55,7 @@ from squeeze_grasp_ros.mechanics.squeeze.stable_pure import plan_squeeze
 from squeeze_grasp_ros.ros.nodes.planner import PARAMETERS
 from squeeze_grasp_ros.planning import ErrorCode
 from squeeze_grasp_ros.scene import build_ring, finger_nodes, placement_node
-from squeeze_grasp_ros.scene_events import event_squeeze_scene
+from squeeze_grasp_ros.scene import event_squeeze_scene
 
 REPO = Path(__file__).resolve().parents[1]
 RESIST_FIG10 = (REPO / "config" / "scenes" / "resist_fig10.yaml").read_text()

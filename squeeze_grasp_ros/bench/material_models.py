@@ -16,8 +16,7 @@ from squeeze_grasp_ros.mechanics.elastic.contact_response import factorization_r
 from squeeze_grasp_ros.mechanics.squeeze.stepper import substep_adaptation
 from squeeze_grasp_ros.mechanics.vocabulary import MaterialModel
 from squeeze_grasp_ros.resources import scene_file
-from squeeze_grasp_ros.scene import load_scene, scene_solid
-from squeeze_grasp_ros.scene_events import event_squeeze_scene
+from squeeze_grasp_ros.scene import GraspSetup, load_scene
 
 TITLE = "Large deformation: the linear model's error against squeeze depth, and its cost"
 OBJECTS = ("foam_square", "disk", "nonconvex_blob")
@@ -33,22 +32,23 @@ per-node gradient cache of the inversion check (about 1 ms per contact node, onc
 object), which is precompute, not squeeze."""
 
 
-def _scene(name: str, nodes: int):
+def _setup(name: str, nodes: int) -> GraspSetup:
+    """The shipped scene ``name`` re-meshed to about ``nodes`` nodes, precomputed."""
     scene = load_scene(scene_file(name))
     obj = dataclasses.replace(scene.object, mesh=dataclasses.replace(scene.object.mesh,
                                                                      nodes=nodes))
-    return dataclasses.replace(scene, object=obj)
+    return GraspSetup.build(dataclasses.replace(scene, object=obj)).precompute()
 
 
-def _run(scene, obj, model: MaterialModel, relative_depth: float):
+def _run(setup: GraspSetup, model: MaterialModel, relative_depth: float):
     start = time.perf_counter()
-    res = event_squeeze_scene(scene, obj, relative_depth=relative_depth, material_model=model)
+    res = setup.event_squeeze(relative_depth=relative_depth, material_model=model)
     return res, time.perf_counter() - start
 
 
-def _best(scene, obj, model: MaterialModel, repeats: int):
+def _best(setup: GraspSetup, model: MaterialModel, repeats: int):
     """(result, best time) of ``repeats`` 12 % squeezes."""
-    runs = [_run(scene, obj, model, 0.12) for _ in range(repeats)]
+    runs = [_run(setup, model, 0.12) for _ in range(repeats)]
     return runs[0][0], min(t for _, t in runs)
 
 
@@ -71,15 +71,13 @@ def run(quick: bool, out_dir: Path, progress) -> list[Table]:
     nodes = 400 if quick else 1200
     rows, curves = [], {}
     for name in OBJECTS:
-        scene = _scene(name, nodes)
-        obj = scene_solid(scene)
-        obj.precompute()
+        setup = _setup(name, nodes)
         for rel in depths:
             progress(f"material_models: {name} at {100 * rel:g} %")
-            linear, _ = _run(scene, obj, MaterialModel.LINEAR, rel)
+            linear, _ = _run(setup, MaterialModel.LINEAR, rel)
             row = [name, 100 * rel, linear.finger_force["F1"][1], linear.health.max_strain]
             for model in NONLINEAR:
-                res, _ = _run(scene, obj, model, rel)
+                res, _ = _run(setup, model, rel)
                 df = res.finger_force["F1"][1] / linear.finger_force["F1"][1] - 1
                 de = res.energy / linear.energy - 1
                 row += [100 * df, 100 * de, res.health.max_strain, res.termination]
@@ -100,17 +98,15 @@ def run(quick: bool, out_dir: Path, progress) -> list[Table]:
     plots.save(fig, out_dir / png)
     progress("material_models: cost of a 12 % foam-square squeeze")
     cost = []
-    scene = _scene("foam_square", 800 if quick else 2000)
-    obj = scene_solid(scene)
-    obj.precompute()
-    linear, t_lin = _best(scene, obj, MaterialModel.LINEAR, LINEAR_REPEATS)
+    setup = _setup("foam_square", 800 if quick else 2000)
+    linear, t_lin = _best(setup, MaterialModel.LINEAR, LINEAR_REPEATS)
     cost.append(["linear", t_lin, 1.0, linear.diagnostics["substeps"],
                  linear.diagnostics["root_evaluations"], "-", "-", "-",
                  linear.finger_force["F1"][1]])
     for model in NONLINEAR:
         for variant, reuse, adapt in VARIANTS:
             with factorization_reuse(reuse), substep_adaptation(adapt):
-                res, t = _best(scene, obj, model, 1 if variant else NONLINEAR_REPEATS)
+                res, t = _best(setup, model, 1 if variant else NONLINEAR_REPEATS)
             nl = res.diagnostics["nonlinear"]
             cost.append([str(model) + variant, t, t / t_lin, res.diagnostics["substeps"],
                          res.diagnostics["root_evaluations"],

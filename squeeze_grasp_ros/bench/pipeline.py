@@ -9,14 +9,12 @@ from pathlib import Path
 
 import yaml
 
-from squeeze_grasp_ros.mechanics.elastic.compliance import ElasticObject
 from squeeze_grasp_ros.ros.nodes import pipeline
 from squeeze_grasp_ros.ros.run.options import RunOptions
 from squeeze_grasp_ros.ros.run.runner import PipelineRunner
 from squeeze_grasp_ros.ros.recording.bag import read_bag
 from squeeze_grasp_ros.resources import scene_file
-from squeeze_grasp_ros.scene import build_mesh, finger_nodes, load_scene, scene_material
-from squeeze_grasp_ros.scene_events import event_squeeze_scene
+from squeeze_grasp_ros.scene import GraspSetup, load_scene
 from squeeze_grasp_ros.sim.world import SimWorld
 from squeeze_grasp_ros.bench.table import Table, best_time, timed
 from squeeze_grasp_ros.mechanics.vocabulary import SQUEEZING_FINGERS
@@ -57,9 +55,7 @@ def bare_mechanics(path: Path) -> float:
     included, as the pipeline builds them too).
     """
     def squeeze():
-        scene = load_scene(path)
-        obj = ElasticObject(build_mesh(scene), scene_material(scene))
-        return event_squeeze_scene(scene, obj, finger_nodes(scene, obj.mesh))
+        return GraspSetup.build(load_scene(path)).event_squeeze()
     return timed(squeeze)[1]
 
 
@@ -105,7 +101,7 @@ def world_loop(scene_path: Path, ticks: int = 700) -> float:
     """CPU seconds of the ROS-free simulated world driven along the scene's squeeze for
     ``ticks`` ticks (devices, stepper, sensors; no messages).
     """
-    world = SimWorld(load_scene(scene_path))
+    world = SimWorld(GraspSetup.build(load_scene(scene_path)))
     depth = world.scene.squeeze.relative_depth / world.relative_per_depth
     start = {f: world.positions[f].copy() for f in SQUEEZING_FINGERS}
     world.start()

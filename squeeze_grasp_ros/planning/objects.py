@@ -5,7 +5,6 @@
 from __future__ import annotations
 
 import hashlib
-import math
 import threading
 import time
 from collections import OrderedDict
@@ -19,15 +18,8 @@ import scipy.sparse as sp
 from squeeze_grasp_ros.inputs import InputError, confine, load_yaml, read_text
 from squeeze_grasp_ros.mechanics.elastic.compliance import ROUTES, ElasticObject
 from squeeze_grasp_ros.mechanics.ring.model import RingModel
-from squeeze_grasp_ros.scene import (
-    Scene,
-    build_mesh,
-    build_outline,
-    build_ring,
-    finger_nodes,
-    parse_scene,
-    scene_material,
-)
+from squeeze_grasp_ros.scene import Scene, parse_scene, requested_nodes
+from squeeze_grasp_ros.scene.setup import RING_STAGES, SOLID_STAGES, GraspSetup
 from squeeze_grasp_ros.planning.errors import ErrorCode, PlannerError, invalid
 
 
@@ -36,12 +28,11 @@ MAX_DIRECTIONS = 100_000
 """Most push directions one resistance sweep may ask for."""
 MAX_BEST_COUNT = 100_000
 """Most placements one grasp map may return as candidates."""
-SOLID_STAGES: tuple[str, ...] = ("mesh", "stiffness", "factorisation", "boundary compliance")
-RING_STAGES: tuple[str, ...] = ("ring model", "compliance")
 
 Progress = Callable[[str, int, int, int], None]
-"""Called as ``progress(stage, index, count, num_nodes)`` when a stage starts; may raise
-:class:`Cancelled` to stop the computation."""
+"""Called as ``progress(stage, index, count, num_nodes)`` when a stage starts (the stages of
+:data:`SOLID_STAGES`, :data:`RING_STAGES`); may raise :class:`Cancelled` to stop the
+computation."""
 
 
 # --------------------------------------------------------------------------- limits and objects
@@ -82,12 +73,10 @@ class LoadedObject:
     Attributes
     ----------
     object_id : str
-    scene : Scene
-        The validated scene it came from (fingers, friction, limits, squeeze defaults).
-    body : ElasticObject or RingModel
-        Precomputed: factorisation and boundary compliance (solid) or compliance (ring).
-    finger_nodes : (int, int)
-        Initial contact nodes of F1, F2 from the scene's placements.
+    setup : GraspSetup
+        The scene made mechanics: the scene (fingers, friction, limits, squeeze defaults), the
+        precomputed body (factorisation and boundary compliance of a solid, or the ring's
+        compliance) and the fingers' initial contact nodes.
     digest : str
         SHA-256 of the scene text and the solver route: same digest, same object.
     precompute_time : float
@@ -95,43 +84,56 @@ class LoadedObject:
     """
 
     object_id: str
-    scene: Scene
-    body: ElasticObject | RingModel
-    finger_nodes: tuple[int, int]
+    setup: GraspSetup
     digest: str
     precompute_time: float
 
     @property
+    def scene(self) -> Scene:
+        """The validated scene the object came from."""
+        return self.setup.scene
+
+    @property
+    def body(self) -> ElasticObject | RingModel:
+        """The precomputed solid or ring model."""
+        return self.setup.body
+
+    @property
+    def finger_nodes(self) -> tuple[int, int]:
+        """Initial contact nodes of F1, F2 from the scene's placements."""
+        return self.setup.contacts
+
+    @property
     def model(self) -> str:
         """Body model: "solid" (FEM mesh) or "ring" (curved beam)."""
-        return "ring" if isinstance(self.body, RingModel) else "solid"
+        return self.setup.model
 
     @property
     def num_nodes(self) -> int:
         """Mesh nodes (solid) or ring nodes."""
-        return int(self.body.n) if self.model == "ring" else int(self.body.mesh.n)
+        return self.setup.num_nodes
 
     @property
     def boundary(self) -> np.ndarray:
         """Nodes a finger can touch: the outer boundary loop (solid) or every ring node."""
-        return self.body.boundary if self.model == "ring" else self.body.mesh.boundary
+        return self.setup.boundary
 
     def solid(self) -> ElasticObject:
         """The FEM object; a ring raises INVALID_ARGUMENT naming the service to use."""
-        if not isinstance(self.body, ElasticObject):
+        if self.model == "ring":
             raise invalid(
                 f"object {self.object_id!r} is a ring model (Sec. 7): use the "
                 "ring_grasp_test service"
             )
-        return self.body
+        return self.setup.solid
 
     def ring(self) -> RingModel:
         """The ring model; a solid raises INVALID_ARGUMENT."""
-        if not isinstance(self.body, RingModel):
+        if self.model != "ring":
             raise invalid(
                 f"object {self.object_id!r} is a solid (object.model: solid), not a ring"
             )
-        return self.body
+        return self.setup.ring
 
 
 @dataclass(frozen=True)
@@ -190,24 +192,6 @@ def read_scene(
     except InputError as exc:
         raise invalid(str(exc)) from None
     return SceneSource(scene, text)
-
-
-def requested_nodes(scene: Scene) -> int | None:
-    """Nodes the scene asks for before anything is built; None for the mesher's default size.
-
-    A ring asks for ``object.ring.elements``; a solid for ``object.mesh.nodes``, or about
-    0.8 * area / max_area for ``object.mesh.max_area`` (the inverse of
-    :func:`~.mechanics.mesh.target_max_area`).
-    """
-    obj = scene.object
-    if obj.model == "ring":
-        return obj.ring.elements
-    if obj.mesh.nodes is not None:
-        return obj.mesh.nodes
-    if obj.mesh.max_area is None:
-        return None
-    area = build_outline(obj.shape).area
-    return math.ceil(0.8 * area / min(obj.mesh.max_area, 0.25 * area))
 
 
 def check_size(count: int | None, limit: int, what: str) -> None:
@@ -282,25 +266,16 @@ def load_object(
     if scene.object.model == "ring":
         check_size(requested_nodes(scene), limits.max_ring_elements, "ring model")
         progress(RING_STAGES[0], 0, len(RING_STAGES), 0)
-        body = build_ring(scene)
-        progress(RING_STAGES[1], 1, len(RING_STAGES), body.n)
-        body.precompute()
-        nodes = finger_nodes(scene, body)
+        setup = GraspSetup.build(scene)
     else:
         limit = limits.max_nodes if key.route == "factorized" else limits.max_spectral_nodes
         check_size(requested_nodes(scene), limit, f"{key.route} mesh")
         progress(SOLID_STAGES[0], 0, len(SOLID_STAGES), 0)
-        mesh = build_mesh(scene)
-        check_size(mesh.n, limit, f"{key.route} mesh")
-        body = ElasticObject(mesh, scene_material(scene), key.route)
-        progress(SOLID_STAGES[1], 1, len(SOLID_STAGES), mesh.n)
-        _ = body.stiffness
-        progress(SOLID_STAGES[2], 2, len(SOLID_STAGES), mesh.n)
-        _ = body.solver
-        progress(SOLID_STAGES[3], 3, len(SOLID_STAGES), mesh.n)
-        body.precompute()
-        nodes = finger_nodes(scene, mesh)
-    return LoadedObject(key.object_id, scene, body, nodes, key.digest, time.perf_counter() - start)
+        setup = GraspSetup.build(scene, route=key.route)
+        check_size(setup.num_nodes, limit, f"{key.route} mesh")
+    setup.precompute(progress)
+    _ = setup.contacts  # the placements are checked at load, not at the first request
+    return LoadedObject(key.object_id, setup, key.digest, time.perf_counter() - start)
 
 
 def resident_bytes(value: object) -> int:

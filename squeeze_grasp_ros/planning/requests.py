@@ -4,7 +4,6 @@
 
 from __future__ import annotations
 
-import dataclasses
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
@@ -15,22 +14,15 @@ from squeeze_grasp_ros.mechanics.elastic.reduced import boundary_displacement, r
 from squeeze_grasp_ros.mechanics.resistance.optimal import (
     Resistance,
     ResistanceSweep,
-    contact_segments,
     optimal_resistance,
-    resistance_grasp,
     sweep_directions,
 )
-from squeeze_grasp_ros.mechanics.resistance.frictional import (
-    FrictionalResistance,
-    add_adversary,
-    frictional_resistance,
-)
+from squeeze_grasp_ros.mechanics.resistance.frictional import FrictionalResistance
 from squeeze_grasp_ros.mechanics.ring.grasp_map import RingGraspMap, ring_grasp_map
 from squeeze_grasp_ros.mechanics.ring.squeeze import RingGrasp, ring_grasp
 from squeeze_grasp_ros.mechanics.squeeze.stable_pure import Squeeze, force_closure, plan_squeeze
 from squeeze_grasp_ros.mechanics.squeeze.events import EventSqueeze
-from squeeze_grasp_ros.scene_events import event_squeeze_scene, scene_contact_model
-from squeeze_grasp_ros.mechanics.vocabulary import Finger, SqueezeKind
+from squeeze_grasp_ros.mechanics.vocabulary import SqueezeKind
 from squeeze_grasp_ros.planning.errors import invalid
 from squeeze_grasp_ros.planning.objects import CONTACT_MODELS, Limits, LoadedObject, MAX_DIRECTIONS
 from squeeze_grasp_ros.planning.checks import check_number, check_step, choice, contact_nodes
@@ -153,7 +145,7 @@ def resistance_plan(
     limits : Limits
         Friction: the scene's squeeze step must be >= ``limits.min_step``.
     """
-    obj = loaded.solid()
+    loaded.solid()  # INVALID_ARGUMENT for a ring
     mode = choice("mode", mode, SqueezeKind.values())
     contact_model = choice("contact_model", contact_model, CONTACT_MODELS)
     x, y, z = (check_number(f"a.{k}", v) for k, v in zip("xyz", a))
@@ -168,11 +160,7 @@ def resistance_plan(
         return ResistancePlan(
             friction_resistance(loaded, nodes, (x, y), mode, tip_radius, limits), None
         )
-    if contact_model == "point":
-        sets = [[int(n)] for n in nodes]
-    else:
-        sets = contact_segments(obj.mesh, nodes.tolist(), width or None)
-    grasp = resistance_grasp(obj, dict(zip(tuple(Finger), sets)))
+    grasp = loaded.setup.resistance_grasp(contact_model, half_width=width or None, nodes=nodes)
     sweep = sweep_directions(grasp, mode, count) if count else None
     return ResistancePlan(optimal_resistance(grasp, (x, y), mode=mode), sweep)
 
@@ -195,20 +183,12 @@ def friction_resistance(
             "gives no adversary tip radius)"
         )
     check_step(scene.squeeze.step, limits)
-    obj = loaded.solid()
+    loaded.solid()  # INVALID_ARGUMENT for a ring
     i, j, k = (int(n) for n in nodes)
-    squeeze = event_squeeze_scene(scene, obj, (i, j))
-    model = scene_contact_model(scene, obj)
-    state = add_adversary(squeeze.state, model, squeeze.displacement, k, radius)
-    return frictional_resistance(
-        model,
-        state,
-        a,
-        mode=mode,
-        step=squeeze.step,
-        event_tol=squeeze.event_tol,
-        contacts=[i, j, k],
-    )
+    setup = loaded.setup
+    squeeze = setup.event_squeeze(contacts=(i, j))
+    return setup.frictional_resistance(squeeze, mode=mode, a=a, tip_radius=radius,
+                                       adversary_node=k)
 
 
 @dataclass(frozen=True)
@@ -305,7 +285,7 @@ def event_squeeze_run(
     progress : callable, optional
         Called with the completed fraction; may raise :class:`Cancelled`.
     """
-    obj = loaded.solid()
+    loaded.solid()  # INVALID_ARGUMENT for a ring
     scene = loaded.scene
     kind = choice("squeeze_type", kind, SqueezeKind.values(), scene.squeeze.type)
     depth = check_number("depth", depth, 0.0)
@@ -315,11 +295,9 @@ def event_squeeze_run(
     step = check_step(check_number("step", step, 0.0) or scene.squeeze.step, limits)
     event_tol = check_number("event_tol", event_tol, 0.0) or scene.squeeze.event_tol
     nodes = contact_nodes(loaded, contacts, count=2, default=loaded.finger_nodes)
-    scene = dataclasses.replace(scene, squeeze=dataclasses.replace(scene.squeeze, type=kind))
-    return event_squeeze_scene(
-        scene,
-        obj,
-        (int(nodes[0]), int(nodes[1])),
+    return loaded.setup.event_squeeze(
+        contacts=(int(nodes[0]), int(nodes[1])),
+        kind=kind,
         depth=depth or None,
         relative_depth=relative_depth or None,
         step=step,

@@ -9,6 +9,8 @@ package builds its mechanics through :class:`~.setup.GraspSetup`, not through th
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from squeeze_grasp_ros.mechanics.elastic import shapes
@@ -53,14 +55,16 @@ def placement_points(scene: Scene) -> list[tuple[float, float]]:
     return [p.point for p in placements if p.point is not None]
 
 
-def build_mesh(scene: Scene) -> Mesh:
+def build_mesh(scene: Scene, *, outline: shapes.Outline | None = None) -> Mesh:
     """Triangulate the scene's solid object with its mesh settings.
 
     A placement given as a point becomes a boundary node exactly (its projection on the
     outline is a kept vertex of the mesh), so the finger touches where the scene says.
+    ``outline`` replaces :func:`build_outline` of ``object.shape`` when it was read already.
     """
-    outline = shapes.with_boundary_points(build_outline(scene.object.shape),
-                                          placement_points(scene))
+    if outline is None:
+        outline = build_outline(scene.object.shape)
+    outline = shapes.with_boundary_points(outline, placement_points(scene))
     ms = scene.object.mesh
     if ms.max_area is not None:
         area = ms.max_area
@@ -127,3 +131,21 @@ def finger_nodes(scene: Scene, mesh: Mesh) -> tuple[int, int]:
     if i == j:
         raise SceneError("fingers.F1 and fingers.F2 are placed on the same boundary node")
     return i, j
+
+
+def requested_nodes(scene: Scene) -> int | None:
+    """Nodes the scene asks for before anything is built; None for the mesher's default size.
+
+    A ring asks for ``object.ring.elements``; a solid for ``object.mesh.nodes``, or about
+    0.8 * area / max_area for ``object.mesh.max_area`` (the inverse of
+    :func:`~squeeze_grasp_ros.mechanics.elastic.mesh.target_max_area`).
+    """
+    obj = scene.object
+    if obj.model == "ring":
+        return obj.ring.elements
+    if obj.mesh.nodes is not None:
+        return obj.mesh.nodes
+    if obj.mesh.max_area is None:
+        return None
+    area = build_outline(obj.shape).area
+    return math.ceil(0.8 * area / min(obj.mesh.max_area, 0.25 * area))

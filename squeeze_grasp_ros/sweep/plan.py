@@ -2,6 +2,11 @@
 # SPDX-License-Identifier: Apache-2.0
 """A sweep spec -> objects, parameter grid and Dask tasks, with seeds derived from ids.
 
+Scenes. Every evaluation is a scene: the base scene with the object, material and parameters
+of the evaluation substituted (:func:`group_scene`, :func:`evaluation_scene`), made mechanics
+by the same :class:`~squeeze_grasp_ros.scene.setup.GraspSetup` as every other front end, so a
+sweep computes what a scene file with the same values would (material model included).
+
 Grouping. The costly shared step of an evaluation is meshing, assembling and factorising the
 object and computing its boundary compliance (0.3-1 s for 1-2k nodes, against 0.05-0.5 s for a
 squeeze); it depends on the object, its mesh settings and its material only. Evaluations are
@@ -27,11 +32,23 @@ from typing import Optional
 
 import numpy as np
 
-from squeeze_grasp_ros.mechanics.squeeze.contact_model import Limits
-from squeeze_grasp_ros.mechanics.elastic.mesh import generate_mesh, target_max_area
 from squeeze_grasp_ros.mechanics.elastic.shapes import Outline
-from squeeze_grasp_ros.scene import MeshSpec, build_outline, load_scene
-from squeeze_grasp_ros.scene_events import scene_limits
+from squeeze_grasp_ros.mechanics.vocabulary import Finger
+from squeeze_grasp_ros.scene import (
+    FingerSpec,
+    FrictionSpec,
+    GraspSetup,
+    MaterialSpec,
+    MeshSpec,
+    ObjectSpec,
+    PickupSpec,
+    PlacementSpec,
+    Scene,
+    SceneError,
+    build_outline,
+    load_scene,
+)
+from squeeze_grasp_ros.scene.checks import validate
 from squeeze_grasp_ros.sweep.spec import LoadedSpec, ObjectEntry, SweepError
 
 
@@ -55,7 +72,7 @@ class ObjectItem:
     id : str
         ``NN-name`` (NN: entry index; families ``NN-name-KKK``).
     shape : dict
-        Scene-style shape mapping (``build_outline``).
+        Scene-style shape mapping (``object.shape``).
     mesh : MeshSpec
     outline : Outline or None
         Outline read from a file by the client (``shape.type: file``), so that workers need
@@ -93,8 +110,12 @@ class Task:
     spec_hash : str
         Hash of the sweep (workers cache prepared groups under it).
     obj : ObjectItem
-    material : tuple of (str, float, float, float)
-        (name, E Pa, nu, thickness m).
+    material : str
+        The material's name.
+    scene : Scene
+        The group's scene (:func:`group_scene`): its object and material, the base scene's
+        squeeze settings and limits; each evaluation places the fingers and sets the
+        parameters (:func:`evaluation_scene`).
     placement_mode : str
     placement_count : int
     placement_filters : tuple of str
@@ -103,9 +124,6 @@ class Task:
     start, stop : int
         Placement index range of this task.
     params : tuple of Params
-    limits : Limits
-    step, event_tol : float
-    max_events_per_depth : int
     adversary : tuple or None
         (position, mode, contacts, directions).
     """
@@ -114,7 +132,8 @@ class Task:
     group: str
     spec_hash: str
     obj: ObjectItem
-    material: tuple
+    material: str
+    scene: Scene
     placement_mode: str
     placement_count: int
     placement_filters: tuple
@@ -124,10 +143,6 @@ class Task:
     start: int
     stop: int
     params: tuple
-    limits: Limits
-    step: float
-    event_tol: float
-    max_events_per_depth: int
     adversary: Optional[tuple]
 
     @property
@@ -192,13 +207,52 @@ def parameter_grid(loaded: LoadedSpec) -> tuple[Params, ...]:
                  for k, (mu, r, kind, (d, rel)) in enumerate(grid))
 
 
-def build_group_mesh(item: ObjectItem):
-    """The mesh of an object (deterministic: the same on every machine with the same Triangle)."""
-    outline = item.outline if item.outline is not None else build_outline(item.shape)
-    ms = item.mesh
-    area = ms.max_area if ms.max_area is not None else target_max_area(
-        outline, ms.nodes if ms.nodes is not None else 600)
-    return generate_mesh(outline, area, min_angle=ms.min_angle)
+UNPLACED: dict = {Finger.F1: FingerSpec(PlacementSpec(angle_deg=180.0)),
+                  Finger.F2: FingerSpec(PlacementSpec(angle_deg=0.0))}
+"""Fingers of a group's scene before an evaluation places them on its nodes (angle placements
+insert no mesh vertex, so the group's mesh is the object's own)."""
+
+
+def group_scene(loaded: LoadedSpec, item: ObjectItem, material: MaterialSpec) -> Scene:
+    """The scene of an (object, material) group: the base scene's squeeze settings, strain
+    limit and the sweep's pickup weight, on ``item`` made of ``material``; friction is set
+    per evaluation.
+    """
+    base = loaded.base
+    strain = base.strain_limit if base.has("strain_limit") else None
+    pickup = PickupSpec(loaded.weight) if loaded.weight is not None else None
+    effects = ("friction",) + (("strain_limit",) if strain else ()) + (
+        ("pickup",) if pickup else ())
+    scene = Scene(object=ObjectSpec(item.shape, material, mesh=item.mesh),
+                  fingers=UNPLACED, name=item.id, squeeze=base.squeeze,
+                  friction=FrictionSpec(min(loaded.friction)), strain_limit=strain,
+                  pickup=pickup, effects=effects)
+    try:
+        return validate(scene)
+    except SceneError as exc:
+        raise SweepError(f"object {item.id}, material: {exc}") from None
+
+
+def evaluation_scene(scene: Scene, nodes: tuple[int, int], params: Params) -> Scene:
+    """The group's ``scene`` with the fingers on ``nodes`` (F1, F2) and the parameters of one
+    evaluation: friction, fingertip radius, squeeze type and depth.
+    """
+    tip = params.tip_radius
+    return dataclasses.replace(
+        scene,
+        fingers={Finger.F1: FingerSpec(PlacementSpec(node=nodes[0]), tip_radius=tip),
+                 Finger.F2: FingerSpec(PlacementSpec(node=nodes[1]), tip_radius=tip)},
+        friction=FrictionSpec(params.mu),
+        squeeze=dataclasses.replace(scene.squeeze, type=params.kind, depth=params.depth,
+                                    relative_depth=params.relative_depth),
+    )
+
+
+def group_setup(task: Task) -> GraspSetup:
+    """The mechanics of the task's group: its scene meshed (the outline read by the client for
+    an outline file), not yet precomputed.
+    """
+    return GraspSetup.build(task.scene, outline=task.obj.outline)
 
 
 def placement_total(loaded: LoadedSpec, item: ObjectItem) -> int:
@@ -206,7 +260,8 @@ def placement_total(loaded: LoadedSpec, item: ObjectItem) -> int:
     pl = loaded.spec.placements
     if pl.mode == "all":
         try:
-            b = len(build_group_mesh(item).boundary)
+            b = len(GraspSetup.build(group_scene(loaded, item, next(iter(
+                loaded.materials.values()))), outline=item.outline).boundary)
         except Exception as exc:
             raise SweepError(f"object {item.id}: meshing failed: {exc}") from None
         return b * (b - 1) // 2
@@ -218,9 +273,6 @@ def plan_tasks(loaded: LoadedSpec) -> list[Task]:
     sw = loaded.spec
     params = parameter_grid(loaded)
     per_task = max(1, sw.chunk // len(params))
-    limits = scene_limits(loaded.base)
-    limits = dataclasses.replace(limits, weight=loaded.weight)
-    sq = loaded.base.squeeze
     adversary = None
     if sw.adversary is not None:
         a = sw.adversary
@@ -232,10 +284,10 @@ def plan_tasks(loaded: LoadedSpec) -> list[Task]:
         total = placement_total(loaded, item)
         for mat_name, m in loaded.materials.items():
             group = f"{item.id}~{mat_name}"
+            scene = group_scene(loaded, item, m)
             for c, start in enumerate(range(0, total, per_task)):
                 tasks.append(Task(
-                    f"{group}~c{c:04d}", group, loaded.hash, item,
-                    (mat_name, m.E, m.nu, m.thickness), pl.mode, pl.count, tuple(pl.require),
-                    float(mu_filter), sw.seed, sw.repeat, start, min(start + per_task, total),
-                    params, limits, sq.step, sq.event_tol, sq.max_events_per_depth, adversary))
+                    f"{group}~c{c:04d}", group, loaded.hash, item, mat_name, scene, pl.mode,
+                    pl.count, tuple(pl.require), float(mu_filter), sw.seed, sw.repeat, start,
+                    min(start + per_task, total), params, adversary))
     return sorted(tasks, key=lambda t: t.id)

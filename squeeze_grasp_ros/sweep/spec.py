@@ -28,7 +28,7 @@ from squeeze_grasp_ros.scene import (
     load_scene,
     read_yaml,
 )
-from squeeze_grasp_ros.scene.checks import check_shape
+from squeeze_grasp_ros.scene.checks import check_material, check_shape
 from squeeze_grasp_ros.scene.schema import key_reference, parse_section, spec
 from squeeze_grasp_ros.mechanics.vocabulary import Finger
 
@@ -364,6 +364,10 @@ def parse_sweep_spec(data: Any, base_dir: Path) -> LoadedSpec:
                 )
             materials[name] = parse_section(MaterialSpec, value, f"materials.{name}",
                                             error=SweepError)
+            try:
+                check_material(materials[name], f"materials.{name}")
+            except SceneError as exc:
+                raise SweepError(str(exc)) from None
     fingers = base.fingers
     tip = fingers[Finger.F1].tip_radius
     if sw.tip_radius is None and not (tip > 0 and fingers[Finger.F2].tip_radius == tip):

@@ -307,18 +307,17 @@ def frictional_resistance(
     --------
     Fig. 10's scene: after its squeeze, the adversary pushes and F2 slips before A's full travel.
 
-    >>> from squeeze_grasp_ros.api import event_squeeze_scene, load_scene, scene_file, scene_solid
-    >>> from squeeze_grasp_ros.scene import placement_node
-    >>> from squeeze_grasp_ros.scene_events import scene_contact_model
-    >>> scene = load_scene(scene_file("resist_fig10"))
-    >>> obj = scene_solid(scene)
-    >>> squeeze, model = event_squeeze_scene(scene, obj), scene_contact_model(scene, obj)
-    >>> adv = scene.adversary
-    >>> node = placement_node(obj.mesh, adv.placement, "adversary")
-    >>> state = add_adversary(squeeze.state, model, squeeze.displacement, node, adv.tip_radius)
+    >>> from squeeze_grasp_ros.api import GraspSetup, load_scene, scene_file
+    >>> setup = GraspSetup.build(load_scene(scene_file("resist_fig10")))
+    >>> squeeze = setup.event_squeeze()
+    >>> model, adv = setup.contact_model(terminations=False), setup.scene.adversary
+    >>> state = add_adversary(squeeze.state, model, squeeze.displacement, setup.adversary_node,
+    ...                       adv.tip_radius)
     >>> res = frictional_resistance(model, state, adv.a)
     >>> print(res.success, res.reason)
     False F2 slips
+
+    The same in one call: :meth:`~squeeze_grasp_ros.scene.setup.GraspSetup.frictional_resistance`.
     """
     a = np.asarray(a, float).reshape(-1)
     require_finite("adversary translation a", a)

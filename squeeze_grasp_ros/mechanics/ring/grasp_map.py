@@ -232,9 +232,8 @@ def ring_grasp_map(ring: RingModel, mu: float, *, epsilon: float | None = None,
 
     Examples
     --------
-    >>> from squeeze_grasp_ros.api import load_scene, scene_file
-    >>> from squeeze_grasp_ros.scene import build_ring
-    >>> ring = build_ring(load_scene(scene_file("ring_ring")))
+    >>> from squeeze_grasp_ros.api import GraspSetup, load_scene, scene_file
+    >>> ring = GraspSetup.build(load_scene(scene_file("ring_ring"))).ring
     >>> gmap = ring_grasp_map(ring, 0.4)
     >>> gmap.n == ring.n, gmap.kind
     (True, 'stable')

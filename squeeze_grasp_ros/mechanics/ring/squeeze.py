@@ -37,7 +37,7 @@ from squeeze_grasp_ros.mechanics.errors import InvalidInputError, require_finite
 from squeeze_grasp_ros.mechanics.elastic.reduced import reduce_blocks
 from squeeze_grasp_ros.mechanics.ring.model import RingModel
 from squeeze_grasp_ros.mechanics.squeeze.stable_pure import two_contact_direction
-from squeeze_grasp_ros.mechanics.vocabulary import SqueezeKind
+from squeeze_grasp_ros.mechanics.vocabulary import SQUEEZING_FINGERS, SqueezeKind
 
 LIMITS: tuple[str, ...] = ("friction_cone_F1", "friction_cone_F2", "strain", "none")
 """Names of what bounds the squeeze depth, indexed by the integer limit codes."""
@@ -334,6 +334,44 @@ class RingGrasp:
         vals = [*self.cone_depths, self.strain_depth]
         return {name: (float(v) if np.isfinite(v) else None) for name, v in zip(LIMITS, vals)}
 
+    def force_angles_at(self, depth: float) -> np.ndarray:
+        """Angle (2,), deg, between each finger's contact force and its contact normal at
+        depth ``depth`` (m); the cone's half-angle is atan(mu).
+        """
+        N = self.normals_at(depth)
+        F = self.forces / np.linalg.norm(self.forces, axis=1, keepdims=True)
+        return np.degrees(np.arccos(np.clip(np.sum(N * F, axis=1), -1.0, 1.0)))
+
+    def to_json(self, depth: float) -> dict:
+        """JSON-able summary (docs/ring.md) with the yes/no test, forces and strain at the
+        requested depth ``depth`` (m).
+        """
+        forces = self.forces_at(depth)
+        at0, at_depth = self.force_angles_at(0.0), self.force_angles_at(depth)
+        return {
+            "elements": len(self.points),
+            "squeeze": self.kind,
+            "mu": self.mu,
+            "epsilon": self.epsilon,
+            "contacts": [int(c) for c in self.contacts],
+            "points": {f: self.points[c].tolist()
+                       for f, c in zip(SQUEEZING_FINGERS, self.contacts)},
+            "depth": float(depth),
+            "relative_depth": self.relative_depth(depth),
+            "max_depth": self.max_depth,
+            "max_relative_depth": self.max_relative_depth,
+            "limit": self.limit,
+            "limit_depths": self.limit_depths(),
+            "feasible_at_requested_depth": self.feasible_at(depth),
+            "forces": {f: forces[k].tolist() for k, f in enumerate(SQUEEZING_FINGERS)},
+            "stiffness": self.stiffness,
+            "max_strain": self.max_strain_at(depth),
+            "max_strain_element": int(np.argmax(self.strains)),
+            "cone_half_angle_deg": float(np.degrees(np.arctan(self.mu))),
+            "force_angle_deg": {f: [float(at0[k]), float(at_depth[k])]
+                                for k, f in enumerate(SQUEEZING_FINGERS)},
+        }
+
 
 def _check_contacts(ring: RingModel, contacts) -> np.ndarray:
     c = np.asarray(contacts, dtype=int).reshape(-1)
@@ -392,12 +430,13 @@ def ring_grasp(
 
     Examples
     --------
-    >>> from squeeze_grasp_ros.api import load_scene, scene_file
-    >>> from squeeze_grasp_ros.scene import build_ring
-    >>> ring = build_ring(load_scene(scene_file("ring_ring")))
+    >>> from squeeze_grasp_ros.api import GraspSetup, load_scene, scene_file
+    >>> ring = GraspSetup.build(load_scene(scene_file("ring_ring"))).ring
     >>> grasp = ring_grasp(ring, [0, ring.n // 2], 0.4)
     >>> print(grasp.kind, bool(grasp.max_depth > 0))
     stable True
+    >>> print(grasp.to_json(0.001)["feasible_at_requested_depth"])
+    True
     """
     if kind not in (SqueezeKind.STABLE, SqueezeKind.PURE):
         raise InvalidInputError(f"squeeze type must be 'stable' or 'pure', got {kind!r}")

@@ -540,7 +540,18 @@ class ContactModel:
         return u.reshape(-1, 2)
 
     def strain_measure(self, sd: SetData, delta: np.ndarray, F: np.ndarray) -> tuple[float, int]:
-        """(largest strain by the limit's criterion, element index) of the configuration."""
+        """(largest strain by the limit's criterion, element index) of the configuration
+        (counted in :attr:`strain_evaluations`).
+        """
+        self._cache["strain_evaluations"] = self.strain_evaluations + 1
+        return self._measure_strain(sd, delta, F)
+
+    @property
+    def strain_evaluations(self) -> int:
+        """How many configurations' strain was measured (the strain-limit check's work)."""
+        return self._cache.get("strain_evaluations", 0)
+
+    def _measure_strain(self, sd: SetData, delta: np.ndarray, F: np.ndarray) -> tuple[float, int]:
         if sd.strain_map is not None:
             eps = (sd.strain_map @ F.reshape(-1)).reshape(-1, 3)
         else:

@@ -33,14 +33,13 @@ from squeeze_grasp_ros.mechanics.squeeze.contact_state import (
 from squeeze_grasp_ros.mechanics.errors import InvalidInputError, require_finite
 from squeeze_grasp_ros.mechanics.elastic.fem import element_strains, von_mises_stress
 from squeeze_grasp_ros.mechanics.squeeze.fingertips import place_fingertip
-from squeeze_grasp_ros.mechanics.squeeze.stable_pure import plan_squeeze
+from squeeze_grasp_ros.mechanics.squeeze.stable_pure import finger_motion
 from squeeze_grasp_ros.mechanics.squeeze.stepper import TERMINATION_ORDER, advance
 from squeeze_grasp_ros.mechanics.squeeze.nonlinear_model import (NonlinearContactModel,
                                                                   contact_model)
 from squeeze_grasp_ros.mechanics.vocabulary import (
     MaterialModel,
     EventType,
-    Finger,
     SQUEEZING_FINGERS,
     SqueezeKind,
     Termination,
@@ -473,22 +472,8 @@ def event_squeeze(
     radii = (
         dict(tip_radius) if isinstance(tip_radius, Mapping) else dict.fromkeys(names, tip_radius)
     )
-    plan = plan_squeeze(obj, list(contacts), kind=kind)
-    p = obj.mesh.nodes[list(contacts)]
-    distance = float(np.linalg.norm(p[1] - p[0]))
-    if directions is None:
-        u = plan.displacement.reshape(2, 2)
-        dirs = {"F1": u[0], "F2": u[1]}
-        approach = plan.approach_per_unit_depth
-    else:
-        stacked = np.array([directions[n] for n in names], float)
-        norm = float(np.linalg.norm(stacked))
-        if not norm > 0:
-            raise InvalidInputError("squeeze directions must not all be zero")
-        dirs = {n: stacked[k] / norm for k, n in enumerate(names)}
-        approach = float((dirs[Finger.F1] - dirs[Finger.F2]) @ (p[1] - p[0]) / distance)
-        kind = "custom"
-    relative_per_depth = approach / distance
+    motion = finger_motion(obj, contacts, kind=kind, directions=directions)
+    dirs, relative_per_depth, kind = motion.directions, motion.relative_per_depth, motion.kind
     if depth is None:
         if not relative_per_depth > 0:
             raise InvalidInputError(

@@ -157,7 +157,7 @@ class NonlinearContactModel(ContactModel):
         k = int(np.argmax(per_element))
         return float(per_element[k]), k
 
-    def strain_measure(self, sd: SetData, delta: np.ndarray, F: np.ndarray) -> tuple[float, int]:
+    def _measure_strain(self, sd: SetData, delta: np.ndarray, F: np.ndarray) -> tuple[float, int]:
         """(largest strain in the model's measure, element) of the configuration."""
         return self.field_strain(self._field(sd, delta))
 

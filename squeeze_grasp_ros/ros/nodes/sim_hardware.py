@@ -35,7 +35,7 @@ from visualization_msgs.msg import MarkerArray
 from squeeze_grasp_interfaces.msg import ContactEventArray, SimState, TactileArray, Tick
 
 from squeeze_grasp_ros.ros import messages
-from squeeze_grasp_ros.scene import load_scene
+from squeeze_grasp_ros.scene import GraspSetup, load_scene
 from squeeze_grasp_ros.sim.world import SimWorld, TickOutput
 from squeeze_grasp_ros.ros.nodes import pipeline, run_node
 
@@ -70,7 +70,7 @@ class SimHardwareNode(Node):
         if world is None:
             if not self.p["scene"]:
                 raise ValueError("parameter 'scene' (a scene YAML file) is required")
-            world = SimWorld(load_scene(self.p["scene"]))
+            world = SimWorld(GraspSetup.build(load_scene(self.p["scene"])))
         self.world = world
         self.frame = self.p["frame_id"]
         loop = pipeline.loop_qos(self.p["qos_depth"])

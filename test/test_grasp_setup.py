@@ -198,7 +198,7 @@ def test_a_ring_refuses_a_nonlinear_material_model(tmp_path, capsys, model):
 
 def test_a_ring_and_a_solid_answer_their_own_kind_only():
     ring = GraspSetup.build(load_scene(SCENES / "ring_ring.yaml"))
-    with pytest.raises(SceneError, match="needs a solid"):
+    with pytest.raises(SceneError, match="has no solid mesh"):
         _ = ring.solid
     with pytest.raises(SceneError, match="needs a solid object"):
         ring.event_squeeze()

@@ -269,7 +269,7 @@ def test_frictional_resistance_equals_the_mechanics(planner: Harness) -> None:
         expected.travelled,
     )
     assert [(e.type, e.node, e.finger) for e in response.events] == [
-        (e.type, e.node, e.finger) for e in expected.events
+        (e.type.value, e.node, e.finger) for e in expected.events
     ]
     assert [(n.finger, n.node, n.polar_angle) for n in response.nodes] == [
         (f, c.node, c.theta) for f in ("F1", "F2", "A") for c in expected.state.segment(f)
@@ -347,7 +347,7 @@ def test_event_squeeze_service_and_action_equal_the_mechanics(planner: Harness) 
             expected.energy,
         )
         assert [(e.type, e.node, e.finger, e.depth) for e in data.events] == [
-            (e.type, e.node, e.finger, e.depth) for e in expected.events
+            (e.type.value, e.node, e.finger, e.depth) for e in expected.events
         ]
         final = data.final_state
         assert list(

@@ -245,7 +245,7 @@ def test_world_is_a_loop_over_the_stepper(world_run):
 def test_tracker_events_match_the_ground_truth_within_tolerance(world_run):
     states = [contact_modes(out.state) for out in world_run["outputs"]]
     truth = net_events(states)
-    seen = [(k, e.type, e.finger) for k, obs in enumerate(world_run["observed"])
+    seen = [(k, str(e.type), e.finger) for k, obs in enumerate(world_run["observed"])
             for e in obs.events]
     print(f"tolerance: type and finger exact, tick within {EVENT_TOLERANCE_TICKS} ticks; "
           f"ground truth {len(truth)} net events, monitor {len(seen)}")

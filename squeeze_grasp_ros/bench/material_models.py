@@ -14,7 +14,7 @@ from squeeze_grasp_ros import plots
 from squeeze_grasp_ros.bench.table import Table
 from squeeze_grasp_ros.mechanics.elastic.contact_response import factorization_reuse
 from squeeze_grasp_ros.mechanics.squeeze.stepper import substep_adaptation
-from squeeze_grasp_ros.mechanics.vocabulary import MaterialModel
+from squeeze_grasp_ros.mechanics.vocabulary import Finger, MaterialModel
 from squeeze_grasp_ros.resources import scene_file
 from squeeze_grasp_ros.scene import GraspSetup, load_scene
 
@@ -75,10 +75,10 @@ def run(quick: bool, out_dir: Path, progress) -> list[Table]:
         for rel in depths:
             progress(f"material_models: {name} at {100 * rel:g} %")
             linear, _ = _run(setup, MaterialModel.LINEAR, rel)
-            row = [name, 100 * rel, linear.finger_force["F1"][1], linear.health.max_strain]
+            row = [name, 100 * rel, linear.finger_force[Finger.F1][1], linear.health.max_strain]
             for model in NONLINEAR:
                 res, _ = _run(setup, model, rel)
-                df = res.finger_force["F1"][1] / linear.finger_force["F1"][1] - 1
+                df = res.finger_force[Finger.F1][1] / linear.finger_force[Finger.F1][1] - 1
                 de = res.energy / linear.energy - 1
                 row += [100 * df, 100 * de, res.health.max_strain, res.termination]
                 curves.setdefault((name, model), []).append((100 * rel, 100 * df))
@@ -100,9 +100,9 @@ def run(quick: bool, out_dir: Path, progress) -> list[Table]:
     cost = []
     setup = _setup("foam_square", 800 if quick else 2000)
     linear, t_lin = _best(setup, MaterialModel.LINEAR, LINEAR_REPEATS)
-    cost.append(["linear", t_lin, 1.0, linear.diagnostics["substeps"],
+    cost.append([str(MaterialModel.LINEAR), t_lin, 1.0, linear.diagnostics["substeps"],
                  linear.diagnostics["root_evaluations"], "-", "-", "-",
-                 linear.finger_force["F1"][1]])
+                 linear.finger_force[Finger.F1][1]])
     for model in NONLINEAR:
         for variant, reuse, adapt in VARIANTS:
             with factorization_reuse(reuse), substep_adaptation(adapt):
@@ -112,7 +112,7 @@ def run(quick: bool, out_dir: Path, progress) -> list[Table]:
                          res.diagnostics["root_evaluations"],
                          f"{nl['evaluations']} ({nl['look_ups']})",
                          nl["newton_iterations"] / max(nl["evaluations"], 1),
-                         nl["factorizations"], res.finger_force["F1"][1]])
+                         nl["factorizations"], res.finger_force[Finger.F1][1]])
     return [
         Table(TITLE, ["object", "rel. depth [%]", "linear F1 [N]", "linear max strain",
                       "corot. dF [%]", "corot. dE [%]", "corot. max strain", "corot. end",

@@ -17,6 +17,7 @@ from squeeze_grasp_ros.commands.common import (
     load_setup,
 )
 from squeeze_grasp_ros.mechanics.squeeze.graspmap import GraspMap
+from squeeze_grasp_ros.mechanics.vocabulary import ObjectModel
 from squeeze_grasp_ros.scene.studies import grasp_map_study
 
 HELP = (
@@ -39,7 +40,7 @@ def run(args: argparse.Namespace) -> dict:
     """Map every placement pair of the scene's object (solid or ring model)."""
     study = grasp_map_study(load_setup(args.scene, args.solver))
     if args.plot:
-        if study.setup.model == "ring":
+        if study.setup.is_ring:
             plot_map(study.setup.ring, study.map, args.plot)
         else:
             plot(study.setup.solid, study.map, args.plot)
@@ -67,7 +68,7 @@ def plot(obj, gmap: GraspMap, path: str) -> None:
 
 def summary(result: dict) -> str:
     """Counts and the best placements."""
-    if result["model"] == "ring":
+    if result["model"] == ObjectModel.RING:
         return map_summary(result)
     lines = [
         f"{result['pairs']} placements: {result['inward_pairs']} inward, "

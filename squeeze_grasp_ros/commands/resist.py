@@ -25,22 +25,22 @@ from squeeze_grasp_ros.mechanics.resistance.optimal import (
 )
 from squeeze_grasp_ros.mechanics.squeeze.contact_model import ContactModel
 from squeeze_grasp_ros.mechanics.squeeze.events import grasp_health
-from squeeze_grasp_ros.mechanics.vocabulary import ContactMode, Finger, SqueezeKind
+from squeeze_grasp_ros.mechanics.vocabulary import ContactKind, ContactMode, Finger, SqueezeKind
 from squeeze_grasp_ros.scene.studies import resistance_study
 
 HELP = "optimal stable/pure resistance of F1, F2 to the scene's adversary finger A (Sec. 6)"
-CONTACT_MODELS = ("point", "segment", "friction")
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     """SCENE, --mode, --contacts, --directions, --segment-half-width, --compare-direction."""
     add_scene_argument(parser)
     parser.add_argument(
-        "--mode", choices=SqueezeKind.values(), help="resistance type (default: the scene's)"
+        "--mode", choices=SqueezeKind.planned(), help="resistance type (default: the scene's)"
     )
     parser.add_argument(
         "--contacts",
-        choices=CONTACT_MODELS,
+        choices=ContactKind.values(),
+        type=ContactKind,
         help="contact model (default: the scene's adversary.contacts)",
     )
     parser.add_argument(
@@ -187,7 +187,7 @@ def summary(result: dict) -> str:
         f"{result['mode']} resistance, {result['contact_model']} contacts at nodes "
         f"F1 {i}, F2 {j}, A {k}; a = {np.round(result['a'], 6).tolist()} m"
     )
-    if result["contact_model"] == "friction":
+    if result["contact_model"] == ContactKind.FRICTION:
         return friction_summary(head, result)
     if not result["success"]:
         return f"{head}\n{result['reason']}"
@@ -196,8 +196,8 @@ def summary(result: dict) -> str:
         head,
         f"d1 = {np.round(result['d1'], 6).tolist()} m, d2 = "
         f"{np.round(result['d2'], 6).tolist()} m",
-        f"work [J]: F1 {w['F1']:.5g}, F2 {w['F2']:.5g}, total W*_F {w['total']:.5g} "
-        f"(A {w['A']:.5g}); per unit push {result['unit_work']:.5g} J/m^2",
+        f"work [J]: F1 {w[Finger.F1]:.5g}, F2 {w[Finger.F2]:.5g}, total W*_F "
+        f"{w['total']:.5g} (A {w[Finger.A]:.5g}); per unit push {result['unit_work']:.5g} J/m^2",
     ]
     lines += [f"force {f} [N]: {np.round(result['forces'][f], 4).tolist()}" for f in tuple(Finger)]
     cmp = result.get("comparison")

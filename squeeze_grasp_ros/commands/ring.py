@@ -21,7 +21,7 @@ from squeeze_grasp_ros.commands.ring_map import closed, map_summary, plot_map
 from squeeze_grasp_ros.mechanics.ring.grasp_map import bench_ring
 from squeeze_grasp_ros.mechanics.ring.model import RingModel
 from squeeze_grasp_ros.mechanics.ring.squeeze import RingGrasp
-from squeeze_grasp_ros.mechanics.vocabulary import SQUEEZING_FINGERS
+from squeeze_grasp_ros.mechanics.vocabulary import SQUEEZING_FINGERS, Finger, ObjectModel
 from squeeze_grasp_ros.scene import GraspSetup, SceneError, load_scene
 from squeeze_grasp_ros.scene.studies import grasp_map_study, ring_placement
 
@@ -70,7 +70,7 @@ def load_ring(path: str, elements: int | None = None) -> GraspSetup:
     ``object.ring.elements``).
     """
     scene = load_scene(path)
-    if scene.object.model != "ring":
+    if scene.object.model != ObjectModel.RING:
         raise SceneError(
             f"{path}: object.model is {scene.object.model!r}; `ring` needs model: ring"
         )
@@ -89,8 +89,8 @@ def run(args: argparse.Namespace) -> dict:
     setup = load_ring(args.scene, args.elements)
     scene = setup.scene
     if args.bench:
-        return {"model": "ring", "bench": bench_ring(setup.ring, scene.mu, setup.limits.strain,
-                                                     scene.squeeze.type)}
+        bench = bench_ring(setup.ring, scene.mu, setup.limits.strain, scene.squeeze.type)
+        return {"model": ObjectModel.RING, "bench": bench}
     if args.map:
         if args.depth is not None or (args.relative_depth is None
                                       and scene.squeeze.depth is not None):
@@ -196,8 +196,8 @@ def summary(result: dict) -> str:
             f"(relative {result['max_relative_depth']:.4g}), limit {result['limit']}",
             f"requested depth {result['depth']:.4g} m (relative {result['relative_depth']:.4g}): "
             f"{verdict}",
-            f"forces F1 {np.round(result['forces']['F1'], 4).tolist()} N, "
-            f"F2 {np.round(result['forces']['F2'], 4).tolist()} N; max strain "
+            f"forces F1 {np.round(result['forces'][Finger.F1], 4).tolist()} N, "
+            f"F2 {np.round(result['forces'][Finger.F2], 4).tolist()} N; max strain "
             f"{result['max_strain']:.4g}",
         ]
     )

@@ -179,7 +179,7 @@ def plot(obj, res: EventSqueeze, path: str) -> str:
     ax.set_title("polar angles of the contact nodes (Fig. 6)", fontsize=9)
     ax = axes[2]
     ax.set_aspect("auto")
-    for row, kind in enumerate(EventType.values()):
+    for row, kind in enumerate(EventType):
         evs = [e for e in res.events if e.type == kind]
         ax.scatter(
             [e.relative_depth for e in evs],
@@ -189,8 +189,8 @@ def plot(obj, res: EventSqueeze, path: str) -> str:
             marker="|",
         )
     ax.set_yticks(
-        range(len(EventType.values())),
-        [f"{k} ({res.event_counts[k]})" for k in EventType.values()],
+        range(len(EventType)),
+        [f"{k} ({n})" for k, n in res.event_counts.items()],
     )
     ax.set_xlim(0, max(res.relative_depth, 1e-9) * 1.02)
     ax.set_xlabel("relative squeeze depth")
@@ -255,10 +255,11 @@ def summary(result: dict) -> str:
         f"tip radius {result['tip_radius']:g} m, initial contacts {result['contacts']}",
         f"termination: {result['termination']} at depth {result['depth']:.6g} m "
         f"(relative {100 * result['relative_depth']:.3f} %)",
-        "events: " + ", ".join(f"{k} {c[k]}" for k in EventType.values()),
+        "events: " + ", ".join(f"{k} {n}" for k, n in c.items()),
     ]
     for name, seg in result["segments"].items():
-        modes = " ".join(f"{s['node']}{'' if s['mode'] == 'stick' else '~'}" for s in seg)
+        modes = " ".join(f"{s['node']}{'' if s['mode'] == ContactMode.STICK else '~'}"
+                         for s in seg)
         ff = result["finger_force"][name]
         friction = result["dissipation"][name]
         lines.append(

@@ -42,7 +42,7 @@ from functools import cached_property
 import numpy as np
 from squeeze_grasp_ros.mechanics.vocabulary import SqueezeKind, Termination
 
-REACTIONS: tuple[str, ...] = ("hold", "pure", "normals")
+REACTIONS: tuple[str, ...] = ("hold", SqueezeKind.PURE.value, "normals")
 
 
 @dataclass(frozen=True)

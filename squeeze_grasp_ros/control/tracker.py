@@ -51,9 +51,9 @@ from typing import NamedTuple
 import numpy as np
 
 
-from squeeze_grasp_ros.mechanics.vocabulary import ContactMode, Finger, Termination
+from squeeze_grasp_ros.mechanics.vocabulary import ContactMode, EventType, Finger, Termination
 
-ORDER = {"B": 0, "D": 1, "C": 2, "A": 3}
+ORDER: dict[EventType, int] = {EventType.B: 0, EventType.D: 1, EventType.C: 2, EventType.A: 3}
 """Processing order of the events of one tick and finger."""
 
 
@@ -151,10 +151,10 @@ class Patch(NamedTuple):
 
 @dataclass(frozen=True)
 class TrackedEvent:
-    """An event found by the tracker (``type`` A, B, C, D or picked_up)."""
+    """An event found by the tracker: a contact event (A, B, C, D) or picked_up."""
 
-    type: str
-    finger: str
+    type: EventType | Termination
+    finger: Finger | str
     depth: float
     relative_depth: float
     angle: float
@@ -174,8 +174,8 @@ class TrackedAlarm:
 class PredictedEvent:
     """An event of the planner's prediction."""
 
-    type: str
-    finger: str
+    type: EventType
+    finger: Finger
     depth: float
 
 
@@ -422,16 +422,16 @@ class ContactTracker:
         found = []
         for before, after in connected_groups(previous, current, self.config.match_margin):
             if not after:
-                found += [("B", previous[i].angle) for i in before]
+                found += [(EventType.B, previous[i].angle) for i in before]
             elif not before:
                 if self.tracks[name].had_contact:
-                    found += [("A", current[j].angle) for j in after]
+                    found += [(EventType.A, current[j].angle) for j in after]
             elif len(before) == len(after) == 1:
                 old, new = previous[before[0]], current[after[0]]
                 if old.mode == ContactMode.STICK and new.mode == ContactMode.SLIP:
-                    found.append(("C", new.angle))
+                    found.append((EventType.C, new.angle))
                 elif old.mode == ContactMode.SLIP and new.mode == ContactMode.STICK:
-                    found.append(("D", new.angle))
+                    found.append((EventType.D, new.angle))
         found.sort(key=lambda e: (ORDER[e[0]], e[1]))
         return [TrackedEvent(kind, name, self.depth, relative, angle) for kind, angle in found]
 

@@ -20,10 +20,11 @@ from squeeze_grasp_ros.mechanics.elastic.compliance import ROUTES, ElasticObject
 from squeeze_grasp_ros.mechanics.ring.model import RingModel
 from squeeze_grasp_ros.scene import Scene, parse_scene, requested_nodes
 from squeeze_grasp_ros.scene.setup import RING_STAGES, SOLID_STAGES, GraspSetup
+from squeeze_grasp_ros.mechanics.vocabulary import ContactKind, ObjectModel, ShapeType
 from squeeze_grasp_ros.planning.errors import ErrorCode, PlannerError, invalid
 
 
-CONTACT_MODELS: tuple[str, ...] = ("point", "segment", "friction")
+CONTACT_MODELS: tuple[str, ...] = ContactKind.values()
 MAX_DIRECTIONS = 100_000
 """Most push directions one resistance sweep may ask for."""
 MAX_BEST_COUNT = 100_000
@@ -104,8 +105,8 @@ class LoadedObject:
         return self.setup.contacts
 
     @property
-    def model(self) -> str:
-        """Body model: "solid" (FEM mesh) or "ring" (curved beam)."""
+    def model(self) -> ObjectModel:
+        """Body model: solid (FEM mesh) or ring (curved beam)."""
         return self.setup.model
 
     @property
@@ -120,7 +121,7 @@ class LoadedObject:
 
     def solid(self) -> ElasticObject:
         """The FEM object; a ring raises INVALID_ARGUMENT naming the service to use."""
-        if self.model == "ring":
+        if self.setup.is_ring:
             raise invalid(
                 f"object {self.object_id!r} is a ring model (Sec. 7): use the "
                 "ring_grasp_test service"
@@ -129,7 +130,7 @@ class LoadedObject:
 
     def ring(self) -> RingModel:
         """The ring model; a solid raises INVALID_ARGUMENT."""
-        if self.model != "ring":
+        if not self.setup.is_ring:
             raise invalid(
                 f"object {self.object_id!r} is a solid (object.model: solid), not a ring"
             )
@@ -187,7 +188,7 @@ def read_scene(
             data, base_dir = load_yaml(scene_yaml, what="scene_yaml"), None
         scene = parse_scene(data, base_dir=base_dir)
         shape = scene.object.shape
-        if roots is not None and shape["type"] == "file":
+        if roots is not None and shape["type"] == ShapeType.FILE:
             confine(shape["path"], roots, what="object.shape.path")
     except InputError as exc:
         raise invalid(str(exc)) from None
@@ -263,7 +264,7 @@ def load_object(
     """
     scene = source.scene
     start = time.perf_counter()
-    if scene.object.model == "ring":
+    if scene.object.model == ObjectModel.RING:
         check_size(requested_nodes(scene), limits.max_ring_elements, "ring model")
         progress(RING_STAGES[0], 0, len(RING_STAGES), 0)
         setup = GraspSetup.build(scene)

@@ -22,7 +22,7 @@ from squeeze_grasp_ros.mechanics.ring.grasp_map import RingGraspMap, ring_grasp_
 from squeeze_grasp_ros.mechanics.ring.squeeze import RingGrasp, ring_grasp
 from squeeze_grasp_ros.mechanics.squeeze.stable_pure import Squeeze, force_closure, plan_squeeze
 from squeeze_grasp_ros.mechanics.squeeze.events import EventSqueeze
-from squeeze_grasp_ros.mechanics.vocabulary import SqueezeKind
+from squeeze_grasp_ros.mechanics.vocabulary import ContactKind, SqueezeKind
 from squeeze_grasp_ros.planning.errors import invalid
 from squeeze_grasp_ros.planning.objects import CONTACT_MODELS, Limits, LoadedObject, MAX_DIRECTIONS
 from squeeze_grasp_ros.planning.checks import check_number, check_step, choice, contact_nodes
@@ -70,7 +70,7 @@ def squeeze_plan(
         rho, m, >= 0; 0 = unit squeeze.
     """
     obj = loaded.solid()
-    kind = choice("squeeze_type", kind, SqueezeKind.values())
+    kind = choice("squeeze_type", kind, SqueezeKind.planned())
     scale = check_number("depth", depth, 0.0) or 1.0
     nodes = contact_nodes(loaded, contacts, default=loaded.finger_nodes)
     red = reduced_stiffness(obj, nodes)
@@ -135,7 +135,7 @@ def resistance_plan(
     a : (x, y, z)
         Adversary translation, m; z must be 0.
     mode : {"stable", "pure"}
-    contact_model : {"point", "segment", "friction"}
+    contact_model : {"point", "segment", "friction"} (:class:`ContactKind`)
     half_width : float
         Segment half width, m (>= 0; 0 = the node and its two neighbours).
     directions : int
@@ -146,15 +146,15 @@ def resistance_plan(
         Friction: the scene's squeeze step must be >= ``limits.min_step``.
     """
     loaded.solid()  # INVALID_ARGUMENT for a ring
-    mode = choice("mode", mode, SqueezeKind.values())
-    contact_model = choice("contact_model", contact_model, CONTACT_MODELS)
+    mode = choice("mode", mode, SqueezeKind.planned())
+    contact_model = ContactKind(choice("contact_model", contact_model, CONTACT_MODELS))
     x, y, z = (check_number(f"a.{k}", v) for k, v in zip("xyz", a))
     if z != 0.0:
         raise invalid(f"a.z must be 0 (planar objects), got {z}")
     width = check_number("segment_half_width", half_width, 0.0)
     count = int(check_number("directions", directions, 0, MAX_DIRECTIONS))
     nodes = contact_nodes(loaded, contacts, count=3)
-    if contact_model == "friction":
+    if contact_model == ContactKind.FRICTION:
         if count:
             raise invalid("directions: the sweep needs point or segment contacts")
         return ResistancePlan(
@@ -239,7 +239,7 @@ def ring_grasp_test(
         Also map every placement (:func:`~.mechanics.ring_map.ring_grasp_map`).
     """
     ring = loaded.ring()
-    kind = choice("squeeze_type", kind, SqueezeKind.values())
+    kind = choice("squeeze_type", kind, SqueezeKind.planned())
     mu = check_number("mu", mu, 0.0)
     epsilon = check_number("strain_limit", strain_limit, 0.0) or None
     relative = check_number("relative_depth", relative_depth, 0.0, 1.0)
@@ -287,7 +287,7 @@ def event_squeeze_run(
     """
     loaded.solid()  # INVALID_ARGUMENT for a ring
     scene = loaded.scene
-    kind = choice("squeeze_type", kind, SqueezeKind.values(), scene.squeeze.type)
+    kind = choice("squeeze_type", kind, SqueezeKind.planned(), scene.squeeze.type)
     depth = check_number("depth", depth, 0.0)
     relative_depth = check_number("relative_depth", relative_depth, 0.0, 1.0)
     if depth and relative_depth:

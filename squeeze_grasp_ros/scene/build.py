@@ -10,6 +10,8 @@ package builds its mechanics through :class:`~.setup.GraspSetup`, not through th
 from __future__ import annotations
 
 import math
+from collections.abc import Callable, Mapping
+from typing import Any
 
 import numpy as np
 
@@ -19,22 +21,32 @@ from squeeze_grasp_ros.mechanics.elastic.material import Material
 from squeeze_grasp_ros.mechanics.elastic.mesh import Mesh, generate_mesh, target_max_area
 from squeeze_grasp_ros.mechanics.errors import InvalidInputError
 from squeeze_grasp_ros.mechanics.ring.model import RingModel, ring_from_outline
-from squeeze_grasp_ros.mechanics.vocabulary import Finger
+from squeeze_grasp_ros.mechanics.vocabulary import Finger, ObjectModel, ShapeType
 from squeeze_grasp_ros.scene.specs import PlacementSpec, Scene, SceneError
 
 
-def build_outline(shape: dict) -> shapes.Outline:
+SHAPE_BUILDERS: dict[ShapeType, Callable[..., shapes.Outline]] = {
+    ShapeType.RECTANGLE: shapes.rectangle,
+    ShapeType.SQUARE: lambda side: shapes.rectangle(side, side),
+    ShapeType.DISK: shapes.disk,
+    ShapeType.ELLIPSE: shapes.ellipse,
+    ShapeType.SUPERELLIPSE: shapes.superellipse,
+    ShapeType.FOURIER_BLOB: shapes.fourier_blob,
+    ShapeType.POLYGON: shapes.polygon,
+    ShapeType.SPLINE: shapes.spline,
+    ShapeType.FILE: shapes.load_outline,
+    ShapeType.ANNULUS: shapes.annulus,
+}
+"""The outline of each shape type, called with the shape's parameters (:data:`.specs.SHAPES`)."""
+
+
+def build_outline(shape: Mapping[str, Any]) -> shapes.Outline:
     """The :class:`~squeeze_grasp_ros.mechanics.elastic.shapes.Outline` of a validated shape
     mapping.
     """
-    kind = shape["type"]
+    kind = ShapeType(shape["type"])
     try:
-        if kind == "square":
-            return shapes.rectangle(shape["side"], shape["side"])
-        if kind == "file":
-            return shapes.load_outline(shape["path"])
-        builder = getattr(shapes, kind)
-        return builder(**{k: v for k, v in shape.items() if k != "type"})
+        return SHAPE_BUILDERS[kind](**{k: v for k, v in shape.items() if k != "type"})
     except InvalidInputError as exc:
         raise SceneError(f"object.shape: {exc}") from None
     except TypeError as exc:
@@ -88,7 +100,7 @@ def build_ring(scene: Scene) -> RingModel:
     Its nodes act as boundary nodes, so :func:`finger_nodes` places fingers on it.
     """
     obj = scene.object
-    if obj.model != "ring":
+    if obj.model != ObjectModel.RING:
         raise SceneError(f"object.model must be ring for the ring model, got {obj.model!r}")
     try:
         return ring_from_outline(
@@ -141,7 +153,7 @@ def requested_nodes(scene: Scene) -> int | None:
     :func:`~squeeze_grasp_ros.mechanics.elastic.mesh.target_max_area`).
     """
     obj = scene.object
-    if obj.model == "ring":
+    if obj.model == ObjectModel.RING:
         return obj.ring.elements
     if obj.mesh.nodes is not None:
         return obj.mesh.nodes

@@ -11,36 +11,45 @@ also what sweep specs use for their objects and materials.
 
 from __future__ import annotations
 
+import dataclasses
+from collections.abc import Mapping
 from typing import Any
 
 import numpy as np
 
-from squeeze_grasp_ros.mechanics.vocabulary import SQUEEZING_FINGERS, Finger, MaterialModel
+from squeeze_grasp_ros.mechanics.vocabulary import (
+    SQUEEZING_FINGERS,
+    Effect,
+    Finger,
+    MaterialModel,
+    ObjectModel,
+)
 from squeeze_grasp_ros.scene.schema import MAX_INT
 from squeeze_grasp_ros.scene.specs import (
-    EFFECTS,
     SHAPES,
     MaterialSpec,
+    PlacementSpec,
     Scene,
     SceneError,
     SensorsSpec,
     finger_devices,
 )
 
-SECTION_EFFECT = {
-    "friction": "friction",
-    "strain_limit": "strain_limit",
-    "pickup": "pickup",
-    "adversary": "adversary",
-    "actuators": "actuator_lag",
+SECTION_EFFECT: dict[str, Effect] = {
+    "friction": Effect.FRICTION,
+    "strain_limit": Effect.STRAIN_LIMIT,
+    "pickup": Effect.PICKUP,
+    "adversary": Effect.ADVERSARY,
+    "actuators": Effect.ACTUATOR_LAG,
 }
-
-SENSOR_FIELD_EFFECT = {"noise_std": "sensor_noise", "dropout": "sensor_dropout"}
+"""Sections of a scene that exist exactly when their effect is declared."""
+SENSOR_FIELD_EFFECT: dict[str, Effect] = {"noise_std": Effect.SENSOR_NOISE,
+                                          "dropout": Effect.SENSOR_DROPOUT}
 """Fields of the ``sensors`` section that exist exactly when their effect is declared."""
-SENSING_EFFECTS = ("force_sensing", "tactile_sensing")
+SENSING_EFFECTS: tuple[Effect, ...] = (Effect.FORCE_SENSING, Effect.TACTILE_SENSING)
 
 
-def check_shape(shape: dict, where: str = "object.shape") -> None:
+def check_shape(shape: Mapping[str, Any], where: str = "object.shape") -> None:
     """A shape mapping names a known type (:data:`~.specs.SHAPES`) and exactly its parameters,
     each of the right type; errors name ``where.<key>``.
     """
@@ -113,8 +122,9 @@ def _validate_placements(scene: Scene) -> None:
     placements = [(f"fingers.{k}", v.placement) for k, v in scene.fingers.items()]
     if scene.adversary is not None:
         placements.append(("adversary", scene.adversary.placement))
+    keys = [f.name for f in dataclasses.fields(PlacementSpec)]
     for where, p in placements:
-        given = [k for k in ("point", "angle_deg", "node") if getattr(p, k) is not None]
+        given = [k for k in keys if getattr(p, k) is not None]
         if len(given) != 1:
             raise SceneError(
                 f"{where}.placement needs exactly one of point, angle_deg, node; "
@@ -146,10 +156,9 @@ def _validate_squeeze(scene: Scene) -> None:
 
 
 def _validate_effects(scene: Scene) -> None:
-    """Known effects, each once, and a section exactly for each declared effect."""
-    for effect in scene.effects:
-        if effect not in EFFECTS:
-            raise SceneError(f"unknown effect {effect!r} in effects (allowed: {sorted(EFFECTS)})")
+    """Each effect once, and a section exactly for each declared effect (the schema admits
+    only the effects of :data:`~.specs.EFFECTS`).
+    """
     if len(set(scene.effects)) != len(scene.effects):
         raise SceneError("effects lists an effect twice")
     for section, effect in SECTION_EFFECT.items():
@@ -176,13 +185,14 @@ def _validate_object(scene: Scene) -> None:
     is the linear curved-beam model (Sec. 7), so it takes no other material model.
     """
     obj = scene.object
-    if obj.model == "ring" and obj.ring is None:
+    ring = obj.model == ObjectModel.RING
+    if ring and obj.ring is None:
         raise SceneError("object.model is ring but object.ring is missing")
-    if obj.model == "solid" and obj.ring is not None:
+    if not ring and obj.ring is not None:
         raise SceneError("object.ring is given but object.model is solid")
-    if obj.model == "solid" and obj.mesh.max_area is not None and obj.mesh.nodes is not None:
+    if not ring and obj.mesh.max_area is not None and obj.mesh.nodes is not None:
         raise SceneError("object.mesh.max_area and object.mesh.nodes are exclusive; give one")
-    if obj.model == "ring" and obj.material.model != MaterialModel.LINEAR:
+    if ring and obj.material.model != MaterialModel.LINEAR:
         raise SceneError(
             f"object.material.model is {obj.material.model}, but a ring (object.model: ring) "
             "is the linear curved-beam model of Sec. 7: remove object.material.model or "
@@ -237,7 +247,7 @@ def _validate_sensors(scene: Scene) -> None:
     changed = [
         f for f in ("taxels", "taxel_span_deg") if getattr(sensors, f) != getattr(defaults, f)
     ]
-    if changed and not scene.has("tactile_sensing"):
+    if changed and not scene.has(Effect.TACTILE_SENSING):
         raise SceneError(
             f"sensors.{changed[0]} is given but effect 'tactile_sensing' is not "
             "declared in effects"
@@ -248,7 +258,7 @@ def _validate_sensors(scene: Scene) -> None:
 
 def _validate_devices(scene: Scene) -> None:
     """No two fingers on one device."""
-    seen: dict[str, str] = {}
+    seen: dict[str, Finger] = {}
     for name, device in finger_devices(scene).items():
         if device in seen:
             raise SceneError(

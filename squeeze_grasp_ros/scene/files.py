@@ -15,6 +15,7 @@ from pathlib import Path
 from typing import Any
 
 from squeeze_grasp_ros.inputs import InputError, load_yaml, read_text
+from squeeze_grasp_ros.mechanics.vocabulary import Finger, ShapeType
 from squeeze_grasp_ros.scene.checks import validate
 from squeeze_grasp_ros.scene.schema import parse_section
 from squeeze_grasp_ros.scene.specs import FingerSpec, Scene, SceneError
@@ -30,11 +31,14 @@ def parse_scene(data: Any, base_dir: Path | None = None) -> Scene:
         raise SceneError("a scene must be a YAML mapping")
     if isinstance(data.get("fingers"), dict):
         data = dict(data)
-        data["fingers"] = {k: parse_section(FingerSpec, v, f"fingers.{k}", error=SceneError)
-                           for k, v in data["fingers"].items()}
+        data["fingers"] = {
+            Finger(k) if k in Finger.values() else k:
+                parse_section(FingerSpec, v, f"fingers.{k}", error=SceneError)
+            for k, v in data["fingers"].items()}
     scene = validate(parse_section(Scene, data, "", error=SceneError))
     shape = scene.object.shape
-    if shape["type"] == "file" and base_dir is not None and not Path(shape["path"]).is_absolute():
+    if (shape["type"] == ShapeType.FILE and base_dir is not None
+            and not Path(shape["path"]).is_absolute()):
         shape = {**shape, "path": str(Path(base_dir) / shape["path"])}
         scene = dataclasses.replace(scene, object=dataclasses.replace(scene.object, shape=shape))
     return scene

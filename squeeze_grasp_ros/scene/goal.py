@@ -16,7 +16,12 @@ import numpy as np
 from squeeze_grasp_ros.control.motion import GraspGoal
 from squeeze_grasp_ros.mechanics.squeeze.events import EventSqueeze
 from squeeze_grasp_ros.mechanics.squeeze.stable_pure import plan_squeeze
-from squeeze_grasp_ros.mechanics.vocabulary import SQUEEZING_FINGERS, Finger, SqueezeKind
+from squeeze_grasp_ros.mechanics.vocabulary import (
+    SQUEEZING_FINGERS,
+    ContactKind,
+    Finger,
+    SqueezeKind,
+)
 from squeeze_grasp_ros.scene.setup import GraspSetup
 from squeeze_grasp_ros.scene.specs import Scene
 
@@ -45,7 +50,7 @@ class ScenePlan:
 def resists(scene: Scene, *, resist: bool = True) -> bool:
     """True if the scene has a frictional adversary and resistance is asked for."""
     adv = scene.adversary
-    return resist and adv is not None and adv.contacts == "friction"
+    return resist and adv is not None and adv.contacts == ContactKind.FRICTION
 
 
 def resistance_goal(setup: GraspSetup, squeeze: EventSqueeze | None = None) -> dict:

@@ -27,6 +27,7 @@ from __future__ import annotations
 import dataclasses
 import types
 import typing
+from collections.abc import Mapping
 from enum import Enum
 from typing import Any
 
@@ -67,7 +68,9 @@ def spec(
     lo, hi : float, optional
         Range of a number (inclusive unless ``lo_open``).
     choices : tuple of str
-        Allowed values of a string (an enum-typed field takes its members by default).
+        Allowed values of a string (an enum-typed field takes its members' values by default).
+        A mapping (``dict`` or ``Mapping[K, V]``) is checked to be one and kept as given: its
+        document's parser types its keys and values (e.g. a scene's fingers).
     **kw
         ``default`` or ``default_factory`` of :func:`dataclasses.field`.
     """
@@ -158,7 +161,7 @@ def _convert(tp: Any, value: Any, meta: dict, where: str, error: type[SchemaErro
         if not isinstance(value, bool):
             raise error(f"{where} must be true or false, got {value!r}")
         return value
-    if tp is dict:
+    if tp is dict or origin in (dict, Mapping):
         if not isinstance(value, dict):
             raise error(f"{where} must be a mapping, got {value!r}")
         return value

@@ -46,10 +46,13 @@ from squeeze_grasp_ros.mechanics.squeeze.nonlinear_model import contact_model
 from squeeze_grasp_ros.mechanics.squeeze.stable_pure import FingerMotion, finger_motion
 from squeeze_grasp_ros.mechanics.vocabulary import (
     SQUEEZING_FINGERS,
+    ContactKind,
+    Effect,
     Finger,
     MaterialModel,
+    ObjectModel,
+    SqueezeKind,
     StrainCriterion,
-    Termination,
 )
 from squeeze_grasp_ros.scene.build import (
     build_mesh,
@@ -75,11 +78,11 @@ stop the computation."""
 
 def scene_limits(scene: Scene) -> Limits:
     """Strain limit (effect ``strain_limit``) and pickup weight (effect ``pickup``) of a scene."""
-    strain = scene.strain_limit if scene.has(Termination.STRAIN_LIMIT) else None
+    strain = scene.strain_limit if scene.has(Effect.STRAIN_LIMIT) else None
     return Limits(
         strain.epsilon if strain else None,
         strain.criterion if strain else StrainCriterion.PRINCIPAL,
-        scene.pickup.weight if scene.has("pickup") else None,
+        scene.pickup.weight if scene.has(Effect.PICKUP) else None,
     )
 
 
@@ -107,7 +110,7 @@ def check_event_squeeze(scene: Scene) -> Scene:
     SceneError
         Naming ``object.model`` or the finger's ``tip_radius``.
     """
-    if scene.object.model != "solid":
+    if scene.object.model != ObjectModel.SOLID:
         raise SceneError(
             f"object.model is {scene.object.model}: the event-driven squeeze needs "
             "a solid object (rings: `squeeze-grasp ring`)"
@@ -157,7 +160,7 @@ class GraspSetup:
         SceneError
             For a shape, mesh or placement the mechanics refuses (naming the key).
         """
-        if scene.object.model == "ring":
+        if scene.object.model == ObjectModel.RING:
             return cls(scene, build_ring(scene))
         mesh = build_mesh(scene, outline=outline)
         return cls(scene, ElasticObject(mesh, scene_material(scene), route))
@@ -180,19 +183,26 @@ class GraspSetup:
         SceneError
             For a placement off the boundary, or both fingers on one node.
         """
-        return finger_nodes(self.scene, self.body if self.model == "ring" else self.body.mesh)
+        return finger_nodes(self.scene, self.body if self.is_ring else self.body.mesh)
 
     # ----------------------------------------------------------------- the body
     @property
-    def model(self) -> str:
-        """Mechanical model of the object: "solid" or "ring"."""
+    def model(self) -> ObjectModel:
+        """Mechanical model of the object: solid or ring."""
         return self.scene.object.model
+
+    @property
+    def is_ring(self) -> bool:
+        """True for the curved-beam ring model (Sec. 7)."""
+        return self.model == ObjectModel.RING
 
     @property
     def solid(self) -> ElasticObject:
         """The meshed solid; SceneError for a ring."""
         if not isinstance(self.body, ElasticObject):
-            raise SceneError("object.model is ring: this needs a solid (object.model: solid)")
+            raise SceneError("object.model is ring: the curved-beam model of Sec. 7 has no "
+                             "solid mesh; this needs object.model: solid (rings: "
+                             "`squeeze-grasp ring` and `graspmap`)")
         return self.body
 
     @property
@@ -205,12 +215,12 @@ class GraspSetup:
     @property
     def num_nodes(self) -> int:
         """Mesh nodes (solid) or ring nodes."""
-        return int(self.body.n) if self.model == "ring" else int(self.body.mesh.n)
+        return int(self.body.n) if self.is_ring else int(self.body.mesh.n)
 
     @property
     def boundary(self) -> np.ndarray:
         """Nodes a finger can touch: the outer boundary loop (solid) or every ring node."""
-        return self.body.boundary if self.model == "ring" else self.body.mesh.boundary
+        return self.body.boundary if self.is_ring else self.body.mesh.boundary
 
     def precompute(self, progress: Progress | None = None) -> GraspSetup:
         """Factorise the solid and compute its boundary compliance (or the ring's compliance),
@@ -218,7 +228,7 @@ class GraspSetup:
         """
         report = progress or (lambda *args: None)
         n = self.num_nodes
-        if self.model == "ring":
+        if self.is_ring:
             report(RING_STAGES[1], 1, len(RING_STAGES), n)
             self.body.precompute()
             return self
@@ -237,12 +247,12 @@ class GraspSetup:
         return scene_limits(self.scene)
 
     @property
-    def tip_radii(self) -> dict[str, float]:
+    def tip_radii(self) -> dict[Finger, float]:
         """Finger (F1, F2) -> fingertip radius, m."""
         return {n: self.scene.fingers[n].tip_radius for n in SQUEEZING_FINGERS}
 
     @property
-    def given_directions(self) -> dict[str, tuple[float, float]] | None:
+    def given_directions(self) -> dict[Finger, tuple[float, float]] | None:
         """The scene's ``fingers.<F>.direction`` (both or none), else None."""
         if self.scene.fingers[Finger.F1].direction is None:
             return None
@@ -282,7 +292,7 @@ class GraspSetup:
         self,
         *,
         contacts: tuple[int, int] | None = None,
-        kind: str | None = None,
+        kind: SqueezeKind | None = None,
         depth: float | None = None,
         relative_depth: float | None = None,
         step: float | None = None,
@@ -361,7 +371,7 @@ class GraspSetup:
                 "the scene has no adversary section (declare effect 'adversary'); "
                 "see config/scenes/resist_fig9.yaml"
             )
-        node = placement_node(self.solid.mesh, adv.placement, "adversary")
+        node = placement_node(self.solid.mesh, adv.placement, str(Effect.ADVERSARY))
         return check_adversary_node(self.contacts, node)
 
     def adversary_tip(self) -> Fingertip:
@@ -369,13 +379,13 @@ class GraspSetup:
         return place_fingertip(self.solid.mesh, Finger.A, self.adversary_node,
                                self.scene.adversary.tip_radius)
 
-    def resistance_grasp(self, contacts: str, *, half_width: float | None = None,
+    def resistance_grasp(self, contacts: ContactKind, *, half_width: float | None = None,
                          nodes: Sequence[int] | None = None) -> ResistanceGrasp:
         """The fixed-contact resistance problem (Sec. 6.1-6.2) of F1, F2 and A.
 
         Parameters
         ----------
-        contacts : {"point", "segment"}
+        contacts : ContactKind
             Each finger on its node, or on the boundary nodes within ``half_width`` of it.
         half_width : float, optional
             Segment arc length on each side of a node, m (default: the node and its two
@@ -388,7 +398,7 @@ class GraspSetup:
         else:
             nodes = [int(n) for n in nodes]
             check_adversary_node(nodes[:2], nodes[2])
-        if contacts == "point":
+        if contacts == ContactKind.POINT:
             sets = [[n] for n in nodes]
         else:
             sets = contact_segments(self.solid.mesh, nodes, half_width)
@@ -398,7 +408,7 @@ class GraspSetup:
         self,
         squeeze: EventSqueeze,
         *,
-        mode: str | None = None,
+        mode: SqueezeKind | None = None,
         a: Sequence[float] | None = None,
         tip_radius: float | None = None,
         adversary_node: int | None = None,

@@ -11,11 +11,21 @@ and an explicit ``effects:`` list. Adding a section = adding a dataclass here an
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass
-from typing import Optional
+from typing import Any, Optional
 
 from squeeze_grasp_ros.mechanics.elastic.mesh import MAX_MESH_NODES
-from squeeze_grasp_ros.mechanics.vocabulary import MaterialModel
+from squeeze_grasp_ros.mechanics.vocabulary import (
+    ContactKind,
+    Effect,
+    Finger,
+    MaterialModel,
+    ObjectModel,
+    ShapeType,
+    SqueezeKind,
+    StrainCriterion,
+)
 from squeeze_grasp_ros.scene.schema import SchemaError, spec
 
 
@@ -23,16 +33,18 @@ class SceneError(SchemaError):
     """A scene entry is unknown, of the wrong type, out of range or contradictory."""
 
 
-EFFECTS: dict[str, str] = {
-    "friction": "Coulomb friction at the fingertips (needs friction.mu)",
-    "strain_limit": "stop at the proportional limit (needs strain_limit.epsilon)",
-    "pickup": "stop when friction can lift the object's weight (needs pickup.weight)",
-    "adversary": "a third finger pushes after the squeeze (needs adversary)",
-    "force_sensing": "fingertip wrench sensors",
-    "tactile_sensing": "fingertip tactile arrays",
-    "sensor_noise": "Gaussian noise on sensor readings (needs sensors.noise_std, sensors.seed)",
-    "actuator_lag": "first-order lag of the finger actuators (needs actuators.time_constant)",
-    "sensor_dropout": "sensor messages dropped at random (needs sensors.dropout)",
+EFFECTS: dict[Effect, str] = {
+    Effect.FRICTION: "Coulomb friction at the fingertips (needs friction.mu)",
+    Effect.STRAIN_LIMIT: "stop at the proportional limit (needs strain_limit.epsilon)",
+    Effect.PICKUP: "stop when friction can lift the object's weight (needs pickup.weight)",
+    Effect.ADVERSARY: "a third finger pushes after the squeeze (needs adversary)",
+    Effect.FORCE_SENSING: "fingertip wrench sensors",
+    Effect.TACTILE_SENSING: "fingertip tactile arrays",
+    Effect.SENSOR_NOISE: "Gaussian noise on sensor readings (needs sensors.noise_std, "
+                         "sensors.seed)",
+    Effect.ACTUATOR_LAG: "first-order lag of the finger actuators (needs "
+                         "actuators.time_constant)",
+    Effect.SENSOR_DROPOUT: "sensor messages dropped at random (needs sensors.dropout)",
 }
 """Every effect a scene may declare, with what it requires."""
 
@@ -45,21 +57,22 @@ DEVICES: dict[str, str] = {
 }
 """Devices a finger may be mapped to (``fingers.<F>.device``, ``adversary.device``)."""
 
-DEFAULT_DEVICES: dict[str, str] = {"F1": "barrett_f1", "F2": "barrett_f3", "A": "pusher"}
+DEFAULT_DEVICES: dict[Finger, str] = {Finger.F1: "barrett_f1", Finger.F2: "barrett_f3",
+                                      Finger.A: "pusher"}
 """Device of a finger whose scene entry leaves ``device`` empty (Sec. 5.5: both squeezing
 fingers on the Barrett hand; Sec. 6.4: the adversary on the pusher)."""
 
-SHAPES: dict[str, tuple[str, ...]] = {
-    "rectangle": ("width", "height"),
-    "square": ("side",),
-    "disk": ("radius",),
-    "ellipse": ("a", "b"),
-    "superellipse": ("a", "b", "exponent"),
-    "fourier_blob": ("radius", "cos", "sin"),
-    "polygon": ("points",),
-    "spline": ("points",),
-    "file": ("path",),
-    "annulus": ("outer_radius", "inner_radius"),
+SHAPES: dict[ShapeType, tuple[str, ...]] = {
+    ShapeType.RECTANGLE: ("width", "height"),
+    ShapeType.SQUARE: ("side",),
+    ShapeType.DISK: ("radius",),
+    ShapeType.ELLIPSE: ("a", "b"),
+    ShapeType.SUPERELLIPSE: ("a", "b", "exponent"),
+    ShapeType.FOURIER_BLOB: ("radius", "cos", "sin"),
+    ShapeType.POLYGON: ("points",),
+    ShapeType.SPLINE: ("points",),
+    ShapeType.FILE: ("path",),
+    ShapeType.ANNULUS: ("outer_radius", "inner_radius"),
 }
 """Shape types and their parameters (lengths in m; fourier coefficients relative)."""
 
@@ -86,9 +99,9 @@ class MaterialSpec:
     E: float = spec("Young's modulus", "Pa", lo=0.0, lo_open=True)
     nu: float = spec("Poisson's ratio", "", lo=-1.0, hi=0.5, lo_open=True)
     thickness: float = spec("out-of-plane thickness h (ring: width w)", "m", lo=0.0, lo_open=True)
-    model: str = spec("constitutive model of a solid (event-driven squeeze): linear (the "
-                      "paper's), corotational or neo_hookean (finite deformation)",
-                      choices=MaterialModel.values(), default=MaterialModel.LINEAR.value)
+    model: MaterialModel = spec("constitutive model of a solid (event-driven squeeze): linear "
+                                "(the paper's), corotational or neo_hookean (finite "
+                                "deformation)", default=MaterialModel.LINEAR)
 
 
 @dataclass(frozen=True)
@@ -103,9 +116,9 @@ class RingSpec:
 class ObjectSpec:
     """The grasped object."""
 
-    shape: dict = spec("outline: {type: <one of SHAPES>, <its parameters>}")
+    shape: Mapping[str, Any] = spec("outline: {type: <one of SHAPES>, <its parameters>}")
     material: MaterialSpec = spec("material")
-    model: str = spec("mechanical model", choices=("solid", "ring"), default="solid")
+    model: ObjectModel = spec("mechanical model", default=ObjectModel.SOLID)
     mesh: MeshSpec = spec("solid-model triangulation", default_factory=MeshSpec)
     ring: Optional[RingSpec] = spec("ring-model parameters (model: ring)", default=None)
 
@@ -146,7 +159,8 @@ class FingerSpec:
 class SqueezeSpec:
     """The squeeze to perform."""
 
-    type: str = spec("squeeze type", choices=("stable", "pure"), default="stable")
+    type: SqueezeKind = spec("squeeze type", choices=SqueezeKind.planned(),
+                             default=SqueezeKind.STABLE)
     depth: Optional[float] = spec("squeeze depth rho", "m", lo=0.0, default=None)
     relative_depth: Optional[float] = spec(
         "finger approach / initial contact distance", "", lo=0.0, hi=1.0, default=None
@@ -186,10 +200,9 @@ class StrainLimitSpec:
     """Proportional limit (eq. 45)."""
 
     epsilon: float = spec("strain limit epsilon*", "", lo=0.0, lo_open=True)
-    criterion: str = spec(
+    criterion: StrainCriterion = spec(
         "principal: max |eps_1|,|eps_2|; componentwise: |eps_x|,|eps_y| (literal eq. 45)",
-        choices=("principal", "componentwise"),
-        default="principal",
+        default=StrainCriterion.PRINCIPAL,
     )
 
 
@@ -207,10 +220,9 @@ class AdversarySpec:
     placement: PlacementSpec = spec("initial contact of A")
     a: tuple[float, float] = spec("translation of A", "m")
     tip_radius: float = spec("fingertip radius of A", "m", lo=0.0, default=0.0)
-    mode: str = spec("resistance type", choices=("stable", "pure"), default="stable")
-    contacts: str = spec(
-        "contact model", choices=("point", "segment", "friction"), default="point"
-    )
+    mode: SqueezeKind = spec("resistance type", choices=SqueezeKind.planned(),
+                             default=SqueezeKind.STABLE)
+    contacts: ContactKind = spec("contact model", default=ContactKind.POINT)
     device: str = spec(
         "device driving A (empty: DEFAULT_DEVICES)", choices=("",) + tuple(DEVICES), default=""
     )
@@ -296,7 +308,7 @@ class Scene:
     """A validated scene. Build it with :func:`load_scene` or :func:`parse_scene`."""
 
     object: ObjectSpec = spec("the object")
-    fingers: dict = spec("F1, F2: finger specs")
+    fingers: Mapping[Finger, FingerSpec] = spec("F1, F2: finger specs")
     name: str = spec("scene name", default="")
     description: str = spec("free text", default="")
     squeeze: SqueezeSpec = spec("the squeeze", default_factory=SqueezeSpec)
@@ -306,7 +318,7 @@ class Scene:
     )
     pickup: Optional[PickupSpec] = spec("pickup (effect: pickup)", default=None)
     adversary: Optional[AdversarySpec] = spec("adversary finger (effect: adversary)", default=None)
-    effects: tuple[str, ...] = spec("declared effects, see EFFECTS", default=())
+    effects: tuple[Effect, ...] = spec("declared effects, see EFFECTS", default=())
     sensors: Optional[SensorsSpec] = spec(
         "fingertip sensors (effects: sensor_noise, "
         "sensor_dropout;"
@@ -323,16 +335,18 @@ class Scene:
         """Friction coefficient (0 without the friction effect)."""
         return self.friction.mu if self.friction is not None else 0.0
 
-    def has(self, effect: str) -> bool:
-        """True if the scene declares ``effect``."""
+    def has(self, effect: Effect) -> bool:
+        """True if the scene declares ``effect`` (an :class:`Effect`: a termination or a plain
+        string is refused, not silently missed).
+        """
+        if not isinstance(effect, Effect):
+            raise TypeError(f"Scene.has takes an Effect, got {effect!r}")
         return effect in self.effects
 
 
-def finger_devices(scene: Scene) -> dict[str, str]:
-    """Finger name -> device name (``DEVICES``) of every finger of the scene, adversary
-    included.
-    """
-    given = {name: spec_.device for name, spec_ in scene.fingers.items()}
+def finger_devices(scene: Scene) -> dict[Finger, str]:
+    """Finger -> device name (``DEVICES``) of every finger of the scene, adversary included."""
+    given = {Finger(name): spec_.device for name, spec_ in scene.fingers.items()}
     if scene.adversary is not None:
-        given["A"] = scene.adversary.device
+        given[Finger.A] = scene.adversary.device
     return {name: device or DEFAULT_DEVICES[name] for name, device in sorted(given.items())}

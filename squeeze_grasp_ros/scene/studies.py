@@ -42,7 +42,13 @@ from squeeze_grasp_ros.mechanics.ring.squeeze import RingGrasp, ring_grasp
 from squeeze_grasp_ros.mechanics.squeeze.events import EventSqueeze
 from squeeze_grasp_ros.mechanics.squeeze.graspmap import GraspMap, grasp_map
 from squeeze_grasp_ros.mechanics.squeeze.stable_pure import Squeeze, force_closure, plan_squeeze
-from squeeze_grasp_ros.mechanics.vocabulary import MaterialModel, SqueezeKind, Termination
+from squeeze_grasp_ros.mechanics.vocabulary import (
+    ContactKind,
+    Effect,
+    MaterialModel,
+    ObjectModel,
+    SqueezeKind,
+)
 from squeeze_grasp_ros.scene.setup import GraspSetup
 from squeeze_grasp_ros.scene.specs import SceneError
 
@@ -103,15 +109,15 @@ class PointSqueezes:
         return {
             "contacts": [i, j],
             "contact_points": mesh.nodes[[i, j]].tolist(),
-            "stable": _unit_json(self.stable),
-            "pure": _unit_json(self.pure),
+            SqueezeKind.STABLE: _unit_json(self.stable),
+            SqueezeKind.PURE: _unit_json(self.pure),
             "rigid_rotation": self.stable.rigid_rotation,
             "squeeze_type": self.chosen.kind,
             "depth": rho,
             "relative_depth": self.chosen.relative_depth(rho),
             "rigid_rotation_at_depth": {
-                "stable": rho * self.stable.rigid_rotation,
-                "pure": rho * self.pure.rigid_rotation,
+                SqueezeKind.STABLE: rho * self.stable.rigid_rotation,
+                SqueezeKind.PURE: rho * self.pure.rigid_rotation,
             },
             "boundary_displacement": {k: v.tolist()
                                       for k, v in self.boundary_displacement.items()},
@@ -357,8 +363,8 @@ class ResistanceStudy:
 def resistance_study(
     setup: GraspSetup,
     *,
-    mode: str | None = None,
-    contacts: str | None = None,
+    mode: SqueezeKind | None = None,
+    contacts: ContactKind | None = None,
     directions: int | None = None,
     half_width: float | None = None,
     compare_direction: Sequence[float] | None = None,
@@ -371,10 +377,10 @@ def resistance_study(
     _ = setup.adversary_node  # the scene has an adversary, off F1's and F2's nodes
     mode = mode or adv.mode
     contacts = contacts or adv.contacts
-    if contacts != "friction" and directions is not None and directions < 1:
+    if contacts != ContactKind.FRICTION and directions is not None and directions < 1:
         raise InvalidInputError(f"directions must be >= 1, got {directions}")
     _, t_pre = _timed(setup.precompute)
-    if contacts == "friction":
+    if contacts == ContactKind.FRICTION:
         squeeze, t_squeeze = _timed(setup.event_squeeze)
         res, t_res = _timed(lambda: setup.frictional_resistance(squeeze, mode=mode))
         timing = {"precompute_s": t_pre, "squeeze_s": t_squeeze, "resistance_s": t_res}
@@ -400,7 +406,7 @@ def resistance_study(
 def _strain_limit(setup: GraspSetup) -> float | None:
     """epsilon* of the scene, None without the strain_limit effect."""
     scene = setup.scene
-    return scene.strain_limit.epsilon if scene.has(Termination.STRAIN_LIMIT) else None
+    return scene.strain_limit.epsilon if scene.has(Effect.STRAIN_LIMIT) else None
 
 
 @dataclass(frozen=True)
@@ -418,8 +424,8 @@ class RingPlacement:
     depth: float
 
     def to_json(self) -> dict:
-        """``{"model": "ring", ...}`` and :meth:`RingGrasp.to_json` at the requested depth."""
-        return {"model": "ring", **self.grasp.to_json(self.depth)}
+        """The ring model's name and :meth:`RingGrasp.to_json` at the requested depth."""
+        return {"model": ObjectModel.RING, **self.grasp.to_json(self.depth)}
 
 
 def ring_placement(setup: GraspSetup, *, depth: float | None = None,
@@ -459,10 +465,10 @@ class GraspMapStudy:
         (``pairs``) or without its full matrices.
         """
         if isinstance(self.map, RingGraspMap):
-            return {"model": "ring", **self.map.to_json(best=best)}
+            return {"model": ObjectModel.RING, **self.map.to_json(best=best)}
         return {
             **self.map.to_json(pairs=pairs),
-            "model": "solid",
+            "model": ObjectModel.SOLID,
             "note": "point-contact stiffness is mesh dependent: compare placements on one mesh",
         }
 
@@ -472,7 +478,7 @@ def grasp_map_study(setup: GraspSetup, *, relative_depth: float | None = None) -
     solid's at the scene's mu.
     """
     scene = setup.scene
-    if setup.model == "ring":
+    if setup.is_ring:
         requested = scene.squeeze.relative_depth if relative_depth is None else relative_depth
         return GraspMapStudy(setup, ring_grasp_map(
             setup.ring, scene.mu, epsilon=_strain_limit(setup), kind=scene.squeeze.type,

@@ -52,7 +52,7 @@ from squeeze_grasp_ros.sim.sensors import (
     render_tactile,
     tactile_layout,
 )
-from squeeze_grasp_ros.mechanics.vocabulary import Termination
+from squeeze_grasp_ros.mechanics.vocabulary import Effect, Finger, Termination
 
 TERMINATE_ON: tuple[str, ...] = (
     Termination.STRAIN_LIMIT,
@@ -157,10 +157,10 @@ class SimWorld:
         self.directions, self.relative_per_depth = motion.directions, motion.relative_per_depth
         self.state = initial_state(tips, self.relative_per_depth)
         self.adversary = None
-        if scene.has("adversary"):
+        if scene.has(Effect.ADVERSARY):
             self.adversary = setup.adversary_tip()
             tips.append(self.adversary)
-        lag = scene.actuators.time_constant if scene.has("actuator_lag") else 0.0
+        lag = scene.actuators.time_constant if scene.has(Effect.ACTUATOR_LAG) else 0.0
         devices = finger_devices(scene)
         self.fingers: tuple[str, ...] = tuple(t.name for t in tips)
         self.devices: dict[str, DeviceModel] = {
@@ -171,14 +171,14 @@ class SimWorld:
         self.offsets = {t.name: np.zeros(2) for t in tips}
         sensors = scene.sensors
         self.layouts: dict[str, TactileLayout] = {}
-        if scene.has("tactile_sensing"):
+        if scene.has(Effect.TACTILE_SENSING):
             layout = sensors if sensors is not None else SensorsSpec()
             taxels, span = layout.taxels, np.radians(layout.taxel_span_deg)
             self.layouts = {t.name: tactile_layout(t.theta, taxels, span) for t in tips}
         self.randomness = SensorRandomness(
             sensors.seed if sensors is not None and sensors.seed is not None else 0,
-            sensors.noise_std if scene.has("sensor_noise") else None,
-            sensors.dropout if scene.has("sensor_dropout") else None,
+            sensors.noise_std if scene.has(Effect.SENSOR_NOISE) else None,
+            sensors.dropout if scene.has(Effect.SENSOR_DROPOUT) else None,
             self._work,
         )
         self.dt = scene.sim.dt
@@ -225,7 +225,7 @@ class SimWorld:
             if name not in setpoints:
                 continue
             target = np.asarray(setpoints[name], float) + self.offsets[name]
-            waiting = name == "A" and not self._adversary_touching()
+            waiting = name == Finger.A and not self._adversary_touching()
             if waiting and np.any(target != self.positions[name]):
                 target = self._touch_adversary(target)
             device = self.devices[name]
@@ -258,7 +258,7 @@ class SimWorld:
         return self._output(events)
 
     def _adversary_touching(self) -> bool:
-        return any(f.name == "A" for f in self.state.fingers)
+        return any(f.name == Finger.A for f in self.state.fingers)
 
     def _touch_adversary(self, target: np.ndarray) -> np.ndarray:
         """Place A on the deformed boundary; return its setpoint shifted by the same offset."""
@@ -267,10 +267,10 @@ class SimWorld:
         self.state = add_adversary(
             self.state, self.model, field_, self.adversary.node, self.adversary.radius
         )
-        touched = np.asarray(self.state.finger("A").center, float)
-        offset = touched - self.positions["A"]
-        self.offsets["A"] = self.offsets["A"] + offset
-        self.positions["A"] = touched
+        touched = np.asarray(self.state.finger(Finger.A).center, float)
+        offset = touched - self.positions[Finger.A]
+        self.offsets[Finger.A] = self.offsets[Finger.A] + offset
+        self.positions[Finger.A] = touched
         return target + offset
 
     def _output(self, events: tuple[Event, ...]) -> TickOutput:
@@ -289,7 +289,7 @@ class SimWorld:
             "position": self.positions[name] - self.offsets[name],
         }
         rnd = self.randomness
-        if self.scene.has("force_sensing") and not rnd.dropped():
+        if self.scene.has(Effect.FORCE_SENSING) and not rnd.dropped():
             self._work["wrench_evaluations"] += 1
             force, torque = fingertip_wrench(contacts, self.radii[name])
             reading["force"] = rnd.perturb(force)

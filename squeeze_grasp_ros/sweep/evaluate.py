@@ -240,14 +240,13 @@ def evaluate(task: Task, group: Group, index: int, params, resist: dict) -> dict
         row["error"] = f"{type(exc).__name__}: {exc}"
         row["time_s"] = time.perf_counter() - start
         return row
-    counts = res.event_counts
     h = res.health
     row.update(
         {
             "termination": res.termination,
             "depth": res.depth,
             "relative_depth": res.relative_depth,
-            **{f"events_{k}": counts[k] for k in "ABCD"},
+            **{f"events_{k}": n for k, n in res.event_counts.items()},
             "chatter": len(res.chatter),
             "contacts_F1": len(res.segments[Finger.F1]),
             "contacts_F2": len(res.segments[Finger.F2]),

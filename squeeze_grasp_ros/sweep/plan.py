@@ -33,7 +33,7 @@ from typing import Optional
 import numpy as np
 
 from squeeze_grasp_ros.mechanics.elastic.shapes import Outline
-from squeeze_grasp_ros.mechanics.vocabulary import Finger
+from squeeze_grasp_ros.mechanics.vocabulary import Effect, Finger, ShapeType
 from squeeze_grasp_ros.scene import (
     FingerSpec,
     FrictionSpec,
@@ -157,14 +157,14 @@ def _family_shapes(entry: ObjectEntry, seed: int, name: str) -> list[tuple[str, 
     for k in range(fam.count):
         oid = f"{name}-{k:03d}"
         rng = rng_for(seed, "shape", oid)
-        if fam.type == "superellipse":
-            shape = {"type": "superellipse", "a": float(rng.uniform(*fam.a)),
+        if fam.type == ShapeType.SUPERELLIPSE:
+            shape = {"type": ShapeType.SUPERELLIPSE, "a": float(rng.uniform(*fam.a)),
                      "b": float(rng.uniform(*fam.b)),
                      "exponent": float(rng.uniform(*fam.exponent))}
         else:
             h = np.arange(1, fam.harmonics + 1)
             bound = fam.amplitude / h
-            shape = {"type": "fourier_blob", "radius": float(rng.uniform(*fam.radius)),
+            shape = {"type": ShapeType.FOURIER_BLOB, "radius": float(rng.uniform(*fam.radius)),
                      "cos": rng.uniform(-bound, bound).tolist(),
                      "sin": rng.uniform(-bound, bound).tolist()}
         out.append((oid, shape))
@@ -178,7 +178,7 @@ def objects(loaded: LoadedSpec) -> list[ObjectItem]:
         name = loaded.base.name or "base"
         shape = loaded.base.object.shape
         return [ObjectItem(f"00-{name}", shape, loaded.mesh,
-                           build_outline(shape) if shape["type"] == "file" else None)]
+                           build_outline(shape) if shape["type"] == ShapeType.FILE else None)]
     items = []
     for k, entry in enumerate(sw.objects):
         mesh = entry.mesh or loaded.mesh
@@ -189,13 +189,13 @@ def objects(loaded: LoadedSpec) -> list[ObjectItem]:
             mesh = entry.mesh or scene.object.mesh
         elif entry.outline is not None:
             pairs = [(entry.name or Path(entry.outline).stem,
-                      {"type": "file", "path": entry.outline})]
+                      {"type": ShapeType.FILE, "path": entry.outline})]
         elif entry.shape is not None:
             pairs = [(entry.name or entry.shape["type"], entry.shape)]
         else:
             pairs = _family_shapes(entry, sw.seed, entry.name or entry.family.type)
         items += [ObjectItem(f"{k:02d}-{oid}", shape, mesh,
-                             build_outline(shape) if shape["type"] == "file" else None)
+                             build_outline(shape) if shape["type"] == ShapeType.FILE else None)
                   for oid, shape in pairs]
     return items
 
@@ -219,10 +219,10 @@ def group_scene(loaded: LoadedSpec, item: ObjectItem, material: MaterialSpec) ->
     per evaluation.
     """
     base = loaded.base
-    strain = base.strain_limit if base.has("strain_limit") else None
+    strain = base.strain_limit if base.has(Effect.STRAIN_LIMIT) else None
     pickup = PickupSpec(loaded.weight) if loaded.weight is not None else None
-    effects = ("friction",) + (("strain_limit",) if strain else ()) + (
-        ("pickup",) if pickup else ())
+    effects = (Effect.FRICTION,) + ((Effect.STRAIN_LIMIT,) if strain else ()) + (
+        (Effect.PICKUP,) if pickup else ())
     scene = Scene(object=ObjectSpec(item.shape, material, mesh=item.mesh),
                   fingers=UNPLACED, name=item.id, squeeze=base.squeeze,
                   friction=FrictionSpec(min(loaded.friction)), strain_limit=strain,

@@ -30,7 +30,14 @@ from squeeze_grasp_ros.scene import (
 )
 from squeeze_grasp_ros.scene.checks import check_material, check_shape
 from squeeze_grasp_ros.scene.schema import key_reference, parse_section, spec
-from squeeze_grasp_ros.mechanics.vocabulary import Finger
+from squeeze_grasp_ros.mechanics.vocabulary import (
+    ContactKind,
+    Effect,
+    Finger,
+    ObjectModel,
+    ShapeType,
+    SqueezeKind,
+)
 
 
 class SweepError(SceneError):
@@ -39,9 +46,9 @@ class SweepError(SceneError):
     """
 
 
-FAMILIES: dict[str, tuple[str, ...]] = {
-    "superellipse": ("a", "b", "exponent"),
-    "fourier_blob": ("radius",),
+FAMILIES: dict[ShapeType, tuple[str, ...]] = {
+    ShapeType.SUPERELLIPSE: ("a", "b", "exponent"),
+    ShapeType.FOURIER_BLOB: ("radius",),
 }
 """Random shape families and their required parameter ranges."""
 
@@ -50,7 +57,7 @@ FAMILIES: dict[str, tuple[str, ...]] = {
 class FamilySpec:
     """Seeded random shapes: every parameter drawn uniformly from its [low, high] range."""
 
-    type: str = spec("shape family", choices=tuple(FAMILIES))
+    type: ShapeType = spec("shape family", choices=tuple(FAMILIES))
     count: int = spec("number of shapes drawn", lo=1)
     a: Optional[tuple[float, float]] = spec(
         "superellipse: half-width range [low, high]", "m", lo=0.0, lo_open=True, default=None
@@ -133,11 +140,12 @@ class SweepAdversarySpec:
         lo_open=True,
         default=0.5,
     )
-    mode: str = spec("resistance type", choices=("stable", "pure"), default="stable")
-    contacts: str = spec(
+    mode: SqueezeKind = spec("resistance type", choices=SqueezeKind.planned(),
+                             default=SqueezeKind.STABLE)
+    contacts: ContactKind = spec(
         "point: the three nodes; segment: each node and its two neighbours",
-        choices=("point", "segment"),
-        default="point",
+        choices=(ContactKind.POINT.value, ContactKind.SEGMENT.value),
+        default=ContactKind.POINT,
     )
     directions: int = spec(
         "push directions over which W*_F per unit push is minimised and maximised",
@@ -172,8 +180,8 @@ class SweepSpec:
     tip_radius: Optional[tuple[float, ...]] = spec(
         "fingertip radii (both fingers)", "m", lo=0.0, lo_open=True, default=None
     )
-    squeeze: Optional[tuple[str, ...]] = spec(
-        "squeeze types", choices=("stable", "pure"), default=None
+    squeeze: Optional[tuple[SqueezeKind, ...]] = spec(
+        "squeeze types", choices=SqueezeKind.planned(), default=None
     )
     depth: Optional[tuple[float, ...]] = spec(
         "squeeze depths rho", "m", lo=0.0, lo_open=True, default=None
@@ -317,7 +325,7 @@ def parse_sweep_spec(data: Any, base_dir: Path) -> LoadedSpec:
         base = load_scene(sw.base)
     except SceneError as exc:
         raise SweepError(f"base: {exc}") from None
-    if base.object.model != "solid":
+    if base.object.model != ObjectModel.SOLID:
         raise SweepError("base: the sweep needs a solid object (object.model: solid)")
     entries = []
     for k, entry in enumerate(sw.objects or ()):
@@ -336,9 +344,9 @@ def parse_sweep_spec(data: Any, base_dir: Path) -> LoadedSpec:
                 scene = load_scene(entry.scene)
             except SceneError as exc:
                 raise SweepError(f"{where}.scene: {exc}") from None
-            if scene.object.model != "solid":
+            if scene.object.model != ObjectModel.SOLID:
                 raise SweepError(f"{where}.scene: the sweep needs solid objects")
-        if entry.shape is not None and entry.shape.get("type") == "file":
+        if entry.shape is not None and entry.shape.get("type") == ShapeType.FILE:
             path = _absolute(entry.shape["path"], base_dir)
             entry = dataclasses.replace(entry, shape={**entry.shape, "path": path})
             files[f"{where}.shape.path"] = _file_digest(path, f"{where}.shape.path")
@@ -403,7 +411,7 @@ def parse_sweep_spec(data: Any, base_dir: Path) -> LoadedSpec:
     weight = (
         sw.weight
         if sw.weight is not None
-        else (base.pickup.weight if base.has("pickup") else None)
+        else (base.pickup.weight if base.has(Effect.PICKUP) else None)
     )
     ident = {"spec": data, "files": files}
     digest = hashlib.sha256(json.dumps(ident, sort_keys=True, default=str).encode()).hexdigest()

@@ -50,8 +50,8 @@ class RingGraspMap:
     ----------
     n : int
         Number of ring nodes.
-    kind : str
-        Squeeze type ("stable" or "pure").
+    kind : SqueezeKind
+        Squeeze type (stable or pure).
     mu : float
         Friction coefficient.
     epsilon : float or None
@@ -71,7 +71,7 @@ class RingGraspMap:
     """
 
     n: int
-    kind: str
+    kind: SqueezeKind
     mu: float
     epsilon: float | None
     pairs: np.ndarray
@@ -115,7 +115,7 @@ class RingGraspMap:
 
     def best(self, count: int = 5) -> list[dict]:
         """The ``count`` placements with the largest maximum relative depth."""
-        order = np.argsort(-self.max_relative_depth, kind="stable")[:count]
+        order = np.argsort(-self.max_relative_depth, kind="mergesort")[:count]
         return [self._entry(k) for k in order]
 
     def _entry(self, k: int) -> dict:

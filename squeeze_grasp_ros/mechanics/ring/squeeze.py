@@ -37,10 +37,10 @@ from squeeze_grasp_ros.mechanics.errors import InvalidInputError, require_finite
 from squeeze_grasp_ros.mechanics.elastic.reduced import reduce_blocks
 from squeeze_grasp_ros.mechanics.ring.model import RingModel
 from squeeze_grasp_ros.mechanics.squeeze.stable_pure import two_contact_direction
-from squeeze_grasp_ros.mechanics.vocabulary import SQUEEZING_FINGERS, SqueezeKind
+from squeeze_grasp_ros.mechanics.vocabulary import SQUEEZING_FINGERS, RingLimit, SqueezeKind
 
-LIMITS: tuple[str, ...] = ("friction_cone_F1", "friction_cone_F2", "strain", "none")
-"""Names of what bounds the squeeze depth, indexed by the integer limit codes."""
+LIMITS: tuple[RingLimit, ...] = tuple(RingLimit)
+"""What bounds the squeeze depth, indexed by the integer limit codes."""
 EDGE_TOL = 1e-9
 """A force within this relative margin (~rad) of a cone edge at rho = 0+ counts as on the edge."""
 ROOT_IMAG_TOL = 1e-7
@@ -220,7 +220,8 @@ class RingGrasp:
     ----------
     contacts : (2,) ndarray of int
         Initial contact nodes of F1 and F2.
-    kind : {"stable", "pure"}
+    kind : SqueezeKind
+        Stable or pure.
     mu : float
         Friction coefficient (cone half-angle atan(mu)).
     epsilon : float or None
@@ -249,14 +250,14 @@ class RingGrasp:
         Depth at relative depth 1, m (the fingers would meet).
     max_depth : float
         Largest feasible depth, m.
-    limit : str
-        What bounds it: one of :data:`LIMITS`.
+    limit : RingLimit
+        What bounds it.
     condition : float
         Condition number of the reduced compliance (Z^T A Z).
     """
 
     contacts: np.ndarray
-    kind: str
+    kind: SqueezeKind
     mu: float
     epsilon: float | None
     displacement: np.ndarray
@@ -270,7 +271,7 @@ class RingGrasp:
     strain_depth: float
     depth_cap: float
     max_depth: float
-    limit: str
+    limit: RingLimit
     condition: float
 
     @property
@@ -327,7 +328,7 @@ class RingGrasp:
         strain_ok = self.epsilon is None or self.max_strain_at(depth) <= self.epsilon
         return cones_ok and strain_ok
 
-    def limit_depths(self) -> dict[str, float | None]:
+    def limit_depths(self) -> dict[RingLimit, float | None]:
         """Candidate depths (m) by limit name; None where the limit is not reached before the
         smaller of the strain depth and ``depth_cap`` (cone roots are not sought beyond).
         """

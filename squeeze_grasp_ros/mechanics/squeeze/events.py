@@ -28,6 +28,7 @@ from squeeze_grasp_ros.mechanics.squeeze.contact_state import (
     ContactState,
     Event,
     Sample,
+    event_counts,
     initial_state,
 )
 from squeeze_grasp_ros.mechanics.errors import InvalidInputError, require_finite
@@ -38,10 +39,12 @@ from squeeze_grasp_ros.mechanics.squeeze.stepper import TERMINATION_ORDER, advan
 from squeeze_grasp_ros.mechanics.squeeze.nonlinear_model import (NonlinearContactModel,
                                                                   contact_model)
 from squeeze_grasp_ros.mechanics.vocabulary import (
-    MaterialModel,
-    EventType,
     SQUEEZING_FINGERS,
+    ContactMode,
+    Finger,
+    MaterialModel,
     SqueezeKind,
+    StrainCriterion,
     Termination,
 )
 
@@ -161,7 +164,7 @@ class SegmentNode:
     Attributes
     ----------
     node : int
-    mode : {"stick", "slip"}
+    mode : ContactMode
     slip : int
         Slip direction (see :class:`~.contact_state.ContactNode`).
     force : (2,) ndarray
@@ -175,7 +178,7 @@ class SegmentNode:
     """
 
     node: int
-    mode: str
+    mode: ContactMode
     slip: int
     force: np.ndarray
     normal_force: float
@@ -206,25 +209,25 @@ class GraspHealth:
     max_strain : float
         Largest element strain by ``criterion`` (principal: max |eps_1|, |eps_2|).
     max_strain_element : int
-    criterion : str
+    criterion : StrainCriterion
     max_von_mises : float
         Largest plane-stress von Mises stress, Pa.
     max_von_mises_element : int
     max_displacement : float
         Largest nodal displacement magnitude, m.
     max_displacement_node : int
-    slip_margin : dict
+    slip_margin : mapping
         Finger -> min over its contacts of mu f_n - |f_t|, N.
     """
 
     max_strain: float
     max_strain_element: int
-    criterion: str
+    criterion: StrainCriterion
     max_von_mises: float
     max_von_mises_element: int
     max_displacement: float
     max_displacement_node: int
-    slip_margin: dict
+    slip_margin: Mapping[Finger, float]
 
     def to_json(self) -> dict:
         """All fields as a JSON-able dict."""
@@ -246,34 +249,32 @@ class EventSqueeze:
 
     Attributes
     ----------
-    termination : str
-        "depth_reached", "finger_slip", "strain_limit", "picked_up", "contact_lost" or
-        "element_inverted".
+    termination : Termination
     depth, relative_depth : float
         Depth reached, m, and relative depth (fraction).
     target_depth : float
         Requested depth, m.
-    kind : str
-        "stable", "pure" or "custom" (user-given directions).
+    kind : SqueezeKind
+        Stable, pure or custom (user-given directions).
     contacts : tuple of int
         Initial contact nodes (F1, F2).
-    directions : dict
+    directions : mapping
         Finger -> unit translation per depth (m/m).
     mu : float
-    tip_radius : dict
+    tip_radius : mapping
         Finger -> tip radius, m.
     events : tuple of Event
-    segments : dict
+    segments : mapping
         Finger -> tuple of SegmentNode, ordered by polar angle.
     energy : float
         Strain energy 1/2 delta . F, J.
-    work : dict
+    work : mapping
         Finger -> work done on the object, J (sum = energy + frictional dissipation).
-    dissipation : dict
+    dissipation : mapping
         Finger -> energy dissipated by friction at its sliding contacts, J.
-    finger_force : dict
+    finger_force : mapping
         Finger -> (start, end) force along its motion direction, N.
-    trajectories : dict
+    trajectories : mapping
         Node -> ((relative depth, theta rad), ...) while in contact.
     health : GraspHealth
     chatter : tuple of Chatter
@@ -285,26 +286,27 @@ class EventSqueeze:
         Substep and event tolerance used, relative to the object size.
     reference : bool
         Computed by the paper's literal fixed-step route.
-    diagnostics : dict
-    force_curve : dict
+    diagnostics : mapping
+        Stepper and solver counts, residuals and conditions (docs/events.md).
+    force_curve : mapping
         Finger -> ((relative depth, force along its motion N), ...) at every accepted point.
     """
 
-    termination: str
+    termination: Termination
     depth: float
     relative_depth: float
     target_depth: float
-    kind: str
+    kind: SqueezeKind
     contacts: tuple[int, ...]
-    directions: dict
+    directions: Mapping[Finger, np.ndarray]
     mu: float
-    tip_radius: dict
+    tip_radius: Mapping[Finger, float]
     events: tuple[Event, ...]
-    segments: dict
+    segments: Mapping[Finger, tuple[SegmentNode, ...]]
     energy: float
-    work: dict
-    finger_force: dict
-    trajectories: dict
+    work: Mapping[Finger, float]
+    finger_force: Mapping[Finger, tuple[float, float]]
+    trajectories: Mapping[int, tuple[tuple[float, float], ...]]
     health: GraspHealth
     chatter: tuple[Chatter, ...]
     displacement: np.ndarray = field(repr=False)
@@ -312,14 +314,14 @@ class EventSqueeze:
     step: float = 1e-3
     event_tol: float = 1e-9
     reference: bool = False
-    diagnostics: dict = field(default_factory=dict)
-    force_curve: dict = field(default_factory=dict)
-    dissipation: dict = field(default_factory=dict)
+    diagnostics: Mapping[str, object] = field(default_factory=dict)
+    force_curve: Mapping[Finger, tuple[tuple[float, float], ...]] = field(default_factory=dict)
+    dissipation: Mapping[Finger, float] = field(default_factory=dict)
 
     @property
-    def event_counts(self) -> dict:
+    def event_counts(self) -> dict[str, int]:
         """{"A": n, "B": n, "C": n, "D": n}."""
-        return {t: sum(1 for e in self.events if e.type == t) for t in EventType.values()}
+        return event_counts(self.events)
 
     def to_json(self) -> dict:
         """JSON-able dict with the keys and names of docs/design.md §2 and docs/events.md."""

@@ -9,6 +9,7 @@ col(AC) are the pure contact displacements, Theorem 8). Depths follow docs/desig
 """
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass
 
 import numpy as np
@@ -29,7 +30,8 @@ class Squeeze:
 
     Attributes
     ----------
-    kind : {"stable", "pure"}
+    kind : SqueezeKind
+        Stable or pure.
     contacts : (m,) ndarray of int
         Initial contact node indices.
     displacement : (2m,) ndarray
@@ -50,7 +52,7 @@ class Squeeze:
         Largest distance between the contact nodes, m.
     """
 
-    kind: str
+    kind: SqueezeKind
     contacts: np.ndarray
     displacement: np.ndarray
     forces: np.ndarray
@@ -165,20 +167,20 @@ class FingerMotion:
 
     Attributes
     ----------
-    directions : dict
+    directions : mapping
         Finger (F1, F2) -> translation (2,) per unit depth, m/m; the stacked vector has norm 1,
         so the depth is rho.
     relative_per_depth : float
         Relative depth per unit depth, 1/m: the fingers' approach along the chord of the
         contacts over the contacts' distance, per metre of depth (may be <= 0 for given
         directions that do not close the fingers).
-    kind : {"stable", "pure", "custom"}
-        Planned squeeze, or "custom" for user-given directions.
+    kind : SqueezeKind
+        The planned squeeze (stable, pure), or custom for user-given directions.
     """
 
-    directions: dict
+    directions: Mapping[Finger, np.ndarray]
     relative_per_depth: float
-    kind: str
+    kind: SqueezeKind
 
 
 def finger_motion(obj: ElasticObject, contacts, *, kind: SqueezeKind = SqueezeKind.STABLE,
@@ -222,7 +224,7 @@ def finger_motion(obj: ElasticObject, contacts, *, kind: SqueezeKind = SqueezeKi
         raise InvalidInputError("squeeze directions must not all be zero")
     dirs = {n: stacked[k] / norm for k, n in enumerate(SQUEEZING_FINGERS)}
     approach = float((dirs[Finger.F1] - dirs[Finger.F2]) @ (p[1] - p[0]) / distance)
-    return FingerMotion(dirs, approach / distance, "custom")
+    return FingerMotion(dirs, approach / distance, SqueezeKind.CUSTOM)
 
 
 def force_closure(p_i, n_i, p_j, n_j, mu: float) -> bool:

@@ -108,7 +108,7 @@ from squeeze_grasp_ros.mechanics.squeeze.event_functions import (EventValues, ev
                                                                   locate_sign_change,
                                                                   mode_violations, pickup_margin)
 from squeeze_grasp_ros.mechanics.squeeze.fingertips import tip_gaps
-from squeeze_grasp_ros.mechanics.vocabulary import ContactMode, Termination
+from squeeze_grasp_ros.mechanics.vocabulary import ContactMode, EventType, Termination
 
 EVENT_ORDER = {"B": 0, "D": 1, "C+": 2, "C-": 2, "A": 3}
 """Processing order of simultaneous events (C+ and C- never coexist on one node)."""
@@ -213,7 +213,7 @@ class _Run:
 
     # ----------------------------------------------------------------- contact set and solve
     def _refresh_set(self) -> None:
-        order = np.argsort(self.nodes, kind="stable")
+        order = np.argsort(self.nodes, kind="mergesort")
         for name in ("nodes", "fidx", "stick", "slip", "theta"):
             setattr(self, name, getattr(self, name)[order])
         self.sd = self.model.set_data(tuple(self.nodes.tolist()))
@@ -603,7 +603,8 @@ class _Run:
         the point (C for stick -> slip, D for slip -> stick, D then C for a slip reversal).
         """
         self.decide(sorted(nodes))
-        kept = [e for e in self.events[first_event:] if not (e.node in nodes and e.type in "CD")]
+        kept = [e for e in self.events[first_event:]
+                if not (e.node in nodes and e.type in (EventType.C, EventType.D))]
         self.events[first_event:] = kept
         for node in sorted(nodes):
             k = int(np.searchsorted(self.nodes, node))
@@ -618,7 +619,7 @@ class _Run:
             if not new[0]:
                 self.log("C", k)
         for i, e in enumerate(self.events[first_event:], first_event):
-            if e.type == "A" and e.node in nodes:
+            if e.type == EventType.A and e.node in nodes:
                 k = int(np.searchsorted(self.nodes, e.node))
                 self.events[i] = Event(
                     "A",

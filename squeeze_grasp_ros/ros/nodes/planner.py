@@ -49,6 +49,7 @@ from squeeze_grasp_interfaces.srv import (EventSqueeze, GraspMap, LoadObject, Pl
                                           PlanSqueeze, RingGraspTest)
 
 from squeeze_grasp_ros import planning
+from squeeze_grasp_ros.mechanics.vocabulary import ObjectModel
 from squeeze_grasp_ros.ros import messages
 from squeeze_grasp_ros.planning import Cancelled, ErrorCode, Limits
 from squeeze_grasp_ros.resources import share_dir
@@ -228,7 +229,7 @@ class PlannerNode(Node):
             stages = 1
             if goal.scene_yaml or goal.scene_path:
                 source = planning.read_scene(goal.scene_yaml, goal.scene_path, self.roots)
-                stages += len(planning.RING_STAGES if source.scene.object.model == "ring"
+                stages += len(planning.RING_STAGES if source.scene.object.model == ObjectModel.RING
                               else planning.SOLID_STAGES)
                 loaded, _ = planning.load_cached(
                     self.cache, source, object_id, goal.solver_route, self.limits,

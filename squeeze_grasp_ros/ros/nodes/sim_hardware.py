@@ -34,6 +34,7 @@ from visualization_msgs.msg import MarkerArray
 
 from squeeze_grasp_interfaces.msg import ContactEventArray, SimState, TactileArray, Tick
 
+from squeeze_grasp_ros.mechanics.vocabulary import Effect
 from squeeze_grasp_ros.ros import messages
 from squeeze_grasp_ros.scene import GraspSetup, load_scene
 from squeeze_grasp_ros.sim.world import SimWorld, TickOutput
@@ -80,8 +81,9 @@ class SimHardwareNode(Node):
         self.clock_pub = pub(Clock, pipeline.CLOCK, loop)
         self.pose_pubs = {f: pub(PoseStamped, pipeline.device_topic(d, "pose"), sensors)
                           for f, d in self.devices.items()}
+        sensed = world.scene.has(Effect.FORCE_SENSING)
         self.wrench_pubs = {f: pub(WrenchStamped, pipeline.device_topic(d, "wrench"), sensors)
-                            for f, d in self.devices.items() if world.scene.has("force_sensing")}
+                            for f, d in self.devices.items() if sensed}
         self.tactile_pubs = {f: pub(TactileArray, pipeline.device_topic(d, "tactile"), sensors)
                              for f, d in self.devices.items() if f in world.layouts}
         self.msgs = {f: self._reading_messages(f) for f in self.devices}

@@ -15,6 +15,7 @@ from typing import Any
 
 import yaml
 
+from squeeze_grasp_ros.mechanics.vocabulary import Effect
 from squeeze_grasp_ros.resources import config_dir
 from squeeze_grasp_ros.scene import Scene, finger_devices
 
@@ -94,10 +95,10 @@ def node_parameters(
     mapping = [f"{f}:{d}" for f, d in devices.items()]
     streams = [
         s
-        for s, effect in (("wrench", "force_sensing"), ("tactile", "tactile_sensing"))
+        for s, effect in (("wrench", Effect.FORCE_SENSING), ("tactile", Effect.TACTILE_SENSING))
         if scene.has(effect)
     ]
-    noise = scene.sensors.noise_std if scene.has("sensor_noise") else 0.0
+    noise = scene.sensors.noise_std if scene.has(Effect.SENSOR_NOISE) else 0.0
     params["sim_hardware"].update(
         scene=str(Path(scene_path).resolve()),
         participants=["monitor", "executor"] + (["recorder"] if options.record else []),
@@ -107,7 +108,7 @@ def node_parameters(
         finger_devices=mapping,
         streams=streams or [""],
         mu=float(scene.mu),
-        weight=float(scene.pickup.weight) if scene.has("pickup") else 0.0,
+        weight=float(scene.pickup.weight) if scene.has(Effect.PICKUP) else 0.0,
         relative_per_depth=float(relative_per_depth),
         load_threshold=max(float(monitor.get("load_threshold", 0.005)), 6.0 * noise),
     )

@@ -69,10 +69,7 @@ from squeeze_grasp_ros.ros.run.options import (EXECUTORS, PLANNER_MODULE, RunErr
 from squeeze_grasp_ros.ros.run.summary import GRASP_HELD, Observed, Plan, run_summary
 from squeeze_grasp_ros.scene.goal import plan_scene, resistance_goal, resists
 from squeeze_grasp_ros.threads import single_thread_blas
-from squeeze_grasp_ros.mechanics.vocabulary import (
-    SQUEEZING_FINGERS,
-    SqueezeKind,
-)
+from squeeze_grasp_ros.mechanics.vocabulary import SQUEEZING_FINGERS, ShapeType, SqueezeKind
 
 EVENTS_PER_CHECK = 16
 """Queued events :meth:`PipelineRunner.spin_until` executes between two checks of its condition."""
@@ -383,7 +380,7 @@ class PipelineRunner:
         """
         folders = [Path(self.options.scene_path).resolve().parent, share_dir(), Path.cwd()]
         shape = self.scene.object.shape
-        if shape["type"] == "file":
+        if shape["type"] == ShapeType.FILE:
             folders.append(Path(shape["path"]).resolve().parent)
         return [str(f) for f in folders]
 

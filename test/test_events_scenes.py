@@ -14,7 +14,7 @@ import pytest
 import yaml
 
 from squeeze_grasp_ros import cli
-from squeeze_grasp_ros.mechanics.squeeze.contact_model import Limits
+from squeeze_grasp_ros.mechanics.squeeze.contact_model import TerminationLimits
 from squeeze_grasp_ros.mechanics.elastic.fem import element_strains, principal_strains
 from squeeze_grasp_ros.mechanics.squeeze.events import event_squeeze
 from squeeze_grasp_ros.scene import SceneError, parse_scene
@@ -77,7 +77,7 @@ def test_componentwise_strain_criterion_allows_at_least_as_deep_a_squeeze():
     loaded, res = scene_run("foam_square_strain_limit")
     eps_star = loaded.scene.strain_limit.epsilon
     literal = event_squeeze(loaded.solid, loaded.contacts, 0.02, 0.4, relative_depth=0.12,
-                            limits=Limits(eps_star, "componentwise"))
+                            limits=TerminationLimits(eps_star, "componentwise"))
     assert literal.depth >= res.depth
     eps = element_strains(loaded.solid.mesh, literal.displacement)
     if literal.termination == "strain_limit":

@@ -32,6 +32,14 @@ SCENES = Path(__file__).resolve().parents[1] / "config" / "scenes"
 FIG10 = SCENES / "resist_fig10.yaml"
 
 
+LIMITS = planning.PlannerLimits()
+
+
+def load(source: planning.SceneSource) -> planning.LoadedObject:
+    """The planner's object of ``source`` (no ROS: the request layer)."""
+    return planning.load_object(source, planning.object_key(source, "", "", LIMITS), LIMITS)
+
+
 def raw(name: str) -> dict:
     return yaml.safe_load((SCENES / f"{name}.yaml").read_text())
 
@@ -84,13 +92,12 @@ def test_front_ends_share_the_setup():
     scene = load_scene(FIG10)
     world = SimWorld(GraspSetup.build(scene))
     source = planning.read_scene("", str(FIG10))
-    loaded = planning.load_object(source, planning.object_key(source, "", "", planning.Limits()),
-                                  planning.Limits())
+    loaded = load(source)
     assert world.contacts == loaded.finger_nodes == GraspSetup.build(scene).contacts
     assert world.relative_per_depth == loaded.setup.motion.relative_per_depth
     for f in ("F1", "F2"):
         assert np.array_equal(world.directions[f], loaded.setup.motion.directions[f])
-    planned = planning.event_squeeze_run(loaded, [], "", 0.0, 0.0, 0.0, 0.0, planning.Limits())
+    planned = planning.event_squeeze_run(loaded, [], "", 0.0, 0.0, 0.0, 0.0, LIMITS)
     out = json.loads(json.dumps(loaded.setup.event_squeeze().to_json()))
     assert json.loads(json.dumps(planned.to_json())) == out
 
@@ -102,12 +109,11 @@ def test_algorithm_2_is_one_computation_for_every_front_end():
     setup = GraspSetup.build(load_scene(FIG10))
     study = resistance_study(setup)
     source = planning.read_scene("", str(FIG10))
-    loaded = planning.load_object(source, planning.object_key(source, "", "", planning.Limits()),
-                                  planning.Limits())
+    loaded = load(source)
     adv = setup.scene.adversary
     planned = planning.friction_resistance(loaded, np.array([*setup.contacts,
                                                              setup.adversary_node]),
-                                           adv.a, adv.mode, 0.0, planning.Limits())
+                                           adv.a, adv.mode, 0.0, LIMITS)
     assert planned.work == study.resistance.work and planned.reason == study.resistance.reason
     goal = resistance_goal(setup, study.squeeze)
     travel = [s.end for s in study.resistance.stages]
@@ -142,14 +148,13 @@ def test_every_route_refuses_an_adversary_on_a_squeezing_finger(tmp_path, capsys
         with pytest.raises(SceneError, match=message):
             route()
     source = planning.read_scene("", str(path))
-    loaded = planning.load_object(source, planning.object_key(source, "", "", planning.Limits()),
-                                  planning.Limits())
+    loaded = load(source)
     i, j = loaded.finger_nodes
     with pytest.raises(InvalidInputError, match="same boundary node as F1 or F2"):
         loaded.setup.resistance_grasp("point", nodes=(i, j, j))
     with pytest.raises(planning.PlannerError, match="distinct"):
         planning.resistance_plan(loaded, [i, j, i], (0.001, 0.0, 0.0), "stable", "point", 0.0,
-                                 0, 0.0, planning.Limits())
+                                 0, 0.0, LIMITS)
 
 
 def test_a_setup_moves_to_another_scene_of_the_same_object_only():

@@ -232,7 +232,7 @@ def test_failing_evaluation_is_a_row_not_a_crash(tmp_path):
 
 def test_rows_match_the_event_squeeze_and_grasp_map(tmp_path):
     """A row is the event engine's own result for that placement (cross-check in one process)."""
-    from squeeze_grasp_ros.mechanics.squeeze.contact_model import Limits
+    from squeeze_grasp_ros.mechanics.squeeze.contact_model import TerminationLimits
     from squeeze_grasp_ros.mechanics.squeeze.events import event_squeeze
     from squeeze_grasp_ros.sweep.evaluate import prepare
 
@@ -246,7 +246,7 @@ def test_rows_match_the_event_squeeze_and_grasp_map(tmp_path):
         0.01,
         row["mu"],
         relative_depth=0.04,
-        limits=Limits(weight=0.3),
+        limits=TerminationLimits(weight=0.3),
     )
     assert row["termination"] == res.termination and row["depth"] == res.depth
     assert row["energy"] == res.energy and row["work_F1"] == res.work["F1"]

@@ -24,7 +24,7 @@ from squeeze_grasp_ros.planning.errors import (
     ERROR_CODES,
 )
 from squeeze_grasp_ros.planning.objects import (
-    Limits,
+    PlannerLimits,
     LoadedObject,
     SceneSource,
     read_scene,
@@ -69,7 +69,7 @@ __all__ = [
     "Cancelled",
     "ERROR_CODES",
     "ErrorCode",
-    "Limits",
+    "PlannerLimits",
     "LoadedObject",
     "MAX_BEST_COUNT",
     "MAX_DIRECTIONS",

@@ -1,6 +1,8 @@
 # Copyright 2026 squeeze_grasp_ros developers
 # SPDX-License-Identifier: Apache-2.0
-"""Limits of the planner, scene sources and the object cache (a bounded LRU of loaded objects)."""
+"""Limits of the planner (PlannerLimits), scene sources and the object cache (a bounded LRU of
+loaded objects).
+"""
 
 from __future__ import annotations
 
@@ -40,7 +42,7 @@ computation."""
 
 
 @dataclass(frozen=True)
-class Limits:
+class PlannerLimits:
     """What the node accepts (its parameters).
 
     Attributes
@@ -204,7 +206,7 @@ def check_size(count: int | None, limit: int, what: str) -> None:
         )
 
 
-def solver_route(route: str, limits: Limits) -> str:
+def solver_route(route: str, limits: PlannerLimits) -> str:
     """The request's solver route, or the node's default when empty."""
     route = route or limits.default_route
     if route not in ROUTES:
@@ -235,7 +237,8 @@ class ObjectKey:
     digest: str
 
 
-def object_key(source: SceneSource, object_id: str, route: str, limits: Limits) -> ObjectKey:
+def object_key(source: SceneSource, object_id: str, route: str,
+               limits: PlannerLimits) -> ObjectKey:
     """The :class:`ObjectKey` of a load request."""
     route = solver_route(route, limits)
     digest = hashlib.sha256(f"{route}\0{source.text}".encode()).hexdigest()
@@ -243,7 +246,7 @@ def object_key(source: SceneSource, object_id: str, route: str, limits: Limits) 
 
 
 def load_object(
-    source: SceneSource, key: ObjectKey, limits: Limits, progress: Progress = no_progress
+    source: SceneSource, key: ObjectKey, limits: PlannerLimits, progress: Progress = no_progress
 ) -> LoadedObject:
     """Build and precompute the object of a scene, stage by stage.
 
@@ -253,7 +256,7 @@ def load_object(
         The scene (see :func:`read_scene`).
     key : ObjectKey
         Id, solver route (rings ignore it) and digest (see :func:`object_key`).
-    limits : Limits
+    limits : PlannerLimits
     progress : Progress
         Called with :data:`SOLID_STAGES` or :data:`RING_STAGES` as they start.
 
@@ -408,7 +411,7 @@ def load_cached(
     source: SceneSource,
     object_id: str,
     route: str,
-    limits: Limits,
+    limits: PlannerLimits,
     progress: Progress = no_progress,
 ) -> tuple[LoadedObject, bool]:
     """The cached object of the same id, scene and route, or a freshly loaded and cached one.

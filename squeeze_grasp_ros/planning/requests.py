@@ -24,7 +24,12 @@ from squeeze_grasp_ros.mechanics.squeeze.stable_pure import Squeeze, force_closu
 from squeeze_grasp_ros.mechanics.squeeze.events import EventSqueeze
 from squeeze_grasp_ros.mechanics.vocabulary import ContactKind, SqueezeKind
 from squeeze_grasp_ros.planning.errors import invalid
-from squeeze_grasp_ros.planning.objects import CONTACT_MODELS, Limits, LoadedObject, MAX_DIRECTIONS
+from squeeze_grasp_ros.planning.objects import (
+    CONTACT_MODELS,
+    MAX_DIRECTIONS,
+    LoadedObject,
+    PlannerLimits,
+)
 from squeeze_grasp_ros.planning.checks import check_number, check_step, choice, contact_nodes
 
 
@@ -122,7 +127,7 @@ def resistance_plan(
     half_width: float,
     directions: int,
     tip_radius: float,
-    limits: Limits,
+    limits: PlannerLimits,
 ) -> ResistancePlan:
     """Optimal resistance to the adversary translation ``a`` (Sec. 6).
 
@@ -142,7 +147,7 @@ def resistance_plan(
         Push directions to sweep (0 = none; fixed contacts only).
     tip_radius : float
         Friction: A's fingertip radius, m (0 = the scene's adversary tip radius).
-    limits : Limits
+    limits : PlannerLimits
         Friction: the scene's squeeze step must be >= ``limits.min_step``.
     """
     loaded.solid()  # INVALID_ARGUMENT for a ring
@@ -171,7 +176,7 @@ def friction_resistance(
     a: tuple[float, float],
     mode: str,
     tip_radius: float,
-    limits: Limits,
+    limits: PlannerLimits,
 ) -> FrictionalResistance:
     """Algorithm 2 after the scene's event-driven squeeze at F1, F2 (Sec. 6.3)."""
     scene = loaded.scene
@@ -264,7 +269,7 @@ def event_squeeze_run(
     relative_depth: float,
     step: float,
     event_tol: float,
-    limits: Limits,
+    limits: PlannerLimits,
     progress: Callable[[float], None] | None = None,
 ) -> EventSqueeze:
     """The scene's event-driven squeeze (Algorithm 1) with the request's overrides.
@@ -281,7 +286,7 @@ def event_squeeze_run(
         At most one > 0 (rho in m, or the fraction); both 0 = the scene's depth.
     step, event_tol : float
         Relative to the object size; 0 = the scene's. ``step`` must be >= ``limits.min_step``.
-    limits : Limits
+    limits : PlannerLimits
     progress : callable, optional
         Called with the completed fraction; may raise :class:`Cancelled`.
     """

@@ -39,7 +39,7 @@ from squeeze_grasp_ros.mechanics.resistance.optimal import (
     resistance_grasp,
 )
 from squeeze_grasp_ros.mechanics.ring.model import RingModel
-from squeeze_grasp_ros.mechanics.squeeze.contact_model import ContactModel, Limits
+from squeeze_grasp_ros.mechanics.squeeze.contact_model import ContactModel, TerminationLimits
 from squeeze_grasp_ros.mechanics.squeeze.events import EventSqueeze, event_squeeze
 from squeeze_grasp_ros.mechanics.squeeze.fingertips import Fingertip, place_fingertip
 from squeeze_grasp_ros.mechanics.squeeze.nonlinear_model import contact_model
@@ -76,10 +76,10 @@ Progress = Callable[[str, int, int, int], None]
 stop the computation."""
 
 
-def scene_limits(scene: Scene) -> Limits:
+def scene_limits(scene: Scene) -> TerminationLimits:
     """Strain limit (effect ``strain_limit``) and pickup weight (effect ``pickup``) of a scene."""
     strain = scene.strain_limit if scene.has(Effect.STRAIN_LIMIT) else None
-    return Limits(
+    return TerminationLimits(
         strain.epsilon if strain else None,
         strain.criterion if strain else StrainCriterion.PRINCIPAL,
         scene.pickup.weight if scene.has(Effect.PICKUP) else None,
@@ -242,7 +242,7 @@ class GraspSetup:
 
     # ----------------------------------------------------------------- the squeeze
     @property
-    def limits(self) -> Limits:
+    def limits(self) -> TerminationLimits:
         """The termination limits the scene declares (:func:`scene_limits`)."""
         return scene_limits(self.scene)
 
@@ -284,7 +284,7 @@ class GraspSetup:
             Default the scene's ``object.material.model``.
         """
         material = self.scene.object.material.model if material_model is None else material_model
-        limits = self.limits if terminations else Limits()
+        limits = self.limits if terminations else TerminationLimits()
         return contact_model(material, self.solid, self.scene.mu, limits,
                              max_events_per_depth=self.scene.squeeze.max_events_per_depth)
 

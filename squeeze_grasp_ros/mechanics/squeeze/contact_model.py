@@ -65,7 +65,7 @@ largest angle update (rad) falls below it."""
 
 
 @dataclass(frozen=True)
-class Limits:
+class TerminationLimits:
     """Termination criteria a scene declares (paper Sec. 5.1).
 
     Attributes
@@ -391,7 +391,7 @@ class ContactModel:
         The meshed object (its cached boundary compliance is used unless ``reference``).
     mu : float
         Coulomb friction coefficient (>= 0; 0 = frictionless, every contact slides).
-    limits : Limits
+    limits : TerminationLimits
         Strain and pickup criteria (only what the scene declares is computed).
     reference : bool
         The paper's literal route: no cached compliance, a full solve per evaluation.
@@ -402,7 +402,7 @@ class ContactModel:
 
     obj: ElasticObject
     mu: float
-    limits: Limits = field(default_factory=Limits)
+    limits: TerminationLimits = field(default_factory=TerminationLimits)
     reference: bool = False
     max_events_per_depth: int = 4
     _cache: dict = field(default_factory=dict, repr=False, compare=False)

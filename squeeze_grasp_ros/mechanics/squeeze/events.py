@@ -20,7 +20,7 @@ import numpy as np
 from squeeze_grasp_ros.mechanics.elastic.compliance import ElasticObject
 from squeeze_grasp_ros.mechanics.squeeze.contact_model import (
     ContactModel,
-    Limits,
+    TerminationLimits,
 )
 from squeeze_grasp_ros.mechanics.squeeze.contact_state import (
     Chatter,
@@ -418,7 +418,7 @@ def event_squeeze(
     *, kind: str = SqueezeKind.STABLE,
     depth: float | None = None,
     relative_depth: float | None = None,
-    limits: Limits | None = None,
+    limits: TerminationLimits | None = None,
     step: float = 1e-3,
     event_tol: float = 1e-9,
     reference: bool = False,
@@ -443,7 +443,7 @@ def event_squeeze(
     depth, relative_depth : float
         Exactly one: squeeze depth rho, m, or the finger approach over the initial contact
         distance (docs/design.md §2).
-    limits : Limits, optional
+    limits : TerminationLimits, optional
         Strain limit and pickup weight.
     step, event_tol : float
         Substep and event tolerance relative to the object size.
@@ -490,7 +490,7 @@ def event_squeeze(
             "fingers would meet)"
         )
     tips = [place_fingertip(obj.mesh, n, int(c), radii[n]) for n, c in zip(names, contacts)]
-    model = contact_model(material_model, obj, mu, limits or Limits(), reference,
+    model = contact_model(material_model, obj, mu, limits or TerminationLimits(), reference,
                           max_events_per_depth)
     run = squeeze_to_depth(
         model, initial_state(tips, relative_per_depth), dirs, depth, step, event_tol, progress

@@ -51,7 +51,7 @@ from squeeze_grasp_interfaces.srv import (EventSqueeze, GraspMap, LoadObject, Pl
 from squeeze_grasp_ros import planning
 from squeeze_grasp_ros.mechanics.vocabulary import ObjectModel
 from squeeze_grasp_ros.ros import messages
-from squeeze_grasp_ros.planning import Cancelled, ErrorCode, Limits
+from squeeze_grasp_ros.planning import Cancelled, ErrorCode, PlannerLimits
 from squeeze_grasp_ros.resources import share_dir
 from squeeze_grasp_ros.ros.nodes import run_node
 
@@ -100,11 +100,11 @@ class PlannerNode(Node):
             self.declare_parameter(name, default, ParameterDescriptor(
                 description=description, dynamic_typing=isinstance(default, float)))
         value = self._parameter
-        self.limits = Limits(max_nodes=value("max_nodes"),
+        self.limits = PlannerLimits(max_nodes=value("max_nodes"),
                              max_spectral_nodes=value("max_spectral_nodes"),
                              max_ring_elements=value("max_ring_elements"),
                              default_route=planning.solver_route(value("default_solver_route"),
-                                                                 Limits()),
+                                                                 PlannerLimits()),
                              best_count=value("best_count"), min_step=float(value("min_step")))
         roots = [Path(r) for r in value("allowed_roots") if r] or [share_dir(), Path.cwd()]
         self.roots = list(dict.fromkeys(r.resolve() for r in roots))

@@ -170,7 +170,7 @@ def initial_state(tips: list[Fingertip], relative_per_depth: float = 0.0) -> Con
             key=lambda c: c.node,
         )
     )
-    fresh = tuple((kind, t.node) for t in tips for kind in ("B", "C+", "C-"))
+    fresh = tuple((kind, t.node) for t in tips for kind in (EventType.B.value, "C+", "C-"))
     return ContactState(
         fingers, contacts, 0.0, relative_per_depth, tuple(sorted(t.node for t in tips)), fresh
     )

@@ -200,10 +200,10 @@ class TrackerOutput:
 
     stamp_ns: int
     fingers: tuple[str, ...]
-    positions: dict
-    forces: dict
-    normals: dict
-    ages: dict
+    positions: Mapping[str, np.ndarray]
+    forces: Mapping[str, np.ndarray]
+    normals: Mapping[str, np.ndarray]
+    ages: Mapping[str, float]
     patches: tuple[Patch, ...]
     events: tuple[TrackedEvent, ...]
     alarms: tuple[TrackedAlarm, ...]
@@ -297,7 +297,7 @@ class _FingerTrack:
     force: np.ndarray = field(default_factory=lambda: np.zeros(2))
     normal: np.ndarray = field(default_factory=lambda: np.zeros(2))
     had_contact: bool = False
-    stamps: dict = field(default_factory=dict)
+    stamps: dict[str, int] = field(default_factory=dict)
     trig_key: bytes = b""
     trig: tuple = ()
 

@@ -19,7 +19,8 @@ Timings (``timing`` in the JSON, seconds) are wall-clock times of the phases.
 from __future__ import annotations
 
 import time
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
+from typing import Any
 from dataclasses import dataclass
 
 import numpy as np
@@ -93,7 +94,7 @@ class PointSqueezes:
     stable: Squeeze
     pure: Squeeze
     depth: float
-    boundary_displacement: dict
+    boundary_displacement: Mapping[SqueezeKind, np.ndarray]
     reduced_condition: float
 
     @property
@@ -202,7 +203,7 @@ class SqueezeRun:
 
     setup: GraspSetup
     result: EventSqueeze
-    timing: dict
+    timing: Mapping[str, float]
 
     def to_json(self) -> dict:
         """The ``squeeze`` JSON: the scene's name, the result (docs/events.md), the contact
@@ -241,8 +242,8 @@ class ModelComparison:
     """
 
     setup: GraspSetup
-    results: dict
-    seconds: dict
+    results: Mapping[MaterialModel, EventSqueeze]
+    seconds: Mapping[MaterialModel, float]
 
     def rows(self) -> dict:
         """Material model -> forces, energy, contact half-widths, strain, events, time."""
@@ -334,9 +335,9 @@ class ResistanceStudy:
 
     setup: GraspSetup
     resistance: Resistance | FrictionalResistance
-    timing: dict
+    timing: Mapping[str, float]
     grasp: ResistanceGrasp | None = None
-    comparison: dict | None = None
+    comparison: Mapping[str, Any] | None = None
     sweep: ResistanceSweep | None = None
     squeeze: EventSqueeze | None = None
 

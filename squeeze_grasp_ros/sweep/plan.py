@@ -28,7 +28,8 @@ import hashlib
 import itertools
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Optional
+from collections.abc import Mapping
+from typing import Any, Optional
 
 import numpy as np
 
@@ -80,7 +81,7 @@ class ObjectItem:
     """
 
     id: str
-    shape: dict
+    shape: Mapping[str, Any]
     mesh: MeshSpec
     outline: Optional[Outline] = None
 

@@ -17,6 +17,7 @@ import hashlib
 import json
 from dataclasses import dataclass
 from pathlib import Path
+from collections.abc import Mapping
 from typing import Any, Optional
 
 from squeeze_grasp_ros.scene import (
@@ -92,7 +93,8 @@ class ObjectEntry:
     outline: Optional[str] = spec(
         "outline file: CSV 'x,y' per line or JSON {outline: [...]}", "m", default=None
     )
-    shape: Optional[dict] = spec("shape mapping as in scenes (object.shape)", default=None)
+    shape: Optional[Mapping[str, Any]] = spec("shape mapping as in scenes (object.shape)",
+                                              default=None)
     family: Optional[FamilySpec] = spec("seeded random shapes", default=None)
     mesh: Optional[MeshSpec] = spec(
         "mesh settings of this entry (default: the sweep's mesh)", default=None
@@ -170,7 +172,7 @@ class SweepSpec:
     objects: Optional[tuple[ObjectEntry, ...]] = spec(
         "objects (default: the base scene's)", default=None
     )
-    materials: Optional[dict] = spec(
+    materials: Optional[Mapping[str, Any]] = spec(
         "name -> {E, nu, thickness} (default: the base scene's, named 'base')", default=None
     )
     mesh: Optional[MeshSpec] = spec("mesh settings (default: the base scene's)", default=None)
@@ -240,7 +242,7 @@ class LoadedSpec:
 
     spec: SweepSpec
     base: Scene
-    materials: dict
+    materials: Mapping[str, MaterialSpec]
     mesh: MeshSpec
     friction: tuple[float, ...]
     tip_radius: tuple[float, ...]
@@ -248,7 +250,7 @@ class LoadedSpec:
     depths: tuple[tuple[Optional[float], Optional[float]], ...]
     weight: Optional[float]
     hash: str
-    raw: dict
+    raw: Mapping[str, Any]
 
 
 def _absolute(path: Optional[str], base_dir: Path) -> Optional[str]:

@@ -73,8 +73,8 @@ class SqueezeRun:
     events: tuple[Event, ...]
     samples: tuple[Sample, ...]
     chatter: tuple[Chatter, ...]
-    termination: str
-    diagnostics: dict
+    termination: Termination
+    diagnostics: Mapping[str, float]
 
 
 def _merge(total: dict, new: dict) -> None:

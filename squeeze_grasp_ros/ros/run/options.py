@@ -11,6 +11,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 from pathlib import Path
+from collections.abc import Mapping
 from typing import Any
 
 import yaml
@@ -81,7 +82,7 @@ class RunOptions:
     on_slip_alarm: str = "hold"
     resist: bool = True
     planner: bool = True
-    overrides: dict = field(default_factory=dict)
+    overrides: Mapping[str, Mapping[str, Any]] = field(default_factory=dict)
     timeout: float = 300.0
     discovery_wait: float = 1.0
 

@@ -20,6 +20,14 @@ A F2 0.0113
 >>> print(result.termination, f"{result.relative_depth:.2f}")
 depth_reached 0.12
 
+Every front end makes a scene mechanics in one place, a :class:`GraspSetup`: the object, the
+fingers' initial contact nodes and finger motion, the contact model, the squeeze and Algorithm 2:
+
+>>> setup = GraspSetup.build(load_scene(scene_file("resist_fig10")))
+>>> squeeze = setup.event_squeeze()
+>>> print(setup.motion.kind, squeeze.termination, setup.frictional_resistance(squeeze).reason)
+custom depth_reached F2 slips
+
 The same from its parts: the mesh, the fingers' initial contact nodes, the squeeze:
 
 >>> mesh = build_mesh(scene)

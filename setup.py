@@ -60,6 +60,8 @@ setup(
         "ros": ROS_WHEELS + ["mcap>=1.1"],
         # squeeze-grasp sweep: Dask distributed runs the tasks, pyarrow writes the Parquet dataset
         "sweep": ["dask[distributed]>=2024.1", "pyarrow>=14"],
+        # squeeze-grasp outline: sub-pixel contours (marching squares) of masks and depth images
+        "perception": ["scikit-image>=0.22"],
         "test": [
             "pytest>=7",
             "hypothesis>=6",

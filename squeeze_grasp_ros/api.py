@@ -4,7 +4,8 @@
 
 Scenes and shipped files, meshes and elastic objects, stable and pure squeezes, the
 event-driven squeeze with rounded fingertips (Algorithm 1), grasp maps, resistance, rings,
-calibration, the domain vocabulary and the error kinds. SI units throughout; lengths in m,
+calibration, objects seen by a camera (outline extraction needs the ``perception`` extra), the
+domain vocabulary and the error kinds. SI units throughout; lengths in m,
 forces in N, the object frame x right, y up. Everything else in the package is internal and
 may move.
 
@@ -19,6 +20,14 @@ A F1 0.0110
 A F2 0.0113
 >>> print(result.termination, f"{result.relative_depth:.2f}")
 depth_reached 0.12
+
+Every strain and stress names its measure (the model's own; the peak in every measure too):
+
+>>> h = result.health
+>>> print(f"{h.max_strain:.4f}", h.strain_measure, f"{h.max_von_mises:.0f} Pa", h.stress_measure)
+0.2644 small 12923 Pa small_strain
+>>> print({str(m): round(v, 4) for m, v in h.max_principal_strain.items()})
+{'small': 0.2644, 'biot': 0.2615, 'log': 0.3031, 'green_lagrange': 0.2273}
 
 Every front end makes a scene mechanics in one place, a :class:`GraspSetup`: the object, the
 fingers' initial contact nodes and finger motion, the contact model, the squeeze and Algorithm 2:
@@ -62,8 +71,15 @@ from squeeze_grasp_ros.mechanics.squeeze.events import EventSqueeze, event_squee
 from squeeze_grasp_ros.mechanics.squeeze.graspmap import GraspMap, grasp_map
 from squeeze_grasp_ros.mechanics.squeeze.stable_pure import Squeeze, plan_squeeze
 from squeeze_grasp_ros.mechanics.vocabulary import (ContactMode, EventType, Finger,
-                                                    MaterialModel, SqueezeKind,
-                                                    StrainCriterion, Termination)
+                                                    ImageEncoding, MaterialModel, ShapeFit,
+                                                    SqueezeKind, StrainCriterion, StrainMeasure,
+                                                    StressMeasure, Termination)
+from squeeze_grasp_ros.perception.camera import CameraModel, CameraPose
+from squeeze_grasp_ros.perception.camera_info import camera_from_info
+from squeeze_grasp_ros.perception.extract import ObjectOutline, extract_outline
+from squeeze_grasp_ros.perception.render import CameraViews, render_views
+from squeeze_grasp_ros.perception.shape_match import (ShapeMatch, deformed_outline,
+                                                      shape_residual)
 from squeeze_grasp_ros.resources import scene_file
 from squeeze_grasp_ros.scene import (GraspSetup, Scene, build_mesh, event_squeeze_scene,
                                      finger_nodes, load_scene, scene_solid)
@@ -82,9 +98,12 @@ __all__ = [
     "resistance_grasp", "optimal_resistance", "FrictionalResistance", "frictional_resistance",
     "RingModel", "ring_grasp", "ring_grasp_map", "Cuboid", "calibrate_elasticity",
     "match_similarity", "CompressionCurve", "fit_compression",
+    # objects seen by a camera
+    "CameraModel", "CameraPose", "camera_from_info", "CameraViews", "render_views",
+    "ObjectOutline", "extract_outline", "ShapeMatch", "deformed_outline", "shape_residual",
     # vocabulary
     "Finger", "EventType", "ContactMode", "Termination", "SqueezeKind", "StrainCriterion",
-    "MaterialModel",
+    "MaterialModel", "StrainMeasure", "StressMeasure", "ImageEncoding", "ShapeFit",
     # errors
     "SqueezeGraspError", "InvalidInputError", "InfeasibleError", "NumericalError",
     "InternalError",

@@ -2,9 +2,10 @@
 # SPDX-License-Identifier: Apache-2.0
 """Optional parts of the package and how to install them.
 
-``pip install .`` gives the mechanics; ROS 2 (nodes, ``run``, ``replay``, recordings) and the
-Dask sweeps come with extras. Code that needs an extra asks here, so that a missing one ends
-in a sentence saying what to install, never a traceback.
+``pip install .`` gives the mechanics; ROS 2 (nodes, ``run``, ``replay``, recordings), the
+Dask sweeps and outline extraction from images (scikit-image) come with extras. Code that needs
+an extra asks here, so that a missing one ends in a sentence saying what to install, never a
+traceback.
 
 >>> install_hint("rclpy").startswith("pip install '.[ros]'")
 True
@@ -24,6 +25,7 @@ EXTRAS: dict[str, tuple[tuple[str, ...], str]] = {
             "pip install '.[ros]' && squeeze-grasp ros-setup (or source a ROS 2 Jazzy "
             "workspace with squeeze_grasp_interfaces built)"),
     "sweep": (("dask", "distributed", "pyarrow"), "pip install '.[sweep]'"),
+    "perception": (("skimage",), "pip install '.[perception]'"),
 }
 """Extra -> (top-level modules it provides, how to install it)."""
 

@@ -24,7 +24,7 @@ from typing import Any
 import yaml
 
 __all__ = ["InputError", "MAX_FILE_BYTES", "MAX_TEXT_BYTES", "confine", "load_yaml",
-           "read_text"]
+           "read_bytes", "read_text"]
 
 MAX_FILE_BYTES = 8 * 1024 * 1024
 """Bytes read at most from a scene, spec or outline file (8 MiB)."""
@@ -77,6 +77,21 @@ def read_text(path: str | Path, *, what: str, max_bytes: int = MAX_FILE_BYTES) -
     InputError
         Missing, not a regular file, unreadable, too large or not UTF-8 text.
     """
+    data = read_bytes(path, what=what, max_bytes=max_bytes)
+    try:
+        return data.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        raise InputError(f"{what} file is not UTF-8 text (byte {exc.start}): {path}") from None
+
+
+def read_bytes(path: str | Path, *, what: str, max_bytes: int = MAX_FILE_BYTES) -> bytes:
+    """The bytes of a regular file, read up to ``max_bytes``.
+
+    Raises
+    ------
+    InputError
+        Missing, not a regular file, unreadable or too large.
+    """
     path = Path(path)
     if not path.exists():
         raise InputError(f"{what} file not found: {path}")
@@ -89,10 +104,7 @@ def read_text(path: str | Path, *, what: str, max_bytes: int = MAX_FILE_BYTES) -
         raise InputError(f"{what} file cannot be read: {path} ({exc.strerror})") from None
     if len(data) > max_bytes:
         raise InputError(f"{what} file is larger than the {max_bytes}-byte limit: {path}")
-    try:
-        return data.decode("utf-8")
-    except UnicodeDecodeError as exc:
-        raise InputError(f"{what} file is not UTF-8 text (byte {exc.start}): {path}") from None
+    return data
 
 
 def confine(path: str | Path, roots: Iterable[str | Path], *, what: str) -> Path:

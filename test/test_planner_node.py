@@ -32,6 +32,7 @@ from planner_support import (
 )
 from squeeze_grasp_interfaces.action import EventSqueeze as EventSqueezeAction
 from squeeze_grasp_interfaces.action import GraspMap as GraspMapAction
+from squeeze_grasp_interfaces.msg import EventSqueezeData
 from squeeze_grasp_interfaces.srv import (
     EventSqueeze,
     GraspMap,
@@ -56,6 +57,7 @@ from squeeze_grasp_ros.ros.nodes.planner import PARAMETERS
 from squeeze_grasp_ros.planning import ErrorCode
 from squeeze_grasp_ros.scene import build_ring, finger_nodes, placement_node
 from squeeze_grasp_ros.scene import event_squeeze_scene
+from squeeze_grasp_ros.mechanics.vocabulary import MaterialModel
 
 REPO = Path(__file__).resolve().parents[1]
 RESIST_FIG10 = (REPO / "config" / "scenes" / "resist_fig10.yaml").read_text()
@@ -314,7 +316,7 @@ def test_ring_grasp_test_equals_the_mechanics(planner: Harness, kind: str) -> No
     assert (response.max_depth, response.max_relative_depth, response.limit) == (
         grasp.max_depth,
         grasp.max_relative_depth,
-        grasp.limit,
+        grasp.limit.value,
     )
     assert (response.depth, response.feasible) == (depth, grasp.feasible_at(depth))
     assert np.array_equal(flat(response.forces), grasp.forces_at(depth).reshape(-1))
@@ -355,7 +357,32 @@ def test_event_squeeze_service_and_action_equal_the_mechanics(planner: Harness) 
         ) == [(c.node, c.finger, c.theta, *c.force) for c in expected.state.contacts]
         assert (data.work_f1, data.work_f2) == (expected.work["F1"], expected.work["F2"])
         assert data.max_strain == expected.health.max_strain
+        assert (data.material_model, data.strain_measure, data.stress_measure) == (
+            "linear", EventSqueezeData.STRAIN_SMALL, EventSqueezeData.STRESS_SMALL_STRAIN)
     assert fractions and fractions == sorted(fractions) and fractions[-1] == pytest.approx(1.0)
+
+
+def test_event_squeeze_of_a_neo_hookean_object_names_its_measures(planner: Harness) -> None:
+    """A neo-Hookean object's squeeze reports its log strain and Cauchy stress, and says so."""
+    text = BLOB.replace("thickness: 0.0254}", "thickness: 0.0254, model: neo_hookean}")
+    fingers = tuple(planner.load(text, object_id="blob_nh").finger_nodes)
+    expected = event_squeeze_scene(scene_of(text), solid_of(text), fingers)
+    response = planner.call(EventSqueeze, "event_squeeze",
+                            EventSqueeze.Request(object_id="blob_nh"))
+    assert response.success, response.message
+    data = response.squeeze
+    assert (data.material_model, data.strain_measure, data.stress_measure) == (
+        "neo_hookean", EventSqueezeData.STRAIN_LOG, EventSqueezeData.STRESS_CAUCHY)
+    assert (data.max_strain, data.max_von_mises) == (expected.health.max_strain,
+                                                     expected.health.max_von_mises)
+
+
+def test_the_message_constants_are_the_vocabulary() -> None:
+    """EventSqueezeData's STRAIN_*/STRESS_* constants are the measures the models report."""
+    assert {EventSqueezeData.STRAIN_SMALL, EventSqueezeData.STRAIN_BIOT,
+            EventSqueezeData.STRAIN_LOG} == {str(m.strain_measure) for m in MaterialModel}
+    assert {EventSqueezeData.STRESS_SMALL_STRAIN, EventSqueezeData.STRESS_CAUCHY} == {
+        str(m.stress_measure) for m in MaterialModel}
 
 
 def test_grasp_map_action_loads_with_stages_and_equals_the_service(planner: Harness) -> None:

@@ -259,6 +259,39 @@ def test_rows_match_the_event_squeeze_and_grasp_map(tmp_path):
     assert row["resist_min"] <= row["resist_max"]
 
 
+def test_a_sweep_over_material_models_runs_each_and_names_its_measures(tmp_path):
+    """A neo-Hookean material of a sweep is squeezed neo-Hookean (not linear): its row is the
+    event engine's neo-Hookean result, with its log strain and Cauchy stress named, and the
+    report keeps the strains of different measures apart.
+    """
+    from squeeze_grasp_ros.mechanics.squeeze.events import event_squeeze
+    from squeeze_grasp_ros.sweep.evaluate import prepare
+    from squeeze_grasp_ros.sweep.report import summarise
+
+    foam = {"E": 5e4, "nu": 0.3, "thickness": 0.0254}
+    spec = {**SMALL, "objects": SMALL["objects"][:1], "friction": [0.8], "weight": None,
+            "adversary": None, "placements": {"mode": "graspmap", "count": 2},
+            "materials": {"lin": foam, "nh": {**foam, "model": "neo_hookean"}}}
+    spec = {k: v for k, v in spec.items() if v is not None}
+    rows = bare_rows(parse_sweep_spec(spec, tmp_path))
+    measures = {(r["material_id"], r["material_model"], r["strain_measure"],
+                 r["stress_measure"]) for r in rows}
+    assert measures == {("lin", "linear", "small", "small_strain"),
+                        ("nh", "neo_hookean", "log", "cauchy")}
+    task = next(t for t in plan_tasks(parse_sweep_spec(spec, tmp_path)) if "~nh~" in t.id)
+    row = next(r for r in rows if r["task_id"] == task.id)
+    res = event_squeeze(prepare(task).setup.solid, (row["node_F1"], row["node_F2"]), 0.01, 0.8,
+                        relative_depth=0.04, material_model="neo_hookean")
+    h = res.health
+    assert (row["max_strain"], row["max_von_mises"], row["energy"]) == (
+        h.max_strain, h.max_von_mises, res.energy)
+    assert row["max_strain_biot"] == h.max_principal_strain["biot"]
+    dist = summarise(rows)["distributions"]
+    assert {"max_strain [small]", "max_strain [log]", "max_von_mises [small_strain]",
+            "max_von_mises [cauchy]", "max_strain_biot"} <= set(dist)
+    assert "max_strain" not in dist and dist["max_strain [log]"]["count"] == len(rows) // 2
+
+
 # ----------------------------------------------------------------- real Dask
 
 

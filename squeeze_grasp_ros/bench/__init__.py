@@ -19,6 +19,7 @@ SECTIONS: tuple[str, ...] = (
     "ring",
     "events",
     "material_models",
+    "perception",
     "ros_services",
     "pipeline",
     "pareto",
@@ -30,6 +31,7 @@ REQUIREMENTS: dict[str, tuple[tuple[str, ...], str]] = {
     "ros_services": (("rclpy", "squeeze_grasp_interfaces"), EXTRAS["ros"][1]),
     "pipeline": (("rclpy", "squeeze_grasp_interfaces", "mcap"), EXTRAS["ros"][1]),
     "sweep": EXTRAS["sweep"],
+    "perception": EXTRAS["perception"],
 }
 """Section -> (modules it imports beyond the mechanics, how to install them)."""
 

@@ -16,6 +16,8 @@ VERBS: tuple[str, ...] = (
     "graspmap",
     "resist",
     "ring",
+    "render",
+    "outline",
     "run",
     "replay",
     "bench",

@@ -19,7 +19,7 @@ from squeeze_grasp_ros.mechanics.calibration.hyperelastic_fit import (Compressio
                                                                    fit_compression,
                                                                    linear_validity)
 from squeeze_grasp_ros.mechanics.errors import InvalidInputError
-from squeeze_grasp_ros.mechanics.vocabulary import MaterialModel
+from squeeze_grasp_ros.mechanics.vocabulary import MaterialModel, StrainMeasure
 from squeeze_grasp_ros.commands.csv_io import read_columns
 
 HELP = (
@@ -72,6 +72,7 @@ def _compression(args: argparse.Namespace) -> dict:
     linear = fit_compression(curve, model=MaterialModel.LINEAR, nu=args.nu)
     neo = fit_compression(curve, model=MaterialModel.NEO_HOOKEAN, nu=args.nu)
     return {"points": len(force), "max_strain": float(curve.strain.max()),
+            "strain_measure": str(StrainMeasure.BIOT),
             MaterialModel.LINEAR: linear.to_json(), MaterialModel.NEO_HOOKEAN: neo.to_json(),
             "linear_within_5_percent_up_to_strain": linear_validity(neo)}
 
@@ -121,9 +122,10 @@ def summary(result: dict) -> str:
                          f"{'' if fit['nu_fitted'] else ' (given)'}, relative rms residual "
                          f"{fit['residual']:.3g} over {cp['points']} points up to strain "
                          f"{cp['max_strain']:.3g}")
+        measure = StrainMeasure(cp["strain_measure"]).label
         lines.append("linear elasticity (same E, nu) stays within 5 % of the neo-Hookean fit up "
                      f"to {100 * cp['linear_within_5_percent_up_to_strain']:.1f} % compressive "
-                     "strain: beyond that, use material.model: neo_hookean")
+                     f"{measure} strain (-dl / l): beyond that, use material.model: neo_hookean")
     fr = result.get("friction")
     if fr:
         lo, hi = fr["bracket_deg"]

@@ -21,7 +21,12 @@ from squeeze_grasp_ros.commands.ring_map import closed, map_summary, plot_map
 from squeeze_grasp_ros.mechanics.ring.grasp_map import bench_ring
 from squeeze_grasp_ros.mechanics.ring.model import RingModel
 from squeeze_grasp_ros.mechanics.ring.squeeze import RingGrasp
-from squeeze_grasp_ros.mechanics.vocabulary import SQUEEZING_FINGERS, Finger, ObjectModel
+from squeeze_grasp_ros.mechanics.vocabulary import (
+    SQUEEZING_FINGERS,
+    Finger,
+    ObjectModel,
+    StrainMeasure,
+)
 from squeeze_grasp_ros.scene import GraspSetup, SceneError, load_scene
 from squeeze_grasp_ros.scene.studies import grasp_map_study, ring_placement
 
@@ -197,7 +202,8 @@ def summary(result: dict) -> str:
             f"requested depth {result['depth']:.4g} m (relative {result['relative_depth']:.4g}): "
             f"{verdict}",
             f"forces F1 {np.round(result['forces'][Finger.F1], 4).tolist()} N, "
-            f"F2 {np.round(result['forces'][Finger.F2], 4).tolist()} N; max strain "
-            f"{result['max_strain']:.4g}",
+            f"F2 {np.round(result['forces'][Finger.F2], 4).tolist()} N; max fibre strain "
+            f"{result['max_strain']:.4g} ({StrainMeasure(result['strain_measure']).label} "
+            "strain)",
         ]
     )

@@ -12,6 +12,7 @@ from squeeze_grasp_ros import plots
 from squeeze_grasp_ros.mechanics.ring.grasp_map import RingGraspMap
 from squeeze_grasp_ros.mechanics.ring.model import RingModel
 from squeeze_grasp_ros.mechanics.ring.squeeze import LIMITS
+from squeeze_grasp_ros.mechanics.vocabulary import StrainMeasure
 
 
 def closed(points: np.ndarray) -> np.ndarray:
@@ -24,7 +25,7 @@ def outcome_matrix(gmap: RingGraspMap) -> tuple[np.ndarray, list[str]]:
     "succeeds" (at the requested relative depth) and "outside a cone at start"; -1 on the
     diagonal.
     """
-    names = [*LIMITS, "succeeds", "outside a cone at start"]
+    names = [*(limit.value for limit in LIMITS), "succeeds", "outside a cone at start"]
     code = gmap.limit_code.copy()
     if gmap.requested_relative_depth is not None:
         code[gmap.succeeds(gmap.requested_relative_depth)] = len(LIMITS)
@@ -85,7 +86,8 @@ def map_summary(result: dict) -> str:
     """Counts, outcomes and the deepest placements of a ring map's JSON."""
     lines = [
         f"{result['pairs']} placements on {result['elements']} nodes, mu={result['mu']}, "
-        f"epsilon={result['epsilon']}; limits: {result['limits']}"
+        f"epsilon={result['epsilon']} (largest fibre strain, "
+        f"{StrainMeasure(result['strain_measure']).label} strain); limits: {result['limits']}"
     ]
     if "feasible_pairs" in result:
         lines.append(

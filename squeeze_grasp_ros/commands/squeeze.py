@@ -23,7 +23,14 @@ from squeeze_grasp_ros.commands.common import (
 from squeeze_grasp_ros.commands.csv_io import write_points
 from squeeze_grasp_ros.mechanics.squeeze.events import EventSqueeze
 from squeeze_grasp_ros.mechanics.squeeze.fingertips import unit
-from squeeze_grasp_ros.mechanics.vocabulary import ContactMode, EventType, Finger, MaterialModel
+from squeeze_grasp_ros.mechanics.vocabulary import (
+    ContactMode,
+    EventType,
+    Finger,
+    MaterialModel,
+    StrainMeasure,
+    StressMeasure,
+)
 from squeeze_grasp_ros.scene.studies import compare_models, squeeze_run
 
 HELP = "event-driven squeeze with rounded fingertips under Coulomb friction (Sec. 5, Algorithm 1)"
@@ -81,8 +88,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "--compare-models",
         action="store_true",
         help="run the scene under every model and print forces, energy, contact widths, max "
-        "strain, events and termination side by side with the differences from linear; with "
-        "--plot, overlay the deformed outlines and the force-depth curves",
+        "strain (each model's own measure and the common Biot strain), max von Mises stress, "
+        "events and termination side by side with the differences from linear (strains like "
+        "for like, in every measure); with --plot, overlay the deformed outlines and the "
+        "force-depth curves",
     )
     add_solver_argument(parser)
     add_plot_argument(parser)
@@ -223,23 +232,36 @@ def plot_models(obj, results: dict, path: str) -> str:
 def compare_summary(result: dict) -> str:
     """The model comparison as a table."""
     rows, diff = result["models"], result["relative_difference"]
+    common = StrainMeasure(result["common_strain_measure"])
     lines = [f"{result['scene']}: the same squeeze under every material model "
              "(differences relative to linear)",
              f"{'model':<14}{'termination':<15}{'rel. depth':>11}{'F1 force N':>12}"
-             f"{'energy J':>12}{'F1 half-width m':>17}{'max strain':>12}  events  time s"]
+             f"{'energy J':>12}{'F1 half-width m':>17}{'max strain':>12} {'measure':<8}"
+             f"{common.label + ' strain':>12}{'von Mises Pa':>14} {'stress':<13}events  time s"]
     for model, r in rows.items():
         counts = " ".join(f"{k}{v}" for k, v in r["event_counts"].items())
         lines.append(f"{model:<14}{r['termination']:<15}{100 * r['relative_depth']:>10.3f}%"
                      f"{r['force'][Finger.F1]:>12.5g}{r['energy']:>12.5g}"
-                     f"{r['contact_half_width'][Finger.F1]:>17.4g}{r['max_strain']:>12.4g}"
-                     f"  {counts}  {r['seconds']:.2f}")
+                     f"{r['contact_half_width'][Finger.F1]:>17.4g}{r['max_strain']:>12.4g} "
+                     f"{StrainMeasure(r['strain_measure']).label:<8}"
+                     f"{r['max_principal_strain'][common]:>12.4g}{r['max_von_mises']:>14.4g} "
+                     f"{StressMeasure(r['stress_measure']).label:<13}{counts}  "
+                     f"{r['seconds']:.2f}")
     for model, d in diff.items():
         lines.append(f"{model} vs linear: force {100 * d['force'][Finger.F1]:+.2f} %, energy "
-                     f"{100 * d['energy']:+.2f} %, max strain {100 * d['max_strain']:+.2f} %, "
-                     f"F1 half-width {100 * d['contact_half_width'][Finger.F1]:+.2f} %, time "
+                     f"{100 * d['energy']:+.2f} %, max {common.label} strain "
+                     f"{100 * d['max_principal_strain'][common]:+.2f} %, F1 half-width "
+                     f"{100 * d['contact_half_width'][Finger.F1]:+.2f} %, time "
                      f"x{d['seconds_ratio']:.0f}")
-    lines.append("strain measures: " + "; ".join(f"{m}: {r['strain_measure']}"
-                                                 for m, r in rows.items()))
+    lines.append("max principal strain vs linear, like for like (the same measure of both "
+                 "fields):")
+    for model, d in diff.items():
+        lines.append(f"  {model}: " + ", ".join(
+            f"{StrainMeasure(k).label} {100 * v:+.2f} %"
+            for k, v in d["max_principal_strain"].items()))
+    lines.append(f"max strain: in the model's own measure, which its strain limit uses; "
+                 f"{common.label} strain: U - I of every field; von Mises of the model's stress "
+                 "(small-strain: C : eps; Cauchy: true stress)")
     if "plot" in result:
         lines.append(f"plot: {result['plot']}")
     return "\n".join(lines)
@@ -250,11 +272,16 @@ def summary(result: dict) -> str:
     if result.get("compare_models"):
         return compare_summary(result)
     c = result["event_counts"]
+    limit = result["strain_limit"]
     lines = [
-        f"{result['scene']}: {result['squeeze']} squeeze, mu = {result['mu']:g}, "
-        f"tip radius {result['tip_radius']:g} m, initial contacts {result['contacts']}",
+        f"{result['scene']}: {result['squeeze']} squeeze of a {result['material_model']} "
+        f"object, mu = {result['mu']:g}, tip radius {result['tip_radius']:g} m, initial "
+        f"contacts {result['contacts']}",
         f"termination: {result['termination']} at depth {result['depth']:.6g} m "
-        f"(relative {100 * result['relative_depth']:.3f} %)",
+        f"(relative {100 * result['relative_depth']:.3f} %)"
+        + (f"; strain limit {limit['epsilon']:g} on the "
+           f"{StrainMeasure(limit['measure']).label} strain ({limit['criterion']})"
+           if limit else ""),
         "events: " + ", ".join(f"{k} {n}" for k, n in c.items()),
     ]
     for name, seg in result["segments"].items():
@@ -268,11 +295,13 @@ def summary(result: dict) -> str:
             + (f" ({friction:.3g} J dissipated by friction)" if friction > 0 else "")
         )
     h = result["health"]
+    strain = StrainMeasure(h["strain_measure"]).label
     lines.append(
         f"energy {result['energy']:.5g} J; max strain {h['max_strain']:.4g} "
-        f"({h['criterion']}, element {h['max_strain_element']}); max von Mises "
-        f"{h['max_von_mises']:.4g} Pa; max displacement {h['max_displacement']:.4g} m; "
-        "slip margin " + ", ".join(f"{k} {v:.4g} N" for k, v in h["slip_margin"].items())
+        f"({strain} strain, {h['criterion']}, element {h['max_strain_element']}); max von "
+        f"Mises {h['max_von_mises']:.4g} Pa ({StressMeasure(h['stress_measure']).label} "
+        f"stress); max displacement {h['max_displacement']:.4g} m; slip margin "
+        + ", ".join(f"{k} {v:.4g} N" for k, v in h["slip_margin"].items())
     )
     if result["chatter"]:
         lines.append(f"chattering bound froze {len(result['chatter'])} node mode(s)")

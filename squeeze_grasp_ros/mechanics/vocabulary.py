@@ -7,10 +7,11 @@ strings they always had, and ``str(member)`` and f-strings give the bare value. 
 also compare equal to their plain string (``Finger.F1 == "F1"``, same hash), so code that
 receives a string from a file or a message works unchanged.
 
-Two vocabularies share strings with others: the event letters (``EventType.A`` and the
-adversary ``Finger.A``) and the effects (``Effect.STRAIN_LIMIT`` and the termination
-``Termination.STRAIN_LIMIT``, ``Effect.FRICTION`` and the contact kind ``ContactKind.FRICTION``).
-Their members are *codes*, not strings: equal only to themselves, with a hash of their own, so
+Three vocabularies share strings with others: the event letters (``EventType.A`` and the
+adversary ``Finger.A``), the effects (``Effect.STRAIN_LIMIT`` and the termination
+``Termination.STRAIN_LIMIT``, ``Effect.FRICTION`` and the contact kind ``ContactKind.FRICTION``)
+and the ring limits (``RingLimit.NONE`` and ``ShapeFit.NONE``). Their members are *codes*, not
+strings: equal only to themselves, with a hash of their own, so
 a finger is never taken for an event and a termination never for an effect. ``str()`` and
 f-strings still give the bare string and ``.value`` is it (for JSON and messages); a plain
 string converts with the enum (``EventType("A")``), as the parsers and message converters do.
@@ -29,9 +30,10 @@ from __future__ import annotations
 
 from enum import Enum
 
-__all__ = ["ContactKind", "ContactMode", "Effect", "EventType", "Finger", "MaterialModel",
-           "ObjectModel", "RingLimit", "SQUEEZING_FINGERS", "ShapeType", "SqueezeKind",
-           "StrainCriterion", "Termination"]
+__all__ = ["ContactKind", "ContactMode", "DistortionModel", "Effect", "EventType", "Finger",
+           "ImageEncoding", "MaterialModel", "ObjectModel", "RingLimit", "SQUEEZING_FINGERS",
+           "ShapeFit", "ShapeType", "SqueezeKind", "StrainCriterion", "StrainMeasure",
+           "StressMeasure", "Termination"]
 
 
 class _Name(str, Enum):
@@ -143,8 +145,61 @@ class StrainCriterion(_Name):
     """|eps_x|, |eps_y| <= eps* in the object frame (eq. 45 literally)."""
 
 
+class StrainMeasure(_Name):
+    """Measure of a strain, defined by the deformation gradient F = R U of an element.
+
+    At small strain all four agree to first order; at the peak compression of the foam square
+    (about 25 %) they differ by up to a third, so every reported strain names its measure.
+
+    >>> [m.label for m in StrainMeasure]
+    ['small', 'Biot', 'log', 'Green-Lagrange']
+    """
+
+    SMALL = "small"
+    """Small (infinitesimal) strain sym(F) - I = sym(grad u): the linear model's; not frame
+    indifferent (a rigid rotation by theta shows 1 - cos(theta))."""
+    BIOT = "biot"
+    """Biot (nominal, engineering) strain U - I: change of a fibre's length per reference
+    length along the principal directions; the corotational model's."""
+    LOG = "log"
+    """Logarithmic (Hencky, true) strain ln U: the neo-Hookean model's."""
+    GREEN_LAGRANGE = "green_lagrange"
+    """Green-Lagrange strain (F^T F - I) / 2 = (U^2 - I) / 2."""
+
+    @property
+    def label(self) -> str:
+        """Short human-readable name, for text output."""
+        return {"small": "small", "biot": "Biot", "log": "log",
+                "green_lagrange": "Green-Lagrange"}[self.value]
+
+
+class StressMeasure(_Name):
+    """Measure of a reported stress."""
+
+    SMALL_STRAIN = "small_strain"
+    """C : eps of the small strain: the linear model's stress, in which the reference and the
+    deformed configuration are not told apart (Cauchy, Piola and Kirchhoff stresses
+    coincide to first order)."""
+    CAUCHY = "cauchy"
+    """Cauchy (true) stress: force per deformed area, sigma = P F^T / J with the thickness
+    stretch in J; the corotational and neo-Hookean models'."""
+
+    @property
+    def label(self) -> str:
+        """Short human-readable name, for text output."""
+        return {"small_strain": "small-strain", "cauchy": "Cauchy"}[self.value]
+
+
 class MaterialModel(_Name):
-    """Constitutive model of a solid object."""
+    """Constitutive model of a solid object.
+
+    Each model reports strains and tests its strain limit in its own measure, and reports its
+    own stress:
+
+    >>> [(str(m), str(m.strain_measure), str(m.stress_measure)) for m in MaterialModel]
+    [('linear', 'small', 'small_strain'), ('corotational', 'biot', 'cauchy'), \
+('neo_hookean', 'log', 'cauchy')]
+    """
 
     LINEAR = "linear"
     """Small-strain linear elasticity (the paper's model)."""
@@ -152,6 +207,18 @@ class MaterialModel(_Name):
     """Linear stress in the element's rotated frame: exact under rigid rotation."""
     NEO_HOOKEAN = "neo_hookean"
     """Compressible neo-Hookean hyperelasticity in exact plane stress."""
+
+    @property
+    def strain_measure(self) -> StrainMeasure:
+        """The measure of the model's strain: its reports and its strain limit use it."""
+        return {"linear": StrainMeasure.SMALL, "corotational": StrainMeasure.BIOT,
+                "neo_hookean": StrainMeasure.LOG}[self.value]
+
+    @property
+    def stress_measure(self) -> StressMeasure:
+        """The measure of the model's reported stresses."""
+        return (StressMeasure.SMALL_STRAIN if self is MaterialModel.LINEAR
+                else StressMeasure.CAUCHY)
 
 
 class ObjectModel(_Name):
@@ -203,7 +270,7 @@ class Effect(_Code):
     SENSOR_DROPOUT = "sensor_dropout"
 
 
-class RingLimit(_Name):
+class RingLimit(_Code):
     """What bounds a ring squeeze's depth (Sec. 7.1), in the order ties resolve."""
 
     FRICTION_CONE_F1 = "friction_cone_F1"
@@ -214,3 +281,36 @@ class RingLimit(_Name):
     """The most strained element reaches the proportional limit."""
     NONE = "none"
     """Nothing before the fingers meet (relative depth 1)."""
+
+
+class ImageEncoding(_Name):
+    """``sensor_msgs/Image`` encodings that outline extraction reads (perception)."""
+
+    MONO8 = "mono8"
+    """A segmentation mask: 0 background, > 0 object (0-255 as coverage: 127.5 is the edge)."""
+    DEPTH_16UC1 = "16UC1"
+    """Depth in mm (uint16); 0 marks an invalid pixel."""
+    DEPTH_32FC1 = "32FC1"
+    """Depth in m (float32); NaN or 0 marks an invalid pixel."""
+
+
+class DistortionModel(_Name):
+    """``sensor_msgs/CameraInfo.distortion_model`` values that perception reads."""
+
+    PLUMB_BOB = "plumb_bob"
+    """Radial k1, k2, k3 and tangential p1, p2 (Brown-Conrady, as OpenCV)."""
+    RATIONAL_POLYNOMIAL = "rational_polynomial"
+    """Accepted only when its extra coefficients k4-k6 are zero (it is then plumb-bob)."""
+
+
+class ShapeFit(_Name):
+    """Transform fitted between an observed outline and a predicted boundary before the
+    residual is measured (perception, App. C).
+    """
+
+    SIMILARITY = "similarity"
+    """Scale, rotation and translation: App. C's least squares (eqs. 72-85)."""
+    RIGID = "rigid"
+    """Rotation and translation only (the scale of a calibrated camera is known)."""
+    NONE = "none"
+    """No transform: both curves are already in the same frame."""

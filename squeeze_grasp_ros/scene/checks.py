@@ -63,7 +63,7 @@ def check_shape(shape: Mapping[str, Any], where: str = "object.shape") -> None:
             f"unknown key {where}.{unknown[0]} for type {kind} "
             f"(allowed: {sorted(allowed - {'type'})})"
         )
-    optional = {"cos", "sin"}
+    optional = {"cos", "sin", "holes"}
     for key in SHAPES[kind]:
         if key not in shape and key not in optional:
             raise SceneError(f"missing required key {where}.{key} for type {kind}")
@@ -82,7 +82,8 @@ def _is_number(value: Any) -> bool:
 
 def _check_shape_value(key: str, value: Any, where: str) -> None:
     """Types of the shape parameters: lengths are positive numbers (m), ``points`` a list of
-    [x, y] number pairs, ``cos``/``sin`` lists of numbers, ``path`` a non-empty string.
+    [x, y] number pairs, ``holes`` a list of such lists, ``cos``/``sin`` lists of numbers,
+    ``path`` a non-empty string.
     """
     if key == "path":
         if not isinstance(value, str) or not value:
@@ -92,6 +93,12 @@ def _check_shape_value(key: str, value: Any, where: str) -> None:
             isinstance(p, (list, tuple)) and len(p) == 2 and all(map(_is_number, p)) for p in value
         ):
             raise SceneError(f"{where} must be a list of [x, y] number pairs (m)")
+    elif key == "holes":
+        if not isinstance(value, list):
+            raise SceneError(f"{where} must be a list of polygons, each a list of [x, y] number "
+                             "pairs (m)")
+        for k, hole in enumerate(value):
+            _check_shape_value("points", hole, f"{where}[{k}]")
     elif key in ("cos", "sin"):
         if not isinstance(value, list) or not all(map(_is_number, value)):
             raise SceneError(f"{where} must be a list of numbers (relative to the radius)")

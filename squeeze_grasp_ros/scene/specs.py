@@ -69,7 +69,7 @@ SHAPES: dict[ShapeType, tuple[str, ...]] = {
     ShapeType.ELLIPSE: ("a", "b"),
     ShapeType.SUPERELLIPSE: ("a", "b", "exponent"),
     ShapeType.FOURIER_BLOB: ("radius", "cos", "sin"),
-    ShapeType.POLYGON: ("points",),
+    ShapeType.POLYGON: ("points", "holes"),
     ShapeType.SPLINE: ("points",),
     ShapeType.FILE: ("path",),
     ShapeType.ANNULUS: ("outer_radius", "inner_radius"),
@@ -197,11 +197,15 @@ class FrictionSpec:
 
 @dataclass(frozen=True)
 class StrainLimitSpec:
-    """Proportional limit (eq. 45)."""
+    """Proportional limit (eq. 45), on the material model's own strain measure."""
 
-    epsilon: float = spec("strain limit epsilon*", "", lo=0.0, lo_open=True)
+    epsilon: float = spec(
+        "strain limit epsilon*, on the material model's own strain: small strain sym(grad u) "
+        "(linear), Biot U - I (corotational), log ln U (neo_hookean); rings: the largest fibre "
+        "strain (small)", "", lo=0.0, lo_open=True)
     criterion: StrainCriterion = spec(
-        "principal: max |eps_1|,|eps_2|; componentwise: |eps_x|,|eps_y| (literal eq. 45)",
+        "principal: max |eps_1|,|eps_2|; componentwise: |eps_x|,|eps_y| (literal eq. 45; "
+        "linear model only)",
         default=StrainCriterion.PRINCIPAL,
     )
 

@@ -25,7 +25,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from squeeze_grasp_ros.mechanics.elastic.hyperelastic import STRAIN_MEASURES
+from squeeze_grasp_ros.mechanics.elastic.strain_measures import COMMON_STRAIN_MEASURE
 from squeeze_grasp_ros.mechanics.elastic.reduced import boundary_displacement, reduced_stiffness
 from squeeze_grasp_ros.mechanics.errors import InvalidInputError
 from squeeze_grasp_ros.mechanics.resistance.frictional import FrictionalResistance
@@ -246,11 +246,19 @@ class ModelComparison:
     seconds: Mapping[MaterialModel, float]
 
     def rows(self) -> dict:
-        """Material model -> forces, energy, contact half-widths, strain, events, time."""
-        return {m: _model_row(res, m, self.seconds[m]) for m, res in self.results.items()}
+        """Material model -> forces, energy, contact half-widths, strains and stress (with their
+        measures), events, time.
+        """
+        return {m: _model_row(res, self.seconds[m]) for m, res in self.results.items()}
 
     def to_json(self) -> dict:
-        """``models`` (one row each) and ``relative_difference`` from linear."""
+        """``models`` (one row each) and ``relative_difference`` from linear.
+
+        Strains are compared like for like: ``max_principal_strain`` holds every field's
+        largest principal strain in every measure, and its differences are taken measure by
+        measure (``common_strain_measure`` is the one the text shows). A model's own measure
+        (``max_strain``) is never compared with another model's.
+        """
         rows = self.rows()
         base = rows[MaterialModel.LINEAR]
 
@@ -260,22 +268,25 @@ class ModelComparison:
         differences = {
             m: {"force": {f: rel(r["force"][f], base["force"][f]) for f in r["force"]},
                 "energy": rel(r["energy"], base["energy"]),
-                "max_strain": rel(r["max_strain"], base["max_strain"]),
+                "max_principal_strain": {k: rel(v, base["max_principal_strain"][k])
+                                         for k, v in r["max_principal_strain"].items()},
                 "contact_half_width": {f: rel(r["contact_half_width"][f],
                                               base["contact_half_width"][f])
                                        for f in r["contact_half_width"]},
                 "seconds_ratio": r["seconds"] / max(base["seconds"], 1e-12)}
             for m, r in rows.items() if m != MaterialModel.LINEAR}
-        return {"scene": self.setup.scene.name, "compare_models": True, "models": rows,
+        return {"scene": self.setup.scene.name, "compare_models": True,
+                "common_strain_measure": str(COMMON_STRAIN_MEASURE), "models": rows,
                 "relative_difference": differences}
 
 
-def _model_row(res: EventSqueeze, model: str, seconds: float) -> dict:
+def _model_row(res: EventSqueeze, seconds: float) -> dict:
     segments = {f: [s.node for s in seg] for f, seg in res.segments.items()}
     widths = {}
     for f, seg in res.segments.items():
         thetas = [s.theta for s in seg]
         widths[f] = 0.5 * res.tip_radius[f] * (max(thetas) - min(thetas)) if thetas else 0.0
+    h = res.health
     return {
         "termination": res.termination,
         "depth": res.depth,
@@ -284,8 +295,11 @@ def _model_row(res: EventSqueeze, model: str, seconds: float) -> dict:
         "energy": res.energy,
         "contact_half_width": widths,
         "contact_nodes": {f: len(nodes) for f, nodes in segments.items()},
-        "max_strain": res.health.max_strain,
-        "strain_measure": STRAIN_MEASURES[MaterialModel(model)],
+        "max_strain": h.max_strain,
+        "strain_measure": str(h.strain_measure),
+        "max_principal_strain": {str(m): v for m, v in h.max_principal_strain.items()},
+        "max_von_mises": h.max_von_mises,
+        "stress_measure": str(h.stress_measure),
         "event_counts": res.event_counts,
         "work_minus_energy": res.diagnostics["work_minus_energy"],
         "dissipation": sum(res.dissipation.values()),

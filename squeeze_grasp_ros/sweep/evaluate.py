@@ -26,7 +26,7 @@ import numpy as np
 from squeeze_grasp_ros.mechanics.elastic.mesh import Mesh
 from squeeze_grasp_ros.mechanics.resistance.optimal import sweep_directions
 from squeeze_grasp_ros.mechanics.squeeze.graspmap import GraspMap, grasp_map
-from squeeze_grasp_ros.mechanics.vocabulary import Finger, Termination
+from squeeze_grasp_ros.mechanics.vocabulary import Finger, StrainMeasure, Termination
 from squeeze_grasp_ros.scene import GraspSetup
 from squeeze_grasp_ros.scene.setup import check_adversary_node
 from squeeze_grasp_ros.sweep.plan import Task, evaluation_scene, group_setup, rng_for
@@ -39,7 +39,6 @@ COLUMNS: dict[str, str] = {
     "task_id": "string",
     "object_id": "string",
     "material_id": "string",
-    "material_model": "string",
     "placement_id": "string",
     "param_id": "string",
     "repeat": "int32",
@@ -73,11 +72,15 @@ COLUMNS: dict[str, str] = {
     "work_F1": "float64",
     "work_F2": "float64",
     "energy": "float64",
+    "material_model": "string",
     "max_strain": "float64",
+    "strain_measure": "string",
     "max_strain_element": "int32",
     "max_strain_x": "float64",
     "max_strain_y": "float64",
+    "max_strain_biot": "float64",
     "max_von_mises": "float64",
+    "stress_measure": "string",
     "max_von_mises_element": "int32",
     "max_von_mises_x": "float64",
     "max_von_mises_y": "float64",
@@ -258,8 +261,11 @@ def evaluate(task: Task, group: Group, index: int, params, resist: dict) -> dict
             "work_F2": res.work[Finger.F2],
             "energy": res.energy,
             "max_strain": h.max_strain,
+            "strain_measure": str(h.strain_measure),
             "max_strain_element": h.max_strain_element,
+            "max_strain_biot": h.max_principal_strain[StrainMeasure.BIOT],
             "max_von_mises": h.max_von_mises,
+            "stress_measure": str(h.stress_measure),
             "max_von_mises_element": h.max_von_mises_element,
             "slip_margin_F1": h.slip_margin.get(Finger.F1),
             "slip_margin_F2": h.slip_margin.get(Finger.F2),

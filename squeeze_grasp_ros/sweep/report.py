@@ -24,10 +24,26 @@ DISTRIBUTIONS = (
     "resist_max",
     "energy",
     "max_strain",
+    "max_strain_biot",
     "max_von_mises",
     "relative_depth",
     "time_s",
 )
+MEASURED = {"max_strain": "strain_measure", "max_von_mises": "stress_measure"}
+"""Columns whose measure is in another column: their distributions are kept apart per measure
+(a sweep over material models mixes small, Biot and log strains in ``max_strain``)."""
+
+
+def _distribution_values(rows: list[dict], key: str) -> dict[str, list]:
+    """Distribution name -> the non-null values of column ``key``: one named ``key``, or one
+    named ``key [measure]`` per measure of a :data:`MEASURED` column.
+    """
+    split: dict[str, list] = defaultdict(list)
+    for r in rows:
+        if r.get(key) is not None:
+            name = f"{key} [{r.get(MEASURED[key]) or 'unnamed'}]" if key in MEASURED else key
+            split[name].append(r[key])
+    return dict(sorted(split.items()))
 
 
 def success(row: dict) -> bool:
@@ -55,13 +71,11 @@ def summarise(rows: list[dict], best: int = 3) -> dict:
         terminations[r["termination"] or "error"] += 1
     dist = {}
     for key in DISTRIBUTIONS:
-        v = np.array([r[key] for r in rows if r[key] is not None], float)
-        if len(v):
-            dist[key] = {
-                "count": int(len(v)),
-                "quantiles": dict(
-                    zip(("min", "q25", "median", "q75", "max"), np.quantile(v, QUANTILES).tolist())
-                ),
+        for name, values in _distribution_values(rows, key).items():
+            dist[name] = {
+                "count": len(values),
+                "quantiles": dict(zip(("min", "q25", "median", "q75", "max"),
+                                      np.quantile(np.array(values, float), QUANTILES).tolist())),
             }
     qkey = quality_key(rows)
     placements: dict = defaultdict(lambda: {"ok": 0, "n": 0})
@@ -129,12 +143,12 @@ def text(summary: dict, manifest: dict) -> str:
         "",
         "terminations: " + ", ".join(f"{k} {v}" for k, v in summary["terminations"].items()),
         "",
-        f"{'quantity':16s} {'count':>6s} {'min':>10s} {'q25':>10s} {'median':>10s} "
+        f"{'quantity':28s} {'count':>6s} {'min':>10s} {'q25':>10s} {'median':>10s} "
         f"{'q75':>10s} {'max':>10s}",
     ]
     for key, d in summary["distributions"].items():
         q = d["quantiles"]
-        lines.append(f"{key:16s} {d['count']:6d} " + " ".join(f"{q[k]:10.4g}" for k in q))
+        lines.append(f"{key:28s} {d['count']:6d} " + " ".join(f"{q[k]:10.4g}" for k in q))
     unit = "J/m^2" if summary["quality"] == "resist_min" else "N/m"
     lines += [
         "",

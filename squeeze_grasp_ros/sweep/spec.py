@@ -173,7 +173,8 @@ class SweepSpec:
         "objects (default: the base scene's)", default=None
     )
     materials: Optional[Mapping[str, Any]] = spec(
-        "name -> {E, nu, thickness} (default: the base scene's, named 'base')", default=None
+        "name -> {E, nu, thickness[, model]} (default: the base scene's, named 'base')",
+        default=None,
     )
     mesh: Optional[MeshSpec] = spec("mesh settings (default: the base scene's)", default=None)
     friction: Optional[tuple[float, ...]] = spec(

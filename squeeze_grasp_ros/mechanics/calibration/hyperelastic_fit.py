@@ -80,7 +80,7 @@ class CompressionCurve:
 
     @property
     def strain(self) -> np.ndarray:
-        """Compressive engineering strain -dl / l at each point."""
+        """Compressive engineering (Biot, nominal) strain -dl / l at each point."""
         return -np.asarray(self.dl, float) / self.length
 
 

@@ -98,9 +98,3 @@ def principal_strains(strains: np.ndarray) -> np.ndarray:
     radius = np.sqrt((0.5 * (exx - eyy)) ** 2 + (0.5 * gxy) ** 2)
     return np.column_stack([mean + radius, mean - radius])
 
-
-def von_mises_stress(strains: np.ndarray, E: float, nu: float) -> np.ndarray:
-    """Plane-stress von Mises stress (t,), Pa, from engineering strains (t, 3)."""
-    s = strains @ (E * unit_elasticity_matrix(nu)).T
-    sxx, syy, sxy = s[:, 0], s[:, 1], s[:, 2]
-    return np.sqrt(sxx * sxx - sxx * syy + syy * syy + 3.0 * sxy * sxy)

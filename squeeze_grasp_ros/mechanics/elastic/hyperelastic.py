@@ -42,16 +42,9 @@ from squeeze_grasp_ros.mechanics.elastic.fem import element_dofs
 from squeeze_grasp_ros.mechanics.errors import InvalidInputError, NumericalError
 from squeeze_grasp_ros.mechanics.vocabulary import MaterialModel
 
-__all__ = ["Assembly", "InvertedElementError", "MeshGeometry", "STRAIN_MEASURES", "area_ratios",
-           "assemble", "deformation", "gradient_operator", "mesh_geometry", "principal_strains",
-           "stress_and_tangent"]
-
-STRAIN_MEASURES: dict[MaterialModel, str] = {
-    MaterialModel.LINEAR: "small strain sym(grad u)",
-    MaterialModel.COROTATIONAL: "Biot strain U - I",
-    MaterialModel.NEO_HOOKEAN: "logarithmic (Hencky) strain ln(stretch)",
-}
-"""The strain each model reports and tests its strain limit on (principal values)."""
+__all__ = ["Assembly", "InvertedElementError", "MeshGeometry", "area_ratios", "assemble",
+           "deformation", "gradient_operator", "mesh_geometry", "stress_and_tangent",
+           "thickness_stretch"]
 
 _PLANE_STRESS_ITERATIONS = 30
 _SKEW = np.array([[0.0, -1.0], [1.0, 0.0]])
@@ -208,10 +201,14 @@ def _thickness_stretch(J2: np.ndarray, lam: float, mu: float) -> np.ndarray:
     return l3
 
 
-def _neo_hookean(F: np.ndarray, nu: float, tangent: bool):
+def _require_compressible(nu: float) -> None:
     if not nu < 0.5:
         raise InvalidInputError(f"material.nu must be < 0.5 for the neo_hookean model (its "
                                 f"lambda is infinite at 0.5), got {nu}")
+
+
+def _neo_hookean(F: np.ndarray, nu: float, tangent: bool):
+    _require_compressible(nu)
     lam, mu = _lame(nu)
     J2 = F[:, 0, 0] * F[:, 1, 1] - F[:, 0, 1] * F[:, 1, 0]
     l3 = _thickness_stretch(J2, lam, mu)
@@ -231,6 +228,36 @@ def _neo_hookean(F: np.ndarray, nu: float, tangent: bool):
     A = (mu * np.eye(4)[None] + (lam - (lam / l3) ** 2 / w33)[:, None, None] * outer
          - a[:, None, None] * cross).reshape(-1, 2, 2, 2, 2)
     return W, P, A
+
+
+def thickness_stretch(model: MaterialModel | str, F: np.ndarray, *, nu: float) -> np.ndarray:
+    """Out-of-plane stretch lambda3 (t,) of each element under plane stress (sigma33 = 0).
+
+    ``neo_hookean``: the root of mu (lambda3^2 - 1) + lambda ln(det F lambda3) = 0 that the law
+    solves. ``corotational``: the 2-D law is the plane-stress reduction of the 3-D isotropic
+    law T = lambda tr(E) I + 2 mu E on the Biot strain E = U - I, whose T33 = 0 gives
+    lambda3 = 1 - nu / (1 - nu) tr(U - I). The linear model has no thickness stretch.
+
+    Parameters
+    ----------
+    model : MaterialModel or str
+        ``corotational`` or ``neo_hookean``.
+    F : (t, 2, 2) ndarray
+        In-plane deformation gradients (det F > 0).
+    nu : float
+        Poisson's ratio.
+    """
+    model = MaterialModel(model)
+    F = np.asarray(F, float)
+    if model == MaterialModel.COROTATIONAL:
+        _, _, n2 = _rotation(F)  # tr U = |(F11 + F22, F21 - F12)|
+        return 1.0 - nu / (1.0 - nu) * (np.sqrt(n2) - 2.0)
+    if model == MaterialModel.NEO_HOOKEAN:
+        _require_compressible(nu)
+        lam, mu = _lame(nu)
+        return _thickness_stretch(F[:, 0, 0] * F[:, 1, 1] - F[:, 0, 1] * F[:, 1, 0], lam, mu)
+    raise InvalidInputError("the linear model has no thickness stretch (small strain: its "
+                            "stress is C : eps on the reference configuration)")
 
 
 _LAWS = {MaterialModel.LINEAR: _linear, MaterialModel.COROTATIONAL: _corotational,
@@ -341,18 +368,3 @@ def mesh_geometry(nodes: np.ndarray, triangles: np.ndarray) -> MeshGeometry:
     return MeshGeometry(gradient_operator(nodes, triangles), area, G,
                         np.ascontiguousarray(np.swapaxes(G, 1, 2)), dofs, n2, slots.ravel(),
                         keys % n2, indptr)
-
-
-def principal_strains(model: MaterialModel | str, nodes: np.ndarray, triangles: np.ndarray,
-                      u: np.ndarray) -> np.ndarray:
-    """Principal strains (t, 2), largest first, in the model's measure (STRAIN_MEASURES)."""
-    F = deformation(nodes, triangles, u)
-    model = MaterialModel(model)
-    if model == MaterialModel.LINEAR:
-        eps = 0.5 * (F + np.swapaxes(F, 1, 2)) - np.eye(2)
-        return np.linalg.eigvalsh(eps)[:, ::-1]
-    stretch = np.sqrt(np.maximum(np.linalg.eigvalsh(np.einsum("tki,tkj->tij", F, F)), 0.0))
-    stretch = stretch[:, ::-1]
-    if model == MaterialModel.COROTATIONAL:
-        return stretch - 1.0
-    return np.log(np.maximum(stretch, 1e-300))

@@ -17,7 +17,8 @@ from typing import Protocol
 import numpy as np
 
 from squeeze_grasp_ros.mechanics.errors import InvalidInputError
-from squeeze_grasp_ros.mechanics.elastic.shapes import Outline, resample, signed_area
+from squeeze_grasp_ros.mechanics.elastic.shapes import (Outline, interior_point, resample,
+                                                      signed_area)
 
 
 class Mesher(Protocol):
@@ -218,7 +219,7 @@ def generate_mesh(
         k = np.arange(len(loop)) + offset
         segments.append(np.column_stack([k, np.roll(k, -1)]))
         offset += len(loop)
-    holes = np.array([h.mean(axis=0) for h in outline.holes]).reshape(-1, 2)
+    holes = np.array([interior_point(h) for h in outline.holes]).reshape(-1, 2)
     nodes, tris = (mesher or TriangleMesher()).triangulate(
         vertices, np.concatenate(segments), holes, max_area, min_angle
     )

@@ -178,10 +178,64 @@ def with_boundary_points(outline: Outline, points: Sequence[Sequence[float]]) ->
     return Outline(p, outline.holes, corners.astype(int))
 
 
-def polygon(points: Sequence[Sequence[float]]) -> Outline:
-    """A closed simple polygon through ``points`` (m); its vertices are kept as corners."""
+def polygon(points: Sequence[Sequence[float]],
+            holes: Sequence[Sequence[Sequence[float]]] = ()) -> Outline:
+    """A closed simple polygon through ``points`` (m), its vertices kept as corners, with
+    optional polygonal ``holes`` (each a list of [x, y], m) strictly inside it.
+
+    Examples
+    --------
+    >>> frame = polygon([[0, 0], [4, 0], [4, 4], [0, 4]], holes=[[[1, 1], [3, 1], [3, 3]]])
+    >>> frame.area
+    14.0
+    """
     p = validate_polyline(points, ShapeType.POLYGON)
-    return Outline(p, corners=np.arange(len(p)))
+    inner = tuple(validate_polyline(h, f"polygon.holes[{k}]") for k, h in enumerate(holes))
+    for k, hole in enumerate(inner):
+        if not _inside(hole[0], p) or _crosses(p, hole) or any(
+                _crosses(hole, other) or _inside(other[0], hole) for other in inner[:k]):
+            raise InvalidInputError(f"polygon.holes[{k}] must lie strictly inside the polygon "
+                                    "and apart from the other holes")
+    return Outline(p, inner, corners=np.arange(len(p)))
+
+
+def _inside(point: np.ndarray, loop: np.ndarray) -> bool:
+    """True if ``point`` is inside the closed polyline ``loop`` (even-odd ray casting)."""
+    a, b = loop, np.roll(loop, -1, axis=0)
+    x, y = point
+    cut = (a[:, 1] > y) != (b[:, 1] > y)
+    xs = a[cut, 0] + (y - a[cut, 1]) * (b[cut, 0] - a[cut, 0]) / (b[cut, 1] - a[cut, 1])
+    return bool(np.count_nonzero(xs > x) % 2)
+
+
+def _crosses(a: np.ndarray, b: np.ndarray) -> bool:
+    """True if an edge of closed polyline ``a`` crosses or touches an edge of ``b``."""
+    a0, a1 = a, np.roll(a, -1, axis=0)
+    b0, b1 = b, np.roll(b, -1, axis=0)
+
+    def orient(o, q, r):
+        return np.sign((q[..., 0] - o[..., 0]) * (r[..., 1] - o[..., 1])
+                       - (q[..., 1] - o[..., 1]) * (r[..., 0] - o[..., 0]))
+
+    A0, A1, B0, B1 = a0[:, None], a1[:, None], b0[None], b1[None]
+    overlap = np.all((np.minimum(A0, A1) <= np.maximum(B0, B1))
+                     & (np.minimum(B0, B1) <= np.maximum(A0, A1)), axis=-1)
+    return bool(np.any(overlap & (orient(A0, A1, B0) * orient(A0, A1, B1) <= 0)
+                       & (orient(B0, B1, A0) * orient(B0, B1, A1) <= 0)))
+
+
+def interior_point(points: np.ndarray) -> np.ndarray:
+    """A point strictly inside the simple closed polyline ``points`` (n, 2) (also when it is
+    not convex, where the centroid may lie outside): the middle of the first inside span of a
+    horizontal line through the middle of its height.
+    """
+    p = np.asarray(points, float)
+    lo, hi = p[:, 1].min(), p[:, 1].max()
+    y = lo + (0.5 + 1e-3 * np.pi) * (hi - lo)  # an irrational offset misses the vertices
+    a, b = p, np.roll(p, -1, axis=0)
+    cut = (a[:, 1] - y) * (b[:, 1] - y) < 0
+    x = np.sort(a[cut, 0] + (y - a[cut, 1]) * (b[cut, 0] - a[cut, 0]) / (b[cut, 1] - a[cut, 1]))
+    return np.array([0.5 * (x[0] + x[1]), y])
 
 
 def rectangle(width: float, height: float) -> Outline:
@@ -280,7 +334,8 @@ def _csv_points(text: str, name: str) -> list[list[float]]:
 
 
 def load_outline(path: str | Path) -> Outline:
-    """Read an outline from CSV (``x,y`` per line, m) or JSON (``{"outline": [[x, y], ...]}``).
+    """Read an outline from CSV (``x,y`` per line, m) or JSON (``{"outline": [[x, y], ...]}``,
+    optionally ``"holes": [[[x, y], ...], ...]``, as ``squeeze-grasp outline`` writes it).
 
     The points are the vertices of a polygon; vertices where it turns by more than 20 degrees
     are kept as corners when the outline is resampled. The file is read up to
@@ -307,10 +362,18 @@ def load_outline(path: str | Path) -> Outline:
                 for q in pts):
             raise InvalidInputError(f"{name}: 'outline' must be a list of at most "
                                  f"{MAX_OUTLINE_POINTS} [x, y] number pairs")
+        holes = data.get("holes", [])
+        if not isinstance(holes, list) or not all(
+                isinstance(h, list) and all(isinstance(q, list) and len(q) == 2 and all(
+                    isinstance(c, (int, float)) and not isinstance(c, bool) for c in q)
+                    for q in h) for h in holes) or sum(map(len, holes)) > MAX_OUTLINE_POINTS:
+            raise InvalidInputError(f"{name}: 'holes' must be a list of polygons, each a list "
+                                    "of [x, y] number pairs")
     else:
-        pts = _csv_points(text, name)
+        pts, holes = _csv_points(text, name), []
     p = validate_polyline(pts, name)
-    return Outline(p, corners=_turning_corners(p))
+    with_holes = polygon(p, holes) if holes else Outline(p)
+    return Outline(p, with_holes.holes, corners=_turning_corners(p))
 
 
 def resample(

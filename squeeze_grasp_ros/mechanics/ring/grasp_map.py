@@ -25,7 +25,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from squeeze_grasp_ros.mechanics.errors import InvalidInputError
-from squeeze_grasp_ros.mechanics.ring.model import RingModel
+from squeeze_grasp_ros.mechanics.ring.model import FIBRE_STRAIN_MEASURE, RingModel
 from squeeze_grasp_ros.mechanics.ring.squeeze import (
     LIMITS,
     check_limits,
@@ -35,7 +35,7 @@ from squeeze_grasp_ros.mechanics.ring.squeeze import (
     resolve_limits,
     ring_grasp,
 )
-from squeeze_grasp_ros.mechanics.vocabulary import SqueezeKind
+from squeeze_grasp_ros.mechanics.vocabulary import RingLimit, SqueezeKind
 
 CHUNK = 512
 """Placements per block in the strain search (bounds the temporary memory to ~CHUNK * 9n
@@ -87,7 +87,7 @@ class RingGraspMap:
 
     def limit_names(self) -> np.ndarray:
         """(P,) limit names."""
-        return np.asarray(LIMITS)[self.limit_code]
+        return np.asarray(RingLimit.values())[self.limit_code]
 
     def matrix(self, values: np.ndarray, fill: float = np.nan) -> np.ndarray:
         """Symmetric (n, n) matrix of per-placement ``values`` (P,), ``fill`` on the diagonal."""
@@ -111,7 +111,7 @@ class RingGraspMap:
         if started:
             fail &= self.initially_feasible
         codes = self.limit_code[fail]
-        return {name: int(np.sum(codes == k)) for k, name in enumerate(LIMITS)}
+        return {name.value: int(np.sum(codes == k)) for k, name in enumerate(LIMITS)}
 
     def best(self, count: int = 5) -> list[dict]:
         """The ``count`` placements with the largest maximum relative depth."""
@@ -122,18 +122,20 @@ class RingGraspMap:
         return {"contacts": [int(self.pairs[k, 0]), int(self.pairs[k, 1])],
                 "max_depth": float(self.max_depth[k]),
                 "max_relative_depth": float(self.max_relative_depth[k]),
-                "limit": LIMITS[int(self.limit_code[k])]}
+                "limit": LIMITS[int(self.limit_code[k])].value}
 
     def to_json(self, best: int = 10) -> dict:
         """A JSON-able summary: counts, depth statistics, failure modes, best placements."""
         rel = self.max_relative_depth
         out = {
             "elements": self.n, "squeeze": self.kind, "mu": self.mu, "epsilon": self.epsilon,
+            "strain_measure": str(FIBRE_STRAIN_MEASURE),
             "pairs": int(len(self.pairs)),
             "initially_feasible_pairs": int(self.initially_feasible.sum()),
             "max_relative_depth": {"min": float(rel.min()), "median": float(np.median(rel)),
                                    "max": float(rel.max())},
-            "limits": {name: int(np.sum(self.limit_code == k)) for k, name in enumerate(LIMITS)},
+            "limits": {name.value: int(np.sum(self.limit_code == k))
+                       for k, name in enumerate(LIMITS)},
             "best": self.best(best),
         }
         r = self.requested_relative_depth

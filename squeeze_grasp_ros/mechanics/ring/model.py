@@ -62,6 +62,11 @@ from squeeze_grasp_ros.mechanics.errors import (
 from squeeze_grasp_ros.mechanics.elastic.fem import rigid_modes, rotation_mode_norm
 from squeeze_grasp_ros.mechanics.elastic.material import Material
 from squeeze_grasp_ros.mechanics.elastic.shapes import Outline, disk, resample, signed_area
+from squeeze_grasp_ros.mechanics.vocabulary import StrainMeasure
+
+FIBRE_STRAIN_MEASURE = StrainMeasure.SMALL
+"""The measure of the ring's fibre strains |eps| + h/2 |zeta| and of its strain limit: the
+curved beam is linear (small strain)."""
 
 BANDWIDTH = 5
 """Upper bandwidth of the clamped stiffness (two nodes of three DOFs per element)."""

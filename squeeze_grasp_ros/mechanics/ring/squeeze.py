@@ -35,7 +35,7 @@ import numpy as np
 from squeeze_grasp_ros.mechanics.elastic.compliance import node_dofs
 from squeeze_grasp_ros.mechanics.errors import InvalidInputError, require_finite
 from squeeze_grasp_ros.mechanics.elastic.reduced import reduce_blocks
-from squeeze_grasp_ros.mechanics.ring.model import RingModel
+from squeeze_grasp_ros.mechanics.ring.model import FIBRE_STRAIN_MEASURE, RingModel
 from squeeze_grasp_ros.mechanics.squeeze.stable_pure import two_contact_direction
 from squeeze_grasp_ros.mechanics.vocabulary import SQUEEZING_FINGERS, RingLimit, SqueezeKind
 
@@ -354,6 +354,7 @@ class RingGrasp:
             "squeeze": self.kind,
             "mu": self.mu,
             "epsilon": self.epsilon,
+            "strain_measure": str(FIBRE_STRAIN_MEASURE),
             "contacts": [int(c) for c in self.contacts],
             "points": {f: self.points[c].tolist()
                        for f, c in zip(SQUEEZING_FINGERS, self.contacts)},
@@ -361,8 +362,8 @@ class RingGrasp:
             "relative_depth": self.relative_depth(depth),
             "max_depth": self.max_depth,
             "max_relative_depth": self.max_relative_depth,
-            "limit": self.limit,
-            "limit_depths": self.limit_depths(),
+            "limit": self.limit.value,
+            "limit_depths": {k.value: v for k, v in self.limit_depths().items()},
             "feasible_at_requested_depth": self.feasible_at(depth),
             "forces": {f: forces[k].tolist() for k, f in enumerate(SQUEEZING_FINGERS)},
             "stiffness": self.stiffness,

@@ -42,7 +42,7 @@ from squeeze_grasp_ros.mechanics.elastic.fem import (
 from squeeze_grasp_ros.mechanics.elastic.hyperelastic import area_ratios
 from squeeze_grasp_ros.mechanics.squeeze.fingertips import cross, tangent, unit
 from squeeze_grasp_ros.mechanics.elastic.reduced import reduce_blocks
-from squeeze_grasp_ros.mechanics.vocabulary import StrainCriterion
+from squeeze_grasp_ros.mechanics.vocabulary import MaterialModel, StrainCriterion, StrainMeasure
 
 INVERSION_AREA_RATIO = 0.01
 """A squeeze ends ``element_inverted`` when an element's area ratio det F falls to this: the
@@ -424,6 +424,16 @@ class ContactModel:
         return False
 
     @property
+    def constitutive_model(self) -> MaterialModel:
+        """The material law of the object: linear (the reduced stiffness of small strain)."""
+        return MaterialModel.LINEAR
+
+    @property
+    def strain_measure(self) -> StrainMeasure:
+        """The measure of :meth:`max_strain`, :meth:`field_strain` and the strain limit."""
+        return self.constitutive_model.strain_measure
+
+    @property
     def phi(self) -> float:
         """Friction angle atan(mu), rad."""
         return float(np.arctan(self.mu))
@@ -539,19 +549,19 @@ class ContactModel:
         u = sd.A_bc[d] @ F.reshape(-1) + self.obj.rigid[node_dofs(b[rows])] @ g
         return u.reshape(-1, 2)
 
-    def strain_measure(self, sd: SetData, delta: np.ndarray, F: np.ndarray) -> tuple[float, int]:
-        """(largest strain by the limit's criterion, element index) of the configuration
-        (counted in :attr:`strain_evaluations`).
+    def max_strain(self, sd: SetData, delta: np.ndarray, F: np.ndarray) -> tuple[float, int]:
+        """(largest strain by the limit's criterion in :attr:`strain_measure`, element index)
+        of the configuration (counted in :attr:`strain_evaluations`).
         """
         self._cache["strain_evaluations"] = self.strain_evaluations + 1
-        return self._measure_strain(sd, delta, F)
+        return self._max_strain(sd, delta, F)
 
     @property
     def strain_evaluations(self) -> int:
         """How many configurations' strain was measured (the strain-limit check's work)."""
         return self._cache.get("strain_evaluations", 0)
 
-    def _measure_strain(self, sd: SetData, delta: np.ndarray, F: np.ndarray) -> tuple[float, int]:
+    def _max_strain(self, sd: SetData, delta: np.ndarray, F: np.ndarray) -> tuple[float, int]:
         if sd.strain_map is not None:
             eps = (sd.strain_map @ F.reshape(-1)).reshape(-1, 3)
         else:
@@ -568,8 +578,14 @@ class ContactModel:
         return 0.5 * float(np.sum(delta * F))
 
     def field_strain(self, u_hat: np.ndarray) -> tuple[float, int]:
-        """(largest strain by the limit's criterion, element) of a full displacement / L."""
+        """(largest strain by the limit's criterion in :attr:`strain_measure`, element) of a
+        full displacement / L.
+        """
         return strain_criterion(self.element_strains(u_hat).reshape(-1, 3), self.limits.criterion)
+
+    def field_deformation(self, u_hat: np.ndarray) -> np.ndarray:
+        """Deformation gradients F = I + grad u (t, 2, 2) of a full displacement / L (2n,)."""
+        return np.eye(2) + (self.obj.gradient @ u_hat).reshape(-1, 2, 2)
 
     def field_area_ratio(self, u_hat: np.ndarray) -> tuple[float, int]:
         """(smallest det F = deformed / reference element area, element) of a full

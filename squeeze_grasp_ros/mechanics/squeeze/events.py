@@ -32,7 +32,8 @@ from squeeze_grasp_ros.mechanics.squeeze.contact_state import (
     initial_state,
 )
 from squeeze_grasp_ros.mechanics.errors import InvalidInputError, require_finite
-from squeeze_grasp_ros.mechanics.elastic.fem import element_strains, von_mises_stress
+from squeeze_grasp_ros.mechanics.elastic.strain_measures import max_principal_strains
+from squeeze_grasp_ros.mechanics.elastic.stress_measures import element_stresses, von_mises
 from squeeze_grasp_ros.mechanics.squeeze.fingertips import place_fingertip
 from squeeze_grasp_ros.mechanics.squeeze.stable_pure import finger_motion
 from squeeze_grasp_ros.mechanics.squeeze.stepper import TERMINATION_ORDER, advance
@@ -45,6 +46,8 @@ from squeeze_grasp_ros.mechanics.vocabulary import (
     MaterialModel,
     SqueezeKind,
     StrainCriterion,
+    StrainMeasure,
+    StressMeasure,
     Termination,
 )
 
@@ -202,17 +205,27 @@ class SegmentNode:
 
 @dataclass(frozen=True)
 class GraspHealth:
-    """Grasp-health numbers of the final configuration.
+    """Grasp-health numbers of the final configuration; every strain and stress names its
+    measure.
 
     Attributes
     ----------
     max_strain : float
-        Largest element strain by ``criterion`` (principal: max |eps_1|, |eps_2|).
+        Largest element strain by ``criterion`` (principal: max |eps_1|, |eps_2|) in
+        ``strain_measure``: the number the strain limit is tested on.
     max_strain_element : int
     criterion : StrainCriterion
+    strain_measure : StrainMeasure
+        The material model's own measure: small (linear), biot (corotational) or log
+        (neo_hookean).
+    max_principal_strain : mapping
+        StrainMeasure -> largest max(|eps_1|, |eps_2|) of the same field in that measure (every
+        measure, to compare fields of different models like for like).
     max_von_mises : float
-        Largest plane-stress von Mises stress, Pa.
+        Largest plane-stress von Mises stress of ``stress_measure``, Pa.
     max_von_mises_element : int
+    stress_measure : StressMeasure
+        small_strain (linear: C : eps) or cauchy (the nonlinear models).
     max_displacement : float
         Largest nodal displacement magnitude, m.
     max_displacement_node : int
@@ -223,20 +236,26 @@ class GraspHealth:
     max_strain: float
     max_strain_element: int
     criterion: StrainCriterion
+    strain_measure: StrainMeasure
+    max_principal_strain: Mapping[StrainMeasure, float]
     max_von_mises: float
     max_von_mises_element: int
+    stress_measure: StressMeasure
     max_displacement: float
     max_displacement_node: int
     slip_margin: Mapping[Finger, float]
 
     def to_json(self) -> dict:
-        """All fields as a JSON-able dict."""
+        """All fields as a JSON-able dict (measures as their names)."""
         return {
             "max_strain": self.max_strain,
             "max_strain_element": self.max_strain_element,
-            "criterion": self.criterion,
+            "strain_measure": str(self.strain_measure),
+            "criterion": str(self.criterion),
+            "max_principal_strain": {str(m): v for m, v in self.max_principal_strain.items()},
             "max_von_mises": self.max_von_mises,
             "max_von_mises_element": self.max_von_mises_element,
+            "stress_measure": str(self.stress_measure),
             "max_displacement": self.max_displacement,
             "max_displacement_node": self.max_displacement_node,
             "slip_margin": dict(self.slip_margin),
@@ -290,6 +309,11 @@ class EventSqueeze:
         Stepper and solver counts, residuals and conditions (docs/events.md).
     force_curve : mapping
         Finger -> ((relative depth, force along its motion N), ...) at every accepted point.
+    material_model : MaterialModel
+        Constitutive model of the object.
+    strain_limit : float or None
+        The strain limit epsilon* the squeeze tested (in ``health.strain_measure``, by
+        ``health.criterion``); None without one.
     """
 
     termination: Termination
@@ -317,6 +341,8 @@ class EventSqueeze:
     diagnostics: Mapping[str, object] = field(default_factory=dict)
     force_curve: Mapping[Finger, tuple[tuple[float, float], ...]] = field(default_factory=dict)
     dissipation: Mapping[Finger, float] = field(default_factory=dict)
+    material_model: MaterialModel = MaterialModel.LINEAR
+    strain_limit: float | None = None
 
     @property
     def event_counts(self) -> dict[str, int]:
@@ -346,6 +372,10 @@ class EventSqueeze:
             "mu": self.mu,
             "tip_radius": radii[0] if len(set(radii)) == 1 else max(radii),
             "tip_radii": dict(self.tip_radius),
+            "material_model": str(self.material_model),
+            "strain_limit": None if self.strain_limit is None else {
+                "epsilon": self.strain_limit, "measure": str(self.health.strain_measure),
+                "criterion": str(self.health.criterion)},
             "health": self.health.to_json(),
             "chatter": [c.to_json() for c in self.chatter],
             "trajectories": {str(k): [list(p) for p in v] for k, v in self.trajectories.items()},
@@ -367,7 +397,8 @@ def segment_node(c: ContactNode, mu: float) -> SegmentNode:
 def grasp_health(model: ContactModel, state: ContactState) -> tuple[GraspHealth, np.ndarray]:
     """Grasp-health numbers and the full displacement field (n, 2), m, of ``state``.
 
-    One sparse solve (K+ F + R g) for the field; strains and von Mises stresses per element.
+    One sparse solve (K+ F + R g) for the field (the nonlinear models keep theirs); strains in
+    every measure and the model's stress per element.
     """
     obj = model.obj
     L, fu = model.length, model.force_unit
@@ -375,11 +406,13 @@ def grasp_health(model: ContactModel, state: ContactState) -> tuple[GraspHealth,
     sd = model.set_data(nodes)
     delta = np.array([c.displacement for c in state.contacts]) / L
     F = np.array([c.force for c in state.contacts]) / fu
-    u = model.full_displacement(sd, delta, F).reshape(-1, 2) * L
-    eps = element_strains(obj.mesh, u)
-    criterion = model.limits.criterion
-    strain, element = model.field_strain(u.reshape(-1) / L)
-    vm = von_mises_stress(eps, obj.material.E, obj.material.nu)
+    u_hat = model.full_displacement(sd, delta, F)
+    strain, element = model.field_strain(u_hat)
+    deformation = model.field_deformation(u_hat)
+    stress, stress_measure = element_stresses(model.constitutive_model, deformation,
+                                              E=obj.material.E, nu=obj.material.nu)
+    vm = von_mises(stress)
+    u = u_hat.reshape(-1, 2) * L
     norms = np.linalg.norm(u, axis=1)
     margins = {}
     for f in state.fingers:
@@ -387,16 +420,20 @@ def grasp_health(model: ContactModel, state: ContactState) -> tuple[GraspHealth,
         if seg:
             margins[f.name] = float(min(seg))
     health = GraspHealth(
-        strain,
-        element,
-        criterion,
-        float(vm.max()),
-        int(np.argmax(vm)),
-        float(norms.max()),
-        int(np.argmax(norms)),
-        margins,
+        max_strain=strain,
+        max_strain_element=element,
+        criterion=StrainCriterion(model.limits.criterion),
+        strain_measure=model.strain_measure,
+        max_principal_strain=max_principal_strains(deformation),
+        max_von_mises=float(vm.max()),
+        max_von_mises_element=int(np.argmax(vm)),
+        stress_measure=stress_measure,
+        max_displacement=float(norms.max()),
+        max_displacement_node=int(np.argmax(norms)),
+        slip_margin=margins,
     )
-    require_finite("grasp health", [strain, health.max_von_mises, health.max_displacement])
+    require_finite("grasp health", [strain, *health.max_principal_strain.values(),
+                                    health.max_von_mises, health.max_displacement])
     return health, u
 
 
@@ -544,4 +581,6 @@ def event_squeeze(
         event_tol=event_tol,
         reference=reference,
         diagnostics=diag,
+        material_model=model.constitutive_model,
+        strain_limit=model.limits.strain,
     )

@@ -10,7 +10,8 @@ stiffness; :class:`NonlinearContactModel` solves the finite-deformation equilibr
 whole object with the contact displacements prescribed
 (:class:`~squeeze_grasp_ros.mechanics.elastic.contact_response.ContactResponse`), so contact
 normals, gaps and sliding are those of the current configuration. The strain limit uses the
-model's own measure (:data:`~squeeze_grasp_ros.mechanics.elastic.hyperelastic.STRAIN_MEASURES`).
+model's own measure (:attr:`~squeeze_grasp_ros.mechanics.vocabulary.MaterialModel.strain_measure`:
+Biot for corotational, log for neo-Hookean).
 """
 from __future__ import annotations
 
@@ -21,7 +22,8 @@ import numpy as np
 from squeeze_grasp_ros.mechanics.elastic.compliance import node_dofs
 from squeeze_grasp_ros.mechanics.elastic.contact_response import (NEWTON_TOL, ContactResponse,
                                                                   Evaluation, ResponseFailure)
-from squeeze_grasp_ros.mechanics.elastic.hyperelastic import mesh_geometry, principal_strains
+from squeeze_grasp_ros.mechanics.elastic.hyperelastic import mesh_geometry
+from squeeze_grasp_ros.mechanics.elastic.strain_measures import max_principal_strain
 from squeeze_grasp_ros.mechanics.elastic.interior import TangentFactor
 from squeeze_grasp_ros.mechanics.errors import InvalidInputError
 from squeeze_grasp_ros.mechanics.squeeze.contact_model import (ContactModel, Response, SetData,
@@ -56,6 +58,11 @@ class NonlinearContactModel(ContactModel):
         if self.limits.criterion == StrainCriterion.COMPONENTWISE:
             raise InvalidInputError("strain_limit.criterion componentwise is defined for small "
                                     "strains only; use principal with a nonlinear model")
+
+    @property
+    def constitutive_model(self) -> MaterialModel:
+        """The finite-deformation law of the object."""
+        return MaterialModel(self.material_model)
 
     @property
     def adaptive_steps(self) -> bool:
@@ -149,16 +156,11 @@ class NonlinearContactModel(ContactModel):
         return self._response_of(sd).state_energy()
 
     def field_strain(self, u_hat: np.ndarray) -> tuple[float, int]:
-        """(largest absolute principal strain in the model's measure, element)."""
-        mesh = self.obj.mesh
-        eps = principal_strains(self.material_model, mesh.nodes / self.length, mesh.triangles,
-                                u_hat)
-        per_element = np.abs(eps).max(axis=1)
-        k = int(np.argmax(per_element))
-        return float(per_element[k]), k
+        """(largest absolute principal strain in :attr:`strain_measure`, element)."""
+        return max_principal_strain(self.field_deformation(u_hat), self.strain_measure)
 
-    def _measure_strain(self, sd: SetData, delta: np.ndarray, F: np.ndarray) -> tuple[float, int]:
-        """(largest strain in the model's measure, element) of the configuration."""
+    def _max_strain(self, sd: SetData, delta: np.ndarray, F: np.ndarray) -> tuple[float, int]:
+        """(largest strain in :attr:`strain_measure`, element) of the configuration."""
         return self.field_strain(self._field(sd, delta))
 
     def area_ratio(self, sd: SetData, delta: np.ndarray, F: np.ndarray) -> tuple[float, int]:

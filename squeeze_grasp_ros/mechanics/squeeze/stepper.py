@@ -283,7 +283,7 @@ class _Run:
         lim = self.model.limits
         strain = pickup = np.inf
         if lim.strain is not None and Termination.STRAIN_LIMIT in self.terminate_on:
-            strain = lim.strain - self.model.strain_measure(self.sd, sol.delta, sol.F)[0]
+            strain = lim.strain - self.model.max_strain(self.sd, sol.delta, sol.F)[0]
         if lim.weight is not None and Termination.PICKED_UP in self.terminate_on:
             pickup = pickup_margin(
                 self.model.mu,

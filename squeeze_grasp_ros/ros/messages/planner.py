@@ -271,7 +271,7 @@ def ring_grasp_test_response(test: RingTest, best_count: int) -> RingGraspTest.R
         contacts=int32_array(grasp.contacts),
         max_depth=grasp.max_depth,
         max_relative_depth=grasp.max_relative_depth,
-        limit=grasp.limit,
+        limit=grasp.limit.value,
         feasible=test.feasible,
         depth=depth,
         stiffness=grasp.stiffness,
@@ -285,7 +285,8 @@ def event_squeeze_data(result: EventSqueeze, object_id: str) -> EventSqueezeData
     """An event-driven squeeze's outcome as ``EventSqueezeData``.
 
     Finger forces are the final forces along each finger's motion direction (N), the work is
-    each finger's work on the object (J), the health numbers those of the final configuration.
+    each finger's work on the object (J), the health numbers those of the final configuration,
+    with the measures of its strain and stress.
     """
     health = result.health
     return EventSqueezeData(
@@ -306,8 +307,11 @@ def event_squeeze_data(result: EventSqueeze, object_id: str) -> EventSqueezeData
         work_f2=result.work[Finger.F2],
         force_f1=result.finger_force[Finger.F1][1],
         force_f2=result.finger_force[Finger.F2][1],
+        material_model=str(result.material_model),
         max_strain=health.max_strain,
+        strain_measure=str(health.strain_measure),
         max_von_mises=health.max_von_mises,
+        stress_measure=str(health.stress_measure),
         max_displacement=health.max_displacement,
     )
 

@@ -1,0 +1,84 @@
+# Copyright 2026 squeeze_grasp_ros developers
+# SPDX-License-Identifier: Apache-2.0
+"""``squeeze-grasp render``: a scene's object as the simulated top-down camera sees it."""
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+import numpy as np
+
+from squeeze_grasp_ros.commands.camera_args import add_camera_arguments, load_camera
+from squeeze_grasp_ros.commands.common import add_scene_argument, output_file
+from squeeze_grasp_ros.mechanics.errors import InvalidInputError
+from squeeze_grasp_ros.perception.image_files import encode_png
+from squeeze_grasp_ros.perception.render import render_views, ring_band
+from squeeze_grasp_ros.scene import build_outline, load_scene
+
+HELP = ("render a scene's object (its top face, anti-aliased; a ring's wall band) into a mono8 "
+        "mask and a depth image of a calibrated camera above the plane")
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    """SCENE, the camera, the images to write, blur and noise."""
+    add_scene_argument(parser)
+    add_camera_arguments(parser)
+    parser.add_argument("--mask", metavar="FILE.png", type=output_file,
+                        help="write the mono8 mask (PNG, or NPY by suffix)")
+    parser.add_argument("--depth", metavar="FILE.png", type=output_file,
+                        help="write the depth: .png = 16UC1 in mm, .npy = 32FC1 in m")
+    parser.add_argument("--blur", type=float, default=0.0, metavar="PX",
+                        help="Gaussian blur of the coverage, std in px (default 0)")
+    parser.add_argument("--depth-noise", type=float, default=0.0, metavar="M",
+                        help="Gaussian depth noise, std in m (default 0)")
+    parser.add_argument("--mask-noise", type=float, default=0.0, metavar="F",
+                        help="Gaussian noise on the coverage before quantisation, std as a "
+                             "fraction of full scale (default 0)")
+    parser.add_argument("--seed", type=int, default=0, help="seed of the noise (default 0)")
+
+
+def _write(path: str, image: np.ndarray) -> str:
+    if Path(path).suffix.lower() == ".npy":
+        np.save(path, image, allow_pickle=False)
+    elif Path(path).suffix.lower() == ".png":
+        Path(path).write_bytes(encode_png(image))
+    else:
+        raise InvalidInputError(f"{path}: images are written as .png or .npy")
+    return path
+
+
+def run(args: argparse.Namespace) -> dict:
+    """Render and write the images; report what the camera sees."""
+    scene = load_scene(args.scene)
+    camera, pose = load_camera(args)
+    height = scene.object.material.thickness
+    outline = build_outline(scene.object.shape)
+    if scene.object.ring is not None:  # the shape is the wall's middle curve
+        outline = ring_band(outline, scene.object.ring.wall_thickness)
+    views = render_views(outline, camera, pose, top_height=height,
+                         blur_px=args.blur, depth_noise_m=args.depth_noise,
+                         mask_noise=args.mask_noise, seed=args.seed)
+    out = {"scene": args.scene, "camera": camera.to_camera_info(), "pose": pose.to_json(),
+           "top_height": height, "object_pixels": float(views.coverage.sum()),
+           "touches_border": bool(views.coverage[[0, -1], :].any()
+                                  or views.coverage[:, [0, -1]].any())}
+    if args.mask:
+        out["mask"] = _write(args.mask, views.mask)
+    if args.depth:
+        depth = views.depth if Path(args.depth).suffix.lower() == ".npy" else views.depth_mm()
+        out["depth"] = _write(args.depth, depth)
+    return out
+
+
+def summary(result: dict) -> str:
+    """Human-readable report."""
+    cam = result["camera"]
+    lines = [f"{cam['width']} x {cam['height']} px camera at "
+             f"{', '.join(f'{v:.4g}' for v in result['pose']['position'])} m; top face "
+             f"{1e3 * result['top_height']:.4g} mm above the plane covers "
+             f"{result['object_pixels']:.1f} px"
+             + (" (it touches the image border)" if result["touches_border"] else "")]
+    for key in ("mask", "depth"):
+        if key in result:
+            lines.append(f"{key}: {result[key]}")
+    return "\n".join(lines)

@@ -1,0 +1,111 @@
+# Copyright 2026 squeeze_grasp_ros developers
+# SPDX-License-Identifier: Apache-2.0
+"""Principal strains of deformation gradients in every :class:`StrainMeasure`.
+
+For an element's deformation gradient F = I + H = R U (polar decomposition; U has the
+principal stretches lambda_1 >= lambda_2), the principal strains of each measure are
+
+==================  ==================================================================
+``small``           eigenvalues of sym(H) (not a function of U: a rotation shows)
+``biot``            lambda_i - 1 (nominal: change of length per reference length)
+``log``             ln lambda_i
+``green_lagrange``  (lambda_i^2 - 1) / 2, the eigenvalues e_i of (H + H^T + H^T H) / 2
+==================  ==================================================================
+
+The stretches are taken from the Green-Lagrange eigenvalues e_i, which are computed from H
+without cancellation: lambda_i - 1 = 2 e_i / (1 + sqrt(1 + 2 e_i)) and ln lambda_i =
+log1p(2 e_i) / 2 keep full relative accuracy at small strain, where all four measures agree
+to first order.
+
+>>> import numpy as np
+>>> F = np.array([[[0.8, 0.0], [0.0, 1.0]]])  # 20 % uniaxial compression
+>>> {str(m): round(float(principal_strains(F, m)[0, 1]), 6) for m in StrainMeasure}
+{'small': -0.2, 'biot': -0.2, 'log': -0.223144, 'green_lagrange': -0.18}
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from squeeze_grasp_ros.mechanics.elastic.fem import principal_strains as voigt_principal
+from squeeze_grasp_ros.mechanics.errors import InvalidInputError
+from squeeze_grasp_ros.mechanics.vocabulary import StrainMeasure
+
+__all__ = ["COMMON_STRAIN_MEASURE", "max_principal_strain", "max_principal_strains",
+           "principal_strains"]
+
+COMMON_STRAIN_MEASURE = StrainMeasure.BIOT
+"""The measure in which fields of different material models are compared like for like (the
+nominal strain: what a length change per reference length means, and frame indifferent)."""
+
+
+def _small(H: np.ndarray) -> np.ndarray:
+    """Principal small strains (t, 2) of displacement gradients H (t, 2, 2)."""
+    return voigt_principal(np.column_stack([H[:, 0, 0], H[:, 1, 1], H[:, 0, 1] + H[:, 1, 0]]))
+
+
+def _green_lagrange(H: np.ndarray) -> np.ndarray:
+    """Principal Green-Lagrange strains (t, 2) of H: of (H + H^T + H^T H) / 2, in engineering
+    (Voigt) components (xx, yy, 2 xy).
+    """
+    HtH = np.einsum("tki,tkj->tij", H, H)
+    return voigt_principal(np.column_stack([H[:, 0, 0] + 0.5 * HtH[:, 0, 0],
+                                            H[:, 1, 1] + 0.5 * HtH[:, 1, 1],
+                                            H[:, 0, 1] + H[:, 1, 0] + HtH[:, 0, 1]]))
+
+
+def _of_stretch(e: np.ndarray, measure: StrainMeasure) -> np.ndarray:
+    """Principal strains in a measure of the stretch from the Green-Lagrange ones ``e``."""
+    if measure == StrainMeasure.GREEN_LAGRANGE:
+        return e
+    two_e = np.maximum(2.0 * e, -1.0)  # lambda^2 = 1 + 2 e >= 0; clip round-off below it
+    if measure == StrainMeasure.BIOT:
+        return two_e / (1.0 + np.sqrt(1.0 + two_e))
+    with np.errstate(divide="ignore"):
+        return 0.5 * np.log1p(two_e)
+
+
+def principal_strains(F: np.ndarray, measure: StrainMeasure | str) -> np.ndarray:
+    """Principal strains (t, 2), largest first, of deformation gradients ``F`` (t, 2, 2).
+
+    Parameters
+    ----------
+    F : (t, 2, 2) ndarray
+        Deformation gradients I + grad u (dimensionless).
+    measure : StrainMeasure or str
+        ``small``, ``biot``, ``log`` or ``green_lagrange``.
+
+    Returns
+    -------
+    (t, 2) ndarray
+        Dimensionless principal strains. An element collapsed to a line (a zero stretch) has
+        a log strain of -inf; callers check finiteness (no element reaches it: squeezes end
+        at ``element_inverted`` first).
+    """
+    try:
+        measure = StrainMeasure(measure)
+    except ValueError:
+        raise InvalidInputError(f"strain measure must be one of {StrainMeasure.values()}, got "
+                                f"{measure!r}") from None
+    H = np.asarray(F, float) - np.eye(2)
+    if measure == StrainMeasure.SMALL:
+        return _small(H)
+    return _of_stretch(_green_lagrange(H), measure)
+
+
+def _largest(eps: np.ndarray) -> tuple[float, int]:
+    per_element = np.abs(eps).max(axis=1)
+    k = int(np.argmax(per_element))
+    return float(per_element[k]), k
+
+
+def max_principal_strain(F: np.ndarray, measure: StrainMeasure | str) -> tuple[float, int]:
+    """(largest max(|eps_1|, |eps_2|) over the elements, its element) in ``measure``."""
+    return _largest(principal_strains(F, measure))
+
+
+def max_principal_strains(F: np.ndarray) -> dict[StrainMeasure, float]:
+    """Largest absolute principal strain of the elements in every measure, by measure."""
+    H = np.asarray(F, float) - np.eye(2)
+    e = _green_lagrange(H)
+    return {m: _largest(_small(H) if m == StrainMeasure.SMALL else _of_stretch(e, m))[0]
+            for m in StrainMeasure}

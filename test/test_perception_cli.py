@@ -1,0 +1,114 @@
+# Copyright 2026 squeeze_grasp_ros developers
+# SPDX-License-Identifier: Apache-2.0
+"""The ``render`` and ``outline`` verbs as a user runs them: a scene's object rendered into
+PNG/NPY files with the shipped camera calibration, read back as a scene polygon that meshes,
+and bad input ending in one line with exit code 2.
+"""
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+import yaml
+
+from perception_support import skimage_or_skip
+from squeeze_grasp_ros import cli
+from squeeze_grasp_ros.mechanics.elastic.shapes import load_outline
+from squeeze_grasp_ros.resources import config_dir, scene_file
+from squeeze_grasp_ros.scene import build_mesh, build_outline, load_scene, parse_scene
+
+CAMERA = ["--camera-info", str(config_dir() / "examples" / "camera_top.yaml"),
+          "--camera-pose", "0.004", "-0.003", "0.5", "3.1", "0.03", "0.4"]
+
+
+def run_json(capsys, argv):
+    code = cli.main([*argv, "--json"])
+    return code, json.loads(capsys.readouterr().out)
+
+
+def test_render_then_outline_gives_back_the_scene_object(tmp_path, capsys):
+    skimage_or_skip()
+    mask, depth = tmp_path / "mask.png", tmp_path / "depth.png"
+    scene = scene_file("nonconvex_blob")
+    code, rendered = run_json(capsys, ["render", str(scene), *CAMERA, "--mask", str(mask),
+                                       "--depth", str(depth)])
+    assert code == 0 and not rendered["touches_border"]
+    true = build_outline(load_scene(scene).object.shape)
+    for image, extra in ((mask, ["--object-height", "0.0254"]), (depth, [])):
+        out = tmp_path / f"{image.stem}.yaml"
+        code, found = run_json(capsys, ["outline", str(image), *CAMERA, *extra,
+                                        "--output", str(out), "--plot",
+                                        str(tmp_path / f"{image.stem}_plot.png")])
+        assert code == 0
+        assert found["area_m2"] == pytest.approx(true.area, rel=0.005)
+        assert (tmp_path / f"{image.stem}_plot.png").stat().st_size > 10_000
+        shape = yaml.safe_load(out.read_text())["shape"]
+        data = yaml.safe_load(scene.read_text())
+        data["object"]["shape"] = shape
+        data["fingers"] = {"F1": {"tip_radius": 0.015, "placement": {"angle_deg": 180}},
+                           "F2": {"tip_radius": 0.015, "placement": {"angle_deg": 0}}}
+        mesh = build_mesh(parse_scene(data))
+        assert mesh.n > 500
+
+
+def test_a_ring_comes_back_with_its_hole_as_json_outline_file(tmp_path, capsys):
+    skimage_or_skip()
+    depth = tmp_path / "ring.npy"
+    assert cli.main(["render", str(scene_file("ring_ring")), *CAMERA, "--depth",
+                     str(depth)]) == 0
+    assert "depth: " in capsys.readouterr().out
+    assert np.load(depth).dtype == np.float32
+    out = tmp_path / "ring.json"
+    code, found = run_json(capsys, ["outline", str(depth), *CAMERA, "--output", str(out)])
+    assert code == 0 and found["holes"] == 1 and found["encoding"] == "32FC1"
+    assert len(load_outline(out).holes) == 1  # the outline file keeps the hole
+
+
+@pytest.mark.parametrize("argv, message", [
+    (["--camera-pose", "0", "0", "0.5"], "--camera-pose takes 6 numbers"),
+    (["--camera-pose", "0", "0", "-0.5", "3.1", "0", "0"], "above the support plane"),
+    (["--encoding", "16UC1"], "must hold uint16"),
+])
+def test_bad_input_exits_2_with_one_line(tmp_path, capsys, argv, message):
+    mask = tmp_path / "mask.npy"
+    np.save(mask, np.zeros((480, 640), np.uint8))
+    pose = argv if argv[0] == "--camera-pose" else CAMERA[2:]
+    extra = [] if argv[0] == "--camera-pose" else argv
+    code = cli.main(["outline", str(mask), *CAMERA[:2], *pose, *extra])
+    err = capsys.readouterr().err
+    assert code == 2 and message in err and len(err.strip().splitlines()) == 1
+
+
+def test_an_empty_mask_and_a_colour_png_are_refused(tmp_path, capsys):
+    skimage_or_skip()
+    from PIL import Image
+
+    empty, colour = tmp_path / "empty.png", tmp_path / "colour.png"
+    Image.fromarray(np.zeros((480, 640), np.uint8)).save(empty)
+    Image.fromarray(np.zeros((480, 640, 3), np.uint8)).save(colour)
+    assert cli.main(["outline", str(empty), *CAMERA]) == 2
+    assert "no object in view" in capsys.readouterr().err
+    assert cli.main(["outline", str(colour), *CAMERA]) == 2
+    assert "mode RGB" in capsys.readouterr().err
+
+
+def test_scene_polygons_take_holes_and_refuse_bad_ones():
+    """A non-convex hole (its vertex mean lies outside it) meshes to the exact area; a hole
+    crossing the polygon is refused naming it.
+    """
+    base = yaml.safe_load(scene_file("foam_square").read_text())
+    hole = [[-0.03, -0.03], [0.03, -0.03], [0.03, 0.03], [0.0, -0.01], [-0.03, 0.03]]
+    base["object"]["shape"] = {"type": "polygon",
+                               "points": [[-0.05, -0.05], [0.05, -0.05], [0.05, 0.05],
+                                          [-0.05, 0.05]], "holes": [hole]}
+    mesh = build_mesh(parse_scene(base))
+    a, b, c = (mesh.nodes[mesh.triangles[:, k]] for k in range(3))
+    area = 0.5 * np.abs((b - a)[:, 0] * (c - a)[:, 1] - (b - a)[:, 1] * (c - a)[:, 0]).sum()
+    assert len(mesh.inner_boundaries) == 1 and area == pytest.approx(0.01 - 0.0024, rel=1e-9)
+    base["object"]["shape"]["holes"] = [[[0.04, 0.0], [0.07, 0.0], [0.05, 0.02]]]
+    with pytest.raises(Exception, match=r"polygon.holes\[0\] must lie strictly inside"):
+        build_mesh(parse_scene(base))
+    base["object"]["shape"]["holes"] = [[1, 2]]
+    with pytest.raises(Exception, match=r"object.shape.holes\[0\] must be a list of \[x, y\]"):
+        parse_scene(base)

@@ -276,3 +276,15 @@ def test_the_scene_package_sits_below_the_other_application_parts():
     bad = sorted(f"{m} -> {t}" for m in GRAPH if top(m) == "scene"
                  for t in internal(GRAPH[m]) if t != NAME and top(t) not in allowed)
     assert not bad, "\n".join(bad)
+
+
+def test_no_verb_imports_another_verb():
+    """Verbs share helpers (``commands/common.py``, ``commands/ring_map.py``, ...) and the
+    application layer, never each other (``graspmap`` used to import ``ring``).
+    """
+    from squeeze_grasp_ros.commands import VERBS
+
+    verbs = {f"{NAME}.commands.{v}" for v in VERBS}
+    bad = sorted(f"{m} -> {t}" for m in verbs for t in GRAPH[m] if t in verbs - {m})
+    assert not bad, "\n".join(bad)
+    assert f"{NAME}.commands.ring_map" in GRAPH[f"{NAME}.commands.graspmap"]

@@ -60,6 +60,10 @@ setup(
         "ros": ROS_WHEELS + ["mcap>=1.1"],
         # squeeze-grasp sweep: Dask distributed runs the tasks, pyarrow writes the Parquet dataset
         "sweep": ["dask[distributed]>=2024.1", "pyarrow>=14"],
+        # supernodal Cholesky of the interior tangent (SuiteSparse CHOLMOD through cvxopt,
+        # GPL-3.0): about 5x faster factorisations of large nonlinear objects than QDLDL, in
+        # METIS's nested-dissection order (pymetis, MIT)
+        "cholmod": ["cvxopt>=1.3", "pymetis>=2023.1"],
         # squeeze-grasp outline: sub-pixel contours (marching squares) of masks and depth images
         "perception": ["scikit-image>=0.22"],
         "test": [
@@ -72,6 +76,9 @@ setup(
             "colcon-common-extensions>=0.3",
             # the linter test (test/test_lint.py): flake8 and pep257 checks in one tool
             "ruff>=0.5",
+            # both factorisers of the interior tangent are tested (test/test_tangent_factor.py)
+            "cvxopt>=1.3",
+            "pymetis>=2023.1",
         ],
     },
     zip_safe=True,

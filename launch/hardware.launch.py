@@ -5,7 +5,7 @@
     ros2 launch squeeze_grasp_ros hardware.launch.py mu:=0.4 record:=/data/run1
 
 The drivers (Barrett hand, Cobra arm, pusher, fingertip F/T and tactile sensors) provide and
-accept the topics of the hardware contract (README.md, "Hardware contract"):
+accept the topics of the hardware contract (docs/pipeline.md, "Hardware contract"):
 ``devices/<device>/pose``, ``wrench``, ``tactile`` with sensor-data QoS and
 ``devices/<device>/setpoint`` (reliable). The
 nodes run on wall-clock timers (``lockstep: false``) on the newest readings; there is no

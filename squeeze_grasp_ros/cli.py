@@ -11,6 +11,7 @@ import os
 import sys
 from typing import Any
 
+from squeeze_grasp_ros import plots
 from squeeze_grasp_ros.commands import VERBS
 from squeeze_grasp_ros.commands.common import fail
 from squeeze_grasp_ros.exit_codes import ExitCode
@@ -26,8 +27,9 @@ def build_parser() -> argparse.ArgumentParser:
         description="Squeeze grasps of deformable planar objects (Jia, Guo, Lin, IJRR 2014). "
                     "SI units throughout. Scene format: `squeeze-grasp scene-help`.",
         epilog="exit status: 0 done; 1 negative outcome (grasp failed in the world, replay "
-               "differs); 2 invalid input; 4 pipeline or environment failure (e.g. ROS not "
-               "installed); 130 interrupted (Ctrl-C)")
+               "differs); 2 invalid input; 3 a solver failed (the message carries its "
+               "residuals); 4 pipeline or environment failure (e.g. ROS not installed); 130 "
+               "interrupted (Ctrl-C); 143 terminated (SIGTERM)")
     sub = parser.add_subparsers(dest="verb", metavar="VERB", required=True)
     for name in VERBS:
         module = importlib.import_module(f".commands.{name}", __package__)
@@ -71,6 +73,7 @@ def main(argv: list[str] | None = None) -> int:
     "code_name"}``.
     """
     args = build_parser().parse_args(argv)
+    written = len(plots.WRITTEN)
     try:
         result = args._module.run(args)
     except SqueezeGraspError as exc:
@@ -92,7 +95,9 @@ def main(argv: list[str] | None = None) -> int:
                 clean["non_finite"] = bad
             sys.stdout.write(json.dumps(clean, allow_nan=False) + "\n")
         else:
-            print(args._module.summary(result))
+            text = args._module.summary(result)
+            pictures = [f"plot: {p}" for p in plots.WRITTEN[written:] if p not in text]
+            print("\n".join([text, *pictures]) if text else "\n".join(pictures))
         sys.stdout.flush()
     except BrokenPipeError:  # the reader (e.g. `| head`) closed the pipe: not an error
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
@@ -100,4 +105,6 @@ def main(argv: list[str] | None = None) -> int:
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    from squeeze_grasp_ros.entry import cli
+
+    sys.exit(cli())  # as the console script: signals while starting end with one line

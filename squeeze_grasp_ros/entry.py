@@ -9,25 +9,28 @@ changes nothing.
 from __future__ import annotations
 
 import importlib
+import signal
 import sys
 
-from squeeze_grasp_ros.exit_codes import ExitCode
+from squeeze_grasp_ros.exit_codes import raise_on_signals
 from squeeze_grasp_ros.threads import single_thread_blas
 
 __all__ = ["cli", "executor", "monitor", "planner", "recorder", "sim_hardware"]
 
 
 def _run(module: str, name: str):
-    """Run ``module.main()``; a Ctrl-C that nothing inside handled (while the program is still
-    importing numpy, ROS or Dask, say) ends with one line naming ``name`` and exit 130, not a
-    traceback.
+    """Run ``module.main()``; a Ctrl-C, SIGTERM or SIGHUP that nothing inside handled (while the
+    program is still importing numpy, ROS or Dask, say) ends with one line naming ``name`` and
+    exit 128 + the signal number (130, 143, 129), not a traceback or a silent kill.
     """
     single_thread_blas()
+    raise_on_signals()
     try:
         return importlib.import_module(module).main()
-    except KeyboardInterrupt:
-        print(f"\n{name}: interrupted", file=sys.stderr)
-        return int(ExitCode.INTERRUPTED)
+    except KeyboardInterrupt as exc:
+        signum = getattr(exc, "signum", signal.SIGINT)
+        print(f"\n{name}: stopped by {signal.Signals(signum).name}", file=sys.stderr)
+        return 128 + int(signum)
 
 
 def cli():

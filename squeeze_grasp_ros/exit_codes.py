@@ -12,9 +12,10 @@ The codes say who has to act: the user (``USAGE``), nobody because physics said 
 """
 from __future__ import annotations
 
+import signal
 from enum import IntEnum
 
-__all__ = ["ExitCode"]
+__all__ = ["ExitCode", "Interrupted", "raise_on_signals"]
 
 
 class ExitCode(IntEnum):
@@ -46,3 +47,26 @@ class ExitCode(IntEnum):
     INTERNAL = 4
     INTERRUPTED = 130
     TERMINATED = 143
+
+
+class Interrupted(KeyboardInterrupt):
+    """A command stopped by a signal; ``signum`` says which (exit status 128 + ``signum``)."""
+
+    def __init__(self, signum: int) -> None:
+        super().__init__(signal.Signals(signum).name)
+        self.signum = int(signum)
+
+
+def raise_on_signals() -> dict:
+    """Make SIGTERM and SIGHUP raise :class:`Interrupted`, as Ctrl-C raises KeyboardInterrupt.
+
+    Installed first thing by the console scripts (and by ``squeeze-grasp run``), so a signal
+    that arrives while the program is still importing or starting ends it with one line and
+    128 + the signal number instead of the default action (killed, exit -15, no message).
+    Code that must not be cut in half (a run's recording) installs flag-setting handlers of
+    its own over these. Returns the handlers it replaced (signal number -> handler).
+    """
+    def stop(signum: int, _frame: object) -> None:
+        raise Interrupted(signum)
+
+    return {signum: signal.signal(signum, stop) for signum in (signal.SIGTERM, signal.SIGHUP)}

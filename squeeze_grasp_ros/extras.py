@@ -11,12 +11,14 @@ traceback.
 True
 >>> install_hint("numpy") is None
 True
+>>> install_hint("qdldl").startswith("pip install qdldl")
+True
 """
 from __future__ import annotations
 
 import importlib.util
 
-__all__ = ["EXTRAS", "install_hint", "installed"]
+__all__ = ["EXTRAS", "REQUIRED", "install_hint", "installed"]
 
 EXTRAS: dict[str, tuple[tuple[str, ...], str]] = {
     "ros": (("rclpy", "squeeze_grasp_interfaces", "mcap", "ament_index_python", "std_msgs",
@@ -25,9 +27,18 @@ EXTRAS: dict[str, tuple[tuple[str, ...], str]] = {
             "pip install '.[ros]' && squeeze-grasp ros-setup (or source a ROS 2 Jazzy "
             "workspace with squeeze_grasp_interfaces built)"),
     "sweep": (("dask", "distributed", "pyarrow"), "pip install '.[sweep]'"),
+    "cholmod": (("cvxopt", "pymetis"),
+                "pip install '.[cholmod]' (CHOLMOD through cvxopt, GPL-3.0; METIS: pymetis)"),
     "perception": (("skimage",), "pip install '.[perception]'"),
 }
 """Extra -> (top-level modules it provides, how to install it)."""
+
+REQUIRED: dict[str, str] = {
+    "qdldl": "pip install qdldl (a required dependency of the corotational and neo-Hookean "
+             "models that pip installs with the package; on the colcon route it has no rosdep "
+             "key, see docs/ros.md)",
+}
+"""Required modules imported only where they are needed -> how to install them."""
 
 
 def installed(module: str) -> bool:
@@ -41,4 +52,5 @@ def installed(module: str) -> bool:
 def install_hint(module: str) -> str | None:
     """How to install the extra that provides top-level ``module`` (None: not an extra's)."""
     root = module.split(".")[0]
-    return next((how for modules, how in EXTRAS.values() if root in modules), None)
+    return REQUIRED.get(root) or next(
+        (how for modules, how in EXTRAS.values() if root in modules), None)

@@ -17,6 +17,7 @@ InputError: scene: YAML aliases (*name) are not accepted (line 2, column 4)
 from __future__ import annotations
 
 import os
+import stat
 from collections.abc import Iterable
 from pathlib import Path
 from typing import Any
@@ -67,10 +68,48 @@ def load_yaml(text: str, *, what: str, max_bytes: int = MAX_TEXT_BYTES) -> Any:
         raise InputError(f"{what}: invalid YAML{where}: {exc.problem}") from None
     except yaml.YAMLError:
         raise InputError(f"{what}: invalid YAML") from None
+    except RecursionError:
+        raise InputError(f"{what}: YAML nested too deeply") from None
+
+
+def read_bytes(path: str | Path, *, what: str, max_bytes: int = MAX_FILE_BYTES) -> bytes:
+    """The bytes of a regular file, read up to ``max_bytes``.
+
+    The file is opened without blocking and checked on the open descriptor, so a FIFO, a device
+    or a folder is refused at once (a FIFO named like a manifest used to hang the reader in
+    ``open()``), and a sparse file of gigabytes is refused after ``max_bytes + 1`` bytes.
+
+    Raises
+    ------
+    InputError
+        Missing, not a regular file, unreadable or too large.
+    """
+    path = Path(path)
+    try:
+        fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK | getattr(os, "O_CLOEXEC", 0))
+    except FileNotFoundError:
+        raise InputError(f"{what} file not found: {path}") from None
+    except OSError as exc:
+        raise InputError(f"{what} file cannot be read: {path} ({exc.strerror})") from None
+    try:
+        info = os.fstat(fd)
+        if not stat.S_ISREG(info.st_mode):
+            raise InputError(f"{what} path is not a regular file: {path}")
+        if info.st_size > max_bytes:
+            raise InputError(f"{what} file is larger than the {max_bytes}-byte limit: {path}")
+        with os.fdopen(os.dup(fd), "rb") as fh:
+            data = fh.read(max_bytes + 1)
+    except OSError as exc:
+        raise InputError(f"{what} file cannot be read: {path} ({exc.strerror})") from None
+    finally:
+        os.close(fd)
+    if len(data) > max_bytes:
+        raise InputError(f"{what} file is larger than the {max_bytes}-byte limit: {path}")
+    return data
 
 
 def read_text(path: str | Path, *, what: str, max_bytes: int = MAX_FILE_BYTES) -> str:
-    """The UTF-8 text of a regular file, read up to ``max_bytes``.
+    """The UTF-8 text of a regular file, read up to ``max_bytes`` (:func:`read_bytes`).
 
     Raises
     ------
@@ -82,29 +121,6 @@ def read_text(path: str | Path, *, what: str, max_bytes: int = MAX_FILE_BYTES) -
         return data.decode("utf-8")
     except UnicodeDecodeError as exc:
         raise InputError(f"{what} file is not UTF-8 text (byte {exc.start}): {path}") from None
-
-
-def read_bytes(path: str | Path, *, what: str, max_bytes: int = MAX_FILE_BYTES) -> bytes:
-    """The bytes of a regular file, read up to ``max_bytes``.
-
-    Raises
-    ------
-    InputError
-        Missing, not a regular file, unreadable or too large.
-    """
-    path = Path(path)
-    if not path.exists():
-        raise InputError(f"{what} file not found: {path}")
-    if not path.is_file():
-        raise InputError(f"{what} path is not a regular file: {path}")
-    try:
-        with path.open("rb") as fh:
-            data = fh.read(max_bytes + 1)
-    except OSError as exc:
-        raise InputError(f"{what} file cannot be read: {path} ({exc.strerror})") from None
-    if len(data) > max_bytes:
-        raise InputError(f"{what} file is larger than the {max_bytes}-byte limit: {path}")
-    return data
 
 
 def confine(path: str | Path, roots: Iterable[str | Path], *, what: str) -> Path:

@@ -9,6 +9,7 @@ from typing import Sequence
 import numpy as np
 
 from squeeze_grasp_ros.mechanics.elastic.mesh import Mesh
+from squeeze_grasp_ros.outputs import write_atomically
 
 
 def figure(ncols: int = 1, nrows: int = 1, size: float = 4.2):
@@ -22,22 +23,50 @@ def figure(ncols: int = 1, nrows: int = 1, size: float = 4.2):
     return fig, axes.ravel()
 
 
+WRITTEN: list[str] = []
+"""Every file :func:`save` wrote in this process, in order (the CLI names them)."""
+
+
 def save(fig, path: str | Path) -> str:
-    """Write ``fig`` to ``path`` (PNG, 150 dpi), close it and return the path."""
+    """Write ``fig`` to ``path`` (PNG, 150 dpi, replaced atomically; the bounding box grows to
+    hold legends placed outside the axes), close it and return the path; a failed write raises
+    :func:`~squeeze_grasp_ros.outputs.output_error`.
+    """
     import matplotlib.pyplot as plt
 
     fig.tight_layout()
-    fig.savefig(path, dpi=150)
-    plt.close(fig)
+    try:
+        write_atomically(path, lambda tmp: fig.savefig(tmp, dpi=150, format="png",
+                                                       bbox_inches="tight"), "plot")
+    finally:
+        plt.close(fig)
+    WRITTEN.append(str(path))
     return str(path)
 
 
+def legend(ax, ncol: int = 3, **options) -> None:
+    """A legend below ``ax`` (clear of its tick labels and x label), outside the data, in
+    ``ncol`` columns.
+    """
+    from matplotlib.transforms import offset_copy
+
+    handles, _ = ax.get_legend_handles_labels()
+    if handles:
+        below = offset_copy(ax.transAxes, fig=ax.figure, y=-34, units="points")
+        ax.legend(**({"loc": "upper center", "bbox_to_anchor": (0.5, 0.0),
+                      "bbox_transform": below, "ncol": ncol, "fontsize": 8,
+                      "frameon": False} | options))
+
+
 def draw_outline(ax, mesh: Mesh, displacement: np.ndarray | None = None, **style) -> None:
-    """Draw the outer and inner boundary loops, displaced by ``displacement`` (n, 2) m if given."""
+    """Draw the outer and inner boundary loops, displaced by ``displacement`` (n, 2) m if given
+    (a ``label`` in ``style`` names the outer loop only).
+    """
     pts = mesh.nodes if displacement is None else mesh.nodes + displacement
-    for loop in (mesh.boundary, *mesh.inner_boundaries):
+    for k, loop in enumerate((mesh.boundary, *mesh.inner_boundaries)):
         closed = np.append(loop, loop[0])
-        ax.plot(pts[closed, 0], pts[closed, 1], **({"color": "k", "lw": 1.2} | style))
+        ax.plot(pts[closed, 0], pts[closed, 1],
+                **({"color": "k", "lw": 1.2} | style | ({"label": None} if k else {})))
     ax.set_aspect("equal")
     ax.set_xlabel("x [m]")
     ax.set_ylabel("y [m]")

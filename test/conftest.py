@@ -83,3 +83,18 @@ def ros_context() -> Iterator[Context]:
         yield context
     finally:
         context.try_shutdown()
+
+
+@pytest.fixture
+def planner(ros_context: Context) -> Iterator:
+    """A planner and a client on one executor spun by the test thread (a
+    :class:`planner_support.Harness`); afterwards no worker thread is left.
+    """
+    from planner_support import Harness, planner_threads
+
+    harness = Harness(ros_context)
+    try:
+        yield harness
+    finally:
+        harness.close()
+    assert planner_threads() == []

@@ -4,7 +4,7 @@
 
 ``test/js/`` holds the decoder script and a ``package.json`` pinning the libraries; both are
 copied into a cache folder outside the repository, where ``npm install`` fetches the libraries
-once (the npm registry must be reachable the first time).
+once (the npm registry must be reachable the first time; offline, the check skips and says so).
 """
 from __future__ import annotations
 
@@ -32,9 +32,13 @@ def foxglove_decoder() -> Path:
     installed = CACHE / "package.json"
     if not installed.is_file() or installed.read_text() != manifest \
             or not (CACHE / "node_modules").is_dir():
+        done = subprocess.run([npm, "install", "--no-audit", "--no-fund", "--loglevel=error"],
+                              cwd=CACHE, capture_output=True, text=True, timeout=300)
+        if done.returncode != 0:
+            pytest.skip(f"npm install of Foxglove's MCAP libraries into {CACHE} failed (offline? "
+                        f"the npm registry must be reachable once): "
+                        f"{done.stderr.strip().splitlines()[-1:]}")
         installed.write_text(manifest)
-        subprocess.run([npm, "install", "--no-audit", "--no-fund", "--loglevel=error"],
-                       cwd=CACHE, check=True, capture_output=True, timeout=300)
     script = CACHE / "decode_mcap.mjs"
     shutil.copyfile(JS_DIR / "decode_mcap.mjs", script)
     return script

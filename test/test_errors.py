@@ -102,3 +102,15 @@ def test_the_mechanics_use_no_exception_for_control_flow():
     offenders = [hit for p in MECHANICS.rglob("*.py") for hit in caught_package_errors(p)]
     assert offenders == []
     assert caught_package_errors(REPO / "squeeze_grasp_ros" / "cli.py")  # the check can fail
+
+
+def test_help_lists_every_exit_code():
+    """``squeeze-grasp --help`` names every exit status the program can return."""
+    import re
+
+    from squeeze_grasp_ros.cli import build_parser
+    from squeeze_grasp_ros.exit_codes import ExitCode
+
+    epilog = build_parser().epilog
+    listed = {int(n) for n in re.findall(r"(?:^|; |: )(\d+) ", epilog)}
+    assert listed == {int(code) for code in ExitCode}

@@ -355,7 +355,8 @@ def send_and_wait(harness: Harness, calls: list, timeout: float = 120.0) -> list
 def test_thirty_concurrent_requests_all_get_an_answer(planner):
     """30 clients send one load each at once: every one is answered, loaded or BUSY beyond
     max_pending (16). With rclpy's default queue depth of 10, 20 of them went unanswered; the
-    depth is now the service_queue_depth parameter (100).
+    queues now keep every request (planner parameter service_queue_depth 0; bursts of 200:
+    test_planner_clients.py).
     """
 
     def scene(k: int) -> str:  # distinct meshes: no request is a cache hit
@@ -445,8 +446,9 @@ def test_quick_requests_are_answered_while_a_long_one_runs(planner):
 
 def test_a_long_request_whose_client_leaves_is_stopped(planner):
     """ROS 2 services have no cancel: a client that gives up and destroys its client leaves
-    the graph, and the planner stops that request's work at its next progress report instead
-    of computing an answer nobody can take; later requests are served as before.
+    the graph, and the planner stops that request's work at its next progress report or
+    stepper substep instead of computing an answer nobody can take; later requests are served
+    as before.
     """
     from squeeze_grasp_interfaces.srv import EventSqueeze, PlanSqueeze
 
@@ -463,10 +465,9 @@ def test_a_long_request_whose_client_leaves_is_stopped(planner):
     node.destroy_client(slow)
     while planner.planner._pending:
         planner.executor.spin_once(0.05)
-    assert len(planner.planner.abandoned) == 1
-    (fraction,) = planner.planner.abandoned[0]
-    print(f"stopped at {100 * fraction:.1f} % of the squeeze")
-    assert fraction < 1.0
+    (progress,) = planner.planner.abandoned  # the last progress report before it stopped
+    print(f"stopped after the progress report {progress}")
+    assert progress == () or progress[0] < 1.0  # stepper substeps are checkpoints too
     quick = planner.call(PlanSqueeze, "plan_squeeze",
                          PlanSqueeze.Request(object_id="blob", squeeze_type="stable"))
     assert quick.success

@@ -7,8 +7,8 @@ The layers, lowest first, are the ones docs/design.md draws:
 - base: ``inputs``, ``exit_codes``, ``extras``, ``resources``, ``threads``: no package imports;
 - ``mechanics``: the ROS-free core, inside it ``vocabulary``/``errors`` < ``elastic`` <
   ``squeeze`` < ``resistance``, ``ring``; ``calibration`` stands alone;
-- application: ``scene``, ``planning``, ``control``, ``sim``, ``plots``, ``sweep``,
-  ``perception`` and the front door ``api``;
+- application: ``scene``, ``planning``, ``control``, ``sim``, ``plots``, ``outputs``,
+  ``sweep``, ``perception`` and the front door ``api``;
 - ``ros``: the only folder that imports rclpy, ROS messages or the interfaces;
 - front ends: ``commands``, ``bench``, ``cli``, ``entry``.
 
@@ -31,7 +31,7 @@ ROS_MODULES = ("rclpy", "rosidl", "rcl_interfaces", "builtin_interfaces", "std_m
 LAYERS: tuple[tuple[str, ...], ...] = (
     ("inputs", "exit_codes", "extras", "resources", "threads"),
     ("mechanics",),
-    ("scene", "planning", "control", "sim", "plots", "sweep", "perception", "api"),
+    ("scene", "planning", "control", "sim", "plots", "outputs", "sweep", "perception", "api"),
     ("ros",),
     ("commands", "bench", "cli", "entry"),
 )

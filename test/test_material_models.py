@@ -247,7 +247,9 @@ def test_internal_forces_against_scikit_fem(patch):
     """The internal force of each law, assembled independently by scikit-fem's P1 basis from the
     law's stress P(F): the same vector.
     """
-    skfem = pytest.importorskip("skfem")
+    skfem = pytest.importorskip(
+        "skfem", reason="scikit-fem (the independent FEM cross-check) is not installed: "
+                        "pip install scikit-fem")
     from skfem.helpers import ddot, grad
 
     m = skfem.MeshTri(patch.nodes.T.copy(), patch.triangles.T.copy())

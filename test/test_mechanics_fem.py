@@ -64,7 +64,9 @@ def test_rigid_modes_are_in_the_null_space():
 
 
 def test_stiffness_matches_scikit_fem_plane_stress():
-    skfem = pytest.importorskip("skfem")
+    skfem = pytest.importorskip(
+        "skfem", reason="scikit-fem (the independent FEM cross-check) is not installed: "
+                        "pip install scikit-fem")
     from skfem.models.elasticity import linear_elasticity
 
     mesh = blob_mesh(150)

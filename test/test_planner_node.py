@@ -7,7 +7,6 @@ action beside a quick service, cancel, parameters from YAML and a clean shutdown
 
 from __future__ import annotations
 
-from collections.abc import Iterator
 from pathlib import Path
 
 import numpy as np
@@ -61,17 +60,6 @@ from squeeze_grasp_ros.mechanics.vocabulary import MaterialModel
 
 REPO = Path(__file__).resolve().parents[1]
 RESIST_FIG10 = (REPO / "config" / "scenes" / "resist_fig10.yaml").read_text()
-
-
-@pytest.fixture
-def planner(ros_context: Context) -> Iterator[Harness]:
-    """A planner and a client on one executor spun by the test thread."""
-    harness = Harness(ros_context)
-    try:
-        yield harness
-    finally:
-        harness.close()
-    assert planner_threads() == []
 
 
 def variant(text: str, path: tuple[str, ...], value: object) -> str:

@@ -159,8 +159,9 @@ def load_object_cases(draw: st.DrawFn) -> Case:
     object_id = draw(st.sampled_from(["fuzz1", "fuzz2"]))
     if kind == "small":
         data["object"]["mesh"] = {"nodes": draw(st.integers(20, 120))}
-        return Case("load_object", LoadObject,
-                    LoadObject.Request(scene_yaml=scene_text(data), object_id=object_id))
+        return Case("load_object", LoadObject,  # a client reloading its id with a new scene
+                    LoadObject.Request(scene_yaml=scene_text(data), object_id=object_id,
+                                       replace=True))
     if kind == "bad scene":
         path = draw(st.sampled_from(sorted(BAD_SCENE_FIELDS)))
         strategy, reason = BAD_SCENE_FIELDS[path]

@@ -124,6 +124,43 @@ def test_object_cache_is_bounded_by_memory() -> None:
     assert info.value.code == planning.ErrorCode.INVALID_ARGUMENT and tiny.ids() == []
 
 
+MEMORY_PROBE = """
+import ctypes, gc, json, os
+from squeeze_grasp_ros import planning
+from squeeze_grasp_ros.ros.service_latency import scene_text
+
+def rss():
+    gc.collect()
+    ctypes.CDLL("libc.so.6").malloc_trim(0)  # give freed temporaries back to the system
+    return int(open("/proc/self/statm").read().split()[1]) * os.sysconf("SC_PAGE_SIZE")
+
+source = planning.read_scene(scene_text(10000), "")
+limits = planning.PlannerLimits()
+key = planning.object_key(source, "probe", "", limits)
+before = rss()
+loaded = planning.load_object(source, key, limits)
+grown = rss() - before
+counted = planning.resident_bytes(loaded.body)
+del loaded
+print(json.dumps({"grown": grown, "freed": before + grown - rss(), "counted": counted}))
+"""
+
+
+def test_the_object_cache_counts_what_an_object_really_holds() -> None:
+    """An independent measure: the resident memory a fresh process gains by loading a
+    10,000-node object and frees when it drops it (malloc_trim'd). Measured: 86 MB gained,
+    78 MB freed, 82 MB counted; before, the count missed the sparse copies of L and U that
+    scipy's SuperLU keeps once read (46 MB counted; the issue: 389 MiB counted, 669 MiB held).
+    """
+    import json
+    import subprocess
+    import sys
+
+    probe = json.loads(subprocess.run([sys.executable, "-c", MEMORY_PROBE], check=True,
+                                      capture_output=True, text=True).stdout)
+    assert 0.8 * probe["freed"] < probe["counted"] < 1.2 * probe["grown"], probe
+
+
 def test_requested_nodes_are_known_before_meshing() -> None:
     assert planning.requested_nodes(scene_of(BLOB)) == 300
     assert planning.requested_nodes(scene_of(RING)) == 80

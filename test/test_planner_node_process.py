@@ -22,13 +22,14 @@ from rcl_interfaces.srv import GetParameters
 from rclpy.context import Context
 from rclpy.parameter import parameter_value_to_python
 
+from executables import script
 from planner_support import BLOB, Harness, flat, solid_of
 from squeeze_grasp_interfaces.srv import LoadObject, PlanSqueeze
 from squeeze_grasp_ros.mechanics.squeeze.stable_pure import plan_squeeze
 
 REPO = Path(__file__).resolve().parents[1]
 COMMANDS = {
-    "console script": [str(Path(sys.executable).parent / "planner")],
+    "console script": [script("planner")],
     "python -m": [sys.executable, "-m", "squeeze_grasp_ros.ros.nodes.planner"],
 }
 ATTEMPTS, TIMEOUT = 3, 20.0

@@ -193,6 +193,11 @@ def test_shipped_viewers_show_what_a_recording_holds(default_bag):
     for value in paths:
         topic, _, field = value.partition(".")
         assert isinstance(resolve(messages[topic], field), float), value
+    # every plotted topic is a curve: it has a message per tick (executor/status, with one
+    # message per state change, drew the "commanded depth" as a straight line)
+    counts = channel_counts(default_bag)
+    plotted = {value.partition(".")[0] for value in paths}
+    assert min(counts[topic] for topic in plotted) >= 500, counts
     topics = [t for c in panels.values() for t in c.get("topics", {})]
     topics += [c["topicPath"] for c in panels.values() if "topicPath" in c]
     assert set(topics) <= set(messages)

@@ -265,8 +265,18 @@ def test_missing_prerequisites_are_named(tmp_path: Path, monkeypatch) -> None:
 
 def test_main_fails_clearly_outside_a_venv(monkeypatch, capsys) -> None:
     monkeypatch.setattr(sys, "prefix", sys.base_prefix)
-    assert ros_setup.main(["--check"]) == 1
+    assert ros_setup.main(["--check"]) == 4  # the environment failed: the exit table's 4
     assert "not running in a virtual environment" in capsys.readouterr().err
+
+
+def test_a_missing_cmake_exits_4_with_the_install_line(monkeypatch, capsys) -> None:
+    real_which = shutil.which
+    monkeypatch.setattr(shutil, "which", lambda name, *a, **k: None if name == "cmake"
+                        else real_which(name, *a, **k))
+    assert ros_setup.main([]) == 4
+    err = capsys.readouterr().err.strip().splitlines()
+    assert err == ["ros-setup: error: cmake not found on PATH: install it (e.g. apt-get install "
+                   "cmake)"]
 
 
 # --------------------------------------------------------------------------- idempotence
@@ -288,7 +298,7 @@ def test_second_run_is_a_no_op(capsys) -> None:
     assert ros_setup.main(["--check"]) == 0
 
 
-def test_changed_interface_sources_are_detected(tmp_path: Path, capsys) -> None:
+def test_changed_interface_sources_are_detected(tmp_path: Path) -> None:
     source = ros_setup.default_source()
     copy = tmp_path / "msg_defs"
     shutil.copytree(source, copy)
@@ -309,6 +319,12 @@ def test_changed_interface_sources_are_detected(tmp_path: Path, capsys) -> None:
     other_folder = ros_setup.build_settings(layout, copy)
     assert "settings changed" in ros_setup.rebuild_reason(stamp, other_folder, changed, True)
 
+
+@pip_route_only
+def test_check_reports_a_changed_source_folder_of_this_environment(tmp_path: Path,
+                                                                    capsys) -> None:
+    copy = tmp_path / "msg_defs"
+    shutil.copytree(ros_setup.default_source(), copy)
     assert ros_setup.main(["--check", "--source", str(copy)]) == 1
     assert "settings changed" in capsys.readouterr().out
 

@@ -139,6 +139,10 @@ NOT_DOMAIN: dict[tuple[str, str], str] = {
     ("mechanics/squeeze/events.py", "strain_limit"): "the squeeze JSON's key of its limit",
     ("commands/squeeze.py", "strain_limit"): "the squeeze JSON's key of its limit",
     ("perception/camera_info.py", "D"): "the CameraInfo field of the distortion coefficients",
+    ("extras.py", "cholmod"): "the pip extra named after CHOLMOD",
+    ("extras.py", "qdldl"): "the Python module qdldl (a required dependency)",
+    ("scene/specs.py", "adversary"): "the scene section name in a field path",
+    ("sweep/plan.py", "friction"): "the sweep's parameter axis (the spec's key)",
 }
 """Literals that spell a vocabulary word but mean something else, with what they mean."""
 NOT_COUNTED = {RingLimit.NONE.value: "the English word (messages, matplotlib colours, a world "

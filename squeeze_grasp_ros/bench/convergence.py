@@ -168,7 +168,7 @@ def run(quick: bool, out_dir: Path, progress) -> list[Table]:
     fig, (ax0, ax1) = plots.figure(2)
     ax0.loglog(times, errs, "o-")
     for n, t, e in zip((r[0] for r in rows), times, errs):
-        ax0.annotate(f"n={n}", (t, e), fontsize=7)
+        ax0.annotate(f"n={n}", (t, e), fontsize=7, xytext=(4, 4), textcoords="offset points")
     ax0.set_xlabel("time (mesh + precompute + solve) [s]")
     ax0.set_ylabel("relative error of diameter change / force")
     ax0.set_title("far field: accuracy vs time")

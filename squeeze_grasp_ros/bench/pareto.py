@@ -96,13 +96,27 @@ def run(quick: bool, out_dir: Path, progress) -> list[Table]:
     fx = sorted(front, key=lambda k: points[k][0])
     ax.loglog([points[k][0] for k in fx], [points[k][1] for k in fx], "k-", lw=1.5,
               label="Pareto front")
-    for k in fx:
-        ax.annotate(f"n={rows[k][0]}", points[k], fontsize=7)
+    labelled: set = set()
+    for k in fx:  # one label per mesh size on the front, beside its first (cheapest) point
+        if rows[k][0] not in labelled:
+            labelled.add(rows[k][0])
+            ax.annotate(f"n={rows[k][0]}", points[k], fontsize=7, xytext=(4, 4),
+                        textcoords="offset points")
     ax.set_aspect("auto")
+    # a log axis spanning about a decade labels its minor ticks, which overlap: label a few
+    # round values instead
+    from matplotlib.ticker import FixedLocator, NullFormatter, ScalarFormatter
+
+    times = [p[0] for p in points]
+    ticks = [t for t in (0.01, 0.02, 0.05, 0.1, 0.2, 0.5, 1, 2, 5, 10, 20, 50, 100)
+             if min(times) / 1.5 <= t <= max(times) * 1.5]
+    ax.xaxis.set_major_locator(FixedLocator(ticks))
+    ax.xaxis.set_major_formatter(ScalarFormatter())
+    ax.xaxis.set_minor_formatter(NullFormatter())
     ax.set_xlabel("time: mesh + precompute + squeeze [s]")
     ax.set_ylabel("max rel. error of final force and energy")
     ax.set_title("foam square, 12 % squeeze: accuracy vs time")
-    ax.legend(fontsize=8)
+    plots.legend(ax, ncol=3)
     plots.save(fig, out_dir / png)
     columns = ["nodes n", "route", "step h [L]", "event tol [L]", "time [s]", "rel. error"]
     on_front = {route: sum(1 for k in front if rows[k][1] == route)

@@ -146,10 +146,18 @@ def effect_rows(out_dir: Path, progress, repeats: int) -> list:
 
 
 def run(quick: bool, out_dir: Path, progress) -> list[Table]:
-    """Foam square end to end (recording on/off, executors, processes), loop rate, effects."""
-    out_dir = Path(out_dir)
-    out_dir.mkdir(parents=True, exist_ok=True)
-    work = Path(tempfile.mkdtemp(prefix="bench_pipeline_", dir=out_dir))
+    """Foam square end to end (recording on/off, executors, processes), loop rate, effects.
+
+    The recordings and scenes of the runs go to a temporary folder, removed afterwards (also
+    when a run fails): ``out_dir`` gets only what the report shows.
+    """
+    Path(out_dir).mkdir(parents=True, exist_ok=True)
+    with tempfile.TemporaryDirectory(prefix="bench_pipeline_") as work:
+        return _tables(quick, progress, Path(work))
+
+
+def _tables(quick: bool, progress, work: Path) -> list[Table]:
+    """The three tables of :func:`run`, with scratch files in ``work``."""
     progress("pipeline: bare mechanics (and a warm-up run)")
     foam = scene_file("foam_square")
     bare = min(bare_mechanics(foam) for _ in range(2))

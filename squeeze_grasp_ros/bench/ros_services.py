@@ -12,6 +12,8 @@ Three questions, each answered in one run:
 3. Does a long request block quick ones? A GraspMap goal that loads a large mesh runs on the
    planner's worker, first alone (the executor thread's CPU time shows whether the executor
    waits or spins), then while ``plan_squeeze`` requests keep arriving.
+4. Is every request of a burst answered? One client sends N requests (or goals) at once to the
+   planner process, with rclpy's default request queue and with the planner's keep-all one.
 
 Targets: overhead < 2 ms in one process, < 5 ms across processes, a cached stable
 squeeze request < 10 ms end to end. Without rclpy and the interfaces ``squeeze-grasp bench``
@@ -31,6 +33,7 @@ TITLE = "ROS services: round trip over the bare mechanics call"
 def run(quick: bool, out_dir: Path, progress: Callable[[str], None]) -> list[Table]:
     """Measure the three tables in one run."""
     from squeeze_grasp_ros.ros.service_latency import (
+        burst_rows,
         localhost_only,
         long_request_rows,
         overhead_rows,
@@ -41,6 +44,8 @@ def run(quick: bool, out_dir: Path, progress: Callable[[str], None]) -> list[Tab
     with localhost_only() as namespace:
         overhead, by_size = overhead_rows(namespace, sizes, count, progress)
         long_rows = long_request_rows(namespace, 8000 if quick else 20000, progress)
+        bursts = burst_rows(namespace, (10, 50, 200) if quick else (10, 50, 200, 1000),
+                            progress)
     return [
         Table(
             TITLE,
@@ -97,5 +102,27 @@ def run(quick: bool, out_dir: Path, progress: Callable[[str], None]) -> list[Tab
             "spins); then again while ~/plan_squeeze requests are sent back to back from the "
             "same process (client and planner share the executor). Target: p99 of the quick "
             "replies under 10 ms while the goal runs.",
+        ),
+        Table(
+            "ROS services: requests answered in a burst",
+            [
+                "request queue",
+                "burst N",
+                "plan_squeeze answered",
+                "plan_squeeze burst [s]",
+                "load_object answered",
+                "grasp_map goal responses",
+                "grasp_map results",
+                "all N answered",
+            ],
+            bursts,
+            "One client (keep-all queues of its own) sends N requests at once to the planner "
+            "in its own process: plan_squeeze on a cached 500-node object, load_object under "
+            "N distinct ids (at most max_pending = 16 run; the others are answered BUSY), "
+            "grasp_map goals on the cached object (beyond max_pending: accepted, then "
+            "ABORTED with BUSY). Unanswered 10 s after the last answer = lost. The planner's "
+            "parameter service_queue_depth sets its request queues (services and the "
+            "actions' goal, cancel and result services): 10 is rclpy's default, 0 (keep "
+            "all, the default) drops none.",
         ),
     ]

@@ -17,6 +17,7 @@ import os
 import shutil
 import subprocess
 import sys
+import tempfile
 import time
 from pathlib import Path
 
@@ -238,10 +239,15 @@ def scaling_tables(out: Path, nodes: int, count: int, workers: int, progress):
 
 def run(quick: bool, out_dir: Path, progress) -> list[Table]:
     """Three tables: the full sweep with its resume, scaling 1 -> 2 workers against the bare
-    loop, and where a task's time goes.
+    loop, and where a task's time goes. The specs and datasets go to a temporary folder,
+    removed afterwards.
     """
-    out = Path(out_dir) / "sweep"
-    out.mkdir(parents=True, exist_ok=True)
+    with tempfile.TemporaryDirectory(prefix="bench_sweep_") as out:
+        return _tables(quick, Path(out), progress)
+
+
+def _tables(quick: bool, out: Path, progress) -> list[Table]:
+    """The tables of :func:`run`, with scratch files in ``out``."""
     nodes, count, sub_count = (600, 4, 4) if quick else (1500, 48, 16)
     workers = os.cpu_count() or 1
     load0 = os.getloadavg()

@@ -11,6 +11,8 @@ from pathlib import Path
 
 from squeeze_grasp_ros.bench import SECTIONS, missing
 from squeeze_grasp_ros.bench.table import Table
+from squeeze_grasp_ros.commands.common import output_folder
+from squeeze_grasp_ros.outputs import write_atomically
 
 HELP = "run the benchmarks; print tables and write a Markdown report with plots"
 
@@ -20,7 +22,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--quick", action="store_true", help="smaller sizes (about 2 minutes)")
     parser.add_argument("--only", nargs="+", choices=SECTIONS, metavar="SECTION",
                         help=f"run only these sections ({', '.join(SECTIONS)})")
-    parser.add_argument("--out", default="bench_out", help="report directory (default: bench_out)")
+    parser.add_argument("--out", default="bench_out", type=output_folder,
+                        help="report directory (default: bench_out)")
 
 
 def _progress(message: str) -> None:
@@ -30,7 +33,6 @@ def _progress(message: str) -> None:
 def run(args: argparse.Namespace) -> dict:
     """Run the sections; write OUT/report.md and the plots."""
     out = Path(args.out)
-    out.mkdir(parents=True, exist_ok=True)
     tables, skipped = [], []
     for name in args.only or SECTIONS:
         absent, how = missing(name)
@@ -47,7 +49,8 @@ def run(args: argparse.Namespace) -> dict:
               f"Python {platform.python_version()}, {platform.machine()}, "
               f"{platform.processor() or 'cpu'}; times are best-of wall times in one run.\n")
     report = out / "report.md"
-    report.write_text(header + "\n" + "\n".join(t.markdown() for t in tables))
+    text = header + "\n" + "\n".join(t.markdown() for t in tables)
+    write_atomically(report, lambda tmp: tmp.write_text(text), "the report")
     return {"report": str(report),
             "tables": [{"title": t.title, "columns": list(t.columns), "rows": t.rows,
                         "notes": t.notes, "plots": list(t.plots)} for t in tables]}

@@ -11,6 +11,8 @@ from pathlib import Path
 
 from squeeze_grasp_ros.exit_codes import ExitCode
 from squeeze_grasp_ros.mechanics.elastic.compliance import ROUTES
+from squeeze_grasp_ros.mechanics.errors import SqueezeGraspError
+from squeeze_grasp_ros.outputs import output_error, probe_folder
 from squeeze_grasp_ros.scene import GraspSetup, load_scene
 
 
@@ -41,8 +43,27 @@ def add_solver_argument(parser: argparse.ArgumentParser) -> None:
                              "paper's O(n^3) eigendecomposition, for cross-checks)")
 
 
+def int_in(lo: int, hi: int):
+    """Argparse type of an integer in [lo, hi]; the error names the range."""
+
+    def parse(text: str) -> int:
+        try:
+            value = int(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"must be an integer in [{lo}, {hi}], got "
+                                             f"{text[:40]!r}") from None
+        if not lo <= value <= hi:
+            raise argparse.ArgumentTypeError(f"must be in [{lo}, {hi}], got {value}")
+        return value
+
+    parse.__name__ = "integer"
+    return parse
+
+
 def output_file(text: str) -> str:
-    """Argparse type of an output file: a path whose folder exists and that is not a folder."""
+    """Argparse type of an output file: a path whose folder exists and takes new files (probed
+    before any computation), and that is not a folder.
+    """
     path = Path(text)
     if not text:
         raise argparse.ArgumentTypeError("needs a file name")
@@ -50,6 +71,29 @@ def output_file(text: str) -> str:
         raise argparse.ArgumentTypeError(f"{text} is a folder; give a file name in it")
     if not path.resolve().parent.is_dir():
         raise argparse.ArgumentTypeError(f"the folder of {text} does not exist")
+    try:
+        probe_folder(path.resolve().parent, text)
+    except SqueezeGraspError as exc:
+        raise argparse.ArgumentTypeError(str(exc)) from None
+    return text
+
+
+def output_folder(text: str) -> str:
+    """Argparse type of an output folder (a report, plots): created if missing (with its
+    parents) and probed for new files before any computation; not a file.
+    """
+    path = Path(text)
+    if not text.strip():
+        raise argparse.ArgumentTypeError("needs a folder name")
+    if path.exists() and not path.is_dir():
+        raise argparse.ArgumentTypeError(f"{text} exists and is not a folder; give a folder")
+    try:
+        path.mkdir(parents=True, exist_ok=True)
+        probe_folder(path, text)
+    except OSError as exc:
+        raise argparse.ArgumentTypeError(str(output_error(exc, text, "the folder"))) from None
+    except SqueezeGraspError as exc:
+        raise argparse.ArgumentTypeError(str(exc)) from None
     return text
 
 

@@ -8,21 +8,27 @@ header naming the columns.
 from __future__ import annotations
 
 import csv
+import io
 from pathlib import Path
 
 import numpy as np
 
+from squeeze_grasp_ros.inputs import InputError, read_text
 from squeeze_grasp_ros.mechanics.errors import InvalidInputError
+from squeeze_grasp_ros.outputs import write_atomically
 
 
 def read_table(path: str | Path) -> tuple[list[str] | None, list[list[str]]]:
-    """(header or None, rows of cells) of a CSV file."""
+    """(header or None, rows of cells) of a CSV file (a regular file, read up to
+    :data:`~squeeze_grasp_ros.inputs.MAX_FILE_BYTES`).
+    """
     path = Path(path)
-    if not path.is_file():
-        raise InvalidInputError(f"CSV file not found: {path}")
-    with path.open(newline="") as fh:
-        rows = [[c.strip() for c in row] for row in csv.reader(fh)
-                if row and not row[0].lstrip().startswith("#") and any(c.strip() for c in row)]
+    try:
+        text = read_text(path, what="CSV")
+    except InputError as exc:
+        raise InvalidInputError(str(exc)) from None
+    rows = [[c.strip() for c in row] for row in csv.reader(io.StringIO(text, newline=""))
+            if row and not row[0].lstrip().startswith("#") and any(c.strip() for c in row)]
     if not rows:
         raise InvalidInputError(f"{path}: no data rows")
     try:
@@ -60,7 +66,8 @@ def read_columns(path: str | Path, required: tuple[str, ...],
 
 
 def write_points(path: str | Path, points: np.ndarray) -> str:
-    """Write ``x,y`` rows (m) with a header; returns the path."""
-    np.savetxt(path, np.asarray(points, float), delimiter=",", header="x,y", comments="",
-               fmt="%.10g")
+    """Write ``x,y`` rows (m) with a header, atomically; returns the path."""
+    write_atomically(path, lambda tmp: np.savetxt(tmp, np.asarray(points, float), delimiter=",",
+                                                  header="x,y", comments="", fmt="%.10g"),
+                     "CSV")
     return str(path)

@@ -53,15 +53,22 @@ def plot(obj, gmap: GraspMap, path: str) -> None:
     k = np.where(gmap.feasible, gmap.stiffness, np.nan)
     im = ax0.imshow(k, origin="lower", cmap="viridis")
     ax0.set_aspect("equal")
-    ax0.set_xlabel("boundary position j")
-    ax0.set_ylabel("boundary position i")
-    ax0.set_title(f"stable stiffness [N/m] (feasible at mu={gmap.mu})")
+    # rows and columns follow the boundary (counter-clockwise); the ticks name the mesh
+    # nodes there, the numbers the printed list and the JSON use
+    boundary = np.asarray(gmap.boundary)
+    ticks = np.unique(np.linspace(0, len(boundary) - 1, 7).round().astype(int))
+    for axis in (ax0.xaxis, ax0.yaxis):
+        axis.set_ticks(ticks, [str(n) for n in boundary[ticks]])
+    ax0.set_xlabel("node of the second contact (along the boundary)")
+    ax0.set_ylabel("node of the first contact (along the boundary)")
+    ax0.set_title(f"stable stiffness [N/m] (feasible at mu={gmap.mu})", fontsize=10)
     fig.colorbar(im, ax=ax0, shrink=0.8)
     plots.draw_outline(ax1, obj.mesh)
-    for rank, (i, j, _) in enumerate(gmap.best()):
+    for rank, (i, j, quality) in enumerate(gmap.best()):
         p = obj.mesh.nodes[[i, j]]
-        ax1.plot(p[:, 0], p[:, 1], "-o", color=f"C{rank}", ms=4, label=f"#{rank + 1}")
-    ax1.legend(fontsize=8)
+        ax1.plot(p[:, 0], p[:, 1], "-o", color=f"C{rank}", ms=4,
+                 label=f"#{rank + 1}: nodes {i}, {j} ({quality:.4g} N/m)")
+    plots.legend(ax1, ncol=2)
     ax1.set_title("stiffest feasible placements")
     plots.save(fig, path)
 

@@ -43,12 +43,13 @@ def plot(sim: np.ndarray, m: Match, path: str) -> str:
     moved = np.vstack([m.matched, m.matched[:1]])
     ax.plot(closed[:, 0], closed[:, 1], "C0.-", ms=3, lw=0.8, label="simulated")
     ax.plot(moved[:, 0], moved[:, 1], "C1.-", ms=3, lw=0.8, label="measured, matched")
-    for p, q in zip(sim, m.matched):
-        ax.plot([p[0], q[0]], [p[1], q[1]], color="C3", lw=0.6)
+    for k, (p, q) in enumerate(zip(sim, m.matched)):
+        ax.plot([p[0], q[0]], [p[1], q[1]], color="C3", lw=0.6,
+                label="error per node" if k == 0 else None)
     ax.set_aspect("equal")
     ax.set_xlabel("x [m]")
     ax.set_ylabel("y [m]")
-    ax.legend(fontsize=8)
+    plots.legend(ax, ncol=3)
     ax.set_title(f"s = {m.scale:.4g}, rotation {np.degrees(m.rotation):.3g} deg, "
                  f"mean error {1e3 * m.mean_error:.3g} mm", fontsize=9)
     return plots.save(fig, path)

@@ -19,6 +19,7 @@ from squeeze_grasp_ros.mechanics.vocabulary import ImageEncoding
 from squeeze_grasp_ros.perception.camera import CameraModel, CameraPose
 from squeeze_grasp_ros.perception.extract import ObjectOutline, extract_outline
 from squeeze_grasp_ros.perception.image_files import decode_image
+from squeeze_grasp_ros.outputs import write_atomically
 
 HELP = ("the object's outline (m, holes included) from a top-down mono8 mask or depth image, "
         "as a scene polygon or outline file")
@@ -71,7 +72,7 @@ def _write(path: str, found: ObjectOutline, source: str) -> str:
     else:
         raise InvalidInputError(f"--output {path}: give a .yaml (scene shape) or .json "
                                 "(outline file) name")
-    Path(path).write_text(text, encoding="utf-8")
+    write_atomically(path, lambda tmp: tmp.write_text(text, encoding="utf-8"), "the outline")
     return path
 
 

@@ -37,7 +37,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> dict:
-    """Plan both squeezes; see the README for the JSON keys."""
+    """Plan both squeezes; see docs/mechanics.md for the JSON keys."""
     plan = point_squeezes(load_setup(args.scene, args.solver), depth=args.depth,
                           relative_depth=args.relative_depth)
     result = plan.to_json()
@@ -54,19 +54,23 @@ def plot(obj, stable: Squeeze, pure: Squeeze, rho: float, disp: dict, path: str)
     pts = mesh.nodes[stable.contacts]
     L = obj.scale
     plots.draw_outline(axes[0], mesh)
-    plots.draw_arrows(axes[0], pts, stable.displacement.reshape(-1, 2), 0.2 * L, "C0", "stable u")
-    plots.draw_arrows(axes[0], pts, pure.displacement.reshape(-1, 2), 0.2 * L, "C1", "pure v")
-    axes[0].legend(loc="lower right", fontsize=8)
-    axes[0].set_title("unit squeezes")
+    plots.draw_arrows(axes[0], pts, stable.displacement.reshape(-1, 2), 0.2 * L, "C0",
+                      "stable u (finger motion)")
+    plots.draw_arrows(axes[0], pts, pure.displacement.reshape(-1, 2), 0.2 * L, "C1",
+                      "pure v (finger motion)")
+    plots.legend(axes[0], ncol=1)
+    axes[0].set_title("unit squeezes at the contacts")
     for ax, sq, key in ((axes[1], stable, SqueezeKind.STABLE), (axes[2], pure, SqueezeKind.PURE)):
         full = np.zeros_like(mesh.nodes)
         full[mesh.boundary] = disp[key]
-        plots.draw_outline(ax, mesh, color="0.75", lw=0.8)
-        plots.draw_outline(ax, mesh, full)
+        plots.draw_outline(ax, mesh, color="0.75", lw=0.8, label="undeformed")
+        plots.draw_outline(ax, mesh, full, label="deformed (to scale)")
         moved = pts + full[sq.contacts]
-        plots.draw_arrows(ax, moved, rho * sq.forces.reshape(-1, 2), 0.2 * L, "C3", "force")
         f = np.linalg.norm(rho * sq.forces.reshape(-1, 2), axis=1).max()
-        ax.set_title(f"{key}: depth {rho * 1e3:.2f} mm, |f| {f:.3g} N")
+        plots.draw_arrows(ax, moved, rho * sq.forces.reshape(-1, 2), 0.2 * L, "C3",
+                          f"finger force on the object (longest {f:.3g} N)")
+        plots.legend(ax, ncol=1)
+        ax.set_title(f"{key}: depth {rho * 1e3:.3f} mm")
     plots.save(fig, path)
 
 

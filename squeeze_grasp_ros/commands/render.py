@@ -14,6 +14,7 @@ from squeeze_grasp_ros.mechanics.errors import InvalidInputError
 from squeeze_grasp_ros.perception.image_files import encode_png
 from squeeze_grasp_ros.perception.render import render_views, ring_band
 from squeeze_grasp_ros.scene import build_outline, load_scene
+from squeeze_grasp_ros.outputs import write_atomically
 
 HELP = ("render a scene's object (its top face, anti-aliased; a ring's wall band) into a mono8 "
         "mask and a depth image of a calibrated camera above the plane")
@@ -37,11 +38,16 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--seed", type=int, default=0, help="seed of the noise (default 0)")
 
 
+def _save_npy(path: Path, image: np.ndarray) -> None:
+    with open(path, "wb") as fh:  # a file object: np.save would append .npy to the name
+        np.save(fh, image, allow_pickle=False)
+
+
 def _write(path: str, image: np.ndarray) -> str:
     if Path(path).suffix.lower() == ".npy":
-        np.save(path, image, allow_pickle=False)
+        write_atomically(path, lambda tmp: _save_npy(tmp, image), "the image")
     elif Path(path).suffix.lower() == ".png":
-        Path(path).write_bytes(encode_png(image))
+        write_atomically(path, lambda tmp: tmp.write_bytes(encode_png(image)), "the image")
     else:
         raise InvalidInputError(f"{path}: images are written as .png or .npy")
     return path

@@ -13,12 +13,14 @@ from squeeze_grasp_ros.commands.common import (
     add_plot_argument,
     add_scene_argument,
     add_solver_argument,
+    int_in,
     load_setup,
 )
 from squeeze_grasp_ros.mechanics.elastic.reduced import displacement_field
 from squeeze_grasp_ros.mechanics.resistance.forms import expansion_matrix
 from squeeze_grasp_ros.mechanics.resistance.frictional import FrictionalResistance
 from squeeze_grasp_ros.mechanics.resistance.optimal import (
+    MAX_DIRECTIONS,
     Resistance,
     ResistanceGrasp,
     ResistanceSweep,
@@ -45,7 +47,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     )
     parser.add_argument(
         "--directions",
-        type=int,
+        type=int_in(1, MAX_DIRECTIONS),
         metavar="N",
         help="also sweep N adversary push directions (grasp quality, polar plot)",
     )
@@ -93,13 +95,13 @@ def plot(
     pts = mesh.nodes[grasp.red.contacts]
     heads = mesh.nodes[res.contacts]
     plots.draw_outline(axes[0], mesh)
-    plots.mark_nodes(axes[0], pts)
+    plots.mark_nodes(axes[0], pts, label="contact nodes")
     axes[0].set_title(f"{res.mode} resistance ({res.contact_model} contacts)")
     if res.success:
         moves = np.array([res.d1, res.d2, res.a])
-        for p, v, color, name in zip(
-            heads, moves, ("C0", "C1", "C3"), ("d1 (F1)", "d2 (F2)", "a (A)")
-        ):
+        names = ("d1: F1's optimal translation", "d2: F2's optimal translation",
+                 "a: the adversary's push")
+        for p, v, color, name in zip(heads, moves, ("C0", "C1", "C3"), names):
             plots.draw_arrows(
                 axes[0],
                 p[None],
@@ -108,13 +110,16 @@ def plot(
                 color,
                 name,
             )
-        axes[0].legend(loc="lower right", fontsize=8)
+        plots.legend(axes[0], ncol=1)
         delta = expansion_matrix(grasp.counts) @ np.concatenate([res.d1, res.d2, res.a])
         field = displacement_field(obj, grasp.red, delta)
-        plots.draw_outline(axes[1], mesh, color="0.75", lw=0.8)
-        plots.draw_outline(axes[1], mesh, field)
+        plots.draw_outline(axes[1], mesh, color="0.75", lw=0.8, label="undeformed")
+        plots.draw_outline(axes[1], mesh, field, label="deformed (to scale)")
         moved = pts + field[grasp.red.contacts]
-        plots.draw_arrows(axes[1], moved, res.node_forces, 0.25 * L, "C3", "force")
+        longest = float(np.linalg.norm(res.node_forces, axis=1).max())
+        plots.draw_arrows(axes[1], moved, res.node_forces, 0.25 * L, "C3",
+                          f"contact force on the object (longest {longest:.3g} N)")
+        plots.legend(axes[1], ncol=1)
         axes[1].set_title(f"deformed, W*_F = {res.work['total']:.4g} J")
     else:
         axes[1].set_title(res.reason, fontsize=7)
@@ -130,6 +135,8 @@ def plot(
             "C0.-",
             ms=2,
         )
+        ax.set_rlabel_position(202.5)
+        ax.tick_params(axis="y", labelsize=7)
         ax.set_title("W*_F per unit push [J/m^2] vs push direction", fontsize=9)
     plots.save(fig, path)
 
@@ -152,9 +159,9 @@ def draw_tips(ax, mesh, res: FrictionalResistance, which: str, displacement) -> 
             [c.mode == ContactMode.STICK for c in nodes],
             color,
             14,
-            f"{f} ({len(nodes)})",
+            f"{f} ({len(nodes)} nodes)",
         )
-    ax.legend(loc="lower right", fontsize=7)
+    plots.legend(ax, ncol=3, title="contact nodes: filled stick, hollow slip", title_fontsize=8)
 
 
 def plot_friction(
@@ -175,7 +182,7 @@ def plot_friction(
     ax.set_aspect("equal")
     ax.set_xlabel("x [mm]")
     ax.set_ylabel("y [mm]")
-    ax.legend(fontsize=7)
+    plots.legend(ax, ncol=3)
     ax.set_title(f"trajectories, W_F = {res.work['total']:.3g} J", fontsize=9)
     plots.save(fig, path)
 

@@ -16,10 +16,10 @@ import dataclasses
 import numpy as np
 
 from squeeze_grasp_ros import plots
-from squeeze_grasp_ros.commands.common import add_plot_argument, add_scene_argument
+from squeeze_grasp_ros.commands.common import add_plot_argument, add_scene_argument, int_in
 from squeeze_grasp_ros.commands.ring_map import closed, map_summary, plot_map
 from squeeze_grasp_ros.mechanics.ring.grasp_map import bench_ring
-from squeeze_grasp_ros.mechanics.ring.model import RingModel
+from squeeze_grasp_ros.mechanics.ring.model import MAX_RING_ELEMENTS, RingModel
 from squeeze_grasp_ros.mechanics.ring.squeeze import RingGrasp
 from squeeze_grasp_ros.mechanics.vocabulary import (
     SQUEEZING_FINGERS,
@@ -30,6 +30,8 @@ from squeeze_grasp_ros.mechanics.vocabulary import (
 from squeeze_grasp_ros.scene import GraspSetup, SceneError, load_scene
 from squeeze_grasp_ros.scene.studies import grasp_map_study, ring_placement
 
+MAX_BEST = 10_000
+"""Most placements ``--map --best`` lists."""
 HELP = "ring-like object, two point fingers (Sec. 7): max squeeze depth, limit, all-pairs map"
 
 
@@ -54,13 +56,14 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         metavar="FRACTION",
         help="requested finger approach / initial contact distance (default: the scene's)",
     )
-    parser.add_argument("--elements", type=int, metavar="N", help="override object.ring.elements")
+    parser.add_argument("--elements", type=int_in(8, MAX_RING_ELEMENTS), metavar="N",
+                        help=f"override object.ring.elements (8 to {MAX_RING_ELEMENTS})")
     parser.add_argument(
         "--best",
-        type=int,
+        type=int_in(1, MAX_BEST),
         default=10,
         metavar="K",
-        help="--map: list the K placements with the largest maximum depth",
+        help=f"--map: list the K placements with the largest maximum depth (1 to {MAX_BEST})",
     )
     parser.add_argument(
         "--bench",
@@ -80,8 +83,6 @@ def load_ring(path: str, elements: int | None = None) -> GraspSetup:
             f"{path}: object.model is {scene.object.model!r}; `ring` needs model: ring"
         )
     if elements is not None:
-        if elements < 8:
-            raise SceneError(f"--elements must be >= 8, got {elements}")
         ring_spec = dataclasses.replace(scene.object.ring, elements=elements)
         scene = dataclasses.replace(
             scene, object=dataclasses.replace(scene.object, ring=ring_spec)
@@ -147,6 +148,7 @@ def plot_grasp(ring: RingModel, grasp: RingGrasp, depth: float, path: str) -> st
             fc="none",
             ec="0.6",
             ls=":",
+            label="friction cone, undeformed" if k == 0 else None,
         )
         _cone(
             ax0,
@@ -156,12 +158,15 @@ def plot_grasp(ring: RingModel, grasp: RingGrasp, depth: float, path: str) -> st
             0.18 * size,
             color="0.5",
             alpha=0.4,
+            label="friction cone, deformed" if k == 0 else None,
         )
-    plots.draw_arrows(ax0, after[grasp.contacts], grasp.forces, 0.25 * size, "purple", "forces")
+    longest = float(np.linalg.norm(grasp.forces, axis=1).max())
+    plots.draw_arrows(ax0, after[grasp.contacts], grasp.forces, 0.25 * size, "purple",
+                      f"finger force on the ring (longest {longest:.3g} N)")
     ax0.set_aspect("equal")
     ax0.set_xlabel("x [m]")
     ax0.set_ylabel("y [m]")
-    ax0.legend(fontsize=7, loc="upper right")
+    plots.legend(ax0, ncol=2)
     ax0.set_title(
         f"nodes {grasp.contacts.tolist()}: {grasp.limit} at {grasp.max_relative_depth:.3g}"
     )
@@ -176,7 +181,7 @@ def plot_grasp(ring: RingModel, grasp: RingGrasp, depth: float, path: str) -> st
     ax1.axvline(grasp.relative_depth(depth), color="k", lw=0.8, ls=":", label="requested")
     ax1.set_xlabel("relative depth")
     ax1.set_ylabel("angle [deg]")
-    ax1.legend(fontsize=7)
+    plots.legend(ax1, ncol=2)
     ax1.set_title("cone rotation: force-to-normal angle")
     return plots.save(fig, path)
 

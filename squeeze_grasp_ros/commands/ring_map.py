@@ -59,7 +59,7 @@ def plot_map(ring: RingModel, gmap: RingGraspMap, path: str) -> str:
     )
     for color, name in zip(colors[1:], names):
         ax1.plot([], [], "s", color=color, label=name)
-    ax1.legend(fontsize=6, loc="upper left")
+    plots.legend(ax1, ncol=2)
     target = gmap.requested_relative_depth
     ax1.set_title("limit" + (f" / success at relative depth {target:.3g}" if target else ""))
     for ax in (ax0, ax1):
@@ -77,7 +77,7 @@ def plot_map(ring: RingModel, gmap: RingGraspMap, path: str) -> str:
             label=f"{best['contacts']}: {best['max_relative_depth']:.3g}",
         )
     ax2.set_aspect("equal")
-    ax2.legend(fontsize=6)
+    plots.legend(ax2, ncol=2, title="F1, F2 nodes: max relative depth", title_fontsize=8)
     ax2.set_title("deepest placements")
     return plots.save(fig, path)
 

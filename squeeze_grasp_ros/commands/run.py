@@ -6,12 +6,16 @@ time.
 from __future__ import annotations
 
 import argparse
+import errno
 import json
+import os
+import re
 import signal
 import sys
+import tempfile
 from pathlib import Path
 
-from squeeze_grasp_ros.exit_codes import ExitCode
+from squeeze_grasp_ros.exit_codes import ExitCode, raise_on_signals
 from squeeze_grasp_ros.commands.common import add_scene_argument, fail, new_folder
 from squeeze_grasp_ros.control.motion import REACTIONS
 
@@ -53,12 +57,31 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--no-planner", action="store_true",
                         help="plan with the mechanics API instead of the planner node")
     parser.add_argument("--quiet", action="store_true", help="no progress line")
-    parser.add_argument("--discovery-wait", type=float, default=1.0, metavar="SECONDS",
-                        help="least time to discover another simulation on this ROS domain "
-                             "before refusing to run beside it (default: 1; overlaps planning)")
+    parser.add_argument("--namespace", metavar="NS", type=ros_namespace,
+                        help="ROS namespace of the run's nodes (default: a fresh one, "
+                             "/squeeze_grasp/run_<pid>_<random>, so runs on one ROS domain "
+                             "never see each other); with --attach: the running nodes' "
+                             "namespace (default: /)")
     parser.add_argument("--timeout", type=float, default=300.0, metavar="SECONDS",
                         help="wall-clock seconds to wait for any step of the run (a node that "
                              "hangs or dies ends the run with exit 4; default: 300)")
+
+
+NAMESPACE = re.compile(r"(/[A-Za-z_][A-Za-z0-9_]*)+")
+"""A fully qualified ROS namespace (``/a/b_1``)."""
+
+
+def ros_namespace(text: str) -> str:
+    """Argparse type of ``--namespace``: a fully qualified ROS namespace.
+
+    >>> ros_namespace("/lab/run_1")
+    '/lab/run_1'
+    """
+    if not NAMESPACE.fullmatch(text):
+        raise argparse.ArgumentTypeError(
+            f"needs a fully qualified ROS namespace such as /lab/run_1 (each part a letter or "
+            f"_ then letters, digits, _), got {text[:40]!r}")
+    return text
 
 
 def _progress_line(update: dict) -> None:
@@ -74,18 +97,31 @@ def run(args: argparse.Namespace) -> dict | int:
     """Run the pipeline; the JSON summary (see :meth:`PipelineRunner.summary`), or exit code
     130 after Ctrl-C (the recording is finished first).
     """
+    previous = raise_on_signals()  # a signal while rclpy and the nodes start: 128 + N, one line
+    try:
+        return _run(args)
+    finally:
+        for signum, handler in previous.items():
+            signal.signal(signum, handler)
+
+
+def _run(args: argparse.Namespace) -> dict | int:
     from squeeze_grasp_ros.ros.run.options import RunError, RunOptions
     from squeeze_grasp_ros.ros.run.runner import PipelineRunner
 
     if not (args.timeout > 0 and args.timeout < float("inf")):
         return fail(args, f"--timeout must be > 0 s, got {args.timeout}", ExitCode.USAGE)
+    if args.record and not args.attach:  # attach records nothing (the runner says so)
+        refused = prepare_recording(args.record)
+        if refused is not None:
+            return fail(args, refused[0], refused[1])
 
     options = RunOptions(args.scene, record=args.record,
                          include_hidden_topics=args.include_hidden_topics, attach=args.attach,
                          processes=args.processes,
                          executor=args.executor, on_slip_alarm=args.on_slip_alarm,
                          resist=not args.no_resist, planner=not args.no_planner,
-                         timeout=args.timeout, discovery_wait=args.discovery_wait)
+                         timeout=args.timeout, namespace=args.namespace)
     show = not (args.quiet or args.json) and sys.stderr.isatty()
     try:
         result = PipelineRunner(options, _progress_line if show else None).run()
@@ -110,6 +146,37 @@ def run(args: argparse.Namespace) -> dict | int:
         print(json.dumps(result) if args.json else summary(result))
         return ExitCode.OUTCOME
     return result
+
+
+def prepare_recording(folder: str) -> tuple[str, ExitCode] | None:
+    """Create the recording folder and check that the bag's 256 kB reserve fits, before any
+    node starts; (the reason, the exit code) if it cannot: 4 for a full disk or quota, else 2.
+
+    Before, ``--record /proc/x`` and a read-only folder ended in tracebacks, and a disk with
+    less than 256 kB free in a BagError traceback with a 0-byte ``.space_reserve`` left.
+    """
+    from squeeze_grasp_ros.ros.recording.bag import RESERVE_BYTES, SPACE_ERRORS
+
+    path = Path(folder)
+    created = not path.exists()
+    try:
+        path.mkdir(parents=True, exist_ok=True)
+        handle, probe = tempfile.mkstemp(dir=path, prefix=".probe_")
+        try:
+            os.posix_fallocate(handle, 0, RESERVE_BYTES)
+        finally:
+            os.close(handle)
+            os.unlink(probe)
+    except OSError as exc:
+        if created and path.is_dir():
+            path.rmdir()
+        name = errno.errorcode.get(exc.errno or 0, "")
+        code = ExitCode.INTERNAL if exc.errno in SPACE_ERRORS else ExitCode.USAGE
+        return (f"--record {folder}: cannot record there: {exc.strerror}"
+                f"{f' ({name})' if name else ''}"
+                + ("; a recording needs at least 256 kB free" if code == ExitCode.INTERNAL
+                   else ""), code)
+    return None
 
 
 def recording_stopped(record: str | None) -> str | None:

@@ -170,22 +170,32 @@ def plot(obj, res: EventSqueeze, path: str) -> str:
             size=14,
             label=f"{name} ({len(seg)} nodes)",
         )
-    ax.legend(loc="lower right", fontsize=7)
+    plots.legend(ax, ncol=2, title="contact nodes: filled stick, hollow slip", title_fontsize=8)
     ax.set_title(
         f"{res.termination} at {100 * res.relative_depth:.2f} % (mu = {res.mu:g})", fontsize=9
     )
     ax = axes[1]
     ax.set_aspect("auto")
-    order = sorted(res.trajectories, key=lambda k: (res.trajectories[k][0][0], k))
-    for offset, node in enumerate(order):
-        traj = np.array(res.trajectories[node])
-        change = traj[:, 1] - traj[0, 1]
-        scale = max(float(np.abs(change).max()), 1e-12)
-        ax.plot(traj[:, 0], offset + 0.4 * change / scale, lw=1.0)
-        ax.text(traj[-1, 0], offset, f" {node}", fontsize=6, va="center")
+    changes = {node: np.array(t)[:, 1] - t[0][1] for node, t in res.trajectories.items()}
+    if max((float(np.abs(c).max()) for c in changes.values()), default=0.0) < 1e-9:
+        # every node sticks: polar angles stay fixed (Fig. 6 is about sliding nodes)
+        for f, curve in res.force_curve.items():
+            x, y = np.array(curve).T if curve else ([], [])
+            ax.plot(np.asarray(x), y, ls="-" if f == Finger.F1 else "--", label=f)
+        plots.legend(ax, ncol=2)
+        ax.set_ylabel("force along the finger's motion [N]")
+        ax.set_title("every contact node sticks, so no polar angle changes (Fig. 6);\n"
+                     "the finger forces instead", fontsize=9)
+    else:
+        order = sorted(res.trajectories, key=lambda k: (res.trajectories[k][0][0], k))
+        for offset, node in enumerate(order):
+            traj = np.array(res.trajectories[node])
+            scale = max(float(np.abs(changes[node]).max()), 1e-12)
+            ax.plot(traj[:, 0], offset + 0.4 * changes[node] / scale, lw=1.0)
+            ax.text(traj[-1, 0], offset, f" {node}", fontsize=6, va="center")
+        ax.set_ylabel("polar-angle change (each node scaled, offset)")
+        ax.set_title("polar angles of the contact nodes (Fig. 6)", fontsize=9)
     ax.set_xlabel("relative squeeze depth")
-    ax.set_ylabel("polar-angle change (each node scaled, offset)")
-    ax.set_title("polar angles of the contact nodes (Fig. 6)", fontsize=9)
     ax = axes[2]
     ax.set_aspect("auto")
     for row, kind in enumerate(EventType):
@@ -220,12 +230,12 @@ def plot_models(obj, results: dict, path: str) -> str:
                      ls="-" if f == Finger.F1 else "--", label=f"{model} {f}")
     ax0.set_aspect("equal")
     ax0.set_title("deformed outlines (m)")
-    ax0.legend(fontsize=8)
+    plots.legend(ax0, ncol=2)
     ax1.set_aspect("auto")
     ax1.set_xlabel("relative depth (%)")
     ax1.set_ylabel("force along the finger's motion (N)")
     ax1.set_title("force-depth")
-    ax1.legend(fontsize=8)
+    plots.legend(ax1, ncol=3)
     return plots.save(fig, path)
 
 

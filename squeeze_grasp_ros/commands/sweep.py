@@ -20,7 +20,9 @@ EPILOG = ("exit status: 0 every task written (an evaluation that raised is a row
           "and leaves the status 0; the summary counts them); 1 some tasks failed as a whole "
           "(listed with their error in DIR/manifest.json; the other tasks are written, and "
           "re-running the same command retries only the failed ones); 2 invalid spec or option, "
-          "unreachable --scheduler, or the sweep extra missing; 130 stopped by Ctrl-C (SIGINT), "
+          "a spec over the size limits, unreachable --scheduler, an --out that refuses writes, "
+          "a bad manifest, or the sweep extra missing; 4 the disk filled up (the parts written "
+          "are kept; re-run to resume); 130 stopped by Ctrl-C (SIGINT), "
           "143 by SIGTERM, at any point from start-up on: finished parts are kept, re-run to "
           "resume")
 
@@ -60,6 +62,8 @@ def run(args: argparse.Namespace) -> dict | int:
         raise SweepError("--out DIR is required (or use --dry-run)")
     outcome = run_sweep(loaded, args.out, scheduler=args.scheduler, workers=args.workers,
                         progress=not args.no_progress)
+    for line in outcome.repaired:
+        print(f"squeeze-grasp sweep: {args.out}/{line}", file=sys.stderr)
     result = {"dry_run": False, "out": args.out, "spec_hash": loaded.hash, **vars(outcome)}
     if outcome.interrupted is not None:
         name = signal.Signals(outcome.interrupted).name

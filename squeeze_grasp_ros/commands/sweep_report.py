@@ -5,9 +5,12 @@ from __future__ import annotations
 
 import argparse
 
+from squeeze_grasp_ros.commands.common import int_in, output_folder
 from squeeze_grasp_ros.sweep.engine import require_extra
 from squeeze_grasp_ros.sweep.report import plot, summarise, text
 
+MAX_BEST = 10_000
+"""Most best placements listed per object."""
 HELP = ("summarise a sweep directory: success rate by object and material, quality "
         "distributions, best placements per object; --plot writes pictures")
 
@@ -16,29 +19,34 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     """DIR, --best, --plot."""
     parser.add_argument("out", metavar="DIR", help="sweep output directory (squeeze-grasp sweep "
                                                    "--out)")
-    parser.add_argument("--best", type=int, default=3, metavar="N",
-                        help="best placements listed per object (default 3)")
-    parser.add_argument("--plot", metavar="DIR",
+    parser.add_argument("--best", type=int_in(1, MAX_BEST), default=3, metavar="N",
+                        help=f"best placements listed per object (default 3, at most {MAX_BEST})")
+    parser.add_argument("--plot", metavar="DIR", type=output_folder,
                         help="write quality_map.png and outcome.png into this directory")
 
 
 def run(args: argparse.Namespace) -> dict:
-    """Read the dataset and summarise it."""
+    """Read the verified parts and summarise them; parts left out are listed."""
     require_extra()
-    from squeeze_grasp_ros.sweep.store import read_dataset, read_manifest, read_outlines
-    manifest = read_manifest(args.out)
-    rows = read_dataset(args.out).to_pylist()
-    out = {"out": args.out, "manifest": {k: manifest[k] for k in
-                                         ("name", "spec_hash", "package_version", "counts")},
-           **summarise(rows, args.best)}
+    from squeeze_grasp_ros.sweep.store import load_dataset, read_outlines
+    data = load_dataset(args.out)
+    rows = data.table.to_pylist()
+    manifest = {k: data.manifest.get(k) for k in ("name", "spec_hash", "package_version")}
+    out = {"out": args.out, "manifest": {**manifest, "counts": data.counts},
+           "excluded": list(data.excluded), **summarise(rows, args.best)}
     if args.plot and rows:
         out["plots"] = plot(rows, args.plot, read_outlines(args.out))
     return out
 
 
 def summary(result: dict) -> str:
-    """The tables."""
-    lines = [text(result, result["manifest"])]
+    """The tables, after the parts left out."""
+    lines = []
+    if result["excluded"]:
+        lines.append(f"{len(result['excluded'])} part(s) left out of this report (re-run the "
+                     "sweep to redo their tasks):")
+        lines += [f"  {line}" for line in result["excluded"]]
+    lines.append(text(result, result["manifest"]))
     if result.get("plots"):
         lines.append("plots: " + ", ".join(result["plots"]))
     return "\n".join(lines)

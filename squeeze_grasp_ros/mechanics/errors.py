@@ -26,7 +26,7 @@ from collections.abc import Mapping
 import numpy as np
 
 __all__ = ["ConditioningWarning", "InfeasibleError", "InternalError", "InvalidInputError",
-           "NumericalError", "SqueezeGraspError", "require_finite"]
+           "NumericalError", "SqueezeGraspError", "require_finite", "require_relative_depth"]
 
 
 class SqueezeGraspError(Exception):
@@ -71,8 +71,47 @@ class ConditioningWarning(RuntimeWarning):
     """
 
 
+def shown(value) -> str:
+    """``value`` as a message shows it: plain numbers (``nan``, ``1e+308``, ``[0.1, nan]``),
+    never a numpy repr such as ``np.float64(nan)``.
+    """
+    arr = np.asarray(value)
+    if arr.dtype.kind in "fiub":
+        return str(arr.tolist()) if arr.ndim else f"{arr.item():.6g}"
+    return repr(value)
+
+
 def require_finite(name: str, value) -> None:
-    """Raise :class:`InvalidInputError` if ``value`` (scalar or array) has NaN or inf entries."""
+    """Raise :class:`InvalidInputError` if ``value`` (scalar or array) has NaN or inf entries.
+
+    >>> require_finite("slope angle", np.float64("nan"))
+    Traceback (most recent call last):
+    ...
+    squeeze_grasp_ros.mechanics.errors.InvalidInputError: slope angle must be finite, got nan
+    """
     arr = np.asarray(value, dtype=float)
     if not np.all(np.isfinite(arr)):
-        raise InvalidInputError(f"{name} must be finite, got {value!r}")
+        raise InvalidInputError(f"{name} must be finite, got {shown(value)}")
+
+
+def require_relative_depth(relative: float, depth: float | None = None) -> None:
+    """Refuse a relative depth outside [0, 1): at 1 the fingers would meet. With ``depth``
+    (rho, m), the relative depth is the one that depth gives and the message says so. Every
+    verb, service and scene applies this one rule.
+
+    >>> require_relative_depth(5.0)
+    Traceback (most recent call last):
+    ...
+    squeeze_grasp_ros.mechanics.errors.InvalidInputError: relative depth must be in [0, 1) \
+(at 1 the fingers would meet), got 5
+    """
+    require_finite("depth" if depth is not None else "relative depth",
+                   relative if depth is None else depth)
+    if depth is not None and depth < 0:
+        raise InvalidInputError(f"depth must be >= 0 m, got {shown(depth)}")
+    if not 0 <= relative < 1:
+        if depth is None:
+            raise InvalidInputError(f"relative depth must be in [0, 1) (at 1 the fingers would "
+                                    f"meet), got {shown(relative)}")
+        raise InvalidInputError(f"depth {depth:.6g} m is a relative depth of {relative:.6g}: it "
+                                "must be in [0, 1) (at 1 the fingers would meet)")

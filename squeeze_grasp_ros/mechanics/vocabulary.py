@@ -30,10 +30,10 @@ from __future__ import annotations
 
 from enum import Enum
 
-__all__ = ["ContactKind", "ContactMode", "DistortionModel", "Effect", "EventType", "Finger",
-           "ImageEncoding", "MaterialModel", "ObjectModel", "RingLimit", "SQUEEZING_FINGERS",
-           "ShapeFit", "ShapeType", "SqueezeKind", "StrainCriterion", "StrainMeasure",
-           "StressMeasure", "Termination"]
+__all__ = ["ContactKind", "ContactMode", "DistortionModel", "Effect", "EventType", "Factorizer",
+           "Finger", "ImageEncoding", "MaterialModel", "ObjectModel", "RingLimit",
+           "SQUEEZING_FINGERS", "ShapeFit", "ShapeType", "SqueezeKind", "StrainCriterion",
+           "StrainMeasure", "StressMeasure", "Termination"]
 
 
 class _Name(str, Enum):
@@ -314,3 +314,12 @@ class ShapeFit(_Name):
     """Rotation and translation only (the scale of a calibrated camera is known)."""
     NONE = "none"
     """No transform: both curves are already in the same frame."""
+
+
+class Factorizer(_Name):
+    """Sparse factorisation of the interior tangent of the large-deformation models."""
+
+    CHOLMOD = "cholmod"
+    """Supernodal Cholesky LL^T (SuiteSparse CHOLMOD through cvxopt: the ``cholmod`` extra)."""
+    QDLDL = "qdldl"
+    """LDL^T without pivoting (QDLDL); also takes the tangents that are not positive definite."""

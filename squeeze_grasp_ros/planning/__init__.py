@@ -23,6 +23,12 @@ from squeeze_grasp_ros.planning.errors import (
     classify,
     ERROR_CODES,
 )
+from squeeze_grasp_ros.planning.object_ids import (
+    MAX_ID_CHARS,
+    check_object_id,
+    check_digest,
+    shown,
+)
 from squeeze_grasp_ros.planning.objects import (
     PlannerLimits,
     LoadedObject,
@@ -39,12 +45,12 @@ from squeeze_grasp_ros.planning.objects import (
     resident_bytes,
     load_cached,
     CONTACT_MODELS,
-    MAX_DIRECTIONS,
     MAX_BEST_COUNT,
     SOLID_STAGES,
     RING_STAGES,
     Progress,
 )
+from squeeze_grasp_ros.mechanics.resistance.optimal import MAX_DIRECTIONS
 from squeeze_grasp_ros.planning.checks import (
     check_number,
     check_step,
@@ -72,6 +78,7 @@ __all__ = [
     "PlannerLimits",
     "LoadedObject",
     "MAX_BEST_COUNT",
+    "MAX_ID_CHARS",
     "MAX_DIRECTIONS",
     "ObjectCache",
     "ObjectKey",
@@ -84,7 +91,9 @@ __all__ = [
     "SceneSource",
     "SqueezePlan",
     "best_count",
+    "check_digest",
     "check_number",
+    "check_object_id",
     "check_size",
     "check_step",
     "choice",
@@ -103,6 +112,7 @@ __all__ = [
     "resident_bytes",
     "resistance_plan",
     "ring_grasp_test",
+    "shown",
     "solver_route",
     "squeeze_plan",
 ]

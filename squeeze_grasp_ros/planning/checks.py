@@ -10,6 +10,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from squeeze_grasp_ros.planning.errors import invalid
+from squeeze_grasp_ros.planning.object_ids import shown
 from squeeze_grasp_ros.planning.objects import PlannerLimits, LoadedObject, MAX_BEST_COUNT
 
 
@@ -46,7 +47,7 @@ def choice(name: str, value: str, allowed: Sequence[str], default: str | None = 
     if not value and default is not None:
         return default
     if value not in allowed:
-        raise invalid(f"{name} must be one of {list(allowed)}, got {value!r}")
+        raise invalid(f"{name} must be one of {list(allowed)}, got {shown(value)}")
     return value
 
 

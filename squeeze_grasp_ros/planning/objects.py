@@ -20,17 +20,20 @@ import scipy.sparse as sp
 from squeeze_grasp_ros.inputs import InputError, confine, load_yaml, read_text
 from squeeze_grasp_ros.mechanics.elastic.compliance import ROUTES, ElasticObject
 from squeeze_grasp_ros.mechanics.ring.model import RingModel
-from squeeze_grasp_ros.scene import Scene, parse_scene, requested_nodes
-from squeeze_grasp_ros.scene.setup import RING_STAGES, SOLID_STAGES, GraspSetup
 from squeeze_grasp_ros.mechanics.vocabulary import ContactKind, ObjectModel, ShapeType
+from squeeze_grasp_ros.scene import Scene, build_outline, parse_scene, requested_nodes
+from squeeze_grasp_ros.scene.setup import RING_STAGES, SOLID_STAGES, GraspSetup
+from squeeze_grasp_ros.planning.budget import check_load
 from squeeze_grasp_ros.planning.errors import ErrorCode, PlannerError, invalid
+from squeeze_grasp_ros.planning.object_ids import (check_digest, check_object_id, replaced,
+                                                   shown, taken)
 
 
 CONTACT_MODELS: tuple[str, ...] = ContactKind.values()
-MAX_DIRECTIONS = 100_000
-"""Most push directions one resistance sweep may ask for."""
 MAX_BEST_COUNT = 100_000
 """Most placements one grasp map may return as candidates."""
+MAX_PATH_CHARS = 4096
+"""Longest ``scene_path`` (PATH_MAX on Linux): messages quote the path when they refuse it."""
 
 Progress = Callable[[str, int, int, int], None]
 """Called as ``progress(stage, index, count, num_nodes)`` when a stage starts (the stages of
@@ -59,6 +62,9 @@ class PlannerLimits:
         Placements a grasp map returns when a request asks for 0.
     min_step : float
         Smallest event-squeeze substep relative to the object size.
+    max_bytes : int or None
+        Most memory a load may need (the cache's bound): a mesh whose dense blocks would need
+        more is refused before its factorisation (:mod:`.budget`); None = no bound.
     """
 
     max_nodes: int = 60_000
@@ -67,6 +73,7 @@ class PlannerLimits:
     default_route: str = "factorized"
     best_count: int = 10
     min_step: float = 1e-5
+    max_bytes: int | None = None
 
 
 @dataclass(frozen=True)
@@ -176,6 +183,8 @@ def read_scene(
     """
     if bool(scene_yaml) == bool(scene_path):
         raise invalid("give exactly one of scene_yaml and scene_path")
+    if len(scene_path) > MAX_PATH_CHARS:
+        raise invalid(f"scene_path has {len(scene_path)} characters, more than {MAX_PATH_CHARS}")
     try:
         if scene_path:
             path = (
@@ -206,11 +215,27 @@ def check_size(count: int | None, limit: int, what: str) -> None:
         )
 
 
+def node_limit(route: str, limits: PlannerLimits) -> int:
+    """Most mesh nodes of a solid on solver ``route``."""
+    return limits.max_nodes if route == "factorized" else limits.max_spectral_nodes
+
+
+def check_requested(scene: Scene, route: str, limits: PlannerLimits) -> None:
+    """Refuse, before anything is built, a scene that asks for more nodes than the planner's
+    limits (INVALID_ARGUMENT, oversized) or whose outline is invalid (e.g. self-intersecting).
+    """
+    if scene.object.model == ObjectModel.RING:
+        check_size(requested_nodes(scene), limits.max_ring_elements, "ring model")
+    else:
+        build_outline(scene.object.shape)
+        check_size(requested_nodes(scene), node_limit(route, limits), f"{route} mesh")
+
+
 def solver_route(route: str, limits: PlannerLimits) -> str:
     """The request's solver route, or the node's default when empty."""
     route = route or limits.default_route
     if route not in ROUTES:
-        raise invalid(f"solver_route must be one of {list(ROUTES)} or empty, got {route!r}")
+        raise invalid(f"solver_route must be one of {list(ROUTES)} or empty, got {shown(route)}")
     return route
 
 
@@ -225,7 +250,8 @@ class ObjectKey:
     Attributes
     ----------
     object_id : str
-        The request's id, else the scene's name, else ``object-<digest prefix>``.
+        The request's id, else the scene's name, else ``object-<digest prefix>``
+        (:func:`~.object_ids.check_object_id`).
     route : str
         Solver route (the node's default when the request leaves it empty).
     digest : str
@@ -242,7 +268,11 @@ def object_key(source: SceneSource, object_id: str, route: str,
     """The :class:`ObjectKey` of a load request."""
     route = solver_route(route, limits)
     digest = hashlib.sha256(f"{route}\0{source.text}".encode()).hexdigest()
-    return ObjectKey(object_id or source.scene.name or f"object-{digest[:12]}", route, digest)
+    if object_id:
+        object_id = check_object_id(object_id)
+    elif source.scene.name:
+        object_id = check_object_id(source.scene.name, "the scene's name (the default object_id)")
+    return ObjectKey(object_id or f"object-{digest[:12]}", route, digest)
 
 
 def load_object(
@@ -267,16 +297,16 @@ def load_object(
     """
     scene = source.scene
     start = time.perf_counter()
+    check_requested(scene, key.route, limits)
     if scene.object.model == ObjectModel.RING:
-        check_size(requested_nodes(scene), limits.max_ring_elements, "ring model")
         progress(RING_STAGES[0], 0, len(RING_STAGES), 0)
         setup = GraspSetup.build(scene)
     else:
-        limit = limits.max_nodes if key.route == "factorized" else limits.max_spectral_nodes
-        check_size(requested_nodes(scene), limit, f"{key.route} mesh")
         progress(SOLID_STAGES[0], 0, len(SOLID_STAGES), 0)
-        setup = GraspSetup.build(scene, route=key.route)
-        check_size(setup.num_nodes, limit, f"{key.route} mesh")
+        setup = GraspSetup.build(scene, route=key.route, max_nodes=node_limit(key.route, limits))
+        mesh = setup.solid.mesh
+        check_load(boundary_nodes=len(mesh.boundary), nodes=mesh.n, route=key.route,
+                   max_bytes=limits.max_bytes)
     setup.precompute(progress)
     _ = setup.contacts  # the placements are checked at load, not at the first request
     return LoadedObject(key.object_id, setup, key.digest, time.perf_counter() - start)
@@ -287,6 +317,11 @@ def resident_bytes(value: object) -> int:
     factors reached through dataclass fields, instance and cached-property dicts, and
     containers, each counted once. Python object overhead is not counted (it is small next to
     a mesh's compliance and factorisation).
+
+    A SuperLU object also keeps the sparse L and U it built once they were read (scipy caches
+    them; as large as the factorisation): the factorized solver holds them in an attribute so
+    that they are counted (before, a 20,000-node object was counted at 111 MiB and held 205
+    MiB; now 188 MiB counted against 208 MiB of RSS).
     """
     seen: set[int] = set()
     stack, total = [value], 0
@@ -338,27 +373,45 @@ class ObjectCache:
 
     @property
     def bytes(self) -> int:
-        """Bytes of arrays held by the cached objects."""
+        """Bytes of arrays held by the cached objects, counted now."""
         with self._lock:
+            self._recount()
             return sum(self._bytes.values())
 
-    def get(self, object_id: str) -> LoadedObject:
+    def _recount(self) -> None:
+        """Count again what each cached object holds: its caches (load gradients, gradient
+        operators) fill as requests use it, after it was counted on entry (lock held).
+        """
+        for object_id, held in self._objects.items():
+            self._bytes[object_id] = resident_bytes(held.body)
+
+    def get(self, object_id: str, digest: str = "") -> LoadedObject:
         """The object loaded under ``object_id`` (now the most recently used).
+
+        Parameters
+        ----------
+        object_id : str
+        digest : str
+            The ``object_digest`` the client's load returned, or "" (not checked).
 
         Raises
         ------
         PlannerError
-            UNKNOWN_OBJECT. The message does not list the loaded ids: they belong to other
-            clients.
+            UNKNOWN_OBJECT when no object or, with ``digest``, another object is loaded under
+            ``object_id`` (:mod:`.object_ids`). The message does not list the loaded ids: they
+            belong to other clients.
         """
+        check_digest(digest)
         with self._lock:
             loaded = self._objects.get(object_id)
             if loaded is None:
                 raise PlannerError(
                     ErrorCode.UNKNOWN_OBJECT,
-                    f"unknown object_id {object_id!r}: load it first with "
+                    f"unknown object_id {shown(object_id)}: load it first with "
                     "load_object (objects are evicted when the cache is full)",
                 )
+            if digest and loaded.digest != digest:
+                raise replaced(object_id, loaded.digest, digest)
             self._objects.move_to_end(object_id)
             return loaded
 
@@ -371,13 +424,27 @@ class ObjectCache:
             self._objects.move_to_end(object_id)
             return loaded
 
-    def put(self, loaded: LoadedObject) -> list[str]:
-        """Store ``loaded`` (replacing an object of the same id); return the evicted ids.
+    def check_free(self, object_id: str, digest: str) -> None:
+        """Refuse a load of ``digest`` under ``object_id`` while it holds another object.
 
         Raises
         ------
         PlannerError
-            INVALID_ARGUMENT if the object alone needs more than ``max_bytes``.
+            INVALID_ARGUMENT naming the id and the digest it holds (:mod:`.object_ids`).
+        """
+        with self._lock:
+            held = self._objects.get(object_id)
+        if held is not None and held.digest != digest:
+            raise taken(object_id, held.digest)
+
+    def put(self, loaded: LoadedObject, replace: bool = False) -> list[str]:
+        """Store ``loaded``; return the evicted ids.
+
+        Raises
+        ------
+        PlannerError
+            INVALID_ARGUMENT if the object alone needs more than ``max_bytes``, or if another
+            object is loaded under its id and not ``replace`` (:mod:`.object_ids`).
         """
         size = resident_bytes(loaded.body)
         if self.max_bytes is not None and size > self.max_bytes:
@@ -388,9 +455,13 @@ class ObjectCache:
                 "cache_max_megabytes); use a coarser mesh",
             )
         with self._lock:
+            held = self._objects.get(loaded.object_id)
+            if held is not None and held.digest != loaded.digest and not replace:
+                raise taken(loaded.object_id, held.digest)
             self._objects[loaded.object_id] = loaded
             self._bytes[loaded.object_id] = size
             self._objects.move_to_end(loaded.object_id)
+            self._recount()
             evicted = []
             while len(self._objects) > self.capacity or (
                     self.max_bytes is not None and len(self._objects) > 1
@@ -413,8 +484,12 @@ def load_cached(
     route: str,
     limits: PlannerLimits,
     progress: Progress = no_progress,
+    replace: bool = False,
 ) -> tuple[LoadedObject, bool]:
     """The cached object of the same id, scene and route, or a freshly loaded and cached one.
+
+    A load under an id that holds another object is refused unless ``replace``
+    (:mod:`.object_ids`), after the request's size checks and before any other work.
 
     Returns
     -------
@@ -425,6 +500,9 @@ def load_cached(
     cached = cache.find(key.object_id, key.digest)
     if cached is not None:
         return cached, True
+    check_requested(source.scene, key.route, limits)
+    if not replace:
+        cache.check_free(key.object_id, key.digest)
     loaded = load_object(source, key, limits, progress)
-    cache.put(loaded)
+    cache.put(loaded, replace)
     return loaded, False

@@ -12,6 +12,7 @@ import numpy as np
 from squeeze_grasp_ros.mechanics.squeeze.graspmap import GraspMap, grasp_map
 from squeeze_grasp_ros.mechanics.elastic.reduced import boundary_displacement, reduced_stiffness
 from squeeze_grasp_ros.mechanics.resistance.optimal import (
+    MAX_DIRECTIONS,
     Resistance,
     ResistanceSweep,
     optimal_resistance,
@@ -24,12 +25,7 @@ from squeeze_grasp_ros.mechanics.squeeze.stable_pure import Squeeze, force_closu
 from squeeze_grasp_ros.mechanics.squeeze.events import EventSqueeze
 from squeeze_grasp_ros.mechanics.vocabulary import ContactKind, SqueezeKind
 from squeeze_grasp_ros.planning.errors import invalid
-from squeeze_grasp_ros.planning.objects import (
-    CONTACT_MODELS,
-    MAX_DIRECTIONS,
-    LoadedObject,
-    PlannerLimits,
-)
+from squeeze_grasp_ros.planning.objects import CONTACT_MODELS, LoadedObject, PlannerLimits
 from squeeze_grasp_ros.planning.checks import check_number, check_step, choice, contact_nodes
 
 
@@ -128,6 +124,7 @@ def resistance_plan(
     directions: int,
     tip_radius: float,
     limits: PlannerLimits,
+    checkpoint: Callable[[], None] | None = None,
 ) -> ResistancePlan:
     """Optimal resistance to the adversary translation ``a`` (Sec. 6).
 
@@ -149,6 +146,8 @@ def resistance_plan(
         Friction: A's fingertip radius, m (0 = the scene's adversary tip radius).
     limits : PlannerLimits
         Friction: the scene's squeeze step must be >= ``limits.min_step``.
+    checkpoint : callable, optional
+        Friction: called before every stepper substep; may raise :class:`Cancelled`.
     """
     loaded.solid()  # INVALID_ARGUMENT for a ring
     mode = choice("mode", mode, SqueezeKind.planned())
@@ -163,7 +162,8 @@ def resistance_plan(
         if count:
             raise invalid("directions: the sweep needs point or segment contacts")
         return ResistancePlan(
-            friction_resistance(loaded, nodes, (x, y), mode, tip_radius, limits), None
+            friction_resistance(loaded, nodes, (x, y), mode, tip_radius, limits, checkpoint),
+            None,
         )
     grasp = loaded.setup.resistance_grasp(contact_model, half_width=width or None, nodes=nodes)
     sweep = sweep_directions(grasp, mode, count) if count else None
@@ -177,8 +177,11 @@ def friction_resistance(
     mode: str,
     tip_radius: float,
     limits: PlannerLimits,
+    checkpoint: Callable[[], None] | None = None,
 ) -> FrictionalResistance:
-    """Algorithm 2 after the scene's event-driven squeeze at F1, F2 (Sec. 6.3)."""
+    """Algorithm 2 after the scene's event-driven squeeze at F1, F2 (Sec. 6.3); ``checkpoint``
+    is called before every stepper substep of both.
+    """
     scene = loaded.scene
     radius = check_number("adversary_tip_radius", tip_radius, 0.0)
     radius = radius or (scene.adversary.tip_radius if scene.adversary is not None else 0.0)
@@ -191,9 +194,9 @@ def friction_resistance(
     loaded.solid()  # INVALID_ARGUMENT for a ring
     i, j, k = (int(n) for n in nodes)
     setup = loaded.setup
-    squeeze = setup.event_squeeze(contacts=(i, j))
+    squeeze = setup.event_squeeze(contacts=(i, j), checkpoint=checkpoint)
     return setup.frictional_resistance(squeeze, mode=mode, a=a, tip_radius=radius,
-                                       adversary_node=k)
+                                       adversary_node=k, checkpoint=checkpoint)
 
 
 @dataclass(frozen=True)
@@ -271,6 +274,7 @@ def event_squeeze_run(
     event_tol: float,
     limits: PlannerLimits,
     progress: Callable[[float], None] | None = None,
+    checkpoint: Callable[[], None] | None = None,
 ) -> EventSqueeze:
     """The scene's event-driven squeeze (Algorithm 1) with the request's overrides.
 
@@ -289,6 +293,8 @@ def event_squeeze_run(
     limits : PlannerLimits
     progress : callable, optional
         Called with the completed fraction; may raise :class:`Cancelled`.
+    checkpoint : callable, optional
+        Called before every stepper substep; may raise :class:`Cancelled`.
     """
     loaded.solid()  # INVALID_ARGUMENT for a ring
     scene = loaded.scene
@@ -308,4 +314,5 @@ def event_squeeze_run(
         step=step,
         event_tol=event_tol,
         progress=progress,
+        checkpoint=checkpoint,
     )

@@ -37,6 +37,8 @@ from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
+from squeeze_grasp_ros.exit_codes import ExitCode
+
 INTERFACE_PACKAGE = "squeeze_grasp_interfaces"
 INSTALL_HINT = "pip install -e '.[ros]'"
 MIN_PYTHON = (3, 10)
@@ -507,7 +509,11 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 def parse_args(argv: Sequence[str] | None) -> argparse.Namespace:
     """Parse the command line."""
-    parser = argparse.ArgumentParser(prog="squeeze-grasp ros-setup", description=DESCRIPTION)
+    parser = argparse.ArgumentParser(
+        prog="squeeze-grasp ros-setup", description=DESCRIPTION,
+        epilog="exit status: 0 ready; 1 (--check) something is due; 2 invalid option; 4 a "
+               "prerequisite is missing (cmake, a compiler, the ROS wheels, a virtual "
+               "environment) or the build failed")
     add_arguments(parser)
     return parser.parse_args(argv)
 
@@ -585,7 +591,7 @@ def run(args: argparse.Namespace) -> int:
     if problems:
         for problem in problems:
             print(f"ros-setup: error: {problem}", file=sys.stderr)
-        return 1
+        return ExitCode.INTERNAL
     try:
         source = resolve_source(args.source)
         if args.check:
@@ -594,8 +600,8 @@ def run(args: argparse.Namespace) -> int:
             setup(layout, source, args.force, args.verbose)
     except SetupError as error:
         print(f"ros-setup: error: {error}", file=sys.stderr)
-        return 1
-    return 0
+        return ExitCode.INTERNAL
+    return ExitCode.OK
 
 
 if __name__ == "__main__":

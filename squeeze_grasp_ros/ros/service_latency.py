@@ -23,6 +23,7 @@ import yaml
 from rclpy.action import ActionClient
 from rclpy.context import Context
 from rclpy.executors import Executor, SingleThreadedExecutor
+from rclpy.qos import HistoryPolicy, QoSProfile, ReliabilityPolicy
 from rclpy.experimental import EventsExecutor
 from rclpy.signals import SignalHandlerOptions
 from rclpy.task import Future
@@ -197,9 +198,16 @@ def bare_times(loaded: planning.LoadedObject, count: int) -> tuple[np.ndarray, n
 
 
 class PlannerProcess:
-    """The planner as its own process (``python -m squeeze_grasp_ros.ros.nodes.planner``)."""
+    """The planner as its own process (``python -m squeeze_grasp_ros.ros.nodes.planner``).
 
-    def __init__(self, namespace: str) -> None:
+    Parameters
+    ----------
+    namespace : str
+    parameters : dict, optional
+        Planner parameters given on the command line (``-p name:=value``).
+    """
+
+    def __init__(self, namespace: str, parameters: dict[str, Any] | None = None) -> None:
         command = [
             sys.executable,
             "-m",
@@ -210,6 +218,8 @@ class PlannerProcess:
             "--log-level",
             "warn",
         ]
+        for name, value in (parameters or {}).items():
+            command += ["-p", f"{name}:={value}"]
         self.process = subprocess.Popen(
             command,
             stdout=subprocess.DEVNULL,
@@ -354,3 +364,80 @@ def start_goal(session: Session, action: ActionClient, nodes: int, object_id: st
     )
     session.client.spin_until(lambda: sent.done() and bool(started), 120.0)
     return sent.result().get_result_async()
+
+
+BURST_QUEUES: tuple[tuple[str, int], ...] = (
+    ("keep-last 10 (rclpy's default)", 10),
+    ("keep-all (the planner's default)", 0),
+)
+"""Request queues the burst table compares: (label, planner parameter service_queue_depth)."""
+KEEP_ALL = QoSProfile(history=HistoryPolicy.KEEP_ALL, depth=1,
+                      reliability=ReliabilityPolicy.RELIABLE)
+"""The burst client's own queues (a keep-last-10 client would drop responses itself)."""
+
+
+def answered(session: Session, futures: list[Future], quiet: float) -> tuple[int, float]:
+    """Spin until every future is done or ``quiet`` s pass without a new one; (done, seconds
+    until the last one was done).
+    """
+    start = last = time.perf_counter()
+    done = 0
+    while done < len(futures) and time.perf_counter() - last < quiet:
+        session.executor.spin_once(timeout_sec=0.05)
+        now = sum(f.done() for f in futures)
+        if now > done:
+            done, last = now, time.perf_counter()
+    return done, last - start
+
+
+def burst_rows(
+    namespace: str, sizes: tuple[int, ...], progress: Progress, quiet: float = 10.0
+) -> list[list[Any]]:
+    """Per request queue and burst size: how many of ``size`` requests sent at once by one
+    client are answered (``plan_squeeze`` on a cached object; ``load_object`` of distinct ids,
+    OK or BUSY; ``grasp_map`` goals, responses and results), the planner in its own process.
+    A request counts as lost when ``quiet`` s pass without any answer.
+    """
+    rows = []
+    for label, depth in BURST_QUEUES:
+        progress(f"ros_services: bursts, {label}")
+        process = PlannerProcess(namespace, {"service_queue_depth": depth})
+        session = Session(namespace, SingleThreadedExecutor, in_process=False)
+        node, planner = session.client.node, session.client.planner_name
+        plan = node.create_client(PlanSqueeze, f"{planner}/plan_squeeze", qos_profile=KEEP_ALL)
+        load = node.create_client(LoadObject, f"{planner}/load_object", qos_profile=KEEP_ALL)
+        action = ActionClient(node, GraspMap, f"{planner}/grasp_map",
+                              goal_service_qos_profile=KEEP_ALL,
+                              result_service_qos_profile=KEEP_ALL)
+        try:
+            load_by_service(session, 500)
+            if not action.wait_for_server(timeout_sec=30.0):
+                raise TimeoutError("the GraspMap action server did not appear")
+            for size in sizes:
+                request = PlanSqueeze.Request(object_id="n500", squeeze_type=SqueezeKind.STABLE,
+                                              depth=DEPTH)
+                plans, seconds = answered(
+                    session, [plan.call_async(request) for _ in range(size)], quiet)
+                loads = [load.call_async(LoadObject.Request(scene_yaml=scene_text(500),
+                                                            object_id=f"burst{k}"))
+                         for k in range(size)]
+                loaded, _ = answered(session, loads, quiet)
+                codes = [f.result().error_code for f in loads if f.done()]
+                goals = [action.send_goal_async(GraspMap.Goal(object_id="n500", mu=0.4))
+                         for _ in range(size)]
+                responses, _ = answered(session, goals, quiet)
+                results = [f.result().get_result_async() for f in goals
+                           if f.done() and f.result().accepted]
+                ended, _ = answered(session, results, quiet)
+                busy = sum(f.result().result.error_code == planning.ErrorCode.BUSY
+                           for f in results if f.done())
+                rows.append([label, size, plans, seconds,
+                             f"{loaded} ({codes.count(planning.ErrorCode.OK)} OK, "
+                             f"{codes.count(planning.ErrorCode.BUSY)} BUSY)",
+                             responses, f"{ended} ({busy} BUSY)",
+                             "yes" if plans == loaded == responses == ended == size else "no"])
+        finally:
+            action.destroy()
+            session.close()
+            process.stop()
+    return rows

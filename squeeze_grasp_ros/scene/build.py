@@ -18,11 +18,16 @@ import numpy as np
 from squeeze_grasp_ros.mechanics.elastic import shapes
 from squeeze_grasp_ros.mechanics.elastic.compliance import ElasticObject
 from squeeze_grasp_ros.mechanics.elastic.material import Material
-from squeeze_grasp_ros.mechanics.elastic.mesh import Mesh, generate_mesh, target_max_area
+from squeeze_grasp_ros.mechanics.elastic.mesh import (
+    MAX_MESH_NODES,
+    Mesh,
+    generate_mesh,
+    target_max_area,
+)
 from squeeze_grasp_ros.mechanics.errors import InvalidInputError
 from squeeze_grasp_ros.mechanics.ring.model import RingModel, ring_from_outline
 from squeeze_grasp_ros.mechanics.vocabulary import Finger, ObjectModel, ShapeType
-from squeeze_grasp_ros.scene.specs import PlacementSpec, Scene, SceneError
+from squeeze_grasp_ros.scene.specs import PlacementSpec, Scene, SceneError, named_placements
 
 
 SHAPE_BUILDERS: dict[ShapeType, Callable[..., shapes.Outline]] = {
@@ -61,21 +66,31 @@ def scene_material(scene: Scene) -> Material:
 
 def placement_points(scene: Scene) -> list[tuple[float, float]]:
     """The placements given as points (fingers, then the adversary), m."""
-    placements = [f.placement for f in scene.fingers.values()]
-    if scene.adversary is not None:
-        placements.append(scene.adversary.placement)
-    return [p.point for p in placements if p.point is not None]
+    return [p.point for _, p in named_placements(scene) if p.point is not None]
 
 
-def build_mesh(scene: Scene, *, outline: shapes.Outline | None = None) -> Mesh:
+def _check_reach(points: np.ndarray, placement: PlacementSpec, where: str) -> None:
+    """A placement point must be near the object (:func:`shapes.require_within_reach`)."""
+    if placement.point is not None:
+        try:
+            shapes.require_within_reach(points, placement.point, f"{where}.placement.point")
+        except InvalidInputError as exc:
+            raise SceneError(str(exc)) from None
+
+
+def build_mesh(scene: Scene, *, outline: shapes.Outline | None = None,
+               max_nodes: int = MAX_MESH_NODES) -> Mesh:
     """Triangulate the scene's solid object with its mesh settings.
 
     A placement given as a point becomes a boundary node exactly (its projection on the
-    outline is a kept vertex of the mesh), so the finger touches where the scene says.
-    ``outline`` replaces :func:`build_outline` of ``object.shape`` when it was read already.
+    outline is a kept vertex of the mesh), so the finger touches where the scene says. A mesh
+    that would have more than ``max_nodes`` nodes is refused before meshing. ``outline``
+    replaces :func:`build_outline` of ``object.shape`` when it was read already.
     """
     if outline is None:
         outline = build_outline(scene.object.shape)
+    for where, placement in named_placements(scene):
+        _check_reach(outline.points, placement, where)
     outline = shapes.with_boundary_points(outline, placement_points(scene))
     ms = scene.object.mesh
     if ms.max_area is not None:
@@ -83,7 +98,7 @@ def build_mesh(scene: Scene, *, outline: shapes.Outline | None = None) -> Mesh:
     else:
         area = target_max_area(outline, ms.nodes if ms.nodes is not None else 600)
     try:
-        return generate_mesh(outline, area, min_angle=ms.min_angle)
+        return generate_mesh(outline, area, min_angle=ms.min_angle, max_nodes=max_nodes)
     except InvalidInputError as exc:
         raise SceneError(f"object.mesh: {exc}") from None
 
@@ -127,6 +142,7 @@ def placement_node(
             )
         return int(placement.node)
     if placement.point is not None:
+        _check_reach(pts, placement, where)
         k = np.argmin(np.linalg.norm(pts - np.asarray(placement.point), axis=1))
         return int(loop[k])
     c = mesh.centroid

@@ -17,6 +17,8 @@ from typing import Any
 
 import numpy as np
 
+from squeeze_grasp_ros.mechanics.elastic.material import Material, require_poisson_ratio
+from squeeze_grasp_ros.mechanics.errors import InvalidInputError
 from squeeze_grasp_ros.mechanics.vocabulary import (
     SQUEEZING_FINGERS,
     Effect,
@@ -33,6 +35,7 @@ from squeeze_grasp_ros.scene.specs import (
     SceneError,
     SensorsSpec,
     finger_devices,
+    named_placements,
 )
 
 SECTION_EFFECT: dict[str, Effect] = {
@@ -126,11 +129,8 @@ def _validate_fingers(scene: Scene) -> None:
 
 def _validate_placements(scene: Scene) -> None:
     """Every placement (fingers, adversary) names exactly one of point, angle_deg, node."""
-    placements = [(f"fingers.{k}", v.placement) for k, v in scene.fingers.items()]
-    if scene.adversary is not None:
-        placements.append(("adversary", scene.adversary.placement))
     keys = [f.name for f in dataclasses.fields(PlacementSpec)]
-    for where, p in placements:
+    for where, p in named_placements(scene):
         given = [k for k in keys if getattr(p, k) is not None]
         if len(given) != 1:
             raise SceneError(
@@ -179,12 +179,16 @@ def _validate_effects(scene: Scene) -> None:
 
 
 def check_material(material: MaterialSpec, where: str = "object.material") -> None:
-    """The material is one its constitutive model can represent: the neo-Hookean model needs
-    nu < 0.5 (its Lame lambda is infinite at 0.5; plane-stress linear models take 0.5).
+    """The material is one its constitutive model can represent (a plane-stress
+    :class:`Material`, and the model's range of Poisson's ratio,
+    :func:`~squeeze_grasp_ros.mechanics.elastic.material.require_poisson_ratio`: the
+    neo-Hookean model's Lame lambda is infinite at nu = 0.5); errors name ``where.<key>``.
     """
-    if material.model == MaterialModel.NEO_HOOKEAN and not material.nu < 0.5:
-        raise SceneError(f"{where}.nu must be < 0.5 for the neo_hookean model (its "
-                         f"lambda is infinite at 0.5), got {material.nu}")
+    try:
+        Material(material.E, material.nu, material.thickness)
+        require_poisson_ratio(material.nu, material.model)
+    except InvalidInputError as exc:
+        raise SceneError(str(exc).replace("material.", f"{where}.", 1)) from None
 
 
 def _validate_object(scene: Scene) -> None:

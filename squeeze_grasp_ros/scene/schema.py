@@ -78,9 +78,16 @@ def spec(
     return dataclasses.field(metadata=meta, **kw)
 
 
+def _number(x: float) -> str:
+    """A bound as messages show it: 0.5, 1e-06, 1e+13 (not 10000000000000.0)."""
+    return repr(x) if x == 0 or 1e-4 <= abs(x) < 1e6 else f"{x:g}"
+
+
 def describe_range(meta: dict) -> str:
     """The range of an entry in words ("in (0.0, 1.0]", ">= 0", "a finite number")."""
     lo, hi = meta.get("lo"), meta.get("hi")
+    lo = None if lo is None else _number(lo)
+    hi = None if hi is None else _number(hi)
     if lo is not None and hi is not None:
         return f"in {'(' if meta.get('lo_open') else '['}{lo}, {hi}]"
     if lo is not None:

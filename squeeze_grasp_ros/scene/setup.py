@@ -27,6 +27,7 @@ from functools import cached_property
 import numpy as np
 
 from squeeze_grasp_ros.mechanics.elastic.compliance import ElasticObject
+from squeeze_grasp_ros.mechanics.elastic.mesh import MAX_MESH_NODES
 from squeeze_grasp_ros.mechanics.elastic.shapes import Outline
 from squeeze_grasp_ros.mechanics.resistance.frictional import (
     FrictionalResistance,
@@ -142,8 +143,8 @@ class GraspSetup:
     body: ElasticObject | RingModel
 
     @classmethod
-    def build(cls, scene: Scene, *, route: str = "factorized",
-              outline: Outline | None = None) -> GraspSetup:
+    def build(cls, scene: Scene, *, route: str = "factorized", outline: Outline | None = None,
+              max_nodes: int = MAX_MESH_NODES) -> GraspSetup:
         """Mesh (or build the ring model of) ``scene`` and place its fingers.
 
         Parameters
@@ -154,6 +155,9 @@ class GraspSetup:
         outline : Outline, optional
             The object's outline when it was read already (a sweep reads outline files on
             its client); default built from ``object.shape``.
+        max_nodes : int
+            Largest mesh, nodes: a larger one is refused before meshing (the planner passes
+            its limit).
 
         Raises
         ------
@@ -162,7 +166,7 @@ class GraspSetup:
         """
         if scene.object.model == ObjectModel.RING:
             return cls(scene, build_ring(scene))
-        mesh = build_mesh(scene, outline=outline)
+        mesh = build_mesh(scene, outline=outline, max_nodes=max_nodes)
         return cls(scene, ElasticObject(mesh, scene_material(scene), route))
 
     def on(self, scene: Scene) -> GraspSetup:
@@ -300,6 +304,7 @@ class GraspSetup:
         reference: bool = False,
         progress: Callable[[float], None] | None = None,
         material_model: MaterialModel | str | None = None,
+        checkpoint: Callable[[], None] | None = None,
     ) -> EventSqueeze:
         """The scene's squeeze with rounded fingertips (Algorithm 1); arguments override the
         scene's values.
@@ -320,6 +325,8 @@ class GraspSetup:
             Called with the completed fraction of the depth.
         material_model : MaterialModel or str, optional
             Constitutive model; default the scene's ``object.material.model``.
+        checkpoint : callable, optional
+            Called before every substep; may raise to abandon the squeeze (a cancellation).
 
         Raises
         ------
@@ -353,6 +360,7 @@ class GraspSetup:
             progress=progress,
             material_model=scene.object.material.model if material_model is None
             else material_model,
+            checkpoint=checkpoint,
         )
 
     # ----------------------------------------------------------------- the adversary
@@ -412,6 +420,7 @@ class GraspSetup:
         a: Sequence[float] | None = None,
         tip_radius: float | None = None,
         adversary_node: int | None = None,
+        checkpoint: Callable[[], None] | None = None,
     ) -> FrictionalResistance:
         """Algorithm 2 after ``squeeze`` (Sec. 6.3): A touches the squeezed object and pushes,
         F1 and F2 resist with frictional segment contacts.
@@ -428,6 +437,8 @@ class GraspSetup:
             A's fingertip radius, m; default the scene's.
         adversary_node : int, optional
             A's contact node; default :attr:`adversary_node`.
+        checkpoint : callable, optional
+            Called before every substep; may raise to abandon the resistance.
         """
         if None in (mode, a, tip_radius, adversary_node):
             adv = self.scene.adversary
@@ -444,7 +455,7 @@ class GraspSetup:
         state = add_adversary(squeeze.state, model, squeeze.displacement, node, tip_radius)
         return frictional_resistance(model, state, a, mode=mode, step=squeeze.step,
                                      event_tol=squeeze.event_tol,
-                                     contacts=[*squeeze.contacts, node])
+                                     contacts=[*squeeze.contacts, node], checkpoint=checkpoint)
 
 
 def event_squeeze_scene(scene: Scene, obj: ElasticObject | None = None,

@@ -16,6 +16,7 @@ from dataclasses import dataclass
 from typing import Any, Optional
 
 from squeeze_grasp_ros.mechanics.elastic.mesh import MAX_MESH_NODES
+from squeeze_grasp_ros.mechanics.ring.model import MAX_RING_ELEMENTS
 from squeeze_grasp_ros.mechanics.vocabulary import (
     ContactKind,
     Effect,
@@ -96,9 +97,10 @@ class MeshSpec:
 class MaterialSpec:
     """Material of the object (plane stress)."""
 
-    E: float = spec("Young's modulus", "Pa", lo=0.0, lo_open=True)
-    nu: float = spec("Poisson's ratio", "", lo=-1.0, hi=0.5, lo_open=True)
-    thickness: float = spec("out-of-plane thickness h (ring: width w)", "m", lo=0.0, lo_open=True)
+    E: float = spec("Young's modulus (gels to diamond)", "Pa", lo=1e-3, hi=1e13)
+    nu: float = spec("Poisson's ratio (neo_hookean: -0.3 to 0.4999)", "", lo=-0.9, hi=0.5)
+    thickness: float = spec("out-of-plane thickness h (ring: width w)", "m", lo=0.0, hi=1e3,
+                            lo_open=True)
     model: MaterialModel = spec("constitutive model of a solid (event-driven squeeze): linear "
                                 "(the paper's), corotational or neo_hookean (finite "
                                 "deformation)", default=MaterialModel.LINEAR)
@@ -109,7 +111,8 @@ class RingSpec:
     """Curved-beam model of a hollow object (Sec. 7): the shape is the middle curve."""
 
     wall_thickness: float = spec("in-plane wall thickness h", "m", lo=0.0, lo_open=True)
-    elements: int = spec("number of beam elements along the middle curve", lo=8, default=200)
+    elements: int = spec("number of beam elements along the middle curve", lo=8,
+                         hi=MAX_RING_ELEMENTS, default=200)
 
 
 @dataclass(frozen=True)
@@ -192,7 +195,7 @@ class SqueezeSpec:
 class FrictionSpec:
     """Coulomb friction between fingertips and object."""
 
-    mu: float = spec("friction coefficient", "", lo=0.0)
+    mu: float = spec("friction coefficient", "", lo=0.0, hi=1e3)
 
 
 @dataclass(frozen=True)
@@ -346,6 +349,14 @@ class Scene:
         if not isinstance(effect, Effect):
             raise TypeError(f"Scene.has takes an Effect, got {effect!r}")
         return effect in self.effects
+
+
+def named_placements(scene: Scene) -> list[tuple[str, PlacementSpec]]:
+    """(field, placement) of the fingers, then the adversary: ``("fingers.F1", ...)``."""
+    placements = [(f"fingers.{k}", v.placement) for k, v in scene.fingers.items()]
+    if scene.adversary is not None:
+        placements.append(("adversary", scene.adversary.placement))
+    return placements
 
 
 def finger_devices(scene: Scene) -> dict[Finger, str]:

@@ -27,7 +27,7 @@ import numpy as np
 
 from squeeze_grasp_ros.mechanics.elastic.strain_measures import COMMON_STRAIN_MEASURE
 from squeeze_grasp_ros.mechanics.elastic.reduced import boundary_displacement, reduced_stiffness
-from squeeze_grasp_ros.mechanics.errors import InvalidInputError
+from squeeze_grasp_ros.mechanics.errors import InvalidInputError, require_relative_depth
 from squeeze_grasp_ros.mechanics.resistance.frictional import FrictionalResistance
 from squeeze_grasp_ros.mechanics.resistance.optimal import (
     Resistance,
@@ -151,20 +151,10 @@ def _requested_depth(requests, sq: Squeeze) -> float:
     """
     for depth, rel in requests:
         if depth is not None:
-            if not (np.isfinite(depth) and depth >= 0):
-                raise InvalidInputError(f"depth must be >= 0 m, got {depth}")
-            rel = sq.relative_depth(depth)
-            if not rel < 1:
-                raise InvalidInputError(
-                    f"depth {depth:.6g} m is a relative depth of {rel:.6g}: it must be below "
-                    "1 (at 1 the fingers would meet)"
-                )
+            require_relative_depth(sq.relative_depth(depth), depth)
             return depth
         if rel is not None:
-            if not (np.isfinite(rel) and 0 <= rel < 1):
-                raise InvalidInputError(
-                    f"relative depth must be in [0, 1) (at 1 the fingers would meet), got {rel}"
-                )
+            require_relative_depth(rel)
             return sq.depth_for_relative(rel)
     return sq.depth_for_relative(DEFAULT_RELATIVE_DEPTH)
 
@@ -457,7 +447,12 @@ def ring_placement(setup: GraspSetup, *, depth: float | None = None,
     scene = setup.scene
     grasp = ring_grasp(setup.ring, setup.contacts, scene.mu, epsilon=_strain_limit(setup),
                        kind=scene.squeeze.type)
-    rho = depth if depth is not None else grasp.depth_for_relative(relative_depth)
+    if depth is not None:
+        require_relative_depth(grasp.relative_depth(depth), depth)
+        rho = depth
+    else:
+        require_relative_depth(relative_depth)
+        rho = grasp.depth_for_relative(relative_depth)
     return RingPlacement(grasp, rho)
 
 

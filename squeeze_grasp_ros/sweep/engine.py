@@ -23,7 +23,7 @@ import threading
 import sys
 import time
 import urllib.request
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Callable, Optional
 
@@ -109,7 +109,8 @@ class Progress:
 class Outcome:
     """What a sweep run did: counts of tasks and evaluations; seconds in all, summed over the
     tasks for preparing groups and evaluating, and until the cluster was ready; the signal
-    (SIGINT, SIGTERM) that stopped it, or None.
+    (SIGINT, SIGTERM) that stopped it, or None; one line per bad part found at the start, moved
+    to ``damaged/`` and redone (:attr:`.store.Store.repaired`).
     """
 
     tasks: int
@@ -125,6 +126,7 @@ class Outcome:
     prepare_s: float
     evaluate_s: float
     startup_s: float = 0.0
+    repaired: list = field(default_factory=list)
 
 
 @contextlib.contextmanager
@@ -148,6 +150,43 @@ def _sigint_blocked():
         signal.pthread_sigmask(signal.SIG_SETMASK, old)
 
 
+CONNECT_TIMEOUT_S = 20.0
+"""Seconds a ``--scheduler`` has to accept a TCP connection (Dask retries within them)."""
+ANSWER_TIMEOUT_S = 10.0
+"""Seconds more it has to answer Dask's handshake once connected."""
+
+
+def probe_scheduler(address: str, connect_timeout: float = CONNECT_TIMEOUT_S,
+                    answer_timeout: float = ANSWER_TIMEOUT_S) -> None:
+    """Connect to ``address`` and complete Dask's handshake, or raise :class:`SweepError`
+    with one line: "cannot connect" after ``connect_timeout`` seconds, "no Dask scheduler
+    answered" after ``answer_timeout`` more.
+
+    Dask bounds the TCP connect but not the handshake after it, so a port that accepts the
+    connection and never answers in Dask's protocol (the dashboard's HTTP port, a web server)
+    held ``Client()`` for ever; this probe bounds both.
+    """
+    import asyncio
+
+    from distributed.comm import connect
+
+    total = connect_timeout + answer_timeout
+
+    async def handshake() -> None:
+        comm = await asyncio.wait_for(connect(address, timeout=connect_timeout), total)
+        await comm.close()
+
+    try:
+        asyncio.run(handshake())
+    except asyncio.TimeoutError:
+        raise SweepError(
+            f"--scheduler {address}: no Dask scheduler answered within {total:g} s (the port "
+            "accepted the connection but did not answer in Dask's protocol: is it the "
+            "dashboard's HTTP port? A scheduler listens on tcp://HOST:8786 by default)") from None
+    except (OSError, ValueError, TypeError) as exc:
+        raise SweepError(f"--scheduler {address}: cannot connect ({exc})") from None
+
+
 def _start(scheduler: Optional[str], workers: Optional[int], stop: "StopSignals"):
     """The client and the local cluster it drives (None with ``scheduler``).
 
@@ -160,7 +199,8 @@ def _start(scheduler: Optional[str], workers: Optional[int], stop: "StopSignals"
     if scheduler is not None:
         try:
             with stop.at_once():
-                return Client(scheduler, timeout="20s"), None
+                probe_scheduler(scheduler)
+                return Client(scheduler, timeout=f"{CONNECT_TIMEOUT_S:g}s"), None
         except (OSError, TimeoutError) as exc:
             raise SweepError(f"--scheduler {scheduler}: cannot connect ({exc})") from None
     n = workers or os.cpu_count() or 1
@@ -306,7 +346,7 @@ def run_sweep(loaded: LoadedSpec, out: str | Path, *, scheduler: Optional[str] =
         store = Store(out, loaded, tasks)
         todo = [t for t in tasks if not store.done(t.id)]
         outcome = Outcome(len(tasks), len(tasks) - len(todo), 0, 0, 0, 0, 0.0, 0, None, None,
-                          0.0, 0.0)
+                          0.0, 0.0, repaired=list(store.repaired))
         client = cluster = None
         try:
             if todo and stop.signal is None:

@@ -50,6 +50,7 @@ from squeeze_grasp_ros.scene import (
     load_scene,
 )
 from squeeze_grasp_ros.scene.checks import validate
+from squeeze_grasp_ros.sweep.limits import check_evaluations, check_objects, check_parameter_sets
 from squeeze_grasp_ros.sweep.spec import LoadedSpec, ObjectEntry, SweepError
 
 
@@ -172,8 +173,17 @@ def _family_shapes(entry: ObjectEntry, seed: int, name: str) -> list[tuple[str, 
     return out
 
 
+def object_count(loaded: LoadedSpec) -> int:
+    """Number of objects of the sweep, counted without drawing the families."""
+    entries = loaded.spec.objects
+    if entries is None:
+        return 1
+    return sum(e.family.count if e.family is not None else 1 for e in entries)
+
+
 def objects(loaded: LoadedSpec) -> list[ObjectItem]:
-    """Every object of the sweep, in spec order."""
+    """Every object of the sweep, in spec order (at most :data:`~.limits.MAX_OBJECTS`)."""
+    check_objects(object_count(loaded))
     sw = loaded.spec
     if sw.objects is None:
         name = loaded.base.name or "base"
@@ -201,8 +211,17 @@ def objects(loaded: LoadedSpec) -> list[ObjectItem]:
     return items
 
 
+def parameter_axes(loaded: LoadedSpec) -> dict[str, int]:
+    """Length of each parameter axis, in grid order."""
+    return {"friction": len(loaded.friction), "tip_radius": len(loaded.tip_radius),
+            "squeeze": len(loaded.squeeze), "depth": len(loaded.depths)}
+
+
 def parameter_grid(loaded: LoadedSpec) -> tuple[Params, ...]:
-    """Friction x tip_radius x squeeze x depth, ids in that order."""
+    """Friction x tip_radius x squeeze x depth, ids in that order (refused beyond
+    :data:`~.limits.MAX_TASK_EVALUATIONS` sets before any is made).
+    """
+    check_parameter_sets(parameter_axes(loaded))
     grid = itertools.product(loaded.friction, loaded.tip_radius, loaded.squeeze, loaded.depths)
     return tuple(Params(f"q{k:04d}", float(mu), float(r), kind, d, rel)
                  for k, (mu, r, kind, (d, rel)) in enumerate(grid))
@@ -270,10 +289,18 @@ def placement_total(loaded: LoadedSpec, item: ObjectItem) -> int:
 
 
 def plan_tasks(loaded: LoadedSpec) -> list[Task]:
-    """Every task of the sweep, sorted by id."""
+    """Every task of the sweep, sorted by id.
+
+    The sweep's size is checked from its counts first (:mod:`~.limits`): parameter sets and
+    objects before they are made, evaluations and tasks before any task is.
+    """
     sw = loaded.spec
     params = parameter_grid(loaded)
     per_task = max(1, sw.chunk // len(params))
+    items = objects(loaded)
+    totals = [placement_total(loaded, item) for item in items]
+    check_evaluations(sum(totals), len(loaded.materials), len(params),
+                      len(loaded.materials) * sum(-(-t // per_task) for t in totals))
     adversary = None
     if sw.adversary is not None:
         a = sw.adversary
@@ -281,8 +308,7 @@ def plan_tasks(loaded: LoadedSpec) -> list[Task]:
     pl = sw.placements
     mu_filter = pl.mu if pl.mu is not None else min(loaded.friction)
     tasks = []
-    for item in objects(loaded):
-        total = placement_total(loaded, item)
+    for item, total in zip(items, totals):
         for mat_name, m in loaded.materials.items():
             group = f"{item.id}~{mat_name}"
             scene = group_scene(loaded, item, m)

@@ -55,6 +55,10 @@ def success(row: dict) -> bool:
     return row["termination"] in SUCCESS
 
 
+QUALITY_UNITS = {"resist_min": "J/m^2", "stiffness": "N/m"}
+"""The unit of each quality a report can colour by."""
+
+
 def quality_key(rows: list[dict]) -> str:
     """``resist_min`` if any row has it, else ``stiffness``."""
     return "resist_min" if any(r["resist_min"] is not None for r in rows) else "stiffness"
@@ -170,6 +174,8 @@ def plot(rows: list[dict], directory: str | Path, outlines: dict | None = None) 
     paths. ``outlines``: object id -> boundary loop [[x, y], ...], m.
     """
     from matplotlib import colormaps
+    from matplotlib.cm import ScalarMappable
+    from matplotlib.colors import Normalize
 
     from squeeze_grasp_ros import plots
 
@@ -185,21 +191,26 @@ def plot(rows: list[dict], directory: str | Path, outlines: dict | None = None) 
             loop = np.array(outlines[obj] + outlines[obj][:1])
             ax.plot(loop[:, 0], loop[:, 1], color="0.4", lw=0.8)
         ax.set_aspect("equal")
+        ax.locator_params(nbins=4)
         good = [r for r in mine if r[qkey] is not None and success(r)]
         for r in mine:
             if not success(r):
                 ax.plot([r["x_F1"], r["x_F2"]], [r["y_F1"], r["y_F2"]], color="0.8", lw=0.5)
         if good:
             q = np.array([r[qkey] for r in good])
-            norm = (q - q.min()) / max(np.ptp(q), 1e-300)
-            for r, v in zip(good, norm):
-                ax.plot([r["x_F1"], r["x_F2"]], [r["y_F1"], r["y_F2"]], color=cmap(v), lw=1.0)
+            scale = Normalize(q.min(), q.max() if np.ptp(q) > 0 else q.min() + 1.0)
+            for r, v in zip(good, q):
+                ax.plot([r["x_F1"], r["x_F2"]], [r["y_F1"], r["y_F2"]], color=cmap(scale(v)),
+                        lw=1.0)
+            bar = fig.colorbar(ScalarMappable(scale, cmap), ax=ax, shrink=0.7)
+            bar.set_label(f"{qkey} [{QUALITY_UNITS[qkey]}]", fontsize=7)
+            bar.ax.tick_params(labelsize=7)
         pts = np.array(
             [[r[k] for k in ("x_F1", "y_F1")] for r in mine]
             + [[r[k] for k in ("x_F2", "y_F2")] for r in mine]
         )
         ax.scatter(pts[:, 0], pts[:, 1], s=6, color="k")
-        ax.set_title(f"{obj}: {qkey} (bright = high)", fontsize=8)
+        ax.set_title(f"{obj}\n(grey: placements that failed)", fontsize=8)
     for ax in axes[len(objects) :]:
         ax.set_visible(False)
     paths = [plots.save(fig, directory / "quality_map.png")]

@@ -29,6 +29,7 @@ from squeeze_grasp_ros.scene import (
     load_scene,
     read_yaml,
 )
+from squeeze_grasp_ros.mechanics.resistance.optimal import MAX_DIRECTIONS
 from squeeze_grasp_ros.scene.checks import check_material, check_shape
 from squeeze_grasp_ros.scene.schema import key_reference, parse_section, spec
 from squeeze_grasp_ros.mechanics.vocabulary import (
@@ -152,6 +153,7 @@ class SweepAdversarySpec:
     directions: int = spec(
         "push directions over which W*_F per unit push is minimised and maximised",
         lo=1,
+        hi=MAX_DIRECTIONS,
         default=72,
     )
 
@@ -178,7 +180,7 @@ class SweepSpec:
     )
     mesh: Optional[MeshSpec] = spec("mesh settings (default: the base scene's)", default=None)
     friction: Optional[tuple[float, ...]] = spec(
-        "friction coefficients mu", "", lo=0.0, default=None
+        "friction coefficients mu", "", lo=0.0, hi=1e3, default=None
     )
     tip_radius: Optional[tuple[float, ...]] = spec(
         "fingertip radii (both fingers)", "m", lo=0.0, lo_open=True, default=None
@@ -190,7 +192,7 @@ class SweepSpec:
         "squeeze depths rho", "m", lo=0.0, lo_open=True, default=None
     )
     relative_depth: Optional[tuple[float, ...]] = spec(
-        "relative depths (finger approach / initial contact distance)",
+        "relative depths (finger approach / initial contact distance; below 1)",
         "",
         lo=0.0,
         hi=1.0,
@@ -393,6 +395,10 @@ def parse_sweep_spec(data: Any, base_dir: Path) -> LoadedSpec:
         depths = tuple((d, None) for d in _axis(sw.depth, None, "depth"))
     elif sw.relative_depth is not None:
         depths = tuple((None, r) for r in _axis(sw.relative_depth, None, "relative_depth"))
+        for k, r in enumerate(sw.relative_depth):
+            if not r < 1:
+                raise SweepError(f"relative_depth[{k}] must be < 1 (at 1 the fingers would "
+                                 f"meet), got {r}")
     elif base.squeeze.depth is not None or base.squeeze.relative_depth is not None:
         depths = ((base.squeeze.depth, base.squeeze.relative_depth),)
     else:

@@ -7,12 +7,18 @@ Layout::
     DIR/manifest.json           spec, spec hash, package version, per-task status
     DIR/parts/<task id>.parquet one file per finished task (rows sorted by eval_id)
     DIR/outlines/<object id>.json  the object's meshed outer boundary, m (for pictures)
+    DIR/damaged/                parts a resume found bad, moved aside (never deleted)
 
 Parts are written to a temporary file in ``parts/``, flushed to disk and renamed into place,
-so a part either exists complete or not at all, whatever kills the process. A part's existence
-is what marks its task done; the manifest (also replaced atomically) repeats the status for
-people and tools, and records failed tasks with their error. Re-running the same spec into the
-same directory therefore skips exactly the finished tasks.
+so a part either exists complete or not at all, whatever kills the process; a write that fails
+(a full disk) removes its temporary file and ends the sweep with one line. A part vouches for
+itself (task id, spec hash, row checksum: :mod:`.parts`), and what marks its task done is a part
+that passes :func:`~.parts.read_part`: a resume moves every other one to ``damaged/`` and
+redoes its task, and the report leaves it out with a line saying why. The manifest (also
+replaced atomically) repeats the status for people and tools and records failed tasks with their
+error; it is read only as a regular file of at most :data:`MAX_MANIFEST_BYTES` and must have the
+manifest's structure. Re-running the same spec into the same directory therefore skips exactly
+the finished, intact tasks.
 """
 
 from __future__ import annotations
@@ -20,25 +26,25 @@ from __future__ import annotations
 import json
 import os
 import time
+from dataclasses import dataclass
 from importlib import metadata
 from pathlib import Path
 
 import pyarrow as pa
-import pyarrow.parquet as pq
 
-from squeeze_grasp_ros.sweep.evaluate import COLUMNS
+from squeeze_grasp_ros.inputs import InputError, read_bytes
+from squeeze_grasp_ros.mechanics.errors import SqueezeGraspError
+from squeeze_grasp_ros.outputs import output_error, write_atomically
+from squeeze_grasp_ros.sweep.parts import SCHEMA, BadPart, part_table, read_part, write_part
 from squeeze_grasp_ros.sweep.plan import Task
 from squeeze_grasp_ros.sweep.spec import LoadedSpec, SweepError
 
-ARROW_TYPES = {
-    "string": pa.string(),
-    "int32": pa.int32(),
-    "float64": pa.float64(),
-    "bool": pa.bool_(),
-}
-SCHEMA = pa.schema([(name, ARROW_TYPES[kind]) for name, kind in COLUMNS.items()])
-"""Arrow schema of every part."""
 MANIFEST_FORMAT = 1
+MAX_MANIFEST_BYTES = 64 * 1024 * 1024
+"""Largest manifest read (20,000 tasks and an 8 MiB spec take about 11 MB)."""
+MAX_OUTLINE_BYTES = 16 * 1024 * 1024
+"""Largest outline file read for pictures."""
+STATUSES = ("done", "failed", "pending")
 
 
 def package_version() -> str:
@@ -51,74 +57,236 @@ def package_version() -> str:
         return __version__
 
 
-def _atomic_write(path: Path, write) -> None:
-    tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
-    write(tmp)
-    with open(tmp, "rb") as fh:
-        os.fsync(fh.fileno())
-    os.replace(tmp, path)
+def read_manifest(out: str | Path) -> dict:
+    """The manifest of a sweep directory, checked: a regular file of at most
+    :data:`MAX_MANIFEST_BYTES` holding a JSON object with a spec hash and a status per task.
+
+    Raises
+    ------
+    SweepError
+        One line: missing, not a regular file, too large, not JSON, or not a manifest.
+    """
+    path = Path(out) / "manifest.json"
+    if not os.path.lexists(path):
+        raise SweepError(f"{out} is not a sweep directory (no manifest.json)")
+    try:
+        text = read_bytes(path, what="manifest", max_bytes=MAX_MANIFEST_BYTES).decode("utf-8")
+        doc = json.loads(text)
+    except InputError as exc:
+        raise SweepError(str(exc)) from None
+    except UnicodeDecodeError as exc:
+        raise SweepError(f"{path}: not a sweep manifest (not UTF-8 text at byte "
+                         f"{exc.start})") from None
+    except json.JSONDecodeError as exc:
+        raise SweepError(f"{path}: not a sweep manifest (invalid JSON at line {exc.lineno}, "
+                         f"column {exc.colno})") from None
+    except RecursionError:
+        raise SweepError(f"{path}: not a sweep manifest (nested too deeply)") from None
+    problem = _manifest_problem(doc)
+    if problem:
+        raise SweepError(f"{path}: not a sweep manifest ({problem})")
+    return doc
+
+
+def _manifest_problem(doc) -> str | None:
+    """What makes ``doc`` not a manifest, or None."""
+    if not isinstance(doc, dict):
+        return f"a JSON {type(doc).__name__}, not an object"
+    for key, kind in (("spec_hash", str), ("tasks", dict), ("counts", dict),
+                      ("package_version", str)):
+        if not isinstance(doc.get(key), kind):
+            return f"'{key}' is missing or not a {kind.__name__}"
+    for tid, entry in doc["tasks"].items():
+        if not (isinstance(entry, dict) and entry.get("status") in STATUSES):
+            return f"task {tid[:80]!r} has no status among {list(STATUSES)}"
+    return None
+
+
+def _part_entries(parts: Path) -> dict[str, os.DirEntry]:
+    """Task id -> directory entry of every ``*.parquet`` name in ``parts/`` (files, folders,
+    FIFOs alike: :func:`~.parts.read_part` judges them).
+    """
+    if not parts.is_dir():
+        return {}
+    with os.scandir(parts) as it:
+        return {e.name[:-len(".parquet")]: e for e in it
+                if e.name.endswith(".parquet") and not e.name.startswith(".")}
+
+
+@dataclass(frozen=True)
+class Dataset:
+    """The trustworthy rows of a sweep directory and what was left out.
+
+    Attributes
+    ----------
+    table : pyarrow.Table
+        Rows of every part that passed :func:`~.parts.read_part`, sorted by ``eval_id``.
+    manifest : dict
+        The checked manifest.
+    counts : dict
+        Tasks "done" (an intact part), "failed" (recorded failure, no part) and "pending".
+    excluded : tuple of str
+        One line per part left out and per task marked done without a part.
+    """
+
+    table: pa.Table
+    manifest: dict
+    counts: dict
+    excluded: tuple[str, ...]
+
+
+def load_dataset(out: str | Path) -> Dataset:
+    """Every verified row of a sweep directory; bad, foreign or missing parts are listed, not
+    read.
+    """
+    manifest = read_manifest(out)
+    tasks, spec_hash = manifest["tasks"], manifest["spec_hash"]
+    entries = _part_entries(Path(out) / "parts")
+    tables, excluded, done = [], [], set()
+    for tid, entry in sorted(entries.items()):
+        if tid not in tasks:
+            excluded.append(f"parts/{entry.name}: left out: belongs to no task of this sweep")
+            continue
+        try:
+            tables.append(read_part(entry.path, tid, spec_hash))
+            done.add(tid)
+        except BadPart as exc:
+            excluded.append(f"parts/{entry.name}: left out: {exc}")
+    for tid, entry in sorted(tasks.items()):
+        if entry["status"] == "done" and tid not in entries:
+            excluded.append(f"task {tid}: marked done but its part is missing (re-run the "
+                            "sweep to redo it)")
+    failed = {t for t, e in tasks.items() if e["status"] == "failed"} - done
+    counts = {"done": len(done), "failed": len(failed),
+              "pending": len(tasks) - len(done) - len(failed)}
+    table = pa.concat_tables(tables).sort_by("eval_id") if tables else SCHEMA.empty_table()
+    return Dataset(table, manifest, counts, tuple(excluded))
+
+
+def read_dataset(out: str | Path) -> pa.Table:
+    """Every verified row of a sweep directory, sorted by ``eval_id`` (:func:`load_dataset`)."""
+    return load_dataset(out).table
+
+
+def read_outlines(out: str | Path) -> dict[str, list]:
+    """Object id -> outer boundary loop [[x, y], ...], m, of the objects written so far
+    (outline files that are not regular, too large or not an outline are skipped).
+    """
+    outlines = {}
+    folder = Path(out) / "outlines"
+    for p in sorted(folder.glob("*.json")) if folder.is_dir() else ():
+        try:
+            loop = json.loads(read_bytes(p, what="outline", max_bytes=MAX_OUTLINE_BYTES))
+            loop = loop["outline"] if isinstance(loop, dict) else None
+        except (InputError, ValueError, RecursionError):
+            continue
+        if isinstance(loop, list):
+            outlines[p.stem] = loop
+    return outlines
 
 
 class Store:
-    """The output directory of one sweep spec."""
+    """The output directory of one sweep spec.
+
+    Attributes
+    ----------
+    repaired : list of str
+        One line per part the opening found bad and moved to ``damaged/`` (its task is redone).
+    """
 
     def __init__(self, out: str | Path, loaded: LoadedSpec, tasks: list[Task]) -> None:
         self.out = Path(out)
         self.parts = self.out / "parts"
         self.loaded = loaded
         self.tasks = {t.id: t for t in tasks}
-        manifest = self.out / "manifest.json"
         self.errors: dict[str, str] = {}
-        if manifest.exists():
-            try:
-                old = json.loads(manifest.read_text())
-            except ValueError as exc:
-                raise SweepError(
-                    f"{manifest}: unreadable manifest ({exc}); use another --out"
-                ) from None
-            if old.get("spec_hash") != loaded.hash:
+        self.repaired: list[str] = []
+        if os.path.lexists(self.out / "manifest.json"):
+            old = read_manifest(self.out)
+            if old["spec_hash"] != loaded.hash:
                 raise SweepError(
                     f"{self.out} holds a sweep of another spec (hash "
-                    f"{str(old.get('spec_hash'))[:12]}, this spec {loaded.hash[:12]}; "
+                    f"{old['spec_hash'][:12]}, this spec {loaded.hash[:12]}; "
                     "a referenced file may have changed): give another --out or "
                     "delete it"
                 )
-        elif self.out.exists() and any(self.out.iterdir()):
+        elif self.out.is_dir() and any(self.out.iterdir()):
             raise SweepError(
                 f"--out {self.out} exists, is not empty and has no manifest.json: "
                 "give a new or empty directory"
             )
-        self.parts.mkdir(parents=True, exist_ok=True)
-        for stale in self.parts.glob(".*.tmp"):
-            stale.unlink()
-        unknown = sorted(p.stem for p in self.parts.glob("*.parquet") if p.stem not in self.tasks)
+        elif self.out.exists() and not self.out.is_dir():
+            raise SweepError(f"--out {self.out} is a file; give a new or empty directory")
+        try:
+            self.parts.mkdir(parents=True, exist_ok=True)
+            for stale in self.parts.glob(".*.tmp"):
+                stale.unlink()
+        except OSError as exc:
+            raise output_error(exc, self.parts, "the sweep's parts folder") from None
+        entries = _part_entries(self.parts)
+        unknown = sorted(tid for tid in entries if tid not in self.tasks)
         if unknown:
             raise SweepError(f"{self.parts} has parts of no task of this spec ({unknown[0]}...)")
+        self.finished: set[str] = set()
+        for tid, entry in sorted(entries.items()):
+            try:
+                read_part(entry.path, tid, loaded.hash)
+                self.finished.add(tid)
+            except BadPart as exc:
+                self.repaired.append(f"parts/{entry.name}: {exc}; moved to "
+                                     f"{self._set_aside(entry)} and redone")
         self.created = time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime())
         self.write_manifest()
+
+    def _set_aside(self, entry: os.DirEntry) -> Path:
+        """Move a bad part into ``damaged/`` under a name not taken yet; its new path."""
+        folder = self.out / "damaged"
+        try:
+            folder.mkdir(exist_ok=True)
+            k = 0
+            while os.path.lexists(folder / f"{entry.name}.{k}"):
+                k += 1
+            os.replace(entry.path, folder / f"{entry.name}.{k}")
+        except OSError as exc:
+            raise output_error(exc, folder, "a damaged part into") from None
+        return folder / f"{entry.name}.{k}"
 
     def part(self, task_id: str) -> Path:
         """Parquet file of a task."""
         return self.parts / f"{task_id}.parquet"
 
     def done(self, task_id: str) -> bool:
-        """The task's part exists (it is complete: parts appear by rename)."""
-        return self.part(task_id).exists()
+        """The task has an intact part (checked when the store was opened, or written since)."""
+        return task_id in self.finished
 
     def write(self, task: Task, rows: list[dict], outline: list | None = None) -> int:
         """Write a task's rows (and its object's outline, once) atomically and update the
         manifest; returns the row count.
+
+        Raises
+        ------
+        InvalidInputError, InternalError
+            One line when the folder refuses the write (exit 2) or the disk is full (exit 4);
+            the parts written before stay, and re-running resumes.
         """
-        if outline is not None:
-            path = self.out / "outlines" / f"{task.obj.id}.json"
-            if not path.exists():
-                path.parent.mkdir(exist_ok=True)
-                text = json.dumps({"object_id": task.obj.id, "outline": outline})
-                _atomic_write(path, lambda p: p.write_text(text))
-        table = pa.Table.from_pylist(rows, schema=SCHEMA)
-        _atomic_write(self.part(task.id), lambda p: pq.write_table(table, p))
-        self.errors.pop(task.id, None)
-        self.write_manifest()
+        try:
+            if outline is not None:
+                path = self.out / "outlines" / f"{task.obj.id}.json"
+                if not path.exists():
+                    try:
+                        path.parent.mkdir(exist_ok=True)
+                    except OSError as exc:
+                        raise output_error(exc, path.parent, "the outlines folder") from None
+                    text = json.dumps({"object_id": task.obj.id, "outline": outline})
+                    write_atomically(path, lambda p: p.write_text(text), "an outline")
+            table = part_table(rows, task.id, self.loaded.hash)
+            write_atomically(self.part(task.id), lambda p: write_part(p, table), "a part")
+            self.finished.add(task.id)
+            self.errors.pop(task.id, None)
+            self.write_manifest()
+        except SqueezeGraspError as exc:
+            raise type(exc)(f"{exc}; the {len(self.finished)} part(s) written are kept: "
+                            "re-run the same command to resume") from None
         return len(rows)
 
     def fail(self, task: Task, error: str) -> None:
@@ -144,9 +312,7 @@ class Store:
             "package_version": package_version(),
             "created": self.created,
             "updated": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime()),
-            "counts": {
-                k: sum(1 for v in status.values() if v == k) for k in ("done", "failed", "pending")
-            },
+            "counts": {k: sum(1 for v in status.values() if v == k) for k in STATUSES},
             "tasks": {
                 tid: (
                     {"status": s, "error": self.errors[tid]}
@@ -157,32 +323,4 @@ class Store:
             },
         }
         text = json.dumps(doc, indent=1, sort_keys=True, default=str)
-        _atomic_write(self.out / "manifest.json", lambda p: p.write_text(text))
-
-
-def read_dataset(out: str | Path) -> pa.Table:
-    """Every finished row of a sweep directory, sorted by ``eval_id``."""
-    parts = Path(out) / "parts"
-    if not (Path(out) / "manifest.json").is_file():
-        raise SweepError(f"{out} is not a sweep directory (no manifest.json)")
-    files = sorted(parts.glob("*.parquet"))
-    if not files:
-        return SCHEMA.empty_table()
-    table = pa.concat_tables([pq.read_table(f, schema=SCHEMA) for f in files])
-    return table.sort_by("eval_id")
-
-
-def read_outlines(out: str | Path) -> dict[str, list]:
-    """Object id -> outer boundary loop [[x, y], ...], m, of the objects written so far."""
-    return {
-        p.stem: json.loads(p.read_text())["outline"]
-        for p in sorted((Path(out) / "outlines").glob("*.json"))
-    }
-
-
-def read_manifest(out: str | Path) -> dict:
-    """The manifest of a sweep directory."""
-    path = Path(out) / "manifest.json"
-    if not path.is_file():
-        raise SweepError(f"{out} is not a sweep directory (no manifest.json)")
-    return json.loads(path.read_text())
+        write_atomically(self.out / "manifest.json", lambda p: p.write_text(text), "the manifest")

@@ -78,6 +78,7 @@ class FactorizedSolver:
         self.lu = spla.splu(Kp, permc_spec="NATURAL", diag_pivot_thresh=0.0,
                             options={"SymmetricMode": True})
         self.pivoted = not np.array_equal(self.lu.perm_r, np.arange(len(self.order)))
+        self.factor_copies: tuple[sp.csc_matrix, sp.csc_matrix] | tuple[()] = ()
         self.condition = _condition_estimate(Kp, self.lu)
 
     @staticmethod
@@ -118,6 +119,10 @@ class FactorizedSolver:
             E[boundary_dofs, np.arange(len(boundary_dofs))] = 1.0
             return self.solve(E)[boundary_dofs]
         L, U = trailing_factors(self.lu, n_first)
+        # SuperLU keeps the sparse L and U it built for trailing_factors for as long as it
+        # lives (scipy caches them: as large as the factorisation itself). Holding them here
+        # too costs nothing and lets memory accounting (planning.resident_bytes) count them.
+        self.factor_copies = (self.lu.L, self.lu.U)
         X = np.zeros((len(boundary_dofs), len(boundary_dofs)))
         where = np.full(self.K.shape[0], -1)
         where[boundary_dofs] = np.arange(len(boundary_dofs))

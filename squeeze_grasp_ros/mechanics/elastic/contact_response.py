@@ -36,8 +36,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from squeeze_grasp_ros.mechanics.elastic.hyperelastic import (MeshGeometry, area_ratios,
-                                                                assemble, mesh_geometry)
+from squeeze_grasp_ros.mechanics.elastic.hyperelastic import (MeshGeometry, assemble,
+                                                                determinants, mesh_geometry)
 from squeeze_grasp_ros.mechanics.elastic.interior import (ContactStiffness, InteriorBlocks,
                                                           TangentFactor)
 from squeeze_grasp_ros.mechanics.errors import InvalidInputError
@@ -233,9 +233,9 @@ class ContactResponse:
         return self._current.energy
 
     # ------------------------------------------------------------------ helpers
-    def _assemble(self, u: np.ndarray, *, tangent: bool):
+    def _assemble(self, u: np.ndarray, *, tangent: bool, deformation: np.ndarray | None = None):
         return assemble(self.model, self.nodes, self.triangles, u, nu=self.nu,
-                        geometry=self.geometry, tangent=tangent)
+                        geometry=self.geometry, tangent=tangent, deformation=deformation)
 
     def _stiffness(self) -> float:
         """Largest entry of the reference (undeformed) tangent: the scale of NEWTON_TOL."""
@@ -286,23 +286,29 @@ class ContactResponse:
                                                        DISPLACEMENT_FLOOR)
         return known_K if close else None
 
-    def _min_det(self, u: np.ndarray) -> float:
-        return float(area_ratios(self.geometry.gradient, u).min())
+    def _upright(self, u: np.ndarray) -> np.ndarray | None:
+        """The deformation gradients of ``u`` if every area ratio det F is above
+        MIN_AREA_RATIO, else None (an inverted state).
+        """
+        F = self.geometry.deformation(u)
+        return F if float(determinants(F).min()) > MIN_AREA_RATIO else None
 
-    def _start(self, u: np.ndarray, delta: np.ndarray) -> np.ndarray | None:
+    def _start(self, u: np.ndarray, delta: np.ndarray) -> tuple | None:
         """Newton's first iterate for contact displacements ``delta`` from the state ``u``:
         the interior moved along the last converged rate map (first-order predictor, when one
-        is known and it inverts nothing), else where ``u`` has it; None if the contact
-        displacement itself inverts an element.
+        is known and it inverts nothing), else where ``u`` has it; (iterate, its deformation
+        gradients), or None if the contact displacement itself inverts an element.
         """
         plain = u.copy()
         plain[self.cdofs] = delta.reshape(-1)
         if self._current is not None:
             predicted = plain.copy()
             predicted[self.free] -= self._predictor(plain[self.cdofs] - u[self.cdofs])
-            if self._min_det(predicted) > MIN_AREA_RATIO:
-                return predicted
-        return plain if self._min_det(plain) > MIN_AREA_RATIO else None
+            F = self._upright(predicted)
+            if F is not None:
+                return predicted, F
+        F = self._upright(plain)
+        return None if F is None else (plain, F)
 
     def _predictor(self, d: np.ndarray) -> np.ndarray:
         """K_ff^-1 K_fc d at the current state: exact when d is a multiple of a direction the
@@ -320,13 +326,14 @@ class ContactResponse:
         """Equilibrium of the free DOFs with the contact DOFs at ``delta``; (u, assembly, its,
         residual) or a ResponseFailure.
         """
-        u = self._start(u, delta)
-        if u is None:
+        start = self._start(u, delta)
+        if start is None:
             return ResponseFailure("the prescribed contact displacement inverts an element",
                                    inverted=True)
+        u, F = start
         held = self._blocks.solve if self._blocks is not None else None
         solve, fresh, its = (held if _REUSE[0] else None), False, 0
-        asm = self._assemble(u, tangent=False)
+        asm = self._assemble(u, tangent=False, deformation=F)
         scale = max(np.linalg.norm(asm.force[self.cdofs]),
                     self._stiffness() * max(np.linalg.norm(delta), DISPLACEMENT_FLOOR))
         r = asm.force[self.free]
@@ -337,7 +344,7 @@ class ContactResponse:
             if solve is None:
                 K = asm.tangent if asm.tangent is not None else self._known(u, KNOWN_START)
                 if K is None:
-                    asm = self._assemble(u, tangent=True)
+                    asm = self._assemble(u, tangent=True, deformation=asm.deformation)
                     K = asm.tangent
                 solve, fresh = self._factor(K), True
                 if solve is None:
@@ -350,9 +357,10 @@ class ContactResponse:
             for _ in range(BACKTRACKS):
                 trial = u.copy()
                 trial[self.free] += step
-                if self._min_det(trial) > MIN_AREA_RATIO:
+                F = self._upright(trial)
+                if F is not None:
                     inverted = False
-                    t_asm = self._assemble(trial, tangent=False)
+                    t_asm = self._assemble(trial, tangent=False, deformation=F)
                     t_norm = np.linalg.norm(t_asm.force[self.free])
                     if t_norm < norm:
                         break
@@ -408,7 +416,7 @@ class ContactResponse:
         self.stats["iterations"] += its
         K = asm.tangent if asm.tangent is not None else self._known(u, KNOWN_STATE)
         if K is None:
-            K = self._assemble(u, tangent=True).tangent
+            K = self._assemble(u, tangent=True, deformation=asm.deformation).tangent
         self._known_tangent = None
         C = self._stiffness_of(K)
         if C is None:

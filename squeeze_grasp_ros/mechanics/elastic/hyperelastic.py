@@ -43,11 +43,21 @@ from squeeze_grasp_ros.mechanics.errors import InvalidInputError, NumericalError
 from squeeze_grasp_ros.mechanics.vocabulary import MaterialModel
 
 __all__ = ["Assembly", "InvertedElementError", "MeshGeometry", "area_ratios", "assemble",
-           "deformation", "gradient_operator", "mesh_geometry", "stress_and_tangent",
-           "thickness_stretch"]
+           "deformation", "determinants", "gradient_operator", "mesh_geometry",
+           "stress_and_tangent", "thickness_stretch"]
 
 _PLANE_STRESS_ITERATIONS = 30
 _SKEW = np.array([[0.0, -1.0], [1.0, 0.0]])
+_PAIRS = np.indices((2, 2, 2, 2)).reshape(4, -1)  # (i, j, k, l) of the 16 entries of ij x kl
+_OUTER = (2 * _PAIRS[0] + _PAIRS[1], 2 * _PAIRS[2] + _PAIRS[3])
+"""Flat (2x2 -> 4) positions of the factors of g_ij g_kl, entry by entry of a 4x4 tangent."""
+_CROSS = (2 * _PAIRS[0] + _PAIRS[3], 2 * _PAIRS[2] + _PAIRS[1])
+"""The same for G_il G_kj."""
+_TRANSPOSE = np.arange(36).reshape(6, 6).T.ravel()
+"""Entry of a flat 6x6 element matrix that is its transpose's."""
+_FORCE = (np.array([0, 0, 2, 2, 4, 4]), np.array([0, 2, 0, 2, 0, 2]),
+          np.array([1, 1, 3, 3, 5, 5]), np.array([1, 3, 1, 3, 1, 3]))
+"""Flat positions of g_a0, P_i0, g_a1, P_i1 for the element forces in (a, i) order."""
 
 
 class InvertedElementError(NumericalError):
@@ -68,12 +78,15 @@ class Assembly:
         d force / d u, dimensionless, symmetric (None if not assembled).
     min_det : float
         Smallest det F (in-plane) over the elements.
+    deformation : (t, 2, 2) ndarray
+        The deformation gradients F it was assembled from.
     """
 
     energy: float
     force: np.ndarray
     tangent: sp.csr_matrix | None
     min_det: float
+    deformation: np.ndarray
 
 
 def _shape_gradients(nodes: np.ndarray, triangles: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -95,7 +108,10 @@ def deformation(nodes: np.ndarray, triangles: np.ndarray, u: np.ndarray) -> np.n
 
 def _deformation(gradient: sp.csr_matrix, u: np.ndarray) -> np.ndarray:
     """F = I + grad u (t, 2, 2) from the :func:`gradient_operator` of the mesh."""
-    return np.eye(2) + (gradient @ np.asarray(u, float).reshape(-1)).reshape(-1, 2, 2)
+    F = gradient @ np.asarray(u, float).reshape(-1)
+    F[0::4] += 1.0
+    F[3::4] += 1.0
+    return F.reshape(-1, 2, 2)
 
 
 def gradient_operator(nodes: np.ndarray, triangles: np.ndarray) -> sp.csr_matrix:
@@ -130,7 +146,11 @@ def area_ratios(gradient: sp.csr_matrix, u: np.ndarray) -> np.ndarray:
     >>> area_ratios(gradient_operator(X, tri), squash).tolist()
     [-0.5]
     """
-    F = _deformation(gradient, u)
+    return determinants(_deformation(gradient, u))
+
+
+def determinants(F: np.ndarray) -> np.ndarray:
+    """The area ratios det F (t,) of the deformation gradients F (t, 2, 2)."""
     return F[:, 0, 0] * F[:, 1, 1] - F[:, 0, 1] * F[:, 1, 0]
 
 
@@ -210,24 +230,30 @@ def _require_compressible(nu: float) -> None:
 def _neo_hookean(F: np.ndarray, nu: float, tangent: bool):
     _require_compressible(nu)
     lam, mu = _lame(nu)
-    J2 = F[:, 0, 0] * F[:, 1, 1] - F[:, 0, 1] * F[:, 1, 0]
+    J2 = determinants(F)
     l3 = _thickness_stretch(J2, lam, mu)
     lnJ = np.log(J2 * l3)
-    G = np.stack([np.stack([F[:, 1, 1], -F[:, 1, 0]], -1),
-                  np.stack([-F[:, 0, 1], F[:, 0, 0]], -1)], 1) / J2[:, None, None]  # F^-T
+    G = np.empty_like(F)  # F^-T
+    G[:, 0, 0], G[:, 1, 1] = F[:, 1, 1], F[:, 0, 0]
+    G[:, 0, 1], G[:, 1, 0] = -F[:, 1, 0], -F[:, 0, 1]
+    G /= J2[:, None, None]
     I1 = np.einsum("tij,tij->t", F, F) + l3 * l3
     W = 0.5 * mu * (I1 - 3.0) - mu * lnJ + 0.5 * lam * lnJ * lnJ
     a = lam * lnJ - mu
-    P = mu * F + a[:, None, None] * G
+    g = G.reshape(-1, 4)
+    P = (mu * F.reshape(-1, 4) + a[:, None] * g).reshape(-1, 2, 2)
     if not tangent:
         return W, P, None
-    g = G.reshape(-1, 4)
-    outer = g[:, :, None] * g[:, None, :]
-    cross = (G[:, :, None, None, :] * np.swapaxes(G, 1, 2)[:, None, :, :, None]).reshape(-1, 4, 4)
+    # A = mu I + (lam - (lam / l3)^2 / w33) g g^T - a X with X[ij, kl] = G_il G_kj, as (t, 16)
+    # rows built in place (the tangent's arrays are the largest of an assembly)
+    A = np.take(g, _OUTER[0], axis=1) * np.take(g, _OUTER[1], axis=1)
     w33 = mu + mu / l3 ** 2 + lam * (1.0 - lnJ) / l3 ** 2
-    A = (mu * np.eye(4)[None] + (lam - (lam / l3) ** 2 / w33)[:, None, None] * outer
-         - a[:, None, None] * cross).reshape(-1, 2, 2, 2, 2)
-    return W, P, A
+    A *= (lam - (lam / l3) ** 2 / w33)[:, None]
+    A += mu * np.eye(4).ravel()
+    cross = np.take(g, _CROSS[0], axis=1) * np.take(g, _CROSS[1], axis=1)
+    cross *= a[:, None]
+    A -= cross
+    return W, P, A.reshape(-1, 2, 2, 2, 2)
 
 
 def thickness_stretch(model: MaterialModel | str, F: np.ndarray, *, nu: float) -> np.ndarray:
@@ -255,7 +281,7 @@ def thickness_stretch(model: MaterialModel | str, F: np.ndarray, *, nu: float) -
     if model == MaterialModel.NEO_HOOKEAN:
         _require_compressible(nu)
         lam, mu = _lame(nu)
-        return _thickness_stretch(F[:, 0, 0] * F[:, 1, 1] - F[:, 0, 1] * F[:, 1, 0], lam, mu)
+        return _thickness_stretch(determinants(F), lam, mu)
     raise InvalidInputError("the linear model has no thickness stretch (small strain: its "
                             "stress is C : eps on the reference configuration)")
 
@@ -280,7 +306,7 @@ def stress_and_tangent(model: MaterialModel | str, F: np.ndarray, *, nu: float,
 
 def assemble(model: MaterialModel | str, nodes: np.ndarray, triangles: np.ndarray,
              u: np.ndarray, *, nu: float, geometry: MeshGeometry | None = None,
-             tangent: bool = True) -> Assembly:
+             tangent: bool = True, deformation: np.ndarray | None = None) -> Assembly:
     """Energy, internal forces and tangent stiffness of the displacement ``u`` (2n,), m.
 
     Parameters
@@ -301,6 +327,9 @@ def assemble(model: MaterialModel | str, nodes: np.ndarray, triangles: np.ndarra
     tangent : bool
         Assemble the tangent stiffness too (False: energy and forces only, about half the
         work; ``Assembly.tangent`` is None).
+    deformation : (t, 2, 2) ndarray, optional
+        F of ``u`` (:meth:`MeshGeometry.deformation`) when the caller has it already, as after
+        testing a state for inverted elements (computed here otherwise).
 
     Raises
     ------
@@ -308,36 +337,42 @@ def assemble(model: MaterialModel | str, nodes: np.ndarray, triangles: np.ndarra
         If an element has det F <= 0.
     """
     geometry = mesh_geometry(nodes, triangles) if geometry is None else geometry
-    F = _deformation(geometry.gradient, u)
-    det = F[:, 0, 0] * F[:, 1, 1] - F[:, 0, 1] * F[:, 1, 0]
+    F = geometry.deformation(u) if deformation is None else deformation
+    det = determinants(F)
     worst = int(np.argmin(det))
     if not det[worst] > 0:
         raise InvertedElementError(f"element {worst} inverted (det F = {det[worst]:.3g})",
                                    residuals={"det_F": det[worst]})
     W, P, A = stress_and_tangent(model, F, nu=nu, tangent=tangent)
     area, G, Gt = geometry.area, geometry.G, geometry.Gt
-    fe = area[:, None] * (Gt @ P.reshape(-1, 4, 1))[..., 0]
+    # fe[a, i] = g_a0 P_i0 + g_a1 P_i1 (the product Gt P without its zeros)
+    g, p = geometry.grad.reshape(-1, 6), P.reshape(-1, 4)
+    fe = area[:, None] * (np.take(g, _FORCE[0], axis=1) * np.take(p, _FORCE[1], axis=1)
+                          + np.take(g, _FORCE[2], axis=1) * np.take(p, _FORCE[3], axis=1))
     n2 = geometry.n2
     force = np.bincount(geometry.dofs.ravel(), weights=fe.reshape(-1), minlength=n2)
     K = None
     if tangent:
-        ke = area[:, None, None] * (Gt @ A.reshape(-1, 4, 4) @ G)
-        ke = 0.5 * (ke + np.swapaxes(ke, 1, 2))
+        ke = (Gt @ A.reshape(-1, 4, 4) @ G).reshape(-1, 36)
+        ke *= area[:, None]
+        ke = ke + np.take(ke, _TRANSPOSE, axis=1)
+        ke *= 0.5
         data = np.bincount(geometry.slots, weights=ke.ravel(), minlength=len(geometry.indices))
         K = sp.csr_matrix((data, geometry.indices, geometry.indptr), shape=(n2, n2))
-    return Assembly(float(np.dot(W, area)), force, K, float(det[worst]))
+    return Assembly(float(np.dot(W, area)), force, K, float(det[worst]), F)
 
 
 @dataclass(frozen=True)
 class MeshGeometry:
     """What :func:`assemble` needs of a mesh that does not change with the displacement: the
-    :func:`gradient_operator`, element areas, the (t, 4, 6) map of element DOFs to dF, and the
-    sparsity pattern of the stiffness (CSR ``indices``/``indptr``; ``slots`` places every element
-    entry).
+    :func:`gradient_operator`, element areas, the reference shape-function gradients ``grad``
+    (t, 3, 2), the (t, 4, 6) map of element DOFs to dF, and the sparsity pattern of the
+    stiffness (CSR ``indices``/``indptr``; ``slots`` places every element entry).
     """
 
     gradient: sp.csr_matrix
     area: np.ndarray
+    grad: np.ndarray
     G: np.ndarray
     Gt: np.ndarray
     dofs: np.ndarray
@@ -345,6 +380,10 @@ class MeshGeometry:
     slots: np.ndarray
     indices: np.ndarray
     indptr: np.ndarray
+
+    def deformation(self, u: np.ndarray) -> np.ndarray:
+        """Deformation gradients F = I + grad u (t, 2, 2) of the displacement ``u`` (2n,)."""
+        return _deformation(self.gradient, u)
 
 
 def mesh_geometry(nodes: np.ndarray, triangles: np.ndarray) -> MeshGeometry:
@@ -365,6 +404,6 @@ def mesh_geometry(nodes: np.ndarray, triangles: np.ndarray) -> MeshGeometry:
     cols = np.tile(dofs, (1, 6)).ravel()
     keys, slots = np.unique(rows * n2 + cols, return_inverse=True)
     indptr = np.searchsorted(keys // n2, np.arange(n2 + 1))
-    return MeshGeometry(gradient_operator(nodes, triangles), area, G,
+    return MeshGeometry(gradient_operator(nodes, triangles), area, grad, G,
                         np.ascontiguousarray(np.swapaxes(G, 1, 2)), dofs, n2, slots.ravel(),
                         keys % n2, indptr)

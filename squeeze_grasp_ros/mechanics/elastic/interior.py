@@ -1,17 +1,27 @@
 # Copyright 2026 squeeze_grasp_ros developers
 # SPDX-License-Identifier: Apache-2.0
-"""The interior block of a contact set's tangent: its LDL^T factorisation and the contact
+"""The interior block of a contact set's tangent: its sparse factorisation and the contact
 stiffness dF/d delta as an operator.
 
 With the contact DOFs c prescribed, the interior (free) DOFs f of the tangent K carry the
-equilibrium. :class:`TangentFactor` factorises K_ff by LDL^T (QDLDL, with its own
-approximate-minimum-degree order; no pivoting: K_ff of a stable state is positive definite),
-holding the contact DOFs as identity rows, so that one pattern, ordering and solver serve every
-contact set of an object. :class:`InteriorBlocks` gathers a set's K_fc and K_cc out of the
-assembled tangent through index maps built once per set. :class:`ContactStiffness` is
-S = K_cc - K_cf K_ff^-1 K_fc of one state applied to vectors, one interior solve per vector
-(memoised): the stepper needs S times the finger motion (and one more vector per sliding
-contact), never the whole matrix.
+equilibrium. :class:`TangentFactor` factorises K_ff, holding the contact DOFs as identity rows,
+so that one pattern, ordering and symbolic analysis serve every contact set of an object. Two
+factorisers (:class:`~squeeze_grasp_ros.mechanics.vocabulary.Factorizer`):
+
+- ``cholmod``: the supernodal Cholesky factorisation LL^T of SuiteSparse CHOLMOD (through
+  cvxopt, the ``cholmod`` extra), in METIS's nested-dissection order (pymetis, same extra) or
+  CHOLMOD's approximate minimum degree, whichever fills less (its analysis tries both; AMD
+  on the 2,054-node foam square, METIS on 8,038 nodes and more): dense BLAS kernels on the
+  supernodes, about 5x faster than QDLDL on an 8,000-node object, where the factorisation is
+  most of an evaluation's cost. It needs K_ff positive definite (every stable state); a tangent it
+  refuses is factorised by QDLDL.
+- ``qdldl``: LDL^T without pivoting by QDLDL, with its own AMD order; needs only nonzero pivots.
+  The default when cvxopt is not installed.
+
+:class:`InteriorBlocks` gathers a set's K_fc and K_cc out of the assembled tangent through index
+maps built once per set. :class:`ContactStiffness` is S = K_cc - K_cf K_ff^-1 K_fc of one state
+applied to vectors, one interior solve per vector (memoised): the stepper needs S times the
+finger motion (and one more vector per sliding contact), never the whole matrix.
 
 >>> import numpy as np, scipy.sparse as sp
 >>> K = sp.csr_matrix(np.array([[4.0, 1, 0], [1, 3, 1], [0, 1, 2]]))
@@ -22,14 +32,49 @@ contact), never the whole matrix.
 """
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 
 import numpy as np
-import qdldl
 import scipy.sparse as sp
 
-__all__ = ["ContactStiffness", "InteriorBlocks", "TangentFactor"]
+from squeeze_grasp_ros.extras import install_hint, installed
+from squeeze_grasp_ros.mechanics.vocabulary import Factorizer
+
+__all__ = ["ContactStiffness", "Fill", "InteriorBlocks", "TangentFactor", "default_factorizer",
+           "factorizer", "nested_dissection"]
+
+_FACTORIZER: list[Factorizer | None] = [None]
+
+
+def default_factorizer() -> Factorizer:
+    """The factoriser new :class:`TangentFactor` objects use: the one set by
+    :func:`factorizer`, else ``cholmod`` when cvxopt is installed, else ``qdldl``.
+    """
+    if _FACTORIZER[0] is not None:
+        return _FACTORIZER[0]
+    return Factorizer.CHOLMOD if installed("cvxopt") else Factorizer.QDLDL
+
+
+@contextmanager
+def factorizer(method: Factorizer | str) -> Iterator[None]:
+    """Within the block, new :class:`TangentFactor` objects use ``method`` (for comparing the
+    factorisers on one squeeze).
+
+    Raises
+    ------
+    ImportError
+        If ``method`` is ``cholmod`` and cvxopt is not installed.
+    """
+    method = Factorizer(method)
+    if method == Factorizer.CHOLMOD and not installed("cvxopt"):
+        raise ImportError(f"the cholmod factoriser needs cvxopt: {install_hint('cvxopt')}")
+    before, _FACTORIZER[0] = _FACTORIZER[0], method
+    try:
+        yield
+    finally:
+        _FACTORIZER[0] = before
 
 
 def _gather(K: sp.csr_matrix, rows: np.ndarray, cols: np.ndarray, *,
@@ -52,12 +97,61 @@ def _values(block: sp.csc_matrix, at: np.ndarray, K: sp.csr_matrix) -> sp.csc_ma
     return out
 
 
+def nested_dissection(pattern: sp.spmatrix) -> np.ndarray | None:
+    """METIS's nested-dissection order of the DOFs of a tangent with the sparsity ``pattern``
+    (two DOFs per node, x and y, kept together: the order is that of the node graph), as the
+    permutation p of P K P^T = K[p][:, p]; None if pymetis is not installed.
+
+    On the foam square's interior tangent it needs 19 % (8,038 nodes) and 33 % (20,054) fewer
+    flops than approximate minimum degree, and 7-10 % fewer entries of L.
+
+    >>> import scipy.sparse as sp
+    >>> order = nested_dissection(sp.eye(6, k=2) + sp.eye(6) + sp.eye(6, k=-2))
+    >>> order is None or sorted(order.tolist()) == list(range(6))
+    True
+    """
+    if not installed("pymetis"):
+        return None
+    import pymetis
+
+    structure = sp.csr_matrix(pattern, dtype=bool).astype(np.int8)
+    nodes = sp.csr_matrix((structure + structure.T)[0::2][:, 0::2])
+    nodes.setdiag(0)
+    nodes.eliminate_zeros()
+    perm, _ = pymetis.nested_dissection(pymetis.CSRAdjacency(nodes.indptr, nodes.indices))
+    perm = np.asarray(perm, dtype=np.int64)
+    order = np.stack([2 * perm, 2 * perm + 1], 1).reshape(-1)
+    return order[order < pattern.shape[0]]  # an odd size: the last node has x only
+
+
+@dataclass(frozen=True)
+class Fill:
+    """Size and cost of one factorisation of K_ff.
+
+    Attributes
+    ----------
+    nnz : int
+        Entries of the factor L as stored (diagonal included; a supernodal factor stores the
+        zeros inside its dense supernodes).
+    flops : float
+        Multiply-adds of the numeric factorisation, sum over the columns of L of (entries)^2.
+    """
+
+    nnz: int
+    flops: float
+
+
 @dataclass
 class TangentFactor:
-    """LDL^T factorisation of tangents of one mesh with a set of DOFs held: their rows and
-    columns replaced by those of the identity, which leaves K_ff of the other DOFs. Every contact
-    set of an object so shares one sparsity pattern, one ordering and one QDLDL solver, which
-    refactors in place (mutable).
+    """Factorisation of tangents of one mesh with a set of DOFs held: their rows and columns
+    replaced by those of the identity, which leaves K_ff of the other DOFs. Every contact set of
+    an object so shares one sparsity pattern, one ordering and one symbolic analysis; the
+    numeric factorisation is redone in place (mutable).
+
+    Parameters
+    ----------
+    method : Factorizer, optional
+        ``cholmod`` or ``qdldl`` (default: :func:`default_factorizer`).
 
     Attributes
     ----------
@@ -67,13 +161,24 @@ class TangentFactor:
         The held DOFs of that factorisation.
     tangent : scipy.sparse.csr_matrix or None
         Its tangent.
+    fallbacks : int
+        Tangents the Cholesky factorisation refused (K_ff not positive definite) and QDLDL's
+        LDL^T factorised.
     """
 
+    method: Factorizer = field(default_factory=default_factorizer)
     owner: object = None
     held: tuple | None = None
     tangent: sp.csr_matrix | None = field(default=None, repr=False)
-    _solver: "qdldl.Solver | None" = field(default=None, repr=False)
+    fallbacks: int = 0
+    _upper: sp.csc_matrix | None = field(default=None, repr=False)
+    _ldlt: "object | None" = field(default=None, repr=False)  # a qdldl.Solver
+    _cholesky: tuple | None = field(default=None, repr=False)
+    _solve: Callable[[np.ndarray], np.ndarray] | None = field(default=None, repr=False)
     _masks: dict = field(default_factory=dict, repr=False)
+
+    def __post_init__(self) -> None:
+        self.method = Factorizer(self.method)
 
     def _layout(self, K: sp.csr_matrix) -> None:
         self._upper, self._upper_at = _gather(K, np.arange(K.shape[0]), np.arange(K.shape[1]),
@@ -90,6 +195,71 @@ class TangentFactor:
                                  np.flatnonzero(off & (self._rows == self._cols)))
         return self._masks[held]
 
+    def _held_upper(self, K: sp.csr_matrix, held: tuple) -> sp.csc_matrix:
+        """The upper triangle of ``K`` with the DOFs ``held`` held (the shared pattern)."""
+        if self._upper is None:
+            self._layout(K)
+        data = K.data[self._upper_at]
+        off, diagonal = self._mask(held)
+        data[off] = 0.0
+        data[diagonal] = 1.0
+        self._upper.data = data
+        return self._upper
+
+    def _symbolic(self, upper: sp.csc_matrix) -> tuple:
+        """(cvxopt matrix of the pattern of ``upper``, CHOLMOD's symbolic factorisation of it:
+        in the order of :func:`nested_dissection` or CHOLMOD's AMD order, whichever fills less;
+        AMD without pymetis).
+        """
+        import cvxopt
+        from cvxopt import cholmod
+
+        matrix = cvxopt.spmatrix(cvxopt.matrix(upper.data), cvxopt.matrix(self._rows),
+                                 cvxopt.matrix(self._cols), upper.shape)
+        order = nested_dissection(upper)
+        if order is None:
+            return matrix, cholmod.symbolic(matrix, uplo="U")
+        return matrix, cholmod.symbolic(matrix, p=cvxopt.matrix(order.tolist(), tc="i"), uplo="U")
+
+    def _cholmod(self, upper: sp.csc_matrix) -> Callable[[np.ndarray], np.ndarray] | None:
+        """Supernodal LL^T of ``upper`` by CHOLMOD (symbolic analysis once); its solve, or None
+        if the matrix is not positive definite.
+        """
+        import cvxopt
+        from cvxopt import cholmod
+
+        if self._cholesky is None:
+            self._cholesky = self._symbolic(upper)
+        matrix, factor = self._cholesky
+        matrix.V = cvxopt.matrix(upper.data)
+        try:
+            cholmod.numeric(matrix, factor)
+        except ArithmeticError:
+            return None
+
+        def solve(b: np.ndarray) -> np.ndarray:
+            x = cvxopt.matrix(np.asarray(b, float))
+            cholmod.solve(factor, x)
+            return np.asarray(x).reshape(-1)
+
+        return solve
+
+    def _qdldl(self, upper: sp.csc_matrix) -> Callable[[np.ndarray], np.ndarray]:
+        """LDL^T of ``upper`` by QDLDL (ordering once); its solve.
+
+        Raises
+        ------
+        RuntimeError
+            If QDLDL meets a zero pivot.
+        """
+        if self._ldlt is None:
+            import qdldl  # only the large-deformation models need it (``pip install qdldl``)
+
+            self._ldlt = qdldl.Solver(upper, upper=True)
+        else:
+            self._ldlt.update(upper, upper=True)
+        return self._ldlt.solve
+
     def factor(self, K: sp.csr_matrix, held: tuple, owner: object = None) -> None:
         """Factorise the tangent ``K`` with the DOFs ``held`` held, for the state ``owner``.
 
@@ -98,24 +268,40 @@ class TangentFactor:
         RuntimeError
             If K_ff is singular (QDLDL meets a zero pivot).
         """
-        if self._solver is None:
-            self._layout(K)
-        data = K.data[self._upper_at]
-        off, diagonal = self._mask(held)
-        data[off] = 0.0
-        data[diagonal] = 1.0
-        self._upper.data = data
-        if self._solver is None:
-            self._solver = qdldl.Solver(self._upper, upper=True)
-        else:
-            self._solver.update(self._upper, upper=True)
+        upper = self._held_upper(K, held)
+        self.owner = self.held = self.tangent = self._solve = None
+        solve = None
+        if self.method == Factorizer.CHOLMOD:
+            solve = self._cholmod(upper)
+            if solve is None:
+                self.fallbacks += 1
+        self._solve = self._qdldl(upper) if solve is None else solve
         self.owner, self.held, self.tangent = owner, held, K
 
     def solve(self, b: np.ndarray) -> np.ndarray:
         """The solution of (K with the held DOFs held) x = b; a b that is zero on the held
         DOFs gives an x that is zero there, K_ff^-1 b on the others.
         """
-        return self._solver.solve(b)
+        return self._solve(b)
+
+    def fill(self, K: sp.csr_matrix, held: tuple) -> Fill:
+        """Entries and flops of the factor of ``K`` with ``held`` held, in this factoriser's
+        order (a separate factorisation: the one held is kept).
+        """
+        upper = self._held_upper(K, held)
+        if self.method == Factorizer.CHOLMOD:
+            from cvxopt import cholmod
+
+            matrix, factor = self._symbolic(upper)
+            cholmod.numeric(matrix, factor)
+            L = cholmod.getfactor(factor)
+            counts = np.bincount(np.asarray(L.J).reshape(-1), minlength=upper.shape[0])
+        else:
+            import qdldl
+
+            L = qdldl.Solver(upper, upper=True).factors()[0]
+            counts = np.diff(L.indptr) + 1
+        return Fill(int(counts.sum()), float(np.sum(counts.astype(float) ** 2)))
 
 
 @dataclass

@@ -17,8 +17,13 @@ from typing import Protocol
 import numpy as np
 
 from squeeze_grasp_ros.mechanics.errors import InvalidInputError
-from squeeze_grasp_ros.mechanics.elastic.shapes import (Outline, interior_point, resample,
-                                                      signed_area)
+from squeeze_grasp_ros.mechanics.elastic.mesh_size import (
+    MAX_MESH_NODES,
+    NODES_PER_AREA,
+    check_mesh_size,
+    estimate_mesh,
+)
+from squeeze_grasp_ros.mechanics.elastic.shapes import Outline, interior_point, signed_area
 
 
 class Mesher(Protocol):
@@ -31,26 +36,29 @@ class Mesher(Protocol):
         holes: np.ndarray,
         max_area: float,
         min_angle: float,
+        max_nodes: int,
     ) -> tuple[np.ndarray, np.ndarray]:
         """Return ``(nodes (n, 2), triangles (t, 3))`` covering the region.
 
         ``segments`` are index pairs into ``vertices`` that must stay edges (possibly split);
         ``holes`` are points inside holes; ``max_area`` (m^2) and ``min_angle`` (degrees) are the
-        quality bounds.
+        quality bounds; the mesher stops adding nodes at ``max_nodes`` (the caller refuses a mesh
+        that reached it).
         """
 
 
 class TriangleMesher:
     """Mesher backed by the ``triangle`` package (Shewchuk's Triangle; non-commercial licence)."""
 
-    def triangulate(self, vertices, segments, holes, max_area, min_angle):
+    def triangulate(self, vertices, segments, holes, max_area, min_angle, max_nodes):
         import triangle
 
         data = {"vertices": vertices, "segments": segments}
         if len(holes):
             data["holes"] = holes
         area = np.format_float_positional(max_area, trim="-")  # Triangle cannot parse 1e-5
-        out = triangle.triangulate(data, f"pq{min_angle:.6g}a{area}Q")
+        steiner = max(max_nodes - len(vertices), 0)  # S: most nodes Triangle may add
+        out = triangle.triangulate(data, f"pq{min_angle:.6g}a{area}S{steiner}Q")
         return np.asarray(out["vertices"], float), np.asarray(out["triangles"], int)
 
 
@@ -161,31 +169,36 @@ def vertex_normals(points: np.ndarray) -> np.ndarray:
     return nrm / np.linalg.norm(nrm, axis=1, keepdims=True)
 
 
-MAX_MESH_NODES = 250_000
-"""Largest mesh the mesher is asked for (about 0.8 area / max_area nodes); beyond it a solve
-takes minutes and gigabytes, so the request is refused before meshing."""
-
-
 def target_max_area(outline: Outline, nodes: int) -> float:
     """The ``max_area`` (m^2) that gives roughly ``nodes`` mesh nodes for ``outline``."""
     if not 10 <= nodes <= MAX_MESH_NODES:
         raise InvalidInputError(f"mesh.nodes must be in [10, {MAX_MESH_NODES}], got {nodes}")
-    return 1.6 * outline.area / (2.0 * nodes)
+    return 1.6 * outline.area / (2.0 * nodes)  # = NODES_PER_AREA * area / nodes
 
 
 def generate_mesh(
-    outline: Outline, max_area: float, *, min_angle: float = 30.0, mesher: Mesher | None = None
+    outline: Outline,
+    max_area: float,
+    *,
+    min_angle: float = 30.0,
+    mesher: Mesher | None = None,
+    max_nodes: int = MAX_MESH_NODES,
 ) -> Mesh:
     """Mesh ``outline`` with elements of area <= ``max_area`` m^2 and angles >= ``min_angle``.
 
     The boundary is first resampled to the edge length of an equilateral element of the target
-    area, so boundary nodes are evenly spaced and corners are kept.
+    area, so boundary nodes are evenly spaced and corners are kept. The mesh's size is bounded
+    before meshing (:mod:`~squeeze_grasp_ros.mechanics.elastic.mesh_size`): its boundary
+    nodes, its interior nodes and the nodes that features thinner than the element size would
+    force; the mesher itself stops at ``max_nodes``.
 
     Raises
     ------
     InvalidInputError
         If ``max_area`` is not positive or ``min_angle`` is outside (0, 34] degrees (Triangle's
-        guaranteed-termination range), or if the mesher fails.
+        guaranteed-termination range); if the mesh would have more than ``max_nodes`` nodes or
+        more than :data:`~.mesh_size.MAX_BOUNDARY_NODES` boundary nodes, or a thin feature
+        would more than double it (the message names the feature, its width and where it is).
 
     Examples
     --------
@@ -202,17 +215,17 @@ def generate_mesh(
         raise InvalidInputError(f"mesh.min_angle must be in (0, 34] degrees, got {min_angle}")
     if max_area > outline.area:
         max_area = outline.area / 4.0
-    if 0.8 * outline.area / max_area > MAX_MESH_NODES:
-        smallest = 0.8 * outline.area / MAX_MESH_NODES
+    if NODES_PER_AREA * outline.area / max_area > max_nodes:
+        smallest = NODES_PER_AREA * outline.area / max_nodes
         raise InvalidInputError(
             f"mesh.max_area {max_area:.3g} m^2 would give about "
-            f"{0.8 * outline.area / max_area:.3g} nodes on this "
-            f"{outline.area:.3g} m^2 object; at most {MAX_MESH_NODES} are "
+            f"{NODES_PER_AREA * outline.area / max_area:.3g} nodes on this "
+            f"{outline.area:.3g} m^2 object; at most {max_nodes} are "
             f"allowed (max_area >= {smallest:.3g} m^2)"
         )
-    spacing = np.sqrt(4.0 * max_area / np.sqrt(3.0))
-    loops = [resample(outline.points, spacing, outline.corners)]
-    loops += [resample(h if signed_area(h) > 0 else h[::-1], spacing) for h in outline.holes]
+    estimate = estimate_mesh(outline, max_area, max_nodes=max_nodes)
+    check_mesh_size(estimate, max_nodes)
+    loops = estimate.loops
     vertices = np.concatenate(loops)
     segments, offset = [], 0
     for loop in loops:
@@ -221,8 +234,13 @@ def generate_mesh(
         offset += len(loop)
     holes = np.array([interior_point(h) for h in outline.holes]).reshape(-1, 2)
     nodes, tris = (mesher or TriangleMesher()).triangulate(
-        vertices, np.concatenate(segments), holes, max_area, min_angle
+        vertices, np.concatenate(segments), holes, max_area, min_angle, max_nodes
     )
+    if len(nodes) >= max_nodes:
+        raise InvalidInputError(
+            f"the mesher reached the limit of {max_nodes:,} nodes before it met the element "
+            f"size {estimate.spacing:.3g} m and angle {min_angle:g} deg: use larger elements "
+            "(mesh.nodes or mesh.max_area) or a simpler outline")
     return mesh_from_triangles(nodes, tris)
 
 

@@ -147,6 +147,30 @@ def _turning_corners(p: np.ndarray, threshold_deg: float = 20.0) -> np.ndarray:
     return np.flatnonzero(turn > np.radians(threshold_deg))
 
 
+def require_within_reach(points: np.ndarray, point: Sequence[float], name: str) -> None:
+    """Refuse a placement ``point`` (m) far from the closed polyline ``points``: it must lie in
+    the polyline's bounding box grown by the box's larger side on every side. Beyond it the
+    point's nearest boundary place is meaningless (at 1e308 m every distance overflows).
+
+    >>> require_within_reach(rectangle(0.1, 0.1).points, (0.12, 0.0), "point")
+    >>> require_within_reach(rectangle(0.1, 0.1).points, (1e308, 0.0), "point")
+    Traceback (most recent call last):
+    ...
+    squeeze_grasp_ros.mechanics.errors.InvalidInputError: point (1e+308, 0) m is outside the \
+object's reach: it must lie within [-0.15, 0.15] x [-0.15, 0.15] m (the object's bounding box \
+grown by its size, 0.1 m, on every side)
+    """
+    lo, hi = points.min(axis=0), points.max(axis=0)
+    size = float((hi - lo).max())
+    p = np.asarray(point, dtype=float)
+    if not np.all((lo - size <= p) & (p <= hi + size)):
+        raise InvalidInputError(
+            f"{name} ({p[0]:.6g}, {p[1]:.6g}) m is outside the object's reach: it must lie "
+            f"within [{lo[0] - size:.6g}, {hi[0] + size:.6g}] x [{lo[1] - size:.6g}, "
+            f"{hi[1] + size:.6g}] m (the object's bounding box grown by its size, {size:.6g} m, "
+            "on every side)")
+
+
 def with_boundary_points(outline: Outline, points: Sequence[Sequence[float]]) -> Outline:
     """``outline`` with the boundary point nearest to each of ``points`` as a kept vertex.
 
@@ -333,6 +357,16 @@ def _csv_points(text: str, name: str) -> list[list[float]]:
     return pts
 
 
+def _is_coordinate(value) -> bool:
+    """A JSON number that is a finite float (no bool, no integer beyond the float range)."""
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        return False
+    try:
+        return bool(np.isfinite(float(value)))
+    except OverflowError:
+        return False
+
+
 def load_outline(path: str | Path) -> Outline:
     """Read an outline from CSV (``x,y`` per line, m) or JSON (``{"outline": [[x, y], ...]}``,
     optionally ``"holes": [[[x, y], ...], ...]``, as ``squeeze-grasp outline`` writes it).
@@ -353,27 +387,52 @@ def load_outline(path: str | Path) -> Outline:
         except json.JSONDecodeError as exc:
             raise InvalidInputError(f"{name}: invalid JSON at line {exc.lineno}, column "
                                  f"{exc.colno}") from None
+        except RecursionError:
+            raise InvalidInputError(f"{name}: JSON nested too deeply") from None
+        except ValueError:  # an integer of more than 4,300 digits
+            raise InvalidInputError(f"{name}: JSON holds a number too long to read") from None
         if not isinstance(data, dict) or "outline" not in data:
             raise InvalidInputError(f'{name}: JSON outline must be {{"outline": [[x, y], ...]}}')
         pts = data["outline"]
         if not isinstance(pts, list) or len(pts) > MAX_OUTLINE_POINTS or not all(
-                isinstance(q, list) and len(q) == 2
-                and all(isinstance(c, (int, float)) and not isinstance(c, bool) for c in q)
+                isinstance(q, list) and len(q) == 2 and all(map(_is_coordinate, q))
                 for q in pts):
             raise InvalidInputError(f"{name}: 'outline' must be a list of at most "
-                                 f"{MAX_OUTLINE_POINTS} [x, y] number pairs")
+                                 f"{MAX_OUTLINE_POINTS} [x, y] pairs of finite numbers (m)")
         holes = data.get("holes", [])
         if not isinstance(holes, list) or not all(
-                isinstance(h, list) and all(isinstance(q, list) and len(q) == 2 and all(
-                    isinstance(c, (int, float)) and not isinstance(c, bool) for c in q)
-                    for q in h) for h in holes) or sum(map(len, holes)) > MAX_OUTLINE_POINTS:
+                isinstance(h, list) and all(isinstance(q, list) and len(q) == 2
+                                            and all(map(_is_coordinate, q)) for q in h)
+                for h in holes) or sum(map(len, holes)) > MAX_OUTLINE_POINTS:
             raise InvalidInputError(f"{name}: 'holes' must be a list of polygons, each a list "
-                                    "of [x, y] number pairs")
+                                    "of [x, y] pairs of finite numbers (m)")
     else:
         pts, holes = _csv_points(text, name), []
     p = validate_polyline(pts, name)
     with_holes = polygon(p, holes) if holes else Outline(p)
     return Outline(p, with_holes.holes, corners=_turning_corners(p))
+
+
+def _pieces(
+    p: np.ndarray, spacing: float, corners: np.ndarray | None
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Arc-length positions s (N+1,) of the closed polyline ``p``, the anchors (kept vertices,
+    plus the first again one loop later) and the number of parts of each piece between them.
+    """
+    keep = np.union1d(_turning_corners(p), [] if corners is None else corners).astype(int)
+    closed = np.vstack([p, p[:1]])
+    s = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(closed, axis=0), axis=1))])
+    anchors = s[keep] if len(keep) else np.array([0.0])
+    anchors = np.append(anchors, anchors[0] + s[-1])
+    parts = np.maximum(1, np.round(np.diff(anchors) / spacing)).astype(int)
+    return s, anchors, parts
+
+
+def resampled_count(
+    outline_points: np.ndarray, spacing: float, corners: np.ndarray | None = None
+) -> int:
+    """Number of vertices :func:`resample` gives, computed without making them."""
+    return int(_pieces(np.asarray(outline_points, dtype=float), spacing, corners)[2].sum())
 
 
 def resample(
@@ -382,21 +441,14 @@ def resample(
     """Evenly spaced vertices (about ``spacing`` m apart) along a closed polyline.
 
     Vertices listed in ``corners`` (and sharp turns) are kept exactly; each piece between two
-    kept vertices is split into equal arc-length parts.
+    kept vertices is split into equal arc-length parts (so no edge is longer than 1.5 spacing).
     """
     p = np.asarray(outline_points, dtype=float)
-    keep = np.union1d(_turning_corners(p), [] if corners is None else corners).astype(int)
+    s, anchors, parts = _pieces(p, spacing, corners)
     closed = np.vstack([p, p[:1]])
-    seg = np.linalg.norm(np.diff(closed, axis=0), axis=1)
-    s = np.concatenate([[0.0], np.cumsum(seg)])
-    total = s[-1]
-    anchors = s[keep] if len(keep) else np.array([0.0])
-    anchors = np.append(anchors, anchors[0] + total)
-    samples = []
-    for s0, s1 in zip(anchors[:-1], anchors[1:]):
-        k = max(1, int(round((s1 - s0) / spacing)))
-        samples.append(s0 + (s1 - s0) * np.arange(k) / k)
-    t = np.mod(np.concatenate(samples), total)
+    samples = [s0 + (s1 - s0) * np.arange(k) / k
+               for s0, s1, k in zip(anchors[:-1], anchors[1:], parts)]
+    t = np.mod(np.concatenate(samples), s[-1])
     x = np.interp(t, s, closed[:, 0])
     y = np.interp(t, s, closed[:, 1])
     out = np.column_stack([x, y])

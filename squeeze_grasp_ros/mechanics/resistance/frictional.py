@@ -28,7 +28,7 @@ the interface, object frame.
 
 from __future__ import annotations
 
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field, replace
 
 import numpy as np
@@ -43,7 +43,11 @@ from squeeze_grasp_ros.mechanics.squeeze.contact_state import (
 from squeeze_grasp_ros.mechanics.errors import InvalidInputError, require_finite
 from squeeze_grasp_ros.mechanics.squeeze.fingertips import Fingertip
 from squeeze_grasp_ros.mechanics.elastic.mesh import vertex_normals
-from squeeze_grasp_ros.mechanics.resistance.optimal import optimal_resistance, resistance_grasp
+from squeeze_grasp_ros.mechanics.resistance.optimal import (
+    optimal_resistance,
+    require_small_push,
+    resistance_grasp,
+)
 from squeeze_grasp_ros.mechanics.squeeze.stepper import advance
 from squeeze_grasp_ros.mechanics.vocabulary import (
     ContactKind,
@@ -284,6 +288,8 @@ def frictional_resistance(
     step: float = 1e-3,
     event_tol: float = 1e-9,
     contacts: Sequence[int] | None = None,
+    progress: Callable[[float], None] | None = None,
+    checkpoint: Callable[[], None] | None = None,
 ) -> FrictionalResistance:
     """Algorithm 2: F1 and F2 resist A's translation ``a`` from ``state`` (with A touching).
 
@@ -302,6 +308,10 @@ def frictional_resistance(
     contacts : sequence of 3 int, optional
         Initial contact nodes of F1, F2 (before the squeeze) and A, for the report; default:
         the first node of each finger's segment in ``state``.
+    progress : callable, optional
+        Called after every stage with the fraction of a travelled by A.
+    checkpoint : callable, optional
+        Called before every stepper substep; may raise to abandon the computation.
 
     Raises
     ------
@@ -331,6 +341,7 @@ def frictional_resistance(
         raise InvalidInputError(
             f"adversary translation a must be a nonzero [x, y] in m, got {a.tolist()}"
         )
+    require_small_push(a, model.obj.scale)
     if [f.name for f in state.fingers] != list(tuple(Finger)):
         raise InvalidInputError(
             f"the state needs fingers {list(tuple(Finger))}, has {[f.name for f in state.fingers]}"
@@ -347,7 +358,8 @@ def frictional_resistance(
     outcome = None
     while outcome is None:
         segments = {f: tuple(c.node for c in state.segment(f)) for f in tuple(Finger)}
-        stage = optimal_resistance(resistance_grasp(model.obj, segments), a_hat, mode=mode)
+        stage = optimal_resistance(resistance_grasp(model.obj, segments), a_hat, mode=mode,
+                                   per_unit_push=True)
         if not stage.success:
             outcome = (False, stage.reason)
             break
@@ -367,6 +379,7 @@ def frictional_resistance(
             event_tol,
             stop_on_event=True,
             terminate_on=(Termination.FINGER_SLIP,),
+            checkpoint=checkpoint,
         )
         diag["advance_calls"] += 1
         state = result.state
@@ -381,6 +394,8 @@ def frictional_resistance(
         )
         for f in tuple(Finger):
             path[f].append(state.finger(f).translation - start_state.finger(f).translation)
+        if progress is not None:
+            progress(min(travelled / length, 1.0))
         outcome = _outcome(result.termination, state)
         if outcome is None and result.fraction >= 1.0:
             outcome = (True, "adversary completed a")

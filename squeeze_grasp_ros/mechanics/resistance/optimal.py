@@ -328,6 +328,30 @@ class Resistance:
         }
 
 
+MAX_RELATIVE_PUSH = 0.25
+"""Largest adversary translation |a| a resistance accepts, relative to the object size L (the
+larger side of its bounding box). Sec. 6 is small-deformation elasticity at fixed (point,
+segment) or tracked (Algorithm 2) contacts: the fixed-contact optimum is linear in a, so at
+|a| = 9 L (a = 1 m on the 0.11 m blob of Fig. 9) it reported fingers moved by 0.47 m and
+126 J as a success, and Algorithm 2 steps A's travel in substeps of L, so an unbounded |a| is
+unbounded work. Fig. 9 pushes 0.09 L, Fig. 10 0.05 L."""
+
+MAX_DIRECTIONS = 100_000
+"""Most push directions of :func:`sweep_directions` (0.0036 degrees apart; a few MB)."""
+
+
+def require_small_push(a: np.ndarray, size: float) -> None:
+    """Refuse an adversary translation ``a`` (m) longer than :data:`MAX_RELATIVE_PUSH` of the
+    object size ``size`` (m).
+    """
+    length = float(np.hypot(*a))
+    if length > MAX_RELATIVE_PUSH * size:
+        raise InvalidInputError(
+            f"adversary.a is {length:.4g} m long, {length / size:.3g} times the object size "
+            f"{size:.4g} m; the resistance model (small deformations) takes |a| <= "
+            f"{MAX_RELATIVE_PUSH:g} of the size, {MAX_RELATIVE_PUSH * size:.4g} m")
+
+
 def _translation(a, name: str = "adversary translation a") -> np.ndarray:
     a = np.asarray(a, dtype=float).reshape(-1)
     if a.shape != (2,):
@@ -410,8 +434,13 @@ def evaluate_resistance(
     a,
     mode: SqueezeKind = SqueezeKind.STABLE,
     reason: str = "user-given resistance",
+    *,
+    per_unit_push: bool = False,
 ) -> Resistance:
     """Forces, work and constraint residuals of a given resistance (d1, d2) to a, all in m.
+
+    ``a`` is at most :data:`MAX_RELATIVE_PUSH` of the object size, unless ``per_unit_push``:
+    then (d1, d2, a) are rates per metre of A's travel, of any length (the model is linear).
 
     ``success`` is False (the residual is in ``reason``) when (d1, d2, a) violates the mode's
     constraints by more than :data:`FEASIBILITY_TOL`: eqs. (54)-(55) (segments: their Sec. 6.2
@@ -428,6 +457,8 @@ def evaluate_resistance(
     """
     form = grasp.form(mode)
     a = _translation(a)
+    if not per_unit_push:
+        require_small_push(a, grasp.scale)
     x = np.concatenate([np.asarray(d1, float).reshape(2), np.asarray(d2, float).reshape(2), a])
     require_finite("d1, d2", x)
     red, obj = grasp.red, grasp.obj
@@ -490,7 +521,11 @@ def evaluate_resistance(
 
 
 def optimal_resistance(
-    grasp: ResistanceGrasp, a, *, mode: SqueezeKind = SqueezeKind.STABLE
+    grasp: ResistanceGrasp,
+    a,
+    *,
+    mode: SqueezeKind = SqueezeKind.STABLE,
+    per_unit_push: bool = False,
 ) -> Resistance:
     """The resistance (d1, d2) minimising the grasping fingers' work W_F (Sec. 6.1-6.2).
 
@@ -499,9 +534,13 @@ def optimal_resistance(
     grasp : ResistanceGrasp
         Fixed contact sets of F1, F2, A (:func:`resistance_grasp`).
     a : (2,) array_like
-        Adversary translation, m, object frame (nonzero).
+        Adversary translation, m, object frame (nonzero), at most :data:`MAX_RELATIVE_PUSH`
+        of the object size.
     mode : {"stable", "pure"}
         Stable: Delta in col(C) (eqs. 54-61, 66); pure: Delta in col(AC) (eqs. 62-63, 91, 94).
+    per_unit_push : bool
+        ``a`` is a direction of push of any length and the answer is per metre of A's travel
+        (the fixed-contact model is linear in a): no size bound. Algorithm 2's stages.
 
     Returns
     -------
@@ -524,6 +563,8 @@ def optimal_resistance(
     stable True True
     """
     a = _translation(a)
+    if not per_unit_push:
+        require_small_push(a, grasp.scale)
     form = grasp.form(mode)
     L = grasp.scale
     a_hat = a[None] / L
@@ -531,7 +572,8 @@ def optimal_resistance(
         return _cannot_resist(grasp, a)
     x, w, _ = optimum_batch(grasp, mode, a_hat)
     res = evaluate_resistance(
-        grasp, x[0, :2] * L, x[0, 2:] * L, a, mode, reason=f"optimal {mode} resistance"
+        grasp, x[0, :2] * L, x[0, 2:] * L, a, mode, reason=f"optimal {mode} resistance",
+        per_unit_push=per_unit_push,
     )
     closed = float(w[0]) * grasp.obj.material.force_scale * L * L
     scale = max(abs(res.work["total"]), abs(res.energy), 1e-300)
@@ -562,6 +604,7 @@ def resistance_along(
         ``success`` False when no resistance of this mode moves F1 along that line.
     """
     a = _translation(a)
+    require_small_push(a, grasp.scale)
     e = _translation(direction, "d1 direction")
     form = grasp.form(mode)
     L = grasp.scale
@@ -653,9 +696,12 @@ class ResistanceSweep:
 def sweep_directions(
     grasp: ResistanceGrasp, mode: SqueezeKind = SqueezeKind.STABLE, count: int = 360
 ) -> ResistanceSweep:
-    """W*_F of a unit push in ``count`` evenly spaced directions, vectorised (eq. 61)."""
-    if count < 1:
-        raise InvalidInputError(f"number of directions must be >= 1, got {count}")
+    """W*_F of a unit push in ``count`` evenly spaced directions, vectorised (eq. 61); ``count``
+    in [1, :data:`MAX_DIRECTIONS`].
+    """
+    if not 1 <= count <= MAX_DIRECTIONS:
+        raise InvalidInputError(
+            f"number of directions must be in [1, {MAX_DIRECTIONS:,}], got {count}")
     angles = 2.0 * np.pi * np.arange(count) / count
     units = np.column_stack([np.cos(angles), np.sin(angles)])
     x, w, ok = optimum_batch(grasp, mode, units)

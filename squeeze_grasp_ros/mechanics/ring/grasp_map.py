@@ -24,7 +24,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from squeeze_grasp_ros.mechanics.errors import InvalidInputError
+from squeeze_grasp_ros.mechanics.errors import InvalidInputError, require_relative_depth
 from squeeze_grasp_ros.mechanics.ring.model import FIBRE_STRAIN_MEASURE, RingModel
 from squeeze_grasp_ros.mechanics.ring.squeeze import (
     LIMITS,
@@ -114,7 +114,9 @@ class RingGraspMap:
         return {name.value: int(np.sum(codes == k)) for k, name in enumerate(LIMITS)}
 
     def best(self, count: int = 5) -> list[dict]:
-        """The ``count`` placements with the largest maximum relative depth."""
+        """The ``count`` (>= 0) placements with the largest maximum relative depth."""
+        if count < 0:
+            raise InvalidInputError(f"the number of best placements must be >= 0, got {count}")
         order = np.argsort(-self.max_relative_depth, kind="mergesort")[:count]
         return [self._entry(k) for k in order]
 
@@ -243,9 +245,8 @@ def ring_grasp_map(ring: RingModel, mu: float, *, epsilon: float | None = None,
     if kind not in (SqueezeKind.STABLE, SqueezeKind.PURE):
         raise InvalidInputError(f"squeeze type must be 'stable' or 'pure', got {kind!r}")
     check_limits(mu, epsilon)
-    if requested_relative_depth is not None and not 0 < requested_relative_depth <= 1:
-        raise InvalidInputError(f"requested relative depth must be in (0, 1], got "
-                                f"{requested_relative_depth}")
+    if requested_relative_depth is not None:
+        require_relative_depth(requested_relative_depth)
     L = ring.scale
     pairs = _all_pairs(ring.n)
     force, rate, approach = pair_fields(ring, pairs, kind)

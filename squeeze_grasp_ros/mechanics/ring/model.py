@@ -61,7 +61,13 @@ from squeeze_grasp_ros.mechanics.errors import (
 )
 from squeeze_grasp_ros.mechanics.elastic.fem import rigid_modes, rotation_mode_norm
 from squeeze_grasp_ros.mechanics.elastic.material import Material
-from squeeze_grasp_ros.mechanics.elastic.shapes import Outline, disk, resample, signed_area
+from squeeze_grasp_ros.mechanics.elastic.shapes import (
+    Outline,
+    disk,
+    resample,
+    resampled_count,
+    signed_area,
+)
 from squeeze_grasp_ros.mechanics.vocabulary import StrainMeasure
 
 FIBRE_STRAIN_MEASURE = StrainMeasure.SMALL
@@ -353,6 +359,14 @@ class RingModel:
         return self
 
 
+MAX_RING_ELEMENTS = 2_000
+"""Most elements of a ring model. Its compliance, strain influence and grasp map are dense:
+measured on this project's 2-core machine (`squeeze-grasp ring config/scenes/ring_ring.yaml`),
+one placement took 1.4 s and 0.30 GB at 1,000 elements, 3.5 s and 0.84 GB at 2,000, 19 s and
+3.1 GB at 4,000; the all-pairs map 6.6 s and 0.65 GB at 1,000, 48 s and 2.2 GB at 2,000.
+``--elements 100000`` asked for a 447 GiB array."""
+
+
 def ring_from_outline(
     outline: Outline, material: Material, wall_thickness: float, elements: int
 ) -> RingModel:
@@ -367,12 +381,19 @@ def ring_from_outline(
     wall_thickness : float
         In-plane wall thickness h, m.
     elements : int
-        Target number of elements (exact for smooth curves), >= 8.
+        Target number of elements (exact for smooth curves), in [8, :data:`MAX_RING_ELEMENTS`].
     """
-    if elements < 8:
-        raise InvalidInputError(f"ring.elements must be >= 8, got {elements}")
+    if not 8 <= elements <= MAX_RING_ELEMENTS:
+        raise InvalidInputError(
+            f"ring.elements must be in [8, {MAX_RING_ELEMENTS}], got {elements} (the ring "
+            "model is dense: memory grows with the square of the elements)")
     p = outline.points
     perimeter = float(np.sum(np.linalg.norm(np.roll(p, -1, axis=0) - p, axis=1)))
+    count = resampled_count(p, perimeter / elements, outline.corners)
+    if count > MAX_RING_ELEMENTS:
+        raise InvalidInputError(
+            f"the ring's middle curve keeps {count} nodes (its corners are kept), more than "
+            f"{MAX_RING_ELEMENTS}: give fewer ring.elements or a simpler curve")
     nodes = resample(p, perimeter / elements, outline.corners)
     return RingModel(nodes, material, wall_thickness)
 

@@ -31,7 +31,11 @@ from squeeze_grasp_ros.mechanics.squeeze.contact_state import (
     event_counts,
     initial_state,
 )
-from squeeze_grasp_ros.mechanics.errors import InvalidInputError, require_finite
+from squeeze_grasp_ros.mechanics.errors import (
+    InvalidInputError,
+    require_finite,
+    require_relative_depth,
+)
 from squeeze_grasp_ros.mechanics.elastic.strain_measures import max_principal_strains
 from squeeze_grasp_ros.mechanics.elastic.stress_measures import element_stresses, von_mises
 from squeeze_grasp_ros.mechanics.squeeze.fingertips import place_fingertip
@@ -99,6 +103,7 @@ def squeeze_to_depth(
     event_tol: float = 1e-9,
     progress: Callable[[float], None] | None = None,
     terminate_on: tuple[str, ...] = TERMINATION_ORDER,
+    checkpoint: Callable[[], None] | None = None,
 ) -> SqueezeRun:
     """Algorithm 1: advance the fingers along ``directions`` until ``depth`` or a termination.
 
@@ -118,6 +123,8 @@ def squeeze_to_depth(
         Called with the completed fraction after every stepper call.
     terminate_on : tuple of str
         Terminations that end the squeeze besides the depth.
+    checkpoint : callable, optional
+        Called before every substep; may raise to abandon the squeeze (see :func:`advance`).
     """
     if not (np.isfinite(depth) and depth >= 0):
         raise InvalidInputError(f"squeeze depth must be >= 0 m, got {depth}")
@@ -139,6 +146,7 @@ def squeeze_to_depth(
             stop_on_event=True,
             terminate_on=terminate_on,
             first_substep=substep,
+            checkpoint=checkpoint,
         )
         substep = result.next_substep
         diag["advance_calls"] += 1
@@ -463,6 +471,7 @@ def event_squeeze(
     directions: Mapping[str, tuple[float, float]] | None = None,
     progress: Callable[[float], None] | None = None,
     material_model: MaterialModel | str = MaterialModel.LINEAR,
+    checkpoint: Callable[[], None] | None = None,
 ) -> EventSqueeze:
     """Event-driven two-finger squeeze of ``obj`` from initial contact nodes (F1, F2).
 
@@ -495,6 +504,8 @@ def event_squeeze(
     material_model : MaterialModel or str
         ``linear`` (the paper's small-strain model, default), ``corotational`` or
         ``neo_hookean`` (finite deformation: :mod:`.nonlinear_model`).
+    checkpoint : callable, optional
+        Called before every substep; may raise to abandon the squeeze (a cancellation).
 
     Examples
     --------
@@ -519,18 +530,13 @@ def event_squeeze(
                 "the fingers do not approach each other: relative depth undefined"
             )
         depth = relative_depth / relative_per_depth
-    require_finite("depth", depth)
-    if depth < 0 or depth * relative_per_depth >= 1.0:
-        raise InvalidInputError(
-            f"depth {depth:.6g} m is a relative depth of "
-            f"{depth * relative_per_depth:.6g}: it must be in [0, 1) (at 1 the "
-            "fingers would meet)"
-        )
+    require_relative_depth(depth * relative_per_depth, depth)
     tips = [place_fingertip(obj.mesh, n, int(c), radii[n]) for n, c in zip(names, contacts)]
     model = contact_model(material_model, obj, mu, limits or TerminationLimits(), reference,
                           max_events_per_depth)
     run = squeeze_to_depth(
-        model, initial_state(tips, relative_per_depth), dirs, depth, step, event_tol, progress
+        model, initial_state(tips, relative_per_depth), dirs, depth, step, event_tol, progress,
+        checkpoint=checkpoint,
     )
     state = run.state
     health, u_field = grasp_health(model, state)

@@ -23,8 +23,8 @@ from squeeze_grasp_ros.mechanics.elastic.compliance import node_dofs
 from squeeze_grasp_ros.mechanics.elastic.contact_response import (NEWTON_TOL, ContactResponse,
                                                                   Evaluation, ResponseFailure)
 from squeeze_grasp_ros.mechanics.elastic.hyperelastic import mesh_geometry
+from squeeze_grasp_ros.mechanics.elastic.interior import TangentFactor, default_factorizer
 from squeeze_grasp_ros.mechanics.elastic.strain_measures import max_principal_strain
-from squeeze_grasp_ros.mechanics.elastic.interior import TangentFactor
 from squeeze_grasp_ros.mechanics.errors import InvalidInputError
 from squeeze_grasp_ros.mechanics.squeeze.contact_model import (ContactModel, Response, SetData,
                                                                Solution, SolveFailure)
@@ -79,7 +79,9 @@ class NonlinearContactModel(ContactModel):
             mesh = self.obj.mesh
             if "geometry" not in self._cache:
                 self._cache["geometry"] = mesh_geometry(mesh.nodes / self.length, mesh.triangles)
-            shared = self._cache.setdefault("factorization", TangentFactor())
+            if "factorization" not in self._cache:
+                self._cache["factorization"] = TangentFactor()
+            shared = self._cache["factorization"]
             responses[key] = ContactResponse(MaterialModel(self.material_model),
                                              mesh.nodes / self.length, mesh.triangles,
                                              sd.nodes, self.obj.material.nu,
@@ -168,11 +170,15 @@ class NonlinearContactModel(ContactModel):
         return self.field_area_ratio(self._field(sd, delta))
 
     def diagnostics(self) -> dict:
-        """Newton evaluations, iterations and factorisations of the interior solves, and the
-        evaluations answered by a kept state (look-ups).
+        """Newton evaluations, iterations and factorisations of the interior solves, the
+        evaluations answered by a kept state (look-ups), the factoriser and the tangents its
+        Cholesky factorisation refused (LDL^T instead).
         """
         responses = self._cache.get("responses", {}).values()
+        shared = self._cache.get("factorization")
         return {"material_model": str(self.material_model),
+                "factorizer": str(shared.method if shared else default_factorizer()),
+                "ldlt_fallbacks": shared.fallbacks if shared else 0,
                 "evaluations": sum(r.stats["evaluations"] for r in responses),
                 "newton_iterations": sum(r.stats["iterations"] for r in responses),
                 "factorizations": sum(r.stats["factorizations"] for r in responses),

@@ -80,7 +80,7 @@ off the predicted branch is halved.
 from __future__ import annotations
 
 import itertools
-from collections.abc import Iterator, Mapping
+from collections.abc import Callable, Iterator, Mapping
 from contextlib import contextmanager
 
 import numpy as np
@@ -808,8 +808,11 @@ class _Run:
             residuals={"cone": sol.residual},
         )
 
-    def run(self, stop_on_event: bool) -> str | None:
-        """Advance s from 0 to 1 (or to a termination / first event); returns the termination."""
+    def run(self, stop_on_event: bool, checkpoint: Callable[[], None] | None = None) -> str | None:
+        """Advance s from 0 to 1 (or to a termination / first event); returns the termination.
+
+        ``checkpoint`` is called before every substep (it may raise to abandon the motion).
+        """
         sol = self.resolve()
         self.record(sol)
         term = self.termination(sol)
@@ -824,6 +827,8 @@ class _Run:
             h = min(ADAPTIVE_MAX_STEPS * hs, max(hs, self.planned_substep / self.rate))
         rows, va, rates_a = None, None, None
         while self.s < 1.0:
+            if checkpoint is not None:
+                checkpoint()
             a = self.s
             depth_a = self.depth_at(a)
             free = self.free_rows(depth_a)
@@ -1032,6 +1037,7 @@ def advance(
     stop_on_event: bool = False,
     terminate_on: tuple[str, ...] = TERMINATION_ORDER,
     first_substep: float | None = None,
+    checkpoint: Callable[[], None] | None = None,
 ) -> StepResult:
     """Translate fingertips from ``state`` and locate the contact events on the way.
 
@@ -1057,6 +1063,9 @@ def advance(
     first_substep : float, optional
         First substep of a model that adapts its substeps, relative to L (default ``step``):
         a previous call's ``StepResult.next_substep``, to go on where its adaptation ended.
+    checkpoint : callable, optional
+        Called with no arguments before every substep; it may raise (e.g. a cancellation) to
+        abandon the motion, and the exception propagates.
 
     Returns
     -------
@@ -1086,7 +1095,7 @@ def advance(
     run = _Run(model, state, translations, step, min(event_tol, step), tuple(terminate_on))
     if first_substep is not None:
         run.planned_substep = first_substep
-    termination = run.run(stop_on_event)
+    termination = run.run(stop_on_event, checkpoint)
     new_state = run.to_state()
     diag = dict(run.diag)
     diag["sets_factored"] = model._cache.get("sets_factored", 0)

@@ -82,6 +82,7 @@ def load_object_response(
     return success(
         LoadObject.Response,
         object_id=loaded.object_id,
+        object_digest=loaded.digest,
         model=loaded.model,
         num_nodes=loaded.num_nodes,
         num_boundary_nodes=len(loaded.boundary),
@@ -126,9 +127,9 @@ def grasp_candidates(placements: Sequence[tuple[Sequence[int], float]]) -> list[
 
 
 def grasp_map_data(
-    gmap: GraspMap, object_id: str, best_count: int, full_matrices: bool
+    gmap: GraspMap, object_id: str, best_count: int, full_matrices: bool, *, digest: str = ""
 ) -> GraspMapData:
-    """A solid's grasp map as ``GraspMapData``.
+    """A solid's grasp map as ``GraspMapData`` (``digest``: the object's ``object_digest``).
 
     ``best`` holds the ``best_count`` stiffest feasible placements (quality = stiffness, N/m);
     the b x b matrices (row-major, boundary order) only with ``full_matrices``.
@@ -137,6 +138,7 @@ def grasp_map_data(
     low, high = summary["stiffness_range"]
     data = GraspMapData(
         object_id=object_id,
+        object_digest=digest,
         mu=gmap.mu,
         boundary=int32_array(gmap.boundary),
         pairs=summary["pairs"],
@@ -281,8 +283,10 @@ def ring_grasp_test_response(test: RingTest, best_count: int) -> RingGraspTest.R
     )
 
 
-def event_squeeze_data(result: EventSqueeze, object_id: str) -> EventSqueezeData:
-    """An event-driven squeeze's outcome as ``EventSqueezeData``.
+def event_squeeze_data(result: EventSqueeze, object_id: str, *,
+                       digest: str = "") -> EventSqueezeData:
+    """An event-driven squeeze's outcome as ``EventSqueezeData`` (``digest``: the object's
+    ``object_digest``).
 
     Finger forces are the final forces along each finger's motion direction (N), the work is
     each finger's work on the object (J), the health numbers those of the final configuration,
@@ -291,6 +295,7 @@ def event_squeeze_data(result: EventSqueeze, object_id: str) -> EventSqueezeData
     health = result.health
     return EventSqueezeData(
         object_id=object_id,
+        object_digest=digest,
         termination=result.termination,
         squeeze_type=result.kind,
         contacts=int32_array(result.contacts),

@@ -3,9 +3,13 @@
 """The ROS 2 nodes: thin rclpy wiring around the mechanics, one console script each."""
 from __future__ import annotations
 
+import ctypes
+import os
 import signal
+import sys
 import threading
 from collections.abc import Callable
+from pathlib import Path
 
 import rclpy
 from rclpy.executors import Executor, ExternalShutdownException
@@ -13,9 +17,55 @@ from rclpy.experimental import EventsExecutor
 from rclpy.node import Node
 from rclpy.signals import SignalHandlerOptions
 
+from squeeze_grasp_ros.exit_codes import ExitCode
+from squeeze_grasp_ros.mechanics.errors import InvalidInputError
+
+
+PARENT_PID_ENV = "SQUEEZE_GRASP_PARENT_PID"
+"""Environment variable naming the process that started a node (``squeeze-grasp run
+--processes``): the node ends when that process dies."""
+PARAMS_FILE_ENV = "SQUEEZE_GRASP_PARAMS_FILE"
+"""Environment variable naming the parameter file the starting process wrote: a node that
+outlives that process removes it."""
+PR_SET_PDEATHSIG = 1
+"""prctl(2) option: the signal this process gets when the thread that forked it ends."""
+PARENT_DEATH_SIGNAL = signal.SIGUSR1
+"""The signal a node started by a run asks for when that run dies."""
+
+
+def parent_watch(stop: threading.Event) -> Callable[[], bool]:
+    """'Has the process that started this node died?', for a node started by a run.
+
+    With :data:`PARENT_PID_ENV` set, asks Linux for :data:`PARENT_DEATH_SIGNAL` when the parent
+    dies (``prctl(PR_SET_PDEATHSIG)``: the parent cannot catch SIGKILL, so only the children can
+    notice); its handler sets ``stop``. A signal of its own, not SIGTERM: it comes as the
+    forking thread ends, while the dying process's other threads may still be this process's
+    parent, so the parent pid cannot tell it yet. The returned check also compares the parent
+    pid (re-parented: the parent died, also where prctl does not exist). Without the variable,
+    a check that is never true.
+    """
+    text = os.environ.get(PARENT_PID_ENV, "")
+    if not text.isdigit():
+        return lambda: False
+    parent, died = int(text), threading.Event()
+
+    def on_parent_death(*_: object) -> None:
+        died.set()
+        stop.set()
+
+    if sys.platform.startswith("linux"):
+        signal.signal(PARENT_DEATH_SIGNAL, on_parent_death)
+        ctypes.CDLL(None, use_errno=True).prctl(PR_SET_PDEATHSIG, int(PARENT_DEATH_SIGNAL),
+                                                0, 0, 0)
+    return lambda: died.is_set() or os.getppid() != parent
+
+
+class ParameterError(InvalidInputError):
+    """A node parameter is missing or invalid; the message names it."""
+
 
 def run_node(factory: Callable[[], Node], args: list[str] | None = None,
-             executor_type: Callable[[], Executor] = EventsExecutor) -> None:
+             executor_type: Callable[[], Executor] = EventsExecutor) -> int:
     """A node's ``main``: init rclpy, spin the node in the main thread until SIGINT, SIGTERM or
     shutdown, then clean up.
 
@@ -26,7 +76,9 @@ def run_node(factory: Callable[[], Node], args: list[str] | None = None,
     not return after shutdown. SIGINT (Ctrl-C, also what ``ros2 launch`` sends first) and
     SIGTERM only set a flag, so no callback is interrupted halfway; the loop then ends, a node
     with ``drain(executor)`` processes what has already arrived, its ``close()`` is called, and
-    the node is destroyed (the planner joins its workers there).
+    the node is destroyed (the planner joins its workers there). A node started by a run ends
+    the same way when that process dies (:func:`parent_watch`), and removes the run's
+    parameter file.
 
     Parameters
     ----------
@@ -36,18 +88,40 @@ def run_node(factory: Callable[[], Node], args: list[str] | None = None,
         Command-line arguments for ``rclpy.init`` (``--ros-args ...``); None = ``sys.argv``.
     executor_type : callable
         Builds the executor.
+
+    Returns
+    -------
+    int
+        The exit code: 0, or 2 (:attr:`~.ExitCode.USAGE`) when the node refused its
+        parameters (a missing scene, output folder, ...). That error is one line on stderr,
+        ``<program>: error: <what>``, not a traceback. Once built, the node logs
+        ``<name> ready: <its configuration>``.
     """
     stop = threading.Event()
     for signum in (signal.SIGINT, signal.SIGTERM):
         signal.signal(signum, lambda *_: stop.set())
+    orphaned = parent_watch(stop)
     rclpy.init(args=args, signal_handler_options=SignalHandlerOptions.NO)
+    try:
+        node = factory()
+    except ValueError as error:  # InvalidInputError, or a recorder that cannot start its bag
+        print(f"{Path(sys.argv[0]).stem}: error: {error}", file=sys.stderr)
+        rclpy.try_shutdown()
+        return ExitCode.USAGE
+    summary = getattr(node, "ready_summary", lambda: "")()
+    node.get_logger().info(f"{node.get_name()} ready" + (f": {summary}" if summary else ""))
     executor = executor_type()
-    node = factory()
     executor.add_node(node)
     try:
-        while rclpy.ok() and not stop.is_set():
+        while rclpy.ok() and not stop.is_set() and not orphaned():
             executor.spin_once(0.1)
-        if stop.is_set() and hasattr(node, "drain"):
+        if orphaned():
+            node.get_logger().error(f"the process that started this node "
+                                    f"({os.environ[PARENT_PID_ENV]}) has died: shutting down")
+            params = os.environ.get(PARAMS_FILE_ENV)
+            if params:
+                Path(params).unlink(missing_ok=True)
+        if (stop.is_set() or orphaned()) and hasattr(node, "drain"):
             node.drain(executor)
     except ExternalShutdownException:
         pass
@@ -57,3 +131,4 @@ def run_node(factory: Callable[[], Node], args: list[str] | None = None,
         executor.shutdown()
         node.destroy_node()
         rclpy.try_shutdown()
+    return ExitCode.OK

@@ -24,6 +24,8 @@ previous feedback. Cancel: the next cycle holds the measured positions and the g
 """
 from __future__ import annotations
 
+import sys
+
 from typing import Any
 
 from geometry_msgs.msg import PoseStamped
@@ -80,6 +82,13 @@ class _Goal:
 
 class ExecutorNode(Node):
     """Grasp executor action server."""
+
+    def ready_summary(self) -> str:
+        """What the ready line of ``ros2 run`` says: devices, clock and limits."""
+        clock = "lockstep on /clock" if self.p["lockstep"] else "wall-clock timer"
+        return (f"fingers {self.devices}, {clock}, "
+                f"period {self.p['period']} s, max velocity {self.p['max_velocity']} m/s; "
+                f"action {self.resolve_topic_name(pipeline.ACTION)}")
 
     def __init__(self, **kwargs: Any) -> None:
         super().__init__("executor", **kwargs)
@@ -198,10 +207,10 @@ class ExecutorNode(Node):
             goal.since_feedback = []
 
 
-def main(args: list[str] | None = None) -> None:
-    """Run the executor until Ctrl-C or shutdown."""
-    run_node(ExecutorNode, args)
+def main(args: list[str] | None = None) -> int:
+    """Run the executor until Ctrl-C or shutdown; return the exit code."""
+    return run_node(ExecutorNode, args)
 
 
 if __name__ == "__main__":
-    main()
+    sys.exit(main())

@@ -21,6 +21,8 @@ events.
 """
 from __future__ import annotations
 
+import sys
+
 from typing import Any
 
 from geometry_msgs.msg import PoseStamped, WrenchStamped
@@ -95,6 +97,13 @@ class MonitorNode(Node):
             self.create_timer(1.0 / p["rate"], self._timer)
 
     # ----------------------------------------------------------------- inputs
+
+    def ready_summary(self) -> str:
+        """What the ready line of ``ros2 run`` says: fingers, streams, friction, clock."""
+        clock = "lockstep" if self.p["lockstep"] else f"rate {self.p['rate']} Hz"
+        return (f"fingers {self.fingers}, streams {[s for s in self.p['streams'] if s]}, "
+                f"mu {self.p['mu']}, {clock}")
+
     def _prediction(self, msg: ContactEventArray) -> None:
         self.tracker.set_prediction(messages.predicted_events(msg))
 
@@ -157,10 +166,10 @@ class MonitorNode(Node):
         self.answered.answer(ns, [(self.status_pub, messages.monitor_status_msg(out, frame))])
 
 
-def main(args: list[str] | None = None) -> None:
-    """Run the monitor until Ctrl-C or shutdown."""
-    run_node(MonitorNode, args)
+def main(args: list[str] | None = None) -> int:
+    """Run the monitor until Ctrl-C or shutdown; return the exit code."""
+    return run_node(MonitorNode, args)
 
 
 if __name__ == "__main__":
-    main()
+    sys.exit(main())

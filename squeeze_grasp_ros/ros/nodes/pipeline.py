@@ -90,9 +90,27 @@ def pipeline_topics(devices: Iterable[str], *, hidden: bool = False) -> dict[str
     return {("/" + k).replace("//", "/"): v for k, v in types.items()}
 
 
+MESSAGE_PACKAGES: frozenset[str] = frozenset({
+    "squeeze_grasp_interfaces", "std_msgs", "geometry_msgs", "sensor_msgs", "visualization_msgs",
+    "rosgraph_msgs", "action_msgs", "builtin_interfaces", "unique_identifier_msgs"})
+"""Packages whose message types :func:`message_type` resolves: the interfaces this package
+uses. A type name is data (a recording, a parameter): no other module is ever imported."""
+
+
 def message_type(type_name: str) -> type:
-    """The Python class of 'pkg/msg/Type' or of an action's 'pkg/action/Name_Suffix' message."""
-    package, kind, name = type_name.split("/")
+    """The Python class of 'pkg/msg/Type' or of an action's 'pkg/action/Name_Suffix' message,
+    for the packages of :data:`MESSAGE_PACKAGES` only.
+
+    Raises
+    ------
+    ValueError
+        For another package, another kind, or a name that is not one.
+    """
+    package, kind, name = (type_name.split("/") + ["", "", ""])[:3]
+    if (package not in MESSAGE_PACKAGES or kind not in ("msg", "action")
+            or not name.isidentifier() or type_name.count("/") != 2):
+        raise ValueError(f"message type {type_name[:80]!r} is not one of this package's "
+                         f"(pkg/msg/Type with pkg in {sorted(MESSAGE_PACKAGES)})")
     module = importlib.import_module(f"{package}.{kind}")
     if kind == "action" and "_" in name:
         action, _, part = name.partition("_")

@@ -27,8 +27,11 @@ executor thread.
 """
 from __future__ import annotations
 
+import math
 import queue
+import sys
 import threading
+import time
 from collections.abc import Callable
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
@@ -56,6 +59,8 @@ from squeeze_grasp_ros.resources import share_dir
 from squeeze_grasp_ros.ros.nodes import run_node
 
 Response = TypeVar("Response")
+WATCH_PERIOD = 0.1
+"""Wall-clock seconds between two graph queries of a request's abandonment check."""
 
 PARAMETERS: dict[str, tuple[Any, str]] = {
     "max_nodes": (60_000, "largest solid mesh (nodes) the planner builds; larger scenes are "
@@ -70,7 +75,10 @@ PARAMETERS: dict[str, tuple[Any, str]] = {
     "worker_threads": (2, "threads computing long requests (loads, maps, event squeezes)"),
     "best_count": (10, "placements a grasp map returns when a request asks for 0"),
     "min_step": (1e-5, "smallest event-squeeze substep, relative to the object size"),
-    "service_queue_depth": (100, "requests each service queues before DDS drops them"),
+    "service_queue_depth": (0, "requests each service and action queues: 0 = all of them (DDS "
+                               "never drops a request; a client beyond the reader's resource "
+                               "limits is held back), N = the last N (older unread requests "
+                               "are dropped)"),
     "max_pending": (16, "long requests (loads, maps, event squeezes) queued or running at "
                         "once; more are answered BUSY at once"),
     "allowed_roots": ([""], "folders whose files scene_path and a scene's outline file may "
@@ -78,6 +86,24 @@ PARAMETERS: dict[str, tuple[Any, str]] = {
                             "folder and the node's working directory"),
 }
 """Parameter name -> (typed default, description); config/planner.yaml sets the same names."""
+
+
+def request_queue(depth: int) -> QoSProfile:
+    """QoS of the planner's request queues: reliable, volatile, keep-all for ``depth`` 0 (no
+    request is ever dropped), else keep-last ``depth``.
+
+    rclpy's default for services (keep-last 10) drops the 11th and later requests of a burst
+    inside DDS before rclpy sees them; with keep-all a burst of 2,000 ``plan_squeeze`` requests
+    was answered in full (``bench ros_services``).
+
+    >>> request_queue(0).history.name, request_queue(100).depth
+    ('KEEP_ALL', 100)
+    """
+    if depth < 0:
+        raise ValueError(f"service_queue_depth must be >= 0 (0 = keep all), got {depth}")
+    return QoSProfile(history=HistoryPolicy.KEEP_ALL if depth == 0 else HistoryPolicy.KEEP_LAST,
+                      depth=depth or 1, reliability=ReliabilityPolicy.RELIABLE,
+                      durability=DurabilityPolicy.VOLATILE)
 
 
 def _resume(_: Future) -> None:
@@ -105,23 +131,20 @@ class PlannerNode(Node):
                              max_ring_elements=value("max_ring_elements"),
                              default_route=planning.solver_route(value("default_solver_route"),
                                                                  PlannerLimits()),
-                             best_count=value("best_count"), min_step=float(value("min_step")))
+                             best_count=value("best_count"), min_step=float(value("min_step")),
+                             max_bytes=int(value("cache_max_megabytes")) * 2**20)
         roots = [Path(r) for r in value("allowed_roots") if r] or [share_dir(), Path.cwd()]
         self.roots = list(dict.fromkeys(r.resolve() for r in roots))
-        self.cache = planning.ObjectCache(value("cache_size"),
-                                          int(value("cache_max_megabytes")) * 2**20)
+        self.cache = planning.ObjectCache(value("cache_size"), self.limits.max_bytes)
         self._pool = ThreadPoolExecutor(max_workers=value("worker_threads"),
                                         thread_name_prefix="planner-worker")
         self._stopping = threading.Event()
         self.abandoned: list[tuple] = []
-        """Progress (the arguments of the last report) of service requests stopped because
-        their client left the graph."""
+        """Progress (the arguments of the last report before it, () if none) of service
+        requests stopped because their client left the graph."""
         self._feedback: queue.SimpleQueue[tuple[ServerGoalHandle, Any]] = queue.SimpleQueue()
 
-        services = QoSProfile(history=HistoryPolicy.KEEP_LAST,
-                              depth=value("service_queue_depth"),
-                              reliability=ReliabilityPolicy.RELIABLE,
-                              durability=DurabilityPolicy.VOLATILE)
+        services = request_queue(value("service_queue_depth"))
         self._pending = 0
         self._pending_lock = threading.Lock()
         # Reentrant: a long request awaiting its worker must not hold the node's default
@@ -137,15 +160,21 @@ class PlannerNode(Node):
                 (EventSqueeze, "event_squeeze", self._event_squeeze)):
             self.create_service(srv_type, f"~/{name}", callback, qos_profile=services,
                                 callback_group=self._group)
+        # The action servers' goal, cancel and result services default to a queue of 10 too:
+        # 200 goals sent at once got 20 responses (issue 34).
+        queues = {f"{kind}_service_qos_profile": services for kind in ("goal", "cancel", "result")}
         self._actions = [
             ActionServer(self, GraspMapAction, "~/grasp_map", self._execute_grasp_map,
-                         cancel_callback=self._accept_cancel, callback_group=self._group),
+                         cancel_callback=self._accept_cancel, callback_group=self._group,
+                         **queues),
             ActionServer(self, EventSqueezeAction, "~/event_squeeze",
                          self._execute_event_squeeze, cancel_callback=self._accept_cancel,
-                         callback_group=self._group),
+                         callback_group=self._group, **queues),
         ]
-        self.get_logger().info(f"planner ready: {self.limits}; files from "
-                               f"{[str(r) for r in self.roots]}")
+
+    def ready_summary(self) -> str:
+        """What the ready line of ``ros2 run`` says: the limits and the readable folders."""
+        return f"{self.limits}; files from {[str(r) for r in self.roots]}"
 
     def _parameter(self, name: str) -> Any:
         """The value of a declared parameter (an int given for a float is accepted)."""
@@ -161,7 +190,8 @@ class PlannerNode(Node):
         def load() -> LoadObject.Response:
             source = planning.read_scene(request.scene_yaml, request.scene_path, self.roots)
             loaded, cached = planning.load_cached(self.cache, source, request.object_id,
-                                                  request.solver_route, self.limits, watch)
+                                                  request.solver_route, self.limits, watch,
+                                                  request.replace)
             return messages.load_object_response(loaded, cached, request.return_model)
         return await self._in_worker(LoadObject.Response, load)
 
@@ -169,17 +199,18 @@ class PlannerNode(Node):
                       response: PlanSqueeze.Response) -> PlanSqueeze.Response:
         """Stable or pure squeeze of a cached object, inline (milliseconds)."""
         return self._answer(PlanSqueeze.Response, lambda: messages.plan_squeeze_response(
-            planning.squeeze_plan(self.cache.get(request.object_id), request.contacts,
+            planning.squeeze_plan(self._object(request), request.contacts,
                                   request.squeeze_type, request.depth)))
 
     async def _grasp_map(self, request: GraspMap.Request,
                          response: GraspMap.Response) -> GraspMap.Response:
         """All-pairs grasp map of a cached object on a worker."""
         def compute() -> GraspMap.Response:
-            gmap = planning.object_grasp_map(self.cache.get(request.object_id), request.mu)
+            loaded = self._object(request)
+            gmap = planning.object_grasp_map(loaded, request.mu)
             return messages.success(GraspMap.Response, map=messages.grasp_map_data(
-                gmap, request.object_id, planning.best_count(request.best_count, self.limits),
-                request.full_matrices))
+                gmap, loaded.object_id, planning.best_count(request.best_count, self.limits),
+                request.full_matrices, digest=loaded.digest))
         return await self._in_worker(GraspMap.Response, compute)
 
     async def _plan_resistance(self, request: PlanResistance.Request,
@@ -188,18 +219,19 @@ class PlannerNode(Node):
         and Algorithm 2).
         """
         a = request.a
+        watch = self._client_watch("plan_resistance")
         return await self._in_worker(PlanResistance.Response, lambda: (
             messages.plan_resistance_response(planning.resistance_plan(
-                self.cache.get(request.object_id), request.contacts, (a.x, a.y, a.z),
+                self._object(request), request.contacts, (a.x, a.y, a.z),
                 request.mode, request.contact_model, request.segment_half_width,
-                request.directions, request.adversary_tip_radius, self.limits))))
+                request.directions, request.adversary_tip_radius, self.limits, watch))))
 
     async def _ring_grasp_test(self, request: RingGraspTest.Request,
                                response: RingGraspTest.Response) -> RingGraspTest.Response:
         """Ring grasp test (and all-pairs map) on a worker."""
         def compute() -> RingGraspTest.Response:
             test = planning.ring_grasp_test(
-                self.cache.get(request.object_id), request.contacts, request.squeeze_type,
+                self._object(request), request.contacts, request.squeeze_type,
                 request.mu, request.strain_limit, request.relative_depth, request.all_pairs)
             return messages.ring_grasp_test_response(
                 test, planning.best_count(request.best_count, self.limits))
@@ -211,7 +243,7 @@ class PlannerNode(Node):
         watch = self._client_watch("event_squeeze")
         return await self._in_worker(EventSqueeze.Response,
                                      lambda: self._event_squeeze_result(EventSqueeze.Response,
-                                                                        request, watch))
+                                                                        request, watch, watch))
 
     # ------------------------------------------------------------------ actions
 
@@ -225,22 +257,22 @@ class PlannerNode(Node):
         report = self._reporter(goal_handle, messages.grasp_map_feedback)
 
         def compute() -> GraspMapAction.Result:
-            object_id = goal.object_id
             stages = 1
             if goal.scene_yaml or goal.scene_path:
                 source = planning.read_scene(goal.scene_yaml, goal.scene_path, self.roots)
                 stages += len(planning.RING_STAGES if source.scene.object.model == ObjectModel.RING
                               else planning.SOLID_STAGES)
                 loaded, _ = planning.load_cached(
-                    self.cache, source, object_id, goal.solver_route, self.limits,
-                    lambda stage, index, count, nodes: report(stage, index, stages, nodes))
-                object_id = loaded.object_id
-            loaded = self.cache.get(object_id)
+                    self.cache, source, goal.object_id, goal.solver_route, self.limits,
+                    lambda stage, index, count, nodes: report(stage, index, stages, nodes),
+                    goal.replace)
+            else:
+                loaded = self._object(goal)
             report("grasp map", stages - 1, stages, loaded.num_nodes)
             gmap = planning.object_grasp_map(loaded, goal.mu)
             best = planning.best_count(goal.best_count, self.limits)
             return messages.success(GraspMapAction.Result, map=messages.grasp_map_data(
-                gmap, object_id, best, goal.full_matrices))
+                gmap, loaded.object_id, best, goal.full_matrices, digest=loaded.digest))
         return self._finish(goal_handle, await self._in_worker(GraspMapAction.Result, compute))
 
     async def _execute_event_squeeze(self,
@@ -250,20 +282,31 @@ class PlannerNode(Node):
         result = await self._in_worker(
             EventSqueezeAction.Result,
             lambda: self._event_squeeze_result(EventSqueezeAction.Result, goal_handle.request,
-                                               report))
+                                               report, self._goal_check(goal_handle)))
         return self._finish(goal_handle, result)
 
     # ------------------------------------------------------------------ plumbing
 
     def _event_squeeze_result(self, response_type: type[Response], request: Any,
-                              progress: Callable[[float], None] | None = None) -> Response:
-        """The event squeeze of a service request or action goal as ``response_type``."""
-        loaded = self.cache.get(request.object_id)
+                              progress: Callable[[float], None],
+                              checkpoint: Callable[[], None]) -> Response:
+        """The event squeeze of a service request or action goal as ``response_type``; the
+        callbacks may raise :class:`Cancelled` (after every event, before every substep).
+        """
+        loaded = self._object(request)
         result = planning.event_squeeze_run(
             loaded, request.contacts, request.squeeze_type, request.depth,
-            request.relative_depth, request.step, request.event_tol, self.limits, progress)
+            request.relative_depth, request.step, request.event_tol, self.limits, progress,
+            checkpoint)
         return messages.success(response_type,
-                                squeeze=messages.event_squeeze_data(result, loaded.object_id))
+                                squeeze=messages.event_squeeze_data(result, loaded.object_id,
+                                                                    digest=loaded.digest))
+
+    def _object(self, request: Any) -> planning.LoadedObject:
+        """The cached object a request names (``object_id``, checked against its
+        ``object_digest`` when the request quotes one).
+        """
+        return self.cache.get(request.object_id, request.object_digest)
 
     def _answer(self, response_type: type[Response], compute: Callable[[], Response]) -> Response:
         """``compute()``, or a failure response naming the reason; never raises for a request."""
@@ -311,21 +354,41 @@ class PlannerNode(Node):
         return await future
 
     def _client_watch(self, service: str) -> Callable[..., None]:
-        """A progress callback for the worker of a ``~/<service>`` request: raises
-        :class:`Cancelled` once no client of the service is left on the graph (the requester
-        has gone, so nobody can take the answer) or the node is shutting down.
+        """A progress callback (and checkpoint) for the worker of a ``~/<service>`` request:
+        raises :class:`Cancelled` once no client of the service is left on the graph (the
+        requester has gone, so nobody can take the answer) or the node is shutting down.
 
         ROS 2 services have no cancel; a client that gives up and destroys its client (or
-        whose process ends) leaves the graph, and its work stops at the next progress report.
+        whose process ends) leaves the graph, and its work stops at the next progress report
+        or checkpoint (the long loops call it before every stepper substep). The graph is
+        asked at most every :data:`WATCH_PERIOD` s; a progress report always asks.
         """
         name = f"{self.get_fully_qualified_name()}/{service}"
+        asked, reported = [-math.inf], [()]
 
         def check(*progress: Any) -> None:
             if self._stopping.is_set():
                 raise Cancelled("the planner is shutting down")
+            now = time.monotonic()
+            if progress:
+                reported[0] = progress
+            elif now - asked[0] < WATCH_PERIOD:
+                return
+            asked[0] = now
             if self.count_clients(name) == 0:
-                self.abandoned.append(progress)
+                self.abandoned.append(reported[0])
                 raise Cancelled(f"abandoned: no client of {name} is left to take the answer")
+        return check
+
+    def _goal_check(self, goal_handle: ServerGoalHandle) -> Callable[[], None]:
+        """A checkpoint for the worker of a goal: raises :class:`Cancelled` when the goal is
+        being cancelled or the node is shutting down.
+        """
+        def check() -> None:
+            if goal_handle.is_cancel_requested:
+                raise Cancelled("cancelled by the client")
+            if self._stopping.is_set():
+                raise Cancelled("the planner is shutting down")
         return check
 
     def _reporter(self, goal_handle: ServerGoalHandle,
@@ -333,10 +396,10 @@ class PlannerNode(Node):
         """A progress callback for a worker: queues ``feedback(*args)`` for the goal, or raises
         :class:`Cancelled` when the goal is being cancelled or the node is shutting down.
         """
+        check = self._goal_check(goal_handle)
+
         def report(*args: Any) -> None:
-            if goal_handle.is_cancel_requested or self._stopping.is_set():
-                raise Cancelled("cancelled by the client" if goal_handle.is_cancel_requested
-                                else "the planner is shutting down")
+            check()
             self._feedback.put((goal_handle, feedback(*args)))
             self.executor.create_task(self._publish_feedback)
         return report
@@ -371,10 +434,12 @@ class PlannerNode(Node):
         super().destroy_node()
 
 
-def main(args: list[str] | None = None) -> None:
-    """Run the planner on a SingleThreadedExecutor in the main thread until Ctrl-C or shutdown."""
-    run_node(PlannerNode, args, SingleThreadedExecutor)
+def main(args: list[str] | None = None) -> int:
+    """Run the planner on a SingleThreadedExecutor in the main thread until Ctrl-C or
+    shutdown; return the exit code.
+    """
+    return run_node(PlannerNode, args, SingleThreadedExecutor)
 
 
 if __name__ == "__main__":
-    main()
+    sys.exit(main())

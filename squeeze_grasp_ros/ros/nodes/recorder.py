@@ -26,6 +26,8 @@ already arrived, then ``close`` writes the MCAP summary and ``metadata.yaml``.
 """
 from __future__ import annotations
 
+import sys
+
 import struct
 import time
 from collections import deque
@@ -39,7 +41,7 @@ from std_msgs.msg import Header
 from squeeze_grasp_ros.ros import messages
 from squeeze_grasp_ros.ros.recording.bag import BagWriter, qos_dict
 from squeeze_grasp_ros.ros.recording.schema import starts_with_stamp
-from squeeze_grasp_ros.ros.nodes import pipeline, run_node
+from squeeze_grasp_ros.ros.nodes import ParameterError, pipeline, run_node
 
 PARAMETERS: dict[str, tuple[Any, str]] = {
     "output": ("", "bag folder to create (required; must not exist or be empty)"),
@@ -83,15 +85,21 @@ class RecorderNode(Node):
         super().__init__("recorder", **kwargs)
         self.p = p = pipeline.declare(self, PARAMETERS)
         if not p["output"]:
-            raise ValueError("parameter 'output' (the bag folder) is required")
+            raise ParameterError("parameter 'output' (the bag folder) is required: "
+                                 "--ros-args -p output:=/path/to/bag")
         custom = yaml.safe_load(p["custom_data"]) or {}
         self.writer = BagWriter(p["output"], p["compression"], p["chunk_size"],
                                 {str(k): str(v) for k, v in custom.items()})
         topics = pipeline.pipeline_topics(p["devices"], hidden=p["include_hidden_topics"])
+        self.sources = {name: name.lstrip("/") for name in topics}
+        """Recorded name -> the name subscribed to: the pipeline's topics relative to the
+        node's namespace (a run in a namespace records '/sim/tick' from '<ns>/sim/tick'),
+        extra topics as given."""
         for entry in p["extra_topics"]:
             if entry.strip():
                 name, type_name = entry.split()
                 topics[name] = type_name
+                self.sources[name] = name
         self.types = topics
         self.stamped = {name: starts_with_stamp(t) for name, t in topics.items()}
         self.unique = {name for name, stamped in self.stamped.items()
@@ -109,7 +117,7 @@ class RecorderNode(Node):
             qos = pipeline.LATCHED if name in latched else (
                 pipeline.sensor_qos(p["sensor_qos"], p["qos_depth"]) if name in sensors
                 else pipeline.loop_qos(p["qos_depth"]))
-            self.create_subscription(pipeline.message_type(type_name), name,
+            self.create_subscription(pipeline.message_type(type_name), self.sources[name],
                                      lambda data, n=name: self._record(n, data), qos, raw=True)
         self.progress_pub = self.create_publisher(Header, pipeline.RECORDER_PROGRESS,
                                                   pipeline.loop_qos(10))
@@ -118,12 +126,18 @@ class RecorderNode(Node):
                                                     [self.progress_pub])
             pipeline.wall_timer(self, 0.05, self._repeat_report)
 
+
+    def ready_summary(self) -> str:
+        """What the ready line of ``ros2 run`` says: the bag and how many topics."""
+        return f"recording {len(self.types)} topics into {self.p['output']}"
+
     def _offered_qos(self, topic: str) -> list[dict]:
         def name(policy: str, value) -> str:
             return POLICY_NAMES[policy].get(value, "unknown")
         return [qos_dict(name("history", q.history), q.depth, name("reliability", q.reliability),
                          name("durability", q.durability))
-                for q in (i.qos_profile for i in self.get_publishers_info_by_topic(topic))]
+                for q in (i.qos_profile
+                          for i in self.get_publishers_info_by_topic(self.sources[topic]))]
 
     def _record(self, topic: str, data: bytes) -> None:
         ns = cdr_stamp_ns(data) if self.stamped[topic] else self.get_clock().now().nanoseconds
@@ -179,10 +193,10 @@ class RecorderNode(Node):
         self.writer.close()
 
 
-def main(args: list[str] | None = None) -> None:
-    """Record until Ctrl-C or shutdown, then finish the bag."""
-    run_node(RecorderNode, args)
+def main(args: list[str] | None = None) -> int:
+    """Record until Ctrl-C or shutdown, then finish the bag; return the exit code."""
+    return run_node(RecorderNode, args)
 
 
 if __name__ == "__main__":
-    main()
+    sys.exit(main())

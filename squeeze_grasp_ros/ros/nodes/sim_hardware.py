@@ -22,6 +22,8 @@ every re-sent topic carries one message per stamp, which is how the recorder dro
 """
 from __future__ import annotations
 
+import sys
+
 import time
 from typing import Any
 
@@ -38,7 +40,7 @@ from squeeze_grasp_ros.mechanics.vocabulary import Effect
 from squeeze_grasp_ros.ros import messages
 from squeeze_grasp_ros.scene import GraspSetup, load_scene
 from squeeze_grasp_ros.sim.world import SimWorld, TickOutput
-from squeeze_grasp_ros.ros.nodes import pipeline, run_node
+from squeeze_grasp_ros.ros.nodes import ParameterError, pipeline, run_node
 
 PARAMETERS: dict[str, tuple[Any, str]] = {
     "scene": ("", "scene YAML file the world is built from (required)"),
@@ -70,7 +72,8 @@ class SimHardwareNode(Node):
         self.p = pipeline.declare(self, PARAMETERS)
         if world is None:
             if not self.p["scene"]:
-                raise ValueError("parameter 'scene' (a scene YAML file) is required")
+                raise ParameterError("parameter 'scene' (a scene YAML file) is required: "
+                                     "--ros-args -p scene:=/path/to/scene.yaml")
             world = SimWorld(GraspSetup.build(load_scene(self.p["scene"])))
         self.world = world
         self.frame = self.p["frame_id"]
@@ -107,6 +110,12 @@ class SimHardwareNode(Node):
         self.handshake = pipeline.Handshake(self, self.p["participants"],
                                             self.p["handshake_period"], self._start)
         pipeline.wall_timer(self, max(self.p["resend_timeout"] / 2.0, 1e-3), self._check_stalled)
+
+
+    def ready_summary(self) -> str:
+        """What the ready line of ``ros2 run`` says: scene, devices, waiting for whom."""
+        return (f"scene {self.world.scene.name}, fingers {self.devices}, dt {self.world.dt} s; "
+                f"waiting for {list(self.p['participants'])}")
 
     def _reading_messages(self, finger: str) -> dict[str, Any]:
         """One message per reading of ``finger``, refilled every tick (frames and taxel
@@ -200,10 +209,10 @@ class SimHardwareNode(Node):
                 publisher.publish(msg)
 
 
-def main(args: list[str] | None = None) -> None:
-    """Run the simulated hardware until Ctrl-C or shutdown."""
-    run_node(SimHardwareNode, args)
+def main(args: list[str] | None = None) -> int:
+    """Run the simulated hardware until Ctrl-C or shutdown; return the exit code."""
+    return run_node(SimHardwareNode, args)
 
 
 if __name__ == "__main__":
-    main()
+    sys.exit(main())

@@ -36,11 +36,11 @@ from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
+import lz4.frame
 import yaml
-from mcap.exceptions import McapError
-from mcap.reader import make_reader
-from mcap.records import Channel, Message, Metadata, Schema
-from mcap.stream_reader import StreamReader
+import zstandard
+from mcap.records import Channel, Chunk, Message, Metadata, Schema
+from mcap.stream_reader import StreamReader, breakup_chunk
 from mcap.writer import CompressionType, Writer
 
 from squeeze_grasp_ros.inputs import InputError, load_yaml, read_text
@@ -63,6 +63,12 @@ RESERVE_BYTES = 256 * 1024
 RESERVE_NAME = ".space_reserve"
 STOPPED_KEY = "recording_stopped"
 """``custom_data`` key of ``metadata.yaml`` saying why a recording ended early."""
+MAX_CHUNK_BYTES = 64 * 2**20
+"""Largest chunk a reader decompresses (ours are 256 KiB, rosbag2's 768 KiB); checked on the
+chunk's declared size before decompressing, and on what decompression yields."""
+MAX_EXPANSION = 64
+"""A file's chunks may decompress to at most this many times its size, plus one
+:data:`MAX_CHUNK_BYTES` (a run's bag: 6.5 times)."""
 
 
 class _PlainDumper(yaml.SafeDumper):
@@ -171,9 +177,10 @@ class BagWriter:
             raise BagError(
                 f"compression must be one of {sorted(COMPRESSION)}, got {compression!r}"
             )
-        self.path.mkdir(parents=True, exist_ok=True)
+        created = not self.path.exists()
         self.file_name = f"{self.path.name}_0.mcap"
         try:
+            self.path.mkdir(parents=True, exist_ok=True)
             fd = os.open(self.path / RESERVE_NAME, os.O_WRONLY | os.O_CREAT, 0o644)
             try:
                 os.posix_fallocate(fd, 0, RESERVE_BYTES)
@@ -188,6 +195,10 @@ class BagWriter:
             )
             self._writer.start(profile="ros2", library="squeeze_grasp_ros")
         except OSError as exc:
+            for leftover in (self.path / RESERVE_NAME, self.path / self.file_name):
+                leftover.unlink(missing_ok=True)  # not even a 0-byte reserve stays behind
+            if created and self.path.is_dir():
+                self.path.rmdir()
             raise BagError(f"cannot start a recording in {self.path}: {exc.strerror}") from None
         self._schemas: dict[str, int] = {}
         self.topics: dict[str, _Topic] = {}
@@ -433,9 +444,10 @@ def _storage_files(path: Path) -> tuple[list[Path], dict]:
     for name in names:
         file = (path / str(name)).resolve()
         if file.parent != path.resolve() or not file.is_file():
-            raise BagError(f"{meta_path} lists {name!r}, which is not a file of this bag")
+            raise BagError(f"{meta_path} lists {str(name)[:80]!r}, which is not a file of this "
+                           "bag")
         files.append(file)
-    return files, info
+    return list(dict.fromkeys(files)), info  # 'X' and './X' are one file, read once
 
 
 def _embedded_info(path: Path) -> dict:
@@ -443,15 +455,16 @@ def _embedded_info(path: Path) -> dict:
     if path.suffix != ".mcap":
         return {}
     try:
-        with open(path, "rb") as f:
-            for record in make_reader(f).iter_metadata():
-                if record.name == "rosbag2":
+        with open(path, "rb") as f:  # top-level records only: no chunk is decompressed
+            for record in StreamReader(f, emit_chunks=True,
+                                       record_size_limit=MAX_CHUNK_BYTES).records:
+                if isinstance(record, Metadata) and record.name == "rosbag2":
                     data = load_yaml(
                         record.metadata.get("serialized_metadata", ""),
                         what=f"{path} rosbag2 metadata",
                     )
                     return dict((data or {}).get("rosbag2_bagfile_information", data or {}))
-    except (McapError, InputError, OSError, ValueError):
+    except Exception:  # noqa: BLE001 (unreadable: the messages' reader says why)
         return {}
     return {}
 
@@ -467,16 +480,24 @@ def _read_mcap(path: Path) -> Iterator[BagMessage]:
     schemas: dict[int, str] = {}
     topics: dict[int, tuple[str, str]] = {}
     out: list[BagMessage] = []
+    budget = [MAX_EXPANSION * path.stat().st_size + MAX_CHUNK_BYTES]
     try:
         with open(path, "rb") as f:
-            for record in StreamReader(f, validate_crcs=True).records:
-                if isinstance(record, Schema):
-                    schemas[record.id] = record.name
-                elif isinstance(record, Channel):
-                    topics[record.id] = (record.topic, schemas.get(record.schema_id, ""))
-                elif isinstance(record, Message):
-                    topic, type_name = topics[record.channel_id]
-                    out.append(BagMessage(topic, type_name, record.log_time, bytes(record.data)))
+            reader = StreamReader(f, validate_crcs=True, emit_chunks=True,
+                                  record_size_limit=MAX_CHUNK_BYTES)
+            for outer in reader.records:
+                inner = _chunk_records(outer, budget) if isinstance(outer, Chunk) else [outer]
+                for record in inner:
+                    if isinstance(record, Schema):
+                        schemas[record.id] = record.name
+                    elif isinstance(record, Channel):
+                        topics[record.id] = (record.topic, schemas.get(record.schema_id, ""))
+                    elif isinstance(record, Message):
+                        topic, type_name = topics[record.channel_id]
+                        out.append(BagMessage(topic, type_name, record.log_time,
+                                              bytes(record.data)))
+    except BagError:
+        raise
     except Exception as exc:  # noqa: BLE001 (any failure to parse these bytes means corruption)
         raise BagError(
             f"{path} is corrupt ({type(exc).__name__}: {exc}); it cannot be "
@@ -484,6 +505,40 @@ def _read_mcap(path: Path) -> Iterator[BagMessage]:
         ) from None
     out.sort(key=lambda m: m.log_time_ns)
     yield from out
+
+
+def _chunk_records(chunk: Chunk, budget: list[int]) -> list:
+    """The records of ``chunk``, decompressed only if its declared size fits the limits
+    (:data:`MAX_CHUNK_BYTES`, and what is left of ``budget[0]``, which it uses up), and never to
+    more than that size (a decompression bomb is refused, not expanded).
+
+    Raises
+    ------
+    BagError
+        The chunk is, or decompresses to, more than it may.
+    """
+    size = chunk.uncompressed_size
+    if size > MAX_CHUNK_BYTES or size > budget[0]:
+        raise BagError(
+            f"a chunk declares {size:,} bytes uncompressed, more than a reader takes "
+            f"({min(MAX_CHUNK_BYTES, budget[0]):,} bytes: at most {MAX_CHUNK_BYTES // 2**20} MiB "
+            f"a chunk and {MAX_EXPANSION} times the file's size in all); refused before "
+            "decompressing")
+    budget[0] -= size
+    if chunk.compression == "zstd":
+        data = zstandard.ZstdDecompressor().decompress(chunk.data, max_output_size=size)
+    elif chunk.compression == "lz4":
+        data = lz4.frame.LZ4FrameDecompressor().decompress(chunk.data, max_length=size + 1)
+    else:
+        data = chunk.data
+    if len(data) != size:
+        raise BagError(f"a chunk decompresses to {'more' if len(data) > size else 'fewer'} "
+                       f"bytes than the {size:,} it declares")
+    return breakup_chunk(Chunk(compression="", data=data,
+                               message_end_time=chunk.message_end_time,
+                               message_start_time=chunk.message_start_time,
+                               uncompressed_crc=chunk.uncompressed_crc, uncompressed_size=size),
+                         validate_crc=True)
 
 
 def _read_sqlite(path: Path) -> Iterator[BagMessage]:

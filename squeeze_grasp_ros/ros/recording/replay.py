@@ -20,17 +20,18 @@ from collections.abc import Mapping
 from typing import Any
 
 import rclpy
-import yaml
 from rclpy.context import Context
 from rclpy.experimental import EventsExecutor
 from rclpy.node import Node
 from rclpy.parameter import Parameter
 from rclpy.serialization import deserialize_message
 from rclpy.signals import SignalHandlerOptions
+from geometry_msgs.msg import PoseStamped, WrenchStamped
 from rosgraph_msgs.msg import Clock
 
 from squeeze_grasp_interfaces.msg import ContactEventArray, MonitorStatus, TactileArray, Tick
 
+from squeeze_grasp_ros.inputs import InputError, load_yaml
 from squeeze_grasp_ros.ros import messages
 from squeeze_grasp_ros.ros.nodes import pipeline
 from squeeze_grasp_ros.ros.nodes.monitor import MonitorNode
@@ -40,6 +41,15 @@ from squeeze_grasp_ros.ros.recording.bag import BagContents, BagError, read_bag
 from squeeze_grasp_ros.mechanics.vocabulary import Finger
 
 READING = re.compile(r"^/?devices/([^/]+)/(pose|wrench|tactile)$")
+READING_TYPES: dict[str, tuple[str, type]] = {
+    "pose": ("geometry_msgs/msg/PoseStamped", PoseStamped),
+    "wrench": ("geometry_msgs/msg/WrenchStamped", WrenchStamped),
+    "tactile": ("squeeze_grasp_interfaces/msg/TactileArray", TactileArray),
+}
+"""Stream -> (type name, class) of the readings replay publishes: fixed here, never imported
+by a name read from a recording (a crafted recording made replay import any module)."""
+TICK_TIMEOUT = 10.0
+"""Wall-clock seconds replay waits for the monitor's answer to one tick before giving up."""
 
 
 def event_tuple(e: Any) -> tuple:
@@ -57,9 +67,39 @@ def recorded_events(bag: BagContents) -> list[tuple] | None:
             for e in deserialize_message(m.data, ContactEventArray).events]
 
 
+def checked_readings(bag: BagContents) -> list:
+    """The reading messages of a recording, each checked: its topic's type is the one replay
+    publishes for that stream, and it decodes as that type.
+
+    Raises
+    ------
+    BagError
+        Naming the topic, the stamp and what is wrong (a recording is data from elsewhere: one
+        corrupt message used to stall replay until its timeout).
+    """
+    readings = []
+    for m in bag.messages:
+        match = READING.match(m.topic)
+        if not match:
+            continue
+        type_name, cls = READING_TYPES[match.group(2)]
+        if m.type != type_name:
+            raise BagError(f"{m.topic} has type {m.type[:80]!r} in the recording; replay "
+                           f"publishes it as {type_name}")
+        try:
+            deserialize_message(m.data, cls)
+        except Exception as exc:  # noqa: BLE001 (rclpy raises RMWError and others)
+            raise BagError(
+                f"the message on {m.topic} logged at {m.log_time_ns * 1e-9:.6f} s does not "
+                f"decode as {type_name} ({type(exc).__name__}); the recording is corrupt"
+            ) from None
+        readings.append(m)
+    return readings
+
+
 def ticks_of(bag: BagContents) -> list[tuple[int, list]]:
     """[(stamp ns, [reading messages])] in order: by recorded ticks, else by stamp."""
-    readings = [m for m in bag.messages if READING.match(m.topic)]
+    readings = checked_readings(bag)
     by_stamp: dict[int, list] = {}
     for m in readings:
         by_stamp.setdefault(cdr_stamp_ns(m.data), []).append(m)
@@ -79,7 +119,14 @@ def ticks_of(bag: BagContents) -> list[tuple[int, list]]:
 def monitor_parameters(bag: BagContents) -> dict[str, Any]:
     """The monitor parameters of the recording, or defaults with the recorded devices."""
     if "monitor_parameters" in bag.custom_data:
-        return yaml.safe_load(bag.custom_data["monitor_parameters"])
+        try:
+            params = load_yaml(str(bag.custom_data["monitor_parameters"]),
+                               what="custom_data.monitor_parameters")
+        except InputError as exc:
+            raise BagError(str(exc)) from None
+        if not isinstance(params, dict):
+            raise BagError("custom_data.monitor_parameters of the recording is not a mapping")
+        return params
     params = config_parameters("monitor")
     fingers: dict[str, str] = {}
     devices = sorted({READING.match(m.topic).group(1) for m in bag.messages
@@ -107,8 +154,8 @@ class Replayer(Node):
         self.ticks = ticks
         self.clock_pub = self.create_publisher(Clock, pipeline.CLOCK, loop)
         self.tick_pub = self.create_publisher(Tick, pipeline.TICK, loop)
-        self.pubs = {topic: self.create_publisher(pipeline.message_type(bag.types[topic]),
-                                                  topic, loop)
+        self.pubs = {topic: self.create_publisher(
+                         READING_TYPES[READING.match(topic).group(2)][1], topic, loop)
                      for topic in {m.topic for _, group in ticks for m in group}}
         prediction = [m for m in bag.messages if m.topic == "/" + pipeline.PREDICTION]
         if prediction:
@@ -119,6 +166,8 @@ class Replayer(Node):
         self.alarms: list[tuple] = []
         self.status_ns = -1
         self.next = 0
+        self.published = time.monotonic()
+        """Wall-clock time the last tick was published."""
         self.create_subscription(MonitorStatus, pipeline.STATUS, self._status, loop)
         self.handshake = pipeline.Handshake(self, ["monitor"], 0.05, self._publish_next)
 
@@ -141,6 +190,7 @@ class Replayer(Node):
         keys = ["/".join(READING.match(m.topic).groups()) for m in group]
         self.tick_pub.publish(messages.tick_msg(self.next, ns, keys))
         self.next += 1
+        self.published = time.monotonic()
 
     @property
     def finished(self) -> bool:
@@ -176,6 +226,10 @@ def replay(path: str, overrides: Mapping[str, Any] | None = None, timeout: float
             if time.monotonic() > deadline:
                 raise TimeoutError(f"replay timed out after {timeout:.0f} s at tick "
                                    f"{replayer.next} of {len(ticks)}")
+            if replayer.next and time.monotonic() > replayer.published + TICK_TIMEOUT:
+                raise TimeoutError(f"the monitor did not answer tick {replayer.next - 1} of "
+                                   f"{len(ticks)} (t = {ticks[replayer.next - 1][0] * 1e-9:.6f} "
+                                   f"s) within {TICK_TIMEOUT:.0f} s")
             executor.spin_once(0.05)
     finally:
         for node in (monitor, replayer):

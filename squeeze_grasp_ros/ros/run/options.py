@@ -68,9 +68,9 @@ class RunOptions:
         Node name -> parameter overrides (applied last).
     timeout : float
         Wall-clock seconds a run may take.
-    discovery_wait : float
-        Least wall-clock seconds of DDS discovery before the run checks that no other
-        simulation uses its ROS domain (it overlaps the planning).
+    namespace : str or None
+        Namespace of the run's nodes: None = a fresh one of its own (two runs on one ROS domain
+        never see each other), or the namespace of the nodes ``attach`` drives (None: "/").
     """
 
     scene_path: str
@@ -84,7 +84,7 @@ class RunOptions:
     planner: bool = True
     overrides: Mapping[str, Mapping[str, Any]] = field(default_factory=dict)
     timeout: float = 300.0
-    discovery_wait: float = 1.0
+    namespace: str | None = None
 
 
 def node_parameters(

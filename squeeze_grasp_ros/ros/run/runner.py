@@ -23,6 +23,13 @@ drive the steps themselves):
 Every wait spins the executor with a wall-clock timeout; nothing sleeps to synchronise. The
 options and node parameters are in :mod:`.options`, the action client in
 :mod:`.goal_client`, the summary in :mod:`.summary`.
+
+Isolation: a run's own nodes (its planner, the pipeline nodes, its client) live in a namespace
+of their own (:func:`run_namespace`), and ``/clock`` is remapped into it, so every topic,
+service and action of the run carries the run's identity in its name and two runs on one ROS
+domain never see each other's traffic. The run watches its topics (:meth:`PipelineRunner.
+check_graph`): a publisher it did not start on one of them, or a second node with the name of
+one of its nodes, ends the run with :class:`RunError` (exit 4), never a success.
 """
 
 from __future__ import annotations
@@ -30,7 +37,7 @@ from __future__ import annotations
 import importlib.util
 import json
 import os
-import shutil
+import secrets
 import signal
 import subprocess
 import sys
@@ -58,10 +65,11 @@ from squeeze_grasp_interfaces.msg import Alarm, ContactEvent, ContactEventArray,
 
 from squeeze_grasp_ros.ros import messages
 from squeeze_grasp_ros.control.motion import GraspGoal
+from squeeze_grasp_ros.exit_codes import Interrupted
 from squeeze_grasp_ros.ros.recording.bag import plain_yaml
 from squeeze_grasp_ros.resources import config_dir, share_dir
-from squeeze_grasp_ros.scene import GraspSetup, SceneError, load_scene
-from squeeze_grasp_ros.ros.nodes import pipeline
+from squeeze_grasp_ros.scene import GraspSetup, Scene, SceneError, finger_devices, load_scene
+from squeeze_grasp_ros.ros.nodes import PARAMS_FILE_ENV, PARENT_PID_ENV, pipeline
 from squeeze_grasp_ros.ros.nodes.recorder import cdr_stamp_ns
 from squeeze_grasp_ros.ros.run.goal_client import GoalClient
 from squeeze_grasp_ros.ros.run.options import (EXECUTORS, PLANNER_MODULE, RunError,
@@ -71,6 +79,13 @@ from squeeze_grasp_ros.scene.goal import plan_scene, resistance_goal, resists
 from squeeze_grasp_ros.threads import single_thread_blas
 from squeeze_grasp_ros.mechanics.vocabulary import SQUEEZING_FINGERS, ShapeType, SqueezeKind
 
+GRAPH_CHECK_PERIOD = 1.0
+"""Wall-clock seconds between two checks of the run's namespace for foreign traffic."""
+UNKNOWN_NODE = "_NODE_NAME_UNKNOWN_"
+"""The node name rmw reports for a publisher discovered before its node's graph information."""
+UNKNOWN_NODE_GRACE = 10.0
+"""Wall-clock seconds a publisher may stay without a node name before it counts as foreign (a
+plain DDS writer never gets one)."""
 EVENTS_PER_CHECK = 16
 """Queued events :meth:`PipelineRunner.spin_until` executes between two checks of its condition."""
 SERVICE_RETRY = 30.0
@@ -81,12 +96,69 @@ STOP_SIGNALS = (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)
 """Signals that stop a run cleanly (the recording is finished, node processes are stopped)."""
 
 
-class Interrupted(KeyboardInterrupt):
-    """A run stopped by a signal; ``signum`` says which (exit status 128 + signum)."""
+PARAMS_PREFIX = "squeeze_grasp_run_"
+"""Name prefix of the parameter files ``--processes`` writes to the temp folder
+(``squeeze_grasp_run_<pid>_<random>.yaml``)."""
 
-    def __init__(self, signum: int) -> None:
-        super().__init__(signal.Signals(signum).name)
-        self.signum = int(signum)
+
+def remove_stale_parameter_files() -> list[Path]:
+    """Remove the parameter files of runs whose process no longer exists (a run killed with
+    SIGKILL cannot remove its own; its nodes remove it when they notice); returns them.
+    """
+    stale = []
+    for path in Path(tempfile.gettempdir()).glob(f"{PARAMS_PREFIX}*_*.yaml"):
+        pid = path.name[len(PARAMS_PREFIX):].split("_", 1)[0]
+        if pid.isdigit() and not process_exists(int(pid)):
+            path.unlink(missing_ok=True)
+            stale.append(path)
+    return stale
+
+
+def process_exists(pid: int) -> bool:
+    """True if a process ``pid`` exists (of any user)."""
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:
+        return True
+    return True
+
+
+def run_namespace() -> str:
+    """A namespace no other run uses: ``/squeeze_grasp/run_<pid>_<8 random hex digits>``."""
+    return f"/squeeze_grasp/run_{os.getpid()}_{secrets.token_hex(4)}"
+
+
+def run_topics(scene: Scene) -> list[str]:
+    """Every topic of a run of ``scene`` (action topics and handshake included), relative
+    (``/clock`` as ``clock``: it is remapped into the run's namespace).
+    """
+    devices = finger_devices(scene).values()
+    names = list(pipeline.pipeline_topics(devices, hidden=True))
+    names += [f"/{t}" for t in (pipeline.HELLO, pipeline.READY, pipeline.RECORDER_PROGRESS)]
+    return [t.lstrip("/") for t in names]
+
+
+def node_topic(namespace: str, topic: str) -> str:
+    """``topic`` (relative) in ``namespace``.
+
+    >>> node_topic("/lab/run_1", "sim/tick"), node_topic("/", "sim/tick")
+    ('/lab/run_1/sim/tick', '/sim/tick')
+    """
+    return f"{namespace.rstrip('/')}/{topic}"
+
+
+def ros_arguments(namespace: str) -> list[str]:
+    """Command-line ROS arguments that put a node into ``namespace`` with ``/clock`` remapped
+    into it (the nodes on sim time subscribe to the absolute ``/clock``).
+
+    >>> ros_arguments("/lab/run_1")
+    ['--ros-args', '-r', '__ns:=/lab/run_1', '-r', '/clock:=/lab/run_1/clock']
+    """
+    if not namespace or namespace == "/":
+        return ["--ros-args"]
+    return ["--ros-args", "-r", f"__ns:={namespace}", "-r", f"/clock:={namespace}/clock"]
 
 
 class PipelineRunner:
@@ -130,7 +202,17 @@ class PipelineRunner:
             else SingleThreadedExecutor(context=self.context)
         )
         self.events_per_check = EVENTS_PER_CHECK if options.executor == "events" else 0
-        self.client = Node("run", context=self.context)
+        self.namespace = (options.namespace or "/") if options.attach else (
+            options.namespace or run_namespace())
+        """The run's namespace: its own (a fresh one unless given), or the attached nodes'."""
+        self.ours = {"run"}
+        """Names of the nodes this run started in its namespace (grows as they start)."""
+        self.graph_checked = -float("inf")
+        self.topics = [node_topic(self.namespace, t) for t in run_topics(self.scene)]
+        """The run's topics, fully qualified: the ones :meth:`check_graph` watches."""
+        self.unknown_since: dict[bytes, float] = {}
+        """Publisher GID -> when it was first seen without a node name (discovery pending)."""
+        self.client = Node("run", context=self.context, cli_args=ros_arguments(self.namespace))
         self.executor.add_node(self.client)
         self.nodes: list[Node] = []
         self.processes: list[subprocess.Popen] = []
@@ -143,7 +225,6 @@ class PipelineRunner:
         self.sim_state_data: list[bytes] = []
         self.sim_state_ns = -1
         self.recorder_ns = -1
-        self.discard_recording = False
         self.feedback: list[ExecuteGrasp.Feedback] = []
         loop = pipeline.loop_qos(1000)
         c = self.client
@@ -238,9 +319,44 @@ class PipelineRunner:
             if time.monotonic() > deadline:
                 raise RunError(f"timed out after {timeout:.0f} s waiting for {what}")
             self._check_processes()
+            if time.monotonic() > self.graph_checked + GRAPH_CHECK_PERIOD:
+                self.check_graph()
             self.executor.spin_once(0.05)
             for _ in range(self.events_per_check):
                 self.executor.spin_once(0.0)
+
+    def check_graph(self) -> None:
+        """Raise :class:`RunError` if anything foreign takes part in the run.
+
+        Foreign: a publisher on one of the run's topics (the pipeline's, resolved in the run's
+        namespace) from a node this run did not start, or a second node with the name of one
+        of the run's nodes in its namespace (another run, or a planner answering in its
+        place). Subscribers (a viewer) and other nodes are not the run's business. (Not for
+        ``attach``: the nodes there are not the run's own.)
+        """
+        self.graph_checked = time.monotonic()
+        if self.options.attach:
+            return
+        ns, node, now = self.namespace, self.client, time.monotonic()
+        names = Counter(n for n, space in node.get_node_names_and_namespaces()
+                        if space == ns and n in self.ours)
+        foreign = [f"{k} nodes named {ns.rstrip('/')}/{n}" for n, k in names.items() if k > 1]
+        for topic in self.topics:
+            for info in node.get_publishers_info_by_topic(topic):
+                if info.node_name == UNKNOWN_NODE:  # discovered before its node's name
+                    first = self.unknown_since.setdefault(bytes(info.endpoint_gid), now)
+                    if now - first < UNKNOWN_NODE_GRACE:
+                        continue
+                elif info.node_namespace == ns and info.node_name in self.ours:
+                    continue
+                foreign.append(f"{info.node_namespace.rstrip('/')}/{info.node_name} "
+                               f"publishing on {topic}")
+        if foreign:
+            raise RunError(
+                f"foreign traffic in this run's namespace {ns}: {'; '.join(sorted(foreign)[:3])}"
+                f"{' and more' if len(foreign) > 3 else ''}; the run's results cannot be "
+                "trusted, so it is stopped"
+            )
 
     def _check_processes(self) -> None:
         for proc in self.processes:
@@ -259,7 +375,6 @@ class PipelineRunner:
         between this process and the monitor had settled (seen: a run whose 7 monitor events
         never reached the client).
         """
-        discovery_ends = time.monotonic() + self.options.discovery_wait
         plan_source = self._use_planner()
         planner = self._start_planner() if plan_source and not self.options.attach else None
         try:
@@ -267,8 +382,6 @@ class PipelineRunner:
         finally:
             if planner is not None:
                 planner()
-        if not self.options.attach:
-            self._refuse_if_domain_busy(discovery_ends)
         self.timing["plan"] = self.plan.seconds
         self.prediction_pub.publish(self.plan.prediction)
         params = node_parameters(
@@ -276,6 +389,7 @@ class PipelineRunner:
         )
         if not self.options.record:
             del params["recorder"]
+        self.ours |= set(params)
         started = time.perf_counter()
         if self.options.processes:
             self._spawn(params)
@@ -292,36 +406,9 @@ class PipelineRunner:
             self.options.timeout,
             "the publishers of the run's outcome topics",
         )
-        if not self.options.attach:
-            self._refuse_if_domain_busy(time.monotonic(), own=1)
+        self.check_graph()
         self.start_ns = self.sim_state_ns
         self.timing["start_nodes"] = time.perf_counter() - started
-
-    def _refuse_if_domain_busy(self, deadline: float, own: int = 0) -> None:
-        """Refuse to run when another simulated pipeline runs on this ROS domain.
-
-        Two lockstep loops on one domain answer each other's ticks and record each other's
-        messages. Discovery runs while the run plans, for at least ``discovery_wait`` s; then a
-        publisher of ``sim/tick`` means another simulation is running. The check is made again
-        once this run's own nodes are up (``own`` = 1 publisher of its own), before the goal,
-        for a machine so loaded that discovery took longer; that refusal removes the recording
-        folder this run had started (it holds the other run's messages only). Two runs started
-        within that time of each other are not told apart: give concurrent runs their own
-        ROS_DOMAIN_ID.
-        """
-        while time.monotonic() < deadline:
-            self.executor.spin_once(0.02)
-        others = self.client.count_publishers("/" + pipeline.TICK) - own
-        if others > 0:
-            self.discard_recording = bool(own)
-            domain = os.environ.get("ROS_DOMAIN_ID", "0")
-            raise RunError(
-                f"another simulated pipeline is running on ROS_DOMAIN_ID {domain} "
-                f"({others} publisher(s) of /{pipeline.TICK}"
-                f"{', found once this run had started its nodes' if own else ''}); a second "
-                "run would corrupt both. Stop it, or give this run its own domain, e.g. "
-                "ROS_DOMAIN_ID=42 squeeze-grasp run ..."
-            )
 
     def _use_planner(self) -> bool:
         return self.options.attach or (
@@ -342,16 +429,19 @@ class PipelineRunner:
         }
         for name, values in params.items():
             overrides = [Parameter(k, value=v) for k, v in values.items()]
-            node = classes[name](context=self.context, parameter_overrides=overrides)
+            node = classes[name](context=self.context, parameter_overrides=overrides,
+                                 cli_args=ros_arguments(self.namespace))
             self.nodes.append(node)
             self.executor.add_node(node)
 
     def _spawn(self, params: dict[str, dict]) -> None:
-        handle, path = tempfile.mkstemp(prefix=f"squeeze_grasp_run_{os.getpid()}_", suffix=".yaml")
+        remove_stale_parameter_files()
+        handle, path = tempfile.mkstemp(prefix=f"{PARAMS_PREFIX}{os.getpid()}_", suffix=".yaml")
         os.close(handle)
         self.params_file = Path(path)
         self.params_file.write_text(
-            plain_yaml({name: {"ros__parameters": values} for name, values in params.items()})
+            plain_yaml({f"{self.namespace}/{name}": {"ros__parameters": values}
+                        for name, values in params.items()})
         )
         for name in params:
             self.processes.append(
@@ -360,14 +450,25 @@ class PipelineRunner:
                         sys.executable,
                         "-m",
                         f"squeeze_grasp_ros.ros.nodes.{name}",
-                        "--ros-args",
+                        *ros_arguments(self.namespace),
                         "--params-file",
                         str(self.params_file),
                     ],
                     stdin=subprocess.DEVNULL,
-                    env=single_thread_blas(dict(os.environ)),
+                    env=self._child_environment(),
                 )
             )
+
+    def _child_environment(self) -> dict[str, str]:
+        """The environment of a node process: single-threaded BLAS, and this process's pid and
+        parameter file, so that the node ends (and removes the file) if this process dies
+        without stopping it (SIGKILL): :func:`..nodes.parent_watch`.
+        """
+        env = dict(single_thread_blas(dict(os.environ)))
+        env[PARENT_PID_ENV] = str(os.getpid())
+        if self.params_file is not None:
+            env[PARAMS_FILE_ENV] = str(self.params_file)
+        return env
 
     def node(self, name: str) -> Node:
         """The in-process node called ``name``."""
@@ -387,20 +488,21 @@ class PipelineRunner:
     def _start_planner(self) -> Callable[[], None]:
         """Start the planner (thread or process); return the function that stops it."""
         roots = self._planner_roots()
+        self.ours.add("planner")
         if self.options.processes:
             proc = subprocess.Popen(
                 [
                     sys.executable,
                     "-m",
                     PLANNER_MODULE,
-                    "--ros-args",
+                    *ros_arguments(self.namespace),
                     "--params-file",
                     str(config_dir() / "planner.yaml"),
                     "-p",
                     f"allowed_roots:={json.dumps(roots)}",
                 ],
                 stdin=subprocess.DEVNULL,
-                env=single_thread_blas(dict(os.environ)),
+                env=self._child_environment(),
             )
 
             def stop_process() -> None:
@@ -411,7 +513,8 @@ class PipelineRunner:
         from squeeze_grasp_ros.ros.nodes.planner import PlannerNode
 
         node = PlannerNode(
-            context=self.context, parameter_overrides=[Parameter("allowed_roots", value=roots)]
+            context=self.context, parameter_overrides=[Parameter("allowed_roots", value=roots)],
+            cli_args=ros_arguments(self.namespace),
         )
         spinner = SingleThreadedExecutor(context=self.context)
         spinner.add_node(node)
@@ -457,13 +560,16 @@ class PipelineRunner:
         path = str(Path(self.options.scene_path).resolve())
         loaded = self._call(LoadObject, "load_object", LoadObject.Request(scene_path=path))
         squeeze = self._call(
-            EventSqueeze, "event_squeeze", EventSqueeze.Request(object_id=loaded.object_id)
+            EventSqueeze,
+            "event_squeeze",
+            EventSqueeze.Request(object_id=loaded.object_id, object_digest=loaded.object_digest),
         ).squeeze
         pure = self._call(
             PlanSqueeze,
             "plan_squeeze",
             PlanSqueeze.Request(
                 object_id=loaded.object_id,
+                object_digest=loaded.object_digest,
                 contacts=list(loaded.finger_nodes),
                 squeeze_type=SqueezeKind.PURE,
             ),
@@ -580,8 +686,6 @@ class PipelineRunner:
             self.context.try_shutdown()
             if self.params_file is not None:
                 self.params_file.unlink(missing_ok=True)
-            if self.discard_recording and self.options.record:
-                shutil.rmtree(self.options.record, ignore_errors=True)
 
     # ----------------------------------------------------------------- the whole run
     def run(self) -> dict:
@@ -602,6 +706,7 @@ class PipelineRunner:
             self.start()
             self.send_goal()
             result = self.wait_result()
+            self.check_graph()
             return self.summary(result)
         finally:
             try:
@@ -615,9 +720,9 @@ class PipelineRunner:
         observed = Observed(self.sim_state, list(self.sim_events), self.world_end,
                             list(self.monitor_events), self.alarms, self.first_alarm)
         timing = {**self.timing, "total": time.perf_counter() - self.t0, **self._node_timing()}
-        return run_summary(scene=self.scene.name, mode=self.mode(), plan=self.plan,
-                           observed=observed, result=result, recording=self.options.record,
-                           timing=timing)
+        return {**run_summary(scene=self.scene.name, mode=self.mode(), plan=self.plan,
+                              observed=observed, result=result, recording=self.options.record,
+                              timing=timing), "namespace": self.namespace}
 
     def _node_timing(self) -> dict:
         """Wall and CPU time of the stepper (``mechanics``) and of whole world ticks (``world``:

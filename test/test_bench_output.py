@@ -1,0 +1,26 @@
+# Copyright 2026 squeeze_grasp_ros developers
+# SPDX-License-Identifier: Apache-2.0
+"""``squeeze-grasp bench`` writes its report and pictures into ``--out`` and nothing else: the
+recordings, scenes and datasets its sections make are scratch, removed afterwards.
+"""
+from __future__ import annotations
+
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+
+@pytest.mark.slow
+def test_the_quick_pipeline_and_sweep_sections_leave_no_scratch_folder(tmp_path):
+    pytest.importorskip("distributed", reason="the sweep extra is not installed: "
+                                              "pip install '.[sweep]'")
+    out = tmp_path / "bench_out"
+    done = subprocess.run([str(Path(sys.executable).parent / "squeeze-grasp"), "bench",
+                           "--quick", "--only", "pipeline", "sweep", "--out", str(out)],
+                          capture_output=True, text=True, timeout=1800, cwd=tmp_path,
+                          stdin=subprocess.DEVNULL)
+    assert done.returncode == 0, done.stderr[-3000:]
+    assert sorted(p.name for p in out.iterdir()) == ["report.md"]
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["bench_out"]

@@ -1,0 +1,365 @@
+# Copyright 2026 squeeze_grasp_ros developers
+# SPDX-License-Identifier: Apache-2.0
+"""Every console transcript in README.md and docs/ is run and its output compared.
+
+How a transcript is compared, and the masks: ``test/doc_transcripts.py`` (and docs/ci.md).
+A command runs as the user would type it, from a scratch folder in which ``config`` is a copy
+of the repository's and ``launch`` and ``msg_defs`` link to it (so relative paths in the docs
+resolve and files the commands write land in the scratch folder). A command of the colcon
+route runs as its equivalent without ros2cli, which is not on PyPI:
+
+- ``ros2 run squeeze_grasp_ros squeeze-grasp ARGS`` is ``squeeze-grasp ARGS``, and ``$SHARE``
+  (the package's share folder) is the repository, which has the same ``config/`` and
+  ``launch/``;
+- ``ros2 pkg executables squeeze_grasp_ros`` lists the console scripts of the installed
+  distribution;
+- ``ros2 launch squeeze_grasp_ros FILE --show-args`` prints the launch file's declared
+  arguments, read from its source;
+- ``ros2 launch squeeze_grasp_ros sim_pipeline.launch.py [scene:=F] [record:=D]`` is
+  ``squeeze-grasp run F [--record D]``: its ``[run-N]`` lines are the run's summary, compared
+  as a subsequence of the transcript's lines (the launch system's own lines need ros2launch);
+- ``ros2 interface show PKG/srv/T`` prints ``msg_defs/srv/T.srv``;
+- ``/tmp/user/`` (the docs' folder outside the repository) is a folder in the scratch folder.
+
+Mechanics verbs run in this process (``cli.main``), the ROS verbs (``run``, ``replay``,
+``sweep``) as processes; each distinct command runs once per session. Transcripts whose
+commands take more than a few seconds are in the slow suite (``-m slow``).
+"""
+from __future__ import annotations
+
+import ast
+import contextlib
+import importlib.metadata
+import io
+import os
+import re
+import shlex
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import doc_ros_session
+import numpy as np
+import pytest
+from executables import script
+
+from squeeze_grasp_ros.exit_codes import ExitCode
+from squeeze_grasp_ros.extras import install_hint
+from doc_transcripts import (MASKS, PAGES, REPO, Command, Transcript, blocks, compare,
+                             line_matches, number_matches, transcripts)
+
+LINKED = ("launch", "msg_defs")
+SLOW_VERBS = ("run", "replay", "sweep", "bench")
+PROCESS_VERBS = ("run", "replay", "sweep", "sweep-report", "bench", "ros-setup")
+SLOW_OPTIONS = ("--compare-models",)
+RUN_LINE = re.compile(r"^\[run-\d+\] ")
+USER_FOLDER = "/tmp/user/"
+"""The transcripts' working folder outside the repository; a scratch folder stands in for it."""
+
+ALL = transcripts()
+PLANNER_COMMANDS = ("ros2 service", "ros2 param", "ros2 action")
+PLANNER_PAGE, PLANNER_START = REPO / "docs" / "ros.md", "## Parameters"
+
+
+def by_planner_session(transcript: Transcript) -> bool:
+    """Whether the planner session of docs/ros.md runs this transcript (test below)."""
+    return all(c.text.startswith(PLANNER_COMMANDS) for c in transcript.commands)
+
+
+TESTED = [t for t in ALL if t.untested is None and not by_planner_session(t)]
+
+
+def is_slow(transcript: Transcript) -> bool:
+    """Whether a transcript runs a pipeline, a sweep, a benchmark or the model comparison."""
+    for command in transcript.commands:
+        words = squeeze_grasp_words(command.text)
+        if words and (words[0] in SLOW_VERBS or any(o in words for o in SLOW_OPTIONS)):
+            return True
+        if command.text.startswith("ros2 launch") and "--show-args" not in command.text:
+            return True
+    return False
+
+
+def squeeze_grasp_words(text: str) -> list[str] | None:
+    """The arguments of a ``squeeze-grasp`` command (also through ``ros2 run``), else None."""
+    words = shlex.split(text.replace("$SHARE", str(REPO)), comments=True)
+    if words[:3] == ["ros2", "run", "squeeze_grasp_ros"]:
+        words = words[3:]
+    return words[1:] if words and words[0] == "squeeze-grasp" else None
+
+
+@pytest.fixture(scope="session")
+def scratch(tmp_path_factory) -> Path:
+    """The folder the transcripts run in: config/, launch/, msg_defs/ link to the repository."""
+    folder = tmp_path_factory.mktemp("docs")
+    # a copy of config/: a planner reads scene files only inside its share folder and its
+    # working folder, symlinks resolved (on the colcon route the share folder is not REPO)
+    shutil.copytree(REPO / "config", folder / "config")
+    for name in LINKED:
+        (folder / name).symlink_to(REPO / name)
+    (folder / "tmp_user").mkdir()
+    return folder
+
+
+OUTPUTS: dict[str, list[str]] = {}
+"""Each distinct command's output, run once per session."""
+
+
+def run_command(command: Command, folder: Path, again: bool = False) -> list[str]:
+    """The output of ``command`` (or its equivalent, see the module docstring) in ``folder``;
+    ``again``: run it even if it ran before (a transcript repeating a command shows what the
+    repetition does, e.g. a sweep resuming).
+    """
+    if again or command.text not in OUTPUTS:
+        # a terminal shows what follows the last carriage return of a line (progress lines)
+        OUTPUTS[command.text] = [line.rsplit("\r", 1)[-1]
+                                 for line in _run(command.text, folder).split("\n")]
+    return OUTPUTS[command.text]
+
+
+def _run(text: str, folder: Path) -> str:
+    text = text.replace(USER_FOLDER, f"{folder / 'tmp_user'}/")
+    words = squeeze_grasp_words(text)
+    if words is not None:
+        if words and words[0] in PROCESS_VERBS:
+            return _process([script("squeeze-grasp"), *words], folder)
+        return _in_process(words, folder)
+    words = shlex.split(text.replace("$SHARE", str(REPO)), comments=True)
+    if words[0] == "cat":
+        return (folder / words[1]).read_text(encoding="utf-8")
+    if words[0] == "ls":
+        return "  ".join(sorted(p.name for p in (folder / words[1]).iterdir()))
+    if words[0].startswith("SHARE="):
+        return ""
+    if words[0] == "python":
+        return _process([sys.executable, *words[1:]], folder)
+    if words[:3] == ["ros2", "pkg", "executables"]:
+        return executables(words[3])
+    if words[:2] == ["ros2", "launch"] and words[-1] == "--show-args":
+        return show_args(REPO / "launch" / words[3])
+    if words[:2] == ["ros2", "launch"] and words[3] == "sim_pipeline.launch.py":
+        return launched_run(dict(w.split(":=", 1) for w in words[4:]), folder)
+    if words[:3] == ["ros2", "interface", "show"]:
+        package, kind, name = words[3].split("/")
+        return (REPO / "msg_defs" / kind / f"{name}.{kind}").read_text(encoding="utf-8")
+    raise AssertionError(f"no way to run {text!r}: mark the transcript <!-- untested: ... -->")
+
+
+def _in_process(words: list[str], folder: Path) -> str:
+    from squeeze_grasp_ros import cli
+
+    out = io.StringIO()
+    cwd = os.getcwd()
+    os.chdir(folder)
+    try:
+        with contextlib.redirect_stdout(out), contextlib.redirect_stderr(out):
+            code = cli.main(words)
+    finally:
+        os.chdir(cwd)
+    missing = re.search(r"needs (\S+), which is not installed: (.*)", out.getvalue())
+    if code == ExitCode.INTERNAL and missing and install_hint(missing.group(1)):
+        pytest.skip(f"squeeze-grasp {words[0]} needs {missing.group(1)}: {missing.group(2)}")
+    assert code in (0, 1), f"squeeze-grasp {' '.join(words)} exited {code}:\n{out.getvalue()}"
+    return out.getvalue()
+
+
+def _process(argv: list[str], folder: Path) -> str:
+    """The output of a process, stdout and stderr interleaved as on a terminal."""
+    done = subprocess.run(argv, cwd=folder, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
+                          text=True, timeout=900, stdin=subprocess.DEVNULL,
+                          env={**os.environ, "PYTHONUNBUFFERED": "1"})
+    assert done.returncode in (0, 1), f"{argv} exited {done.returncode}:\n{done.stdout}"
+    return done.stdout
+
+
+def executables(package: str) -> str:
+    """What ``ros2 pkg executables PACKAGE`` lists: the console scripts, sorted."""
+    scripts = importlib.metadata.distribution(package).entry_points.select(
+        group="console_scripts")
+    return "\n".join(f"{package} {name}" for name in sorted(e.name for e in scripts))
+
+
+def show_args(launch_file: Path) -> str:
+    """``ros2 launch ... --show-args``: every ``DeclareLaunchArgument`` of the file, in order.
+
+    A default computed from the package's share folder (``get_package_share_directory``) is
+    evaluated with that folder as ``<install prefix>/share/<package>``.
+    """
+    tree = ast.parse(launch_file.read_text(encoding="utf-8"))
+    values = {"Path": Path, "str": str,
+              "get_package_share_directory": lambda p: f"<install prefix>/share/{p}"}
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Assign) and len(node.targets) == 1 \
+                and isinstance(node.targets[0], ast.Name):
+            with contextlib.suppress(Exception):
+                values[node.targets[0].id] = eval(  # noqa: S307 (the repository's own file)
+                    compile(ast.Expression(node.value), str(launch_file), "eval"), values)
+    lines = ["Arguments (pass arguments as '<name>:=<value>'):"]
+    for call in ast.walk(tree):
+        if not (isinstance(call, ast.Call) and getattr(call.func, "id", "")
+                == "DeclareLaunchArgument"):
+            continue
+        keywords = {k.arg: k.value for k in call.keywords}
+        default = eval(compile(ast.Expression(keywords["default_value"]), str(launch_file),
+                               "eval"), values)
+        lines += ["", f"    {ast.literal_eval(call.args[0])!r}:",
+                  f"        {ast.literal_eval(keywords['description'])}",
+                  f"        (default: {default!r})"]
+    return "\n".join(lines)
+
+
+def launched_run(arguments: dict[str, str], folder: Path) -> str:
+    """``sim_pipeline.launch.py``'s run, as the run's own lines prefixed by ``[run-N] ``."""
+    scene = arguments.get("scene") or str(REPO / "config" / "scenes" / "foam_square.yaml")
+    argv = [script("squeeze-grasp"), "run", scene]
+    if arguments.get("record"):
+        argv += ["--record", arguments["record"]]
+    return _process(argv, folder)
+
+
+def check(transcript: Transcript, folder: Path) -> None:
+    """Run every command of ``transcript`` and compare its output."""
+    problems, seen = [], set()
+    for command in transcript.commands:
+        output = run_command(command, folder, again=command.text in seen)
+        seen.add(command.text)
+        if command.text.startswith("ros2 launch") and "--show-args" not in command.text:
+            problem = compare_subsequence(command.output, output)
+        else:
+            problem = compare(command.output, output)
+        if problem:
+            problems.append(f"$ {command.text}\n  {problem}")
+    assert not problems, f"{transcript.name}:\n" + "\n".join(problems)
+
+
+def compare_subsequence(expected: tuple[str, ...], actual: list[str]) -> str | None:
+    """The ``[run-N]`` lines of a launch transcript, in order, against the run's lines."""
+    wanted = [RUN_LINE.sub("", line) for line in expected if RUN_LINE.match(line)]
+    assert wanted, "a launch transcript without [run-N] lines cannot be compared"
+    k = 0
+    for line in actual:
+        if k < len(wanted) and line_matches(wanted[k], line):
+            k += 1
+    if k == len(wanted):
+        return None
+    shown = "\n".join(f"    {line}" for line in actual)
+    return f"no run line matches {wanted[k]!r}\n  actual output:\n{shown}"
+
+
+@pytest.mark.parametrize(
+    "transcript",
+    [pytest.param(t, id=t.name, marks=[pytest.mark.slow] if is_slow(t) else [])
+     for t in TESTED])
+def test_transcript(transcript, scratch):
+    check(transcript, scratch)
+
+
+def test_planner_examples(scratch):
+    """docs/ros.md's snippets and ros2 commands against a real planner process."""
+    problems = []
+    for step, output in doc_ros_session.run(PLANNER_PAGE, PLANNER_START, scratch):
+        if step.expected is not None:
+            problem = compare(step.expected, output)
+            if problem:
+                problems.append(f"docs/ros.md:{step.block.line}:\n{step.source}\n  {problem}")
+    assert not problems, "\n".join(problems)
+
+
+def test_every_transcript_is_tested_or_says_why_not():
+    assert len(ALL) >= 20
+    for t in ALL:
+        assert t.commands, f"{t.name}: a console block without a '$ command' line"
+        if t.untested is not None:
+            assert len(t.untested) > 15, f"{t.name}: say why it is untested"
+        elif by_planner_session(t):
+            assert t.page == PLANNER_PAGE and t.line > PLANNER_PAGE.read_text(
+                encoding="utf-8")[:PLANNER_PAGE.read_text(encoding="utf-8").index(
+                    PLANNER_START)].count("\n"), f"{t.name}: no planner session runs it"
+
+
+def test_command_outputs_are_console_blocks():
+    """A block of another language that shows ``$ command`` lines is a transcript in
+    disguise: it would escape the test.
+    """
+    disguised = [f"{b.page.relative_to(REPO)}:{b.line}" for page in PAGES
+                 for b in blocks(page) if b.language != "console"
+                 and any(line.startswith("$ ") for line in b.lines)]
+    assert disguised == []
+
+
+def test_untested_markers_stand_right_before_a_transcript():
+    marked = {(t.page, t.line) for t in ALL if t.untested is not None}
+    for page in PAGES:
+        inside = {k for b in blocks(page) for k in range(b.line, b.line + len(b.lines) + 1)}
+        lines = page.read_text(encoding="utf-8").splitlines()
+        for k, line in enumerate(lines, start=1):
+            if line.strip().startswith("<!-- untested:") and k not in inside:
+                fence = next(j for j in range(k + 1, len(lines) + 1) if lines[j - 1].strip())
+                assert (page, fence) in marked, f"{page.name}:{k}: not right before a transcript"
+
+
+def test_the_comparison_can_fail():
+    """The comparison itself: numbers at the printed precision, masks, ellipses."""
+    assert number_matches("8.485", "8.48528")
+    assert not number_matches("8.489", "8.48528")
+    assert number_matches("-5.214e-15", "3e-17")
+    assert number_matches("0", "-2.95e-17")
+    assert not number_matches("0.01277", "0.012559")
+    assert number_matches("467.15707834831113", "467.1570783483")
+    assert not number_matches("467.15707834831113", "467.157")
+    assert line_matches("time: precompute 0.049 s, squeeze 0.127 s",
+                        "time: precompute 1.5 s, squeeze 12 s")
+    assert not line_matches("after 701 ticks = 0.700 s sim time", "after 700 ticks = 0.699 s "
+                            "sim time")
+    assert not line_matches("  t=   0.1040 s   A F1", "  t=   0.1050 s   A F1")
+    assert line_matches("contacts: nodes ..., 49", "contacts: nodes 114, 49")
+    assert not line_matches("contacts: nodes 115, 49", "contacts: nodes 114, 49")
+    assert compare(("a 1", "...", "z 2"), ["a 1", "b", "c", "z 2"]) is None
+    assert compare(("a 1", "z 2"), ["a 1", "b", "z 2"]) is not None
+    assert compare(("a 1",), ["a 1", "more"]) is not None
+    assert {m.name for m in MASKS} >= {"seconds", "pid", "goal id", "temporary path"}
+
+
+def heading_anchor(heading: str) -> str:
+    """GitHub's anchor of a Markdown heading."""
+    return re.sub(r"[^\w\- ]", "", heading.strip().lower()).replace(" ", "-")
+
+
+def test_every_relative_link_and_anchor_exists():
+    broken = []
+    for page in PAGES:
+        for found in re.finditer(r"\]\(([^)#\s]*)(#[^)\s]*)?\)", page.read_text(encoding="utf-8")):
+            target, anchor = found.groups()
+            if target.startswith(("http://", "https://")):
+                continue
+            path = page.parent / target if target else page
+            if not path.exists():
+                broken.append(f"{page.name}: {target}")
+            elif anchor and path.suffix == ".md":
+                headings = [heading_anchor(line.lstrip("#")) for line in
+                            path.read_text(encoding="utf-8").splitlines() if line.startswith("#")]
+                if anchor[1:] not in headings:
+                    broken.append(f"{page.name}: {target}{anchor}")
+    assert broken == []
+
+
+def test_the_executor_goal_example_is_the_foam_squares_plan():
+    """docs/pipeline.md's ``ros2 action send_goal`` example is the planned goal of the shipped
+    foam square, to its printed precision.
+    """
+    from squeeze_grasp_ros.api import load_scene, scene_file
+    from squeeze_grasp_ros.scene.goal import plan_scene
+
+    page = REPO / "docs" / "pipeline.md"
+    block = next(b for b in blocks(page) if b.language == "bash"
+                 and "/executor/execute_grasp" in "\n".join(b.lines))
+    text = " ".join(block.lines)
+    printed = [re.search(rf"{key}: ([-0-9.e]+)", text).group(1)
+               for key in ("depth", "relative_per_depth")]
+    printed += re.findall(r"[xy]: ([-0-9.e]+)", text)
+    goal = plan_scene(load_scene(scene_file("foam_square"))).goal
+    actual = [goal.depth, goal.relative_per_depth, *np.asarray(goal.directions).ravel()]
+    assert len(printed) == len(actual) == 6
+    assert all(number_matches(p, repr(float(a))) for p, a in zip(printed, actual)), \
+        (printed, actual)

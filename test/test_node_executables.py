@@ -1,0 +1,64 @@
+# Copyright 2026 squeeze_grasp_ros developers
+# SPDX-License-Identifier: Apache-2.0
+"""The node executables as ``ros2 run`` starts them: a ready line, and one clear line (exit 2)
+when a required parameter is missing. Real processes on real rclpy.
+"""
+from __future__ import annotations
+
+import signal
+import subprocess
+import time
+from pathlib import Path
+
+import pytest
+from executables import script
+
+REPO = Path(__file__).resolve().parents[1]
+
+
+@pytest.mark.parametrize("node, parameter", [("sim_hardware", "scene"), ("recorder", "output")])
+def test_a_missing_required_parameter_is_one_line_and_exit_2(node, parameter):
+    done = subprocess.run([script(node)], capture_output=True, text=True, timeout=120,
+                          stdin=subprocess.DEVNULL)
+    assert done.returncode == 2
+    lines = done.stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith(f"{node}: error: parameter '{parameter}'")
+    assert f"-p {parameter}:=" in lines[0]
+
+
+def test_every_node_logs_when_it_is_ready(tmp_path):
+    """Started alone (as ``ros2 run`` does), each node says it is ready and what it serves,
+    and stops cleanly on SIGINT.
+    """
+    scene = REPO / "config" / "scenes" / "foam_square.yaml"
+    commands = {
+        "executor": [],
+        "monitor": [],
+        "sim_hardware": ["-p", f"scene:={scene}"],
+        "recorder": ["-p", f"output:={tmp_path / 'bag'}"],
+        "planner": [],
+    }
+    processes = {name: subprocess.Popen([script(name), "--ros-args", *extra],
+                                        stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
+                                        text=True, cwd=tmp_path, stdin=subprocess.DEVNULL)
+                 for name, extra in commands.items()}
+    outputs = {}
+    try:
+        for name, process in processes.items():
+            deadline, lines = time.monotonic() + 120, []
+            while time.monotonic() < deadline:
+                line = process.stdout.readline()
+                lines.append(line)
+                if f"[{name}]: {name} ready: " in line or not line:
+                    break
+            outputs[name] = "".join(lines)
+    finally:
+        for process in processes.values():
+            process.send_signal(signal.SIGINT)
+        codes = {name: p.wait(timeout=60) for name, p in processes.items()}
+    for name in commands:
+        assert f"[{name}]: {name} ready: " in outputs[name], outputs[name]
+    assert "scene foam_square" in outputs["sim_hardware"]
+    assert f"into {tmp_path / 'bag'}" in outputs["recorder"]
+    assert "action /executor/execute_grasp" in outputs["executor"]
+    assert codes == dict.fromkeys(commands, 0)

@@ -1,0 +1,288 @@
+# Copyright 2026 squeeze_grasp_ros developers
+# SPDX-License-Identifier: Apache-2.0
+"""Several clients of one planner on real rclpy: bursts of requests and goals, shared object
+ids, bounded identifiers and abandoned work (issue 34, items 2, 9, 10, 11, 15).
+"""
+from __future__ import annotations
+
+import time
+from collections import Counter
+
+import yaml
+from rclpy.action import ActionClient
+from rclpy.qos import HistoryPolicy, QoSProfile, ReliabilityPolicy
+
+from action_msgs.msg import GoalStatus
+from planner_support import BLOB, Harness
+from test_planner_node import RESIST_FIG10
+from squeeze_grasp_interfaces.action import GraspMap as GraspMapAction
+from squeeze_grasp_interfaces.srv import EventSqueeze, LoadObject, PlanSqueeze
+from squeeze_grasp_ros.planning import ErrorCode
+
+BURST = 200
+"""Requests or goals sent at once (the issue's burst)."""
+KEEP_ALL = QoSProfile(history=HistoryPolicy.KEEP_ALL, depth=1,
+                      reliability=ReliabilityPolicy.RELIABLE)
+"""A burst client's own queue: a client with rclpy's default (keep-last 10) drops responses."""
+
+
+def spin_until_done(harness: Harness, futures: list, timeout: float = 120.0) -> None:
+    """Spin the harness until every future is done; fail naming how many were not."""
+    deadline = time.monotonic() + timeout
+    while not all(f.done() for f in futures):
+        assert time.monotonic() < deadline, \
+            f"{sum(not f.done() for f in futures)} of {len(futures)} never answered"
+        harness.executor.spin_once(0.05)
+
+
+def burst(harness: Harness, srv_type: type, name: str, requests: list) -> list:
+    """Send every request at once from one keep-all client; the responses, in order."""
+    client = harness.node.create_client(srv_type, f"{harness.planner_name}/{name}",
+                                        qos_profile=KEEP_ALL)
+    assert client.wait_for_service(timeout_sec=30.0)
+    futures = [client.call_async(r) for r in requests]
+    spin_until_done(harness, futures)
+    return [f.result() for f in futures]
+
+
+# --------------------------------------------------------------------------- bursts
+
+
+def test_a_burst_of_200_plan_squeeze_requests_is_answered_in_full(planner):
+    """Before: 105 of 200 answered (a request queue of 100 inside DDS dropped the rest)."""
+    planner.load(BLOB, "blob")
+    responses = burst(planner, PlanSqueeze, "plan_squeeze", [
+        PlanSqueeze.Request(object_id="blob", squeeze_type="stable", depth=1e-3 * (1 + k % 3))
+        for k in range(BURST)])
+    assert all(r.success for r in responses)
+    stiffness = {round(r.stiffness, 9) for r in responses}
+    assert len(stiffness) == 1  # one object, one stiffness whatever the depth
+
+
+def test_a_burst_of_200_loads_gets_200_answers_ok_or_busy(planner):
+    """Before: 16 OK, 94 BUSY and 90 never answered. Now every load beyond max_pending (16)
+    is answered BUSY at once with the reason, and the others load.
+    """
+    responses = burst(planner, LoadObject, "load_object", [
+        LoadObject.Request(scene_yaml=BLOB, object_id=f"o{k}") for k in range(BURST)])
+    codes = Counter(ErrorCode(r.error_code) for r in responses)
+    assert set(codes) <= {ErrorCode.OK, ErrorCode.BUSY}, codes
+    assert codes[ErrorCode.OK] >= 16 and codes[ErrorCode.BUSY] > 0, codes
+    busy = [r.message for r in responses if r.error_code == ErrorCode.BUSY]
+    assert all("max_pending" in m and "retry" in m for m in busy)
+
+
+def test_a_burst_of_200_grasp_map_goals_gets_200_responses_and_results(planner):
+    """Before: 20 goal responses and 12 results of 200 (the action server's goal and result
+    services kept rclpy's default queue of 10). Every goal is now accepted and ends: SUCCEEDED
+    with the map, or ABORTED with error code BUSY and the reason.
+    """
+    planner.load(BLOB, "blob")
+    action = ActionClient(planner.node, GraspMapAction, f"{planner.planner_name}/grasp_map",
+                          goal_service_qos_profile=KEEP_ALL,
+                          result_service_qos_profile=KEEP_ALL)
+    try:
+        assert action.wait_for_server(timeout_sec=30.0)
+        sent = [action.send_goal_async(GraspMapAction.Goal(object_id="blob", mu=0.4))
+                for _ in range(BURST)]
+        spin_until_done(planner, sent)
+        assert all(f.result().accepted for f in sent)
+        results = [f.result().get_result_async() for f in sent]
+        spin_until_done(planner, results)
+    finally:
+        action.destroy()
+    outcomes = Counter((r.result().status, ErrorCode(r.result().result.error_code))
+                       for r in results)
+    assert set(outcomes) <= {(GoalStatus.STATUS_SUCCEEDED, ErrorCode.OK),
+                             (GoalStatus.STATUS_ABORTED, ErrorCode.BUSY)}, outcomes
+    assert outcomes[(GoalStatus.STATUS_SUCCEEDED, ErrorCode.OK)] >= 16
+    maps = {r.result().result.map.pairs for r in results
+            if r.result().status == GoalStatus.STATUS_SUCCEEDED}
+    assert len(maps) == 1 and maps.pop() > 0
+
+
+# --------------------------------------------------------------------------- object ids
+
+DISK = """
+name: stiff_disk
+object:
+  shape: {type: disk, radius: 0.05}
+  material: {E: 5.0e6, nu: 0.3, thickness: 0.0254}
+  mesh: {nodes: 300}
+fingers:
+  F1: {placement: {angle_deg: 180}}
+  F2: {placement: {angle_deg: 0}}
+"""
+"""Another client's object: a disk 100 times stiffer than BLOB."""
+
+
+def stiffness(harness: Harness, object_id: str, digest: str = "") -> PlanSqueeze.Response:
+    """A stable squeeze of ``object_id`` at the scene's placements (quoting ``digest``)."""
+    return harness.call(PlanSqueeze, "plan_squeeze", PlanSqueeze.Request(
+        object_id=object_id, object_digest=digest, squeeze_type="stable", depth=1e-3))
+
+
+def test_a_load_under_another_clients_id_is_refused_and_the_owner_keeps_its_object(planner):
+    """Before: client B's disk replaced client A's object and A's next plan_squeeze answered
+    with the disk's stiffness (44,801.8 N/m instead of 469.61).
+    """
+    a = planner.load(BLOB, "obj")
+    own = stiffness(planner, "obj", a.object_digest)
+    disk = stiffness(planner, planner.load(DISK, "disk").object_id)
+    assert disk.stiffness > 10 * own.stiffness  # the two objects are told apart by stiffness
+    b = planner.call(LoadObject, "load_object", LoadObject.Request(scene_yaml=DISK,
+                                                                   object_id="obj"))
+    assert b.error_code == ErrorCode.INVALID_ARGUMENT
+    assert "'obj' is already loaded from another scene" in b.message and "replace" in b.message
+    after = stiffness(planner, "obj", a.object_digest)
+    assert after.success and after.stiffness == own.stiffness
+    again = planner.load(BLOB, "obj")  # the same scene again: the cached object
+    assert again.object_digest == a.object_digest and again.precompute_time == 0.0
+
+
+def test_a_replaced_object_is_refused_to_clients_quoting_the_old_digest(planner):
+    a = planner.load(BLOB, "obj")
+    b = planner.load(DISK, "obj", replace=True)
+    assert b.object_digest != a.object_digest and len(b.object_digest) == 64
+    stale = stiffness(planner, "obj", a.object_digest)
+    assert stale.error_code == ErrorCode.UNKNOWN_OBJECT
+    assert "holds another object now" in stale.message and a.object_digest[:12] in stale.message
+    current = stiffness(planner, "obj", b.object_digest)
+    assert current.success and current.stiffness == stiffness(planner, "obj").stiffness
+    event = planner.call(EventSqueeze, "event_squeeze", EventSqueeze.Request(
+        object_id="obj", object_digest=a.object_digest))
+    assert event.error_code == ErrorCode.UNKNOWN_OBJECT
+
+
+def test_an_id_evicted_and_loaded_again_from_another_scene_is_detected(ros_context):
+    """With a cache of one object, A's object is evicted and B loads its own under the freed
+    id: A's request quoting its digest is refused instead of computing on B's disk.
+    """
+    from rclpy.parameter import Parameter
+
+    harness = Harness(ros_context, parameter_overrides=[Parameter("cache_size", value=1)])
+    try:
+        a = harness.load(BLOB, "obj")
+        harness.load(BLOB, "other")  # evicts obj
+        harness.load(DISK, "obj")  # a free id: allowed
+        stale = stiffness(harness, "obj", a.object_digest)
+        assert stale.error_code == ErrorCode.UNKNOWN_OBJECT, stale.message
+        bad = stiffness(harness, "obj", "not-a-digest")
+        assert bad.error_code == ErrorCode.INVALID_ARGUMENT and "64 hex digits" in bad.message
+    finally:
+        harness.close()
+
+
+def test_two_clients_loading_one_id_at_once_get_one_object(planner):
+    """Concurrent loads of two scenes under one id: one wins, the other is refused (the check
+    is repeated when the object is stored), and the id holds the winner's object.
+    """
+    responses = burst(planner, LoadObject, "load_object", [
+        LoadObject.Request(scene_yaml=text, object_id="shared") for text in (BLOB, DISK)])
+    winners = [r for r in responses if r.success]
+    losers = [r for r in responses if not r.success]
+    assert len(winners) == 1 and len(losers) == 1, [r.message for r in responses]
+    assert losers[0].error_code == ErrorCode.INVALID_ARGUMENT
+    assert stiffness(planner, "shared", winners[0].object_digest).success
+
+
+# --------------------------------------------------------------------------- echoes
+
+
+def test_no_response_or_log_line_echoes_a_huge_field(planner, capfd):
+    """Before: a 1 MB object_id came back whole in the response (1,000,097 characters) and in
+    the log line.
+    """
+    huge = "x" * 1_000_000
+    planner.load(BLOB, "blob")
+    unknown = stiffness(planner, huge)
+    assert unknown.error_code == ErrorCode.UNKNOWN_OBJECT and "(1000000 characters)" in \
+        unknown.message and len(unknown.message) < 300
+    load = planner.call(LoadObject, "load_object", LoadObject.Request(scene_yaml=BLOB,
+                                                                      object_id=huge))
+    assert load.error_code == ErrorCode.INVALID_ARGUMENT and load.object_id == ""
+    assert load.message == "object_id has 1000000 characters, more than 256"
+    kind = planner.call(PlanSqueeze, "plan_squeeze", PlanSqueeze.Request(
+        object_id="blob", squeeze_type=huge))
+    assert kind.error_code == ErrorCode.INVALID_ARGUMENT and len(kind.message) < 300
+    path = planner.call(LoadObject, "load_object", LoadObject.Request(scene_path=huge))
+    assert path.error_code == ErrorCode.INVALID_ARGUMENT and len(path.message) < 300
+    name = planner.call(LoadObject, "load_object", LoadObject.Request(
+        scene_yaml=BLOB.replace("name: blob", f"name: {'n' * 300}")))
+    assert name.error_code == ErrorCode.INVALID_ARGUMENT
+    assert name.message.startswith("the scene's name (the default object_id) has 300 characters")
+    control = planner.call(LoadObject, "load_object", LoadObject.Request(
+        scene_yaml=BLOB, object_id="a\nb"))
+    assert control.error_code == ErrorCode.INVALID_ARGUMENT and "control character" in \
+        control.message
+    logged = capfd.readouterr()
+    longest = max(len(line) for line in (logged.out + logged.err).splitlines())
+    assert longest < 1000, longest
+
+
+# --------------------------------------------------------------------------- abandoned work
+
+
+def test_a_frictional_resistance_whose_client_leaves_stops_inside_its_squeeze(planner):
+    """Before: plan_resistance with frictional contacts ran to its end (18 s in the issue)
+    after its client had gone. The planner now asks the graph before stepper substeps (at most
+    every 0.1 s), so the request stops inside the squeeze that precedes Algorithm 2, before
+    any progress report, and the planner serves the next request.
+    """
+    from geometry_msgs.msg import Vector3
+
+    from squeeze_grasp_interfaces.srv import PlanResistance
+    from squeeze_grasp_ros.scene import placement_node
+
+    data = yaml.safe_load(RESIST_FIG10)
+    data["object"]["mesh"]["nodes"] = 3000
+    data["squeeze"]["step"] = 2e-5  # about 1,500 substeps, seconds of work
+    loaded = planner.load(yaml.safe_dump(data), "fig10")
+    obj = planner.planner.cache.get("fig10")
+    adversary = placement_node(obj.solid().mesh, obj.scene.adversary.placement, "adversary")
+    slow = planner.node.create_client(PlanResistance,
+                                      f"{planner.planner_name}/plan_resistance")
+    assert slow.wait_for_service(timeout_sec=30.0)
+    slow.call_async(PlanResistance.Request(
+        object_id="fig10", object_digest=loaded.object_digest,
+        contacts=[*loaded.finger_nodes, adversary], a=Vector3(x=0.0024, y=0.0044),
+        mode="stable", contact_model="friction"))
+    deadline = time.monotonic() + 60
+    while planner.planner._pending == 0:
+        assert time.monotonic() < deadline
+        planner.executor.spin_once(0.01)
+    planner.node.destroy_client(slow)
+    while planner.planner._pending:
+        assert time.monotonic() < deadline
+        planner.executor.spin_once(0.05)
+    assert planner.planner.abandoned == [()]  # stopped before its first progress report
+    assert stiffness(planner, "fig10").success
+
+
+def test_a_load_whose_dense_blocks_exceed_the_memory_bound_is_refused_before_factoring(
+        ros_context):
+    """Before: a thin rectangle (height 1e-5 m, every node on the boundary) grew the planner
+    by gigabytes inside SuperLU for minutes and could not be stopped. The mesher now refuses
+    that one before meshing; what it allows is sized right after meshing against the planner's
+    memory bound, before the factorisation: here a 1 mm strip of 2,000 nodes (664 on the
+    boundary; measured: its load peaks at 173 MB and the object holds 86 MB) against a bound
+    of 64 MiB. The refusal is the budget's, not the cache's after the work.
+    """
+    from rclpy.parameter import Parameter
+
+    data = yaml.safe_load(BLOB)
+    data["object"]["shape"] = {"type": "rectangle", "width": 0.1, "height": 1e-3}
+    data["object"]["mesh"] = {"nodes": 2000}
+    harness = Harness(ros_context,
+                      parameter_overrides=[Parameter("cache_max_megabytes", value=64)])
+    try:
+        response = harness.call(LoadObject, "load_object", LoadObject.Request(
+            scene_yaml=yaml.safe_dump(data), object_id="strip"))
+        assert response.error_code == ErrorCode.INVALID_ARGUMENT, response.message
+        assert "MiB for its dense" in response.message and "2 rows per boundary node" in \
+            response.message and "cache_max_megabytes" in response.message
+        assert harness.planner.cache.ids() == []
+        data["object"]["mesh"] = {"nodes": 300}  # 64 MiB is plenty for a coarser strip
+        assert harness.load(yaml.safe_dump(data), "strip").success
+    finally:
+        harness.close()

@@ -1,0 +1,155 @@
+# Copyright 2026 squeeze_grasp_ros developers
+# SPDX-License-Identifier: Apache-2.0
+"""The two factorisers of the interior tangent (CHOLMOD's supernodal LL^T, QDLDL's LDL^T):
+solves against SciPy's, the LDL^T fallback for a tangent that is not positive definite, the
+fill counts on an analytic case, and one squeeze under each with the same events and forces.
+
+The CHOLMOD tests need cvxopt (``pip install '.[cholmod]'``, in the test extra) and skip with
+that line without it.
+"""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
+
+from foam_support import foam_square
+from squeeze_grasp_ros.api import event_squeeze
+from squeeze_grasp_ros.extras import installed
+from squeeze_grasp_ros.mechanics.elastic import hyperelastic as H
+from squeeze_grasp_ros.mechanics.elastic import interior
+from squeeze_grasp_ros.mechanics.elastic.interior import TangentFactor, factorizer
+from squeeze_grasp_ros.mechanics.vocabulary import Factorizer
+
+CHOLMOD = pytest.param(
+    Factorizer.CHOLMOD,
+    marks=pytest.mark.skipif(not installed("cvxopt"),
+                             reason="cvxopt not installed: pip install '.[cholmod]'"))
+METHODS = (CHOLMOD, Factorizer.QDLDL)
+
+
+def held_block(K: sp.spmatrix, held: np.ndarray) -> tuple[sp.csc_matrix, np.ndarray]:
+    """K_ff of the DOFs not ``held``, and those DOFs."""
+    free = np.setdiff1d(np.arange(K.shape[0]), held)
+    return sp.csc_matrix(K)[free][:, free], free
+
+
+@pytest.fixture(scope="module")
+def stressed():
+    """The neo-Hookean tangent of a compressed and sheared foam square (about 500 nodes) and
+    six held nodes.
+    """
+    _, obj, _ = foam_square(500)
+    X = obj.mesh.nodes / 0.1
+    u = (X @ np.array([[-0.08, 0.02], [0.03, 0.05]])).ravel()
+    K = H.assemble("neo_hookean", X, obj.mesh.triangles, u, nu=0.3).tangent
+    nodes = np.random.default_rng(5).choice(len(X), 6, replace=False)
+    held = np.sort(np.r_[2 * nodes, 2 * nodes + 1])
+    return K, held
+
+
+@pytest.mark.parametrize("method", METHODS)
+def test_a_factoriser_solves_the_interior_block_as_scipy_does(method, stressed):
+    """The solve is K_ff^-1 b on the free DOFs and 0 on the held ones, to 1e-12 of SciPy's spsolve;
+    refactoring another tangent of the same mesh in place gives that tangent's solution.
+    """
+    K, held = stressed
+    factor = TangentFactor(method)
+    rng = np.random.default_rng(1)
+    for scale in (1.0, 2.5):
+        Kf, free = held_block(scale * K, held)
+        factor.factor(scale * K.tocsr(), tuple(held.tolist()))
+        b = np.zeros(K.shape[0])
+        b[free] = rng.standard_normal(len(free))
+        x = factor.solve(b)
+        ref = spla.spsolve(Kf, b[free])
+        assert np.abs(x[free] - ref).max() < 1e-12 * np.abs(ref).max()
+        assert not x[held].any()
+    assert factor.fallbacks == 0 and factor.method == method
+
+
+@pytest.mark.parametrize("method", METHODS)
+def test_a_tangent_that_is_not_positive_definite_is_factorised_by_ldlt(method):
+    """K_ff with eigenvalues 3 and -1 (pivots 1 and -3: nonzero): the Cholesky factorisation
+    refuses it, LDL^T takes it (one fallback counted), and the solve is exact.
+    """
+    K = sp.csr_matrix(np.array([[1.0, 2.0, 0.5], [2.0, 1.0, 0.0], [0.5, 0.0, 4.0]]))
+    factor = TangentFactor(method)
+    factor.factor(K, (2,))
+    x = factor.solve(np.array([1.0, 0.0, 0.0]))
+    assert np.allclose(x, [-1 / 3, 2 / 3, 0.0], rtol=0, atol=1e-15)
+    assert factor.fallbacks == (method == Factorizer.CHOLMOD)
+
+
+@pytest.mark.parametrize("method", METHODS)
+def test_fill_of_a_tridiagonal_matrix(method):
+    """A path graph has an elimination order without fill: LDL^T stores exactly its 2n - 1
+    entries and 4(n - 1) + 1 multiply-adds; a supernodal factor may store zeros inside its
+    supernodes but never fewer entries.
+    """
+    n = 40
+    K = sp.diags([-np.ones(n - 1), 2.5 * np.ones(n), -np.ones(n - 1)], [-1, 0, 1]).tocsr()
+    fill = TangentFactor(method).fill(K, (0,))
+    if method == Factorizer.QDLDL:
+        assert (fill.nnz, fill.flops) == (2 * n - 1, 4 * (n - 1) + 1)
+    else:
+        assert fill.nnz >= 2 * n - 1 and fill.flops >= 4 * (n - 1) + 1
+
+
+def test_both_orders_fill_a_mesh_alike(stressed):
+    """Both factorisers order by approximate minimum degree: on a 500-node mesh their factors
+    are within a factor 1.5 of each other and many times the tangent's lower triangle.
+    """
+    pytest.importorskip("cvxopt", reason="pip install '.[cholmod]'")
+    K, held = stressed
+    held = tuple(held.tolist())
+    a, b = (TangentFactor(m).fill(K.tocsr(), held) for m in Factorizer)
+    assert 1 / 1.5 < a.nnz / b.nnz < 1.5
+    assert min(a.nnz, b.nnz) > 2 * sp.tril(K).nnz
+
+
+def test_a_squeeze_gives_the_same_events_and_forces_under_either_factoriser():
+    """The neo-Hookean foam square (about 400 nodes) at 12 % under each factoriser: the same
+    events; depths and forces agree to the contact model's accuracy (the factorisations differ
+    in rounding only; Newton stops at a relative residual of 1e-10, so a different rounding
+    can end an evaluation one iteration earlier or later).
+    """
+    pytest.importorskip("cvxopt", reason="pip install '.[cholmod]'")
+    _, obj, contacts = foam_square(400)
+    runs = {}
+    for method in Factorizer:
+        with factorizer(method):
+            runs[method] = event_squeeze(obj, contacts, 0.02, 0.4, relative_depth=0.12,
+                                         material_model="neo_hookean")
+    a, b = runs[Factorizer.CHOLMOD], runs[Factorizer.QDLDL]
+    assert a.diagnostics["nonlinear"]["factorizer"] == "cholmod"
+    assert b.diagnostics["nonlinear"]["factorizer"] == "qdldl"
+    assert len(a.events) >= 4
+    assert [(e.type, e.node, e.finger, e.mode) for e in a.events] == \
+        [(e.type, e.node, e.finger, e.mode) for e in b.events]
+    depths = np.array([[e.depth, f.depth] for e, f in zip(a.events, b.events)])
+    assert np.abs(depths[:, 0] - depths[:, 1]).max() < 1e-9 * a.depth
+    for finger in ("F1", "F2"):
+        assert a.finger_force[finger][1] == pytest.approx(b.finger_force[finger][1], rel=1e-9)
+    assert a.energy == pytest.approx(b.energy, rel=1e-9)
+
+
+def test_the_cholmod_factoriser_without_cvxopt_names_the_install_line(monkeypatch):
+    monkeypatch.setattr(interior, "installed", lambda module: False)
+    with pytest.raises(ImportError, match=r"pip install '\.\[cholmod\]'"):
+        with factorizer("cholmod"):
+            pass
+    assert interior.default_factorizer() == Factorizer.QDLDL
+
+
+def test_the_nested_dissection_order_keeps_a_node_s_dofs_together(stressed):
+    """METIS's order of the tangent's DOFs is a permutation in which x and y of each node
+    follow each other, and it is the same on every call (METIS's seed is fixed).
+    """
+    pytest.importorskip("pymetis", reason="pip install '.[cholmod]'")
+    K, _ = stressed
+    order = interior.nested_dissection(K)
+    assert sorted(order.tolist()) == list(range(K.shape[0]))
+    assert np.array_equal(order[1::2], order[0::2] + 1) and not (order[0::2] % 2).any()
+    assert np.array_equal(order, interior.nested_dissection(K))

@@ -65,7 +65,7 @@ from squeeze_grasp_ros.mechanics.resistance.optimal import optimal_resistance, r
 from squeeze_grasp_ros.mechanics.ring.grasp_map import ring_grasp_map
 from squeeze_grasp_ros.mechanics.ring.model import RingModel
 from squeeze_grasp_ros.mechanics.ring.squeeze import ring_grasp
-from squeeze_grasp_ros.mechanics.squeeze.contact_model import TerminationLimits
+from squeeze_grasp_ros.mechanics.squeeze.contact_model import SolveOptions, TerminationLimits
 from squeeze_grasp_ros.mechanics.squeeze.contact_state import ContactState, Event
 from squeeze_grasp_ros.mechanics.squeeze.events import EventSqueeze, event_squeeze
 from squeeze_grasp_ros.mechanics.squeeze.graspmap import GraspMap, grasp_map
@@ -92,7 +92,8 @@ __all__ = [
     "Material", "Mesh", "generate_mesh", "ElasticObject", "ReducedStiffness",
     "reduced_stiffness",
     # squeezes
-    "Squeeze", "plan_squeeze", "TerminationLimits", "EventSqueeze", "Event", "ContactState",
+    "Squeeze", "plan_squeeze", "TerminationLimits", "SolveOptions", "EventSqueeze", "Event",
+    "ContactState",
     "event_squeeze", "GraspMap", "grasp_map",
     # resistance, rings, calibration
     "resistance_grasp", "optimal_resistance", "FrictionalResistance", "frictional_resistance",

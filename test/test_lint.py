@@ -5,6 +5,7 @@ line length 99), pep257 docstrings and copyright headers; settings in ``ruff.tom
 """
 from __future__ import annotations
 
+import ast
 import subprocess
 import sys
 from pathlib import Path
@@ -46,3 +47,39 @@ def test_copyright_headers():
     missing = [str(p.relative_to(REPO)) for p in python_files()
                if not p.read_text(encoding="utf-8").startswith(HEADER)]
     assert len(python_files()) > 100 and missing == []
+
+
+STEPPER = ("squeeze_grasp_ros/mechanics/squeeze/stepper",
+           "squeeze_grasp_ros/mechanics/squeeze/event_key.py")
+MAX_STEPPER_COMPLEXITY = 15
+MAX_MECHANICS_CLASS_LINES = 300
+
+
+def complexity_findings(limit: int) -> list[str]:
+    """The findings of ruff's C901 (McCabe complexity above ``limit``) in the stepper."""
+    result = subprocess.run([sys.executable, "-m", "ruff", "check", "--select", "C901",
+                             "--config", f"lint.mccabe.max-complexity={limit}",
+                             "--output-format", "concise", *STEPPER],
+                            cwd=REPO, capture_output=True, text=True)
+    assert result.returncode in (0, 1), result.stderr
+    return [line for line in result.stdout.splitlines() if ".py:" in line]
+
+
+def test_no_stepper_function_is_too_complex():
+    """Every function of the stepper stays within McCabe complexity 15, and the check sees
+    them: at a limit of 5 it flags some.
+    """
+    assert complexity_findings(MAX_STEPPER_COMPLEXITY) == []
+    assert len(complexity_findings(5)) >= 3
+
+
+def test_no_mechanics_class_is_over_300_lines():
+    """No class in ``mechanics/`` spans more than 300 lines (docstring included)."""
+    sizes = {}
+    for path in sorted((REPO / "squeeze_grasp_ros" / "mechanics").rglob("*.py")):
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+            if isinstance(node, ast.ClassDef):
+                name = f"{path.relative_to(REPO)}:{node.name}"
+                sizes[name] = node.end_lineno - node.lineno + 1
+    assert len(sizes) > 50 and max(sizes.values()) > 100
+    assert {k: v for k, v in sizes.items() if v > MAX_MECHANICS_CLASS_LINES} == {}

@@ -359,12 +359,12 @@ def test_adaptive_substeps_agree_with_the_step_grid(model, square):
     depths to 4 event tolerances, the same forces and energy to 1e-8, work = energy to 1e-7,
     and needs at most 2/3 of the grid's evaluations.
     """
-    from squeeze_grasp_ros.mechanics.squeeze.stepper import substep_adaptation
+    from squeeze_grasp_ros.mechanics.squeeze.contact_model import SolveOptions
 
     _, obj, contacts = square
     adaptive = squeeze(obj, contacts, model, relative_depth=0.12)
-    with substep_adaptation(False):
-        grid = squeeze(obj, contacts, model, relative_depth=0.12)
+    grid = squeeze(obj, contacts, model, relative_depth=0.12,
+                   options=SolveOptions(adaptive_substeps=False))
 
     def events(res):
         return [(e.type, e.node, e.finger, e.mode, e.slip) for e in res.events]

@@ -17,12 +17,11 @@ import numpy as np
 from squeeze_grasp_ros import plots
 from squeeze_grasp_ros.bench.table import Table
 from squeeze_grasp_ros.extras import install_hint
-from squeeze_grasp_ros.mechanics.elastic.contact_response import factorization_reuse
 from squeeze_grasp_ros.mechanics.elastic.hyperelastic import assemble
 from squeeze_grasp_ros.mechanics.elastic.interior import (Fill, TangentFactor,
                                                           default_factorizer, factorizer)
 from squeeze_grasp_ros.mechanics.elastic.strain_measures import COMMON_STRAIN_MEASURE
-from squeeze_grasp_ros.mechanics.squeeze.stepper import substep_adaptation
+from squeeze_grasp_ros.mechanics.squeeze.contact_model import SolveOptions
 from squeeze_grasp_ros.mechanics.vocabulary import Factorizer, Finger, MaterialModel
 from squeeze_grasp_ros.resources import scene_file
 from squeeze_grasp_ros.scene import GraspSetup, load_scene
@@ -57,16 +56,19 @@ def _setup(name: str, nodes: int) -> GraspSetup:
     return GraspSetup.build(dataclasses.replace(scene, object=obj)).precompute()
 
 
-def _run(setup: GraspSetup, model: MaterialModel, relative_depth: float):
+def _run(setup: GraspSetup, model: MaterialModel, relative_depth: float,
+         options: SolveOptions = SolveOptions()):
     """(result, wall time, CPU time of this process) of one squeeze."""
     start, cpu = time.perf_counter(), time.process_time()
-    res = setup.event_squeeze(relative_depth=relative_depth, material_model=model)
+    res = setup.event_squeeze(relative_depth=relative_depth, material_model=model,
+                              options=options)
     return res, time.perf_counter() - start, time.process_time() - cpu
 
 
-def _best(setup: GraspSetup, model: MaterialModel, repeats: int):
+def _best(setup: GraspSetup, model: MaterialModel, repeats: int,
+          options: SolveOptions = SolveOptions()):
     """(result, best wall time, best CPU time) of ``repeats`` 12 % squeezes."""
-    runs = [_run(setup, model, 0.12) for _ in range(repeats)]
+    runs = [_run(setup, model, 0.12, options) for _ in range(repeats)]
     return runs[0][0], min(run[1] for run in runs), min(run[2] for run in runs)
 
 
@@ -226,8 +228,8 @@ def run(quick: bool, out_dir: Path, progress) -> list[Table]:
                  linear.finger_force[Finger.F1][1]])
     for model in NONLINEAR:
         for variant, reuse, adapt in VARIANTS:
-            with factorization_reuse(reuse), substep_adaptation(adapt):
-                res, t, _ = _best(setup, model, 1 if variant else NONLINEAR_REPEATS)
+            res, t, _ = _best(setup, model, 1 if variant else NONLINEAR_REPEATS,
+                              SolveOptions(adaptive_substeps=adapt, reuse_factorizations=reuse))
             nl = res.diagnostics["nonlinear"]
             cost.append([str(model) + variant, t, t / t_lin, res.diagnostics["substeps"],
                          res.diagnostics["root_evaluations"],

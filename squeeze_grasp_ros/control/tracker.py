@@ -24,7 +24,7 @@ Patches that merge or split (sliding nodes moving across the taxels) are connect
 several patches and raise no event.
 
 Events of one tick are ordered by finger (F1, F2, A), then B < D < C < A (the stepper's
-order), then angle. Alarms (active while their condition holds):
+``PROCESSING_ORDER``), then angle. Alarms (active while their condition holds):
 
 - ``slip_imminent``: every loaded taxel of the finger uses at least ``alarm_ratio`` of its
   friction cone, all pushing the same way (a finger slips when all its contact nodes slide the
@@ -51,10 +51,8 @@ from typing import NamedTuple
 import numpy as np
 
 
+from squeeze_grasp_ros.mechanics.squeeze.event_key import PROCESSING_ORDER, processing_rank
 from squeeze_grasp_ros.mechanics.vocabulary import ContactMode, EventType, Finger, Termination
-
-ORDER: dict[EventType, int] = {EventType.B: 0, EventType.D: 1, EventType.C: 2, EventType.A: 3}
-"""Processing order of the events of one tick and finger."""
 
 
 @dataclass(frozen=True)
@@ -432,7 +430,7 @@ class ContactTracker:
                     found.append((EventType.C, new.angle))
                 elif old.mode == ContactMode.SLIP and new.mode == ContactMode.STICK:
                     found.append((EventType.D, new.angle))
-        found.sort(key=lambda e: (ORDER[e[0]], e[1]))
+        found.sort(key=lambda e: (processing_rank(e[0]), e[1]))
         return [TrackedEvent(kind, name, self.depth, relative, angle) for kind, angle in found]
 
     @staticmethod
@@ -509,7 +507,7 @@ class ContactTracker:
         tol = self.config.prediction_tolerance
         out = []
         for e in events:
-            if e.type not in ORDER:
+            if e.type not in PROCESSING_ORDER:
                 continue
             hit = next((k for k in self.unmatched if self.prediction[k].type == e.type
                         and self.prediction[k].finger == e.finger

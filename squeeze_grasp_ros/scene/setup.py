@@ -40,7 +40,8 @@ from squeeze_grasp_ros.mechanics.resistance.optimal import (
     resistance_grasp,
 )
 from squeeze_grasp_ros.mechanics.ring.model import RingModel
-from squeeze_grasp_ros.mechanics.squeeze.contact_model import ContactModel, TerminationLimits
+from squeeze_grasp_ros.mechanics.squeeze.contact_model import (ContactModel, SolveOptions,
+                                                             TerminationLimits)
 from squeeze_grasp_ros.mechanics.squeeze.events import EventSqueeze, event_squeeze
 from squeeze_grasp_ros.mechanics.squeeze.fingertips import Fingertip, place_fingertip
 from squeeze_grasp_ros.mechanics.squeeze.nonlinear_model import contact_model
@@ -305,6 +306,7 @@ class GraspSetup:
         progress: Callable[[float], None] | None = None,
         material_model: MaterialModel | str | None = None,
         checkpoint: Callable[[], None] | None = None,
+        options: SolveOptions | None = None,
     ) -> EventSqueeze:
         """The scene's squeeze with rounded fingertips (Algorithm 1); arguments override the
         scene's values.
@@ -327,6 +329,9 @@ class GraspSetup:
             Constitutive model; default the scene's ``object.material.model``.
         checkpoint : callable, optional
             Called before every substep; may raise to abandon the squeeze (a cancellation).
+        options : SolveOptions, optional
+            Switches of the large-deformation savings (see
+            :func:`~squeeze_grasp_ros.mechanics.squeeze.events.event_squeeze`).
 
         Raises
         ------
@@ -361,6 +366,7 @@ class GraspSetup:
             material_model=scene.object.material.model if material_model is None
             else material_model,
             checkpoint=checkpoint,
+            options=options,
         )
 
     # ----------------------------------------------------------------- the adversary

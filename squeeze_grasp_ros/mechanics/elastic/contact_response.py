@@ -30,8 +30,6 @@ energies / (E h L^2).
 """
 from __future__ import annotations
 
-from collections.abc import Iterator
-from contextlib import contextmanager
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -43,8 +41,7 @@ from squeeze_grasp_ros.mechanics.elastic.interior import (ContactStiffness, Inte
 from squeeze_grasp_ros.mechanics.errors import InvalidInputError
 from squeeze_grasp_ros.mechanics.vocabulary import MaterialModel
 
-__all__ = ["ContactResponse", "Evaluation", "NEWTON_TOL", "ResponseFailure",
-           "factorization_reuse"]
+__all__ = ["ContactResponse", "Evaluation", "NEWTON_TOL", "ResponseFailure"]
 
 NEWTON_TOL = 1e-10
 """Interior Newton stops when ||f_free|| <= NEWTON_TOL * max(||f_contact||, |K0| ||delta||),
@@ -69,19 +66,6 @@ model) or for Newton's first factorisation (KNOWN_START). A node that touched a 
 event tolerance moves the field by 1e-10 to 3e-8 of it."""
 REUSE_CONTRACTION = 0.25
 BACKTRACKS = 30
-_REUSE = [True]
-
-
-@contextmanager
-def factorization_reuse(enabled: bool) -> Iterator[None]:
-    """Within the block, interior Newton re-uses factorisations (the default) or refactors the
-    tangent at every iteration (full Newton): for measuring what the reuse saves.
-    """
-    before, _REUSE[0] = _REUSE[0], enabled
-    try:
-        yield
-    finally:
-        _REUSE[0] = before
 
 
 @dataclass(frozen=True)
@@ -150,6 +134,9 @@ class ContactResponse:
         share between the contact sets of one object (built here otherwise).
     factorization : TangentFactor, optional
         The object's factorisation, shared between its contact sets (one of its own otherwise).
+    reuse : bool
+        Newton re-uses the factorisation held while the residual contracts (default; False:
+        full Newton, a refactorisation per iteration, to measure what the reuse saves).
     """
 
     model: MaterialModel
@@ -159,6 +146,7 @@ class ContactResponse:
     nu: float
     geometry: MeshGeometry | None = field(default=None, repr=False)
     factorization: TangentFactor = field(default_factory=TangentFactor, repr=False)
+    reuse: bool = True
     stats: dict = field(default_factory=lambda: {"evaluations": 0, "iterations": 0,
                                                  "factorizations": 0, "substeps": 0,
                                                  "look_ups": 0})
@@ -258,22 +246,12 @@ class ContactResponse:
             return None
 
     def _stiffness_of(self, K) -> ContactStiffness | None:
-        """dF/d delta of the state whose tangent is ``K``, factorising K_ff for it; its solve
-        refactors whenever the shared factorisation has moved on to another state.
+        """dF/d delta of the state whose tangent is ``K`` (:meth:`.InteriorBlocks.owned_stiffness`:
+        it owns the factorisation of K_ff, and refactors whenever that has moved on).
         """
-        token = object()
-        if self._blocks is not None and self._blocks.factored is K:
-            self._blocks.owner = token
-        elif self._factor(K, token) is None:
+        if self._blocks is None and self._factor(K) is None:
             return None
-        blocks = self._blocks
-
-        def solve(r: np.ndarray) -> np.ndarray:
-            if blocks.owner is not token:
-                self._factor(K, token)
-            return blocks.solve(r)
-
-        return blocks.contact_stiffness(K, solve, token)
+        return self._blocks.owned_stiffness(K, lambda owner: self._factor(K, owner))
 
     def _known(self, u: np.ndarray, tol: float):
         """The tangent of the state this set was continued from, if ``u`` is that state to
@@ -332,7 +310,7 @@ class ContactResponse:
                                    inverted=True)
         u, F = start
         held = self._blocks.solve if self._blocks is not None else None
-        solve, fresh, its = (held if _REUSE[0] else None), False, 0
+        solve, fresh, its = (held if self.reuse else None), False, 0
         asm = self._assemble(u, tangent=False, deformation=F)
         scale = max(np.linalg.norm(asm.force[self.cdofs]),
                     self._stiffness() * max(np.linalg.norm(delta), DISPLACEMENT_FLOOR))
@@ -375,7 +353,7 @@ class ContactResponse:
                 continue
             contraction = t_norm / norm
             u, asm, r, norm = trial, t_asm, t_asm.force[self.free], t_norm
-            if contraction > REUSE_CONTRACTION or not _REUSE[0]:
+            if contraction > REUSE_CONTRACTION or not self.reuse:
                 solve = None
         return u, asm, its, norm / scale
 

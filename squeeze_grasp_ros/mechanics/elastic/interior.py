@@ -369,6 +369,26 @@ class InteriorBlocks:
         return ContactStiffness(_values(*self._cc, K).toarray(), _values(*self._fc, K), solve,
                                 owner, K)
 
+    def owned_stiffness(self, K: sp.csr_matrix,
+                        factor: Callable[[object], object]) -> "ContactStiffness | None":
+        """S of the state whose tangent is ``K``, owning the factorisation of K_ff (taken over
+        when it is of ``K`` already); its solves refactor whenever the shared factorisation has
+        moved on to another state. ``factor(owner)`` factorises K_ff of ``K`` for ``owner``
+        (the caller counts it) and returns None if it is singular, as then does this.
+        """
+        token = object()
+        if self.factored is K:
+            self.owner = token
+        elif factor(token) is None:
+            return None
+
+        def solve(r: np.ndarray) -> np.ndarray:
+            if self.owner is not token:
+                factor(token)
+            return self._solve(r)
+
+        return self.contact_stiffness(K, solve, token)
+
 
 @dataclass
 class ContactStiffness:

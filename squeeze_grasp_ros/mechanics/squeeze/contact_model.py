@@ -97,6 +97,25 @@ class TerminationLimits:
 
 
 @dataclass(frozen=True)
+class SolveOptions:
+    """The two savings of a large-deformation squeeze, as switches for measuring what they save
+    (forces and events agree to the Newton tolerance either way; the linear model has neither).
+
+    Attributes
+    ----------
+    adaptive_substeps : bool
+        The stepper adapts its substeps between events (default); False keeps the ``step``
+        grid.
+    reuse_factorizations : bool
+        Interior Newton re-uses the factorisation held while the residual contracts
+        (default); False refactors at every iteration (full Newton).
+    """
+
+    adaptive_substeps: bool = True
+    reuse_factorizations: bool = True
+
+
+@dataclass(frozen=True)
 class SetData:
     """Dimensionless data of one contact set (nodes sorted).
 
@@ -398,6 +417,8 @@ class ContactModel:
     max_events_per_depth : int
         Chattering bound: a node with more events than this within one depth step is frozen in
         its mode for one depth step (reported).
+    options : SolveOptions
+        Switches of the large-deformation savings (for measuring them).
     """
 
     obj: ElasticObject
@@ -405,6 +426,7 @@ class ContactModel:
     limits: TerminationLimits = field(default_factory=TerminationLimits)
     reference: bool = False
     max_events_per_depth: int = 4
+    options: SolveOptions = field(default_factory=SolveOptions)
     _cache: dict = field(default_factory=dict, repr=False, compare=False)
 
     def __post_init__(self) -> None:

@@ -15,6 +15,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from squeeze_grasp_ros.mechanics.squeeze.event_key import EventFunction, EventKey
 from squeeze_grasp_ros.mechanics.squeeze.fingertips import Fingertip, unit
 from squeeze_grasp_ros.mechanics.vocabulary import ContactMode, EventType, Finger, Termination
 
@@ -108,9 +109,10 @@ class ContactState:
     undetermined : tuple of int
         Contact nodes whose mode is decided by hypothesis-and-test at the next motion (initial
         contacts have zero force, so their mode depends on the direction of motion).
-    fresh : tuple of (str, int)
+    fresh : tuple of EventKey
         Event functions that are zero by construction at this state (e.g. the cone margin of a
         node that just stuck); their sign is judged by their derivative along the next motion.
+        Keys without a finger (:attr:`~.event_key.EventKey.at_node`).
     history : tuple of (int, float)
         Recent (node, depth in m) events, kept for the chattering bound.
     holds : tuple of (int, float)
@@ -122,7 +124,7 @@ class ContactState:
     depth: float = 0.0
     relative_per_depth: float = 0.0
     undetermined: tuple[int, ...] = ()
-    fresh: tuple[tuple[str, int], ...] = ()
+    fresh: tuple[EventKey, ...] = ()
     history: tuple[tuple[int, float], ...] = ()
     holds: tuple[tuple[int, float], ...] = ()
 
@@ -170,7 +172,8 @@ def initial_state(tips: list[Fingertip], relative_per_depth: float = 0.0) -> Con
             key=lambda c: c.node,
         )
     )
-    fresh = tuple((kind, t.node) for t in tips for kind in (EventType.B.value, "C+", "C-"))
+    fresh = tuple(EventKey(function, t.node) for t in tips for function in (
+        EventFunction.NORMAL_FORCE, EventFunction.CONE_PLUS, EventFunction.CONE_MINUS))
     return ContactState(
         fingers, contacts, 0.0, relative_per_depth, tuple(sorted(t.node for t in tips)), fresh
     )

@@ -20,6 +20,7 @@ import numpy as np
 from squeeze_grasp_ros.mechanics.elastic.compliance import ElasticObject
 from squeeze_grasp_ros.mechanics.squeeze.contact_model import (
     ContactModel,
+    SolveOptions,
     TerminationLimits,
 )
 from squeeze_grasp_ros.mechanics.squeeze.contact_state import (
@@ -472,6 +473,7 @@ def event_squeeze(
     progress: Callable[[float], None] | None = None,
     material_model: MaterialModel | str = MaterialModel.LINEAR,
     checkpoint: Callable[[], None] | None = None,
+    options: SolveOptions | None = None,
 ) -> EventSqueeze:
     """Event-driven two-finger squeeze of ``obj`` from initial contact nodes (F1, F2).
 
@@ -506,6 +508,9 @@ def event_squeeze(
         ``neo_hookean`` (finite deformation: :mod:`.nonlinear_model`).
     checkpoint : callable, optional
         Called before every substep; may raise to abandon the squeeze (a cancellation).
+    options : SolveOptions, optional
+        Switches of the large-deformation savings (adaptive substeps, factorisation reuse),
+        for measuring them; default both on.
 
     Examples
     --------
@@ -533,7 +538,7 @@ def event_squeeze(
     require_relative_depth(depth * relative_per_depth, depth)
     tips = [place_fingertip(obj.mesh, n, int(c), radii[n]) for n, c in zip(names, contacts)]
     model = contact_model(material_model, obj, mu, limits or TerminationLimits(), reference,
-                          max_events_per_depth)
+                          max_events_per_depth, options or SolveOptions())
     run = squeeze_to_depth(
         model, initial_state(tips, relative_per_depth), dirs, depth, step, event_tol, progress,
         checkpoint=checkpoint,

@@ -66,10 +66,11 @@ class NonlinearContactModel(ContactModel):
 
     @property
     def adaptive_steps(self) -> bool:
-        """True: every evaluation is a nonlinear solve of the whole object, so the stepper
-        adapts its substeps between events to the curvature of the force path.
+        """True unless ``options`` switch it off: every evaluation is a nonlinear solve of the
+        whole object, so the stepper adapts its substeps between events to the curvature of
+        the force path.
         """
-        return True
+        return self.options.adaptive_substeps
 
     # ------------------------------------------------------------------ the response
     def _response_of(self, sd: SetData) -> ContactResponse:
@@ -86,7 +87,8 @@ class NonlinearContactModel(ContactModel):
                                              mesh.nodes / self.length, mesh.triangles,
                                              sd.nodes, self.obj.material.nu,
                                              geometry=self._cache["geometry"],
-                                             factorization=shared)
+                                             factorization=shared,
+                                             reuse=self.options.reuse_factorizations)
             last = self._cache.get("last")
             if last is not None:
                 responses[key].continue_from(last)

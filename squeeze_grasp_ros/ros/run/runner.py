@@ -325,7 +325,7 @@ class PipelineRunner:
             for _ in range(self.events_per_check):
                 self.executor.spin_once(0.0)
 
-    def check_graph(self) -> None:
+    def check_graph(self) -> bool:
         """Raise :class:`RunError` if anything foreign takes part in the run.
 
         Foreign: a publisher on one of the run's topics (the pipeline's, resolved in the run's
@@ -333,11 +333,18 @@ class PipelineRunner:
         of the run's nodes in its namespace (another run, or a planner answering in its
         place). Subscribers (a viewer) and other nodes are not the run's business. (Not for
         ``attach``: the nodes there are not the run's own.)
+
+        Returns
+        -------
+        bool
+            Whether a publisher on the run's topics is still unnamed (discovered before its
+            node, and younger than :data:`UNKNOWN_NODE_GRACE`): neither cleared nor foreign yet.
         """
         self.graph_checked = time.monotonic()
         if self.options.attach:
-            return
+            return False
         ns, node, now = self.namespace, self.client, time.monotonic()
+        pending = False
         names = Counter(n for n, space in node.get_node_names_and_namespaces()
                         if space == ns and n in self.ours)
         foreign = [f"{k} nodes named {ns.rstrip('/')}/{n}" for n, k in names.items() if k > 1]
@@ -346,6 +353,7 @@ class PipelineRunner:
                 if info.node_name == UNKNOWN_NODE:  # discovered before its node's name
                     first = self.unknown_since.setdefault(bytes(info.endpoint_gid), now)
                     if now - first < UNKNOWN_NODE_GRACE:
+                        pending = True
                         continue
                 elif info.node_namespace == ns and info.node_name in self.ours:
                     continue
@@ -357,6 +365,15 @@ class PipelineRunner:
                 f"{' and more' if len(foreign) > 3 else ''}; the run's results cannot be "
                 "trusted, so it is stopped"
             )
+        return pending
+
+    def check_graph_before_success(self) -> None:
+        """The last :meth:`check_graph` before a result is reported: a publisher still unnamed
+        is waited for until it is named (ours) or its grace ends (foreign: raised), so a run
+        that ends inside an intruder's grace never reports success.
+        """
+        while self.check_graph():
+            self.executor.spin_once(0.1)
 
     def _check_processes(self) -> None:
         for proc in self.processes:
@@ -706,7 +723,7 @@ class PipelineRunner:
             self.start()
             self.send_goal()
             result = self.wait_result()
-            self.check_graph()
+            self.check_graph_before_success()
             return self.summary(result)
         finally:
             try:

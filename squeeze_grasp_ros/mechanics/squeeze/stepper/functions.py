@@ -1,0 +1,282 @@
+# Copyright 2026 squeeze_grasp_ros developers
+# SPDX-License-Identifier: Apache-2.0
+"""The event functions: their values and slopes d/ds at a solution (paper Sec. 5.1-5.3).
+
+:func:`event_values` and :func:`pickup_margin` are pure functions of one contact set's arrays;
+:class:`EventFunctions` evaluates them for a call (its model, finger motion and terminations)
+at a solution and names each by its :class:`~..event_key.EventKey`:
+
+=============  ==========================================  =============  ========  ========
+key function   value (positive = no event)                 nodes          slope     paper
+=============  ==========================================  =============  ========  ========
+GAP            gap |x_k - o_f| - r_f, per finger           free boundary  yes       eq. 48
+NORMAL_FORCE   normal force f_n = f . e(theta)             contact        yes       eq. 49
+CONE_PLUS/-    cone margins mu f_n +/- f_t                 sticking       yes       eq. 50
+SLIP_RATE      slip . d theta / ds (slip rate)             sliding        no        eq. 51
+AREA           min det F - INVERSION_AREA_RATIO            (object)       no
+STRAIN         eps* - max strain (with a strain limit)     (object)       no        eq. 45
+PICKUP         w / n_f - min_f sum_k c_k (with a weight)   (object)       no
+=============  ==========================================  =============  ========  ========
+
+A new kind of event is a new :class:`~..event_key.EventFunction`, its value in
+:meth:`EventFunctions.entries` and :meth:`EventFunctions.value`, and, if it has one, its slope
+in :meth:`EventFunctions.slopes` (then it is located on Hermite interpolants and checked for
+double roots inside an adaptive substep).
+
+>>> values = event_values(mu=0.5, fn=np.array([1.0]), ft=np.array([0.2]), slip=np.array([0]),
+...                       dtheta=np.zeros(1), radius=np.ones(1), rate=1.0, gaps=np.zeros((0, 2)))
+>>> float(values.c_plus[0]), float(values.c_minus[0])
+(0.7, 0.3)
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from functools import cached_property
+
+import numpy as np
+
+from squeeze_grasp_ros.mechanics.squeeze.contact_model import (INVERSION_AREA_RATIO,
+                                                               ContactModel, Solution)
+from squeeze_grasp_ros.mechanics.squeeze.event_key import EventFunction, EventKey, KeyTable
+from squeeze_grasp_ros.mechanics.squeeze.stepper.contact_set import ContactSet
+from squeeze_grasp_ros.mechanics.squeeze.stepper.motion import FingerMotion
+from squeeze_grasp_ros.mechanics.vocabulary import Termination
+
+__all__ = ["EventFunctions", "EventValues", "event_values", "pickup_margin"]
+
+_NO_ROWS = np.zeros(0, int)
+
+
+def pickup_margin(
+    mu: float,
+    fn: np.ndarray,
+    ft: np.ndarray,
+    stick: np.ndarray,
+    finger: np.ndarray,
+    fingers: list[int],
+    weight: float,
+) -> float:
+    """How far the grasp is from lifting the object, in force units (> 0: cannot lift yet).
+
+    The object lies on a horizontal plane and is lifted out of it. A contact node with normal
+    force f_n and in-plane tangential force f_t can supply at most
+    c_k = sqrt(mu^2 f_n^2 - f_t^2) of vertical friction (Sec. 5.1); a sliding node (force on the
+    cone edge) supplies none. The object is picked up when every finger with contacts can
+    supply its share: min over those fingers of sum_k c_k >= w / (number of such fingers)
+    (torque balance by friction assumed, as in the paper). Returns w / n_f - min_f sum_k c_k.
+    """
+    c = np.where(stick, np.sqrt(np.maximum(mu * mu * fn * fn - ft * ft, 0.0)), 0.0)
+    totals = [c[finger == f].sum() for f in fingers]
+    return float(weight / len(fingers) - min(totals))
+
+
+@dataclass(frozen=True)
+class EventValues:
+    """Event-function values at one solution.
+
+    Attributes
+    ----------
+    fn : (m,) ndarray
+        Normal forces (Event B at 0).
+    c_plus, c_minus : (m,) ndarray
+        Cone margins mu f_n + f_t and mu f_n - f_t (Event C at 0).
+    d : (m,) ndarray
+        Slip rates of sliding nodes along their slip direction (Event D at 0).
+    gaps : (k, f) ndarray
+        Gaps of free boundary nodes to every fingertip (Event A at 0).
+    strain, pickup : float
+        Termination margins (inf when not checked).
+    area : float
+        Smallest element area ratio det F less the inversion threshold (termination at 0; inf
+        when not checked).
+    """
+
+    fn: np.ndarray
+    c_plus: np.ndarray
+    c_minus: np.ndarray
+    d: np.ndarray
+    gaps: np.ndarray
+    strain: float
+    pickup: float
+    area: float = np.inf
+
+    def of_contact(self, function: EventFunction, k: int) -> float:
+        """The value of a per-contact function (B, C+, C-, D) of contact k."""
+        return float({EventFunction.NORMAL_FORCE: self.fn, EventFunction.CONE_PLUS: self.c_plus,
+                      EventFunction.CONE_MINUS: self.c_minus,
+                      EventFunction.SLIP_RATE: self.d}[function][k])
+
+
+def event_values(*, mu: float, fn: np.ndarray, ft: np.ndarray, slip: np.ndarray,
+                 dtheta: np.ndarray, radius: np.ndarray, rate: float, gaps: np.ndarray,
+                 strain: float = np.inf, pickup: float = np.inf,
+                 area: float = np.inf) -> EventValues:
+    """The event functions of one contact set at one solution.
+
+    ``slip`` is each node's slip direction (0 when sticking), ``dtheta`` d theta/ds, ``radius``
+    the tip radius of its finger, ``rate`` the length of the fingers' motion per unit s.
+    """
+    d = slip * dtheta * radius / (rate if rate > 0 else 1.0)
+    return EventValues(fn, mu * fn + ft, mu * fn - ft, d, gaps, strain, pickup, area)
+
+
+@dataclass(frozen=True)
+class EventFunctions:
+    """The event functions of one call (dimensionless).
+
+    Attributes
+    ----------
+    model : ContactModel
+    motion : FingerMotion
+    terminate_on : tuple of Termination
+        Terminations the call checks (strain and pickup only if the model's limits declare
+        them; element inversion always).
+    """
+
+    model: ContactModel
+    motion: FingerMotion
+    terminate_on: tuple[str, ...]
+
+    @property
+    def frictionless(self) -> bool:
+        """Whether mu = 0: every contact slides and no cone margin is watched."""
+        return self.model.mu == 0.0
+
+    def free_rows(self, contacts: ContactSet, held: list[int]) -> np.ndarray:
+        """Boundary loop positions watched for Event A: not in contact, not ``held``."""
+        mask = np.ones(len(self.model.boundary_nodes), bool)
+        mask[contacts.rows] = False
+        for node in held:
+            mask[self.model.obj.boundary_positions([node])[0]] = False
+        return np.flatnonzero(mask)
+
+    def rows_of(self, nodes) -> np.ndarray:
+        """Boundary loop positions of ``nodes``."""
+        return self.model.obj.boundary_positions(nodes)
+
+    @cached_property
+    def keys(self) -> KeyTable:
+        """The object's event keys (kept by its model across calls)."""
+        return self.model._cache.setdefault("event_keys", KeyTable())
+
+    @cached_property
+    def _gap_keys(self) -> list[tuple[EventKey, ...]]:
+        """The gap keys of every boundary loop position, one per finger."""
+        return self.keys.gaps(self.model.boundary_nodes.tolist(), len(self.motion.names))
+
+    @cached_property
+    def _boundary(self) -> np.ndarray:
+        """Undeformed positions / L (b, 2) of the outer boundary loop."""
+        return self.model.positions(self.model.boundary_nodes)
+
+    def _boundary_points(self, contacts: ContactSet, sol: Solution,
+                         rows: np.ndarray) -> np.ndarray:
+        """Deformed positions / L of boundary loop positions ``rows`` at ``sol``."""
+        u = self.model.boundary_displacement(contacts.data, sol.delta, sol.F, rows)
+        return self._boundary[rows] + u
+
+    def boundary_point(self, contacts: ContactSet, sol: Solution, node: int) -> np.ndarray:
+        """Deformed position / L (2,) of boundary ``node`` at ``sol``."""
+        return self._boundary_points(contacts, sol, self.rows_of([node]))[0]
+
+    def gaps(self, contacts: ContactSet, sol: Solution, s: float,
+             rows: np.ndarray) -> np.ndarray:
+        """Gaps (k, f) of boundary positions ``rows`` to every fingertip."""
+        return self.motion.gaps(self._boundary_points(contacts, sol, rows), s)
+
+    def termination_values(self, contacts: ContactSet, sol: Solution) -> tuple[float, float]:
+        """(eps* - max strain, pickup margin); inf for criteria not declared or not enabled."""
+        model, lim = self.model, self.model.limits
+        strain = pickup = np.inf
+        if lim.strain is not None and Termination.STRAIN_LIMIT in self.terminate_on:
+            strain = lim.strain - model.max_strain(contacts.data, sol.delta, sol.F)[0]
+        if lim.weight is not None and Termination.PICKED_UP in self.terminate_on:
+            pickup = pickup_margin(model.mu, sol.normal(), sol.tangential(), contacts.stick,
+                                   contacts.finger, sorted(set(contacts.finger.tolist())),
+                                   lim.weight / model.force_unit)
+        return strain, pickup
+
+    def area_value(self, contacts: ContactSet, sol: Solution) -> float:
+        """The smallest area ratio det F less INVERSION_AREA_RATIO (element_inverted at <= 0)."""
+        return self.model.area_ratio(contacts.data, sol.delta, sol.F)[0] - INVERSION_AREA_RATIO
+
+    def values(self, contacts: ContactSet, sol: Solution, s: float, rows: np.ndarray,
+               terminations: bool = True) -> EventValues:
+        """All event functions at ``sol`` (and the termination functions if asked)."""
+        strain, pickup = (self.termination_values(contacts, sol) if terminations
+                          else (np.inf, np.inf))
+        area = (self.area_value(contacts, sol) if terminations and self.motion.rate > 0
+                else np.inf)
+        return event_values(mu=self.model.mu, fn=sol.normal(), ft=sol.tangential(),
+                            slip=contacts.slip, dtheta=sol.dtheta,
+                            radius=self.motion.radius[contacts.finger], rate=self.motion.rate,
+                            gaps=self.gaps(contacts, sol, s, rows), strain=strain,
+                            pickup=pickup, area=area)
+
+    def entries(self, contacts: ContactSet, v: EventValues, rows: np.ndarray,
+                held: np.ndarray) -> list[tuple[EventKey, float]]:
+        """The watched functions as (key, value), in a fixed order: per contact not ``held``
+        (mask) its normal force and its cone margins or slip rate, then every free boundary
+        row's gaps, then the terminations that are checked.
+        """
+        out, key = [], self.keys.get
+        for k, node in enumerate(contacts.nodes.tolist()):
+            if held[k]:
+                continue
+            out.append((key(EventFunction.NORMAL_FORCE, node), v.fn[k]))
+            if self.frictionless:
+                continue
+            if contacts.stick[k]:
+                out.append((key(EventFunction.CONE_PLUS, node), v.c_plus[k]))
+                out.append((key(EventFunction.CONE_MINUS, node), v.c_minus[k]))
+            else:
+                out.append((key(EventFunction.SLIP_RATE, node), v.d[k]))
+        gap_keys = self._gap_keys
+        for r, row in enumerate(rows.tolist()):
+            out.extend(zip(gap_keys[row], v.gaps[r]))
+        for function, value in ((EventFunction.AREA, v.area), (EventFunction.STRAIN, v.strain),
+                                (EventFunction.PICKUP, v.pickup)):
+            if np.isfinite(value):
+                out.append((key(function), value))
+        return out
+
+    def slopes(self, contacts: ContactSet, sol: Solution, s: float,
+               rows: np.ndarray) -> dict[EventKey, float]:
+        """Slopes d/ds at ``sol`` of the gaps of boundary positions ``rows`` and of every
+        contact's normal force and cone margins (the functions with
+        :attr:`~..event_key.EventFunction.has_slope`).
+        """
+        fn_r, ft_r = sol.normal_rate(), sol.tangential_rate()
+        mu = self.model.mu
+        out = {}
+        if len(rows):
+            points = self._boundary_points(contacts, sol, rows)
+            velocities = self.model.boundary_rate(contacts.data, sol, rows)
+            g_rate = self.motion.gap_slopes(points, velocities, s)
+            gap_keys = self._gap_keys
+            for j, row in enumerate(rows.tolist()):
+                out.update(zip(gap_keys[row], g_rate[j].tolist()))
+        key = self.keys.get
+        for k, node in enumerate(contacts.nodes.tolist()):
+            out[key(EventFunction.NORMAL_FORCE, node)] = float(fn_r[k])
+            out[key(EventFunction.CONE_PLUS, node)] = float(mu * fn_r[k] + ft_r[k])
+            out[key(EventFunction.CONE_MINUS, node)] = float(mu * fn_r[k] - ft_r[k])
+        return out
+
+    def value(self, key: EventKey, contacts: ContactSet, sol: Solution, s: float) -> float:
+        """The value of one function at ``sol`` (for root location)."""
+        function = key.function
+        if function == EventFunction.AREA:
+            return self.area_value(contacts, sol)
+        if function in (EventFunction.STRAIN, EventFunction.PICKUP):
+            strain, pickup = self.termination_values(contacts, sol)
+            return strain if function == EventFunction.STRAIN else pickup
+        if function == EventFunction.GAP:
+            return float(self.gaps(contacts, sol, s, self.rows_of([key.node]))[0, key.finger])
+        v = self.values(contacts, sol, s, _NO_ROWS, terminations=False)
+        return v.of_contact(function, contacts.index(key.node))
+
+    def slope(self, key: EventKey, contacts: ContactSet, sol: Solution, s: float) -> float:
+        """The slope d/ds of one function that has one."""
+        rows = self.rows_of([key.node]) if key.function == EventFunction.GAP else _NO_ROWS
+        return self.slopes(contacts, sol, s, rows)[key]

@@ -1,0 +1,182 @@
+# Copyright 2026 squeeze_grasp_ros developers
+# SPDX-License-Identifier: Apache-2.0
+"""The mode decision: hypothesis-and-test of contact modes along the motion (Algorithm 1 lines
+2 and 13).
+
+Where a node's mode is not fixed by its past (a new contact, an initial contact, nodes whose
+C/D events at one point would flip back), each hypothesis is solved and tested: stick needs a
+positive normal force inside the cone, slide needs a positive normal force and a slip rate of
+the assumed sign. A function that is zero by construction at the point (a new contact's normal
+force and cone margins, a sliding node's margin on its slip side) must grow along the motion
+instead of being positive. :func:`decide_modes` is a function of the contact set and a solver,
+so it can be tested with any solver.
+"""
+from __future__ import annotations
+
+import itertools
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+
+from squeeze_grasp_ros.mechanics.errors import NumericalError
+from squeeze_grasp_ros.mechanics.squeeze.contact_model import Solution, SolveFailure
+from squeeze_grasp_ros.mechanics.squeeze.event_key import EventFunction, EventKey
+from squeeze_grasp_ros.mechanics.squeeze.stepper.contact_set import ContactSet
+
+__all__ = ["MAX_JOINT_NODES", "ModeChoice", "decide_modes", "mode_violations", "zero_functions"]
+
+MAX_JOINT_NODES = 3
+"""Up to this many undecided nodes every combination of modes is tried; beyond, node by node."""
+
+Attempt = Callable[[ContactSet], "Solution | SolveFailure"]
+"""A solver of a contact set at the current point (the modes it is given, its own angles)."""
+
+
+def mode_violations(*, mu: float, fn: float, ft: float, fn_rate: float, ft_rate: float,
+                    dtheta: float, stick: bool, slip: int, frictionless: bool,
+                    zero: set[EventFunction]) -> int:
+    """Violated conditions of a mode hypothesis for one contact (0 = consistent).
+
+    A function in ``zero`` (normal force or a cone margin that is zero by construction now)
+    must grow along the motion; any other must be positive. Stick: normal force and both cone
+    margins; slip: normal force and slip rate of the assumed sign.
+
+    >>> mode_violations(mu=0.5, fn=1.0, ft=0.8, fn_rate=0.0, ft_rate=0.0, dtheta=0.0,
+    ...                 stick=True, slip=0, frictionless=False, zero=set())  # outside the cone
+    1
+    """
+    def ok(function: EventFunction, value: float, rate: float) -> bool:
+        return rate > 0 if function in zero else value > 0
+
+    bad = int(not ok(EventFunction.NORMAL_FORCE, fn, fn_rate))
+    if stick:
+        bad += int(not ok(EventFunction.CONE_PLUS, mu * fn + ft, mu * fn_rate + ft_rate))
+        bad += int(not ok(EventFunction.CONE_MINUS, mu * fn - ft, mu * fn_rate - ft_rate))
+    elif not frictionless:
+        bad += int(slip * dtheta <= 0)
+    return bad
+
+
+def zero_functions(contacts: ContactSet, fresh: set[EventKey]) -> set[EventKey]:
+    """Functions zero by construction now: the ``fresh`` ones and each sliding node's cone
+    margin on its slip side (its force lies on that cone edge).
+    """
+    zero = set(fresh)
+    for node, stick, slip in zip(contacts.nodes.tolist(), contacts.stick, contacts.slip):
+        if not stick and slip:
+            zero.add(EventKey(EventFunction.cone_edge(slip), node))
+    return zero
+
+
+@dataclass(frozen=True)
+class ModeChoice:
+    """The modes a decision chose (of the whole set) and the solution in them.
+
+    Attributes
+    ----------
+    stick, slip : (m,) ndarray
+    theta : (m,) ndarray
+        Polar angles of the solution in these modes, rad.
+    violations : int
+        Violated conditions of the chosen hypothesis (0: consistent).
+    """
+
+    stick: np.ndarray
+    slip: np.ndarray
+    theta: np.ndarray
+    violations: int
+
+
+def _violations(contacts: ContactSet, sol: Solution, k: int, zero: set[EventKey], mu: float,
+                stick: bool, slip: int) -> int:
+    """:func:`mode_violations` of contact k in the hypothesis (stick, slip)."""
+    node = int(contacts.nodes[k])
+    return mode_violations(
+        mu=mu, fn=float(sol.normal()[k]), ft=float(sol.tangential()[k]),
+        fn_rate=float(sol.normal_rate()[k]), ft_rate=float(sol.tangential_rate()[k]),
+        dtheta=float(sol.dtheta[k]), stick=bool(stick), slip=int(slip),
+        frictionless=mu == 0.0, zero={key.function for key in zero if key.node == node})
+
+
+def _options(mu: float) -> list[tuple[bool, int]]:
+    """Hypotheses per node in the order tried: stick, slip +1, slip -1 (slide if mu = 0)."""
+    return [(False, 0)] if mu == 0.0 else [(True, 0), (False, 1), (False, -1)]
+
+
+def _node_by_node(contacts: ContactSet, idx: list[int], zero: set[EventKey], attempt: Attempt,
+                  mu: float) -> tuple:
+    """Node-by-node hypothesis-and-test (two passes) for many undecided nodes."""
+    options = _options(mu)
+    stick, slip = contacts.stick.copy(), contacts.slip.copy()
+    choice = {k: options[0] for k in idx}
+    for _ in range(2):
+        for k in idx:
+            for st, sl in options:
+                stick[k], slip[k] = st, sl
+                sol = attempt(contacts.with_modes(stick, slip))
+                if isinstance(sol, SolveFailure):
+                    continue
+                if _violations(contacts, sol, k, zero, mu, st, sl) == 0:
+                    choice[k] = (st, sl)
+                    break
+            stick[k], slip[k] = choice[k]
+    return tuple(choice[k] for k in idx)
+
+
+def _no_mode(nodes: list[int], failures: list[SolveFailure]) -> Exception:
+    """The error when no hypothesis could be solved."""
+    if failures and all(f.indeterminate for f in failures):
+        return failures[-1].error()
+    residual = min((f.residual for f in failures), default=float("inf"))
+    return NumericalError(f"no contact mode of nodes {sorted(nodes)} can be solved",
+                          residuals={"cone": residual})
+
+
+def decide_modes(contacts: ContactSet, nodes: list[int], zero: set[EventKey], attempt: Attempt,
+                 *, mu: float) -> ModeChoice:
+    """Joint hypothesis-and-test for the modes of contact ``nodes``.
+
+    Options per node in the order stick, slip +1, slip -1; every combination for up to
+    MAX_JOINT_NODES nodes (the first consistent one wins, else the one with fewest
+    violations), node by node in two passes for more. The other contacts keep their modes.
+
+    Parameters
+    ----------
+    contacts : ContactSet
+    nodes : list of int
+        The nodes to decide (contacts of the set).
+    zero : set of EventKey
+        Functions zero by construction at the point (:func:`zero_functions`).
+    attempt : callable
+        Solves a contact set at the point, or returns why not.
+    mu : float
+        Friction coefficient (0: every node slides).
+
+    Raises
+    ------
+    InvalidInputError, NumericalError
+        If no hypothesis can be solved.
+    """
+    idx = [contacts.index(n) for n in sorted(nodes)]
+    if len(idx) <= MAX_JOINT_NODES:
+        candidates = itertools.product(_options(mu), repeat=len(idx))
+    else:
+        candidates = [_node_by_node(contacts, idx, zero, attempt, mu)]
+    best, failures = None, []
+    for combo in candidates:
+        stick, slip = contacts.stick.copy(), contacts.slip.copy()
+        for k, (st, sl) in zip(idx, combo):
+            stick[k], slip[k] = st, sl
+        sol = attempt(contacts.with_modes(stick, slip))
+        if isinstance(sol, SolveFailure):
+            failures.append(sol)
+            continue
+        bad = sum(_violations(contacts, sol, k, zero, mu, stick[k], slip[k]) for k in idx)
+        if best is None or bad < best.violations:
+            best = ModeChoice(stick, slip, sol.theta, bad)
+        if bad == 0:
+            break
+    if best is None:
+        raise _no_mode(nodes, failures)
+    return best

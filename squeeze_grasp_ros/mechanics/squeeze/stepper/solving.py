@@ -1,0 +1,168 @@
+# Copyright 2026 squeeze_grasp_ros developers
+# SPDX-License-Identifier: Apache-2.0
+"""Solving the fixed-set problem along a stepper call, and the call's counters.
+
+:class:`SetSolver` solves a :class:`~.contact_set.ContactSet` at a point s of the call's
+:class:`~.motion.FingerMotion` (:func:`~..contact_model.attempt_fixed_set`), continues a
+solution from one point to another and halves a substep whose continuation fails.
+:class:`Counters` collects what every unit of a call counts (``StepResult.diagnostics``).
+"""
+from __future__ import annotations
+
+from dataclasses import asdict, dataclass
+
+import numpy as np
+
+from squeeze_grasp_ros.mechanics.errors import NumericalError
+from squeeze_grasp_ros.mechanics.squeeze.contact_model import (ContactModel, Solution,
+                                                               SolveFailure, attempt_fixed_set)
+from squeeze_grasp_ros.mechanics.squeeze.stepper.contact_set import ContactSet
+from squeeze_grasp_ros.mechanics.squeeze.stepper.motion import FingerMotion
+
+__all__ = ["CONTINUATION_ITERATIONS", "Counters", "MAX_ANGLE_JUMP", "MAX_SUBSTEP_HALVINGS",
+           "SetSolver", "SolvedPoints"]
+
+MAX_SUBSTEP_HALVINGS = 12
+CONTINUATION_ITERATIONS = 12
+MAX_ANGLE_JUMP = 0.05
+"""Continuation safeguards: Newton iterations and distance (rad) from the predicted angles
+beyond which a substep is halved."""
+
+
+@dataclass
+class Counters:
+    """Diagnostics of one stepper call (maxima over its solves, counts of its work).
+
+    Attributes
+    ----------
+    newton_max_iterations, newton_max_residual, jacobian_max_condition
+        Of the fixed-set Newton solves (sliding angles).
+    root_evaluations : int
+        Solves spent locating events.
+    substeps, substep_halvings, substep_rejections : int
+        Accepted substeps, halvings of a failed continuation, adaptive substeps rejected for
+        a dip of an event function inside.
+    ambiguous_modes : int
+        Mode decisions with no consistent hypothesis (the fewest violations won).
+    inversion : str or None
+        Why no state beyond the last point exists (the call ended ``element_inverted``).
+    min_area_ratio, inverted_element
+        Smallest det F and its element when the inversion threshold was reached.
+    """
+
+    newton_max_iterations: int = 0
+    newton_max_residual: float = 0.0
+    jacobian_max_condition: float = 1.0
+    root_evaluations: int = 0
+    substeps: int = 0
+    substep_halvings: int = 0
+    substep_rejections: int = 0
+    ambiguous_modes: int = 0
+    inversion: str | None = None
+    min_area_ratio: float | None = None
+    inverted_element: int | None = None
+
+    def note(self, sol: Solution) -> None:
+        """Take a solution's Newton iterations, residual and Jacobian condition into the maxima."""
+        self.newton_max_iterations = max(self.newton_max_iterations, sol.iterations)
+        self.newton_max_residual = max(self.newton_max_residual, sol.residual)
+        self.jacobian_max_condition = max(self.jacobian_max_condition, sol.jacobian_condition)
+
+    def as_dict(self) -> dict:
+        """The counters that apply (the inversion ones only when it happened)."""
+        return {k: v for k, v in asdict(self).items() if v is not None}
+
+
+@dataclass(frozen=True)
+class SetSolver:
+    """Fixed-set solves of one call (model, finger motion; counts into ``counters``)."""
+
+    model: ContactModel
+    motion: FingerMotion
+    counters: Counters
+
+    def attempt(self, contacts: ContactSet, s: float,
+                theta: np.ndarray | None = None) -> Solution | SolveFailure:
+        """The solution of ``contacts`` at s (from ``theta``, default the set's), or why none."""
+        motion, f = self.motion, contacts.finger
+        sol = attempt_fixed_set(
+            self.model.response(contacts.data),
+            contacts.configuration(motion.radius),
+            motion.start[f] + s * motion.translation[f],
+            motion.translation[f],
+            contacts.theta if theta is None else theta,
+            self.model.phi,
+        )
+        if not isinstance(sol, SolveFailure):
+            self.counters.note(sol)
+        return sol
+
+    def solve(self, contacts: ContactSet, s: float) -> Solution:
+        """:meth:`attempt`, raising the failure's error."""
+        sol = self.attempt(contacts, s)
+        if isinstance(sol, SolveFailure):
+            raise sol.error()
+        return sol
+
+    def continue_to(self, contacts: ContactSet, sol_a: Solution, a: float,
+                    b: float) -> Solution | SolveFailure:
+        """Solve at b by continuation from the solution at a (predictor theta + dtheta/ds (b-a)).
+
+        Fails if Newton fails, needs more than CONTINUATION_ITERATIONS iterations or lands more
+        than MAX_ANGLE_JUMP (rad) from the prediction (another solution branch).
+        """
+        guess = sol_a.theta + sol_a.dtheta * (b - a)
+        sol = self.attempt(contacts, b, theta=guess)
+        if isinstance(sol, SolveFailure):
+            return sol
+        if (
+            sol.iterations > CONTINUATION_ITERATIONS
+            or np.abs(sol.theta - guess).max() > MAX_ANGLE_JUMP
+        ):
+            return SolveFailure(
+                f"continuation from s = {a:.6g} to {b:.6g} left the solution branch", sol.residual
+            )
+        return sol
+
+    def substep(self, contacts: ContactSet, sol_a: Solution, a: float,
+                b: float) -> tuple[float, Solution | SolveFailure]:
+        """(b, solution at b) by continuation from a, halving the substep while it fails.
+
+        A failure because every state beyond a inverts an element is returned as (a, failure):
+        the squeeze ends there. Any other failure after MAX_SUBSTEP_HALVINGS raises.
+        """
+        for _ in range(MAX_SUBSTEP_HALVINGS):
+            sol = self.continue_to(contacts, sol_a, a, b)
+            if not isinstance(sol, SolveFailure):
+                return b, sol
+            self.counters.substep_halvings += 1
+            b = a + 0.5 * (b - a)
+        if sol.inverted:
+            return a, sol
+        raise NumericalError(
+            f"the fixed-set solve failed near depth {self.motion.depth_at(a):.6g} m "
+            f"after {MAX_SUBSTEP_HALVINGS} substep halvings: {sol.reason}",
+            residuals={"cone": sol.residual},
+        )
+
+
+class SolvedPoints:
+    """Solutions of one contact set at points of a substep; a new point is solved by
+    continuation from the nearest one solved so far (root location).
+    """
+
+    def __init__(self, solver: SetSolver, contacts: ContactSet,
+                 points: list[tuple[float, Solution]]) -> None:
+        self.solver, self.contacts, self.points = solver, contacts, list(points)
+
+    def at(self, s: float) -> Solution:
+        """The solution at s; NumericalError (or InvalidInputError) if none is found."""
+        for at, sol in self.points:
+            if at == s:
+                return sol
+        near, sol_near = min(self.points, key=lambda p: abs(p[0] - s))
+        sol = self.solver.continue_to(self.contacts, sol_near, near, s)
+        if isinstance(sol, SolveFailure):
+            raise sol.error()
+        self.points.append((s, sol))
+        return sol

@@ -161,6 +161,24 @@ def ros_arguments(namespace: str) -> list[str]:
     return ["--ros-args", "-r", f"__ns:={namespace}", "-r", f"/clock:={namespace}/clock"]
 
 
+
+CHILD_STOP_TIMEOUT = 30.0
+"""Wall-clock seconds a node process has to end after SIGINT before it is killed."""
+
+
+def stop_child(proc: subprocess.Popen, signum: int | None = signal.SIGINT) -> None:
+    """Stop a node process: ``signum`` (None: already sent), then SIGKILL if it has not ended
+    within :data:`CHILD_STOP_TIMEOUT` (a process still importing under load ignores SIGINT
+    until its handlers are installed).
+    """
+    if signum is not None and proc.poll() is None:
+        proc.send_signal(signum)
+    try:
+        proc.wait(CHILD_STOP_TIMEOUT)
+    except subprocess.TimeoutExpired:
+        proc.kill()
+        proc.wait()
+
 class PipelineRunner:
     """The pipeline of one scene on real rclpy nodes (see the module docstring).
 
@@ -522,11 +540,7 @@ class PipelineRunner:
                 env=self._child_environment(),
             )
 
-            def stop_process() -> None:
-                proc.send_signal(signal.SIGINT)
-                proc.wait(30)
-
-            return stop_process
+            return lambda: stop_child(proc)
         from squeeze_grasp_ros.ros.nodes.planner import PlannerNode
 
         node = PlannerNode(
@@ -689,11 +703,7 @@ class PipelineRunner:
                 if proc.poll() is None:
                     proc.send_signal(signal.SIGINT)
             for proc in self.processes:
-                try:
-                    proc.wait(30)
-                except subprocess.TimeoutExpired:
-                    proc.kill()
-                    proc.wait()
+                stop_child(proc, signum=None)
         finally:
             for node in self.nodes + [self.client]:
                 if node in self.executor.get_nodes():

@@ -8,9 +8,9 @@ PlannerClient`: ``event_squeeze`` for the directions and the predicted events, `
 for the pure directions (a slip reaction). In one process the planner is handed the object the
 run built (:class:`RunObject`: the scene parsed and meshed once, shared with the simulated
 world), so it loads nothing; as a process it loads the scene file itself (``load_object``).
-Without the planner (``--no-planner``) :func:`..scene_plan.plan_scene` plans with the mechanics.
+Without the planner (``--no-planner``) :func:`...scene.goal.plan_scene` plans with the mechanics.
 The resistance waypoints of a scene with a frictional adversary come from Algorithm 2
-(:func:`..scene_plan.resistance_goal`) either way: no service returns them.
+(:func:`...scene.goal.resistance_goal`) either way: no service returns them.
 """
 from __future__ import annotations
 
@@ -32,15 +32,15 @@ from squeeze_grasp_interfaces.srv import EventSqueeze, LoadObject, PlanSqueeze
 
 from squeeze_grasp_ros import planning
 from squeeze_grasp_ros.control.motion import GraspGoal
-from squeeze_grasp_ros.mechanics.vocabulary import SQUEEZING_FINGERS, SqueezeKind
+from squeeze_grasp_ros.mechanics.vocabulary import SQUEEZING_FINGERS, ShapeType, SqueezeKind
 from squeeze_grasp_ros.resources import config_dir, share_dir
 from squeeze_grasp_ros.ros import messages
 from squeeze_grasp_ros.ros.nodes.planner_client import PlannerClient
 from squeeze_grasp_ros.ros.run.options import RunError, RunOptions
 from squeeze_grasp_ros.ros.run.processes import NodeProcesses, ros_arguments
 from squeeze_grasp_ros.inputs import InputError, load_yaml, read_text
-from squeeze_grasp_ros.scene import Scene, SceneError, parse_scene
-from squeeze_grasp_ros.scene_plan import plan_scene, resistance_goal, resists
+from squeeze_grasp_ros.scene import GraspSetup, Scene, SceneError, parse_scene
+from squeeze_grasp_ros.scene.goal import plan_scene, resistance_goal, resists
 
 __all__ = ["SERVICE_RETRY", "Plan", "PlannerHost", "RunObject", "plan_with_mechanics",
            "plan_with_planner", "planner_roots"]
@@ -111,7 +111,7 @@ class RunObject:
         """This scene with its object meshed and precomputed under the planner's default limits
         (one mesh), registered under the scene's name as a planner would.
         """
-        limits = planning.Limits()
+        limits = planning.PlannerLimits()
         key = planning.object_key(self.source, "", "", limits)
         return RunObject(self.source, planning.load_object(self.source, key, limits))
 
@@ -122,7 +122,7 @@ def planner_roots(scene_path: str, scene: Scene) -> list[str]:
     """
     folders = [Path(scene_path).resolve().parent, share_dir(), Path.cwd()]
     shape = scene.object.shape
-    if shape["type"] == "file":
+    if shape["type"] == ShapeType.FILE:
         folders.append(Path(shape["path"]).resolve().parent)
     return [str(f) for f in folders]
 
@@ -230,9 +230,7 @@ def _resistance(run_object: RunObject, options: RunOptions) -> dict:
     if not resists(scene, resist=options.resist):
         return {}
     loaded = run_object.loaded
-    if loaded is None:
-        return resistance_goal(scene)
-    return resistance_goal(scene, loaded.solid(), tuple(loaded.finger_nodes))
+    return resistance_goal(GraspSetup.build(scene) if loaded is None else loaded.setup)
 
 
 def plan_with_mechanics(run_object: RunObject, options: RunOptions) -> Plan:
@@ -240,7 +238,7 @@ def plan_with_mechanics(run_object: RunObject, options: RunOptions) -> Plan:
     loaded = run_object.loaded
     plan = plan_scene(run_object.scene, on_slip_alarm=options.on_slip_alarm,
                       resist=options.resist,
-                      obj=loaded.solid() if loaded is not None else None)
+                      setup=loaded.setup if loaded is not None else None)
     squeeze = plan.squeeze
     prediction = messages.prediction_msg(
         [messages.contact_event_msg(e) for e in squeeze.events], squeeze.termination,

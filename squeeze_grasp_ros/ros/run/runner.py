@@ -235,7 +235,7 @@ class PipelineRunner:
 
         classes = {"sim_hardware": SimHardwareNode, "monitor": MonitorNode,
                    "executor": ExecutorNode, "recorder": RecorderNode}
-        world = SimWorld(self.scene, self.run_object.loaded.solid())
+        world = SimWorld(self.run_object.loaded.setup)
         for name, values in params.items():
             overrides = [Parameter(k, value=v) for k, v in values.items()]
             extra = {"world": world} if name == "sim_hardware" else {}

@@ -29,10 +29,28 @@ def _run(module: str, name: str):
     raise_on_signals()
     try:
         return importlib.import_module(module).main()
-    except KeyboardInterrupt as exc:
-        signum = getattr(exc, "signum", signal.SIGINT)
+    except (KeyboardInterrupt, ImportError) as exc:
+        stop = _interruption(exc)
+        if stop is None:
+            raise
+        signum = getattr(stop, "signum", signal.SIGINT)
         print(f"\n{name}: stopped by {signal.Signals(signum).name}", file=sys.stderr)
         return 128 + int(signum)
+
+
+def _interruption(exc: BaseException) -> KeyboardInterrupt | None:
+    """The KeyboardInterrupt (or :class:`.exit_codes.Interrupted`) behind ``exc``, or None.
+
+    A signal that arrives while a C extension initialises (rclpy's, seen under load) surfaces as
+    an ImportError ("initialization failed") caused by the signal's exception.
+    """
+    seen: set[int] = set()
+    while exc is not None and id(exc) not in seen:
+        if isinstance(exc, KeyboardInterrupt):
+            return exc
+        seen.add(id(exc))
+        exc = exc.__cause__ or exc.__context__
+    return None
 
 
 def cli():

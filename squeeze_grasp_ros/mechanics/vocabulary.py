@@ -18,7 +18,7 @@ from enum import Enum
 
 __all__ = ["ContactMode", "DistortionModel", "EventType", "Factorizer", "Finger",
            "ImageEncoding", "MaterialModel", "SQUEEZING_FINGERS", "ShapeFit", "SqueezeKind",
-           "StrainCriterion", "StrainMeasure", "StressMeasure", "Termination"]
+           "StrainCriterion", "StrainMeasure", "StressMeasure", "Termination", "TipKind"]
 
 
 class _Name(str, Enum):
@@ -87,6 +87,16 @@ class SqueezeKind(_Name):
 
     STABLE = "stable"
     PURE = "pure"
+
+
+class TipKind(_Name):
+    """Shape of a rigid fingertip (the face that touches the object)."""
+
+    CIRCLE = "circle"
+    """A circle of radius r: the paper's rounded fingertip (Sec. 5, Fig. 5)."""
+    PAD = "pad"
+    """A flat pad of width w whose two edges are rounded with radius r_e (a parallel
+    gripper's jaw): the flat face is w - 2 r_e wide."""
 
 
 class StrainCriterion(_Name):

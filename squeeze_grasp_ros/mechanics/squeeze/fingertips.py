@@ -43,8 +43,7 @@ class Fingertip:
 
     Attributes
     ----------
-    name : str
-        "F1", "F2" or "A".
+    name : Finger
     node : int
         Mesh node of the initial contact (on the outer boundary).
     center : (2,) ndarray
@@ -64,7 +63,7 @@ class Fingertip:
         placed (within TOUCH_TOLERANCE).
     """
 
-    name: str
+    name: Finger
     node: int
     center: np.ndarray
     radius: float

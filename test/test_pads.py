@@ -271,3 +271,64 @@ def test_circles_of_growing_radius_tend_to_the_pad():
     assert errors[2] < 1e-4 * pad
     assert errors[0] / errors[1] == pytest.approx(10, rel=0.05)
     assert errors[1] / errors[2] == pytest.approx(10, rel=0.05)
+
+
+# --- scenes -----------------------------------------------------------------------------------
+
+def block_scene(**finger):
+    """The nu = 0 block as a scene, both fingers given ``finger`` (tip or tip_radius)."""
+    from squeeze_grasp_ros.scene import parse_scene
+
+    return parse_scene({
+        "object": {"shape": {"type": "rectangle", "width": W, "height": H},
+                   "material": {"E": E, "nu": 0.0, "thickness": THICKNESS}},
+        "fingers": {"F1": {**finger, "placement": {"point": [-W / 2, 0.0]}},
+                    "F2": {**finger, "placement": {"point": [W / 2, 0.0]}}},
+        "squeeze": {"depth": DEPTH}, "friction": {"mu": 0.2}, "effects": ["friction"],
+    })
+
+
+def test_scene_pad_tips_drive_the_same_squeeze_as_the_mechanics():
+    from squeeze_grasp_ros.scene import GraspSetup
+
+    scene = block_scene(tip={"shape": "pad", "width": 0.05, "edge_radius": 0.003})
+    assert scene.fingers["F1"].tip_radius == 0.003  # filled: the radius that touches
+    setup = GraspSetup.build(scene)
+    via_scene = setup.event_squeeze()
+    direct = event_squeeze(setup.solid, setup.contacts, WIDE_PAD, 0.2, depth=DEPTH)
+    assert np.array_equal(finger_force(via_scene), finger_force(direct))
+    # the nu = 0 closed form again, through the scene's own mesh
+    closing = np.sqrt(2) * DEPTH
+    assert finger_force(via_scene)[0] == pytest.approx(E * closing / W * H * THICKNESS, rel=1e-8)
+    assert via_scene.to_json()["tips"]["F1"] == {"shape": "pad", "width": 0.05,
+                                                 "edge_radius": 0.003}
+
+
+def test_scene_circle_tip_is_tip_radius():
+    from squeeze_grasp_ros.scene import GraspSetup
+
+    scene = block_scene(tip={"shape": "circle", "radius": 0.01})
+    assert scene.fingers["F2"].tip_radius == 0.01
+    a = GraspSetup.build(scene).event_squeeze()
+    b = GraspSetup.build(block_scene(tip_radius=0.01)).event_squeeze()
+    assert np.array_equal(finger_force(a), finger_force(b))
+    assert a.to_json()["tips"]["F1"] == {"shape": "circle", "radius": 0.01}
+
+
+@pytest.mark.parametrize(("finger", "message"), [
+    ({"tip": {"shape": "pad", "width": 0.05}}, r"fingers\.F1\.tip\.edge_radius is required"),
+    ({"tip": {"shape": "pad", "width": 0.004, "edge_radius": 0.003}},
+     r"fingers\.F1\.tip\.width must be >= 2 fingers\.F1\.tip\.edge_radius"),
+    ({"tip": {"shape": "circle", "radius": 0.01, "width": 0.02}},
+     r"fingers\.F1\.tip\.width does not apply to shape: circle"),
+    ({"tip": {"shape": "circle", "radius": 0.01}, "tip_radius": 0.02},
+     r"fingers\.F1: give tip or tip_radius, not both"),
+    ({"tip": {"shape": "square", "radius": 0.01}}, r"fingers\.F1\.tip\.shape"),
+    ({"tip": {"shape": "pad", "width": -0.05, "edge_radius": 0.003}},
+     r"fingers\.F1\.tip\.width"),
+])
+def test_bad_tips_name_the_field(finger, message):
+    from squeeze_grasp_ros.scene import SceneError
+
+    with pytest.raises(SceneError, match=message):
+        block_scene(**finger)

@@ -74,6 +74,15 @@ def scene_file(name: str) -> Path:
     return path
 
 
+def device_file(name: str) -> Path:
+    """A shipped gripper device file by name, e.g. ``device_file("generic_85mm")``."""
+    path = config_dir() / "devices" / f"{name}.yaml"
+    if not path.is_file():
+        shipped = sorted(p.stem for p in (config_dir() / "devices").glob("*.yaml"))
+        raise ResourceError(f"no shipped device {name!r}; shipped devices: {', '.join(shipped)}")
+    return path
+
+
 def viewer_file(name: str) -> Path:
     """A shipped viewer configuration (``<share>/config/viewers/<name>``)."""
     path = config_dir() / "viewers" / name

@@ -27,7 +27,7 @@ from squeeze_grasp_ros.mechanics.vocabulary import (
     ObjectModel,
     TipKind,
 )
-from squeeze_grasp_ros.scene.schema import MAX_INT
+from squeeze_grasp_ros.scene.schema import MAX_INT, SchemaError
 from squeeze_grasp_ros.scene.specs import (
     SHAPES,
     MaterialSpec,
@@ -134,18 +134,20 @@ def _validate_fingers(scene: Scene) -> None:
                 raise SceneError(f"fingers.{name}: give tip or tip_radius, not both")
 
 
-def check_tip(tip: TipSpec, where: str) -> None:
-    """A circle has a radius and nothing else; a pad a width and an edge radius, w >= 2 r_e."""
+def check_tip(tip: TipSpec, where: str, error: type[SchemaError] = SceneError) -> None:
+    """A circle has a radius and nothing else; a pad a width and an edge radius, w >= 2 r_e
+    (``error``: the document's error class).
+    """
     need = ("radius",) if tip.shape == TipKind.CIRCLE else ("width", "edge_radius")
     for key in ("radius", "width", "edge_radius"):
         value = getattr(tip, key)
         if key in need and value is None:
-            raise SceneError(f"{where}.{key} is required for shape: {tip.shape.value}")
+            raise error(f"{where}.{key} is required for shape: {tip.shape.value}")
         if key not in need and value is not None:
-            raise SceneError(f"{where}.{key} does not apply to shape: {tip.shape.value} "
+            raise error(f"{where}.{key} does not apply to shape: {tip.shape.value} "
                              f"(give {', '.join(need)})")
     if tip.shape == TipKind.PAD and tip.width < 2.0 * tip.edge_radius:
-        raise SceneError(f"{where}.width must be >= 2 {where}.edge_radius "
+        raise error(f"{where}.width must be >= 2 {where}.edge_radius "
                          f"({2.0 * tip.edge_radius:g} m), got {tip.width:g} m")
 
 

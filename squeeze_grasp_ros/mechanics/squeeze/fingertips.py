@@ -111,16 +111,13 @@ def place_fingertip(mesh: Mesh, name: str, node: int, radius: float | TipShape,
 def _approach(mesh: Mesh, name: str, node: int, shape: TipShape, theta0: float) -> Fingertip:
     """The tip facing e(theta0) moved along it until its face first touches the boundary."""
     r, a = shape.radius, shape.half_flat
-    e0, t0 = unit(theta0), tangent(theta0)
+    e0 = unit(theta0)
     boundary = mesh.boundary
-    rel = mesh.nodes[boundary] - (mesh.nodes[node] - r * e0)
-    lateral = np.abs(rel @ t0) - a
-    reach = lateral < r
-    # how far the face reaches towards the object at each node's lateral position
-    front = np.sqrt(np.maximum(r * r - np.maximum(lateral, 0.0) ** 2, 0.0))
-    need = np.where(reach, front - rel @ e0, -np.inf)
-    first = int(np.argmax(need))
-    center = mesh.nodes[node] - r * e0 - max(float(need[first]), 0.0) * e0
+    # set on the node, then backed off until no boundary node is ahead of its face
+    center = mesh.nodes[node] - r * e0
+    clear = shape.clearance(mesh.nodes[boundary], center[None], [theta0])[0]
+    first = int(np.argmin(clear))
+    center = center + min(float(clear[first]), 0.0) * e0
     tips = TipGeometry.of([shape], [theta0])
     gaps = tips.gaps(mesh.nodes[boundary], center[None])[:, 0]
     size = float(np.ptp(mesh.nodes, axis=0).max())

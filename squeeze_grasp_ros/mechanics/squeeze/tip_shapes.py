@@ -127,6 +127,21 @@ class TipShape:
             return {"shape": self.kind.value, "radius": self.radius}
         return {"shape": self.kind.value, "width": self.width, "edge_radius": self.radius}
 
+    def clearance(self, points: np.ndarray, centers: np.ndarray, facing) -> np.ndarray:
+        """How far (k, p) each of k tips, at reference points ``centers`` (k, 2) and facing
+        e(``facing``) (k,), can advance along its facing before its face reaches each of
+        ``points`` (p, 2), m; +inf for points beside the tip's swath (|lateral| >= a + rho).
+
+        The face's front at lateral offset l lies sqrt(rho^2 - max(|l| - a, 0)^2) ahead of the
+        reference point, so a tip first touches the point of least clearance.
+        """
+        facing = np.asarray(facing, float)
+        rel = points[None, :, :] - np.asarray(centers, float)[:, None, :]
+        ahead = np.einsum("kpi,ki->kp", rel, unit(facing))
+        beside = np.abs(np.einsum("kpi,ki->kp", rel, tangent(facing))) - self.half_flat
+        front = np.sqrt(np.maximum(self.radius ** 2 - np.maximum(beside, 0.0) ** 2, 0.0))
+        return np.where(beside < self.radius, ahead - front, np.inf)
+
     def outline(self, center, facing: float, points: int = 90) -> np.ndarray:
         """Points (k, 2) of the tip's face about ``center`` (m) facing ``facing`` (rad), for
         pictures: the whole circle, or the pad's front (flat and rounded edges) closed by its

@@ -120,7 +120,7 @@ def summary(result: dict) -> str:
              + ("" if result["weight"] is None else f", lift {result['weight']:g} N"),
              " rank  nodes        centre [mm]        yaw [deg]  aperture [mm]  k [N/m]"]
     for c in result["candidates"]:
-        x, y = (1e3 * v for v in c["center"])
+        x, y = (round(1e3 * v, 2) + 0.0 for v in c["center"])  # no "-0.00"
         lines.append(f"  #{c['rank'] + 1:<3d} {c['nodes'][0]:5d} {c['nodes'][1]:5d}  "
                      f"({x:8.2f}, {y:8.2f})  {np.degrees(c['yaw']):8.2f}  "
                      f"{1e3 * c['aperture_at_contact']:10.2f}  {c['stiffness']:9.4g}")

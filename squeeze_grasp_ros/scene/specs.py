@@ -320,7 +320,8 @@ class SensorsSpec:
         "taxels per fingertip tactile array (effect: tactile_sensing)", "", lo=2, default=96
     )
     taxel_span_deg: float = spec(
-        "arc of the fingertip covered by the tactile array, centred on the initial contact",
+        "arc of a round fingertip covered by the tactile array, centred on the initial "
+        "contact (a pad's array covers its whole face)",
         "deg",
         lo=0.0,
         hi=360.0,

@@ -177,8 +177,10 @@ def test_evaluation_is_the_event_squeeze_with_pads_and_matches_the_block_closed_
     d = c.closing_direction
     direct = event_squeeze(obj, c.first_contacts, wide.pad, 0.3, depth=closing / np.sqrt(2),
                            directions={Finger.F1: d, Finger.F2: -d},
-                           facing={Finger.F1: c.yaw, Finger.F2: c.yaw + np.pi})
-    assert ev.jaw_force == 0.5 * sum(direct.finger_force[f][1] for f in (Finger.F1, Finger.F2))
+                           facing={Finger.F1: c.yaw, Finger.F2: c.yaw + np.pi},
+                           origins={Finger.F1: c.center - W * d, Finger.F2: c.center + W * d})
+    assert ev.jaw_force == pytest.approx(
+        0.5 * sum(direct.finger_force[f][1] for f in (Finger.F1, Finger.F2)), rel=1e-12)
     assert ev.command_force == pytest.approx(1.25 * ev.jaw_force)
     assert ev.lift_force == pytest.approx(0.5 / (2 * 0.3))
     assert ev.holds_weight == (ev.jaw_force >= ev.lift_force)
@@ -227,3 +229,21 @@ def test_gripper_plan_verb_rejects_bad_input_with_exit_2(args, message, capsys):
     code = main(["gripper-plan", str(scene_file("sponge_gripper")), *args])
     assert code == 2
     assert message in capsys.readouterr().err
+
+
+def test_the_evaluated_jaws_sit_where_the_candidate_put_them():
+    """An off-centre candidate on the sponge, whose pads touch with an edge: the evaluated
+    squeeze's pads start at the candidate's first contacts and on its closing line."""
+    setup, gmap = sponge()
+    jaws = load_gripper(device_file("generic_85mm")).jaws()
+    c = gripper_candidates(setup.solid, gmap, jaws, count=1)[0]
+    ev = evaluate_candidate(setup.solid, c, jaws, 0.6, closing=0.002)
+    assert ev.squeeze.contacts == c.first_contacts
+    d = c.closing_direction
+    t = np.array([-d[1], d[0]])
+    for name, sign in ((Finger.F1, -1.0), (Finger.F2, 1.0)):
+        finger = ev.squeeze.state.finger(name)
+        start = finger.center - finger.translation  # the reference point at first contact
+        assert (start - c.center) @ t == pytest.approx(0.0, abs=1e-12)  # on the line
+        face = (start - c.center) @ d - sign * jaws.pad.radius  # F1's face is r ahead of it
+        assert face == pytest.approx(sign * 0.5 * c.aperture, abs=1e-12)

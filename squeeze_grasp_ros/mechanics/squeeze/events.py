@@ -13,7 +13,7 @@ SI units at the interface, object frame.
 
 from __future__ import annotations
 
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -481,6 +481,7 @@ def event_squeeze(
     checkpoint: Callable[[], None] | None = None,
     options: SolveOptions | None = None,
     facing: Mapping[str, float] | None = None,
+    origins: Mapping[str, Sequence[float]] | None = None,
 ) -> EventSqueeze:
     """Event-driven two-finger squeeze of ``obj`` from initial contact nodes (F1, F2).
 
@@ -525,6 +526,9 @@ def event_squeeze(
         facing, or a pad, approaches along it until it touches the object
         (:func:`~.fingertips.place_fingertip`); the node it touches first is its initial
         contact (``contacts`` of the result).
+    origins : mapping, optional
+        Finger -> where a tip given a facing starts its approach (its reference point, m; a
+        gripper jaw on its closing line); default on its contact node.
 
     Examples
     --------
@@ -539,8 +543,8 @@ def event_squeeze(
         raise InvalidInputError("give exactly one of depth (m) and relative_depth")
     names = SQUEEZING_FINGERS
     shapes = dict(tip) if isinstance(tip, Mapping) else dict.fromkeys(names, tip)
-    facing = dict(facing or {})
-    tips = [place_fingertip(obj.mesh, n, int(c), shapes[n], facing.get(n))
+    facing, origins = dict(facing or {}), dict(origins or {})
+    tips = [place_fingertip(obj.mesh, n, int(c), shapes[n], facing.get(n), origins.get(n))
             for n, c in zip(names, contacts)]
     contacts = tuple(t.node for t in tips)
     radii = {t.name: t.radius for t in tips}

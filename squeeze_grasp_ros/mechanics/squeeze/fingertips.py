@@ -74,7 +74,7 @@ class Fingertip:
 
 
 def place_fingertip(mesh: Mesh, name: str, node: int, radius: float | TipShape,
-                    facing: float | None = None) -> Fingertip:
+                    facing: float | None = None, origin=None) -> Fingertip:
     """Fingertip ``name`` of ``radius`` (m; or any :class:`TipShape`) touching boundary
     ``node``.
 
@@ -84,7 +84,8 @@ def place_fingertip(mesh: Mesh, name: str, node: int, radius: float | TipShape,
     object along that direction until its face first touches the outer boundary, at ``node``
     when the boundary allows (a pad set square on a convex side), else at the node it meets
     first, which becomes the initial contact; every other node then touching is in
-    :attr:`Fingertip.touching`.
+    :attr:`Fingertip.touching`. With ``origin`` (x, y), m, the tip's reference point starts
+    there (a gripper jaw on its closing line, clear of the object) instead of on ``node``.
 
     Raises
     ------
@@ -105,19 +106,25 @@ def place_fingertip(mesh: Mesh, name: str, node: int, radius: float | TipShape,
     theta0 = float(np.arctan2(-n[1], -n[0])) if facing is None else float(facing)
     if shape.kind == TipKind.CIRCLE and facing is None:
         return Fingertip(name, int(node), p + r * n, float(r), theta0, facing=theta0)
-    return _approach(mesh, name, int(node), shape, theta0)
+    return _approach(mesh, name, int(node), shape, theta0, origin)
 
 
-def _approach(mesh: Mesh, name: str, node: int, shape: TipShape, theta0: float) -> Fingertip:
+def _approach(mesh: Mesh, name: str, node: int, shape: TipShape, theta0: float,
+              origin) -> Fingertip:
     """The tip facing e(theta0) moved along it until its face first touches the boundary."""
     r, a = shape.radius, shape.half_flat
     e0 = unit(theta0)
     boundary = mesh.boundary
-    # set on the node, then backed off until no boundary node is ahead of its face
-    center = mesh.nodes[node] - r * e0
+    # from the origin, advanced until its face touches; or set on the node, then backed off
+    # until no boundary node is ahead of its face
+    center = mesh.nodes[node] - r * e0 if origin is None else np.asarray(origin, float)
     clear = shape.clearance(mesh.nodes[boundary], center[None], [theta0])[0]
     first = int(np.argmin(clear))
-    center = center + min(float(clear[first]), 0.0) * e0
+    if not np.isfinite(clear[first]):
+        raise InvalidInputError(f"fingers.{name}: the tip's approach from {origin} misses "
+                                "the object")
+    advance = float(clear[first]) if origin is not None else min(float(clear[first]), 0.0)
+    center = center + advance * e0
     tips = TipGeometry.of([shape], [theta0])
     gaps = tips.gaps(mesh.nodes[boundary], center[None])[:, 0]
     size = float(np.ptp(mesh.nodes, axis=0).max())

@@ -322,8 +322,11 @@ def evaluate_candidate(obj: ElasticObject, candidate: GripperCandidate, jaws: Pa
         raise InvalidInputError(f"weight must be > 0 N, got {weight}")
     search = min(0.5 * candidate.aperture, travel) if limit_search is None else limit_search
     d = candidate.closing_direction
+    far = candidate.aperture + 10.0 * obj.scale  # each jaw starts clear, on the closing line
     kw = dict(directions={Finger.F1: d, Finger.F2: -d},
               facing={Finger.F1: candidate.yaw, Finger.F2: candidate.yaw + np.pi},
+              origins={Finger.F1: candidate.center - far * d,
+                       Finger.F2: candidate.center + far * d},
               material_model=material_model)
     nodes = candidate.first_contacts
     planned = event_squeeze(obj, nodes, jaws.pad, mu, depth=closing / SQRT2,

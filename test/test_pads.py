@@ -258,6 +258,27 @@ def test_pad_of_vanishing_flat_is_the_circle():
         assert gap < 10 * eps / r * np.linalg.norm(finger_force(circle))
 
 
+def test_pad_of_vanishing_width_is_the_point_finger():
+    """A pad narrower than the mesh's node spacing touches one node all the way: the squeeze is
+    the paper's stable squeeze at point contacts (Sec. 3-4, :func:`plan_squeeze`, an
+    independent solve), forces linear in depth; wider pads gather contacts and force.
+    """
+    from squeeze_grasp_ros.mechanics.squeeze.stable_pure import plan_squeeze
+
+    obj, ends = disk()
+    depth = 0.003
+    point = plan_squeeze(obj, list(ends)).forces.reshape(2, 2)[0] * depth
+    forces = []
+    for width in (0.02, 0.01, 0.002, 0.0005):
+        sq = event_squeeze(obj, ends, TipShape.pad(width=width, edge_radius=width / 4), 0.5,
+                           depth=depth)
+        forces.append(finger_force(sq)[0])
+        if width <= 0.002:
+            assert len(sq.segments["F1"]) == 1 and sum(sq.event_counts.values()) == 0
+            assert np.allclose(finger_force(sq), point, rtol=1e-10, atol=1e-12 * point[0])
+    assert forces[0] > forces[1] > forces[2] == pytest.approx(point[0], rel=1e-10)
+
+
 def test_circles_of_growing_radius_tend_to_the_pad():
     """Circles of radius R facing the block's sides: the face deviates from the flat by
     ~ H^2 / (8 R) over the side, so the force error falls like 1/R.

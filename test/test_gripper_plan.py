@@ -233,7 +233,8 @@ def test_gripper_plan_verb_rejects_bad_input_with_exit_2(args, message, capsys):
 
 def test_the_evaluated_jaws_sit_where_the_candidate_put_them():
     """An off-centre candidate on the sponge, whose pads touch with an edge: the evaluated
-    squeeze's pads start at the candidate's first contacts and on its closing line."""
+    squeeze's pads start at the candidate's first contacts and on its closing line.
+    """
     setup, gmap = sponge()
     jaws = load_gripper(device_file("generic_85mm")).jaws()
     c = gripper_candidates(setup.solid, gmap, jaws, count=1)[0]

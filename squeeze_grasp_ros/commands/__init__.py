@@ -21,6 +21,8 @@ VERBS: dict[str, str] = {
                  "angle (App. B)",
     "graspmap": "all-pairs grasp map: stiffness, inwardness and force closure of every "
                 "placement (ring scenes: feasibility and maximum depth, Sec. 7)",
+    "gripper_plan": "parallel-jaw gripper grasps: ranked poses, aperture at first contact and "
+                    "at the planned closing, jaw force, slip/strain limit, effort to command",
     "resist": "optimal stable/pure resistance of F1, F2 to the scene's adversary finger A "
               "(Sec. 6)",
     "ring": "ring-like object, two point fingers (Sec. 7): max squeeze depth, limit, all-pairs "

@@ -49,6 +49,14 @@ PREDICTION = "planner/predicted_events"
 EXECUTOR_STATUS = "executor/status"
 OBJECT_POSE = "object_pose"
 ACTION = "executor/execute_grasp"
+CAMERA_MASK = "camera/mask"
+CAMERA_DEPTH = "camera/depth"
+CAMERA_INFO = "camera/camera_info"
+CAMERA_POSE = "camera/pose"
+OUTLINE = "outline/outline"
+SEEN_OUTLINE = "outline/seen"
+OUTLINE_ERRORS = "outline/errors"
+SHAPE_RESIDUAL = "monitor/shape_residual"
 
 
 def device_topic(device: str, stream: str) -> str:

@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 import yaml
 
-from squeeze_grasp_ros.planning import (ErrorCode, FramePose, Limits, PlannerError,
+from squeeze_grasp_ros.planning import (ErrorCode, FramePose, PlannerLimits, PlannerError,
                                         TypedMaterial, TypedObject, load_object, object_key,
                                         object_source, read_scene, squeeze_plan, typed_scene)
 
@@ -22,7 +22,7 @@ REPO = Path(__file__).resolve().parents[1]
 FOAM = (REPO / "config" / "scenes" / "foam_square.yaml").read_text()
 FOAM_MATERIAL = TypedMaterial(5.0e4, 0.3, 0.0254)
 SQUARE = ((-0.05, -0.05), (0.05, -0.05), (0.05, 0.05), (-0.05, 0.05))
-LIMITS = Limits()
+LIMITS = PlannerLimits()
 
 
 def loaded(source):
@@ -141,7 +141,7 @@ def test_exactly_one_source_of_the_object():
 
 def test_the_planner_limits_apply_to_typed_objects():
     source = typed_scene(foam_like(mesh_nodes=50_000))
-    small = Limits(max_nodes=5_000)
+    small = PlannerLimits(max_nodes=5_000)
     with pytest.raises(PlannerError, match="oversized factorized mesh: 50000 nodes"):
         load_object(source, object_key(source, "x", "", small), small)
 

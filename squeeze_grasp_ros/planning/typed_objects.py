@@ -37,7 +37,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from squeeze_grasp_ros.mechanics.vocabulary import Finger, MaterialModel
+from squeeze_grasp_ros.mechanics.vocabulary import Effect, Finger, MaterialModel, ShapeType
 from squeeze_grasp_ros.planning.errors import invalid
 from squeeze_grasp_ros.planning.objects import SceneSource, read_scene
 from squeeze_grasp_ros.scene import SHAPES, SceneError, build_outline, parse_scene
@@ -51,8 +51,8 @@ OBJECT_FRAME = "object"
 PLANAR_TOLERANCE = 1e-6
 """Largest tilt (rad) of ``frame_pose``'s z axis from the object's z that counts as planar."""
 
-TYPED_SHAPES: tuple[str, ...] = tuple(
-    s for s in SHAPES if s not in ("polygon", "spline", "file"))
+TYPED_SHAPES: tuple[ShapeType, ...] = tuple(
+    s for s in SHAPES if s not in (ShapeType.POLYGON, ShapeType.SPLINE, ShapeType.FILE))
 """Shapes a typed request may name (a polygon is given as the outline; files and splines are
 scene-only)."""
 
@@ -206,27 +206,27 @@ def _shape(obj: TypedObject, pose: tuple[np.ndarray, np.ndarray]) -> dict:
         if len(obj.outline) < 3:
             raise invalid(f"object.outline.polygon.points has {len(obj.outline)} points; an "
                           "outline needs at least 3 (m)")
-        shape: dict = {"type": "polygon",
+        shape: dict = {"type": ShapeType.POLYGON.value,
                        "points": _points(obj.outline, pose, "object.outline.polygon.points")}
         if len(obj.holes):
             shape["holes"] = [_points(h, pose, f"object.holes[{k}].points")
                               for k, h in enumerate(obj.holes)]
         return shape
     if obj.shape not in TYPED_SHAPES:
-        raise invalid(f"object.shape must be one of {list(TYPED_SHAPES)} (or give "
+        raise invalid(f"object.shape must be one of {[s.value for s in TYPED_SHAPES]} (or give "
                       f"object.outline), got {obj.shape!r}")
     if len(obj.holes):
         raise invalid("object.holes go with object.outline; a named shape has none (annulus: "
                       "outer_radius and inner_radius)")
-    kind = obj.shape
+    kind = ShapeType(obj.shape)
     expected = SHAPES[kind]
     unknown = sorted(set(obj.shape_parameters) - set(expected))
     if unknown:
         raise invalid(f"object.shape_parameters: unknown parameter {unknown[0]!r} of shape "
-                      f"{kind} (its parameters: {list(expected)})")
-    shape = {"type": kind}
+                      f"{kind.value} (its parameters: {list(expected)})")
+    shape = {"type": kind.value}
     for name, values in obj.shape_parameters.items():
-        many = kind == "fourier_blob" and name in ("cos", "sin")
+        many = kind == ShapeType.FOURIER_BLOB and name in ("cos", "sin")
         if not many and len(values) != 1:
             raise invalid(f"object.shape_parameters {name} takes one value, got {len(values)}")
         shape[name] = [float(v) for v in values] if many else float(values[0])
@@ -267,7 +267,7 @@ def scene_data(obj: TypedObject) -> dict:
             "fingers": fingers}
     if obj.mu:
         data["friction"] = {"mu": float(obj.mu)}
-        data["effects"] = ["friction"]
+        data["effects"] = [Effect.FRICTION.value]
     return data
 
 

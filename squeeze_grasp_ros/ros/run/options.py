@@ -119,6 +119,7 @@ def node_parameters(
         output=str(options.record or ""),
         devices=list(devices.values()),
         include_hidden_topics=options.include_hidden_topics,
+        camera=scene.has(Effect.CAMERA),
     )
     for name, values in options.overrides.items():
         params[name].update(values)

@@ -61,7 +61,7 @@ __all__ = [
     "CameraSpec", "FingerSpec", "FrictionSpec", "MaterialSpec", "MeshSpec", "ObjectSpec",
     "PickupSpec", "PlacementSpec", "RingSpec", "Scene", "SceneError", "SensorsSpec", "SimSpec",
     "SqueezeSpec", "StrainLimitSpec", "build_mesh", "build_outline", "build_ring",
-    "finger_devices", "finger_nodes", "load_scene", "parse_scene", "placement_node", "placement_points",
-    "read_yaml", "requested_nodes", "scene_help", "scene_limits", "scene_material",
-    "scene_solid", "GraspSetup", "event_squeeze_scene",
+    "finger_devices", "finger_nodes", "load_scene", "parse_scene", "placement_node",
+    "placement_points", "read_yaml", "requested_nodes", "scene_help", "scene_limits",
+    "scene_material", "scene_solid", "GraspSetup", "event_squeeze_scene",
 ]

@@ -347,9 +347,8 @@ class CameraSpec:
         "first frame's mask outline and loads it through the typed load_object request",
         default=False)
     shape_mismatch_threshold: float = spec(
-        "monitor: RMS distance of the seen outline from the predicted deformed boundary (after "
-        "the App. C similarity fit) that raises shape_mismatch", "m", lo=0.0, lo_open=True,
-        default=1e-3)
+        "monitor: RMS distance of the predicted deformed boundary from the seen outline (after "
+        "a rigid fit) that raises shape_mismatch", "m", lo=0.0, lo_open=True, default=5e-4)
 
 
 @dataclass(frozen=True)

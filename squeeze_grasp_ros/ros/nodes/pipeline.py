@@ -57,6 +57,7 @@ OUTLINE = "outline/outline"
 SEEN_OUTLINE = "outline/seen"
 OUTLINE_ERRORS = "outline/errors"
 SHAPE_RESIDUAL = "monitor/shape_residual"
+PREDICTED_SHAPES = "planner/predicted_shapes"
 
 
 def device_topic(device: str, stream: str) -> str:
@@ -94,7 +95,8 @@ def pipeline_topics(devices: Iterable[str], *, hidden: bool = False,
         types.update({CAMERA_MASK: "sensor_msgs/msg/Image", CAMERA_DEPTH: "sensor_msgs/msg/Image",
                       CAMERA_INFO: "sensor_msgs/msg/CameraInfo",
                       CAMERA_POSE: "geometry_msgs/msg/PoseStamped",
-                      SHAPE_RESIDUAL: "squeeze_grasp_interfaces/msg/ShapeResidual"})
+                      SHAPE_RESIDUAL: "squeeze_grasp_interfaces/msg/ShapeResidual",
+                      PREDICTED_SHAPES: "squeeze_grasp_interfaces/msg/PredictedShapes"})
     stream_types = {"setpoint": "geometry_msgs/msg/PoseStamped",
                     "pose": "geometry_msgs/msg/PoseStamped",
                     "wrench": "geometry_msgs/msg/WrenchStamped",

@@ -115,7 +115,8 @@ class RecorderNode(Node):
         latched = {"/" + pipeline.PREDICTION, "/" + pipeline.OBJECT_POSE,
                    f"/{pipeline.ACTION}/_action/status"} | {
                        "/" + t for t in (pipeline.CAMERA_POSE, pipeline.CAMERA_MASK,
-                                         pipeline.CAMERA_DEPTH, pipeline.CAMERA_INFO)}
+                                         pipeline.CAMERA_DEPTH, pipeline.CAMERA_INFO,
+                                         pipeline.PREDICTED_SHAPES)}
         sensors = {name for name in topics if name.rsplit("/", 1)[-1] in pipeline.STREAMS}
         for name, type_name in topics.items():
             qos = pipeline.LATCHED if name in latched else (

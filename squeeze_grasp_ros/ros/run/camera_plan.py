@@ -18,18 +18,20 @@ from typing import Any, Callable
 from geometry_msgs.msg import PoseStamped
 from sensor_msgs.msg import CameraInfo, Image
 
-from squeeze_grasp_interfaces.msg import ObjectDescription
+from squeeze_grasp_interfaces.msg import ObjectDescription, PredictedShapes
 
 from squeeze_grasp_ros.mechanics.vocabulary import Finger, ShapeFit
 from squeeze_grasp_ros.perception.extract import ObjectOutline, extract_outline
 from squeeze_grasp_ros.perception.shape_match import shape_residual
+from squeeze_grasp_ros.perception.shape_watch import predict_shapes
+from squeeze_grasp_ros.ros import messages
 from squeeze_grasp_ros.ros.messages.images import camera_model, camera_pose, image_array
-from squeeze_grasp_ros.ros.messages.objects import object_description
+from squeeze_grasp_ros.ros.messages.objects import object_description, polygon_msg
 from squeeze_grasp_ros.ros.nodes import pipeline
 from squeeze_grasp_ros.ros.run.options import RunError
-from squeeze_grasp_ros.scene import Scene, build_outline
+from squeeze_grasp_ros.scene import GraspSetup, Scene, build_outline
 
-__all__ = ["first_outline", "seen_description", "seen_report"]
+__all__ = ["first_outline", "predicted_shapes_msg", "seen_description", "seen_report"]
 
 
 def first_outline(node: Any, spin_until: Callable[..., None], scene: Scene,
@@ -99,3 +101,14 @@ def seen_report(scene: Scene, seen: ObjectOutline) -> dict:
             "rms_m": match.rms_m, "max_m": max(match.max_m, match.reverse_max_m),
             "area_m2": seen.outline.area, "true_area_m2": truth.area,
             "pixel_m": seen.pixel_size_m, "tolerance_m": seen.tolerance_m}
+
+
+def predicted_shapes_msg(scene: Scene, depth: float, ns: int,
+                         frame_id: str = pipeline.FRAME) -> PredictedShapes:
+    """The ``PredictedShapes`` of the planner's model (``scene``: the seen object's typed scene
+    on the camera route) squeezed to ``depth`` (m), for the monitor's shape watch.
+    """
+    predicted = predict_shapes(GraspSetup.build(scene).precompute(), depth)
+    return PredictedShapes(header=messages.header(ns, frame_id),
+                           depths=[float(d) for d in predicted.depths],
+                           outlines=[polygon_msg(o) for o in predicted.outlines])

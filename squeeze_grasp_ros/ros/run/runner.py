@@ -34,6 +34,7 @@ one of its nodes, ends the run with :class:`RunError` (exit 4), never a success.
 
 from __future__ import annotations
 
+import dataclasses
 import importlib.util
 import json
 import os
@@ -61,7 +62,8 @@ from rclpy.signals import SignalHandlerOptions
 from std_msgs.msg import Header
 
 from squeeze_grasp_interfaces.action import ExecuteGrasp
-from squeeze_grasp_interfaces.msg import Alarm, ContactEvent, ContactEventArray, SimState
+from squeeze_grasp_interfaces.msg import (Alarm, ContactEvent, ContactEventArray,
+                                          PredictedShapes, SimState)
 
 from squeeze_grasp_ros.ros import messages
 from squeeze_grasp_ros.control.motion import GraspGoal
@@ -72,7 +74,10 @@ from squeeze_grasp_ros.resources import config_dir, share_dir
 from squeeze_grasp_ros.scene import GraspSetup, Scene, SceneError, finger_devices, load_scene
 from squeeze_grasp_ros.ros.nodes import PARAMS_FILE_ENV, PARENT_PID_ENV, pipeline
 from squeeze_grasp_ros.ros.nodes.recorder import cdr_stamp_ns
-from squeeze_grasp_ros.ros.run.camera_plan import first_outline, seen_description, seen_report
+from squeeze_grasp_ros.planning.typed_objects import typed_scene
+from squeeze_grasp_ros.ros.messages.objects import typed_object
+from squeeze_grasp_ros.ros.run.camera_plan import (first_outline, predicted_shapes_msg,
+                                                   seen_description, seen_report)
 from squeeze_grasp_ros.ros.run.goal_client import GoalClient
 from squeeze_grasp_ros.ros.run.options import (EXECUTORS, PLANNER_MODULE, RunError,
                                                RunOptions, node_parameters)
@@ -435,6 +440,8 @@ class PipelineRunner:
                 planner()
         self.timing["plan"] = self.plan.seconds
         self.prediction_pub.publish(self.plan.prediction)
+        if self.scene.has(Effect.CAMERA):
+            self._publish_predicted_shapes()
         params = node_parameters(
             self.scene, self.options.scene_path, self.options, self.plan.goal.relative_per_depth
         )
@@ -458,6 +465,20 @@ class PipelineRunner:
         self.check_graph()
         self.start_ns = self.sim_state_ns
         self.timing["start_nodes"] = time.perf_counter() - started
+
+    def _publish_predicted_shapes(self) -> None:
+        """Latch the predicted deformed boundary along the squeeze for the monitor's shape
+        watch: the planner's model (the seen outline's typed scene on the camera route, else
+        the scene) squeezed to the planned depth.
+        """
+        started = time.perf_counter()
+        model = self.scene if self.seen is None else typed_scene(typed_object(
+            seen_description(self.scene, self.seen))).scene
+        model = dataclasses.replace(model, squeeze=self.scene.squeeze)
+        msg = predicted_shapes_msg(model, self.plan.goal.depth, 0)
+        self.client.create_publisher(PredictedShapes, pipeline.PREDICTED_SHAPES,
+                                     pipeline.LATCHED).publish(msg)
+        self.timing["predicted_shapes"] = time.perf_counter() - started
 
     def _start_nodes(self, params: dict[str, dict]) -> None:
         """Start the nodes of ``params`` (processes or in this process; none when attached)."""

@@ -67,7 +67,8 @@ def test_the_camera_section_and_effect_go_together():
 
 def test_frames_come_at_the_camera_rate_and_show_the_deformed_object():
     """10 Hz at dt = 1 ms: frames at ticks 0, 100, 200; a scene without the effect renders
-    none; the mask's object area follows the deformed outline's (the square bulges)."""
+    none; the mask's object area follows the deformed outline's (the square bulges).
+    """
     world = SimWorld(GraspSetup.build(load_scene(CAMERA_SCENE)))
     assert [k for k in range(301) if world.camera.due(k)] == [0, 100, 200, 300]
     plain = SimWorld(GraspSetup.build(load_scene(YAML_SCENE)))
@@ -86,7 +87,8 @@ def test_frames_come_at_the_camera_rate_and_show_the_deformed_object():
 
 def seen_setup(scene_path: Path) -> tuple:
     """(seen typed scene, seen outline) of a camera scene's first frame, ROS-free: what the
-    run's camera route builds (render, extract, typed object)."""
+    run's camera route builds (render, extract, typed object).
+    """
     skimage_or_skip()
     from squeeze_grasp_ros.perception.extract import extract_outline
     from squeeze_grasp_ros.planning.typed_objects import typed_scene
@@ -168,7 +170,8 @@ def test_the_shape_watch_catches_a_larger_object_and_names_why_not_nu():
     first frame on (the similarity scale says 0.95). A 30 % error in nu changes the deformed
     outline by less than a tenth of a pixel at 60 % depth: below what this camera resolves
     (docs/perception.md says so); E does not change the shape at all under displacement
-    control."""
+    control.
+    """
     skimage_or_skip()
     from squeeze_grasp_ros.perception.extract import extract_outline
 

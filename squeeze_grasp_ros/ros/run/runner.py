@@ -422,10 +422,11 @@ class PipelineRunner:
         """
         plan_source = self._use_planner()
         if self.sees_object:
-            if not plan_source or self.options.attach:
-                raise RunError("camera.plan_from_images plans with this run's planner node: "
-                               "not with --attach, and the planner must be installed")
-            # the world and its camera first: the planner sees the object in its first frame
+            if not plan_source:
+                raise RunError("camera.plan_from_images plans with the planner node: install "
+                               "it (pip install -e '.[ros]' and squeeze-grasp ros-setup)")
+            # the world and its camera first (attached: already running, its first frame
+            # latched): the planner sees the object in its first frame
             self._start_nodes({"sim_hardware": node_parameters(
                 self.scene, self.options.scene_path, self.options, 0.0)["sim_hardware"]})
             started = time.perf_counter()

@@ -146,7 +146,6 @@ NOT_DOMAIN: dict[tuple[str, str], str] = {
     ("commands/render.py", "camera"): "the render JSON's key of the camera info",
     ("ros/nodes/recorder.py", "camera"): "the recorder parameter named after the camera",
     ("scene/checks.py", "camera"): "a scene section name (SECTION_EFFECT's keys)",
-    ("planning/typed_objects.py", "polygon"): "the scene's error text it renames (polygon.holes)",
     ("planning/typed_objects.py", "point"): "the placement key of a scene finger",
     ("planning/typed_objects.py", "friction"): "a scene section name",
 }

@@ -57,12 +57,12 @@ TYPED_SHAPES: tuple[ShapeType, ...] = tuple(
 scene-only)."""
 
 FIELDS: dict[str, str] = {
+    "object.shape: polygon.holes": "object.holes",
+    "object.shape: polygon": "object.outline.polygon.points",
     "object.material.E": "object.material.youngs_modulus",
     "object.material.nu": "object.material.poisson_ratio",
     "object.mesh.max_area": "object.mesh_max_area",
     "object.mesh.nodes": "object.mesh_nodes",
-    "polygon.holes": "object.holes",
-    "polygon": "object.outline.polygon.points",
     "object.shape.": "object.shape_parameters ",
     "object.shape": "object.outline / object.shape",
     "fingers.F1.placement.point": "object.placements[0]",

@@ -49,6 +49,7 @@ class ShapeWatcher:
         self.depths: OrderedDict[int, float] = OrderedDict()
         self.active = False
         self.matched = 0
+        self.skipped = 0
         sub = node.create_subscription
         sub(Image, pipeline.CAMERA_MASK, self._image, pipeline.LATCHED)
         sub(CameraInfo, pipeline.CAMERA_INFO, self._info, pipeline.LATCHED)
@@ -84,8 +85,11 @@ class ShapeWatcher:
 
     def _match(self, msg: Image, ns: int, depth: float) -> None:
         if self.prediction is None or self.camera is None or self.pose is None:
-            self.node.get_logger().warning(
-                "shape watch: frame skipped (no prediction, camera_info or camera pose yet)")
+            if not self.skipped:  # once: a launched world publishes before the run plans
+                self.node.get_logger().warning(
+                    "shape watch: frame skipped (no prediction, camera_info or camera pose "
+                    "yet); frames before the prediction are not matched")
+            self.skipped += 1
             return
         try:
             pixels, encoding = image_array(msg)

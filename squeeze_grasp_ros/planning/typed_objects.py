@@ -40,10 +40,11 @@ from scipy.spatial.transform import Rotation
 from squeeze_grasp_ros.mechanics.vocabulary import Effect, Finger, MaterialModel, ShapeType
 from squeeze_grasp_ros.planning.errors import invalid
 from squeeze_grasp_ros.planning.objects import SceneSource, read_scene
-from squeeze_grasp_ros.scene import SHAPES, SceneError, build_outline, parse_scene
+from squeeze_grasp_ros.mechanics.elastic.shapes import Outline
+from squeeze_grasp_ros.scene import SHAPES, Scene, SceneError, build_outline, parse_scene
 
 __all__ = ["OBJECT_FRAME", "PLANAR_TOLERANCE", "TYPED_SHAPES", "FramePose", "TypedMaterial",
-           "TypedObject", "object_source", "scene_data", "typed_scene"]
+           "TypedObject", "object_source", "scene_data", "seen_object", "typed_scene"]
 
 OBJECT_FRAME = "object"
 """The planner's frame: outlines in it (or in the unnamed frame "") need no ``frame_pose``."""
@@ -308,3 +309,31 @@ def object_source(scene_yaml: str, scene_path: str, typed: TypedObject,
         raise invalid("give exactly one of scene_yaml, scene_path and object (outline points "
                       "or shape)")
     return read_scene(scene_yaml, scene_path, roots)
+
+
+def seen_object(scene: Scene, outline: Outline, frame_id: str = OBJECT_FRAME) -> TypedObject:
+    """The typed object a robot describes after seeing ``outline`` (m, in ``frame_id``): the
+    seen outline with what it is told rather than sees, from ``scene`` (material, mesh size,
+    the fingers' placement points, their radius, friction).
+
+    Raises
+    ------
+    PlannerError
+        INVALID_ARGUMENT when the fingers are not placed by points or have different tip radii
+        (a typed object has one radius, and an angle or node index refers to the true outline).
+    """
+    fingers = [scene.fingers[f] for f in (Finger.F1, Finger.F2)]
+    if any(f.placement.point is None for f in fingers):
+        raise invalid("planning from a seen outline needs fingers placed by point (m): an "
+                      "angle or node index refers to the true outline, which is not seen")
+    if fingers[0].tip_radius != fingers[1].tip_radius:
+        raise invalid("planning from a seen outline needs equal fingertip radii for F1 and F2")
+    material = scene.object.material
+    return TypedObject(
+        material=TypedMaterial(material.E, material.nu, material.thickness,
+                               material.model.value),
+        outline=np.asarray(outline.points, float).tolist(),
+        holes=[np.asarray(h, float).tolist() for h in outline.holes], frame_id=frame_id,
+        mesh_nodes=scene.object.mesh.nodes or 0,
+        placements=[f.placement.point for f in fingers], tip_radius=fingers[0].tip_radius,
+        mu=scene.mu)

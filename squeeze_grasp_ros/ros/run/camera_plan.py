@@ -20,10 +20,12 @@ from sensor_msgs.msg import CameraInfo, Image
 
 from squeeze_grasp_interfaces.msg import ObjectDescription, PredictedShapes
 
-from squeeze_grasp_ros.mechanics.vocabulary import Finger, ShapeFit
+from squeeze_grasp_ros.mechanics.vocabulary import ShapeFit
 from squeeze_grasp_ros.perception.extract import ObjectOutline, extract_outline
 from squeeze_grasp_ros.perception.shape_match import shape_residual
 from squeeze_grasp_ros.perception.shape_watch import predict_shapes
+from squeeze_grasp_ros.planning import PlannerError
+from squeeze_grasp_ros.planning.typed_objects import seen_object
 from squeeze_grasp_ros.ros import messages
 from squeeze_grasp_ros.ros.messages.images import camera_model, camera_pose, image_array
 from squeeze_grasp_ros.ros.messages.objects import object_description, polygon_msg
@@ -68,27 +70,25 @@ def first_outline(node: Any, spin_until: Callable[..., None], scene: Scene,
 
 
 def seen_description(scene: Scene, seen: ObjectOutline) -> ObjectDescription:
-    """The typed ``load_object`` object: the seen outline with the scene's material, mesh size,
-    finger placements (points), tip radius and friction.
+    """The typed ``load_object`` object of a seen outline
+    (:func:`~squeeze_grasp_ros.planning.typed_objects.seen_object`).
 
     Raises
     ------
     RunError
-        When the fingers are not placed by points or have different tip radii (a typed object
-        has one radius and point placements).
+        When the scene's fingers cannot be described with it (placements not by point, tip
+        radii that differ).
     """
-    fingers = [scene.fingers[f] for f in (Finger.F1, Finger.F2)]
-    if any(f.placement.point is None for f in fingers):
-        raise RunError("camera.plan_from_images needs fingers placed by point (m): an angle or "
-                       "node index refers to the true outline, which the planner does not see")
-    if fingers[0].tip_radius != fingers[1].tip_radius:
-        raise RunError("camera.plan_from_images needs equal fingertip radii for F1 and F2")
-    material = scene.object.material
+    try:
+        typed = seen_object(scene, seen.outline, seen.frame_id)
+    except PlannerError as error:
+        raise RunError(f"camera.plan_from_images: {error}") from None
+    m = typed.material
     return object_description(
-        seen.outline, seen.frame_id, youngs_modulus=material.E, poisson_ratio=material.nu,
-        thickness=material.thickness, model=material.model.value,
-        placements=[f.placement.point for f in fingers], tip_radius=fingers[0].tip_radius,
-        mu=scene.mu, mesh_nodes=scene.object.mesh.nodes or 0)
+        seen.outline, typed.frame_id, youngs_modulus=m.youngs_modulus,
+        poisson_ratio=m.poisson_ratio, thickness=m.thickness, model=m.model,
+        placements=typed.placements, tip_radius=typed.tip_radius, mu=typed.mu,
+        mesh_nodes=typed.mesh_nodes)
 
 
 def seen_report(scene: Scene, seen: ObjectOutline) -> dict:

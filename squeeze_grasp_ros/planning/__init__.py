@@ -65,6 +65,7 @@ from squeeze_grasp_ros.planning.checks import (
     choice,
     contact_nodes,
 )
+from squeeze_grasp_ros.planning.gripper import gripper_grasp_plan, read_gripper
 from squeeze_grasp_ros.planning.requests import (
     SqueezePlan,
     squeeze_plan,
@@ -111,6 +112,7 @@ __all__ = [
     "contact_nodes",
     "event_squeeze_run",
     "friction_resistance",
+    "gripper_grasp_plan",
     "invalid",
     "load_cached",
     "load_object",
@@ -118,6 +120,7 @@ __all__ = [
     "object_grasp_map",
     "object_key",
     "object_source",
+    "read_gripper",
     "read_scene",
     "requested_nodes",
     "resident_bytes",

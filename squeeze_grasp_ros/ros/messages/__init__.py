@@ -36,6 +36,11 @@ from squeeze_grasp_ros.ros.messages.planner import (
     event_squeeze_data,
     event_squeeze_feedback,
 )
+from squeeze_grasp_ros.ros.messages.gripper import (
+    gripper_grasps,
+    gripper_pose,
+    plan_gripper_grasp_response,
+)
 from squeeze_grasp_ros.ros.messages.contacts import (
     contact_node_msg,
     contact_state_msg,
@@ -121,6 +126,8 @@ __all__ = [
     "grasp_map_data",
     "grasp_map_feedback",
     "grasp_result",
+    "gripper_grasps",
+    "gripper_pose",
     "header",
     "int32_array",
     "invalid_goal_result",
@@ -128,6 +135,7 @@ __all__ = [
     "monitor_status_msg",
     "object_description",
     "object_model",
+    "plan_gripper_grasp_response",
     "observation",
     "patches_state_msg",
     "plan_resistance_response",

@@ -326,6 +326,9 @@ def seen_object(scene: Scene, outline: Outline, frame_id: str = OBJECT_FRAME) ->
     if any(f.placement.point is None for f in fingers):
         raise invalid("planning from a seen outline needs fingers placed by point (m): an "
                       "angle or node index refers to the true outline, which is not seen")
+    if any(f.tip is not None for f in fingers):
+        raise invalid("planning from a seen outline takes round fingertips (tip_radius); a "
+                      "typed object has no fingers.<F>.tip")
     if fingers[0].tip_radius != fingers[1].tip_radius:
         raise invalid("planning from a seen outline needs equal fingertip radii for F1 and F2")
     material = scene.object.material

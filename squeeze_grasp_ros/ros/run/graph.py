@@ -19,6 +19,7 @@ from collections.abc import Callable, Iterable
 
 from rclpy.node import Node
 
+from squeeze_grasp_ros.mechanics.vocabulary import Effect
 from squeeze_grasp_ros.ros.nodes import pipeline
 from squeeze_grasp_ros.ros.run.options import RunError
 from squeeze_grasp_ros.scene import Scene, finger_devices
@@ -45,7 +46,8 @@ def run_topics(scene: Scene) -> list[str]:
     (``/clock`` as ``clock``: it is remapped into the run's namespace).
     """
     devices = finger_devices(scene).values()
-    names = list(pipeline.pipeline_topics(devices, hidden=True))
+    names = list(pipeline.pipeline_topics(devices, hidden=True,
+                                          camera=scene.has(Effect.CAMERA)))
     names += [f"/{t}" for t in (pipeline.HELLO, pipeline.READY, pipeline.RECORDER_PROGRESS)]
     return [t.lstrip("/") for t in names]
 

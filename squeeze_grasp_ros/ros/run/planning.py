@@ -27,7 +27,7 @@ from rclpy.context import Context
 from rclpy.executors import SingleThreadedExecutor
 from rclpy.parameter import Parameter
 
-from squeeze_grasp_interfaces.msg import ContactEventArray
+from squeeze_grasp_interfaces.msg import ContactEventArray, ObjectDescription
 from squeeze_grasp_interfaces.srv import EventSqueeze, LoadObject, PlanSqueeze
 
 from squeeze_grasp_ros import planning
@@ -193,22 +193,28 @@ def _call(planner: PlannerClient, srv_type: Any, name: str, request: Any, timeou
 
 
 def plan_with_planner(planner: PlannerClient, run_object: RunObject, scene_path: str,
-                      options: RunOptions) -> Plan:
+                      options: RunOptions, seen: ObjectDescription | None = None) -> Plan:
     """Plan with the planner node: ``event_squeeze`` and ``plan_squeeze`` of the object it
-    holds (``run_object.loaded``), or of the scene file it loads (``load_object``).
+    holds (``run_object.loaded``), of the scene file it loads (``load_object``), or, with
+    ``seen`` (camera.plan_from_images), of the object the camera saw, squeezed as the scene says.
     """
     t0 = time.perf_counter()
     loaded, timeout = run_object.loaded, options.timeout
-    if loaded is not None:
+    if loaded is not None and seen is None:
         object_id, digest, nodes = loaded.object_id, loaded.digest, list(loaded.finger_nodes)
     else:
-        response = _call(planner, LoadObject, "load_object",
-                         LoadObject.Request(scene_path=str(Path(scene_path).resolve())), timeout)
+        request = (LoadObject.Request(object=seen) if seen is not None
+                   else LoadObject.Request(scene_path=str(Path(scene_path).resolve())))
+        response = _call(planner, LoadObject, "load_object", request, timeout)
         object_id, digest = response.object_id, response.object_digest
         nodes = list(response.finger_nodes)
-    squeeze = _call(planner, EventSqueeze, "event_squeeze",
-                    EventSqueeze.Request(object_id=object_id, object_digest=digest),
-                    timeout).squeeze
+    request = EventSqueeze.Request(object_id=object_id, object_digest=digest)
+    if seen is not None:  # a typed object has no squeeze section: the scene's squeeze
+        spec = run_object.scene.squeeze
+        request.squeeze_type = spec.type.value
+        request.depth, request.relative_depth = spec.depth or 0.0, spec.relative_depth or 0.0
+        request.step, request.event_tol = spec.step, spec.event_tol
+    squeeze = _call(planner, EventSqueeze, "event_squeeze", request, timeout).squeeze
     pure = _call(planner, PlanSqueeze, "plan_squeeze",
                  PlanSqueeze.Request(object_id=object_id, object_digest=digest, contacts=nodes,
                                      squeeze_type=SqueezeKind.PURE), timeout)

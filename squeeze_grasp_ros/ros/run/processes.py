@@ -91,20 +91,22 @@ class NodeProcesses:
         self.namespace = namespace
         self.running: dict[str, subprocess.Popen] = {}
         """Node name -> its process, in start order."""
-        self.params_file: Path | None = None
+        self.params_files: list[Path] = []
+        """The run's parameter files (one per :meth:`start_nodes`), removed at :meth:`stop_all`."""
 
     def start_nodes(self, params: Mapping[str, Mapping[str, Any]]) -> None:
-        """Write the run's parameter file and start one process per node of ``params``."""
+        """Write a parameter file and start one process per node of ``params``."""
         remove_stale_parameter_files()
         handle, path = tempfile.mkstemp(prefix=f"{PARAMS_PREFIX}{os.getpid()}_", suffix=".yaml")
         os.close(handle)
-        self.params_file = Path(path)
-        self.params_file.write_text(
+        params_file = Path(path)
+        self.params_files.append(params_file)
+        params_file.write_text(
             plain_yaml({f"{self.namespace}/{name}": {"ros__parameters": dict(values)}
                         for name, values in params.items()})
         )
         for name in params:
-            self.start(name, ["--params-file", str(self.params_file)])
+            self.start(name, ["--params-file", str(params_file)])
 
     def start(self, name: str, arguments: Sequence[str]) -> subprocess.Popen:
         """Start node ``name`` (module ``ros.nodes.<name>``) in the run's namespace with more
@@ -127,8 +129,8 @@ class NodeProcesses:
         """
         env = dict(single_thread_blas(dict(os.environ)))
         env[PARENT_PID_ENV] = str(os.getpid())
-        if self.params_file is not None:
-            env[PARAMS_FILE_ENV] = str(self.params_file)
+        if self.params_files:
+            env[PARAMS_FILE_ENV] = str(self.params_files[-1])
         return env
 
     def check(self) -> None:
@@ -154,8 +156,8 @@ class NodeProcesses:
         for proc in self.running.values():
             _wait(proc)
         self.running.clear()
-        if self.params_file is not None:
-            self.params_file.unlink(missing_ok=True)
+        for params_file in self.params_files:
+            params_file.unlink(missing_ok=True)
 
 
 def _wait(proc: subprocess.Popen) -> None:

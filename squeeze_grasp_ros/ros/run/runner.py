@@ -26,11 +26,13 @@ synchronise.
 
 from __future__ import annotations
 
+import dataclasses
 import importlib.util
 import signal
 import threading
 import time
 from collections.abc import Callable
+from pathlib import Path
 from typing import Any
 
 import rclpy
@@ -42,9 +44,15 @@ from rclpy.parameter import Parameter
 from rclpy.signals import SignalHandlerOptions
 
 from squeeze_grasp_interfaces.action import ExecuteGrasp
-from squeeze_grasp_interfaces.msg import ContactEventArray
+from squeeze_grasp_interfaces.msg import ContactEventArray, PredictedShapes
 
 from squeeze_grasp_ros.exit_codes import Interrupted
+from squeeze_grasp_ros.mechanics.vocabulary import Effect
+from squeeze_grasp_ros.perception.extract import ObjectOutline
+from squeeze_grasp_ros.planning.typed_objects import typed_scene
+from squeeze_grasp_ros.ros.messages.objects import typed_object
+from squeeze_grasp_ros.ros.run.camera_plan import (first_outline, predicted_shapes_msg,
+                                                   seen_description, seen_report)
 from squeeze_grasp_ros.ros import messages
 from squeeze_grasp_ros.ros.nodes import pipeline
 from squeeze_grasp_ros.ros.nodes.planner_client import PlannerClient
@@ -126,6 +134,8 @@ class PipelineRunner:
             ContactEventArray, pipeline.PREDICTION, pipeline.LATCHED)
         self.goal = GoalClient(self.client, self.observer.on_feedback)
         self.plan: Plan | None = None
+        self.seen: ObjectOutline | None = None
+        """The outline the camera's first frame showed (camera.plan_from_images)."""
         self.start_ns = 0
 
     # ----------------------------------------------------------------- waiting
@@ -178,20 +188,30 @@ class PipelineRunner:
         started = time.perf_counter()
         if not (options.processes or options.attach):
             self.run_object = self.run_object.build()
+        if self.sees_object:
+            if not (options.attach or (options.planner and _planner_installed())):
+                raise RunError("camera.plan_from_images plans with the planner node: install "
+                               "it (pip install -e '.[ros]' and squeeze-grasp ros-setup)")
+            # the world and its camera first (attached: already running, its first frame
+            # latched): the planner sees the object in its first frame
+            self._start_nodes({"sim_hardware": node_parameters(
+                self.scene, options.scene_path, options, 0.0)["sim_hardware"]})
+            frame = time.perf_counter()
+            self.seen = first_outline(self.client, self.spin_until, self.scene, options.timeout)
+            self.timing["first_frame"] = time.perf_counter() - frame
         self.plan = self._plan()
         self.timing["plan"] = time.perf_counter() - started
         self.prediction_pub.publish(self.plan.prediction)
+        if self.scene.has(Effect.CAMERA):
+            self._publish_predicted_shapes()
         params = node_parameters(self.scene, options.scene_path, options,
                                  self.plan.goal.relative_per_depth)
         if not options.record:
             del params["recorder"]
+        if self.sees_object:
+            del params["sim_hardware"]
         started = time.perf_counter()
-        if self.graph is not None:
-            self.graph.ours |= set(params)
-        if self.processes is not None:
-            self.processes.start_nodes(params)
-        elif not options.attach:
-            self._construct(params)
+        self._start_nodes(params)
         self.spin_until(lambda: self.goal.action.server_is_ready(), options.timeout,
                         "the executor's action server")
         self.spin_until(lambda: self.observer.sim_state_ns >= 0, options.timeout, "tick 0")
@@ -201,6 +221,34 @@ class PipelineRunner:
             self.graph.check()
         self.start_ns = self.observer.sim_state_ns
         self.timing["start_nodes"] = time.perf_counter() - started
+
+    def _start_nodes(self, params: dict[str, dict]) -> None:
+        """Start the nodes of ``params`` (processes or in this process; none when attached)."""
+        if self.graph is not None:
+            self.graph.ours |= set(params)
+        if self.processes is not None:
+            self.processes.start_nodes(params)
+        elif not self.options.attach:
+            self._construct(params)
+
+    @property
+    def sees_object(self) -> bool:
+        """Whether the planner sees the object through the camera (camera.plan_from_images)."""
+        return self.scene.has(Effect.CAMERA) and self.scene.camera.plan_from_images
+
+    def _publish_predicted_shapes(self) -> None:
+        """Latch the predicted deformed boundary along the squeeze for the monitor's shape
+        watch: the planner's model (the seen outline's typed scene on the camera route, else
+        the scene) squeezed to the planned depth.
+        """
+        started = time.perf_counter()
+        model = self.scene if self.seen is None else typed_scene(typed_object(
+            seen_description(self.scene, self.seen))).scene
+        model = dataclasses.replace(model, squeeze=self.scene.squeeze)
+        msg = predicted_shapes_msg(model, self.plan.goal.depth, 0)
+        self.client.create_publisher(PredictedShapes, pipeline.PREDICTED_SHAPES,
+                                     pipeline.LATCHED).publish(msg)
+        self.timing["predicted_shapes"] = time.perf_counter() - started
 
     def _plan(self) -> Plan:
         """The plan, from the run's own planner (started for it and stopped after it), the
@@ -218,14 +266,15 @@ class PipelineRunner:
                                None if options.processes else self.run_object)
         try:
             client = PlannerClient(self.client, self.executor, "planner", wait=self.wait)
-            return plan_with_planner(client, self.run_object, options.scene_path, options)
+            seen = None if self.seen is None else seen_description(self.scene, self.seen)
+            return plan_with_planner(client, self.run_object, options.scene_path, options, seen)
         finally:
             if host is not None:
                 host.stop()
 
     def _construct(self, params: dict[str, dict]) -> None:
-        """Build the pipeline nodes in this process; the simulated world gets the run's object
-        (no second mesh).
+        """Build the pipeline nodes in this process; the simulated world of the run's scene gets
+        the run's object (no second mesh).
         """
         from squeeze_grasp_ros.ros.nodes.executor import ExecutorNode
         from squeeze_grasp_ros.ros.nodes.monitor import MonitorNode
@@ -235,10 +284,14 @@ class PipelineRunner:
 
         classes = {"sim_hardware": SimHardwareNode, "monitor": MonitorNode,
                    "executor": ExecutorNode, "recorder": RecorderNode}
-        world = SimWorld(self.run_object.loaded.setup)
+        own_scene = str(Path(self.options.scene_path).resolve())
         for name, values in params.items():
             overrides = [Parameter(k, value=v) for k, v in values.items()]
-            extra = {"world": world} if name == "sim_hardware" else {}
+            # the world of the run's own scene is built from the run's object; a world given
+            # another scene (an override: the world differs from what the planner is told)
+            # builds its own
+            extra = ({"world": SimWorld(self.run_object.loaded.setup)}
+                     if name == "sim_hardware" and values.get("scene") == own_scene else {})
             node = classes[name](context=self.context, parameter_overrides=overrides,
                                  cli_args=ros_arguments(self.namespace), **extra)
             self.nodes[name] = node
@@ -356,7 +409,8 @@ class PipelineRunner:
         return {**run_summary(scene=self.scene.name, mode=self.mode(), plan=self.plan,
                               observed=self.observer.observed(), result=result,
                               recording=self.options.record, timing=timing),
-                "namespace": self.namespace}
+                "namespace": self.namespace,
+                **({"seen_outline": seen_report(self.scene, self.seen)} if self.seen else {})}
 
     def _node_timing(self) -> dict:
         """Wall and CPU time of the stepper (``mechanics``) and of whole world ticks (``world``:

@@ -347,7 +347,7 @@ def test_decided_modes_hold_one_step_further_along_the_motion():
             assert choice.violations == 0
             decided = contacts.with_modes(choice.stick, choice.slip).with_theta(choice.theta)
             later = solver.solve(decided, 0.05)
-            fn, ft = later.normal(), later.tangential()
+            fn, ft = later.normal, later.tangential
             for k in range(len(decided)):
                 assert fn[k] > 0
                 if decided.stick[k]:

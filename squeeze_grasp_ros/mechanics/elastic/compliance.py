@@ -50,8 +50,11 @@ issued."""
 
 def node_dofs(nodes) -> np.ndarray:
     """Interleaved DOF indices (2m,) of ``nodes``: x_1, y_1, x_2, y_2, ..."""
-    nodes = np.asarray(nodes, dtype=int)
-    return np.stack([2 * nodes, 2 * nodes + 1], axis=-1).reshape(-1)
+    nodes = np.asarray(nodes, dtype=int).reshape(-1)
+    dofs = np.empty(2 * nodes.size, int)
+    np.multiply(nodes, 2, out=dofs[0::2])
+    np.add(dofs[0::2], 1, out=dofs[1::2])
+    return dofs
 
 
 class FactorizedSolver:

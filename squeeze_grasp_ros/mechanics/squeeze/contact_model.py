@@ -29,6 +29,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from functools import cached_property
 
 import numpy as np
 
@@ -166,6 +167,9 @@ class Solution:
         Largest |f_k x e(alpha_k)| over sliding nodes, dimensionless force.
     jacobian_condition : float
         Condition number of the Newton Jacobian (1 without sliding nodes).
+
+    The force components and their rates (:attr:`normal`, :attr:`tangential`, ...) are
+    computed on first use and kept: every event function of the point reads them.
     """
 
     theta: np.ndarray
@@ -178,25 +182,35 @@ class Solution:
     residual: float
     jacobian_condition: float
 
+    @cached_property
+    def unit(self) -> np.ndarray:
+        """e(theta) (m, 2) of every contact, computed once per solution."""
+        return unit(self.theta)
+
+    @cached_property
+    def tangent(self) -> np.ndarray:
+        """t(theta) (m, 2) of every contact, computed once per solution."""
+        return tangent(self.theta)
+
+    @cached_property
     def normal(self) -> np.ndarray:
         """f_n = F . e(theta) (m,)."""
-        return np.einsum("ij,ij->i", self.F, unit(self.theta))
+        return np.einsum("ij,ij->i", self.F, self.unit)
 
+    @cached_property
     def tangential(self) -> np.ndarray:
         """f_t = F . t(theta) (m,)."""
-        return np.einsum("ij,ij->i", self.F, tangent(self.theta))
+        return np.einsum("ij,ij->i", self.F, self.tangent)
 
+    @cached_property
     def normal_rate(self) -> np.ndarray:
         """D f_n / ds (m,)."""
-        return np.einsum("ij,ij->i", self.dF, unit(self.theta)) + self.dtheta * np.einsum(
-            "ij,ij->i", self.F, tangent(self.theta)
-        )
+        return np.einsum("ij,ij->i", self.dF, self.unit) + self.dtheta * self.tangential
 
+    @cached_property
     def tangential_rate(self) -> np.ndarray:
         """D f_t / ds (m,)."""
-        return np.einsum("ij,ij->i", self.dF, tangent(self.theta)) - self.dtheta * np.einsum(
-            "ij,ij->i", self.F, unit(self.theta)
-        )
+        return np.einsum("ij,ij->i", self.dF, self.tangent) - self.dtheta * self.normal
 
 
 @dataclass(frozen=True)
@@ -218,6 +232,11 @@ class Configuration:
     stick: np.ndarray
     slip: np.ndarray
     radius: np.ndarray
+
+    @cached_property
+    def sliding(self) -> np.ndarray:
+        """Indices of the sliding nodes (the unknowns of eq. 47)."""
+        return np.flatnonzero(~self.stick)
 
 
 Response = Callable[[np.ndarray], "tuple[np.ndarray, np.ndarray] | SolveFailure"]
@@ -277,15 +296,16 @@ def stiffness_scale(C) -> float:
     return float(np.abs(C).max()) if scale is None else float(scale)
 
 
-def angle_response(C, theta: np.ndarray, r: np.ndarray, P: np.ndarray) -> np.ndarray:
+def angle_response(C, t: np.ndarray, r: np.ndarray, P: np.ndarray) -> np.ndarray:
     """dF_k / d theta_j = C_kj r_j t(theta_j) for the sliding nodes j in P: (m, 2, |P|).
 
-    ``C`` is the (2m, 2m) contact stiffness or an operator that applies it (``C @ V``).
+    ``C`` is the (2m, 2m) contact stiffness or an operator that applies it (``C @ V``); ``t``
+    the tangents t(theta) (m, 2) of every contact.
     """
-    m, cols = len(theta), np.arange(len(P))
+    m, cols = len(t), np.arange(len(P))
     V = np.zeros((2 * m, len(P)))
-    t = r[P, None] * tangent(theta[P])
-    V[2 * P, cols], V[2 * P + 1, cols] = t[:, 0], t[:, 1]
+    tp = r[P, None] * t[P]
+    V[2 * P, cols], V[2 * P + 1, cols] = tp[:, 0], tp[:, 1]
     return (C @ V).reshape(m, 2, len(P))
 
 
@@ -324,28 +344,60 @@ def attempt_fixed_set(
     """
     m = len(theta0)
     theta = np.array(theta0, float)
-    P = np.flatnonzero(~cfg.stick)
-    r = cfg.radius
+    P, r = cfg.sliding, cfg.radius
+    delta = centers + r[:, None] * unit(theta) - cfg.p0
+    out = response(delta)
+    if isinstance(out, SolveFailure):
+        return out
+    F, C = out
+    it, residual, cond = 0, 0.0, 1.0
+    if len(P):
+        newton = _slide(response, cfg, centers, theta, phi, delta, F, C)
+        if isinstance(newton, SolveFailure):
+            return newton
+        theta, delta, F, C, J, it, residual, cond = newton
+    dF0 = (C @ dirs.reshape(-1)).reshape(m, 2)
+    dtheta = np.zeros(m)
+    t = tangent(theta)
+    if len(P):
+        ea = unit(theta[P] - cfg.slip[P] * phi)
+        G = angle_response(C, t, r, P)
+        try:
+            dtheta[P] = -np.linalg.solve(J, cross(dF0[P], ea))
+        except np.linalg.LinAlgError:
+            return SolveFailure(SINGULAR_SLIDING, residual, indeterminate=True)
+        dF = dF0 + G @ dtheta[P]
+    else:
+        dF = dF0
+    ddelta = dirs + (r * dtheta)[:, None] * t
+    if not (np.isfinite(F).all() and np.isfinite(dF).all() and np.isfinite(theta).all()):
+        return SolveFailure("non-finite contact forces or angles in the fixed-set solve", residual)
+    sol = Solution(theta, delta, F, dtheta, dF, ddelta, it, residual, cond)
+    sol.__dict__["tangent"] = t  # the angles' tangents, already computed (cached_property)
+    return sol
+
+
+def _slide(response: Response, cfg: Configuration, centers: np.ndarray, theta: np.ndarray,
+           phi: float, delta: np.ndarray, F: np.ndarray, C) -> tuple | SolveFailure:
+    """Newton with backtracking on the sliding angles of :func:`attempt_fixed_set`, from
+    ``theta`` (its response ``delta``, ``F``, ``C``); returns (theta, delta, F, C, Jacobian,
+    iterations, residual, Jacobian condition) or the failure.
+    """
+    P, r = cfg.sliding, cfg.radius
+    edge = cfg.slip[P] * phi
 
     def forces(th: np.ndarray):
-        delta = centers + r[:, None] * unit(th) - cfg.p0
-        out = response(delta)
-        return (delta, out, None) if isinstance(out, SolveFailure) else (delta, *out)
+        d = centers + r[:, None] * unit(th) - cfg.p0
+        out = response(d)
+        return (d, out, None) if isinstance(out, SolveFailure) else (d, *out)
 
-    def cone_residual(th: np.ndarray, F: np.ndarray) -> np.ndarray:
-        return cross(F[P], unit(th[P] - cfg.slip[P] * phi))
-
-    delta, F, C = forces(theta)
-    if isinstance(F, SolveFailure):
-        return F
     force_scale = max(stiffness_scale(C) * float(r.max()), 1e-300)
     tol = max(NEWTON_TOL, getattr(response, "tolerance", 0.0))
-    it, residual, cond = 0, 0.0, 1.0
-    J = np.zeros((0, 0))
-    R = cone_residual(theta, F)
-    while len(P):
-        ea = unit(theta[P] - cfg.slip[P] * phi)
-        G = angle_response(C, theta, r, P)
+    it, cond = 0, 1.0
+    R = cross(F[P], unit(theta[P] - edge))
+    while True:
+        ea = unit(theta[P] - edge)
+        G = angle_response(C, tangent(theta), r, P)
         J = cross(np.moveaxis(G[P], 2, 1), ea[:, None, :]) + np.diag(
             np.einsum("ij,ij->i", F[P], ea)
         )
@@ -371,7 +423,7 @@ def attempt_fixed_set(
                     return t_F
                 step = 0.5 * step
                 continue
-            t_R = cone_residual(trial, t_F)
+            t_R = cross(t_F[P], unit(trial[P] - edge))
             if np.abs(t_R).max() < residual or np.abs(step).max() < NEWTON_TOL:
                 break
             step = 0.5 * step
@@ -382,22 +434,7 @@ def attempt_fixed_set(
             residual = float(np.abs(R).max())
             cond = float(np.linalg.cond(J))
             break
-    dF0 = (C @ dirs.reshape(-1)).reshape(m, 2)
-    dtheta = np.zeros(m)
-    if len(P):
-        ea = unit(theta[P] - cfg.slip[P] * phi)
-        G = angle_response(C, theta, r, P)
-        try:
-            dtheta[P] = -np.linalg.solve(J, cross(dF0[P], ea))
-        except np.linalg.LinAlgError:
-            return SolveFailure(SINGULAR_SLIDING, residual, indeterminate=True)
-        dF = dF0 + G @ dtheta[P]
-    else:
-        dF = dF0
-    ddelta = dirs + (r * dtheta)[:, None] * tangent(theta)
-    if not (np.all(np.isfinite(F)) and np.all(np.isfinite(dF)) and np.all(np.isfinite(theta))):
-        return SolveFailure("non-finite contact forces or angles in the fixed-set solve", residual)
-    return Solution(theta, delta, F, dtheta, dF, ddelta, it, residual, cond)
+    return theta, delta, F, C, J, it, residual, cond
 
 
 @dataclass(frozen=True)
@@ -621,13 +658,13 @@ class ContactModel:
         """
         g = sd.E.T @ delta.reshape(-1)
         rigid = (self.obj.rigid_gradients @ g).reshape(-1, 4)
-        nodes = tuple(sd.nodes.tolist())
-        if self._cache.get("gradient_bounds", (None,))[0] != nodes:
-            self._cache["gradient_bounds"] = (nodes, self.obj.gradient_bounds(nodes))
-        bound = (self._cache["gradient_bounds"][1] @ np.linalg.norm(F, axis=1)
-                 + np.sqrt((rigid * rigid).sum(axis=1)))
-        near = np.flatnonzero(bound >= GRADIENT_BOUND_EXACT)
-        rest = np.delete(bound, near)
+        bounds = self._cache.get("gradient_bounds")
+        if bounds is None or bounds[0] is not sd:  # the bounds of the last contact set kept
+            bounds = self._cache["gradient_bounds"] = (
+                sd, self.obj.gradient_bounds(tuple(sd.nodes.tolist())))
+        bound = bounds[1] @ np.sqrt((F * F).sum(axis=1)) + np.sqrt((rigid * rigid).sum(axis=1))
+        exact = bound >= GRADIENT_BOUND_EXACT
+        near, rest = np.flatnonzero(exact), bound[~exact]
         floor = (1.0 - rest.max()) ** 2 if rest.size else np.inf
         if near.size == 0:
             return float(floor), -1

@@ -26,15 +26,25 @@ from squeeze_grasp_ros.mechanics.vocabulary import Finger
 
 
 def unit(theta) -> np.ndarray:
-    """e(theta) = (cos, sin) stacked on the last axis, (..., 2)."""
+    """e(theta) = (cos, sin) stacked on the last axis, (..., 2).
+
+    >>> unit([0.0, np.pi / 2]).round(12).tolist()
+    [[1.0, 0.0], [0.0, 1.0]]
+    """
     theta = np.asarray(theta, float)
-    return np.stack([np.cos(theta), np.sin(theta)], axis=-1)
+    out = np.empty(theta.shape + (2,))
+    np.cos(theta, out=out[..., 0])
+    np.sin(theta, out=out[..., 1])
+    return out
 
 
 def tangent(theta) -> np.ndarray:
     """t(theta) = (-sin, cos) stacked on the last axis, (..., 2)."""
     theta = np.asarray(theta, float)
-    return np.stack([-np.sin(theta), np.cos(theta)], axis=-1)
+    out = np.empty(theta.shape + (2,))
+    np.negative(np.sin(theta), out=out[..., 0])
+    np.cos(theta, out=out[..., 1])
+    return out
 
 
 def cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:

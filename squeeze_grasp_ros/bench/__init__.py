@@ -18,6 +18,7 @@ SECTIONS: tuple[str, ...] = (
     "resistance",
     "ring",
     "events",
+    "evaluation",
     "material_models",
     "perception",
     "ros_services",

@@ -27,11 +27,9 @@ from launch.substitutions import LaunchConfiguration
 from launch_ros.actions import Node
 from launch_ros.substitutions import ExecutableInPackage
 
-from squeeze_grasp_ros.mechanics.elastic.compliance import ElasticObject
 from squeeze_grasp_ros.ros.run.options import RunOptions, node_parameters
 from squeeze_grasp_ros.resources import config_dir, scene_file, viewer_file
-from squeeze_grasp_ros.scene import build_mesh, finger_nodes, load_scene, scene_material
-from squeeze_grasp_ros.sim.world import squeeze_geometry
+from squeeze_grasp_ros.scene import GraspSetup, load_scene
 
 TRUE = ("true", "1", "yes", "on")
 
@@ -54,11 +52,9 @@ def nodes(context, *args, **kwargs):
     scene_path = LaunchConfiguration("scene").perform(context) or str(scene_file("foam_square"))
     record = LaunchConfiguration("record").perform(context)
     hidden = LaunchConfiguration("include_hidden_topics").perform(context).lower() in TRUE
-    scene = load_scene(scene_path)
-    obj = ElasticObject(build_mesh(scene), scene_material(scene))
-    _, relative_per_depth = squeeze_geometry(scene, obj, finger_nodes(scene, obj.mesh))
+    setup = GraspSetup.build(load_scene(scene_path))
     options = RunOptions(scene_path, record=record or None, include_hidden_topics=hidden)
-    params = node_parameters(scene, scene_path, options, relative_per_depth)
+    params = node_parameters(setup.scene, scene_path, options, setup.motion.relative_per_depth)
     if not record:
         del params["recorder"]
     roots = [str(Path(scene_path).resolve().parent), str(config_dir().parent), str(Path.cwd())]

@@ -29,6 +29,14 @@ Every strain and stress names its measure (the model's own; the peak in every me
 >>> print({str(m): round(v, 4) for m, v in h.max_principal_strain.items()})
 {'small': 0.2644, 'biot': 0.2615, 'log': 0.3031, 'green_lagrange': 0.2273}
 
+Every front end makes a scene mechanics in one place, a :class:`GraspSetup`: the object, the
+fingers' initial contact nodes and finger motion, the contact model, the squeeze and Algorithm 2:
+
+>>> setup = GraspSetup.build(load_scene(scene_file("resist_fig10")))
+>>> squeeze = setup.event_squeeze()
+>>> print(setup.motion.kind, squeeze.termination, setup.frictional_resistance(squeeze).reason)
+custom depth_reached F2 slips
+
 The same from its parts: the mesh, the fingers' initial contact nodes, the squeeze:
 
 >>> mesh = build_mesh(scene)
@@ -57,7 +65,7 @@ from squeeze_grasp_ros.mechanics.resistance.optimal import optimal_resistance, r
 from squeeze_grasp_ros.mechanics.ring.grasp_map import ring_grasp_map
 from squeeze_grasp_ros.mechanics.ring.model import RingModel
 from squeeze_grasp_ros.mechanics.ring.squeeze import ring_grasp
-from squeeze_grasp_ros.mechanics.squeeze.contact_model import Limits, SolveOptions
+from squeeze_grasp_ros.mechanics.squeeze.contact_model import SolveOptions, TerminationLimits
 from squeeze_grasp_ros.mechanics.squeeze.contact_state import ContactState, Event
 from squeeze_grasp_ros.mechanics.squeeze.events import EventSqueeze, event_squeeze
 from squeeze_grasp_ros.mechanics.squeeze.graspmap import GraspMap, grasp_map
@@ -73,18 +81,19 @@ from squeeze_grasp_ros.perception.render import CameraViews, render_views
 from squeeze_grasp_ros.perception.shape_match import (ShapeMatch, deformed_outline,
                                                       shape_residual)
 from squeeze_grasp_ros.resources import scene_file
-from squeeze_grasp_ros.scene import Scene, build_mesh, finger_nodes, load_scene, scene_solid
-from squeeze_grasp_ros.scene_events import event_squeeze_scene
+from squeeze_grasp_ros.scene import (GraspSetup, Scene, build_mesh, event_squeeze_scene,
+                                     finger_nodes, load_scene, scene_solid)
 
 __all__ = [
     # scenes
-    "Scene", "load_scene", "scene_file", "build_mesh", "scene_solid", "finger_nodes",
-    "event_squeeze_scene",
+    "Scene", "load_scene", "scene_file", "GraspSetup", "build_mesh", "scene_solid",
+    "finger_nodes", "event_squeeze_scene",
     # elastic objects
     "Material", "Mesh", "generate_mesh", "ElasticObject", "ReducedStiffness",
     "reduced_stiffness",
     # squeezes
-    "Squeeze", "plan_squeeze", "Limits", "SolveOptions", "EventSqueeze", "Event", "ContactState",
+    "Squeeze", "plan_squeeze", "TerminationLimits", "SolveOptions", "EventSqueeze", "Event",
+    "ContactState",
     "event_squeeze", "GraspMap", "grasp_map",
     # resistance, rings, calibration
     "resistance_grasp", "optimal_resistance", "FrictionalResistance", "frictional_resistance",

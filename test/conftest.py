@@ -21,6 +21,16 @@ from squeeze_grasp_ros.threads import single_thread_blas
 
 single_thread_blas()  # as the installed executables do, before any test imports numpy
 
+try:  # hypothesis is a test dependency, but conftest must load without it (colcon test)
+    from hypothesis import settings
+except ImportError:
+    pass
+else:
+    # No per-example deadline: on a shared machine an example's wall time says nothing about
+    # the code (a 0.6 ms example took 289 ms under load and failed as "Unreliable timings").
+    settings.register_profile("squeeze_grasp_ros", deadline=None)
+    settings.load_profile("squeeze_grasp_ros")
+
 if TYPE_CHECKING:
     from rclpy.context import Context
 

@@ -349,7 +349,7 @@ def test_the_executor_goal_example_is_the_foam_squares_plan():
     foam square, to its printed precision.
     """
     from squeeze_grasp_ros.api import load_scene, scene_file
-    from squeeze_grasp_ros.scene_plan import plan_scene
+    from squeeze_grasp_ros.scene.goal import plan_scene
 
     page = REPO / "docs" / "pipeline.md"
     block = next(b for b in blocks(page) if b.language == "bash"

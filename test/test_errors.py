@@ -18,7 +18,7 @@ from squeeze_grasp_ros.mechanics.squeeze import contact_model
 from squeeze_grasp_ros.mechanics.elastic.compliance import ElasticObject
 from squeeze_grasp_ros.planning import ErrorCode, PlannerError, classify
 from squeeze_grasp_ros.scene import build_mesh, finger_nodes, load_scene, scene_material
-from squeeze_grasp_ros.scene_events import event_squeeze_scene
+from squeeze_grasp_ros.scene import event_squeeze_scene
 
 REPO = Path(__file__).resolve().parents[1]
 MECHANICS = REPO / "squeeze_grasp_ros" / "mechanics"

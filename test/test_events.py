@@ -25,6 +25,7 @@ from squeeze_grasp_ros.mechanics.elastic.mesh import (
 from squeeze_grasp_ros.mechanics.squeeze.oneshot import one_shot_solve
 from squeeze_grasp_ros.mechanics.squeeze.stable_pure import plan_squeeze
 from squeeze_grasp_ros.mechanics.squeeze.events import event_squeeze
+from squeeze_grasp_ros.mechanics.vocabulary import EventType
 from squeeze_grasp_ros.mechanics.squeeze.stepper import advance
 
 FOAM = Material(5e4, 0.3, 0.0254)
@@ -150,9 +151,9 @@ def test_invariants_hold_at_every_event(mu):
     dirs = squeeze_directions(obj, contacts)
     states = walk(model, start(obj, contacts), dirs, 0.0085)
     events = [e for r, _ in states for e in r.events]
-    assert len(events) >= 12 and {e.type for e in events} >= {"A"}
+    assert len(events) >= 12 and {e.type for e in events} >= {EventType.A}
     if mu < 0.1:
-        assert {"C", "D"} <= {e.type for e in events}
+        assert {EventType.C, EventType.D} <= {e.type for e in events}
     for _, state in states:
         check_state(model, state)
     sizes = {f: len(states[-1][1].segment(f)) for f in ("F1", "F2")}

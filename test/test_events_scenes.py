@@ -14,21 +14,19 @@ import pytest
 import yaml
 
 from squeeze_grasp_ros import cli
-from squeeze_grasp_ros.commands.common import load_solid
-from squeeze_grasp_ros.mechanics.squeeze.contact_model import Limits
+from squeeze_grasp_ros.mechanics.squeeze.contact_model import TerminationLimits
 from squeeze_grasp_ros.mechanics.elastic.fem import element_strains, principal_strains
 from squeeze_grasp_ros.mechanics.squeeze.events import event_squeeze
 from squeeze_grasp_ros.scene import SceneError, parse_scene
-from squeeze_grasp_ros.scene_events import event_squeeze_scene
+from squeeze_grasp_ros.scene import GraspSetup, event_squeeze_scene, load_scene
 
 SCENES = Path(__file__).resolve().parents[1] / "config" / "scenes"
 
 
 @functools.lru_cache(maxsize=None)
 def scene_run(name: str):
-    loaded = load_solid(str(SCENES / f"{name}.yaml"))
-    loaded.obj.precompute()
-    return loaded, event_squeeze_scene(loaded.scene, loaded.obj, loaded.contacts)
+    setup = GraspSetup.build(load_scene(SCENES / f"{name}.yaml")).precompute()
+    return setup, setup.event_squeeze()
 
 
 def test_foam_square_runs_out_of_the_box():
@@ -70,7 +68,7 @@ def test_strain_limit_scene_stops_at_the_proportional_limit():
     assert res.termination == "strain_limit"
     assert res.depth < res.target_depth
     # independent: principal strains of the final displacement field from the FEM module
-    eps = np.abs(principal_strains(element_strains(loaded.obj.mesh, res.displacement))).max()
+    eps = np.abs(principal_strains(element_strains(loaded.solid.mesh, res.displacement))).max()
     assert eps == pytest.approx(eps_star, rel=1e-6)
     assert res.health.max_strain == pytest.approx(eps_star, rel=1e-6)
 
@@ -78,10 +76,10 @@ def test_strain_limit_scene_stops_at_the_proportional_limit():
 def test_componentwise_strain_criterion_allows_at_least_as_deep_a_squeeze():
     loaded, res = scene_run("foam_square_strain_limit")
     eps_star = loaded.scene.strain_limit.epsilon
-    literal = event_squeeze(loaded.obj, loaded.contacts, 0.02, 0.4, relative_depth=0.12,
-                            limits=Limits(eps_star, "componentwise"))
+    literal = event_squeeze(loaded.solid, loaded.contacts, 0.02, 0.4, relative_depth=0.12,
+                            limits=TerminationLimits(eps_star, "componentwise"))
     assert literal.depth >= res.depth
-    eps = element_strains(loaded.obj.mesh, literal.displacement)
+    eps = element_strains(loaded.solid.mesh, literal.displacement)
     if literal.termination == "strain_limit":
         assert np.abs(eps[:, :2]).max() == pytest.approx(eps_star, rel=1e-6)
     else:

@@ -10,10 +10,9 @@ import numpy as np
 import pytest
 
 from squeeze_grasp_ros.bench.events import event_error, foam_square
-from squeeze_grasp_ros.commands.common import load_solid
 from squeeze_grasp_ros.mechanics.squeeze.oneshot import one_shot_solve
 from squeeze_grasp_ros.mechanics.squeeze.events import event_squeeze
-from squeeze_grasp_ros.scene_events import event_squeeze_scene
+from squeeze_grasp_ros.scene import GraspSetup, load_scene
 
 SCENES = Path(__file__).resolve().parents[1] / "config" / "scenes"
 pytestmark = pytest.mark.slow
@@ -43,10 +42,9 @@ def test_literal_fixed_step_route_converges_to_the_located_events():
     ],
 )
 def test_one_shot_invariant_on_every_event_scene(name):
-    loaded = load_solid(str(SCENES / f"{name}.yaml"))
-    loaded.obj.precompute()
-    res = event_squeeze_scene(loaded.scene, loaded.obj, loaded.contacts)
-    shot = one_shot_solve(loaded.obj, res.state, res.mu)
+    setup = GraspSetup.build(load_scene(SCENES / f"{name}.yaml")).precompute()
+    res = setup.event_squeeze()
+    shot = one_shot_solve(setup.solid, res.state, res.mu)
     F = np.array([c.force for c in res.state.contacts])
     assert np.abs(shot.forces - F).max() < 1e-8 * np.abs(F).max()
     assert (

@@ -34,7 +34,7 @@ from squeeze_grasp_ros.mechanics.resistance.optimal import (
 )
 from squeeze_grasp_ros.mechanics.ring.model import ring_from_outline
 from squeeze_grasp_ros.scene import parse_scene, scene_solid
-from squeeze_grasp_ros.scene_events import event_squeeze_scene
+from squeeze_grasp_ros.scene import event_squeeze_scene
 
 SCENES = Path(__file__).resolve().parents[1] / "config" / "scenes"
 FOAM = str(SCENES / "foam_square.yaml")

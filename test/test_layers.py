@@ -7,8 +7,8 @@ The layers, lowest first, are the ones docs/design.md draws:
 - base: ``inputs``, ``exit_codes``, ``extras``, ``resources``, ``threads``: no package imports;
 - ``mechanics``: the ROS-free core, inside it ``vocabulary``/``errors`` < ``elastic`` <
   ``squeeze`` < ``resistance``, ``ring``; ``calibration`` stands alone;
-- application: ``scene``, ``scene_events``, ``planning``, ``control``, ``sim``, ``plots``,
-  ``outputs``, ``sweep``, ``perception`` and the front door ``api``;
+- application: ``scene``, ``planning``, ``control``, ``sim``, ``plots``, ``outputs``,
+  ``sweep``, ``perception`` and the front door ``api``;
 - ``ros``: the only folder that imports rclpy, ROS messages or the interfaces;
 - front ends: ``commands``, ``bench``, ``cli``, ``entry``.
 
@@ -31,8 +31,7 @@ ROS_MODULES = ("rclpy", "rosidl", "rcl_interfaces", "builtin_interfaces", "std_m
 LAYERS: tuple[tuple[str, ...], ...] = (
     ("inputs", "exit_codes", "extras", "resources", "threads"),
     ("mechanics",),
-    ("scene", "scene_events", "scene_plan", "planning", "control", "sim", "plots", "outputs",
-     "sweep", "perception", "api"),
+    ("scene", "planning", "control", "sim", "plots", "outputs", "sweep", "perception", "api"),
     ("ros",),
     ("commands", "bench", "cli", "entry"),
 )
@@ -206,3 +205,86 @@ def test_the_design_diagram_matches_the_layers():
         for b, rank_b in MECHANICS_ORDER.items():
             if rank_a > rank_b and not {a, b} & {"calibration"}:
                 assert parts[a] < parts[b], f"{a} must be drawn above {b}"
+
+
+SCENE_BUILDERS = frozenset({"build_mesh", "build_ring", "finger_nodes", "placement_node",
+                            "placement_points", "scene_material", "scene_solid"})
+"""The builders of ``scene/build.py``: a scene's mesh, material, ring, finger nodes (an outline
+is geometry, not mechanics: sweeps read outline files on their client with ``build_outline``,
+and the planner estimates sizes with ``requested_nodes`` before building anything)."""
+MECHANICS_BUILDERS = frozenset({"ElasticObject", "RingModel", "Material", "generate_mesh",
+                                "ring_from_outline", "contact_model", "ContactModel",
+                                "NonlinearContactModel", "event_squeeze", "finger_motion",
+                                "place_fingertip"})
+"""Constructors of the mechanics a scene becomes: object, material, mesh, ring, contact model,
+finger motion, fingertips, the event-driven squeeze."""
+API = f"{NAME}.api"
+"""The front door re-exports the builders for users; it builds nothing itself."""
+
+
+def scene_users() -> dict[str, ast.Module]:
+    """Modules outside ``scene/`` and ``mechanics/`` that import from the scene package."""
+    users = {}
+    for path in PACKAGE.rglob("*.py"):
+        name = module_name(path)
+        if top(name) in ("scene", "mechanics") or name == API:
+            continue
+        if any(t == f"{NAME}.scene" or t.startswith(f"{NAME}.scene.") for t in GRAPH[name]):
+            users[name] = ast.parse(path.read_text(encoding="utf-8"))
+    return users
+
+
+def test_only_the_scene_package_builds_mechanics_from_a_scene():
+    """A scene becomes mechanics in one place (``scene.setup.GraspSetup``): no module outside
+    ``scene/`` imports the scene builders, and no module that reads scenes calls a mechanics
+    constructor itself (it asks its GraspSetup). Benchmarks that build objects from outlines
+    of their own, without a scene, are not concerned.
+    """
+    users = scene_users()
+    assert {f"{NAME}.planning.objects", f"{NAME}.sim.world", f"{NAME}.sweep.evaluate",
+            f"{NAME}.commands.squeeze", f"{NAME}.bench.pipeline"} <= set(users), sorted(users)
+    offenders = []
+    for name, tree in users.items():
+        for node in ast.walk(tree):
+            if isinstance(node, ast.ImportFrom) and (node.module or "").startswith(
+                    f"{NAME}.scene"):
+                offenders += [f"{name} imports {a.name}" for a in node.names
+                              if a.name in SCENE_BUILDERS or node.module.endswith(".build")]
+            if isinstance(node, ast.Call) and isinstance(node.func, ast.Name):
+                if node.func.id in MECHANICS_BUILDERS:
+                    offenders.append(f"{name}:{node.lineno} calls {node.func.id}")
+    assert not offenders, "mechanics built from a scene outside scene/:\n" + "\n".join(
+        sorted(offenders))
+
+
+def test_the_scene_builders_are_found_by_the_check():
+    """The check above is not vacuous: it sees the builders where they are allowed."""
+    tree = ast.parse((PACKAGE / "scene" / "setup.py").read_text(encoding="utf-8"))
+    imported = {a.name for n in ast.walk(tree) if isinstance(n, ast.ImportFrom)
+                for a in n.names}
+    called = {n.func.id for n in ast.walk(tree) if isinstance(n, ast.Call)
+              and isinstance(n.func, ast.Name)}
+    assert {"build_mesh", "finger_nodes"} <= imported and "ElasticObject" in called
+
+
+def test_the_scene_package_sits_below_the_other_application_parts():
+    """``scene/`` imports only the base, ``mechanics`` and ``control`` (the executor's goal):
+    planning, the simulated world, sweeps and every front end build on it, never the reverse.
+    """
+    allowed = {"inputs", "exit_codes", "extras", "resources", "threads", "mechanics", "scene",
+               "control"}
+    bad = sorted(f"{m} -> {t}" for m in GRAPH if top(m) == "scene"
+                 for t in internal(GRAPH[m]) if t != NAME and top(t) not in allowed)
+    assert not bad, "\n".join(bad)
+
+
+def test_no_verb_imports_another_verb():
+    """Verbs share helpers (``commands/common.py``, ``commands/ring_map.py``, ...) and the
+    application layer, never each other (``graspmap`` used to import ``ring``).
+    """
+    from squeeze_grasp_ros.commands import VERBS
+
+    verbs = {f"{NAME}.commands.{v}" for v in VERBS}
+    bad = sorted(f"{m} -> {t}" for m in verbs for t in GRAPH[m] if t in verbs - {m})
+    assert not bad, "\n".join(bad)
+    assert f"{NAME}.commands.ring_map" in GRAPH[f"{NAME}.commands.graspmap"]

@@ -22,7 +22,7 @@ from squeeze_grasp_ros.ros.recording.bag import read_bag
 from squeeze_grasp_ros.ros.recording.replay import replay
 from squeeze_grasp_ros.ros.recording.schema import own_text
 from squeeze_grasp_ros.scene import build_mesh, finger_nodes, load_scene, scene_material
-from squeeze_grasp_ros.scene_events import event_squeeze_scene
+from squeeze_grasp_ros.scene import event_squeeze_scene
 
 from pipeline_support import (
     EVENT_TOLERANCE_TICKS,
@@ -85,7 +85,7 @@ def assert_ground_truth_is_the_mechanics(run: dict, path: str) -> None:
     )
     truth = run["events"]
     assert [(e["type"], e["node"], e["finger"]) for e in truth] == [
-        (e.type, e.node, e.finger) for e in api.events
+        (e.type.value, e.node, e.finger) for e in api.events
     ]
     assert all(abs(e["depth"] - a.depth) <= tol for e, a in zip(truth, api.events))
     expected = api.termination
@@ -358,7 +358,7 @@ def test_resistance_ground_truth_equals_algorithm_2():
     run = PipelineRunner(RunOptions(path, planner=False)).run()
     assert run["termination"] == "resisted"
     assert [(e["type"], e["node"], e["finger"]) for e in run["events"]] == [
-        (e.type, e.node, e.finger) for e in squeeze.events + plan.events
+        (e.type.value, e.node, e.finger) for e in squeeze.events + plan.events
     ]
     assert (run["world_termination"], plan.reason) == ("finger_slip", "F2 slips")
     for finger in ("F1", "F2", "A"):

@@ -55,7 +55,7 @@ from squeeze_grasp_ros.mechanics.squeeze.stable_pure import plan_squeeze
 from squeeze_grasp_ros.ros.nodes.planner import PARAMETERS
 from squeeze_grasp_ros.planning import ErrorCode
 from squeeze_grasp_ros.scene import build_ring, finger_nodes, placement_node
-from squeeze_grasp_ros.scene_events import event_squeeze_scene
+from squeeze_grasp_ros.scene import event_squeeze_scene
 from squeeze_grasp_ros.mechanics.vocabulary import MaterialModel
 
 REPO = Path(__file__).resolve().parents[1]
@@ -259,7 +259,7 @@ def test_frictional_resistance_equals_the_mechanics(planner: Harness) -> None:
         expected.travelled,
     )
     assert [(e.type, e.node, e.finger) for e in response.events] == [
-        (e.type, e.node, e.finger) for e in expected.events
+        (e.type.value, e.node, e.finger) for e in expected.events
     ]
     assert [(n.finger, n.node, n.polar_angle) for n in response.nodes] == [
         (f, c.node, c.theta) for f in ("F1", "F2", "A") for c in expected.state.segment(f)
@@ -304,7 +304,7 @@ def test_ring_grasp_test_equals_the_mechanics(planner: Harness, kind: str) -> No
     assert (response.max_depth, response.max_relative_depth, response.limit) == (
         grasp.max_depth,
         grasp.max_relative_depth,
-        grasp.limit,
+        grasp.limit.value,
     )
     assert (response.depth, response.feasible) == (depth, grasp.feasible_at(depth))
     assert np.array_equal(flat(response.forces), grasp.forces_at(depth).reshape(-1))
@@ -337,7 +337,7 @@ def test_event_squeeze_service_and_action_equal_the_mechanics(planner: Harness) 
             expected.energy,
         )
         assert [(e.type, e.node, e.finger, e.depth) for e in data.events] == [
-            (e.type, e.node, e.finger, e.depth) for e in expected.events
+            (e.type.value, e.node, e.finger, e.depth) for e in expected.events
         ]
         final = data.final_state
         assert list(

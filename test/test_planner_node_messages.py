@@ -86,7 +86,7 @@ def test_grasp_map_data_best_and_matrices() -> None:
 
 
 def test_object_cache_evicts_the_least_recently_used() -> None:
-    limits = planning.Limits()
+    limits = planning.PlannerLimits()
     source = planning.read_scene(BLOB, "")
     cache = planning.ObjectCache(2)
     for object_id in ("a", "b"):
@@ -105,7 +105,7 @@ def test_object_cache_is_bounded_by_memory() -> None:
     """The cache counts the arrays an object holds (its boundary compliance, stiffness and
     factorisation dominate) and evicts by bytes; one object larger than the bound is refused.
     """
-    limits = planning.Limits()
+    limits = planning.PlannerLimits()
     source = planning.read_scene(BLOB, "")
     loaded = planning.load_object(source, planning.object_key(source, "a", "", limits), limits)
     body = loaded.body
@@ -135,7 +135,7 @@ def rss():
     return int(open("/proc/self/statm").read().split()[1]) * os.sysconf("SC_PAGE_SIZE")
 
 source = planning.read_scene(scene_text(10000), "")
-limits = planning.Limits()
+limits = planning.PlannerLimits()
 key = planning.object_key(source, "probe", "", limits)
 before = rss()
 loaded = planning.load_object(source, key, limits)
@@ -179,7 +179,7 @@ def test_progress_can_cancel_a_load() -> None:
             raise planning.Cancelled()
 
     source = planning.read_scene(BLOB, "")
-    limits = planning.Limits()
+    limits = planning.PlannerLimits()
     with pytest.raises(planning.Cancelled):
         planning.load_object(source, planning.object_key(source, "", "", limits), limits,
                              progress)

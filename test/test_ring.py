@@ -9,6 +9,7 @@ from functools import cache
 import numpy as np
 import pytest
 
+from squeeze_grasp_ros.mechanics.vocabulary import RingLimit
 from squeeze_grasp_ros.mechanics.elastic import shapes
 from squeeze_grasp_ros.mechanics.elastic.compliance import node_dofs
 from squeeze_grasp_ros.mechanics.errors import InvalidInputError
@@ -216,7 +217,7 @@ def _cone_angle_violated(g, depth):
 def test_cone_depth_equals_brute_force_scan():
     ring = make_ring(elements=120)
     g = ring_grasp(ring, (25, 85), 0.24)
-    assert g.limit.startswith("friction_cone")
+    assert g.limit in (RingLimit.FRICTION_CONE_F1, RingLimit.FRICTION_CONE_F2)
     finger = LIMITS.index(g.limit)
     assert not any(_cone_angle_violated(g, 0.0))
     depths = np.linspace(0, g.depth_cap, 2001)
@@ -232,7 +233,7 @@ def test_cone_depth_equals_brute_force_scan():
 def test_strain_depth_is_where_strain_reaches_epsilon():
     ring = make_ring("disk", 120)
     g = ring_grasp(ring, (0, 60), 0.3, epsilon=0.004)
-    assert g.limit == "strain"
+    assert g.limit is RingLimit.STRAIN
     assert g.max_strain_at(g.max_depth) == pytest.approx(0.004, rel=1e-12)
     F = np.zeros((ring.n, 2))
     F[[0, 60]] = g.forces_at(g.max_depth)
@@ -257,7 +258,7 @@ def test_fig14_cones_rotating_away_break_a_force_closure_grasp():
     assert np.all(_angles(probe, 0.05 * probe.depth_cap) > psi0)
     mu = np.tan(np.radians(psi0.max() + 1.0))
     g = ring_grasp(ring, pair, mu)
-    assert g.limit in ("friction_cone_F1", "friction_cone_F2")
+    assert g.limit in (RingLimit.FRICTION_CONE_F1, RingLimit.FRICTION_CONE_F2)
     assert 0 < g.max_relative_depth < 0.5
     gmap = ring_grasp_map(ring, mu)
     k = gmap.lookup(*pair)
@@ -273,7 +274,7 @@ def test_fig15_cones_rotating_toward_each_other_strengthen_the_grasp():
     assert np.all(_angles(probe, depth) < psi0)
     mu = np.tan(np.radians(psi0.max() + 0.2))
     g = ring_grasp(ring, pair, mu, epsilon=0.03)
-    assert g.limit in ("strain", "none")
+    assert g.limit in (RingLimit.STRAIN, RingLimit.NONE)
     assert np.all(g.cone_depths >= g.max_depth)
     worst = g.cone_margins_at(0.0).min(axis=1)
     assert np.all(g.cone_margins_at(g.max_depth).min(axis=1) > worst)
@@ -347,7 +348,7 @@ def test_cli_single_placement_and_map(tmp_path, capsys):
     g = ring_grasp(ring, contacts, 0.5, epsilon=0.03)
     assert out["contacts"] == list(contacts)
     assert out["max_depth"] == pytest.approx(g.max_depth)
-    assert out["limit"] == g.limit
+    assert out["limit"] == g.limit.value
     assert out["feasible_at_requested_depth"] == (out["relative_depth"] <= g.max_relative_depth)
     assert out["relative_depth"] == pytest.approx(0.05)
     assert set(out["forces"]) == {"F1", "F2"} and out["max_strain"] > 0

@@ -56,7 +56,7 @@ def mutate(path: str, value):
     ("squeeze.depth", 0.01, "exclusive"),
     ("squeeze.type", "gentle", "squeeze.type must be one of"),
     ("friction", KeyError, "effect 'friction' is declared but section friction is missing"),
-    ("effects", ["friction", "levitation"], "unknown effect 'levitation'"),
+    ("effects", ["friction", "levitation"], r"effects\[1\] must be one of .* got 'levitation'"),
     ("strain_limit", {"epsilon": 0.1}, "section strain_limit is given but effect"),
     ("object.material.E", "soft", "object.material.E must be a number"),
     ("object.material", KeyError, "missing required key object.material"),

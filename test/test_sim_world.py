@@ -18,11 +18,11 @@ from squeeze_grasp_ros.control.tracker import ContactTracker, FingerSample, Trac
 from squeeze_grasp_ros.mechanics.squeeze.contact_state import initial_state
 from squeeze_grasp_ros.mechanics.squeeze.fingertips import place_fingertip
 from squeeze_grasp_ros.mechanics.squeeze.stepper import advance
-from squeeze_grasp_ros.scene import SceneError, parse_scene
+from squeeze_grasp_ros.scene import GraspSetup, SceneError, parse_scene
 from squeeze_grasp_ros.sim.devices import device_model, follow
 from squeeze_grasp_ros.sim.sensors import (SensorRandomness, fingertip_wrench, render_tactile,
                                            tactile_layout, taxel_weights)
-from squeeze_grasp_ros.sim.world import SimWorld, squeeze_geometry
+from squeeze_grasp_ros.sim.world import SimWorld
 
 from pipeline_support import (EVENT_TOLERANCE_TICKS, SMALL_SQUARE, contact_modes, match_within,
                               net_events, scene_data)
@@ -44,7 +44,7 @@ def world_run():
 
 def closed_loop(scene, tracker_config: TrackerConfig | None = None, limits=MotionLimits()):
     """Run the ROS-free loop world -> tracker -> program -> world until the goal ends."""
-    world = SimWorld(scene)
+    world = SimWorld(GraspSetup.build(scene))
     depth = scene.squeeze.relative_depth / world.relative_per_depth
     goal = GraspGoal(("F1", "F2"), np.array([world.directions["F1"], world.directions["F2"]]),
                      depth, world.relative_per_depth)
@@ -175,23 +175,23 @@ def test_an_undeclared_effect_costs_nothing():
     """Counted work, not time: every effect's counter is zero unless the scene declares it."""
     everything = {"friction", "force_sensing", "tactile_sensing", "sensor_noise",
                   "sensor_dropout", "actuator_lag", "strain_limit"}
-    full = drive(SimWorld(effect_scene(everything)))
+    full = drive(SimWorld(GraspSetup.build(effect_scene(everything))))
     assert all(full[c] > 0 for c in EFFECT_COUNTERS.values()), full
     for effect, counter in EFFECT_COUNTERS.items():
         kept = everything - {effect}
         if effect in ("force_sensing", "tactile_sensing"):
             kept -= {"sensor_noise", "sensor_dropout"} if not (kept & {"force_sensing",
                                                                      "tactile_sensing"}) else set()
-        world = SimWorld(effect_scene(kept))
+        world = SimWorld(GraspSetup.build(effect_scene(kept)))
         work = drive(world)
         print(f"without {effect}: {dict(work)}")
         assert work[counter] == 0, (effect, work)
-    bare = SimWorld(effect_scene({"friction"}))
+    bare = SimWorld(GraspSetup.build(effect_scene({"friction"})))
     work = drive(bare)
     assert set(work) <= {"stepper_calls"}, work
     assert bare.model.limits.strain is None and bare.model.limits.weight is None
     assert bare.layouts == {} and bare.randomness.noise_std is None
-    frictionless = SimWorld(effect_scene(set()))
+    frictionless = SimWorld(GraspSetup.build(effect_scene(set())))
     assert frictionless.model.mu == 0.0
 
 
@@ -222,8 +222,10 @@ def test_world_is_a_loop_over_the_stepper(world_run):
     tips = [place_fingertip(world.obj.mesh, f, n, 0.02) for f, n in zip(("F1", "F2"),
                                                                          world.contacts)]
     state = initial_state(tips, world.relative_per_depth)
-    _, rpd = squeeze_geometry(scene, world.obj, world.contacts)
-    assert rpd == world.relative_per_depth
+    p = world.obj.mesh.nodes[list(world.contacts)]
+    assert scene.squeeze.type == "stable"  # each finger moves rho/sqrt(2) toward the other
+    assert world.relative_per_depth == pytest.approx(np.sqrt(2) / np.linalg.norm(p[1] - p[0]),
+                                                     rel=1e-12)
     outputs = world_run["outputs"]
     positions = [{r.finger: r.position for r in out.readings} for out in outputs]
     for before, after, out in zip(positions, positions[1:], outputs[1:]):
@@ -243,7 +245,7 @@ def test_world_is_a_loop_over_the_stepper(world_run):
 def test_tracker_events_match_the_ground_truth_within_tolerance(world_run):
     states = [contact_modes(out.state) for out in world_run["outputs"]]
     truth = net_events(states)
-    seen = [(k, e.type, e.finger) for k, obs in enumerate(world_run["observed"])
+    seen = [(k, str(e.type), e.finger) for k, obs in enumerate(world_run["observed"])
             for e in obs.events]
     print(f"tolerance: type and finger exact, tick within {EVENT_TOLERANCE_TICKS} ticks; "
           f"ground truth {len(truth)} net events, monitor {len(seen)}")
@@ -309,6 +311,6 @@ def test_scene_yaml_round_trip_of_pipeline_sections(tmp_path):
     data["effects"] = data["effects"] + ["sensor_noise", "actuator_lag"]
     path.write_text(yaml.safe_dump(data))
     scene = parse_scene(yaml.safe_load(path.read_text()))
-    world = SimWorld(scene)
+    world = SimWorld(GraspSetup.build(scene))
     assert world.dt_ns == 2_000_000 and len(world.layouts["F1"].angles) == 48
     assert world.devices["F1"].time_constant == 0.004

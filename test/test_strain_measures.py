@@ -23,7 +23,7 @@ from squeeze_grasp_ros.mechanics.elastic.material import Material
 from squeeze_grasp_ros.mechanics.elastic.strain_measures import principal_strains
 from squeeze_grasp_ros.mechanics.elastic.stress_measures import element_stresses, von_mises
 from squeeze_grasp_ros.mechanics.vocabulary import MaterialModel, StrainMeasure, StressMeasure
-from squeeze_grasp_ros.scene_events import event_squeeze_scene
+from squeeze_grasp_ros.scene import event_squeeze_scene
 
 E, NU = 5e4, 0.3
 X = np.array([[0.0, 0.0], [0.02, 0.0], [0.005, 0.015]])

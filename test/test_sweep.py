@@ -220,7 +220,8 @@ def test_failing_evaluation_is_a_row_not_a_crash(tmp_path):
         tmp_path,
     )
     rows = run_task(plan_tasks(loaded)[0])["rows"]
-    assert rows and all("puts A on F1's or F2's node" in r["error"] for r in rows)
+    assert rows and all(r["error"].startswith("SceneError: adversary.position 1e-06 is on the "
+                                              "same boundary node as F1 or F2") for r in rows)
     assert all(r["termination"] is None and r["stiffness"] > 0 for r in rows)
     loaded = parse_sweep_spec(
         {**SMALL, "objects": SMALL["objects"][:1], "friction": [0.3]}, tmp_path
@@ -232,7 +233,7 @@ def test_failing_evaluation_is_a_row_not_a_crash(tmp_path):
 
 def test_rows_match_the_event_squeeze_and_grasp_map(tmp_path):
     """A row is the event engine's own result for that placement (cross-check in one process)."""
-    from squeeze_grasp_ros.mechanics.squeeze.contact_model import Limits
+    from squeeze_grasp_ros.mechanics.squeeze.contact_model import TerminationLimits
     from squeeze_grasp_ros.mechanics.squeeze.events import event_squeeze
     from squeeze_grasp_ros.sweep.evaluate import prepare
 
@@ -241,18 +242,18 @@ def test_rows_match_the_event_squeeze_and_grasp_map(tmp_path):
     row = run_task(task)["rows"][-1]
     group = prepare(task)
     res = event_squeeze(
-        group.obj,
+        group.setup.solid,
         (row["node_F1"], row["node_F2"]),
         0.01,
         row["mu"],
         relative_depth=0.04,
-        limits=Limits(weight=0.3),
+        limits=TerminationLimits(weight=0.3),
     )
     assert row["termination"] == res.termination and row["depth"] == res.depth
     assert row["energy"] == res.energy and row["work_F1"] == res.work["F1"]
     assert row["events_A"] == res.event_counts["A"]
     assert row["picked_up"] == (res.termination == "picked_up")
-    b = list(group.obj.mesh.boundary)
+    b = list(group.setup.solid.mesh.boundary)
     assert (
         row["stiffness"] == group.gmap.stiffness[b.index(row["node_F1"]), b.index(row["node_F2"])]
     )
@@ -280,7 +281,7 @@ def test_a_sweep_over_material_models_runs_each_and_names_its_measures(tmp_path)
                         ("nh", "neo_hookean", "log", "cauchy")}
     task = next(t for t in plan_tasks(parse_sweep_spec(spec, tmp_path)) if "~nh~" in t.id)
     row = next(r for r in rows if r["task_id"] == task.id)
-    res = event_squeeze(prepare(task).obj, (row["node_F1"], row["node_F2"]), 0.01, 0.8,
+    res = event_squeeze(prepare(task).setup.solid, (row["node_F1"], row["node_F2"]), 0.01, 0.8,
                         relative_depth=0.04, material_model="neo_hookean")
     h = res.health
     assert (row["max_strain"], row["max_von_mises"], row["energy"]) == (
@@ -539,7 +540,7 @@ def test_a_task_that_fails_as_a_whole_exits_1_and_is_the_only_one_retried(tmp_pa
     assert manifest["counts"] == {"done": 4, "failed": 1, "pending": 0}
     assert manifest["tasks"][bad[0]]["status"] == "failed"
     error = manifest["tasks"][bad[0]]["error"]
-    assert error.startswith("InvalidInputError: mesh.max_area 1e-10 m^2 would give about")
+    assert error.startswith("SceneError: object.mesh: mesh.max_area 1e-10 m^2 would give about")
     parts = out / "parts"
     assert sorted(p.stem for p in parts.glob("*.parquet")) == good
     clean = parse_sweep_spec({**data, "objects": SMALL["objects"]}, tmp_path)
@@ -808,3 +809,59 @@ def test_a_failed_task_is_recorded_and_redone(tmp_path):
     again.write(tasks[0], res["rows"], res["outline"])
     manifest = json.loads((tmp_path / "o" / "manifest.json").read_text())
     assert manifest["tasks"][tasks[0].id]["status"] == "done"
+
+
+# ----------------------------------------------------------------- the material model
+
+
+FOAM = {"E": 5.0e4, "nu": 0.3, "thickness": 0.0254}
+
+
+def test_a_sweep_computes_the_material_model_of_its_spec(tmp_path):
+    """Issue 34 item 1, its reproduction: the foam square on 400 nodes, one grasp-map placement,
+    mu 0.8, tip 0.02 m, 12 %, two materials equal but for ``model``. The rows differ, each
+    records its model, and each equals the mechanics' own event-driven squeeze of that model on
+    an independently built mesh.
+    """
+    from squeeze_grasp_ros.mechanics.elastic.compliance import ElasticObject
+    from squeeze_grasp_ros.mechanics.elastic.material import Material
+    from squeeze_grasp_ros.mechanics.elastic.mesh import generate_mesh, target_max_area
+    from squeeze_grasp_ros.mechanics.elastic.shapes import rectangle
+    from squeeze_grasp_ros.mechanics.squeeze.events import event_squeeze
+
+    loaded = parse_sweep_spec({
+        "base": BASE, "mesh": {"nodes": 400}, "friction": [0.8], "tip_radius": [0.02],
+        "relative_depth": [0.12], "placements": {"mode": "graspmap", "count": 1},
+        "materials": {"lin": FOAM, "nh": {**FOAM, "model": "neo_hookean"}},
+    }, tmp_path)
+    rows = {r["material_id"]: r for t in plan_tasks(loaded) for r in run_task(t)["rows"]}
+    lin, nh = rows["lin"], rows["nh"]
+    assert lin["error"] is None and nh["error"] is None
+    assert (lin["material_model"], nh["material_model"]) == ("linear", "neo_hookean")
+    assert (lin["node_F1"], lin["node_F2"]) == (nh["node_F1"], nh["node_F2"])
+    assert abs(nh["force_F1_end"] / lin["force_F1_end"] - 1) > 1e-3
+    outline = rectangle(0.1, 0.1)
+    obj = ElasticObject(generate_mesh(outline, target_max_area(outline, 400), min_angle=30.0),
+                        Material(**FOAM)).precompute()
+    for row, model in ((lin, "linear"), (nh, "neo_hookean")):
+        res = event_squeeze(obj, (row["node_F1"], row["node_F2"]), 0.02, 0.8,
+                            relative_depth=0.12, material_model=model)
+        assert row["force_F1_end"] == pytest.approx(res.finger_force["F1"][1], rel=1e-9)
+        assert row["energy"] == pytest.approx(res.energy, rel=1e-9)
+        assert row["termination"] == res.termination
+
+
+def test_a_sweep_refuses_what_the_scene_refuses(tmp_path):
+    """``nu: 0.5`` with the neo-Hookean model is refused by the sweep spec as by a scene."""
+    spec = {"base": BASE, "materials": {"nh": {**FOAM, "nu": 0.5, "model": "neo_hookean"}}}
+    with pytest.raises(SweepError, match=r"materials\.nh\.nu must be in \[-0\.3, 0\.4999\] "
+                       r"for the neo_hookean model, got 0\.5"):
+        parse_sweep_spec(spec, tmp_path)
+    scene = yaml.safe_load(Path(BASE).read_text())
+    scene["object"]["material"].update(nu=0.5, model="neo_hookean")
+    from squeeze_grasp_ros.scene import SceneError, parse_scene
+    with pytest.raises(SceneError, match=r"object\.material\.nu must be in \[-0\.3, 0\.4999\] "
+                       r"for the neo_hookean model, got 0\.5"):
+        parse_scene(scene)
+    spec["materials"]["nh"]["model"] = "linear"
+    assert parse_sweep_spec(spec, tmp_path).materials["nh"].nu == 0.5

@@ -107,7 +107,7 @@ def squeeze_rows(
                     obj.mesh.n,
                     len(obj.mesh.boundary),
                     len(res.state.contacts),
-                    "/".join(str(c[k]) for k in "ABCD"),
+                    "/".join(str(n) for n in c.values()),
                     t_pre,
                     t,
                     t_pre + t,

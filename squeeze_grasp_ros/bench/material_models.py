@@ -22,10 +22,9 @@ from squeeze_grasp_ros.mechanics.elastic.interior import (Fill, TangentFactor,
                                                           default_factorizer, factorizer)
 from squeeze_grasp_ros.mechanics.elastic.strain_measures import COMMON_STRAIN_MEASURE
 from squeeze_grasp_ros.mechanics.squeeze.contact_model import SolveOptions
-from squeeze_grasp_ros.mechanics.vocabulary import Factorizer, MaterialModel
+from squeeze_grasp_ros.mechanics.vocabulary import Factorizer, Finger, MaterialModel
 from squeeze_grasp_ros.resources import scene_file
-from squeeze_grasp_ros.scene import finger_nodes, load_scene, scene_solid
-from squeeze_grasp_ros.scene_events import event_squeeze_scene
+from squeeze_grasp_ros.scene import GraspSetup, load_scene
 
 TITLE = "Large deformation: the linear model's error against squeeze depth, and its cost"
 OBJECTS = ("foam_square", "disk", "nonconvex_blob")
@@ -49,37 +48,39 @@ SCALING_TARGETS = (8000, 10.0, 20000, 60.0)
 table, met in the same run as the linear rows."""
 
 
-def _scene(name: str, nodes: int):
+def _setup(name: str, nodes: int) -> GraspSetup:
+    """The shipped scene ``name`` re-meshed to about ``nodes`` nodes, precomputed."""
     scene = load_scene(scene_file(name))
     obj = dataclasses.replace(scene.object, mesh=dataclasses.replace(scene.object.mesh,
                                                                      nodes=nodes))
-    return dataclasses.replace(scene, object=obj)
+    return GraspSetup.build(dataclasses.replace(scene, object=obj)).precompute()
 
 
-def _run(scene, obj, model: MaterialModel, relative_depth: float,
+def _run(setup: GraspSetup, model: MaterialModel, relative_depth: float,
          options: SolveOptions = SolveOptions()):
     """(result, wall time, CPU time of this process) of one squeeze."""
     start, cpu = time.perf_counter(), time.process_time()
-    res = event_squeeze_scene(scene, obj, relative_depth=relative_depth, material_model=model,
+    res = setup.event_squeeze(relative_depth=relative_depth, material_model=model,
                               options=options)
     return res, time.perf_counter() - start, time.process_time() - cpu
 
 
-def _best(scene, obj, model: MaterialModel, repeats: int,
+def _best(setup: GraspSetup, model: MaterialModel, repeats: int,
           options: SolveOptions = SolveOptions()):
     """(result, best wall time, best CPU time) of ``repeats`` 12 % squeezes."""
-    runs = [_run(scene, obj, model, 0.12, options) for _ in range(repeats)]
+    runs = [_run(setup, model, 0.12, options) for _ in range(repeats)]
     return runs[0][0], min(run[1] for run in runs), min(run[2] for run in runs)
 
 
-def _fill(scene, obj) -> Fill:
+def _fill(setup: GraspSetup) -> Fill:
     """nnz(L) and flops of the factor of the undeformed neo-Hookean K_ff of the scene's
     initial contact set, in the default factoriser's order.
     """
-    mesh = obj.mesh
+    solid = setup.solid
+    mesh = solid.mesh
     K = assemble(MaterialModel.NEO_HOOKEAN, mesh.nodes, mesh.triangles,
-                 np.zeros(2 * len(mesh.nodes)), nu=obj.material.nu).tangent
-    held = tuple(sorted(2 * k + c for k in finger_nodes(scene, mesh) for c in (0, 1)))
+                 np.zeros(2 * len(mesh.nodes)), nu=solid.material.nu).tangent
+    held = tuple(sorted(2 * k + c for k in setup.contacts for c in (0, 1)))
     return TangentFactor().fill(K, held)
 
 
@@ -88,11 +89,11 @@ def _exponent(n: list, y: list) -> float:
     return float(np.polyfit(np.log(n), np.log(y), 1)[0])
 
 
-def _neo_row(scene, obj, linear: tuple, repeats: int) -> tuple[list, float, dict]:
+def _neo_row(setup: GraspSetup, linear: tuple, repeats: int) -> tuple[list, float, dict]:
     """(row from the factoriser on, time, nonlinear diagnostics) of the neo-Hookean squeeze;
     ``linear`` is (wall, CPU) time of the linear one.
     """
-    res, t, cpu = _best(scene, obj, MaterialModel.NEO_HOOKEAN, repeats)
+    res, t, cpu = _best(setup, MaterialModel.NEO_HOOKEAN, repeats)
     nl = res.diagnostics["nonlinear"]
     return ([nl["factorizer"], linear[0], t, t / linear[0], cpu / linear[1], len(res.events),
              nl["evaluations"], nl["evaluations"] / max(len(res.events), 1),
@@ -108,14 +109,12 @@ def _scaling(quick: bool, progress) -> Table:
     sizes = QUICK_SCALING_NODES if quick else SCALING_NODES
     for nodes in sizes:
         progress(f"material_models: scaling, {nodes} nodes")
-        scene = _scene("foam_square", nodes)
-        obj = scene_solid(scene)
-        obj.precompute()
-        _, t_l, cpu_l = _best(scene, obj, MaterialModel.LINEAR, LINEAR_REPEATS)
-        row, t, nl = _neo_row(scene, obj, (t_l, cpu_l),
+        setup = _setup("foam_square", nodes)
+        _, t_l, cpu_l = _best(setup, MaterialModel.LINEAR, LINEAR_REPEATS)
+        row, t, nl = _neo_row(setup, (t_l, cpu_l),
                               NONLINEAR_REPEATS if nodes <= 2000 else 1)
-        fill = _fill(scene, obj)
-        size = len(obj.mesh.nodes)
+        fill = _fill(setup)
+        size = setup.num_nodes
         rows.append([size, *row, fill.nnz, fill.flops / 1e6, 1e3 * t / nl["evaluations"]])
         n.append(size), per_eval.append(t / nl["evaluations"]), nnz.append(fill.nnz)
         flops.append(fill.flops), evals.append(nl["evaluations"]), t_neo.append(t)
@@ -123,7 +122,7 @@ def _scaling(quick: bool, progress) -> Table:
         if method == Factorizer.CHOLMOD and nodes == QDLDL_NODES[quick]:
             progress(f"material_models: scaling, {nodes} nodes with qdldl")
             with factorizer(Factorizer.QDLDL):
-                row, t, nl = _neo_row(scene, obj, (t_l, cpu_l), 1)
+                row, t, nl = _neo_row(setup, (t_l, cpu_l), 1)
             rows.append([size, *row, "-", "-", 1e3 * t / nl["evaluations"]])
     load.append(os.getloadavg()[0])
     growth = ", ".join(f"{name} n^{_exponent(n, y):.2f}" for name, y in (
@@ -193,17 +192,15 @@ def run(quick: bool, out_dir: Path, progress) -> list[Table]:
     nodes = 400 if quick else 1200
     rows, curves = [], {}
     for name in OBJECTS:
-        scene = _scene(name, nodes)
-        obj = scene_solid(scene)
-        obj.precompute()
+        setup = _setup(name, nodes)
         for rel in depths:
             progress(f"material_models: {name} at {100 * rel:g} %")
-            linear = _run(scene, obj, MaterialModel.LINEAR, rel)[0]
+            linear = _run(setup, MaterialModel.LINEAR, rel)[0]
             common = linear.health.max_principal_strain[COMMON_STRAIN_MEASURE]
-            row = [name, 100 * rel, linear.finger_force["F1"][1], common]
+            row = [name, 100 * rel, linear.finger_force[Finger.F1][1], common]
             for model in NONLINEAR:
-                res = _run(scene, obj, model, rel)[0]
-                df = res.finger_force["F1"][1] / linear.finger_force["F1"][1] - 1
+                res = _run(setup, model, rel)[0]
+                df = res.finger_force[Finger.F1][1] / linear.finger_force[Finger.F1][1] - 1
                 de = res.energy / linear.energy - 1
                 ds = res.health.max_principal_strain[COMMON_STRAIN_MEASURE] / common - 1
                 row += [100 * df, 100 * de, 100 * ds, res.termination]
@@ -224,23 +221,21 @@ def run(quick: bool, out_dir: Path, progress) -> list[Table]:
     plots.save(fig, out_dir / png)
     progress("material_models: cost of a 12 % foam-square squeeze")
     cost = []
-    scene = _scene("foam_square", 800 if quick else 2000)
-    obj = scene_solid(scene)
-    obj.precompute()
-    linear, t_lin, _ = _best(scene, obj, MaterialModel.LINEAR, LINEAR_REPEATS)
-    cost.append(["linear", t_lin, 1.0, linear.diagnostics["substeps"],
+    setup = _setup("foam_square", 800 if quick else 2000)
+    linear, t_lin, _ = _best(setup, MaterialModel.LINEAR, LINEAR_REPEATS)
+    cost.append([str(MaterialModel.LINEAR), t_lin, 1.0, linear.diagnostics["substeps"],
                  linear.diagnostics["root_evaluations"], "-", "-", "-",
-                 linear.finger_force["F1"][1]])
+                 linear.finger_force[Finger.F1][1]])
     for model in NONLINEAR:
         for variant, reuse, adapt in VARIANTS:
-            res, t, _ = _best(scene, obj, model, 1 if variant else NONLINEAR_REPEATS,
+            res, t, _ = _best(setup, model, 1 if variant else NONLINEAR_REPEATS,
                               SolveOptions(adaptive_substeps=adapt, reuse_factorizations=reuse))
             nl = res.diagnostics["nonlinear"]
             cost.append([str(model) + variant, t, t / t_lin, res.diagnostics["substeps"],
                          res.diagnostics["root_evaluations"],
                          f"{nl['evaluations']} ({nl['look_ups']})",
                          nl["newton_iterations"] / max(nl["evaluations"], 1),
-                         nl["factorizations"], res.finger_force["F1"][1]])
+                         nl["factorizations"], res.finger_force[Finger.F1][1]])
     return [
         Table(TITLE, ["object", "rel. depth [%]", "linear F1 [N]", f"linear max {label} strain",
                       "corot. dF [%]", "corot. dE [%]", f"corot. d{label} [%]", "corot. end",

@@ -12,6 +12,7 @@ from pathlib import Path
 import numpy as np
 from scipy.spatial.distance import directed_hausdorff
 
+from squeeze_grasp_ros.mechanics.vocabulary import ImageEncoding
 from squeeze_grasp_ros import plots
 from squeeze_grasp_ros.bench.table import Table, best_time
 from squeeze_grasp_ros.mechanics.elastic.shapes import Outline, resample
@@ -20,8 +21,7 @@ from squeeze_grasp_ros.perception.extract import extract_outline
 from squeeze_grasp_ros.perception.render import render_views
 from squeeze_grasp_ros.perception.shape_match import deformed_outline, shape_residual
 from squeeze_grasp_ros.resources import scene_file
-from squeeze_grasp_ros.scene import build_mesh, load_scene, scene_solid
-from squeeze_grasp_ros.scene_events import event_squeeze_scene
+from squeeze_grasp_ros.scene import GraspSetup, load_scene
 
 TITLE = "Outline extraction: time against resolution, accuracy against noise"
 TARGETS_MS = {"mask": 5.0, "depth": 15.0, "match": 5.0}
@@ -74,8 +74,8 @@ def run(quick: bool, out_dir: Path, progress) -> list[Table]:
     scene = load_scene(scene_file("foam_square"))
     thickness = scene.object.material.thickness
     progress("perception: the foam square's 12 % squeeze (the predicted boundary)")
-    predicted = deformed_outline(build_mesh(scene), event_squeeze_scene(
-        scene, scene_solid(scene)).displacement)
+    setup = GraspSetup.build(scene)
+    predicted = deformed_outline(setup.solid.mesh, setup.event_squeeze().displacement)
     pose = _pose()
     load = os.getloadavg()[0]
     time_rows = []
@@ -85,10 +85,11 @@ def run(quick: bool, out_dir: Path, progress) -> list[Table]:
         views = render_views(predicted, camera, pose, top_height=thickness, depth_noise_m=0.001,
                              seed=1)
         def mask():
-            return extract_outline(views.mask, "mono8", camera, pose, object_height_m=thickness)
+            return extract_outline(views.mask, ImageEncoding.MONO8, camera, pose,
+                                   object_height_m=thickness)
 
         def depth():
-            return extract_outline(views.depth, "32FC1", camera, pose)
+            return extract_outline(views.depth, ImageEncoding.DEPTH_32FC1, camera, pose)
 
         seen = mask()
 
@@ -109,9 +110,9 @@ def run(quick: bool, out_dir: Path, progress) -> list[Table]:
             views = render_views(predicted, camera, pose, top_height=thickness,
                                  depth_noise_m=noise, mask_noise=noise / 0.02, blur_px=blur,
                                  seed=2)
-            for image, encoding, options in ((views.mask, "mono8",
+            for image, encoding, options in ((views.mask, ImageEncoding.MONO8,
                                               {"object_height_m": thickness}),
-                                             (views.depth, "32FC1", {})):
+                                             (views.depth, ImageEncoding.DEPTH_32FC1, {})):
                 found = extract_outline(image, encoding, camera, pose, **options)
                 row.append(hausdorff_px(found.outline, predicted, camera, pose, thickness))
                 if blur == 0.0:

@@ -9,47 +9,50 @@ from pathlib import Path
 
 import yaml
 
-from squeeze_grasp_ros.mechanics.elastic.compliance import ElasticObject
 from squeeze_grasp_ros.ros.nodes import pipeline
 from squeeze_grasp_ros.ros.run.options import RunOptions
 from squeeze_grasp_ros.ros.run.runner import PipelineRunner
 from squeeze_grasp_ros.ros.recording.bag import read_bag
 from squeeze_grasp_ros.resources import scene_file
-from squeeze_grasp_ros.scene import build_mesh, finger_nodes, load_scene, scene_material
-from squeeze_grasp_ros.scene_events import event_squeeze_scene
+from squeeze_grasp_ros.scene import GraspSetup, load_scene
 from squeeze_grasp_ros.sim.world import SimWorld
 from squeeze_grasp_ros.bench.table import Table, best_time, timed
-from squeeze_grasp_ros.mechanics.vocabulary import SQUEEZING_FINGERS
+from squeeze_grasp_ros.mechanics.vocabulary import SQUEEZING_FINGERS, Effect
 
 TITLE = "Pipeline on real rclpy nodes: end to end, lockstep rate, recording, effects"
-EFFECT_SCENE = {
-    "name": "effects", "object": {"shape": {"type": "square", "side": 0.1},
-                                  "material": {"E": 5.0e4, "nu": 0.3, "thickness": 0.0254},
-                                  "mesh": {"nodes": 2000, "min_angle": 30}},
-    "fingers": {"F1": {"tip_radius": 0.02, "placement": {"point": [-0.05, 0.0]}},
-                "F2": {"tip_radius": 0.02, "placement": {"point": [0.05, 0.0]}}},
-    "squeeze": {"type": "stable", "relative_depth": 0.12},
-}
-"""The foam square of Sec. 5.5 without effects; each row of the effect table adds some."""
-MU = {"friction": {"mu": 0.4}}
-SENSED = ("friction", "force_sensing", "tactile_sensing")
+EFFECT_SCENE = yaml.safe_load("""
+name: effects
+object:
+  shape: {type: square, side: 0.1}
+  material: {E: 5.0e4, nu: 0.3, thickness: 0.0254}
+  mesh: {nodes: 2000, min_angle: 30}
+fingers:
+  F1: {tip_radius: 0.02, placement: {point: [-0.05, 0.0]}}
+  F2: {tip_radius: 0.02, placement: {point: [0.05, 0.0]}}
+squeeze: {type: stable, relative_depth: 0.12}
+friction: {mu: 0.4}
+""")
+"""The foam square of Sec. 5.5 with friction only; each row of the effect table adds effects."""
+BASE_ROW = f"{Effect.FRICTION} (base)"
+SENSED_ROW = "force + tactile sensing"
+SENSED = (Effect.FRICTION, Effect.FORCE_SENSING, Effect.TACTILE_SENSING)
 EFFECTS = (
-    ("friction (base)", ("friction",), MU, None),
-    ("force_sensing", ("friction", "force_sensing"), MU, "friction (base)"),
-    ("tactile_sensing", ("friction", "tactile_sensing"), MU, "friction (base)"),
-    ("force + tactile sensing", SENSED, MU, "friction (base)"),
-    ("sensor_noise", SENSED + ("sensor_noise",),
-     {**MU, "sensors": {"noise_std": 0.001, "seed": 1}}, "force + tactile sensing"),
-    ("sensor_dropout", SENSED + ("sensor_dropout",),
-     {**MU, "sensors": {"dropout": 0.02, "seed": 1}}, "force + tactile sensing"),
-    ("actuator_lag", ("friction", "actuator_lag"),
-     {**MU, "actuators": {"time_constant": 0.005}}, "friction (base)"),
-    ("strain_limit", ("friction", "strain_limit"),
-     {**MU, "strain_limit": {"epsilon": 0.5}}, "friction (base)"),
-    ("pickup", ("friction", "pickup"), {**MU, "pickup": {"weight": 100.0}}, "friction (base)"),
+    (BASE_ROW, (Effect.FRICTION,), "", None),
+    (str(Effect.FORCE_SENSING), (Effect.FRICTION, Effect.FORCE_SENSING), "", BASE_ROW),
+    (str(Effect.TACTILE_SENSING), (Effect.FRICTION, Effect.TACTILE_SENSING), "", BASE_ROW),
+    (SENSED_ROW, SENSED, "", BASE_ROW),
+    (str(Effect.SENSOR_NOISE), SENSED + (Effect.SENSOR_NOISE,),
+     "sensors: {noise_std: 0.001, seed: 1}", SENSED_ROW),
+    (str(Effect.SENSOR_DROPOUT), SENSED + (Effect.SENSOR_DROPOUT,),
+     "sensors: {dropout: 0.02, seed: 1}", SENSED_ROW),
+    (str(Effect.ACTUATOR_LAG), (Effect.FRICTION, Effect.ACTUATOR_LAG),
+     "actuators: {time_constant: 0.005}", BASE_ROW),
+    (str(Effect.STRAIN_LIMIT), (Effect.FRICTION, Effect.STRAIN_LIMIT),
+     "strain_limit: {epsilon: 0.5}", BASE_ROW),
+    (str(Effect.PICKUP), (Effect.FRICTION, Effect.PICKUP), "pickup: {weight: 100.0}", BASE_ROW),
 )
-"""(row, effects, sections, base row): a strain limit the squeeze never reaches and a weight it
-never lifts, so every run makes the same motion and only the checks cost."""
+"""(row, effects, their sections as YAML, base row): a strain limit the squeeze never reaches
+and a weight it never lifts, so every run makes the same motion and only the checks cost."""
 
 
 def bare_mechanics(path: Path) -> float:
@@ -57,9 +60,7 @@ def bare_mechanics(path: Path) -> float:
     included, as the pipeline builds them too).
     """
     def squeeze():
-        scene = load_scene(path)
-        obj = ElasticObject(build_mesh(scene), scene_material(scene))
-        return event_squeeze_scene(scene, obj, finger_nodes(scene, obj.mesh))
+        return GraspSetup.build(load_scene(path)).event_squeeze()
     return timed(squeeze)[1]
 
 
@@ -105,7 +106,7 @@ def world_loop(scene_path: Path, ticks: int = 700) -> float:
     """CPU seconds of the ROS-free simulated world driven along the scene's squeeze for
     ``ticks`` ticks (devices, stepper, sensors; no messages).
     """
-    world = SimWorld(load_scene(scene_path))
+    world = SimWorld(GraspSetup.build(load_scene(scene_path)))
     depth = world.scene.squeeze.relative_depth / world.relative_per_depth
     start = {f: world.positions[f].copy() for f in SQUEEZING_FINGERS}
     world.start()
@@ -126,8 +127,9 @@ def effect_rows(out_dir: Path, progress, repeats: int) -> list:
     paths = {}
     for k, (name, effects, sections, _) in enumerate(EFFECTS):
         paths[name] = out_dir / f"effect_{k}.yaml"
-        paths[name].write_text(yaml.safe_dump({**EFFECT_SCENE, **sections,
-                                               "effects": list(effects)}))
+        scene = {**EFFECT_SCENE, **(yaml.safe_load(sections) if sections else {}),
+                 "effects": [e.value for e in effects]}
+        paths[name].write_text(yaml.safe_dump(scene))
     world: dict[str, float] = {name: float("inf") for name in paths}
     loop: dict[str, float] = {name: float("inf") for name in paths}
     world_loop(scene_file("foam_square"))

@@ -22,7 +22,7 @@ from squeeze_grasp_ros.mechanics.resistance.optimal import (
     sweep_directions,
 )
 from squeeze_grasp_ros.bench.table import Table, best_time, timed
-from squeeze_grasp_ros.mechanics.vocabulary import Finger, SqueezeKind
+from squeeze_grasp_ros.mechanics.vocabulary import ContactKind, Finger, SqueezeKind
 
 TITLE = "Optimal resistance (Sec. 6.1-6.2): time per adversary direction"
 MATERIAL = Material(5e4, 0.3, 0.0254)
@@ -70,12 +70,12 @@ def resistance_rows(
             np.argmin(np.linalg.norm(mesh.nodes[b][None] - PLACEMENT[:, None], axis=2), axis=1)
         ]
         models = {
-            "point": [[n] for n in nodes],
-            "segment": contact_segments(mesh, nodes, SEGMENT_HALF_WIDTH),
+            ContactKind.POINT: [[n] for n in nodes],
+            ContactKind.SEGMENT: contact_segments(mesh, nodes, SEGMENT_HALF_WIDTH),
         }
         for model, sets in models.items():
             segments = dict(zip(tuple(Finger), sets))
-            for mode in SqueezeKind.values():
+            for mode in SqueezeKind.planned():
                 grasp = resistance_grasp(obj, segments)
                 t_warm = best_time(lambda: optimal_resistance(grasp, PUSH, mode=mode))
                 t_cold = best_time(

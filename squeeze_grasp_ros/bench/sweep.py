@@ -32,44 +32,19 @@ from squeeze_grasp_ros.bench.table import Table
 from squeeze_grasp_ros.threads import single_thread_blas
 
 TITLE = "Grasp-dataset sweep on Dask"
-OBJECTS = [
-    {"shape": {"type": "square", "side": 0.1}},
-    {"shape": {"type": "disk", "radius": 0.05}},
-    {"shape": {"type": "ellipse", "a": 0.06, "b": 0.035}},
-    {
-        "shape": {
-            "type": "spline",
-            "points": [
-                [0.06, 0.0],
-                [0.045, 0.04],
-                [0.0, 0.05],
-                [-0.045, 0.04],
-                [-0.06, 0.0],
-                [-0.04, -0.035],
-                [0.0, -0.012],
-                [0.04, -0.035],
-            ],
-        }
-    },
-    {
-        "family": {
-            "type": "superellipse",
-            "count": 4,
-            "a": [0.04, 0.06],
-            "b": [0.03, 0.05],
-            "exponent": [2.5, 6.0],
-        }
-    },
-    {
-        "family": {
-            "type": "fourier_blob",
-            "count": 4,
-            "radius": [0.04, 0.06],
-            "harmonics": 4,
-            "amplitude": 0.15,
-        }
-    },
-]
+OBJECTS = yaml.safe_load("""
+- shape: {type: square, side: 0.1}
+- shape: {type: disk, radius: 0.05}
+- shape: {type: ellipse, a: 0.06, b: 0.035}
+- shape:
+    type: spline
+    points: [[0.06, 0.0], [0.045, 0.04], [0.0, 0.05], [-0.045, 0.04], [-0.06, 0.0],
+             [-0.04, -0.035], [0.0, -0.012], [0.04, -0.035]]
+- family: {type: superellipse, count: 4, a: [0.04, 0.06], b: [0.03, 0.05],
+           exponent: [2.5, 6.0]}
+- family: {type: fourier_blob, count: 4, radius: [0.04, 0.06], harmonics: 4,
+           amplitude: 0.15}
+""")
 """12 distinct objects: 4 fixed shapes, 4 superellipses, 4 Fourier blobs."""
 
 
@@ -78,18 +53,20 @@ def bench_spec(nodes: int, placements: int) -> dict:
     2 tip radii x 2 depths, with pickup weight and adversary (every field recorded).
     """
     return {
-        "name": "bench",
+        **yaml.safe_load("""
+name: bench
+seed: 19
+friction: [0.3, 0.6, 0.9]
+tip_radius: [0.01, 0.02]
+relative_depth: [0.04, 0.08]
+weight: 1.0
+adversary: {directions: 72}
+chunk: 48
+"""),
         "base": str(scene_file("foam_square")),
-        "seed": 19,
         "objects": OBJECTS,
         "mesh": {"nodes": nodes},
-        "friction": [0.3, 0.6, 0.9],
-        "tip_radius": [0.01, 0.02],
-        "relative_depth": [0.04, 0.08],
         "placements": {"mode": "graspmap", "count": placements},
-        "weight": 1.0,
-        "adversary": {"directions": 72},
-        "chunk": 48,
     }
 
 

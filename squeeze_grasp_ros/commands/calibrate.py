@@ -73,7 +73,7 @@ def _compression(args: argparse.Namespace) -> dict:
     neo = fit_compression(curve, model=MaterialModel.NEO_HOOKEAN, nu=args.nu)
     return {"points": len(force), "max_strain": float(curve.strain.max()),
             "strain_measure": str(StrainMeasure.BIOT),
-            "linear": linear.to_json(), "neo_hookean": neo.to_json(),
+            MaterialModel.LINEAR: linear.to_json(), MaterialModel.NEO_HOOKEAN: neo.to_json(),
             "linear_within_5_percent_up_to_strain": linear_validity(neo)}
 
 
@@ -116,7 +116,7 @@ def summary(result: dict) -> str:
                      f"{el['nu_residual']:.2g})")
     cp = result.get("compression")
     if cp:
-        for name in ("linear", "neo_hookean"):
+        for name in (MaterialModel.LINEAR, MaterialModel.NEO_HOOKEAN):
             fit = cp[name]
             lines.append(f"{name}: E = {fit['E']:.5g} Pa, nu = {fit['nu']:.4g}"
                          f"{'' if fit['nu_fitted'] else ' (given)'}, relative rms residual "

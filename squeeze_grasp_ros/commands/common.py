@@ -7,14 +7,13 @@ import argparse
 import json
 import re
 import sys
-from dataclasses import dataclass
 from pathlib import Path
 
 from squeeze_grasp_ros.exit_codes import ExitCode
+from squeeze_grasp_ros.mechanics.elastic.compliance import ROUTES
 from squeeze_grasp_ros.mechanics.errors import SqueezeGraspError
 from squeeze_grasp_ros.outputs import output_error, probe_folder
-from squeeze_grasp_ros.mechanics.elastic.compliance import ROUTES, ElasticObject
-from squeeze_grasp_ros.scene import Scene, build_mesh, finger_nodes, load_scene, scene_material
+from squeeze_grasp_ros.scene import GraspSetup, load_scene
 
 
 FIELD = re.compile(r"^([A-Za-z_][\w.\[\]]*) (?:must|is|needs|has)\b")
@@ -118,18 +117,8 @@ def add_plot_argument(parser: argparse.ArgumentParser) -> None:
                         help="write a figure to this PNG file")
 
 
-@dataclass(frozen=True)
-class LoadedScene:
-    """A scene with its meshed elastic object and initial finger contact nodes."""
-
-    scene: Scene
-    obj: ElasticObject
-    contacts: tuple[int, int]
-
-
-def load_solid(path: str, solver: str = "factorized") -> LoadedScene:
-    """Load a solid-model scene, mesh it and locate the fingers' initial contact nodes."""
-    scene = load_scene(path)
-    mesh = build_mesh(scene)
-    obj = ElasticObject(mesh, scene_material(scene), solver)
-    return LoadedScene(scene, obj, finger_nodes(scene, mesh))
+def load_setup(path: str, solver: str = "factorized") -> GraspSetup:
+    """The scene of file ``path`` made mechanics (:class:`GraspSetup`), a solid meshed for the
+    ``solver`` route.
+    """
+    return GraspSetup.build(load_scene(path), route=solver)

@@ -9,15 +9,16 @@ import argparse
 import numpy as np
 
 from squeeze_grasp_ros import plots
-from squeeze_grasp_ros.mechanics.squeeze.graspmap import GraspMap, grasp_map
-from squeeze_grasp_ros.scene import build_ring, load_scene
-from squeeze_grasp_ros.commands import ring
+from squeeze_grasp_ros.commands.ring_map import map_summary, plot_map
 from squeeze_grasp_ros.commands.common import (
     add_plot_argument,
     add_scene_argument,
     add_solver_argument,
-    load_solid,
+    load_setup,
 )
+from squeeze_grasp_ros.mechanics.squeeze.graspmap import GraspMap
+from squeeze_grasp_ros.mechanics.vocabulary import ObjectModel
+from squeeze_grasp_ros.scene.studies import grasp_map_study
 
 HELP = (
     "all-pairs grasp map: stiffness, inwardness and force closure of every placement "
@@ -37,18 +38,13 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 def run(args: argparse.Namespace) -> dict:
     """Map every placement pair of the scene's object (solid or ring model)."""
-    scene = load_scene(args.scene)
-    if scene.object.model == "ring":
-        return ring.map_result(scene, build_ring(scene), scene.squeeze.relative_depth, args.plot)
-    loaded = load_solid(args.scene, args.solver)
-    gmap = grasp_map(loaded.obj, loaded.scene.mu)
+    study = grasp_map_study(load_setup(args.scene, args.solver))
     if args.plot:
-        plot(loaded.obj, gmap, args.plot)
-    return {
-        **gmap.to_json(pairs=args.pairs),
-        "model": "solid",
-        "note": "point-contact stiffness is mesh dependent: compare placements on one mesh",
-    }
+        if study.setup.is_ring:
+            plot_map(study.setup.ring, study.map, args.plot)
+        else:
+            plot(study.setup.solid, study.map, args.plot)
+    return study.to_json(pairs=args.pairs)
 
 
 def plot(obj, gmap: GraspMap, path: str) -> None:
@@ -79,8 +75,8 @@ def plot(obj, gmap: GraspMap, path: str) -> None:
 
 def summary(result: dict) -> str:
     """Counts and the best placements."""
-    if result["model"] == "ring":
-        return ring.summary(result)
+    if result["model"] == ObjectModel.RING:
+        return map_summary(result)
     lines = [
         f"{result['pairs']} placements: {result['inward_pairs']} inward, "
         f"{result['force_closure_pairs']} force closure (mu={result['mu']}), "

@@ -6,8 +6,7 @@ from __future__ import annotations
 import argparse
 
 from squeeze_grasp_ros import plots
-from squeeze_grasp_ros.scene import build_mesh, load_scene, scene_material
-from squeeze_grasp_ros.commands.common import add_plot_argument, add_scene_argument
+from squeeze_grasp_ros.commands.common import add_plot_argument, add_scene_argument, load_setup
 
 HELP = "triangulate the scene's object (nodes, triangles, boundary loop, material)"
 
@@ -20,9 +19,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 def run(args: argparse.Namespace) -> dict:
     """Mesh the scene; JSON keys: nodes, triangles, boundary (0-based, CCW), material."""
-    scene = load_scene(args.scene)
-    mesh = build_mesh(scene)
-    mat = scene_material(scene)
+    setup = load_setup(args.scene)
+    scene, obj = setup.scene, setup.solid
+    mesh, mat = obj.mesh, obj.material
     if args.plot:
         fig, (ax,) = plots.figure(size=5.0)
         ax.triplot(mesh.nodes[:, 0], mesh.nodes[:, 1], mesh.triangles, lw=0.4, color="0.6")

@@ -9,20 +9,17 @@ import argparse
 import numpy as np
 
 from squeeze_grasp_ros import plots
-from squeeze_grasp_ros.mechanics.errors import require_relative_depth
-from squeeze_grasp_ros.mechanics.elastic.reduced import boundary_displacement, reduced_stiffness
-from squeeze_grasp_ros.mechanics.squeeze.stable_pure import Squeeze, force_closure, plan_squeeze
 from squeeze_grasp_ros.commands.common import (
     add_plot_argument,
     add_scene_argument,
     add_solver_argument,
-    load_solid,
+    load_setup,
 )
+from squeeze_grasp_ros.mechanics.squeeze.stable_pure import Squeeze
 from squeeze_grasp_ros.mechanics.vocabulary import SqueezeKind
+from squeeze_grasp_ros.scene.studies import point_squeezes
 
 HELP = "stable and pure squeezes at the scene's finger placements (point contacts, Sec. 3-4)"
-DEFAULT_RELATIVE_DEPTH = 0.05
-"""Relative depth used when neither the scene nor the command line gives a depth."""
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -39,70 +36,14 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     add_plot_argument(parser)
 
 
-def squeeze_json(sq: Squeeze) -> dict:
-    """JSON block of a unit squeeze."""
-    return {
-        "displacement": sq.displacement.tolist(),
-        "forces": sq.forces.tolist(),
-        "energy_per_unit_depth2": sq.energy_per_unit_depth2,
-        "stiffness": sq.stiffness,
-        "rigid_rotation": sq.rigid_rotation,
-        "inward": sq.inward,
-        "relative_depth_per_unit_depth": sq.relative_depth(1.0),
-    }
-
-
-def requested_depth(args: argparse.Namespace, scene_squeeze, sq: Squeeze) -> float:
-    """Depth rho (m) from the command line, else the scene, else DEFAULT_RELATIVE_DEPTH."""
-    for depth, rel in (
-        (args.depth, args.relative_depth),
-        (scene_squeeze.depth, scene_squeeze.relative_depth),
-    ):
-        if depth is not None:
-            require_relative_depth(sq.relative_depth(depth), depth)
-            return depth
-        if rel is not None:
-            require_relative_depth(rel)
-            return sq.depth_for_relative(rel)
-    return sq.depth_for_relative(DEFAULT_RELATIVE_DEPTH)
-
-
 def run(args: argparse.Namespace) -> dict:
     """Plan both squeezes; see docs/mechanics.md for the JSON keys."""
-    loaded = load_solid(args.scene, args.solver)
-    obj, (i, j) = loaded.obj, loaded.contacts
-    red = reduced_stiffness(obj, [i, j])
-    stable = plan_squeeze(obj, [i, j], kind=SqueezeKind.STABLE, red=red)
-    pure = plan_squeeze(obj, [i, j], kind=SqueezeKind.PURE, red=red)
-    chosen = stable if loaded.scene.squeeze.type == SqueezeKind.STABLE else pure
-    rho = requested_depth(args, loaded.scene.squeeze, chosen)
-    disp = {
-        k: boundary_displacement(obj, red, rho * sq.displacement)
-        for k, sq in ((SqueezeKind.STABLE, stable), (SqueezeKind.PURE, pure))
-    }
-    mesh = obj.mesh
-    result = {
-        "contacts": [i, j],
-        "contact_points": mesh.nodes[[i, j]].tolist(),
-        "stable": squeeze_json(stable),
-        "pure": squeeze_json(pure),
-        "rigid_rotation": stable.rigid_rotation,
-        "squeeze_type": chosen.kind,
-        "depth": rho,
-        "relative_depth": chosen.relative_depth(rho),
-        "rigid_rotation_at_depth": {
-            "stable": rho * stable.rigid_rotation,
-            "pure": rho * pure.rigid_rotation,
-        },
-        "boundary_displacement": {k: v.tolist() for k, v in disp.items()},
-        "force_closure": force_closure(
-            mesh.nodes[i], mesh.normal_at(i), mesh.nodes[j], mesh.normal_at(j), loaded.scene.mu
-        ),
-        "mu": loaded.scene.mu,
-        "diagnostics": {**obj.diagnostics(), "reduced_condition": red.condition},
-    }
+    plan = point_squeezes(load_setup(args.scene, args.solver), depth=args.depth,
+                          relative_depth=args.relative_depth)
+    result = plan.to_json()
     if args.plot:
-        plot(obj, stable, pure, rho, disp, args.plot)
+        plot(plan.setup.solid, plan.stable, plan.pure, plan.depth, plan.boundary_displacement,
+             args.plot)
     return result
 
 

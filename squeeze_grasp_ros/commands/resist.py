@@ -5,58 +5,44 @@
 from __future__ import annotations
 
 import argparse
-import time
 
 import numpy as np
 
 from squeeze_grasp_ros import plots
-from squeeze_grasp_ros.mechanics.squeeze.contact_model import ContactModel
-from squeeze_grasp_ros.mechanics.errors import InvalidInputError
+from squeeze_grasp_ros.commands.common import (
+    add_plot_argument,
+    add_scene_argument,
+    add_solver_argument,
+    int_in,
+    load_setup,
+)
 from squeeze_grasp_ros.mechanics.elastic.reduced import displacement_field
+from squeeze_grasp_ros.mechanics.resistance.forms import expansion_matrix
+from squeeze_grasp_ros.mechanics.resistance.frictional import FrictionalResistance
 from squeeze_grasp_ros.mechanics.resistance.optimal import (
     MAX_DIRECTIONS,
     Resistance,
     ResistanceGrasp,
     ResistanceSweep,
-    compare_resistances,
-    contact_segments,
-    optimal_resistance,
-    resistance_along,
-    resistance_grasp,
-    sweep_directions,
 )
-from squeeze_grasp_ros.mechanics.resistance.forms import expansion_matrix
-from squeeze_grasp_ros.mechanics.resistance.frictional import (
-    FrictionalResistance,
-    add_adversary,
-    frictional_resistance,
-)
+from squeeze_grasp_ros.mechanics.squeeze.contact_model import ContactModel
 from squeeze_grasp_ros.mechanics.squeeze.events import grasp_health
-from squeeze_grasp_ros.scene import SceneError, placement_node
-from squeeze_grasp_ros.scene_events import event_squeeze_scene, scene_contact_model
-from squeeze_grasp_ros.commands.common import (
-    LoadedScene,
-    add_plot_argument,
-    add_scene_argument,
-    add_solver_argument,
-    int_in,
-    load_solid,
-)
-from squeeze_grasp_ros.mechanics.vocabulary import ContactMode, Finger, SqueezeKind
+from squeeze_grasp_ros.mechanics.vocabulary import ContactKind, ContactMode, Finger, SqueezeKind
+from squeeze_grasp_ros.scene.studies import resistance_study
 
 HELP = "optimal stable/pure resistance of F1, F2 to the scene's adversary finger A (Sec. 6)"
-CONTACT_MODELS = ("point", "segment", "friction")
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     """SCENE, --mode, --contacts, --directions, --segment-half-width, --compare-direction."""
     add_scene_argument(parser)
     parser.add_argument(
-        "--mode", choices=SqueezeKind.values(), help="resistance type (default: the scene's)"
+        "--mode", choices=SqueezeKind.planned(), help="resistance type (default: the scene's)"
     )
     parser.add_argument(
         "--contacts",
-        choices=CONTACT_MODELS,
+        choices=ContactKind.values(),
+        type=ContactKind,
         help="contact model (default: the scene's adversary.contacts)",
     )
     parser.add_argument(
@@ -82,116 +68,19 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     add_plot_argument(parser)
 
 
-def adversary_node(loaded: LoadedScene) -> int:
-    """The adversary's initial contact node (distinct from F1's and F2's)."""
-    k = placement_node(loaded.obj.mesh, loaded.scene.adversary.placement, "adversary")
-    if k in loaded.contacts:
-        raise SceneError("adversary.placement is on the same boundary node as F1 or F2")
-    return k
-
-
-def build_grasp(
-    loaded: LoadedScene, contact_model: str, half_width: float | None
-) -> ResistanceGrasp:
-    """The fixed-contact problem of the scene's F1, F2 and adversary placements."""
-    nodes = [*loaded.contacts, adversary_node(loaded)]
-    if contact_model == "point":
-        sets = [[n] for n in nodes]
-    else:
-        sets = contact_segments(loaded.obj.mesh, nodes, half_width)
-    return resistance_grasp(loaded.obj, dict(zip(tuple(Finger), sets)))
-
-
-def run_friction(loaded: LoadedScene, mode: str, plot_path: str | None) -> dict:
-    """Algorithm 2 after the scene's event-driven squeeze (frictional segment contacts)."""
-    scene, obj = loaded.scene, loaded.obj
-    adv = scene.adversary
-    k = adversary_node(loaded)
-    start = time.perf_counter()
-    obj.precompute()
-    t_pre = time.perf_counter() - start
-    start = time.perf_counter()
-    squeeze = event_squeeze_scene(scene, obj, loaded.contacts)
-    t_squeeze = time.perf_counter() - start
-    model = scene_contact_model(scene, obj)
-    start = time.perf_counter()
-    state = add_adversary(squeeze.state, model, squeeze.displacement, k, adv.tip_radius)
-    res = frictional_resistance(
-        model,
-        state,
-        adv.a,
-        mode=mode,
-        step=squeeze.step,
-        event_tol=squeeze.event_tol,
-        contacts=[*loaded.contacts, k],
-    )
-    timing = {
-        "precompute_s": t_pre,
-        "squeeze_s": t_squeeze,
-        "resistance_s": time.perf_counter() - start,
-    }
-    out = {
-        "scene": scene.name,
-        **res.to_json(),
-        "contact_points": obj.mesh.nodes[res.contacts].tolist(),
-        "squeeze": {
-            "termination": squeeze.termination,
-            "depth": squeeze.depth,
-            "event_counts": squeeze.event_counts,
-            "work": dict(squeeze.work),
-        },
-        "timing": timing,
-    }
-    if plot_path:
-        plot_friction(model, squeeze.displacement, res, plot_path)
-    return out
-
-
 def run(args: argparse.Namespace) -> dict:
     """Optimal resistance (and sweep / comparison when asked); see docs/resistance.md."""
-    loaded = load_solid(args.scene, args.solver)
-    adv = loaded.scene.adversary
-    if adv is None:
-        raise SceneError(
-            "the scene has no adversary section (declare effect 'adversary'); "
-            "see config/scenes/resist_fig9.yaml"
-        )
-    mode = args.mode or adv.mode
-    contact_model = args.contacts or adv.contacts
-    if contact_model == "friction":
-        return run_friction(loaded, mode, args.plot)
-    if args.directions is not None and args.directions < 1:
-        raise InvalidInputError(f"--directions must be >= 1, got {args.directions}")
-    half_width = args.segment_half_width
-    half_width = adv.segment_half_width if half_width is None else half_width
-    start = time.perf_counter()
-    loaded.obj.precompute()
-    t_pre = time.perf_counter() - start
-    start = time.perf_counter()
-    grasp = build_grasp(loaded, contact_model, half_width)
-    res = optimal_resistance(grasp, adv.a, mode=mode)
-    timing = {"precompute_s": t_pre, "resistance_s": time.perf_counter() - start}
-    out = {
-        "scene": loaded.scene.name,
-        **res.to_json(),
-        "contact_points": loaded.obj.mesh.nodes[res.contacts].tolist(),
-    }
-    direction = args.compare_direction or adv.compare_direction
-    if direction is not None and res.success:
-        out["comparison"] = compare_resistances(
-            res, resistance_along(grasp, adv.a, direction, mode)
-        )
-    sweep = None
-    if args.directions:
-        start = time.perf_counter()
-        sweep = sweep_directions(grasp, mode, args.directions)
-        timing["sweep_s"] = time.perf_counter() - start
-        out["sweep"] = sweep.to_json()
-    out["timing"] = timing
-    out["diagnostics"] = {**out["diagnostics"], **loaded.obj.diagnostics()}
+    study = resistance_study(load_setup(args.scene, args.solver), mode=args.mode,
+                             contacts=args.contacts, directions=args.directions,
+                             half_width=args.segment_half_width,
+                             compare_direction=args.compare_direction)
     if args.plot:
-        plot(grasp, res, sweep, args.plot)
-    return out
+        if study.squeeze is not None:
+            plot_friction(study.setup.contact_model(terminations=False),
+                          study.squeeze.displacement, study.resistance, args.plot)
+        else:
+            plot(study.grasp, study.resistance, study.sweep, args.plot)
+    return study.to_json()
 
 
 def plot(
@@ -305,7 +194,7 @@ def summary(result: dict) -> str:
         f"{result['mode']} resistance, {result['contact_model']} contacts at nodes "
         f"F1 {i}, F2 {j}, A {k}; a = {np.round(result['a'], 6).tolist()} m"
     )
-    if result["contact_model"] == "friction":
+    if result["contact_model"] == ContactKind.FRICTION:
         return friction_summary(head, result)
     if not result["success"]:
         return f"{head}\n{result['reason']}"
@@ -314,8 +203,8 @@ def summary(result: dict) -> str:
         head,
         f"d1 = {np.round(result['d1'], 6).tolist()} m, d2 = "
         f"{np.round(result['d2'], 6).tolist()} m",
-        f"work [J]: F1 {w['F1']:.5g}, F2 {w['F2']:.5g}, total W*_F {w['total']:.5g} "
-        f"(A {w['A']:.5g}); per unit push {result['unit_work']:.5g} J/m^2",
+        f"work [J]: F1 {w[Finger.F1]:.5g}, F2 {w[Finger.F2]:.5g}, total W*_F "
+        f"{w['total']:.5g} (A {w[Finger.A]:.5g}); per unit push {result['unit_work']:.5g} J/m^2",
     ]
     lines += [f"force {f} [N]: {np.round(result['forces'][f], 4).tolist()}" for f in tuple(Finger)]
     cmp = result.get("comparison")

@@ -16,17 +16,19 @@ import dataclasses
 import numpy as np
 
 from squeeze_grasp_ros import plots
-from squeeze_grasp_ros.mechanics.ring.grasp_map import RingGraspMap, bench_ring, ring_grasp_map
-from squeeze_grasp_ros.mechanics.errors import require_relative_depth
-from squeeze_grasp_ros.mechanics.ring.model import (
-    FIBRE_STRAIN_MEASURE,
-    MAX_RING_ELEMENTS,
-    RingModel,
-)
-from squeeze_grasp_ros.mechanics.ring.squeeze import LIMITS, RingGrasp, ring_grasp
-from squeeze_grasp_ros.scene import Scene, SceneError, build_ring, finger_nodes, load_scene
 from squeeze_grasp_ros.commands.common import add_plot_argument, add_scene_argument, int_in
-from squeeze_grasp_ros.mechanics.vocabulary import SQUEEZING_FINGERS, StrainMeasure, Termination
+from squeeze_grasp_ros.commands.ring_map import closed, map_summary, plot_map
+from squeeze_grasp_ros.mechanics.ring.grasp_map import bench_ring
+from squeeze_grasp_ros.mechanics.ring.model import MAX_RING_ELEMENTS, RingModel
+from squeeze_grasp_ros.mechanics.ring.squeeze import RingGrasp
+from squeeze_grasp_ros.mechanics.vocabulary import (
+    SQUEEZING_FINGERS,
+    Finger,
+    ObjectModel,
+    StrainMeasure,
+)
+from squeeze_grasp_ros.scene import GraspSetup, SceneError, load_scene
+from squeeze_grasp_ros.scene.studies import grasp_map_study, ring_placement
 
 MAX_BEST = 10_000
 """Most placements ``--map --best`` lists."""
@@ -71,10 +73,12 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     add_plot_argument(parser)
 
 
-def load_ring(path: str, elements: int | None = None) -> tuple[Scene, RingModel]:
-    """The scene and its ring model (``elements`` overrides ``object.ring.elements``)."""
+def load_ring(path: str, elements: int | None = None) -> GraspSetup:
+    """The ring scene of file ``path`` made mechanics (``elements`` overrides
+    ``object.ring.elements``).
+    """
     scene = load_scene(path)
-    if scene.object.model != "ring":
+    if scene.object.model != ObjectModel.RING:
         raise SceneError(
             f"{path}: object.model is {scene.object.model!r}; `ring` needs model: ring"
         )
@@ -83,111 +87,31 @@ def load_ring(path: str, elements: int | None = None) -> tuple[Scene, RingModel]
         scene = dataclasses.replace(
             scene, object=dataclasses.replace(scene.object, ring=ring_spec)
         )
-    return scene, build_ring(scene)
-
-
-def strain_limit(scene: Scene) -> float | None:
-    """epsilon* of the scene, None without the strain_limit effect."""
-    return scene.strain_limit.epsilon if scene.has(Termination.STRAIN_LIMIT) else None
-
-
-def requested(scene: Scene, args: argparse.Namespace) -> tuple[float | None, float | None]:
-    """(depth m, relative depth): the command line wins over the scene; at most one is set."""
-    if args.depth is not None or args.relative_depth is not None:
-        return args.depth, args.relative_depth
-    return scene.squeeze.depth, scene.squeeze.relative_depth
+    return GraspSetup.build(scene)
 
 
 def run(args: argparse.Namespace) -> dict:
     """One placement, the map (``--map``) or timings (``--bench``)."""
-    scene, ring = load_ring(args.scene, args.elements)
-    mu, eps, kind = scene.mu, strain_limit(scene), scene.squeeze.type
+    setup = load_ring(args.scene, args.elements)
+    scene = setup.scene
     if args.bench:
-        return {"model": "ring", "bench": bench_ring(ring, mu, eps, kind)}
-    depth, relative = requested(scene, args)
+        bench = bench_ring(setup.ring, scene.mu, setup.limits.strain, scene.squeeze.type)
+        return {"model": ObjectModel.RING, "bench": bench}
     if args.map:
-        if depth is not None:
+        if args.depth is not None or (args.relative_depth is None
+                                      and scene.squeeze.depth is not None):
             raise SceneError(
                 "the grasp map compares placements at a relative depth: give "
                 "squeeze.relative_depth or --relative-depth, not a depth in m"
             )
-        return map_result(scene, ring, relative, args.plot, args.best)
-    if depth is None and relative is None:
-        raise SceneError(
-            "give squeeze.depth or squeeze.relative_depth (or --depth/--relative-depth)"
-        )
-    grasp = ring_grasp(ring, finger_nodes(scene, ring), mu, epsilon=eps, kind=kind)
-    if depth is not None:
-        require_relative_depth(grasp.relative_depth(depth), depth)
-        rho = depth
-    else:
-        require_relative_depth(relative)
-        rho = grasp.depth_for_relative(relative)
+        study = grasp_map_study(setup, relative_depth=args.relative_depth)
+        if args.plot:
+            plot_map(setup.ring, study.map, args.plot)
+        return study.to_json(best=args.best)
+    placement = ring_placement(setup, depth=args.depth, relative_depth=args.relative_depth)
     if args.plot:
-        plot_grasp(ring, grasp, rho, args.plot)
-    return grasp_json(ring, grasp, rho)
-
-
-def map_result(
-    scene: Scene,
-    ring: RingModel,
-    relative_depth: float | None,
-    plot: str | None = None,
-    best: int = 10,
-) -> dict:
-    """The all-pairs map of a ring scene as JSON (``graspmap`` serves ring scenes with this)."""
-    gmap = ring_grasp_map(
-        ring,
-        scene.mu,
-        epsilon=strain_limit(scene),
-        kind=scene.squeeze.type,
-        requested_relative_depth=relative_depth,
-    )
-    if plot:
-        plot_map(ring, gmap, plot)
-    return {"model": "ring", **gmap.to_json(best=best)}
-
-
-def force_angles(grasp: RingGrasp, depth: float) -> np.ndarray:
-    """Angle (deg) between each contact force and its contact normal at ``depth`` (m)."""
-    N = grasp.normals_at(depth)
-    F = grasp.forces / np.linalg.norm(grasp.forces, axis=1, keepdims=True)
-    return np.degrees(np.arccos(np.clip(np.sum(N * F, axis=1), -1.0, 1.0)))
-
-
-def grasp_json(ring: RingModel, grasp: RingGrasp, depth: float) -> dict:
-    """The JSON result of one placement at requested depth ``depth`` (m)."""
-    forces = grasp.forces_at(depth)
-    at0, at_depth = force_angles(grasp, 0.0), force_angles(grasp, depth)
-    return {
-        "model": "ring",
-        "elements": ring.n,
-        "squeeze": grasp.kind,
-        "mu": grasp.mu,
-        "epsilon": grasp.epsilon,
-        "strain_measure": str(FIBRE_STRAIN_MEASURE),
-        "contacts": [int(c) for c in grasp.contacts],
-        "points": {f: ring.points[c].tolist() for f, c in zip(SQUEEZING_FINGERS, grasp.contacts)},
-        "depth": float(depth),
-        "relative_depth": grasp.relative_depth(depth),
-        "max_depth": grasp.max_depth,
-        "max_relative_depth": grasp.max_relative_depth,
-        "limit": grasp.limit,
-        "limit_depths": grasp.limit_depths(),
-        "feasible_at_requested_depth": grasp.feasible_at(depth),
-        "forces": {f: forces[k].tolist() for k, f in enumerate(SQUEEZING_FINGERS)},
-        "stiffness": grasp.stiffness,
-        "max_strain": grasp.max_strain_at(depth),
-        "max_strain_element": int(np.argmax(grasp.strains)),
-        "cone_half_angle_deg": float(np.degrees(np.arctan(grasp.mu))),
-        "force_angle_deg": {
-            f: [float(at0[k]), float(at_depth[k])] for k, f in enumerate(SQUEEZING_FINGERS)
-        },
-    }
-
-
-def _closed(points: np.ndarray) -> np.ndarray:
-    return np.vstack([points, points[:1]])
+        plot_grasp(setup.ring, placement.grasp, placement.depth, args.plot)
+    return placement.to_json()
 
 
 def _cone(ax, apex: np.ndarray, normal: np.ndarray, mu: float, length: float, **style) -> None:
@@ -206,9 +130,9 @@ def plot_grasp(ring: RingModel, grasp: RingGrasp, depth: float, path: str) -> st
     """Deformed ring with forces and cones (left); force-to-normal angles vs depth (right)."""
     fig, (ax0, ax1) = plots.figure(2, size=5.0)
     before, after = ring.points, grasp.displaced(depth)
-    ax0.plot(*_closed(before).T, color="0.6", lw=1.0, ls="--", label="undeformed")
+    ax0.plot(*closed(before).T, color="0.6", lw=1.0, ls="--", label="undeformed")
     ax0.plot(
-        *_closed(after).T,
+        *closed(after).T,
         color="k",
         lw=1.6,
         label=f"relative depth {grasp.relative_depth(depth):.3g}",
@@ -248,7 +172,7 @@ def plot_grasp(ring: RingModel, grasp: RingGrasp, depth: float, path: str) -> st
     )
     top = min(grasp.depth_cap, max(1.5 * depth, 1.2 * grasp.max_depth, 1e-9))
     rhos = np.linspace(0.0, top, 200)
-    angles = np.array([force_angles(grasp, r) for r in rhos])
+    angles = np.array([grasp.force_angles_at(r) for r in rhos])
     rel = rhos * grasp.approach_per_unit_depth / grasp.initial_distance
     for k, f in enumerate(SQUEEZING_FINGERS):
         ax1.plot(rel, angles[:, k], label=f"{f}: force vs normal")
@@ -259,68 +183,6 @@ def plot_grasp(ring: RingModel, grasp: RingGrasp, depth: float, path: str) -> st
     ax1.set_ylabel("angle [deg]")
     plots.legend(ax1, ncol=2)
     ax1.set_title("cone rotation: force-to-normal angle")
-    return plots.save(fig, path)
-
-
-def outcome_matrix(gmap: RingGraspMap) -> tuple[np.ndarray, list[str]]:
-    """(n, n) outcome codes with the row as F1's node, and their names: the limit codes, then
-    "succeeds" (at the requested relative depth) and "outside a cone at start"; -1 on the
-    diagonal.
-    """
-    names = [*LIMITS, "succeeds", "outside a cone at start"]
-    code = gmap.limit_code.copy()
-    if gmap.requested_relative_depth is not None:
-        code[gmap.succeeds(gmap.requested_relative_depth)] = len(LIMITS)
-    code[~gmap.initially_feasible] = len(LIMITS) + 1
-    swapped = np.choose(np.minimum(code, 2), [1, 0, code]) if len(code) else code
-    out = np.full((gmap.n, gmap.n), -1)
-    i, j = gmap.pairs.T
-    out[i, j], out[j, i] = code, swapped
-    return out, names
-
-
-def plot_map(ring: RingModel, gmap: RingGraspMap, path: str) -> str:
-    """Max relative depth over (F1 node, F2 node) (left), outcome (middle), the deepest
-    placements on the ring (right).
-    """
-    from matplotlib.colors import ListedColormap
-
-    fig, (ax0, ax1, ax2) = plots.figure(3, size=4.6)
-    im = ax0.imshow(gmap.matrix(gmap.max_relative_depth), origin="lower", cmap="viridis")
-    fig.colorbar(im, ax=ax0, shrink=0.75)
-    ax0.set_title("max relative depth")
-    code, names = outcome_matrix(gmap)
-    colors = ["white", "tab:red", "tab:orange", "tab:blue", "tab:gray", "tab:green", "0.85"]
-    ax1.imshow(
-        code,
-        origin="lower",
-        cmap=ListedColormap(colors),
-        vmin=-1.5,
-        vmax=len(names) - 0.5,
-        interpolation="nearest",
-    )
-    for color, name in zip(colors[1:], names):
-        ax1.plot([], [], "s", color=color, label=name)
-    plots.legend(ax1, ncol=2)
-    target = gmap.requested_relative_depth
-    ax1.set_title("limit" + (f" / success at relative depth {target:.3g}" if target else ""))
-    for ax in (ax0, ax1):
-        ax.set_xlabel("F2 node j")
-        ax.set_ylabel("F1 node i")
-    ax2.plot(*_closed(ring.points).T, color="k", lw=1.2)
-    for rank, best in enumerate(gmap.best(5)):
-        p = ring.points[best["contacts"]]
-        ax2.plot(
-            p[:, 0],
-            p[:, 1],
-            "-o",
-            ms=4,
-            color=f"C{rank}",
-            label=f"{best['contacts']}: {best['max_relative_depth']:.3g}",
-        )
-    ax2.set_aspect("equal")
-    plots.legend(ax2, ncol=2, title="F1, F2 nodes: max relative depth", title_fontsize=8)
-    ax2.set_title("deepest placements")
     return plots.save(fig, path)
 
 
@@ -336,25 +198,7 @@ def summary(result: dict) -> str:
             "ms min"
         )
     if "pairs" in result:
-        lines = [
-            f"{result['pairs']} placements on {result['elements']} nodes, mu={result['mu']}, "
-            f"epsilon={result['epsilon']} (largest fibre strain, "
-            f"{StrainMeasure(result['strain_measure']).label} strain); limits: {result['limits']}"
-        ]
-        if "feasible_pairs" in result:
-            lines.append(
-                f"{result['feasible_pairs']} succeed at relative depth "
-                f"{result['requested_relative_depth']}; {result['initially_infeasible_pairs']} "
-                f"start outside a cone; failures during the squeeze: "
-                f"{result['failure_modes_during_squeeze']}"
-            )
-        lines.append("deepest placements (F1, F2, max relative depth, limit):")
-        lines += [
-            f"  {b['contacts'][0]:5d} {b['contacts'][1]:5d}  {b['max_relative_depth']:.4g}  "
-            f"{b['limit']}"
-            for b in result["best"]
-        ]
-        return "\n".join(lines)
+        return map_summary(result)
     verdict = "feasible" if result["feasible_at_requested_depth"] else "NOT feasible"
     return "\n".join(
         [
@@ -362,8 +206,8 @@ def summary(result: dict) -> str:
             f"(relative {result['max_relative_depth']:.4g}), limit {result['limit']}",
             f"requested depth {result['depth']:.4g} m (relative {result['relative_depth']:.4g}): "
             f"{verdict}",
-            f"forces F1 {np.round(result['forces']['F1'], 4).tolist()} N, "
-            f"F2 {np.round(result['forces']['F2'], 4).tolist()} N; max fibre strain "
+            f"forces F1 {np.round(result['forces'][Finger.F1], 4).tolist()} N, "
+            f"F2 {np.round(result['forces'][Finger.F2], 4).tolist()} N; max fibre strain "
             f"{result['max_strain']:.4g} ({StrainMeasure(result['strain_measure']).label} "
             "strain)",
         ]

@@ -17,6 +17,7 @@ from pathlib import Path
 
 from squeeze_grasp_ros.exit_codes import ExitCode, raise_on_signals
 from squeeze_grasp_ros.commands.common import add_scene_argument, fail, new_folder
+from squeeze_grasp_ros.control.motion import REACTIONS
 
 HELP = ("run a scene through the planner, executor, simulated hardware, monitor and recorder "
         "nodes (lockstep sim time) and summarise it")
@@ -47,7 +48,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--executor", choices=EXECUTOR_CHOICES, default="events",
                         help="rclpy executor of the one-process mode (default: events, "
                              "rclpy.experimental.EventsExecutor; single = SingleThreadedExecutor)")
-    parser.add_argument("--on-slip-alarm", choices=("hold", "pure", "normals"), default="hold",
+    parser.add_argument("--on-slip-alarm", choices=REACTIONS, default=REACTIONS[0],
                         help="executor reaction to an imminent-slip alarm: hold (default), or "
                              "change the squeeze direction once to the pure squeeze or along the "
                              "measured contact normals")

@@ -8,26 +8,30 @@ from __future__ import annotations
 
 import argparse
 import sys
-import time
 
 import numpy as np
 
 from squeeze_grasp_ros import plots
 
-from squeeze_grasp_ros.mechanics.squeeze.fingertips import unit
-from squeeze_grasp_ros.mechanics.squeeze.events import EventSqueeze
-from squeeze_grasp_ros.scene_events import event_squeeze_scene
 from squeeze_grasp_ros.commands.common import (
     add_plot_argument,
     add_scene_argument,
     add_solver_argument,
-    load_solid,
+    load_setup,
     output_file,
 )
 from squeeze_grasp_ros.commands.csv_io import write_points
-from squeeze_grasp_ros.mechanics.elastic.strain_measures import COMMON_STRAIN_MEASURE
-from squeeze_grasp_ros.mechanics.vocabulary import (ContactMode, EventType, Finger, MaterialModel,
-                                                    StrainMeasure, StressMeasure)
+from squeeze_grasp_ros.mechanics.squeeze.events import EventSqueeze
+from squeeze_grasp_ros.mechanics.squeeze.fingertips import unit
+from squeeze_grasp_ros.mechanics.vocabulary import (
+    ContactMode,
+    EventType,
+    Finger,
+    MaterialModel,
+    StrainMeasure,
+    StressMeasure,
+)
+from squeeze_grasp_ros.scene.studies import compare_models, squeeze_run
 
 HELP = "event-driven squeeze with rounded fingertips under Coulomb friction (Sec. 5, Algorithm 1)"
 BAR_WIDTH = 30
@@ -115,44 +119,30 @@ class ProgressBar:
 
 def run(args: argparse.Namespace) -> dict:
     """Run the squeeze; JSON keys per docs/design.md §2 (see docs/events.md)."""
+    setup = load_setup(args.scene, args.solver)
+    overrides = {"depth": args.depth, "relative_depth": args.relative_depth,
+                 "step": args.step, "event_tol": args.event_tol}
     if args.compare_models:
-        return compare_models(args)
-    loaded = load_solid(args.scene, args.solver)
-    start = time.perf_counter()
-    if not args.reference:
-        loaded.obj.precompute()
-    t_pre = time.perf_counter() - start
+        comparison = compare_models(
+            setup, on_model=lambda m: print(f"squeeze: {m} ...", file=sys.stderr, flush=True),
+            **overrides)
+        out = comparison.to_json()
+        if args.plot:
+            out["plot"] = plot_models(setup.solid, comparison.results, args.plot)
+        return out
     bar = ProgressBar()
-    start = time.perf_counter()
     try:
-        res = event_squeeze_scene(
-            loaded.scene,
-            loaded.obj,
-            loaded.contacts,
-            depth=args.depth,
-            relative_depth=args.relative_depth,
-            step=args.step,
-            event_tol=args.event_tol,
-            reference=args.reference,
-            progress=bar,
-            material_model=args.model,
-        )
+        squeezed = squeeze_run(setup, reference=args.reference, progress=bar,
+                               material_model=args.model, **overrides)
     finally:
         bar.close()
-    t_run = time.perf_counter() - start
-    out = {
-        "scene": loaded.scene.name,
-        **res.to_json(),
-        "contact_points": loaded.obj.mesh.nodes[list(res.contacts)].tolist(),
-        "mesh": {"nodes": loaded.obj.mesh.n, "boundary": len(loaded.obj.mesh.boundary)},
-        "timing": {"precompute_s": t_pre, "squeeze_s": t_run},
-    }
+    out, res, obj = squeezed.to_json(), squeezed.result, setup.solid
     if args.plot:
-        out["plot"] = plot(loaded.obj, res, args.plot)
+        out["plot"] = plot(obj, res, args.plot)
     if args.save_boundary:
-        loop = loaded.obj.mesh.boundary
+        loop = obj.mesh.boundary
         out["boundary_csv"] = write_points(
-            args.save_boundary, loaded.obj.mesh.nodes[loop] + res.displacement[loop]
+            args.save_boundary, obj.mesh.nodes[loop] + res.displacement[loop]
         )
     return out
 
@@ -208,7 +198,7 @@ def plot(obj, res: EventSqueeze, path: str) -> str:
     ax.set_xlabel("relative squeeze depth")
     ax = axes[2]
     ax.set_aspect("auto")
-    for row, kind in enumerate(EventType.values()):
+    for row, kind in enumerate(EventType):
         evs = [e for e in res.events if e.type == kind]
         ax.scatter(
             [e.relative_depth for e in evs],
@@ -218,84 +208,13 @@ def plot(obj, res: EventSqueeze, path: str) -> str:
             marker="|",
         )
     ax.set_yticks(
-        range(len(EventType.values())),
-        [f"{k} ({res.event_counts[k]})" for k in EventType.values()],
+        range(len(EventType)),
+        [f"{k} ({n})" for k, n in res.event_counts.items()],
     )
     ax.set_xlim(0, max(res.relative_depth, 1e-9) * 1.02)
     ax.set_xlabel("relative squeeze depth")
     ax.set_title("event timeline (F1 blue, F2 orange)", fontsize=9)
     return plots.save(fig, path)
-
-
-def _model_row(res: EventSqueeze, seconds: float) -> dict:
-    segments = {f: [s.node for s in seg] for f, seg in res.segments.items()}
-    widths = {}
-    for f, seg in res.segments.items():
-        thetas = [s.theta for s in seg]
-        widths[f] = 0.5 * res.tip_radius[f] * (max(thetas) - min(thetas)) if thetas else 0.0
-    h = res.health
-    return {
-        "termination": res.termination,
-        "depth": res.depth,
-        "relative_depth": res.relative_depth,
-        "force": {f: res.finger_force[f][1] for f in res.segments},
-        "energy": res.energy,
-        "contact_half_width": widths,
-        "contact_nodes": {f: len(nodes) for f, nodes in segments.items()},
-        "max_strain": h.max_strain,
-        "strain_measure": str(h.strain_measure),
-        "max_principal_strain": {str(m): v for m, v in h.max_principal_strain.items()},
-        "max_von_mises": h.max_von_mises,
-        "stress_measure": str(h.stress_measure),
-        "event_counts": res.event_counts,
-        "work_minus_energy": res.diagnostics["work_minus_energy"],
-        "dissipation": sum(res.dissipation.values()),
-        "nonlinear": res.diagnostics.get("nonlinear"),
-        "seconds": seconds,
-    }
-
-
-def compare_models(args: argparse.Namespace) -> dict:
-    """The scene under every material model, with relative differences from linear.
-
-    Strains are compared like for like: ``max_principal_strain`` holds every field's largest
-    principal strain in every measure, and its differences are taken measure by measure
-    (``common_strain_measure`` is the one the text shows). A model's own measure
-    (``max_strain``) is never compared with another model's.
-    """
-    loaded = load_solid(args.scene, args.solver)
-    loaded.obj.precompute()
-    rows, results = {}, {}
-    for model in MaterialModel.values():
-        print(f"squeeze: {model} ...", file=sys.stderr, flush=True)
-        start = time.perf_counter()
-        res = event_squeeze_scene(
-            loaded.scene, loaded.obj, loaded.contacts, depth=args.depth,
-            relative_depth=args.relative_depth, step=args.step, event_tol=args.event_tol,
-            material_model=model)
-        rows[model] = _model_row(res, time.perf_counter() - start)
-        results[model] = res
-    base = rows[MaterialModel.LINEAR]
-
-    def rel(value: float, ref: float) -> float:
-        return (value - ref) / abs(ref) if ref else float("nan")
-
-    differences = {
-        m: {"force": {f: rel(r["force"][f], base["force"][f]) for f in r["force"]},
-            "energy": rel(r["energy"], base["energy"]),
-            "max_principal_strain": {k: rel(v, base["max_principal_strain"][k])
-                                     for k, v in r["max_principal_strain"].items()},
-            "contact_half_width": {f: rel(r["contact_half_width"][f],
-                                          base["contact_half_width"][f])
-                                   for f in r["contact_half_width"]},
-            "seconds_ratio": r["seconds"] / max(base["seconds"], 1e-12)}
-        for m, r in rows.items() if m != MaterialModel.LINEAR}
-    out = {"scene": loaded.scene.name, "compare_models": True,
-           "common_strain_measure": str(COMMON_STRAIN_MEASURE), "models": rows,
-           "relative_difference": differences}
-    if args.plot:
-        out["plot"] = plot_models(loaded.obj, results, args.plot)
-    return out
 
 
 def plot_models(obj, results: dict, path: str) -> str:
@@ -373,10 +292,11 @@ def summary(result: dict) -> str:
         + (f"; strain limit {limit['epsilon']:g} on the "
            f"{StrainMeasure(limit['measure']).label} strain ({limit['criterion']})"
            if limit else ""),
-        "events: " + ", ".join(f"{k} {c[k]}" for k in EventType.values()),
+        "events: " + ", ".join(f"{k} {n}" for k, n in c.items()),
     ]
     for name, seg in result["segments"].items():
-        modes = " ".join(f"{s['node']}{'' if s['mode'] == 'stick' else '~'}" for s in seg)
+        modes = " ".join(f"{s['node']}{'' if s['mode'] == ContactMode.STICK else '~'}"
+                         for s in seg)
         ff = result["finger_force"][name]
         friction = result["dissipation"][name]
         lines.append(

@@ -40,9 +40,9 @@ from dataclasses import dataclass, field
 from functools import cached_property
 
 import numpy as np
-from squeeze_grasp_ros.mechanics.vocabulary import SqueezeKind, Termination
+from squeeze_grasp_ros.mechanics.vocabulary import Finger, SqueezeKind, Termination
 
-REACTIONS: tuple[str, ...] = ("hold", "pure", "normals")
+REACTIONS: tuple[str, ...] = ("hold", SqueezeKind.PURE.value, "normals")
 
 
 @dataclass(frozen=True)
@@ -207,7 +207,7 @@ class Command:
     message : str
     """
 
-    setpoints: dict
+    setpoints: Mapping[Finger, np.ndarray]
     state: str
     termination: str | None = None
     message: str = ""

@@ -52,7 +52,7 @@ import numpy as np
 
 
 from squeeze_grasp_ros.mechanics.squeeze.event_key import PROCESSING_ORDER, processing_rank
-from squeeze_grasp_ros.mechanics.vocabulary import ContactMode, Finger, Termination
+from squeeze_grasp_ros.mechanics.vocabulary import ContactMode, EventType, Finger, Termination
 
 
 @dataclass(frozen=True)
@@ -149,10 +149,10 @@ class Patch(NamedTuple):
 
 @dataclass(frozen=True)
 class TrackedEvent:
-    """An event found by the tracker (``type`` A, B, C, D or picked_up)."""
+    """An event found by the tracker: a contact event (A, B, C, D) or picked_up."""
 
-    type: str
-    finger: str
+    type: EventType | Termination
+    finger: Finger | str
     depth: float
     relative_depth: float
     angle: float
@@ -172,8 +172,8 @@ class TrackedAlarm:
 class PredictedEvent:
     """An event of the planner's prediction."""
 
-    type: str
-    finger: str
+    type: EventType
+    finger: Finger
     depth: float
 
 
@@ -198,10 +198,10 @@ class TrackerOutput:
 
     stamp_ns: int
     fingers: tuple[str, ...]
-    positions: dict
-    forces: dict
-    normals: dict
-    ages: dict
+    positions: Mapping[str, np.ndarray]
+    forces: Mapping[str, np.ndarray]
+    normals: Mapping[str, np.ndarray]
+    ages: Mapping[str, float]
     patches: tuple[Patch, ...]
     events: tuple[TrackedEvent, ...]
     alarms: tuple[TrackedAlarm, ...]
@@ -295,7 +295,7 @@ class _FingerTrack:
     force: np.ndarray = field(default_factory=lambda: np.zeros(2))
     normal: np.ndarray = field(default_factory=lambda: np.zeros(2))
     had_contact: bool = False
-    stamps: dict = field(default_factory=dict)
+    stamps: dict[str, int] = field(default_factory=dict)
     trig_key: bytes = b""
     trig: tuple = ()
 
@@ -420,16 +420,16 @@ class ContactTracker:
         found = []
         for before, after in connected_groups(previous, current, self.config.match_margin):
             if not after:
-                found += [("B", previous[i].angle) for i in before]
+                found += [(EventType.B, previous[i].angle) for i in before]
             elif not before:
                 if self.tracks[name].had_contact:
-                    found += [("A", current[j].angle) for j in after]
+                    found += [(EventType.A, current[j].angle) for j in after]
             elif len(before) == len(after) == 1:
                 old, new = previous[before[0]], current[after[0]]
                 if old.mode == ContactMode.STICK and new.mode == ContactMode.SLIP:
-                    found.append(("C", new.angle))
+                    found.append((EventType.C, new.angle))
                 elif old.mode == ContactMode.SLIP and new.mode == ContactMode.STICK:
-                    found.append(("D", new.angle))
+                    found.append((EventType.D, new.angle))
         found.sort(key=lambda e: (processing_rank(e[0]), e[1]))
         return [TrackedEvent(kind, name, self.depth, relative, angle) for kind, angle in found]
 

@@ -2,23 +2,38 @@
 # SPDX-License-Identifier: Apache-2.0
 """The domain vocabulary: one string enum per kind of name.
 
-Each member *is* its string (``Finger.F1 == "F1"``, same hash), so JSON, YAML scenes, CSV
-columns and ROS messages keep the exact strings they always had, and code that receives a
-plain string from a file works unchanged. ``str(member)`` and f-strings give the bare value.
+Each member *is* its string: JSON, YAML scenes, CSV columns and ROS messages carry the exact
+strings they always had, and ``str(member)`` and f-strings give the bare value. Most members
+also compare equal to their plain string (``Finger.F1 == "F1"``, same hash), so code that
+receives a string from a file or a message works unchanged.
 
->>> from squeeze_grasp_ros.mechanics.vocabulary import Finger, Termination
+Three vocabularies share strings with others: the event letters (``EventType.A`` and the
+adversary ``Finger.A``), the effects (``Effect.STRAIN_LIMIT`` and the termination
+``Termination.STRAIN_LIMIT``, ``Effect.FRICTION`` and the contact kind ``ContactKind.FRICTION``)
+and the ring limits (``RingLimit.NONE`` and ``ShapeFit.NONE``). Their members are *codes*, not
+strings: equal only to themselves, with a hash of their own, so
+a finger is never taken for an event and a termination never for an effect. ``str()`` and
+f-strings still give the bare string and ``.value`` is it (for JSON and messages); a plain
+string converts with the enum (``EventType("A")``), as the parsers and message converters do.
+
+>>> from squeeze_grasp_ros.mechanics.vocabulary import EventType, Finger, Termination
 >>> Finger.F1 == "F1", f"{Termination.STRAIN_LIMIT}"
 (True, 'strain_limit')
 >>> Finger("F2") is Finger.F2
 True
+>>> Finger.A == EventType.A, hash(Finger.A) == hash(EventType.A), EventType.A == "A"
+(False, False, False)
+>>> EventType("A") is EventType.A, f"{EventType.A}", EventType.A.value
+(True, 'A', 'A')
 """
 from __future__ import annotations
 
 from enum import Enum
 
-__all__ = ["ContactMode", "DistortionModel", "EventType", "Factorizer", "Finger",
-           "ImageEncoding", "MaterialModel", "SQUEEZING_FINGERS", "ShapeFit", "SqueezeKind",
-           "StrainCriterion", "StrainMeasure", "StressMeasure", "Termination"]
+__all__ = ["ContactKind", "ContactMode", "DistortionModel", "Effect", "EventType", "Factorizer",
+           "Finger", "ImageEncoding", "MaterialModel", "ObjectModel", "RingLimit",
+           "SQUEEZING_FINGERS", "ShapeFit", "ShapeType", "SqueezeKind", "StrainCriterion",
+           "StrainMeasure", "StressMeasure", "Termination"]
 
 
 class _Name(str, Enum):
@@ -29,6 +44,29 @@ class _Name(str, Enum):
     __str__ = str.__str__
     __format__ = str.__format__
     __repr__ = str.__repr__
+
+    @classmethod
+    def values(cls) -> tuple[str, ...]:
+        """All values, in declaration order."""
+        return tuple(m.value for m in cls)
+
+
+class _Code(Enum):
+    """A name whose string another vocabulary uses too (see the module docstring): not a
+    string, equal only to itself; ``str()``, format and ``repr()`` give the bare value.
+    """
+
+    def __str__(self) -> str:
+        return self._value_
+
+    def __format__(self, spec: str) -> str:
+        return format(self._value_, spec)
+
+    def __repr__(self) -> str:
+        return repr(self._value_)
+
+    def __hash__(self) -> int:
+        return hash((type(self).__name__, self._value_))
 
     @classmethod
     def values(cls) -> tuple[str, ...]:
@@ -48,7 +86,7 @@ SQUEEZING_FINGERS: tuple[Finger, Finger] = (Finger.F1, Finger.F2)
 """The two fingers of a squeeze, in canonical order."""
 
 
-class EventType(_Name):
+class EventType(_Code):
     """Contact events of the event-driven squeeze (paper Sec. 5.3)."""
 
     A = "A"
@@ -83,10 +121,19 @@ class Termination(_Name):
 
 
 class SqueezeKind(_Name):
-    """Stable or pure: the squeeze (paper Sec. 2.4) and the resistance built on it (Sec. 6.1)."""
+    """Stable or pure: the squeeze (paper Sec. 2.4) and the resistance built on it (Sec. 6.1);
+    custom: an event-driven squeeze along user-given finger directions.
+    """
 
     STABLE = "stable"
     PURE = "pure"
+    CUSTOM = "custom"
+    """Finger directions given by the user (``fingers.<F>.direction``), not planned."""
+
+    @classmethod
+    def planned(cls) -> tuple[str, ...]:
+        """The kinds a planner computes (and a scene or request may ask for): stable, pure."""
+        return (cls.STABLE.value, cls.PURE.value)
 
 
 class StrainCriterion(_Name):
@@ -172,6 +219,68 @@ class MaterialModel(_Name):
         """The measure of the model's reported stresses."""
         return (StressMeasure.SMALL_STRAIN if self is MaterialModel.LINEAR
                 else StressMeasure.CAUCHY)
+
+
+class ObjectModel(_Name):
+    """Mechanical model of an object (``object.model``)."""
+
+    SOLID = "solid"
+    """Plane-stress finite elements of the whole planar object (Sec. 2-6)."""
+    RING = "ring"
+    """Curved beam along the middle curve of a hollow object (Sec. 7)."""
+
+
+class ShapeType(_Name):
+    """Outline types of a scene's ``object.shape.type``."""
+
+    RECTANGLE = "rectangle"
+    SQUARE = "square"
+    DISK = "disk"
+    ELLIPSE = "ellipse"
+    SUPERELLIPSE = "superellipse"
+    FOURIER_BLOB = "fourier_blob"
+    POLYGON = "polygon"
+    SPLINE = "spline"
+    FILE = "file"
+    ANNULUS = "annulus"
+
+
+class ContactKind(_Name):
+    """How F1, F2 and A touch the object in a resistance (Sec. 6)."""
+
+    POINT = "point"
+    """At one node each, fixed (Sec. 6.1)."""
+    SEGMENT = "segment"
+    """On fixed boundary segments around each node (Sec. 6.2)."""
+    FRICTION = "friction"
+    """Rounded fingertips under Coulomb friction after the squeeze: Algorithm 2 (Sec. 6.3)."""
+
+
+class Effect(_Code):
+    """What a scene may switch on (``effects:``); an undeclared effect costs nothing."""
+
+    FRICTION = "friction"
+    STRAIN_LIMIT = "strain_limit"
+    PICKUP = "pickup"
+    ADVERSARY = "adversary"
+    FORCE_SENSING = "force_sensing"
+    TACTILE_SENSING = "tactile_sensing"
+    SENSOR_NOISE = "sensor_noise"
+    ACTUATOR_LAG = "actuator_lag"
+    SENSOR_DROPOUT = "sensor_dropout"
+
+
+class RingLimit(_Code):
+    """What bounds a ring squeeze's depth (Sec. 7.1), in the order ties resolve."""
+
+    FRICTION_CONE_F1 = "friction_cone_F1"
+    """F1's contact force reaches an edge of its friction cone."""
+    FRICTION_CONE_F2 = "friction_cone_F2"
+    """F2's contact force reaches an edge of its friction cone."""
+    STRAIN = "strain"
+    """The most strained element reaches the proportional limit."""
+    NONE = "none"
+    """Nothing before the fingers meet (relative depth 1)."""
 
 
 class ImageEncoding(_Name):

@@ -89,7 +89,7 @@ def choose_object(inside: np.ndarray, *, min_area_px: int, ambiguous_ratio: floa
     """
     labels, count = ndimage.label(inside)
     areas = np.bincount(labels.ravel(), minlength=count + 1)[1:]
-    order = np.argsort(-areas, kind="stable")
+    order = np.argsort(-areas, kind="mergesort")
     kept = [int(k) for k in order if areas[k] >= min_area_px]
     if not kept:
         raise InvalidInputError(f"{what}: no object in view (no blob of at least {min_area_px} "

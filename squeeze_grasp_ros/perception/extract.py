@@ -32,7 +32,7 @@ from scipy import ndimage
 
 from squeeze_grasp_ros.mechanics.elastic.shapes import Outline, signed_area, validate_polyline
 from squeeze_grasp_ros.mechanics.errors import InvalidInputError
-from squeeze_grasp_ros.mechanics.vocabulary import ImageEncoding
+from squeeze_grasp_ros.mechanics.vocabulary import ImageEncoding, ShapeType
 from squeeze_grasp_ros.perception.blobs import Blob, BlobChoice, choose_object
 from squeeze_grasp_ros.perception.camera import CameraModel, CameraPose
 from squeeze_grasp_ros.perception.simplify import kept_vertices, sharpen_corners
@@ -125,7 +125,7 @@ class ObjectOutline:
         """The outline as a scene's ``object.shape``: ``{"type": "polygon", "points": [[x, y],
         ...]}``, plus ``"holes": [[[x, y], ...], ...]`` when it has holes (m).
         """
-        shape = {"type": "polygon", "points": self.outline.points.tolist()}
+        shape = {"type": ShapeType.POLYGON.value, "points": self.outline.points.tolist()}
         if self.outline.holes:
             shape["holes"] = [h.tolist() for h in self.outline.holes]
         return shape

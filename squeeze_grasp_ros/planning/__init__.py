@@ -30,7 +30,7 @@ from squeeze_grasp_ros.planning.object_ids import (
     shown,
 )
 from squeeze_grasp_ros.planning.objects import (
-    Limits,
+    PlannerLimits,
     LoadedObject,
     SceneSource,
     read_scene,
@@ -75,7 +75,7 @@ __all__ = [
     "Cancelled",
     "ERROR_CODES",
     "ErrorCode",
-    "Limits",
+    "PlannerLimits",
     "LoadedObject",
     "MAX_BEST_COUNT",
     "MAX_ID_CHARS",

@@ -11,7 +11,7 @@ import numpy as np
 
 from squeeze_grasp_ros.planning.errors import invalid
 from squeeze_grasp_ros.planning.object_ids import shown
-from squeeze_grasp_ros.planning.objects import Limits, LoadedObject, MAX_BEST_COUNT
+from squeeze_grasp_ros.planning.objects import PlannerLimits, LoadedObject, MAX_BEST_COUNT
 
 
 # --------------------------------------------------------------------------- request checks
@@ -27,7 +27,7 @@ def check_number(name: str, value: float, low: float = -math.inf, high: float = 
     return float(value)
 
 
-def check_step(step: float, limits: Limits) -> float:
+def check_step(step: float, limits: PlannerLimits) -> float:
     """An event-squeeze substep no smaller than the node's ``min_step``."""
     if step < limits.min_step:
         raise invalid(
@@ -37,7 +37,7 @@ def check_step(step: float, limits: Limits) -> float:
     return step
 
 
-def best_count(requested: int, limits: Limits) -> int:
+def best_count(requested: int, limits: PlannerLimits) -> int:
     """Placements a map returns: ``requested`` in [1, MAX_BEST_COUNT], or the default for 0."""
     return int(check_number("best_count", requested, 0, MAX_BEST_COUNT)) or limits.best_count
 

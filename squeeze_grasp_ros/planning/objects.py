@@ -1,11 +1,12 @@
 # Copyright 2026 squeeze_grasp_ros developers
 # SPDX-License-Identifier: Apache-2.0
-"""Limits of the planner, scene sources and the object cache (a bounded LRU of loaded objects)."""
+"""Limits of the planner (PlannerLimits), scene sources and the object cache (a bounded LRU of
+loaded objects).
+"""
 
 from __future__ import annotations
 
 import hashlib
-import math
 import threading
 import time
 from collections import OrderedDict
@@ -19,39 +20,32 @@ import scipy.sparse as sp
 from squeeze_grasp_ros.inputs import InputError, confine, load_yaml, read_text
 from squeeze_grasp_ros.mechanics.elastic.compliance import ROUTES, ElasticObject
 from squeeze_grasp_ros.mechanics.ring.model import RingModel
-from squeeze_grasp_ros.scene import (
-    Scene,
-    build_mesh,
-    build_outline,
-    build_ring,
-    finger_nodes,
-    parse_scene,
-    scene_material,
-)
+from squeeze_grasp_ros.mechanics.vocabulary import ContactKind, ObjectModel, ShapeType
+from squeeze_grasp_ros.scene import Scene, build_outline, parse_scene, requested_nodes
+from squeeze_grasp_ros.scene.setup import RING_STAGES, SOLID_STAGES, GraspSetup
 from squeeze_grasp_ros.planning.budget import check_load
 from squeeze_grasp_ros.planning.errors import ErrorCode, PlannerError, invalid
 from squeeze_grasp_ros.planning.object_ids import (check_digest, check_object_id, replaced,
                                                    shown, taken)
 
 
-CONTACT_MODELS: tuple[str, ...] = ("point", "segment", "friction")
+CONTACT_MODELS: tuple[str, ...] = ContactKind.values()
 MAX_BEST_COUNT = 100_000
 """Most placements one grasp map may return as candidates."""
-SOLID_STAGES: tuple[str, ...] = ("mesh", "stiffness", "factorisation", "boundary compliance")
-RING_STAGES: tuple[str, ...] = ("ring model", "compliance")
 MAX_PATH_CHARS = 4096
 """Longest ``scene_path`` (PATH_MAX on Linux): messages quote the path when they refuse it."""
 
 Progress = Callable[[str, int, int, int], None]
-"""Called as ``progress(stage, index, count, num_nodes)`` when a stage starts; may raise
-:class:`Cancelled` to stop the computation."""
+"""Called as ``progress(stage, index, count, num_nodes)`` when a stage starts (the stages of
+:data:`SOLID_STAGES`, :data:`RING_STAGES`); may raise :class:`Cancelled` to stop the
+computation."""
 
 
 # --------------------------------------------------------------------------- limits and objects
 
 
 @dataclass(frozen=True)
-class Limits:
+class PlannerLimits:
     """What the node accepts (its parameters).
 
     Attributes
@@ -89,12 +83,10 @@ class LoadedObject:
     Attributes
     ----------
     object_id : str
-    scene : Scene
-        The validated scene it came from (fingers, friction, limits, squeeze defaults).
-    body : ElasticObject or RingModel
-        Precomputed: factorisation and boundary compliance (solid) or compliance (ring).
-    finger_nodes : (int, int)
-        Initial contact nodes of F1, F2 from the scene's placements.
+    setup : GraspSetup
+        The scene made mechanics: the scene (fingers, friction, limits, squeeze defaults), the
+        precomputed body (factorisation and boundary compliance of a solid, or the ring's
+        compliance) and the fingers' initial contact nodes.
     digest : str
         SHA-256 of the scene text and the solver route: same digest, same object.
     precompute_time : float
@@ -102,43 +94,56 @@ class LoadedObject:
     """
 
     object_id: str
-    scene: Scene
-    body: ElasticObject | RingModel
-    finger_nodes: tuple[int, int]
+    setup: GraspSetup
     digest: str
     precompute_time: float
 
     @property
-    def model(self) -> str:
-        """Body model: "solid" (FEM mesh) or "ring" (curved beam)."""
-        return "ring" if isinstance(self.body, RingModel) else "solid"
+    def scene(self) -> Scene:
+        """The validated scene the object came from."""
+        return self.setup.scene
+
+    @property
+    def body(self) -> ElasticObject | RingModel:
+        """The precomputed solid or ring model."""
+        return self.setup.body
+
+    @property
+    def finger_nodes(self) -> tuple[int, int]:
+        """Initial contact nodes of F1, F2 from the scene's placements."""
+        return self.setup.contacts
+
+    @property
+    def model(self) -> ObjectModel:
+        """Body model: solid (FEM mesh) or ring (curved beam)."""
+        return self.setup.model
 
     @property
     def num_nodes(self) -> int:
         """Mesh nodes (solid) or ring nodes."""
-        return int(self.body.n) if self.model == "ring" else int(self.body.mesh.n)
+        return self.setup.num_nodes
 
     @property
     def boundary(self) -> np.ndarray:
         """Nodes a finger can touch: the outer boundary loop (solid) or every ring node."""
-        return self.body.boundary if self.model == "ring" else self.body.mesh.boundary
+        return self.setup.boundary
 
     def solid(self) -> ElasticObject:
         """The FEM object; a ring raises INVALID_ARGUMENT naming the service to use."""
-        if not isinstance(self.body, ElasticObject):
+        if self.setup.is_ring:
             raise invalid(
                 f"object {self.object_id!r} is a ring model (Sec. 7): use the "
                 "ring_grasp_test service"
             )
-        return self.body
+        return self.setup.solid
 
     def ring(self) -> RingModel:
         """The ring model; a solid raises INVALID_ARGUMENT."""
-        if not isinstance(self.body, RingModel):
+        if not self.setup.is_ring:
             raise invalid(
                 f"object {self.object_id!r} is a solid (object.model: solid), not a ring"
             )
-        return self.body
+        return self.setup.ring
 
 
 @dataclass(frozen=True)
@@ -194,29 +199,11 @@ def read_scene(
             data, base_dir = load_yaml(scene_yaml, what="scene_yaml"), None
         scene = parse_scene(data, base_dir=base_dir)
         shape = scene.object.shape
-        if roots is not None and shape["type"] == "file":
+        if roots is not None and shape["type"] == ShapeType.FILE:
             confine(shape["path"], roots, what="object.shape.path")
     except InputError as exc:
         raise invalid(str(exc)) from None
     return SceneSource(scene, text)
-
-
-def requested_nodes(scene: Scene) -> int | None:
-    """Nodes the scene asks for before anything is built; None for the mesher's default size.
-
-    A ring asks for ``object.ring.elements``; a solid for ``object.mesh.nodes``, or about
-    0.8 * area / max_area for ``object.mesh.max_area`` (the inverse of
-    :func:`~.mechanics.mesh.target_max_area`).
-    """
-    obj = scene.object
-    if obj.model == "ring":
-        return obj.ring.elements
-    if obj.mesh.nodes is not None:
-        return obj.mesh.nodes
-    if obj.mesh.max_area is None:
-        return None
-    area = build_outline(obj.shape).area
-    return math.ceil(0.8 * area / min(obj.mesh.max_area, 0.25 * area))
 
 
 def check_size(count: int | None, limit: int, what: str) -> None:
@@ -228,23 +215,23 @@ def check_size(count: int | None, limit: int, what: str) -> None:
         )
 
 
-def node_limit(route: str, limits: Limits) -> int:
+def node_limit(route: str, limits: PlannerLimits) -> int:
     """Most mesh nodes of a solid on solver ``route``."""
     return limits.max_nodes if route == "factorized" else limits.max_spectral_nodes
 
 
-def check_requested(scene: Scene, route: str, limits: Limits) -> None:
+def check_requested(scene: Scene, route: str, limits: PlannerLimits) -> None:
     """Refuse, before anything is built, a scene that asks for more nodes than the planner's
     limits (INVALID_ARGUMENT, oversized) or whose outline is invalid (e.g. self-intersecting).
     """
-    if scene.object.model == "ring":
+    if scene.object.model == ObjectModel.RING:
         check_size(requested_nodes(scene), limits.max_ring_elements, "ring model")
     else:
         build_outline(scene.object.shape)
         check_size(requested_nodes(scene), node_limit(route, limits), f"{route} mesh")
 
 
-def solver_route(route: str, limits: Limits) -> str:
+def solver_route(route: str, limits: PlannerLimits) -> str:
     """The request's solver route, or the node's default when empty."""
     route = route or limits.default_route
     if route not in ROUTES:
@@ -276,7 +263,8 @@ class ObjectKey:
     digest: str
 
 
-def object_key(source: SceneSource, object_id: str, route: str, limits: Limits) -> ObjectKey:
+def object_key(source: SceneSource, object_id: str, route: str,
+               limits: PlannerLimits) -> ObjectKey:
     """The :class:`ObjectKey` of a load request."""
     route = solver_route(route, limits)
     digest = hashlib.sha256(f"{route}\0{source.text}".encode()).hexdigest()
@@ -288,7 +276,7 @@ def object_key(source: SceneSource, object_id: str, route: str, limits: Limits) 
 
 
 def load_object(
-    source: SceneSource, key: ObjectKey, limits: Limits, progress: Progress = no_progress
+    source: SceneSource, key: ObjectKey, limits: PlannerLimits, progress: Progress = no_progress
 ) -> LoadedObject:
     """Build and precompute the object of a scene, stage by stage.
 
@@ -298,7 +286,7 @@ def load_object(
         The scene (see :func:`read_scene`).
     key : ObjectKey
         Id, solver route (rings ignore it) and digest (see :func:`object_key`).
-    limits : Limits
+    limits : PlannerLimits
     progress : Progress
         Called with :data:`SOLID_STAGES` or :data:`RING_STAGES` as they start.
 
@@ -310,27 +298,18 @@ def load_object(
     scene = source.scene
     start = time.perf_counter()
     check_requested(scene, key.route, limits)
-    if scene.object.model == "ring":
+    if scene.object.model == ObjectModel.RING:
         progress(RING_STAGES[0], 0, len(RING_STAGES), 0)
-        body = build_ring(scene)
-        progress(RING_STAGES[1], 1, len(RING_STAGES), body.n)
-        body.precompute()
-        nodes = finger_nodes(scene, body)
+        setup = GraspSetup.build(scene)
     else:
         progress(SOLID_STAGES[0], 0, len(SOLID_STAGES), 0)
-        limit = node_limit(key.route, limits)
-        mesh = build_mesh(scene, max_nodes=limit)
+        setup = GraspSetup.build(scene, route=key.route, max_nodes=node_limit(key.route, limits))
+        mesh = setup.solid.mesh
         check_load(boundary_nodes=len(mesh.boundary), nodes=mesh.n, route=key.route,
                    max_bytes=limits.max_bytes)
-        body = ElasticObject(mesh, scene_material(scene), key.route)
-        progress(SOLID_STAGES[1], 1, len(SOLID_STAGES), mesh.n)
-        _ = body.stiffness
-        progress(SOLID_STAGES[2], 2, len(SOLID_STAGES), mesh.n)
-        _ = body.solver
-        progress(SOLID_STAGES[3], 3, len(SOLID_STAGES), mesh.n)
-        body.precompute()
-        nodes = finger_nodes(scene, mesh)
-    return LoadedObject(key.object_id, scene, body, nodes, key.digest, time.perf_counter() - start)
+    setup.precompute(progress)
+    _ = setup.contacts  # the placements are checked at load, not at the first request
+    return LoadedObject(key.object_id, setup, key.digest, time.perf_counter() - start)
 
 
 def resident_bytes(value: object) -> int:
@@ -503,7 +482,7 @@ def load_cached(
     source: SceneSource,
     object_id: str,
     route: str,
-    limits: Limits,
+    limits: PlannerLimits,
     progress: Progress = no_progress,
     replace: bool = False,
 ) -> tuple[LoadedObject, bool]:

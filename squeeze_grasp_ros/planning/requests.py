@@ -4,7 +4,6 @@
 
 from __future__ import annotations
 
-import dataclasses
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
@@ -16,24 +15,17 @@ from squeeze_grasp_ros.mechanics.resistance.optimal import (
     MAX_DIRECTIONS,
     Resistance,
     ResistanceSweep,
-    contact_segments,
     optimal_resistance,
-    resistance_grasp,
     sweep_directions,
 )
-from squeeze_grasp_ros.mechanics.resistance.frictional import (
-    FrictionalResistance,
-    add_adversary,
-    frictional_resistance,
-)
+from squeeze_grasp_ros.mechanics.resistance.frictional import FrictionalResistance
 from squeeze_grasp_ros.mechanics.ring.grasp_map import RingGraspMap, ring_grasp_map
 from squeeze_grasp_ros.mechanics.ring.squeeze import RingGrasp, ring_grasp
 from squeeze_grasp_ros.mechanics.squeeze.stable_pure import Squeeze, force_closure, plan_squeeze
 from squeeze_grasp_ros.mechanics.squeeze.events import EventSqueeze
-from squeeze_grasp_ros.scene_events import event_squeeze_scene, scene_contact_model
-from squeeze_grasp_ros.mechanics.vocabulary import Finger, SqueezeKind
+from squeeze_grasp_ros.mechanics.vocabulary import ContactKind, SqueezeKind
 from squeeze_grasp_ros.planning.errors import invalid
-from squeeze_grasp_ros.planning.objects import CONTACT_MODELS, Limits, LoadedObject
+from squeeze_grasp_ros.planning.objects import CONTACT_MODELS, LoadedObject, PlannerLimits
 from squeeze_grasp_ros.planning.checks import check_number, check_step, choice, contact_nodes
 
 
@@ -79,7 +71,7 @@ def squeeze_plan(
         rho, m, >= 0; 0 = unit squeeze.
     """
     obj = loaded.solid()
-    kind = choice("squeeze_type", kind, SqueezeKind.values())
+    kind = choice("squeeze_type", kind, SqueezeKind.planned())
     scale = check_number("depth", depth, 0.0) or 1.0
     nodes = contact_nodes(loaded, contacts, default=loaded.finger_nodes)
     red = reduced_stiffness(obj, nodes)
@@ -131,7 +123,7 @@ def resistance_plan(
     half_width: float,
     directions: int,
     tip_radius: float,
-    limits: Limits,
+    limits: PlannerLimits,
     checkpoint: Callable[[], None] | None = None,
 ) -> ResistancePlan:
     """Optimal resistance to the adversary translation ``a`` (Sec. 6).
@@ -145,39 +137,35 @@ def resistance_plan(
     a : (x, y, z)
         Adversary translation, m; z must be 0.
     mode : {"stable", "pure"}
-    contact_model : {"point", "segment", "friction"}
+    contact_model : {"point", "segment", "friction"} (:class:`ContactKind`)
     half_width : float
         Segment half width, m (>= 0; 0 = the node and its two neighbours).
     directions : int
         Push directions to sweep (0 = none; fixed contacts only).
     tip_radius : float
         Friction: A's fingertip radius, m (0 = the scene's adversary tip radius).
-    limits : Limits
+    limits : PlannerLimits
         Friction: the scene's squeeze step must be >= ``limits.min_step``.
     checkpoint : callable, optional
         Friction: called before every stepper substep; may raise :class:`Cancelled`.
     """
-    obj = loaded.solid()
-    mode = choice("mode", mode, SqueezeKind.values())
-    contact_model = choice("contact_model", contact_model, CONTACT_MODELS)
+    loaded.solid()  # INVALID_ARGUMENT for a ring
+    mode = choice("mode", mode, SqueezeKind.planned())
+    contact_model = ContactKind(choice("contact_model", contact_model, CONTACT_MODELS))
     x, y, z = (check_number(f"a.{k}", v) for k, v in zip("xyz", a))
     if z != 0.0:
         raise invalid(f"a.z must be 0 (planar objects), got {z}")
     width = check_number("segment_half_width", half_width, 0.0)
     count = int(check_number("directions", directions, 0, MAX_DIRECTIONS))
     nodes = contact_nodes(loaded, contacts, count=3)
-    if contact_model == "friction":
+    if contact_model == ContactKind.FRICTION:
         if count:
             raise invalid("directions: the sweep needs point or segment contacts")
         return ResistancePlan(
             friction_resistance(loaded, nodes, (x, y), mode, tip_radius, limits, checkpoint),
             None,
         )
-    if contact_model == "point":
-        sets = [[int(n)] for n in nodes]
-    else:
-        sets = contact_segments(obj.mesh, nodes.tolist(), width or None)
-    grasp = resistance_grasp(obj, dict(zip(tuple(Finger), sets)))
+    grasp = loaded.setup.resistance_grasp(contact_model, half_width=width or None, nodes=nodes)
     sweep = sweep_directions(grasp, mode, count) if count else None
     return ResistancePlan(optimal_resistance(grasp, (x, y), mode=mode), sweep)
 
@@ -188,7 +176,7 @@ def friction_resistance(
     a: tuple[float, float],
     mode: str,
     tip_radius: float,
-    limits: Limits,
+    limits: PlannerLimits,
     checkpoint: Callable[[], None] | None = None,
 ) -> FrictionalResistance:
     """Algorithm 2 after the scene's event-driven squeeze at F1, F2 (Sec. 6.3); ``checkpoint``
@@ -203,21 +191,12 @@ def friction_resistance(
             "gives no adversary tip radius)"
         )
     check_step(scene.squeeze.step, limits)
-    obj = loaded.solid()
+    loaded.solid()  # INVALID_ARGUMENT for a ring
     i, j, k = (int(n) for n in nodes)
-    squeeze = event_squeeze_scene(scene, obj, (i, j), checkpoint=checkpoint)
-    model = scene_contact_model(scene, obj)
-    state = add_adversary(squeeze.state, model, squeeze.displacement, k, radius)
-    return frictional_resistance(
-        model,
-        state,
-        a,
-        mode=mode,
-        step=squeeze.step,
-        event_tol=squeeze.event_tol,
-        contacts=[i, j, k],
-        checkpoint=checkpoint,
-    )
+    setup = loaded.setup
+    squeeze = setup.event_squeeze(contacts=(i, j), checkpoint=checkpoint)
+    return setup.frictional_resistance(squeeze, mode=mode, a=a, tip_radius=radius,
+                                       adversary_node=k, checkpoint=checkpoint)
 
 
 @dataclass(frozen=True)
@@ -268,7 +247,7 @@ def ring_grasp_test(
         Also map every placement (:func:`~.mechanics.ring_map.ring_grasp_map`).
     """
     ring = loaded.ring()
-    kind = choice("squeeze_type", kind, SqueezeKind.values())
+    kind = choice("squeeze_type", kind, SqueezeKind.planned())
     mu = check_number("mu", mu, 0.0)
     epsilon = check_number("strain_limit", strain_limit, 0.0) or None
     relative = check_number("relative_depth", relative_depth, 0.0, 1.0)
@@ -293,7 +272,7 @@ def event_squeeze_run(
     relative_depth: float,
     step: float,
     event_tol: float,
-    limits: Limits,
+    limits: PlannerLimits,
     progress: Callable[[float], None] | None = None,
     checkpoint: Callable[[], None] | None = None,
 ) -> EventSqueeze:
@@ -311,15 +290,15 @@ def event_squeeze_run(
         At most one > 0 (rho in m, or the fraction); both 0 = the scene's depth.
     step, event_tol : float
         Relative to the object size; 0 = the scene's. ``step`` must be >= ``limits.min_step``.
-    limits : Limits
+    limits : PlannerLimits
     progress : callable, optional
         Called with the completed fraction; may raise :class:`Cancelled`.
     checkpoint : callable, optional
         Called before every stepper substep; may raise :class:`Cancelled`.
     """
-    obj = loaded.solid()
+    loaded.solid()  # INVALID_ARGUMENT for a ring
     scene = loaded.scene
-    kind = choice("squeeze_type", kind, SqueezeKind.values(), scene.squeeze.type)
+    kind = choice("squeeze_type", kind, SqueezeKind.planned(), scene.squeeze.type)
     depth = check_number("depth", depth, 0.0)
     relative_depth = check_number("relative_depth", relative_depth, 0.0, 1.0)
     if depth and relative_depth:
@@ -327,11 +306,9 @@ def event_squeeze_run(
     step = check_step(check_number("step", step, 0.0) or scene.squeeze.step, limits)
     event_tol = check_number("event_tol", event_tol, 0.0) or scene.squeeze.event_tol
     nodes = contact_nodes(loaded, contacts, count=2, default=loaded.finger_nodes)
-    scene = dataclasses.replace(scene, squeeze=dataclasses.replace(scene.squeeze, type=kind))
-    return event_squeeze_scene(
-        scene,
-        obj,
-        (int(nodes[0]), int(nodes[1])),
+    return loaded.setup.event_squeeze(
+        contacts=(int(nodes[0]), int(nodes[1])),
+        kind=kind,
         depth=depth or None,
         relative_depth=relative_depth or None,
         step=step,

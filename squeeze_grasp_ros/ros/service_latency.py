@@ -150,7 +150,7 @@ class Session:
 def build_object(nodes: int) -> planning.LoadedObject:
     """The benchmark object of about ``nodes`` nodes, loaded under ``n<nodes>`` in this process."""
     source = planning.read_scene(scene_text(nodes), "")
-    limits = planning.Limits()
+    limits = planning.PlannerLimits()
     return planning.load_object(
         source, planning.object_key(source, f"n{nodes}", "", limits), limits
     )

@@ -36,28 +36,14 @@ from __future__ import annotations
 import time
 from collections import Counter
 from collections.abc import Mapping
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 
-from squeeze_grasp_ros.mechanics.elastic.compliance import ElasticObject
-from squeeze_grasp_ros.mechanics.squeeze.contact_model import ContactModel
 from squeeze_grasp_ros.mechanics.squeeze.contact_state import ContactState, Event, initial_state
-from squeeze_grasp_ros.mechanics.squeeze.fingertips import place_fingertip
 from squeeze_grasp_ros.mechanics.resistance.frictional import add_adversary
-from squeeze_grasp_ros.mechanics.squeeze.stable_pure import plan_squeeze
-from squeeze_grasp_ros.mechanics.squeeze.nonlinear_model import contact_model
 from squeeze_grasp_ros.mechanics.squeeze.stepper import advance
-from squeeze_grasp_ros.scene import (
-    Scene,
-    SensorsSpec,
-    build_mesh,
-    finger_devices,
-    finger_nodes,
-    placement_node,
-    scene_material,
-)
-from squeeze_grasp_ros.scene_events import scene_limits
+from squeeze_grasp_ros.scene import GraspSetup, SensorsSpec, finger_devices
 from squeeze_grasp_ros.sim.devices import DeviceModel, device_model, follow
 from squeeze_grasp_ros.sim.sensors import (
     SensorRandomness,
@@ -66,8 +52,7 @@ from squeeze_grasp_ros.sim.sensors import (
     render_tactile,
     tactile_layout,
 )
-from squeeze_grasp_ros.mechanics.vocabulary import (Finger, MaterialModel, SQUEEZING_FINGERS,
-                                                    Termination)
+from squeeze_grasp_ros.mechanics.vocabulary import Effect, Finger, Termination
 
 TERMINATE_ON: tuple[str, ...] = (
     Termination.STRAIN_LIMIT,
@@ -75,43 +60,6 @@ TERMINATE_ON: tuple[str, ...] = (
     Termination.PICKED_UP,
 )
 """Stepper terminations that end the simulated world (as in Algorithm 1)."""
-
-
-def squeeze_geometry(
-    scene: Scene, obj: ElasticObject, contacts: tuple[int, int]
-) -> tuple[dict[str, np.ndarray], float]:
-    """(finger -> translation per unit depth (m/m), relative depth per unit depth (1/m)).
-
-    The scene's stable or pure squeeze (:func:`..mechanics.squeeze.plan_squeeze`; approach
-    ||u_1 - u_2|| per unit depth, docs/design.md §2), or its user-given ``fingers.<F>.direction``
-    scaled to a unit stacked vector (approach along the chord of the contacts), as the
-    event-driven squeeze sets them up.
-    """
-    chord = np.diff(obj.mesh.nodes[list(contacts)], axis=0)[0]
-    distance = float(np.linalg.norm(chord))
-    if scene.fingers[Finger.F1].direction is None:
-        plan = plan_squeeze(obj, list(contacts), kind=scene.squeeze.type)
-        u = plan.displacement.reshape(2, 2)
-        return {"F1": u[0], "F2": u[1]}, plan.approach_per_unit_depth / distance
-    u = np.array([scene.fingers[n].direction for n in SQUEEZING_FINGERS], float)
-    u = u / np.linalg.norm(u)
-    return {"F1": u[0], "F2": u[1]}, float((u[0] - u[1]) @ chord) / distance**2
-
-
-@dataclass(frozen=True)
-class CountingContactModel(ContactModel):
-    """A :class:`ContactModel` that counts its strain-field work in ``counter``."""
-
-    counter: Counter = field(default_factory=Counter, repr=False, compare=False)
-
-    def max_strain(self, sd, delta, F):
-        """Largest strain of a configuration (counted as ``strain_evaluations``)."""
-        self.counter["strain_evaluations"] += 1
-        return super().max_strain(sd, delta, F)
-
-    def _strain_map(self, dofs):
-        self.counter["strain_maps"] += 1
-        return super()._strain_map(dofs)
 
 
 @dataclass(frozen=True)
@@ -192,42 +140,27 @@ class SimWorld:
 
     Parameters
     ----------
-    scene : Scene
-        A solid-model scene with rounded fingertips.
-    obj : ElasticObject, optional
-        The meshed object (built from the scene if omitted).
+    setup : GraspSetup
+        A solid-model scene with rounded fingertips, made mechanics (precomputed here).
     """
 
-    def __init__(self, scene: Scene, obj: ElasticObject | None = None) -> None:
+    def __init__(self, setup: GraspSetup) -> None:
+        scene = setup.scene
+        self.setup = setup.precompute()
         self.scene = scene
-        self.work: Counter = Counter()
-        if obj is None:
-            obj = ElasticObject(build_mesh(scene), scene_material(scene))
-        self.obj = obj.precompute()
-        material = MaterialModel(scene.object.material.model)
-        events_per_depth = scene.squeeze.max_events_per_depth
-        self.model = (
-            CountingContactModel(obj, scene.mu, scene_limits(scene),
-                                 max_events_per_depth=events_per_depth, counter=self.work)
-            if material == MaterialModel.LINEAR
-            else contact_model(material, obj, scene.mu, scene_limits(scene),
-                               max_events_per_depth=events_per_depth)
-        )
-        mesh = obj.mesh
-        self.contacts = finger_nodes(scene, mesh)
-        tips = [
-            place_fingertip(mesh, name, node, scene.fingers[name].tip_radius)
-            for name, node in zip(SQUEEZING_FINGERS, self.contacts)
-        ]
-        self.directions, self.relative_per_depth = squeeze_geometry(scene, obj, self.contacts)
+        self._work: Counter = Counter()
+        self.obj = setup.solid
+        self.model = setup.contact_model()
+        self.contacts = setup.contacts
+        tips = setup.fingertips()
+        motion = setup.motion
+        self.directions, self.relative_per_depth = motion.directions, motion.relative_per_depth
         self.state = initial_state(tips, self.relative_per_depth)
         self.adversary = None
-        if scene.has("adversary"):
-            adv = scene.adversary
-            node = placement_node(mesh, adv.placement, "adversary")
-            self.adversary = place_fingertip(mesh, "A", node, adv.tip_radius)
+        if scene.has(Effect.ADVERSARY):
+            self.adversary = setup.adversary_tip()
             tips.append(self.adversary)
-        lag = scene.actuators.time_constant if scene.has("actuator_lag") else 0.0
+        lag = scene.actuators.time_constant if scene.has(Effect.ACTUATOR_LAG) else 0.0
         devices = finger_devices(scene)
         self.fingers: tuple[str, ...] = tuple(t.name for t in tips)
         self.devices: dict[str, DeviceModel] = {
@@ -238,15 +171,15 @@ class SimWorld:
         self.offsets = {t.name: np.zeros(2) for t in tips}
         sensors = scene.sensors
         self.layouts: dict[str, TactileLayout] = {}
-        if scene.has("tactile_sensing"):
+        if scene.has(Effect.TACTILE_SENSING):
             layout = sensors if sensors is not None else SensorsSpec()
             taxels, span = layout.taxels, np.radians(layout.taxel_span_deg)
             self.layouts = {t.name: tactile_layout(t.theta, taxels, span) for t in tips}
         self.randomness = SensorRandomness(
             sensors.seed if sensors is not None and sensors.seed is not None else 0,
-            sensors.noise_std if scene.has("sensor_noise") else None,
-            sensors.dropout if scene.has("sensor_dropout") else None,
-            self.work,
+            sensors.noise_std if scene.has(Effect.SENSOR_NOISE) else None,
+            sensors.dropout if scene.has(Effect.SENSOR_DROPOUT) else None,
+            self._work,
         )
         self.dt = scene.sim.dt
         self.dt_ns = int(round(scene.sim.dt * 1e9))
@@ -258,6 +191,17 @@ class SimWorld:
         self.step_cpu_seconds = 0.0
         self.step_size = scene.squeeze.step
         self.event_tol = scene.squeeze.event_tol
+
+    @property
+    def work(self) -> Counter:
+        """Counted optional work: one counter per kind (sensor renderings, noise draws, lag
+        updates, stepper calls, strain evaluations of the strain limit, ...); a kind never
+        done has no entry.
+        """
+        work = Counter(self._work)
+        if self.model.strain_evaluations:
+            work["strain_evaluations"] = self.model.strain_evaluations
+        return work
 
     # ----------------------------------------------------------------- ticks
     def start(self) -> TickOutput:
@@ -281,12 +225,12 @@ class SimWorld:
             if name not in setpoints:
                 continue
             target = np.asarray(setpoints[name], float) + self.offsets[name]
-            waiting = name == "A" and not self._adversary_touching()
+            waiting = name == Finger.A and not self._adversary_touching()
             if waiting and np.any(target != self.positions[name]):
                 target = self._touch_adversary(target)
             device = self.devices[name]
             if device.lagged:
-                self.work["lag_updates"] += 1
+                self._work["lag_updates"] += 1
             new = follow(device, self.positions[name], target, self.dt)
             moves[name] = new - self.positions[name]
             self.positions[name] = new
@@ -297,7 +241,7 @@ class SimWorld:
             k: tuple(v) for k, v in moves.items() if k in touching and np.any(v != 0.0)
         }
         if translations and self.termination is None:
-            self.work["stepper_calls"] += 1
+            self._work["stepper_calls"] += 1
             started, cpu = time.perf_counter(), time.thread_time()
             result = advance(
                 self.model,
@@ -314,19 +258,19 @@ class SimWorld:
         return self._output(events)
 
     def _adversary_touching(self) -> bool:
-        return any(f.name == "A" for f in self.state.fingers)
+        return any(f.name == Finger.A for f in self.state.fingers)
 
     def _touch_adversary(self, target: np.ndarray) -> np.ndarray:
         """Place A on the deformed boundary; return its setpoint shifted by the same offset."""
-        self.work["adversary_placements"] += 1
+        self._work["adversary_placements"] += 1
         field_ = self.displacement_field()
         self.state = add_adversary(
             self.state, self.model, field_, self.adversary.node, self.adversary.radius
         )
-        touched = np.asarray(self.state.finger("A").center, float)
-        offset = touched - self.positions["A"]
-        self.offsets["A"] = self.offsets["A"] + offset
-        self.positions["A"] = touched
+        touched = np.asarray(self.state.finger(Finger.A).center, float)
+        offset = touched - self.positions[Finger.A]
+        self.offsets[Finger.A] = self.offsets[Finger.A] + offset
+        self.positions[Finger.A] = touched
         return target + offset
 
     def _output(self, events: tuple[Event, ...]) -> TickOutput:
@@ -345,13 +289,13 @@ class SimWorld:
             "position": self.positions[name] - self.offsets[name],
         }
         rnd = self.randomness
-        if self.scene.has("force_sensing") and not rnd.dropped():
-            self.work["wrench_evaluations"] += 1
+        if self.scene.has(Effect.FORCE_SENSING) and not rnd.dropped():
+            self._work["wrench_evaluations"] += 1
             force, torque = fingertip_wrench(contacts, self.radii[name])
             reading["force"] = rnd.perturb(force)
             reading["torque"] = rnd.perturb(torque, self.radii[name])
         if name in self.layouts and not rnd.dropped():
-            self.work["tactile_renderings"] += 1
+            self._work["tactile_renderings"] += 1
             normal, tangential = render_tactile(self.layouts[name], contacts)
             reading["normal"] = rnd.perturb(normal)
             reading["tangential"] = rnd.perturb(tangential)
@@ -370,13 +314,13 @@ class SimWorld:
 
     def displacement_field(self) -> np.ndarray:
         """Displacement (n, 2) of every mesh node, m (one sparse solve; counted)."""
-        self.work["displacement_fields"] += 1
+        self._work["displacement_fields"] += 1
         sd, delta, forces = self._contact_solution()
         return self.model.full_displacement(sd, delta, forces).reshape(-1, 2) * self.model.length
 
     def view(self) -> WorldView:
         """Deformed outline, fingertips and contacts for display (counted as ``views``)."""
-        self.work["views"] += 1
+        self._work["views"] += 1
         sd, delta, forces = self._contact_solution()
         mesh = self.obj.mesh
         outline = (

@@ -2,11 +2,13 @@
 # SPDX-License-Identifier: Apache-2.0
 """Worker side of a sweep: prepare a group once, then run the evaluations of a task.
 
-:func:`run_task` is what Dask calls. It prepares the task's group (mesh, stiffness,
-factorisation, boundary compliance, point-contact grasp map, placements) or takes it from the
-process's cache, then runs every (placement, parameter) evaluation of the task with
-:func:`~squeeze_grasp_ros.mechanics.squeeze.events.event_squeeze` (Algorithm 1) and returns one
-row per evaluation (:data:`COLUMNS`). An evaluation that raises becomes a row with its
+:func:`run_task` is what Dask calls. It prepares the task's group (the group scene made
+mechanics by :class:`~squeeze_grasp_ros.scene.setup.GraspSetup`: mesh, stiffness,
+factorisation, boundary compliance; the point-contact grasp map; placements) or takes it from
+the process's cache, then runs every (placement, parameter) evaluation of the task: the
+evaluation's scene (:func:`~.plan.evaluation_scene`) on the group's body, squeezed by
+:meth:`~squeeze_grasp_ros.scene.setup.GraspSetup.event_squeeze` (Algorithm 1), one row per
+evaluation (:data:`COLUMNS`). An evaluation that raises becomes a row with its
 ``error``; the record of a squeeze is what the event engine reports (termination, events,
 finger forces, work, energy, grasp health, slip margins); this module adds only the locations
 of the strain and stress maxima, the pickup outcome, W*_F over push directions and the
@@ -21,18 +23,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from squeeze_grasp_ros.mechanics.elastic.compliance import ElasticObject
-from squeeze_grasp_ros.mechanics.squeeze.graspmap import GraspMap, grasp_map
-from squeeze_grasp_ros.mechanics.elastic.material import Material
 from squeeze_grasp_ros.mechanics.elastic.mesh import Mesh
-from squeeze_grasp_ros.mechanics.resistance.optimal import (
-    contact_segments,
-    resistance_grasp,
-    sweep_directions,
-)
-from squeeze_grasp_ros.mechanics.squeeze.events import event_squeeze
-from squeeze_grasp_ros.sweep.plan import Task, build_group_mesh, rng_for
+from squeeze_grasp_ros.mechanics.resistance.optimal import sweep_directions
+from squeeze_grasp_ros.mechanics.squeeze.graspmap import GraspMap, grasp_map
 from squeeze_grasp_ros.mechanics.vocabulary import Finger, StrainMeasure, Termination
+from squeeze_grasp_ros.scene import GraspSetup
+from squeeze_grasp_ros.scene.setup import check_adversary_node
+from squeeze_grasp_ros.sweep.plan import Task, evaluation_scene, group_setup, rng_for
 
 CACHE_GROUPS = 4
 """Prepared groups kept per worker process (a 2k-node group holds a few MB)."""
@@ -109,8 +106,8 @@ class Group:
 
     Attributes
     ----------
-    obj : ElasticObject
-        Factorised, boundary compliance computed.
+    setup : GraspSetup
+        The group's scene made mechanics: factorised, boundary compliance computed.
     gmap : GraspMap
         Point-contact grasp map (force closure at the task's ``placement_mu``).
     placements : list of (int, int, int)
@@ -119,7 +116,7 @@ class Group:
         Seconds spent preparing.
     """
 
-    obj: ElasticObject
+    setup: GraspSetup
     gmap: GraspMap
     placements: list
     prepare_s: float
@@ -163,32 +160,27 @@ def prepare(task: Task) -> Group:
         _CACHE.move_to_end(key)
         return _CACHE[key]
     start = time.perf_counter()
-    mesh = build_group_mesh(task.obj)
-    _, E, nu, h, _ = task.material
-    obj = ElasticObject(mesh, Material(E, nu, h)).precompute()
-    gmap = grasp_map(obj, task.placement_mu)
-    group = Group(obj, gmap, select_placements(task, mesh, gmap), time.perf_counter() - start)
+    setup = group_setup(task).precompute()
+    gmap = grasp_map(setup.solid, task.placement_mu)
+    group = Group(setup, gmap, select_placements(task, setup.solid.mesh, gmap),
+                  time.perf_counter() - start)
     _CACHE[key] = group
     while len(_CACHE) > CACHE_GROUPS:
         _CACHE.popitem(last=False)
     return group
 
 
-def _adversary(group: Group, i: int, j: int, spec: tuple) -> dict:
+def _adversary(setup: GraspSetup, i: int, j: int, spec: tuple) -> dict:
     """W*_F per unit push, minimum and maximum over the push directions (J/m^2)."""
     position, mode, contacts, directions = spec
-    mesh = group.obj.mesh
+    mesh = setup.solid.mesh
     b = len(mesh.boundary)
     pi, pj = mesh.boundary_position(i), mesh.boundary_position(j)
     k = int(mesh.boundary[(pi + int(round(position * ((pj - pi) % b)))) % b])
     out = {"node_A": k}
-    if k in (i, j):
-        raise ValueError(f"adversary.position {position} puts A on F1's or F2's node")
-    nodes = [i, j, k]
-    sets = [[n] for n in nodes] if contacts == "point" else contact_segments(mesh, nodes)
-    ext = sweep_directions(
-        resistance_grasp(group.obj, dict(zip(tuple(Finger), sets))), mode, directions
-    ).extremes()
+    check_adversary_node((i, j), k, f"adversary.position {position}")
+    grasp = setup.resistance_grasp(contacts, nodes=(i, j, k))
+    ext = sweep_directions(grasp, mode, directions).extremes()
     for key in ("min", "max"):
         if ext[key] is not None:
             out[f"resist_{key}"] = ext[key]["unit_work"]
@@ -204,7 +196,8 @@ def _centroid(mesh: Mesh, element: int) -> tuple[float, float]:
 def evaluate(task: Task, group: Group, index: int, params, resist: dict) -> dict:
     """One row: the event-driven squeeze of placement ``index`` with ``params``."""
     repeat, i, j = group.placements[index]
-    mesh = group.obj.mesh
+    setup = group.setup.on(evaluation_scene(task.scene, (i, j), params))
+    mesh = setup.solid.mesh
     gpos = mesh.boundary_position(i), mesh.boundary_position(j)
     row = dict.fromkeys(COLUMNS)
     row.update(
@@ -212,8 +205,8 @@ def evaluate(task: Task, group: Group, index: int, params, resist: dict) -> dict
             "eval_id": f"{task.group}/p{index:05d}/{params.id}",
             "task_id": task.id,
             "object_id": task.obj.id,
-            "material_id": task.material[0],
-            "material_model": task.material[4],
+            "material_id": task.material,
+            "material_model": str(setup.scene.object.material.model),
             "placement_id": f"p{index:05d}",
             "param_id": params.id,
             "repeat": repeat,
@@ -235,25 +228,12 @@ def evaluate(task: Task, group: Group, index: int, params, resist: dict) -> dict
     )
     start = time.perf_counter()
     try:
-        res = event_squeeze(
-            group.obj,
-            (i, j),
-            params.tip_radius,
-            params.mu,
-            kind=params.kind,
-            depth=params.depth,
-            relative_depth=params.relative_depth,
-            limits=task.limits,
-            step=task.step,
-            event_tol=task.event_tol,
-            max_events_per_depth=task.max_events_per_depth,
-            material_model=task.material[4],
-        )
+        res = setup.event_squeeze()
         if task.adversary is not None:
             key = (i, j)
             if key not in resist:
                 try:
-                    resist[key] = _adversary(group, i, j, task.adversary)
+                    resist[key] = _adversary(setup, i, j, task.adversary)
                 except Exception as exc:  # noqa: BLE001 - recorded in the row
                     resist[key] = exc
             if isinstance(resist[key], Exception):
@@ -263,14 +243,13 @@ def evaluate(task: Task, group: Group, index: int, params, resist: dict) -> dict
         row["error"] = f"{type(exc).__name__}: {exc}"
         row["time_s"] = time.perf_counter() - start
         return row
-    counts = res.event_counts
     h = res.health
     row.update(
         {
             "termination": res.termination,
             "depth": res.depth,
             "relative_depth": res.relative_depth,
-            **{f"events_{k}": counts[k] for k in "ABCD"},
+            **{f"events_{k}": n for k, n in res.event_counts.items()},
             "chatter": len(res.chatter),
             "contacts_F1": len(res.segments[Finger.F1]),
             "contacts_F2": len(res.segments[Finger.F2]),
@@ -291,7 +270,7 @@ def evaluate(task: Task, group: Group, index: int, params, resist: dict) -> dict
             "slip_margin_F1": h.slip_margin.get(Finger.F1),
             "slip_margin_F2": h.slip_margin.get(Finger.F2),
             "picked_up": (res.termination == Termination.PICKED_UP)
-            if task.limits.weight is not None
+            if setup.limits.weight is not None
             else None,
         }
     )
@@ -313,7 +292,7 @@ def run_task(task: Task) -> dict:
     for index in range(task.start, min(task.stop, len(group.placements))):
         for params in task.params:
             rows.append(evaluate(task, group, index, params, resist))
-    mesh = group.obj.mesh
+    mesh = group.setup.solid.mesh
     return {
         "rows": sorted(rows, key=lambda r: r["eval_id"]),
         "outline": mesh.nodes[mesh.boundary].tolist(),

@@ -2,6 +2,11 @@
 # SPDX-License-Identifier: Apache-2.0
 """A sweep spec -> objects, parameter grid and Dask tasks, with seeds derived from ids.
 
+Scenes. Every evaluation is a scene: the base scene with the object, material and parameters
+of the evaluation substituted (:func:`group_scene`, :func:`evaluation_scene`), made mechanics
+by the same :class:`~squeeze_grasp_ros.scene.setup.GraspSetup` as every other front end, so a
+sweep computes what a scene file with the same values would (material model included).
+
 Grouping. The costly shared step of an evaluation is meshing, assembling and factorising the
 object and computing its boundary compliance (0.3-1 s for 1-2k nodes, against 0.05-0.5 s for a
 squeeze); it depends on the object, its mesh settings and its material only. Evaluations are
@@ -23,15 +28,28 @@ import hashlib
 import itertools
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Optional
+from collections.abc import Mapping
+from typing import Any, Optional
 
 import numpy as np
 
-from squeeze_grasp_ros.mechanics.squeeze.contact_model import Limits
-from squeeze_grasp_ros.mechanics.elastic.mesh import generate_mesh, target_max_area
 from squeeze_grasp_ros.mechanics.elastic.shapes import Outline
-from squeeze_grasp_ros.scene import MeshSpec, build_outline, load_scene
-from squeeze_grasp_ros.scene_events import scene_limits
+from squeeze_grasp_ros.mechanics.vocabulary import Effect, Finger, ShapeType
+from squeeze_grasp_ros.scene import (
+    FingerSpec,
+    FrictionSpec,
+    GraspSetup,
+    MaterialSpec,
+    MeshSpec,
+    ObjectSpec,
+    PickupSpec,
+    PlacementSpec,
+    Scene,
+    SceneError,
+    build_outline,
+    load_scene,
+)
+from squeeze_grasp_ros.scene.checks import validate
 from squeeze_grasp_ros.sweep.limits import check_evaluations, check_objects, check_parameter_sets
 from squeeze_grasp_ros.sweep.spec import LoadedSpec, ObjectEntry, SweepError
 
@@ -56,7 +74,7 @@ class ObjectItem:
     id : str
         ``NN-name`` (NN: entry index; families ``NN-name-KKK``).
     shape : dict
-        Scene-style shape mapping (``build_outline``).
+        Scene-style shape mapping (``object.shape``).
     mesh : MeshSpec
     outline : Outline or None
         Outline read from a file by the client (``shape.type: file``), so that workers need
@@ -64,7 +82,7 @@ class ObjectItem:
     """
 
     id: str
-    shape: dict
+    shape: Mapping[str, Any]
     mesh: MeshSpec
     outline: Optional[Outline] = None
 
@@ -94,8 +112,12 @@ class Task:
     spec_hash : str
         Hash of the sweep (workers cache prepared groups under it).
     obj : ObjectItem
-    material : tuple of (str, float, float, float, str)
-        (name, E Pa, nu, thickness m, material model).
+    material : str
+        The material's name.
+    scene : Scene
+        The group's scene (:func:`group_scene`): its object and material, the base scene's
+        squeeze settings and limits; each evaluation places the fingers and sets the
+        parameters (:func:`evaluation_scene`).
     placement_mode : str
     placement_count : int
     placement_filters : tuple of str
@@ -104,9 +126,6 @@ class Task:
     start, stop : int
         Placement index range of this task.
     params : tuple of Params
-    limits : Limits
-    step, event_tol : float
-    max_events_per_depth : int
     adversary : tuple or None
         (position, mode, contacts, directions).
     """
@@ -115,7 +134,8 @@ class Task:
     group: str
     spec_hash: str
     obj: ObjectItem
-    material: tuple
+    material: str
+    scene: Scene
     placement_mode: str
     placement_count: int
     placement_filters: tuple
@@ -125,10 +145,6 @@ class Task:
     start: int
     stop: int
     params: tuple
-    limits: Limits
-    step: float
-    event_tol: float
-    max_events_per_depth: int
     adversary: Optional[tuple]
 
     @property
@@ -143,14 +159,14 @@ def _family_shapes(entry: ObjectEntry, seed: int, name: str) -> list[tuple[str, 
     for k in range(fam.count):
         oid = f"{name}-{k:03d}"
         rng = rng_for(seed, "shape", oid)
-        if fam.type == "superellipse":
-            shape = {"type": "superellipse", "a": float(rng.uniform(*fam.a)),
+        if fam.type == ShapeType.SUPERELLIPSE:
+            shape = {"type": ShapeType.SUPERELLIPSE, "a": float(rng.uniform(*fam.a)),
                      "b": float(rng.uniform(*fam.b)),
                      "exponent": float(rng.uniform(*fam.exponent))}
         else:
             h = np.arange(1, fam.harmonics + 1)
             bound = fam.amplitude / h
-            shape = {"type": "fourier_blob", "radius": float(rng.uniform(*fam.radius)),
+            shape = {"type": ShapeType.FOURIER_BLOB, "radius": float(rng.uniform(*fam.radius)),
                      "cos": rng.uniform(-bound, bound).tolist(),
                      "sin": rng.uniform(-bound, bound).tolist()}
         out.append((oid, shape))
@@ -173,7 +189,7 @@ def objects(loaded: LoadedSpec) -> list[ObjectItem]:
         name = loaded.base.name or "base"
         shape = loaded.base.object.shape
         return [ObjectItem(f"00-{name}", shape, loaded.mesh,
-                           build_outline(shape) if shape["type"] == "file" else None)]
+                           build_outline(shape) if shape["type"] == ShapeType.FILE else None)]
     items = []
     for k, entry in enumerate(sw.objects):
         mesh = entry.mesh or loaded.mesh
@@ -184,13 +200,13 @@ def objects(loaded: LoadedSpec) -> list[ObjectItem]:
             mesh = entry.mesh or scene.object.mesh
         elif entry.outline is not None:
             pairs = [(entry.name or Path(entry.outline).stem,
-                      {"type": "file", "path": entry.outline})]
+                      {"type": ShapeType.FILE, "path": entry.outline})]
         elif entry.shape is not None:
             pairs = [(entry.name or entry.shape["type"], entry.shape)]
         else:
             pairs = _family_shapes(entry, sw.seed, entry.name or entry.family.type)
         items += [ObjectItem(f"{k:02d}-{oid}", shape, mesh,
-                             build_outline(shape) if shape["type"] == "file" else None)
+                             build_outline(shape) if shape["type"] == ShapeType.FILE else None)
                   for oid, shape in pairs]
     return items
 
@@ -211,13 +227,52 @@ def parameter_grid(loaded: LoadedSpec) -> tuple[Params, ...]:
                  for k, (mu, r, kind, (d, rel)) in enumerate(grid))
 
 
-def build_group_mesh(item: ObjectItem):
-    """The mesh of an object (deterministic: the same on every machine with the same Triangle)."""
-    outline = item.outline if item.outline is not None else build_outline(item.shape)
-    ms = item.mesh
-    area = ms.max_area if ms.max_area is not None else target_max_area(
-        outline, ms.nodes if ms.nodes is not None else 600)
-    return generate_mesh(outline, area, min_angle=ms.min_angle)
+UNPLACED: dict = {Finger.F1: FingerSpec(PlacementSpec(angle_deg=180.0)),
+                  Finger.F2: FingerSpec(PlacementSpec(angle_deg=0.0))}
+"""Fingers of a group's scene before an evaluation places them on its nodes (angle placements
+insert no mesh vertex, so the group's mesh is the object's own)."""
+
+
+def group_scene(loaded: LoadedSpec, item: ObjectItem, material: MaterialSpec) -> Scene:
+    """The scene of an (object, material) group: the base scene's squeeze settings, strain
+    limit and the sweep's pickup weight, on ``item`` made of ``material``; friction is set
+    per evaluation.
+    """
+    base = loaded.base
+    strain = base.strain_limit if base.has(Effect.STRAIN_LIMIT) else None
+    pickup = PickupSpec(loaded.weight) if loaded.weight is not None else None
+    effects = (Effect.FRICTION,) + ((Effect.STRAIN_LIMIT,) if strain else ()) + (
+        (Effect.PICKUP,) if pickup else ())
+    scene = Scene(object=ObjectSpec(item.shape, material, mesh=item.mesh),
+                  fingers=UNPLACED, name=item.id, squeeze=base.squeeze,
+                  friction=FrictionSpec(min(loaded.friction)), strain_limit=strain,
+                  pickup=pickup, effects=effects)
+    try:
+        return validate(scene)
+    except SceneError as exc:
+        raise SweepError(f"object {item.id}, material: {exc}") from None
+
+
+def evaluation_scene(scene: Scene, nodes: tuple[int, int], params: Params) -> Scene:
+    """The group's ``scene`` with the fingers on ``nodes`` (F1, F2) and the parameters of one
+    evaluation: friction, fingertip radius, squeeze type and depth.
+    """
+    tip = params.tip_radius
+    return dataclasses.replace(
+        scene,
+        fingers={Finger.F1: FingerSpec(PlacementSpec(node=nodes[0]), tip_radius=tip),
+                 Finger.F2: FingerSpec(PlacementSpec(node=nodes[1]), tip_radius=tip)},
+        friction=FrictionSpec(params.mu),
+        squeeze=dataclasses.replace(scene.squeeze, type=params.kind, depth=params.depth,
+                                    relative_depth=params.relative_depth),
+    )
+
+
+def group_setup(task: Task) -> GraspSetup:
+    """The mechanics of the task's group: its scene meshed (the outline read by the client for
+    an outline file), not yet precomputed.
+    """
+    return GraspSetup.build(task.scene, outline=task.obj.outline)
 
 
 def placement_total(loaded: LoadedSpec, item: ObjectItem) -> int:
@@ -225,7 +280,8 @@ def placement_total(loaded: LoadedSpec, item: ObjectItem) -> int:
     pl = loaded.spec.placements
     if pl.mode == "all":
         try:
-            b = len(build_group_mesh(item).boundary)
+            b = len(GraspSetup.build(group_scene(loaded, item, next(iter(
+                loaded.materials.values()))), outline=item.outline).boundary)
         except Exception as exc:
             raise SweepError(f"object {item.id}: meshing failed: {exc}") from None
         return b * (b - 1) // 2
@@ -245,9 +301,6 @@ def plan_tasks(loaded: LoadedSpec) -> list[Task]:
     totals = [placement_total(loaded, item) for item in items]
     check_evaluations(sum(totals), len(loaded.materials), len(params),
                       len(loaded.materials) * sum(-(-t // per_task) for t in totals))
-    limits = scene_limits(loaded.base)
-    limits = dataclasses.replace(limits, weight=loaded.weight)
-    sq = loaded.base.squeeze
     adversary = None
     if sw.adversary is not None:
         a = sw.adversary
@@ -258,11 +311,10 @@ def plan_tasks(loaded: LoadedSpec) -> list[Task]:
     for item, total in zip(items, totals):
         for mat_name, m in loaded.materials.items():
             group = f"{item.id}~{mat_name}"
+            scene = group_scene(loaded, item, m)
             for c, start in enumerate(range(0, total, per_task)):
                 tasks.append(Task(
-                    f"{group}~c{c:04d}", group, loaded.hash, item,
-                    (mat_name, m.E, m.nu, m.thickness, m.model), pl.mode, pl.count,
-                    tuple(pl.require), float(mu_filter), sw.seed, sw.repeat, start,
-                    min(start + per_task, total), params, limits, sq.step, sq.event_tol,
-                    sq.max_events_per_depth, adversary))
+                    f"{group}~c{c:04d}", group, loaded.hash, item, mat_name, scene, pl.mode,
+                    pl.count, tuple(pl.require), float(mu_filter), sw.seed, sw.repeat, start,
+                    min(start + per_task, total), params, adversary))
     return sorted(tasks, key=lambda t: t.id)

@@ -6,7 +6,7 @@ A sweep names a base scene (defaults for everything not swept: material, mesh, f
 fingertip, squeeze, strain limit, event tolerances), the objects, the axes (materials, friction,
 fingertip radius, squeeze type, depth), the placements per object, an optional pickup weight and
 an optional adversary. The parser is the scene parser
-(:func:`~squeeze_grasp_ros.scene.parse_section`):
+(:func:`~squeeze_grasp_ros.scene.schema.parse_section`):
 unknown keys, wrong types and values out of range raise :class:`SweepError` naming the key.
 """
 
@@ -17,6 +17,7 @@ import hashlib
 import json
 from dataclasses import dataclass
 from pathlib import Path
+from collections.abc import Mapping
 from typing import Any, Optional
 
 from squeeze_grasp_ros.scene import (
@@ -24,18 +25,21 @@ from squeeze_grasp_ros.scene import (
     MeshSpec,
     Scene,
     SceneError,
-    _validate_shape,
     build_outline,
-    key_reference,
     load_scene,
-    parse_section,
     read_yaml,
-    spec,
 )
-from squeeze_grasp_ros.mechanics.elastic.material import require_poisson_ratio
-from squeeze_grasp_ros.mechanics.errors import InvalidInputError
 from squeeze_grasp_ros.mechanics.resistance.optimal import MAX_DIRECTIONS
-from squeeze_grasp_ros.mechanics.vocabulary import Finger
+from squeeze_grasp_ros.scene.checks import check_material, check_shape
+from squeeze_grasp_ros.scene.schema import key_reference, parse_section, spec
+from squeeze_grasp_ros.mechanics.vocabulary import (
+    ContactKind,
+    Effect,
+    Finger,
+    ObjectModel,
+    ShapeType,
+    SqueezeKind,
+)
 
 
 class SweepError(SceneError):
@@ -44,9 +48,9 @@ class SweepError(SceneError):
     """
 
 
-FAMILIES: dict[str, tuple[str, ...]] = {
-    "superellipse": ("a", "b", "exponent"),
-    "fourier_blob": ("radius",),
+FAMILIES: dict[ShapeType, tuple[str, ...]] = {
+    ShapeType.SUPERELLIPSE: ("a", "b", "exponent"),
+    ShapeType.FOURIER_BLOB: ("radius",),
 }
 """Random shape families and their required parameter ranges."""
 
@@ -55,7 +59,7 @@ FAMILIES: dict[str, tuple[str, ...]] = {
 class FamilySpec:
     """Seeded random shapes: every parameter drawn uniformly from its [low, high] range."""
 
-    type: str = spec("shape family", choices=tuple(FAMILIES))
+    type: ShapeType = spec("shape family", choices=tuple(FAMILIES))
     count: int = spec("number of shapes drawn", lo=1)
     a: Optional[tuple[float, float]] = spec(
         "superellipse: half-width range [low, high]", "m", lo=0.0, lo_open=True, default=None
@@ -90,7 +94,8 @@ class ObjectEntry:
     outline: Optional[str] = spec(
         "outline file: CSV 'x,y' per line or JSON {outline: [...]}", "m", default=None
     )
-    shape: Optional[dict] = spec("shape mapping as in scenes (object.shape)", default=None)
+    shape: Optional[Mapping[str, Any]] = spec("shape mapping as in scenes (object.shape)",
+                                              default=None)
     family: Optional[FamilySpec] = spec("seeded random shapes", default=None)
     mesh: Optional[MeshSpec] = spec(
         "mesh settings of this entry (default: the sweep's mesh)", default=None
@@ -138,11 +143,12 @@ class SweepAdversarySpec:
         lo_open=True,
         default=0.5,
     )
-    mode: str = spec("resistance type", choices=("stable", "pure"), default="stable")
-    contacts: str = spec(
+    mode: SqueezeKind = spec("resistance type", choices=SqueezeKind.planned(),
+                             default=SqueezeKind.STABLE)
+    contacts: ContactKind = spec(
         "point: the three nodes; segment: each node and its two neighbours",
-        choices=("point", "segment"),
-        default="point",
+        choices=(ContactKind.POINT.value, ContactKind.SEGMENT.value),
+        default=ContactKind.POINT,
     )
     directions: int = spec(
         "push directions over which W*_F per unit push is minimised and maximised",
@@ -168,7 +174,7 @@ class SweepSpec:
     objects: Optional[tuple[ObjectEntry, ...]] = spec(
         "objects (default: the base scene's)", default=None
     )
-    materials: Optional[dict] = spec(
+    materials: Optional[Mapping[str, Any]] = spec(
         "name -> {E, nu, thickness[, model]} (default: the base scene's, named 'base')",
         default=None,
     )
@@ -179,8 +185,8 @@ class SweepSpec:
     tip_radius: Optional[tuple[float, ...]] = spec(
         "fingertip radii (both fingers)", "m", lo=0.0, lo_open=True, default=None
     )
-    squeeze: Optional[tuple[str, ...]] = spec(
-        "squeeze types", choices=("stable", "pure"), default=None
+    squeeze: Optional[tuple[SqueezeKind, ...]] = spec(
+        "squeeze types", choices=SqueezeKind.planned(), default=None
     )
     depth: Optional[tuple[float, ...]] = spec(
         "squeeze depths rho", "m", lo=0.0, lo_open=True, default=None
@@ -239,7 +245,7 @@ class LoadedSpec:
 
     spec: SweepSpec
     base: Scene
-    materials: dict
+    materials: Mapping[str, MaterialSpec]
     mesh: MeshSpec
     friction: tuple[float, ...]
     tip_radius: tuple[float, ...]
@@ -247,7 +253,7 @@ class LoadedSpec:
     depths: tuple[tuple[Optional[float], Optional[float]], ...]
     weight: Optional[float]
     hash: str
-    raw: dict
+    raw: Mapping[str, Any]
 
 
 def _absolute(path: Optional[str], base_dir: Path) -> Optional[str]:
@@ -290,7 +296,7 @@ def _check_entry(entry: ObjectEntry, where: str) -> None:
             )
     if entry.shape is not None:
         try:
-            _validate_shape(entry.shape)
+            check_shape(entry.shape)
             build_outline(entry.shape)
         except SceneError as exc:
             raise SweepError(f"{where}: {exc}".replace("object.shape", "shape")) from None
@@ -317,20 +323,14 @@ def parse_sweep_spec(data: Any, base_dir: Path) -> LoadedSpec:
     """Validate a sweep given as a mapping; relative paths are relative to ``base_dir``."""
     if not isinstance(data, dict):
         raise SweepError("a sweep spec must be a YAML mapping")
-    try:
-        sw = parse_section(SweepSpec, data, "")
-    except SweepError:
-        raise
-    except SceneError as exc:
-        # the scene parser prefixes top-level unknown keys with "." (empty section path)
-        raise SweepError(str(exc).replace("unknown key .", "unknown key ", 1)) from None
+    sw = parse_section(SweepSpec, data, "", error=SweepError)
     sw = dataclasses.replace(sw, base=_absolute(sw.base, base_dir))
     files = {"base": _file_digest(sw.base, "base")}
     try:
         base = load_scene(sw.base)
     except SceneError as exc:
         raise SweepError(f"base: {exc}") from None
-    if base.object.model != "solid":
+    if base.object.model != ObjectModel.SOLID:
         raise SweepError("base: the sweep needs a solid object (object.model: solid)")
     entries = []
     for k, entry in enumerate(sw.objects or ()):
@@ -349,9 +349,9 @@ def parse_sweep_spec(data: Any, base_dir: Path) -> LoadedSpec:
                 scene = load_scene(entry.scene)
             except SceneError as exc:
                 raise SweepError(f"{where}.scene: {exc}") from None
-            if scene.object.model != "solid":
+            if scene.object.model != ObjectModel.SOLID:
                 raise SweepError(f"{where}.scene: the sweep needs solid objects")
-        if entry.shape is not None and entry.shape.get("type") == "file":
+        if entry.shape is not None and entry.shape.get("type") == ShapeType.FILE:
             path = _absolute(entry.shape["path"], base_dir)
             entry = dataclasses.replace(entry, shape={**entry.shape, "path": path})
             files[f"{where}.shape.path"] = _file_digest(path, f"{where}.shape.path")
@@ -375,13 +375,12 @@ def parse_sweep_spec(data: Any, base_dir: Path) -> LoadedSpec:
                 raise SweepError(
                     f"materials: name {name!r} must use letters, digits, '_', '.', '-'"
                 )
+            materials[name] = parse_section(MaterialSpec, value, f"materials.{name}",
+                                            error=SweepError)
             try:
-                materials[name] = parse_section(MaterialSpec, value, f"materials.{name}")
-                require_poisson_ratio(materials[name].nu, materials[name].model)
+                check_material(materials[name], f"materials.{name}")
             except SceneError as exc:
                 raise SweepError(str(exc)) from None
-            except InvalidInputError as exc:
-                raise SweepError(f"materials.{name}: {exc}") from None
     fingers = base.fingers
     tip = fingers[Finger.F1].tip_radius
     if sw.tip_radius is None and not (tip > 0 and fingers[Finger.F2].tip_radius == tip):
@@ -421,7 +420,7 @@ def parse_sweep_spec(data: Any, base_dir: Path) -> LoadedSpec:
     weight = (
         sw.weight
         if sw.weight is not None
-        else (base.pickup.weight if base.has("pickup") else None)
+        else (base.pickup.weight if base.has(Effect.PICKUP) else None)
     )
     ident = {"spec": data, "files": files}
     digest = hashlib.sha256(json.dumps(ident, sort_keys=True, default=str).encode()).hexdigest()

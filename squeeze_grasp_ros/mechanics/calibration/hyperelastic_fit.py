@@ -186,7 +186,7 @@ def linear_validity(fit: MaterialFit, *, tolerance: float = 0.05,
     always does): the squeeze depth range where the linear model suffices for this material.
     """
     strain = np.linspace(1e-4, max_strain, 2000)
-    P_lin, _ = uniaxial_response("linear", 1 - strain, E=fit.E, nu=fit.nu)
-    P_nh, _ = uniaxial_response("neo_hookean", 1 - strain, E=fit.E, nu=fit.nu)
+    P_lin, _ = uniaxial_response(MaterialModel.LINEAR, 1 - strain, E=fit.E, nu=fit.nu)
+    P_nh, _ = uniaxial_response(MaterialModel.NEO_HOOKEAN, 1 - strain, E=fit.E, nu=fit.nu)
     off = np.abs(P_lin / P_nh - 1.0) > tolerance
     return float(strain[np.argmax(off)]) if off.any() else max_strain

@@ -16,6 +16,7 @@ from typing import Sequence
 import numpy as np
 from scipy.interpolate import CubicSpline
 
+from squeeze_grasp_ros.mechanics.vocabulary import ShapeType
 from squeeze_grasp_ros.inputs import InputError, read_text
 from squeeze_grasp_ros.mechanics.errors import InvalidInputError
 
@@ -80,7 +81,7 @@ def _segments_intersect(p: np.ndarray) -> bool:
     if np.any((np.abs(cross_turn) <= tol * size) & (dot_turn < 0)):
         return True
     lo, hi = np.minimum(a, b) - tol, np.maximum(a, b) + tol
-    order = np.argsort(lo[:, 0], kind="stable")
+    order = np.argsort(lo[:, 0], kind="mergesort")
     reach = np.searchsorted(lo[order, 0], hi[order, 0], side="right")
     counts = np.maximum(reach - np.arange(n) - 1, 0)
     first = np.repeat(np.arange(n), counts)
@@ -212,7 +213,7 @@ def polygon(points: Sequence[Sequence[float]],
     >>> frame.area
     14.0
     """
-    p = validate_polyline(points, "polygon")
+    p = validate_polyline(points, ShapeType.POLYGON)
     inner = tuple(validate_polyline(h, f"polygon.holes[{k}]") for k, h in enumerate(holes))
     for k, hole in enumerate(inner):
         if not _inside(hole[0], p) or _crosses(p, hole) or any(
@@ -276,7 +277,7 @@ def ellipse(a: float, b: float) -> Outline:
     """Ellipse with semi-axes ``a`` (x) and ``b`` (y), m, centred at the origin."""
     _positive(a=a, b=b)
     t = np.linspace(0.0, 2 * np.pi, DENSE, endpoint=False)
-    return _smooth(a * np.cos(t), b * np.sin(t), "ellipse")
+    return _smooth(a * np.cos(t), b * np.sin(t), ShapeType.ELLIPSE)
 
 
 def disk(radius: float) -> Outline:
@@ -293,7 +294,7 @@ def superellipse(a: float, b: float, exponent: float) -> Outline:
     c, s = np.cos(t), np.sin(t)
     x = a * np.sign(c) * np.abs(c) ** (2.0 / exponent)
     y = b * np.sign(s) * np.abs(s) ** (2.0 / exponent)
-    return _smooth(x, y, "superellipse")
+    return _smooth(x, y, ShapeType.SUPERELLIPSE)
 
 
 def fourier_blob(radius: float, cos: Sequence[float] = (), sin: Sequence[float] = ()) -> Outline:
@@ -310,7 +311,7 @@ def fourier_blob(radius: float, cos: Sequence[float] = (), sin: Sequence[float] 
         r += sk * np.sin(k * t)
     if np.min(r) <= 0.05:
         raise InvalidInputError("fourier_blob coefficients make the radius vanish; reduce them")
-    return _smooth(radius * r * np.cos(t), radius * r * np.sin(t), "fourier_blob")
+    return _smooth(radius * r * np.cos(t), radius * r * np.sin(t), ShapeType.FOURIER_BLOB)
 
 
 def spline(points: Sequence[Sequence[float]]) -> Outline:
@@ -320,7 +321,7 @@ def spline(points: Sequence[Sequence[float]]) -> Outline:
     s = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(closed, axis=0), axis=1))])
     cs = CubicSpline(s, closed, bc_type="periodic")
     dense = cs(np.linspace(0.0, s[-1], DENSE, endpoint=False))
-    return Outline(validate_polyline(dense, "spline"))
+    return Outline(validate_polyline(dense, ShapeType.SPLINE))
 
 
 def annulus(outer_radius: float, inner_radius: float) -> Outline:

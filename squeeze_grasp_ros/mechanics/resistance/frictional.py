@@ -28,13 +28,18 @@ the interface, object frame.
 
 from __future__ import annotations
 
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field, replace
 
 import numpy as np
 
 from squeeze_grasp_ros.mechanics.squeeze.contact_model import ContactModel
-from squeeze_grasp_ros.mechanics.squeeze.contact_state import ContactState, Event, initial_state
+from squeeze_grasp_ros.mechanics.squeeze.contact_state import (
+    ContactState,
+    Event,
+    event_counts,
+    initial_state,
+)
 from squeeze_grasp_ros.mechanics.errors import InvalidInputError, require_finite
 from squeeze_grasp_ros.mechanics.squeeze.fingertips import Fingertip
 from squeeze_grasp_ros.mechanics.elastic.mesh import vertex_normals
@@ -45,8 +50,8 @@ from squeeze_grasp_ros.mechanics.resistance.optimal import (
 )
 from squeeze_grasp_ros.mechanics.squeeze.stepper import advance
 from squeeze_grasp_ros.mechanics.vocabulary import (
+    ContactKind,
     ContactMode,
-    EventType,
     Finger,
     SqueezeKind,
     Termination,
@@ -66,8 +71,8 @@ class ResistanceStage:
         Distance travelled by A at the stage's start and end, m.
     psi : (4,) ndarray
         (psi1, psi2): translations of F1 and F2 per unit translation of A (dimensionless).
-    segments : dict of str to tuple of int
-        Contact nodes of F1, F2, A during the stage (I, J, K).
+    segments : mapping
+        Finger -> contact nodes of F1, F2, A during the stage (I, J, K).
     events : tuple of Event
         Events located at the stage's end.
     """
@@ -75,7 +80,7 @@ class ResistanceStage:
     start: float
     end: float
     psi: np.ndarray
-    segments: dict
+    segments: Mapping[Finger, tuple[int, ...]]
     events: tuple[Event, ...]
 
     def to_json(self) -> dict:
@@ -83,9 +88,9 @@ class ResistanceStage:
         return {
             "start": self.start,
             "end": self.end,
-            "psi": {"F1": self.psi[:2].tolist(), "F2": self.psi[2:].tolist()},
+            "psi": {Finger.F1: self.psi[:2].tolist(), Finger.F2: self.psi[2:].tolist()},
             "segments": {f: list(v) for f, v in self.segments.items()},
-            "events": [e.type for e in self.events],
+            "events": [e.type.value for e in self.events],
         }
 
 
@@ -99,8 +104,8 @@ class FrictionalResistance:
         A completed a, or A slipped, while F1 and F2 held.
     reason : str
         "adversary completed a", "adversary slips", "F1 slips", "F2 slips", or a lost contact.
-    mode : {"stable", "pure"}
-        How each stage's directions were chosen.
+    mode : SqueezeKind
+        How each stage's directions were chosen (stable or pure).
     contacts : list of int
         Initial contact nodes [i, j, k] of F1, F2 (before the squeeze) and A.
     a : (2,) ndarray
@@ -109,14 +114,14 @@ class FrictionalResistance:
         Distance A translated, m.
     d1, d2 : (2,) ndarray
         Total translations of F1 and F2 during the resistance, m.
-    work : dict
+    work : mapping
         Work of F1, F2, A during the resistance, J; "total" = F1 + F2 (W_F).
-    forces : dict
+    forces : mapping
         Finger -> (start, end) resultant force on the object, N (each (2,)).
-    force_along : dict
+    force_along : mapping
         F1, F2 -> (start, end) force component along the finger's total translation, N
         (Table 3); A -> along a.
-    trajectories : dict
+    trajectories : mapping
         Finger -> (k, 2) translation since the start of the resistance at each stage end, m
         (the paths are straight between these points).
     events : tuple of Event
@@ -128,32 +133,33 @@ class FrictionalResistance:
         Final state (F1, F2, A).
     start_state : ContactState
         State at the start of the resistance (A just touching).
-    diagnostics : dict
+    diagnostics : mapping
+        Stage counts, conditions and the stepper's counts.
     """
 
     success: bool
     reason: str
-    mode: str
+    mode: SqueezeKind
     contacts: list
     a: np.ndarray
     travelled: float
     d1: np.ndarray
     d2: np.ndarray
-    work: dict
-    forces: dict
-    force_along: dict
-    trajectories: dict
+    work: Mapping[str, float]
+    forces: Mapping[Finger, tuple[np.ndarray, np.ndarray]]
+    force_along: Mapping[Finger, tuple[float, float]]
+    trajectories: Mapping[Finger, np.ndarray]
     events: tuple[Event, ...]
     event_travel: tuple[float, ...]
     stages: tuple[ResistanceStage, ...]
     state: ContactState = field(repr=False)
     start_state: ContactState = field(repr=False)
-    diagnostics: dict = field(default_factory=dict)
+    diagnostics: Mapping[str, object] = field(default_factory=dict)
 
     @property
-    def event_counts(self) -> dict:
+    def event_counts(self) -> dict[str, int]:
         """{"A": n, "B": n, "C": n, "D": n} during the resistance."""
-        return {t: sum(1 for e in self.events if e.type == t) for t in EventType.values()}
+        return event_counts(self.events)
 
     def to_json(self) -> dict:
         """JSON-able dict with the keys of the fixed-contact resistance plus trajectories."""
@@ -161,7 +167,7 @@ class FrictionalResistance:
             "success": self.success,
             "reason": self.reason,
             "mode": self.mode,
-            "contact_model": "friction",
+            "contact_model": ContactKind.FRICTION,
             "contacts": list(self.contacts),
             "segments": {
                 f: [
@@ -222,9 +228,8 @@ def add_adversary(
     deformed = mesh.nodes[loop] + displacement[loop]
     k = mesh.boundary_position(int(node))
     n = vertex_normals(deformed)[k]
-    tip = Fingertip(
-        "A", int(node), deformed[k] + radius * n, float(radius), float(np.arctan2(-n[1], -n[0]))
-    )
+    tip = Fingertip(Finger.A, int(node), deformed[k] + radius * n, float(radius),
+                    float(np.arctan2(-n[1], -n[0])))
     touch = initial_state([tip])
     contact = replace(touch.contacts[0], displacement=np.asarray(displacement[node], float))
     return replace(
@@ -237,7 +242,7 @@ def add_adversary(
     )
 
 
-def slipping_fingers(state: ContactState) -> list[str]:
+def slipping_fingers(state: ContactState) -> list[Finger]:
     """Fingers whose contact nodes all slide the same way (Sec. 5.1)."""
     out = []
     for f in state.fingers:
@@ -251,7 +256,7 @@ def slipping_fingers(state: ContactState) -> list[str]:
     return out
 
 
-def _lost_finger(state: ContactState) -> str:
+def _lost_finger(state: ContactState) -> Finger:
     """The finger whose last contact lost its normal force (after a contact_lost termination)."""
     pressing = {
         f.name: sum(c.normal_force() for c in state.contacts if c.finger == f.name)
@@ -264,12 +269,12 @@ def _outcome(termination: str | None, state: ContactState) -> tuple[bool, str] |
     """(success, reason) if the stepper's termination ends Algorithm 2, else None."""
     if termination == Termination.FINGER_SLIP:
         slipping = slipping_fingers(state)
-        if "A" in slipping:
+        if Finger.A in slipping:
             return True, "adversary slips"
         return False, f"{slipping[0] if slipping else 'a grasping finger'} slips"
     if termination == Termination.CONTACT_LOST:
         finger = _lost_finger(state)
-        return finger == "A", f"{finger} lost contact"
+        return finger == Finger.A, f"{finger} lost contact"
     if termination is not None:
         return False, f"stopped by {termination}"
     return None
@@ -317,18 +322,17 @@ def frictional_resistance(
     --------
     Fig. 10's scene: after its squeeze, the adversary pushes and F2 slips before A's full travel.
 
-    >>> from squeeze_grasp_ros.api import event_squeeze_scene, load_scene, scene_file, scene_solid
-    >>> from squeeze_grasp_ros.scene import placement_node
-    >>> from squeeze_grasp_ros.scene_events import scene_contact_model
-    >>> scene = load_scene(scene_file("resist_fig10"))
-    >>> obj = scene_solid(scene)
-    >>> squeeze, model = event_squeeze_scene(scene, obj), scene_contact_model(scene, obj)
-    >>> adv = scene.adversary
-    >>> node = placement_node(obj.mesh, adv.placement, "adversary")
-    >>> state = add_adversary(squeeze.state, model, squeeze.displacement, node, adv.tip_radius)
+    >>> from squeeze_grasp_ros.api import GraspSetup, load_scene, scene_file
+    >>> setup = GraspSetup.build(load_scene(scene_file("resist_fig10")))
+    >>> squeeze = setup.event_squeeze()
+    >>> model, adv = setup.contact_model(terminations=False), setup.scene.adversary
+    >>> state = add_adversary(squeeze.state, model, squeeze.displacement, setup.adversary_node,
+    ...                       adv.tip_radius)
     >>> res = frictional_resistance(model, state, adv.a)
     >>> print(res.success, res.reason)
     False F2 slips
+
+    The same in one call: :meth:`~squeeze_grasp_ros.scene.setup.GraspSetup.frictional_resistance`.
     """
     a = np.asarray(a, float).reshape(-1)
     require_finite("adversary translation a", a)
@@ -363,7 +367,8 @@ def frictional_resistance(
             diag["stage_reduced_condition_max"], stage.diagnostics["reduced_condition"]
         )
         remaining = length - travelled
-        moves = {"F1": remaining * stage.d1, "F2": remaining * stage.d2, "A": remaining * a_hat}
+        moves = {Finger.F1: remaining * stage.d1, Finger.F2: remaining * stage.d2,
+                 Finger.A: remaining * a_hat}
         depth0 = state.depth
         rate = float(np.linalg.norm(np.concatenate(list(moves.values()))))
         result = advance(
@@ -433,7 +438,7 @@ def _summary(
     forces = {f: (start.finger_force(f), end.finger_force(f)) for f in tuple(Finger)}
     along = {}
     for f in tuple(Finger):
-        d = a if f == "A" else moved[f]
+        d = a if f == Finger.A else moved[f]
         unit = d / max(float(np.linalg.norm(d)), 1e-300)
         along[f] = (float(forces[f][0] @ unit), float(forces[f][1] @ unit))
     success, reason = outcome

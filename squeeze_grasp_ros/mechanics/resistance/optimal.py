@@ -59,7 +59,8 @@ from squeeze_grasp_ros.mechanics.resistance.forms import (
     pure_form,
     stable_form,
 )
-from squeeze_grasp_ros.mechanics.vocabulary import ContactMode, EventType, Finger, SqueezeKind
+from squeeze_grasp_ros.mechanics.squeeze.contact_state import event_counts
+from squeeze_grasp_ros.mechanics.vocabulary import ContactKind, ContactMode, Finger, SqueezeKind
 
 FEASIBILITY_TOL = 1e-7
 """Relative constraint residual above which a resistance is reported as infeasible."""
@@ -76,9 +77,9 @@ class ResistanceGrasp:
     ----------
     obj : ElasticObject
         The object (its cached compliance is reused, never recomputed).
-    segments : dict of str to (k,) ndarray of int
-        Mesh node indices of the contact sets I, J, K keyed "F1", "F2", "A"; the first node of
-        each set is the finger's initial contact node.
+    segments : mapping
+        Finger (F1, F2, A) -> mesh node indices (k,) of its contact set I, J, K; the first node
+        of each set is the finger's initial contact node.
     red : ReducedStiffness
         Reduced stiffness (SI) of the nodes of I, J, K concatenated in that order.
     G : (6, 6) ndarray
@@ -90,7 +91,7 @@ class ResistanceGrasp:
     """
 
     obj: ElasticObject
-    segments: dict
+    segments: Mapping[Finger, np.ndarray]
     red: ReducedStiffness
     G: np.ndarray
     points: np.ndarray
@@ -102,9 +103,9 @@ class ResistanceGrasp:
         return np.array([len(self.segments[f]) for f in tuple(Finger)])
 
     @property
-    def kind(self) -> str:
-        """Contact kind: "point" if every finger touches one node, else "segment"."""
-        return "point" if np.all(self.counts == 1) else "segment"
+    def kind(self) -> ContactKind:
+        """Contact kind: point if every finger touches one node, else segment."""
+        return ContactKind.POINT if np.all(self.counts == 1) else ContactKind.SEGMENT
 
     @property
     def contacts(self) -> list[int]:
@@ -128,16 +129,17 @@ class ResistanceGrasp:
         E_fingers = expansion_matrix(self.counts).T @ self.red.E
         return pure_form(self.G, null_basis(E_fingers.T))
 
-    def form(self, mode: str) -> StableForm | PureForm:
+    def form(self, mode: SqueezeKind) -> StableForm | PureForm:
         """The :class:`StableForm` or :class:`PureForm` of ``mode``."""
-        if mode not in SqueezeKind.values():
+        if mode not in SqueezeKind.planned():
             raise InvalidInputError(
-                f"resistance mode must be one of {list(SqueezeKind.values())}, got {mode!r}"
+                f"resistance mode must be one of {list(SqueezeKind.planned())}, got {mode!r}"
             )
         return self.stable if mode == SqueezeKind.STABLE else self.pure
 
 
-def resistance_grasp(obj: ElasticObject, segments: Mapping[str, Sequence[int]]) -> ResistanceGrasp:
+def resistance_grasp(obj: ElasticObject,
+                     segments: Mapping[Finger, Sequence[int]]) -> ResistanceGrasp:
     """The resistance problem for contact sets ``segments`` = {"F1": I, "F2": J, "A": K}.
 
     Parameters
@@ -209,10 +211,10 @@ def contact_segments(
         gap = np.abs(s - s[k])
         dist = np.minimum(gap, perimeter - gap)
         if half_width is None:
-            near = np.argsort(dist, kind="stable")[:3]
+            near = np.argsort(dist, kind="mergesort")[:3]
         else:
             near = np.flatnonzero(dist <= half_width * (1 + 1e-12))
-            near = near[np.argsort(dist[near], kind="stable")]
+            near = near[np.argsort(dist[near], kind="mergesort")]
         out.append(loop[near])
     return out
 
@@ -223,8 +225,10 @@ class Resistance:
 
     Attributes
     ----------
-    mode : {"stable", "pure"}
-    contact_model : {"point", "segment"}
+    mode : SqueezeKind
+        Stable or pure.
+    contact_model : ContactKind
+        Point or segment.
     success : bool
         False when the adversary cannot be resisted in this mode, or a user-given resistance
         violates the mode's constraints.
@@ -232,16 +236,17 @@ class Resistance:
         Why (human-readable).
     contacts : list of int
         Initial contact nodes [i, j, k] of F1, F2, A.
-    segments : dict of str to list of int
-        Contact node sets of F1, F2, A.
+    segments : mapping
+        Finger -> contact node set of F1, F2, A.
     a : (2,) ndarray
         Adversary translation, m, object frame.
     d1, d2 : (2,) ndarray or None
         Translations of F1 and F2, m (None if there is no resistance).
-    work : dict of str to float or None
-        Work of each finger, J; "total" = F1 + F2 = W_F (eq. 53).
-    forces : dict of str to (2,) ndarray or None
-        Resultant force of each finger on the object, N.
+    work : mapping
+        Finger or "total" -> work, J (None without a resistance); total = F1 + F2 = W_F
+        (eq. 53).
+    forces : mapping
+        Finger -> resultant force (2,) on the object, N (None without a resistance).
     node_forces : (m, 2) ndarray or None
         Force at each contact node, N, in the order of the segments F1, F2, A.
     energy : float or None
@@ -250,31 +255,32 @@ class Resistance:
         Rigid-rotation angle of the displacement field, rad (zero for a pure resistance).
     unit_work : float or None
         W_F / ||a||^2, J/m^2: the work to resist a unit push in this direction.
-    event_counts : dict of str to int
-        Contact events A, B, C, D (all zero at fixed contacts).
-    diagnostics : dict
+    event_counts : mapping
+        Contact events A, B, C, D by letter (all zero at fixed contacts).
+    diagnostics : mapping
         Residuals and condition numbers (see :func:`optimal_resistance`).
     """
 
-    mode: str
-    contact_model: str
+    mode: SqueezeKind
+    contact_model: ContactKind
     success: bool
     reason: str
     contacts: list
-    segments: dict
+    segments: Mapping[Finger, Sequence[int]]
     a: np.ndarray
     d1: np.ndarray | None = None
     d2: np.ndarray | None = None
-    work: dict = field(
-        default_factory=lambda: {k: None for k in (Finger.F1, Finger.F2, "A", "total")}
+    work: Mapping[str, float | None] = field(
+        default_factory=lambda: {k: None for k in (*Finger, "total")}
     )
-    forces: dict = field(default_factory=lambda: {f: None for f in tuple(Finger)})
+    forces: Mapping[Finger, np.ndarray | None] = field(
+        default_factory=lambda: {f: None for f in tuple(Finger)})
     node_forces: np.ndarray | None = None
     energy: float | None = None
     rigid_rotation: float | None = None
     unit_work: float | None = None
-    event_counts: dict = field(default_factory=lambda: dict.fromkeys(EventType.values(), 0))
-    diagnostics: dict = field(default_factory=dict)
+    event_counts: Mapping[str, int] = field(default_factory=lambda: event_counts(()))
+    diagnostics: Mapping[str, object] = field(default_factory=dict)
 
     def psi(self) -> tuple[np.ndarray, np.ndarray] | None:
         """(psi1, psi2) of eq. (61): d1 / ||a||, d2 / ||a|| (dimensionless), or None."""
@@ -311,7 +317,7 @@ class Resistance:
             "a": vec(self.a),
             "d1": vec(self.d1),
             "d2": vec(self.d2),
-            "psi": None if psi is None else {"F1": vec(psi[0]), "F2": vec(psi[1])},
+            "psi": None if psi is None else {Finger.F1: vec(psi[0]), Finger.F2: vec(psi[1])},
             "work": dict(self.work),
             "unit_work": self.unit_work,
             "energy": self.energy,

@@ -35,7 +35,7 @@ from squeeze_grasp_ros.mechanics.ring.squeeze import (
     resolve_limits,
     ring_grasp,
 )
-from squeeze_grasp_ros.mechanics.vocabulary import SqueezeKind
+from squeeze_grasp_ros.mechanics.vocabulary import RingLimit, SqueezeKind
 
 CHUNK = 512
 """Placements per block in the strain search (bounds the temporary memory to ~CHUNK * 9n
@@ -50,8 +50,8 @@ class RingGraspMap:
     ----------
     n : int
         Number of ring nodes.
-    kind : str
-        Squeeze type ("stable" or "pure").
+    kind : SqueezeKind
+        Squeeze type (stable or pure).
     mu : float
         Friction coefficient.
     epsilon : float or None
@@ -71,7 +71,7 @@ class RingGraspMap:
     """
 
     n: int
-    kind: str
+    kind: SqueezeKind
     mu: float
     epsilon: float | None
     pairs: np.ndarray
@@ -87,7 +87,7 @@ class RingGraspMap:
 
     def limit_names(self) -> np.ndarray:
         """(P,) limit names."""
-        return np.asarray(LIMITS)[self.limit_code]
+        return np.asarray(RingLimit.values())[self.limit_code]
 
     def matrix(self, values: np.ndarray, fill: float = np.nan) -> np.ndarray:
         """Symmetric (n, n) matrix of per-placement ``values`` (P,), ``fill`` on the diagonal."""
@@ -111,20 +111,20 @@ class RingGraspMap:
         if started:
             fail &= self.initially_feasible
         codes = self.limit_code[fail]
-        return {name: int(np.sum(codes == k)) for k, name in enumerate(LIMITS)}
+        return {name.value: int(np.sum(codes == k)) for k, name in enumerate(LIMITS)}
 
     def best(self, count: int = 5) -> list[dict]:
         """The ``count`` (>= 0) placements with the largest maximum relative depth."""
         if count < 0:
             raise InvalidInputError(f"the number of best placements must be >= 0, got {count}")
-        order = np.argsort(-self.max_relative_depth, kind="stable")[:count]
+        order = np.argsort(-self.max_relative_depth, kind="mergesort")[:count]
         return [self._entry(k) for k in order]
 
     def _entry(self, k: int) -> dict:
         return {"contacts": [int(self.pairs[k, 0]), int(self.pairs[k, 1])],
                 "max_depth": float(self.max_depth[k]),
                 "max_relative_depth": float(self.max_relative_depth[k]),
-                "limit": LIMITS[int(self.limit_code[k])]}
+                "limit": LIMITS[int(self.limit_code[k])].value}
 
     def to_json(self, best: int = 10) -> dict:
         """A JSON-able summary: counts, depth statistics, failure modes, best placements."""
@@ -136,7 +136,8 @@ class RingGraspMap:
             "initially_feasible_pairs": int(self.initially_feasible.sum()),
             "max_relative_depth": {"min": float(rel.min()), "median": float(np.median(rel)),
                                    "max": float(rel.max())},
-            "limits": {name: int(np.sum(self.limit_code == k)) for k, name in enumerate(LIMITS)},
+            "limits": {name.value: int(np.sum(self.limit_code == k))
+                       for k, name in enumerate(LIMITS)},
             "best": self.best(best),
         }
         r = self.requested_relative_depth
@@ -235,9 +236,8 @@ def ring_grasp_map(ring: RingModel, mu: float, *, epsilon: float | None = None,
 
     Examples
     --------
-    >>> from squeeze_grasp_ros.api import load_scene, scene_file
-    >>> from squeeze_grasp_ros.scene import build_ring
-    >>> ring = build_ring(load_scene(scene_file("ring_ring")))
+    >>> from squeeze_grasp_ros.api import GraspSetup, load_scene, scene_file
+    >>> ring = GraspSetup.build(load_scene(scene_file("ring_ring"))).ring
     >>> gmap = ring_grasp_map(ring, 0.4)
     >>> gmap.n == ring.n, gmap.kind
     (True, 'stable')

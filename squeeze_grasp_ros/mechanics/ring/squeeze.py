@@ -35,12 +35,12 @@ import numpy as np
 from squeeze_grasp_ros.mechanics.elastic.compliance import node_dofs
 from squeeze_grasp_ros.mechanics.errors import InvalidInputError, require_finite
 from squeeze_grasp_ros.mechanics.elastic.reduced import reduce_blocks
-from squeeze_grasp_ros.mechanics.ring.model import RingModel
+from squeeze_grasp_ros.mechanics.ring.model import FIBRE_STRAIN_MEASURE, RingModel
 from squeeze_grasp_ros.mechanics.squeeze.stable_pure import two_contact_direction
-from squeeze_grasp_ros.mechanics.vocabulary import SqueezeKind
+from squeeze_grasp_ros.mechanics.vocabulary import SQUEEZING_FINGERS, RingLimit, SqueezeKind
 
-LIMITS: tuple[str, ...] = ("friction_cone_F1", "friction_cone_F2", "strain", "none")
-"""Names of what bounds the squeeze depth, indexed by the integer limit codes."""
+LIMITS: tuple[RingLimit, ...] = tuple(RingLimit)
+"""What bounds the squeeze depth, indexed by the integer limit codes."""
 EDGE_TOL = 1e-9
 """A force within this relative margin (~rad) of a cone edge at rho = 0+ counts as on the edge."""
 ROOT_IMAG_TOL = 1e-7
@@ -220,7 +220,8 @@ class RingGrasp:
     ----------
     contacts : (2,) ndarray of int
         Initial contact nodes of F1 and F2.
-    kind : {"stable", "pure"}
+    kind : SqueezeKind
+        Stable or pure.
     mu : float
         Friction coefficient (cone half-angle atan(mu)).
     epsilon : float or None
@@ -249,14 +250,14 @@ class RingGrasp:
         Depth at relative depth 1, m (the fingers would meet).
     max_depth : float
         Largest feasible depth, m.
-    limit : str
-        What bounds it: one of :data:`LIMITS`.
+    limit : RingLimit
+        What bounds it.
     condition : float
         Condition number of the reduced compliance (Z^T A Z).
     """
 
     contacts: np.ndarray
-    kind: str
+    kind: SqueezeKind
     mu: float
     epsilon: float | None
     displacement: np.ndarray
@@ -270,7 +271,7 @@ class RingGrasp:
     strain_depth: float
     depth_cap: float
     max_depth: float
-    limit: str
+    limit: RingLimit
     condition: float
 
     @property
@@ -327,12 +328,51 @@ class RingGrasp:
         strain_ok = self.epsilon is None or self.max_strain_at(depth) <= self.epsilon
         return cones_ok and strain_ok
 
-    def limit_depths(self) -> dict[str, float | None]:
+    def limit_depths(self) -> dict[RingLimit, float | None]:
         """Candidate depths (m) by limit name; None where the limit is not reached before the
         smaller of the strain depth and ``depth_cap`` (cone roots are not sought beyond).
         """
         vals = [*self.cone_depths, self.strain_depth]
         return {name: (float(v) if np.isfinite(v) else None) for name, v in zip(LIMITS, vals)}
+
+    def force_angles_at(self, depth: float) -> np.ndarray:
+        """Angle (2,), deg, between each finger's contact force and its contact normal at
+        depth ``depth`` (m); the cone's half-angle is atan(mu).
+        """
+        N = self.normals_at(depth)
+        F = self.forces / np.linalg.norm(self.forces, axis=1, keepdims=True)
+        return np.degrees(np.arccos(np.clip(np.sum(N * F, axis=1), -1.0, 1.0)))
+
+    def to_json(self, depth: float) -> dict:
+        """JSON-able summary (docs/ring.md) with the yes/no test, forces and strain at the
+        requested depth ``depth`` (m).
+        """
+        forces = self.forces_at(depth)
+        at0, at_depth = self.force_angles_at(0.0), self.force_angles_at(depth)
+        return {
+            "elements": len(self.points),
+            "squeeze": self.kind,
+            "mu": self.mu,
+            "epsilon": self.epsilon,
+            "strain_measure": str(FIBRE_STRAIN_MEASURE),
+            "contacts": [int(c) for c in self.contacts],
+            "points": {f: self.points[c].tolist()
+                       for f, c in zip(SQUEEZING_FINGERS, self.contacts)},
+            "depth": float(depth),
+            "relative_depth": self.relative_depth(depth),
+            "max_depth": self.max_depth,
+            "max_relative_depth": self.max_relative_depth,
+            "limit": self.limit.value,
+            "limit_depths": {k.value: v for k, v in self.limit_depths().items()},
+            "feasible_at_requested_depth": self.feasible_at(depth),
+            "forces": {f: forces[k].tolist() for k, f in enumerate(SQUEEZING_FINGERS)},
+            "stiffness": self.stiffness,
+            "max_strain": self.max_strain_at(depth),
+            "max_strain_element": int(np.argmax(self.strains)),
+            "cone_half_angle_deg": float(np.degrees(np.arctan(self.mu))),
+            "force_angle_deg": {f: [float(at0[k]), float(at_depth[k])]
+                                for k, f in enumerate(SQUEEZING_FINGERS)},
+        }
 
 
 def _check_contacts(ring: RingModel, contacts) -> np.ndarray:
@@ -392,12 +432,13 @@ def ring_grasp(
 
     Examples
     --------
-    >>> from squeeze_grasp_ros.api import load_scene, scene_file
-    >>> from squeeze_grasp_ros.scene import build_ring
-    >>> ring = build_ring(load_scene(scene_file("ring_ring")))
+    >>> from squeeze_grasp_ros.api import GraspSetup, load_scene, scene_file
+    >>> ring = GraspSetup.build(load_scene(scene_file("ring_ring"))).ring
     >>> grasp = ring_grasp(ring, [0, ring.n // 2], 0.4)
     >>> print(grasp.kind, bool(grasp.max_depth > 0))
     stable True
+    >>> print(grasp.to_json(0.001)["feasible_at_requested_depth"])
+    True
     """
     if kind not in (SqueezeKind.STABLE, SqueezeKind.PURE):
         raise InvalidInputError(f"squeeze type must be 'stable' or 'pure', got {kind!r}")

@@ -66,7 +66,7 @@ largest angle update (rad) falls below it."""
 
 
 @dataclass(frozen=True)
-class Limits:
+class TerminationLimits:
     """Termination criteria a scene declares (paper Sec. 5.1).
 
     Attributes
@@ -447,7 +447,7 @@ class ContactModel:
         The meshed object (its cached boundary compliance is used unless ``reference``).
     mu : float
         Coulomb friction coefficient (>= 0; 0 = frictionless, every contact slides).
-    limits : Limits
+    limits : TerminationLimits
         Strain and pickup criteria (only what the scene declares is computed).
     reference : bool
         The paper's literal route: no cached compliance, a full solve per evaluation.
@@ -460,7 +460,7 @@ class ContactModel:
 
     obj: ElasticObject
     mu: float
-    limits: Limits = field(default_factory=Limits)
+    limits: TerminationLimits = field(default_factory=TerminationLimits)
     reference: bool = False
     max_events_per_depth: int = 4
     options: SolveOptions = field(default_factory=SolveOptions)
@@ -610,8 +610,17 @@ class ContactModel:
 
     def max_strain(self, sd: SetData, delta: np.ndarray, F: np.ndarray) -> tuple[float, int]:
         """(largest strain by the limit's criterion in :attr:`strain_measure`, element index)
-        of the configuration.
+        of the configuration (counted in :attr:`strain_evaluations`).
         """
+        self._cache["strain_evaluations"] = self.strain_evaluations + 1
+        return self._max_strain(sd, delta, F)
+
+    @property
+    def strain_evaluations(self) -> int:
+        """How many configurations' strain was measured (the strain-limit check's work)."""
+        return self._cache.get("strain_evaluations", 0)
+
+    def _max_strain(self, sd: SetData, delta: np.ndarray, F: np.ndarray) -> tuple[float, int]:
         if sd.strain_map is not None:
             eps = (sd.strain_map @ F.reshape(-1)).reshape(-1, 3)
         else:

@@ -9,13 +9,15 @@ energy in J, polar angles in rad about the fingertip centre (see :mod:`.fingerti
 
 from __future__ import annotations
 
+from collections import Counter
+from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field
 
 import numpy as np
 
 from squeeze_grasp_ros.mechanics.squeeze.event_key import EventFunction, EventKey
 from squeeze_grasp_ros.mechanics.squeeze.fingertips import Fingertip, unit
-from squeeze_grasp_ros.mechanics.vocabulary import ContactMode, Finger
+from squeeze_grasp_ros.mechanics.vocabulary import ContactMode, EventType, Finger, Termination
 
 
 @dataclass(frozen=True)
@@ -24,8 +26,7 @@ class FingerState:
 
     Attributes
     ----------
-    name : str
-        "F1", "F2" or "A".
+    name : Finger
     center : (2,) ndarray
         Current tip centre, m.
     radius : float
@@ -40,7 +41,7 @@ class FingerState:
         -f_t r d theta over them: the friction force against the slip along the tip).
     """
 
-    name: str
+    name: Finger
     center: np.ndarray
     radius: float
     translation: np.ndarray
@@ -56,9 +57,9 @@ class ContactNode:
     ----------
     node : int
         Mesh node index.
-    finger : str
-        Name of the finger it touches.
-    mode : {"stick", "slip"}
+    finger : Finger
+        The finger it touches.
+    mode : ContactMode
         Sticking (moves with the finger, eq. 46) or sliding (force on a cone edge, eq. 47).
     slip : int
         Slip direction for sliding nodes: +1 if its polar angle increases relative to the tip,
@@ -73,8 +74,8 @@ class ContactNode:
     """
 
     node: int
-    finger: str
-    mode: str
+    finger: Finger
+    mode: ContactMode
     slip: int
     theta: float
     displacement: np.ndarray
@@ -127,18 +128,18 @@ class ContactState:
     history: tuple[tuple[int, float], ...] = ()
     holds: tuple[tuple[int, float], ...] = ()
 
-    def finger(self, name: str) -> FingerState:
+    def finger(self, name: Finger) -> FingerState:
         """The finger called ``name``."""
         for f in self.fingers:
             if f.name == name:
                 return f
         raise KeyError(f"no finger {name!r} in the state (have {[f.name for f in self.fingers]})")
 
-    def segment(self, name: str) -> tuple[ContactNode, ...]:
+    def segment(self, name: Finger) -> tuple[ContactNode, ...]:
         """Contact nodes of finger ``name``, ordered by polar angle."""
         return tuple(sorted((c for c in self.contacts if c.finger == name), key=lambda c: c.theta))
 
-    def finger_force(self, name: str) -> np.ndarray:
+    def finger_force(self, name: Finger) -> np.ndarray:
         """Total force (2,) of finger ``name`` on the object, N."""
         forces = [c.force for c in self.contacts if c.finger == name]
         return np.sum(forces, axis=0) if forces else np.zeros(2)
@@ -184,10 +185,12 @@ class Event:
 
     Attributes
     ----------
-    type : {"A", "B", "C", "D"}
+    type : EventType
+        A (new contact), B (break), C (stick to slip) or D (slip to stick); a plain letter is
+        converted.
     node : int
         Mesh node index.
-    finger : str
+    finger : Finger
         The finger involved.
     depth : float
         Squeeze depth at the event, m.
@@ -199,18 +202,22 @@ class Event:
         Slip direction after the event (see :class:`ContactNode`).
     """
 
-    type: str
+    type: EventType
     node: int
-    finger: str
+    finger: Finger
     depth: float
     relative_depth: float
     mode: str
     slip: int = 0
 
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "type", EventType(self.type))
+        object.__setattr__(self, "finger", Finger(self.finger))
+
     def to_json(self) -> dict:
         """``{"type", "node", "finger", "depth", "relative_depth", "mode", "slip"}``."""
         return {
-            "type": self.type,
+            "type": self.type.value,
             "node": self.node,
             "finger": self.finger,
             "depth": self.depth,
@@ -218,6 +225,14 @@ class Event:
             "mode": self.mode,
             "slip": self.slip,
         }
+
+
+def event_counts(events: Iterable[Event]) -> dict[str, int]:
+    """Events of each type, ``{"A": n, "B": n, "C": n, "D": n}`` (keyed by the letters, as in
+    JSON).
+    """
+    counted = Counter(e.type for e in events)
+    return {t.value: counted[t] for t in EventType}
 
 
 @dataclass(frozen=True)
@@ -232,14 +247,14 @@ class Sample:
         Contact nodes.
     thetas : tuple of float
         Their polar angles, rad.
-    finger_forces : dict
-        Finger name -> total force (fx, fy) on the object, N.
+    finger_forces : mapping
+        Finger -> total force (fx, fy) on the object, N.
     """
 
     depth: float
     nodes: tuple[int, ...]
     thetas: tuple[float, ...]
-    finger_forces: dict = field(default_factory=dict)
+    finger_forces: Mapping[Finger, tuple[float, float]] = field(default_factory=dict)
 
 
 @dataclass(frozen=True)
@@ -249,7 +264,7 @@ class Chatter:
     Attributes
     ----------
     node : int
-    finger : str
+    finger : Finger
     depth : float
         Depth at which it was frozen, m.
     until : float
@@ -257,7 +272,7 @@ class Chatter:
     """
 
     node: int
-    finger: str
+    finger: Finger
     depth: float
     until: float
 
@@ -279,14 +294,13 @@ class StepResult:
     fraction : float
         Fraction of the requested translations applied (< 1 after a termination or when
         stopping at the first event).
-    termination : str or None
-        "strain_limit", "finger_slip", "picked_up", "contact_lost" or "element_inverted" if one
-        ended the motion.
+    termination : Termination or None
+        The termination that ended the motion, if one did.
     samples : tuple of Sample
         Accepted points (substep ends and event points), for trajectories.
     chatter : tuple of Chatter
         Nodes frozen by the chattering bound during the call.
-    diagnostics : dict
+    diagnostics : mapping
         Newton iterations and residuals, root-finding evaluations, condition numbers.
     next_substep : float
         The substep the call would have taken next, relative to the object size (the ``step``
@@ -297,8 +311,8 @@ class StepResult:
     state: ContactState
     events: tuple[Event, ...]
     fraction: float
-    termination: str | None
+    termination: Termination | None
     samples: tuple[Sample, ...]
     chatter: tuple[Chatter, ...]
-    diagnostics: dict
+    diagnostics: Mapping[str, float]
     next_substep: float

@@ -20,8 +20,8 @@ import numpy as np
 from squeeze_grasp_ros.mechanics.elastic.compliance import ElasticObject
 from squeeze_grasp_ros.mechanics.squeeze.contact_model import (
     ContactModel,
-    Limits,
     SolveOptions,
+    TerminationLimits,
 )
 from squeeze_grasp_ros.mechanics.squeeze.contact_state import (
     Chatter,
@@ -29,6 +29,7 @@ from squeeze_grasp_ros.mechanics.squeeze.contact_state import (
     ContactState,
     Event,
     Sample,
+    event_counts,
     initial_state,
 )
 from squeeze_grasp_ros.mechanics.errors import (
@@ -39,15 +40,15 @@ from squeeze_grasp_ros.mechanics.errors import (
 from squeeze_grasp_ros.mechanics.elastic.strain_measures import max_principal_strains
 from squeeze_grasp_ros.mechanics.elastic.stress_measures import element_stresses, von_mises
 from squeeze_grasp_ros.mechanics.squeeze.fingertips import place_fingertip
-from squeeze_grasp_ros.mechanics.squeeze.stable_pure import plan_squeeze
+from squeeze_grasp_ros.mechanics.squeeze.stable_pure import finger_motion
 from squeeze_grasp_ros.mechanics.squeeze.stepper import TERMINATION_ORDER, advance
 from squeeze_grasp_ros.mechanics.squeeze.nonlinear_model import (NonlinearContactModel,
                                                                   contact_model)
 from squeeze_grasp_ros.mechanics.vocabulary import (
-    MaterialModel,
-    EventType,
-    Finger,
     SQUEEZING_FINGERS,
+    ContactMode,
+    Finger,
+    MaterialModel,
     SqueezeKind,
     StrainCriterion,
     StrainMeasure,
@@ -80,8 +81,8 @@ class SqueezeRun:
     events: tuple[Event, ...]
     samples: tuple[Sample, ...]
     chatter: tuple[Chatter, ...]
-    termination: str
-    diagnostics: dict
+    termination: Termination
+    diagnostics: Mapping[str, float]
 
 
 def _merge(total: dict, new: dict) -> None:
@@ -175,7 +176,7 @@ class SegmentNode:
     Attributes
     ----------
     node : int
-    mode : {"stick", "slip"}
+    mode : ContactMode
     slip : int
         Slip direction (see :class:`~.contact_state.ContactNode`).
     force : (2,) ndarray
@@ -189,7 +190,7 @@ class SegmentNode:
     """
 
     node: int
-    mode: str
+    mode: ContactMode
     slip: int
     force: np.ndarray
     normal_force: float
@@ -226,7 +227,7 @@ class GraspHealth:
     strain_measure : StrainMeasure
         The material model's own measure: small (linear), biot (corotational) or log
         (neo_hookean).
-    max_principal_strain : dict
+    max_principal_strain : mapping
         StrainMeasure -> largest max(|eps_1|, |eps_2|) of the same field in that measure (every
         measure, to compare fields of different models like for like).
     max_von_mises : float
@@ -237,7 +238,7 @@ class GraspHealth:
     max_displacement : float
         Largest nodal displacement magnitude, m.
     max_displacement_node : int
-    slip_margin : dict
+    slip_margin : mapping
         Finger -> min over its contacts of mu f_n - |f_t|, N.
     """
 
@@ -245,13 +246,13 @@ class GraspHealth:
     max_strain_element: int
     criterion: StrainCriterion
     strain_measure: StrainMeasure
-    max_principal_strain: dict
+    max_principal_strain: Mapping[StrainMeasure, float]
     max_von_mises: float
     max_von_mises_element: int
     stress_measure: StressMeasure
     max_displacement: float
     max_displacement_node: int
-    slip_margin: dict
+    slip_margin: Mapping[Finger, float]
 
     def to_json(self) -> dict:
         """All fields as a JSON-able dict (measures as their names)."""
@@ -276,34 +277,32 @@ class EventSqueeze:
 
     Attributes
     ----------
-    termination : str
-        "depth_reached", "finger_slip", "strain_limit", "picked_up", "contact_lost" or
-        "element_inverted".
+    termination : Termination
     depth, relative_depth : float
         Depth reached, m, and relative depth (fraction).
     target_depth : float
         Requested depth, m.
-    kind : str
-        "stable", "pure" or "custom" (user-given directions).
+    kind : SqueezeKind
+        Stable, pure or custom (user-given directions).
     contacts : tuple of int
         Initial contact nodes (F1, F2).
-    directions : dict
+    directions : mapping
         Finger -> unit translation per depth (m/m).
     mu : float
-    tip_radius : dict
+    tip_radius : mapping
         Finger -> tip radius, m.
     events : tuple of Event
-    segments : dict
+    segments : mapping
         Finger -> tuple of SegmentNode, ordered by polar angle.
     energy : float
         Strain energy 1/2 delta . F, J.
-    work : dict
+    work : mapping
         Finger -> work done on the object, J (sum = energy + frictional dissipation).
-    dissipation : dict
+    dissipation : mapping
         Finger -> energy dissipated by friction at its sliding contacts, J.
-    finger_force : dict
+    finger_force : mapping
         Finger -> (start, end) force along its motion direction, N.
-    trajectories : dict
+    trajectories : mapping
         Node -> ((relative depth, theta rad), ...) while in contact.
     health : GraspHealth
     chatter : tuple of Chatter
@@ -315,8 +314,9 @@ class EventSqueeze:
         Substep and event tolerance used, relative to the object size.
     reference : bool
         Computed by the paper's literal fixed-step route.
-    diagnostics : dict
-    force_curve : dict
+    diagnostics : mapping
+        Stepper and solver counts, residuals and conditions (docs/events.md).
+    force_curve : mapping
         Finger -> ((relative depth, force along its motion N), ...) at every accepted point.
     material_model : MaterialModel
         Constitutive model of the object.
@@ -325,21 +325,21 @@ class EventSqueeze:
         ``health.criterion``); None without one.
     """
 
-    termination: str
+    termination: Termination
     depth: float
     relative_depth: float
     target_depth: float
-    kind: str
+    kind: SqueezeKind
     contacts: tuple[int, ...]
-    directions: dict
+    directions: Mapping[Finger, np.ndarray]
     mu: float
-    tip_radius: dict
+    tip_radius: Mapping[Finger, float]
     events: tuple[Event, ...]
-    segments: dict
+    segments: Mapping[Finger, tuple[SegmentNode, ...]]
     energy: float
-    work: dict
-    finger_force: dict
-    trajectories: dict
+    work: Mapping[Finger, float]
+    finger_force: Mapping[Finger, tuple[float, float]]
+    trajectories: Mapping[int, tuple[tuple[float, float], ...]]
     health: GraspHealth
     chatter: tuple[Chatter, ...]
     displacement: np.ndarray = field(repr=False)
@@ -347,16 +347,16 @@ class EventSqueeze:
     step: float = 1e-3
     event_tol: float = 1e-9
     reference: bool = False
-    diagnostics: dict = field(default_factory=dict)
-    force_curve: dict = field(default_factory=dict)
-    dissipation: dict = field(default_factory=dict)
+    diagnostics: Mapping[str, object] = field(default_factory=dict)
+    force_curve: Mapping[Finger, tuple[tuple[float, float], ...]] = field(default_factory=dict)
+    dissipation: Mapping[Finger, float] = field(default_factory=dict)
     material_model: MaterialModel = MaterialModel.LINEAR
     strain_limit: float | None = None
 
     @property
-    def event_counts(self) -> dict:
+    def event_counts(self) -> dict[str, int]:
         """{"A": n, "B": n, "C": n, "D": n}."""
-        return {t: sum(1 for e in self.events if e.type == t) for t in EventType.values()}
+        return event_counts(self.events)
 
     def to_json(self) -> dict:
         """JSON-able dict with the keys and names of docs/design.md §2 and docs/events.md."""
@@ -464,7 +464,7 @@ def event_squeeze(
     *, kind: str = SqueezeKind.STABLE,
     depth: float | None = None,
     relative_depth: float | None = None,
-    limits: Limits | None = None,
+    limits: TerminationLimits | None = None,
     step: float = 1e-3,
     event_tol: float = 1e-9,
     reference: bool = False,
@@ -491,7 +491,7 @@ def event_squeeze(
     depth, relative_depth : float
         Exactly one: squeeze depth rho, m, or the finger approach over the initial contact
         distance (docs/design.md §2).
-    limits : Limits, optional
+    limits : TerminationLimits, optional
         Strain limit and pickup weight.
     step, event_tol : float
         Substep and event tolerance relative to the object size.
@@ -527,22 +527,8 @@ def event_squeeze(
     radii = (
         dict(tip_radius) if isinstance(tip_radius, Mapping) else dict.fromkeys(names, tip_radius)
     )
-    plan = plan_squeeze(obj, list(contacts), kind=kind)
-    p = obj.mesh.nodes[list(contacts)]
-    distance = float(np.linalg.norm(p[1] - p[0]))
-    if directions is None:
-        u = plan.displacement.reshape(2, 2)
-        dirs = {"F1": u[0], "F2": u[1]}
-        approach = plan.approach_per_unit_depth
-    else:
-        stacked = np.array([directions[n] for n in names], float)
-        norm = float(np.linalg.norm(stacked))
-        if not norm > 0:
-            raise InvalidInputError("squeeze directions must not all be zero")
-        dirs = {n: stacked[k] / norm for k, n in enumerate(names)}
-        approach = float((dirs[Finger.F1] - dirs[Finger.F2]) @ (p[1] - p[0]) / distance)
-        kind = "custom"
-    relative_per_depth = approach / distance
+    motion = finger_motion(obj, contacts, kind=kind, directions=directions)
+    dirs, relative_per_depth, kind = motion.directions, motion.relative_per_depth, motion.kind
     if depth is None:
         if not relative_per_depth > 0:
             raise InvalidInputError(
@@ -551,7 +537,7 @@ def event_squeeze(
         depth = relative_depth / relative_per_depth
     require_relative_depth(depth * relative_per_depth, depth)
     tips = [place_fingertip(obj.mesh, n, int(c), radii[n]) for n, c in zip(names, contacts)]
-    model = contact_model(material_model, obj, mu, limits or Limits(), reference,
+    model = contact_model(material_model, obj, mu, limits or TerminationLimits(), reference,
                           max_events_per_depth, options or SolveOptions())
     run = squeeze_to_depth(
         model, initial_state(tips, relative_per_depth), dirs, depth, step, event_tol, progress,

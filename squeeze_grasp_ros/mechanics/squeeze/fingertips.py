@@ -58,8 +58,7 @@ class Fingertip:
 
     Attributes
     ----------
-    name : str
-        "F1", "F2" or "A".
+    name : Finger
     node : int
         Mesh node of the initial contact (on the outer boundary).
     center : (2,) ndarray
@@ -70,14 +69,14 @@ class Fingertip:
         Polar angle of the initial contact node about the centre, rad (the direction of -n).
     """
 
-    name: str
+    name: Finger
     node: int
     center: np.ndarray
     radius: float
     theta: float
 
 
-def place_fingertip(mesh: Mesh, name: str, node: int, radius: float) -> Fingertip:
+def place_fingertip(mesh: Mesh, name: Finger, node: int, radius: float) -> Fingertip:
     """Fingertip ``name`` of radius ``radius`` (m) touching boundary ``node`` on its outward
     normal.
 
@@ -95,7 +94,8 @@ def place_fingertip(mesh: Mesh, name: str, node: int, radius: float) -> Fingerti
     n = mesh.normal_at(int(node))
     p = mesh.nodes[int(node)]
     center = p + radius * n
-    return Fingertip(name, int(node), center, float(radius), float(np.arctan2(-n[1], -n[0])))
+    return Fingertip(Finger(name), int(node), center, float(radius),
+                     float(np.arctan2(-n[1], -n[0])))
 
 
 def tip_gaps(points: np.ndarray, centers: np.ndarray, radii: np.ndarray) -> np.ndarray:

@@ -163,7 +163,7 @@ class NonlinearContactModel(ContactModel):
         """(largest absolute principal strain in :attr:`strain_measure`, element)."""
         return max_principal_strain(self.field_deformation(u_hat), self.strain_measure)
 
-    def max_strain(self, sd: SetData, delta: np.ndarray, F: np.ndarray) -> tuple[float, int]:
+    def _max_strain(self, sd: SetData, delta: np.ndarray, F: np.ndarray) -> tuple[float, int]:
         """(largest strain in :attr:`strain_measure`, element) of the configuration."""
         return self.field_strain(self._field(sd, delta))
 

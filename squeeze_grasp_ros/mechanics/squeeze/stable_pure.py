@@ -9,6 +9,7 @@ col(AC) are the pure contact displacements, Theorem 8). Depths follow docs/desig
 """
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass
 
 import numpy as np
@@ -20,8 +21,7 @@ from squeeze_grasp_ros.mechanics.elastic.reduced import (
     reduced_stiffness,
     rotation_angle,
 )
-from squeeze_grasp_ros.mechanics.vocabulary import SqueezeKind
-
+from squeeze_grasp_ros.mechanics.vocabulary import SQUEEZING_FINGERS, Finger, SqueezeKind
 
 
 @dataclass(frozen=True)
@@ -30,7 +30,8 @@ class Squeeze:
 
     Attributes
     ----------
-    kind : {"stable", "pure"}
+    kind : SqueezeKind
+        Stable or pure.
     contacts : (m,) ndarray of int
         Initial contact node indices.
     displacement : (2m,) ndarray
@@ -51,7 +52,7 @@ class Squeeze:
         Largest distance between the contact nodes, m.
     """
 
-    kind: str
+    kind: SqueezeKind
     contacts: np.ndarray
     displacement: np.ndarray
     forces: np.ndarray
@@ -158,6 +159,72 @@ def plan_squeeze(obj: ElasticObject, contacts, *, kind: SqueezeKind = SqueezeKin
         approach_per_unit_depth=approach,
         initial_distance=dist,
     )
+
+
+@dataclass(frozen=True)
+class FingerMotion:
+    """How the two fingers of a squeeze translate per unit depth (docs/design.md §2).
+
+    Attributes
+    ----------
+    directions : mapping
+        Finger (F1, F2) -> translation (2,) per unit depth, m/m; the stacked vector has norm 1,
+        so the depth is rho.
+    relative_per_depth : float
+        Relative depth per unit depth, 1/m: the fingers' approach along the chord of the
+        contacts over the contacts' distance, per metre of depth (may be <= 0 for given
+        directions that do not close the fingers).
+    kind : SqueezeKind
+        The planned squeeze (stable, pure), or custom for user-given directions.
+    """
+
+    directions: Mapping[Finger, np.ndarray]
+    relative_per_depth: float
+    kind: SqueezeKind
+
+
+def finger_motion(obj: ElasticObject, contacts, *, kind: SqueezeKind = SqueezeKind.STABLE,
+                  directions=None) -> FingerMotion:
+    """The finger translations of a squeeze from initial contact nodes (F1, F2).
+
+    Parameters
+    ----------
+    obj : ElasticObject
+    contacts : (int, int)
+        Initial contact nodes of F1 and F2.
+    kind : {"stable", "pure"}
+        The planned squeeze (:func:`plan_squeeze`) whose contact displacement the fingers
+        follow; ignored when ``directions`` is given.
+    directions : mapping, optional
+        User-given finger -> translation direction; scaled so the stacked vector has norm 1.
+
+    Raises
+    ------
+    InvalidInputError
+        For bad contacts, an unknown kind or all-zero directions.
+
+    Examples
+    --------
+    >>> from squeeze_grasp_ros.api import GraspSetup, load_scene, scene_file
+    >>> setup = GraspSetup.build(load_scene(scene_file("foam_square")))
+    >>> motion = finger_motion(setup.solid, setup.contacts)
+    >>> print(motion.kind, f"{motion.relative_per_depth:.3f} 1/m")
+    stable 14.142 1/m
+    """
+    p = obj.mesh.nodes[list(contacts)]
+    distance = float(np.linalg.norm(p[1] - p[0]))
+    if directions is None:
+        plan = plan_squeeze(obj, list(contacts), kind=kind)
+        u = plan.displacement.reshape(2, 2)
+        return FingerMotion({Finger.F1: u[0], Finger.F2: u[1]},
+                            plan.approach_per_unit_depth / distance, plan.kind)
+    stacked = np.array([directions[n] for n in SQUEEZING_FINGERS], float)
+    norm = float(np.linalg.norm(stacked))
+    if not norm > 0:
+        raise InvalidInputError("squeeze directions must not all be zero")
+    dirs = {n: stacked[k] / norm for k, n in enumerate(SQUEEZING_FINGERS)}
+    approach = float((dirs[Finger.F1] - dirs[Finger.F2]) @ (p[1] - p[0]) / distance)
+    return FingerMotion(dirs, approach / distance, SqueezeKind.CUSTOM)
 
 
 def force_closure(p_i, n_i, p_j, n_j, mu: float) -> bool:

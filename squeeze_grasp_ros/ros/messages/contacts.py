@@ -24,7 +24,8 @@ from squeeze_grasp_ros.mechanics.vocabulary import ContactMode
 from squeeze_grasp_ros.ros.messages.common import (float64_array, set_stamp, vector3)
 
 
-CONTACT_MODES: dict[str, int] = {"stick": ContactNode.STICK, "slip": ContactNode.SLIP}
+CONTACT_MODES: dict[ContactMode, int] = {ContactMode.STICK: ContactNode.STICK,
+                                         ContactMode.SLIP: ContactNode.SLIP}
 """Mechanics contact mode -> ``ContactNode.mode`` (= ``ContactState.modes``) constant."""
 
 
@@ -105,7 +106,7 @@ def contact_event_msg(event: contact_state.Event, header: Header | None = None) 
     """A located event (types A-D of Sec. 5.3) as ``ContactEvent`` (depth rho in m)."""
     return ContactEvent(
         header=header or Header(),
-        type=event.type,
+        type=event.type.value,
         node=int(event.node),
         finger=event.finger,
         depth=float(event.depth),

@@ -25,6 +25,7 @@ from squeeze_grasp_ros.control.tracker import (
 )
 
 
+from squeeze_grasp_ros.mechanics.vocabulary import EventType, Finger
 from squeeze_grasp_ros.ros.messages.common import (float64_array, header, vector3)
 from squeeze_grasp_ros.ros.messages.contacts import (CONTACT_MODES, contact_arrays_msg)
 
@@ -40,7 +41,7 @@ def tracked_event_msg(event: TrackedEvent, ns: int) -> ContactEvent:
     """A monitor event as ``ContactEvent`` (node -1: taxel patches are not mesh nodes)."""
     return ContactEvent(
         header=header(ns),
-        type=event.type,
+        type=str(event.type),
         node=-1,
         finger=event.finger,
         depth=float(event.depth),
@@ -112,4 +113,5 @@ def prediction_msg(
 
 def predicted_events(msg: ContactEventArray) -> list[PredictedEvent]:
     """The A-D events of a prediction for the tracker."""
-    return [PredictedEvent(e.type, e.finger, float(e.depth)) for e in msg.events]
+    return [PredictedEvent(EventType(e.type), Finger(e.finger), float(e.depth))
+            for e in msg.events]

@@ -32,6 +32,7 @@ from squeeze_grasp_ros.planning import (
     RingTest,
     SqueezePlan,
 )
+from squeeze_grasp_ros.mechanics import vocabulary
 from squeeze_grasp_ros.mechanics.vocabulary import Finger
 
 from squeeze_grasp_ros.ros.messages.common import (
@@ -76,7 +77,8 @@ def load_object_response(
 
     ``precompute_time`` is 0 for a cache hit; ``model_data`` is filled for solids when asked.
     """
-    model = object_model(loaded) if return_model and loaded.model == "solid" else ObjectModel()
+    solid = loaded.model == vocabulary.ObjectModel.SOLID
+    model = object_model(loaded) if return_model and solid else ObjectModel()
     return success(
         LoadObject.Response,
         object_id=loaded.object_id,
@@ -237,11 +239,11 @@ def resistance_fields(d1: np.ndarray, d2: np.ndarray, work: dict, forces: dict) 
         "d2": vector3(d2),
         "work_f1": work[Finger.F1],
         "work_f2": work[Finger.F2],
-        "work_a": work["A"],
+        "work_a": work[Finger.A],
         "work_total": work["total"],
         "force_f1": vector3(forces[Finger.F1]),
         "force_f2": vector3(forces[Finger.F2]),
-        "force_a": vector3(forces["A"]),
+        "force_a": vector3(forces[Finger.A]),
     }
 
 
@@ -271,7 +273,7 @@ def ring_grasp_test_response(test: RingTest, best_count: int) -> RingGraspTest.R
         contacts=int32_array(grasp.contacts),
         max_depth=grasp.max_depth,
         max_relative_depth=grasp.max_relative_depth,
-        limit=grasp.limit,
+        limit=grasp.limit.value,
         feasible=test.feasible,
         depth=depth,
         stiffness=grasp.stiffness,

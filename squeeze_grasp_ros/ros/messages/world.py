@@ -19,6 +19,7 @@ from squeeze_grasp_ros.mechanics.squeeze import contact_state
 
 from squeeze_grasp_ros.sim.world import WorldView
 
+from squeeze_grasp_ros.mechanics.vocabulary import ContactMode
 from squeeze_grasp_ros.ros.messages.common import (float64_array, header, stamp_ns, vector3)
 from squeeze_grasp_ros.ros.messages.contacts import (contact_event_msg, contact_state_msg)
 
@@ -86,8 +87,8 @@ def event_record(msg: ContactEvent) -> dict:
 MARKER_COLOURS: dict[str, tuple[float, float, float]] = {
     "outline": (0.2, 0.4, 0.9),
     "tip": (0.5, 0.5, 0.5),
-    "stick": (0.1, 0.75, 0.2),
-    "slip": (0.9, 0.2, 0.1),
+    ContactMode.STICK: (0.1, 0.75, 0.2),
+    ContactMode.SLIP: (0.9, 0.2, 0.1),
     "force": (0.95, 0.7, 0.1),
 }
 """RGB of the visualisation markers (contacts: sticking green, sliding red)."""

@@ -52,8 +52,9 @@ from squeeze_grasp_interfaces.srv import (EventSqueeze, GraspMap, LoadObject, Pl
                                           PlanSqueeze, RingGraspTest)
 
 from squeeze_grasp_ros import planning
+from squeeze_grasp_ros.mechanics.vocabulary import ObjectModel
 from squeeze_grasp_ros.ros import messages
-from squeeze_grasp_ros.planning import Cancelled, ErrorCode, Limits
+from squeeze_grasp_ros.planning import Cancelled, ErrorCode, PlannerLimits
 from squeeze_grasp_ros.resources import share_dir
 from squeeze_grasp_ros.ros.nodes import run_node
 
@@ -125,11 +126,11 @@ class PlannerNode(Node):
             self.declare_parameter(name, default, ParameterDescriptor(
                 description=description, dynamic_typing=isinstance(default, float)))
         value = self._parameter
-        self.limits = Limits(max_nodes=value("max_nodes"),
+        self.limits = PlannerLimits(max_nodes=value("max_nodes"),
                              max_spectral_nodes=value("max_spectral_nodes"),
                              max_ring_elements=value("max_ring_elements"),
                              default_route=planning.solver_route(value("default_solver_route"),
-                                                                 Limits()),
+                                                                 PlannerLimits()),
                              best_count=value("best_count"), min_step=float(value("min_step")),
                              max_bytes=int(value("cache_max_megabytes")) * 2**20)
         roots = [Path(r) for r in value("allowed_roots") if r] or [share_dir(), Path.cwd()]
@@ -259,7 +260,7 @@ class PlannerNode(Node):
             stages = 1
             if goal.scene_yaml or goal.scene_path:
                 source = planning.read_scene(goal.scene_yaml, goal.scene_path, self.roots)
-                stages += len(planning.RING_STAGES if source.scene.object.model == "ring"
+                stages += len(planning.RING_STAGES if source.scene.object.model == ObjectModel.RING
                               else planning.SOLID_STAGES)
                 loaded, _ = planning.load_cached(
                     self.cache, source, goal.object_id, goal.solver_route, self.limits,

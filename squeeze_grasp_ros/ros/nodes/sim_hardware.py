@@ -36,8 +36,9 @@ from visualization_msgs.msg import MarkerArray
 
 from squeeze_grasp_interfaces.msg import ContactEventArray, SimState, TactileArray, Tick
 
+from squeeze_grasp_ros.mechanics.vocabulary import Effect
 from squeeze_grasp_ros.ros import messages
-from squeeze_grasp_ros.scene import load_scene
+from squeeze_grasp_ros.scene import GraspSetup, load_scene
 from squeeze_grasp_ros.sim.world import SimWorld, TickOutput
 from squeeze_grasp_ros.ros.nodes import ParameterError, pipeline, run_node
 
@@ -73,7 +74,7 @@ class SimHardwareNode(Node):
             if not self.p["scene"]:
                 raise ParameterError("parameter 'scene' (a scene YAML file) is required: "
                                      "--ros-args -p scene:=/path/to/scene.yaml")
-            world = SimWorld(load_scene(self.p["scene"]))
+            world = SimWorld(GraspSetup.build(load_scene(self.p["scene"])))
         self.world = world
         self.frame = self.p["frame_id"]
         loop = pipeline.loop_qos(self.p["qos_depth"])
@@ -83,8 +84,9 @@ class SimHardwareNode(Node):
         self.clock_pub = pub(Clock, pipeline.CLOCK, loop)
         self.pose_pubs = {f: pub(PoseStamped, pipeline.device_topic(d, "pose"), sensors)
                           for f, d in self.devices.items()}
+        sensed = world.scene.has(Effect.FORCE_SENSING)
         self.wrench_pubs = {f: pub(WrenchStamped, pipeline.device_topic(d, "wrench"), sensors)
-                            for f, d in self.devices.items() if world.scene.has("force_sensing")}
+                            for f, d in self.devices.items() if sensed}
         self.tactile_pubs = {f: pub(TactileArray, pipeline.device_topic(d, "tactile"), sensors)
                              for f, d in self.devices.items() if f in world.layouts}
         self.msgs = {f: self._reading_messages(f) for f in self.devices}

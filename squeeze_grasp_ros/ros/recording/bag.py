@@ -401,8 +401,8 @@ class BagContents:
     """
 
     messages: tuple[BagMessage, ...]
-    types: dict
-    custom_data: dict
+    types: dict[str, str]
+    custom_data: dict[str, str]
 
     def counts(self) -> Counter:
         """Messages per topic."""

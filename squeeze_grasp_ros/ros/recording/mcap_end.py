@@ -15,7 +15,7 @@ import io
 import struct
 from collections import Counter
 from dataclasses import dataclass, field
-from typing import BinaryIO
+from typing import Any, BinaryIO
 
 from mcap.data_stream import ReadDataStream, RecordBuilder
 from mcap.opcode import Opcode
@@ -49,8 +49,8 @@ class DataSection:
     """
 
     end: int = len(MCAP0_MAGIC)
-    schemas: dict = field(default_factory=dict)
-    channels: dict = field(default_factory=dict)
+    schemas: dict[int, Any] = field(default_factory=dict)
+    channels: dict[int, Any] = field(default_factory=dict)
     chunk_indexes: list = field(default_factory=list)
     metadata_indexes: list = field(default_factory=list)
     counts: Counter = field(default_factory=Counter)

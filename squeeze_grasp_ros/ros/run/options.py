@@ -11,10 +11,12 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 from pathlib import Path
+from collections.abc import Mapping
 from typing import Any
 
 import yaml
 
+from squeeze_grasp_ros.mechanics.vocabulary import Effect
 from squeeze_grasp_ros.resources import config_dir
 from squeeze_grasp_ros.scene import Scene, finger_devices
 
@@ -80,7 +82,7 @@ class RunOptions:
     on_slip_alarm: str = "hold"
     resist: bool = True
     planner: bool = True
-    overrides: dict = field(default_factory=dict)
+    overrides: Mapping[str, Mapping[str, Any]] = field(default_factory=dict)
     timeout: float = 300.0
     namespace: str | None = None
 
@@ -94,10 +96,10 @@ def node_parameters(
     mapping = [f"{f}:{d}" for f, d in devices.items()]
     streams = [
         s
-        for s, effect in (("wrench", "force_sensing"), ("tactile", "tactile_sensing"))
+        for s, effect in (("wrench", Effect.FORCE_SENSING), ("tactile", Effect.TACTILE_SENSING))
         if scene.has(effect)
     ]
-    noise = scene.sensors.noise_std if scene.has("sensor_noise") else 0.0
+    noise = scene.sensors.noise_std if scene.has(Effect.SENSOR_NOISE) else 0.0
     params["sim_hardware"].update(
         scene=str(Path(scene_path).resolve()),
         participants=["monitor", "executor"] + (["recorder"] if options.record else []),
@@ -107,7 +109,7 @@ def node_parameters(
         finger_devices=mapping,
         streams=streams or [""],
         mu=float(scene.mu),
-        weight=float(scene.pickup.weight) if scene.has("pickup") else 0.0,
+        weight=float(scene.pickup.weight) if scene.has(Effect.PICKUP) else 0.0,
         relative_per_depth=float(relative_per_depth),
         load_threshold=max(float(monitor.get("load_threshold", 0.005)), 6.0 * noise),
     )

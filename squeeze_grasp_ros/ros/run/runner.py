@@ -14,9 +14,9 @@ drive the steps themselves):
    launch`` would start them);
 3. the plan: the planner node's services when the planner exists (``load_object``,
    ``event_squeeze`` for the directions and the predicted events, ``plan_squeeze`` for the pure
-   directions), else :func:`squeeze_grasp_ros.scene_plan.plan_scene` directly; the resistance
+   directions), else :func:`squeeze_grasp_ros.scene.goal.plan_scene` directly; the resistance
    waypoints (scenes with a frictional adversary) from Algorithm 2
-   (:func:`squeeze_grasp_ros.scene_plan.resistance_goal`);
+   (:func:`squeeze_grasp_ros.scene.goal.resistance_goal`);
 4. the prediction latched on ``planner/predicted_events``, the ``ExecuteGrasp`` goal, progress
    from its feedback, the result; ground truth from ``sim/events`` and ``sim/state``.
 
@@ -68,24 +68,16 @@ from squeeze_grasp_ros.control.motion import GraspGoal
 from squeeze_grasp_ros.exit_codes import Interrupted
 from squeeze_grasp_ros.ros.recording.bag import plain_yaml
 from squeeze_grasp_ros.resources import config_dir, share_dir
-from squeeze_grasp_ros.scene import (
-    Scene,
-    SceneError,
-    finger_devices,
-    load_scene,
-)
+from squeeze_grasp_ros.scene import GraspSetup, Scene, SceneError, finger_devices, load_scene
 from squeeze_grasp_ros.ros.nodes import PARAMS_FILE_ENV, PARENT_PID_ENV, pipeline
 from squeeze_grasp_ros.ros.nodes.recorder import cdr_stamp_ns
 from squeeze_grasp_ros.ros.run.goal_client import GoalClient
 from squeeze_grasp_ros.ros.run.options import (EXECUTORS, PLANNER_MODULE, RunError,
                                                RunOptions, node_parameters)
 from squeeze_grasp_ros.ros.run.summary import GRASP_HELD, Observed, Plan, run_summary
-from squeeze_grasp_ros.scene_plan import plan_scene, resistance_goal, resists
+from squeeze_grasp_ros.scene.goal import plan_scene, resistance_goal, resists
 from squeeze_grasp_ros.threads import single_thread_blas
-from squeeze_grasp_ros.mechanics.vocabulary import (
-    SQUEEZING_FINGERS,
-    SqueezeKind,
-)
+from squeeze_grasp_ros.mechanics.vocabulary import SQUEEZING_FINGERS, ShapeType, SqueezeKind
 
 GRAPH_CHECK_PERIOD = 1.0
 """Wall-clock seconds between two checks of the run's namespace for foreign traffic."""
@@ -168,6 +160,24 @@ def ros_arguments(namespace: str) -> list[str]:
         return ["--ros-args"]
     return ["--ros-args", "-r", f"__ns:={namespace}", "-r", f"/clock:={namespace}/clock"]
 
+
+
+CHILD_STOP_TIMEOUT = 30.0
+"""Wall-clock seconds a node process has to end after SIGINT before it is killed."""
+
+
+def stop_child(proc: subprocess.Popen, signum: int | None = signal.SIGINT) -> None:
+    """Stop a node process: ``signum`` (None: already sent), then SIGKILL if it has not ended
+    within :data:`CHILD_STOP_TIMEOUT` (a process still importing under load ignores SIGINT
+    until its handlers are installed).
+    """
+    if signum is not None and proc.poll() is None:
+        proc.send_signal(signum)
+    try:
+        proc.wait(CHILD_STOP_TIMEOUT)
+    except subprocess.TimeoutExpired:
+        proc.kill()
+        proc.wait()
 
 class PipelineRunner:
     """The pipeline of one scene on real rclpy nodes (see the module docstring).
@@ -506,7 +516,7 @@ class PipelineRunner:
         """
         folders = [Path(self.options.scene_path).resolve().parent, share_dir(), Path.cwd()]
         shape = self.scene.object.shape
-        if shape["type"] == "file":
+        if shape["type"] == ShapeType.FILE:
             folders.append(Path(shape["path"]).resolve().parent)
         return [str(f) for f in folders]
 
@@ -530,11 +540,7 @@ class PipelineRunner:
                 env=self._child_environment(),
             )
 
-            def stop_process() -> None:
-                proc.send_signal(signal.SIGINT)
-                proc.wait(30)
-
-            return stop_process
+            return lambda: stop_child(proc)
         from squeeze_grasp_ros.ros.nodes.planner import PlannerNode
 
         node = PlannerNode(
@@ -607,7 +613,7 @@ class PipelineRunner:
         )
         rpd = squeeze.relative_depth / squeeze.depth if squeeze.depth > 0 else 0.0
         resist = resists(self.scene, resist=self.options.resist)
-        resistance = resistance_goal(self.scene) if resist else {}
+        resistance = resistance_goal(GraspSetup.build(self.scene)) if resist else {}
         goal = GraspGoal(
             SQUEEZING_FINGERS,
             directions,
@@ -697,11 +703,7 @@ class PipelineRunner:
                 if proc.poll() is None:
                     proc.send_signal(signal.SIGINT)
             for proc in self.processes:
-                try:
-                    proc.wait(30)
-                except subprocess.TimeoutExpired:
-                    proc.kill()
-                    proc.wait()
+                stop_child(proc, signum=None)
         finally:
             for node in self.nodes + [self.client]:
                 if node in self.executor.get_nodes():

@@ -51,7 +51,7 @@ class Observed:
 
     state: SimState
     sim_events: Sequence[ContactEvent]
-    world_end: dict | None
+    world_end: Mapping[str, Any] | None
     monitor_events: Sequence[ContactEvent]
     alarms: Counter
     first_alarm: Mapping[str, dict]

@@ -59,7 +59,7 @@ class ContactSet:
     @classmethod
     def of(cls, model: ContactModel, nodes, finger, stick, slip, theta) -> ContactSet:
         """The set of these nodes (any order; sorted here) and its model data."""
-        order = np.argsort(np.asarray(nodes, int), kind="stable")
+        order = np.argsort(np.asarray(nodes, int), kind="mergesort")
         nodes = np.asarray(nodes, int)[order]
         return cls(nodes, np.asarray(finger, int)[order], np.asarray(stick, bool)[order],
                    np.asarray(slip, int)[order], np.asarray(theta, float)[order],

@@ -14,13 +14,16 @@ from dataclasses import dataclass
 import numpy as np
 
 from squeeze_grasp_ros.control.motion import GraspGoal
-from squeeze_grasp_ros.mechanics.elastic.compliance import ElasticObject
-from squeeze_grasp_ros.mechanics.resistance.frictional import add_adversary, frictional_resistance
 from squeeze_grasp_ros.mechanics.squeeze.events import EventSqueeze
 from squeeze_grasp_ros.mechanics.squeeze.stable_pure import plan_squeeze
-from squeeze_grasp_ros.mechanics.vocabulary import SQUEEZING_FINGERS, Finger, SqueezeKind
-from squeeze_grasp_ros.scene import Scene, finger_nodes, placement_node, scene_solid
-from squeeze_grasp_ros.scene_events import event_squeeze_scene, scene_contact_model
+from squeeze_grasp_ros.mechanics.vocabulary import (
+    SQUEEZING_FINGERS,
+    ContactKind,
+    Finger,
+    SqueezeKind,
+)
+from squeeze_grasp_ros.scene.setup import GraspSetup
+from squeeze_grasp_ros.scene.specs import Scene
 
 __all__ = ["ScenePlan", "plan_scene", "resistance_goal", "resists"]
 
@@ -47,34 +50,22 @@ class ScenePlan:
 def resists(scene: Scene, *, resist: bool = True) -> bool:
     """True if the scene has a frictional adversary and resistance is asked for."""
     adv = scene.adversary
-    return resist and adv is not None and adv.contacts == "friction"
+    return resist and adv is not None and adv.contacts == ContactKind.FRICTION
 
 
-def resistance_goal(scene: Scene, obj: ElasticObject | None = None,
-                    contacts: tuple[int, int] | None = None,
-                    squeeze: EventSqueeze | None = None) -> dict:
+def resistance_goal(setup: GraspSetup, squeeze: EventSqueeze | None = None) -> dict:
     """The resistance fields of a :class:`GraspGoal` after the scene's squeeze (Algorithm 2).
 
-    The adversary is sent as far as Algorithm 2 got (all of a, or until it slipped). ``obj``,
-    ``contacts`` and ``squeeze`` default to the scene's; pass them to reuse a squeeze.
+    The adversary is sent as far as Algorithm 2 got (all of a, or until it slipped).
+    ``squeeze`` defaults to the setup's; pass it to reuse a squeeze.
     """
-    adv = scene.adversary
-    if obj is None:
-        obj = scene_solid(scene)
-    if contacts is None:
-        contacts = finger_nodes(scene, obj.mesh)
     if squeeze is None:
-        squeeze = event_squeeze_scene(scene, obj, contacts)
-    model = scene_contact_model(scene, obj)
-    node = placement_node(obj.mesh, adv.placement, "adversary")
-    state = add_adversary(squeeze.state, model, squeeze.displacement, node, adv.tip_radius)
-    plan = frictional_resistance(
-        model, state, adv.a, mode=adv.mode, step=squeeze.step, event_tol=squeeze.event_tol
-    )
+        squeeze = setup.event_squeeze()
+    plan = setup.frictional_resistance(squeeze)
     travel = np.array([s.end for s in plan.stages])
     keep = np.concatenate([[True], np.diff(travel) > 0]) & (travel > 0)
     waypoints = np.stack([plan.trajectories[f][1:] for f in SQUEEZING_FINGERS], axis=1)
-    a = np.asarray(adv.a, float)
+    a = np.asarray(setup.scene.adversary.a, float)
     travel = travel[keep]
     return {
         "adversary": Finger.A,
@@ -89,14 +80,13 @@ def plan_scene(scene: Scene, *, on_slip_alarm: str = "hold", resist: bool = True
     at the same contacts and, for a frictional adversary, the resistance waypoints.
     """
     t0 = time.perf_counter()
-    obj = scene_solid(scene)
-    contacts = finger_nodes(scene, obj.mesh)
-    result = event_squeeze_scene(scene, obj, contacts)
+    setup = GraspSetup.build(scene)
+    result = setup.event_squeeze()
     directions = np.array([result.directions[f] for f in SQUEEZING_FINGERS])
     rpd = result.relative_depth / result.depth if result.depth > 0 else 0.0
-    pure = plan_squeeze(obj, list(contacts), kind=SqueezeKind.PURE).displacement.reshape(2, 2)
-    resistance = (resistance_goal(scene, obj, contacts, result)
-                  if resists(scene, resist=resist) else {})
+    pure = plan_squeeze(setup.solid, list(setup.contacts),
+                        kind=SqueezeKind.PURE).displacement.reshape(2, 2)
+    resistance = resistance_goal(setup, result) if resists(scene, resist=resist) else {}
     goal = GraspGoal(SQUEEZING_FINGERS, directions, result.target_depth, rpd, on_slip_alarm,
                      pure, **resistance)
     return ScenePlan(goal, result, time.perf_counter() - t0)

@@ -36,6 +36,7 @@ from pathlib import Path
 import yaml
 
 from squeeze_grasp_ros.bench.table import Table
+from squeeze_grasp_ros.mechanics.vocabulary import Factorizer
 from squeeze_grasp_ros.resources import share_dir
 from squeeze_grasp_ros.sweep.evaluate import clear_cache, prepare, run_task
 from squeeze_grasp_ros.sweep.plan import plan_tasks
@@ -47,8 +48,7 @@ KERNEL_PATTERNS: tuple[str, ...] = (
     r"|slogdet)$",
     r"_flapack|_fblas",
     r"SuperLU|_superlu|gstrf|gstrs",
-    r"qdldl",
-    r"cholmod",
+    *(re.escape(f.value) for f in Factorizer),  # QDLDL, CHOLMOD: module names as the values
 )
 """Regular expressions on a profile entry's ``file:function``: a match is a linear-algebra
 kernel (LAPACK through numpy.linalg's factorising functions or scipy.linalg, SuperLU, QDLDL,

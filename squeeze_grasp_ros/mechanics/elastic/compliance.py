@@ -308,9 +308,15 @@ class ElasticObject:
 
     def boundary_positions(self, nodes) -> np.ndarray:
         """Position of each node in the outer boundary loop, -1 where it is not on it."""
+        return self._boundary_lookup[np.asarray(nodes, dtype=int)]
+
+    @cached_property
+    def _boundary_lookup(self) -> np.ndarray:
+        """Position in the outer boundary loop of every mesh node (n,), -1 off it."""
         lookup = -np.ones(self.mesh.n, dtype=int)
         lookup[self.mesh.boundary] = np.arange(len(self.mesh.boundary))
-        return lookup[np.asarray(nodes, dtype=int)]
+        lookup.flags.writeable = False
+        return lookup
 
     @cached_property
     def boundary_compliance(self) -> np.ndarray:

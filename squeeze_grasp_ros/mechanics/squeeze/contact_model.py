@@ -63,6 +63,9 @@ SINGULAR_SLIDING = (
 NEWTON_TOL = 1e-14
 """Newton stops when the cone residual is below this times the force scale |C| r, or when the
 largest angle update (rad) falls below it."""
+BOUNDARY_ROWS_KEPT = 8
+"""Row selections of the boundary compliance the fast model keeps for its last contact set
+(each 2k x 2m floats for k rows and m contacts)."""
 
 
 @dataclass(frozen=True)
@@ -604,9 +607,25 @@ class ContactModel:
         if sd.A_bc is None:
             u = self.full_displacement(sd, delta, F).reshape(-1, 2)
             return u[b[rows]]
-        d = node_dofs(rows)
-        u = sd.A_bc[d] @ F.reshape(-1) + self.obj.rigid[node_dofs(b[rows])] @ g
+        A, R = self._boundary_rows(sd, rows)
+        u = A @ F.reshape(-1) + R @ g
         return u.reshape(-1, 2)
+
+    def _boundary_rows(self, sd: SetData, rows: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """The rows of A_bc and of the rigid modes of boundary positions ``rows``, kept for the
+        last contact set (a substep's start and end, its events' look-ups ask for the same rows).
+        """
+        kept = self._cache.get("boundary_rows")
+        if kept is None or kept[0] is not sd:
+            kept = self._cache["boundary_rows"] = (sd, {})
+        tag = (rows.dtype.str, rows.tobytes())
+        made = kept[1].get(tag)
+        if made is None:
+            if len(kept[1]) >= BOUNDARY_ROWS_KEPT:
+                kept[1].clear()
+            made = kept[1][tag] = (sd.A_bc[node_dofs(rows)],
+                                   self.obj.rigid[node_dofs(self.boundary_nodes[rows])])
+        return made
 
     def max_strain(self, sd: SetData, delta: np.ndarray, F: np.ndarray) -> tuple[float, int]:
         """(largest strain by the limit's criterion in :attr:`strain_measure`, element index)
@@ -667,17 +686,20 @@ class ContactModel:
         """
         g = sd.E.T @ delta.reshape(-1)
         rigid = (self.obj.rigid_gradients @ g).reshape(-1, 4)
-        bounds = self._cache.get("gradient_bounds")
-        if bounds is None or bounds[0] is not sd:  # the bounds of the last contact set kept
-            bounds = self._cache["gradient_bounds"] = (
-                sd, self.obj.gradient_bounds(tuple(sd.nodes.tolist())))
-        bound = bounds[1] @ np.sqrt((F * F).sum(axis=1)) + np.sqrt((rigid * rigid).sum(axis=1))
+        kept = self._cache.get("gradient_bounds")
+        if kept is None or kept["set"] is not sd:  # the last contact set's bounds are kept
+            kept = self._cache["gradient_bounds"] = {
+                "set": sd, "bounds": self.obj.gradient_bounds(tuple(sd.nodes.tolist()))}
+        bound = (kept["bounds"] @ np.sqrt((F * F).sum(axis=1))
+                 + np.sqrt((rigid * rigid).sum(axis=1)))
         exact = bound >= GRADIENT_BOUND_EXACT
         near, rest = np.flatnonzero(exact), bound[~exact]
         floor = (1.0 - rest.max()) ** 2 if rest.size else np.inf
         if near.size == 0:
             return float(floor), -1
-        H = rigid[near] + sum(G[near] @ f for G, f in zip(self.obj.load_gradients(sd.nodes), F))
+        if "loads" not in kept:
+            kept["loads"] = self.obj.load_gradients(sd.nodes)
+        H = rigid[near] + sum(G[near] @ f for G, f in zip(kept["loads"], F))
         det = (1.0 + H[:, 0]) * (1.0 + H[:, 3]) - H[:, 1] * H[:, 2]
         k = int(np.argmin(det))
         return (float(det[k]), int(near[k])) if det[k] <= floor else (float(floor), -1)

@@ -48,9 +48,10 @@ def test_a_pure_python_workload_has_no_kernel_time():
 
 
 @pytest.mark.slow
-def test_the_example_sweep_evaluations_are_profiled_with_their_sparse_solves():
+def test_the_example_sweep_evaluations_are_timed_and_profiled_with_their_sparse_solves():
     m = measure(share_dir() / "config" / "sweeps" / "example.yaml", tasks=1)
     names = {f for (_, _, f) in m["stats"].stats}
-    assert m["evaluations"] > 0 and m["cpu_s"] > 0
+    assert 0 < m["profiled"] < m["evaluations"]  # one task profiled, all timed
+    assert m["cpu_s"] > 0 and m["control_s"] > 0
     assert "<method 'solve' of 'SuperLU' objects>" in names
     assert 0.0 < m["kernel_s"] < m["profiled_s"]

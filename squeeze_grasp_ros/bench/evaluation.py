@@ -2,11 +2,14 @@
 # SPDX-License-Identifier: Apache-2.0
 """One event-driven evaluation: where its time goes, and the share of linear-algebra kernels.
 
-The example sweep's evaluations (``config/sweeps/example.yaml``, the quick run its first two
-tasks) run once untimed to prepare their groups, once timed (CPU time of this process, BLAS as
-the process has it) and once under :mod:`cProfile`. The profile's self times are sorted into
-linear-algebra kernels (:data:`KERNEL_PATTERNS`) and everything else; the share is the kernels'
-self time over the profile's total. A reader reproduces it with
+The example sweep's evaluations (``config/sweeps/example.yaml``, 288 of them) are prepared
+(mesh, factorisation, grasp map per group, untimed), timed (CPU time of this process) between
+two runs of a pure-Python control loop, and profiled with :mod:`cProfile` (the quick run
+profiles its first two tasks). The time per evaluation, divided by the control loop's, is
+compared with the same figures recorded at the commit before issue 33 §1
+(:data:`BASELINE_MS_PER_EVALUATION`). The profile's self times are sorted into linear-algebra
+kernels (:data:`KERNEL_PATTERNS`) and everything else; the share is the kernels' self time
+over the profile's total. A reader reproduces it with
 
     python -m squeeze_grasp_ros.bench.evaluation [SPEC] [--tasks N]
 
@@ -54,6 +57,25 @@ KERNEL_PATTERNS: tuple[str, ...] = (
 kernel (LAPACK through numpy.linalg's factorising functions or scipy.linalg, SuperLU, QDLDL,
 CHOLMOD). numpy.linalg's helpers and its vector norms (reductions, no LAPACK) are not."""
 COMMAND = "python -m squeeze_grasp_ros.bench.evaluation"
+CONTROL_ITERATIONS = 5_000_000
+BASELINE_COMMIT = "9db5097"
+BASELINE_MS_PER_EVALUATION = 12.50
+BASELINE_CONTROL_S = 0.199
+"""The example sweep's 288 evaluations at commit 9db5097 (before issue 33 §1), single-threaded
+BLAS: CPU ms per evaluation, and :func:`control_seconds`'s loop (best of two) just before in
+another process, on the project's 2-core machine at load 10-13 (interleaved with this
+branch's same runs: 9.83 ms, control 0.203 s). The speed-up column divides both by this run's,
+so a machine slower or busier for pure Python by some factor leaves the ratio alone."""
+
+
+def control_seconds() -> float:
+    """CPU seconds of a fixed pure-Python integer loop (:data:`CONTROL_ITERATIONS`): the
+    machine's speed for interpreter work, beside the evaluations it normalises.
+    """
+    start, x = time.process_time(), 0
+    for i in range(CONTROL_ITERATIONS):
+        x += i * i % 7
+    return time.process_time() - start
 
 
 def is_kernel(filename: str, function: str) -> bool:
@@ -81,54 +103,66 @@ def kernel_share(stats: pstats.Stats) -> tuple[float, float, int]:
 
 
 def measure(spec: Path, tasks: int | None) -> dict:
-    """Time and profile the evaluations of ``spec``'s first ``tasks`` tasks (all if None)."""
+    """Time all of ``spec``'s evaluations (CPU, groups prepared first) between two runs of
+    the control loop, and profile those of its first ``tasks`` tasks (all if None).
+    """
     loaded = parse_sweep_spec(yaml.safe_load(spec.read_text()), spec.parent)
-    chosen = list(plan_tasks(loaded))[:tasks]
+    every = list(plan_tasks(loaded))
     clear_cache()
-    for task in chosen:
+    for task in every:
         prepare(task)
+    control = control_seconds()
     start = time.process_time()
-    n = sum(len(run_task(task)["rows"]) for task in chosen)
+    n = sum(len(run_task(task)["rows"]) for task in every)
     cpu = time.process_time() - start
+    control = min(control, control_seconds())
+    chosen = every[:tasks]
     profile = cProfile.Profile(time.process_time)  # CPU time: the machine is shared
     profile.enable()
-    for task in chosen:
-        run_task(task)
+    profiled = sum(len(run_task(task)["rows"]) for task in chosen)
     profile.disable()
     stats = pstats.Stats(profile)
     kernel, total, calls = kernel_share(stats)
-    return {"evaluations": n, "cpu_s": cpu, "kernel_s": kernel, "profiled_s": total,
-            "calls": calls, "stats": stats}
+    return {"evaluations": n, "cpu_s": cpu, "control_s": control, "profiled": profiled,
+            "kernel_s": kernel, "profiled_s": total, "calls": calls, "stats": stats}
 
 
 def table(m: dict, spec: Path, tasks: int | None) -> Table:
     """The measurement as a table (per evaluation)."""
-    n = m["evaluations"]
+    n, k = m["evaluations"], m["profiled"]
+    ms = 1e3 * m["cpu_s"] / n
     load = tuple(round(x, 1) for x in os.getloadavg())
     arg = f" --tasks {tasks}" if tasks else ""
+    speed_up = (BASELINE_MS_PER_EVALUATION / BASELINE_CONTROL_S) / (ms / m["control_s"])
     return Table(
-        f"{TITLE}: share of linear-algebra kernels ({spec.name}, cProfile)",
-        ["evaluations", "CPU per evaluation [ms]", "profiled per evaluation [ms]",
-         "kernels per evaluation (profiled) [ms]", "kernel share of the profile [%]",
-         "kernels / unprofiled CPU [%]",
+        f"{TITLE}: CPU time and the share of linear-algebra kernels ({spec.name})",
+        ["evaluations", "CPU per evaluation [ms]", "control loop [s]",
+         f"speed-up over {BASELINE_COMMIT} (control-normalised)", "profiled evaluations",
+         "profiled per evaluation [ms]", "kernels per evaluation (profiled) [ms]",
+         "kernel share of the profile [%]", "kernels / unprofiled CPU [%]",
          "Python-visible calls per evaluation"],
-        [[n, 1e3 * m["cpu_s"] / n, 1e3 * m["profiled_s"] / n, 1e3 * m["kernel_s"] / n,
-          100 * m["kernel_s"] / m["profiled_s"], 100 * m["kernel_s"] / m["cpu_s"],
-          round(m["calls"] / n)]],
-        f"Kernels: self time of the profile entries matching {' or '.join(KERNEL_PATTERNS)} "
-        "(numpy.linalg's factorising functions whole, since their LAPACK gufuncs are invisible "
-        "to cProfile; `@` products count with their callers). CPU per evaluation: an "
-        "unprofiled run of the same evaluations, groups prepared before. "
-        f"Reproduce: `{COMMAND} {spec}{arg}`. "
-        f"Load average (1, 5, 15 min) {load} on {os.cpu_count()} cores.",
+        [[n, ms, m["control_s"], speed_up, k, 1e3 * m["profiled_s"] / k,
+          1e3 * m["kernel_s"] / k, 100 * m["kernel_s"] / m["profiled_s"],
+          100 * (m["kernel_s"] / k) / (m["cpu_s"] / n), round(m["calls"] / k)]],
+        f"CPU per evaluation: all {n} evaluations unprofiled, groups prepared before, BLAS as "
+        f"this process has it; the control loop ({CONTROL_ITERATIONS:,} pure-Python integer "
+        f"iterations, best of one run before and one after) normalises the speed-up against "
+        f"the figure recorded at {BASELINE_COMMIT} ({BASELINE_MS_PER_EVALUATION:.2f} ms per "
+        f"evaluation, control {BASELINE_CONTROL_S:.3f} s, single-threaded BLAS, this "
+        "machine). Kernels: self time of the cProfile (CPU clock) entries matching "
+        f"{' or '.join(KERNEL_PATTERNS)} (numpy.linalg's factorising functions whole, since "
+        "their LAPACK gufuncs are invisible to cProfile; `@` products count with their "
+        "callers); kernels / unprofiled CPU estimates the share without the profiler's "
+        f"overhead. Reproduce: `{COMMAND} {spec}{arg}`. Load average (1, 5, 15 min) {load} "
+        f"on {os.cpu_count()} cores.",
     )
 
 
 def run(quick: bool, out_dir: Path, progress) -> list[Table]:
-    """The example sweep's evaluations (its first two tasks when quick)."""
+    """The example sweep's evaluations (profiled: its first two tasks when quick)."""
     spec = share_dir() / "config" / "sweeps" / "example.yaml"
     tasks = 2 if quick else None
-    progress(f"evaluation: profiling the evaluations of {spec.name}")
+    progress(f"evaluation: timing and profiling the evaluations of {spec.name}")
     return [table(measure(spec, tasks), spec, tasks)]
 
 

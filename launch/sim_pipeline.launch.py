@@ -13,7 +13,10 @@ sends the executor its goal, prints the summary and ends the launch with the run
 /executor/execute_grasp squeeze_grasp_interfaces/action/ExecuteGrasp '{...}'``, see
 docs/pipeline.md). Arguments: ``scene`` (default: the shipped foam square), ``record`` (bag
 folder; empty: no recorder), ``include_hidden_topics`` (record the action's hidden topics too),
-``rviz`` (start RViz2 with the shipped configuration), ``run``.
+``rviz`` (start RViz2 with the shipped configuration), ``run``, ``namespace`` (empty: the
+nodes' own names at the root, which the RViz2 configuration expects, one such launch per ROS
+domain; ``namespace:=/lab/a``: every node, topic, service and ``/clock`` under ``/lab/a``, so
+launches in different namespaces share a domain without seeing each other).
 """
 import shutil
 from pathlib import Path
@@ -58,17 +61,20 @@ def nodes(context, *args, **kwargs):
     if not record:
         del params["recorder"]
     roots = [str(Path(scene_path).resolve().parent), str(config_dir().parent), str(Path.cwd())]
+    namespace = LaunchConfiguration("namespace").perform(context).rstrip("/")
+    placed = {"namespace": namespace,
+              "remappings": [("/clock", f"{namespace}/clock")]} if namespace else {}
     actions = [LogInfo(msg=f"scene {scene_path}"),
                Node(package="squeeze_grasp_ros", executable="planner", name="planner",
                     parameters=[str(config_dir() / "planner.yaml"), {"allowed_roots": roots}],
-                    output="screen")]
+                    output="screen", **placed)]
     for name, values in params.items():
         actions.append(Node(package="squeeze_grasp_ros", executable=name, name=name,
-                            parameters=[values], output="screen"))
+                            parameters=[values], output="screen", **placed))
     if LaunchConfiguration("run").perform(context).lower() in TRUE:
         client = ExecuteProcess(
             cmd=[ExecutableInPackage("squeeze-grasp", "squeeze_grasp_ros"), "run", scene_path,
-                 "--attach"], output="screen", name="run")
+                 "--attach", "--namespace", namespace or "/"], output="screen", name="run")
         actions += [client, RegisterEventHandler(OnProcessExit(
             target_action=client,
             on_exit=[LogInfo(msg="the run has ended; shutting the pipeline down"),
@@ -77,7 +83,8 @@ def nodes(context, *args, **kwargs):
 
 
 def generate_launch_description() -> LaunchDescription:
-    """[scene:=FILE] [record:=DIR] [include_hidden_topics:=true] [rviz:=true] [run:=false]."""
+    """[scene:=FILE] [record:=DIR] [include_hidden_topics:=true] [rviz:=true] [run:=false]
+    [namespace:=/NS]."""
     return LaunchDescription([
         DeclareLaunchArgument("scene", default_value="",
                               description="scene YAML file (empty: the shipped foam square)"),
@@ -92,5 +99,9 @@ def generate_launch_description() -> LaunchDescription:
         DeclareLaunchArgument("rviz", default_value="false",
                               description="start RViz2 with share/squeeze_grasp_ros/config/"
                                           "viewers/squeeze_grasp.rviz"),
+        DeclareLaunchArgument("namespace", default_value="",
+                              description="put every node, topic and /clock under this "
+                                          "namespace (empty: the root), so that launches in "
+                                          "different namespaces share a ROS domain"),
         OpaqueFunction(function=nodes),
     ])

@@ -84,7 +84,8 @@ def nodes(context, *args, **kwargs):
 
 def generate_launch_description() -> LaunchDescription:
     """[scene:=FILE] [record:=DIR] [include_hidden_topics:=true] [rviz:=true] [run:=false]
-    [namespace:=/NS]."""
+    [namespace:=/NS].
+    """
     return LaunchDescription([
         DeclareLaunchArgument("scene", default_value="",
                               description="scene YAML file (empty: the shipped foam square)"),

@@ -153,13 +153,24 @@ def test_ctrl_c_while_the_program_starts_is_one_line_not_a_traceback(delay, tmp_
                                               "'.[sweep]'")
     proc = subprocess.Popen([script("squeeze-grasp"), "sweep", str(cli_sweep_spec()), "--out",
                              str(tmp_path / "out"), "--workers", "1"], stdout=subprocess.PIPE,
-                            stderr=subprocess.PIPE, text=True, start_new_session=True)
+                            stderr=subprocess.PIPE, text=True, start_new_session=True,
+                            preexec_fn=terminal_sigint)
     time.sleep(delay)
     os.killpg(proc.pid, signal.SIGINT)
     _, err = proc.communicate(timeout=60)
     assert proc.returncode == 130, err
     assert "Traceback" not in err
     assert "interrupted" in err or "stopped by SIGINT" in err
+
+
+def terminal_sigint() -> None:
+    """SIGINT as a terminal leaves it to a foreground program (in the child, before exec).
+
+    A job started in the background of a non-interactive shell (``cmd &``, a CI runner, some
+    ``colcon test`` launches) inherits SIGINT ignored, and Python then installs no
+    KeyboardInterrupt handler: Ctrl-C during the imports would be lost, whatever the program.
+    """
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
 
 
 def cli_sweep_spec() -> Path:

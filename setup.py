@@ -43,6 +43,7 @@ setup(
         (f"share/{PACKAGE}/config", glob("config/*.yaml")),
         (f"share/{PACKAGE}/config/scenes", glob("config/scenes/*.yaml")),
         (f"share/{PACKAGE}/config/sweeps", glob("config/sweeps/*.yaml")),
+        (f"share/{PACKAGE}/config/devices", glob("config/devices/*.yaml")),
         (f"share/{PACKAGE}/config/viewers", glob("config/viewers/*")),
         (f"share/{PACKAGE}/config/examples", glob("config/examples/*")),
     ],

@@ -74,7 +74,8 @@ def nodes(context, *args, **kwargs):
     if LaunchConfiguration("run").perform(context).lower() in TRUE:
         client = ExecuteProcess(
             cmd=[ExecutableInPackage("squeeze-grasp", "squeeze_grasp_ros"), "run", scene_path,
-                 "--attach", "--namespace", namespace or "/"], output="screen", name="run")
+                 "--attach", *(["--namespace", namespace] if namespace else [])],
+            output="screen", name="run")
         actions += [client, RegisterEventHandler(OnProcessExit(
             target_action=client,
             on_exit=[LogInfo(msg="the run has ended; shutting the pipeline down"),
@@ -83,9 +84,7 @@ def nodes(context, *args, **kwargs):
 
 
 def generate_launch_description() -> LaunchDescription:
-    """[scene:=FILE] [record:=DIR] [include_hidden_topics:=true] [rviz:=true] [run:=false]
-    [namespace:=/NS].
-    """
+    """Arguments: scene, record, include_hidden_topics, rviz, run, namespace."""
     return LaunchDescription([
         DeclareLaunchArgument("scene", default_value="",
                               description="scene YAML file (empty: the shipped foam square)"),

@@ -65,13 +65,23 @@ def config_dir() -> Path:
     return share_dir() / "config"
 
 
+def _shipped(folder: str, kind: str, name: str) -> Path:
+    """``<config>/<folder>/<name>.yaml``, or ResourceError listing the shipped ``kind``s."""
+    path = config_dir() / folder / f"{name}.yaml"
+    if not path.is_file():
+        shipped = sorted(p.stem for p in (config_dir() / folder).glob("*.yaml"))
+        raise ResourceError(f"no shipped {kind} {name!r}; shipped {kind}s: {', '.join(shipped)}")
+    return path
+
+
 def scene_file(name: str) -> Path:
     """A shipped scene by name, e.g. ``scene_file("foam_square")``, m/kg/s SI scene YAML."""
-    path = config_dir() / "scenes" / f"{name}.yaml"
-    if not path.is_file():
-        shipped = sorted(p.stem for p in (config_dir() / "scenes").glob("*.yaml"))
-        raise ResourceError(f"no shipped scene {name!r}; shipped scenes: {', '.join(shipped)}")
-    return path
+    return _shipped("scenes", "scene", name)
+
+
+def device_file(name: str) -> Path:
+    """A shipped gripper device file by name, e.g. ``device_file("generic_85mm")``."""
+    return _shipped("devices", "device", name)
 
 
 def viewer_file(name: str) -> Path:

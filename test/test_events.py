@@ -11,11 +11,13 @@ import functools
 import numpy as np
 import pytest
 
+from contact_support import check_state
+
 from squeeze_grasp_ros.mechanics.elastic import shapes
 from squeeze_grasp_ros.mechanics.elastic.compliance import ElasticObject
 from squeeze_grasp_ros.mechanics.squeeze.contact_model import ContactModel
 from squeeze_grasp_ros.mechanics.squeeze.contact_state import ContactState, initial_state
-from squeeze_grasp_ros.mechanics.squeeze.fingertips import place_fingertip, tip_gaps
+from squeeze_grasp_ros.mechanics.squeeze.fingertips import place_fingertip
 from squeeze_grasp_ros.mechanics.elastic.material import Material
 from squeeze_grasp_ros.mechanics.elastic.mesh import (
     generate_mesh,
@@ -97,51 +99,6 @@ def walk(model: ContactModel, state: ContactState, dirs: dict, depth: float, **k
         if r.termination:
             break
     return out
-
-
-def forces_and_field(model: ContactModel, state: ContactState):
-    L, fu = model.length, model.force_unit
-    sd = model.set_data(tuple(c.node for c in state.contacts))
-    delta = np.array([c.displacement for c in state.contacts]) / L
-    F = np.array([c.force for c in state.contacts]) / fu
-    return F * fu, model.full_displacement(sd, delta, F).reshape(-1, 2) * L
-
-
-def check_state(model: ContactModel, state: ContactState, tol: float = 1e-9) -> None:
-    """Equilibrium, friction cones and no penetration, from the full displacement field."""
-    obj = model.obj
-    mesh = obj.mesh
-    F, u = forces_and_field(model, state)
-    scale = np.abs(F).max()
-    nodes = np.array([c.node for c in state.contacts])
-    # equilibrium of the external forces and of the full FEM problem K u = f
-    assert np.abs(F.sum(axis=0)).max() < 1e-10 * scale
-    p = mesh.nodes[nodes]
-    assert abs(np.sum(p[:, 0] * F[:, 1] - p[:, 1] * F[:, 0])) < 1e-10 * scale * obj.scale
-    f_full = np.zeros(2 * mesh.n)
-    f_full[np.stack([2 * nodes, 2 * nodes + 1], 1).ravel()] = F.ravel()
-    K = obj.stiffness * obj.material.force_scale
-    assert np.abs(K @ u.ravel() - f_full).max() < 1e-8 * scale
-    # contact nodes lie on their tip circle; forces inside / on the friction cone
-    mu = model.mu
-    for c, f in zip(state.contacts, F):
-        tip = state.finger(c.finger)
-        x = mesh.nodes[c.node] + u[c.node]
-        assert abs(np.linalg.norm(x - tip.center) - tip.radius) < 1e-12
-        fn, ft = c.normal_force(), c.tangential_force()
-        assert np.allclose(f, c.force)
-        assert fn > -1e-6 * scale
-        if c.mode == "stick":
-            assert abs(ft) <= mu * fn + 1e-6 * scale
-        else:
-            assert abs(mu * fn - abs(ft)) < 1e-9 * scale
-            assert ft * c.slip <= 1e-9 * scale  # friction opposes the slip
-    # no non-contact boundary node inside a fingertip beyond the tolerance
-    free = np.setdiff1d(mesh.boundary, nodes)
-    centers = np.array([f.center for f in state.fingers])
-    radii = np.array([f.radius for f in state.fingers])
-    gaps = tip_gaps(mesh.nodes[free] + u[free], centers, radii)
-    assert gaps.min() > -10 * tol * obj.scale
 
 
 @pytest.mark.parametrize("mu", [0.4, 0.05])

@@ -128,6 +128,7 @@ NOT_DOMAIN: dict[tuple[str, str], str] = {
     ("mechanics/squeeze/contact_state.py", "slip"): "the JSON key of the slip direction field",
     ("mechanics/squeeze/events.py", "slip"): "the JSON key of the slip direction field",
     ("planning/requests.py", "strain_limit"): "the request field named in its error",
+    ("planning/gripper.py", "strain_limit"): "the request field named in its error",
     ("ros/messages/contacts.py", "B"): "the array typecode of unsigned bytes",
     ("scene/checks.py", "friction"): "a scene section name (SECTION_EFFECT's keys)",
     ("scene/checks.py", "strain_limit"): "a scene section name (SECTION_EFFECT's keys)",

@@ -19,6 +19,7 @@ SECTIONS: tuple[str, ...] = (
     "ring",
     "events",
     "evaluation",
+    "gripper",
     "material_models",
     "perception",
     "ros_services",

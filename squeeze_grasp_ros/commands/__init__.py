@@ -14,6 +14,7 @@ VERBS: tuple[str, ...] = (
     "match",
     "calibrate",
     "graspmap",
+    "gripper_plan",
     "resist",
     "ring",
     "render",

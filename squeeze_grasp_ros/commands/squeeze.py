@@ -22,7 +22,6 @@ from squeeze_grasp_ros.commands.common import (
 )
 from squeeze_grasp_ros.commands.csv_io import write_points
 from squeeze_grasp_ros.mechanics.squeeze.events import EventSqueeze
-from squeeze_grasp_ros.mechanics.squeeze.fingertips import unit
 from squeeze_grasp_ros.mechanics.vocabulary import (
     ContactMode,
     EventType,
@@ -30,6 +29,7 @@ from squeeze_grasp_ros.mechanics.vocabulary import (
     MaterialModel,
     StrainMeasure,
     StressMeasure,
+    TipKind,
 )
 from squeeze_grasp_ros.scene.studies import compare_models, squeeze_run
 
@@ -158,7 +158,7 @@ def plot(obj, res: EventSqueeze, path: str) -> str:
     plots.draw_outline(ax, mesh, res.displacement)
     for name, color in ((Finger.F1, "C0"), (Finger.F2, "C1")):
         finger = res.state.finger(name)
-        arc = finger.center + finger.radius * unit(np.linspace(0, 2 * np.pi, 181))
+        arc = res.tips[name].outline(finger.center, finger.facing)
         ax.plot(arc[:, 0], arc[:, 1], color=color, lw=1.0)
         seg = res.state.segment(name)
         pts = np.array([mesh.nodes[c.node] + c.displacement for c in seg])
@@ -277,6 +277,18 @@ def compare_summary(result: dict) -> str:
     return "\n".join(lines)
 
 
+def tip_words(tips: dict) -> str:
+    """``tip radius 0.02 m`` for circles alike, else each finger's tip (``F1 pad 0.022 m
+    wide, edges 0.002 m``).
+    """
+    words = {name: (f"pad {t['width']:g} m wide, edges {t['edge_radius']:g} m"
+                    if t["shape"] == TipKind.PAD else f"tip radius {t['radius']:g} m")
+             for name, t in tips.items()}
+    if len(set(words.values())) == 1:
+        return next(iter(words.values()))
+    return ", ".join(f"{name} {text}" for name, text in words.items())
+
+
 def summary(result: dict) -> str:
     """Human-readable squeeze report."""
     if result.get("compare_models"):
@@ -285,7 +297,7 @@ def summary(result: dict) -> str:
     limit = result["strain_limit"]
     lines = [
         f"{result['scene']}: {result['squeeze']} squeeze of a {result['material_model']} "
-        f"object, mu = {result['mu']:g}, tip radius {result['tip_radius']:g} m, initial "
+        f"object, mu = {result['mu']:g}, {tip_words(result['tips'])}, initial "
         f"contacts {result['contacts']}",
         f"termination: {result['termination']} at depth {result['depth']:.6g} m "
         f"(relative {100 * result['relative_depth']:.3f} %)"

@@ -33,7 +33,7 @@ from enum import Enum
 __all__ = ["ContactKind", "ContactMode", "DistortionModel", "Effect", "EventType", "Factorizer",
            "Finger", "ImageEncoding", "MaterialModel", "ObjectModel", "RingLimit",
            "SQUEEZING_FINGERS", "ShapeFit", "ShapeType", "SqueezeKind", "StrainCriterion",
-           "StrainMeasure", "StressMeasure", "Termination"]
+           "StrainMeasure", "StressMeasure", "Termination", "TipKind"]
 
 
 class _Name(str, Enum):
@@ -134,6 +134,16 @@ class SqueezeKind(_Name):
     def planned(cls) -> tuple[str, ...]:
         """The kinds a planner computes (and a scene or request may ask for): stable, pure."""
         return (cls.STABLE.value, cls.PURE.value)
+
+
+class TipKind(_Name):
+    """Shape of a rigid fingertip (the face that touches the object)."""
+
+    CIRCLE = "circle"
+    """A circle of radius r: the paper's rounded fingertip (Sec. 5, Fig. 5)."""
+    PAD = "pad"
+    """A flat pad of width w whose two edges are rounded with radius r_e (a parallel
+    gripper's jaw): the flat face is w - 2 r_e wide."""
 
 
 class StrainCriterion(_Name):

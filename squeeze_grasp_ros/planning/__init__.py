@@ -58,6 +58,7 @@ from squeeze_grasp_ros.planning.checks import (
     choice,
     contact_nodes,
 )
+from squeeze_grasp_ros.planning.gripper import gripper_grasp_plan, read_gripper
 from squeeze_grasp_ros.planning.requests import (
     SqueezePlan,
     squeeze_plan,
@@ -101,12 +102,14 @@ __all__ = [
     "contact_nodes",
     "event_squeeze_run",
     "friction_resistance",
+    "gripper_grasp_plan",
     "invalid",
     "load_cached",
     "load_object",
     "no_progress",
     "object_grasp_map",
     "object_key",
+    "read_gripper",
     "read_scene",
     "requested_nodes",
     "resident_bytes",

@@ -25,8 +25,9 @@ from squeeze_grasp_ros.mechanics.vocabulary import (
     Finger,
     MaterialModel,
     ObjectModel,
+    TipKind,
 )
-from squeeze_grasp_ros.scene.schema import MAX_INT
+from squeeze_grasp_ros.scene.schema import MAX_INT, SchemaError
 from squeeze_grasp_ros.scene.specs import (
     SHAPES,
     MaterialSpec,
@@ -34,6 +35,7 @@ from squeeze_grasp_ros.scene.specs import (
     Scene,
     SceneError,
     SensorsSpec,
+    TipSpec,
     finger_devices,
     named_placements,
 )
@@ -125,6 +127,37 @@ def _validate_fingers(scene: Scene) -> None:
         raise SceneError(
             f"fingers.{given[0]}.direction is given: give direction for every finger or for none"
         )
+    for name, finger in scene.fingers.items():
+        if finger.tip is not None:
+            check_tip(finger.tip, f"fingers.{name}.tip")
+            if finger.tip_radius not in (0.0, finger.tip.contact_radius):
+                raise SceneError(f"fingers.{name}: give tip or tip_radius, not both")
+
+
+def check_tip(tip: TipSpec, where: str, error: type[SchemaError] = SceneError) -> None:
+    """A circle has a radius and nothing else; a pad a width and an edge radius, w >= 2 r_e
+    (``error``: the document's error class).
+    """
+    need = ("radius",) if tip.shape == TipKind.CIRCLE else ("width", "edge_radius")
+    for key in ("radius", "width", "edge_radius"):
+        value = getattr(tip, key)
+        if key in need and value is None:
+            raise error(f"{where}.{key} is required for shape: {tip.shape.value}")
+        if key not in need and value is not None:
+            raise error(f"{where}.{key} does not apply to shape: {tip.shape.value} "
+                             f"(give {', '.join(need)})")
+    if tip.shape == TipKind.PAD and tip.width < 2.0 * tip.edge_radius:
+        raise error(f"{where}.width must be >= 2 {where}.edge_radius "
+                         f"({2.0 * tip.edge_radius:g} m), got {tip.width:g} m")
+
+
+def with_tip_radii(scene: Scene) -> Scene:
+    """The scene with ``tip_radius`` filled from ``tip`` where a finger declares one (a pad's
+    edge radius), so every reader of ``tip_radius`` sees the radius that touches.
+    """
+    fingers = {name: dataclasses.replace(f, tip_radius=f.tip.contact_radius)
+               if f.tip is not None else f for name, f in scene.fingers.items()}
+    return dataclasses.replace(scene, fingers=fingers)
 
 
 def _validate_placements(scene: Scene) -> None:
@@ -213,7 +246,8 @@ def _validate_object(scene: Scene) -> None:
 
 
 def validate(scene: Scene) -> Scene:
-    """Run every cross-field check of a parsed scene; return it unchanged.
+    """Run every cross-field check of a parsed scene; return it with the fingers'
+    ``tip_radius`` filled from their ``tip`` (:func:`with_tip_radii`).
 
     Raises
     ------
@@ -225,7 +259,7 @@ def validate(scene: Scene) -> Scene:
                   _validate_squeeze, _validate_effects, _validate_sensors, _validate_devices,
                   _validate_object):
         check(scene)
-    return scene
+    return with_tip_radii(scene)
 
 
 def _validate_sensors(scene: Scene) -> None:

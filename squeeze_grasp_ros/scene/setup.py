@@ -44,6 +44,7 @@ from squeeze_grasp_ros.mechanics.squeeze.contact_model import (ContactModel, Sol
                                                              TerminationLimits)
 from squeeze_grasp_ros.mechanics.squeeze.events import EventSqueeze, event_squeeze
 from squeeze_grasp_ros.mechanics.squeeze.fingertips import Fingertip, place_fingertip
+from squeeze_grasp_ros.mechanics.squeeze.tip_shapes import TipShape
 from squeeze_grasp_ros.mechanics.squeeze.nonlinear_model import contact_model
 from squeeze_grasp_ros.mechanics.squeeze.stable_pure import FingerMotion, finger_motion
 from squeeze_grasp_ros.mechanics.vocabulary import (
@@ -253,8 +254,15 @@ class GraspSetup:
 
     @property
     def tip_radii(self) -> dict[Finger, float]:
-        """Finger (F1, F2) -> fingertip radius, m."""
+        """Finger (F1, F2) -> fingertip radius (a pad's edge radius), m."""
         return {n: self.scene.fingers[n].tip_radius for n in SQUEEZING_FINGERS}
+
+    @property
+    def tip_shapes(self) -> dict[Finger, TipShape]:
+        """Finger (F1, F2) -> fingertip shape (``fingers.<F>.tip``, else a circle of
+        ``tip_radius``).
+        """
+        return {n: self.scene.fingers[n].tip_shape() for n in SQUEEZING_FINGERS}
 
     @property
     def given_directions(self) -> dict[Finger, tuple[float, float]] | None:
@@ -264,9 +272,12 @@ class GraspSetup:
         return {n: self.scene.fingers[n].direction for n in SQUEEZING_FINGERS}
 
     def fingertips(self) -> list[Fingertip]:
-        """F1's and F2's fingertips touching their contact nodes, on the outward normals."""
-        mesh = self.solid.mesh
-        return [place_fingertip(mesh, name, node, self.scene.fingers[name].tip_radius)
+        """F1's and F2's fingertips touching their contact nodes: circles on the outward
+        normals, pads facing the inward normals and moved along them until they touch
+        (:func:`~squeeze_grasp_ros.mechanics.squeeze.fingertips.place_fingertip`).
+        """
+        mesh, shapes = self.solid.mesh, self.tip_shapes
+        return [place_fingertip(mesh, name, node, shapes[name])
                 for name, node in zip(SQUEEZING_FINGERS, self.contacts)]
 
     @cached_property
@@ -351,7 +362,7 @@ class GraspSetup:
         return event_squeeze(
             self.solid,
             self.contacts if contacts is None else contacts,
-            self.tip_radii,
+            self.tip_shapes,
             scene.mu,
             kind=sq.type if kind is None else kind,
             depth=depth,

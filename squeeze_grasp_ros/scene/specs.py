@@ -26,7 +26,9 @@ from squeeze_grasp_ros.mechanics.vocabulary import (
     ShapeType,
     SqueezeKind,
     StrainCriterion,
+    TipKind,
 )
+from squeeze_grasp_ros.mechanics.squeeze.tip_shapes import TipShape
 from squeeze_grasp_ros.scene.schema import SchemaError, spec
 
 
@@ -140,11 +142,47 @@ class PlacementSpec:
 
 
 @dataclass(frozen=True)
+class TipSpec:
+    """A fingertip's shape: the paper's circle, or a flat pad with rounded edges (a gripper's
+    jaw; docs/events.md "Flat pads").
+    """
+
+    shape: TipKind = spec("tip shape", default=TipKind.CIRCLE)
+    radius: Optional[float] = spec("circle radius (shape: circle)", "m", lo=0.0, lo_open=True,
+                                   default=None)
+    width: Optional[float] = spec("whole pad width w across the closing direction, at least "
+                                  "2 edge_radius (shape: pad)", "m", lo=0.0, lo_open=True,
+                                  default=None)
+    edge_radius: Optional[float] = spec("radius r_e of the pad's two rounded edges; the flat "
+                                        "face is w - 2 r_e wide (shape: pad)", "m", lo=0.0,
+                                        lo_open=True, default=None)
+
+    def shape_of(self) -> TipShape:
+        """The mechanics' :class:`~squeeze_grasp_ros.mechanics.squeeze.tip_shapes.TipShape`
+        (fields checked by :mod:`.checks`).
+        """
+        if self.shape == TipKind.CIRCLE:
+            return TipShape.circle(self.radius)
+        return TipShape.pad(width=self.width, edge_radius=self.edge_radius)
+
+    @property
+    def contact_radius(self) -> float:
+        """The radius of the rounded part that touches, m: the circle's, or the pad's edge
+        radius (what ``tip_radius`` holds for a finger declared with ``tip``).
+        """
+        return self.radius if self.shape == TipKind.CIRCLE else self.edge_radius
+
+
+@dataclass(frozen=True)
 class FingerSpec:
     """One finger."""
 
     placement: PlacementSpec = spec("initial contact")
-    tip_radius: float = spec("fingertip radius (0 = point finger)", "m", lo=0.0, default=0.0)
+    tip_radius: float = spec("fingertip radius (0 = point finger); with tip given, filled "
+                             "with the tip's radius (a pad's edge radius)", "m", lo=0.0,
+                             default=0.0)
+    tip: Optional[TipSpec] = spec("fingertip shape instead of tip_radius: {shape: circle, "
+                                  "radius} or {shape: pad, width, edge_radius}", default=None)
     device: str = spec(
         "device driving this finger (empty: DEFAULT_DEVICES)",
         choices=("",) + tuple(DEVICES),
@@ -156,6 +194,10 @@ class FingerSpec:
         "",
         default=None,
     )
+
+    def tip_shape(self) -> TipShape:
+        """The fingertip as the mechanics takes it: ``tip``, else a circle of ``tip_radius``."""
+        return self.tip.shape_of() if self.tip is not None else TipShape.circle(self.tip_radius)
 
 
 @dataclass(frozen=True)
@@ -278,7 +320,8 @@ class SensorsSpec:
         "taxels per fingertip tactile array (effect: tactile_sensing)", "", lo=2, default=96
     )
     taxel_span_deg: float = spec(
-        "arc of the fingertip covered by the tactile array, centred on the initial contact",
+        "arc of a round fingertip covered by the tactile array, centred on the initial "
+        "contact (a pad's array covers its whole face)",
         "deg",
         lo=0.0,
         hi=360.0,

@@ -7,11 +7,14 @@ frame ``<finger>_tip`` is the object frame moved to the tip centre):
 
 - **Wrench** (geometry_msgs/WrenchStamped convention): the force and torque the object applies
   *to the fingertip*, at the tip centre, N and N m: f = -sum_k f_k, tau_z = sum_k
-  (r e(theta_k)) x (-f_k), where f_k is the stepper's force of the finger on contact node k at
-  polar angle theta_k (:mod:`..mechanics.fingertips`).
-- **Tactile array**: taxels at fixed polar angles alpha_j (rad, fingertip frame) spaced
-  ``delta`` apart. Each contact node spreads its normal force f_n = f_k . e(theta_k) (> 0 while
-  pressing) and tangential force f_t = f_k . t(theta_k) (+ counter-clockwise) over the two
+  x(theta_k) x (-f_k), where f_k is the stepper's force of the finger on contact node k at
+  contact coordinate theta_k and x(theta_k) the face point there relative to the tip's
+  reference point (a circle's centre: r e(theta_k); :mod:`..mechanics.squeeze.tip_shapes`).
+- **Tactile array**: taxels at fixed contact coordinates alpha_j (rad, fingertip frame; a
+  circle's polar angles, on a pad r_e alpha is the distance along the face) spaced ``delta``
+  apart (r delta along the face, on either shape). Each contact node spreads its normal force
+  f_n = f_k . e(nu_k) (> 0 while pressing; nu_k its contact normal's angle) and tangential
+  force f_t = f_k . t(nu_k) (+ counter-clockwise) over the two
   taxels that bracket it with hat weights max(0, 1 - |theta_k - alpha_j| / delta), which sum to 1
   inside the array: the total force is preserved, but taxels are not mesh nodes (a node between
   two taxels loads both; nodes beyond the array's ends are not sensed).
@@ -28,6 +31,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from squeeze_grasp_ros.mechanics.squeeze.contact_state import ContactNode
+from squeeze_grasp_ros.mechanics.squeeze.tip_shapes import TipGeometry
 
 
 @dataclass(frozen=True)
@@ -37,10 +41,15 @@ class TactileLayout:
     Attributes
     ----------
     angles : (n,) ndarray
-        Polar angles of the taxel centres, rad, fingertip frame, increasing.
+        Contact coordinates of the taxel centres, rad, fingertip frame, increasing (a
+        circle's polar angles).
+    periodic : bool
+        The coordinates are angles on a circle (taken modulo 2 pi); a pad's are not (its face
+        spans more than 2 pi of coordinate: r_e times it is the length along the face).
     """
 
     angles: np.ndarray
+    periodic: bool = True
 
     @property
     def spacing(self) -> float:
@@ -48,15 +57,19 @@ class TactileLayout:
         return float(self.angles[1] - self.angles[0])
 
 
-def tactile_layout(center: float, taxels: int, span: float) -> TactileLayout:
-    """``taxels`` taxels evenly over ``span`` rad centred on polar angle ``center`` rad."""
-    return TactileLayout(center + np.linspace(-0.5 * span, 0.5 * span, taxels))
+def tactile_layout(center: float, taxels: int, span: float,
+                   periodic: bool = True) -> TactileLayout:
+    """``taxels`` taxels evenly over ``span`` rad centred on contact coordinate ``center``
+    rad (``periodic``: a circle's angles).
+    """
+    return TactileLayout(center + np.linspace(-0.5 * span, 0.5 * span, taxels), periodic)
 
 
 def taxel_weights(layout: TactileLayout, thetas: np.ndarray) -> np.ndarray:
     """Hat weights (k, n) of contact angles ``thetas`` (k,) rad on the taxels."""
     offset = np.asarray(thetas, float)[:, None] - layout.angles[None, :]
-    offset = (offset + np.pi) % (2.0 * np.pi) - np.pi
+    if layout.periodic:
+        offset = (offset + np.pi) % (2.0 * np.pi) - np.pi
     return np.maximum(0.0, 1.0 - np.abs(offset) / layout.spacing)
 
 
@@ -68,10 +81,11 @@ def contact_arrays(contacts: list[ContactNode]) -> tuple[np.ndarray, np.ndarray]
 
 def contact_components(contacts: list[ContactNode]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """(thetas, normal forces, tangential forces) (k,) of contact nodes (rad, N, N): the force
-    on the object projected on e(theta) and t(theta).
+    on the object projected on the contact normal e(nu) and t(nu) (nu = theta on a circle).
     """
     thetas, forces = contact_arrays(contacts)
-    cos, sin = np.cos(thetas), np.sin(thetas)
+    nu = np.array([c.normal_angle for c in contacts], float)
+    cos, sin = np.cos(nu), np.sin(nu)
     return (thetas, forces[:, 0] * cos + forces[:, 1] * sin,
             forces[:, 1] * cos - forces[:, 0] * sin)
 
@@ -87,13 +101,17 @@ def render_tactile(
     return fn @ w, ft @ w
 
 
-def fingertip_wrench(contacts: list[ContactNode], radius: float) -> tuple[np.ndarray, np.ndarray]:
-    """(force (3,), torque (3,)) the object applies to the fingertip at its centre, N and N m."""
+def fingertip_wrench(contacts: list[ContactNode],
+                     tip: TipGeometry) -> tuple[np.ndarray, np.ndarray]:
+    """(force (3,), torque (3,)) the object applies to the fingertip at its reference point (a
+    circle's centre), N and N m; ``tip`` is the finger's tip (one, m).
+    """
     if not contacts:
         return np.zeros(3), np.zeros(3)
     thetas, on_object = contact_arrays(contacts)
     forces = -on_object
-    torque_z = radius * float(np.cos(thetas) @ forces[:, 1] - np.sin(thetas) @ forces[:, 0])
+    arms = tip.offset(thetas, np.zeros(len(thetas), int))
+    torque_z = float(arms[:, 0] @ forces[:, 1] - arms[:, 1] @ forces[:, 0])
     total = forces.sum(axis=0)
     return np.array([total[0], total[1], 0.0]), np.array([0.0, 0.0, torque_z])
 

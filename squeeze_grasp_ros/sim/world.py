@@ -43,6 +43,7 @@ import numpy as np
 from squeeze_grasp_ros.mechanics.squeeze.contact_state import ContactState, Event, initial_state
 from squeeze_grasp_ros.mechanics.resistance.frictional import add_adversary
 from squeeze_grasp_ros.mechanics.squeeze.stepper import advance
+from squeeze_grasp_ros.mechanics.squeeze.tip_shapes import TipGeometry
 from squeeze_grasp_ros.scene import GraspSetup, SensorsSpec, finger_devices
 from squeeze_grasp_ros.sim.devices import DeviceModel, device_model, follow
 from squeeze_grasp_ros.sim.sensors import (
@@ -167,6 +168,8 @@ class SimWorld:
             t.name: device_model(devices[t.name], lag) for t in tips
         }
         self.radii = {t.name: t.radius for t in tips}
+        self.tips = {t.name: TipGeometry(np.array([t.radius]), np.array([t.flat]),
+                                         np.array([t.facing])) for t in tips}
         self.positions = {t.name: np.asarray(t.center, float) for t in tips}
         self.offsets = {t.name: np.zeros(2) for t in tips}
         sensors = scene.sensors
@@ -174,7 +177,11 @@ class SimWorld:
         if scene.has(Effect.TACTILE_SENSING):
             layout = sensors if sensors is not None else SensorsSpec()
             taxels, span = layout.taxels, np.radians(layout.taxel_span_deg)
-            self.layouts = {t.name: tactile_layout(t.theta, taxels, span) for t in tips}
+            # a pad's array covers its whole face: the flat and both rounded edges
+            self.layouts = {t.name: tactile_layout(t.theta, taxels, span) if t.flat == 0.0
+                            else tactile_layout(t.facing, taxels, 2 * t.flat / t.radius + np.pi,
+                                                periodic=False)
+                            for t in tips}
         self.randomness = SensorRandomness(
             sensors.seed if sensors is not None and sensors.seed is not None else 0,
             sensors.noise_std if scene.has(Effect.SENSOR_NOISE) else None,
@@ -291,7 +298,7 @@ class SimWorld:
         rnd = self.randomness
         if self.scene.has(Effect.FORCE_SENSING) and not rnd.dropped():
             self._work["wrench_evaluations"] += 1
-            force, torque = fingertip_wrench(contacts, self.radii[name])
+            force, torque = fingertip_wrench(contacts, self.tips[name])
             reading["force"] = rnd.perturb(force)
             reading["torque"] = rnd.perturb(torque, self.radii[name])
         if name in self.layouts and not rnd.dropped():

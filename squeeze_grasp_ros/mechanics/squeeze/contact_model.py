@@ -3,15 +3,17 @@
 """Mechanics of one fixed contact set under rounded fingertips (paper Sec. 5.2, eqs. 46-47).
 
 Between events the contact set S = T u P (sticking, sliding) is fixed. Every contact node k
-lies on its fingertip circle, x_k = o_f + r_f e(theta_k), so its displacement is
-delta_k = o_f + r_f e(theta_k) - p_k (eq. 46 summed over steps); sticking nodes keep their
-polar angle, sliding nodes have the force on a friction-cone edge (eq. 47):
+lies on its fingertip, x_k = o_f + x_f(q_k) (for a circle x_f(q) = r_f e(q), q the polar angle;
+a pad's face in :mod:`.tip_shapes`), so its displacement is delta_k = o_f + x_f(q_k) - p_k
+(eq. 46 summed over steps); sticking nodes keep their coordinate q, sliding nodes have the force
+on a friction-cone edge about the contact normal e(nu_k), nu_k = nu_f(q_k) (eq. 47):
 
-    f_k x e(theta_k - slip_k phi) = 0,   phi = atan(mu),   F = C delta   (eq. 31)
+    f_k x e(nu_k - slip_k phi) = 0,   phi = atan(mu),   F = C delta   (eq. 31)
 
-solved by Newton on the sliding angles. Totals, not increments, are used: F = C delta holds
-for the final contact set with total displacements (the one-shot invariant of Sec. 5.3), so
-the state between events is a function of the finger positions alone and does not drift.
+solved by Newton on the sliding coordinates (a circle's angles). Totals, not increments, are
+used: F = C delta holds for the final contact set with total displacements (the one-shot
+invariant of Sec. 5.3), so the state between events is a function of the finger positions
+alone and does not drift.
 
 Costs (docs/design.md §3): per contact set a gather of the cached boundary compliance (O(m^2)) and
 a null-space reduction (O(m^3)), cached by the set; per evaluation O(m^2 |P|) for Newton and
@@ -41,7 +43,7 @@ from squeeze_grasp_ros.mechanics.elastic.fem import (
     strain_displacement,
 )
 from squeeze_grasp_ros.mechanics.elastic.hyperelastic import area_ratios
-from squeeze_grasp_ros.mechanics.squeeze.fingertips import cross, tangent, unit
+from squeeze_grasp_ros.mechanics.squeeze.tip_shapes import TipGeometry, cross, tangent, unit
 from squeeze_grasp_ros.mechanics.elastic.reduced import reduce_blocks
 from squeeze_grasp_ros.mechanics.vocabulary import MaterialModel, StrainCriterion, StrainMeasure
 
@@ -153,7 +155,7 @@ class Solution:
     Attributes
     ----------
     theta : (m,) ndarray
-        Polar angles, rad.
+        Contact coordinates q (a circle's polar angles), rad.
     delta : (m, 2) ndarray
         Contact-node displacements / L.
     F : (m, 2) ndarray
@@ -170,6 +172,10 @@ class Solution:
         Largest |f_k x e(alpha_k)| over sliding nodes, dimensionless force.
     jacobian_condition : float
         Condition number of the Newton Jacobian (1 without sliding nodes).
+    nu : (m,) ndarray or None
+        Angles of the contact normals e(nu), rad (None: ``theta``, circular tips).
+    kappa : (m,) ndarray or None
+        d nu / d theta: 1 on a circle or a pad's rounded edge, 0 on a flat face (None: 1).
 
     The force components and their rates (:attr:`normal`, :attr:`tangential`, ...) are
     computed on first use and kept: every event function of the point reads them.
@@ -184,36 +190,48 @@ class Solution:
     iterations: int
     residual: float
     jacobian_condition: float
+    nu: np.ndarray | None = None
+    kappa: np.ndarray | None = None
+
+    @property
+    def normal_angle(self) -> np.ndarray:
+        """The contact normals' angles nu (m,), rad."""
+        return self.theta if self.nu is None else self.nu
+
+    @property
+    def normal_turn(self) -> np.ndarray:
+        """The rates d nu / ds (m,): how fast each contact normal turns (0 on a flat face)."""
+        return self.dtheta if self.kappa is None else self.kappa * self.dtheta
 
     @cached_property
     def unit(self) -> np.ndarray:
-        """e(theta) (m, 2) of every contact, computed once per solution."""
-        return unit(self.theta)
+        """e(nu) (m, 2) of every contact, computed once per solution."""
+        return unit(self.normal_angle)
 
     @cached_property
     def tangent(self) -> np.ndarray:
-        """t(theta) (m, 2) of every contact, computed once per solution."""
-        return tangent(self.theta)
+        """t(nu) (m, 2) of every contact, computed once per solution."""
+        return tangent(self.normal_angle)
 
     @cached_property
     def normal(self) -> np.ndarray:
-        """f_n = F . e(theta) (m,)."""
+        """f_n = F . e(nu) (m,)."""
         return np.einsum("ij,ij->i", self.F, self.unit)
 
     @cached_property
     def tangential(self) -> np.ndarray:
-        """f_t = F . t(theta) (m,)."""
+        """f_t = F . t(nu) (m,)."""
         return np.einsum("ij,ij->i", self.F, self.tangent)
 
     @cached_property
     def normal_rate(self) -> np.ndarray:
         """D f_n / ds (m,)."""
-        return np.einsum("ij,ij->i", self.dF, self.unit) + self.dtheta * self.tangential
+        return np.einsum("ij,ij->i", self.dF, self.unit) + self.normal_turn * self.tangential
 
     @cached_property
     def tangential_rate(self) -> np.ndarray:
         """D f_t / ds (m,)."""
-        return np.einsum("ij,ij->i", self.dF, self.tangent) - self.dtheta * self.normal
+        return np.einsum("ij,ij->i", self.dF, self.tangent) - self.normal_turn * self.normal
 
 
 @dataclass(frozen=True)
@@ -227,19 +245,14 @@ class Configuration:
     stick : (m,) ndarray of bool
     slip : (m,) ndarray of int
         Slip direction of sliding nodes (+1/-1), 0 for sticking ones.
-    radius : (m,) ndarray
-        Tip radius of each node's finger / L.
+    tip : TipGeometry
+        The tip of each node's finger, lengths / L.
     """
 
     p0: np.ndarray
     stick: np.ndarray
     slip: np.ndarray
-    radius: np.ndarray
-
-    @cached_property
-    def sliding(self) -> np.ndarray:
-        """Indices of the sliding nodes (the unknowns of eq. 47)."""
-        return np.flatnonzero(~self.stick)
+    tip: TipGeometry
 
 
 Response = Callable[[np.ndarray], "tuple[np.ndarray, np.ndarray] | SolveFailure"]
@@ -299,16 +312,16 @@ def stiffness_scale(C) -> float:
     return float(np.abs(C).max()) if scale is None else float(scale)
 
 
-def angle_response(C, t: np.ndarray, r: np.ndarray, P: np.ndarray) -> np.ndarray:
-    """dF_k / d theta_j = C_kj r_j t(theta_j) for the sliding nodes j in P: (m, 2, |P|).
+def angle_response(C, nu: np.ndarray, r: np.ndarray, P: np.ndarray) -> np.ndarray:
+    """dF_k / d q_j = C_kj r_j t(nu_j) for the sliding nodes j in P: (m, 2, |P|) (dx_j / dq_j
+    = r_j t(nu_j) on any tip of :mod:`.tip_shapes`).
 
-    ``C`` is the (2m, 2m) contact stiffness or an operator that applies it (``C @ V``); ``t``
-    the tangents t(theta) (m, 2) of every contact.
+    ``C`` is the (2m, 2m) contact stiffness or an operator that applies it (``C @ V``).
     """
-    m, cols = len(t), np.arange(len(P))
+    m, cols = len(nu), np.arange(len(P))
     V = np.zeros((2 * m, len(P)))
-    tp = r[P, None] * t[P]
-    V[2 * P, cols], V[2 * P + 1, cols] = tp[:, 0], tp[:, 1]
+    t = r[P, None] * tangent(nu[P])
+    V[2 * P, cols], V[2 * P + 1, cols] = t[:, 0], t[:, 1]
     return (C @ V).reshape(m, 2, len(P))
 
 
@@ -320,7 +333,7 @@ def attempt_fixed_set(
     theta0: np.ndarray,
     phi: float,
 ) -> Solution | SolveFailure:
-    """Solve the sliding constraints (eq. 47) for one contact set at given tip centres.
+    """Solve the sliding constraints (eq. 47) for one contact set at given tip positions.
 
     Parameters
     ----------
@@ -331,11 +344,12 @@ def attempt_fixed_set(
     cfg : Configuration
         Modes and geometry.
     centers : (m, 2) ndarray
-        Tip centre of each node's finger / L.
+        Tip reference point (a circle's centre) of each node's finger / L.
     dirs : (m, 2) ndarray
         Translation of each node's finger per unit step parameter s / L (for the rates).
     theta0 : (m,) ndarray
-        Polar angles: exact for sticking nodes, Newton's initial guess for sliding ones.
+        Contact coordinates (a circle's polar angles): exact for sticking nodes, Newton's
+        initial guess for sliding ones.
     phi : float
         Friction angle atan(mu), rad.
 
@@ -347,62 +361,32 @@ def attempt_fixed_set(
     """
     m = len(theta0)
     theta = np.array(theta0, float)
-    P, r = cfg.sliding, cfg.radius
-    delta = centers + r[:, None] * unit(theta) - cfg.p0
-    out = response(delta)
-    if isinstance(out, SolveFailure):
-        return out
-    F, C = out
-    it, residual, cond = 0, 0.0, 1.0
-    if len(P):
-        newton = _slide(response, cfg, centers, theta, phi, delta, F, C)
-        if isinstance(newton, SolveFailure):
-            return newton
-        theta, delta, F, C, J, it, residual, cond = newton
-    dF0 = (C @ dirs.reshape(-1)).reshape(m, 2)
-    dtheta = np.zeros(m)
-    t = tangent(theta)
-    if len(P):
-        ea = unit(theta[P] - cfg.slip[P] * phi)
-        G = angle_response(C, t, r, P)
-        try:
-            dtheta[P] = -np.linalg.solve(J, cross(dF0[P], ea))
-        except np.linalg.LinAlgError:
-            return SolveFailure(SINGULAR_SLIDING, residual, indeterminate=True)
-        dF = dF0 + G @ dtheta[P]
-    else:
-        dF = dF0
-    ddelta = dirs + (r * dtheta)[:, None] * t
-    if not (np.isfinite(F).all() and np.isfinite(dF).all() and np.isfinite(theta).all()):
-        return SolveFailure("non-finite contact forces or angles in the fixed-set solve", residual)
-    sol = Solution(theta, delta, F, dtheta, dF, ddelta, it, residual, cond)
-    sol.__dict__["tangent"] = t  # the angles' tangents, already computed (cached_property)
-    return sol
-
-
-def _slide(response: Response, cfg: Configuration, centers: np.ndarray, theta: np.ndarray,
-           phi: float, delta: np.ndarray, F: np.ndarray, C) -> tuple | SolveFailure:
-    """Newton with backtracking on the sliding angles of :func:`attempt_fixed_set`, from
-    ``theta`` (its response ``delta``, ``F``, ``C``); returns (theta, delta, F, C, Jacobian,
-    iterations, residual, Jacobian condition) or the failure.
-    """
-    P, r = cfg.sliding, cfg.radius
-    edge = cfg.slip[P] * phi
+    P = np.flatnonzero(~cfg.stick)
+    tip = cfg.tip
+    r = tip.radius
 
     def forces(th: np.ndarray):
-        d = centers + r[:, None] * unit(th) - cfg.p0
-        out = response(d)
-        return (d, out, None) if isinstance(out, SolveFailure) else (d, *out)
+        delta = centers + tip.offset(th) - cfg.p0
+        out = response(delta)
+        return (delta, out, None) if isinstance(out, SolveFailure) else (delta, *out)
 
+    def cone_residual(th: np.ndarray, F: np.ndarray) -> np.ndarray:
+        return cross(F[P], unit(tip.normal_angle(th)[P] - cfg.slip[P] * phi))
+
+    delta, F, C = forces(theta)
+    if isinstance(F, SolveFailure):
+        return F
     force_scale = max(stiffness_scale(C) * float(r.max()), 1e-300)
     tol = max(NEWTON_TOL, getattr(response, "tolerance", 0.0))
-    it, cond = 0, 1.0
-    R = cross(F[P], unit(theta[P] - edge))
-    while True:
-        ea = unit(theta[P] - edge)
-        G = angle_response(C, tangent(theta), r, P)
+    it, residual, cond = 0, 0.0, 1.0
+    J = np.zeros((0, 0))
+    R = cone_residual(theta, F)
+    while len(P):
+        nu = tip.normal_angle(theta)
+        ea = unit(nu[P] - cfg.slip[P] * phi)
+        G = angle_response(C, nu, r, P)
         J = cross(np.moveaxis(G[P], 2, 1), ea[:, None, :]) + np.diag(
-            np.einsum("ij,ij->i", F[P], ea)
+            np.einsum("ij,ij->i", F[P], ea) * tip.curvature(theta)[P]
         )
         residual = float(np.abs(R).max())
         if residual <= tol * force_scale:
@@ -426,7 +410,7 @@ def _slide(response: Response, cfg: Configuration, centers: np.ndarray, theta: n
                     return t_F
                 step = 0.5 * step
                 continue
-            t_R = cross(t_F[P], unit(trial[P] - edge))
+            t_R = cone_residual(trial, t_F)
             if np.abs(t_R).max() < residual or np.abs(step).max() < NEWTON_TOL:
                 break
             step = 0.5 * step
@@ -437,12 +421,28 @@ def _slide(response: Response, cfg: Configuration, centers: np.ndarray, theta: n
             residual = float(np.abs(R).max())
             cond = float(np.linalg.cond(J))
             break
-    return theta, delta, F, C, J, it, residual, cond
+    dF0 = (C @ dirs.reshape(-1)).reshape(m, 2)
+    dtheta = np.zeros(m)
+    nu, kappa = tip.normal_angle(theta), tip.curvature(theta)
+    if len(P):
+        ea = unit(nu[P] - cfg.slip[P] * phi)
+        G = angle_response(C, nu, r, P)
+        try:
+            dtheta[P] = -np.linalg.solve(J, cross(dF0[P], ea))
+        except np.linalg.LinAlgError:
+            return SolveFailure(SINGULAR_SLIDING, residual, indeterminate=True)
+        dF = dF0 + G @ dtheta[P]
+    else:
+        dF = dF0
+    ddelta = dirs + (r * dtheta)[:, None] * tangent(nu)
+    if not (np.all(np.isfinite(F)) and np.all(np.isfinite(dF)) and np.all(np.isfinite(theta))):
+        return SolveFailure("non-finite contact forces or angles in the fixed-set solve", residual)
+    return Solution(theta, delta, F, dtheta, dF, ddelta, it, residual, cond, nu, kappa)
 
 
 @dataclass(frozen=True)
 class ContactModel:
-    """An elastic object under frictional rounded-fingertip contact.
+    """An elastic object under frictional contact with rounded fingertips or pads.
 
     Parameters
     ----------

@@ -4,7 +4,8 @@
 
 All quantities are SI in the object frame (x right, y up, origin of the mesh coordinates):
 positions and displacements in m, forces in N (applied by the finger on the object), work and
-energy in J, polar angles in rad about the fingertip centre (see :mod:`.fingertips`).
+energy in J, contact coordinates in rad (for a circular tip the polar angle about its centre;
+see :mod:`.tip_shapes`).
 """
 
 from __future__ import annotations
@@ -16,7 +17,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from squeeze_grasp_ros.mechanics.squeeze.event_key import EventFunction, EventKey
-from squeeze_grasp_ros.mechanics.squeeze.fingertips import Fingertip, unit
+from squeeze_grasp_ros.mechanics.squeeze.fingertips import Fingertip
+from squeeze_grasp_ros.mechanics.squeeze.tip_shapes import TipGeometry, tangent, unit
 from squeeze_grasp_ros.mechanics.vocabulary import ContactMode, EventType, Finger, Termination
 
 
@@ -28,9 +30,9 @@ class FingerState:
     ----------
     name : Finger
     center : (2,) ndarray
-        Current tip centre, m.
+        Current tip reference point (a circle's centre), m.
     radius : float
-        Tip radius, m.
+        Tip radius (a pad's edge radius), m.
     translation : (2,) ndarray
         Accumulated translation since the initial placement, m.
     work : float
@@ -39,6 +41,10 @@ class FingerState:
     dissipation : float
         Energy dissipated by friction at this finger's sliding contacts, J (integral of
         -f_t r d theta over them: the friction force against the slip along the tip).
+    flat : float
+        Half the width of the tip's flat face, m (0 for a circle; :mod:`.tip_shapes`).
+    facing : float
+        Angle of the tip's facing direction, rad.
     """
 
     name: Finger
@@ -47,6 +53,15 @@ class FingerState:
     translation: np.ndarray
     work: float = 0.0
     dissipation: float = 0.0
+    flat: float = 0.0
+    facing: float = 0.0
+
+
+def tip_geometry(fingers: tuple[FingerState, ...]) -> TipGeometry:
+    """The tips of ``fingers`` (m), in their order."""
+    return TipGeometry(np.array([f.radius for f in fingers], float),
+                       np.array([f.flat for f in fingers], float),
+                       np.array([f.facing for f in fingers], float))
 
 
 @dataclass(frozen=True)
@@ -62,15 +77,18 @@ class ContactNode:
     mode : ContactMode
         Sticking (moves with the finger, eq. 46) or sliding (force on a cone edge, eq. 47).
     slip : int
-        Slip direction for sliding nodes: +1 if its polar angle increases relative to the tip,
-        -1 if it decreases (the friction force opposes it: the force lies on edge
-        e(theta - slip*phi)); 0 for sticking nodes.
+        Slip direction for sliding nodes: +1 if its contact coordinate increases relative to
+        the tip, -1 if it decreases (the friction force opposes it: the force lies on edge
+        e(nu - slip*phi)); 0 for sticking nodes.
     theta : float
-        Polar angle about the tip centre, rad.
+        Contact coordinate q on the tip, rad (a circle's polar angle about its centre).
     displacement : (2,) ndarray
         Node displacement from the undeformed configuration, m.
     force : (2,) ndarray
         Contact force of the finger on the node, N.
+    normal_angle : float
+        Angle nu of the contact normal e(nu) into the object, rad (default ``theta``: a
+        circle's).
     """
 
     node: int
@@ -80,14 +98,19 @@ class ContactNode:
     theta: float
     displacement: np.ndarray
     force: np.ndarray
+    normal_angle: float | None = None
+
+    def __post_init__(self) -> None:
+        if self.normal_angle is None:
+            object.__setattr__(self, "normal_angle", self.theta)
 
     def normal_force(self) -> float:
-        """F . e(theta), N (> 0 while pressing)."""
-        return float(self.force @ unit(self.theta))
+        """F . e(nu), N (> 0 while pressing)."""
+        return float(self.force @ unit(self.normal_angle))
 
     def tangential_force(self) -> float:
-        """F . t(theta), N."""
-        return float(self.force[1] * np.cos(self.theta) - self.force[0] * np.sin(self.theta))
+        """F . t(nu), N."""
+        return float(self.force @ tangent(self.normal_angle))
 
 
 @dataclass(frozen=True)
@@ -136,7 +159,7 @@ class ContactState:
         raise KeyError(f"no finger {name!r} in the state (have {[f.name for f in self.fingers]})")
 
     def segment(self, name: Finger) -> tuple[ContactNode, ...]:
-        """Contact nodes of finger ``name``, ordered by polar angle."""
+        """Contact nodes of finger ``name``, ordered by contact coordinate."""
         return tuple(sorted((c for c in self.contacts if c.finger == name), key=lambda c: c.theta))
 
     def finger_force(self, name: Finger) -> np.ndarray:
@@ -151,7 +174,8 @@ class ContactState:
 
 
 def initial_state(tips: list[Fingertip], relative_per_depth: float = 0.0) -> ContactState:
-    """The state at depth 0: each fingertip touching its initial node with zero force.
+    """The state at depth 0: each fingertip touching its initial node (and any other node it
+    touches where it was placed, :attr:`~.fingertips.Fingertip.touching`) with zero force.
 
     Initial modes are undetermined: the stepper decides them by hypothesis-and-test along the
     first motion (Algorithm 1, line 2).
@@ -159,23 +183,27 @@ def initial_state(tips: list[Fingertip], relative_per_depth: float = 0.0) -> Con
     order = {name: k for k, name in enumerate(Finger.values())}
     tips = sorted(tips, key=lambda t: order[t.name])
     fingers = tuple(
-        FingerState(t.name, np.asarray(t.center, float), t.radius, np.zeros(2)) for t in tips
+        FingerState(t.name, np.asarray(t.center, float), t.radius, np.zeros(2), flat=t.flat,
+                    facing=t.facing)
+        for t in tips
     )
+    geometry = tip_geometry(fingers)
+    touching = [(k, t.name, node, q) for k, t in enumerate(tips)
+                for node, q in ((t.node, t.theta), *t.touching)]
     contacts = tuple(
         sorted(
             (
-                ContactNode(
-                    t.node, t.name, ContactMode.STICK, 0, t.theta, np.zeros(2), np.zeros(2)
-                )
-                for t in tips
+                ContactNode(node, name, ContactMode.STICK, 0, q, np.zeros(2), np.zeros(2),
+                            float(geometry.normal_angle(np.array([q]), np.array([k]))[0]))
+                for k, name, node, q in touching
             ),
             key=lambda c: c.node,
         )
     )
-    fresh = tuple(EventKey(function, t.node) for t in tips for function in (
+    fresh = tuple(EventKey(function, node) for _, _, node, _ in touching for function in (
         EventFunction.NORMAL_FORCE, EventFunction.CONE_PLUS, EventFunction.CONE_MINUS))
     return ContactState(
-        fingers, contacts, 0.0, relative_per_depth, tuple(sorted(t.node for t in tips)), fresh
+        fingers, contacts, 0.0, relative_per_depth, tuple(c.node for c in contacts), fresh
     )
 
 

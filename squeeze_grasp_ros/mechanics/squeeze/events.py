@@ -1,6 +1,7 @@
 # Copyright 2026 squeeze_grasp_ros developers
 # SPDX-License-Identifier: Apache-2.0
-"""Event-driven squeeze to a depth with rounded fingertips under Coulomb friction (Algorithm 1).
+"""Event-driven squeeze to a depth with rounded fingertips or flat pads under Coulomb friction
+(Algorithm 1).
 
 :func:`squeeze_to_depth` is Algorithm 1 as a loop over the incremental stepper
 (:func:`~.stepper.advance`, one call per event point); :func:`event_squeeze` sets it up from
@@ -12,7 +13,7 @@ SI units at the interface, object frame.
 
 from __future__ import annotations
 
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -40,6 +41,7 @@ from squeeze_grasp_ros.mechanics.errors import (
 from squeeze_grasp_ros.mechanics.elastic.strain_measures import max_principal_strains
 from squeeze_grasp_ros.mechanics.elastic.stress_measures import element_stresses, von_mises
 from squeeze_grasp_ros.mechanics.squeeze.fingertips import place_fingertip
+from squeeze_grasp_ros.mechanics.squeeze.tip_shapes import TipShape
 from squeeze_grasp_ros.mechanics.squeeze.stable_pure import finger_motion
 from squeeze_grasp_ros.mechanics.squeeze.stepper import TERMINATION_ORDER, advance
 from squeeze_grasp_ros.mechanics.squeeze.nonlinear_model import (NonlinearContactModel,
@@ -182,11 +184,11 @@ class SegmentNode:
     force : (2,) ndarray
         Contact force on the object, N.
     normal_force, tangential_force : float
-        f . e(theta) and f . t(theta), N.
+        f . e(nu) and f . t(nu), N (nu: the contact normal's angle).
     slip_margin : float
         mu f_n - |f_t|, N (0 on the cone edge).
     theta : float
-        Polar angle, rad.
+        Contact coordinate (a circle's polar angle), rad.
     """
 
     node: int
@@ -290,7 +292,7 @@ class EventSqueeze:
         Finger -> unit translation per depth (m/m).
     mu : float
     tip_radius : mapping
-        Finger -> tip radius, m.
+        Finger -> tip radius (a pad's edge radius), m.
     events : tuple of Event
     segments : mapping
         Finger -> tuple of SegmentNode, ordered by polar angle.
@@ -323,6 +325,8 @@ class EventSqueeze:
     strain_limit : float or None
         The strain limit epsilon* the squeeze tested (in ``health.strain_measure``, by
         ``health.criterion``); None without one.
+    tips : mapping
+        Finger -> TipShape (circle or pad).
     """
 
     termination: Termination
@@ -352,6 +356,7 @@ class EventSqueeze:
     dissipation: Mapping[Finger, float] = field(default_factory=dict)
     material_model: MaterialModel = MaterialModel.LINEAR
     strain_limit: float | None = None
+    tips: Mapping[Finger, TipShape] = field(default_factory=dict)
 
     @property
     def event_counts(self) -> dict[str, int]:
@@ -381,6 +386,7 @@ class EventSqueeze:
             "mu": self.mu,
             "tip_radius": radii[0] if len(set(radii)) == 1 else max(radii),
             "tip_radii": dict(self.tip_radius),
+            "tips": {k: v.to_json() for k, v in self.tips.items()},
             "material_model": str(self.material_model),
             "strain_limit": None if self.strain_limit is None else {
                 "epsilon": self.strain_limit, "measure": str(self.health.strain_measure),
@@ -459,7 +465,7 @@ def polar_trajectories(samples: tuple[Sample, ...], relative_per_depth: float) -
 def event_squeeze(
     obj: ElasticObject,
     contacts: tuple[int, int],
-    tip_radius: float | Mapping[str, float],
+    tip: float | TipShape | Mapping[str, float | TipShape],
     mu: float,
     *, kind: str = SqueezeKind.STABLE,
     depth: float | None = None,
@@ -474,6 +480,8 @@ def event_squeeze(
     material_model: MaterialModel | str = MaterialModel.LINEAR,
     checkpoint: Callable[[], None] | None = None,
     options: SolveOptions | None = None,
+    facing: Mapping[str, float] | None = None,
+    origins: Mapping[str, Sequence[float]] | None = None,
 ) -> EventSqueeze:
     """Event-driven two-finger squeeze of ``obj`` from initial contact nodes (F1, F2).
 
@@ -482,8 +490,9 @@ def event_squeeze(
     obj : ElasticObject
     contacts : (int, int)
         Initial contact nodes of F1 and F2 on the outer boundary.
-    tip_radius : float or mapping
-        Fingertip radius, m (one for both, or per finger).
+    tip : float, TipShape or mapping
+        Fingertip: a circle's radius, m, or a :class:`~.tip_shapes.TipShape` (circle or
+        pad), one for both fingers or per finger.
     mu : float
         Friction coefficient.
     kind : {"stable", "pure"}
@@ -511,6 +520,15 @@ def event_squeeze(
     options : SolveOptions, optional
         Switches of the large-deformation savings (adaptive substeps, factorisation reuse),
         for measuring them; default both on.
+    facing : mapping, optional
+        Finger -> the angle (rad) of the direction its tip faces, into the object (a gripper's
+        closing direction); default the inward normal at its contact node. A tip given a
+        facing, or a pad, approaches along it until it touches the object
+        (:func:`~.fingertips.place_fingertip`); the node it touches first is its initial
+        contact (``contacts`` of the result).
+    origins : mapping, optional
+        Finger -> where a tip given a facing starts its approach (its reference point, m; a
+        gripper jaw on its closing line); default on its contact node.
 
     Examples
     --------
@@ -524,9 +542,14 @@ def event_squeeze(
     if (depth is None) == (relative_depth is None):
         raise InvalidInputError("give exactly one of depth (m) and relative_depth")
     names = SQUEEZING_FINGERS
-    radii = (
-        dict(tip_radius) if isinstance(tip_radius, Mapping) else dict.fromkeys(names, tip_radius)
-    )
+    shapes = dict(tip) if isinstance(tip, Mapping) else dict.fromkeys(names, tip)
+    facing, origins = dict(facing or {}), dict(origins or {})
+    tips = [place_fingertip(obj.mesh, n, int(c), shapes[n], facing.get(n), origins.get(n))
+            for n, c in zip(names, contacts)]
+    contacts = tuple(t.node for t in tips)
+    radii = {t.name: t.radius for t in tips}
+    shapes = {n: s if isinstance(s, TipShape) else TipShape.circle(radii[n])
+              for n, s in shapes.items() if n in names}
     motion = finger_motion(obj, contacts, kind=kind, directions=directions)
     dirs, relative_per_depth, kind = motion.directions, motion.relative_per_depth, motion.kind
     if depth is None:
@@ -536,7 +559,6 @@ def event_squeeze(
             )
         depth = relative_depth / relative_per_depth
     require_relative_depth(depth * relative_per_depth, depth)
-    tips = [place_fingertip(obj.mesh, n, int(c), radii[n]) for n, c in zip(names, contacts)]
     model = contact_model(material_model, obj, mu, limits or TerminationLimits(), reference,
                           max_events_per_depth, options or SolveOptions())
     run = squeeze_to_depth(
@@ -595,4 +617,5 @@ def event_squeeze(
         diagnostics=diag,
         material_model=model.constitutive_model,
         strain_limit=model.limits.strain,
+        tips=shapes,
     )

@@ -7,12 +7,13 @@ shape of an incremental squeeze can be regenerated "in one shot". This module do
 independently of the stepper's route (no compliance, no reduced stiffness C): it solves the
 saddle-point system of the full stiffness K with sparse LU,
 
-    K u - sum_{k in T} E_k f_k - sum_{k in P} E_k lambda_k e(theta_k - slip_k phi) = 0
-    u_k = o_f + r_f e(theta_k) - p_k                            (k in T: theta_k given;
+    K u - sum_{k in T} E_k f_k - sum_{k in P} E_k lambda_k e(nu(theta_k) - slip_k phi) = 0
+    u_k = o_f + x_f(theta_k) - p_k                              (k in T: theta_k given;
                                                                  k in P: theta_k unknown)
 
 by Newton on (u, f_T, theta_P, lambda_P): sticking nodes are Dirichlet conditions with
-reaction forces f_k, sliding nodes lie on their tip circle with the force on the friction-cone
+reaction forces f_k, sliding nodes lie on their tip (x_f(theta) = r_f e(theta) for a circle,
+a pad's face in :mod:`.tip_shapes`, contact normal e(nu)) with the force on the friction-cone
 edge. Dimensionless inside (lengths by L, forces by E h L); SI out.
 """
 from __future__ import annotations
@@ -24,9 +25,9 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from squeeze_grasp_ros.mechanics.elastic.compliance import ElasticObject
-from squeeze_grasp_ros.mechanics.squeeze.contact_state import ContactState
+from squeeze_grasp_ros.mechanics.squeeze.contact_state import ContactState, tip_geometry
 from squeeze_grasp_ros.mechanics.errors import NumericalError
-from squeeze_grasp_ros.mechanics.squeeze.fingertips import tangent, unit
+from squeeze_grasp_ros.mechanics.squeeze.tip_shapes import tangent, unit
 from squeeze_grasp_ros.mechanics.vocabulary import ContactMode
 
 ONE_SHOT_MAX_ITERATIONS = 30
@@ -43,7 +44,8 @@ class OneShot:
     forces : (m, 2) ndarray
         Contact forces in the state's contact order, N.
     theta : (m,) ndarray
-        Polar angles of the contact nodes, rad (solved for sliding nodes).
+        Contact coordinates (a circle's polar angles) of the contact nodes, rad (solved for
+        sliding nodes).
     iterations : int
         Newton iterations.
     residual : float
@@ -61,8 +63,9 @@ def one_shot_solve(obj: ElasticObject, state: ContactState, mu: float,
                    theta_perturbation: float = 1e-3) -> OneShot:
     """Solve the full FEM problem for the contact set and modes of ``state``.
 
-    Sticking nodes keep the state's polar angles; sliding nodes start Newton from the state's
-    angles shifted by ``theta_perturbation`` (rad) so the solve cannot simply return its input.
+    Sticking nodes keep the state's contact coordinates; sliding nodes start Newton from the
+    state's coordinates shifted by ``theta_perturbation`` (rad) so the solve cannot simply
+    return its input.
 
     Raises
     ------
@@ -77,9 +80,11 @@ def one_shot_solve(obj: ElasticObject, state: ContactState, mu: float,
     nodes = np.array([c.node for c in contacts], int)
     stick = np.array([c.mode == ContactMode.STICK for c in contacts], bool)
     slip = np.array([c.slip for c in contacts], float)
-    fingers = {f.name: f for f in state.fingers}
-    centers = np.array([fingers[c.finger].center for c in contacts]) / L
-    radius = np.array([fingers[c.finger].radius for c in contacts]) / L
+    fingers = {f.name: k for k, f in enumerate(state.fingers)}
+    owner = np.array([fingers[c.finger] for c in contacts], int)
+    centers = np.array([state.fingers[k].center for k in owner]) / L
+    tip = tip_geometry(state.fingers).scaled(L).take(owner)
+    radius = tip.radius
     p0 = obj.mesh.nodes[nodes] / L
     theta = np.array([c.theta for c in contacts], float)
     T, P = np.flatnonzero(stick), np.flatnonzero(~stick)
@@ -97,9 +102,10 @@ def one_shot_solve(obj: ElasticObject, state: ContactState, mu: float,
     lam = np.zeros(nP)
     residual = np.inf
     for it in range(ONE_SHOT_MAX_ITERATIONS):
-        alpha = theta[P] - slip[P] * phi
+        nu, kappa = tip.normal_angle(theta), tip.curvature(theta)
+        alpha = nu[P] - slip[P] * phi
         ea, ta = unit(alpha), tangent(alpha)
-        target = centers + radius[:, None] * unit(theta) - p0
+        target = centers + tip.offset(theta) - p0
         r_u = K @ u - ET @ fT - EP @ (lam[:, None] * ea).reshape(-1)
         r_T = (ET.T @ u) - target[T].reshape(-1)
         r_P = (EP.T @ u) - target[P].reshape(-1)
@@ -107,16 +113,16 @@ def one_shot_solve(obj: ElasticObject, state: ContactState, mu: float,
         residual = float(np.linalg.norm(r) / max(np.linalg.norm(u), 1e-300))
         if it > 0 and residual < 1e-12:
             break
-        # d r_u / d theta_P = -E_P lambda t(alpha); d r_P / d theta_P = -r t(theta)
+        # d r_u / d theta_P = -E_P lambda kappa t(alpha); d r_P / d theta_P = -r t(nu)
         cols = np.arange(nP)
 
         def blk(v: np.ndarray) -> sp.csr_matrix:
             return sp.csr_matrix((v.reshape(-1), (np.arange(2 * nP), np.repeat(cols, 2))),
                                  shape=(2 * nP, nP))
         J = sp.bmat([
-            [K, -ET, -EP @ blk(lam[:, None] * ta), -EP @ blk(ea)],
+            [K, -ET, -EP @ blk((lam * kappa[P])[:, None] * ta), -EP @ blk(ea)],
             [ET.T, None, None, None],
-            [EP.T, None, -blk(radius[P, None] * tangent(theta[P])), None],
+            [EP.T, None, -blk(radius[P, None] * tangent(nu[P])), None],
         ], format="csc")
         dx = spla.spsolve(J, -r)
         if not np.all(np.isfinite(dx)):
@@ -131,5 +137,5 @@ def one_shot_solve(obj: ElasticObject, state: ContactState, mu: float,
         raise NumericalError("one-shot Newton did not converge", residuals={"newton": residual})
     forces = np.zeros((len(nodes), 2))
     forces[T] = fT.reshape(-1, 2)
-    forces[P] = lam[:, None] * unit(theta[P] - slip[P] * phi)
+    forces[P] = lam[:, None] * unit(tip.normal_angle(theta)[P] - slip[P] * phi)
     return OneShot(u.reshape(-1, 2) * L, forces * fu, theta, it, residual)

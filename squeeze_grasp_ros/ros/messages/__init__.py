@@ -35,6 +35,11 @@ from squeeze_grasp_ros.ros.messages.planner import (
     event_squeeze_data,
     event_squeeze_feedback,
 )
+from squeeze_grasp_ros.ros.messages.gripper import (
+    gripper_grasps,
+    gripper_pose,
+    plan_gripper_grasp_response,
+)
 from squeeze_grasp_ros.ros.messages.contacts import (
     contact_node_msg,
     contact_state_msg,
@@ -112,12 +117,15 @@ __all__ = [
     "grasp_map_data",
     "grasp_map_feedback",
     "grasp_result",
+    "gripper_grasps",
+    "gripper_pose",
     "header",
     "int32_array",
     "invalid_goal_result",
     "load_object_response",
     "monitor_status_msg",
     "object_model",
+    "plan_gripper_grasp_response",
     "observation",
     "patches_state_msg",
     "plan_resistance_response",

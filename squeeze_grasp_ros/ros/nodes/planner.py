@@ -14,6 +14,7 @@ name                       kind     computation
 ``~/plan_resistance``      service  optimal resistance to an adversary finger (worker)
 ``~/ring_grasp_test``      service  ring grasp test and ring grasp map (worker)
 ``~/event_squeeze``        service  event-driven squeeze, Algorithm 1 (worker)
+``~/plan_gripper_grasp``   service  parallel-jaw gripper grasps: pose, aperture, effort (worker)
 ``~/grasp_map``            action   load + precompute + map with progress and cancel
 ``~/event_squeeze``        action   event-driven squeeze with progress and cancel
 =========================  =======  ====================================================
@@ -48,8 +49,9 @@ from rclpy.task import Future
 
 from squeeze_grasp_interfaces.action import EventSqueeze as EventSqueezeAction
 from squeeze_grasp_interfaces.action import GraspMap as GraspMapAction
-from squeeze_grasp_interfaces.srv import (EventSqueeze, GraspMap, LoadObject, PlanResistance,
-                                          PlanSqueeze, RingGraspTest)
+from squeeze_grasp_interfaces.srv import (EventSqueeze, GraspMap, LoadObject,
+                                          PlanGripperGrasp, PlanResistance, PlanSqueeze,
+                                          RingGraspTest)
 
 from squeeze_grasp_ros import planning
 from squeeze_grasp_ros.mechanics.vocabulary import ObjectModel
@@ -157,7 +159,8 @@ class PlannerNode(Node):
                 (GraspMap, "grasp_map", self._grasp_map),
                 (PlanResistance, "plan_resistance", self._plan_resistance),
                 (RingGraspTest, "ring_grasp_test", self._ring_grasp_test),
-                (EventSqueeze, "event_squeeze", self._event_squeeze)):
+                (EventSqueeze, "event_squeeze", self._event_squeeze),
+                (PlanGripperGrasp, "plan_gripper_grasp", self._plan_gripper_grasp)):
             self.create_service(srv_type, f"~/{name}", callback, qos_profile=services,
                                 callback_group=self._group)
         # The action servers' goal, cancel and result services default to a queue of 10 too:
@@ -244,6 +247,24 @@ class PlannerNode(Node):
         return await self._in_worker(EventSqueeze.Response,
                                      lambda: self._event_squeeze_result(EventSqueeze.Response,
                                                                         request, watch, watch))
+
+    async def _plan_gripper_grasp(self, request: PlanGripperGrasp.Request,
+                                  response: PlanGripperGrasp.Response
+                                  ) -> PlanGripperGrasp.Response:
+        """Ranked gripper grasps of a cached solid on a worker (a grasp map, then the best
+        candidates' event squeezes with pads).
+        """
+        def compute() -> PlanGripperGrasp.Response:
+            loaded = self._object(request)
+            plan = planning.gripper_grasp_plan(
+                loaded, planning.read_gripper(request.gripper_yaml, request.gripper_name),
+                mu=request.mu, relative_closing=request.relative_closing,
+                count=request.count, evaluate=request.evaluate,
+                yaw_range=(request.yaw_min, request.yaw_max) if request.use_yaw_range else None,
+                weight=request.weight, force_margin=request.force_margin,
+                strain_limit=request.strain_limit, limits=self.limits)
+            return messages.plan_gripper_grasp_response(plan, loaded.digest)
+        return await self._in_worker(PlanGripperGrasp.Response, compute)
 
     # ------------------------------------------------------------------ actions
 

@@ -15,6 +15,7 @@ import numpy as np
 from squeeze_grasp_ros.mechanics.squeeze.contact_model import (Configuration, ContactModel,
                                                                SetData)
 from squeeze_grasp_ros.mechanics.squeeze.contact_state import ContactState
+from squeeze_grasp_ros.mechanics.squeeze.tip_shapes import TipGeometry
 from squeeze_grasp_ros.mechanics.vocabulary import ContactMode
 
 __all__ = ["ContactSet", "SLIP_RATE_ZERO"]
@@ -86,9 +87,9 @@ class ContactSet:
         """Finger index of contact ``node``."""
         return int(self.finger[self.index(node)])
 
-    def configuration(self, radius: np.ndarray) -> Configuration:
-        """The fixed-set problem's data, with the fingers' tip radii ``radius`` (f,)."""
-        return Configuration(self.positions, self.stick, self.slip, radius[self.finger])
+    def configuration(self, tip: TipGeometry) -> Configuration:
+        """The fixed-set problem's data, with the fingers' tips ``tip`` (f)."""
+        return Configuration(self.positions, self.stick, self.slip, tip.take(self.finger))
 
     def with_modes(self, stick: np.ndarray, slip: np.ndarray) -> ContactSet:
         """The same nodes in other modes."""

@@ -2,46 +2,51 @@
 # SPDX-License-Identifier: Apache-2.0
 """The fingertips of one stepper call: where they are at s, and their shape.
 
-Within a call finger f moves from c_f to c_f + s d_f, s in [0, 1]. The tips are rigid circles;
-their shape enters the stepper only through :meth:`FingerMotion.gaps`,
-:meth:`FingerMotion.gap_slopes` and :meth:`FingerMotion.touch_angle` (and the fixed-set solve's
-:class:`~..contact_model.Configuration`), so another tip shape replaces those.
-Dimensionless (lengths / L).
+Within a call finger f moves from c_f to c_f + s d_f, s in [0, 1]. The tips are rigid circles
+or flat pads with rounded edges (:mod:`..tip_shapes`); their shape enters the stepper only
+through :meth:`FingerMotion.gaps`, :meth:`FingerMotion.gap_slopes` and
+:meth:`FingerMotion.touch_angle` (and the fixed-set solve's
+:class:`~..contact_model.Configuration`). Dimensionless (lengths / L).
 """
 from __future__ import annotations
 
 from collections.abc import Mapping
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 
 from squeeze_grasp_ros.mechanics.errors import InvalidInputError, require_finite
-from squeeze_grasp_ros.mechanics.squeeze.contact_state import ContactState
-from squeeze_grasp_ros.mechanics.squeeze.fingertips import tip_gaps
+from squeeze_grasp_ros.mechanics.squeeze.contact_state import ContactState, tip_geometry
+from squeeze_grasp_ros.mechanics.squeeze.tip_shapes import TipGeometry
 
 __all__ = ["FingerMotion"]
 
 
 @dataclass(frozen=True)
 class FingerMotion:
-    """Straight finger paths of one call and the round tips that follow them.
+    """Straight finger paths of one call and the tips that follow them.
 
     Attributes
     ----------
     names : tuple of str
         Finger names, in the state's order (a finger index is a position here).
     start : (f, 2) ndarray
-        Tip centres at s = 0, / L.
+        Tip reference points (a circle's centre) at s = 0, / L.
     translation : (f, 2) ndarray
         Translation of each finger over the call, / L.
     radius : (f,) ndarray
-        Tip radii / L.
+        Tip radii (a pad's edge radius) / L.
     rate : float
         Length of the stacked translation (depth per unit s, / L).
     depth0 : float
         Depth at s = 0, m.
     length : float
         The object size L, m.
+    flat : (f,) ndarray or None
+        Half widths of the tips' flat faces / L (None: circles).
+    facing : (f,) ndarray or None
+        Angles of the tips' facing directions, rad (None: 0).
     """
 
     names: tuple[str, ...]
@@ -51,6 +56,15 @@ class FingerMotion:
     rate: float
     depth0: float
     length: float
+    flat: np.ndarray | None = None
+    facing: np.ndarray | None = None
+
+    @cached_property
+    def tip(self) -> TipGeometry:
+        """The tips (f), lengths / L."""
+        zeros = np.zeros(len(self.radius))
+        return TipGeometry(self.radius, zeros if self.flat is None else self.flat,
+                           zeros if self.facing is None else self.facing)
 
     @classmethod
     def of(cls, state: ContactState, translations: Mapping[str, tuple[float, float]],
@@ -66,9 +80,10 @@ class FingerMotion:
             )
         D = np.array([translations.get(n, (0.0, 0.0)) for n in names], float) / length
         require_finite("finger translations", D)
+        tip = tip_geometry(state.fingers).scaled(length)
         return cls(names, np.array([f.center for f in state.fingers], float) / length, D,
-                   np.array([f.radius for f in state.fingers], float) / length,
-                   float(np.linalg.norm(D)), state.depth, length)
+                   tip.radius, float(np.linalg.norm(D)), state.depth, length, tip.flat,
+                   tip.facing)
 
     def centers(self, s: float) -> np.ndarray:
         """Tip centres (f, 2) at s."""
@@ -80,20 +95,16 @@ class FingerMotion:
 
     def gaps(self, points: np.ndarray, s: float) -> np.ndarray:
         """Gaps (k, f) of ``points`` (k, 2) to every tip at s (negative: penetration)."""
-        return tip_gaps(points, self.centers(s), self.radius)
+        return self.tip.gaps(points, self.centers(s))
 
     def gap_slopes(self, points: np.ndarray, velocities: np.ndarray, s: float) -> np.ndarray:
         """d/ds (k, f) of the gaps of ``points`` (k, 2) that move with ``velocities`` (d/ds)."""
-        rel = points[:, None, :] - self.centers(s)[None]
-        rel_rate = velocities[:, None, :] - self.translation[None]
-        return np.einsum("rfi,rfi->rf", rel, rel_rate) / np.linalg.norm(rel, axis=2)
+        return self.tip.gap_slopes(points, velocities, self.centers(s), self.translation)
 
     def touch_angle(self, point: np.ndarray, finger: int, s: float, near: float | None) -> float:
-        """Polar angle (rad) of ``point`` about tip ``finger`` at s, taken within pi of
-        ``near`` (the mean angle of the finger's other contacts, so a segment stays unwrapped).
+        """Contact coordinate (rad; a circle's polar angle) of ``point`` on tip ``finger`` at
+        s, its normal within pi of ``near``'s (the mean coordinate of the finger's other
+        contacts, so a segment stays unwrapped; default the tip's facing direction).
         """
         rel = point - (self.start[finger] + s * self.translation[finger])
-        theta = float(np.arctan2(rel[1], rel[0]))
-        if near is None:
-            return theta
-        return near + float(np.angle(np.exp(1j * (theta - near))))
+        return self.tip.coordinate(rel, finger, near)

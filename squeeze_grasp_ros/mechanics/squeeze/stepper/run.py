@@ -174,9 +174,10 @@ class _Call:
         """Add the work of every finger over [a, b] (cubic Hermite in s) and the frictional
         dissipation at its contacts (trapezoid in s; modes are fixed within [a, b]).
 
-        A contact node sits on its tip at polar angle theta, so it moves relative to the tip by
-        r d theta: the finger's force does F . dc = F . dx - f_t r d theta, and
-        -f_t r d theta (>= 0 against the slip, 0 while sticking) is what friction dissipates.
+        A contact node sits on its tip at coordinate theta (a circle's polar angle), so it moves
+        relative to the tip by r d theta along the face (:mod:`..tip_shapes`, any shape): the
+        finger's force does F . dc = F . dx - f_t r d theta, and -f_t r d theta (>= 0 against
+        the slip, 0 while sticking) is what friction dissipates.
         """
         h = b - a
         finger, D = self.events.contacts.finger, self.motion.translation
@@ -215,6 +216,8 @@ class _Call:
                 (self.t0[f] + s * motion.translation[f]) * L,
                 float(self.work[f] * fu * L),
                 float(self.dissipation[f] * fu * L),
+                float(motion.tip.flat[f] * L),
+                float(motion.tip.facing[f]),
             )
             for f, n in enumerate(motion.names)
         )
@@ -228,6 +231,7 @@ class _Call:
                 float(sol.theta[k]),
                 sol.delta[k] * L,
                 sol.F[k] * fu,
+                float(sol.normal_angle[k]),
             )
             for k, node in enumerate(c.nodes.tolist())
         )

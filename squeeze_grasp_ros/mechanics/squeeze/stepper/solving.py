@@ -87,7 +87,7 @@ class SetSolver:
         motion, f = self.motion, contacts.finger
         sol = attempt_fixed_set(
             self.model.response(contacts.data),
-            contacts.configuration(motion.radius),
+            contacts.configuration(motion.tip),
             motion.start[f] + s * motion.translation[f],
             motion.translation[f],
             contacts.theta if theta is None else theta,

@@ -1,0 +1,62 @@
+# Copyright 2026 squeeze_grasp_ros developers
+# SPDX-License-Identifier: Apache-2.0
+"""``plan_gripper_grasp``: a gripper plan as ``PlanGripperGrasp`` response."""
+from __future__ import annotations
+
+import math
+
+from geometry_msgs.msg import PoseStamped
+
+from squeeze_grasp_interfaces.msg import GripperGrasp
+from squeeze_grasp_interfaces.srv import PlanGripperGrasp
+
+from squeeze_grasp_ros.mechanics.squeeze.gripper_grasp import GripperCandidate
+from squeeze_grasp_ros.ros.messages.common import float64_array, header, int32_array, success
+from squeeze_grasp_ros.scene.gripper_plan import GripperPlan
+
+OBJECT_FRAME = "object"
+"""The frame of the poses: the scene's object frame (the pipeline's ``FRAME``)."""
+
+
+def gripper_pose(candidate: GripperCandidate) -> PoseStamped:
+    """The gripper centre with its x axis along the closing direction (a yaw about z)."""
+    msg = PoseStamped(header=header(0, OBJECT_FRAME))
+    msg.pose.position.x, msg.pose.position.y = (float(v) for v in candidate.center)
+    msg.pose.orientation.z = math.sin(0.5 * candidate.yaw)
+    msg.pose.orientation.w = math.cos(0.5 * candidate.yaw)
+    return msg
+
+
+def gripper_grasps(plan: GripperPlan) -> list[GripperGrasp]:
+    """One ``GripperGrasp`` per ranked candidate, the evaluated ones with their command."""
+    evaluated = {e.candidate.rank: e for e in plan.evaluations}
+    out = []
+    for c in plan.candidates:
+        msg = GripperGrasp(pose=gripper_pose(c), rank=c.rank, nodes=int32_array(c.nodes),
+                           first_contacts=int32_array(c.first_contacts),
+                           aperture_at_contact=c.aperture, stiffness=c.stiffness,
+                           work_quality=c.work_quality)
+        e = evaluated.get(c.rank)
+        if e is not None:
+            command = plan.command(e)
+            msg.evaluated = True
+            msg.closing, msg.aperture_planned, msg.jaw_force = e.closing, e.aperture, e.jaw_force
+            msg.termination = str(e.termination)
+            msg.has_limit = e.limit is not None
+            msg.limit_closing = e.limit_closing or 0.0
+            msg.limit_termination = "" if e.limit is None else str(e.limit)
+            msg.limit_searched_to = e.limit_search
+            msg.command_force, msg.exceeds_max_force = command["jaw_force"], e.exceeds_max_force
+            msg.lift_force = e.lift_force or 0.0
+            msg.holds_weight = bool(e.holds_weight)
+            msg.joint_names = command["joints"]
+            msg.joint_positions = float64_array(command["positions"])
+            msg.joint_efforts = float64_array(command["efforts"])
+        out.append(msg)
+    return out
+
+
+def plan_gripper_grasp_response(plan: GripperPlan, digest: str) -> PlanGripperGrasp.Response:
+    """A successful response carrying ``plan``."""
+    return success(PlanGripperGrasp.Response, object_digest=digest, gripper=plan.gripper.name,
+                   candidates=gripper_grasps(plan))

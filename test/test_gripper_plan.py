@@ -1,0 +1,250 @@
+# Copyright 2026 squeeze_grasp_ros developers
+# SPDX-License-Identifier: Apache-2.0
+"""Parallel-jaw grippers: the device file and its transmission, ``plan_gripper_grasp`` against
+the grasp map, analytic first-contact geometry, the event squeeze called directly and the
+closed-form jaw force of a block between wide pads, and the ``gripper-plan`` verb.
+"""
+from __future__ import annotations
+
+import functools
+import json
+
+import numpy as np
+import pytest
+
+from squeeze_grasp_ros.cli import main
+from squeeze_grasp_ros.mechanics.elastic import shapes
+from squeeze_grasp_ros.mechanics.elastic.compliance import ElasticObject
+from squeeze_grasp_ros.mechanics.elastic.material import Material
+from squeeze_grasp_ros.mechanics.elastic.mesh import generate_mesh, target_max_area
+from squeeze_grasp_ros.mechanics.errors import InfeasibleError
+from squeeze_grasp_ros.mechanics.squeeze.events import event_squeeze
+from squeeze_grasp_ros.mechanics.squeeze.graspmap import grasp_map
+from squeeze_grasp_ros.mechanics.squeeze.gripper_grasp import (evaluate_candidate,
+                                                               gripper_candidates)
+from squeeze_grasp_ros.resources import device_file, scene_file
+from squeeze_grasp_ros.scene import GraspSetup, load_scene
+from squeeze_grasp_ros.scene.gripper import GripperError, load_gripper, parse_gripper
+from squeeze_grasp_ros.scene.gripper_plan import plan_gripper_grasp
+from squeeze_grasp_ros.mechanics.vocabulary import Finger
+
+E, THICKNESS = 5e4, 0.01
+W, H = 0.06, 0.03
+
+
+def device(**changes) -> dict:
+    """The generic 85 mm gripper's document with ``changes`` (nested keys with dots)."""
+    data = {"name": "test_gripper", "opening": {"min": 0.0, "max": 0.085}, "max_force": 235.0,
+            "pad": {"shape": "pad", "width": 0.022, "edge_radius": 0.002},
+            "transmission": {"joints": ["finger_joint"], "position_per_aperture": -0.8 / 0.085,
+                             "position_offset": 0.8}}
+    for key, value in changes.items():
+        *path, last = key.split(".")
+        node = data
+        for part in path:
+            node = node[part]
+        node[last] = value
+    return data
+
+
+@functools.lru_cache(maxsize=None)
+def sponge():
+    setup = GraspSetup.build(load_scene(scene_file("sponge_gripper")))
+    return setup, grasp_map(setup.solid, setup.scene.mu)
+
+
+@functools.lru_cache(maxsize=None)
+def block():
+    outline = shapes.rectangle(W, H)
+    return ElasticObject(generate_mesh(outline, target_max_area(outline, 400)),
+                         Material(E, 0.0, THICKNESS)).precompute()
+
+
+# --- the device -------------------------------------------------------------------------------
+
+def test_shipped_device_transmission_round_trips():
+    g = load_gripper(device_file("generic_85mm"))
+    assert g.joint_positions(0.085) == pytest.approx((0.0,), abs=1e-12)  # open
+    assert g.joint_positions(0.0) == (0.8,)  # closed
+    for aperture in np.linspace(0, 0.085, 7):
+        assert g.aperture(g.joint_positions(aperture)[0]) == pytest.approx(aperture, abs=1e-15)
+    assert g.jaw_force(g.joint_efforts(12.5)[0]) == 12.5
+    franka = parse_gripper(device(**{"transmission.joints": ["j1", "j2"],
+                                     "transmission.position_per_aperture": 0.5,
+                                     "transmission.position_offset": 0.0}))
+    assert franka.joint_positions(0.06) == (0.03, 0.03)  # each finger half the aperture
+
+
+@pytest.mark.parametrize(("changes", "message"), [
+    ({"opening.max": 0.0}, r"gripper\.opening\.max must be > 0"),
+    ({"opening.min": 0.09}, r"gripper\.opening\.max must be > gripper\.opening\.min"),
+    ({"max_force": -1.0}, r"gripper\.max_force"),
+    ({"pad.width": 0.003}, r"gripper\.pad\.width must be >= 2 gripper\.pad\.edge_radius"),
+    ({"transmission.position_per_aperture": 0.0},
+     r"gripper\.transmission\.position_per_aperture must be a nonzero"),
+    ({"transmission.joints": []}, r"gripper\.transmission\.joints must name"),
+    ({"transmission.joints": ["a", "a"]}, r"gripper\.transmission\.joints repeats"),
+    ({"colour": "red"}, r"colour"),
+])
+def test_bad_device_files_name_the_field(changes, message):
+    with pytest.raises(GripperError, match=message):
+        parse_gripper(device(**changes))
+
+
+# --- candidates against the grasp map and geometry -------------------------------------------
+
+def test_candidates_are_the_grasp_maps_best_placements_the_pads_make():
+    setup, gmap = sponge()
+    jaws = load_gripper(device_file("generic_85mm")).jaws()
+    found = gripper_candidates(setup.solid, gmap, jaws, count=50)
+    assert len(found) == 50
+    index = {int(n): k for k, n in enumerate(gmap.boundary)}
+    k = [gmap.stiffness[index[c.first_contacts[0]], index[c.first_contacts[1]]] for c in found]
+    assert np.array_equal(k, [c.stiffness for c in found])
+    assert all(np.diff(k) <= 0)  # ranked by work quality k / 2
+    for c in found:
+        i, j = (index[n] for n in c.first_contacts)
+        assert gmap.feasible[i, j]  # the pads' own placement is inward and force closing
+        assert 0 < c.aperture <= jaws.max_aperture
+    # no feasible placement the pads make is better than the best candidate
+    all_found = gripper_candidates(setup.solid, gmap, jaws, count=100000)
+    assert max(c.stiffness for c in all_found) == found[0].stiffness
+
+
+def test_first_contact_geometry_on_a_block():
+    """Pads wider than the block's side closing along x: the aperture is W and the centre is on
+    the closing line midway, whatever the line's height.
+    """
+    obj = block()
+    wide = parse_gripper(device(**{"pad.width": 0.05, "pad.edge_radius": 0.003})).jaws()
+    gmap = grasp_map(obj, 0.3)
+    found = gripper_candidates(obj, gmap, wide, count=1000, yaw_range=(-1e-9, 1e-9))
+    assert found
+    for c in found:
+        assert abs(np.sin(c.yaw)) < 1e-9
+        assert c.aperture == pytest.approx(W, abs=1e-12)
+        assert c.center[0] == pytest.approx(0.0, abs=1e-12)
+    # a narrow pad on a tilted line touches with its rounded edge: the clearance is the
+    # distance along the line to the nearest node within the swath, by brute force
+    narrow = load_gripper(device_file("generic_85mm")).jaws()
+    nodes = obj.mesh.nodes[obj.mesh.boundary]
+    for c in gripper_candidates(obj, gmap, narrow, count=40):
+        d = c.closing_direction
+        t = np.array([-d[1], d[0]])
+        face = c.center - 0.5 * c.aperture * d  # F1's face middle
+        s = (nodes - face) @ d
+        lat = np.abs((nodes - face) @ t)
+        a, r = narrow.pad.half_flat, narrow.pad.radius
+        recede = np.where(lat <= a, 0.0, r - np.sqrt(np.maximum(r * r - (lat - a) ** 2, 0)))
+        ahead = np.where(lat < a + r, s + recede, np.inf)
+        assert ahead.min() == pytest.approx(0.0, abs=1e-12)  # touching, nothing inside
+
+
+def test_yaw_range_is_modulo_pi():
+    setup, gmap = sponge()
+    jaws = load_gripper(device_file("generic_85mm")).jaws()
+    lo, hi = np.radians(80), np.radians(100)
+    found = gripper_candidates(setup.solid, gmap, jaws, count=30, yaw_range=(lo, hi))
+    assert found
+    assert all(np.mod(c.yaw - lo, np.pi) <= hi - lo + 1e-12 for c in found)
+
+
+def test_a_too_large_object_has_no_gripper_grasp():
+    setup = GraspSetup.build(load_scene(scene_file("foam_square")))  # 100 mm > 85 mm
+    with pytest.raises(InfeasibleError, match="fits test_gripper's opening"):
+        plan_gripper_grasp(setup.solid, parse_gripper(device()), 0.4, relative_closing=0.1,
+                           count=3, evaluate=0)
+
+
+# --- evaluation against the event squeeze -----------------------------------------------------
+
+def test_evaluation_is_the_event_squeeze_with_pads_and_matches_the_block_closed_form():
+    """A block with nu = 0 between pads covering its sides.
+
+    The jaw force at closing c is E H h c / W (uniform compression), and equals the event
+    squeeze called directly.
+    """
+    obj = block()
+    wide = parse_gripper(device(**{"pad.width": 0.05, "pad.edge_radius": 0.003})).jaws()
+    gmap = grasp_map(obj, 0.3)
+    c = min(gripper_candidates(obj, gmap, wide, count=1000, yaw_range=(-1e-9, 1e-9)),
+            key=lambda c: abs(c.center[1]))
+    assert abs(c.center[1]) + wide.pad.half_flat > H / 2  # the pads cover the sides
+    closing = 0.002
+    ev = evaluate_candidate(obj, c, wide, 0.3, closing=closing, weight=0.5)
+    assert ev.jaw_force == pytest.approx(E * H * THICKNESS * closing / W, rel=1e-8)
+    assert ev.aperture == pytest.approx(W - closing, rel=1e-12)
+    d = c.closing_direction
+    direct = event_squeeze(obj, c.first_contacts, wide.pad, 0.3, depth=closing / np.sqrt(2),
+                           directions={Finger.F1: d, Finger.F2: -d},
+                           facing={Finger.F1: c.yaw, Finger.F2: c.yaw + np.pi},
+                           origins={Finger.F1: c.center - W * d, Finger.F2: c.center + W * d})
+    assert ev.jaw_force == pytest.approx(
+        0.5 * sum(direct.finger_force[f][1] for f in (Finger.F1, Finger.F2)), rel=1e-12)
+    assert ev.command_force == pytest.approx(1.25 * ev.jaw_force)
+    assert ev.lift_force == pytest.approx(0.5 / (2 * 0.3))
+    assert ev.holds_weight == (ev.jaw_force >= ev.lift_force)
+
+
+def test_plan_commands_joint_positions_and_efforts_through_the_transmission():
+    setup, gmap = sponge()
+    gripper = load_gripper(device_file("generic_85mm"))
+    plan = plan_gripper_grasp(setup.solid, gripper, 0.6, relative_closing=0.15, count=4,
+                              evaluate=2, gmap=gmap)
+    out = plan.to_json()
+    assert [c["rank"] for c in out["candidates"]] == [0, 1, 2, 3]
+    for row, ev in zip(out["candidates"], plan.evaluations):
+        cmd = row["command"]
+        assert gripper.aperture(cmd["positions"][0]) == pytest.approx(ev.aperture, abs=1e-12)
+        assert cmd["efforts"][0] == pytest.approx(1.25 * ev.jaw_force)
+        assert ev.closing == pytest.approx(0.15 * ev.candidate.aperture, rel=1e-9)
+        # symmetric jaws: each jaw's force along its motion is the same
+        f = ev.squeeze.finger_force
+        assert f[Finger.F1][1] == pytest.approx(f[Finger.F2][1], rel=1e-9)
+    assert "command" not in out["candidates"][2]
+
+
+# --- the verb ---------------------------------------------------------------------------------
+
+def test_gripper_plan_verb_json_and_plot(tmp_path, capsys):
+    png = tmp_path / "plan.png"
+    code = main(["gripper-plan", str(scene_file("sponge_gripper")), "--count", "3",
+                 "--evaluate", "1", "--yaw-range", "80", "100", "--weight", "0.2", "--json",
+                 "--plot", str(png)])
+    assert code == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["gripper"] == "generic_85mm" and len(out["candidates"]) == 3
+    best = out["candidates"][0]
+    assert best["lift_force"] == pytest.approx(0.2 / (2 * 0.6))
+    assert best["command"]["joints"] == ["finger_joint"]
+    assert png.stat().st_size > 10000
+
+
+@pytest.mark.parametrize(("args", "message"), [
+    (["--gripper", "no_such_gripper"], "--gripper: no shipped device 'no_such_gripper'"),
+    (["--relative-closing", "1.5"], "relative closing must be in (0, 1)"),
+    (["--margin", "0.5"], "force margin must be >= 1"),
+])
+def test_gripper_plan_verb_rejects_bad_input_with_exit_2(args, message, capsys):
+    code = main(["gripper-plan", str(scene_file("sponge_gripper")), *args])
+    assert code == 2
+    assert message in capsys.readouterr().err
+
+
+def test_the_evaluated_jaws_sit_where_the_candidate_put_them():
+    """An off-centre candidate on the sponge, whose pads touch with an edge: the evaluated
+    squeeze's pads start at the candidate's first contacts and on its closing line.
+    """
+    setup, gmap = sponge()
+    jaws = load_gripper(device_file("generic_85mm")).jaws()
+    c = gripper_candidates(setup.solid, gmap, jaws, count=1)[0]
+    ev = evaluate_candidate(setup.solid, c, jaws, 0.6, closing=0.002)
+    assert ev.squeeze.contacts == c.first_contacts
+    d = c.closing_direction
+    t = np.array([-d[1], d[0]])
+    for name, sign in ((Finger.F1, -1.0), (Finger.F2, 1.0)):
+        finger = ev.squeeze.state.finger(name)
+        start = finger.center - finger.translation  # the reference point at first contact
+        assert (start - c.center) @ t == pytest.approx(0.0, abs=1e-12)  # on the line
+        face = (start - c.center) @ d - sign * jaws.pad.radius  # F1's face is r ahead of it
+        assert face == pytest.approx(sign * 0.5 * c.aperture, abs=1e-12)

@@ -113,7 +113,9 @@ def node_parameters(
         relative_per_depth=float(relative_per_depth),
         load_threshold=max(float(monitor.get("load_threshold", 0.005)), 6.0 * noise),
     )
-    params["executor"].update(finger_devices=mapping, period=float(scene.sim.dt))
+    params["executor"].update(
+        finger_devices=mapping, period=float(scene.sim.dt),
+        controller_scene=str(Path(scene_path).resolve()) if scene.controller else "")
     custom = {"scene": Path(scene_path).read_text(), "scene_path": str(scene_path)}
     params["recorder"].update(
         output=str(options.record or ""),

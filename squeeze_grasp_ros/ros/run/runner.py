@@ -68,6 +68,7 @@ from squeeze_grasp_ros.control.motion import GraspGoal
 from squeeze_grasp_ros.exit_codes import Interrupted
 from squeeze_grasp_ros.ros.recording.bag import plain_yaml
 from squeeze_grasp_ros.resources import config_dir, share_dir
+from squeeze_grasp_ros.ros.nodes.sim_controllers import JOINT_STATES
 from squeeze_grasp_ros.scene import GraspSetup, Scene, SceneError, finger_devices, load_scene
 from squeeze_grasp_ros.ros.nodes import PARAMS_FILE_ENV, PARENT_PID_ENV, pipeline
 from squeeze_grasp_ros.ros.nodes.recorder import cdr_stamp_ns
@@ -137,6 +138,8 @@ def run_topics(scene: Scene) -> list[str]:
     devices = finger_devices(scene).values()
     names = list(pipeline.pipeline_topics(devices, hidden=True))
     names += [f"/{t}" for t in (pipeline.HELLO, pipeline.READY, pipeline.RECORDER_PROGRESS)]
+    if scene.controller is not None:
+        names += [f"/{scene.controller.name}/joint_trajectory", f"/{JOINT_STATES}"]
     return [t.lstrip("/") for t in names]
 
 

@@ -12,7 +12,8 @@ gripper (``controller: {type: joint_trajectory, ...}``) and for its joint_state_
   any setpoint (speed limit, actuator lag);
 - a refused trajectory (joint names other than the controller's, sizes that do not match,
   non-finite positions, an aperture beyond the opening range, points all in the past) is
-  logged as one warning line and not followed: the active trajectory stays;
+  logged as one warning line and not followed: the active trajectory stays (before tick 0 the
+  controller is inactive and refuses every trajectory);
 - it publishes ``sensor_msgs/JointState`` on ``joint_states`` every tick, stamped with the
   tick: each joint's position at the measured aperture and its effort for the jaw force (the
   mean of the two jaws' ground-truth forces along the closing line), through the transmission.
@@ -88,6 +89,9 @@ class SimJointTrajectoryController:
     def _trajectory(self, msg: JointTrajectory) -> None:
         now = self.now_ns()
         try:
+            if now < 0:
+                raise TrajectoryRefused("the simulated clock has not started (the controller "
+                                        "is not active yet)")
             order = self._order(list(msg.joint_names))
             start = messages.stamp_ns(msg.header.stamp) or now
             points = []

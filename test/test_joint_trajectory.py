@@ -108,7 +108,8 @@ def test_the_shipped_sponge_maps_its_jaws_to_the_generic_gripper():
 @pytest.mark.parametrize("controller, message", [
     ({"jaws": ["F1", "F1"]}, "controller.jaws must be two distinct"),
     ({"joints": ["a", "b"]}, "controller.joints must be 1 distinct"),
-    ({"device": "no_such_gripper"}, "no shipped device 'no_such_gripper'"),
+    ({"device": "no_such_gripper"}, "controller.device: no shipped device 'no_such_gripper'"),
+    ({"device": "nope.yaml"}, "controller.device: gripper device file not found"),
     ({"type": "gripper_action"}, "controller.type"),
 ])
 def test_controller_section_errors_name_the_field(controller, message):
@@ -116,6 +117,13 @@ def test_controller_section_errors_name_the_field(controller, message):
                "device": "generic_85mm", **controller}
     with pytest.raises(SceneError, match=message):
         scene_controller(parse_scene(sponge_data(controller=section)), SPONGE)
+
+
+def test_loading_a_scene_checks_its_controller_section(tmp_path):
+    data = sponge_data()
+    data["controller"]["jaws"] = ["F2", "F1", "F1"]
+    with pytest.raises(SceneError, match="controller.jaws must be two distinct"):
+        load_scene(write_scene(tmp_path, data))
 
 
 def test_a_jaw_whose_tip_is_not_the_device_pad_is_refused():

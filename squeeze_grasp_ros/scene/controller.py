@@ -27,6 +27,7 @@ from pathlib import Path
 from squeeze_grasp_ros.mechanics.vocabulary import Finger
 from squeeze_grasp_ros.resources import ResourceError, device_file
 from squeeze_grasp_ros.scene.gripper import GripperSpec, load_gripper
+from squeeze_grasp_ros.scene.schema import SchemaError
 from squeeze_grasp_ros.scene.specs import ControllerSpec, Scene, SceneError
 
 __all__ = ["JawController", "scene_controller"]
@@ -60,12 +61,15 @@ class JawController:
 
 
 def _device(spec: ControllerSpec, base: Path) -> GripperSpec:
+    """The gripper of ``controller.device``: a device file (.yaml, relative to ``base``) or a
+    shipped name; errors prefixed with the field.
+    """
     path = Path(spec.device)
-    if path.suffix in (".yaml", ".yml"):
-        return load_gripper(path if path.is_absolute() else base / path)
     try:
+        if path.suffix in (".yaml", ".yml"):
+            return load_gripper(path if path.is_absolute() else base / path)
         return load_gripper(device_file(spec.device))
-    except ResourceError as exc:
+    except (ResourceError, SchemaError) as exc:
         raise SceneError(f"controller.device: {exc}") from None
 
 

@@ -8,12 +8,14 @@ the Cartesian setpoint route on real rclpy, and a hostile trajectory client.
 from __future__ import annotations
 
 import time
+from collections import Counter
 from pathlib import Path
 
 import numpy as np
 import pytest
 import rclpy
 import yaml
+from mcap.reader import make_reader
 from builtin_interfaces.msg import Duration
 from rclpy.context import Context
 from rclpy.executors import SingleThreadedExecutor
@@ -134,9 +136,9 @@ def test_a_jaw_whose_tip_is_not_the_device_pad_is_refused():
 
 
 # --------------------------------------------------------------------------- end to end
-def run_sponge(path: str) -> dict:
+def run_sponge(path: str, record: str | None = None) -> dict:
     """Run a sponge scene on real rclpy; the ground truth and what went on the JTC topics."""
-    runner = PipelineRunner(RunOptions(path, planner=False))
+    runner = PipelineRunner(RunOptions(path, planner=False, record=record))
     seen = {"trajectories": [], "joint_states": [], "setpoints": []}
     client = runner.client
     for topic, cls, key in (("gripper_controller/joint_trajectory", JointTrajectory,
@@ -164,7 +166,7 @@ def run_sponge(path: str) -> dict:
 
 
 def test_sponge_through_the_jtc_equals_the_cartesian_route(tmp_path):
-    jtc = run_sponge(str(SPONGE))
+    jtc = run_sponge(str(SPONGE), record=str(tmp_path / "bag"))
     cartesian = run_sponge(write_scene(tmp_path, sponge_data(controller=None)))
     print(f"JTC route: {len(jtc['trajectories'])} trajectories, {len(jtc['joint_states'])} "
           f"joint states, {len(jtc['events'])} events, forces {jtc['forces'].tolist()} N")
@@ -179,6 +181,12 @@ def test_sponge_through_the_jtc_equals_the_cartesian_route(tmp_path):
           f"{np.abs(jtc['forces'] - cartesian['forces']).max() / scale:.1e} relative")
     np.testing.assert_allclose(jtc["forces"], cartesian["forces"], rtol=0, atol=1e-6 * scale)
     assert jtc["depth"] == pytest.approx(cartesian["depth"], rel=1e-6)
+    # the recording holds both controller topics, message for message (independent reader)
+    with open(next((tmp_path / "bag").glob("*.mcap")), "rb") as stream:
+        recorded = Counter(channel.topic for _, channel, _ in
+                           make_reader(stream).iter_messages())
+    assert recorded["gripper_controller/joint_trajectory"] == len(jtc["trajectories"])
+    assert recorded["joint_states"] == len(jtc["joint_states"])
     # the joint state's effort is the jaw force through the transmission (effort_per_force 1)
     last = jtc["joint_states"][-1]
     assert last.effort[0] == pytest.approx(abs(jtc["forces"][0, 1]), rel=1e-3)

@@ -92,7 +92,8 @@ def pipeline_topics(devices: Iterable[str], *, hidden: bool = False) -> dict[str
 
 MESSAGE_PACKAGES: frozenset[str] = frozenset({
     "squeeze_grasp_interfaces", "std_msgs", "geometry_msgs", "sensor_msgs", "visualization_msgs",
-    "rosgraph_msgs", "action_msgs", "builtin_interfaces", "unique_identifier_msgs"})
+    "rosgraph_msgs", "action_msgs", "builtin_interfaces", "unique_identifier_msgs",
+    "trajectory_msgs"})
 """Packages whose message types :func:`message_type` resolves: the interfaces this package
 uses. A type name is data (a recording, a parameter): no other module is ever imported."""
 

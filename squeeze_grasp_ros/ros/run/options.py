@@ -122,6 +122,10 @@ def node_parameters(
         devices=list(devices.values()),
         include_hidden_topics=options.include_hidden_topics,
     )
+    if scene.controller is not None:
+        params["recorder"]["extra_topics"] = [
+            f"{scene.controller.name}/joint_trajectory trajectory_msgs/msg/JointTrajectory",
+            "joint_states sensor_msgs/msg/JointState"]
     for name, values in options.overrides.items():
         params[name].update(values)
     custom["monitor_parameters"] = yaml.safe_dump(params["monitor"], sort_keys=True)

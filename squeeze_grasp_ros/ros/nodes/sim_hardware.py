@@ -121,9 +121,14 @@ class SimHardwareNode(Node):
 
 
     def ready_summary(self) -> str:
-        """What the ready line of ``ros2 run`` says: scene, devices, waiting for whom."""
-        return (f"scene {self.world.scene.name}, fingers {self.devices}, dt {self.world.dt} s; "
-                f"waiting for {list(self.p['participants'])}")
+        """What the ready line of ``ros2 run`` says: scene, devices, controller, waiting for
+        whom.
+        """
+        jaws = "" if self.controller is None else (
+            f", jaws {list(self.controller.fingers)} by a simulated JointTrajectoryController on "
+            f"{self.controller.topic}")
+        return (f"scene {self.world.scene.name}, fingers {self.devices}{jaws}, "
+                f"dt {self.world.dt} s; waiting for {list(self.p['participants'])}")
 
     def _reading_messages(self, finger: str) -> dict[str, Any]:
         """One message per reading of ``finger``, refilled every tick (frames and taxel

@@ -98,6 +98,7 @@ setup(
             "monitor = squeeze_grasp_ros.entry:monitor",
             "sim_hardware = squeeze_grasp_ros.entry:sim_hardware",
             "recorder = squeeze_grasp_ros.entry:recorder",
+            "outline = squeeze_grasp_ros.entry:outline",
         ],
     },
 )

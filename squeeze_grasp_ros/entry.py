@@ -15,7 +15,7 @@ import sys
 from squeeze_grasp_ros.exit_codes import raise_on_signals
 from squeeze_grasp_ros.threads import single_thread_blas
 
-__all__ = ["cli", "executor", "monitor", "planner", "recorder", "sim_hardware"]
+__all__ = ["cli", "executor", "monitor", "outline", "planner", "recorder", "sim_hardware"]
 
 
 def _run(module: str, name: str):
@@ -61,3 +61,8 @@ def sim_hardware():
 def recorder():
     """``ros2 run squeeze_grasp_ros recorder``."""
     return _run("squeeze_grasp_ros.ros.nodes.recorder", "recorder")
+
+
+def outline():
+    """``ros2 run squeeze_grasp_ros outline``."""
+    return _run("squeeze_grasp_ros.ros.nodes.outline", "outline")

@@ -37,6 +37,7 @@ def test_every_node_logs_when_it_is_ready(tmp_path):
         "sim_hardware": ["-p", f"scene:={scene}"],
         "recorder": ["-p", f"output:={tmp_path / 'bag'}"],
         "planner": [],
+        "outline": [],
     }
     processes = {name: subprocess.Popen([script(name), "--ros-args", *extra],
                                         stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
@@ -61,4 +62,5 @@ def test_every_node_logs_when_it_is_ready(tmp_path):
     assert "scene foam_square" in outputs["sim_hardware"]
     assert f"into {tmp_path / 'bag'}" in outputs["recorder"]
     assert "action /executor/execute_grasp" in outputs["executor"]
+    assert "camera/mask, camera/pose, frame object" in outputs["outline"]
     assert codes == dict.fromkeys(commands, 0)

@@ -448,7 +448,7 @@ def bad_requests(fingers: list[int], interior: int) -> list[tuple[str, object, o
             LoadObject,
             LoadObject.Request(),
             ErrorCode.INVALID_ARGUMENT,
-            "exactly one of scene_yaml and scene_path",
+            "exactly one of scene_yaml, scene_path and object",
         ),
         (
             "load_object",

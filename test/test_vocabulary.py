@@ -144,6 +144,11 @@ NOT_DOMAIN: dict[tuple[str, str], str] = {
     ("extras.py", "qdldl"): "the Python module qdldl (a required dependency)",
     ("scene/specs.py", "adversary"): "the scene section name in a field path",
     ("sweep/plan.py", "friction"): "the sweep's parameter axis (the spec's key)",
+    ("commands/render.py", "camera"): "the render JSON's key of the camera info",
+    ("ros/nodes/recorder.py", "camera"): "the recorder parameter named after the camera",
+    ("scene/checks.py", "camera"): "a scene section name (SECTION_EFFECT's keys)",
+    ("planning/typed_objects.py", "point"): "the placement key of a scene finger",
+    ("planning/typed_objects.py", "friction"): "a scene section name",
 }
 """Literals that spell a vocabulary word but mean something else, with what they mean."""
 NOT_COUNTED = {RingLimit.NONE.value: "the English word (messages, matplotlib colours, a world "

@@ -240,6 +240,13 @@ def summary(result: dict) -> str:
         f"wall time {timing['total']:.2f} s (plan {timing['plan']:.2f} s, nodes "
         f"{timing['start_nodes']:.2f} s, lockstep loop {timing['loop']:.2f} s)",
     ]
+    seen = result.get("seen_outline")
+    if seen:
+        lines.insert(1, f"camera: planned from the first frame's outline ({seen['vertices']} "
+                        f"vertices, {seen['holes']} holes, area {seen['area_m2'] * 1e4:.2f} cm^2 "
+                        f"vs {seen['true_area_m2'] * 1e4:.2f} cm^2 true); seen vertices from the "
+                        f"true outline: rms {seen['rms_m'] * 1e3:.3f} mm, max "
+                        f"{seen['max_m'] * 1e3:.3f} mm (pixel {seen['pixel_m'] * 1e3:.3f} mm)")
     if result["recording"]:
         lines.append(f"recording: {result['recording']}")
     return "\n".join(lines)

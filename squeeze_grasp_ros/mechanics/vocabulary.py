@@ -279,6 +279,7 @@ class Effect(_Code):
     SENSOR_NOISE = "sensor_noise"
     ACTUATOR_LAG = "actuator_lag"
     SENSOR_DROPOUT = "sensor_dropout"
+    CAMERA = "camera"
 
 
 class RingLimit(_Code):

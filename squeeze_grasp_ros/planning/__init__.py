@@ -50,6 +50,13 @@ from squeeze_grasp_ros.planning.objects import (
     RING_STAGES,
     Progress,
 )
+from squeeze_grasp_ros.planning.typed_objects import (
+    FramePose,
+    TypedMaterial,
+    TypedObject,
+    object_source,
+    typed_scene,
+)
 from squeeze_grasp_ros.mechanics.resistance.optimal import MAX_DIRECTIONS
 from squeeze_grasp_ros.planning.checks import (
     check_number,
@@ -76,6 +83,7 @@ __all__ = [
     "Cancelled",
     "ERROR_CODES",
     "ErrorCode",
+    "FramePose",
     "PlannerLimits",
     "LoadedObject",
     "MAX_BEST_COUNT",
@@ -91,6 +99,8 @@ __all__ = [
     "SOLID_STAGES",
     "SceneSource",
     "SqueezePlan",
+    "TypedMaterial",
+    "TypedObject",
     "best_count",
     "check_digest",
     "check_number",
@@ -109,6 +119,7 @@ __all__ = [
     "no_progress",
     "object_grasp_map",
     "object_key",
+    "object_source",
     "read_gripper",
     "read_scene",
     "requested_nodes",
@@ -118,4 +129,5 @@ __all__ = [
     "shown",
     "solver_route",
     "squeeze_plan",
+    "typed_scene",
 ]

@@ -37,6 +37,7 @@ from squeeze_grasp_ros.scene.specs import (
     EFFECTS,
     SHAPES,
     ActuatorsSpec,
+    CameraSpec,
     AdversarySpec,
     FingerSpec,
     FrictionSpec,
@@ -57,10 +58,10 @@ from squeeze_grasp_ros.scene.specs import (
 
 __all__ = [
     "DEFAULT_DEVICES", "DEVICES", "EFFECTS", "SHAPES", "ActuatorsSpec", "AdversarySpec",
-    "FingerSpec", "FrictionSpec", "MaterialSpec", "MeshSpec", "ObjectSpec", "PickupSpec",
-    "PlacementSpec", "RingSpec", "Scene", "SceneError", "SensorsSpec", "SimSpec", "SqueezeSpec",
-    "StrainLimitSpec", "build_mesh", "build_outline", "build_ring", "finger_devices",
-    "finger_nodes", "load_scene", "parse_scene", "placement_node", "placement_points",
-    "read_yaml", "requested_nodes", "scene_help", "scene_limits", "scene_material",
-    "scene_solid", "GraspSetup", "event_squeeze_scene",
+    "CameraSpec", "FingerSpec", "FrictionSpec", "MaterialSpec", "MeshSpec", "ObjectSpec",
+    "PickupSpec", "PlacementSpec", "RingSpec", "Scene", "SceneError", "SensorsSpec", "SimSpec",
+    "SqueezeSpec", "StrainLimitSpec", "build_mesh", "build_outline", "build_ring",
+    "finger_devices", "finger_nodes", "load_scene", "parse_scene", "placement_node",
+    "placement_points", "read_yaml", "requested_nodes", "scene_help", "scene_limits",
+    "scene_material", "scene_solid", "GraspSetup", "event_squeeze_scene",
 ]

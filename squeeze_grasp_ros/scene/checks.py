@@ -46,6 +46,7 @@ SECTION_EFFECT: dict[str, Effect] = {
     "pickup": Effect.PICKUP,
     "adversary": Effect.ADVERSARY,
     "actuators": Effect.ACTUATOR_LAG,
+    "camera": Effect.CAMERA,
 }
 """Sections of a scene that exist exactly when their effect is declared."""
 SENSOR_FIELD_EFFECT: dict[str, Effect] = {"noise_std": Effect.SENSOR_NOISE,

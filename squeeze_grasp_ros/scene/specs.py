@@ -49,6 +49,8 @@ EFFECTS: dict[Effect, str] = {
     Effect.ACTUATOR_LAG: "first-order lag of the finger actuators (needs "
                          "actuators.time_constant)",
     Effect.SENSOR_DROPOUT: "sensor messages dropped at random (needs sensors.dropout)",
+    Effect.CAMERA: "a top-down camera renders the deformed object into mask and depth images "
+                   "(needs camera)",
 }
 """Every effect a scene may declare, with what it requires."""
 
@@ -372,6 +374,45 @@ class ControllerSpec:
 
 
 @dataclass(frozen=True)
+class CameraSpec:
+    """A simulated top-down camera above the object (effect: camera): pinhole intrinsics,
+    plumb-bob distortion and the pose of its optical frame (z along the view, x right, y down)
+    in the object frame, whose z = 0 plane is the support.
+    """
+
+    width: int = spec("image width", "px", lo=16, hi=8192, default=640)
+    height: int = spec("image height", "px", lo=16, hi=8192, default=480)
+    fx: float = spec("focal length along u", "px", lo=0.0, lo_open=True, default=465.0)
+    fy: float = spec("focal length along v", "px", lo=0.0, lo_open=True, default=465.0)
+    cx: float = spec("principal point u (pixel centres at integers)", "px", default=319.5)
+    cy: float = spec("principal point v", "px", default=239.5)
+    distortion: tuple[float, float, float, float, float] = spec(
+        "plumb-bob k1, k2, p1, p2, k3", "", default=(0.0, 0.0, 0.0, 0.0, 0.0))
+    pose: tuple[float, float, float, float, float, float] = spec(
+        "optical frame in the object frame: x y z roll pitch yaw (fixed axes, as tf2's "
+        "static_transform_publisher); straight down from 0.5 m: [0, 0, 0.5, 3.14159265, 0, 0]",
+        "m, rad", default=(0.0, 0.0, 0.5, 3.141592653589793, 0.0, 0.0))
+    rate: float = spec("frame rate in sim time", "Hz", lo=0.0, lo_open=True, default=10.0)
+    blur: float = spec("Gaussian blur (defocus) of the coverage, standard deviation", "px",
+                       lo=0.0, hi=20.0, default=0.5)
+    depth_noise: float = spec("Gaussian noise of every depth pixel, standard deviation", "m",
+                              lo=0.0, hi=0.1, default=0.001)
+    mask_noise: float = spec("Gaussian noise of the coverage before it is quantised into the "
+                             "mask, fraction of full scale", "", lo=0.0, hi=1.0, default=0.0)
+    seed: int = spec("seed of the noise draws (frame k draws with seed + k)", "", lo=0,
+                     default=0)
+    frame_id: str = spec("optical frame name of the images and CameraInfo",
+                         default="camera_optical_frame")
+    plan_from_images: bool = spec(
+        "the planner sees the object instead of being given it: squeeze-grasp run extracts the "
+        "first frame's mask outline and loads it through the typed load_object request",
+        default=False)
+    shape_mismatch_threshold: float = spec(
+        "monitor: RMS distance of the predicted deformed boundary from the seen outline (after "
+        "a rigid fit) that raises shape_mismatch", "m", lo=0.0, lo_open=True, default=5e-4)
+
+
+@dataclass(frozen=True)
 class Scene:
     """A validated scene. Build it with :func:`load_scene` or :func:`parse_scene`."""
 
@@ -399,6 +440,7 @@ class Scene:
     sim: SimSpec = spec("simulated clock", default_factory=SimSpec)
     controller: Optional[ControllerSpec] = spec(
         "the fingers' gripper under a stock ros2_control controller", default=None)
+    camera: Optional[CameraSpec] = spec("top-down camera (effect: camera)", default=None)
 
     @property
     def mu(self) -> float:

@@ -13,7 +13,8 @@ One :meth:`SimWorld.step` is one lockstep tick of ``scene.sim.dt`` seconds:
 Only declared effects are composed (``scene.effects``): ``friction`` sets mu (else 0),
 ``strain_limit`` and ``pickup`` set the stepper's termination limits, ``adversary`` adds the
 third fingertip and its pusher, ``force_sensing``/``tactile_sensing`` render wrenches/taxels,
-``sensor_noise``/``sensor_dropout`` draw random numbers, ``actuator_lag`` lags the devices. Every
+``sensor_noise``/``sensor_dropout`` draw random numbers, ``actuator_lag`` lags the devices,
+``camera`` renders the deformed object at its frame rate (:meth:`SimWorld.camera_frame`). Every
 piece of optional work increments a counter of :attr:`SimWorld.work`; the wall and CPU time spent
 in the stepper are :attr:`SimWorld.stepper_seconds` and ``stepper_cpu_seconds``, those of whole
 ticks (devices, stepper, sensors) ``step_seconds`` and ``step_cpu_seconds`` (benchmarks subtract
@@ -45,6 +46,8 @@ from squeeze_grasp_ros.mechanics.resistance.frictional import add_adversary
 from squeeze_grasp_ros.mechanics.squeeze.stepper import advance
 from squeeze_grasp_ros.mechanics.squeeze.tip_shapes import TipGeometry
 from squeeze_grasp_ros.scene import GraspSetup, SensorsSpec, finger_devices
+from squeeze_grasp_ros.perception.shape_match import deformed_outline
+from squeeze_grasp_ros.sim.camera import CameraFrame, SimCamera
 from squeeze_grasp_ros.sim.devices import DeviceModel, device_model, follow
 from squeeze_grasp_ros.sim.sensors import (
     SensorRandomness,
@@ -198,6 +201,8 @@ class SimWorld:
         self.step_cpu_seconds = 0.0
         self.step_size = scene.squeeze.step
         self.event_tol = scene.squeeze.event_tol
+        self.camera = (SimCamera(scene.camera, scene.object.material.thickness, self.dt)
+                       if scene.has(Effect.CAMERA) else None)
 
     @property
     def work(self) -> Counter:
@@ -324,6 +329,20 @@ class SimWorld:
         self._work["displacement_fields"] += 1
         sd, delta, forces = self._contact_solution()
         return self.model.full_displacement(sd, delta, forces).reshape(-1, 2) * self.model.length
+
+    def deformed_outline(self):
+        """The deformed outline (outer boundary and holes), object frame, m (one sparse solve)."""
+        return deformed_outline(self.obj.mesh, self.displacement_field())
+
+    def camera_frame(self, index: int, stamp_ns: int) -> CameraFrame | None:
+        """The camera's frame of tick ``index`` (sim time ``stamp_ns``) when the scene declares
+        a camera and the tick takes one (its rate in sim time), else None (counted as
+        ``camera_frames``).
+        """
+        if self.camera is None or not self.camera.due(index):
+            return None
+        self._work["camera_frames"] += 1
+        return self.camera.render(self.deformed_outline(), stamp_ns)
 
     def view(self) -> WorldView:
         """Deformed outline, fingertips and contacts for display (counted as ``views``)."""

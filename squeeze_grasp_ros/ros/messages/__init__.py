@@ -5,7 +5,8 @@
 ``from squeeze_grasp_ros.ros import messages`` gives them all (``messages.stamp``, ...); the
 modules are ``common`` (arrays, stamps, responses), ``planner`` (service responses and action
 feedback), ``contacts`` (contact states, events, tactile arrays), ``devices`` (poses, wrenches,
-ticks), ``world`` (ground truth, markers), ``monitor`` and ``executor``.
+ticks), ``world`` (ground truth, markers), ``monitor``, ``executor`` and ``objects`` (typed
+objects, outlines).
 """
 
 from squeeze_grasp_ros.ros.messages.common import (
@@ -78,6 +79,14 @@ from squeeze_grasp_ros.ros.messages.monitor import (
     prediction_msg,
     predicted_events,
 )
+from squeeze_grasp_ros.ros.messages.objects import (
+    polygon_points,
+    polygon_msg,
+    typed_object,
+    object_description,
+    shape_parameters,
+    seen_outline_msg,
+)
 from squeeze_grasp_ros.ros.messages.executor import (
     observation,
     grasp_goal,
@@ -124,12 +133,15 @@ __all__ = [
     "invalid_goal_result",
     "load_object_response",
     "monitor_status_msg",
+    "object_description",
     "object_model",
     "plan_gripper_grasp_response",
     "observation",
     "patches_state_msg",
     "plan_resistance_response",
     "plan_squeeze_response",
+    "polygon_msg",
+    "polygon_points",
     "pose_in_base",
     "pose_msg",
     "pose_position",
@@ -137,7 +149,9 @@ __all__ = [
     "prediction_msg",
     "resistance_fields",
     "ring_grasp_test_response",
+    "seen_outline_msg",
     "set_stamp",
+    "shape_parameters",
     "sim_events_msg",
     "sim_state_msg",
     "stamp",
@@ -148,6 +162,7 @@ __all__ = [
     "tick_msg",
     "tracked_event_msg",
     "tracked_events_msg",
+    "typed_object",
     "vector3",
     "world_markers",
     "wrench_force",

@@ -17,7 +17,8 @@ becomes active; ``monitor/status`` lists the alarms active at every tick), the r
 ``monitor/contact_state`` and, last, the ``monitor/status`` the executor acts on. A repeated
 ``sim/tick`` (a re-sent tick) gets the same status again, nothing else. The planner's
 prediction (``planner/predicted_events``, latched) is compared with the observed
-events.
+events. With ``shape_watch`` the camera's frames are matched against the predicted deformed
+boundary (:mod:`.shape_watcher`): ``monitor/shape_residual`` and the ``shape_mismatch`` alarm.
 """
 from __future__ import annotations
 
@@ -34,6 +35,7 @@ from squeeze_grasp_interfaces.msg import (Alarm, ContactEventArray, ContactState
 from squeeze_grasp_ros.ros import messages
 from squeeze_grasp_ros.control.tracker import ContactTracker, FingerSample, TrackerConfig
 from squeeze_grasp_ros.ros.nodes import pipeline, run_node
+from squeeze_grasp_ros.ros.nodes.shape_watcher import ShapeWatcher
 
 PARAMETERS: dict[str, tuple[Any, str]] = {
     "finger_devices": (["F1:barrett_f1", "F2:barrett_f3"], "finger:device of every fingertip"),
@@ -52,6 +54,9 @@ PARAMETERS: dict[str, tuple[Any, str]] = {
     "frame_id": (pipeline.FRAME, "object frame"),
     "sensor_qos": ("reliable", "QoS of the readings: reliable (lockstep) or sensor_data"),
     "qos_depth": (100, "history depth of the reliable topics"),
+    "shape_watch": (False, "match camera frames against planner/predicted_shapes (App. C)"),
+    "shape_mismatch_threshold": (5e-4, "RMS residual that raises shape_mismatch, m"),
+    "object_height": (0.0, "shape watch: height of the object's top face above the plane, m"),
 }
 """Parameter name -> (typed default, description); config/monitor.yaml sets them."""
 
@@ -89,6 +94,8 @@ class MonitorNode(Node):
         self.expected: dict[int, set[str]] = {}
         self.answered = pipeline.TickAnswer()
         self.active_alarms: set[tuple[str, str]] = set()
+        self.shapes = (ShapeWatcher(self, self.alarm_pub, p["shape_mismatch_threshold"],
+                                    p["object_height"]) if p["shape_watch"] else None)
         if p["lockstep"]:
             self.create_subscription(Tick, pipeline.TICK, self._tick, loop)
             self.participant = pipeline.Participant(self, "monitor", [pipeline.TICK],
@@ -164,6 +171,8 @@ class MonitorNode(Node):
         for publisher, msg in batch:
             publisher.publish(msg)
         self.answered.answer(ns, [(self.status_pub, messages.monitor_status_msg(out, frame))])
+        if self.shapes is not None:
+            self.shapes.tick(ns, out.depth)
 
 
 def main(args: list[str] | None = None) -> int:

@@ -49,6 +49,15 @@ PREDICTION = "planner/predicted_events"
 EXECUTOR_STATUS = "executor/status"
 OBJECT_POSE = "object_pose"
 ACTION = "executor/execute_grasp"
+CAMERA_MASK = "camera/mask"
+CAMERA_DEPTH = "camera/depth"
+CAMERA_INFO = "camera/camera_info"
+CAMERA_POSE = "camera/pose"
+OUTLINE = "outline/outline"
+SEEN_OUTLINE = "outline/seen"
+OUTLINE_ERRORS = "outline/errors"
+SHAPE_RESIDUAL = "monitor/shape_residual"
+PREDICTED_SHAPES = "planner/predicted_shapes"
 
 
 def device_topic(device: str, stream: str) -> str:
@@ -56,11 +65,13 @@ def device_topic(device: str, stream: str) -> str:
     return f"devices/{device}/{stream}"
 
 
-def pipeline_topics(devices: Iterable[str], *, hidden: bool = False) -> dict[str, str]:
+def pipeline_topics(devices: Iterable[str], *, hidden: bool = False,
+                    camera: bool = False) -> dict[str, str]:
     """Topic (fully qualified) -> type of every topic of a run with ``devices``.
 
     ``hidden`` adds the executor action's hidden topics (``.../_action/feedback`` and
-    ``.../_action/status``), which rosbag2 too records only when asked.
+    ``.../_action/status``), which rosbag2 too records only when asked; ``camera`` the camera's
+    images, its info and pose, and the monitor's shape residual (scenes with a camera).
     """
     types = {
         CLOCK: "rosgraph_msgs/msg/Clock",
@@ -80,6 +91,12 @@ def pipeline_topics(devices: Iterable[str], *, hidden: bool = False) -> dict[str
         types[f"{ACTION}/_action/feedback"] = \
             "squeeze_grasp_interfaces/action/ExecuteGrasp_FeedbackMessage"
         types[f"{ACTION}/_action/status"] = "action_msgs/msg/GoalStatusArray"
+    if camera:
+        types.update({CAMERA_MASK: "sensor_msgs/msg/Image", CAMERA_DEPTH: "sensor_msgs/msg/Image",
+                      CAMERA_INFO: "sensor_msgs/msg/CameraInfo",
+                      CAMERA_POSE: "geometry_msgs/msg/PoseStamped",
+                      SHAPE_RESIDUAL: "squeeze_grasp_interfaces/msg/ShapeResidual",
+                      PREDICTED_SHAPES: "squeeze_grasp_interfaces/msg/PredictedShapes"})
     stream_types = {"setpoint": "geometry_msgs/msg/PoseStamped",
                     "pose": "geometry_msgs/msg/PoseStamped",
                     "wrench": "geometry_msgs/msg/WrenchStamped",

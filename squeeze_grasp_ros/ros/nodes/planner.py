@@ -8,7 +8,7 @@ Run it with ``ros2 run squeeze_grasp_ros planner --ros-args --params-file config
 =========================  =======  ====================================================
 name                       kind     computation
 =========================  =======  ====================================================
-``~/load_object``          service  mesh, factor and cache a scene's object (worker)
+``~/load_object``          service  mesh, factor and cache a scene's or typed object (worker)
 ``~/plan_squeeze``         service  stable / pure squeeze at point contacts (inline)
 ``~/grasp_map``            service  all-pairs grasp map of a loaded solid (worker)
 ``~/plan_resistance``      service  optimal resistance to an adversary finger (worker)
@@ -191,7 +191,8 @@ class PlannerNode(Node):
         watch = self._client_watch("load_object")
 
         def load() -> LoadObject.Response:
-            source = planning.read_scene(request.scene_yaml, request.scene_path, self.roots)
+            source = planning.object_source(request.scene_yaml, request.scene_path,
+                                            messages.typed_object(request.object), self.roots)
             loaded, cached = planning.load_cached(self.cache, source, request.object_id,
                                                   request.solver_route, self.limits, watch,
                                                   request.replace)

@@ -47,6 +47,7 @@ PARAMETERS: dict[str, tuple[Any, str]] = {
     "output": ("", "bag folder to create (required; must not exist or be empty)"),
     "devices": (["barrett_f1", "barrett_f3"], "devices whose topics are recorded"),
     "extra_topics": ([""], "more topics to record, as 'name pkg/msg/Type' ('' = none)"),
+    "camera": (False, "also record the camera's images, info and pose, and the shape residual"),
     "include_hidden_topics": (False, "also record the executor action's hidden topics "
                                      "(_action/feedback, _action/status), as rosbag2 does only "
                                      "with --include-hidden-topics"),
@@ -90,7 +91,8 @@ class RecorderNode(Node):
         custom = yaml.safe_load(p["custom_data"]) or {}
         self.writer = BagWriter(p["output"], p["compression"], p["chunk_size"],
                                 {str(k): str(v) for k, v in custom.items()})
-        topics = pipeline.pipeline_topics(p["devices"], hidden=p["include_hidden_topics"])
+        topics = pipeline.pipeline_topics(p["devices"], hidden=p["include_hidden_topics"],
+                                          camera=p["camera"])
         self.sources = {name: name.lstrip("/") for name in topics}
         """Recorded name -> the name subscribed to: the pipeline's topics relative to the
         node's namespace (a run in a namespace records '/sim/tick' from '<ns>/sim/tick'),
@@ -111,7 +113,10 @@ class RecorderNode(Node):
         self.newest_tick_ns = -1
         self.reported_ns = -1
         latched = {"/" + pipeline.PREDICTION, "/" + pipeline.OBJECT_POSE,
-                   f"/{pipeline.ACTION}/_action/status"}
+                   f"/{pipeline.ACTION}/_action/status"} | {
+                       "/" + t for t in (pipeline.CAMERA_POSE, pipeline.CAMERA_MASK,
+                                         pipeline.CAMERA_DEPTH, pipeline.CAMERA_INFO,
+                                         pipeline.PREDICTED_SHAPES)}
         sensors = {name for name in topics if name.rsplit("/", 1)[-1] in pipeline.STREAMS}
         for name, type_name in topics.items():
             qos = pipeline.LATCHED if name in latched else (

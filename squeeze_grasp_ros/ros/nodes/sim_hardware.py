@@ -31,15 +31,18 @@ import numpy as np
 from geometry_msgs.msg import PoseStamped, WrenchStamped
 from rclpy.node import Node
 from rosgraph_msgs.msg import Clock
+from sensor_msgs.msg import CameraInfo, Image
 from std_msgs.msg import Header
 from visualization_msgs.msg import MarkerArray
 
 from squeeze_grasp_interfaces.msg import ContactEventArray, SimState, TactileArray, Tick
 
-from squeeze_grasp_ros.mechanics.vocabulary import Effect
+from squeeze_grasp_ros.mechanics.vocabulary import Effect, ImageEncoding
 from squeeze_grasp_ros.ros import messages
 from squeeze_grasp_ros.scene import GraspSetup, load_scene
 from squeeze_grasp_ros.scene.controller import scene_controller
+from squeeze_grasp_ros.ros.messages.images import camera_info_msg, image_msg, pose_of_camera
+from squeeze_grasp_ros.sim.camera import CameraFrame
 from squeeze_grasp_ros.sim.world import SimWorld, TickOutput
 from squeeze_grasp_ros.ros.nodes import ParameterError, pipeline, run_node
 from squeeze_grasp_ros.ros.nodes.sim_controllers import SimJointTrajectoryController
@@ -96,6 +99,13 @@ class SimHardwareNode(Node):
         self.state_pub = pub(SimState, pipeline.SIM_STATE, loop)
         self.event_pub = pub(ContactEventArray, pipeline.SIM_EVENTS, loop)
         self.marker_pub = pub(MarkerArray, pipeline.MARKERS, loop)
+        self.camera_pubs: dict[str, Any] = {}
+        self.first_frame: list = []
+        if world.camera is not None:
+            self.camera_pubs = camera_publishers(self)
+            self.first_frame = camera_messages(self.camera_pubs, world.camera_frame(0, 0))
+            for publisher, msg in self.first_frame:
+                publisher.publish(msg)
         for finger, device in self.devices.items():
             self.create_subscription(PoseStamped, pipeline.device_topic(device, "setpoint"),
                                      lambda msg, f=finger: self._setpoint(f, msg), loop)
@@ -202,6 +212,10 @@ class SimHardwareNode(Node):
             batch.append(self.controller.joint_state(out))
         batch.append((self.state_pub, messages.sim_state_msg(out.state, self.world.fingers,
                                                              out.termination, ns, frame)))
+        if out.index == 0:
+            batch += self.first_frame
+        elif (frame_out := self.world.camera_frame(out.index, ns)) is not None:
+            batch += camera_messages(self.camera_pubs, frame_out)
         tick = (self.tick_pub, messages.tick_msg(out.index, ns, readings))
         self.current, self.now_ns = batch + [tick], ns
         if self._display_due(out.index) and self.marker_pub.get_subscription_count() > 0:
@@ -225,6 +239,30 @@ class SimHardwareNode(Node):
             self.last_progress = time.monotonic()
             for publisher, msg in self.current:
                 publisher.publish(msg)
+
+
+def camera_publishers(node: Node) -> dict[str, Any]:
+    """Publishers of the camera topics, transient-local (a late subscriber gets the newest
+    frame: the first one before tick 0); publishes the camera's pose once.
+    """
+    pubs = {topic: node.create_publisher(msg_type, topic, pipeline.LATCHED)
+            for topic, msg_type in ((pipeline.CAMERA_MASK, Image), (pipeline.CAMERA_DEPTH, Image),
+                                    (pipeline.CAMERA_INFO, CameraInfo))}
+    world = node.world
+    pose = PoseStamped(header=messages.header(0, node.frame),
+                       pose=pose_of_camera(world.camera.pose))
+    node.create_publisher(PoseStamped, pipeline.CAMERA_POSE, pipeline.LATCHED).publish(pose)
+    return pubs
+
+
+def camera_messages(pubs: dict[str, Any], frame: CameraFrame) -> list:
+    """(publisher, message) of one camera frame: mask, depth, CameraInfo, stamped alike."""
+    ns, camera, views = frame.stamp_ns, frame.views.camera, frame.views
+    return [(pubs[pipeline.CAMERA_MASK], image_msg(views.mask, ImageEncoding.MONO8, ns,
+                                                   camera.frame_id)),
+            (pubs[pipeline.CAMERA_DEPTH], image_msg(views.depth, ImageEncoding.DEPTH_32FC1, ns,
+                                                    camera.frame_id)),
+            (pubs[pipeline.CAMERA_INFO], camera_info_msg(camera, ns))]
 
 
 def main(args: list[str] | None = None) -> int:

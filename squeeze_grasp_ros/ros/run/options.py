@@ -113,6 +113,10 @@ def node_parameters(
         relative_per_depth=float(relative_per_depth),
         load_threshold=max(float(monitor.get("load_threshold", 0.005)), 6.0 * noise),
     )
+    if scene.has(Effect.CAMERA):
+        monitor.update(shape_watch=True,
+                       shape_mismatch_threshold=float(scene.camera.shape_mismatch_threshold),
+                       object_height=float(scene.object.material.thickness))
     params["executor"].update(
         finger_devices=mapping, period=float(scene.sim.dt),
         controller_scene=str(Path(scene_path).resolve()) if scene.controller else "")
@@ -121,6 +125,7 @@ def node_parameters(
         output=str(options.record or ""),
         devices=list(devices.values()),
         include_hidden_topics=options.include_hidden_topics,
+        camera=scene.has(Effect.CAMERA),
     )
     if scene.controller is not None:
         params["recorder"]["extra_topics"] = [

@@ -34,6 +34,7 @@ one of its nodes, ends the run with :class:`RunError` (exit 4), never a success.
 
 from __future__ import annotations
 
+import dataclasses
 import importlib.util
 import json
 import os
@@ -61,24 +62,31 @@ from rclpy.signals import SignalHandlerOptions
 from std_msgs.msg import Header
 
 from squeeze_grasp_interfaces.action import ExecuteGrasp
-from squeeze_grasp_interfaces.msg import Alarm, ContactEvent, ContactEventArray, SimState
+from squeeze_grasp_interfaces.msg import (Alarm, ContactEvent, ContactEventArray,
+                                          PredictedShapes, SimState)
 
 from squeeze_grasp_ros.ros import messages
 from squeeze_grasp_ros.control.motion import GraspGoal
 from squeeze_grasp_ros.exit_codes import Interrupted
+from squeeze_grasp_ros.perception.extract import ObjectOutline
 from squeeze_grasp_ros.ros.recording.bag import plain_yaml
 from squeeze_grasp_ros.resources import config_dir, share_dir
 from squeeze_grasp_ros.ros.nodes.sim_controllers import JOINT_STATES
 from squeeze_grasp_ros.scene import GraspSetup, Scene, SceneError, finger_devices, load_scene
 from squeeze_grasp_ros.ros.nodes import PARAMS_FILE_ENV, PARENT_PID_ENV, pipeline
 from squeeze_grasp_ros.ros.nodes.recorder import cdr_stamp_ns
+from squeeze_grasp_ros.planning.typed_objects import typed_scene
+from squeeze_grasp_ros.ros.messages.objects import typed_object
+from squeeze_grasp_ros.ros.run.camera_plan import (first_outline, predicted_shapes_msg,
+                                                   seen_description, seen_report)
 from squeeze_grasp_ros.ros.run.goal_client import GoalClient
 from squeeze_grasp_ros.ros.run.options import (EXECUTORS, PLANNER_MODULE, RunError,
                                                RunOptions, node_parameters)
 from squeeze_grasp_ros.ros.run.summary import GRASP_HELD, Observed, Plan, run_summary
 from squeeze_grasp_ros.scene.goal import plan_scene, resistance_goal, resists
 from squeeze_grasp_ros.threads import single_thread_blas
-from squeeze_grasp_ros.mechanics.vocabulary import SQUEEZING_FINGERS, ShapeType, SqueezeKind
+from squeeze_grasp_ros.mechanics.vocabulary import (SQUEEZING_FINGERS, Effect, ShapeType,
+                                                    SqueezeKind)
 
 GRAPH_CHECK_PERIOD = 1.0
 """Wall-clock seconds between two checks of the run's namespace for foreign traffic."""
@@ -136,7 +144,7 @@ def run_topics(scene: Scene) -> list[str]:
     (``/clock`` as ``clock``: it is remapped into the run's namespace).
     """
     devices = finger_devices(scene).values()
-    names = list(pipeline.pipeline_topics(devices, hidden=True))
+    names = list(pipeline.pipeline_topics(devices, hidden=True, camera=scene.has(Effect.CAMERA)))
     names += [f"/{t}" for t in (pipeline.HELLO, pipeline.READY, pipeline.RECORDER_PROGRESS)]
     if scene.controller is not None:
         names += [f"/{scene.controller.name}/joint_trajectory", f"/{JOINT_STATES}"]
@@ -237,7 +245,7 @@ class PipelineRunner:
         self.executor.add_node(self.client)
         self.nodes: list[Node] = []
         self.processes: list[subprocess.Popen] = []
-        self.params_file: Path | None = None
+        self.params_files: list[Path] = []
         self.sim_events: list[ContactEvent] = []
         self.world_end: dict | None = None
         self.monitor_events: list[ContactEvent] = []
@@ -266,6 +274,8 @@ class PipelineRunner:
         )
         self.goal = GoalClient(c, self._feedback)
         self.plan: Plan | None = None
+        self.seen: ObjectOutline | None = None
+        """The outline the camera's first frame showed (camera.plan_from_images)."""
         self.start_ns = 0
 
     # ----------------------------------------------------------------- callbacks
@@ -414,6 +424,18 @@ class PipelineRunner:
         never reached the client).
         """
         plan_source = self._use_planner()
+        if self.sees_object:
+            if not plan_source:
+                raise RunError("camera.plan_from_images plans with the planner node: install "
+                               "it (pip install -e '.[ros]' and squeeze-grasp ros-setup)")
+            # the world and its camera first (attached: already running, its first frame
+            # latched): the planner sees the object in its first frame
+            self._start_nodes({"sim_hardware": node_parameters(
+                self.scene, self.options.scene_path, self.options, 0.0)["sim_hardware"]})
+            started = time.perf_counter()
+            self.seen = first_outline(self.client, self.spin_until, self.scene,
+                                      self.options.timeout)
+            self.timing["first_frame"] = time.perf_counter() - started
         planner = self._start_planner() if plan_source and not self.options.attach else None
         try:
             self.plan = self._plan_with_planner() if plan_source else self._plan_with_mechanics()
@@ -422,17 +444,17 @@ class PipelineRunner:
                 planner()
         self.timing["plan"] = self.plan.seconds
         self.prediction_pub.publish(self.plan.prediction)
+        if self.scene.has(Effect.CAMERA):
+            self._publish_predicted_shapes()
         params = node_parameters(
             self.scene, self.options.scene_path, self.options, self.plan.goal.relative_per_depth
         )
         if not self.options.record:
             del params["recorder"]
-        self.ours |= set(params)
+        if self.sees_object:
+            del params["sim_hardware"]
         started = time.perf_counter()
-        if self.options.processes:
-            self._spawn(params)
-        elif not self.options.attach:
-            self._construct(params)
+        self._start_nodes(params)
         self.spin_until(
             lambda: self.goal.action.server_is_ready(),
             self.options.timeout,
@@ -447,6 +469,33 @@ class PipelineRunner:
         self.check_graph()
         self.start_ns = self.sim_state_ns
         self.timing["start_nodes"] = time.perf_counter() - started
+
+    def _publish_predicted_shapes(self) -> None:
+        """Latch the predicted deformed boundary along the squeeze for the monitor's shape
+        watch: the planner's model (the seen outline's typed scene on the camera route, else
+        the scene) squeezed to the planned depth.
+        """
+        started = time.perf_counter()
+        model = self.scene if self.seen is None else typed_scene(typed_object(
+            seen_description(self.scene, self.seen))).scene
+        model = dataclasses.replace(model, squeeze=self.scene.squeeze)
+        msg = predicted_shapes_msg(model, self.plan.goal.depth, 0)
+        self.client.create_publisher(PredictedShapes, pipeline.PREDICTED_SHAPES,
+                                     pipeline.LATCHED).publish(msg)
+        self.timing["predicted_shapes"] = time.perf_counter() - started
+
+    def _start_nodes(self, params: dict[str, dict]) -> None:
+        """Start the nodes of ``params`` (processes or in this process; none when attached)."""
+        self.ours |= set(params)
+        if self.options.processes:
+            self._spawn(params)
+        elif not self.options.attach:
+            self._construct(params)
+
+    @property
+    def sees_object(self) -> bool:
+        """Whether the planner sees the object through the camera (camera.plan_from_images)."""
+        return self.scene.has(Effect.CAMERA) and self.scene.camera.plan_from_images
 
     def _use_planner(self) -> bool:
         return self.options.attach or (
@@ -476,8 +525,9 @@ class PipelineRunner:
         remove_stale_parameter_files()
         handle, path = tempfile.mkstemp(prefix=f"{PARAMS_PREFIX}{os.getpid()}_", suffix=".yaml")
         os.close(handle)
-        self.params_file = Path(path)
-        self.params_file.write_text(
+        params_file = Path(path)
+        self.params_files.append(params_file)
+        params_file.write_text(
             plain_yaml({f"{self.namespace}/{name}": {"ros__parameters": values}
                         for name, values in params.items()})
         )
@@ -490,7 +540,7 @@ class PipelineRunner:
                         f"squeeze_grasp_ros.ros.nodes.{name}",
                         *ros_arguments(self.namespace),
                         "--params-file",
-                        str(self.params_file),
+                        str(params_file),
                     ],
                     stdin=subprocess.DEVNULL,
                     env=self._child_environment(),
@@ -504,8 +554,8 @@ class PipelineRunner:
         """
         env = dict(single_thread_blas(dict(os.environ)))
         env[PARENT_PID_ENV] = str(os.getpid())
-        if self.params_file is not None:
-            env[PARAMS_FILE_ENV] = str(self.params_file)
+        if self.params_files:
+            env[PARAMS_FILE_ENV] = str(self.params_files[-1])
         return env
 
     def node(self, name: str) -> Node:
@@ -592,12 +642,17 @@ class PipelineRunner:
 
         t0 = time.perf_counter()
         path = str(Path(self.options.scene_path).resolve())
-        loaded = self._call(LoadObject, "load_object", LoadObject.Request(scene_path=path))
-        squeeze = self._call(
-            EventSqueeze,
-            "event_squeeze",
-            EventSqueeze.Request(object_id=loaded.object_id, object_digest=loaded.object_digest),
-        ).squeeze
+        request = (LoadObject.Request(object=seen_description(self.scene, self.seen))
+                   if self.seen is not None else LoadObject.Request(scene_path=path))
+        loaded = self._call(LoadObject, "load_object", request)
+        request = EventSqueeze.Request(object_id=loaded.object_id,
+                                       object_digest=loaded.object_digest)
+        if self.seen is not None:  # a typed object has no squeeze section: the scene's squeeze
+            spec = self.scene.squeeze
+            request.squeeze_type = spec.type.value
+            request.depth, request.relative_depth = spec.depth or 0.0, spec.relative_depth or 0.0
+            request.step, request.event_tol = spec.step, spec.event_tol
+        squeeze = self._call(EventSqueeze, "event_squeeze", request).squeeze
         pure = self._call(
             PlanSqueeze,
             "plan_squeeze",
@@ -714,8 +769,8 @@ class PipelineRunner:
                 node.destroy_node()
             self.executor.shutdown()
             self.context.try_shutdown()
-            if self.params_file is not None:
-                self.params_file.unlink(missing_ok=True)
+            for params_file in self.params_files:
+                params_file.unlink(missing_ok=True)
 
     # ----------------------------------------------------------------- the whole run
     def run(self) -> dict:
@@ -752,7 +807,8 @@ class PipelineRunner:
         timing = {**self.timing, "total": time.perf_counter() - self.t0, **self._node_timing()}
         return {**run_summary(scene=self.scene.name, mode=self.mode(), plan=self.plan,
                               observed=observed, result=result, recording=self.options.record,
-                              timing=timing), "namespace": self.namespace}
+                              timing=timing), "namespace": self.namespace,
+                **({"seen_outline": seen_report(self.scene, self.seen)} if self.seen else {})}
 
     def _node_timing(self) -> dict:
         """Wall and CPU time of the stepper (``mechanics``) and of whole world ticks (``world``:

@@ -1,0 +1,159 @@
+# Copyright 2026 squeeze_grasp_ros developers
+# SPDX-License-Identifier: Apache-2.0
+"""The outline node: a top-down camera's mask or depth image -> the object's outline.
+
+Run it with ``ros2 run squeeze_grasp_ros outline --ros-args -p camera_pose:="[0.0, 0.0, 0.5,
+3.14159265, 0.0, 0.0]" -p object_height:=0.0254``. It subscribes to
+
+- ``camera/mask`` (parameter ``image_topic``): ``sensor_msgs/Image``, ``mono8`` mask, or a
+  ``16UC1``/``32FC1`` depth image (the encoding decides);
+- ``camera/camera_info``: ``sensor_msgs/CameraInfo`` (pinhole, plumb-bob), the newest one is
+  used for each image;
+- ``camera/pose`` (latched ``geometry_msgs/PoseStamped``, optional): the camera's optical
+  frame in the plane frame; it replaces the ``camera_pose`` parameter once it arrives, and its
+  ``header.frame_id`` must be the node's ``frame_id``.
+
+For each image it runs :func:`~squeeze_grasp_ros.perception.extract.extract_outline` and
+publishes ``outline/outline`` (``geometry_msgs/PolygonStamped``: the outer boundary, m, in
+``frame_id``, z at the top face; what RViz and Foxglove draw) and ``outline/seen``
+(``SeenOutline``: the same with the holes, area, tolerance and pixel size; what a client
+passes on to ``load_object``). A view that would give a wrong outline (no object, an object
+cut by the border, two similar blobs, a tilted support, NaNs next to the object, a wrong
+image size) publishes nothing on those topics: its reason goes to ``outline/errors``
+(``std_msgs/String``, stamped in the text) and to the log (once until the reason changes).
+"""
+from __future__ import annotations
+
+import sys
+from typing import Any
+
+from geometry_msgs.msg import PolygonStamped, PoseStamped
+from rclpy.node import Node
+from sensor_msgs.msg import CameraInfo, Image
+from std_msgs.msg import String
+
+from squeeze_grasp_interfaces.msg import SeenOutline
+
+from squeeze_grasp_ros.mechanics.errors import InvalidInputError
+from squeeze_grasp_ros.perception.camera import CameraModel, CameraPose
+from squeeze_grasp_ros.perception.extract import extract_outline
+from squeeze_grasp_ros.ros import messages
+from squeeze_grasp_ros.ros.messages.images import camera_model, camera_pose, image_array
+from squeeze_grasp_ros.ros.nodes import ParameterError, pipeline, run_node
+
+PARAMETERS: dict[str, tuple[Any, str]] = {
+    "image_topic": (pipeline.CAMERA_MASK, "image to read: mono8 mask, 16UC1 or 32FC1 depth"),
+    "camera_pose": ([0.0] * 6, "camera optical frame in the plane frame: x y z roll pitch yaw "
+                               "(m, rad) or x y z qx qy qz qw; all zeros = wait for "
+                               "camera/pose"),
+    "frame_id": (pipeline.FRAME, "plane frame: the outline's frame (z = 0 on the support)"),
+    "object_height": (0.0, "mask: height of the object's top face above the plane, m"),
+    "tolerance": (0.0, "simplification tolerance, m (0: 0.15 pixel footprints)"),
+    "min_height": (0.004, "depth: a pixel this far above the support is object, m"),
+    "plane_tolerance": (0.002, "depth: largest offset and unevenness of the support, m"),
+    "max_tilt_deg": (2.0, "depth: largest tilt of the support, deg"),
+    "min_area_px": (9, "blobs and holes smaller than this are ignored, px"),
+    "ambiguous_ratio": (0.8, "refuse a view whose second blob has this fraction of the "
+                             "object's area"),
+    "qos_depth": (10, "history depth of the image and outline topics"),
+}
+"""Parameter name -> (typed default, description)."""
+
+
+def pose_parameter(values: list[float]) -> CameraPose | None:
+    """The ``camera_pose`` parameter as a pose; None when all zeros (wait for the topic)."""
+    if not any(values):
+        return None
+    try:
+        if len(values) == 6:
+            return CameraPose.from_xyz_rpy(*values)
+        if len(values) == 7:
+            return CameraPose.from_xyz_quaternion(*values)
+    except InvalidInputError as error:
+        raise ParameterError(f"parameter camera_pose: {error}") from None
+    raise ParameterError(f"parameter camera_pose takes 6 numbers (x y z roll pitch yaw) or 7 "
+                         f"(x y z qx qy qz qw), got {len(values)}")
+
+
+class OutlineNode(Node):
+    """Outline extraction on a camera stream."""
+
+    def __init__(self, **kwargs: Any) -> None:
+        super().__init__("outline", **kwargs)
+        self.p = p = pipeline.declare(self, PARAMETERS)
+        self.pose = pose_parameter(list(p["camera_pose"]))
+        self.camera: CameraModel | None = None
+        self.last_error = ""
+        depth = p["qos_depth"]
+        self.create_subscription(Image, p["image_topic"], self._image, depth)
+        self.create_subscription(CameraInfo, pipeline.CAMERA_INFO, self._info, depth)
+        self.create_subscription(PoseStamped, pipeline.CAMERA_POSE, self._pose, pipeline.LATCHED)
+        self.outline_pub = self.create_publisher(PolygonStamped, pipeline.OUTLINE, depth)
+        self.seen_pub = self.create_publisher(SeenOutline, pipeline.SEEN_OUTLINE, depth)
+        self.error_pub = self.create_publisher(String, pipeline.OUTLINE_ERRORS, depth)
+
+    def ready_summary(self) -> str:
+        """What the ready line says: the image topic, the pose source and the frame."""
+        pose = ("camera/pose" if self.pose is None
+                else f"camera at {', '.join(f'{v:g}' for v in self.pose.position)} m")
+        return f"{self.p['image_topic']}, {pose}, frame {self.p['frame_id']}"
+
+    def _info(self, msg: CameraInfo) -> None:
+        try:
+            self.camera = camera_model(msg)
+        except InvalidInputError as error:
+            self.camera = None
+            self._refuse(msg.header.stamp, str(error))
+
+    def _pose(self, msg: PoseStamped) -> None:
+        if msg.header.frame_id != self.p["frame_id"]:
+            self._refuse(msg.header.stamp, f"camera/pose is in frame {msg.header.frame_id!r}, "
+                                           f"not the plane frame {self.p['frame_id']!r}")
+            return
+        try:
+            self.pose = camera_pose(msg.pose)
+        except InvalidInputError as error:
+            self._refuse(msg.header.stamp, f"camera/pose: {error}")
+
+    def _image(self, msg: Image) -> None:
+        if self.camera is None or self.pose is None:
+            self._refuse(msg.header.stamp, "no camera_info yet" if self.camera is None
+                         else "no camera pose yet (parameter camera_pose or camera/pose)")
+            return
+        p = self.p
+        try:
+            pixels, encoding = image_array(msg)
+            seen = extract_outline(
+                pixels, encoding, self.camera, self.pose, tolerance_m=p["tolerance"] or None,
+                object_height_m=p["object_height"], min_height_m=p["min_height"],
+                plane_tolerance_m=p["plane_tolerance"], max_tilt_deg=p["max_tilt_deg"],
+                min_area_px=p["min_area_px"], ambiguous_ratio=p["ambiguous_ratio"],
+                frame_id=p["frame_id"])
+        except InvalidInputError as error:
+            self._refuse(msg.header.stamp, str(error))
+            return
+        self.last_error = ""
+        out = messages.seen_outline_msg(
+            seen.outline, frame_id=seen.frame_id, ns=messages.stamp_ns(msg.header.stamp),
+            encoding=seen.encoding, plane_height=seen.plane_height,
+            tolerance=seen.tolerance_m, pixel_size=seen.pixel_size_m,
+            other_blobs=len(seen.others))
+        self.outline_pub.publish(out.outline)
+        self.seen_pub.publish(out)
+
+    def _refuse(self, stamp: Any, reason: str) -> None:
+        """Publish ``reason`` on outline/errors; log it when it differs from the last one."""
+        ns = messages.stamp_ns(stamp)
+        self.error_pub.publish(String(data=f"{ns * 1e-9:.6f} s: {reason}"))
+        if reason != self.last_error:
+            self.get_logger().warning(f"no outline: {reason}")
+            self.last_error = reason
+
+
+def main(args: list[str] | None = None) -> int:
+    """Run the outline node until Ctrl-C or shutdown; return the exit code."""
+    return run_node(OutlineNode, args)
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,114 @@
+# Copyright 2026 squeeze_grasp_ros developers
+# SPDX-License-Identifier: Apache-2.0
+"""Planning from what the camera sees (scene key ``camera.plan_from_images``).
+
+The run never hands the planner the scene's shape. It waits for the simulated camera's first
+frame (``camera/mask``, ``camera/camera_info``, ``camera/pose``; latched, published by
+``sim_hardware`` before tick 0), extracts the outline
+(:func:`~squeeze_grasp_ros.perception.extract.extract_outline`), and describes the object to
+``load_object`` with typed fields: the seen outline, plus what a robot is told rather than
+sees (the material, the mesh size, where the fingers are, their radius, the friction). The
+summary then says how far the seen outline was from the scene's true one
+(:func:`seen_report`: point-to-curve distances, no fit).
+"""
+from __future__ import annotations
+
+from typing import Any, Callable
+
+from geometry_msgs.msg import PoseStamped
+from sensor_msgs.msg import CameraInfo, Image
+
+from squeeze_grasp_interfaces.msg import ObjectDescription, PredictedShapes
+
+from squeeze_grasp_ros.mechanics.vocabulary import ShapeFit
+from squeeze_grasp_ros.perception.extract import ObjectOutline, extract_outline
+from squeeze_grasp_ros.perception.shape_match import shape_residual
+from squeeze_grasp_ros.perception.shape_watch import predict_shapes
+from squeeze_grasp_ros.planning import PlannerError
+from squeeze_grasp_ros.planning.typed_objects import seen_object
+from squeeze_grasp_ros.ros import messages
+from squeeze_grasp_ros.ros.messages.images import camera_model, camera_pose, image_array
+from squeeze_grasp_ros.ros.messages.objects import object_description, polygon_msg
+from squeeze_grasp_ros.ros.nodes import pipeline
+from squeeze_grasp_ros.ros.run.options import RunError
+from squeeze_grasp_ros.scene import GraspSetup, Scene, build_outline
+
+__all__ = ["first_outline", "predicted_shapes_msg", "seen_description", "seen_report"]
+
+
+def first_outline(node: Any, spin_until: Callable[..., None], scene: Scene,
+                  timeout: float) -> ObjectOutline:
+    """The outline in the camera's first frame (mask), read over ROS by ``node``.
+
+    Raises
+    ------
+    RunError
+        When the frame does not arrive in ``timeout`` s, or the view gives no outline (the
+        reason of :class:`~squeeze_grasp_ros.mechanics.errors.InvalidInputError`).
+    """
+    got: dict[str, Any] = {}
+    subscriptions = [
+        node.create_subscription(msg_type, topic, lambda msg, k=topic: got.setdefault(k, msg),
+                                 pipeline.LATCHED)
+        for topic, msg_type in ((pipeline.CAMERA_MASK, Image), (pipeline.CAMERA_INFO, CameraInfo),
+                                (pipeline.CAMERA_POSE, PoseStamped))]
+    try:
+        spin_until(lambda: len(got) == len(subscriptions), timeout, "the camera's first frame")
+    finally:
+        for subscription in subscriptions:
+            node.destroy_subscription(subscription)
+    pose_msg = got[pipeline.CAMERA_POSE]
+    try:
+        pixels, encoding = image_array(got[pipeline.CAMERA_MASK])
+        return extract_outline(pixels, encoding, camera_model(got[pipeline.CAMERA_INFO]),
+                               camera_pose(pose_msg.pose),
+                               object_height_m=scene.object.material.thickness,
+                               frame_id=pose_msg.header.frame_id)
+    except ValueError as error:
+        raise RunError(f"camera.plan_from_images: the first frame gives no outline: "
+                       f"{error}") from None
+
+
+def seen_description(scene: Scene, seen: ObjectOutline) -> ObjectDescription:
+    """The typed ``load_object`` object of a seen outline
+    (:func:`~squeeze_grasp_ros.planning.typed_objects.seen_object`).
+
+    Raises
+    ------
+    RunError
+        When the scene's fingers cannot be described with it (placements not by point, tip
+        radii that differ).
+    """
+    try:
+        typed = seen_object(scene, seen.outline, seen.frame_id)
+    except PlannerError as error:
+        raise RunError(f"camera.plan_from_images: {error}") from None
+    m = typed.material
+    return object_description(
+        seen.outline, typed.frame_id, youngs_modulus=m.youngs_modulus,
+        poisson_ratio=m.poisson_ratio, thickness=m.thickness, model=m.model,
+        placements=typed.placements, tip_radius=typed.tip_radius, mu=typed.mu,
+        mesh_nodes=typed.mesh_nodes)
+
+
+def seen_report(scene: Scene, seen: ObjectOutline) -> dict:
+    """How far the seen outline is from the scene's true one: point-to-curve distances of the
+    seen vertices from the true outline (no fit), m, and the areas, m^2.
+    """
+    truth = build_outline(scene.object.shape)
+    match = shape_residual(truth, seen.outline, fit=ShapeFit.NONE)
+    return {"vertices": int(len(seen.outline.points)), "holes": len(seen.outline.holes),
+            "rms_m": match.rms_m, "max_m": max(match.max_m, match.reverse_max_m),
+            "area_m2": seen.outline.area, "true_area_m2": truth.area,
+            "pixel_m": seen.pixel_size_m, "tolerance_m": seen.tolerance_m}
+
+
+def predicted_shapes_msg(scene: Scene, depth: float, ns: int,
+                         frame_id: str = pipeline.FRAME) -> PredictedShapes:
+    """The ``PredictedShapes`` of the planner's model (``scene``: the seen object's typed scene
+    on the camera route) squeezed to ``depth`` (m), for the monitor's shape watch.
+    """
+    predicted = predict_shapes(GraspSetup.build(scene).precompute(), depth)
+    return PredictedShapes(header=messages.header(ns, frame_id),
+                           depths=[float(d) for d in predicted.depths],
+                           outlines=[polygon_msg(o) for o in predicted.outlines])

@@ -1,0 +1,140 @@
+# Copyright 2026 squeeze_grasp_ros developers
+# SPDX-License-Identifier: Apache-2.0
+"""The outline node on real rclpy (issue 32, item 2): rendered mask and depth images of a
+ring-like object published as ``sensor_msgs/Image`` + ``CameraInfo`` come back as the outline
+(PolygonStamped and SeenOutline with its hole) within a pixel of the truth; bad views are
+refused on ``outline/errors``; the image conversions round-trip both byte orders.
+"""
+from __future__ import annotations
+
+import time
+
+import numpy as np
+import pytest
+from scipy.spatial.distance import directed_hausdorff
+
+from perception_support import CAMERA, pose, skimage_or_skip
+from squeeze_grasp_ros.mechanics.elastic import shapes
+from squeeze_grasp_ros.mechanics.elastic.shapes import resample
+from squeeze_grasp_ros.mechanics.vocabulary import ImageEncoding
+from squeeze_grasp_ros.perception.render import render_views
+
+HEIGHT = 0.02
+
+
+def hausdorff(a: np.ndarray, b: np.ndarray) -> float:
+    a, b = resample(a, 2e-4), resample(b, 2e-4)
+    return max(directed_hausdorff(a, b)[0], directed_hausdorff(b, a)[0])
+
+
+def test_images_round_trip_through_messages():
+    from squeeze_grasp_ros.ros.messages.images import image_array, image_msg
+
+    rng = np.random.default_rng(3)
+    for encoding, pixels in ((ImageEncoding.MONO8, rng.integers(0, 255, (5, 7), np.uint8)),
+                             (ImageEncoding.DEPTH_16UC1, rng.integers(0, 60000, (5, 7),
+                                                                      np.uint16)),
+                             (ImageEncoding.DEPTH_32FC1, rng.random((5, 7), np.float32))):
+        msg = image_msg(pixels, encoding, 7, "cam")
+        back, got = image_array(msg)
+        assert got == encoding and np.array_equal(back, pixels)
+    big = image_msg(pixels, ImageEncoding.DEPTH_32FC1, 0, "cam")
+    big.is_bigendian, big.data = 1, pixels.astype(">f4").tobytes()
+    assert np.array_equal(image_array(big)[0], pixels)
+    padded = image_msg(pixels, ImageEncoding.DEPTH_32FC1, 0, "cam")
+    padded.step = 7 * 4 + 4
+    padded.data = np.pad(pixels.view(np.uint8).reshape(5, 28), ((0, 0), (0, 4))).tobytes()
+    assert np.array_equal(image_array(padded)[0], pixels)
+    padded.data = padded.data[:-1]
+    with pytest.raises(ValueError, match="step x height"):
+        image_array(padded)
+
+
+def test_the_outline_node_publishes_the_seen_outline(ros_context):
+    skimage_or_skip()
+    import rclpy
+    from geometry_msgs.msg import PolygonStamped
+    from rclpy.executors import SingleThreadedExecutor
+    from rclpy.parameter import Parameter
+    from sensor_msgs.msg import CameraInfo, Image
+    from std_msgs.msg import String
+
+    from squeeze_grasp_interfaces.msg import SeenOutline
+    from squeeze_grasp_ros.ros.messages.images import camera_info_msg, image_msg
+    from squeeze_grasp_ros.ros.messages.objects import polygon_points
+    from squeeze_grasp_ros.ros.nodes.outline import OutlineNode
+
+    truth = shapes.annulus(0.05, 0.02)
+    view_pose = pose(0.01, -0.01, 0.3)
+    views = render_views(truth, CAMERA, view_pose, top_height=HEIGHT)
+    rpy = [0.01, -0.01, 0.5, np.pi + 0.04, -0.02, 0.3]
+    node = OutlineNode(context=ros_context, parameter_overrides=[
+        Parameter("camera_pose", value=rpy), Parameter("object_height", value=HEIGHT)])
+    client = rclpy.create_node("outline_test", context=ros_context)
+    executor = SingleThreadedExecutor(context=ros_context)
+    for n in (node, client):
+        executor.add_node(n)
+    got: dict[str, list] = {"seen": [], "outline": [], "errors": []}
+    client.create_subscription(SeenOutline, "outline/seen", got["seen"].append, 10)
+    client.create_subscription(PolygonStamped, "outline/outline", got["outline"].append, 10)
+    client.create_subscription(String, "outline/errors", got["errors"].append, 10)
+    images = client.create_publisher(Image, "camera/mask", 10)
+    infos = client.create_publisher(CameraInfo, "camera/camera_info", 10)
+
+    def spin_until(done, what):
+        deadline = time.monotonic() + 30
+        while not done():
+            assert time.monotonic() < deadline, f"timed out waiting for {what}"
+            executor.spin_once(0.05)
+
+    try:
+        spin_until(lambda: images.get_subscription_count() and infos.get_subscription_count(),
+                   "the node's subscriptions")
+        images.publish(image_msg(views.mask, ImageEncoding.MONO8, 1_000, "cam"))
+        spin_until(lambda: got["errors"], "the refusal without camera_info")
+        assert "no camera_info yet" in got["errors"][0].data
+        infos.publish(camera_info_msg(CAMERA, 2_000))
+        spin_until(lambda: node.camera is not None, "the camera info")
+        images.publish(image_msg(views.mask, ImageEncoding.MONO8, 3_000, "cam"))
+        spin_until(lambda: got["seen"] and got["outline"], "the outline")
+        seen = got["seen"][0]
+        assert seen.outline.header.frame_id == "object" and seen.encoding == "mono8"
+        assert seen.outline.header.stamp.nanosec == 3_000
+        assert len(seen.holes) == 1 and seen.other_blobs == 0
+        assert seen.area == pytest.approx(truth.area, rel=0.005)
+        pixel = seen.pixel_size
+        outer = np.asarray(polygon_points(seen.outline.polygon))
+        hole = np.asarray(polygon_points(seen.holes[0]))
+        assert hausdorff(outer, truth.points) < 0.5 * pixel
+        assert hausdorff(hole, truth.holes[0]) < 0.5 * pixel
+        assert np.allclose([p.z for p in seen.outline.polygon.points], HEIGHT, atol=1e-6)
+        assert polygon_points(got["outline"][0].polygon) == polygon_points(seen.outline.polygon)
+
+        depth = render_views(truth, CAMERA, view_pose, top_height=HEIGHT,
+                             depth_noise_m=0.0005, seed=2)
+        images.publish(image_msg(depth.depth_mm(), ImageEncoding.DEPTH_16UC1, 4_000, "cam"))
+        spin_until(lambda: len(got["seen"]) == 2, "the outline of the depth image")
+        empty = np.zeros_like(views.mask)
+        images.publish(image_msg(empty, ImageEncoding.MONO8, 5_000, "cam"))
+        spin_until(lambda: len(got["errors"]) == 2, "the empty view's refusal")
+        assert "no object" in got["errors"][1].data and len(got["seen"]) == 2
+        cut = np.zeros_like(views.mask)
+        cut[:, :100] = 255
+        images.publish(image_msg(cut, ImageEncoding.MONO8, 6_000, "cam"))
+        spin_until(lambda: len(got["errors"]) == 3, "the border view's refusal")
+        assert "border" in got["errors"][2].data
+    finally:
+        executor.shutdown()
+        client.destroy_node()
+        node.destroy_node()
+
+
+def test_a_bad_camera_pose_parameter_is_refused():
+    from squeeze_grasp_ros.ros.nodes import ParameterError
+    from squeeze_grasp_ros.ros.nodes.outline import pose_parameter
+
+    assert pose_parameter([0.0] * 6) is None
+    with pytest.raises(ParameterError, match="6 numbers .* or 7"):
+        pose_parameter([1.0, 2.0])
+    with pytest.raises(ParameterError, match="camera_pose: .*above the support plane"):
+        pose_parameter([0.0, 0.0, -0.5, np.pi, 0.0, 0.0])

@@ -1,0 +1,203 @@
+# Copyright 2026 squeeze_grasp_ros developers
+# SPDX-License-Identifier: Apache-2.0
+"""Objects given as typed fields (issue 32, item 1): the ROS-free conversion against the YAML
+route (same mesh, same plan), frames placed by a pose, the validation messages naming the
+message fields, and ``load_object`` on a real planner node with an ``ObjectDescription``.
+"""
+from __future__ import annotations
+
+import math
+from collections.abc import Iterator
+from pathlib import Path
+
+import numpy as np
+import pytest
+import yaml
+
+from squeeze_grasp_ros.planning import (ErrorCode, FramePose, PlannerLimits, PlannerError,
+                                        TypedMaterial, TypedObject, load_object, object_key,
+                                        object_source, read_scene, squeeze_plan, typed_scene)
+
+REPO = Path(__file__).resolve().parents[1]
+FOAM = (REPO / "config" / "scenes" / "foam_square.yaml").read_text()
+FOAM_MATERIAL = TypedMaterial(5.0e4, 0.3, 0.0254)
+SQUARE = ((-0.05, -0.05), (0.05, -0.05), (0.05, 0.05), (-0.05, 0.05))
+LIMITS = PlannerLimits()
+
+
+def loaded(source):
+    return load_object(source, object_key(source, "x", "", LIMITS), LIMITS)
+
+
+def foam_like(**fields) -> TypedObject:
+    """The foam square scene's object, fingers and friction as typed fields."""
+    base = dict(material=FOAM_MATERIAL, outline=SQUARE, mesh_nodes=2000,
+                placements=((-0.05, 0.0), (0.05, 0.0)), tip_radius=0.02, mu=0.4)
+    return TypedObject(**{**base, **fields})
+
+
+def test_a_typed_square_meshes_and_plans_like_the_yaml_scene():
+    """The foam square as an outline polygon and as a named shape: same nodes, same contact
+    nodes and the same squeeze forces as config/scenes/foam_square.yaml (which names a square).
+    """
+    yaml_object = loaded(read_scene(FOAM, ""))
+    polygon = loaded(typed_scene(foam_like()))
+    shape = loaded(typed_scene(foam_like(outline=(), shape="square",
+                                         shape_parameters={"side": (0.1,)})))
+    reference = squeeze_plan(yaml_object, [], "stable", 0.003)
+    for typed in (polygon, shape):
+        assert typed.num_nodes == yaml_object.num_nodes
+        assert typed.finger_nodes == yaml_object.finger_nodes
+        np.testing.assert_allclose(typed.body.mesh.nodes, yaml_object.body.mesh.nodes,
+                                   atol=1e-12)
+        assert typed.scene.mu == 0.4
+        plan = squeeze_plan(typed, [], "stable", 0.003)
+        np.testing.assert_allclose(plan.boundary_displacement, reference.boundary_displacement,
+                                   rtol=1e-9, atol=1e-15)
+
+
+def test_an_outline_in_another_frame_lands_where_its_pose_puts_it():
+    """The square given in a frame turned 30 degrees and shifted, with the pose of that frame
+    (z of the pose dropped): the scene's outline and placements are the object-frame square's
+    to float rounding, and it meshes and plans like it (the mesher sees points 1e-17 m apart
+    from the direct ones, so its refinement may differ by a few nodes: forces within 1 %).
+    """
+    angle, shift = math.radians(30.0), np.array([0.2, -0.1])
+    R = np.array([[math.cos(angle), -math.sin(angle)], [math.sin(angle), math.cos(angle)]])
+    local = (np.asarray(SQUARE) - shift) @ R  # object = R local + shift
+    fingers = (np.array([[-0.05, 0.0], [0.05, 0.0]]) - shift) @ R
+    pose = FramePose((0.2, -0.1, 0.7), (0.0, 0.0, math.sin(angle / 2), math.cos(angle / 2)))
+    source = typed_scene(foam_like(outline=local, placements=fingers, frame_id="camera_plane",
+                                   frame_pose=pose))
+    np.testing.assert_allclose(source.scene.object.shape["points"], SQUARE, atol=1e-15)
+    np.testing.assert_allclose([f.placement.point for f in source.scene.fingers.values()],
+                               [[-0.05, 0.0], [0.05, 0.0]], atol=1e-15)
+    moved, direct = loaded(source), loaded(typed_scene(foam_like()))
+    assert abs(moved.num_nodes - direct.num_nodes) <= 0.02 * direct.num_nodes
+    for obj in (moved, direct):
+        np.testing.assert_allclose(obj.body.mesh.nodes[list(obj.finger_nodes)],
+                                   [[-0.05, 0.0], [0.05, 0.0]], atol=1e-12)
+    forces = [np.linalg.norm(squeeze_plan(o, [], "stable", 0.003).squeeze.forces)
+              for o in (moved, direct)]
+    assert forces[0] == pytest.approx(forces[1], rel=0.01)
+
+
+def test_holes_make_a_ring_like_solid():
+    hole = [(0.02 * math.cos(t), 0.02 * math.sin(t)) for t in np.linspace(0, 2 * math.pi, 24,
+                                                                          endpoint=False)]
+    ring = loaded(typed_scene(foam_like(holes=[hole], mesh_nodes=800)))
+    inner = np.linalg.norm(ring.body.mesh.nodes, axis=1)
+    assert inner.min() == pytest.approx(0.02, rel=0.05)
+    mesh = ring.body.mesh
+    corners = mesh.nodes[mesh.triangles]
+    edges = corners[:, 1:] - corners[:, :1]
+    area = 0.5 * np.abs(edges[:, 0, 0] * edges[:, 1, 1] - edges[:, 0, 1] * edges[:, 1, 0]).sum()
+    assert area == pytest.approx(0.01 - math.pi * 0.02**2, rel=0.01)
+
+
+@pytest.mark.parametrize("fields, words", [
+    (dict(material=TypedMaterial(-1.0, 0.3, 0.01)),
+     ["object.material.youngs_modulus", "Pa", "[0.001, 1e+13]"]),
+    (dict(material=TypedMaterial(5e4, 0.7, 0.01)), ["object.material.poisson_ratio", "0.5"]),
+    (dict(material=TypedMaterial(5e4, 0.3, 0.0)), ["object.material.thickness", "m"]),
+    (dict(material=TypedMaterial(5e4, 0.3, 0.01, "rubbery")), ["object.material.model",
+                                                                "neo_hookean"]),
+    (dict(outline=((0, 0), (0.1, 0.1), (0.1, 0), (0, 0.08))),
+     ["object.outline.polygon.points", "self-intersect"]),
+    (dict(outline=((0, 0), (0.1, 0))), ["object.outline.polygon.points", "at least 3"]),
+    (dict(outline=((0, 0), (0.1, 0), (float("nan"), 0.1))),
+     ["object.outline.polygon.points[2]", "finite"]),
+    (dict(holes=[((0.5, 0.5), (0.6, 0.5), (0.6, 0.6))]), ["object.holes", "inside"]),
+    (dict(outline=(), shape="disk", shape_parameters={"radius": (-0.05,)}),
+     ["object.shape_parameters radius", "m"]),
+    (dict(outline=(), shape="disk", shape_parameters={"side": (0.05,)}),
+     ["object.shape_parameters", "'side'", "radius"]),
+    (dict(outline=(), shape="file"), ["object.shape", "disk"]),
+    (dict(shape="disk"), ["either object.outline", "not both"]),
+    (dict(mesh_nodes=5), ["object.mesh_nodes", "10"]),
+    (dict(mesh_max_area=-1.0), ["object.mesh_max_area", "m^2"]),
+    (dict(placements=((0.0, 0.0),)), ["object.placements", "2 points"]),
+    (dict(tip_radius=-0.01), ["object.tip_radius", "m"]),
+    (dict(mu=-0.2), ["object.mu"]),
+    (dict(frame_id="tilted", frame_pose=FramePose((0, 0, 0), (0.1, 0.0, 0.0, 0.995))),
+     ["object.frame_pose", "rad", "z axis"]),
+])
+def test_bad_typed_objects_name_the_message_field(fields, words):
+    with pytest.raises(PlannerError) as caught:
+        typed_scene(foam_like(**fields))
+    assert caught.value.code == ErrorCode.INVALID_ARGUMENT
+    for word in words:
+        assert word in str(caught.value), str(caught.value)
+
+
+def test_exactly_one_source_of_the_object():
+    with pytest.raises(PlannerError, match="exactly one of scene_yaml, scene_path and object"):
+        object_source(FOAM, "", foam_like())
+    with pytest.raises(PlannerError, match="exactly one of scene_yaml, scene_path and object"):
+        object_source("", "", TypedObject(material=FOAM_MATERIAL))
+    assert object_source(FOAM, "", TypedObject(material=FOAM_MATERIAL)).scene.name == \
+        "foam_square"
+
+
+def test_the_planner_limits_apply_to_typed_objects():
+    source = typed_scene(foam_like(mesh_nodes=50_000))
+    small = PlannerLimits(max_nodes=5_000)
+    with pytest.raises(PlannerError, match="oversized factorized mesh: 50000 nodes"):
+        load_object(source, object_key(source, "x", "", small), small)
+
+
+def test_the_digest_follows_the_object_not_the_field_order():
+    a, b = typed_scene(foam_like()), typed_scene(foam_like(mu=0.4, tip_radius=0.02))
+    assert object_key(a, "", "", LIMITS).digest == object_key(b, "", "", LIMITS).digest
+    c = typed_scene(foam_like(material=TypedMaterial(6.0e4, 0.3, 0.0254)))
+    assert object_key(a, "", "", LIMITS).digest != object_key(c, "", "", LIMITS).digest
+    assert yaml.safe_load(a.text)["object"]["material"]["E"] == 5.0e4
+
+
+# --------------------------------------------------------------------------- on the node
+
+
+@pytest.fixture
+def planner(ros_context) -> Iterator:
+    from planner_support import Harness
+
+    harness = Harness(ros_context)
+    try:
+        yield harness
+    finally:
+        harness.close()
+
+
+def test_load_object_takes_an_object_description(planner):
+    """``load_object`` with a PolygonStamped outline, typed material and mesh size: the same
+    object as the YAML route (nodes, contact nodes, plan), and refusals name the field.
+    """
+    from squeeze_grasp_interfaces.srv import LoadObject, PlanSqueeze
+
+    from squeeze_grasp_ros.mechanics.elastic.shapes import Outline
+    from squeeze_grasp_ros.ros.messages.objects import object_description
+
+    by_yaml = planner.load(FOAM, object_id="yaml")
+    description = object_description(
+        Outline(np.asarray(SQUARE)), "object", youngs_modulus=5.0e4, poisson_ratio=0.3,
+        thickness=0.0254, placements=((-0.05, 0.0), (0.05, 0.0)), tip_radius=0.02, mu=0.4,
+        mesh_nodes=2000)
+    typed = planner.call(LoadObject, "load_object",
+                         LoadObject.Request(object=description, object_id="typed"))
+    assert typed.success, typed.message
+    # the polygon's points travel as float32 (geometry_msgs/Point32, 0.05 m -> 0.05 + 7e-10 m):
+    # the mesher refines a little differently, the squeeze stays within 1 %
+    assert abs(typed.num_nodes - by_yaml.num_nodes) <= 0.02 * by_yaml.num_nodes
+    assert typed.mu == by_yaml.mu
+    plans = [planner.call(PlanSqueeze, "plan_squeeze",
+                          PlanSqueeze.Request(object_id=i, squeeze_type="stable", depth=0.003))
+             for i in ("yaml", "typed")]
+    forces = [np.linalg.norm(np.asarray(p.forces)) for p in plans]
+    assert forces[1] == pytest.approx(forces[0], rel=0.01)
+    description.material.youngs_modulus = 0.0
+    refused = planner.call(LoadObject, "load_object", LoadObject.Request(object=description))
+    assert not refused.success and refused.error_code == LoadObject.Response.INVALID_ARGUMENT
+    assert "object.material.youngs_modulus must be in [0.001, 1e+13] Pa" in refused.message
+    both = planner.call(LoadObject, "load_object",
+                        LoadObject.Request(object=description, scene_yaml=FOAM))
+    assert not both.success and "exactly one of scene_yaml, scene_path and object" in both.message

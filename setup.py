@@ -12,6 +12,7 @@ ROS_WHEELS = [
     "ros-jazzy-std-msgs",
     "ros-jazzy-geometry-msgs",
     "ros-jazzy-sensor-msgs",
+    "ros-jazzy-trajectory-msgs",
     "ros-jazzy-visualization-msgs",
     "ros-jazzy-rosgraph-msgs",
     "ros-jazzy-action-msgs",

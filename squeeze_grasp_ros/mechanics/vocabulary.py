@@ -30,9 +30,10 @@ from __future__ import annotations
 
 from enum import Enum
 
-__all__ = ["ContactKind", "ContactMode", "DistortionModel", "Effect", "EventType", "Factorizer",
-           "Finger", "ImageEncoding", "MaterialModel", "ObjectModel", "RingLimit",
-           "SQUEEZING_FINGERS", "ShapeFit", "ShapeType", "SqueezeKind", "StrainCriterion",
+__all__ = ["ContactKind", "ContactMode", "ControllerKind", "DistortionModel", "Effect",
+           "EventType", "Factorizer", "Finger", "ImageEncoding", "MaterialModel", "ObjectModel",
+           "RingLimit", "SQUEEZING_FINGERS", "ShapeFit", "ShapeType", "SqueezeKind",
+           "StrainCriterion",
            "StrainMeasure", "StressMeasure", "Termination", "TipKind"]
 
 
@@ -312,6 +313,14 @@ class DistortionModel(_Name):
     """Radial k1, k2, k3 and tangential p1, p2 (Brown-Conrady, as OpenCV)."""
     RATIONAL_POLYNOMIAL = "rational_polynomial"
     """Accepted only when its extra coefficients k4-k6 are zero (it is then plumb-bob)."""
+
+
+class ControllerKind(_Name):
+    """Stock ros2_control controller interfaces a scene's gripper can be driven through."""
+
+    JOINT_TRAJECTORY = "joint_trajectory"
+    """A JointTrajectoryController: ``trajectory_msgs/JointTrajectory`` on
+    ``<controller>/joint_trajectory``."""
 
 
 class ShapeFit(_Name):

@@ -53,5 +53,9 @@ def read_yaml(path: str | Path, what: str = "scene") -> Any:
 
 
 def load_scene(path: str | Path) -> Scene:
-    """Read and validate a YAML scene file."""
-    return parse_scene(read_yaml(path), base_dir=Path(path).parent)
+    """Read and validate a YAML scene file (its ``controller:`` section against its device too)."""
+    from squeeze_grasp_ros.scene.controller import scene_controller  # it reads device files
+
+    scene = parse_scene(read_yaml(path), base_dir=Path(path).parent)
+    scene_controller(scene, path)
+    return scene

@@ -132,4 +132,4 @@ def parse_gripper(data, where: str = "gripper") -> GripperSpec:
 
 def load_gripper(path: str | Path) -> GripperSpec:
     """Read and validate a gripper device file."""
-    return parse_gripper(read_yaml(path, what="gripper device file"))
+    return parse_gripper(read_yaml(path, what="gripper device"))

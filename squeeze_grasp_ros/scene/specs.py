@@ -19,6 +19,7 @@ from squeeze_grasp_ros.mechanics.elastic.mesh import MAX_MESH_NODES
 from squeeze_grasp_ros.mechanics.ring.model import MAX_RING_ELEMENTS
 from squeeze_grasp_ros.mechanics.vocabulary import (
     ContactKind,
+    ControllerKind,
     Effect,
     Finger,
     MaterialModel,
@@ -356,6 +357,23 @@ class SimSpec:
 
 
 @dataclass(frozen=True)
+class ControllerSpec:
+    """Two fingers carried by the jaws of a parallel gripper under a stock ros2_control
+    controller (docs/grippers.md): the executor commands the controller, the simulated hardware
+    stands in for it.
+    """
+
+    type: ControllerKind = spec("the controller's interface")
+    name: str = spec("the controller's name (its topic is <name>/joint_trajectory)")
+    device: str = spec("the gripper device: a shipped device name (config/devices) or a "
+                       "device file, relative to the scene")
+    joints: tuple[str, ...] = spec("the controller's joints (empty: the device's "
+                                   "transmission.joints)", default=())
+    jaws: tuple[Finger, ...] = spec("the two fingers the jaws carry, F1's jaw first",
+                                    default=(Finger.F1, Finger.F2))
+
+
+@dataclass(frozen=True)
 class CameraSpec:
     """A simulated top-down camera above the object (effect: camera): pinhole intrinsics,
     plumb-bob distortion and the pose of its optical frame (z along the view, x right, y down)
@@ -420,6 +438,8 @@ class Scene:
         "actuator dynamics (effect: actuator_lag)", default=None
     )
     sim: SimSpec = spec("simulated clock", default_factory=SimSpec)
+    controller: Optional[ControllerSpec] = spec(
+        "the fingers' gripper under a stock ros2_control controller", default=None)
     camera: Optional[CameraSpec] = spec("top-down camera (effect: camera)", default=None)
 
     @property

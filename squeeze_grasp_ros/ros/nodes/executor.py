@@ -18,6 +18,12 @@ data and slip alarms, and the reactive redirection of the program.
 - Hardware (``lockstep: false``): a wall-clock timer at 1 / ``period`` runs the cycle on the
   newest status.
 
+Stock controller (``controller_scene``: a scene with a ``controller:`` section, docs/grippers.md):
+the jaws' setpoints become one aperture on the jaw line (fixed by the jaws' measured tips when
+a goal starts) and are sent through the gripper's transmission as ``trajectory_msgs/
+JointTrajectory`` on ``<controller>/joint_trajectory``, one point per control cycle
+(:mod:`.jaw_commands`); the other fingers keep their setpoint topics.
+
 Feedback (every ``feedback_every`` cycles): state, measured depth and forces, events since the
 previous feedback. Cancel: the next cycle holds the measured positions and the goal ends
 ``canceled``. Only one goal runs at a time; others are rejected.
@@ -40,6 +46,7 @@ from squeeze_grasp_interfaces.msg import ExecutorStatus, MonitorStatus
 from squeeze_grasp_ros.ros import messages
 from squeeze_grasp_ros.control.motion import Command, GraspProgram, MotionLimits, goal_problem
 from squeeze_grasp_ros.ros.nodes import pipeline, run_node
+from squeeze_grasp_ros.ros.nodes.jaw_commands import JawCommands
 
 PARAMETERS: dict[str, tuple[Any, str]] = {
     "finger_devices": (["F1:barrett_f1", "F2:barrett_f3"], "finger:device of every fingertip"),
@@ -57,6 +64,8 @@ PARAMETERS: dict[str, tuple[Any, str]] = {
     "feedback_every": (10, "cycles between action feedback messages"),
     "lockstep": (True, "cycle on each monitor status (simulation) or on a wall-clock timer"),
     "qos_depth": (100, "history depth of the reliable topics"),
+    "controller_scene": ("", "scene file whose controller: section drives the jaws through "
+                             "a stock controller (empty: setpoint topics only)"),
 }
 """Parameter name -> (typed default, description); config/executor.yaml sets them."""
 
@@ -86,7 +95,8 @@ class ExecutorNode(Node):
     def ready_summary(self) -> str:
         """What the ready line of ``ros2 run`` says: devices, clock and limits."""
         clock = "lockstep on /clock" if self.p["lockstep"] else "wall-clock timer"
-        return (f"fingers {self.devices}, {clock}, "
+        jaws = f"jaws {list(self.jaws.fingers)} on {self.jaws.topic}, " if self.jaws else ""
+        return (f"fingers {self.devices}, {jaws}{clock}, "
                 f"period {self.p['period']} s, max velocity {self.p['max_velocity']} m/s; "
                 f"action {self.resolve_topic_name(pipeline.ACTION)}")
 
@@ -99,9 +109,11 @@ class ExecutorNode(Node):
                                    float(p["stale_budget"]))
         self.period_ns = int(round(p["period"] * 1e9))
         loop = pipeline.loop_qos(p["qos_depth"])
+        self.jaws = JawCommands.of(self, p["controller_scene"], p["period"], loop)
         self.setpoint_pubs = {f: self.create_publisher(PoseStamped,
                                                        pipeline.device_topic(d, "setpoint"), loop)
-                              for f, d in self.devices.items()}
+                              for f, d in self.devices.items()
+                              if self.jaws is None or f not in self.jaws.fingers}
         self.status_pub = self.create_publisher(ExecutorStatus, pipeline.EXECUTOR_STATUS, loop)
         pose_pub = self.create_publisher(PoseStamped, pipeline.OBJECT_POSE, pipeline.LATCHED)
         pose_pub.publish(messages.pose_in_base(p["object_pose"], p["base_frame"]))
@@ -117,7 +129,8 @@ class ExecutorNode(Node):
         self.state = ExecutorStatus.IDLE
         if p["lockstep"]:
             self.participant = pipeline.Participant(self, "executor", [pipeline.STATUS],
-                                                    list(self.setpoint_pubs.values()))
+                                                    list(self.setpoint_pubs.values())
+                                                    + ([self.jaws.publisher] if self.jaws else []))
         else:
             self.create_timer(p["period"], self._timer)
 
@@ -169,18 +182,22 @@ class ExecutorNode(Node):
         """One control cycle on status ``msg``; publish the setpoints, finish the goal if done."""
         goal = self.goal
         ns = messages.stamp_ns(msg.header.stamp)
+        obs = messages.observation(msg)
         if goal.start_ns is None:
             goal.start_ns = ns
+            if self.jaws is not None:
+                self.jaws.start(obs)
         goal.events += msg.events
         goal.since_feedback += msg.events
         if goal.handle.is_cancel_requested:
             goal.program.cancel()
-        obs = messages.observation(msg)
         command = goal.program.step(obs, self.p["period"])
         stamp = ns + self.period_ns if now_ns is None else now_ns
-        self.answered.answer(ns, [(self.setpoint_pubs[f],
-                                   messages.fill_pose(self.setpoints[f], xy, stamp))
-                                  for f, xy in command.setpoints.items()])
+        batch = [(self.setpoint_pubs[f], messages.fill_pose(self.setpoints[f], xy, stamp))
+                 for f, xy in command.setpoints.items() if f in self.setpoint_pubs]
+        if self.jaws is not None:
+            batch.append(self.jaws.trajectory(command.setpoints, ns if now_ns is None else 0))
+        self.answered.answer(ns, batch)
         self._report(command, obs, ns)
         if command.termination is not None:
             self.goal = None

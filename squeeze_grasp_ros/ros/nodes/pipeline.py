@@ -65,16 +65,19 @@ def device_topic(device: str, stream: str) -> str:
     return f"devices/{device}/{stream}"
 
 
-def loop_topics(devices: Iterable[str]) -> list[str]:
+def loop_topics(devices: Iterable[str], *, silent: Iterable[str] = ()) -> list[str]:
     """The topics every lockstep tick publishes whatever the scene's effects (relative): the
     tick, the ground truth, the monitor's status and contact state, each device's pose and
-    setpoint. A recorder is ready once each has a publisher, so the first tick's messages of
-    every loop node reach it (across processes, discovery can match the executor seconds after
-    the driver).
+    setpoint (but not the setpoint of a ``silent`` device, which a stock controller drives).
+    A recorder is ready once each has a publisher, so the first tick's messages of every loop
+    node reach it (across processes, discovery can match the executor seconds after the
+    driver).
     """
     names = [TICK, SIM_STATE, STATUS, CONTACT_STATE]
     for device in devices:
-        names += [device_topic(device, "pose"), device_topic(device, "setpoint")]
+        names.append(device_topic(device, "pose"))
+        if device not in set(silent):
+            names.append(device_topic(device, "setpoint"))
     return names
 
 
@@ -122,7 +125,8 @@ def pipeline_topics(devices: Iterable[str], *, hidden: bool = False,
 
 MESSAGE_PACKAGES: frozenset[str] = frozenset({
     "squeeze_grasp_interfaces", "std_msgs", "geometry_msgs", "sensor_msgs", "visualization_msgs",
-    "rosgraph_msgs", "action_msgs", "builtin_interfaces", "unique_identifier_msgs"})
+    "rosgraph_msgs", "action_msgs", "builtin_interfaces", "unique_identifier_msgs",
+    "trajectory_msgs"})
 """Packages whose message types :func:`message_type` resolves: the interfaces this package
 uses. A type name is data (a recording, a parameter): no other module is ever imported."""
 

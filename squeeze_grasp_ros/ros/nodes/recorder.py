@@ -47,6 +47,8 @@ PARAMETERS: dict[str, tuple[Any, str]] = {
     "output": ("", "bag folder to create (required; must not exist or be empty)"),
     "devices": (["barrett_f1", "barrett_f3"], "devices whose topics are recorded"),
     "extra_topics": ([""], "more topics to record, as 'name pkg/msg/Type' ('' = none)"),
+    "silent_setpoints": ([""], "devices whose setpoint topics have no publisher (a stock "
+                               "controller drives them; '' = none): not awaited at start-up"),
     "camera": (False, "also record the camera's images, info and pose, and the shape residual"),
     "include_hidden_topics": (False, "also record the executor action's hidden topics "
                                      "(_action/feedback, _action/status), as rosbag2 does only "
@@ -127,8 +129,10 @@ class RecorderNode(Node):
         self.progress_pub = self.create_publisher(Header, pipeline.RECORDER_PROGRESS,
                                                   pipeline.loop_qos(10))
         if p["lockstep"]:
-            self.participant = pipeline.Participant(
-                self, "recorder", pipeline.loop_topics(p["devices"]), [self.progress_pub])
+            awaited = pipeline.loop_topics(p["devices"],
+                                           silent=[d for d in p["silent_setpoints"] if d])
+            self.participant = pipeline.Participant(self, "recorder", awaited,
+                                                    [self.progress_pub])
             pipeline.wall_timer(self, 0.05, self._repeat_report)
 
 

@@ -40,10 +40,12 @@ from squeeze_grasp_interfaces.msg import ContactEventArray, SimState, TactileArr
 from squeeze_grasp_ros.mechanics.vocabulary import Effect, ImageEncoding
 from squeeze_grasp_ros.ros import messages
 from squeeze_grasp_ros.scene import GraspSetup, load_scene
+from squeeze_grasp_ros.scene.controller import scene_controller
 from squeeze_grasp_ros.ros.messages.images import camera_info_msg, image_msg, pose_of_camera
 from squeeze_grasp_ros.sim.camera import CameraFrame
 from squeeze_grasp_ros.sim.world import SimWorld, TickOutput
 from squeeze_grasp_ros.ros.nodes import ParameterError, pipeline, run_node
+from squeeze_grasp_ros.ros.nodes.sim_controllers import SimJointTrajectoryController
 
 PARAMETERS: dict[str, tuple[Any, str]] = {
     "scene": ("", "scene YAML file the world is built from (required)"),
@@ -107,6 +109,12 @@ class SimHardwareNode(Node):
         for finger, device in self.devices.items():
             self.create_subscription(PoseStamped, pipeline.device_topic(device, "setpoint"),
                                      lambda msg, f=finger: self._setpoint(f, msg), loop)
+        jaws = scene_controller(world.scene, self.p["scene"] or ".")
+        self.controller = None if jaws is None else SimJointTrajectoryController(
+            self, world, jaws, loop, now_ns=lambda: self.now_ns, on_command=self._try_step)
+        """The simulated stock controller of the scene's gripper (sim_controllers), if any."""
+        self.commanded = set(self.devices) - set(jaws.jaws if jaws else ())
+        """Fingers commanded by setpoints (the others by the controller)."""
         self.flow_control = "recorder" in self.p["participants"]
         self.recorder_ns = -1
         self.create_subscription(Header, pipeline.RECORDER_PROGRESS, self._progress, loop)
@@ -123,9 +131,14 @@ class SimHardwareNode(Node):
 
 
     def ready_summary(self) -> str:
-        """What the ready line of ``ros2 run`` says: scene, devices, waiting for whom."""
-        return (f"scene {self.world.scene.name}, fingers {self.devices}, dt {self.world.dt} s; "
-                f"waiting for {list(self.p['participants'])}")
+        """What the ready line of ``ros2 run`` says: scene, devices, controller, waiting for
+        whom.
+        """
+        jaws = "" if self.controller is None else (
+            f", jaws {list(self.controller.fingers)} by a simulated JointTrajectoryController on "
+            f"{self.controller.topic}")
+        return (f"scene {self.world.scene.name}, fingers {self.devices}{jaws}, "
+                f"dt {self.world.dt} s; waiting for {list(self.p['participants'])}")
 
     def _reading_messages(self, finger: str) -> dict[str, Any]:
         """One message per reading of ``finger``, refilled every tick (frames and taxel
@@ -157,12 +170,15 @@ class SimHardwareNode(Node):
         self._try_step()
 
     def _try_step(self) -> None:
-        if len(self.pending) < len(self.devices):
+        if not self.commanded <= set(self.pending) or (
+                self.controller is not None and not self.controller.commanded):
             return
         window = self.p["recorder_window"] * self.world.dt_ns
         if self.flow_control and self.recorder_ns < self.now_ns - window:
             return
         setpoints, self.pending = self.pending, {}
+        if self.controller is not None:
+            setpoints.update(self.controller.setpoints(self.now_ns + self.world.dt_ns))
         self._publish(self.world.step(setpoints))
 
     def _publish(self, out: TickOutput) -> None:
@@ -192,6 +208,8 @@ class SimHardwareNode(Node):
         if out.events or ending:
             batch.append((self.event_pub, messages.sim_events_msg(
                 out.events, out.termination if ending else "", out.state, ns)))
+        if self.controller is not None:
+            batch.append(self.controller.joint_state(out))
         batch.append((self.state_pub, messages.sim_state_msg(out.state, self.world.fingers,
                                                              out.termination, ns, frame)))
         if out.index == 0:

@@ -21,6 +21,7 @@ from rclpy.node import Node
 
 from squeeze_grasp_ros.mechanics.vocabulary import Effect
 from squeeze_grasp_ros.ros.nodes import pipeline
+from squeeze_grasp_ros.ros.nodes.sim_controllers import JOINT_STATES
 from squeeze_grasp_ros.ros.run.options import RunError
 from squeeze_grasp_ros.scene import Scene, finger_devices
 
@@ -49,6 +50,8 @@ def run_topics(scene: Scene) -> list[str]:
     names = list(pipeline.pipeline_topics(devices, hidden=True,
                                           camera=scene.has(Effect.CAMERA)))
     names += [f"/{t}" for t in (pipeline.HELLO, pipeline.READY, pipeline.RECORDER_PROGRESS)]
+    if scene.controller is not None:
+        names += [f"/{scene.controller.name}/joint_trajectory", f"/{JOINT_STATES}"]
     return [t.lstrip("/") for t in names]
 
 

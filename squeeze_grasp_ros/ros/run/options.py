@@ -117,7 +117,9 @@ def node_parameters(
         monitor.update(shape_watch=True,
                        shape_mismatch_threshold=float(scene.camera.shape_mismatch_threshold),
                        object_height=float(scene.object.material.thickness))
-    params["executor"].update(finger_devices=mapping, period=float(scene.sim.dt))
+    params["executor"].update(
+        finger_devices=mapping, period=float(scene.sim.dt),
+        controller_scene=str(Path(scene_path).resolve()) if scene.controller else "")
     custom = {"scene": Path(scene_path).read_text(), "scene_path": str(scene_path)}
     params["recorder"].update(
         output=str(options.record or ""),
@@ -125,6 +127,11 @@ def node_parameters(
         include_hidden_topics=options.include_hidden_topics,
         camera=scene.has(Effect.CAMERA),
     )
+    if scene.controller is not None:
+        params["recorder"]["extra_topics"] = [
+            f"{scene.controller.name}/joint_trajectory trajectory_msgs/msg/JointTrajectory",
+            "joint_states sensor_msgs/msg/JointState"]
+        params["recorder"]["silent_setpoints"] = [devices[f] for f in scene.controller.jaws]
     for name, values in options.overrides.items():
         params[name].update(values)
     custom["monitor_parameters"] = yaml.safe_dump(params["monitor"], sort_keys=True)

@@ -1,0 +1,147 @@
+# Copyright 2026 squeeze_grasp_ros developers
+# SPDX-License-Identifier: Apache-2.0
+"""Jaw setpoints as joint trajectories, and a JointTrajectoryController's following of them.
+
+Both sides of the stock ``joint_trajectory`` interface (docs/grippers.md) work on the jaw line:
+the jaws close symmetrically along the line through their tips' reference points, so a pair of
+fingertip setpoints is one aperture (the distance between the pad faces) and back.
+
+:class:`TrajectoryFollower` is the simulated controller's core, with the semantics of
+ros2_controllers' JointTrajectoryController (position interface, linear interpolation):
+
+- a trajectory must name exactly the controller's joints (in any order), its points
+  ``time_from_start`` strictly increasing, each point one finite position per joint; it starts
+  at ``header.stamp`` (zero: on receipt);
+- a new trajectory replaces the old one from its first point in the future: the command
+  interpolates linearly from the commanded position at receipt to that point, then between
+  points, and holds the last point; a trajectory whose points all lie in the past is refused;
+- refusals leave the active trajectory untouched. Beyond the stock controller, this one also
+  refuses positions whose aperture lies outside the gripper's opening range or whose joints
+  disagree on the aperture (the joints of a parallel gripper move together).
+
+>>> line = JawLine.between(np.array([0.0, -0.03]), np.array([0.0, 0.03]), reach=0.002)
+>>> round(line.aperture(np.array([0.0, -0.025]), np.array([0.0, 0.025])), 12)
+0.046
+>>> follower = TrajectoryFollower(0.05, opening=(0.0, 0.085))
+>>> follower.accept([(1_000_000, (0.04,))], now_ns=0, to_aperture=lambda p: p)
+>>> follower.sample(500_000), follower.sample(1_000_000), follower.sample(9_000_000)
+(0.045, 0.04, 0.04)
+"""
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+__all__ = ["JawLine", "TrajectoryFollower", "TrajectoryRefused"]
+
+APERTURE_AGREEMENT = 1e-9
+"""Largest spread of the apertures a trajectory point's joints stand for, m."""
+
+
+class TrajectoryRefused(ValueError):
+    """A trajectory the controller does not follow; the message says why."""
+
+
+@dataclass(frozen=True)
+class JawLine:
+    """The line the two jaws close on.
+
+    Attributes
+    ----------
+    centre : ndarray (2,)
+        Midway between the jaws' tip reference points, m (object frame).
+    direction : ndarray (2,)
+        Unit closing direction of F1's jaw (from its tip toward the other's).
+    reach : float
+        Distance from a tip's reference point to its face along the line, m (a pad's edge
+        radius, a circle's radius).
+    """
+
+    centre: np.ndarray
+    direction: np.ndarray
+    reach: float
+
+    @classmethod
+    def between(cls, first: np.ndarray, second: np.ndarray, *, reach: float) -> JawLine:
+        """The line through the tip reference points ``first`` (F1's jaw) and ``second`` (m)."""
+        first, second = np.asarray(first, float), np.asarray(second, float)
+        gap = second - first
+        length = float(np.hypot(*gap))
+        if not length > 2.0 * reach:
+            raise ValueError(f"the jaws' tips are {length:g} m apart: their faces overlap "
+                             f"(reach {reach:g} m each)")
+        return cls(0.5 * (first + second), gap / length, float(reach))
+
+    def aperture(self, first: np.ndarray, second: np.ndarray) -> float:
+        """The distance between the pad faces (m) of tips at ``first`` and ``second`` (m),
+        measured along the line.
+        """
+        return float(np.dot(np.asarray(second, float) - first, self.direction)) - 2 * self.reach
+
+    def positions(self, aperture: float) -> tuple[np.ndarray, np.ndarray]:
+        """The tips' reference points (m) at ``aperture`` (m), symmetric about the centre."""
+        half = 0.5 * float(aperture) + self.reach
+        return self.centre - half * self.direction, self.centre + half * self.direction
+
+
+class TrajectoryFollower:
+    """A JointTrajectoryController's command for one parallel gripper, as an aperture (m).
+
+    Parameters
+    ----------
+    aperture : float
+        The commanded aperture before any trajectory (the jaws' initial aperture), m.
+    opening : (float, float)
+        The gripper's opening range (min, max), m.
+    """
+
+    def __init__(self, aperture: float, *, opening: tuple[float, float]) -> None:
+        self.opening = (float(opening[0]), float(opening[1]))
+        self.knots: list[tuple[int, float]] = [(0, float(aperture))]
+        """(time ns, aperture m) of the active trajectory, its anchor first."""
+
+    def sample(self, t_ns: int) -> float:
+        """The commanded aperture (m) at sim time ``t_ns``: linear between knots, held after
+        the last.
+        """
+        times = [t for t, _ in self.knots]
+        values = [a for _, a in self.knots]
+        if t_ns >= times[-1]:
+            return values[-1]
+        return float(np.interp(t_ns, times, values))
+
+    def accept(self, points: Sequence[tuple[int, Sequence[float]]], *, now_ns: int,
+               to_aperture: Callable[[float], float]) -> None:
+        """Replace the active trajectory by ``points`` (absolute time ns, joint positions),
+        from the first point after ``now_ns``.
+
+        Raises
+        ------
+        TrajectoryRefused
+            Saying why; the active trajectory is kept.
+        """
+        if not points:
+            raise TrajectoryRefused("it has no points")
+        times = [t for t, _ in points]
+        if any(b <= a for a, b in zip(times, times[1:])):
+            raise TrajectoryRefused("its points' time_from_start are not strictly increasing")
+        knots = []
+        lo, hi = self.opening
+        for k, (t, positions) in enumerate(points):
+            values = np.asarray(positions, float)
+            if not np.all(np.isfinite(values)):
+                raise TrajectoryRefused(f"point {k} has non-finite positions {list(values)}")
+            apertures = [to_aperture(v) for v in values]
+            if max(apertures) - min(apertures) > APERTURE_AGREEMENT:
+                raise TrajectoryRefused(f"point {k}'s joints stand for different apertures "
+                                        f"{apertures} m (the jaws move together)")
+            if not lo <= apertures[0] <= hi:
+                raise TrajectoryRefused(f"point {k}'s aperture {apertures[0]:g} m is outside "
+                                        f"the opening range [{lo:g}, {hi:g}] m")
+            knots.append((int(t), float(np.mean(apertures))))
+        future = [knot for knot in knots if knot[0] > now_ns]
+        if not future:
+            raise TrajectoryRefused("all its points lie in the past")
+        self.knots = [(int(now_ns), self.sample(now_ns))] + future

@@ -1,0 +1,138 @@
+# Copyright 2026 squeeze_grasp_ros developers
+# SPDX-License-Identifier: Apache-2.0
+"""Simulated stock ros2_control controllers of the simulated hardware (docs/grippers.md).
+
+:class:`SimJointTrajectoryController` stands in for a JointTrajectoryController on a scene's
+gripper (``controller: {type: joint_trajectory, ...}``) and for its joint_state_broadcaster:
+
+- it subscribes ``<controller>/joint_trajectory`` (``trajectory_msgs/JointTrajectory``) and
+  follows the accepted trajectory in sim time (:class:`..control.joint_trajectory.
+  TrajectoryFollower`: position interface, linear interpolation); each tick, the commanded
+  aperture becomes the jaws' tip setpoints on the jaw line, which the world's devices follow as
+  any setpoint (speed limit, actuator lag);
+- a refused trajectory (joint names other than the controller's, sizes that do not match,
+  non-finite positions, an aperture beyond the opening range, points all in the past) is
+  logged as one warning line and not followed: the active trajectory stays (before tick 0 the
+  controller is inactive and refuses every trajectory);
+- it publishes ``sensor_msgs/JointState`` on ``joint_states`` every tick, stamped with the
+  tick: each joint's position at the measured aperture and its effort for the jaw force (the
+  mean of the two jaws' ground-truth forces along the closing line), through the transmission.
+
+In lockstep, a tick's jaw setpoints are ready once a trajectory was accepted since the
+previous step (the executor sends one per control cycle).
+"""
+from __future__ import annotations
+
+from collections.abc import Callable
+from typing import Any
+
+import numpy as np
+from rclpy.node import Node
+from sensor_msgs.msg import JointState
+from trajectory_msgs.msg import JointTrajectory
+
+from squeeze_grasp_ros.control.joint_trajectory import (
+    JawLine,
+    TrajectoryFollower,
+    TrajectoryRefused,
+)
+from squeeze_grasp_ros.ros import messages
+from squeeze_grasp_ros.scene.controller import JawController
+from squeeze_grasp_ros.sim.world import SimWorld, TickOutput
+
+JOINT_STATES = "joint_states"
+"""The joint_state_broadcaster's topic (relative)."""
+
+
+class SimJointTrajectoryController:
+    """A simulated JointTrajectoryController and joint_state_broadcaster on ``node``.
+
+    Parameters
+    ----------
+    node : Node
+        The simulated hardware node.
+    world : SimWorld
+    controller : JawController
+        The scene's resolved ``controller:`` section.
+    qos : QoSProfile
+        Of the trajectory subscription and the joint states.
+    now_ns : callable
+        The current sim time, ns (the last published tick).
+    on_command : callable
+        Called after each accepted trajectory (the lockstep's chance to step).
+    """
+
+    def __init__(self, node: Node, world: SimWorld, controller: JawController, qos: Any, *,
+                 now_ns: Callable[[], int], on_command: Callable[[], None]) -> None:
+        self.node, self.world, self.controller = node, world, controller
+        self.now_ns, self.on_command = now_ns, on_command
+        first, second = controller.jaws
+        self.line = JawLine.between(world.positions[first], world.positions[second],
+                                    reach=controller.gripper.pad.contact_radius)
+        opening = controller.gripper.opening
+        self.follower = TrajectoryFollower(
+            self.line.aperture(world.positions[first], world.positions[second]),
+            opening=(opening.min, opening.max))
+        self.commanded = False
+        self.refusals: list[str] = []
+        """Why each refused trajectory was refused, in order."""
+        self.topic = node.resolve_topic_name(controller.topic)
+        node.create_subscription(JointTrajectory, controller.topic, self._trajectory, qos)
+        self.state_pub = node.create_publisher(JointState, JOINT_STATES, qos)
+        self.state_msg = JointState(name=list(controller.joints))
+
+    @property
+    def fingers(self) -> tuple[str, str]:
+        """The fingers whose setpoints this controller gives."""
+        return self.controller.jaws
+
+    def _trajectory(self, msg: JointTrajectory) -> None:
+        now = self.now_ns()
+        try:
+            if now < 0:
+                raise TrajectoryRefused("the simulated clock has not started (the controller "
+                                        "is not active yet)")
+            order = self._order(list(msg.joint_names))
+            start = messages.stamp_ns(msg.header.stamp) or now
+            points = []
+            for k, point in enumerate(msg.points):
+                if len(point.positions) != len(order):
+                    raise TrajectoryRefused(f"point {k} has {len(point.positions)} positions "
+                                            f"for {len(order)} joints")
+                tfs = point.time_from_start.sec * 1_000_000_000 + point.time_from_start.nanosec
+                points.append((start + tfs, [point.positions[i] for i in order]))
+            self.follower.accept(points, now_ns=now, to_aperture=self.controller.gripper.aperture)
+        except TrajectoryRefused as exc:
+            self.refusals.append(str(exc))
+            self.node.get_logger().warning(f"refused the trajectory on {self.topic}: {exc}")
+            return
+        self.commanded = True
+        self.on_command()
+
+    def _order(self, names: list[str]) -> list[int]:
+        """Index in ``names`` of each controller joint; refuse other or missing names."""
+        joints = list(self.controller.joints)
+        if sorted(names) != sorted(joints):
+            raise TrajectoryRefused(f"its joint_names {names} are not the controller's joints "
+                                    f"{joints}")
+        return [names.index(j) for j in joints]
+
+    def setpoints(self, t_ns: int) -> dict[str, np.ndarray]:
+        """The jaws' tip setpoints (m) at sim time ``t_ns``; the command is consumed."""
+        self.commanded = False
+        first, second = self.line.positions(self.follower.sample(t_ns))
+        return dict(zip(self.fingers, (first, second)))
+
+    def joint_state(self, out: TickOutput) -> tuple[Any, JointState]:
+        """(publisher, message) of the joint states of tick ``out``."""
+        first, second = self.fingers
+        positions = {r.finger: r.position for r in out.readings}
+        aperture = self.line.aperture(positions[first], positions[second])
+        u = self.line.direction
+        force = 0.5 * (float(np.dot(out.state.finger_force(first)[:2], u))
+                       - float(np.dot(out.state.finger_force(second)[:2], u)))
+        msg = self.state_msg
+        messages.set_stamp(msg.header.stamp, out.stamp_ns)
+        msg.position = [float(p) for p in self.controller.joint_positions(aperture)]
+        msg.effort = [float(e) for e in self.controller.joint_efforts(force)]
+        return self.state_pub, msg

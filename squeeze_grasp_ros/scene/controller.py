@@ -1,0 +1,103 @@
+# Copyright 2026 squeeze_grasp_ros developers
+# SPDX-License-Identifier: Apache-2.0
+"""A scene's gripper under a stock ros2_control controller (``controller:``, docs/grippers.md).
+
+The section maps two fingers (the jaws) to a parallel-gripper device and names the controller
+that drives its joints::
+
+    controller: {type: joint_trajectory, name: gripper_controller, device: generic_85mm}
+
+:func:`scene_controller` resolves the device (a shipped name or a file relative to the scene)
+and checks it against the scene: the jaws are two distinct squeezing fingers whose tips are
+the device's pad, and the controller's joints (default: the device's
+``transmission.joints``) are as many as the transmission has.
+
+>>> from squeeze_grasp_ros.resources import scene_file
+>>> from squeeze_grasp_ros.scene import load_scene
+>>> path = scene_file("sponge_gripper")
+>>> jtc = scene_controller(load_scene(path), path)
+>>> jtc.topic, jtc.joints, [round(p, 4) for p in jtc.joint_positions(0.05)]
+('gripper_controller/joint_trajectory', ('finger_joint',), [0.3294])
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+from squeeze_grasp_ros.mechanics.vocabulary import Finger
+from squeeze_grasp_ros.resources import ResourceError, device_file
+from squeeze_grasp_ros.scene.gripper import GripperSpec, load_gripper
+from squeeze_grasp_ros.scene.schema import SchemaError
+from squeeze_grasp_ros.scene.specs import ControllerSpec, Scene, SceneError
+
+__all__ = ["JawController", "scene_controller"]
+
+
+@dataclass(frozen=True)
+class JawController:
+    """A resolved ``controller:`` section: the spec, its gripper device and joint names."""
+
+    spec: ControllerSpec
+    gripper: GripperSpec
+    joints: tuple[str, ...]
+
+    @property
+    def jaws(self) -> tuple[Finger, Finger]:
+        """The fingers the jaws carry, F1's jaw (the closing direction's origin) first."""
+        return self.spec.jaws[0], self.spec.jaws[1]
+
+    @property
+    def topic(self) -> str:
+        """The controller's trajectory topic, relative: ``<name>/joint_trajectory``."""
+        return f"{self.spec.name}/joint_trajectory"
+
+    def joint_positions(self, aperture: float) -> tuple[float, ...]:
+        """Each controller joint's position at ``aperture`` (m), through the transmission."""
+        return self.gripper.joint_positions(aperture)[:1] * len(self.joints)
+
+    def joint_efforts(self, force: float) -> tuple[float, ...]:
+        """Each controller joint's effort for a jaw force ``force`` (N)."""
+        return self.gripper.joint_efforts(force)[:1] * len(self.joints)
+
+
+def _device(spec: ControllerSpec, base: Path) -> GripperSpec:
+    """The gripper of ``controller.device``: a device file (.yaml, relative to ``base``) or a
+    shipped name; errors prefixed with the field.
+    """
+    path = Path(spec.device)
+    try:
+        if path.suffix in (".yaml", ".yml"):
+            return load_gripper(path if path.is_absolute() else base / path)
+        return load_gripper(device_file(spec.device))
+    except (ResourceError, SchemaError) as exc:
+        raise SceneError(f"controller.device: {exc}") from None
+
+
+def scene_controller(scene: Scene, scene_path: str | Path) -> JawController | None:
+    """The scene's resolved ``controller:`` section, or None without one.
+
+    Raises
+    ------
+    SceneError
+        Naming the field: jaws not two distinct squeezing fingers, a jaw's tip other than the
+        device's pad, joints not as many as the transmission's.
+    """
+    spec = scene.controller
+    if spec is None:
+        return None
+    gripper = _device(spec, Path(scene_path).parent)
+    jaws = spec.jaws
+    if len(jaws) != 2 or jaws[0] == jaws[1] or any(j not in scene.fingers for j in jaws):
+        raise SceneError(f"controller.jaws must be two distinct fingers of the scene "
+                         f"({sorted(scene.fingers)}), got {list(jaws)}")
+    pad = gripper.pad.shape_of()
+    for jaw in jaws:
+        if scene.fingers[jaw].tip_shape() != pad:
+            raise SceneError(f"fingers.{jaw}.tip must be the device's pad ({gripper.name}: "
+                             f"{pad.to_json()}), got {scene.fingers[jaw].tip_shape().to_json()}")
+    joints = spec.joints or gripper.transmission.joints
+    if len(joints) != len(gripper.transmission.joints) or len(set(joints)) != len(joints):
+        raise SceneError(f"controller.joints must be {len(gripper.transmission.joints)} distinct "
+                         f"names (as {gripper.name}'s transmission.joints), got {list(joints)}")
+    return JawController(spec, gripper, tuple(joints))
+

@@ -1,0 +1,252 @@
+# Copyright 2026 squeeze_grasp_ros developers
+# SPDX-License-Identifier: Apache-2.0
+"""The stock JointTrajectoryController route of a gripper scene (docs/grippers.md): the
+follower's semantics, the scene section's checks, the sponge gripper through the JTC against
+the Cartesian setpoint route on real rclpy, and a hostile trajectory client.
+"""
+
+from __future__ import annotations
+
+import time
+from collections import Counter
+from pathlib import Path
+
+import numpy as np
+import pytest
+import rclpy
+import yaml
+from mcap.reader import make_reader
+from builtin_interfaces.msg import Duration
+from rclpy.context import Context
+from rclpy.executors import SingleThreadedExecutor
+from rclpy.node import Node
+from sensor_msgs.msg import JointState
+from trajectory_msgs.msg import JointTrajectory, JointTrajectoryPoint
+
+from squeeze_grasp_ros.control.joint_trajectory import (
+    JawLine,
+    TrajectoryFollower,
+    TrajectoryRefused,
+)
+from squeeze_grasp_ros.ros.nodes import pipeline
+from squeeze_grasp_ros.ros.nodes.sim_hardware import SimHardwareNode
+from squeeze_grasp_ros.ros.run.options import RunOptions
+from squeeze_grasp_ros.ros.run.runner import PipelineRunner
+from squeeze_grasp_ros.scene import SceneError, load_scene, parse_scene
+from squeeze_grasp_ros.scene.controller import scene_controller
+
+from pipeline_support import write_scene
+
+SPONGE = Path(__file__).resolve().parents[1] / "config" / "scenes" / "sponge_gripper.yaml"
+MS = 1_000_000
+
+
+def sponge_data(**changes) -> dict:
+    data = yaml.safe_load(SPONGE.read_text())
+    data.update(changes)
+    return {k: v for k, v in data.items() if v is not None}
+
+
+# --------------------------------------------------------------------------- the follower
+def follower() -> TrajectoryFollower:
+    return TrajectoryFollower(0.05, opening=(0.0, 0.085))
+
+
+def test_follower_interpolates_linearly_and_holds_the_last_point():
+    f = follower()
+    f.accept([(10 * MS, (0.04,)), (30 * MS, (0.02,))], now_ns=0, to_aperture=lambda p: p)
+    # anchor (0, 0.05) -> (10 ms, 0.04) -> (30 ms, 0.02), held after
+    for t, expected in ((0, 0.05), (5 * MS, 0.045), (10 * MS, 0.04), (20 * MS, 0.03),
+                        (30 * MS, 0.02), (99 * MS, 0.02)):
+        assert f.sample(t) == pytest.approx(expected, abs=1e-15)
+
+
+def test_a_new_trajectory_replaces_the_old_from_its_first_future_point():
+    f = follower()
+    f.accept([(10 * MS, (0.04,))], now_ns=0, to_aperture=lambda p: p)
+    # at 5 ms the command is 0.045; the new trajectory's 2 ms point is past and dropped
+    f.accept([(2 * MS, (0.0,)), (15 * MS, (0.065,))], now_ns=5 * MS, to_aperture=lambda p: p)
+    assert f.sample(5 * MS) == pytest.approx(0.045)
+    assert f.sample(10 * MS) == pytest.approx(0.055)
+    assert f.sample(15 * MS) == pytest.approx(0.065)
+
+
+@pytest.mark.parametrize("points, why", [
+    ([], "no points"),
+    ([(10 * MS, (float("nan"),))], "non-finite"),
+    ([(10 * MS, (0.09,))], "outside the opening range"),
+    ([(10 * MS, (-0.001,))], "outside the opening range"),
+    ([(10 * MS, (0.04,)), (10 * MS, (0.03,))], "strictly increasing"),
+    ([(10 * MS, (0.04, 0.03))], "different apertures"),
+    ([(1 * MS, (0.04,))], "in the past"),
+])
+def test_a_refused_trajectory_keeps_the_active_one(points, why):
+    f = follower()
+    f.accept([(20 * MS, (0.03,))], now_ns=0, to_aperture=lambda p: p)
+    before = list(f.knots)
+    with pytest.raises(TrajectoryRefused, match=why):
+        f.accept(points, now_ns=2 * MS, to_aperture=lambda p: p)
+    assert f.knots == before
+
+
+def test_jaw_line_round_trip_and_symmetry():
+    line = JawLine.between(np.array([0.01, -0.027]), np.array([0.03, 0.027]), reach=0.002)
+    first, second = line.positions(0.031)
+    assert line.aperture(first, second) == pytest.approx(0.031, abs=1e-15)
+    np.testing.assert_allclose(0.5 * (first + second), line.centre, atol=1e-15)
+    with pytest.raises(ValueError, match="overlap"):
+        JawLine.between(np.zeros(2), np.array([0.0, 0.003]), reach=0.002)
+
+
+# --------------------------------------------------------------------------- the scene section
+def test_the_shipped_sponge_maps_its_jaws_to_the_generic_gripper():
+    jaws = scene_controller(load_scene(SPONGE), SPONGE)
+    assert jaws.topic == "gripper_controller/joint_trajectory"
+    assert jaws.joints == ("finger_joint",) and jaws.jaws == ("F1", "F2")
+    # transmission of generic_85mm: 0.8 rad closed, 0 rad open at 85 mm
+    assert jaws.joint_positions(0.085)[0] == pytest.approx(0.0, abs=1e-12)
+
+
+@pytest.mark.parametrize("controller, message", [
+    ({"jaws": ["F1", "F1"]}, "controller.jaws must be two distinct"),
+    ({"joints": ["a", "b"]}, "controller.joints must be 1 distinct"),
+    ({"device": "no_such_gripper"}, "controller.device: no shipped device 'no_such_gripper'"),
+    ({"device": "nope.yaml"}, "controller.device: gripper device file not found"),
+    ({"type": "gripper_action"}, "controller.type"),
+])
+def test_controller_section_errors_name_the_field(controller, message):
+    section = {"type": "joint_trajectory", "name": "gripper_controller",
+               "device": "generic_85mm", **controller}
+    with pytest.raises(SceneError, match=message):
+        scene_controller(parse_scene(sponge_data(controller=section)), SPONGE)
+
+
+def test_loading_a_scene_checks_its_controller_section(tmp_path):
+    data = sponge_data()
+    data["controller"]["jaws"] = ["F2", "F1", "F1"]
+    with pytest.raises(SceneError, match="controller.jaws must be two distinct"):
+        load_scene(write_scene(tmp_path, data))
+
+
+def test_a_jaw_whose_tip_is_not_the_device_pad_is_refused():
+    data = sponge_data()
+    data["fingers"]["F2"]["tip"] = {"shape": "pad", "width": 0.03, "edge_radius": 0.002}
+    with pytest.raises(SceneError, match="fingers.F2.tip must be the device's pad"):
+        scene_controller(parse_scene(data), SPONGE)
+
+
+# --------------------------------------------------------------------------- end to end
+def run_sponge(path: str, record: str | None = None) -> dict:
+    """Run a sponge scene on real rclpy; the ground truth and what went on the JTC topics."""
+    runner = PipelineRunner(RunOptions(path, planner=False, record=record))
+    seen = {"trajectories": [], "joint_states": [], "setpoints": []}
+    client = runner.client
+    for topic, cls, key in (("gripper_controller/joint_trajectory", JointTrajectory,
+                             "trajectories"),
+                            ("joint_states", JointState, "joint_states"),
+                            (pipeline.device_topic("barrett_f1", "setpoint"),
+                             pipeline.message_type("geometry_msgs/msg/PoseStamped"),
+                             "setpoints")):
+        client.create_subscription(cls, topic, lambda m, k=key: seen[k].append(m),
+                                   pipeline.loop_qos(1000))
+    try:
+        runner.start()
+        runner.send_goal()
+        result = runner.wait_result()
+        state = runner.observer.sim_states[-1]
+    finally:
+        runner.shutdown()
+    assert result.termination == "depth_reached"
+    events = [(e.header.stamp.sec, e.header.stamp.nanosec, e.type, e.finger, e.node)
+              for e in runner.observer.sim_events]
+    forces = np.array([[v.x, v.y] for v in state.forces])
+    return {"events": events, "forces": forces, "depth": state.contacts.depth, **seen}
+
+
+def test_sponge_through_the_jtc_equals_the_cartesian_route(tmp_path):
+    jtc = run_sponge(str(SPONGE), record=str(tmp_path / "bag"))
+    cartesian = run_sponge(write_scene(tmp_path, sponge_data(controller=None)))
+    print(f"JTC route: {len(jtc['trajectories'])} trajectories, {len(jtc['joint_states'])} "
+          f"joint states, {len(jtc['events'])} events, forces {jtc['forces'].tolist()} N")
+    # the routes really differ: the jaw setpoints go to the controller, not to the device topic
+    assert jtc["trajectories"] and not jtc["setpoints"] and not cartesian["trajectories"]
+    assert cartesian["setpoints"] and not cartesian["joint_states"]
+    assert all(len(t.points) == 1 and t.joint_names == ["finger_joint"]
+               for t in jtc["trajectories"])
+    assert len(jtc["events"]) == 20 and jtc["events"] == cartesian["events"]
+    scale = np.abs(cartesian["forces"]).max()
+    print(f"largest force difference JTC - Cartesian: "
+          f"{np.abs(jtc['forces'] - cartesian['forces']).max() / scale:.1e} relative")
+    np.testing.assert_allclose(jtc["forces"], cartesian["forces"], rtol=0, atol=1e-6 * scale)
+    assert jtc["depth"] == pytest.approx(cartesian["depth"], rel=1e-6)
+    # the recording holds both controller topics, message for message (independent reader)
+    with open(next((tmp_path / "bag").glob("*.mcap")), "rb") as stream:
+        recorded = Counter(channel.topic for _, channel, _ in
+                           make_reader(stream).iter_messages())
+    assert recorded["gripper_controller/joint_trajectory"] == len(jtc["trajectories"])
+    assert recorded["joint_states"] == len(jtc["joint_states"])
+    # the joint state's effort is the jaw force through the transmission (effort_per_force 1)
+    last = jtc["joint_states"][-1]
+    assert last.effort[0] == pytest.approx(abs(jtc["forces"][0, 1]), rel=1e-3)
+
+
+# --------------------------------------------------------------------------- hostile client
+def hostile(names: list[str], positions: list[float], ms: int = 5) -> JointTrajectory:
+    return JointTrajectory(joint_names=names, points=[JointTrajectoryPoint(
+        positions=positions, time_from_start=Duration(nanosec=ms * MS))])
+
+
+def test_a_hostile_trajectory_is_refused_with_a_log_line_not_followed(capfd):
+    context = Context()
+    rclpy.init(context=context)
+    executor = SingleThreadedExecutor(context=context)
+    sim = SimHardwareNode(context=context, parameter_overrides=[
+        rclpy.parameter.Parameter("scene", value=str(SPONGE)),
+        rclpy.parameter.Parameter("participants", value=["hostile"])])
+    client = Node("hostile", context=context)
+    try:
+        executor.add_node(sim)
+        executor.add_node(client)
+        pub = client.create_publisher(JointTrajectory, "gripper_controller/joint_trajectory",
+                                      pipeline.loop_qos(10))
+        pipeline.Participant(client, "hostile", [], [pub])  # answers sim/hello: tick 0
+        deadline = time.monotonic() + 10
+        while pub.get_subscription_count() == 0 and time.monotonic() < deadline:
+            executor.spin_once(timeout_sec=0.05)
+        while sim.now_ns < 0 and time.monotonic() < deadline:
+            executor.spin_once(timeout_sec=0.05)
+        assert sim.now_ns == 0
+        jtc = sim.controller
+        before = list(jtc.follower.knots)
+        gripper = jtc.controller.gripper
+        for msg in (hostile(["wrong_joint"], [0.4]),
+                    hostile(["finger_joint"], [float("nan")]),
+                    hostile(["finger_joint"], list(gripper.joint_positions(0.1))),
+                    hostile(["finger_joint", "finger_joint"], [0.4, 0.4]),
+                    hostile(["finger_joint"], [0.4, 0.5])):
+            pub.publish(msg)
+        deadline = time.monotonic() + 10
+        while len(jtc.refusals) < 5 and time.monotonic() < deadline:
+            executor.spin_once(timeout_sec=0.05)
+        assert jtc.follower.knots == before and sim.now_ns == 0
+        assert len(jtc.refusals) == 5
+        for reason, text in zip(jtc.refusals, ("not the controller's joints", "non-finite",
+                                               "outside the opening range",
+                                               "not the controller's joints", "2 positions")):
+            assert text in reason
+        # a valid one is followed: 0.05 m -> 0.04 m in 5 ms is 0.048 m at tick 1 (1 ms), of
+        # which each jaw's device (0.1 m/s) covers 0.1 mm
+        pub.publish(hostile(["finger_joint"], list(gripper.joint_positions(0.04))))
+        deadline = time.monotonic() + 10
+        while sim.now_ns < MS and time.monotonic() < deadline:
+            executor.spin_once(timeout_sec=0.05)
+        assert sim.now_ns == MS and jtc.follower.sample(MS) == pytest.approx(0.048)
+        world = sim.world.positions
+        assert jtc.line.aperture(world["F1"], world["F2"]) == pytest.approx(0.0498, abs=1e-12)
+    finally:
+        executor.shutdown()
+        sim.destroy_node()
+        client.destroy_node()
+        rclpy.shutdown(context=context)
+    err = capfd.readouterr().err
+    assert err.count("refused the trajectory on /gripper_controller/joint_trajectory") == 5

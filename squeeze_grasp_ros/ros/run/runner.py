@@ -76,6 +76,7 @@ from squeeze_grasp_ros.ros.nodes import PARAMS_FILE_ENV, PARENT_PID_ENV, pipelin
 from squeeze_grasp_ros.ros.nodes.recorder import cdr_stamp_ns
 from squeeze_grasp_ros.planning.typed_objects import typed_scene
 from squeeze_grasp_ros.ros.messages.objects import typed_object
+from squeeze_grasp_ros.control.force_watch import squeeze_forces
 from squeeze_grasp_ros.ros.run.camera_plan import (first_outline, predicted_shapes_msg,
                                                    seen_description, seen_report)
 from squeeze_grasp_ros.ros.run.goal_client import GoalClient
@@ -679,8 +680,9 @@ class PipelineRunner:
             **resistance,
         )
         prediction = messages.prediction_msg(
-            list(squeeze.events), squeeze.termination, squeeze.depth
-        )
+            list(squeeze.events), squeeze.termination, squeeze.depth,
+            messages.force_curve(squeeze.curve_depths, squeeze.curve_force_f1,
+                                 squeeze.curve_force_f2))
         return Plan(goal, prediction, "planner", time.perf_counter() - t0)
 
     def _plan_with_mechanics(self) -> Plan:
@@ -689,7 +691,7 @@ class PipelineRunner:
         squeeze = plan.squeeze
         prediction = messages.prediction_msg(
             [messages.contact_event_msg(e) for e in squeeze.events], squeeze.termination,
-            squeeze.depth)
+            squeeze.depth, squeeze_forces(squeeze))
         return Plan(plan.goal, prediction, "mechanics", plan.seconds)
 
     # ----------------------------------------------------------------- the goal

@@ -83,10 +83,10 @@ class ForceCheck:
 
 def squeeze_forces(result: EventSqueeze) -> PredictedForces | None:
     """The force curve of an event-driven squeeze (its ``force_curve``, whose depths are
-    relative) against depth in m; None for a squeeze without relative depth (its curve has no
-    depths to convert) or with fewer than two points.
+    relative) against depth in m; None for a squeeze that ended at depth 0 (e.g. a finger slipped
+    at once: no depths to convert the relative ones with) or with fewer than two points.
     """
-    if not result.relative_depth > 0:  # depths are not recoverable from relative ones
+    if not result.relative_depth > 0:
         return None
     per_relative = result.depth / result.relative_depth
     curves = {f: np.asarray(c, float).reshape(-1, 2) for f, c in result.force_curve.items()}

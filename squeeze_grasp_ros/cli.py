@@ -11,33 +11,53 @@ import os
 import sys
 from typing import Any
 
-from squeeze_grasp_ros import plots
 from squeeze_grasp_ros.commands import VERBS
-from squeeze_grasp_ros.commands.common import fail
 from squeeze_grasp_ros.exit_codes import ExitCode
-from squeeze_grasp_ros.extras import install_hint
-from squeeze_grasp_ros.mechanics.errors import (InfeasibleError, InternalError, InvalidInputError,
-                                               NumericalError, SqueezeGraspError)
+
+EPILOG = ("exit status: 0 done; 1 negative outcome (grasp failed in the world, replay differs); "
+          "2 invalid input; 3 a solver failed (the message carries its residuals); 4 pipeline or "
+          "environment failure (e.g. ROS not installed); 130 interrupted (Ctrl-C); 143 "
+          "terminated (SIGTERM)")
+
+
+class _Verbs(argparse._SubParsersAction):
+    """The verb sub-parsers, each filled by its module only when that verb is chosen, so that
+    ``--help`` and every verb import only what they use (argparse calls this action once, with
+    the verb and its arguments, before it parses them).
+    """
+
+    def __call__(self, parser, namespace, values, option_string=None):
+        add_verb_arguments(self._name_parser_map[values[0]])
+        super().__call__(parser, namespace, values, option_string)
+
+
+def add_verb_arguments(parser: argparse.ArgumentParser) -> argparse.ArgumentParser:
+    """Import the module of ``parser``'s verb and let it add its arguments (once), plus
+    ``--json`` if it has none; returns ``parser``.
+    """
+    name = parser.get_default("_verb")
+    if parser.get_default("_module") is None:
+        module = importlib.import_module(f".commands.{name}", __package__)
+        module.add_arguments(parser)
+        if not any(a.dest == "json" for a in parser._actions):
+            parser.add_argument("--json", action="store_true", help="print machine-readable JSON")
+        parser.set_defaults(_module=module)
+    return parser
 
 
 def build_parser() -> argparse.ArgumentParser:
-    """The argument parser with one sub-command per verb module."""
+    """The argument parser with one sub-command per verb (:data:`.commands.VERBS`); a verb's
+    arguments are added when it is chosen (:func:`add_verb_arguments`).
+    """
     parser = argparse.ArgumentParser(
         prog="squeeze-grasp",
         description="Squeeze grasps of deformable planar objects (Jia, Guo, Lin, IJRR 2014). "
                     "SI units throughout. Scene format: `squeeze-grasp scene-help`.",
-        epilog="exit status: 0 done; 1 negative outcome (grasp failed in the world, replay "
-               "differs); 2 invalid input; 3 a solver failed (the message carries its "
-               "residuals); 4 pipeline or environment failure (e.g. ROS not installed); 130 "
-               "interrupted (Ctrl-C); 143 terminated (SIGTERM)")
-    sub = parser.add_subparsers(dest="verb", metavar="VERB", required=True)
-    for name in VERBS:
-        module = importlib.import_module(f".commands.{name}", __package__)
-        p = sub.add_parser(name.replace("_", "-"), help=module.HELP, description=module.HELP)
-        module.add_arguments(p)
-        if not any(a.dest == "json" for a in p._actions):
-            p.add_argument("--json", action="store_true", help="print machine-readable JSON")
-        p.set_defaults(_module=module)
+        epilog=EPILOG)
+    sub = parser.add_subparsers(action=_Verbs, dest="verb", metavar="VERB", required=True)
+    for name, help_ in VERBS.items():
+        verb = sub.add_parser(name.replace("_", "-"), help=help_, description=help_)
+        verb.set_defaults(_verb=name, _module=None)
     return parser
 
 
@@ -55,14 +75,16 @@ def finite_json(value: Any, path: str = "", bad: list[str] | None = None) -> Any
     return value
 
 
-EXIT_CODES: dict[type[SqueezeGraspError], ExitCode] = {
-    InvalidInputError: ExitCode.USAGE,
-    InfeasibleError: ExitCode.OUTCOME,
-    NumericalError: ExitCode.NUMERICAL,
-    InternalError: ExitCode.INTERNAL,
-    SqueezeGraspError: ExitCode.INTERNAL,
-}
-"""The exit code of each error kind (first match wins)."""
+def exit_code(error: Exception) -> ExitCode:
+    """The exit code of an error of the package (:mod:`.mechanics.errors`, by who must act):
+    2 for invalid input, 1 for a physical "no", 3 for a failed solver, 4 otherwise.
+    """
+    from squeeze_grasp_ros.mechanics.errors import (InfeasibleError, InvalidInputError,
+                                                   NumericalError)
+
+    codes = ((InvalidInputError, ExitCode.USAGE), (InfeasibleError, ExitCode.OUTCOME),
+             (NumericalError, ExitCode.NUMERICAL))
+    return next((code for kind, code in codes if isinstance(error, kind)), ExitCode.INTERNAL)
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -73,12 +95,16 @@ def main(argv: list[str] | None = None) -> int:
     "code_name"}``.
     """
     args = build_parser().parse_args(argv)
+    from squeeze_grasp_ros import plots
+    from squeeze_grasp_ros.commands.common import fail
+    from squeeze_grasp_ros.extras import install_hint
+    from squeeze_grasp_ros.mechanics.errors import SqueezeGraspError
+
     written = len(plots.WRITTEN)
     try:
         result = args._module.run(args)
     except SqueezeGraspError as exc:
-        return fail(args, str(exc), next(code for kind, code in EXIT_CODES.items()
-                                         if isinstance(exc, kind)))
+        return fail(args, str(exc), exit_code(exc))
     except ModuleNotFoundError as exc:
         hint = install_hint(exc.name or "")
         if hint is None:

@@ -3,8 +3,9 @@
 """Console-script entry points: configure the process, then import and run the target.
 
 Each sets single-threaded BLAS (:func:`squeeze_grasp_ros.threads.single_thread_blas`)
-before numpy is loaded, unless the user set the variables; importing the package as a library
-changes nothing.
+before numpy is loaded, unless the user set the variables; ``squeeze-grasp`` also keeps its
+standard output for its results (:func:`squeeze_grasp_ros.stdout.reserve_stdout`: the
+middleware's diagnostics go to stderr). Importing the package as a library changes nothing.
 """
 from __future__ import annotations
 
@@ -13,6 +14,7 @@ import signal
 import sys
 
 from squeeze_grasp_ros.exit_codes import raise_on_signals
+from squeeze_grasp_ros.stdout import reserve_stdout
 from squeeze_grasp_ros.threads import single_thread_blas
 
 __all__ = ["cli", "executor", "monitor", "outline", "planner", "recorder", "sim_hardware"]
@@ -27,14 +29,33 @@ def _run(module: str, name: str):
     raise_on_signals()
     try:
         return importlib.import_module(module).main()
-    except KeyboardInterrupt as exc:
-        signum = getattr(exc, "signum", signal.SIGINT)
+    except (KeyboardInterrupt, ImportError) as exc:
+        stop = _interruption(exc)
+        if stop is None:
+            raise
+        signum = getattr(stop, "signum", signal.SIGINT)
         print(f"\n{name}: stopped by {signal.Signals(signum).name}", file=sys.stderr)
         return 128 + int(signum)
 
 
+def _interruption(exc: BaseException) -> KeyboardInterrupt | None:
+    """The KeyboardInterrupt (or :class:`.exit_codes.Interrupted`) behind ``exc``, or None.
+
+    A signal that arrives while a C extension initialises (rclpy's, seen under load) surfaces as
+    an ImportError ("initialization failed") caused by the signal's exception.
+    """
+    seen: set[int] = set()
+    while exc is not None and id(exc) not in seen:
+        if isinstance(exc, KeyboardInterrupt):
+            return exc
+        seen.add(id(exc))
+        exc = exc.__cause__ or exc.__context__
+    return None
+
+
 def cli():
     """``squeeze-grasp``."""
+    reserve_stdout()
     return _run("squeeze_grasp_ros.cli", "squeeze-grasp")
 
 

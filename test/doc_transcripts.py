@@ -153,6 +153,8 @@ MASKS = (
          "how `run` ran the nodes: a launch transcript's run is attached to the launched nodes, "
          "its equivalent runs them in one process"),
     Mask("pid", r"pid \[\d+\]", "a process id"),
+    Mask("run namespace", r"run_\d+_[0-9a-f]{8}",
+         "a run's own namespace: its process id and 8 random hexadecimal digits"),
     Mask("log stamp", r"\[\d{9,}\.\d+\]", "the wall-clock stamp of a ROS log line"),
     Mask("log folder", r"/\S*\.ros/log/\S+", "a dated log folder of ros2 launch"),
     Mask("goal id", r"\b[0-9a-f]{32}\b", "a random action goal id"),

@@ -165,7 +165,7 @@ def test_stale_parameter_files_are_removed_at_the_next_start(tmp_path):
     """
     import tempfile
 
-    from squeeze_grasp_ros.ros.run.runner import remove_stale_parameter_files
+    from squeeze_grasp_ros.ros.run.processes import remove_stale_parameter_files
 
     gone = subprocess.run([sys.executable, "-c", "import os; print(os.getpid())"],
                           capture_output=True, text=True).stdout.strip()
@@ -383,3 +383,25 @@ def test_a_bag_that_cannot_start_leaves_nothing_behind(tmp_path):
     assert done.stdout.splitlines() == [
         f"cannot start a recording in {mount / 'bag'}: No space left on device", "[]"], \
         done.stderr
+
+
+def test_a_signal_while_a_c_extension_initialises_ends_with_one_line(tmp_path):
+    """Seen under load: SIGTERM 1.5 s into `run` arrived while rclpy's C extension initialised;
+    pybind11 turned the signal's exception into ImportError('initialization failed') and the
+    run ended with exit 1 and a traceback. The console script now finds the signal behind the
+    ImportError (exit 143, one line); an ImportError without a signal behind it still raises.
+    """
+    (tmp_path / "ext_stopped.py").write_text(
+        "import signal\nfrom squeeze_grasp_ros.exit_codes import Interrupted\n"
+        "try:\n    raise Interrupted(signal.SIGTERM)\n"
+        "except Interrupted as exc:\n    raise ImportError('initialization failed') from exc\n")
+    (tmp_path / "ext_broken.py").write_text("raise ImportError('initialization failed')\n")
+    script = ("import sys\nfrom squeeze_grasp_ros.entry import _run\n"
+              "sys.exit(_run(sys.argv[1], 'x'))")
+    stopped = subprocess.run([sys.executable, "-c", script, "ext_stopped"], cwd=tmp_path,
+                             capture_output=True, text=True)
+    assert stopped.returncode == 143
+    assert stopped.stderr.strip() == "x: stopped by SIGTERM"
+    broken = subprocess.run([sys.executable, "-c", script, "ext_broken"], cwd=tmp_path,
+                            capture_output=True, text=True)
+    assert broken.returncode == 1 and "ImportError: initialization failed" in broken.stderr

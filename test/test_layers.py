@@ -4,7 +4,8 @@
 
 The layers, lowest first, are the ones docs/design.md draws:
 
-- base: ``inputs``, ``exit_codes``, ``extras``, ``resources``, ``threads``: no package imports;
+- base: ``inputs``, ``exit_codes``, ``extras``, ``resources``, ``threads``, ``stdout``, and the
+  build tools of ``buildtool`` (the interface build: cmake, never rclpy): no package imports;
 - ``mechanics``: the ROS-free core, inside it ``vocabulary``/``errors`` < ``elastic`` <
   ``squeeze`` < ``resistance``, ``ring``; ``calibration`` stands alone;
 - application: ``scene``, ``planning``, ``control``, ``sim``, ``plots``, ``outputs``,
@@ -29,7 +30,7 @@ ROS_MODULES = ("rclpy", "rosidl", "rcl_interfaces", "builtin_interfaces", "std_m
                "geometry_msgs", "sensor_msgs", "visualization_msgs", "rosgraph_msgs",
                "action_msgs", "squeeze_grasp_interfaces", "launch", "launch_ros", "rosbag2")
 LAYERS: tuple[tuple[str, ...], ...] = (
-    ("inputs", "exit_codes", "extras", "resources", "threads"),
+    ("inputs", "exit_codes", "extras", "resources", "threads", "stdout", "buildtool"),
     ("mechanics",),
     ("scene", "planning", "control", "sim", "plots", "outputs", "sweep", "perception", "api"),
     ("ros",),

@@ -256,7 +256,7 @@ def test_sensor_dropout_makes_the_executor_hold(tmp_path):
     assert run["termination"] == "depth_reached"
     # one alarm message per stale episode; the executor holds on every stale tick
     assert run["hold_ticks"] > 0 and 1 <= run["alarms"]["stale_sensor"] <= run["hold_ticks"]
-    positions = [np.array([[p.x, p.y] for p in s.positions]) for s in runner.sim_states]
+    positions = [np.array([[p.x, p.y] for p in s.positions]) for s in runner.observer.sim_states]
     moves = [np.abs(b - a).max() for a, b in zip(positions, positions[1:])]
     assert sum(1 for m in moves if m == 0.0) >= run["hold_ticks"]
 
@@ -291,7 +291,8 @@ def test_cancel_holds_position(tmp_path):
         runner.start()
         runner.send_goal()
         runner.spin_until(
-            lambda: runner.feedback and runner.feedback[-1].depth > 1e-3, 120, "1 mm of depth"
+            lambda: runner.observer.feedback and runner.observer.feedback[-1].depth > 1e-3, 120,
+            "1 mm of depth"
         )
         runner.cancel()
         result = runner.wait_result()
@@ -299,7 +300,7 @@ def test_cancel_holds_position(tmp_path):
         runner.shutdown()
     assert result.termination == "canceled" and not result.success
     assert 1e-3 < result.depth < runner.plan.goal.depth
-    last, before = runner.sim_states[-1], runner.sim_states[-2]
+    last, before = runner.observer.sim_states[-1], runner.observer.sim_states[-2]
     assert [(p.x, p.y) for p in last.positions] == [(p.x, p.y) for p in before.positions]
 
 
@@ -384,3 +385,40 @@ def test_a_neo_hookean_world_is_the_neo_hookean_mechanics(tmp_path):
         **data["object"], "material": {**data["object"]["material"], "model": "linear"}})
     _, api = mechanics(write_scene(tmp_path, linear))
     assert run["forces"]["F1"][0] / api.state.finger_force("F1")[0] - 1 > 1e-3
+
+
+def _count_calls(monkeypatch, module, name: str) -> list:
+    """Replace function ``module.name`` by a counting wrapper in every loaded module that holds
+    it (modules imported later take it from ``module``); returns the list of calls.
+    """
+    import sys
+
+    original, calls = getattr(module, name), []
+
+    def counted(*args, **kwargs):
+        calls.append(args)
+        return original(*args, **kwargs)
+
+    for mod in list(sys.modules.values()):
+        if getattr(mod, name, None) is original:
+            monkeypatch.setattr(mod, name, counted)
+    return calls
+
+
+def test_a_run_parses_its_scene_once_and_meshes_it_once(tmp_path, monkeypatch):
+    """Before: one process parsed the scene file 3 times and meshed the object twice (runner,
+    planner, simulated world). Now the run reads the scene once and builds its object once for
+    the planner and the world; the recorder, monitor and executor in the same process build
+    nothing. Calls are counted in every thread (the run's planner spins in a thread).
+    """
+    import triangle
+
+    import squeeze_grasp_ros.scene as scene_module
+
+    path = write_scene(tmp_path, scene_data(SMALL_SQUARE, name="once", squeeze={
+        "type": "stable", "relative_depth": 0.02}))
+    parses = _count_calls(monkeypatch, scene_module, "parse_scene")
+    meshes = _count_calls(monkeypatch, triangle, "triangulate")
+    run = PipelineRunner(RunOptions(path, record=str(tmp_path / "bag"))).run()
+    assert run["success"] and run["plan_source"] == "planner"
+    assert len(parses) == 1 and len(meshes) == 1, (len(parses), len(meshes))

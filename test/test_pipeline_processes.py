@@ -6,6 +6,7 @@ interrupted run leaves a readable recording.
 from __future__ import annotations
 
 import json
+import os
 import signal
 import subprocess
 import sys
@@ -104,11 +105,32 @@ def test_sigint_leaves_a_readable_recording(tmp_path, processes):
     assert nodes.stdout.strip() == "", "node processes outlived the run"
 
 
-def test_run_verb_prints_json(tmp_path):
+BROKEN_PROFILE = """<?xml version="1.0" encoding="UTF-8" ?>
+<profiles xmlns="http://www.eprosima.com/XMLSchemas/fastRTPS_Profiles">
+  <participant profile_name="noisy" is_default_profile="true">
+    <rtps><builtin><discovery_config><leaseDuration><sec>never</sec></leaseDuration>
+    </discovery_config></builtin></rtps>
+  </participant>
+</profiles>
+"""
+"""A Fast DDS profile with a bad value: the middleware logs XMLPARSER errors through its
+default log consumer, which writes to file descriptor 1 (as it does the shared-memory
+transport's ``Failed init_port`` errors under load), and still starts."""
+
+
+def test_run_verb_prints_json_whatever_the_middleware_logs(tmp_path):
+    """``run --json`` prints one JSON object on stdout even when Fast DDS logs errors (to the
+    process's descriptor 1): they reach stderr, so ``| jq`` always parses.
+    """
     path = write_scene(tmp_path, QUICK)
+    profile = tmp_path / "noisy_profile.xml"
+    profile.write_text(BROKEN_PROFILE)
+    env = {**os.environ, "FASTRTPS_DEFAULT_PROFILES_FILE": str(profile)}
     done = subprocess.run(run_command("run", path, "--json", "--no-planner"),
-                          capture_output=True, text=True, timeout=300)
+                          capture_output=True, text=True, timeout=300, env=env)
     assert done.returncode == 0, done.stderr[-2000:]
+    assert "XMLPARSER" in done.stderr and "XML_ERROR" in done.stderr  # the middleware logged
+    assert len(done.stdout.splitlines()) == 1, done.stdout[:2000]
     result = json.loads(done.stdout)
     assert result["termination"] in ("depth_reached", "slip_alarm")
     assert result["plan_source"] == "mechanics" and result["events"]

@@ -2,8 +2,8 @@
 # SPDX-License-Identifier: Apache-2.0
 """Real ROS 2 from PyPI: rclpy and our interfaces work with nothing sourced; ros-setup is safe.
 
-These tests need the ``ros`` extra and ``python -m squeeze_grasp_ros.ros.interfaces`` to have run
-(CI does both); they fail rather than skip without them. Under the colcon route
+These tests need the ``ros`` extra and ``python -m squeeze_grasp_ros.buildtool.interfaces`` to
+have run (CI does both); they fail rather than skip without them. Under the colcon route
 (``colcon test`` in a workspace whose overlay provides ``squeeze_grasp_interfaces``) the tests
 about *this environment's* ros-setup build are skipped: there the interfaces come from the
 workspace, not from ``sys.prefix``, and ros-setup is not how they were built.
@@ -19,7 +19,7 @@ from pathlib import Path
 
 import pytest
 
-from squeeze_grasp_ros.ros import interfaces as ros_setup
+from squeeze_grasp_ros.buildtool import interfaces as ros_setup
 
 WAIT_S = 10.0
 CMAKE_TEMPLATE = """\
@@ -327,6 +327,18 @@ def test_check_reports_a_changed_source_folder_of_this_environment(tmp_path: Pat
     shutil.copytree(ros_setup.default_source(), copy)
     assert ros_setup.main(["--check", "--source", str(copy)]) == 1
     assert "settings changed" in capsys.readouterr().out
+
+
+@pip_route_only
+def test_the_default_source_is_the_repository_s_from_any_folder(tmp_path: Path,
+                                                                 monkeypatch) -> None:
+    """``squeeze-grasp ros-setup`` of an editable install finds ``msg_defs/`` next to the
+    package wherever it is run (the interface build once looked inside the package folder).
+    """
+    monkeypatch.chdir(tmp_path)
+    source = ros_setup.default_source()
+    assert (source / "package.xml").is_file() and source.parent == Path(ros_setup.__file__
+                                                                        ).parents[2]
 
 
 def test_hidden_files_do_not_change_the_digest(tmp_path: Path) -> None:

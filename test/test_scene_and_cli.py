@@ -143,6 +143,36 @@ def test_cli_builds_and_runs_mechanics_verbs_without_ros(tmp_path):
     assert '"boundary"' in out.stdout
 
 
+IMPORTED = ("import sys\n"
+            "from squeeze_grasp_ros import cli\n"
+            "try:\n"
+            "    cli.main(sys.argv[1:])\n"
+            "except SystemExit:\n"
+            "    pass\n"
+            "verbs = sorted(m.rsplit('.', 1)[1] for m in sys.modules\n"
+            "               if m.startswith('squeeze_grasp_ros.commands.')\n"
+            "               and m.rsplit('.', 1)[1] in cli.VERBS)\n"
+            "sys.stderr.write(repr((verbs, 'numpy' in sys.modules)))\n")
+"""Run the CLI with the arguments given, then report on stderr which verb modules it imported
+and whether numpy was loaded."""
+
+
+@pytest.mark.parametrize(("argv", "verbs", "numpy"), [
+    (["--help"], [], False),
+    (["plan", "--help"], ["plan"], True),
+    (["scene-help"], ["scene_help"], True),
+    (["plan", str(FOAM), "--json"], ["plan"], True),
+    (["nope"], [], False),
+], ids=["help", "plan-help", "scene-help", "plan", "unknown-verb"])
+def test_the_parser_imports_only_the_chosen_verb(argv, verbs, numpy):
+    """Listing the verbs imports none of them (nor numpy); running one imports only it (the
+    parser once imported all verb modules, about 110 package modules, before any verb ran).
+    """
+    out = subprocess.run([sys.executable, "-c", IMPORTED, *argv], capture_output=True,
+                         text=True, timeout=120)
+    assert out.stderr.rsplit("\n", 1)[-1] == repr((verbs, numpy)), out.stderr[-2000:]
+
+
 @pytest.mark.parametrize("delay", [0.1, 0.25, 0.5])
 def test_ctrl_c_while_the_program_starts_is_one_line_not_a_traceback(delay, tmp_path):
     """The installed ``squeeze-grasp`` interrupted while it is still importing (numpy, scipy,

@@ -325,6 +325,18 @@ def test_zero_functions_are_the_fresh_ones_and_the_slip_side_cone():
                            stick=True, slip=0, frictionless=False, zero={B, CP, CM}) == 0
 
 
+
+def test_a_zero_function_must_grow_faster_than_the_noise_floor():
+    """A rate of round-off size (the slide of a rigidly sliding object leaves the normal-force
+    rate an exact zero) is not growth; above the floor it is.
+    """
+    args = dict(mu=0.5, fn=0.0, ft=0.0, ft_rate=0.0, dtheta=-0.5, stick=False, slip=-1,
+                frictionless=False, zero={B})
+    assert mode_violations(fn_rate=1e-15, **args) == 0
+    assert mode_violations(fn_rate=1e-15, rate_floor=1e-12, **args) == 1
+    assert mode_violations(fn_rate=-1e-15, rate_floor=1e-12, **args) == 1
+    assert mode_violations(fn_rate=1e-6, rate_floor=1e-12, **args) == 0
+
 def test_decided_modes_hold_one_step_further_along_the_motion():
     """Decide the modes of every contact for fingers that push at an angle to the squeeze
     line (the initial contacts of the square, zero force: a two-force body, so they stick; and
@@ -347,7 +359,7 @@ def test_decided_modes_hold_one_step_further_along_the_motion():
             assert choice.violations == 0
             decided = contacts.with_modes(choice.stick, choice.slip).with_theta(choice.theta)
             later = solver.solve(decided, 0.05)
-            fn, ft = later.normal(), later.tangential()
+            fn, ft = later.normal, later.tangential
             for k in range(len(decided)):
                 assert fn[k] > 0
                 if decided.stick[k]:

@@ -18,6 +18,7 @@ SECTIONS: tuple[str, ...] = (
     "resistance",
     "ring",
     "events",
+    "evaluation",
     "gripper",
     "material_models",
     "perception",

@@ -16,10 +16,13 @@ from squeeze_grasp_ros.ros.recording.bag import read_bag
 from squeeze_grasp_ros.resources import scene_file
 from squeeze_grasp_ros.scene import GraspSetup, load_scene
 from squeeze_grasp_ros.sim.world import SimWorld
+from squeeze_grasp_ros.bench.lockstep import bare_ratio_table, profile_table
+from squeeze_grasp_ros.bench.startup import startup_table
 from squeeze_grasp_ros.bench.table import Table, best_time, timed
 from squeeze_grasp_ros.mechanics.vocabulary import SQUEEZING_FINGERS, Effect
 
-TITLE = "Pipeline on real rclpy nodes: end to end, lockstep rate, recording, effects"
+TITLE = ("Pipeline on real rclpy nodes: end to end, lockstep rate against the bare loop, one "
+         "tick's profile, start-up, recording, effects")
 EFFECT_SCENE = yaml.safe_load("""
 name: effects
 object:
@@ -157,7 +160,7 @@ def run(quick: bool, out_dir: Path, progress) -> list[Table]:
 
 
 def _tables(quick: bool, progress, work: Path) -> list[Table]:
-    """The three tables of :func:`run`, with scratch files in ``work``."""
+    """The tables of :func:`run`, with scratch files in ``work``."""
     progress("pipeline: bare mechanics (and a warm-up run)")
     foam = scene_file("foam_square")
     bare = min(bare_mechanics(foam) for _ in range(2))
@@ -252,4 +255,8 @@ def _tables(quick: bool, progress, work: Path) -> list[Table]:
         "costs nothing during the squeeze (its fingertip joins the stepper when it first moves); "
         "without friction the squeeze is a different motion (every node slides), so friction is "
         "the base.")
-    return [end_to_end, rate, effects]
+    progress("pipeline: one tick's profile")
+    profile = profile_table(foam, work / "profiled")
+    ratio = bare_ratio_table(foam, 2 if quick else repeats, progress)
+    startup = startup_table(2 if quick else repeats, progress)
+    return [end_to_end, rate, ratio, profile, startup, effects]

@@ -14,8 +14,6 @@ from squeeze_grasp_ros.bench.table import Table
 from squeeze_grasp_ros.commands.common import output_folder
 from squeeze_grasp_ros.outputs import write_atomically
 
-HELP = "run the benchmarks; print tables and write a Markdown report with plots"
-
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     """--quick, --only, --out."""

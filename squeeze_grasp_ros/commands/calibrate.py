@@ -22,9 +22,6 @@ from squeeze_grasp_ros.mechanics.errors import InvalidInputError
 from squeeze_grasp_ros.mechanics.vocabulary import MaterialModel, StrainMeasure
 from squeeze_grasp_ros.commands.csv_io import read_columns
 
-HELP = (
-    "Young's modulus, Poisson's ratio from cuboid compressions; mu from the slope angle (App. B)"
-)
 CUBOID_COLUMNS = ("force", "length", "width", "height", "dl", "dw")
 
 

@@ -20,11 +20,6 @@ from squeeze_grasp_ros.mechanics.squeeze.graspmap import GraspMap
 from squeeze_grasp_ros.mechanics.vocabulary import ObjectModel
 from squeeze_grasp_ros.scene.studies import grasp_map_study
 
-HELP = (
-    "all-pairs grasp map: stiffness, inwardness and force closure of every placement "
-    "(ring scenes: feasibility and maximum depth, Sec. 7)"
-)
-
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     """SCENE, --pairs, --solver, --plot."""

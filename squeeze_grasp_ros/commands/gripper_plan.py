@@ -18,9 +18,6 @@ from squeeze_grasp_ros.resources import ResourceError, device_file
 from squeeze_grasp_ros.scene.gripper import GripperSpec, load_gripper
 from squeeze_grasp_ros.scene.gripper_plan import DEFAULT_MARGIN, GripperPlan, scene_gripper_plan
 
-HELP = ("parallel-jaw gripper grasps: ranked poses, aperture at first contact and at the "
-        "planned closing, jaw force, slip/strain limit, effort to command")
-
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     """SCENE, --gripper, --count, --evaluate, --yaw-range, --weight, --relative-closing,

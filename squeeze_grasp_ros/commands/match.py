@@ -12,8 +12,6 @@ from squeeze_grasp_ros.mechanics.calibration.matching import Match, match_simila
 from squeeze_grasp_ros.commands.common import add_plot_argument
 from squeeze_grasp_ros.commands.csv_io import read_points
 
-HELP = "least-squares scale/rotation/translation of measured onto simulated points (App. C)"
-
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     """SIM.csv MEASURED.csv, --plot."""

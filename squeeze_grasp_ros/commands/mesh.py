@@ -8,8 +8,6 @@ import argparse
 from squeeze_grasp_ros import plots
 from squeeze_grasp_ros.commands.common import add_plot_argument, add_scene_argument, load_setup
 
-HELP = "triangulate the scene's object (nodes, triangles, boundary loop, material)"
-
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     """SCENE and --plot."""

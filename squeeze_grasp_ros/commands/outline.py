@@ -21,8 +21,6 @@ from squeeze_grasp_ros.perception.extract import ObjectOutline, extract_outline
 from squeeze_grasp_ros.perception.image_files import decode_image
 from squeeze_grasp_ros.outputs import write_atomically
 
-HELP = ("the object's outline (m, holes included) from a top-down mono8 mask or depth image, "
-        "as a scene polygon or outline file")
 
 MAX_IMAGE_BYTES = 256 * 1024 * 1024
 """Largest image file read (256 MiB)."""

@@ -19,8 +19,6 @@ from squeeze_grasp_ros.mechanics.squeeze.stable_pure import Squeeze
 from squeeze_grasp_ros.mechanics.vocabulary import SqueezeKind
 from squeeze_grasp_ros.scene.studies import point_squeezes
 
-HELP = "stable and pure squeezes at the scene's finger placements (point contacts, Sec. 3-4)"
-
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     """SCENE, depth overrides, --solver, --plot."""

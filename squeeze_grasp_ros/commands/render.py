@@ -16,9 +16,6 @@ from squeeze_grasp_ros.perception.render import render_views, ring_band
 from squeeze_grasp_ros.scene import build_outline, load_scene
 from squeeze_grasp_ros.outputs import write_atomically
 
-HELP = ("render a scene's object (its top face, anti-aliased; a ring's wall band) into a mono8 "
-        "mask and a depth image of a calibrated camera above the plane")
-
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     """SCENE, the camera, the images to write, blur and noise."""

@@ -13,11 +13,6 @@ import yaml
 from squeeze_grasp_ros.exit_codes import ExitCode
 from squeeze_grasp_ros.commands.common import fail
 
-HELP = (
-    "replay a recording's sensor topics on its sim time into a fresh monitor and check that "
-    "it reproduces the recorded event sequence"
-)
-
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     """DIR and monitor parameter overrides for recordings made by other tools."""

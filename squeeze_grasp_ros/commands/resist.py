@@ -30,8 +30,6 @@ from squeeze_grasp_ros.mechanics.squeeze.events import grasp_health
 from squeeze_grasp_ros.mechanics.vocabulary import ContactKind, ContactMode, Finger, SqueezeKind
 from squeeze_grasp_ros.scene.studies import resistance_study
 
-HELP = "optimal stable/pure resistance of F1, F2 to the scene's adversary finger A (Sec. 6)"
-
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     """SCENE, --mode, --contacts, --directions, --segment-half-width, --compare-direction."""

@@ -32,7 +32,6 @@ from squeeze_grasp_ros.scene.studies import grasp_map_study, ring_placement
 
 MAX_BEST = 10_000
 """Most placements ``--map --best`` lists."""
-HELP = "ring-like object, two point fingers (Sec. 7): max squeeze depth, limit, all-pairs map"
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:

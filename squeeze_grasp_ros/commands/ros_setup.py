@@ -5,13 +5,12 @@ from __future__ import annotations
 
 import argparse
 
-from squeeze_grasp_ros.ros import interfaces as ros_setup
-
-HELP = ros_setup.DESCRIPTION
+from squeeze_grasp_ros.buildtool import interfaces as ros_setup
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     """--source, --force, --verbose, --check."""
+    parser.description = ros_setup.DESCRIPTION
     ros_setup.add_arguments(parser)
 
 

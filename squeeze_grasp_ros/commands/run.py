@@ -20,8 +20,6 @@ from squeeze_grasp_ros.commands.common import add_scene_argument, fail, new_fold
 from squeeze_grasp_ros.control.force_watch import FORCE_MISMATCH
 from squeeze_grasp_ros.control.motion import REACTIONS
 
-HELP = ("run a scene through the planner, executor, simulated hardware, monitor and recorder "
-        "nodes (lockstep sim time) and summarise it")
 EXECUTOR_CHOICES: tuple[str, ...] = ("events", "single")
 """``--executor`` values (equal to ``nodes.runner.EXECUTORS``; kept here so that building the CLI
 parser never imports rclpy: ``squeeze-grasp ros-setup`` must run before the interfaces exist)."""
@@ -148,9 +146,8 @@ def _run(args: argparse.Namespace) -> dict | int:
     finally:
         if show:
             sys.stderr.write("\n")
-    stopped = recording_stopped(args.record)
+    stopped = result.get("recording_stopped")
     if stopped is not None:
-        result["recording_stopped"] = stopped
         print(json.dumps(result) if args.json else summary(result))
         print(f"squeeze-grasp run: the recording in {args.record} stopped early: {stopped}; "
               "it is readable up to there", file=sys.stderr)
@@ -190,18 +187,6 @@ def prepare_recording(folder: str) -> tuple[str, ExitCode] | None:
                 + ("; a recording needs at least 256 kB free" if code == ExitCode.INTERNAL
                    else ""), code)
     return None
-
-
-def recording_stopped(record: str | None) -> str | None:
-    """Why the recording of a finished run ended early (a full disk), from its metadata.yaml."""
-    if not record:
-        return None
-    from squeeze_grasp_ros.ros.recording.bag import STOPPED_KEY, BagError, bag_info
-
-    try:
-        return bag_info(record).get("custom_data", {}).get(STOPPED_KEY)
-    except BagError as exc:
-        return f"the recording is not readable: {exc}"
 
 
 def recording_state(record: str | None) -> str:

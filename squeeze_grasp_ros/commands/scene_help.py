@@ -7,8 +7,6 @@ import argparse
 
 from squeeze_grasp_ros.scene import scene_help
 
-HELP = "list every scene key, unit, range, shape type and effect"
-
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     """No options."""

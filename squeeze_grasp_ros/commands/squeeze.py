@@ -33,7 +33,6 @@ from squeeze_grasp_ros.mechanics.vocabulary import (
 )
 from squeeze_grasp_ros.scene.studies import compare_models, squeeze_run
 
-HELP = "event-driven squeeze with rounded fingertips under Coulomb friction (Sec. 5, Algorithm 1)"
 BAR_WIDTH = 30
 
 

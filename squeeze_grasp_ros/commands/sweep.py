@@ -14,8 +14,6 @@ from squeeze_grasp_ros.exit_codes import ExitCode
 from squeeze_grasp_ros.sweep.engine import dry_run, run_sweep
 from squeeze_grasp_ros.sweep.spec import SweepError, load_sweep_spec
 
-HELP = ("evaluate a sweep spec (objects x materials x friction x tips x squeezes x depths x "
-        "placements) on Dask into a Parquet dataset; re-run to resume")
 EPILOG = ("exit status: 0 every task written (an evaluation that raised is a row with its error "
           "and leaves the status 0; the summary counts them); 1 some tasks failed as a whole "
           "(listed with their error in DIR/manifest.json; the other tasks are written, and "

@@ -7,8 +7,6 @@ import argparse
 
 from squeeze_grasp_ros.sweep.spec import sweep_help
 
-HELP = "list every sweep-spec key, unit, range and shape family"
-
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     """No options."""

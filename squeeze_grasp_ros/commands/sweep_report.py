@@ -11,8 +11,6 @@ from squeeze_grasp_ros.sweep.report import plot, summarise, text
 
 MAX_BEST = 10_000
 """Most best placements listed per object."""
-HELP = ("summarise a sweep directory: success rate by object and material, quality "
-        "distributions, best placements per object; --plot writes pictures")
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:

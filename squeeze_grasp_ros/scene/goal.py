@@ -75,12 +75,14 @@ def resistance_goal(setup: GraspSetup, squeeze: EventSqueeze | None = None) -> d
     }
 
 
-def plan_scene(scene: Scene, *, on_slip_alarm: str = "hold", resist: bool = True) -> ScenePlan:
+def plan_scene(scene: Scene, *, on_slip_alarm: str = "hold", resist: bool = True,
+               setup: GraspSetup | None = None) -> ScenePlan:
     """Plan the scene's grasp with the mechanics: one event-driven squeeze, the pure directions
-    at the same contacts and, for a frictional adversary, the resistance waypoints.
+    at the same contacts and, for a frictional adversary, the resistance waypoints. ``setup`` is
+    the scene's :class:`GraspSetup` if it was built already (default: built here).
     """
     t0 = time.perf_counter()
-    setup = GraspSetup.build(scene)
+    setup = GraspSetup.build(scene) if setup is None else setup
     result = setup.event_squeeze()
     directions = np.array([result.directions[f] for f in SQUEEZING_FINGERS])
     rpd = result.relative_depth / result.depth if result.depth > 0 else 0.0

@@ -50,8 +50,11 @@ issued."""
 
 def node_dofs(nodes) -> np.ndarray:
     """Interleaved DOF indices (2m,) of ``nodes``: x_1, y_1, x_2, y_2, ..."""
-    nodes = np.asarray(nodes, dtype=int)
-    return np.stack([2 * nodes, 2 * nodes + 1], axis=-1).reshape(-1)
+    nodes = np.asarray(nodes, dtype=int).reshape(-1)
+    dofs = np.empty(2 * nodes.size, int)
+    np.multiply(nodes, 2, out=dofs[0::2])
+    np.add(dofs[0::2], 1, out=dofs[1::2])
+    return dofs
 
 
 class FactorizedSolver:
@@ -305,9 +308,15 @@ class ElasticObject:
 
     def boundary_positions(self, nodes) -> np.ndarray:
         """Position of each node in the outer boundary loop, -1 where it is not on it."""
+        return self._boundary_lookup[np.asarray(nodes, dtype=int)]
+
+    @cached_property
+    def _boundary_lookup(self) -> np.ndarray:
+        """Position in the outer boundary loop of every mesh node (n,), -1 off it."""
         lookup = -np.ones(self.mesh.n, dtype=int)
         lookup[self.mesh.boundary] = np.arange(len(self.mesh.boundary))
-        return lookup[np.asarray(nodes, dtype=int)]
+        lookup.flags.writeable = False
+        return lookup
 
     @cached_property
     def boundary_compliance(self) -> np.ndarray:

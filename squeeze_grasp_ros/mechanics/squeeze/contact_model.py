@@ -31,6 +31,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from functools import cached_property
 
 import numpy as np
 
@@ -64,6 +65,9 @@ SINGULAR_SLIDING = (
 NEWTON_TOL = 1e-14
 """Newton stops when the cone residual is below this times the force scale |C| r, or when the
 largest angle update (rad) falls below it."""
+BOUNDARY_ROWS_KEPT = 8
+"""Row selections of the boundary compliance the fast model keeps for its last contact set
+(each 2k x 2m floats for k rows and m contacts)."""
 
 
 @dataclass(frozen=True)
@@ -172,6 +176,9 @@ class Solution:
         Angles of the contact normals e(nu), rad (None: ``theta``, circular tips).
     kappa : (m,) ndarray or None
         d nu / d theta: 1 on a circle or a pad's rounded edge, 0 on a flat face (None: 1).
+
+    The force components and their rates (:attr:`normal`, :attr:`tangential`, ...) are
+    computed on first use and kept: every event function of the point reads them.
     """
 
     theta: np.ndarray
@@ -196,27 +203,35 @@ class Solution:
         """The rates d nu / ds (m,): how fast each contact normal turns (0 on a flat face)."""
         return self.dtheta if self.kappa is None else self.kappa * self.dtheta
 
+    @cached_property
+    def unit(self) -> np.ndarray:
+        """e(nu) (m, 2) of every contact, computed once per solution."""
+        return unit(self.normal_angle)
+
+    @cached_property
+    def tangent(self) -> np.ndarray:
+        """t(nu) (m, 2) of every contact, computed once per solution."""
+        return tangent(self.normal_angle)
+
+    @cached_property
     def normal(self) -> np.ndarray:
         """f_n = F . e(nu) (m,)."""
-        return np.einsum("ij,ij->i", self.F, unit(self.normal_angle))
+        return np.einsum("ij,ij->i", self.F, self.unit)
 
+    @cached_property
     def tangential(self) -> np.ndarray:
         """f_t = F . t(nu) (m,)."""
-        return np.einsum("ij,ij->i", self.F, tangent(self.normal_angle))
+        return np.einsum("ij,ij->i", self.F, self.tangent)
 
+    @cached_property
     def normal_rate(self) -> np.ndarray:
         """D f_n / ds (m,)."""
-        nu = self.normal_angle
-        return np.einsum("ij,ij->i", self.dF, unit(nu)) + self.normal_turn * np.einsum(
-            "ij,ij->i", self.F, tangent(nu)
-        )
+        return np.einsum("ij,ij->i", self.dF, self.unit) + self.normal_turn * self.tangential
 
+    @cached_property
     def tangential_rate(self) -> np.ndarray:
         """D f_t / ds (m,)."""
-        nu = self.normal_angle
-        return np.einsum("ij,ij->i", self.dF, tangent(nu)) - self.normal_turn * np.einsum(
-            "ij,ij->i", self.F, unit(nu)
-        )
+        return np.einsum("ij,ij->i", self.dF, self.tangent) - self.normal_turn * self.normal
 
 
 @dataclass(frozen=True)
@@ -592,9 +607,25 @@ class ContactModel:
         if sd.A_bc is None:
             u = self.full_displacement(sd, delta, F).reshape(-1, 2)
             return u[b[rows]]
-        d = node_dofs(rows)
-        u = sd.A_bc[d] @ F.reshape(-1) + self.obj.rigid[node_dofs(b[rows])] @ g
+        A, R = self._boundary_rows(sd, rows)
+        u = A @ F.reshape(-1) + R @ g
         return u.reshape(-1, 2)
+
+    def _boundary_rows(self, sd: SetData, rows: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """The rows of A_bc and of the rigid modes of boundary positions ``rows``, kept for the
+        last contact set (a substep's start and end, its events' look-ups ask for the same rows).
+        """
+        kept = self._cache.get("boundary_rows")
+        if kept is None or kept[0] is not sd:
+            kept = self._cache["boundary_rows"] = (sd, {})
+        tag = (rows.dtype.str, rows.tobytes())
+        made = kept[1].get(tag)
+        if made is None:
+            if len(kept[1]) >= BOUNDARY_ROWS_KEPT:
+                kept[1].clear()
+            made = kept[1][tag] = (sd.A_bc[node_dofs(rows)],
+                                   self.obj.rigid[node_dofs(self.boundary_nodes[rows])])
+        return made
 
     def max_strain(self, sd: SetData, delta: np.ndarray, F: np.ndarray) -> tuple[float, int]:
         """(largest strain by the limit's criterion in :attr:`strain_measure`, element index)
@@ -655,17 +686,20 @@ class ContactModel:
         """
         g = sd.E.T @ delta.reshape(-1)
         rigid = (self.obj.rigid_gradients @ g).reshape(-1, 4)
-        nodes = tuple(sd.nodes.tolist())
-        if self._cache.get("gradient_bounds", (None,))[0] != nodes:
-            self._cache["gradient_bounds"] = (nodes, self.obj.gradient_bounds(nodes))
-        bound = (self._cache["gradient_bounds"][1] @ np.linalg.norm(F, axis=1)
+        kept = self._cache.get("gradient_bounds")
+        if kept is None or kept["set"] is not sd:  # the last contact set's bounds are kept
+            kept = self._cache["gradient_bounds"] = {
+                "set": sd, "bounds": self.obj.gradient_bounds(tuple(sd.nodes.tolist()))}
+        bound = (kept["bounds"] @ np.sqrt((F * F).sum(axis=1))
                  + np.sqrt((rigid * rigid).sum(axis=1)))
-        near = np.flatnonzero(bound >= GRADIENT_BOUND_EXACT)
-        rest = np.delete(bound, near)
+        exact = bound >= GRADIENT_BOUND_EXACT
+        near, rest = np.flatnonzero(exact), bound[~exact]
         floor = (1.0 - rest.max()) ** 2 if rest.size else np.inf
         if near.size == 0:
             return float(floor), -1
-        H = rigid[near] + sum(G[near] @ f for G, f in zip(self.obj.load_gradients(sd.nodes), F))
+        if "loads" not in kept:
+            kept["loads"] = self.obj.load_gradients(sd.nodes)
+        H = rigid[near] + sum(G[near] @ f for G, f in zip(kept["loads"], F))
         det = (1.0 + H[:, 0]) * (1.0 + H[:, 3]) - H[:, 1] * H[:, 2]
         k = int(np.argmin(det))
         return (float(det[k]), int(near[k])) if det[k] <= floor else (float(floor), -1)

@@ -17,8 +17,8 @@ True
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, field
 from enum import Enum
+from typing import NamedTuple
 
 from squeeze_grasp_ros.mechanics.vocabulary import EventType, Termination
 
@@ -99,9 +99,12 @@ _SLOPED = frozenset({EventFunction.GAP, EventFunction.NORMAL_FORCE, EventFunctio
                      EventFunction.CONE_MINUS})
 
 
-@dataclass(frozen=True, order=True)
-class EventKey:
+class EventKey(NamedTuple):
     """One event function of a stepper call.
+
+    A named tuple: the stepper's tables of function values are dicts keyed by it, hundreds of
+    look-ups per substep, and a tuple of a str enum and two ints hashes and compares in C (a
+    frozen dataclass calls a Python ``__hash__`` at every look-up). Keys order as their fields.
 
     Attributes
     ----------
@@ -115,14 +118,6 @@ class EventKey:
     function: EventFunction
     node: int = WHOLE_OBJECT
     finger: int = ANY_FINGER
-    _hash: int = field(init=False, repr=False, compare=False)
-
-    def __post_init__(self) -> None:
-        # keys are hashed in every dict of function values: once here, not at each look-up
-        object.__setattr__(self, "_hash", hash((self.function, self.node, self.finger)))
-
-    def __hash__(self) -> int:
-        return self._hash
 
     @classmethod
     def gap(cls, node: int, finger: int) -> EventKey:
@@ -144,8 +139,8 @@ class EventKey:
 
 class KeyTable:
     """Each key made once: the stepper's tables of function values hold hundreds of keys per
-    substep (a gap per free boundary node and finger), and making a frozen dataclass costs
-    about a microsecond, ten times a look-up here. One table per object (its contact model
+    substep (a gap per free boundary node and finger), and making a key in Python costs
+    several times a look-up here. One table per object (its contact model
     keeps it across stepper calls).
 
     >>> table = KeyTable()

@@ -603,9 +603,10 @@ def event_squeeze(
         finger_force=forces_along,
         trajectories=polar_trajectories(run.samples, relative_per_depth),
         force_curve={n: tuple((s.depth * relative_per_depth,
-                               float(np.asarray(s.finger_forces[n]) @ dirs[n])
-                               / max(float(np.linalg.norm(dirs[n])), 1e-300))
-                              for s in run.samples) for n in names},
+                               float(np.asarray(s.finger_forces[n]) @ dirs[n]) / length)
+                              for s in run.samples)
+                     for n, length in ((n, max(float(np.linalg.norm(dirs[n])), 1e-300))
+                                       for n in names)},
         health=health,
         chatter=run.chatter,
         displacement=u_field,

@@ -54,15 +54,25 @@ __all__ = ["TipGeometry", "TipShape", "cross", "tangent", "unit"]
 
 
 def unit(theta) -> np.ndarray:
-    """e(theta) = (cos, sin) stacked on the last axis, (..., 2)."""
+    """e(theta) = (cos, sin) stacked on the last axis, (..., 2).
+
+    >>> unit([0.0, np.pi / 2]).round(12).tolist()
+    [[1.0, 0.0], [0.0, 1.0]]
+    """
     theta = np.asarray(theta, float)
-    return np.stack([np.cos(theta), np.sin(theta)], axis=-1)
+    out = np.empty(theta.shape + (2,))
+    np.cos(theta, out=out[..., 0])
+    np.sin(theta, out=out[..., 1])
+    return out
 
 
 def tangent(theta) -> np.ndarray:
     """t(theta) = (-sin, cos) stacked on the last axis, (..., 2)."""
     theta = np.asarray(theta, float)
-    return np.stack([-np.sin(theta), np.cos(theta)], axis=-1)
+    out = np.empty(theta.shape + (2,))
+    np.negative(np.sin(theta), out=out[..., 0])
+    np.cos(theta, out=out[..., 1])
+    return out
 
 
 def cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -228,7 +238,7 @@ class TipGeometry:
         ``centers`` (k, 2); negative values are penetrations.
         """
         w, _ = self._closest(points[:, None, :] - centers[None, :, :])
-        return np.linalg.norm(w, axis=-1) - self.radius[None, :]
+        return np.sqrt((w * w).sum(axis=-1)) - self.radius[None, :]  # np.linalg.norm's sums
 
     def gap_slopes(self, points: np.ndarray, velocities: np.ndarray, centers: np.ndarray,
                    center_rates: np.ndarray) -> np.ndarray:

@@ -66,6 +66,19 @@ def device_topic(device: str, stream: str) -> str:
     return f"devices/{device}/{stream}"
 
 
+def loop_topics(devices: Iterable[str]) -> list[str]:
+    """The topics every lockstep tick publishes whatever the scene's effects (relative): the
+    tick, the ground truth, the monitor's status and contact state, each device's pose and
+    setpoint. A recorder is ready once each has a publisher, so the first tick's messages of
+    every loop node reach it (across processes, discovery can match the executor seconds after
+    the driver).
+    """
+    names = [TICK, SIM_STATE, STATUS, CONTACT_STATE]
+    for device in devices:
+        names += [device_topic(device, "pose"), device_topic(device, "setpoint")]
+    return names
+
+
 def pipeline_topics(devices: Iterable[str], *, hidden: bool = False,
                     camera: bool = False) -> dict[str, str]:
     """Topic (fully qualified) -> type of every topic of a run with ``devices``.

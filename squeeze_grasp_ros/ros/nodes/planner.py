@@ -33,7 +33,7 @@ import queue
 import sys
 import threading
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 from typing import Any, TypeVar
@@ -117,11 +117,14 @@ class PlannerNode(Node):
 
     Parameters
     ----------
+    objects : sequence of planning.LoadedObject
+        Objects loaded already, put into the cache under their ids (a run in this process hands
+        over the object it built for its simulated world, so the scene is meshed once).
     **kwargs
         Passed to :class:`rclpy.node.Node` (e.g. ``context``, ``parameter_overrides``).
     """
 
-    def __init__(self, **kwargs: Any) -> None:
+    def __init__(self, *, objects: Sequence[planning.LoadedObject] = (), **kwargs: Any) -> None:
         super().__init__("planner", **kwargs)
         for name, (default, description) in PARAMETERS.items():
             # float parameters also take YAML integers (``min_step: 1`` is an int in YAML)
@@ -138,6 +141,8 @@ class PlannerNode(Node):
         roots = [Path(r) for r in value("allowed_roots") if r] or [share_dir(), Path.cwd()]
         self.roots = list(dict.fromkeys(r.resolve() for r in roots))
         self.cache = planning.ObjectCache(value("cache_size"), self.limits.max_bytes)
+        for loaded in objects:
+            self.cache.put(loaded)
         self._pool = ThreadPoolExecutor(max_workers=value("worker_threads"),
                                         thread_name_prefix="planner-worker")
         self._stopping = threading.Event()

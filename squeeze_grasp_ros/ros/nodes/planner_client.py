@@ -4,9 +4,10 @@
 
 :class:`PlannerClient` spins the given executor in the calling thread until a response
 arrives (a ``spin_once`` loop with a deadline: rclpy 7.1.6's ``spin_until_future_complete``
-leaves tasks behind when used in a loop, docs/design.md §5). Across processes the first
-request can be lost even after ``wait_for_service``; ``attempts`` re-sends it (the planner's
-requests are idempotent).
+leaves tasks behind when used in a loop, docs/design.md §5), or with the caller's own wait
+(``squeeze-grasp run`` checks for Ctrl-C, dead node processes and foreign traffic while it
+waits). Across processes the first request can be lost even after the service is discovered;
+``attempts`` re-sends it (the planner's requests are idempotent).
 """
 from __future__ import annotations
 
@@ -17,6 +18,9 @@ from typing import Any
 from rclpy.client import Client
 from rclpy.executors import Executor
 from rclpy.node import Node
+
+Wait = Callable[[Callable[[], bool], float], None]
+"""``wait(done, timeout)``: spin until ``done()``; raise TimeoutError after ``timeout`` s."""
 
 
 class PlannerClient:
@@ -29,13 +33,18 @@ class PlannerClient:
     executor : Executor
         Spun by :meth:`spin_until`; it may also carry the planner itself (one process).
     planner_name : str
-        Fully qualified name of the planner node, e.g. ``/planner``.
+        Name of the planner node, e.g. ``/planner`` (a relative name resolves in ``node``'s
+        namespace).
+    wait : callable, optional
+        How to wait (:data:`Wait`); default :meth:`spin_until`.
     """
 
-    def __init__(self, node: Node, executor: Executor, planner_name: str = "/planner") -> None:
+    def __init__(self, node: Node, executor: Executor, planner_name: str = "/planner", *,
+                 wait: Wait | None = None) -> None:
         self.node = node
         self.executor = executor
         self.planner_name = planner_name
+        self.wait = wait or self.spin_until
         self._clients: dict[str, Client] = {}
 
     def client(self, srv_type: Any, name: str, timeout: float = 30.0) -> Client:
@@ -48,8 +57,11 @@ class PlannerClient:
         """
         if name not in self._clients:
             client = self.node.create_client(srv_type, f"{self.planner_name}/{name}")
-            if not client.wait_for_service(timeout_sec=timeout):
-                raise TimeoutError(f"service {self.planner_name}/{name} not available")
+            try:
+                self.wait(client.service_is_ready, timeout)
+            except TimeoutError:
+                self.node.destroy_client(client)
+                raise TimeoutError(f"service {self.planner_name}/{name} not available") from None
             self._clients[name] = client
         return self._clients[name]
 
@@ -66,7 +78,7 @@ class PlannerClient:
         request : Any
             The request message.
         timeout : float
-            Seconds to wait for each attempt.
+            Seconds to wait for the service to appear, and for each attempt.
         attempts : int
             Times the request is sent before giving up.
 
@@ -75,11 +87,11 @@ class PlannerClient:
         TimeoutError
             If no attempt is answered.
         """
-        client = self.client(srv_type, name)
+        client = self.client(srv_type, name, timeout)
         for attempt in range(attempts):
             future = client.call_async(request)
             try:
-                self.spin_until(future.done, timeout)
+                self.wait(future.done, timeout)
             except TimeoutError:
                 client.remove_pending_request(future)
                 if attempt == attempts - 1:

@@ -127,8 +127,8 @@ class RecorderNode(Node):
         self.progress_pub = self.create_publisher(Header, pipeline.RECORDER_PROGRESS,
                                                   pipeline.loop_qos(10))
         if p["lockstep"]:
-            self.participant = pipeline.Participant(self, "recorder", [pipeline.TICK],
-                                                    [self.progress_pub])
+            self.participant = pipeline.Participant(
+                self, "recorder", pipeline.loop_topics(p["devices"]), [self.progress_pub])
             pipeline.wall_timer(self, 0.05, self._repeat_report)
 
 

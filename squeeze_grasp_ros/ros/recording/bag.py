@@ -210,6 +210,9 @@ class BagWriter:
         """Why the bag stopped taking messages (a write failed for lack of room), or None."""
         self.dropped = 0
         """Messages given to :meth:`write` that are not in the file (after a failure)."""
+        self.stopped: str | None = None
+        """After :meth:`close`: why the recording stopped early and how many messages it lost
+        (what ``metadata.yaml`` says under ``custom_data.recording_stopped``), or None."""
 
     def add_topic(self, name: str, type_name: str, offered_qos: Sequence[dict] = ()) -> None:
         """Declare topic ``name`` of type ``type_name`` ('pkg/msg/Type') with its offered QoS."""
@@ -338,8 +341,8 @@ class BagWriter:
         while len(self._stream.boundaries) > 1:
             section = self._count_kept(self._stream.boundaries[-1])
             lost = written + self.dropped - sum(t.count for t in self.topics.values())
-            self.custom_data[STOPPED_KEY] = (f"{self.failure}; the last {lost} messages were not "
-                                             "recorded")
+            self.stopped = f"{self.failure}; the last {lost} messages were not recorded"
+            self.custom_data[STOPPED_KEY] = self.stopped
             info = self.metadata()
             tail = b""
             for record in (Metadata("rosbag2", {"serialized_metadata": plain_yaml(info)}), None):

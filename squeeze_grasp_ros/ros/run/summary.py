@@ -9,26 +9,16 @@ from dataclasses import dataclass
 from typing import Any
 
 from squeeze_grasp_interfaces.action import ExecuteGrasp
-from squeeze_grasp_interfaces.msg import ContactEvent, ContactEventArray, SimState
+from squeeze_grasp_interfaces.msg import ContactEvent, SimState
 
-from squeeze_grasp_ros.control.motion import GraspGoal
 from squeeze_grasp_ros.mechanics.vocabulary import EventType, Termination
 from squeeze_grasp_ros.ros import messages
+from squeeze_grasp_ros.ros.run.planning import Plan
 
-__all__ = ["GRASP_HELD", "Observed", "Plan", "event_list", "outcome", "run_summary"]
+__all__ = ["GRASP_HELD", "Observed", "event_list", "outcome", "run_summary"]
 
 GRASP_HELD: tuple[str, ...] = ("none", Termination.PICKED_UP)
 """World terminations after which the grasp holds ("none": the world never ended)."""
-
-
-@dataclass(frozen=True)
-class Plan:
-    """What the executor is asked to do and what the planner predicts."""
-
-    goal: GraspGoal
-    prediction: ContactEventArray
-    source: str
-    seconds: float
 
 
 @dataclass(frozen=True)

@@ -191,7 +191,7 @@ class EventFunctions:
         if lim.strain is not None and Termination.STRAIN_LIMIT in self.terminate_on:
             strain = lim.strain - model.max_strain(contacts.data, sol.delta, sol.F)[0]
         if lim.weight is not None and Termination.PICKED_UP in self.terminate_on:
-            pickup = pickup_margin(model.mu, sol.normal(), sol.tangential(), contacts.stick,
+            pickup = pickup_margin(model.mu, sol.normal, sol.tangential, contacts.stick,
                                    contacts.finger, sorted(set(contacts.finger.tolist())),
                                    lim.weight / model.force_unit)
         return strain, pickup
@@ -207,7 +207,7 @@ class EventFunctions:
                           else (np.inf, np.inf))
         area = (self.area_value(contacts, sol) if terminations and self.motion.rate > 0
                 else np.inf)
-        return event_values(mu=self.model.mu, fn=sol.normal(), ft=sol.tangential(),
+        return event_values(mu=self.model.mu, fn=sol.normal, ft=sol.tangential,
                             slip=contacts.slip, dtheta=sol.dtheta,
                             radius=self.motion.radius[contacts.finger], rate=self.motion.rate,
                             gaps=self.gaps(contacts, sol, s, rows), strain=strain,
@@ -219,26 +219,60 @@ class EventFunctions:
         (mask) its normal force and its cone margins or slip rate, then every free boundary
         row's gaps, then the terminations that are checked.
         """
-        out, key = [], self.keys.get
-        for k, node in enumerate(contacts.nodes.tolist()):
-            if held[k]:
-                continue
-            out.append((key(EventFunction.NORMAL_FORCE, node), v.fn[k]))
-            if self.frictionless:
-                continue
-            if contacts.stick[k]:
-                out.append((key(EventFunction.CONE_PLUS, node), v.c_plus[k]))
-                out.append((key(EventFunction.CONE_MINUS, node), v.c_minus[k]))
-            else:
-                out.append((key(EventFunction.SLIP_RATE, node), v.d[k]))
-        gap_keys = self._gap_keys
-        for r, row in enumerate(rows.tolist()):
-            out.extend(zip(gap_keys[row], v.gaps[r]))
+        keys, pick = self._contact_entries(contacts, held)
+        table = np.concatenate((v.fn, v.c_plus, v.c_minus, v.d))
+        out = list(zip(keys, table[pick]))
+        out.extend(zip(self._row_gap_keys(rows), v.gaps.ravel()))
         for function, value in ((EventFunction.AREA, v.area), (EventFunction.STRAIN, v.strain),
                                 (EventFunction.PICKUP, v.pickup)):
             if np.isfinite(value):
-                out.append((key(function), value))
+                out.append((self.keys.get(function), value))
         return out
+
+    @cached_property
+    def _entry_tables(self) -> dict[tuple, object]:
+        """Key lists made so far in the call (:meth:`_contact_entries`, :meth:`_row_gap_keys`,
+        :meth:`_sloped_keys`), by what they depend on.
+        """
+        return {}
+
+    def _contact_entries(self, contacts: ContactSet,
+                         held: np.ndarray) -> tuple[list[EventKey], np.ndarray]:
+        """The keys of the per-contact functions :meth:`entries` watches, and where each one's
+        value is in the table (fn, c_plus, c_minus, d) of the contacts' values laid end to end.
+        """
+        tag = ("contacts", contacts.nodes.tobytes(), contacts.stick.tobytes(),
+               np.asarray(held, bool).tobytes())
+        made = self._entry_tables.get(tag)
+        if made is None:
+            m, keys, pick, key = len(contacts), [], [], self.keys.get
+            for k, node in enumerate(contacts.nodes.tolist()):
+                if held[k]:
+                    continue
+                keys.append(key(EventFunction.NORMAL_FORCE, node))
+                pick.append(k)
+                if self.frictionless:
+                    continue
+                if contacts.stick[k]:
+                    keys += [key(EventFunction.CONE_PLUS, node),
+                             key(EventFunction.CONE_MINUS, node)]
+                    pick += [m + k, 2 * m + k]
+                else:
+                    keys.append(key(EventFunction.SLIP_RATE, node))
+                    pick.append(3 * m + k)
+            made = self._entry_tables[tag] = (keys, np.array(pick, int))
+        return made
+
+    def _row_gap_keys(self, rows: np.ndarray) -> list[EventKey]:
+        """The gap keys of boundary positions ``rows``, row after row, finger after finger
+        (the order of a (rows, fingers) array raveled).
+        """
+        tag = ("rows", rows.dtype.str, rows.tobytes())
+        made = self._entry_tables.get(tag)
+        if made is None:
+            gap_keys = self._gap_keys
+            made = self._entry_tables[tag] = [k for row in rows.tolist() for k in gap_keys[row]]
+        return made
 
     def slopes(self, contacts: ContactSet, sol: Solution, s: float,
                rows: np.ndarray) -> dict[EventKey, float]:
@@ -246,22 +280,32 @@ class EventFunctions:
         contact's normal force and cone margins (the functions with
         :attr:`~..event_key.EventFunction.has_slope`).
         """
-        fn_r, ft_r = sol.normal_rate(), sol.tangential_rate()
+        fn_r, ft_r = sol.normal_rate, sol.tangential_rate
         mu = self.model.mu
         out = {}
         if len(rows):
             points = self._boundary_points(contacts, sol, rows)
             velocities = self.model.boundary_rate(contacts.data, sol, rows)
             g_rate = self.motion.gap_slopes(points, velocities, s)
-            gap_keys = self._gap_keys
-            for j, row in enumerate(rows.tolist()):
-                out.update(zip(gap_keys[row], g_rate[j].tolist()))
-        key = self.keys.get
-        for k, node in enumerate(contacts.nodes.tolist()):
-            out[key(EventFunction.NORMAL_FORCE, node)] = float(fn_r[k])
-            out[key(EventFunction.CONE_PLUS, node)] = float(mu * fn_r[k] + ft_r[k])
-            out[key(EventFunction.CONE_MINUS, node)] = float(mu * fn_r[k] - ft_r[k])
+            out.update(zip(self._row_gap_keys(rows), g_rate.ravel().tolist()))
+        rates = np.empty((len(contacts), 3))
+        rates[:, 0] = fn_r
+        rates[:, 1] = mu * fn_r + ft_r
+        rates[:, 2] = mu * fn_r - ft_r
+        out.update(zip(self._sloped_keys(contacts), rates.ravel().tolist()))
         return out
+
+    def _sloped_keys(self, contacts: ContactSet) -> list[EventKey]:
+        """Each contact's normal-force and cone-margin keys, contact after contact."""
+        tag = ("sloped", contacts.nodes.tobytes())
+        made = self._entry_tables.get(tag)
+        if made is None:
+            key = self.keys.get
+            made = self._entry_tables[tag] = [
+                key(function, node) for node in contacts.nodes.tolist()
+                for function in (EventFunction.NORMAL_FORCE, EventFunction.CONE_PLUS,
+                                 EventFunction.CONE_MINUS)]
+        return made
 
     def value(self, key: EventKey, contacts: ContactSet, sol: Solution, s: float) -> float:
         """The value of one function at ``sol`` (for root location)."""

@@ -8,8 +8,11 @@ C/D events at one point would flip back), each hypothesis is solved and tested: 
 positive normal force inside the cone, slide needs a positive normal force and a slip rate of
 the assumed sign. A function that is zero by construction at the point (a new contact's normal
 force and cone margins, a sliding node's margin on its slip side) must grow along the motion
-instead of being positive. :func:`decide_modes` is a function of the contact set and a solver,
-so it can be tested with any solver.
+instead of being positive, faster than a noise floor (:data:`RATE_NOISE`): where a hypothesis
+leaves such a function's rate an exact zero in exact arithmetic (a node of an object that
+slides rigidly along its fingers), the computed rate is round-off of about 1e-15 whose sign
+depends on the factoriser, and it must not decide the mode. :func:`decide_modes` is a function
+of the contact set and a solver, so it can be tested with any solver.
 """
 from __future__ import annotations
 
@@ -24,10 +27,16 @@ from squeeze_grasp_ros.mechanics.squeeze.contact_model import Solution, SolveFai
 from squeeze_grasp_ros.mechanics.squeeze.event_key import EventFunction, EventKey
 from squeeze_grasp_ros.mechanics.squeeze.stepper.contact_set import ContactSet
 
-__all__ = ["MAX_JOINT_NODES", "ModeChoice", "decide_modes", "mode_violations", "zero_functions"]
+__all__ = ["MAX_JOINT_NODES", "RATE_NOISE", "ModeChoice", "decide_modes", "mode_violations",
+           "zero_functions"]
 
 MAX_JOINT_NODES = 3
 """Up to this many undecided nodes every combination of modes is tried; beyond, node by node."""
+RATE_NOISE = 1e-10
+"""Noise floor of the rate of a function zero by construction, relative to the force rate a
+stuck contact would see (the fingers' motion per unit s, forces / (E h L)): a rate at or below
+it does not count as growing (:func:`mode_violations`). Round-off rates are about 1e-14 of
+that scale; a stuck contact's rates in the shipped scenes are 1e-2 to 1 of it."""
 
 Attempt = Callable[[ContactSet], "Solution | SolveFailure"]
 """A solver of a contact set at the current point (the modes it is given, its own angles)."""
@@ -35,11 +44,12 @@ Attempt = Callable[[ContactSet], "Solution | SolveFailure"]
 
 def mode_violations(*, mu: float, fn: float, ft: float, fn_rate: float, ft_rate: float,
                     dtheta: float, stick: bool, slip: int, frictionless: bool,
-                    zero: set[EventFunction]) -> int:
+                    zero: set[EventFunction], rate_floor: float = 0.0) -> int:
     """Violated conditions of a mode hypothesis for one contact (0 = consistent).
 
     A function in ``zero`` (normal force or a cone margin that is zero by construction now)
-    must grow along the motion; any other must be positive. Stick: normal force and both cone
+    must grow along the motion, at a rate above ``rate_floor`` (force per unit s, the units of
+    the rates); any other must be positive. Stick: normal force and both cone
     margins; slip: normal force and slip rate of the assumed sign.
 
     >>> mode_violations(mu=0.5, fn=1.0, ft=0.8, fn_rate=0.0, ft_rate=0.0, dtheta=0.0,
@@ -47,7 +57,7 @@ def mode_violations(*, mu: float, fn: float, ft: float, fn_rate: float, ft_rate:
     1
     """
     def ok(function: EventFunction, value: float, rate: float) -> bool:
-        return rate > 0 if function in zero else value > 0
+        return rate > rate_floor if function in zero else value > 0
 
     bad = int(not ok(EventFunction.NORMAL_FORCE, fn, fn_rate))
     if stick:
@@ -89,14 +99,15 @@ class ModeChoice:
 
 
 def _violations(contacts: ContactSet, sol: Solution, k: int, zero: set[EventKey], mu: float,
-                stick: bool, slip: int) -> int:
+                stick: bool, slip: int, rate_floor: float) -> int:
     """:func:`mode_violations` of contact k in the hypothesis (stick, slip)."""
     node = int(contacts.nodes[k])
     return mode_violations(
-        mu=mu, fn=float(sol.normal()[k]), ft=float(sol.tangential()[k]),
-        fn_rate=float(sol.normal_rate()[k]), ft_rate=float(sol.tangential_rate()[k]),
+        mu=mu, fn=float(sol.normal[k]), ft=float(sol.tangential[k]),
+        fn_rate=float(sol.normal_rate[k]), ft_rate=float(sol.tangential_rate[k]),
         dtheta=float(sol.dtheta[k]), stick=bool(stick), slip=int(slip),
-        frictionless=mu == 0.0, zero={key.function for key in zero if key.node == node})
+        frictionless=mu == 0.0, zero={key.function for key in zero if key.node == node},
+        rate_floor=rate_floor)
 
 
 def _options(mu: float) -> list[tuple[bool, int]]:
@@ -105,7 +116,7 @@ def _options(mu: float) -> list[tuple[bool, int]]:
 
 
 def _node_by_node(contacts: ContactSet, idx: list[int], zero: set[EventKey], attempt: Attempt,
-                  mu: float) -> tuple:
+                  mu: float, rate_floor: float) -> tuple:
     """Node-by-node hypothesis-and-test (two passes) for many undecided nodes."""
     options = _options(mu)
     stick, slip = contacts.stick.copy(), contacts.slip.copy()
@@ -117,7 +128,7 @@ def _node_by_node(contacts: ContactSet, idx: list[int], zero: set[EventKey], att
                 sol = attempt(contacts.with_modes(stick, slip))
                 if isinstance(sol, SolveFailure):
                     continue
-                if _violations(contacts, sol, k, zero, mu, st, sl) == 0:
+                if _violations(contacts, sol, k, zero, mu, st, sl, rate_floor) == 0:
                     choice[k] = (st, sl)
                     break
             stick[k], slip[k] = choice[k]
@@ -134,7 +145,7 @@ def _no_mode(nodes: list[int], failures: list[SolveFailure]) -> Exception:
 
 
 def decide_modes(contacts: ContactSet, nodes: list[int], zero: set[EventKey], attempt: Attempt,
-                 *, mu: float) -> ModeChoice:
+                 *, mu: float, rate_floor: float = 0.0) -> ModeChoice:
     """Joint hypothesis-and-test for the modes of contact ``nodes``.
 
     Options per node in the order stick, slip +1, slip -1; every combination for up to
@@ -152,6 +163,9 @@ def decide_modes(contacts: ContactSet, nodes: list[int], zero: set[EventKey], at
         Solves a contact set at the point, or returns why not.
     mu : float
         Friction coefficient (0: every node slides).
+    rate_floor : float
+        Rates of functions in ``zero`` at or below it do not count as growing (the stepper
+        passes :data:`RATE_NOISE` x its force-rate scale).
 
     Raises
     ------
@@ -162,7 +176,7 @@ def decide_modes(contacts: ContactSet, nodes: list[int], zero: set[EventKey], at
     if len(idx) <= MAX_JOINT_NODES:
         candidates = itertools.product(_options(mu), repeat=len(idx))
     else:
-        candidates = [_node_by_node(contacts, idx, zero, attempt, mu)]
+        candidates = [_node_by_node(contacts, idx, zero, attempt, mu, rate_floor)]
     best, failures = None, []
     for combo in candidates:
         stick, slip = contacts.stick.copy(), contacts.slip.copy()
@@ -172,7 +186,8 @@ def decide_modes(contacts: ContactSet, nodes: list[int], zero: set[EventKey], at
         if isinstance(sol, SolveFailure):
             failures.append(sol)
             continue
-        bad = sum(_violations(contacts, sol, k, zero, mu, stick[k], slip[k]) for k in idx)
+        bad = sum(_violations(contacts, sol, k, zero, mu, stick[k], slip[k], rate_floor)
+                  for k in idx)
         if best is None or bad < best.violations:
             best = ModeChoice(stick, slip, sol.theta, bad)
         if bad == 0:

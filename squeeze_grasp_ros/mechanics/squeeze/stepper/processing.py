@@ -34,7 +34,8 @@ from squeeze_grasp_ros.mechanics.squeeze.event_key import WHOLE_OBJECT, EventFun
 from squeeze_grasp_ros.mechanics.squeeze.stepper.chatter import ChatterBound
 from squeeze_grasp_ros.mechanics.squeeze.stepper.contact_set import ContactSet
 from squeeze_grasp_ros.mechanics.squeeze.stepper.functions import EventFunctions
-from squeeze_grasp_ros.mechanics.squeeze.stepper.modes import decide_modes, zero_functions
+from squeeze_grasp_ros.mechanics.squeeze.stepper.modes import (RATE_NOISE, decide_modes,
+                                                                zero_functions)
 from squeeze_grasp_ros.mechanics.squeeze.stepper.solving import SetSolver
 from squeeze_grasp_ros.mechanics.vocabulary import ContactMode, EventType, Termination
 
@@ -119,6 +120,14 @@ class EventProcessor:
         return self.chatter.admit(node, self.motion.names[finger], self.depth)
 
     # ------------------------------------------------------------------ modes
+    @property
+    def rate_floor(self) -> float:
+        """The mode decision's noise floor on rates: :data:`~.modes.RATE_NOISE` x the motion
+        per unit s (in units of E h and L a contact stiffness is of order 1, so this is the
+        force rate of a stuck contact to within a factor of ten either way).
+        """
+        return RATE_NOISE * self.motion.rate
+
     def decide(self, nodes: list[int]) -> None:
         """Decide the modes of contact ``nodes`` jointly (:func:`~.modes.decide_modes`) and
         update the fresh keys: a node that sticks keeps its cone margins that were zero, one
@@ -127,7 +136,7 @@ class EventProcessor:
         zero = zero_functions(self.contacts, self.fresh)
         choice = decide_modes(self.contacts, nodes, zero,
                               lambda contacts: self.solver.attempt(contacts, self.s),
-                              mu=self.model.mu)
+                              mu=self.model.mu, rate_floor=self.rate_floor)
         if choice.violations > 0:
             self.solver.counters.ambiguous_modes += 1
         self.contacts = self.contacts.with_modes(choice.stick, choice.slip).with_theta(

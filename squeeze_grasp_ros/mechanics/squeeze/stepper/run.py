@@ -182,8 +182,8 @@ class _Call:
         h = b - a
         finger, D = self.events.contacts.finger, self.motion.translation
         r = self.motion.radius[finger]
-        pa = -sa.tangential() * r * sa.dtheta
-        pb = -sb.tangential() * r * sb.dtheta
+        pa = -sa.tangential * r * sa.dtheta
+        pb = -sb.tangential * r * sb.dtheta
         for f in range(len(self.motion.names)):
             mine = finger == f
             if not mine.any():

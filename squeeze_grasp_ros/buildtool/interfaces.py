@@ -14,7 +14,8 @@ the job without anything sourced:
    ``<prefix>/lib``;
 4. record a stamp (sources digest + build settings) so a second run is a fast no-op.
 
-It never imports rclpy. Run it as ``python -m squeeze_grasp_ros.ros.interfaces`` (or the
+It never imports rclpy (it runs before rclpy can load our interfaces), so it is a build tool,
+not part of ``ros/``. Run it as ``python -m squeeze_grasp_ros.buildtool.interfaces`` (or the
 ``squeeze-grasp ros-setup`` verb).
 """
 
@@ -478,7 +479,7 @@ def verify_import(prefix: Path) -> None:
 
 def default_source() -> Path:
     """Return ``msg_defs/`` next to the package (editable install) or in the working dir."""
-    candidates = [Path(__file__).resolve().parent.parent / "msg_defs", Path.cwd() / "msg_defs"]
+    candidates = [Path(__file__).resolve().parents[2] / "msg_defs", Path.cwd() / "msg_defs"]
     for candidate in candidates:
         if (candidate / "package.xml").is_file():
             return candidate

@@ -1,0 +1,156 @@
+# Copyright 2026 squeeze_grasp_ros developers
+# SPDX-License-Identifier: Apache-2.0
+"""The floor of a lockstep loop on rclpy: the pipeline's message graph with no work in it.
+
+:func:`bare_loop_rate` runs three nodes and a client on one executor, in the pipeline's shape
+(``squeeze-grasp run`` without recording, two devices with every sensor):
+
+- ``sim`` publishes tick t: a clock (to ``monitor`` and ``executor``), three readings per
+  device and a tick (to ``monitor``), a state (to the client): 9 messages, 10 deliveries;
+- ``monitor``, once it has the tick and all six readings of t, publishes a state (no
+  subscriber) and a status (to ``executor``): 2 messages, 1 delivery;
+- ``executor``, on the status of t, publishes one setpoint per device (to ``sim``): 2
+  messages, 2 deliveries;
+- ``sim``, once it has both setpoints, publishes tick t + 1.
+
+Every message is a ``std_msgs/Header`` whose stamp is the tick, on the pipeline's reliable
+loop QoS. The same 13 messages and 13 deliveries per tick as the pipeline, the same executor,
+and nothing else: no mechanics, no tracker, no program, no message payload.
+"""
+from __future__ import annotations
+
+import time
+
+import rclpy
+from rclpy.context import Context
+from rclpy.executors import Executor, SingleThreadedExecutor
+from rclpy.experimental import EventsExecutor
+from rclpy.node import Node
+from rclpy.signals import SignalHandlerOptions
+from std_msgs.msg import Header
+
+from squeeze_grasp_ros.ros.nodes.pipeline import loop_qos
+
+__all__ = ["DEVICES", "READINGS", "bare_loop_rate"]
+
+DEVICES = ("f1", "f2")
+READINGS = ("pose", "wrench", "tactile")
+
+
+def _header(tick: int) -> Header:
+    msg = Header()
+    msg.stamp.sec, msg.stamp.nanosec = divmod(tick, 1_000_000_000)
+    return msg
+
+
+def _tick(msg: Header) -> int:
+    return msg.stamp.sec * 1_000_000_000 + msg.stamp.nanosec
+
+
+class _Sim:
+    def __init__(self, node: Node, ticks: int) -> None:
+        qos = loop_qos(10)
+        self.ticks, self.tick, self.pending = ticks, 0, set()
+        self.pubs = [node.create_publisher(Header, "clock", qos)]
+        self.pubs += [node.create_publisher(Header, f"{d}/{r}", qos)
+                      for d in DEVICES for r in READINGS]
+        self.pubs += [node.create_publisher(Header, "state", qos),
+                      node.create_publisher(Header, "tick", qos)]
+        for d in DEVICES:
+            node.create_subscription(Header, f"{d}/setpoint",
+                                     lambda msg, d=d: self._setpoint(d, msg), qos)
+
+    def publish(self) -> None:
+        msg = _header(self.tick)
+        for pub in self.pubs:
+            pub.publish(msg)
+
+    def _setpoint(self, device: str, msg: Header) -> None:
+        if _tick(msg) != self.tick + 1:
+            return
+        self.pending.add(device)
+        if len(self.pending) == len(DEVICES):
+            self.pending = set()
+            self.tick += 1
+            if self.tick < self.ticks:
+                self.publish()
+
+
+class _Monitor:
+    def __init__(self, node: Node) -> None:
+        qos = loop_qos(10)
+        self.received: dict[int, int] = {}
+        node.create_subscription(Header, "clock", lambda _: None, qos)
+        for topic in [f"{d}/{r}" for d in DEVICES for r in READINGS] + ["tick"]:
+            node.create_subscription(Header, topic, self._reading, qos)
+        self.pubs = [node.create_publisher(Header, "contact_state", qos),
+                     node.create_publisher(Header, "status", qos)]
+
+    def _reading(self, msg: Header) -> None:
+        tick = _tick(msg)
+        self.received[tick] = self.received.get(tick, 0) + 1
+        if self.received[tick] == len(DEVICES) * len(READINGS) + 1:
+            del self.received[tick]
+            for pub in self.pubs:
+                pub.publish(msg)
+
+
+class _Executor:
+    def __init__(self, node: Node) -> None:
+        qos = loop_qos(10)
+        node.create_subscription(Header, "clock", lambda _: None, qos)
+        node.create_subscription(Header, "status", self._status, qos)
+        self.pubs = [node.create_publisher(Header, f"{d}/setpoint", qos) for d in DEVICES]
+
+    def _status(self, msg: Header) -> None:
+        out = _header(_tick(msg) + 1)
+        for pub in self.pubs:
+            pub.publish(out)
+
+
+def bare_loop_rate(ticks: int, *, executor: str = "events", namespace: str = "/bare_loop"
+                   ) -> float:
+    """Ticks per wall-clock second of the bare loop (module docstring) over ``ticks`` ticks.
+
+    Parameters
+    ----------
+    ticks : int
+        Lockstep ticks to run (after discovery has matched every subscription).
+    executor : {"events", "single"}
+        rclpy's ``EventsExecutor`` or ``SingleThreadedExecutor``, as ``squeeze-grasp run``.
+    namespace : str
+        Namespace of the loop's nodes (keep it apart from other loops on the domain).
+
+    Returns
+    -------
+    float
+        Ticks per second, wall clock, from the first tick's publication to the last tick.
+    """
+    context = Context()
+    rclpy.init(context=context, signal_handler_options=SignalHandlerOptions.NO)
+    spin: Executor = (EventsExecutor(context=context) if executor == "events"
+                      else SingleThreadedExecutor(context=context))
+    nodes = [Node(name, namespace=namespace, context=context)
+             for name in ("sim", "monitor", "executor", "client")]
+    try:
+        sim, _, _ = _Sim(nodes[0], ticks), _Monitor(nodes[1]), _Executor(nodes[2])
+        nodes[3].create_subscription(Header, "state", lambda _: None, loop_qos(10))
+        for node in nodes:
+            spin.add_node(node)
+        subscribed = [(p, 2 if p.topic_name.endswith("/clock") else 1) for p in sim.pubs]
+        deadline = time.monotonic() + 30.0
+        while not all(p.get_subscription_count() >= n for p, n in subscribed):
+            if time.monotonic() > deadline:
+                raise TimeoutError("the bare loop's subscriptions did not match within 30 s")
+            spin.spin_once(0.01)
+        started = time.perf_counter()
+        sim.publish()
+        while sim.tick < ticks:
+            spin.spin_once(1.0)
+        return ticks / (time.perf_counter() - started)
+    finally:
+        for node in nodes:
+            spin.remove_node(node)
+            node.destroy_node()
+        spin.shutdown()
+        context.try_shutdown()

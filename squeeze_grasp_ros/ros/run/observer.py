@@ -1,0 +1,135 @@
+# Copyright 2026 squeeze_grasp_ros developers
+# SPDX-License-Identifier: Apache-2.0
+"""What a run's client receives while the goal runs: the ground truth (``sim/state``,
+``sim/events``), the monitor's events and alarms, the recorder's progress and the goal's
+feedback. :meth:`Observer.observed` turns it into the :class:`.summary.Observed` of the summary.
+"""
+from __future__ import annotations
+
+from collections import Counter
+from collections.abc import Callable
+from typing import Any
+
+from rclpy.node import Node
+from rclpy.serialization import deserialize_message
+from std_msgs.msg import Header
+
+from squeeze_grasp_interfaces.action import ExecuteGrasp
+from squeeze_grasp_interfaces.msg import Alarm, ContactEvent, ContactEventArray, SimState
+
+from squeeze_grasp_ros.ros import messages
+from squeeze_grasp_ros.ros.nodes import pipeline
+from squeeze_grasp_ros.ros.nodes.recorder import cdr_stamp_ns
+from squeeze_grasp_ros.ros.run.summary import GRASP_HELD, Observed
+
+__all__ = ["Observer", "Progress"]
+
+Progress = Callable[[dict], None]
+"""Called with ``{"state", "depth", "relative_depth", "forces", "events"}`` at every feedback."""
+
+
+class Observer:
+    """The run client's subscriptions to the outcome topics, and what they received.
+
+    Parameters
+    ----------
+    node : Node
+        The run's client node.
+    progress : callable, optional
+        Called at every feedback of the goal (:data:`Progress`).
+    """
+
+    def __init__(self, node: Node, progress: Progress | None = None) -> None:
+        self.progress = progress
+        self.sim_events: list[ContactEvent] = []
+        self.world_end: dict | None = None
+        """``{"termination", "depth", "stamp_ns"}`` once the world ended."""
+        self.monitor_events: list[ContactEvent] = []
+        self.alarms: Counter = Counter()
+        self.first_alarm: dict[str, dict] = {}
+        self.sim_state_data: list[bytes] = []
+        """Every ground-truth state received, serialised (decoded on demand)."""
+        self.sim_state_ns = -1
+        self.recorder_ns = -1
+        self.feedback: list[ExecuteGrasp.Feedback] = []
+        loop = pipeline.loop_qos(1000)
+        self.subscriptions = [
+            node.create_subscription(ContactEventArray, pipeline.SIM_EVENTS, self._sim_events,
+                                     loop),
+            node.create_subscription(ContactEventArray, pipeline.EVENTS,
+                                     lambda msg: self.monitor_events.extend(msg.events), loop),
+            node.create_subscription(Alarm, pipeline.ALARMS, self._alarm, loop),
+            node.create_subscription(SimState, pipeline.SIM_STATE, self._state, loop, raw=True),
+        ]
+        """The subscriptions to the outcome topics (they must match before the goal is sent)."""
+        node.create_subscription(Header, pipeline.RECORDER_PROGRESS, self._recorder_progress,
+                                 loop)
+
+    # ----------------------------------------------------------------- callbacks
+    def _sim_events(self, msg: ContactEventArray) -> None:
+        self.sim_events += msg.events
+        if msg.termination:
+            self.world_end = {
+                "termination": msg.termination,
+                "depth": float(msg.depth),
+                "stamp_ns": messages.stamp_ns(msg.header.stamp),
+            }
+
+    def _alarm(self, msg: Alarm) -> None:
+        self.alarms[msg.type] += 1
+        self.first_alarm.setdefault(
+            msg.type,
+            {
+                "stamp_ns": messages.stamp_ns(msg.header.stamp),
+                "finger": msg.finger,
+                "message": msg.message,
+            },
+        )
+
+    def _state(self, data: bytes) -> None:
+        self.sim_state_data.append(data)
+        self.sim_state_ns = cdr_stamp_ns(data)
+
+    def _recorder_progress(self, msg: Header) -> None:
+        self.recorder_ns = max(self.recorder_ns, messages.stamp_ns(msg.stamp))
+
+    def on_feedback(self, msg: Any) -> None:
+        """The goal's feedback callback (records it, reports progress)."""
+        fb = msg.feedback
+        self.feedback.append(fb)
+        if self.progress is not None:
+            self.progress(
+                {
+                    "state": fb.state,
+                    "depth": fb.depth,
+                    "relative_depth": fb.relative_depth,
+                    "forces": {f: [v.x, v.y] for f, v in zip(fb.fingers, fb.forces)},
+                    "events": len(self.monitor_events),
+                }
+            )
+
+    # ----------------------------------------------------------------- what was received
+    def matched(self) -> bool:
+        """True once every outcome subscription has a publisher."""
+        return all(s.get_publisher_count() > 0 for s in self.subscriptions)
+
+    def world_failed(self) -> bool:
+        """True once the simulated world has ended with a termination that loses the grasp."""
+        return self.world_end is not None and self.world_end["termination"] not in GRASP_HELD
+
+    @property
+    def sim_state(self) -> SimState | None:
+        """The newest ground-truth state, or None before tick 0."""
+        return (
+            deserialize_message(self.sim_state_data[-1], SimState) if self.sim_state_data else None
+        )
+
+    @property
+    def sim_states(self) -> list[SimState]:
+        """Every ground-truth state received, in order (one per tick, re-sent ticks repeated)."""
+        return [deserialize_message(data, SimState) for data in self.sim_state_data]
+
+    def observed(self) -> Observed:
+        """What was received, for the summary."""
+        return Observed(self.sim_state, list(self.sim_events), self.world_end,
+                        list(self.monitor_events), self.alarms, self.first_alarm)

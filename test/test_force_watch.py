@@ -12,11 +12,11 @@ solid scenes' runs raise none.
 from __future__ import annotations
 
 import re
-from pathlib import Path
 
 import numpy as np
 import pytest
 import yaml
+from pipeline_support import run_scene
 
 from squeeze_grasp_ros.control.force_watch import (FORCE_MISMATCH, PredictedForces,
                                                    check_forces, force_along_motion,
@@ -120,23 +120,6 @@ def test_a_malformed_curve_is_refused():
 DEPTH = re.compile(r"at depth ([0-9.e+-]+) mm")
 
 
-def run_scene(tmp_path: Path, data: dict, world: dict | None = None) -> dict:
-    """A ``run`` of ``data`` through the real nodes (one executor); ``world``: the simulated
-    world's scene instead of ``data`` (what the planner does not know).
-    """
-    from squeeze_grasp_ros.ros.run.options import RunOptions
-    from squeeze_grasp_ros.ros.run.runner import PipelineRunner
-
-    path = tmp_path / f"{data['name']}.yaml"
-    path.write_text(yaml.safe_dump(data))
-    overrides = {}
-    if world is not None:
-        world_path = tmp_path / "world.yaml"
-        world_path.write_text(yaml.safe_dump(world))
-        overrides = {"sim_hardware": {"scene": str(world_path)}}
-    return PipelineRunner(RunOptions(str(path), overrides=overrides)).run()
-
-
 @pytest.mark.parametrize("factor", [1.3, 0.7])
 def test_a_world_E_30_percent_off_raises_force_mismatch_before_60_percent(tmp_path, factor):
     data = yaml.safe_load(FOAM.read_text())
@@ -168,11 +151,7 @@ def test_a_right_model_raises_no_force_mismatch_over_the_shipped_scenes(tmp_path
     from mcap.reader import make_reader
     from mcap_ros2.decoder import DecoderFactory
 
-    from squeeze_grasp_ros.ros.run.options import RunOptions
-    from squeeze_grasp_ros.ros.run.runner import PipelineRunner
-
-    summary = PipelineRunner(RunOptions(str(scene_file(name)),
-                                        record=str(tmp_path / "bag"))).run()
+    summary = run_scene(tmp_path, yaml.safe_load(scene_file(name).read_text()), record=True)
     assert summary["alarms"].get(FORCE_MISMATCH, 0) == 0, summary["first_alarms"]
     with open(next((tmp_path / "bag").glob("*.mcap")), "rb") as f:
         residuals = [m for _, _, _, m in make_reader(
@@ -183,3 +162,17 @@ def test_a_right_model_raises_no_force_mismatch_over_the_shipped_scenes(tmp_path
         < 0.5 * residuals[0].tolerance
     assert residuals[0].tolerance == 0.1
     assert min(r.depth for r in residuals) >= 0.01 * summary["prediction"]["depth"]
+
+
+def test_run_refuses_a_missing_world_in_one_line(tmp_path):
+    import subprocess
+
+    from executables import script
+
+    done = subprocess.run([script("squeeze-grasp"), "run", str(FOAM), "--world",
+                           str(tmp_path / "no_world.yaml")], capture_output=True, text=True,
+                          timeout=120)
+    assert done.returncode == 2
+    assert done.stderr.strip().splitlines() == [
+        f"squeeze-grasp run: error: --world must name a scene YAML file, got "
+        f"'{tmp_path / 'no_world.yaml'}' (no such file)"]

@@ -83,3 +83,22 @@ def match_within(expected, observed, ticks: int) -> list[str]:
         if len(a) != len(b) or any(abs(x - y) > ticks for x, y in zip(a, b)):
             problems.append(f"{key}: ground truth at ticks {a}, monitor at {b}")
     return problems
+
+
+def run_scene(tmp_path: Path, data: dict, world: dict | None = None, record: bool = False):
+    """A ``run`` of scene ``data`` through the real nodes (one executor); ``world``: the
+    simulated world's scene instead (what the planner does not know); ``record``: into
+    ``tmp_path / "bag"``. Returns the run's summary.
+    """
+    from squeeze_grasp_ros.ros.run.options import RunOptions
+    from squeeze_grasp_ros.ros.run.runner import PipelineRunner
+
+    path = tmp_path / f"{data['name']}.yaml"
+    path.write_text(yaml.safe_dump(data))
+    overrides = {}
+    if world is not None:
+        world_path = tmp_path / "world.yaml"
+        world_path.write_text(yaml.safe_dump(world))
+        overrides = {"sim_hardware": {"scene": str(world_path)}}
+    return PipelineRunner(RunOptions(str(path), overrides=overrides,
+                                     record=str(tmp_path / "bag") if record else None)).run()

@@ -22,6 +22,7 @@ import pytest
 import yaml
 
 from perception_support import skimage_or_skip
+from pipeline_support import run_scene
 from squeeze_grasp_ros.mechanics.vocabulary import Effect, ObjectModel
 from squeeze_grasp_ros.perception.shape_match import deformed_outline
 from squeeze_grasp_ros.perception.shape_watch import PredictedShapes, check_frame
@@ -202,21 +203,6 @@ def test_the_shape_watch_catches_a_larger_object_and_names_why_not_nu():
 
 
 # --------------------------------------------------------------------------- on real rclpy
-
-
-def run_scene(tmp_path: Path, data: dict, world: dict | None = None, record: bool = False):
-    from squeeze_grasp_ros.ros.run.options import RunOptions
-    from squeeze_grasp_ros.ros.run.runner import PipelineRunner
-
-    path = tmp_path / f"{data['name']}.yaml"
-    path.write_text(yaml.safe_dump(data))
-    overrides = {}
-    if world is not None:
-        world_path = tmp_path / "world.yaml"
-        world_path.write_text(yaml.safe_dump(world))
-        overrides = {"sim_hardware": {"scene": str(world_path)}}
-    return PipelineRunner(RunOptions(str(path), overrides=overrides,
-                                     record=str(tmp_path / "bag") if record else None)).run()
 
 
 def test_the_camera_closed_run_matches_the_yaml_route(tmp_path):

@@ -17,6 +17,7 @@ from pathlib import Path
 
 from squeeze_grasp_ros.exit_codes import ExitCode, raise_on_signals
 from squeeze_grasp_ros.commands.common import add_scene_argument, fail, new_folder
+from squeeze_grasp_ros.control.force_watch import FORCE_MISMATCH
 from squeeze_grasp_ros.control.motion import REACTIONS
 
 EXECUTOR_CHOICES: tuple[str, ...] = ("events", "single")
@@ -25,7 +26,9 @@ parser never imports rclpy: ``squeeze-grasp ros-setup`` must run before the inte
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    """SCENE, --record DIR, --processes, --executor, --on-slip-alarm, --no-resist, --no-planner."""
+    """SCENE, --record DIR, --processes, --executor, --on-slip-alarm, --world, --no-resist,
+    --no-planner.
+    """
     add_scene_argument(parser)
     parser.add_argument("--record", metavar="DIR", type=new_folder,
                         help="record every topic into this rosbag2 folder (MCAP storage); if "
@@ -50,6 +53,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="executor reaction to an imminent-slip alarm: hold (default), or "
                              "change the squeeze direction once to the pure squeeze or along the "
                              "measured contact normals")
+    parser.add_argument("--world", metavar="SCENE",
+                        help="scene YAML of the simulated world (default: SCENE itself): a "
+                             "world the planner does not know, e.g. another E or outline, to "
+                             "see the monitor's force and shape watches catch the model error")
     parser.add_argument("--no-resist", action="store_true",
                         help="skip the resistance phase of a scene with a frictional adversary")
     parser.add_argument("--no-planner", action="store_true",
@@ -114,7 +121,13 @@ def _run(args: argparse.Namespace) -> dict | int:
         if refused is not None:
             return fail(args, refused[0], refused[1])
 
-    options = RunOptions(args.scene, record=args.record,
+    overrides = {}
+    if args.world is not None:
+        if not Path(args.world).is_file():
+            return fail(args, f"--world must name a scene YAML file, got {args.world!r} (no "
+                              "such file)", ExitCode.USAGE)
+        overrides = {"sim_hardware": {"scene": str(Path(args.world).resolve())}}
+    options = RunOptions(args.scene, record=args.record, overrides=overrides,
                          include_hidden_topics=args.include_hidden_topics, attach=args.attach,
                          processes=args.processes,
                          executor=args.executor, on_slip_alarm=args.on_slip_alarm,
@@ -225,6 +238,9 @@ def summary(result: dict) -> str:
         f"wall time {timing['total']:.2f} s (plan {timing['plan']:.2f} s, nodes "
         f"{timing['start_nodes']:.2f} s, lockstep loop {timing['loop']:.2f} s)",
     ]
+    first = result["first_alarms"].get(FORCE_MISMATCH)
+    if first:  # the force watch's verdict on the model: where the forces first left it
+        lines.insert(5, f"first {FORCE_MISMATCH}: {first['message']}")
     seen = result.get("seen_outline")
     if seen:
         lines.insert(1, f"camera: planned from the first frame's outline ({seen['vertices']} "

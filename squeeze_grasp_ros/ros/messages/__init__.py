@@ -77,6 +77,8 @@ from squeeze_grasp_ros.ros.messages.monitor import (
     patches_state_msg,
     monitor_status_msg,
     prediction_msg,
+    force_curve,
+    predicted_forces,
     predicted_events,
 )
 from squeeze_grasp_ros.ros.messages.objects import (
@@ -147,6 +149,8 @@ __all__ = [
     "pose_position",
     "predicted_events",
     "prediction_msg",
+    "force_curve",
+    "predicted_forces",
     "resistance_fields",
     "ring_grasp_test_response",
     "seen_outline_msg",

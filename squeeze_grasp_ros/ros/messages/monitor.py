@@ -17,6 +17,7 @@ from squeeze_grasp_interfaces.msg import (
     MonitorStatus,
 )
 
+from squeeze_grasp_ros.control.force_watch import PredictedForces
 from squeeze_grasp_ros.control.tracker import (
     PredictedEvent,
     TrackedAlarm,
@@ -105,10 +106,32 @@ def monitor_status_msg(out: TrackerOutput, frame_id: str) -> MonitorStatus:
 
 
 def prediction_msg(
-    events: Sequence[ContactEvent], termination: str, depth: float
+    events: Sequence[ContactEvent], termination: str, depth: float,
+    forces: PredictedForces | None = None,
 ) -> ContactEventArray:
-    """The planner's predicted events as ``ContactEventArray``."""
-    return ContactEventArray(events=list(events), termination=termination, depth=float(depth))
+    """The planner's predicted events as ``ContactEventArray``, with its force curve
+    (``forces``) for the monitor's force watch.
+    """
+    msg = ContactEventArray(events=list(events), termination=termination, depth=float(depth))
+    if forces is not None:
+        msg.force_depths = float64_array(forces.depths)
+        msg.force_f1 = float64_array(forces.forces[Finger.F1])
+        msg.force_f2 = float64_array(forces.forces[Finger.F2])
+    return msg
+
+
+def force_curve(depths: Sequence[float], f1: Sequence[float],
+                f2: Sequence[float]) -> PredictedForces | None:
+    """A force curve from message arrays (m; N, N), None when it has fewer than two points."""
+    if len(depths) < 2:
+        return None
+    return PredictedForces(np.asarray(depths, float), {Finger.F1: np.asarray(f1, float),
+                                                       Finger.F2: np.asarray(f2, float)})
+
+
+def predicted_forces(msg: ContactEventArray) -> PredictedForces | None:
+    """The force curve of a prediction (None when it has none)."""
+    return force_curve(msg.force_depths, msg.force_f1, msg.force_f2)
 
 
 def predicted_events(msg: ContactEventArray) -> list[PredictedEvent]:

@@ -21,6 +21,7 @@ from squeeze_grasp_interfaces.msg import (
 )
 from squeeze_grasp_interfaces.srv import LoadObject, PlanResistance, PlanSqueeze, RingGraspTest
 
+from squeeze_grasp_ros.control.force_watch import squeeze_forces
 from squeeze_grasp_ros.mechanics.squeeze.graspmap import GraspMap
 
 from squeeze_grasp_ros.mechanics.resistance.frictional import FrictionalResistance
@@ -293,6 +294,7 @@ def event_squeeze_data(result: EventSqueeze, object_id: str, *,
     with the measures of its strain and stress.
     """
     health = result.health
+    curve = squeeze_forces(result)
     return EventSqueezeData(
         object_id=object_id,
         object_digest=digest,
@@ -318,6 +320,9 @@ def event_squeeze_data(result: EventSqueeze, object_id: str, *,
         max_von_mises=health.max_von_mises,
         stress_measure=str(health.stress_measure),
         max_displacement=health.max_displacement,
+        curve_depths=float64_array(curve.depths if curve else []),
+        curve_force_f1=float64_array(curve.forces[Finger.F1] if curve else []),
+        curve_force_f2=float64_array(curve.forces[Finger.F2] if curve else []),
     )
 
 

@@ -19,9 +19,13 @@ becomes active; ``monitor/status`` lists the alarms active at every tick), the r
 prediction (``planner/predicted_events``, latched) is compared with the observed
 events. With ``shape_watch`` the camera's frames are matched against the predicted deformed
 boundary (:mod:`.shape_watcher`): ``monitor/shape_residual`` and the ``shape_mismatch`` alarm.
+With ``force_watch`` (on by default) the measured finger forces are compared with the
+prediction's force curve (:mod:`.force_watcher`): ``monitor/force_residual`` and the
+``force_mismatch`` alarm (a wrong E: the shape cannot show it, the forces do).
 """
 from __future__ import annotations
 
+import dataclasses
 import sys
 
 from typing import Any
@@ -35,6 +39,7 @@ from squeeze_grasp_interfaces.msg import (Alarm, ContactEventArray, ContactState
 from squeeze_grasp_ros.ros import messages
 from squeeze_grasp_ros.control.tracker import ContactTracker, FingerSample, TrackerConfig
 from squeeze_grasp_ros.ros.nodes import pipeline, run_node
+from squeeze_grasp_ros.ros.nodes.force_watcher import ForceWatcher
 from squeeze_grasp_ros.ros.nodes.shape_watcher import ShapeWatcher
 
 PARAMETERS: dict[str, tuple[Any, str]] = {
@@ -57,6 +62,9 @@ PARAMETERS: dict[str, tuple[Any, str]] = {
     "shape_watch": (False, "match camera frames against planner/predicted_shapes (App. C)"),
     "shape_mismatch_threshold": (5e-4, "RMS residual that raises shape_mismatch, m"),
     "object_height": (0.0, "shape watch: height of the object's top face above the plane, m"),
+    "force_watch": (True, "compare finger forces with the prediction's force curve"),
+    "force_tolerance": (0.1, "relative force error that raises force_mismatch"),
+    "force_min_fraction": (0.01, "force watch: fraction of the predicted depth not judged"),
 }
 """Parameter name -> (typed default, description); config/monitor.yaml sets them."""
 
@@ -96,6 +104,8 @@ class MonitorNode(Node):
         self.active_alarms: set[tuple[str, str]] = set()
         self.shapes = (ShapeWatcher(self, self.alarm_pub, p["shape_mismatch_threshold"],
                                     p["object_height"]) if p["shape_watch"] else None)
+        self.forces = (ForceWatcher(self, p["force_tolerance"], p["force_min_fraction"], loop)
+                       if p["force_watch"] else None)
         if p["lockstep"]:
             self.create_subscription(Tick, pipeline.TICK, self._tick, loop)
             self.participant = pipeline.Participant(self, "monitor", [pipeline.TICK],
@@ -113,6 +123,8 @@ class MonitorNode(Node):
 
     def _prediction(self, msg: ContactEventArray) -> None:
         self.tracker.set_prediction(messages.predicted_events(msg))
+        if self.forces is not None:
+            self.forces.set_prediction(msg)
 
     def _reading(self, key: str, msg: Any) -> None:
         ns = messages.stamp_ns(msg.header.stamp)
@@ -160,9 +172,14 @@ class MonitorNode(Node):
         return {f: FingerSample(**v) for f, v in fields.items()}
 
     def _process(self, ns: int) -> None:
-        out = self.tracker.update(ns, self._samples())
+        samples = self._samples()
+        out = self.tracker.update(ns, samples)
         frame = self.p["frame_id"]
         batch = [(self.event_pub, messages.tracked_events_msg(out))] if out.events else []
+        if self.forces is not None:
+            residual, alarms = self.forces.tick(out, samples, frame)
+            batch += residual
+            out = dataclasses.replace(out, alarms=out.alarms + alarms)
         active = {(a.type, a.finger) for a in out.alarms}
         batch += [(self.alarm_pub, messages.alarm_msg(a, ns)) for a in out.alarms
                   if (a.type, a.finger) not in self.active_alarms]

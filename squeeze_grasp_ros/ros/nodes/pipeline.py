@@ -57,6 +57,7 @@ OUTLINE = "outline/outline"
 SEEN_OUTLINE = "outline/seen"
 OUTLINE_ERRORS = "outline/errors"
 SHAPE_RESIDUAL = "monitor/shape_residual"
+FORCE_RESIDUAL = "monitor/force_residual"
 PREDICTED_SHAPES = "planner/predicted_shapes"
 
 
@@ -99,6 +100,7 @@ def pipeline_topics(devices: Iterable[str], *, hidden: bool = False,
         CONTACT_STATE: "squeeze_grasp_interfaces/msg/ContactState",
         EVENTS: "squeeze_grasp_interfaces/msg/ContactEventArray",
         ALARMS: "squeeze_grasp_interfaces/msg/Alarm",
+        FORCE_RESIDUAL: "squeeze_grasp_interfaces/msg/ForceResidual",
         PREDICTION: "squeeze_grasp_interfaces/msg/ContactEventArray",
         EXECUTOR_STATUS: "squeeze_grasp_interfaces/msg/ExecutorStatus",
         OBJECT_POSE: "geometry_msgs/msg/PoseStamped",

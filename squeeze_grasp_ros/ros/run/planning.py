@@ -31,6 +31,7 @@ from squeeze_grasp_interfaces.msg import ContactEventArray, ObjectDescription
 from squeeze_grasp_interfaces.srv import EventSqueeze, LoadObject, PlanSqueeze
 
 from squeeze_grasp_ros import planning
+from squeeze_grasp_ros.control.force_watch import squeeze_forces
 from squeeze_grasp_ros.control.motion import GraspGoal
 from squeeze_grasp_ros.mechanics.vocabulary import SQUEEZING_FINGERS, ShapeType, SqueezeKind
 from squeeze_grasp_ros.resources import config_dir, share_dir
@@ -225,8 +226,10 @@ def plan_with_planner(planner: PlannerClient, run_object: RunObject, scene_path:
     goal = GraspGoal(SQUEEZING_FINGERS, directions, squeeze.target_depth, rpd,
                      options.on_slip_alarm, np.asarray(pure.displacement, float).reshape(2, 2),
                      **resistance)
-    prediction = messages.prediction_msg(list(squeeze.events), squeeze.termination,
-                                         squeeze.depth)
+    prediction = messages.prediction_msg(
+        list(squeeze.events), squeeze.termination, squeeze.depth,
+        messages.force_curve(squeeze.curve_depths, squeeze.curve_force_f1,
+                             squeeze.curve_force_f2))
     return Plan(goal, prediction, "planner", time.perf_counter() - t0)
 
 
@@ -248,7 +251,7 @@ def plan_with_mechanics(run_object: RunObject, options: RunOptions) -> Plan:
     squeeze = plan.squeeze
     prediction = messages.prediction_msg(
         [messages.contact_event_msg(e) for e in squeeze.events], squeeze.termination,
-        squeeze.depth)
+        squeeze.depth, squeeze_forces(squeeze))
     return Plan(plan.goal, prediction, "mechanics", plan.seconds)
 
 

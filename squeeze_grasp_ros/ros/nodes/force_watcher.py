@@ -1,0 +1,67 @@
+# Copyright 2026 squeeze_grasp_ros developers
+# SPDX-License-Identifier: Apache-2.0
+"""The monitor's force watch (parameter ``force_watch``): measured finger forces against the
+planner's force curve (:mod:`squeeze_grasp_ros.control.force_watch`).
+
+The curve comes with the planner's latched prediction (``planner/predicted_events``: its
+``force_depths``, ``force_f1``, ``force_f2``); a prediction without one switches the watch off.
+At every tick the monitor closes within the predicted depth (past its first
+``force_min_fraction``), the measured force on the object of each finger with a wrench or
+tactile sensor (the negated wrench, else the taxel sum) along its measured motion (its position
+against its first) is compared with the prediction at the measured depth:
+``monitor/force_residual`` (``ForceResidual``), and a ``force_mismatch`` alarm for a finger
+whose relative error exceeds ``force_tolerance`` (value: the relative error).
+"""
+from __future__ import annotations
+
+from collections.abc import Mapping
+from typing import Any
+
+import numpy as np
+from rclpy.node import Node
+
+from squeeze_grasp_interfaces.msg import ContactEventArray, ForceResidual
+
+from squeeze_grasp_ros.control.force_watch import (PredictedForces, check_forces,
+                                                   force_along_motion)
+from squeeze_grasp_ros.control.tracker import FingerSample, TrackedAlarm, TrackerOutput
+from squeeze_grasp_ros.ros import messages
+from squeeze_grasp_ros.ros.nodes import pipeline
+
+
+class ForceWatcher:
+    """Compares forces for ``node`` (the monitor), which calls :meth:`tick` before its status."""
+
+    def __init__(self, node: Node, tolerance: float, min_fraction: float, qos: Any) -> None:
+        self.tolerance, self.min_fraction = tolerance, min_fraction
+        self.prediction: PredictedForces | None = None
+        self.start: dict[str, np.ndarray] = {}
+        self.residual_pub = node.create_publisher(ForceResidual, pipeline.FORCE_RESIDUAL, qos)
+
+    def set_prediction(self, msg: ContactEventArray) -> None:
+        """Take the force curve of the planner's prediction (none: the watch is idle)."""
+        self.prediction = messages.predicted_forces(msg)
+
+    def tick(self, out: TrackerOutput, samples: Mapping[str, FingerSample],
+             frame_id: str) -> tuple[list[tuple[Any, Any]], tuple[TrackedAlarm, ...]]:
+        """The tick's residual message (as ``(publisher, message)``) and its alarms; only
+        fingers with a wrench or tactile reading in ``samples`` are judged.
+        """
+        for finger, position in out.positions.items():
+            self.start.setdefault(finger, position)
+        if self.prediction is None:
+            return [], ()
+        measured = {f: force_along_motion(out.forces[f], out.positions[f], self.start[f])
+                    for f, s in samples.items() if f in out.positions
+                    and (s.force is not None or s.normal is not None)}
+        check = check_forces(self.prediction, out.depth, measured, tolerance=self.tolerance,
+                             min_fraction=self.min_fraction)
+        if check is None:
+            return [], ()
+        fingers = list(check.measured)
+        msg = ForceResidual(header=messages.header(out.stamp_ns, frame_id), depth=check.depth,
+                            fingers=fingers, tolerance=float(self.tolerance),
+                            measured=[check.measured[f] for f in fingers],
+                            predicted=[check.predicted[f] for f in fingers],
+                            relative_error=[check.relative_error[f] for f in fingers])
+        return [(self.residual_pub, msg)], check.alarms

@@ -22,16 +22,22 @@ import shutil
 from pathlib import Path
 
 from launch import LaunchDescription
-from launch.actions import (DeclareLaunchArgument, EmitEvent, ExecuteProcess, LogInfo,
-                            OpaqueFunction, RegisterEventHandler)
+from launch.actions import (
+    DeclareLaunchArgument,
+    EmitEvent,
+    ExecuteProcess,
+    LogInfo,
+    OpaqueFunction,
+    RegisterEventHandler,
+)
 from launch.event_handlers import OnProcessExit
 from launch.events import Shutdown
 from launch.substitutions import LaunchConfiguration
 from launch_ros.actions import Node
 from launch_ros.substitutions import ExecutableInPackage
 
-from squeeze_grasp_ros.ros.run.options import RunOptions, node_parameters
 from squeeze_grasp_ros.resources import config_dir, scene_file, viewer_file
+from squeeze_grasp_ros.ros.run.options import RunOptions, node_parameters
 from squeeze_grasp_ros.scene import GraspSetup, load_scene
 
 TRUE = ("true", "1", "yes", "on")

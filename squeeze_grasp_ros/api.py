@@ -48,19 +48,27 @@ depth_reached A
 """
 from __future__ import annotations
 
-from squeeze_grasp_ros.mechanics.calibration.hyperelastic_fit import (CompressionCurve,
-                                                                   fit_compression)
-from squeeze_grasp_ros.mechanics.calibration.material_fit import Cuboid, calibrate_elasticity
+from squeeze_grasp_ros.mechanics.calibration.hyperelastic_fit import (
+                                                                   CompressionCurve,
+                                                                   fit_compression,
+)
 from squeeze_grasp_ros.mechanics.calibration.matching import match_similarity
+from squeeze_grasp_ros.mechanics.calibration.material_fit import Cuboid, calibrate_elasticity
 from squeeze_grasp_ros.mechanics.elastic.compliance import ElasticObject
 from squeeze_grasp_ros.mechanics.elastic.material import Material
 from squeeze_grasp_ros.mechanics.elastic.mesh import Mesh, generate_mesh
 from squeeze_grasp_ros.mechanics.elastic.reduced import ReducedStiffness, reduced_stiffness
-from squeeze_grasp_ros.mechanics.errors import (InfeasibleError, InternalError,
-                                               InvalidInputError, NumericalError,
-                                               SqueezeGraspError)
-from squeeze_grasp_ros.mechanics.resistance.frictional import (FrictionalResistance,
-                                                               frictional_resistance)
+from squeeze_grasp_ros.mechanics.errors import (
+                                                                   InfeasibleError,
+                                                                   InternalError,
+                                                                   InvalidInputError,
+                                                                   NumericalError,
+                                                                   SqueezeGraspError,
+)
+from squeeze_grasp_ros.mechanics.resistance.frictional import (
+                                                                   FrictionalResistance,
+                                                                   frictional_resistance,
+)
 from squeeze_grasp_ros.mechanics.resistance.optimal import optimal_resistance, resistance_grasp
 from squeeze_grasp_ros.mechanics.ring.grasp_map import ring_grasp_map
 from squeeze_grasp_ros.mechanics.ring.model import RingModel
@@ -70,19 +78,34 @@ from squeeze_grasp_ros.mechanics.squeeze.contact_state import ContactState, Even
 from squeeze_grasp_ros.mechanics.squeeze.events import EventSqueeze, event_squeeze
 from squeeze_grasp_ros.mechanics.squeeze.graspmap import GraspMap, grasp_map
 from squeeze_grasp_ros.mechanics.squeeze.stable_pure import Squeeze, plan_squeeze
-from squeeze_grasp_ros.mechanics.vocabulary import (ContactMode, EventType, Finger,
-                                                    ImageEncoding, MaterialModel, ShapeFit,
-                                                    SqueezeKind, StrainCriterion, StrainMeasure,
-                                                    StressMeasure, Termination)
+from squeeze_grasp_ros.mechanics.vocabulary import (
+                                                                   ContactMode,
+                                                                   EventType,
+                                                                   Finger,
+                                                                   ImageEncoding,
+                                                                   MaterialModel,
+                                                                   ShapeFit,
+                                                                   SqueezeKind,
+                                                                   StrainCriterion,
+                                                                   StrainMeasure,
+                                                                   StressMeasure,
+                                                                   Termination,
+)
 from squeeze_grasp_ros.perception.camera import CameraModel, CameraPose
 from squeeze_grasp_ros.perception.camera_info import camera_from_info
 from squeeze_grasp_ros.perception.extract import ObjectOutline, extract_outline
 from squeeze_grasp_ros.perception.render import CameraViews, render_views
-from squeeze_grasp_ros.perception.shape_match import (ShapeMatch, deformed_outline,
-                                                      shape_residual)
+from squeeze_grasp_ros.perception.shape_match import ShapeMatch, deformed_outline, shape_residual
 from squeeze_grasp_ros.resources import scene_file
-from squeeze_grasp_ros.scene import (GraspSetup, Scene, build_mesh, event_squeeze_scene,
-                                     finger_nodes, load_scene, scene_solid)
+from squeeze_grasp_ros.scene import (
+                                                                   GraspSetup,
+                                                                   Scene,
+                                                                   build_mesh,
+                                                                   event_squeeze_scene,
+                                                                   finger_nodes,
+                                                                   load_scene,
+                                                                   scene_solid,
+)
 
 __all__ = [
     # scenes

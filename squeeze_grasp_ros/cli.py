@@ -79,8 +79,11 @@ def exit_code(error: Exception) -> ExitCode:
     """The exit code of an error of the package (:mod:`.mechanics.errors`, by who must act):
     2 for invalid input, 1 for a physical "no", 3 for a failed solver, 4 otherwise.
     """
-    from squeeze_grasp_ros.mechanics.errors import (InfeasibleError, InvalidInputError,
-                                                   NumericalError)
+    from squeeze_grasp_ros.mechanics.errors import (
+        InfeasibleError,
+        InvalidInputError,
+        NumericalError,
+    )
 
     codes = ((InvalidInputError, ExitCode.USAGE), (InfeasibleError, ExitCode.OUTCOME),
              (NumericalError, ExitCode.NUMERICAL))

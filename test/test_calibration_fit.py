@@ -10,7 +10,12 @@ import pytest
 
 from squeeze_grasp_ros.cli import main
 from squeeze_grasp_ros.mechanics.calibration.hyperelastic_fit import (
-    CompressionCurve, MaterialFit, fit_compression, linear_validity, uniaxial_response)
+    CompressionCurve,
+    MaterialFit,
+    fit_compression,
+    linear_validity,
+    uniaxial_response,
+)
 from squeeze_grasp_ros.mechanics.elastic import hyperelastic
 from squeeze_grasp_ros.mechanics.vocabulary import MaterialModel
 

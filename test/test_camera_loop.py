@@ -20,9 +20,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 import yaml
-
 from perception_support import skimage_or_skip
 from pipeline_support import run_scene
+
 from squeeze_grasp_ros.mechanics.vocabulary import Effect, ObjectModel
 from squeeze_grasp_ros.perception.shape_match import deformed_outline
 from squeeze_grasp_ros.perception.shape_watch import PredictedShapes, check_frame

@@ -42,12 +42,22 @@ from pathlib import Path
 import doc_ros_session
 import numpy as np
 import pytest
+from doc_transcripts import (
+    MASKS,
+    PAGES,
+    REPO,
+    Command,
+    Transcript,
+    blocks,
+    compare,
+    line_matches,
+    number_matches,
+    transcripts,
+)
 from executables import script
 
 from squeeze_grasp_ros.exit_codes import ExitCode
 from squeeze_grasp_ros.extras import install_hint
-from doc_transcripts import (MASKS, PAGES, REPO, Command, Transcript, blocks, compare,
-                             line_matches, number_matches, transcripts)
 
 LINKED = ("launch", "msg_defs")
 SLOW_VERBS = ("run", "replay", "sweep", "bench")

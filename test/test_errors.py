@@ -14,11 +14,16 @@ import pytest
 from squeeze_grasp_ros.cli import main
 from squeeze_grasp_ros.exit_codes import ExitCode
 from squeeze_grasp_ros.mechanics import errors
-from squeeze_grasp_ros.mechanics.squeeze import contact_model
 from squeeze_grasp_ros.mechanics.elastic.compliance import ElasticObject
+from squeeze_grasp_ros.mechanics.squeeze import contact_model
 from squeeze_grasp_ros.planning import ErrorCode, PlannerError, classify
-from squeeze_grasp_ros.scene import build_mesh, finger_nodes, load_scene, scene_material
-from squeeze_grasp_ros.scene import event_squeeze_scene
+from squeeze_grasp_ros.scene import (
+    build_mesh,
+    event_squeeze_scene,
+    finger_nodes,
+    load_scene,
+    scene_material,
+)
 
 REPO = Path(__file__).resolve().parents[1]
 MECHANICS = REPO / "squeeze_grasp_ros" / "mechanics"

@@ -11,8 +11,11 @@ import numpy as np
 from hypothesis import assume, given
 from hypothesis import strategies as st
 
-from squeeze_grasp_ros.mechanics.squeeze.stepper.location import (hermite_dips, hermite_root,
-                                                                  locate_sign_change)
+from squeeze_grasp_ros.mechanics.squeeze.stepper.location import (
+    hermite_dips,
+    hermite_root,
+    locate_sign_change,
+)
 
 coefficient = st.floats(-4.0, 4.0)
 

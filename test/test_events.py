@@ -10,25 +10,24 @@ import functools
 
 import numpy as np
 import pytest
-
 from contact_support import check_state
 
 from squeeze_grasp_ros.mechanics.elastic import shapes
 from squeeze_grasp_ros.mechanics.elastic.compliance import ElasticObject
-from squeeze_grasp_ros.mechanics.squeeze.contact_model import ContactModel
-from squeeze_grasp_ros.mechanics.squeeze.contact_state import ContactState, initial_state
-from squeeze_grasp_ros.mechanics.squeeze.fingertips import place_fingertip
 from squeeze_grasp_ros.mechanics.elastic.material import Material
 from squeeze_grasp_ros.mechanics.elastic.mesh import (
     generate_mesh,
     mesh_from_triangles,
     target_max_area,
 )
+from squeeze_grasp_ros.mechanics.squeeze.contact_model import ContactModel
+from squeeze_grasp_ros.mechanics.squeeze.contact_state import ContactState, initial_state
+from squeeze_grasp_ros.mechanics.squeeze.events import event_squeeze
+from squeeze_grasp_ros.mechanics.squeeze.fingertips import place_fingertip
 from squeeze_grasp_ros.mechanics.squeeze.oneshot import one_shot_solve
 from squeeze_grasp_ros.mechanics.squeeze.stable_pure import plan_squeeze
-from squeeze_grasp_ros.mechanics.squeeze.events import event_squeeze
-from squeeze_grasp_ros.mechanics.vocabulary import EventType
 from squeeze_grasp_ros.mechanics.squeeze.stepper import advance
+from squeeze_grasp_ros.mechanics.vocabulary import EventType
 
 FOAM = Material(5e4, 0.3, 0.0254)
 RADIUS = 0.02

@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 from squeeze_grasp_ros import cli
-from squeeze_grasp_ros.mechanics.elastic import shapes
+from squeeze_grasp_ros.mechanics.calibration.matching import match_similarity
 from squeeze_grasp_ros.mechanics.calibration.material_fit import (
     Cuboid,
     bisect_slope,
@@ -20,11 +20,11 @@ from squeeze_grasp_ros.mechanics.calibration.material_fit import (
     friction_from_angle,
     friction_from_trials,
 )
+from squeeze_grasp_ros.mechanics.elastic import shapes
 from squeeze_grasp_ros.mechanics.elastic.compliance import ElasticObject
-from squeeze_grasp_ros.mechanics.errors import InvalidInputError
-from squeeze_grasp_ros.mechanics.calibration.matching import match_similarity
 from squeeze_grasp_ros.mechanics.elastic.material import Material
 from squeeze_grasp_ros.mechanics.elastic.mesh import generate_mesh
+from squeeze_grasp_ros.mechanics.errors import InvalidInputError
 
 SCENES = Path(__file__).resolve().parents[1] / "config" / "scenes"
 

@@ -14,11 +14,16 @@ import pytest
 import yaml
 
 from squeeze_grasp_ros import cli
-from squeeze_grasp_ros.mechanics.squeeze.contact_model import TerminationLimits
 from squeeze_grasp_ros.mechanics.elastic.fem import element_strains, principal_strains
+from squeeze_grasp_ros.mechanics.squeeze.contact_model import TerminationLimits
 from squeeze_grasp_ros.mechanics.squeeze.events import event_squeeze
-from squeeze_grasp_ros.scene import SceneError, parse_scene
-from squeeze_grasp_ros.scene import GraspSetup, event_squeeze_scene, load_scene
+from squeeze_grasp_ros.scene import (
+    GraspSetup,
+    SceneError,
+    event_squeeze_scene,
+    load_scene,
+    parse_scene,
+)
 
 SCENES = Path(__file__).resolve().parents[1] / "config" / "scenes"
 

@@ -10,8 +10,8 @@ import numpy as np
 import pytest
 
 from squeeze_grasp_ros.bench.events import event_error, foam_square
-from squeeze_grasp_ros.mechanics.squeeze.oneshot import one_shot_solve
 from squeeze_grasp_ros.mechanics.squeeze.events import event_squeeze
+from squeeze_grasp_ros.mechanics.squeeze.oneshot import one_shot_solve
 from squeeze_grasp_ros.scene import GraspSetup, load_scene
 
 SCENES = Path(__file__).resolve().parents[1] / "config" / "scenes"

@@ -18,9 +18,13 @@ import pytest
 import yaml
 from pipeline_support import run_scene
 
-from squeeze_grasp_ros.control.force_watch import (FORCE_MISMATCH, PredictedForces,
-                                                   check_forces, force_along_motion,
-                                                   squeeze_forces)
+from squeeze_grasp_ros.control.force_watch import (
+    FORCE_MISMATCH,
+    PredictedForces,
+    check_forces,
+    force_along_motion,
+    squeeze_forces,
+)
 from squeeze_grasp_ros.mechanics.errors import InvalidInputError
 from squeeze_grasp_ros.mechanics.vocabulary import Finger
 from squeeze_grasp_ros.resources import scene_file

@@ -20,13 +20,15 @@ from squeeze_grasp_ros.mechanics.elastic.mesh import generate_mesh, target_max_a
 from squeeze_grasp_ros.mechanics.errors import InfeasibleError
 from squeeze_grasp_ros.mechanics.squeeze.events import event_squeeze
 from squeeze_grasp_ros.mechanics.squeeze.graspmap import grasp_map
-from squeeze_grasp_ros.mechanics.squeeze.gripper_grasp import (evaluate_candidate,
-                                                               gripper_candidates)
+from squeeze_grasp_ros.mechanics.squeeze.gripper_grasp import (
+    evaluate_candidate,
+    gripper_candidates,
+)
+from squeeze_grasp_ros.mechanics.vocabulary import Finger
 from squeeze_grasp_ros.resources import device_file, scene_file
 from squeeze_grasp_ros.scene import GraspSetup, load_scene
 from squeeze_grasp_ros.scene.gripper import GripperError, load_gripper, parse_gripper
 from squeeze_grasp_ros.scene.gripper_plan import plan_gripper_grasp
-from squeeze_grasp_ros.mechanics.vocabulary import Finger
 
 E, THICKNESS = 5e4, 0.01
 W, H = 0.06, 0.03

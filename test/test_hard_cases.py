@@ -13,8 +13,6 @@ import pytest
 
 from squeeze_grasp_ros.mechanics.elastic import shapes
 from squeeze_grasp_ros.mechanics.elastic.compliance import ElasticObject
-from squeeze_grasp_ros.mechanics.errors import ConditioningWarning, InvalidInputError
-from squeeze_grasp_ros.mechanics.squeeze.graspmap import grasp_map
 from squeeze_grasp_ros.mechanics.elastic.material import Material
 from squeeze_grasp_ros.mechanics.elastic.mesh import (
     Mesh,
@@ -23,6 +21,8 @@ from squeeze_grasp_ros.mechanics.elastic.mesh import (
     target_max_area,
 )
 from squeeze_grasp_ros.mechanics.elastic.reduced import displacement_field, reduced_stiffness
+from squeeze_grasp_ros.mechanics.errors import ConditioningWarning, InvalidInputError
+from squeeze_grasp_ros.mechanics.squeeze.graspmap import grasp_map
 from squeeze_grasp_ros.mechanics.squeeze.stable_pure import plan_squeeze
 
 EQUILIBRIUM_TOL = 1e-9

@@ -16,8 +16,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 import yaml
-
 from output_support import CLI, private_mount
+
 from squeeze_grasp_ros.api import load_scene, scene_file
 from squeeze_grasp_ros.cli import main
 from squeeze_grasp_ros.mechanics.elastic import shapes
@@ -33,8 +33,7 @@ from squeeze_grasp_ros.mechanics.resistance.optimal import (
     sweep_directions,
 )
 from squeeze_grasp_ros.mechanics.ring.model import ring_from_outline
-from squeeze_grasp_ros.scene import parse_scene, scene_solid
-from squeeze_grasp_ros.scene import event_squeeze_scene
+from squeeze_grasp_ros.scene import event_squeeze_scene, parse_scene, scene_solid
 
 SCENES = Path(__file__).resolve().parents[1] / "config" / "scenes"
 FOAM = str(SCENES / "foam_square.yaml")

@@ -18,14 +18,14 @@ from pathlib import Path
 
 import pytest
 import yaml
+from planner_support import BLOB, Harness
 from rclpy.context import Context
 
-from planner_support import BLOB, Harness
+from squeeze_grasp_interfaces.srv import LoadObject
 from squeeze_grasp_ros.cli import main
 from squeeze_grasp_ros.inputs import MAX_FILE_BYTES
 from squeeze_grasp_ros.planning import ErrorCode
 from squeeze_grasp_ros.scene import SceneError, build_mesh, parse_scene
-from squeeze_grasp_interfaces.srv import LoadObject
 
 SPIKE = [[-0.05, -0.05], [0.05, -0.05], [0.05, 0.05], [0.0, 0.0], [-0.05, 0.05], [0.0, 0.0]]
 """A square with a vertex repeated at a non-adjacent position: a zero-width spike that made the

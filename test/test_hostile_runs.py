@@ -10,19 +10,18 @@ from __future__ import annotations
 import contextlib
 import json
 import os
+import shutil
 import signal
 import subprocess
 import sys
 import time
 from pathlib import Path
 
-import shutil
-
 import pytest
 import rclpy
 import yaml
-
 from pipeline_support import SMALL_SQUARE
+
 from squeeze_grasp_ros.cli import main
 from squeeze_grasp_ros.ros.recording.bag import read_bag
 

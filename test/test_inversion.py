@@ -10,8 +10,8 @@ import json
 
 import numpy as np
 import pytest
-
 from foam_support import foam_square
+
 from squeeze_grasp_ros.api import ElasticObject, event_squeeze, scene_file
 from squeeze_grasp_ros.cli import main
 from squeeze_grasp_ros.mechanics.elastic.hyperelastic import area_ratios, gradient_operator

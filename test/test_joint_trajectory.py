@@ -15,8 +15,9 @@ import numpy as np
 import pytest
 import rclpy
 import yaml
-from mcap.reader import make_reader
 from builtin_interfaces.msg import Duration
+from mcap.reader import make_reader
+from pipeline_support import write_scene
 from rclpy.context import Context
 from rclpy.executors import SingleThreadedExecutor
 from rclpy.node import Node
@@ -34,8 +35,6 @@ from squeeze_grasp_ros.ros.run.options import RunOptions
 from squeeze_grasp_ros.ros.run.runner import PipelineRunner
 from squeeze_grasp_ros.scene import SceneError, load_scene, parse_scene
 from squeeze_grasp_ros.scene.controller import scene_controller
-
-from pipeline_support import write_scene
 
 SPONGE = Path(__file__).resolve().parents[1] / "config" / "scenes" / "sponge_gripper.yaml"
 MS = 1_000_000

@@ -1,7 +1,8 @@
 # Copyright 2026 squeeze_grasp_ros developers
 # SPDX-License-Identifier: Apache-2.0
 """The checks ``ros2 pkg create`` sets up for a Python package: code style (flake8's checks,
-line length 99), pep257 docstrings and copyright headers; settings in ``ruff.toml``.
+line length 99), pep257 docstrings and copyright headers, plus sorted imports (isort's rules);
+settings in ``ruff.toml``.
 """
 from __future__ import annotations
 
@@ -33,7 +34,8 @@ def ruff_findings() -> list[str]:
     return [line for line in result.stdout.splitlines() if ".py:" in line]
 
 
-@pytest.mark.parametrize("codes", [("E", "W", "F"), ("D",)], ids=["flake8", "pep257"])
+@pytest.mark.parametrize("codes", [("E", "W", "F"), ("D",), ("I",)],
+                         ids=["flake8", "pep257", "isort"])
 def test_ruff(codes):
     found = [f for f in ruff_findings() if f.split(": ", 1)[1].startswith(codes)]
     assert found == [], "\n".join(found)

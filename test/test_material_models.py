@@ -7,15 +7,19 @@ rotated scenes, work = energy, scaling with E, nu near 0.5).
 """
 from __future__ import annotations
 
-
 import numpy as np
 import pytest
+from foam_support import foam_square
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from foam_support import foam_square
-from squeeze_grasp_ros.api import (ElasticObject, Material, NumericalError, event_squeeze,
-                                   scene_file)
+from squeeze_grasp_ros.api import (
+    ElasticObject,
+    Material,
+    NumericalError,
+    event_squeeze,
+    scene_file,
+)
 from squeeze_grasp_ros.mechanics.elastic import hyperelastic as H
 from squeeze_grasp_ros.mechanics.elastic import shapes
 from squeeze_grasp_ros.mechanics.elastic.contact_response import ContactResponse

@@ -10,9 +10,7 @@ import pytest
 from squeeze_grasp_ros.mechanics.elastic import shapes
 from squeeze_grasp_ros.mechanics.elastic.analytic import disk_diameter_change_across
 from squeeze_grasp_ros.mechanics.elastic.compliance import ElasticObject, node_dofs
-from squeeze_grasp_ros.mechanics.errors import InvalidInputError
 from squeeze_grasp_ros.mechanics.elastic.fem import element_strains, stiffness_matrix
-from squeeze_grasp_ros.mechanics.squeeze.graspmap import grasp_map
 from squeeze_grasp_ros.mechanics.elastic.material import Material
 from squeeze_grasp_ros.mechanics.elastic.mesh import (
     Mesh,
@@ -21,6 +19,8 @@ from squeeze_grasp_ros.mechanics.elastic.mesh import (
     mesh_from_triangles,
 )
 from squeeze_grasp_ros.mechanics.elastic.reduced import displacement_field, reduced_stiffness
+from squeeze_grasp_ros.mechanics.errors import InvalidInputError
+from squeeze_grasp_ros.mechanics.squeeze.graspmap import grasp_map
 from squeeze_grasp_ros.mechanics.squeeze.stable_pure import plan_squeeze
 
 MAT = Material(5e4, 0.3, 0.0254)

@@ -11,9 +11,9 @@ import time
 
 import numpy as np
 import pytest
+from perception_support import CAMERA, pose, skimage_or_skip
 from scipy.spatial.distance import directed_hausdorff
 
-from perception_support import CAMERA, pose, skimage_or_skip
 from squeeze_grasp_ros.mechanics.elastic import shapes
 from squeeze_grasp_ros.mechanics.elastic.shapes import resample
 from squeeze_grasp_ros.mechanics.vocabulary import ImageEncoding

@@ -15,8 +15,14 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from matplotlib.path import Path as MplPath
 
-from squeeze_grasp_ros.mechanics.elastic.shapes import (Outline, annulus, fourier_blob,
-                                                        polygon, rectangle, resample)
+from squeeze_grasp_ros.mechanics.elastic.shapes import (
+    Outline,
+    annulus,
+    fourier_blob,
+    polygon,
+    rectangle,
+    resample,
+)
 from squeeze_grasp_ros.mechanics.errors import InvalidInputError, NumericalError
 from squeeze_grasp_ros.perception.camera import CameraModel, CameraPose
 from squeeze_grasp_ros.perception.camera_info import camera_from_info

@@ -11,8 +11,8 @@ import json
 import numpy as np
 import pytest
 import yaml
-
 from perception_support import skimage_or_skip
+
 from squeeze_grasp_ros import cli
 from squeeze_grasp_ros.mechanics.elastic.shapes import load_outline
 from squeeze_grasp_ros.resources import config_dir, scene_file

@@ -11,9 +11,15 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from perception_support import (
+    CAMERA,
+    hausdorff_px,
+    pose,
+    shipped_shapes,
+    skimage_or_skip,
+    transformed,
+)
 
-from perception_support import (CAMERA, hausdorff_px, pose, shipped_shapes, skimage_or_skip,
-                                transformed)
 from squeeze_grasp_ros.mechanics.elastic.shapes import Outline, rectangle
 from squeeze_grasp_ros.mechanics.errors import InvalidInputError
 from squeeze_grasp_ros.perception.extract import extract_outline

@@ -16,14 +16,17 @@ from functools import lru_cache
 import numpy as np
 import pytest
 import yaml
-
 from perception_support import CAMERA, pose, skimage_or_skip
+
 from squeeze_grasp_ros.api import build_mesh, event_squeeze_scene, scene_file, scene_solid
 from squeeze_grasp_ros.mechanics.elastic.shapes import Outline, ellipse, resample
 from squeeze_grasp_ros.mechanics.errors import InvalidInputError
 from squeeze_grasp_ros.perception.render import render_views
-from squeeze_grasp_ros.perception.shape_match import (closest_on_curves, deformed_outline,
-                                                      shape_residual)
+from squeeze_grasp_ros.perception.shape_match import (
+    closest_on_curves,
+    deformed_outline,
+    shape_residual,
+)
 from squeeze_grasp_ros.scene import parse_scene
 
 THICKNESS = 0.0254

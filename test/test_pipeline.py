@@ -12,18 +12,6 @@ from pathlib import Path
 import numpy as np
 import pytest
 import yaml
-from rclpy.serialization import deserialize_message
-
-from squeeze_grasp_ros.mechanics.elastic.compliance import ElasticObject
-from squeeze_grasp_ros.ros.nodes import pipeline
-from squeeze_grasp_ros.ros.run.options import RunOptions
-from squeeze_grasp_ros.ros.run.runner import PipelineRunner
-from squeeze_grasp_ros.ros.recording.bag import read_bag
-from squeeze_grasp_ros.ros.recording.replay import replay
-from squeeze_grasp_ros.ros.recording.schema import own_text
-from squeeze_grasp_ros.scene import build_mesh, finger_nodes, load_scene, scene_material
-from squeeze_grasp_ros.scene import event_squeeze_scene
-
 from pipeline_support import (
     EVENT_TOLERANCE_TICKS,
     SLIPPING_SQUARE,
@@ -33,6 +21,22 @@ from pipeline_support import (
     net_events,
     scene_data,
     write_scene,
+)
+from rclpy.serialization import deserialize_message
+
+from squeeze_grasp_ros.mechanics.elastic.compliance import ElasticObject
+from squeeze_grasp_ros.ros.nodes import pipeline
+from squeeze_grasp_ros.ros.recording.bag import read_bag
+from squeeze_grasp_ros.ros.recording.replay import replay
+from squeeze_grasp_ros.ros.recording.schema import own_text
+from squeeze_grasp_ros.ros.run.options import RunOptions
+from squeeze_grasp_ros.ros.run.runner import PipelineRunner
+from squeeze_grasp_ros.scene import (
+    build_mesh,
+    event_squeeze_scene,
+    finger_nodes,
+    load_scene,
+    scene_material,
 )
 
 SCENES = Path(__file__).resolve().parents[1] / "config" / "scenes"
@@ -333,11 +337,11 @@ def test_resistance_ground_truth_equals_algorithm_2():
     squeeze, then the executor streams Algorithm 2's waypoints; the simulated world's events,
     termination and work are those of the mechanics API.
     """
-    from squeeze_grasp_ros.mechanics.squeeze.contact_model import ContactModel
     from squeeze_grasp_ros.mechanics.resistance.frictional import (
         add_adversary,
         frictional_resistance,
     )
+    from squeeze_grasp_ros.mechanics.squeeze.contact_model import ContactModel
     from squeeze_grasp_ros.scene import placement_node
 
     path = str(SCENES / "resist_fig10.yaml")

@@ -13,14 +13,13 @@ import sys
 from pathlib import Path
 
 import pytest
+from pipeline_support import SMALL_SQUARE, scene_data, write_scene
 from rclpy.serialization import deserialize_message
 
 from squeeze_grasp_ros.ros.nodes import pipeline
+from squeeze_grasp_ros.ros.recording.bag import read_bag
 from squeeze_grasp_ros.ros.run.options import RunOptions
 from squeeze_grasp_ros.ros.run.runner import PipelineRunner
-from squeeze_grasp_ros.ros.recording.bag import read_bag
-
-from pipeline_support import SMALL_SQUARE, scene_data, write_scene
 
 QUICK = scene_data(SMALL_SQUARE, name="quick_square",
                    squeeze={"type": "stable", "relative_depth": 0.06})

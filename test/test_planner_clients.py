@@ -9,12 +9,12 @@ import time
 from collections import Counter
 
 import yaml
-from rclpy.action import ActionClient
-from rclpy.qos import HistoryPolicy, QoSProfile, ReliabilityPolicy
-
 from action_msgs.msg import GoalStatus
 from planner_support import BLOB, Harness
+from rclpy.action import ActionClient
+from rclpy.qos import HistoryPolicy, QoSProfile, ReliabilityPolicy
 from test_planner_node import RESIST_FIG10
+
 from squeeze_grasp_interfaces.action import GraspMap as GraspMapAction
 from squeeze_grasp_interfaces.srv import EventSqueeze, LoadObject, PlanSqueeze
 from squeeze_grasp_ros.planning import ErrorCode

@@ -15,12 +15,8 @@ import numpy as np
 import pytest
 import rclpy
 import yaml
-from geometry_msgs.msg import Vector3
-from rclpy.context import Context
-from rclpy.signals import SignalHandlerOptions
-from rclpy.task import Future
-
 from action_msgs.msg import GoalStatus
+from geometry_msgs.msg import Vector3
 from planner_support import (
     BLOB,
     RING,
@@ -31,6 +27,10 @@ from planner_support import (
     scene_of,
     solid_of,
 )
+from rclpy.context import Context
+from rclpy.signals import SignalHandlerOptions
+from rclpy.task import Future
+
 from squeeze_grasp_interfaces.action import EventSqueeze as EventSqueezeAction
 from squeeze_grasp_interfaces.action import GraspMap as GraspMapAction
 from squeeze_grasp_interfaces.msg import EventSqueezeData
@@ -42,23 +42,22 @@ from squeeze_grasp_interfaces.srv import (
     PlanSqueeze,
     RingGraspTest,
 )
-from squeeze_grasp_ros.mechanics.squeeze.contact_model import ContactModel
-from squeeze_grasp_ros.mechanics.squeeze.graspmap import grasp_map
 from squeeze_grasp_ros.mechanics.elastic.reduced import boundary_displacement, reduced_stiffness
+from squeeze_grasp_ros.mechanics.resistance.frictional import add_adversary, frictional_resistance
 from squeeze_grasp_ros.mechanics.resistance.optimal import (
     contact_segments,
     optimal_resistance,
     resistance_grasp,
     sweep_directions,
 )
-from squeeze_grasp_ros.mechanics.resistance.frictional import add_adversary, frictional_resistance
 from squeeze_grasp_ros.mechanics.ring.squeeze import ring_grasp
+from squeeze_grasp_ros.mechanics.squeeze.contact_model import ContactModel
+from squeeze_grasp_ros.mechanics.squeeze.graspmap import grasp_map
 from squeeze_grasp_ros.mechanics.squeeze.stable_pure import plan_squeeze
-from squeeze_grasp_ros.ros.nodes.planner import PARAMETERS
-from squeeze_grasp_ros.planning import ErrorCode
-from squeeze_grasp_ros.scene import build_ring, finger_nodes, placement_node
-from squeeze_grasp_ros.scene import event_squeeze_scene
 from squeeze_grasp_ros.mechanics.vocabulary import MaterialModel
+from squeeze_grasp_ros.planning import ErrorCode
+from squeeze_grasp_ros.ros.nodes.planner import PARAMETERS
+from squeeze_grasp_ros.scene import build_ring, event_squeeze_scene, finger_nodes, placement_node
 
 REPO = Path(__file__).resolve().parents[1]
 RESIST_FIG10 = (REPO / "config" / "scenes" / "resist_fig10.yaml").read_text()

@@ -24,11 +24,17 @@ import yaml
 from geometry_msgs.msg import Vector3
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
+from planner_support import BLOB, RING, Harness, flat, planner_threads, scene_of, solid_of
 from rclpy.context import Context
 
-from planner_support import BLOB, RING, Harness, flat, planner_threads, scene_of, solid_of
-from squeeze_grasp_interfaces.srv import (EventSqueeze, GraspMap, LoadObject, PlanResistance,
-                                          PlanSqueeze, RingGraspTest)
+from squeeze_grasp_interfaces.srv import (
+    EventSqueeze,
+    GraspMap,
+    LoadObject,
+    PlanResistance,
+    PlanSqueeze,
+    RingGraspTest,
+)
 from squeeze_grasp_ros.mechanics.squeeze.graspmap import grasp_map
 from squeeze_grasp_ros.mechanics.squeeze.stable_pure import plan_squeeze
 from squeeze_grasp_ros.planning import ErrorCode

@@ -7,19 +7,25 @@ import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
-
 from planner_support import BLOB, RING, scene_of, solid_of
+
 from squeeze_grasp_interfaces.action import EventSqueeze as EventSqueezeAction
 from squeeze_grasp_interfaces.action import GraspMap as GraspMapAction
 from squeeze_grasp_interfaces.msg import ContactNode, TactileArray
-from squeeze_grasp_interfaces.srv import (EventSqueeze, GraspMap, LoadObject, PlanResistance,
-                                          PlanSqueeze, RingGraspTest)
+from squeeze_grasp_interfaces.srv import (
+    EventSqueeze,
+    GraspMap,
+    LoadObject,
+    PlanResistance,
+    PlanSqueeze,
+    RingGraspTest,
+)
 from squeeze_grasp_ros import planning
-from squeeze_grasp_ros.ros import messages
-from squeeze_grasp_ros.mechanics.squeeze.contact_state import ContactState, Event, FingerState
 from squeeze_grasp_ros.mechanics.squeeze.contact_state import ContactNode as MechanicsContactNode
+from squeeze_grasp_ros.mechanics.squeeze.contact_state import ContactState, Event, FingerState
 from squeeze_grasp_ros.mechanics.squeeze.graspmap import grasp_map
 from squeeze_grasp_ros.planning import ErrorCode
+from squeeze_grasp_ros.ros import messages
 from squeeze_grasp_ros.scene import build_mesh
 
 RESPONSES = [LoadObject.Response, PlanSqueeze.Response, GraspMap.Response,

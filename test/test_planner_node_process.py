@@ -18,12 +18,12 @@ from pathlib import Path
 import numpy as np
 import pytest
 import yaml
+from executables import script
+from planner_support import BLOB, Harness, flat, solid_of
 from rcl_interfaces.srv import GetParameters
 from rclpy.context import Context
 from rclpy.parameter import parameter_value_to_python
 
-from executables import script
-from planner_support import BLOB, Harness, flat, solid_of
 from squeeze_grasp_interfaces.srv import LoadObject, PlanSqueeze
 from squeeze_grasp_ros.mechanics.squeeze.stable_pure import plan_squeeze
 

@@ -22,9 +22,9 @@ import zstandard
 from mcap.data_stream import RecordBuilder
 from mcap.records import Chunk, DataEnd, Footer, Header
 from mcap.writer import CompressionType, Writer
+from test_recording_readers import record
 
 from squeeze_grasp_ros.ros.recording.bag import MAX_CHUNK_BYTES, BagError, read_bag
-from test_recording_readers import record
 
 MAGIC = b"\x89MCAP0\r\n"
 

@@ -11,14 +11,13 @@ from __future__ import annotations
 from pathlib import Path
 
 import pytest
+from foxglove_support import foxglove_decode
 from mcap.reader import make_reader
+from pipeline_support import SMALL_SQUARE, write_scene
 
+from squeeze_grasp_ros.ros.recording.schema import SEPARATOR, message_definition, own_text
 from squeeze_grasp_ros.ros.run.options import RunOptions
 from squeeze_grasp_ros.ros.run.runner import PipelineRunner
-from squeeze_grasp_ros.ros.recording.schema import SEPARATOR, message_definition, own_text
-
-from foxglove_support import foxglove_decode
-from pipeline_support import SMALL_SQUARE, write_scene
 
 ACTION_TOPICS = {"/executor/execute_grasp/_action/feedback",
                  "/executor/execute_grasp/_action/status"}

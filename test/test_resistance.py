@@ -16,10 +16,11 @@ from scipy.optimize import minimize
 from squeeze_grasp_ros.cli import main
 from squeeze_grasp_ros.mechanics.elastic import shapes
 from squeeze_grasp_ros.mechanics.elastic.compliance import ElasticObject
-from squeeze_grasp_ros.mechanics.errors import InvalidInputError
 from squeeze_grasp_ros.mechanics.elastic.material import Material
 from squeeze_grasp_ros.mechanics.elastic.mesh import generate_mesh, mesh_from_triangles
 from squeeze_grasp_ros.mechanics.elastic.reduced import displacement_field
+from squeeze_grasp_ros.mechanics.errors import InvalidInputError
+from squeeze_grasp_ros.mechanics.resistance.forms import expansion_matrix, pure_form
 from squeeze_grasp_ros.mechanics.resistance.optimal import (
     ResistanceGrasp,
     compare_resistances,
@@ -30,7 +31,6 @@ from squeeze_grasp_ros.mechanics.resistance.optimal import (
     resistance_grasp,
     sweep_directions,
 )
-from squeeze_grasp_ros.mechanics.resistance.forms import expansion_matrix, pure_form
 from squeeze_grasp_ros.mechanics.vocabulary import Finger
 
 SCENES = "config/scenes"

@@ -15,16 +15,16 @@ import pytest
 from squeeze_grasp_ros.cli import main
 from squeeze_grasp_ros.mechanics.elastic import shapes
 from squeeze_grasp_ros.mechanics.elastic.compliance import ElasticObject
-from squeeze_grasp_ros.mechanics.squeeze.contact_model import ContactModel
-from squeeze_grasp_ros.mechanics.errors import InvalidInputError
 from squeeze_grasp_ros.mechanics.elastic.material import Material
 from squeeze_grasp_ros.mechanics.elastic.mesh import generate_mesh
-from squeeze_grasp_ros.mechanics.resistance.optimal import evaluate_resistance, resistance_grasp
+from squeeze_grasp_ros.mechanics.errors import InvalidInputError
 from squeeze_grasp_ros.mechanics.resistance.frictional import (
     add_adversary,
     frictional_resistance,
     slipping_fingers,
 )
+from squeeze_grasp_ros.mechanics.resistance.optimal import evaluate_resistance, resistance_grasp
+from squeeze_grasp_ros.mechanics.squeeze.contact_model import ContactModel
 from squeeze_grasp_ros.mechanics.squeeze.events import event_squeeze
 from squeeze_grasp_ros.mechanics.vocabulary import Finger
 

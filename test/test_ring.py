@@ -9,12 +9,11 @@ from functools import cache
 import numpy as np
 import pytest
 
-from squeeze_grasp_ros.mechanics.vocabulary import RingLimit
 from squeeze_grasp_ros.mechanics.elastic import shapes
 from squeeze_grasp_ros.mechanics.elastic.compliance import node_dofs
-from squeeze_grasp_ros.mechanics.errors import InvalidInputError
 from squeeze_grasp_ros.mechanics.elastic.material import Material
 from squeeze_grasp_ros.mechanics.elastic.reduced import reduce_blocks
+from squeeze_grasp_ros.mechanics.errors import InvalidInputError
 from squeeze_grasp_ros.mechanics.ring.grasp_map import ring_grasp_map
 from squeeze_grasp_ros.mechanics.ring.model import (
     RingModel,
@@ -30,6 +29,7 @@ from squeeze_grasp_ros.mechanics.ring.squeeze import (
     polyval,
     ring_grasp,
 )
+from squeeze_grasp_ros.mechanics.vocabulary import RingLimit
 
 E, W, H = 2.0e9, 0.01, 0.003
 

@@ -69,6 +69,7 @@ def spin_until(executor, condition: Callable[[], bool], timeout: float = WAIT_S)
 @pip_route_only
 def test_rclpy_and_interfaces_import_from_this_environment() -> None:
     import rclpy
+
     import squeeze_grasp_interfaces.msg
     import squeeze_grasp_interfaces.srv
 
@@ -100,6 +101,7 @@ def test_interface_constants() -> None:
 def test_nested_message_serialization_round_trip() -> None:
     from geometry_msgs.msg import Vector3
     from rclpy.serialization import deserialize_message, serialize_message
+
     from squeeze_grasp_interfaces.msg import ContactNode, SimState
 
     state = SimState(fingers=["F1", "F2"], termination="finger_slip")
@@ -116,6 +118,7 @@ def test_nested_message_serialization_round_trip() -> None:
 def test_contact_event_publish_subscribe(ros_context) -> None:
     import rclpy
     from rclpy.executors import SingleThreadedExecutor
+
     from squeeze_grasp_interfaces.msg import ContactEvent
 
     node = rclpy.create_node("test_contact_events", context=ros_context)
@@ -140,6 +143,7 @@ def test_contact_event_publish_subscribe(ros_context) -> None:
 def test_plan_squeeze_service_round_trip(ros_context) -> None:
     import rclpy
     from rclpy.executors import SingleThreadedExecutor
+
     from squeeze_grasp_interfaces.srv import PlanSqueeze
 
     def reject(request: PlanSqueeze.Request, response: PlanSqueeze.Response):

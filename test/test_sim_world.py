@@ -11,24 +11,39 @@ from collections import Counter
 import numpy as np
 import pytest
 import yaml
+from pipeline_support import (
+    EVENT_TOLERANCE_TICKS,
+    SMALL_SQUARE,
+    contact_modes,
+    match_within,
+    net_events,
+    scene_data,
+)
 
-from squeeze_grasp_ros.control.motion import (GraspGoal, GraspProgram, MotionLimits,
-                                              Observation, goal_problem)
+from squeeze_grasp_ros.control.motion import (
+    GraspGoal,
+    GraspProgram,
+    MotionLimits,
+    Observation,
+    goal_problem,
+)
 from squeeze_grasp_ros.control.tracker import ContactTracker, FingerSample, TrackerConfig
 from squeeze_grasp_ros.mechanics.squeeze.contact_state import initial_state
 from squeeze_grasp_ros.mechanics.squeeze.fingertips import place_fingertip
 from squeeze_grasp_ros.mechanics.squeeze.stepper import advance
+from squeeze_grasp_ros.mechanics.squeeze.tip_shapes import TipGeometry, TipShape
 from squeeze_grasp_ros.mechanics.vocabulary import EventType
 from squeeze_grasp_ros.resources import scene_file
 from squeeze_grasp_ros.scene import GraspSetup, SceneError, load_scene, parse_scene
 from squeeze_grasp_ros.sim.devices import device_model, follow
-from squeeze_grasp_ros.mechanics.squeeze.tip_shapes import TipGeometry, TipShape
-from squeeze_grasp_ros.sim.sensors import (SensorRandomness, fingertip_wrench, render_tactile,
-                                           tactile_layout, taxel_weights)
+from squeeze_grasp_ros.sim.sensors import (
+    SensorRandomness,
+    fingertip_wrench,
+    render_tactile,
+    tactile_layout,
+    taxel_weights,
+)
 from squeeze_grasp_ros.sim.world import SimWorld
-
-from pipeline_support import (EVENT_TOLERANCE_TICKS, SMALL_SQUARE, contact_modes, match_within,
-                              net_events, scene_data)
 
 
 def scene_with(**changes):

@@ -20,25 +20,33 @@ from squeeze_grasp_ros.mechanics.elastic.compliance import ElasticObject
 from squeeze_grasp_ros.mechanics.elastic.material import Material
 from squeeze_grasp_ros.mechanics.elastic.mesh import generate_mesh, target_max_area
 from squeeze_grasp_ros.mechanics.errors import InvalidInputError, NumericalError
-from squeeze_grasp_ros.mechanics.squeeze.contact_model import (ContactModel, Solution,
-                                                               SolveFailure)
+from squeeze_grasp_ros.mechanics.squeeze.contact_model import ContactModel, Solution, SolveFailure
 from squeeze_grasp_ros.mechanics.squeeze.contact_state import ContactState, initial_state
-from squeeze_grasp_ros.mechanics.squeeze.event_key import (PROCESSING_ORDER, EventFunction,
-                                                           EventKey, processing_rank)
+from squeeze_grasp_ros.mechanics.squeeze.event_key import (
+    PROCESSING_ORDER,
+    EventFunction,
+    EventKey,
+    processing_rank,
+)
 from squeeze_grasp_ros.mechanics.squeeze.fingertips import place_fingertip
 from squeeze_grasp_ros.mechanics.squeeze.stable_pure import plan_squeeze
 from squeeze_grasp_ros.mechanics.squeeze.stepper import advance
 from squeeze_grasp_ros.mechanics.squeeze.stepper.chatter import ChatterBound
 from squeeze_grasp_ros.mechanics.squeeze.stepper.contact_set import ContactSet
 from squeeze_grasp_ros.mechanics.squeeze.stepper.functions import EventFunctions
-from squeeze_grasp_ros.mechanics.squeeze.stepper.location import (crossings, dips_inside,
-                                                                  earliest_crossing)
-from squeeze_grasp_ros.mechanics.squeeze.stepper.modes import (decide_modes, mode_violations,
-                                                               zero_functions)
+from squeeze_grasp_ros.mechanics.squeeze.stepper.location import (
+    crossings,
+    dips_inside,
+    earliest_crossing,
+)
+from squeeze_grasp_ros.mechanics.squeeze.stepper.modes import (
+    decide_modes,
+    mode_violations,
+    zero_functions,
+)
 from squeeze_grasp_ros.mechanics.squeeze.stepper.motion import FingerMotion
 from squeeze_grasp_ros.mechanics.squeeze.stepper.solving import Counters, SetSolver
-from squeeze_grasp_ros.mechanics.squeeze.stepper.substeps import (ADAPTIVE_MAX_STEPS,
-                                                                  SubstepControl)
+from squeeze_grasp_ros.mechanics.squeeze.stepper.substeps import ADAPTIVE_MAX_STEPS, SubstepControl
 from squeeze_grasp_ros.mechanics.vocabulary import EventType, Termination
 
 GAP, B, CP, CM, D = (EventFunction.GAP, EventFunction.NORMAL_FORCE, EventFunction.CONE_PLUS,

@@ -19,8 +19,8 @@ from pathlib import Path
 
 import pytest
 import yaml
-
 from output_support import CLI, private_mount
+
 from squeeze_grasp_ros.cli import main
 
 pa = pytest.importorskip("pyarrow", reason="pip install -e '.[sweep]'")

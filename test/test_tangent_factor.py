@@ -15,10 +15,15 @@ import numpy as np
 import pytest
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
-
 from foam_support import foam_square
-from squeeze_grasp_ros.api import (event_squeeze, event_squeeze_scene, load_scene, scene_file,
-                                   scene_solid)
+
+from squeeze_grasp_ros.api import (
+    event_squeeze,
+    event_squeeze_scene,
+    load_scene,
+    scene_file,
+    scene_solid,
+)
 from squeeze_grasp_ros.extras import installed
 from squeeze_grasp_ros.mechanics.elastic import hyperelastic as H
 from squeeze_grasp_ros.mechanics.elastic import interior

@@ -9,12 +9,11 @@ import math
 import os
 
 import pytest
+from pipeline_support import SMALL_SQUARE, scene_data, write_scene
 
 from squeeze_grasp_ros.bench.lockstep import tick_profile
 from squeeze_grasp_ros.ros.bare_loop import bare_loop_rate
 from squeeze_grasp_ros.ros.run.tick_profile import SPIN, STAGES
-
-from pipeline_support import SMALL_SQUARE, scene_data, write_scene
 
 
 @pytest.mark.parametrize("executor", ["events", "single"])

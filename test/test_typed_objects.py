@@ -14,9 +14,20 @@ import numpy as np
 import pytest
 import yaml
 
-from squeeze_grasp_ros.planning import (ErrorCode, FramePose, PlannerLimits, PlannerError,
-                                        TypedMaterial, TypedObject, load_object, object_key,
-                                        object_source, read_scene, squeeze_plan, typed_scene)
+from squeeze_grasp_ros.planning import (
+    ErrorCode,
+    FramePose,
+    PlannerError,
+    PlannerLimits,
+    TypedMaterial,
+    TypedObject,
+    load_object,
+    object_key,
+    object_source,
+    read_scene,
+    squeeze_plan,
+    typed_scene,
+)
 
 REPO = Path(__file__).resolve().parents[1]
 FOAM = (REPO / "config" / "scenes" / "foam_square.yaml").read_text()
@@ -173,7 +184,6 @@ def test_load_object_takes_an_object_description(planner):
     object as the YAML route (nodes, contact nodes, plan), and refusals name the field.
     """
     from squeeze_grasp_interfaces.srv import LoadObject, PlanSqueeze
-
     from squeeze_grasp_ros.mechanics.elastic.shapes import Outline
     from squeeze_grasp_ros.ros.messages.objects import object_description
 

@@ -32,8 +32,8 @@ from squeeze_grasp_ros.mechanics.vocabulary import (
     SqueezeKind,
     Termination,
 )
-from squeeze_grasp_ros.scene import load_scene
 from squeeze_grasp_ros.resources import scene_file
+from squeeze_grasp_ros.scene import load_scene
 
 PACKAGE = Path(squeeze_grasp_ros.__file__).parent
 VOCABULARIES = [v for v in vars(vocabulary).values()

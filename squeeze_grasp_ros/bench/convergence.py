@@ -14,14 +14,14 @@ from pathlib import Path
 import numpy as np
 
 from squeeze_grasp_ros import plots
+from squeeze_grasp_ros.bench.events import foam_square
+from squeeze_grasp_ros.bench.table import Table, timed
 from squeeze_grasp_ros.mechanics.elastic import shapes
 from squeeze_grasp_ros.mechanics.elastic.analytic import disk_diameter_change_across
 from squeeze_grasp_ros.mechanics.elastic.compliance import ElasticObject
 from squeeze_grasp_ros.mechanics.elastic.material import Material
 from squeeze_grasp_ros.mechanics.elastic.mesh import generate_mesh, target_max_area
 from squeeze_grasp_ros.mechanics.squeeze.events import EventSqueeze, event_squeeze
-from squeeze_grasp_ros.bench.events import foam_square
-from squeeze_grasp_ros.bench.table import Table, timed
 from squeeze_grasp_ros.mechanics.vocabulary import Finger
 
 TITLE = "Mesh resolution: error and time"

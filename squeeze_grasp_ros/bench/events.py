@@ -12,12 +12,12 @@ from typing import Callable, Sequence
 
 import numpy as np
 
+from squeeze_grasp_ros.bench.table import Table
 from squeeze_grasp_ros.mechanics.elastic import shapes
 from squeeze_grasp_ros.mechanics.elastic.compliance import ElasticObject
 from squeeze_grasp_ros.mechanics.elastic.material import Material
 from squeeze_grasp_ros.mechanics.elastic.mesh import generate_mesh, target_max_area
 from squeeze_grasp_ros.mechanics.squeeze.events import EventSqueeze, event_squeeze
-from squeeze_grasp_ros.bench.table import Table
 
 TITLE = "Event-driven squeeze (Sec. 5, Algorithm 1)"
 FOAM = Material(5e4, 0.3, 0.0254)

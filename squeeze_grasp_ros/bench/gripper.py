@@ -9,8 +9,10 @@ from pathlib import Path
 
 from squeeze_grasp_ros.bench.table import Table, best_time, timed
 from squeeze_grasp_ros.mechanics.squeeze.graspmap import grasp_map
-from squeeze_grasp_ros.mechanics.squeeze.gripper_grasp import (evaluate_candidate,
-                                                               gripper_candidates)
+from squeeze_grasp_ros.mechanics.squeeze.gripper_grasp import (
+    evaluate_candidate,
+    gripper_candidates,
+)
 from squeeze_grasp_ros.resources import device_file, scene_file
 from squeeze_grasp_ros.scene import GraspSetup, load_scene
 from squeeze_grasp_ros.scene.gripper import load_gripper

@@ -18,8 +18,12 @@ from squeeze_grasp_ros import plots
 from squeeze_grasp_ros.bench.table import Table
 from squeeze_grasp_ros.extras import install_hint
 from squeeze_grasp_ros.mechanics.elastic.hyperelastic import assemble
-from squeeze_grasp_ros.mechanics.elastic.interior import (Fill, TangentFactor,
-                                                          default_factorizer, factorizer)
+from squeeze_grasp_ros.mechanics.elastic.interior import (
+    Fill,
+    TangentFactor,
+    default_factorizer,
+    factorizer,
+)
 from squeeze_grasp_ros.mechanics.elastic.strain_measures import COMMON_STRAIN_MEASURE
 from squeeze_grasp_ros.mechanics.squeeze.contact_model import SolveOptions
 from squeeze_grasp_ros.mechanics.vocabulary import Factorizer, Finger, MaterialModel

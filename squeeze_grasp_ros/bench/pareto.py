@@ -17,10 +17,10 @@ from pathlib import Path
 import numpy as np
 
 from squeeze_grasp_ros import plots
-from squeeze_grasp_ros.mechanics.errors import InvalidInputError, NumericalError
-from squeeze_grasp_ros.mechanics.squeeze.events import event_squeeze
 from squeeze_grasp_ros.bench.events import foam_square
 from squeeze_grasp_ros.bench.table import Table
+from squeeze_grasp_ros.mechanics.errors import InvalidInputError, NumericalError
+from squeeze_grasp_ros.mechanics.squeeze.events import event_squeeze
 from squeeze_grasp_ros.mechanics.vocabulary import Finger
 
 TITLE = "Accuracy vs time: Pareto front of the squeeze settings"

@@ -15,10 +15,10 @@ from pathlib import Path
 import numpy as np
 from scipy.spatial.distance import directed_hausdorff
 
-from squeeze_grasp_ros.mechanics.vocabulary import Finger, ImageEncoding
 from squeeze_grasp_ros import plots
 from squeeze_grasp_ros.bench.table import Table, best_time
 from squeeze_grasp_ros.mechanics.elastic.shapes import Outline, resample
+from squeeze_grasp_ros.mechanics.vocabulary import Finger, ImageEncoding
 from squeeze_grasp_ros.perception.camera import CameraModel, CameraPose
 from squeeze_grasp_ros.perception.extract import ObjectOutline, extract_outline
 from squeeze_grasp_ros.perception.render import render_views

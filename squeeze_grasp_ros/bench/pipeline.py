@@ -9,17 +9,17 @@ from pathlib import Path
 
 import yaml
 
-from squeeze_grasp_ros.ros.nodes import pipeline
-from squeeze_grasp_ros.ros.run.options import RunOptions
-from squeeze_grasp_ros.ros.run.runner import PipelineRunner
-from squeeze_grasp_ros.ros.recording.bag import read_bag
-from squeeze_grasp_ros.resources import scene_file
-from squeeze_grasp_ros.scene import GraspSetup, load_scene
-from squeeze_grasp_ros.sim.world import SimWorld
 from squeeze_grasp_ros.bench.lockstep import bare_ratio_table, profile_table
 from squeeze_grasp_ros.bench.startup import startup_table
 from squeeze_grasp_ros.bench.table import Table, best_time, timed
 from squeeze_grasp_ros.mechanics.vocabulary import SQUEEZING_FINGERS, Effect
+from squeeze_grasp_ros.resources import scene_file
+from squeeze_grasp_ros.ros.nodes import pipeline
+from squeeze_grasp_ros.ros.recording.bag import read_bag
+from squeeze_grasp_ros.ros.run.options import RunOptions
+from squeeze_grasp_ros.ros.run.runner import PipelineRunner
+from squeeze_grasp_ros.scene import GraspSetup, load_scene
+from squeeze_grasp_ros.sim.world import SimWorld
 
 TITLE = ("Pipeline on real rclpy nodes: end to end, lockstep rate against the bare loop, one "
          "tick's profile, start-up, recording, effects")

@@ -11,6 +11,7 @@ from typing import Callable, Sequence
 
 import numpy as np
 
+from squeeze_grasp_ros.bench.table import Table, best_time, timed
 from squeeze_grasp_ros.mechanics.elastic import shapes
 from squeeze_grasp_ros.mechanics.elastic.compliance import ElasticObject
 from squeeze_grasp_ros.mechanics.elastic.material import Material
@@ -21,7 +22,6 @@ from squeeze_grasp_ros.mechanics.resistance.optimal import (
     resistance_grasp,
     sweep_directions,
 )
-from squeeze_grasp_ros.bench.table import Table, best_time, timed
 from squeeze_grasp_ros.mechanics.vocabulary import ContactKind, Finger, SqueezeKind
 
 TITLE = "Optimal resistance (Sec. 6.1-6.2): time per adversary direction"

@@ -9,16 +9,16 @@ from pathlib import Path
 import numpy as np
 
 from squeeze_grasp_ros import plots
+from squeeze_grasp_ros.bench.convergence import observed_orders
+from squeeze_grasp_ros.bench.table import Table, best_time, timed
 from squeeze_grasp_ros.mechanics.elastic.material import Material
+from squeeze_grasp_ros.mechanics.elastic.shapes import ellipse
 from squeeze_grasp_ros.mechanics.ring.grasp_map import ring_grasp_map
 from squeeze_grasp_ros.mechanics.ring.model import (
     circle_diametral_response,
     ring_diameter_changes,
     ring_from_outline,
 )
-from squeeze_grasp_ros.mechanics.elastic.shapes import ellipse
-from squeeze_grasp_ros.bench.convergence import observed_orders
-from squeeze_grasp_ros.bench.table import Table, best_time, timed
 from squeeze_grasp_ros.mechanics.vocabulary import SqueezeKind
 
 TITLE = "Ring discretisation: error against the closed form and time"

@@ -7,14 +7,14 @@ from pathlib import Path
 
 import numpy as np
 
+from squeeze_grasp_ros.bench.table import Table, best_time, timed
 from squeeze_grasp_ros.mechanics.elastic import shapes
 from squeeze_grasp_ros.mechanics.elastic.compliance import ElasticObject
-from squeeze_grasp_ros.mechanics.squeeze.graspmap import grasp_map
 from squeeze_grasp_ros.mechanics.elastic.material import Material
 from squeeze_grasp_ros.mechanics.elastic.mesh import generate_mesh, target_max_area
 from squeeze_grasp_ros.mechanics.elastic.reduced import boundary_displacement, reduced_stiffness
+from squeeze_grasp_ros.mechanics.squeeze.graspmap import grasp_map
 from squeeze_grasp_ros.mechanics.squeeze.stable_pure import plan_squeeze
-from squeeze_grasp_ros.bench.table import Table, best_time, timed
 from squeeze_grasp_ros.mechanics.vocabulary import SqueezeKind
 
 TITLE = "Solver routes: precompute and squeeze time vs mesh size"

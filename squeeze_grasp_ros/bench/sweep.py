@@ -23,12 +23,12 @@ from pathlib import Path
 
 import yaml
 
+from squeeze_grasp_ros.bench.table import Table
 from squeeze_grasp_ros.resources import scene_file
 from squeeze_grasp_ros.sweep.engine import run_sweep
 from squeeze_grasp_ros.sweep.evaluate import clear_cache, run_task
 from squeeze_grasp_ros.sweep.plan import plan_tasks
 from squeeze_grasp_ros.sweep.spec import parse_sweep_spec
-from squeeze_grasp_ros.bench.table import Table
 from squeeze_grasp_ros.threads import single_thread_blas
 
 TITLE = "Grasp-dataset sweep on Dask"

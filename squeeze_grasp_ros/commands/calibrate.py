@@ -9,18 +9,20 @@ import argparse
 
 import numpy as np
 
+from squeeze_grasp_ros.commands.csv_io import read_columns
+from squeeze_grasp_ros.mechanics.calibration.hyperelastic_fit import (
+    CompressionCurve,
+    fit_compression,
+    linear_validity,
+)
 from squeeze_grasp_ros.mechanics.calibration.material_fit import (
     Cuboid,
     calibrate_elasticity,
     friction_from_angle,
     friction_from_trials,
 )
-from squeeze_grasp_ros.mechanics.calibration.hyperelastic_fit import (CompressionCurve,
-                                                                   fit_compression,
-                                                                   linear_validity)
 from squeeze_grasp_ros.mechanics.errors import InvalidInputError
 from squeeze_grasp_ros.mechanics.vocabulary import MaterialModel, StrainMeasure
-from squeeze_grasp_ros.commands.csv_io import read_columns
 
 CUBOID_COLUMNS = ("force", "length", "width", "height", "dl", "dw")
 

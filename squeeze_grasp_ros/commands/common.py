@@ -15,7 +15,6 @@ from squeeze_grasp_ros.mechanics.errors import SqueezeGraspError
 from squeeze_grasp_ros.outputs import output_error, probe_folder
 from squeeze_grasp_ros.scene import GraspSetup, load_scene
 
-
 FIELD = re.compile(r"^([A-Za-z_][\w.\[\]]*) (?:must|is|needs|has)\b")
 """A message that starts with the name of the offending field ("object.shape.side must ...")."""
 

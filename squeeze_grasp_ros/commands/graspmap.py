@@ -9,13 +9,13 @@ import argparse
 import numpy as np
 
 from squeeze_grasp_ros import plots
-from squeeze_grasp_ros.commands.ring_map import map_summary, plot_map
 from squeeze_grasp_ros.commands.common import (
     add_plot_argument,
     add_scene_argument,
     add_solver_argument,
     load_setup,
 )
+from squeeze_grasp_ros.commands.ring_map import map_summary, plot_map
 from squeeze_grasp_ros.mechanics.squeeze.graspmap import GraspMap
 from squeeze_grasp_ros.mechanics.vocabulary import ObjectModel
 from squeeze_grasp_ros.scene.studies import grasp_map_study

@@ -11,8 +11,13 @@ from pathlib import Path
 import numpy as np
 
 from squeeze_grasp_ros import plots
-from squeeze_grasp_ros.commands.common import (add_plot_argument, add_scene_argument,
-                                               add_solver_argument, int_in, load_setup)
+from squeeze_grasp_ros.commands.common import (
+    add_plot_argument,
+    add_scene_argument,
+    add_solver_argument,
+    int_in,
+    load_setup,
+)
 from squeeze_grasp_ros.mechanics.errors import InvalidInputError
 from squeeze_grasp_ros.resources import ResourceError, device_file
 from squeeze_grasp_ros.scene.gripper import GripperSpec, load_gripper

@@ -8,9 +8,9 @@ import argparse
 import numpy as np
 
 from squeeze_grasp_ros import plots
-from squeeze_grasp_ros.mechanics.calibration.matching import Match, match_similarity
 from squeeze_grasp_ros.commands.common import add_plot_argument
 from squeeze_grasp_ros.commands.csv_io import read_points
+from squeeze_grasp_ros.mechanics.calibration.matching import Match, match_similarity
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:

@@ -16,11 +16,10 @@ from squeeze_grasp_ros.commands.common import add_plot_argument, output_file
 from squeeze_grasp_ros.inputs import InputError, read_bytes
 from squeeze_grasp_ros.mechanics.errors import InvalidInputError
 from squeeze_grasp_ros.mechanics.vocabulary import ImageEncoding
+from squeeze_grasp_ros.outputs import write_atomically
 from squeeze_grasp_ros.perception.camera import CameraModel, CameraPose
 from squeeze_grasp_ros.perception.extract import ObjectOutline, extract_outline
 from squeeze_grasp_ros.perception.image_files import decode_image
-from squeeze_grasp_ros.outputs import write_atomically
-
 
 MAX_IMAGE_BYTES = 256 * 1024 * 1024
 """Largest image file read (256 MiB)."""

@@ -11,10 +11,10 @@ import numpy as np
 from squeeze_grasp_ros.commands.camera_args import add_camera_arguments, load_camera
 from squeeze_grasp_ros.commands.common import add_scene_argument, output_file
 from squeeze_grasp_ros.mechanics.errors import InvalidInputError
+from squeeze_grasp_ros.outputs import write_atomically
 from squeeze_grasp_ros.perception.image_files import encode_png
 from squeeze_grasp_ros.perception.render import render_views, ring_band
 from squeeze_grasp_ros.scene import build_outline, load_scene
-from squeeze_grasp_ros.outputs import write_atomically
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:

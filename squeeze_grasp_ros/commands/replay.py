@@ -10,8 +10,8 @@ import sys
 
 import yaml
 
-from squeeze_grasp_ros.exit_codes import ExitCode
 from squeeze_grasp_ros.commands.common import fail
+from squeeze_grasp_ros.exit_codes import ExitCode
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:

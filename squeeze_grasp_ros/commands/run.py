@@ -15,10 +15,10 @@ import sys
 import tempfile
 from pathlib import Path
 
-from squeeze_grasp_ros.exit_codes import ExitCode, raise_on_signals
 from squeeze_grasp_ros.commands.common import add_scene_argument, fail, new_folder
 from squeeze_grasp_ros.control.force_watch import FORCE_MISMATCH
 from squeeze_grasp_ros.control.motion import REACTIONS
+from squeeze_grasp_ros.exit_codes import ExitCode, raise_on_signals
 
 EXECUTOR_CHOICES: tuple[str, ...] = ("events", "single")
 """``--executor`` values (equal to ``nodes.runner.EXECUTORS``; kept here so that building the CLI

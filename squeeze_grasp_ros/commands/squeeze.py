@@ -12,7 +12,6 @@ import sys
 import numpy as np
 
 from squeeze_grasp_ros import plots
-
 from squeeze_grasp_ros.commands.common import (
     add_plot_argument,
     add_scene_argument,

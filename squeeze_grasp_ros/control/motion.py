@@ -40,6 +40,7 @@ from dataclasses import dataclass, field
 from functools import cached_property
 
 import numpy as np
+
 from squeeze_grasp_ros.mechanics.vocabulary import Finger, SqueezeKind, Termination
 
 REACTIONS: tuple[str, ...] = ("hold", SqueezeKind.PURE.value, "normals")

@@ -50,7 +50,6 @@ from typing import NamedTuple
 
 import numpy as np
 
-
 from squeeze_grasp_ros.mechanics.squeeze.event_key import PROCESSING_ORDER, processing_rank
 from squeeze_grasp_ros.mechanics.vocabulary import ContactMode, EventType, Finger, Termination
 

@@ -15,40 +15,60 @@ raise :class:`Cancelled`.
 Units are SI and coordinates are in the object frame of the scene (x right, y up).
 """
 
+from squeeze_grasp_ros.mechanics.resistance.optimal import MAX_DIRECTIONS
+from squeeze_grasp_ros.planning.checks import (
+    best_count,
+    check_number,
+    check_step,
+    choice,
+    contact_nodes,
+)
 from squeeze_grasp_ros.planning.errors import (
+    ERROR_CODES,
+    Cancelled,
     ErrorCode,
     PlannerError,
-    Cancelled,
-    invalid,
     classify,
-    ERROR_CODES,
+    invalid,
 )
+from squeeze_grasp_ros.planning.gripper import gripper_grasp_plan, read_gripper
 from squeeze_grasp_ros.planning.object_ids import (
     MAX_ID_CHARS,
-    check_object_id,
     check_digest,
+    check_object_id,
     shown,
 )
 from squeeze_grasp_ros.planning.objects import (
-    PlannerLimits,
-    LoadedObject,
-    SceneSource,
-    read_scene,
-    requested_nodes,
-    check_size,
-    solver_route,
-    no_progress,
-    ObjectKey,
-    object_key,
-    load_object,
-    ObjectCache,
-    resident_bytes,
-    load_cached,
     CONTACT_MODELS,
     MAX_BEST_COUNT,
-    SOLID_STAGES,
     RING_STAGES,
+    SOLID_STAGES,
+    LoadedObject,
+    ObjectCache,
+    ObjectKey,
+    PlannerLimits,
     Progress,
+    SceneSource,
+    check_size,
+    load_cached,
+    load_object,
+    no_progress,
+    object_key,
+    read_scene,
+    requested_nodes,
+    resident_bytes,
+    solver_route,
+)
+from squeeze_grasp_ros.planning.requests import (
+    ResistancePlan,
+    RingTest,
+    SqueezePlan,
+    event_squeeze_run,
+    friction_resistance,
+    object_grasp_map,
+    resistance_plan,
+    ring_grasp_test,
+    squeeze_plan,
 )
 from squeeze_grasp_ros.planning.typed_objects import (
     FramePose,
@@ -56,26 +76,6 @@ from squeeze_grasp_ros.planning.typed_objects import (
     TypedObject,
     object_source,
     typed_scene,
-)
-from squeeze_grasp_ros.mechanics.resistance.optimal import MAX_DIRECTIONS
-from squeeze_grasp_ros.planning.checks import (
-    check_number,
-    check_step,
-    best_count,
-    choice,
-    contact_nodes,
-)
-from squeeze_grasp_ros.planning.gripper import gripper_grasp_plan, read_gripper
-from squeeze_grasp_ros.planning.requests import (
-    SqueezePlan,
-    squeeze_plan,
-    object_grasp_map,
-    ResistancePlan,
-    resistance_plan,
-    friction_resistance,
-    RingTest,
-    ring_grasp_test,
-    event_squeeze_run,
 )
 
 __all__ = [

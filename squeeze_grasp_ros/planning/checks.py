@@ -11,8 +11,7 @@ import numpy as np
 
 from squeeze_grasp_ros.planning.errors import invalid
 from squeeze_grasp_ros.planning.object_ids import shown
-from squeeze_grasp_ros.planning.objects import PlannerLimits, LoadedObject, MAX_BEST_COUNT
-
+from squeeze_grasp_ros.planning.objects import MAX_BEST_COUNT, LoadedObject, PlannerLimits
 
 # --------------------------------------------------------------------------- request checks
 

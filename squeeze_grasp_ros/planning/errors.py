@@ -6,7 +6,6 @@ from __future__ import annotations
 
 from enum import IntEnum
 
-
 from squeeze_grasp_ros.mechanics.errors import (
     InfeasibleError,
     InternalError,

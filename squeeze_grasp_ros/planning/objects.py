@@ -21,13 +21,17 @@ from squeeze_grasp_ros.inputs import InputError, confine, load_yaml, read_text
 from squeeze_grasp_ros.mechanics.elastic.compliance import ROUTES, ElasticObject
 from squeeze_grasp_ros.mechanics.ring.model import RingModel
 from squeeze_grasp_ros.mechanics.vocabulary import ContactKind, ObjectModel, ShapeType
-from squeeze_grasp_ros.scene import Scene, build_outline, parse_scene, requested_nodes
-from squeeze_grasp_ros.scene.setup import RING_STAGES, SOLID_STAGES, GraspSetup
 from squeeze_grasp_ros.planning.budget import check_load
 from squeeze_grasp_ros.planning.errors import ErrorCode, PlannerError, invalid
-from squeeze_grasp_ros.planning.object_ids import (check_digest, check_object_id, replaced,
-                                                   shown, taken)
-
+from squeeze_grasp_ros.planning.object_ids import (
+    check_digest,
+    check_object_id,
+    replaced,
+    shown,
+    taken,
+)
+from squeeze_grasp_ros.scene import Scene, build_outline, parse_scene, requested_nodes
+from squeeze_grasp_ros.scene.setup import RING_STAGES, SOLID_STAGES, GraspSetup
 
 CONTACT_MODELS: tuple[str, ...] = ContactKind.values()
 MAX_BEST_COUNT = 100_000

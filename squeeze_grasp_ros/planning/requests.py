@@ -9,8 +9,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from squeeze_grasp_ros.mechanics.squeeze.graspmap import GraspMap, grasp_map
 from squeeze_grasp_ros.mechanics.elastic.reduced import boundary_displacement, reduced_stiffness
+from squeeze_grasp_ros.mechanics.resistance.frictional import FrictionalResistance
 from squeeze_grasp_ros.mechanics.resistance.optimal import (
     MAX_DIRECTIONS,
     Resistance,
@@ -18,16 +18,15 @@ from squeeze_grasp_ros.mechanics.resistance.optimal import (
     optimal_resistance,
     sweep_directions,
 )
-from squeeze_grasp_ros.mechanics.resistance.frictional import FrictionalResistance
 from squeeze_grasp_ros.mechanics.ring.grasp_map import RingGraspMap, ring_grasp_map
 from squeeze_grasp_ros.mechanics.ring.squeeze import RingGrasp, ring_grasp
-from squeeze_grasp_ros.mechanics.squeeze.stable_pure import Squeeze, force_closure, plan_squeeze
 from squeeze_grasp_ros.mechanics.squeeze.events import EventSqueeze
+from squeeze_grasp_ros.mechanics.squeeze.graspmap import GraspMap, grasp_map
+from squeeze_grasp_ros.mechanics.squeeze.stable_pure import Squeeze, force_closure, plan_squeeze
 from squeeze_grasp_ros.mechanics.vocabulary import ContactKind, SqueezeKind
+from squeeze_grasp_ros.planning.checks import check_number, check_step, choice, contact_nodes
 from squeeze_grasp_ros.planning.errors import invalid
 from squeeze_grasp_ros.planning.objects import CONTACT_MODELS, LoadedObject, PlannerLimits
-from squeeze_grasp_ros.planning.checks import check_number, check_step, choice, contact_nodes
-
 
 # --------------------------------------------------------------------------- computations
 

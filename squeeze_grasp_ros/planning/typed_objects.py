@@ -37,10 +37,10 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.spatial.transform import Rotation
 
+from squeeze_grasp_ros.mechanics.elastic.shapes import Outline
 from squeeze_grasp_ros.mechanics.vocabulary import Effect, Finger, MaterialModel, ShapeType
 from squeeze_grasp_ros.planning.errors import invalid
 from squeeze_grasp_ros.planning.objects import SceneSource, read_scene
-from squeeze_grasp_ros.mechanics.elastic.shapes import Outline
 from squeeze_grasp_ros.scene import SHAPES, Scene, SceneError, build_outline, parse_scene
 
 __all__ = ["OBJECT_FRAME", "PLANAR_TOLERANCE", "TYPED_SHAPES", "FramePose", "TypedMaterial",

@@ -23,22 +23,21 @@ import yaml
 from rclpy.action import ActionClient
 from rclpy.context import Context
 from rclpy.executors import Executor, SingleThreadedExecutor
-from rclpy.qos import HistoryPolicy, QoSProfile, ReliabilityPolicy
 from rclpy.experimental import EventsExecutor
+from rclpy.qos import HistoryPolicy, QoSProfile, ReliabilityPolicy
 from rclpy.signals import SignalHandlerOptions
 from rclpy.task import Future
 
 from squeeze_grasp_interfaces.action import GraspMap
 from squeeze_grasp_interfaces.srv import LoadObject, PlanSqueeze
-
 from squeeze_grasp_ros import planning
-from squeeze_grasp_ros.ros import messages
 from squeeze_grasp_ros.mechanics.elastic.reduced import boundary_displacement, reduced_stiffness
 from squeeze_grasp_ros.mechanics.squeeze.stable_pure import plan_squeeze
+from squeeze_grasp_ros.mechanics.vocabulary import SqueezeKind
+from squeeze_grasp_ros.ros import messages
 from squeeze_grasp_ros.ros.nodes.planner import PlannerNode
 from squeeze_grasp_ros.ros.nodes.planner_client import PlannerClient
 from squeeze_grasp_ros.threads import single_thread_blas
-from squeeze_grasp_ros.mechanics.vocabulary import SqueezeKind
 
 DEPTH = 0.004
 """Squeeze depth rho of the benchmarked requests, m."""

@@ -29,7 +29,6 @@ from squeeze_grasp_ros.mechanics.ring.model import RingModel, ring_from_outline
 from squeeze_grasp_ros.mechanics.vocabulary import Finger, ObjectModel, ShapeType
 from squeeze_grasp_ros.scene.specs import PlacementSpec, Scene, SceneError, named_placements
 
-
 SHAPE_BUILDERS: dict[ShapeType, Callable[..., shapes.Outline]] = {
     ShapeType.RECTANGLE: shapes.rectangle,
     ShapeType.SQUARE: lambda side: shapes.rectangle(side, side),

@@ -17,10 +17,12 @@ import numpy as np
 from squeeze_grasp_ros.mechanics.elastic.compliance import ElasticObject
 from squeeze_grasp_ros.mechanics.errors import InfeasibleError, InvalidInputError
 from squeeze_grasp_ros.mechanics.squeeze.graspmap import GraspMap, grasp_map
-from squeeze_grasp_ros.mechanics.squeeze.gripper_grasp import (GripperCandidate,
-                                                               GripperEvaluation,
-                                                               evaluate_candidate,
-                                                               gripper_candidates)
+from squeeze_grasp_ros.mechanics.squeeze.gripper_grasp import (
+    GripperCandidate,
+    GripperEvaluation,
+    evaluate_candidate,
+    gripper_candidates,
+)
 from squeeze_grasp_ros.mechanics.vocabulary import MaterialModel
 from squeeze_grasp_ros.scene.gripper import GripperSpec
 from squeeze_grasp_ros.scene.setup import GraspSetup

@@ -40,13 +40,16 @@ from squeeze_grasp_ros.mechanics.resistance.optimal import (
     resistance_grasp,
 )
 from squeeze_grasp_ros.mechanics.ring.model import RingModel
-from squeeze_grasp_ros.mechanics.squeeze.contact_model import (ContactModel, SolveOptions,
-                                                             TerminationLimits)
+from squeeze_grasp_ros.mechanics.squeeze.contact_model import (
+    ContactModel,
+    SolveOptions,
+    TerminationLimits,
+)
 from squeeze_grasp_ros.mechanics.squeeze.events import EventSqueeze, event_squeeze
 from squeeze_grasp_ros.mechanics.squeeze.fingertips import Fingertip, place_fingertip
-from squeeze_grasp_ros.mechanics.squeeze.tip_shapes import TipShape
 from squeeze_grasp_ros.mechanics.squeeze.nonlinear_model import contact_model
 from squeeze_grasp_ros.mechanics.squeeze.stable_pure import FingerMotion, finger_motion
+from squeeze_grasp_ros.mechanics.squeeze.tip_shapes import TipShape
 from squeeze_grasp_ros.mechanics.vocabulary import (
     SQUEEZING_FINGERS,
     ContactKind,

@@ -17,6 +17,7 @@ from typing import Any, Optional
 
 from squeeze_grasp_ros.mechanics.elastic.mesh import MAX_MESH_NODES
 from squeeze_grasp_ros.mechanics.ring.model import MAX_RING_ELEMENTS
+from squeeze_grasp_ros.mechanics.squeeze.tip_shapes import TipShape
 from squeeze_grasp_ros.mechanics.vocabulary import (
     ContactKind,
     ControllerKind,
@@ -29,7 +30,6 @@ from squeeze_grasp_ros.mechanics.vocabulary import (
     StrainCriterion,
     TipKind,
 )
-from squeeze_grasp_ros.mechanics.squeeze.tip_shapes import TipShape
 from squeeze_grasp_ros.scene.schema import SchemaError, spec
 
 

@@ -20,13 +20,13 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable, Mapping, Sequence
-from typing import Any
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
-from squeeze_grasp_ros.mechanics.elastic.strain_measures import COMMON_STRAIN_MEASURE
 from squeeze_grasp_ros.mechanics.elastic.reduced import boundary_displacement, reduced_stiffness
+from squeeze_grasp_ros.mechanics.elastic.strain_measures import COMMON_STRAIN_MEASURE
 from squeeze_grasp_ros.mechanics.errors import InvalidInputError, require_relative_depth
 from squeeze_grasp_ros.mechanics.resistance.frictional import FrictionalResistance
 from squeeze_grasp_ros.mechanics.resistance.optimal import (

@@ -41,12 +41,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from squeeze_grasp_ros.mechanics.squeeze.contact_state import ContactState, Event, initial_state
 from squeeze_grasp_ros.mechanics.resistance.frictional import add_adversary
+from squeeze_grasp_ros.mechanics.squeeze.contact_state import ContactState, Event, initial_state
 from squeeze_grasp_ros.mechanics.squeeze.stepper import advance
 from squeeze_grasp_ros.mechanics.squeeze.tip_shapes import TipGeometry
-from squeeze_grasp_ros.scene import GraspSetup, SensorsSpec, finger_devices
+from squeeze_grasp_ros.mechanics.vocabulary import Effect, Finger, Termination
 from squeeze_grasp_ros.perception.shape_match import deformed_outline
+from squeeze_grasp_ros.scene import GraspSetup, SensorsSpec, finger_devices
 from squeeze_grasp_ros.sim.camera import CameraFrame, SimCamera
 from squeeze_grasp_ros.sim.devices import DeviceModel, device_model, follow
 from squeeze_grasp_ros.sim.sensors import (
@@ -56,7 +57,6 @@ from squeeze_grasp_ros.sim.sensors import (
     render_tactile,
     tactile_layout,
 )
-from squeeze_grasp_ros.mechanics.vocabulary import Effect, Finger, Termination
 
 TERMINATE_ON: tuple[str, ...] = (
     Termination.STRAIN_LIMIT,

@@ -19,8 +19,8 @@ import importlib.util
 import logging
 import os
 import signal
-import threading
 import sys
+import threading
 import time
 import urllib.request
 from dataclasses import dataclass, field

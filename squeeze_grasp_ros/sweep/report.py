@@ -14,6 +14,7 @@ from collections import defaultdict
 from pathlib import Path
 
 import numpy as np
+
 from squeeze_grasp_ros.mechanics.vocabulary import Termination
 
 SUCCESS = (Termination.DEPTH_REACHED, Termination.PICKED_UP)

@@ -15,11 +15,20 @@ from __future__ import annotations
 import dataclasses
 import hashlib
 import json
+from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
-from collections.abc import Mapping
 from typing import Any, Optional
 
+from squeeze_grasp_ros.mechanics.resistance.optimal import MAX_DIRECTIONS
+from squeeze_grasp_ros.mechanics.vocabulary import (
+    ContactKind,
+    Effect,
+    Finger,
+    ObjectModel,
+    ShapeType,
+    SqueezeKind,
+)
 from squeeze_grasp_ros.scene import (
     MaterialSpec,
     MeshSpec,
@@ -29,17 +38,8 @@ from squeeze_grasp_ros.scene import (
     load_scene,
     read_yaml,
 )
-from squeeze_grasp_ros.mechanics.resistance.optimal import MAX_DIRECTIONS
 from squeeze_grasp_ros.scene.checks import check_material, check_shape
 from squeeze_grasp_ros.scene.schema import key_reference, parse_section, spec
-from squeeze_grasp_ros.mechanics.vocabulary import (
-    ContactKind,
-    Effect,
-    Finger,
-    ObjectModel,
-    ShapeType,
-    SqueezeKind,
-)
 
 
 class SweepError(SceneError):

@@ -28,7 +28,6 @@ import scipy.linalg as la
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from squeeze_grasp_ros.mechanics.errors import ConditioningWarning, InvalidInputError
 from squeeze_grasp_ros.mechanics.elastic.fem import (
     rigid_modes,
     rotation_mode_norm,
@@ -38,6 +37,7 @@ from squeeze_grasp_ros.mechanics.elastic.hyperelastic import gradient_operator
 from squeeze_grasp_ros.mechanics.elastic.material import Material
 from squeeze_grasp_ros.mechanics.elastic.mesh import Mesh
 from squeeze_grasp_ros.mechanics.elastic.schur import minimum_degree_order, trailing_factors
+from squeeze_grasp_ros.mechanics.errors import ConditioningWarning, InvalidInputError
 
 Route = Literal["factorized", "spectral"]
 GRADIENT_BOUND_BYTES = 128 * 2**20

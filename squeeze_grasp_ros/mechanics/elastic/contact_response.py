@@ -34,10 +34,17 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from squeeze_grasp_ros.mechanics.elastic.hyperelastic import (MeshGeometry, assemble,
-                                                                determinants, mesh_geometry)
-from squeeze_grasp_ros.mechanics.elastic.interior import (ContactStiffness, InteriorBlocks,
-                                                          TangentFactor)
+from squeeze_grasp_ros.mechanics.elastic.hyperelastic import (
+    MeshGeometry,
+    assemble,
+    determinants,
+    mesh_geometry,
+)
+from squeeze_grasp_ros.mechanics.elastic.interior import (
+    ContactStiffness,
+    InteriorBlocks,
+    TangentFactor,
+)
 from squeeze_grasp_ros.mechanics.errors import InvalidInputError
 from squeeze_grasp_ros.mechanics.vocabulary import MaterialModel
 

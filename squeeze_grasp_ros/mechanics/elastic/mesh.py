@@ -16,7 +16,6 @@ from typing import Protocol
 
 import numpy as np
 
-from squeeze_grasp_ros.mechanics.errors import InvalidInputError
 from squeeze_grasp_ros.mechanics.elastic.mesh_size import (
     MAX_MESH_NODES,
     NODES_PER_AREA,
@@ -24,6 +23,7 @@ from squeeze_grasp_ros.mechanics.elastic.mesh_size import (
     estimate_mesh,
 )
 from squeeze_grasp_ros.mechanics.elastic.shapes import Outline, interior_point, signed_area
+from squeeze_grasp_ros.mechanics.errors import InvalidInputError
 
 
 class Mesher(Protocol):

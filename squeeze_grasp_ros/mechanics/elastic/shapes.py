@@ -16,9 +16,9 @@ from typing import Sequence
 import numpy as np
 from scipy.interpolate import CubicSpline
 
-from squeeze_grasp_ros.mechanics.vocabulary import ShapeType
 from squeeze_grasp_ros.inputs import InputError, read_text
 from squeeze_grasp_ros.mechanics.errors import InvalidInputError
+from squeeze_grasp_ros.mechanics.vocabulary import ShapeType
 
 DENSE = 2048
 """Number of samples of a smooth outline before resampling."""

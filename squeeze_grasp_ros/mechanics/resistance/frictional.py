@@ -33,6 +33,13 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
+from squeeze_grasp_ros.mechanics.elastic.mesh import vertex_normals
+from squeeze_grasp_ros.mechanics.errors import InvalidInputError, require_finite
+from squeeze_grasp_ros.mechanics.resistance.optimal import (
+    optimal_resistance,
+    require_small_push,
+    resistance_grasp,
+)
 from squeeze_grasp_ros.mechanics.squeeze.contact_model import ContactModel
 from squeeze_grasp_ros.mechanics.squeeze.contact_state import (
     ContactState,
@@ -40,14 +47,7 @@ from squeeze_grasp_ros.mechanics.squeeze.contact_state import (
     event_counts,
     initial_state,
 )
-from squeeze_grasp_ros.mechanics.errors import InvalidInputError, require_finite
 from squeeze_grasp_ros.mechanics.squeeze.fingertips import Fingertip
-from squeeze_grasp_ros.mechanics.elastic.mesh import vertex_normals
-from squeeze_grasp_ros.mechanics.resistance.optimal import (
-    optimal_resistance,
-    require_small_push,
-    resistance_grasp,
-)
 from squeeze_grasp_ros.mechanics.squeeze.stepper import advance
 from squeeze_grasp_ros.mechanics.vocabulary import (
     ContactKind,

@@ -41,15 +41,13 @@ from typing import Mapping, Sequence
 import numpy as np
 
 from squeeze_grasp_ros.mechanics.elastic.compliance import ElasticObject
-
-from squeeze_grasp_ros.mechanics.errors import InvalidInputError, require_finite
-
 from squeeze_grasp_ros.mechanics.elastic.mesh import Mesh
 from squeeze_grasp_ros.mechanics.elastic.reduced import (
     ReducedStiffness,
     reduced_stiffness,
     rotation_angle,
 )
+from squeeze_grasp_ros.mechanics.errors import InvalidInputError, require_finite
 from squeeze_grasp_ros.mechanics.resistance.forms import (
     PureForm,
     StableForm,

@@ -53,12 +53,6 @@ import numpy as np
 import scipy.linalg as la
 import scipy.sparse as sp
 
-from squeeze_grasp_ros.mechanics.errors import (
-    InternalError,
-    InvalidInputError,
-    NumericalError,
-    require_finite,
-)
 from squeeze_grasp_ros.mechanics.elastic.fem import rigid_modes, rotation_mode_norm
 from squeeze_grasp_ros.mechanics.elastic.material import Material
 from squeeze_grasp_ros.mechanics.elastic.shapes import (
@@ -67,6 +61,12 @@ from squeeze_grasp_ros.mechanics.elastic.shapes import (
     resample,
     resampled_count,
     signed_area,
+)
+from squeeze_grasp_ros.mechanics.errors import (
+    InternalError,
+    InvalidInputError,
+    NumericalError,
+    require_finite,
 )
 from squeeze_grasp_ros.mechanics.vocabulary import StrainMeasure
 

@@ -33,8 +33,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from squeeze_grasp_ros.mechanics.elastic.compliance import node_dofs
-from squeeze_grasp_ros.mechanics.errors import InvalidInputError, require_finite
 from squeeze_grasp_ros.mechanics.elastic.reduced import reduce_blocks
+from squeeze_grasp_ros.mechanics.errors import InvalidInputError, require_finite
 from squeeze_grasp_ros.mechanics.ring.model import FIBRE_STRAIN_MEASURE, RingModel
 from squeeze_grasp_ros.mechanics.squeeze.stable_pure import two_contact_direction
 from squeeze_grasp_ros.mechanics.vocabulary import SQUEEZING_FINGERS, RingLimit, SqueezeKind

@@ -36,15 +36,15 @@ from functools import cached_property
 import numpy as np
 
 from squeeze_grasp_ros.mechanics.elastic.compliance import ElasticObject, node_dofs
-from squeeze_grasp_ros.mechanics.errors import InvalidInputError, NumericalError
 from squeeze_grasp_ros.mechanics.elastic.fem import (
     element_dofs,
     principal_strains,
     strain_displacement,
 )
 from squeeze_grasp_ros.mechanics.elastic.hyperelastic import area_ratios
-from squeeze_grasp_ros.mechanics.squeeze.tip_shapes import TipGeometry, cross, tangent, unit
 from squeeze_grasp_ros.mechanics.elastic.reduced import reduce_blocks
+from squeeze_grasp_ros.mechanics.errors import InvalidInputError, NumericalError
+from squeeze_grasp_ros.mechanics.squeeze.tip_shapes import TipGeometry, cross, tangent, unit
 from squeeze_grasp_ros.mechanics.vocabulary import MaterialModel, StrainCriterion, StrainMeasure
 
 INVERSION_AREA_RATIO = 0.01

@@ -19,6 +19,13 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from squeeze_grasp_ros.mechanics.elastic.compliance import ElasticObject
+from squeeze_grasp_ros.mechanics.elastic.strain_measures import max_principal_strains
+from squeeze_grasp_ros.mechanics.elastic.stress_measures import element_stresses, von_mises
+from squeeze_grasp_ros.mechanics.errors import (
+    InvalidInputError,
+    require_finite,
+    require_relative_depth,
+)
 from squeeze_grasp_ros.mechanics.squeeze.contact_model import (
     ContactModel,
     SolveOptions,
@@ -33,19 +40,14 @@ from squeeze_grasp_ros.mechanics.squeeze.contact_state import (
     event_counts,
     initial_state,
 )
-from squeeze_grasp_ros.mechanics.errors import (
-    InvalidInputError,
-    require_finite,
-    require_relative_depth,
-)
-from squeeze_grasp_ros.mechanics.elastic.strain_measures import max_principal_strains
-from squeeze_grasp_ros.mechanics.elastic.stress_measures import element_stresses, von_mises
 from squeeze_grasp_ros.mechanics.squeeze.fingertips import place_fingertip
-from squeeze_grasp_ros.mechanics.squeeze.tip_shapes import TipShape
+from squeeze_grasp_ros.mechanics.squeeze.nonlinear_model import (
+    NonlinearContactModel,
+    contact_model,
+)
 from squeeze_grasp_ros.mechanics.squeeze.stable_pure import finger_motion
 from squeeze_grasp_ros.mechanics.squeeze.stepper import TERMINATION_ORDER, advance
-from squeeze_grasp_ros.mechanics.squeeze.nonlinear_model import (NonlinearContactModel,
-                                                                  contact_model)
+from squeeze_grasp_ros.mechanics.squeeze.tip_shapes import TipShape
 from squeeze_grasp_ros.mechanics.vocabulary import (
     SQUEEZING_FINGERS,
     ContactMode,

@@ -23,10 +23,15 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from squeeze_grasp_ros.mechanics.errors import InvalidInputError
 from squeeze_grasp_ros.mechanics.elastic.mesh import Mesh
-from squeeze_grasp_ros.mechanics.squeeze.tip_shapes import (TipGeometry, TipShape, cross,
-                                                            tangent, unit)
+from squeeze_grasp_ros.mechanics.errors import InvalidInputError
+from squeeze_grasp_ros.mechanics.squeeze.tip_shapes import (
+    TipGeometry,
+    TipShape,
+    cross,
+    tangent,
+    unit,
+)
 from squeeze_grasp_ros.mechanics.vocabulary import Finger, TipKind
 
 __all__ = ["TOUCH_TOLERANCE", "Fingertip", "cross", "place_fingertip", "tangent", "unit"]

@@ -36,8 +36,8 @@ from squeeze_grasp_ros.mechanics.elastic.compliance import ElasticObject
 from squeeze_grasp_ros.mechanics.errors import InvalidInputError
 from squeeze_grasp_ros.mechanics.squeeze.contact_model import TerminationLimits
 from squeeze_grasp_ros.mechanics.squeeze.events import EventSqueeze, event_squeeze
-from squeeze_grasp_ros.mechanics.squeeze.graspmap import GraspMap
 from squeeze_grasp_ros.mechanics.squeeze.fingertips import TOUCH_TOLERANCE
+from squeeze_grasp_ros.mechanics.squeeze.graspmap import GraspMap
 from squeeze_grasp_ros.mechanics.squeeze.tip_shapes import TipShape, tangent, unit
 from squeeze_grasp_ros.mechanics.vocabulary import Finger, MaterialModel, Termination
 

@@ -20,14 +20,23 @@ from dataclasses import dataclass
 import numpy as np
 
 from squeeze_grasp_ros.mechanics.elastic.compliance import node_dofs
-from squeeze_grasp_ros.mechanics.elastic.contact_response import (NEWTON_TOL, ContactResponse,
-                                                                  Evaluation, ResponseFailure)
+from squeeze_grasp_ros.mechanics.elastic.contact_response import (
+    NEWTON_TOL,
+    ContactResponse,
+    Evaluation,
+    ResponseFailure,
+)
 from squeeze_grasp_ros.mechanics.elastic.hyperelastic import mesh_geometry
 from squeeze_grasp_ros.mechanics.elastic.interior import TangentFactor, default_factorizer
 from squeeze_grasp_ros.mechanics.elastic.strain_measures import max_principal_strain
 from squeeze_grasp_ros.mechanics.errors import InvalidInputError
-from squeeze_grasp_ros.mechanics.squeeze.contact_model import (ContactModel, Response, SetData,
-                                                               Solution, SolveFailure)
+from squeeze_grasp_ros.mechanics.squeeze.contact_model import (
+    ContactModel,
+    Response,
+    SetData,
+    Solution,
+    SolveFailure,
+)
 from squeeze_grasp_ros.mechanics.vocabulary import MaterialModel, StrainCriterion
 
 __all__ = ["NonlinearContactModel", "RESPONSE_ACCURACY", "contact_model"]

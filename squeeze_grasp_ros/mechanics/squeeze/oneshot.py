@@ -25,8 +25,8 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from squeeze_grasp_ros.mechanics.elastic.compliance import ElasticObject
-from squeeze_grasp_ros.mechanics.squeeze.contact_state import ContactState, tip_geometry
 from squeeze_grasp_ros.mechanics.errors import NumericalError
+from squeeze_grasp_ros.mechanics.squeeze.contact_state import ContactState, tip_geometry
 from squeeze_grasp_ros.mechanics.squeeze.tip_shapes import tangent, unit
 from squeeze_grasp_ros.mechanics.vocabulary import ContactMode
 

@@ -15,12 +15,12 @@ from dataclasses import dataclass
 import numpy as np
 
 from squeeze_grasp_ros.mechanics.elastic.compliance import ElasticObject
-from squeeze_grasp_ros.mechanics.errors import InfeasibleError, InvalidInputError
 from squeeze_grasp_ros.mechanics.elastic.reduced import (
     ReducedStiffness,
     reduced_stiffness,
     rotation_angle,
 )
+from squeeze_grasp_ros.mechanics.errors import InfeasibleError, InvalidInputError
 from squeeze_grasp_ros.mechanics.vocabulary import SQUEEZING_FINGERS, Finger, SqueezeKind
 
 

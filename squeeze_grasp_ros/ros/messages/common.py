@@ -13,8 +13,6 @@ from geometry_msgs.msg import Vector3
 from rosgraph_msgs.msg import Clock
 from std_msgs.msg import Header
 
-
-
 from squeeze_grasp_ros.planning import (
     ErrorCode,
 )

@@ -16,13 +16,9 @@ from squeeze_grasp_interfaces.msg import (
     ContactState,
     TactileArray,
 )
-
 from squeeze_grasp_ros.mechanics.squeeze import contact_state
-
 from squeeze_grasp_ros.mechanics.vocabulary import ContactMode
-
-from squeeze_grasp_ros.ros.messages.common import (float64_array, set_stamp, vector3)
-
+from squeeze_grasp_ros.ros.messages.common import float64_array, set_stamp, vector3
 
 CONTACT_MODES: dict[ContactMode, int] = {ContactMode.STICK: ContactNode.STICK,
                                          ContactMode.SLIP: ContactNode.SLIP}

@@ -12,11 +12,7 @@ from std_msgs.msg import Header
 from squeeze_grasp_interfaces.msg import (
     Tick,
 )
-
-
-
-from squeeze_grasp_ros.ros.messages.common import (header, set_stamp)
-
+from squeeze_grasp_ros.ros.messages.common import header, set_stamp
 
 # --------------------------------------------------------------------------- pipeline: devices
 

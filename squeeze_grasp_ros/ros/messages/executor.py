@@ -14,12 +14,8 @@ from squeeze_grasp_interfaces.msg import (
     ExecutorStatus,
     MonitorStatus,
 )
-
 from squeeze_grasp_ros.control.motion import Command, GraspGoal, GraspProgram, Observation
-
-
-from squeeze_grasp_ros.ros.messages.common import (float64_array, header, stamp_ns, vector3)
-
+from squeeze_grasp_ros.ros.messages.common import float64_array, header, stamp_ns, vector3
 
 # --------------------------------------------------------------------------- pipeline: executor
 

@@ -9,7 +9,6 @@ from geometry_msgs.msg import PoseStamped
 
 from squeeze_grasp_interfaces.msg import GripperGrasp
 from squeeze_grasp_interfaces.srv import PlanGripperGrasp
-
 from squeeze_grasp_ros.mechanics.squeeze.gripper_grasp import GripperCandidate
 from squeeze_grasp_ros.ros.messages.common import float64_array, header, int32_array, success
 from squeeze_grasp_ros.scene.gripper_plan import GripperPlan

@@ -16,7 +16,6 @@ from squeeze_grasp_interfaces.msg import (
     ContactState,
     MonitorStatus,
 )
-
 from squeeze_grasp_ros.control.force_watch import PredictedForces
 from squeeze_grasp_ros.control.tracker import (
     PredictedEvent,
@@ -24,12 +23,9 @@ from squeeze_grasp_ros.control.tracker import (
     TrackedEvent,
     TrackerOutput,
 )
-
-
 from squeeze_grasp_ros.mechanics.vocabulary import EventType, Finger
-from squeeze_grasp_ros.ros.messages.common import (float64_array, header, vector3)
-from squeeze_grasp_ros.ros.messages.contacts import (CONTACT_MODES, contact_arrays_msg)
-
+from squeeze_grasp_ros.ros.messages.common import float64_array, header, vector3
+from squeeze_grasp_ros.ros.messages.contacts import CONTACT_MODES, contact_arrays_msg
 
 # --------------------------------------------------------------------------- pipeline: monitor
 

@@ -9,7 +9,6 @@ import numpy as np
 from geometry_msgs.msg import Point, Point32, Polygon, PolygonStamped
 
 from squeeze_grasp_interfaces.msg import Material, ObjectDescription, SeenOutline, ShapeParameter
-
 from squeeze_grasp_ros.mechanics.elastic.shapes import Outline
 from squeeze_grasp_ros.planning.typed_objects import FramePose, TypedMaterial, TypedObject
 from squeeze_grasp_ros.ros.messages.common import header

@@ -20,12 +20,12 @@ from squeeze_grasp_interfaces.msg import (
     ObjectModel,
 )
 from squeeze_grasp_interfaces.srv import LoadObject, PlanResistance, PlanSqueeze, RingGraspTest
-
 from squeeze_grasp_ros.control.force_watch import squeeze_forces
-from squeeze_grasp_ros.mechanics.squeeze.graspmap import GraspMap
-
+from squeeze_grasp_ros.mechanics import vocabulary
 from squeeze_grasp_ros.mechanics.resistance.frictional import FrictionalResistance
 from squeeze_grasp_ros.mechanics.squeeze.events import EventSqueeze
+from squeeze_grasp_ros.mechanics.squeeze.graspmap import GraspMap
+from squeeze_grasp_ros.mechanics.vocabulary import Finger
 from squeeze_grasp_ros.planning import (
     ErrorCode,
     LoadedObject,
@@ -33,9 +33,6 @@ from squeeze_grasp_ros.planning import (
     RingTest,
     SqueezePlan,
 )
-from squeeze_grasp_ros.mechanics import vocabulary
-from squeeze_grasp_ros.mechanics.vocabulary import Finger
-
 from squeeze_grasp_ros.ros.messages.common import (
     bool_list,
     failure,

@@ -14,15 +14,11 @@ from squeeze_grasp_interfaces.msg import (
     ContactEventArray,
     SimState,
 )
-
 from squeeze_grasp_ros.mechanics.squeeze import contact_state
-
-from squeeze_grasp_ros.sim.world import WorldView
-
 from squeeze_grasp_ros.mechanics.vocabulary import ContactMode
-from squeeze_grasp_ros.ros.messages.common import (float64_array, header, stamp_ns, vector3)
-from squeeze_grasp_ros.ros.messages.contacts import (contact_event_msg, contact_state_msg)
-
+from squeeze_grasp_ros.ros.messages.common import float64_array, header, stamp_ns, vector3
+from squeeze_grasp_ros.ros.messages.contacts import contact_event_msg, contact_state_msg
+from squeeze_grasp_ros.sim.world import WorldView
 
 # --------------------------------------------------------------------------- pipeline: ground trut
 

@@ -20,7 +20,6 @@ from rclpy.signals import SignalHandlerOptions
 from squeeze_grasp_ros.exit_codes import ExitCode
 from squeeze_grasp_ros.mechanics.errors import InvalidInputError
 
-
 PARENT_PID_ENV = "SQUEEZE_GRASP_PARENT_PID"
 """Environment variable naming the process that started a node (``squeeze-grasp run
 --processes``): the node ends when that process dies."""

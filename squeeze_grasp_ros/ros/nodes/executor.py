@@ -31,7 +31,6 @@ previous feedback. Cancel: the next cycle holds the measured positions and the g
 from __future__ import annotations
 
 import sys
-
 from typing import Any
 
 from geometry_msgs.msg import PoseStamped
@@ -42,9 +41,8 @@ from rclpy.task import Future
 
 from squeeze_grasp_interfaces.action import ExecuteGrasp
 from squeeze_grasp_interfaces.msg import ExecutorStatus, MonitorStatus
-
-from squeeze_grasp_ros.ros import messages
 from squeeze_grasp_ros.control.motion import Command, GraspProgram, MotionLimits, goal_problem
+from squeeze_grasp_ros.ros import messages
 from squeeze_grasp_ros.ros.nodes import pipeline, run_node
 from squeeze_grasp_ros.ros.nodes.jaw_commands import JawCommands
 

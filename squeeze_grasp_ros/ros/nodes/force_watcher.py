@@ -21,9 +21,7 @@ import numpy as np
 from rclpy.node import Node
 
 from squeeze_grasp_interfaces.msg import ContactEventArray, ForceResidual
-
-from squeeze_grasp_ros.control.force_watch import (PredictedForces, check_forces,
-                                                   force_along_motion)
+from squeeze_grasp_ros.control.force_watch import PredictedForces, check_forces, force_along_motion
 from squeeze_grasp_ros.control.tracker import FingerSample, TrackedAlarm, TrackerOutput
 from squeeze_grasp_ros.ros import messages
 from squeeze_grasp_ros.ros.nodes import pipeline

@@ -27,17 +27,21 @@ from __future__ import annotations
 
 import dataclasses
 import sys
-
 from typing import Any
 
 from geometry_msgs.msg import PoseStamped, WrenchStamped
 from rclpy.node import Node
 
-from squeeze_grasp_interfaces.msg import (Alarm, ContactEventArray, ContactState, MonitorStatus,
-                                          TactileArray, Tick)
-
-from squeeze_grasp_ros.ros import messages
+from squeeze_grasp_interfaces.msg import (
+    Alarm,
+    ContactEventArray,
+    ContactState,
+    MonitorStatus,
+    TactileArray,
+    Tick,
+)
 from squeeze_grasp_ros.control.tracker import ContactTracker, FingerSample, TrackerConfig
+from squeeze_grasp_ros.ros import messages
 from squeeze_grasp_ros.ros.nodes import pipeline, run_node
 from squeeze_grasp_ros.ros.nodes.force_watcher import ForceWatcher
 from squeeze_grasp_ros.ros.nodes.shape_watcher import ShapeWatcher

@@ -33,7 +33,6 @@ from sensor_msgs.msg import CameraInfo, Image
 from std_msgs.msg import String
 
 from squeeze_grasp_interfaces.msg import SeenOutline
-
 from squeeze_grasp_ros.mechanics.errors import InvalidInputError
 from squeeze_grasp_ros.perception.camera import CameraModel, CameraPose
 from squeeze_grasp_ros.perception.extract import extract_outline

@@ -41,23 +41,28 @@ from typing import Any, TypeVar
 from rcl_interfaces.msg import ParameterDescriptor
 from rclpy.action import ActionServer, CancelResponse
 from rclpy.action.server import ServerGoalHandle
-from rclpy.executors import SingleThreadedExecutor
 from rclpy.callback_groups import ReentrantCallbackGroup
+from rclpy.executors import SingleThreadedExecutor
 from rclpy.node import Node
 from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
 from rclpy.task import Future
 
 from squeeze_grasp_interfaces.action import EventSqueeze as EventSqueezeAction
 from squeeze_grasp_interfaces.action import GraspMap as GraspMapAction
-from squeeze_grasp_interfaces.srv import (EventSqueeze, GraspMap, LoadObject,
-                                          PlanGripperGrasp, PlanResistance, PlanSqueeze,
-                                          RingGraspTest)
-
+from squeeze_grasp_interfaces.srv import (
+    EventSqueeze,
+    GraspMap,
+    LoadObject,
+    PlanGripperGrasp,
+    PlanResistance,
+    PlanSqueeze,
+    RingGraspTest,
+)
 from squeeze_grasp_ros import planning
 from squeeze_grasp_ros.mechanics.vocabulary import ObjectModel
-from squeeze_grasp_ros.ros import messages
 from squeeze_grasp_ros.planning import Cancelled, ErrorCode, PlannerLimits
 from squeeze_grasp_ros.resources import share_dir
+from squeeze_grasp_ros.ros import messages
 from squeeze_grasp_ros.ros.nodes import run_node
 
 Response = TypeVar("Response")

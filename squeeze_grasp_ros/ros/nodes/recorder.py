@@ -26,9 +26,8 @@ already arrived, then ``close`` writes the MCAP summary and ``metadata.yaml``.
 """
 from __future__ import annotations
 
-import sys
-
 import struct
+import sys
 import time
 from collections import deque
 from typing import Any
@@ -39,9 +38,9 @@ from rclpy.qos import DurabilityPolicy, HistoryPolicy, ReliabilityPolicy
 from std_msgs.msg import Header
 
 from squeeze_grasp_ros.ros import messages
+from squeeze_grasp_ros.ros.nodes import ParameterError, pipeline, run_node
 from squeeze_grasp_ros.ros.recording.bag import BagWriter, qos_dict
 from squeeze_grasp_ros.ros.recording.schema import starts_with_stamp
-from squeeze_grasp_ros.ros.nodes import ParameterError, pipeline, run_node
 
 PARAMETERS: dict[str, tuple[Any, str]] = {
     "output": ("", "bag folder to create (required; must not exist or be empty)"),

@@ -21,7 +21,6 @@ from rclpy.node import Node
 from sensor_msgs.msg import CameraInfo, Image
 
 from squeeze_grasp_interfaces.msg import Alarm, PredictedShapes, ShapeResidual
-
 from squeeze_grasp_ros.mechanics.errors import InvalidInputError
 from squeeze_grasp_ros.perception.extract import extract_outline
 from squeeze_grasp_ros.perception.shape_watch import PredictedShapes as Prediction

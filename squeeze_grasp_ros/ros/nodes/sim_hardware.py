@@ -23,7 +23,6 @@ every re-sent topic carries one message per stamp, which is how the recorder dro
 from __future__ import annotations
 
 import sys
-
 import time
 from typing import Any
 
@@ -36,16 +35,15 @@ from std_msgs.msg import Header
 from visualization_msgs.msg import MarkerArray
 
 from squeeze_grasp_interfaces.msg import ContactEventArray, SimState, TactileArray, Tick
-
 from squeeze_grasp_ros.mechanics.vocabulary import Effect, ImageEncoding
 from squeeze_grasp_ros.ros import messages
-from squeeze_grasp_ros.scene import GraspSetup, load_scene
-from squeeze_grasp_ros.scene.controller import scene_controller
 from squeeze_grasp_ros.ros.messages.images import camera_info_msg, image_msg, pose_of_camera
-from squeeze_grasp_ros.sim.camera import CameraFrame
-from squeeze_grasp_ros.sim.world import SimWorld, TickOutput
 from squeeze_grasp_ros.ros.nodes import ParameterError, pipeline, run_node
 from squeeze_grasp_ros.ros.nodes.sim_controllers import SimJointTrajectoryController
+from squeeze_grasp_ros.scene import GraspSetup, load_scene
+from squeeze_grasp_ros.scene.controller import scene_controller
+from squeeze_grasp_ros.sim.camera import CameraFrame
+from squeeze_grasp_ros.sim.world import SimWorld, TickOutput
 
 PARAMETERS: dict[str, tuple[Any, str]] = {
     "scene": ("", "scene YAML file the world is built from (required)"),

@@ -19,8 +19,20 @@ from typing import Any, BinaryIO
 
 from mcap.data_stream import ReadDataStream, RecordBuilder
 from mcap.opcode import Opcode
-from mcap.records import (Channel, Chunk, ChunkIndex, DataEnd, Footer, Message, MessageIndex,
-                          Metadata, MetadataIndex, Schema, Statistics, SummaryOffset)
+from mcap.records import (
+    Channel,
+    Chunk,
+    ChunkIndex,
+    DataEnd,
+    Footer,
+    Message,
+    MessageIndex,
+    Metadata,
+    MetadataIndex,
+    Schema,
+    Statistics,
+    SummaryOffset,
+)
 from mcap.stream_reader import breakup_chunk
 from mcap.writer import MCAP0_MAGIC
 

@@ -20,25 +20,24 @@ from collections.abc import Mapping
 from typing import Any
 
 import rclpy
+from geometry_msgs.msg import PoseStamped, WrenchStamped
 from rclpy.context import Context
 from rclpy.experimental import EventsExecutor
 from rclpy.node import Node
 from rclpy.parameter import Parameter
 from rclpy.serialization import deserialize_message
 from rclpy.signals import SignalHandlerOptions
-from geometry_msgs.msg import PoseStamped, WrenchStamped
 from rosgraph_msgs.msg import Clock
 
 from squeeze_grasp_interfaces.msg import ContactEventArray, MonitorStatus, TactileArray, Tick
-
 from squeeze_grasp_ros.inputs import InputError, load_yaml
+from squeeze_grasp_ros.mechanics.vocabulary import Finger
 from squeeze_grasp_ros.ros import messages
 from squeeze_grasp_ros.ros.nodes import pipeline
 from squeeze_grasp_ros.ros.nodes.monitor import MonitorNode
 from squeeze_grasp_ros.ros.nodes.recorder import cdr_stamp_ns
-from squeeze_grasp_ros.ros.run.options import config_parameters
 from squeeze_grasp_ros.ros.recording.bag import BagContents, BagError, read_bag
-from squeeze_grasp_ros.mechanics.vocabulary import Finger
+from squeeze_grasp_ros.ros.run.options import config_parameters
 
 READING = re.compile(r"^/?devices/([^/]+)/(pose|wrench|tactile)$")
 READING_TYPES: dict[str, tuple[str, type]] = {

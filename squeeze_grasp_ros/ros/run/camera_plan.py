@@ -19,7 +19,6 @@ from geometry_msgs.msg import PoseStamped
 from sensor_msgs.msg import CameraInfo, Image
 
 from squeeze_grasp_interfaces.msg import ObjectDescription, PredictedShapes
-
 from squeeze_grasp_ros.mechanics.vocabulary import ShapeFit
 from squeeze_grasp_ros.perception.extract import ObjectOutline, extract_outline
 from squeeze_grasp_ros.perception.shape_match import shape_residual

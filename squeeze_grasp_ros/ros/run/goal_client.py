@@ -22,7 +22,6 @@ from rclpy.node import Node
 from unique_identifier_msgs.msg import UUID
 
 from squeeze_grasp_interfaces.action import ExecuteGrasp
-
 from squeeze_grasp_ros.ros.nodes import pipeline
 from squeeze_grasp_ros.ros.run.options import RunError
 

@@ -29,17 +29,16 @@ from rclpy.parameter import Parameter
 
 from squeeze_grasp_interfaces.msg import ContactEventArray, ObjectDescription
 from squeeze_grasp_interfaces.srv import EventSqueeze, LoadObject, PlanSqueeze
-
 from squeeze_grasp_ros import planning
 from squeeze_grasp_ros.control.force_watch import squeeze_forces
 from squeeze_grasp_ros.control.motion import GraspGoal
+from squeeze_grasp_ros.inputs import InputError, load_yaml, read_text
 from squeeze_grasp_ros.mechanics.vocabulary import SQUEEZING_FINGERS, ShapeType, SqueezeKind
 from squeeze_grasp_ros.resources import config_dir, share_dir
 from squeeze_grasp_ros.ros import messages
 from squeeze_grasp_ros.ros.nodes.planner_client import PlannerClient
 from squeeze_grasp_ros.ros.run.options import RunError, RunOptions
 from squeeze_grasp_ros.ros.run.processes import NodeProcesses, ros_arguments
-from squeeze_grasp_ros.inputs import InputError, load_yaml, read_text
 from squeeze_grasp_ros.scene import GraspSetup, Scene, SceneError, parse_scene
 from squeeze_grasp_ros.scene.goal import plan_scene, resistance_goal, resists
 

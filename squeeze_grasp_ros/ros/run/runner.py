@@ -45,26 +45,39 @@ from rclpy.signals import SignalHandlerOptions
 
 from squeeze_grasp_interfaces.action import ExecuteGrasp
 from squeeze_grasp_interfaces.msg import ContactEventArray, PredictedShapes
-
 from squeeze_grasp_ros.exit_codes import Interrupted
 from squeeze_grasp_ros.mechanics.vocabulary import Effect
 from squeeze_grasp_ros.perception.extract import ObjectOutline
 from squeeze_grasp_ros.planning.typed_objects import typed_scene
-from squeeze_grasp_ros.ros.messages.objects import typed_object
-from squeeze_grasp_ros.ros.run.camera_plan import (first_outline, predicted_shapes_msg,
-                                                   seen_description, seen_report)
 from squeeze_grasp_ros.ros import messages
+from squeeze_grasp_ros.ros.messages.objects import typed_object
 from squeeze_grasp_ros.ros.nodes import pipeline
 from squeeze_grasp_ros.ros.nodes.planner_client import PlannerClient
 from squeeze_grasp_ros.ros.recording.bag import STOPPED_KEY, BagError, bag_info
+from squeeze_grasp_ros.ros.run.camera_plan import (
+    first_outline,
+    predicted_shapes_msg,
+    seen_description,
+    seen_report,
+)
 from squeeze_grasp_ros.ros.run.goal_client import GoalClient
 from squeeze_grasp_ros.ros.run.graph import GraphWatch, run_namespace, run_topics
 from squeeze_grasp_ros.ros.run.observer import Observer, Progress
-from squeeze_grasp_ros.ros.run.options import (EXECUTORS, PLANNER_MODULE, RunError, RunOptions,
-                                               node_parameters)
-from squeeze_grasp_ros.ros.run.planning import (Plan, PlannerHost, RunObject,
-                                                plan_with_mechanics, plan_with_planner,
-                                                planner_roots)
+from squeeze_grasp_ros.ros.run.options import (
+    EXECUTORS,
+    PLANNER_MODULE,
+    RunError,
+    RunOptions,
+    node_parameters,
+)
+from squeeze_grasp_ros.ros.run.planning import (
+    Plan,
+    PlannerHost,
+    RunObject,
+    plan_with_mechanics,
+    plan_with_planner,
+    planner_roots,
+)
 from squeeze_grasp_ros.ros.run.processes import NodeProcesses, ros_arguments
 from squeeze_grasp_ros.ros.run.summary import run_summary
 from squeeze_grasp_ros.scene import SceneError

@@ -10,7 +10,6 @@ from typing import Any
 
 from squeeze_grasp_interfaces.action import ExecuteGrasp
 from squeeze_grasp_interfaces.msg import ContactEvent, SimState
-
 from squeeze_grasp_ros.mechanics.vocabulary import EventType, Termination
 from squeeze_grasp_ros.ros import messages
 from squeeze_grasp_ros.ros.run.planning import Plan

@@ -37,7 +37,11 @@ theta + dtheta/ds ds, Newton with line search); a substep whose Newton solve is 
 off the predicted branch is halved.
 """
 
-from squeeze_grasp_ros.mechanics.squeeze.stepper.run import (MIN_EVENT_TOL, MIN_STEP,
-                                                             TERMINATION_ORDER, advance)
+from squeeze_grasp_ros.mechanics.squeeze.stepper.run import (
+                                                             MIN_EVENT_TOL,
+                                                             MIN_STEP,
+                                                             TERMINATION_ORDER,
+                                                             advance,
+)
 
 __all__ = ["MIN_EVENT_TOL", "MIN_STEP", "TERMINATION_ORDER", "advance"]

@@ -12,8 +12,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from squeeze_grasp_ros.mechanics.squeeze.contact_model import (Configuration, ContactModel,
-                                                               SetData)
+from squeeze_grasp_ros.mechanics.squeeze.contact_model import Configuration, ContactModel, SetData
 from squeeze_grasp_ros.mechanics.squeeze.contact_state import ContactState
 from squeeze_grasp_ros.mechanics.squeeze.tip_shapes import TipGeometry
 from squeeze_grasp_ros.mechanics.vocabulary import ContactMode

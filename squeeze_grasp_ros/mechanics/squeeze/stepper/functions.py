@@ -35,8 +35,11 @@ from functools import cached_property
 
 import numpy as np
 
-from squeeze_grasp_ros.mechanics.squeeze.contact_model import (INVERSION_AREA_RATIO,
-                                                               ContactModel, Solution)
+from squeeze_grasp_ros.mechanics.squeeze.contact_model import (
+    INVERSION_AREA_RATIO,
+    ContactModel,
+    Solution,
+)
 from squeeze_grasp_ros.mechanics.squeeze.event_key import EventFunction, EventKey, KeyTable
 from squeeze_grasp_ros.mechanics.squeeze.stepper.contact_set import ContactSet
 from squeeze_grasp_ros.mechanics.squeeze.stepper.motion import FingerMotion

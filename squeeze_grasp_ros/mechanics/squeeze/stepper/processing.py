@@ -34,8 +34,11 @@ from squeeze_grasp_ros.mechanics.squeeze.event_key import WHOLE_OBJECT, EventFun
 from squeeze_grasp_ros.mechanics.squeeze.stepper.chatter import ChatterBound
 from squeeze_grasp_ros.mechanics.squeeze.stepper.contact_set import ContactSet
 from squeeze_grasp_ros.mechanics.squeeze.stepper.functions import EventFunctions
-from squeeze_grasp_ros.mechanics.squeeze.stepper.modes import (RATE_NOISE, decide_modes,
-                                                                zero_functions)
+from squeeze_grasp_ros.mechanics.squeeze.stepper.modes import (
+    RATE_NOISE,
+    decide_modes,
+    zero_functions,
+)
 from squeeze_grasp_ros.mechanics.squeeze.stepper.solving import SetSolver
 from squeeze_grasp_ros.mechanics.vocabulary import ContactMode, EventType, Termination
 

@@ -18,18 +18,26 @@ import numpy as np
 
 from squeeze_grasp_ros.mechanics.errors import InvalidInputError
 from squeeze_grasp_ros.mechanics.squeeze.contact_model import ContactModel, Solution, SolveFailure
-from squeeze_grasp_ros.mechanics.squeeze.contact_state import (ContactNode, ContactState,
-                                                               FingerState, Sample, StepResult)
+from squeeze_grasp_ros.mechanics.squeeze.contact_state import (
+    ContactNode,
+    ContactState,
+    FingerState,
+    Sample,
+    StepResult,
+)
 from squeeze_grasp_ros.mechanics.squeeze.event_key import EventFunction, EventKey
 from squeeze_grasp_ros.mechanics.squeeze.stepper.chatter import ChatterBound
 from squeeze_grasp_ros.mechanics.squeeze.stepper.contact_set import ContactSet
 from squeeze_grasp_ros.mechanics.squeeze.stepper.functions import EventFunctions
-from squeeze_grasp_ros.mechanics.squeeze.stepper.location import (Values, crossings, dips_inside,
-                                                                  earliest_crossing)
+from squeeze_grasp_ros.mechanics.squeeze.stepper.location import (
+    Values,
+    crossings,
+    dips_inside,
+    earliest_crossing,
+)
 from squeeze_grasp_ros.mechanics.squeeze.stepper.motion import FingerMotion
 from squeeze_grasp_ros.mechanics.squeeze.stepper.processing import EventProcessor
-from squeeze_grasp_ros.mechanics.squeeze.stepper.solving import (Counters, SetSolver,
-                                                                 SolvedPoints)
+from squeeze_grasp_ros.mechanics.squeeze.stepper.solving import Counters, SetSolver, SolvedPoints
 from squeeze_grasp_ros.mechanics.squeeze.stepper.substeps import SubstepControl
 from squeeze_grasp_ros.mechanics.vocabulary import ContactMode, Termination
 

@@ -14,8 +14,12 @@ from dataclasses import asdict, dataclass
 import numpy as np
 
 from squeeze_grasp_ros.mechanics.errors import NumericalError
-from squeeze_grasp_ros.mechanics.squeeze.contact_model import (ContactModel, Solution,
-                                                               SolveFailure, attempt_fixed_set)
+from squeeze_grasp_ros.mechanics.squeeze.contact_model import (
+    ContactModel,
+    Solution,
+    SolveFailure,
+    attempt_fixed_set,
+)
 from squeeze_grasp_ros.mechanics.squeeze.stepper.contact_set import ContactSet
 from squeeze_grasp_ros.mechanics.squeeze.stepper.motion import FingerMotion
 

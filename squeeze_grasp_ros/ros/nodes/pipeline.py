@@ -79,10 +79,11 @@ def loop_topics(devices: Iterable[str], *, silent: Iterable[str] = ()) -> list[s
     node reach it (across processes, discovery can match the executor seconds after the
     driver).
     """
+    silent = set(silent)
     names = [TICK, SIM_STATE, STATUS, CONTACT_STATE]
     for device in devices:
         names.append(device_topic(device, "pose"))
-        if device not in set(silent):
+        if device not in silent:
             names.append(device_topic(device, "setpoint"))
     return names
 

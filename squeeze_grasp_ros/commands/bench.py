@@ -10,16 +10,22 @@ import sys
 from pathlib import Path
 
 from squeeze_grasp_ros.bench import SECTIONS, missing
+from squeeze_grasp_ros.bench.sweep_large import DEFAULT_EVALUATIONS, TARGET_EVALUATIONS
 from squeeze_grasp_ros.bench.table import Table
-from squeeze_grasp_ros.commands.common import output_folder
+from squeeze_grasp_ros.commands.common import int_in, output_folder
 from squeeze_grasp_ros.outputs import write_atomically
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    """--quick, --only, --out."""
+    """--quick, --only, --large, --out."""
     parser.add_argument("--quick", action="store_true", help="smaller sizes (about 2 minutes)")
     parser.add_argument("--only", nargs="+", choices=SECTIONS, metavar="SECTION",
                         help=f"run only these sections ({', '.join(SECTIONS)})")
+    parser.add_argument("--large", nargs="?", const=DEFAULT_EVALUATIONS, default=None,
+                        type=int_in(1, 10_000_000), metavar="N",
+                        help="the sweep section runs N evaluations (default "
+                             f"{DEFAULT_EVALUATIONS:,}) on the local Dask cluster instead of "
+                             f"its tables and extrapolates to {TARGET_EVALUATIONS:,}")
     parser.add_argument("--out", default="bench_out", type=output_folder,
                         help="report directory (default: bench_out)")
 
@@ -37,6 +43,10 @@ def run(args: argparse.Namespace) -> dict:
         if absent:
             _progress(f"skipped {name}: {', '.join(absent)} not installed ({how})")
             skipped.append([name, ", ".join(absent), how])
+            continue
+        if name == "sweep" and args.large:
+            module = importlib.import_module("..bench.sweep_large", __package__)
+            tables += module.run(args.large, _progress)
             continue
         module = importlib.import_module(f"..bench.{name}", __package__)
         tables += module.run(args.quick, out, _progress)

@@ -66,6 +66,9 @@ setup(
         # GPL-3.0): about 5x faster factorisations of large nonlinear objects than QDLDL, in
         # METIS's nested-dissection order (pymetis, MIT)
         "cholmod": ["cvxopt>=1.3", "pymetis>=2023.1"],
+        # the linear model's fixed-set Newton compiled (numba: BSD, LLVM-based, wheels for
+        # CPython 3.10-3.13); without it the same solve runs in numpy, bit for bit alike
+        "fast": ["numba>=0.60"],
         # squeeze-grasp outline: sub-pixel contours (marching squares) of masks and depth images
         "perception": ["scikit-image>=0.22"],
         "test": [

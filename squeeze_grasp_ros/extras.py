@@ -30,6 +30,7 @@ EXTRAS: dict[str, tuple[tuple[str, ...], str]] = {
     "cholmod": (("cvxopt", "pymetis"),
                 "pip install '.[cholmod]' (CHOLMOD through cvxopt, GPL-3.0; METIS: pymetis)"),
     "perception": (("skimage",), "pip install '.[perception]'"),
+    "fast": (("numba",), "pip install '.[fast]'"),
 }
 """Extra -> (top-level modules it provides, how to install it)."""
 

@@ -17,6 +17,7 @@ from typing import IO, TYPE_CHECKING
 
 import pytest
 
+from squeeze_grasp_ros.mechanics.squeeze.fixed_set_kernel import KERNEL_VARIABLE, Kernel
 from squeeze_grasp_ros.threads import single_thread_blas
 
 single_thread_blas()  # as the installed executables do, before any test imports numpy
@@ -75,6 +76,18 @@ def pytest_unconfigure(config: pytest.Config) -> None:
     """Release this session's domain id."""
     if DOMAIN_LOCK in config.stash:
         config.stash[DOMAIN_LOCK].close()
+
+
+@pytest.fixture(params=[k.value for k in Kernel])
+def kernel(request: pytest.FixtureRequest, monkeypatch: pytest.MonkeyPatch) -> Kernel:
+    """Each route of the linear model's fixed-set solve in turn (numpy, numba); the numba one
+    skips, with the install line, without the ``fast`` extra.
+    """
+    if request.param == Kernel.NUMBA:
+        pytest.importorskip("numba", reason="the fast extra is not installed: "
+                                            "pip install '.[fast]'")
+    monkeypatch.setenv(KERNEL_VARIABLE, request.param)
+    return Kernel(request.param)
 
 
 @pytest.fixture

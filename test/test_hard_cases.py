@@ -237,6 +237,7 @@ def check_event_result(res, obj) -> None:
     assert sum(res.work.values()) >= res.energy * (1 - 1e-6)
 
 
+@pytest.mark.usefixtures("kernel")  # both fixed-set routes
 def test_event_squeeze_E_from_foam_to_steel_changes_forces_only():
     obj, contacts = foam()
     base = squeeze(obj, contacts)
@@ -268,6 +269,7 @@ def test_event_squeeze_object_size_scales_depths_and_forces(size):
 
 
 @pytest.mark.parametrize("mu", [1e-6, 1e3])
+@pytest.mark.usefixtures("kernel")  # both fixed-set routes
 def test_event_squeeze_friction_extremes(mu):
     """A squeeze line exactly along both normals (structured symmetric mesh) needs no friction
     at first; as the segments grow, a nearly frictionless tip lets nodes slide.
@@ -286,6 +288,7 @@ def test_event_squeeze_friction_extremes(mu):
         assert "slip" in modes
 
 
+@pytest.mark.usefixtures("kernel")  # both fixed-set routes
 def test_frictionless_single_node_contacts_are_a_clear_error():
     """With mu = 0 and one node per finger the object can slide along the tips: the problem is
     indeterminate, and the engine says so instead of returning garbage.
@@ -308,6 +311,7 @@ def test_event_squeeze_from_a_nanometre_depth():
     assert tiny.energy == pytest.approx(rho**2 * plan.energy_per_unit_depth2, rel=1e-6)
 
 
+@pytest.mark.usefixtures("kernel")  # both fixed-set routes
 def test_event_squeeze_on_a_nonconvex_object():
     pts = [
         [0.06, 0.0],

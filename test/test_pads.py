@@ -172,6 +172,7 @@ def test_wide_pads_compress_a_block_uniformly(model):
     assert sum(sq.event_counts.values()) == 0
 
 
+@pytest.mark.usefixtures("kernel")  # both fixed-set routes
 def test_pads_bound_the_stiffness_of_a_poisson_block():
     """A Poisson block (nu = 0.3) under sticking pads.
 
@@ -190,6 +191,7 @@ def test_pads_bound_the_stiffness_of_a_poisson_block():
 
 # --- events and invariants ---------------------------------------------------------------------
 
+@pytest.mark.usefixtures("kernel")  # both fixed-set routes
 def test_slipping_pads_keep_the_invariants():
     """Low friction on the Poisson block: nodes near the pad's corners slip outwards (C,
     possibly sticking again, D); the end state is in equilibrium, on the face, inside the cones.
@@ -204,6 +206,7 @@ def test_slipping_pads_keep_the_invariants():
     check_state(ContactModel(obj, 0.05), sq.state)
 
 
+@pytest.mark.usefixtures("kernel")  # both fixed-set routes
 def test_pads_wrap_a_disk_with_new_contacts():
     """A pad flattens a disk: contacts spread over the flat (events A), the normal of every
     node on the flat is the pad's facing, and the invariants hold.
@@ -220,6 +223,7 @@ def test_pads_wrap_a_disk_with_new_contacts():
     check_state(ContactModel(obj, 0.5), sq.state)
 
 
+@pytest.mark.usefixtures("kernel")  # both fixed-set routes
 def test_pad_squeeze_of_a_symmetric_object_is_symmetric():
     """A structured mesh symmetric about both axes: the two jaws' forces mirror each other and
     each jaw's nodal forces mirror about the closing line.

@@ -44,6 +44,7 @@ from squeeze_grasp_ros.mechanics.elastic.fem import (
 from squeeze_grasp_ros.mechanics.elastic.hyperelastic import area_ratios
 from squeeze_grasp_ros.mechanics.elastic.reduced import reduce_blocks
 from squeeze_grasp_ros.mechanics.errors import InvalidInputError, NumericalError
+from squeeze_grasp_ros.mechanics.squeeze.fixed_set_kernel import Kernel, compiled, selected
 from squeeze_grasp_ros.mechanics.squeeze.tip_shapes import TipGeometry, cross, tangent, unit
 from squeeze_grasp_ros.mechanics.vocabulary import MaterialModel, StrainCriterion, StrainMeasure
 
@@ -291,6 +292,24 @@ class SolveFailure:
         return NumericalError(self.reason, residuals={"cone": self.residual})
 
 
+@dataclass(frozen=True, eq=False)
+class LinearResponse:
+    """The linear model's response F = C delta of a contact set with m nodes: a
+    :data:`Response` whose constant stiffness the compiled fixed-set kernel reads.
+
+    Attributes
+    ----------
+    C : (2m, 2m) ndarray
+        The set's reduced stiffness (forces / (E h L) per displacement / L).
+    """
+
+    C: np.ndarray
+
+    def __call__(self, delta: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(F (m, 2), dF/d delta = C) at contact displacements ``delta`` (m, 2)."""
+        return (self.C @ delta.reshape(-1)).reshape(delta.shape), self.C
+
+
 def solve_fixed_set(
     C: np.ndarray,
     cfg: Configuration,
@@ -359,6 +378,8 @@ def attempt_fixed_set(
         The failure when Newton does not converge, its Jacobian is singular or it produces
         non-finite values.
     """
+    if isinstance(response, LinearResponse) and selected() == Kernel.NUMBA:
+        return _attempt_compiled(response.C, cfg, centers, dirs, theta0, phi)
     m = len(theta0)
     theta = np.array(theta0, float)
     P = np.flatnonzero(~cfg.stick)
@@ -435,9 +456,41 @@ def attempt_fixed_set(
     else:
         dF = dF0
     ddelta = dirs + (r * dtheta)[:, None] * tangent(nu)
-    if not (np.all(np.isfinite(F)) and np.all(np.isfinite(dF)) and np.all(np.isfinite(theta))):
-        return SolveFailure("non-finite contact forces or angles in the fixed-set solve", residual)
-    return Solution(theta, delta, F, dtheta, dF, ddelta, it, residual, cond, nu, kappa)
+    return _checked(Solution(theta, delta, F, dtheta, dF, ddelta, it, residual, cond, nu, kappa))
+
+
+def _checked(sol: Solution) -> Solution | SolveFailure:
+    """``sol``, or the failure when its forces, their rates or its angles are not finite."""
+    if not (np.all(np.isfinite(sol.F)) and np.all(np.isfinite(sol.dF))
+            and np.all(np.isfinite(sol.theta))):
+        return SolveFailure("non-finite contact forces or angles in the fixed-set solve",
+                            sol.residual)
+    return sol
+
+
+def _attempt_compiled(C: np.ndarray, cfg: Configuration, centers: np.ndarray, dirs: np.ndarray,
+                      theta0: np.ndarray, phi: float) -> Solution | SolveFailure:
+    """:func:`attempt_fixed_set` of a linear response by the compiled kernel
+    (:func:`.fixed_set_numba.solve_linear`): the same iteration, sums in another order.
+    """
+    kernel, tip = compiled(), cfg.tip
+    P = np.flatnonzero(~cfg.stick)
+    r = tip.radius
+    force_scale = max(stiffness_scale(C) * float(r.max()), 1e-300)
+    status, it, residual, theta, delta, F, dtheta, dF, ddelta, J = kernel.solve_linear(
+        np.ascontiguousarray(C, float), np.ascontiguousarray(cfg.p0, float),
+        np.ascontiguousarray(centers, float), np.ascontiguousarray(dirs, float),
+        np.array(theta0, float), P, cfg.slip.astype(float), float(phi), r, tip.flat / r,
+        np.asarray(tip.facing, float), NEWTON_TOL, force_scale, NEWTON_MAX_ITERATIONS,
+        NEWTON_BACKTRACKS, NEWTON_TOL)
+    if status == kernel.NOT_CONVERGED:
+        return SolveFailure(
+            f"Newton on the sliding angles did not converge in {it} iterations", residual)
+    if status == kernel.SINGULAR:
+        return SolveFailure(SINGULAR_SLIDING, residual, indeterminate=True)
+    cond = float(np.linalg.cond(J)) if len(P) else 1.0
+    return _checked(Solution(theta, delta, F, dtheta, dF, ddelta, it, residual, cond,
+                             tip.normal_angle(theta), tip.curvature(theta)))
 
 
 @dataclass(frozen=True)
@@ -523,12 +576,7 @@ class ContactModel:
 
     def response(self, sd: SetData) -> Response:
         """The set's elastic response F = C delta with its constant reduced stiffness."""
-        C = sd.C
-        m = len(sd.nodes)
-
-        def linear(delta: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-            return (C @ delta.reshape(-1)).reshape(m, 2), C
-        return linear
+        return LinearResponse(sd.C)
 
     def set_data(self, nodes: tuple[int, ...]) -> SetData:
         """Reduced data of the contact set ``nodes`` (sorted), cached per set (fast model)."""

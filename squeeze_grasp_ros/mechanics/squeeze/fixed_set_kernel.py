@@ -1,0 +1,71 @@
+# Copyright 2026 squeeze_grasp_ros developers
+# SPDX-License-Identifier: Apache-2.0
+"""The linear model's fixed-set solve as one compiled kernel (numba), with the numpy route as
+its fallback.
+
+:func:`~.contact_model.attempt_fixed_set` solves the sliding constraints (eq. 47) by Newton on
+a handful of contact coordinates. With the linear model's constant stiffness, F = C delta, the
+whole loop is small dense arithmetic on m <= a few tens of contacts: in numpy it is some forty
+Python-level calls per Newton iteration on 2-vectors, most of an evaluation's fixed-set time.
+:func:`.fixed_set_numba.solve_linear` runs the same iteration, the same backtracking, stopping
+tests and rates, in one call compiled by numba (``pip install '.[fast]'``). Its products and
+solves call the BLAS and LAPACK routines numpy calls (gemv, gemm, gesv), its sines and cosines
+are the same, and its elementwise arithmetic is written in numpy's order, so the two routes give
+the same floats: the example sweep's 288 rows and the golden runs are identical bit for bit
+(docs/design.md, "The evaluation kernel").
+
+The route is chosen at each solve: :data:`KERNEL_VARIABLE` = ``numpy`` or ``numba``
+(:class:`Kernel`); unset means numba when it is installed. Asking for numba without it
+installed raises an error that names the extra.
+"""
+from __future__ import annotations
+
+import os
+from enum import Enum
+from functools import cache
+
+from squeeze_grasp_ros.extras import EXTRAS
+from squeeze_grasp_ros.mechanics.errors import InvalidInputError
+
+KERNEL_VARIABLE = "SQUEEZE_GRASP_KERNEL"
+"""Environment variable that selects the fixed-set route (:class:`Kernel` values)."""
+
+
+class Kernel(str, Enum):
+    """Route of the linear model's fixed-set solve."""
+
+    NUMPY = "numpy"
+    """The numpy route (:func:`~.contact_model.attempt_fixed_set`'s own loop)."""
+    NUMBA = "numba"
+    """:func:`.fixed_set_numba.solve_linear`, compiled by numba (the ``fast`` extra)."""
+
+
+def selected() -> Kernel:
+    """The route :data:`KERNEL_VARIABLE` asks for (default: numba when installed).
+
+    >>> import os; os.environ[KERNEL_VARIABLE] = "numpy"; selected()
+    <Kernel.NUMPY: 'numpy'>
+    >>> del os.environ[KERNEL_VARIABLE]
+    """
+    text = os.environ.get(KERNEL_VARIABLE, "")
+    if not text:
+        return Kernel.NUMBA if compiled() is not None else Kernel.NUMPY
+    try:
+        kernel = Kernel(text)
+    except ValueError:
+        raise InvalidInputError(
+            f"{KERNEL_VARIABLE} must be one of {[k.value for k in Kernel]}, got {text!r}"
+        ) from None
+    if kernel == Kernel.NUMBA and compiled() is None:
+        raise InvalidInputError(f"{KERNEL_VARIABLE}=numba needs numba: {EXTRAS['fast'][1]}")
+    return kernel
+
+
+@cache
+def compiled():
+    """The compiled module :mod:`.fixed_set_numba`, or None without numba."""
+    try:
+        from squeeze_grasp_ros.mechanics.squeeze import fixed_set_numba
+    except ImportError:
+        return None
+    return fixed_set_numba

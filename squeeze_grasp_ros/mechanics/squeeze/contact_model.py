@@ -63,6 +63,7 @@ SINGULAR_SLIDING = (
     "do not fix the object's position (e.g. a frictionless finger touching at one "
     "node lets the object slide along the tip); use mu > 0"
 )
+NON_FINITE = "non-finite contact forces or angles in the fixed-set solve"
 NEWTON_TOL = 1e-14
 """Newton stops when the cone residual is below this times the force scale |C| r, or when the
 largest angle update (rad) falls below it."""
@@ -463,34 +464,29 @@ def _checked(sol: Solution) -> Solution | SolveFailure:
     """``sol``, or the failure when its forces, their rates or its angles are not finite."""
     if not (np.all(np.isfinite(sol.F)) and np.all(np.isfinite(sol.dF))
             and np.all(np.isfinite(sol.theta))):
-        return SolveFailure("non-finite contact forces or angles in the fixed-set solve",
-                            sol.residual)
+        return SolveFailure(NON_FINITE, sol.residual)
     return sol
 
 
 def _attempt_compiled(C: np.ndarray, cfg: Configuration, centers: np.ndarray, dirs: np.ndarray,
                       theta0: np.ndarray, phi: float) -> Solution | SolveFailure:
     """:func:`attempt_fixed_set` of a linear response by the compiled kernel
-    (:func:`.fixed_set_numba.solve_linear`): the same iteration, sums in another order.
+    (:func:`.fixed_set_numba.solve_linear`): the same iteration and the same floats.
     """
     kernel, tip = compiled(), cfg.tip
-    P = np.flatnonzero(~cfg.stick)
-    r = tip.radius
-    force_scale = max(stiffness_scale(C) * float(r.max()), 1e-300)
-    status, it, residual, theta, delta, F, dtheta, dF, ddelta, J = kernel.solve_linear(
-        np.ascontiguousarray(C, float), np.ascontiguousarray(cfg.p0, float),
-        np.ascontiguousarray(centers, float), np.ascontiguousarray(dirs, float),
-        np.array(theta0, float), P, cfg.slip.astype(float), float(phi), r, tip.flat / r,
-        np.asarray(tip.facing, float), NEWTON_TOL, force_scale, NEWTON_MAX_ITERATIONS,
-        NEWTON_BACKTRACKS, NEWTON_TOL)
+    status, it, residual, theta, delta, F, dtheta, dF, ddelta, J, nu, kappa = (
+        kernel.solve_linear(C, cfg.p0, centers, dirs, np.asarray(theta0, float), cfg.stick,
+                            cfg.slip, float(phi), tip.radius, tip.flat, tip.facing, NEWTON_TOL,
+                            NEWTON_MAX_ITERATIONS, NEWTON_BACKTRACKS, NEWTON_TOL))
     if status == kernel.NOT_CONVERGED:
         return SolveFailure(
             f"Newton on the sliding angles did not converge in {it} iterations", residual)
     if status == kernel.SINGULAR:
         return SolveFailure(SINGULAR_SLIDING, residual, indeterminate=True)
-    cond = float(np.linalg.cond(J)) if len(P) else 1.0
-    return _checked(Solution(theta, delta, F, dtheta, dF, ddelta, it, residual, cond,
-                             tip.normal_angle(theta), tip.curvature(theta)))
+    if status == kernel.NON_FINITE:
+        return SolveFailure(NON_FINITE, residual)
+    cond = float(np.linalg.cond(J)) if J.size else 1.0
+    return Solution(theta, delta, F, dtheta, dF, ddelta, it, residual, cond, nu, kappa)
 
 
 @dataclass(frozen=True)

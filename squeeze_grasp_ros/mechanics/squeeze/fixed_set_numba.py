@@ -12,7 +12,7 @@ from __future__ import annotations
 import numba
 import numpy as np
 
-SOLVED, NOT_CONVERGED, SINGULAR = 0, 1, 2
+SOLVED, NOT_CONVERGED, SINGULAR, NON_FINITE = 0, 1, 2, 3
 """How :func:`solve_linear` ended (its first return value)."""
 jit = numba.njit(cache=True, nogil=True)
 
@@ -75,8 +75,8 @@ def _solve(A, b, x):
 
 
 @jit
-def solve_linear(C, p0, centers, dirs, theta0, P, slip, phi, radius, h, facing, tol,
-                 force_scale, max_iterations, backtracks, newton_tol):
+def solve_linear(C, p0, centers, dirs, theta0, stick, slip, phi, radius, flat, facing, tol,
+                 max_iterations, backtracks, newton_tol):
     """Newton on the sliding coordinates of one contact set with F = C delta (dimensionless):
     the numpy route's iteration (:func:`~.contact_model.attempt_fixed_set`) as loops.
 
@@ -88,16 +88,16 @@ def solve_linear(C, p0, centers, dirs, theta0, P, slip, phi, radius, h, facing, 
         Undeformed node positions, tip reference points, tip translation per unit s.
     theta0 : (m,) ndarray
         Contact coordinates (exact for sticking nodes, the guess for sliding ones), rad.
-    P : (k,) ndarray of int
-        The sliding nodes.
-    slip : (m,) ndarray of float
+    stick : (m,) ndarray of bool
+        The sticking nodes (the others slide).
+    slip : (m,) ndarray of int
         Slip directions (+1/-1; 0 for sticking nodes).
     phi : float
         Friction angle, rad.
-    radius, h, facing : (m,) ndarray
-        Each node's tip: rho, a / rho, theta0 (:class:`~.tip_shapes.TipGeometry`).
-    tol, force_scale : float
-        The cone residual's stopping bound is ``tol * force_scale``.
+    radius, flat, facing : (m,) ndarray
+        Each node's tip: rho, a, theta0 (:class:`~.tip_shapes.TipGeometry`).
+    tol : float
+        The cone residual's stopping bound is ``tol`` times the force scale max |C| max rho.
     max_iterations, backtracks : int
     newton_tol : float
         The step size below which Newton stops (rad).
@@ -105,12 +105,17 @@ def solve_linear(C, p0, centers, dirs, theta0, P, slip, phi, radius, h, facing, 
     Returns
     -------
     tuple
-        (:data:`SOLVED`, :data:`NOT_CONVERGED` or :data:`SINGULAR`; iterations, residual,
-        theta, delta, F, dtheta, dF, ddelta, J): J is the last Jacobian (k, k), for its
-        condition number.
+        (:data:`SOLVED`, :data:`NOT_CONVERGED`, :data:`SINGULAR` or :data:`NON_FINITE`;
+        iterations, residual, theta, delta, F, dtheta, dF, ddelta, J, nu, kappa): J is the last
+        Jacobian (k, k), for its condition number; nu and kappa the normal angles and
+        curvatures (:meth:`~.tip_shapes.TipGeometry.normal_angle`, ``curvature``) at theta.
     """
+    P = np.flatnonzero(~stick)
+    h = flat / radius
+    force_scale = max(np.abs(C).max() * radius.max(), 1e-300)
     m, n = theta0.shape[0], P.shape[0]
     theta = theta0.copy()
+    nu, kappa = np.empty(m), np.empty(m)
     delta, F = np.empty((m, 2)), np.empty((m, 2))
     t_delta, t_F = np.empty((m, 2)), np.empty((m, 2))
     R, t_R, step, trial = np.empty(n), np.empty(n), np.empty(n), np.empty(m)
@@ -125,10 +130,10 @@ def solve_linear(C, p0, centers, dirs, theta0, P, slip, phi, radius, h, facing, 
         if residual <= tol * force_scale:
             break
         if it >= max_iterations:
-            return NOT_CONVERGED, it, residual, theta, delta, F, dtheta, dF, \
-                ddelta, J
+            return NOT_CONVERGED, it, residual, theta, delta, F, dtheta, dF, ddelta, J, nu, \
+                kappa
         if not _solve(J, R, step):
-            return SINGULAR, it, residual, theta, delta, F, dtheta, dF, ddelta, J
+            return SINGULAR, it, residual, theta, delta, F, dtheta, dF, ddelta, J, nu, kappa
         it += 1
         for _ in range(backtracks):
             trial[:] = theta
@@ -154,15 +159,18 @@ def solve_linear(C, p0, centers, dirs, theta0, P, slip, phi, radius, h, facing, 
             a = theta[p] - c - slip[p] * phi
             rhs[i] = dF[p, 0] * np.sin(a) - dF[p, 1] * np.cos(a)
         if not _solve(J, rhs, step):
-            return SINGULAR, it, residual, theta, delta, F, dtheta, dF, ddelta, J
+            return SINGULAR, it, residual, theta, delta, F, dtheta, dF, ddelta, J, nu, kappa
         for i in range(n):
             dtheta[P[i]] = -step[i]
         rate = dtheta[P]
         for k in range(m):  # numpy's (m, 2, k) @ (k,): one product per contact
             dF[k] += np.dot(G[2 * k:2 * k + 2], rate)
     for k in range(m):
-        c = min(max(theta[k] - facing[k], -h[k]), h[k])
-        nu = theta[k] - c
-        ddelta[k, 0] = dirs[k, 0] + radius[k] * dtheta[k] * -np.sin(nu)
-        ddelta[k, 1] = dirs[k, 1] + radius[k] * dtheta[k] * np.cos(nu)
-    return SOLVED, it, residual, theta, delta, F, dtheta, dF, ddelta, J
+        u = theta[k] - facing[k]
+        nu[k] = theta[k] - min(max(u, -h[k]), h[k])
+        kappa[k] = 0.0 if flat[k] > 0.0 and abs(u) <= h[k] else 1.0
+        ddelta[k, 0] = dirs[k, 0] + radius[k] * dtheta[k] * -np.sin(nu[k])
+        ddelta[k, 1] = dirs[k, 1] + radius[k] * dtheta[k] * np.cos(nu[k])
+    finite = np.all(np.isfinite(F)) and np.all(np.isfinite(dF)) and np.all(np.isfinite(theta))
+    return SOLVED if finite else NON_FINITE, it, residual, theta, delta, F, dtheta, dF, ddelta, \
+        J, nu, kappa

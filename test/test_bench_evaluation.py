@@ -2,6 +2,7 @@
 # SPDX-License-Identifier: Apache-2.0
 """The evaluation bench's kernel share: which profile entries count as linear algebra."""
 import cProfile
+import os
 import pstats
 import time
 
@@ -10,7 +11,16 @@ import pytest
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from squeeze_grasp_ros.bench.evaluation import is_kernel, kernel_share, measure
+from squeeze_grasp_ros.bench.evaluation import (
+    compiled_seconds,
+    is_kernel,
+    kernel_share,
+    measure,
+    route,
+    routes,
+)
+from squeeze_grasp_ros.mechanics.squeeze.contact_model import attempt_fixed_set
+from squeeze_grasp_ros.mechanics.squeeze.fixed_set_kernel import KERNEL_VARIABLE, Kernel
 from squeeze_grasp_ros.resources import share_dir
 
 
@@ -45,6 +55,23 @@ def test_dense_and_sparse_factorisations_count_and_python_and_norms_do_not():
 def test_a_pure_python_workload_has_no_kernel_time():
     stats = _profile(lambda: sorted(str(i) for i in range(50_000)))
     assert kernel_share(stats)[0] == 0.0
+
+
+def test_the_compiled_kernel_is_found_in_a_profile_of_its_route_only(monkeypatch):
+    pytest.importorskip("numba", reason="the fast extra is not installed: pip install '.[fast]'")
+    from test_fixed_set_kernel import random_set
+
+    assert routes() == [Kernel.NUMPY, Kernel.NUMBA]
+    problems = [random_set(np.random.default_rng(seed), m=4) for seed in range(30)]
+    seconds = {}
+    monkeypatch.setenv(KERNEL_VARIABLE, "numpy")
+    for kernel in Kernel:
+        with route(kernel):
+            attempt_fixed_set(*problems[0])  # compiled or loaded before the profile
+            stats = _profile(lambda: [attempt_fixed_set(*p) for p in problems])
+        seconds[kernel] = compiled_seconds(stats)
+        assert os.environ[KERNEL_VARIABLE] == "numpy"  # the route is restored after
+    assert seconds[Kernel.NUMPY] == 0.0 < seconds[Kernel.NUMBA]
 
 
 @pytest.mark.slow

@@ -28,6 +28,7 @@ time is compiled code, hardly lengthened by the profiler: an estimate of the unp
 """
 from __future__ import annotations
 
+import contextlib
 import cProfile
 import os
 import pstats
@@ -39,6 +40,7 @@ from pathlib import Path
 import yaml
 
 from squeeze_grasp_ros.bench.table import Table
+from squeeze_grasp_ros.mechanics.squeeze.fixed_set_kernel import KERNEL_VARIABLE, Kernel, compiled
 from squeeze_grasp_ros.mechanics.vocabulary import Factorizer
 from squeeze_grasp_ros.resources import share_dir
 from squeeze_grasp_ros.sweep.evaluate import clear_cache, prepare, run_task
@@ -57,6 +59,9 @@ KERNEL_PATTERNS: tuple[str, ...] = (
 kernel (LAPACK through numpy.linalg's factorising functions or scipy.linalg, SuperLU, QDLDL,
 CHOLMOD). numpy.linalg's helpers and its vector norms (reductions, no LAPACK) are not."""
 COMMAND = "python -m squeeze_grasp_ros.bench.evaluation"
+COMPILED_PATTERN = r"fixed_set_numba\.py:\d*\(?solve_linear"
+"""The compiled fixed-set kernel's profile entry (numba's dispatcher: its self time is the
+compiled call, BLAS and LAPACK inside included)."""
 CONTROL_ITERATIONS = 5_000_000
 BASELINE_COMMIT = "9db5097"
 BASELINE_MS_PER_EVALUATION = 12.50
@@ -102,15 +107,52 @@ def kernel_share(stats: pstats.Stats) -> tuple[float, float, int]:
     return kernel, total, calls
 
 
+def compiled_seconds(stats: pstats.Stats) -> float:
+    """Self time [s] of the compiled fixed-set kernel's calls in a profile (0 without)."""
+    return sum(self_time for (filename, line, function), (_, _, self_time, _, _)
+               in stats.stats.items()
+               if re.search(COMPILED_PATTERN, f"{filename}:{line}({function}"))
+
+
+def routes() -> list[Kernel]:
+    """The fixed-set routes this environment has: numpy, and numba with the ``fast`` extra."""
+    return [Kernel.NUMPY] + ([Kernel.NUMBA] if compiled() is not None else [])
+
+
+@contextlib.contextmanager
+def route(kernel: Kernel):
+    """Run the fixed-set solves by ``kernel`` inside (:data:`KERNEL_VARIABLE`)."""
+    before = os.environ.get(KERNEL_VARIABLE)
+    os.environ[KERNEL_VARIABLE] = kernel.value
+    try:
+        yield
+    finally:
+        if before is None:
+            del os.environ[KERNEL_VARIABLE]
+        else:
+            os.environ[KERNEL_VARIABLE] = before
+
+
+def measure_routes(spec: Path, tasks: int | None) -> dict[Kernel, dict]:
+    """:func:`measure` of each fixed-set route (:func:`routes`), one after the other."""
+    out = {}
+    for kernel in routes():
+        with route(kernel):
+            out[kernel] = measure(spec, tasks)
+    return out
+
+
 def measure(spec: Path, tasks: int | None) -> dict:
     """Time all of ``spec``'s evaluations (CPU, groups prepared first) between two runs of
-    the control loop, and profile those of its first ``tasks`` tasks (all if None).
+    the control loop, and profile those of its first ``tasks`` tasks (all if None). The first
+    task runs once untimed (numba's compiled code is loaded or compiled on first use).
     """
     loaded = parse_sweep_spec(yaml.safe_load(spec.read_text()), spec.parent)
     every = list(plan_tasks(loaded))
     clear_cache()
     for task in every:
         prepare(task)
+    run_task(every[0])
     control, per_task = control_seconds(), []
     for task in every:
         start = time.process_time()
@@ -127,28 +169,40 @@ def measure(spec: Path, tasks: int | None) -> dict:
     stats = pstats.Stats(profile)
     kernel, total, calls = kernel_share(stats)
     return {"evaluations": n, "cpu_s": cpu, "control_s": control, "profiled": profiled,
-            "profiled_cpu_s": chosen_cpu,
-            "kernel_s": kernel, "profiled_s": total, "calls": calls, "stats": stats}
+            "profiled_cpu_s": chosen_cpu, "kernel_s": kernel, "profiled_s": total,
+            "compiled_s": compiled_seconds(stats), "calls": calls, "stats": stats}
 
 
-def table(m: dict, spec: Path, tasks: int | None) -> Table:
-    """The measurement as a table (per evaluation)."""
-    n, k = m["evaluations"], m["profiled"]
-    ms = 1e3 * m["cpu_s"] / n
+def table(measured: dict[Kernel, dict], spec: Path, tasks: int | None) -> Table:
+    """The measurements as a table (per evaluation), a row per fixed-set route."""
     load = tuple(round(x, 1) for x in os.getloadavg())
     arg = f" --tasks {tasks}" if tasks else ""
-    speed_up = (BASELINE_MS_PER_EVALUATION / BASELINE_CONTROL_S) / (ms / m["control_s"])
+    rows, numpy_ratio = [], None
+    for kernel, m in measured.items():
+        n, k = m["evaluations"], m["profiled"]
+        ms = 1e3 * m["cpu_s"] / n
+        ratio = ms / m["control_s"]
+        numpy_ratio = ratio if numpy_ratio is None else numpy_ratio
+        rows.append([kernel.value, n, ms, m["control_s"],
+                     (BASELINE_MS_PER_EVALUATION / BASELINE_CONTROL_S) / ratio,
+                     numpy_ratio / ratio, k, 1e3 * m["profiled_s"] / k, 1e3 * m["kernel_s"] / k,
+                     100 * m["kernel_s"] / m["profiled_s"],
+                     100 * m["kernel_s"] / m["profiled_cpu_s"],
+                     100 * m["compiled_s"] / m["profiled_s"], round(m["calls"] / k)])
     return Table(
         f"{TITLE}: CPU time and the share of linear-algebra kernels ({spec.name})",
-        ["evaluations", "CPU per evaluation [ms]", "control loop [s]",
-         f"speed-up over {BASELINE_COMMIT} (control-normalised)", "profiled evaluations",
+        ["fixed-set route", "evaluations", "CPU per evaluation [ms]", "control loop [s]",
+         f"speed-up over {BASELINE_COMMIT} (control-normalised)",
+         "speed-up over the numpy route (control-normalised)", "profiled evaluations",
          "profiled per evaluation [ms]", "kernels per evaluation (profiled) [ms]",
          "kernel share of the profile [%]", "kernels / unprofiled CPU [%]",
+         "compiled fixed-set kernel, share of the profile [%]",
          "Python-visible calls per evaluation"],
-        [[n, ms, m["control_s"], speed_up, k, 1e3 * m["profiled_s"] / k,
-          1e3 * m["kernel_s"] / k, 100 * m["kernel_s"] / m["profiled_s"],
-          100 * m["kernel_s"] / m["profiled_cpu_s"], round(m["calls"] / k)]],
-        f"CPU per evaluation: all {n} evaluations unprofiled, groups prepared before, BLAS as "
+        rows,
+        "Fixed-set route: the linear model's Newton on the sliding contacts in numpy, or "
+        "compiled by numba (the `fast` extra; the same floats); the routes run one after the "
+        "other, each with its own control loop. CPU per evaluation: all evaluations "
+        "unprofiled, groups prepared before, BLAS as "
         f"this process has it; the control loop ({CONTROL_ITERATIONS:,} pure-Python integer "
         f"iterations, best of one run before and one after) normalises the speed-up against "
         f"the figure recorded at {BASELINE_COMMIT} ({BASELINE_MS_PER_EVALUATION:.2f} ms per "
@@ -157,7 +211,8 @@ def table(m: dict, spec: Path, tasks: int | None) -> Table:
         f"{' or '.join(KERNEL_PATTERNS)} (numpy.linalg's factorising functions whole, since "
         "their LAPACK gufuncs are invisible to cProfile; `@` products count with their "
         "callers); kernels / unprofiled CPU (the profiled evaluations' own unprofiled time) "
-        "estimates the share without the profiler's overhead. "
+        "estimates the share without the profiler's overhead. The compiled kernel's column is "
+        "its calls' self time (its BLAS and LAPACK calls inside, not counted as kernels). "
         f"Reproduce: `{COMMAND} {spec}{arg}`. Load average (1, 5, 15 min) {load} on "
         f"{os.cpu_count()} cores.",
     )
@@ -167,8 +222,9 @@ def run(quick: bool, out_dir: Path, progress) -> list[Table]:
     """The example sweep's evaluations (profiled: its first two tasks when quick)."""
     spec = share_dir() / "config" / "sweeps" / "example.yaml"
     tasks = 2 if quick else None
-    progress(f"evaluation: timing and profiling the evaluations of {spec.name}")
-    return [table(measure(spec, tasks), spec, tasks)]
+    progress(f"evaluation: timing and profiling the evaluations of {spec.name} "
+             f"({', '.join(k.value for k in routes())})")
+    return [table(measure_routes(spec, tasks), spec, tasks)]
 
 
 if __name__ == "__main__":
@@ -176,6 +232,8 @@ if __name__ == "__main__":
     n_tasks = int(args[args.index("--tasks") + 1]) if "--tasks" in args else None
     path = Path(args[0]) if args and not args[0].startswith("--") else (
         share_dir() / "config" / "sweeps" / "example.yaml")
-    result = measure(path, n_tasks)
-    print(table(result, path, n_tasks).markdown())
-    result["stats"].sort_stats("tottime").print_stats(25)
+    results = measure_routes(path, n_tasks)
+    print(table(results, path, n_tasks).markdown())
+    for name, result in results.items():
+        print(f"\nfixed-set route {name.value}: the largest self times")
+        result["stats"].sort_stats("tottime").print_stats(25)

@@ -6,6 +6,8 @@ the route chosen by ``SQUEEZE_GRASP_KERNEL`` with clear errors.
 """
 from __future__ import annotations
 
+import os
+
 import numpy as np
 import pytest
 
@@ -18,7 +20,12 @@ from squeeze_grasp_ros.mechanics.squeeze.contact_model import (
     attempt_fixed_set,
 )
 from squeeze_grasp_ros.mechanics.squeeze.events import event_squeeze
-from squeeze_grasp_ros.mechanics.squeeze.fixed_set_kernel import KERNEL_VARIABLE, Kernel, selected
+from squeeze_grasp_ros.mechanics.squeeze.fixed_set_kernel import (
+    KERNEL_VARIABLE,
+    Kernel,
+    prefer_compiled,
+    selected,
+)
 from squeeze_grasp_ros.mechanics.squeeze.tip_shapes import TipGeometry, cross, unit
 
 numba = pytest.importorskip("numba", reason="the fast extra is not installed: "
@@ -110,8 +117,14 @@ def test_an_event_squeeze_is_the_same_on_both_routes(mu, monkeypatch):
 
 
 def test_the_route_is_chosen_by_the_environment(monkeypatch):
-    monkeypatch.delenv(KERNEL_VARIABLE, raising=False)
-    assert selected() == Kernel.NUMBA  # numba is installed here (the module skips otherwise)
+    monkeypatch.setenv(KERNEL_VARIABLE, "numpy")  # restored (unset or as it was) after the test
+    monkeypatch.delenv(KERNEL_VARIABLE)
+    assert selected() == Kernel.NUMPY  # a one-off process does not pay numba's start-up
+    prefer_compiled()  # what the sweep does: numba is installed here (the module skips else)
+    assert os.environ[KERNEL_VARIABLE] == "numba" and selected() == Kernel.NUMBA
+    monkeypatch.setenv(KERNEL_VARIABLE, "numpy")
+    prefer_compiled()  # a route the user chose stays
+    assert selected() == Kernel.NUMPY
     monkeypatch.setenv(KERNEL_VARIABLE, "numpy")
     assert selected() == Kernel.NUMPY
     monkeypatch.setenv(KERNEL_VARIABLE, "fortran")
@@ -122,8 +135,11 @@ def test_the_route_is_chosen_by_the_environment(monkeypatch):
 
 def test_without_numba_the_numpy_route_runs_and_asking_for_numba_names_the_extra(monkeypatch):
     monkeypatch.setattr(fixed_set_kernel, "compiled", lambda: None)
-    monkeypatch.delenv(KERNEL_VARIABLE, raising=False)
-    assert selected() == Kernel.NUMPY
+    monkeypatch.setattr(fixed_set_kernel, "installed", lambda module: False)
+    monkeypatch.setenv(KERNEL_VARIABLE, "numpy")
+    monkeypatch.delenv(KERNEL_VARIABLE)
+    prefer_compiled()
+    assert KERNEL_VARIABLE not in os.environ and selected() == Kernel.NUMPY
     monkeypatch.setenv(KERNEL_VARIABLE, "numba")
     with pytest.raises(InvalidInputError, match=r"needs numba: pip install '\.\[fast\]'"):
         selected()

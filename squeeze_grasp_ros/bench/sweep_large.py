@@ -8,7 +8,8 @@ material, friction, tips, depths, pickup and adversary) with its objects replace
 Fourier blobs of about 400 nodes, as many as ``N`` evaluations need
 (:func:`large_spec`). The sweep runs with the progress line, one worker per core; the table gives
 what it did and what 1,000,000 evaluations would take at the same rate and Parquet size per
-row, with the machine's cores and load before and after.
+row, with the machine's cores and load before and after. As ``squeeze-grasp sweep`` does, it runs
+the fixed-set solves by the compiled kernel when numba is installed.
 """
 
 from __future__ import annotations
@@ -21,6 +22,7 @@ from pathlib import Path
 import yaml
 
 from squeeze_grasp_ros.bench.table import Table
+from squeeze_grasp_ros.mechanics.squeeze.fixed_set_kernel import prefer_compiled
 from squeeze_grasp_ros.resources import share_dir
 
 DEFAULT_EVALUATIONS = 100_000
@@ -59,6 +61,8 @@ def run(evaluations: int, progress) -> list[Table]:
     """Run the large sweep in a temporary folder (removed afterwards) and extrapolate."""
     from squeeze_grasp_ros.sweep.engine import run_sweep  # the [sweep] extra: Dask, Arrow
     from squeeze_grasp_ros.sweep.spec import parse_sweep_spec
+
+    prefer_compiled()  # as squeeze-grasp sweep: the compiled kernel with numba installed
 
     workers = os.cpu_count() or 1
     load0 = os.getloadavg()

@@ -11,6 +11,7 @@ import signal
 import sys
 
 from squeeze_grasp_ros.exit_codes import ExitCode
+from squeeze_grasp_ros.mechanics.squeeze.fixed_set_kernel import prefer_compiled
 from squeeze_grasp_ros.sweep.engine import dry_run, run_sweep
 from squeeze_grasp_ros.sweep.spec import SweepError, load_sweep_spec
 
@@ -58,6 +59,7 @@ def run(args: argparse.Namespace) -> dict | int:
                 **dry_run(loaded, workers=args.workers, scheduler=args.scheduler)}
     if not args.out:
         raise SweepError("--out DIR is required (or use --dry-run)")
+    prefer_compiled()  # the local workers' evaluations by the compiled kernel, with numba
     outcome = run_sweep(loaded, args.out, scheduler=args.scheduler, workers=args.workers,
                         progress=not args.no_progress)
     for line in outcome.repaired:

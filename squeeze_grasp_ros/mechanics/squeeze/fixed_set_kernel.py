@@ -15,8 +15,12 @@ the same floats: the example sweep's 288 rows and the golden runs are identical 
 (docs/design.md, "The evaluation kernel").
 
 The route is chosen at each solve: :data:`KERNEL_VARIABLE` = ``numpy`` or ``numba``
-(:class:`Kernel`); unset means numba when it is installed. Asking for numba without it
-installed raises an error that names the extra.
+(:class:`Kernel`); unset means numpy, because a process pays numba's import and the load of its
+cached code (about 0.2 s of CPU; 12 s to compile on first use after an install) for a few
+milliseconds saved per evaluation. ``squeeze-grasp sweep`` and the large bench sweep, whose
+workers run thousands of evaluations, set it to numba when numba is installed
+(:func:`prefer_compiled`). Asking for numba without it installed raises an error that names the
+extra.
 """
 from __future__ import annotations
 
@@ -24,7 +28,7 @@ import os
 from enum import Enum
 from functools import cache
 
-from squeeze_grasp_ros.extras import EXTRAS
+from squeeze_grasp_ros.extras import EXTRAS, installed
 from squeeze_grasp_ros.mechanics.errors import InvalidInputError
 
 KERNEL_VARIABLE = "SQUEEZE_GRASP_KERNEL"
@@ -41,7 +45,7 @@ class Kernel(str, Enum):
 
 
 def selected() -> Kernel:
-    """The route :data:`KERNEL_VARIABLE` asks for (default: numba when installed).
+    """The route :data:`KERNEL_VARIABLE` asks for (default: numpy).
 
     >>> import os; os.environ[KERNEL_VARIABLE] = "numpy"; selected()
     <Kernel.NUMPY: 'numpy'>
@@ -49,7 +53,7 @@ def selected() -> Kernel:
     """
     text = os.environ.get(KERNEL_VARIABLE, "")
     if not text:
-        return Kernel.NUMBA if compiled() is not None else Kernel.NUMPY
+        return Kernel.NUMPY
     try:
         kernel = Kernel(text)
     except ValueError:
@@ -69,3 +73,12 @@ def compiled():
     except ImportError:
         return None
     return fixed_set_numba
+
+
+def prefer_compiled() -> None:
+    """Set :data:`KERNEL_VARIABLE` to numba in this process's environment, which the processes
+    it starts (a local Dask cluster's workers) inherit, when numba is installed and the
+    variable is unset: for runs of many evaluations, where numba's start-up is paid once.
+    """
+    if installed("numba"):
+        os.environ.setdefault(KERNEL_VARIABLE, Kernel.NUMBA.value)

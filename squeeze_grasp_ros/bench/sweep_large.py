@@ -23,6 +23,7 @@ import yaml
 
 from squeeze_grasp_ros.bench.table import Table
 from squeeze_grasp_ros.mechanics.squeeze.fixed_set_kernel import prefer_compiled
+from squeeze_grasp_ros.mechanics.vocabulary import ShapeType
 from squeeze_grasp_ros.resources import share_dir
 
 DEFAULT_EVALUATIONS = 100_000
@@ -44,7 +45,7 @@ def large_spec(evaluations: int) -> dict:
     data.update(
         name="large",
         base=str((example.parent / data["base"]).resolve()),
-        objects=[{"family": {"type": "fourier_blob", "count": objects,
+        objects=[{"family": {"type": ShapeType.FOURIER_BLOB.value, "count": objects,
                              "radius": [0.04, 0.06], "harmonics": 4, "amplitude": 0.15}}],
         placements={"mode": "graspmap", "count": placements},
     )

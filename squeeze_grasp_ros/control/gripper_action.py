@@ -1,0 +1,159 @@
+# Copyright 2026 squeeze_grasp_ros developers
+# SPDX-License-Identifier: Apache-2.0
+"""The goal semantics of ros2_controllers' gripper action controllers (Jazzy), ROS-free.
+
+Both the GripperActionController (``control_msgs/action/GripperCommand``) and the
+ParallelGripperController (``control_msgs/action/ParallelGripperCommand``) control one joint
+through its position command interface, and judge the active goal every update from the
+joint's position and velocity state, in joint units:
+
+- **reached**: ``|command - position| < goal_tolerance``: the goal succeeds with
+  ``reached_goal = true, stalled = false``;
+- **stalled**: otherwise, while ``|velocity| > stall_velocity_threshold`` the goal counts as
+  moving; once it has not moved for more than ``stall_timeout`` s the goal ends with
+  ``stalled = true, reached_goal = false``: aborted, or succeeded with ``allow_stalling``;
+- a new goal preempts the active one; a cancel holds the measured position;
+- the result's ``effort`` is the controller's computed command, which for a position interface
+  is the goal's effort limit (not a measurement: the measured effort is on ``joint_states``).
+
+:class:`GripperServo` is that logic plus what the simulated hardware adds in place of a
+gripper's own servo: the commanded position approaches the goal's at the goal's speed limit,
+and the jaws stop closing while the jaw effort is at the effort limit (a force-controlled stop:
+the jaws then stand still, and the goal stalls).
+
+>>> servo = GripperServo(GripperParameters(goal_tolerance=0.01, stall_timeout=0.5),
+...                      position=0.0)
+>>> servo.accept(GripperGoal(position=0.1, effort=5.0, velocity=1.0), now=0.0)
+>>> round(servo.command(0.0, 0.0, dt=0.01), 6)
+0.01
+>>> servo.update(now=0.01, position=0.095, velocity=0.5) is None
+False
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from squeeze_grasp_ros.mechanics.vocabulary import _Name
+
+__all__ = ["GoalEnd", "GripperGoal", "GripperOutcome", "GripperParameters", "GripperServo"]
+
+
+class GoalEnd(_Name):
+    """How a gripper goal ended."""
+
+    SUCCEEDED = "succeeded"
+    ABORTED = "aborted"
+
+
+@dataclass(frozen=True)
+class GripperParameters:
+    """The controller's parameters (joint units: rad or m, and their efforts), with the stock
+    defaults of the Jazzy ParallelGripperController.
+
+    Attributes
+    ----------
+    goal_tolerance : float
+        A goal is reached within this distance of its position (default 0.01).
+    stall_velocity_threshold : float
+        Slower than this the joint counts as standing still, per s (default 0.001).
+    stall_timeout : float
+        Standing still this long (s) while the goal is not reached is a stall (default 1.0).
+    allow_stalling : bool
+        A stall succeeds instead of aborting (default False).
+    max_effort : float
+        Effort limit of a goal that gives none (default 10.0).
+    max_velocity : float
+        Speed limit of a goal that gives none, per s (default 0.1; ``inf``: the command jumps
+        to the goal, as the GripperActionController's).
+    """
+
+    goal_tolerance: float = 0.01
+    stall_velocity_threshold: float = 0.001
+    stall_timeout: float = 1.0
+    allow_stalling: bool = False
+    max_effort: float = 10.0
+    max_velocity: float = 0.1
+
+
+@dataclass(frozen=True)
+class GripperGoal:
+    """One accepted goal: joint position, effort limit and speed limit (joint units)."""
+
+    position: float
+    effort: float
+    velocity: float
+
+
+@dataclass(frozen=True)
+class GripperOutcome:
+    """The end of a goal: the action's result fields and the goal's end state."""
+
+    end: GoalEnd
+    position: float
+    effort: float
+    reached_goal: bool
+    stalled: bool
+
+
+class GripperServo:
+    """The active goal of one gripper joint and the position command it yields.
+
+    Parameters
+    ----------
+    parameters : GripperParameters
+    position : float
+        The joint's measured position at activation (the first command holds it).
+    """
+
+    def __init__(self, parameters: GripperParameters, *, position: float) -> None:
+        self.parameters = parameters
+        self.goal: GripperGoal | None = None
+        self.target = float(position)
+        self.commanded = float(position)
+        self.effort = parameters.max_effort
+        self.velocity = parameters.max_velocity
+        self.last_movement = 0.0
+
+    def accept(self, goal: GripperGoal, *, now: float) -> None:
+        """Make ``goal`` active (the caller preempts the previous one); ``now`` in s."""
+        self.goal = goal
+        self.target, self.effort, self.velocity = goal.position, goal.effort, goal.velocity
+        self.last_movement = float(now)
+
+    def cancel(self, position: float) -> None:
+        """Drop the active goal and hold ``position`` with the default limits."""
+        self.goal = None
+        self.target = self.commanded = float(position)
+        self.effort, self.velocity = self.parameters.max_effort, self.parameters.max_velocity
+
+    def update(self, *, now: float, position: float, velocity: float) -> GripperOutcome | None:
+        """Judge the active goal at time ``now`` (s) from the measured joint ``position`` and
+        ``velocity``; the outcome when it ends (the goal is then no longer active).
+        """
+        if self.goal is None:
+            return None
+        p = self.parameters
+        if abs(self.target - position) < p.goal_tolerance:
+            return self._end(GoalEnd.SUCCEEDED, position, reached=True)
+        if abs(velocity) > p.stall_velocity_threshold:
+            self.last_movement = float(now)
+        elif now - self.last_movement > p.stall_timeout:
+            return self._end(GoalEnd.SUCCEEDED if p.allow_stalling else GoalEnd.ABORTED,
+                             position, reached=False)
+        return None
+
+    def _end(self, end: GoalEnd, position: float, *, reached: bool) -> GripperOutcome:
+        self.goal = None
+        return GripperOutcome(end, float(position), float(self.effort), reached, not reached)
+
+    def command(self, position: float, effort: float, *, dt: float) -> float:
+        """The joint position command of the next ``dt`` s, from the measured ``position`` and
+        ``effort``: toward the target at the speed limit, and no further toward it than the
+        measured position while ``|effort|`` is at the effort limit.
+        """
+        step = self.velocity * dt
+        self.commanded = min(max(self.target, self.commanded - step), self.commanded + step)
+        if self.goal is not None and abs(effort) >= self.effort > 0.0 and \
+                abs(self.target - self.commanded) < abs(self.target - position):
+            self.commanded = float(position)
+        return self.commanded

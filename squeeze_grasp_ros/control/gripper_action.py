@@ -31,11 +31,17 @@ False
 """
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 from squeeze_grasp_ros.mechanics.vocabulary import _Name
 
-__all__ = ["GoalEnd", "GripperGoal", "GripperOutcome", "GripperParameters", "GripperServo"]
+__all__ = ["GoalEnd", "GoalRefused", "GripperGoal", "GripperOutcome", "GripperParameters",
+           "GripperServo", "gripper_goal"]
+
+
+class GoalRefused(ValueError):
+    """A goal the controller rejects; the message says why."""
 
 
 class GoalEnd(_Name):
@@ -157,3 +163,51 @@ class GripperServo:
                 abs(self.target - self.commanded) < abs(self.target - position):
             self.commanded = float(position)
         return self.commanded
+
+
+def gripper_goal(position: float, effort: float | None, velocity: float | None, *,
+                 parameters: GripperParameters, joint_range: tuple[float, float],
+                 effort_limit: float) -> GripperGoal:
+    """The goal of a request, checked (joint units).
+
+    Parameters
+    ----------
+    position : float
+        The requested joint position.
+    effort, velocity : float or None
+        The requested effort and speed limits; None or an effort of 0: the parameters'.
+    parameters : GripperParameters
+    joint_range : (float, float)
+        The joint positions of the device's opening range (either order).
+    effort_limit : float
+        The device's largest joint effort.
+
+    Raises
+    ------
+    GoalRefused
+        Naming the field and its valid range. The stock controllers accept any position and
+        effort; this one refuses what the device cannot do.
+
+    >>> p = GripperParameters(max_effort=3.0)
+    >>> gripper_goal(0.2, 0.0, None, parameters=p, joint_range=(0.8, 0.0), effort_limit=235.0)
+    GripperGoal(position=0.2, effort=3.0, velocity=0.1)
+    >>> gripper_goal(0.9, 1.0, None, parameters=p, joint_range=(0.8, 0.0), effort_limit=235.0)
+    Traceback (most recent call last):
+    ...
+    squeeze_grasp_ros.control.gripper_action.GoalRefused: position 0.9 is outside the joint range [0, 0.8]
+    """
+    lo, hi = sorted(joint_range)
+    if not math.isfinite(position):
+        raise GoalRefused(f"position {position} is not finite")
+    if not lo <= position <= hi:
+        raise GoalRefused(f"position {position:g} is outside the joint range [{lo:g}, {hi:g}]")
+    if effort is None or effort == 0.0:
+        effort = parameters.max_effort
+    elif not (math.isfinite(effort) and 0.0 < effort <= effort_limit):
+        raise GoalRefused(f"effort {effort:g} is outside (0, {effort_limit:g}], the device's "
+                          "effort limit (0: the controller's max_effort)")
+    if velocity is None:
+        velocity = parameters.max_velocity
+    elif not (math.isfinite(velocity) and velocity > 0.0):
+        raise GoalRefused(f"velocity {velocity:g} must be finite and > 0")
+    return GripperGoal(float(position), float(effort), float(velocity))

@@ -6,6 +6,8 @@ The section maps two fingers (the jaws) to a parallel-gripper device and names t
 that drives its joints::
 
     controller: {type: joint_trajectory, name: gripper_controller, device: generic_85mm}
+    controller: {type: parallel_gripper, name: gripper_controller, device: generic_85mm,
+                 goal_tolerance: 1.0e-6, stall_timeout: 0.05}
 
 :func:`scene_controller` resolves the device (a shipped name or a file relative to the scene)
 and checks it against the scene: the jaws are two distinct squeezing fingers whose tips are
@@ -24,7 +26,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 from pathlib import Path
 
-from squeeze_grasp_ros.mechanics.vocabulary import Finger
+from squeeze_grasp_ros.control.gripper_action import GripperParameters
+from squeeze_grasp_ros.mechanics.vocabulary import ControllerKind, Finger
 from squeeze_grasp_ros.resources import ResourceError, device_file
 from squeeze_grasp_ros.scene.gripper import GripperSpec, load_gripper
 from squeeze_grasp_ros.scene.schema import SchemaError
@@ -47,9 +50,36 @@ class JawController:
         return self.spec.jaws[0], self.spec.jaws[1]
 
     @property
+    def kind(self) -> ControllerKind:
+        """The controller's interface."""
+        return ControllerKind(self.spec.type)
+
+    @property
     def topic(self) -> str:
-        """The controller's trajectory topic, relative: ``<name>/joint_trajectory``."""
-        return f"{self.spec.name}/joint_trajectory"
+        """The controller's command topic or action, relative: ``<name>/joint_trajectory`` or
+        ``<name>/gripper_cmd``.
+        """
+        suffix = "gripper_cmd" if self.kind.is_action else "joint_trajectory"
+        return f"{self.spec.name}/{suffix}"
+
+    @property
+    def effort_limit(self) -> float:
+        """The largest joint effort of the device (its ``max_force`` through the
+        transmission).
+        """
+        return abs(self.gripper.joint_efforts(self.gripper.max_force)[0])
+
+    def parameters(self) -> GripperParameters:
+        """The gripper action controller's parameters (joint units); ``max_effort`` 0 is the
+        device's limit, and the GripperActionController's command jumps to the goal.
+        """
+        s = self.spec
+        return GripperParameters(
+            goal_tolerance=s.goal_tolerance, stall_velocity_threshold=s.stall_velocity_threshold,
+            stall_timeout=s.stall_timeout, allow_stalling=s.allow_stalling,
+            max_effort=s.max_effort or self.effort_limit,
+            max_velocity=(s.max_velocity if self.kind is ControllerKind.PARALLEL_GRIPPER
+                          else float("inf")))
 
     def joint_positions(self, aperture: float) -> tuple[float, ...]:
         """Each controller joint's position at ``aperture`` (m), through the transmission."""
@@ -99,5 +129,8 @@ def scene_controller(scene: Scene, scene_path: str | Path) -> JawController | No
     if len(joints) != len(gripper.transmission.joints) or len(set(joints)) != len(joints):
         raise SceneError(f"controller.joints must be {len(gripper.transmission.joints)} distinct "
                          f"names (as {gripper.name}'s transmission.joints), got {list(joints)}")
+    if ControllerKind(spec.type).is_action and len(joints) != 1:
+        raise SceneError(f"controller.joints: a {spec.type} controller drives one joint (its "
+                         f"'joint' parameter), {gripper.name}'s transmission has {list(joints)}")
     return JawController(spec, gripper, tuple(joints))
 

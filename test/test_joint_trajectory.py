@@ -111,7 +111,8 @@ def test_the_shipped_sponge_maps_its_jaws_to_the_generic_gripper():
     ({"joints": ["a", "b"]}, "controller.joints must be 1 distinct"),
     ({"device": "no_such_gripper"}, "controller.device: no shipped device 'no_such_gripper'"),
     ({"device": "nope.yaml"}, "controller.device: gripper device file not found"),
-    ({"type": "gripper_action"}, "controller.type"),
+    ({"type": "effort_gripper"}, "controller.type"),
+    ({"type": "gripper_action", "joints": ["a", "b"]}, "controller.joints must be 1 distinct"),
 ])
 def test_controller_section_errors_name_the_field(controller, message):
     section = {"type": "joint_trajectory", "name": "gripper_controller",

@@ -388,8 +388,9 @@ class ControllerSpec:
     max_velocity: float = spec("parallel_gripper: speed limit of a goal without one (the "
                                "GripperActionController has none: its command jumps to the goal)",
                                "joint units/s", lo=0.0, lo_open=True, default=0.1)
-    effort_margin: float = spec("gripper_action, parallel_gripper: the executor's effort limit is "
-                                "the planned jaw force times this margin", "", lo=1.0,
+    effort_margin: float = spec("gripper_action, parallel_gripper: the executor's effort limit "
+                                "is the planned jaw force times this margin (below 1 the jaws "
+                                "stall short of the planned depth)", "", lo=0.0, lo_open=True,
                                 default=1.25)
 
 

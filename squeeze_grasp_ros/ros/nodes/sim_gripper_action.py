@@ -93,7 +93,7 @@ class SimGripperActionController(SimJaws):
     @property
     def commanded(self) -> bool:
         """True when the executor has answered the current tick."""
-        return self.answered_ns >= self.now_ns >= 0
+        return self.answered_ns >= self.now_ns() >= 0
 
     def _cycle(self, msg: Header) -> None:
         self.answered_ns = max(self.answered_ns, messages.stamp_ns(msg.stamp))

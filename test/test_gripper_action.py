@@ -7,8 +7,12 @@ rules of ros2_controllers' Jazzy sources and a spring closed in by the jaws.
 from __future__ import annotations
 
 import math
+import subprocess
+import sys
+from pathlib import Path
 
 import pytest
+import yaml
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
@@ -22,6 +26,8 @@ from squeeze_grasp_ros.control.gripper_action import (
 )
 
 DT = 1e-3
+REPO = Path(__file__).resolve().parents[1]
+SPONGE = REPO / "config" / "scenes" / "sponge_gripper.yaml"
 
 
 @settings(max_examples=60, deadline=None)
@@ -29,7 +35,8 @@ DT = 1e-3
        tolerance=st.floats(1e-6, 0.1))
 def test_reached_exactly_within_the_goal_tolerance(target, position, tolerance):
     """check_for_success: the goal succeeds with reached_goal iff |command - position| <
-    goal_tolerance, whatever the velocity."""
+    goal_tolerance, whatever the velocity.
+    """
     servo = GripperServo(GripperParameters(goal_tolerance=tolerance), position=0.0)
     servo.accept(GripperGoal(target, 5.0, 0.1), now=0.0)
     outcome = servo.update(now=0.001, position=position, velocity=0.5)
@@ -46,7 +53,8 @@ def test_reached_exactly_within_the_goal_tolerance(target, position, tolerance):
                                                   (True, GoalEnd.SUCCEEDED)])
 def test_stall_after_the_timeout_below_the_velocity_threshold(allow_stalling, end):
     """Standing still (|v| <= threshold) for more than stall_timeout s short of the goal is a
-    stall: aborted, or succeeded with allow_stalling; any faster tick restarts the timer."""
+    stall: aborted, or succeeded with allow_stalling; any faster tick restarts the timer.
+    """
     p = GripperParameters(stall_velocity_threshold=0.001, stall_timeout=0.05,
                           allow_stalling=allow_stalling)
     servo = GripperServo(p, position=0.0)
@@ -63,7 +71,8 @@ def test_stall_after_the_timeout_below_the_velocity_threshold(allow_stalling, en
 
 def test_command_speed_limit_and_jump():
     """The parallel controller's speed limit moves the command by velocity dt per tick; the
-    GripperActionController's (no limit) jumps to the goal."""
+    GripperActionController's (no limit) jumps to the goal.
+    """
     servo = GripperServo(GripperParameters(), position=0.0)
     servo.accept(GripperGoal(0.01, 5.0, 2.0), now=0.0)
     steps = [servo.command(0.0, 0.0, dt=DT) for _ in range(6)]
@@ -87,7 +96,8 @@ def spring_close(stiffness: float, contact: float, effort: float, *, stall_timeo
                  ticks: int) -> tuple[list[float], object]:
     """Jaws (joint = aperture, m; effort = jaw force, N) closing from 0.05 m on a spring that
     pushes back k (contact - a) below the aperture ``contact``; the joint follows its command
-    exactly. Returns (apertures, outcome)."""
+    exactly. Returns (apertures, outcome).
+    """
     p = GripperParameters(goal_tolerance=1e-6, stall_timeout=stall_timeout)
     servo = GripperServo(p, position=0.05)
     servo.accept(gripper_goal(0.0, effort, 0.02, parameters=p, joint_range=(0.0, 0.085),
@@ -107,7 +117,8 @@ def spring_close(stiffness: float, contact: float, effort: float, *, stall_timeo
 def test_force_controlled_stop_stalls_at_the_effort_limit():
     """With max effort F on a spring k, the jaws stop where the force first reaches F (within
     one tick's closing, 20 um at 0.02 m/s), stand still, and the goal stalls stall_timeout
-    later: aborted, reached_goal false, effort = F."""
+    later: aborted, reached_goal false, effort = F.
+    """
     k, contact, f_max = 1000.0, 0.04, 5.0
     apertures, outcome = spring_close(k, contact, f_max, stall_timeout=0.05, ticks=5000)
     stop = contact - f_max / k
@@ -148,3 +159,40 @@ def test_goal_defaults_from_the_parameters():
                         effort_limit=235.0) == GripperGoal(0.4, 7.0, 0.3)
     assert gripper_goal(0.4, 0.0, 0.1, parameters=p, joint_range=(0.0, 0.8),
                         effort_limit=235.0) == GripperGoal(0.4, 7.0, 0.1)
+
+
+# --------------------------------------------------------------------------- without control_msgs
+def test_without_control_msgs_the_ros_tests_skip_saying_how_to_build_it():
+    """A fresh machine has no control_msgs: the action tests skip with the ros-setup line and
+    the doctest sweep skips the two modules that import it, nothing fails.
+    """
+    hide = "import sys; sys.modules['control_msgs'] = None; import pytest; "
+    tests = ["test/test_gripper_action_ros.py", "test/test_doctests.py::test_examples"]
+    result = subprocess.run(
+        [sys.executable, "-c", hide + f"sys.exit(pytest.main(['-q', '-rs', *{tests!r}, "
+         "'-k', 'action_ros or jaw_action or sim_gripper_action', '-p', 'no:cacheprovider']))"],
+        cwd=REPO, capture_output=True, text=True, timeout=300)
+    out = result.stdout
+    assert result.returncode == 0, out + result.stderr
+    assert "control_msgs is not built: squeeze-grasp ros-setup --control-msgs DIR" in out
+    assert "SKIPPED [2] test/test_doctests.py" in out
+    assert "needs control_msgs.action, which is not installed: squeeze-grasp ros-setup " \
+           "--control-msgs DIR" in out
+    assert "3 skipped" in out and "failed" not in out
+
+
+def test_an_action_controller_without_control_msgs_is_a_parameter_error(monkeypatch):
+    from squeeze_grasp_ros.ros.nodes import ParameterError
+    from squeeze_grasp_ros.ros.nodes.sim_hardware import sim_controller
+    from squeeze_grasp_ros.scene import parse_scene
+    from squeeze_grasp_ros.scene.controller import scene_controller
+
+    data = yaml.safe_load(SPONGE.read_text())
+    data["controller"]["type"] = "parallel_gripper"
+    jaws = scene_controller(parse_scene(data), SPONGE)
+    monkeypatch.setitem(sys.modules, "control_msgs", None)
+    monkeypatch.delitem(sys.modules, "squeeze_grasp_ros.ros.nodes.sim_gripper_action",
+                        raising=False)
+    with pytest.raises(ParameterError, match="controller.type parallel_gripper needs "
+                       "control_msgs .*squeeze-grasp ros-setup --control-msgs DIR"):
+        sim_controller(jaws)

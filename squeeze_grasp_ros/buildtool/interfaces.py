@@ -41,6 +41,8 @@ from pathlib import Path
 from squeeze_grasp_ros.exit_codes import ExitCode
 
 INTERFACE_PACKAGE = "squeeze_grasp_interfaces"
+INTERFACE_MODULES = (f"{INTERFACE_PACKAGE}.msg", f"{INTERFACE_PACKAGE}.srv")
+"""What a build of the interfaces must make importable."""
 INSTALL_HINT = "pip install -e '.[ros]'"
 MIN_PYTHON = (3, 10)
 MAX_PYTHON = (3, 13)
@@ -457,8 +459,7 @@ def build_and_install(layout: Layout, source: Path, verbose: bool) -> None:
     shutil.copyfile(layout.build_dir / "install_manifest.txt", layout.manifest_file)
 
 
-def verify_import(prefix: Path, modules: Sequence[str] = (f"{INTERFACE_PACKAGE}.msg",
-                                                         f"{INTERFACE_PACKAGE}.srv")) -> None:
+def verify_import(prefix: Path, modules: Sequence[str] = INTERFACE_MODULES) -> None:
     """Import the generated ``modules`` in a fresh interpreter of the environment.
 
     Raises
@@ -579,8 +580,8 @@ def setup(layout: Layout, source: Path, force: bool, verbose: bool) -> None:
 
 
 def build_package(layout: Layout, source: Path, *, package: str = INTERFACE_PACKAGE,
-                  modules: Sequence[str] = (f"{INTERFACE_PACKAGE}.msg", f"{INTERFACE_PACKAGE}.srv"),
-                  force: bool, verbose: bool) -> None:
+                  modules: Sequence[str] = INTERFACE_MODULES, force: bool,
+                  verbose: bool) -> None:
     """Build and install the interface package ``package`` from ``source`` when due (its
     stamp, build tree and manifest in ``layout.state_dir``), then import ``modules``.
     """

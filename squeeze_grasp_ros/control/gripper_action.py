@@ -191,10 +191,11 @@ def gripper_goal(position: float, effort: float | None, velocity: float | None, 
     >>> p = GripperParameters(max_effort=3.0)
     >>> gripper_goal(0.2, 0.0, None, parameters=p, joint_range=(0.8, 0.0), effort_limit=235.0)
     GripperGoal(position=0.2, effort=3.0, velocity=0.1)
-    >>> gripper_goal(0.9, 1.0, None, parameters=p, joint_range=(0.8, 0.0), effort_limit=235.0)
-    Traceback (most recent call last):
-    ...
-    squeeze_grasp_ros.control.gripper_action.GoalRefused: position 0.9 is outside the joint range [0, 0.8]
+    >>> try:
+    ...     gripper_goal(0.9, 1.0, None, parameters=p, joint_range=(0.8, 0.0), effort_limit=9.0)
+    ... except GoalRefused as exc:
+    ...     print(exc)
+    position 0.9 is outside the joint range [0, 0.8]
     """
     lo, hi = sorted(joint_range)
     if not math.isfinite(position):

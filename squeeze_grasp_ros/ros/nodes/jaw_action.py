@@ -127,7 +127,9 @@ class JawAction:
             self.handle = future.result()
             if not self.handle.accepted:
                 self.outcome = (ExecuteGrasp.Result.GRIPPER_REJECTED, False,
-                                f"{self.topic} rejected the goal {self.sent} (its log says why)")
+                                f"{self.controller.topic} rejected the goal (position "
+                                f"{self.sent['position']:.6g}, max_effort "
+                                f"{self.sent['max_effort']:.6g}): its log says why")
             else:
                 self.handle.get_result_async().add_done_callback(self._result)
             on_answer()
@@ -141,8 +143,10 @@ class JawAction:
             else getattr(result, "position", 0.0)
         effort = result.state.effort[0] if self.parallel and len(result.state.effort) \
             else getattr(result, "effort", 0.0)
-        detail = (f"{self.topic}: reached_goal {result.reached_goal}, stalled {result.stalled}, "
-                  f"position {position:.6g}, effort {effort:.6g} (sent {self.sent})")
+        detail = (f"{self.controller.topic}: reached_goal {result.reached_goal}, stalled "
+                  f"{result.stalled}, position {position:.6g}, effort {effort:.6g} (goal: "
+                  f"position {self.sent['position']:.6g}, max_effort "
+                  f"{self.sent['max_effort']:.6g})")
         succeeded = response.status == GOAL_STATUS_SUCCEEDED
         if result.reached_goal:
             self.outcome = (ExecuteGrasp.Result.DEPTH_REACHED, True, detail)

@@ -143,7 +143,9 @@ class ExecutorNode(Node):
                                                     list(self.setpoint_pubs.values())
                                                     + ([self.jaws.publisher] if self.jaws else [])
                                                     + ([self.jaw_action.publisher]
-                                                       if self.jaw_action else []))
+                                                       if self.jaw_action else []),
+                                                    condition=self.jaw_action.ready
+                                                    if self.jaw_action else None)
         else:
             self.create_timer(p["period"], self._timer)
 

@@ -15,7 +15,9 @@ line from the jaws' measured tips (as :mod:`.jaw_commands`), and sends
 - **max_effort** (parallel: ``effort[0]``) = the planned jaw force at that depth (the planner's
   force curve, ``planner/predicted_events``, mean of the two jaws) times the controller
   section's ``effort_margin``, through the transmission, capped at the device's limit; without
-  a force curve, 0: the controller's own ``max_effort``.
+  a force curve, 0: the controller's own ``max_effort``. In lockstep the executor is ready only
+  once the force curve is here when somebody publishes one (a run latches it before its nodes
+  start).
 
 The grasp goal then ends on the gripper goal's result: ``reached_goal`` -> depth_reached;
 ``stalled`` -> gripper_stalled (success only if the controller allows stalling); a rejection
@@ -82,6 +84,13 @@ class JawAction:
     def fingers(self) -> tuple[str, str]:
         """The fingers the jaws carry."""
         return self.controller.jaws
+
+    def ready(self) -> bool:
+        """True once the planner's force curve is here, or when nobody publishes one (the
+        executor's lockstep readiness: its first goal's effort depends on it).
+        """
+        return self.forces is not None or \
+            self.node.count_publishers(pipeline.PREDICTION) == 0
 
     def _prediction(self, msg: ContactEventArray) -> None:
         self.forces = messages.predicted_forces(msg)

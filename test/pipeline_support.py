@@ -102,3 +102,32 @@ def run_scene(tmp_path: Path, data: dict, world: dict | None = None, record: boo
         overrides = {"sim_hardware": {"scene": str(world_path)}}
     return PipelineRunner(RunOptions(str(path), overrides=overrides,
                                      record=str(tmp_path / "bag") if record else None)).run()
+
+
+def run_observed(path: str, topics=(), record: str | None = None) -> dict:
+    """Run scene file ``path`` (planned with the mechanics) through the real nodes: its result,
+    the ground-truth events as (stamp s, stamp ns, type, finger, node), the final forces on the
+    object (N, one row per finger) and depth (m), and under each key of ``topics`` ((key, topic,
+    message class) each) the messages the run published there.
+    """
+    import numpy as np
+
+    from squeeze_grasp_ros.ros.nodes import pipeline
+    from squeeze_grasp_ros.ros.run.options import RunOptions
+    from squeeze_grasp_ros.ros.run.runner import PipelineRunner
+
+    runner = PipelineRunner(RunOptions(path, planner=False, record=record))
+    seen = {key: [] for key, _, _ in topics}
+    for key, topic, cls in topics:
+        runner.client.create_subscription(cls, topic, seen[key].append, pipeline.loop_qos(1000))
+    try:
+        runner.start()
+        runner.send_goal()
+        result = runner.wait_result()
+        state = runner.observer.sim_states[-1]
+    finally:
+        runner.shutdown()
+    events = [(e.header.stamp.sec, e.header.stamp.nanosec, e.type, e.finger, e.node)
+              for e in runner.observer.sim_events]
+    return {"result": result, "events": events, "depth": state.contacts.depth,
+            "forces": np.array([[v.x, v.y] for v in state.forces]), **seen}

@@ -196,3 +196,15 @@ def test_an_action_controller_without_control_msgs_is_a_parameter_error(monkeypa
     with pytest.raises(ParameterError, match="controller.type parallel_gripper needs "
                        "control_msgs .*squeeze-grasp ros-setup --control-msgs DIR"):
         sim_controller(jaws)
+
+
+def test_the_force_stop_outlasts_the_goal():
+    """After a stall ends the goal the command and its effort limit stay (stock: the command
+    struct is unchanged): the jaws still do not close while at the limit."""
+    servo = GripperServo(GripperParameters(stall_timeout=0.0), position=0.05)
+    servo.accept(GripperGoal(0.0, 5.0, 0.02), now=0.0)
+    assert servo.command(0.05, 5.0, dt=DT) == 0.05
+    assert servo.update(now=DT, position=0.05, velocity=0.0).stalled
+    assert servo.goal is None
+    assert servo.command(0.05, 5.0, dt=DT) == 0.05
+    assert servo.command(0.05, 4.0, dt=DT) == pytest.approx(0.05 - 0.02 * DT)

@@ -19,7 +19,7 @@ import pytest
 import rclpy
 import yaml
 from mcap.reader import make_reader
-from pipeline_support import write_scene
+from pipeline_support import run_observed, write_scene
 
 if importlib.util.find_spec("control_msgs") is None:
     pytest.skip("control_msgs is not built: squeeze-grasp ros-setup --control-msgs DIR (DIR a "
@@ -35,8 +35,6 @@ from sensor_msgs.msg import JointState  # noqa: E402
 
 from squeeze_grasp_ros.ros.nodes import pipeline  # noqa: E402
 from squeeze_grasp_ros.ros.nodes.sim_hardware import SimHardwareNode  # noqa: E402
-from squeeze_grasp_ros.ros.run.options import RunOptions  # noqa: E402
-from squeeze_grasp_ros.ros.run.runner import PipelineRunner  # noqa: E402
 
 SPONGE = Path(__file__).resolve().parents[1] / "config" / "scenes" / "sponge_gripper.yaml"
 TIGHT = {"goal_tolerance": 1e-7, "stall_timeout": 0.02}
@@ -52,22 +50,12 @@ def sponge(kind: str | None, **controller) -> dict:
 
 
 def run(path: str, record: str | None = None) -> dict:
-    """Run a sponge scene on real rclpy: result, ground-truth events and forces, joint states."""
-    runner = PipelineRunner(RunOptions(path, planner=False, record=record))
-    states: list = []
-    runner.client.create_subscription(JointState, "joint_states", states.append,
-                                      pipeline.loop_qos(1000))
-    try:
-        runner.start()
-        runner.send_goal()
-        result = runner.wait_result()
-        state = runner.observer.sim_states[-1]
-    finally:
-        runner.shutdown()
-    return {"result": result, "states": states,
-            "events": [(e.type, e.finger, e.node) for e in runner.observer.sim_events],
-            "forces": np.array([[v.x, v.y] for v in state.forces]),
-            "depth": state.contacts.depth}
+    """Run a sponge scene on real rclpy: result, ground-truth events (without their ticks: the
+    routes close at different speeds) and forces, joint states.
+    """
+    out = run_observed(path, [("states", "joint_states", JointState)], record=record)
+    out["events"] = [(kind, finger, node) for _, _, kind, finger, node in out["events"]]
+    return out
 
 
 @pytest.fixture(scope="module")

@@ -17,7 +17,7 @@ import rclpy
 import yaml
 from builtin_interfaces.msg import Duration
 from mcap.reader import make_reader
-from pipeline_support import write_scene
+from pipeline_support import run_observed, write_scene
 from rclpy.context import Context
 from rclpy.executors import SingleThreadedExecutor
 from rclpy.node import Node
@@ -31,8 +31,6 @@ from squeeze_grasp_ros.control.joint_trajectory import (
 )
 from squeeze_grasp_ros.ros.nodes import pipeline
 from squeeze_grasp_ros.ros.nodes.sim_hardware import SimHardwareNode
-from squeeze_grasp_ros.ros.run.options import RunOptions
-from squeeze_grasp_ros.ros.run.runner import PipelineRunner
 from squeeze_grasp_ros.scene import SceneError, load_scene, parse_scene
 from squeeze_grasp_ros.scene.controller import scene_controller
 
@@ -138,29 +136,13 @@ def test_a_jaw_whose_tip_is_not_the_device_pad_is_refused():
 # --------------------------------------------------------------------------- end to end
 def run_sponge(path: str, record: str | None = None) -> dict:
     """Run a sponge scene on real rclpy; the ground truth and what went on the JTC topics."""
-    runner = PipelineRunner(RunOptions(path, planner=False, record=record))
-    seen = {"trajectories": [], "joint_states": [], "setpoints": []}
-    client = runner.client
-    for topic, cls, key in (("gripper_controller/joint_trajectory", JointTrajectory,
-                             "trajectories"),
-                            ("joint_states", JointState, "joint_states"),
-                            (pipeline.device_topic("barrett_f1", "setpoint"),
-                             pipeline.message_type("geometry_msgs/msg/PoseStamped"),
-                             "setpoints")):
-        client.create_subscription(cls, topic, lambda m, k=key: seen[k].append(m),
-                                   pipeline.loop_qos(1000))
-    try:
-        runner.start()
-        runner.send_goal()
-        result = runner.wait_result()
-        state = runner.observer.sim_states[-1]
-    finally:
-        runner.shutdown()
-    assert result.termination == "depth_reached"
-    events = [(e.header.stamp.sec, e.header.stamp.nanosec, e.type, e.finger, e.node)
-              for e in runner.observer.sim_events]
-    forces = np.array([[v.x, v.y] for v in state.forces])
-    return {"events": events, "forces": forces, "depth": state.contacts.depth, **seen}
+    out = run_observed(path, [
+        ("trajectories", "gripper_controller/joint_trajectory", JointTrajectory),
+        ("joint_states", "joint_states", JointState),
+        ("setpoints", pipeline.device_topic("barrett_f1", "setpoint"),
+         pipeline.message_type("geometry_msgs/msg/PoseStamped"))], record=record)
+    assert out["result"].termination == "depth_reached"
+    return out
 
 
 def test_sponge_through_the_jtc_equals_the_cartesian_route(tmp_path):

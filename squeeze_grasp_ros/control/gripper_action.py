@@ -155,11 +155,12 @@ class GripperServo:
     def command(self, position: float, effort: float, *, dt: float) -> float:
         """The joint position command of the next ``dt`` s, from the measured ``position`` and
         ``effort``: toward the target at the speed limit, and no further toward it than the
-        measured position while ``|effort|`` is at the effort limit.
+        measured position while ``|effort|`` is at the effort limit (also after the goal ended:
+        the command and its limit stay, as on the stock controllers).
         """
         step = self.velocity * dt
         self.commanded = min(max(self.target, self.commanded - step), self.commanded + step)
-        if self.goal is not None and abs(effort) >= self.effort > 0.0 and \
+        if abs(effort) >= self.effort > 0.0 and \
                 abs(self.target - self.commanded) < abs(self.target - position):
             self.commanded = float(position)
         return self.commanded

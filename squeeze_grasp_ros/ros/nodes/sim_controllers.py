@@ -111,13 +111,8 @@ class SimJointTrajectoryController(SimJaws):
 
     Parameters
     ----------
-    node : Node
-        The simulated hardware node.
-    world : SimWorld
-    controller : JawController
-        The scene's resolved ``controller:`` section.
-    qos : QoSProfile
-        Of the trajectory subscription and the joint states.
+    node, world, controller, qos
+        As :class:`SimJaws` (``qos`` also of the trajectory subscription).
     now_ns : callable
         The current sim time, ns (the last published tick).
     on_command : callable

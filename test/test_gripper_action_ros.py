@@ -36,6 +36,7 @@ from std_msgs.msg import Header  # noqa: E402
 
 from squeeze_grasp_ros.ros.nodes import pipeline  # noqa: E402
 from squeeze_grasp_ros.ros.nodes.sim_hardware import SimHardwareNode  # noqa: E402
+from squeeze_grasp_ros.scene import GraspSetup, load_scene  # noqa: E402
 
 SPONGE = Path(__file__).resolve().parents[1] / "config" / "scenes" / "sponge_gripper.yaml"
 TIGHT = {"goal_tolerance": 1e-7, "stall_timeout": 0.02}
@@ -82,6 +83,13 @@ def test_sponge_through_the_action_controller_equals_the_jtc_route(kind, jtc_rou
     print(f"largest force difference {kind} - JTC: {error:.1e} relative")
     assert error < 1e-3
     assert action["depth"] == pytest.approx(jtc_route["depth"], rel=1e-3)
+    # and the mechanics API's event squeeze with the same pads, called directly
+    direct = GraspSetup.build(load_scene(SPONGE)).event_squeeze(depth=action["depth"])
+    assert action["events"] == [(str(e.type), str(e.finger), e.node) for e in direct.events]
+    want = np.array([direct.state.finger_force(f)[:2] for f in ("F1", "F2")])
+    print(f"largest force difference {kind} - mechanics API: "
+          f"{np.abs(action['forces'] - want).max() / scale:.1e} relative")
+    np.testing.assert_allclose(action["forces"], want, rtol=0, atol=1e-3 * scale)
     # the bag, read with mcap's own reader: one message per tick on each stamped topic (a tick
     # re-sent under load repeats its messages: count stamps), the action's status changes
     stamps: dict[str, set] = {"joint_states": set(), pipeline.EXECUTOR_CYCLE: set()}

@@ -68,12 +68,12 @@ def package_folder(source: Path) -> Path:
         if manifest.is_file() and f"<name>{PACKAGE}</name>" in manifest.read_text("utf-8"):
             missing = [name for name in INTERFACES if not (folder / name).is_file()]
             if missing:
-                raise interfaces.SetupError(
+                raise interfaces.SourceError(
                     f"{folder} is not Jazzy's control_msgs (missing {', '.join(missing)}): "
                     "check out the jazzy branch of ros-controls/control_msgs")
             return folder
-    raise interfaces.SetupError(f"--control-msgs {source}: no control_msgs package.xml there "
-                                "or in its control_msgs/ folder")
+    raise interfaces.SourceError(f"--control-msgs {source}: no control_msgs package.xml there "
+                                 "or in its control_msgs/ folder")
 
 
 def stage(folder: Path, into: Path) -> Path:

@@ -78,6 +78,10 @@ class SetupError(RuntimeError):
     """A step of the setup failed; the message says what to do."""
 
 
+class SourceError(SetupError):
+    """A source folder given on the command line is not what it must be (exit 2)."""
+
+
 @dataclass(frozen=True)
 class Layout:
     """Where things go inside the environment.
@@ -628,7 +632,7 @@ def run(args: argparse.Namespace) -> int:
                                force=args.force, verbose=args.verbose)
     except SetupError as error:
         print(f"ros-setup: error: {error}", file=sys.stderr)
-        return ExitCode.INTERNAL
+        return ExitCode.USAGE if isinstance(error, SourceError) else ExitCode.INTERNAL
     return ExitCode.OK
 
 

@@ -123,7 +123,9 @@ class ExecutorNode(Node):
         controller (jaw_action), if any."""
         jaw_fingers = controller.jaws if controller is not None else ()
         self.setpoint_pubs = {f: self.create_publisher(PoseStamped,
-                                                       pipeline.device_topic(d, "setpoint"), loop)
+                                                       pipeline.device_topic(d, "setpoint"),
+                                                       pipeline.loop_qos(p["qos_depth"],
+                                                                         kept=True))
                               for f, d in self.devices.items() if f not in jaw_fingers}
         self.status_pub = self.create_publisher(ExecutorStatus, pipeline.EXECUTOR_STATUS, loop)
         pose_pub = self.create_publisher(PoseStamped, pipeline.OBJECT_POSE, pipeline.LATCHED)

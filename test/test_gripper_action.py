@@ -190,7 +190,8 @@ def test_an_action_controller_without_control_msgs_is_a_parameter_error(monkeypa
     data = yaml.safe_load(SPONGE.read_text())
     data["controller"]["type"] = "parallel_gripper"
     jaws = scene_controller(parse_scene(data), SPONGE)
-    monkeypatch.setitem(sys.modules, "control_msgs", None)
+    for name in ("control_msgs", "control_msgs.action", "control_msgs.msg"):
+        monkeypatch.setitem(sys.modules, name, None)     # as on a fresh machine
     monkeypatch.delitem(sys.modules, "squeeze_grasp_ros.ros.nodes.sim_gripper_action",
                         raising=False)
     with pytest.raises(ParameterError, match="controller.type parallel_gripper needs "
@@ -200,7 +201,8 @@ def test_an_action_controller_without_control_msgs_is_a_parameter_error(monkeypa
 
 def test_the_force_stop_outlasts_the_goal():
     """After a stall ends the goal the command and its effort limit stay (stock: the command
-    struct is unchanged): the jaws still do not close while at the limit."""
+    struct is unchanged): the jaws still do not close while at the limit.
+    """
     servo = GripperServo(GripperParameters(stall_timeout=0.0), position=0.05)
     servo.accept(GripperGoal(0.0, 5.0, 0.02), now=0.0)
     assert servo.command(0.05, 5.0, dt=DT) == 0.05

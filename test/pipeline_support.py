@@ -104,11 +104,13 @@ def run_scene(tmp_path: Path, data: dict, world: dict | None = None, record: boo
                                      record=str(tmp_path / "bag") if record else None)).run()
 
 
-def run_observed(path: str, topics=(), record: str | None = None) -> dict:
+def run_observed(path: str, topics=(), record: str | None = None,
+                 cancel_after: float | None = None) -> dict:
     """Run scene file ``path`` (planned with the mechanics) through the real nodes: its result,
     the ground-truth events as (stamp s, stamp ns, type, finger, node), the final forces on the
     object (N, one row per finger) and depth (m), and under each key of ``topics`` ((key, topic,
-    message class) each) the messages the run published there.
+    message class) each) the messages the run published there. ``cancel_after``: cancel the
+    goal once that much sim time (s) has passed.
     """
     import numpy as np
 
@@ -122,6 +124,10 @@ def run_observed(path: str, topics=(), record: str | None = None) -> dict:
         runner.client.create_subscription(cls, topic, seen[key].append, pipeline.loop_qos(1000))
     try:
         runner.start()
+        if cancel_after is not None:
+            failed = runner.observer.world_failed
+            runner.observer.world_failed = lambda: failed() or (
+                runner.observer.sim_state_ns - runner.start_ns > cancel_after * 1e9)
         runner.send_goal()
         result = runner.wait_result()
         state = runner.observer.sim_states[-1]

@@ -127,6 +127,18 @@ def test_an_effort_below_the_planned_force_stalls(tmp_path):
     assert limit <= force <= 1.05 * limit
 
 
+def test_a_canceled_grasp_cancels_the_gripper_goal(tmp_path):
+    """A cancel of the grasp goal mid-squeeze cancels the gripper goal: the controller holds the
+    measured position and the goal ends canceled, short of the planned depth.
+    """
+    out = run_observed(write_scene(tmp_path, sponge("parallel_gripper", **TIGHT)),
+                       cancel_after=0.2)
+    result = out["result"]
+    print(f"{result.termination} after {result.ticks} ticks, depth {result.depth:.6g} m")
+    assert result.termination == "canceled" and not result.success
+    assert 150 < result.ticks < 400 and 0.0 < out["depth"] < 0.7 * 5.3033e-3
+
+
 # --------------------------------------------------------------------------- hostile client
 def wait(executor, condition, seconds=10.0):
     deadline = time.monotonic() + seconds

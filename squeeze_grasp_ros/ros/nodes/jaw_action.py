@@ -140,12 +140,15 @@ class JawAction:
                                 f"{self.sent['position']:.6g}, max_effort "
                                 f"{self.sent['max_effort']:.6g}): its log says why")
             else:
-                self.handle.get_result_async().add_done_callback(self._result)
+                handle = self.handle
+                handle.get_result_async().add_done_callback(lambda f: self._result(f, handle))
             on_answer()
 
         self.client.send_goal_async(goal).add_done_callback(answered)
 
-    def _result(self, future: Any) -> None:
+    def _result(self, future: Any, handle: Any) -> None:
+        if handle is not self.handle:           # canceled, or an earlier grasp goal's
+            return
         response = future.result()
         result = response.result
         position = result.state.position[0] if self.parallel and len(result.state.position) \
@@ -170,6 +173,6 @@ class JawAction:
         """
         if self.handle is None or not self.handle.accepted or self.outcome is not None:
             return False
-        self.outcome = ("", False, "")
         self.handle.cancel_goal_async().add_done_callback(lambda _: on_answer())
+        self.handle = None
         return True

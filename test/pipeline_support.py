@@ -3,6 +3,7 @@
 """Scenes and comparisons shared by the simulated-world and pipeline tests."""
 from __future__ import annotations
 
+import contextlib
 import copy
 from pathlib import Path
 
@@ -137,3 +138,34 @@ def run_observed(path: str, topics=(), record: str | None = None,
               for e in runner.observer.sim_events]
     return {"result": result, "events": events, "depth": state.contacts.depth,
             "forces": np.array([[v.x, v.y] for v in state.forces]), **seen}
+
+
+@contextlib.contextmanager
+def sim_and_client(scene: str, name: str = "hostile"):
+    """A simulated hardware node of scene file ``scene`` and a client node ``name`` (the one
+    lockstep participant it waits for), on one executor of a context of their own; yields
+    (executor, sim, client) and shuts everything down after.
+    """
+    import rclpy
+    from rclpy.context import Context
+    from rclpy.executors import SingleThreadedExecutor
+    from rclpy.node import Node
+
+    from squeeze_grasp_ros.ros.nodes.sim_hardware import SimHardwareNode
+
+    context = Context()
+    rclpy.init(context=context)
+    executor = SingleThreadedExecutor(context=context)
+    sim = SimHardwareNode(context=context, parameter_overrides=[
+        rclpy.parameter.Parameter("scene", value=str(scene)),
+        rclpy.parameter.Parameter("participants", value=[name])])
+    client = Node(name, context=context)
+    try:
+        executor.add_node(sim)
+        executor.add_node(client)
+        yield executor, sim, client
+    finally:
+        executor.shutdown()
+        sim.destroy_node()
+        client.destroy_node()
+        rclpy.shutdown(context=context)

@@ -15,10 +15,9 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-import rclpy
 import yaml
 from mcap.reader import make_reader
-from pipeline_support import run_observed, write_scene
+from pipeline_support import run_observed, sim_and_client, write_scene
 
 if importlib.util.find_spec("control_msgs") is None:
     pytest.skip("control_msgs is not built: squeeze-grasp ros-setup --control-msgs DIR (DIR a "
@@ -27,15 +26,11 @@ if importlib.util.find_spec("control_msgs") is None:
 
 from control_msgs.action import GripperCommand, ParallelGripperCommand  # noqa: E402
 from rclpy.action import ActionClient  # noqa: E402
-from rclpy.context import Context  # noqa: E402
-from rclpy.executors import SingleThreadedExecutor  # noqa: E402
-from rclpy.node import Node  # noqa: E402
 from rclpy.serialization import deserialize_message  # noqa: E402
 from sensor_msgs.msg import JointState  # noqa: E402
 from std_msgs.msg import Header  # noqa: E402
 
 from squeeze_grasp_ros.ros.nodes import pipeline  # noqa: E402
-from squeeze_grasp_ros.ros.nodes.sim_hardware import SimHardwareNode  # noqa: E402
 from squeeze_grasp_ros.scene import GraspSetup, load_scene  # noqa: E402
 
 SPONGE = Path(__file__).resolve().parents[1] / "config" / "scenes" / "sponge_gripper.yaml"
@@ -154,17 +149,8 @@ def test_a_hostile_action_client_is_rejected(kind, tmp_path, capfd):
     the jaws unmoved; a valid goal is accepted.
     """
     path = write_scene(tmp_path, sponge(kind, **TIGHT))
-    context = Context()
-    rclpy.init(context=context)
-    executor = SingleThreadedExecutor(context=context)
-    sim = SimHardwareNode(context=context, parameter_overrides=[
-        rclpy.parameter.Parameter("scene", value=path),
-        rclpy.parameter.Parameter("participants", value=["hostile"])])
-    client = Node("hostile", context=context)
     action = ParallelGripperCommand if kind == "parallel_gripper" else GripperCommand
-    try:
-        executor.add_node(sim)
-        executor.add_node(client)
+    with sim_and_client(path) as (executor, sim, client):
         cycle = client.create_publisher(pipeline.message_type("std_msgs/msg/Header"),
                                         pipeline.EXECUTOR_CYCLE, pipeline.loop_qos(10))
         pipeline.Participant(client, "hostile", [], [cycle])
@@ -197,10 +183,5 @@ def test_a_hostile_action_client_is_rejected(kind, tmp_path, capfd):
         assert sim.now_ns == 0 and all(np.array_equal(sim.world.positions[f], p)
                                        for f, p in before.items())
         assert goal(0.4, effort=3.0).accepted
-    finally:
-        executor.shutdown()
-        sim.destroy_node()
-        client.destroy_node()
-        rclpy.shutdown(context=context)
     err = capfd.readouterr().err
     assert err.count("rejected the goal on /gripper_controller/gripper_cmd") == len(hostile)

@@ -13,14 +13,10 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-import rclpy
 import yaml
 from builtin_interfaces.msg import Duration
 from mcap.reader import make_reader
-from pipeline_support import run_observed, write_scene
-from rclpy.context import Context
-from rclpy.executors import SingleThreadedExecutor
-from rclpy.node import Node
+from pipeline_support import run_observed, sim_and_client, write_scene
 from sensor_msgs.msg import JointState
 from trajectory_msgs.msg import JointTrajectory, JointTrajectoryPoint
 
@@ -30,7 +26,6 @@ from squeeze_grasp_ros.control.joint_trajectory import (
     TrajectoryRefused,
 )
 from squeeze_grasp_ros.ros.nodes import pipeline
-from squeeze_grasp_ros.ros.nodes.sim_hardware import SimHardwareNode
 from squeeze_grasp_ros.scene import SceneError, load_scene, parse_scene
 from squeeze_grasp_ros.scene.controller import scene_controller
 
@@ -179,16 +174,7 @@ def hostile(names: list[str], positions: list[float], ms: int = 5) -> JointTraje
 
 
 def test_a_hostile_trajectory_is_refused_with_a_log_line_not_followed(capfd):
-    context = Context()
-    rclpy.init(context=context)
-    executor = SingleThreadedExecutor(context=context)
-    sim = SimHardwareNode(context=context, parameter_overrides=[
-        rclpy.parameter.Parameter("scene", value=str(SPONGE)),
-        rclpy.parameter.Parameter("participants", value=["hostile"])])
-    client = Node("hostile", context=context)
-    try:
-        executor.add_node(sim)
-        executor.add_node(client)
+    with sim_and_client(SPONGE) as (executor, sim, client):
         pub = client.create_publisher(JointTrajectory, "gripper_controller/joint_trajectory",
                                       pipeline.loop_qos(10))
         pipeline.Participant(client, "hostile", [], [pub])  # answers sim/hello: tick 0
@@ -225,10 +211,5 @@ def test_a_hostile_trajectory_is_refused_with_a_log_line_not_followed(capfd):
         assert sim.now_ns == MS and jtc.follower.sample(MS) == pytest.approx(0.048)
         world = sim.world.positions
         assert jtc.line.aperture(world["F1"], world["F2"]) == pytest.approx(0.0498, abs=1e-12)
-    finally:
-        executor.shutdown()
-        sim.destroy_node()
-        client.destroy_node()
-        rclpy.shutdown(context=context)
     err = capfd.readouterr().err
     assert err.count("refused the trajectory on /gripper_controller/joint_trajectory") == 5

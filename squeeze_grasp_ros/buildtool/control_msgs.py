@@ -106,19 +106,22 @@ def source_argument(arg: Path | None) -> Path | None:
     return Path(value) if value else None
 
 
+def state(prefix: Path) -> str:
+    """One line: where the environment's control_msgs comes from, or why there is none."""
+    elsewhere = installed_elsewhere(prefix)
+    if elsewhere is not None:
+        return f"{PACKAGE}: using the installed package at {elsewhere}"
+    if interfaces.interfaces_installed(prefix, PACKAGE):
+        return f"{PACKAGE}: built in this environment (its gripper actions)"
+    return (f"{PACKAGE}: not built (no sources given: --control-msgs DIR or {ENV_VAR}=DIR, a "
+            "jazzy checkout of ros-controls/control_msgs); the GripperCommand and "
+            "ParallelGripperCommand routes are unavailable, everything else works")
+
+
 def setup(prefix: Path, source: Path | None, *, force: bool, verbose: bool) -> None:
     """Build control_msgs' gripper actions from ``source`` when given, or say why not."""
     if source is None:
-        elsewhere = installed_elsewhere(prefix)
-        if elsewhere is not None:
-            interfaces.say(f"{PACKAGE}: using the installed package at {elsewhere}")
-        elif interfaces.interfaces_installed(prefix, PACKAGE):
-            interfaces.say(f"{PACKAGE}: built earlier in this environment (its gripper actions)")
-        else:
-            interfaces.say(f"{PACKAGE}: not built (no sources given: --control-msgs DIR or "
-                           f"{ENV_VAR}=DIR, a jazzy checkout of ros-controls/control_msgs); the "
-                           "GripperCommand and ParallelGripperCommand routes are unavailable, "
-                           "everything else works")
+        interfaces.say(state(prefix))
         return
     folder = package_folder(source.resolve())
     where = layout(prefix)

@@ -625,7 +625,9 @@ def run(args: argparse.Namespace) -> int:
     try:
         source = resolve_source(args.source)
         if args.check:
-            return report(layout, source)
+            code = report(layout, source)
+            say(control_msgs.state(layout.prefix))
+            return code
         with state_lock(layout):
             setup(layout, source, args.force, args.verbose)
             control_msgs.setup(layout.prefix, control_msgs.source_argument(args.control_msgs),

@@ -59,8 +59,8 @@ class JawController:
         """The controller's command topic or action, relative: ``<name>/joint_trajectory`` or
         ``<name>/gripper_cmd``.
         """
-        suffix = "gripper_cmd" if self.kind.is_action else "joint_trajectory"
-        return f"{self.spec.name}/{suffix}"
+        name = self.spec.name
+        return f"{name}/gripper_cmd" if self.kind.is_action else f"{name}/joint_trajectory"
 
     @property
     def effort_limit(self) -> float:

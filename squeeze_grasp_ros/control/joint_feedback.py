@@ -14,25 +14,25 @@ monitor sees, through the device's transmission (docs/grippers.md):
 - what a scalar force cannot show: which nodes touch, stick or slide (events A-D need taxels),
   and the tangential force on the pad faces.
 
-The **slip watch** (:class:`JointSlipWatch`) is designed from the squeeze's force-closing curve.
-Closing the jaws on an elastic object whose contacts hold raises F at least as fast as the
-secant F / c since first touch (c = closing since first touch): the stiffness grows as contacts
-spread (events A), so the curve is convex and its tangent k_t = dF/dc never falls below the
-secant k_s = F / c (the event squeeze's force curves show k_t / k_s between 1 and 1.5). When the
-object gives way between the jaws (a finger slips, Sec. 5.1: its contact nodes all slide one
-way, the object rotates or squirts out), closing no longer loads it: F stops rising or drops.
-The watch therefore raises ``slip_imminent`` when, over the last ``window`` m of closing, k_t <
-``ratio`` k_s (value: k_t / k_s; negative when F drops), the chord taken to the start of that
-window, once the jaws have closed at least two windows. It is a detection, not a forecast: the
-finger slip of the paper's quasi-static model has no precursor in F(c) (k_t / k_s rises toward
-it), and taxels (the tracker's cone-usage alarm) are what sees it coming. With the planner's
-prediction, the force watch's ``force_mismatch`` is the other test: F(c) monotone, "F below the
-predicted force at this closing" is "closing beyond the predicted closing at this force", the
-aperture below the predicted one.
+The **slip watch** (:class:`JointSlipWatch`) is designed from the squeeze's force-closing curve
+F(c), c the aperture's closing since the first reading in contact. While the contacts hold,
+closing on an elastic object loads it ever faster: the stiffness grows as contacts spread
+(events A), so F(c) is convex and its tangent k_t = dF/dc never falls below the chord k_s from
+the first reading in contact (the event squeeze's force curves show k_t / k_s between 1 and 1.5,
+``test/test_joint_feedback.py``). When the object gives way between the jaws (a finger slips,
+Sec. 5.1: its contact nodes all slide one way, the object turns or squirts out), closing no
+longer loads it: F stops rising or drops. The watch raises ``slip_imminent`` for both jaws when,
+over the last ``window`` m of closing, k_t < ``ratio`` k_s, the chord taken to the start of
+that window (value: k_t / k_s, negative when F drops; judged once the jaws have closed two
+windows). It is a detection, not a forecast: the finger slip of the paper's quasi-static model
+has no precursor in F(c) (k_t / k_s rises toward it); the taxels' cone usage (the tracker's
+alarm) is what sees a slip coming. With the planner's prediction, the force watch's
+``force_mismatch`` is the other test: F(c) being increasing, "F below the predicted force at
+this closing" is "the aperture below the predicted aperture at this force".
 
-Contact: a jaw is in contact while F > ``contact_force``; its **first touch** is the aperture of
-the last reading before (where F starts from zero: the origin of the closing c); a jaw that had contact and has none raises
-``contact_lost``, as the tracker does on taxels.
+Contact: a jaw is in contact while F > ``contact_force``; its **first touch** is the aperture
+of the last reading without contact (where F starts from zero); a jaw that had contact and has
+none raises ``contact_lost``, as the tracker does on taxels.
 
 >>> watch = JointSlipWatch(("F1", "F2"), contact_force=0.01, window=5e-5, ratio=0.5)
 >>> readings = [(0.05, 0.0), (0.0499, 0.05), (0.0498, 0.1), (0.0497, 0.15), (0.0496, 0.2)]

@@ -62,7 +62,6 @@ from squeeze_grasp_ros.ros.nodes.sim_controllers import JOINT_STATES
 from squeeze_grasp_ros.scene import load_scene
 from squeeze_grasp_ros.scene.controller import JawController, JointReadingError, scene_controller
 
-
 PARAMETERS: dict[str, tuple[Any, str]] = {
     "finger_devices": (["F1:barrett_f1", "F2:barrett_f3"], "finger:device of every fingertip"),
     "streams": (["wrench", "tactile"], "sensor streams each finger has (staleness test)"),

@@ -338,8 +338,9 @@ class PipelineRunner:
         goal is cancelled, so the executor holds instead of driving fingers that no longer move
         the object; not when the monitor watches the jaws on joint feedback alone (a gripper
         scene without wrench and tactile sensing): its slip watch, not the ground truth, is
-        then what stops the goal. If the status topic reports the goal finished but the result response does
-        not come within a few seconds (lost across processes), the result is requested again.
+        then what stops the goal. If the status topic reports the goal finished but the result
+        response does not come within a few seconds (lost across processes), the result is
+        requested again.
         """
         result = self.goal.result(self.spin_until, self.options.timeout,
                                   (lambda: False) if self.joint_feedback

@@ -7,15 +7,20 @@ curves, and gripper scenes without fingertip sensors on real rclpy.
 
 from __future__ import annotations
 
+import json
+from collections import Counter
 from pathlib import Path
 
 import numpy as np
 import pytest
 import yaml
+from foxglove_support import first_messages, layout_paths, resolve
+from mcap.reader import make_reader
 from pipeline_support import write_scene
 
 from squeeze_grasp_ros.control.joint_feedback import JointSlipWatch
 from squeeze_grasp_ros.mechanics.elastic.compliance import ElasticObject
+from squeeze_grasp_ros.resources import viewer_file
 from squeeze_grasp_ros.ros.run.options import RunOptions
 from squeeze_grasp_ros.ros.run.runner import PipelineRunner
 from squeeze_grasp_ros.scene import (
@@ -133,10 +138,12 @@ def test_the_monitor_measures_depth_and_force_from_joint_states(tmp_path):
 
 
 @pytest.mark.parametrize("reaction", ["hold", "normals"])
-def test_the_jaws_slip_the_joint_watch_stops_the_squeeze(reaction):
+def test_the_jaws_slip_the_joint_watch_stops_the_squeeze(reaction, tmp_path):
     termination, closing, _ = squeeze_curve(SLIP)
     assert termination == "finger_slip"
-    run = PipelineRunner(RunOptions(str(SLIP), planner=False, on_slip_alarm=reaction)).run()
+    bag = tmp_path / "bag"
+    run = PipelineRunner(RunOptions(str(SLIP), planner=False, on_slip_alarm=reaction,
+                                    record=str(bag))).run()
     slip_depth = run["world_end"]["depth"]
     print(f"{reaction}: {run['outcome']}; world slip at {slip_depth * 1e3:.4f} mm, alarm at "
           f"{run['measured_depth'] * 1e3:.4f} mm; first alarm {run['first_alarms']}")
@@ -152,3 +159,14 @@ def test_the_jaws_slip_the_joint_watch_stops_the_squeeze(reaction):
     if reaction == "hold":
         assert run["measured_depth"] - slip_depth <= (WINDOW + 3e-5) / np.sqrt(2.0)
     print(f"first alarm at tick {ticks:.0f}")
+    # the shipped Foxglove layout's jaw panel plots numbers of this recording, one per tick
+    panels = json.loads(viewer_file("foxglove_layout.json").read_text())["configById"]
+    paths = [p["value"] for p in panels["Plot!jaws"]["paths"]]
+    assert paths and all(v in layout_paths(panels) for v in paths)
+    messages = first_messages(bag)
+    with open(next(bag.glob("*.mcap")), "rb") as stream:
+        counts = Counter(channel.topic for _, channel, _ in make_reader(stream).iter_messages())
+    for value in paths:
+        topic, _, path = value.partition(".")
+        assert isinstance(resolve(messages[topic], path), float), value
+        assert counts[topic] == run["ticks"] + 1, value

@@ -182,8 +182,8 @@ def test_sponge_through_the_jtc_equals_the_cartesian_route(tmp_path):
     with open(next((tmp_path / "bag").glob("*.mcap")), "rb") as stream:
         recorded = Counter(channel.topic for _, channel, _ in
                            make_reader(stream).iter_messages())
-    assert recorded["gripper_controller/joint_trajectory"] == len(jtc["trajectories"])
-    assert recorded["joint_states"] == len(jtc["joint_states"])
+    assert recorded["/gripper_controller/joint_trajectory"] == len(jtc["trajectories"])
+    assert recorded["/joint_states"] == len(jtc["joint_states"])
     # the joint state's effort is the jaw force through the transmission (effort_per_force 1)
     last = jtc["joint_states"][-1]
     assert last.effort[0] == pytest.approx(abs(jtc["forces"][0, 1]), rel=1e-3)

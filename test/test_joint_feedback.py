@@ -17,10 +17,14 @@ import yaml
 from foxglove_support import first_messages, layout_paths, resolve
 from mcap.reader import make_reader
 from pipeline_support import write_scene
+from rclpy.serialization import deserialize_message
 
+from squeeze_grasp_interfaces.msg import MonitorStatus
 from squeeze_grasp_ros.control.joint_feedback import JointSlipWatch
 from squeeze_grasp_ros.mechanics.elastic.compliance import ElasticObject
 from squeeze_grasp_ros.resources import viewer_file
+from squeeze_grasp_ros.ros.recording.bag import read_bag
+from squeeze_grasp_ros.ros.recording.replay import replay
 from squeeze_grasp_ros.ros.run.options import RunOptions
 from squeeze_grasp_ros.ros.run.runner import PipelineRunner
 from squeeze_grasp_ros.scene import (
@@ -170,3 +174,9 @@ def test_the_jaws_slip_the_joint_watch_stops_the_squeeze(reaction, tmp_path):
         topic, _, path = value.partition(".")
         assert isinstance(resolve(messages[topic], path), float), value
         assert counts[topic] == run["ticks"] + 1, value
+    # replayed into a fresh monitor, the recorded joint states raise the same alarms
+    replayed = replay(str(bag))
+    recorded = [a for m in read_bag(bag).messages if m.topic == "/monitor/status"
+                for a in deserialize_message(m.data, MonitorStatus).alarms]
+    assert replayed["ticks"] == run["ticks"] + 1
+    assert replayed["alarms"] == len(recorded) >= 2

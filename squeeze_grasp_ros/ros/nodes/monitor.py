@@ -66,7 +66,8 @@ PARAMETERS: dict[str, tuple[Any, str]] = {
     "finger_devices": (["F1:barrett_f1", "F2:barrett_f3"], "finger:device of every fingertip"),
     "streams": (["wrench", "tactile"], "sensor streams each finger has (staleness test)"),
     "mu": (0.4, "friction coefficient of the fingertips"),
-    "load_threshold": (0.002, "a taxel is loaded above this normal force, N"),
+    "load_threshold": (0.002, "a taxel (joint feedback: a jaw) is loaded above this normal "
+                              "force, N"),
     "edge_tolerance": (1e-4, "a patch slides at cone usage >= 1 - edge_tolerance"),
     "alarm_ratio": (0.9, "cone usage of every loaded taxel that raises slip_imminent"),
     "match_margin": (0, "taxels by which patch ranges are widened to connect them over ticks"),
@@ -287,8 +288,9 @@ class JointFeedback:
             touched = self.watch.first_touch
             self.alarms = self.watch.update(reading.aperture, reading.force)
             if touched is None and self.watch.first_touch is not None:
-                logger.info(f"first touch of the jaws at aperture {reading.aperture * 1e3:.4f} "
-                            f"mm, jaw force {reading.force:.4g} N")
+                logger.info(f"first touch of the jaws at aperture "
+                            f"{self.watch.first_touch * 1e3:.4f} mm (jaw force "
+                            f"{reading.force:.4g} N at {reading.aperture * 1e3:.4f} mm)")
         push = reading.force * self.line.direction
         for jaw, position, sign in zip((first, second), self.line.positions(reading.aperture),
                                        (1.0, -1.0)):

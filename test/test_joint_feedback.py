@@ -21,19 +21,12 @@ from rclpy.serialization import deserialize_message
 
 from squeeze_grasp_interfaces.msg import MonitorStatus
 from squeeze_grasp_ros.control.joint_feedback import JointSlipWatch
-from squeeze_grasp_ros.mechanics.elastic.compliance import ElasticObject
 from squeeze_grasp_ros.resources import viewer_file
 from squeeze_grasp_ros.ros.recording.bag import read_bag
 from squeeze_grasp_ros.ros.recording.replay import replay
 from squeeze_grasp_ros.ros.run.options import RunOptions
 from squeeze_grasp_ros.ros.run.runner import PipelineRunner
-from squeeze_grasp_ros.scene import (
-    build_mesh,
-    event_squeeze_scene,
-    finger_nodes,
-    load_scene,
-    scene_material,
-)
+from squeeze_grasp_ros.scene import event_squeeze_scene, load_scene
 from squeeze_grasp_ros.scene.controller import JointReadingError, scene_controller
 
 SCENES = Path(__file__).resolve().parents[1] / "config" / "scenes"
@@ -46,9 +39,7 @@ def squeeze_curve(path: Path):
     """(termination, jaw-force curve against closing of the aperture, m -> N) of the mechanics
     API's event squeeze of a scene: the independent reference of the slip watch.
     """
-    scene = load_scene(path)
-    obj = ElasticObject(build_mesh(scene), scene_material(scene))
-    result = event_squeeze_scene(scene, obj, finger_nodes(scene, obj.mesh))
+    result = event_squeeze_scene(load_scene(path))
     curve = np.asarray(result.force_curve["F1"], float).reshape(-1, 2)
     depth = curve[:, 0] * result.depth / result.relative_depth
     # both jaws close along the line by the same amount: aperture closing = sqrt(2) * depth

@@ -18,10 +18,12 @@ from foxglove_support import first_messages, layout_paths, resolve
 from mcap.reader import make_reader
 from pipeline_support import write_scene
 from rclpy.serialization import deserialize_message
+from sensor_msgs.msg import JointState
 
 from squeeze_grasp_interfaces.msg import MonitorStatus
 from squeeze_grasp_ros.control.joint_feedback import JointSlipWatch
 from squeeze_grasp_ros.resources import viewer_file
+from squeeze_grasp_ros.ros.nodes.monitor import JointFeedback
 from squeeze_grasp_ros.ros.recording.bag import read_bag
 from squeeze_grasp_ros.ros.recording.replay import replay
 from squeeze_grasp_ros.ros.run.options import RunOptions
@@ -171,3 +173,49 @@ def test_the_jaws_slip_the_joint_watch_stops_the_squeeze(reaction, tmp_path):
                 for a in deserialize_message(m.data, MonitorStatus).alarms]
     assert replayed["ticks"] == run["ticks"] + 1
     assert replayed["alarms"] == len(recorded) >= 2
+
+
+class Log:
+    def __init__(self) -> None:
+        self.lines: list[str] = []
+
+    def warning(self, text: str) -> None:
+        self.lines.append(text)
+
+    info = warning
+
+
+def test_a_hostile_joint_state_is_ignored_with_one_warning_line():
+    params = {"controller_scene": str(SLIP), "load_threshold": 0.002,
+              "joint_slip_window": WINDOW, "joint_slip_ratio": RATIO}
+    jaws = JointFeedback.of(params, [])
+    assert JointFeedback.of(params, ["wrench"]) is None  # sensors: their route
+    poses = {"F1": np.array([0.012, -0.026]), "F2": np.array([0.012, 0.026])}
+    log = Log()
+
+    def sample(msg):
+        fields = {f: {"position": p.copy()} for f, p in poses.items()}
+        jaws.replace(fields, msg, log)
+        return fields
+
+    gripper = jaws.controller.gripper
+    bad = [JointState(name=["wrong_joint"], position=[0.3], effort=[1.0]),
+           JointState(name=["finger_joint"], position=[float("nan")], effort=[1.0]),
+           JointState(name=["finger_joint"], position=[0.3], effort=[])]
+    for k, msg in enumerate(bad):
+        msg.header.stamp.nanosec = (k + 1) * 1_000_000
+        assert all("force" not in f for f in sample(msg).values())
+        sample(msg)  # the same stamp again (a re-sent tick): no second line
+    assert len(log.lines) == 3
+    for line, why in zip(log.lines, ("are missing", "not finite", "one of each")):
+        assert line.startswith("ignored the joint state") and why in line
+    # a good one: the jaws on the line at the joint's aperture, each pushing with the effort
+    good = JointState(name=["finger_joint"], position=list(gripper.joint_positions(0.04)),
+                      effort=list(gripper.joint_efforts(2.5)))
+    good.header.stamp.nanosec = 9_000_000
+    fields = sample(good)
+    gap = fields["F2"]["position"] - fields["F1"]["position"]
+    assert np.linalg.norm(gap) == pytest.approx(0.04 + 2 * gripper.pad.contact_radius)
+    np.testing.assert_allclose(fields["F1"]["force"], [0.0, -2.5, 0.0], atol=1e-12)
+    np.testing.assert_allclose(fields["F2"]["force"], [0.0, 2.5, 0.0], atol=1e-12)
+    assert fields["F1"]["force_stamp_ns"] == 9_000_000

@@ -8,8 +8,9 @@ gripper (``controller: {type: joint_trajectory, ...}``) and for its joint_state_
 - it subscribes ``<controller>/joint_trajectory`` (``trajectory_msgs/JointTrajectory``) and
   follows the accepted trajectory in sim time (:class:`..control.joint_trajectory.
   TrajectoryFollower`: position interface, linear interpolation); each tick, the commanded
-  aperture becomes the jaws' tip setpoints on the jaw line, which the world's devices follow as
-  any setpoint (speed limit, actuator lag);
+  aperture, saturated by the joint limits (the opening range, and the device file's
+  ``max_speed`` of the aperture), becomes the jaws' tip setpoints on the jaw line, which the
+  world's devices follow as any setpoint (their own speed limit, actuator lag);
 - a refused trajectory (joint names other than the controller's, sizes that do not match,
   non-finite positions, an aperture beyond the opening range, points all in the past) is
   logged as one warning line and not followed: the active trajectory stays (before tick 0 the
@@ -66,6 +67,8 @@ class SimJaws:
                                     reach=controller.gripper.pad.contact_radius)
         self.aperture = self.line.aperture(world.positions[first], world.positions[second])
         """The measured aperture of the last tick, m."""
+        self.limited = (0, self.aperture)
+        """(sim time ns, aperture m) of the last command after the joint limits."""
         self.topic = node.resolve_topic_name(controller.topic)
         self.refusals: list[str] = []
         """Why each refused command was refused, in order."""
@@ -76,6 +79,19 @@ class SimJaws:
     def fingers(self) -> tuple[str, str]:
         """The fingers whose setpoints this controller gives."""
         return self.controller.jaws
+
+    def limit(self, t_ns: int, aperture: float) -> float:
+        """``aperture`` (m) commanded for sim time ``t_ns``, saturated by the joint limits as
+        ros2_control's limit enforcement does to a position command: within the opening range,
+        and moving at most ``max_speed`` (the device file's aperture speed) times the time since
+        the last command.
+        """
+        gripper = self.controller.gripper
+        reach = gripper.max_speed * max(t_ns - self.limited[0], 0) * 1e-9
+        aperture = float(np.clip(aperture, self.limited[1] - reach, self.limited[1] + reach))
+        aperture = float(np.clip(aperture, gripper.opening.min, gripper.opening.max))
+        self.limited = (t_ns, aperture)
+        return aperture
 
     def jaw_setpoints(self, aperture: float) -> dict[str, np.ndarray]:
         """The jaws' tip setpoints (m) at ``aperture`` (m) on the jaw line."""
@@ -160,6 +176,8 @@ class SimJointTrajectoryController(SimJaws):
         return [names.index(j) for j in joints]
 
     def setpoints(self, t_ns: int) -> dict[str, np.ndarray]:
-        """The jaws' tip setpoints (m) at sim time ``t_ns``; the command is consumed."""
+        """The jaws' tip setpoints (m) at sim time ``t_ns``, within the joint limits
+        (:meth:`SimJaws.limit`); the command is consumed.
+        """
         self.commanded = False
-        return self.jaw_setpoints(self.follower.sample(t_ns))
+        return self.jaw_setpoints(self.limit(t_ns, self.follower.sample(t_ns)))

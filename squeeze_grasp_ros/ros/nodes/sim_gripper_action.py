@@ -175,10 +175,12 @@ class SimGripperActionController(SimJaws):
 
     # ----------------------------------------------------------------- the ticks
     def setpoints(self, t_ns: int) -> dict[str, np.ndarray]:
-        """The jaws' tip setpoints (m) for the step to sim time ``t_ns``."""
+        """The jaws' tip setpoints (m) for the step to sim time ``t_ns``, within the joint
+        limits (:meth:`.sim_controllers.SimJaws.limit`).
+        """
         dt = self.world.dt
         joint = self.servo.command(self.position, self.effort, dt=dt)
-        return self.jaw_setpoints(self.controller.gripper.aperture(joint))
+        return self.jaw_setpoints(self.limit(t_ns, self.controller.gripper.aperture(joint)))
 
     def joint_state(self, out: TickOutput) -> tuple[Any, Any]:
         """The joint states of tick ``out``; the active goal is judged on them."""

@@ -91,12 +91,13 @@ def test_sponge_through_the_action_controller_equals_the_jtc_route(kind, jtc_rou
     statuses = 0
     with open(next((tmp_path / "bag").glob("*.mcap")), "rb") as stream:
         for _, channel, message in make_reader(stream).iter_messages():
-            if channel.topic in stamps:
-                cls = JointState if channel.topic == "joint_states" else Header
+            topic = channel.topic.lstrip("/")          # recorded under the run's namespace
+            if topic in stamps:
+                cls = JointState if topic == "joint_states" else Header
                 msg = deserialize_message(message.data, cls)
                 stamp = (msg.header if cls is JointState else msg).stamp
-                stamps[channel.topic].add((stamp.sec, stamp.nanosec))
-            statuses += channel.topic == "gripper_controller/gripper_cmd/_action/status"
+                stamps[topic].add((stamp.sec, stamp.nanosec))
+            statuses += topic == "gripper_controller/gripper_cmd/_action/status"
     assert len(stamps["joint_states"]) == len({(m.header.stamp.sec, m.header.stamp.nanosec)
                                                for m in action["states"]}) > result.ticks
     assert len(stamps[pipeline.EXECUTOR_CYCLE]) == result.ticks

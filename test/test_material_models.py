@@ -247,25 +247,32 @@ def test_neo_hookean_refuses_nu_one_half():
         H.stress_and_tangent("neo_hookean", np.eye(2)[None], nu=0.5)
 
 
-def test_internal_forces_against_scikit_fem(patch):
-    """The internal force of each law, assembled independently by scikit-fem's P1 basis from the
-    law's stress P(F): the same vector.
+def _scikit_fem_state(patch, u: np.ndarray):
+    """(skfem, its vector P1 basis on ``patch``, our DOF -> its DOF, ``u`` in its order), or a
+    visible skip when scikit-fem is not installed.
     """
     skfem = pytest.importorskip(
         "skfem", reason="scikit-fem (the independent FEM cross-check) is not installed: "
                         "pip install scikit-fem")
-    from skfem.helpers import ddot, grad
-
     m = skfem.MeshTri(patch.nodes.T.copy(), patch.triangles.T.copy())
     basis = skfem.Basis(m, skfem.ElementVector(skfem.ElementTriP1()))
-    rng = np.random.default_rng(11)
-    u = 0.001 * rng.standard_normal(2 * patch.n)
     # skfem orders vector DOFs node-wise (x1, y1, x2, ...) like ours for ElementVector(P1)
     nodal = basis.nodal_dofs
     ours_to_sk = np.empty(2 * patch.n, int)
     ours_to_sk[0::2], ours_to_sk[1::2] = nodal[0], nodal[1]
     w = np.empty(basis.N)
     w[ours_to_sk] = u
+    return skfem, basis, ours_to_sk, w
+
+
+def test_internal_forces_against_scikit_fem(patch):
+    """The internal force of each law, assembled independently by scikit-fem's P1 basis from the
+    law's stress P(F): the same vector.
+    """
+    u = 0.001 * np.random.default_rng(11).standard_normal(2 * patch.n)
+    skfem, basis, ours_to_sk, w = _scikit_fem_state(patch, u)
+    from skfem.helpers import ddot, grad
+
     for model in MODELS:
         @skfem.LinearForm
         def residual(v, p):
@@ -285,19 +292,10 @@ def test_tangent_against_scikit_fem(patch):
     the law's dP/dF: the same matrix (our assembly precomputes the pattern and the products of
     the shape-function gradients per mesh and scatters every element at once).
     """
-    skfem = pytest.importorskip(
-        "skfem", reason="scikit-fem (the independent FEM cross-check) is not installed: "
-                        "pip install scikit-fem")
+    u = 0.002 * np.random.default_rng(5).standard_normal(2 * patch.n)
+    skfem, basis, ours_to_sk, w = _scikit_fem_state(patch, u)
     from skfem.helpers import grad
 
-    m = skfem.MeshTri(patch.nodes.T.copy(), patch.triangles.T.copy())
-    basis = skfem.Basis(m, skfem.ElementVector(skfem.ElementTriP1()))
-    u = 0.002 * np.random.default_rng(5).standard_normal(2 * patch.n)
-    nodal = basis.nodal_dofs
-    ours_to_sk = np.empty(2 * patch.n, int)
-    ours_to_sk[0::2], ours_to_sk[1::2] = nodal[0], nodal[1]
-    w = np.empty(basis.N)
-    w[ours_to_sk] = u
     for model in MODELS:
         @skfem.BilinearForm
         def stiffness(du, v, p):

@@ -211,6 +211,24 @@ class _Call:
         self.samples.append(Sample(self.events.depth, tuple(contacts.nodes.tolist()),
                                    tuple(sol.theta.tolist()), forces))
 
+    def result(self, sol: Solution, termination: str | None,
+               next_substep: float) -> StepResult:
+        """The call's :class:`StepResult`, ending at the current point with ``sol``."""
+        model = self.model
+        diag = self.counters.as_dict()
+        diag["sets_factored"] = model._cache.get("sets_factored", 0)
+        diag["reduced_max_condition"] = model._cache.get("max_condition", 1.0)
+        return StepResult(
+            self.to_state(sol),
+            tuple(self.events.events),
+            float(self.events.s),
+            termination,
+            tuple(self.samples),
+            tuple(self.chatter.chatter),
+            diag,
+            next_substep,
+        )
+
     def to_state(self, sol: Solution) -> ContactState:
         """The frozen SI state at the current point, with the solution ``sol`` there."""
         L, fu = self.model.length, self.model.force_unit
@@ -321,16 +339,4 @@ def advance(
     call = _Call(model, state, translations, step, min(event_tol, step), tuple(terminate_on))
     sol, termination, next_substep = call.run(
         stop_on_event, step if first_substep is None else first_substep, checkpoint)
-    diag = call.counters.as_dict()
-    diag["sets_factored"] = model._cache.get("sets_factored", 0)
-    diag["reduced_max_condition"] = model._cache.get("max_condition", 1.0)
-    return StepResult(
-        call.to_state(sol),
-        tuple(call.events.events),
-        float(call.events.s),
-        termination,
-        tuple(call.samples),
-        tuple(call.chatter.chatter),
-        diag,
-        next_substep,
-    )
+    return call.result(sol, termination, next_substep)

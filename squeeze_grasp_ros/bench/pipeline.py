@@ -19,7 +19,7 @@ from squeeze_grasp_ros.ros.recording.bag import read_bag
 from squeeze_grasp_ros.ros.run.options import RunOptions
 from squeeze_grasp_ros.ros.run.runner import PipelineRunner
 from squeeze_grasp_ros.scene import GraspSetup, load_scene
-from squeeze_grasp_ros.sim.world import SimWorld
+from squeeze_grasp_ros.sim.world import SimWorld, TickOutput
 
 TITLE = ("Pipeline on real rclpy nodes: end to end, lockstep rate against the bare loop, one "
          "tick's profile, start-up, recording, effects")
@@ -105,20 +105,26 @@ def loop_rate(runs: list[dict], excluded: str = "mechanics", clock: str = "") ->
     return max(rates, default=float("nan"))
 
 
+def squeeze_world(world: SimWorld, ticks: int = 700) -> list[TickOutput]:
+    """Drive ``world`` along its scene's squeeze (both fingers to the squeeze depth in equal
+    setpoint steps) for ``ticks`` ticks, ROS-free: every tick's output, tick 0 included.
+    """
+    depth = world.scene.squeeze.relative_depth / world.relative_per_depth
+    start = {f: world.positions[f].copy() for f in SQUEEZING_FINGERS}
+    out = [world.start()]
+    for k in range(1, ticks + 1):
+        out.append(world.step({f: start[f] + depth * k / ticks * world.directions[f]
+                               for f in start}))
+    return out
+
+
 def world_loop(scene_path: Path, ticks: int = 700) -> float:
     """CPU seconds of the ROS-free simulated world driven along the scene's squeeze for
     ``ticks`` ticks (devices, stepper, sensors; no messages).
     """
     world = SimWorld(GraspSetup.build(load_scene(scene_path)))
-    depth = world.scene.squeeze.relative_depth / world.relative_per_depth
-    start = {f: world.positions[f].copy() for f in SQUEEZING_FINGERS}
-    world.start()
-
-    def drive():
-        for k in range(1, ticks + 1):
-            world.step({f: start[f] + depth * k / ticks * world.directions[f] for f in start})
     cpu = time.process_time()
-    drive()
+    squeeze_world(world, ticks)
     return time.process_time() - cpu
 
 

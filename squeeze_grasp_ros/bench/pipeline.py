@@ -12,6 +12,7 @@ import yaml
 from squeeze_grasp_ros.bench.lockstep import bare_ratio_table, profile_table
 from squeeze_grasp_ros.bench.startup import startup_table
 from squeeze_grasp_ros.bench.table import Table, best_time, timed
+from squeeze_grasp_ros.bench.world_pace import world_pace_table
 from squeeze_grasp_ros.mechanics.vocabulary import SQUEEZING_FINGERS, Effect
 from squeeze_grasp_ros.resources import scene_file
 from squeeze_grasp_ros.ros.nodes import pipeline
@@ -22,7 +23,8 @@ from squeeze_grasp_ros.scene import GraspSetup, load_scene
 from squeeze_grasp_ros.sim.world import SimWorld, TickOutput
 
 TITLE = ("Pipeline on real rclpy nodes: end to end, lockstep rate against the bare loop, one "
-         "tick's profile, start-up, recording, effects")
+         "tick's profile, the world's mechanics against the event squeeze, start-up, recording, "
+         "effects")
 EFFECT_SCENE = yaml.safe_load("""
 name: effects
 object:
@@ -265,4 +267,5 @@ def _tables(quick: bool, progress, work: Path) -> list[Table]:
     profile = profile_table(foam, work / "profiled")
     ratio = bare_ratio_table(foam, 2 if quick else repeats, progress)
     startup = startup_table(2 if quick else repeats, progress)
-    return [end_to_end, rate, ratio, profile, startup, effects]
+    pace = world_pace_table(foam, 2 if quick else repeats, progress)
+    return [end_to_end, rate, ratio, profile, pace, startup, effects]

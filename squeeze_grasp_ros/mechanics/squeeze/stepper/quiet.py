@@ -25,19 +25,27 @@ the margin, a sliding contact, a nonlinear material, a long translation) is hand
 from __future__ import annotations
 
 from collections.abc import Mapping
+from dataclasses import dataclass
 
 import numpy as np
 
+from squeeze_grasp_ros.mechanics.elastic.compliance import node_dofs
 from squeeze_grasp_ros.mechanics.squeeze.contact_model import (
     INVERSION_AREA_RATIO,
     ContactModel,
     Solution,
-    SolveFailure,
 )
-from squeeze_grasp_ros.mechanics.squeeze.contact_state import ContactState, StepResult
+from squeeze_grasp_ros.mechanics.squeeze.contact_state import (
+    ContactState,
+    StepResult,
+    tip_geometry,
+)
 from squeeze_grasp_ros.mechanics.squeeze.stepper.area_watch import AreaWatch
+from squeeze_grasp_ros.mechanics.squeeze.stepper.contact_set import ContactSet
+from squeeze_grasp_ros.mechanics.squeeze.stepper.motion import FingerMotion
 from squeeze_grasp_ros.mechanics.squeeze.stepper.run import TERMINATION_ORDER, _Call, advance
 from squeeze_grasp_ros.mechanics.squeeze.stepper.substeps import SubstepControl
+from squeeze_grasp_ros.mechanics.squeeze.tip_shapes import tangent, unit
 from squeeze_grasp_ros.mechanics.vocabulary import ContactMode, MaterialModel
 
 __all__ = ["QUIET_MARGIN", "QuietSteps"]
@@ -75,6 +83,10 @@ class QuietSteps:
         self.terminate_on = tuple(terminate_on)
         self.calls = {"quiet": 0, "full": 0}
         self._checked: ContactState | None = None
+        self._tips: tuple | None = None
+        self._set: _Sticking | None = None
+        self._gap_ref: dict | None = None
+        self._boundary = model.positions(model.boundary_nodes)
         self._applies = (quiet and model.constitutive_model == MaterialModel.LINEAR
                          and not model.reference and not model.adaptive_steps
                          and model.mu > 0.0)
@@ -94,45 +106,153 @@ class QuietSteps:
     def _quiet(self, state: ContactState,
                translations: Mapping[str, tuple[float, float]]) -> StepResult | None:
         """The quiet call's result, or None when the call is not quiet."""
-        if (state.fresh or state.undetermined or not state.contacts
+        if (state.fresh or state.undetermined or len(state.contacts) < 2
                 or any(c.mode != ContactMode.STICK for c in state.contacts)):
             return None
-        call = _Call(self.model, state, translations, self.step, min(self.event_tol, self.step),
-                     self.terminate_on)
-        rate = call.motion.rate
-        if rate == 0 or SubstepControl(call.step / rate, False, call.step / rate).end(0.0) < 1.0:
+        motion = self._motion(state, translations)
+        if motion is None:
             return None
-        ev, solver, functions = call.events, call.solver, call.functions
-        depth = call.motion.depth_at(0.0)
-        rows = functions.free_rows(ev.contacts, call.chatter.held_nodes(depth))
-        watched = ~call.chatter.held(ev.contacts.nodes, depth)
-        sol_a = solver.solve(ev.contacts, 0.0)
-        if state is not self._checked and not self._clear(call, sol_a, 0.0, rows, watched):
+        rate = motion.rate
+        if rate == 0 or SubstepControl(self.step / rate, False, self.step / rate).end(0.0) < 1.0:
             return None
-        sol_b = solver.continue_to(ev.contacts, sol_a, 0.0, 1.0)
-        if isinstance(sol_b, SolveFailure) or not self._clear(call, sol_b, 1.0, rows, watched):
+        sticking = self._sticking(state, motion)
+        call = _Call(self.model, state, translations, self.step,
+                     min(self.event_tol, self.step), self.terminate_on, motion=motion,
+                     contacts=sticking.contacts)
+        depth = motion.depth_at(0.0)
+        rows = call.functions.free_rows(sticking.contacts, call.chatter.held_nodes(depth))
+        watched = ~call.chatter.held(sticking.contacts.nodes, depth)
+        sol_a = sticking.solution(motion, 0.0)
+        if sol_a is None or (state is not self._checked
+                             and not self._clear(call, sticking, sol_a, 0.0, rows, watched)):
+            return None
+        sol_b = sticking.solution(motion, 1.0)
+        if sol_b is None or not self._clear(call, sticking, sol_b, 1.0, rows, watched):
             return None
         call.record(sol_a)
         call.counters.substeps += 1
         call.integrate_work(sol_a, sol_b, 0.0, 1.0)
-        ev.move_to(1.0, sol_b.theta.copy())
+        call.events.move_to(1.0, sol_b.theta.copy())
         call.record(sol_b)
         result = call.result(sol_b, None, self.step)
         self._checked = result.state
         return result
 
-    def _clear(self, call: _Call, sol: Solution, s: float, rows: np.ndarray,
-               watched: np.ndarray) -> bool:
+    def _motion(self, state: ContactState,
+                translations: Mapping[str, tuple[float, float]]) -> FingerMotion | None:
+        """:meth:`FingerMotion.of` (the tips kept while they are the same), or None for a
+        translation :func:`~.run.advance` would refuse (it then says why).
+        """
+        L = self.model.length
+        names = tuple(f.name for f in state.fingers)
+        if not set(translations) <= set(names):
+            return None
+        key = tuple((f.name, f.radius, f.flat, f.facing) for f in state.fingers)
+        if self._tips is None or self._tips[0] != key:
+            self._tips = (key, tip_geometry(state.fingers).scaled(L))
+        tips = self._tips[1]
+        D = np.array([translations.get(n, (0.0, 0.0)) for n in names], float) / L
+        if not np.all(np.isfinite(D)):
+            return None
+        return FingerMotion(names, np.array([f.center for f in state.fingers], float) / L, D,
+                            tips.radius, float(np.linalg.norm(D)), state.depth, L, tips.flat,
+                            tips.facing)
+
+    def _sticking(self, state: ContactState, motion: FingerMotion) -> _Sticking:
+        """The state's contact set and its constants (kept while the set and angles stay)."""
+        key = (self._tips[0], tuple((c.node, c.finger, c.theta) for c in state.contacts))
+        if self._set is None or self._set.key != key:
+            contacts = ContactSet.of_state(self.model, state)
+            tip = motion.tip.take(contacts.finger)
+            nu = tip.normal_angle(contacts.theta)
+            self._set = _Sticking(key, contacts, contacts.data.C, tip.offset(contacts.theta),
+                                  nu, tip.curvature(contacts.theta), unit(nu), tangent(nu),
+                                  tip.radius)
+        return self._set
+
+    def _clear(self, call: _Call, sticking: _Sticking, sol: Solution, s: float,
+               rows: np.ndarray, watched: np.ndarray) -> bool:
         """Whether every function the call watches at ``sol`` (point s; the boundary ``rows``,
         the contacts not held) and every termination it checks is above :data:`QUIET_MARGIN`.
         """
-        functions, contacts = call.functions, call.events.contacts
-        v = functions.values(contacts, sol, s, rows, terminations=False)
-        lowest = min(v.fn[watched].min(initial=np.inf), v.c_plus[watched].min(initial=np.inf),
-                     v.c_minus[watched].min(initial=np.inf), v.gaps.min(initial=np.inf))
-        if not lowest > QUIET_MARGIN:
+        model, contacts = self.model, sticking.contacts
+        fn = np.einsum("ij,ij->i", sol.F[watched], sticking.unit[watched])
+        ft = np.einsum("ij,ij->i", sol.F[watched], sticking.tangent[watched])
+        cone = model.mu * fn - np.abs(ft)
+        if not (min(fn.min(initial=np.inf), cone.min(initial=np.inf)) > QUIET_MARGIN
+                and self._gaps_clear(call.motion, sticking, sol, s, rows)):
             return False
-        strain, pickup = functions.termination_values(contacts, sol)
+        strain, pickup = call.functions.termination_values(contacts, sol)
         return (strain > QUIET_MARGIN and pickup > QUIET_MARGIN
                 and self.area.above(contacts.data, sol.delta, sol.F,
                                     INVERSION_AREA_RATIO + QUIET_MARGIN))
+
+    def _gaps_clear(self, motion: FingerMotion, sticking: _Sticking, sol: Solution, s: float,
+                    rows: np.ndarray) -> bool:
+        """Whether every gap of the boundary ``rows`` to every tip is above :data:`QUIET_MARGIN`
+        at ``sol``: from the last gaps computed for the set and rows while a bound allows, else
+        computed (and kept).
+
+        A gap is 1-Lipschitz in the boundary point and in the tip's position (a distance to a
+        convex shape), and a boundary point moves by u_i = A_i F + R_i g (the set's boundary
+        compliance rows and rigid modes, g = E^T delta), so a gap is at least its kept value
+        less max_i(||A_i|| ||F - F_ref|| + ||R_i|| ||g - g_ref||) less the tips' travel.
+        """
+        model, sd = self.model, sticking.contacts.data
+        g = sd.E.T @ sol.delta.reshape(-1)
+        centers = motion.centers(s)
+        ref = self._gap_ref
+        if ref is None or ref["set"] is not sticking or not np.array_equal(ref["rows"], rows):
+            ref = None
+        else:
+            moved = (ref["A"] * np.linalg.norm(sol.F - ref["F"])
+                     + ref["R"] * np.linalg.norm(g - ref["g"])
+                     + np.sqrt(((centers - ref["centers"]) ** 2).sum(axis=1)).max())
+            if ref["lowest"] - moved * (1.0 + 1e-12) > QUIET_MARGIN:
+                return True
+        points = self._boundary[rows] + model.boundary_displacement(sd, sol.delta, sol.F, rows)
+        lowest = float(motion.gaps(points, s).min(initial=np.inf))
+        if ref is None:
+            A = sd.A_bc[node_dofs(rows)].reshape(len(rows), -1)
+            R = model.obj.rigid[node_dofs(model.boundary_nodes[rows])].reshape(len(rows), -1)
+            ref = {"set": sticking, "rows": rows,
+                   "A": float(np.sqrt((A * A).sum(axis=1)).max(initial=0.0)),
+                   "R": float(np.sqrt((R * R).sum(axis=1)).max(initial=0.0))}
+        self._gap_ref = {**ref, "F": sol.F, "g": g, "centers": centers, "lowest": lowest}
+        return lowest > QUIET_MARGIN
+
+
+@dataclass(frozen=True)
+class _Sticking:
+    """One contact set with every node sticking, at its polar angles: what the fixed-set
+    solve of :func:`~..contact_model.attempt_fixed_set` computes once for the set (the nodes
+    ride on their tips, so only the tips' positions change).
+    """
+
+    key: tuple
+    contacts: ContactSet
+    C: np.ndarray
+    offset: np.ndarray
+    nu: np.ndarray
+    kappa: np.ndarray
+    unit: np.ndarray
+    tangent: np.ndarray
+    radius: np.ndarray
+
+    def solution(self, motion: FingerMotion, s: float) -> Solution | None:
+        """:func:`~..contact_model.attempt_fixed_set` of the set at point s of ``motion``
+        with no sliding node (the same operations: F = C delta, dF/ds = C d delta/ds), or None
+        if a value is not finite.
+        """
+        c, m = self.contacts, len(self.contacts)
+        f = c.finger
+        dirs = motion.translation[f]
+        theta = np.array(c.theta, float)
+        delta = motion.start[f] + s * motion.translation[f] + self.offset - c.positions
+        F = (self.C @ delta.reshape(-1)).reshape(m, 2)
+        dF = (self.C @ dirs.reshape(-1)).reshape(m, 2)
+        dtheta = np.zeros(m)
+        ddelta = dirs + (self.radius * dtheta)[:, None] * self.tangent
+        if not (np.all(np.isfinite(F)) and np.all(np.isfinite(dF))):
+            return None
+        return Solution(theta, delta, F, dtheta, dF, ddelta, 0, 0.0, 1.0, self.nu, self.kappa)

@@ -72,16 +72,21 @@ class _Call:
 
     def __init__(self, model: ContactModel, state: ContactState,
                  translations: Mapping[str, tuple[float, float]], step: float,
-                 event_tol: float, terminate_on: tuple[str, ...]) -> None:
+                 event_tol: float, terminate_on: tuple[str, ...], *,
+                 motion: FingerMotion | None = None, contacts: ContactSet | None = None) -> None:
+        """``motion`` and ``contacts``, when given, are those of ``state`` and
+        ``translations`` (a caller that keeps them across calls).
+        """
         L, fu = model.length, model.force_unit
         self.model, self.step, self.tol = model, step, event_tol
-        self.motion = FingerMotion.of(state, translations, L)
+        self.motion = FingerMotion.of(state, translations, L) if motion is None else motion
         self.counters = Counters()
         self.solver = SetSolver(model, self.motion, self.counters)
         self.functions = EventFunctions(model, self.motion, terminate_on)
         self.chatter = ChatterBound(state, step * L, model.max_events_per_depth)
-        self.events = EventProcessor(state, ContactSet.of_state(model, state), self.functions,
-                                     self.solver, self.chatter, event_tol)
+        self.events = EventProcessor(state, ContactSet.of_state(model, state) if contacts is None
+                                     else contacts, self.functions, self.solver, self.chatter,
+                                     event_tol)
         self.t0 = np.array([f.translation for f in state.fingers], float) / L
         self.work = np.array([f.work for f in state.fingers], float) / (fu * L)
         self.dissipation = np.array([f.dissipation for f in state.fingers], float) / (fu * L)
@@ -247,19 +252,22 @@ class _Call:
             )
             for f, n in enumerate(motion.names)
         )
-        signs = c.slip_signs(sol.dtheta, self.functions.frictionless)
+        signs = c.slip_signs(sol.dtheta, self.functions.frictionless).tolist()
+        delta, F = sol.delta * L, sol.F * fu
         contacts = tuple(
             ContactNode(
-                int(node),
-                motion.names[c.finger[k]],
-                ContactMode.STICK if c.stick[k] else ContactMode.SLIP,
-                0 if c.stick[k] else int(signs[k]),
-                float(sol.theta[k]),
-                sol.delta[k] * L,
-                sol.F[k] * fu,
-                float(sol.normal_angle[k]),
+                node,
+                motion.names[finger],
+                ContactMode.STICK if stick else ContactMode.SLIP,
+                0 if stick else sign,
+                theta,
+                delta[k],
+                F[k],
+                normal,
             )
-            for k, node in enumerate(c.nodes.tolist())
+            for k, (node, finger, stick, sign, theta, normal) in enumerate(zip(
+                c.nodes.tolist(), c.finger.tolist(), c.stick.tolist(), signs,
+                sol.theta.tolist(), sol.normal_angle.tolist()))
         )
         depth = ev.depth
         return ContactState(fingers, contacts, depth, ev.relative_per_depth,

@@ -86,6 +86,7 @@ class QuietSteps:
         self._tips: tuple | None = None
         self._set: _Sticking | None = None
         self._gap_ref: dict | None = None
+        self._rows: tuple | None = None
         self._boundary = model.positions(model.boundary_nodes)
         self._applies = (quiet and model.constitutive_model == MaterialModel.LINEAR
                          and not model.reference and not model.adaptive_steps
@@ -119,9 +120,7 @@ class QuietSteps:
         call = _Call(self.model, state, translations, self.step,
                      min(self.event_tol, self.step), self.terminate_on, motion=motion,
                      contacts=sticking.contacts)
-        depth = motion.depth_at(0.0)
-        rows = call.functions.free_rows(sticking.contacts, call.chatter.held_nodes(depth))
-        watched = ~call.chatter.held(sticking.contacts.nodes, depth)
+        rows, watched = self._watched(call, sticking, motion.depth_at(0.0))
         sol_a = sticking.solution(motion, 0.0)
         if sol_a is None or (state is not self._checked
                              and not self._clear(call, sticking, sol_a, 0.0, rows, watched)):
@@ -137,6 +136,18 @@ class QuietSteps:
         result = call.result(sol_b, None, self.step)
         self._checked = result.state
         return result
+
+    def _watched(self, call: _Call, sticking: _Sticking,
+                 depth: float) -> tuple[np.ndarray, np.ndarray]:
+        """(free boundary rows, mask of the contacts not held) at ``depth``, as the call's
+        full path watches them (kept while the set and the held nodes stay).
+        """
+        held = call.chatter.held_nodes(depth)
+        key = (sticking.key, tuple(held))
+        if self._rows is None or self._rows[0] != key:
+            self._rows = (key, call.functions.free_rows(sticking.contacts, held),
+                          ~call.chatter.held(sticking.contacts.nodes, depth))
+        return self._rows[1], self._rows[2]
 
     def _motion(self, state: ContactState,
                 translations: Mapping[str, tuple[float, float]]) -> FingerMotion | None:

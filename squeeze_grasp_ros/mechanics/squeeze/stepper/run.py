@@ -194,9 +194,12 @@ class _Call:
         """
         h = b - a
         finger, D = self.events.contacts.finger, self.motion.translation
-        r = self.motion.radius[finger]
-        pa = -sa.tangential * r * sa.dtheta
-        pb = -sb.tangential * r * sb.dtheta
+        # no node slides at either end: the dissipation adds zeros (it is never -0.0)
+        sliding = sa.dtheta.any() or sb.dtheta.any()
+        if sliding:
+            r = self.motion.radius[finger]
+            pa = -sa.tangential * r * sa.dtheta
+            pb = -sb.tangential * r * sb.dtheta
         for f in range(len(self.motion.names)):
             mine = finger == f
             if not mine.any():
@@ -204,7 +207,8 @@ class _Call:
             ya, yb = sa.F[mine].sum(axis=0) @ D[f], sb.F[mine].sum(axis=0) @ D[f]
             ra, rb = sa.dF[mine].sum(axis=0) @ D[f], sb.dF[mine].sum(axis=0) @ D[f]
             self.work[f] += 0.5 * h * (ya + yb) + h * h / 12.0 * (ra - rb)
-            self.dissipation[f] += 0.5 * h * (pa[mine].sum() + pb[mine].sum())
+            if sliding:
+                self.dissipation[f] += 0.5 * h * (pa[mine].sum() + pb[mine].sum())
 
     def record(self, sol: Solution) -> None:
         """Append a trajectory sample at the current point."""

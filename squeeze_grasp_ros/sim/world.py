@@ -7,7 +7,9 @@ One :meth:`SimWorld.step` is one lockstep tick of ``scene.sim.dt`` seconds:
 1. every device moves its fingertip toward its setpoint (:func:`.devices.follow`);
 2. the per-tick translations of the fingertips in contact go to the incremental stepper
    (:func:`..mechanics.stepper.advance`), which locates the contact events on the way
-   (ground truth);
+   (ground truth); a tick that crosses no event on a linear object with every contact sticking
+   is answered without the stepper's event loop, with the same result
+   (:class:`..mechanics.squeeze.stepper.QuietSteps`);
 3. the declared sensors read the new contact state (:mod:`.sensors`).
 
 Only declared effects are composed (``scene.effects``): ``friction`` sets mu (else 0),

@@ -121,12 +121,14 @@ class QuietSteps:
                      min(self.event_tol, self.step), self.terminate_on, motion=motion,
                      contacts=sticking.contacts)
         rows, watched = self._watched(call, sticking, motion.depth_at(0.0))
-        sol_a = sticking.solution(motion, 0.0)
-        if sol_a is None or (state is not self._checked
-                             and not self._clear(call, sticking, sol_a, 0.0, rows, watched)):
+        solutions = sticking.solutions(motion)
+        if solutions is None:
             return None
-        sol_b = sticking.solution(motion, 1.0)
-        if sol_b is None or not self._clear(call, sticking, sol_b, 1.0, rows, watched):
+        sol_a, sol_b = solutions
+        if state is not self._checked and not self._clear(call, sticking, sol_a, 0.0, rows,
+                                                          watched):
+            return None
+        if not self._clear(call, sticking, sol_b, 1.0, rows, watched):
             return None
         call.record(sol_a)
         call.counters.substeps += 1
@@ -250,20 +252,25 @@ class _Sticking:
     tangent: np.ndarray
     radius: np.ndarray
 
-    def solution(self, motion: FingerMotion, s: float) -> Solution | None:
-        """:func:`~..contact_model.attempt_fixed_set` of the set at point s of ``motion``
-        with no sliding node (the same operations: F = C delta, dF/ds = C d delta/ds), or None
-        if a value is not finite.
+    def solutions(self, motion: FingerMotion) -> tuple[Solution, Solution] | None:
+        """:func:`~..contact_model.attempt_fixed_set` of the set at s = 0 and s = 1 of
+        ``motion`` with no sliding node (the same operations: F = C delta, dF/ds = C d delta/ds,
+        the same along the motion), or None if a value is not finite.
         """
         c, m = self.contacts, len(self.contacts)
         f = c.finger
         dirs = motion.translation[f]
         theta = np.array(c.theta, float)
-        delta = motion.start[f] + s * motion.translation[f] + self.offset - c.positions
-        F = (self.C @ delta.reshape(-1)).reshape(m, 2)
         dF = (self.C @ dirs.reshape(-1)).reshape(m, 2)
         dtheta = np.zeros(m)
         ddelta = dirs + (self.radius * dtheta)[:, None] * self.tangent
-        if not (np.all(np.isfinite(F)) and np.all(np.isfinite(dF))):
+        out = []
+        for s in (0.0, 1.0):
+            delta = motion.start[f] + s * motion.translation[f] + self.offset - c.positions
+            F = (self.C @ delta.reshape(-1)).reshape(m, 2)
+            out.append(Solution(theta, delta, F, dtheta, dF, ddelta, 0, 0.0, 1.0, self.nu,
+                                self.kappa))
+        if not (np.isfinite(out[0].F).all() and np.isfinite(out[1].F).all()
+                and np.isfinite(dF).all()):
             return None
-        return Solution(theta, delta, F, dtheta, dF, ddelta, 0, 0.0, 1.0, self.nu, self.kappa)
+        return out[0], out[1]

@@ -64,7 +64,7 @@ class AreaWatch:
         if ref is None or ref["set"] is not sd or ref["reach"] != reach or self._drift(
                 ref, g, norms) > ref["budget"]:
             ref = self._renew(sd, g, norms, reach)
-        rigid = ref["rigid"] @ g
+        rigid = ref["rigid_rows"] @ g
         bound = ref["bounds"] @ norms + np.sqrt((rigid * rigid).sum(axis=1))
         exact = bound >= GRADIENT_BOUND_EXACT
         if np.any(bound[~exact] >= reach):
@@ -96,7 +96,8 @@ class AreaWatch:
         loads = obj.load_gradients(sd.nodes)
         self._ref = {
             "set": sd, "reach": reach, "norms": norms, "g": g, "budget": budget,
-            "column_max": bounds.max(axis=0), "bounds": bounds[kept], "rigid": self._rigid[kept],
+            "column_max": bounds.max(axis=0), "bounds": bounds[kept],
+            "rigid_rows": self._rigid[kept],
             "loads": np.concatenate([G[kept] for G in loads], axis=2),
         }
         return self._ref

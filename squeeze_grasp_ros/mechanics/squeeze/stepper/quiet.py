@@ -218,8 +218,8 @@ class QuietSteps:
         if ref is None or ref["set"] is not sticking or not np.array_equal(ref["rows"], rows):
             ref = None
         else:
-            moved = (ref["A"] * np.linalg.norm(sol.F - ref["F"])
-                     + ref["R"] * np.linalg.norm(g - ref["g"])
+            moved = (ref["a_norm"] * np.linalg.norm(sol.F - ref["F"])
+                     + ref["r_norm"] * np.linalg.norm(g - ref["g"])
                      + np.sqrt(((centers - ref["centers"]) ** 2).sum(axis=1)).max())
             if ref["lowest"] - moved * (1.0 + 1e-12) > QUIET_MARGIN:
                 return True
@@ -229,8 +229,8 @@ class QuietSteps:
             A = sd.A_bc[node_dofs(rows)].reshape(len(rows), -1)
             R = model.obj.rigid[node_dofs(model.boundary_nodes[rows])].reshape(len(rows), -1)
             ref = {"set": sticking, "rows": rows,
-                   "A": float(np.sqrt((A * A).sum(axis=1)).max(initial=0.0)),
-                   "R": float(np.sqrt((R * R).sum(axis=1)).max(initial=0.0))}
+                   "a_norm": float(np.sqrt((A * A).sum(axis=1)).max(initial=0.0)),
+                   "r_norm": float(np.sqrt((R * R).sum(axis=1)).max(initial=0.0))}
         self._gap_ref = {**ref, "F": sol.F, "g": g, "centers": centers, "lowest": lowest}
         return lowest > QUIET_MARGIN
 

@@ -21,8 +21,11 @@ the device's pad, and the controller's joints (default: the device's
 """
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
+
+import numpy as np
 
 from squeeze_grasp_ros.mechanics.vocabulary import Finger
 from squeeze_grasp_ros.resources import ResourceError, device_file
@@ -30,7 +33,27 @@ from squeeze_grasp_ros.scene.gripper import GripperSpec, load_gripper
 from squeeze_grasp_ros.scene.schema import SchemaError
 from squeeze_grasp_ros.scene.specs import ControllerSpec, Scene, SceneError
 
-__all__ = ["JawController", "scene_controller"]
+__all__ = ["JawController", "JawReading", "JointReadingError", "scene_controller"]
+
+
+class JointReadingError(ValueError):
+    """A joint state that cannot be read as jaw feedback; the message says why."""
+
+
+@dataclass(frozen=True)
+class JawReading:
+    """One joint state as jaw feedback (:meth:`JawController.reading`).
+
+    Attributes
+    ----------
+    aperture : float
+        Distance between the pad faces, m.
+    force : float
+        Each jaw's push on the object along the closing line, N (> 0 squeezing).
+    """
+
+    aperture: float
+    force: float
 
 
 @dataclass(frozen=True)
@@ -58,6 +81,34 @@ class JawController:
     def joint_efforts(self, force: float) -> tuple[float, ...]:
         """Each controller joint's effort for a jaw force ``force`` (N)."""
         return self.gripper.joint_efforts(force)[:1] * len(self.joints)
+
+    def reading(self, names: Sequence[str], positions: Sequence[float],
+                efforts: Sequence[float]) -> JawReading:
+        """The aperture and jaw force of a joint state (``sensor_msgs/JointState`` fields)
+        through the transmission: the mean over the controller's joints; other joints in the
+        message are ignored.
+
+        Raises
+        ------
+        JointReadingError
+            A controller joint missing, positions or efforts not one per name, or not finite.
+        """
+        names = list(names)
+        if len(positions) != len(names) or len(efforts) != len(names):
+            raise JointReadingError(f"{len(names)} names, {len(positions)} positions and "
+                                    f"{len(efforts)} efforts: one of each per joint expected")
+        missing = [j for j in self.joints if j not in names]
+        if missing:
+            raise JointReadingError(f"the controller's joints {missing} are missing (got "
+                                    f"{names})")
+        index = [names.index(j) for j in self.joints]
+        p = np.array([positions[i] for i in index], float)
+        e = np.array([efforts[i] for i in index], float)
+        if not (np.all(np.isfinite(p)) and np.all(np.isfinite(e))):
+            raise JointReadingError(f"positions {p.tolist()} or efforts {e.tolist()} are not "
+                                    "finite")
+        return JawReading(float(np.mean([self.gripper.aperture(v) for v in p])),
+                          float(np.mean([self.gripper.jaw_force(v) for v in e])))
 
 
 def _device(spec: ControllerSpec, base: Path) -> GripperSpec:

@@ -8,8 +8,9 @@ gripper (``controller: {type: joint_trajectory, ...}``) and for its joint_state_
 - it subscribes ``<controller>/joint_trajectory`` (``trajectory_msgs/JointTrajectory``) and
   follows the accepted trajectory in sim time (:class:`..control.joint_trajectory.
   TrajectoryFollower`: position interface, linear interpolation); each tick, the commanded
-  aperture becomes the jaws' tip setpoints on the jaw line, which the world's devices follow as
-  any setpoint (speed limit, actuator lag);
+  aperture, saturated by the joint limits (the opening range, and the device file's
+  ``max_speed`` of the aperture), becomes the jaws' tip setpoints on the jaw line, which the
+  world's devices follow as any setpoint (their own speed limit, actuator lag);
 - a refused trajectory (joint names other than the controller's, sizes that do not match,
   non-finite positions, an aperture beyond the opening range, points all in the past) is
   logged as one warning line and not followed: the active trajectory stays (before tick 0 the
@@ -73,6 +74,8 @@ class SimJointTrajectoryController:
         self.follower = TrajectoryFollower(
             self.line.aperture(world.positions[first], world.positions[second]),
             opening=(opening.min, opening.max))
+        self.limited = (0, self.follower.sample(0))
+        """(sim time ns, aperture m) of the last command after the joint limits."""
         self.commanded = False
         self.refusals: list[str] = []
         """Why each refused trajectory was refused, in order."""
@@ -118,9 +121,20 @@ class SimJointTrajectoryController:
         return [names.index(j) for j in joints]
 
     def setpoints(self, t_ns: int) -> dict[str, np.ndarray]:
-        """The jaws' tip setpoints (m) at sim time ``t_ns``; the command is consumed."""
+        """The jaws' tip setpoints (m) at sim time ``t_ns``; the command is consumed.
+
+        The trajectory's aperture is saturated by the joint limits, as ros2_control's limit
+        enforcement does to a position command: within the opening range, and moving at most
+        ``max_speed`` (the device file's aperture speed) times the time since the last command.
+        """
         self.commanded = False
-        first, second = self.line.positions(self.follower.sample(t_ns))
+        gripper = self.controller.gripper
+        reach = gripper.max_speed * max(t_ns - self.limited[0], 0) * 1e-9
+        aperture = float(np.clip(self.follower.sample(t_ns), self.limited[1] - reach,
+                                 self.limited[1] + reach))
+        aperture = float(np.clip(aperture, gripper.opening.min, gripper.opening.max))
+        self.limited = (t_ns, aperture)
+        first, second = self.line.positions(aperture)
         return dict(zip(self.fingers, (first, second)))
 
     def joint_state(self, out: TickOutput) -> tuple[Any, JointState]:

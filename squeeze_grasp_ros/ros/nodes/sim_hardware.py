@@ -10,8 +10,9 @@ advances it in lockstep (docs/design.md §4), driven by messages, never by timer
 2. a tick k is ``/clock`` = t_k, every device's ``pose``, ``wrench`` and ``tactile`` reading
    stamped t_k (a reading dropped by the sensor_dropout effect is skipped), the ground-truth
    events of the tick as one ``sim/events`` array (with the termination reason at the tick the
-   world ends), the ground-truth state (``sim/state``), markers at ``display_rate``, and last
-   ``sim/tick`` listing the readings it published;
+   world ends), a simulated controller's ``joint_states``, the ground-truth state
+   (``sim/state``), markers at ``display_rate``, and last ``sim/tick`` listing the readings it
+   published (``joint_states`` among them);
 3. when every device's setpoint stamped after t_k has arrived (and the recorder is no more than
    ``recorder_window`` ticks behind), the world steps (:class:`..sim.world.SimWorld`) and
    tick k+1 follows.
@@ -39,7 +40,10 @@ from squeeze_grasp_ros.mechanics.vocabulary import Effect, ImageEncoding
 from squeeze_grasp_ros.ros import messages
 from squeeze_grasp_ros.ros.messages.images import camera_info_msg, image_msg, pose_of_camera
 from squeeze_grasp_ros.ros.nodes import ParameterError, pipeline, run_node
-from squeeze_grasp_ros.ros.nodes.sim_controllers import SimJointTrajectoryController
+from squeeze_grasp_ros.ros.nodes.sim_controllers import (
+    JOINT_STATES,
+    SimJointTrajectoryController,
+)
 from squeeze_grasp_ros.scene import GraspSetup, load_scene
 from squeeze_grasp_ros.scene.controller import scene_controller
 from squeeze_grasp_ros.sim.camera import CameraFrame
@@ -211,6 +215,7 @@ class SimHardwareNode(Node):
                 out.events, out.termination if ending else "", out.state, ns)))
         if self.controller is not None:
             batch.append(self.controller.joint_state(out))
+            readings.append(JOINT_STATES)
         batch.append((self.state_pub, messages.sim_state_msg(out.state, self.world.fingers,
                                                              out.termination, ns, frame)))
         if out.index == 0:

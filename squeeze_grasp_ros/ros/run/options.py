@@ -117,9 +117,10 @@ def node_parameters(
         monitor.update(shape_watch=True,
                        shape_mismatch_threshold=float(scene.camera.shape_mismatch_threshold),
                        object_height=float(scene.object.material.thickness))
+    controller_scene = str(Path(scene_path).resolve()) if scene.controller else ""
+    monitor["controller_scene"] = controller_scene
     params["executor"].update(
-        finger_devices=mapping, period=float(scene.sim.dt),
-        controller_scene=str(Path(scene_path).resolve()) if scene.controller else "")
+        finger_devices=mapping, period=float(scene.sim.dt), controller_scene=controller_scene)
     custom = {"scene": Path(scene_path).read_text(), "scene_path": str(scene_path)}
     params["recorder"].update(
         output=str(options.record or ""),

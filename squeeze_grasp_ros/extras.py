@@ -31,8 +31,13 @@ EXTRAS: dict[str, tuple[tuple[str, ...], str]] = {
                 "pip install '.[cholmod]' (CHOLMOD through cvxopt, GPL-3.0; METIS: pymetis)"),
     "perception": (("skimage",), "pip install '.[perception]'"),
     "fast": (("numba",), "pip install '.[fast]'"),
+    "control_msgs": (("control_msgs",),
+                     "squeeze-grasp ros-setup --control-msgs DIR (DIR a jazzy checkout of "
+                     "github.com/ros-controls/control_msgs; docs/grippers.md), or source a ROS 2 "
+                     "Jazzy install that has it"),
 }
-"""Extra -> (top-level modules it provides, how to install it)."""
+"""Extra -> (top-level modules it provides, how to install it); control_msgs is no pip extra
+(it has no wheel): ``ros-setup`` builds its gripper actions from sources."""
 
 REQUIRED: dict[str, str] = {
     "qdldl": "pip install qdldl (a required dependency of the corotational and neo-Hookean "

@@ -50,3 +50,32 @@ def foxglove_decode(mcap_file: Path) -> dict[str, dict]:
                           text=True, timeout=120)
     assert done.returncode == 0, done.stderr
     return json.loads(done.stdout)
+
+
+def resolve(message, path: str):
+    """The value of a Foxglove message path below the topic ('forces[0].x') in a message."""
+    value = message
+    for part in path.split("."):
+        name, _, index = part.partition("[")
+        value = getattr(value, name)
+        if index:
+            value = value[int(index.rstrip("]"))]
+    return value
+
+
+def first_messages(bag: Path) -> dict:
+    """The first message of every topic of a recording (rosbags' reader)."""
+    from rosbags.highlevel import AnyReader
+
+    out = {}
+    with AnyReader([bag]) as reader:
+        for connection, _, raw in reader.messages():
+            if connection.topic not in out:
+                out[connection.topic] = reader.deserialize(raw, connection.msgtype)
+    return out
+
+
+def layout_paths(panels: dict) -> list[str]:
+    """Every plotted message path ('/topic.field[0].x') of a Foxglove layout's panels."""
+    paths = [p["value"] for c in panels.values() for p in c.get("paths", [])]
+    return paths + [c["xAxisPath"]["value"] for c in panels.values() if "xAxisPath" in c]

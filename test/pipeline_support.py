@@ -3,6 +3,7 @@
 """Scenes and comparisons shared by the simulated-world and pipeline tests."""
 from __future__ import annotations
 
+import contextlib
 import copy
 from pathlib import Path
 
@@ -102,3 +103,69 @@ def run_scene(tmp_path: Path, data: dict, world: dict | None = None, record: boo
         overrides = {"sim_hardware": {"scene": str(world_path)}}
     return PipelineRunner(RunOptions(str(path), overrides=overrides,
                                      record=str(tmp_path / "bag") if record else None)).run()
+
+
+def run_observed(path: str, topics=(), record: str | None = None,
+                 cancel_after: float | None = None) -> dict:
+    """Run scene file ``path`` (planned with the mechanics) through the real nodes: its result,
+    the ground-truth events as (stamp s, stamp ns, type, finger, node), the final forces on the
+    object (N, one row per finger) and depth (m), and under each key of ``topics`` ((key, topic,
+    message class) each) the messages the run published there. ``cancel_after``: cancel the
+    goal once that much sim time (s) has passed.
+    """
+    import numpy as np
+
+    from squeeze_grasp_ros.ros.nodes import pipeline
+    from squeeze_grasp_ros.ros.run.options import RunOptions
+    from squeeze_grasp_ros.ros.run.runner import PipelineRunner
+
+    runner = PipelineRunner(RunOptions(path, planner=False, record=record))
+    seen = {key: [] for key, _, _ in topics}
+    for key, topic, cls in topics:
+        runner.client.create_subscription(cls, topic, seen[key].append, pipeline.loop_qos(1000))
+    try:
+        runner.start()
+        if cancel_after is not None:
+            failed = runner.observer.world_failed
+            runner.observer.world_failed = lambda: failed() or (
+                runner.observer.sim_state_ns - runner.start_ns > cancel_after * 1e9)
+        runner.send_goal()
+        result = runner.wait_result()
+        state = runner.observer.sim_states[-1]
+    finally:
+        runner.shutdown()
+    events = [(e.header.stamp.sec, e.header.stamp.nanosec, e.type, e.finger, e.node)
+              for e in runner.observer.sim_events]
+    return {"result": result, "events": events, "depth": state.contacts.depth,
+            "forces": np.array([[v.x, v.y] for v in state.forces]), **seen}
+
+
+@contextlib.contextmanager
+def sim_and_client(scene: str, name: str = "hostile"):
+    """A simulated hardware node of scene file ``scene`` and a client node ``name`` (the one
+    lockstep participant it waits for), on one executor of a context of their own; yields
+    (executor, sim, client) and shuts everything down after.
+    """
+    import rclpy
+    from rclpy.context import Context
+    from rclpy.executors import SingleThreadedExecutor
+    from rclpy.node import Node
+
+    from squeeze_grasp_ros.ros.nodes.sim_hardware import SimHardwareNode
+
+    context = Context()
+    rclpy.init(context=context)
+    executor = SingleThreadedExecutor(context=context)
+    sim = SimHardwareNode(context=context, parameter_overrides=[
+        rclpy.parameter.Parameter("scene", value=str(scene)),
+        rclpy.parameter.Parameter("participants", value=[name])])
+    client = Node(name, context=context)
+    try:
+        executor.add_node(sim)
+        executor.add_node(client)
+        yield executor, sim, client
+    finally:
+        executor.shutdown()
+        sim.destroy_node()
+        client.destroy_node()
+        rclpy.shutdown(context=context)

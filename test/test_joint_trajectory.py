@@ -17,7 +17,7 @@ import rclpy
 import yaml
 from builtin_interfaces.msg import Duration
 from mcap.reader import make_reader
-from pipeline_support import write_scene
+from pipeline_support import run_observed, write_scene
 from rclpy.context import Context
 from rclpy.executors import SingleThreadedExecutor
 from rclpy.node import Node
@@ -31,8 +31,6 @@ from squeeze_grasp_ros.control.joint_trajectory import (
 )
 from squeeze_grasp_ros.ros.nodes import pipeline
 from squeeze_grasp_ros.ros.nodes.sim_hardware import SimHardwareNode
-from squeeze_grasp_ros.ros.run.options import RunOptions
-from squeeze_grasp_ros.ros.run.runner import PipelineRunner
 from squeeze_grasp_ros.scene import SceneError, load_scene, parse_scene
 from squeeze_grasp_ros.scene.controller import scene_controller
 
@@ -111,7 +109,8 @@ def test_the_shipped_sponge_maps_its_jaws_to_the_generic_gripper():
     ({"joints": ["a", "b"]}, "controller.joints must be 1 distinct"),
     ({"device": "no_such_gripper"}, "controller.device: no shipped device 'no_such_gripper'"),
     ({"device": "nope.yaml"}, "controller.device: gripper device file not found"),
-    ({"type": "gripper_action"}, "controller.type"),
+    ({"type": "effort_gripper"}, "controller.type"),
+    ({"type": "gripper_action", "joints": ["a", "b"]}, "controller.joints must be 1 distinct"),
 ])
 def test_controller_section_errors_name_the_field(controller, message):
     section = {"type": "joint_trajectory", "name": "gripper_controller",
@@ -137,29 +136,13 @@ def test_a_jaw_whose_tip_is_not_the_device_pad_is_refused():
 # --------------------------------------------------------------------------- end to end
 def run_sponge(path: str, record: str | None = None) -> dict:
     """Run a sponge scene on real rclpy; the ground truth and what went on the JTC topics."""
-    runner = PipelineRunner(RunOptions(path, planner=False, record=record))
-    seen = {"trajectories": [], "joint_states": [], "setpoints": []}
-    client = runner.client
-    for topic, cls, key in (("gripper_controller/joint_trajectory", JointTrajectory,
-                             "trajectories"),
-                            ("joint_states", JointState, "joint_states"),
-                            (pipeline.device_topic("barrett_f1", "setpoint"),
-                             pipeline.message_type("geometry_msgs/msg/PoseStamped"),
-                             "setpoints")):
-        client.create_subscription(cls, topic, lambda m, k=key: seen[k].append(m),
-                                   pipeline.loop_qos(1000))
-    try:
-        runner.start()
-        runner.send_goal()
-        result = runner.wait_result()
-        state = runner.observer.sim_states[-1]
-    finally:
-        runner.shutdown()
-    assert result.termination == "depth_reached"
-    events = [(e.header.stamp.sec, e.header.stamp.nanosec, e.type, e.finger, e.node)
-              for e in runner.observer.sim_events]
-    forces = np.array([[v.x, v.y] for v in state.forces])
-    return {"events": events, "forces": forces, "depth": state.contacts.depth, **seen}
+    out = run_observed(path, [
+        ("trajectories", "gripper_controller/joint_trajectory", JointTrajectory),
+        ("joint_states", "joint_states", JointState),
+        ("setpoints", pipeline.device_topic("barrett_f1", "setpoint"),
+         pipeline.message_type("geometry_msgs/msg/PoseStamped"))], record=record)
+    assert out["result"].termination == "depth_reached"
+    return out
 
 
 def test_sponge_through_the_jtc_equals_the_cartesian_route(tmp_path):
@@ -182,8 +165,8 @@ def test_sponge_through_the_jtc_equals_the_cartesian_route(tmp_path):
     with open(next((tmp_path / "bag").glob("*.mcap")), "rb") as stream:
         recorded = Counter(channel.topic for _, channel, _ in
                            make_reader(stream).iter_messages())
-    assert recorded["gripper_controller/joint_trajectory"] == len(jtc["trajectories"])
-    assert recorded["joint_states"] == len(jtc["joint_states"])
+    assert recorded["/gripper_controller/joint_trajectory"] == len(jtc["trajectories"])
+    assert recorded["/joint_states"] == len(jtc["joint_states"])
     # the joint state's effort is the jaw force through the transmission (effort_per_force 1)
     last = jtc["joint_states"][-1]
     assert last.effort[0] == pytest.approx(abs(jtc["forces"][0, 1]), rel=1e-3)
@@ -195,25 +178,41 @@ def hostile(names: list[str], positions: list[float], ms: int = 5) -> JointTraje
         positions=positions, time_from_start=Duration(nanosec=ms * MS))])
 
 
+class SimWithClient:
+    """The simulated hardware of a scene and a client node that answers its hello (tick 0)."""
+
+    def __init__(self, scene: Path) -> None:
+        self.context = Context()
+        rclpy.init(context=self.context)
+        self.executor = SingleThreadedExecutor(context=self.context)
+        self.sim = SimHardwareNode(context=self.context, parameter_overrides=[
+            rclpy.parameter.Parameter("scene", value=str(scene)),
+            rclpy.parameter.Parameter("participants", value=["hostile"])])
+        self.client = Node("hostile", context=self.context)
+        self.executor.add_node(self.sim)
+        self.executor.add_node(self.client)
+        self.pub = self.client.create_publisher(
+            JointTrajectory, "gripper_controller/joint_trajectory", pipeline.loop_qos(10))
+        pipeline.Participant(self.client, "hostile", [], [self.pub])
+        self.spin_until(lambda: self.pub.get_subscription_count() > 0)
+        self.spin_until(lambda: self.sim.now_ns >= 0)
+
+    def spin_until(self, condition, timeout: float = 10.0) -> None:
+        deadline = time.monotonic() + timeout
+        while not condition() and time.monotonic() < deadline:
+            self.executor.spin_once(timeout_sec=0.05)
+
+    def close(self) -> None:
+        self.executor.shutdown()
+        self.sim.destroy_node()
+        self.client.destroy_node()
+        rclpy.shutdown(context=self.context)
+
+
 def test_a_hostile_trajectory_is_refused_with_a_log_line_not_followed(capfd):
-    context = Context()
-    rclpy.init(context=context)
-    executor = SingleThreadedExecutor(context=context)
-    sim = SimHardwareNode(context=context, parameter_overrides=[
-        rclpy.parameter.Parameter("scene", value=str(SPONGE)),
-        rclpy.parameter.Parameter("participants", value=["hostile"])])
-    client = Node("hostile", context=context)
+    rig = SimWithClient(SPONGE)
+    sim, pub = rig.sim, rig.pub
     try:
-        executor.add_node(sim)
-        executor.add_node(client)
-        pub = client.create_publisher(JointTrajectory, "gripper_controller/joint_trajectory",
-                                      pipeline.loop_qos(10))
-        pipeline.Participant(client, "hostile", [], [pub])  # answers sim/hello: tick 0
-        deadline = time.monotonic() + 10
-        while pub.get_subscription_count() == 0 and time.monotonic() < deadline:
-            executor.spin_once(timeout_sec=0.05)
-        while sim.now_ns < 0 and time.monotonic() < deadline:
-            executor.spin_once(timeout_sec=0.05)
         assert sim.now_ns == 0
         jtc = sim.controller
         before = list(jtc.follower.knots)
@@ -224,9 +223,7 @@ def test_a_hostile_trajectory_is_refused_with_a_log_line_not_followed(capfd):
                     hostile(["finger_joint", "finger_joint"], [0.4, 0.4]),
                     hostile(["finger_joint"], [0.4, 0.5])):
             pub.publish(msg)
-        deadline = time.monotonic() + 10
-        while len(jtc.refusals) < 5 and time.monotonic() < deadline:
-            executor.spin_once(timeout_sec=0.05)
+        rig.spin_until(lambda: len(jtc.refusals) >= 5)
         assert jtc.follower.knots == before and sim.now_ns == 0
         assert len(jtc.refusals) == 5
         for reason, text in zip(jtc.refusals, ("not the controller's joints", "non-finite",
@@ -234,18 +231,40 @@ def test_a_hostile_trajectory_is_refused_with_a_log_line_not_followed(capfd):
                                                "not the controller's joints", "2 positions")):
             assert text in reason
         # a valid one is followed: 0.05 m -> 0.04 m in 5 ms is 0.048 m at tick 1 (1 ms), of
-        # which each jaw's device (0.1 m/s) covers 0.1 mm
+        # which the joint's speed limit (max_speed 0.15 m/s of aperture) lets 0.15 mm through
         pub.publish(hostile(["finger_joint"], list(gripper.joint_positions(0.04))))
-        deadline = time.monotonic() + 10
-        while sim.now_ns < MS and time.monotonic() < deadline:
-            executor.spin_once(timeout_sec=0.05)
+        rig.spin_until(lambda: sim.now_ns >= MS)
         assert sim.now_ns == MS and jtc.follower.sample(MS) == pytest.approx(0.048)
         world = sim.world.positions
-        assert jtc.line.aperture(world["F1"], world["F2"]) == pytest.approx(0.0498, abs=1e-12)
+        assert jtc.line.aperture(world["F1"], world["F2"]) == pytest.approx(0.04985, abs=1e-12)
     finally:
-        executor.shutdown()
-        sim.destroy_node()
-        client.destroy_node()
-        rclpy.shutdown(context=context)
+        rig.close()
     err = capfd.readouterr().err
     assert err.count("refused the trajectory on /gripper_controller/joint_trajectory") == 5
+
+
+def test_the_simulated_controller_keeps_the_device_speed_limit(tmp_path):
+    """A slow gripper (max_speed 0.04 m/s of aperture, below its jaws' devices' 0.1 m/s each):
+    commanded to close 10 mm at once, the jaws close 0.04 mm per 1 ms tick, not faster.
+    """
+    device = yaml.safe_load((SPONGE.parents[1] / "devices" / "generic_85mm.yaml").read_text())
+    device.update(name="slow_85mm", max_speed=0.04)
+    (tmp_path / "slow_85mm.yaml").write_text(yaml.safe_dump(device))
+    data = sponge_data()
+    data["controller"]["device"] = "slow_85mm.yaml"
+    rig = SimWithClient(Path(write_scene(tmp_path, data)))
+    try:
+        jtc = rig.sim.controller
+        gripper = jtc.controller.gripper
+        world = rig.sim.world.positions
+        apertures = [jtc.line.aperture(world["F1"], world["F2"])]
+        for tick in range(1, 6):
+            rig.pub.publish(hostile(["finger_joint"],
+                                    list(gripper.joint_positions(apertures[0] - 0.01)), ms=1))
+            rig.spin_until(lambda t=tick: rig.sim.now_ns >= t * MS)
+            apertures.append(jtc.line.aperture(world["F1"], world["F2"]))
+    finally:
+        rig.close()
+    steps = -np.diff(apertures)
+    print(f"aperture per tick [mm]: {(steps * 1e3).tolist()}")
+    np.testing.assert_allclose(steps, 0.04 * 1e-3, rtol=1e-9)

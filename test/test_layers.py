@@ -28,7 +28,8 @@ PACKAGE = Path(squeeze_grasp_ros.__file__).parent
 NAME = "squeeze_grasp_ros"
 ROS_MODULES = ("rclpy", "rosidl", "rcl_interfaces", "builtin_interfaces", "std_msgs",
                "geometry_msgs", "sensor_msgs", "visualization_msgs", "rosgraph_msgs",
-               "action_msgs", "squeeze_grasp_interfaces", "launch", "launch_ros", "rosbag2")
+               "action_msgs", "squeeze_grasp_interfaces", "launch", "launch_ros", "rosbag2",
+               "control_msgs", "trajectory_msgs")
 LAYERS: tuple[tuple[str, ...], ...] = (
     ("inputs", "exit_codes", "extras", "resources", "threads", "stdout", "buildtool"),
     ("mechanics",),

@@ -247,25 +247,32 @@ def test_neo_hookean_refuses_nu_one_half():
         H.stress_and_tangent("neo_hookean", np.eye(2)[None], nu=0.5)
 
 
-def test_internal_forces_against_scikit_fem(patch):
-    """The internal force of each law, assembled independently by scikit-fem's P1 basis from the
-    law's stress P(F): the same vector.
+def _scikit_fem_state(patch, u: np.ndarray):
+    """(skfem, its vector P1 basis on ``patch``, our DOF -> its DOF, ``u`` in its order), or a
+    visible skip when scikit-fem is not installed.
     """
     skfem = pytest.importorskip(
         "skfem", reason="scikit-fem (the independent FEM cross-check) is not installed: "
                         "pip install scikit-fem")
-    from skfem.helpers import ddot, grad
-
     m = skfem.MeshTri(patch.nodes.T.copy(), patch.triangles.T.copy())
     basis = skfem.Basis(m, skfem.ElementVector(skfem.ElementTriP1()))
-    rng = np.random.default_rng(11)
-    u = 0.001 * rng.standard_normal(2 * patch.n)
     # skfem orders vector DOFs node-wise (x1, y1, x2, ...) like ours for ElementVector(P1)
     nodal = basis.nodal_dofs
     ours_to_sk = np.empty(2 * patch.n, int)
     ours_to_sk[0::2], ours_to_sk[1::2] = nodal[0], nodal[1]
     w = np.empty(basis.N)
     w[ours_to_sk] = u
+    return skfem, basis, ours_to_sk, w
+
+
+def test_internal_forces_against_scikit_fem(patch):
+    """The internal force of each law, assembled independently by scikit-fem's P1 basis from the
+    law's stress P(F): the same vector.
+    """
+    u = 0.001 * np.random.default_rng(11).standard_normal(2 * patch.n)
+    skfem, basis, ours_to_sk, w = _scikit_fem_state(patch, u)
+    from skfem.helpers import ddot, grad
+
     for model in MODELS:
         @skfem.LinearForm
         def residual(v, p):
@@ -278,6 +285,63 @@ def test_internal_forces_against_scikit_fem(patch):
         sk = residual.assemble(basis, w=basis.interpolate(w))[ours_to_sk]
         ours = H.assemble(model, patch.nodes, patch.triangles, u, nu=0.3).force
         assert np.allclose(ours, sk, rtol=1e-10, atol=1e-12 * np.abs(ours).max())
+
+
+def test_tangent_against_scikit_fem(patch):
+    """The tangent stiffness of each law, assembled independently by scikit-fem's P1 basis from
+    the law's dP/dF: the same matrix (our assembly precomputes the pattern and the products of
+    the shape-function gradients per mesh and scatters every element at once).
+    """
+    u = 0.002 * np.random.default_rng(5).standard_normal(2 * patch.n)
+    skfem, basis, ours_to_sk, w = _scikit_fem_state(patch, u)
+    from skfem.helpers import grad
+
+    for model in MODELS:
+        @skfem.BilinearForm
+        def stiffness(du, v, p):
+            Fq = np.eye(2)[:, :, None, None] + p["w"].grad
+            flat = np.moveaxis(Fq, (0, 1), (-2, -1)).reshape(-1, 2, 2)
+            _, _, A = H.stress_and_tangent(model, flat, nu=0.3)
+            Aq = np.moveaxis(A.reshape(Fq.shape[2:] + (2, 2, 2, 2)), (-4, -3, -2, -1),
+                             (0, 1, 2, 3))
+            return np.einsum("ijkl...,kl...,ij...->...", Aq, grad(du), grad(v))
+
+        sk = stiffness.assemble(basis, w=basis.interpolate(w))[ours_to_sk][:, ours_to_sk]
+        ours = H.assemble(model, patch.nodes, patch.triangles, u, nu=0.3).tangent
+        sym = 0.5 * (sk + sk.T)  # ours is symmetrised (the corotational dP/dF is not exactly)
+        assert abs(ours - sym).max() <= 1e-12 * abs(sym).max(), model
+        assert ours.nnz == sk.nnz
+
+
+def test_assembly_against_an_element_by_element_loop(patch):
+    """Forces, energy and tangent against the textbook loop over elements (B^T P and
+    B^T A B per element, added into dense arrays): equal to round-off for every law.
+    """
+    rng = np.random.default_rng(9)
+    u = 0.003 * rng.standard_normal(2 * patch.n)
+    X, tri = patch.nodes, patch.triangles
+    for model in MODELS:
+        ours = H.assemble(model, X, tri, u, nu=0.3)
+        F = H.deformation(X, tri, u)
+        W, P, A = H.stress_and_tangent(model, F, nu=0.3)
+        n2 = 2 * patch.n
+        K, f, energy = np.zeros((n2, n2)), np.zeros(n2), 0.0
+        for e, (a, b, c) in enumerate(tri):
+            J = np.column_stack([X[b] - X[a], X[c] - X[a]])
+            area = 0.5 * abs(np.linalg.det(J))
+            g = np.array([[-1.0, -1.0], [1.0, 0.0], [0.0, 1.0]]) @ np.linalg.inv(J)
+            B = np.zeros((4, 6))  # dF_ij / du_(node, k) = delta_ik g_node,j
+            for node in range(3):
+                for i in range(2):
+                    B[2 * i:2 * i + 2, 2 * node + i] = g[node]
+            dofs = np.array([[2 * k, 2 * k + 1] for k in (a, b, c)]).ravel()
+            f[dofs] += area * B.T @ P[e].ravel()
+            K[np.ix_(dofs, dofs)] += area * B.T @ A[e].reshape(4, 4) @ B
+            energy += area * W[e]
+        K = 0.5 * (K + K.T)
+        assert ours.energy == pytest.approx(energy, rel=1e-13), model
+        assert np.abs(ours.force - f).max() <= 1e-13 * np.abs(f).max(), model
+        assert np.abs(ours.tangent.toarray() - K).max() <= 1e-13 * np.abs(K).max(), model
 
 
 # --------------------------------------------------------------------------- the squeeze

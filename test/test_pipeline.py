@@ -308,6 +308,26 @@ def test_cancel_holds_position(tmp_path):
     assert [(p.x, p.y) for p in last.positions] == [(p.x, p.y) for p in before.positions]
 
 
+def test_quiet_world_ticks_give_the_same_recording_byte_for_byte(foam, tmp_path, monkeypatch):
+    """The foam-square run with every world tick through the stepper's advance() (no quiet
+    ticks, as before issue 33) records the same messages, byte for byte, at the same times as
+    the fixture's run (quiet ticks on).
+    """
+    import functools
+
+    import squeeze_grasp_ros.sim.world as world_module
+
+    monkeypatch.setattr(world_module, "SimWorld",
+                        functools.partial(world_module.SimWorld, quiet=False))
+    run = PipelineRunner(RunOptions(foam["path"], record=str(tmp_path / "bag"))).run()
+    for key in ("events", "monitor_events", "forces", "work", "ticks"):
+        assert run[key] == foam["run"][key], key
+    ours, reference = read_bag(tmp_path / "bag"), read_bag(foam["bag"])
+    assert ours.counts() == reference.counts()
+    assert sorted((m.topic, m.log_time_ns, bytes(m.data)) for m in ours.messages) == sorted(
+        (m.topic, m.log_time_ns, bytes(m.data)) for m in reference.messages)
+
+
 def test_single_threaded_executor_gives_the_same_run_and_recording(small, tmp_path):
     """Also covers the recorder's drain at shutdown on this executor (its progress timer and
     the re-sent last tick once kept it from ever seeing the executor idle).

@@ -84,3 +84,40 @@ def test_a_gripper_too_small_is_not_feasible(planner: Harness) -> None:
                             request(gripper_name="", gripper_yaml=small))
     assert not response.success and response.error_code == ErrorCode.NOT_FEASIBLE
     assert "fits tiny's opening" in response.message
+
+
+def candidate_fields(response: PlanGripperGrasp.Response) -> list[tuple]:
+    return [(c.rank, list(c.nodes), list(c.first_contacts), c.aperture_at_contact, c.stiffness,
+             c.pose.pose.position.x, c.pose.pose.position.y) for c in response.candidates]
+
+
+def test_the_grasp_map_is_cached_with_the_loaded_object(planner: Harness) -> None:
+    planner.load(SPONGE)
+    maps = planner.planner.cache.get("sponge_gripper").maps
+    first = planner.call(PlanGripperGrasp, "plan_gripper_grasp", request(evaluate=0))
+    second = planner.call(PlanGripperGrasp, "plan_gripper_grasp", request(evaluate=0))
+    assert first.success and second.success
+    assert (maps.misses, maps.hits) == (1, 1)
+    assert candidate_fields(second) == candidate_fields(first) and len(first.candidates) == 5
+    # the map is of point contacts: another pad, gripper or yaw range is ranked on the same map
+    small_pads = load_gripper(device_file("generic_85mm"))
+    other = planner.call(PlanGripperGrasp, "plan_gripper_grasp", request(
+        evaluate=0, gripper_name="", use_yaw_range=True, yaw_min=1.2, yaw_max=1.9,
+        gripper_yaml=device_file("generic_85mm").read_text().replace(
+            f"width: {small_pads.pad.width}", "width: 0.01")))
+    assert other.success and (maps.misses, maps.hits) == (1, 2)
+    assert candidate_fields(other) != candidate_fields(first)
+    # another mu is another map, and the answer of the first comes again from the cache
+    assert planner.call(PlanGripperGrasp, "plan_gripper_grasp", request(mu=0.2)).success
+    again = planner.call(PlanGripperGrasp, "plan_gripper_grasp", request(evaluate=0))
+    assert (maps.misses, maps.hits) == (2, 3)
+    assert candidate_fields(again) == candidate_fields(first)
+    # a reload of the same scene keeps the object and its maps; another object under the id
+    # replaces both
+    planner.load(SPONGE)
+    assert planner.planner.cache.get("sponge_gripper").maps is maps
+    planner.load(SPONGE.replace("E: 5.0e4", "E: 6.0e4"), object_id="sponge_gripper", replace=True)
+    fresh = planner.planner.cache.get("sponge_gripper").maps
+    assert fresh is not maps and (fresh.misses, fresh.hits) == (0, 0)
+    planner.call(PlanGripperGrasp, "plan_gripper_grasp", request(evaluate=0))
+    assert (fresh.misses, fresh.hits) == (1, 0)

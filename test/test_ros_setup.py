@@ -360,3 +360,63 @@ def test_source_without_package_files_is_rejected(tmp_path: Path, missing: str) 
             (tmp_path / name).write_text("")
     with pytest.raises(ros_setup.SetupError, match=missing):
         ros_setup.resolve_source(tmp_path)
+
+
+# --------------------------------------------------------------------------- control_msgs
+def fake_control_msgs(root: Path, *, parallel: bool = True) -> Path:
+    """A control_msgs package folder with the gripper interfaces (and one more)."""
+    from squeeze_grasp_ros.buildtool import control_msgs
+
+    package = root / "control_msgs"
+    package.mkdir(parents=True)
+    (package / "package.xml").write_text("<package><name>control_msgs</name></package>")
+    for name in (*control_msgs.INTERFACES, "msg/JointJog.msg"):
+        if parallel or "Parallel" not in name:
+            (package / name).parent.mkdir(parents=True, exist_ok=True)
+            (package / name).write_text(f"# {name}\n")
+    return package
+
+
+def test_control_msgs_stages_only_the_gripper_interfaces(tmp_path):
+    from squeeze_grasp_ros.buildtool import control_msgs
+
+    package = fake_control_msgs(tmp_path / "checkout")
+    for given in (tmp_path / "checkout", package):    # the checkout or its package folder
+        assert control_msgs.package_folder(given) == package
+    staged = control_msgs.stage(package, tmp_path / "staged")
+    files = sorted(p.relative_to(staged).as_posix() for p in staged.rglob("*") if p.is_file())
+    assert files == sorted(["CMakeLists.txt", "package.xml", *control_msgs.INTERFACES])
+    cmake = (staged / "CMakeLists.txt").read_text()
+    assert "project(control_msgs)" in cmake and "JointJog" not in cmake
+    assert all(name in cmake for name in control_msgs.INTERFACES)
+    digest = ros_setup.source_digest(staged)
+    control_msgs.stage(package, tmp_path / "staged")   # staged again: the same build stamp
+    assert ros_setup.source_digest(staged) == digest
+
+
+def test_control_msgs_sources_that_are_not_jazzy_are_refused_exit_2(tmp_path, capsys):
+    from squeeze_grasp_ros.buildtool import control_msgs
+
+    with pytest.raises(ros_setup.SourceError, match="no control_msgs package.xml"):
+        control_msgs.package_folder(tmp_path)
+    old = fake_control_msgs(tmp_path / "humble", parallel=False)
+    with pytest.raises(ros_setup.SourceError, match="is not Jazzy's control_msgs \\(missing "
+                       "action/ParallelGripperCommand.action\\)"):
+        control_msgs.package_folder(old)
+    if not ros_setup.find_problems(Path(sys.prefix)):
+        assert ros_setup.main(["--control-msgs", str(tmp_path / "nothing")]) == 2
+        assert "no control_msgs package.xml" in capsys.readouterr().err
+
+
+def test_without_sources_ros_setup_says_why_control_msgs_is_not_built(monkeypatch, capsys,
+                                                                       tmp_path):
+    from squeeze_grasp_ros.buildtool import control_msgs
+
+    monkeypatch.delenv(control_msgs.ENV_VAR, raising=False)
+    assert control_msgs.source_argument(None) is None
+    monkeypatch.setenv(control_msgs.ENV_VAR, str(tmp_path))
+    assert control_msgs.source_argument(None) == tmp_path
+    monkeypatch.setitem(sys.modules, "control_msgs", None)   # as on a fresh machine
+    control_msgs.setup(tmp_path, None, force=False, verbose=False)
+    assert "control_msgs: not built (no sources given: --control-msgs DIR or " \
+           "SQUEEZE_GRASP_CONTROL_MSGS=DIR" in capsys.readouterr().out

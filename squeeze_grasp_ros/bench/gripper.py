@@ -1,6 +1,8 @@
 # Copyright 2026 squeeze_grasp_ros developers
 # SPDX-License-Identifier: Apache-2.0
-"""Parallel-jaw gripper planning: ranking time against the grasp map's, and the evaluation."""
+"""Parallel-jaw gripper planning: ranking time against the grasp map's, and the evaluation;
+with ROS installed, the executor's first command to the gripper's controller.
+"""
 
 from __future__ import annotations
 
@@ -8,6 +10,7 @@ import dataclasses
 from pathlib import Path
 
 from squeeze_grasp_ros.bench.table import Table, best_time, timed
+from squeeze_grasp_ros.extras import EXTRAS, installed
 from squeeze_grasp_ros.mechanics.squeeze.graspmap import grasp_map
 from squeeze_grasp_ros.mechanics.squeeze.gripper_grasp import (
     evaluate_candidate,
@@ -41,7 +44,7 @@ def run(quick: bool, out_dir: Path, progress) -> list[Table]:
             obj, best[0], jaws, mu, closing=scene.squeeze.relative_depth * best[0].aperture))
         rows.append([obj.mesh.n, len(obj.mesh.boundary), len(best), 1e3 * t_map,
                      1e3 * t_rank, t_eval, ev.jaw_force, sum(ev.squeeze.event_counts.values())])
-    return [Table(
+    tables = [Table(
         "gripper: plan_gripper_grasp's stages",
         ["nodes", "boundary", "candidates", "grasp map [ms]", "rank 100 [ms]",
          "evaluate best [s]", "jaw force [N]", "events"],
@@ -53,3 +56,9 @@ def run(quick: bool, out_dir: Path, progress) -> list[Table]:
                "the aperture, for the slip/strain/inversion limit. Target of issue 31: "
                "ranking 100 candidates on a cached 2,000-node object under 50 ms."),
     )]
+    if all(installed(m) for m in ("rclpy", "squeeze_grasp_interfaces")):
+        from squeeze_grasp_ros.bench.first_command import first_command_table
+        tables.append(first_command_table(3 if quick else 10, progress))
+    else:
+        progress(f"gripper: the first-command table needs ROS: {EXTRAS['ros'][1]}")
+    return tables

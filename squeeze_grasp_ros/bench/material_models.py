@@ -1,14 +1,18 @@
 # Copyright 2026 squeeze_grasp_ros developers
 # SPDX-License-Identifier: Apache-2.0
 """The linear model's error against the finite-deformation models as the squeeze deepens, what
-a nonlinear squeeze costs (Newton iterations, factorisations, time against linear), and how
-that cost grows with the mesh (fill of the factor, evaluations, fitted exponents).
+a nonlinear squeeze costs (Newton iterations, factorisations, time against linear), how that
+cost grows with the mesh (fill of the factor, evaluations, fitted exponents), and where it goes
+(a cProfile of one neo-Hookean squeeze per mesh, its CPU time split into assembly, ordering and
+symbolic analysis, numeric factorisation, solves and the rest).
 """
 
 from __future__ import annotations
 
+import cProfile
 import dataclasses
 import os
+import pstats
 import time
 from pathlib import Path
 
@@ -88,6 +92,93 @@ def _fill(setup: GraspSetup) -> Fill:
     return TangentFactor().fill(K, held)
 
 
+PHASES: tuple[tuple[str, tuple[tuple[str, str, int], ...]], ...] = (
+    ("assembly", (("elastic/hyperelastic.py", "assemble", 1),)),
+    ("ordering + symbolic", (("elastic/interior.py", "_symbolic", 1),)),
+    ("numeric factorisation", (("elastic/interior.py", "_cholmod", 1),
+                               ("elastic/interior.py", "_symbolic", -1),
+                               ("elastic/interior.py", "_qdldl", 1))),
+    ("solves", (("elastic/interior.py", "_solve", 1),)),
+)
+"""Phases of a nonlinear squeeze as signed sums of cProfile cumulative times of the functions
+(file suffix, name) that do them: the element assembly (energy, forces, tangent), CHOLMOD's
+ordering (METIS or AMD) and symbolic analysis, the numeric factorisations (CHOLMOD's, or
+QDLDL's, whose first also orders and analyses), the interior solves (Newton steps, dF/d delta
+on the finger motion, predictors). The rest is the stepper, the contact model and Newton's
+bookkeeping."""
+
+
+def _cumulative(stats: pstats.Stats, suffix: str, name: str) -> tuple[float, int]:
+    """(cumulative time, calls) of the profiled functions ``name`` in files ending ``suffix``."""
+    time_, calls = 0.0, 0
+    for (filename, _, function), (_, ncalls, _, cumulative, _) in stats.stats.items():
+        if function == name and filename.replace(os.sep, "/").endswith(suffix):
+            time_, calls = time_ + cumulative, calls + ncalls
+    return time_, calls
+
+
+def phases(setup: GraspSetup) -> dict:
+    """CPU seconds of one profiled 12 % neo-Hookean squeeze of ``setup`` by :data:`PHASES`
+    (and ``rest``, ``total``), with the calls of each phase's first function and the
+    squeeze's nonlinear diagnostics (``diagnostics``) and events (``events``).
+    """
+    profile = cProfile.Profile(time.process_time)  # CPU time: the machine is shared
+    profile.enable()
+    res = setup.event_squeeze(relative_depth=0.12, material_model=MaterialModel.NEO_HOOKEAN)
+    profile.disable()
+    stats = pstats.Stats(profile)
+    total = sum(entry[2] for entry in stats.stats.values())
+    out = {"total": total, "calls": {}, "diagnostics": res.diagnostics["nonlinear"],
+           "events": len(res.events)}
+    for name, parts in PHASES:
+        timed = [(sign, *_cumulative(stats, suffix, function))
+                 for suffix, function, sign in parts]
+        out[name] = sum(sign * t for sign, t, _ in timed)
+        out["calls"][name] = timed[0][2]
+    out["rest"] = total - sum(out[name] for name, _ in PHASES)
+    return out
+
+
+def _phase_table(sizes: list, measured: list, fill: list, load: tuple) -> Table:
+    """Where a neo-Hookean squeeze's CPU time goes on each mesh (:func:`phases`)."""
+    rows, per = [], {"evaluation": [], "assembly": [], "factorisation": [], "solve": []}
+    for size, m in zip(sizes, measured):
+        d, calls = m["diagnostics"], m["calls"]
+        evals = max(d["evaluations"], 1)
+        rows.append([size, m["total"],
+                     *(100 * m[name] / m["total"] for name, _ in PHASES),
+                     100 * m["rest"] / m["total"],
+                     d["evaluations"] / max(m["events"], 1), d["newton_iterations"] / evals,
+                     calls["assembly"] / evals, calls["solves"] / evals,
+                     1e3 * m["total"] / evals, 1e3 * m["assembly"] / max(calls["assembly"], 1),
+                     1e3 * m["numeric factorisation"] / max(d["factorizations"], 1),
+                     1e3 * m["solves"] / max(calls["solves"], 1)])
+        per["evaluation"].append(m["total"] / evals)
+        per["assembly"].append(m["assembly"] / max(calls["assembly"], 1))
+        per["factorisation"].append(m["numeric factorisation"] / max(d["factorizations"], 1))
+        per["solve"].append(m["solves"] / max(calls["solves"], 1))
+    fits = ", ".join(f"per {name} n^{_exponent(sizes, y):.2f}" for name, y in per.items())
+    fill_fit = (f"nnz(L) n^{_exponent(sizes, [f.nnz for f in fill]):.2f}, factor flops "
+                f"n^{_exponent(sizes, [f.flops for f in fill]):.2f}")
+    return Table("Where a neo-Hookean squeeze's time goes (foam square, 12 %, cProfile, CPU)",
+                 ["nodes", "profiled CPU [s]", *(f"{name} [%]" for name, _ in PHASES),
+                  "rest [%]", "evaluations / event", "Newton its / evaluation",
+                  "assemblies / evaluation", "solves / evaluation", "CPU / evaluation [ms]",
+                  "ms / assembly", "ms / factorisation", "ms / solve"],
+                 rows,
+                 "One more neo-Hookean squeeze per mesh of the growth table, under cProfile "
+                 "with the process's CPU clock; a phase is the cumulative time of the "
+                 "functions that do it (assembly: hyperelastic.assemble, energy and forces "
+                 "with or without the tangent; ordering + symbolic: the factoriser's analysis, "
+                 "once per object; numeric factorisation: CHOLMOD's numeric LL^T, or QDLDL's "
+                 "LDL^T with its first ordering; solves: the interior solves), the rest the "
+                 "stepper, contact model and Newton bookkeeping. The profiler lengthens Python "
+                 "calls, so the rest reads high on small meshes. Fitted over the meshes: "
+                 f"{fits}; against {fill_fit} of the undeformed interior tangent. Load average "
+                 f"(1 min) {load[0]:.1f} before and {load[1]:.1f} after, on {os.cpu_count()} "
+                 "cores.")
+
+
 def _exponent(n: list, y: list) -> float:
     """Least-squares slope of log y against log n."""
     return float(np.polyfit(np.log(n), np.log(y), 1)[0])
@@ -99,16 +190,18 @@ def _neo_row(setup: GraspSetup, linear: tuple, repeats: int) -> tuple[list, floa
     """
     res, t, cpu = _best(setup, MaterialModel.NEO_HOOKEAN, repeats)
     nl = res.diagnostics["nonlinear"]
-    return ([nl["factorizer"], linear[0], t, t / linear[0], cpu / linear[1], len(res.events),
+    return ([nl["factorizer"], linear[0], t, t / linear[0], cpu / linear[1], cpu, len(res.events),
              nl["evaluations"], nl["evaluations"] / max(len(res.events), 1),
              nl["newton_iterations"] / nl["evaluations"], nl["factorizations"]], t, nl)
 
 
-def _scaling(quick: bool, progress) -> Table:
+def _scaling(quick: bool, progress) -> tuple[Table, Table]:
     """The neo-Hookean foam square at 12 % on growing meshes, beside linear in the same run;
-    with CHOLMOD installed, also with QDLDL at QDLDL_NODES.
+    with CHOLMOD installed, also with QDLDL at QDLDL_NODES; and where its time goes on each
+    mesh (:func:`phases`).
     """
     rows, n, per_eval, nnz, flops, evals, t_neo, t_lin = [], [], [], [], [], [], [], []
+    profiled, fills = [], []
     method, load = default_factorizer(), [os.getloadavg()[0]]
     sizes = QUICK_SCALING_NODES if quick else SCALING_NODES
     for nodes in sizes:
@@ -123,18 +216,23 @@ def _scaling(quick: bool, progress) -> Table:
         n.append(size), per_eval.append(t / nl["evaluations"]), nnz.append(fill.nnz)
         flops.append(fill.flops), evals.append(nl["evaluations"]), t_neo.append(t)
         t_lin.append(t_l)
+        progress(f"material_models: scaling, {nodes} nodes profiled")
+        profiled.append(phases(setup))
+        fills.append(fill)
         if method == Factorizer.CHOLMOD and nodes == QDLDL_NODES[quick]:
             progress(f"material_models: scaling, {nodes} nodes with qdldl")
             with factorizer(Factorizer.QDLDL):
                 row, t, nl = _neo_row(setup, (t_l, cpu_l), 1)
             rows.append([size, *row, "-", "-", 1e3 * t / nl["evaluations"]])
     load.append(os.getloadavg()[0])
+    where = _phase_table(n, profiled, fills, tuple(load))
     growth = ", ".join(f"{name} n^{_exponent(n, y):.2f}" for name, y in (
         ("time per evaluation", per_eval), ("nnz(L)", nnz), ("factor flops", flops),
         ("evaluations", evals), ("neo-Hookean squeeze", t_neo), ("linear squeeze", t_lin)))
     return Table("Growth with the mesh (foam square, neo-Hookean, 12 %)",
                  ["nodes", "factoriser", "linear [s]", "neo-Hookean [s]", "x linear",
-                  "x linear (CPU)", "events", "evaluations", "evaluations / event",
+                  "x linear (CPU)", "neo-Hookean CPU [s]", "events", "evaluations",
+                  "evaluations / event",
                   "Newton its / evaluation", "factorisations", "nnz(L)", "factor Mflop",
                   "ms / evaluation"],
                  rows,
@@ -142,7 +240,8 @@ def _scaling(quick: bool, progress) -> Table:
                  f"neo-Hookean squeezes run one after the other (linear: best of "
                  f"{LINEAR_REPEATS}; neo-Hookean: best of {NONLINEAR_REPEATS} up to 2,000 "
                  "nodes, one run above); 'x linear' compares wall times, 'x linear (CPU)' the "
-                 "CPU times of this process, which other processes on the machine inflate less. "
+                 "CPU times of this process, which other processes on the machine inflate less "
+                 "(the neo-Hookean squeeze's own CPU seconds beside its wall time). "
                  "nnz(L) and factor Mflop (sum of squared column "
                  "counts) are those of the undeformed interior tangent of the initial contact "
                  "set in the factoriser's order (a supernodal factor stores the zeros of its "
@@ -151,7 +250,7 @@ def _scaling(quick: bool, progress) -> Table:
                  "factorisation and about three solves and three force assemblies (the Newton "
                  "iterations, dF/d delta on the finger motion). Load average (1 min) "
                  f"{load[0]:.1f} before and {load[1]:.1f} after, on {os.cpu_count()} cores. "
-                 + _scaling_verdict(rows, quick, method))
+                 + _scaling_verdict(rows, quick, method)), where
 
 
 def _scaling_verdict(rows: list, quick: bool, method: Factorizer) -> str:
@@ -167,7 +266,8 @@ def _scaling_verdict(rows: list, quick: bool, method: Factorizer) -> str:
             f"{got_ratio:.1f}x ({'met' if got_ratio <= ratio else 'not met'}; "
             f"{at[ratio_nodes][5]:.1f}x in CPU time)",
             f"under {seconds:g} s at {at[time_nodes][0]:,} nodes: {got_time:.1f} s "
-            f"({'met' if got_time <= seconds else 'not met'})"]
+            f"({'met' if got_time <= seconds else 'not met'}; {at[time_nodes][6]:.1f} s of "
+            "CPU time)"]
     if method != Factorizer.CHOLMOD:
         said.append(f"factoriser qdldl: cvxopt is not installed ({install_hint('cvxopt')}) "
                     "and CHOLMOD's supernodal factorisation is what the targets were met with")
@@ -277,5 +377,5 @@ def run(quick: bool, out_dir: Path, progress) -> list[Table]:
               f"{LINEAR_REPEATS} runs and includes the element-inversion check; the default "
               f"nonlinear rows are the best of {NONLINEAR_REPEATS}, the variants one run each. "
               + _verdict(cost, quick)),
-        _scaling(quick, progress),
+        *_scaling(quick, progress),
     ]

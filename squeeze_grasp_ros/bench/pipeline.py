@@ -12,6 +12,7 @@ import yaml
 from squeeze_grasp_ros.bench.lockstep import bare_ratio_table, profile_table
 from squeeze_grasp_ros.bench.startup import startup_table
 from squeeze_grasp_ros.bench.table import Table, best_time, timed
+from squeeze_grasp_ros.bench.world_pace import world_pace_table
 from squeeze_grasp_ros.mechanics.vocabulary import SQUEEZING_FINGERS, Effect
 from squeeze_grasp_ros.resources import scene_file
 from squeeze_grasp_ros.ros.nodes import pipeline
@@ -19,10 +20,11 @@ from squeeze_grasp_ros.ros.recording.bag import read_bag
 from squeeze_grasp_ros.ros.run.options import RunOptions
 from squeeze_grasp_ros.ros.run.runner import PipelineRunner
 from squeeze_grasp_ros.scene import GraspSetup, load_scene
-from squeeze_grasp_ros.sim.world import SimWorld
+from squeeze_grasp_ros.sim.world import SimWorld, TickOutput
 
 TITLE = ("Pipeline on real rclpy nodes: end to end, lockstep rate against the bare loop, one "
-         "tick's profile, start-up, recording, effects")
+         "tick's profile, the world's mechanics against the event squeeze, start-up, recording, "
+         "effects")
 EFFECT_SCENE = yaml.safe_load("""
 name: effects
 object:
@@ -105,20 +107,26 @@ def loop_rate(runs: list[dict], excluded: str = "mechanics", clock: str = "") ->
     return max(rates, default=float("nan"))
 
 
+def squeeze_world(world: SimWorld, ticks: int = 700) -> list[TickOutput]:
+    """Drive ``world`` along its scene's squeeze (both fingers to the squeeze depth in equal
+    setpoint steps) for ``ticks`` ticks, ROS-free: every tick's output, tick 0 included.
+    """
+    depth = world.scene.squeeze.relative_depth / world.relative_per_depth
+    start = {f: world.positions[f].copy() for f in SQUEEZING_FINGERS}
+    out = [world.start()]
+    for k in range(1, ticks + 1):
+        out.append(world.step({f: start[f] + depth * k / ticks * world.directions[f]
+                               for f in start}))
+    return out
+
+
 def world_loop(scene_path: Path, ticks: int = 700) -> float:
     """CPU seconds of the ROS-free simulated world driven along the scene's squeeze for
     ``ticks`` ticks (devices, stepper, sensors; no messages).
     """
     world = SimWorld(GraspSetup.build(load_scene(scene_path)))
-    depth = world.scene.squeeze.relative_depth / world.relative_per_depth
-    start = {f: world.positions[f].copy() for f in SQUEEZING_FINGERS}
-    world.start()
-
-    def drive():
-        for k in range(1, ticks + 1):
-            world.step({f: start[f] + depth * k / ticks * world.directions[f] for f in start})
     cpu = time.process_time()
-    drive()
+    squeeze_world(world, ticks)
     return time.process_time() - cpu
 
 
@@ -259,4 +267,5 @@ def _tables(quick: bool, progress, work: Path) -> list[Table]:
     profile = profile_table(foam, work / "profiled")
     ratio = bare_ratio_table(foam, 2 if quick else repeats, progress)
     startup = startup_table(2 if quick else repeats, progress)
-    return [end_to_end, rate, ratio, profile, startup, effects]
+    pace = world_pace_table(foam, 2 if quick else repeats, progress)
+    return [end_to_end, rate, ratio, profile, pace, startup, effects]

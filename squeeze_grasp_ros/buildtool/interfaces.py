@@ -41,6 +41,8 @@ from pathlib import Path
 from squeeze_grasp_ros.exit_codes import ExitCode
 
 INTERFACE_PACKAGE = "squeeze_grasp_interfaces"
+INTERFACE_MODULES = (f"{INTERFACE_PACKAGE}.msg", f"{INTERFACE_PACKAGE}.srv")
+"""What a build of the interfaces must make importable."""
 INSTALL_HINT = "pip install -e '.[ros]'"
 MIN_PYTHON = (3, 10)
 MAX_PYTHON = (3, 13)
@@ -74,6 +76,10 @@ _CMAKE_DIRS = ("share", "lib/cmake")
 
 class SetupError(RuntimeError):
     """A step of the setup failed; the message says what to do."""
+
+
+class SourceError(SetupError):
+    """A source folder given on the command line is not what it must be (exit 2)."""
 
 
 @dataclass(frozen=True)
@@ -327,7 +333,8 @@ def write_stamp(layout: Layout, settings: dict[str, object], digest: str) -> Non
 
 
 def rebuild_reason(
-    stamp: dict[str, object] | None, settings: dict[str, object], digest: str, installed: bool
+    stamp: dict[str, object] | None, settings: dict[str, object], digest: str, installed: bool,
+    *, package: str = INTERFACE_PACKAGE,
 ) -> str | None:
     """Say why the interfaces must be built, or return None when they are current.
 
@@ -341,6 +348,8 @@ def rebuild_reason(
         Current `source_digest` of the interface folder.
     installed : bool
         Whether the package is importable from the environment.
+    package : str
+        The package's name (for the message).
 
     Returns
     -------
@@ -354,13 +363,13 @@ def rebuild_reason(
     if stamp.get("sources") != digest:
         return "interface sources changed"
     if not installed:
-        return f"{INTERFACE_PACKAGE} is missing from the environment"
+        return f"{package} is missing from the environment"
     return None
 
 
-def interfaces_installed(prefix: Path) -> bool:
-    """Return True when ``squeeze_grasp_interfaces`` is importable from inside ``prefix``."""
-    spec = importlib.util.find_spec(INTERFACE_PACKAGE)
+def interfaces_installed(prefix: Path, package: str = INTERFACE_PACKAGE) -> bool:
+    """Return True when ``package`` is importable from inside ``prefix``."""
+    spec = importlib.util.find_spec(package)
     origin = spec.origin if spec is not None else None
     return origin is not None and Path(origin).resolve().is_relative_to(prefix.resolve())
 
@@ -454,15 +463,15 @@ def build_and_install(layout: Layout, source: Path, verbose: bool) -> None:
     shutil.copyfile(layout.build_dir / "install_manifest.txt", layout.manifest_file)
 
 
-def verify_import(prefix: Path) -> None:
-    """Import the generated messages and services in a fresh interpreter of the environment.
+def verify_import(prefix: Path, modules: Sequence[str] = INTERFACE_MODULES) -> None:
+    """Import the generated ``modules`` in a fresh interpreter of the environment.
 
     Raises
     ------
     SetupError
         The import failed.
     """
-    code = f"import {INTERFACE_PACKAGE}.msg, {INTERFACE_PACKAGE}.srv"
+    code = f"import {', '.join(modules)}"
     result = subprocess.run(
         [sys.executable, "-c", code],
         env=build_environment(prefix),
@@ -500,6 +509,14 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         default=None,
         metavar="DIR",
         help="interface package folder (default: the repository's msg_defs/)",
+    )
+    parser.add_argument(
+        "--control-msgs",
+        type=Path,
+        default=None,
+        metavar="DIR",
+        help="also build control_msgs' gripper actions from its Jazzy sources in DIR (default: "
+        "$SQUEEZE_GRASP_CONTROL_MSGS; without either, control_msgs is not built)",
     )
     parser.add_argument("--force", action="store_true", help="rebuild even when up to date")
     parser.add_argument("--verbose", action="store_true", help="show cmake's output")
@@ -563,20 +580,30 @@ def setup(layout: Layout, source: Path, force: bool, verbose: bool) -> None:
     repaired = repair_cmake_paths(layout.prefix, python_include_dir(), numpy_include_dir())
     if repaired:
         say(f"repaired wheel include paths in {len(repaired)} CMake files")
+    build_package(layout, source, force=force, verbose=verbose)
+
+
+def build_package(layout: Layout, source: Path, *, package: str = INTERFACE_PACKAGE,
+                  modules: Sequence[str] = INTERFACE_MODULES, force: bool,
+                  verbose: bool) -> None:
+    """Build and install the interface package ``package`` from ``source`` when due (its
+    stamp, build tree and manifest in ``layout.state_dir``), then import ``modules``.
+    """
     settings = build_settings(layout, source)
     digest = source_digest(source)
     reason = rebuild_reason(
-        read_stamp(layout), settings, digest, interfaces_installed(layout.prefix)
+        read_stamp(layout), settings, digest, interfaces_installed(layout.prefix, package),
+        package=package,
     )
     if reason is None and not force:
-        say(f"{INTERFACE_PACKAGE} is up to date (--force rebuilds)")
+        say(f"{package} is up to date (--force rebuilds)")
         return
-    say(f"building {INTERFACE_PACKAGE}: {reason or 'forced'}")
+    say(f"building {package}: {reason or 'forced'}")
     start = time.monotonic()
     build_and_install(layout, source, verbose)
-    verify_import(layout.prefix)
+    verify_import(layout.prefix, modules)
     write_stamp(layout, settings, digest)
-    say(f"built {INTERFACE_PACKAGE} in {time.monotonic() - start:.1f} s")
+    say(f"built {package} in {time.monotonic() - start:.1f} s")
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -586,6 +613,8 @@ def main(argv: list[str] | None = None) -> int:
 
 def run(args: argparse.Namespace) -> int:
     """Run ``ros-setup`` with parsed options; return the process exit code."""
+    from squeeze_grasp_ros.buildtool import control_msgs  # it builds on this module
+
     layout = Layout.for_prefix(Path(sys.prefix))
     problems = find_problems(layout.prefix)
     say(f"environment {layout.prefix} (Python {sys.version.split()[0]})")
@@ -596,12 +625,16 @@ def run(args: argparse.Namespace) -> int:
     try:
         source = resolve_source(args.source)
         if args.check:
-            return report(layout, source)
+            code = report(layout, source)
+            say(control_msgs.state(layout.prefix))
+            return code
         with state_lock(layout):
             setup(layout, source, args.force, args.verbose)
+            control_msgs.setup(layout.prefix, control_msgs.source_argument(args.control_msgs),
+                               force=args.force, verbose=args.verbose)
     except SetupError as error:
         print(f"ros-setup: error: {error}", file=sys.stderr)
-        return ExitCode.INTERNAL
+        return ExitCode.USAGE if isinstance(error, SourceError) else ExitCode.INTERNAL
     return ExitCode.OK
 
 

@@ -321,6 +321,17 @@ class ControllerKind(_Name):
     JOINT_TRAJECTORY = "joint_trajectory"
     """A JointTrajectoryController: ``trajectory_msgs/JointTrajectory`` on
     ``<controller>/joint_trajectory``."""
+    GRIPPER_ACTION = "gripper_action"
+    """A GripperActionController: ``control_msgs/action/GripperCommand`` on
+    ``<controller>/gripper_cmd``."""
+    PARALLEL_GRIPPER = "parallel_gripper"
+    """Jazzy's ParallelGripperController: ``control_msgs/action/ParallelGripperCommand`` on
+    ``<controller>/gripper_cmd``."""
+
+    @property
+    def is_action(self) -> bool:
+        """True for the gripper action controllers."""
+        return self is not ControllerKind.JOINT_TRAJECTORY
 
 
 class ShapeFit(_Name):

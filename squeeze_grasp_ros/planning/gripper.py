@@ -49,14 +49,16 @@ def gripper_grasp_plan(loaded: LoadedObject, gripper: GripperSpec, *, mu: float,
                        yaw_range: tuple[float, float] | None, weight: float,
                        force_margin: float, strain_limit: float,
                        limits: PlannerLimits) -> GripperPlan:
-    """:func:`~squeeze_grasp_ros.scene.gripper_plan.plan_gripper_grasp` of a cached solid, the
-    request's zeros meaning "none" / "default" as the service documents.
+    """:func:`~squeeze_grasp_ros.scene.gripper_plan.plan_gripper_grasp` of a cached solid and
+    its cached grasp map at ``mu``, the request's zeros meaning "none" / "default" as the
+    service documents.
     """
     count = best_count(count, limits)
     if not 0 <= evaluate <= count:
         raise invalid(f"evaluate must be in [0, count={count}], got {evaluate}")
+    mu = check_number("mu", mu, 0.0)
     return plan_gripper_grasp(
-        loaded.solid(), gripper, check_number("mu", mu, 0.0),
+        loaded.solid(), gripper, mu, gmap=loaded.grasp_map(mu),
         relative_closing=check_number("relative_closing", relative_closing, 0.0, 1.0),
         count=count, evaluate=evaluate,
         yaw_range=None if yaw_range is None else tuple(

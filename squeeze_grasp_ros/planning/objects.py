@@ -11,7 +11,7 @@ import threading
 import time
 from collections import OrderedDict
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -20,6 +20,7 @@ import scipy.sparse as sp
 from squeeze_grasp_ros.inputs import InputError, confine, load_yaml, read_text
 from squeeze_grasp_ros.mechanics.elastic.compliance import ROUTES, ElasticObject
 from squeeze_grasp_ros.mechanics.ring.model import RingModel
+from squeeze_grasp_ros.mechanics.squeeze.graspmap import GraspMap, grasp_map
 from squeeze_grasp_ros.mechanics.vocabulary import ContactKind, ObjectModel, ShapeType
 from squeeze_grasp_ros.planning.budget import check_load
 from squeeze_grasp_ros.planning.errors import ErrorCode, PlannerError, invalid
@@ -80,6 +81,42 @@ class PlannerLimits:
     max_bytes: int | None = None
 
 
+class GraspMapCache:
+    """Grasp maps of one loaded object by friction coefficient, the newest ``size`` kept.
+
+    The map is of point contacts (Sec. 4: stiffness, inwardness and force closure of node
+    pairs), so the solid and mu are its whole key: a gripper's pads, opening or the request's
+    yaw range enter only the ranking made from it. Thread-safe; two workers asking for a missing
+    map at once may both compute it (the same map), none waits for the other.
+
+    Attributes
+    ----------
+    hits, misses : int
+        Requests served from the cache, and computed.
+    """
+
+    def __init__(self, size: int = 4) -> None:
+        self.size = size
+        self.maps: OrderedDict[float, GraspMap] = OrderedDict()
+        self.lock = threading.Lock()
+        self.hits = self.misses = 0
+
+    def get(self, mu: float, compute: Callable[[], GraspMap]) -> GraspMap:
+        """The map at ``mu``: cached, else ``compute()`` and kept."""
+        with self.lock:
+            if mu in self.maps:
+                self.hits += 1
+                self.maps.move_to_end(mu)
+                return self.maps[mu]
+            self.misses += 1
+        gmap = compute()
+        with self.lock:
+            self.maps[mu] = gmap
+            while len(self.maps) > self.size:
+                self.maps.popitem(last=False)
+        return gmap
+
+
 @dataclass(frozen=True)
 class LoadedObject:
     """An object with its precomputed mechanics, as the planner caches it.
@@ -95,12 +132,21 @@ class LoadedObject:
         SHA-256 of the scene text and the solver route: same digest, same object.
     precompute_time : float
         Wall time of meshing and precompute, s.
+    maps : GraspMapCache
+        The grasp maps computed for this object (:meth:`grasp_map`); a reload builds a new
+        object, so they go with the old one.
     """
 
     object_id: str
     setup: GraspSetup
     digest: str
     precompute_time: float
+    maps: GraspMapCache = field(default_factory=lambda: GraspMapCache(), compare=False,
+                                repr=False)
+
+    def grasp_map(self, mu: float) -> GraspMap:
+        """The all-pairs grasp map of the solid at friction ``mu``, computed once per mu."""
+        return self.maps.get(float(mu), lambda: grasp_map(self.solid(), float(mu)))
 
     @property
     def scene(self) -> Scene:

@@ -21,7 +21,7 @@ from squeeze_grasp_ros.mechanics.resistance.optimal import (
 from squeeze_grasp_ros.mechanics.ring.grasp_map import RingGraspMap, ring_grasp_map
 from squeeze_grasp_ros.mechanics.ring.squeeze import RingGrasp, ring_grasp
 from squeeze_grasp_ros.mechanics.squeeze.events import EventSqueeze
-from squeeze_grasp_ros.mechanics.squeeze.graspmap import GraspMap, grasp_map
+from squeeze_grasp_ros.mechanics.squeeze.graspmap import GraspMap
 from squeeze_grasp_ros.mechanics.squeeze.stable_pure import Squeeze, force_closure, plan_squeeze
 from squeeze_grasp_ros.mechanics.vocabulary import ContactKind, SqueezeKind
 from squeeze_grasp_ros.planning.checks import check_number, check_step, choice, contact_nodes
@@ -94,8 +94,10 @@ def squeeze_plan(
 
 
 def object_grasp_map(loaded: LoadedObject, mu: float) -> GraspMap:
-    """All-pairs grasp map of a solid (:func:`~.mechanics.graspmap.grasp_map`); mu >= 0."""
-    return grasp_map(loaded.solid(), check_number("mu", mu, 0.0))
+    """All-pairs grasp map of a solid (:func:`~.mechanics.graspmap.grasp_map`), mu >= 0;
+    cached with the object (:meth:`~.objects.LoadedObject.grasp_map`).
+    """
+    return loaded.grasp_map(check_number("mu", mu, 0.0))
 
 
 @dataclass(frozen=True)

@@ -6,6 +6,8 @@ The section maps two fingers (the jaws) to a parallel-gripper device and names t
 that drives its joints::
 
     controller: {type: joint_trajectory, name: gripper_controller, device: generic_85mm}
+    controller: {type: parallel_gripper, name: gripper_controller, device: generic_85mm,
+                 goal_tolerance: 1.0e-6, stall_timeout: 0.05}
 
 :func:`scene_controller` resolves the device (a shipped name or a file relative to the scene)
 and checks it against the scene: the jaws are two distinct squeezing fingers whose tips are
@@ -21,16 +23,40 @@ the device's pad, and the controller's joints (default: the device's
 """
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
-from squeeze_grasp_ros.mechanics.vocabulary import Finger
+import numpy as np
+
+from squeeze_grasp_ros.control.gripper_action import GripperParameters
+from squeeze_grasp_ros.mechanics.vocabulary import ControllerKind, Finger
 from squeeze_grasp_ros.resources import ResourceError, device_file
 from squeeze_grasp_ros.scene.gripper import GripperSpec, load_gripper
 from squeeze_grasp_ros.scene.schema import SchemaError
 from squeeze_grasp_ros.scene.specs import ControllerSpec, Scene, SceneError
 
-__all__ = ["JawController", "scene_controller"]
+__all__ = ["JawController", "JawReading", "JointReadingError", "scene_controller"]
+
+
+class JointReadingError(ValueError):
+    """A joint state that cannot be read as jaw feedback; the message says why."""
+
+
+@dataclass(frozen=True)
+class JawReading:
+    """One joint state as jaw feedback (:meth:`JawController.reading`).
+
+    Attributes
+    ----------
+    aperture : float
+        Distance between the pad faces, m.
+    force : float
+        Each jaw's push on the object along the closing line, N (> 0 squeezing).
+    """
+
+    aperture: float
+    force: float
 
 
 @dataclass(frozen=True)
@@ -47,9 +73,36 @@ class JawController:
         return self.spec.jaws[0], self.spec.jaws[1]
 
     @property
+    def kind(self) -> ControllerKind:
+        """The controller's interface."""
+        return ControllerKind(self.spec.type)
+
+    @property
     def topic(self) -> str:
-        """The controller's trajectory topic, relative: ``<name>/joint_trajectory``."""
-        return f"{self.spec.name}/joint_trajectory"
+        """The controller's command topic or action, relative: ``<name>/joint_trajectory`` or
+        ``<name>/gripper_cmd``.
+        """
+        name = self.spec.name
+        return f"{name}/gripper_cmd" if self.kind.is_action else f"{name}/joint_trajectory"
+
+    @property
+    def effort_limit(self) -> float:
+        """The largest joint effort of the device (its ``max_force`` through the
+        transmission).
+        """
+        return abs(self.gripper.joint_efforts(self.gripper.max_force)[0])
+
+    def parameters(self) -> GripperParameters:
+        """The gripper action controller's parameters (joint units); ``max_effort`` 0 is the
+        device's limit, and the GripperActionController's command jumps to the goal.
+        """
+        s = self.spec
+        return GripperParameters(
+            goal_tolerance=s.goal_tolerance, stall_velocity_threshold=s.stall_velocity_threshold,
+            stall_timeout=s.stall_timeout, allow_stalling=s.allow_stalling,
+            max_effort=s.max_effort or self.effort_limit,
+            max_velocity=(s.max_velocity if self.kind is ControllerKind.PARALLEL_GRIPPER
+                          else float("inf")))
 
     def joint_positions(self, aperture: float) -> tuple[float, ...]:
         """Each controller joint's position at ``aperture`` (m), through the transmission."""
@@ -58,6 +111,34 @@ class JawController:
     def joint_efforts(self, force: float) -> tuple[float, ...]:
         """Each controller joint's effort for a jaw force ``force`` (N)."""
         return self.gripper.joint_efforts(force)[:1] * len(self.joints)
+
+    def reading(self, names: Sequence[str], positions: Sequence[float],
+                efforts: Sequence[float]) -> JawReading:
+        """The aperture and jaw force of a joint state (``sensor_msgs/JointState`` fields)
+        through the transmission: the mean over the controller's joints; other joints in the
+        message are ignored.
+
+        Raises
+        ------
+        JointReadingError
+            A controller joint missing, positions or efforts not one per name, or not finite.
+        """
+        names = list(names)
+        if len(positions) != len(names) or len(efforts) != len(names):
+            raise JointReadingError(f"{len(names)} names, {len(positions)} positions and "
+                                    f"{len(efforts)} efforts: one of each per joint expected")
+        missing = [j for j in self.joints if j not in names]
+        if missing:
+            raise JointReadingError(f"the controller's joints {missing} are missing (got "
+                                    f"{names})")
+        index = [names.index(j) for j in self.joints]
+        p = np.array([positions[i] for i in index], float)
+        e = np.array([efforts[i] for i in index], float)
+        if not (np.all(np.isfinite(p)) and np.all(np.isfinite(e))):
+            raise JointReadingError(f"positions {p.tolist()} or efforts {e.tolist()} are not "
+                                    "finite")
+        return JawReading(float(np.mean([self.gripper.aperture(v) for v in p])),
+                          float(np.mean([self.gripper.jaw_force(v) for v in e])))
 
 
 def _device(spec: ControllerSpec, base: Path) -> GripperSpec:
@@ -99,5 +180,8 @@ def scene_controller(scene: Scene, scene_path: str | Path) -> JawController | No
     if len(joints) != len(gripper.transmission.joints) or len(set(joints)) != len(joints):
         raise SceneError(f"controller.joints must be {len(gripper.transmission.joints)} distinct "
                          f"names (as {gripper.name}'s transmission.joints), got {list(joints)}")
+    if ControllerKind(spec.type).is_action and len(joints) != 1:
+        raise SceneError(f"controller.joints: a {spec.type} controller drives one joint (its "
+                         f"'joint' parameter), {gripper.name}'s transmission has {list(joints)}")
     return JawController(spec, gripper, tuple(joints))
 

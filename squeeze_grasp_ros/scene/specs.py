@@ -364,13 +364,34 @@ class ControllerSpec:
     """
 
     type: ControllerKind = spec("the controller's interface")
-    name: str = spec("the controller's name (its topic is <name>/joint_trajectory)")
+    name: str = spec("the controller's name (its topic is <name>/joint_trajectory, its action "
+                     "<name>/gripper_cmd)")
     device: str = spec("the gripper device: a shipped device name (config/devices) or a "
                        "device file, relative to the scene")
     joints: tuple[str, ...] = spec("the controller's joints (empty: the device's "
                                    "transmission.joints)", default=())
     jaws: tuple[Finger, ...] = spec("the two fingers the jaws carry, F1's jaw first",
                                     default=(Finger.F1, Finger.F2))
+    goal_tolerance: float = spec("gripper_action, parallel_gripper: a goal is reached within "
+                                 "this distance of its joint position", "joint units", lo=0.0,
+                                 default=0.01)
+    stall_velocity_threshold: float = spec("gripper_action, parallel_gripper: slower than this "
+                                           "the joint stands still", "joint units/s", lo=0.0,
+                                           default=0.001)
+    stall_timeout: float = spec("gripper_action, parallel_gripper: standing still this long "
+                                "short of the goal is a stall", "s", lo=0.0, default=1.0)
+    allow_stalling: bool = spec("gripper_action, parallel_gripper: a stall succeeds instead of "
+                                "aborting", default=False)
+    max_effort: float = spec("gripper_action, parallel_gripper: effort limit of a goal without "
+                             "one and of the hold after a cancel (0: the device's max_force "
+                             "through the transmission)", "joint effort", lo=0.0, default=0.0)
+    max_velocity: float = spec("parallel_gripper: speed limit of a goal without one (the "
+                               "GripperActionController has none: its command jumps to the goal)",
+                               "joint units/s", lo=0.0, lo_open=True, default=0.1)
+    effort_margin: float = spec("gripper_action, parallel_gripper: the executor's effort limit "
+                                "is the planned jaw force times this margin (below 1 the jaws "
+                                "stall short of the planned depth)", "", lo=0.0, lo_open=True,
+                                default=1.25)
 
 
 @dataclass(frozen=True)

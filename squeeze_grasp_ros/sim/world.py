@@ -7,7 +7,9 @@ One :meth:`SimWorld.step` is one lockstep tick of ``scene.sim.dt`` seconds:
 1. every device moves its fingertip toward its setpoint (:func:`.devices.follow`);
 2. the per-tick translations of the fingertips in contact go to the incremental stepper
    (:func:`..mechanics.stepper.advance`), which locates the contact events on the way
-   (ground truth);
+   (ground truth); a tick that crosses no event on a linear object with every contact sticking
+   is answered without the stepper's event loop, with the same result
+   (:class:`..mechanics.squeeze.stepper.QuietSteps`);
 3. the declared sensors read the new contact state (:mod:`.sensors`).
 
 Only declared effects are composed (``scene.effects``): ``friction`` sets mu (else 0),
@@ -43,7 +45,7 @@ import numpy as np
 
 from squeeze_grasp_ros.mechanics.resistance.frictional import add_adversary
 from squeeze_grasp_ros.mechanics.squeeze.contact_state import ContactState, Event, initial_state
-from squeeze_grasp_ros.mechanics.squeeze.stepper import advance
+from squeeze_grasp_ros.mechanics.squeeze.stepper import QuietSteps
 from squeeze_grasp_ros.mechanics.squeeze.tip_shapes import TipGeometry
 from squeeze_grasp_ros.mechanics.vocabulary import Effect, Finger, Termination
 from squeeze_grasp_ros.perception.shape_match import deformed_outline
@@ -146,9 +148,13 @@ class SimWorld:
     ----------
     setup : GraspSetup
         A solid-model scene with rounded fingertips, made mechanics (precomputed here).
+    quiet : bool
+        Answer the ticks that cross no event without the stepper's event loop
+        (:class:`~..mechanics.squeeze.stepper.QuietSteps`: the same results); False sends every
+        tick through :func:`~..mechanics.squeeze.stepper.advance` (to compare the two).
     """
 
-    def __init__(self, setup: GraspSetup) -> None:
+    def __init__(self, setup: GraspSetup, *, quiet: bool = True) -> None:
         scene = setup.scene
         self.setup = setup.precompute()
         self.scene = scene
@@ -201,6 +207,8 @@ class SimWorld:
         self.step_cpu_seconds = 0.0
         self.step_size = scene.squeeze.step
         self.event_tol = scene.squeeze.event_tol
+        self.stepper = QuietSteps(self.model, self.step_size, self.event_tol, TERMINATE_ON,
+                                  quiet=quiet)
         self.camera = (SimCamera(scene.camera, scene.object.material.thickness, self.dt)
                        if scene.has(Effect.CAMERA) else None)
 
@@ -255,14 +263,7 @@ class SimWorld:
         if translations and self.termination is None:
             self._work["stepper_calls"] += 1
             started, cpu = time.perf_counter(), time.thread_time()
-            result = advance(
-                self.model,
-                self.state,
-                translations,
-                self.step_size,
-                self.event_tol,
-                terminate_on=TERMINATE_ON,
-            )
+            result = self.stepper.advance(self.state, translations)
             self.stepper_seconds += time.perf_counter() - started
             self.stepper_cpu_seconds += time.thread_time() - cpu
             self.state, events = result.state, result.events

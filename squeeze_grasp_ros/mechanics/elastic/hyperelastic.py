@@ -48,13 +48,15 @@ __all__ = ["Assembly", "InvertedElementError", "MeshGeometry", "area_ratios", "a
 
 _PLANE_STRESS_ITERATIONS = 30
 _SKEW = np.array([[0.0, -1.0], [1.0, 0.0]])
-_PAIRS = np.indices((2, 2, 2, 2)).reshape(4, -1)  # (i, j, k, l) of the 16 entries of ij x kl
-_OUTER = (2 * _PAIRS[0] + _PAIRS[1], 2 * _PAIRS[2] + _PAIRS[3])
-"""Flat (2x2 -> 4) positions of the factors of g_ij g_kl, entry by entry of a 4x4 tangent."""
-_CROSS = (2 * _PAIRS[0] + _PAIRS[3], 2 * _PAIRS[2] + _PAIRS[1])
+_I, _K, _J, _L = np.indices((2, 2, 2, 2)).reshape(4, -1)
+"""(i, k, j, l) of the 16 entries of a tangent dP_ij/dF_kl stored in (ik, jl) order, the order
+the stiffness product of :func:`assemble` reads them in."""
+_OUTER = (2 * _I + _J, 2 * _K + _L)
+"""Flat (2x2 -> 4) positions of the factors of g_ij g_kl, entry by entry of such a tangent."""
+_CROSS = (2 * _I + _L, 2 * _K + _J)
 """The same for G_il G_kj."""
-_TRANSPOSE = np.arange(36).reshape(6, 6).T.ravel()
-"""Entry of a flat 6x6 element matrix that is its transpose's."""
+_IDENTITY = ((_I == _K) & (_J == _L)).astype(float)
+"""delta_ik delta_jl in that order."""
 _FORCE = (np.array([0, 0, 2, 2, 4, 4]), np.array([0, 2, 0, 2, 0, 2]),
           np.array([1, 1, 3, 3, 5, 5]), np.array([1, 3, 1, 3, 1, 3]))
 """Flat positions of g_a0, P_i0, g_a1, P_i1 for the element forces in (a, i) order."""
@@ -245,15 +247,16 @@ def _neo_hookean(F: np.ndarray, nu: float, tangent: bool):
     if not tangent:
         return W, P, None
     # A = mu I + (lam - (lam / l3)^2 / w33) g g^T - a X with X[ij, kl] = G_il G_kj, as (t, 16)
-    # rows built in place (the tangent's arrays are the largest of an assembly)
+    # rows in (ik, jl) order built in place (the tangent's arrays are the largest of an
+    # assembly); returned as the (i, j, k, l) view of them
     A = np.take(g, _OUTER[0], axis=1) * np.take(g, _OUTER[1], axis=1)
     w33 = mu + mu / l3 ** 2 + lam * (1.0 - lnJ) / l3 ** 2
     A *= (lam - (lam / l3) ** 2 / w33)[:, None]
-    A += mu * np.eye(4).ravel()
+    A += mu * _IDENTITY
     cross = np.take(g, _CROSS[0], axis=1) * np.take(g, _CROSS[1], axis=1)
     cross *= a[:, None]
     A -= cross
-    return W, P, A.reshape(-1, 2, 2, 2, 2)
+    return W, P, A.reshape(-1, 2, 2, 2, 2).transpose(0, 1, 3, 2, 4)
 
 
 def thickness_stretch(model: MaterialModel | str, F: np.ndarray, *, nu: float) -> np.ndarray:
@@ -344,42 +347,73 @@ def assemble(model: MaterialModel | str, nodes: np.ndarray, triangles: np.ndarra
         raise InvertedElementError(f"element {worst} inverted (det F = {det[worst]:.3g})",
                                    residuals={"det_F": det[worst]})
     W, P, A = stress_and_tangent(model, F, nu=nu, tangent=tangent)
-    area, G, Gt = geometry.area, geometry.G, geometry.Gt
-    # fe[a, i] = g_a0 P_i0 + g_a1 P_i1 (the product Gt P without its zeros)
-    g, p = geometry.grad.reshape(-1, 6), P.reshape(-1, 4)
-    fe = area[:, None] * (np.take(g, _FORCE[0], axis=1) * np.take(p, _FORCE[1], axis=1)
-                          + np.take(g, _FORCE[2], axis=1) * np.take(p, _FORCE[3], axis=1))
-    n2 = geometry.n2
-    force = np.bincount(geometry.dofs.ravel(), weights=fe.reshape(-1), minlength=n2)
+    # element forces fe[a, i] = area (g_a0 P_i0 + g_a1 P_i1), scattered onto the DOFs
+    g, p = geometry.weighted_grad.reshape(-1, 6), P.reshape(-1, 4)
+    fe = (np.take(g, _FORCE[0], axis=1) * np.take(p, _FORCE[1], axis=1)
+          + np.take(g, _FORCE[2], axis=1) * np.take(p, _FORCE[3], axis=1))
+    force = np.bincount(geometry.dofs, weights=fe.reshape(-1), minlength=geometry.n2)
     K = None
     if tangent:
-        ke = (Gt @ A.reshape(-1, 4, 4) @ G).reshape(-1, 36)
-        ke *= area[:, None]
-        ke = ke + np.take(ke, _TRANSPOSE, axis=1)
-        ke *= 0.5
-        data = np.bincount(geometry.slots, weights=ke.ravel(), minlength=len(geometry.indices))
-        K = sp.csr_matrix((data, geometry.indices, geometry.indptr), shape=(n2, n2))
-    return Assembly(float(np.dot(W, area)), force, K, float(det[worst]), F)
+        K = sp.csr_matrix((_stiffness_data(geometry, A), geometry.indices, geometry.indptr),
+                          shape=(geometry.n2, geometry.n2))
+    return Assembly(float(np.einsum("t,t->", W, geometry.area)), force, K, float(det[worst]), F)
+
+
+def _stiffness_data(geometry: MeshGeometry, A: np.ndarray) -> np.ndarray:
+    """The CSR values (in the pattern of ``geometry``) of the stiffness of the tangents
+    ``A`` = dP/dF (t, 2, 2, 2, 2), symmetrised.
+
+    Element e adds k[(a, i), (b, k)] = area sum_jl g_aj g_bl A_ijkl: one (9 x 4) @ (4 x 4)
+    product per element, of the mesh's area-weighted g_aj g_bl (rows ab, columns jl) and A
+    ordered (ik, jl); its (a, b, i, k) entries go to their CSR positions by one bincount, and
+    the symmetric part is taken once on the assembled values (K_sym = (K + K^T) / 2).
+    """
+    t = len(A)
+    # (i, j, k, l) -> (i, k, j, l): rows ik, columns jl (no copy for a law that stores A so)
+    ordered = np.ascontiguousarray(np.transpose(A, (0, 1, 3, 2, 4))).reshape(t, 4, 4)
+    ke = geometry.weighted_outer @ np.swapaxes(ordered, 1, 2)
+    data = np.bincount(geometry.slots, weights=ke.reshape(-1), minlength=len(geometry.indices))
+    data += data[geometry.transpose]
+    data *= 0.5
+    return data
 
 
 @dataclass(frozen=True)
 class MeshGeometry:
-    """What :func:`assemble` needs of a mesh that does not change with the displacement: the
-    :func:`gradient_operator`, element areas, the reference shape-function gradients ``grad``
-    (t, 3, 2), the (t, 4, 6) map of element DOFs to dF, and the sparsity pattern of the
-    stiffness (CSR ``indices``/``indptr``; ``slots`` places every element entry).
+    """What :func:`assemble` needs of a mesh that does not change with the displacement.
+
+    Attributes
+    ----------
+    gradient : (4t, 2n) scipy.sparse.csr_matrix
+        :func:`gradient_operator` of the mesh.
+    area : (t,) ndarray
+        Element areas.
+    weighted_grad : (t, 3, 2) ndarray
+        area * g_aj: the reference shape-function gradients weighted by the element area.
+    weighted_outer : (t, 9, 4) ndarray
+        area * g_aj g_bl, rows (a, b), columns (j, l).
+    dofs : (6t,) ndarray of int
+        DOF of each element's (a, i), element by element.
+    n2 : int
+        Number of DOFs.
+    slots : (36t,) ndarray of int
+        CSR position of each element entry (a, b, i, k) -> row (a, i), column (b, k).
+    indices, indptr : ndarray of int
+        The CSR pattern of the stiffness (column indices, row pointers; sorted).
+    transpose : (nnz,) ndarray of int
+        CSR position of the transposed entry of each entry.
     """
 
     gradient: sp.csr_matrix
     area: np.ndarray
-    grad: np.ndarray
-    G: np.ndarray
-    Gt: np.ndarray
+    weighted_grad: np.ndarray
+    weighted_outer: np.ndarray
     dofs: np.ndarray
     n2: int
     slots: np.ndarray
     indices: np.ndarray
     indptr: np.ndarray
+    transpose: np.ndarray
 
     def deformation(self, u: np.ndarray) -> np.ndarray:
         """Deformation gradients F = I + grad u (t, 2, 2) of the displacement ``u`` (2n,)."""
@@ -389,21 +423,24 @@ class MeshGeometry:
 def mesh_geometry(nodes: np.ndarray, triangles: np.ndarray) -> MeshGeometry:
     """The displacement-independent part of :func:`assemble` for ``nodes`` (n, 2) and
     ``triangles`` (t, 3); build it once and pass it as ``geometry`` to assemble many states.
+
+    The stiffness pattern and the place of every element entry in it are computed here once
+    per mesh, so that an assembly is a product per element and one scatter.
     """
     nodes = np.asarray(nodes, float)
     triangles = np.asarray(triangles, int)
+    t = len(triangles)
     grad, area = _shape_gradients(nodes, triangles)
-    # dF_ij / du_(a, k) = delta_ik grad_aj, as a (t, 4, 6) matrix on (ij) x (a k)
-    G = np.zeros((len(triangles), 2, 2, 3, 2))
-    for i in range(2):
-        G[:, i, :, :, i] = np.swapaxes(grad, 1, 2)
-    G = G.reshape(len(triangles), 4, 6)
-    dofs = element_dofs(triangles)
+    weighted = area[:, None, None] * grad
+    outer = np.einsum("taj,tbl->tabjl", weighted, grad).reshape(t, 9, 4)
+    dofs = element_dofs(triangles).reshape(t, 3, 2)
     n2 = 2 * len(nodes)
-    rows = np.repeat(dofs, 6, axis=1).ravel()
-    cols = np.tile(dofs, (1, 6)).ravel()
+    # element entry (a, b, i, k): row dof(a, i), column dof(b, k)
+    rows = np.broadcast_to(dofs[:, :, None, :, None], (t, 3, 3, 2, 2)).reshape(-1)
+    cols = np.broadcast_to(dofs[:, None, :, None, :], (t, 3, 3, 2, 2)).reshape(-1)
     keys, slots = np.unique(rows * n2 + cols, return_inverse=True)
-    indptr = np.searchsorted(keys // n2, np.arange(n2 + 1))
-    return MeshGeometry(gradient_operator(nodes, triangles), area, grad, G,
-                        np.ascontiguousarray(np.swapaxes(G, 1, 2)), dofs, n2, slots.ravel(),
-                        keys % n2, indptr)
+    row_of, col_of = keys // n2, keys % n2
+    indptr = np.searchsorted(row_of, np.arange(n2 + 1))
+    transpose = np.searchsorted(keys, col_of * n2 + row_of)  # the pattern is symmetric
+    return MeshGeometry(gradient_operator(nodes, triangles), area, weighted, outer,
+                        dofs.reshape(-1), n2, slots.reshape(-1), col_of, indptr, transpose)

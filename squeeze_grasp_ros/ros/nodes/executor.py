@@ -22,7 +22,10 @@ Stock controller (``controller_scene``: a scene with a ``controller:`` section, 
 the jaws' setpoints become one aperture on the jaw line (fixed by the jaws' measured tips when
 a goal starts) and are sent through the gripper's transmission as ``trajectory_msgs/
 JointTrajectory`` on ``<controller>/joint_trajectory``, one point per control cycle
-(:mod:`.jaw_commands`); the other fingers keep their setpoint topics.
+(:mod:`.jaw_commands`); or, under a gripper action controller, the planned aperture and effort
+are one ``control_msgs`` GripperCommand / ParallelGripperCommand goal on
+``<controller>/gripper_cmd`` whose result ends the grasp goal (:mod:`.jaw_action`). The other
+fingers keep their setpoint topics.
 
 Feedback (every ``feedback_every`` cycles): state, measured depth and forces, events since the
 previous feedback. Cancel: the next cycle holds the measured positions and the goal ends
@@ -43,8 +46,10 @@ from squeeze_grasp_interfaces.action import ExecuteGrasp
 from squeeze_grasp_interfaces.msg import ExecutorStatus, MonitorStatus
 from squeeze_grasp_ros.control.motion import Command, GraspProgram, MotionLimits, goal_problem
 from squeeze_grasp_ros.ros import messages
-from squeeze_grasp_ros.ros.nodes import pipeline, run_node
+from squeeze_grasp_ros.ros.nodes import ParameterError, pipeline, run_node
 from squeeze_grasp_ros.ros.nodes.jaw_commands import JawCommands
+from squeeze_grasp_ros.scene import load_scene
+from squeeze_grasp_ros.scene.controller import JawController, scene_controller
 
 PARAMETERS: dict[str, tuple[Any, str]] = {
     "finger_devices": (["F1:barrett_f1", "F2:barrett_f3"], "finger:device of every fingertip"),
@@ -93,7 +98,8 @@ class ExecutorNode(Node):
     def ready_summary(self) -> str:
         """What the ready line of ``ros2 run`` says: devices, clock and limits."""
         clock = "lockstep on /clock" if self.p["lockstep"] else "wall-clock timer"
-        jaws = f"jaws {list(self.jaws.fingers)} on {self.jaws.topic}, " if self.jaws else ""
+        driver = self.jaws or self.jaw_action
+        jaws = f"jaws {list(driver.fingers)} on {driver.topic}, " if driver else ""
         return (f"fingers {self.devices}, {jaws}{clock}, "
                 f"period {self.p['period']} s, max velocity {self.p['max_velocity']} m/s; "
                 f"action {self.resolve_topic_name(pipeline.ACTION)}")
@@ -107,13 +113,20 @@ class ExecutorNode(Node):
                                    float(p["stale_budget"]))
         self.period_ns = int(round(p["period"] * 1e9))
         loop = pipeline.loop_qos(p["qos_depth"])
-        self.jaws = JawCommands.of(self, p["controller_scene"], p["period"], loop)
+        controller = scene_controller(load_scene(p["controller_scene"]), p["controller_scene"]) \
+            if p["controller_scene"] else None
+        action = controller is not None and controller.kind.is_action
+        self.jaws = JawCommands(self, controller, p["period"], loop) \
+            if controller is not None and not action else None
+        self.jaw_action = jaw_action(self, controller, loop) if action else None
+        """The scene's gripper under a JointTrajectoryController (jaws) or a gripper action
+        controller (jaw_action), if any."""
+        jaw_fingers = controller.jaws if controller is not None else ()
         self.setpoint_pubs = {f: self.create_publisher(PoseStamped,
                                                        pipeline.device_topic(d, "setpoint"),
                                                        pipeline.loop_qos(p["qos_depth"],
                                                                          kept=True))
-                              for f, d in self.devices.items()
-                              if self.jaws is None or f not in self.jaws.fingers}
+                              for f, d in self.devices.items() if f not in jaw_fingers}
         self.status_pub = self.create_publisher(ExecutorStatus, pipeline.EXECUTOR_STATUS, loop)
         pose_pub = self.create_publisher(PoseStamped, pipeline.OBJECT_POSE, pipeline.LATCHED)
         pose_pub.publish(messages.pose_in_base(p["object_pose"], p["base_frame"]))
@@ -130,7 +143,11 @@ class ExecutorNode(Node):
         if p["lockstep"]:
             self.participant = pipeline.Participant(self, "executor", [pipeline.STATUS],
                                                     list(self.setpoint_pubs.values())
-                                                    + ([self.jaws.publisher] if self.jaws else []))
+                                                    + ([self.jaws.publisher] if self.jaws else [])
+                                                    + ([self.jaw_action.publisher]
+                                                       if self.jaw_action else []),
+                                                    condition=self.jaw_action.ready
+                                                    if self.jaw_action else None)
         else:
             self.create_timer(p["period"], self._timer)
 
@@ -192,6 +209,9 @@ class ExecutorNode(Node):
         if goal.handle.is_cancel_requested:
             goal.program.cancel()
         command = goal.program.step(obs, self.p["period"])
+        if self.jaw_action is not None:
+            self._action_cycle(goal, command, obs, ns, now_ns)
+            return
         stamp = ns + self.period_ns if now_ns is None else now_ns
         batch = [(self.setpoint_pubs[f], messages.fill_pose(self.setpoints[f], xy, stamp))
                  for f, xy in command.setpoints.items() if f in self.setpoint_pubs]
@@ -203,6 +223,46 @@ class ExecutorNode(Node):
             self.goal = None
             goal.done.set_result(messages.grasp_result(
                 goal.program, command, obs, goal.events, (ns - goal.start_ns) * 1e-9, SUCCESS))
+
+    def _action_cycle(self, goal: _Goal, command: Command, obs, ns: int,
+                      now_ns: int | None) -> None:
+        """A cycle of the action route (:mod:`.jaw_action`): the jaws' goal at the first cycle,
+        a cancel on the program's reactions, the end on the gripper goal's result; the other
+        fingers' setpoints as usual. In lockstep the tick is answered once the request is.
+        """
+        action = self.jaw_action
+        stamp = ns + self.period_ns if now_ns is None else now_ns
+        batch = [(self.setpoint_pubs[f], messages.fill_pose(self.setpoints[f], xy, stamp))
+                 for f, xy in command.setpoints.items() if f in self.setpoint_pubs]
+        batch.append(action.cycle_msg(ns))
+        self.answered.answer(ns, [])
+
+        def answer() -> None:
+            if self.answered.stamp_ns == ns:
+                self.answered.answer(ns, batch)
+
+        end = None
+        if command.termination not in (None, ExecuteGrasp.Result.DEPTH_REACHED):
+            end = (command.termination, command.termination in SUCCESS, command.message)
+            waiting = action.cancel(answer)
+        elif goal.program.ticks == 1:
+            position, effort = action.target(goal.program.goal, obs)
+            action.send(position, effort, answer)
+            waiting = True
+        else:
+            end, waiting = action.outcome, False
+        if not waiting:
+            answer()
+        termination = None if end is None else end[0]
+        report = Command(command.setpoints, "holding" if end else "squeezing", termination,
+                         "" if end is None else end[2])
+        self._report(report, obs, ns)
+        if end is not None:
+            self.goal = None
+            result = messages.grasp_result(goal.program, report, obs, goal.events,
+                                           (ns - goal.start_ns) * 1e-9, SUCCESS)
+            result.success = bool(end[1])
+            goal.done.set_result(result)
 
     def _report(self, command: Command, obs, ns: int) -> None:
         """Executor status on state changes; action feedback every ``feedback_every`` cycles."""
@@ -222,6 +282,23 @@ class ExecutorNode(Node):
                 command.state, obs, program.fingers, goal.since_feedback,
                 program.goal.relative_per_depth))
             goal.since_feedback = []
+
+
+def jaw_action(node: Node, controller: JawController, qos: Any) -> Any:
+    """The executor's side of a gripper action controller (:class:`.jaw_action.JawAction`).
+
+    Raises
+    ------
+    ParameterError
+        Without control_msgs in the environment.
+    """
+    try:
+        from squeeze_grasp_ros.ros.nodes.jaw_action import JawAction
+    except ImportError as exc:
+        raise ParameterError(f"controller.type {controller.kind} needs control_msgs ({exc}): "
+                             "build it with squeeze-grasp ros-setup --control-msgs DIR "
+                             "(docs/grippers.md)") from None
+    return JawAction(node, controller, qos)
 
 
 def main(args: list[str] | None = None) -> int:

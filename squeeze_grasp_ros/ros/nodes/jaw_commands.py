@@ -25,8 +25,7 @@ from trajectory_msgs.msg import JointTrajectory, JointTrajectoryPoint
 from squeeze_grasp_ros.control.joint_trajectory import JawLine
 from squeeze_grasp_ros.control.motion import Observation
 from squeeze_grasp_ros.ros import messages
-from squeeze_grasp_ros.scene import load_scene
-from squeeze_grasp_ros.scene.controller import JawController, scene_controller
+from squeeze_grasp_ros.scene.controller import JawController
 
 
 class JawCommands:
@@ -51,14 +50,6 @@ class JawCommands:
             JointTrajectoryPoint(time_from_start=Duration(sec=self.period_ns // 1_000_000_000,
                                                           nanosec=self.period_ns % 1_000_000_000))
         ])
-
-    @classmethod
-    def of(cls, node: Node, scene_path: str, period: float, qos: Any) -> JawCommands | None:
-        """The commands of the ``controller:`` section of scene ``scene_path`` ("": None)."""
-        if not scene_path:
-            return None
-        controller = scene_controller(load_scene(scene_path), scene_path)
-        return None if controller is None else cls(node, controller, period, qos)
 
     @property
     def fingers(self) -> tuple[str, str]:

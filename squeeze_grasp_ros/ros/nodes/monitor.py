@@ -22,6 +22,15 @@ boundary (:mod:`.shape_watcher`): ``monitor/shape_residual`` and the ``shape_mis
 With ``force_watch`` (on by default) the measured finger forces are compared with the
 prediction's force curve (:mod:`.force_watcher`): ``monitor/force_residual`` and the
 ``force_mismatch`` alarm (a wrong E: the shape cannot show it, the forces do).
+
+Joint feedback (``controller_scene``: a scene whose ``controller:`` section maps the jaws to a
+parallel gripper, and no ``wrench`` or ``tactile`` stream): the jaws' only sensor is the
+controller's ``joint_states`` (``sensor_msgs/JointState``, listed in each tick's readings). The
+aperture and jaw force come through the transmission (:mod:`..control.joint_feedback`): the
+jaws' positions on the jaw line (fixed by their first pose readings, the gripper's pose) give
+the depth, the force ``wrench`` stands in for, first touch, ``contact_lost`` and the slip watch's
+``slip_imminent`` (the jaws close while the force stops rising); events A-D need taxels, so
+none are tracked and the prediction's events are not compared (the force watch is).
 """
 from __future__ import annotations
 
@@ -29,8 +38,10 @@ import dataclasses
 import sys
 from typing import Any
 
+import numpy as np
 from geometry_msgs.msg import PoseStamped, WrenchStamped
 from rclpy.node import Node
+from sensor_msgs.msg import JointState
 
 from squeeze_grasp_interfaces.msg import (
     Alarm,
@@ -40,17 +51,23 @@ from squeeze_grasp_interfaces.msg import (
     TactileArray,
     Tick,
 )
+from squeeze_grasp_ros.control.joint_feedback import JointSlipWatch
+from squeeze_grasp_ros.control.joint_trajectory import JawLine
 from squeeze_grasp_ros.control.tracker import ContactTracker, FingerSample, TrackerConfig
 from squeeze_grasp_ros.ros import messages
 from squeeze_grasp_ros.ros.nodes import pipeline, run_node
 from squeeze_grasp_ros.ros.nodes.force_watcher import ForceWatcher
 from squeeze_grasp_ros.ros.nodes.shape_watcher import ShapeWatcher
+from squeeze_grasp_ros.ros.nodes.sim_controllers import JOINT_STATES
+from squeeze_grasp_ros.scene import load_scene
+from squeeze_grasp_ros.scene.controller import JawController, JointReadingError, scene_controller
 
 PARAMETERS: dict[str, tuple[Any, str]] = {
     "finger_devices": (["F1:barrett_f1", "F2:barrett_f3"], "finger:device of every fingertip"),
     "streams": (["wrench", "tactile"], "sensor streams each finger has (staleness test)"),
     "mu": (0.4, "friction coefficient of the fingertips"),
-    "load_threshold": (0.002, "a taxel is loaded above this normal force, N"),
+    "load_threshold": (0.002, "a taxel (joint feedback: a jaw) is loaded above this normal "
+                              "force, N"),
     "edge_tolerance": (1e-4, "a patch slides at cone usage >= 1 - edge_tolerance"),
     "alarm_ratio": (0.9, "cone usage of every loaded taxel that raises slip_imminent"),
     "match_margin": (0, "taxels by which patch ranges are widened to connect them over ticks"),
@@ -69,6 +86,12 @@ PARAMETERS: dict[str, tuple[Any, str]] = {
     "force_watch": (True, "compare finger forces with the prediction's force curve"),
     "force_tolerance": (0.1, "relative force error that raises force_mismatch"),
     "force_min_fraction": (0.01, "force watch: fraction of the predicted depth not judged"),
+    "controller_scene": ("", "scene file whose controller: section's jaws report on "
+                             "joint_states (used without wrench and tactile streams)"),
+    "joint_slip_window": (1e-4, "joint feedback: closing over which the jaw stiffness is "
+                                "measured, m"),
+    "joint_slip_ratio": (0.5, "joint feedback: tangent / secant jaw stiffness below which "
+                              "slip_imminent is raised"),
 }
 """Parameter name -> (typed default, description); config/monitor.yaml sets them."""
 
@@ -80,11 +103,14 @@ class MonitorNode(Node):
         super().__init__("monitor", **kwargs)
         self.p = p = pipeline.declare(self, PARAMETERS)
         self.fingers = pipeline.parse_mapping(p["finger_devices"], "finger_devices")
+        streams = [s for s in p["streams"] if s]
+        self.jaws = JointFeedback.of(p, streams)
+        """The jaws on joint feedback (None: the sensors' route)."""
         self.tracker = ContactTracker(TrackerConfig(
             p["mu"], p["load_threshold"], p["edge_tolerance"], p["alarm_ratio"],
             p["match_margin"], p["stale_after"], p["weight"] or None,
             p["prediction_tolerance"], p["relative_per_depth"]), list(self.fingers),
-            [s for s in p["streams"] if s])
+            streams if self.jaws is None else ["wrench"])
         loop = pipeline.loop_qos(p["qos_depth"])
         sensors = pipeline.sensor_qos(p["sensor_qos"], p["qos_depth"])
         types = {"pose": PoseStamped, "wrench": WrenchStamped, "tactile": TactileArray}
@@ -95,6 +121,10 @@ class MonitorNode(Node):
                 self.keys[key] = (finger, stream)
                 self.create_subscription(msg_type, pipeline.device_topic(device, stream),
                                          lambda msg, k=key: self._reading(k, msg), sensors)
+        if self.jaws is not None:
+            self.keys[JOINT_STATES] = ("", JOINT_STATES)
+            self.create_subscription(JointState, JOINT_STATES,
+                                     lambda msg: self._reading(JOINT_STATES, msg), sensors)
         self.create_subscription(ContactEventArray, pipeline.PREDICTION, self._prediction,
                                  pipeline.LATCHED)
         self.event_pub = self.create_publisher(ContactEventArray, pipeline.EVENTS, loop)
@@ -123,11 +153,13 @@ class MonitorNode(Node):
     def ready_summary(self) -> str:
         """What the ready line of ``ros2 run`` says: fingers, streams, friction, clock."""
         clock = "lockstep" if self.p["lockstep"] else f"rate {self.p['rate']} Hz"
-        return (f"fingers {self.fingers}, streams {[s for s in self.p['streams'] if s]}, "
-                f"mu {self.p['mu']}, {clock}")
+        streams = [s for s in self.p["streams"] if s] if self.jaws is None else [
+            f"{JOINT_STATES} of {self.jaws.controller.spec.name}"]
+        return f"fingers {self.fingers}, streams {streams}, mu {self.p['mu']}, {clock}"
 
     def _prediction(self, msg: ContactEventArray) -> None:
-        self.tracker.set_prediction(messages.predicted_events(msg))
+        if self.jaws is None:
+            self.tracker.set_prediction(messages.predicted_events(msg))
         if self.forces is not None:
             self.forces.set_prediction(msg)
 
@@ -145,7 +177,7 @@ class MonitorNode(Node):
         ns = messages.stamp_ns(msg.header.stamp)
         if not self.answered.is_new(ns):
             return
-        self.expected[ns] = set(msg.readings)
+        self.expected[ns] = set(msg.readings) & self.keys.keys()
         self._try_close(ns)
 
     def _try_close(self, ns: int) -> None:
@@ -168,17 +200,23 @@ class MonitorNode(Node):
             ns = messages.stamp_ns(msg.header.stamp)
             if stream == "pose":
                 fields[finger]["position"] = messages.pose_position(msg)
+            elif stream == JOINT_STATES:
+                continue
             elif stream == "wrench":
                 fields[finger].update(force=messages.wrench_force(msg), force_stamp_ns=ns)
             else:
                 taxels = messages.tactile_readings(msg)
                 fields[finger].update(angles=taxels.angles, normal=taxels.normal,
                                       tangential=taxels.tangential, tactile_stamp_ns=ns)
+        if self.jaws is not None:
+            self.jaws.replace(fields, self.latest.get(JOINT_STATES), self.get_logger())
         return {f: FingerSample(**v) for f, v in fields.items()}
 
     def _process(self, ns: int) -> None:
         samples = self._samples()
         out = self.tracker.update(ns, samples)
+        if self.jaws is not None:
+            out = dataclasses.replace(out, alarms=out.alarms + self.jaws.alarms)
         frame = self.p["frame_id"]
         batch = [(self.event_pub, messages.tracked_events_msg(out))] if out.events else []
         if self.forces is not None:
@@ -195,6 +233,71 @@ class MonitorNode(Node):
         self.answered.answer(ns, [(self.status_pub, messages.monitor_status_msg(out, frame))])
         if self.shapes is not None:
             self.shapes.tick(ns, out.depth)
+
+
+class JointFeedback:
+    """The jaws' readings from ``joint_states`` in place of their wrench and pose.
+
+    Parameters
+    ----------
+    controller : JawController
+    watch : JointSlipWatch
+    """
+
+    def __init__(self, controller: JawController, watch: JointSlipWatch) -> None:
+        self.controller, self.watch = controller, watch
+        self.line: JawLine | None = None
+        self.stamp_ns: int | None = None
+        self.alarms: tuple = ()
+        """The slip watch's alarms of the newest joint state."""
+
+    @classmethod
+    def of(cls, p: dict[str, Any], streams: list[str]) -> JointFeedback | None:
+        """The jaws' joint feedback of the monitor's parameters ``p``: None without a
+        ``controller_scene`` whose scene has a controller, or with a wrench or tactile stream.
+        """
+        if not p["controller_scene"] or {"wrench", "tactile"} & set(streams):
+            return None
+        controller = scene_controller(load_scene(p["controller_scene"]), p["controller_scene"])
+        if controller is None:
+            return None
+        return cls(controller, JointSlipWatch(
+            controller.jaws, contact_force=p["load_threshold"], window=p["joint_slip_window"],
+            ratio=p["joint_slip_ratio"]))
+
+    def replace(self, fields: dict[str, dict[str, Any]], msg: JointState | None,
+                logger: Any) -> None:
+        """Put the jaws' position and force of joint state ``msg`` into the tracker's sample
+        ``fields`` (finger -> FingerSample keywords); run the slip watch on a new state.
+        """
+        first, second = self.controller.jaws
+        if self.line is None:
+            if msg is None or any("position" not in fields[j] for j in (first, second)):
+                return
+            self.line = JawLine.between(fields[first]["position"], fields[second]["position"],
+                                        reach=self.controller.gripper.pad.contact_radius)
+        ns = messages.stamp_ns(msg.header.stamp)
+        try:
+            reading = self.controller.reading(msg.name, msg.position, msg.effort)
+        except JointReadingError as exc:
+            if ns != self.stamp_ns:
+                logger.warning(f"ignored the joint state of {ns * 1e-9:.3f} s: {exc}")
+                self.stamp_ns = ns
+            return
+        if ns != self.stamp_ns:
+            self.stamp_ns = ns
+            touched = self.watch.first_touch
+            self.alarms = self.watch.update(reading.aperture, reading.force)
+            if touched is None and self.watch.first_touch is not None:
+                logger.info(f"first touch of the jaws at aperture "
+                            f"{self.watch.first_touch * 1e3:.4f} mm (jaw force "
+                            f"{reading.force:.4g} N at {reading.aperture * 1e3:.4f} mm)")
+        push = reading.force * self.line.direction
+        for jaw, position, sign in zip((first, second), self.line.positions(reading.aperture),
+                                       (1.0, -1.0)):
+            # the wrench of the object on the jaw: minus the jaw's push on the object
+            fields[jaw].update(position=position, force=np.append(-sign * push, 0.0),
+                               force_stamp_ns=ns)
 
 
 def main(args: list[str] | None = None) -> int:

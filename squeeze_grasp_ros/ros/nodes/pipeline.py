@@ -52,6 +52,9 @@ EVENTS = "monitor/events"
 ALARMS = "monitor/alarms"
 PREDICTION = "planner/predicted_events"
 EXECUTOR_STATUS = "executor/status"
+EXECUTOR_CYCLE = "executor/cycle"
+"""std_msgs/Header stamped with each tick the executor has answered, once its requests to a
+gripper action controller for that tick were acknowledged (the lockstep of the action route)."""
 OBJECT_POSE = "object_pose"
 ACTION = "executor/execute_grasp"
 CAMERA_MASK = "camera/mask"
@@ -278,20 +281,25 @@ class Participant:
         Topics this node needs publishers on before it is ready.
     outputs : sequence of Publisher
         Publishers that need a subscriber before it is ready.
+    condition : callable, optional
+        A further condition of readiness.
     """
 
-    def __init__(self, node: Node, name: str, inputs: Sequence[str], outputs: Sequence) -> None:
+    def __init__(self, node: Node, name: str, inputs: Sequence[str], outputs: Sequence, *,
+                 condition: Callable[[], bool] | None = None) -> None:
         self.node = node
         self.name = name
         self.inputs = list(inputs)
         self.outputs = list(outputs)
+        self.condition = condition
         self._ready = node.create_publisher(String, READY, loop_qos(10))
         node.create_subscription(String, HELLO, self._hello, loop_qos(10))
 
     def ready(self) -> bool:
         """True when every input has a publisher and every output a subscriber."""
         return (all(self.node.count_publishers(t) > 0 for t in self.inputs)
-                and all(p.get_subscription_count() > 0 for p in self.outputs))
+                and all(p.get_subscription_count() > 0 for p in self.outputs)
+                and (self.condition is None or self.condition()))
 
     def _hello(self, _: String) -> None:
         if self.ready():

@@ -97,12 +97,14 @@ class RecorderNode(Node):
         self.sources = {name: name.lstrip("/") for name in topics}
         """Recorded name -> the name subscribed to: the pipeline's topics relative to the
         node's namespace (a run in a namespace records '/sim/tick' from '<ns>/sim/tick'),
-        extra topics as given."""
+        extra topics as given, a relative one recorded as the pipeline's are ('joint_states'
+        as '/joint_states', the name a viewer's layout uses)."""
         for entry in p["extra_topics"]:
             if entry.strip():
                 name, type_name = entry.split()
-                topics[name] = type_name
-                self.sources[name] = name
+                recorded = name if name.startswith("/") else "/" + name
+                topics[recorded] = type_name
+                self.sources[recorded] = name
         self.types = topics
         self.stamped = {name: starts_with_stamp(t) for name, t in topics.items()}
         self.unique = {name for name, stamped in self.stamped.items()

@@ -8,8 +8,9 @@ gripper (``controller: {type: joint_trajectory, ...}``) and for its joint_state_
 - it subscribes ``<controller>/joint_trajectory`` (``trajectory_msgs/JointTrajectory``) and
   follows the accepted trajectory in sim time (:class:`..control.joint_trajectory.
   TrajectoryFollower`: position interface, linear interpolation); each tick, the commanded
-  aperture becomes the jaws' tip setpoints on the jaw line, which the world's devices follow as
-  any setpoint (speed limit, actuator lag);
+  aperture, saturated by the joint limits (the opening range, and the device file's
+  ``max_speed`` of the aperture), becomes the jaws' tip setpoints on the jaw line, which the
+  world's devices follow as any setpoint (their own speed limit, actuator lag);
 - a refused trajectory (joint names other than the controller's, sizes that do not match,
   non-finite positions, an aperture beyond the opening range, points all in the past) is
   logged as one warning line and not followed: the active trajectory stays (before tick 0 the
@@ -44,8 +45,9 @@ JOINT_STATES = "joint_states"
 """The joint_state_broadcaster's topic (relative)."""
 
 
-class SimJointTrajectoryController:
-    """A simulated JointTrajectoryController and joint_state_broadcaster on ``node``.
+class SimJaws:
+    """What every simulated controller of a parallel gripper shares: the jaw line (fixed by the
+    jaws' initial tips) and the joint_state_broadcaster.
 
     Parameters
     ----------
@@ -55,7 +57,78 @@ class SimJointTrajectoryController:
     controller : JawController
         The scene's resolved ``controller:`` section.
     qos : QoSProfile
-        Of the trajectory subscription and the joint states.
+        Of the joint states (and the controller's own topics).
+    """
+
+    def __init__(self, node: Node, world: SimWorld, controller: JawController, qos: Any) -> None:
+        self.node, self.world, self.controller = node, world, controller
+        first, second = controller.jaws
+        self.line = JawLine.between(world.positions[first], world.positions[second],
+                                    reach=controller.gripper.pad.contact_radius)
+        self.aperture = self.line.aperture(world.positions[first], world.positions[second])
+        """The measured aperture of the last tick, m."""
+        self.limited = (0, self.aperture)
+        """(sim time ns, aperture m) of the last command after the joint limits."""
+        self.topic = node.resolve_topic_name(controller.topic)
+        self.refusals: list[str] = []
+        """Why each refused command was refused, in order."""
+        self.state_pub = node.create_publisher(JointState, JOINT_STATES, qos)
+        self.state_msg = JointState(name=list(controller.joints))
+
+    @property
+    def fingers(self) -> tuple[str, str]:
+        """The fingers whose setpoints this controller gives."""
+        return self.controller.jaws
+
+    def limit(self, t_ns: int, aperture: float) -> float:
+        """``aperture`` (m) commanded for sim time ``t_ns``, saturated by the joint limits as
+        ros2_control's limit enforcement does to a position command: within the opening range,
+        and moving at most ``max_speed`` (the device file's aperture speed) times the time since
+        the last command.
+        """
+        gripper = self.controller.gripper
+        reach = gripper.max_speed * max(t_ns - self.limited[0], 0) * 1e-9
+        aperture = float(np.clip(aperture, self.limited[1] - reach, self.limited[1] + reach))
+        aperture = float(np.clip(aperture, gripper.opening.min, gripper.opening.max))
+        self.limited = (t_ns, aperture)
+        return aperture
+
+    def jaw_setpoints(self, aperture: float) -> dict[str, np.ndarray]:
+        """The jaws' tip setpoints (m) at ``aperture`` (m) on the jaw line."""
+        return dict(zip(self.fingers, self.line.positions(aperture)))
+
+    def measure(self, out: TickOutput) -> tuple[float, float]:
+        """(aperture m, jaw force N) of tick ``out``: the measured aperture, and the mean of the
+        two jaws' ground-truth forces along the closing line.
+        """
+        first, second = self.fingers
+        positions = {r.finger: r.position for r in out.readings}
+        aperture = self.line.aperture(positions[first], positions[second])
+        u = self.line.direction
+        force = 0.5 * (float(np.dot(out.state.finger_force(first)[:2], u))
+                       - float(np.dot(out.state.finger_force(second)[:2], u)))
+        return aperture, force
+
+    def joint_state(self, out: TickOutput) -> tuple[Any, JointState]:
+        """(publisher, message) of the joint states of tick ``out``: each joint's position at the
+        measured aperture and its effort for the jaw force, through the transmission.
+        """
+        aperture, force = self.measure(out)
+        self.aperture = aperture
+        msg = self.state_msg
+        messages.set_stamp(msg.header.stamp, out.stamp_ns)
+        msg.position = [float(p) for p in self.controller.joint_positions(aperture)]
+        msg.effort = [float(e) for e in self.controller.joint_efforts(force)]
+        return self.state_pub, msg
+
+
+class SimJointTrajectoryController(SimJaws):
+    """A simulated JointTrajectoryController and joint_state_broadcaster on ``node``.
+
+    Parameters
+    ----------
+    node, world, controller, qos
+        As :class:`SimJaws` (``qos`` also of the trajectory subscription).
     now_ns : callable
         The current sim time, ns (the last published tick).
     on_command : callable
@@ -64,27 +137,12 @@ class SimJointTrajectoryController:
 
     def __init__(self, node: Node, world: SimWorld, controller: JawController, qos: Any, *,
                  now_ns: Callable[[], int], on_command: Callable[[], None]) -> None:
-        self.node, self.world, self.controller = node, world, controller
+        super().__init__(node, world, controller, qos)
         self.now_ns, self.on_command = now_ns, on_command
-        first, second = controller.jaws
-        self.line = JawLine.between(world.positions[first], world.positions[second],
-                                    reach=controller.gripper.pad.contact_radius)
         opening = controller.gripper.opening
-        self.follower = TrajectoryFollower(
-            self.line.aperture(world.positions[first], world.positions[second]),
-            opening=(opening.min, opening.max))
+        self.follower = TrajectoryFollower(self.aperture, opening=(opening.min, opening.max))
         self.commanded = False
-        self.refusals: list[str] = []
-        """Why each refused trajectory was refused, in order."""
-        self.topic = node.resolve_topic_name(controller.topic)
         node.create_subscription(JointTrajectory, controller.topic, self._trajectory, qos)
-        self.state_pub = node.create_publisher(JointState, JOINT_STATES, qos)
-        self.state_msg = JointState(name=list(controller.joints))
-
-    @property
-    def fingers(self) -> tuple[str, str]:
-        """The fingers whose setpoints this controller gives."""
-        return self.controller.jaws
 
     def _trajectory(self, msg: JointTrajectory) -> None:
         now = self.now_ns()
@@ -118,21 +176,8 @@ class SimJointTrajectoryController:
         return [names.index(j) for j in joints]
 
     def setpoints(self, t_ns: int) -> dict[str, np.ndarray]:
-        """The jaws' tip setpoints (m) at sim time ``t_ns``; the command is consumed."""
+        """The jaws' tip setpoints (m) at sim time ``t_ns``, within the joint limits
+        (:meth:`SimJaws.limit`); the command is consumed.
+        """
         self.commanded = False
-        first, second = self.line.positions(self.follower.sample(t_ns))
-        return dict(zip(self.fingers, (first, second)))
-
-    def joint_state(self, out: TickOutput) -> tuple[Any, JointState]:
-        """(publisher, message) of the joint states of tick ``out``."""
-        first, second = self.fingers
-        positions = {r.finger: r.position for r in out.readings}
-        aperture = self.line.aperture(positions[first], positions[second])
-        u = self.line.direction
-        force = 0.5 * (float(np.dot(out.state.finger_force(first)[:2], u))
-                       - float(np.dot(out.state.finger_force(second)[:2], u)))
-        msg = self.state_msg
-        messages.set_stamp(msg.header.stamp, out.stamp_ns)
-        msg.position = [float(p) for p in self.controller.joint_positions(aperture)]
-        msg.effort = [float(e) for e in self.controller.joint_efforts(force)]
-        return self.state_pub, msg
+        return self.jaw_setpoints(self.limit(t_ns, self.follower.sample(t_ns)))

@@ -10,8 +10,9 @@ advances it in lockstep (docs/design.md §4), driven by messages, never by timer
 2. a tick k is ``/clock`` = t_k, every device's ``pose``, ``wrench`` and ``tactile`` reading
    stamped t_k (a reading dropped by the sensor_dropout effect is skipped), the ground-truth
    events of the tick as one ``sim/events`` array (with the termination reason at the tick the
-   world ends), the ground-truth state (``sim/state``), markers at ``display_rate``, and last
-   ``sim/tick`` listing the readings it published;
+   world ends), a simulated controller's ``joint_states``, the ground-truth state
+   (``sim/state``), markers at ``display_rate``, and last ``sim/tick`` listing the readings it
+   published (``joint_states`` among them);
 3. when every device's setpoint stamped after t_k has arrived (and the recorder is no more than
    ``recorder_window`` ticks behind), the world steps (:class:`..sim.world.SimWorld`) and
    tick k+1 follows.
@@ -35,13 +36,16 @@ from std_msgs.msg import Header
 from visualization_msgs.msg import MarkerArray
 
 from squeeze_grasp_interfaces.msg import ContactEventArray, SimState, TactileArray, Tick
-from squeeze_grasp_ros.mechanics.vocabulary import Effect, ImageEncoding
+from squeeze_grasp_ros.mechanics.vocabulary import ControllerKind, Effect, ImageEncoding
 from squeeze_grasp_ros.ros import messages
 from squeeze_grasp_ros.ros.messages.images import camera_info_msg, image_msg, pose_of_camera
 from squeeze_grasp_ros.ros.nodes import ParameterError, pipeline, run_node
-from squeeze_grasp_ros.ros.nodes.sim_controllers import SimJointTrajectoryController
+from squeeze_grasp_ros.ros.nodes.sim_controllers import (
+    JOINT_STATES,
+    SimJointTrajectoryController,
+)
 from squeeze_grasp_ros.scene import GraspSetup, load_scene
-from squeeze_grasp_ros.scene.controller import scene_controller
+from squeeze_grasp_ros.scene.controller import JawController, scene_controller
 from squeeze_grasp_ros.sim.camera import CameraFrame
 from squeeze_grasp_ros.sim.world import SimWorld, TickOutput
 
@@ -111,7 +115,7 @@ class SimHardwareNode(Node):
             self.create_subscription(PoseStamped, pipeline.device_topic(device, "setpoint"),
                                      lambda msg, f=finger: self._setpoint(f, msg), loop)
         jaws = scene_controller(world.scene, self.p["scene"] or ".")
-        self.controller = None if jaws is None else SimJointTrajectoryController(
+        self.controller = None if jaws is None else sim_controller(jaws)(
             self, world, jaws, loop, now_ns=lambda: self.now_ns, on_command=self._try_step)
         """The simulated stock controller of the scene's gripper (sim_controllers), if any."""
         self.commanded = set(self.devices) - set(jaws.jaws if jaws else ())
@@ -136,8 +140,8 @@ class SimHardwareNode(Node):
         whom.
         """
         jaws = "" if self.controller is None else (
-            f", jaws {list(self.controller.fingers)} by a simulated JointTrajectoryController on "
-            f"{self.controller.topic}")
+            f", jaws {list(self.controller.fingers)} by a simulated "
+            f"{CONTROLLER_NAMES[self.controller.controller.kind]} on {self.controller.topic}")
         return (f"scene {self.world.scene.name}, fingers {self.devices}{jaws}, "
                 f"dt {self.world.dt} s; waiting for {list(self.p['participants'])}")
 
@@ -211,6 +215,7 @@ class SimHardwareNode(Node):
                 out.events, out.termination if ending else "", out.state, ns)))
         if self.controller is not None:
             batch.append(self.controller.joint_state(out))
+            readings.append(JOINT_STATES)
         batch.append((self.state_pub, messages.sim_state_msg(out.state, self.world.fingers,
                                                              out.termination, ns, frame)))
         if out.index == 0:
@@ -240,6 +245,31 @@ class SimHardwareNode(Node):
             self.last_progress = time.monotonic()
             for publisher, msg in self.current:
                 publisher.publish(msg)
+
+
+CONTROLLER_NAMES = {ControllerKind.JOINT_TRAJECTORY: "JointTrajectoryController",
+                    ControllerKind.GRIPPER_ACTION: "GripperActionController",
+                    ControllerKind.PARALLEL_GRIPPER: "ParallelGripperController"}
+"""The stock controller each ``controller.type`` stands for."""
+
+
+def sim_controller(jaws: JawController) -> type:
+    """The simulated controller class of a scene's ``controller:`` section.
+
+    Raises
+    ------
+    ParameterError
+        A gripper action controller without control_msgs in the environment.
+    """
+    if not jaws.kind.is_action:
+        return SimJointTrajectoryController
+    try:
+        from squeeze_grasp_ros.ros.nodes.sim_gripper_action import SimGripperActionController
+    except ImportError as exc:
+        raise ParameterError(f"controller.type {jaws.kind} needs control_msgs ({exc}): build it "
+                             "with squeeze-grasp ros-setup --control-msgs DIR (docs/grippers.md)"
+                             ) from None
+    return SimGripperActionController
 
 
 def camera_publishers(node: Node) -> dict[str, Any]:

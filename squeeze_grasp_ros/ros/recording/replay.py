@@ -2,15 +2,16 @@
 # SPDX-License-Identifier: Apache-2.0
 """Replay a recording's sensor topics into a fresh monitor, in lockstep on the recorded sim time.
 
-The recording's readings (``devices/<device>/{pose,wrench,tactile}``, any writer: ours, ``ros2
-bag record``, rosbags; MCAP or SQLite3) are grouped into ticks: by the recorded ``sim/tick``
-messages when there are any (the exact readings of each tick), else by stamp. For each tick the
-replayer publishes ``/clock``, the readings' recorded bytes unchanged and a ``sim/tick`` listing
-them, and waits for the monitor's status of that tick before the next, so a run of the monitor
-sees exactly what it saw live. The monitor's parameters come from the recording's
-``custom_data`` (``monitor_parameters``, written by ``squeeze-grasp run``), else from
-``config/monitor.yaml`` with the finger-device mapping read from the tactile arrays, plus
-``overrides``. The replayed events are compared with the recorded ``monitor/events``.
+The recording's readings (``devices/<device>/{pose,wrench,tactile}`` and a gripper's
+``joint_states``; any writer: ours, ``ros2 bag record``, rosbags; MCAP or SQLite3) are grouped
+into ticks: by the recorded ``sim/tick`` messages when there are any (the exact readings of each
+tick), else by stamp. For each tick the replayer publishes ``/clock``, the readings' recorded
+bytes unchanged and a ``sim/tick`` listing them, and waits for the monitor's status of that tick
+before the next, so a run of the monitor sees exactly what it saw live. The monitor's
+parameters come from the recording's ``custom_data`` (``monitor_parameters``, written by
+``squeeze-grasp run``), else from ``config/monitor.yaml`` with the finger-device mapping read
+from the tactile arrays, plus ``overrides``. The replayed events are compared with the recorded
+``monitor/events``.
 """
 from __future__ import annotations
 
@@ -28,6 +29,7 @@ from rclpy.parameter import Parameter
 from rclpy.serialization import deserialize_message
 from rclpy.signals import SignalHandlerOptions
 from rosgraph_msgs.msg import Clock
+from sensor_msgs.msg import JointState
 
 from squeeze_grasp_interfaces.msg import ContactEventArray, MonitorStatus, TactileArray, Tick
 from squeeze_grasp_ros.inputs import InputError, load_yaml
@@ -36,19 +38,34 @@ from squeeze_grasp_ros.ros import messages
 from squeeze_grasp_ros.ros.nodes import pipeline
 from squeeze_grasp_ros.ros.nodes.monitor import MonitorNode
 from squeeze_grasp_ros.ros.nodes.recorder import cdr_stamp_ns
+from squeeze_grasp_ros.ros.nodes.sim_controllers import JOINT_STATES
 from squeeze_grasp_ros.ros.recording.bag import BagContents, BagError, read_bag
 from squeeze_grasp_ros.ros.run.options import config_parameters
 
-READING = re.compile(r"^/?devices/([^/]+)/(pose|wrench|tactile)$")
+READING = re.compile(r"^/?(?:devices/([^/]+)/(pose|wrench|tactile)|(joint_states))$")
 READING_TYPES: dict[str, tuple[str, type]] = {
     "pose": ("geometry_msgs/msg/PoseStamped", PoseStamped),
     "wrench": ("geometry_msgs/msg/WrenchStamped", WrenchStamped),
     "tactile": ("squeeze_grasp_interfaces/msg/TactileArray", TactileArray),
+    JOINT_STATES: ("sensor_msgs/msg/JointState", JointState),
 }
 """Stream -> (type name, class) of the readings replay publishes: fixed here, never imported
 by a name read from a recording (a crafted recording made replay import any module)."""
 TICK_TIMEOUT = 10.0
 """Wall-clock seconds replay waits for the monitor's answer to one tick before giving up."""
+
+
+def reading_of(topic: str) -> tuple[str, str, str] | None:
+    """(device, stream, the key a ``sim/tick`` lists) of a reading's topic, else None: a
+    device's ``pose``/``wrench``/``tactile`` ("barrett_f1/pose"), or a simulated controller's
+    ``joint_states`` (no device; key "joint_states").
+    """
+    match = READING.match(topic)
+    if match is None:
+        return None
+    if match.group(3):
+        return "", JOINT_STATES, JOINT_STATES
+    return match.group(1), match.group(2), f"{match.group(1)}/{match.group(2)}"
 
 
 def event_tuple(e: Any) -> tuple:
@@ -78,10 +95,10 @@ def checked_readings(bag: BagContents) -> list:
     """
     readings = []
     for m in bag.messages:
-        match = READING.match(m.topic)
-        if not match:
+        reading = reading_of(m.topic)
+        if reading is None:
             continue
-        type_name, cls = READING_TYPES[match.group(2)]
+        type_name, cls = READING_TYPES[reading[1]]
         if m.type != type_name:
             raise BagError(f"{m.topic} has type {m.type[:80]!r} in the recording; replay "
                            f"publishes it as {type_name}")
@@ -111,7 +128,7 @@ def ticks_of(bag: BagContents) -> list[tuple[int, list]]:
         ns = messages.stamp_ns(tick.header.stamp)
         keys = set(tick.readings)
         out.append((ns, [r for r in by_stamp.get(ns, [])
-                         if "/".join(READING.match(r.topic).groups()) in keys]))
+                         if reading_of(r.topic)[2] in keys]))
     return out
 
 
@@ -128,18 +145,18 @@ def monitor_parameters(bag: BagContents) -> dict[str, Any]:
         return params
     params = config_parameters("monitor")
     fingers: dict[str, str] = {}
-    devices = sorted({READING.match(m.topic).group(1) for m in bag.messages
-                      if READING.match(m.topic)})
-    for m in bag.messages:
-        match = READING.match(m.topic)
-        if match and match.group(2) == "tactile":
-            fingers.setdefault(match.group(1), deserialize_message(m.data, TactileArray).finger)
+    readings = [(m, reading_of(m.topic)) for m in bag.messages]
+    readings = [(m, r) for m, r in readings if r is not None and r[0]]
+    devices = sorted({r[0] for _, r in readings})
+    for m, (device, stream, _) in readings:
+        if stream == "tactile":
+            fingers.setdefault(device, deserialize_message(m.data, TactileArray).finger)
     free = [f for f in Finger.values() if f not in fingers.values()]
     for device in devices:
         if device not in fingers:
             fingers[device] = free.pop(0)
     params["finger_devices"] = [f"{f}:{d}" for d, f in fingers.items()]
-    streams = {READING.match(m.topic).group(2) for m in bag.messages if READING.match(m.topic)}
+    streams = {r[1] for _, r in readings}
     params["streams"] = sorted(streams - {"pose"}) or [""]
     return params
 
@@ -154,7 +171,7 @@ class Replayer(Node):
         self.clock_pub = self.create_publisher(Clock, pipeline.CLOCK, loop)
         self.tick_pub = self.create_publisher(Tick, pipeline.TICK, loop)
         self.pubs = {topic: self.create_publisher(
-                         READING_TYPES[READING.match(topic).group(2)][1], topic, loop)
+                         READING_TYPES[reading_of(topic)[1]][1], topic, loop)
                      for topic in {m.topic for _, group in ticks for m in group}}
         prediction = [m for m in bag.messages if m.topic == "/" + pipeline.PREDICTION]
         if prediction:
@@ -186,7 +203,7 @@ class Replayer(Node):
         self.clock_pub.publish(messages.clock_msg(ns))
         for m in group:
             self.pubs[m.topic].publish(m.data)
-        keys = ["/".join(READING.match(m.topic).groups()) for m in group]
+        keys = [reading_of(m.topic)[2] for m in group]
         self.tick_pub.publish(messages.tick_msg(self.next, ns, keys))
         self.next += 1
         self.published = time.monotonic()

@@ -21,8 +21,7 @@ from rclpy.node import Node
 
 from squeeze_grasp_ros.mechanics.vocabulary import Effect
 from squeeze_grasp_ros.ros.nodes import pipeline
-from squeeze_grasp_ros.ros.nodes.sim_controllers import JOINT_STATES
-from squeeze_grasp_ros.ros.run.options import RunError
+from squeeze_grasp_ros.ros.run.options import RunError, controller_topics
 from squeeze_grasp_ros.scene import Scene, finger_devices
 
 __all__ = ["GRAPH_CHECK_PERIOD", "UNKNOWN_NODE", "UNKNOWN_NODE_GRACE", "GraphWatch",
@@ -51,7 +50,7 @@ def run_topics(scene: Scene) -> list[str]:
                                           camera=scene.has(Effect.CAMERA)))
     names += [f"/{t}" for t in (pipeline.HELLO, pipeline.READY, pipeline.RECORDER_PROGRESS)]
     if scene.controller is not None:
-        names += [f"/{scene.controller.name}/joint_trajectory", f"/{JOINT_STATES}"]
+        names += [f"/{topic.split()[0]}" for topic in controller_topics(scene.controller)]
     return [t.lstrip("/") for t in names]
 
 

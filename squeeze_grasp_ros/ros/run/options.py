@@ -16,9 +16,11 @@ from typing import Any
 
 import yaml
 
-from squeeze_grasp_ros.mechanics.vocabulary import Effect
+from squeeze_grasp_ros.mechanics.vocabulary import ControllerKind, Effect
 from squeeze_grasp_ros.resources import config_dir
+from squeeze_grasp_ros.ros.nodes import pipeline
 from squeeze_grasp_ros.scene import Scene, finger_devices
+from squeeze_grasp_ros.scene.specs import ControllerSpec
 
 __all__ = ["EXECUTORS", "NODES", "PLANNER_MODULE", "RunError", "RunOptions", "config_parameters",
            "node_parameters"]
@@ -117,9 +119,10 @@ def node_parameters(
         monitor.update(shape_watch=True,
                        shape_mismatch_threshold=float(scene.camera.shape_mismatch_threshold),
                        object_height=float(scene.object.material.thickness))
+    controller_scene = str(Path(scene_path).resolve()) if scene.controller else ""
+    monitor["controller_scene"] = controller_scene
     params["executor"].update(
-        finger_devices=mapping, period=float(scene.sim.dt),
-        controller_scene=str(Path(scene_path).resolve()) if scene.controller else "")
+        finger_devices=mapping, period=float(scene.sim.dt), controller_scene=controller_scene)
     custom = {"scene": Path(scene_path).read_text(), "scene_path": str(scene_path)}
     params["recorder"].update(
         output=str(options.record or ""),
@@ -128,12 +131,22 @@ def node_parameters(
         camera=scene.has(Effect.CAMERA),
     )
     if scene.controller is not None:
-        params["recorder"]["extra_topics"] = [
-            f"{scene.controller.name}/joint_trajectory trajectory_msgs/msg/JointTrajectory",
-            "joint_states sensor_msgs/msg/JointState"]
+        params["recorder"]["extra_topics"] = controller_topics(scene.controller)
         params["recorder"]["silent_setpoints"] = [devices[f] for f in scene.controller.jaws]
     for name, values in options.overrides.items():
         params[name].update(values)
     custom["monitor_parameters"] = yaml.safe_dump(params["monitor"], sort_keys=True)
     params["recorder"]["custom_data"] = yaml.safe_dump(custom)
     return params
+
+
+def controller_topics(spec: ControllerSpec) -> list[str]:
+    """"topic type" of each recorded topic of a scene's controller (relative): its command
+    topic or its action's status, the executor's cycle, and joint_states.
+    """
+    if not ControllerKind(spec.type).is_action:
+        return [f"{spec.name}/joint_trajectory trajectory_msgs/msg/JointTrajectory",
+                "joint_states sensor_msgs/msg/JointState"]
+    return [f"{spec.name}/gripper_cmd/_action/status action_msgs/msg/GoalStatusArray",
+            f"{pipeline.EXECUTOR_CYCLE} std_msgs/msg/Header",
+            "joint_states sensor_msgs/msg/JointState"]

@@ -321,6 +321,12 @@ class PipelineRunner:
         self.loop_started = time.perf_counter()
         self.loop_cpu_started = time.process_time()
 
+    @property
+    def joint_feedback(self) -> bool:
+        """The monitor watches the jaws on ``joint_states`` alone (a controller, no sensors)."""
+        return self.scene.controller is not None and not (
+            self.scene.has(Effect.FORCE_SENSING) or self.scene.has(Effect.TACTILE_SENSING))
+
     def cancel(self) -> None:
         """Ask the executor to cancel the goal (it holds position)."""
         self.goal.cancel()
@@ -330,11 +336,15 @@ class PipelineRunner:
 
         When the simulated world ends with a lost grasp (a finger slipped, the strain limit), the
         goal is cancelled, so the executor holds instead of driving fingers that no longer move
-        the object. If the status topic reports the goal finished but the result response does
-        not come within a few seconds (lost across processes), the result is requested again.
+        the object; not when the monitor watches the jaws on joint feedback alone (a gripper
+        scene without wrench and tactile sensing): its slip watch, not the ground truth, is
+        then what stops the goal. If the status topic reports the goal finished but the result
+        response does not come within a few seconds (lost across processes), the result is
+        requested again.
         """
         result = self.goal.result(self.spin_until, self.options.timeout,
-                                  self.observer.world_failed)
+                                  (lambda: False) if self.joint_feedback
+                                  else self.observer.world_failed)
         self.timing["loop"] = time.perf_counter() - self.loop_started
         self.timing["loop_cpu"] = time.process_time() - self.loop_cpu_started
         final = self.start_ns + result.ticks * int(round(self.scene.sim.dt * 1e9))

@@ -58,10 +58,9 @@ def outcome(observed: Observed, result: ExecuteGrasp.Result) -> str:
         return "grasp held" if world == "none" else "object picked up"
     if world not in GRASP_HELD:
         depth = observed.world_end["depth"] if observed.world_end else float("nan")
-        return (
-            f"grasp failed in the world: {world} at depth {depth * 1e3:.4f} mm; the "
-            "executor was stopped"
-        )
+        stopped = ("the executor was stopped" if result.termination == "canceled" else
+                   f"the executor ended {result.termination}")
+        return f"grasp failed in the world: {world} at depth {depth * 1e3:.4f} mm; {stopped}"
     return f"executor did not finish: {result.termination} ({result.message})"
 
 

@@ -22,6 +22,7 @@ module                      what it holds
 :mod:`.location`            crossings and root location (Hermite, regula falsi)
 :mod:`.substeps`            substep control (grid or adaptive)
 :mod:`.run`                 :func:`advance`: the substep loop that joins them
+:mod:`.quiet`               :class:`QuietSteps`: calls that cross no event, without the loop
 ==========================  ===============================================================
 
 At each substep end the fixed-set problem is solved and the event functions are evaluated; a
@@ -37,6 +38,7 @@ theta + dtheta/ds ds, Newton with line search); a substep whose Newton solve is 
 off the predicted branch is halved.
 """
 
+from squeeze_grasp_ros.mechanics.squeeze.stepper.quiet import QuietSteps
 from squeeze_grasp_ros.mechanics.squeeze.stepper.run import (
                                                              MIN_EVENT_TOL,
                                                              MIN_STEP,
@@ -44,4 +46,4 @@ from squeeze_grasp_ros.mechanics.squeeze.stepper.run import (
                                                              advance,
 )
 
-__all__ = ["MIN_EVENT_TOL", "MIN_STEP", "TERMINATION_ORDER", "advance"]
+__all__ = ["MIN_EVENT_TOL", "MIN_STEP", "TERMINATION_ORDER", "QuietSteps", "advance"]

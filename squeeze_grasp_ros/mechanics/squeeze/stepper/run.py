@@ -72,16 +72,21 @@ class _Call:
 
     def __init__(self, model: ContactModel, state: ContactState,
                  translations: Mapping[str, tuple[float, float]], step: float,
-                 event_tol: float, terminate_on: tuple[str, ...]) -> None:
+                 event_tol: float, terminate_on: tuple[str, ...], *,
+                 motion: FingerMotion | None = None, contacts: ContactSet | None = None) -> None:
+        """``motion`` and ``contacts``, when given, are those of ``state`` and
+        ``translations`` (a caller that keeps them across calls).
+        """
         L, fu = model.length, model.force_unit
         self.model, self.step, self.tol = model, step, event_tol
-        self.motion = FingerMotion.of(state, translations, L)
+        self.motion = FingerMotion.of(state, translations, L) if motion is None else motion
         self.counters = Counters()
         self.solver = SetSolver(model, self.motion, self.counters)
         self.functions = EventFunctions(model, self.motion, terminate_on)
         self.chatter = ChatterBound(state, step * L, model.max_events_per_depth)
-        self.events = EventProcessor(state, ContactSet.of_state(model, state), self.functions,
-                                     self.solver, self.chatter, event_tol)
+        self.events = EventProcessor(state, ContactSet.of_state(model, state) if contacts is None
+                                     else contacts, self.functions, self.solver, self.chatter,
+                                     event_tol)
         self.t0 = np.array([f.translation for f in state.fingers], float) / L
         self.work = np.array([f.work for f in state.fingers], float) / (fu * L)
         self.dissipation = np.array([f.dissipation for f in state.fingers], float) / (fu * L)
@@ -189,9 +194,12 @@ class _Call:
         """
         h = b - a
         finger, D = self.events.contacts.finger, self.motion.translation
-        r = self.motion.radius[finger]
-        pa = -sa.tangential * r * sa.dtheta
-        pb = -sb.tangential * r * sb.dtheta
+        # no node slides at either end: the dissipation adds zeros (it is never -0.0)
+        sliding = sa.dtheta.any() or sb.dtheta.any()
+        if sliding:
+            r = self.motion.radius[finger]
+            pa = -sa.tangential * r * sa.dtheta
+            pb = -sb.tangential * r * sb.dtheta
         for f in range(len(self.motion.names)):
             mine = finger == f
             if not mine.any():
@@ -199,7 +207,8 @@ class _Call:
             ya, yb = sa.F[mine].sum(axis=0) @ D[f], sb.F[mine].sum(axis=0) @ D[f]
             ra, rb = sa.dF[mine].sum(axis=0) @ D[f], sb.dF[mine].sum(axis=0) @ D[f]
             self.work[f] += 0.5 * h * (ya + yb) + h * h / 12.0 * (ra - rb)
-            self.dissipation[f] += 0.5 * h * (pa[mine].sum() + pb[mine].sum())
+            if sliding:
+                self.dissipation[f] += 0.5 * h * (pa[mine].sum() + pb[mine].sum())
 
     def record(self, sol: Solution) -> None:
         """Append a trajectory sample at the current point."""
@@ -210,6 +219,24 @@ class _Call:
         }
         self.samples.append(Sample(self.events.depth, tuple(contacts.nodes.tolist()),
                                    tuple(sol.theta.tolist()), forces))
+
+    def result(self, sol: Solution, termination: str | None,
+               next_substep: float) -> StepResult:
+        """The call's :class:`StepResult`, ending at the current point with ``sol``."""
+        model = self.model
+        diag = self.counters.as_dict()
+        diag["sets_factored"] = model._cache.get("sets_factored", 0)
+        diag["reduced_max_condition"] = model._cache.get("max_condition", 1.0)
+        return StepResult(
+            self.to_state(sol),
+            tuple(self.events.events),
+            float(self.events.s),
+            termination,
+            tuple(self.samples),
+            tuple(self.chatter.chatter),
+            diag,
+            next_substep,
+        )
 
     def to_state(self, sol: Solution) -> ContactState:
         """The frozen SI state at the current point, with the solution ``sol`` there."""
@@ -229,19 +256,22 @@ class _Call:
             )
             for f, n in enumerate(motion.names)
         )
-        signs = c.slip_signs(sol.dtheta, self.functions.frictionless)
+        signs = c.slip_signs(sol.dtheta, self.functions.frictionless).tolist()
+        delta, F = sol.delta * L, sol.F * fu
         contacts = tuple(
             ContactNode(
-                int(node),
-                motion.names[c.finger[k]],
-                ContactMode.STICK if c.stick[k] else ContactMode.SLIP,
-                0 if c.stick[k] else int(signs[k]),
-                float(sol.theta[k]),
-                sol.delta[k] * L,
-                sol.F[k] * fu,
-                float(sol.normal_angle[k]),
+                node,
+                motion.names[finger],
+                ContactMode.STICK if stick else ContactMode.SLIP,
+                0 if stick else sign,
+                theta,
+                delta[k],
+                F[k],
+                normal,
             )
-            for k, node in enumerate(c.nodes.tolist())
+            for k, (node, finger, stick, sign, theta, normal) in enumerate(zip(
+                c.nodes.tolist(), c.finger.tolist(), c.stick.tolist(), signs,
+                sol.theta.tolist(), sol.normal_angle.tolist()))
         )
         depth = ev.depth
         return ContactState(fingers, contacts, depth, ev.relative_per_depth,
@@ -321,16 +351,4 @@ def advance(
     call = _Call(model, state, translations, step, min(event_tol, step), tuple(terminate_on))
     sol, termination, next_substep = call.run(
         stop_on_event, step if first_substep is None else first_substep, checkpoint)
-    diag = call.counters.as_dict()
-    diag["sets_factored"] = model._cache.get("sets_factored", 0)
-    diag["reduced_max_condition"] = model._cache.get("max_condition", 1.0)
-    return StepResult(
-        call.to_state(sol),
-        tuple(call.events.events),
-        float(call.events.s),
-        termination,
-        tuple(call.samples),
-        tuple(call.chatter.chatter),
-        diag,
-        next_substep,
-    )
+    return call.result(sol, termination, next_substep)

@@ -9,7 +9,7 @@ solution from one point to another and halves a substep whose continuation fails
 """
 from __future__ import annotations
 
-from dataclasses import asdict, dataclass
+from dataclasses import dataclass, fields
 
 import numpy as np
 
@@ -74,7 +74,7 @@ class Counters:
 
     def as_dict(self) -> dict:
         """The counters that apply (the inversion ones only when it happened)."""
-        return {k: v for k, v in asdict(self).items() if v is not None}
+        return {f.name: v for f in fields(self) if (v := getattr(self, f.name)) is not None}
 
 
 @dataclass(frozen=True)

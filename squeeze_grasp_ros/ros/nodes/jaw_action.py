@@ -1,0 +1,178 @@
+# Copyright 2026 squeeze_grasp_ros developers
+# SPDX-License-Identifier: Apache-2.0
+"""The executor's side of a stock gripper action controller (docs/grippers.md).
+
+A squeeze of the jaws is one goal: at the grasp goal's first cycle the executor fixes the jaw
+line from the jaws' measured tips (as :mod:`.jaw_commands`), and sends
+``control_msgs/action/GripperCommand`` (``type: gripper_action``) or
+``ParallelGripperCommand`` (``type: parallel_gripper``) on ``<controller>/gripper_cmd`` with
+
+- **position** = the planned aperture (the jaws' tips after the planned depth along the goal's
+  directions, measured between the pad faces on the jaw line) through the device's
+  transmission: the controller joint's position, in its convention (the generic 85 mm
+  gripper's: a Robotiq-style knuckle angle, 0.8 rad closed, 0 rad open at 85 mm; a device with
+  ``position_per_aperture: 1`` takes the jaw gap in m);
+- **max_effort** (parallel: ``effort[0]``) = the planned jaw force at that depth (the planner's
+  force curve, ``planner/predicted_events``, mean of the two jaws) times the controller
+  section's ``effort_margin``, through the transmission, capped at the device's limit; without
+  a force curve, 0: the controller's own ``max_effort``. In lockstep the executor is ready only
+  once the force curve is here when somebody publishes one (a run latches it before its nodes
+  start).
+
+The grasp goal then ends on the gripper goal's result: ``reached_goal`` -> depth_reached;
+``stalled`` -> gripper_stalled (success only if the controller allows stalling); a rejection
+-> gripper_rejected; another end (preempted) -> gripper_aborted. A cancel, an imminent slip of a
+jaw, a lost contact or a pick-up cancels the gripper goal (the controller holds the measured
+position) and ends the grasp goal as on the setpoint route.
+
+In lockstep the executor answers each tick on ``executor/cycle`` once its request of that tick
+(goal or cancel) has been answered, so the simulated controller has it before the step.
+"""
+from __future__ import annotations
+
+from collections.abc import Callable
+from typing import Any
+
+import numpy as np
+from control_msgs.action import GripperCommand, ParallelGripperCommand
+from rclpy.action import ActionClient
+from rclpy.node import Node
+from std_msgs.msg import Header
+
+from squeeze_grasp_interfaces.action import ExecuteGrasp
+from squeeze_grasp_interfaces.msg import ContactEventArray
+from squeeze_grasp_ros.control.joint_trajectory import JawLine
+from squeeze_grasp_ros.control.motion import GraspGoal, Observation
+from squeeze_grasp_ros.mechanics.vocabulary import ControllerKind
+from squeeze_grasp_ros.ros import messages
+from squeeze_grasp_ros.ros.nodes import pipeline
+from squeeze_grasp_ros.scene.controller import JawController
+
+__all__ = ["JawAction"]
+
+GOAL_STATUS_SUCCEEDED = 4
+"""action_msgs/GoalStatus STATUS_SUCCEEDED."""
+
+
+class JawAction:
+    """Grasp goals -> one gripper action goal of one controller.
+
+    Parameters
+    ----------
+    node : Node
+    controller : JawController
+    qos : QoSProfile
+    """
+
+    def __init__(self, node: Node, controller: JawController, qos: Any) -> None:
+        self.node, self.controller = node, controller
+        self.parallel = controller.kind is ControllerKind.PARALLEL_GRIPPER
+        self.action = ParallelGripperCommand if self.parallel else GripperCommand
+        self.topic = node.resolve_topic_name(controller.topic)
+        self.client = ActionClient(node, self.action, controller.topic)
+        self.publisher = node.create_publisher(Header, pipeline.EXECUTOR_CYCLE, qos)
+        self.forces = None
+        node.create_subscription(ContactEventArray, pipeline.PREDICTION, self._prediction,
+                                 pipeline.LATCHED)
+        self.line: JawLine | None = None
+        self.handle: Any = None
+        self.outcome: tuple[str, bool, str] | None = None
+        """(termination, success, message) once the gripper goal ended."""
+        self.sent: dict[str, float] = {}
+
+    @property
+    def fingers(self) -> tuple[str, str]:
+        """The fingers the jaws carry."""
+        return self.controller.jaws
+
+    def ready(self) -> bool:
+        """True once the planner's force curve is here, or when nobody publishes one (the
+        executor's lockstep readiness: its first goal's effort depends on it).
+        """
+        return self.forces is not None or \
+            self.node.count_publishers(pipeline.PREDICTION) == 0
+
+    def _prediction(self, msg: ContactEventArray) -> None:
+        self.forces = messages.predicted_forces(msg)
+
+    def cycle_msg(self, ns: int) -> tuple[Any, Header]:
+        """(publisher, message) answering tick ``ns``."""
+        return self.publisher, messages.header(ns)
+
+    # ----------------------------------------------------------------- the goal
+    def target(self, goal: GraspGoal, obs: Observation) -> tuple[float, float]:
+        """(joint position, joint effort limit) of grasp goal ``goal`` from its first
+        observation (fixes the jaw line).
+        """
+        first, second = self.fingers
+        self.line = JawLine.between(obs.positions[first], obs.positions[second],
+                                    reach=self.controller.gripper.pad.contact_radius)
+        end = {f: np.asarray(obs.positions[f], float) + goal.depth * np.asarray(d, float)
+               for f, d in zip(goal.fingers, goal.directions)}
+        aperture = self.line.aperture(end.get(first, obs.positions[first]),
+                                      end.get(second, obs.positions[second]))
+        position = self.controller.joint_positions(aperture)[0]
+        effort = 0.0
+        if self.forces is not None:
+            force = 0.5 * sum(self.forces.at(f, goal.depth) for f in self.fingers
+                              if f in self.forces.forces)
+            effort = min(abs(self.controller.joint_efforts(force)[0])
+                         * self.controller.spec.effort_margin, self.controller.effort_limit)
+        return position, effort
+
+    def send(self, position: float, effort: float, on_answer: Callable[[], None]) -> None:
+        """Send the goal; ``on_answer`` once the controller accepted or rejected it."""
+        goal = self.action.Goal()
+        if self.parallel:
+            goal.command.name = [self.controller.joints[0]]
+            goal.command.position = [float(position)]
+            goal.command.effort = [float(effort)] if effort > 0.0 else []
+        else:
+            goal.command.position, goal.command.max_effort = float(position), float(effort)
+        self.sent = {"position": float(position), "max_effort": float(effort)}
+        self.outcome, self.handle = None, None
+
+        def answered(future: Any) -> None:
+            self.handle = future.result()
+            if not self.handle.accepted:
+                self.outcome = (ExecuteGrasp.Result.GRIPPER_REJECTED, False,
+                                f"{self.controller.topic} rejected the goal (position "
+                                f"{self.sent['position']:.6g}, max_effort "
+                                f"{self.sent['max_effort']:.6g}): its log says why")
+            else:
+                handle = self.handle
+                handle.get_result_async().add_done_callback(lambda f: self._result(f, handle))
+            on_answer()
+
+        self.client.send_goal_async(goal).add_done_callback(answered)
+
+    def _result(self, future: Any, handle: Any) -> None:
+        if handle is not self.handle:           # canceled, or an earlier grasp goal's
+            return
+        response = future.result()
+        result = response.result
+        position = result.state.position[0] if self.parallel and len(result.state.position) \
+            else getattr(result, "position", 0.0)
+        effort = result.state.effort[0] if self.parallel and len(result.state.effort) \
+            else getattr(result, "effort", 0.0)
+        detail = (f"{self.controller.topic}: reached_goal {result.reached_goal}, stalled "
+                  f"{result.stalled}, position {position:.6g}, effort {effort:.6g} (goal: "
+                  f"position {self.sent['position']:.6g}, max_effort "
+                  f"{self.sent['max_effort']:.6g})")
+        succeeded = response.status == GOAL_STATUS_SUCCEEDED
+        if result.reached_goal:
+            self.outcome = (ExecuteGrasp.Result.DEPTH_REACHED, True, detail)
+        elif result.stalled:
+            self.outcome = (ExecuteGrasp.Result.GRIPPER_STALLED, succeeded, detail)
+        elif self.outcome is None:
+            self.outcome = (ExecuteGrasp.Result.GRIPPER_ABORTED, False, detail)
+
+    def cancel(self, on_answer: Callable[[], None]) -> bool:
+        """Cancel the running gripper goal (the controller holds position); ``on_answer`` once
+        the cancel was answered. False when no goal runs (nothing to wait for).
+        """
+        if self.handle is None or not self.handle.accepted or self.outcome is not None:
+            return False
+        self.handle.cancel_goal_async().add_done_callback(lambda _: on_answer())
+        self.handle = None
+        return True

@@ -1,0 +1,188 @@
+# Copyright 2026 squeeze_grasp_ros developers
+# SPDX-License-Identifier: Apache-2.0
+"""The gripper action routes on real rclpy (docs/grippers.md): the sponge gripper through a
+simulated ParallelGripperController and GripperActionController against the
+JointTrajectoryController route, a stall at a low effort, and a hostile action client.
+
+They need control_msgs, which has no wheel: without it they skip, saying how to build it.
+"""
+from __future__ import annotations
+
+import importlib.util
+import math
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+import yaml
+from mcap.reader import make_reader
+from pipeline_support import run_observed, sim_and_client, write_scene
+
+if importlib.util.find_spec("control_msgs") is None:
+    pytest.skip("control_msgs is not built: squeeze-grasp ros-setup --control-msgs DIR (DIR a "
+                "jazzy checkout of github.com/ros-controls/control_msgs)",
+                allow_module_level=True)
+
+from control_msgs.action import GripperCommand, ParallelGripperCommand  # noqa: E402
+from rclpy.action import ActionClient  # noqa: E402
+from rclpy.serialization import deserialize_message  # noqa: E402
+from sensor_msgs.msg import JointState  # noqa: E402
+from std_msgs.msg import Header  # noqa: E402
+
+from squeeze_grasp_ros.ros.nodes import pipeline  # noqa: E402
+from squeeze_grasp_ros.scene import GraspSetup, load_scene  # noqa: E402
+
+SPONGE = Path(__file__).resolve().parents[1] / "config" / "scenes" / "sponge_gripper.yaml"
+TIGHT = {"goal_tolerance": 1e-7, "stall_timeout": 0.02}
+
+
+def sponge(kind: str | None, **controller) -> dict:
+    data = yaml.safe_load(SPONGE.read_text())
+    if kind is not None:
+        data["controller"] = {"type": kind, "name": "gripper_controller",
+                              "device": "generic_85mm", **controller}
+    data["name"] = f"sponge_{kind}"
+    return data
+
+
+def run(path: str, record: str | None = None) -> dict:
+    """Run a sponge scene on real rclpy: result, ground-truth events (without their ticks: the
+    routes close at different speeds) and forces, joint states.
+    """
+    out = run_observed(path, [("states", "joint_states", JointState)], record=record)
+    out["events"] = [(kind, finger, node) for _, _, kind, finger, node in out["events"]]
+    return out
+
+
+@pytest.fixture(scope="module")
+def jtc_route(tmp_path_factory):
+    return run(str(SPONGE))
+
+
+@pytest.mark.parametrize("kind", ["parallel_gripper", "gripper_action"])
+def test_sponge_through_the_action_controller_equals_the_jtc_route(kind, jtc_route, tmp_path):
+    """One goal (planned aperture, planned force x 1.25) reaches the planned depth: the same
+    20 events in the same order as the JointTrajectory route and forces within 0.1 % (the
+    issue's target for the world against the mechanics API, which test_sim_world checks for
+    this world); the action's status and joint_states are in the bag.
+    """
+    action = run(write_scene(tmp_path, sponge(kind, **TIGHT)), record=str(tmp_path / "bag"))
+    result = action["result"]
+    print(f"{kind}: {result.termination} after {result.ticks} ticks: {result.message}")
+    assert result.success and result.termination == "depth_reached"
+    assert "reached_goal True, stalled False" in result.message
+    assert action["events"] == jtc_route["events"] and len(action["events"]) == 20
+    scale = np.abs(jtc_route["forces"]).max()
+    error = np.abs(action["forces"] - jtc_route["forces"]).max() / scale
+    print(f"largest force difference {kind} - JTC: {error:.1e} relative")
+    assert error < 1e-3
+    assert action["depth"] == pytest.approx(jtc_route["depth"], rel=1e-3)
+    # and the mechanics API's event squeeze with the same pads, called directly
+    direct = GraspSetup.build(load_scene(SPONGE)).event_squeeze(depth=action["depth"])
+    assert action["events"] == [(str(e.type), str(e.finger), e.node) for e in direct.events]
+    want = np.array([direct.state.finger_force(f)[:2] for f in ("F1", "F2")])
+    print(f"largest force difference {kind} - mechanics API: "
+          f"{np.abs(action['forces'] - want).max() / scale:.1e} relative")
+    np.testing.assert_allclose(action["forces"], want, rtol=0, atol=1e-3 * scale)
+    # the bag, read with mcap's own reader: one message per tick on each stamped topic (a tick
+    # re-sent under load repeats its messages: count stamps), the action's status changes
+    stamps: dict[str, set] = {"joint_states": set(), pipeline.EXECUTOR_CYCLE: set()}
+    statuses = 0
+    with open(next((tmp_path / "bag").glob("*.mcap")), "rb") as stream:
+        for _, channel, message in make_reader(stream).iter_messages():
+            topic = channel.topic.lstrip("/")          # recorded under the run's namespace
+            if topic in stamps:
+                cls = JointState if topic == "joint_states" else Header
+                msg = deserialize_message(message.data, cls)
+                stamp = (msg.header if cls is JointState else msg).stamp
+                stamps[topic].add((stamp.sec, stamp.nanosec))
+            statuses += topic == "gripper_controller/gripper_cmd/_action/status"
+    assert len(stamps["joint_states"]) == len({(m.header.stamp.sec, m.header.stamp.nanosec)
+                                               for m in action["states"]}) > result.ticks
+    assert len(stamps[pipeline.EXECUTOR_CYCLE]) == result.ticks
+    assert statuses >= 2                          # executing, succeeded
+    # the jaw force on joint_states is the ground truth's through the transmission (1 N/N)
+    assert action["states"][-1].effort[0] == pytest.approx(abs(action["forces"][0, 1]),
+                                                           rel=1e-3)
+
+
+def test_an_effort_below_the_planned_force_stalls(tmp_path):
+    """With effort_margin 0.5 the jaws stop at half the planned force and the goal aborts
+    stalled after stall_timeout: the run says gripper_stalled, not success.
+    """
+    out = run(write_scene(tmp_path, sponge("parallel_gripper", effort_margin=0.5, **TIGHT)))
+    result = out["result"]
+    print(f"{result.termination}: {result.message}; depth {result.depth:.6g} m")
+    assert not result.success and result.termination == "gripper_stalled"
+    assert "reached_goal False, stalled True" in result.message
+    limit = float(result.message.split("max_effort ")[1].rstrip(")"))  # N (1 N per N)
+    planned_force = 5.9703                       # docs/grippers.md's run (F1 along y, N)
+    assert limit == pytest.approx(0.5 * planned_force, rel=1e-4)
+    force = abs(out["forces"][0, 1])             # stopped at the first tick at the limit
+    assert limit <= force <= 1.05 * limit
+
+
+def test_a_canceled_grasp_cancels_the_gripper_goal(tmp_path):
+    """A cancel of the grasp goal mid-squeeze cancels the gripper goal: the controller holds the
+    measured position and the goal ends canceled, short of the planned depth.
+    """
+    out = run_observed(write_scene(tmp_path, sponge("parallel_gripper", **TIGHT)),
+                       cancel_after=0.2)
+    result = out["result"]
+    print(f"{result.termination} after {result.ticks} ticks, depth {result.depth:.6g} m")
+    assert result.termination == "canceled" and not result.success
+    assert 150 < result.ticks < 400 and 0.0 < out["depth"] < 0.7 * 5.3033e-3
+
+
+# --------------------------------------------------------------------------- hostile client
+def wait(executor, condition, seconds=10.0):
+    deadline = time.monotonic() + seconds
+    while not condition() and time.monotonic() < deadline:
+        executor.spin_once(timeout_sec=0.05)
+    return condition()
+
+
+@pytest.mark.parametrize("kind", ["parallel_gripper", "gripper_action"])
+def test_a_hostile_action_client_is_rejected(kind, tmp_path, capfd):
+    """NaN position, a position outside the opening range, an effort beyond the device's 235 N
+    and (parallel) a wrong joint name or two positions: each goal rejected with one log line,
+    the jaws unmoved; a valid goal is accepted.
+    """
+    path = write_scene(tmp_path, sponge(kind, **TIGHT))
+    action = ParallelGripperCommand if kind == "parallel_gripper" else GripperCommand
+    with sim_and_client(path) as (executor, sim, client):
+        cycle = client.create_publisher(pipeline.message_type("std_msgs/msg/Header"),
+                                        pipeline.EXECUTOR_CYCLE, pipeline.loop_qos(10))
+        pipeline.Participant(client, "hostile", [], [cycle])
+        ac = ActionClient(client, action, "gripper_controller/gripper_cmd")
+        assert wait(executor, lambda: sim.now_ns == 0 and ac.server_is_ready())
+        before = dict(sim.world.positions)
+
+        def goal(position, effort=0.0, name=("finger_joint",), positions=None):
+            g = action.Goal()
+            if kind == "parallel_gripper":
+                g.command.name = list(name)
+                g.command.position = positions or [position]
+                g.command.effort = [effort] if effort else []
+            else:
+                g.command.position, g.command.max_effort = position, effort
+            future = ac.send_goal_async(g)
+            assert wait(executor, future.done)
+            return future.result()
+
+        hostile = [goal(math.nan), goal(0.9), goal(-0.1), goal(0.4, effort=300.0)]
+        if kind == "parallel_gripper":
+            hostile += [goal(0.4, name=("wrong_joint",)), goal(0.4, positions=[0.4, 0.4])]
+        assert not any(h.accepted for h in hostile)
+        reasons = sim.controller.refusals
+        for reason, text in zip(reasons, ("position nan is not finite", "outside the joint range",
+                                          "outside the joint range", "effort 300 is outside",
+                                          "not the controller's joint", "has 2 values")):
+            assert text in reason
+        assert len(reasons) == len(hostile)
+        assert sim.now_ns == 0 and all(np.array_equal(sim.world.positions[f], p)
+                                       for f, p in before.items())
+        assert goal(0.4, effort=3.0).accepted
+    err = capfd.readouterr().err
+    assert err.count("rejected the goal on /gripper_controller/gripper_cmd") == len(hostile)

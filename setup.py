@@ -67,8 +67,9 @@ setup(
         # METIS's nested-dissection order (pymetis, MIT)
         "cholmod": ["cvxopt>=1.3", "pymetis>=2023.1"],
         # the linear model's fixed-set Newton compiled (numba: BSD, LLVM-based, wheels for
-        # CPython 3.10-3.13); without it the same solve runs in numpy, bit for bit alike
-        "fast": ["numba>=0.60"],
+        # CPython 3.10-3.13); without it the same solve runs in numpy, bit for bit alike.
+        # 0.68 takes numpy 2.4 (0.62 made pip downgrade numpy to 2.3, which moves round-off)
+        "fast": ["numba>=0.68"],
         # squeeze-grasp outline: sub-pixel contours (marching squares) of masks and depth images
         "perception": ["scikit-image>=0.22"],
         "test": [

@@ -259,6 +259,23 @@ def test_a_frictional_resistance_whose_client_leaves_stops_inside_its_squeeze(pl
     assert stiffness(planner, "fig10").success
 
 
+def test_a_client_the_graph_does_not_know_yet_is_not_taken_for_gone(planner, monkeypatch):
+    """Before: a `--processes` run's first load_object was refused "abandoned: no client ...
+    is left" because the planner's graph had not yet learnt of the client whose request it was
+    serving. A client unknown to the graph now counts as gone only after the discovery grace;
+    with the grace at zero the same request is refused (the check still works).
+    """
+    from squeeze_grasp_ros.ros.nodes import planner as planner_module
+
+    monkeypatch.setattr(planner.planner, "count_clients", lambda name: 0)
+    assert planner.load(BLOB, "unseen").success
+    monkeypatch.setattr(planner_module, "DISCOVERY_GRACE", -1.0)
+    refused = planner.call(LoadObject, "load_object",
+                           LoadObject.Request(scene_yaml=BLOB, object_id="unseen_late"))
+    assert not refused.success and refused.error_code == ErrorCode.CANCELLED
+    assert "abandoned" in refused.message
+
+
 def test_a_load_whose_dense_blocks_exceed_the_memory_bound_is_refused_before_factoring(
         ros_context):
     """Before: a thin rectangle (height 1e-5 m, every node on the boundary) grew the planner

@@ -68,6 +68,10 @@ from squeeze_grasp_ros.ros.nodes import run_node
 Response = TypeVar("Response")
 WATCH_PERIOD = 0.1
 """Wall-clock seconds between two graph queries of a request's abandonment check."""
+DISCOVERY_GRACE = 5.0
+"""Wall-clock seconds a request's client may stay unknown to the planner's graph before its
+absence counts as abandonment (across processes the graph can learn of a client after its
+request arrived)."""
 
 PARAMETERS: dict[str, tuple[Any, str]] = {
     "max_nodes": (60_000, "largest solid mesh (nodes) the planner builds; larger scenes are "
@@ -393,10 +397,14 @@ class PlannerNode(Node):
         ROS 2 services have no cancel; a client that gives up and destroys its client (or
         whose process ends) leaves the graph, and its work stops at the next progress report
         or checkpoint (the long loops call it before every stepper substep). The graph is
-        asked at most every :data:`WATCH_PERIOD` s; a progress report always asks.
+        asked at most every :data:`WATCH_PERIOD` s; a progress report always asks. Clients
+        count as gone only once the graph has shown one during this request, or after
+        :data:`DISCOVERY_GRACE` s: across processes the graph can learn of a client after its
+        request arrived (a run's first ``load_object`` was refused as abandoned).
         """
         name = f"{self.get_fully_qualified_name()}/{service}"
         asked, reported = [-math.inf], [()]
+        seen, since = [self.count_clients(name) > 0], time.monotonic()
 
         def check(*progress: Any) -> None:
             if self._stopping.is_set():
@@ -407,7 +415,9 @@ class PlannerNode(Node):
             elif now - asked[0] < WATCH_PERIOD:
                 return
             asked[0] = now
-            if self.count_clients(name) == 0:
+            if self.count_clients(name) > 0:
+                seen[0] = True
+            elif seen[0] or now - since > DISCOVERY_GRACE:
                 self.abandoned.append(reported[0])
                 raise Cancelled(f"abandoned: no client of {name} is left to take the answer")
         return check

@@ -372,3 +372,80 @@ def test_a_ring_hole_is_watched_on_ros_and_a_missing_one_raises_shape_mismatch(t
     first = wrong["first_alarms"]["shape_mismatch"]
     assert first["stamp_ns"] == 0, first
     assert "1 of 1 predicted holes not seen" in first["message"]
+
+
+def test_a_frame_before_the_prediction_waits_for_it(ros_context):
+    """The monitor's shape watch on real rclpy, in the order a launched world gives: the
+    tick-0 frame (latched) arrives and tick 0 closes before the prediction does. Nothing is
+    matched or dropped then; when the prediction arrives the frame is matched at tick 0's
+    depth, and a frame whose tick has not closed waits for it.
+    """
+    skimage_or_skip()
+    import rclpy
+    from geometry_msgs.msg import PoseStamped
+    from rclpy.executors import SingleThreadedExecutor
+    from sensor_msgs.msg import CameraInfo, Image
+
+    from squeeze_grasp_interfaces.msg import Alarm, ShapeResidual
+    from squeeze_grasp_interfaces.msg import PredictedShapes as PredictedShapesMsg
+    from squeeze_grasp_ros.ros import messages
+    from squeeze_grasp_ros.ros.messages.images import pose_of_camera
+    from squeeze_grasp_ros.ros.nodes import pipeline
+    from squeeze_grasp_ros.ros.nodes.shape_watcher import ShapeWatcher
+    from squeeze_grasp_ros.ros.nodes.sim_hardware import camera_messages
+    from squeeze_grasp_ros.ros.run.camera_plan import predicted_shapes_msg
+
+    scene = parse_scene(with_camera(yaml.safe_load(YAML_SCENE.read_text())))
+    world = SimWorld(GraspSetup.build(scene))
+    monitor = rclpy.create_node("watch_test_monitor", context=ros_context)
+    camera = rclpy.create_node("watch_test_camera", context=ros_context)
+    executor = SingleThreadedExecutor(context=ros_context)
+    for node in (monitor, camera):
+        executor.add_node(node)
+    try:
+        watcher = ShapeWatcher(monitor, monitor.create_publisher(Alarm, "alarms", 10),
+                               scene.camera.shape_mismatch_threshold, 0.0254)
+        residuals: list = []
+        camera.create_subscription(ShapeResidual, pipeline.SHAPE_RESIDUAL, residuals.append,
+                                   pipeline.loop_qos(100))
+        pubs = {t: camera.create_publisher(m, t, pipeline.LATCHED) for t, m in (
+            (pipeline.CAMERA_MASK, Image), (pipeline.CAMERA_DEPTH, Image),
+            (pipeline.CAMERA_INFO, CameraInfo))}
+        pose = PoseStamped(header=messages.header(0, "object"),
+                           pose=pose_of_camera(world.camera.pose))
+        camera.create_publisher(PoseStamped, pipeline.CAMERA_POSE, pipeline.LATCHED).publish(pose)
+
+        def spin_until(done, timeout=20.0):
+            import time
+            deadline = time.monotonic() + timeout
+            while not done():
+                assert time.monotonic() < deadline, "not done in time"
+                executor.spin_once(timeout_sec=0.05)
+
+        for pub, msg in camera_messages(pubs, world.camera_frame(0, 0)):
+            pub.publish(msg)
+        spin_until(lambda: watcher.waiting and watcher.camera is not None
+                   and watcher.pose is not None)
+        watcher.tick(0, 0.0)  # tick 0 closes: the prediction is not there yet
+        for _ in range(10):
+            executor.spin_once(timeout_sec=0.02)
+        assert residuals == [] and list(watcher.waiting) == [0] and watcher.dropped == 0
+
+        early = world.camera_frame(100, 100_000_000)  # a frame of tick 100, not closed yet
+        for pub, msg in camera_messages(pubs, early):
+            pub.publish(msg)
+        spin_until(lambda: 100_000_000 in watcher.waiting)
+        camera.create_publisher(PredictedShapesMsg, pipeline.PREDICTED_SHAPES,
+                                pipeline.LATCHED).publish(
+            predicted_shapes_msg(scene, 0.005, 0))
+        spin_until(lambda: len(residuals) == 1)
+        assert messages.stamp_ns(residuals[0].header.stamp) == 0 and residuals[0].depth == 0.0
+        assert residuals[0].rms < 0.25 * scene.camera.shape_mismatch_threshold
+        assert list(watcher.waiting) == [100_000_000]
+        watcher.tick(100_000_000, 0.0)
+        spin_until(lambda: len(residuals) == 2)
+        assert messages.stamp_ns(residuals[1].header.stamp) == 100_000_000
+    finally:
+        executor.shutdown()
+        for node in (monitor, camera):
+            node.destroy_node()

@@ -136,3 +136,36 @@ def test_run_verb_prints_json_whatever_the_middleware_logs(tmp_path):
     replayed = subprocess.run(run_command("replay", "--help"), capture_output=True, text=True)
     assert replayed.returncode == 0 and "--param" in replayed.stdout
     assert Path(path).is_file()
+
+
+@pytest.mark.parametrize("kept", [True, False])
+def test_a_recorder_that_matches_late_still_gets_the_first_lockstep_messages(ros_context, kept):
+    """The lockstep topics' publishers keep their last messages for a late transient-local
+    reader (the recorder across processes: it can see a publisher in the graph before that
+    writer has matched its reader). The volatile case is the control: it gets nothing.
+    """
+    import time
+
+    from rclpy.executors import SingleThreadedExecutor
+    from rclpy.node import Node
+    from std_msgs.msg import Header
+
+    writer = Node("monitor_like", context=ros_context)
+    reader = Node("recorder_like", context=ros_context)
+    publisher = writer.create_publisher(Header, pipeline.STATUS, pipeline.loop_qos(100, kept=True))
+    for tick in range(3):
+        publisher.publish(Header(frame_id=str(tick)))
+    got: list[str] = []
+    reader.create_subscription(Header, pipeline.STATUS, lambda m: got.append(m.frame_id),
+                               pipeline.loop_qos(1000, kept=kept))
+    executor = SingleThreadedExecutor(context=ros_context)
+    executor.add_node(reader)
+    deadline = time.monotonic() + 5.0
+    while len(got) < 3 and time.monotonic() < deadline:
+        executor.spin_once(timeout_sec=0.05)
+    if not kept:
+        executor.spin_once(timeout_sec=0.5)
+    assert got == (["0", "1", "2"] if kept else [])
+    executor.shutdown()
+    writer.destroy_node()
+    reader.destroy_node()

@@ -109,7 +109,9 @@ class ExecutorNode(Node):
         loop = pipeline.loop_qos(p["qos_depth"])
         self.jaws = JawCommands.of(self, p["controller_scene"], p["period"], loop)
         self.setpoint_pubs = {f: self.create_publisher(PoseStamped,
-                                                       pipeline.device_topic(d, "setpoint"), loop)
+                                                       pipeline.device_topic(d, "setpoint"),
+                                                       pipeline.loop_qos(p["qos_depth"],
+                                                                         kept=True))
                               for f, d in self.devices.items()
                               if self.jaws is None or f not in self.jaws.fingers}
         self.status_pub = self.create_publisher(ExecutorStatus, pipeline.EXECUTOR_STATUS, loop)

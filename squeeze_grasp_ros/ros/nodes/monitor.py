@@ -99,8 +99,9 @@ class MonitorNode(Node):
                                  pipeline.LATCHED)
         self.event_pub = self.create_publisher(ContactEventArray, pipeline.EVENTS, loop)
         self.alarm_pub = self.create_publisher(Alarm, pipeline.ALARMS, loop)
-        self.state_pub = self.create_publisher(ContactState, pipeline.CONTACT_STATE, loop)
-        self.status_pub = self.create_publisher(MonitorStatus, pipeline.STATUS, loop)
+        kept = pipeline.loop_qos(p["qos_depth"], kept=True)
+        self.state_pub = self.create_publisher(ContactState, pipeline.CONTACT_STATE, kept)
+        self.status_pub = self.create_publisher(MonitorStatus, pipeline.STATUS, kept)
         self.latest: dict[str, Any] = {}
         self.buffer: dict[int, dict[str, Any]] = {}
         self.expected: dict[int, set[str]] = {}

@@ -189,16 +189,28 @@ def parse_mapping(entries: Sequence[str], what: str) -> dict[str, str]:
     return out
 
 
-def loop_qos(depth: int) -> QoSProfile:
-    """Reliable, keep-last ``depth``, volatile: commands, states, events, lockstep ticks."""
+def loop_qos(depth: int, *, kept: bool = False) -> QoSProfile:
+    """Reliable, keep-last ``depth``: commands, states, events, lockstep ticks.
+
+    Volatile, unless ``kept``: then transient-local, so that a reader asking for it that
+    matches late still receives the last ``depth`` messages. The publishers of the lockstep
+    topics a recorder awaits (:func:`loop_topics`) offer it and the lockstep recorder asks
+    for it: across processes the recorder can see a publisher in the graph before that
+    publisher's writer has matched the recorder's reader, and a volatile writer drops what it
+    sends before the match (the first ticks). Every volatile reader stays compatible.
+    """
+    durability = DurabilityPolicy.TRANSIENT_LOCAL if kept else DurabilityPolicy.VOLATILE
     return QoSProfile(depth=depth, reliability=ReliabilityPolicy.RELIABLE,
-                      history=HistoryPolicy.KEEP_LAST, durability=DurabilityPolicy.VOLATILE)
+                      history=HistoryPolicy.KEEP_LAST, durability=durability)
 
 
-def sensor_qos(kind: str, depth: int) -> QoSProfile:
-    """QoS of the sensor streams: "reliable" (simulation) or "sensor_data" (hardware)."""
+def sensor_qos(kind: str, depth: int, *, kept: bool = False) -> QoSProfile:
+    """QoS of the sensor streams: "reliable" (simulation) or "sensor_data" (hardware).
+
+    ``kept`` as in :func:`loop_qos` (reliable streams only: best effort keeps nothing).
+    """
     if kind == "reliable":
-        return loop_qos(depth)
+        return loop_qos(depth, kept=kept)
     if kind == "sensor_data":
         return qos_profile_sensor_data
     raise ValueError(f"sensor_qos must be 'reliable' or 'sensor_data', got {kind!r}")

@@ -119,10 +119,14 @@ class RecorderNode(Node):
                                          pipeline.CAMERA_DEPTH, pipeline.CAMERA_INFO,
                                          pipeline.PREDICTED_SHAPES)}
         sensors = {name for name in topics if name.rsplit("/", 1)[-1] in pipeline.STREAMS}
+        kept = ({"/" + t for t in pipeline.loop_topics(p["devices"])} if p["lockstep"]
+                else set())
+        """Lockstep topics whose publishers keep their last messages for a late reader."""
         for name, type_name in topics.items():
             qos = pipeline.LATCHED if name in latched else (
-                pipeline.sensor_qos(p["sensor_qos"], p["qos_depth"]) if name in sensors
-                else pipeline.loop_qos(p["qos_depth"]))
+                pipeline.sensor_qos(p["sensor_qos"], p["qos_depth"], kept=name in kept)
+                if name in sensors
+                else pipeline.loop_qos(p["qos_depth"], kept=name in kept))
             self.create_subscription(pipeline.message_type(type_name), self.sources[name],
                                      lambda data, n=name: self._record(n, data), qos, raw=True)
         self.progress_pub = self.create_publisher(Header, pipeline.RECORDER_PROGRESS,

@@ -82,10 +82,13 @@ class SimHardwareNode(Node):
         self.frame = self.p["frame_id"]
         loop = pipeline.loop_qos(self.p["qos_depth"])
         sensors = pipeline.sensor_qos(self.p["sensor_qos"], self.p["qos_depth"])
+        kept = pipeline.loop_qos(self.p["qos_depth"], kept=True)
+        kept_sensors = pipeline.sensor_qos(self.p["sensor_qos"], self.p["qos_depth"], kept=True)
         self.devices = {f: world.devices[f].name for f in world.fingers}
         pub = self.create_publisher
         self.clock_pub = pub(Clock, pipeline.CLOCK, loop)
-        self.pose_pubs = {f: pub(PoseStamped, pipeline.device_topic(d, "pose"), sensors)
+        self.pose_pubs = {f: pub(PoseStamped, pipeline.device_topic(d, "pose"),
+                                     kept_sensors)
                           for f, d in self.devices.items()}
         sensed = world.scene.has(Effect.FORCE_SENSING)
         self.wrench_pubs = {f: pub(WrenchStamped, pipeline.device_topic(d, "wrench"), sensors)
@@ -93,8 +96,8 @@ class SimHardwareNode(Node):
         self.tactile_pubs = {f: pub(TactileArray, pipeline.device_topic(d, "tactile"), sensors)
                              for f, d in self.devices.items() if f in world.layouts}
         self.msgs = {f: self._reading_messages(f) for f in self.devices}
-        self.tick_pub = pub(Tick, pipeline.TICK, loop)
-        self.state_pub = pub(SimState, pipeline.SIM_STATE, loop)
+        self.tick_pub = pub(Tick, pipeline.TICK, kept)
+        self.state_pub = pub(SimState, pipeline.SIM_STATE, kept)
         self.event_pub = pub(ContactEventArray, pipeline.SIM_EVENTS, loop)
         self.marker_pub = pub(MarkerArray, pipeline.MARKERS, loop)
         self.camera_pubs: dict[str, Any] = {}

@@ -159,11 +159,10 @@ def test_the_shape_watch_is_silent_when_the_model_is_right(path):
     frame = world.camera.render(truth, 0)
     seen = extract_outline(frame.views.mask, "mono8", world.camera.model, world.camera.pose,
                            object_height_m=scene.object.material.thickness)
-    match, scale, mismatch = check_frame(seen.outline, predicted, depth,
-                                         scene.camera.shape_mismatch_threshold)
-    assert not mismatch, match.rms_m
-    assert match.rms_m < 0.25 * scene.camera.shape_mismatch_threshold
-    assert scale == pytest.approx(1.0, abs=0.01)
+    check = check_frame(seen.outline, predicted, depth, scene.camera.shape_mismatch_threshold)
+    assert not check.mismatch, check.match.rms_m
+    assert check.match.rms_m < 0.25 * scene.camera.shape_mismatch_threshold
+    assert check.scale == pytest.approx(1.0, abs=0.01)
 
 
 def test_the_shape_watch_catches_a_larger_object_and_names_why_not_nu():
@@ -195,11 +194,81 @@ def test_the_shape_watch_catches_a_larger_object_and_names_why_not_nu():
             seen = extract_outline(frame.views.mask, "mono8", sim.camera.model, sim.camera.pose,
                                    object_height_m=0.0254)
             results[name, d] = check_frame(seen.outline, predicted, d, threshold)
-    assert all(results["larger", d][2] for d in (0.0, depth))
-    assert results["larger", depth][0].rms_m > 4 * threshold
-    assert results["larger", 0.0][1] == pytest.approx(1 / 1.05, abs=0.005)
-    assert not results["nu", depth][2] and not results["E", depth][2]
-    assert results["E", depth][0].rms_m < 0.2 * threshold
+    assert all(results["larger", d].mismatch for d in (0.0, depth))
+    assert results["larger", depth].match.rms_m > 4 * threshold
+    assert results["larger", 0.0].scale == pytest.approx(1 / 1.05, abs=0.005)
+    assert not results["nu", depth].mismatch and not results["E", depth].mismatch
+    assert results["E", depth].match.rms_m < 0.2 * threshold
+
+
+RING = {
+    "name": "foam_ring",
+    "object": {"shape": {"type": "annulus", "outer_radius": 0.05, "inner_radius": 0.025},
+               "material": {"E": 5.0e4, "nu": 0.3, "thickness": 0.0254},
+               "mesh": {"nodes": 1000, "min_angle": 30}},
+    "fingers": {"F1": {"tip_radius": 0.02, "placement": {"point": [-0.05, 0.0]}},
+                "F2": {"tip_radius": 0.02, "placement": {"point": [0.05, 0.0]}}},
+    "squeeze": {"type": "stable", "relative_depth": 0.12},
+    "friction": {"mu": 0.4},
+    "effects": ["friction", "force_sensing", "tactile_sensing"],
+}
+"""A foam ring (a meshed annulus, 5 cm outer and 2.5 cm inner radius) squeezed 12 %: its hole
+is watched with its outer curve."""
+
+
+def test_the_shape_watch_watches_a_ring_hole_and_reports_one_that_closes():
+    """The ring seen straight down at 60 % of its squeeze depth: the prediction carries the
+    hole, the frame shows it, every predicted node (outer and hole) is measured and the watch
+    is silent. The same frame without its hole, or with the hole shrunk below what the
+    extraction keeps (9 px), raises shape_mismatch and says a predicted hole was not seen; a
+    predicted hole too small to be seen is not expected.
+    """
+    skimage_or_skip()
+    from squeeze_grasp_ros.mechanics.elastic.shapes import Outline
+    from squeeze_grasp_ros.perception.extract import MIN_AREA_PX, extract_outline
+    from squeeze_grasp_ros.perception.shape_watch import predict_shapes
+
+    scene = parse_scene(with_camera(RING, pose=[0.0, 0.0, 0.5, np.pi, 0.0, 0.0]))
+    setup = GraspSetup.build(scene).precompute()
+    depth = 0.6 * setup.event_squeeze().target_depth
+    predicted = predict_shapes(setup, depth, samples=3)
+    mesh = setup.solid.mesh
+    assert predicted.hole_count == 1 and len(predicted.holes[0][0]) == len(
+        mesh.inner_boundaries[0])
+    truth = deformed_outline(mesh, setup.event_squeeze(depth=depth).displacement)
+    at_depth = predicted.at(depth)
+    assert np.abs(at_depth.holes[0] - truth.holes[0]).max() < 1e-12  # a sample: exact
+    world = SimWorld(setup)
+
+    def seen(outline: Outline):
+        frame = world.camera.render(outline, 0)
+        return extract_outline(frame.views.mask, "mono8", world.camera.model,
+                               world.camera.pose, object_height_m=0.0254)
+
+    right = seen(truth)
+    smallest = MIN_AREA_PX * right.pixel_size_m ** 2
+    threshold = scene.camera.shape_mismatch_threshold
+    check = check_frame(right.outline, predicted, depth, threshold, min_hole_area=smallest)
+    assert (check.holes_predicted, check.holes_seen, check.mismatch) == (1, 1, False)
+    assert len(check.match.distances) == len(mesh.boundary) + len(mesh.inner_boundaries[0])
+    assert check.match.rms_m < 0.25 * threshold and check.reason == ""
+
+    hole = truth.holes[0]
+    centre = hole.mean(axis=0)
+    shrunk = centre + (hole - centre) * 0.7 * right.pixel_size_m / 0.025  # ~1.5 px across
+    for outline in (Outline(truth.points), Outline(truth.points, (shrunk,))):
+        view = seen(outline)
+        assert view.outline.holes == ()
+        check = check_frame(view.outline, predicted, depth, threshold, min_hole_area=smallest)
+        assert check.mismatch and (check.holes_predicted, check.holes_seen) == (1, 0)
+        assert "1 of 1 predicted holes not seen" in check.reason
+        assert check.match.rms_m > threshold  # the hole's nodes lie far from the seen curve
+    tiny = predict_shapes(setup, depth, samples=2)
+    tiny = type(tiny)(tiny.depths, tiny.outlines, tuple(
+        (centre + (loops[0] - centre) * 1e-3,) for loops in tiny.holes))
+    check = check_frame(seen(Outline(truth.points)).outline, tiny, depth, threshold,
+                        min_hole_area=smallest)
+    assert check.holes_predicted == 0 and not check.mismatch
 
 
 # --------------------------------------------------------------------------- on real rclpy
@@ -238,6 +307,11 @@ def test_the_camera_closed_run_matches_the_yaml_route(tmp_path):
     assert images["/camera/camera_info"][0].k[0] == 465.0
     residuals = images["/monitor/shape_residual"]
     assert len(residuals) >= 7 and max(r.rms for r in residuals) < 5e-4
+    # every frame is matched, the tick-0 one too (latched before the prediction: it waits)
+    from squeeze_grasp_ros.ros import messages
+
+    stamps = [messages.stamp_ns(m.header.stamp) for m in images["/camera/mask"]]
+    assert sorted(messages.stamp_ns(r.header.stamp) for r in residuals) == sorted(stamps)
     assert len(images["/planner/predicted_shapes"]) == 1
 
     import json
@@ -265,3 +339,113 @@ def test_shape_mismatch_is_raised_when_the_world_is_larger(tmp_path):
     first = summary["first_alarms"]["shape_mismatch"]
     assert first["stamp_ns"] < 0.6 * summary["sim_time"] * 1e9, first
     assert "similarity scale 0.95" in first["message"]
+
+
+def test_a_ring_hole_is_watched_on_ros_and_a_missing_one_raises_shape_mismatch(tmp_path):
+    """The foam ring with the camera, run through the real nodes: every frame is matched with
+    its hole (``ShapeResidual.holes_predicted == holes_seen == 1``) and nothing is raised. The
+    same plan against a world whose object has no hole (a disk): ``shape_mismatch`` from the
+    first frame on, naming the hole that is not seen.
+    """
+    skimage_or_skip()
+    from mcap.reader import make_reader
+    from mcap_ros2.decoder import DecoderFactory
+
+    data = with_camera(RING, pose=[0.0, 0.0, 0.5, np.pi, 0.0, 0.0])
+    (tmp_path / "right").mkdir()
+    right = run_scene(tmp_path / "right", data, record=True)
+    assert right["outcome"] == "grasp held"
+    assert right["alarms"].get("shape_mismatch", 0) == 0
+    with open(next((tmp_path / "right" / "bag").glob("*.mcap")), "rb") as f:
+        reader = make_reader(f, decoder_factories=[DecoderFactory()])
+        residuals = [msg for _, _, _, msg in reader.iter_decoded_messages(
+            topics=["/monitor/shape_residual"])]
+    assert len(residuals) >= 7
+    assert all((r.holes_predicted, r.holes_seen) == (1, 1) for r in residuals)
+    assert max(r.rms for r in residuals) < 0.25 * residuals[0].threshold
+
+    disk = copy.deepcopy(data)
+    disk["object"]["shape"] = {"type": "disk", "radius": 0.05}
+    (tmp_path / "disk").mkdir()
+    wrong = run_scene(tmp_path / "disk", data, world=disk)
+    assert wrong["alarms"].get("shape_mismatch", 0) >= 1
+    first = wrong["first_alarms"]["shape_mismatch"]
+    assert first["stamp_ns"] == 0, first
+    assert "1 of 1 predicted holes not seen" in first["message"]
+
+
+def test_a_frame_before_the_prediction_waits_for_it(ros_context):
+    """The monitor's shape watch on real rclpy, in the order a launched world gives: the
+    tick-0 frame (latched) arrives and tick 0 closes before the prediction does. Nothing is
+    matched or dropped then; when the prediction arrives the frame is matched at tick 0's
+    depth, and a frame whose tick has not closed waits for it.
+    """
+    skimage_or_skip()
+    import rclpy
+    from geometry_msgs.msg import PoseStamped
+    from rclpy.executors import SingleThreadedExecutor
+    from sensor_msgs.msg import CameraInfo, Image
+
+    from squeeze_grasp_interfaces.msg import Alarm, ShapeResidual
+    from squeeze_grasp_interfaces.msg import PredictedShapes as PredictedShapesMsg
+    from squeeze_grasp_ros.ros import messages
+    from squeeze_grasp_ros.ros.messages.images import pose_of_camera
+    from squeeze_grasp_ros.ros.nodes import pipeline
+    from squeeze_grasp_ros.ros.nodes.shape_watcher import ShapeWatcher
+    from squeeze_grasp_ros.ros.nodes.sim_hardware import camera_messages
+    from squeeze_grasp_ros.ros.run.camera_plan import predicted_shapes_msg
+
+    scene = parse_scene(with_camera(yaml.safe_load(YAML_SCENE.read_text())))
+    world = SimWorld(GraspSetup.build(scene))
+    monitor = rclpy.create_node("watch_test_monitor", context=ros_context)
+    camera = rclpy.create_node("watch_test_camera", context=ros_context)
+    executor = SingleThreadedExecutor(context=ros_context)
+    for node in (monitor, camera):
+        executor.add_node(node)
+    try:
+        watcher = ShapeWatcher(monitor, monitor.create_publisher(Alarm, "alarms", 10),
+                               scene.camera.shape_mismatch_threshold, 0.0254)
+        residuals: list = []
+        camera.create_subscription(ShapeResidual, pipeline.SHAPE_RESIDUAL, residuals.append,
+                                   pipeline.loop_qos(100))
+        pubs = {t: camera.create_publisher(m, t, pipeline.LATCHED) for t, m in (
+            (pipeline.CAMERA_MASK, Image), (pipeline.CAMERA_DEPTH, Image),
+            (pipeline.CAMERA_INFO, CameraInfo))}
+        pose = PoseStamped(header=messages.header(0, "object"),
+                           pose=pose_of_camera(world.camera.pose))
+        camera.create_publisher(PoseStamped, pipeline.CAMERA_POSE, pipeline.LATCHED).publish(pose)
+
+        def spin_until(done, timeout=20.0):
+            import time
+            deadline = time.monotonic() + timeout
+            while not done():
+                assert time.monotonic() < deadline, "not done in time"
+                executor.spin_once(timeout_sec=0.05)
+
+        for pub, msg in camera_messages(pubs, world.camera_frame(0, 0)):
+            pub.publish(msg)
+        spin_until(lambda: watcher.waiting and watcher.camera is not None
+                   and watcher.pose is not None)
+        watcher.tick(0, 0.0)  # tick 0 closes: the prediction is not there yet
+        for _ in range(10):
+            executor.spin_once(timeout_sec=0.02)
+        assert residuals == [] and list(watcher.waiting) == [0] and watcher.dropped == 0
+
+        early = world.camera_frame(100, 100_000_000)  # a frame of tick 100, not closed yet
+        for pub, msg in camera_messages(pubs, early):
+            pub.publish(msg)
+        spin_until(lambda: 100_000_000 in watcher.waiting)
+        camera.create_publisher(PredictedShapesMsg, pipeline.PREDICTED_SHAPES,
+                                pipeline.LATCHED).publish(
+            predicted_shapes_msg(scene, 0.005, 0))
+        spin_until(lambda: len(residuals) == 1)
+        assert messages.stamp_ns(residuals[0].header.stamp) == 0 and residuals[0].depth == 0.0
+        assert residuals[0].rms < 0.25 * scene.camera.shape_mismatch_threshold
+        assert list(watcher.waiting) == [100_000_000]
+        watcher.tick(100_000_000, 0.0)
+        spin_until(lambda: len(residuals) == 2)
+        assert messages.stamp_ns(residuals[1].header.stamp) == 100_000_000
+    finally:
+        executor.shutdown()
+        for node in (monitor, camera):
+            node.destroy_node()

@@ -211,3 +211,82 @@ def test_load_object_takes_an_object_description(planner):
     both = planner.call(LoadObject, "load_object",
                         LoadObject.Request(object=description, scene_yaml=FOAM))
     assert not both.success and "exactly one of scene_yaml, scene_path and object" in both.message
+
+
+def test_the_frame_pose_comes_from_a_pose_topic(ros_context):
+    """Planner parameters ``frame_pose_topic``/``frame_pose_frame``: an outline in frame
+    ``table`` without ``frame_pose`` is placed by the newest latched ``PoseStamped`` there,
+    landing on the same object (same digest) as the request that carries that pose itself.
+    No pose yet, a stale pose (beyond ``frame_pose_max_age`` of the outline's stamp) and a pose
+    in another parent frame are refused with what to do; a pose in the request wins.
+    """
+    from geometry_msgs.msg import PoseStamped
+    from planner_support import Harness
+    from rclpy.parameter import Parameter
+
+    from squeeze_grasp_interfaces.srv import LoadObject
+    from squeeze_grasp_ros.mechanics.elastic.shapes import Outline
+    from squeeze_grasp_ros.ros import messages
+    from squeeze_grasp_ros.ros.messages.objects import object_description
+    from squeeze_grasp_ros.ros.nodes import pipeline
+
+    harness = Harness(ros_context, parameter_overrides=[
+        Parameter("frame_pose_topic", value="table/pose"),
+        Parameter("frame_pose_frame", value="table"),
+        Parameter("frame_pose_max_age", value=1.0)])
+    try:
+        # the square in the table frame, whose origin is at (0.2, 0.1) m turned by 90 deg
+        local = Outline(np.asarray(SQUARE) + [0.01, 0.0])
+        quarter = (0.0, 0.0, math.sin(math.pi / 4), math.cos(math.pi / 4))
+
+        def request(stamp_s: float, frame: str = "table", pose=None) -> LoadObject.Request:
+            description = object_description(
+                local, frame, youngs_modulus=5.0e4, poisson_ratio=0.3, thickness=0.0254,
+                mesh_nodes=400)
+            description.outline.header.stamp = messages.header(int(stamp_s * 1e9)).stamp
+            if pose is not None:
+                description.frame_pose.position.x, description.frame_pose.position.y = pose
+                (description.frame_pose.orientation.x, description.frame_pose.orientation.y,
+                 description.frame_pose.orientation.z,
+                 description.frame_pose.orientation.w) = quarter
+            return LoadObject.Request(object=description)
+
+        def load(req: LoadObject.Request) -> LoadObject.Response:
+            return harness.call(LoadObject, "load_object", req)
+
+        missing = load(request(10.0))
+        assert not missing.success and missing.error_code == LoadObject.Response.INVALID_ARGUMENT
+        assert "object.frame_pose is unset, so its pose comes from table/pose" in missing.message
+        assert "nothing has arrived yet" in missing.message
+
+        publisher = harness.node.create_publisher(PoseStamped, "table/pose", pipeline.LATCHED)
+
+        def publish(stamp_s: float, parent: str = "object") -> None:
+            pose = PoseStamped(header=messages.header(int(stamp_s * 1e9), parent))
+            pose.pose.position.x, pose.pose.position.y = 0.2, 0.1
+            (pose.pose.orientation.x, pose.pose.orientation.y, pose.pose.orientation.z,
+             pose.pose.orientation.w) = quarter
+            publisher.publish(pose)
+            harness.spin_until(lambda: harness.planner.frame_poses.latest is not None and (
+                messages.stamp_ns(harness.planner.frame_poses.latest.header.stamp)
+                == int(stamp_s * 1e9)))
+
+        publish(10.0)
+        by_topic = load(request(10.4))
+        assert by_topic.success, by_topic.message
+        by_request = load(request(10.4, pose=(0.2, 0.1)))
+        in_object = load(request(10.4, frame="object"))
+        assert by_request.success and in_object.success
+        assert by_topic.object_digest == by_request.object_digest != in_object.object_digest
+
+        stale = load(request(12.0))
+        assert not stale.success and "2.000 s from the outline's stamp" in stale.message
+        assert "frame_pose_max_age = 1 s): stale" in stale.message
+        assert load(request(12.0, pose=(0.2, 0.1))).success  # the request's pose wins
+        assert load(request(12.0, frame="shelf")).success  # other frames: as before
+
+        publish(12.0, parent="map")
+        wrong = load(request(12.0))
+        assert not wrong.success and "whose pose is in frame 'map'" in wrong.message
+    finally:
+        harness.close()

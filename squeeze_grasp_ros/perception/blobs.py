@@ -87,8 +87,16 @@ def choose_object(inside: np.ndarray, *, min_area_px: int, ambiguous_ratio: floa
         No blob (an empty view), the object touching the image border, or two blobs of similar
         size.
     """
-    labels, count = ndimage.label(inside)
-    areas = np.bincount(labels.ravel(), minlength=count + 1)[1:]
+    # label only the bounding box of all pixels inside (the object and the other blobs): a
+    # top-down view is mostly background, and labelling the whole frame was most of a 640 x
+    # 480 mask's extraction time
+    rows, cols = np.flatnonzero(inside.any(axis=1)), np.flatnonzero(inside.any(axis=0))
+    labels = np.zeros(inside.shape, np.int32)
+    origin = (int(rows[0]), int(cols[0])) if rows.size else (0, 0)
+    crop = (slice(origin[0], int(rows[-1]) + 1 if rows.size else 0),
+            slice(origin[1], int(cols[-1]) + 1 if rows.size else 0))
+    count = ndimage.label(inside[crop], output=labels[crop])
+    areas = np.bincount(labels[crop].ravel(), minlength=count + 1)[1:]
     order = np.argsort(-areas, kind="mergesort")
     kept = [int(k) for k in order if areas[k] >= min_area_px]
     if not kept:
@@ -101,7 +109,9 @@ def choose_object(inside: np.ndarray, *, min_area_px: int, ambiguous_ratio: floa
             f"similar size ({int(areas[first])} and {int(areas[kept[1]])} px; the second is at "
             f"least ambiguous_ratio = {ambiguous_ratio:g} of the first): which one is the object "
             "is ambiguous; show one object or mask the others")
-    boxes = ndimage.find_objects(labels)
+    boxes = [(slice(r.start + origin[0], r.stop + origin[0]),
+              slice(c.start + origin[1], c.stop + origin[1]))
+             for r, c in ndimage.find_objects(labels[crop])]
     box = boxes[first]
     H, W = inside.shape
     if box[0].start == 0 or box[1].start == 0 or box[0].stop == H or box[1].stop == W:

@@ -38,7 +38,7 @@ from squeeze_grasp_ros.perception.camera import CameraModel, CameraPose
 from squeeze_grasp_ros.perception.simplify import kept_vertices, sharpen_corners
 from squeeze_grasp_ros.perception.support import SupportPlane, fit_support, floor_grids
 
-__all__ = ["DEFAULT_TOLERANCE_PX", "ObjectOutline", "extract_outline"]
+__all__ = ["DEFAULT_TOLERANCE_PX", "MIN_AREA_PX", "ObjectOutline", "extract_outline"]
 
 DEFAULT_TOLERANCE_PX = 0.15
 """Default simplification tolerance, in pixel footprints at the object."""
@@ -59,6 +59,9 @@ CORNER_STRAIGHT_PX = 0.12
 0.09 px (marching squares on slanted edges); an arc strays span^2 / (16 R) from its best line,
 so only arcs of radius R >= 33 px pass, and those turn far less than 30 degrees between the
 two stretches (12 px apart): smooth bends are never made corners."""
+
+MIN_AREA_PX = 9
+"""Default smallest blob and hole that counts, px (``extract_outline``'s ``min_area_px``)."""
 
 IMAGE_TYPES: dict[ImageEncoding, tuple[type, ...]] = {
     ImageEncoding.MONO8: (np.uint8, np.bool_),
@@ -237,7 +240,7 @@ def extract_outline(image: np.ndarray, encoding: ImageEncoding | str, camera: Ca
                     pose: CameraPose, *, tolerance_m: float | None = None,
                     object_height_m: float = 0.0, min_height_m: float = 0.004,
                     plane_tolerance_m: float = 0.002, max_tilt_deg: float = 2.0,
-                    min_area_px: int = 9, ambiguous_ratio: float = 0.8,
+                    min_area_px: int = MIN_AREA_PX, ambiguous_ratio: float = 0.8,
                     frame_id: str = "plane") -> ObjectOutline:
     """The object's outline from a top-down mask or depth image.
 

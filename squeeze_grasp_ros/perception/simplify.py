@@ -84,9 +84,12 @@ def _line(points: np.ndarray, tolerance: float):
     when they stray from it by more than ``tolerance`` (they are not straight).
     """
     centre = points.mean(axis=0)
-    _, _, vt = np.linalg.svd(points - centre, full_matrices=False)
-    off = np.abs((points - centre) @ np.array([-vt[0, 1], vt[0, 0]]))
-    return (centre, vt[0]) if off.max() <= tolerance else None
+    d = points - centre
+    sxx, syy, sxy = d[:, 0] @ d[:, 0], d[:, 1] @ d[:, 1], d[:, 0] @ d[:, 1]
+    angle = 0.5 * np.arctan2(2.0 * sxy, sxx - syy)  # principal axis of the 2 x 2 scatter
+    direction = np.array([np.cos(angle), np.sin(angle)])
+    off = np.abs(d @ np.array([-direction[1], direction[0]]))
+    return (centre, direction) if off.max() <= tolerance else None
 
 
 def _corner(p: np.ndarray, gap: np.ndarray, skip: float, span: float, tolerance: float,

@@ -64,6 +64,7 @@ from squeeze_grasp_ros.planning import Cancelled, ErrorCode, PlannerLimits
 from squeeze_grasp_ros.resources import share_dir
 from squeeze_grasp_ros.ros import messages
 from squeeze_grasp_ros.ros.nodes import run_node
+from squeeze_grasp_ros.ros.nodes.frame_pose_topic import frame_pose_topic
 
 Response = TypeVar("Response")
 WATCH_PERIOD = 0.1
@@ -92,6 +93,12 @@ PARAMETERS: dict[str, tuple[Any, str]] = {
                                "are dropped)"),
     "max_pending": (16, "long requests (loads, maps, event squeezes) queued or running at "
                         "once; more are answered BUSY at once"),
+    "frame_pose_topic": ("", "geometry_msgs/PoseStamped topic (latched) with the pose of "
+                             "frame_pose_frame in the object frame, for typed objects whose "
+                             "outline is in that frame and whose frame_pose is unset; '' = none"),
+    "frame_pose_frame": ("", "the outline frame whose pose frame_pose_topic carries"),
+    "frame_pose_max_age": (1.0, "s, largest distance of the topic's pose stamp from the "
+                                "outline's stamp (unstamped: the planner's clock); 0 = any age"),
     "allowed_roots": ([""], "folders whose files scene_path and a scene's outline file may "
                             "name (symlinks and '..' resolved first); [''] = the package share "
                             "folder and the node's working directory"),
@@ -159,6 +166,7 @@ class PlannerNode(Node):
         """Progress (the arguments of the last report before it, () if none) of service
         requests stopped because their client left the graph."""
         self._feedback: queue.SimpleQueue[tuple[ServerGoalHandle, Any]] = queue.SimpleQueue()
+        self.frame_poses = frame_pose_topic(self, value)
 
         services = request_queue(value("service_queue_depth"))
         self._pending = 0
@@ -205,8 +213,11 @@ class PlannerNode(Node):
         watch = self._client_watch("load_object")
 
         def load() -> LoadObject.Response:
-            source = planning.object_source(request.scene_yaml, request.scene_path,
-                                            messages.typed_object(request.object), self.roots)
+            typed = messages.typed_object(request.object)
+            if self.frame_poses is not None:
+                typed = self.frame_poses.resolve(request.object, typed)
+            source = planning.object_source(request.scene_yaml, request.scene_path, typed,
+                                            self.roots)
             loaded, cached = planning.load_cached(self.cache, source, request.object_id,
                                                   request.solver_route, self.limits, watch,
                                                   request.replace)

@@ -105,9 +105,11 @@ def seen_report(scene: Scene, seen: ObjectOutline) -> dict:
 def predicted_shapes_msg(scene: Scene, depth: float, ns: int,
                          frame_id: str = pipeline.FRAME) -> PredictedShapes:
     """The ``PredictedShapes`` of the planner's model (``scene``: the seen object's typed scene
-    on the camera route) squeezed to ``depth`` (m), for the monitor's shape watch.
+    on the camera route) squeezed to ``depth`` (m), for the monitor's shape watch: the outer
+    boundary and, depth-major, the holes.
     """
     predicted = predict_shapes(GraspSetup.build(scene).precompute(), depth)
     return PredictedShapes(header=messages.header(ns, frame_id),
                            depths=[float(d) for d in predicted.depths],
-                           outlines=[polygon_msg(o) for o in predicted.outlines])
+                           outlines=[polygon_msg(o) for o in predicted.outlines],
+                           holes=[polygon_msg(h) for loops in predicted.holes for h in loops])

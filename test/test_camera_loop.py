@@ -321,6 +321,16 @@ def test_the_camera_closed_run_matches_the_yaml_route(tmp_path):
     layout = json.loads(viewer_file("foxglove_layout.json").read_text())["configById"]
     image_panel = layout["Image!camera"]["imageMode"]
     assert image_panel["imageTopic"] in images and image_panel["calibrationTopic"] in images
+    # the live shape residual panel plots numbers of this recording, one per frame
+    from foxglove_support import first_messages, layout_paths, resolve
+
+    first = first_messages(tmp_path / "bag")
+    plotted = layout_paths({"shape": layout["Plot!shape_residual"]})
+    assert plotted
+    for value in plotted:
+        topic, _, field = value.partition(".")
+        assert topic == "/monitor/shape_residual"
+        assert isinstance(resolve(first[topic], field), float), value
 
     from foxglove_support import foxglove_decode
 

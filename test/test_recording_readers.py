@@ -25,6 +25,8 @@ ACTION_TOPICS = {"/executor/execute_grasp/_action/feedback",
 
 GRIPPER_TOPICS = ("/joint_states",)
 """Topics of the shipped Foxglove layout that only a gripper scene's recording holds."""
+CAMERA_TOPICS = ("/monitor/shape_residual",)
+"""Plotted topics of the shipped layout that only a camera scene's recording holds."""
 
 
 def record(directory: Path, *, hidden: bool) -> Path:
@@ -168,8 +170,10 @@ def test_shipped_viewers_show_what_a_recording_holds(default_bag):
     messages = first_messages(default_bag.parent)
     layout = json.loads(viewer_file("foxglove_layout.json").read_text())
     panels = layout["configById"]
-    # the gripper's joint_states panel: test_joint_feedback checks it on a gripper recording
-    paths = [v for v in layout_paths(panels) if not v.startswith(GRIPPER_TOPICS)]
+    # the gripper's joint_states panel: test_joint_feedback checks it on a gripper recording;
+    # the shape residual panel: test_camera_loop on a camera recording
+    paths = [v for v in layout_paths(panels)
+             if not v.startswith(GRIPPER_TOPICS + CAMERA_TOPICS)]
     assert paths
     for value in paths:
         topic, _, field = value.partition(".")

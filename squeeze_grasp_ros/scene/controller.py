@@ -23,13 +23,14 @@ the device's pad, and the controller's joints (default: the device's
 """
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
 from squeeze_grasp_ros.control.gripper_action import GripperParameters
+from squeeze_grasp_ros.control.joint_trajectory import JawLine
 from squeeze_grasp_ros.mechanics.vocabulary import ControllerKind, Finger
 from squeeze_grasp_ros.resources import ResourceError, device_file
 from squeeze_grasp_ros.scene.gripper import GripperSpec, load_gripper
@@ -71,6 +72,14 @@ class JawController:
     def jaws(self) -> tuple[Finger, Finger]:
         """The fingers the jaws carry, F1's jaw (the closing direction's origin) first."""
         return self.spec.jaws[0], self.spec.jaws[1]
+
+    def jaw_line(self, positions: Mapping[str, np.ndarray]) -> JawLine:
+        """The jaw line through the jaws' tip reference points ``positions[finger]`` (m), with
+        the pad's contact radius as each jaw's reach.
+        """
+        first, second = self.jaws
+        return JawLine.between(positions[first], positions[second],
+                               reach=self.gripper.pad.contact_radius)
 
     @property
     def kind(self) -> ControllerKind:

@@ -105,8 +105,7 @@ class JawAction:
         observation (fixes the jaw line).
         """
         first, second = self.fingers
-        self.line = JawLine.between(obs.positions[first], obs.positions[second],
-                                    reach=self.controller.gripper.pad.contact_radius)
+        self.line = self.controller.jaw_line(obs.positions)
         end = {f: np.asarray(obs.positions[f], float) + goal.depth * np.asarray(d, float)
                for f, d in zip(goal.fingers, goal.directions)}
         aperture = self.line.aperture(end.get(first, obs.positions[first]),

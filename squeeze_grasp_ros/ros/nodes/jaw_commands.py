@@ -58,9 +58,7 @@ class JawCommands:
 
     def start(self, obs: Observation) -> None:
         """Fix the jaw line from the jaws' measured tips (a goal's first cycle)."""
-        first, second = self.fingers
-        self.line = JawLine.between(obs.positions[first], obs.positions[second],
-                                    reach=self.controller.gripper.pad.contact_radius)
+        self.line = self.controller.jaw_line(obs.positions)
 
     def trajectory(self, setpoints: Mapping[str, np.ndarray], start_ns: int
                    ) -> tuple[Any, JointTrajectory]:

@@ -274,8 +274,8 @@ class JointFeedback:
         if self.line is None:
             if msg is None or any("position" not in fields[j] for j in (first, second)):
                 return
-            self.line = JawLine.between(fields[first]["position"], fields[second]["position"],
-                                        reach=self.controller.gripper.pad.contact_radius)
+            self.line = self.controller.jaw_line({j: fields[j]["position"]
+                                                  for j in (first, second)})
         ns = messages.stamp_ns(msg.header.stamp)
         try:
             reading = self.controller.reading(msg.name, msg.position, msg.effort)

@@ -33,7 +33,6 @@ from sensor_msgs.msg import JointState
 from trajectory_msgs.msg import JointTrajectory
 
 from squeeze_grasp_ros.control.joint_trajectory import (
-    JawLine,
     TrajectoryFollower,
     TrajectoryRefused,
 )
@@ -63,8 +62,7 @@ class SimJaws:
     def __init__(self, node: Node, world: SimWorld, controller: JawController, qos: Any) -> None:
         self.node, self.world, self.controller = node, world, controller
         first, second = controller.jaws
-        self.line = JawLine.between(world.positions[first], world.positions[second],
-                                    reach=controller.gripper.pad.contact_radius)
+        self.line = controller.jaw_line(world.positions)
         self.aperture = self.line.aperture(world.positions[first], world.positions[second])
         """The measured aperture of the last tick, m."""
         self.limited = (0, self.aperture)

@@ -173,3 +173,23 @@ def test_run_and_replay_from_the_install(workspace):
     replay = run_installed(workspace, "squeeze-grasp", "replay", str(bag))
     assert replay.returncode == 0, replay.stderr[-3000:]
     assert "reproduced exactly" in replay.stdout
+
+
+def test_package_xml_declares_every_ros_package_the_code_imports():
+    """rosdep installs what package.xml declares: every ROS interface package imported by the
+    package or its launch files (``*_msgs``, ``*_interfaces``) is an ``exec_depend`` (none is
+    built against: the package is pure Python).
+    """
+    import re
+    import xml.etree.ElementTree as ET
+
+    imported = set()
+    for folder in ("squeeze_grasp_ros", "launch"):
+        for path in (REPO / folder).rglob("*.py"):
+            imported |= set(re.findall(r"^\s*(?:from|import) ([a-z_]+(?:_msgs|_interfaces))\b",
+                                       path.read_text(), flags=re.M))
+    manifest = ET.parse(REPO / "package.xml").getroot()
+    declared = {e.text for e in manifest.findall("exec_depend")}
+    assert {"control_msgs", "trajectory_msgs", "sensor_msgs"} <= imported
+    assert sorted(imported - declared) == []
+    assert not {e.text for e in manifest.findall("build_depend")} & imported

@@ -176,9 +176,9 @@ def test_run_and_replay_from_the_install(workspace):
 
 
 def test_package_xml_declares_every_ros_package_the_code_imports():
-    """rosdep installs what package.xml declares: every ROS interface package imported by the
-    package or its launch files (``*_msgs``, ``*_interfaces``) is an ``exec_depend`` (none is
-    built against: the package is pure Python).
+    """What rosdep installs is what package.xml declares: every ROS interface package imported
+    by the package or its launch files (``*_msgs``, ``*_interfaces``) is an ``exec_depend``
+    (none is built against: the package is pure Python).
     """
     import re
     import xml.etree.ElementTree as ET

@@ -268,3 +268,38 @@ def test_the_simulated_controller_keeps_the_device_speed_limit(tmp_path):
     steps = -np.diff(apertures)
     print(f"aperture per tick [mm]: {(steps * 1e3).tolist()}")
     np.testing.assert_allclose(steps, 0.04 * 1e-3, rtol=1e-9)
+
+
+# --------------------------------------------------------------------------- recording
+def test_a_processes_run_records_the_controller_topics_from_their_first_message(tmp_path):
+    """Across processes the recorder can see a publisher before that writer matched its reader;
+    the controller's per-tick topics (the executor's trajectory and the joint_state_broadcaster's
+    joint_states) are transient-local and awaited by the recorder, so the bag has them from
+    their first message: a joint state per tick from tick 0, a trajectory per executor cycle.
+    """
+    from squeeze_grasp_ros.ros.run.options import RunOptions, node_parameters
+    from squeeze_grasp_ros.ros.run.runner import PipelineRunner
+
+    data = sponge_data(squeeze={"type": "stable", "relative_depth": 0.04})
+    data["object"]["mesh"]["nodes"] = 300
+    path = write_scene(tmp_path, data)
+    params = node_parameters(load_scene(path), path, RunOptions(path, record="x"), 1.0)
+    assert params["recorder"]["lockstep_topics"] == ["gripper_controller/joint_trajectory",
+                                                     "joint_states"]
+    result = PipelineRunner(RunOptions(path, record=str(tmp_path / "bag"),
+                                       processes=True)).run()
+    assert result["mode"] == "processes" and result["termination"] == "depth_reached"
+    stamps: dict[str, list[int]] = {}
+    qos: dict[str, str] = {}
+    with open(next((tmp_path / "bag").glob("*.mcap")), "rb") as stream:
+        for _, channel, message in make_reader(stream).iter_messages():
+            stamps.setdefault(channel.topic, []).append(message.log_time)
+            qos[channel.topic] = channel.metadata.get("offered_qos_profiles", "")
+    ticks, states = stamps["/sim/tick"], stamps["/joint_states"]
+    trajectories = stamps["/gripper_controller/joint_trajectory"]
+    print(f"{len(ticks)} ticks, {len(states)} joint states, {len(trajectories)} trajectories")
+    assert states == ticks and states[0] == 0
+    dt = int(round(float(data.get("sim", {}).get("dt", 1e-3)) * 1e9))
+    assert np.all(np.diff(trajectories) == dt) and len(trajectories) == result["ticks"]
+    for topic in ("/joint_states", "/gripper_controller/joint_trajectory"):
+        assert "durability: transient_local" in qos[topic], (topic, qos[topic])

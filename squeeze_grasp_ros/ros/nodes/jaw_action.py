@@ -62,6 +62,8 @@ class JawAction:
     node : Node
     controller : JawController
     qos : QoSProfile
+        Its depth is the cycle publisher's; that publisher is transient-local (a lockstep
+        topic a recorder awaits, :func:`.pipeline.loop_qos`).
     """
 
     def __init__(self, node: Node, controller: JawController, qos: Any) -> None:
@@ -70,7 +72,8 @@ class JawAction:
         self.action = ParallelGripperCommand if self.parallel else GripperCommand
         self.topic = node.resolve_topic_name(controller.topic)
         self.client = ActionClient(node, self.action, controller.topic)
-        self.publisher = node.create_publisher(Header, pipeline.EXECUTOR_CYCLE, qos)
+        self.publisher = node.create_publisher(Header, pipeline.EXECUTOR_CYCLE,
+                                               pipeline.loop_qos(qos.depth, kept=True))
         self.forces = None
         node.create_subscription(ContactEventArray, pipeline.PREDICTION, self._prediction,
                                  pipeline.LATCHED)

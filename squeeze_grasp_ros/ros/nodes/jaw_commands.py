@@ -25,6 +25,7 @@ from trajectory_msgs.msg import JointTrajectory, JointTrajectoryPoint
 from squeeze_grasp_ros.control.joint_trajectory import JawLine
 from squeeze_grasp_ros.control.motion import Observation
 from squeeze_grasp_ros.ros import messages
+from squeeze_grasp_ros.ros.nodes import pipeline
 from squeeze_grasp_ros.scene.controller import JawController
 
 
@@ -38,12 +39,15 @@ class JawCommands:
     period : float
         The control period, s (each message's ``time_from_start``).
     qos : QoSProfile
+        Its depth is the publisher's; the publisher is transient-local (a lockstep topic a
+        recorder awaits, :func:`.pipeline.loop_qos`).
     """
 
     def __init__(self, node: Node, controller: JawController, period: float, qos: Any) -> None:
         self.controller = controller
         self.topic = node.resolve_topic_name(controller.topic)
-        self.publisher = node.create_publisher(JointTrajectory, controller.topic, qos)
+        self.publisher = node.create_publisher(JointTrajectory, controller.topic,
+                                               pipeline.loop_qos(qos.depth, kept=True))
         self.period_ns = int(round(period * 1e9))
         self.line: JawLine | None = None
         self.msg = JointTrajectory(joint_names=list(controller.joints), points=[

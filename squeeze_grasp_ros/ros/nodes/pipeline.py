@@ -55,6 +55,8 @@ EXECUTOR_STATUS = "executor/status"
 EXECUTOR_CYCLE = "executor/cycle"
 """std_msgs/Header stamped with each tick the executor has answered, once its requests to a
 gripper action controller for that tick were acknowledged (the lockstep of the action route)."""
+JOINT_STATES = "joint_states"
+"""The joint_state_broadcaster's topic (a stock controller's joint feedback)."""
 OBJECT_POSE = "object_pose"
 ACTION = "executor/execute_grasp"
 CAMERA_MASK = "camera/mask"

@@ -46,6 +46,10 @@ PARAMETERS: dict[str, tuple[Any, str]] = {
     "output": ("", "bag folder to create (required; must not exist or be empty)"),
     "devices": (["barrett_f1", "barrett_f3"], "devices whose topics are recorded"),
     "extra_topics": ([""], "more topics to record, as 'name pkg/msg/Type' ('' = none)"),
+    "lockstep_topics": ([""], "extra topics every lockstep tick publishes from a "
+                        "transient-local publisher (a stock controller's joint_states and its "
+                        "command): awaited and read transient-local like the pipeline's "
+                        "('' = none)"),
     "silent_setpoints": ([""], "devices whose setpoint topics have no publisher (a stock "
                                "controller drives them; '' = none): not awaited at start-up"),
     "camera": (False, "also record the camera's images, info and pose, and the shape residual"),
@@ -121,8 +125,9 @@ class RecorderNode(Node):
                                          pipeline.CAMERA_DEPTH, pipeline.CAMERA_INFO,
                                          pipeline.PREDICTED_SHAPES)}
         sensors = {name for name in topics if name.rsplit("/", 1)[-1] in pipeline.STREAMS}
-        kept = ({"/" + t for t in pipeline.loop_topics(p["devices"])} if p["lockstep"]
-                else set())
+        extra_loop = [t for t in p["lockstep_topics"] if t.strip()]
+        kept = ({"/" + t.lstrip("/") for t in [*pipeline.loop_topics(p["devices"]), *extra_loop]}
+                if p["lockstep"] else set())
         """Lockstep topics whose publishers keep their last messages for a late reader."""
         for name, type_name in topics.items():
             qos = pipeline.LATCHED if name in latched else (
@@ -136,6 +141,7 @@ class RecorderNode(Node):
         if p["lockstep"]:
             awaited = pipeline.loop_topics(p["devices"],
                                            silent=[d for d in p["silent_setpoints"] if d])
+            awaited += extra_loop
             self.participant = pipeline.Participant(self, "recorder", awaited,
                                                     [self.progress_pub])
             pipeline.wall_timer(self, 0.05, self._repeat_report)

@@ -37,11 +37,10 @@ from squeeze_grasp_ros.control.joint_trajectory import (
     TrajectoryRefused,
 )
 from squeeze_grasp_ros.ros import messages
+from squeeze_grasp_ros.ros.nodes import pipeline
+from squeeze_grasp_ros.ros.nodes.pipeline import JOINT_STATES
 from squeeze_grasp_ros.scene.controller import JawController
 from squeeze_grasp_ros.sim.world import SimWorld, TickOutput
-
-JOINT_STATES = "joint_states"
-"""The joint_state_broadcaster's topic (relative)."""
 
 
 class SimJaws:
@@ -56,7 +55,8 @@ class SimJaws:
     controller : JawController
         The scene's resolved ``controller:`` section.
     qos : QoSProfile
-        Of the joint states (and the controller's own topics).
+        Of the controller's own topics; the joint states go out with its depth,
+        transient-local (a lockstep topic a recorder awaits, :func:`.pipeline.loop_qos`).
     """
 
     def __init__(self, node: Node, world: SimWorld, controller: JawController, qos: Any) -> None:
@@ -70,7 +70,8 @@ class SimJaws:
         self.topic = node.resolve_topic_name(controller.topic)
         self.refusals: list[str] = []
         """Why each refused command was refused, in order."""
-        self.state_pub = node.create_publisher(JointState, JOINT_STATES, qos)
+        self.state_pub = node.create_publisher(JointState, JOINT_STATES,
+                                                pipeline.loop_qos(qos.depth, kept=True))
         self.state_msg = JointState(name=list(controller.joints))
 
     @property

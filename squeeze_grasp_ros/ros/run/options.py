@@ -133,11 +133,23 @@ def node_parameters(
     if scene.controller is not None:
         params["recorder"]["extra_topics"] = controller_topics(scene.controller)
         params["recorder"]["silent_setpoints"] = [devices[f] for f in scene.controller.jaws]
+        params["recorder"]["lockstep_topics"] = controller_lockstep_topics(scene.controller)
     for name, values in options.overrides.items():
         params[name].update(values)
     custom["monitor_parameters"] = yaml.safe_dump(params["monitor"], sort_keys=True)
     params["recorder"]["custom_data"] = yaml.safe_dump(custom)
     return params
+
+
+def controller_lockstep_topics(spec: ControllerSpec) -> list[str]:
+    """The recorded topics of a scene's controller that every lockstep tick publishes
+    (relative): its command (the executor's trajectory, or its cycle on an action route) and
+    joint_states. Their publishers are transient-local and the recorder awaits them, so a
+    recorder in another process does not miss their first messages (docs/design.md).
+    """
+    command = (pipeline.EXECUTOR_CYCLE if ControllerKind(spec.type).is_action
+               else f"{spec.name}/joint_trajectory")
+    return [command, pipeline.JOINT_STATES]
 
 
 def controller_topics(spec: ControllerSpec) -> list[str]:

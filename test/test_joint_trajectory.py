@@ -303,3 +303,66 @@ def test_a_processes_run_records_the_controller_topics_from_their_first_message(
     assert np.all(np.diff(trajectories) == dt) and len(trajectories) == result["ticks"]
     for topic in ("/joint_states", "/gripper_controller/joint_trajectory"):
         assert "durability: transient_local" in qos[topic], (topic, qos[topic])
+
+
+# --------------------------------------------------------------------------- effort limit
+def weak_gripper_scene(tmp_path: Path, max_force: float) -> Path:
+    """The sponge scene on the generic gripper with its ``max_force`` lowered (N)."""
+    device = yaml.safe_load((SPONGE.parents[1] / "devices" / "generic_85mm.yaml").read_text())
+    device.update(name="weak_85mm", max_force=max_force)
+    (tmp_path / "weak_85mm.yaml").write_text(yaml.safe_dump(device))
+    data = sponge_data()
+    data["controller"]["device"] = "weak_85mm.yaml"
+    return Path(write_scene(tmp_path, data))
+
+
+def squeeze_by_hand(scene: Path, ticks: int) -> tuple[np.ndarray, np.ndarray, float]:
+    """Command the scene's JTC to close 10 mm below the initial aperture, one message per tick;
+    the measured (aperture m, jaw force N) of each tick, and the commanded aperture.
+    """
+    rig = SimWithClient(scene)
+    try:
+        jtc = rig.sim.controller
+        target = jtc.aperture - 0.01
+        apertures, forces = [], []
+        for tick in range(1, ticks + 1):
+            rig.pub.publish(hostile(["finger_joint"],
+                                    list(jtc.controller.gripper.joint_positions(target)), ms=1))
+            rig.spin_until(lambda t=tick: rig.sim.now_ns >= t * MS)
+            apertures.append(jtc.aperture)
+            forces.append(jtc.force)
+    finally:
+        rig.close()
+    return np.array(apertures), np.array(forces), target
+
+
+def test_the_simulated_controller_stops_the_jaws_at_the_device_effort_limit(tmp_path):
+    """A position JTC limits no effort; the gripper's drive does: commanded 10 mm into the
+    sponge, a gripper of 1.5 N closes until its jaw force reaches 1.5 N and holds there, short
+    of the command, while the stock 235 N gripper goes on loading the sponge.
+    """
+    ticks = 120
+    weak_a, weak_f, target = squeeze_by_hand(weak_gripper_scene(tmp_path, 1.5), ticks)
+    strong_a, strong_f, _ = squeeze_by_hand(SPONGE, ticks)
+    stop = int(np.argmax(weak_f >= 1.5))
+    print(f"weak gripper: {weak_f[stop]:.4g} N at tick {stop + 1}, held at "
+          f"{weak_a[-1] * 1e3:.4f} mm (commanded {target * 1e3:.4f} mm); stock gripper "
+          f"{strong_f[-1]:.4g} N at {strong_a[-1] * 1e3:.4f} mm")
+    assert weak_f[stop] >= 1.5 and 0 < stop < ticks - 20
+    # up to the stop both grippers close alike; after it the weak one holds
+    np.testing.assert_allclose(weak_a[:stop + 1], strong_a[:stop + 1], rtol=0, atol=1e-12)
+    assert np.ptp(weak_a[stop + 1:]) < 1e-6 and weak_a[-1] > target + 5e-3
+    assert weak_f.max() < 1.5 * 1.2 and strong_f[-1] > 2 * 1.5
+
+
+def test_the_executor_refuses_a_plan_beyond_the_device_effort(tmp_path):
+    """The sponge's plan needs 5.97 N per jaw; on a 3 N gripper the executor refuses the goal
+    (invalid_goal, naming the force and the limit) and sends no trajectory.
+    """
+    out = run_observed(str(weak_gripper_scene(tmp_path, 3.0)), [
+        ("trajectories", "gripper_controller/joint_trajectory", JointTrajectory)])
+    result = out["result"]
+    print(result.message)
+    assert result.termination == "invalid_goal" and not result.success
+    assert "max_force 3 N" in result.message and "jaw force of 5.97 N" in result.message
+    assert out["trajectories"] == []

@@ -22,7 +22,8 @@ Stock controller (``controller_scene``: a scene with a ``controller:`` section, 
 the jaws' setpoints become one aperture on the jaw line (fixed by the jaws' measured tips when
 a goal starts) and are sent through the gripper's transmission as ``trajectory_msgs/
 JointTrajectory`` on ``<controller>/joint_trajectory``, one point per control cycle
-(:mod:`.jaw_commands`); or, under a gripper action controller, the planned aperture and effort
+(:mod:`.jaw_commands`; a goal whose planned jaw force is beyond the device's ``max_force`` is
+refused ``invalid_goal``); or, under a gripper action controller, the planned aperture and effort
 are one ``control_msgs`` GripperCommand / ParallelGripperCommand goal on
 ``<controller>/gripper_cmd`` whose result ends the grasp goal (:mod:`.jaw_action`). The other
 fingers keep their setpoint topics.
@@ -147,7 +148,8 @@ class ExecutorNode(Node):
                                                     + ([self.jaw_action.publisher]
                                                        if self.jaw_action else []),
                                                     condition=self.jaw_action.ready
-                                                    if self.jaw_action else None)
+                                                    if self.jaw_action else
+                                                    self.jaws.plan.ready if self.jaws else None)
         else:
             self.create_timer(p["period"], self._timer)
 
@@ -166,6 +168,8 @@ class ExecutorNode(Node):
     async def _execute(self, handle: ServerGoalHandle) -> ExecuteGrasp.Result:
         goal = messages.grasp_goal(handle.request)
         problem = goal_problem(goal, list(self.devices))
+        if problem is None and self.jaws is not None:
+            problem = self.jaws.effort_problem(goal)
         if problem is not None:
             handle.abort()
             return messages.invalid_goal_result(problem)

@@ -40,12 +40,12 @@ from rclpy.node import Node
 from std_msgs.msg import Header
 
 from squeeze_grasp_interfaces.action import ExecuteGrasp
-from squeeze_grasp_interfaces.msg import ContactEventArray
 from squeeze_grasp_ros.control.joint_trajectory import JawLine
 from squeeze_grasp_ros.control.motion import GraspGoal, Observation
 from squeeze_grasp_ros.mechanics.vocabulary import ControllerKind
 from squeeze_grasp_ros.ros import messages
 from squeeze_grasp_ros.ros.nodes import pipeline
+from squeeze_grasp_ros.ros.nodes.jaw_commands import PlannedJawForce
 from squeeze_grasp_ros.scene.controller import JawController
 
 __all__ = ["JawAction"]
@@ -74,9 +74,7 @@ class JawAction:
         self.client = ActionClient(node, self.action, controller.topic)
         self.publisher = node.create_publisher(Header, pipeline.EXECUTOR_CYCLE,
                                                pipeline.loop_qos(qos.depth, kept=True))
-        self.forces = None
-        node.create_subscription(ContactEventArray, pipeline.PREDICTION, self._prediction,
-                                 pipeline.LATCHED)
+        self.plan = PlannedJawForce(node, controller)
         self.line: JawLine | None = None
         self.handle: Any = None
         self.outcome: tuple[str, bool, str] | None = None
@@ -92,11 +90,7 @@ class JawAction:
         """True once the planner's force curve is here, or when nobody publishes one (the
         executor's lockstep readiness: its first goal's effort depends on it).
         """
-        return self.forces is not None or \
-            self.node.count_publishers(pipeline.PREDICTION) == 0
-
-    def _prediction(self, msg: ContactEventArray) -> None:
-        self.forces = messages.predicted_forces(msg)
+        return self.plan.ready()
 
     def cycle_msg(self, ns: int) -> tuple[Any, Header]:
         """(publisher, message) answering tick ``ns``."""
@@ -115,9 +109,8 @@ class JawAction:
                                       end.get(second, obs.positions[second]))
         position = self.controller.joint_positions(aperture)[0]
         effort = 0.0
-        if self.forces is not None:
-            force = 0.5 * sum(self.forces.at(f, goal.depth) for f in self.fingers
-                              if f in self.forces.forces)
+        force = self.plan.at(goal.depth)
+        if force is not None:
             effort = min(abs(self.controller.joint_efforts(force)[0])
                          * self.controller.spec.effort_margin, self.controller.effort_limit)
         return position, effort

@@ -11,6 +11,13 @@ cycle's tick in lockstep; zero, "on receipt", on hardware). One point because th
 reactive: each setpoint depends on the newest status, so the executor commits to the next
 period only, and the controller interpolates from its current command to it; a longer horizon
 would be replaced by the next cycle's message anyway.
+
+A position-interface JointTrajectoryController does not limit effort (a trajectory point's
+``effort`` goes to an effort command interface only, and ros2_control's joint limiters clamp
+an effort *command* at ``max_effort``, not the force a position-controlled drive exerts): the
+gripper's drive stops at its own limit. So the executor refuses a grasp goal whose planned jaw
+force (the planner's force curve at the goal's depth, :class:`PlannedJawForce`) is beyond the
+device's ``max_force``: the jaws would stall short of the planned aperture.
 """
 from __future__ import annotations
 
@@ -22,11 +29,46 @@ from builtin_interfaces.msg import Duration
 from rclpy.node import Node
 from trajectory_msgs.msg import JointTrajectory, JointTrajectoryPoint
 
+from squeeze_grasp_interfaces.msg import ContactEventArray
 from squeeze_grasp_ros.control.joint_trajectory import JawLine
-from squeeze_grasp_ros.control.motion import Observation
+from squeeze_grasp_ros.control.motion import GraspGoal, Observation
 from squeeze_grasp_ros.ros import messages
 from squeeze_grasp_ros.ros.nodes import pipeline
 from squeeze_grasp_ros.scene.controller import JawController
+
+
+class PlannedJawForce:
+    """The planner's force curve (``planner/predicted_events``, latched) as the jaw force of a
+    squeeze depth: the mean of the two jaws' predicted forces.
+
+    Parameters
+    ----------
+    node : Node
+    controller : JawController
+    """
+
+    def __init__(self, node: Node, controller: JawController) -> None:
+        self.node, self.controller = node, controller
+        self.forces = None
+        node.create_subscription(ContactEventArray, pipeline.PREDICTION, self._prediction,
+                                 pipeline.LATCHED)
+
+    def _prediction(self, msg: ContactEventArray) -> None:
+        self.forces = messages.predicted_forces(msg)
+
+    def ready(self) -> bool:
+        """True once the force curve is here, or when nobody publishes one (the executor's
+        lockstep readiness: its first goal is judged on it).
+        """
+        return self.forces is not None or \
+            self.node.count_publishers(pipeline.PREDICTION) == 0
+
+    def at(self, depth: float) -> float | None:
+        """The planned jaw force at squeeze depth ``depth`` (m), N; None without a curve."""
+        if self.forces is None:
+            return None
+        jaws = [f for f in self.controller.jaws if f in self.forces.forces]
+        return 0.5 * sum(self.forces.at(f, depth) for f in jaws) if jaws else None
 
 
 class JawCommands:
@@ -49,6 +91,7 @@ class JawCommands:
         self.publisher = node.create_publisher(JointTrajectory, controller.topic,
                                                pipeline.loop_qos(qos.depth, kept=True))
         self.period_ns = int(round(period * 1e9))
+        self.plan = PlannedJawForce(node, controller)
         self.line: JawLine | None = None
         self.msg = JointTrajectory(joint_names=list(controller.joints), points=[
             JointTrajectoryPoint(time_from_start=Duration(sec=self.period_ns // 1_000_000_000,
@@ -59,6 +102,20 @@ class JawCommands:
     def fingers(self) -> tuple[str, str]:
         """The fingers the jaws carry."""
         return self.controller.jaws
+
+    def effort_problem(self, goal: GraspGoal) -> str | None:
+        """Why grasp goal ``goal`` is beyond the device's effort, or None: its planned jaw
+        force at the goal's depth is above the device's ``max_force`` (without a force curve,
+        nothing is known and nothing refused).
+        """
+        force = self.plan.at(goal.depth)
+        gripper = self.controller.gripper
+        if force is None or force <= gripper.max_force:
+            return None
+        return (f"the plan needs a jaw force of {force:.4g} N at depth {goal.depth * 1e3:.4g} "
+                f"mm, beyond {gripper.name}'s max_force {gripper.max_force:.4g} N (a position "
+                f"JointTrajectoryController does not limit effort: the drive would stall short "
+                f"of the planned aperture); plan a shallower squeeze or a stronger gripper")
 
     def start(self, obs: Observation) -> None:
         """Fix the jaw line from the jaws' measured tips (a goal's first cycle)."""

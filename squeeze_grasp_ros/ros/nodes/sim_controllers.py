@@ -10,7 +10,9 @@ gripper (``controller: {type: joint_trajectory, ...}``) and for its joint_state_
   TrajectoryFollower`: position interface, linear interpolation); each tick, the commanded
   aperture, saturated by the joint limits (the opening range, and the device file's
   ``max_speed`` of the aperture), becomes the jaws' tip setpoints on the jaw line, which the
-  world's devices follow as any setpoint (their own speed limit, actuator lag);
+  world's devices follow as any setpoint (their own speed limit, actuator lag); while the
+  measured jaw force is at the device's ``max_force`` the jaws close no further (the drive's
+  effort limit: the stock controller itself limits no effort on a position interface);
 - a refused trajectory (joint names other than the controller's, sizes that do not match,
   non-finite positions, an aperture beyond the opening range, points all in the past) is
   logged as one warning line and not followed: the active trajectory stays (before tick 0 the
@@ -65,6 +67,8 @@ class SimJaws:
         self.line = controller.jaw_line(world.positions)
         self.aperture = self.line.aperture(world.positions[first], world.positions[second])
         """The measured aperture of the last tick, m."""
+        self.force = 0.0
+        """The measured jaw force of the last tick, N."""
         self.limited = (0, self.aperture)
         """(sim time ns, aperture m) of the last command after the joint limits."""
         self.topic = node.resolve_topic_name(controller.topic)
@@ -83,12 +87,16 @@ class SimJaws:
         """``aperture`` (m) commanded for sim time ``t_ns``, saturated by the joint limits as
         ros2_control's limit enforcement does to a position command: within the opening range,
         and moving at most ``max_speed`` (the device file's aperture speed) times the time since
-        the last command.
+        the last command; and, as the gripper's drive does (not the controller: a position
+        interface carries no effort), closing no further than the measured aperture while the
+        measured jaw force is at or above the device's ``max_force``.
         """
         gripper = self.controller.gripper
         reach = gripper.max_speed * max(t_ns - self.limited[0], 0) * 1e-9
         aperture = float(np.clip(aperture, self.limited[1] - reach, self.limited[1] + reach))
         aperture = float(np.clip(aperture, gripper.opening.min, gripper.opening.max))
+        if self.force >= gripper.max_force:
+            aperture = max(aperture, self.aperture)
         self.limited = (t_ns, aperture)
         return aperture
 
@@ -113,7 +121,7 @@ class SimJaws:
         measured aperture and its effort for the jaw force, through the transmission.
         """
         aperture, force = self.measure(out)
-        self.aperture = aperture
+        self.aperture, self.force = aperture, force
         msg = self.state_msg
         messages.set_stamp(msg.header.stamp, out.stamp_ns)
         msg.position = [float(p) for p in self.controller.joint_positions(aperture)]

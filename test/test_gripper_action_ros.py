@@ -135,6 +135,34 @@ def test_a_canceled_grasp_cancels_the_gripper_goal(tmp_path):
     assert 150 < result.ticks < 400 and 0.0 < out["depth"] < 0.7 * 5.3033e-3
 
 
+@pytest.mark.parametrize("kind", ["parallel_gripper", "gripper_action"])
+def test_the_jaws_slip_under_an_action_controller_the_alarm_cancels_the_goal(kind, tmp_path):
+    """The slip scene (a jaw slips at 1.99 mm in the world) through a gripper action
+    controller, watched on joint_states alone: the monitor's slip watch raises slip_imminent,
+    the executor cancels the gripper goal (its status goes to CANCELED: the controller holds)
+    and ends the grasp goal slip_alarm, after the world's slip and short of the planned depth.
+    """
+    from action_msgs.msg import GoalStatus, GoalStatusArray
+
+    data = yaml.safe_load((SPONGE.parent / "sponge_gripper_slip.yaml").read_text())
+    data["controller"] = {"type": kind, "name": "gripper_controller", "device": "generic_85mm",
+                          **TIGHT}
+    data["name"] = f"slip_{kind}"
+    out = run_observed(write_scene(tmp_path, data), [
+        ("status", "gripper_controller/gripper_cmd/_action/status", GoalStatusArray),
+        ("alarms", pipeline.ALARMS, pipeline.message_type("squeeze_grasp_interfaces/msg/Alarm"))])
+    result = out["result"]
+    statuses = [s.status for msg in out["status"] for s in msg.status_list]
+    print(f"{kind}: {result.termination} after {result.ticks} ticks at depth "
+          f"{result.depth * 1e3:.4f} mm; gripper goal statuses {statuses}; first alarm "
+          f"{out['alarms'][0].message if out['alarms'] else None}")
+    assert result.termination == "slip_alarm" and not result.success
+    assert {(a.type, a.finger) for a in out["alarms"]} >= {("slip_imminent", "F1"),
+                                                           ("slip_imminent", "F2")}
+    assert GoalStatus.STATUS_CANCELED in statuses and GoalStatus.STATUS_SUCCEEDED not in statuses
+    assert 1.99e-3 < result.depth < 0.5 * 5.3033e-3
+
+
 # --------------------------------------------------------------------------- hostile client
 def wait(executor, condition, seconds=10.0):
     deadline = time.monotonic() + seconds

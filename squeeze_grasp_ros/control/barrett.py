@@ -49,7 +49,7 @@ from enum import Enum
 import numpy as np
 from scipy.optimize import brentq, minimize_scalar
 
-__all__ = ["COUPLING", "BarrettFinger", "BarrettHand", "HandPose", "HandSolution",
+__all__ = ["COUPLING", "JOINTS", "BarrettFinger", "BarrettHand", "HandPose", "HandSolution",
            "ReachError"]
 
 COUPLING = 1.0 / 3.0
@@ -148,8 +148,8 @@ class BarrettHand:
         Phi3: the distal link's fixed angle to the proximal one at a zero distal joint.
     coupling : float
         Distal over proximal joint angle.
-    proximal_max, spread_max : float
-        The proximal and spread joints' upper limits (both start at 0).
+    proximal_max, distal_max, spread_max : float
+        The proximal, distal and spread joints' upper limits (all start at 0).
     """
 
     pose: HandPose = field(default_factory=HandPose)
@@ -160,7 +160,14 @@ class BarrettHand:
     distal_offset: float = np.deg2rad(42.0)
     coupling: float = COUPLING
     proximal_max: float = 2.44
+    distal_max: float = 0.84
     spread_max: float = np.pi
+
+    def limits(self) -> list[tuple[float, float]]:
+        """Each joint's range (rad), in the order of :data:`JOINTS`."""
+        ranges = {"1": (0.0, self.spread_max), "2": (0.0, self.proximal_max),
+                  "3": (0.0, self.distal_max)}
+        return [ranges[name[-7]] for name in JOINTS]
 
     # ----------------------------------------------------------------- one finger's plane
     def rho(self, proximal: float, distal: float | None = None) -> float:

@@ -34,7 +34,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["JawLine", "TrajectoryFollower", "TrajectoryRefused"]
+__all__ = ["JawLine", "JointFollower", "TrajectoryFollower", "TrajectoryRefused"]
 
 APERTURE_AGREEMENT = 1e-9
 """Largest spread of the apertures a trajectory point's joints stand for, m."""
@@ -141,6 +141,70 @@ class TrajectoryFollower:
                 raise TrajectoryRefused(f"point {k}'s aperture {apertures[0]:g} m is outside "
                                         f"the opening range [{lo:g}, {hi:g}] m")
             knots.append((int(t), float(np.mean(apertures))))
+        future = [knot for knot in knots if knot[0] > now_ns]
+        if not future:
+            raise TrajectoryRefused("all its points lie in the past")
+        self.knots = [(int(now_ns), self.sample(now_ns))] + future
+
+
+class JointFollower:
+    """A JointTrajectoryController's command for several independent joints (a hand), rad.
+
+    The semantics of :class:`TrajectoryFollower` in joint space: linear interpolation of every
+    joint between knots, the last knot held, a new trajectory replacing the old from its first
+    point in the future; refused: unordered times, non-finite positions, a position outside its
+    joint's range, points all in the past.
+
+    Parameters
+    ----------
+    positions : sequence of float
+        The commanded joint positions before any trajectory (the hand's initial joints).
+    limits : sequence of (float, float)
+        Each joint's range (min, max).
+    names : sequence of str
+        The joints' names (for the refusals' messages).
+    """
+
+    def __init__(self, positions: Sequence[float], *, limits: Sequence[tuple[float, float]],
+                 names: Sequence[str]) -> None:
+        self.limits = np.asarray(limits, float)
+        self.names = tuple(names)
+        self.knots: list[tuple[int, np.ndarray]] = [(0, np.asarray(positions, float))]
+
+    def sample(self, t_ns: int) -> np.ndarray:
+        """The commanded joint positions at sim time ``t_ns``."""
+        times = [t for t, _ in self.knots]
+        if t_ns >= times[-1]:
+            return self.knots[-1][1].copy()
+        values = np.array([v for _, v in self.knots])
+        return np.array([np.interp(t_ns, times, values[:, j]) for j in range(values.shape[1])])
+
+    def accept(self, points: Sequence[tuple[int, Sequence[float]]], *, now_ns: int) -> None:
+        """Replace the active trajectory by ``points`` (absolute time ns, joint positions in
+        the order of ``names``) from the first point after ``now_ns``.
+
+        Raises
+        ------
+        TrajectoryRefused
+            Saying why; the active trajectory is kept.
+        """
+        if not points:
+            raise TrajectoryRefused("it has no points")
+        times = [t for t, _ in points]
+        if any(b <= a for a, b in zip(times, times[1:])):
+            raise TrajectoryRefused("its points' time_from_start are not strictly increasing")
+        knots = []
+        for k, (t, positions) in enumerate(points):
+            values = np.asarray(positions, float)
+            if not np.all(np.isfinite(values)):
+                raise TrajectoryRefused(f"point {k} has non-finite positions {list(values)}")
+            outside = [f"{self.names[j]} {values[j]:g} (range [{lo:g}, {hi:g}])"
+                       for j, (lo, hi) in enumerate(self.limits)
+                       if not lo - 1e-12 <= values[j] <= hi + 1e-12]
+            if outside:
+                raise TrajectoryRefused(f"point {k} has positions outside the joint limits: "
+                                        f"{', '.join(outside)} rad")
+            knots.append((int(t), values))
         future = [knot for knot in knots if knot[0] > now_ns]
         if not future:
             raise TrajectoryRefused("all its points lie in the past")

@@ -29,15 +29,20 @@ from pathlib import Path
 
 import numpy as np
 
+from squeeze_grasp_ros.control.barrett import JOINTS, BarrettFinger, BarrettHand, HandPose
 from squeeze_grasp_ros.control.gripper_action import GripperParameters
 from squeeze_grasp_ros.control.joint_trajectory import JawLine
-from squeeze_grasp_ros.mechanics.vocabulary import ControllerKind, Finger
+from squeeze_grasp_ros.mechanics.vocabulary import ControllerKind, Effect, Finger
 from squeeze_grasp_ros.resources import ResourceError, device_file
 from squeeze_grasp_ros.scene.gripper import GripperSpec, load_gripper
 from squeeze_grasp_ros.scene.schema import SchemaError
-from squeeze_grasp_ros.scene.specs import ControllerSpec, Scene, SceneError
+from squeeze_grasp_ros.scene.specs import ControllerSpec, Scene, SceneError, finger_devices
 
-__all__ = ["JawController", "JawReading", "JointReadingError", "scene_controller"]
+__all__ = ["HAND_DEVICE", "HandController", "JawController", "JawReading", "JointReadingError",
+           "scene_controller"]
+
+HAND_DEVICE = "bh8"
+"""``controller.device`` of the Barrett hand (its joints: :mod:`..control.barrett`)."""
 
 
 class JointReadingError(ValueError):
@@ -150,6 +155,69 @@ class JawController:
                           float(np.mean([self.gripper.jaw_force(v) for v in e])))
 
 
+@dataclass(frozen=True)
+class HandController:
+    """A resolved ``controller:`` section of the Barrett hand (``device: bh8``): the scene's
+    fingers it carries, each a finger of the hand (by its device), and the hand's kinematics at
+    the declared palm pose.
+    """
+
+    spec: ControllerSpec
+    hand: BarrettHand
+    fingers: dict[Finger, BarrettFinger]
+
+    @property
+    def jaws(self) -> tuple[Finger, ...]:
+        """The scene's fingers the hand carries (the controller's command replaces their
+        setpoint topics).
+        """
+        return tuple(self.fingers)
+
+    @property
+    def joints(self) -> tuple[str, ...]:
+        """The hand's joints, in its drivers' order."""
+        return JOINTS
+
+    @property
+    def kind(self) -> ControllerKind:
+        """The controller's interface (a JointTrajectoryController)."""
+        return ControllerKind.JOINT_TRAJECTORY
+
+    @property
+    def topic(self) -> str:
+        """The controller's command topic, relative: ``<name>/joint_trajectory``."""
+        return f"{self.spec.name}/joint_trajectory"
+
+
+def _hand(scene: Scene, spec: ControllerSpec) -> HandController:
+    """The Barrett hand's controller of a scene, checked; errors name the field."""
+    if ControllerKind(spec.type) is not ControllerKind.JOINT_TRAJECTORY:
+        raise SceneError(f"controller.type: the {HAND_DEVICE} hand is driven by a "
+                         f"joint_trajectory controller, got {spec.type}")
+    if spec.palm is None:
+        raise SceneError(f"controller.palm: the {HAND_DEVICE} hand needs its palm's pose "
+                         "[x m, y m, yaw deg] in the object frame")
+    if not (scene.has(Effect.FORCE_SENSING) or scene.has(Effect.TACTILE_SENSING)):
+        raise SceneError(f"controller.device {HAND_DEVICE}: the monitor watches the hand's "
+                         "fingers on their force or tactile sensors (effects force_sensing or "
+                         "tactile_sensing); the hand's joint feedback alone is not built")
+    devices = finger_devices(scene)
+    fingers = {}
+    for jaw in spec.jaws:
+        if jaw not in scene.fingers:
+            raise SceneError(f"controller.jaws: {jaw} is not a finger of the scene "
+                             f"({sorted(scene.fingers)})")
+        try:
+            fingers[Finger(jaw)] = BarrettFinger(devices[jaw])
+        except ValueError:
+            raise SceneError(f"controller.jaws: {jaw}'s device {devices[jaw]} is not a finger "
+                             f"of the {HAND_DEVICE} hand "
+                             f"({[f.value for f in BarrettFinger]})") from None
+    x, y, yaw = spec.palm
+    return HandController(spec, BarrettHand(pose=HandPose((float(x), float(y)),
+                                                          float(np.deg2rad(yaw)))), fingers)
+
+
 def _device(spec: ControllerSpec, base: Path) -> GripperSpec:
     """The gripper of ``controller.device``: a device file (.yaml, relative to ``base``) or a
     shipped name; errors prefixed with the field.
@@ -163,7 +231,8 @@ def _device(spec: ControllerSpec, base: Path) -> GripperSpec:
         raise SceneError(f"controller.device: {exc}") from None
 
 
-def scene_controller(scene: Scene, scene_path: str | Path) -> JawController | None:
+def scene_controller(scene: Scene, scene_path: str | Path
+                     ) -> JawController | HandController | None:
     """The scene's resolved ``controller:`` section, or None without one.
 
     Raises
@@ -175,6 +244,8 @@ def scene_controller(scene: Scene, scene_path: str | Path) -> JawController | No
     spec = scene.controller
     if spec is None:
         return None
+    if spec.device == HAND_DEVICE:
+        return _hand(scene, spec)
     gripper = _device(spec, Path(scene_path).parent)
     jaws = spec.jaws
     if len(jaws) != 2 or jaws[0] == jaws[1] or any(j not in scene.fingers for j in jaws):

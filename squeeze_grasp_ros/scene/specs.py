@@ -358,9 +358,9 @@ class SimSpec:
 
 @dataclass(frozen=True)
 class ControllerSpec:
-    """Two fingers carried by the jaws of a parallel gripper under a stock ros2_control
-    controller (docs/grippers.md): the executor commands the controller, the simulated hardware
-    stands in for it.
+    """Two fingers carried by the jaws of a parallel gripper, or by the Barrett hand (device
+    ``bh8``), under a stock ros2_control controller (docs/grippers.md): the executor commands
+    the controller, the simulated hardware stands in for it.
     """
 
     type: ControllerKind = spec("the controller's interface")
@@ -388,6 +388,9 @@ class ControllerSpec:
     max_velocity: float = spec("parallel_gripper: speed limit of a goal without one (the "
                                "GripperActionController has none: its command jumps to the goal)",
                                "joint units/s", lo=0.0, lo_open=True, default=0.1)
+    palm: Optional[tuple[float, float, float]] = spec(
+        "device bh8 (the Barrett hand): the palm's centre x, y (m) and the yaw of its x axis "
+        "(deg) in the object frame", default=None)
     effort_margin: float = spec("gripper_action, parallel_gripper: the executor's effort limit "
                                 "is the planned jaw force times this margin (below 1 the jaws "
                                 "stall short of the planned depth)", "", lo=0.0, lo_open=True,

@@ -48,9 +48,9 @@ from squeeze_grasp_interfaces.msg import ExecutorStatus, MonitorStatus
 from squeeze_grasp_ros.control.motion import Command, GraspProgram, MotionLimits, goal_problem
 from squeeze_grasp_ros.ros import messages
 from squeeze_grasp_ros.ros.nodes import ParameterError, pipeline, run_node
-from squeeze_grasp_ros.ros.nodes.jaw_commands import JawCommands
+from squeeze_grasp_ros.ros.nodes.jaw_commands import HandCommands, JawCommands
 from squeeze_grasp_ros.scene import load_scene
-from squeeze_grasp_ros.scene.controller import JawController, scene_controller
+from squeeze_grasp_ros.scene.controller import HandController, JawController, scene_controller
 
 PARAMETERS: dict[str, tuple[Any, str]] = {
     "finger_devices": (["F1:barrett_f1", "F2:barrett_f3"], "finger:device of every fingertip"),
@@ -117,8 +117,9 @@ class ExecutorNode(Node):
         controller = scene_controller(load_scene(p["controller_scene"]), p["controller_scene"]) \
             if p["controller_scene"] else None
         action = controller is not None and controller.kind.is_action
-        self.jaws = JawCommands(self, controller, p["period"], loop) \
-            if controller is not None and not action else None
+        self.jaws = (HandCommands if isinstance(controller, HandController) else JawCommands)(
+            self, controller, p["period"], loop) if controller is not None and not action \
+            else None
         self.jaw_action = jaw_action(self, controller, loop) if action else None
         """The scene's gripper under a JointTrajectoryController (jaws) or a gripper action
         controller (jaw_action), if any."""
@@ -149,7 +150,7 @@ class ExecutorNode(Node):
                                                        if self.jaw_action else []),
                                                     condition=self.jaw_action.ready
                                                     if self.jaw_action else
-                                                    self.jaws.plan.ready if self.jaws else None)
+                                                    self.jaws.ready if self.jaws else None)
         else:
             self.create_timer(p["period"], self._timer)
 

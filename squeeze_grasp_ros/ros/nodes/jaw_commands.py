@@ -21,7 +21,7 @@ device's ``max_force``: the jaws would stall short of the planned aperture.
 """
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from typing import Any
 
 import numpy as np
@@ -30,11 +30,12 @@ from rclpy.node import Node
 from trajectory_msgs.msg import JointTrajectory, JointTrajectoryPoint
 
 from squeeze_grasp_interfaces.msg import ContactEventArray
+from squeeze_grasp_ros.control.barrett import JOINTS, HandSolution, ReachError
 from squeeze_grasp_ros.control.joint_trajectory import JawLine
 from squeeze_grasp_ros.control.motion import GraspGoal, Observation
 from squeeze_grasp_ros.ros import messages
 from squeeze_grasp_ros.ros.nodes import pipeline
-from squeeze_grasp_ros.scene.controller import JawController
+from squeeze_grasp_ros.scene.controller import HandController, JawController
 
 
 class PlannedJawForce:
@@ -93,15 +94,16 @@ class JawCommands:
         self.period_ns = int(round(period * 1e9))
         self.plan = PlannedJawForce(node, controller)
         self.line: JawLine | None = None
-        self.msg = JointTrajectory(joint_names=list(controller.joints), points=[
-            JointTrajectoryPoint(time_from_start=Duration(sec=self.period_ns // 1_000_000_000,
-                                                          nanosec=self.period_ns % 1_000_000_000))
-        ])
+        self.msg = one_point_trajectory(controller.joints, self.period_ns)
 
     @property
     def fingers(self) -> tuple[str, str]:
         """The fingers the jaws carry."""
         return self.controller.jaws
+
+    def ready(self) -> bool:
+        """The executor's lockstep readiness (:meth:`PlannedJawForce.ready`)."""
+        return self.plan.ready()
 
     def effort_problem(self, goal: GraspGoal) -> str | None:
         """Why grasp goal ``goal`` is beyond the device's effort, or None: its planned jaw
@@ -131,4 +133,83 @@ class JawCommands:
         msg = self.msg
         messages.set_stamp(msg.header.stamp, start_ns)
         msg.points[0].positions = [float(p) for p in self.controller.joint_positions(aperture)]
+        return self.publisher, msg
+
+
+def one_point_trajectory(joints: Sequence[str], period_ns: int) -> JointTrajectory:
+    """A ``JointTrajectory`` of ``joints`` with one point at ``time_from_start`` =
+    ``period_ns``.
+    """
+    return JointTrajectory(joint_names=list(joints), points=[JointTrajectoryPoint(
+        time_from_start=Duration(sec=period_ns // 1_000_000_000,
+                                 nanosec=period_ns % 1_000_000_000))])
+
+
+class HandCommands:
+    """Fingertip setpoints of the Barrett hand's fingers -> ``JointTrajectory`` messages of its
+    JointTrajectoryController: each cycle the inverse kinematics of the carried fingers'
+    setpoints (:mod:`..control.barrett`: the spread from finger 1 or 2, the distal joints
+    coupled), one point one control period ahead, all eight joints (as :class:`JawCommands`).
+
+    A setpoint out of the hand's reach is not sent: the last reachable joints are repeated and
+    a warning names the finger, the target and the reach (once per goal).
+
+    Parameters
+    ----------
+    node, period, qos
+        As :class:`JawCommands`.
+    controller : HandController
+    """
+
+    def __init__(self, node: Node, controller: HandController, period: float, qos: Any
+                 ) -> None:
+        self.node, self.controller = node, controller
+        self.topic = node.resolve_topic_name(controller.topic)
+        self.publisher = node.create_publisher(JointTrajectory, controller.topic,
+                                               pipeline.loop_qos(qos.depth, kept=True))
+        self.msg = one_point_trajectory(JOINTS, int(round(period * 1e9)))
+        self.solution: HandSolution | None = None
+        """The last inverse kinematics sent."""
+        self.warned = False
+
+    @property
+    def fingers(self) -> tuple[str, ...]:
+        """The fingers the hand carries."""
+        return self.controller.jaws
+
+    def ready(self) -> bool:
+        """The executor's lockstep readiness: nothing to wait for."""
+        return True
+
+    def effort_problem(self, goal: GraspGoal) -> str | None:
+        """None: the hand's joint efforts are not modelled."""
+        del goal
+        return None
+
+    def _targets(self, tips: Mapping[str, np.ndarray]) -> dict:
+        return {hand_finger: tips[finger]
+                for finger, hand_finger in self.controller.fingers.items()}
+
+    def start(self, obs: Observation) -> None:
+        """The joints of the measured tips (a goal's first cycle)."""
+        self.solution = self.controller.hand.inverse(self._targets(obs.positions),
+                                                     tolerance=np.inf)
+        self.warned = False
+
+    def trajectory(self, setpoints: Mapping[str, np.ndarray], start_ns: int
+                   ) -> tuple[Any, JointTrajectory]:
+        """(publisher, message) commanding the carried fingers' ``setpoints`` (m) one period
+        after ``start_ns`` (the message's ``header.stamp``; 0 = on receipt).
+        """
+        try:
+            self.solution = self.controller.hand.inverse(self._targets(setpoints),
+                                                         rest=self.solution.joints)
+        except ReachError as exc:
+            if not self.warned:
+                self.node.get_logger().warning(f"{self.topic}: holding the last reachable "
+                                               f"joints: {exc}")
+                self.warned = True
+        msg = self.msg
+        messages.set_stamp(msg.header.stamp, start_ns)
+        msg.points[0].positions = [float(self.solution.joints[j]) for j in JOINTS]
         return self.publisher, msg

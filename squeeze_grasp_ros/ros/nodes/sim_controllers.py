@@ -34,15 +34,47 @@ from rclpy.node import Node
 from sensor_msgs.msg import JointState
 from trajectory_msgs.msg import JointTrajectory
 
+from squeeze_grasp_ros.control.barrett import JOINTS
 from squeeze_grasp_ros.control.joint_trajectory import (
+    JointFollower,
     TrajectoryFollower,
     TrajectoryRefused,
 )
 from squeeze_grasp_ros.ros import messages
 from squeeze_grasp_ros.ros.nodes import pipeline
 from squeeze_grasp_ros.ros.nodes.pipeline import JOINT_STATES
-from squeeze_grasp_ros.scene.controller import JawController
+from squeeze_grasp_ros.scene.controller import HandController, JawController
 from squeeze_grasp_ros.sim.world import SimWorld, TickOutput
+
+
+def trajectory_points(msg: JointTrajectory, joints: tuple[str, ...], now: int
+                      ) -> list[tuple[int, list[float]]]:
+    """(absolute time ns, positions in the order of ``joints``) of each point of ``msg``, as a
+    JointTrajectoryController reads it at sim time ``now`` (a zero stamp: on receipt).
+
+    Raises
+    ------
+    TrajectoryRefused
+        The controller inactive (``now`` < 0), joint names other than ``joints`` (any order),
+        a point's positions not one per joint.
+    """
+    if now < 0:
+        raise TrajectoryRefused("the simulated clock has not started (the controller is not "
+                                "active yet)")
+    names = list(msg.joint_names)
+    if sorted(names) != sorted(joints):
+        raise TrajectoryRefused(f"its joint_names {names} are not the controller's joints "
+                                f"{list(joints)}")
+    order = [names.index(j) for j in joints]
+    start = messages.stamp_ns(msg.header.stamp) or now
+    points = []
+    for k, point in enumerate(msg.points):
+        if len(point.positions) != len(order):
+            raise TrajectoryRefused(f"point {k} has {len(point.positions)} positions for "
+                                    f"{len(order)} joints")
+        tfs = point.time_from_start.sec * 1_000_000_000 + point.time_from_start.nanosec
+        points.append((start + tfs, [point.positions[i] for i in order]))
+    return points
 
 
 class SimJaws:
@@ -154,19 +186,8 @@ class SimJointTrajectoryController(SimJaws):
     def _trajectory(self, msg: JointTrajectory) -> None:
         now = self.now_ns()
         try:
-            if now < 0:
-                raise TrajectoryRefused("the simulated clock has not started (the controller "
-                                        "is not active yet)")
-            order = self._order(list(msg.joint_names))
-            start = messages.stamp_ns(msg.header.stamp) or now
-            points = []
-            for k, point in enumerate(msg.points):
-                if len(point.positions) != len(order):
-                    raise TrajectoryRefused(f"point {k} has {len(point.positions)} positions "
-                                            f"for {len(order)} joints")
-                tfs = point.time_from_start.sec * 1_000_000_000 + point.time_from_start.nanosec
-                points.append((start + tfs, [point.positions[i] for i in order]))
-            self.follower.accept(points, now_ns=now, to_aperture=self.controller.gripper.aperture)
+            self.follower.accept(trajectory_points(msg, self.controller.joints, now), now_ns=now,
+                                 to_aperture=self.controller.gripper.aperture)
         except TrajectoryRefused as exc:
             self.refusals.append(str(exc))
             self.node.get_logger().warning(f"refused the trajectory on {self.topic}: {exc}")
@@ -174,17 +195,86 @@ class SimJointTrajectoryController(SimJaws):
         self.commanded = True
         self.on_command()
 
-    def _order(self, names: list[str]) -> list[int]:
-        """Index in ``names`` of each controller joint; refuse other or missing names."""
-        joints = list(self.controller.joints)
-        if sorted(names) != sorted(joints):
-            raise TrajectoryRefused(f"its joint_names {names} are not the controller's joints "
-                                    f"{joints}")
-        return [names.index(j) for j in joints]
-
     def setpoints(self, t_ns: int) -> dict[str, np.ndarray]:
         """The jaws' tip setpoints (m) at sim time ``t_ns``, within the joint limits
         (:meth:`SimJaws.limit`); the command is consumed.
         """
         self.commanded = False
         return self.jaw_setpoints(self.limit(t_ns, self.follower.sample(t_ns)))
+
+
+class SimHandTrajectoryController:
+    """A simulated JointTrajectoryController and joint_state_broadcaster of the Barrett hand
+    (``controller: {type: joint_trajectory, device: bh8, palm: ...}``) on ``node``.
+
+    It follows the accepted trajectory of the hand's eight joints in sim time (linear in joint
+    space, :class:`..control.joint_trajectory.JointFollower`; positions outside a joint's range
+    refused); each tick the commanded joints become the carried fingers' tip setpoints through
+    the forward kinematics (:mod:`..control.barrett`), which the world's devices follow as any
+    setpoint. ``joint_states`` carries every joint's position, from the inverse kinematics of
+    the measured tips (the closest configuration, distal joints coupled); no effort (the
+    simulated hand has no joint torque sensing).
+
+    Parameters
+    ----------
+    node, world, qos, now_ns, on_command
+        As :class:`SimJointTrajectoryController`.
+    controller : HandController
+        The scene's resolved ``controller:`` section.
+    """
+
+    def __init__(self, node: Node, world: SimWorld, controller: HandController, qos: Any, *,
+                 now_ns: Callable[[], int], on_command: Callable[[], None]) -> None:
+        self.node, self.world, self.controller = node, world, controller
+        self.now_ns, self.on_command = now_ns, on_command
+        self.hand = controller.hand
+        self.joints = self.hand.inverse(self._measured(world.positions)).joints
+        """The joints of the last measured tips, rad."""
+        self.follower = JointFollower([self.joints[j] for j in JOINTS],
+                                      limits=self.hand.limits(), names=JOINTS)
+        self.topic = node.resolve_topic_name(controller.topic)
+        self.refusals: list[str] = []
+        self.commanded = False
+        self.state_pub = node.create_publisher(JointState, JOINT_STATES,
+                                               pipeline.loop_qos(qos.depth, kept=True))
+        self.state_msg = JointState(name=list(JOINTS))
+        node.create_subscription(JointTrajectory, controller.topic, self._trajectory, qos)
+
+    @property
+    def fingers(self) -> tuple[str, ...]:
+        """The fingers whose setpoints this controller gives."""
+        return self.controller.jaws
+
+    def _measured(self, positions: dict) -> dict:
+        return {hand_finger: positions[finger]
+                for finger, hand_finger in self.controller.fingers.items()}
+
+    def _trajectory(self, msg: JointTrajectory) -> None:
+        now = self.now_ns()
+        try:
+            self.follower.accept(trajectory_points(msg, JOINTS, now), now_ns=now)
+        except TrajectoryRefused as exc:
+            self.refusals.append(str(exc))
+            self.node.get_logger().warning(f"refused the trajectory on {self.topic}: {exc}")
+            return
+        self.commanded = True
+        self.on_command()
+
+    def setpoints(self, t_ns: int) -> dict[str, np.ndarray]:
+        """The carried fingers' tip setpoints (m) at sim time ``t_ns``: the forward kinematics
+        of the commanded joints; the command is consumed.
+        """
+        self.commanded = False
+        tips = self.hand.forward(dict(zip(JOINTS, self.follower.sample(t_ns))))
+        return {finger: tips[hand_finger]
+                for finger, hand_finger in self.controller.fingers.items()}
+
+    def joint_state(self, out: TickOutput) -> tuple[Any, JointState]:
+        """(publisher, message) of the joint states of tick ``out``."""
+        positions = {r.finger: r.position for r in out.readings}
+        self.joints = self.hand.inverse(self._measured(positions), rest=self.joints,
+                                        tolerance=np.inf).joints
+        msg = self.state_msg
+        messages.set_stamp(msg.header.stamp, out.stamp_ns)
+        msg.position = [float(self.joints[j]) for j in JOINTS]
+        return self.state_pub, msg

@@ -42,10 +42,11 @@ from squeeze_grasp_ros.ros.messages.images import camera_info_msg, image_msg, po
 from squeeze_grasp_ros.ros.nodes import ParameterError, pipeline, run_node
 from squeeze_grasp_ros.ros.nodes.sim_controllers import (
     JOINT_STATES,
+    SimHandTrajectoryController,
     SimJointTrajectoryController,
 )
 from squeeze_grasp_ros.scene import GraspSetup, load_scene
-from squeeze_grasp_ros.scene.controller import JawController, scene_controller
+from squeeze_grasp_ros.scene.controller import HandController, JawController, scene_controller
 from squeeze_grasp_ros.sim.camera import CameraFrame
 from squeeze_grasp_ros.sim.world import SimWorld, TickOutput
 
@@ -253,7 +254,7 @@ CONTROLLER_NAMES = {ControllerKind.JOINT_TRAJECTORY: "JointTrajectoryController"
 """The stock controller each ``controller.type`` stands for."""
 
 
-def sim_controller(jaws: JawController) -> type:
+def sim_controller(jaws: JawController | HandController) -> type:
     """The simulated controller class of a scene's ``controller:`` section.
 
     Raises
@@ -261,6 +262,8 @@ def sim_controller(jaws: JawController) -> type:
     ParameterError
         A gripper action controller without control_msgs in the environment.
     """
+    if isinstance(jaws, HandController):
+        return SimHandTrajectoryController
     if not jaws.kind.is_action:
         return SimJointTrajectoryController
     try:

@@ -114,3 +114,53 @@ def test_the_shipped_scene_maps_fingers_1_and_2():
     assert {f.value: h.value for f, h in controller.fingers.items()} == {
         "F1": "barrett_f1", "F2": "barrett_f2"}
     assert controller.topic == "hand_controller/joint_trajectory"
+
+
+def test_a_hostile_hand_trajectory_is_refused_and_a_valid_one_followed(tmp_path, capfd):
+    """Wrong joint names, a NaN, a proximal joint beyond its 2.44 rad are refused with a log
+    line (the hand holds); a valid trajectory moves finger 1's tip to the forward kinematics of
+    the commanded joints.
+    """
+    import time
+
+    from builtin_interfaces.msg import Duration
+    from pipeline_support import sim_and_client
+    from trajectory_msgs.msg import JointTrajectoryPoint
+
+    def trajectory(names, positions) -> JointTrajectory:
+        return JointTrajectory(joint_names=list(names), points=[JointTrajectoryPoint(
+            positions=[float(p) for p in positions], time_from_start=Duration(nanosec=1_000_000))])
+
+    path = write_scene(tmp_path, scene_data())
+    with sim_and_client(path) as (executor, sim, client):
+        publisher = client.create_publisher(JointTrajectory, "hand_controller/joint_trajectory",
+                                            pipeline.loop_qos(10))
+        pipeline.Participant(client, "hostile", [], [publisher])
+
+        def spin_until(condition, timeout=10.0):
+            deadline = time.monotonic() + timeout
+            while not condition() and time.monotonic() < deadline:
+                executor.spin_once(timeout_sec=0.05)
+
+        spin_until(lambda: sim.now_ns >= 0)
+        hand = sim.controller
+        start = [hand.joints[j] for j in JOINTS]
+        bad = dict(zip(JOINTS, start), bh_j12_joint=2.6)
+        for msg in (trajectory(["bh_j11_joint"], [0.1]),
+                    trajectory(JOINTS, [float("nan")] + start[1:]),
+                    trajectory(JOINTS, [bad[j] for j in JOINTS])):
+            publisher.publish(msg)
+        spin_until(lambda: len(hand.refusals) >= 3)
+        assert sim.now_ns == 0 and len(hand.refusals) == 3
+        for reason, text in zip(hand.refusals, ("not the controller's joints", "non-finite",
+                                                "bh_j12_joint 2.6 (range [0, 2.44])")):
+            assert text in reason
+        goal = dict(zip(JOINTS, start), bh_j12_joint=start[1] + 5e-4,
+                    bh_j13_joint=(start[1] + 5e-4) / 3)   # ~0.06 mm: within a tick
+        publisher.publish(trajectory(JOINTS, [goal[j] for j in JOINTS]))
+        spin_until(lambda: sim.now_ns >= 1_000_000)
+        assert sim.now_ns == 1_000_000
+        expected = hand.hand.forward(goal)["barrett_f1"]
+        np.testing.assert_allclose(sim.world.positions["F1"], expected, atol=1e-12)
+    assert capfd.readouterr().err.count(
+        "refused the trajectory on /hand_controller/joint_trajectory") == 3

@@ -132,7 +132,7 @@ class TrajectoryFollower:
         for k, (t, positions) in enumerate(points):
             values = np.asarray(positions, float)
             if not np.all(np.isfinite(values)):
-                raise TrajectoryRefused(f"point {k} has non-finite positions {list(values)}")
+                raise TrajectoryRefused(f"point {k} has non-finite positions {values.tolist()}")
             apertures = [to_aperture(v) for v in values]
             if max(apertures) - min(apertures) > APERTURE_AGREEMENT:
                 raise TrajectoryRefused(f"point {k}'s joints stand for different apertures "
@@ -197,7 +197,7 @@ class JointFollower:
         for k, (t, positions) in enumerate(points):
             values = np.asarray(positions, float)
             if not np.all(np.isfinite(values)):
-                raise TrajectoryRefused(f"point {k} has non-finite positions {list(values)}")
+                raise TrajectoryRefused(f"point {k} has non-finite positions {values.tolist()}")
             outside = [f"{self.names[j]} {values[j]:g} (range [{lo:g}, {hi:g}])"
                        for j, (lo, hi) in enumerate(self.limits)
                        if not lo - 1e-12 <= values[j] <= hi + 1e-12]

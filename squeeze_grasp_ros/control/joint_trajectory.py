@@ -44,6 +44,44 @@ class TrajectoryRefused(ValueError):
     """A trajectory the controller does not follow; the message says why."""
 
 
+def checked_points(points: Sequence[tuple[int, Sequence[float]]]
+                   ) -> list[tuple[int, np.ndarray]]:
+    """``points`` (time ns, positions) with their positions as arrays, checked as every
+    JointTrajectoryController checks them.
+
+    Raises
+    ------
+    TrajectoryRefused
+        No points, times not strictly increasing, non-finite positions.
+    """
+    if not points:
+        raise TrajectoryRefused("it has no points")
+    times = [t for t, _ in points]
+    if any(b <= a for a, b in zip(times, times[1:])):
+        raise TrajectoryRefused("its points' time_from_start are not strictly increasing")
+    out = []
+    for k, (t, positions) in enumerate(points):
+        values = np.asarray(positions, float)
+        if not np.all(np.isfinite(values)):
+            raise TrajectoryRefused(f"point {k} has non-finite positions {values.tolist()}")
+        out.append((int(t), values))
+    return out
+
+
+def future_knots(knots: list, now_ns: int) -> list:
+    """The knots (time ns first) after ``now_ns``: where a new trajectory replaces the old.
+
+    Raises
+    ------
+    TrajectoryRefused
+        All of them in the past.
+    """
+    future = [knot for knot in knots if knot[0] > now_ns]
+    if not future:
+        raise TrajectoryRefused("all its points lie in the past")
+    return future
+
+
 @dataclass(frozen=True)
 class JawLine:
     """The line the two jaws close on.
@@ -122,17 +160,9 @@ class TrajectoryFollower:
         TrajectoryRefused
             Saying why; the active trajectory is kept.
         """
-        if not points:
-            raise TrajectoryRefused("it has no points")
-        times = [t for t, _ in points]
-        if any(b <= a for a, b in zip(times, times[1:])):
-            raise TrajectoryRefused("its points' time_from_start are not strictly increasing")
         knots = []
         lo, hi = self.opening
-        for k, (t, positions) in enumerate(points):
-            values = np.asarray(positions, float)
-            if not np.all(np.isfinite(values)):
-                raise TrajectoryRefused(f"point {k} has non-finite positions {values.tolist()}")
+        for k, (t, values) in enumerate(checked_points(points)):
             apertures = [to_aperture(v) for v in values]
             if max(apertures) - min(apertures) > APERTURE_AGREEMENT:
                 raise TrajectoryRefused(f"point {k}'s joints stand for different apertures "
@@ -140,11 +170,8 @@ class TrajectoryFollower:
             if not lo <= apertures[0] <= hi:
                 raise TrajectoryRefused(f"point {k}'s aperture {apertures[0]:g} m is outside "
                                         f"the opening range [{lo:g}, {hi:g}] m")
-            knots.append((int(t), float(np.mean(apertures))))
-        future = [knot for knot in knots if knot[0] > now_ns]
-        if not future:
-            raise TrajectoryRefused("all its points lie in the past")
-        self.knots = [(int(now_ns), self.sample(now_ns))] + future
+            knots.append((t, float(np.mean(apertures))))
+        self.knots = [(int(now_ns), self.sample(now_ns))] + future_knots(knots, now_ns)
 
 
 class JointFollower:
@@ -188,24 +215,13 @@ class JointFollower:
         TrajectoryRefused
             Saying why; the active trajectory is kept.
         """
-        if not points:
-            raise TrajectoryRefused("it has no points")
-        times = [t for t, _ in points]
-        if any(b <= a for a, b in zip(times, times[1:])):
-            raise TrajectoryRefused("its points' time_from_start are not strictly increasing")
         knots = []
-        for k, (t, positions) in enumerate(points):
-            values = np.asarray(positions, float)
-            if not np.all(np.isfinite(values)):
-                raise TrajectoryRefused(f"point {k} has non-finite positions {values.tolist()}")
+        for k, (t, values) in enumerate(checked_points(points)):
             outside = [f"{self.names[j]} {values[j]:g} (range [{lo:g}, {hi:g}])"
                        for j, (lo, hi) in enumerate(self.limits)
                        if not lo - 1e-12 <= values[j] <= hi + 1e-12]
             if outside:
                 raise TrajectoryRefused(f"point {k} has positions outside the joint limits: "
                                         f"{', '.join(outside)} rad")
-            knots.append((int(t), values))
-        future = [knot for knot in knots if knot[0] > now_ns]
-        if not future:
-            raise TrajectoryRefused("all its points lie in the past")
-        self.knots = [(int(now_ns), self.sample(now_ns))] + future
+            knots.append((t, values))
+        self.knots = [(int(now_ns), self.sample(now_ns))] + future_knots(knots, now_ns)

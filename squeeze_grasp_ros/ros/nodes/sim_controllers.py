@@ -77,6 +77,28 @@ def trajectory_points(msg: JointTrajectory, joints: tuple[str, ...], now: int
     return points
 
 
+class TrajectoryTopic:
+    """A simulated controller's ``<controller>/joint_trajectory`` subscription: what it does
+    with a message. The owner has ``now_ns``, ``on_command``, ``node``, ``topic``,
+    ``refusals`` and ``commanded``.
+    """
+
+    def _receive(self, msg: JointTrajectory, joints: tuple[str, ...],
+                 accept: Callable[[list, int], None]) -> None:
+        """Read ``msg`` for ``joints`` and ``accept(points, now)``; a refusal is logged as one
+        warning line and kept in ``refusals``, an acceptance is the lockstep's chance to step.
+        """
+        now = self.now_ns()
+        try:
+            accept(trajectory_points(msg, joints, now), now)
+        except TrajectoryRefused as exc:
+            self.refusals.append(str(exc))
+            self.node.get_logger().warning(f"refused the trajectory on {self.topic}: {exc}")
+            return
+        self.commanded = True
+        self.on_command()
+
+
 class SimJaws:
     """What every simulated controller of a parallel gripper shares: the jaw line (fixed by the
     jaws' initial tips) and the joint_state_broadcaster.
@@ -161,7 +183,7 @@ class SimJaws:
         return self.state_pub, msg
 
 
-class SimJointTrajectoryController(SimJaws):
+class SimJointTrajectoryController(SimJaws, TrajectoryTopic):
     """A simulated JointTrajectoryController and joint_state_broadcaster on ``node``.
 
     Parameters
@@ -184,16 +206,8 @@ class SimJointTrajectoryController(SimJaws):
         node.create_subscription(JointTrajectory, controller.topic, self._trajectory, qos)
 
     def _trajectory(self, msg: JointTrajectory) -> None:
-        now = self.now_ns()
-        try:
-            self.follower.accept(trajectory_points(msg, self.controller.joints, now), now_ns=now,
-                                 to_aperture=self.controller.gripper.aperture)
-        except TrajectoryRefused as exc:
-            self.refusals.append(str(exc))
-            self.node.get_logger().warning(f"refused the trajectory on {self.topic}: {exc}")
-            return
-        self.commanded = True
-        self.on_command()
+        self._receive(msg, self.controller.joints, lambda points, now: self.follower.accept(
+            points, now_ns=now, to_aperture=self.controller.gripper.aperture))
 
     def setpoints(self, t_ns: int) -> dict[str, np.ndarray]:
         """The jaws' tip setpoints (m) at sim time ``t_ns``, within the joint limits
@@ -203,7 +217,7 @@ class SimJointTrajectoryController(SimJaws):
         return self.jaw_setpoints(self.limit(t_ns, self.follower.sample(t_ns)))
 
 
-class SimHandTrajectoryController:
+class SimHandTrajectoryController(TrajectoryTopic):
     """A simulated JointTrajectoryController and joint_state_broadcaster of the Barrett hand
     (``controller: {type: joint_trajectory, device: bh8, palm: ...}``) on ``node``.
 
@@ -250,15 +264,7 @@ class SimHandTrajectoryController:
                 for finger, hand_finger in self.controller.fingers.items()}
 
     def _trajectory(self, msg: JointTrajectory) -> None:
-        now = self.now_ns()
-        try:
-            self.follower.accept(trajectory_points(msg, JOINTS, now), now_ns=now)
-        except TrajectoryRefused as exc:
-            self.refusals.append(str(exc))
-            self.node.get_logger().warning(f"refused the trajectory on {self.topic}: {exc}")
-            return
-        self.commanded = True
-        self.on_command()
+        self._receive(msg, JOINTS, lambda points, now: self.follower.accept(points, now_ns=now))
 
     def setpoints(self, t_ns: int) -> dict[str, np.ndarray]:
         """The carried fingers' tip setpoints (m) at sim time ``t_ns``: the forward kinematics

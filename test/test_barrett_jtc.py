@@ -164,3 +164,29 @@ def test_a_hostile_hand_trajectory_is_refused_and_a_valid_one_followed(tmp_path,
         np.testing.assert_allclose(sim.world.positions["F1"], expected, atol=1e-12)
     assert capfd.readouterr().err.count(
         "refused the trajectory on /hand_controller/joint_trajectory") == 3
+
+
+def test_a_palm_out_of_reach_of_the_placements_is_one_error_line(tmp_path):
+    """The palm 0.5 m from the square: the simulated hardware refuses to start, naming the
+    palm, the finger, its target and its reach.
+    """
+    from squeeze_grasp_ros.ros.nodes import ParameterError
+    from squeeze_grasp_ros.ros.nodes.sim_hardware import SimHardwareNode
+
+    data = scene_data()
+    data["controller"]["palm"] = [0.0, 0.5, 0.0]
+    path = write_scene(tmp_path, data)
+    import rclpy
+    from rclpy.context import Context
+
+    context = Context()
+    rclpy.init(context=context)
+    try:
+        with pytest.raises(ParameterError, match=r"controller.palm \[0.0, 0.5, 0.0\]: the "
+                                                 r"fingers' initial tips are out of the hand's "
+                                                 r"reach: barrett_f1: target \(-0.07, 0\) m lies "
+                                                 r".* beyond its reach"):
+            SimHardwareNode(context=context, parameter_overrides=[
+                rclpy.parameter.Parameter("scene", value=path)])
+    finally:
+        rclpy.shutdown(context=context)

@@ -34,14 +34,14 @@ from rclpy.node import Node
 from sensor_msgs.msg import JointState
 from trajectory_msgs.msg import JointTrajectory
 
-from squeeze_grasp_ros.control.barrett import JOINTS
+from squeeze_grasp_ros.control.barrett import JOINTS, ReachError
 from squeeze_grasp_ros.control.joint_trajectory import (
     JointFollower,
     TrajectoryFollower,
     TrajectoryRefused,
 )
 from squeeze_grasp_ros.ros import messages
-from squeeze_grasp_ros.ros.nodes import pipeline
+from squeeze_grasp_ros.ros.nodes import ParameterError, pipeline
 from squeeze_grasp_ros.ros.nodes.pipeline import JOINT_STATES
 from squeeze_grasp_ros.scene.controller import HandController, JawController
 from squeeze_grasp_ros.sim.world import SimWorld, TickOutput
@@ -235,6 +235,12 @@ class SimHandTrajectoryController(TrajectoryTopic):
         As :class:`SimJointTrajectoryController`.
     controller : HandController
         The scene's resolved ``controller:`` section.
+
+    Raises
+    ------
+    ParameterError
+        The fingers' initial tips (the scene's placements) out of the hand's reach from its
+        palm pose.
     """
 
     def __init__(self, node: Node, world: SimWorld, controller: HandController, qos: Any, *,
@@ -242,8 +248,12 @@ class SimHandTrajectoryController(TrajectoryTopic):
         self.node, self.world, self.controller = node, world, controller
         self.now_ns, self.on_command = now_ns, on_command
         self.hand = controller.hand
-        self.joints = self.hand.inverse(self._measured(world.positions)).joints
-        """The joints of the last measured tips, rad."""
+        try:
+            self.joints = self.hand.inverse(self._measured(world.positions)).joints
+            """The joints of the last measured tips, rad."""
+        except ReachError as exc:
+            raise ParameterError(f"controller.palm {list(controller.spec.palm)}: the fingers' "
+                                 f"initial tips are out of the hand's reach: {exc}") from None
         self.follower = JointFollower([self.joints[j] for j in JOINTS],
                                       limits=self.hand.limits(), names=JOINTS)
         self.topic = node.resolve_topic_name(controller.topic)

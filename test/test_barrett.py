@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from hypothesis import given, settings
+from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
 from squeeze_grasp_ros.control.barrett import (
@@ -86,6 +86,8 @@ def test_forward_kinematics_equals_a_chain_of_transforms(spread, q, d, x, y, yaw
 @settings(max_examples=80, deadline=None)
 @given(spread=st.floats(0.0, np.pi), q1=st.floats(0.0, 2.39), q3=st.floats(0.0, 2.39),
        yaw=st.floats(-np.pi, np.pi))
+@example(spread=np.pi, q1=0.0, q3=0.0, yaw=0.0)          # the spread's upper limit
+@example(spread=0.0, q1=2.0, q3=0.0, yaw=0.0)            # finger 1's tip behind its axis
 def test_inverse_of_forward_gives_the_joints_back_with_zero_residual(spread, q1, q3, yaw):
     hand = BarrettHand(pose=HandPose((0.01, -0.02), yaw))
     joints = joints_of(spread, q1, 0.0, q3)
@@ -95,11 +97,12 @@ def test_inverse_of_forward_gives_the_joints_back_with_zero_residual(spread, q1,
     again = hand.forward(solution.joints)
     for finger in (F1, F3):
         np.testing.assert_allclose(again[finger], tips[finger], atol=1e-12)
-    # the joints themselves where they are unique: the proximal angles on the branch; the
-    # spread unless finger 1's tip sits on its own spread axis (any spread reaches it)
-    assert solution.joints["bh_j12_joint"] == pytest.approx(q1, abs=1e-7)
+    # the joints themselves where they are unique: the thumb's proximal angle on the branch;
+    # finger 1's where its tip is ahead of its spread axis (a tip behind it, rho < 0, is also
+    # reached ahead at the spread turned by pi, which the inverse prefers)
     assert solution.joints["bh_j32_joint"] == pytest.approx(q3, abs=1e-7)
-    if abs(hand.rho(q1)) > 1e-3 and 1e-6 < spread < np.pi - 1e-6:
+    if hand.rho(q1) > 1e-3 and 1e-6 < spread < np.pi - 1e-6:
+        assert solution.joints["bh_j12_joint"] == pytest.approx(q1, abs=1e-7)
         assert solution.joints["bh_j11_joint"] == pytest.approx(spread, abs=1e-9)
     # one spread motor, coupled distal joints
     assert solution.joints["bh_j11_joint"] == solution.joints["bh_j21_joint"]

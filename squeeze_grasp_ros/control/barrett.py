@@ -280,8 +280,10 @@ class BarrettHand:
         heading = float(np.arctan2(d[1], d[0]))
         sign = -1.0 if finger is BarrettFinger.F1 else 1.0
         for candidate in (heading, heading + np.pi):      # ahead, then behind the axis
-            spread = float(np.mod(sign * (candidate + np.pi / 2) + np.pi, 2 * np.pi) - np.pi)
-            if -1e-12 <= spread <= self.spread_max + 1e-12:
-                return float(np.clip(spread, 0.0, self.spread_max))
+            spread = float(np.mod(sign * (candidate + np.pi / 2), 2 * np.pi))   # [0, 2 pi)
+            if spread <= self.spread_max + 1e-12:
+                return min(spread, self.spread_max)
+            if spread >= 2 * np.pi - 1e-12:
+                return 0.0
         raise ReachError(f"{finger.value}: no spread in [0, {self.spread_max:.6g}] rad points "
                          f"its closing line at ({target[0]:.6g}, {target[1]:.6g}) m")

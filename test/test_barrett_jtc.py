@@ -67,6 +67,8 @@ def test_the_foam_square_through_the_hand_jtc_equals_the_setpoint_route(tmp_path
     print(f"largest force difference hand JTC - Cartesian: {difference:.1e} relative")
     assert difference < 1e-9
     assert jtc["depth"] == pytest.approx(cartesian["depth"], rel=1e-9)
+    # the monitor positions the fingers from joint_states there, from their poses here
+    assert jtc["result"].depth == pytest.approx(cartesian["result"].depth, rel=1e-9)
     # feedback: the last joint state through the forward kinematics is finger 1's measured tip
     hand = scene_controller(load_scene(SCENE), SCENE).hand
     last = jtc["joint_states"][-1]
@@ -190,3 +192,36 @@ def test_a_palm_out_of_reach_of_the_placements_is_one_error_line(tmp_path):
                 rclpy.parameter.Parameter("scene", value=path)])
     finally:
         rclpy.shutdown(context=context)
+
+
+def test_the_monitor_positions_the_hand_fingers_from_joint_states():
+    """The monitor's hand feedback: the carried fingers' positions are the forward kinematics
+    of the joint state (the poses are replaced); a state missing a joint or with a NaN is
+    ignored with one warning per stamp.
+    """
+    from builtin_interfaces.msg import Time
+
+    from squeeze_grasp_ros.ros.nodes.monitor import HandFeedback
+
+    feedback = HandFeedback.of({"controller_scene": str(SCENE)})
+    joints = dict(zip(JOINTS, (0.9, 1.2, 0.4, 0.9, 1.1, 1.1 / 3, 0.0, 0.0)))
+    msg = JointState(name=list(JOINTS), position=list(joints.values()))
+    msg.header.stamp = Time(sec=1)
+    fields = {"F1": {"position": np.zeros(2)}, "F2": {"position": np.zeros(2)}}
+    feedback.replace(fields, msg, None)
+    tips = feedback.controller.hand.forward(joints)
+    np.testing.assert_array_equal(fields["F1"]["position"], tips["barrett_f1"])
+    np.testing.assert_array_equal(fields["F2"]["position"], tips["barrett_f2"])
+    warnings = []
+
+    class Log:
+        warning = warnings.append
+
+    for bad in (JointState(name=list(JOINTS[:-1]), position=[0.0] * 7),
+                JointState(name=list(JOINTS), position=[float("nan")] + [0.0] * 7)):
+        bad.header.stamp = Time(sec=len(warnings) + 2)
+        before = {f: v["position"].copy() for f, v in fields.items()}
+        feedback.replace(fields, bad, Log())
+        assert all(np.array_equal(fields[f]["position"], before[f]) for f in fields)
+    assert len(warnings) == 2 and "bh_j33_joint" in warnings[0] and "nan" in warnings[1]
+    assert HandFeedback.of({"controller_scene": ""}) is None

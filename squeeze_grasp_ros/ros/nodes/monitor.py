@@ -31,6 +31,11 @@ jaws' positions on the jaw line (fixed by their first pose readings, the gripper
 the depth, the force ``wrench`` stands in for, first touch, ``contact_lost`` and the slip watch's
 ``slip_imminent`` (the jaws close while the force stops rising); events A-D need taxels, so
 none are tracked and the prediction's events are not compared (the force watch is).
+
+The Barrett hand under a JointTrajectoryController (``controller: {device: bh8, ...}``): the
+carried fingers' positions come from ``joint_states`` through the hand's forward kinematics
+(:mod:`..control.barrett`) in place of their pose readings; their force and tactile sensors
+are read as on the setpoint route.
 """
 from __future__ import annotations
 
@@ -60,7 +65,12 @@ from squeeze_grasp_ros.ros.nodes.force_watcher import ForceWatcher
 from squeeze_grasp_ros.ros.nodes.shape_watcher import ShapeWatcher
 from squeeze_grasp_ros.ros.nodes.sim_controllers import JOINT_STATES
 from squeeze_grasp_ros.scene import load_scene
-from squeeze_grasp_ros.scene.controller import JawController, JointReadingError, scene_controller
+from squeeze_grasp_ros.scene.controller import (
+    HandController,
+    JawController,
+    JointReadingError,
+    scene_controller,
+)
 
 PARAMETERS: dict[str, tuple[Any, str]] = {
     "finger_devices": (["F1:barrett_f1", "F2:barrett_f3"], "finger:device of every fingertip"),
@@ -106,6 +116,8 @@ class MonitorNode(Node):
         streams = [s for s in p["streams"] if s]
         self.jaws = JointFeedback.of(p, streams)
         """The jaws on joint feedback (None: the sensors' route)."""
+        self.hand = HandFeedback.of(p) if self.jaws is None else None
+        """The Barrett hand's fingers positioned by its joint states (None: their poses)."""
         self.tracker = ContactTracker(TrackerConfig(
             p["mu"], p["load_threshold"], p["edge_tolerance"], p["alarm_ratio"],
             p["match_margin"], p["stale_after"], p["weight"] or None,
@@ -121,7 +133,7 @@ class MonitorNode(Node):
                 self.keys[key] = (finger, stream)
                 self.create_subscription(msg_type, pipeline.device_topic(device, stream),
                                          lambda msg, k=key: self._reading(k, msg), sensors)
-        if self.jaws is not None:
+        if self.jaws is not None or self.hand is not None:
             self.keys[JOINT_STATES] = ("", JOINT_STATES)
             self.create_subscription(JointState, JOINT_STATES,
                                      lambda msg: self._reading(JOINT_STATES, msg), sensors)
@@ -155,6 +167,8 @@ class MonitorNode(Node):
         clock = "lockstep" if self.p["lockstep"] else f"rate {self.p['rate']} Hz"
         streams = [s for s in self.p["streams"] if s] if self.jaws is None else [
             f"{JOINT_STATES} of {self.jaws.controller.spec.name}"]
+        if self.hand is not None:
+            streams.append(f"{JOINT_STATES} of {self.hand.controller.spec.name} (positions)")
         return f"fingers {self.fingers}, streams {streams}, mu {self.p['mu']}, {clock}"
 
     def _prediction(self, msg: ContactEventArray) -> None:
@@ -210,6 +224,8 @@ class MonitorNode(Node):
                                       tangential=taxels.tangential, tactile_stamp_ns=ns)
         if self.jaws is not None:
             self.jaws.replace(fields, self.latest.get(JOINT_STATES), self.get_logger())
+        if self.hand is not None:
+            self.hand.replace(fields, self.latest.get(JOINT_STATES), self.get_logger())
         return {f: FingerSample(**v) for f, v in fields.items()}
 
     def _process(self, ns: int) -> None:
@@ -233,6 +249,53 @@ class MonitorNode(Node):
         self.answered.answer(ns, [(self.status_pub, messages.monitor_status_msg(out, frame))])
         if self.shapes is not None:
             self.shapes.tick(ns, out.depth)
+
+
+class HandFeedback:
+    """The Barrett hand's carried fingers positioned by ``joint_states`` through the forward
+    kinematics, in place of their pose readings.
+
+    Parameters
+    ----------
+    controller : HandController
+    """
+
+    def __init__(self, controller: HandController) -> None:
+        self.controller = controller
+        self.stamp_ns: int | None = None
+
+    @classmethod
+    def of(cls, p: dict[str, Any]) -> HandFeedback | None:
+        """The hand's feedback of the monitor's parameters ``p``: None unless the
+        ``controller_scene``'s controller is the Barrett hand.
+        """
+        if not p["controller_scene"]:
+            return None
+        controller = scene_controller(load_scene(p["controller_scene"]), p["controller_scene"])
+        return cls(controller) if isinstance(controller, HandController) else None
+
+    def replace(self, fields: dict[str, dict[str, Any]], msg: JointState | None,
+                logger: Any) -> None:
+        """Put the carried fingers' tip positions of joint state ``msg`` into the tracker's
+        sample ``fields``; a state without every hand joint, or not finite, is ignored with a
+        warning (the poses stay).
+        """
+        if msg is None:
+            return
+        ns = messages.stamp_ns(msg.header.stamp)
+        joints = dict(zip(msg.name, msg.position))
+        try:
+            if len(msg.position) != len(msg.name) or not np.all(np.isfinite(msg.position)):
+                raise ValueError(f"positions {list(msg.position)} are not one finite value per "
+                                 f"name {list(msg.name)}")
+            tips = self.controller.hand.forward(joints)
+        except ValueError as exc:
+            if ns != self.stamp_ns:
+                logger.warning(f"ignored the joint state of {ns * 1e-9:.3f} s: {exc}")
+                self.stamp_ns = ns
+            return
+        for finger, hand_finger in self.controller.fingers.items():
+            fields[finger]["position"] = tips[hand_finger]
 
 
 class JointFeedback:

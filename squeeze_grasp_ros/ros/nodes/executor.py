@@ -100,7 +100,8 @@ class ExecutorNode(Node):
         """What the ready line of ``ros2 run`` says: devices, clock and limits."""
         clock = "lockstep on /clock" if self.p["lockstep"] else "wall-clock timer"
         driver = self.jaws or self.jaw_action
-        jaws = f"jaws {list(driver.fingers)} on {driver.topic}, " if driver else ""
+        carried = "hand fingers" if isinstance(driver, HandCommands) else "jaws"
+        jaws = f"{carried} {list(driver.fingers)} on {driver.topic}, " if driver else ""
         return (f"fingers {self.devices}, {jaws}{clock}, "
                 f"period {self.p['period']} s, max velocity {self.p['max_velocity']} m/s; "
                 f"action {self.resolve_topic_name(pipeline.ACTION)}")

@@ -140,8 +140,10 @@ class SimHardwareNode(Node):
         """What the ready line of ``ros2 run`` says: scene, devices, controller, waiting for
         whom.
         """
+        carried = "hand fingers" if isinstance(self.controller, SimHandTrajectoryController) \
+            else "jaws"
         jaws = "" if self.controller is None else (
-            f", jaws {list(self.controller.fingers)} by a simulated "
+            f", {carried} {list(self.controller.fingers)} by a simulated "
             f"{CONTROLLER_NAMES[self.controller.controller.kind]} on {self.controller.topic}")
         return (f"scene {self.world.scene.name}, fingers {self.devices}{jaws}, "
                 f"dt {self.world.dt} s; waiting for {list(self.p['participants'])}")

@@ -26,6 +26,17 @@ def test_a_missing_required_parameter_is_one_line_and_exit_2(node, parameter):
     assert f"-p {parameter}:=" in lines[0]
 
 
+def test_ros_args_rcl_cannot_parse_are_one_error_line_and_exit_2():
+    # an unquoted YAML list whose items hold a colon, as a user types it after -p
+    done = subprocess.run([script("monitor"), "--ros-args", "-p",
+                           "finger_devices:=[F1:jaw_f1, F2:jaw_f2]"], capture_output=True,
+                          text=True, timeout=120, stdin=subprocess.DEVNULL)
+    assert done.returncode == 2
+    assert "Traceback" not in done.stderr
+    ours = [line for line in done.stderr.splitlines() if line.startswith("monitor: error:")]
+    assert len(ours) == 1 and "finger_devices:=[F1:jaw_f1, F2:jaw_f2]" in ours[0]
+
+
 def test_every_node_logs_when_it_is_ready(tmp_path):
     """Started alone (as ``ros2 run`` does), each node says it is ready and what it serves,
     and stops cleanly on SIGINT.

@@ -14,11 +14,15 @@ from pathlib import Path
 import rclpy
 from rclpy.executors import Executor, ExternalShutdownException
 from rclpy.experimental import EventsExecutor
+from rclpy.impl.implementation_singleton import rclpy_implementation
 from rclpy.node import Node
 from rclpy.signals import SignalHandlerOptions
 
 from squeeze_grasp_ros.exit_codes import ExitCode
 from squeeze_grasp_ros.mechanics.errors import InvalidInputError
+
+RCLError = rclpy_implementation.RCLError
+"""What rcl raises, e.g. on ``--ros-args`` it cannot parse."""
 
 PARENT_PID_ENV = "SQUEEZE_GRASP_PARENT_PID"
 """Environment variable naming the process that started a node (``squeeze-grasp run
@@ -91,8 +95,9 @@ def run_node(factory: Callable[[], Node], args: list[str] | None = None,
     Returns
     -------
     int
-        The exit code: 0, or 2 (:attr:`~.ExitCode.USAGE`) when the node refused its
-        parameters (a missing scene, output folder, ...). That error is one line on stderr,
+        The exit code: 0, or 2 (:attr:`~.ExitCode.USAGE`) when rcl could not parse the
+        ``--ros-args`` or the node refused its parameters (a missing scene, output folder,
+        ...). That error is one line on stderr (rcl logs its own ``[ERROR]`` line first),
         ``<program>: error: <what>``, not a traceback. Once built, the node logs
         ``<name> ready: <its configuration>``.
     """
@@ -100,7 +105,11 @@ def run_node(factory: Callable[[], Node], args: list[str] | None = None,
     for signum in (signal.SIGINT, signal.SIGTERM):
         signal.signal(signum, lambda *_: stop.set())
     orphaned = parent_watch(stop)
-    rclpy.init(args=args, signal_handler_options=SignalHandlerOptions.NO)
+    try:
+        rclpy.init(args=args, signal_handler_options=SignalHandlerOptions.NO)
+    except RCLError as error:  # a --ros-args rule rcl cannot parse (e.g. unquoted YAML)
+        print(f"{Path(sys.argv[0]).stem}: error: {error}", file=sys.stderr)
+        return ExitCode.USAGE
     try:
         node = factory()
     except ValueError as error:  # InvalidInputError, or a recorder that cannot start its bag

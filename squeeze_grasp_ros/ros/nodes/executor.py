@@ -79,6 +79,8 @@ SUCCESS = (ExecuteGrasp.Result.DEPTH_REACHED, ExecuteGrasp.Result.RESISTED,
 HOLDS = (ExecuteGrasp.Result.CANCELED, ExecuteGrasp.Result.SLIP_ALARM,
          ExecuteGrasp.Result.STALE_DATA)
 """Terminations after which the executor reports that it holds position."""
+UNSEEN_AGE = 1e300
+"""s: the sensor age a monitor status gives a finger it has no reading of."""
 
 
 class _Goal:
@@ -91,6 +93,7 @@ class _Goal:
         self.events: list = []
         self.since_feedback: list = []
         self.start_ns: int | None = None
+        self.waiting_since_ns: int | None = None
 
 
 class ExecutorNode(Node):
@@ -207,6 +210,8 @@ class ExecutorNode(Node):
         ns = messages.stamp_ns(msg.header.stamp)
         obs = messages.observation(msg)
         if goal.start_ns is None:
+            if self._unseen(goal, msg, ns):
+                return
             goal.start_ns = ns
             if self.jaws is not None:
                 self.jaws.start(obs)
@@ -229,6 +234,26 @@ class ExecutorNode(Node):
             self.goal = None
             goal.done.set_result(messages.grasp_result(
                 goal.program, command, obs, goal.events, (ns - goal.start_ns) * 1e-9, SUCCESS))
+
+    def _unseen(self, goal: _Goal, msg: MonitorStatus, ns: int) -> bool:
+        """True while a finger of the goal has no reading yet (hardware: a goal sent before the
+        monitor saw the fingers, whose status reports them at the origin): the goal waits,
+        commanding nothing, and ends ``stale_data`` after ``stale_budget``.
+        """
+        unseen = [f for f, age in zip(msg.fingers, msg.sensor_age)
+                  if f in goal.program.fingers and not age < UNSEEN_AGE]
+        if not unseen:
+            return False
+        goal.waiting_since_ns = ns if goal.waiting_since_ns is None else goal.waiting_since_ns
+        if (ns - goal.waiting_since_ns) * 1e-9 > self.p["stale_budget"]:
+            self.goal = None
+            goal.done.set_result(messages.grasp_result(
+                goal.program, Command({}, "holding", ExecuteGrasp.Result.STALE_DATA,
+                                      f"no reading of {', '.join(unseen)} within stale_budget "
+                                      f"{self.p['stale_budget']} s of the goal; nothing was "
+                                      "commanded"),
+                None, [], (ns - goal.waiting_since_ns) * 1e-9, SUCCESS))
+        return True
 
     def _action_cycle(self, goal: _Goal, command: Command, obs, ns: int,
                       now_ns: int | None) -> None:

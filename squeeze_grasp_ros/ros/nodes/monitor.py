@@ -104,6 +104,9 @@ PARAMETERS: dict[str, tuple[Any, str]] = {
                               "slip_imminent is raised"),
 }
 """Parameter name -> (typed default, description); config/monitor.yaml sets them."""
+POSE_JOINT_TOLERANCE = 1e-5
+"""m: the largest gap between the jaws' aperture of their first pose readings and of the first
+joint state that passes without a warning."""
 
 
 class MonitorNode(Node):
@@ -334,7 +337,8 @@ class JointFeedback:
         ``fields`` (finger -> FingerSample keywords); run the slip watch on a new state.
         """
         first, second = self.controller.jaws
-        if self.line is None:
+        fixed = self.line is None
+        if fixed:
             if msg is None or any("position" not in fields[j] for j in (first, second)):
                 return
             self.line = self.controller.jaw_line({j: fields[j]["position"]
@@ -347,6 +351,14 @@ class JointFeedback:
                 logger.warning(f"ignored the joint state of {ns * 1e-9:.3f} s: {exc}")
                 self.stamp_ns = ns
             return
+        if fixed:
+            posed = self.line.aperture(fields[first]["position"], fields[second]["position"])
+            if abs(posed - reading.aperture) > POSE_JOINT_TOLERANCE:
+                logger.warning(
+                    f"the jaws' pose readings put the pad faces {posed * 1e3:.4f} mm apart, "
+                    f"joint_states {reading.aperture * 1e3:.4f} mm: the jaws jump to the joint "
+                    "reading, and a depth measured from the poses counts the jump (publish the "
+                    "tips' centres: the pad faces plus the edge radius)")
         if ns != self.stamp_ns:
             self.stamp_ns = ns
             touched = self.watch.first_touch

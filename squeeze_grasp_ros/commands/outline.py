@@ -50,9 +50,11 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--frame-id", default="plane", help="name of the plane frame "
                                                             "(default plane)")
     parser.add_argument("--output", metavar="FILE", type=output_file,
-                        help="write the outline: .yaml = a scene's object.shape (polygon with "
-                             "holes), .json = an outline file ({\"outline\", \"holes\"}) for "
-                             "shape type file")
+                        help="write the outline: .yaml = a scene's object.shape (the "
+                             "recognised disk, ellipse or annulus when it is centred at the "
+                             "frame's origin, else a polygon, or a spline when it has no "
+                             "corners, with holes), .json = an outline file ({\"outline\", "
+                             "\"holes\"}) for shape type file")
     add_plot_argument(parser)
 
 
@@ -63,8 +65,8 @@ def _write(path: str, found: ObjectOutline, source: str) -> str:
                 "object.shape\n" + yaml.safe_dump({"shape": found.to_scene_shape()},
                                                   default_flow_style=None, sort_keys=False))
     elif suffix == ".json":
-        shape = found.to_scene_shape()
-        text = json.dumps({"outline": shape["points"], "holes": shape.get("holes", []),
+        text = json.dumps({"outline": found.outline.points.tolist(),
+                           "holes": [h.tolist() for h in found.outline.holes],
                            "frame_id": found.frame_id}) + "\n"
     else:
         raise InvalidInputError(f"--output {path}: give a .yaml (scene shape) or .json "

@@ -144,6 +144,18 @@ def summary(result: dict) -> str:
              f"pixel {1e3 * result['pixel_size_m']:.4g} mm at the object; simplified to "
              f"{1e3 * result['tolerance_m']:.3g} mm from {result['contour_points']} contour "
              "points"]
+    primitive = result["primitive"]
+    if primitive is None:
+        lines.append(f"shape: {result['recognised']} ("
+                     + ("corners kept" if result["recognised"] == "polygon"
+                        else "smooth, no primitive fits") + ")")
+    else:
+        parameters = ", ".join(f"{k} {1e3 * v:.4g} mm" for k, v in primitive.items()
+                               if k not in ("type", "centre", "residual_m", "theta"))
+        lines.append(f"shape: {primitive['type']} at ({1e3 * primitive['centre'][0]:.4g}, "
+                     f"{1e3 * primitive['centre'][1]:.4g}) mm, {parameters}"
+                     + (f", theta {primitive['theta']:.4g} rad" if "theta" in primitive else "")
+                     + f"; fitted within {1e3 * primitive['residual_m']:.3g} mm")
     if result["support"]:
         s = result["support"]
         lines.append(f"support plane: tilt {s['tilt_deg']:.3g} deg, flatness "

@@ -121,24 +121,27 @@ def recognise(outer: np.ndarray, holes: list[np.ndarray], tolerance: float) -> P
 
 def _ellipse_points(centre: np.ndarray, a: float, b: float, theta: float,
                     tolerance: float) -> np.ndarray:
-    """Counter-clockwise samples of an ellipse whose chords stray at most ``tolerance``, moved
-    out radially so that the polygon's area is the ellipse's (an inscribed polygon's chords
-    would cut about 2/3 of their sagitta times the perimeter off it).
-    """
+    """Counter-clockwise samples of an ellipse whose chords stray at most ``tolerance``."""
     step = 2.0 * np.arccos(max(1.0 - tolerance / max(a, b), -1.0))  # sagitta of the arc
     n = max(16, int(np.ceil(2.0 * np.pi / step)))
     t = np.linspace(0.0, 2.0 * np.pi, n, endpoint=False)
-    grow = np.sqrt(2.0 * np.pi / (n * np.sin(2.0 * np.pi / n)))  # the affine image of a circle's
     c, s = np.cos(theta), np.sin(theta)
-    x, y = grow * a * np.cos(t), grow * b * np.sin(t)
+    x, y = a * np.cos(t), b * np.sin(t)
     return np.column_stack([centre[0] + c * x - s * y, centre[1] + s * x + c * y])
 
 
+CHORD_FRACTION = 0.125
+"""The fitted curve's chords stray at most this fraction of the simplification tolerance: the
+polygon through the samples then loses at most 2/3 of that times the perimeter in area (0.03 %
+for the foam ring's outer circle seen at 1 mm a pixel)."""
+
+
 def sampled(primitive: Primitive, tolerance: float) -> tuple[np.ndarray, tuple[np.ndarray, ...]]:
-    """The primitive's outer curve and holes, sampled counter-clockwise with chords within
-    ``tolerance`` (m) of the curve.
+    """The primitive's outer curve and holes, sampled counter-clockwise on the curve with
+    chords within :data:`CHORD_FRACTION` of ``tolerance`` (m) of it.
     """
     p, c = primitive.parameters, primitive.centre
+    tolerance = CHORD_FRACTION * tolerance
     if primitive.shape == ShapeType.ANNULUS:
         return (_ellipse_points(c, p["outer_radius"], p["outer_radius"], 0.0, tolerance),
                 (_ellipse_points(c, p["inner_radius"], p["inner_radius"], 0.0, tolerance),))

@@ -84,11 +84,15 @@ def shape_parameters(parameters: dict[str, Sequence[float] | float]) -> list[Sha
 
 def seen_outline_msg(outline: Outline, *, frame_id: str, ns: int, encoding: str,
                      plane_height: float, tolerance: float, pixel_size: float,
-                     other_blobs: int) -> SeenOutline:
-    """A ``SeenOutline`` of an extracted outline (m, plane frame, top at ``plane_height``)."""
+                     other_blobs: int, shape: str = "", fit_residual: float = 0.0
+                     ) -> SeenOutline:
+    """A ``SeenOutline`` of an extracted outline (m, plane frame, top at ``plane_height``),
+    recognised as ``shape`` with the fit's largest residual ``fit_residual`` (m).
+    """
     return SeenOutline(
         outline=PolygonStamped(header=header(ns, frame_id),
                                polygon=polygon_msg(outline.points, plane_height)),
         holes=[polygon_msg(h, plane_height) for h in outline.holes],
         encoding=str(encoding), area=float(outline.area), tolerance=float(tolerance),
-        pixel_size=float(pixel_size), other_blobs=int(other_blobs))
+        pixel_size=float(pixel_size), other_blobs=int(other_blobs), shape=str(shape),
+        fit_residual=float(fit_residual))

@@ -246,8 +246,9 @@ def summary(result: dict) -> str:
         fit = seen.get("fit_residual_m")
         shape = seen["recognised"] + ("" if fit is None else f" fitted within {fit * 1e3:.3f} mm")
         lines.insert(1, f"camera: planned from the first frame's outline ({shape}, "
-                        f"{seen['vertices']} vertices, {seen['holes']} holes, area {seen['area_m2'] * 1e4:.2f} cm^2 "
-                        f"vs {seen['true_area_m2'] * 1e4:.2f} cm^2 true); seen vertices from the "
+                        f"{seen['vertices']} vertices, {seen['holes']} holes, area "
+                        f"{seen['area_m2'] * 1e4:.2f} cm^2 vs "
+                        f"{seen['true_area_m2'] * 1e4:.2f} cm^2 true); seen vertices from the "
                         f"true outline: rms {seen['rms_m'] * 1e3:.3f} mm, max "
                         f"{seen['max_m'] * 1e3:.3f} mm (pixel {seen['pixel_m'] * 1e3:.3f} mm)")
     if result["recording"]:

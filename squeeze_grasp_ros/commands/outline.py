@@ -15,7 +15,7 @@ from squeeze_grasp_ros.commands.camera_args import add_camera_arguments, load_ca
 from squeeze_grasp_ros.commands.common import add_plot_argument, output_file
 from squeeze_grasp_ros.inputs import InputError, read_bytes
 from squeeze_grasp_ros.mechanics.errors import InvalidInputError
-from squeeze_grasp_ros.mechanics.vocabulary import ImageEncoding
+from squeeze_grasp_ros.mechanics.vocabulary import ImageEncoding, ShapeType
 from squeeze_grasp_ros.outputs import write_atomically
 from squeeze_grasp_ros.perception.camera import CameraModel, CameraPose
 from squeeze_grasp_ros.perception.extract import ObjectOutline, extract_outline
@@ -147,7 +147,7 @@ def summary(result: dict) -> str:
     primitive = result["primitive"]
     if primitive is None:
         lines.append(f"shape: {result['recognised']} ("
-                     + ("corners kept" if result["recognised"] == "polygon"
+                     + ("corners kept" if result["recognised"] == ShapeType.POLYGON
                         else "smooth, no primitive fits") + ")")
     else:
         parameters = ", ".join(f"{k} {1e3 * v:.4g} mm" for k, v in primitive.items()

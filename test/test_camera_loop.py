@@ -123,10 +123,14 @@ def test_the_seen_foam_square_plans_like_the_yaml_one():
 
 
 def prediction_two_samples(setup: GraspSetup, depth: float) -> PredictedShapes:
+    """The boundary nodes (outer, and each hole's) at rest and squeezed to ``depth``."""
     mesh = setup.solid.mesh
-    rest = mesh.nodes[mesh.boundary]
-    moved = rest + setup.event_squeeze(depth=depth).displacement[mesh.boundary]
-    return PredictedShapes(np.array([0.0, depth]), (rest, moved))
+    displacement = setup.event_squeeze(depth=depth).displacement
+    loops = [mesh.boundary, *mesh.inner_boundaries]
+    rest = [mesh.nodes[loop] for loop in loops]
+    moved = [mesh.nodes[loop] + displacement[loop] for loop in loops]
+    holes = (tuple(rest[1:]), tuple(moved[1:])) if len(loops) > 1 else ()
+    return PredictedShapes(np.array([0.0, depth]), (rest[0], moved[0]), holes)
 
 
 def shipped_solid_scenes() -> list[Path]:

@@ -101,6 +101,7 @@ def test_the_outline_node_publishes_the_seen_outline(ros_context):
         assert seen.outline.header.frame_id == "object" and seen.encoding == "mono8"
         assert seen.outline.header.stamp.nanosec == 3_000
         assert len(seen.holes) == 1 and seen.other_blobs == 0
+        assert seen.shape == "annulus" and 0 < seen.fit_residual < 0.3 * seen.pixel_size
         assert seen.area == pytest.approx(truth.area, rel=0.005)
         pixel = seen.pixel_size
         outer = np.asarray(polygon_points(seen.outline.polygon))

@@ -102,8 +102,8 @@ def camera_loop(progress) -> list[Table]:
     progress("perception: the camera loop's first frame")
     world = SimWorld(GraspSetup.build(scene))
     seen = _seen(world, build_outline(scene.object.shape))
-    seen_scene = dataclasses.replace(typed_scene(seen_object(scene, seen.outline)).scene,
-                                     squeeze=scene.squeeze)
+    typed = seen_object(scene, seen.to_scene_shape())
+    seen_scene = dataclasses.replace(typed_scene(typed).scene, squeeze=scene.squeeze)
     routes = []
     for name, route in (("YAML scene", load_scene(scene_file("foam_square"))),
                         ("seen by the camera", seen_scene)):

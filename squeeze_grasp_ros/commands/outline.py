@@ -15,7 +15,7 @@ from squeeze_grasp_ros.commands.camera_args import add_camera_arguments, load_ca
 from squeeze_grasp_ros.commands.common import add_plot_argument, output_file
 from squeeze_grasp_ros.inputs import InputError, read_bytes
 from squeeze_grasp_ros.mechanics.errors import InvalidInputError
-from squeeze_grasp_ros.mechanics.vocabulary import ImageEncoding
+from squeeze_grasp_ros.mechanics.vocabulary import ImageEncoding, ShapeType
 from squeeze_grasp_ros.outputs import write_atomically
 from squeeze_grasp_ros.perception.camera import CameraModel, CameraPose
 from squeeze_grasp_ros.perception.extract import ObjectOutline, extract_outline
@@ -50,9 +50,11 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--frame-id", default="plane", help="name of the plane frame "
                                                             "(default plane)")
     parser.add_argument("--output", metavar="FILE", type=output_file,
-                        help="write the outline: .yaml = a scene's object.shape (polygon with "
-                             "holes), .json = an outline file ({\"outline\", \"holes\"}) for "
-                             "shape type file")
+                        help="write the outline: .yaml = a scene's object.shape (the "
+                             "recognised disk, ellipse or annulus when it is centred at the "
+                             "frame's origin, else a polygon, or a spline when it has no "
+                             "corners, with holes), .json = an outline file ({\"outline\", "
+                             "\"holes\"}) for shape type file")
     add_plot_argument(parser)
 
 
@@ -63,8 +65,8 @@ def _write(path: str, found: ObjectOutline, source: str) -> str:
                 "object.shape\n" + yaml.safe_dump({"shape": found.to_scene_shape()},
                                                   default_flow_style=None, sort_keys=False))
     elif suffix == ".json":
-        shape = found.to_scene_shape()
-        text = json.dumps({"outline": shape["points"], "holes": shape.get("holes", []),
+        text = json.dumps({"outline": found.outline.points.tolist(),
+                           "holes": [h.tolist() for h in found.outline.holes],
                            "frame_id": found.frame_id}) + "\n"
     else:
         raise InvalidInputError(f"--output {path}: give a .yaml (scene shape) or .json "
@@ -142,6 +144,18 @@ def summary(result: dict) -> str:
              f"pixel {1e3 * result['pixel_size_m']:.4g} mm at the object; simplified to "
              f"{1e3 * result['tolerance_m']:.3g} mm from {result['contour_points']} contour "
              "points"]
+    primitive = result["primitive"]
+    if primitive is None:
+        lines.append(f"shape: {result['recognised']} ("
+                     + ("corners kept" if result["recognised"] == ShapeType.POLYGON
+                        else "smooth, no primitive fits") + ")")
+    else:
+        parameters = ", ".join(f"{k} {1e3 * v:.4g} mm" for k, v in primitive.items()
+                               if k not in ("type", "centre", "residual_m", "theta"))
+        lines.append(f"shape: {primitive['type']} at ({1e3 * primitive['centre'][0]:.4g}, "
+                     f"{1e3 * primitive['centre'][1]:.4g}) mm, {parameters}"
+                     + (f", theta {primitive['theta']:.4g} rad" if "theta" in primitive else "")
+                     + f"; fitted within {1e3 * primitive['residual_m']:.3g} mm")
     if result["support"]:
         s = result["support"]
         lines.append(f"support plane: tilt {s['tilt_deg']:.3g} deg, flatness "

@@ -243,9 +243,12 @@ def summary(result: dict) -> str:
         lines.insert(5, f"first {FORCE_MISMATCH}: {first['message']}")
     seen = result.get("seen_outline")
     if seen:
-        lines.insert(1, f"camera: planned from the first frame's outline ({seen['vertices']} "
-                        f"vertices, {seen['holes']} holes, area {seen['area_m2'] * 1e4:.2f} cm^2 "
-                        f"vs {seen['true_area_m2'] * 1e4:.2f} cm^2 true); seen vertices from the "
+        fit = seen.get("fit_residual_m")
+        shape = seen["recognised"] + ("" if fit is None else f" fitted within {fit * 1e3:.3f} mm")
+        lines.insert(1, f"camera: planned from the first frame's outline ({shape}, "
+                        f"{seen['vertices']} vertices, {seen['holes']} holes, area "
+                        f"{seen['area_m2'] * 1e4:.2f} cm^2 vs "
+                        f"{seen['true_area_m2'] * 1e4:.2f} cm^2 true); seen vertices from the "
                         f"true outline: rms {seen['rms_m'] * 1e3:.3f} mm, max "
                         f"{seen['max_m'] * 1e3:.3f} mm (pixel {seen['pixel_m'] * 1e3:.3f} mm)")
     if result["recording"]:

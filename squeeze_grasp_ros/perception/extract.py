@@ -8,6 +8,10 @@ undistorted and its ray met with the plane of the object's top face, and the cur
 simplified by Douglas-Peucker (:mod:`.simplify`) to a stated tolerance in metres; corners where
 straight stretches meet are rebuilt as the intersection of lines fitted to them (an iso-contour
 cuts a corner short). Closed holes become holes of the outline (a ring or annulus-like object).
+A circle, an ellipse or a circle with a concentric circular hole that fits the traced points
+within :data:`PRIMITIVE_TOLERANCE_PX` is recognised as a ``disk``, ``ellipse`` or ``annulus``
+(:mod:`.primitives`); other outlines without a rebuilt corner are smooth (``spline``), so
+meshing makes none of their vertices a corner.
 
 - **mask** (``mono8``): 0 is background, larger values object; read as coverage (value / 255,
   or / 1 for a 0/1 mask) with the edge at half coverage, so an anti-aliased mask gives edges
@@ -35,10 +39,12 @@ from squeeze_grasp_ros.mechanics.errors import InvalidInputError
 from squeeze_grasp_ros.mechanics.vocabulary import ImageEncoding, ShapeType
 from squeeze_grasp_ros.perception.blobs import Blob, BlobChoice, choose_object
 from squeeze_grasp_ros.perception.camera import CameraModel, CameraPose
+from squeeze_grasp_ros.perception.primitives import Primitive, recognise, sampled, scene_shape
 from squeeze_grasp_ros.perception.simplify import kept_vertices, sharpen_corners
 from squeeze_grasp_ros.perception.support import SupportPlane, fit_support, floor_grids
 
-__all__ = ["DEFAULT_TOLERANCE_PX", "MIN_AREA_PX", "ObjectOutline", "extract_outline"]
+__all__ = ["DEFAULT_TOLERANCE_PX", "MIN_AREA_PX", "PRIMITIVE_TOLERANCE_PX", "ObjectOutline",
+           "extract_outline"]
 
 DEFAULT_TOLERANCE_PX = 0.15
 """Default simplification tolerance, in pixel footprints at the object."""
@@ -59,6 +65,12 @@ CORNER_STRAIGHT_PX = 0.12
 0.09 px (marching squares on slanted edges); an arc strays span^2 / (16 R) from its best line,
 so only arcs of radius R >= 33 px pass, and those turn far less than 30 degrees between the
 two stretches (12 px apart): smooth bends are never made corners."""
+
+PRIMITIVE_TOLERANCE_PX = 0.3
+"""Largest distance (pixel footprints) of a traced point from a fitted circle or ellipse for
+the curve to be recognised as one (:mod:`.primitives`). Anti-aliased masks trace edges within
+about 0.1 px; a binary mask's staircase strays about 0.5 px, so its circles stay smooth curves
+(``spline``) rather than primitives."""
 
 MIN_AREA_PX = 9
 """Default smallest blob and hole that counts, px (``extract_outline``'s ``min_area_px``)."""
@@ -107,6 +119,13 @@ class ObjectOutline:
         Largest reprojection residual of the undistorted contour points, px.
     support : SupportPlane or None
         The fitted support plane (depth images).
+    shape : ShapeType
+        What the outline was recognised as: ``disk``, ``ellipse`` or ``annulus`` (a primitive
+        fitted within :data:`PRIMITIVE_TOLERANCE_PX`; the outline is then the fitted curve), else
+        ``polygon`` when a corner was rebuilt on a curve (every vertex is kept as a corner) or
+        ``spline`` for smooth curves without corners.
+    primitive : Primitive or None
+        The fitted primitive (centre, parameters, residual), when one was recognised.
     """
 
     outline: Outline
@@ -123,12 +142,27 @@ class ObjectOutline:
     small_holes: int
     undistort_residual_px: float
     support: SupportPlane | None = None
+    shape: ShapeType = ShapeType.POLYGON
+    primitive: Primitive | None = None
+
+    @property
+    def smooth(self) -> bool:
+        """Whether the outline has no corners (its vertices sample smooth curves)."""
+        return self.shape != ShapeType.POLYGON
 
     def to_scene_shape(self) -> dict:
-        """The outline as a scene's ``object.shape``: ``{"type": "polygon", "points": [[x, y],
-        ...]}``, plus ``"holes": [[[x, y], ...], ...]`` when it has holes (m).
+        """The outline as a scene's ``object.shape``: the named ``disk``, ``ellipse`` or
+        ``annulus`` when a primitive was recognised at the frame's origin (centre within
+        :data:`PRIMITIVE_TOLERANCE_PX`, axes along x and y), else ``{"type": "polygon",
+        "points": [[x, y], ...]}`` (``"spline"`` when it is :attr:`smooth`), plus ``"holes":
+        [[[x, y], ...], ...]`` when it has holes (m).
         """
-        shape = {"type": ShapeType.POLYGON.value, "points": self.outline.points.tolist()}
+        if self.primitive is not None:
+            named = scene_shape(self.primitive, PRIMITIVE_TOLERANCE_PX * self.pixel_size_m)
+            if named is not None:
+                return named
+        kind = ShapeType.SPLINE if self.smooth else ShapeType.POLYGON
+        shape = {"type": kind.value, "points": self.outline.points.tolist()}
         if self.outline.holes:
             shape["holes"] = [h.tolist() for h in self.outline.holes]
         return shape
@@ -144,7 +178,9 @@ class ObjectOutline:
                 "others": [b.to_json() for b in self.others], "specks": self.specks,
                 "small_holes": self.small_holes,
                 "undistort_residual_px": self.undistort_residual_px,
-                "support": None if self.support is None else self.support.to_json()}
+                "support": None if self.support is None else self.support.to_json(),
+                "recognised": self.shape.value,
+                "primitive": None if self.primitive is None else self.primitive.to_json()}
 
 
 def _check_image(image: np.ndarray, encoding: ImageEncoding, camera: CameraModel) -> np.ndarray:
@@ -194,13 +230,14 @@ def _trace(field: np.ndarray, level: float, choice: BlobChoice, min_area_px: int
     return [loops[outer]] + [loops[k] for k in holes], len(loops) - 1 - len(holes)
 
 
-def _simplify(points: np.ndarray, tolerance: float, pixel: float, name: str) -> np.ndarray:
+def _simplify(points: np.ndarray, tolerance: float, pixel: float, name: str):
+    """The simplified vertices of a traced curve (m) and whether any is a rebuilt corner."""
     kept = kept_vertices(points, tolerance)
-    vertices = sharpen_corners(points, kept, radius=CORNER_RADIUS_PX * pixel,
-                               span=CORNER_SPAN_PX * pixel, tolerance=CORNER_STRAIGHT_PX * pixel,
-                               max_cut=CORNER_CUT_PX * pixel)
+    vertices, corners = sharpen_corners(
+        points, kept, radius=CORNER_RADIUS_PX * pixel, span=CORNER_SPAN_PX * pixel,
+        tolerance=CORNER_STRAIGHT_PX * pixel, max_cut=CORNER_CUT_PX * pixel)
     try:
-        return validate_polyline(vertices, name)
+        return validate_polyline(vertices, name), bool(corners.any())
     except InvalidInputError as exc:
         raise InvalidInputError(f"{exc}; the simplified {name} is not a simple curve: lower "
                                 f"tolerance_m (now {tolerance:g} m)") from None
@@ -208,8 +245,9 @@ def _simplify(points: np.ndarray, tolerance: float, pixel: float, name: str) -> 
 
 def _outline(loops: list[np.ndarray], camera: CameraModel, pose: CameraPose,
              plane_height: float, tolerance_m: float | None, centroid_px: tuple[float, float]):
-    """Back-project and simplify the traced loops; returns (Outline, tolerance, pixel size,
-    undistortion residual).
+    """Back-project the traced loops and recognise a primitive in them, or simplify them;
+    returns (Outline, shape type, primitive or None, tolerance, pixel size, undistortion
+    residual).
     """
     centre = camera.back_project(pose, np.array([centroid_px]), plane_height).points[0]
     pixel = camera.ground_pixel_size(pose, np.array([*centre, plane_height]))
@@ -219,15 +257,23 @@ def _outline(loops: list[np.ndarray], camera: CameraModel, pose: CameraPose,
     sizes = [len(loop) for loop in loops]
     plane = camera.back_project(pose, np.concatenate(loops), plane_height)
     metric = np.split(plane.points, np.cumsum(sizes)[:-1])
-    outer = _simplify(metric[0], tolerance, pixel, "extracted outline")
-    holes = tuple(_simplify(h, tolerance, pixel, f"extracted hole {k + 1}")
-                  for k, h in enumerate(metric[1:]))
+    primitive = recognise(metric[0], metric[1:], PRIMITIVE_TOLERANCE_PX * pixel)
+    if primitive is not None:
+        outer, holes = sampled(primitive, tolerance)
+        return (Outline(outer, holes), primitive.shape, primitive, tolerance, pixel,
+                plane.undistort_residual_px)
+    outer, cornered = _simplify(metric[0], tolerance, pixel, "extracted outline")
+    simplified = [_simplify(h, tolerance, pixel, f"extracted hole {k + 1}")
+                  for k, h in enumerate(metric[1:])]
+    holes = tuple(h for h, _ in simplified)
     boundary = MplPath(outer)
     for k, hole in enumerate(holes):
         if not np.all(boundary.contains_points(hole)):
             raise InvalidInputError(f"extracted hole {k + 1} crosses the simplified outer curve: "
                                     f"lower tolerance_m (now {tolerance:g} m)")
-    return Outline(outer, holes), tolerance, pixel, plane.undistort_residual_px
+    cornered = cornered or any(c for _, c in simplified)
+    shape = ShapeType.POLYGON if cornered else ShapeType.SPLINE
+    return Outline(outer, holes), shape, None, tolerance, pixel, plane.undistort_residual_px
 
 
 def _positive(**values: float) -> None:
@@ -314,11 +360,11 @@ def extract_outline(image: np.ndarray, encoding: ImageEncoding | str, camera: Ca
                                                                          int(round(u))])
         plane_height = float(under) + top
     loops, small = _trace(field, level, choice, min_area_px)
-    outline, tolerance, pixel, residual = _outline(loops, camera, pose, plane_height,
-                                                   tolerance_m, choice.blob.centroid_px)
+    outline, shape, primitive, tolerance, pixel, residual = _outline(
+        loops, camera, pose, plane_height, tolerance_m, choice.blob.centroid_px)
     return ObjectOutline(outline, frame_id, encoding, plane_height, level, tolerance, pixel,
                          sum(map(len, loops)), choice.blob, choice.others, choice.specks, small,
-                         residual, support)
+                         residual, support, shape, primitive)
 
 
 def _top_height(field: np.ndarray, choice: BlobChoice) -> float:

@@ -116,7 +116,8 @@ def _corner(p: np.ndarray, gap: np.ndarray, skip: float, span: float, tolerance:
 
 
 def sharpen_corners(points: np.ndarray, kept: np.ndarray, *, radius: float, span: float,
-                    tolerance: float, max_cut: float, min_turn_deg: float = 30.0) -> np.ndarray:
+                    tolerance: float, max_cut: float, min_turn_deg: float = 30.0
+                    ) -> tuple[np.ndarray, np.ndarray]:
     """Simplified vertices of closed curve ``points`` with its traced corners made sharp again.
 
     An iso-contour cuts a corner of the true outline short (by about a third of a pixel at a
@@ -143,9 +144,11 @@ def sharpen_corners(points: np.ndarray, kept: np.ndarray, *, radius: float, span
 
     Returns
     -------
-    (m, 2) ndarray
+    vertices : (m, 2) ndarray
         The simplified vertices, corners moved (vertices turning more than
         :data:`CANDIDATE_TURN_DEG` are tried, sharpest first).
+    corners : (m,) ndarray of bool
+        Which vertices are rebuilt corners (the others lie on the traced curve).
     """
     p = np.asarray(points, float)
     n = len(p)
@@ -173,4 +176,4 @@ def sharpen_corners(points: np.ndarray, kept: np.ndarray, *, radius: float, span
                 out[c], moved[c] = corner, True
                 drop |= (np.abs(gap[kept]) < skip) & ~moved  # the rounded tip's vertices
             break
-    return out[~drop]
+    return out[~drop], moved[~drop]

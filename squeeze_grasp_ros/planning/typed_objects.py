@@ -33,11 +33,11 @@ import json
 import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from squeeze_grasp_ros.mechanics.elastic.shapes import Outline
 from squeeze_grasp_ros.mechanics.vocabulary import Effect, Finger, MaterialModel, ShapeType
 from squeeze_grasp_ros.planning.errors import invalid
 from squeeze_grasp_ros.planning.objects import SceneSource, read_scene
@@ -150,7 +150,9 @@ class TypedObject:
     frame_id : str
         Frame of the outline and placements; "" or "object" = the planner's object frame.
     shape : str
-        A shape of :data:`TYPED_SHAPES` when ``outline`` is empty.
+        A shape of :data:`TYPED_SHAPES` when ``outline`` is empty; with an outline, ``spline``
+        says its points (and its holes') sample smooth curves: closed cubic splines through
+        them, no vertex kept as a corner (empty: a polygon, every vertex a corner).
     shape_parameters : mapping of str to tuple of float
         The shape's parameters (``squeeze-grasp scene-help``), one value for a scalar.
     frame_pose : FramePose
@@ -201,13 +203,16 @@ def _points(points: Sequence[Sequence[float]], pose: tuple[np.ndarray, np.ndarra
 
 def _shape(obj: TypedObject, pose: tuple[np.ndarray, np.ndarray]) -> dict:
     """The scene's ``object.shape`` of the request."""
-    if len(obj.outline) and obj.shape:
-        raise invalid("give either object.outline (points) or object.shape, not both")
+    smooth = obj.shape == ShapeType.SPLINE.value
+    if len(obj.outline) and obj.shape and not smooth:
+        raise invalid("give either object.outline (points) or object.shape, not both (with an "
+                      f"outline, object.shape may only be {ShapeType.SPLINE.value!r}: smooth)")
     if len(obj.outline):
         if len(obj.outline) < 3:
             raise invalid(f"object.outline.polygon.points has {len(obj.outline)} points; an "
                           "outline needs at least 3 (m)")
-        shape: dict = {"type": ShapeType.POLYGON.value,
+        kind = ShapeType.SPLINE if smooth else ShapeType.POLYGON
+        shape: dict = {"type": kind.value,
                        "points": _points(obj.outline, pose, "object.outline.polygon.points")}
         if len(obj.holes):
             shape["holes"] = [_points(h, pose, f"object.holes[{k}].points")
@@ -311,10 +316,12 @@ def object_source(scene_yaml: str, scene_path: str, typed: TypedObject,
     return read_scene(scene_yaml, scene_path, roots)
 
 
-def seen_object(scene: Scene, outline: Outline, frame_id: str = OBJECT_FRAME) -> TypedObject:
-    """The typed object a robot describes after seeing ``outline`` (m, in ``frame_id``): the
-    seen outline with what it is told rather than sees, from ``scene`` (material, mesh size,
-    the fingers' placement points, their radius, friction).
+def seen_object(scene: Scene, shape: Mapping[str, Any],
+                frame_id: str = OBJECT_FRAME) -> TypedObject:
+    """The typed object a robot describes after seeing ``shape`` (a scene's ``object.shape``,
+    m, in ``frame_id``: a ``polygon`` or ``spline`` with its points and holes, or a named
+    shape with its parameters): the seen shape with what it is told rather than sees, from
+    ``scene`` (material, mesh size, the fingers' placement points, their radius, friction).
 
     Raises
     ------
@@ -331,12 +338,18 @@ def seen_object(scene: Scene, outline: Outline, frame_id: str = OBJECT_FRAME) ->
                       "typed object has no fingers.<F>.tip")
     if fingers[0].tip_radius != fingers[1].tip_radius:
         raise invalid("planning from a seen outline needs equal fingertip radii for F1 and F2")
+    kind = ShapeType(shape["type"])
+    if kind in (ShapeType.POLYGON, ShapeType.SPLINE):
+        drawn = {"outline": np.asarray(shape["points"], float).tolist(),
+                 "holes": [np.asarray(h, float).tolist() for h in shape.get("holes", ())],
+                 "shape": ShapeType.SPLINE.value if kind == ShapeType.SPLINE else ""}
+    else:
+        drawn = {"shape": kind.value, "shape_parameters": {
+            k: tuple(np.atleast_1d(v).astype(float)) for k, v in shape.items() if k != "type"}}
     material = scene.object.material
     return TypedObject(
         material=TypedMaterial(material.E, material.nu, material.thickness,
                                material.model.value),
-        outline=np.asarray(outline.points, float).tolist(),
-        holes=[np.asarray(h, float).tolist() for h in outline.holes], frame_id=frame_id,
-        mesh_nodes=scene.object.mesh.nodes or 0,
+        frame_id=frame_id, mesh_nodes=scene.object.mesh.nodes or 0,
         placements=[f.placement.point for f in fingers], tip_radius=fingers[0].tip_radius,
-        mu=scene.mu)
+        mu=scene.mu, **drawn)

@@ -215,12 +215,17 @@ def polygon(points: Sequence[Sequence[float]],
     """
     p = validate_polyline(points, ShapeType.POLYGON)
     inner = tuple(validate_polyline(h, f"polygon.holes[{k}]") for k, h in enumerate(holes))
-    for k, hole in enumerate(inner):
-        if not _inside(hole[0], p) or _crosses(p, hole) or any(
-                _crosses(hole, other) or _inside(other[0], hole) for other in inner[:k]):
-            raise InvalidInputError(f"polygon.holes[{k}] must lie strictly inside the polygon "
-                                    "and apart from the other holes")
+    _check_holes(p, inner, ShapeType.POLYGON.value)
     return Outline(p, inner, corners=np.arange(len(p)))
+
+
+def _check_holes(outer: np.ndarray, inner: tuple[np.ndarray, ...], name: str) -> None:
+    """Refuse holes that are not strictly inside ``outer`` and apart from each other."""
+    for k, hole in enumerate(inner):
+        if not _inside(hole[0], outer) or _crosses(outer, hole) or any(
+                _crosses(hole, other) or _inside(other[0], hole) for other in inner[:k]):
+            raise InvalidInputError(f"{name}.holes[{k}] must lie strictly inside the {name} "
+                                    "and apart from the other holes")
 
 
 def _inside(point: np.ndarray, loop: np.ndarray) -> bool:
@@ -314,14 +319,31 @@ def fourier_blob(radius: float, cos: Sequence[float] = (), sin: Sequence[float] 
     return _smooth(radius * r * np.cos(t), radius * r * np.sin(t), ShapeType.FOURIER_BLOB)
 
 
-def spline(points: Sequence[Sequence[float]]) -> Outline:
-    """Closed periodic cubic spline through the user's ``points`` (m), by chord length."""
-    p = validate_polyline(points, "spline.points")
+def _spline_curve(points: Sequence[Sequence[float]], name: str) -> np.ndarray:
+    """Dense samples of the closed periodic cubic spline through ``points`` (m)."""
+    p = validate_polyline(points, name)
     closed = np.vstack([p, p[:1]])
     s = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(closed, axis=0), axis=1))])
     cs = CubicSpline(s, closed, bc_type="periodic")
-    dense = cs(np.linspace(0.0, s[-1], DENSE, endpoint=False))
-    return Outline(validate_polyline(dense, ShapeType.SPLINE))
+    return validate_polyline(cs(np.linspace(0.0, s[-1], DENSE, endpoint=False)), name)
+
+
+def spline(points: Sequence[Sequence[float]],
+           holes: Sequence[Sequence[Sequence[float]]] = ()) -> Outline:
+    """Closed periodic cubic spline through the user's ``points`` (m), by chord length, with
+    optional ``holes`` (each a list of [x, y], m), smooth splines too, strictly inside it.
+
+    Examples
+    --------
+    >>> t = np.linspace(0, 2 * np.pi, 12, endpoint=False)
+    >>> ring = spline(np.c_[np.cos(t), np.sin(t)], holes=[0.5 * np.c_[np.cos(t), np.sin(t)]])
+    >>> round(ring.area / (0.75 * np.pi), 3), len(ring.corners)
+    (1.0, 0)
+    """
+    outer = _spline_curve(points, ShapeType.SPLINE)
+    inner = tuple(_spline_curve(h, f"spline.holes[{k}]") for k, h in enumerate(holes))
+    _check_holes(outer, inner, ShapeType.SPLINE.value)
+    return Outline(outer, inner)
 
 
 def annulus(outer_radius: float, inner_radius: float) -> Outline:

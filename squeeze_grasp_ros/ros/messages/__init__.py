@@ -70,6 +70,7 @@ from squeeze_grasp_ros.ros.messages.monitor import (
     tracked_events_msg,
 )
 from squeeze_grasp_ros.ros.messages.objects import (
+    description_msg,
     object_description,
     polygon_msg,
     polygon_points,
@@ -135,6 +136,7 @@ __all__ = [
     "invalid_goal_result",
     "load_object_response",
     "monitor_status_msg",
+    "description_msg",
     "object_description",
     "object_model",
     "plan_gripper_grasp_response",

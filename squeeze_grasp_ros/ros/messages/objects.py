@@ -49,15 +49,30 @@ def object_description(outline: Outline, frame_id: str, *, youngs_modulus: float
                        placements: Sequence[Sequence[float]] = (), tip_radius: float = 0.0,
                        mu: float = 0.0, mesh_nodes: int = 0) -> ObjectDescription:
     """An ``ObjectDescription`` of an outline (m, in ``frame_id``) and a material."""
+    return description_msg(TypedObject(
+        material=TypedMaterial(youngs_modulus, poisson_ratio, thickness, model),
+        outline=np.asarray(outline.points, float).tolist(),
+        holes=[np.asarray(h, float).tolist() for h in outline.holes], frame_id=frame_id,
+        mesh_nodes=mesh_nodes, placements=placements, tip_radius=tip_radius, mu=mu))
+
+
+def description_msg(typed: TypedObject) -> ObjectDescription:
+    """The ``ObjectDescription`` of a :class:`TypedObject` (the inverse of
+    :func:`typed_object`; the frame pose is left unset, the identity).
+    """
+    m = typed.material
     msg = ObjectDescription(
-        holes=[polygon_msg(h) for h in outline.holes],
-        material=Material(youngs_modulus=float(youngs_modulus),
-                          poisson_ratio=float(poisson_ratio), thickness=float(thickness),
-                          model=model),
-        mesh_nodes=int(mesh_nodes), tip_radius=float(tip_radius), mu=float(mu))
-    msg.outline = PolygonStamped(polygon=polygon_msg(outline.points))
-    msg.outline.header.frame_id = frame_id
-    msg.placements = [Point(x=float(x), y=float(y)) for x, y in placements]
+        shape=typed.shape, shape_parameters=shape_parameters(typed.shape_parameters),
+        holes=[polygon_msg(np.asarray(h, float)) for h in typed.holes],
+        material=Material(youngs_modulus=float(m.youngs_modulus),
+                          poisson_ratio=float(m.poisson_ratio), thickness=float(m.thickness),
+                          model=m.model),
+        mesh_max_area=float(typed.mesh_max_area), mesh_nodes=int(typed.mesh_nodes),
+        tip_radius=float(typed.tip_radius), mu=float(typed.mu))
+    msg.outline = PolygonStamped(polygon=polygon_msg(np.asarray(typed.outline, float)
+                                                     .reshape(-1, 2)))
+    msg.outline.header.frame_id = typed.frame_id
+    msg.placements = [Point(x=float(x), y=float(y)) for x, y in typed.placements]
     return msg
 
 
@@ -69,11 +84,15 @@ def shape_parameters(parameters: dict[str, Sequence[float] | float]) -> list[Sha
 
 def seen_outline_msg(outline: Outline, *, frame_id: str, ns: int, encoding: str,
                      plane_height: float, tolerance: float, pixel_size: float,
-                     other_blobs: int) -> SeenOutline:
-    """A ``SeenOutline`` of an extracted outline (m, plane frame, top at ``plane_height``)."""
+                     other_blobs: int, shape: str = "", fit_residual: float = 0.0
+                     ) -> SeenOutline:
+    """A ``SeenOutline`` of an extracted outline (m, plane frame, top at ``plane_height``),
+    recognised as ``shape`` with the fit's largest residual ``fit_residual`` (m).
+    """
     return SeenOutline(
         outline=PolygonStamped(header=header(ns, frame_id),
                                polygon=polygon_msg(outline.points, plane_height)),
         holes=[polygon_msg(h, plane_height) for h in outline.holes],
         encoding=str(encoding), area=float(outline.area), tolerance=float(tolerance),
-        pixel_size=float(pixel_size), other_blobs=int(other_blobs))
+        pixel_size=float(pixel_size), other_blobs=int(other_blobs), shape=str(shape),
+        fit_residual=float(fit_residual))

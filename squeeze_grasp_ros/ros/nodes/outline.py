@@ -136,7 +136,8 @@ class OutlineNode(Node):
             seen.outline, frame_id=seen.frame_id, ns=messages.stamp_ns(msg.header.stamp),
             encoding=seen.encoding, plane_height=seen.plane_height,
             tolerance=seen.tolerance_m, pixel_size=seen.pixel_size_m,
-            other_blobs=len(seen.others))
+            other_blobs=len(seen.others), shape=seen.shape.value,
+            fit_residual=0.0 if seen.primitive is None else seen.primitive.residual_m)
         self.outline_pub.publish(out.outline)
         self.seen_pub.publish(out)
 

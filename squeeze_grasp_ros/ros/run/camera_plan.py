@@ -27,7 +27,7 @@ from squeeze_grasp_ros.planning import PlannerError
 from squeeze_grasp_ros.planning.typed_objects import seen_object
 from squeeze_grasp_ros.ros import messages
 from squeeze_grasp_ros.ros.messages.images import camera_model, camera_pose, image_array
-from squeeze_grasp_ros.ros.messages.objects import object_description, polygon_msg
+from squeeze_grasp_ros.ros.messages.objects import description_msg, polygon_msg
 from squeeze_grasp_ros.ros.nodes import pipeline
 from squeeze_grasp_ros.ros.run.options import RunError
 from squeeze_grasp_ros.scene import GraspSetup, Scene, build_outline
@@ -79,15 +79,9 @@ def seen_description(scene: Scene, seen: ObjectOutline) -> ObjectDescription:
         radii that differ).
     """
     try:
-        typed = seen_object(scene, seen.outline, seen.frame_id)
+        return description_msg(seen_object(scene, seen.to_scene_shape(), seen.frame_id))
     except PlannerError as error:
         raise RunError(f"camera.plan_from_images: {error}") from None
-    m = typed.material
-    return object_description(
-        seen.outline, typed.frame_id, youngs_modulus=m.youngs_modulus,
-        poisson_ratio=m.poisson_ratio, thickness=m.thickness, model=m.model,
-        placements=typed.placements, tip_radius=typed.tip_radius, mu=typed.mu,
-        mesh_nodes=typed.mesh_nodes)
 
 
 def seen_report(scene: Scene, seen: ObjectOutline) -> dict:
@@ -96,7 +90,9 @@ def seen_report(scene: Scene, seen: ObjectOutline) -> dict:
     """
     truth = build_outline(scene.object.shape)
     match = shape_residual(truth, seen.outline, fit=ShapeFit.NONE)
-    return {"vertices": int(len(seen.outline.points)), "holes": len(seen.outline.holes),
+    return {"recognised": seen.shape.value,
+            "fit_residual_m": None if seen.primitive is None else seen.primitive.residual_m,
+            "vertices": int(len(seen.outline.points)), "holes": len(seen.outline.holes),
             "rms_m": match.rms_m, "max_m": max(match.max_m, match.reverse_max_m),
             "area_m2": seen.outline.area, "true_area_m2": truth.area,
             "pixel_m": seen.pixel_size_m, "tolerance_m": seen.tolerance_m}

@@ -30,6 +30,8 @@ from squeeze_grasp_ros.ros.messages.contacts import (
     contact_node_msg,
     contact_records,
     contact_state_msg,
+    fill_contact_arrays,
+    fill_contact_state,
     fill_tactile,
     tactile_array_msg,
     tactile_readings,
@@ -60,6 +62,8 @@ from squeeze_grasp_ros.ros.messages.gripper import (
 )
 from squeeze_grasp_ros.ros.messages.monitor import (
     alarm_msg,
+    fill_monitor_status,
+    fill_patches_state,
     force_curve,
     monitor_status_msg,
     patches_state_msg,
@@ -94,6 +98,7 @@ from squeeze_grasp_ros.ros.messages.planner import (
 from squeeze_grasp_ros.ros.messages.world import (
     MARKER_COLOURS,
     event_record,
+    fill_sim_state,
     sim_events_msg,
     sim_state_msg,
     world_markers,
@@ -116,7 +121,12 @@ __all__ = [
     "event_squeeze_feedback",
     "executor_status_msg",
     "failure",
+    "fill_contact_arrays",
+    "fill_contact_state",
+    "fill_monitor_status",
+    "fill_patches_state",
     "fill_pose",
+    "fill_sim_state",
     "fill_tactile",
     "fill_wrench",
     "float64_array",

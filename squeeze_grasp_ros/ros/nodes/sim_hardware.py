@@ -100,6 +100,8 @@ class SimHardwareNode(Node):
         self.tactile_pubs = {f: pub(TactileArray, pipeline.device_topic(d, "tactile"), sensors)
                              for f, d in self.devices.items() if f in world.layouts}
         self.msgs = {f: self._reading_messages(f) for f in self.devices}
+        self.state_msg: SimState | None = None
+        """The ground truth message, built at tick 0 and refilled in place after it."""
         self.tick_pub = pub(Tick, pipeline.TICK, kept)
         self.state_pub = pub(SimState, pipeline.SIM_STATE, kept)
         self.event_pub = pub(ContactEventArray, pipeline.SIM_EVENTS, loop)
@@ -189,8 +191,9 @@ class SimHardwareNode(Node):
     def _publish(self, out: TickOutput) -> None:
         """Publish tick ``out`` (clock first, sim/tick last) and keep it for a re-send.
 
-        The per-device readings are refilled in place (one message object per publisher);
-        markers are built only at the display rate and only while somebody subscribes.
+        The per-device readings and the ground truth are refilled in place (one message
+        object per publisher); markers are built only at the display rate and only while
+        somebody subscribes.
         """
         ns, frame = out.stamp_ns, self.frame
         batch = [(self.clock_pub, messages.clock_msg(ns))]
@@ -216,8 +219,12 @@ class SimHardwareNode(Node):
         if self.controller is not None:
             batch.append(self.controller.joint_state(out))
             readings.append(JOINT_STATES)
-        batch.append((self.state_pub, messages.sim_state_msg(out.state, self.world.fingers,
-                                                             out.termination, ns, frame)))
+        if self.state_msg is None:
+            self.state_msg = messages.sim_state_msg(out.state, self.world.fingers,
+                                                    out.termination, ns, frame)
+        else:
+            messages.fill_sim_state(self.state_msg, out.state, out.termination, ns)
+        batch.append((self.state_pub, self.state_msg))
         if out.index == 0:
             batch += self.first_frame
         elif (frame_out := self.world.camera_frame(out.index, ns)) is not None:

@@ -27,7 +27,6 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from matplotlib.path import Path as MplPath
 from scipy import ndimage
 
 from squeeze_grasp_ros.mechanics.elastic.shapes import Outline, signed_area, validate_polyline
@@ -222,6 +221,8 @@ def _outline(loops: list[np.ndarray], camera: CameraModel, pose: CameraPose,
     outer = _simplify(metric[0], tolerance, pixel, "extracted outline")
     holes = tuple(_simplify(h, tolerance, pixel, f"extracted hole {k + 1}")
                   for k, h in enumerate(metric[1:]))
+    from matplotlib.path import Path as MplPath  # 0.1-0.2 s to import: only when extracting
+
     boundary = MplPath(outer)
     for k, hole in enumerate(holes):
         if not np.all(boundary.contains_points(hole)):

@@ -25,7 +25,6 @@ from squeeze_grasp_ros.ros.messages.common import (
 from squeeze_grasp_ros.ros.messages.contacts import (
     CONTACT_MODES,
     TactileReadings,
-    contact_arrays_msg,
     contact_event_msg,
     contact_node_msg,
     contact_records,
@@ -111,7 +110,6 @@ __all__ = [
     "alarm_msg",
     "bool_list",
     "clock_msg",
-    "contact_arrays_msg",
     "contact_event_msg",
     "contact_node_msg",
     "contact_records",

@@ -64,22 +64,6 @@ def fill_contact_state(msg: ContactState, state: contact_state.ContactState) -> 
     )
 
 
-def contact_arrays_msg(
-    fingers: list[str],
-    nodes: list[int],
-    angles: list[float],
-    modes: list[int],
-    forces_x: list[float],
-    forces_y: list[float],
-    depth: float,
-    relative_depth: float,
-    header: Header | None = None,
-) -> ContactState:
-    """``ContactState`` of parallel per-contact lists (angles rad, forces N, depth m)."""
-    return fill_contact_arrays(ContactState(header=header or Header()), fingers, nodes, angles,
-                               modes, forces_x, forces_y, depth, relative_depth)
-
-
 def fill_contact_arrays(
     msg: ContactState,
     fingers: list[str],

@@ -9,6 +9,12 @@ ticks), ``world`` (ground truth, markers), ``monitor``, ``executor`` and ``objec
 objects, outlines).
 """
 
+from squeeze_grasp_ros.ros.messages.cdr import (
+    cdr_stamp_ns,
+    pose_position_cdr,
+    tactile_readings_cdr,
+    wrench_force_cdr,
+)
 from squeeze_grasp_ros.ros.messages.common import (
     bool_list,
     clock_msg,
@@ -109,6 +115,7 @@ __all__ = [
     "TactileReadings",
     "alarm_msg",
     "bool_list",
+    "cdr_stamp_ns",
     "clock_msg",
     "contact_event_msg",
     "contact_node_msg",
@@ -155,6 +162,7 @@ __all__ = [
     "pose_in_base",
     "pose_msg",
     "pose_position",
+    "pose_position_cdr",
     "predicted_events",
     "prediction_msg",
     "force_curve",
@@ -171,6 +179,7 @@ __all__ = [
     "success",
     "tactile_array_msg",
     "tactile_readings",
+    "tactile_readings_cdr",
     "tick_msg",
     "tracked_event_msg",
     "tracked_events_msg",
@@ -178,5 +187,6 @@ __all__ = [
     "vector3",
     "world_markers",
     "wrench_force",
+    "wrench_force_cdr",
     "wrench_msg",
 ]

@@ -115,7 +115,8 @@ class SimHardwareNode(Node):
                 publisher.publish(msg)
         for finger, device in self.devices.items():
             self.create_subscription(PoseStamped, pipeline.device_topic(device, "setpoint"),
-                                     lambda msg, f=finger: self._setpoint(f, msg), loop)
+                                     lambda data, f=finger: self._setpoint(f, data), loop,
+                                     raw=True)
         jaws = scene_controller(world.scene, self.p["scene"] or ".")
         self.controller = None if jaws is None else sim_controller(jaws)(
             self, world, jaws, loop, now_ns=lambda: self.now_ns, on_command=self._try_step)
@@ -166,10 +167,12 @@ class SimHardwareNode(Node):
         self.get_logger().info(f"lockstep start: fingers {self.devices}, dt {self.world.dt} s")
         self._publish(self.world.start())
 
-    def _setpoint(self, finger: str, msg: PoseStamped) -> None:
-        if self.now_ns < 0 or messages.stamp_ns(msg.header.stamp) <= self.now_ns:
+    def _setpoint(self, finger: str, data: bytes) -> None:
+        """A setpoint, read from its CDR bytes (:mod:`..messages.cdr`)."""
+        ns, position = messages.pose_position_cdr(data)
+        if self.now_ns < 0 or ns <= self.now_ns:
             return
-        self.pending[finger] = messages.pose_position(msg)
+        self.pending[finger] = position
         self._try_step()
 
     def _progress(self, msg: Header) -> None:

@@ -31,7 +31,6 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from matplotlib.path import Path as MplPath
 from scipy import ndimage
 
 from squeeze_grasp_ros.mechanics.elastic.shapes import Outline, signed_area, validate_polyline
@@ -266,6 +265,8 @@ def _outline(loops: list[np.ndarray], camera: CameraModel, pose: CameraPose,
     simplified = [_simplify(h, tolerance, pixel, f"extracted hole {k + 1}")
                   for k, h in enumerate(metric[1:])]
     holes = tuple(h for h, _ in simplified)
+    from matplotlib.path import Path as MplPath  # 0.1-0.2 s to import: only when extracting
+
     boundary = MplPath(outer)
     for k, hole in enumerate(holes):
         if not np.all(boundary.contains_points(hole)):

@@ -9,6 +9,12 @@ ticks), ``world`` (ground truth, markers), ``monitor``, ``executor`` and ``objec
 objects, outlines).
 """
 
+from squeeze_grasp_ros.ros.messages.cdr import (
+    cdr_stamp_ns,
+    pose_position_cdr,
+    tactile_readings_cdr,
+    wrench_force_cdr,
+)
 from squeeze_grasp_ros.ros.messages.common import (
     bool_list,
     clock_msg,
@@ -25,11 +31,12 @@ from squeeze_grasp_ros.ros.messages.common import (
 from squeeze_grasp_ros.ros.messages.contacts import (
     CONTACT_MODES,
     TactileReadings,
-    contact_arrays_msg,
     contact_event_msg,
     contact_node_msg,
     contact_records,
     contact_state_msg,
+    fill_contact_arrays,
+    fill_contact_state,
     fill_tactile,
     tactile_array_msg,
     tactile_readings,
@@ -60,6 +67,8 @@ from squeeze_grasp_ros.ros.messages.gripper import (
 )
 from squeeze_grasp_ros.ros.messages.monitor import (
     alarm_msg,
+    fill_monitor_status,
+    fill_patches_state,
     force_curve,
     monitor_status_msg,
     patches_state_msg,
@@ -95,6 +104,7 @@ from squeeze_grasp_ros.ros.messages.planner import (
 from squeeze_grasp_ros.ros.messages.world import (
     MARKER_COLOURS,
     event_record,
+    fill_sim_state,
     sim_events_msg,
     sim_state_msg,
     world_markers,
@@ -106,8 +116,8 @@ __all__ = [
     "TactileReadings",
     "alarm_msg",
     "bool_list",
+    "cdr_stamp_ns",
     "clock_msg",
-    "contact_arrays_msg",
     "contact_event_msg",
     "contact_node_msg",
     "contact_records",
@@ -117,7 +127,12 @@ __all__ = [
     "event_squeeze_feedback",
     "executor_status_msg",
     "failure",
+    "fill_contact_arrays",
+    "fill_contact_state",
+    "fill_monitor_status",
+    "fill_patches_state",
     "fill_pose",
+    "fill_sim_state",
     "fill_tactile",
     "fill_wrench",
     "float64_array",
@@ -149,6 +164,7 @@ __all__ = [
     "pose_in_base",
     "pose_msg",
     "pose_position",
+    "pose_position_cdr",
     "predicted_events",
     "prediction_msg",
     "force_curve",
@@ -165,6 +181,7 @@ __all__ = [
     "success",
     "tactile_array_msg",
     "tactile_readings",
+    "tactile_readings_cdr",
     "tick_msg",
     "tracked_event_msg",
     "tracked_events_msg",
@@ -172,5 +189,6 @@ __all__ = [
     "vector3",
     "world_markers",
     "wrench_force",
+    "wrench_force_cdr",
     "wrench_msg",
 ]

@@ -43,8 +43,16 @@ def contact_state_msg(
     state: contact_state.ContactState, header: Header | None = None
 ) -> ContactState:
     """The contact set of a stepper state as ``ContactState`` (depth rho in m)."""
+    return fill_contact_state(ContactState(header=header or Header()), state)
+
+
+def fill_contact_state(msg: ContactState, state: contact_state.ContactState) -> ContactState:
+    """Refill a ``ContactState`` in place with the contact set of a stepper state (its header
+    stays).
+    """
     contacts = state.contacts
-    return contact_arrays_msg(
+    return fill_contact_arrays(
+        msg,
         [c.finger for c in contacts],
         [int(c.node) for c in contacts],
         [float(c.theta) for c in contacts],
@@ -53,11 +61,11 @@ def contact_state_msg(
         [float(c.force[1]) for c in contacts],
         float(state.depth),
         float(state.relative_depth),
-        header,
     )
 
 
-def contact_arrays_msg(
+def fill_contact_arrays(
+    msg: ContactState,
     fingers: list[str],
     nodes: list[int],
     angles: list[float],
@@ -66,20 +74,19 @@ def contact_arrays_msg(
     forces_y: list[float],
     depth: float,
     relative_depth: float,
-    header: Header | None = None,
 ) -> ContactState:
-    """``ContactState`` of parallel per-contact lists (angles rad, forces N, depth m)."""
-    return ContactState(
-        header=header or Header(),
-        fingers=fingers,
-        nodes=array.array("i", nodes),
-        polar_angles=array.array("d", angles),
-        modes=array.array("B", modes),
-        forces_x=array.array("d", forces_x),
-        forces_y=array.array("d", forces_y),
-        depth=depth,
-        relative_depth=relative_depth,
-    )
+    """Refill a ``ContactState`` in place with parallel per-contact lists (angles rad, forces
+    N, depth m); its header stays.
+    """
+    msg.fingers = fingers
+    msg.nodes = array.array("i", nodes)
+    msg.polar_angles = array.array("d", angles)
+    msg.modes = array.array("B", modes)
+    msg.forces_x = array.array("d", forces_x)
+    msg.forces_y = array.array("d", forces_y)
+    msg.depth = depth
+    msg.relative_depth = relative_depth
+    return msg
 
 
 def contact_records(msg: ContactState) -> list[dict]:

@@ -7,7 +7,7 @@ import math
 from collections.abc import Sequence
 
 import numpy as np
-from geometry_msgs.msg import Point
+from geometry_msgs.msg import Point, Vector3
 
 from squeeze_grasp_interfaces.msg import (
     Alarm,
@@ -24,14 +24,10 @@ from squeeze_grasp_ros.control.tracker import (
     TrackerOutput,
 )
 from squeeze_grasp_ros.mechanics.vocabulary import EventType, Finger
-from squeeze_grasp_ros.ros.messages.common import float64_array, header, vector3
-from squeeze_grasp_ros.ros.messages.contacts import CONTACT_MODES, contact_arrays_msg
+from squeeze_grasp_ros.ros.messages.common import float64_array, header, set_stamp
+from squeeze_grasp_ros.ros.messages.contacts import CONTACT_MODES, fill_contact_arrays
 
 # --------------------------------------------------------------------------- pipeline: monitor
-
-
-def _point(xy: np.ndarray) -> Point:
-    return Point(x=float(xy[0]), y=float(xy[1]))
 
 
 def tracked_event_msg(event: TrackedEvent, ns: int) -> ContactEvent:
@@ -69,9 +65,18 @@ def patches_state_msg(out: TrackerOutput, frame_id: str) -> ContactState:
     """The monitor's reconstructed contact patches as ``ContactState`` (node = -1, polar angle
     = the patch's mean taxel angle, force = the patch force on the object, N).
     """
+    return fill_patches_state(ContactState(header=header(out.stamp_ns, frame_id)), out)
+
+
+def fill_patches_state(msg: ContactState, out: TrackerOutput) -> ContactState:
+    """Refill a :func:`patches_state_msg` in place with the patches of a new tick (its frame
+    stays).
+    """
     patches = out.patches
     trig = [(math.cos(p.angle), math.sin(p.angle)) for p in patches]
-    return contact_arrays_msg(
+    set_stamp(msg.header.stamp, out.stamp_ns)
+    return fill_contact_arrays(
+        msg,
         [p.finger for p in patches],
         [-1] * len(patches),
         [p.angle for p in patches],
@@ -80,25 +85,34 @@ def patches_state_msg(out: TrackerOutput, frame_id: str) -> ContactState:
         [p.normal * s + p.tangential * c for p, (c, s) in zip(patches, trig)],
         out.depth,
         out.relative_depth,
-        header(out.stamp_ns, frame_id),
     )
 
 
 def monitor_status_msg(out: TrackerOutput, frame_id: str) -> MonitorStatus:
     """The monitor's per-tick ``MonitorStatus`` (fingers without a pose report the origin)."""
-    zero = np.zeros(2)
-    return MonitorStatus(
-        header=header(out.stamp_ns, frame_id),
-        fingers=list(out.fingers),
-        positions=[_point(out.positions.get(f, zero)) for f in out.fingers],
-        forces=[vector3(out.forces[f]) for f in out.fingers],
-        normals=[vector3(out.normals[f]) for f in out.fingers],
-        sensor_age=float64_array([min(out.ages[f], 1e300) for f in out.fingers]),
-        depth=out.depth,
-        relative_depth=out.relative_depth,
-        events=[tracked_event_msg(e, out.stamp_ns) for e in out.events],
-        alarms=[alarm_msg(a, out.stamp_ns) for a in out.alarms],
-    )
+    msg = MonitorStatus(header=header(out.stamp_ns, frame_id), fingers=list(out.fingers),
+                        positions=[Point() for _ in out.fingers],
+                        forces=[Vector3() for _ in out.fingers],
+                        normals=[Vector3() for _ in out.fingers])
+    return fill_monitor_status(msg, out)
+
+
+def fill_monitor_status(msg: MonitorStatus, out: TrackerOutput) -> MonitorStatus:
+    """Refill a :func:`monitor_status_msg` in place with a new tick of the same fingers (its
+    frame stays).
+    """
+    set_stamp(msg.header.stamp, out.stamp_ns)
+    for f, point, force, normal in zip(out.fingers, msg.positions, msg.forces, msg.normals):
+        xy = out.positions.get(f)
+        point.x, point.y = (float(xy[0]), float(xy[1])) if xy is not None else (0.0, 0.0)
+        force.x, force.y = float(out.forces[f][0]), float(out.forces[f][1])
+        normal.x, normal.y = float(out.normals[f][0]), float(out.normals[f][1])
+    msg.sensor_age = float64_array([min(out.ages[f], 1e300) for f in out.fingers])
+    msg.depth = out.depth
+    msg.relative_depth = out.relative_depth
+    msg.events = [tracked_event_msg(e, out.stamp_ns) for e in out.events]
+    msg.alarms = [alarm_msg(a, out.stamp_ns) for a in out.alarms]
+    return msg
 
 
 def prediction_msg(

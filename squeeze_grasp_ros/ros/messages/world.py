@@ -6,18 +6,19 @@ from __future__ import annotations
 from collections.abc import Sequence
 
 import numpy as np
-from geometry_msgs.msg import Point
+from geometry_msgs.msg import Point, Vector3
 from visualization_msgs.msg import Marker, MarkerArray
 
 from squeeze_grasp_interfaces.msg import (
     ContactEvent,
     ContactEventArray,
+    ContactState,
     SimState,
 )
 from squeeze_grasp_ros.mechanics.squeeze import contact_state
 from squeeze_grasp_ros.mechanics.vocabulary import ContactMode
-from squeeze_grasp_ros.ros.messages.common import float64_array, header, stamp_ns, vector3
-from squeeze_grasp_ros.ros.messages.contacts import contact_event_msg, contact_state_msg
+from squeeze_grasp_ros.ros.messages.common import float64_array, header, set_stamp, stamp_ns
+from squeeze_grasp_ros.ros.messages.contacts import contact_event_msg, fill_contact_state
 from squeeze_grasp_ros.sim.world import WorldView
 
 # --------------------------------------------------------------------------- pipeline: ground trut
@@ -31,23 +32,33 @@ def sim_state_msg(
     frame_id: str,
 ) -> SimState:
     """Ground truth of the simulated world as ``SimState`` (fingers without a tip: zeros)."""
-    present = {f.name: f for f in state.fingers}
-    positions, forces, work = [], [], []
-    for name in fingers:
-        f = present.get(name)
-        positions.append(Point(x=float(f.center[0]), y=float(f.center[1])) if f else Point())
-        forces.append(vector3(state.finger_force(name)))
-        work.append(f.work if f else 0.0)
     stamp_header = header(ns, frame_id)
-    return SimState(
-        header=stamp_header,
-        fingers=list(fingers),
-        positions=positions,
-        forces=forces,
-        work=float64_array(work),
-        contacts=contact_state_msg(state, stamp_header),
-        termination=termination or "",
-    )
+    msg = SimState(header=stamp_header, fingers=list(fingers),
+                   positions=[Point() for _ in fingers], forces=[Vector3() for _ in fingers],
+                   contacts=ContactState(header=stamp_header))
+    return fill_sim_state(msg, state, termination, ns)
+
+
+def fill_sim_state(
+    msg: SimState, state: contact_state.ContactState, termination: str | None, ns: int
+) -> SimState:
+    """Refill a :func:`sim_state_msg` in place with a new state at sim time ``ns`` (its
+    fingers and frame stay): what the simulated hardware publishes every tick.
+    """
+    present = {f.name: f for f in state.fingers}
+    work = []
+    for name, point, force in zip(msg.fingers, msg.positions, msg.forces):
+        f = present.get(name)
+        point.x, point.y = (float(f.center[0]), float(f.center[1])) if f else (0.0, 0.0)
+        xy = state.finger_force(name)
+        force.x, force.y = float(xy[0]), float(xy[1])
+        work.append(f.work if f else 0.0)
+    set_stamp(msg.header.stamp, ns)
+    set_stamp(msg.contacts.header.stamp, ns)
+    msg.work = float64_array(work)
+    fill_contact_state(msg.contacts, state)
+    msg.termination = termination or ""
+    return msg
 
 
 def sim_events_msg(

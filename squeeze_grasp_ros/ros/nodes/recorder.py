@@ -26,7 +26,6 @@ already arrived, then ``close`` writes the MCAP summary and ``metadata.yaml``.
 """
 from __future__ import annotations
 
-import struct
 import sys
 import time
 from collections import deque
@@ -76,12 +75,6 @@ POLICY_NAMES = {
                    DurabilityPolicy.TRANSIENT_LOCAL: "transient_local"},
 }
 """rclpy QoS policies -> the names rosbag2 v9 writes (per policy: their integer values overlap)."""
-
-
-def cdr_stamp_ns(data: bytes) -> int:
-    """Stamp (ns) at the start of a CDR message whose first field is a header or a time."""
-    sec, nanosec = struct.unpack_from("<iI" if data[1] & 1 else ">iI", data, 4)
-    return sec * 1_000_000_000 + nanosec
 
 
 class RecorderNode(Node):
@@ -160,7 +153,8 @@ class RecorderNode(Node):
                           for i in self.get_publishers_info_by_topic(self.sources[topic]))]
 
     def _record(self, topic: str, data: bytes) -> None:
-        ns = cdr_stamp_ns(data) if self.stamped[topic] else self.get_clock().now().nanoseconds
+        ns = (messages.cdr_stamp_ns(data) if self.stamped[topic]
+              else self.get_clock().now().nanoseconds)
         if topic in self.unique:
             if ns in self.recent[topic]:
                 self.duplicates += 1

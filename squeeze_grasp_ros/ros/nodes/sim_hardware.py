@@ -101,6 +101,8 @@ class SimHardwareNode(Node):
         self.tactile_pubs = {f: pub(TactileArray, pipeline.device_topic(d, "tactile"), sensors)
                              for f, d in self.devices.items() if f in world.layouts}
         self.msgs = {f: self._reading_messages(f) for f in self.devices}
+        self.state_msg: SimState | None = None
+        """The ground truth message, built at tick 0 and refilled in place after it."""
         self.tick_pub = pub(Tick, pipeline.TICK, kept)
         self.state_pub = pub(SimState, pipeline.SIM_STATE, kept)
         self.event_pub = pub(ContactEventArray, pipeline.SIM_EVENTS, loop)
@@ -114,7 +116,8 @@ class SimHardwareNode(Node):
                 publisher.publish(msg)
         for finger, device in self.devices.items():
             self.create_subscription(PoseStamped, pipeline.device_topic(device, "setpoint"),
-                                     lambda msg, f=finger: self._setpoint(f, msg), loop)
+                                     lambda data, f=finger: self._setpoint(f, data), loop,
+                                     raw=True)
         jaws = scene_controller(world.scene, self.p["scene"] or ".")
         self.controller = None if jaws is None else sim_controller(jaws)(
             self, world, jaws, loop, now_ns=lambda: self.now_ns, on_command=self._try_step)
@@ -167,10 +170,12 @@ class SimHardwareNode(Node):
         self.get_logger().info(f"lockstep start: fingers {self.devices}, dt {self.world.dt} s")
         self._publish(self.world.start())
 
-    def _setpoint(self, finger: str, msg: PoseStamped) -> None:
-        if self.now_ns < 0 or messages.stamp_ns(msg.header.stamp) <= self.now_ns:
+    def _setpoint(self, finger: str, data: bytes) -> None:
+        """A setpoint, read from its CDR bytes (:mod:`..messages.cdr`)."""
+        ns, position = messages.pose_position_cdr(data)
+        if self.now_ns < 0 or ns <= self.now_ns:
             return
-        self.pending[finger] = messages.pose_position(msg)
+        self.pending[finger] = position
         self._try_step()
 
     def _progress(self, msg: Header) -> None:
@@ -192,8 +197,9 @@ class SimHardwareNode(Node):
     def _publish(self, out: TickOutput) -> None:
         """Publish tick ``out`` (clock first, sim/tick last) and keep it for a re-send.
 
-        The per-device readings are refilled in place (one message object per publisher);
-        markers are built only at the display rate and only while somebody subscribes.
+        The per-device readings and the ground truth are refilled in place (one message
+        object per publisher); markers are built only at the display rate and only while
+        somebody subscribes.
         """
         ns, frame = out.stamp_ns, self.frame
         batch = [(self.clock_pub, messages.clock_msg(ns))]
@@ -219,8 +225,12 @@ class SimHardwareNode(Node):
         if self.controller is not None:
             batch.append(self.controller.joint_state(out))
             readings.append(JOINT_STATES)
-        batch.append((self.state_pub, messages.sim_state_msg(out.state, self.world.fingers,
-                                                             out.termination, ns, frame)))
+        if self.state_msg is None:
+            self.state_msg = messages.sim_state_msg(out.state, self.world.fingers,
+                                                    out.termination, ns, frame)
+        else:
+            messages.fill_sim_state(self.state_msg, out.state, out.termination, ns)
+        batch.append((self.state_pub, self.state_msg))
         if out.index == 0:
             batch += self.first_frame
         elif (frame_out := self.world.camera_frame(out.index, ns)) is not None:

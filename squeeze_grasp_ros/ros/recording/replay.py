@@ -35,9 +35,9 @@ from squeeze_grasp_interfaces.msg import ContactEventArray, MonitorStatus, Tacti
 from squeeze_grasp_ros.inputs import InputError, load_yaml
 from squeeze_grasp_ros.mechanics.vocabulary import Finger
 from squeeze_grasp_ros.ros import messages
+from squeeze_grasp_ros.ros.messages.cdr import cdr_stamp_ns
 from squeeze_grasp_ros.ros.nodes import pipeline
 from squeeze_grasp_ros.ros.nodes.monitor import MonitorNode
-from squeeze_grasp_ros.ros.nodes.recorder import cdr_stamp_ns
 from squeeze_grasp_ros.ros.nodes.sim_controllers import JOINT_STATES
 from squeeze_grasp_ros.ros.recording.bag import BagContents, BagError, read_bag
 from squeeze_grasp_ros.ros.run.options import config_parameters

@@ -17,8 +17,8 @@ from std_msgs.msg import Header
 from squeeze_grasp_interfaces.action import ExecuteGrasp
 from squeeze_grasp_interfaces.msg import Alarm, ContactEvent, ContactEventArray, SimState
 from squeeze_grasp_ros.ros import messages
+from squeeze_grasp_ros.ros.messages.cdr import cdr_stamp_ns
 from squeeze_grasp_ros.ros.nodes import pipeline
-from squeeze_grasp_ros.ros.nodes.recorder import cdr_stamp_ns
 from squeeze_grasp_ros.ros.run.summary import GRASP_HELD, Observed
 
 __all__ = ["Observer", "Progress"]

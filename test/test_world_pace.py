@@ -121,3 +121,30 @@ def test_area_watch_answers_as_the_full_area_check():
             assert watch.above(sd, delta, F, level) == expected, (tick.index, level)
             answers.add(expected)
     assert answers == {True, False} and watch.renewals >= 2
+
+
+def test_area_watch_skips_only_where_the_full_check_agrees():
+    """At one level, called tick after tick: AreaWatch answers most ticks from its bound on
+    the motion since its last True answer, and still answers as ``area_ratio`` at every tick,
+    also across the tick where the smallest area ratio passes the level (chosen in the middle
+    of the squeeze's range, so both answers occur).
+    """
+    world = SimWorld(GraspSetup.build(load_scene(scene_file("foam_square"))), quiet=False)
+    model, ticks = world.model, squeeze_world(world, 300)[1:]
+    configurations, ratios = [], []
+    for tick in ticks:
+        contacts = tick.state.contacts
+        sd = model.set_data(tuple(c.node for c in contacts))
+        delta = np.array([c.displacement for c in contacts]) / model.length
+        F = np.array([c.force for c in contacts]) / model.force_unit
+        configurations.append((sd, delta, F))
+        ratios.append(model.area_ratio(sd, delta, F)[0])
+    skips = {}
+    for level in (INVERSION_AREA_RATIO + 1e-12, 0.5 * (max(ratios) + min(ratios))):
+        watch = AreaWatch(model)
+        answers = [watch.above(*c, level) for c in configurations]
+        assert answers == [r > level for r in ratios], level
+        skips[level] = watch.skips
+    print(f"AreaWatch skips of {len(ticks)} ticks per level: {skips}")
+    assert answers.count(False) > 0 and answers.count(True) > 0
+    assert min(skips.values()) > 0 and max(skips.values()) > len(ticks) // 2

@@ -93,6 +93,7 @@ class QuietSteps:
         self._set: _Sticking | None = None
         self._gap_ref: dict | None = None
         self._mode: _Mode | None = None
+        self._contact_ref: tuple | None = None
         self._boundary = model.positions(model.boundary_nodes)
         self._applies = (quiet and model.constitutive_model == MaterialModel.LINEAR
                          and not model.reference and not model.adaptive_steps
@@ -162,8 +163,9 @@ class QuietSteps:
             None if watched.all() else watched, sticking.unit[watched],
             sticking.tangent[watched], expiry,
             tuple(fingers == f for f in range(len(names))),
-            tuple((node, names[f], theta, nu) for node, f, theta, nu in zip(
-                contacts.nodes.tolist(), fingers.tolist(), thetas, sticking.nu.tolist())),
+            tuple(ContactNode(node, names[f], ContactMode.STICK, 0, theta, None, None, nu)
+                  for node, f, theta, nu in zip(contacts.nodes.tolist(), fingers.tolist(),
+                                                thetas, sticking.nu.tolist())),
             tuple(contacts.nodes.tolist()), tuple(thetas),
             model.length, model.force_unit, model._cache)
 
@@ -198,9 +200,11 @@ class QuietSteps:
             contacts = ContactSet.of_state(self.model, state)
             tip = motion.tip.take(contacts.finger)
             nu = tip.normal_angle(contacts.theta)
+            dtheta, t = np.zeros(len(contacts)), tangent(nu)
             self._set = _Sticking(key, contacts, contacts.data.C, tip.offset(contacts.theta),
-                                  nu, tip.curvature(contacts.theta), unit(nu), tangent(nu),
-                                  tip.radius)
+                                  nu, tip.curvature(contacts.theta), unit(nu), t, tip.radius,
+                                  np.array(contacts.theta, float), dtheta,
+                                  (tip.radius * dtheta)[:, None] * t)
         return self._set
 
     def _clear(self, mode: _Mode, motion: FingerMotion, sol: Solution, s: float) -> bool:
@@ -208,18 +212,32 @@ class QuietSteps:
         rows and contacts not held) and every termination it checks is above
         :data:`QUIET_MARGIN`.
         """
-        model, contacts = self.model, mode.sticking.contacts
-        F = sol.F[mode.watched] if mode.watched is not None else sol.F
-        fn = np.einsum("ij,ij->i", F, mode.unit)
-        ft = np.einsum("ij,ij->i", F, mode.tangent)
-        cone = model.mu * fn - np.abs(ft)
-        if not (min(fn.min(initial=np.inf), cone.min(initial=np.inf)) > QUIET_MARGIN
+        contacts = mode.sticking.contacts
+        if not (self._contacts_clear(mode, sol.F)
                 and self._gaps_clear(mode, motion.centers(s), sol)):
             return False
         strain, pickup = mode.functions.termination_values(contacts, sol)
         return (strain > QUIET_MARGIN and pickup > QUIET_MARGIN
                 and self.area.above(contacts.data, sol.delta, sol.F,
                                     INVERSION_AREA_RATIO + QUIET_MARGIN))
+
+    def _contacts_clear(self, mode: _Mode, F: np.ndarray) -> bool:
+        """Whether the normal force f_n and both cone margins mu f_n -+ f_t of every contact
+        not held are above :data:`QUIET_MARGIN` at the forces ``F``: from the lowest value
+        computed last for the mode while a bound allows (each moves by at most
+        (1 + mu) ||F - F_ref||), else computed (and kept).
+        """
+        mu, ref = self.model.mu, self._contact_ref
+        if ref is not None and ref[0] is mode:
+            dF = F - ref[1]
+            if ref[2] - (1.0 + mu) * np.sqrt(np.vdot(dF, dF)) * (1.0 + 1e-12) > QUIET_MARGIN:
+                return True
+        watched = F[mode.watched] if mode.watched is not None else F
+        fn = np.einsum("ij,ij->i", watched, mode.unit)
+        ft = np.einsum("ij,ij->i", watched, mode.tangent)
+        lowest = min(fn.min(initial=np.inf), (mu * fn - np.abs(ft)).min(initial=np.inf))
+        self._contact_ref = (mode, F, lowest)
+        return lowest > QUIET_MARGIN
 
     def _gaps_clear(self, mode: _Mode, centers: np.ndarray, sol: Solution) -> bool:
         """Whether every gap of the mode's free boundary rows to every tip (at ``centers``) is
@@ -260,8 +278,9 @@ class _Mode:
     """What stays fixed while calls stay quiet in one sticking mode: the set's constants, the
     functions watched (the free boundary ``rows``; the contacts not held, their normals'
     ``unit`` and ``tangent``), the depth (m) at which a hold of the chattering bound ``expiry``
-    ends, and the parts of a result that do not move (each finger's contact mask, each
-    contact's node, finger, angle and normal angle).
+    ends, and the parts of a result that do not move (each finger's contact mask; each
+    contact's node, finger, mode, angle and normal angle, as a ContactNode without its
+    displacement and force).
     """
 
     sticking: _Sticking
@@ -274,7 +293,7 @@ class _Mode:
     tangent: np.ndarray
     expiry: float
     masks: tuple[np.ndarray, ...]
-    contacts: tuple[tuple, ...]
+    contacts: tuple[ContactNode, ...]
     nodes: tuple[int, ...]
     thetas: tuple[float, ...]
     length: float
@@ -311,14 +330,23 @@ class _Mode:
                         float(f_old.dissipation / (fu * L) * fu * L), flat[f], facing[f])
             for f, (n, f_old) in enumerate(zip(names, old)))
         delta, F = sol_b.delta * L, sol_b.F * fu
-        contacts = tuple(ContactNode(node, name, ContactMode.STICK, 0, theta, delta[k], F[k], nu)
-                         for k, (node, name, theta, nu) in enumerate(self.contacts))
+        contacts = tuple(_moved(c, delta[k], F[k]) for k, c in enumerate(self.contacts))
         holds = tuple(sorted((n, u) for n, u in state.holds if u > depth))
         new = ContactState(fingers, contacts, depth, state.relative_per_depth, (), (),
                            state.history, holds)
         diagnostics = {**_DIAGNOSTICS, "sets_factored": self.cache.get("sets_factored", 0),
                        "reduced_max_condition": self.cache.get("max_condition", 1.0)}
         return StepResult(new, (), 1.0, None, samples, (), diagnostics, step)
+
+
+def _moved(contact: ContactNode, displacement: np.ndarray, force: np.ndarray) -> ContactNode:
+    """``contact`` with another ``displacement`` and ``force``: the fields ContactNode's
+    __init__ would set, set at once (a quiet tick makes one per contact; the frozen dataclass's
+    __init__ and ``dataclasses.replace`` cost three times as much).
+    """
+    moved = object.__new__(ContactNode)
+    moved.__dict__.update(contact.__dict__, displacement=displacement, force=force)
+    return moved
 
 
 _DIAGNOSTICS = {**Counters().as_dict(), "substeps": 1}
@@ -329,7 +357,9 @@ _DIAGNOSTICS = {**Counters().as_dict(), "substeps": 1}
 class _Sticking:
     """One contact set with every node sticking, at its polar angles: what the fixed-set
     solve of :func:`~..contact_model.attempt_fixed_set` computes once for the set (the nodes
-    ride on their tips, so only the tips' positions change).
+    ride on their tips, so only the tips' positions change): ``theta`` as an array, ``dtheta``
+    zero, and ``slide`` the nodes' motion along their tips (r dtheta t, zeros) that
+    d delta / ds adds to the tips' translation.
     """
 
     key: tuple
@@ -341,6 +371,9 @@ class _Sticking:
     unit: np.ndarray
     tangent: np.ndarray
     radius: np.ndarray
+    theta: np.ndarray
+    dtheta: np.ndarray
+    slide: np.ndarray
 
     def solutions(self, motion: FingerMotion) -> tuple[Solution, Solution] | None:
         """:func:`~..contact_model.attempt_fixed_set` of the set at s = 0 and s = 1 of
@@ -350,17 +383,14 @@ class _Sticking:
         c, m = self.contacts, len(self.contacts)
         f = c.finger
         start, dirs = motion.start[f], motion.translation[f]
-        theta = np.array(c.theta, float)
         dF = (self.C @ dirs.reshape(-1)).reshape(m, 2)
-        dtheta = np.zeros(m)
-        ddelta = dirs + (self.radius * dtheta)[:, None] * self.tangent
+        ddelta = dirs + self.slide
         out = []
         for s in (0.0, 1.0):
             delta = start + s * dirs + self.offset - c.positions
             F = (self.C @ delta.reshape(-1)).reshape(m, 2)
-            out.append(Solution(theta, delta, F, dtheta, dF, ddelta, 0, 0.0, 1.0, self.nu,
-                                self.kappa))
-        if not (np.isfinite(out[0].F).all() and np.isfinite(out[1].F).all()
-                and np.isfinite(dF).all()):
+            out.append(Solution(self.theta, delta, F, self.dtheta, dF, ddelta, 0, 0.0, 1.0,
+                                self.nu, self.kappa))
+        if not np.isfinite((out[0].F, out[1].F, dF)).all():
             return None
         return out[0], out[1]

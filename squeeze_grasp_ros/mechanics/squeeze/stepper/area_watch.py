@@ -56,7 +56,8 @@ class AreaWatch:
         self._ref: dict | None = None
         self._last: dict | None = None
         R = model.obj.rigid_gradients.reshape(-1, 4, 3)
-        self._rigid = R
+        self._rigid, self._rigid_2d = R, model.obj.rigid_gradients
+        self._node_largest: dict[int, float] = {}
         self._rigid_norm = float(np.sqrt((R * R).sum(axis=(1, 2))).max())
 
     def above(self, sd: SetData, delta: np.ndarray, F: np.ndarray, level: float) -> bool:
@@ -75,7 +76,7 @@ class AreaWatch:
         drift = 0.0 if stale else self._drift(ref, g, norms)
         if stale or drift > ref["budget"]:
             ref, drift = self._renew(sd, g, norms, reach), 0.0
-        rigid = ref["rigid_rows"] @ g
+        rigid = (ref["rigid_rows"] @ g).reshape(-1, 4)
         bound = ref["bounds"] @ norms + np.sqrt((rigid * rigid).sum(axis=1))
         exact = bound >= GRADIENT_BOUND_EXACT
         if np.any(bound[~exact] >= reach):
@@ -119,12 +120,23 @@ class AreaWatch:
         return float(ref["column_max"] @ np.abs(norms - ref["norms"])
                      + self._rigid_norm * np.linalg.norm(g - ref["g"])) * (1.0 + _SLACK)
 
+    def _largest(self, nodes: list[int]) -> np.ndarray:
+        """max_e b_ek for each node k of ``nodes`` (kept per node: a node's gradients per unit
+        load do not change).
+        """
+        largest = self._node_largest
+        missing = [k for k in nodes if k not in largest]
+        if missing:
+            for k, b in zip(missing, self.model.obj.gradient_bounds(tuple(missing)).T):
+                largest[k] = float(b.max())
+        return np.array([largest[k] for k in nodes])
+
     def _renew(self, sd: SetData, g: np.ndarray, norms: np.ndarray, reach: float) -> dict:
         """Bound every element at this configuration and keep the largest bounds' elements."""
         self.renewals += 1
         obj = self.model.obj
         bounds = obj.gradient_bounds(tuple(sd.nodes.tolist()))
-        rigid = self._rigid @ g
+        rigid = (self._rigid_2d @ g).reshape(-1, 4)
         B = bounds @ norms + np.sqrt((rigid * rigid).sum(axis=1))
         if len(B) > AREA_CANDIDATES:
             kept = np.argpartition(-B, AREA_CANDIDATES)[:AREA_CANDIDATES]
@@ -135,8 +147,8 @@ class AreaWatch:
         loads = obj.load_gradients(sd.nodes)
         self._ref = {
             "set": sd, "reach": reach, "norms": norms, "g": g, "budget": budget,
-            "column_max": bounds.max(axis=0), "bounds": bounds[kept],
-            "rigid_rows": self._rigid[kept],
+            "column_max": self._largest(sd.nodes.tolist()), "bounds": bounds[kept],
+            "rigid_rows": self._rigid[kept].reshape(-1, 3),
             "loads": np.concatenate([G[kept] for G in loads], axis=2),
         }
         self._last = None

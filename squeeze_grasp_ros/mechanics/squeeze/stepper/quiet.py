@@ -95,6 +95,7 @@ class QuietSteps:
         self._mode: _Mode | None = None
         self._contact_ref: tuple | None = None
         self._boundary = model.positions(model.boundary_nodes)
+        self._length = model.length
         self._applies = (quiet and model.constitutive_model == MaterialModel.LINEAR
                          and not model.reference and not model.adaptive_steps
                          and model.mu > 0.0)
@@ -162,7 +163,8 @@ class QuietSteps:
             sticking, names, motion.tip, functions, functions.free_rows(contacts, held),
             None if watched.all() else watched, sticking.unit[watched],
             sticking.tangent[watched], expiry,
-            tuple(fingers == f for f in range(len(names))),
+            tuple((_rows_of(fingers == f), bool((fingers == f).any()))
+                  for f in range(len(names))),
             tuple(ContactNode(node, names[f], ContactMode.STICK, 0, theta, None, None, nu)
                   for node, f, theta, nu in zip(contacts.nodes.tolist(), fingers.tolist(),
                                                 thetas, sticking.nu.tolist())),
@@ -174,23 +176,26 @@ class QuietSteps:
         """:meth:`FingerMotion.of` (the tips kept while they are the same), or None for a
         translation :func:`~.run.advance` would refuse (it then says why).
         """
-        L = self.model.length
+        L = self._length
         fingers = state.fingers
         if self._tips is None or self._tips[0] is not fingers:
-            names = tuple(f.name for f in fingers)
             key = tuple((f.name, f.radius, f.flat, f.facing) for f in fingers)
             if self._tips is None or self._tips[1] != key:
-                self._tips = (fingers, key, names, tip_geometry(fingers).scaled(L))
+                names = tuple(f.name for f in fingers)
+                self._tips = (fingers, key, names, frozenset(names),
+                              tip_geometry(fingers).scaled(L))
             else:
                 self._tips = (fingers, *self._tips[1:])
-        names, tips = self._tips[2], self._tips[3]
-        if not translations.keys() <= set(names):
+        names, known, tips = self._tips[2:]
+        if not translations.keys() <= known:
             return None
         D = np.array([translations.get(n, (0.0, 0.0)) for n in names], float) / L
-        if not np.all(np.isfinite(D)):
+        if not np.isfinite(D).all():
             return None
+        d = D.ravel()
+        # the norm as np.linalg.norm computes it (sqrt of the dot product), without its checks
         return FingerMotion(names, np.array([f.center for f in fingers], float) / L, D,
-                            tips.radius, float(np.linalg.norm(D)), state.depth, L, tips.flat,
+                            tips.radius, float(np.sqrt(d.dot(d))), state.depth, L, tips.flat,
                             tips.facing)
 
     def _sticking(self, state: ContactState, motion: FingerMotion) -> _Sticking:
@@ -278,7 +283,8 @@ class _Mode:
     """What stays fixed while calls stay quiet in one sticking mode: the set's constants, the
     functions watched (the free boundary ``rows``; the contacts not held, their normals'
     ``unit`` and ``tangent``), the depth (m) at which a hold of the chattering bound ``expiry``
-    ends, and the parts of a result that do not move (each finger's contact mask; each
+    ends, and the parts of a result that do not move (each finger's contact rows, a slice
+    when they are consecutive, and whether it has any; each
     contact's node, finger, mode, angle and normal angle, as a ContactNode without its
     displacement and force).
     """
@@ -292,7 +298,7 @@ class _Mode:
     unit: np.ndarray
     tangent: np.ndarray
     expiry: float
-    masks: tuple[np.ndarray, ...]
+    masks: tuple[tuple[slice | np.ndarray, bool], ...]
     contacts: tuple[ContactNode, ...]
     nodes: tuple[int, ...]
     thetas: tuple[float, ...]
@@ -311,11 +317,11 @@ class _Mode:
         work = np.array([f.work for f in old], float) / (fu * L)
         t0 = np.array([f.translation for f in old], float) / L
         forces_a, forces_b = {}, {}
-        for f, mine in enumerate(self.masks):
+        for f, (mine, touching) in enumerate(self.masks):
             ya, yb = sol_a.F[mine].sum(axis=0), sol_b.F[mine].sum(axis=0)
             forces_a[names[f]] = tuple((ya * fu).tolist())
             forces_b[names[f]] = tuple((yb * fu).tolist())
-            if mine.any():
+            if touching:
                 # h = 1; sol_a.dF is sol_b.dF (one motion, one set), so the Hermite term
                 # h^2 / 12 (ra - rb) is 0.0 exactly (ra, rb finite)
                 work[f] += 0.5 * (ya @ D[f] + yb @ D[f]) + 0.0
@@ -337,6 +343,16 @@ class _Mode:
         diagnostics = {**_DIAGNOSTICS, "sets_factored": self.cache.get("sets_factored", 0),
                        "reduced_max_condition": self.cache.get("max_condition", 1.0)}
         return StepResult(new, (), 1.0, None, samples, (), diagnostics, step)
+
+
+def _rows_of(mask: np.ndarray) -> slice | np.ndarray:
+    """The rows of a boolean ``mask`` as a slice when they are consecutive (indexing by it
+    gives the same rows in the same order, without a copy), else the mask.
+    """
+    rows = np.flatnonzero(mask)
+    if len(rows) and rows[-1] - rows[0] + 1 == len(rows):
+        return slice(int(rows[0]), int(rows[-1]) + 1)
+    return mask
 
 
 def _moved(contact: ContactNode, displacement: np.ndarray, force: np.ndarray) -> ContactNode:

@@ -21,6 +21,16 @@ the end (and at the start, unless the state is the one its last quiet call retur
 returns the same :class:`~..contact_state.StepResult`. Anything else (a function at or below
 the margin, a sliding contact, a nonlinear material, a long translation) is handed to
 :func:`~.run.advance` whole, so events are located exactly as before.
+
+Within one sticking mode everything but the finger positions stays: the set's stiffness and tip
+offsets, the watched rows and contacts, each contact's node, finger and angles. The first quiet
+call of a mode keeps them (:class:`_Mode`, until the next full call or until a hold of the
+chattering bound expires), and the calls after it compute only what moves: the two solves, the
+work integral, the samples' finger forces, the new contacts' displacements and forces. The
+checks at the end answer from bounds on the change since their last evaluation where they can:
+the contact functions (each moves by at most (1 + mu) ||dF||), the gaps (1-Lipschitz in the
+boundary point and the tip), the area ratio (:class:`~.area_watch.AreaWatch`); a bound that
+does not clear its functions has them evaluated.
 """
 from __future__ import annotations
 

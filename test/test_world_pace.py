@@ -121,3 +121,64 @@ def test_area_watch_answers_as_the_full_area_check():
             assert watch.above(sd, delta, F, level) == expected, (tick.index, level)
             answers.add(expected)
     assert answers == {True, False} and watch.renewals >= 2
+
+
+def test_area_watch_skips_only_where_the_full_check_agrees():
+    """At one level, called tick after tick: AreaWatch answers most ticks from its bound on
+    the motion since its last True answer, and still answers as ``area_ratio`` at every tick,
+    also across the tick where the smallest area ratio passes the level (chosen in the middle
+    of the squeeze's range, so both answers occur).
+    """
+    world = SimWorld(GraspSetup.build(load_scene(scene_file("foam_square"))), quiet=False)
+    model, ticks = world.model, squeeze_world(world, 300)[1:]
+    configurations, ratios = [], []
+    for tick in ticks:
+        contacts = tick.state.contacts
+        sd = model.set_data(tuple(c.node for c in contacts))
+        delta = np.array([c.displacement for c in contacts]) / model.length
+        F = np.array([c.force for c in contacts]) / model.force_unit
+        configurations.append((sd, delta, F))
+        ratios.append(model.area_ratio(sd, delta, F)[0])
+    skips = {}
+    for level in (INVERSION_AREA_RATIO + 1e-12, 0.5 * (max(ratios) + min(ratios))):
+        watch = AreaWatch(model)
+        answers = [watch.above(*c, level) for c in configurations]
+        assert answers == [r > level for r in ratios], level
+        skips[level] = watch.skips
+    print(f"AreaWatch skips of {len(ticks)} ticks per level: {skips}")
+    assert answers.count(False) > 0 and answers.count(True) > 0
+    assert min(skips.values()) > 0 and max(skips.values()) > len(ticks) // 2
+
+
+def test_quiet_results_are_advance_results_field_by_field():
+    """Beyond the state: a quiet call's samples (depths, nodes, angles, finger forces),
+    diagnostics, fraction and next substep are those advance() returns for the same call.
+    """
+    from squeeze_grasp_ros.mechanics.squeeze.stepper import advance
+
+    world = SimWorld(GraspSetup.build(load_scene(scene_file("foam_square"))), quiet=True)
+    stepper, calls = world.stepper, []
+    quiet = stepper._quiet
+
+    def keep(state, translations):
+        result = quiet(state, translations)
+        if result is not None:
+            calls.append((state, dict(translations), result))
+        return result
+
+    stepper._quiet = keep
+    squeeze_world(world, 300)
+    assert len(calls) > 250
+    for state, translations, ours in calls[::10]:
+        theirs = advance(world.model, state, translations, stepper.step, stepper.event_tol,
+                         terminate_on=stepper.terminate_on)
+        assert (ours.events, ours.fraction, ours.termination, ours.chatter,
+                ours.next_substep) == (theirs.events, theirs.fraction, theirs.termination,
+                                       theirs.chatter, theirs.next_substep)
+        # sets_factored and reduced_max_condition are the model's running totals (advance()
+        # is called here after the whole run): the rest are the call's own counters
+        model_totals = ("sets_factored", "reduced_max_condition")
+        assert list(ours.diagnostics) == list(theirs.diagnostics)
+        assert {k: v for k, v in ours.diagnostics.items() if k not in model_totals} == {
+            k: v for k, v in theirs.diagnostics.items() if k not in model_totals}
+        assert ours.samples == theirs.samples

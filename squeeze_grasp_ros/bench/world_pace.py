@@ -85,7 +85,9 @@ def world_pace_table(path: Path, repeats: int, progress) -> Table:
         "Event squeeze: GraspSetup.event_squeeze() of the same scene (Algorithm 1 to the same "
         "depth, its substeps on the step grid), mesh and precomputation excluded for both. A "
         "quiet tick (mechanics/squeeze/stepper/quiet.py) makes the same two fixed-set solves as "
-        "advance() and skips the rest of its event loop; ticks that cross an event, slide or use "
-        "a finite-deformation material go through advance(). Both give the same states bit for "
-        "bit (test/test_world_pace.py).",
+        "advance(), keeps what its contact mode fixes from the mode's first quiet tick, checks "
+        "the watched functions from bounds on their change where it can, and skips the rest of "
+        "the event loop; ticks that cross an event, slide or use a finite-deformation material "
+        "go through advance(). Both give the same states bit for bit "
+        "(test/test_world_pace.py).",
     )

@@ -15,6 +15,11 @@ so :class:`AreaWatch` bounds every element once at a reference configuration, ke
 :data:`AREA_CANDIDATES` elements with the largest bounds (and their load gradients, stacked),
 and, while that drift stays below the gap between the kept bounds and the rest, answers from the
 kept elements alone: an element outside them has B_e < 1 - sqrt(level), so det F > level.
+
+From one configuration answered True to the next, every element's gradient moves by at most the
+same kind of bound, so a call close enough to the last answers True from that bound alone (the
+kept elements' margins and the rest's budget; :meth:`AreaWatch._still_above`): no element is
+looked at while the fingers move by a small part of what brings an element near inversion.
 """
 from __future__ import annotations
 
@@ -47,9 +52,12 @@ class AreaWatch:
     def __init__(self, model: ContactModel) -> None:
         self.model = model
         self.renewals = 0
+        self.skips = 0
         self._ref: dict | None = None
+        self._last: dict | None = None
         R = model.obj.rigid_gradients.reshape(-1, 4, 3)
-        self._rigid = R
+        self._rigid, self._rigid_2d = R, model.obj.rigid_gradients
+        self._node_largest: dict[int, float] = {}
         self._rigid_norm = float(np.sqrt((R * R).sum(axis=(1, 2))).max())
 
     def above(self, sd: SetData, delta: np.ndarray, F: np.ndarray, level: float) -> bool:
@@ -58,34 +66,77 @@ class AreaWatch:
         threshold.
         """
         g = sd.E.T @ delta.reshape(-1)
+        if self._still_above(sd, g, F, level):
+            self.skips += 1
+            return True
         norms = np.sqrt((F * F).sum(axis=1))
         reach = 1.0 - level ** 0.5
         ref = self._ref
-        if ref is None or ref["set"] is not sd or ref["reach"] != reach or self._drift(
-                ref, g, norms) > ref["budget"]:
-            ref = self._renew(sd, g, norms, reach)
-        rigid = ref["rigid_rows"] @ g
+        stale = ref is None or ref["set"] is not sd or ref["reach"] != reach
+        drift = 0.0 if stale else self._drift(ref, g, norms)
+        if stale or drift > ref["budget"]:
+            ref, drift = self._renew(sd, g, norms, reach), 0.0
+        rigid = (ref["rigid_rows"] @ g).reshape(-1, 4)
         bound = ref["bounds"] @ norms + np.sqrt((rigid * rigid).sum(axis=1))
         exact = bound >= GRADIENT_BOUND_EXACT
         if np.any(bound[~exact] >= reach):
             return False  # a bound of the rest is at or past the level
-        if not exact.any():
-            return True
-        H = rigid[exact] + ref["loads"][exact] @ F.reshape(-1)
-        det = (1.0 + H[:, 0]) * (1.0 + H[:, 3]) - H[:, 1] * H[:, 2]
-        return bool(det.min() > level)
+        det = np.inf
+        if exact.any():
+            H = rigid[exact] + ref["loads"][exact] @ F.reshape(-1)
+            det = ((1.0 + H[:, 0]) * (1.0 + H[:, 3]) - H[:, 1] * H[:, 2]).min()
+            if not det > level:
+                return False
+        self._last = {"ref": ref, "level": level, "g": g, "F": F, "drift": drift,
+                      "det": det, "below": reach - bound[~exact].max(initial=-np.inf),
+                      "largest": bound.max(initial=0.0)}
+        return True
+
+    def _still_above(self, sd: SetData, g: np.ndarray, F: np.ndarray, level: float) -> bool:
+        """Whether the last configuration answered True (for the same set, level and
+        reference) bounds this one above ``level`` without looking at any element.
+
+        Every element's gradient moves by ||dH_e|| <= d = sum_k max_e(b_ek) ||dF_k||
+        + max_e ||R_e|| ||dg|| from the last configuration. A kept element without a solve
+        had its bound at least ``below`` under the reach, a kept one with a solve det F >= det,
+        and for a 2 x 2 gradient |d det(I + H)| <= ||dH|| (sqrt 2 + ||H|| + ||dH|| / 2), with
+        ||H|| at most the largest kept bound plus d; the rest stay within the reference's
+        budget while its drift (at most the last drift plus d) does.
+        """
+        last = self._last
+        if last is None or last["ref"] is not self._ref or last["ref"]["set"] is not sd or (
+                last["level"] != level):
+            return False
+        ref = last["ref"]
+        dF, dg = F - last["F"], g - last["g"]
+        moved = float(ref["column_max"] @ np.sqrt((dF * dF).sum(axis=1))
+                      + self._rigid_norm * np.sqrt(dg @ dg)) * (1.0 + _SLACK)
+        change = moved * (2.0 ** 0.5 + last["largest"] + moved) * (1.0 + _SLACK)
+        return (moved < last["below"] and last["drift"] + moved <= ref["budget"]
+                and last["det"] - change > level)
 
     def _drift(self, ref: dict, g: np.ndarray, norms: np.ndarray) -> float:
         """The bound on how far any element's bound moved from the reference (with slack)."""
         return float(ref["column_max"] @ np.abs(norms - ref["norms"])
                      + self._rigid_norm * np.linalg.norm(g - ref["g"])) * (1.0 + _SLACK)
 
+    def _largest(self, nodes: list[int]) -> np.ndarray:
+        """max_e b_ek for each node k of ``nodes`` (kept per node: a node's gradients per unit
+        load do not change).
+        """
+        largest = self._node_largest
+        missing = [k for k in nodes if k not in largest]
+        if missing:
+            for k, b in zip(missing, self.model.obj.gradient_bounds(tuple(missing)).T):
+                largest[k] = float(b.max())
+        return np.array([largest[k] for k in nodes])
+
     def _renew(self, sd: SetData, g: np.ndarray, norms: np.ndarray, reach: float) -> dict:
         """Bound every element at this configuration and keep the largest bounds' elements."""
         self.renewals += 1
         obj = self.model.obj
         bounds = obj.gradient_bounds(tuple(sd.nodes.tolist()))
-        rigid = self._rigid @ g
+        rigid = (self._rigid_2d @ g).reshape(-1, 4)
         B = bounds @ norms + np.sqrt((rigid * rigid).sum(axis=1))
         if len(B) > AREA_CANDIDATES:
             kept = np.argpartition(-B, AREA_CANDIDATES)[:AREA_CANDIDATES]
@@ -96,8 +147,9 @@ class AreaWatch:
         loads = obj.load_gradients(sd.nodes)
         self._ref = {
             "set": sd, "reach": reach, "norms": norms, "g": g, "budget": budget,
-            "column_max": bounds.max(axis=0), "bounds": bounds[kept],
-            "rigid_rows": self._rigid[kept],
+            "column_max": self._largest(sd.nodes.tolist()), "bounds": bounds[kept],
+            "rigid_rows": self._rigid[kept].reshape(-1, 3),
             "loads": np.concatenate([G[kept] for G in loads], axis=2),
         }
+        self._last = None
         return self._ref

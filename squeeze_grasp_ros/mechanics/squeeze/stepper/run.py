@@ -200,16 +200,14 @@ class _Call:
             r = self.motion.radius[finger]
             pa = -sa.tangential * r * sa.dtheta
             pb = -sb.tangential * r * sb.dtheta
-        # each finger's total force and rate at both ends, summed in contact order (the
-        # order of a masked sum along axis 0: the same floats), in one pass over the contacts
-        totals = np.zeros((4, len(self.motion.names), 2))
-        for t, x in enumerate((sa.F, sb.F, sa.dF, sb.dF)):
-            np.add.at(totals[t], finger, x)
-        for f in np.flatnonzero(np.bincount(finger, minlength=len(totals[0]))).tolist():
-            ya, yb, ra, rb = (totals[t, f] @ D[f] for t in range(4))
+        for f in range(len(self.motion.names)):
+            mine = finger == f
+            if not mine.any():
+                continue
+            ya, yb = sa.F[mine].sum(axis=0) @ D[f], sb.F[mine].sum(axis=0) @ D[f]
+            ra, rb = sa.dF[mine].sum(axis=0) @ D[f], sb.dF[mine].sum(axis=0) @ D[f]
             self.work[f] += 0.5 * h * (ya + yb) + h * h / 12.0 * (ra - rb)
             if sliding:
-                mine = finger == f
                 self.dissipation[f] += 0.5 * h * (pa[mine].sum() + pb[mine].sum())
 
     def record(self, sol: Solution) -> None:

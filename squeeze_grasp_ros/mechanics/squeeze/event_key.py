@@ -23,7 +23,7 @@ from typing import NamedTuple
 from squeeze_grasp_ros.mechanics.vocabulary import EventType, Termination
 
 __all__ = ["ANY_FINGER", "EventFunction", "EventKey", "KeyTable", "PROCESSING_ORDER",
-           "WHOLE_OBJECT", "processing_rank"]
+           "SHARED_KEYS", "WHOLE_OBJECT", "processing_rank"]
 
 PROCESSING_ORDER: tuple[EventType, ...] = (EventType.B, EventType.D, EventType.C, EventType.A)
 """Processing order of simultaneous events: break < slip -> stick < stick -> slip < new
@@ -140,25 +140,36 @@ class EventKey(NamedTuple):
 class KeyTable:
     """Each key made once: the stepper's tables of function values hold hundreds of keys per
     substep (a gap per free boundary node and finger), and making a key in Python costs
-    several times a look-up here. One table per object (its contact model
-    keeps it across stepper calls).
+    several times a look-up here. Keys are values, the same for every object and model: the
+    stepper uses one table for the process (:data:`SHARED_KEYS`), so a sweep that builds a
+    model per evaluation makes an object's gap keys once, not once per evaluation. The table
+    is bounded: past ``max_keys`` keys or ``max_loops`` boundary loops it starts again (a
+    key made again equals the old one).
 
     >>> table = KeyTable()
     >>> table.get(EventFunction.NORMAL_FORCE, 4) is table.get(EventFunction.NORMAL_FORCE, 4)
     True
     >>> table.gaps([7, 9], fingers=2)[1] == (EventKey.gap(9, 0), EventKey.gap(9, 1))
     True
+    >>> small = KeyTable(max_keys=2)  # full: starts again, with keys equal to the old ones
+    >>> [small.get(f) for f in EventFunction][-1] == EventKey(list(EventFunction)[-1])
+    True
+    >>> len(EventFunction) > 2 and len(small._keys) <= 2
+    True
     """
 
-    def __init__(self) -> None:
+    def __init__(self, *, max_keys: int = 1_000_000, max_loops: int = 64) -> None:
         self._keys: dict[tuple, EventKey] = {}
         self._gaps: dict[tuple, list[tuple[EventKey, ...]]] = {}
+        self._max_keys, self._max_loops = max_keys, max_loops
 
     def get(self, function: EventFunction, node: int = WHOLE_OBJECT,
             finger: int = ANY_FINGER) -> EventKey:
         """The key of (function, node, finger)."""
         made = self._keys.get((function, node, finger))
         if made is None:
+            if len(self._keys) >= self._max_keys:
+                self._keys.clear()
             made = self._keys[(function, node, finger)] = EventKey(function, node, finger)
         return made
 
@@ -166,7 +177,14 @@ class KeyTable:
         """Per node of ``nodes`` (a boundary loop), its gap keys to fingers 0 .. fingers - 1."""
         made = self._gaps.get((tuple(nodes), fingers))
         if made is None:
+            if len(self._gaps) >= self._max_loops:
+                self._gaps.clear()
             made = [tuple(self.get(EventFunction.GAP, node, f) for f in range(fingers))
                     for node in nodes]
             self._gaps[(tuple(nodes), fingers)] = made
         return made
+
+
+SHARED_KEYS = KeyTable()
+"""The process's key table (the stepper's; threads may share it: a race makes a key twice,
+and the two are equal)."""

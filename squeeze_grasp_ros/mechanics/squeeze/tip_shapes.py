@@ -44,6 +44,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 
@@ -223,13 +224,18 @@ class TipGeometry:
         t = self if index is None else self.take(index)
         c = self._clip(q, index)
         nu = np.asarray(q, float) - c
-        return t.radius[:, None] * (c[:, None] * tangent(t.facing) + unit(nu))
+        return t.radius[:, None] * (c[:, None] * t._facing_tangent + unit(nu))
+
+    @cached_property
+    def _facing_tangent(self) -> np.ndarray:
+        """t(theta0) (k, 2) of every tip (the gaps ask for it at every substep)."""
+        return tangent(self.facing)
 
     def _closest(self, rel: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """(w, tau) for points ``rel`` (..., k, 2) relative to each tip's reference point:
         w = rel - tau t(theta0), tau = clip(rel . t(theta0), -a, a).
         """
-        t0 = tangent(self.facing)
+        t0 = self._facing_tangent
         tau = np.clip(np.einsum("...ki,ki->...k", rel, t0), -self.flat, self.flat)
         return rel - tau[..., None] * t0, tau
 

@@ -8,7 +8,7 @@ one, and a change of the nodes gathers the new set's data from the contact model
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -90,19 +90,27 @@ class ContactSet:
         """The fixed-set problem's data, with the fingers' tips ``tip`` (f)."""
         return Configuration(self.positions, self.stick, self.slip, tip.take(self.finger))
 
+    def _with(self, stick: np.ndarray, slip: np.ndarray, theta: np.ndarray) -> ContactSet:
+        """The same nodes in modes ``stick``, ``slip`` at polar angles ``theta`` (built
+        directly: :func:`dataclasses.replace` reads the fields' metadata at every call, and a
+        stepper call makes a set per substep).
+        """
+        return ContactSet(self.nodes, self.finger, stick, slip, theta, self.data,
+                          self.positions, self.rows)
+
     def with_modes(self, stick: np.ndarray, slip: np.ndarray) -> ContactSet:
         """The same nodes in other modes."""
-        return replace(self, stick=stick, slip=slip)
+        return self._with(stick, slip, self.theta)
 
     def with_mode(self, k: int, stick: bool, slip: int) -> ContactSet:
         """Contact k in another mode."""
         new_stick, new_slip = self.stick.copy(), self.slip.copy()
         new_stick[k], new_slip[k] = stick, slip
-        return replace(self, stick=new_stick, slip=new_slip)
+        return self._with(new_stick, new_slip, self.theta)
 
     def with_theta(self, theta: np.ndarray) -> ContactSet:
         """The same contacts at other polar angles."""
-        return replace(self, theta=theta)
+        return self._with(self.stick, self.slip, theta)
 
     def added(self, model: ContactModel, nodes: list[int], fingers: list[int],
               thetas: list[float]) -> ContactSet:

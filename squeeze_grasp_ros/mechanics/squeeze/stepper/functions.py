@@ -40,7 +40,12 @@ from squeeze_grasp_ros.mechanics.squeeze.contact_model import (
     ContactModel,
     Solution,
 )
-from squeeze_grasp_ros.mechanics.squeeze.event_key import EventFunction, EventKey, KeyTable
+from squeeze_grasp_ros.mechanics.squeeze.event_key import (
+    SHARED_KEYS,
+    EventFunction,
+    EventKey,
+    KeyTable,
+)
 from squeeze_grasp_ros.mechanics.squeeze.stepper.contact_set import ContactSet
 from squeeze_grasp_ros.mechanics.squeeze.stepper.motion import FingerMotion
 from squeeze_grasp_ros.mechanics.vocabulary import Termination
@@ -157,10 +162,10 @@ class EventFunctions:
         """Boundary loop positions of ``nodes``."""
         return self.model.obj.boundary_positions(nodes)
 
-    @cached_property
+    @property
     def keys(self) -> KeyTable:
-        """The object's event keys (kept by its model across calls)."""
-        return self.model._cache.setdefault("event_keys", KeyTable())
+        """The event keys (one table for the process: keys are values)."""
+        return SHARED_KEYS
 
     @cached_property
     def _gap_keys(self) -> list[tuple[EventKey, ...]]:

@@ -182,7 +182,8 @@ class NonlinearContactModel(ContactModel):
 
     def diagnostics(self) -> dict:
         """Newton evaluations, iterations and factorisations of the interior solves, the
-        evaluations answered by a kept state (look-ups), the factoriser and the tangents its
+        evaluations answered by a kept state (look-ups), the factoriser, its orderings and
+        symbolic analyses (one per object: every contact set shares them) and the tangents its
         Cholesky factorisation refused (LDL^T instead).
         """
         responses = self._cache.get("responses", {}).values()
@@ -190,6 +191,7 @@ class NonlinearContactModel(ContactModel):
         return {"material_model": str(self.material_model),
                 "factorizer": str(shared.method if shared else default_factorizer()),
                 "ldlt_fallbacks": shared.fallbacks if shared else 0,
+                "analyses": shared.analyses if shared else 0,
                 "evaluations": sum(r.stats["evaluations"] for r in responses),
                 "newton_iterations": sum(r.stats["iterations"] for r in responses),
                 "factorizations": sum(r.stats["factorizations"] for r in responses),

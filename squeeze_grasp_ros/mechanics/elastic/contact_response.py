@@ -47,7 +47,6 @@ from squeeze_grasp_ros.mechanics.elastic.interior import (
 )
 from squeeze_grasp_ros.mechanics.errors import InvalidInputError
 from squeeze_grasp_ros.mechanics.vocabulary import MaterialModel
-from squeeze_grasp_ros.threads import one_blas_thread
 
 __all__ = ["ContactResponse", "Evaluation", "NEWTON_TOL", "ResponseFailure"]
 
@@ -367,13 +366,7 @@ class ContactResponse:
 
     # ------------------------------------------------------------------ public
     def evaluate(self, delta: np.ndarray) -> Evaluation | ResponseFailure:
-        """The equilibrium at contact displacements ``delta`` (m, 2), or why none was found
-        (BLAS held at one thread meanwhile: :func:`~squeeze_grasp_ros.threads.one_blas_thread`).
-        """
-        with one_blas_thread():
-            return self._evaluate(delta)
-
-    def _evaluate(self, delta: np.ndarray) -> Evaluation | ResponseFailure:
+        """The equilibrium at contact displacements ``delta`` (m, 2), or why none was found."""
         delta = np.asarray(delta, float).reshape(-1, 2)
         kept = self._recall(delta)
         if kept is not None:

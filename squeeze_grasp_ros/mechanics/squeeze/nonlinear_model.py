@@ -38,6 +38,7 @@ from squeeze_grasp_ros.mechanics.squeeze.contact_model import (
     SolveFailure,
 )
 from squeeze_grasp_ros.mechanics.vocabulary import MaterialModel, StrainCriterion
+from squeeze_grasp_ros.threads import one_blas_thread
 
 __all__ = ["NonlinearContactModel", "RESPONSE_ACCURACY", "contact_model"]
 
@@ -115,7 +116,8 @@ class NonlinearContactModel(ContactModel):
 
     def _evaluate(self, sd: SetData, delta: np.ndarray) -> Evaluation | ResponseFailure:
         response = self._response_of(sd)
-        out = response.evaluate(delta)
+        with one_blas_thread():  # numpy's BLAS threads spin between the factorisations
+            out = response.evaluate(delta)
         if isinstance(out, Evaluation):
             last = self._cache.get("last")
             if last is not None and last is not response:

@@ -46,12 +46,14 @@ def one_blas_thread() -> AbstractContextManager:
     """A context in which every BLAS library loaded in this process runs one thread, whatever
     the environment; the previous thread counts come back on exit.
 
-    The nonlinear contact model's evaluations and the interior factorisations and solves run in it: numpy's multithreaded OpenBLAS, woken
-    by the small products between the sparse factorisations, spins on the second core and made a
-    neo-Hookean squeeze 1.9-2.2x slower in wall time and 2.3x in CPU time on 2 cores (CHOLMOD's
-    own OpenBLAS, loaded by cvxopt, runs one thread already). The libraries are those loaded at
-    the first call. Without threadpoolctl (a pip dependency; a colcon build may lack it) the
-    context changes nothing: the installed executables set the thread variables themselves.
+    The nonlinear contact model's evaluations and the interior factorisations and solves run
+    in it: numpy's multithreaded OpenBLAS, woken by the small products between the sparse
+    factorisations, spins on the second core and made a neo-Hookean squeeze use 2.0x the CPU
+    time on 2 cores, and up to 2.1x the wall time when another process held the other core
+    (CHOLMOD's own OpenBLAS, loaded by cvxopt, runs one thread already). The libraries are
+    those loaded at the first call. Without threadpoolctl (a pip dependency; a colcon build
+    may lack it) the context changes nothing: the installed executables set the thread
+    variables themselves.
 
     >>> import numpy
     >>> with one_blas_thread():

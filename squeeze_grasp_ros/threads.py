@@ -18,8 +18,9 @@ block and restores the caller's setting after it.
 from __future__ import annotations
 
 import os
-from collections.abc import MutableMapping
-from contextlib import AbstractContextManager, nullcontext
+import threading
+from collections.abc import Iterator, MutableMapping
+from contextlib import contextmanager
 
 __all__ = ["BLAS_THREAD_VARIABLES", "one_blas_thread", "single_thread_blas"]
 
@@ -40,11 +41,17 @@ def single_thread_blas(env: MutableMapping[str, str] | None = None) -> MutableMa
 _CONTROLLER: list = []
 """The process's threadpoolctl.ThreadpoolController, made at the first :func:`one_blas_thread`
 (finding the loaded BLAS libraries costs about 0.2 ms; limiting them with it about 15 us)."""
+_HELD = {"depth": 0, "limiter": None}
+"""How many :func:`one_blas_thread` blocks are open in this process, and the limiter of the
+outermost (the thread counts are process-wide, so is the count)."""
+_LOCK = threading.Lock()
 
 
-def one_blas_thread() -> AbstractContextManager:
+@contextmanager
+def one_blas_thread() -> Iterator[None]:
     """A context in which every BLAS library loaded in this process runs one thread, whatever
-    the environment; the previous thread counts come back on exit.
+    the environment; the previous thread counts come back when the outermost such block ends
+    (a nested block costs a counter, not a limit).
 
     The nonlinear contact model's evaluations and the interior factorisations and solves run
     in it: numpy's multithreaded OpenBLAS, woken by the small products between the sparse
@@ -69,4 +76,18 @@ def one_blas_thread() -> AbstractContextManager:
             _CONTROLLER.append(None)
         else:
             _CONTROLLER.append(ThreadpoolController().select(user_api="blas"))
-    return nullcontext() if _CONTROLLER[0] is None else _CONTROLLER[0].limit(limits=1)
+    controller = _CONTROLLER[0]
+    if controller is not None:
+        with _LOCK:
+            _HELD["depth"] += 1
+            if _HELD["depth"] == 1:
+                _HELD["limiter"] = controller.limit(limits=1)
+    try:
+        yield
+    finally:
+        if controller is not None:
+            with _LOCK:
+                _HELD["depth"] -= 1
+                if _HELD["depth"] == 0:
+                    _HELD["limiter"].restore_original_limits()
+                    _HELD["limiter"] = None

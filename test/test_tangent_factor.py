@@ -240,3 +240,22 @@ def test_factorisations_solves_and_evaluations_run_blas_on_one_thread(method, mo
     assert res.termination == "depth_reached"
     assert {name for name, _ in seen} == {chosen.__name__, "assemble"}
     assert all(threads == {1} for _, threads in seen)
+
+
+def test_nested_one_thread_blocks_give_the_callers_threads_back_once():
+    """An inner block's end keeps BLAS at one thread for the outer one; the outermost end
+    gives the caller's two threads back.
+    """
+    threadpoolctl = pytest.importorskip("threadpoolctl")
+    from squeeze_grasp_ros.threads import one_blas_thread
+
+    def blas_threads() -> set:
+        return {info["num_threads"] for info in threadpoolctl.threadpool_info()
+                if info["user_api"] == "blas" and "cvxopt" not in info["filepath"]}
+
+    with threadpoolctl.threadpool_limits(limits=2, user_api="blas"):
+        with one_blas_thread():
+            with one_blas_thread():
+                assert blas_threads() == {1}
+            assert blas_threads() == {1}
+        assert blas_threads() == {2}

@@ -55,6 +55,8 @@ setup(
         "triangle>=20230923",
         # LDL^T of the interior tangent of the large-deformation models (QDLDL, Apache-2.0)
         "qdldl>=0.1.7",
+        # one BLAS thread around the nonlinear solves of a library caller (BSD-3-Clause)
+        "threadpoolctl>=3.1",
         "matplotlib>=3.7",
         "pyyaml>=6",
     ],

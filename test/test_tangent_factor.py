@@ -28,7 +28,7 @@ from squeeze_grasp_ros.extras import installed
 from squeeze_grasp_ros.mechanics.elastic import hyperelastic as H
 from squeeze_grasp_ros.mechanics.elastic import interior
 from squeeze_grasp_ros.mechanics.elastic.interior import TangentFactor, factorizer
-from squeeze_grasp_ros.mechanics.vocabulary import Factorizer
+from squeeze_grasp_ros.mechanics.vocabulary import EventType, Factorizer
 
 CHOLMOD = pytest.param(
     Factorizer.CHOLMOD,
@@ -189,3 +189,73 @@ def test_an_object_sliding_rigidly_at_depth_zero_logs_the_same_events_under_eith
     assert runs[Factorizer.CHOLMOD] == runs[Factorizer.QDLDL]
     linear = events(material_model="linear")
     assert [e[:4] for e in runs[Factorizer.QDLDL][1]] == [e[:4] for e in linear[1]]
+
+
+@pytest.mark.parametrize("method", METHODS)
+def test_one_ordering_and_symbolic_analysis_serve_every_contact_set(method):
+    """A neo-Hookean squeeze that adds contacts (each a new contact set, new held DOFs) orders
+    and analyses the interior tangent once; every other factorisation is numeric only.
+    """
+    _, obj, contacts = foam_square(400)
+    with factorizer(method):
+        res = event_squeeze(obj, contacts, 0.02, 0.4, relative_depth=0.12,
+                            material_model="neo_hookean")
+    nl = res.diagnostics["nonlinear"]
+    assert sum(e.type == EventType.A for e in res.events) >= 2
+    assert nl["factorizations"] > 5 * len(res.events)
+    assert nl["analyses"] == 1
+
+
+@pytest.mark.parametrize("method", METHODS)
+def test_factorisations_solves_and_evaluations_run_blas_on_one_thread(method, monkeypatch):
+    """With a caller's BLAS at two threads, the factorisation, its solves and a nonlinear
+    evaluation's assemblies see one thread, and the caller's two come back after each.
+    """
+    threadpoolctl = pytest.importorskip("threadpoolctl")
+    from squeeze_grasp_ros.mechanics.elastic import contact_response
+
+    seen = []
+
+    def blas_threads() -> set:
+        return {info["num_threads"] for info in threadpoolctl.threadpool_info()
+                if info["user_api"] == "blas" and "cvxopt" not in info["filepath"]}
+
+    def recording(function):
+        def call(*args, **kwargs):
+            seen.append((function.__name__, blas_threads()))
+            return function(*args, **kwargs)
+        call.__name__ = function.__name__
+        return call
+
+    chosen = TangentFactor._cholmod if method == Factorizer.CHOLMOD else TangentFactor._qdldl
+    monkeypatch.setattr(TangentFactor, chosen.__name__, recording(chosen))
+    monkeypatch.setattr(contact_response, "assemble", recording(contact_response.assemble))
+    _, obj, contacts = foam_square(300)
+    with threadpoolctl.threadpool_limits(limits=2, user_api="blas"):
+        assert blas_threads() == {2}
+        with factorizer(method):
+            res = event_squeeze(obj, contacts, 0.02, 0.4, relative_depth=0.03,
+                                material_model="neo_hookean")
+        assert blas_threads() == {2}
+    assert res.termination == "depth_reached"
+    assert {name for name, _ in seen} == {chosen.__name__, "assemble"}
+    assert all(threads == {1} for _, threads in seen)
+
+
+def test_nested_one_thread_blocks_give_the_callers_threads_back_once():
+    """An inner block's end keeps BLAS at one thread for the outer one; the outermost end
+    gives the caller's two threads back.
+    """
+    threadpoolctl = pytest.importorskip("threadpoolctl")
+    from squeeze_grasp_ros.threads import one_blas_thread
+
+    def blas_threads() -> set:
+        return {info["num_threads"] for info in threadpoolctl.threadpool_info()
+                if info["user_api"] == "blas" and "cvxopt" not in info["filepath"]}
+
+    with threadpoolctl.threadpool_limits(limits=2, user_api="blas"):
+        with one_blas_thread():
+            with one_blas_thread():
+                assert blas_threads() == {1}
+            assert blas_threads() == {1}
+        assert blas_threads() == {2}

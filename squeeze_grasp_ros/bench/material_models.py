@@ -192,7 +192,8 @@ def _neo_row(setup: GraspSetup, linear: tuple, repeats: int) -> tuple[list, floa
     nl = res.diagnostics["nonlinear"]
     return ([nl["factorizer"], linear[0], t, t / linear[0], cpu / linear[1], cpu, len(res.events),
              nl["evaluations"], nl["evaluations"] / max(len(res.events), 1),
-             nl["newton_iterations"] / nl["evaluations"], nl["factorizations"]], t, nl)
+             nl["newton_iterations"] / nl["evaluations"], nl["factorizations"], nl["analyses"]],
+            t, nl)
 
 
 def _scaling(quick: bool, progress) -> tuple[Table, Table]:
@@ -233,7 +234,8 @@ def _scaling(quick: bool, progress) -> tuple[Table, Table]:
                  ["nodes", "factoriser", "linear [s]", "neo-Hookean [s]", "x linear",
                   "x linear (CPU)", "neo-Hookean CPU [s]", "events", "evaluations",
                   "evaluations / event",
-                  "Newton its / evaluation", "factorisations", "nnz(L)", "factor Mflop",
+                  "Newton its / evaluation", "factorisations", "symbolic analyses", "nnz(L)",
+                  "factor Mflop",
                   "ms / evaluation"],
                  rows,
                  f"The shipped foam square re-meshed; events to 1e-9 L. Each row's linear and "
@@ -245,7 +247,9 @@ def _scaling(quick: bool, progress) -> tuple[Table, Table]:
                  "nnz(L) and factor Mflop (sum of squared column "
                  "counts) are those of the undeformed interior tangent of the initial contact "
                  "set in the factoriser's order (a supernodal factor stores the zeros of its "
-                 "supernodes). Fitted over the rows of the default factoriser: "
+                 "supernodes); symbolic analyses: the orderings and symbolic factorisations of "
+                 "the squeeze (one per object: every contact set holds its DOFs in one shared "
+                 "pattern). Fitted over the rows of the default factoriser: "
                  f"{growth}. An evaluation costs one assembly of the tangent, one numeric "
                  "factorisation and about three solves and three force assemblies (the Newton "
                  "iterations, dF/d delta on the finger motion). Load average (1 min) "

@@ -57,9 +57,6 @@ _CROSS = (2 * _I + _L, 2 * _K + _J)
 """The same for G_il G_kj."""
 _IDENTITY = ((_I == _K) & (_J == _L)).astype(float)
 """delta_ik delta_jl in that order."""
-_FORCE = (np.array([0, 0, 2, 2, 4, 4]), np.array([0, 2, 0, 2, 0, 2]),
-          np.array([1, 1, 3, 3, 5, 5]), np.array([1, 3, 1, 3, 1, 3]))
-"""Flat positions of g_a0, P_i0, g_a1, P_i1 for the element forces in (a, i) order."""
 
 
 class InvertedElementError(NumericalError):
@@ -347,11 +344,7 @@ def assemble(model: MaterialModel | str, nodes: np.ndarray, triangles: np.ndarra
         raise InvertedElementError(f"element {worst} inverted (det F = {det[worst]:.3g})",
                                    residuals={"det_F": det[worst]})
     W, P, A = stress_and_tangent(model, F, nu=nu, tangent=tangent)
-    # element forces fe[a, i] = area (g_a0 P_i0 + g_a1 P_i1), scattered onto the DOFs
-    g, p = geometry.weighted_grad.reshape(-1, 6), P.reshape(-1, 4)
-    fe = (np.take(g, _FORCE[0], axis=1) * np.take(p, _FORCE[1], axis=1)
-          + np.take(g, _FORCE[2], axis=1) * np.take(p, _FORCE[3], axis=1))
-    force = np.bincount(geometry.dofs, weights=fe.reshape(-1), minlength=geometry.n2)
+    force = geometry.force_operator @ P.reshape(-1)  # f[(a, i)] = sum_e area g_aj P_ij
     K = None
     if tangent:
         K = sp.csr_matrix((_stiffness_data(geometry, A), geometry.indices, geometry.indptr),
@@ -388,12 +381,11 @@ class MeshGeometry:
         :func:`gradient_operator` of the mesh.
     area : (t,) ndarray
         Element areas.
-    weighted_grad : (t, 3, 2) ndarray
-        area * g_aj: the reference shape-function gradients weighted by the element area.
+    force_operator : (2n, 4t) scipy.sparse.csr_matrix
+        The internal forces of the element stresses: (area-weighted ``gradient``)^T, so that
+        ``force_operator @ P.reshape(-1)`` sums area g_aj P_ij onto DOF (a, i).
     weighted_outer : (t, 9, 4) ndarray
         area * g_aj g_bl, rows (a, b), columns (j, l).
-    dofs : (6t,) ndarray of int
-        DOF of each element's (a, i), element by element.
     n2 : int
         Number of DOFs.
     slots : (36t,) ndarray of int
@@ -406,9 +398,8 @@ class MeshGeometry:
 
     gradient: sp.csr_matrix
     area: np.ndarray
-    weighted_grad: np.ndarray
+    force_operator: sp.csr_matrix
     weighted_outer: np.ndarray
-    dofs: np.ndarray
     n2: int
     slots: np.ndarray
     indices: np.ndarray
@@ -442,5 +433,7 @@ def mesh_geometry(nodes: np.ndarray, triangles: np.ndarray) -> MeshGeometry:
     row_of, col_of = keys // n2, keys % n2
     indptr = np.searchsorted(row_of, np.arange(n2 + 1))
     transpose = np.searchsorted(keys, col_of * n2 + row_of)  # the pattern is symmetric
-    return MeshGeometry(gradient_operator(nodes, triangles), area, weighted, outer,
-                        dofs.reshape(-1), n2, slots.reshape(-1), col_of, indptr, transpose)
+    gradient = gradient_operator(nodes, triangles)
+    forces = sp.csr_matrix(gradient.multiply(np.repeat(area, 4)[:, None]).T)
+    return MeshGeometry(gradient, area, forces, outer, n2, slots.reshape(-1), col_of, indptr,
+                        transpose)

@@ -41,6 +41,7 @@ import scipy.sparse as sp
 
 from squeeze_grasp_ros.extras import install_hint, installed
 from squeeze_grasp_ros.mechanics.vocabulary import Factorizer
+from squeeze_grasp_ros.threads import one_blas_thread
 
 __all__ = ["ContactStiffness", "Fill", "InteriorBlocks", "TangentFactor", "default_factorizer",
            "factorizer", "nested_dissection"]
@@ -164,6 +165,9 @@ class TangentFactor:
     fallbacks : int
         Tangents the Cholesky factorisation refused (K_ff not positive definite) and QDLDL's
         LDL^T factorised.
+    analyses : int
+        Orderings and symbolic analyses done (CHOLMOD's, QDLDL's): one per factoriser used,
+        however many tangents and contact sets it factorises.
     """
 
     method: Factorizer = field(default_factory=default_factorizer)
@@ -171,6 +175,7 @@ class TangentFactor:
     held: tuple | None = None
     tangent: sp.csr_matrix | None = field(default=None, repr=False)
     fallbacks: int = 0
+    analyses: int = 0
     _upper: sp.csc_matrix | None = field(default=None, repr=False)
     _ldlt: "object | None" = field(default=None, repr=False)  # a qdldl.Solver
     _cholesky: tuple | None = field(default=None, repr=False)
@@ -230,6 +235,7 @@ class TangentFactor:
 
         if self._cholesky is None:
             self._cholesky = self._symbolic(upper)
+            self.analyses += 1
         matrix, factor = self._cholesky
         matrix.V = cvxopt.matrix(upper.data)
         try:
@@ -256,6 +262,7 @@ class TangentFactor:
             import qdldl  # only the large-deformation models need it (``pip install qdldl``)
 
             self._ldlt = qdldl.Solver(upper, upper=True)
+            self.analyses += 1
         else:
             self._ldlt.update(upper, upper=True)
         return self._ldlt.solve
@@ -271,18 +278,21 @@ class TangentFactor:
         upper = self._held_upper(K, held)
         self.owner = self.held = self.tangent = self._solve = None
         solve = None
-        if self.method == Factorizer.CHOLMOD:
-            solve = self._cholmod(upper)
-            if solve is None:
-                self.fallbacks += 1
-        self._solve = self._qdldl(upper) if solve is None else solve
+        with one_blas_thread():
+            if self.method == Factorizer.CHOLMOD:
+                solve = self._cholmod(upper)
+                if solve is None:
+                    self.fallbacks += 1
+            self._solve = self._qdldl(upper) if solve is None else solve
         self.owner, self.held, self.tangent = owner, held, K
 
     def solve(self, b: np.ndarray) -> np.ndarray:
         """The solution of (K with the held DOFs held) x = b; a b that is zero on the held
-        DOFs gives an x that is zero there, K_ff^-1 b on the others.
+        DOFs gives an x that is zero there, K_ff^-1 b on the others (factorisations and solves
+        run BLAS on one thread: :func:`~squeeze_grasp_ros.threads.one_blas_thread`).
         """
-        return self._solve(b)
+        with one_blas_thread():
+            return self._solve(b)
 
     def fill(self, K: sp.csr_matrix, held: tuple) -> Fill:
         """Entries and flops of the factor of ``K`` with ``held`` held, in this factoriser's

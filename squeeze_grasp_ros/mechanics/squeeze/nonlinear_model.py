@@ -38,6 +38,7 @@ from squeeze_grasp_ros.mechanics.squeeze.contact_model import (
     SolveFailure,
 )
 from squeeze_grasp_ros.mechanics.vocabulary import MaterialModel, StrainCriterion
+from squeeze_grasp_ros.threads import one_blas_thread
 
 __all__ = ["NonlinearContactModel", "RESPONSE_ACCURACY", "contact_model"]
 
@@ -115,7 +116,8 @@ class NonlinearContactModel(ContactModel):
 
     def _evaluate(self, sd: SetData, delta: np.ndarray) -> Evaluation | ResponseFailure:
         response = self._response_of(sd)
-        out = response.evaluate(delta)
+        with one_blas_thread():  # numpy's BLAS threads spin between the factorisations
+            out = response.evaluate(delta)
         if isinstance(out, Evaluation):
             last = self._cache.get("last")
             if last is not None and last is not response:
@@ -182,7 +184,8 @@ class NonlinearContactModel(ContactModel):
 
     def diagnostics(self) -> dict:
         """Newton evaluations, iterations and factorisations of the interior solves, the
-        evaluations answered by a kept state (look-ups), the factoriser and the tangents its
+        evaluations answered by a kept state (look-ups), the factoriser, its orderings and
+        symbolic analyses (one per object: every contact set shares them) and the tangents its
         Cholesky factorisation refused (LDL^T instead).
         """
         responses = self._cache.get("responses", {}).values()
@@ -190,6 +193,7 @@ class NonlinearContactModel(ContactModel):
         return {"material_model": str(self.material_model),
                 "factorizer": str(shared.method if shared else default_factorizer()),
                 "ldlt_fallbacks": shared.fallbacks if shared else 0,
+                "analyses": shared.analyses if shared else 0,
                 "evaluations": sum(r.stats["evaluations"] for r in responses),
                 "newton_iterations": sum(r.stats["iterations"] for r in responses),
                 "factorizations": sum(r.stats["factorizations"] for r in responses),

@@ -210,7 +210,7 @@ class ExecutorNode(Node):
         ns = messages.stamp_ns(msg.header.stamp)
         obs = messages.observation(msg)
         if goal.start_ns is None:
-            if self._unseen(goal, msg, ns):
+            if not self.p["lockstep"] and self._unseen(goal, msg, ns):
                 return
             goal.start_ns = ns
             if self.jaws is not None:
@@ -236,9 +236,10 @@ class ExecutorNode(Node):
                 goal.program, command, obs, goal.events, (ns - goal.start_ns) * 1e-9, SUCCESS))
 
     def _unseen(self, goal: _Goal, msg: MonitorStatus, ns: int) -> bool:
-        """True while a finger of the goal has no reading yet (hardware: a goal sent before the
-        monitor saw the fingers, whose status reports them at the origin): the goal waits,
-        commanding nothing, and ends ``stale_data`` after ``stale_budget``.
+        """True while a finger of the goal has no reading yet (hardware mode: a goal sent before
+        the monitor saw the fingers, whose status reports them at the origin): the goal waits,
+        commanding nothing, and ends ``stale_data`` after ``stale_budget``. Not in lockstep,
+        where every tick must be answered: there the program's own stale check ends the goal.
         """
         unseen = [f for f, age in zip(msg.fingers, msg.sensor_age)
                   if f in goal.program.fingers and not age < UNSEEN_AGE]

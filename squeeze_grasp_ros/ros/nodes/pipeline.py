@@ -224,6 +224,11 @@ def sensor_qos(kind: str, depth: int, *, kept: bool = False) -> QoSProfile:
 LATCHED = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE,
                      history=HistoryPolicy.KEEP_LAST, durability=DurabilityPolicy.TRANSIENT_LOCAL)
 """Transient-local: late subscribers get the last message (prediction, object pose)."""
+CAMERA = QoSProfile(depth=8, reliability=ReliabilityPolicy.RELIABLE,
+                    history=HistoryPolicy.KEEP_LAST, durability=DurabilityPolicy.TRANSIENT_LOCAL)
+"""The camera's images and info: transient-local like :data:`LATCHED`, but keeping the last 8
+frames on both sides, so that a frame still in flight across processes when the next one is
+written is not replaced (a history of one lost 1-2 of 7 masks per multi-process run)."""
 
 
 def declare(node: Node, parameters: Mapping[str, tuple[Any, str]]) -> dict[str, Any]:

@@ -114,19 +114,20 @@ class RecorderNode(Node):
         self.reported_ns = -1
         latched = {"/" + pipeline.PREDICTION, "/" + pipeline.OBJECT_POSE,
                    f"/{pipeline.ACTION}/_action/status"} | {
-                       "/" + t for t in (pipeline.CAMERA_POSE, pipeline.CAMERA_MASK,
-                                         pipeline.CAMERA_DEPTH, pipeline.CAMERA_INFO,
-                                         pipeline.PREDICTED_SHAPES)}
+                       "/" + t for t in (pipeline.CAMERA_POSE, pipeline.PREDICTED_SHAPES)}
+        camera = {"/" + t for t in (pipeline.CAMERA_MASK, pipeline.CAMERA_DEPTH,
+                                    pipeline.CAMERA_INFO)}
         sensors = {name for name in topics if name.rsplit("/", 1)[-1] in pipeline.STREAMS}
         extra_loop = [t for t in p["lockstep_topics"] if t.strip()]
         kept = ({"/" + t.lstrip("/") for t in [*pipeline.loop_topics(p["devices"]), *extra_loop]}
                 if p["lockstep"] else set())
         """Lockstep topics whose publishers keep their last messages for a late reader."""
         for name, type_name in topics.items():
-            qos = pipeline.LATCHED if name in latched else (
-                pipeline.sensor_qos(p["sensor_qos"], p["qos_depth"], kept=name in kept)
-                if name in sensors
-                else pipeline.loop_qos(p["qos_depth"], kept=name in kept))
+            qos = (pipeline.LATCHED if name in latched
+                   else pipeline.CAMERA if name in camera
+                   else pipeline.sensor_qos(p["sensor_qos"], p["qos_depth"], kept=name in kept)
+                   if name in sensors
+                   else pipeline.loop_qos(p["qos_depth"], kept=name in kept))
             self.create_subscription(pipeline.message_type(type_name), self.sources[name],
                                      lambda data, n=name: self._record(n, data), qos, raw=True)
         self.progress_pub = self.create_publisher(Header, pipeline.RECORDER_PROGRESS,

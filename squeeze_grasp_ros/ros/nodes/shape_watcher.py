@@ -59,8 +59,8 @@ class ShapeWatcher:
         self.active = False
         self.dropped = 0
         sub = node.create_subscription
-        sub(Image, pipeline.CAMERA_MASK, self._image, pipeline.LATCHED)
-        sub(CameraInfo, pipeline.CAMERA_INFO, self._info, pipeline.LATCHED)
+        sub(Image, pipeline.CAMERA_MASK, self._image, pipeline.CAMERA)
+        sub(CameraInfo, pipeline.CAMERA_INFO, self._info, pipeline.CAMERA)
         sub(PoseStamped, pipeline.CAMERA_POSE, self._pose, pipeline.LATCHED)
         sub(PredictedShapes, pipeline.PREDICTED_SHAPES, self._prediction, pipeline.LATCHED)
         self.residual_pub = node.create_publisher(ShapeResidual, pipeline.SHAPE_RESIDUAL,

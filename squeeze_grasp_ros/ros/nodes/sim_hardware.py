@@ -288,10 +288,11 @@ def sim_controller(jaws: JawController | HandController) -> type:
 
 
 def camera_publishers(node: Node) -> dict[str, Any]:
-    """Publishers of the camera topics, transient-local (a late subscriber gets the newest
-    frame: the first one before tick 0); publishes the camera's pose once.
+    """Publishers of the camera topics, transient-local with :data:`.pipeline.CAMERA`'s history
+    (a late subscriber gets the frames kept, the first one before tick 0); publishes the
+    camera's pose once.
     """
-    pubs = {topic: node.create_publisher(msg_type, topic, pipeline.LATCHED)
+    pubs = {topic: node.create_publisher(msg_type, topic, pipeline.CAMERA)
             for topic, msg_type in ((pipeline.CAMERA_MASK, Image), (pipeline.CAMERA_DEPTH, Image),
                                     (pipeline.CAMERA_INFO, CameraInfo))}
     world = node.world

@@ -48,7 +48,8 @@ def first_outline(node: Any, spin_until: Callable[..., None], scene: Scene,
     got: dict[str, Any] = {}
     subscriptions = [
         node.create_subscription(msg_type, topic, lambda msg, k=topic: got.setdefault(k, msg),
-                                 pipeline.LATCHED)
+                                 pipeline.LATCHED if topic == pipeline.CAMERA_POSE
+                                 else pipeline.CAMERA)
         for topic, msg_type in ((pipeline.CAMERA_MASK, Image), (pipeline.CAMERA_INFO, CameraInfo),
                                 (pipeline.CAMERA_POSE, PoseStamped))]
     try:

@@ -474,19 +474,16 @@ def test_every_camera_frame_crosses_processes_to_the_recorder_and_the_monitor(tm
     """
     skimage_or_skip()
     import subprocess
-    import sys
 
+    from executables import script
     from rosbags.highlevel import AnyReader
 
     from squeeze_grasp_ros.ros import messages
 
     scene = config_dir() / "scenes" / "foam_ring_camera.yaml"
     bag = tmp_path / "bag"
-    proc = subprocess.run([sys.executable, "-c",
-                           "import sys\nfrom squeeze_grasp_ros.entry import cli\n"
-                           "sys.argv[0] = 'squeeze-grasp'\nsys.exit(cli())",
-                           "run", str(scene), "--quiet", "--processes", "--record", str(bag)],
-                          capture_output=True, text=True, timeout=300)
+    proc = subprocess.run([script("squeeze-grasp"), "run", str(scene), "--quiet", "--processes",
+                           "--record", str(bag)], capture_output=True, text=True, timeout=300)
     assert proc.returncode == 0, proc.stderr[-2000:]
     stamps: dict[str, list[int]] = {}
     ticks = 0

@@ -66,6 +66,7 @@ from squeeze_grasp_ros.ros.messages.gripper import (
     plan_gripper_grasp_response,
 )
 from squeeze_grasp_ros.ros.messages.monitor import (
+    UNSEEN_AGE,
     alarm_msg,
     fill_monitor_status,
     fill_patches_state,
@@ -114,6 +115,7 @@ __all__ = [
     "CONTACT_MODES",
     "MARKER_COLOURS",
     "TactileReadings",
+    "UNSEEN_AGE",
     "alarm_msg",
     "bool_list",
     "cdr_stamp_ns",

@@ -29,6 +29,10 @@ from squeeze_grasp_ros.ros.messages.contacts import CONTACT_MODES, fill_contact_
 
 # --------------------------------------------------------------------------- pipeline: monitor
 
+UNSEEN_AGE = 1e300
+"""s: the sensor age a ``MonitorStatus`` gives a finger the monitor has no reading of (the
+tracker's infinite age, kept finite for the message)."""
+
 
 def tracked_event_msg(event: TrackedEvent, ns: int) -> ContactEvent:
     """A monitor event as ``ContactEvent`` (node -1: taxel patches are not mesh nodes)."""
@@ -107,7 +111,7 @@ def fill_monitor_status(msg: MonitorStatus, out: TrackerOutput) -> MonitorStatus
         point.x, point.y = (float(xy[0]), float(xy[1])) if xy is not None else (0.0, 0.0)
         force.x, force.y = float(out.forces[f][0]), float(out.forces[f][1])
         normal.x, normal.y = float(out.normals[f][0]), float(out.normals[f][1])
-    msg.sensor_age = float64_array([min(out.ages[f], 1e300) for f in out.fingers])
+    msg.sensor_age = float64_array([min(out.ages[f], UNSEEN_AGE) for f in out.fingers])
     msg.depth = out.depth
     msg.relative_depth = out.relative_depth
     msg.events = [tracked_event_msg(e, out.stamp_ns) for e in out.events]

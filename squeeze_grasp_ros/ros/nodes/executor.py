@@ -79,8 +79,6 @@ SUCCESS = (ExecuteGrasp.Result.DEPTH_REACHED, ExecuteGrasp.Result.RESISTED,
 HOLDS = (ExecuteGrasp.Result.CANCELED, ExecuteGrasp.Result.SLIP_ALARM,
          ExecuteGrasp.Result.STALE_DATA)
 """Terminations after which the executor reports that it holds position."""
-UNSEEN_AGE = 1e300
-"""s: the sensor age a monitor status gives a finger it has no reading of."""
 
 
 class _Goal:
@@ -242,7 +240,7 @@ class ExecutorNode(Node):
         where every tick must be answered: there the program's own stale check ends the goal.
         """
         unseen = [f for f, age in zip(msg.fingers, msg.sensor_age)
-                  if f in goal.program.fingers and not age < UNSEEN_AGE]
+                  if f in goal.program.fingers and not age < messages.UNSEEN_AGE]
         if not unseen:
             return False
         goal.waiting_since_ns = ns if goal.waiting_since_ns is None else goal.waiting_since_ns

@@ -50,9 +50,11 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="rclpy executor of the one-process mode (default: events, "
                              "rclpy.experimental.EventsExecutor; single = SingleThreadedExecutor)")
     parser.add_argument("--on-slip-alarm", choices=REACTIONS, default=REACTIONS[0],
-                        help="executor reaction to an imminent-slip alarm: hold (default), or "
+                        help="executor reaction to an imminent-slip alarm: hold (default), "
                              "change the squeeze direction once to the pure squeeze or along the "
-                             "measured contact normals")
+                             "measured contact normals, or resqueeze: open past first contact "
+                             "and squeeze again, 25 %% short of the alarm's depth "
+                             "(docs/grippers.md)")
     parser.add_argument("--world", metavar="SCENE",
                         help="scene YAML of the simulated world (default: SCENE itself): a "
                              "world the planner does not know, e.g. another E or outline, to "
@@ -208,6 +210,17 @@ def _vector(v: list) -> str:
     return f"({v[0]:+.4f}, {v[1]:+.4f})"
 
 
+def _resqueezes(result: dict) -> str:
+    """The line of a goal that released and squeezed again after slip alarms."""
+    released = "; ".join(
+        f"{r['stamp_ns'] * 1e-9:.3f} s"
+        + (f" after {r['after']['termination']} at {r['after']['depth'] * 1e3:.4f} mm"
+           if r["after"] else "") for r in result["world_releases"]) or "never"
+    return (f"re-squeezed: {result['attempts']} squeezes, the last planned to "
+            f"{result['planned_depth'] * 1e3:.4f} mm; the world released the object at "
+            f"{released}")
+
+
 def summary(result: dict) -> str:
     """Human-readable report of a run."""
     counts = " ".join(f"{k} {v}" for k, v in result["event_counts"].items())
@@ -241,6 +254,8 @@ def summary(result: dict) -> str:
     first = result["first_alarms"].get(FORCE_MISMATCH)
     if first:  # the force watch's verdict on the model: where the forces first left it
         lines.insert(5, f"first {FORCE_MISMATCH}: {first['message']}")
+    if result["resqueezed"]:
+        lines.insert(2, _resqueezes(result))
     seen = result.get("seen_outline")
     if seen:
         fit = seen.get("fit_residual_m")

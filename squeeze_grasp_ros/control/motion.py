@@ -24,13 +24,31 @@ Reactions (checked in this order every cycle):
    ``slip_alarm``; with "pure" / "normals": once, continue the remaining depth from the current
    setpoints along the pure-squeeze directions / along each finger's measured contact normal
    (scaled so the stacked direction has unit norm), ignoring the alarm for ``redirect_grace``
-   cycles; an alarm after that ends the goal as with "hold". In the resistance phase an alarm of
-   the adversary ends it successfully (the adversary slips, as in Algorithm 2);
+   cycles; an alarm after that ends the goal as with "hold"; with "resqueeze": release and
+   squeeze again (below), at most ``max_attempts`` squeezes in all, then as with "hold". In the
+   resistance phase an alarm of the adversary ends it successfully (the adversary slips, as in
+   Algorithm 2);
 4. ``stale_sensor`` alarm of a moving finger -> hold the current setpoints (v = 0) until fresh.
+
+**Re-squeeze** ("resqueeze"). At the alarm the squeeze's measured depth rho_s is noted (the
+monitor's depth less its depth when the current squeeze passed first contact). The squeezing
+fingers then open along straight lines to their *release positions* x0_f - c d_f / g (x0_f the
+first-contact position, where the goal started; c = ``release_clearance``; g = max_f |d_f|, so
+the finger with the longest direction opens c past first contact and the others in
+proportion). The phase ends when they are there and the monitor has reported every squeezing
+finger free (a ``contact_lost`` alarm since the release began); if that does not come within
+``stale_budget`` of reaching the release positions the goal ends ``slip_alarm``. The next squeeze
+runs the same placement and directions from the release positions, through first contact, to
+the depth (1 - ``resqueeze_margin``) rho_s: the depth the plan reached with the slip measured
+``resqueeze_margin`` short of it. During the release ``slip_imminent`` and ``contact_lost``
+are ignored; in a re-squeeze a finger's ``contact_lost`` counts only after the monitor has seen
+it loaded again (a cycle with a non-zero force and no such alarm), since the approach to first
+contact is free by design.
 
 Fingers the goal does not move hold the positions measured at the start. Work is integrated
 from measurements: W_f += (F_prev + F_cur)/2 . (x_cur - x_prev), forces of the finger on the
-object (N), positions in m.
+object (N), positions in m; a re-squeeze starts it again from zero (the work of the last
+squeeze).
 """
 
 from __future__ import annotations
@@ -43,7 +61,17 @@ import numpy as np
 
 from squeeze_grasp_ros.mechanics.vocabulary import Finger, SqueezeKind, Termination
 
-REACTIONS: tuple[str, ...] = ("hold", SqueezeKind.PURE.value, "normals")
+RESQUEEZE = "resqueeze"
+"""The reaction that releases and squeezes again (``ExecuteGrasp.Goal.REACT_RESQUEEZE``)."""
+REACTIONS: tuple[str, ...] = ("hold", SqueezeKind.PURE.value, "normals", RESQUEEZE)
+DEFAULT_ATTEMPTS = 2
+"""Squeezes in all, the first included, of a "resqueeze" goal that gives none."""
+DEFAULT_MARGIN = 0.25
+"""Fraction of the alarm depth a re-squeeze stays below, when the goal gives none."""
+DEFAULT_CLEARANCE = 0.002
+"""How far a released finger opens past first contact (m), when the goal gives none: 2 mm,
+clear of the object at rest for the shipped pads and circles while a gripper opens in 0.2 s at
+the default ``max_velocity``."""
 
 
 @dataclass(frozen=True)
@@ -86,9 +114,16 @@ class GraspGoal:
         Squeeze depth to reach, m.
     relative_per_depth : float
         1/m, for reports.
-    on_slip_alarm : {"hold", "pure", "normals"}
+    on_slip_alarm : {"hold", "pure", "normals", "resqueeze"}
     pure_directions : (f, 2) ndarray or None
         For "pure".
+    max_attempts : int
+        For "resqueeze": squeezes in all, the first included (>= 1).
+    resqueeze_margin : float
+        For "resqueeze": a re-squeeze's depth is (1 - margin) times the measured depth of the
+        alarm, in (0, 1).
+    release_clearance : float
+        For "resqueeze": how far the fingers open past first contact, m (> 0; see the module).
     adversary : str
         Adversary finger of the resistance ("" = no resistance).
     adversary_translation : (2,) ndarray
@@ -105,6 +140,9 @@ class GraspGoal:
     relative_per_depth: float = 0.0
     on_slip_alarm: str = "hold"
     pure_directions: np.ndarray | None = None
+    max_attempts: int = DEFAULT_ATTEMPTS
+    resqueeze_margin: float = DEFAULT_MARGIN
+    release_clearance: float = DEFAULT_CLEARANCE
     adversary: str = ""
     adversary_translation: np.ndarray = field(default_factory=lambda: np.zeros(2))
     resist_travel: np.ndarray = field(default_factory=lambda: np.zeros(0))
@@ -139,6 +177,16 @@ def goal_problem(goal: GraspGoal, known: Sequence[str]) -> str | None:
         or not np.any(goal.pure_directions)
     ):
         return f"on_slip_alarm 'pure' needs {f} finite, not all zero pure_directions"
+    if goal.on_slip_alarm == RESQUEEZE:
+        if not goal.max_attempts >= 1:
+            return f"max_attempts must be >= 1, got {goal.max_attempts}"
+        if not 0.0 < goal.resqueeze_margin < 1.0:
+            return f"resqueeze_margin must be in (0, 1), got {goal.resqueeze_margin}"
+        if not (np.isfinite(goal.release_clearance) and goal.release_clearance > 0.0):
+            return f"release_clearance must be finite and > 0 m, got {goal.release_clearance}"
+        if goal.resist:
+            return ("on_slip_alarm 'resqueeze' cannot be combined with a resistance: its "
+                    "waypoints are planned for the goal's depth, not a re-squeeze's")
     if goal.resist:
         return _resistance_problem(goal, known)
     return None
@@ -298,6 +346,20 @@ class GraspProgram:
         self.cancel_requested = False
         self.work = {f: 0.0 for f in self.fingers}
         self._last: Observation | None = None
+        self.attempts = 1
+        """Squeezes started (re-squeezes after slip alarms included)."""
+        self.planned_depth = goal.depth
+        """Depth the current squeeze aims at, m."""
+        self.first_contact: np.ndarray | None = None
+        """(f, 2) positions of the squeezing fingers at the goal's start, m."""
+        self.depth_offset = 0.0
+        """The monitor's depth when the current squeeze passed first contact, m."""
+        self.approaching = False
+        """A re-squeeze has not yet passed first contact."""
+        self.armed = set(goal.fingers)
+        """Fingers whose ``contact_lost`` alarm counts (see the module)."""
+        self.freed: set[str] = set()
+        self.release_wait = 0.0
 
     def cancel(self) -> None:
         """Request a cancel: the next cycle holds the measured positions and ends the goal."""
@@ -311,6 +373,11 @@ class GraspProgram:
         if self.path is None:
             self.commanded = {f: np.asarray(obs.positions[f], float) for f in self.fingers}
             self._start_squeeze(self.goal.directions)
+            self.first_contact = self.path.start.copy()
+        if self.phase == "release":
+            return self._release_step(obs, dt)
+        if self.attempts > 1:
+            self._approach(obs)
         terminal = self._terminal(obs)
         if terminal is not None:
             return terminal
@@ -320,7 +387,11 @@ class GraspProgram:
         elif self.phase == "resist" and self.goal.adversary in alarmed:
             return self._finish(obs, "resisted", "the adversary slips", measured=True)
         elif alarmed & set(self.goal.fingers):
-            if self.goal.on_slip_alarm == "hold" or self.redirected or self.phase != "squeeze":
+            if (self.goal.on_slip_alarm == RESQUEEZE and self.phase == "squeeze"
+                    and self.attempts < self.goal.max_attempts):
+                return self._release(obs, dt)
+            if self.goal.on_slip_alarm in ("hold", RESQUEEZE) or self.redirected \
+                    or self.phase != "squeeze":
                 return self._finish(
                     obs,
                     "slip_alarm",
@@ -366,7 +437,7 @@ class GraspProgram:
             )
         lost = {finger for kind, finger in obs.alarms if kind == Termination.CONTACT_LOST} & set(
             self.moving
-        )
+        ) & self.armed
         if lost:
             return self._finish(
                 obs,
@@ -402,6 +473,70 @@ class GraspProgram:
         self.s, self.v = 0.0, 0.0
         self.redirected = True
         self.grace = self.limits.redirect_grace
+
+    def _release(self, obs: Observation, dt: float) -> Command:
+        """A slip alarm to re-squeeze: note the depth, open toward the release positions."""
+        goal = self.goal
+        self.planned_depth = (1.0 - goal.resqueeze_margin) * (obs.depth - self.depth_offset)
+        self.commanded = {f: np.asarray(obs.positions[f], float) for f in self.fingers}
+        start = np.array([self.commanded[f] for f in goal.fingers])
+        self.path = straight_path(start, self._release_positions() - start, 1.0)
+        self.s, self.v = 0.0, 0.0
+        self.phase, self.armed, self.freed, self.release_wait = "release", set(), set(), 0.0
+        self._advance(dt)
+        return Command(self._setpoints(), "releasing", None,
+                       f"imminent slip at depth {(obs.depth - self.depth_offset) * 1e3:.4g} mm: "
+                       f"releasing to squeeze again to {self.planned_depth * 1e3:.4g} mm")
+
+    def _release_positions(self) -> np.ndarray:
+        """(f, 2) first-contact positions moved back by ``release_clearance`` (see the module)."""
+        directions = np.asarray(self.goal.directions, float)
+        gain = float(np.linalg.norm(directions, axis=1).max())
+        return self.first_contact - (self.goal.release_clearance / gain) * directions
+
+    def _release_step(self, obs: Observation, dt: float) -> Command:
+        """A cycle of the release: open, then squeeze again once every finger is free."""
+        goal = self.goal
+        if self.cancel_requested:
+            return self._finish(obs, "canceled", "goal canceled", measured=True)
+        self.freed |= {finger for kind, finger in obs.alarms
+                       if kind == Termination.CONTACT_LOST} & set(goal.fingers)
+        if self.s < self.path.end or not self._settled(obs):
+            self._advance(dt)
+            return Command(self._setpoints(), "releasing")
+        if self.freed != set(goal.fingers):
+            self.release_wait += dt
+            if self.release_wait > self.limits.stale_budget:
+                return self._finish(obs, "slip_alarm", "released for a re-squeeze, but the "
+                                    "monitor reported no contact loss of " + ", ".join(
+                                        sorted(set(goal.fingers) - self.freed))
+                                    + f" within stale_budget {self.limits.stale_budget} s")
+            return Command(self._setpoints(), "releasing")
+        directions = np.asarray(goal.directions, float)
+        gain = float(np.linalg.norm(directions, axis=1).max())
+        start = np.array([self.commanded[f] for f in goal.fingers])
+        self.path = straight_path(start, directions,
+                                  goal.release_clearance / gain + self.planned_depth)
+        self.s, self.v = 0.0, 0.0
+        self.phase, self.attempts, self.approaching = "squeeze", self.attempts + 1, True
+        self.work = {f: 0.0 for f in self.fingers}
+        self._advance(dt)
+        return Command(self._setpoints(), "squeezing")
+
+    def _approach(self, obs: Observation) -> None:
+        """In a re-squeeze: the depth offset at first contact, and which fingers are loaded."""
+        goal = self.goal
+        lost = {finger for kind, finger in obs.alarms if kind == Termination.CONTACT_LOST}
+        self.armed |= {f for f in goal.fingers
+                       if f not in lost and np.any(obs.forces.get(f, 0.0))}
+        if not self.approaching:
+            return
+        past = np.array([obs.positions[f] for f in goal.fingers]) - self.first_contact
+        directions = np.asarray(goal.directions, float)
+        along = float(np.sum(past * directions)) / float(np.sum(directions * directions))
+        if along >= 0.0:
+            self.approaching = False
+            self.depth_offset = obs.depth - float(np.linalg.norm(past))
 
     def _settled(self, obs: Observation) -> bool:
         tol = self.limits.position_tolerance

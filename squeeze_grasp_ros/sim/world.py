@@ -26,6 +26,21 @@ When the stepper reports a termination (a finger slips, the strain limit, pickup
 contact) the object's motion can no longer be simulated: the world *ends*, the contact state
 freezes (the sensors keep reading it) and the devices still follow their setpoints.
 
+**Release and a fresh squeeze.** An ended world whose fingertips have all left the object
+(every tip of the frozen state clear of the object's outline *at rest*: a positive gap to every
+outer boundary node, :meth:`~..mechanics.squeeze.tip_shapes.TipGeometry.gaps`) *releases* it at
+that tick: the elastic object, quasi-static, relaxes to its rest configuration (no contacts,
+zero forces, zero displacement; :attr:`TickOutput.released`) and the world runs again
+(termination None). What happened to the object during the slip is not modelled: it is assumed
+back at its rest pose in the object frame (the rigid shift of a real slip, the object's turn in
+the jaws, is not simulated). While released, the tips move freely. When every released tip
+touches the rest outline again (a gap <= 0), a fresh squeeze starts from the rest state at the
+scene's placements (:func:`~..mechanics.squeeze.contact_state.initial_state`: a new mechanics
+state on the same cached object and contact model), advanced at once by each tip's translation
+past its placement. The world assumes the tips come back through their first-contact positions
+(the executor's re-squeeze does); a tip that comes back elsewhere is still placed at its
+first-contact node. A scene with an adversary that has touched the object does not release.
+
 The adversary's pusher waits at its home (its fingertip touching the undeformed object at its
 placement) until its setpoint first moves; then a guarded move places its fingertip on the
 *deformed* boundary (:func:`..mechanics.resistance_friction.add_adversary`). The pusher's
@@ -44,7 +59,12 @@ from dataclasses import dataclass
 import numpy as np
 
 from squeeze_grasp_ros.mechanics.resistance.frictional import add_adversary
-from squeeze_grasp_ros.mechanics.squeeze.contact_state import ContactState, Event, initial_state
+from squeeze_grasp_ros.mechanics.squeeze.contact_state import (
+    ContactState,
+    Event,
+    FingerState,
+    initial_state,
+)
 from squeeze_grasp_ros.mechanics.squeeze.stepper import QuietSteps
 from squeeze_grasp_ros.mechanics.squeeze.tip_shapes import TipGeometry
 from squeeze_grasp_ros.mechanics.vocabulary import Effect, Finger, Termination
@@ -59,6 +79,9 @@ from squeeze_grasp_ros.sim.sensors import (
     render_tactile,
     tactile_layout,
 )
+
+RELEASED = "released"
+"""The ``sim/events`` termination field at the tick an ended world released the object."""
 
 TERMINATE_ON: tuple[str, ...] = (
     Termination.STRAIN_LIMIT,
@@ -109,9 +132,11 @@ class TickOutput:
     events : tuple of Event
         Ground-truth events located during the motion into this tick, in processing order.
     termination : str or None
-        Set from the tick at which the world ended on.
+        Set from the tick at which the world ended on (None again once it released the object).
     state : ContactState
         Ground-truth contact state.
+    released : bool
+        True at the tick the ended world released the object (see the module).
     """
 
     index: int
@@ -120,6 +145,7 @@ class TickOutput:
     events: tuple[Event, ...]
     termination: str | None
     state: ContactState
+    released: bool = False
 
 
 @dataclass(frozen=True)
@@ -166,6 +192,12 @@ class SimWorld:
         motion = setup.motion
         self.directions, self.relative_per_depth = motion.directions, motion.relative_per_depth
         self.state = initial_state(tips, self.relative_per_depth)
+        self.placements = tuple(tips)
+        """The squeezing tips at their placements: where a fresh squeeze starts from rest."""
+        self.rest_outline = self.obj.mesh.nodes[self.obj.mesh.boundary]
+        """The outer boundary at rest (b, 2), m: what a released tip must clear and touch."""
+        self.released = False
+        """True while the object is released (at rest, no contacts; see the module)."""
         self.adversary = None
         if scene.has(Effect.ADVERSARY):
             self.adversary = setup.adversary_tip()
@@ -256,6 +288,18 @@ class SimWorld:
             self.positions[name] = new
         self.index += 1
         events: tuple[Event, ...] = ()
+        if self.termination is not None and self._tips_clear():
+            self._release()
+            return self._output(events, released=True)
+        if self.released:
+            if not self._tips_touch():
+                self._release()
+                return self._output(events)
+            self._work["fresh_squeezes"] += 1
+            self.state, self.released = initial_state(list(self.placements),
+                                                      self.relative_per_depth), False
+            moves = {t.name: self.positions[t.name] - np.asarray(t.center, float)
+                     for t in self.placements}
         touching = {f.name for f in self.state.fingers}
         translations = {
             k: tuple(v) for k, v in moves.items() if k in touching and np.any(v != 0.0)
@@ -273,6 +317,30 @@ class SimWorld:
     def _adversary_touching(self) -> bool:
         return any(f.name == Finger.A for f in self.state.fingers)
 
+    def _rest_gaps(self, names) -> np.ndarray:
+        """Smallest gap (m) of each of the tips ``names`` at its position to the rest outline."""
+        return np.array([self.tips[n].gaps(self.rest_outline, self.positions[n][None]).min()
+                         for n in names])
+
+    def _tips_clear(self) -> bool:
+        """Every tip of the ended state is clear of the object at rest (no adversary)."""
+        names = [f.name for f in self.state.fingers]
+        return Finger.A not in names and bool(np.all(self._rest_gaps(names) > 0.0))
+
+    def _tips_touch(self) -> bool:
+        """Every squeezing tip touches (or enters) the object at rest."""
+        return bool(np.all(self._rest_gaps([t.name for t in self.placements]) <= 0.0))
+
+    def _release(self) -> None:
+        """The object at rest and free: no contacts, the tips where the devices hold them."""
+        if not self.released:
+            self._work["releases"] += 1
+        self.released, self.termination = True, None
+        self.state = ContactState(
+            tuple(FingerState(t.name, self.positions[t.name].copy(), t.radius, np.zeros(2),
+                              flat=t.flat, facing=t.facing) for t in self.placements),
+            (), 0.0, self.relative_per_depth)
+
     def _touch_adversary(self, target: np.ndarray) -> np.ndarray:
         """Place A on the deformed boundary; return its setpoint shifted by the same offset."""
         self._work["adversary_placements"] += 1
@@ -286,10 +354,11 @@ class SimWorld:
         self.positions[Finger.A] = touched
         return target + offset
 
-    def _output(self, events: tuple[Event, ...]) -> TickOutput:
+    def _output(self, events: tuple[Event, ...], *, released: bool = False) -> TickOutput:
         readings = tuple(self._read(name) for name in self.fingers)
         return TickOutput(
-            self.index, self.index * self.dt_ns, readings, events, self.termination, self.state
+            self.index, self.index * self.dt_ns, readings, events, self.termination, self.state,
+            released,
         )
 
     def _read(self, name: str) -> FingerReading:
@@ -328,6 +397,8 @@ class SimWorld:
     def displacement_field(self) -> np.ndarray:
         """Displacement (n, 2) of every mesh node, m (one sparse solve; counted)."""
         self._work["displacement_fields"] += 1
+        if not self.state.contacts:  # released: the object at rest
+            return np.zeros_like(self.obj.mesh.nodes)
         sd, delta, forces = self._contact_solution()
         return self.model.full_displacement(sd, delta, forces).reshape(-1, 2) * self.model.length
 
@@ -348,12 +419,12 @@ class SimWorld:
     def view(self) -> WorldView:
         """Deformed outline, fingertips and contacts for display (counted as ``views``)."""
         self._work["views"] += 1
-        sd, delta, forces = self._contact_solution()
         mesh = self.obj.mesh
-        outline = (
-            mesh.nodes[mesh.boundary]
-            + self.model.boundary_displacement(sd, delta, forces) * self.model.length
-        )
+        outline = self.rest_outline
+        if self.state.contacts:
+            sd, delta, forces = self._contact_solution()
+            outline = outline + (self.model.boundary_displacement(sd, delta, forces)
+                                 * self.model.length)
         tips = tuple(
             (f.name, np.asarray(f.center, float), float(f.radius)) for f in self.state.fingers
         )

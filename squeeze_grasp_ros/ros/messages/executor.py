@@ -14,7 +14,15 @@ from squeeze_grasp_interfaces.msg import (
     ExecutorStatus,
     MonitorStatus,
 )
-from squeeze_grasp_ros.control.motion import Command, GraspGoal, GraspProgram, Observation
+from squeeze_grasp_ros.control.motion import (
+    DEFAULT_ATTEMPTS,
+    DEFAULT_CLEARANCE,
+    DEFAULT_MARGIN,
+    Command,
+    GraspGoal,
+    GraspProgram,
+    Observation,
+)
 from squeeze_grasp_ros.ros.messages.common import float64_array, header, stamp_ns, vector3
 
 # --------------------------------------------------------------------------- pipeline: executor
@@ -57,6 +65,9 @@ def grasp_goal(msg: ExecuteGrasp.Goal) -> GraspGoal:
         float(msg.relative_per_depth),
         msg.on_slip_alarm or "hold",
         _planar(msg.pure_directions) if msg.pure_directions else None,
+        int(msg.max_attempts) or DEFAULT_ATTEMPTS,
+        float(msg.resqueeze_margin) or DEFAULT_MARGIN,
+        float(msg.release_clearance) or DEFAULT_CLEARANCE,
         msg.adversary if msg.resist else "",
         np.array([msg.adversary_translation.x, msg.adversary_translation.y]),
         np.asarray(msg.resist_travel, float),
@@ -72,6 +83,9 @@ def grasp_goal_msg(goal: GraspGoal) -> ExecuteGrasp.Goal:
         depth=float(goal.depth),
         relative_per_depth=float(goal.relative_per_depth),
         on_slip_alarm=goal.on_slip_alarm,
+        max_attempts=int(goal.max_attempts),
+        resqueeze_margin=float(goal.resqueeze_margin),
+        release_clearance=float(goal.release_clearance),
         resist=goal.resist,
         adversary=goal.adversary,
         adversary_translation=vector3(goal.adversary_translation),
@@ -89,10 +103,14 @@ def grasp_feedback(
     fingers: Sequence[str],
     events: Sequence[ContactEvent],
     relative_per_depth: float,
+    attempt: int = 1,
 ) -> ExecuteGrasp.Feedback:
-    """``ExecuteGrasp`` feedback: measured depth and forces, events since the last feedback."""
+    """``ExecuteGrasp`` feedback: measured depth and forces, events since the last feedback,
+    the squeeze under way (from 1).
+    """
     return ExecuteGrasp.Feedback(
         state=state,
+        attempt=int(attempt),
         depth=obs.depth,
         relative_depth=obs.depth * relative_per_depth,
         fingers=list(fingers),
@@ -109,19 +127,25 @@ def grasp_result(
     duration: float,
     success_terminations: Sequence[str],
 ) -> ExecuteGrasp.Result:
-    """``ExecuteGrasp`` result of a finished :class:`GraspProgram` (measured numbers)."""
+    """``ExecuteGrasp`` result of a finished :class:`GraspProgram` (measured numbers; the depth
+    of the last squeeze, from its first contact).
+    """
     fingers = list(program.fingers)
     forces = obs.forces if obs is not None else {}
+    depth = obs.depth - program.depth_offset if obs is not None else 0.0
     return ExecuteGrasp.Result(
         success=command.termination in success_terminations,
         termination=command.termination,
         message=command.message,
-        depth=obs.depth if obs is not None else 0.0,
-        relative_depth=(obs.depth if obs is not None else 0.0) * program.goal.relative_per_depth,
+        depth=depth,
+        relative_depth=depth * program.goal.relative_per_depth,
         ticks=program.ticks,
         duration=float(duration),
         hold_ticks=program.hold_ticks,
         redirected=program.redirected,
+        attempts=program.attempts,
+        resqueezed=program.attempts > 1,
+        planned_depth=float(program.planned_depth),
         fingers=fingers,
         forces=[vector3(forces.get(f, np.zeros(2))) for f in fingers],
         work=float64_array([program.work[f] for f in fingers]),

@@ -45,7 +45,13 @@ from rclpy.task import Future
 
 from squeeze_grasp_interfaces.action import ExecuteGrasp
 from squeeze_grasp_interfaces.msg import ExecutorStatus, MonitorStatus
-from squeeze_grasp_ros.control.motion import Command, GraspProgram, MotionLimits, goal_problem
+from squeeze_grasp_ros.control.motion import (
+    RESQUEEZE,
+    Command,
+    GraspProgram,
+    MotionLimits,
+    goal_problem,
+)
 from squeeze_grasp_ros.ros import messages
 from squeeze_grasp_ros.ros.nodes import ParameterError, pipeline, run_node
 from squeeze_grasp_ros.ros.nodes.jaw_commands import HandCommands, JawCommands
@@ -173,6 +179,9 @@ class ExecutorNode(Node):
         problem = goal_problem(goal, list(self.devices))
         if problem is None and self.jaws is not None:
             problem = self.jaws.effort_problem(goal)
+        if problem is None and self.jaw_action is not None and goal.on_slip_alarm == RESQUEEZE:
+            problem = ("on_slip_alarm 'resqueeze' is not built for a gripper action controller "
+                       "(one gripper goal per grasp goal); use the joint_trajectory route")
         if problem is not None:
             handle.abort()
             return messages.invalid_goal_result(problem)
@@ -310,7 +319,7 @@ class ExecutorNode(Node):
         if program.ticks % self.p["feedback_every"] == 0 or command.termination is not None:
             goal.handle.publish_feedback(messages.grasp_feedback(
                 command.state, obs, program.fingers, goal.since_feedback,
-                program.goal.relative_per_depth))
+                program.goal.relative_per_depth, program.attempts))
             goal.since_feedback = []
 
 

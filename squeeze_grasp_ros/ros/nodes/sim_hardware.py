@@ -10,7 +10,8 @@ advances it in lockstep (docs/design.md §4), driven by messages, never by timer
 2. a tick k is ``/clock`` = t_k, every device's ``pose``, ``wrench`` and ``tactile`` reading
    stamped t_k (a reading dropped by the sensor_dropout effect is skipped), the ground-truth
    events of the tick as one ``sim/events`` array (with the termination reason at the tick the
-   world ends), a simulated controller's ``joint_states``, the ground-truth state
+   world ends, and ``released`` at the tick an ended world releases the object), a simulated
+   controller's ``joint_states``, the ground-truth state
    (``sim/state``), markers at ``display_rate``, and last ``sim/tick`` listing the readings it
    published (``joint_states`` among them);
 3. when every device's setpoint stamped after t_k has arrived (and the recorder is no more than
@@ -48,7 +49,7 @@ from squeeze_grasp_ros.ros.nodes.sim_controllers import (
 from squeeze_grasp_ros.scene import GraspSetup, load_scene
 from squeeze_grasp_ros.scene.controller import HandController, JawController, scene_controller
 from squeeze_grasp_ros.sim.camera import CameraFrame
-from squeeze_grasp_ros.sim.world import SimWorld, TickOutput
+from squeeze_grasp_ros.sim.world import RELEASED, SimWorld, TickOutput
 
 PARAMETERS: dict[str, tuple[Any, str]] = {
     "scene": ("", "scene YAML file the world is built from (required)"),
@@ -218,10 +219,11 @@ class SimHardwareNode(Node):
                               messages.fill_tactile(msgs["tactile"], r.normal, r.tangential, ns)))
                 readings.append(f"{device}/tactile")
         ending = out.termination is not None and not self.ended
-        self.ended = self.ended or ending
-        if out.events or ending:
+        self.ended = (self.ended or ending) and not out.released
+        if out.events or ending or out.released:
             batch.append((self.event_pub, messages.sim_events_msg(
-                out.events, out.termination if ending else "", out.state, ns)))
+                out.events, out.termination if ending else RELEASED if out.released else "",
+                out.state, ns)))
         if self.controller is not None:
             batch.append(self.controller.joint_state(out))
             readings.append(JOINT_STATES)

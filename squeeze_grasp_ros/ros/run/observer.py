@@ -20,6 +20,7 @@ from squeeze_grasp_ros.ros import messages
 from squeeze_grasp_ros.ros.messages.cdr import cdr_stamp_ns
 from squeeze_grasp_ros.ros.nodes import pipeline
 from squeeze_grasp_ros.ros.run.summary import GRASP_HELD, Observed
+from squeeze_grasp_ros.sim.world import RELEASED
 
 __all__ = ["Observer", "Progress"]
 
@@ -42,7 +43,10 @@ class Observer:
         self.progress = progress
         self.sim_events: list[ContactEvent] = []
         self.world_end: dict | None = None
-        """``{"termination", "depth", "stamp_ns"}`` once the world ended."""
+        """``{"termination", "depth", "stamp_ns"}`` once the world ended (the last end)."""
+        self.world_releases: list[dict] = []
+        """``{"stamp_ns", "after"}`` of every release of the object (after: the end it
+        follows, as ``world_end``)."""
         self.monitor_events: list[ContactEvent] = []
         self.alarms: Counter = Counter()
         self.first_alarm: dict[str, dict] = {}
@@ -67,7 +71,11 @@ class Observer:
     # ----------------------------------------------------------------- callbacks
     def _sim_events(self, msg: ContactEventArray) -> None:
         self.sim_events += msg.events
-        if msg.termination:
+        if msg.termination == RELEASED:
+            self.world_releases.append({"stamp_ns": messages.stamp_ns(msg.header.stamp),
+                                        "after": self.world_end})
+            self.world_end = None
+        elif msg.termination:
             self.world_end = {
                 "termination": msg.termination,
                 "depth": float(msg.depth),
@@ -131,4 +139,5 @@ class Observer:
     def observed(self) -> Observed:
         """What was received, for the summary."""
         return Observed(self.sim_state, list(self.sim_events), self.world_end,
-                        list(self.monitor_events), self.alarms, self.first_alarm)
+                        list(self.monitor_events), self.alarms, self.first_alarm,
+                        list(self.world_releases))

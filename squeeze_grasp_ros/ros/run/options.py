@@ -60,7 +60,7 @@ class RunOptions:
         One process per node instead of one executor in this process.
     executor : {"events", "single"}
         rclpy executor of the one-process mode.
-    on_slip_alarm : {"hold", "pure", "normals"}
+    on_slip_alarm : {"hold", "pure", "normals", "resqueeze"}
         The executor's reaction to an imminent-slip alarm.
     resist : bool
         Run the resistance phase when the scene has a frictional adversary.

@@ -45,6 +45,7 @@ from rclpy.signals import SignalHandlerOptions
 
 from squeeze_grasp_interfaces.action import ExecuteGrasp
 from squeeze_grasp_interfaces.msg import ContactEventArray, PredictedShapes
+from squeeze_grasp_ros.control.motion import RESQUEEZE
 from squeeze_grasp_ros.exit_codes import Interrupted
 from squeeze_grasp_ros.mechanics.vocabulary import Effect
 from squeeze_grasp_ros.perception.extract import ObjectOutline
@@ -338,12 +339,14 @@ class PipelineRunner:
         goal is cancelled, so the executor holds instead of driving fingers that no longer move
         the object; not when the monitor watches the jaws on joint feedback alone (a gripper
         scene without wrench and tactile sensing): its slip watch, not the ground truth, is
-        then what stops the goal. If the status topic reports the goal finished but the result
-        response does not come within a few seconds (lost across processes), the result is
-        requested again.
+        then what stops the goal; nor when the goal re-squeezes after a slip alarm (the world
+        releases the object when the fingers open, :mod:`...sim.world`). If the status topic
+        reports the goal finished but the result response does not come within a few seconds
+        (lost across processes), the result is requested again.
         """
         result = self.goal.result(self.spin_until, self.options.timeout,
                                   (lambda: False) if self.joint_feedback
+                                  or self.plan.goal.on_slip_alarm == RESQUEEZE
                                   else self.observer.world_failed)
         self.timing["loop"] = time.perf_counter() - self.loop_started
         self.timing["loop_cpu"] = time.process_time() - self.loop_cpu_started

@@ -31,11 +31,15 @@ class Observed:
     sim_events : sequence of ContactEvent
         Ground-truth events of the simulated world.
     world_end : dict or None
-        ``{"termination", "depth", "stamp_ns"}`` once the world ended, else None.
+        ``{"termination", "depth", "stamp_ns"}`` once the world ended, else None (None again
+        after a release).
     monitor_events : sequence of ContactEvent
         The monitor's events, from the sensors.
     alarms : Counter
         Alarm counts by type; ``first_alarm`` the first alarm of each type.
+    world_releases : sequence of dict
+        ``{"stamp_ns", "after"}`` of every release of the object by an ended world (after: the
+        ``world_end`` it follows).
     """
 
     state: SimState
@@ -44,6 +48,7 @@ class Observed:
     monitor_events: Sequence[ContactEvent]
     alarms: Counter
     first_alarm: Mapping[str, dict]
+    world_releases: Sequence[Mapping[str, Any]] = ()
 
 
 def event_list(events: Sequence[ContactEvent]) -> list[dict]:
@@ -89,6 +94,10 @@ def run_summary(*, scene: str, mode: str, plan: Plan, observed: Observed,
         "sim_time": float(result.duration),
         "hold_ticks": int(result.hold_ticks),
         "redirected": bool(result.redirected),
+        "attempts": int(result.attempts),
+        "resqueezed": bool(result.resqueezed),
+        "planned_depth": float(result.planned_depth),
+        "world_releases": list(observed.world_releases),
         "events": event_list(gt_events),
         "event_counts": {t: sum(1 for e in gt_events if e.type == t) for t in EventType.values()},
         "world_end": observed.world_end,

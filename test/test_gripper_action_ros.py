@@ -163,6 +163,58 @@ def test_the_jaws_slip_under_an_action_controller_the_alarm_cancels_the_goal(kin
     assert 1.99e-3 < result.depth < 0.5 * 5.3033e-3
 
 
+@pytest.mark.parametrize("kind", ["parallel_gripper", "gripper_action"])
+def test_the_jaws_slip_under_an_action_controller_and_are_squeezed_again(kind, tmp_path):
+    """The slip scene through a gripper action controller with ``on_slip_alarm: resqueeze``:
+    three gripper goals (the squeeze, canceled at the alarm; the release to first contact + 2 x
+    2 mm, succeeded; the re-squeeze, succeeded at 0.75 of the alarm's depth), the world
+    releases the object once, and the grasp is held: the mechanics API's squeeze to that
+    depth, as on the JointTrajectory route (test_resqueeze.py).
+    """
+    from action_msgs.msg import GoalStatus, GoalStatusArray
+
+    from squeeze_grasp_ros.ros.run.options import RunOptions
+    from squeeze_grasp_ros.ros.run.runner import PipelineRunner
+
+    data = yaml.safe_load((SPONGE.parent / "sponge_gripper_slip.yaml").read_text())
+    data["controller"] = {"type": kind, "name": "gripper_controller", "device": "generic_85mm",
+                          **TIGHT}
+    data["name"] = f"slip_{kind}"
+    path = write_scene(tmp_path, data)
+    runner = PipelineRunner(RunOptions(path, planner=False, on_slip_alarm="resqueeze"))
+    statuses: dict = {}
+
+    def status(msg: GoalStatusArray) -> None:
+        for s in msg.status_list:
+            statuses.setdefault(bytes(s.goal_info.goal_id.uuid), []).append(s.status)
+
+    runner.client.create_subscription(GoalStatusArray,
+                                      "gripper_controller/gripper_cmd/_action/status", status,
+                                      pipeline.loop_qos(1000))
+    try:
+        runner.start()
+        runner.send_goal()
+        result = runner.wait_result()
+        releases = list(runner.observer.world_releases)
+        state = runner.observer.sim_states[-1]
+    finally:
+        runner.shutdown()
+    ends = [seen[-1] for seen in statuses.values()]
+    print(f"{kind}: {result.termination} after {result.ticks} ticks, {result.attempts} squeezes "
+          f"to {result.planned_depth * 1e3:.4f} mm; gripper goals end {ends}")
+    assert result.termination == "depth_reached" and result.success
+    assert result.attempts == 2 and result.resqueezed and len(releases) == 1
+    assert ends == [GoalStatus.STATUS_CANCELED, GoalStatus.STATUS_SUCCEEDED,
+                    GoalStatus.STATUS_SUCCEEDED]
+    assert state.termination == "" and state.contacts.depth == pytest.approx(
+        result.planned_depth, rel=1e-9)
+    direct = GraspSetup.build(load_scene(path)).event_squeeze(depth=state.contacts.depth)
+    for k, name in enumerate(("F1", "F2")):
+        got = np.array([state.forces[k].x, state.forces[k].y])
+        want = direct.state.finger_force(name)
+        assert np.linalg.norm(got - want) <= 1e-3 * np.linalg.norm(want)
+
+
 # --------------------------------------------------------------------------- hostile client
 def wait(executor, condition, seconds=10.0):
     deadline = time.monotonic() + seconds

@@ -480,7 +480,7 @@ class GraspProgram:
         self.planned_depth = (1.0 - goal.resqueeze_margin) * (obs.depth - self.depth_offset)
         self.commanded = {f: np.asarray(obs.positions[f], float) for f in self.fingers}
         start = np.array([self.commanded[f] for f in goal.fingers])
-        self.path = straight_path(start, self._release_positions() - start, 1.0)
+        self.path = straight_path(start, self.release_positions() - start, 1.0)
         self.s, self.v = 0.0, 0.0
         self.phase, self.armed, self.freed, self.release_wait = "release", set(), set(), 0.0
         self._advance(dt)
@@ -488,8 +488,10 @@ class GraspProgram:
                        f"imminent slip at depth {(obs.depth - self.depth_offset) * 1e3:.4g} mm: "
                        f"releasing to squeeze again to {self.planned_depth * 1e3:.4g} mm")
 
-    def _release_positions(self) -> np.ndarray:
-        """(f, 2) first-contact positions moved back by ``release_clearance`` (see the module)."""
+    def release_positions(self) -> np.ndarray:
+        """(f, 2) first-contact positions moved back by ``release_clearance`` (see the module),
+        m, in the order of the goal's fingers.
+        """
         directions = np.asarray(self.goal.directions, float)
         gain = float(np.linalg.norm(directions, axis=1).max())
         return self.first_contact - (self.goal.release_clearance / gain) * directions

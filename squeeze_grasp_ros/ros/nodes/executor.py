@@ -46,7 +46,6 @@ from rclpy.task import Future
 from squeeze_grasp_interfaces.action import ExecuteGrasp
 from squeeze_grasp_interfaces.msg import ExecutorStatus, MonitorStatus
 from squeeze_grasp_ros.control.motion import (
-    RESQUEEZE,
     Command,
     GraspProgram,
     MotionLimits,
@@ -98,6 +97,8 @@ class _Goal:
         self.since_feedback: list = []
         self.start_ns: int | None = None
         self.waiting_since_ns: int | None = None
+        self.releasing = False
+        """The action route's gripper goal is a release's (its result is not the goal's)."""
 
 
 class ExecutorNode(Node):
@@ -179,9 +180,6 @@ class ExecutorNode(Node):
         problem = goal_problem(goal, list(self.devices))
         if problem is None and self.jaws is not None:
             problem = self.jaws.effort_problem(goal)
-        if problem is None and self.jaw_action is not None and goal.on_slip_alarm == RESQUEEZE:
-            problem = ("on_slip_alarm 'resqueeze' is not built for a gripper action controller "
-                       "(one gripper goal per grasp goal); use the joint_trajectory route")
         if problem is not None:
             handle.abort()
             return messages.invalid_goal_result(problem)
@@ -280,16 +278,34 @@ class ExecutorNode(Node):
             if self.answered.stamp_ns == ns:
                 self.answered.answer(ns, batch)
 
-        end = None
+        end, program = None, goal.program
         if command.termination not in (None, ExecuteGrasp.Result.DEPTH_REACHED):
             end = (command.termination, command.termination in SUCCESS, command.message)
             waiting = action.cancel(answer)
-        elif goal.program.ticks == 1:
-            position, effort = action.target(goal.program.goal, obs)
+        elif program.ticks == 1:
+            position, effort = action.target(program.goal, obs)
+            action.send(position, effort, answer)
+            waiting = True
+        elif command.state == ExecutorStatus.RELEASING and not goal.releasing:
+            goal.releasing = True
+            opening = action.opening(dict(zip(program.goal.fingers,
+                                              program.release_positions())))
+
+            def release() -> None:
+                action.send(opening, 0.0, answer)
+
+            if not action.cancel(release):
+                release()
+            waiting = True
+        elif goal.releasing and command.state == ExecutorStatus.SQUEEZING:
+            goal.releasing = False
+            position, effort = action.squeeze(
+                program.goal, dict(zip(program.goal.fingers, program.first_contact)),
+                program.planned_depth)
             action.send(position, effort, answer)
             waiting = True
         else:
-            end, waiting = action.outcome, False
+            end, waiting = (None if goal.releasing else action.outcome), False
         if not waiting:
             answer()
         termination = None if end is None else end[0]

@@ -25,12 +25,18 @@ The grasp goal then ends on the gripper goal's result: ``reached_goal`` -> depth
 jaw, a lost contact or a pick-up cancels the gripper goal (the controller holds the measured
 position) and ends the grasp goal as on the setpoint route.
 
+A re-squeeze (``on_slip_alarm: resqueeze``, docs/grippers.md) is three gripper goals: the
+first squeeze's, canceled at the slip alarm; one to the release aperture (effort 0: the
+controller's own limit) whose result is not the grasp goal's; and, once the jaws are there and
+the monitor reported them free, one to the re-squeeze's aperture and effort, whose result ends
+the grasp goal.
+
 In lockstep the executor answers each tick on ``executor/cycle`` once its request of that tick
 (goal or cancel) has been answered, so the simulated controller has it before the step.
 """
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from typing import Any
 
 import numpy as np
@@ -101,19 +107,29 @@ class JawAction:
         """(joint position, joint effort limit) of grasp goal ``goal`` from its first
         observation (fixes the jaw line).
         """
-        first, second = self.fingers
         self.line = self.controller.jaw_line(obs.positions)
-        end = {f: np.asarray(obs.positions[f], float) + goal.depth * np.asarray(d, float)
+        return self.squeeze(goal, obs.positions, goal.depth)
+
+    def squeeze(self, goal: GraspGoal, start: Mapping[str, np.ndarray],
+                depth: float) -> tuple[float, float]:
+        """(joint position, joint effort limit) of a squeeze of ``goal``'s fingers from
+        ``start`` (m) to ``depth`` (m) along its directions, on the fixed jaw line.
+        """
+        end = {f: np.asarray(start[f], float) + depth * np.asarray(d, float)
                for f, d in zip(goal.fingers, goal.directions)}
-        aperture = self.line.aperture(end.get(first, obs.positions[first]),
-                                      end.get(second, obs.positions[second]))
-        position = self.controller.joint_positions(aperture)[0]
+        position = self.opening({f: end.get(f, start[f]) for f in self.fingers})
         effort = 0.0
-        force = self.plan.at(goal.depth)
+        force = self.plan.at(depth)
         if force is not None:
             effort = min(abs(self.controller.joint_efforts(force)[0])
                          * self.controller.spec.effort_margin, self.controller.effort_limit)
         return position, effort
+
+    def opening(self, tips: Mapping[str, np.ndarray]) -> float:
+        """The joint position putting the jaws' tips at ``tips`` (m) on the fixed jaw line."""
+        first, second = self.fingers
+        return float(self.controller.joint_positions(self.line.aperture(tips[first],
+                                                                        tips[second]))[0])
 
     def send(self, position: float, effort: float, on_answer: Callable[[], None]) -> None:
         """Send the goal; ``on_answer`` once the controller accepted or rejected it."""

@@ -9,7 +9,8 @@ A goal (a squeeze, then optionally a resistance) becomes a
 (``devices/<device>/setpoint``: fingertip centre in the object frame ``frame_id``; the object
 frame's pose in ``base_frame`` is the ``object_pose`` parameter, published latched on
 ``object_pose`` for the drivers), with the velocity and acceleration limits, the holds on stale
-data and slip alarms, and the reactive redirection of the program.
+data and slip alarms, and the program's reactions (a redirection, or a release and a re-squeeze
+after a slip alarm, :mod:`..control.motion`).
 
 - Lockstep (simulation): a cycle runs when the status of tick t arrives; the setpoints are
   stamped t + ``period``. While no goal runs the executor does not answer, so simulated time
@@ -25,7 +26,8 @@ JointTrajectory`` on ``<controller>/joint_trajectory``, one point per control cy
 (:mod:`.jaw_commands`; a goal whose planned jaw force is beyond the device's ``max_force`` is
 refused ``invalid_goal``); or, under a gripper action controller, the planned aperture and effort
 are one ``control_msgs`` GripperCommand / ParallelGripperCommand goal on
-``<controller>/gripper_cmd`` whose result ends the grasp goal (:mod:`.jaw_action`). The other
+``<controller>/gripper_cmd`` whose result ends the grasp goal (:mod:`.jaw_action`; a re-squeeze
+adds a release goal and a second squeeze's goal). The other
 fingers keep their setpoint topics.
 
 Feedback (every ``feedback_every`` cycles): state, measured depth and forces, events since the

@@ -15,9 +15,9 @@ import sys
 import tempfile
 from pathlib import Path
 
-from squeeze_grasp_ros.commands.common import add_scene_argument, fail, new_folder
+from squeeze_grasp_ros.commands.common import add_scene_argument, fail, int_in, new_folder
 from squeeze_grasp_ros.control.force_watch import FORCE_MISMATCH
-from squeeze_grasp_ros.control.motion import REACTIONS
+from squeeze_grasp_ros.control.motion import DEFAULT_ATTEMPTS, DEFAULT_MARGIN, REACTIONS
 from squeeze_grasp_ros.exit_codes import ExitCode, raise_on_signals
 
 EXECUTOR_CHOICES: tuple[str, ...] = ("events", "single")
@@ -25,8 +25,20 @@ EXECUTOR_CHOICES: tuple[str, ...] = ("events", "single")
 parser never imports rclpy: ``squeeze-grasp ros-setup`` must run before the interfaces exist)."""
 
 
+def _margin(text: str) -> float:
+    """Argparse type of ``--resqueeze-margin``: a fraction in (0, 1)."""
+    try:
+        value = float(text)
+    except ValueError:
+        value = float("nan")
+    if not 0.0 < value < 1.0:
+        raise argparse.ArgumentTypeError(f"must be a fraction in (0, 1), got {text[:40]!r}")
+    return value
+
+
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    """SCENE, --record DIR, --processes, --executor, --on-slip-alarm, --world, --no-resist,
+    """SCENE, --record DIR, --processes, --executor, --on-slip-alarm (--max-attempts,
+    --resqueeze-margin), --world, --no-resist,
     --no-planner.
     """
     add_scene_argument(parser)
@@ -53,8 +65,15 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="executor reaction to an imminent-slip alarm: hold (default), "
                              "change the squeeze direction once to the pure squeeze or along the "
                              "measured contact normals, or resqueeze: open past first contact "
-                             "and squeeze again, 25 %% short of the alarm's depth "
-                             "(docs/grippers.md)")
+                             "and squeeze again short of the alarm's depth (docs/grippers.md)")
+    parser.add_argument("--max-attempts", type=int_in(1, 100), default=DEFAULT_ATTEMPTS,
+                        metavar="N", help="with --on-slip-alarm resqueeze: squeezes in all, the "
+                                          f"first included (default {DEFAULT_ATTEMPTS})")
+    parser.add_argument("--resqueeze-margin", type=_margin, default=DEFAULT_MARGIN,
+                        metavar="FRACTION",
+                        help="with --on-slip-alarm resqueeze: a re-squeeze goes to (1 - FRACTION) "
+                             f"x the alarm's measured depth, FRACTION in (0, 1) (default "
+                             f"{DEFAULT_MARGIN})")
     parser.add_argument("--world", metavar="SCENE",
                         help="scene YAML of the simulated world (default: SCENE itself): a "
                              "world the planner does not know, e.g. another E or outline, to "
@@ -133,6 +152,7 @@ def _run(args: argparse.Namespace) -> dict | int:
                          include_hidden_topics=args.include_hidden_topics, attach=args.attach,
                          processes=args.processes,
                          executor=args.executor, on_slip_alarm=args.on_slip_alarm,
+                         max_attempts=args.max_attempts, resqueeze_margin=args.resqueeze_margin,
                          resist=not args.no_resist, planner=not args.no_planner,
                          timeout=args.timeout, namespace=args.namespace)
     show = not (args.quiet or args.json) and sys.stderr.isatty()

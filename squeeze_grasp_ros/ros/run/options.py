@@ -16,6 +16,7 @@ from typing import Any
 
 import yaml
 
+from squeeze_grasp_ros.control.motion import DEFAULT_ATTEMPTS, DEFAULT_MARGIN
 from squeeze_grasp_ros.mechanics.vocabulary import ControllerKind, Effect
 from squeeze_grasp_ros.resources import config_dir
 from squeeze_grasp_ros.ros.nodes import pipeline
@@ -62,6 +63,10 @@ class RunOptions:
         rclpy executor of the one-process mode.
     on_slip_alarm : {"hold", "pure", "normals", "resqueeze"}
         The executor's reaction to an imminent-slip alarm.
+    max_attempts : int
+        With "resqueeze": squeezes in all, the first included.
+    resqueeze_margin : float
+        With "resqueeze": a re-squeeze's depth is (1 - margin) x the alarm's, margin in (0, 1).
     resist : bool
         Run the resistance phase when the scene has a frictional adversary.
     planner : bool
@@ -82,6 +87,8 @@ class RunOptions:
     processes: bool = False
     executor: str = "events"
     on_slip_alarm: str = "hold"
+    max_attempts: int = DEFAULT_ATTEMPTS
+    resqueeze_margin: float = DEFAULT_MARGIN
     resist: bool = True
     planner: bool = True
     overrides: Mapping[str, Mapping[str, Any]] = field(default_factory=dict)

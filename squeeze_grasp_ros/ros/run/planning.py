@@ -14,6 +14,7 @@ The resistance waypoints of a scene with a frictional adversary come from Algori
 """
 from __future__ import annotations
 
+import dataclasses
 import json
 import math
 import threading
@@ -224,7 +225,7 @@ def plan_with_planner(planner: PlannerClient, run_object: RunObject, scene_path:
     resistance = _resistance(run_object, options)
     goal = GraspGoal(SQUEEZING_FINGERS, directions, squeeze.target_depth, rpd,
                      options.on_slip_alarm, np.asarray(pure.displacement, float).reshape(2, 2),
-                     **resistance)
+                     options.max_attempts, options.resqueeze_margin, **resistance)
     prediction = messages.prediction_msg(
         list(squeeze.events), squeeze.termination, squeeze.depth,
         messages.force_curve(squeeze.curve_depths, squeeze.curve_force_f1,
@@ -251,6 +252,8 @@ def plan_with_mechanics(run_object: RunObject, options: RunOptions) -> Plan:
     prediction = messages.prediction_msg(
         [messages.contact_event_msg(e) for e in squeeze.events], squeeze.termination,
         squeeze.depth, squeeze_forces(squeeze))
-    return Plan(plan.goal, prediction, "mechanics", plan.seconds)
+    goal = dataclasses.replace(plan.goal, max_attempts=options.max_attempts,
+                               resqueeze_margin=options.resqueeze_margin)
+    return Plan(goal, prediction, "mechanics", plan.seconds)
 
 

@@ -153,7 +153,7 @@ def locate_sign_change(
     """
     evaluations, retained, width = 0, 0, b - a
     ra, rb = slopes if slopes is not None else (0.0, 0.0)
-    sure = slopes is not None and skip_sure
+    sure = slopes is not None and skip_sure and b - a > tol
     curvature = hermite_curvature(a, b, ga, gb, ra, rb) if sure else 0.0
     while b - a > tol:
         if evaluations >= MAX_ROOT_ITERATIONS:

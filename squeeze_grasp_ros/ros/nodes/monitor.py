@@ -27,7 +27,8 @@ Joint feedback (``controller_scene``: a scene whose ``controller:`` section maps
 parallel gripper, and no ``wrench`` or ``tactile`` stream): the jaws' only sensor is the
 controller's ``joint_states`` (``sensor_msgs/JointState``, listed in each tick's readings). The
 aperture and jaw force come through the transmission (:mod:`..control.joint_feedback`): the
-jaws' positions on the jaw line (fixed by their first pose readings, the gripper's pose) give
+jaws' positions on the jaw line (fixed by the gripper's pose: the ``gripper_pose`` parameter, else
+the ``gripper_pose`` topic, else the jaws' first pose readings) give
 the depth, the force ``wrench`` stands in for, first touch, ``contact_lost`` and the slip watch's
 ``slip_imminent`` (the jaws close while the force stops rising); events A-D need taxels, so
 none are tracked and the prediction's events are not compared (the force watch is).
@@ -46,6 +47,7 @@ from typing import Any
 import numpy as np
 from geometry_msgs.msg import PoseStamped, WrenchStamped
 from rclpy.node import Node
+from rclpy.parameter import Parameter
 from sensor_msgs.msg import JointState
 
 from squeeze_grasp_interfaces.msg import (
@@ -60,7 +62,7 @@ from squeeze_grasp_ros.control.joint_feedback import JointSlipWatch
 from squeeze_grasp_ros.control.joint_trajectory import JawLine
 from squeeze_grasp_ros.control.tracker import ContactTracker, FingerSample, TrackerConfig
 from squeeze_grasp_ros.ros import messages
-from squeeze_grasp_ros.ros.nodes import pipeline, run_node
+from squeeze_grasp_ros.ros.nodes import ParameterError, pipeline, run_node
 from squeeze_grasp_ros.ros.nodes.force_watcher import ForceWatcher
 from squeeze_grasp_ros.ros.nodes.shape_watcher import ShapeWatcher
 from squeeze_grasp_ros.ros.nodes.sim_controllers import JOINT_STATES
@@ -102,6 +104,10 @@ PARAMETERS: dict[str, tuple[Any, str]] = {
                                 "measured, m"),
     "joint_slip_ratio": (0.5, "joint feedback: tangent / secant jaw stiffness below which "
                               "slip_imminent is raised"),
+    "gripper_pose": (Parameter.Type.DOUBLE_ARRAY,
+                     "joint feedback: the gripper's centre and closing direction in the object "
+                     "frame, [x m, y m, yaw deg], fixing the jaw line (else the gripper_pose "
+                     "topic, else the jaws' pose readings)"),
 }
 """Parameter name -> (typed default, description); config/monitor.yaml sets them."""
 POSE_JOINT_TOLERANCE = 1e-5
@@ -160,6 +166,11 @@ class MonitorNode(Node):
                     msg_type, pipeline.device_topic(device, stream),
                     lambda data, k=key, read=READINGS[stream]: self._reading(k, *read(data)),
                     sensors, raw=True)
+        if self.jaws is not None:
+            self.create_subscription(PoseStamped, pipeline.GRIPPER_POSE,
+                                     lambda msg: self.jaws.set_pose(msg, p["frame_id"],
+                                                                    self.get_logger()),
+                                     pipeline.LATCHED)
         if self.jaws is not None or self.hand is not None:
             self.keys[JOINT_STATES] = ("", JOINT_STATES)
             self.create_subscription(
@@ -198,7 +209,7 @@ class MonitorNode(Node):
         """What the ready line of ``ros2 run`` says: fingers, streams, friction, clock."""
         clock = "lockstep" if self.p["lockstep"] else f"rate {self.p['rate']} Hz"
         streams = [s for s in self.p["streams"] if s] if self.jaws is None else [
-            f"{JOINT_STATES} of {self.jaws.controller.spec.name}"]
+            f"{JOINT_STATES} of {self.jaws.controller.spec.name} ({self.jaws.source()})"]
         if self.hand is not None:
             streams.append(f"{JOINT_STATES} of {self.hand.controller.spec.name} (positions)")
         return f"fingers {self.fingers}, streams {streams}, mu {self.p['mu']}, {clock}"
@@ -338,8 +349,13 @@ class JointFeedback:
     watch : JointSlipWatch
     """
 
-    def __init__(self, controller: JawController, watch: JointSlipWatch) -> None:
+    def __init__(self, controller: JawController, watch: JointSlipWatch, *,
+                 pose: tuple[np.ndarray, float] | None = None) -> None:
         self.controller, self.watch = controller, watch
+        self.posed: JawLine | None = None
+        """The jaw line of the gripper's pose (parameter or topic; None: the jaws' poses)."""
+        if pose is not None:
+            self.posed = JawLine.at_pose(*pose, reach=controller.gripper.pad.contact_radius)
         self.line: JawLine | None = None
         self.stamp_ns: int | None = None
         self.alarms: tuple = ()
@@ -353,11 +369,38 @@ class JointFeedback:
         if not p["controller_scene"] or {"wrench", "tactile"} & set(streams):
             return None
         controller = scene_controller(load_scene(p["controller_scene"]), p["controller_scene"])
-        if controller is None:
+        if not isinstance(controller, JawController):
             return None
+        pose = p.get("gripper_pose")
+        if pose is not None:
+            if len(pose) != 3 or not np.all(np.isfinite(pose)):
+                raise ParameterError(f"gripper_pose must be [x m, y m, yaw deg], three finite "
+                                     f"numbers, got {list(pose)}")
+            pose = (np.array(pose[:2], float), float(np.deg2rad(pose[2])))
         return cls(controller, JointSlipWatch(
             controller.jaws, contact_force=p["load_threshold"], window=p["joint_slip_window"],
-            ratio=p["joint_slip_ratio"]))
+            ratio=p["joint_slip_ratio"]), pose=pose)
+
+    def set_pose(self, msg: PoseStamped, frame_id: str, logger: Any) -> None:
+        """Take the gripper's pose from a ``gripper_pose`` message (it replaces the parameter);
+        a pose in another frame, not finite or tilted out of the plane is ignored with a
+        warning.
+        """
+        try:
+            centre, yaw = messages.gripper_line_pose(msg, frame_id)
+        except ValueError as exc:
+            logger.warning(f"ignored the {pipeline.GRIPPER_POSE} message: {exc}")
+            return
+        self.posed = JawLine.at_pose(centre, yaw,
+                                     reach=self.controller.gripper.pad.contact_radius)
+
+    def source(self) -> str:
+        """Where the jaw line comes from (the ready line)."""
+        if self.posed is not None:
+            c, d = self.posed.centre, self.posed.direction
+            return (f"jaw line at ({c[0]:.6g}, {c[1]:.6g}) m, yaw "
+                    f"{np.rad2deg(np.arctan2(d[1], d[0])):.6g} deg")
+        return f"jaw line from {pipeline.GRIPPER_POSE} or the jaws' poses"
 
     def replace(self, fields: dict[str, dict[str, Any]], msg: JointState | None,
                 logger: Any) -> None:
@@ -365,9 +408,13 @@ class JointFeedback:
         ``fields`` (finger -> FingerSample keywords); run the slip watch on a new state.
         """
         first, second = self.controller.jaws
+        if msg is None:
+            return
+        if self.posed is not None:
+            self.line = self.posed
         fixed = self.line is None
         if fixed:
-            if msg is None or any("position" not in fields[j] for j in (first, second)):
+            if any("position" not in fields[j] for j in (first, second)):
                 return
             self.line = self.controller.jaw_line({j: fields[j]["position"]
                                                   for j in (first, second)})

@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 import yaml
 from mcap.reader import make_reader
-from pipeline_support import run_observed, write_scene
+from pipeline_support import LogLines, run_observed, write_scene
 from scipy.optimize import brentq
 from sensor_msgs.msg import JointState
 from trajectory_msgs.msg import JointTrajectory
@@ -359,17 +359,14 @@ def test_the_monitor_reads_the_hand_efforts_and_refuses_a_singular_posture(tmp_p
     joints = dict(zip(JOINTS, (0.9, 1.2, 0.4, 0.9, 1.1, 1.1 / 3, 0.0, 0.0)))
     pushes = {BarrettFinger.F1: np.array([2.0, 0.5]), BarrettFinger.F2: np.array([-2.0, -0.5])}
     tau = hand.efforts(joints, pushes)
-    warnings = []
-
-    class Log:
-        warning = warnings.append
-        info = warnings.append
+    log = LogLines()
+    warnings = log.lines
 
     def state(sec, positions, efforts):
         msg = JointState(name=list(JOINTS), position=list(positions), effort=list(efforts))
         msg.header.stamp = Time(sec=sec)
         fields = {"F1": {}, "F2": {}}
-        feedback.replace(fields, msg, Log())
+        feedback.replace(fields, msg, log)
         return fields
 
     fields = state(1, joints.values(), [tau[j] for j in JOINTS])
@@ -385,3 +382,43 @@ def test_the_monitor_reads_the_hand_efforts_and_refuses_a_singular_posture(tmp_p
     for sec in (3, 4):
         assert state(sec, singular.values(), [tau[j] for j in JOINTS]) == {"F1": {}, "F2": {}}
     assert len(warnings) == 3 and "barrett_f1: its joint efforts do not determine" in warnings[2]
+
+
+def test_the_hand_slip_watch_on_efforts_fires_when_the_force_stops_rising(tmp_path):
+    """Fingers 1 and 2 close on a spring along the line between them (the foam square's
+    placement); the efforts are the statics of the spring's force. While it rises no alarm;
+    once it stops rising (a slip) the slip watch raises ``slip_imminent`` for both fingers
+    within a window of closing.
+    """
+    from builtin_interfaces.msg import Time
+
+    from squeeze_grasp_ros.ros.nodes.monitor import HandFeedback
+
+    path = write_scene(tmp_path, scene_data(effects=["friction"]))
+    feedback = HandFeedback.of({"controller_scene": path, "load_threshold": 0.002,
+                                "joint_slip_window": 1e-4, "joint_slip_ratio": 0.5}, [""])
+    hand = feedback.controller.hand
+    log = LogLines()
+    alarms = []
+    for k in range(200):
+        closing = 2e-5 * k                  # of the tip distance: each tip moves 10 um a tick
+        tips = {BarrettFinger.F1: np.array([-0.07 + closing / 2, 0.0]),
+                BarrettFinger.F2: np.array([0.07 - closing / 2, 0.0])}
+        joints = hand.inverse(tips).joints
+        # touch at 0.1 mm of closing, a 500 N/m spring, the force flat at 1 N from 2.1 mm on
+        force = 500.0 * min(max(closing - 1e-4, 0.0), 2e-3)
+        tau = hand.efforts(joints, {BarrettFinger.F1: np.array([force, 0.0]),
+                                    BarrettFinger.F2: np.array([-force, 0.0])})
+        msg = JointState(name=list(JOINTS), position=[joints[j] for j in JOINTS],
+                         effort=[tau[j] for j in JOINTS])
+        msg.header.stamp = Time(nanosec=10**6 * k)
+        feedback.replace({"F1": {}, "F2": {}}, msg, log)
+        alarms.append((closing, [(a.type, a.finger) for a in feedback.alarms]))
+    plateau = 2.1e-3
+    assert not [a for c, a in alarms if c <= plateau and a]
+    late = [a for c, a in alarms if c > plateau + 1e-4 + 1e-9]
+    assert late and all(a == [("slip_imminent", "F1"), ("slip_imminent", "F2")] for a in late)
+    # first touch: the tip distance of the last reading without force, 0.14 m less 0.1 mm
+    assert 0.14 - 1.2e-4 <= feedback.watch.first_touch <= 0.14 - 1e-4
+    assert log.lines == [f"first touch of the hand's fingers at tip distance "
+                         f"{feedback.watch.first_touch * 1e3:.4f} mm (force 0.01 N)"]

@@ -36,7 +36,9 @@ none are tracked and the prediction's events are not compared (the force watch i
 The Barrett hand under a JointTrajectoryController (``controller: {device: bh8, ...}``): the
 carried fingers' positions come from ``joint_states`` through the hand's forward kinematics
 (:mod:`..control.barrett`) in place of their pose readings; their force and tactile sensors
-are read as on the setpoint route.
+are read as on the setpoint route, or, without them, their forces come from the joint efforts
+(J^T F = tau per finger; a posture where that is ill-conditioned is refused) with the slip
+watch on fingers 1 and 2 as on a gripper's jaws.
 """
 from __future__ import annotations
 

@@ -458,6 +458,7 @@ class JointFeedback:
             return
         self.posed = JawLine.at_pose(centre, yaw,
                                      reach=self.controller.gripper.pad.contact_radius)
+        logger.info(f"{pipeline.GRIPPER_POSE}: {self.source()}")
 
     def source(self) -> str:
         """Where the jaw line comes from (the ready line)."""

@@ -28,7 +28,7 @@ from squeeze_grasp_ros.control.barrett import (
     HandPose,
     SingularPosture,
 )
-from squeeze_grasp_ros.ros.nodes import pipeline
+from squeeze_grasp_ros.ros.nodes import ParameterError, pipeline
 from squeeze_grasp_ros.ros.recording.replay import replay
 from squeeze_grasp_ros.scene import SceneError, load_scene, parse_scene
 from squeeze_grasp_ros.scene.controller import HandController, scene_controller
@@ -287,7 +287,6 @@ def test_a_palm_out_of_reach_of_the_placements_is_one_error_line(tmp_path):
     """The palm 0.5 m from the square: the simulated hardware refuses to start, naming the
     palm, the finger, its target and its reach.
     """
-    from squeeze_grasp_ros.ros.nodes import ParameterError
     from squeeze_grasp_ros.ros.nodes.sim_hardware import SimHardwareNode
 
     data = scene_data()
@@ -356,6 +355,8 @@ def test_the_monitor_reads_the_hand_efforts_and_refuses_a_singular_posture(tmp_p
     feedback = HandFeedback.of({"controller_scene": path, "load_threshold": 0.002,
                                 "joint_slip_window": 1e-4, "joint_slip_ratio": 0.5}, [""])
     hand = feedback.controller.hand
+    with pytest.raises(ParameterError, match="hand_max_condition must be >= 1"):
+        HandFeedback.of({"controller_scene": path, "hand_max_condition": 0.5}, [""])
     joints = dict(zip(JOINTS, (0.9, 1.2, 0.4, 0.9, 1.1, 1.1 / 3, 0.0, 0.0)))
     pushes = {BarrettFinger.F1: np.array([2.0, 0.5]), BarrettFinger.F2: np.array([-2.0, -0.5])}
     tau = hand.efforts(joints, pushes)

@@ -342,10 +342,14 @@ class HandFeedback:
         controller = scene_controller(load_scene(p["controller_scene"]), p["controller_scene"])
         if not isinstance(controller, HandController):
             return None
+        max_condition = p.get("hand_max_condition", MAX_CONDITION)
+        if not max_condition >= 1.0:
+            raise ParameterError(f"hand_max_condition must be >= 1 (a condition number), got "
+                                 f"{max_condition}")
         watch = None if {"wrench", "tactile"} & set(streams) else JointSlipWatch(
             controller.jaws, contact_force=p["load_threshold"], window=p["joint_slip_window"],
             ratio=p["joint_slip_ratio"])
-        return cls(controller, watch, max_condition=p.get("hand_max_condition", MAX_CONDITION))
+        return cls(controller, watch, max_condition=max_condition)
 
     def replace(self, fields: dict[str, dict[str, Any]], msg: JointState | None,
                 logger: Any) -> None:

@@ -225,6 +225,19 @@ def test_a_singular_posture_is_refused_with_a_clear_error():
         hand.tip_force(BarrettFinger.F3, joints, tau)
 
 
+def test_efforts_out_of_the_models_proportions_show_in_the_residual():
+    # a driver that copies one strain-gauge torque into a finger's proximal and distal efforts
+    # and reports no spread torque (RobotnikAutomation's bhand_controller): the least squares
+    # cannot fit both joints, and the residual says so; the model's own efforts leave none
+    hand = BarrettHand()
+    joints = dict(zip(JOINTS, (0.9, 1.1, 1.1 / 3, 0.9, 1.1, 1.1 / 3, 0.0, 0.0)))
+    tau = hand.efforts(joints, {BarrettFinger.F1: np.array([1.0, -0.5])})
+    assert hand.tip_force(BarrettFinger.F1, joints, tau).residual < 1e-15
+    driver = {**tau, "bh_j11_joint": 0.0, "bh_j12_joint": tau["bh_j13_joint"]}
+    assert hand.tip_force(BarrettFinger.F1, joints, driver).residual > 0.1 * abs(
+        tau["bh_j13_joint"])
+
+
 def test_the_shipped_scene_maps_fingers_1_and_2():
     controller = scene_controller(load_scene(SCENE), SCENE)
     assert isinstance(controller, HandController)

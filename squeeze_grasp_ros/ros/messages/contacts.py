@@ -142,7 +142,7 @@ class TactileReadings:
     tangential: np.ndarray
 
 
-def _check_taxels(finger: str, *arrays: Sequence[float]) -> None:
+def check_taxels(finger: str, *arrays: Sequence[float]) -> None:
     """Raise ValueError unless the tactile arrays of ``finger`` have one entry per taxel."""
     sizes = {len(a) for a in arrays}
     if len(sizes) != 1:
@@ -157,7 +157,7 @@ def tactile_array_msg(readings: TactileReadings, header: Header | None = None) -
     ValueError
         If the arrays differ in length.
     """
-    _check_taxels(readings.finger, readings.angles, readings.normal, readings.tangential)
+    check_taxels(readings.finger, readings.angles, readings.normal, readings.tangential)
     return TactileArray(
         header=header or Header(),
         finger=readings.finger,
@@ -178,7 +178,7 @@ def fill_tactile(
     ValueError
         If the force arrays do not have one entry per taxel.
     """
-    _check_taxels(msg.finger, msg.taxel_angles, normal, tangential)
+    check_taxels(msg.finger, msg.taxel_angles, normal, tangential)
     set_stamp(msg.header.stamp, ns)
     msg.normal_forces = float64_array(normal)
     msg.tangential_forces = float64_array(tangential)

@@ -78,10 +78,14 @@ def test_tactile_arrays_of_different_lengths_are_refused():
 
 @settings(max_examples=40, deadline=None)
 @given(STAMPS, st.integers(min_value=0, max_value=2**64 - 1), st.lists(NAMES, max_size=7))
-def test_clock_and_tick_are_rclpys(ns, index, readings):
+def test_clock_and_tick_are_rclpys_and_read_back(ns, index, readings):
+    """The tick's readings are read back from rclpy's serialisation and from the writer's."""
     _same(messages.clock_cdr(ns), Clock(clock=messages.stamp(ns)))
-    _same(messages.tick_cdr(index, ns, readings), Tick(header=messages.header(ns), index=index,
-                                                       readings=readings))
+    tick = Tick(header=messages.header(ns), index=index, readings=readings)
+    data = messages.tick_cdr(index, ns, readings)
+    _same(data, tick)
+    for serialised in (data, serialize_message(tick)):
+        assert messages.tick_readings_cdr(serialised) == (ns, readings)
 
 
 CONTACTS = st.lists(st.tuples(st.sampled_from(["F1", "F2", "A"]),

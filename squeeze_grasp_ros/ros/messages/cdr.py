@@ -31,8 +31,8 @@ import numpy as np
 
 from squeeze_grasp_ros.ros.messages.contacts import TactileReadings, check_taxels
 
-__all__ = ["CdrWriter", "cdr_stamp_ns", "clock_cdr", "pose_position_cdr",
-           "pose_stamped_cdr", "tactile_array_cdr", "tactile_readings_cdr", "tick_cdr",
+__all__ = ["CdrWriter", "cdr_stamp_ns", "clock_cdr", "pose_position_cdr", "pose_stamped_cdr",
+           "tactile_array_cdr", "tactile_readings_cdr", "tick_cdr", "tick_readings_cdr",
            "wrench_force_cdr", "wrench_stamped_cdr", "write_contact_arrays"]
 
 _BODY = 4
@@ -59,6 +59,12 @@ class _Reader:
         self.offset += 4
         return value
 
+    def uint64(self) -> int:
+        self._align(8)
+        (value,) = struct.unpack_from(self.order + "Q", self.data, self.offset)
+        self.offset += 8
+        return value
+
     def skip_string(self) -> None:
         size = self.uint32()
         self.offset += size
@@ -67,6 +73,10 @@ class _Reader:
         size = self.uint32()
         self.offset += size
         return bytes(self.data[self.offset - size:self.offset - 1]).decode()
+
+    def strings(self) -> list[str]:
+        """A ``string[]`` sequence."""
+        return [self.string() for _ in range(self.uint32())]
 
     def float64s(self, count: int) -> np.ndarray:
         """``count`` float64 values (a fixed-size run of fields or a sequence's elements; an
@@ -124,6 +134,17 @@ def tactile_readings_cdr(data: bytes) -> tuple[int, TactileReadings]:
     finger = reader.string()
     return stamp, TactileReadings(finger, reader.sequence(), reader.sequence(),
                                   reader.sequence())
+
+
+def tick_readings_cdr(data: bytes) -> tuple[int, list[str]]:
+    """(stamp ns, readings "<device>/<stream>") of a serialised
+    ``squeeze_grasp_interfaces/Tick``.
+    """
+    reader = _Reader(data)
+    stamp = reader.header()
+    reader.skip_string()
+    reader.uint64()  # the tick's index
+    return stamp, reader.strings()
 
 
 _ZEROS = tuple(bytes(n) for n in range(8))

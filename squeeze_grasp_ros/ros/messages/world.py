@@ -48,7 +48,7 @@ def fill_sim_state(
     msg: SimState, state: contact_state.ContactState, termination: str | None, ns: int
 ) -> SimState:
     """Refill a :func:`sim_state_msg` in place with a new state at sim time ``ns`` (its
-    fingers and frame stay): what the simulated hardware publishes every tick.
+    fingers and frame stay).
     """
     present = {f.name: f for f in state.fingers}
     work = []

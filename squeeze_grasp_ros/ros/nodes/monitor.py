@@ -183,7 +183,7 @@ class MonitorNode(Node):
         self.forces = (ForceWatcher(self, p["force_tolerance"], p["force_min_fraction"], loop)
                        if p["force_watch"] else None)
         if p["lockstep"]:
-            self.create_subscription(Tick, pipeline.TICK, self._tick, loop)
+            self.create_subscription(Tick, pipeline.TICK, self._tick, loop, raw=True)
             self.participant = pipeline.Participant(self, "monitor", [pipeline.TICK],
                                                     [self.status_pub])
         else:
@@ -218,11 +218,12 @@ class MonitorNode(Node):
         self.buffer.setdefault(ns, {})[key] = msg
         self._try_close(ns)
 
-    def _tick(self, msg: Tick) -> None:
-        ns = messages.stamp_ns(msg.header.stamp)
+    def _tick(self, data: bytes) -> None:
+        """A ``sim/tick``, read from its CDR bytes (:mod:`..messages.cdr`)."""
+        ns, readings = messages.tick_readings_cdr(data)
         if not self.answered.is_new(ns):
             return
-        self.expected[ns] = set(msg.readings) & self.keys.keys()
+        self.expected[ns] = set(readings) & self.keys.keys()
         self._try_close(ns)
 
     def _try_close(self, ns: int) -> None:

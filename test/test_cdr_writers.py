@@ -16,7 +16,7 @@ from hypothesis import strategies as st
 from rclpy.serialization import deserialize_message, serialize_message
 from rosgraph_msgs.msg import Clock
 
-from squeeze_grasp_interfaces.msg import ContactState, MonitorStatus, SimState, Tick
+from squeeze_grasp_interfaces.msg import ContactState, ForceResidual, MonitorStatus, SimState, Tick
 from squeeze_grasp_ros.control.tracker import Patch, TrackedAlarm, TrackedEvent, TrackerOutput
 from squeeze_grasp_ros.mechanics.vocabulary import ContactMode, EventType
 from squeeze_grasp_ros.ros import messages
@@ -134,6 +134,19 @@ def test_monitor_status_and_patches_are_rclpys(out, frame):
     _same(status, messages.monitor_status_msg(out, frame))
     assert isinstance(deserialize_message(status, MonitorStatus), MonitorStatus)
     _same(messages.patches_state_cdr(out, frame), messages.patches_state_msg(out, frame))
+
+
+@settings(max_examples=40, deadline=None)
+@given(STAMPS, NAMES, FINITE, st.lists(st.tuples(NAMES, FINITE, FINITE, FINITE), max_size=3),
+       FINITE)
+def test_force_residual_is_rclpys(ns, frame, depth, rows, tolerance):
+    fingers, measured, predicted, relative = (list(c) for c in zip(*rows)) if rows \
+        else ([], [], [], [])
+    _same(messages.force_residual_cdr(ns, frame, depth, fingers, measured, predicted, relative,
+                                      tolerance),
+          ForceResidual(header=messages.header(ns, frame), depth=depth, fingers=fingers,
+                        measured=measured, predicted=predicted, relative_error=relative,
+                        tolerance=tolerance))
 
 
 def test_the_worlds_ground_truth_is_rclpys_tick_by_tick():

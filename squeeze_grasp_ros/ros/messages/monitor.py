@@ -169,6 +169,22 @@ def monitor_status_cdr(out: TrackerOutput, frame_id: str) -> bytes:
     return writer.data()
 
 
+def force_residual_cdr(ns: int, frame_id: str, depth: float, fingers: Sequence[str],
+                       measured: Sequence[float], predicted: Sequence[float],
+                       relative_error: Sequence[float], tolerance: float) -> bytes:
+    """A ``squeeze_grasp_interfaces/ForceResidual`` (depth m, forces N, per finger in
+    ``fingers``' order), serialised (:mod:`.cdr`): the force watch's message of a tick.
+    """
+    writer = CdrWriter()
+    writer.header(ns, frame_id)
+    writer.float64(depth)
+    writer.strings(fingers)
+    for values in (measured, predicted, relative_error):
+        writer.sequence(values)
+    writer.float64(tolerance)
+    return writer.data()
+
+
 def prediction_msg(
     events: Sequence[ContactEvent], termination: str, depth: float,
     forces: PredictedForces | None = None,

@@ -17,7 +17,8 @@ from squeeze_grasp_ros.exit_codes import raise_on_signals
 from squeeze_grasp_ros.stdout import reserve_stdout
 from squeeze_grasp_ros.threads import single_thread_blas
 
-__all__ = ["cli", "executor", "monitor", "outline", "planner", "recorder", "sim_hardware"]
+__all__ = ["cli", "cli_process", "executor", "monitor", "outline", "planner", "recorder",
+           "sim_hardware"]
 
 
 def _run(module: str, name: str):
@@ -54,11 +55,16 @@ def _interruption(exc: BaseException) -> KeyboardInterrupt | None:
 
 
 def cli():
-    """``squeeze-grasp``; a verb that used ROS (``run``, ``replay``, ...) ends the process
-    as soon as it has finished (:func:`_end_after_ros`).
-    """
+    """``squeeze-grasp`` in this process: its exit code, returned to the caller."""
     reserve_stdout()
-    code = _run("squeeze_grasp_ros.cli", "squeeze-grasp")
+    return _run("squeeze_grasp_ros.cli", "squeeze-grasp")
+
+
+def cli_process():
+    """The ``squeeze-grasp`` console script: :func:`cli`, after which a verb that used ROS
+    (``run``, ``replay``, ...) ends the process at once (:func:`_end_after_ros`).
+    """
+    code = cli()
     if "rclpy" in sys.modules:
         _end_after_ros(code)
     return code

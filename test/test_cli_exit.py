@@ -1,8 +1,9 @@
 # Copyright 2026 squeeze_grasp_ros developers
 # SPDX-License-Identifier: Apache-2.0
-"""How ``squeeze-grasp`` ends after a verb that used ROS (entry._end_after_ros): at once, with
-the verb's exit code, its exit handlers run and its buffered output written; a verb without ROS
-ends as usual.
+"""How the ``squeeze-grasp`` console script ends after a verb that used ROS
+(entry._end_after_ros): at once, with the verb's exit code, its exit handlers run and its
+buffered output written; a verb without ROS returns as usual (and ``entry.cli``, the function a
+Python caller uses, always returns: test_recording_crafted measures replay's memory after it).
 """
 from __future__ import annotations
 
@@ -29,7 +30,7 @@ def test_the_exit_code_handlers_and_buffered_output_survive():
 
 
 def test_a_verb_without_ros_returns_to_the_caller():
-    """The console script's ``cli()`` returns its verb's code (no ``os._exit``) when rclpy was
+    """The console script's function returns its verb's code (no ``os._exit``) when rclpy was
     never loaded: here ``plan``.
     """
     from squeeze_grasp_ros.resources import scene_file
@@ -37,8 +38,8 @@ def test_a_verb_without_ros_returns_to_the_caller():
     scene = str(scene_file("foam_square"))
     script = ("import sys\n"
               f"sys.argv = ['squeeze-grasp', 'plan', {scene!r}, '--json']\n"
-              "from squeeze_grasp_ros.entry import cli\n"
-              "code = cli()\n"
+              "from squeeze_grasp_ros.entry import cli_process\n"
+              "code = cli_process()\n"
               "print('rclpy' in sys.modules, int(code), 'returned', file=sys.stderr)")
     done = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True,
                           timeout=120)

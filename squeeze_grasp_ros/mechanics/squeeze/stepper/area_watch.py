@@ -92,6 +92,44 @@ class AreaWatch:
                       "largest": bound.max(initial=0.0)}
         return True
 
+    def rate(self, sd: SetData, force_rates: np.ndarray, rigid_rate: float) -> float:
+        """A bound on how fast the gradient bound ``moved`` of :meth:`_still_above` grows per
+        unit of a motion that moves each contact force of ``sd`` by at most ``force_rates``
+        (m,) and the rigid part g by at most ``rigid_rate`` per unit (slack included).
+        """
+        return float(self._largest(sd.nodes.tolist()) @ force_rates
+                     + self._rigid_norm * rigid_rate) * (1.0 + _SLACK) ** 2
+
+    def reserve(self, sd: SetData, delta: np.ndarray, F: np.ndarray, level: float) -> float:
+        """How much every element's gradient may still change (in the bound ``moved`` of
+        :meth:`_still_above`) from this configuration with every element's det F above
+        ``level``; 0.0 when a kept element's is not above it here.
+
+        A kept element's det F is computed here, and moves by at most
+        moved (sqrt 2 + ||H_e|| + moved) (:meth:`_still_above`); the rest stay below the reach
+        while the reference's drift stays within its budget (the reference is renewed when
+        half the budget is used). With det F above ``level`` for every element, the area check
+        of :func:`~.run.advance` finds no event: an element it bounds instead of solving has
+        B_e < GRADIENT_BOUND_EXACT, and then a floor (1 - B_e)^2 > INVERSION_AREA_RATIO.
+        """
+        g = sd.E.T @ delta.reshape(-1)
+        norms = np.sqrt((F * F).sum(axis=1))
+        reach = 1.0 - level ** 0.5
+        ref = self._ref
+        stale = ref is None or ref["set"] is not sd or ref["reach"] != reach
+        drift = 0.0 if stale else self._drift(ref, g, norms)
+        if stale or drift > 0.5 * ref["budget"]:
+            ref, drift = self._renew(sd, g, norms, reach), 0.0
+        H = (ref["rigid_rows"] @ g).reshape(-1, 4) + ref["loads"] @ F.reshape(-1)
+        det = (1.0 + H[:, 0]) * (1.0 + H[:, 3]) - H[:, 1] * H[:, 2]
+        if not det.min(initial=np.inf) > level:
+            return 0.0
+        # per element the largest m with m (sqrt 2 + ||H_e|| + m) (1 + slack) < det - level
+        b, c = 2.0 ** 0.5 + np.sqrt((H * H).sum(axis=1)), (det - level) / (1.0 + _SLACK)
+        most = min((2.0 * c / (b + np.sqrt(b * b + 4.0 * c))).min(initial=np.inf),
+                   ref["budget"] - drift)
+        return max(0.0, float(most) * (1.0 - _SLACK))
+
     def _still_above(self, sd: SetData, g: np.ndarray, F: np.ndarray, level: float) -> bool:
         """Whether the last configuration answered True (for the same set, level and
         reference) bounds this one above ``level`` without looking at any element.

@@ -311,11 +311,13 @@ class QuietSteps:
         L, fu, old = mode.length, mode.force_unit, state.fingers
         work = np.array([f.work for f in old], float) / (fu * L)
         forces_a, forces_b = {}, {}
+        both = np.array((F_a, F_b))
         for f, (name, mine, touching, *_) in enumerate(mode.fingers):
-            ya, yb = F_a[mine].sum(axis=0), F_b[mine].sum(axis=0)
-            forces_a[name] = tuple((ya * fu).tolist())
-            forces_b[name] = tuple((yb * fu).tolist())
+            # each end's finger force, summed over the same rows in the same order
+            y = both[:, mine].sum(axis=1)
+            forces_a[name], forces_b[name] = map(tuple, (y * fu).tolist())
             if touching:
+                ya, yb = y
                 # h = 1; the set and the motion are those of both ends, so dF / ds is the same
                 # there and the Hermite term h^2 / 12 (ra - rb) is 0.0 exactly (ra, rb finite)
                 work[f] += 0.5 * (ya @ D[f] + yb @ D[f]) + 0.0

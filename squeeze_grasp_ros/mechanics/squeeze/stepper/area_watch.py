@@ -58,7 +58,7 @@ class AreaWatch:
         self._ref: dict | None = None
         R = model.obj.rigid_gradients.reshape(-1, 4, 3)
         self._rigid, self._rigid_2d = R, model.obj.rigid_gradients
-        self._node_largest: dict[int, float] = {}
+        self._of_set: tuple | None = None
         self._rigid_norm = float(np.sqrt((R * R).sum(axis=(1, 2))).max())
 
     def rate(self, sd: SetData, force_rates: np.ndarray, rigid_rate: float) -> float:
@@ -66,7 +66,7 @@ class AreaWatch:
         moves each contact force of ``sd`` by at most ``force_rates`` (m,) and the rigid part g
         by at most ``rigid_rate`` per unit (slack included).
         """
-        return float(self._largest(sd.nodes.tolist()) @ force_rates
+        return float(self._set(sd)[2] @ force_rates
                      + self._rigid_norm * rigid_rate) * (1.0 + _SLACK) ** 2
 
     def reserve(self, sd: SetData, delta: np.ndarray, F: np.ndarray, level: float) -> float:
@@ -77,9 +77,10 @@ class AreaWatch:
         A kept element's det F is computed here, and for a 2 x 2 gradient it moves by at most
         moved (sqrt 2 + ||H_e|| + moved) (|d det(I + H)| <= ||dH|| (sqrt 2 + ||H||) +
         ||dH||^2 / 2); the rest stay below the reach while the reference's drift stays within
-        its budget (the reference is renewed when half the budget is used). With det F above ``level`` for every element, the area check
-        of :func:`~.run.advance` finds no event: an element it bounds instead of solving has
-        B_e < GRADIENT_BOUND_EXACT, and then a floor (1 - B_e)^2 > INVERSION_AREA_RATIO.
+        its budget (the reference is renewed when half the budget is used). With det F above
+        ``level`` for every element, the area check of :func:`~.run.advance` finds no event: an
+        element it bounds instead of solving has B_e < GRADIENT_BOUND_EXACT, and then a floor
+        (1 - B_e)^2 > INVERSION_AREA_RATIO.
         """
         g = sd.E.T @ delta.reshape(-1)
         norms = np.sqrt((F * F).sum(axis=1))
@@ -104,22 +105,22 @@ class AreaWatch:
         return float(ref["column_max"] @ np.abs(norms - ref["norms"])
                      + self._rigid_norm * np.linalg.norm(g - ref["g"])) * (1.0 + _SLACK)
 
-    def _largest(self, nodes: list[int]) -> np.ndarray:
-        """max_e b_ek for each node k of ``nodes`` (kept per node: a node's gradients per unit
-        load do not change).
+    def _set(self, sd: SetData) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(b_ek (t, m), the load gradients (t, 4, 2m) stacked, max_e b_ek (m,)) of the set
+        ``sd``, kept for the last set (its renewals need them again).
         """
-        largest = self._node_largest
-        missing = [k for k in nodes if k not in largest]
-        if missing:
-            for k, b in zip(missing, self.model.obj.gradient_bounds(tuple(missing)).T):
-                largest[k] = float(b.max())
-        return np.array([largest[k] for k in nodes])
+        kept = self._of_set
+        if kept is None or kept[0] is not sd:
+            obj = self.model.obj
+            bounds = obj.gradient_bounds(tuple(sd.nodes.tolist()))
+            loads = np.concatenate(obj.load_gradients(sd.nodes), axis=2)
+            kept = self._of_set = (sd, bounds, loads, bounds.max(axis=0))
+        return kept[1:]
 
     def _renew(self, sd: SetData, g: np.ndarray, norms: np.ndarray, reach: float) -> dict:
         """Bound every element at this configuration and keep the largest bounds' elements."""
         self.renewals += 1
-        obj = self.model.obj
-        bounds = obj.gradient_bounds(tuple(sd.nodes.tolist()))
+        bounds, loads, column_max = self._set(sd)
         rigid = (self._rigid_2d @ g).reshape(-1, 4)
         B = bounds @ norms + np.sqrt((rigid * rigid).sum(axis=1))
         if len(B) > AREA_CANDIDATES:
@@ -128,11 +129,9 @@ class AreaWatch:
         else:
             kept, budget = np.arange(len(B)), np.inf
         kept = np.sort(kept)
-        loads = obj.load_gradients(sd.nodes)
         self._ref = {
             "set": sd, "reach": reach, "norms": norms, "g": g, "budget": budget,
-            "column_max": self._largest(sd.nodes.tolist()),
-            "rigid_rows": self._rigid[kept].reshape(-1, 3),
-            "loads": np.concatenate([G[kept] for G in loads], axis=2),
+            "column_max": column_max, "rigid_rows": self._rigid[kept].reshape(-1, 3),
+            "loads": loads[kept],
         }
         return self._ref

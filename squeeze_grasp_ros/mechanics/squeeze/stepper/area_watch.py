@@ -105,16 +105,15 @@ class AreaWatch:
         return float(ref["column_max"] @ np.abs(norms - ref["norms"])
                      + self._rigid_norm * np.linalg.norm(g - ref["g"])) * (1.0 + _SLACK)
 
-    def _set(self, sd: SetData) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """(b_ek (t, m), the load gradients (t, 4, 2m) stacked, max_e b_ek (m,)) of the set
+    def _set(self, sd: SetData) -> tuple[np.ndarray, list[np.ndarray], np.ndarray]:
+        """(b_ek (t, m), each node's load gradients (t, 4, 2), max_e b_ek (m,)) of the set
         ``sd``, kept for the last set (its renewals need them again).
         """
         kept = self._of_set
         if kept is None or kept[0] is not sd:
             obj = self.model.obj
             bounds = obj.gradient_bounds(tuple(sd.nodes.tolist()))
-            loads = np.concatenate(obj.load_gradients(sd.nodes), axis=2)
-            kept = self._of_set = (sd, bounds, loads, bounds.max(axis=0))
+            kept = self._of_set = (sd, bounds, obj.load_gradients(sd.nodes), bounds.max(axis=0))
         return kept[1:]
 
     def _renew(self, sd: SetData, g: np.ndarray, norms: np.ndarray, reach: float) -> dict:
@@ -132,6 +131,6 @@ class AreaWatch:
         self._ref = {
             "set": sd, "reach": reach, "norms": norms, "g": g, "budget": budget,
             "column_max": column_max, "rigid_rows": self._rigid[kept].reshape(-1, 3),
-            "loads": loads[kept],
+            "loads": np.concatenate([G[kept] for G in loads], axis=2),
         }
         return self._ref

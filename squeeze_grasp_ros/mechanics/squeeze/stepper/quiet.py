@@ -148,13 +148,13 @@ class QuietSteps:
         mode = self._enter(state, motion)
         start, D = motion.start, motion.translation
         ends = mode.sticking.ends(start, D)
-        if ends is None or self._evaluate(mode, start, ends[0], ends[1], D) <= 0.0:
-            return None
-        end = start + D
-        reach = self._evaluate(mode, end, ends[2], ends[3], D)
+        reach = 0.0 if ends is None else self._evaluate(mode, start, ends[0], ends[1], D)
         if reach <= 0.0:
             return None
-        self._mode, self._reach = mode, (end, reach * reach)
+        self._mode, self._reach = mode, (start, reach * reach)
+        end = start + D
+        if not self._within(end, ends[2], ends[3], D):
+            return None
         t0 = np.array([f.translation for f in state.fingers], float) / self._length
         return self._result(mode, state, (start, D, motion.rate, t0), ends)
 
@@ -178,17 +178,26 @@ class QuietSteps:
         ends = mode.sticking.ends(start, D)
         if ends is None:
             return None
-        end = start + D
-        ref, reach2 = self._reach
-        off = (end - ref).ravel()
-        if not off @ off < reach2:
-            reach = self._evaluate(mode, end, ends[2], ends[3], D)
-            if reach <= 0.0:
-                return None
-            self._reach = (end, reach * reach)
-        elif self._terminations and not self._terminations_clear(mode, ends[2], ends[3], D):
+        if not self._within(start + D, ends[2], ends[3], D):
             return None
         return self._result(mode, state, (start, D, rate, moved / L), ends)
+
+    def _within(self, end: np.ndarray, delta: np.ndarray, F: np.ndarray, D: np.ndarray) -> bool:
+        """Whether every watched function of the mode is above :data:`QUIET_MARGIN` at the end
+        of the call (tips at ``end``, the set at ``delta``, ``F``): from the reach of their last
+        evaluation when the end lies within it (the terminations declared evaluated), else
+        evaluated there (and the reach renewed).
+        """
+        mode = self._mode
+        ref, reach2 = self._reach
+        off = (end - ref).ravel()
+        if off @ off < reach2:
+            return not self._terminations or self._terminations_clear(mode, delta, F, D)
+        reach = self._evaluate(mode, end, delta, F, D)
+        if reach <= 0.0:
+            return False
+        self._reach = (end, reach * reach)
+        return True
 
     def _enter(self, state: ContactState, motion: FingerMotion) -> _Mode:
         """The constants of the state's sticking mode (its contact set, the functions watched,

@@ -318,31 +318,32 @@ class QuietSteps:
         start, D, rate, t0 = motion
         _, F_a, delta_b, F_b = ends
         L, fu, old = mode.length, mode.force_unit, state.fingers
-        work = np.array([f.work for f in old], float) / (fu * L)
-        forces_a, forces_b = {}, {}
+        forces_a, forces_b, fingers = {}, {}, []
         both = np.array((F_a, F_b))
-        for f, (name, mine, touching, *_) in enumerate(mode.fingers):
+        # FingerMotion.depth_at(s): depth0 + s * rate * length
+        depth = state.depth + 1.0 * rate * L
+        centers, moved = (start + 1.0 * D) * L, (t0 + 1.0 * D) * L
+        for f, ((name, mine, touching, radius, flat, facing), f_old) in enumerate(
+                zip(mode.fingers, old)):
             # each end's finger force, summed over the same rows in the same order
             y = both[:, mine].sum(axis=1)
             forces_a[name], forces_b[name] = map(tuple, (y * fu).tolist())
+            # the work as advance() keeps it (/ (fu L)), in Python floats (the same IEEE
+            # operations as its float64 array's)
+            work = f_old.work / (fu * L)
             if touching:
-                ya, yb = y
                 # h = 1; the set and the motion are those of both ends, so dF / ds is the same
                 # there and the Hermite term h^2 / 12 (ra - rb) is 0.0 exactly (ra, rb finite)
-                work[f] += 0.5 * (ya @ D[f] + yb @ D[f]) + 0.0
-        # FingerMotion.depth_at(s): depth0 + s * rate * length
-        depth = state.depth + 1.0 * rate * L
+                ya, yb = y
+                work += 0.5 * (float(ya @ D[f]) + float(yb @ D[f])) + 0.0
+            fingers.append(FingerState(name, centers[f], radius, moved[f], float(work * fu * L),
+                                       float(f_old.dissipation / (fu * L) * fu * L), flat,
+                                       facing))
         samples = (Sample(state.depth + 0.0 * rate * L, mode.nodes, mode.thetas, forces_a),
                    Sample(depth, mode.nodes, mode.thetas, forces_b))
-        centers, moved = (start + 1.0 * D) * L, (t0 + 1.0 * D) * L
-        fingers = tuple(
-            FingerState(name, centers[f], radius, moved[f], float(work[f] * fu * L),
-                        float(f_old.dissipation / (fu * L) * fu * L), flat, facing)
-            for f, ((name, _, _, radius, flat, facing), f_old) in enumerate(
-                zip(mode.fingers, old)))
         contacts = tuple(map(_moved, mode.contacts, delta_b * L, F_b * fu))
         holds = tuple(sorted((n, u) for n, u in state.holds if u > depth))
-        new = ContactState(fingers, contacts, depth, state.relative_per_depth, (), (),
+        new = ContactState(tuple(fingers), contacts, depth, state.relative_per_depth, (), (),
                            state.history, holds)
         diagnostics = {**_DIAGNOSTICS, "sets_factored": mode.cache.get("sets_factored", 0),
                        "reduced_max_condition": mode.cache.get("max_condition", 1.0)}

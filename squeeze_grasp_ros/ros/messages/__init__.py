@@ -62,6 +62,7 @@ from squeeze_grasp_ros.ros.messages.executor import (
 )
 from squeeze_grasp_ros.ros.messages.gripper import (
     gripper_grasps,
+    gripper_line_pose,
     gripper_pose,
     plan_gripper_grasp_response,
 )
@@ -147,6 +148,7 @@ __all__ = [
     "grasp_map_feedback",
     "grasp_result",
     "gripper_grasps",
+    "gripper_line_pose",
     "gripper_pose",
     "header",
     "int32_array",

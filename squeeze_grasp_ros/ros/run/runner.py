@@ -323,7 +323,9 @@ class PipelineRunner:
 
     @property
     def joint_feedback(self) -> bool:
-        """The monitor watches the jaws on ``joint_states`` alone (a controller, no sensors)."""
+        """The monitor watches the jaws (or the hand's fingers) on ``joint_states`` alone (a
+        controller, no sensors).
+        """
         return self.scene.controller is not None and not (
             self.scene.has(Effect.FORCE_SENSING) or self.scene.has(Effect.TACTILE_SENSING))
 

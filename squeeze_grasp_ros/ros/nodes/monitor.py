@@ -197,16 +197,13 @@ class MonitorNode(Node):
         self.buffer: dict[int, dict[str, Any]] = {}
         self.expected: dict[int, set[str]] = {}
         self.answered = pipeline.TickAnswer()
-        self.reused: tuple[ContactState, MonitorStatus] | None = None
-        """The contact state and status messages, built at the first tick and refilled in
-        place after it (the answer kept for a repeated tick is always the newest)."""
         self.active_alarms: set[tuple[str, str]] = set()
         self.shapes = (ShapeWatcher(self, self.alarm_pub, p["shape_mismatch_threshold"],
                                     p["object_height"]) if p["shape_watch"] else None)
         self.forces = (ForceWatcher(self, p["force_tolerance"], p["force_min_fraction"], loop)
                        if p["force_watch"] else None)
         if p["lockstep"]:
-            self.create_subscription(Tick, pipeline.TICK, self._tick, loop)
+            self.create_subscription(Tick, pipeline.TICK, self._tick, loop, raw=True)
             self.participant = pipeline.Participant(self, "monitor", [pipeline.TICK],
                                                     [self.status_pub])
         else:
@@ -242,11 +239,12 @@ class MonitorNode(Node):
         self.buffer.setdefault(ns, {})[key] = msg
         self._try_close(ns)
 
-    def _tick(self, msg: Tick) -> None:
-        ns = messages.stamp_ns(msg.header.stamp)
+    def _tick(self, data: bytes) -> None:
+        """A ``sim/tick``, read from its CDR bytes (:mod:`..messages.cdr`)."""
+        ns, readings = messages.tick_readings_cdr(data)
         if not self.answered.is_new(ns):
             return
-        self.expected[ns] = set(msg.readings) & self.keys.keys()
+        self.expected[ns] = set(readings) & self.keys.keys()
         self._try_close(ns)
 
     def _try_close(self, ns: int) -> None:
@@ -290,16 +288,10 @@ class MonitorNode(Node):
         batch += [(self.alarm_pub, messages.alarm_msg(a, ns)) for a in out.alarms
                   if (a.type, a.finger) not in self.active_alarms]
         self.active_alarms = active
-        if self.reused is None:
-            self.reused = (messages.patches_state_msg(out, frame),
-                           messages.monitor_status_msg(out, frame))
-        else:
-            messages.fill_patches_state(self.reused[0], out)
-            messages.fill_monitor_status(self.reused[1], out)
-        batch.append((self.state_pub, self.reused[0]))
+        batch.append((self.state_pub, messages.patches_state_cdr(out, frame)))
         for publisher, msg in batch:
             publisher.publish(msg)
-        self.answered.answer(ns, [(self.status_pub, self.reused[1])])
+        self.answered.answer(ns, [(self.status_pub, messages.monitor_status_cdr(out, frame))])
         if self.shapes is not None:
             self.shapes.tick(ns, out.depth)
 

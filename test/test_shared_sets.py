@@ -104,3 +104,24 @@ def test_the_planners_reduced_stiffness_is_kept_per_object_and_equals_a_fresh_on
     for name in ("contacts", "A", "B", "C", "E", "H"):
         np.testing.assert_array_equal(getattr(first, name), getattr(fresh, name))
     assert reduced_stiffness(obj, nodes[::-1]) is not first
+
+
+def test_models_in_threads_end_with_one_set_per_contact_set():
+    """Models of one object in four threads reduce the same sets at once: each thread's model
+    holds the one set the object kept (a second reduction of a set gives way to the first).
+    """
+    from concurrent.futures import ThreadPoolExecutor
+
+    obj, _ = fresh_block()
+    loop = obj.mesh.boundary.tolist()
+    pairs = [tuple(sorted((loop[0], loop[k]))) for k in range(3, 30, 3)]
+
+    def reduce_all(mu: float) -> list:
+        model = ContactModel(obj, mu)
+        return [model.set_data(pair) for pair in pairs]
+
+    with ThreadPoolExecutor(4) as pool:
+        runs = list(pool.map(reduce_all, (0.1, 0.2, 0.3, 0.4)))
+    for k, pair in enumerate(pairs):
+        assert all(run[k] is runs[0][k] for run in runs)
+        assert ContactModel(obj, 0.5).set_data(pair) is runs[0][k]

@@ -153,7 +153,7 @@ def reduced_stiffness(obj: ElasticObject, contacts) -> ReducedStiffness:
         red = ReducedStiffness(contacts, A_hat / eh, B, C_hat * eh, E, H_hat / eh, condition)
         require_finite("reduced stiffness", red.C)
         if len(kept) >= REDUCED_KEPT:
-            kept.pop(next(iter(kept)))
+            kept.pop(next(iter(kept)), None)
         kept[tag] = red
     return red
 

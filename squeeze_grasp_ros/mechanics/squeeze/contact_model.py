@@ -29,6 +29,7 @@ Everything here is dimensionless: lengths by L = obj.scale, forces by E h L.
 
 from __future__ import annotations
 
+import threading
 from collections import OrderedDict
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -157,27 +158,35 @@ class SetData:
 
 class SharedSets:
     """The reduced contact sets of one object that its fast contact models share, the least
-    recently used dropped beyond SHARED_SET_BYTES (the last one put always stays).
+    recently used dropped beyond SHARED_SET_BYTES (the last one put always stays). Safe for
+    the models of several threads (a Dask worker with more than one).
     """
 
     def __init__(self) -> None:
         self._sets: OrderedDict[tuple, SetData] = OrderedDict()
+        self._lock = threading.Lock()
         self.nbytes = 0
 
     def get(self, tag: tuple) -> SetData | None:
         """The set kept under ``tag`` (now the most recently used), or None."""
-        data = self._sets.get(tag)
-        if data is not None:
-            self._sets.move_to_end(tag)
-        return data
+        with self._lock:
+            data = self._sets.get(tag)
+            if data is not None:
+                self._sets.move_to_end(tag)
+            return data
 
     def put(self, tag: tuple, data: SetData) -> SetData:
-        """Keep ``data`` under ``tag``; returns it."""
-        self._sets[tag] = data
-        self.nbytes += _set_bytes(data)
-        while self.nbytes > SHARED_SET_BYTES and len(self._sets) > 1:
-            self.nbytes -= _set_bytes(self._sets.popitem(last=False)[1])
-        return data
+        """Keep ``data`` under ``tag`` (unless a set is kept there already); returns the set
+        kept.
+        """
+        with self._lock:
+            if tag in self._sets:
+                return self._sets[tag]
+            self._sets[tag] = data
+            self.nbytes += _set_bytes(data)
+            while self.nbytes > SHARED_SET_BYTES and len(self._sets) > 1:
+                self.nbytes -= _set_bytes(self._sets.popitem(last=False)[1])
+            return data
 
 
 def _set_bytes(data: SetData) -> int:
@@ -632,7 +641,8 @@ class ContactModel:
         if self.reference:
             data = self._reduce(key)
         else:
-            shared = self.obj._shared.setdefault("contact_sets", SharedSets())
+            shared = (self.obj._shared.get("contact_sets")
+                      or self.obj._shared.setdefault("contact_sets", SharedSets()))
             tag = (key, self.limits.strain is not None)
             data = shared.get(tag)
             if data is None:

@@ -33,6 +33,18 @@ SLIPPING_SQUARE = {**copy.deepcopy(SMALL_SQUARE), "name": "slipping_square",
 """An 800-node square at mu = 0.05 whose squeeze ends with a finger slipping (Sec. 5.1)."""
 
 
+class LogLines:
+    """A node logger stand-in that keeps its warning and info lines."""
+
+    def __init__(self) -> None:
+        self.lines: list[str] = []
+
+    def warning(self, text: str) -> None:
+        self.lines.append(text)
+
+    info = warning
+
+
 def scene_data(base: dict, **changes) -> dict:
     """A deep copy of ``base`` with top-level keys replaced (None deletes a key)."""
     data = copy.deepcopy(base)

@@ -15,6 +15,7 @@ from squeeze_grasp_ros.mechanics.squeeze.stepper.location import (
     hermite_dips,
     hermite_root,
     locate_sign_change,
+    surely_positive,
 )
 
 coefficient = st.floats(-4.0, 4.0)
@@ -89,3 +90,49 @@ def test_slopes_locate_roots_with_fewer_evaluations_than_regula_falsi():
     falsi = [located(*case, slopes=False)[2] for case in grid]
     assert sum(hermite) <= 0.75 * sum(falsi)
     assert np.median(hermite) <= 5 < np.median(falsi)
+
+
+@given(st.floats(0.05, 0.95), st.floats(0.1, 5.0), st.floats(0.0, 6.0),
+       st.sampled_from([1e-6, 1e-9, 1e-12]))
+def test_skipping_the_sure_evaluations_gives_the_same_bracket(root, k, w, tol):
+    """Dear evaluations (``skip_sure``): the bracket is the one that evaluating every point
+    gives, bit for bit, with at most one evaluation fewer (the one that would close it) and
+    never more.
+    """
+    def located_with(skip_sure):
+        g, dg = one_root(root, k, w)
+        return locate_sign_change(lambda s: (g(s), dg(s)), 0.0, 1.0, g(0.0), g(1.0), tol,
+                                  slopes=(dg(0.0), dg(1.0)), skip_sure=skip_sure)
+
+    every, sure = located_with(False), located_with(True)
+    assert sure[:2] == every[:2]
+    assert every[2] - 1 <= sure[2] <= every[2]
+
+
+def test_skipping_the_sure_evaluations_saves_one_in_most_locations():
+    """Over the fixed grid of the regula falsi comparison (375 roots) the sure route gives the
+    same brackets with at least 0.8 of them one evaluation cheaper (measured: 357 of 375, 1,452
+    evaluations against 1,809).
+    """
+    grid = list(itertools.product((0.1, 0.3, 0.5, 0.7, 0.9), (0.1, 0.5, 1.0, 2.0, 5.0),
+                                  (0.0, 1.0, 2.5, 4.0, 6.0), (1e-6, 1e-9, 1e-12)))
+    saved = 0
+    for root, k, w, tol in grid:
+        g, dg = one_root(root, k, w)
+        every, sure = (locate_sign_change(lambda s: (g(s), dg(s)), 0.0, 1.0, g(0.0), g(1.0), tol,
+                                          slopes=(dg(0.0), dg(1.0)), skip_sure=skip)
+                       for skip in (False, True))
+        assert sure[:2] == every[:2]
+        saved += every[2] - sure[2]
+    assert saved >= 0.8 * len(grid)
+
+
+def test_a_function_near_its_root_is_not_sure():
+    """surely_positive refuses a point whose model value is within the margin of zero, or
+    where the curvature could bend the function to zero: the evaluation is then made.
+    """
+    h, r = 0.49e-9, -1.0
+    assert surely_positive(0.25e-9 * r, r, h, 0.0)
+    assert not surely_positive(0.45e-9 * r, r, h, 0.0)
+    assert not surely_positive(0.25e-9 * r, r, h, 1e9)  # g'' of 1e9 bends 0.24e-9 away
+    assert not surely_positive(-1.0, 0.0, h, 0.0)  # no slope: no model

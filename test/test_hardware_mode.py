@@ -5,7 +5,9 @@
 The controller here is not ours: a plain rclpy node that takes ``JointTrajectory`` on
 ``gripper_controller/joint_trajectory``, moves its one joint toward the last point at the
 device's speed and publishes ``joint_states`` at 100 Hz, as joint_state_broadcaster would; and
-a stand-in for the lab's forward kinematics that publishes the jaws' tips once; and a plain
+a stand-in for the lab's forward kinematics that publishes the jaws' tips once, or none at all
+(the joint_states-only route: the gripper's pose as the monitor's ``gripper_pose`` parameter or
+one message on ``gripper_pose``, as tf2 gives it); and a plain
 rclpy ``control_msgs/action/GripperCommand`` server closing on a spring whose force stops rising
 (a slip). Our monitor and executor run in hardware mode on wall-clock timers. The tests read the
 commands as a controller would: topic, joint names, positions in the device file's joint
@@ -119,7 +121,8 @@ class Rig:
     """
 
     def __init__(self, scene: Path, joint: Joint, *,
-                 reach: float | None = DEVICE["pad"]["edge_radius"]) -> None:
+                 reach: float | None = DEVICE["pad"]["edge_radius"],
+                 gripper_pose: list[float] | None = None) -> None:
         self.context = Context()
         rclpy.init(context=self.context)
         self.spin = MultiThreadedExecutor(num_threads=3, context=self.context)
@@ -127,7 +130,8 @@ class Rig:
         common = [Parameter("lockstep", value=False),
                   Parameter("finger_devices", value=["F1:jaw_f1", "F2:jaw_f2"]),
                   Parameter("controller_scene", value=str(scene))]
-        self.monitor = MonitorNode(context=self.context, parameter_overrides=common + [
+        posed = [] if gripper_pose is None else [Parameter("gripper_pose", value=gripper_pose)]
+        self.monitor = MonitorNode(context=self.context, parameter_overrides=common + posed + [
             Parameter("streams", value=[""]), Parameter("rate", value=100.0),
             Parameter("stale_after", value=0.1), Parameter("force_watch", value=False)])
         self.executor = ExecutorNode(context=self.context, parameter_overrides=common + [
@@ -139,14 +143,15 @@ class Rig:
                       self.client_node]
         for node in self.nodes:
             self.spin.add_node(node)
-        poses = {d: self.kinematics.create_publisher(
-            PoseStamped, pipeline.device_topic(d, "pose"), pipeline.LATCHED)
-            for d in ("jaw_f1", "jaw_f2")}
+        if reach is None:       # no pose topics
+            return
         # the tips' centres: half the aperture between the pad faces plus the pad's edge radius
-        tip = OPEN / 2 + (reach or 0.0)
+        tip = OPEN / 2 + reach
         now = self.kinematics.get_clock().now().nanoseconds
-        for device, y in (("jaw_f1", -tip), ("jaw_f2", tip)) if reach is not None else ():
-            poses[device].publish(messages.pose_msg((0.0, y), now, pipeline.FRAME))
+        for device, y in (("jaw_f1", -tip), ("jaw_f2", tip)):
+            self.kinematics.create_publisher(
+                PoseStamped, pipeline.device_topic(device, "pose"), pipeline.LATCHED).publish(
+                messages.pose_msg((0.0, y), now, pipeline.FRAME))
 
     def spin_until(self, condition, timeout: float = 30.0) -> None:
         deadline = time.monotonic() + timeout
@@ -208,6 +213,81 @@ def test_the_executor_drives_an_outside_jtc_in_wall_time(capfd):
     finally:
         rig.close()
     assert "pose readings put the pad faces" not in capfd.readouterr().err
+
+
+def pose_topics(rig: Rig) -> dict[str, int]:
+    """The publishers of the jaws' pose topics (none on the joint_states-only route)."""
+    return {d: rig.monitor.count_publishers(pipeline.device_topic(d, "pose"))
+            for d in ("jaw_f1", "jaw_f2")}
+
+
+def test_joint_states_alone_with_the_gripper_pose_parameter_end_as_planned(capfd):
+    # no pose topic at all: the gripper's centre (0, 0) and closing direction +y (yaw 90 deg,
+    # F1's jaw closing toward F2's) fix the jaw line, joint_states move the jaws on it
+    rig = Rig(SCENE, Joint(OPEN), reach=None, gripper_pose=[0.0, 0.0, 90.0])
+    try:
+        result = rig.squeeze()
+        assert pose_topics(rig) == {"jaw_f1": 0, "jaw_f2": 0}
+        assert result.termination == ExecuteGrasp.Result.DEPTH_REACHED, result.message
+        assert result.success
+        q = np.array([msg.points[0].positions[0] for msg in rig.outside.received])
+        lo, hi = sorted((joint_of(DEVICE["opening"]["min"]), joint_of(DEVICE["opening"]["max"])))
+        assert np.all(np.diff(q) >= -1e-12)
+        assert q[-1] == pytest.approx(joint_of(PLANNED), abs=1e-3 * (hi - lo))
+        assert result.depth == pytest.approx(DEPTH, rel=0.05)
+        # the jaws' tips as the monitor puts them: on the line x = 0, symmetric about the
+        # centre, the pad faces at the aperture of the joint's reading
+        line = rig.monitor.jaws.line
+        first, second = line.positions(OPEN)
+        np.testing.assert_allclose(first, [0.0, -(OPEN / 2 + DEVICE["pad"]["edge_radius"])],
+                                   atol=1e-15)
+        np.testing.assert_allclose(second, -first, atol=1e-15)
+        assert "jaw line at (0, 0) m, yaw 90 deg" in rig.monitor.ready_summary()
+    finally:
+        rig.close()
+    assert "pose readings put the pad faces" not in capfd.readouterr().err
+
+
+def test_joint_states_alone_with_a_gripper_pose_message_stop_on_the_slip(tmp_path):
+    # the gripper's pose as a lab's tf2 lookup gives it (PoseStamped in the object frame, a
+    # rotation about z), published once, latched; the jaws close on a spring whose force stops
+    # rising at 10 N (50 mm), short of the planned 45.9 mm
+    joint = Joint(OPEN, touch=0.055, stiffness=2000.0, plateau=10.0, speed=0.02)
+    rig = Rig(SCENE, joint, reach=None)
+    publisher = rig.kinematics.create_publisher(PoseStamped, pipeline.GRIPPER_POSE,
+                                                pipeline.LATCHED)
+    pose = PoseStamped()
+    pose.header.frame_id = pipeline.FRAME
+    pose.pose.orientation.z = pose.pose.orientation.w = math.sqrt(0.5)   # yaw 90 deg
+    publisher.publish(pose)
+    try:
+        result = rig.squeeze()
+        assert pose_topics(rig) == {"jaw_f1": 0, "jaw_f2": 0}
+        assert result.termination == ExecuteGrasp.Result.SLIP_ALARM, result.message
+        assert not result.success and "slip" in result.message
+        np.testing.assert_allclose(rig.monitor.jaws.line.direction, [0.0, 1.0], atol=1e-15)
+        # the jaws stopped past the plateau's start, short of the plan: the last command holds
+        q = [msg.points[0].positions[0] for msg in rig.outside.received]
+        assert joint_of(0.050) < q[-1] < joint_of(PLANNED)
+    finally:
+        rig.close()
+
+
+def test_a_gripper_pose_out_of_the_plane_or_frame_is_refused():
+    def stamped(frame: str, tilt: float) -> PoseStamped:
+        msg = PoseStamped()
+        msg.header.frame_id = frame
+        # the closing direction (x axis) turned by ``tilt`` about the y axis: out of the plane
+        msg.pose.orientation.y, msg.pose.orientation.w = -math.sin(tilt / 2), math.cos(tilt / 2)
+        return msg
+
+    centre, yaw = messages.gripper_line_pose(stamped("object", 0.005), "object")
+    assert yaw == pytest.approx(0.0, abs=1e-12) and list(centre) == [0.0, 0.0]
+    # sin 0.05 = 0.04998 > 0.01
+    with pytest.raises(ValueError, match=r"leaves the object plane: its z component is 0.04998"):
+        messages.gripper_line_pose(stamped("object", 0.05), "object")
+    with pytest.raises(ValueError, match="in frame 'base_link', not the object frame 'object'"):
+        messages.gripper_line_pose(stamped("base_link", 0.0), "object")
 
 
 def test_jaw_poses_that_disagree_with_joint_states_are_named_once(capfd):

@@ -16,7 +16,7 @@ import pytest
 import yaml
 from foxglove_support import first_messages, layout_paths, resolve
 from mcap.reader import make_reader
-from pipeline_support import write_scene
+from pipeline_support import LogLines, write_scene
 from rclpy.serialization import deserialize_message
 from sensor_msgs.msg import JointState
 
@@ -175,23 +175,13 @@ def test_the_jaws_slip_the_joint_watch_stops_the_squeeze(reaction, tmp_path):
     assert replayed["alarms"] == len(recorded) >= 2
 
 
-class Log:
-    def __init__(self) -> None:
-        self.lines: list[str] = []
-
-    def warning(self, text: str) -> None:
-        self.lines.append(text)
-
-    info = warning
-
-
 def test_a_hostile_joint_state_is_ignored_with_one_warning_line():
     params = {"controller_scene": str(SLIP), "load_threshold": 0.002,
               "joint_slip_window": WINDOW, "joint_slip_ratio": RATIO}
     jaws = JointFeedback.of(params, [])
     assert JointFeedback.of(params, ["wrench"]) is None  # sensors: their route
     poses = {"F1": np.array([0.012, -0.026]), "F2": np.array([0.012, 0.026])}
-    log = Log()
+    log = LogLines()
 
     def sample(msg):
         fields = {f: {"position": p.copy()} for f, p in poses.items()}

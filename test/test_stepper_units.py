@@ -561,3 +561,34 @@ def test_the_chattering_bound_freezes_a_node_for_one_window():
     assert bound.admit(5, "F1", 1.15)  # its events at 0 and 0.1 left the window
     carried = ChatterBound(ContactState((), (), history=((7, 0.0),), holds=((7, 0.5),)), 1.0, 1)
     assert carried.held_nodes(0.2) == [7] and not carried.admit(7, "A", 0.2)
+
+
+@given(st.lists(st.tuples(st.floats(0.01, 0.99), st.floats(-0.9, 3.0), st.booleans()),
+                min_size=1, max_size=6),
+       st.sampled_from([1e-9, 1e-6]))
+def test_skipping_the_sure_evaluations_gives_the_same_event_point(spec, tol):
+    """With ``skip_sure`` (a model whose evaluations are dear) the event point is the one
+    the evaluating route finds, bit for bit, with no more location evaluations; a crossing
+    with slopes located alone costs one fewer (a quadratic is its own Hermite interpolant, so
+    the first point lands a quarter tolerance past the root and the evaluating route closes
+    the bracket from below, at a point whose sign is sure).
+    """
+    keys = [EventKey.gap(10 + k, 0) if sloped else EventKey(D, 10 + k)
+            for k, (_, _, sloped) in enumerate(spec)]
+    roots = {key: r for key, (r, _, _) in zip(keys, spec)}
+    curv = {key: c for key, (_, c, _) in zip(keys, spec)}
+    runs = []
+    for skip_sure in (False, True):
+        value, slope, _ = analytic(roots, curv)
+        s_e, evaluations = earliest_crossing(
+            keys, 0.0, 1.0, tol, start={k: value(k, 0.0) for k in keys},
+            end={k: value(k, 1.0) for k in keys},
+            start_slopes={k: slope(k, 0.0) for k in keys if k.function.has_slope},
+            end_slopes={k: slope(k, 1.0) for k in keys if k.function.has_slope},
+            fresh=set(), value=value, slope=slope, order=order, skip_sure=skip_sure)
+        runs.append((s_e, evaluations))
+    (s_every, n_every), (s_sure, n_sure) = runs
+    assert s_sure == s_every
+    assert n_sure <= n_every
+    if len(keys) == 1 and keys[0].function.has_slope:
+        assert n_sure == n_every - 1

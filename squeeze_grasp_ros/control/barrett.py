@@ -49,8 +49,13 @@ from enum import Enum
 import numpy as np
 from scipy.optimize import brentq, minimize_scalar
 
-__all__ = ["COUPLING", "JOINTS", "BarrettFinger", "BarrettHand", "HandPose", "HandSolution",
-           "ReachError"]
+__all__ = ["COUPLING", "JOINTS", "MAX_CONDITION", "BarrettFinger", "BarrettHand", "HandPose",
+           "HandSolution", "ReachError", "SingularPosture", "TipForce"]
+
+MAX_CONDITION = 100.0
+"""Largest condition number of a finger's J^T (:meth:`BarrettHand.tip_force`) at which its tip
+force is recovered from its joint efforts: an effort error dtau gives a force error up to
+condition * |dtau| / |tau| relative."""
 
 COUPLING = 1.0 / 3.0
 """Distal over proximal joint angle of a BH8 finger (Barrett's stated ratio; the joint ranges'
@@ -114,6 +119,32 @@ class HandPose:
         c, s = np.cos(self.yaw), np.sin(self.yaw)
         p = np.asarray(point, float)
         return np.array([c * p[0] - s * p[1], s * p[0] + c * p[1]]) + np.asarray(self.centre)
+
+
+class SingularPosture(ValueError):
+    """A posture at which a finger's joint efforts do not determine its planar tip force; the
+    message names the finger, its joints and the conditioning.
+    """
+
+
+@dataclass(frozen=True)
+class TipForce:
+    """A fingertip's planar force recovered from its joint efforts (:meth:`BarrettHand.tip_force`).
+
+    Attributes
+    ----------
+    force : ndarray (2,)
+        The finger's push on the object, object frame, N.
+    condition : float
+        The condition number of the finger's J^T (3 x 2).
+    residual : float
+        The largest |J^T F - tau| over the finger's three joints, N m (0 for efforts of the
+        model: a driver's efforts that break the model's proportions show here).
+    """
+
+    force: np.ndarray
+    condition: float
+    residual: float
 
 
 @dataclass(frozen=True)
@@ -218,6 +249,80 @@ class BarrettHand:
             palm = self.base(finger) + rho * np.array([np.cos(angle), np.sin(angle)])
             tips[finger] = self.pose.to_object(palm)
         return tips
+
+    # ----------------------------------------------------------------- statics
+    def jacobian(self, finger: BarrettFinger, joints: Mapping[str, float]) -> np.ndarray:
+        """The fingertip's planar velocity per joint velocity: (2, 3), m/rad, object frame,
+        columns the spread, proximal and distal joints each moved alone (the thumb's spread
+        column zero: it has none). The tip moves along its line e_k by the proximal and distal
+        joints (d rho / dq e_k; the height they also change is not modelled) and across it by
+        the spread (rho de_k / dspread).
+        """
+        spread = float(joints[finger.spread]) if finger.spread else 0.0
+        q2, q3 = float(joints[finger.proximal]), float(joints[finger.distal])
+        angle = self.direction(finger, spread)
+        along = np.array([np.cos(angle), np.sin(angle)])
+        across = np.array([-np.sin(angle), np.cos(angle)])
+        turn = -1.0 if finger is BarrettFinger.F1 else 1.0      # d angle / d spread
+        distal = -self.distal_link * np.sin(q2 + q3 + self.distal_offset)
+        columns = np.column_stack([
+            (self.rho(q2, q3) * turn * across) if finger.spread else np.zeros(2),
+            (-self.proximal_link * np.sin(q2) + distal) * along, distal * along])
+        c, s = np.cos(self.pose.yaw), np.sin(self.pose.yaw)
+        return np.array([[c, -s], [s, c]]) @ columns
+
+    def efforts(self, joints: Mapping[str, float],
+                forces: Mapping[BarrettFinger, np.ndarray]) -> dict[str, float]:
+        """Every joint's torque (N m, order of :data:`JOINTS`) holding the fingertips' pushes
+        ``forces`` (object frame, N; fingers not given push nothing): tau = J^T F per finger,
+        each joint's own torque, as a torque sensor at that joint reads it. The drivetrain
+        couples them: one motor drives a finger's proximal and distal joints (distal = 1/3 of
+        proximal), so that motor carries tau_proximal + tau_distal / 3; one motor drives both
+        spread joints, carrying bh_j11 + bh_j21.
+        """
+        out = {j: 0.0 for j in JOINTS}
+        for finger, force in forces.items():
+            finger = BarrettFinger(finger)
+            tau = self.jacobian(finger, joints).T @ np.asarray(force, float)
+            names = (finger.spread, finger.proximal, finger.distal)
+            for name, value in zip(names, tau):
+                if name is not None:
+                    out[name] = float(value)
+        return out
+
+    def tip_force(self, finger: BarrettFinger, joints: Mapping[str, float],
+                  efforts: Mapping[str, float], *, max_condition: float = MAX_CONDITION
+                  ) -> TipForce:
+        """The fingertip's planar push on the object from its joints' efforts (N m): the
+        least-squares solution of J^T F = tau over its spread, proximal and distal joints.
+
+        Raises
+        ------
+        SingularPosture
+            The thumb (no spread joint: its force across its line is borne by its structure,
+            so its efforts give one component only), or a J^T whose condition number exceeds
+            ``max_condition`` (the tip near its spread axis, where the spread hardly moves it).
+        """
+        finger = BarrettFinger(finger)
+        if finger.spread is None:
+            raise SingularPosture(
+                f"{finger.value}: the thumb has no spread joint, so its joint efforts give its "
+                "tip force along its closing line only (the force across it is borne by its "
+                "structure); watch it on a force or tactile sensor")
+        a = self.jacobian(finger, joints).T
+        condition = float(np.linalg.cond(a))
+        if not condition <= max_condition:
+            rho = self.rho(joints[finger.proximal], joints[finger.distal])
+            raise SingularPosture(
+                f"{finger.value}: its joint efforts do not determine its tip force at spread "
+                f"{joints[finger.spread]:.4g}, proximal {joints[finger.proximal]:.4g}, distal "
+                f"{joints[finger.distal]:.4g} rad: J^T has condition number {condition:.3g} > "
+                f"{max_condition:g} (the tip {rho * 1e3:.3g} mm from its spread axis, where the "
+                "spread hardly moves it)")
+        tau = np.array([efforts[finger.spread], efforts[finger.proximal],
+                        efforts[finger.distal]], float)
+        force = np.linalg.lstsq(a, tau, rcond=None)[0]
+        return TipForce(force, condition, float(np.max(np.abs(a @ force - tau))))
 
     def inverse(self, targets: Mapping[BarrettFinger, np.ndarray], *,
                 rest: Mapping[str, float] | None = None, spread: float | None = None,

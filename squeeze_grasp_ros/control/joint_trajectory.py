@@ -112,6 +112,18 @@ class JawLine:
                              f"(reach {reach:g} m each)")
         return cls(0.5 * (first + second), gap / length, float(reach))
 
+    @classmethod
+    def at_pose(cls, centre: np.ndarray, yaw: float, *, reach: float) -> JawLine:
+        """The line of a gripper whose centre (midway between the pad faces, m) is ``centre``
+        and whose closing direction (F1's jaw's motion, the x axis of ``plan_gripper_grasp``'s
+        pose) is at ``yaw`` (rad) from the object frame's x axis.
+        """
+        centre = np.asarray(centre, float)
+        if not (centre.shape == (2,) and np.all(np.isfinite(centre)) and np.isfinite(yaw)):
+            raise ValueError(f"the gripper's pose must be a finite centre (x, y) m and yaw rad, "
+                             f"got {centre.tolist()}, {yaw}")
+        return cls(centre, np.array([np.cos(yaw), np.sin(yaw)]), float(reach))
+
     def aperture(self, first: np.ndarray, second: np.ndarray) -> float:
         """The distance between the pad faces (m) of tips at ``first`` and ``second`` (m),
         measured along the line.

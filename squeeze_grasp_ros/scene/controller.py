@@ -197,10 +197,6 @@ def _hand(scene: Scene, spec: ControllerSpec) -> HandController:
     if spec.palm is None:
         raise SceneError(f"controller.palm: the {HAND_DEVICE} hand needs its palm's pose "
                          "[x m, y m, yaw deg] in the object frame")
-    if not (scene.has(Effect.FORCE_SENSING) or scene.has(Effect.TACTILE_SENSING)):
-        raise SceneError(f"controller.device {HAND_DEVICE}: the monitor watches the hand's "
-                         "fingers on their force or tactile sensors (effects force_sensing or "
-                         "tactile_sensing); the hand's joint feedback alone is not built")
     devices = finger_devices(scene)
     fingers = {}
     for jaw in spec.jaws:
@@ -213,6 +209,13 @@ def _hand(scene: Scene, spec: ControllerSpec) -> HandController:
             raise SceneError(f"controller.jaws: {jaw}'s device {devices[jaw]} is not a finger "
                              f"of the {HAND_DEVICE} hand "
                              f"({[f.value for f in BarrettFinger]})") from None
+    if not (scene.has(Effect.FORCE_SENSING) or scene.has(Effect.TACTILE_SENSING)) and (
+            len(fingers) != 2 or BarrettFinger.F3 in fingers.values()):
+        raise SceneError(f"controller.jaws: without force_sensing or tactile_sensing the monitor "
+                         f"reads the {HAND_DEVICE} hand's fingers from their joint efforts, which "
+                         "determine the tip forces of fingers 1 and 2 only (the thumb has no "
+                         "spread joint): carry two fingers on barrett_f1 and barrett_f2, got "
+                         f"{ {f: h.value for f, h in fingers.items()} }")
     x, y, yaw = spec.palm
     return HandController(spec, BarrettHand(pose=HandPose((float(x), float(y)),
                                                           float(np.deg2rad(yaw)))), fingers)

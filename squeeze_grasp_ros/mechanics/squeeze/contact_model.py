@@ -580,6 +580,14 @@ class ContactModel:
         return False
 
     @property
+    def dear_evaluations(self) -> bool:
+        """Whether an evaluation of a contact set's response is dear (a nonlinear solve of the
+        whole object), so that event location skips the evaluations whose outcome is sure
+        (:func:`~.stepper.location.earliest_crossing`); False here: a small dense product.
+        """
+        return False
+
+    @property
     def constitutive_model(self) -> MaterialModel:
         """The material law of the object: linear (the reduced stiffness of small strain)."""
         return MaterialModel.LINEAR

@@ -82,6 +82,13 @@ class NonlinearContactModel(ContactModel):
         """
         return self.options.adaptive_substeps
 
+    @property
+    def dear_evaluations(self) -> bool:
+        """True: every evaluation is a nonlinear solve of the whole object (event location
+        skips those whose outcome the known values and slopes make sure).
+        """
+        return True
+
     # ------------------------------------------------------------------ the response
     def _response_of(self, sd: SetData) -> ContactResponse:
         responses = self._cache.setdefault("responses", {})

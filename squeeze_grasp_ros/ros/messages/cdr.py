@@ -1,6 +1,6 @@
 # Copyright 2026 squeeze_grasp_ros developers
 # SPDX-License-Identifier: Apache-2.0
-"""The device readings read straight from their serialised CDR bytes.
+"""The lockstep loop's messages read from, and written to, their serialised CDR bytes.
 
 A lockstep tick delivers six readings to the monitor and two setpoints to the simulated
 hardware. rclpy turns each into Python message objects (a ``PoseStamped`` is six of them,
@@ -10,6 +10,13 @@ pose's position, a wrench's force and a tactile array's taxels. The values are t
 numbers bit for bit (``test/test_cdr_readings.py`` checks them against rclpy's own
 deserialisation, for every alignment a frame id or finger name can cause).
 
+The other way, the loop's publishers hand rclpy the serialised bytes (``Publisher.publish``
+takes ``bytes``): :class:`CdrWriter` and the ``*_cdr`` writers below put a tick's readings, its
+ground truth, the monitor's status and contact state and the executor's setpoints straight
+from numpy into CDR, where rclpy would first fill a Python message and then convert it field by
+field (``test/test_cdr_writers.py`` checks every writer against rclpy's deserialisation; the
+alignment padding is written as zeros, where rclpy leaves whatever its buffer held).
+
 The layout is classic CDR (XCDR1, ``CDR_LE`` or ``CDR_BE``), what rmw implementations of ROS 2
 Jazzy send: a 4-byte encapsulation header, then the fields in order, each aligned to its own
 size counted from the end of that header; a string is a uint32 length (its terminating NUL
@@ -17,13 +24,16 @@ included) and its bytes, a sequence a uint32 count and its elements.
 """
 from __future__ import annotations
 
+import functools
 import struct
 
 import numpy as np
 
-from squeeze_grasp_ros.ros.messages.contacts import TactileReadings
+from squeeze_grasp_ros.ros.messages.contacts import TactileReadings, check_taxels
 
-__all__ = ["cdr_stamp_ns", "pose_position_cdr", "tactile_readings_cdr", "wrench_force_cdr"]
+__all__ = ["CdrWriter", "cdr_stamp_ns", "clock_cdr", "pose_position_cdr", "pose_stamped_cdr",
+           "tactile_array_cdr", "tactile_readings_cdr", "tick_cdr", "tick_readings_cdr",
+           "wrench_force_cdr", "wrench_stamped_cdr", "write_contact_arrays"]
 
 _BODY = 4
 """Bytes of the encapsulation header; alignment counts from its end."""
@@ -49,6 +59,12 @@ class _Reader:
         self.offset += 4
         return value
 
+    def uint64(self) -> int:
+        self._align(8)
+        (value,) = struct.unpack_from(self.order + "Q", self.data, self.offset)
+        self.offset += 8
+        return value
+
     def skip_string(self) -> None:
         size = self.uint32()
         self.offset += size
@@ -57,6 +73,10 @@ class _Reader:
         size = self.uint32()
         self.offset += size
         return bytes(self.data[self.offset - size:self.offset - 1]).decode()
+
+    def strings(self) -> list[str]:
+        """A ``string[]`` sequence."""
+        return [self.string() for _ in range(self.uint32())]
 
     def float64s(self, count: int) -> np.ndarray:
         """``count`` float64 values (a fixed-size run of fields or a sequence's elements; an
@@ -114,3 +134,180 @@ def tactile_readings_cdr(data: bytes) -> tuple[int, TactileReadings]:
     finger = reader.string()
     return stamp, TactileReadings(finger, reader.sequence(), reader.sequence(),
                                   reader.sequence())
+
+
+def tick_readings_cdr(data: bytes) -> tuple[int, list[str]]:
+    """(stamp ns, readings "<device>/<stream>") of a serialised
+    ``squeeze_grasp_interfaces/Tick``.
+    """
+    reader = _Reader(data)
+    stamp = reader.header()
+    reader.skip_string()
+    reader.uint64()  # the tick's index
+    return stamp, reader.strings()
+
+
+_ZEROS = tuple(bytes(n) for n in range(8))
+"""Padding of 0-7 bytes."""
+_U32, _I32, _U64, _F64, _TIME = (struct.Struct(f).pack for f in ("<I", "<i", "<Q", "<d", "<iI"))
+
+
+@functools.lru_cache(maxsize=256)
+def _string(text: str) -> bytes:
+    """A string's CDR: its uint32 length (the NUL included), its UTF-8 bytes and a NUL (after
+    4-byte alignment). Cached: a tick writes the same finger names and frames again and again.
+    """
+    data = text.encode()
+    return _U32(len(data) + 1) + data + b"\x00"
+
+
+class CdrWriter:
+    """One classic little-endian CDR message (``CDR_LE``), written field by field.
+
+    The mirror of the readers above: every field aligned to its own size counted from the end
+    of the encapsulation header, the padding zeros; a string is its uint32 length (the NUL
+    included), its UTF-8 bytes and a NUL; a sequence its uint32 count and its elements (an empty
+    one is not aligned, as Fast CDR writes it).
+    """
+
+    __slots__ = ("buffer",)
+
+    def __init__(self) -> None:
+        self.buffer = bytearray(b"\x00\x01\x00\x00")
+
+    def _align(self, size: int) -> None:
+        buffer = self.buffer
+        buffer += _ZEROS[-(len(buffer) - _BODY) % size]
+
+    def uint32(self, value: int) -> None:
+        buffer = self.buffer
+        buffer += _ZEROS[-len(buffer) % 4]
+        buffer += _U32(value)
+
+    def int32(self, value: int) -> None:
+        buffer = self.buffer
+        buffer += _ZEROS[-len(buffer) % 4]
+        buffer += _I32(value)
+
+    def uint64(self, value: int) -> None:
+        self._align(8)
+        self.buffer += _U64(value)
+
+    def float64(self, value: float) -> None:
+        self._align(8)
+        self.buffer += _F64(value)
+
+    def string(self, text: str) -> None:
+        buffer = self.buffer
+        buffer += _ZEROS[-len(buffer) % 4]
+        buffer += _string(text)
+
+    def strings(self, texts) -> None:
+        """A ``string[]`` sequence."""
+        buffer = self.buffer
+        buffer += _ZEROS[-len(buffer) % 4]
+        buffer += _U32(len(texts))
+        for text in texts:
+            buffer += _ZEROS[-len(buffer) % 4]
+            buffer += _string(text)
+
+    def header(self, ns: int, frame_id: str = "") -> None:
+        """A ``std_msgs/Header`` stamped ``ns`` nanoseconds (its stamp first, as the readers
+        read it).
+        """
+        buffer = self.buffer
+        buffer += _ZEROS[-len(buffer) % 4]
+        buffer += _TIME(*divmod(int(ns), 1_000_000_000))
+        buffer += _string(frame_id)
+
+    def float64s(self, values) -> None:
+        """A fixed-size run of float64 fields (``Point``, ``Vector3``, ...), or the elements of
+        a sequence of such messages; nothing, not even alignment, for none.
+        """
+        data = np.asarray(values, dtype="<f8")
+        if data.size:
+            self._align(8)
+            self.buffer += data.tobytes()
+
+    def sequence(self, values, dtype: str = "<f8") -> None:
+        """A sequence of numbers (``float64[]`` by default; ``"<i4"`` int32, ``"u1"`` uint8):
+        its count, then its elements aligned to their size (nothing for none, as Fast CDR
+        writes it).
+        """
+        data = np.asarray(values, dtype=dtype)
+        self.uint32(data.size)
+        if data.size:
+            self._align(data.itemsize)
+            self.buffer += data.tobytes()
+
+    def data(self) -> bytes:
+        """The serialised message, ready for ``Publisher.publish``."""
+        return bytes(self.buffer)
+
+
+def pose_stamped_cdr(position, ns: int, frame_id: str) -> bytes:
+    """A ``geometry_msgs/PoseStamped`` of a fingertip centre (x, y), m, at z = 0 with the
+    identity orientation (:func:`..devices.pose_msg`'s message), serialised.
+    """
+    writer = CdrWriter()
+    writer.header(ns, frame_id)
+    writer.float64s((position[0], position[1], 0.0, 0.0, 0.0, 0.0, 1.0))
+    return writer.data()
+
+
+def wrench_stamped_cdr(force, torque, ns: int, frame_id: str) -> bytes:
+    """A ``geometry_msgs/WrenchStamped`` of a force (3,), N, and torque (3,), N m, serialised."""
+    writer = CdrWriter()
+    writer.header(ns, frame_id)
+    writer.float64s(np.concatenate((force, torque)))
+    return writer.data()
+
+
+def tactile_array_cdr(readings: TactileReadings, ns: int, frame_id: str) -> bytes:
+    """A ``squeeze_grasp_interfaces/TactileArray`` (angles rad, forces N), serialised.
+
+    Raises
+    ------
+    ValueError
+        If the arrays differ in length.
+    """
+    check_taxels(readings.finger, readings.angles, readings.normal, readings.tangential)
+    writer = CdrWriter()
+    writer.header(ns, frame_id)
+    writer.string(readings.finger)
+    for values in (readings.angles, readings.normal, readings.tangential):
+        writer.sequence(values)
+    return writer.data()
+
+
+def clock_cdr(ns: int) -> bytes:
+    """The ``rosgraph_msgs/Clock`` of sim time ``ns``, serialised."""
+    return b"\x00\x01\x00\x00" + _TIME(*divmod(int(ns), 1_000_000_000))
+
+
+def tick_cdr(index: int, ns: int, readings) -> bytes:
+    """The ``squeeze_grasp_interfaces/Tick`` of lockstep tick ``index`` at sim time ``ns``
+    (readings as "<device>/<stream>"), serialised.
+    """
+    writer = CdrWriter()
+    writer.header(ns)
+    writer.uint64(index)
+    writer.strings(readings)
+    return writer.data()
+
+
+def write_contact_arrays(writer: CdrWriter, ns: int, frame_id: str, fingers, nodes, angles,
+                         modes, forces_x, forces_y, depth: float, relative_depth: float) -> None:
+    """A ``squeeze_grasp_interfaces/ContactState`` (parallel per-contact arrays: angles rad,
+    forces N; depth m) into ``writer``.
+    """
+    writer.header(ns, frame_id)
+    writer.strings(fingers)
+    writer.sequence(nodes, "<i4")
+    writer.sequence(angles)
+    writer.sequence(modes, "u1")
+    writer.sequence(forces_x)
+    writer.sequence(forces_y)
+    writer.float64(depth)
+    writer.float64(relative_depth)
+

@@ -18,7 +18,7 @@ from squeeze_grasp_interfaces.msg import (
 )
 from squeeze_grasp_ros.mechanics.squeeze import contact_state
 from squeeze_grasp_ros.mechanics.vocabulary import ContactMode
-from squeeze_grasp_ros.ros.messages.common import float64_array, set_stamp, vector3
+from squeeze_grasp_ros.ros.messages.common import float64_array, vector3
 
 CONTACT_MODES: dict[ContactMode, int] = {ContactMode.STICK: ContactNode.STICK,
                                          ContactMode.SLIP: ContactNode.SLIP}
@@ -142,7 +142,7 @@ class TactileReadings:
     tangential: np.ndarray
 
 
-def _check_taxels(finger: str, *arrays: Sequence[float]) -> None:
+def check_taxels(finger: str, *arrays: Sequence[float]) -> None:
     """Raise ValueError unless the tactile arrays of ``finger`` have one entry per taxel."""
     sizes = {len(a) for a in arrays}
     if len(sizes) != 1:
@@ -157,7 +157,7 @@ def tactile_array_msg(readings: TactileReadings, header: Header | None = None) -
     ValueError
         If the arrays differ in length.
     """
-    _check_taxels(readings.finger, readings.angles, readings.normal, readings.tangential)
+    check_taxels(readings.finger, readings.angles, readings.normal, readings.tangential)
     return TactileArray(
         header=header or Header(),
         finger=readings.finger,
@@ -167,22 +167,6 @@ def tactile_array_msg(readings: TactileReadings, header: Header | None = None) -
     )
 
 
-def fill_tactile(
-    msg: TactileArray, normal: np.ndarray, tangential: np.ndarray, ns: int
-) -> TactileArray:
-    """Refill a :func:`tactile_array_msg` in place with new taxel forces, N, and stamp (the
-    taxel angles stay).
-
-    Raises
-    ------
-    ValueError
-        If the force arrays do not have one entry per taxel.
-    """
-    _check_taxels(msg.finger, msg.taxel_angles, normal, tangential)
-    set_stamp(msg.header.stamp, ns)
-    msg.normal_forces = float64_array(normal)
-    msg.tangential_forces = float64_array(tangential)
-    return msg
 
 
 def tactile_readings(msg: TactileArray) -> TactileReadings:

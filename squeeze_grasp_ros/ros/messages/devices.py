@@ -12,7 +12,7 @@ from std_msgs.msg import Header
 from squeeze_grasp_interfaces.msg import (
     Tick,
 )
-from squeeze_grasp_ros.ros.messages.common import header, set_stamp
+from squeeze_grasp_ros.ros.messages.common import header
 
 # --------------------------------------------------------------------------- pipeline: devices
 
@@ -26,12 +26,6 @@ def pose_msg(position: Sequence[float] | np.ndarray, ns: int, frame_id: str) -> 
     return msg
 
 
-def fill_pose(msg: PoseStamped, position: Sequence[float] | np.ndarray, ns: int) -> PoseStamped:
-    """Refill a :func:`pose_msg` in place with a new position (x, y), m, and stamp; returns it."""
-    set_stamp(msg.header.stamp, ns)
-    point = msg.pose.position
-    point.x, point.y = float(position[0]), float(position[1])
-    return msg
 
 
 def pose_position(msg: PoseStamped) -> np.ndarray:
@@ -56,15 +50,6 @@ def wrench_msg(force: np.ndarray, torque: np.ndarray, ns: int, frame_id: str) ->
     return msg
 
 
-def fill_wrench(
-    msg: WrenchStamped, force: np.ndarray, torque: np.ndarray, ns: int
-) -> WrenchStamped:
-    """Refill a :func:`wrench_msg` in place with a new force, N, torque, N m, and stamp."""
-    set_stamp(msg.header.stamp, ns)
-    f, t = msg.wrench.force, msg.wrench.torque
-    f.x, f.y, f.z = (float(v) for v in force)
-    t.x, t.y, t.z = (float(v) for v in torque)
-    return msg
 
 
 def wrench_force(msg: WrenchStamped) -> np.ndarray:

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
 from geometry_msgs.msg import PoseStamped
 
 from squeeze_grasp_interfaces.msg import GripperGrasp
@@ -24,6 +25,40 @@ def gripper_pose(candidate: GripperCandidate) -> PoseStamped:
     msg.pose.orientation.z = math.sin(0.5 * candidate.yaw)
     msg.pose.orientation.w = math.cos(0.5 * candidate.yaw)
     return msg
+
+
+PLANAR_TILT = 0.01
+"""Largest out-of-plane component of a gripper pose's closing direction (its x axis), as the
+sine of its tilt from the object plane (0.57 degrees)."""
+
+
+def gripper_line_pose(msg: PoseStamped, frame_id: str) -> tuple[np.ndarray, float]:
+    """The gripper centre (x, y), m, and closing direction's yaw, rad, of a ``PoseStamped`` in
+    the object frame ``frame_id``: the inverse of :func:`gripper_pose` (the x axis of the pose's
+    orientation is the closing direction; its projection on the plane is taken).
+
+    Raises
+    ------
+    ValueError
+        Another frame, values not finite, a quaternion of zero length, or an x axis tilted out
+        of the object plane beyond :data:`PLANAR_TILT`.
+    """
+    if msg.header.frame_id != frame_id:
+        raise ValueError(f"the gripper pose is in frame '{msg.header.frame_id}', not the object "
+                         f"frame '{frame_id}' (transform it with tf2 first)")
+    p, q = msg.pose.position, msg.pose.orientation
+    values = np.array([p.x, p.y, q.x, q.y, q.z, q.w])
+    norm = float(np.linalg.norm(values[2:]))
+    if not (np.all(np.isfinite(values)) and norm > 0.0):
+        raise ValueError(f"the gripper pose's position ({p.x}, {p.y}) and orientation "
+                         f"({q.x}, {q.y}, {q.z}, {q.w}) must be finite, the quaternion nonzero")
+    x, y, z, w = values[2:] / norm
+    axis = np.array([1 - 2 * (y * y + z * z), 2 * (x * y + w * z), 2 * (x * z - w * y)])
+    if abs(axis[2]) > PLANAR_TILT:
+        raise ValueError(f"the gripper pose's closing direction (its x axis) leaves the object "
+                         f"plane: its z component is {axis[2]:.4g}, at most {PLANAR_TILT:g} "
+                         "allowed")
+    return values[:2].copy(), float(np.arctan2(axis[1], axis[0]))
 
 
 def gripper_grasps(plan: GripperPlan) -> list[GripperGrasp]:

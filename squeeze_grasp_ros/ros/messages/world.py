@@ -17,8 +17,13 @@ from squeeze_grasp_interfaces.msg import (
 )
 from squeeze_grasp_ros.mechanics.squeeze import contact_state
 from squeeze_grasp_ros.mechanics.vocabulary import ContactMode
+from squeeze_grasp_ros.ros.messages.cdr import CdrWriter, write_contact_arrays
 from squeeze_grasp_ros.ros.messages.common import float64_array, header, set_stamp, stamp_ns
-from squeeze_grasp_ros.ros.messages.contacts import contact_event_msg, fill_contact_state
+from squeeze_grasp_ros.ros.messages.contacts import (
+    CONTACT_MODES,
+    contact_event_msg,
+    fill_contact_state,
+)
 from squeeze_grasp_ros.sim.world import WorldView
 
 # --------------------------------------------------------------------------- pipeline: ground trut
@@ -43,7 +48,7 @@ def fill_sim_state(
     msg: SimState, state: contact_state.ContactState, termination: str | None, ns: int
 ) -> SimState:
     """Refill a :func:`sim_state_msg` in place with a new state at sim time ``ns`` (its
-    fingers and frame stay): what the simulated hardware publishes every tick.
+    fingers and frame stay).
     """
     present = {f.name: f for f in state.fingers}
     work = []
@@ -59,6 +64,37 @@ def fill_sim_state(
     fill_contact_state(msg.contacts, state)
     msg.termination = termination or ""
     return msg
+
+
+def sim_state_cdr(
+    state: contact_state.ContactState,
+    fingers: Sequence[str],
+    termination: str | None,
+    ns: int,
+    frame_id: str,
+) -> bytes:
+    """:func:`sim_state_msg`'s message, serialised (:mod:`.cdr`): what the simulated hardware
+    publishes every tick, without a Python message in between.
+    """
+    present = {f.name: f for f in state.fingers}
+    rows = [(c.finger, c.node, c.theta, CONTACT_MODES[c.mode], c.force) for c in state.contacts]
+    names, nodes, angles, modes, forces = zip(*rows) if rows else ((),) * 5
+    forces = np.reshape(forces, (len(rows), 2))
+    totals = [forces[[name == f for name in names]].sum(axis=0) if f in names else (0.0, 0.0)
+              for f in fingers]
+    writer = CdrWriter()
+    writer.header(ns, frame_id)
+    writer.strings(fingers)
+    for values in ([(*present[f].center[:2], 0.0) if f in present else (0.0, 0.0, 0.0)
+                    for f in fingers],
+                   [(x, y, 0.0) for x, y in totals]):
+        writer.uint32(len(fingers))
+        writer.float64s(values)
+    writer.sequence([present[f].work if f in present else 0.0 for f in fingers])
+    write_contact_arrays(writer, ns, frame_id, names, nodes, angles, modes, forces[:, 0],
+                         forces[:, 1], state.depth, state.relative_depth)
+    writer.string(termination or "")
+    return writer.data()
 
 
 def sim_events_msg(

@@ -141,8 +141,6 @@ class ExecutorNode(Node):
         self.goal: _Goal | None = None
         self.latest: MonitorStatus | None = None
         self.answered = pipeline.TickAnswer()
-        self.setpoints = {f: messages.pose_msg((0.0, 0.0), 0, self.p["frame_id"])
-                          for f in self.setpoint_pubs}
         self.state = ExecutorStatus.IDLE
         if p["lockstep"]:
             self.participant = pipeline.Participant(self, "executor", [pipeline.STATUS],
@@ -222,8 +220,7 @@ class ExecutorNode(Node):
             self._action_cycle(goal, command, obs, ns, now_ns)
             return
         stamp = ns + self.period_ns if now_ns is None else now_ns
-        batch = [(self.setpoint_pubs[f], messages.fill_pose(self.setpoints[f], xy, stamp))
-                 for f, xy in command.setpoints.items() if f in self.setpoint_pubs]
+        batch = self._setpoints(command, stamp)
         if self.jaws is not None:
             batch.append(self.jaws.trajectory(command.setpoints, ns if now_ns is None else 0))
         self.answered.answer(ns, batch)
@@ -232,6 +229,14 @@ class ExecutorNode(Node):
             self.goal = None
             goal.done.set_result(messages.grasp_result(
                 goal.program, command, obs, goal.events, (ns - goal.start_ns) * 1e-9, SUCCESS))
+
+    def _setpoints(self, command: Command, stamp: int) -> list:
+        """(publisher, serialised PoseStamped) of each commanded finger with a setpoint topic,
+        stamped ``stamp`` (:mod:`..messages.cdr`).
+        """
+        frame = self.p["frame_id"]
+        return [(self.setpoint_pubs[f], messages.pose_stamped_cdr(xy, stamp, frame))
+                for f, xy in command.setpoints.items() if f in self.setpoint_pubs]
 
     def _unseen(self, goal: _Goal, msg: MonitorStatus, ns: int) -> bool:
         """True while a finger of the goal has no reading yet (hardware mode: a goal sent before
@@ -262,8 +267,7 @@ class ExecutorNode(Node):
         """
         action = self.jaw_action
         stamp = ns + self.period_ns if now_ns is None else now_ns
-        batch = [(self.setpoint_pubs[f], messages.fill_pose(self.setpoints[f], xy, stamp))
-                 for f, xy in command.setpoints.items() if f in self.setpoint_pubs]
+        batch = self._setpoints(command, stamp)
         batch.append(action.cycle_msg(ns))
         self.answered.answer(ns, [])
 

@@ -42,8 +42,8 @@ class ForceWatcher:
 
     def tick(self, out: TrackerOutput, samples: Mapping[str, FingerSample],
              frame_id: str) -> tuple[list[tuple[Any, Any]], tuple[TrackedAlarm, ...]]:
-        """The tick's residual message (as ``(publisher, message)``) and its alarms; only
-        fingers with a wrench or tactile reading in ``samples`` are judged.
+        """The tick's residual message (as ``(publisher, serialised message)``) and its
+        alarms; only fingers with a wrench or tactile reading in ``samples`` are judged.
         """
         for finger, position in out.positions.items():
             self.start.setdefault(finger, position)
@@ -57,9 +57,8 @@ class ForceWatcher:
         if check is None:
             return [], ()
         fingers = list(check.measured)
-        msg = ForceResidual(header=messages.header(out.stamp_ns, frame_id), depth=check.depth,
-                            fingers=fingers, tolerance=float(self.tolerance),
-                            measured=[check.measured[f] for f in fingers],
-                            predicted=[check.predicted[f] for f in fingers],
-                            relative_error=[check.relative_error[f] for f in fingers])
-        return [(self.residual_pub, msg)], check.alarms
+        data = messages.force_residual_cdr(
+            out.stamp_ns, frame_id, check.depth, fingers, [check.measured[f] for f in fingers],
+            [check.predicted[f] for f in fingers], [check.relative_error[f] for f in fingers],
+            float(self.tolerance))
+        return [(self.residual_pub, data)], check.alarms

@@ -182,7 +182,7 @@ class HandCommands:
         return True
 
     def effort_problem(self, goal: GraspGoal) -> str | None:
-        """None: the hand's joint efforts are not modelled."""
+        """None: no effort limit of the hand is modelled."""
         del goal
         return None
 

@@ -27,7 +27,8 @@ Joint feedback (``controller_scene``: a scene whose ``controller:`` section maps
 parallel gripper, and no ``wrench`` or ``tactile`` stream): the jaws' only sensor is the
 controller's ``joint_states`` (``sensor_msgs/JointState``, listed in each tick's readings). The
 aperture and jaw force come through the transmission (:mod:`..control.joint_feedback`): the
-jaws' positions on the jaw line (fixed by their first pose readings, the gripper's pose) give
+jaws' positions on the jaw line (fixed by the gripper's pose: the ``gripper_pose`` parameter, else
+the ``gripper_pose`` topic, else the jaws' first pose readings) give
 the depth, the force ``wrench`` stands in for, first touch, ``contact_lost`` and the slip watch's
 ``slip_imminent`` (the jaws close while the force stops rising); events A-D need taxels, so
 none are tracked and the prediction's events are not compared (the force watch is).
@@ -35,7 +36,9 @@ none are tracked and the prediction's events are not compared (the force watch i
 The Barrett hand under a JointTrajectoryController (``controller: {device: bh8, ...}``): the
 carried fingers' positions come from ``joint_states`` through the hand's forward kinematics
 (:mod:`..control.barrett`) in place of their pose readings; their force and tactile sensors
-are read as on the setpoint route.
+are read as on the setpoint route, or, without them, their forces come from the joint efforts
+(J^T F = tau per finger; a posture where that is ill-conditioned is refused) with the slip
+watch on fingers 1 and 2 as on a gripper's jaws.
 """
 from __future__ import annotations
 
@@ -46,6 +49,7 @@ from typing import Any
 import numpy as np
 from geometry_msgs.msg import PoseStamped, WrenchStamped
 from rclpy.node import Node
+from rclpy.parameter import Parameter
 from sensor_msgs.msg import JointState
 
 from squeeze_grasp_interfaces.msg import (
@@ -56,11 +60,12 @@ from squeeze_grasp_interfaces.msg import (
     TactileArray,
     Tick,
 )
+from squeeze_grasp_ros.control.barrett import MAX_CONDITION, SingularPosture
 from squeeze_grasp_ros.control.joint_feedback import JointSlipWatch
 from squeeze_grasp_ros.control.joint_trajectory import JawLine
 from squeeze_grasp_ros.control.tracker import ContactTracker, FingerSample, TrackerConfig
 from squeeze_grasp_ros.ros import messages
-from squeeze_grasp_ros.ros.nodes import pipeline, run_node
+from squeeze_grasp_ros.ros.nodes import ParameterError, pipeline, run_node
 from squeeze_grasp_ros.ros.nodes.force_watcher import ForceWatcher
 from squeeze_grasp_ros.ros.nodes.shape_watcher import ShapeWatcher
 from squeeze_grasp_ros.ros.nodes.sim_controllers import JOINT_STATES
@@ -102,6 +107,13 @@ PARAMETERS: dict[str, tuple[Any, str]] = {
                                 "measured, m"),
     "joint_slip_ratio": (0.5, "joint feedback: tangent / secant jaw stiffness below which "
                               "slip_imminent is raised"),
+    "hand_max_condition": (MAX_CONDITION, "Barrett hand on joint efforts: largest condition "
+                                          "number of a finger's J^T at which its tip force is "
+                                          "read"),
+    "gripper_pose": (Parameter.Type.DOUBLE_ARRAY,
+                     "joint feedback: the gripper's centre and closing direction in the object "
+                     "frame, [x m, y m, yaw deg], fixing the jaw line (else the gripper_pose "
+                     "topic, else the jaws' pose readings)"),
 }
 """Parameter name -> (typed default, description); config/monitor.yaml sets them."""
 POSE_JOINT_TOLERANCE = 1e-5
@@ -141,13 +153,16 @@ class MonitorNode(Node):
         streams = [s for s in p["streams"] if s]
         self.jaws = JointFeedback.of(p, streams)
         """The jaws on joint feedback (None: the sensors' route)."""
-        self.hand = HandFeedback.of(p) if self.jaws is None else None
+        self.hand = HandFeedback.of(p, streams) if self.jaws is None else None
         """The Barrett hand's fingers positioned by its joint states (None: their poses)."""
+        self.joint_forces = self.jaws is not None or (self.hand is not None
+                                                      and self.hand.watch is not None)
+        """The forces come from joint efforts (no fingertip sensor: no events A-D)."""
         self.tracker = ContactTracker(TrackerConfig(
             p["mu"], p["load_threshold"], p["edge_tolerance"], p["alarm_ratio"],
             p["match_margin"], p["stale_after"], p["weight"] or None,
             p["prediction_tolerance"], p["relative_per_depth"]), list(self.fingers),
-            streams if self.jaws is None else ["wrench"])
+            ["wrench"] if self.joint_forces else streams)
         loop = pipeline.loop_qos(p["qos_depth"])
         sensors = pipeline.sensor_qos(p["sensor_qos"], p["qos_depth"])
         types = {"pose": PoseStamped, "wrench": WrenchStamped, "tactile": TactileArray}
@@ -160,6 +175,11 @@ class MonitorNode(Node):
                     msg_type, pipeline.device_topic(device, stream),
                     lambda data, k=key, read=READINGS[stream]: self._reading(k, *read(data)),
                     sensors, raw=True)
+        if self.jaws is not None:
+            self.create_subscription(PoseStamped, pipeline.GRIPPER_POSE,
+                                     lambda msg: self.jaws.set_pose(msg, p["frame_id"],
+                                                                    self.get_logger()),
+                                     pipeline.LATCHED)
         if self.jaws is not None or self.hand is not None:
             self.keys[JOINT_STATES] = ("", JOINT_STATES)
             self.create_subscription(
@@ -177,16 +197,13 @@ class MonitorNode(Node):
         self.buffer: dict[int, dict[str, Any]] = {}
         self.expected: dict[int, set[str]] = {}
         self.answered = pipeline.TickAnswer()
-        self.reused: tuple[ContactState, MonitorStatus] | None = None
-        """The contact state and status messages, built at the first tick and refilled in
-        place after it (the answer kept for a repeated tick is always the newest)."""
         self.active_alarms: set[tuple[str, str]] = set()
         self.shapes = (ShapeWatcher(self, self.alarm_pub, p["shape_mismatch_threshold"],
                                     p["object_height"]) if p["shape_watch"] else None)
         self.forces = (ForceWatcher(self, p["force_tolerance"], p["force_min_fraction"], loop)
                        if p["force_watch"] else None)
         if p["lockstep"]:
-            self.create_subscription(Tick, pipeline.TICK, self._tick, loop)
+            self.create_subscription(Tick, pipeline.TICK, self._tick, loop, raw=True)
             self.participant = pipeline.Participant(self, "monitor", [pipeline.TICK],
                                                     [self.status_pub])
         else:
@@ -198,13 +215,14 @@ class MonitorNode(Node):
         """What the ready line of ``ros2 run`` says: fingers, streams, friction, clock."""
         clock = "lockstep" if self.p["lockstep"] else f"rate {self.p['rate']} Hz"
         streams = [s for s in self.p["streams"] if s] if self.jaws is None else [
-            f"{JOINT_STATES} of {self.jaws.controller.spec.name}"]
+            f"{JOINT_STATES} of {self.jaws.controller.spec.name} ({self.jaws.source()})"]
         if self.hand is not None:
-            streams.append(f"{JOINT_STATES} of {self.hand.controller.spec.name} (positions)")
+            read = "positions" if self.hand.watch is None else "positions and efforts"
+            streams.append(f"{JOINT_STATES} of {self.hand.controller.spec.name} ({read})")
         return f"fingers {self.fingers}, streams {streams}, mu {self.p['mu']}, {clock}"
 
     def _prediction(self, msg: ContactEventArray) -> None:
-        if self.jaws is None:
+        if not self.joint_forces:
             self.tracker.set_prediction(messages.predicted_events(msg))
         if self.forces is not None:
             self.forces.set_prediction(msg)
@@ -221,11 +239,12 @@ class MonitorNode(Node):
         self.buffer.setdefault(ns, {})[key] = msg
         self._try_close(ns)
 
-    def _tick(self, msg: Tick) -> None:
-        ns = messages.stamp_ns(msg.header.stamp)
+    def _tick(self, data: bytes) -> None:
+        """A ``sim/tick``, read from its CDR bytes (:mod:`..messages.cdr`)."""
+        ns, readings = messages.tick_readings_cdr(data)
         if not self.answered.is_new(ns):
             return
-        self.expected[ns] = set(msg.readings) & self.keys.keys()
+        self.expected[ns] = set(readings) & self.keys.keys()
         self._try_close(ns)
 
     def _try_close(self, ns: int) -> None:
@@ -256,8 +275,9 @@ class MonitorNode(Node):
     def _process(self, ns: int) -> None:
         samples = self._samples()
         out = self.tracker.update(ns, samples)
-        if self.jaws is not None:
-            out = dataclasses.replace(out, alarms=out.alarms + self.jaws.alarms)
+        watched = self.jaws or self.hand
+        if watched is not None and watched.alarms:
+            out = dataclasses.replace(out, alarms=out.alarms + watched.alarms)
         frame = self.p["frame_id"]
         batch = [(self.event_pub, messages.tracked_events_msg(out))] if out.events else []
         if self.forces is not None:
@@ -268,65 +288,117 @@ class MonitorNode(Node):
         batch += [(self.alarm_pub, messages.alarm_msg(a, ns)) for a in out.alarms
                   if (a.type, a.finger) not in self.active_alarms]
         self.active_alarms = active
-        if self.reused is None:
-            self.reused = (messages.patches_state_msg(out, frame),
-                           messages.monitor_status_msg(out, frame))
-        else:
-            messages.fill_patches_state(self.reused[0], out)
-            messages.fill_monitor_status(self.reused[1], out)
-        batch.append((self.state_pub, self.reused[0]))
+        batch.append((self.state_pub, messages.patches_state_cdr(out, frame)))
         for publisher, msg in batch:
             publisher.publish(msg)
-        self.answered.answer(ns, [(self.status_pub, self.reused[1])])
+        self.answered.answer(ns, [(self.status_pub, messages.monitor_status_cdr(out, frame))])
         if self.shapes is not None:
             self.shapes.tick(ns, out.depth)
 
 
 class HandFeedback:
     """The Barrett hand's carried fingers positioned by ``joint_states`` through the forward
-    kinematics, in place of their pose readings.
+    kinematics, in place of their pose readings; without fingertip sensors (``watch`` given),
+    also their forces from the joint efforts (J^T F = tau per finger,
+    :meth:`..control.barrett.BarrettHand.tip_force`) in place of their wrenches, and the slip
+    watch on the two fingers as on a gripper's jaws (:class:`..control.joint_feedback.
+    JointSlipWatch`: the distance between the tips' centres for the aperture, the mean of the
+    two pushes along the line between them for the jaw force).
 
     Parameters
     ----------
     controller : HandController
+    watch : JointSlipWatch, optional
+        The slip watch of the two carried fingers (None: their force sensors are read).
+    max_condition : float
+        The largest condition number of a finger's J^T whose efforts are read.
     """
 
-    def __init__(self, controller: HandController) -> None:
-        self.controller = controller
+    def __init__(self, controller: HandController, watch: JointSlipWatch | None = None, *,
+                 max_condition: float = MAX_CONDITION) -> None:
+        self.controller, self.watch, self.max_condition = controller, watch, max_condition
         self.stamp_ns: int | None = None
+        self.watched_ns: int | None = None
+        self.singular = False
+        self.alarms: tuple = ()
+        """The slip watch's alarms of the newest joint state."""
 
     @classmethod
-    def of(cls, p: dict[str, Any]) -> HandFeedback | None:
+    def of(cls, p: dict[str, Any], streams: list[str]) -> HandFeedback | None:
         """The hand's feedback of the monitor's parameters ``p``: None unless the
-        ``controller_scene``'s controller is the Barrett hand.
+        ``controller_scene``'s controller is the Barrett hand; its efforts are read without a
+        ``wrench`` or ``tactile`` stream.
         """
         if not p["controller_scene"]:
             return None
         controller = scene_controller(load_scene(p["controller_scene"]), p["controller_scene"])
-        return cls(controller) if isinstance(controller, HandController) else None
+        if not isinstance(controller, HandController):
+            return None
+        max_condition = p.get("hand_max_condition", MAX_CONDITION)
+        if not max_condition >= 1.0:
+            raise ParameterError(f"hand_max_condition must be >= 1 (a condition number), got "
+                                 f"{max_condition}")
+        watch = None if {"wrench", "tactile"} & set(streams) else JointSlipWatch(
+            controller.jaws, contact_force=p["load_threshold"], window=p["joint_slip_window"],
+            ratio=p["joint_slip_ratio"])
+        return cls(controller, watch, max_condition=max_condition)
 
     def replace(self, fields: dict[str, dict[str, Any]], msg: JointState | None,
                 logger: Any) -> None:
-        """Put the carried fingers' tip positions of joint state ``msg`` into the tracker's
-        sample ``fields``; a state without every hand joint, or not finite, is ignored with a
-        warning (the poses stay).
+        """Put the carried fingers' tip positions (and, reading efforts, forces) of joint state
+        ``msg`` into the tracker's sample ``fields``; a state without every hand joint, not
+        finite, or (reading efforts) at a posture whose efforts do not determine a tip force is
+        ignored with a warning (the readings go stale).
         """
         if msg is None:
             return
         ns = messages.stamp_ns(msg.header.stamp)
+        hand, fingers = self.controller.hand, self.controller.fingers
         joints = dict(zip(msg.name, msg.position))
         try:
             if len(msg.position) != len(msg.name) or not np.all(np.isfinite(msg.position)):
                 raise ValueError(f"positions {list(msg.position)} are not one finite value per "
                                  f"name {list(msg.name)}")
-            tips = self.controller.hand.forward(joints)
+            tips = hand.forward(joints)
+            pushes = {} if self.watch is None else self._pushes(msg, joints)
+        except SingularPosture as exc:
+            if not self.singular:
+                logger.warning(f"ignored the joint states from {ns * 1e-9:.3f} s on: {exc}")
+            self.singular = True
+            return
         except ValueError as exc:
             if ns != self.stamp_ns:
                 logger.warning(f"ignored the joint state of {ns * 1e-9:.3f} s: {exc}")
                 self.stamp_ns = ns
             return
-        for finger, hand_finger in self.controller.fingers.items():
+        self.singular = False
+        for finger, hand_finger in fingers.items():
             fields[finger]["position"] = tips[hand_finger]
+            if self.watch is not None:
+                # the wrench of the object on the finger: minus the finger's push
+                fields[finger].update(force=np.append(-pushes[finger], 0.0), force_stamp_ns=ns)
+        if self.watch is not None and ns != self.watched_ns:
+            self.watched_ns = ns
+            first, second = (tips[fingers[f]] for f in self.controller.jaws)
+            distance = float(np.hypot(*(second - first)))
+            u = (second - first) / distance
+            one, other = (pushes[f] for f in self.controller.jaws)
+            force = 0.5 * float(np.dot(one, u) - np.dot(other, u))
+            touched = self.watch.first_touch
+            self.alarms = self.watch.update(distance, force)
+            if touched is None and self.watch.first_touch is not None:
+                logger.info(f"first touch of the hand's fingers at tip distance "
+                            f"{self.watch.first_touch * 1e3:.4f} mm (force {force:.4g} N)")
+
+    def _pushes(self, msg: JointState, joints: dict[str, float]) -> dict[str, np.ndarray]:
+        """Each carried finger's push on the object (N) from the efforts of ``msg``."""
+        if len(msg.effort) != len(msg.name) or not np.all(np.isfinite(msg.effort)):
+            raise ValueError(f"efforts {list(msg.effort)} are not one finite value per name "
+                             f"{list(msg.name)}")
+        efforts = dict(zip(msg.name, msg.effort))
+        return {finger: self.controller.hand.tip_force(
+                    hand_finger, joints, efforts, max_condition=self.max_condition).force
+                for finger, hand_finger in self.controller.fingers.items()}
 
 
 class JointFeedback:
@@ -338,8 +410,13 @@ class JointFeedback:
     watch : JointSlipWatch
     """
 
-    def __init__(self, controller: JawController, watch: JointSlipWatch) -> None:
+    def __init__(self, controller: JawController, watch: JointSlipWatch, *,
+                 pose: tuple[np.ndarray, float] | None = None) -> None:
         self.controller, self.watch = controller, watch
+        self.posed: JawLine | None = None
+        """The jaw line of the gripper's pose (parameter or topic; None: the jaws' poses)."""
+        if pose is not None:
+            self.posed = JawLine.at_pose(*pose, reach=controller.gripper.pad.contact_radius)
         self.line: JawLine | None = None
         self.stamp_ns: int | None = None
         self.alarms: tuple = ()
@@ -353,11 +430,39 @@ class JointFeedback:
         if not p["controller_scene"] or {"wrench", "tactile"} & set(streams):
             return None
         controller = scene_controller(load_scene(p["controller_scene"]), p["controller_scene"])
-        if controller is None:
+        if not isinstance(controller, JawController):
             return None
+        pose = p.get("gripper_pose")
+        if pose is not None:
+            if len(pose) != 3 or not np.all(np.isfinite(pose)):
+                raise ParameterError(f"gripper_pose must be [x m, y m, yaw deg], three finite "
+                                     f"numbers, got {list(pose)}")
+            pose = (np.array(pose[:2], float), float(np.deg2rad(pose[2])))
         return cls(controller, JointSlipWatch(
             controller.jaws, contact_force=p["load_threshold"], window=p["joint_slip_window"],
-            ratio=p["joint_slip_ratio"]))
+            ratio=p["joint_slip_ratio"]), pose=pose)
+
+    def set_pose(self, msg: PoseStamped, frame_id: str, logger: Any) -> None:
+        """Take the gripper's pose from a ``gripper_pose`` message (it replaces the parameter);
+        a pose in another frame, not finite or tilted out of the plane is ignored with a
+        warning.
+        """
+        try:
+            centre, yaw = messages.gripper_line_pose(msg, frame_id)
+        except ValueError as exc:
+            logger.warning(f"ignored the {pipeline.GRIPPER_POSE} message: {exc}")
+            return
+        self.posed = JawLine.at_pose(centre, yaw,
+                                     reach=self.controller.gripper.pad.contact_radius)
+        logger.info(f"{pipeline.GRIPPER_POSE}: {self.source()}")
+
+    def source(self) -> str:
+        """Where the jaw line comes from (the ready line)."""
+        if self.posed is not None:
+            c, d = self.posed.centre, self.posed.direction
+            return (f"jaw line at ({c[0]:.6g}, {c[1]:.6g}) m, yaw "
+                    f"{np.rad2deg(np.arctan2(d[1], d[0])):.6g} deg")
+        return f"jaw line from {pipeline.GRIPPER_POSE} or the jaws' poses"
 
     def replace(self, fields: dict[str, dict[str, Any]], msg: JointState | None,
                 logger: Any) -> None:
@@ -365,9 +470,13 @@ class JointFeedback:
         ``fields`` (finger -> FingerSample keywords); run the slip watch on a new state.
         """
         first, second = self.controller.jaws
+        if msg is None:
+            return
+        if self.posed is not None:
+            self.line = self.posed
         fixed = self.line is None
         if fixed:
-            if msg is None or any("position" not in fields[j] for j in (first, second)):
+            if any("position" not in fields[j] for j in (first, second)):
                 return
             self.line = self.controller.jaw_line({j: fields[j]["position"]
                                                   for j in (first, second)})

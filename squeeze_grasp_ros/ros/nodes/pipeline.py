@@ -24,6 +24,7 @@ from typing import Any
 from rcl_interfaces.msg import ParameterDescriptor
 from rclpy.clock import Clock, ClockType
 from rclpy.node import Node
+from rclpy.parameter import Parameter
 from rclpy.qos import (
     DurabilityPolicy,
     HistoryPolicy,
@@ -58,6 +59,9 @@ gripper action controller for that tick were acknowledged (the lockstep of the a
 JOINT_STATES = "joint_states"
 """The joint_state_broadcaster's topic (a stock controller's joint feedback)."""
 OBJECT_POSE = "object_pose"
+GRIPPER_POSE = "gripper_pose"
+"""geometry_msgs/PoseStamped of a parallel gripper in the object frame (its centre, x axis the
+closing direction: ``plan_gripper_grasp``'s pose), from which the monitor fixes the jaw line."""
 ACTION = "executor/execute_grasp"
 CAMERA_MASK = "camera/mask"
 CAMERA_DEPTH = "camera/depth"
@@ -232,11 +236,19 @@ written is not replaced (a history of one lost 1-2 of 7 masks per multi-process 
 
 
 def declare(node: Node, parameters: Mapping[str, tuple[Any, str]]) -> dict[str, Any]:
-    """Declare typed parameters (float ones also accept YAML integers); return their values."""
+    """Declare typed parameters (float ones also accept YAML integers); return their values.
+
+    A default that is a ``Parameter.Type`` declares a parameter of that type without a default
+    (its value None unless given).
+    """
     values = {}
     for name, (default, description) in parameters.items():
         node.declare_parameter(name, default, ParameterDescriptor(
             description=description, dynamic_typing=isinstance(default, float)))
+        if isinstance(default, Parameter.Type):
+            # typed without a default: None unless given
+            values[name] = node.get_parameter_or(name, Parameter(name, value=None)).value
+            continue
         value = node.get_parameter(name).value
         values[name] = float(value) if isinstance(default, float) else value
     return values

@@ -226,8 +226,10 @@ class SimHandTrajectoryController(TrajectoryTopic):
     refused); each tick the commanded joints become the carried fingers' tip setpoints through
     the forward kinematics (:mod:`..control.barrett`), which the world's devices follow as any
     setpoint. ``joint_states`` carries every joint's position, from the inverse kinematics of
-    the measured tips (the closest configuration, distal joints coupled); no effort (the
-    simulated hand has no joint torque sensing).
+    the measured tips (the closest configuration, distal joints coupled), and its effort: the
+    statics of the planar model, tau = J^T F at each carried finger's joints for the finger's
+    ground-truth push F on the object (:meth:`..control.barrett.BarrettHand.efforts`; each
+    joint's own torque; 0 at the joints of fingers the scene does not carry).
 
     Parameters
     ----------
@@ -290,7 +292,11 @@ class SimHandTrajectoryController(TrajectoryTopic):
         positions = {r.finger: r.position for r in out.readings}
         self.joints = self.hand.inverse(self._measured(positions), rest=self.joints,
                                         tolerance=np.inf).joints
+        efforts = self.hand.efforts(self.joints, {
+            hand_finger: out.state.finger_force(finger)[:2]
+            for finger, hand_finger in self.controller.fingers.items()})
         msg = self.state_msg
         messages.set_stamp(msg.header.stamp, out.stamp_ns)
         msg.position = [float(self.joints[j]) for j in JOINTS]
+        msg.effort = [efforts[j] for j in JOINTS]
         return self.state_pub, msg

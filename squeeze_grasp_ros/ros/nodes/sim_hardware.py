@@ -27,7 +27,6 @@ import sys
 import time
 from typing import Any
 
-import numpy as np
 from geometry_msgs.msg import PoseStamped, WrenchStamped
 from rclpy.node import Node
 from rosgraph_msgs.msg import Clock
@@ -100,9 +99,6 @@ class SimHardwareNode(Node):
                             for f, d in self.devices.items() if sensed}
         self.tactile_pubs = {f: pub(TactileArray, pipeline.device_topic(d, "tactile"), sensors)
                              for f, d in self.devices.items() if f in world.layouts}
-        self.msgs = {f: self._reading_messages(f) for f in self.devices}
-        self.state_msg: SimState | None = None
-        """The ground truth message, built at tick 0 and refilled in place after it."""
         self.tick_pub = pub(Tick, pipeline.TICK, kept)
         self.state_pub = pub(SimState, pipeline.SIM_STATE, kept)
         self.event_pub = pub(ContactEventArray, pipeline.SIM_EVENTS, loop)
@@ -151,20 +147,6 @@ class SimHardwareNode(Node):
         return (f"scene {self.world.scene.name}, fingers {self.devices}{jaws}, "
                 f"dt {self.world.dt} s; waiting for {list(self.p['participants'])}")
 
-    def _reading_messages(self, finger: str) -> dict[str, Any]:
-        """One message per reading of ``finger``, refilled every tick (frames and taxel
-        angles set once).
-        """
-        tip = f"{finger}_tip"
-        out: dict[str, Any] = {"pose": messages.pose_msg((0.0, 0.0), 0, self.frame),
-                               "wrench": messages.wrench_msg(np.zeros(3), np.zeros(3), 0, tip)}
-        if finger in self.world.layouts:
-            angles = self.world.layouts[finger].angles
-            out["tactile"] = messages.tactile_array_msg(messages.TactileReadings(
-                finger, angles, np.zeros_like(angles), np.zeros_like(angles)),
-                messages.header(0, tip))
-        return out
-
     # ----------------------------------------------------------------- the loop
     def _start(self) -> None:
         self.get_logger().info(f"lockstep start: fingers {self.devices}, dt {self.world.dt} s")
@@ -197,25 +179,26 @@ class SimHardwareNode(Node):
     def _publish(self, out: TickOutput) -> None:
         """Publish tick ``out`` (clock first, sim/tick last) and keep it for a re-send.
 
-        The per-device readings and the ground truth are refilled in place (one message
-        object per publisher); markers are built only at the display rate and only while
-        somebody subscribes.
+        The tick's clock, readings, ground truth and tick message go out as CDR written
+        straight from the world's arrays (:mod:`..messages.cdr`); markers are built only at the
+        display rate and only while somebody subscribes.
         """
         ns, frame = out.stamp_ns, self.frame
-        batch = [(self.clock_pub, messages.clock_msg(ns))]
+        batch = [(self.clock_pub, messages.clock_cdr(ns))]
         readings = []
         for r in out.readings:
-            device, msgs = self.devices[r.finger], self.msgs[r.finger]
+            device, tip = self.devices[r.finger], f"{r.finger}_tip"
             batch.append((self.pose_pubs[r.finger],
-                          messages.fill_pose(msgs["pose"], r.position, ns)))
+                          messages.pose_stamped_cdr(r.position, ns, frame)))
             readings.append(f"{device}/pose")
             if r.force is not None:
                 batch.append((self.wrench_pubs[r.finger],
-                              messages.fill_wrench(msgs["wrench"], r.force, r.torque, ns)))
+                              messages.wrench_stamped_cdr(r.force, r.torque, ns, tip)))
                 readings.append(f"{device}/wrench")
             if r.normal is not None:
-                batch.append((self.tactile_pubs[r.finger],
-                              messages.fill_tactile(msgs["tactile"], r.normal, r.tangential, ns)))
+                batch.append((self.tactile_pubs[r.finger], messages.tactile_array_cdr(
+                    messages.TactileReadings(r.finger, self.world.layouts[r.finger].angles,
+                                             r.normal, r.tangential), ns, tip)))
                 readings.append(f"{device}/tactile")
         ending = out.termination is not None and not self.ended
         self.ended = self.ended or ending
@@ -225,17 +208,13 @@ class SimHardwareNode(Node):
         if self.controller is not None:
             batch.append(self.controller.joint_state(out))
             readings.append(JOINT_STATES)
-        if self.state_msg is None:
-            self.state_msg = messages.sim_state_msg(out.state, self.world.fingers,
-                                                    out.termination, ns, frame)
-        else:
-            messages.fill_sim_state(self.state_msg, out.state, out.termination, ns)
-        batch.append((self.state_pub, self.state_msg))
+        batch.append((self.state_pub, messages.sim_state_cdr(out.state, self.world.fingers,
+                                                             out.termination, ns, frame)))
         if out.index == 0:
             batch += self.first_frame
         elif (frame_out := self.world.camera_frame(out.index, ns)) is not None:
             batch += camera_messages(self.camera_pubs, frame_out)
-        tick = (self.tick_pub, messages.tick_msg(out.index, ns, readings))
+        tick = (self.tick_pub, messages.tick_cdr(out.index, ns, readings))
         self.current, self.now_ns = batch + [tick], ns
         if self._display_due(out.index) and self.marker_pub.get_subscription_count() > 0:
             batch.append((self.marker_pub, messages.world_markers(self.world.view(), ns, frame)))

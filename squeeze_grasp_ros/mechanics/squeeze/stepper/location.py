@@ -2,14 +2,15 @@
 # SPDX-License-Identifier: Apache-2.0
 """Root location: which event functions crossed zero in a substep, and where the first did.
 
-A function that changes sign in a substep [a, b] is located to a bracket of depth width
-<= ``event_tol`` * L: one with slopes at both ends on its cubic Hermite interpolants (2-3
-evaluations per event), the others by a safeguarded Illinois (regula falsi) iteration
-(:func:`locate_sign_change`). :func:`earliest_crossing` takes the crossings in the order of
-their interpolated roots; one still positive at the start of the earliest bracket needs no
-location of its own. The earliest bracket end wins, so the state at an event has the condition
-just met; it lands about a quarter tolerance past the root, never on it, where functions
-crossing at the same point would have round-off signs.
+A function that changes sign in a substep [a, b] is located to a bracket of depth width <=
+``event_tol`` * L: one with slopes at both ends on its cubic Hermite interpolants (2-3
+evaluations per event; 1-2 where evaluations are dear and those whose outcome is sure are
+skipped: :func:`surely_positive`), the others by a safeguarded Illinois (regula falsi)
+iteration (:func:`locate_sign_change`). :func:`earliest_crossing` takes the crossings in the
+order of their interpolated roots; one still positive at the start of the earliest bracket
+needs no location of its own. The earliest bracket end wins, so the state at an event has the
+condition just met; it lands about a quarter tolerance past the root, never on it, where
+functions crossing at the same point would have round-off signs.
 
 Everything here is a function of its arguments: the functions are given as callables of
 (key, s), so it is tested on known functions as well as on the stepper's.
@@ -24,8 +25,9 @@ from squeeze_grasp_ros.mechanics.errors import NumericalError
 from squeeze_grasp_ros.mechanics.squeeze.event_key import EventKey
 from squeeze_grasp_ros.mechanics.squeeze.stepper.functions import WatchedValues
 
-__all__ = ["MAX_ROOT_ITERATIONS", "crossings", "dips_inside", "earliest_crossing",
-           "hermite_dips", "hermite_root", "locate_sign_change"]
+__all__ = ["MAX_ROOT_ITERATIONS", "SURE_MARGIN", "crossings", "dips_inside",
+           "earliest_crossing", "hermite_curvature", "hermite_dips", "hermite_root",
+           "locate_sign_change", "surely_positive"]
 
 MAX_ROOT_ITERATIONS = 200
 
@@ -58,6 +60,43 @@ def hermite_root(a: float, b: float, ga: float, gb: float, ra: float, rb: float)
     return float(a + t[0] * (b - a)) if len(t) else None
 
 
+def hermite_curvature(a: float, b: float, ga: float, gb: float, ra: float, rb: float) -> float:
+    """Largest |d^2/ds^2| on [a, b] of the cubic Hermite interpolant (values ga, gb and slopes
+    ra, rb at a, b): its second derivative is linear, so the larger of its end values.
+
+    >>> hermite_curvature(0.0, 2.0, 0.0, 4.0, 0.0, 4.0)  # s^2
+    2.0
+    """
+    h = b - a
+    c3, c2, _, _ = _hermite_coefficients(ga, gb, ra, rb, h)
+    return float(max(abs(2 * c2), abs(6 * c3 + 2 * c2)) / (h * h))
+
+
+SURE_MARGIN = 0.2
+"""A sign is certain from a Taylor model when the model's value clears zero by this fraction of
+the change its slope makes over the step, after the curvature bound: for a gap about 1e-10 L at
+the default 1e-9 L event tolerance, far above the round-off of a converged evaluation (with and
+without the skips, the neo-Hookean foam square's event depths agree to 4e-16 L)."""
+
+
+def surely_positive(g: float, r: float, h: float, curvature: float) -> bool:
+    """Whether a function with value ``g`` and slope ``r`` at s is surely > 0 at s - h (h > 0),
+    given ``curvature``, an estimate of the size of its second derivative: the first-order
+    Taylor model g - h r, less twice the remainder that curvature gives (curvature h^2 / 2),
+    clears zero by SURE_MARGIN h |r|.
+
+    Event location asks this of the point that would close a bracket from below: the exact
+    value and slope at the bracket's end b a quarter tolerance past the root, the point half a
+    tolerance back, whose evaluation it can then skip.
+
+    >>> surely_positive(-0.25e-9, -1.0, 0.49e-9, 1.0)  # root 0.25e-9 back: 0.24e-9 to spare
+    True
+    >>> surely_positive(-0.45e-9, -1.0, 0.49e-9, 1.0)  # 0.04e-9: not sure
+    False
+    """
+    return g - h * r - curvature * h * h > SURE_MARGIN * h * abs(r)
+
+
 def hermite_dips(a: float, b: float, ga, gb, ra, rb) -> np.ndarray:
     """Whether the cubic Hermite interpolant of each function (values ga, gb > 0 and slopes
     ra, rb at a, b; arrays) goes to or below zero inside (a, b): a double root (a node grazing
@@ -81,7 +120,8 @@ def hermite_dips(a: float, b: float, ga, gb, ra, rb) -> np.ndarray:
 
 def locate_sign_change(
     g: Callable[[float], float | tuple[float, float]], a: float, b: float, ga: float,
-    gb: float, tol: float, slopes: tuple[float, float] | None = None,
+    gb: float, tol: float, slopes: tuple[float, float] | None = None, *,
+    skip_sure: bool = False,
 ) -> tuple[float, float, int]:
     """Bracket [a, b] of width <= tol around the first sign change (ga > 0 >= gb).
 
@@ -92,9 +132,15 @@ def locate_sign_change(
     beyond the root rather than on it, where the signs of other functions that cross at the
     same point would be round-off. A point is kept 0.49 tol inside the bracket, so a converged
     estimate closes it from the other side, and every third point bisects a bracket that did
-    not halve. Returns (a, b, evaluations).
+    not halve. With slopes and ``skip_sure`` (evaluations are dear), a point that would close
+    the bracket from below (within tol of b) is not evaluated when the exact value and slope at
+    b make its sign certain (:func:`surely_positive`, the curvature taken from the Hermite
+    interpolant of the first bracket): the bracket closes as that evaluation would have closed
+    it, so an event located on its first point costs one evaluation instead of two. Returns
+    (a, b, evaluations).
 
-    cos s = 1/2 on [0, 2] (root pi/3): 9 evaluations without slopes, 4 with them.
+    cos s = 1/2 on [0, 2] (root pi/3): 9 evaluations without slopes, 4 with them, 3 skipping
+    the sure one (the same bracket).
 
     >>> from math import cos, sin, pi
     >>> locate_sign_change(lambda s: cos(s) - 0.5, 0.0, 2.0, 0.5, cos(2) - 0.5, 1e-9)[2]
@@ -103,9 +149,14 @@ def locate_sign_change(
     ...                              cos(2) - 0.5, 1e-9, slopes=(0.0, -sin(2)))
     >>> a < pi / 3 <= b, b - a <= 1e-9, n
     (True, True, 4)
+    >>> locate_sign_change(lambda s: (cos(s) - 0.5, -sin(s)), 0.0, 2.0, 0.5, cos(2) - 0.5,
+    ...                    1e-9, slopes=(0.0, -sin(2)), skip_sure=True) == (a, b, 3)
+    True
     """
     evaluations, retained, width = 0, 0, b - a
     ra, rb = slopes if slopes is not None else (0.0, 0.0)
+    sure = slopes is not None and skip_sure and b - a > tol
+    curvature = hermite_curvature(a, b, ga, gb, ra, rb) if sure else 0.0
     while b - a > tol:
         if evaluations >= MAX_ROOT_ITERATIONS:
             raise NumericalError(
@@ -123,6 +174,9 @@ def locate_sign_change(
         c = min(max(c, a + 0.49 * tol), b - 0.49 * tol)
         if evaluations % 3 == 2:
             width = b - a
+        if sure and b - c <= tol and surely_positive(gb, rb, b - c, curvature):
+            a = c  # the point would close the bracket from below: its sign is certain
+            break
         gc = g(c)
         evaluations += 1
         if slopes is not None:
@@ -191,11 +245,27 @@ def _estimate(key: EventKey, a: float, b: float, start: Values, end: Values,
     return b if not ga > gb else a + (b - a) * ga / (ga - gb)
 
 
+def _later(key: EventKey, hi: float, lo: float, a: float, b: float, start: Values, end: Values,
+           start_slopes: Values, end_slopes: Values, value: Callable[[EventKey, float], float],
+           slope: Callable[[EventKey, float], float]) -> bool:
+    """Whether ``key``'s function is surely still > 0 at ``lo``, the start of the earliest
+    bracket [lo, hi] (it then crosses no earlier, and needs no location of its own), from its
+    exact value and slope at the event point ``hi`` and the curvature of its Hermite
+    interpolant on [a, b] (:func:`surely_positive`); False (not sure: evaluate at ``lo``) for
+    a function without slopes.
+    """
+    if key not in start_slopes or key not in end_slopes:
+        return False
+    curvature = hermite_curvature(a, b, start[key], end[key], start_slopes[key],
+                                  end_slopes[key])
+    return surely_positive(value(key, hi), slope(key, hi), hi - lo, curvature)
+
+
 def earliest_crossing(
     crossed: list[EventKey], a: float, b: float, tol: float, *, start: Values, end: Values,
     start_slopes: Values, end_slopes: Values, fresh: Collection[EventKey],
     value: Callable[[EventKey, float], float], slope: Callable[[EventKey, float], float],
-    order: Callable[[EventKey], tuple],
+    order: Callable[[EventKey], tuple], skip_sure: bool = False,
 ) -> tuple[float, int]:
     """Bracket the first zero of the ``crossed`` functions in [a, b]; (its end, evaluations).
 
@@ -216,6 +286,12 @@ def earliest_crossing(
         (key, s) -> the function's value or slope at s.
     order : callable
         Key -> processing order; breaks ties between brackets that end at the same s.
+    skip_sure : bool
+        Evaluations are dear: skip those whose outcome the exact values and slopes already
+        known make certain (:func:`surely_positive`): the closing point of a bracket
+        (:func:`locate_sign_change`) and, for a function crossed later than the earliest
+        bracket, its value at that bracket's start (from its value and slope at the event
+        point). The brackets are those the evaluations would have given.
 
     Returns
     -------
@@ -232,8 +308,11 @@ def earliest_crossing(
         hi_end, g_hi, r_hi = b, end[key], end_slopes.get(key)
         if best is not None:
             lo_best = best[-1]
+            if lo_best <= a or skip_sure and _later(key, best[0], lo_best, a, b, start, end,
+                                                    start_slopes, end_slopes, value, slope):
+                continue
             g_hi = value(key, lo_best)
-            if g_hi > 0 or lo_best <= a:
+            if g_hi > 0:
                 continue
             hi_end = lo_best
             r_hi = slope(key, lo_best) if key in end_slopes else None
@@ -254,7 +333,8 @@ def earliest_crossing(
             hi = lo
         else:
             lo, hi, n = locate_sign_change(g, lo, hi_end, glo, g_hi, tol,
-                                           slopes=(r_lo, r_hi) if sloped else None)
+                                           slopes=(r_lo, r_hi) if sloped else None,
+                                           skip_sure=skip_sure)
             evaluations += n
         rank = (hi, *order(key), lo)
         best = rank if best is None or rank < best else best

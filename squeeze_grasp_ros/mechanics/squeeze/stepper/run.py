@@ -178,7 +178,7 @@ class _Call:
             start_slopes=start_slopes, end_slopes=end_slopes, fresh=self.events.fresh,
             value=lambda key, s: f.value(key, contacts, points.at(s), s),
             slope=lambda key, s: f.slope(key, contacts, points.at(s), s),
-            order=self.events.order)
+            order=self.events.order, skip_sure=self.model.dear_evaluations)
         self.counters.root_evaluations += evaluations
         return s_e, points.at(s_e)
 

@@ -98,6 +98,45 @@ def match_within(expected, observed, ticks: int) -> list[str]:
     return problems
 
 
+def closed_loop(scene, tracker_config=None, limits=None, prediction=()):
+    """Run the ROS-free loop world -> tracker -> program -> world until the goal ends
+    (``prediction``: the tracker's predicted events, PredictedEvent each).
+    """
+    import numpy as np
+
+    from squeeze_grasp_ros.control.motion import GraspGoal, GraspProgram, MotionLimits, Observation
+    from squeeze_grasp_ros.control.tracker import ContactTracker, FingerSample, TrackerConfig
+    from squeeze_grasp_ros.scene import GraspSetup
+    from squeeze_grasp_ros.sim.world import SimWorld
+
+    world = SimWorld(GraspSetup.build(scene))
+    depth = scene.squeeze.relative_depth / world.relative_per_depth
+    goal = GraspGoal(("F1", "F2"), np.array([world.directions["F1"], world.directions["F2"]]),
+                     depth, world.relative_per_depth)
+    program = GraspProgram(goal, limits or MotionLimits(), world.fingers)
+    tracker = ContactTracker(tracker_config or TrackerConfig(mu=scene.mu), world.fingers,
+                             prediction=prediction)
+    out = world.start()
+    outputs, observed, commands = [out], [], []
+    while True:
+        samples = {r.finger: FingerSample(
+            r.position, r.force, out.stamp_ns if r.force is not None else None,
+            world.layouts[r.finger].angles if r.normal is not None else None, r.normal,
+            r.tangential, out.stamp_ns if r.normal is not None else None) for r in out.readings}
+        tracked = tracker.update(out.stamp_ns, samples)
+        observed.append(tracked)
+        command = program.step(Observation(
+            out.stamp_ns, tracked.positions, tracked.forces, tracked.normals,
+            tuple((a.type, a.finger) for a in tracked.alarms),
+            tuple(e.type for e in tracked.events), tracked.depth), world.dt)
+        commands.append(command)
+        out = world.step(command.setpoints)
+        outputs.append(out)
+        if command.termination is not None:
+            return {"world": world, "outputs": outputs, "observed": observed,
+                    "commands": commands, "program": program}
+
+
 def run_scene(tmp_path: Path, data: dict, world: dict | None = None, record: bool = False):
     """A ``run`` of scene ``data`` through the real nodes (one executor); ``world``: the
     simulated world's scene instead (what the planner does not know); ``record``: into

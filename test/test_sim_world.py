@@ -14,6 +14,7 @@ import yaml
 from pipeline_support import (
     EVENT_TOLERANCE_TICKS,
     SMALL_SQUARE,
+    closed_loop,
     contact_modes,
     match_within,
     net_events,
@@ -58,35 +59,6 @@ def world_run():
     """
     return closed_loop(scene_with(), TrackerConfig(mu=SMALL_SQUARE["friction"]["mu"],
                                                    alarm_ratio=2.0))
-
-
-def closed_loop(scene, tracker_config: TrackerConfig | None = None, limits=MotionLimits()):
-    """Run the ROS-free loop world -> tracker -> program -> world until the goal ends."""
-    world = SimWorld(GraspSetup.build(scene))
-    depth = scene.squeeze.relative_depth / world.relative_per_depth
-    goal = GraspGoal(("F1", "F2"), np.array([world.directions["F1"], world.directions["F2"]]),
-                     depth, world.relative_per_depth)
-    program = GraspProgram(goal, limits, world.fingers)
-    tracker = ContactTracker(tracker_config or TrackerConfig(mu=scene.mu), world.fingers)
-    out = world.start()
-    outputs, observed, commands = [out], [], []
-    while True:
-        samples = {r.finger: FingerSample(
-            r.position, r.force, out.stamp_ns if r.force is not None else None,
-            world.layouts[r.finger].angles if r.normal is not None else None, r.normal,
-            r.tangential, out.stamp_ns if r.normal is not None else None) for r in out.readings}
-        tracked = tracker.update(out.stamp_ns, samples)
-        observed.append(tracked)
-        command = program.step(Observation(
-            out.stamp_ns, tracked.positions, tracked.forces, tracked.normals,
-            tuple((a.type, a.finger) for a in tracked.alarms),
-            tuple(e.type for e in tracked.events), tracked.depth), world.dt)
-        commands.append(command)
-        out = world.step(command.setpoints)
-        outputs.append(out)
-        if command.termination is not None:
-            return {"world": world, "outputs": outputs, "observed": observed,
-                    "commands": commands, "program": program}
 
 
 # --------------------------------------------------------------------------- devices

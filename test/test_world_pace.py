@@ -15,6 +15,7 @@ import yaml
 
 from squeeze_grasp_ros.bench.pipeline import squeeze_world
 from squeeze_grasp_ros.mechanics.squeeze.contact_model import INVERSION_AREA_RATIO
+from squeeze_grasp_ros.mechanics.squeeze.stepper import area_watch
 from squeeze_grasp_ros.mechanics.squeeze.stepper.area_watch import AreaWatch
 from squeeze_grasp_ros.resources import scene_file
 from squeeze_grasp_ros.scene import GraspSetup, load_scene, parse_scene
@@ -62,8 +63,10 @@ def test_foam_square_quiet_ticks_are_advance_bit_for_bit():
     quiet, q, full, f = _worlds(load_scene(scene_file("foam_square")), 700)
     assert sum(len(t.events) for t in q) == 12
     assert quiet.stepper.calls["quiet"] >= 600 and full.stepper.calls["quiet"] == 0
-    print(f"foam square: {quiet.stepper.calls}; stepper s quiet {quiet.stepper_seconds:.3f}, "
-          f"advance {full.stepper_seconds:.3f}")
+    # most quiet ticks end within the reach of the last evaluation of the watched functions
+    assert quiet.stepper.evaluations < quiet.stepper.calls["quiet"] // 4
+    print(f"foam square: {quiet.stepper.calls}, {quiet.stepper.evaluations} evaluations; "
+          f"stepper s quiet {quiet.stepper_seconds:.3f}, advance {full.stepper_seconds:.3f}")
     _assert_same_ticks(q, f)
 
 
@@ -103,51 +106,107 @@ def test_nonlinear_worlds_take_every_tick_through_advance(model):
     _assert_same_ticks(q, f)
 
 
-def test_area_watch_answers_as_the_full_area_check():
-    """AreaWatch's answer equals ``area_ratio(...)[0] > level`` along a squeeze, at levels
-    around the smallest area ratio (so both answers occur), while it renews its reference.
-    """
+def _configurations(ticks: int):
+    """(model, [(set data, delta, F) per tick]) of the foam square's squeeze through advance()."""
     world = SimWorld(GraspSetup.build(load_scene(scene_file("foam_square"))), quiet=False)
-    watch, model = AreaWatch(world.model), world.model
-    answers = set()
-    for tick in squeeze_world(world, 200)[1:]:
+    model, out = world.model, []
+    for tick in squeeze_world(world, ticks)[1:]:
         contacts = tick.state.contacts
         sd = model.set_data(tuple(c.node for c in contacts))
         delta = np.array([c.displacement for c in contacts]) / model.length
         F = np.array([c.force for c in contacts]) / model.force_unit
-        ratio = model.area_ratio(sd, delta, F)[0]
-        for level in (INVERSION_AREA_RATIO + 1e-12, ratio - 1e-9, ratio + 1e-9):
-            expected = ratio > level
-            assert watch.above(sd, delta, F, level) == expected, (tick.index, level)
-            answers.add(expected)
-    assert answers == {True, False} and watch.renewals >= 2
+        out.append((sd, delta, F))
+    return model, out
 
 
-def test_area_watch_skips_only_where_the_full_check_agrees():
-    """At one level, called tick after tick: AreaWatch answers most ticks from its bound on
-    the motion since its last True answer, and still answers as ``area_ratio`` at every tick,
-    also across the tick where the smallest area ratio passes the level (chosen in the middle
-    of the squeeze's range, so both answers occur).
+def _smallest_det(model, sd, delta, F) -> float:
+    """Every element's det(I + grad u) from the full displacement field (one sparse solve,
+    not the bounds or the kept gradients AreaWatch uses): the smallest.
     """
-    world = SimWorld(GraspSetup.build(load_scene(scene_file("foam_square"))), quiet=False)
-    model, ticks = world.model, squeeze_world(world, 300)[1:]
-    configurations, ratios = [], []
-    for tick in ticks:
-        contacts = tick.state.contacts
-        sd = model.set_data(tuple(c.node for c in contacts))
-        delta = np.array([c.displacement for c in contacts]) / model.length
-        F = np.array([c.force for c in contacts]) / model.force_unit
-        configurations.append((sd, delta, F))
-        ratios.append(model.area_ratio(sd, delta, F)[0])
-    skips = {}
-    for level in (INVERSION_AREA_RATIO + 1e-12, 0.5 * (max(ratios) + min(ratios))):
-        watch = AreaWatch(model)
-        answers = [watch.above(*c, level) for c in configurations]
-        assert answers == [r > level for r in ratios], level
-        skips[level] = watch.skips
-    print(f"AreaWatch skips of {len(ticks)} ticks per level: {skips}")
-    assert answers.count(False) > 0 and answers.count(True) > 0
-    assert min(skips.values()) > 0 and max(skips.values()) > len(ticks) // 2
+    H = (model.obj.gradient @ model.full_displacement(sd, delta, F)).reshape(-1, 4)
+    return float(((1.0 + H[:, 0]) * (1.0 + H[:, 3]) - H[:, 1] * H[:, 2]).min())
+
+
+def _moved(model, a, b) -> float:
+    """The bound on every element's gradient change from configuration a to b: sum_k
+    max_e b_ek ||dF_k|| + max_e ||R_e|| ||dg|| (from the object's gradient bounds).
+    """
+    (sd, delta_a, F_a), (_, delta_b, F_b) = a, b
+    column_max = model.obj.gradient_bounds(tuple(sd.nodes.tolist())).max(axis=0)
+    R = model.obj.rigid_gradients.reshape(-1, 4, 3)
+    dg = sd.E.T @ (delta_b - delta_a).reshape(-1)
+    return float(column_max @ np.linalg.norm(F_b - F_a, axis=1)
+                 + np.sqrt((R * R).sum(axis=(1, 2))).max() * np.linalg.norm(dg))
+
+
+def test_area_reserve_holds_every_element_above_the_level_within_it(monkeypatch):
+    """AreaWatch.reserve against the full field: at a level just under the configuration's
+    smallest det F, every later configuration of the same set whose gradients moved by less
+    than the reserve has every element above the level, the reach covers later ticks, and
+    the squeeze passes the level beyond it (so the check can fail). At a level above the
+    smallest det F the reserve is 0. Every element is kept (levels this high leave none to a
+    bound: the foam square stays far from inversion); at the stepper's level the default
+    candidates give a reserve at every tick.
+    """
+    model, configurations = _configurations(300)
+    dets = [_smallest_det(model, *c) for c in configurations]
+    monkeypatch.setattr(area_watch, "AREA_CANDIDATES", 10 ** 9)
+    watch, covered, beyond = AreaWatch(model), 0, 0
+    for i in range(0, len(configurations), 10):
+        assert watch.reserve(*configurations[i], dets[i] + 1e-9) == 0.0, i
+        for level in (dets[i] - 0.02, dets[i] - 0.1):
+            reserve = watch.reserve(*configurations[i], level)
+            assert reserve > 0.0, i
+            for j in range(i + 1, len(configurations)):
+                if configurations[j][0] is not configurations[i][0]:
+                    break
+                if _moved(model, configurations[i], configurations[j]) < reserve:
+                    assert dets[j] > level, (i, j)
+                    covered += 1
+                elif dets[j] <= level:
+                    beyond += 1
+    print(f"area reserve: {covered} later ticks within a reach, {beyond} below its level "
+          f"beyond it, {watch.renewals} renewals")
+    assert covered > 20 and beyond > 0
+    monkeypatch.undo()
+    watch = AreaWatch(model)
+    assert all(watch.reserve(*c, INVERSION_AREA_RATIO + 1e-12) > 0.0 for c in configurations)
+
+
+def test_travel_rates_bound_the_watched_functions_change():
+    """Within one sticking mode of the quiet world, every watched function moves by at most
+    its rate (stepper/travel.py) times the fingers' stacked translation: the contacts' normal
+    forces and cone margins, and the free rows' gaps from the full displacement field (not
+    the boundary compliance the rates are made from).
+    """
+    world = SimWorld(GraspSetup.build(load_scene(scene_file("foam_square"))))
+    stepper, seen = world.stepper, []
+    result = stepper._result
+
+    def keep(mode, state, motion, ends):
+        out = result(mode, state, motion, ends)
+        seen.append((mode, motion[0] + motion[1], ends[2], ends[3]))
+        return out
+
+    stepper._result = keep
+    squeeze_world(world, 300)
+    model, checked = world.model, 0
+    boundary = model.positions(model.boundary_nodes)
+    for (mode, c0, d0, F0), (other, c1, d1, F1) in zip(seen, seen[1:]):
+        if other is not mode:
+            continue
+        sd, rates, mu = mode.sticking.contacts.data, mode.rates, model.mu
+        travel = np.linalg.norm(c1 - c0)
+        values = []
+        for c, delta, F in ((c0, d0, F0), (c1, d1, F1)):
+            fn, ft = (F * mode.unit).sum(axis=1), (F * mode.tangent).sum(axis=1)
+            u = model.full_displacement(sd, delta, F).reshape(-1, 2)
+            points = boundary[mode.rows] + u[model.boundary_nodes[mode.rows]]
+            values.append((fn, mu * fn - np.abs(ft), mode.tip.gaps(points, c)))
+        for a, b, rate in zip(*values, (rates.normal, rates.cone, rates.gaps)):
+            assert np.all(np.abs(b - a) <= rate * travel * (1 + 1e-9) + 1e-13), mode
+        checked += 1
+    assert checked > 200
 
 
 def test_quiet_results_are_advance_results_field_by_field():

@@ -33,7 +33,25 @@ Events of one tick are ordered by finger (F1, F2, A), then B < D < C < A (the st
 - ``contact_lost``: the finger had loaded taxels and has none now.
 - ``prediction_mismatch`` (at the tick it is found): an observed event of a type and finger the
   planner did not predict within ``prediction_tolerance`` of depth, or a predicted one that
-  the depth passed without being observed.
+  the depth passed without being observed. Stick-slip events of *mirror patches* are exempt
+  (below).
+
+Mirror patches. A finger loaded symmetrically (a fingertip squeezing a symmetric object along
+its symmetry axis) has pairs of contact patches mirrored about its force line, the direction of
+the resultant of its patch forces: two patches on opposite sides of it whose mean angle lies
+within ``mirror_tolerance`` of their angular separation from it (0.05: for the two neighbours of
+the patch on the line, a tenth of a boundary spacing; measured on the foam ring: 0.01 squeezed
+along its symmetry axis, the mesh's asymmetry, and 0.25 for the nearest pair of F1 touching
+1 cm off it). Which patch of a mirror pair sticks and which
+slides is a tie: the mechanics decides it by round-off, so a mesh a few micrometres different
+(an outline seen by a camera) decides it the other way, for the rest of the squeeze (the foam
+ring on its axis: the world's side node of F2 sticks at 0.7-0.999 of its cone from 2.7 to
+7.4 mm of depth where the planner's slides from 2.4 mm). The tie decides which patch of the
+pair slides and when, not whether the finger has stick-slip events: an unpredicted C or D event
+of a patch with a mirror partner at its tick raises no alarm when the prediction has C or D
+events on that finger, and a predicted C or D the depth passed unobserved raises none while
+its finger holds a mirror pair. New contacts and breaks (A, B) are always compared, and so are
+C and D of fingers loaded off their symmetry line and of fingers the planner predicts none for.
 
 Pickup (effect ``pickup``): the tracker reports a ``picked_up`` event when every finger in
 contact can supply its share w / n_f of vertical friction, sum over its sticking taxels of
@@ -52,6 +70,9 @@ import numpy as np
 
 from squeeze_grasp_ros.mechanics.squeeze.event_key import PROCESSING_ORDER, processing_rank
 from squeeze_grasp_ros.mechanics.vocabulary import ContactMode, EventType, Finger, Termination
+
+STICK_SLIP = (EventType.C, EventType.D)
+"""The events of a contact's mode (stick -> slip, slip -> stick)."""
 
 
 @dataclass(frozen=True)
@@ -78,6 +99,10 @@ class TrackerConfig:
         Depth tolerance when matching observed events to the prediction, m.
     relative_per_depth : float
         Relative depth per unit depth, 1/m (for reports).
+    mirror_tolerance : float
+        Two patches of a finger are a mirror pair when the mean of their angles lies within
+        this fraction of their angular separation from the finger's force line (0: exact
+        mirror images only; 0.5 at most).
     """
 
     mu: float
@@ -89,6 +114,7 @@ class TrackerConfig:
     weight: float | None = None
     prediction_tolerance: float = 5e-4
     relative_per_depth: float = 0.0
+    mirror_tolerance: float = 0.05
 
 
 @dataclass(frozen=True)
@@ -148,13 +174,17 @@ class Patch(NamedTuple):
 
 @dataclass(frozen=True)
 class TrackedEvent:
-    """An event found by the tracker: a contact event (A, B, C, D) or picked_up."""
+    """An event found by the tracker: a contact event (A, B, C, D) or picked_up.
+
+    ``mirrored``: a C or D event of a patch with a mirror partner (a tie, see the module).
+    """
 
     type: EventType | Termination
     finger: Finger | str
     depth: float
     relative_depth: float
     angle: float
+    mirrored: bool = False
 
 
 @dataclass(frozen=True)
@@ -265,6 +295,37 @@ def patches_of(finger: str, taxels: LoadedTaxels, config: TrackerConfig) -> list
     return out
 
 
+def mirrored_patches(patches: Sequence[Patch], tolerance: float) -> frozenset[int]:
+    """Indices of the patches of one finger that have a mirror partner about its force line.
+
+    The force line is the direction of the resultant of the patch forces (normal along the
+    patch angle, tangential along the angle's positive tangent). Patches i and j are mirror
+    images when they lie on opposite sides of it and the mean of their angles is within
+    ``tolerance`` times their angular separation of it.
+
+    Examples
+    --------
+    >>> from squeeze_grasp_ros.control.tracker import Patch, mirrored_patches
+    >>> side = [Patch("F1", a, 0.45, t, "stick", 0) for a, t in ((-0.16, 0.18), (0.16, -0.18))]
+    >>> sorted(mirrored_patches([side[0], Patch("F1", 0.0, 0.63, 0.0, "stick", 0), side[1]], 0.25))
+    [0, 2]
+    >>> sorted(mirrored_patches([side[0], Patch("F1", 0.4, 0.6, 0.0, "stick", 0)], 0.25))
+    []
+    """
+    if len(patches) < 2:
+        return frozenset()
+    angle = np.array([p.angle for p in patches])
+    normal = np.array([p.normal for p in patches])
+    tangential = np.array([p.tangential for p in patches])
+    c, s = np.cos(angle), np.sin(angle)
+    line = np.arctan2(normal @ s + tangential @ c, normal @ c - tangential @ s)
+    offset = np.angle(np.exp(1j * (angle - line)))
+    i, j = np.triu_indices(len(patches), 1)
+    pair = (offset[i] * offset[j] < 0.0) & (
+        np.abs(offset[i] + offset[j]) <= tolerance * np.abs(offset[i] - offset[j]))
+    return frozenset(i[pair].tolist() + j[pair].tolist())
+
+
 def connected_groups(previous: Sequence[Patch], current: Sequence[Patch],
                      margin: int) -> list[tuple[list[int], list[int]]]:
     """Groups (previous indices, current indices) of patches linked by overlapping taxel ranges.
@@ -321,6 +382,8 @@ class ContactTracker:
         self.fingers = tuple(sorted(fingers, key=lambda n: order.get(n, len(order))))
         self.streams = tuple(streams)
         self.tracks = {f: _FingerTrack() for f in self.fingers}
+        self.mirrored: dict[str, frozenset[int]] = {f: frozenset() for f in self.fingers}
+        """Per finger, its current patches with a mirror partner (indices)."""
         self.depth = 0.0
         self.picked_up = False
         self.set_prediction(prediction)
@@ -329,6 +392,8 @@ class ContactTracker:
         """Replace the prediction the observed events are compared with."""
         self.prediction = list(prediction)
         self.unmatched = list(range(len(self.prediction)))
+        self.stick_slip_fingers = {p.finger for p in self.prediction if p.type in STICK_SLIP}
+        """The fingers the prediction has C or D events for."""
 
     def update(self, stamp_ns: int, samples: Mapping[str, FingerSample]) -> TrackerOutput:
         """Process the readings of one tick (newest reading per finger and stream)."""
@@ -348,6 +413,7 @@ class ContactTracker:
                 trig = self._trig(track, sample)
                 taxels = loaded_taxels(sample, cfg.load_threshold, trig)
                 current = patches_of(name, taxels, cfg)
+                self.mirrored[name] = mirrored_patches(current, cfg.mirror_tolerance)
                 events += self._events(name, track.patches, current, relative)
                 track.patches = current
                 track.had_contact = track.had_contact or bool(current)
@@ -419,18 +485,20 @@ class ContactTracker:
         found = []
         for before, after in connected_groups(previous, current, self.config.match_margin):
             if not after:
-                found += [(EventType.B, previous[i].angle) for i in before]
+                found += [(EventType.B, previous[i].angle, False) for i in before]
             elif not before:
                 if self.tracks[name].had_contact:
-                    found += [(EventType.A, current[j].angle) for j in after]
+                    found += [(EventType.A, current[j].angle, False) for j in after]
             elif len(before) == len(after) == 1:
                 old, new = previous[before[0]], current[after[0]]
+                mirrored = after[0] in self.mirrored[name]
                 if old.mode == ContactMode.STICK and new.mode == ContactMode.SLIP:
-                    found.append((EventType.C, new.angle))
+                    found.append((EventType.C, new.angle, mirrored))
                 elif old.mode == ContactMode.SLIP and new.mode == ContactMode.STICK:
-                    found.append((EventType.D, new.angle))
+                    found.append((EventType.D, new.angle, mirrored))
         found.sort(key=lambda e: (processing_rank(e[0]), e[1]))
-        return [TrackedEvent(kind, name, self.depth, relative, angle) for kind, angle in found]
+        return [TrackedEvent(kind, name, self.depth, relative, angle, mirrored)
+                for kind, angle, mirrored in found]
 
     @staticmethod
     def _force(sample: FingerSample, trig: tuple[np.ndarray, np.ndarray] | None,
@@ -511,15 +579,17 @@ class ContactTracker:
             hit = next((k for k in self.unmatched if self.prediction[k].type == e.type
                         and self.prediction[k].finger == e.finger
                         and abs(self.prediction[k].depth - e.depth) <= tol), None)
-            if hit is None:
+            if hit is None and not (e.mirrored and e.finger in self.stick_slip_fingers):
                 out.append(TrackedAlarm("prediction_mismatch", e.finger, e.depth,
                                         f"event {e.type} on {e.finger} at depth {e.depth:.6g} m "
                                         "was not predicted"))
-            else:
+            elif hit is not None:
                 self.unmatched.remove(hit)
         for k in [k for k in self.unmatched if self.prediction[k].depth + tol < self.depth]:
             p = self.prediction[k]
             self.unmatched.remove(k)
+            if p.type in STICK_SLIP and self.mirrored.get(p.finger):
+                continue
             out.append(TrackedAlarm("prediction_mismatch", p.finger, p.depth,
                                     f"predicted event {p.type} on {p.finger} at depth "
                                     f"{p.depth:.6g} m was not observed"))

@@ -10,8 +10,10 @@ straight stretches meet are rebuilt as the intersection of lines fitted to them 
 cuts a corner short). Closed holes become holes of the outline (a ring or annulus-like object).
 A circle, an ellipse or a circle with a concentric circular hole that fits the traced points
 within :data:`PRIMITIVE_TOLERANCE_PX` is recognised as a ``disk``, ``ellipse`` or ``annulus``
-(:mod:`.primitives`); other outlines without a rebuilt corner are smooth (``spline``), so
-meshing makes none of their vertices a corner.
+(:mod:`.primitives`). Outlines whose rebuilt corners join straight edges are polygons; the
+others are splines (``spline``) with declared corners where a spline through the vertices
+would stray from the traced points (:func:`.simplify.spline_corners`: straight edges and
+curved stretches, a mixed outline), none when it stays within reach of them (a smooth curve).
 
 - **mask** (``mono8``): 0 is background, larger values object; read as coverage (value / 255,
   or / 1 for a 0/1 mask) with the edge at half coverage, so an anti-aliased mask gives edges
@@ -39,7 +41,14 @@ from squeeze_grasp_ros.mechanics.vocabulary import ImageEncoding, ShapeType
 from squeeze_grasp_ros.perception.blobs import Blob, BlobChoice, choose_object
 from squeeze_grasp_ros.perception.camera import CameraModel, CameraPose
 from squeeze_grasp_ros.perception.primitives import Primitive, recognise, sampled, scene_shape
-from squeeze_grasp_ros.perception.simplify import kept_vertices, sharpen_corners
+from squeeze_grasp_ros.perception.simplify import (
+    KINK_TURN_DEG,
+    kept_vertices,
+    segment_distances,
+    sharpen_corners,
+    spline_corners,
+    vertex_turns,
+)
 from squeeze_grasp_ros.perception.support import SupportPlane, fit_support, floor_grids
 
 __all__ = ["DEFAULT_TOLERANCE_PX", "MIN_AREA_PX", "PRIMITIVE_TOLERANCE_PX", "ObjectOutline",
@@ -64,6 +73,14 @@ CORNER_STRAIGHT_PX = 0.12
 0.09 px (marching squares on slanted edges); an arc strays span^2 / (16 R) from its best line,
 so only arcs of radius R >= 33 px pass, and those turn far less than 30 degrees between the
 two stretches (12 px apart): smooth bends are never made corners."""
+
+STRAIGHT_PX = 1.0
+"""An outline with rebuilt corners whose other vertices all lie within this (pixel footprints)
+of the segment joining the two corners around them (rebuilt, or kinks turning more than
+:data:`~.simplify.KINK_TURN_DEG`: a corner noise kept from being rebuilt) is a polygon
+(straight edges: noisy depth strays up to about 1 px); otherwise it has curved stretches and is
+a spline with declared corners (a mixed outline: an arc of radius R px between corners strays
+R (1 - cos(a / 2)) from its chord, 3.5 px for a quarter circle of 12 px)."""
 
 PRIMITIVE_TOLERANCE_PX = 0.3
 """Largest distance (pixel footprints) of a traced point from a fitted circle or ellipse for
@@ -121,8 +138,9 @@ class ObjectOutline:
     shape : ShapeType
         What the outline was recognised as: ``disk``, ``ellipse`` or ``annulus`` (a primitive
         fitted within :data:`PRIMITIVE_TOLERANCE_PX`; the outline is then the fitted curve), else
-        ``polygon`` when a corner was rebuilt on a curve (every vertex is kept as a corner) or
-        ``spline`` for smooth curves without corners.
+        ``polygon`` when rebuilt corners join straight edges or a hole has a rebuilt corner
+        (every vertex is kept as a corner) or ``spline`` for curves, its corners (straight
+        edges meeting arcs) in ``outline.corners``.
     primitive : Primitive or None
         The fitted primitive (centre, parameters, residual), when one was recognised.
     """
@@ -146,7 +164,9 @@ class ObjectOutline:
 
     @property
     def smooth(self) -> bool:
-        """Whether the outline has no corners (its vertices sample smooth curves)."""
+        """Whether the outline is no polygon: its vertices sample smooth curves, between its
+        declared corners (``outline.corners``, a mixed outline) if it has any.
+        """
         return self.shape != ShapeType.POLYGON
 
     def to_scene_shape(self) -> dict:
@@ -162,6 +182,8 @@ class ObjectOutline:
                 return named
         kind = ShapeType.SPLINE if self.smooth else ShapeType.POLYGON
         shape = {"type": kind.value, "points": self.outline.points.tolist()}
+        if self.smooth and len(self.outline.corners):
+            shape["corners"] = self.outline.corners.tolist()
         if self.outline.holes:
             shape["holes"] = [h.tolist() for h in self.outline.holes]
         return shape
@@ -230,16 +252,35 @@ def _trace(field: np.ndarray, level: float, choice: BlobChoice, min_area_px: int
 
 
 def _simplify(points: np.ndarray, tolerance: float, pixel: float, name: str):
-    """The simplified vertices of a traced curve (m) and whether any is a rebuilt corner."""
+    """The simplified vertices of a traced curve (m, counter-clockwise) and which of them are
+    rebuilt corners (bool each).
+    """
     kept = kept_vertices(points, tolerance)
     vertices, corners = sharpen_corners(
         points, kept, radius=CORNER_RADIUS_PX * pixel, span=CORNER_SPAN_PX * pixel,
         tolerance=CORNER_STRAIGHT_PX * pixel, max_cut=CORNER_CUT_PX * pixel)
     try:
-        return validate_polyline(vertices, name), bool(corners.any())
+        out = validate_polyline(vertices, name)
     except InvalidInputError as exc:
         raise InvalidInputError(f"{exc}; the simplified {name} is not a simple curve: lower "
                                 f"tolerance_m (now {tolerance:g} m)") from None
+    if len(out) != len(corners):  # repeated vertices dropped: keep every vertex a corner
+        return out, np.ones(len(out), bool)
+    return out, (corners[::-1] if signed_area(vertices) < 0 else corners)
+
+
+def _straight(vertices: np.ndarray, corners: np.ndarray, reach: float) -> bool:
+    """Whether the vertices between each two consecutive rebuilt corners lie within ``reach``
+    (m) of the segment joining them (straight edges with extra vertices: a polygon).
+    """
+    start = np.flatnonzero(corners)
+    n = len(vertices)
+    for a, b in zip(start, np.roll(start, -1)):
+        run = vertices[np.arange(a + 1, b + (n if b <= a else 0)) % n]
+        ends = np.broadcast_to(vertices[a], run.shape), np.broadcast_to(vertices[b], run.shape)
+        if len(run) and segment_distances(run, *ends).max() > reach:
+            return False
+    return True
 
 
 def _outline(loops: list[np.ndarray], camera: CameraModel, pose: CameraPose,
@@ -272,9 +313,17 @@ def _outline(loops: list[np.ndarray], camera: CameraModel, pose: CameraPose,
         if not np.all(boundary.contains_points(hole)):
             raise InvalidInputError(f"extracted hole {k + 1} crosses the simplified outer curve: "
                                     f"lower tolerance_m (now {tolerance:g} m)")
-    cornered = cornered or any(c for _, c in simplified)
-    shape = ShapeType.POLYGON if cornered else ShapeType.SPLINE
-    return Outline(outer, holes), shape, None, tolerance, pixel, plane.undistort_residual_px
+    kinks = cornered | (np.abs(vertex_turns(outer)) > KINK_TURN_DEG)  # a rounded corner too
+    straight = cornered.any() and _straight(outer, kinks, STRAIGHT_PX * pixel)
+    if straight or any(c.any() for _, c in simplified):
+        return (Outline(outer, holes), ShapeType.POLYGON, None, tolerance, pixel,
+                plane.undistort_residual_px)
+    corners = spline_corners(metric[0], outer, cornered,
+                             tolerance=max(tolerance, PRIMITIVE_TOLERANCE_PX * pixel),
+                             radius=CORNER_RADIUS_PX * pixel)
+    shape = ShapeType.POLYGON if corners.all() else ShapeType.SPLINE
+    return (Outline(outer, holes, np.flatnonzero(corners)), shape, None, tolerance, pixel,
+            plane.undistort_residual_px)
 
 
 def _positive(**values: float) -> None:

@@ -17,7 +17,10 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["kept_vertices", "sharpen_corners", "simplify_closed", "segment_distances"]
+from squeeze_grasp_ros.mechanics.errors import InvalidInputError
+
+__all__ = ["curve_distances", "kept_vertices", "segment_distances", "sharpen_corners",
+           "simplify_closed", "spline_corners", "vertex_turns"]
 
 
 def segment_distances(points: np.ndarray, start: np.ndarray, end: np.ndarray) -> np.ndarray:
@@ -177,3 +180,77 @@ def sharpen_corners(points: np.ndarray, kept: np.ndarray, *, radius: float, span
                 drop |= (np.abs(gap[kept]) < skip) & ~moved  # the rounded tip's vertices
             break
     return out[~drop], moved[~drop]
+
+
+def curve_distances(points: np.ndarray, curve: np.ndarray) -> np.ndarray:
+    """Distance of each of ``points`` to the closed polyline ``curve`` (dense samples), m: to
+    the two curve segments at the nearest sample.
+    """
+    from scipy.spatial import cKDTree
+
+    _, k = cKDTree(curve).query(points)
+    n = len(curve)
+    return np.minimum(
+        segment_distances(points, curve[(k - 1) % n], curve[k]),
+        segment_distances(points, curve[k], curve[(k + 1) % n]))
+
+
+def vertex_turns(vertices: np.ndarray) -> np.ndarray:
+    """Turning angle at each vertex of a closed polyline, deg (positive to the left)."""
+    edge = np.diff(np.vstack([vertices[-1:], vertices, vertices[:1]]), axis=0)
+    a, b = edge[:-1], edge[1:]
+    return np.degrees(np.arctan2(a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0],
+                                 np.einsum("ij,ij->i", a, b)))
+
+
+KINK_TURN_DEG = 30.0
+"""A simplified vertex turning more than this is a kink the corner rebuild left rounded (a line
+meeting a tight arc): a spline through the vertices starts with it as a corner."""
+
+
+def spline_corners(points: np.ndarray, vertices: np.ndarray, corners: np.ndarray, *,
+                   tolerance: float, radius: float) -> np.ndarray:
+    """Which ``vertices`` of traced closed curve ``points`` a spline through them must keep as
+    corners for every traced point to lie within ``tolerance`` of it.
+
+    Starting from the rebuilt ``corners`` (bool per vertex) and the vertices turning more than
+    :data:`KINK_TURN_DEG`, the curve through the vertices is a cubic spline from corner to
+    corner (``shapes.spline`` with ``corners``); where traced points stray farther than
+    ``tolerance`` from it (a straight edge the spline bends, the end of an arc), both ends of
+    the nearest vertex segment become corners, until none strays. All corners is the
+    Douglas-Peucker polygon, within tolerance by construction. A spline that crosses itself
+    takes its sharpest vertex that is no corner as one more corner. Traced points within
+    ``radius`` of a rebuilt corner are not judged (the trace cuts the corner short by more
+    than the tolerance).
+    """
+    from squeeze_grasp_ros.mechanics.elastic.shapes import spline
+
+    corner = np.asarray(corners, bool)
+    if corner.any():
+        rebuilt = vertices[corner]
+        near = np.linalg.norm(points[:, None] - rebuilt[None], axis=2).min(axis=1) < radius
+        points = points[~near]
+    turn = np.abs(vertex_turns(vertices))
+    corner = corner | (turn > KINK_TURN_DEG)
+    n = len(vertices)
+    while not corner.all():
+        try:
+            curve = spline(vertices, corners=np.flatnonzero(corner)).points
+        except InvalidInputError:  # it crosses itself: the sharpest free vertex is a corner
+            corner = corner.copy()
+            corner[np.argmax(np.where(corner, -1.0, turn))] = True
+            continue
+        far = points[curve_distances(points, curve) > tolerance]
+        if not len(far):
+            break
+        ends = vertices[(np.arange(n) + 1) % n]
+        segment = np.argmin(np.stack([
+            segment_distances(far, np.broadcast_to(a, far.shape), np.broadcast_to(b, far.shape))
+            for a, b in zip(vertices, ends)], axis=1), axis=1)
+        grown = corner.copy()
+        grown[segment] = True
+        grown[(segment + 1) % n] = True
+        if (grown == corner).all():
+            break
+        corner = grown
+    return corner

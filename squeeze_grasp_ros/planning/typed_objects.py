@@ -152,9 +152,12 @@ class TypedObject:
     shape : str
         A shape of :data:`TYPED_SHAPES` when ``outline`` is empty; with an outline, ``spline``
         says its points (and its holes') sample smooth curves: closed cubic splines through
-        them, no vertex kept as a corner (empty: a polygon, every vertex a corner).
+        them, no vertex kept as a corner unless declared in ``shape_parameters["corners"]``
+        (empty: a polygon, every vertex a corner).
     shape_parameters : mapping of str to tuple of float
-        The shape's parameters (``squeeze-grasp scene-help``), one value for a scalar.
+        The shape's parameters (``squeeze-grasp scene-help``), one value for a scalar; with a
+        spline outline, ``corners``: indices of the outline's vertices kept as corners (a
+        mixed outline: straight edges with real corners and curved stretches).
     frame_pose : FramePose
         Pose of ``frame_id`` in the object frame (ignored for the object frame).
     material : TypedMaterial
@@ -214,6 +217,7 @@ def _shape(obj: TypedObject, pose: tuple[np.ndarray, np.ndarray]) -> dict:
         kind = ShapeType.SPLINE if smooth else ShapeType.POLYGON
         shape: dict = {"type": kind.value,
                        "points": _points(obj.outline, pose, "object.outline.polygon.points")}
+        shape.update(_spline_corners(obj, smooth))
         if len(obj.holes):
             shape["holes"] = [_points(h, pose, f"object.holes[{k}].points")
                               for k, h in enumerate(obj.holes)]
@@ -237,6 +241,24 @@ def _shape(obj: TypedObject, pose: tuple[np.ndarray, np.ndarray]) -> dict:
             raise invalid(f"object.shape_parameters {name} takes one value, got {len(values)}")
         shape[name] = [float(v) for v in values] if many else float(values[0])
     return shape
+
+
+def _spline_corners(obj: TypedObject, smooth: bool) -> dict:
+    """``{"corners": [...]}`` from the ``corners`` shape parameter of a spline outline (vertex
+    indices of the outline), else {}; any other parameter with an outline is refused.
+    """
+    extra = sorted(set(obj.shape_parameters) - ({"corners"} if smooth else set()))
+    if extra:
+        raise invalid(f"object.shape_parameters: {extra[0]!r} does not go with object.outline "
+                      "(a spline outline takes only 'corners', its corner vertices' indices)")
+    values = obj.shape_parameters.get("corners", ())
+    if not len(values):
+        return {}
+    index = [float(v) for v in values]
+    if any(not v.is_integer() or v < 0 or v >= len(obj.outline) for v in index):
+        raise invalid(f"object.shape_parameters corners must be indices of the outline's "
+                      f"points (0 to {len(obj.outline) - 1}), got {index}")
+    return {"corners": [int(v) for v in index]}
 
 
 def _renamed(message: str) -> str:
@@ -343,6 +365,8 @@ def seen_object(scene: Scene, shape: Mapping[str, Any],
         drawn = {"outline": np.asarray(shape["points"], float).tolist(),
                  "holes": [np.asarray(h, float).tolist() for h in shape.get("holes", ())],
                  "shape": ShapeType.SPLINE.value if kind == ShapeType.SPLINE else ""}
+        if shape.get("corners"):
+            drawn["shape_parameters"] = {"corners": tuple(float(k) for k in shape["corners"])}
     else:
         drawn = {"shape": kind.value, "shape_parameters": {
             k: tuple(np.atleast_1d(v).astype(float)) for k, v in shape.items() if k != "type"}}

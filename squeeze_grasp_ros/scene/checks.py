@@ -69,7 +69,7 @@ def check_shape(shape: Mapping[str, Any], where: str = "object.shape") -> None:
             f"unknown key {where}.{unknown[0]} for type {kind} "
             f"(allowed: {sorted(allowed - {'type'})})"
         )
-    optional = {"cos", "sin", "holes"}
+    optional = {"cos", "sin", "holes", "corners"}
     for key in SHAPES[kind]:
         if key not in shape and key not in optional:
             raise SceneError(f"missing required key {where}.{key} for type {kind}")
@@ -88,7 +88,8 @@ def _is_number(value: Any) -> bool:
 
 def _check_shape_value(key: str, value: Any, where: str) -> None:
     """Types of the shape parameters: lengths are positive numbers (m), ``points`` a list of
-    [x, y] number pairs, ``holes`` a list of such lists, ``cos``/``sin`` lists of numbers,
+    [x, y] number pairs, ``holes`` a list of such lists, ``corners`` a list of vertex indices,
+    ``cos``/``sin`` lists of numbers,
     ``path`` a non-empty string.
     """
     if key == "path":
@@ -105,6 +106,11 @@ def _check_shape_value(key: str, value: Any, where: str) -> None:
                              "pairs (m)")
         for k, hole in enumerate(value):
             _check_shape_value("points", hole, f"{where}[{k}]")
+    elif key == "corners":
+        if not isinstance(value, list) or not all(
+                isinstance(k, int) and not isinstance(k, bool) and k >= 0 for k in value):
+            raise SceneError(f"{where} must be a list of vertex indices of points (integers "
+                             f">= 0), got {value!r}")
     elif key in ("cos", "sin"):
         if not isinstance(value, list) or not all(map(_is_number, value)):
             raise SceneError(f"{where} must be a list of numbers (relative to the radius)")

@@ -76,7 +76,7 @@ SHAPES: dict[ShapeType, tuple[str, ...]] = {
     ShapeType.SUPERELLIPSE: ("a", "b", "exponent"),
     ShapeType.FOURIER_BLOB: ("radius", "cos", "sin"),
     ShapeType.POLYGON: ("points", "holes"),
-    ShapeType.SPLINE: ("points", "holes"),
+    ShapeType.SPLINE: ("points", "holes", "corners"),
     ShapeType.FILE: ("path",),
     ShapeType.ANNULUS: ("outer_radius", "inner_radius"),
 }

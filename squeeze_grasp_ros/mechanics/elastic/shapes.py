@@ -328,10 +328,67 @@ def _spline_curve(points: Sequence[Sequence[float]], name: str) -> np.ndarray:
     return validate_polyline(cs(np.linspace(0.0, s[-1], DENSE, endpoint=False)), name)
 
 
+def _corner_indices(corners: Sequence[int], n: int) -> np.ndarray:
+    """Validated, sorted, distinct corner vertex indices of an ``n``-point spline."""
+    idx = np.asarray(corners, dtype=float).ravel()
+    if idx.size and (np.any(idx != np.round(idx)) or idx.min() < 0 or idx.max() >= n):
+        raise InvalidInputError(f"spline.corners must be indices of spline.points (integers "
+                                f"0 to {n - 1}), got {idx.tolist()}")
+    idx = idx.astype(int)
+    if len(np.unique(idx)) != len(idx):
+        raise InvalidInputError(f"spline.corners must be distinct, got {idx.tolist()}")
+    return np.sort(idx)
+
+
+def _cornered_curve(points: Sequence[Sequence[float]], corners: np.ndarray,
+                    name: str) -> tuple[np.ndarray, np.ndarray]:
+    """Dense samples of the closed curve through ``points`` whose ``corners`` are kept as
+    corners: between two consecutive corners a cubic spline by chord length (not-a-knot; a
+    straight segment between adjacent corners), sampled about as densely as :data:`DENSE`
+    samples the whole curve. Returns the samples and the corners' indices among them.
+    """
+    validate_polyline(points, name)
+    p = np.asarray(points, dtype=float)
+    n = len(p)
+    closed = np.linalg.norm(np.diff(np.vstack([p, p[:1]]), axis=0), axis=1).sum()
+    pieces, out_corners, count = [], [], 0
+    for k, start in enumerate(corners):
+        end = corners[(k + 1) % len(corners)] + (n if k + 1 == len(corners) else 0)
+        stretch = p[np.arange(start, end + 1) % n]
+        s = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(stretch, axis=0),
+                                                            axis=1))])
+        if s[-1] == 0.0:
+            raise InvalidInputError(f"{name}: corners {start} and {end % n} are the same point")
+        samples = max(1, int(np.ceil(DENSE * s[-1] / closed)))
+        t = np.linspace(0.0, s[-1], samples, endpoint=False)
+        if len(stretch) == 2:
+            piece = stretch[0] + np.outer(t / s[-1], stretch[1] - stretch[0])
+        else:
+            piece = CubicSpline(s, stretch, bc_type="not-a-knot" if len(stretch) > 3
+                                else "natural")(t)
+        out_corners.append(count)
+        pieces.append(piece)
+        count += len(piece)
+    dense, kept = np.vstack(pieces), np.array(out_corners, dtype=int)
+    if signed_area(dense) < 0:  # clockwise points: the outline runs the other way
+        dense, kept = dense[::-1], np.sort(len(dense) - 1 - kept)
+    out = validate_polyline(dense, name)
+    if len(out) != len(dense):
+        raise InvalidInputError(f"{name} has repeated consecutive points")
+    return out, kept
+
+
 def spline(points: Sequence[Sequence[float]],
-           holes: Sequence[Sequence[Sequence[float]]] = ()) -> Outline:
+           holes: Sequence[Sequence[Sequence[float]]] = (),
+           corners: Sequence[int] = ()) -> Outline:
     """Closed periodic cubic spline through the user's ``points`` (m), by chord length, with
     optional ``holes`` (each a list of [x, y], m), smooth splines too, strictly inside it.
+
+    ``corners`` (indices into ``points``) declares vertices where the outer curve may turn
+    sharply (a mixed outline: straight edges with real corners and curved stretches, a D shape
+    or a rounded rectangle): the curve is then a not-a-knot cubic spline by chord length from
+    one corner to the next (straight between adjacent corners), and the corners are kept as
+    mesh corners (:attr:`Outline.corners`).
 
     Examples
     --------
@@ -339,11 +396,19 @@ def spline(points: Sequence[Sequence[float]],
     >>> ring = spline(np.c_[np.cos(t), np.sin(t)], holes=[0.5 * np.c_[np.cos(t), np.sin(t)]])
     >>> round(ring.area / (0.75 * np.pi), 3), len(ring.corners)
     (1.0, 0)
+    >>> a = np.linspace(-np.pi / 2, np.pi / 2, 9)
+    >>> d = spline(np.c_[np.cos(a), np.sin(a)], corners=[0, 8])  # a half disk: a D
+    >>> round(d.area / (np.pi / 2), 3), len(d.corners)
+    (1.0, 2)
     """
-    outer = _spline_curve(points, ShapeType.SPLINE)
+    corner = _corner_indices(corners, len(points))
+    if len(corner):
+        outer, kept = _cornered_curve(points, corner, ShapeType.SPLINE)
+    else:
+        outer, kept = _spline_curve(points, ShapeType.SPLINE), np.zeros(0, dtype=int)
     inner = tuple(_spline_curve(h, f"spline.holes[{k}]") for k, h in enumerate(holes))
     _check_holes(outer, inner, ShapeType.SPLINE.value)
-    return Outline(outer, inner)
+    return Outline(outer, inner, kept)
 
 
 def annulus(outer_radius: float, inner_radius: float) -> Outline:

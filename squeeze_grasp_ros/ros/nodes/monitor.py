@@ -90,6 +90,8 @@ PARAMETERS: dict[str, tuple[Any, str]] = {
     "weight": (0.0, "object weight for the pickup test, N (0: no pickup test)"),
     "prediction_tolerance": (5e-4, "depth tolerance of the prediction comparison, m"),
     "relative_per_depth": (0.0, "relative depth per unit depth, 1/m (reports)"),
+    "mirror_tolerance": (0.05, "patches mirrored about the finger's force line within this "
+                               "fraction of their separation are a tie (no C/D mismatch)"),
     "lockstep": (True, "close ticks on sim/tick (simulation) or on a wall-clock timer"),
     "rate": (100.0, "hardware mode: status rate, Hz"),
     "frame_id": (pipeline.FRAME, "object frame"),
@@ -161,8 +163,8 @@ class MonitorNode(Node):
         self.tracker = ContactTracker(TrackerConfig(
             p["mu"], p["load_threshold"], p["edge_tolerance"], p["alarm_ratio"],
             p["match_margin"], p["stale_after"], p["weight"] or None,
-            p["prediction_tolerance"], p["relative_per_depth"]), list(self.fingers),
-            ["wrench"] if self.joint_forces else streams)
+            p["prediction_tolerance"], p["relative_per_depth"], p["mirror_tolerance"]),
+            list(self.fingers), ["wrench"] if self.joint_forces else streams)
         loop = pipeline.loop_qos(p["qos_depth"])
         sensors = pipeline.sensor_qos(p["sensor_qos"], p["qos_depth"])
         types = {"pose": PoseStamped, "wrench": WrenchStamped, "tactile": TactileArray}

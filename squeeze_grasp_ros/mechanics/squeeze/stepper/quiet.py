@@ -15,31 +15,31 @@ terminations), the watched functions at both ends, keyed tables of every functio
 * the translation is at most one grid substep (the call is one substep from s = 0 to 1),
 
 such a call makes exactly two solves (at s = 0 and s = 1), finds no event and ends at s = 1.
-:class:`QuietSteps` makes those same two solves (the same functions on the same arrays, so the
-same forces bit for bit), checks that every watched function is above :data:`QUIET_MARGIN` at
-the end (and at the start, unless the state is the one its last quiet call returned), and
-returns the same :class:`~..contact_state.StepResult`. Anything else (a function at or below
-the margin, a sliding contact, a nonlinear material, a long translation) is handed to
-:func:`~.run.advance` whole, so events are located exactly as before.
+:class:`QuietSteps` makes those same two solves (the same operations on the same arrays, so
+the same forces bit for bit), makes sure every watched function is above :data:`QUIET_MARGIN`
+at both ends, and returns the same :class:`~..contact_state.StepResult`. Anything else (a
+function at or below the margin, a sliding contact, a nonlinear material, a long translation)
+is handed to :func:`~.run.advance` whole, so events are located exactly as before.
 
 Within one sticking mode everything but the finger positions stays: the set's stiffness and tip
 offsets, the watched rows and contacts, each contact's node, finger and angles. The first quiet
 call of a mode keeps them (:class:`_Mode`, until the next full call or until a hold of the
 chattering bound expires), and the calls after it compute only what moves: the two solves, the
-work integral, the samples' finger forces, the new contacts' displacements and forces. The
-checks at the end answer from bounds on the change since their last evaluation where they can:
-the contact functions (each moves by at most (1 + mu) ||dF||), the gaps (1-Lipschitz in the
-boundary point and the tip), the area ratio (:class:`~.area_watch.AreaWatch`); a bound that
-does not clear its functions has them evaluated.
+work integral, the samples' finger forces, the contacts' displacements and forces. Every watched
+function is then affine in the fingers' translation, with a rate the mode fixes
+(:class:`~.travel.TravelRates`): where the functions are evaluated (the mode's first call, and
+whenever the fingers leave the last reach) they give a travel within which none can reach the
+margin, and a call that ends within it evaluates none. Only the strain limit and the pickup
+margin, when declared, are evaluated at every call.
 """
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping
 from dataclasses import dataclass
 
 import numpy as np
 
-from squeeze_grasp_ros.mechanics.elastic.compliance import node_dofs
 from squeeze_grasp_ros.mechanics.squeeze.contact_model import (
     INVERSION_AREA_RATIO,
     ContactModel,
@@ -60,9 +60,9 @@ from squeeze_grasp_ros.mechanics.squeeze.stepper.functions import EventFunctions
 from squeeze_grasp_ros.mechanics.squeeze.stepper.motion import FingerMotion
 from squeeze_grasp_ros.mechanics.squeeze.stepper.run import TERMINATION_ORDER, advance
 from squeeze_grasp_ros.mechanics.squeeze.stepper.solving import Counters
-from squeeze_grasp_ros.mechanics.squeeze.stepper.substeps import SubstepControl
+from squeeze_grasp_ros.mechanics.squeeze.stepper.travel import TravelRates
 from squeeze_grasp_ros.mechanics.squeeze.tip_shapes import TipGeometry, tangent, unit
-from squeeze_grasp_ros.mechanics.vocabulary import ContactMode, MaterialModel
+from squeeze_grasp_ros.mechanics.vocabulary import ContactMode, MaterialModel, Termination
 
 __all__ = ["QUIET_MARGIN", "QuietSteps"]
 
@@ -71,6 +71,7 @@ QUIET_MARGIN = 1e-12
 exceed for a call to be quiet. The start of the next call re-solves the state from its SI
 values, which moves the functions by round-off (about 1e-16); a function within this margin of
 zero goes through the full stepper, so that round-off can never hide or invent an event."""
+_STILL = (0.0, 0.0)
 
 
 class QuietSteps:
@@ -90,6 +91,9 @@ class QuietSteps:
     ----------
     calls : dict
         ``{"quiet": n, "full": n}``: how many calls took each path.
+    evaluations : int
+        Quiet calls that evaluated the watched functions (the others ended within the reach of
+        the last evaluation).
     """
 
     def __init__(self, model: ContactModel, step: float, event_tol: float,
@@ -98,17 +102,22 @@ class QuietSteps:
         self.model, self.step, self.event_tol = model, step, event_tol
         self.terminate_on = tuple(terminate_on)
         self.calls = {"quiet": 0, "full": 0}
+        self.evaluations = 0
         self._checked: ContactState | None = None
+        self._fingers: tuple[np.ndarray, np.ndarray] | None = None
         self._tips: tuple | None = None
         self._set: _Sticking | None = None
-        self._gap_ref: dict | None = None
         self._mode: _Mode | None = None
-        self._contact_ref: tuple | None = None
+        self._reach: tuple[np.ndarray, float] | None = None
         self._boundary = model.positions(model.boundary_nodes)
         self._length = model.length
         self._applies = (quiet and model.constitutive_model == MaterialModel.LINEAR
                          and not model.reference and not model.adaptive_steps
                          and model.mu > 0.0)
+        limits = model.limits
+        self._terminations = (
+            (limits.strain is not None and Termination.STRAIN_LIMIT in self.terminate_on)
+            or (limits.weight is not None and Termination.PICKED_UP in self.terminate_on))
         self.area = AreaWatch(model) if self._applies else None
 
     def advance(self, state: ContactState,
@@ -127,35 +136,73 @@ class QuietSteps:
                translations: Mapping[str, tuple[float, float]]) -> StepResult | None:
         """The quiet call's result, or None when the call is not quiet."""
         mode = self._mode
-        if mode is not None and not (state is self._checked and state.depth < mode.expiry):
-            mode = None
-        if mode is None and (state.fresh or state.undetermined or len(state.contacts) < 2
-                             or any(c.mode != ContactMode.STICK for c in state.contacts)):
+        if mode is not None and state is self._checked and state.depth < mode.expiry:
+            return self._next(mode, state, translations)
+        self._mode = None
+        if (state.fresh or state.undetermined or len(state.contacts) < 2
+                or any(c.mode != ContactMode.STICK for c in state.contacts)):
             return None
         motion = self._motion(state, translations)
-        if motion is None:
+        if motion is None or not _one_substep(self.step, motion.rate):
             return None
-        rate = motion.rate
-        if rate == 0 or SubstepControl(self.step / rate, False, self.step / rate).end(0.0) < 1.0:
+        mode = self._enter(state, motion)
+        start, D = motion.start, motion.translation
+        ends = mode.sticking.ends(start, D)
+        reach = 0.0 if ends is None else self._evaluate(mode, start, ends[0], ends[1], D)
+        if reach <= 0.0:
             return None
-        if mode is None:
-            mode = self._enter(state, motion)
-        solutions = mode.sticking.solutions(motion)
-        if solutions is None:
+        self._mode, self._reach = mode, (start, reach * reach)
+        end = start + D
+        if not self._within(end, ends[2], ends[3], D):
             return None
-        sol_a, sol_b = solutions
-        if mode is not self._mode and not self._clear(mode, motion, sol_a, 0.0):
+        t0 = np.array([f.translation for f in state.fingers], float) / self._length
+        return self._result(mode, state, (start, D, motion.rate, t0), ends)
+
+    def _next(self, mode: _Mode, state: ContactState,
+              translations: Mapping[str, tuple[float, float]]) -> StepResult | None:
+        """The next quiet call of ``mode`` from ``state`` (the state its last call returned),
+        or None when it is not quiet.
+        """
+        L = self._length
+        if not translations.keys() <= mode.known:
             return None
-        self._mode = mode
-        if not self._clear(mode, motion, sol_b, 1.0):
+        D = np.array([translations.get(n, _STILL) for n in mode.names], float) / L
+        d = D.ravel()
+        # the norm as np.linalg.norm computes it (sqrt of the dot product), without its checks;
+        # a translation with a value that is not finite has a rate that is not
+        rate = float(np.sqrt(d.dot(d)))
+        if not (math.isfinite(rate) and _one_substep(self.step, rate)):
             return None
-        result = mode.result(state, motion, sol_a, sol_b, self.step)
-        self._checked = result.state
-        return result
+        centers, moved = self._fingers
+        start = centers / L
+        ends = mode.sticking.ends(start, D)
+        if ends is None:
+            return None
+        if not self._within(start + D, ends[2], ends[3], D):
+            return None
+        return self._result(mode, state, (start, D, rate, moved / L), ends)
+
+    def _within(self, end: np.ndarray, delta: np.ndarray, F: np.ndarray, D: np.ndarray) -> bool:
+        """Whether every watched function of the mode is above :data:`QUIET_MARGIN` at the end
+        of the call (tips at ``end``, the set at ``delta``, ``F``): from the reach of their last
+        evaluation when the end lies within it (the terminations declared evaluated), else
+        evaluated there (and the reach renewed).
+        """
+        mode = self._mode
+        ref, reach2 = self._reach
+        off = (end - ref).ravel()
+        if off @ off < reach2:
+            return not self._terminations or self._terminations_clear(mode, delta, F, D)
+        reach = self._evaluate(mode, end, delta, F, D)
+        if reach <= 0.0:
+            return False
+        self._reach = (end, reach * reach)
+        return True
 
     def _enter(self, state: ContactState, motion: FingerMotion) -> _Mode:
         """The constants of the state's sticking mode (its contact set, the functions watched,
-        the results' fixed parts), until a hold of the chattering bound expires.
+        the results' fixed parts, the functions' rates), until a hold of the chattering bound
+        expires.
         """
         model = self.model
         sticking = self._sticking(state, motion)
@@ -167,19 +214,26 @@ class QuietSteps:
         watched = ~chatter.held(contacts.nodes, depth)
         expiry = min((until for until in chatter.holds.values() if until > depth),
                      default=np.inf)
-        names, fingers = motion.names, contacts.finger
+        names, fingers, L = motion.names, contacts.finger, model.length
+        rows = functions.free_rows(contacts, held)
         thetas = np.array(contacts.theta, float).tolist()
+        watched = None if watched.all() else watched
+        normal = sticking.unit if watched is None else sticking.unit[watched]
+        along = sticking.tangent if watched is None else sticking.tangent[watched]
+        radius, flat, facing = (motion.radius * L, (motion.tip.flat * L).tolist(),
+                                motion.tip.facing.tolist())
         return _Mode(
-            sticking, names, motion.tip, functions, functions.free_rows(contacts, held),
-            None if watched.all() else watched, sticking.unit[watched],
-            sticking.tangent[watched], expiry,
-            tuple((_rows_of(fingers == f), bool((fingers == f).any()))
-                  for f in range(len(names))),
+            sticking, names, frozenset(names), motion.tip, functions, rows, watched, normal,
+            along, expiry,
+            tuple((names[f], _rows_of(fingers == f), bool((fingers == f).any()), radius[f],
+                   flat[f], facing[f]) for f in range(len(names))),
             tuple(ContactNode(node, names[f], ContactMode.STICK, 0, theta, None, None, nu)
                   for node, f, theta, nu in zip(contacts.nodes.tolist(), fingers.tolist(),
                                                 thetas, sticking.nu.tolist())),
             tuple(contacts.nodes.tolist()), tuple(thetas),
-            model.length, model.force_unit, model._cache)
+            TravelRates.of(model, contacts, len(names), rows, watched, normal, along,
+                           self.area),
+            L, model.force_unit, model._cache)
 
     def _motion(self, state: ContactState,
                 translations: Mapping[str, tuple[float, float]]) -> FingerMotion | None:
@@ -199,11 +253,10 @@ class QuietSteps:
         names, known, tips = self._tips[2:]
         if not translations.keys() <= known:
             return None
-        D = np.array([translations.get(n, (0.0, 0.0)) for n in names], float) / L
+        D = np.array([translations.get(n, _STILL) for n in names], float) / L
         if not np.isfinite(D).all():
             return None
         d = D.ravel()
-        # the norm as np.linalg.norm computes it (sqrt of the dot product), without its checks
         return FingerMotion(names, np.array([f.center for f in fingers], float) / L, D,
                             tips.radius, float(np.sqrt(d.dot(d))), state.depth, L, tips.flat,
                             tips.facing)
@@ -217,90 +270,107 @@ class QuietSteps:
             nu = tip.normal_angle(contacts.theta)
             dtheta, t = np.zeros(len(contacts)), tangent(nu)
             self._set = _Sticking(key, contacts, contacts.data.C, tip.offset(contacts.theta),
-                                  nu, tip.curvature(contacts.theta), unit(nu), t, tip.radius,
-                                  np.array(contacts.theta, float), dtheta,
+                                  contacts.positions, nu, tip.curvature(contacts.theta),
+                                  unit(nu), t, np.array(contacts.theta, float), dtheta,
                                   (tip.radius * dtheta)[:, None] * t)
         return self._set
 
-    def _clear(self, mode: _Mode, motion: FingerMotion, sol: Solution, s: float) -> bool:
-        """Whether every function a call watches at ``sol`` (point s; the mode's free boundary
-        rows and contacts not held) and every termination it checks is above
-        :data:`QUIET_MARGIN`.
+    def _evaluate(self, mode: _Mode, centers: np.ndarray, delta: np.ndarray, F: np.ndarray,
+                  D: np.ndarray) -> float:
+        """Evaluate every function a call watches at the configuration ``delta``, ``F`` with
+        the tips at ``centers`` (the mode's contacts not held, its free boundary rows, the
+        terminations checked): the travel within which none reaches :data:`QUIET_MARGIN`
+        (:meth:`~.travel.TravelRates.travel`), 0.0 when one is at or below it already.
         """
-        contacts = mode.sticking.contacts
-        if not (self._contacts_clear(mode, sol.F)
-                and self._gaps_clear(mode, motion.centers(s), sol)):
-            return False
-        strain, pickup = mode.functions.termination_values(contacts, sol)
-        return (strain > QUIET_MARGIN and pickup > QUIET_MARGIN
-                and self.area.above(contacts.data, sol.delta, sol.F,
-                                    INVERSION_AREA_RATIO + QUIET_MARGIN))
-
-    def _contacts_clear(self, mode: _Mode, F: np.ndarray) -> bool:
-        """Whether the normal force f_n and both cone margins mu f_n -+ f_t of every contact
-        not held are above :data:`QUIET_MARGIN` at the forces ``F``: from the lowest value
-        computed last for the mode while a bound allows (each moves by at most
-        (1 + mu) ||F - F_ref||), else computed (and kept).
-        """
-        mu, ref = self.model.mu, self._contact_ref
-        if ref is not None and ref[0] is mode:
-            dF = F - ref[1]
-            if ref[2] - (1.0 + mu) * np.sqrt(np.vdot(dF, dF)) * (1.0 + 1e-12) > QUIET_MARGIN:
-                return True
-        watched = F[mode.watched] if mode.watched is not None else F
+        self.evaluations += 1
+        if self._terminations and not self._terminations_clear(mode, delta, F, D):
+            return 0.0
+        watched = F if mode.watched is None else F[mode.watched]
         fn = np.einsum("ij,ij->i", watched, mode.unit)
         ft = np.einsum("ij,ij->i", watched, mode.tangent)
-        lowest = min(fn.min(initial=np.inf), (mu * fn - np.abs(ft)).min(initial=np.inf))
-        self._contact_ref = (mode, F, lowest)
-        return lowest > QUIET_MARGIN
+        sd, rows = mode.sticking.contacts.data, mode.rows
+        points = self._boundary[rows] + self.model.boundary_displacement(sd, delta, F, rows)
+        gaps = mode.tip.gaps(points, centers)
+        lowest = min(fn.min(initial=np.inf), gaps.min(initial=np.inf))
+        if not lowest > QUIET_MARGIN:
+            return 0.0
+        reserve = self.area.reserve(sd, delta, F, INVERSION_AREA_RATIO + QUIET_MARGIN)
+        return mode.rates.travel(fn, self.model.mu * fn - np.abs(ft), gaps, reserve,
+                                 QUIET_MARGIN)
 
-    def _gaps_clear(self, mode: _Mode, centers: np.ndarray, sol: Solution) -> bool:
-        """Whether every gap of the mode's free boundary rows to every tip (at ``centers``) is
-        above :data:`QUIET_MARGIN` at ``sol``: from the last gaps computed for the set and rows
-        while a bound allows, else computed (and kept).
-
-        A gap is 1-Lipschitz in the boundary point and in the tip's position (a distance to a
-        convex shape), and a boundary point moves by u_i = A_i F + R_i g (the set's boundary
-        compliance rows and rigid modes, g = E^T delta), so a gap is at least its kept value
-        less max_i(||A_i|| ||F - F_ref|| + ||R_i|| ||g - g_ref||) less the tips' travel.
+    def _terminations_clear(self, mode: _Mode, delta: np.ndarray, F: np.ndarray,
+                            D: np.ndarray) -> bool:
+        """Whether the strain limit's and the pickup margin's functions (those declared) are
+        above :data:`QUIET_MARGIN` at ``delta``, ``F`` (evaluated: they have no rate here).
         """
-        model, sd, rows = self.model, mode.sticking.contacts.data, mode.rows
-        g = sd.E.T @ sol.delta.reshape(-1)
-        ref = self._gap_ref
-        if ref is None or ref["set"] is not mode.sticking or not np.array_equal(ref["rows"], rows):
-            ref = None
-        else:
-            dF, dg, dc = sol.F - ref["F"], g - ref["g"], centers - ref["centers"]
-            moved = (ref["a_norm"] * np.sqrt(np.vdot(dF, dF))
-                     + ref["r_norm"] * np.sqrt(np.vdot(dg, dg))
-                     + np.sqrt((dc * dc).sum(axis=1).max()))
-            if ref["lowest"] - moved * (1.0 + 1e-12) > QUIET_MARGIN:
-                return True
-        points = self._boundary[rows] + model.boundary_displacement(sd, sol.delta, sol.F, rows)
-        lowest = float(mode.tip.gaps(points, centers).min(initial=np.inf))
-        if ref is None:
-            A = sd.A_bc[node_dofs(rows)].reshape(len(rows), -1)
-            R = model.obj.rigid[node_dofs(model.boundary_nodes[rows])].reshape(len(rows), -1)
-            ref = {"set": mode.sticking, "rows": rows,
-                   "a_norm": float(np.sqrt((A * A).sum(axis=1)).max(initial=0.0)),
-                   "r_norm": float(np.sqrt((R * R).sum(axis=1)).max(initial=0.0))}
-        self._gap_ref = {**ref, "F": sol.F, "g": g, "centers": centers, "lowest": lowest}
-        return lowest > QUIET_MARGIN
+        sol = mode.sticking.solution(delta, F, D)
+        strain, pickup = mode.functions.termination_values(mode.sticking.contacts, sol)
+        return strain > QUIET_MARGIN and pickup > QUIET_MARGIN
+
+    def _result(self, mode: _Mode, state: ContactState, motion: tuple,
+                ends: tuple[np.ndarray, ...]) -> StepResult:
+        """The :class:`StepResult` :func:`~.run.advance` returns for a call of one substep
+        with no event (``motion``: start (f, 2), translation (f, 2), rate, the fingers'
+        translations so far (f, 2), all / L; ``ends``: delta and F at s = 0 and s = 1): the
+        same operations on the same numbers as its ``integrate_work``, ``record`` and
+        ``to_state``.
+        """
+        start, D, rate, t0 = motion
+        _, F_a, delta_b, F_b = ends
+        L, fu, old = mode.length, mode.force_unit, state.fingers
+        forces_a, forces_b, fingers = {}, {}, []
+        both = np.array((F_a, F_b))
+        # FingerMotion.depth_at(s): depth0 + s * rate * length
+        depth = state.depth + 1.0 * rate * L
+        centers, moved = (start + 1.0 * D) * L, (t0 + 1.0 * D) * L
+        for f, ((name, mine, touching, radius, flat, facing), f_old) in enumerate(
+                zip(mode.fingers, old)):
+            # each end's finger force, summed over the same rows in the same order
+            y = both[:, mine].sum(axis=1)
+            forces_a[name], forces_b[name] = map(tuple, (y * fu).tolist())
+            # the work as advance() keeps it (/ (fu L)), in Python floats (the same IEEE
+            # operations as its float64 array's)
+            work = f_old.work / (fu * L)
+            if touching:
+                # h = 1; the set and the motion are those of both ends, so dF / ds is the same
+                # there and the Hermite term h^2 / 12 (ra - rb) is 0.0 exactly (ra, rb finite)
+                ya, yb = y
+                work += 0.5 * (float(ya @ D[f]) + float(yb @ D[f])) + 0.0
+            fingers.append(FingerState(name, centers[f], radius, moved[f], float(work * fu * L),
+                                       float(f_old.dissipation / (fu * L) * fu * L), flat,
+                                       facing))
+        samples = (Sample(state.depth + 0.0 * rate * L, mode.nodes, mode.thetas, forces_a),
+                   Sample(depth, mode.nodes, mode.thetas, forces_b))
+        contacts = tuple(map(_moved, mode.contacts, delta_b * L, F_b * fu))
+        holds = tuple(sorted((n, u) for n, u in state.holds if u > depth))
+        new = ContactState(tuple(fingers), contacts, depth, state.relative_per_depth, (), (),
+                           state.history, holds)
+        diagnostics = {**_DIAGNOSTICS, "sets_factored": mode.cache.get("sets_factored", 0),
+                       "reduced_max_condition": mode.cache.get("max_condition", 1.0)}
+        self._checked, self._fingers = new, (centers, moved)
+        return StepResult(new, (), 1.0, None, samples, (), diagnostics, self.step)
+
+
+def _one_substep(step: float, rate: float) -> bool:
+    """Whether a call at ``rate`` is one grid substep (SubstepControl's end(0.0) is 1.0)."""
+    return rate > 0.0 and step / rate >= 1.0
 
 
 @dataclass(frozen=True)
 class _Mode:
     """What stays fixed while calls stay quiet in one sticking mode: the set's constants, the
-    functions watched (the free boundary ``rows``; the contacts not held, their normals'
-    ``unit`` and ``tangent``), the depth (m) at which a hold of the chattering bound ``expiry``
-    ends, and the parts of a result that do not move (each finger's contact rows, a slice
-    when they are consecutive, and whether it has any; each
-    contact's node, finger, mode, angle and normal angle, as a ContactNode without its
-    displacement and force).
+    finger names (and as a set), the tips, the functions watched (the free boundary ``rows``;
+    the contacts ``watched``, None for all, their normals' ``unit`` and ``tangent``), the depth
+    (m) at which a hold of the chattering bound ``expiry`` ends, and the parts of a result that
+    do not move: per finger its name, its contact rows (a slice when they are consecutive),
+    whether it has any, its radius, flat and facing; each contact's node, finger, mode, angle
+    and normal angle, as a ContactNode without its displacement and force. ``rates``: how fast
+    the watched functions change with the fingers' translation.
     """
 
     sticking: _Sticking
     names: tuple[str, ...]
+    known: frozenset
     tip: TipGeometry
     functions: EventFunctions
     rows: np.ndarray
@@ -308,51 +378,14 @@ class _Mode:
     unit: np.ndarray
     tangent: np.ndarray
     expiry: float
-    masks: tuple[tuple[slice | np.ndarray, bool], ...]
+    fingers: tuple[tuple, ...]
     contacts: tuple[ContactNode, ...]
     nodes: tuple[int, ...]
     thetas: tuple[float, ...]
+    rates: TravelRates
     length: float
     force_unit: float
     cache: dict
-
-    def result(self, state: ContactState, motion: FingerMotion, sol_a: Solution,
-               sol_b: Solution, step: float) -> StepResult:
-        """The :class:`StepResult` :func:`~.run.advance` returns for a call of one substep
-        from ``sol_a`` (s = 0) to ``sol_b`` (s = 1) with no event: the same operations on the
-        same numbers as its ``integrate_work``, ``record`` and ``to_state``.
-        """
-        L, fu = self.length, self.force_unit
-        D, names, old = motion.translation, self.names, state.fingers
-        work = np.array([f.work for f in old], float) / (fu * L)
-        t0 = np.array([f.translation for f in old], float) / L
-        forces_a, forces_b = {}, {}
-        for f, (mine, touching) in enumerate(self.masks):
-            ya, yb = sol_a.F[mine].sum(axis=0), sol_b.F[mine].sum(axis=0)
-            forces_a[names[f]] = tuple((ya * fu).tolist())
-            forces_b[names[f]] = tuple((yb * fu).tolist())
-            if touching:
-                # h = 1; sol_a.dF is sol_b.dF (one motion, one set), so the Hermite term
-                # h^2 / 12 (ra - rb) is 0.0 exactly (ra, rb finite)
-                work[f] += 0.5 * (ya @ D[f] + yb @ D[f]) + 0.0
-        depth = motion.depth_at(1.0)
-        samples = (Sample(motion.depth_at(0.0), self.nodes, self.thetas, forces_a),
-                   Sample(depth, self.nodes, self.thetas, forces_b))
-        radius, flat, facing = (motion.radius * L, (motion.tip.flat * L).tolist(),
-                                motion.tip.facing.tolist())
-        centers, moved = (motion.start + 1.0 * D) * L, (t0 + 1.0 * D) * L
-        fingers = tuple(
-            FingerState(n, centers[f], radius[f], moved[f], float(work[f] * fu * L),
-                        float(f_old.dissipation / (fu * L) * fu * L), flat[f], facing[f])
-            for f, (n, f_old) in enumerate(zip(names, old)))
-        delta, F = sol_b.delta * L, sol_b.F * fu
-        contacts = tuple(_moved(c, delta[k], F[k]) for k, c in enumerate(self.contacts))
-        holds = tuple(sorted((n, u) for n, u in state.holds if u > depth))
-        new = ContactState(fingers, contacts, depth, state.relative_per_depth, (), (),
-                           state.history, holds)
-        diagnostics = {**_DIAGNOSTICS, "sets_factored": self.cache.get("sets_factored", 0),
-                       "reduced_max_condition": self.cache.get("max_condition", 1.0)}
-        return StepResult(new, (), 1.0, None, samples, (), diagnostics, step)
 
 
 def _rows_of(mask: np.ndarray) -> slice | np.ndarray:
@@ -383,40 +416,47 @@ _DIAGNOSTICS = {**Counters().as_dict(), "substeps": 1}
 class _Sticking:
     """One contact set with every node sticking, at its polar angles: what the fixed-set
     solve of :func:`~..contact_model.attempt_fixed_set` computes once for the set (the nodes
-    ride on their tips, so only the tips' positions change): ``theta`` as an array, ``dtheta``
-    zero, and ``slide`` the nodes' motion along their tips (r dtheta t, zeros) that
-    d delta / ds adds to the tips' translation.
+    ride on their tips, so only the tips' positions change): the tips' ``offset`` and the
+    nodes' undeformed ``positions`` (/ L), ``theta`` as an array, ``dtheta`` zero, and
+    ``slide`` the nodes' motion along their tips (r dtheta t, zeros) that d delta / ds adds to
+    the tips' translation.
     """
 
     key: tuple
     contacts: ContactSet
     C: np.ndarray
     offset: np.ndarray
+    positions: np.ndarray
     nu: np.ndarray
     kappa: np.ndarray
     unit: np.ndarray
     tangent: np.ndarray
-    radius: np.ndarray
     theta: np.ndarray
     dtheta: np.ndarray
     slide: np.ndarray
 
-    def solutions(self, motion: FingerMotion) -> tuple[Solution, Solution] | None:
-        """:func:`~..contact_model.attempt_fixed_set` of the set at s = 0 and s = 1 of
-        ``motion`` with no sliding node (the same operations: F = C delta, dF/ds = C d delta/ds,
-        the same along the motion), or None if a value is not finite.
+    def ends(self, start: np.ndarray, D: np.ndarray) -> tuple[np.ndarray, ...] | None:
+        """(delta, F) at s = 0 and at s = 1 of the tips moving from ``start`` by ``D`` (f, 2),
+        as :func:`~..contact_model.attempt_fixed_set` computes them with no sliding node
+        (delta = c(s) + offset - X, F = C delta), or None if a force is not finite.
         """
-        c, m = self.contacts, len(self.contacts)
-        f = c.finger
-        start, dirs = motion.start[f], motion.translation[f]
-        dF = (self.C @ dirs.reshape(-1)).reshape(m, 2)
-        ddelta = dirs + self.slide
-        out = []
-        for s in (0.0, 1.0):
-            delta = start + s * dirs + self.offset - c.positions
-            F = (self.C @ delta.reshape(-1)).reshape(m, 2)
-            out.append(Solution(self.theta, delta, F, self.dtheta, dF, ddelta, 0, 0.0, 1.0,
-                                self.nu, self.kappa))
-        if not np.isfinite((out[0].F, out[1].F, dF)).all():
+        f = self.contacts.finger
+        start, dirs = start[f], D[f]
+        m = len(f)
+        delta_a = start + 0.0 * dirs + self.offset - self.positions
+        delta_b = start + 1.0 * dirs + self.offset - self.positions
+        F_a = (self.C @ delta_a.reshape(-1)).reshape(m, 2)
+        F_b = (self.C @ delta_b.reshape(-1)).reshape(m, 2)
+        # a sum of values is finite only if they all are (or it overflows: then not quiet)
+        if not math.isfinite(F_a.sum() + F_b.sum()):
             return None
-        return out[0], out[1]
+        return delta_a, F_a, delta_b, F_b
+
+    def solution(self, delta: np.ndarray, F: np.ndarray, D: np.ndarray) -> Solution:
+        """The fixed-set solve's :class:`~..contact_model.Solution` at ``delta``, ``F`` of the
+        motion by ``D`` (its rates: dF / ds = C d delta / ds, d delta / ds = D + slide).
+        """
+        dirs = D[self.contacts.finger]
+        dF = (self.C @ dirs.reshape(-1)).reshape(-1, 2)
+        return Solution(self.theta, delta, F, self.dtheta, dF, dirs + self.slide, 0, 0.0, 1.0,
+                        self.nu, self.kappa)

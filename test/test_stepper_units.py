@@ -33,7 +33,11 @@ from squeeze_grasp_ros.mechanics.squeeze.stable_pure import plan_squeeze
 from squeeze_grasp_ros.mechanics.squeeze.stepper import advance
 from squeeze_grasp_ros.mechanics.squeeze.stepper.chatter import ChatterBound
 from squeeze_grasp_ros.mechanics.squeeze.stepper.contact_set import ContactSet
-from squeeze_grasp_ros.mechanics.squeeze.stepper.functions import EventFunctions
+from squeeze_grasp_ros.mechanics.squeeze.stepper.functions import (
+    EventFunctions,
+    KeyOrder,
+    WatchedValues,
+)
 from squeeze_grasp_ros.mechanics.squeeze.stepper.location import (
     crossings,
     dips_inside,
@@ -473,6 +477,29 @@ def test_crossings_and_dips():
     assert dips_inside(a, b, start, end, slopes_a, slopes_b, set())
     assert not dips_inside(a, b, start, end, slopes_a, slopes_b, {graze.at_node})
     assert not dips_inside(a, b, start, end, {stays: 1.0}, {stays: 1.0}, set())
+
+
+def test_crossings_of_watched_arrays_are_those_of_their_mappings():
+    """A substep's two WatchedValues (one key order) are compared as arrays; the result is that
+    of the same values as dicts, fresh keys, terminations and a NaN at the end included, and
+    values of another key order are compared by key.
+    """
+    keys = (EventKey(B, 1), EventKey(CP, 2), EventKey(B, 3), EventKey.gap(4, 0),
+            EventKey.gap(4, 1), EventKey(B, 5))
+    order = KeyOrder(keys)
+    area, pickup = (EventKey(function) for function in (EventFunction.AREA,
+                                                        EventFunction.PICKUP))
+    start = WatchedValues(order, np.array([1.0, 0.0, 1.0, 1.0, 0.0, 2.0]),
+                          {area: 0.5, pickup: 1.0})
+    end = WatchedValues(order, np.array([-1.0, -1.0, 2.0, 0.0, -3.0, np.nan]),
+                        {area: -0.1, pickup: 2.0})
+    assert dict(start) == dict(zip(keys, start.values)) | start.ends and len(end) == 8
+    for fresh in (set(), {keys[1]}, {keys[4].at_node}):
+        expected = crossings(dict(start), dict(end), fresh)
+        assert crossings(start, end, fresh) == expected
+    assert crossings(start, end, set()) == [keys[0], keys[3], keys[5], area]
+    other = WatchedValues(KeyOrder(keys[::-1]), end.values[::-1].copy(), end.ends)
+    assert crossings(start, other, set()) == crossings(dict(start), dict(other), set())
 
 
 # ---------------------------------------------------------------------------- substeps

@@ -32,7 +32,8 @@ from squeeze_grasp_ros.scene.setup import check_adversary_node
 from squeeze_grasp_ros.sweep.plan import Task, evaluation_scene, group_setup, rng_for
 
 CACHE_GROUPS = 4
-"""Prepared groups kept per worker process (a 2k-node group holds a few MB)."""
+"""Prepared groups kept per worker process (a 2k-node group holds a few MB, and its object up
+to SHARED_SET_BYTES of reduced contact sets shared by its evaluations)."""
 
 COLUMNS: dict[str, str] = {
     "eval_id": "string",

@@ -193,6 +193,10 @@ class ElasticObject:
     route: Route = "factorized"
     _diag: dict = field(default_factory=dict, repr=False, compare=False)
     _load_gradients: dict = field(default_factory=dict, repr=False, compare=False)
+    _shared: dict = field(default_factory=dict, repr=False, compare=False)
+    """What the users of this object keep with it, by their own keys, so that all of its
+    users share it: the contact models' reduced contact sets
+    (:meth:`~squeeze_grasp_ros.mechanics.squeeze.contact_model.ContactModel.set_data`)."""
 
     def __post_init__(self) -> None:
         if self.route not in ROUTES:

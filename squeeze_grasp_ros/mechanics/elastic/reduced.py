@@ -27,6 +27,9 @@ from squeeze_grasp_ros.mechanics.errors import (
     require_finite,
 )
 
+REDUCED_KEPT = 1024
+"""Reduced stiffnesses an object keeps for :func:`reduced_stiffness` (the oldest dropped)."""
+
 
 @dataclass(frozen=True)
 class ReducedStiffness:
@@ -118,6 +121,10 @@ def reduce_blocks(
 def reduced_stiffness(obj: ElasticObject, contacts) -> ReducedStiffness:
     """Reduced stiffness of ``obj`` for contact nodes ``contacts`` (m >= 2 distinct nodes).
 
+    The object keeps the last REDUCED_KEPT of them (by the nodes in their order), for all of
+    its users: a sweep plans every parameter set of a placement on the same pair. The arrays
+    are shared: do not write to them.
+
     Examples
     --------
     >>> from squeeze_grasp_ros.api import load_scene, scene_file, scene_solid
@@ -135,12 +142,19 @@ def reduced_stiffness(obj: ElasticObject, contacts) -> ReducedStiffness:
         raise InvalidInputError(f"contacts must be distinct nodes, got {contacts.tolist()}")
     if contacts.min() < 0 or contacts.max() >= obj.mesh.n:
         raise InvalidInputError(f"contacts must be node indices in [0, {obj.mesh.n - 1}]")
-    A_hat = obj.compliance_block(contacts)
-    B = obj.rigid[node_dofs(contacts)]
-    C_hat, E, H_hat, condition = reduce_blocks(A_hat, B)
-    eh = obj.material.force_scale
-    red = ReducedStiffness(contacts, A_hat / eh, B, C_hat * eh, E, H_hat / eh, condition)
-    require_finite("reduced stiffness", red.C)
+    kept = obj._shared.setdefault("reduced_stiffness", {})
+    tag = tuple(contacts.tolist())
+    red = kept.get(tag)
+    if red is None:
+        A_hat = obj.compliance_block(contacts)
+        B = obj.rigid[node_dofs(contacts)]
+        C_hat, E, H_hat, condition = reduce_blocks(A_hat, B)
+        eh = obj.material.force_scale
+        red = ReducedStiffness(contacts, A_hat / eh, B, C_hat * eh, E, H_hat / eh, condition)
+        require_finite("reduced stiffness", red.C)
+        if len(kept) >= REDUCED_KEPT:
+            kept.pop(next(iter(kept)), None)
+        kept[tag] = red
     return red
 
 

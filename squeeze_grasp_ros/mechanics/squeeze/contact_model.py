@@ -29,6 +29,8 @@ Everything here is dimensionless: lengths by L = obj.scale, forces by E h L.
 
 from __future__ import annotations
 
+import threading
+from collections import OrderedDict
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from functools import cached_property
@@ -70,6 +72,10 @@ largest angle update (rad) falls below it."""
 BOUNDARY_ROWS_KEPT = 8
 """Row selections of the boundary compliance the fast model keeps for its last contact set
 (each 2k x 2m floats for k rows and m contacts)."""
+SHARED_SET_BYTES = 64 * 2**20
+"""Memory an object keeps for the reduced data of contact sets its fast contact models share
+(:meth:`ContactModel.set_data`; a set of m contacts holds 2m (2b + 2m + 3) floats, and
+6 t m more with a strain limit, for b boundary nodes and t elements)."""
 
 
 @dataclass(frozen=True)
@@ -148,6 +154,45 @@ class SetData:
     A_bc: np.ndarray | None
     strain_map: np.ndarray | None
     condition: float
+
+
+class SharedSets:
+    """The reduced contact sets of one object that its fast contact models share, the least
+    recently used dropped beyond SHARED_SET_BYTES (the last one put always stays). Safe for
+    the models of several threads (a Dask worker with more than one).
+    """
+
+    def __init__(self) -> None:
+        self._sets: OrderedDict[tuple, SetData] = OrderedDict()
+        self._lock = threading.Lock()
+        self.nbytes = 0
+
+    def get(self, tag: tuple) -> SetData | None:
+        """The set kept under ``tag`` (now the most recently used), or None."""
+        with self._lock:
+            data = self._sets.get(tag)
+            if data is not None:
+                self._sets.move_to_end(tag)
+            return data
+
+    def put(self, tag: tuple, data: SetData) -> SetData:
+        """Keep ``data`` under ``tag`` (unless a set is kept there already); returns the set
+        kept.
+        """
+        with self._lock:
+            if tag in self._sets:
+                return self._sets[tag]
+            self._sets[tag] = data
+            self.nbytes += _set_bytes(data)
+            while self.nbytes > SHARED_SET_BYTES and len(self._sets) > 1:
+                self.nbytes -= _set_bytes(self._sets.popitem(last=False)[1])
+            return data
+
+
+def _set_bytes(data: SetData) -> int:
+    """Memory of a set's arrays, bytes."""
+    return sum(0 if a is None else a.nbytes
+               for a in (data.C, data.E, data.A_bc, data.strain_map))
 
 
 @dataclass(frozen=True)
@@ -583,7 +628,14 @@ class ContactModel:
         return LinearResponse(sd.C)
 
     def set_data(self, nodes: tuple[int, ...]) -> SetData:
-        """Reduced data of the contact set ``nodes`` (sorted), cached per set (fast model)."""
+        """Reduced data of the contact set ``nodes`` (sorted), cached per set (fast model).
+
+        The fast model's sets are shared by every model of the same object (a sweep's
+        evaluations of one object with other friction, tips or placements reduce a set once):
+        the object keeps them, the least recently used dropped beyond SHARED_SET_BYTES. A
+        model counts a set in ``sets_factored`` (and its condition in ``max_condition``) on
+        its own first use, whether it reduced the set or took it from the object.
+        """
         key = tuple(int(k) for k in nodes)
         sets = self._cache.setdefault("sets", {})
         if key in sets:
@@ -594,13 +646,29 @@ class ContactModel:
                 "at "
                 "least 2 are needed to hold it (Lemma 2)"
             )
+        if self.reference:
+            data = self._reduce(key)
+        else:
+            shared = (self.obj._shared.get("contact_sets")
+                      or self.obj._shared.setdefault("contact_sets", SharedSets()))
+            tag = (key, self.limits.strain is not None)
+            data = shared.get(tag)
+            if data is None:
+                data = shared.put(tag, self._reduce(key))
+        sets[key] = data
+        self._cache["max_condition"] = max(self._cache.get("max_condition", 0.0), data.condition)
+        self._cache["sets_factored"] = self._cache.get("sets_factored", 0) + 1
+        return data
+
+    def _reduce(self, key: tuple[int, ...]) -> SetData:
+        """The reduced data of the contact set ``key`` (sorted node indices)."""
         idx = np.array(key)
         dofs = node_dofs(idx)
         if self.reference:
             A_hat = self.unit_responses(dofs)[dofs]
             A_hat = 0.5 * (A_hat + A_hat.T)
             A_bc = None
-            sets.clear()
+            self._cache["sets"].clear()
         else:
             pos = self.obj.boundary_positions(idx)
             if np.any(pos < 0):
@@ -613,11 +681,7 @@ class ContactModel:
         strain_map = None
         if self.limits.strain is not None and not self.reference:
             strain_map = self.element_strains(self.unit_responses(dofs))
-        data = SetData(idx, C, E, A_bc, strain_map, condition)
-        sets[key] = data
-        self._cache["max_condition"] = max(self._cache.get("max_condition", 0.0), condition)
-        self._cache["sets_factored"] = self._cache.get("sets_factored", 0) + 1
-        return data
+        return SetData(idx, C, E, A_bc, strain_map, condition)
 
     def _strain_b(self) -> np.ndarray:
         """Element strain-displacement matrices with coordinates / L, (t, 3, 6)."""

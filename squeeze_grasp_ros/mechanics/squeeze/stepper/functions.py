@@ -30,6 +30,7 @@ double roots inside an adaptive substep).
 """
 from __future__ import annotations
 
+from collections.abc import Iterator, Mapping
 from dataclasses import dataclass
 from functools import cached_property
 
@@ -50,7 +51,8 @@ from squeeze_grasp_ros.mechanics.squeeze.stepper.contact_set import ContactSet
 from squeeze_grasp_ros.mechanics.squeeze.stepper.motion import FingerMotion
 from squeeze_grasp_ros.mechanics.vocabulary import Termination
 
-__all__ = ["EventFunctions", "EventValues", "event_values", "pickup_margin"]
+__all__ = ["EventFunctions", "EventValues", "KeyOrder", "WatchedValues", "event_values",
+           "pickup_margin"]
 
 _NO_ROWS = np.zeros(0, int)
 
@@ -126,6 +128,49 @@ def event_values(*, mu: float, fn: np.ndarray, ft: np.ndarray, slip: np.ndarray,
     """
     d = slip * dtheta * radius / (rate if rate > 0 else 1.0)
     return EventValues(fn, mu * fn + ft, mu * fn - ft, d, gaps, strain, pickup, area)
+
+
+@dataclass(frozen=True, eq=False)
+class KeyOrder:
+    """The keys of the watched functions held in one array, in its order."""
+
+    keys: tuple[EventKey, ...]
+
+    @cached_property
+    def position(self) -> dict[EventKey, int]:
+        """Each key's index in the array."""
+        return {key: k for k, key in enumerate(self.keys)}
+
+
+class WatchedValues(Mapping):
+    """The watched functions' values at one point, by key (a read-only mapping): the
+    per-contact functions and the gaps in one array ``values`` with its keys ``order``, the
+    terminations checked in ``ends``. Two of them with the same ``order`` (a substep's ends)
+    are compared elementwise (:func:`~.location.crossings`).
+    """
+
+    __slots__ = ("ends", "order", "values")
+
+    def __init__(self, order: KeyOrder, values: np.ndarray, ends: dict[EventKey, float]) -> None:
+        self.order, self.values, self.ends = order, values, ends
+
+    def __getitem__(self, key: EventKey) -> float:
+        k = self.order.position.get(key)
+        return self.ends[key] if k is None else self.values[k]
+
+    def __contains__(self, key: object) -> bool:
+        return key in self.order.position or key in self.ends
+
+    def __iter__(self) -> Iterator[EventKey]:
+        yield from self.order.keys
+        yield from self.ends
+
+    def __len__(self) -> int:
+        return len(self.order.keys) + len(self.ends)
+
+    def items(self) -> list[tuple[EventKey, float]]:  # type: ignore[override]
+        """(key, value) in order."""
+        return [*zip(self.order.keys, self.values), *self.ends.items()]
 
 
 @dataclass(frozen=True)
@@ -222,20 +267,25 @@ class EventFunctions:
                             pickup=pickup, area=area)
 
     def entries(self, contacts: ContactSet, v: EventValues, rows: np.ndarray,
-                held: np.ndarray) -> list[tuple[EventKey, float]]:
-        """The watched functions as (key, value), in a fixed order: per contact not ``held``
-        (mask) its normal force and its cone margins or slip rate, then every free boundary
-        row's gaps, then the terminations that are checked.
+                held: np.ndarray) -> WatchedValues:
+        """The watched functions by key, in a fixed order: per contact not ``held`` (mask) its
+        normal force and its cone margins or slip rate, then every free boundary row's gaps
+        (one array, its keys a table kept for the contact set, mask and rows), then the
+        terminations that are checked.
         """
         keys, pick = self._contact_entries(contacts, held)
+        tag = ("watched", id(keys), rows.dtype.str, rows.tobytes())
+        order = self._entry_tables.get(tag)
+        if order is None:
+            order = self._entry_tables[tag] = KeyOrder((*keys, *self._row_gap_keys(rows)))
         table = np.concatenate((v.fn, v.c_plus, v.c_minus, v.d))
-        out = list(zip(keys, table[pick]))
-        out.extend(zip(self._row_gap_keys(rows), v.gaps.ravel()))
+        values = np.concatenate((table[pick], v.gaps.ravel()))
+        ends = {}
         for function, value in ((EventFunction.AREA, v.area), (EventFunction.STRAIN, v.strain),
                                 (EventFunction.PICKUP, v.pickup)):
             if np.isfinite(value):
-                out.append((self.keys.get(function), value))
-        return out
+                ends[self.keys.get(function)] = value
+        return WatchedValues(order, values, ends)
 
     @cached_property
     def _entry_tables(self) -> dict[tuple, object]:

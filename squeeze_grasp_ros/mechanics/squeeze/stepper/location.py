@@ -23,6 +23,7 @@ import numpy as np
 
 from squeeze_grasp_ros.mechanics.errors import NumericalError
 from squeeze_grasp_ros.mechanics.squeeze.event_key import EventKey
+from squeeze_grasp_ros.mechanics.squeeze.stepper.functions import WatchedValues
 
 __all__ = ["MAX_ROOT_ITERATIONS", "SURE_MARGIN", "crossings", "dips_inside",
            "earliest_crossing", "hermite_curvature", "hermite_dips", "hermite_root",
@@ -201,8 +202,19 @@ def locate_sign_change(
 def crossings(start: Values, end: Values, fresh: Collection[EventKey]) -> list[EventKey]:
     """Keys whose function went from > 0 (or zero by construction: ``fresh``) at the start of
     a substep to <= 0 at its end, in the order of ``end``.
+
+    Two :class:`~.functions.WatchedValues` with the same keys (a substep's ends) are compared
+    as arrays: only the functions not positive at the end are looked at one by one.
     """
     out = []
+    if (isinstance(start, WatchedValues) and isinstance(end, WatchedValues)
+            and start.order is end.order):
+        keys, a = start.order.keys, start.values
+        for k in np.flatnonzero(~(end.values > 0)).tolist():
+            key = keys[k]
+            if a[k] > 0 or key.at_node in fresh:
+                out.append(key)
+        start, end = start.ends, end.ends
     for key, value in end.items():
         if value > 0 or key not in start:
             continue

@@ -162,7 +162,7 @@ class EventProcessor:
         slopes = functions.slopes(contacts, sol, self.s, functions.rows_of(gap_nodes))
         out = []
         for key, value in functions.entries(contacts, v, rows,
-                                            self.chatter.held(contacts.nodes, depth)):
+                                            self.chatter.held(contacts.nodes, depth)).items():
             if key in slopes and key.at_node in self.fresh:
                 if key.function == EventFunction.GAP and value > self.tol:
                     continue  # a freed node is at zero gap only to the finger that released it

@@ -436,3 +436,46 @@ def test_the_hand_slip_watch_on_efforts_fires_when_the_force_stops_rising(tmp_pa
     assert 0.14 - 1.2e-4 <= feedback.watch.first_touch <= 0.14 - 1e-4
     assert log.lines == [f"first touch of the hand's fingers at tip distance "
                          f"{feedback.watch.first_touch * 1e3:.4f} mm (force 0.01 N)"]
+
+
+def test_setpoints_off_a_fingers_line_are_commanded_as_the_closest_reachable_joints(ros_context):
+    """A setpoint the hand cannot reach exactly (a tilted squeeze's round-off, or a redirect off
+    the fingers' lines) moves the fingers to the closest reachable joints instead of holding the
+    last ones (which left a run waiting for a depth it could never reach); beyond
+    REACH_TOLERANCE the executor warns once, naming the finger.
+    """
+    from rclpy.node import Node
+
+    from squeeze_grasp_ros.control.motion import Observation
+    from squeeze_grasp_ros.ros.nodes.jaw_commands import REACH_TOLERANCE, HandCommands
+
+    controller = scene_controller(load_scene(SCENE), SCENE)
+    hand = controller.hand
+    node = Node("hand_commands_test", context=ros_context)
+    try:
+        log = LogLines()
+        node.get_logger = lambda: log
+        commands = HandCommands(node, controller, 0.001, pipeline.loop_qos(4))
+        tips = {"F1": np.array([-0.07, 0.0]), "F2": np.array([0.07, 0.0])}
+        zeros = {f: np.zeros(2) for f in tips}
+        commands.start(Observation(0, tips, zeros, zeros))
+        inward = np.array([1e-3, 0.0])
+        # the spread follows finger 1's target, so finger 2's line is fixed by it: push finger
+        # 2's setpoint across that line by round-off, then by a millimetre
+        for step, (off, warned) in enumerate(((1e-8, False), (1e-3, True)), start=1):
+            targets = {"F1": tips["F1"] + step * inward,
+                       "F2": tips["F2"] - step * inward + np.array([0.0, off])}
+            before = dict(commands.solution.joints)
+            _, msg = commands.trajectory(targets, 0)
+            after = commands.solution.joints
+            assert after[BarrettFinger.F2.proximal] != before[BarrettFinger.F2.proximal]
+            reached = hand.forward(after)
+            assert np.hypot(*(reached[BarrettFinger.F1] - targets["F1"])) < 1e-12
+            assert 0.5 * off < np.hypot(*(reached[BarrettFinger.F2] - targets["F2"])) <= off
+            assert list(msg.points[0].positions) == [after[j] for j in JOINTS]
+            assert bool(log.lines) is warned, (off, log.lines)
+        assert len(log.lines) == 1 and "barrett_f2" in log.lines[0], log.lines
+        assert "closest reachable" in log.lines[0]
+        assert 1e-8 < REACH_TOLERANCE < 1e-3
+    finally:
+        node.destroy_node()

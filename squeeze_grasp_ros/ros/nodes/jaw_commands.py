@@ -37,6 +37,11 @@ from squeeze_grasp_ros.ros import messages
 from squeeze_grasp_ros.ros.nodes import pipeline
 from squeeze_grasp_ros.scene.controller import HandController, JawController
 
+REACH_TOLERANCE = 1e-6
+"""m: how far the hand's closest reachable joints may put a fingertip from its setpoint before
+the executor warns (a thousandth of a millimetre, far below the hand's resolution; setpoints of a
+tilted squeeze fall about 1e-8 m off a finger's line by round-off alone)."""
+
 
 class PlannedJawForce:
     """The planner's force curve (``planner/predicted_events``, latched) as the jaw force of a
@@ -151,8 +156,10 @@ class HandCommands:
     setpoints (:mod:`..control.barrett`: the spread from finger 1 or 2, the distal joints
     coupled), one point one control period ahead, all eight joints (as :class:`JawCommands`).
 
-    A setpoint out of the hand's reach is not sent: the last reachable joints are repeated and
-    a warning names the finger, the target and the reach (once per goal).
+    A setpoint the hand cannot reach (off a finger's closing line, or beyond its range along
+    it) is commanded as the closest reachable joints, as a parallel gripper's setpoints are taken
+    along its jaw line; when that is more than :data:`REACH_TOLERANCE` away, a warning names the
+    finger, the target and the reach (once per goal).
 
     Parameters
     ----------
@@ -201,14 +208,17 @@ class HandCommands:
         """(publisher, message) commanding the carried fingers' ``setpoints`` (m) one period
         after ``start_ns`` (the message's ``header.stamp``; 0 = on receipt).
         """
-        try:
-            self.solution = self.controller.hand.inverse(self._targets(setpoints),
-                                                         rest=self.solution.joints)
-        except ReachError as exc:
-            if not self.warned:
-                self.node.get_logger().warning(f"{self.topic}: holding the last reachable "
+        targets = self._targets(setpoints)
+        self.solution = self.controller.hand.inverse(targets, rest=self.solution.joints,
+                                                     tolerance=np.inf)
+        if self.solution.residual > REACH_TOLERANCE and not self.warned:
+            try:
+                self.controller.hand.inverse(targets, rest=self.solution.joints,
+                                             tolerance=REACH_TOLERANCE)
+            except ReachError as exc:
+                self.node.get_logger().warning(f"{self.topic}: commanding the closest reachable "
                                                f"joints: {exc}")
-                self.warned = True
+            self.warned = True
         msg = self.msg
         messages.set_stamp(msg.header.stamp, start_ns)
         msg.points[0].positions = [float(self.solution.joints[j]) for j in JOINTS]

@@ -127,20 +127,22 @@ def jaw_loop(world: SimWorld, goal: GraspGoal, limits: MotionLimits = MotionLimi
     closing = np.asarray(world.directions["F1"], float)
     closing /= np.linalg.norm(closing)
     out = world.start()
-    trace = []
+    trace, depths = [], []
     while True:
         positions = {r.finger: r.position for r in out.readings}
         tracked = depth.update(out.stamp_ns, {f: FingerSample(p) for f, p in positions.items()})
         force = float(out.state.finger_force("F1") @ closing)
         alarms = watch.update(float(np.linalg.norm(positions["F2"] - positions["F1"])), force)
         forces = {f: out.state.finger_force(f) for f in world.fingers}
-        command = program.step(Observation(
+        obs = Observation(
             out.stamp_ns, positions, forces, {f: np.zeros(2) for f in world.fingers},
-            tuple((a.type, a.finger) for a in alarms), (), tracked.depth), world.dt)
+            tuple((a.type, a.finger) for a in alarms), (), tracked.depth)
+        command = program.step(obs, world.dt)
         trace.append((out, command, tracked.depth, alarms))
+        depths.append(program.depth(obs))
         out = world.step(command.setpoints)
         if command.termination is not None:
-            return {"program": program, "trace": trace, "last": out}
+            return {"program": program, "trace": trace, "last": out, "depths": depths}
 
 
 def slip_goal(world: SimWorld, **reaction) -> GraspGoal:
@@ -182,6 +184,12 @@ def test_the_program_releases_and_squeezes_again_below_the_alarm_depth(setup):
     steps = [np.linalg.norm(b[1].setpoints[f] - a[1].setpoints[f])
              for a, b in zip(trace, trace[1:]) for f in ("F1", "F2")]
     assert max(steps) <= MotionLimits().max_velocity * world.dt * (1 + 1e-9)
+    # the depth the executor reports (feedback, status, result) is the squeeze under way's:
+    # negative while the jaws stand open past first contact, the planned depth at the end
+    opened = min(d for d, (_, command, _, _) in zip(run["depths"], trace)
+                 if command.state == "releasing")
+    assert opened == pytest.approx(-0.002 * np.sqrt(2), abs=2 * MotionLimits().position_tolerance)
+    assert run["depths"][-1] == pytest.approx(program.planned_depth, rel=1e-6)
     # the last squeeze is a fresh one from rest: the mechanics API's squeeze to that depth
     assert last.state.depth == pytest.approx(program.planned_depth, rel=1e-9)
     direct = setup.event_squeeze(depth=last.state.depth)

@@ -361,6 +361,17 @@ class GraspProgram:
         self.freed: set[str] = set()
         self.release_wait = 0.0
 
+    def depth(self, obs: Observation) -> float:
+        """The current squeeze's measured depth (m): the monitor's depth past this squeeze's
+        first contact; while releasing, and while a re-squeeze approaches, the fingers' travel
+        past their first-contact positions along the squeeze directions, negative while open.
+        """
+        if self.phase != "release" and not self.approaching:
+            return obs.depth - self.depth_offset
+        past = np.array([obs.positions[f] for f in self.goal.fingers]) - self.first_contact
+        along = float(np.sum(past * np.asarray(self.goal.directions, float)))
+        return float(np.copysign(np.linalg.norm(past), along))
+
     def cancel(self) -> None:
         """Request a cancel: the next cycle holds the measured positions and ends the goal."""
         self.cancel_requested = True
@@ -477,7 +488,7 @@ class GraspProgram:
     def _release(self, obs: Observation, dt: float) -> Command:
         """A slip alarm to re-squeeze: note the depth, open toward the release positions."""
         goal = self.goal
-        self.planned_depth = (1.0 - goal.resqueeze_margin) * (obs.depth - self.depth_offset)
+        self.planned_depth = (1.0 - goal.resqueeze_margin) * self.depth(obs)
         self.commanded = {f: np.asarray(obs.positions[f], float) for f in self.fingers}
         start = np.array([self.commanded[f] for f in goal.fingers])
         self.path = straight_path(start, self.release_positions() - start, 1.0)
@@ -485,7 +496,7 @@ class GraspProgram:
         self.phase, self.armed, self.freed, self.release_wait = "release", set(), set(), 0.0
         self._advance(dt)
         return Command(self._setpoints(), "releasing", None,
-                       f"imminent slip at depth {(obs.depth - self.depth_offset) * 1e3:.4g} mm: "
+                       f"imminent slip at depth {self.depth(obs) * 1e3:.4g} mm: "
                        f"releasing to squeeze again to {self.planned_depth * 1e3:.4g} mm")
 
     def release_positions(self) -> np.ndarray:

@@ -103,16 +103,17 @@ def grasp_feedback(
     fingers: Sequence[str],
     events: Sequence[ContactEvent],
     relative_per_depth: float,
-    attempt: int = 1,
+    attempt: int,
+    depth: float,
 ) -> ExecuteGrasp.Feedback:
-    """``ExecuteGrasp`` feedback: measured depth and forces, events since the last feedback,
-    the squeeze under way (from 1).
+    """``ExecuteGrasp`` feedback: the squeeze under way (from 1) and its measured ``depth`` (m,
+    :meth:`.GraspProgram.depth`), the measured forces, events since the last feedback.
     """
     return ExecuteGrasp.Feedback(
         state=state,
         attempt=int(attempt),
-        depth=obs.depth,
-        relative_depth=obs.depth * relative_per_depth,
+        depth=float(depth),
+        relative_depth=depth * relative_per_depth,
         fingers=list(fingers),
         forces=[vector3(obs.forces.get(f, np.zeros(2))) for f in fingers],
         latest_events=list(events),
@@ -132,7 +133,7 @@ def grasp_result(
     """
     fingers = list(program.fingers)
     forces = obs.forces if obs is not None else {}
-    depth = obs.depth - program.depth_offset if obs is not None else 0.0
+    depth = program.depth(obs) if obs is not None else 0.0
     return ExecuteGrasp.Result(
         success=command.termination in success_terminations,
         termination=command.termination,

@@ -335,13 +335,13 @@ class ExecutorNode(Node):
             state = ExecutorStatus.ABORTED
         if state != self.state:
             self.state = state
-            self.status_pub.publish(messages.executor_status_msg(state, obs.depth,
-                                                                 command.message, ns))
+            self.status_pub.publish(messages.executor_status_msg(
+                state, goal.program.depth(obs), command.message, ns))
         program = goal.program
         if program.ticks % self.p["feedback_every"] == 0 or command.termination is not None:
             goal.handle.publish_feedback(messages.grasp_feedback(
                 command.state, obs, program.fingers, goal.since_feedback,
-                program.goal.relative_per_depth, program.attempts))
+                program.goal.relative_per_depth, program.attempts, program.depth(obs)))
             goal.since_feedback = []
 
 

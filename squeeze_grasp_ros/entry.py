@@ -17,8 +17,7 @@ from squeeze_grasp_ros.exit_codes import raise_on_signals
 from squeeze_grasp_ros.stdout import reserve_stdout
 from squeeze_grasp_ros.threads import single_thread_blas
 
-__all__ = ["cli", "cli_process", "executor", "monitor", "outline", "planner", "recorder",
-           "sim_hardware"]
+__all__ = ["cli", "executor", "monitor", "outline", "planner", "recorder", "sim_hardware"]
 
 
 def _run(module: str, name: str):
@@ -58,37 +57,6 @@ def cli():
     """``squeeze-grasp`` in this process: its exit code, returned to the caller."""
     reserve_stdout()
     return _run("squeeze_grasp_ros.cli", "squeeze-grasp")
-
-
-def cli_process():
-    """The ``squeeze-grasp`` console script: :func:`cli`, after which a verb that used ROS
-    (``run``, ``replay``, ...) ends the process at once (:func:`_end_after_ros`).
-    """
-    code = cli()
-    if "rclpy" in sys.modules:
-        _end_after_ros(code)
-    return code
-
-
-def _end_after_ros(code) -> None:
-    """End the process with ``code`` now, without the interpreter's teardown.
-
-    The verb has shut its rclpy context down (nodes destroyed, recordings closed, ROS logging
-    finished) before it returns; what the teardown would add is the middleware's static
-    destructors, which sleep 100 ms (strace: a ``clock_nanosleep`` of 100 ms after the
-    interpreter's exit handlers) and take 0.15-0.2 s of a 1.9 s ``run`` in all. The standard
-    streams are flushed first; exit handlers still run.
-    """
-    import atexit
-    import os
-
-    atexit._run_exitfuncs()
-    for stream in (sys.stdout, sys.stderr):
-        try:
-            stream.flush()
-        except (OSError, ValueError):  # a closed pipe or stream: nothing more to write
-            pass
-    os._exit(0 if code is None else int(code))
 
 
 def planner():

@@ -149,7 +149,13 @@ class NodeProcesses:
     def stop_all(self) -> None:
         """Stop every node (:data:`STOP_SIGNAL` to all, then wait for each; kill one that does
         not end within :data:`STOP_TIMEOUT`) and remove the parameter file.
+
+        The simulated hardware is stopped first and on its own: at its end it waits for its
+        readers to acknowledge its camera frames (``SimHardwareNode.close``), which they can
+        only do while they still run.
         """
+        if "sim_hardware" in self.running:
+            self.stop("sim_hardware")
         for proc in self.running.values():
             if proc.poll() is None:
                 proc.send_signal(STOP_SIGNAL)

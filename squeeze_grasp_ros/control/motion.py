@@ -368,9 +368,16 @@ class GraspProgram:
         """
         if self.phase != "release" and not self.approaching:
             return obs.depth - self.depth_offset
+        return self._travel(obs)
+
+    def _travel(self, obs: Observation) -> float:
+        """The fingers' travel past their first-contact positions (m, the length of all their
+        displacements together), negative when it is against the squeeze directions.
+        """
         past = np.array([obs.positions[f] for f in self.goal.fingers]) - self.first_contact
-        along = float(np.sum(past * np.asarray(self.goal.directions, float)))
-        return float(np.copysign(np.linalg.norm(past), along))
+        travel = float(np.linalg.norm(past))
+        return travel if float(np.sum(past * np.asarray(self.goal.directions, float))) >= 0.0 \
+            else -travel
 
     def cancel(self) -> None:
         """Request a cancel: the next cycle holds the measured positions and ends the goal."""
@@ -544,12 +551,10 @@ class GraspProgram:
                        if f not in lost and np.any(obs.forces.get(f, 0.0))}
         if not self.approaching:
             return
-        past = np.array([obs.positions[f] for f in goal.fingers]) - self.first_contact
-        directions = np.asarray(goal.directions, float)
-        along = float(np.sum(past * directions)) / float(np.sum(directions * directions))
-        if along >= 0.0:
+        travel = self._travel(obs)
+        if travel >= 0.0:
             self.approaching = False
-            self.depth_offset = obs.depth - float(np.linalg.norm(past))
+            self.depth_offset = obs.depth - travel
 
     def _settled(self, obs: Observation) -> bool:
         tol = self.limits.position_tolerance

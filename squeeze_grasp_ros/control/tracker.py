@@ -62,6 +62,8 @@ Forces are those of the fingers *on the object* (the negated wrench, else the ta
 """
 from __future__ import annotations
 
+import functools
+import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import NamedTuple
@@ -265,10 +267,14 @@ def loaded_taxels(sample: FingerSample, threshold: float,
     """The loaded taxels of a reading with tactile data (``trig``: cos and sin of all its
     taxel angles).
     """
-    index = np.flatnonzero(sample.normal > threshold)
+    index = (sample.normal > threshold).nonzero()[0]
     cos, sin = trig
     return LoadedTaxels(index, sample.normal[index], sample.tangential[index],
                         sample.angles[index], cos[index], sin[index])
+
+
+_FIRST = np.zeros(1, dtype=np.intp)
+"""The first run's start in :func:`patches_of`."""
 
 
 def patches_of(finger: str, taxels: LoadedTaxels, config: TrackerConfig) -> list[Patch]:
@@ -278,11 +284,11 @@ def patches_of(finger: str, taxels: LoadedTaxels, config: TrackerConfig) -> list
     index = taxels.index
     if not len(index):
         return []
-    breaks = np.flatnonzero(np.diff(index) > 1) + 1
-    starts = np.concatenate([[0], breaks])
-    sums = np.add.reduceat(np.stack([taxels.normal, taxels.tangential,
-                                     taxels.normal * taxels.angles]), starts, axis=1)
-    lasts = np.concatenate([index[breaks - 1], index[-1:]])
+    breaks = ((index[1:] - index[:-1]) > 1).nonzero()[0] + 1
+    starts = np.concatenate((_FIRST, breaks))
+    sums = np.add.reduceat(np.array((taxels.normal, taxels.tangential,
+                                     taxels.normal * taxels.angles)), starts, axis=1)
+    lasts = np.concatenate((index[breaks - 1], index[-1:]))
     mu, edge = config.mu, 1.0 - config.edge_tolerance
     out = []
     for first, last, normal, tangential, moment in zip(index[starts].tolist(), lasts.tolist(),
@@ -314,16 +320,25 @@ def mirrored_patches(patches: Sequence[Patch], tolerance: float) -> frozenset[in
     """
     if len(patches) < 2:
         return frozenset()
-    angle = np.array([p.angle for p in patches])
-    normal = np.array([p.normal for p in patches])
-    tangential = np.array([p.tangential for p in patches])
+    angle, normal, tangential = np.array(tuple(zip(*patches))[1:4], dtype=float)
     c, s = np.cos(angle), np.sin(angle)
     line = np.arctan2(normal @ s + tangential @ c, normal @ c - tangential @ s)
     offset = np.angle(np.exp(1j * (angle - line)))
-    i, j = np.triu_indices(len(patches), 1)
+    i, j = _pairs(len(patches))
     pair = (offset[i] * offset[j] < 0.0) & (
         np.abs(offset[i] + offset[j]) <= tolerance * np.abs(offset[i] - offset[j]))
     return frozenset(i[pair].tolist() + j[pair].tolist())
+
+
+@functools.lru_cache(maxsize=64)
+def _pairs(count: int) -> tuple[np.ndarray, np.ndarray]:
+    """The index pairs (i < j) of ``count`` patches (``np.triu_indices``, kept: a finger has
+    the same few patches tick after tick).
+    """
+    pairs = np.triu_indices(count, 1)
+    for index in pairs:
+        index.flags.writeable = False
+    return pairs
 
 
 def connected_groups(previous: Sequence[Patch], current: Sequence[Patch],
@@ -523,7 +538,7 @@ class ContactTracker:
             return np.zeros(2)
         w = taxels.normal
         v = np.array([w @ taxels.cos, w @ taxels.sin])
-        return v / np.linalg.norm(v)
+        return v / math.sqrt(v @ v)
 
     def _alarms(self, name: str, track: _FingerTrack, taxels: LoadedTaxels | None,
                 stamp_ns: int) -> list[TrackedAlarm]:

@@ -202,10 +202,6 @@ class CdrWriter:
     def __init__(self) -> None:
         self.buffer = bytearray(b"\x00\x01\x00\x00")
 
-    def _align(self, size: int) -> None:
-        buffer = self.buffer
-        buffer += _ZEROS[-(len(buffer) - _BODY) % size]
-
     def uint32(self, value: int) -> None:
         buffer = self.buffer
         buffer += _ZEROS[-len(buffer) % 4]
@@ -217,12 +213,14 @@ class CdrWriter:
         buffer += _I32(value)
 
     def uint64(self, value: int) -> None:
-        self._align(8)
-        self.buffer += _U64(value)
+        buffer = self.buffer
+        buffer += _ZEROS[-(len(buffer) - _BODY) % 8]
+        buffer += _U64(value)
 
     def float64(self, value: float) -> None:
-        self._align(8)
-        self.buffer += _F64(value)
+        buffer = self.buffer
+        buffer += _ZEROS[-(len(buffer) - _BODY) % 8]
+        buffer += _F64(value)
 
     def string(self, text: str) -> None:
         buffer = self.buffer
@@ -253,8 +251,9 @@ class CdrWriter:
         """
         data = np.asarray(values, dtype="<f8")
         if data.size:
-            self._align(8)
-            self.buffer += data.tobytes()
+            buffer = self.buffer
+            buffer += _ZEROS[-(len(buffer) - _BODY) % 8]
+            buffer += data.tobytes()
 
     def sequence(self, values, dtype: str = "<f8") -> None:
         """A sequence of numbers (``float64[]`` by default; ``"<i4"`` int32, ``"u1"`` uint8):
@@ -262,10 +261,12 @@ class CdrWriter:
         writes it).
         """
         data = np.asarray(values, dtype=dtype)
-        self.uint32(data.size)
-        if data.size:
-            self._align(data.itemsize)
-            self.buffer += data.tobytes()
+        size, buffer = data.size, self.buffer
+        buffer += _ZEROS[-len(buffer) % 4]
+        buffer += _U32(size)
+        if size:
+            buffer += _ZEROS[-(len(buffer) - _BODY) % data.itemsize]
+            buffer += data.tobytes()
 
     def data(self) -> bytes:
         """The serialised message, ready for ``Publisher.publish``."""

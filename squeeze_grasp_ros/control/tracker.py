@@ -75,6 +75,9 @@ from squeeze_grasp_ros.mechanics.vocabulary import ContactMode, EventType, Finge
 
 STICK_SLIP = (EventType.C, EventType.D)
 """The events of a contact's mode (stick -> slip, slip -> stick)."""
+STICK_TO_SLIP = (ContactMode.STICK, ContactMode.SLIP)
+SLIP_TO_STICK = (ContactMode.SLIP, ContactMode.STICK)
+"""A patch's (previous, current) modes at a C and at a D event."""
 
 
 @dataclass(frozen=True)
@@ -373,6 +376,8 @@ class _FingerTrack:
     stamps: dict[str, int] = field(default_factory=dict)
     trig_key: bytes = b""
     trig: tuple = ()
+    mirror_of: list | None = None
+    mirrored: frozenset = frozenset()
 
 
 class ContactTracker:
@@ -397,8 +402,6 @@ class ContactTracker:
         self.fingers = tuple(sorted(fingers, key=lambda n: order.get(n, len(order))))
         self.streams = tuple(streams)
         self.tracks = {f: _FingerTrack() for f in self.fingers}
-        self.mirrored: dict[str, frozenset[int]] = {f: frozenset() for f in self.fingers}
-        """Per finger, its current patches with a mirror partner (indices)."""
         self.depth = 0.0
         self.picked_up = False
         self.set_prediction(prediction)
@@ -428,7 +431,6 @@ class ContactTracker:
                 trig = self._trig(track, sample)
                 taxels = loaded_taxels(sample, cfg.load_threshold, trig)
                 current = patches_of(name, taxels, cfg)
-                self.mirrored[name] = mirrored_patches(current, cfg.mirror_tolerance)
                 events += self._events(name, track.patches, current, relative)
                 track.patches = current
                 track.had_contact = track.had_contact or bool(current)
@@ -474,6 +476,16 @@ class ContactTracker:
             track.position = position
         self.depth += float(np.sqrt(step))
 
+    def _mirrored(self, track: _FingerTrack, patches: list[Patch]) -> frozenset[int]:
+        """Indices of ``patches`` (a finger's current ones) with a mirror partner
+        (:func:`mirrored_patches`), computed when first asked for this list: only a C or D
+        event, or a predicted one the depth passed, needs them.
+        """
+        if track.mirror_of is not patches:
+            track.mirror_of = patches
+            track.mirrored = mirrored_patches(patches, self.config.mirror_tolerance)
+        return track.mirrored
+
     @staticmethod
     def _trig(track: _FingerTrack, sample: FingerSample) -> tuple[np.ndarray, np.ndarray]:
         """Cos and sin of the finger's taxel angles, recomputed only when the angles change."""
@@ -506,11 +518,11 @@ class ContactTracker:
                     found += [(EventType.A, current[j].angle, False) for j in after]
             elif len(before) == len(after) == 1:
                 old, new = previous[before[0]], current[after[0]]
-                mirrored = after[0] in self.mirrored[name]
-                if old.mode == ContactMode.STICK and new.mode == ContactMode.SLIP:
-                    found.append((EventType.C, new.angle, mirrored))
-                elif old.mode == ContactMode.SLIP and new.mode == ContactMode.STICK:
-                    found.append((EventType.D, new.angle, mirrored))
+                kind = (EventType.C if (old.mode, new.mode) == STICK_TO_SLIP else
+                        EventType.D if (old.mode, new.mode) == SLIP_TO_STICK else None)
+                if kind is not None:
+                    mirrored = after[0] in self._mirrored(self.tracks[name], current)
+                    found.append((kind, new.angle, mirrored))
         found.sort(key=lambda e: (processing_rank(e[0]), e[1]))
         return [TrackedEvent(kind, name, self.depth, relative, angle, mirrored)
                 for kind, angle, mirrored in found]
@@ -603,7 +615,8 @@ class ContactTracker:
         for k in [k for k in self.unmatched if self.prediction[k].depth + tol < self.depth]:
             p = self.prediction[k]
             self.unmatched.remove(k)
-            if p.type in STICK_SLIP and self.mirrored.get(p.finger):
+            track = self.tracks.get(p.finger)
+            if p.type in STICK_SLIP and track and self._mirrored(track, track.patches):
                 continue
             out.append(TrackedAlarm("prediction_mismatch", p.finger, p.depth,
                                     f"predicted event {p.type} on {p.finger} at depth "

@@ -136,6 +136,28 @@ def test_monitor_status_and_patches_are_rclpys(out, frame):
     _same(messages.patches_state_cdr(out, frame), messages.patches_state_msg(out, frame))
 
 
+@settings(max_examples=80, deadline=None)
+@given(tracker_outputs(), NAMES)
+def test_the_executors_observation_reads_the_status_bytes_as_rclpys_message(out, frame):
+    """The executor reads a status without events and alarms from its bytes (ours and rclpy's,
+    whose padding differs): the observation of rclpy's message, bit for bit; a status with an
+    event or an alarm is left to rclpy (None).
+    """
+    msg = messages.monitor_status_msg(out, frame)
+    want = messages.observation(msg)
+    for data in (messages.monitor_status_cdr(out, frame), serialize_message(msg)):
+        got = messages.observation_cdr(data)
+        if out.events or out.alarms:
+            assert got is None
+            continue
+        assert (got.stamp_ns, got.alarms, got.events) == (want.stamp_ns, (), ())
+        assert np.float64(got.depth).tobytes() == np.float64(want.depth).tobytes()
+        for ours, theirs in ((got.positions, want.positions), (got.forces, want.forces),
+                             (got.normals, want.normals)):
+            assert list(ours) == list(theirs) == list(out.fingers)
+            assert all(ours[f].tobytes() == theirs[f].tobytes() for f in ours)
+
+
 @settings(max_examples=40, deadline=None)
 @given(STAMPS, NAMES, FINITE, st.lists(st.tuples(NAMES, FINITE, FINITE, FINITE), max_size=3),
        FINITE)

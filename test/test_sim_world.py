@@ -36,9 +36,11 @@ from squeeze_grasp_ros.mechanics.squeeze.tip_shapes import TipGeometry, TipShape
 from squeeze_grasp_ros.mechanics.vocabulary import EventType
 from squeeze_grasp_ros.resources import scene_file
 from squeeze_grasp_ros.scene import GraspSetup, SceneError, load_scene, parse_scene
+from squeeze_grasp_ros.sim import sensors
 from squeeze_grasp_ros.sim.devices import device_model, follow
 from squeeze_grasp_ros.sim.sensors import (
     SensorRandomness,
+    contact_geometry,
     fingertip_wrench,
     render_tactile,
     tactile_layout,
@@ -355,3 +357,38 @@ def test_pad_sensors_see_the_pad_contacts(pad_run):
     seen = [(k, str(e.type), e.finger) for k, obs in enumerate(pad_run["observed"])
             for e in obs.events]
     assert match_within(net_events(states), seen, EVENT_TOLERANCE_TICKS) == []
+
+
+@pytest.mark.parametrize("run", ["world_run", "pad_run"])
+def test_sensors_kept_geometry_reads_the_same_bits(run, request, monkeypatch):
+    """The world's sensors keep their nodes' lever arms and taxel weights while the nodes'
+    coordinates stay put (:class:`FingerSensors`): every reading of a sliding run (the small
+    square at mu = 0.05) and of the pads is bit for bit what the sensor functions compute from
+    that tick's contacts. On the foam square (mu = 0.4, sticking), the geometry is computed
+    once per change of the contact nodes, not once per reading.
+    """
+    outputs = request.getfixturevalue(run)["outputs"]
+    world = request.getfixturevalue(run)["world"]
+    for out in outputs:
+        for reading in out.readings:
+            contacts = [c for c in out.state.contacts if c.finger == reading.finger]
+            force, torque = fingertip_wrench(contacts, world.tips[reading.finger])
+            normal, tangential = render_tactile(world.layouts[reading.finger], contacts)
+            for got, want in ((reading.force, force), (reading.torque, torque),
+                              (reading.normal, normal), (reading.tangential, tangential)):
+                assert got.tobytes() == want.tobytes()
+    if run == "pad_run":
+        computed = []
+        monkeypatch.setattr(sensors, "contact_geometry",
+                            lambda *a: computed.append(1) or contact_geometry(*a))
+        foam = SimWorld(GraspSetup.build(load_scene(scene_file("foam_square"))))
+        depth = foam.scene.squeeze.relative_depth / foam.relative_per_depth
+        start = {f: foam.positions[f].copy() for f in ("F1", "F2")}
+        changes = 0
+        previous = None
+        for k in range(301):
+            out = foam.step({f: start[f] + depth * k / 300 * foam.directions[f] for f in start})
+            nodes = [(c.finger, c.theta, c.normal_angle) for c in out.state.contacts]
+            changes += nodes != previous
+            previous = nodes
+        assert 0 < len(computed) <= 2 * changes < 301

@@ -34,7 +34,7 @@ def first_command(scene: str) -> dict[str, float]:
             answer = accept(goal)
             marks.setdefault("accepted", time.perf_counter())
             latest = executor.latest
-            marks.setdefault("tick_ns", messages.stamp_ns(latest.header.stamp) if latest else 0)
+            marks.setdefault("tick_ns", messages.cdr_stamp_ns(latest) if latest else 0)
             return answer
 
         executor.server.register_goal_callback(on_goal)

@@ -62,6 +62,8 @@ Forces are those of the fingers *on the object* (the negated wrench, else the ta
 """
 from __future__ import annotations
 
+import functools
+import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import NamedTuple
@@ -73,6 +75,9 @@ from squeeze_grasp_ros.mechanics.vocabulary import ContactMode, EventType, Finge
 
 STICK_SLIP = (EventType.C, EventType.D)
 """The events of a contact's mode (stick -> slip, slip -> stick)."""
+STICK_TO_SLIP = (ContactMode.STICK, ContactMode.SLIP)
+SLIP_TO_STICK = (ContactMode.SLIP, ContactMode.STICK)
+"""A patch's (previous, current) modes at a C and at a D event."""
 
 
 @dataclass(frozen=True)
@@ -265,10 +270,14 @@ def loaded_taxels(sample: FingerSample, threshold: float,
     """The loaded taxels of a reading with tactile data (``trig``: cos and sin of all its
     taxel angles).
     """
-    index = np.flatnonzero(sample.normal > threshold)
+    index = (sample.normal > threshold).nonzero()[0]
     cos, sin = trig
     return LoadedTaxels(index, sample.normal[index], sample.tangential[index],
                         sample.angles[index], cos[index], sin[index])
+
+
+_FIRST = np.zeros(1, dtype=np.intp)
+"""The first run's start in :func:`patches_of`."""
 
 
 def patches_of(finger: str, taxels: LoadedTaxels, config: TrackerConfig) -> list[Patch]:
@@ -278,11 +287,11 @@ def patches_of(finger: str, taxels: LoadedTaxels, config: TrackerConfig) -> list
     index = taxels.index
     if not len(index):
         return []
-    breaks = np.flatnonzero(np.diff(index) > 1) + 1
-    starts = np.concatenate([[0], breaks])
-    sums = np.add.reduceat(np.stack([taxels.normal, taxels.tangential,
-                                     taxels.normal * taxels.angles]), starts, axis=1)
-    lasts = np.concatenate([index[breaks - 1], index[-1:]])
+    breaks = ((index[1:] - index[:-1]) > 1).nonzero()[0] + 1
+    starts = np.concatenate((_FIRST, breaks))
+    sums = np.add.reduceat(np.array((taxels.normal, taxels.tangential,
+                                     taxels.normal * taxels.angles)), starts, axis=1)
+    lasts = np.concatenate((index[breaks - 1], index[-1:]))
     mu, edge = config.mu, 1.0 - config.edge_tolerance
     out = []
     for first, last, normal, tangential, moment in zip(index[starts].tolist(), lasts.tolist(),
@@ -314,16 +323,25 @@ def mirrored_patches(patches: Sequence[Patch], tolerance: float) -> frozenset[in
     """
     if len(patches) < 2:
         return frozenset()
-    angle = np.array([p.angle for p in patches])
-    normal = np.array([p.normal for p in patches])
-    tangential = np.array([p.tangential for p in patches])
+    angle, normal, tangential = np.array(tuple(zip(*patches))[1:4], dtype=float)
     c, s = np.cos(angle), np.sin(angle)
     line = np.arctan2(normal @ s + tangential @ c, normal @ c - tangential @ s)
     offset = np.angle(np.exp(1j * (angle - line)))
-    i, j = np.triu_indices(len(patches), 1)
+    i, j = _pairs(len(patches))
     pair = (offset[i] * offset[j] < 0.0) & (
         np.abs(offset[i] + offset[j]) <= tolerance * np.abs(offset[i] - offset[j]))
     return frozenset(i[pair].tolist() + j[pair].tolist())
+
+
+@functools.lru_cache(maxsize=64)
+def _pairs(count: int) -> tuple[np.ndarray, np.ndarray]:
+    """The index pairs (i < j) of ``count`` patches (``np.triu_indices``, kept: a finger has
+    the same few patches tick after tick).
+    """
+    pairs = np.triu_indices(count, 1)
+    for index in pairs:
+        index.flags.writeable = False
+    return pairs
 
 
 def connected_groups(previous: Sequence[Patch], current: Sequence[Patch],
@@ -358,6 +376,8 @@ class _FingerTrack:
     stamps: dict[str, int] = field(default_factory=dict)
     trig_key: bytes = b""
     trig: tuple = ()
+    mirror_of: list | None = None
+    mirrored: frozenset = frozenset()
 
 
 class ContactTracker:
@@ -382,8 +402,6 @@ class ContactTracker:
         self.fingers = tuple(sorted(fingers, key=lambda n: order.get(n, len(order))))
         self.streams = tuple(streams)
         self.tracks = {f: _FingerTrack() for f in self.fingers}
-        self.mirrored: dict[str, frozenset[int]] = {f: frozenset() for f in self.fingers}
-        """Per finger, its current patches with a mirror partner (indices)."""
         self.depth = 0.0
         self.picked_up = False
         self.set_prediction(prediction)
@@ -413,7 +431,6 @@ class ContactTracker:
                 trig = self._trig(track, sample)
                 taxels = loaded_taxels(sample, cfg.load_threshold, trig)
                 current = patches_of(name, taxels, cfg)
-                self.mirrored[name] = mirrored_patches(current, cfg.mirror_tolerance)
                 events += self._events(name, track.patches, current, relative)
                 track.patches = current
                 track.had_contact = track.had_contact or bool(current)
@@ -459,6 +476,16 @@ class ContactTracker:
             track.position = position
         self.depth += float(np.sqrt(step))
 
+    def _mirrored(self, track: _FingerTrack, patches: list[Patch]) -> frozenset[int]:
+        """Indices of ``patches`` (a finger's current ones) with a mirror partner
+        (:func:`mirrored_patches`), computed when first asked for this list: only a C or D
+        event, or a predicted one the depth passed, needs them.
+        """
+        if track.mirror_of is not patches:
+            track.mirror_of = patches
+            track.mirrored = mirrored_patches(patches, self.config.mirror_tolerance)
+        return track.mirrored
+
     @staticmethod
     def _trig(track: _FingerTrack, sample: FingerSample) -> tuple[np.ndarray, np.ndarray]:
         """Cos and sin of the finger's taxel angles, recomputed only when the angles change."""
@@ -491,11 +518,11 @@ class ContactTracker:
                     found += [(EventType.A, current[j].angle, False) for j in after]
             elif len(before) == len(after) == 1:
                 old, new = previous[before[0]], current[after[0]]
-                mirrored = after[0] in self.mirrored[name]
-                if old.mode == ContactMode.STICK and new.mode == ContactMode.SLIP:
-                    found.append((EventType.C, new.angle, mirrored))
-                elif old.mode == ContactMode.SLIP and new.mode == ContactMode.STICK:
-                    found.append((EventType.D, new.angle, mirrored))
+                kind = (EventType.C if (old.mode, new.mode) == STICK_TO_SLIP else
+                        EventType.D if (old.mode, new.mode) == SLIP_TO_STICK else None)
+                if kind is not None:
+                    mirrored = after[0] in self._mirrored(self.tracks[name], current)
+                    found.append((kind, new.angle, mirrored))
         found.sort(key=lambda e: (processing_rank(e[0]), e[1]))
         return [TrackedEvent(kind, name, self.depth, relative, angle, mirrored)
                 for kind, angle, mirrored in found]
@@ -523,7 +550,7 @@ class ContactTracker:
             return np.zeros(2)
         w = taxels.normal
         v = np.array([w @ taxels.cos, w @ taxels.sin])
-        return v / np.linalg.norm(v)
+        return v / math.sqrt(v @ v)
 
     def _alarms(self, name: str, track: _FingerTrack, taxels: LoadedTaxels | None,
                 stamp_ns: int) -> list[TrackedAlarm]:
@@ -588,7 +615,8 @@ class ContactTracker:
         for k in [k for k in self.unmatched if self.prediction[k].depth + tol < self.depth]:
             p = self.prediction[k]
             self.unmatched.remove(k)
-            if p.type in STICK_SLIP and self.mirrored.get(p.finger):
+            track = self.tracks.get(p.finger)
+            if p.type in STICK_SLIP and track and self._mirrored(track, track.patches):
                 continue
             out.append(TrackedAlarm("prediction_mismatch", p.finger, p.depth,
                                     f"predicted event {p.type} on {p.finger} at depth "

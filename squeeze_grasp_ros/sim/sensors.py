@@ -26,6 +26,7 @@ change the noise values of the messages that are delivered.
 """
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -73,25 +74,62 @@ def taxel_weights(layout: TactileLayout, thetas: np.ndarray) -> np.ndarray:
     return np.maximum(0.0, 1.0 - np.abs(offset) / layout.spacing)
 
 
-def contact_arrays(contacts: list[ContactNode]) -> tuple[np.ndarray, np.ndarray]:
+def contact_arrays(contacts: Sequence[ContactNode]) -> tuple[np.ndarray, np.ndarray]:
     """(thetas (k,), rad; forces on the object (k, 2), N) of contact nodes."""
     return (np.array([c.theta for c in contacts], float),
             np.array([c.force for c in contacts], float).reshape(-1, 2))
 
 
-def contact_components(contacts: list[ContactNode]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+@dataclass(frozen=True)
+class ContactGeometry:
+    """What a finger's sensors need of its contact nodes' coordinates: the wrench's lever arms
+    and the taxels' projections and weights. They depend on the coordinates only, which stay
+    put while the nodes stick, so :class:`FingerSensors` keeps them from tick to tick.
+
+    Attributes
+    ----------
+    arms : (k, 2) ndarray
+        Face point of each node relative to the tip's reference point, m.
+    cos, sin : (k,) ndarray
+        Cosine and sine of each node's contact normal angle nu.
+    weights : (k, n) ndarray or None
+        Hat weights of the nodes on the taxels (:func:`taxel_weights`; None without an array).
+    """
+
+    arms: np.ndarray
+    cos: np.ndarray
+    sin: np.ndarray
+    weights: np.ndarray | None
+
+
+def contact_geometry(thetas: np.ndarray, normal_angles: np.ndarray, tip: TipGeometry,
+                     layout: TactileLayout | None) -> ContactGeometry:
+    """The :class:`ContactGeometry` of nodes at contact coordinates ``thetas`` with contact
+    normal angles ``normal_angles`` (k,), rad, on ``tip`` (one, m) and ``layout``.
+    """
+    return ContactGeometry(tip.offset(thetas, np.zeros(len(thetas), int)), np.cos(normal_angles),
+                           np.sin(normal_angles),
+                           None if layout is None else taxel_weights(layout, thetas))
+
+
+def contact_components(contacts: Sequence[ContactNode]) -> tuple[np.ndarray, np.ndarray,
+                                                                  np.ndarray]:
     """(thetas, normal forces, tangential forces) (k,) of contact nodes (rad, N, N): the force
     on the object projected on the contact normal e(nu) and t(nu) (nu = theta on a circle).
     """
     thetas, forces = contact_arrays(contacts)
     nu = np.array([c.normal_angle for c in contacts], float)
-    cos, sin = np.cos(nu), np.sin(nu)
-    return (thetas, forces[:, 0] * cos + forces[:, 1] * sin,
-            forces[:, 1] * cos - forces[:, 0] * sin)
+    return (thetas, *_components(forces, np.cos(nu), np.sin(nu)))
+
+
+def _components(forces: np.ndarray, cos: np.ndarray, sin: np.ndarray
+                ) -> tuple[np.ndarray, np.ndarray]:
+    """(normal, tangential) (k,) of forces (k, 2) along e(nu) and t(nu)."""
+    return forces[:, 0] * cos + forces[:, 1] * sin, forces[:, 1] * cos - forces[:, 0] * sin
 
 
 def render_tactile(
-    layout: TactileLayout, contacts: list[ContactNode]
+    layout: TactileLayout, contacts: Sequence[ContactNode]
 ) -> tuple[np.ndarray, np.ndarray]:
     """(normal, tangential) taxel forces (n,), N, of one finger's contact nodes."""
     if not contacts:
@@ -101,7 +139,7 @@ def render_tactile(
     return fn @ w, ft @ w
 
 
-def fingertip_wrench(contacts: list[ContactNode],
+def fingertip_wrench(contacts: Sequence[ContactNode],
                      tip: TipGeometry) -> tuple[np.ndarray, np.ndarray]:
     """(force (3,), torque (3,)) the object applies to the fingertip at its reference point (a
     circle's centre), N and N m; ``tip`` is the finger's tip (one, m).
@@ -109,11 +147,63 @@ def fingertip_wrench(contacts: list[ContactNode],
     if not contacts:
         return np.zeros(3), np.zeros(3)
     thetas, on_object = contact_arrays(contacts)
+    return _wrench(on_object, tip.offset(thetas, np.zeros(len(thetas), int)))
+
+
+def _wrench(on_object: np.ndarray, arms: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(force (3,), torque (3,)) on the fingertip of forces on the object (k, 2) at ``arms``."""
     forces = -on_object
-    arms = tip.offset(thetas, np.zeros(len(thetas), int))
     torque_z = float(arms[:, 0] @ forces[:, 1] - arms[:, 1] @ forces[:, 0])
     total = forces.sum(axis=0)
     return np.array([total[0], total[1], 0.0]), np.array([0.0, 0.0, torque_z])
+
+
+class FingerSensors:
+    """One fingertip's wrench sensor and tactile array, reading its contact nodes per tick.
+
+    The same numbers as :func:`fingertip_wrench` and :func:`render_tactile`, bit for bit, with
+    the nodes' :class:`ContactGeometry` kept from the previous tick while their coordinates
+    and normal angles are unchanged (sticking nodes move with the tip): on a tick where they
+    are, only the force products remain.
+
+    Parameters
+    ----------
+    tip : TipGeometry
+        The finger's tip (one, m).
+    layout : TactileLayout, optional
+        Its tactile array (None: none).
+    """
+
+    def __init__(self, tip: TipGeometry, layout: TactileLayout | None = None) -> None:
+        self.tip, self.layout = tip, layout
+        self._key: bytes | None = None
+        self._geometry: ContactGeometry | None = None
+
+    def read(self, contacts: Sequence[ContactNode]) -> tuple[np.ndarray, ContactGeometry]:
+        """(forces on the object (k, 2), N; their :class:`ContactGeometry`) of the finger's
+        contact nodes.
+        """
+        thetas, forces = contact_arrays(contacts)
+        nu = np.array([c.normal_angle for c in contacts], float)
+        key = thetas.tobytes() + nu.tobytes()
+        if key != self._key:
+            self._key, self._geometry = key, contact_geometry(thetas, nu, self.tip, self.layout)
+        return forces, self._geometry
+
+    def wrench(self, forces: np.ndarray, geometry: ContactGeometry
+               ) -> tuple[np.ndarray, np.ndarray]:
+        """:func:`fingertip_wrench` of nodes read by :meth:`read`."""
+        if not len(forces):
+            return np.zeros(3), np.zeros(3)
+        return _wrench(forces, geometry.arms)
+
+    def tactile(self, forces: np.ndarray, geometry: ContactGeometry
+                ) -> tuple[np.ndarray, np.ndarray]:
+        """:func:`render_tactile` of nodes read by :meth:`read`."""
+        if not len(forces):
+            return np.zeros(len(self.layout.angles)), np.zeros(len(self.layout.angles))
+        fn, ft = _components(forces, geometry.cos, geometry.sin)
+        return fn @ geometry.weights, ft @ geometry.weights
 
 
 class SensorRandomness:

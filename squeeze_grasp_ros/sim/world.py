@@ -73,10 +73,9 @@ from squeeze_grasp_ros.scene import GraspSetup, SensorsSpec, finger_devices
 from squeeze_grasp_ros.sim.camera import CameraFrame, SimCamera
 from squeeze_grasp_ros.sim.devices import DeviceModel, device_model, follow
 from squeeze_grasp_ros.sim.sensors import (
+    FingerSensors,
     SensorRandomness,
     TactileLayout,
-    fingertip_wrench,
-    render_tactile,
     tactile_layout,
 )
 
@@ -223,6 +222,9 @@ class SimWorld:
                             else tactile_layout(t.facing, taxels, 2 * t.flat / t.radius + np.pi,
                                                 periodic=False)
                             for t in tips}
+        self.sensors = {t.name: FingerSensors(self.tips[t.name], self.layouts.get(t.name))
+                        for t in tips}
+        """Each finger's wrench sensor and tactile array (:class:`.sensors.FingerSensors`)."""
         self.randomness = SensorRandomness(
             sensors.seed if sensors is not None and sensors.seed is not None else 0,
             sensors.noise_std if scene.has(Effect.SENSOR_NOISE) else None,
@@ -370,15 +372,18 @@ class SimWorld:
             "device": device,
             "position": self.positions[name] - self.offsets[name],
         }
-        rnd = self.randomness
+        rnd, sensors = self.randomness, self.sensors[name]
+        sensed = None
         if self.scene.has(Effect.FORCE_SENSING) and not rnd.dropped():
             self._work["wrench_evaluations"] += 1
-            force, torque = fingertip_wrench(contacts, self.tips[name])
+            forces, geometry = sensed = sensors.read(contacts)
+            force, torque = sensors.wrench(forces, geometry)
             reading["force"] = rnd.perturb(force)
             reading["torque"] = rnd.perturb(torque, self.radii[name])
         if name in self.layouts and not rnd.dropped():
             self._work["tactile_renderings"] += 1
-            normal, tangential = render_tactile(self.layouts[name], contacts)
+            forces, geometry = sensed or sensors.read(contacts)
+            normal, tangential = sensors.tactile(forces, geometry)
             reading["normal"] = rnd.perturb(normal)
             reading["tangential"] = rnd.perturb(tangential)
         return FingerReading(**reading)

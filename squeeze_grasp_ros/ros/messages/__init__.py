@@ -62,6 +62,7 @@ from squeeze_grasp_ros.ros.messages.executor import (
     grasp_result,
     invalid_goal_result,
     observation,
+    observation_cdr,
 )
 from squeeze_grasp_ros.ros.messages.gripper import (
     gripper_grasps,
@@ -166,6 +167,7 @@ __all__ = [
     "object_model",
     "plan_gripper_grasp_response",
     "observation",
+    "observation_cdr",
     "patches_state_msg",
     "patches_state_cdr",
     "plan_resistance_response",

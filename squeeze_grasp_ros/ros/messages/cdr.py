@@ -2,13 +2,15 @@
 # SPDX-License-Identifier: Apache-2.0
 """The lockstep loop's messages read from, and written to, their serialised CDR bytes.
 
-A lockstep tick delivers six readings to the monitor and two setpoints to the simulated
-hardware. rclpy turns each into Python message objects (a ``PoseStamped`` is six of them,
-about 40 us), of which a node needs a stamp and a few numbers. These functions read those
-numbers from the bytes of a raw subscription instead, in a few microseconds: the stamp, a
-pose's position, a wrench's force and a tactile array's taxels. The values are the same float64
-numbers bit for bit (``test/test_cdr_readings.py`` checks them against rclpy's own
-deserialisation, for every alignment a frame id or finger name can cause).
+A lockstep tick delivers six readings to the monitor, its status to the executor and two
+setpoints to the simulated hardware. rclpy turns each into Python message objects (a
+``PoseStamped`` is six of them, about 40 us), of which a node needs a stamp and a few numbers.
+These functions read those numbers from the bytes of a raw subscription instead, in a few
+microseconds: the stamp, a pose's position, a wrench's force, a tactile array's taxels and a
+status's per-finger vectors and depth (a status with events or alarms is left to rclpy). The
+values are the same float64 numbers bit for bit (``test/test_cdr_readings.py`` and
+``test/test_cdr_writers.py`` check them against rclpy's own deserialisation, for every
+alignment a frame id or finger name can cause).
 
 The other way, the loop's publishers hand rclpy the serialised bytes (``Publisher.publish``
 takes ``bytes``): :class:`CdrWriter` and the ``*_cdr`` writers below put a tick's readings, its
@@ -31,7 +33,8 @@ import numpy as np
 
 from squeeze_grasp_ros.ros.messages.contacts import TactileReadings, check_taxels
 
-__all__ = ["CdrWriter", "cdr_stamp_ns", "clock_cdr", "pose_position_cdr", "pose_stamped_cdr",
+__all__ = ["CdrWriter", "cdr_stamp_ns", "clock_cdr", "monitor_status_cdr_reading",
+           "pose_position_cdr", "pose_stamped_cdr",
            "tactile_array_cdr", "tactile_readings_cdr", "tick_cdr", "tick_readings_cdr",
            "wrench_force_cdr", "wrench_stamped_cdr", "write_contact_arrays"]
 
@@ -62,6 +65,12 @@ class _Reader:
     def uint64(self) -> int:
         self._align(8)
         (value,) = struct.unpack_from(self.order + "Q", self.data, self.offset)
+        self.offset += 8
+        return value
+
+    def float64(self) -> float:
+        self._align(8)
+        (value,) = struct.unpack_from(self.order + "d", self.data, self.offset)
         self.offset += 8
         return value
 
@@ -147,6 +156,24 @@ def tick_readings_cdr(data: bytes) -> tuple[int, list[str]]:
     return stamp, reader.strings()
 
 
+def monitor_status_cdr_reading(data: bytes) -> tuple | None:
+    """(stamp ns, fingers, positions (k, 3) m, forces (k, 3) N, normals (k, 3), depth m) of a
+    serialised ``squeeze_grasp_interfaces/MonitorStatus`` that carries no event and no alarm
+    (most ticks); None when it carries any (deserialise it whole then).
+    """
+    reader = _Reader(data)
+    stamp = reader.header()
+    reader.skip_string()
+    fingers = reader.strings()
+    vectors = [reader.float64s(3 * reader.uint32()).reshape(-1, 3) for _ in range(3)]
+    reader.sequence()  # sensor ages
+    depth = reader.float64()
+    reader.float64()  # relative depth
+    if reader.uint32() or reader.uint32():  # events, then alarms
+        return None
+    return (stamp, fingers, *vectors, depth)
+
+
 _ZEROS = tuple(bytes(n) for n in range(8))
 """Padding of 0-7 bytes."""
 _U32, _I32, _U64, _F64, _TIME = (struct.Struct(f).pack for f in ("<I", "<i", "<Q", "<d", "<iI"))
@@ -175,10 +202,6 @@ class CdrWriter:
     def __init__(self) -> None:
         self.buffer = bytearray(b"\x00\x01\x00\x00")
 
-    def _align(self, size: int) -> None:
-        buffer = self.buffer
-        buffer += _ZEROS[-(len(buffer) - _BODY) % size]
-
     def uint32(self, value: int) -> None:
         buffer = self.buffer
         buffer += _ZEROS[-len(buffer) % 4]
@@ -190,12 +213,14 @@ class CdrWriter:
         buffer += _I32(value)
 
     def uint64(self, value: int) -> None:
-        self._align(8)
-        self.buffer += _U64(value)
+        buffer = self.buffer
+        buffer += _ZEROS[-(len(buffer) - _BODY) % 8]
+        buffer += _U64(value)
 
     def float64(self, value: float) -> None:
-        self._align(8)
-        self.buffer += _F64(value)
+        buffer = self.buffer
+        buffer += _ZEROS[-(len(buffer) - _BODY) % 8]
+        buffer += _F64(value)
 
     def string(self, text: str) -> None:
         buffer = self.buffer
@@ -226,8 +251,9 @@ class CdrWriter:
         """
         data = np.asarray(values, dtype="<f8")
         if data.size:
-            self._align(8)
-            self.buffer += data.tobytes()
+            buffer = self.buffer
+            buffer += _ZEROS[-(len(buffer) - _BODY) % 8]
+            buffer += data.tobytes()
 
     def sequence(self, values, dtype: str = "<f8") -> None:
         """A sequence of numbers (``float64[]`` by default; ``"<i4"`` int32, ``"u1"`` uint8):
@@ -235,10 +261,12 @@ class CdrWriter:
         writes it).
         """
         data = np.asarray(values, dtype=dtype)
-        self.uint32(data.size)
-        if data.size:
-            self._align(data.itemsize)
-            self.buffer += data.tobytes()
+        size, buffer = data.size, self.buffer
+        buffer += _ZEROS[-len(buffer) % 4]
+        buffer += _U32(size)
+        if size:
+            buffer += _ZEROS[-(len(buffer) - _BODY) % data.itemsize]
+            buffer += data.tobytes()
 
     def data(self) -> bytes:
         """The serialised message, ready for ``Publisher.publish``."""

@@ -23,6 +23,7 @@ from squeeze_grasp_ros.control.motion import (
     GraspProgram,
     Observation,
 )
+from squeeze_grasp_ros.ros.messages.cdr import monitor_status_cdr_reading
 from squeeze_grasp_ros.ros.messages.common import float64_array, header, stamp_ns, vector3
 
 # --------------------------------------------------------------------------- pipeline: executor
@@ -40,6 +41,20 @@ def observation(msg: MonitorStatus) -> Observation:
         tuple(e.type for e in msg.events),
         float(msg.depth),
     )
+
+
+def observation_cdr(data: bytes) -> Observation | None:
+    """The :class:`Observation` of a serialised ``MonitorStatus``, read from its bytes
+    (:mod:`.cdr`; the same numbers as :func:`observation` of the message), when the status
+    carries no event and no alarm, as at most ticks; None when it carries any.
+    """
+    read = monitor_status_cdr_reading(data)
+    if read is None:
+        return None
+    ns, fingers, positions, forces, normals, depth = read
+    return Observation(ns, {f: positions[k, :2].copy() for k, f in enumerate(fingers)},
+                       {f: forces[k, :2].copy() for k, f in enumerate(fingers)},
+                       {f: normals[k, :2].copy() for k, f in enumerate(fingers)}, (), (), depth)
 
 
 def _planar(vectors: Sequence[Vector3]) -> np.ndarray:

@@ -43,6 +43,7 @@ from geometry_msgs.msg import PoseStamped
 from rclpy.action import ActionServer, CancelResponse, GoalResponse
 from rclpy.action.server import ServerGoalHandle
 from rclpy.node import Node
+from rclpy.serialization import deserialize_message
 from rclpy.task import Future
 
 from squeeze_grasp_interfaces.action import ExecuteGrasp
@@ -143,12 +144,13 @@ class ExecutorNode(Node):
         self.status_pub = self.create_publisher(ExecutorStatus, pipeline.EXECUTOR_STATUS, loop)
         pose_pub = self.create_publisher(PoseStamped, pipeline.OBJECT_POSE, pipeline.LATCHED)
         pose_pub.publish(messages.pose_in_base(p["object_pose"], p["base_frame"]))
-        self.create_subscription(MonitorStatus, pipeline.STATUS, self._status, loop)
+        self.create_subscription(MonitorStatus, pipeline.STATUS, self._status, loop, raw=True)
         self.server = ActionServer(self, ExecuteGrasp, pipeline.ACTION, self._execute,
                                    goal_callback=self._accept_goal,
                                    cancel_callback=lambda _: CancelResponse.ACCEPT)
         self.goal: _Goal | None = None
-        self.latest: MonitorStatus | None = None
+        self.latest: bytes | None = None
+        """The newest status, serialised (a raw subscription: :meth:`_cycle` reads it)."""
         self.answered = pipeline.TickAnswer()
         self.state = ExecutorStatus.IDLE
         if p["lockstep"]:
@@ -186,7 +188,7 @@ class ExecutorNode(Node):
         self.goal = _Goal(GraspProgram(goal, self.limits, list(self.devices)), handle)
         done = self.goal.done
         if self.p["lockstep"] and self.latest is not None and \
-                messages.stamp_ns(self.latest.header.stamp) > self.answered.stamp_ns:
+                messages.cdr_stamp_ns(self.latest) > self.answered.stamp_ns:
             self._cycle(self.latest)
         result = await done
         if result.termination == ExecuteGrasp.Result.CANCELED:
@@ -198,30 +200,40 @@ class ExecutorNode(Node):
         return result
 
     # ----------------------------------------------------------------- cycles
-    def _status(self, msg: MonitorStatus) -> None:
-        if not self.answered.is_new(messages.stamp_ns(msg.header.stamp)):
+    def _status(self, data: bytes) -> None:
+        if not self.answered.is_new(messages.cdr_stamp_ns(data)):
             return
-        self.latest = msg
+        self.latest = data
         if self.p["lockstep"] and self.goal is not None:
-            self._cycle(msg)
+            self._cycle(data)
 
     def _timer(self) -> None:
         if self.goal is not None and self.latest is not None:
             self._cycle(self.latest, self.get_clock().now().nanoseconds)
 
-    def _cycle(self, msg: MonitorStatus, now_ns: int | None = None) -> None:
-        """One control cycle on status ``msg``; publish the setpoints, finish the goal if done."""
+    def _cycle(self, data: bytes, now_ns: int | None = None) -> None:
+        """One control cycle on the serialised status ``data``; publish the setpoints, finish
+        the goal if done.
+
+        A status without events and alarms (most ticks) is read from its bytes
+        (:func:`..messages.observation_cdr`); one with any is deserialised, and its events are
+        kept for the result.
+        """
         goal = self.goal
-        ns = messages.stamp_ns(msg.header.stamp)
-        obs = messages.observation(msg)
+        obs = messages.observation_cdr(data)
+        msg = None if obs is not None else deserialize_message(data, MonitorStatus)
+        obs = obs or messages.observation(msg)
+        ns = obs.stamp_ns
         if goal.start_ns is None:
-            if not self.p["lockstep"] and self._unseen(goal, msg, ns):
+            if not self.p["lockstep"] and self._unseen(
+                    goal, msg or deserialize_message(data, MonitorStatus), ns):
                 return
             goal.start_ns = ns
             if self.jaws is not None:
                 self.jaws.start(obs)
-        goal.events += msg.events
-        goal.since_feedback += msg.events
+        if msg is not None:
+            goal.events += msg.events
+            goal.since_feedback += msg.events
         if goal.handle.is_cancel_requested:
             goal.program.cancel()
         command = goal.program.step(obs, self.p["period"])

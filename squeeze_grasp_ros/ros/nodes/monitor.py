@@ -285,7 +285,8 @@ class MonitorNode(Node):
         if self.forces is not None:
             residual, alarms = self.forces.tick(out, samples, frame)
             batch += residual
-            out = dataclasses.replace(out, alarms=out.alarms + alarms)
+            if alarms:
+                out = dataclasses.replace(out, alarms=out.alarms + alarms)
         active = {(a.type, a.finger) for a in out.alarms}
         batch += [(self.alarm_pub, messages.alarm_msg(a, ns)) for a in out.alarms
                   if (a.type, a.finger) not in self.active_alarms]

@@ -59,7 +59,7 @@ from functools import cached_property
 
 import numpy as np
 
-from squeeze_grasp_ros.mechanics.vocabulary import Finger, SqueezeKind, Termination
+from squeeze_grasp_ros.mechanics.vocabulary import AlarmType, Finger, SqueezeKind, Termination
 
 RESQUEEZE = "resqueeze"
 """The reaction that releases and squeezes again (``ExecuteGrasp.Goal.REACT_RESQUEEZE``)."""
@@ -399,7 +399,7 @@ class GraspProgram:
         terminal = self._terminal(obs)
         if terminal is not None:
             return terminal
-        alarmed = {finger for kind, finger in obs.alarms if kind == "slip_imminent"}
+        alarmed = {finger for kind, finger in obs.alarms if kind == AlarmType.SLIP_IMMINENT}
         if self.grace > 0:
             self.grace -= 1
         elif self.phase == "resist" and self.goal.adversary in alarmed:
@@ -417,7 +417,7 @@ class GraspProgram:
                     measured=True,
                 )
             self._redirect(obs)
-        stale = {finger for kind, finger in obs.alarms if kind == "stale_sensor"}
+        stale = {finger for kind, finger in obs.alarms if kind == AlarmType.STALE_SENSOR}
         if stale & set(self.moving):
             self.v = 0.0
             self.hold_ticks += 1

@@ -30,9 +30,9 @@ from __future__ import annotations
 
 from enum import Enum
 
-__all__ = ["ContactKind", "ContactMode", "ControllerKind", "DistortionModel", "Effect",
-           "EventType", "Factorizer", "Finger", "ImageEncoding", "MaterialModel", "ObjectModel",
-           "RingLimit", "SQUEEZING_FINGERS", "ShapeFit", "ShapeType", "SqueezeKind",
+__all__ = ["AlarmType", "ContactKind", "ContactMode", "ControllerKind", "DistortionModel",
+           "Effect", "EventType", "Factorizer", "Finger", "ImageEncoding", "MaterialModel",
+           "ObjectModel", "RingLimit", "SQUEEZING_FINGERS", "ShapeFit", "ShapeType", "SqueezeKind",
            "StrainCriterion",
            "StrainMeasure", "StressMeasure", "Termination", "TipKind"]
 
@@ -119,6 +119,20 @@ class Termination(_Name):
     ELEMENT_INVERTED = "element_inverted"
     """An element of the object turned inside out (det F <= 0): the material model has left
     its range, so the squeeze cannot go deeper. Always checked, whatever the scene declares."""
+
+
+class AlarmType(_Name):
+    """The monitor's alarms (``squeeze_grasp_interfaces/msg/Alarm`` constants); the
+    ``contact_lost`` alarm is :attr:`Termination.CONTACT_LOST`, the grasp's end it causes.
+    """
+
+    SLIP_IMMINENT = "slip_imminent"
+    STALE_SENSOR = "stale_sensor"
+    PREDICTION_MISMATCH = "prediction_mismatch"
+    SHAPE_MISMATCH = "shape_mismatch"
+    FORCE_MISMATCH = "force_mismatch"
+    WEIGHT_SLIP = "weight_slip"
+    """The object is picked up but the jaw force no longer carries its weight by friction."""
 
 
 class SqueezeKind(_Name):

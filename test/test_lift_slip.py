@@ -18,7 +18,7 @@ from rclpy.context import Context
 from sensor_msgs.msg import JointState
 
 from squeeze_grasp_ros.control.joint_feedback import WeightWatch
-from squeeze_grasp_ros.mechanics.vocabulary import AlarmType
+from squeeze_grasp_ros.mechanics.vocabulary import Termination
 from squeeze_grasp_ros.ros.nodes import ParameterError
 from squeeze_grasp_ros.ros.nodes.monitor import JointFeedback
 
@@ -55,7 +55,7 @@ def test_the_pickup_verdict_is_the_closed_form_from_the_joint_efforts():
         fields = {f: {"position": p.copy()} for f, p in poses.items()}
         jaws.replace(fields, msg, log)
         picked.append(jaws.take_picked_up())
-        weight = [a for a in jaws.alarms if a.type == AlarmType.WEIGHT_SLIP]
+        weight = [a for a in jaws.alarms if a.type == Termination.WEIGHT_SLIP]
         alarmed.append(weight)
     carried = 2.0 * MU * forces / WEIGHT
     first = int(np.argmax(carried >= MARGIN))

@@ -217,7 +217,7 @@ class WeightWatch:
         if carried >= 1.0:
             return False, ()
         return False, tuple(TrackedAlarm(
-            AlarmType.WEIGHT_SLIP, jaw, carried,
+            Termination.WEIGHT_SLIP, jaw, carried,
             f"{jaw}: jaw force {force:.4g} N below the {self.need:.4g} N that carries the weight "
             f"{self.weight:g} N by friction (mu {self.mu:g}): 2 mu F / w = {carried:.3g}")
             for jaw in self.jaws)

@@ -119,11 +119,15 @@ class Termination(_Name):
     ELEMENT_INVERTED = "element_inverted"
     """An element of the object turned inside out (det F <= 0): the material model has left
     its range, so the squeeze cannot go deeper. Always checked, whatever the scene declares."""
+    WEIGHT_SLIP = "weight_slip"
+    """Lifted, the object slips out of the grip: friction cannot carry its weight (the pickup
+    criterion fails at the lift; the world of a gripper scene, docs/grippers.md)."""
 
 
 class AlarmType(_Name):
     """The monitor's alarms (``squeeze_grasp_interfaces/msg/Alarm`` constants); the
-    ``contact_lost`` alarm is :attr:`Termination.CONTACT_LOST`, the grasp's end it causes.
+    ``contact_lost`` and ``weight_slip`` alarms are :attr:`Termination.CONTACT_LOST` and
+    :attr:`Termination.WEIGHT_SLIP`, the grasp's ends they signal.
     """
 
     SLIP_IMMINENT = "slip_imminent"
@@ -131,8 +135,6 @@ class AlarmType(_Name):
     PREDICTION_MISMATCH = "prediction_mismatch"
     SHAPE_MISMATCH = "shape_mismatch"
     FORCE_MISMATCH = "force_mismatch"
-    WEIGHT_SLIP = "weight_slip"
-    """The object is picked up but the jaw force no longer carries its weight by friction."""
 
 
 class SqueezeKind(_Name):

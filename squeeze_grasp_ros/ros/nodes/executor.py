@@ -36,6 +36,7 @@ previous feedback. Cancel: the next cycle holds the measured positions and the g
 """
 from __future__ import annotations
 
+import math
 import sys
 from typing import Any
 
@@ -71,6 +72,8 @@ PARAMETERS: dict[str, tuple[Any, str]] = {
     "redirect_grace": (20, "cycles the slip alarm is ignored after a redirection"),
     "stale_budget": (0.1, "longest hold for stale sensor data, s; past it the goal ends "
                           "stale_data"),
+    "lift_watch": (0.0, "after picked_up, hold this long watching for weight_slip before the "
+                        "goal ends picked_up, s (0: end at picked_up)"),
     "period": (0.001, "control cycle, s (lockstep: the simulated tick)"),
     "feedback_every": (10, "cycles between action feedback messages"),
     "lockstep": (True, "cycle on each monitor status (simulation) or on a wall-clock timer"),
@@ -122,7 +125,10 @@ class ExecutorNode(Node):
         self.devices = pipeline.parse_mapping(p["finger_devices"], "finger_devices")
         self.limits = MotionLimits(p["max_velocity"], p["max_acceleration"],
                                    p["position_tolerance"], p["redirect_grace"],
-                                   float(p["stale_budget"]))
+                                   float(p["stale_budget"]), float(p["lift_watch"]))
+        if not (math.isfinite(self.limits.lift_watch) and self.limits.lift_watch >= 0.0):
+            raise ParameterError(f"lift_watch must be a finite number >= 0 s, got "
+                                 f"{self.limits.lift_watch}")
         self.period_ns = int(round(p["period"] * 1e9))
         loop = pipeline.loop_qos(p["qos_depth"])
         controller = scene_controller(load_scene(p["controller_scene"]), p["controller_scene"]) \

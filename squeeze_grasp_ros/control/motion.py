@@ -474,7 +474,7 @@ class GraspProgram:
         if Termination.PICKED_UP in obs.events and self.phase == "squeeze" \
                 and not self.under_weight:
             if self.limits.lift_watch > 0.0:
-                return self._lift(obs)
+                return self.lift(obs)
             return self._finish(
                 obs, Termination.PICKED_UP, "friction can lift the object", measured=True
             )
@@ -538,8 +538,10 @@ class GraspProgram:
                        f"{what} at depth {self.depth(obs) * 1e3:.4g} mm: "
                        f"releasing to squeeze again to {self.planned_depth * 1e3:.4g} mm")
 
-    def _lift(self, obs: Observation) -> Command:
-        """Picked up: hold the measured positions while the arm lifts (see the module)."""
+    def lift(self, obs: Observation) -> Command:
+        """Picked up (or a squeeze under weight at its depth): hold the measured positions
+        while the arm lifts (see the module).
+        """
         self.commanded = {f: np.asarray(obs.positions[f], float) for f in self.fingers}
         self.phase, self.lift_time, self.v = "lift", 0.0, 0.0
         return Command(self._setpoints(), "holding", None,
@@ -630,7 +632,7 @@ class GraspProgram:
         if self.phase == "resist":
             return self._finish(obs, "resisted", "the adversary completed its translation")
         if self.under_weight:
-            return self._lift(obs)
+            return self.lift(obs)
         if not self.goal.resist:
             return self._finish(obs, Termination.DEPTH_REACHED, "squeeze depth reached")
         goal = self.goal

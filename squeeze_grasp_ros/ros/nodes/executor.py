@@ -104,6 +104,9 @@ class _Goal:
         self.waiting_since_ns: int | None = None
         self.releasing = False
         """The action route's gripper goal is a release's (its result is not the goal's)."""
+        self.lifting = False
+        """The action route's jaws hold while the arm lifts (the gripper goal was canceled, or
+        reached a squeeze's depth under weight): its result is not the goal's."""
 
 
 class ExecutorNode(Node):
@@ -298,8 +301,11 @@ class ExecutorNode(Node):
             position, effort = action.target(program.goal, obs)
             action.send(position, effort, answer)
             waiting = True
+        elif program.phase == "lift" and not goal.lifting:
+            goal.lifting = True  # picked up: the controller holds while the arm lifts
+            waiting = action.cancel(answer)
         elif command.state == ExecutorStatus.RELEASING and not goal.releasing:
-            goal.releasing = True
+            goal.releasing, goal.lifting = True, False
             opening = action.opening(dict(zip(program.goal.fingers,
                                               program.release_positions())))
 
@@ -314,10 +320,15 @@ class ExecutorNode(Node):
             position, effort = action.squeeze(
                 program.goal, dict(zip(program.goal.fingers, program.first_contact)),
                 program.planned_depth)
+            if program.under_weight:
+                effort = 0.0  # deeper than the plan's force curve: the controller's own limit
             action.send(position, effort, answer)
             waiting = True
         else:
-            end, waiting = (None if goal.releasing else action.outcome), False
+            end, waiting = (None if goal.releasing or goal.lifting else action.outcome), False
+            if end is not None and program.under_weight and end[1]:
+                # a squeeze deeper under weight reached its depth: hold and watch the lift
+                command, end, goal.lifting = program.lift(obs), None, True
         if not waiting:
             answer()
         termination = None if end is None else end[0]

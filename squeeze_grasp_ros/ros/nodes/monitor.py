@@ -30,8 +30,10 @@ aperture and jaw force come through the transmission (:mod:`..control.joint_feed
 jaws' positions on the jaw line (fixed by the gripper's pose: the ``gripper_pose`` parameter, else
 the ``gripper_pose`` topic, else the jaws' first pose readings) give
 the depth, the force ``wrench`` stands in for, first touch, ``contact_lost`` and the slip watch's
-``slip_imminent`` (the jaws close while the force stops rising); events A-D need taxels, so
-none are tracked and the prediction's events are not compared (the force watch is).
+``slip_imminent`` (the jaws close while the force stops rising), and with a ``weight`` the
+lift's verdict (:class:`..control.joint_feedback.WeightWatch`: the ``picked_up`` event once
+2 mu F >= ``weight_margin`` w, then ``weight_slip`` while 2 mu F < w); events A-D need taxels,
+so none are tracked and the prediction's events are not compared (the force watch is).
 
 The Barrett hand under a JointTrajectoryController (``controller: {device: bh8, ...}``): the
 carried fingers' positions come from ``joint_states`` through the hand's forward kinematics

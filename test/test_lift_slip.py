@@ -118,6 +118,79 @@ def test_the_monitor_node_refuses_a_hostile_weight_on_real_rclpy(weight, ros_con
         MonitorNode(context=ros_context, parameter_overrides=[Parameter("weight", value=weight)])
 
 
+# --------------------------------------------------------------------------- the world's lift
+def lift_world(weight: float, lift_after: float = 0.005):
+    from squeeze_grasp_ros.scene import GraspSetup, parse_scene
+    from squeeze_grasp_ros.sim.world import SimWorld
+
+    data = yaml.safe_load((SCENES / "sponge_gripper_lift.yaml").read_text())
+    data["pickup"] = {"weight": weight, "lift_after": lift_after}
+    data["object"]["mesh"]["nodes"] = 400
+    return SimWorld(GraspSetup.build(parse_scene(data)))
+
+
+def jaw_setpoints(world, s: float) -> dict:
+    """Both jaws of ``world`` at squeeze parameter ``s`` (m) from their placements."""
+    return {t.name: np.asarray(t.center, float) + s * np.asarray(world.directions[t.name])
+            for t in world.placements}
+
+
+def vertical_supply(state, mu: float) -> dict:
+    """Per finger, the vertical friction its sticking contact nodes can supply (N), computed
+    here from the contact records: sum sqrt(mu^2 f_n^2 - f_t^2), f_n and f_t the force along
+    and across each node's contact normal (Sec. 5.1's cone, out of the plane).
+    """
+    out = {"F1": 0.0, "F2": 0.0}
+    for c in state.contacts:
+        if c.mode != "stick":
+            continue
+        normal = np.array([np.cos(c.normal_angle), np.sin(c.normal_angle)])
+        fn, ft = float(c.force @ normal), float(c.force @ np.array([-normal[1], normal[0]]))
+        out[c.finger] += math.sqrt(max(mu * mu * fn * fn - ft * ft, 0.0))
+    return out
+
+
+@pytest.mark.parametrize("share", [0.98, 1.02])
+def test_the_world_lifts_once_the_jaws_stand_still_and_judges_the_weight(share):
+    """The world does not end the squeeze at the pickup criterion while the jaws close (the
+    weight is carried long before 3 mm); it lifts lift_after (5 ticks) after they stop, and
+    holds (picked_up, frozen) or lets the object slip out (weight_slip: no contact, no force,
+    released once the jaws open clear of it) exactly as the criterion computed here from the
+    contact nodes' forces says, for a weight 2 % below and above what the grip carries.
+    """
+    probe = lift_world(0.1)
+    probe.start()
+    step, steps = 1e-5, 300
+    for k in range(1, steps + 1):
+        out = probe.step(jaw_setpoints(probe, k * step))
+        assert out.termination is None
+    supply = vertical_supply(out.state, probe.model.mu)
+    carried = 2.0 * min(supply.values())  # each jaw carries half the weight
+    world = lift_world(share * carried)
+    world.start()
+    for k in range(1, steps + 1):
+        out = world.step(jaw_setpoints(world, k * step))
+    ends = []
+    for _ in range(world.lift_ticks + 3):
+        out = world.step(jaw_setpoints(world, steps * step))
+        ends.append(out.termination)
+    held = share < 1.0
+    end = "picked_up" if held else "weight_slip"
+    assert world.lift_ticks == 5 and ends == [None] * 4 + [end] * 4
+    assert world.lift_margin == pytest.approx(share * carried / 2 - carried / 2, rel=1e-9)
+    if held:
+        assert len(out.state.contacts) > 0
+        assert out.state.depth == pytest.approx(steps * step, rel=1e-9)
+        return
+    assert out.state.contacts == () and world.work["lifts"] == 1
+    assert out.state.depth == pytest.approx(steps * step, rel=1e-9)
+    released = []
+    for k in range(steps, -300, -5):  # open past the placements: the object is released
+        out = world.step(jaw_setpoints(world, k * step))
+        released += [k] if out.released else []
+    assert len(released) == 1 and out.termination is None
+
+
 # --------------------------------------------------------------------------- on real rclpy
 LIFT, HEAVY = SCENES / "sponge_gripper_lift.yaml", SCENES / "sponge_gripper_lift_heavy.yaml"
 
@@ -255,3 +328,63 @@ def test_the_weight_slip_under_an_action_controller(kind, tmp_path):
     assert run["attempts"] == 2 and len(run["world_releases"]) == 1
     assert run["planned_depth"] == pytest.approx(1.25 * slipped["measured_depth"], rel=1e-9)
     assert 2 * MU * jaw_forces(run, path)[-1] >= 4.2
+
+
+# --------------------------------------------------------------------------- the program
+def lift_program(reaction: str = "hold", attempts: int = 2):
+    from squeeze_grasp_ros.control.motion import GraspGoal, GraspProgram, MotionLimits
+
+    goal = GraspGoal(("F1", "F2"), np.array([[0.0, 1.0], [0.0, -1.0]]) / np.sqrt(2), 0.005,
+                     on_slip_alarm=reaction, max_attempts=attempts)
+    return GraspProgram(goal, MotionLimits(lift_watch=0.003), ("F1", "F2"))
+
+
+def observation(depth: float, alarms=(), events=()):
+    from squeeze_grasp_ros.control.motion import Observation
+
+    positions = {"F1": np.array([0.0, -0.025 + depth / np.sqrt(2)]),
+                 "F2": np.array([0.0, 0.025 - depth / np.sqrt(2)])}
+    return Observation(0, positions, {f: np.zeros(2) for f in positions},
+                       {f: np.zeros(2) for f in positions}, tuple(alarms), tuple(events), depth)
+
+
+SLIPPED = [("weight_slip", "F1"), ("weight_slip", "F2"), ("contact_lost", "F1"),
+           ("contact_lost", "F2")]
+
+
+@pytest.mark.parametrize("reaction", ["hold", "pure", "normals", "resqueeze"])
+def test_the_program_holds_at_picked_up_and_reacts_to_a_weight_slip(reaction):
+    """picked_up: hold the measured aperture and watch (state holding, no end); a weight slip
+    with the jaws' contact lost at once: resqueeze releases to squeeze 25 % deeper than the
+    alarm's depth, every other reaction ends slip_alarm (a redirection adds no force).
+    """
+    program = lift_program(reaction)
+    program.step(observation(0.0), 0.001)
+    command = program.step(observation(0.003, events=["picked_up"]), 0.001)
+    assert command.state == "holding" and command.termination is None
+    np.testing.assert_array_equal(command.setpoints["F1"], observation(0.003).positions["F1"])
+    command = program.step(observation(0.003, SLIPPED), 0.001)
+    if reaction == "resqueeze":
+        assert command.state == "releasing" and command.termination is None
+        assert program.planned_depth == pytest.approx(1.25 * 0.003, rel=1e-12)
+        assert program.freed == {"F1", "F2"}  # the contact lost at the slip frees the jaws
+        assert "slip under the weight at depth 3 mm" in command.message
+    else:
+        assert command.termination == "slip_alarm"
+        assert command.message == "slip under the weight of F1, F2"
+
+
+def test_the_lift_ends_picked_up_after_lift_watch_or_contact_lost_and_a_last_attempt_holds():
+    program = lift_program()
+    program.step(observation(0.0), 0.001)
+    program.step(observation(0.003, events=["picked_up"]), 0.001)
+    ends = [program.step(observation(0.003), 0.001).termination for _ in range(3)]
+    assert ends == [None, None, "picked_up"]
+    program = lift_program()
+    program.step(observation(0.0), 0.001)
+    program.step(observation(0.003, events=["picked_up"]), 0.001)
+    assert program.step(observation(0.003, SLIPPED[2:]), 0.001).termination == "contact_lost"
+    program = lift_program("resqueeze", attempts=1)
+    program.step(observation(0.0), 0.001)
+    program.step(observation(0.003, events=["picked_up"]), 0.001)
+    assert program.step(observation(0.003, SLIPPED), 0.001).termination == "slip_alarm"

@@ -259,9 +259,13 @@ def test_an_object_heavier_than_planned_slips_and_the_executor_holds(tmp_path):
     """sponge_gripper_lift_heavy (4.2 N planned as 3 N): picked up at the planned weight, lifted,
     the world's criterion fails: the sponge slips out (world weight_slip, no contact), the jaw
     force on joint_states falls to zero, the monitor raises weight_slip (value 2 mu F / w = 0)
-    and contact_lost for both jaws, and the executor ends slip_alarm holding.
+    and contact_lost for both jaws, and the executor ends slip_alarm holding; recorded and
+    replayed, the same picked_up and the same four alarms.
     """
-    run = lift_run(HEAVY)
+    from squeeze_grasp_ros.ros.recording.replay import replay
+
+    bag = tmp_path / "bag"
+    run = lift_run(HEAVY, record=str(bag))
     print(run["outcome"], run["message"], run["first_alarms"])
     assert run["world_termination"] == "weight_slip" and run["termination"] == "slip_alarm"
     assert run["message"] == "slip under the weight of F1, F2"
@@ -273,6 +277,9 @@ def test_an_object_heavier_than_planned_slips_and_the_executor_holds(tmp_path):
     forces = jaw_forces(run, str(HEAVY))
     assert forces[-1] == 0.0 and 2 * MU * forces.max() >= MARGIN * 3.0
     assert run["world_end"]["depth"] == pytest.approx(run["measured_depth"], rel=1e-9)
+    # replayed into a fresh monitor, the recorded joint states give the same verdict
+    replayed = replay(str(bag))
+    assert replayed["alarms"] == 4 and [e["type"] for e in replayed["events"]] == ["picked_up"]
 
 
 def test_the_heavy_object_is_squeezed_again_deeper_and_held(tmp_path):

@@ -156,7 +156,8 @@ def test_the_world_lifts_once_the_jaws_stand_still_and_judges_the_weight(share):
     weight is carried long before 3 mm); it lifts lift_after (5 ticks) after they stop, and
     holds (picked_up, frozen) or lets the object slip out (weight_slip: no contact, no force,
     released once the jaws open clear of it) exactly as the criterion computed here from the
-    contact nodes' forces says, for a weight 2 % below and above what the grip carries.
+    contact nodes' forces says, for a weight 2 % below and above what the grip carries. The
+    jaws standing at their placements before the squeeze lift nothing.
     """
     probe = lift_world(0.1)
     probe.start()
@@ -168,6 +169,8 @@ def test_the_world_lifts_once_the_jaws_stand_still_and_judges_the_weight(share):
     carried = 2.0 * min(supply.values())  # each jaw carries half the weight
     world = lift_world(share * carried)
     world.start()
+    for _ in range(world.lift_ticks + 3):  # at the placements, before the squeeze: no lift
+        assert world.step(jaw_setpoints(world, 0.0)).termination is None
     for k in range(1, steps + 1):
         out = world.step(jaw_setpoints(world, k * step))
     ends = []

@@ -28,10 +28,10 @@ freezes (the sensors keep reading it) and the devices still follow their setpoin
 
 **The lift of a gripper scene** (effect ``pickup`` and a ``controller:`` section). A lab lifts
 the object once its gripper has closed, so the squeeze is not ended by the stepper's pickup
-criterion; instead, once every squeezing tip has stood still in contact for
-``pickup.lift_after`` s, the simulated arm lifts, and the world judges the lift with the
-stepper's own criterion (:func:`~..mechanics.squeeze.stepper.functions.pickup_margin`: each
-finger's sticking nodes supply sum sqrt(mu^2 f_n^2 - f_t^2) of vertical friction, against
+criterion; instead, once every squeezing tip has squeezed (a positive depth) and stood still
+in contact for ``pickup.lift_after`` s, the simulated arm lifts, and the world judges the lift
+with the stepper's own criterion (:func:`~..mechanics.squeeze.stepper.functions.pickup_margin`:
+each finger's sticking nodes supply sum sqrt(mu^2 f_n^2 - f_t^2) of vertical friction, against
 its share of ``pickup.weight``, the true weight) on the contact state at that tick:
 
 - it holds: the world ends ``picked_up`` (the object hangs in the jaws, the state frozen);
@@ -344,11 +344,14 @@ class SimWorld:
         return self._output(events)
 
     def _watch_lift(self, moves: Mapping[str, np.ndarray]) -> None:
-        """Count the ticks the squeezing tips stood still in contact; lift after enough."""
+        """Count the ticks the squeezing tips stood still in contact, once they have squeezed
+        (a positive depth: not at the placements before the goal); lift after enough.
+        """
         names = [t.name for t in self.placements]
         touching = {c.finger for c in self.state.contacts}
         still = all(not np.any(moves.get(n, 0.0)) for n in names)
-        self.still_ticks = self.still_ticks + 1 if still and touching >= set(names) else 0
+        squeezed = touching >= set(names) and self.state.depth > 0.0
+        self.still_ticks = self.still_ticks + 1 if still and squeezed else 0
         if self.still_ticks < self.lift_ticks:
             return
         self._work["lifts"] += 1

@@ -315,18 +315,24 @@ def test_the_heavy_object_is_squeezed_again_deeper_and_held(tmp_path):
 
 @pytest.mark.parametrize("kind", ["parallel_gripper", "gripper_action"])
 def test_the_weight_slip_under_an_action_controller(kind, tmp_path):
-    """The heavy scene under a gripper action controller: at picked_up the gripper goal is
-    canceled (the controller holds) and the arm lifts; the sponge slips, and with resqueeze the
-    executor opens and squeezes again deeper with a new gripper goal, whose reached depth is
-    lifted again: held. Without resqueeze it ends slip_alarm.
+    """The lift scenes under a gripper action controller: at picked_up the gripper goal is
+    canceled (the controller holds) and the arm lifts. The light sponge is held; the heavy one
+    slips (slip_alarm), and with resqueeze the executor opens and squeezes again deeper with a
+    new gripper goal, whose reached depth is lifted again: held.
     """
     if importlib.util.find_spec("control_msgs") is None:
         pytest.skip("control_msgs is not built: squeeze-grasp ros-setup --control-msgs DIR (DIR "
                     "a jazzy checkout of github.com/ros-controls/control_msgs)")
+    controller = {"type": kind, "name": "gripper_controller", "device": "generic_85mm",
+                  "goal_tolerance": 1e-7, "stall_timeout": 0.02}
+    data = yaml.safe_load(LIFT.read_text())
+    data.update(name=f"lift_{kind}", controller=controller)
+    held = lift_run(write_scene(tmp_path, data))
+    print(kind, held["outcome"], held["message"])
+    assert held["termination"] == "picked_up" and held["world_termination"] == "picked_up"
+    assert held["alarms"] == {}
     data = yaml.safe_load(HEAVY.read_text())
-    data["controller"] = {"type": kind, "name": "gripper_controller", "device": "generic_85mm",
-                          "goal_tolerance": 1e-7, "stall_timeout": 0.02}
-    data["name"] = f"heavy_{kind}"
+    data.update(name=f"heavy_{kind}", controller=controller)
     path = write_scene(tmp_path, data)
     slipped = lift_run(path)
     print(kind, slipped["outcome"], slipped["message"])

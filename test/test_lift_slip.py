@@ -106,6 +106,38 @@ def test_no_weight_no_pickup_test_and_a_bad_margin_or_mu_is_refused():
         jaw_feedback(mu=0.0)
 
 
+@pytest.mark.parametrize("pickup, why", [
+    ({"weight": 0.0}, "pickup.weight must be > 0.0 N, got 0.0"),
+    ({"weight": -1.0}, "pickup.weight must be > 0.0 N, got -1.0"),
+    ({"weight": float("nan")}, "pickup.weight must be a finite number N, got nan"),
+    ({"weight": 3.0, "lift_after": 0.0}, "pickup.lift_after must be > 0.0 s, got 0.0"),
+    ({"weight": 3.0, "planned_weight": -2.0}, "pickup.planned_weight must be > 0.0 N, got -2.0"),
+])
+def test_a_hostile_scene_weight_is_refused_by_run_in_one_line(pickup, why, tmp_path):
+    """``run`` of a lift scene whose pickup section is out of range: exit code 2 and one line
+    naming the field and its range, no traceback.
+    """
+    import subprocess
+
+    from executables import script
+
+    data = yaml.safe_load((SCENES / "sponge_gripper_lift.yaml").read_text())
+    data["pickup"] = pickup
+    done = subprocess.run([script("squeeze-grasp"), "run", write_scene(tmp_path, data)],
+                          capture_output=True, text=True, timeout=120)
+    assert done.returncode == 2 and done.stdout == ""
+    assert done.stderr == f"squeeze-grasp run: error: {why}\n"
+
+
+def test_a_planned_weight_needs_a_controller():
+    from squeeze_grasp_ros.scene import SceneError, parse_scene
+
+    data = yaml.safe_load((SCENES / "sponge_gripper_lift_heavy.yaml").read_text())
+    del data["controller"]
+    with pytest.raises(SceneError, match=r"pickup.planned_weight needs a controller: section"):
+        parse_scene(data)
+
+
 @pytest.mark.parametrize("weight", [-1.0, float("nan")])
 def test_the_monitor_node_refuses_a_hostile_weight_on_real_rclpy(weight, ros_context: Context):
     """Every route: the monitor's weight parameter, before any joint feedback is built."""

@@ -18,7 +18,7 @@ from scipy.spatial.distance import directed_hausdorff
 from squeeze_grasp_ros import plots
 from squeeze_grasp_ros.bench.table import Table, best_time
 from squeeze_grasp_ros.mechanics.elastic.shapes import Outline, resample
-from squeeze_grasp_ros.mechanics.vocabulary import Finger, ImageEncoding
+from squeeze_grasp_ros.mechanics.vocabulary import AlarmType, Finger, ImageEncoding
 from squeeze_grasp_ros.perception.camera import CameraModel, CameraPose
 from squeeze_grasp_ros.perception.extract import ObjectOutline, extract_outline
 from squeeze_grasp_ros.perception.render import render_views
@@ -156,7 +156,7 @@ def camera_loop(progress) -> list[Table]:
         Table("Shape watch: what the camera sees when the model is wrong (foam square, 60 % "
               "depth)",
               ["the model is wrong about", "rms [mm]", "max [mm]", "similarity scale",
-               "shape_mismatch", "F1 force vs model at 60 % [%]",
+               AlarmType.SHAPE_MISMATCH, "F1 force vs model at 60 % [%]",
                "F1 force vs model at 100 % [%]"],
               watch_rows,
               "The world's deformed square at 60 % of the planned depth, seen by the scene's "

@@ -23,11 +23,12 @@ import numpy as np
 from squeeze_grasp_ros.control.tracker import TrackedAlarm
 from squeeze_grasp_ros.mechanics.errors import InvalidInputError
 from squeeze_grasp_ros.mechanics.squeeze.events import EventSqueeze
+from squeeze_grasp_ros.mechanics.vocabulary import AlarmType
 
 __all__ = ["FORCE_MISMATCH", "ForceCheck", "PredictedForces", "check_forces",
            "force_along_motion", "squeeze_forces"]
 
-FORCE_MISMATCH = "force_mismatch"
+FORCE_MISMATCH = AlarmType.FORCE_MISMATCH
 """The alarm type (``Alarm.FORCE_MISMATCH`` over ROS), like the tracker's alarm names."""
 
 

@@ -30,6 +30,9 @@ alarm) is what sees a slip coming. With the planner's prediction, the force watc
 ``force_mismatch`` is the other test: F(c) being increasing, "F below the predicted force at
 this closing" is "the aperture below the predicted aperture at this force".
 
+The **weight watch** (:class:`WeightWatch`) judges a lift: the object hangs between the pads, each
+carrying half its weight w by friction, at most mu F: the grasp holds while 2 mu F >= w.
+
 Contact: a jaw is in contact while F > ``contact_force``; its **first touch** is the aperture
 of the last reading without contact (where F starts from zero); a jaw that had contact and has
 none raises ``contact_lost``, as the tracker does on taxels.
@@ -45,16 +48,19 @@ none raises ``contact_lost``, as the tracker does on taxels.
 """
 from __future__ import annotations
 
+import math
 from collections import deque
 from collections.abc import Sequence
 
 from squeeze_grasp_ros.control.tracker import TrackedAlarm
-from squeeze_grasp_ros.mechanics.vocabulary import Termination
+from squeeze_grasp_ros.mechanics.vocabulary import AlarmType, Termination
 
-__all__ = ["JointSlipWatch"]
+__all__ = ["JointSlipWatch", "WeightWatch", "weight_problem"]
 
-SLIP_IMMINENT = "slip_imminent"
+SLIP_IMMINENT = AlarmType.SLIP_IMMINENT
 """The alarm type the executor reacts to (``Alarm.SLIP_IMMINENT``)."""
+DEFAULT_WEIGHT_MARGIN = 1.25
+"""The weight watch's margin on the weight for ``picked_up`` (the planner's effort margin)."""
 
 
 class JointSlipWatch:
@@ -128,3 +134,90 @@ class JointSlipWatch:
 
     def _alarms(self, kind: str, value: float, message: str) -> tuple[TrackedAlarm, ...]:
         return tuple(TrackedAlarm(kind, jaw, value, f"{jaw}: {message}") for jaw in self.jaws)
+
+
+def weight_problem(weight: float, *, mu: float, margin: float) -> str | None:
+    """Why a weight watch cannot be built from ``weight`` (N), ``mu`` and ``margin``, or None.
+
+    >>> weight_problem(float("nan"), mu=0.6, margin=1.25)
+    'weight must be a finite number > 0 N (0: no pickup test), got nan'
+    """
+    if not (math.isfinite(weight) and weight > 0.0):
+        return f"weight must be a finite number > 0 N (0: no pickup test), got {weight}"
+    if not (math.isfinite(mu) and mu > 0.0):
+        return f"mu must be a finite number > 0 to carry a weight by friction, got {mu}"
+    if not (math.isfinite(margin) and margin >= 1.0):
+        return f"weight_margin must be a finite number >= 1, got {margin}"
+    return None
+
+
+class WeightWatch:
+    """Whether the jaw force carries the object's weight by friction on both pads.
+
+    The object hangs between the two pads (closing line horizontal, gravity along the pad
+    faces); each pad carries half its weight w by friction, at most mu F with F the jaw force.
+    That is the stepper's pickup criterion (:func:`..mechanics.squeeze.stepper.functions.
+    pickup_margin`: each finger supplies w / 2 of vertical friction, sum over its sticking
+    nodes of sqrt(mu^2 f_n^2 - f_t^2)) with the pads' in-plane tangential forces f_t taken as
+    zero: a scalar jaw force cannot show them, and they only lower the supply; ``margin``
+    covers them.
+
+    - ``picked_up`` (an event): the first reading with 2 mu F >= margin w;
+    - ``weight_slip`` (an alarm for both jaws, active while it holds): after ``picked_up``,
+      2 mu F < w: friction no longer carries the weight (the jaw force relaxed or was lowered,
+      the object is heavier than the watch's w, or it slipped out of the jaws: F fell to the
+      contact force). Its value is 2 mu F / w, the fraction of the weight friction carries.
+
+    Once the jaws have lost contact after ``picked_up`` (the object is out of them), the watch
+    starts again: the next grip is a new pickup.
+
+    Parameters
+    ----------
+    jaws : sequence of str
+        The fingers the jaws carry: the alarm is raised for each.
+    mu : float
+        The pads' friction coefficient (> 0).
+    weight : float
+        The object's weight w, N (> 0).
+    margin : float
+        Factor (>= 1) on w that the friction must carry for ``picked_up``.
+    contact_force : float
+        A jaw is in contact above this force, N.
+
+    >>> watch = WeightWatch(("F1", "F2"), mu=0.5, weight=1.0, margin=1.25, contact_force=0.01)
+    >>> watch.update(1.2), watch.update(1.3)[0]  # needs w / (2 mu) = 1 N, with the margin 1.25
+    ((False, ()), True)
+    >>> [a.type for a in watch.update(0.9)[1]]  # below w / (2 mu): the weight slips
+    ['weight_slip', 'weight_slip']
+    >>> watch.update(1.1)  # between w and margin w: held, no new event
+    (False, ())
+    """
+
+    def __init__(self, jaws: Sequence[str], *, mu: float, weight: float,
+                 margin: float = DEFAULT_WEIGHT_MARGIN, contact_force: float = 0.0) -> None:
+        problem = weight_problem(weight, mu=mu, margin=margin)
+        if problem is not None:
+            raise ValueError(problem)
+        self.jaws = tuple(jaws)
+        self.mu, self.weight, self.margin = float(mu), float(weight), float(margin)
+        self.contact_force = float(contact_force)
+        self.need = self.weight / (2.0 * self.mu)
+        """The jaw force that carries the weight, w / (2 mu), N."""
+        self.picked_up = False
+        """``picked_up`` was reported and the jaws have not lost contact since."""
+
+    def update(self, force: float) -> tuple[bool, tuple[TrackedAlarm, ...]]:
+        """(``picked_up`` at this reading, the alarms) of one reading of the jaw force (N)."""
+        carried = 2.0 * self.mu * force / self.weight
+        if not self.picked_up:
+            self.picked_up = carried >= self.margin
+            return self.picked_up, ()
+        if force <= self.contact_force:
+            self.picked_up = False
+        if carried >= 1.0:
+            return False, ()
+        return False, tuple(TrackedAlarm(
+            Termination.WEIGHT_SLIP, jaw, carried,
+            f"{jaw}: jaw force {force:.4g} N below the {self.need:.4g} N that carries the weight "
+            f"{self.weight:g} N by friction (mu {self.mu:g}): 2 mu F / w = {carried:.3g}")
+            for jaw in self.jaws)

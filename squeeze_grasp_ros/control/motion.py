@@ -45,6 +45,17 @@ are ignored; in a re-squeeze a finger's ``contact_lost`` counts only after the m
 it loaded again (a cycle with a non-zero force and no such alarm), since the approach to first
 contact is free by design.
 
+**The lift** (``lift_watch`` > 0). A ``picked_up`` event (friction carries the weight) does not
+end the goal at once: the fingers hold their measured positions while the lab's arm lifts, and
+the goal watches the monitor for ``lift_watch`` s. Without alarm it then ends ``picked_up``.
+A ``weight_slip`` alarm (friction no longer carries the weight) is a slip alarm under weight:
+with "resqueeze" (attempts left) the fingers release as above and squeeze again *deeper*, to
+(1 + ``resqueeze_margin``) times the depth measured at the alarm (a larger jaw force carries
+more weight; a shallower squeeze could not), ignoring ``picked_up`` on the way, and at that
+depth hold and watch the lift again; else the goal ends ``slip_alarm`` (every other reaction
+holds: a redirection cannot add force). A ``contact_lost`` alarm without it ends the goal
+``contact_lost``.
+
 Fingers the goal does not move hold the positions measured at the start. Work is integrated
 from measurements: W_f += (F_prev + F_cur)/2 . (x_cur - x_prev), forces of the finger on the
 object (N), positions in m; a re-squeeze starts it again from zero (the work of the last
@@ -59,7 +70,7 @@ from functools import cached_property
 
 import numpy as np
 
-from squeeze_grasp_ros.mechanics.vocabulary import Finger, SqueezeKind, Termination
+from squeeze_grasp_ros.mechanics.vocabulary import AlarmType, Finger, SqueezeKind, Termination
 
 RESQUEEZE = "resqueeze"
 """The reaction that releases and squeezes again (``ExecuteGrasp.Goal.REACT_RESQUEEZE``)."""
@@ -91,6 +102,9 @@ class MotionLimits:
     stale_budget : float
         Longest uninterrupted hold for stale sensor data, s of (sim) time; past it the goal
         ends ``stale_data`` holding position.
+    lift_watch : float
+        After ``picked_up``, how long the fingers hold watching for ``weight_slip`` before the
+        goal ends ``picked_up``, s (0: it ends at ``picked_up``).
     """
 
     max_velocity: float = 0.01
@@ -98,6 +112,7 @@ class MotionLimits:
     position_tolerance: float = 1e-7
     redirect_grace: int = 20
     stale_budget: float = 0.1
+    lift_watch: float = 0.0
 
 
 @dataclass(frozen=True)
@@ -360,6 +375,11 @@ class GraspProgram:
         """Fingers whose ``contact_lost`` alarm counts (see the module)."""
         self.freed: set[str] = set()
         self.release_wait = 0.0
+        self.lift_time = 0.0
+        """Time held since the lift began, s."""
+        self.under_weight = False
+        """The current squeeze follows a weight slip: it ignores ``picked_up`` and lifts at its
+        depth."""
 
     def depth(self, obs: Observation) -> float:
         """The current squeeze's measured depth (m): the monitor's depth past this squeeze's
@@ -394,12 +414,14 @@ class GraspProgram:
             self.first_contact = self.path.start.copy()
         if self.phase == "release":
             return self._release_step(obs, dt)
+        if self.phase == "lift":
+            return self._lift_step(obs, dt)
         if self.attempts > 1:
             self._approach(obs)
         terminal = self._terminal(obs)
         if terminal is not None:
             return terminal
-        alarmed = {finger for kind, finger in obs.alarms if kind == "slip_imminent"}
+        alarmed = {finger for kind, finger in obs.alarms if kind == AlarmType.SLIP_IMMINENT}
         if self.grace > 0:
             self.grace -= 1
         elif self.phase == "resist" and self.goal.adversary in alarmed:
@@ -417,7 +439,7 @@ class GraspProgram:
                     measured=True,
                 )
             self._redirect(obs)
-        stale = {finger for kind, finger in obs.alarms if kind == "stale_sensor"}
+        stale = {finger for kind, finger in obs.alarms if kind == AlarmType.STALE_SENSOR}
         if stale & set(self.moving):
             self.v = 0.0
             self.hold_ticks += 1
@@ -449,7 +471,10 @@ class GraspProgram:
     def _terminal(self, obs: Observation) -> Command | None:
         if self.cancel_requested:
             return self._finish(obs, "canceled", "goal canceled", measured=True)
-        if Termination.PICKED_UP in obs.events and self.phase == "squeeze":
+        if Termination.PICKED_UP in obs.events and self.phase == "squeeze" \
+                and not self.under_weight:
+            if self.limits.lift_watch > 0.0:
+                return self.lift(obs)
             return self._finish(
                 obs, Termination.PICKED_UP, "friction can lift the object", measured=True
             )
@@ -492,19 +517,59 @@ class GraspProgram:
         self.redirected = True
         self.grace = self.limits.redirect_grace
 
-    def _release(self, obs: Observation, dt: float) -> Command:
-        """A slip alarm to re-squeeze: note the depth, open toward the release positions."""
+    def _release(self, obs: Observation, dt: float, *, deeper: bool = False) -> Command:
+        """A slip alarm to re-squeeze: note the depth, open toward the release positions (a
+        weight slip, ``deeper``: to squeeze again deeper).
+        """
         goal = self.goal
-        self.planned_depth = (1.0 - goal.resqueeze_margin) * self.depth(obs)
+        sign = 1.0 if deeper else -1.0
+        self.planned_depth = (1.0 + sign * goal.resqueeze_margin) * self.depth(obs)
+        self.under_weight = deeper
         self.commanded = {f: np.asarray(obs.positions[f], float) for f in self.fingers}
         start = np.array([self.commanded[f] for f in goal.fingers])
         self.path = straight_path(start, self.release_positions() - start, 1.0)
         self.s, self.v = 0.0, 0.0
-        self.phase, self.armed, self.freed, self.release_wait = "release", set(), set(), 0.0
+        self.phase, self.armed, self.release_wait = "release", set(), 0.0
+        self.freed = {finger for kind, finger in obs.alarms
+                      if kind == Termination.CONTACT_LOST} & set(goal.fingers)
         self._advance(dt)
+        what = "slip under the weight" if deeper else "imminent slip"
         return Command(self._setpoints(), "releasing", None,
-                       f"imminent slip at depth {self.depth(obs) * 1e3:.4g} mm: "
+                       f"{what} at depth {self.depth(obs) * 1e3:.4g} mm: "
                        f"releasing to squeeze again to {self.planned_depth * 1e3:.4g} mm")
+
+    def lift(self, obs: Observation) -> Command:
+        """Picked up (or a squeeze under weight at its depth): hold the measured positions
+        while the arm lifts (see the module).
+        """
+        self.commanded = {f: np.asarray(obs.positions[f], float) for f in self.fingers}
+        self.phase, self.lift_time, self.v = "lift", 0.0, 0.0
+        return Command(self._setpoints(), "holding", None,
+                       f"picked up at depth {self.depth(obs) * 1e3:.4g} mm: holding while "
+                       f"lifted, watching for a weight slip for {self.limits.lift_watch:g} s")
+
+    def _lift_step(self, obs: Observation, dt: float) -> Command:
+        """A cycle of the lift: a weight slip, a lost contact, or held long enough."""
+        goal = self.goal
+        if self.cancel_requested:
+            return self._finish(obs, "canceled", "goal canceled", measured=True)
+        alarms = set(obs.alarms)
+        slipped = sorted(f for f in goal.fingers if (Termination.WEIGHT_SLIP, f) in alarms)
+        if slipped:
+            if goal.on_slip_alarm == RESQUEEZE and self.attempts < goal.max_attempts:
+                return self._release(obs, dt, deeper=True)
+            return self._finish(obs, "slip_alarm", "slip under the weight of "
+                                + ", ".join(slipped), measured=True)
+        lost = sorted(f for f in goal.fingers if (Termination.CONTACT_LOST, f) in alarms)
+        if lost:
+            return self._finish(obs, Termination.CONTACT_LOST, "no contact on "
+                                + ", ".join(lost), measured=True)
+        self.lift_time += dt
+        if self.lift_time >= self.limits.lift_watch - 1e-12:
+            return self._finish(obs, Termination.PICKED_UP,
+                                f"friction carries the object's weight (held "
+                                f"{self.lift_time:.4g} s after the pickup)")
+        return Command(self._setpoints(), "holding")
 
     def release_positions(self) -> np.ndarray:
         """(f, 2) first-contact positions moved back by ``release_clearance`` (see the module),
@@ -566,6 +631,8 @@ class GraspProgram:
     def _phase_done(self, obs: Observation) -> Command | None:
         if self.phase == "resist":
             return self._finish(obs, "resisted", "the adversary completed its translation")
+        if self.under_weight:
+            return self.lift(obs)
         if not self.goal.resist:
             return self._finish(obs, Termination.DEPTH_REACHED, "squeeze depth reached")
         goal = self.goal

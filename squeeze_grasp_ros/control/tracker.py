@@ -71,7 +71,13 @@ from typing import NamedTuple
 import numpy as np
 
 from squeeze_grasp_ros.mechanics.squeeze.event_key import PROCESSING_ORDER, processing_rank
-from squeeze_grasp_ros.mechanics.vocabulary import ContactMode, EventType, Finger, Termination
+from squeeze_grasp_ros.mechanics.vocabulary import (
+    AlarmType,
+    ContactMode,
+    EventType,
+    Finger,
+    Termination,
+)
 
 STICK_SLIP = (EventType.C, EventType.D)
 """The events of a contact's mode (stick -> slip, slip -> stick)."""
@@ -558,14 +564,14 @@ class ContactTracker:
         out = []
         age = self._age(track, stamp_ns)
         if age > cfg.stale_after:
-            out.append(TrackedAlarm("stale_sensor", name, age,
+            out.append(TrackedAlarm(AlarmType.STALE_SENSOR, name, age,
                                     f"newest {name} reading is {age * 1e3:.3g} ms old"))
         if track.had_contact and not track.patches:
             out.append(TrackedAlarm(Termination.CONTACT_LOST, name, 0.0, f"{name} has no loaded "
                                                                          "taxel"))
         usage = self._cone_usage(taxels)
         if usage is not None:
-            out.append(TrackedAlarm("slip_imminent", name, usage,
+            out.append(TrackedAlarm(AlarmType.SLIP_IMMINENT, name, usage,
                                     f"every loaded taxel of {name} uses >= {usage:.3f} of its "
                                     "friction cone in one direction"))
         return out
@@ -607,7 +613,7 @@ class ContactTracker:
                         and self.prediction[k].finger == e.finger
                         and abs(self.prediction[k].depth - e.depth) <= tol), None)
             if hit is None and not (e.mirrored and e.finger in self.stick_slip_fingers):
-                out.append(TrackedAlarm("prediction_mismatch", e.finger, e.depth,
+                out.append(TrackedAlarm(AlarmType.PREDICTION_MISMATCH, e.finger, e.depth,
                                         f"event {e.type} on {e.finger} at depth {e.depth:.6g} m "
                                         "was not predicted"))
             elif hit is not None:
@@ -618,7 +624,7 @@ class ContactTracker:
             track = self.tracks.get(p.finger)
             if p.type in STICK_SLIP and track and self._mirrored(track, track.patches):
                 continue
-            out.append(TrackedAlarm("prediction_mismatch", p.finger, p.depth,
+            out.append(TrackedAlarm(AlarmType.PREDICTION_MISMATCH, p.finger, p.depth,
                                     f"predicted event {p.type} on {p.finger} at depth "
                                     f"{p.depth:.6g} m was not observed"))
         return out

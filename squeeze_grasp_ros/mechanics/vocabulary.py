@@ -30,9 +30,9 @@ from __future__ import annotations
 
 from enum import Enum
 
-__all__ = ["ContactKind", "ContactMode", "ControllerKind", "DistortionModel", "Effect",
-           "EventType", "Factorizer", "Finger", "ImageEncoding", "MaterialModel", "ObjectModel",
-           "RingLimit", "SQUEEZING_FINGERS", "ShapeFit", "ShapeType", "SqueezeKind",
+__all__ = ["AlarmType", "ContactKind", "ContactMode", "ControllerKind", "DistortionModel",
+           "Effect", "EventType", "Factorizer", "Finger", "ImageEncoding", "MaterialModel",
+           "ObjectModel", "RingLimit", "SQUEEZING_FINGERS", "ShapeFit", "ShapeType", "SqueezeKind",
            "StrainCriterion",
            "StrainMeasure", "StressMeasure", "Termination", "TipKind"]
 
@@ -119,6 +119,22 @@ class Termination(_Name):
     ELEMENT_INVERTED = "element_inverted"
     """An element of the object turned inside out (det F <= 0): the material model has left
     its range, so the squeeze cannot go deeper. Always checked, whatever the scene declares."""
+    WEIGHT_SLIP = "weight_slip"
+    """Lifted, the object slips out of the grip: friction cannot carry its weight (the pickup
+    criterion fails at the lift; the world of a gripper scene, docs/grippers.md)."""
+
+
+class AlarmType(_Name):
+    """The monitor's alarms (``squeeze_grasp_interfaces/msg/Alarm`` constants); the
+    ``contact_lost`` and ``weight_slip`` alarms are :attr:`Termination.CONTACT_LOST` and
+    :attr:`Termination.WEIGHT_SLIP`, the grasp's ends they signal.
+    """
+
+    SLIP_IMMINENT = "slip_imminent"
+    STALE_SENSOR = "stale_sensor"
+    PREDICTION_MISMATCH = "prediction_mismatch"
+    SHAPE_MISMATCH = "shape_mismatch"
+    FORCE_MISMATCH = "force_mismatch"
 
 
 class SqueezeKind(_Name):

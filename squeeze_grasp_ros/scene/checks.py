@@ -216,6 +216,10 @@ def _validate_effects(scene: Scene) -> None:
             )
         if scene.has(effect) and not present:
             raise SceneError(f"effect {effect!r} is declared but section {section} is missing")
+    if scene.pickup is not None and scene.pickup.planned_weight is not None \
+            and scene.controller is None:
+        raise SceneError("pickup.planned_weight needs a controller: section (only the lift after "
+                         "a gripper's squeeze can meet a weight other than the planned one)")
 
 
 def check_material(material: MaterialSpec, where: str = "object.material") -> None:

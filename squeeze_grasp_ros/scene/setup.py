@@ -83,12 +83,14 @@ stop the computation."""
 
 
 def scene_limits(scene: Scene) -> TerminationLimits:
-    """Strain limit (effect ``strain_limit``) and pickup weight (effect ``pickup``) of a scene."""
+    """Strain limit (effect ``strain_limit``) and pickup weight (effect ``pickup``: the weight
+    the plan takes, ``pickup.planned_weight`` when given) of a scene.
+    """
     strain = scene.strain_limit if scene.has(Effect.STRAIN_LIMIT) else None
     return TerminationLimits(
         strain.epsilon if strain else None,
         strain.criterion if strain else StrainCriterion.PRINCIPAL,
-        scene.pickup.weight if scene.has(Effect.PICKUP) else None,
+        scene.pickup.believed_weight if scene.has(Effect.PICKUP) else None,
     )
 
 

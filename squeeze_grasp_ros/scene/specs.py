@@ -263,6 +263,17 @@ class PickupSpec:
     """Lift the object against gravity."""
 
     weight: float = spec("object weight", "N", lo=0.0, lo_open=True)
+    planned_weight: Optional[float] = spec(
+        "the weight the plan and the monitor take (default: weight; below it: an object "
+        "heavier than planned)", "N", lo=0.0, lo_open=True, default=None)
+    lift_after: float = spec(
+        "a scene with a controller: the simulated arm lifts once the jaws have stood still in "
+        "contact this long", "s", lo=0.0, lo_open=True, default=0.005)
+
+    @property
+    def believed_weight(self) -> float:
+        """The weight the plan and the monitor take, N."""
+        return self.weight if self.planned_weight is None else self.planned_weight
 
 
 @dataclass(frozen=True)

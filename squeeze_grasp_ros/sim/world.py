@@ -26,6 +26,21 @@ When the stepper reports a termination (a finger slips, the strain limit, pickup
 contact) the object's motion can no longer be simulated: the world *ends*, the contact state
 freezes (the sensors keep reading it) and the devices still follow their setpoints.
 
+**The lift of a gripper scene** (effect ``pickup`` and a ``controller:`` section). A lab lifts
+the object once its gripper has closed, so the squeeze is not ended by the stepper's pickup
+criterion; instead, once every squeezing tip has squeezed (a positive depth) and stood still
+in contact for ``pickup.lift_after`` s, the simulated arm lifts, and the world judges the lift
+with the stepper's own criterion (:func:`~..mechanics.squeeze.stepper.functions.pickup_margin`:
+each finger's sticking nodes supply sum sqrt(mu^2 f_n^2 - f_t^2) of vertical friction, against
+its share of ``pickup.weight``, the true weight) on the contact state at that tick:
+
+- it holds: the world ends ``picked_up`` (the object hangs in the jaws, the state frozen);
+- it does not: the object slips out of the grip under its weight and stays behind on the
+  plane: the world ends ``weight_slip`` with no contact (the tips hold no force), and
+  releases the object as after any end once the tips are clear of it (below), so a re-squeeze
+  starts from rest. The slip itself (the pads sliding along the object's height) is not
+  followed: the jaws lose the object at the lift's tick.
+
 **Release and a fresh squeeze.** An ended world whose fingertips have all left the object
 (every tip of the frozen state clear of the object's outline *at rest*: a positive gap to every
 outer boundary node, :meth:`~..mechanics.squeeze.tip_shapes.TipGeometry.gaps`) *releases* it at
@@ -66,8 +81,9 @@ from squeeze_grasp_ros.mechanics.squeeze.contact_state import (
     initial_state,
 )
 from squeeze_grasp_ros.mechanics.squeeze.stepper import QuietSteps
+from squeeze_grasp_ros.mechanics.squeeze.stepper.functions import pickup_margin
 from squeeze_grasp_ros.mechanics.squeeze.tip_shapes import TipGeometry
-from squeeze_grasp_ros.mechanics.vocabulary import Effect, Finger, Termination
+from squeeze_grasp_ros.mechanics.vocabulary import ContactMode, Effect, Finger, Termination
 from squeeze_grasp_ros.perception.shape_match import deformed_outline
 from squeeze_grasp_ros.scene import GraspSetup, SensorsSpec, finger_devices
 from squeeze_grasp_ros.sim.camera import CameraFrame, SimCamera
@@ -241,7 +257,18 @@ class SimWorld:
         self.step_cpu_seconds = 0.0
         self.step_size = scene.squeeze.step
         self.event_tol = scene.squeeze.event_tol
-        self.stepper = QuietSteps(self.model, self.step_size, self.event_tol, TERMINATE_ON,
+        self.lift_weight = (scene.pickup.weight if scene.has(Effect.PICKUP)
+                            and scene.controller is not None else None)
+        """The true weight a gripper scene's lift meets, N (None: no lift; see the module)."""
+        self.lift_ticks = (max(1, int(round(scene.pickup.lift_after / scene.sim.dt)))
+                           if self.lift_weight is not None else 0)
+        self.still_ticks = 0
+        """Ticks the squeezing tips have stood still in contact (the lift's count)."""
+        self.lift_margin: float | None = None
+        """The pickup margin at the lift, N (<= 0: held); None before a lift."""
+        terminate_on = tuple(t for t in TERMINATE_ON if self.lift_weight is None
+                             or t != Termination.PICKED_UP)
+        self.stepper = QuietSteps(self.model, self.step_size, self.event_tol, terminate_on,
                                   quiet=quiet)
         self.camera = (SimCamera(scene.camera, scene.object.material.thickness, self.dt)
                        if scene.has(Effect.CAMERA) else None)
@@ -314,7 +341,36 @@ class SimWorld:
             self.stepper_cpu_seconds += time.thread_time() - cpu
             self.state, events = result.state, result.events
             self.termination = result.termination
+        if self.lift_weight is not None and self.termination is None:
+            self._watch_lift(moves)
         return self._output(events)
+
+    def _watch_lift(self, moves: Mapping[str, np.ndarray]) -> None:
+        """Count the ticks the squeezing tips stood still in contact, once they have squeezed
+        (a positive depth: not at the placements before the goal); lift after enough.
+        """
+        names = [t.name for t in self.placements]
+        touching = {c.finger for c in self.state.contacts}
+        still = all(not np.any(moves.get(n, 0.0)) for n in names)
+        squeezed = touching >= set(names) and self.state.depth > 0.0
+        self.still_ticks = self.still_ticks + 1 if still and squeezed else 0
+        if self.still_ticks < self.lift_ticks:
+            return
+        self._work["lifts"] += 1
+        contacts = self.state.contacts
+        order = {n: k for k, n in enumerate(names)}
+        self.lift_margin = pickup_margin(
+            self.model.mu, np.array([c.normal_force() for c in contacts]),
+            np.array([c.tangential_force() for c in contacts]),
+            np.array([c.mode == ContactMode.STICK for c in contacts]),
+            np.array([order[c.finger] for c in contacts]), list(range(len(names))),
+            self.lift_weight)
+        self.still_ticks = 0
+        if self.lift_margin <= 0.0:
+            self.termination = Termination.PICKED_UP
+            return
+        self.termination = Termination.WEIGHT_SLIP
+        self.state = self._free_state(self.state.depth)
 
     def _adversary_touching(self) -> bool:
         return any(f.name == Finger.A for f in self.state.fingers)
@@ -338,10 +394,14 @@ class SimWorld:
         if not self.released:
             self._work["releases"] += 1
         self.released, self.termination = True, None
-        self.state = ContactState(
+        self.state = self._free_state()
+
+    def _free_state(self, depth: float = 0.0) -> ContactState:
+        """No contacts, the tips where the devices hold them (``depth``: the state's, m)."""
+        return ContactState(
             tuple(FingerState(t.name, self.positions[t.name].copy(), t.radius, np.zeros(2),
                               flat=t.flat, facing=t.facing) for t in self.placements),
-            (), 0.0, self.relative_per_depth)
+            (), depth, self.relative_per_depth)
 
     def _touch_adversary(self, target: np.ndarray) -> np.ndarray:
         """Place A on the deformed boundary; return its setpoint shifted by the same offset."""

@@ -36,6 +36,7 @@ previous feedback. Cancel: the next cycle holds the measured positions and the g
 """
 from __future__ import annotations
 
+import math
 import sys
 from typing import Any
 
@@ -72,6 +73,8 @@ PARAMETERS: dict[str, tuple[Any, str]] = {
     "redirect_grace": (20, "cycles the slip alarm is ignored after a redirection"),
     "stale_budget": (0.1, "longest hold for stale sensor data, s; past it the goal ends "
                           "stale_data"),
+    "lift_watch": (0.0, "after picked_up, hold this long watching for weight_slip before the "
+                        "goal ends picked_up, s (0: end at picked_up)"),
     "period": (0.001, "control cycle, s (lockstep: the simulated tick)"),
     "feedback_every": (10, "cycles between action feedback messages"),
     "lockstep": (True, "cycle on each monitor status (simulation) or on a wall-clock timer"),
@@ -102,6 +105,9 @@ class _Goal:
         self.waiting_since_ns: int | None = None
         self.releasing = False
         """The action route's gripper goal is a release's (its result is not the goal's)."""
+        self.lifting = False
+        """The action route's jaws hold while the arm lifts (the gripper goal was canceled, or
+        reached a squeeze's depth under weight): its result is not the goal's."""
 
 
 class ExecutorNode(Node):
@@ -123,7 +129,10 @@ class ExecutorNode(Node):
         self.devices = pipeline.parse_mapping(p["finger_devices"], "finger_devices")
         self.limits = MotionLimits(p["max_velocity"], p["max_acceleration"],
                                    p["position_tolerance"], p["redirect_grace"],
-                                   float(p["stale_budget"]))
+                                   float(p["stale_budget"]), float(p["lift_watch"]))
+        if not (math.isfinite(self.limits.lift_watch) and self.limits.lift_watch >= 0.0):
+            raise ParameterError(f"lift_watch must be a finite number >= 0 s, got "
+                                 f"{self.limits.lift_watch}")
         self.period_ns = int(round(p["period"] * 1e9))
         loop = pipeline.loop_qos(p["qos_depth"])
         controller = scene_controller(load_scene(p["controller_scene"]), p["controller_scene"]) \
@@ -304,8 +313,11 @@ class ExecutorNode(Node):
             position, effort = action.target(program.goal, obs)
             action.send(position, effort, answer)
             waiting = True
+        elif program.phase == "lift" and not goal.lifting:
+            goal.lifting = True  # picked up: the controller holds while the arm lifts
+            waiting = action.cancel(answer)
         elif command.state == ExecutorStatus.RELEASING and not goal.releasing:
-            goal.releasing = True
+            goal.releasing, goal.lifting = True, False
             opening = action.opening(dict(zip(program.goal.fingers,
                                               program.release_positions())))
 
@@ -320,10 +332,15 @@ class ExecutorNode(Node):
             position, effort = action.squeeze(
                 program.goal, dict(zip(program.goal.fingers, program.first_contact)),
                 program.planned_depth)
+            if program.under_weight:
+                effort = 0.0  # deeper than the plan's force curve: the controller's own limit
             action.send(position, effort, answer)
             waiting = True
         else:
-            end, waiting = (None if goal.releasing else action.outcome), False
+            end, waiting = (None if goal.releasing or goal.lifting else action.outcome), False
+            if end is not None and program.under_weight and end[1]:
+                # a squeeze deeper under weight reached its depth: hold and watch the lift
+                command, end, goal.lifting = program.lift(obs), None, True
         if not waiting:
             answer()
         termination = None if end is None else end[0]

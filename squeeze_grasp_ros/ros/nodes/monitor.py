@@ -30,8 +30,10 @@ aperture and jaw force come through the transmission (:mod:`..control.joint_feed
 jaws' positions on the jaw line (fixed by the gripper's pose: the ``gripper_pose`` parameter, else
 the ``gripper_pose`` topic, else the jaws' first pose readings) give
 the depth, the force ``wrench`` stands in for, first touch, ``contact_lost`` and the slip watch's
-``slip_imminent`` (the jaws close while the force stops rising); events A-D need taxels, so
-none are tracked and the prediction's events are not compared (the force watch is).
+``slip_imminent`` (the jaws close while the force stops rising), and with a ``weight`` the
+lift's verdict (:class:`..control.joint_feedback.WeightWatch`: the ``picked_up`` event once
+2 mu F >= ``weight_margin`` w, then ``weight_slip`` while 2 mu F < w); events A-D need taxels,
+so none are tracked and the prediction's events are not compared (the force watch is).
 
 The Barrett hand under a JointTrajectoryController (``controller: {device: bh8, ...}``): the
 carried fingers' positions come from ``joint_states`` through the hand's forward kinematics
@@ -61,9 +63,20 @@ from squeeze_grasp_interfaces.msg import (
     Tick,
 )
 from squeeze_grasp_ros.control.barrett import MAX_CONDITION, SingularPosture
-from squeeze_grasp_ros.control.joint_feedback import JointSlipWatch
+from squeeze_grasp_ros.control.joint_feedback import (
+    DEFAULT_WEIGHT_MARGIN,
+    JointSlipWatch,
+    WeightWatch,
+    weight_problem,
+)
 from squeeze_grasp_ros.control.joint_trajectory import JawLine
-from squeeze_grasp_ros.control.tracker import ContactTracker, FingerSample, TrackerConfig
+from squeeze_grasp_ros.control.tracker import (
+    ContactTracker,
+    FingerSample,
+    TrackedEvent,
+    TrackerConfig,
+)
+from squeeze_grasp_ros.mechanics.vocabulary import Termination
 from squeeze_grasp_ros.ros import messages
 from squeeze_grasp_ros.ros.nodes import ParameterError, pipeline, run_node
 from squeeze_grasp_ros.ros.nodes.force_watcher import ForceWatcher
@@ -88,6 +101,8 @@ PARAMETERS: dict[str, tuple[Any, str]] = {
     "match_margin": (0, "taxels by which patch ranges are widened to connect them over ticks"),
     "stale_after": (0.0025, "age of a finger's newest reading that makes it stale, s"),
     "weight": (0.0, "object weight for the pickup test, N (0: no pickup test)"),
+    "weight_margin": (DEFAULT_WEIGHT_MARGIN, "joint feedback: picked_up once 2 mu F >= "
+                                             "weight_margin * weight (>= 1)"),
     "prediction_tolerance": (5e-4, "depth tolerance of the prediction comparison, m"),
     "relative_per_depth": (0.0, "relative depth per unit depth, 1/m (reports)"),
     "mirror_tolerance": (0.05, "patches mirrored about the finger's force line within this "
@@ -152,6 +167,9 @@ class MonitorNode(Node):
         super().__init__("monitor", **kwargs)
         self.p = p = pipeline.declare(self, PARAMETERS)
         self.fingers = pipeline.parse_mapping(p["finger_devices"], "finger_devices")
+        if not (np.isfinite(p["weight"]) and p["weight"] >= 0.0):
+            raise ParameterError(f"weight must be a finite number >= 0 N (0: no pickup test), "
+                                 f"got {p['weight']}")
         streams = [s for s in p["streams"] if s]
         self.jaws = JointFeedback.of(p, streams)
         """The jaws on joint feedback (None: the sensors' route)."""
@@ -280,6 +298,9 @@ class MonitorNode(Node):
         watched = self.jaws or self.hand
         if watched is not None and watched.alarms:
             out = dataclasses.replace(out, alarms=out.alarms + watched.alarms)
+        if self.jaws is not None and self.jaws.take_picked_up():
+            out = dataclasses.replace(out, events=out.events + (TrackedEvent(
+                Termination.PICKED_UP, "", out.depth, out.relative_depth, 0.0),))
         frame = self.p["frame_id"]
         batch = [(self.event_pub, messages.tracked_events_msg(out))] if out.events else []
         if self.forces is not None:
@@ -411,11 +432,18 @@ class JointFeedback:
     ----------
     controller : JawController
     watch : JointSlipWatch
+    weight : WeightWatch, optional
+        The lift's watch (with the monitor's ``weight``): ``picked_up`` and ``weight_slip``.
+    pose : (centre (2,) m, yaw rad), optional
+        The gripper's pose fixing the jaw line.
     """
 
     def __init__(self, controller: JawController, watch: JointSlipWatch, *,
+                 weight: WeightWatch | None = None,
                  pose: tuple[np.ndarray, float] | None = None) -> None:
-        self.controller, self.watch = controller, watch
+        self.controller, self.watch, self.weight = controller, watch, weight
+        self.picked_up = False
+        """The weight watch reported ``picked_up`` at the newest joint state, not yet taken."""
         self.posed: JawLine | None = None
         """The jaw line of the gripper's pose (parameter or topic; None: the jaws' poses)."""
         if pose is not None:
@@ -441,9 +469,22 @@ class JointFeedback:
                 raise ParameterError(f"gripper_pose must be [x m, y m, yaw deg], three finite "
                                      f"numbers, got {list(pose)}")
             pose = (np.array(pose[:2], float), float(np.deg2rad(pose[2])))
+        weight = None
+        if p.get("weight"):
+            margin = p.get("weight_margin", DEFAULT_WEIGHT_MARGIN)
+            problem = weight_problem(p["weight"], mu=p["mu"], margin=margin)
+            if problem is not None:
+                raise ParameterError(problem)
+            weight = WeightWatch(controller.jaws, mu=p["mu"], weight=p["weight"], margin=margin,
+                                 contact_force=p["load_threshold"])
         return cls(controller, JointSlipWatch(
             controller.jaws, contact_force=p["load_threshold"], window=p["joint_slip_window"],
-            ratio=p["joint_slip_ratio"]), pose=pose)
+            ratio=p["joint_slip_ratio"]), weight=weight, pose=pose)
+
+    def take_picked_up(self) -> bool:
+        """Whether the weight watch reported ``picked_up`` since the last call."""
+        picked, self.picked_up = self.picked_up, False
+        return picked
 
     def set_pose(self, msg: PoseStamped, frame_id: str, logger: Any) -> None:
         """Take the gripper's pose from a ``gripper_pose`` message (it replaces the parameter);
@@ -503,6 +544,14 @@ class JointFeedback:
             self.stamp_ns = ns
             touched = self.watch.first_touch
             self.alarms = self.watch.update(reading.aperture, reading.force)
+            if self.weight is not None:
+                picked, alarms = self.weight.update(reading.force)
+                self.alarms += alarms
+                self.picked_up = self.picked_up or picked
+                if picked:
+                    logger.info(f"picked up: jaw force {reading.force:.4g} N carries "
+                                f"{self.weight.margin:g} x the weight {self.weight.weight:g} N "
+                                f"(needs {self.weight.need:.4g} N at mu {self.weight.mu:g})")
             if touched is None and self.watch.first_touch is not None:
                 logger.info(f"first touch of the jaws at aperture "
                             f"{self.watch.first_touch * 1e3:.4f} mm (jaw force "

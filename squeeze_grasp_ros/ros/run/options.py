@@ -118,7 +118,7 @@ def node_parameters(
         finger_devices=mapping,
         streams=streams or [""],
         mu=float(scene.mu),
-        weight=float(scene.pickup.weight) if scene.has(Effect.PICKUP) else 0.0,
+        weight=float(scene.pickup.believed_weight) if scene.has(Effect.PICKUP) else 0.0,
         relative_per_depth=float(relative_per_depth),
         load_threshold=max(float(monitor.get("load_threshold", 0.005)), 6.0 * noise),
     )
@@ -129,7 +129,8 @@ def node_parameters(
     controller_scene = str(Path(scene_path).resolve()) if scene.controller else ""
     monitor["controller_scene"] = controller_scene
     params["executor"].update(
-        finger_devices=mapping, period=float(scene.sim.dt), controller_scene=controller_scene)
+        finger_devices=mapping, period=float(scene.sim.dt), controller_scene=controller_scene,
+        lift_watch=lift_watch(scene))
     custom = {"scene": Path(scene_path).read_text(), "scene_path": str(scene_path)}
     params["recorder"].update(
         output=str(options.record or ""),
@@ -146,6 +147,21 @@ def node_parameters(
     custom["monitor_parameters"] = yaml.safe_dump(params["monitor"], sort_keys=True)
     params["recorder"]["custom_data"] = yaml.safe_dump(custom)
     return params
+
+
+LIFT_WATCH = 0.02
+"""s the executor watches a lift past the world's ``pickup.lift_after`` (run's lift_watch)."""
+
+
+def lift_watch(scene: Scene) -> float:
+    """The executor's ``lift_watch`` for ``scene``: a scene with a ``controller:`` and the
+    pickup effect is lifted by the world ``pickup.lift_after`` s after its jaws stand still
+    (:mod:`..sim.world`), so the executor watches that long and ``LIFT_WATCH`` more; other
+    scenes end at ``picked_up`` (0).
+    """
+    if scene.controller is None or not scene.has(Effect.PICKUP):
+        return 0.0
+    return float(scene.pickup.lift_after) + LIFT_WATCH
 
 
 def controller_lockstep_topics(spec: ControllerSpec) -> list[str]:

@@ -13,7 +13,9 @@ sends the executor its goal, prints the summary and ends the launch with the run
 /executor/execute_grasp squeeze_grasp_interfaces/action/ExecuteGrasp '{...}'``, see
 docs/pipeline.md). Arguments: ``scene`` (default: the shipped foam square), ``record`` (bag
 folder; empty: no recorder), ``include_hidden_topics`` (record the action's hidden topics too),
-``rviz`` (start RViz2 with the shipped configuration), ``run``, ``namespace`` (empty: the
+``rviz`` (start RViz2 with the shipped configuration), ``run``, ``on_slip_alarm``,
+``max_attempts`` and ``resqueeze_margin`` (the executor's reaction to a slip alarm, as ``run``'s
+options of the same names, checked by it; empty: its defaults), ``namespace`` (empty: the
 nodes' own names at the root, which the RViz2 configuration expects, one such launch per ROS
 domain; ``namespace:=/lab/a``: every node, topic, service and ``/clock`` under ``/lab/a``, so
 launches in different namespaces share a domain without seeing each other).
@@ -78,9 +80,13 @@ def nodes(context, *args, **kwargs):
         actions.append(Node(package="squeeze_grasp_ros", executable=name, name=name,
                             parameters=[values], output="screen", **placed))
     if LaunchConfiguration("run").perform(context).lower() in TRUE:
+        given = {name: LaunchConfiguration(name).perform(context)
+                 for name in ("on_slip_alarm", "max_attempts", "resqueeze_margin")}
+        reaction = [f"--{name.replace('_', '-')}={value}"
+                    for name, value in given.items() if value]
         client = ExecuteProcess(
             cmd=[ExecutableInPackage("squeeze-grasp", "squeeze_grasp_ros"), "run", scene_path,
-                 "--attach", *(["--namespace", namespace] if namespace else [])],
+                 "--attach", *reaction, *(["--namespace", namespace] if namespace else [])],
             output="screen", name="run")
         actions += [client, RegisterEventHandler(OnProcessExit(
             target_action=client,
@@ -90,7 +96,7 @@ def nodes(context, *args, **kwargs):
 
 
 def generate_launch_description() -> LaunchDescription:
-    """Arguments: scene, record, include_hidden_topics, rviz, run, namespace."""
+    """Arguments: scene, record, include_hidden_topics, rviz, run, the slip reaction, namespace."""
     return LaunchDescription([
         DeclareLaunchArgument("scene", default_value="",
                               description="scene YAML file (empty: the shipped foam square)"),
@@ -102,6 +108,17 @@ def generate_launch_description() -> LaunchDescription:
                               description="run the scene (plan, send the goal, print the "
                                           "summary, then shut down); false: only start the "
                                           "nodes"),
+        DeclareLaunchArgument("on_slip_alarm", default_value="",
+                              description="the executor's reaction to a slip alarm: hold, "
+                                          "pure, normals or resqueeze (run's --on-slip-alarm; "
+                                          "empty: its default, hold)"),
+        DeclareLaunchArgument("max_attempts", default_value="",
+                              description="with on_slip_alarm:=resqueeze: squeezes in all, the "
+                                          "first included (empty: run's default, 2)"),
+        DeclareLaunchArgument("resqueeze_margin", default_value="",
+                              description="with on_slip_alarm:=resqueeze: a re-squeeze goes to "
+                                          "(1 - margin) x the alarm's depth, margin in (0, 1) "
+                                          "(empty: run's default, 0.25)"),
         DeclareLaunchArgument("rviz", default_value="false",
                               description="start RViz2 with share/squeeze_grasp_ros/config/"
                                           "viewers/squeeze_grasp.rviz"),

@@ -225,6 +225,9 @@ def launched_run(arguments: dict[str, str], folder: Path) -> str:
     argv = [script("squeeze-grasp"), "run", scene]
     if arguments.get("record"):
         argv += ["--record", arguments["record"]]
+    reaction = ("on_slip_alarm", "max_attempts", "resqueeze_margin")
+    argv += [f"--{name.replace('_', '-')}={arguments[name]}"
+             for name in reaction if arguments.get(name)]
     return _process(argv, folder)
 
 

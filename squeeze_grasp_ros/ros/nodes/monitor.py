@@ -21,7 +21,8 @@ events. With ``shape_watch`` the camera's frames are matched against the predict
 boundary (:mod:`.shape_watcher`): ``monitor/shape_residual`` and the ``shape_mismatch`` alarm.
 With ``force_watch`` (on by default) the measured finger forces are compared with the
 prediction's force curve (:mod:`.force_watcher`): ``monitor/force_residual`` and the
-``force_mismatch`` alarm (a wrong E: the shape cannot show it, the forces do).
+``force_mismatch`` alarm (a wrong E: the shape at a depth cannot show it, the forces do, and
+so does the shape at the measured force, the shape watch's second residual).
 
 Joint feedback (``controller_scene``: a scene whose ``controller:`` section maps the jaws to a
 parallel gripper, and no ``wrench`` or ``tactile`` stream): the jaws' only sensor is the

@@ -42,8 +42,11 @@ from squeeze_grasp_ros.mechanics.vocabulary import ShapeFit
 from squeeze_grasp_ros.perception.shape_match import ShapeMatch, deformed_outline, shape_residual
 from squeeze_grasp_ros.scene import GraspSetup
 
-__all__ = ["DEFAULT_SAMPLES", "AtForce", "DepthAtForce", "FrameCheck", "PredictedShapes",
-           "check_frame", "depth_at_force", "pair_force", "predict_shapes"]
+__all__ = ["DEFAULT_SAMPLES", "SHAPE_MISMATCH", "AtForce", "DepthAtForce", "FrameCheck",
+           "PredictedShapes", "check_frame", "depth_at_force", "pair_force", "predict_shapes"]
+
+SHAPE_MISMATCH = "shape_mismatch"
+"""The alarm type (``Alarm.SHAPE_MISMATCH`` over ROS), like the tracker's alarm names."""
 
 DEFAULT_SAMPLES = 6
 """Depth samples of a prediction, 0 and the target depth included."""

@@ -23,9 +23,15 @@ import yaml
 from perception_support import skimage_or_skip
 from pipeline_support import run_scene
 
+from squeeze_grasp_ros.control.force_watch import squeeze_forces
 from squeeze_grasp_ros.mechanics.vocabulary import Effect, ObjectModel
 from squeeze_grasp_ros.perception.shape_match import deformed_outline
-from squeeze_grasp_ros.perception.shape_watch import PredictedShapes, check_frame
+from squeeze_grasp_ros.perception.shape_watch import (
+    PredictedShapes,
+    check_frame,
+    depth_at_force,
+    pair_force,
+)
 from squeeze_grasp_ros.resources import config_dir
 from squeeze_grasp_ros.scene import GraspSetup, SceneError, load_scene, parse_scene
 from squeeze_grasp_ros.sim.world import SimWorld
@@ -147,7 +153,9 @@ def shipped_solid_scenes() -> list[Path]:
 @pytest.mark.parametrize("path", shipped_solid_scenes(), ids=lambda p: p.stem)
 def test_the_shape_watch_is_silent_when_the_model_is_right(path):
     """Each shipped solid scene seen by the default camera (0.5 m up, 1 mm depth noise, half a
-    pixel of blur) at 60 % of its squeeze depth: no shape_mismatch at the default threshold.
+    pixel of blur) at 60 % of its squeeze depth: no shape_mismatch at the default thresholds,
+    at equal depth and at equal force (the depth the model's force curve gives for the
+    world's force).
     """
     skimage_or_skip()
     from squeeze_grasp_ros.perception.extract import extract_outline
@@ -155,7 +163,9 @@ def test_the_shape_watch_is_silent_when_the_model_is_right(path):
     data = yaml.safe_load(path.read_text())
     scene = parse_scene(with_camera(data, pose=[0.0, 0.0, 0.5, np.pi, 0.0, 0.0]))
     setup = GraspSetup.build(scene).precompute()
-    depth = 0.6 * setup.event_squeeze().target_depth  # (a slipping squeeze stops earlier)
+    # a slipping squeeze stops earlier: its depth reached (none: a finger slips at once)
+    squeezed = setup.event_squeeze(depth=0.6 * setup.event_squeeze().target_depth)
+    depth = squeezed.depth or 0.6 * setup.event_squeeze().target_depth
     predicted = prediction_two_samples(setup, depth)
     world = SimWorld(setup)
     truth = deformed_outline(setup.solid.mesh,
@@ -167,6 +177,17 @@ def test_the_shape_watch_is_silent_when_the_model_is_right(path):
     assert not check.mismatch, check.match.rms_m
     assert check.match.rms_m < 0.25 * scene.camera.shape_mismatch_threshold
     assert check.scale == pytest.approx(1.0, abs=0.01)
+    # at equal force: the world's pair force at that depth, through the model's force curve
+    curve = squeeze_forces(setup.event_squeeze())
+    if curve is None:  # no depth and no force curve: the watch says no_force_curve
+        assert squeezed.depth == 0.0
+        return
+    force = pair_force({f: float(np.linalg.norm(v)) for f, v in squeezed.finger_force.items()})
+    found = depth_at_force(curve, force, min_force=0.05)
+    assert found.matched and found.depth == pytest.approx(depth, rel=0.01), found
+    at_force = check_frame(seen.outline, predicted, found.depth,
+                           scene.camera.shape_at_force_threshold)
+    assert at_force.match.rms_m < 0.75 * scene.camera.shape_at_force_threshold
 
 
 def test_the_shape_watch_catches_a_larger_object_and_names_why_not_nu():
@@ -400,7 +421,7 @@ def test_a_frame_before_the_prediction_waits_for_it(ros_context):
     from rclpy.executors import SingleThreadedExecutor
     from sensor_msgs.msg import CameraInfo, Image
 
-    from squeeze_grasp_interfaces.msg import Alarm, ShapeResidual
+    from squeeze_grasp_interfaces.msg import Alarm, ContactEventArray, ShapeResidual
     from squeeze_grasp_interfaces.msg import PredictedShapes as PredictedShapesMsg
     from squeeze_grasp_ros.ros import messages
     from squeeze_grasp_ros.ros.messages.images import pose_of_camera
@@ -418,7 +439,9 @@ def test_a_frame_before_the_prediction_waits_for_it(ros_context):
         executor.add_node(node)
     try:
         watcher = ShapeWatcher(monitor, monitor.create_publisher(Alarm, "alarms", 10),
-                               scene.camera.shape_mismatch_threshold, 0.0254)
+                               threshold=scene.camera.shape_mismatch_threshold,
+                               at_force_threshold=scene.camera.shape_at_force_threshold,
+                               object_height=0.0254, min_force=0.05)
         residuals: list = []
         camera.create_subscription(ShapeResidual, pipeline.SHAPE_RESIDUAL, residuals.append,
                                    pipeline.loop_qos(100))
@@ -440,7 +463,7 @@ def test_a_frame_before_the_prediction_waits_for_it(ros_context):
             pub.publish(msg)
         spin_until(lambda: watcher.waiting and watcher.camera is not None
                    and watcher.pose is not None)
-        watcher.tick(0, 0.0)  # tick 0 closes: the prediction is not there yet
+        watcher.close(0, 0.0, 0.0)  # tick 0 closes: the predictions are not there yet
         for _ in range(10):
             executor.spin_once(timeout_sec=0.02)
         assert residuals == [] and list(watcher.waiting) == [0] and watcher.dropped == 0
@@ -452,13 +475,22 @@ def test_a_frame_before_the_prediction_waits_for_it(ros_context):
         camera.create_publisher(PredictedShapesMsg, pipeline.PREDICTED_SHAPES,
                                 pipeline.LATCHED).publish(
             predicted_shapes_msg(scene, 0.005, 0))
+        for _ in range(10):  # the force curve (planner/predicted_events) is still missing
+            executor.spin_once(timeout_sec=0.02)
+        assert residuals == []
+        curve = squeeze_forces(GraspSetup.build(scene).precompute().event_squeeze(depth=0.005))
+        camera.create_publisher(ContactEventArray, pipeline.PREDICTION, pipeline.LATCHED).publish(
+            messages.prediction_msg([], "none", 0.005, curve))
         spin_until(lambda: len(residuals) == 1)
         assert messages.stamp_ns(residuals[0].header.stamp) == 0 and residuals[0].depth == 0.0
         assert residuals[0].rms < 0.25 * scene.camera.shape_mismatch_threshold
+        assert (residuals[0].at_force, residuals[0].depth_at_force) == ("below_min_force", 0.0)
         assert list(watcher.waiting) == [100_000_000]
-        watcher.tick(100_000_000, 0.0)
+        watcher.close(100_000_000, 0.0, None)
         spin_until(lambda: len(residuals) == 2)
         assert messages.stamp_ns(residuals[1].header.stamp) == 100_000_000
+        # no force measured: the equal-force match is skipped, and says why, never NaN
+        assert (residuals[1].at_force, residuals[1].rms_at_force) == ("no_force", 0.0)
     finally:
         executor.shutdown()
         for node in (monitor, camera):

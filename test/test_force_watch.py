@@ -1,8 +1,9 @@
 # Copyright 2026 squeeze_grasp_ros developers
 # SPDX-License-Identifier: Apache-2.0
-"""The force watch: a wrong Young's modulus, invisible to the camera under displacement
-control, shows in the finger forces (issue 32's target: raised before 60 % of the squeeze
-depth for a 30 % error in E, in both directions; silent for a right model).
+"""The force watch: a wrong Young's modulus, invisible to the camera at equal depth under
+displacement control (test_shape_at_force.py: the shape at equal force sees it), shows in the
+finger forces (issue 32's target: raised before 60 % of the squeeze depth for a 30 % error in
+E, in both directions; silent for a right model).
 
 ROS-free: the scaling law the watch rests on (forces along the squeeze scale with E, the
 depths of the force curve do not), the curve's units, the comparison itself. On real rclpy:

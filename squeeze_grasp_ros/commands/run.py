@@ -19,6 +19,7 @@ from squeeze_grasp_ros.commands.common import add_scene_argument, fail, int_in, 
 from squeeze_grasp_ros.control.force_watch import FORCE_MISMATCH
 from squeeze_grasp_ros.control.motion import DEFAULT_ATTEMPTS, DEFAULT_MARGIN, REACTIONS
 from squeeze_grasp_ros.exit_codes import ExitCode, raise_on_signals
+from squeeze_grasp_ros.perception.shape_watch import SHAPE_MISMATCH
 
 EXECUTOR_CHOICES: tuple[str, ...] = ("events", "single")
 """``--executor`` values (equal to ``nodes.runner.EXECUTORS``; kept here so that building the CLI
@@ -271,9 +272,10 @@ def summary(result: dict) -> str:
         f"wall time {timing['total']:.2f} s (plan {timing['plan']:.2f} s, nodes "
         f"{timing['start_nodes']:.2f} s, lockstep loop {timing['loop']:.2f} s)",
     ]
-    first = result["first_alarms"].get(FORCE_MISMATCH)
-    if first:  # the force watch's verdict on the model: where the forces first left it
-        lines.insert(5, f"first {FORCE_MISMATCH}: {first['message']}")
+    # the watches' verdicts on the model: where the forces, then the shape, first left it
+    verdicts = [f"first {kind}: {result['first_alarms'][kind]['message']}"
+                for kind in (FORCE_MISMATCH, SHAPE_MISMATCH) if kind in result["first_alarms"]]
+    lines[5:5] = verdicts
     if result["resqueezed"]:
         lines.insert(2, _resqueezes(result))
     seen = result.get("seen_outline")

@@ -6,8 +6,10 @@ Under displacement control (the fingers are driven to a depth) the deformed shap
 object does not depend on its Young's modulus E: the stiffness scales with E, the prescribed
 displacements do not, so the displacement field is the same and only the forces scale with E
 (linear and neo-Hookean; the friction ratios are unchanged). A wrong E is therefore invisible to
-the camera's shape watch and shows here: the measured force of each finger along its motion
-direction against the planner's prediction at the measured depth
+the camera's shape watch at equal depth (its equal-force residual sees it,
+:func:`squeeze_grasp_ros.perception.shape_watch.depth_at_force`) and shows here: the measured
+force of each finger along its motion direction against the planner's prediction at the
+measured depth
 (:meth:`PredictedForces.at`, linear between the planner's accepted points). Above
 ``tolerance`` in relative error the finger raises ``force_mismatch``
 (:func:`check_forces`). The first ``min_fraction`` of the predicted depth is not judged: the

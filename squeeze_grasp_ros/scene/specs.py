@@ -445,6 +445,11 @@ class CameraSpec:
     shape_mismatch_threshold: float = spec(
         "monitor: RMS distance of the predicted deformed boundary from the seen outline (after "
         "a rigid fit) that raises shape_mismatch", "m", lo=0.0, lo_open=True, default=5e-4)
+    shape_at_force_threshold: float = spec(
+        "monitor: RMS distance of the deformed boundary the model predicts for the measured "
+        "finger force from the seen outline (after a rigid fit) that raises shape_mismatch "
+        "(sees a wrong E, which the equal-depth residual cannot)", "m", lo=0.0, lo_open=True,
+        default=1.5e-4)
 
 
 @dataclass(frozen=True)

@@ -27,13 +27,33 @@ from squeeze_grasp_ros.ros import messages
 from squeeze_grasp_ros.ros.nodes import pipeline
 
 
+class MotionForces:
+    """Each finger's measured force on the object along its measured motion (its position
+    against its first), tick by tick; the force watch and the shape watch each keep one.
+    """
+
+    def __init__(self) -> None:
+        self.start: dict[str, np.ndarray] = {}
+
+    def measure(self, out: TrackerOutput,
+                samples: Mapping[str, FingerSample]) -> dict[str, float]:
+        """Finger -> force along its motion (N), for the fingers with a wrench or tactile
+        reading (or a joint effort in its place) in ``samples``.
+        """
+        for finger, position in out.positions.items():
+            self.start.setdefault(finger, position)
+        return {f: force_along_motion(out.forces[f], out.positions[f], self.start[f])
+                for f, s in samples.items() if f in out.positions
+                and (s.force is not None or s.normal is not None)}
+
+
 class ForceWatcher:
     """Compares forces for ``node`` (the monitor), which calls :meth:`tick` before its status."""
 
     def __init__(self, node: Node, tolerance: float, min_fraction: float, qos: Any) -> None:
         self.tolerance, self.min_fraction = tolerance, min_fraction
         self.prediction: PredictedForces | None = None
-        self.start: dict[str, np.ndarray] = {}
+        self.motion = MotionForces()
         self.residual_pub = node.create_publisher(ForceResidual, pipeline.FORCE_RESIDUAL, qos)
 
     def set_prediction(self, msg: ContactEventArray) -> None:
@@ -45,13 +65,9 @@ class ForceWatcher:
         """The tick's residual message (as ``(publisher, serialised message)``) and its
         alarms; only fingers with a wrench or tactile reading in ``samples`` are judged.
         """
-        for finger, position in out.positions.items():
-            self.start.setdefault(finger, position)
+        measured = self.motion.measure(out, samples)
         if self.prediction is None:
             return [], ()
-        measured = {f: force_along_motion(out.forces[f], out.positions[f], self.start[f])
-                    for f, s in samples.items() if f in out.positions
-                    and (s.force is not None or s.normal is not None)}
         check = check_forces(self.prediction, out.depth, measured, tolerance=self.tolerance,
                              min_fraction=self.min_fraction)
         if check is None:

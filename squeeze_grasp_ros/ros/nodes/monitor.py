@@ -21,7 +21,8 @@ events. With ``shape_watch`` the camera's frames are matched against the predict
 boundary (:mod:`.shape_watcher`): ``monitor/shape_residual`` and the ``shape_mismatch`` alarm.
 With ``force_watch`` (on by default) the measured finger forces are compared with the
 prediction's force curve (:mod:`.force_watcher`): ``monitor/force_residual`` and the
-``force_mismatch`` alarm (a wrong E: the shape cannot show it, the forces do).
+``force_mismatch`` alarm (a wrong E: the shape at a depth cannot show it, the forces do, and
+so does the shape at the measured force, the shape watch's second residual).
 
 Joint feedback (``controller_scene``: a scene whose ``controller:`` section maps the jaws to a
 parallel gripper, and no ``wrench`` or ``tactile`` stream): the jaws' only sensor is the
@@ -113,7 +114,11 @@ PARAMETERS: dict[str, tuple[Any, str]] = {
     "sensor_qos": ("reliable", "QoS of the readings: reliable (lockstep) or sensor_data"),
     "qos_depth": (100, "history depth of the reliable topics"),
     "shape_watch": (False, "match camera frames against planner/predicted_shapes (App. C)"),
-    "shape_mismatch_threshold": (5e-4, "RMS residual that raises shape_mismatch, m"),
+    "shape_mismatch_threshold": (5e-4, "equal-depth RMS residual that raises shape_mismatch, m"),
+    "shape_at_force_threshold": (1.5e-4, "equal-force RMS residual (the seen outline against the "
+                                         "boundary predicted for the measured force) that "
+                                         "raises shape_mismatch, m"),
+    "shape_min_force": (0.05, "shape watch: smallest pair force matched at equal force, N"),
     "object_height": (0.0, "shape watch: height of the object's top face above the plane, m"),
     "force_watch": (True, "compare finger forces with the prediction's force curve"),
     "force_tolerance": (0.1, "relative force error that raises force_mismatch"),
@@ -218,8 +223,10 @@ class MonitorNode(Node):
         self.expected: dict[int, set[str]] = {}
         self.answered = pipeline.TickAnswer()
         self.active_alarms: set[tuple[str, str]] = set()
-        self.shapes = (ShapeWatcher(self, self.alarm_pub, p["shape_mismatch_threshold"],
-                                    p["object_height"]) if p["shape_watch"] else None)
+        self.shapes = (ShapeWatcher(
+            self, self.alarm_pub, threshold=p["shape_mismatch_threshold"],
+            at_force_threshold=p["shape_at_force_threshold"], object_height=p["object_height"],
+            min_force=p["shape_min_force"]) if p["shape_watch"] else None)
         self.forces = (ForceWatcher(self, p["force_tolerance"], p["force_min_fraction"], loop)
                        if p["force_watch"] else None)
         if p["lockstep"]:
@@ -317,7 +324,7 @@ class MonitorNode(Node):
             publisher.publish(msg)
         self.answered.answer(ns, [(self.status_pub, messages.monitor_status_cdr(out, frame))])
         if self.shapes is not None:
-            self.shapes.tick(ns, out.depth)
+            self.shapes.tick(ns, out, samples)
 
 
 class HandFeedback:

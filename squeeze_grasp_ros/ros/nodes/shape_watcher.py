@@ -4,16 +4,22 @@
 deformed boundary (:mod:`squeeze_grasp_ros.perception.shape_watch`, paper App. C).
 
 It reads ``camera/mask``, ``camera/camera_info``, ``camera/pose`` and the planner's latched
-``planner/predicted_shapes``. A frame is matched once the monitor has closed the tick of the
-frame's stamp (so the depth is the tracker's depth at that tick); the residual goes to
-``monitor/shape_residual`` and, when it first exceeds ``shape_mismatch_threshold`` or the
-frame shows another number of holes than predicted (a hole closed or vanished), a
-``shape_mismatch`` alarm to ``monitor/alarms`` (value: the RMS residual, m; one alarm per
-episode). A frame that gives no outline is logged and skipped.
+``planner/predicted_shapes`` and ``planner/predicted_events`` (its force curve). A frame is
+matched once the monitor has closed the tick of the frame's stamp (so the depth and the force
+are the tracker's at that tick) twice: at the measured depth, and at the depth the prediction's
+pair force curve gives for the measured pair force (the mean of the fingers' forces along their
+motion; :func:`~squeeze_grasp_ros.perception.shape_watch.depth_at_force`, skipped below
+``shape_min_force``, outside the curve or where it is not rising, with the reason in the
+message). The residuals go to ``monitor/shape_residual``; when the equal-depth RMS first exceeds
+``shape_mismatch_threshold``, the frame shows another number of holes than predicted (a hole
+closed or vanished), or the equal-force RMS exceeds ``shape_at_force_threshold`` (a wrong E), a
+``shape_mismatch`` alarm goes to ``monitor/alarms`` (value: the RMS residual that exceeded its
+threshold, m; the message names it; one alarm per episode). A frame that gives no outline is
+logged and skipped.
 
 Frames are kept until they can be matched: the world's first frame (tick 0) is latched before
 the run has latched the prediction, and the latched topics arrive in any order, so a frame
-waits for its tick to close *and* for the prediction, the camera info and the pose. At most
+waits for its tick to close *and* for the predictions, the camera info and the pose. At most
 :data:`PENDING_FRAMES` wait; beyond that (no prediction ever comes: a world launched without a
 run) the oldest is dropped, with one log line.
 """
@@ -27,35 +33,62 @@ from geometry_msgs.msg import PoseStamped
 from rclpy.node import Node
 from sensor_msgs.msg import CameraInfo, Image
 
-from squeeze_grasp_interfaces.msg import Alarm, PredictedShapes, ShapeResidual
+from squeeze_grasp_interfaces.msg import Alarm, ContactEventArray, PredictedShapes, ShapeResidual
+from squeeze_grasp_ros.control.force_watch import PredictedForces
+from squeeze_grasp_ros.control.tracker import FingerSample, TrackerOutput
 from squeeze_grasp_ros.mechanics.errors import InvalidInputError
 from squeeze_grasp_ros.perception.extract import MIN_AREA_PX, extract_outline
+from squeeze_grasp_ros.perception.shape_watch import (
+    AtForce,
+    DepthAtForce,
+    check_frame,
+    depth_at_force,
+    pair_force,
+)
 from squeeze_grasp_ros.perception.shape_watch import PredictedShapes as Prediction
-from squeeze_grasp_ros.perception.shape_watch import check_frame
 from squeeze_grasp_ros.ros import messages
 from squeeze_grasp_ros.ros.messages.images import camera_model, camera_pose, image_array
 from squeeze_grasp_ros.ros.messages.objects import polygon_points
 from squeeze_grasp_ros.ros.nodes import pipeline
+from squeeze_grasp_ros.ros.nodes.force_watcher import MotionForces
 
 DEPTH_HISTORY = 4096
-"""Closed ticks whose depth is kept for frames that arrive after their tick closed."""
+"""Closed ticks whose depth and force are kept for frames that arrive after their tick
+closed."""
 
 PENDING_FRAMES = 64
 """Frames kept while their tick is open or the prediction has not arrived (6.4 s at 10 Hz)."""
 
 
 class ShapeWatcher:
-    """Matches camera frames for ``node`` (the monitor), which calls :meth:`tick`."""
+    """Matches camera frames for ``node`` (the monitor), which calls :meth:`tick`.
 
-    def __init__(self, node: Node, alarm_pub: Any, threshold: float,
-                 object_height: float) -> None:
+    Parameters
+    ----------
+    threshold, at_force_threshold : float
+        m, the RMS residuals at equal depth and at equal force that raise ``shape_mismatch``.
+    object_height : float
+        m, the object's top face above the support plane.
+    min_force : float
+        N, the smallest pair force matched at equal force.
+    """
+
+    def __init__(self, node: Node, alarm_pub: Any, *, threshold: float,
+                 at_force_threshold: float, object_height: float, min_force: float) -> None:
         self.node, self.alarm_pub = node, alarm_pub
         self.threshold, self.object_height = threshold, object_height
+        self.at_force_threshold, self.min_force = at_force_threshold, min_force
         self.prediction: Prediction | None = None
+        self.forces: PredictedForces | None = None
+        self.has_events = False
+        """The planner's ``predicted_events`` (with or without a force curve) has arrived."""
+        self.motion = MotionForces()
         self.camera = self.pose = None
         self.frame_id = pipeline.FRAME
         self.waiting: dict[int, Image] = {}
-        self.depths: OrderedDict[int, float] = OrderedDict()
+        self.depths: OrderedDict[int, tuple[float, float | None]] = OrderedDict()
+        """Closed tick -> (depth m, pair force N or None)."""
+        self.skipped: AtForce | None = None
         self.active = False
         self.dropped = 0
         sub = node.create_subscription
@@ -63,6 +96,7 @@ class ShapeWatcher:
         sub(CameraInfo, pipeline.CAMERA_INFO, self._info, pipeline.CAMERA)
         sub(PoseStamped, pipeline.CAMERA_POSE, self._pose, pipeline.LATCHED)
         sub(PredictedShapes, pipeline.PREDICTED_SHAPES, self._prediction, pipeline.LATCHED)
+        sub(ContactEventArray, pipeline.PREDICTION, self._events, pipeline.LATCHED)
         self.residual_pub = node.create_publisher(ShapeResidual, pipeline.SHAPE_RESIDUAL,
                                                   pipeline.loop_qos(100))
 
@@ -87,6 +121,10 @@ class ShapeWatcher:
             tuple(holes[k * per:(k + 1) * per]) for k in range(len(outlines))) if per else ())
         self._flush()
 
+    def _events(self, msg: ContactEventArray) -> None:
+        self.forces, self.has_events = messages.predicted_forces(msg), True
+        self._flush()
+
     def _image(self, msg: Image) -> None:
         self.waiting[messages.stamp_ns(msg.header.stamp)] = msg
         while len(self.waiting) > PENDING_FRAMES:
@@ -95,31 +133,48 @@ class ShapeWatcher:
             if not self.dropped:
                 self.node.get_logger().warning(
                     f"shape watch: more than {PENDING_FRAMES} frames wait for the prediction "
-                    f"(planner/predicted_shapes), the camera info or the pose; dropping the "
+                    f"(planner/predicted_shapes, planner/predicted_events), the camera info or "
+                    f"the pose; dropping the "
                     f"oldest (first at {dropped * 1e-9:.3f} s)")
             self.dropped += 1
         self._flush()
 
-    def tick(self, ns: int, depth: float) -> None:
-        """The monitor closed tick ``ns`` at ``depth`` (m): match the frames up to it."""
-        self.depths[ns] = depth
+    def tick(self, ns: int, out: TrackerOutput, samples: dict[str, FingerSample]) -> None:
+        """The monitor closed tick ``ns`` (its tracker output and samples): match the frames up
+        to it.
+        """
+        self.close(ns, out.depth, pair_force(self.motion.measure(out, samples)))
+
+    def close(self, ns: int, depth: float, force: float | None) -> None:
+        """Tick ``ns`` closed at ``depth`` (m) with the pair ``force`` (N; None: not
+        measured): match the frames up to it.
+        """
+        self.depths[ns] = (depth, force)
         while len(self.depths) > DEPTH_HISTORY:
             self.depths.popitem(last=False)
         self._flush()
 
     def _flush(self) -> None:
-        """Match the waiting frames whose tick has closed, once the prediction, the camera
+        """Match the waiting frames whose tick has closed, once the predictions, the camera
         info and the pose are known.
         """
-        if self.prediction is None or self.camera is None or self.pose is None \
-                or not self.depths:
+        if self.prediction is None or not self.has_events or self.camera is None \
+                or self.pose is None or not self.depths:
             return
         closed = next(reversed(self.depths))
         for stamp in sorted(s for s in self.waiting if s <= closed):
             self._match(self.waiting.pop(stamp), stamp,
-                        self.depths.get(stamp, self.depths[closed]))
+                        *self.depths.get(stamp, self.depths[closed]))
 
-    def _match(self, msg: Image, ns: int, depth: float) -> None:
+    def _at_force(self, force: float | None) -> DepthAtForce:
+        """The predicted depth for the measured pair ``force``, or why there is none."""
+        if self.forces is None:
+            return DepthAtForce(AtForce.NO_FORCE_CURVE, 0.0)
+        if force is None:
+            return DepthAtForce(AtForce.NO_FORCE, 0.0)
+        return depth_at_force(self.forces, force, min_force=self.min_force)
+
+    def _match(self, msg: Image, ns: int, depth: float, force: float | None) -> None:
         try:
             pixels, encoding = image_array(msg)
             seen = extract_outline(pixels, encoding, self.camera, self.pose,
@@ -128,19 +183,46 @@ class ShapeWatcher:
             self.node.get_logger().warning(f"shape watch: no outline at {ns * 1e-9:.3f} s: "
                                            f"{error}")
             return
+        smallest = MIN_AREA_PX * seen.pixel_size_m ** 2
         check = check_frame(seen.outline, self.prediction, depth, self.threshold,
-                            min_hole_area=MIN_AREA_PX * seen.pixel_size_m ** 2)
+                            min_hole_area=smallest)
         match = check.match
+        inverted = self._at_force(force)
+        at_force = check_frame(seen.outline, self.prediction, inverted.depth,
+                               self.at_force_threshold, min_hole_area=smallest).match \
+            if inverted.matched else None
+        if not inverted.matched and inverted.status is not self.skipped:
+            self.node.get_logger().info(
+                f"shape watch: no equal-force match from {ns * 1e-9:.3f} s on: "
+                f"{inverted.reason(self.min_force)}")
+        self.skipped = None if inverted.matched else inverted.status
         self.residual_pub.publish(ShapeResidual(
             header=messages.header(ns, self.frame_id), depth=float(depth), rms=match.rms_m,
             max=match.max_m, scale=float(check.scale), rotation=float(match.rotation),
             threshold=float(self.threshold), holes_predicted=check.holes_predicted,
-            holes_seen=check.holes_seen))
-        if check.mismatch and not self.active:
-            self.alarm_pub.publish(Alarm(
-                header=messages.header(ns), type=Alarm.SHAPE_MISMATCH, finger="",
-                value=match.rms_m,
-                message=f"{check.reason}: seen outline {match.rms_m * 1e3:.3f} mm RMS from the "
-                        f"predicted boundary at depth {depth * 1e3:.3f} mm (threshold "
-                        f"{self.threshold * 1e3:.3f} mm; similarity scale {check.scale:.4f})"))
-        self.active = check.mismatch
+            holes_seen=check.holes_seen, force=float(inverted.force),
+            at_force=inverted.status.value, depth_at_force=inverted.depth,
+            rms_at_force=at_force.rms_m if at_force else 0.0,
+            max_at_force=at_force.max_m if at_force else 0.0,
+            threshold_at_force=float(self.at_force_threshold)))
+        wrong_e = at_force is not None and at_force.rms_m > self.at_force_threshold
+        mismatch = check.mismatch or wrong_e
+        if mismatch and not self.active:
+            if check.mismatch:
+                value, message = match.rms_m, (
+                    f"{check.reason}: seen outline {match.rms_m * 1e3:.3f} mm RMS from the "
+                    f"predicted boundary at depth {depth * 1e3:.3f} mm (equal-depth residual; "
+                    f"threshold {self.threshold * 1e3:.3f} mm; similarity scale "
+                    f"{check.scale:.4f})")
+            else:
+                value, message = at_force.rms_m, (
+                    f"equal-force residual above the threshold: seen outline "
+                    f"{at_force.rms_m * 1e3:.3f} mm RMS from the boundary the model predicts "
+                    f"for the measured pair force {inverted.force:.4g} N, at depth "
+                    f"{inverted.depth * 1e3:.3f} mm against the measured {depth * 1e3:.3f} mm "
+                    f"(threshold {self.at_force_threshold * 1e3:.3f} mm; equal-depth residual "
+                    f"{match.rms_m * 1e3:.3f} mm): the object is "
+                    f"{'softer' if inverted.depth < depth else 'stiffer'} than the model")
+            self.alarm_pub.publish(Alarm(header=messages.header(ns), type=Alarm.SHAPE_MISMATCH,
+                                         finger="", value=value, message=message))
+        self.active = mismatch

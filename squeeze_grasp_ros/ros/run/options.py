@@ -125,6 +125,9 @@ def node_parameters(
     if scene.has(Effect.CAMERA):
         monitor.update(shape_watch=True,
                        shape_mismatch_threshold=float(scene.camera.shape_mismatch_threshold),
+                       shape_at_force_threshold=float(scene.camera.shape_at_force_threshold),
+                       shape_min_force=max(float(monitor.get("shape_min_force", 0.05)),
+                                           20.0 * noise),
                        object_height=float(scene.object.material.thickness))
     controller_scene = str(Path(scene_path).resolve()) if scene.controller else ""
     monitor["controller_scene"] = controller_scene

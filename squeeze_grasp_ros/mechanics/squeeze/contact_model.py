@@ -836,7 +836,9 @@ class ContactModel:
         kept = self._gradient_bounds(sd)
         if "loads" in kept and "stacked" not in kept:
             kept["stacked"] = np.ascontiguousarray(np.stack(kept["loads"]))
-        return kept["bounds"], kept.get("stacked")
+        if "contiguous" not in kept:
+            kept["contiguous"] = np.ascontiguousarray(kept["bounds"])
+        return kept["contiguous"], kept.get("stacked")
 
 
 def strain_criterion(eps: np.ndarray, criterion: str) -> tuple[float, int]:

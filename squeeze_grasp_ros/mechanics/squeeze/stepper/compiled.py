@@ -116,7 +116,6 @@ class CompiledSubsteps:
         A_rows, R_rows = model._boundary_rows(sd, rows) if len(rows) else (
             np.zeros((0, 2 * len(contacts))), np.zeros((0, 3)))
         _, pick = functions._contact_entries(contacts, held)
-        bounds, loads = model.area_tables(sd)
         tables = (
             (np.ascontiguousarray(sd.C), np.ascontiguousarray(contacts.positions, float),
              np.ascontiguousarray(contacts.stick), np.ascontiguousarray(contacts.slip),
@@ -127,7 +126,6 @@ class CompiledSubsteps:
             (np.ascontiguousarray(pick, int), np.ascontiguousarray(A_rows),
              np.ascontiguousarray(R_rows), np.ascontiguousarray(sd.E),
              np.ascontiguousarray(functions._boundary[rows])),
-            (np.ascontiguousarray(bounds), _NO_LOADS if loads is None else loads),
         )
         self._tables = (sd, key, tables)
         return tables
@@ -141,7 +139,9 @@ class CompiledSubsteps:
         ev, model, motion = call.events, call.model, call.motion
         contacts = ev.contacts
         held = call.chatter.held(contacts.nodes, motion.depth_at(a))
-        problem, watched, area = self._set_tables(contacts, start.rows, held)
+        problem, watched = self._set_tables(contacts, start.rows, held)
+        bounds, loads = model.area_tables(contacts.data)  # loads: kept once an element neared
+        area = (bounds, _NO_LOADS if loads is None else loads)
         m, nf = len(contacts), len(motion.names)
         n = int(np.count_nonzero(~contacts.stick))
         ends = start.values.ends

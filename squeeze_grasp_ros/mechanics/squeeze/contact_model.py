@@ -819,26 +819,19 @@ class ContactModel:
 
 
     def _gradient_bounds(self, sd: SetData) -> dict:
-        """What :meth:`area_ratio` keeps for the last contact set: its gradient bounds, and
-        its load gradients once an element came near the threshold.
-        """
+        """What :meth:`area_ratio` keeps of the last set (bounds; loads once an element neared)."""
         kept = self._cache.get("gradient_bounds")
-        if kept is None or kept["set"] is not sd:  # the last contact set's bounds are kept
+        if kept is None or kept["set"] is not sd:
             kept = self._cache["gradient_bounds"] = {
                 "set": sd, "bounds": self.obj.gradient_bounds(tuple(sd.nodes.tolist()))}
         return kept
 
     def area_tables(self, sd: SetData) -> tuple[np.ndarray, np.ndarray | None]:
-        """The tables :meth:`area_ratio` bounds and computes det F with, for the compiled
-        substeps: the gradient bounds (t, m) and, once kept, the load gradients stacked
-        (m, t, 4, 2) (None before an element came near the threshold).
-        """
+        """:meth:`area_ratio`'s bounds (t, m) and loads stacked (m, t, 4, 2; None until kept)."""
         kept = self._gradient_bounds(sd)
         if "loads" in kept and "stacked" not in kept:
             kept["stacked"] = np.ascontiguousarray(np.stack(kept["loads"]))
-        if "contiguous" not in kept:
-            kept["contiguous"] = np.ascontiguousarray(kept["bounds"])
-        return kept["contiguous"], kept.get("stacked")
+        return kept["bounds"], kept.get("stacked")
 
 
 def strain_criterion(eps: np.ndarray, criterion: str) -> tuple[float, int]:

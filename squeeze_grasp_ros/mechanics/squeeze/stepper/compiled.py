@@ -141,7 +141,7 @@ class CompiledSubsteps:
         held = call.chatter.held(contacts.nodes, motion.depth_at(a))
         problem, watched = self._set_tables(contacts, start.rows, held)
         bounds, loads = model.area_tables(contacts.data)  # loads: kept once an element neared
-        area = (bounds, _NO_LOADS if loads is None else loads)
+        area = (np.ascontiguousarray(bounds), _NO_LOADS if loads is None else loads)
         m, nf = len(contacts), len(motion.names)
         n = int(np.count_nonzero(~contacts.stick))
         ends = start.values.ends

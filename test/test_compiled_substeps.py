@@ -121,3 +121,34 @@ def test_what_the_kernel_does_not_take_stays_in_python(monkeypatch):
     setup.event_squeeze(checkpoint=lambda: None)
     setup.event_squeeze(material_model="neo_hookean", relative_depth=0.02)
     assert calls == []
+
+
+def _example_rows(route: Kernel, tasks: int | None, monkeypatch) -> list[dict]:
+    """The example sweep's rows (its first ``tasks`` tasks) on ``route``, without time_s."""
+    import yaml
+
+    from squeeze_grasp_ros.sweep.evaluate import clear_cache, prepare, run_task
+    from squeeze_grasp_ros.sweep.plan import plan_tasks
+    from squeeze_grasp_ros.sweep.spec import parse_sweep_spec
+
+    spec = SCENES.parent / "sweeps" / "example.yaml"
+    every = list(plan_tasks(parse_sweep_spec(yaml.safe_load(spec.read_text()), spec.parent)))
+    monkeypatch.setenv(KERNEL_VARIABLE, route.value)
+    clear_cache()  # fresh groups: what objects keep from the other route is not reused
+    rows = []
+    for task in every[:tasks]:
+        prepare(task)
+        rows += [{k: v for k, v in row.items() if k != "time_s"} for row in run_task(task)["rows"]]
+    return rows
+
+
+@pytest.mark.parametrize("tasks", [1, pytest.param(None, marks=pytest.mark.slow)])
+def test_the_example_sweep_rows_are_identical_on_both_routes(tasks, monkeypatch):
+    """The example sweep's rows (one task of 48 by default, all 288 in the slow suite) are the
+    same on both routes apart from their timing (NaN fields NaN on both).
+    """
+    a = _example_rows(Kernel.NUMPY, tasks, monkeypatch)
+    b = _example_rows(Kernel.NUMBA, tasks, monkeypatch)
+    assert len(a) == len(b) >= 48
+    for x, y in zip(a, b):
+        _same(x, y)

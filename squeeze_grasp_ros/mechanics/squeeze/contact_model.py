@@ -802,10 +802,7 @@ class ContactModel:
         """
         g = sd.E.T @ delta.reshape(-1)
         rigid = (self.obj.rigid_gradients @ g).reshape(-1, 4)
-        kept = self._cache.get("gradient_bounds")
-        if kept is None or kept["set"] is not sd:  # the last contact set's bounds are kept
-            kept = self._cache["gradient_bounds"] = {
-                "set": sd, "bounds": self.obj.gradient_bounds(tuple(sd.nodes.tolist()))}
+        kept = self._gradient_bounds(sd)
         bound = (kept["bounds"] @ np.sqrt((F * F).sum(axis=1))
                  + np.sqrt((rigid * rigid).sum(axis=1)))
         exact = bound >= GRADIENT_BOUND_EXACT
@@ -819,6 +816,22 @@ class ContactModel:
         det = (1.0 + H[:, 0]) * (1.0 + H[:, 3]) - H[:, 1] * H[:, 2]
         k = int(np.argmin(det))
         return (float(det[k]), int(near[k])) if det[k] <= floor else (float(floor), -1)
+
+
+    def _gradient_bounds(self, sd: SetData) -> dict:
+        """What :meth:`area_ratio` keeps of the last set (bounds; loads once an element neared)."""
+        kept = self._cache.get("gradient_bounds")
+        if kept is None or kept["set"] is not sd:
+            kept = self._cache["gradient_bounds"] = {
+                "set": sd, "bounds": self.obj.gradient_bounds(tuple(sd.nodes.tolist()))}
+        return kept
+
+    def area_tables(self, sd: SetData) -> tuple[np.ndarray, np.ndarray | None]:
+        """:meth:`area_ratio`'s bounds (t, m) and loads stacked (m, t, 4, 2; None until kept)."""
+        kept = self._gradient_bounds(sd)
+        if "loads" in kept and "stacked" not in kept:
+            kept["stacked"] = np.ascontiguousarray(np.stack(kept["loads"]))
+        return kept["bounds"], kept.get("stacked")
 
 
 def strain_criterion(eps: np.ndarray, criterion: str) -> tuple[float, int]:

@@ -75,6 +75,18 @@ def compiled():
     return fixed_set_numba
 
 
+@cache
+def compiled_substeps():
+    """The compiled module :mod:`.substeps_numba` (the substeps between events), or None
+    without numba.
+    """
+    try:
+        from squeeze_grasp_ros.mechanics.squeeze import substeps_numba
+    except ImportError:
+        return None
+    return substeps_numba
+
+
 def prefer_compiled() -> None:
     """Set :data:`KERNEL_VARIABLE` to numba in this process's environment, which the processes
     it starts (a local Dask cluster's workers) inherit, when numba is installed and the

@@ -22,6 +22,7 @@ module                      what it holds
 :mod:`.location`            crossings and root location (Hermite, regula falsi)
 :mod:`.substeps`            substep control (grid or adaptive)
 :mod:`.run`                 :func:`advance`: the substep loop that joins them
+:mod:`.compiled`            the substeps between events in one numba call (numba route)
 :mod:`.quiet`               :class:`QuietSteps`: calls that cross no event, without the loop
 ==========================  ===============================================================
 

@@ -57,6 +57,10 @@ class ChatterBound:
         """Nodes frozen at ``depth``."""
         return [node for node, until in self.holds.items() if until > depth]
 
+    def expiry(self, depth: float) -> float:
+        """The depth (m) at which the first hold active at ``depth`` expires (inf: none)."""
+        return min((until for until in self.holds.values() if until > depth), default=np.inf)
+
     def state_holds(self, depth: float) -> tuple[tuple[int, float], ...]:
         """(node, until) of the holds still active at ``depth``, for the next call's state."""
         return tuple(sorted((n, u) for n, u in self.holds.items() if u > depth))

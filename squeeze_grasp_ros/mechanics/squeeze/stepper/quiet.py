@@ -55,6 +55,7 @@ from squeeze_grasp_ros.mechanics.squeeze.contact_state import (
 )
 from squeeze_grasp_ros.mechanics.squeeze.stepper.area_watch import AreaWatch
 from squeeze_grasp_ros.mechanics.squeeze.stepper.chatter import ChatterBound
+from squeeze_grasp_ros.mechanics.squeeze.stepper.compiled import QUIET_MARGIN
 from squeeze_grasp_ros.mechanics.squeeze.stepper.contact_set import ContactSet
 from squeeze_grasp_ros.mechanics.squeeze.stepper.functions import EventFunctions
 from squeeze_grasp_ros.mechanics.squeeze.stepper.motion import FingerMotion
@@ -66,11 +67,6 @@ from squeeze_grasp_ros.mechanics.vocabulary import ContactMode, MaterialModel, T
 
 __all__ = ["QUIET_MARGIN", "QuietSteps"]
 
-QUIET_MARGIN = 1e-12
-"""Dimensionless value (gap / L, force / (E h L), area ratio) every watched function must
-exceed for a call to be quiet. The start of the next call re-solves the state from its SI
-values, which moves the functions by round-off (about 1e-16); a function within this margin of
-zero goes through the full stepper, so that round-off can never hide or invent an event."""
 _STILL = (0.0, 0.0)
 
 

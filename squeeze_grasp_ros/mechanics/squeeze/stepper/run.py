@@ -27,6 +27,7 @@ from squeeze_grasp_ros.mechanics.squeeze.contact_state import (
 )
 from squeeze_grasp_ros.mechanics.squeeze.event_key import EventFunction, EventKey
 from squeeze_grasp_ros.mechanics.squeeze.stepper.chatter import ChatterBound
+from squeeze_grasp_ros.mechanics.squeeze.stepper.compiled import CompiledSubsteps
 from squeeze_grasp_ros.mechanics.squeeze.stepper.contact_set import ContactSet
 from squeeze_grasp_ros.mechanics.squeeze.stepper.functions import EventFunctions
 from squeeze_grasp_ros.mechanics.squeeze.stepper.location import (
@@ -109,13 +110,23 @@ class _Call:
             return sol, term, planned
         adaptive = self.model.adaptive_steps and not self.model.reference
         control = SubstepControl(self.step / rate, adaptive, planned / rate)
-        start = None
+        start, compiled = None, CompiledSubsteps.of(self, checkpoint)
+        python_next = False
         while ev.s < 1.0:
             if checkpoint is not None:
                 checkpoint()
             a = ev.s
             depth_a = self.motion.depth_at(a)
             start = self._watched_at(sol, a, depth_a, start, adaptive)
+            if compiled is not None and not python_next and not ev.fresh:
+                chunk = compiled.run(sol, a, start, self.chatter.expiry(depth_a))
+                python_next = chunk.python_next
+                if chunk.count:
+                    sol = chunk.sol
+                    ev.move_to(chunk.s, sol.theta.copy())
+                    start = self._watched(sol, chunk.s, depth_a, start.rows, adaptive)
+                    continue
+            python_next = False
             b, sol_b = self.solver.substep(ev.contacts, sol, a, control.end(a))
             if isinstance(sol_b, SolveFailure):
                 self.counters.inversion = sol_b.reason

@@ -1,0 +1,180 @@
+# Copyright 2026 squeeze_grasp_ros developers
+# SPDX-License-Identifier: Apache-2.0
+"""The substeps between events in one compiled call (the numba route of the linear model).
+
+:class:`CompiledSubsteps` hands the substep loop of a :func:`~.run.advance` call to
+:func:`..substeps_numba.advance_quiet` while nothing needs Python: the model's response is the
+linear F = C delta with the fast model's boundary compliance, the substeps keep the grid, no
+function is zero by construction at the start (``fresh``), no strain limit is checked and no
+``checkpoint`` is given. It gathers the contact set's tables (the fixed-set problem, the rows of
+the boundary operator for the free rows, the area bounds, where each watched value is), calls
+the kernel, and applies what it returns to the call: the accepted substeps' samples, work,
+dissipation and counters, the solution at the last point and the watched values there
+(recomputed by the numpy code, so the next substep starts from the same floats). The substep
+the kernel stops before is then run by the Python loop, which locates and processes its events.
+With ``SQUEEZE_GRASP_KERNEL=numpy`` (or without numba) none of this runs: the Python loop is
+the reference path.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from squeeze_grasp_ros.mechanics.squeeze.contact_model import (
+    GRADIENT_BOUND_EXACT,
+    INVERSION_AREA_RATIO,
+    NEWTON_BACKTRACKS,
+    NEWTON_MAX_ITERATIONS,
+    NEWTON_TOL,
+    ContactModel,
+    Solution,
+)
+from squeeze_grasp_ros.mechanics.squeeze.contact_state import Sample
+from squeeze_grasp_ros.mechanics.squeeze.event_key import SHARED_KEYS, EventFunction
+from squeeze_grasp_ros.mechanics.squeeze.fixed_set_kernel import (
+    Kernel,
+    compiled_substeps,
+    selected,
+)
+from squeeze_grasp_ros.mechanics.squeeze.stepper.solving import (
+    CONTINUATION_ITERATIONS,
+    MAX_ANGLE_JUMP,
+)
+from squeeze_grasp_ros.mechanics.vocabulary import Termination
+
+__all__ = ["CHUNK", "QUIET_MARGIN", "Chunk", "CompiledSubsteps"]
+
+QUIET_MARGIN = 1e-12
+"""Dimensionless value (gap / L, force / (E h L), area ratio) every watched function must
+exceed for a call to be quiet. The start of the next call re-solves the state from its SI
+values, which moves the functions by round-off (about 1e-16); a function within this margin of
+zero goes through the full stepper, so that round-off can never hide or invent an event. The
+compiled substeps take a substep as quiet on the same margin (their watched values are the
+numpy route's to round-off)."""
+CHUNK = 256
+"""Substeps the compiled loop runs before it returns its samples (it is called again)."""
+_NO_LOADS = np.zeros((0, 0, 4, 2))
+_END_KEYS = (SHARED_KEYS.get(EventFunction.AREA), SHARED_KEYS.get(EventFunction.PICKUP))
+"""The terminations the kernel watches, in its order (a strain limit runs in Python)."""
+
+
+class Chunk:
+    """What one compiled run did: ``count`` accepted substeps ending at ``s`` with ``sol``,
+    and whether the next substep must run in Python (``python_next``).
+    """
+
+    __slots__ = ("count", "python_next", "s", "sol")
+
+    def __init__(self, count: int, python_next: bool, s: float, sol: Solution | None) -> None:
+        self.count, self.python_next, self.s, self.sol = count, python_next, s, sol
+
+
+class CompiledSubsteps:
+    """The compiled substeps of one :func:`~.run.advance` call (see the module).
+
+    Use :meth:`of`, which returns None when the call cannot use them.
+    """
+
+    def __init__(self, call) -> None:
+        self.call = call
+        self.kernel = compiled_substeps()
+        model, motion = call.model, call.motion
+        lim = model.limits
+        self.weight = (lim.weight / model.force_unit
+                       if lim.weight is not None and Termination.PICKED_UP in call.functions
+                       .terminate_on else np.nan)
+        self.tip_tables = (np.ascontiguousarray(motion.tip.radius, float),
+                           np.ascontiguousarray(motion.tip.flat, float),
+                           np.ascontiguousarray(motion.tip._facing_tangent, float))
+        self.rigid_gradients = np.ascontiguousarray(model.obj.rigid_gradients)
+        self.D = np.ascontiguousarray(motion.translation, float)
+        self.origin = np.ascontiguousarray(motion.start, float)
+        self._tables: tuple | None = None
+
+    @classmethod
+    def of(cls, call, checkpoint) -> CompiledSubsteps | None:
+        """The compiled substeps of ``call``, or None when it must run in Python."""
+        model = call.model
+        lim = model.limits
+        if (checkpoint is not None or selected() != Kernel.NUMBA or model.reference
+                or model.adaptive_steps or type(model).response is not ContactModel.response
+                or call.motion.rate == 0
+                or (lim.strain is not None
+                    and Termination.STRAIN_LIMIT in call.functions.terminate_on)):
+            return None
+        return cls(call)
+
+    def _set_tables(self, contacts, rows: np.ndarray, held: np.ndarray) -> tuple:
+        """The contact set's tables for the kernel (kept while the set, rows and holds are)."""
+        key = (contacts.stick.tobytes(), contacts.slip.tobytes(), rows.tobytes(),
+               held.tobytes())
+        kept = self._tables
+        if kept is not None and kept[0] is contacts.data and kept[1] == key:
+            return kept[2]
+        model, functions, motion = self.call.model, self.call.functions, self.call.motion
+        sd = contacts.data
+        tip = motion.tip.take(contacts.finger)
+        A_rows, R_rows = model._boundary_rows(sd, rows) if len(rows) else (
+            np.zeros((0, 2 * len(contacts))), np.zeros((0, 3)))
+        _, pick = functions._contact_entries(contacts, held)
+        tables = (
+            (np.ascontiguousarray(sd.C), np.ascontiguousarray(contacts.positions, float),
+             np.ascontiguousarray(contacts.stick), np.ascontiguousarray(contacts.slip),
+             float(model.phi), np.ascontiguousarray(tip.radius, float),
+             np.ascontiguousarray(tip.flat, float), np.ascontiguousarray(tip.facing, float),
+             np.ascontiguousarray(contacts.finger),
+             np.array(sorted(set(contacts.finger.tolist())), int)),
+            (np.ascontiguousarray(pick, int), np.ascontiguousarray(A_rows),
+             np.ascontiguousarray(R_rows), np.ascontiguousarray(sd.E),
+             np.ascontiguousarray(functions._boundary[rows])),
+        )
+        self._tables = (sd, key, tables)
+        return tables
+
+    def run(self, sol: Solution, a: float, start, expiry: float) -> Chunk:
+        """Accepted substeps from a (the call's current point, solution ``sol``, watched
+        values ``start``) until one needs Python; their samples, work and counters are
+        applied to the call.
+        """
+        call = self.call
+        ev, model, motion = call.events, call.model, call.motion
+        contacts = ev.contacts
+        held = call.chatter.held(contacts.nodes, motion.depth_at(a))
+        problem, watched = self._set_tables(contacts, start.rows, held)
+        bounds, loads = model.area_tables(contacts.data)  # loads: kept once an element neared
+        area = (np.ascontiguousarray(bounds), _NO_LOADS if loads is None else loads)
+        m, nf = len(contacts), len(motion.names)
+        n = int(np.count_nonzero(~contacts.stick))
+        ends = start.values.ends
+        start_ends = np.array([ends.get(key, np.inf) for key in _END_KEYS])
+        s_out, theta_out = np.empty(CHUNK), np.empty((CHUNK, m))
+        forces_out, jacobians = np.empty((CHUNK, nf, 2)), np.empty((CHUNK, n, n))
+        c = np.ascontiguousarray
+        (count, why, most_it, most_res, theta, delta, F, dtheta, dF, ddelta, nu, kappa, J, it,
+         res) = self.kernel.advance_quiet(
+            a, call.step / motion.rate, c(sol.theta), c(sol.dtheta), c(sol.F), c(sol.dF),
+            c(sol.tangential), c(start.values.values, float), start_ends, *problem,
+            self.origin, self.D, NEWTON_TOL, NEWTON_MAX_ITERATIONS, NEWTON_BACKTRACKS,
+            CONTINUATION_ITERATIONS, MAX_ANGLE_JUMP, watched[0], float(model.mu),
+            float(motion.rate), *watched[1:], *self.tip_tables, self.rigid_gradients, *area,
+            GRADIENT_BOUND_EXACT, INVERSION_AREA_RATIO, self.weight, float(motion.depth0),
+            float(motion.length), expiry, QUIET_MARGIN, float(model.force_unit), call.work,
+            call.dissipation, s_out, theta_out, forces_out, jacobians)
+        python_next = why != self.kernel.FULL
+        if count == 0:
+            return Chunk(0, python_next, a, None)
+        counters = call.counters
+        counters.substeps += count
+        counters.newton_max_iterations = max(counters.newton_max_iterations, most_it)
+        counters.newton_max_residual = max(counters.newton_max_residual, most_res)
+        if n:
+            counters.jacobian_max_condition = max(
+                counters.jacobian_max_condition, float(np.linalg.cond(jacobians[:count]).max()))
+        nodes, names = tuple(contacts.nodes.tolist()), motion.names
+        for s, th, forces in zip(s_out[:count].tolist(), theta_out[:count].tolist(),
+                                 forces_out[:count].tolist()):
+            call.samples.append(Sample(motion.depth_at(s), nodes, tuple(th),
+                                       {name: tuple(f) for name, f in zip(names, forces)}))
+        cond = float(np.linalg.cond(J)) if J.size else 1.0
+        b = float(s_out[count - 1])
+        return Chunk(count, python_next, b,
+                     Solution(theta, delta, F, dtheta, dF, ddelta, it, res, cond, nu, kappa))

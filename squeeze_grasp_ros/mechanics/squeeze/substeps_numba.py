@@ -1,0 +1,379 @@
+# Copyright 2026 squeeze_grasp_ros developers
+# SPDX-License-Identifier: Apache-2.0
+"""The linear model's substeps between events compiled by numba (the ``fast`` extra): advance a
+stepper call from one point to the substep before the next event, in one call.
+
+:func:`advance_quiet` runs the substep loop of :meth:`~.stepper.run._Call.run` for a fixed
+contact set: the continuation solve at each substep end (:func:`.fixed_set_numba.solve_linear`,
+the same floats as the numpy route), the watched event functions there (normal forces, cone
+margins, slip rates, the free boundary rows' gaps through the boundary compliance rows, the
+area ratio, the pickup margin), the fingers' work and dissipation, and each accepted point's
+sample. It returns to Python (:mod:`.stepper.compiled`) before any substep that needs Python:
+one on which a watched function may cross zero (it is not above ``margin`` at the end, or
+surely below zero at the start), a continuation that fails or would be halved, an element
+near inversion before its load gradients are kept, a hold of the chattering bound that expires.
+Python then runs that substep as before, so events are located and processed by the same code.
+
+The work, the dissipation and the samples' finger forces are written in numpy's order (a
+masked ``sum(axis=0)`` adds rows one after the other from 0.0; a 1-D ``sum`` is numpy's
+pairwise sum), so they are the same floats; the watched values only decide whether a substep
+is surely quiet, with ``margin`` to spare for the order of their arithmetic.
+"""
+from __future__ import annotations
+
+import numba
+import numpy as np
+
+from squeeze_grasp_ros.mechanics.squeeze.fixed_set_numba import SOLVED, solve_linear
+
+END, CROSSING, SOLVE, LOADS, EXPIRY, FULL = 0, 1, 2, 3, 4, 5
+"""Why :func:`advance_quiet` returned: s reached 1, a watched function may cross on the next
+substep, its continuation fails (or would be halved), an element is near inversion without its
+load gradients, a hold expires at the next substep's start, the sample buffers are full."""
+jit = numba.njit(cache=True, nogil=True)
+
+
+@jit
+def _block(a, lo, n):
+    """The sum of a[lo:lo + n], n <= 128, in the order of numpy's ``pairwise_sum``."""
+    if n < 8:
+        res = 0.0
+        for i in range(lo, lo + n):
+            res += a[i]
+        return res
+    r0, r1, r2, r3 = a[lo], a[lo + 1], a[lo + 2], a[lo + 3]
+    r4, r5, r6, r7 = a[lo + 4], a[lo + 5], a[lo + 6], a[lo + 7]
+    i = 8
+    while i < n - n % 8:
+        r0 += a[lo + i]
+        r1 += a[lo + i + 1]
+        r2 += a[lo + i + 2]
+        r3 += a[lo + i + 3]
+        r4 += a[lo + i + 4]
+        r5 += a[lo + i + 5]
+        r6 += a[lo + i + 6]
+        r7 += a[lo + i + 7]
+        i += 8
+    res = ((r0 + r1) + (r2 + r3)) + ((r4 + r5) + (r6 + r7))
+    while i < n:
+        res += a[lo + i]
+        i += 1
+    return res
+
+
+@jit
+def np_sum(a):
+    """``a.sum()`` of a 1-D array, in numpy's order: blocks of at most 128 summed by
+    :func:`_block`, longer runs split in halves (multiples of 8) and added, as numpy's
+    recursive pairwise sum (written with a stack: numba's cache does not keep recursion).
+    """
+    ops = np.empty((192, 3), np.int64)  # (start, length, 0: sum it / 1: add the last two)
+    vals = np.empty(96)
+    ops[0, 0], ops[0, 1], ops[0, 2] = 0, a.shape[0], 0
+    top, nv = 1, 0
+    while top:
+        top -= 1
+        lo, n, kind = ops[top, 0], ops[top, 1], ops[top, 2]
+        if kind == 1:
+            nv -= 1
+            vals[nv - 1] = vals[nv - 1] + vals[nv]
+        elif n <= 128:
+            vals[nv] = _block(a, lo, n)
+            nv += 1
+        else:
+            n2 = n // 2
+            n2 -= n2 % 8
+            ops[top, 0], ops[top, 1], ops[top, 2] = 0, 0, 1
+            ops[top + 1, 0], ops[top + 1, 1], ops[top + 1, 2] = lo + n2, n - n2, 0
+            ops[top + 2, 0], ops[top + 2, 1], ops[top + 2, 2] = lo, n2, 0
+            top += 3
+    return 0.0 + vals[0]
+
+
+@jit
+def _finger_sums(F, finger, f):
+    """``F[finger == f].sum(axis=0)`` (rows added in order from 0.0)."""
+    s0, s1 = 0.0, 0.0
+    for k in range(F.shape[0]):
+        if finger[k] == f:
+            s0 += F[k, 0]
+            s1 += F[k, 1]
+    return s0, s1
+
+
+@jit
+def _dot2(x0, x1, y):
+    """``np.array([x0, x1]) @ y`` for a 2-vector y (BLAS ddot's order)."""
+    return 0.0 + ((0.0 + x0 * y[0]) + x1 * y[1])
+
+
+@jit
+def _tangential(F, nu):
+    """f_t = F . t(nu) (m,), as ``np.einsum('ij,ij->i', F, tangent(nu))``."""
+    out = np.empty(nu.shape[0])
+    for k in range(nu.shape[0]):
+        out[k] = (0.0 + F[k, 0] * -np.sin(nu[k])) + F[k, 1] * np.cos(nu[k])
+    return out
+
+
+@jit
+def _work(F_a, dF_a, ft_a, dth_a, F_b, dF_b, ft_b, dth_b, a, b, finger, D, radius_c, work,
+          dissipation):
+    """:meth:`~.stepper.run._Call.integrate_work` over [a, b], in place."""
+    h = b - a
+    m = finger.shape[0]
+    sliding = False
+    for k in range(m):
+        if dth_a[k] != 0.0 or dth_b[k] != 0.0:
+            sliding = True
+    pa, pb = np.empty(m), np.empty(m)
+    if sliding:
+        for k in range(m):
+            pa[k] = -ft_a[k] * radius_c[k] * dth_a[k]
+            pb[k] = -ft_b[k] * radius_c[k] * dth_b[k]
+    for f in range(D.shape[0]):
+        n = 0
+        for k in range(m):
+            if finger[k] == f:
+                n += 1
+        if n == 0:
+            continue
+        x0, x1 = _finger_sums(F_a, finger, f)
+        ya = _dot2(x0, x1, D[f])
+        x0, x1 = _finger_sums(F_b, finger, f)
+        yb = _dot2(x0, x1, D[f])
+        x0, x1 = _finger_sums(dF_a, finger, f)
+        ra = _dot2(x0, x1, D[f])
+        x0, x1 = _finger_sums(dF_b, finger, f)
+        rb = _dot2(x0, x1, D[f])
+        work[f] += 0.5 * h * (ya + yb) + h * h / 12.0 * (ra - rb)
+        if sliding:
+            qa, qb = np.empty(n), np.empty(n)
+            i = 0
+            for k in range(m):
+                if finger[k] == f:
+                    qa[i], qb[i] = pa[k], pb[k]
+                    i += 1
+            dissipation[f] += 0.5 * h * (np_sum(qa) + np_sum(qb))
+
+
+@jit
+def _area(delta, F, E, rigid_gradients, bounds, loads, exact_bound):
+    """(smallest det F as :meth:`~.contact_model.ContactModel.area_ratio` bounds or computes
+    it, whether an element needed its load gradients and none were given).
+    """
+    g = np.dot(E.T, delta.ravel())
+    rigid = np.dot(rigid_gradients, g)
+    t = bounds.shape[0]
+    norms = np.empty(F.shape[0])
+    for k in range(F.shape[0]):
+        norms[k] = np.sqrt(F[k, 0] * F[k, 0] + F[k, 1] * F[k, 1])
+    bound = np.dot(bounds, norms)
+    floor_bound, near = -1.0, 0
+    for e in range(t):
+        r = rigid[4 * e:4 * e + 4]
+        b_e = bound[e] + np.sqrt(r[0] * r[0] + r[1] * r[1] + r[2] * r[2] + r[3] * r[3])
+        if b_e >= exact_bound:
+            near += 1
+        elif b_e > floor_bound:
+            floor_bound = b_e
+    floor = (1.0 - floor_bound) ** 2 if floor_bound >= 0.0 else np.inf
+    if near == 0:
+        return floor, False
+    if loads.shape[0] != F.shape[0]:
+        return floor, True
+    smallest = floor
+    for e in range(t):
+        r = rigid[4 * e:4 * e + 4]
+        b_e = bound[e] + np.sqrt(r[0] * r[0] + r[1] * r[1] + r[2] * r[2] + r[3] * r[3])
+        if b_e < exact_bound:
+            continue
+        H = r.copy()
+        for k in range(F.shape[0]):
+            for i in range(4):
+                H[i] += loads[k, e, i, 0] * F[k, 0] + loads[k, e, i, 1] * F[k, 1]
+        det = (1.0 + H[0]) * (1.0 + H[3]) - H[1] * H[2]
+        smallest = min(smallest, det)
+    return smallest, False
+
+
+@jit
+def _pickup(mu, fn, ft, stick, finger, fingers, weight):
+    """:func:`~.stepper.functions.pickup_margin` (inf when ``weight`` is NaN: not checked)."""
+    if np.isnan(weight):
+        return np.inf
+    least = np.inf
+    for f in fingers:
+        total = 0.0
+        for k in range(fn.shape[0]):
+            if finger[k] == f and stick[k]:
+                total += np.sqrt(max(mu * mu * fn[k] * fn[k] - ft[k] * ft[k], 0.0))
+        least = min(least, total)
+    return weight / fingers.shape[0] - least
+
+
+@jit
+def _watched(theta, delta, F, dtheta, nu, pick, mu, slip, radius_c, rate, A_rows, R_rows, E,
+             boundary0, centers_f, radius_f, flat_f, t0_f, out):
+    """The watched per-contact values (``pick`` into fn, c+, c-, d laid end to end) and the
+    free rows' gaps to every finger, in :meth:`~.stepper.functions.EventFunctions.entries`'s
+    order, into ``out``; returns (fn, ft).
+    """
+    m = theta.shape[0]
+    fn, ft = np.empty(m), np.empty(m)
+    table = np.empty(4 * m)
+    for k in range(m):
+        c, s = np.cos(nu[k]), np.sin(nu[k])
+        fn[k] = F[k, 0] * c + F[k, 1] * s
+        ft[k] = F[k, 0] * -s + F[k, 1] * c
+        table[k] = fn[k]
+        table[m + k] = mu * fn[k] + ft[k]
+        table[2 * m + k] = mu * fn[k] - ft[k]
+        table[3 * m + k] = slip[k] * dtheta[k] * radius_c[k] / rate
+    for i in range(pick.shape[0]):
+        out[i] = table[pick[i]]
+    i = pick.shape[0]
+    rows = boundary0.shape[0]
+    if rows:
+        g = np.dot(E.T, delta.ravel())
+        u = np.dot(A_rows, F.ravel()) + np.dot(R_rows, g)
+        for r in range(rows):
+            x, y = boundary0[r, 0] + u[2 * r], boundary0[r, 1] + u[2 * r + 1]
+            for f in range(centers_f.shape[0]):
+                rx, ry = x - centers_f[f, 0], y - centers_f[f, 1]
+                tau = min(max(rx * t0_f[f, 0] + ry * t0_f[f, 1], -flat_f[f]), flat_f[f])
+                wx, wy = rx - tau * t0_f[f, 0], ry - tau * t0_f[f, 1]
+                out[i] = np.sqrt(wx * wx + wy * wy) - radius_f[f]
+                i += 1
+    return fn, ft
+
+
+@jit
+def _sure(start, end, margin):
+    """Whether no function goes from > 0 at the start to <= 0 at the end, with ``margin``."""
+    for k in range(end.shape[0]):
+        if not (end[k] > margin or start[k] < -margin):
+            return False
+    return True
+
+
+@jit
+def advance_quiet(a, h, theta, dtheta, F, dF, ft, start_values, start_ends,
+                  C, p0, stick, slip, phi, radius_c, flat_c, facing_c, finger, fingers,
+                  origin, D, newton_tol, max_iterations, backtracks, continuation_iterations,
+                  max_angle_jump, pick, mu, rate, A_rows, R_rows, E, boundary0, radius_f,
+                  flat_f, t0_f, rigid_gradients, bounds, loads, exact_bound, inversion_ratio,
+                  weight, depth0, length, expiry, margin, force_unit, work, dissipation,
+                  s_out, theta_out, forces_out, jacobians):
+    """Substeps of one contact set from s = a while each is surely quiet (module docstring).
+
+    Parameters
+    ----------
+    a, h : float
+        The current point and the grid substep (in s).
+    theta, dtheta, F, dF, ft : ndarray
+        The solution at a (angles, their rates, forces, their rates, tangential forces).
+    start_values, start_ends : ndarray
+        The watched values at a (per contact and gaps; area and pickup margins, inf when not
+        watched).
+    C, p0, stick, slip, phi, radius_c, flat_c, facing_c : ndarray or float
+        The fixed-set problem (:func:`.fixed_set_numba.solve_linear`'s arguments).
+    finger, fingers : ndarray of int
+        Each contact's finger; the fingers with contacts, ascending.
+    origin, D : (f, 2) ndarray
+        Each finger's tip reference point at s = 0 and its translation over the call.
+    newton_tol, max_iterations, backtracks : float, int, int
+        Newton's settings; ``continuation_iterations``, ``max_angle_jump`` the continuation's.
+    pick, mu, rate, A_rows, R_rows, E, boundary0, radius_f, flat_f, t0_f
+        The watched functions: where each per-contact value is in the table, friction, motion
+        per unit s, the rows of the boundary compliance and of the rigid modes of the free
+        rows, the rigid map, the rows' undeformed positions and the fingers' tips.
+    rigid_gradients, bounds, loads, exact_bound, inversion_ratio
+        The area check (:meth:`~.contact_model.ContactModel.area_ratio`); ``loads`` (m, t, 4,
+        2) or empty when not kept.
+    weight : float
+        The pickup weight / force unit, NaN when not checked.
+    depth0, length, expiry : float
+        Depth (m) at s = 0, L (m), the depth at which the next hold expires.
+    margin : float
+        How far above zero a function must be to be surely positive.
+    force_unit : float
+    work, dissipation : (f,) ndarray
+        Accumulated in place.
+    s_out, theta_out, forces_out, jacobians : ndarray
+        Each accepted point's s, angles, finger forces (N) and Newton Jacobian.
+
+    Returns
+    -------
+    tuple
+        (accepted substeps, why it returned, largest Newton iterations and residual, and the
+        last point's theta, delta, F, dtheta, dF, ddelta, nu, kappa, J, iterations,
+        residual).
+    """
+    m = theta.shape[0]
+    nf = origin.shape[0]
+    centers = np.empty((m, 2))
+    dirs = np.empty((m, 2))
+    for k in range(m):
+        dirs[k, 0], dirs[k, 1] = D[finger[k], 0], D[finger[k], 1]
+    centers_f = np.empty((nf, 2))
+    values = np.empty(start_values.shape[0])
+    ends = np.empty(2)
+    starts, start_e = start_values.copy(), start_ends.copy()
+    count, why, most_it, most_res = 0, END, 0, 0.0
+    delta_b = np.empty((m, 2))
+    ddelta_b, nu_b, kappa_b = np.empty((m, 2)), np.empty(m), np.empty(m)
+    J_b = np.empty((0, 0))
+    it_b, res_b = 0, 0.0
+    theta_a, dtheta_a, F_a, dF_a, ft_a = theta, dtheta, F, dF, ft
+    while a < 1.0:
+        if count == s_out.shape[0]:
+            why = FULL
+            break
+        if depth0 + a * rate * length >= expiry:
+            why = EXPIRY
+            break
+        b = min(a + h, 1.0)
+        guess = theta_a + dtheta_a * (b - a)
+        for k in range(m):
+            centers[k, 0] = origin[finger[k], 0] + b * D[finger[k], 0]
+            centers[k, 1] = origin[finger[k], 1] + b * D[finger[k], 1]
+        status, it, res, th, de, Fb, dth, dFb, dde, J, nu, kappa = solve_linear(
+            C, p0, centers, dirs, guess, stick, slip, phi, radius_c, flat_c, facing_c,
+            newton_tol, max_iterations, backtracks, newton_tol)
+        if status != SOLVED or it > continuation_iterations or \
+                np.abs(th - guess).max() > max_angle_jump:
+            why = SOLVE
+            break
+        for f in range(nf):
+            centers_f[f, 0] = origin[f, 0] + b * D[f, 0]
+            centers_f[f, 1] = origin[f, 1] + b * D[f, 1]
+        fn, ft_b = _watched(th, de, Fb, dth, nu, pick, mu, slip, radius_c, rate, A_rows,
+                            R_rows, E, boundary0, centers_f, radius_f, flat_f, t0_f, values)
+        det, missing = _area(de, Fb, E, rigid_gradients, bounds, loads, exact_bound)
+        if missing:
+            why = LOADS
+            break
+        ends[0] = det - inversion_ratio
+        ends[1] = _pickup(mu, fn, ft_b, stick, finger, fingers, weight)
+        if not (_sure(starts, values, margin) and _sure(start_e, ends, margin)):
+            why = CROSSING
+            break
+        ft_b = _tangential(Fb, nu)
+        _work(F_a, dF_a, ft_a, dtheta_a, Fb, dFb, ft_b, dth, a, b, finger, D, radius_c, work,
+              dissipation)
+        most_it, most_res = max(most_it, it), max(most_res, res)
+        s_out[count] = b
+        theta_out[count] = th
+        for f in range(nf):
+            x0, x1 = _finger_sums(Fb, finger, f)
+            forces_out[count, f, 0], forces_out[count, f, 1] = x0 * force_unit, x1 * force_unit
+        if J.shape[0]:
+            jacobians[count] = J
+        count += 1
+        starts[:], start_e[:] = values, ends
+        theta_a, dtheta_a, F_a, dF_a, ft_a = th, dth, Fb, dFb, ft_b
+        delta_b, ddelta_b, nu_b, kappa_b, J_b, it_b, res_b = de, dde, nu, kappa, J, it, res
+        a = b
+    return (count, why, most_it, most_res, theta_a, delta_b, F_a, dtheta_a, dF_a, ddelta_b,
+            nu_b, kappa_b, J_b, it_b, res_b)

@@ -1,0 +1,154 @@
+# Copyright 2026 squeeze_grasp_ros developers
+# SPDX-License-Identifier: Apache-2.0
+"""The compiled substeps between events (numba route, ``fast`` extra) against the Python loop:
+numpy's summation order reproduced, whole event squeezes of shipped scenes identical field by
+field with the kernel doing most substeps, and the cases that must stay in Python.
+"""
+from __future__ import annotations
+
+import dataclasses
+import functools
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from squeeze_grasp_ros.mechanics.squeeze.fixed_set_kernel import KERNEL_VARIABLE, Kernel
+from squeeze_grasp_ros.mechanics.squeeze.stepper import compiled as compiled_module
+from squeeze_grasp_ros.scene import GraspSetup, load_scene
+
+numba = pytest.importorskip("numba", reason="the fast extra is not installed: "
+                                            "pip install '.[fast]'")
+substeps_numba = pytest.importorskip("squeeze_grasp_ros.mechanics.squeeze.substeps_numba")
+
+SCENES = Path(__file__).resolve().parents[1] / "config" / "scenes"
+
+
+def test_sums_are_numpys_to_the_bit():
+    rng = np.random.default_rng(33)
+    for n in [0, 1, 2, 7, 8, 9, 15, 16, 17, 127, 128, 129, 255, 256, 1000, 2049]:
+        for _ in range(5):
+            a = rng.standard_normal(n) * 10.0 ** rng.integers(-8, 8, n)
+            assert substeps_numba.np_sum(a) == a.sum(), n
+    assert str(substeps_numba.np_sum(np.array([-0.0, -0.0]))) == str(np.array([-0.0]).sum())
+    F = rng.standard_normal((9, 2))
+    finger = rng.integers(0, 2, 9)
+    for f in (0, 1, 2):
+        assert substeps_numba._finger_sums(F, finger, f) == tuple(F[finger == f].sum(axis=0))
+
+
+def _same(a, b, path: str = "") -> None:
+    """Assert two results equal field by field, floats bit for bit (NaN equal to NaN)."""
+    if dataclasses.is_dataclass(a):
+        for f in dataclasses.fields(a):
+            _same(getattr(a, f.name), getattr(b, f.name), f"{path}.{f.name}")
+    elif isinstance(a, dict):
+        assert a.keys() == b.keys(), path
+        for key in a:
+            if not (path.endswith("diagnostics") and key == "compliance"):  # an estimate
+                _same(a[key], b[key], f"{path}[{key}]")
+    elif isinstance(a, (list, tuple)):
+        assert len(a) == len(b), path
+        for i, (x, y) in enumerate(zip(a, b)):
+            _same(x, y, f"{path}[{i}]")
+    elif isinstance(a, np.ndarray):
+        np.testing.assert_array_equal(a, b, err_msg=path)
+    elif isinstance(a, float):
+        assert a == b or (a != a and b != b), (path, a, b)
+    else:
+        assert a == b, (path, a, b)
+
+
+@functools.lru_cache(maxsize=None)
+def _setup(name: str) -> GraspSetup:
+    return GraspSetup.build(load_scene(SCENES / f"{name}.yaml")).precompute()
+
+
+@pytest.mark.parametrize("name", ["foam_square", "foam_square_low_friction", "disk_finger_slip",
+                                  "foam_square_pickup", "sponge_gripper_slip"])
+def test_event_squeezes_are_identical_with_the_compiled_substeps(name, monkeypatch):
+    """Events, samples, forces, work and diagnostics of the numba route are the numpy route's
+    to the bit, while the kernel runs most of the substeps (stick and slip, circles and pads,
+    pickup, finger slip).
+    """
+    accepted = []
+    run = compiled_module.CompiledSubsteps.run
+
+    def counting(self, *args):
+        chunk = run(self, *args)
+        accepted.append(chunk.count)
+        return chunk
+
+    monkeypatch.setattr(compiled_module.CompiledSubsteps, "run", counting)
+    results = {}
+    for route in Kernel:
+        monkeypatch.setenv(KERNEL_VARIABLE, route.value)
+        results[route] = _setup(name).event_squeeze()
+        if route == Kernel.NUMPY:
+            assert not accepted  # the reference path never calls the kernel
+    a, b = results[Kernel.NUMPY], results[Kernel.NUMBA]
+    _same(a, b)
+    # the substeps the kernel stops before (a crossing, the first after an event) run in
+    # Python: about one in three in these short squeezes of 33-94 substeps
+    substeps = b.diagnostics["substeps"]
+    assert sum(accepted) >= 0.4 * substeps > 0, (sum(accepted), substeps)
+
+
+def test_low_friction_squeeze_keeps_its_physics_on_the_compiled_route(monkeypatch):
+    """An independent check of what the kernel produced: sliding contacts on their cone edge,
+    sticking ones inside it, and the fingers' work at least the stored energy (friction
+    dissipates).
+    """
+    monkeypatch.setenv(KERNEL_VARIABLE, Kernel.NUMBA.value)
+    res = _setup("foam_square_low_friction").event_squeeze()
+    assert res.event_counts["C"] >= 1
+    for seg in res.segments.values():
+        for s in seg:
+            assert s.slip_margin >= -1e-9 * abs(s.normal_force)
+    assert sum(res.work.values()) > res.energy
+
+
+def test_what_the_kernel_does_not_take_stays_in_python(monkeypatch):
+    """Nonlinear materials, strain limits and checkpoints run the Python loop on the numba
+    route (their results are those of the numpy route, which the golden tests check).
+    """
+    calls = []
+    monkeypatch.setattr(compiled_module.CompiledSubsteps, "run",
+                        lambda self, *args: calls.append(args))
+    monkeypatch.setenv(KERNEL_VARIABLE, Kernel.NUMBA.value)
+    _setup("foam_square_strain_limit").event_squeeze()
+    setup = _setup("foam_square")
+    setup.event_squeeze(checkpoint=lambda: None)
+    setup.event_squeeze(material_model="neo_hookean", relative_depth=0.02)
+    assert calls == []
+
+
+def _example_rows(route: Kernel, tasks: int | None, monkeypatch) -> list[dict]:
+    """The example sweep's rows (its first ``tasks`` tasks) on ``route``, without time_s."""
+    import yaml
+
+    from squeeze_grasp_ros.sweep.evaluate import clear_cache, prepare, run_task
+    from squeeze_grasp_ros.sweep.plan import plan_tasks
+    from squeeze_grasp_ros.sweep.spec import parse_sweep_spec
+
+    spec = SCENES.parent / "sweeps" / "example.yaml"
+    every = list(plan_tasks(parse_sweep_spec(yaml.safe_load(spec.read_text()), spec.parent)))
+    monkeypatch.setenv(KERNEL_VARIABLE, route.value)
+    clear_cache()  # fresh groups: what objects keep from the other route is not reused
+    rows = []
+    for task in every[:tasks]:
+        prepare(task)
+        rows += [{k: v for k, v in row.items() if k != "time_s"} for row in run_task(task)["rows"]]
+    return rows
+
+
+@pytest.mark.parametrize("tasks", [1, pytest.param(None, marks=pytest.mark.slow)])
+def test_the_example_sweep_rows_are_identical_on_both_routes(tasks, monkeypatch):
+    """The example sweep's rows (one task of 48 by default, all 288 in the slow suite) are the
+    same on both routes apart from their timing (NaN fields NaN on both).
+    """
+    a = _example_rows(Kernel.NUMPY, tasks, monkeypatch)
+    b = _example_rows(Kernel.NUMBA, tasks, monkeypatch)
+    assert len(a) == len(b) >= 48
+    for x, y in zip(a, b):
+        _same(x, y)

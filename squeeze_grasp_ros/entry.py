@@ -79,14 +79,13 @@ def end_after_ros(code: int | None) -> None:
     (the interpreter's normal exit follows) otherwise.
 
     The teardown it skips writes nothing and took 0.3-0.5 s after a 2 s ``run`` at load 4-6
-    (docs/pipeline.md,
-    start-up): the interpreter's final garbage collections over the 80,000 objects of a run's
-    1,300 modules, and Fast DDS's ``DomainParticipantFactory`` destructor (a C++ static
-    destructor), which sleeps an unconditional 100 ms before it stops its log thread. By the
-    time a verb returns it has destroyed its nodes, closed its recording (the recorder's close
-    writes the MCAP footer and ``metadata.yaml``) and stopped its node processes; shutting its
-    rclpy contexts down has also finished ROS logging (rcl's log file is flushed and closed
-    with the last context that started it).
+    (docs/pipeline.md, start-up): the interpreter's final garbage collections over the 80,000
+    objects of a run's 1,300 modules, and Fast DDS's ``DomainParticipantFactory`` destructor (a
+    C++ static destructor), which sleeps an unconditional 100 ms before it stops its log thread.
+    By the time a verb returns it has destroyed its nodes, closed its recording (the
+    recorder's close writes the MCAP footer and ``metadata.yaml``) and stopped its node
+    processes; shutting its rclpy contexts down has also finished ROS logging (rcl's log file
+    is flushed and closed with the last context that started it).
 
     Checked first: rclpy was imported, no rclpy context still holds ROS logging (one was left
     running: the normal exit), and no thread but the main one and daemon threads is alive (the

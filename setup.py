@@ -98,7 +98,7 @@ setup(
     tests_require=["pytest"],
     entry_points={
         "console_scripts": [
-            "squeeze-grasp = squeeze_grasp_ros.entry:cli",
+            "squeeze-grasp = squeeze_grasp_ros.entry:cli_process",
             "planner = squeeze_grasp_ros.entry:planner",
             "executor = squeeze_grasp_ros.entry:executor",
             "monitor = squeeze_grasp_ros.entry:monitor",

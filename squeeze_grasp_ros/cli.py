@@ -134,6 +134,6 @@ def main(argv: list[str] | None = None) -> int:
 
 
 if __name__ == "__main__":
-    from squeeze_grasp_ros.entry import cli
+    from squeeze_grasp_ros.entry import cli_process
 
-    sys.exit(cli())  # as the console script: signals while starting end with one line
+    sys.exit(cli_process())  # as the console script: signals while starting end with one line

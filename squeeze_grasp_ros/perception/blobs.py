@@ -11,7 +11,6 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy import ndimage
 
 from squeeze_grasp_ros.mechanics.errors import InvalidInputError
 
@@ -87,6 +86,8 @@ def choose_object(inside: np.ndarray, *, min_area_px: int, ambiguous_ratio: floa
         No blob (an empty view), the object touching the image border, or two blobs of similar
         size.
     """
+    from scipy import ndimage
+
     # label only the bounding box of all pixels inside (the object and the other blobs): a
     # top-down view is mostly background, and labelling the whole frame was most of a 640 x
     # 480 mask's extraction time

@@ -33,7 +33,6 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy import ndimage
 
 from squeeze_grasp_ros.mechanics.elastic.shapes import Outline, signed_area, validate_polyline
 from squeeze_grasp_ros.mechanics.errors import InvalidInputError
@@ -422,6 +421,8 @@ def _top_height(field: np.ndarray, choice: BlobChoice) -> float:
     inside the edge (the edge's mixed pixels would pull a thin wall's median down), or over all
     its pixels when it is too thin to keep ten.
     """
+    from scipy import ndimage
+
     blob = choice.labels[choice.box] == choice.label
     inner = ndimage.binary_erosion(blob)
     heights = field[choice.box][inner if inner.sum() >= 10 else blob]
@@ -432,6 +433,8 @@ def _check_invalid_near(valid: np.ndarray, choice: BlobChoice) -> None:
     """Refuse invalid depth pixels inside or next to the object (its outline is unknown
     there).
     """
+    from scipy import ndimage
+
     rows, cols = choice.box
     window = (slice(rows.start - 1, rows.stop + 1), slice(cols.start - 1, cols.stop + 1))
     near = ndimage.binary_dilation(choice.labels[window] == choice.label, iterations=2)

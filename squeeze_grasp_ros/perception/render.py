@@ -27,7 +27,6 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.ndimage import gaussian_filter
 
 from squeeze_grasp_ros.mechanics.elastic.mesh import vertex_normals
 from squeeze_grasp_ros.mechanics.elastic.shapes import Outline, signed_area, validate_polyline
@@ -240,6 +239,8 @@ def render_views(outline: Outline, camera: CameraModel, pose: CameraPose, *,
         For a negative option, a top face at or above the camera, or a view in which some
         pixel does not see the plane.
     """
+    from scipy.ndimage import gaussian_filter
+
     for name, value in (("top_height", top_height), ("blur_px", blur_px),
                         ("depth_noise_m", depth_noise_m), ("mask_noise", mask_noise)):
         if not (np.isfinite(value) and value >= 0):

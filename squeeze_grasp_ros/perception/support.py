@@ -14,7 +14,6 @@ from dataclasses import dataclass
 from functools import lru_cache
 
 import numpy as np
-from scipy import ndimage
 
 from squeeze_grasp_ros.mechanics.errors import InvalidInputError
 from squeeze_grasp_ros.perception.camera import CameraModel, CameraPose
@@ -116,6 +115,8 @@ def fit_support(heights: np.ndarray, valid: np.ndarray, camera: CameraModel, pos
     InvalidInputError
         Too little support in view, or a support that is tilted, shifted or not planar.
     """
+    from scipy import ndimage
+
     bx, by = _block_centres(camera, pose)
     mean_h, count = _block_means(heights, valid)
     full = count >= BLOCK * BLOCK // 2

@@ -22,7 +22,6 @@ from pathlib import Path
 from typing import Any
 
 from squeeze_grasp_ros.ros.nodes import PARAMS_FILE_ENV, PARENT_PID_ENV
-from squeeze_grasp_ros.ros.recording.bag import plain_yaml
 from squeeze_grasp_ros.ros.run.options import RunError
 from squeeze_grasp_ros.threads import single_thread_blas
 
@@ -96,6 +95,8 @@ class NodeProcesses:
 
     def start_nodes(self, params: Mapping[str, Mapping[str, Any]]) -> None:
         """Write a parameter file and start one process per node of ``params``."""
+        from squeeze_grasp_ros.ros.recording.bag import plain_yaml  # loads MCAP: processes only
+
         remove_stale_parameter_files()
         handle, path = tempfile.mkstemp(prefix=f"{PARAMS_PREFIX}{os.getpid()}_", suffix=".yaml")
         os.close(handle)

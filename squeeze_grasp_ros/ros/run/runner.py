@@ -55,7 +55,6 @@ from squeeze_grasp_ros.ros import messages
 from squeeze_grasp_ros.ros.messages.objects import typed_object
 from squeeze_grasp_ros.ros.nodes import pipeline
 from squeeze_grasp_ros.ros.nodes.planner_client import PlannerClient
-from squeeze_grasp_ros.ros.recording.bag import STOPPED_KEY, BagError, bag_info
 from squeeze_grasp_ros.ros.run.camera_plan import (
     first_outline,
     predicted_shapes_msg,
@@ -298,12 +297,15 @@ class PipelineRunner:
         """
         from squeeze_grasp_ros.ros.nodes.executor import ExecutorNode
         from squeeze_grasp_ros.ros.nodes.monitor import MonitorNode
-        from squeeze_grasp_ros.ros.nodes.recorder import RecorderNode
         from squeeze_grasp_ros.ros.nodes.sim_hardware import SimHardwareNode
         from squeeze_grasp_ros.sim.world import SimWorld
 
         classes = {"sim_hardware": SimHardwareNode, "monitor": MonitorNode,
-                   "executor": ExecutorNode, "recorder": RecorderNode}
+                   "executor": ExecutorNode}
+        if "recorder" in params:  # the MCAP writer's libraries load only for a recording
+            from squeeze_grasp_ros.ros.nodes.recorder import RecorderNode
+
+            classes["recorder"] = RecorderNode
         own_scene = str(Path(self.options.scene_path).resolve())
         for name, values in params.items():
             overrides = [Parameter(k, value=v) for k, v in values.items()]
@@ -399,6 +401,8 @@ class PipelineRunner:
             return None
         if self.recorder is not None:
             return self.recorder.writer.stopped
+        from squeeze_grasp_ros.ros.recording.bag import STOPPED_KEY, BagError, bag_info
+
         try:
             return bag_info(self.options.record).get("custom_data", {}).get(STOPPED_KEY)
         except BagError as exc:

@@ -43,6 +43,8 @@ from squeeze_grasp_ros.perception.camera import CameraModel, CameraPose
 from squeeze_grasp_ros.perception.primitives import Primitive, recognise, sampled, scene_shape
 from squeeze_grasp_ros.perception.simplify import (
     KINK_TURN_DEG,
+    centred_vertices,
+    joined_curve,
     kept_vertices,
     segment_distances,
     sharpen_corners,
@@ -81,6 +83,14 @@ of the segment joining the two corners around them (rebuilt, or kinks turning mo
 (straight edges: noisy depth strays up to about 1 px); otherwise it has curved stretches and is
 a spline with declared corners (a mixed outline: an arc of radius R px between corners strays
 R (1 - cos(a / 2)) from its chord, 3.5 px for a quarter circle of 12 px)."""
+
+CENTRE_WINDOW_PX = 2.0
+"""Half-length (pixel footprints) of the stretch of traced points a smooth outline's vertex is
+the mean of (:func:`~.simplify.centred_vertices`)."""
+
+JOIN_SPACING_PX = 1.0
+"""Spacing (pixel footprints) of the samples of a mixed outline's piecewise spline
+(:func:`~.simplify.joined_curve`)."""
 
 PRIMITIVE_TOLERANCE_PX = 0.3
 """Largest distance (pixel footprints) of a traced point from a fitted circle or ellipse for
@@ -318,11 +328,21 @@ def _outline(loops: list[np.ndarray], camera: CameraModel, pose: CameraPose,
     if straight or any(c.any() for _, c in simplified):
         return (Outline(outer, holes), ShapeType.POLYGON, None, tolerance, pixel,
                 plane.undistort_residual_px)
+    window = CENTRE_WINDOW_PX * pixel
+    outer = centred_vertices(metric[0], outer, cornered, window=window)
+    holes = tuple(centred_vertices(t, h, np.zeros(len(h), bool), window=window)
+                  for t, h in zip(metric[1:], holes))
     corners = spline_corners(metric[0], outer, cornered,
                              tolerance=max(tolerance, PRIMITIVE_TOLERANCE_PX * pixel),
                              radius=CORNER_RADIUS_PX * pixel)
-    shape = ShapeType.POLYGON if corners.all() else ShapeType.SPLINE
-    return (Outline(outer, holes, np.flatnonzero(corners)), shape, None, tolerance, pixel,
+    if corners.all():
+        return (Outline(outer, holes, np.arange(len(outer))), ShapeType.POLYGON, None,
+                tolerance, pixel, plane.undistort_residual_px)
+    if corners.any():
+        outer, at = joined_curve(outer, corners, spacing=JOIN_SPACING_PX * pixel)
+    else:
+        at = np.zeros(0, int)
+    return (Outline(outer, holes, at), ShapeType.SPLINE, None, tolerance, pixel,
             plane.undistort_residual_px)
 
 

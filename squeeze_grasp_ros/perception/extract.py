@@ -48,6 +48,7 @@ from squeeze_grasp_ros.perception.simplify import (
     kept_vertices,
     segment_distances,
     sharpen_corners,
+    smoothed_curve,
     spline_corners,
     vertex_turns,
 )
@@ -87,6 +88,10 @@ R (1 - cos(a / 2)) from its chord, 3.5 px for a quarter circle of 12 px)."""
 CENTRE_WINDOW_PX = 2.0
 """Half-length (pixel footprints) of the stretch of traced points a smooth outline's vertex is
 the mean of (:func:`~.simplify.centred_vertices`)."""
+
+TRACE_NOISE_PX = 0.05
+"""RMS wobble (pixel footprints) of a traced edge the smoothing spline may leave unfitted
+(:func:`~.simplify.smoothed_curve`)."""
 
 JOIN_SPACING_PX = 1.0
 """Spacing (pixel footprints) of the samples of a mixed outline's piecewise spline
@@ -328,6 +333,18 @@ def _outline(loops: list[np.ndarray], camera: CameraModel, pose: CameraPose,
     if straight or any(c.any() for _, c in simplified):
         return (Outline(outer, holes), ShapeType.POLYGON, None, tolerance, pixel,
                 plane.undistort_residual_px)
+    reach = max(tolerance, PRIMITIVE_TOLERANCE_PX * pixel)
+    smoothed = smoothed_curve(metric[0], outer, kinks, tolerance=reach,
+                              spacing=JOIN_SPACING_PX * pixel,
+                              clearance=CORNER_RADIUS_PX * pixel, noise=TRACE_NOISE_PX * pixel)
+    if smoothed is not None:
+        fitted_holes = [smoothed_curve(t, h, np.zeros(len(h), bool), tolerance=reach,
+                                       spacing=JOIN_SPACING_PX * pixel, clearance=0.0,
+                                       noise=TRACE_NOISE_PX * pixel)
+                        for t, h in zip(metric[1:], holes)]
+        holes = tuple(h if f is None else f[0] for h, f in zip(holes, fitted_holes))
+        return (Outline(smoothed[0], holes, smoothed[1]), ShapeType.SPLINE, None, tolerance,
+                pixel, plane.undistort_residual_px)
     window = CENTRE_WINDOW_PX * pixel
     outer = centred_vertices(metric[0], outer, cornered, window=window)
     holes = tuple(centred_vertices(t, h, np.zeros(len(h), bool), window=window)

@@ -17,11 +17,12 @@ from __future__ import annotations
 
 import numpy as np
 
+from squeeze_grasp_ros.mechanics.elastic.shapes import signed_area
 from squeeze_grasp_ros.mechanics.errors import InvalidInputError
 
 __all__ = ["centred_vertices", "curve_distances", "joined_curve", "kept_vertices",
-           "segment_distances", "sharpen_corners", "simplify_closed", "spline_corners",
-           "vertex_turns"]
+           "segment_distances", "sharpen_corners", "simplify_closed", "smoothed_curve",
+           "spline_corners", "vertex_turns"]
 
 
 def segment_distances(points: np.ndarray, start: np.ndarray, end: np.ndarray) -> np.ndarray:
@@ -416,3 +417,97 @@ def joined_curve(vertices: np.ndarray, breaks: np.ndarray, *, spacing: float
     t = np.mod(np.concatenate(pieces), s[-1])
     samples = np.column_stack([np.interp(t, s, closed[:, 0]), np.interp(t, s, closed[:, 1])])
     return samples, first[np.abs(vertex_turns(dense))[at] > JOIN_TURN_DEG]
+
+
+def smoothed_curve(points: np.ndarray, vertices: np.ndarray, corners: np.ndarray, *,
+                   tolerance: float, spacing: float, clearance: float, noise: float
+                   ) -> tuple[np.ndarray, np.ndarray] | None:
+    """Even samples of the smoothing cubic spline (FITPACK ``splprep``) fitted to traced
+    closed curve ``points`` between the ``vertices`` flagged ``corners`` (bool each), and the
+    corners' indices among the samples; None when no fit keeps every traced point within
+    ``tolerance`` of the samples.
+
+    A spline *through* simplified vertices inherits their extremal bias (Douglas-Peucker keeps
+    the crests of the trace's wobble) and, where a straight edge runs into an arc, bends
+    (an interpolating cubic cannot jump in curvature: a rounded rectangle's spline turned by
+    -26 degrees at a join). A least-squares smoothing spline fits the trace itself: unbiased,
+    tangent-continuous through the joins, its residual sum of squares at most ``noise``^2 per
+    traced point (quartered until every point is within ``tolerance``). Between two corners the
+    curve is an open smoothing spline pinned at both (straight when fewer than 8 traced points
+    lie between them); without corners the spline is periodic.
+    Traced points within ``clearance`` of a corner are not fitted (the trace cuts it short).
+
+    Parameters
+    ----------
+    points : (n, 2) ndarray
+        The traced closed curve, m (the samples run counter-clockwise).
+    vertices, corners : (k, 2) ndarray, (k,) ndarray of bool
+        Its simplified vertices and which are corners (rebuilt, or kinks).
+    tolerance, spacing, clearance, noise : float
+        Lengths, m: the largest distance of a fitted traced point from the curve, the largest
+        distance between samples, the clearance around corners and the trace's noise.
+    """
+    from scipy.interpolate import splev, splprep
+    from scipy.spatial import cKDTree
+
+    p = np.asarray(points, float)
+    n = len(p)
+    step = np.linalg.norm(np.roll(p, -1, axis=0) - p, axis=1)
+    arc = np.concatenate([[0.0], np.cumsum(step)])[:n]
+    total = arc[-1] + step[-1]
+    corner_xy = np.asarray(vertices, float)[np.asarray(corners, bool)]
+    fitted = np.ones(n, bool)
+    if len(corner_xy):
+        fitted = np.linalg.norm(p[:, None] - corner_xy[None], axis=2).min(axis=1) >= clearance
+        at = cKDTree(p).query(corner_xy)[1]
+        order = np.argsort(arc[at])
+        corner_xy, at = corner_xy[order], at[order]
+
+    def piece(chain: np.ndarray, ends: tuple | None, smooth: float) -> np.ndarray:
+        """Dense samples of one stretch (``ends``: its two corners, or None: periodic)."""
+        if ends is None:
+            data, weights, periodic = chain, np.ones(len(chain)), 1
+        else:
+            data = np.vstack([ends[0], chain, ends[1]])
+            weights = np.r_[1e3, np.ones(len(chain)), 1e3]
+            periodic = 0
+        gaps = np.linalg.norm(np.diff(data, axis=0), axis=1)
+        keep = np.r_[True, gaps > 1e-9 * max(gaps.max(), 1e-300)]
+        data, weights = data[keep], weights[keep]
+        u = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(data, axis=0), axis=1))])
+        length = u[-1] + (np.linalg.norm(data[0] - data[-1]) if periodic else 0.0)
+        tck, _ = splprep(data.T, w=weights, u=u / length, s=smooth * len(data), k=3,
+                         per=periodic, quiet=2)
+        count = max(8, int(np.ceil(length / spacing)))
+        return np.column_stack(splev(np.linspace(0.0, 1.0, count, endpoint=not periodic),
+                                     tck))[:-1 if not periodic else None]
+
+    smooth = noise ** 2
+    for _ in range(6):
+        if not len(corner_xy):
+            if fitted.sum() < 8:
+                return None
+            samples, anchors = piece(p, None, smooth), np.zeros(0, int)
+        else:
+            parts, anchors, count = [], [], 0
+            for k in range(len(at)):
+                a, b = at[k], at[(k + 1) % len(at)]
+                run = p[np.arange(a, b + (n if b <= a else 0)) % n]
+                run = run[fitted[np.arange(a, b + (n if b <= a else 0)) % n]]
+                ends = corner_xy[k], corner_xy[(k + 1) % len(at)]
+                if len(run) < 8:  # too short to fit: straight
+                    length = np.linalg.norm(ends[1] - ends[0])
+                    m = max(1, int(np.ceil(length / spacing)))
+                    part = ends[0] + np.outer(np.arange(m) / m, ends[1] - ends[0])
+                else:
+                    part = piece(run, ends, smooth)
+                anchors.append(count)
+                parts.append(part)
+                count += len(part)
+            samples, anchors = np.vstack(parts), np.array(anchors)
+        if curve_distances(p[fitted], samples).max() <= tolerance:
+            if signed_area(samples) < 0:  # the trace ran clockwise
+                return samples[::-1], np.sort(len(samples) - 1 - anchors)
+            return samples, anchors
+        smooth *= 0.25
+    return None

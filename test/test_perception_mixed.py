@@ -26,7 +26,7 @@ from squeeze_grasp_ros.mechanics.vocabulary import ShapeType
 from squeeze_grasp_ros.perception.render import render_views
 from squeeze_grasp_ros.planning.errors import PlannerError
 from squeeze_grasp_ros.planning.typed_objects import TypedMaterial, TypedObject, typed_scene
-from squeeze_grasp_ros.scene import SceneError, build_outline, parse_scene
+from squeeze_grasp_ros.scene import build_outline, parse_scene
 
 HEIGHT = 0.02
 """Top face height, m."""
@@ -72,7 +72,8 @@ TRUE_CORNERS = {"stadium": 0, "rounded_rectangle": 0, "d_shape": 2}
 """Corners of each truth (tangent discontinuities): the D's two, where its diameter meets the
 arc; the stadium's and the rounded rectangle's straight edges run into their arcs tangentially."""
 
-VIEWS = [(0.0, 0.0, 0.0), (0.37e-3, -0.81e-3, 0.3), (-1.3e-3, 0.55e-3, -1.1), (0.21e-3, 0.13e-3, 2.0)]
+VIEWS = [(0.0, 0.0, 0.0), (0.37e-3, -0.81e-3, 0.3), (-1.3e-3, 0.55e-3, -1.1),
+         (0.21e-3, 0.13e-3, 2.0)]
 """Camera offsets (m) and yaw (rad): sub-pixel shifts and rotations."""
 
 

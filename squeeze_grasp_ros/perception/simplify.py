@@ -452,15 +452,12 @@ def smoothed_curve(points: np.ndarray, vertices: np.ndarray, corners: np.ndarray
 
     p = np.asarray(points, float)
     n = len(p)
-    step = np.linalg.norm(np.roll(p, -1, axis=0) - p, axis=1)
-    arc = np.concatenate([[0.0], np.cumsum(step)])[:n]
-    total = arc[-1] + step[-1]
     corner_xy = np.asarray(vertices, float)[np.asarray(corners, bool)]
     fitted = np.ones(n, bool)
     if len(corner_xy):
         fitted = np.linalg.norm(p[:, None] - corner_xy[None], axis=2).min(axis=1) >= clearance
         at = cKDTree(p).query(corner_xy)[1]
-        order = np.argsort(arc[at])
+        order = np.argsort(at)  # in the trace's order
         corner_xy, at = corner_xy[order], at[order]
 
     def piece(chain: np.ndarray, ends: tuple | None, smooth: float) -> np.ndarray:

@@ -11,9 +11,12 @@ cuts a corner short). Closed holes become holes of the outline (a ring or annulu
 A circle, an ellipse or a circle with a concentric circular hole that fits the traced points
 within :data:`PRIMITIVE_TOLERANCE_PX` is recognised as a ``disk``, ``ellipse`` or ``annulus``
 (:mod:`.primitives`). Outlines whose rebuilt corners join straight edges are polygons; the
-others are splines (``spline``) with declared corners where a spline through the vertices
-would stray from the traced points (:func:`.simplify.spline_corners`: straight edges and
-curved stretches, a mixed outline), none when it stays within reach of them (a smooth curve).
+others are splines (``spline``): a smoothing spline fitted to the trace
+(:func:`.simplify.smoothed_curve`), pinned at the real corners (rebuilt, or kinks) of a mixed
+outline (straight edges and curved stretches) and at none of a smooth curve; tangent joins of
+a straight edge and an arc are no corners. When no smoothing spline fits, a spline through the
+simplified vertices with corners where it would stray from the traced points
+(:func:`.simplify.spline_corners`).
 
 - **mask** (``mono8``): 0 is background, larger values object; read as coverage (value / 255,
   or / 1 for a 0/1 mask) with the edge at half coverage, so an anti-aliased mask gives edges

@@ -113,34 +113,33 @@ def _circle(points: np.ndarray, tolerance: float):
     return np.asarray(model.center, float), float(model.radius)
 
 
-SIDE_SPANS = (4.0, 2.0, 1.0)
-"""Lengths (multiples of ``span``) of the stretch beside a corner that is fitted as a line or a
-circle, longest first. A 40 px arc strays only 0.1 px from a line over 8 px, and a circle
-fitted to 8 px of it has its radius off by half (the corner then 0.5 px off): the longest
-stretch that is straight or circular decides which it is."""
-
+SIDE_SPANS = (4.0, 2.0)
+"""Lengths (multiples of ``span``) of the longer stretches beside a corner that are fitted as
+a line or a circle, longest first. A 40 px arc strays only 0.1 px from a line over 8 px (one
+span), and a circle fitted to 8 px of it has its radius off by half (the corner then 0.5 px
+off): the longer stretches tell an arc from a line."""
 
 LINE_BESIDE_ARC = 2.0
 """A straight side meets an arc at a corner only when it is straight over this many spans (a
 D's diameter is; a gently curved side, straight to the tolerance over one span only, is not)."""
 
 
-def _side(p: np.ndarray, gap: np.ndarray, skip: float, span: float, tolerance: float):
-    """The side of a corner after the point at ``gap`` = 0: ``("line", f, centre, direction)``
-    or ``("arc", f, centre, radius)`` fitted within ``tolerance`` to the longest stretch from
-    ``skip`` to ``skip + f span`` (``f`` of :data:`SIDE_SPANS`) that is straight or circular;
-    None when none is.
+def _stretch(p: np.ndarray, gap: np.ndarray, skip: float, length: float) -> np.ndarray:
+    """The traced points from ``skip`` to ``skip + length`` after the point at ``gap`` = 0."""
+    return p[(gap >= skip) & (gap <= skip + length)]
+
+
+def _arc_side(p: np.ndarray, gap: np.ndarray, skip: float, span: float, tolerance: float):
+    """The circle (centre, radius) fitted within ``tolerance`` to the longest stretch (of
+    :data:`SIDE_SPANS`) after the point at ``gap`` = 0 that is circular and not straight, or
+    None.
     """
     for factor in SIDE_SPANS:
-        stretch = p[(gap >= skip) & (gap <= skip + factor * span)]
-        if len(stretch) < 3:
-            continue
-        line = _line(stretch, tolerance)
-        if line is not None:
-            return ("line", factor, *line)
-        circle = _circle(stretch, tolerance)
-        if circle is not None:
-            return ("arc", factor, *circle)
+        stretch = _stretch(p, gap, skip, factor * span)
+        if len(stretch) >= 3 and _line(stretch, tolerance) is None:
+            circle = _circle(stretch, tolerance)
+            if circle is not None:
+                return circle
     return None
 
 
@@ -166,32 +165,36 @@ def _line_meets_arc(line, circle, near: np.ndarray, arc_after: bool):
 def _corner(p: np.ndarray, gap: np.ndarray, skip: float, span: float, tolerance: float,
             max_cut: float, min_turn_deg: float) -> np.ndarray | None:
     """The rebuilt corner from the stretches from ``skip`` on before and after the point at
-    ``gap`` = 0 (signed arc length; :func:`_side`), or None when it is not a clean corner: two
-    straight sides meet at the intersection of their lines; a straight side and a circular arc
-    (a D shape's diameter meeting its arc) where the line meets the circle.
+    ``gap`` = 0 (signed arc length), or None when it is not a clean corner: a straight side
+    (over :data:`LINE_BESIDE_ARC` spans) and a circular arc (a D shape's diameter meeting its
+    arc) meet where the line meets the circle; two sides straight over ``span`` meet at the
+    intersection of their lines.
     """
-    sides = _side(p, -gap, skip, span, tolerance), _side(p, gap, skip, span, tolerance)
-    if sides[0] is None or sides[1] is None:
+    before = _stretch(p, -gap, skip, span)
+    after = _stretch(p, gap, skip, span)
+    if len(before) < 3 or len(after) < 3:
         return None
-    kinds = sides[0][0], sides[1][0]
-    if kinds == ("line", "line"):
-        (_, _, c0, d0), (_, _, c1, d1) = sides
-        det = d0[0] * d1[1] - d0[1] * d1[0]
-        if abs(det) < np.sin(np.radians(min_turn_deg)):
-            return None
-        w = c1 - c0
-        corner = c0 + d0 * (w[0] * d1[1] - w[1] * d1[0]) / det
-    elif "line" in kinds and "arc" in kinds:
-        arc_after = kinds[1] == "arc"
-        line, arc = (sides[0], sides[1]) if arc_after else (sides[1], sides[0])
-        if line[1] < LINE_BESIDE_ARC:  # a gently curved side, straight only over a short span
-            return None
-        met = _line_meets_arc(line[2:], arc[2:], p[np.argmin(np.abs(gap))], arc_after)
+    lines = _line(before, tolerance), _line(after, tolerance)
+    long_line = [_line(_stretch(p, g, skip, LINE_BESIDE_ARC * span), tolerance)
+                 for g in (-gap, gap)]
+    arcs = [None if long_line[1 - k] is None else _arc_side(p, g, skip, span, tolerance)
+            for k, g in enumerate((-gap, gap))]
+    if arcs[0] is not None or arcs[1] is not None:
+        arc_after = arcs[1] is not None
+        line, arc = (long_line[0], arcs[1]) if arc_after else (long_line[1], arcs[0])
+        met = _line_meets_arc(line, arc, p[np.argmin(np.abs(gap))], arc_after)
         if met is None:
             return None
         corner, d0, d1 = met
         if abs(d0[0] * d1[1] - d0[1] * d1[0]) < np.sin(np.radians(min_turn_deg)):
             return None  # a tangent join (a straight edge running into an arc): no corner
+    elif lines[0] is not None and lines[1] is not None:
+        (c0, d0), (c1, d1) = lines
+        det = d0[0] * d1[1] - d0[1] * d1[0]
+        if abs(det) < np.sin(np.radians(min_turn_deg)):
+            return None
+        w = c1 - c0
+        corner = c0 + d0 * (w[0] * d1[1] - w[1] * d1[0]) / det
     else:
         return None
     half_angle = 0.5 * (np.pi - np.arccos(np.clip(abs(d0 @ d1), 0.0, 1.0)))

@@ -136,7 +136,9 @@ class ObjectOutline:
         above the support, m (depth).
     tolerance_m : float
         Douglas-Peucker tolerance of the simplification, m: every traced contour point lies
-        within it of the outline.
+        within it of a polygon outline; of a spline outline, within the larger of it and
+        :data:`PRIMITIVE_TOLERANCE_PX` pixel footprints (outside :data:`CORNER_RADIUS_PX` of its
+        rebuilt corners).
     pixel_size_m : float
         Footprint of one pixel at the object's centroid on its top face, m.
     contour_points : int

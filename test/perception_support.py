@@ -67,22 +67,24 @@ def hausdorff_px(a: Outline, b: Outline, camera: CameraModel, camera_pose: Camer
                  height: float, *, exclude: np.ndarray | None = None,
                  radius_px: float = 3.0) -> float:
     """Symmetric Hausdorff distance (px) between the images of two outlines at ``height``:
-    each curve projected and sampled every 0.05 px; samples within ``radius_px`` of the images
-    of the ``exclude`` points (m) are left out.
+    each curve projected and sampled every 0.05 px; the samples of either curve within
+    ``radius_px`` of the images of the ``exclude`` points (m) are not measured, but are still
+    there to be measured to (else a sample just outside the radius, whose nearest neighbour on
+    the other curve lies just inside it, is measured to a farther one).
     """
     def project(points: np.ndarray) -> np.ndarray:
         return camera.project(camera_pose, np.column_stack([points, np.full(len(points),
                                                                              height)]))
 
-    def samples(outline: Outline) -> np.ndarray:
+    def samples(outline: Outline) -> tuple[np.ndarray, np.ndarray]:
         loops = [resample(uv, 0.05, np.arange(len(uv)))
                  for uv in map(project, (outline.points, *outline.holes))]
         points = np.concatenate(loops)
         if exclude is not None and len(exclude):
             near = np.linalg.norm(points[:, None] - project(exclude)[None], axis=2).min(axis=1)
-            points = points[near > radius_px]
-        return points
+            return points[near > radius_px], points
+        return points, points
 
     assert len(a.holes) == len(b.holes), f"{len(a.holes)} holes against {len(b.holes)}"
-    pa, pb = samples(a), samples(b)
-    return max(directed_hausdorff(pa, pb)[0], directed_hausdorff(pb, pa)[0])
+    (pa, all_a), (pb, all_b) = samples(a), samples(b)
+    return max(directed_hausdorff(pa, all_b)[0], directed_hausdorff(pb, all_a)[0])

@@ -52,6 +52,34 @@ def test_render_then_outline_gives_back_the_scene_object(tmp_path, capsys):
         assert mesh.n > 500
 
 
+def test_a_d_shape_comes_back_as_a_spline_with_its_two_corners(tmp_path, capsys):
+    """A user's D (a half disk as a spline with its two corners) through render and outline:
+    the report names the corners, the scene shape keeps exactly two, within 0.5 mm (half a
+    pixel) of the true ones.
+    """
+    skimage_or_skip()
+    a = np.linspace(-np.pi / 2, np.pi / 2, 81)
+    points = np.c_[0.04 * np.cos(a) - 0.02, 0.04 * np.sin(a)]
+    data = yaml.safe_load(scene_file("nonconvex_blob").read_text())
+    data["object"]["shape"] = {"type": "spline", "points": points.tolist(), "corners": [0, 80]}
+    data["fingers"] = {"F1": {"tip_radius": 0.015, "placement": {"point": [-0.02, 0.0]}},
+                       "F2": {"tip_radius": 0.015, "placement": {"point": [0.02, 0.0]}}}
+    scene, mask, out = tmp_path / "d.yaml", tmp_path / "d.png", tmp_path / "d_seen.yaml"
+    scene.write_text(yaml.safe_dump(data))
+    assert cli.main(["render", str(scene), *CAMERA, "--mask", str(mask)]) == 0
+    height = str(data["object"]["material"]["thickness"])
+    capsys.readouterr()
+    assert cli.main(["outline", str(mask), *CAMERA, "--object-height", height,
+                     "--output", str(out)]) == 0
+    assert "shape: spline (smooth between 2 corners, no primitive fits)" in \
+        capsys.readouterr().out
+    shape = yaml.safe_load(out.read_text())["shape"]
+    corners = np.array(shape["points"])[shape["corners"]]
+    assert len(corners) == 2
+    offset = np.linalg.norm(corners[:, None] - points[[0, -1]][None], axis=2).min(axis=1)
+    assert offset.max() < 5e-4, offset
+
+
 def test_a_ring_comes_back_with_its_hole_as_json_outline_file(tmp_path, capsys):
     skimage_or_skip()
     depth = tmp_path / "ring.npy"

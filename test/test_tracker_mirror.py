@@ -26,10 +26,13 @@ from squeeze_grasp_ros.control.tracker import (
     FingerSample,
     PredictedEvent,
     TrackerConfig,
+    mirror_tolerance_for,
 )
+from squeeze_grasp_ros.mechanics.errors import InvalidInputError
 from squeeze_grasp_ros.mechanics.vocabulary import EventType, Finger
 from squeeze_grasp_ros.resources import config_dir
 from squeeze_grasp_ros.scene import GraspSetup, parse_scene
+from squeeze_grasp_ros.scene.specs import SensorsSpec
 
 RING = yaml.safe_load((config_dir() / "scenes" / "foam_ring_camera.yaml").read_text())
 MISMATCH = "prediction_mismatch"
@@ -83,7 +86,27 @@ def seen_ring():
     frame = world.camera.render(build_outline(scene.object.shape), 0)
     seen = extract_outline(frame.views.mask, "mono8", world.camera.model, world.camera.pose,
                            object_height_m=scene.object.material.thickness, frame_id="object")
-    return ring(shape=seen.to_scene_shape())
+    planned = ring(shape=seen.to_scene_shape())
+    DERIVED["tolerance"] = derived_tolerance(planned, seen.tolerance_m)
+    return planned
+
+
+DERIVED: dict[str, float] = {}
+"""The mirror tolerance derived for the seen ring (set by the ``seen_ring`` fixture)."""
+
+
+def derived_tolerance(planned, outline_error: float) -> float:
+    """:func:`mirror_tolerance_for` the planner's mesh of ``planned`` (its median boundary
+    spacing), the outline error (m), F1's fingertip and the scene's taxel pitch.
+    """
+    mesh = GraspSetup.build(planned).precompute().solid.mesh
+    loop = mesh.nodes[mesh.boundary]
+    spacing = float(np.median(np.linalg.norm(np.diff(np.vstack([loop, loop[:1]]), axis=0),
+                                             axis=1)))
+    sensors = planned.sensors or SensorsSpec()
+    pitch = np.radians(sensors.taxel_span_deg) / (sensors.taxels - 1)
+    return mirror_tolerance_for(spacing, outline_error,
+                                tip_radius=planned.fingers["F1"].tip_radius, taxel_pitch=pitch)
 
 
 def test_the_on_axis_ring_seen_by_the_camera_raises_no_mismatch(seen_ring):
@@ -106,13 +129,46 @@ def test_the_on_axis_ring_seen_by_the_camera_raises_no_mismatch(seen_ring):
     assert strict and all(a.finger in {e.finger for e in mirrored} for a in strict), strict
 
 
+def test_the_derived_tolerance_keeps_the_on_axis_ring_a_tie(seen_ring):
+    """The tolerance derived from the seen ring's mesh spacing, its outline error (the
+    extraction's tolerance), the fingertip and the taxel pitch, (e + R dtheta / 2) / (2 h),
+    lies between the on-axis pairs' asymmetry (no alarm with it) and the off-axis pair's
+    offset (every event compared: the test below uses it too).
+    """
+    tolerance = DERIVED["tolerance"]
+    assert 0.0 < tolerance < 0.25
+    events, alarms = monitored(ring(), seen_ring, mirror_tolerance=tolerance)
+    assert alarms == []
+    assert any(e.mirrored for e in events)
+    off_events, off_alarms = monitored(ring(0.01), ring(0.01), mirror_tolerance=tolerance)
+    assert off_alarms == [] and not any(e.mirrored for e in off_events)
+
+
+def test_the_derived_tolerance_grows_with_the_outline_error_and_shrinks_with_the_spacing():
+    """The formula's limits: exact outlines and point-like taxels leave no tolerance; a finer
+    mesh (half the spacing) doubles it; it is capped at 0.5 and refuses a non-positive
+    spacing with the field named.
+    """
+    assert mirror_tolerance_for(0.003, 0.0, tip_radius=0.02, taxel_pitch=0.0) == 0.0
+    coarse = mirror_tolerance_for(0.004, 1e-4, tip_radius=0.02, taxel_pitch=0.02)
+    assert mirror_tolerance_for(0.002, 1e-4, tip_radius=0.02, taxel_pitch=0.02) == \
+        pytest.approx(2 * coarse)
+    assert coarse == pytest.approx((1e-4 + 0.5 * 0.02 * 0.02) / 0.008)
+    assert mirror_tolerance_for(1e-4, 1e-3, tip_radius=0.02, taxel_pitch=0.1) == 0.5
+    with pytest.raises(InvalidInputError, match="spacing must be a positive length"):
+        mirror_tolerance_for(0.0, 1e-4, tip_radius=0.02, taxel_pitch=0.02)
+
+
+@pytest.mark.parametrize("derived", [False, True], ids=["default", "derived"])
 @pytest.mark.parametrize("planned, why", [
     (dict(inner=0.02), "a hole 20 % smaller: new contacts at other depths"),
     (dict(outer=0.0525, inner=0.02625), "a ring 5 % larger: no stick-slip on F1 predicted"),
     (dict(nu=0.45), "nu 0.45 instead of 0.3: no stick-slip predicted at all"),
 ])
-def test_a_wrong_object_on_the_axis_still_raises_the_alarm(planned, why):
-    _, alarms = monitored(ring(), ring(**planned))
+def test_a_wrong_object_on_the_axis_still_raises_the_alarm(planned, why, derived, seen_ring):
+    """With the default tolerance and with the one derived for the seen ring."""
+    config = {"mirror_tolerance": DERIVED["tolerance"]} if derived else {}
+    _, alarms = monitored(ring(), ring(**planned), **config)
     assert alarms, why
 
 

@@ -146,9 +146,11 @@ def summary(result: dict) -> str:
              "points"]
     primitive = result["primitive"]
     if primitive is None:
+        corners = len(result["shape"].get("corners", []))
         lines.append(f"shape: {result['recognised']} ("
                      + ("corners kept" if result["recognised"] == ShapeType.POLYGON
-                        else "smooth, no primitive fits") + ")")
+                        else f"smooth{f' between {corners} corners' if corners else ''}, no "
+                             "primitive fits") + ")")
     else:
         parameters = ", ".join(f"{k} {1e3 * v:.4g} mm" for k, v in primitive.items()
                                if k not in ("type", "centre", "residual_m", "theta"))

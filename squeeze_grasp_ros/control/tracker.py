@@ -39,10 +39,12 @@ Events of one tick are ordered by finger (F1, F2, A), then B < D < C < A (the st
 Mirror patches. A finger loaded symmetrically (a fingertip squeezing a symmetric object along
 its symmetry axis) has pairs of contact patches mirrored about its force line, the direction of
 the resultant of its patch forces: two patches on opposite sides of it whose mean angle lies
-within ``mirror_tolerance`` of their angular separation from it (0.05: for the two neighbours of
-the patch on the line, a tenth of a boundary spacing; measured on the foam ring: 0.01 squeezed
-along its symmetry axis, the mesh's asymmetry, and 0.25 for the nearest pair of F1 touching
-1 cm off it). Which patch of a mirror pair sticks and which
+within ``mirror_tolerance`` of their angular separation from it. The tolerance follows from
+the mesh and the outline (:func:`mirror_tolerance_for`): (e + R dtheta / 2) / (2 h) for
+boundary spacing h, outline error e, fingertip radius R and taxel pitch dtheta, 0.05-0.07 for
+the foam ring seen by the shipped camera (the default 0.05; measured on that ring: 0.01
+squeezed along its symmetry axis, and 0.25 for the nearest pair of F1 touching 1 cm off it).
+Which patch of a mirror pair sticks and which
 slides is a tie: the mechanics decides it by round-off, so a mesh a few micrometres different
 (an outline seen by a camera) decides it the other way, for the rest of the squeeze (the foam
 ring on its axis: the world's side node of F2 sticks at 0.7-0.999 of its cone from 2.7 to
@@ -70,6 +72,7 @@ from typing import NamedTuple
 
 import numpy as np
 
+from squeeze_grasp_ros.mechanics.errors import InvalidInputError
 from squeeze_grasp_ros.mechanics.squeeze.event_key import PROCESSING_ORDER, processing_rank
 from squeeze_grasp_ros.mechanics.vocabulary import (
     AlarmType,
@@ -113,7 +116,8 @@ class TrackerConfig:
     mirror_tolerance : float
         Two patches of a finger are a mirror pair when the mean of their angles lies within
         this fraction of their angular separation from the finger's force line (0: exact
-        mirror images only; 0.5 at most).
+        mirror images only; 0.5 at most; :func:`mirror_tolerance_for` derives it from the
+        mesh spacing, the outline's error and the taxel pitch).
     """
 
     mu: float
@@ -308,6 +312,60 @@ def patches_of(finger: str, taxels: LoadedTaxels, config: TrackerConfig) -> list
         out.append(Patch(finger, moment / normal, normal, tangential,
                          ContactMode.SLIP if sliding else ContactMode.STICK, slip, first, last))
     return out
+
+
+def mirror_tolerance_for(spacing: float, outline_error: float, *, tip_radius: float,
+                         taxel_pitch: float) -> float:
+    """The mirror rule's tolerance (:func:`mirrored_patches`) for a mesh and an outline.
+
+    The nearest mirror pair are the neighbours of the contact node on the force line, a
+    boundary spacing ``h`` either side of it: on a fingertip of radius ``R`` their angles from
+    the line are about -h / R and +h / R, their separation 2 h / R. A squeeze symmetric about
+    the object's axis is so only to within the outline's error ``e`` (the planner's outline,
+    on which the fingers are placed, is that far from the world's: the contact moves along the
+    boundary by up to e), and each patch's angle is a taxel-weighted mean, off by at most half
+    a taxel pitch ``dtheta``. The pair's mean angle then lies within e / R + dtheta / 2 of the
+    line, a fraction
+
+        tolerance = (e + R dtheta / 2) / (2 h)
+
+    of the separation. Farther pairs (k spacings out) have k times the separation and fall
+    inside it more easily; a finger off the axis by more than the tolerance's e is no tie.
+
+    Parameters
+    ----------
+    spacing : float
+        Boundary node spacing h of the mesh, m.
+    outline_error : float
+        Largest distance e of the planner's outline from the world's, m (0 when the planner is
+        given the world's outline; on the camera route the extraction's tolerance).
+    tip_radius : float
+        Fingertip radius R, m.
+    taxel_pitch : float
+        Angle dtheta between neighbouring taxels, rad.
+
+    Returns
+    -------
+    float
+        The tolerance, capped at 0.5 (beyond it any two patches on opposite sides would pair).
+
+    Examples
+    --------
+    The foam ring (96 boundary nodes on a 5 cm radius) seen by the shipped camera (extraction
+    tolerance 0.152 mm), fingertips of 2 cm with 96 taxels over 150 degrees:
+
+    >>> from math import pi, radians
+    >>> round(mirror_tolerance_for(2 * pi * 0.05 / 96, 0.152e-3, tip_radius=0.02,
+    ...                            taxel_pitch=radians(150 / 95)), 3)
+    0.065
+    """
+    for name, value in (("spacing", spacing), ("tip_radius", tip_radius)):
+        if not (np.isfinite(value) and value > 0):
+            raise InvalidInputError(f"{name} must be a positive length in m, got {value!r}")
+    for name, value in (("outline_error", outline_error), ("taxel_pitch", taxel_pitch)):
+        if not (np.isfinite(value) and value >= 0):
+            raise InvalidInputError(f"{name} must be >= 0, got {value!r}")
+    return min(0.5, (outline_error + 0.5 * tip_radius * taxel_pitch) / (2.0 * spacing))
 
 
 def mirrored_patches(patches: Sequence[Patch], tolerance: float) -> frozenset[int]:

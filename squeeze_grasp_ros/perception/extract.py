@@ -11,9 +11,12 @@ cuts a corner short). Closed holes become holes of the outline (a ring or annulu
 A circle, an ellipse or a circle with a concentric circular hole that fits the traced points
 within :data:`PRIMITIVE_TOLERANCE_PX` is recognised as a ``disk``, ``ellipse`` or ``annulus``
 (:mod:`.primitives`). Outlines whose rebuilt corners join straight edges are polygons; the
-others are splines (``spline``) with declared corners where a spline through the vertices
-would stray from the traced points (:func:`.simplify.spline_corners`: straight edges and
-curved stretches, a mixed outline), none when it stays within reach of them (a smooth curve).
+others are splines (``spline``): a smoothing spline fitted to the trace
+(:func:`.simplify.smoothed_curve`), pinned at the real corners (rebuilt, or kinks) of a mixed
+outline (straight edges and curved stretches) and at none of a smooth curve; tangent joins of
+a straight edge and an arc are no corners. When no smoothing spline fits, a spline through the
+simplified vertices with corners where it would stray from the traced points
+(:func:`.simplify.spline_corners`).
 
 - **mask** (``mono8``): 0 is background, larger values object; read as coverage (value / 255,
   or / 1 for a 0/1 mask) with the edge at half coverage, so an anti-aliased mask gives edges
@@ -42,9 +45,12 @@ from squeeze_grasp_ros.perception.camera import CameraModel, CameraPose
 from squeeze_grasp_ros.perception.primitives import Primitive, recognise, sampled, scene_shape
 from squeeze_grasp_ros.perception.simplify import (
     KINK_TURN_DEG,
+    centred_vertices,
+    joined_curve,
     kept_vertices,
     segment_distances,
     sharpen_corners,
+    smoothed_curve,
     spline_corners,
     vertex_turns,
 )
@@ -80,6 +86,18 @@ of the segment joining the two corners around them (rebuilt, or kinks turning mo
 (straight edges: noisy depth strays up to about 1 px); otherwise it has curved stretches and is
 a spline with declared corners (a mixed outline: an arc of radius R px between corners strays
 R (1 - cos(a / 2)) from its chord, 3.5 px for a quarter circle of 12 px)."""
+
+CENTRE_WINDOW_PX = 2.0
+"""Half-length (pixel footprints) of the stretch of traced points a smooth outline's vertex is
+the mean of (:func:`~.simplify.centred_vertices`)."""
+
+TRACE_NOISE_PX = 0.05
+"""RMS wobble (pixel footprints) of a traced edge the smoothing spline may leave unfitted
+(:func:`~.simplify.smoothed_curve`)."""
+
+JOIN_SPACING_PX = 1.0
+"""Spacing (pixel footprints) of the samples of a mixed outline's piecewise spline
+(:func:`~.simplify.joined_curve`)."""
 
 PRIMITIVE_TOLERANCE_PX = 0.3
 """Largest distance (pixel footprints) of a traced point from a fitted circle or ellipse for
@@ -117,7 +135,9 @@ class ObjectOutline:
         above the support, m (depth).
     tolerance_m : float
         Douglas-Peucker tolerance of the simplification, m: every traced contour point lies
-        within it of the outline.
+        within it of a polygon outline; of a spline outline, within the larger of it and
+        :data:`PRIMITIVE_TOLERANCE_PX` pixel footprints (outside :data:`CORNER_RADIUS_PX` of its
+        rebuilt corners).
     pixel_size_m : float
         Footprint of one pixel at the object's centroid on its top face, m.
     contour_points : int
@@ -317,11 +337,33 @@ def _outline(loops: list[np.ndarray], camera: CameraModel, pose: CameraPose,
     if straight or any(c.any() for _, c in simplified):
         return (Outline(outer, holes), ShapeType.POLYGON, None, tolerance, pixel,
                 plane.undistort_residual_px)
+    reach = max(tolerance, PRIMITIVE_TOLERANCE_PX * pixel)
+    smoothed = smoothed_curve(metric[0], outer, kinks, tolerance=reach,
+                              spacing=JOIN_SPACING_PX * pixel,
+                              clearance=CORNER_RADIUS_PX * pixel, noise=TRACE_NOISE_PX * pixel)
+    if smoothed is not None:
+        fitted_holes = [smoothed_curve(t, h, np.zeros(len(h), bool), tolerance=reach,
+                                       spacing=JOIN_SPACING_PX * pixel, clearance=0.0,
+                                       noise=TRACE_NOISE_PX * pixel)
+                        for t, h in zip(metric[1:], holes)]
+        holes = tuple(h if f is None else f[0] for h, f in zip(holes, fitted_holes))
+        return (Outline(smoothed[0], holes, smoothed[1]), ShapeType.SPLINE, None, tolerance,
+                pixel, plane.undistort_residual_px)
+    window = CENTRE_WINDOW_PX * pixel
+    outer = centred_vertices(metric[0], outer, cornered, window=window)
+    holes = tuple(centred_vertices(t, h, np.zeros(len(h), bool), window=window)
+                  for t, h in zip(metric[1:], holes))
     corners = spline_corners(metric[0], outer, cornered,
                              tolerance=max(tolerance, PRIMITIVE_TOLERANCE_PX * pixel),
                              radius=CORNER_RADIUS_PX * pixel)
-    shape = ShapeType.POLYGON if corners.all() else ShapeType.SPLINE
-    return (Outline(outer, holes, np.flatnonzero(corners)), shape, None, tolerance, pixel,
+    if corners.all():
+        return (Outline(outer, holes, np.arange(len(outer))), ShapeType.POLYGON, None,
+                tolerance, pixel, plane.undistort_residual_px)
+    if corners.any():
+        outer, at = joined_curve(outer, corners, spacing=JOIN_SPACING_PX * pixel)
+    else:
+        at = np.zeros(0, int)
+    return (Outline(outer, holes, at), ShapeType.SPLINE, None, tolerance, pixel,
             plane.undistort_residual_px)
 
 

@@ -23,7 +23,7 @@ import numpy as np
 
 from squeeze_grasp_ros.mechanics.vocabulary import ShapeType
 
-__all__ = ["Primitive", "fit_loop", "recognise", "sampled", "scene_shape"]
+__all__ = ["Primitive", "fit_loop", "fitted_model", "recognise", "sampled", "scene_shape"]
 
 CIRCLE_OVER_ELLIPSE = 1e-3
 """An ellipse whose axes differ by less than this fraction is reported as a circle."""
@@ -58,7 +58,7 @@ class Primitive:
                 "residual_m": float(self.residual_m)}
 
 
-def _model(kind, points: np.ndarray):
+def fitted_model(kind, points: np.ndarray):
     """A scikit-image model fitted to ``points``, or None when the fit fails."""
     if hasattr(kind, "from_estimate"):  # scikit-image >= 0.26
         model = kind.from_estimate(points)
@@ -74,13 +74,13 @@ def fit_loop(points: np.ndarray, tolerance: float) -> Primitive | None:
     from skimage.measure import CircleModel, EllipseModel
 
     p = np.asarray(points, float)
-    circle = _model(CircleModel, p)
+    circle = fitted_model(CircleModel, p)
     if circle is not None and np.all(np.isfinite(circle.center)):
         worst = float(np.abs(circle.residuals(p)).max())
         if worst <= tolerance:
             return Primitive(ShapeType.DISK, np.asarray(circle.center, float),
                              {"radius": float(circle.radius)}, worst)
-    ellipse = _model(EllipseModel, p)
+    ellipse = fitted_model(EllipseModel, p)
     if ellipse is None or not np.all(np.isfinite(ellipse.center)):
         return None
     worst = float(np.abs(ellipse.residuals(p)).max())

@@ -219,6 +219,13 @@ class ContactResponse:
             return True
         return self._recall(delta) is not None
 
+    @property
+    def bordered(self) -> int:
+        """Times this set solved with the factorisation of a subset of its DOFs, bordered,
+        instead of factorising its own K_ff (:class:`~.interior.InteriorBlocks`).
+        """
+        return 0 if self._blocks is None else self._blocks.bordered
+
     def state_u(self) -> np.ndarray:
         """Displacement (2n,) of the last evaluated state."""
         return self._u
@@ -240,25 +247,39 @@ class ContactResponse:
                                               .max())
         return self._reference_stiffness
 
+    def _interior(self, K) -> InteriorBlocks:
+        """This set's blocks of the tangent pattern of ``K`` (built at the first tangent)."""
+        if self._blocks is None:
+            self._blocks = InteriorBlocks(K, self.free, self.cdofs, self.factorization)
+        return self._blocks
+
     def _factor(self, K, owner: object = None):
         """Factorise K_ff of the tangent ``K`` (for the state ``owner``; None for a Newton
         iterate); its solve, or None if K_ff is singular.
         """
-        if self._blocks is None:
-            self._blocks = InteriorBlocks(K, self.free, self.cdofs, self.factorization)
+        self._interior(K)
         self.stats["factorizations"] += 1
         try:
             return self._blocks.factor(K, owner)
         except (ValueError, RuntimeError):
             return None
 
+    def _held(self):
+        """The solve of the factorisation held for this set's K_ff (its own, or that of the
+        set it was continued from, bordered: :class:`~.interior.InteriorBlocks`), of whichever
+        state factorised it; None if none serves.
+        """
+        if self._blocks is None and self._known_tangent is not None:
+            self._interior(self._known_tangent[1])
+        return None if self._blocks is None else self._blocks.solve
+
     def _stiffness_of(self, K) -> ContactStiffness | None:
         """dF/d delta of the state whose tangent is ``K`` (:meth:`.InteriorBlocks.owned_stiffness`:
-        it owns the factorisation of K_ff, and refactors whenever that has moved on).
+        it owns the factorisation of K_ff, and refactors whenever that has moved on). A set
+        continued from a subset of its DOFs at that set's state takes its factorisation,
+        bordered (:class:`~.interior.InteriorBlocks`).
         """
-        if self._blocks is None and self._factor(K) is None:
-            return None
-        return self._blocks.owned_stiffness(K, lambda owner: self._factor(K, owner))
+        return self._interior(K).owned_stiffness(K, lambda owner: self._factor(K, owner))
 
     def _known(self, u: np.ndarray, tol: float):
         """The tangent of the state this set was continued from, if ``u`` is that state to
@@ -316,7 +337,7 @@ class ContactResponse:
             return ResponseFailure("the prescribed contact displacement inverts an element",
                                    inverted=True)
         u, F = start
-        held = self._blocks.solve if self._blocks is not None else None
+        held = self._held()
         solve, fresh, its = (held if self.reuse else None), False, 0
         asm = self._assemble(u, tangent=False, deformation=F)
         scale = max(np.linalg.norm(asm.force[self.cdofs]),

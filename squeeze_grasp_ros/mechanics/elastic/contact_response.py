@@ -190,13 +190,15 @@ class ContactResponse:
 
     def continue_from(self, other: "ContactResponse") -> None:
         """Start from the current state of ``other`` (another contact set of the same object):
-        its field, and its tangent, which the first evaluation takes instead of assembling it
-        when that state is already in equilibrium here (a node that just touched a tip).
+        its field, its tangent (taken for an assembly while that state is in equilibrium here:
+        a node just touched a tip) and its factorisation, bordered (:class:`.InteriorBlocks`).
         """
         self.warm_start(other.state_u())
         self._reference_stiffness = other._reference_stiffness
         if other._current is not None:
             self._known_tangent = (other.state_u(), other._current.C.tangent)
+            self._blocks = self._blocks or InteriorBlocks(other._current.C.tangent, self.free,
+                                                          self.cdofs, self.factorization)
 
     def forget(self) -> None:
         """Drop the kept states but the current one (their tangents hold memory)."""
@@ -219,13 +221,6 @@ class ContactResponse:
             return True
         return self._recall(delta) is not None
 
-    @property
-    def bordered(self) -> int:
-        """Times this set solved with the factorisation of a subset of its DOFs, bordered,
-        instead of factorising its own K_ff (:class:`~.interior.InteriorBlocks`).
-        """
-        return 0 if self._blocks is None else self._blocks.bordered
-
     def state_u(self) -> np.ndarray:
         """Displacement (2n,) of the last evaluated state."""
         return self._u
@@ -247,39 +242,25 @@ class ContactResponse:
                                               .max())
         return self._reference_stiffness
 
-    def _interior(self, K) -> InteriorBlocks:
-        """This set's blocks of the tangent pattern of ``K`` (built at the first tangent)."""
-        if self._blocks is None:
-            self._blocks = InteriorBlocks(K, self.free, self.cdofs, self.factorization)
-        return self._blocks
-
     def _factor(self, K, owner: object = None):
         """Factorise K_ff of the tangent ``K`` (for the state ``owner``; None for a Newton
         iterate); its solve, or None if K_ff is singular.
         """
-        self._interior(K)
+        if self._blocks is None:
+            self._blocks = InteriorBlocks(K, self.free, self.cdofs, self.factorization)
         self.stats["factorizations"] += 1
         try:
             return self._blocks.factor(K, owner)
         except (ValueError, RuntimeError):
             return None
 
-    def _held(self):
-        """The solve of the factorisation held for this set's K_ff (its own, or that of the
-        set it was continued from, bordered: :class:`~.interior.InteriorBlocks`), of whichever
-        state factorised it; None if none serves.
-        """
-        if self._blocks is None and self._known_tangent is not None:
-            self._interior(self._known_tangent[1])
-        return None if self._blocks is None else self._blocks.solve
-
     def _stiffness_of(self, K) -> ContactStiffness | None:
         """dF/d delta of the state whose tangent is ``K`` (:meth:`.InteriorBlocks.owned_stiffness`:
-        it owns the factorisation of K_ff, and refactors whenever that has moved on). A set
-        continued from a subset of its DOFs at that set's state takes its factorisation,
-        bordered (:class:`~.interior.InteriorBlocks`).
+        it owns the factorisation of K_ff, and refactors whenever that has moved on).
         """
-        return self._interior(K).owned_stiffness(K, lambda owner: self._factor(K, owner))
+        if self._blocks is None and self._factor(K) is None:
+            return None
+        return self._blocks.owned_stiffness(K, lambda owner: self._factor(K, owner))
 
     def _known(self, u: np.ndarray, tol: float):
         """The tangent of the state this set was continued from, if ``u`` is that state to
@@ -337,7 +318,7 @@ class ContactResponse:
             return ResponseFailure("the prescribed contact displacement inverts an element",
                                    inverted=True)
         u, F = start
-        held = self._held()
+        held = self._blocks.solve if self._blocks is not None else None
         solve, fresh, its = (held if self.reuse else None), False, 0
         asm = self._assemble(u, tangent=False, deformation=F)
         scale = max(np.linalg.norm(asm.force[self.cdofs]),

@@ -177,6 +177,9 @@ class TangentFactor:
     generation : int
         Numeric factorisations done: what is derived from the one held (the bordered solves of
         :class:`InteriorBlocks`) is valid while this is unchanged.
+    bordered : int
+        Contact sets that solved with the factorisation held of a subset of their DOFs,
+        bordered (:class:`InteriorBlocks`), instead of factorising their own K_ff.
     """
 
     method: Factorizer = field(default_factory=default_factorizer)
@@ -186,6 +189,7 @@ class TangentFactor:
     fallbacks: int = 0
     analyses: int = 0
     generation: int = 0
+    bordered: int = 0
     _upper: sp.csc_matrix | None = field(default=None, repr=False)
     _ldlt: "object | None" = field(default=None, repr=False)  # a qdldl.Solver
     _cholesky: tuple | None = field(default=None, repr=False)
@@ -356,18 +360,12 @@ class InteriorBlocks:
         Interior and contact DOFs.
     shared : TangentFactor
         The object's factorisation (one per mesh, shared by its contact sets).
-
-    Attributes
-    ----------
-    bordered : int
-        Bordered solvers built: factorisations of this set's K_ff not done.
     """
 
     pattern: sp.csr_matrix
     free: np.ndarray
     cdofs: np.ndarray
     shared: TangentFactor = field(default_factory=TangentFactor)
-    bordered: int = 0
     _border: tuple = field(default=(-1, None), repr=False)
 
     def __post_init__(self) -> None:
@@ -393,7 +391,7 @@ class InteriorBlocks:
                 units[added, np.arange(len(added))] = 1.0
                 Z = self.shared.solve(units)
                 border = (added, Z, Z[added])
-                self.bordered += 1
+                self.shared.bordered += 1
         self._border = (self.shared.generation, border)
         return border
 

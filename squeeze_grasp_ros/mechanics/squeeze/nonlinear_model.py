@@ -206,7 +206,7 @@ class NonlinearContactModel(ContactModel):
                 "evaluations": sum(r.stats["evaluations"] for r in responses),
                 "newton_iterations": sum(r.stats["iterations"] for r in responses),
                 "factorizations": sum(r.stats["factorizations"] for r in responses),
-                "bordered": sum(r.bordered for r in responses),
+                "bordered": shared.bordered if shared else 0,
                 "look_ups": sum(r.stats["look_ups"] for r in responses),
                 "load_substeps": sum(r.stats["substeps"] for r in responses)}
 

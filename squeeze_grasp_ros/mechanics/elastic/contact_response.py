@@ -242,15 +242,15 @@ class ContactResponse:
                                               .max())
         return self._reference_stiffness
 
-    def _factor(self, K, owner: object = None):
+    def _factor(self, K, owner: object = None, held: tuple | None = None):
         """Factorise K_ff of the tangent ``K`` (for the state ``owner``; None for a Newton
-        iterate); its solve, or None if K_ff is singular.
+        iterate; ``held``: :meth:`.InteriorBlocks.factor`); its solve, or None if singular.
         """
         if self._blocks is None:
             self._blocks = InteriorBlocks(K, self.free, self.cdofs, self.factorization)
         self.stats["factorizations"] += 1
         try:
-            return self._blocks.factor(K, owner)
+            return self._blocks.factor(K, owner, held)
         except (ValueError, RuntimeError):
             return None
 
@@ -260,7 +260,7 @@ class ContactResponse:
         """
         if self._blocks is None and self._factor(K) is None:
             return None
-        return self._blocks.owned_stiffness(K, lambda owner: self._factor(K, owner))
+        return self._blocks.owned_stiffness(K, lambda *args: self._factor(K, *args))
 
     def _known(self, u: np.ndarray, tol: float):
         """The tangent of the state this set was continued from, if ``u`` is that state to

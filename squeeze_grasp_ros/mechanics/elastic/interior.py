@@ -405,12 +405,13 @@ class InteriorBlocks:
             x -= Z @ np.linalg.solve(G, x[added])
         return x[self.free]
 
-    def factor(self, K: sp.csr_matrix, owner: object = None) -> Callable[[np.ndarray],
-                                                                          np.ndarray]:
+    def factor(self, K: sp.csr_matrix, owner: object = None,
+               held: tuple | None = None) -> Callable[[np.ndarray], np.ndarray]:
         """Factorise K_ff of the tangent ``K`` (same pattern) and return its solve; ``owner``
-        names the state the factorisation now belongs to.
+        names the state the factorisation now belongs to; ``held``: a subset of this set's
+        DOFs to hold instead of all of them (the solve borders that factorisation).
         """
-        self.shared.factor(K, self.held, owner)
+        self.shared.factor(K, self.held if held is None else held, owner)
         return self._solve
 
     @property
@@ -450,19 +451,26 @@ class InteriorBlocks:
     def owned_stiffness(self, K: sp.csr_matrix,
                         factor: Callable[[object], object]) -> "ContactStiffness | None":
         """S of the state whose tangent is ``K``, owning the factorisation of K_ff (taken over
-        when it is of ``K`` already); its solves refactor whenever the shared factorisation has
-        moved on to another state. ``factor(owner)`` factorises K_ff of ``K`` for ``owner``
-        (the caller counts it) and returns None if it is singular, as then does this.
+        when it is of ``K`` already, bordered or not); its solves take it back whenever the
+        shared factorisation has moved on to another state: with no factorisation when that
+        holds ``K`` with the same DOFs again, else refactoring ``K`` with the DOFs it held at
+        first (a bordered state stays bordered, so its solves keep their bits).
+        ``factor(owner[, held])`` factorises ``K`` for ``owner`` (:meth:`factor`; the caller
+        counts it) and returns None if it is singular, as then does this.
         """
         token = object()
         if self.factored is K:
             self.owner = token
         elif factor(token) is None:
             return None
+        held = self.shared.held
 
         def solve(r: np.ndarray) -> np.ndarray:
             if self.owner is not token:
-                factor(token)
+                if self.shared.tangent is K and self.shared.held == held:
+                    self.owner = token
+                else:
+                    factor(token, held)
             return self._solve(r)
 
         return self.contact_stiffness(K, solve, token)

@@ -109,6 +109,37 @@ def test_a_set_grown_by_nodes_solves_with_the_smaller_set_s_factor_bordered(meth
         assert not blocks.serves and blocks.solve is None and blocks.owner is None
 
 
+def test_a_bordered_state_keeps_its_bits_when_the_factorisation_moves_on(stressed):
+    """The S of a state that took a subset's factorisation bordered: after the shared
+    factorisation moved to another tangent its solve refactors its tangent with the subset's
+    DOFs (bordered again: the same bits), and after it came back to that tangent and those DOFs
+    by another way it takes it without a factorisation.
+    """
+    K, held = stressed
+    K = K.tocsr()
+    factor = TangentFactor(Factorizer.QDLDL)
+    factor.factor(K, tuple(held.tolist()))
+    node = np.setdiff1d(np.arange(K.shape[0] // 2), held // 2)[7]
+    grown = np.sort(np.r_[held, 2 * node, 2 * node + 1])
+    blocks = interior.InteriorBlocks(K, np.setdiff1d(np.arange(K.shape[0]), grown), grown,
+                                     factor)
+    calls = []
+
+    def refactor(owner, held_dofs=None):
+        calls.append(held_dofs)
+        return blocks.factor(K, owner, held_dofs)
+
+    S = blocks.owned_stiffness(K, refactor)
+    assert calls == [] and blocks.owner is S.owner
+    r = np.random.default_rng(4).standard_normal(len(blocks.free))
+    first = S.solve(r)
+    factor.factor(2.0 * K, tuple(grown.tolist()))
+    assert blocks.owner is not S.owner
+    assert np.array_equal(S.solve(r), first) and calls == [tuple(held.tolist())]
+    factor.factor(K, tuple(held.tolist()))
+    assert np.array_equal(S.solve(r), first) and len(calls) == 1
+
+
 def test_a_squeeze_bordering_the_factor_gives_the_events_and_forces_of_its_own_factors(
         monkeypatch):
     """The neo-Hookean foam square (about 400 nodes) at 12 %: each contact set a node joins

@@ -154,9 +154,8 @@ def test_the_response_tangent_is_the_derivative_of_its_forces(model, patch):
 
 
 def test_a_response_returns_to_a_kept_state_without_solving(patch):
-    """Evaluating again at a delta solved shortly before, or one within SAME_POINT of it,
-    restores that state (field, energy, tangent) without a Newton iteration or a factorisation;
-    an older one, or one 1e-12 away, is solved again.
+    """Evaluating again at a delta solved shortly before restores that state (field, energy,
+    tangent) without a Newton iteration or a factorisation; an older one is solved again.
     """
     from squeeze_grasp_ros.mechanics.elastic.contact_response import KEPT_STATES
 
@@ -177,13 +176,6 @@ def test_a_response_returns_to_a_kept_state_without_solving(patch):
     oldest = response.evaluate(deltas[0])
     assert response.stats["evaluations"] == before["evaluations"] + 1
     assert abs(oldest.energy - first[0].energy) < 1e-12 * first[0].energy
-    nudged = deltas[3].copy()
-    nudged[:, 0] += 2e-16  # the same point to the round-off of a difference of coordinates
-    assert response.evaluate(nudged) is first[3]
-    assert response.stats["look_ups"] == before["look_ups"] + 2
-    nudged[:, 0] += 1e-12
-    response.evaluate(nudged)
-    assert response.stats["evaluations"] == before["evaluations"] + 2
 
 
 def test_the_linear_law_is_the_cst_stiffness(patch):

@@ -71,10 +71,6 @@ continued from takes that state's tangent: as its own (KNOWN_STATE: its dF/d del
 from the exact one by about 1e-9 of its largest entry, within RESPONSE_ACCURACY of the contact
 model) or for Newton's first factorisation (KNOWN_START). A node that touched a tip within the
 event tolerance moves the field by 1e-10 to 3e-8 of it."""
-SAME_POINT = 1e-15
-"""Contact displacements (/ L) that agree to this are one point (a kept state's is looked up):
-the round-off of a displacement computed as a difference of coordinates of order 1, as when the
-stepper returns to an event point by another sum (a few units in the last place)."""
 REUSE_CONTRACTION = 0.25
 BACKTRACKS = 30
 
@@ -209,9 +205,9 @@ class ContactResponse:
         self._kept = self._kept[-1:]
 
     def _recall(self, delta: np.ndarray) -> Evaluation | None:
-        """Make the kept state at ``delta`` (to SAME_POINT) the current one; its evaluation."""
+        """Make the kept state at exactly ``delta`` the current one; its evaluation or None."""
         for kept_delta, out in reversed(self._kept):
-            if np.abs(kept_delta - delta).max() <= SAME_POINT:
+            if np.array_equal(kept_delta, delta):
                 self._u, self._delta, self._current = out.u, kept_delta, out
                 return out
         return None

@@ -502,6 +502,32 @@ def test_crossings_of_watched_arrays_are_those_of_their_mappings():
     assert crossings(start, other, set()) == crossings(dict(start), dict(other), set())
 
 
+def test_dips_of_watched_arrays_are_those_of_their_mappings():
+    """A substep's two WatchedValues are read as arrays at the sloped keys: whether a Hermite
+    interpolant dips inside is that of the same values as dicts, for grazing and steady
+    functions, a function not positive at an end, fresh nodes, and a sloped key of another order.
+    """
+    keys = (EventKey(B, 1), EventKey(CP, 1), EventKey.gap(4, 0), EventKey.gap(4, 1),
+            EventKey.gap(6, 0), EventKey(B, 7))
+    order = KeyOrder(keys)
+    start = WatchedValues(order, np.array([1.0, 1.0, 1.0, 1.0, -0.5, 1.0]), {})
+    end = WatchedValues(order, np.array([1.0, 2.0, 1.0, 1.0, 1.0, 1.0]), {})
+    a, b = 0.0, 1.0
+    cases = [({keys[0]: 1.0, keys[2]: -6.0, keys[4]: -9.0}, {keys[0]: 1.0, keys[2]: 6.0,
+                                                              keys[4]: 9.0}),
+             ({keys[1]: 0.1, keys[3]: -1.0}, {keys[1]: 0.1, keys[3]: 1.0}),
+             ({keys[5]: -7.0, keys[3]: -6.0}, {keys[5]: 7.0})]
+    seen = set()
+    for slopes_a, slopes_b in cases:
+        for fresh in (set(), {4}, {7}):
+            expected = dips_inside(a, b, dict(start), dict(end), slopes_a, slopes_b, fresh)
+            assert dips_inside(a, b, start, end, slopes_a, slopes_b, fresh) == expected
+            seen.add(expected)
+    assert seen == {True, False}
+    stray = EventKey.gap(9, 0)
+    assert dips_inside(a, b, start, end, {stray: -6.0}, {stray: 6.0}, set()) is False
+
+
 # ---------------------------------------------------------------------------- substeps
 def linear_path(F0, dF, s):
     z = np.zeros((len(F0), 2))

@@ -190,13 +190,15 @@ class ContactResponse:
 
     def continue_from(self, other: "ContactResponse") -> None:
         """Start from the current state of ``other`` (another contact set of the same object):
-        its field, and its tangent, which the first evaluation takes instead of assembling it
-        when that state is already in equilibrium here (a node that just touched a tip).
+        its field, its tangent (taken for an assembly while that state is in equilibrium here:
+        a node just touched a tip) and its factorisation, bordered (:class:`.InteriorBlocks`).
         """
         self.warm_start(other.state_u())
         self._reference_stiffness = other._reference_stiffness
         if other._current is not None:
             self._known_tangent = (other.state_u(), other._current.C.tangent)
+            self._blocks = self._blocks or InteriorBlocks(other._current.C.tangent, self.free,
+                                                          self.cdofs, self.factorization)
 
     def forget(self) -> None:
         """Drop the kept states but the current one (their tangents hold memory)."""
@@ -240,15 +242,15 @@ class ContactResponse:
                                               .max())
         return self._reference_stiffness
 
-    def _factor(self, K, owner: object = None):
+    def _factor(self, K, owner: object = None, held: tuple | None = None):
         """Factorise K_ff of the tangent ``K`` (for the state ``owner``; None for a Newton
-        iterate); its solve, or None if K_ff is singular.
+        iterate; ``held``: :meth:`.InteriorBlocks.factor`); its solve, or None if singular.
         """
         if self._blocks is None:
             self._blocks = InteriorBlocks(K, self.free, self.cdofs, self.factorization)
         self.stats["factorizations"] += 1
         try:
-            return self._blocks.factor(K, owner)
+            return self._blocks.factor(K, owner, held)
         except (ValueError, RuntimeError):
             return None
 
@@ -258,7 +260,7 @@ class ContactResponse:
         """
         if self._blocks is None and self._factor(K) is None:
             return None
-        return self._blocks.owned_stiffness(K, lambda owner: self._factor(K, owner))
+        return self._blocks.owned_stiffness(K, lambda *args: self._factor(K, *args))
 
     def _known(self, u: np.ndarray, tol: float):
         """The tangent of the state this set was continued from, if ``u`` is that state to

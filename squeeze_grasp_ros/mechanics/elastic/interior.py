@@ -43,10 +43,16 @@ from squeeze_grasp_ros.extras import install_hint, installed
 from squeeze_grasp_ros.mechanics.vocabulary import Factorizer
 from squeeze_grasp_ros.threads import one_blas_thread
 
-__all__ = ["ContactStiffness", "Fill", "InteriorBlocks", "TangentFactor", "default_factorizer",
-           "factorizer", "nested_dissection"]
+__all__ = ["ContactStiffness", "Fill", "InteriorBlocks", "MAX_BORDERED_DOFS", "TangentFactor",
+           "default_factorizer", "factorizer", "nested_dissection"]
 
 _FACTORIZER: list[Factorizer | None] = [None]
+
+MAX_BORDERED_DOFS = 4
+"""A contact set whose DOFs add at most this many to those of the factorisation held (the set
+before one or two nodes touched) solves with it bordered (:class:`InteriorBlocks`) instead of a
+factorisation of its own: one solve per added DOF against one factorisation, which costs 4-8
+solves on the foam square's meshes."""
 
 
 def default_factorizer() -> Factorizer:
@@ -168,6 +174,12 @@ class TangentFactor:
     analyses : int
         Orderings and symbolic analyses done (CHOLMOD's, QDLDL's): one per factoriser used,
         however many tangents and contact sets it factorises.
+    generation : int
+        Numeric factorisations done: what is derived from the one held (the bordered solves of
+        :class:`InteriorBlocks`) is valid while this is unchanged.
+    bordered : int
+        Contact sets that solved with the factorisation held of a subset of their DOFs,
+        bordered (:class:`InteriorBlocks`), instead of factorising their own K_ff.
     """
 
     method: Factorizer = field(default_factory=default_factorizer)
@@ -176,6 +188,8 @@ class TangentFactor:
     tangent: sp.csr_matrix | None = field(default=None, repr=False)
     fallbacks: int = 0
     analyses: int = 0
+    generation: int = 0
+    bordered: int = 0
     _upper: sp.csc_matrix | None = field(default=None, repr=False)
     _ldlt: "object | None" = field(default=None, repr=False)  # a qdldl.Solver
     _cholesky: tuple | None = field(default=None, repr=False)
@@ -244,9 +258,10 @@ class TangentFactor:
             return None
 
         def solve(b: np.ndarray) -> np.ndarray:
-            x = cvxopt.matrix(np.asarray(b, float))
+            b = np.asarray(b, float)
+            x = cvxopt.matrix(b)  # (n, k): k right-hand sides in one pass over the factor
             cholmod.solve(factor, x)
-            return np.asarray(x).reshape(-1)
+            return np.asarray(x).reshape(b.shape)
 
         return solve
 
@@ -265,7 +280,15 @@ class TangentFactor:
             self.analyses += 1
         else:
             self._ldlt.update(upper, upper=True)
-        return self._ldlt.solve
+        ldlt = self._ldlt
+
+        def solve(b: np.ndarray) -> np.ndarray:
+            b = np.asarray(b, float)
+            if b.ndim == 1:
+                return ldlt.solve(b)
+            return np.column_stack([ldlt.solve(column) for column in b.T])
+
+        return solve
 
     def factor(self, K: sp.csr_matrix, held: tuple, owner: object = None) -> None:
         """Factorise the tangent ``K`` with the DOFs ``held`` held, for the state ``owner``.
@@ -277,6 +300,7 @@ class TangentFactor:
         """
         upper = self._held_upper(K, held)
         self.owner = self.held = self.tangent = self._solve = None
+        self.generation += 1
         solve = None
         with one_blas_thread():
             if self.method == Factorizer.CHOLMOD:
@@ -287,9 +311,10 @@ class TangentFactor:
         self.owner, self.held, self.tangent = owner, held, K
 
     def solve(self, b: np.ndarray) -> np.ndarray:
-        """The solution of (K with the held DOFs held) x = b; a b that is zero on the held
-        DOFs gives an x that is zero there, K_ff^-1 b on the others (factorisations and solves
-        run BLAS on one thread: :func:`~squeeze_grasp_ros.threads.one_blas_thread`).
+        """The solution of (K with the held DOFs held) x = b, for b (n,) or (n, k) (k
+        right-hand sides); a b that is zero on the held DOFs gives an x that is zero there,
+        K_ff^-1 b on the others (factorisations and solves run BLAS on one thread:
+        :func:`~squeeze_grasp_ros.threads.one_blas_thread`).
         """
         with one_blas_thread():
             return self._solve(b)
@@ -319,6 +344,14 @@ class InteriorBlocks:
     """Index maps from an assembled tangent K (fixed CSR pattern) to the blocks of one contact
     set, and the K_ff solves of a shared :class:`TangentFactor`.
 
+    The shared factorisation serves this set when it holds this set's DOFs, or a subset of them
+    missing at most MAX_BORDERED_DOFS (the set before a node touched a tip: the DOFs it adds
+    are a low-rank change of the constrained system). A solve then borders the held factor:
+    with A the held matrix, D the DOFs this set adds and Z = A^-1 E_D (one solve per added
+    DOF, once per factorisation), x = A^-1 b - Z (E_D^T Z)^-1 E_D^T A^-1 b is zero on D and
+    solves this set's K_ff x = b on its free DOFs (exact up to round-off, one factorisation
+    fewer).
+
     Parameters
     ----------
     pattern : scipy.sparse.csr_matrix
@@ -333,29 +366,65 @@ class InteriorBlocks:
     free: np.ndarray
     cdofs: np.ndarray
     shared: TangentFactor = field(default_factory=TangentFactor)
+    _border: tuple = field(default=(-1, None), repr=False)
 
     def __post_init__(self) -> None:
         self.held = tuple(int(k) for k in self.cdofs)
         self._fc = _gather(self.pattern, self.free, self.cdofs)
         self._cc = _gather(self.pattern, self.cdofs, self.cdofs)
 
+    def _bordering(self) -> tuple | None:
+        """(D, Z, E_D^T Z) bordering the shared factorisation to this set, () when it holds
+        exactly this set's DOFs, None when it does not serve this set (see the class).
+        """
+        generation, border = self._border
+        if generation == self.shared.generation:
+            return border
+        held = self.shared.held
+        border = None
+        if held == self.held:
+            border = ()
+        elif held is not None and set(held) <= set(self.held):
+            added = np.array(sorted(set(self.held) - set(held)), dtype=np.int64)
+            if len(added) <= MAX_BORDERED_DOFS:
+                units = np.zeros((self.pattern.shape[0], len(added)))
+                units[added, np.arange(len(added))] = 1.0
+                Z = self.shared.solve(units)
+                border = (added, Z, Z[added])
+                self.shared.bordered += 1
+        self._border = (self.shared.generation, border)
+        return border
+
     def _solve(self, r: np.ndarray) -> np.ndarray:
         b = np.zeros(self.pattern.shape[0])
         b[self.free] = r
-        return self.shared.solve(b)[self.free]
+        x = self.shared.solve(b)
+        border = self._bordering()
+        if border:
+            added, Z, G = border
+            x -= Z @ np.linalg.solve(G, x[added])
+        return x[self.free]
 
-    def factor(self, K: sp.csr_matrix, owner: object = None) -> Callable[[np.ndarray],
-                                                                          np.ndarray]:
+    def factor(self, K: sp.csr_matrix, owner: object = None,
+               held: tuple | None = None) -> Callable[[np.ndarray], np.ndarray]:
         """Factorise K_ff of the tangent ``K`` (same pattern) and return its solve; ``owner``
-        names the state the factorisation now belongs to.
+        names the state the factorisation now belongs to; ``held``: a subset of this set's
+        DOFs to hold instead of all of them (the solve borders that factorisation).
         """
-        self.shared.factor(K, self.held, owner)
+        self.shared.factor(K, self.held if held is None else held, owner)
         return self._solve
+
+    @property
+    def serves(self) -> bool:
+        """Whether the shared factorisation held now solves with this set's K_ff (its own, or
+        bordered from a subset's: see the class).
+        """
+        return self._bordering() is not None
 
     @property
     def owner(self) -> object:
         """The state whose factorisation of this set's K_ff is held, None if none is."""
-        return self.shared.owner if self.shared.held == self.held else None
+        return self.shared.owner if self.serves else None
 
     @owner.setter
     def owner(self, token: object) -> None:
@@ -364,14 +433,14 @@ class InteriorBlocks:
     @property
     def factored(self) -> sp.csr_matrix | None:
         """The tangent whose K_ff of this set is factorised now, None if none is."""
-        return self.shared.tangent if self.shared.held == self.held else None
+        return self.shared.tangent if self.serves else None
 
     @property
     def solve(self) -> Callable[[np.ndarray], np.ndarray] | None:
         """The solve of the factorisation of this set's K_ff held now (of whichever state
         :attr:`owner` names), None if the object's factorisation is of another set.
         """
-        return self._solve if self.shared.held == self.held else None
+        return self._solve if self.serves else None
 
     def contact_stiffness(self, K: sp.csr_matrix, solve: Callable[[np.ndarray], np.ndarray],
                           owner: object = None) -> "ContactStiffness":
@@ -382,19 +451,26 @@ class InteriorBlocks:
     def owned_stiffness(self, K: sp.csr_matrix,
                         factor: Callable[[object], object]) -> "ContactStiffness | None":
         """S of the state whose tangent is ``K``, owning the factorisation of K_ff (taken over
-        when it is of ``K`` already); its solves refactor whenever the shared factorisation has
-        moved on to another state. ``factor(owner)`` factorises K_ff of ``K`` for ``owner``
-        (the caller counts it) and returns None if it is singular, as then does this.
+        when it is of ``K`` already, bordered or not); its solves take it back whenever the
+        shared factorisation has moved on to another state: with no factorisation when that
+        holds ``K`` with the same DOFs again, else refactoring ``K`` with the DOFs it held at
+        first (a bordered state stays bordered, so its solves keep their bits).
+        ``factor(owner[, held])`` factorises ``K`` for ``owner`` (:meth:`factor`; the caller
+        counts it) and returns None if it is singular, as then does this.
         """
         token = object()
         if self.factored is K:
             self.owner = token
         elif factor(token) is None:
             return None
+        held = self.shared.held
 
         def solve(r: np.ndarray) -> np.ndarray:
             if self.owner is not token:
-                factor(token)
+                if self.shared.tangent is K and self.shared.held == held:
+                    self.owner = token
+                else:
+                    factor(token, held)
             return self._solve(r)
 
         return self.contact_stiffness(K, solve, token)

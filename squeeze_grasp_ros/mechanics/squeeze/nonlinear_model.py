@@ -191,7 +191,9 @@ class NonlinearContactModel(ContactModel):
 
     def diagnostics(self) -> dict:
         """Newton evaluations, iterations and factorisations of the interior solves, the
-        evaluations answered by a kept state (look-ups), the factoriser, its orderings and
+        contact sets that solved with the factorisation of the set they grew from, bordered,
+        instead of one of their own (``bordered``), the evaluations answered by a kept state
+        (look-ups), the factoriser, its orderings and
         symbolic analyses (one per object: every contact set shares them) and the tangents its
         Cholesky factorisation refused (LDL^T instead).
         """
@@ -204,6 +206,7 @@ class NonlinearContactModel(ContactModel):
                 "evaluations": sum(r.stats["evaluations"] for r in responses),
                 "newton_iterations": sum(r.stats["iterations"] for r in responses),
                 "factorizations": sum(r.stats["factorizations"] for r in responses),
+                "bordered": shared.bordered if shared else 0,
                 "look_ups": sum(r.stats["look_ups"] for r in responses),
                 "load_substeps": sum(r.stats["substeps"] for r in responses)}
 

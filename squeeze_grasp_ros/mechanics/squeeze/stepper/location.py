@@ -227,9 +227,24 @@ def dips_inside(a: float, b: float, start: Values, end: Values, start_slopes: Va
                 end_slopes: Values, fresh: Collection[EventKey]) -> bool:
     """Whether a function with slopes, positive at both ends of [a, b] (and not zero by
     construction at a: ``fresh``), goes to zero inside on its cubic Hermite interpolant.
+
+    Two :class:`~.functions.WatchedValues` with the same keys (a substep's ends) are read as
+    arrays at the sloped keys' positions.
     """
-    keys = [key for key in end_slopes if key in start_slopes and key in start and key in end
-            and start[key] > 0 and end[key] > 0 and (not fresh or key.at_node not in fresh)]
+    sloped = [key for key in end_slopes if key in start_slopes]
+    position = (start.order.position if isinstance(start, WatchedValues)
+                and isinstance(end, WatchedValues) and start.order is end.order else {})
+    at = [position.get(key) for key in sloped]
+    if sloped and None not in at:
+        ga, gb = start.values[at], end.values[at]
+        keep = (ga > 0) & (gb > 0)
+        if fresh:
+            keep &= np.array([key.at_node not in fresh for key in sloped])
+        ra = np.array([start_slopes[key] for key in sloped])
+        rb = np.array([end_slopes[key] for key in sloped])
+        return bool(hermite_dips(a, b, ga[keep], gb[keep], ra[keep], rb[keep]).any())
+    keys = [key for key in sloped if key in start and key in end and start[key] > 0
+            and end[key] > 0 and (not fresh or key.at_node not in fresh)]
     return bool(hermite_dips(a, b, *(np.array([v[key] for key in keys])
                                      for v in (start, end, start_slopes, end_slopes))).any())
 

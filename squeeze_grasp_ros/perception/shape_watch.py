@@ -38,14 +38,14 @@ import numpy as np
 from squeeze_grasp_ros.control.force_watch import PredictedForces
 from squeeze_grasp_ros.mechanics.elastic.shapes import Outline, signed_area
 from squeeze_grasp_ros.mechanics.errors import InvalidInputError
-from squeeze_grasp_ros.mechanics.vocabulary import ShapeFit
+from squeeze_grasp_ros.mechanics.vocabulary import AlarmType, ShapeFit
 from squeeze_grasp_ros.perception.shape_match import ShapeMatch, deformed_outline, shape_residual
 from squeeze_grasp_ros.scene import GraspSetup
 
 __all__ = ["DEFAULT_SAMPLES", "SHAPE_MISMATCH", "AtForce", "DepthAtForce", "FrameCheck",
            "PredictedShapes", "check_frame", "depth_at_force", "pair_force", "predict_shapes"]
 
-SHAPE_MISMATCH = "shape_mismatch"
+SHAPE_MISMATCH = AlarmType.SHAPE_MISMATCH
 """The alarm type (``Alarm.SHAPE_MISMATCH`` over ROS), like the tracker's alarm names."""
 
 DEFAULT_SAMPLES = 6

@@ -172,7 +172,9 @@ class ContactResponse:
                                     "object")
         n2 = 2 * len(self.nodes)
         self.cdofs = np.stack([2 * self.contacts, 2 * self.contacts + 1], 1).reshape(-1)
-        self.free = np.setdiff1d(np.arange(n2), self.cdofs)
+        interior = np.ones(n2, dtype=bool)
+        interior[self.cdofs] = False
+        self.free = np.flatnonzero(interior)
         if self.geometry is None:
             self.geometry = mesh_geometry(self.nodes, self.triangles)
         if self._u is None:

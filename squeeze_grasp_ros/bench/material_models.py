@@ -288,7 +288,7 @@ def _scaling_verdict(rows: list, quick: bool, method: Factorizer) -> str:
         if ratio_nodes not in at or time_nodes not in at:
             continue
         got_ratio, got_time = at[ratio_nodes][5], at[time_nodes][4]
-        said += [f"{kernel} route: neo-Hookean within {ratio:g}x linear at "
+        said += [f"{kernel.value} route: neo-Hookean within {ratio:g}x linear at "
                  f"{at[ratio_nodes][0]:,} nodes: {got_ratio:.1f}x "
                  f"({'met' if got_ratio <= ratio else 'not met'}; "
                  f"{at[ratio_nodes][6]:.1f}x in CPU time)",

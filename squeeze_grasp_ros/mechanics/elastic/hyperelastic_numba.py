@@ -5,7 +5,8 @@ for the energy, the internal forces and the tangent's CSR values.
 
 :func:`~.hyperelastic.assemble` runs this instead of the numpy route when the mesh's
 :class:`~.hyperelastic.MeshGeometry` was built with ``compiled=True`` (the nonlinear contact
-model asks for it when the fixed-set kernel route is numba: :mod:`.fixed_set_kernel`). The law
+model asks for it when the fixed-set kernel route is numba:
+:mod:`~squeeze_grasp_ros.mechanics.squeeze.fixed_set_kernel`). The law
 is the numpy route's (:func:`~.hyperelastic._neo_hookean`), whose vectorised thickness-stretch
 Newton and logarithms (numpy's SIMD ``log``, several times faster than a compiled scalar one)
 it is given; the kernel does the rest. The element stiffness is written in closed form: with
@@ -16,7 +17,7 @@ v_ai = (F^-T grad N_a)_i and the law's A = mu I + c g g^T - a X,
 whose products are formed so that k is symmetric bit for bit; scattered in one element order
 into the CSR values, the assembled tangent is symmetric bit for bit with no symmetrisation pass.
 Its floats differ from the numpy route's in the last bits (the order of the sums), by about
-1e-15 relative (``test_material_models.py`` compares the two routes).
+1e-15 relative (``test_hyperelastic_kernel.py`` compares the two routes).
 
 Every function is compiled on first use and cached on disk (numba's ``cache=True``); each stays
 callable from Python as ``f.py_func``, the same code uncompiled.

@@ -23,6 +23,7 @@ from squeeze_grasp_ros.mechanics.elastic import shapes
 from squeeze_grasp_ros.mechanics.errors import InvalidInputError
 from squeeze_grasp_ros.mechanics.vocabulary import ShapeType
 from squeeze_grasp_ros.perception.extract import PRIMITIVE_TOLERANCE_PX, extract_outline
+from squeeze_grasp_ros.perception.primitives import ellipse_distances
 from squeeze_grasp_ros.perception.render import render_views
 from squeeze_grasp_ros.planning.errors import PlannerError
 from squeeze_grasp_ros.planning.typed_objects import TypedMaterial, TypedObject, typed_scene
@@ -75,6 +76,48 @@ def test_disks_ellipses_and_annuli_are_recognised_with_their_parameters(scale, d
         report = seen.to_json()
         assert report["recognised"] == kind.value
         assert report["primitive"]["residual_m"] == seen.primitive.residual_m
+
+
+def _on_ellipse(t, centre, a, b, theta):
+    c, s = np.cos(theta), np.sin(theta)
+    x, y = a * np.cos(t), b * np.sin(t)
+    return np.column_stack([centre[0] + c * x - s * y, centre[1] + s * x + c * y])
+
+
+def test_ellipse_distances_match_two_independent_measures():
+    """The vectorised point-to-ellipse distance (the ellipse check's residual) against the
+    nearest of 200,001 dense samples polished by a bounded scalar minimisation, and against
+    scikit-image's per-point ``leastsq`` near the curve (where its start is in the right basin):
+    eccentric and near-round ellipses, points inside, outside, at the centre and on both axes.
+    """
+    skimage_or_skip()
+    from scipy.optimize import minimize_scalar
+    from skimage.measure import EllipseModel
+
+    rng = np.random.default_rng(7)
+    dense_t = np.linspace(0.0, 2.0 * np.pi, 200_001)
+    for a, b in [(2.0, 1.0), (3.0, 0.2), (1.0, 0.999), (0.5, 1.5)]:
+        centre, theta = rng.normal(size=2), rng.uniform(-4.0, 4.0)
+        frame = np.array([[np.cos(theta), -np.sin(theta)], [np.sin(theta), np.cos(theta)]])
+        axes = np.array([[0.0, 0.0], [0.3, 0.0], [4.0, 0.0], [0.0, 0.1], [0.0, -3.0]])
+        points = np.vstack([centre + axes @ frame.T, centre + 2.0 * rng.normal(size=(25, 2))])
+        found = ellipse_distances(points, centre, a, b, theta)
+        dense = _on_ellipse(dense_t, centre, a, b, theta)
+        for point, distance in zip(points, found):
+            near = dense_t[np.argmin(np.sum((dense - point) ** 2, axis=1))]
+            best = minimize_scalar(
+                lambda t: np.linalg.norm(_on_ellipse(np.array([t]), centre, a, b, theta)[0]
+                                         - point),
+                bounds=(near - 1e-3, near + 1e-3), method="bounded",
+                options={"xatol": 1e-13}).fun
+            assert distance == pytest.approx(best, abs=1e-9)
+        near_curve = _on_ellipse(rng.uniform(0, 2 * np.pi, 40), centre, a, b, theta) \
+            * rng.uniform(0.97, 1.03, (40, 1)) + 0.03 * centre
+        model = EllipseModel.from_estimate(_on_ellipse(dense_t[::1000], centre, a, b, theta))
+        reference = np.abs(model.residuals(near_curve))
+        mine = ellipse_distances(near_curve, np.asarray(model.center, float),
+                                 *map(float, model.axis_lengths), float(model.theta))
+        np.testing.assert_allclose(mine, reference, rtol=1e-6, atol=1e-9)  # leastsq xtol
 
 
 def test_primitives_at_the_origin_become_named_scene_shapes():

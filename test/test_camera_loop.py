@@ -474,7 +474,7 @@ def test_a_frame_before_the_prediction_waits_for_it(ros_context):
         spin_until(lambda: 100_000_000 in watcher.waiting)
         camera.create_publisher(PredictedShapesMsg, pipeline.PREDICTED_SHAPES,
                                 pipeline.LATCHED).publish(
-            predicted_shapes_msg(scene, 0.005, 0))
+            predicted_shapes_msg(GraspSetup.build(scene).precompute(), 0.005, 0))
         for _ in range(10):  # the force curve (planner/predicted_events) is still missing
             executor.spin_once(timeout_sec=0.02)
         assert residuals == []

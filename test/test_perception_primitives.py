@@ -240,6 +240,12 @@ def test_the_foam_ring_on_its_axis_from_the_camera_raises_no_alarm(tmp_path):
     (before: world 7 events, planner 6, ``prediction_mismatch`` x3); the monitor takes the
     stick-slip events of mirror patches as ties: no alarm. The YAML route (the true ring) on
     the axis is unchanged: the same world events, no alarm.
+
+    The monitor runs with the mirror tolerance derived for the seen ring, (e + R dtheta / 2) /
+    (2 h): e the extraction's stated tolerance, h the seen ring's mesh spacing (96 nodes on its
+    outer circle, 3.27 mm), R and dtheta the scene's fingertip and taxels; a planner told the
+    wrong Poisson's ratio (0.45 for 0.3: no stick-slip predicted) still raises
+    ``prediction_mismatch`` with it.
     """
     skimage_or_skip()
     data = yaml.safe_load(RING_SCENE.read_text())
@@ -248,6 +254,21 @@ def test_the_foam_ring_on_its_axis_from_the_camera_raises_no_alarm(tmp_path):
     assert seen["outcome"] == "grasp held" and seen["seen_outline"]["recognised"] == "annulus"
     assert not seen["alarms"], seen["alarms"]
     assert seen["event_counts"]["C"] + seen["event_counts"]["D"] > 0
+    mirror = seen["seen_outline"]["mirror_tolerance"]
+    spacing = 2 * np.pi * 0.05 / 96
+    assert mirror["spacing_m"] == pytest.approx(spacing, rel=0.02)
+    assert mirror["outline_error_m"] == seen["seen_outline"]["tolerance_m"]
+    pitch = np.radians(150.0) / 95
+    assert mirror["value"] == mirror["used"] == pytest.approx(
+        (mirror["outline_error_m"] + 0.5 * 0.02 * pitch) / (2 * spacing), rel=0.02)
+    assert 0.05 < mirror["value"] < 0.25  # above the default, below the off-axis pair's 0.25
+    wrong = copy.deepcopy(data)
+    wrong["object"]["material"]["nu"] = 0.45
+    (tmp_path / "wrong").mkdir()
+    told_wrong = run_scene(tmp_path / "wrong", wrong, world=data)
+    assert told_wrong["seen_outline"]["mirror_tolerance"]["used"] == pytest.approx(
+        mirror["value"], rel=0.02)
+    assert "prediction_mismatch" in told_wrong["alarms"], told_wrong["alarms"]
     yaml_route = copy.deepcopy(data)
     yaml_route["camera"]["plan_from_images"] = False
     (tmp_path / "yaml").mkdir()

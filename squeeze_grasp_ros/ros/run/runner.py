@@ -59,6 +59,7 @@ from squeeze_grasp_ros.ros.run.camera_plan import (
     first_outline,
     predicted_shapes_msg,
     seen_description,
+    seen_mirror_tolerance,
     seen_report,
 )
 from squeeze_grasp_ros.ros.run.goal_client import GoalClient
@@ -81,7 +82,7 @@ from squeeze_grasp_ros.ros.run.planning import (
 )
 from squeeze_grasp_ros.ros.run.processes import NodeProcesses, ros_arguments
 from squeeze_grasp_ros.ros.run.summary import run_summary
-from squeeze_grasp_ros.scene import SceneError
+from squeeze_grasp_ros.scene import GraspSetup, SceneError
 
 __all__ = ["EVENTS_PER_CHECK", "STOP_SIGNALS", "PipelineRunner"]
 
@@ -149,6 +150,7 @@ class PipelineRunner:
         self.goal = GoalClient(self.client, self.observer.on_feedback)
         self.plan: Plan | None = None
         self.seen: ObjectOutline | None = None
+        self.mirror: dict | None = None  # the seen object's mirror tolerance, and its sources
         """The outline the camera's first frame showed (camera.plan_from_images)."""
         self.start_ns = 0
 
@@ -218,8 +220,11 @@ class PipelineRunner:
         self.prediction_pub.publish(self.plan.prediction)
         if self.scene.has(Effect.CAMERA):
             self._publish_predicted_shapes()
+        derived = None if self.mirror is None else self.mirror["value"]
         params = node_parameters(self.scene, options.scene_path, options,
-                                 self.plan.goal.relative_per_depth)
+                                 self.plan.goal.relative_per_depth, mirror_tolerance=derived)
+        if self.mirror is not None:  # what the monitor runs with (an override wins)
+            self.mirror["used"] = float(params["monitor"]["mirror_tolerance"])
         if not options.record:
             del params["recorder"]
         if self.sees_object:
@@ -258,7 +263,10 @@ class PipelineRunner:
         started = time.perf_counter()
         model = self.scene if self.seen is None else typed_scene(typed_object(
             seen_description(self.scene, self.seen))).scene
-        model = dataclasses.replace(model, squeeze=self.scene.squeeze)
+        model = GraspSetup.build(dataclasses.replace(model, squeeze=self.scene.squeeze))
+        model = model.precompute()
+        if self.seen is not None:
+            self.mirror = seen_mirror_tolerance(model, self.scene, self.seen)
         msg = predicted_shapes_msg(model, self.plan.goal.depth, 0)
         self.client.create_publisher(PredictedShapes, pipeline.PREDICTED_SHAPES,
                                      pipeline.LATCHED).publish(msg)
@@ -449,7 +457,8 @@ class PipelineRunner:
                               observed=self.observer.observed(), result=result,
                               recording=self.options.record, timing=timing),
                 "namespace": self.namespace,
-                **({"seen_outline": seen_report(self.scene, self.seen)} if self.seen else {})}
+                **({"seen_outline": {**seen_report(self.scene, self.seen),
+                                     "mirror_tolerance": self.mirror}} if self.seen else {})}
 
     def _node_timing(self) -> dict:
         """Wall and CPU time of the stepper (``mechanics``) and of whole world ticks (``world``:

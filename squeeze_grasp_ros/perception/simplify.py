@@ -88,7 +88,7 @@ def _line(points: np.ndarray, tolerance: float):
     """Centre and unit direction of the total-least-squares line through ``points``, or None
     when they stray from it by more than ``tolerance`` (they are not straight).
     """
-    centre = points.mean(axis=0)
+    centre = points.sum(axis=0) / len(points)  # the mean, without np.mean's call overhead
     d = points - centre
     sxx, syy, sxy = d[:, 0] @ d[:, 0], d[:, 1] @ d[:, 1], d[:, 0] @ d[:, 1]
     angle = 0.5 * np.arctan2(2.0 * sxy, sxx - syy)  # principal axis of the 2 x 2 scatter
@@ -98,19 +98,18 @@ def _line(points: np.ndarray, tolerance: float):
 
 
 def _circle(points: np.ndarray, tolerance: float):
-    """Centre and radius of the circle through ``points`` (scikit-image ``CircleModel``), or
-    None when they stray from it by more than ``tolerance`` (they are no circular arc).
+    """Centre and radius of the circle through ``points`` (scikit-image ``CircleModel``'s fit,
+    :func:`~.primitives.fit_circle`), or None when they stray from it by more than
+    ``tolerance`` (they are no circular arc).
     """
-    from skimage.measure import CircleModel
+    from squeeze_grasp_ros.perception.primitives import fit_circle
 
-    from squeeze_grasp_ros.perception.primitives import fitted_model
-
-    model = fitted_model(CircleModel, points)
-    if model is None or not np.all(np.isfinite(model.center)):
+    circle = fit_circle(points)
+    if circle is None or not np.all(np.isfinite(circle[0])):
         return None
-    if np.abs(model.residuals(points)).max() > tolerance:
+    if np.abs(circle[1] - np.linalg.norm(points - circle[0], axis=1)).max() > tolerance:
         return None
-    return np.asarray(model.center, float), float(model.radius)
+    return circle
 
 
 SIDE_SPANS = (4.0, 2.0)
@@ -174,11 +173,15 @@ def _corner(p: np.ndarray, gap: np.ndarray, skip: float, span: float, tolerance:
     after = _stretch(p, gap, skip, span)
     if len(before) < 3 or len(after) < 3:
         return None
-    lines = _line(before, tolerance), _line(after, tolerance)
     long_line = [_line(_stretch(p, g, skip, LINE_BESIDE_ARC * span), tolerance)
                  for g in (-gap, gap)]
     arcs = [None if long_line[1 - k] is None else _arc_side(p, g, skip, span, tolerance)
             for k, g in enumerate((-gap, gap))]
+    # the short sides' lines only where no arc meets a line (most tries on a noisy trace)
+    lines = (None, None) if arcs[0] is not None or arcs[1] is not None else (
+        _line(before, tolerance), None)
+    if lines[0] is not None:
+        lines = (lines[0], _line(after, tolerance))
     if arcs[0] is not None or arcs[1] is not None:
         arc_after = arcs[1] is not None
         line, arc = (long_line[0], arcs[1]) if arc_after else (long_line[1], arcs[0])

@@ -23,7 +23,7 @@ from squeeze_grasp_ros.mechanics.elastic import shapes
 from squeeze_grasp_ros.mechanics.errors import InvalidInputError
 from squeeze_grasp_ros.mechanics.vocabulary import ShapeType
 from squeeze_grasp_ros.perception.extract import PRIMITIVE_TOLERANCE_PX, extract_outline
-from squeeze_grasp_ros.perception.primitives import ellipse_distances
+from squeeze_grasp_ros.perception.primitives import ellipse_distances, fit_circle
 from squeeze_grasp_ros.perception.render import render_views
 from squeeze_grasp_ros.planning.errors import PlannerError
 from squeeze_grasp_ros.planning.typed_objects import TypedMaterial, TypedObject, typed_scene
@@ -118,6 +118,27 @@ def test_ellipse_distances_match_two_independent_measures():
         mine = ellipse_distances(near_curve, np.asarray(model.center, float),
                                  *map(float, model.axis_lengths), float(model.theta))
         np.testing.assert_allclose(mine, reference, rtol=1e-6, atol=1e-9)  # leastsq xtol
+
+
+def test_fit_circle_is_scikit_images_circle_estimate():
+    """The corner rebuild's circle fit against scikit-image's ``CircleModel`` on noisy arcs of
+    several lengths and places: the same centre and radius to the last bit; points that tell no
+    circle (all at one point, collinear) give None, as the model's estimate fails.
+    """
+    skimage_or_skip()
+    from skimage.measure import CircleModel
+
+    rng = np.random.default_rng(3)
+    for span in (0.2, 1.0, 6.0):
+        t = rng.uniform(0.0, span, 30)
+        points = rng.normal(size=2) + rng.uniform(0.01, 2.0) * np.c_[np.cos(t), np.sin(t)] \
+            + 1e-4 * rng.normal(size=(30, 2))
+        model = CircleModel.from_estimate(points)
+        centre, radius = fit_circle(points)
+        assert np.array_equal(centre, model.center) and radius == model.radius
+    assert fit_circle(np.ones((5, 2))) is None
+    assert fit_circle(np.c_[np.arange(5.0), 2 * np.arange(5.0)]) is None
+    assert not CircleModel.from_estimate(np.c_[np.arange(5.0), 2 * np.arange(5.0)])
 
 
 def test_primitives_at_the_origin_become_named_scene_shapes():

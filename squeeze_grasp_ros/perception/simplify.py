@@ -84,17 +84,51 @@ CANDIDATE_TURN_DEG = 10.0
 tip may spread its turn over several vertices."""
 
 
-def _line(points: np.ndarray, tolerance: float):
-    """Centre and unit direction of the total-least-squares line through ``points``, or None
-    when they stray from it by more than ``tolerance`` (they are not straight).
+def _stretch_lines(p: np.ndarray, gaps: np.ndarray, starts: np.ndarray, lengths: np.ndarray,
+                   tolerance: float):
+    """The traced stretches beside every corner candidate, and the total-least-squares line
+    through each, all at once.
+
+    Stretch (c, i, s, j) holds the traced points whose signed arc length from candidate c's
+    vertex, times -1 before it (s = 0) and +1 after it (s = 1), lies in [``starts[i]``,
+    ``starts[i] + lengths[j]``], in the trace's order (``gaps``: (C, n) signed arc lengths).
+
+    Returns
+    -------
+    points : (m, 2) ndarray
+        The stretches' points, one after the other.
+    first, count : (C, I, 2, J) ndarray of int
+        Where each stretch starts in ``points`` and how many points it has.
+    centre, direction : (C, I, 2, J, 2) ndarray
+        Centre and unit direction of the line through each (NaN for an empty stretch).
+    straight : (C, I, 2, J) ndarray of bool
+        Whether every point of the stretch lies within ``tolerance`` of its line.
     """
-    centre = points.sum(axis=0) / len(points)  # the mean, without np.mean's call overhead
-    d = points - centre
-    sxx, syy, sxy = d[:, 0] @ d[:, 0], d[:, 1] @ d[:, 1], d[:, 0] @ d[:, 1]
-    angle = 0.5 * np.arctan2(2.0 * sxy, sxx - syy)  # principal axis of the 2 x 2 scatter
-    direction = np.array([np.cos(angle), np.sin(angle)])
-    off = np.abs(d @ np.array([-direction[1], direction[0]]))
-    return (centre, direction) if off.max() <= tolerance else None
+    side = np.stack([-gaps, gaps], axis=1)[:, None, :, None, :]  # (C, 1, 2, 1, n)
+    lo = starts[None, :, None, None, None]
+    inside = (side >= lo) & (side <= lo + lengths[None, None, None, :, None])
+    shape = inside.shape[:-1]
+    row, col = np.nonzero(inside.reshape(-1, gaps.shape[1]))  # row-major: the trace's order
+    count = np.bincount(row, minlength=int(np.prod(shape)))
+    first = np.cumsum(count) - count
+    points = p[col]
+    used = count > 0
+    at, size = first[used], count[used]
+    centre = np.full((len(count), 2), np.nan)
+    direction = np.full((len(count), 2), np.nan)
+    straight = np.zeros(len(count), bool)
+    if len(at):
+        mean = np.add.reduceat(points, at, axis=0) / size[:, None]
+        d = points - np.repeat(mean, size, axis=0)
+        sxx, syy, sxy = (np.add.reduceat(u * v, at) for u, v in (
+            (d[:, 0], d[:, 0]), (d[:, 1], d[:, 1]), (d[:, 0], d[:, 1])))
+        angle = 0.5 * np.arctan2(2.0 * sxy, sxx - syy)  # principal axis of the 2 x 2 scatter
+        cos, sin = np.cos(angle), np.sin(angle)
+        off = np.abs(np.repeat(cos, size) * d[:, 1] - np.repeat(sin, size) * d[:, 0])
+        centre[used], direction[used] = mean, np.column_stack([cos, sin])
+        straight[used] = np.maximum.reduceat(off, at) <= tolerance
+    return (points, first.reshape(shape), count.reshape(shape), centre.reshape(*shape, 2),
+            direction.reshape(*shape, 2), straight.reshape(shape))
 
 
 def _circle(points: np.ndarray, tolerance: float):
@@ -122,20 +156,37 @@ LINE_BESIDE_ARC = 2.0
 """A straight side meets an arc at a corner only when it is straight over this many spans (a
 D's diameter is; a gently curved side, straight to the tolerance over one span only, is not)."""
 
-
-def _stretch(p: np.ndarray, gap: np.ndarray, skip: float, length: float) -> np.ndarray:
-    """The traced points from ``skip`` to ``skip + length`` after the point at ``gap`` = 0."""
-    return p[(gap >= skip) & (gap <= skip + length)]
+STRETCH_SPANS = tuple(sorted({1.0, LINE_BESIDE_ARC, *SIDE_SPANS}))
+"""Every stretch length (multiples of ``span``) the corner rebuild fits a line to."""
 
 
-def _arc_side(p: np.ndarray, gap: np.ndarray, skip: float, span: float, tolerance: float):
+class _Stretches:
+    """The stretches beside one corner candidate at one skip (a view of
+    :func:`_stretch_lines`' results): ``points(side, spans)`` and ``line(side, spans)``
+    (centre, direction, or None when not straight), side 0 before the vertex and 1 after it.
+    """
+
+    def __init__(self, fits: tuple, c: int, i: int):
+        self.fits, self.c, self.i = fits, c, i
+
+    def points(self, side: int, spans: float) -> np.ndarray:
+        points, first, count = self.fits[:3]
+        k = (self.c, self.i, side, STRETCH_SPANS.index(spans))
+        return points[first[k]:first[k] + count[k]]
+
+    def line(self, side: int, spans: float):
+        _, _, count, centre, direction, straight = self.fits
+        k = (self.c, self.i, side, STRETCH_SPANS.index(spans))
+        return (centre[k], direction[k]) if straight[k] else None
+
+
+def _arc_side(stretches: _Stretches, side: int, tolerance: float):
     """The circle (centre, radius) fitted within ``tolerance`` to the longest stretch (of
-    :data:`SIDE_SPANS`) after the point at ``gap`` = 0 that is circular and not straight, or
-    None.
+    :data:`SIDE_SPANS`) on ``side`` that is circular and not straight, or None.
     """
     for factor in SIDE_SPANS:
-        stretch = _stretch(p, gap, skip, factor * span)
-        if len(stretch) >= 3 and _line(stretch, tolerance) is None:
+        stretch = stretches.points(side, factor)
+        if len(stretch) >= 3 and stretches.line(side, factor) is None:
             circle = _circle(stretch, tolerance)
             if circle is not None:
                 return circle
@@ -161,27 +212,19 @@ def _line_meets_arc(line, circle, near: np.ndarray, arc_after: bool):
     return (corner, d0, tangent) if arc_after else (corner, tangent, d0)
 
 
-def _corner(p: np.ndarray, gap: np.ndarray, skip: float, span: float, tolerance: float,
-            max_cut: float, min_turn_deg: float) -> np.ndarray | None:
-    """The rebuilt corner from the stretches from ``skip`` on before and after the point at
+def _corner(p: np.ndarray, gap: np.ndarray, skip: float, stretches: _Stretches,
+            tolerance: float, max_cut: float, min_turn_deg: float) -> np.ndarray | None:
+    """The rebuilt corner from the ``stretches`` from ``skip`` on before and after the point at
     ``gap`` = 0 (signed arc length), or None when it is not a clean corner: a straight side
     (over :data:`LINE_BESIDE_ARC` spans) and a circular arc (a D shape's diameter meeting its
-    arc) meet where the line meets the circle; two sides straight over ``span`` meet at the
+    arc) meet where the line meets the circle; two sides straight over a span meet at the
     intersection of their lines.
     """
-    before = _stretch(p, -gap, skip, span)
-    after = _stretch(p, gap, skip, span)
-    if len(before) < 3 or len(after) < 3:
+    if len(stretches.points(0, 1.0)) < 3 or len(stretches.points(1, 1.0)) < 3:
         return None
-    long_line = [_line(_stretch(p, g, skip, LINE_BESIDE_ARC * span), tolerance)
-                 for g in (-gap, gap)]
-    arcs = [None if long_line[1 - k] is None else _arc_side(p, g, skip, span, tolerance)
-            for k, g in enumerate((-gap, gap))]
-    # the short sides' lines only where no arc meets a line (most tries on a noisy trace)
-    lines = (None, None) if arcs[0] is not None or arcs[1] is not None else (
-        _line(before, tolerance), None)
-    if lines[0] is not None:
-        lines = (lines[0], _line(after, tolerance))
+    long_line = [stretches.line(side, LINE_BESIDE_ARC) for side in (0, 1)]
+    arcs = [None if long_line[1 - side] is None else _arc_side(stretches, side, tolerance)
+            for side in (0, 1)]
     if arcs[0] is not None or arcs[1] is not None:
         arc_after = arcs[1] is not None
         line, arc = (long_line[0], arcs[1]) if arc_after else (long_line[1], arcs[0])
@@ -191,15 +234,16 @@ def _corner(p: np.ndarray, gap: np.ndarray, skip: float, span: float, tolerance:
         corner, d0, d1 = met
         if abs(d0[0] * d1[1] - d0[1] * d1[0]) < np.sin(np.radians(min_turn_deg)):
             return None  # a tangent join (a straight edge running into an arc): no corner
-    elif lines[0] is not None and lines[1] is not None:
+    else:
+        lines = stretches.line(0, 1.0), stretches.line(1, 1.0)
+        if lines[0] is None or lines[1] is None:
+            return None
         (c0, d0), (c1, d1) = lines
         det = d0[0] * d1[1] - d0[1] * d1[0]
         if abs(det) < np.sin(np.radians(min_turn_deg)):
             return None
         w = c1 - c0
         corner = c0 + d0 * (w[0] * d1[1] - w[1] * d1[0]) / det
-    else:
-        return None
     half_angle = 0.5 * (np.pi - np.arccos(np.clip(abs(d0 @ d1), 0.0, 1.0)))
     cut = np.linalg.norm(p[np.abs(gap) < skip] - corner, axis=1).min(initial=np.inf)
     return corner if cut <= max_cut / np.sin(half_angle) else None
@@ -252,12 +296,17 @@ def sharpen_corners(points: np.ndarray, kept: np.ndarray, *, radius: float, span
     out = q.copy()
     drop = np.zeros(len(q), bool)
     moved = np.zeros(len(q), bool)
-    for c in np.argsort(-turn)[:np.count_nonzero(turn > CANDIDATE_TURN_DEG)]:
+    candidates = np.argsort(-turn)[:np.count_nonzero(turn > CANDIDATE_TURN_DEG)]
+    skips = np.array([radius, 1.5 * radius, 2.25 * radius])  # acute tips are rounded farther
+    gaps = (arc[None, :n] - arc[kept[candidates]][:, None] + 0.5 * total) % total - 0.5 * total
+    fits = _stretch_lines(p, gaps, skips, np.array(STRETCH_SPANS) * span, tolerance)
+    for k, c in enumerate(candidates):
         if drop[c]:  # another vertex of the same corner was moved already
             continue
-        gap = (arc[:n] - arc[kept[c]] + 0.5 * total) % total - 0.5 * total  # signed arc
-        for skip in (radius, 1.5 * radius, 2.25 * radius):  # acute tips are rounded farther
-            corner = _corner(p, gap, skip, span, tolerance, max_cut, min_turn_deg)
+        gap = gaps[k]  # signed arc length from the vertex
+        for i, skip in enumerate(skips):
+            corner = _corner(p, gap, skip, _Stretches(fits, k, i), tolerance, max_cut,
+                             min_turn_deg)
             if corner is None:
                 continue
             if moved.any() and np.linalg.norm(out[moved] - corner, axis=1).min() < skip:

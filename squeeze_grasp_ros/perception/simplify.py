@@ -84,25 +84,27 @@ CANDIDATE_TURN_DEG = 10.0
 tip may spread its turn over several vertices."""
 
 
-def _stretch_lines(p: np.ndarray, gaps: np.ndarray, starts: np.ndarray, lengths: np.ndarray,
-                   tolerance: float):
-    """The traced stretches beside every corner candidate, and the total-least-squares line
-    through each, all at once.
+def _stretch_fits(p: np.ndarray, gaps: np.ndarray, starts: np.ndarray, lengths: np.ndarray,
+                  tolerance: float) -> dict[str, np.ndarray]:
+    """The traced stretches beside every corner candidate, and the total-least-squares line and
+    the circle fitted to each, all at once.
 
     Stretch (c, i, s, j) holds the traced points whose signed arc length from candidate c's
     vertex, times -1 before it (s = 0) and +1 after it (s = 1), lies in [``starts[i]``,
     ``starts[i] + lengths[j]``], in the trace's order (``gaps``: (C, n) signed arc lengths).
+    The circle is scikit-image ``CircleModel``'s algebraic fit (:func:`~.primitives.fit_circle`:
+    data centred and scaled to unit spread, least squares on [2x, 2y, 1] -> x^2 + y^2, the
+    radius the RMS distance to the centre), solved here by its 3 x 3 normal equations for all
+    stretches at once.
 
     Returns
     -------
-    points : (m, 2) ndarray
-        The stretches' points, one after the other.
-    first, count : (C, I, 2, J) ndarray of int
-        Where each stretch starts in ``points`` and how many points it has.
-    centre, direction : (C, I, 2, J, 2) ndarray
-        Centre and unit direction of the line through each (NaN for an empty stretch).
-    straight : (C, I, 2, J) ndarray of bool
-        Whether every point of the stretch lies within ``tolerance`` of its line.
+    dict
+        ``points`` (m, 2): the stretches' points one after the other; per stretch, shaped
+        (C, I, 2, J): ``first`` and ``count`` (where it starts in ``points``, how many),
+        ``straight`` (every point within ``tolerance`` of its line), ``circular`` (at least 3
+        points, a circle fitted, every point within ``tolerance`` of it), ``radius``; and
+        (C, I, 2, J, 2): ``centre``, ``direction`` (the line's), ``circle`` (the centre).
     """
     side = np.stack([-gaps, gaps], axis=1)[:, None, :, None, :]  # (C, 1, 2, 1, n)
     lo = starts[None, :, None, None, None]
@@ -112,38 +114,56 @@ def _stretch_lines(p: np.ndarray, gaps: np.ndarray, starts: np.ndarray, lengths:
     count = np.bincount(row, minlength=int(np.prod(shape)))
     first = np.cumsum(count) - count
     points = p[col]
+    out = {"points": points, "first": first, "count": count,
+           **{k: np.full((len(count), 2), np.nan) for k in ("centre", "direction", "circle")},
+           "radius": np.full(len(count), np.nan), "straight": np.zeros(len(count), bool),
+           "circular": np.zeros(len(count), bool)}
     used = count > 0
     at, size = first[used], count[used]
-    centre = np.full((len(count), 2), np.nan)
-    direction = np.full((len(count), 2), np.nan)
-    straight = np.zeros(len(count), bool)
     if len(at):
-        mean = np.add.reduceat(points, at, axis=0) / size[:, None]
-        d = points - np.repeat(mean, size, axis=0)
-        sxx, syy, sxy = (np.add.reduceat(u * v, at) for u, v in (
-            (d[:, 0], d[:, 0]), (d[:, 1], d[:, 1]), (d[:, 0], d[:, 1])))
+        def sums(values: np.ndarray) -> np.ndarray:
+            return np.add.reduceat(values, at, axis=0)
+
+        def each(values: np.ndarray) -> np.ndarray:
+            return np.repeat(values, size, axis=0)
+
+        mean = sums(points) / size[:, None]
+        d = points - each(mean)
+        sxx, syy, sxy = sums(d[:, 0] * d[:, 0]), sums(d[:, 1] * d[:, 1]), sums(d[:, 0] * d[:, 1])
         angle = 0.5 * np.arctan2(2.0 * sxy, sxx - syy)  # principal axis of the 2 x 2 scatter
         cos, sin = np.cos(angle), np.sin(angle)
-        off = np.abs(np.repeat(cos, size) * d[:, 1] - np.repeat(sin, size) * d[:, 0])
-        centre[used], direction[used] = mean, np.column_stack([cos, sin])
-        straight[used] = np.maximum.reduceat(off, at) <= tolerance
-    return (points, first.reshape(shape), count.reshape(shape), centre.reshape(*shape, 2),
-            direction.reshape(*shape, 2), straight.reshape(shape))
-
-
-def _circle(points: np.ndarray, tolerance: float):
-    """Centre and radius of the circle through ``points`` (scikit-image ``CircleModel``'s fit,
-    :func:`~.primitives.fit_circle`), or None when they stray from it by more than
-    ``tolerance`` (they are no circular arc).
-    """
-    from squeeze_grasp_ros.perception.primitives import fit_circle
-
-    circle = fit_circle(points)
-    if circle is None or not np.all(np.isfinite(circle[0])):
-        return None
-    if np.abs(circle[1] - np.linalg.norm(points - circle[0], axis=1)).max() > tolerance:
-        return None
-    return circle
+        off = np.abs(each(cos) * d[:, 1] - each(sin) * d[:, 0])
+        out["centre"][used], out["direction"][used] = mean, np.column_stack([cos, sin])
+        out["straight"][used] = np.maximum.reduceat(off, at) <= tolerance
+        # the circles, on the centred points scaled to unit spread (std over both columns)
+        scale = np.sqrt((sxx + syy) / (2 * size))
+        with np.errstate(divide="ignore", invalid="ignore"):
+            u = d / each(scale)[:, None]
+        f = np.sum(u * u, axis=1)
+        suu = sums(u[:, 0] * u[:, 1])
+        normal = np.empty((len(at), 3, 3))
+        normal[:, 0, 0], normal[:, 1, 1] = 4.0 * sums(u[:, 0] ** 2), 4.0 * sums(u[:, 1] ** 2)
+        normal[:, 0, 1] = normal[:, 1, 0] = 4.0 * suu
+        normal[:, :2, 2] = 2.0 * sums(u)
+        normal[:, 2, :2] = normal[:, :2, 2]
+        normal[:, 2, 2] = size
+        rhs = np.column_stack([2.0 * sums(u * f[:, None]), sums(f)])
+        # the design [2x, 2y, 1] has rank 3 (lstsq's test): away from a collinear or tiny set
+        fit = (size >= 3) & (scale >= np.finfo(float).tiny) & np.all(np.isfinite(normal),
+                                                                      axis=(1, 2))
+        fit[fit] &= np.abs(np.linalg.det(normal[fit])) > 1e-10 * size[fit] ** 3
+        solved = np.linalg.solve(np.where(fit[:, None, None], normal, np.eye(3)),
+                                 np.where(fit[:, None], rhs, 0.0)[..., None])[..., 0]
+        c = solved[:, :2]
+        with np.errstate(invalid="ignore"):
+            radius = np.sqrt(sums(np.sum((u - each(c)) ** 2, axis=1)) / size) * scale
+            centre = c * scale[:, None] + mean
+            stray = np.maximum.reduceat(np.abs(each(radius) - np.linalg.norm(
+                points - each(centre), axis=1)), at)
+            circular = fit & np.all(np.isfinite(centre), axis=1) & (stray <= tolerance)
+        out["circle"][used], out["radius"][used] = centre, radius
+        out["circular"][used] = circular
+    return {k: v if k == "points" else v.reshape(*shape, *v.shape[1:]) for k, v in out.items()}
 
 
 SIDE_SPANS = (4.0, 2.0)
@@ -161,33 +181,43 @@ STRETCH_SPANS = tuple(sorted({1.0, LINE_BESIDE_ARC, *SIDE_SPANS}))
 
 
 class _Stretches:
-    """The stretches beside one corner candidate at one skip (a view of
-    :func:`_stretch_lines`' results): ``points(side, spans)`` and ``line(side, spans)``
-    (centre, direction, or None when not straight), side 0 before the vertex and 1 after it.
+    """The stretches beside one corner candidate at one skip (a view of :func:`_stretch_fits`'
+    results), side 0 before the vertex and 1 after it, ``spans`` one of
+    :data:`STRETCH_SPANS`.
     """
 
-    def __init__(self, fits: tuple, c: int, i: int):
+    def __init__(self, fits: dict[str, np.ndarray], c: int, i: int):
         self.fits, self.c, self.i = fits, c, i
 
-    def points(self, side: int, spans: float) -> np.ndarray:
-        points, first, count = self.fits[:3]
-        k = (self.c, self.i, side, STRETCH_SPANS.index(spans))
-        return points[first[k]:first[k] + count[k]]
+    def _at(self, side: int, spans: float) -> tuple[int, int, int, int]:
+        return self.c, self.i, side, STRETCH_SPANS.index(spans)
+
+    def count(self, side: int, spans: float) -> int:
+        """How many traced points the stretch holds."""
+        return int(self.fits["count"][self._at(side, spans)])
 
     def line(self, side: int, spans: float):
-        _, _, count, centre, direction, straight = self.fits
-        k = (self.c, self.i, side, STRETCH_SPANS.index(spans))
-        return (centre[k], direction[k]) if straight[k] else None
+        """(centre, direction) of the stretch's line, or None when it is not straight."""
+        k = self._at(side, spans)
+        if not self.fits["straight"][k]:
+            return None
+        return self.fits["centre"][k], self.fits["direction"][k]
+
+    def circle(self, side: int, spans: float):
+        """(centre, radius) of the stretch's circle, or None when it is not circular."""
+        k = self._at(side, spans)
+        if not self.fits["circular"][k]:
+            return None
+        return self.fits["circle"][k], float(self.fits["radius"][k])
 
 
-def _arc_side(stretches: _Stretches, side: int, tolerance: float):
-    """The circle (centre, radius) fitted within ``tolerance`` to the longest stretch (of
-    :data:`SIDE_SPANS`) on ``side`` that is circular and not straight, or None.
+def _arc_side(stretches: _Stretches, side: int):
+    """The circle (centre, radius) of the longest stretch (of :data:`SIDE_SPANS`) on ``side``
+    that is circular and not straight, or None.
     """
     for factor in SIDE_SPANS:
-        stretch = stretches.points(side, factor)
-        if len(stretch) >= 3 and stretches.line(side, factor) is None:
-            circle = _circle(stretch, tolerance)
+        if stretches.count(side, factor) >= 3 and stretches.line(side, factor) is None:
+            circle = stretches.circle(side, factor)
             if circle is not None:
                 return circle
     return None
@@ -213,17 +243,17 @@ def _line_meets_arc(line, circle, near: np.ndarray, arc_after: bool):
 
 
 def _corner(p: np.ndarray, gap: np.ndarray, skip: float, stretches: _Stretches,
-            tolerance: float, max_cut: float, min_turn_deg: float) -> np.ndarray | None:
+            max_cut: float, min_turn_deg: float) -> np.ndarray | None:
     """The rebuilt corner from the ``stretches`` from ``skip`` on before and after the point at
     ``gap`` = 0 (signed arc length), or None when it is not a clean corner: a straight side
     (over :data:`LINE_BESIDE_ARC` spans) and a circular arc (a D shape's diameter meeting its
     arc) meet where the line meets the circle; two sides straight over a span meet at the
     intersection of their lines.
     """
-    if len(stretches.points(0, 1.0)) < 3 or len(stretches.points(1, 1.0)) < 3:
+    if stretches.count(0, 1.0) < 3 or stretches.count(1, 1.0) < 3:
         return None
     long_line = [stretches.line(side, LINE_BESIDE_ARC) for side in (0, 1)]
-    arcs = [None if long_line[1 - side] is None else _arc_side(stretches, side, tolerance)
+    arcs = [None if long_line[1 - side] is None else _arc_side(stretches, side)
             for side in (0, 1)]
     if arcs[0] is not None or arcs[1] is not None:
         arc_after = arcs[1] is not None
@@ -299,14 +329,13 @@ def sharpen_corners(points: np.ndarray, kept: np.ndarray, *, radius: float, span
     candidates = np.argsort(-turn)[:np.count_nonzero(turn > CANDIDATE_TURN_DEG)]
     skips = np.array([radius, 1.5 * radius, 2.25 * radius])  # acute tips are rounded farther
     gaps = (arc[None, :n] - arc[kept[candidates]][:, None] + 0.5 * total) % total - 0.5 * total
-    fits = _stretch_lines(p, gaps, skips, np.array(STRETCH_SPANS) * span, tolerance)
+    fits = _stretch_fits(p, gaps, skips, np.array(STRETCH_SPANS) * span, tolerance)
     for k, c in enumerate(candidates):
         if drop[c]:  # another vertex of the same corner was moved already
             continue
         gap = gaps[k]  # signed arc length from the vertex
         for i, skip in enumerate(skips):
-            corner = _corner(p, gap, skip, _Stretches(fits, k, i), tolerance, max_cut,
-                             min_turn_deg)
+            corner = _corner(p, gap, skip, _Stretches(fits, k, i), max_cut, min_turn_deg)
             if corner is None:
                 continue
             if moved.any() and np.linalg.norm(out[moved] - corner, axis=1).min() < skip:

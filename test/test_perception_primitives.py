@@ -298,6 +298,24 @@ def test_the_foam_ring_on_its_axis_from_the_camera_raises_no_alarm(tmp_path):
     assert by_yaml["event_counts"] == seen["event_counts"]
     assert len(by_yaml["prediction"]["events"]) == sum(by_yaml["event_counts"].values())
 
+def test_the_summary_says_whether_the_derived_mirror_tolerance_is_applied():
+    """The run's line for the derived tolerance: applied (its formula and sources), overridden
+    (the value used and the one derived), or not applied when ``run --attach`` finds the
+    monitor already running with its own parameter.
+    """
+    from squeeze_grasp_ros.commands.run import _mirror
+
+    mirror = {"value": 0.0652, "spacing_m": 3.27e-3, "outline_error_m": 1.52e-4,
+              "tip_radius_m": 0.02, "taxel_pitch_rad": np.radians(150.0) / 95}
+    applied = _mirror({**mirror, "used": 0.0652})
+    assert applied.startswith("monitor: mirror_tolerance 0.065 = (e + R dtheta / 2) / (2 h)")
+    assert "h 3.27 mm" in applied and "e 0.152 mm" in applied and "dtheta 1.58 deg" in applied
+    assert _mirror({**mirror, "used": 0.2}).startswith(
+        "monitor: mirror_tolerance 0.200 as set (derived 0.065")
+    assert _mirror({**mirror, "used": None}).endswith(
+        "not applied: the attached monitor runs with its own parameter")
+
+
 def test_the_seen_ring_meshes_like_the_yaml_ring():
     """ROS-free: the ring the camera sees, described by name, meshes to within 1 % of the YAML
     ring's boundary nodes (the polygon route made each of its 60 + 60 seen vertices a corner).

@@ -249,6 +249,9 @@ def _mirror(mirror: dict) -> str:
                f" mm, outline error e {mirror['outline_error_m'] * 1e3:.3f} mm (the extraction's"
                f" tolerance), fingertip R {mirror['tip_radius_m'] * 1e3:g} mm, taxel pitch dtheta "
                f"{math.degrees(mirror['taxel_pitch_rad']):.2f} deg")
+    if mirror.get("used", mirror["value"]) is None:
+        return (f"monitor: mirror_tolerance {mirror['value']:.3f} derived = {derived}; not "
+                "applied: the attached monitor runs with its own parameter")
     if mirror.get("used", mirror["value"]) != mirror["value"]:
         return (f"monitor: mirror_tolerance {mirror['used']:.3f} as set (derived "
                 f"{mirror['value']:.3f} = {derived})")

@@ -223,8 +223,10 @@ class PipelineRunner:
         derived = None if self.mirror is None else self.mirror["value"]
         params = node_parameters(self.scene, options.scene_path, options,
                                  self.plan.goal.relative_per_depth, mirror_tolerance=derived)
-        if self.mirror is not None:  # what the monitor runs with (an override wins)
-            self.mirror["used"] = float(params["monitor"]["mirror_tolerance"])
+        if self.mirror is not None:  # what the monitor runs with (an override wins; attached:
+            # the running monitor keeps its own)
+            self.mirror["used"] = None if options.attach else float(
+                params["monitor"]["mirror_tolerance"])
         if not options.record:
             del params["recorder"]
         if self.sees_object:

@@ -104,7 +104,7 @@ def _stretch_fits(p: np.ndarray, gaps: np.ndarray, starts: np.ndarray, lengths: 
         (C, I, 2, J): ``first`` and ``count`` (where it starts in ``points``, how many),
         ``straight`` (every point within ``tolerance`` of its line), ``circular`` (at least 3
         points, a circle fitted, every point within ``tolerance`` of it), ``radius``; and
-        (C, I, 2, J, 2): ``centre``, ``direction`` (the line's), ``circle`` (the centre).
+        (C, I, 2, J, 2): ``centre``, ``direction`` (the line's), ``centre_of_circle``.
     """
     side = np.stack([-gaps, gaps], axis=1)[:, None, :, None, :]  # (C, 1, 2, 1, n)
     lo = starts[None, :, None, None, None]
@@ -115,7 +115,8 @@ def _stretch_fits(p: np.ndarray, gaps: np.ndarray, starts: np.ndarray, lengths: 
     first = np.cumsum(count) - count
     points = p[col]
     out = {"points": points, "first": first, "count": count,
-           **{k: np.full((len(count), 2), np.nan) for k in ("centre", "direction", "circle")},
+           **{k: np.full((len(count), 2), np.nan)
+              for k in ("centre", "direction", "centre_of_circle")},
            "radius": np.full(len(count), np.nan), "straight": np.zeros(len(count), bool),
            "circular": np.zeros(len(count), bool)}
     used = count > 0
@@ -161,7 +162,7 @@ def _stretch_fits(p: np.ndarray, gaps: np.ndarray, starts: np.ndarray, lengths: 
             stray = np.maximum.reduceat(np.abs(each(radius) - np.linalg.norm(
                 points - each(centre), axis=1)), at)
             circular = fit & np.all(np.isfinite(centre), axis=1) & (stray <= tolerance)
-        out["circle"][used], out["radius"][used] = centre, radius
+        out["centre_of_circle"][used], out["radius"][used] = centre, radius
         out["circular"][used] = circular
     return {k: v if k == "points" else v.reshape(*shape, *v.shape[1:]) for k, v in out.items()}
 
@@ -208,7 +209,7 @@ class _Stretches:
         k = self._at(side, spans)
         if not self.fits["circular"][k]:
             return None
-        return self.fits["circle"][k], float(self.fits["radius"][k])
+        return self.fits["centre_of_circle"][k], float(self.fits["radius"][k])
 
 
 def _arc_side(stretches: _Stretches, side: int):

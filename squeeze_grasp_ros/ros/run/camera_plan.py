@@ -21,7 +21,7 @@ from sensor_msgs.msg import CameraInfo, Image
 
 from squeeze_grasp_interfaces.msg import ObjectDescription, PredictedShapes
 from squeeze_grasp_ros.control.tracker import mirror_tolerance_for
-from squeeze_grasp_ros.mechanics.vocabulary import ShapeFit
+from squeeze_grasp_ros.mechanics.vocabulary import Finger, ShapeFit
 from squeeze_grasp_ros.perception.extract import ObjectOutline, extract_outline
 from squeeze_grasp_ros.perception.shape_match import shape_residual
 from squeeze_grasp_ros.perception.shape_watch import predict_shapes
@@ -120,7 +120,7 @@ def seen_mirror_tolerance(model: GraspSetup, scene: Scene, seen: ObjectOutline) 
     spacing = float(np.median(np.linalg.norm(loop - np.roll(loop, 1, axis=0), axis=1)))
     sensors = scene.sensors or SensorsSpec()
     pitch = float(np.radians(sensors.taxel_span_deg) / (sensors.taxels - 1))
-    radius = float(scene.fingers["F1"].tip_radius)
+    radius = float(scene.fingers[Finger.F1].tip_radius)
     return {"value": mirror_tolerance_for(spacing, seen.tolerance_m, tip_radius=radius,
                                           taxel_pitch=pitch),
             "spacing_m": spacing, "outline_error_m": float(seen.tolerance_m),

@@ -251,10 +251,9 @@ def test_ties_the_d_across_its_corners():
 def test_ties_the_rounded_rectangle_along_its_axis():
     """A tie in itself: the rounded rectangle squeezed along its long axis (1,000 nodes, 10 %)
     gives 12 A events, 11 when its true outline is moved by 10 um sin(2 theta) along its normals
-    (the short sides skewed by 10 um: on which side of the finger a flat side's next node comes
-    in is decided by micrometres, and the last two come within 1.5 % of the final depth). Each
-    seen view gives the truth's events or the moved truth's; contact nodes within one spacing,
-    forces within 1 %.
+    (the short sides skewed by 10 um; its last two new contacts come within 1.5 % of the final
+    depth, so micrometres decide whether they come before it). Each seen view gives the truth's
+    events or the moved truth's; contact nodes within one spacing, forces within 1 %.
     """
     skimage_or_skip()
     squeezed = squeezer("rounded_rectangle", "along", 1000, 0.10)

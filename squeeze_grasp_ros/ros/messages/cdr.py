@@ -27,14 +27,16 @@ included) and its bytes, a sequence a uint32 count and its elements.
 from __future__ import annotations
 
 import functools
+import math
 import struct
+import threading
 
 import numpy as np
 
 from squeeze_grasp_ros.ros.messages.contacts import TactileReadings, check_taxels
 
-__all__ = ["CdrWriter", "cdr_stamp_ns", "clock_cdr", "monitor_status_cdr_reading",
-           "pose_position_cdr", "pose_stamped_cdr",
+__all__ = ["CdrTemplate", "CdrWriter", "cdr_stamp_ns", "clock_cdr", "monitor_status_cdr_reading",
+           "pose_position_cdr", "pose_stamped_cdr", "refilled",
            "tactile_array_cdr", "tactile_readings_cdr", "tick_cdr", "tick_readings_cdr",
            "wrench_force_cdr", "wrench_stamped_cdr", "write_contact_arrays"]
 
@@ -212,15 +214,21 @@ class CdrWriter:
         buffer += _ZEROS[-len(buffer) % 4]
         buffer += _I32(value)
 
-    def uint64(self, value: int) -> None:
+    def uint64(self, value: int) -> int:
+        """Write a ``uint64``; return its offset."""
         buffer = self.buffer
         buffer += _ZEROS[-(len(buffer) - _BODY) % 8]
+        offset = len(buffer)
         buffer += _U64(value)
+        return offset
 
-    def float64(self, value: float) -> None:
+    def float64(self, value: float) -> int:
+        """Write a ``float64``; return its offset."""
         buffer = self.buffer
         buffer += _ZEROS[-(len(buffer) - _BODY) % 8]
+        offset = len(buffer)
         buffer += _F64(value)
+        return offset
 
     def string(self, text: str) -> None:
         buffer = self.buffer
@@ -236,29 +244,35 @@ class CdrWriter:
             buffer += _ZEROS[-len(buffer) % 4]
             buffer += _string(text)
 
-    def header(self, ns: int, frame_id: str = "") -> None:
+    def header(self, ns: int, frame_id: str = "") -> int:
         """A ``std_msgs/Header`` stamped ``ns`` nanoseconds (its stamp first, as the readers
-        read it).
+        read it); return the stamp's offset.
         """
         buffer = self.buffer
         buffer += _ZEROS[-len(buffer) % 4]
+        offset = len(buffer)
         buffer += _TIME(*divmod(int(ns), 1_000_000_000))
         buffer += _string(frame_id)
+        return offset
 
-    def float64s(self, values) -> None:
+    def float64s(self, values) -> int:
         """A fixed-size run of float64 fields (``Point``, ``Vector3``, ...), or the elements of
-        a sequence of such messages; nothing, not even alignment, for none.
+        a sequence of such messages; nothing, not even alignment, for none. Return the offset
+        of the first value (the end of the buffer for none).
         """
         data = np.asarray(values, dtype="<f8")
+        buffer = self.buffer
         if data.size:
-            buffer = self.buffer
             buffer += _ZEROS[-(len(buffer) - _BODY) % 8]
+            offset = len(buffer)
             buffer += data.tobytes()
+            return offset
+        return len(buffer)
 
-    def sequence(self, values, dtype: str = "<f8") -> None:
+    def sequence(self, values, dtype: str = "<f8") -> int:
         """A sequence of numbers (``float64[]`` by default; ``"<i4"`` int32, ``"u1"`` uint8):
         its count, then its elements aligned to their size (nothing for none, as Fast CDR
-        writes it).
+        writes it). Return the offset of the first element (the end of the buffer for none).
         """
         data = np.asarray(values, dtype=dtype)
         size, buffer = data.size, self.buffer
@@ -266,29 +280,102 @@ class CdrWriter:
         buffer += _U32(size)
         if size:
             buffer += _ZEROS[-(len(buffer) - _BODY) % data.itemsize]
+            offset = len(buffer)
             buffer += data.tobytes()
+            return offset
+        return len(buffer)
 
     def data(self) -> bytes:
         """The serialised message, ready for ``Publisher.publish``."""
         return bytes(self.buffer)
 
 
+class CdrTemplate:
+    """A serialised message to refill in place: the next message of the same layout (the same
+    strings and sequence lengths) differs only in its stamps, ``uint64`` counters and float64
+    runs, which :meth:`refill` writes over the first message's bytes.
+
+    Parameters
+    ----------
+    writer : CdrWriter
+        The first message, written in full; its buffer is kept (and no longer grows).
+    stamps : sequence of int
+        Offsets of the message's stamps (``builtin_interfaces/Time``).
+    runs : sequence of (int, int or tuple of int)
+        (offset, shape) of each float64 run refilled, in :meth:`refill`'s order (a shape
+        (k, 3): k vectors).
+    counters : sequence of int
+        Offsets of the ``uint64`` fields refilled.
+    """
+
+    __slots__ = ("buffer", "counters", "runs", "stamps")
+
+    def __init__(self, writer: CdrWriter, stamps=(), runs=(), counters=()) -> None:
+        self.buffer = writer.buffer
+        self.stamps = tuple(stamps)
+        views = (np.frombuffer(self.buffer, "<f8", math.prod(np.atleast_1d(shape)),
+                               offset).reshape(shape) for offset, shape in runs)
+        self.runs = tuple((index, view) for index, view in enumerate(views) if view.size)
+        """(index in refill's values, writable view) of each run that has numbers."""
+        self.counters = tuple(counters)
+
+    def refill(self, ns: int, values=(), counts=()) -> bytes:
+        """The message stamped ``ns`` with float64 runs ``values`` (each as many numbers as its
+        run) and counters ``counts``, serialised; the same bytes a writer would write.
+        """
+        buffer = self.buffer
+        sec, nanosec = divmod(int(ns), 1_000_000_000)
+        for offset in self.stamps:
+            _TIME_INTO(buffer, offset, sec, nanosec)
+        for offset, count in zip(self.counters, counts):
+            _U64_INTO(buffer, offset, count)
+        for index, run in self.runs:
+            run[:] = values[index]
+        return bytes(buffer)
+
+
+_TIME_INTO, _U64_INTO = (struct.Struct(f).pack_into for f in ("<iI", "<Q"))
+KEPT_LAYOUTS = 256
+"""Templates each thread keeps (all are dropped when it has more, e.g. after many scenes)."""
+_LAYOUTS = threading.local()
+
+
+def refilled(key: tuple, write, ns: int, values=(), counts=()) -> bytes:
+    """A message of layout ``key``: :meth:`CdrTemplate.refill` of the template kept for it (per
+    thread: a refill is not atomic), or, the first time, the bytes of ``write()``, a function
+    that writes the message in full and returns its :class:`CdrTemplate`.
+    """
+    kept = _LAYOUTS.__dict__
+    template = kept.get(key)
+    if template is not None:
+        return template.refill(ns, values, counts)
+    template = write()
+    if len(kept) >= KEPT_LAYOUTS:
+        kept.clear()
+    kept[key] = template
+    return bytes(template.buffer)
+
+
 def pose_stamped_cdr(position, ns: int, frame_id: str) -> bytes:
     """A ``geometry_msgs/PoseStamped`` of a fingertip centre (x, y), m, at z = 0 with the
     identity orientation (:func:`..devices.pose_msg`'s message), serialised.
     """
-    writer = CdrWriter()
-    writer.header(ns, frame_id)
-    writer.float64s((position[0], position[1], 0.0, 0.0, 0.0, 0.0, 1.0))
-    return writer.data()
+    def write() -> CdrTemplate:
+        writer = CdrWriter()
+        stamp = writer.header(ns, frame_id)
+        at = writer.float64s((position[0], position[1], 0.0, 0.0, 0.0, 0.0, 1.0))
+        return CdrTemplate(writer, (stamp,), ((at, 2),))
+    return refilled(("pose", frame_id), write, ns, (position[:2],))
 
 
 def wrench_stamped_cdr(force, torque, ns: int, frame_id: str) -> bytes:
     """A ``geometry_msgs/WrenchStamped`` of a force (3,), N, and torque (3,), N m, serialised."""
-    writer = CdrWriter()
-    writer.header(ns, frame_id)
-    writer.float64s(np.concatenate((force, torque)))
-    return writer.data()
+    def write() -> CdrTemplate:
+        writer = CdrWriter()
+        stamp = writer.header(ns, frame_id)
+        forces = writer.float64s(np.concatenate((force, torque)))
+        return CdrTemplate(writer, (stamp,), ((forces, 3), (forces + 24, 3)))
+    return refilled(("wrench", frame_id), write, ns, (force, torque))
 
 
 def tactile_array_cdr(readings: TactileReadings, ns: int, frame_id: str) -> bytes:
@@ -300,12 +387,16 @@ def tactile_array_cdr(readings: TactileReadings, ns: int, frame_id: str) -> byte
         If the arrays differ in length.
     """
     check_taxels(readings.finger, readings.angles, readings.normal, readings.tangential)
-    writer = CdrWriter()
-    writer.header(ns, frame_id)
-    writer.string(readings.finger)
-    for values in (readings.angles, readings.normal, readings.tangential):
-        writer.sequence(values)
-    return writer.data()
+    arrays = (readings.angles, readings.normal, readings.tangential)
+    count = len(readings.angles)
+
+    def write() -> CdrTemplate:
+        writer = CdrWriter()
+        stamp = writer.header(ns, frame_id)
+        writer.string(readings.finger)
+        return CdrTemplate(writer, (stamp,),
+                           tuple((writer.sequence(values), count) for values in arrays))
+    return refilled(("tactile", frame_id, readings.finger, count), write, ns, arrays)
 
 
 def clock_cdr(ns: int) -> bytes:
@@ -317,25 +408,28 @@ def tick_cdr(index: int, ns: int, readings) -> bytes:
     """The ``squeeze_grasp_interfaces/Tick`` of lockstep tick ``index`` at sim time ``ns``
     (readings as "<device>/<stream>"), serialised.
     """
-    writer = CdrWriter()
-    writer.header(ns)
-    writer.uint64(index)
-    writer.strings(readings)
-    return writer.data()
+    def write() -> CdrTemplate:
+        writer = CdrWriter()
+        stamp = writer.header(ns)
+        at = writer.uint64(index)
+        writer.strings(readings)
+        return CdrTemplate(writer, (stamp,), (), (at,))
+    return refilled(("tick", *readings), write, ns, (), (index,))
 
 
 def write_contact_arrays(writer: CdrWriter, ns: int, frame_id: str, fingers, nodes, angles,
-                         modes, forces_x, forces_y, depth: float, relative_depth: float) -> None:
+                         modes, forces_x, forces_y, depth: float, relative_depth: float
+                         ) -> tuple[int, list[tuple[int, int]]]:
     """A ``squeeze_grasp_interfaces/ContactState`` (parallel per-contact arrays: angles rad,
-    forces N; depth m) into ``writer``.
+    forces N; depth m) into ``writer``. Return its stamp's offset and (offset, count) of its
+    float64 runs: angles, forces x and y, depth, relative depth (:class:`CdrTemplate`).
     """
-    writer.header(ns, frame_id)
+    stamp = writer.header(ns, frame_id)
     writer.strings(fingers)
     writer.sequence(nodes, "<i4")
-    writer.sequence(angles)
+    count = len(nodes)
+    runs = [(writer.sequence(angles), count)]
     writer.sequence(modes, "u1")
-    writer.sequence(forces_x)
-    writer.sequence(forces_y)
-    writer.float64(depth)
-    writer.float64(relative_depth)
-
+    runs += [(writer.sequence(forces_x), count), (writer.sequence(forces_y), count),
+             (writer.float64(depth), 1), (writer.float64(relative_depth), 1)]
+    return stamp, runs

@@ -30,6 +30,7 @@ import functools
 import math
 import struct
 import threading
+from typing import NamedTuple
 
 import numpy as np
 
@@ -138,42 +139,153 @@ def wrench_force_cdr(data: bytes) -> tuple[int, np.ndarray]:
 def tactile_readings_cdr(data: bytes) -> tuple[int, TactileReadings]:
     """(stamp ns, taxel angles in rad and forces in N) of a serialised
     ``squeeze_grasp_interfaces/TactileArray``.
+
+    An array of the layout of one read before (the same length, frame, finger and taxel count)
+    is read at that one's offsets.
     """
+    layout = _TACTILE_LAYOUTS.get(len(data))
+    if layout is not None and data[1] == 1 and data[_BODY + 8:layout.start] == layout.prefix \
+            and all(data[at:at + 4] == layout.count for at in layout.counts):
+        return cdr_stamp_ns(data), TactileReadings(
+            layout.finger, *(np.frombuffer(data, "<f8", layout.size, at).copy()
+                             for at in layout.runs))
     reader = _Reader(data)
     stamp = reader.header()
     reader.skip_string()
     finger = reader.string()
-    return stamp, TactileReadings(finger, reader.sequence(), reader.sequence(),
-                                  reader.sequence())
+    counts, runs, arrays = [], [], []
+    for _ in range(3):
+        counts.append(reader.offset + -(reader.offset - _BODY) % 4)
+        arrays.append(reader.sequence())
+        runs.append(reader.offset - 8 * len(arrays[-1]))
+    count = len(arrays[0])
+    if reader.order == "<" and reader.offset == len(data) and count and \
+            all(len(a) == count for a in arrays) and len(_TACTILE_LAYOUTS) < 64:
+        _TACTILE_LAYOUTS[len(data)] = _Layout(counts[0] + 4, bytes(data[_BODY + 8:counts[0] + 4]),
+                                              tuple(counts[1:]),
+                                              bytes(data[counts[0]:counts[0] + 4]), finger,
+                                              count, tuple(runs))
+    return stamp, TactileReadings(finger, *arrays)
 
 
 def tick_readings_cdr(data: bytes) -> tuple[int, list[str]]:
     """(stamp ns, readings "<device>/<stream>") of a serialised
     ``squeeze_grasp_interfaces/Tick``.
+
+    The readings of a tick with an empty frame id (as the simulated hardware writes it) are
+    looked up by their bytes when the same list was read before.
     """
+    tail = data[_BODY + 24:] if data[1] == 1 and data[_BODY + 8:_BODY + 16] == _NO_FRAME \
+        else None
+    readings = _TICK_READINGS.get(tail)
+    if readings is not None:
+        return cdr_stamp_ns(data), list(readings)
     reader = _Reader(data)
     stamp = reader.header()
     reader.skip_string()
     reader.uint64()  # the tick's index
-    return stamp, reader.strings()
+    readings = reader.strings()
+    if tail is not None and len(_TICK_READINGS) < 64:
+        _TICK_READINGS[bytes(tail)] = tuple(readings)
+    return stamp, readings
+
+
+class _Layout(NamedTuple):
+    """Where a message read before keeps its arrays (byte offsets): a tactile array."""
+
+    start: int
+    """End of the frame id and the finger name (from the end of the stamp: ``prefix``)."""
+    prefix: bytes
+    """The bytes from the end of the stamp to ``start``, the first count included."""
+    counts: tuple[int, ...]
+    """Offsets of the other arrays' counts."""
+    count: bytes
+    """Each count's bytes."""
+    finger: str
+    size: int
+    """Numbers per array."""
+    runs: tuple[int, ...]
+    """Offsets of the arrays."""
+
+
+_TACTILE_LAYOUTS: dict[int, _Layout] = {}
+"""Tactile array layouts read before, by message length (little-endian, at most 64)."""
+_TICK_READINGS: dict[bytes, tuple[str, ...]] = {}
+"""A tick's readings by the bytes of its ``string[]`` (at most 64 lists)."""
+_NO_FRAME = b"\x01\x00\x00\x00\x00\x00\x00\x00"
+"""An empty frame id (its length 1, the NUL) and the zero padding before the tick's index."""
 
 
 def monitor_status_cdr_reading(data: bytes) -> tuple | None:
     """(stamp ns, fingers, positions (k, 3) m, forces (k, 3) N, normals (k, 3), depth m) of a
     serialised ``squeeze_grasp_interfaces/MonitorStatus`` that carries no event and no alarm
     (most ticks); None when it carries any (deserialise it whole then).
+
+    The arrays are read-only views of ``data``. A status of the layout of one read before (the
+    same length, frame, fingers and counts, no event and no alarm) is read at that one's offsets
+    (:class:`_StatusLayout`), without walking its fields again.
     """
+    layout = _STATUS_LAYOUTS.get(len(data))
+    if layout is not None and data[1] == 1 and data[-8:] == _NO_EVENTS \
+            and data[_BODY + 8:layout.start] == layout.prefix \
+            and all(data[at:at + 4] == layout.count for at in layout.counts):
+        runs = [np.frombuffer(data, "<f8", layout.size, at).reshape(-1, 3)
+                for at in layout.runs]
+        (depth,) = _F64_FROM(data, layout.depth)
+        return (cdr_stamp_ns(data), layout.fingers, *runs, depth)
     reader = _Reader(data)
     stamp = reader.header()
     reader.skip_string()
     fingers = reader.strings()
-    vectors = [reader.float64s(3 * reader.uint32()).reshape(-1, 3) for _ in range(3)]
+    start, counts, runs = reader.offset, [], []
+    for _ in range(3):
+        counts.append(reader.offset + -(reader.offset - _BODY) % 4)
+        count = reader.uint32()
+        if count:
+            reader._align(8)
+        runs.append(reader.offset)
+        reader.offset += 24 * count
     reader.sequence()  # sensor ages
+    depth_at = reader.offset + -(reader.offset - _BODY) % 8
     depth = reader.float64()
     reader.float64()  # relative depth
     if reader.uint32() or reader.uint32():  # events, then alarms
         return None
+    vectors = [np.frombuffer(data, reader.order + "f8", 3 * len(fingers), at).reshape(-1, 3)
+               .astype(np.float64) for at in runs]
+    if reader.order == "<" and reader.offset == len(data) and len(set(map(
+            bytes, (data[at:at + 4] for at in counts)))) == 1 and len(_STATUS_LAYOUTS) < 64:
+        _STATUS_LAYOUTS[len(data)] = _StatusLayout(start, bytes(data[_BODY + 8:start]),
+                                                   tuple(counts),
+                                                   bytes(data[counts[0]:counts[0] + 4]),
+                                                   tuple(fingers), 3 * len(fingers),
+                                                   tuple(runs), depth_at)
     return (stamp, fingers, *vectors, depth)
+
+
+class _StatusLayout(NamedTuple):
+    """Where a ``MonitorStatus`` without events and alarms keeps its numbers (byte offsets)."""
+
+    start: int
+    """End of the frame id and the finger names (from the end of the stamp: ``prefix``)."""
+    prefix: bytes
+    counts: tuple[int, ...]
+    """Offsets of the positions', forces' and normals' counts."""
+    count: bytes
+    """Each count's bytes (the number of fingers)."""
+    fingers: tuple[str, ...]
+    size: int
+    """float64 numbers per vector run (3 per finger)."""
+    runs: tuple[int, ...]
+    """Offsets of the positions, forces and normals."""
+    depth: int
+
+
+_STATUS_LAYOUTS: dict[int, _StatusLayout] = {}
+"""Status layouts read before, by message length (little-endian, at most 64)."""
+_NO_EVENTS = bytes(8)
+"""A status's last 8 bytes without events and alarms: their two zero counts."""
+_F64_FROM = struct.Struct("<d").unpack_from
 
 
 _ZEROS = tuple(bytes(n) for n in range(8))

@@ -3,6 +3,7 @@
 """The simulated world's ground truth and its markers."""
 from __future__ import annotations
 
+import functools
 from collections.abc import Sequence
 
 import numpy as np
@@ -85,9 +86,9 @@ def sim_state_cdr(
     contacts = state.contacts
     layout = tuple((c.finger, c.node, c.mode) for c in contacts)
     forces = np.array([c.force for c in contacts]).reshape(len(contacts), 2)
-    names = [c.finger for c in contacts]
-    totals = [forces[[name == f for name in names]].sum(axis=0) if f in names else (0.0, 0.0)
-              for f in fingers]
+    names = tuple(c.finger for c in contacts)
+    totals = [forces[rows].sum(axis=0) if rows is not None else (0.0, 0.0)
+              for rows in _finger_rows(names, tuple(fingers))]
     values = ([(*present[f].center[:2], 0.0) if f in present else (0.0, 0.0, 0.0)
                for f in fingers],
               [(x, y, 0.0) for x, y in totals],
@@ -111,6 +112,13 @@ def sim_state_cdr(
         return CdrTemplate(writer, (stamp, nested[0]), runs + nested[1])
     return refilled(("sim_state", frame_id, tuple(fingers), tuple(present), layout,
                      termination or ""), write, ns, values)
+
+
+@functools.lru_cache(maxsize=64)
+def _finger_rows(names: tuple[str, ...], fingers: tuple[str, ...]) -> list[np.ndarray | None]:
+    """Each finger's rows among contacts of fingers ``names`` (None: it has none)."""
+    return [np.flatnonzero([name == f for name in names]) if f in names else None
+            for f in fingers]
 
 
 def sim_events_msg(

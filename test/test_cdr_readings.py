@@ -107,7 +107,7 @@ def _same_reading(ours, theirs) -> None:
 @settings(max_examples=60, deadline=None)
 @given(STAMPS, STAMPS, st.sampled_from(["F1", "F2", "ab"]), st.integers(1, 9),
        st.lists(st.sampled_from(["F1", "F2", "ab", "c"]), min_size=1, max_size=3, unique=True),
-       st.lists(NAMES, max_size=6), FINITE)
+       st.lists(NAMES, max_size=6), st.floats(-1e6, 1e6))
 def test_a_layout_read_before_reads_as_the_full_walk(ns, later, finger, taxels, fingers,
                                                      readings, value):
     """The second message of a layout (tactile array, status, tick) is read at the first's

@@ -39,7 +39,8 @@ from squeeze_grasp_ros.ros.messages.contacts import TactileReadings, check_taxel
 __all__ = ["CdrTemplate", "CdrWriter", "cdr_stamp_ns", "clock_cdr", "monitor_status_cdr_reading",
            "pose_position_cdr", "pose_stamped_cdr", "refilled",
            "tactile_array_cdr", "tactile_readings_cdr", "tick_cdr", "tick_readings_cdr",
-           "wrench_force_cdr", "wrench_stamped_cdr", "write_contact_arrays"]
+           "wrench_force_cdr", "wrench_stamped_cdr", "write_contact_arrays",
+           "write_finger_vectors"]
 
 _BODY = 4
 """Bytes of the encapsulation header; alignment counts from its end."""
@@ -544,4 +545,21 @@ def write_contact_arrays(writer: CdrWriter, ns: int, frame_id: str, fingers, nod
     writer.sequence(modes, "u1")
     runs += [(writer.sequence(forces_x), count), (writer.sequence(forces_y), count),
              (writer.float64(depth), 1), (writer.float64(relative_depth), 1)]
+    return stamp, runs
+
+
+def write_finger_vectors(writer: CdrWriter, ns: int, frame_id: str, fingers, vectors,
+                         per_finger) -> tuple[int, list[tuple[int, tuple[int, int] | int]]]:
+    """The per-finger head of ``MonitorStatus`` and ``SimState`` into ``writer``: a header, the
+    ``string[]`` of ``fingers``, a ``Point[]`` / ``Vector3[]`` of each of ``vectors`` (each one
+    (x, y, z) per finger) and the ``float64[]`` ``per_finger``. Return the stamp's offset and
+    the (offset, shape) of each run (:class:`CdrTemplate`).
+    """
+    stamp = writer.header(ns, frame_id)
+    writer.strings(fingers)
+    runs: list = []
+    for values in vectors:
+        writer.uint32(len(fingers))
+        runs.append((writer.float64s(values), (len(fingers), 3)))
+    runs.append((writer.sequence(per_finger), len(fingers)))
     return stamp, runs

@@ -29,6 +29,7 @@ from squeeze_grasp_ros.ros.messages.cdr import (
     CdrWriter,
     refilled,
     write_contact_arrays,
+    write_finger_vectors,
 )
 from squeeze_grasp_ros.ros.messages.common import float64_array, header, set_stamp
 from squeeze_grasp_ros.ros.messages.contacts import CONTACT_MODES, fill_contact_arrays
@@ -157,14 +158,8 @@ def monitor_status_cdr(out: TrackerOutput, frame_id: str) -> bytes:
 
     def write() -> CdrTemplate:
         writer = CdrWriter()
-        stamp = writer.header(ns, frame_id)
-        writer.strings(fingers)
-        runs = []
-        for vectors in values[:3]:
-            writer.uint32(len(fingers))
-            runs.append((writer.float64s(vectors), (len(fingers), 3)))
-        runs += [(writer.sequence(values[3]), len(fingers)), (writer.float64(out.depth), 1),
-                 (writer.float64(out.relative_depth), 1)]
+        stamp, runs = write_finger_vectors(writer, ns, frame_id, fingers, values[:3], values[3])
+        runs += [(writer.float64(out.depth), 1), (writer.float64(out.relative_depth), 1)]
         writer.uint32(len(out.events))
         for event in out.events:
             writer.header(ns)

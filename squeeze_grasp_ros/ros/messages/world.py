@@ -23,6 +23,7 @@ from squeeze_grasp_ros.ros.messages.cdr import (
     CdrWriter,
     refilled,
     write_contact_arrays,
+    write_finger_vectors,
 )
 from squeeze_grasp_ros.ros.messages.common import float64_array, header, set_stamp, stamp_ns
 from squeeze_grasp_ros.ros.messages.contacts import (
@@ -98,13 +99,7 @@ def sim_state_cdr(
 
     def write() -> CdrTemplate:
         writer = CdrWriter()
-        stamp = writer.header(ns, frame_id)
-        writer.strings(fingers)
-        runs = []
-        for vectors in values[:2]:
-            writer.uint32(len(fingers))
-            runs.append((writer.float64s(vectors), (len(fingers), 3)))
-        runs.append((writer.sequence(values[2]), len(fingers)))
+        stamp, runs = write_finger_vectors(writer, ns, frame_id, fingers, values[:2], values[2])
         nested = write_contact_arrays(writer, ns, frame_id, names, [c.node for c in contacts],
                                       values[3], [CONTACT_MODES[c.mode] for c in contacts],
                                       values[4], values[5], values[6], values[7])

@@ -91,6 +91,10 @@ class SimHardwareNode(Node):
         kept = pipeline.loop_qos(self.p["qos_depth"], kept=True)
         kept_sensors = pipeline.sensor_qos(self.p["sensor_qos"], self.p["qos_depth"], kept=True)
         self.devices = {f: world.devices[f].name for f in world.fingers}
+        self.labels = {f: (f"{d}/pose", f"{d}/wrench", f"{d}/tactile", f"{f}_tip")
+                       for f, d in self.devices.items()}
+        """Finger -> its readings' names in ``sim/tick`` (pose, wrench, tactile) and its
+        sensors' frame."""
         pub = self.create_publisher
         self.clock_pub = pub(Clock, pipeline.CLOCK, loop)
         self.pose_pubs = {f: pub(PoseStamped, pipeline.device_topic(d, "pose"),
@@ -189,19 +193,19 @@ class SimHardwareNode(Node):
         batch = [(self.clock_pub, messages.clock_cdr(ns))]
         readings = []
         for r in out.readings:
-            device, tip = self.devices[r.finger], f"{r.finger}_tip"
+            pose, wrench, tactile, tip = self.labels[r.finger]
             batch.append((self.pose_pubs[r.finger],
                           messages.pose_stamped_cdr(r.position, ns, frame)))
-            readings.append(f"{device}/pose")
+            readings.append(pose)
             if r.force is not None:
                 batch.append((self.wrench_pubs[r.finger],
                               messages.wrench_stamped_cdr(r.force, r.torque, ns, tip)))
-                readings.append(f"{device}/wrench")
+                readings.append(wrench)
             if r.normal is not None:
                 batch.append((self.tactile_pubs[r.finger], messages.tactile_array_cdr(
                     messages.TactileReadings(r.finger, self.world.layouts[r.finger].angles,
                                              r.normal, r.tangential), ns, tip)))
-                readings.append(f"{device}/tactile")
+                readings.append(tactile)
         ending = out.termination is not None and not self.ended
         self.ended = (self.ended or ending) and not out.released
         if out.events or ending or out.released:

@@ -21,6 +21,7 @@ from squeeze_grasp_ros.mechanics.squeeze.contact_model import (
     TerminationLimits,
 )
 from squeeze_grasp_ros.mechanics.squeeze.events import event_squeeze
+from squeeze_grasp_ros.mechanics.squeeze.stable_pure import finger_motion, plan_squeeze
 from squeeze_grasp_ros.mechanics.squeeze.tip_shapes import TipShape
 
 W, H = 0.04, 0.02
@@ -104,6 +105,28 @@ def test_the_planners_reduced_stiffness_is_kept_per_object_and_equals_a_fresh_on
     for name in ("contacts", "A", "B", "C", "E", "H"):
         np.testing.assert_array_equal(getattr(first, name), getattr(fresh, name))
     assert reduced_stiffness(obj, nodes[::-1]) is not first
+
+
+@pytest.mark.parametrize("kind", ["stable", "pure"])
+def test_the_squeeze_plan_is_kept_per_object_and_its_motion_is_a_fresh_plans(kind, monkeypatch):
+    from squeeze_grasp_ros.mechanics.squeeze import stable_pure
+
+    obj, ends = fresh_block()
+    plans = []
+    plan = stable_pure.plan_squeeze
+    monkeypatch.setattr(stable_pure, "plan_squeeze",
+                        lambda *a, **k: plans.append(1) or plan(*a, **k))
+    first = finger_motion(obj, ends, kind=kind)
+    first.directions["F1"][:] = 0.0  # a caller's copy: the kept plan is not touched
+    again = finger_motion(obj, ends, kind=kind)
+    assert len(plans) == 1
+    fresh_obj, _ = fresh_block()
+    fresh = plan_squeeze(fresh_obj, list(ends), kind=kind).displacement.reshape(2, 2)
+    np.testing.assert_array_equal(again.directions["F1"], fresh[0])
+    np.testing.assert_array_equal(again.directions["F2"], fresh[1])
+    assert again.kind == kind
+    finger_motion(obj, ends[::-1], kind=kind)
+    assert len(plans) == 2
 
 
 def test_models_in_threads_end_with_one_set_per_contact_set():

@@ -836,9 +836,7 @@ class ContactModel:
 
 def strain_criterion(eps: np.ndarray, criterion: str) -> tuple[float, int]:
     """(max strain, element) from engineering strains (t, 3) by ``criterion`` (eq. 45)."""
-    if criterion == StrainCriterion.COMPONENTWISE:
-        per_element = np.abs(eps[:, :2]).max(axis=1)
-    else:
-        per_element = np.abs(principal_strains(eps)).max(axis=1)
+    pair = eps if criterion == StrainCriterion.COMPONENTWISE else principal_strains(eps)
+    per_element = np.maximum(np.abs(pair[:, 0]), np.abs(pair[:, 1]))
     k = int(np.argmax(per_element))
     return float(per_element[k]), k

@@ -683,12 +683,19 @@ class ContactModel:
             strain_map = self.element_strains(self.unit_responses(dofs))
         return SetData(idx, C, E, A_bc, strain_map, condition)
 
-    def _strain_b(self) -> np.ndarray:
-        """Element strain-displacement matrices with coordinates / L, (t, 3, 6)."""
-        if "strain_b" not in self._cache:
-            B, _ = strain_displacement(self.obj.mesh.nodes / self.length, self.obj.mesh.triangles)
-            self._cache["strain_b"] = B
-        return self._cache["strain_b"]
+    def _strain_b(self) -> tuple[np.ndarray, np.ndarray]:
+        """Element strain-displacement matrices with coordinates / L (t, 3, 6) and each
+        element's DOFs (t, 6): the object's, shared by all of its models (L is its scale), so
+        a sweep computes them once per object rather than once per evaluation. Read-only.
+        """
+        kept = self.obj._shared.get("strain_b")
+        if kept is None:
+            triangles = self.obj.mesh.triangles
+            B, _ = strain_displacement(self.obj.mesh.nodes / self.length, triangles)
+            dofs = element_dofs(triangles)
+            B.flags.writeable = dofs.flags.writeable = False
+            kept = self.obj._shared["strain_b"] = (B, dofs)
+        return kept
 
     def unit_responses(self, dofs: np.ndarray) -> np.ndarray:
         """K+ applied to unit loads at ``dofs``: (2n, len(dofs)), by direct sparse solves."""
@@ -700,8 +707,8 @@ class ContactModel:
         """Engineering strains (t*3,) or (t*3, k) of dimensionless nodal displacements (2n[,
         k]).
         """
-        B = self._strain_b()
-        de = u_hat[element_dofs(self.obj.mesh.triangles)]
+        B, dofs = self._strain_b()
+        de = u_hat[dofs]
         return np.einsum("tij,tj...->ti...", B, de).reshape((-1,) + u_hat.shape[1:])
 
     def full_displacement(self, sd: SetData, delta: np.ndarray, F: np.ndarray) -> np.ndarray:

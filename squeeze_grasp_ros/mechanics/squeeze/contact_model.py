@@ -683,20 +683,6 @@ class ContactModel:
             strain_map = self.element_strains(self.unit_responses(dofs))
         return SetData(idx, C, E, A_bc, strain_map, condition)
 
-    def _strain_b(self) -> tuple[np.ndarray, np.ndarray]:
-        """Element strain-displacement matrices with coordinates / L (t, 3, 6) and each
-        element's DOFs (t, 6): the object's, shared by all of its models (L is its scale), so
-        a sweep computes them once per object rather than once per evaluation. Read-only.
-        """
-        kept = self.obj._shared.get("strain_b")
-        if kept is None:
-            triangles = self.obj.mesh.triangles
-            B, _ = strain_displacement(self.obj.mesh.nodes / self.length, triangles)
-            dofs = element_dofs(triangles)
-            B.flags.writeable = dofs.flags.writeable = False
-            kept = self.obj._shared["strain_b"] = (B, dofs)
-        return kept
-
     def unit_responses(self, dofs: np.ndarray) -> np.ndarray:
         """K+ applied to unit loads at ``dofs``: (2n, len(dofs)), by direct sparse solves."""
         unit_loads = np.zeros((2 * self.obj.mesh.n, len(dofs)))
@@ -707,7 +693,7 @@ class ContactModel:
         """Engineering strains (t*3,) or (t*3, k) of dimensionless nodal displacements (2n[,
         k]).
         """
-        B, dofs = self._strain_b()
+        B, dofs = strain_tables(self.obj, self.length)
         de = u_hat[dofs]
         return np.einsum("tij,tj...->ti...", B, de).reshape((-1,) + u_hat.shape[1:])
 
@@ -839,6 +825,20 @@ class ContactModel:
         if "loads" in kept and "stacked" not in kept:
             kept["stacked"] = np.ascontiguousarray(np.stack(kept["loads"]))
         return kept["bounds"], kept.get("stacked")
+
+
+def strain_tables(obj: ElasticObject, length: float) -> tuple[np.ndarray, np.ndarray]:
+    """The element strain-displacement matrices with coordinates / ``length`` (t, 3, 6) and
+    the elements' DOFs (t, 6), kept on ``obj`` (read-only) for all of its contact models,
+    whose length is its scale: a sweep computes them once per object, not per evaluation.
+    """
+    kept = obj._shared.get("strain_b")
+    if kept is None or kept[0] != length:
+        B, _ = strain_displacement(obj.mesh.nodes / length, obj.mesh.triangles)
+        dofs = element_dofs(obj.mesh.triangles)
+        B.flags.writeable = dofs.flags.writeable = False
+        kept = obj._shared["strain_b"] = (length, B, dofs)
+    return kept[1], kept[2]
 
 
 def strain_criterion(eps: np.ndarray, criterion: str) -> tuple[float, int]:

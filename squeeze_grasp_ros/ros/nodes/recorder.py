@@ -23,22 +23,29 @@ than its ``recorder_window`` ahead (no message is lost to a full history); a wal
 repeats the newest tick 20 times a second, so the report of the last tick of a run arrives even
 if one copy is lost. On Ctrl-C / SIGINT it first writes what has
 already arrived, then ``close`` writes the MCAP summary and ``metadata.yaml``.
+
+A message the middleware reports lost (``message_lost``: a reliable writer gave up a message
+before this reader received it, its history having moved on, or a message sent before the
+writer matched this reader) is counted per topic, logged as an error at the end and listed in
+``metadata.yaml`` under ``custom_data.messages_lost`` (:data:`..recording.bag.LOST_KEY`), so a
+recording with a gap says so.
 """
 from __future__ import annotations
 
 import sys
 import time
-from collections import deque
+from collections import Counter, deque
 from typing import Any
 
 import yaml
+from rclpy.event_handler import QoSMessageLostInfo, SubscriptionEventCallbacks
 from rclpy.node import Node
 from rclpy.qos import DurabilityPolicy, HistoryPolicy, ReliabilityPolicy
 from std_msgs.msg import Header
 
 from squeeze_grasp_ros.ros import messages
 from squeeze_grasp_ros.ros.nodes import ParameterError, pipeline, run_node
-from squeeze_grasp_ros.ros.recording.bag import BagWriter, qos_dict
+from squeeze_grasp_ros.ros.recording.bag import LOST_KEY, BagWriter, qos_dict
 from squeeze_grasp_ros.ros.recording.schema import starts_with_stamp
 
 PARAMETERS: dict[str, tuple[Any, str]] = {
@@ -109,6 +116,8 @@ class RecorderNode(Node):
         self.recent = {name: deque(maxlen=DUPLICATE_WINDOW) for name in self.unique}
         self.duplicates = 0
         self.written = 0
+        self.lost: Counter[str] = Counter()
+        """Recorded topic -> messages the middleware reported lost on its way here."""
         self.ticks = 0
         self.newest_tick_ns = -1
         self.reported_ns = -1
@@ -128,8 +137,11 @@ class RecorderNode(Node):
                    else pipeline.sensor_qos(p["sensor_qos"], p["qos_depth"], kept=name in kept)
                    if name in sensors
                    else pipeline.loop_qos(p["qos_depth"], kept=name in kept))
-            self.create_subscription(pipeline.message_type(type_name), self.sources[name],
-                                     lambda data, n=name: self._record(n, data), qos, raw=True)
+            self.create_subscription(
+                pipeline.message_type(type_name), self.sources[name],
+                lambda data, n=name: self._record(n, data), qos, raw=True,
+                event_callbacks=SubscriptionEventCallbacks(
+                    message_lost=lambda info, n=name: self._lost(n, info)))
         self.progress_pub = self.create_publisher(Header, pipeline.RECORDER_PROGRESS,
                                                   pipeline.loop_qos(10))
         if p["lockstep"]:
@@ -176,6 +188,9 @@ class RecorderNode(Node):
             if self.ticks % self.p["progress_every"] == 0:
                 self._report()
 
+    def _lost(self, topic: str, info: QoSMessageLostInfo) -> None:
+        self.lost[topic] += info.total_count_change
+
     def _report(self) -> None:
         """Publish the newest tick written, if not reported yet."""
         if self.newest_tick_ns > self.reported_ns:
@@ -204,8 +219,20 @@ class RecorderNode(Node):
                 return
 
     def close(self) -> None:
-        """Finish the recording (summary and metadata.yaml); safe to call twice."""
+        """Finish the recording (summary and metadata.yaml, with the messages reported lost);
+        safe to call twice.
+        """
+        if self.lost and not self.writer.closed:
+            self.writer.custom_data[LOST_KEY] = lost_text(self.lost)
+            self.get_logger().error(f"{self.p['output']} misses messages the middleware "
+                                    f"reported lost: {lost_text(self.lost)}")
         self.writer.close()
+
+
+def lost_text(lost: Counter[str]) -> str:
+    """``{topic: count, ...}`` (YAML flow mapping, by topic) of the messages lost."""
+    return yaml.safe_dump(dict(sorted(lost.items())), default_flow_style=True,
+                          width=1 << 16).strip()
 
 
 def main(args: list[str] | None = None) -> int:

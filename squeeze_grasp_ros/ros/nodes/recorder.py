@@ -19,7 +19,8 @@ message can differ.)
 
 In lockstep it takes part in the start-up handshake and reports on ``recorder/progress`` the
 newest tick it has written, every ``progress_every`` ticks, so ``sim_hardware`` never runs more
-than its ``recorder_window`` ahead (no message is lost to a full history); a wall-clock timer
+than its ``recorder_window`` ahead (what a stalled recorder process has not taken yet stays
+within what the middleware holds for it, docs/pipeline.md); a wall-clock timer
 repeats the newest tick 20 times a second, so the report of the last tick of a run arrives even
 if one copy is lost. On Ctrl-C / SIGINT it first writes what has
 already arrived, then ``close`` writes the MCAP summary and ``metadata.yaml``.
@@ -66,7 +67,7 @@ PARAMETERS: dict[str, tuple[Any, str]] = {
     "chunk_size": (262144, "uncompressed chunk size written out when full, bytes"),
     "custom_data": ("{}", "YAML mapping of strings stored in metadata.yaml custom_data"),
     "lockstep": (True, "take part in the start-up handshake and report progress"),
-    "progress_every": (10, "ticks between recorder/progress reports"),
+    "progress_every": (5, "ticks between recorder/progress reports"),
     "sensor_qos": ("reliable", "QoS of the readings: reliable (lockstep) or sensor_data"),
     "qos_depth": (1000, "history depth of the subscriptions"),
 }

@@ -59,7 +59,7 @@ PARAMETERS: dict[str, tuple[Any, str]] = {
     "participants": (["monitor", "executor"], "nodes whose sim/ready starts tick 0"),
     "handshake_period": (0.05, "wall-clock seconds between start-up hellos"),
     "resend_timeout": (1.0, "wall-clock seconds without progress before a tick is re-sent"),
-    "recorder_window": (50, "ticks the recorder may lag behind (if 'recorder' participates)"),
+    "recorder_window": (20, "ticks the recorder may lag behind (if 'recorder' participates)"),
 }
 """Parameter name -> (typed default, description); config/sim_hardware.yaml sets them."""
 

@@ -106,7 +106,8 @@ def run_node(factory: Callable[[], Node], args: list[str] | None = None,
     not return after shutdown. SIGINT (Ctrl-C, also what ``ros2 launch`` sends first) and
     SIGTERM only set a flag, so no callback is interrupted halfway; the loop then ends, a node
     with ``drain(executor)`` processes what has already arrived, the node waits until its readers
-    have acknowledged what it published (:func:`wait_acknowledged`), its ``close()`` is called, and
+    have acknowledged what it published (:func:`wait_acknowledged`; not a node whose
+    ``acknowledged_at_end`` is False), its ``close()`` is called, and
     the node is destroyed (the planner joins its workers there). A node started by a run ends
     the same way when that process dies (:func:`parent_watch`), and removes the run's
     parameter file.
@@ -159,7 +160,8 @@ def run_node(factory: Callable[[], Node], args: list[str] | None = None,
                 Path(params).unlink(missing_ok=True)
         if (stop.is_set() or orphaned()) and hasattr(node, "drain"):
             node.drain(executor)
-        wait_acknowledged(node)
+        if getattr(node, "acknowledged_at_end", True):
+            wait_acknowledged(node)
     except ExternalShutdownException:
         pass
     finally:

@@ -88,6 +88,11 @@ POLICY_NAMES = {
 class RecorderNode(Node):
     """Raw-subscription recorder writing a rosbag2 MCAP bag."""
 
+    acknowledged_at_end = False
+    """Its one publication, ``recorder/progress``, is flow control nobody needs once it ends:
+    :func:`..nodes.run_node` does not wait for its readers (a wait ends only at the writer's
+    next heartbeat, up to 3 s)."""
+
     def __init__(self, **kwargs: Any) -> None:
         super().__init__("recorder", **kwargs)
         self.p = p = pipeline.declare(self, PARAMETERS)

@@ -170,11 +170,17 @@ def _run(args: argparse.Namespace) -> dict | int:
     finally:
         if show:
             sys.stderr.write("\n")
-    stopped = result.get("recording_stopped")
-    if stopped is not None:
+    stopped, lost = result.get("recording_stopped"), result.get("recording_lost")
+    if stopped is not None or lost:
         print(json.dumps(result) if args.json else summary(result))
-        print(f"squeeze-grasp run: the recording in {args.record} stopped early: {stopped}; "
-              "it is readable up to there", file=sys.stderr)
+        if stopped is not None:
+            print(f"squeeze-grasp run: the recording in {args.record} stopped early: "
+                  f"{stopped}; it is readable up to there", file=sys.stderr)
+        if lost:
+            print(f"squeeze-grasp run: the recording in {args.record} is incomplete: "
+                  f"{sum(lost.values())} messages never reached the recorder ("
+                  + ", ".join(f"{topic} {n}" for topic, n in sorted(lost.items()))
+                  + ")", file=sys.stderr)
         return ExitCode.INTERNAL
     if not result["success"]:
         print(json.dumps(result) if args.json else summary(result))

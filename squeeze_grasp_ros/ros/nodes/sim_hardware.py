@@ -29,7 +29,6 @@ import time
 from typing import Any
 
 from geometry_msgs.msg import PoseStamped, WrenchStamped
-from rclpy.duration import Duration
 from rclpy.node import Node
 from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import CameraInfo, Image
@@ -60,7 +59,7 @@ PARAMETERS: dict[str, tuple[Any, str]] = {
     "participants": (["monitor", "executor"], "nodes whose sim/ready starts tick 0"),
     "handshake_period": (0.05, "wall-clock seconds between start-up hellos"),
     "resend_timeout": (1.0, "wall-clock seconds without progress before a tick is re-sent"),
-    "recorder_window": (50, "ticks the recorder may lag behind (if 'recorder' participates)"),
+    "recorder_window": (20, "ticks the recorder may lag behind (if 'recorder' participates)"),
 }
 """Parameter name -> (typed default, description); config/sim_hardware.yaml sets them."""
 
@@ -230,22 +229,6 @@ class SimHardwareNode(Node):
         for publisher, msg in batch + [tick]:
             publisher.publish(msg)
 
-    def close(self) -> None:
-        """Before the process ends: wait until every reader has acknowledged the camera frames
-        (at most :data:`CAMERA_ACK_TIMEOUT` s of wall time per topic).
-
-        A large image crosses processes in fragments, and a lost fragment is sent again only
-        after the middleware's next heartbeat (seconds): a frame shortly before the run's end
-        was then never delivered, and the recorder and the shape watch lost the last masks of
-        ``run --processes`` in about a third of the runs. ``run`` stops this node first and
-        the readers after it (:meth:`..run.processes.NodeProcesses.stop_all`), so they still
-        take the frames while this waits.
-        """
-        for topic, publisher in self.camera_pubs.items():
-            if not publisher.wait_for_all_acked(Duration(seconds=CAMERA_ACK_TIMEOUT)):
-                self.get_logger().warning(f"{topic}: the last frames were not acknowledged by "
-                                          f"every reader within {CAMERA_ACK_TIMEOUT:g} s")
-
     def _display_due(self, index: int) -> bool:
         rate = self.p["display_rate"]
         if rate <= 0.0:
@@ -261,11 +244,6 @@ class SimHardwareNode(Node):
             for publisher, msg in self.current:
                 publisher.publish(msg)
 
-
-CAMERA_ACK_TIMEOUT = 5.0
-"""s of wall time the world waits at its end for the readers of its camera frames to
-acknowledge them (longer than the middleware's heartbeat period, which paces the repair of a
-lost fragment)."""
 
 CONTROLLER_NAMES = {ControllerKind.JOINT_TRAJECTORY: "JointTrajectoryController",
                     ControllerKind.GRIPPER_ACTION: "GripperActionController",

@@ -36,6 +36,7 @@ from pathlib import Path
 from typing import Any
 
 import rclpy
+import yaml
 from rclpy.context import Context
 from rclpy.executors import SingleThreadedExecutor
 from rclpy.experimental import EventsExecutor
@@ -402,26 +403,38 @@ class PipelineRunner:
             self.executor.shutdown()
             self.context.try_shutdown()
 
-    def recording_stopped(self) -> str | None:
-        """Why the finished run's recording stopped early (a full disk), or None: as the
-        recorder node reports it in this process, or, for a recorder process, as it wrote it
-        into the bag it finished.
+    def recording_defects(self) -> dict:
+        """What is wrong with the finished run's recording: ``recording_stopped``, why it
+        stopped early (a full disk), and ``recording_lost``, the messages per topic the
+        middleware reported lost on their way to the recorder; as the recorder node reports
+        them in this process, or, for a recorder process, as it wrote them into the bag it
+        finished. Empty when the recording is complete (or there is none).
         """
         if not self.options.record:
-            return None
+            return {}
         if self.recorder is not None:
-            return self.recorder.writer.stopped
-        from squeeze_grasp_ros.ros.recording.bag import STOPPED_KEY, BagError, bag_info
+            stopped, lost = self.recorder.writer.stopped, dict(self.recorder.lost)
+        else:
+            from squeeze_grasp_ros.ros.recording.bag import (
+                LOST_KEY,
+                STOPPED_KEY,
+                BagError,
+                bag_info,
+            )
 
-        try:
-            return bag_info(self.options.record).get("custom_data", {}).get(STOPPED_KEY)
-        except BagError as exc:
-            return f"the recording is not readable: {exc}"
+            try:
+                custom = bag_info(self.options.record).get("custom_data", {})
+            except BagError as exc:
+                return {"recording_stopped": f"the recording is not readable: {exc}"}
+            stopped, lost = custom.get(STOPPED_KEY), yaml.safe_load(custom.get(LOST_KEY, "{}"))
+        return {**({"recording_stopped": stopped} if stopped is not None else {}),
+                **({"recording_lost": lost} if lost else {})}
 
     # ----------------------------------------------------------------- the whole run
     def run(self) -> dict:
         """Start, execute the goal, shut down; returns the JSON summary, with
-        ``recording_stopped`` if the recording stopped early.
+        ``recording_stopped`` if the recording stopped early and ``recording_lost`` if it
+        misses messages (:meth:`recording_defects`).
 
         SIGINT (Ctrl-C), SIGTERM and SIGHUP set a flag that the waiting loop turns into
         :class:`Interrupted` between callbacks, so no callback (a recorder write) is cut in half;
@@ -447,10 +460,7 @@ class PipelineRunner:
             finally:
                 for signum, handler in previous.items():
                     signal.signal(signum, handler)
-        stopped = self.recording_stopped()
-        if stopped is not None:
-            summary["recording_stopped"] = stopped
-        return summary
+        return {**summary, **self.recording_defects()}
 
     def summary(self, result: ExecuteGrasp.Result) -> dict:
         """JSON-able summary of a finished goal (:func:`.summary.run_summary`)."""

@@ -365,6 +365,41 @@ def test_the_camera_closed_run_matches_the_yaml_route(tmp_path):
         assert decoded[topic]["decoded"] == decoded[topic]["messages"] == len(images[topic])
 
 
+def test_the_camera_closed_run_of_a_stadium_plans_the_worlds_events(tmp_path):
+    """A mixed outline on the camera route (issue 32's target): the stadium of
+    ``test_perception_mixed.py`` (the true shape a dense spline) squeezed across its straight
+    sides with ``foam_square_camera``'s camera. The planner's seen spline and the world's true
+    one are meshed on their resampled boundaries, so the plan has the world's events and the
+    monitor raises no ``prediction_mismatch``; the events and forces are the YAML route's.
+    Before, the true stadium's mesh had a split segment beside F2: 9 A events in the world
+    against the plan's 8, and a false ``prediction_mismatch``.
+    """
+    skimage_or_skip()
+    from test_perception_mixed import FINGERS, HEIGHT, true_shape
+
+    data = yaml.safe_load(CAMERA_SCENE.read_text())
+    data["name"] = "stadium_camera"
+    data["object"] = {"shape": true_shape("stadium"),
+                      "material": {"E": 5.0e4, "nu": 0.3, "thickness": HEIGHT},
+                      "mesh": {"nodes": 1000, "min_angle": 30}}
+    for finger, point in zip(("F1", "F2"), FINGERS["stadium", "across"]):
+        data["fingers"][finger]["placement"] = {"point": point}
+    data["squeeze"] = {"type": "stable", "relative_depth": 0.10}
+    seen = run_scene(tmp_path, data)
+    plain = {key: value for key, value in data.items() if key != "camera"}
+    plain["effects"] = [e for e in data["effects"] if e != Effect.CAMERA.value]
+    (tmp_path / "yaml").mkdir()
+    by_yaml = run_scene(tmp_path / "yaml", plain)
+    assert seen["seen_outline"]["recognised"] == "spline"
+    assert seen["outcome"] == by_yaml["outcome"] == "grasp held"
+    assert seen["event_counts"] == by_yaml["event_counts"]
+    assert len(seen["prediction"]["events"]) == sum(seen["event_counts"].values())
+    assert not seen["alarms"], seen["alarms"]
+    for finger in ("F1", "F2"):
+        np.testing.assert_allclose(np.linalg.norm(seen["forces"][finger]),
+                                   np.linalg.norm(by_yaml["forces"][finger]), rtol=0.01)
+
+
 def test_shape_mismatch_is_raised_when_the_world_is_larger(tmp_path):
     skimage_or_skip()
     data = with_camera(yaml.safe_load(YAML_SCENE.read_text()))
@@ -474,7 +509,7 @@ def test_a_frame_before_the_prediction_waits_for_it(ros_context):
         spin_until(lambda: 100_000_000 in watcher.waiting)
         camera.create_publisher(PredictedShapesMsg, pipeline.PREDICTED_SHAPES,
                                 pipeline.LATCHED).publish(
-            predicted_shapes_msg(scene, 0.005, 0))
+            predicted_shapes_msg(GraspSetup.build(scene).precompute(), 0.005, 0))
         for _ in range(10):  # the force curve (planner/predicted_events) is still missing
             executor.spin_once(timeout_sec=0.02)
         assert residuals == []

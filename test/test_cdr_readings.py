@@ -6,6 +6,7 @@ and odd-length taxel arrays, big-endian data, and what is refused.
 """
 from __future__ import annotations
 
+import dataclasses
 import struct
 
 import numpy as np
@@ -14,7 +15,10 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from rclpy.serialization import serialize_message
 
+from squeeze_grasp_ros.control.tracker import TrackedEvent, TrackerOutput
+from squeeze_grasp_ros.mechanics.vocabulary import EventType
 from squeeze_grasp_ros.ros import messages
+from squeeze_grasp_ros.ros.messages import cdr
 
 FINITE = st.floats(allow_nan=False, allow_infinity=False, width=64)
 NAMES = st.text(alphabet="abcdefghijklmnopqrstuvwxyz_/0123456789", max_size=17)
@@ -75,3 +79,61 @@ def test_big_endian_pose_is_read():
 def test_what_is_not_classic_cdr_is_refused(data):
     with pytest.raises(ValueError, match="classic CDR"):
         messages.pose_position_cdr(data)
+
+
+def _forgetting(read, data):
+    """``read(data)`` with no layout kept from earlier reads (the full walk over the fields)."""
+    cdr._TACTILE_LAYOUTS.clear()
+    cdr._STATUS_LAYOUTS.clear()
+    cdr._TICK_READINGS.clear()
+    return read(data)
+
+
+def _same_reading(ours, theirs) -> None:
+    if dataclasses.is_dataclass(ours):
+        assert type(ours) is type(theirs)
+        ours, theirs = ([getattr(r, f.name) for f in dataclasses.fields(r)]
+                        for r in (ours, theirs))
+    if isinstance(ours, np.ndarray):
+        assert ours.dtype == theirs.dtype and ours.tobytes() == theirs.tobytes()
+    elif isinstance(ours, (tuple, list)):
+        assert len(ours) == len(theirs)
+        for a, b in zip(ours, theirs):
+            _same_reading(a, b)
+    else:
+        assert ours == theirs
+
+
+@settings(max_examples=60, deadline=None)
+@given(STAMPS, STAMPS, st.sampled_from(["F1", "F2", "ab"]), st.integers(1, 9),
+       st.lists(st.sampled_from(["F1", "F2", "ab", "c"]), min_size=1, max_size=3, unique=True),
+       st.lists(NAMES, max_size=6), st.floats(-1e6, 1e6))
+def test_a_layout_read_before_reads_as_the_full_walk(ns, later, finger, taxels, fingers,
+                                                     readings, value):
+    """The second message of a layout (tactile array, status, tick) is read at the first's
+    offsets: the same stamp, names and numbers as walking its fields; a message of the same
+    length but another layout (other finger names, counts, an event) is not misread.
+    """
+    first = messages.tactile_array_cdr(messages.TactileReadings(
+        finger, np.zeros(taxels), np.ones(taxels), np.zeros(taxels)), ns, "F1_tip")
+    second = messages.tactile_array_cdr(messages.TactileReadings(
+        finger, np.full(taxels, value), np.arange(taxels) * value, -np.ones(taxels)), later,
+        "F1_tip")
+    other = messages.tactile_array_cdr(messages.TactileReadings(
+        {"F1": "F2", "F2": "ab", "ab": "F1"}[finger], np.ones(taxels), np.ones(taxels),
+        np.ones(taxels)), later, "F1_tip")
+    vectors = {f: np.array([value, -value]) for f in fingers}
+    outs = [TrackerOutput(stamp, tuple(names), vectors, vectors, vectors,
+                          {f: 0.0 for f in fingers}, (), events, (), value, 0.5)
+            for stamp, names, events in (
+                (ns, fingers, ()), (later, fingers, ()), (later, fingers[::-1], ()),
+                (later, fingers, (TrackedEvent(EventType.A, fingers[0], 0.0, 0.0, 0.0),)))]
+    statuses = [messages.monitor_status_cdr(out, "object") for out in outs]
+    ticks = [messages.tick_cdr(k, stamp, readings) for k, stamp in ((0, ns), (7, later))]
+    for read, kept, data in ((messages.tactile_readings_cdr, first, [second, other]),
+                             (cdr.monitor_status_cdr_reading, statuses[0], statuses[1:]),
+                             (messages.tick_readings_cdr, ticks[0], ticks[1:])):
+        for message in data:
+            want = _forgetting(read, message)
+            read(kept)
+            _same_reading(read(message), want)

@@ -9,6 +9,8 @@ along the foam square's squeeze serialises alike tick by tick.
 """
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 import pytest
 from hypothesis import given, settings
@@ -20,6 +22,7 @@ from squeeze_grasp_interfaces.msg import ContactState, ForceResidual, MonitorSta
 from squeeze_grasp_ros.control.tracker import Patch, TrackedAlarm, TrackedEvent, TrackerOutput
 from squeeze_grasp_ros.mechanics.vocabulary import ContactMode, EventType
 from squeeze_grasp_ros.ros import messages
+from squeeze_grasp_ros.ros.messages import cdr
 from squeeze_grasp_ros.ros.messages.cdr import CdrWriter, write_contact_arrays
 
 FINITE = st.floats(allow_nan=False, allow_infinity=False, width=64)
@@ -190,3 +193,88 @@ def test_the_worlds_ground_truth_is_rclpys_tick_by_tick():
             _same(data, messages.sim_state_msg(out.state, world.fingers, termination,
                                                out.stamp_ns, "object"))
             assert isinstance(deserialize_message(data, SimState), SimState)
+
+
+def _fresh(write, *args) -> bytes:
+    """``write(*args)`` written in full: every kept template dropped first."""
+    cdr._LAYOUTS.__dict__.clear()
+    return write(*args)
+
+
+@settings(max_examples=40, deadline=None)
+@given(STAMPS, STAMPS, NAMES, NAMES, st.lists(st.tuples(FINITE, FINITE, FINITE), max_size=9),
+       st.integers(min_value=0, max_value=2**64 - 1), st.lists(NAMES, max_size=7))
+def test_a_refilled_message_is_the_bytes_a_fresh_writer_writes(ns, later, frame, finger, taxels,
+                                                               index, readings):
+    """The second message of a layout refills the first's bytes (cdr.CdrTemplate): the stamp,
+    the counters and every number are the new message's, byte for byte what the writer writes
+    from scratch; the first message's bytes are not touched.
+    """
+    array = np.array(taxels, dtype=float).reshape(-1, 3)
+    first = messages.TactileReadings(finger, *array.T)
+    second = messages.TactileReadings(finger, *(0.5 * array.T[::-1] - 1.0))
+    calls = [(messages.pose_stamped_cdr, (array[:1, :2].sum(axis=0), ns, frame),
+              (np.array([0.5, -3.0]), later, frame)),
+             (messages.wrench_stamped_cdr, (np.ones(3), np.zeros(3), ns, frame),
+              (array[:1].sum(axis=0), -array[-1:].sum(axis=0), later, frame)),
+             (messages.tactile_array_cdr, (first, ns, frame), (second, later, frame)),
+             (messages.tick_cdr, (0, ns, readings), (index, later, readings))]
+    for write, before, after in calls:
+        kept = _fresh(write, *before)
+        refilled = write(*after)
+        assert refilled == _fresh(write, *after)
+        assert kept == _fresh(write, *before)
+
+
+def test_the_worlds_ground_truth_refills_as_written():
+    """Along the foam square's squeeze (contacts appear and change mode: new layouts; most
+    ticks keep the layout: refills) every tick's SimState is the bytes written from scratch.
+    """
+    from squeeze_grasp_ros.bench.pipeline import squeeze_world
+    from squeeze_grasp_ros.resources import scene_file
+    from squeeze_grasp_ros.scene import GraspSetup, load_scene
+    from squeeze_grasp_ros.sim.world import SimWorld
+
+    world = SimWorld(GraspSetup.build(load_scene(scene_file("foam_square"))))
+    outputs = squeeze_world(world, 200)
+    cdr._LAYOUTS.__dict__.clear()
+    kept = [messages.sim_state_cdr(out.state, world.fingers, None, out.stamp_ns, "object")
+            for out in outputs]
+    assert len(cdr._LAYOUTS.__dict__) < len(outputs) / 4  # most ticks refilled
+    assert kept == [_fresh(messages.sim_state_cdr, out.state, world.fingers, None,
+                           out.stamp_ns, "object") for out in outputs]
+
+
+@settings(max_examples=60, deadline=None)
+@given(tracker_outputs(), NAMES, STAMPS, st.floats(-1e6, 1e6))
+def test_the_monitors_messages_refill_as_written(out, frame, later, scale):
+    """The monitor's status, contact state and force residual of a second tick with the same
+    fingers and patches (new stamp, positions, forces, ages, depths) are the bytes written from
+    scratch; a status with events or alarms is always written in full.
+    """
+    def shifted(v):
+        return v * 0.5 - scale
+
+    nxt = dataclasses.replace(
+        out, stamp_ns=later, positions={f: shifted(v) for f, v in out.positions.items()},
+        forces={f: shifted(v) for f, v in out.forces.items()},
+        normals={f: -v for f, v in out.normals.items()},
+        ages={f: a / 2.0 for f, a in out.ages.items()},
+        patches=tuple(p._replace(angle=shifted(p.angle), normal=p.tangential,
+                                 tangential=shifted(p.normal)) for p in out.patches),
+        depth=shifted(out.depth), relative_depth=-out.relative_depth)
+    residual = (frame, out.depth, list(out.fingers))
+    for write, args in ((messages.monitor_status_cdr, (frame,)),
+                        (messages.patches_state_cdr, (frame,))):
+        kept = _fresh(write, out, *args)
+        assert write(nxt, *args) == _fresh(write, nxt, *args)
+        assert kept == _fresh(write, out, *args)
+    k = len(out.fingers)
+    kept = _fresh(messages.force_residual_cdr, out.stamp_ns, *residual, [1.0] * k, [2.0] * k,
+                  [0.5] * k, 0.1)
+    again = messages.force_residual_cdr(later, frame, nxt.depth, list(out.fingers),
+                                        [scale] * k, [-scale] * k, [0.25] * k, 0.2)
+    assert again == _fresh(messages.force_residual_cdr, later, frame, nxt.depth,
+                           list(out.fingers), [scale] * k, [-scale] * k, [0.25] * k, 0.2)
+    assert kept == _fresh(messages.force_residual_cdr, out.stamp_ns, *residual, [1.0] * k,
+                          [2.0] * k, [0.5] * k, 0.1)

@@ -32,9 +32,9 @@ class RecordingMesher(TriangleMesher):
     def __init__(self) -> None:
         self.calls = 0
 
-    def triangulate(self, *args):
+    def triangulate(self, *args, **kwargs):
         self.calls += 1
-        return super().triangulate(*args)
+        return super().triangulate(*args, **kwargs)
 
 
 def star(points: int, inner: float, outer: float) -> shapes.Outline:

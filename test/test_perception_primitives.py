@@ -23,6 +23,7 @@ from squeeze_grasp_ros.mechanics.elastic import shapes
 from squeeze_grasp_ros.mechanics.errors import InvalidInputError
 from squeeze_grasp_ros.mechanics.vocabulary import ShapeType
 from squeeze_grasp_ros.perception.extract import PRIMITIVE_TOLERANCE_PX, extract_outline
+from squeeze_grasp_ros.perception.primitives import ellipse_distances, fit_circle
 from squeeze_grasp_ros.perception.render import render_views
 from squeeze_grasp_ros.planning.errors import PlannerError
 from squeeze_grasp_ros.planning.typed_objects import TypedMaterial, TypedObject, typed_scene
@@ -75,6 +76,69 @@ def test_disks_ellipses_and_annuli_are_recognised_with_their_parameters(scale, d
         report = seen.to_json()
         assert report["recognised"] == kind.value
         assert report["primitive"]["residual_m"] == seen.primitive.residual_m
+
+
+def _on_ellipse(t, centre, a, b, theta):
+    c, s = np.cos(theta), np.sin(theta)
+    x, y = a * np.cos(t), b * np.sin(t)
+    return np.column_stack([centre[0] + c * x - s * y, centre[1] + s * x + c * y])
+
+
+def test_ellipse_distances_match_two_independent_measures():
+    """The vectorised point-to-ellipse distance (the ellipse check's residual) against the
+    nearest of 200,001 dense samples polished by a bounded scalar minimisation, and against
+    scikit-image's per-point ``leastsq`` near the curve (where its start is in the right basin):
+    eccentric and near-round ellipses, points inside, outside, at the centre and on both axes.
+    """
+    skimage_or_skip()
+    from scipy.optimize import minimize_scalar
+    from skimage.measure import EllipseModel
+
+    rng = np.random.default_rng(7)
+    dense_t = np.linspace(0.0, 2.0 * np.pi, 200_001)
+    for a, b in [(2.0, 1.0), (3.0, 0.2), (1.0, 0.999), (0.5, 1.5)]:
+        centre, theta = rng.normal(size=2), rng.uniform(-4.0, 4.0)
+        frame = np.array([[np.cos(theta), -np.sin(theta)], [np.sin(theta), np.cos(theta)]])
+        axes = np.array([[0.0, 0.0], [0.3, 0.0], [4.0, 0.0], [0.0, 0.1], [0.0, -3.0]])
+        points = np.vstack([centre + axes @ frame.T, centre + 2.0 * rng.normal(size=(25, 2))])
+        found = ellipse_distances(points, centre, a, b, theta)
+        dense = _on_ellipse(dense_t, centre, a, b, theta)
+        for point, distance in zip(points, found):
+            near = dense_t[np.argmin(np.sum((dense - point) ** 2, axis=1))]
+            best = minimize_scalar(
+                lambda t: np.linalg.norm(_on_ellipse(np.array([t]), centre, a, b, theta)[0]
+                                         - point),
+                bounds=(near - 1e-3, near + 1e-3), method="bounded",
+                options={"xatol": 1e-13}).fun
+            assert distance == pytest.approx(best, abs=1e-9)
+        near_curve = _on_ellipse(rng.uniform(0, 2 * np.pi, 40), centre, a, b, theta) \
+            * rng.uniform(0.97, 1.03, (40, 1)) + 0.03 * centre
+        model = EllipseModel.from_estimate(_on_ellipse(dense_t[::1000], centre, a, b, theta))
+        reference = np.abs(model.residuals(near_curve))
+        mine = ellipse_distances(near_curve, np.asarray(model.center, float),
+                                 *map(float, model.axis_lengths), float(model.theta))
+        np.testing.assert_allclose(mine, reference, rtol=1e-6, atol=1e-9)  # leastsq xtol
+
+
+def test_fit_circle_is_scikit_images_circle_estimate():
+    """The corner rebuild's circle fit against scikit-image's ``CircleModel`` on noisy arcs of
+    several lengths and places: the same centre and radius to the last bit; points that tell no
+    circle (all at one point, collinear) give None, as the model's estimate fails.
+    """
+    skimage_or_skip()
+    from skimage.measure import CircleModel
+
+    rng = np.random.default_rng(3)
+    for span in (0.2, 1.0, 6.0):
+        t = rng.uniform(0.0, span, 30)
+        points = rng.normal(size=2) + rng.uniform(0.01, 2.0) * np.c_[np.cos(t), np.sin(t)] \
+            + 1e-4 * rng.normal(size=(30, 2))
+        model = CircleModel.from_estimate(points)
+        centre, radius = fit_circle(points)
+        assert np.array_equal(centre, model.center) and radius == model.radius
+    assert fit_circle(np.ones((5, 2))) is None
+    assert fit_circle(np.c_[np.arange(5.0), 2 * np.arange(5.0)]) is None
+    assert not CircleModel.from_estimate(np.c_[np.arange(5.0), 2 * np.arange(5.0)])
 
 
 def test_primitives_at_the_origin_become_named_scene_shapes():
@@ -197,6 +261,12 @@ def test_the_foam_ring_on_its_axis_from_the_camera_raises_no_alarm(tmp_path):
     (before: world 7 events, planner 6, ``prediction_mismatch`` x3); the monitor takes the
     stick-slip events of mirror patches as ties: no alarm. The YAML route (the true ring) on
     the axis is unchanged: the same world events, no alarm.
+
+    The monitor runs with the mirror tolerance derived for the seen ring, (e + R dtheta / 2) /
+    (2 h): e the extraction's stated tolerance, h the seen ring's mesh spacing (96 nodes on its
+    outer circle, 3.27 mm), R and dtheta the scene's fingertip and taxels; a planner told the
+    wrong Poisson's ratio (0.45 for 0.3: no stick-slip predicted) still raises
+    ``prediction_mismatch`` with it.
     """
     skimage_or_skip()
     data = yaml.safe_load(RING_SCENE.read_text())
@@ -205,6 +275,21 @@ def test_the_foam_ring_on_its_axis_from_the_camera_raises_no_alarm(tmp_path):
     assert seen["outcome"] == "grasp held" and seen["seen_outline"]["recognised"] == "annulus"
     assert not seen["alarms"], seen["alarms"]
     assert seen["event_counts"]["C"] + seen["event_counts"]["D"] > 0
+    mirror = seen["seen_outline"]["mirror_tolerance"]
+    spacing = 2 * np.pi * 0.05 / 96
+    assert mirror["spacing_m"] == pytest.approx(spacing, rel=0.02)
+    assert mirror["outline_error_m"] == seen["seen_outline"]["tolerance_m"]
+    pitch = np.radians(150.0) / 95
+    assert mirror["value"] == mirror["used"] == pytest.approx(
+        (mirror["outline_error_m"] + 0.5 * 0.02 * pitch) / (2 * spacing), rel=0.02)
+    assert 0.05 < mirror["value"] < 0.25  # above the default, below the off-axis pair's 0.25
+    wrong = copy.deepcopy(data)
+    wrong["object"]["material"]["nu"] = 0.45
+    (tmp_path / "wrong").mkdir()
+    told_wrong = run_scene(tmp_path / "wrong", wrong, world=data)
+    assert told_wrong["seen_outline"]["mirror_tolerance"]["used"] == pytest.approx(
+        mirror["value"], rel=0.02)
+    assert "prediction_mismatch" in told_wrong["alarms"], told_wrong["alarms"]
     yaml_route = copy.deepcopy(data)
     yaml_route["camera"]["plan_from_images"] = False
     (tmp_path / "yaml").mkdir()
@@ -212,6 +297,24 @@ def test_the_foam_ring_on_its_axis_from_the_camera_raises_no_alarm(tmp_path):
     assert not by_yaml["alarms"], by_yaml["alarms"]
     assert by_yaml["event_counts"] == seen["event_counts"]
     assert len(by_yaml["prediction"]["events"]) == sum(by_yaml["event_counts"].values())
+
+def test_the_summary_says_whether_the_derived_mirror_tolerance_is_applied():
+    """The run's line for the derived tolerance: applied (its formula and sources), overridden
+    (the value used and the one derived), or not applied when ``run --attach`` finds the
+    monitor already running with its own parameter.
+    """
+    from squeeze_grasp_ros.commands.run import _mirror
+
+    mirror = {"value": 0.0652, "spacing_m": 3.27e-3, "outline_error_m": 1.52e-4,
+              "tip_radius_m": 0.02, "taxel_pitch_rad": np.radians(150.0) / 95}
+    applied = _mirror({**mirror, "used": 0.0652})
+    assert applied.startswith("monitor: mirror_tolerance 0.065 = (e + R dtheta / 2) / (2 h)")
+    assert "h 3.27 mm" in applied and "e 0.152 mm" in applied and "dtheta 1.58 deg" in applied
+    assert _mirror({**mirror, "used": 0.2}).startswith(
+        "monitor: mirror_tolerance 0.200 as set (derived 0.065")
+    assert _mirror({**mirror, "used": None}).endswith(
+        "not applied: the attached monitor runs with its own parameter")
+
 
 def test_the_seen_ring_meshes_like_the_yaml_ring():
     """ROS-free: the ring the camera sees, described by name, meshes to within 1 % of the YAML

@@ -21,6 +21,7 @@ from squeeze_grasp_ros.mechanics.squeeze.contact_model import (
     TerminationLimits,
 )
 from squeeze_grasp_ros.mechanics.squeeze.events import event_squeeze
+from squeeze_grasp_ros.mechanics.squeeze.stable_pure import finger_motion, plan_squeeze
 from squeeze_grasp_ros.mechanics.squeeze.tip_shapes import TipShape
 
 W, H = 0.04, 0.02
@@ -61,10 +62,13 @@ def test_models_of_one_object_share_its_sets_and_squeeze_as_on_a_fresh_object(ke
         assert warm[mu].events == cold.events and warm[mu].termination == cold.termination
         np.testing.assert_array_equal(warm[mu].displacement, cold.displacement)
         assert warm[mu].finger_force == cold.finger_force
+        assert warm[mu].health == cold.health  # strains from the object's shared B matrices
 
     nodes = tuple(sorted(ends))
     a, b = ContactModel(obj, 0.4), ContactModel(obj, 0.05)
     assert a.set_data(nodes) is b.set_data(nodes)
+    B, dofs = contact_model.strain_tables(obj, a.length)
+    assert contact_model.strain_tables(obj, b.length)[0] is B and not B.flags.writeable
     # a strain limit needs the strain map: its sets are kept apart, with it
     strained = ContactModel(obj, 0.4, TerminationLimits(strain=0.1)).set_data(nodes)
     assert strained is not a.set_data(nodes) and strained.strain_map is not None
@@ -104,6 +108,28 @@ def test_the_planners_reduced_stiffness_is_kept_per_object_and_equals_a_fresh_on
     for name in ("contacts", "A", "B", "C", "E", "H"):
         np.testing.assert_array_equal(getattr(first, name), getattr(fresh, name))
     assert reduced_stiffness(obj, nodes[::-1]) is not first
+
+
+@pytest.mark.parametrize("kind", ["stable", "pure"])
+def test_the_squeeze_plan_is_kept_per_object_and_its_motion_is_a_fresh_plans(kind, monkeypatch):
+    from squeeze_grasp_ros.mechanics.squeeze import stable_pure
+
+    obj, ends = fresh_block()
+    plans = []
+    plan = stable_pure.plan_squeeze
+    monkeypatch.setattr(stable_pure, "plan_squeeze",
+                        lambda *a, **k: plans.append(1) or plan(*a, **k))
+    first = finger_motion(obj, ends, kind=kind)
+    first.directions["F1"][:] = 0.0  # a caller's copy: the kept plan is not touched
+    again = finger_motion(obj, ends, kind=kind)
+    assert len(plans) == 1
+    fresh_obj, _ = fresh_block()
+    fresh = plan_squeeze(fresh_obj, list(ends), kind=kind).displacement.reshape(2, 2)
+    np.testing.assert_array_equal(again.directions["F1"], fresh[0])
+    np.testing.assert_array_equal(again.directions["F2"], fresh[1])
+    assert again.kind == kind
+    finger_motion(obj, ends[::-1], kind=kind)
+    assert len(plans) == 2
 
 
 def test_models_in_threads_end_with_one_set_per_contact_set():

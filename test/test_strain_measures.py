@@ -20,7 +20,10 @@ from squeeze_grasp_ros.api import load_scene, scene_file, scene_solid
 from squeeze_grasp_ros.cli import main
 from squeeze_grasp_ros.mechanics.elastic.hyperelastic import deformation
 from squeeze_grasp_ros.mechanics.elastic.material import Material
-from squeeze_grasp_ros.mechanics.elastic.strain_measures import principal_strains
+from squeeze_grasp_ros.mechanics.elastic.strain_measures import (
+    max_principal_strains,
+    principal_strains,
+)
 from squeeze_grasp_ros.mechanics.elastic.stress_measures import element_stresses, von_mises
 from squeeze_grasp_ros.mechanics.vocabulary import MaterialModel, StrainMeasure, StressMeasure
 from squeeze_grasp_ros.scene import event_squeeze_scene
@@ -99,6 +102,27 @@ def test_small_strains_keep_their_digits():
     h = np.diag(F[0]) - 1.0
     for measure in StrainMeasure:
         assert principal_strains(F, measure)[0] == pytest.approx(h, rel=1e-12)
+
+
+def test_the_largest_strains_of_a_field_are_its_elements_eigenvalues():
+    """A field of 500 random gradients: the Green-Lagrange principal strains are the
+    eigenvalues of (F^T F - I) / 2 (numpy's eigvalsh), and the largest strain of each measure
+    is the largest |eigenvalue| mapped to the measure over the elements.
+    """
+    rng = np.random.default_rng(7)
+    F = np.eye(2) + 0.3 * rng.standard_normal((500, 2, 2))
+    F[:, 0, 0] = np.abs(F[:, 0, 0]) + 0.5  # keep det F > 0
+    F[:, 1, 1] = np.abs(F[:, 1, 1]) + 0.5
+    e = np.linalg.eigvalsh(0.5 * (np.swapaxes(F, 1, 2) @ F - np.eye(2)))[:, ::-1]
+    np.testing.assert_allclose(principal_strains(F, StrainMeasure.GREEN_LAGRANGE), e,
+                               rtol=1e-12, atol=1e-14)
+    stretch = np.sqrt(1 + 2 * e)
+    small = np.linalg.eigvalsh(0.5 * (F + np.swapaxes(F, 1, 2)) - np.eye(2))
+    expected = {StrainMeasure.GREEN_LAGRANGE: e, StrainMeasure.BIOT: stretch - 1,
+                StrainMeasure.LOG: np.log(stretch), StrainMeasure.SMALL: small}
+    largest = max_principal_strains(F)
+    for measure, eps in expected.items():
+        assert largest[measure] == pytest.approx(float(np.abs(eps).max()), rel=1e-12)
 
 
 def test_an_unknown_measure_names_the_valid_ones():

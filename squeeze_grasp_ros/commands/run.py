@@ -8,6 +8,7 @@ from __future__ import annotations
 import argparse
 import errno
 import json
+import math
 import os
 import re
 import signal
@@ -169,11 +170,17 @@ def _run(args: argparse.Namespace) -> dict | int:
     finally:
         if show:
             sys.stderr.write("\n")
-    stopped = result.get("recording_stopped")
-    if stopped is not None:
+    stopped, lost = result.get("recording_stopped"), result.get("recording_lost")
+    if stopped is not None or lost:
         print(json.dumps(result) if args.json else summary(result))
-        print(f"squeeze-grasp run: the recording in {args.record} stopped early: {stopped}; "
-              "it is readable up to there", file=sys.stderr)
+        if stopped is not None:
+            print(f"squeeze-grasp run: the recording in {args.record} stopped early: "
+                  f"{stopped}; it is readable up to there", file=sys.stderr)
+        if lost:
+            print(f"squeeze-grasp run: the recording in {args.record} is incomplete: "
+                  f"{sum(lost.values())} messages never reached the recorder ("
+                  + ", ".join(f"{topic} {n}" for topic, n in sorted(lost.items()))
+                  + ")", file=sys.stderr)
         return ExitCode.INTERNAL
     if not result["success"]:
         print(json.dumps(result) if args.json else summary(result))
@@ -242,6 +249,21 @@ def _resqueezes(result: dict) -> str:
             f"{released}")
 
 
+def _mirror(mirror: dict) -> str:
+    """The line of the monitor's mirror tolerance derived for the object the camera saw."""
+    derived = (f"(e + R dtheta / 2) / (2 h) for boundary spacing h {mirror['spacing_m'] * 1e3:.2f}"
+               f" mm, outline error e {mirror['outline_error_m'] * 1e3:.3f} mm (the extraction's"
+               f" tolerance), fingertip R {mirror['tip_radius_m'] * 1e3:g} mm, taxel pitch dtheta "
+               f"{math.degrees(mirror['taxel_pitch_rad']):.2f} deg")
+    if mirror.get("used", mirror["value"]) is None:
+        return (f"monitor: mirror_tolerance {mirror['value']:.3f} derived = {derived}; not "
+                "applied: the attached monitor runs with its own parameter")
+    if mirror.get("used", mirror["value"]) != mirror["value"]:
+        return (f"monitor: mirror_tolerance {mirror['used']:.3f} as set (derived "
+                f"{mirror['value']:.3f} = {derived})")
+    return f"monitor: mirror_tolerance {mirror['value']:.3f} = {derived}"
+
+
 def summary(result: dict) -> str:
     """Human-readable report of a run."""
     counts = " ".join(f"{k} {v}" for k, v in result["event_counts"].items())
@@ -288,6 +310,8 @@ def summary(result: dict) -> str:
                         f"{seen['true_area_m2'] * 1e4:.2f} cm^2 true); seen vertices from the "
                         f"true outline: rms {seen['rms_m'] * 1e3:.3f} mm, max "
                         f"{seen['max_m'] * 1e3:.3f} mm (pixel {seen['pixel_m'] * 1e3:.3f} mm)")
+        if seen.get("mirror_tolerance"):
+            lines.insert(2, _mirror(seen["mirror_tolerance"]))
     if result["recording"]:
         lines.append(f"recording: {result['recording']}")
     return "\n".join(lines)

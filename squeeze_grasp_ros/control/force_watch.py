@@ -17,6 +17,8 @@ forces start at zero, so a relative error there is noise over nothing.
 """
 from __future__ import annotations
 
+import functools
+import math
 from collections.abc import Mapping
 from dataclasses import dataclass
 
@@ -61,6 +63,13 @@ class PredictedForces:
         """Finger's predicted force at ``depth`` (m), N: linear between samples, held beyond."""
         return float(np.interp(depth, self.depths, self.forces[finger]))
 
+    @functools.cached_property
+    def largest(self) -> dict[str, float]:
+        """Finger -> its largest predicted |force|, N (computed once: the watch asks at every
+        tick).
+        """
+        return {f: float(np.abs(c).max()) for f, c in self.forces.items()}
+
 
 @dataclass(frozen=True)
 class ForceCheck:
@@ -104,7 +113,7 @@ def force_along_motion(force: np.ndarray, position: np.ndarray, start: np.ndarra
     0 before it has moved.
     """
     motion = np.asarray(position, float) - np.asarray(start, float)
-    length = float(np.linalg.norm(motion))
+    length = math.sqrt(motion.dot(motion))  # np.linalg.norm's own arithmetic, without its wrapper
     return float(np.asarray(force, float)[:2] @ motion) / length if length > 0 else 0.0
 
 
@@ -123,7 +132,7 @@ def check_forces(prediction: PredictedForces, depth: float, measured: Mapping[st
         return None
     predicted = {f: prediction.at(f, depth) for f in measured if f in prediction.forces}
     fingers = [f for f, p in predicted.items()
-               if abs(p) > 0 and abs(p) >= min_fraction * np.abs(prediction.forces[f]).max()]
+               if abs(p) > 0 and abs(p) >= min_fraction * prediction.largest[f]]
     if not fingers:
         return None
     predicted = {f: predicted[f] for f in fingers}

@@ -317,7 +317,7 @@ class PolylinePath:
         """Positions (f, 2) at progress s."""
         if self.end == 0.0:
             return self.start.copy()
-        k = int(np.clip(np.searchsorted(self.knots, s, side="right") - 1, 0, len(self.knots) - 2))
+        k = min(max(int(self.knots.searchsorted(s, side="right")) - 1, 0), len(self.knots) - 2)
         w = (s - self.knots[k]) / (self.knots[k + 1] - self.knots[k])
         return self.start + self.offsets[k] + w * (self.offsets[k + 1] - self.offsets[k])
 

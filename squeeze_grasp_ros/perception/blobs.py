@@ -99,7 +99,7 @@ def choose_object(inside: np.ndarray, *, min_area_px: int, ambiguous_ratio: floa
     count = ndimage.label(inside[crop], output=labels[crop])
     areas = np.bincount(labels[crop].ravel(), minlength=count + 1)[1:]
     order = np.argsort(-areas, kind="mergesort")
-    kept = [int(k) for k in order if areas[k] >= min_area_px]
+    kept = [int(k) for k in order[areas[order] >= min_area_px]]  # noisy depth: 1000s of specks
     if not kept:
         raise InvalidInputError(f"{what}: no object in view (no blob of at least {min_area_px} "
                                 f"px; largest {int(areas.max()) if count else 0} px)")
@@ -110,9 +110,13 @@ def choose_object(inside: np.ndarray, *, min_area_px: int, ambiguous_ratio: floa
             f"similar size ({int(areas[first])} and {int(areas[kept[1]])} px; the second is at "
             f"least ambiguous_ratio = {ambiguous_ratio:g} of the first): which one is the object "
             "is ambiguous; show one object or mask the others")
-    boxes = [(slice(r.start + origin[0], r.stop + origin[0]),
-              slice(c.start + origin[1], c.stop + origin[1]))
-             for r, c in ndimage.find_objects(labels[crop])]
+    # the boxes of the kept blobs only (find_objects on every speck's label built a list of
+    # thousands of slices)
+    rank = np.zeros(count + 1, np.int32)
+    rank[np.array(kept) + 1] = np.arange(1, len(kept) + 1)
+    boxes = {k: (slice(r.start + origin[0], r.stop + origin[0]),
+                 slice(c.start + origin[1], c.stop + origin[1]))
+             for k, (r, c) in zip(kept, ndimage.find_objects(rank[labels[crop]]))}
     box = boxes[first]
     H, W = inside.shape
     if box[0].start == 0 or box[1].start == 0 or box[0].stop == H or box[1].stop == W:

@@ -84,33 +84,87 @@ CANDIDATE_TURN_DEG = 10.0
 tip may spread its turn over several vertices."""
 
 
-def _line(points: np.ndarray, tolerance: float):
-    """Centre and unit direction of the total-least-squares line through ``points``, or None
-    when they stray from it by more than ``tolerance`` (they are not straight).
+def _stretch_fits(p: np.ndarray, gaps: np.ndarray, starts: np.ndarray, lengths: np.ndarray,
+                  tolerance: float) -> dict[str, np.ndarray]:
+    """The traced stretches beside every corner candidate, and the total-least-squares line and
+    the circle fitted to each, all at once.
+
+    Stretch (c, i, s, j) holds the traced points whose signed arc length from candidate c's
+    vertex, times -1 before it (s = 0) and +1 after it (s = 1), lies in [``starts[i]``,
+    ``starts[i] + lengths[j]``], in the trace's order (``gaps``: (C, n) signed arc lengths).
+    The circle is scikit-image ``CircleModel``'s algebraic fit (:func:`~.primitives.fit_circle`:
+    data centred and scaled to unit spread, least squares on [2x, 2y, 1] -> x^2 + y^2, the
+    radius the RMS distance to the centre), solved here by its 3 x 3 normal equations for all
+    stretches at once.
+
+    Returns
+    -------
+    dict
+        ``points`` (m, 2): the stretches' points one after the other; per stretch, shaped
+        (C, I, 2, J): ``first`` and ``count`` (where it starts in ``points``, how many),
+        ``straight`` (every point within ``tolerance`` of its line), ``circular`` (at least 3
+        points, a circle fitted, every point within ``tolerance`` of it), ``radius``; and
+        (C, I, 2, J, 2): ``centre``, ``direction`` (the line's), ``centre_of_circle``.
     """
-    centre = points.mean(axis=0)
-    d = points - centre
-    sxx, syy, sxy = d[:, 0] @ d[:, 0], d[:, 1] @ d[:, 1], d[:, 0] @ d[:, 1]
-    angle = 0.5 * np.arctan2(2.0 * sxy, sxx - syy)  # principal axis of the 2 x 2 scatter
-    direction = np.array([np.cos(angle), np.sin(angle)])
-    off = np.abs(d @ np.array([-direction[1], direction[0]]))
-    return (centre, direction) if off.max() <= tolerance else None
+    side = np.stack([-gaps, gaps], axis=1)[:, None, :, None, :]  # (C, 1, 2, 1, n)
+    lo = starts[None, :, None, None, None]
+    inside = (side >= lo) & (side <= lo + lengths[None, None, None, :, None])
+    shape = inside.shape[:-1]
+    row, col = np.nonzero(inside.reshape(-1, gaps.shape[1]))  # row-major: the trace's order
+    count = np.bincount(row, minlength=int(np.prod(shape)))
+    first = np.cumsum(count) - count
+    points = p[col]
+    out = {"points": points, "first": first, "count": count,
+           **{k: np.full((len(count), 2), np.nan)
+              for k in ("centre", "direction", "centre_of_circle")},
+           "radius": np.full(len(count), np.nan), "straight": np.zeros(len(count), bool),
+           "circular": np.zeros(len(count), bool)}
+    used = count > 0
+    at, size = first[used], count[used]
+    if len(at):
+        def sums(values: np.ndarray) -> np.ndarray:
+            return np.add.reduceat(values, at, axis=0)
 
+        def each(values: np.ndarray) -> np.ndarray:
+            return np.repeat(values, size, axis=0)
 
-def _circle(points: np.ndarray, tolerance: float):
-    """Centre and radius of the circle through ``points`` (scikit-image ``CircleModel``), or
-    None when they stray from it by more than ``tolerance`` (they are no circular arc).
-    """
-    from skimage.measure import CircleModel
-
-    from squeeze_grasp_ros.perception.primitives import fitted_model
-
-    model = fitted_model(CircleModel, points)
-    if model is None or not np.all(np.isfinite(model.center)):
-        return None
-    if np.abs(model.residuals(points)).max() > tolerance:
-        return None
-    return np.asarray(model.center, float), float(model.radius)
+        mean = sums(points) / size[:, None]
+        d = points - each(mean)
+        sxx, syy, sxy = sums(d[:, 0] * d[:, 0]), sums(d[:, 1] * d[:, 1]), sums(d[:, 0] * d[:, 1])
+        angle = 0.5 * np.arctan2(2.0 * sxy, sxx - syy)  # principal axis of the 2 x 2 scatter
+        cos, sin = np.cos(angle), np.sin(angle)
+        off = np.abs(each(cos) * d[:, 1] - each(sin) * d[:, 0])
+        out["centre"][used], out["direction"][used] = mean, np.column_stack([cos, sin])
+        out["straight"][used] = np.maximum.reduceat(off, at) <= tolerance
+        # the circles, on the centred points scaled to unit spread (std over both columns)
+        scale = np.sqrt((sxx + syy) / (2 * size))
+        with np.errstate(divide="ignore", invalid="ignore"):
+            u = d / each(scale)[:, None]
+        f = np.sum(u * u, axis=1)
+        suu = sums(u[:, 0] * u[:, 1])
+        normal = np.empty((len(at), 3, 3))
+        normal[:, 0, 0], normal[:, 1, 1] = 4.0 * sums(u[:, 0] ** 2), 4.0 * sums(u[:, 1] ** 2)
+        normal[:, 0, 1] = normal[:, 1, 0] = 4.0 * suu
+        normal[:, :2, 2] = 2.0 * sums(u)
+        normal[:, 2, :2] = normal[:, :2, 2]
+        normal[:, 2, 2] = size
+        rhs = np.column_stack([2.0 * sums(u * f[:, None]), sums(f)])
+        # the design [2x, 2y, 1] has rank 3 (lstsq's test): away from a collinear or tiny set
+        fit = (size >= 3) & (scale >= np.finfo(float).tiny) & np.all(np.isfinite(normal),
+                                                                      axis=(1, 2))
+        fit[fit] &= np.abs(np.linalg.det(normal[fit])) > 1e-10 * size[fit] ** 3
+        solved = np.linalg.solve(np.where(fit[:, None, None], normal, np.eye(3)),
+                                 np.where(fit[:, None], rhs, 0.0)[..., None])[..., 0]
+        c = solved[:, :2]
+        with np.errstate(invalid="ignore"):
+            radius = np.sqrt(sums(np.sum((u - each(c)) ** 2, axis=1)) / size) * scale
+            centre = c * scale[:, None] + mean
+            stray = np.maximum.reduceat(np.abs(each(radius) - np.linalg.norm(
+                points - each(centre), axis=1)), at)
+            circular = fit & np.all(np.isfinite(centre), axis=1) & (stray <= tolerance)
+        out["centre_of_circle"][used], out["radius"][used] = centre, radius
+        out["circular"][used] = circular
+    return {k: v if k == "points" else v.reshape(*shape, *v.shape[1:]) for k, v in out.items()}
 
 
 SIDE_SPANS = (4.0, 2.0)
@@ -123,21 +177,48 @@ LINE_BESIDE_ARC = 2.0
 """A straight side meets an arc at a corner only when it is straight over this many spans (a
 D's diameter is; a gently curved side, straight to the tolerance over one span only, is not)."""
 
-
-def _stretch(p: np.ndarray, gap: np.ndarray, skip: float, length: float) -> np.ndarray:
-    """The traced points from ``skip`` to ``skip + length`` after the point at ``gap`` = 0."""
-    return p[(gap >= skip) & (gap <= skip + length)]
+STRETCH_SPANS = tuple(sorted({1.0, LINE_BESIDE_ARC, *SIDE_SPANS}))
+"""Every stretch length (multiples of ``span``) the corner rebuild fits a line to."""
 
 
-def _arc_side(p: np.ndarray, gap: np.ndarray, skip: float, span: float, tolerance: float):
-    """The circle (centre, radius) fitted within ``tolerance`` to the longest stretch (of
-    :data:`SIDE_SPANS`) after the point at ``gap`` = 0 that is circular and not straight, or
-    None.
+class _Stretches:
+    """The stretches beside one corner candidate at one skip (a view of :func:`_stretch_fits`'
+    results), side 0 before the vertex and 1 after it, ``spans`` one of
+    :data:`STRETCH_SPANS`.
+    """
+
+    def __init__(self, fits: dict[str, np.ndarray], c: int, i: int):
+        self.fits, self.c, self.i = fits, c, i
+
+    def _at(self, side: int, spans: float) -> tuple[int, int, int, int]:
+        return self.c, self.i, side, STRETCH_SPANS.index(spans)
+
+    def count(self, side: int, spans: float) -> int:
+        """How many traced points the stretch holds."""
+        return int(self.fits["count"][self._at(side, spans)])
+
+    def line(self, side: int, spans: float):
+        """(centre, direction) of the stretch's line, or None when it is not straight."""
+        k = self._at(side, spans)
+        if not self.fits["straight"][k]:
+            return None
+        return self.fits["centre"][k], self.fits["direction"][k]
+
+    def circle(self, side: int, spans: float):
+        """(centre, radius) of the stretch's circle, or None when it is not circular."""
+        k = self._at(side, spans)
+        if not self.fits["circular"][k]:
+            return None
+        return self.fits["centre_of_circle"][k], float(self.fits["radius"][k])
+
+
+def _arc_side(stretches: _Stretches, side: int):
+    """The circle (centre, radius) of the longest stretch (of :data:`SIDE_SPANS`) on ``side``
+    that is circular and not straight, or None.
     """
     for factor in SIDE_SPANS:
-        stretch = _stretch(p, gap, skip, factor * span)
-        if len(stretch) >= 3 and _line(stretch, tolerance) is None:
-            circle = _circle(stretch, tolerance)
+        if stretches.count(side, factor) >= 3 and stretches.line(side, factor) is None:
+            circle = stretches.circle(side, factor)
             if circle is not None:
                 return circle
     return None
@@ -162,23 +243,19 @@ def _line_meets_arc(line, circle, near: np.ndarray, arc_after: bool):
     return (corner, d0, tangent) if arc_after else (corner, tangent, d0)
 
 
-def _corner(p: np.ndarray, gap: np.ndarray, skip: float, span: float, tolerance: float,
+def _corner(p: np.ndarray, gap: np.ndarray, skip: float, stretches: _Stretches,
             max_cut: float, min_turn_deg: float) -> np.ndarray | None:
-    """The rebuilt corner from the stretches from ``skip`` on before and after the point at
+    """The rebuilt corner from the ``stretches`` from ``skip`` on before and after the point at
     ``gap`` = 0 (signed arc length), or None when it is not a clean corner: a straight side
     (over :data:`LINE_BESIDE_ARC` spans) and a circular arc (a D shape's diameter meeting its
-    arc) meet where the line meets the circle; two sides straight over ``span`` meet at the
+    arc) meet where the line meets the circle; two sides straight over a span meet at the
     intersection of their lines.
     """
-    before = _stretch(p, -gap, skip, span)
-    after = _stretch(p, gap, skip, span)
-    if len(before) < 3 or len(after) < 3:
+    if stretches.count(0, 1.0) < 3 or stretches.count(1, 1.0) < 3:
         return None
-    lines = _line(before, tolerance), _line(after, tolerance)
-    long_line = [_line(_stretch(p, g, skip, LINE_BESIDE_ARC * span), tolerance)
-                 for g in (-gap, gap)]
-    arcs = [None if long_line[1 - k] is None else _arc_side(p, g, skip, span, tolerance)
-            for k, g in enumerate((-gap, gap))]
+    long_line = [stretches.line(side, LINE_BESIDE_ARC) for side in (0, 1)]
+    arcs = [None if long_line[1 - side] is None else _arc_side(stretches, side)
+            for side in (0, 1)]
     if arcs[0] is not None or arcs[1] is not None:
         arc_after = arcs[1] is not None
         line, arc = (long_line[0], arcs[1]) if arc_after else (long_line[1], arcs[0])
@@ -188,15 +265,16 @@ def _corner(p: np.ndarray, gap: np.ndarray, skip: float, span: float, tolerance:
         corner, d0, d1 = met
         if abs(d0[0] * d1[1] - d0[1] * d1[0]) < np.sin(np.radians(min_turn_deg)):
             return None  # a tangent join (a straight edge running into an arc): no corner
-    elif lines[0] is not None and lines[1] is not None:
+    else:
+        lines = stretches.line(0, 1.0), stretches.line(1, 1.0)
+        if lines[0] is None or lines[1] is None:
+            return None
         (c0, d0), (c1, d1) = lines
         det = d0[0] * d1[1] - d0[1] * d1[0]
         if abs(det) < np.sin(np.radians(min_turn_deg)):
             return None
         w = c1 - c0
         corner = c0 + d0 * (w[0] * d1[1] - w[1] * d1[0]) / det
-    else:
-        return None
     half_angle = 0.5 * (np.pi - np.arccos(np.clip(abs(d0 @ d1), 0.0, 1.0)))
     cut = np.linalg.norm(p[np.abs(gap) < skip] - corner, axis=1).min(initial=np.inf)
     return corner if cut <= max_cut / np.sin(half_angle) else None
@@ -249,12 +327,16 @@ def sharpen_corners(points: np.ndarray, kept: np.ndarray, *, radius: float, span
     out = q.copy()
     drop = np.zeros(len(q), bool)
     moved = np.zeros(len(q), bool)
-    for c in np.argsort(-turn)[:np.count_nonzero(turn > CANDIDATE_TURN_DEG)]:
+    candidates = np.argsort(-turn)[:np.count_nonzero(turn > CANDIDATE_TURN_DEG)]
+    skips = np.array([radius, 1.5 * radius, 2.25 * radius])  # acute tips are rounded farther
+    gaps = (arc[None, :n] - arc[kept[candidates]][:, None] + 0.5 * total) % total - 0.5 * total
+    fits = _stretch_fits(p, gaps, skips, np.array(STRETCH_SPANS) * span, tolerance)
+    for k, c in enumerate(candidates):
         if drop[c]:  # another vertex of the same corner was moved already
             continue
-        gap = (arc[:n] - arc[kept[c]] + 0.5 * total) % total - 0.5 * total  # signed arc
-        for skip in (radius, 1.5 * radius, 2.25 * radius):  # acute tips are rounded farther
-            corner = _corner(p, gap, skip, span, tolerance, max_cut, min_turn_deg)
+        gap = gaps[k]  # signed arc length from the vertex
+        for i, skip in enumerate(skips):
+            corner = _corner(p, gap, skip, _Stretches(fits, k, i), max_cut, min_turn_deg)
             if corner is None:
                 continue
             if moved.any() and np.linalg.norm(out[moved] - corner, axis=1).min() < skip:

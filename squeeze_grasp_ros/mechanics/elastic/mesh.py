@@ -25,6 +25,13 @@ from squeeze_grasp_ros.mechanics.elastic.mesh_size import (
 from squeeze_grasp_ros.mechanics.elastic.shapes import Outline, interior_point, signed_area
 from squeeze_grasp_ros.mechanics.errors import InvalidInputError
 
+ANGLE_SLACK = 1.0
+"""Degrees by which a mesh kept to its resampled boundary may miss ``min_angle`` before it is
+meshed again with boundary splits allowed. Without splits Triangle's angle bound no longer holds
+at the boundary: on the mixed outlines of ``test/test_perception_mixed.py`` (300 to 4,000
+nodes) it missed 30 degrees by 0.02 at most, while a 4 mm strip meshed with 2 cm elements had
+a 2.7 degree triangle (``test/test_mesh_boundary.py``)."""
+
 
 class Mesher(Protocol):
     """Triangulates a planar straight-line graph with quality controls."""
@@ -37,20 +44,24 @@ class Mesher(Protocol):
         max_area: float,
         min_angle: float,
         max_nodes: int,
+        *,
+        split_boundary: bool = True,
     ) -> tuple[np.ndarray, np.ndarray]:
         """Return ``(nodes (n, 2), triangles (t, 3))`` covering the region.
 
-        ``segments`` are index pairs into ``vertices`` that must stay edges (possibly split);
-        ``holes`` are points inside holes; ``max_area`` (m^2) and ``min_angle`` (degrees) are the
-        quality bounds; the mesher stops adding nodes at ``max_nodes`` (the caller refuses a mesh
-        that reached it).
+        ``segments`` are index pairs into ``vertices`` that must stay edges (split by the
+        mesher where its quality refinement needs it, unless ``split_boundary`` is False: then
+        the segments' vertices are the only nodes on them); ``holes`` are points inside holes;
+        ``max_area`` (m^2) and ``min_angle`` (degrees) are the quality bounds; the mesher stops
+        adding nodes at ``max_nodes`` (the caller refuses a mesh that reached it).
         """
 
 
 class TriangleMesher:
     """Mesher backed by the ``triangle`` package (Shewchuk's Triangle; non-commercial licence)."""
 
-    def triangulate(self, vertices, segments, holes, max_area, min_angle, max_nodes):
+    def triangulate(self, vertices, segments, holes, max_area, min_angle, max_nodes, *,
+                    split_boundary=True):
         import triangle
 
         data = {"vertices": vertices, "segments": segments}
@@ -58,7 +69,8 @@ class TriangleMesher:
             data["holes"] = holes
         area = np.format_float_positional(max_area, trim="-")  # Triangle cannot parse 1e-5
         steiner = max(max_nodes - len(vertices), 0)  # S: most nodes Triangle may add
-        out = triangle.triangulate(data, f"pq{min_angle:.6g}a{area}S{steiner}Q")
+        keep = "" if split_boundary else "Y"  # Y: no Steiner points on the boundary
+        out = triangle.triangulate(data, f"pq{min_angle:.6g}a{area}S{steiner}{keep}Q")
         return np.asarray(out["vertices"], float), np.asarray(out["triangles"], int)
 
 
@@ -183,6 +195,7 @@ def generate_mesh(
     min_angle: float = 30.0,
     mesher: Mesher | None = None,
     max_nodes: int = MAX_MESH_NODES,
+    split_boundary: bool = True,
 ) -> Mesh:
     """Mesh ``outline`` with elements of area <= ``max_area`` m^2 and angles >= ``min_angle``.
 
@@ -191,6 +204,15 @@ def generate_mesh(
     before meshing (:mod:`~squeeze_grasp_ros.mechanics.elastic.mesh_size`): its boundary
     nodes, its interior nodes and the nodes that features thinner than the element size would
     force; the mesher itself stops at ``max_nodes``.
+
+    With ``split_boundary`` (the default) the mesher's quality refinement may split boundary
+    segments. Whether it does is a tie: a resampled segment a hair longer than the element size
+    carries a triangle a hair over ``max_area``, whose circumcentre encroaches on the segment,
+    so two outlines a few micrometres apart can differ by several boundary nodes. With
+    ``split_boundary=False`` the boundary nodes are exactly the resampled loops (Triangle's
+    ``Y`` switch), so they depend only on the outline's arc length and corners; if that mesh
+    misses ``min_angle`` (a feature thinner than the element size needs boundary nodes closer
+    than the spacing), the outline is meshed again with splits allowed.
 
     Raises
     ------
@@ -233,15 +255,23 @@ def generate_mesh(
         segments.append(np.column_stack([k, np.roll(k, -1)]))
         offset += len(loop)
     holes = np.array([interior_point(h) for h in outline.holes]).reshape(-1, 2)
-    nodes, tris = (mesher or TriangleMesher()).triangulate(
-        vertices, np.concatenate(segments), holes, max_area, min_angle, max_nodes
-    )
-    if len(nodes) >= max_nodes:
-        raise InvalidInputError(
-            f"the mesher reached the limit of {max_nodes:,} nodes before it met the element "
-            f"size {estimate.spacing:.3g} m and angle {min_angle:g} deg: use larger elements "
-            "(mesh.nodes or mesh.max_area) or a simpler outline")
-    return mesh_from_triangles(nodes, tris)
+    segments = np.concatenate(segments)
+    mesher = mesher or TriangleMesher()
+
+    def triangulated(split: bool) -> Mesh:
+        nodes, tris = mesher.triangulate(vertices, segments, holes, max_area, min_angle,
+                                         max_nodes, split_boundary=split)
+        if len(nodes) >= max_nodes:
+            raise InvalidInputError(
+                f"the mesher reached the limit of {max_nodes:,} nodes before it met the "
+                f"element size {estimate.spacing:.3g} m and angle {min_angle:g} deg: use "
+                "larger elements (mesh.nodes or mesh.max_area) or a simpler outline")
+        return mesh_from_triangles(nodes, tris)
+
+    mesh = triangulated(split_boundary)
+    if not split_boundary and mesh.min_angle_deg() < min_angle - ANGLE_SLACK:
+        mesh = triangulated(True)
+    return mesh
 
 
 def mesh_from_triangles(nodes: np.ndarray, triangles: np.ndarray) -> Mesh:

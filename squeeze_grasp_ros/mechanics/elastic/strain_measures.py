@@ -47,10 +47,11 @@ def _green_lagrange(H: np.ndarray) -> np.ndarray:
     """Principal Green-Lagrange strains (t, 2) of H: of (H + H^T + H^T H) / 2, in engineering
     (Voigt) components (xx, yy, 2 xy).
     """
-    HtH = np.einsum("tki,tkj->tij", H, H)
-    return voigt_principal(np.column_stack([H[:, 0, 0] + 0.5 * HtH[:, 0, 0],
-                                            H[:, 1, 1] + 0.5 * HtH[:, 1, 1],
-                                            H[:, 0, 1] + H[:, 1, 0] + HtH[:, 0, 1]]))
+    h00, h01, h10, h11 = H[:, 0, 0], H[:, 0, 1], H[:, 1, 0], H[:, 1, 1]
+    # the three entries of H^T H that enter, summed over k in einsum's order (k = 0, then 1)
+    return voigt_principal(np.column_stack([h00 + 0.5 * (h00 * h00 + h10 * h10),
+                                            h11 + 0.5 * (h01 * h01 + h11 * h11),
+                                            h01 + h10 + (h00 * h01 + h10 * h11)]))
 
 
 def _of_stretch(e: np.ndarray, measure: StrainMeasure) -> np.ndarray:
@@ -93,7 +94,7 @@ def principal_strains(F: np.ndarray, measure: StrainMeasure | str) -> np.ndarray
 
 
 def _largest(eps: np.ndarray) -> tuple[float, int]:
-    per_element = np.abs(eps).max(axis=1)
+    per_element = np.maximum(np.abs(eps[:, 0]), np.abs(eps[:, 1]))
     k = int(np.argmax(per_element))
     return float(per_element[k]), k
 

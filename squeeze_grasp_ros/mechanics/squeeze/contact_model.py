@@ -683,13 +683,6 @@ class ContactModel:
             strain_map = self.element_strains(self.unit_responses(dofs))
         return SetData(idx, C, E, A_bc, strain_map, condition)
 
-    def _strain_b(self) -> np.ndarray:
-        """Element strain-displacement matrices with coordinates / L, (t, 3, 6)."""
-        if "strain_b" not in self._cache:
-            B, _ = strain_displacement(self.obj.mesh.nodes / self.length, self.obj.mesh.triangles)
-            self._cache["strain_b"] = B
-        return self._cache["strain_b"]
-
     def unit_responses(self, dofs: np.ndarray) -> np.ndarray:
         """K+ applied to unit loads at ``dofs``: (2n, len(dofs)), by direct sparse solves."""
         unit_loads = np.zeros((2 * self.obj.mesh.n, len(dofs)))
@@ -700,8 +693,8 @@ class ContactModel:
         """Engineering strains (t*3,) or (t*3, k) of dimensionless nodal displacements (2n[,
         k]).
         """
-        B = self._strain_b()
-        de = u_hat[element_dofs(self.obj.mesh.triangles)]
+        B, dofs = strain_tables(self.obj, self.length)
+        de = u_hat[dofs]
         return np.einsum("tij,tj...->ti...", B, de).reshape((-1,) + u_hat.shape[1:])
 
     def full_displacement(self, sd: SetData, delta: np.ndarray, F: np.ndarray) -> np.ndarray:
@@ -834,11 +827,23 @@ class ContactModel:
         return kept["bounds"], kept.get("stacked")
 
 
+def strain_tables(obj: ElasticObject, length: float) -> tuple[np.ndarray, np.ndarray]:
+    """The element strain-displacement matrices with coordinates / ``length`` (t, 3, 6) and
+    the elements' DOFs (t, 6), kept on ``obj`` (read-only) for all of its contact models,
+    whose length is its scale: a sweep computes them once per object, not per evaluation.
+    """
+    kept = obj._shared.get("strain_b")
+    if kept is None or kept[0] != length:
+        B, _ = strain_displacement(obj.mesh.nodes / length, obj.mesh.triangles)
+        dofs = element_dofs(obj.mesh.triangles)
+        B.flags.writeable = dofs.flags.writeable = False
+        kept = obj._shared["strain_b"] = (length, B, dofs)
+    return kept[1], kept[2]
+
+
 def strain_criterion(eps: np.ndarray, criterion: str) -> tuple[float, int]:
     """(max strain, element) from engineering strains (t, 3) by ``criterion`` (eq. 45)."""
-    if criterion == StrainCriterion.COMPONENTWISE:
-        per_element = np.abs(eps[:, :2]).max(axis=1)
-    else:
-        per_element = np.abs(principal_strains(eps)).max(axis=1)
+    pair = eps if criterion == StrainCriterion.COMPONENTWISE else principal_strains(eps)
+    per_element = np.maximum(np.abs(pair[:, 0]), np.abs(pair[:, 1]))
     k = int(np.argmax(per_element))
     return float(per_element[k]), k

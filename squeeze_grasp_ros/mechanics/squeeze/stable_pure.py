@@ -16,6 +16,7 @@ import numpy as np
 
 from squeeze_grasp_ros.mechanics.elastic.compliance import ElasticObject
 from squeeze_grasp_ros.mechanics.elastic.reduced import (
+    REDUCED_KEPT,
     ReducedStiffness,
     reduced_stiffness,
     rotation_angle,
@@ -214,9 +215,9 @@ def finger_motion(obj: ElasticObject, contacts, *, kind: SqueezeKind = SqueezeKi
     p = obj.mesh.nodes[list(contacts)]
     distance = float(np.linalg.norm(p[1] - p[0]))
     if directions is None:
-        plan = plan_squeeze(obj, list(contacts), kind=kind)
+        plan = _kept_plan(obj, contacts, kind)
         u = plan.displacement.reshape(2, 2)
-        return FingerMotion({Finger.F1: u[0], Finger.F2: u[1]},
+        return FingerMotion({Finger.F1: u[0].copy(), Finger.F2: u[1].copy()},
                             plan.approach_per_unit_depth / distance, plan.kind)
     stacked = np.array([directions[n] for n in SQUEEZING_FINGERS], float)
     norm = float(np.linalg.norm(stacked))
@@ -225,6 +226,23 @@ def finger_motion(obj: ElasticObject, contacts, *, kind: SqueezeKind = SqueezeKi
     dirs = {n: stacked[k] / norm for k, n in enumerate(SQUEEZING_FINGERS)}
     approach = float((dirs[Finger.F1] - dirs[Finger.F2]) @ (p[1] - p[0]) / distance)
     return FingerMotion(dirs, approach / distance, SqueezeKind.CUSTOM)
+
+
+def _kept_plan(obj: ElasticObject, contacts, kind: SqueezeKind) -> Squeeze:
+    """:func:`plan_squeeze` of ``contacts`` and ``kind``, kept on the object (the last
+    REDUCED_KEPT, beside the reduced stiffnesses it is planned from): a sweep squeezes every
+    placement at several depths, frictions and tips, each with the same plan. Callers copy
+    what they hand on; a failed plan is not kept (it raises again).
+    """
+    kept = obj._shared.setdefault("squeeze_plans", {})
+    tag = (str(kind), tuple(int(c) for c in contacts))
+    plan = kept.get(tag)
+    if plan is None:
+        plan = plan_squeeze(obj, list(contacts), kind=kind)
+        if len(kept) >= REDUCED_KEPT:
+            kept.pop(next(iter(kept)), None)
+        kept[tag] = plan
+    return plan
 
 
 def force_closure(p_i, n_i, p_j, n_j, mu: float) -> bool:

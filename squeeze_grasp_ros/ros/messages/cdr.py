@@ -27,16 +27,20 @@ included) and its bytes, a sequence a uint32 count and its elements.
 from __future__ import annotations
 
 import functools
+import math
 import struct
+import threading
+from typing import NamedTuple
 
 import numpy as np
 
 from squeeze_grasp_ros.ros.messages.contacts import TactileReadings, check_taxels
 
-__all__ = ["CdrWriter", "cdr_stamp_ns", "clock_cdr", "monitor_status_cdr_reading",
-           "pose_position_cdr", "pose_stamped_cdr",
+__all__ = ["CdrTemplate", "CdrWriter", "cdr_stamp_ns", "clock_cdr", "monitor_status_cdr_reading",
+           "pose_position_cdr", "pose_stamped_cdr", "refilled",
            "tactile_array_cdr", "tactile_readings_cdr", "tick_cdr", "tick_readings_cdr",
-           "wrench_force_cdr", "wrench_stamped_cdr", "write_contact_arrays"]
+           "wrench_force_cdr", "wrench_stamped_cdr", "write_contact_arrays",
+           "write_finger_vectors"]
 
 _BODY = 4
 """Bytes of the encapsulation header; alignment counts from its end."""
@@ -136,42 +140,153 @@ def wrench_force_cdr(data: bytes) -> tuple[int, np.ndarray]:
 def tactile_readings_cdr(data: bytes) -> tuple[int, TactileReadings]:
     """(stamp ns, taxel angles in rad and forces in N) of a serialised
     ``squeeze_grasp_interfaces/TactileArray``.
+
+    An array of the layout of one read before (the same length, frame, finger and taxel count)
+    is read at that one's offsets.
     """
+    layout = _TACTILE_LAYOUTS.get(len(data))
+    if layout is not None and data[1] == 1 and data[_BODY + 8:layout.start] == layout.prefix \
+            and all(data[at:at + 4] == layout.count for at in layout.counts):
+        return cdr_stamp_ns(data), TactileReadings(
+            layout.finger, *(np.frombuffer(data, "<f8", layout.size, at).copy()
+                             for at in layout.runs))
     reader = _Reader(data)
     stamp = reader.header()
     reader.skip_string()
     finger = reader.string()
-    return stamp, TactileReadings(finger, reader.sequence(), reader.sequence(),
-                                  reader.sequence())
+    counts, runs, arrays = [], [], []
+    for _ in range(3):
+        counts.append(reader.offset + -(reader.offset - _BODY) % 4)
+        arrays.append(reader.sequence())
+        runs.append(reader.offset - 8 * len(arrays[-1]))
+    count = len(arrays[0])
+    if reader.order == "<" and reader.offset == len(data) and count and \
+            all(len(a) == count for a in arrays) and len(_TACTILE_LAYOUTS) < 64:
+        _TACTILE_LAYOUTS[len(data)] = _Layout(counts[0] + 4, bytes(data[_BODY + 8:counts[0] + 4]),
+                                              tuple(counts[1:]),
+                                              bytes(data[counts[0]:counts[0] + 4]), finger,
+                                              count, tuple(runs))
+    return stamp, TactileReadings(finger, *arrays)
 
 
 def tick_readings_cdr(data: bytes) -> tuple[int, list[str]]:
     """(stamp ns, readings "<device>/<stream>") of a serialised
     ``squeeze_grasp_interfaces/Tick``.
+
+    The readings of a tick with an empty frame id (as the simulated hardware writes it) are
+    looked up by their bytes when the same list was read before.
     """
+    tail = data[_BODY + 24:] if data[1] == 1 and data[_BODY + 8:_BODY + 16] == _NO_FRAME \
+        else None
+    readings = _TICK_READINGS.get(tail)
+    if readings is not None:
+        return cdr_stamp_ns(data), list(readings)
     reader = _Reader(data)
     stamp = reader.header()
     reader.skip_string()
     reader.uint64()  # the tick's index
-    return stamp, reader.strings()
+    readings = reader.strings()
+    if tail is not None and len(_TICK_READINGS) < 64:
+        _TICK_READINGS[bytes(tail)] = tuple(readings)
+    return stamp, readings
+
+
+class _Layout(NamedTuple):
+    """Where a message read before keeps its arrays (byte offsets): a tactile array."""
+
+    start: int
+    """End of the frame id and the finger name (from the end of the stamp: ``prefix``)."""
+    prefix: bytes
+    """The bytes from the end of the stamp to ``start``, the first count included."""
+    counts: tuple[int, ...]
+    """Offsets of the other arrays' counts."""
+    count: bytes
+    """Each count's bytes."""
+    finger: str
+    size: int
+    """Numbers per array."""
+    runs: tuple[int, ...]
+    """Offsets of the arrays."""
+
+
+_TACTILE_LAYOUTS: dict[int, _Layout] = {}
+"""Tactile array layouts read before, by message length (little-endian, at most 64)."""
+_TICK_READINGS: dict[bytes, tuple[str, ...]] = {}
+"""A tick's readings by the bytes of its ``string[]`` (at most 64 lists)."""
+_NO_FRAME = b"\x01\x00\x00\x00\x00\x00\x00\x00"
+"""An empty frame id (its length 1, the NUL) and the zero padding before the tick's index."""
 
 
 def monitor_status_cdr_reading(data: bytes) -> tuple | None:
     """(stamp ns, fingers, positions (k, 3) m, forces (k, 3) N, normals (k, 3), depth m) of a
     serialised ``squeeze_grasp_interfaces/MonitorStatus`` that carries no event and no alarm
     (most ticks); None when it carries any (deserialise it whole then).
+
+    The arrays are read-only views of ``data``. A status of the layout of one read before (the
+    same length, frame, fingers and counts, no event and no alarm) is read at that one's offsets
+    (:class:`_StatusLayout`), without walking its fields again.
     """
+    layout = _STATUS_LAYOUTS.get(len(data))
+    if layout is not None and data[1] == 1 and data[-8:] == _NO_EVENTS \
+            and data[_BODY + 8:layout.start] == layout.prefix \
+            and all(data[at:at + 4] == layout.count for at in layout.counts):
+        runs = [np.frombuffer(data, "<f8", layout.size, at).reshape(-1, 3)
+                for at in layout.runs]
+        (depth,) = _F64_FROM(data, layout.depth)
+        return (cdr_stamp_ns(data), layout.fingers, *runs, depth)
     reader = _Reader(data)
     stamp = reader.header()
     reader.skip_string()
     fingers = reader.strings()
-    vectors = [reader.float64s(3 * reader.uint32()).reshape(-1, 3) for _ in range(3)]
+    start, counts, runs = reader.offset, [], []
+    for _ in range(3):
+        counts.append(reader.offset + -(reader.offset - _BODY) % 4)
+        count = reader.uint32()
+        if count:
+            reader._align(8)
+        runs.append(reader.offset)
+        reader.offset += 24 * count
     reader.sequence()  # sensor ages
+    depth_at = reader.offset + -(reader.offset - _BODY) % 8
     depth = reader.float64()
     reader.float64()  # relative depth
     if reader.uint32() or reader.uint32():  # events, then alarms
         return None
+    vectors = [np.frombuffer(data, reader.order + "f8", 3 * len(fingers), at).reshape(-1, 3)
+               .astype(np.float64) for at in runs]
+    if reader.order == "<" and reader.offset == len(data) and len(set(map(
+            bytes, (data[at:at + 4] for at in counts)))) == 1 and len(_STATUS_LAYOUTS) < 64:
+        _STATUS_LAYOUTS[len(data)] = _StatusLayout(start, bytes(data[_BODY + 8:start]),
+                                                   tuple(counts),
+                                                   bytes(data[counts[0]:counts[0] + 4]),
+                                                   tuple(fingers), 3 * len(fingers),
+                                                   tuple(runs), depth_at)
     return (stamp, fingers, *vectors, depth)
+
+
+class _StatusLayout(NamedTuple):
+    """Where a ``MonitorStatus`` without events and alarms keeps its numbers (byte offsets)."""
+
+    start: int
+    """End of the frame id and the finger names (from the end of the stamp: ``prefix``)."""
+    prefix: bytes
+    counts: tuple[int, ...]
+    """Offsets of the positions', forces' and normals' counts."""
+    count: bytes
+    """Each count's bytes (the number of fingers)."""
+    fingers: tuple[str, ...]
+    size: int
+    """float64 numbers per vector run (3 per finger)."""
+    runs: tuple[int, ...]
+    """Offsets of the positions, forces and normals."""
+    depth: int
+
+
+_STATUS_LAYOUTS: dict[int, _StatusLayout] = {}
+"""Status layouts read before, by message length (little-endian, at most 64)."""
+_NO_EVENTS = bytes(8)
+"""A status's last 8 bytes without events and alarms: their two zero counts."""
+_F64_FROM = struct.Struct("<d").unpack_from
 
 
 _ZEROS = tuple(bytes(n) for n in range(8))
@@ -212,15 +327,21 @@ class CdrWriter:
         buffer += _ZEROS[-len(buffer) % 4]
         buffer += _I32(value)
 
-    def uint64(self, value: int) -> None:
+    def uint64(self, value: int) -> int:
+        """Write a ``uint64``; return its offset."""
         buffer = self.buffer
         buffer += _ZEROS[-(len(buffer) - _BODY) % 8]
+        offset = len(buffer)
         buffer += _U64(value)
+        return offset
 
-    def float64(self, value: float) -> None:
+    def float64(self, value: float) -> int:
+        """Write a ``float64``; return its offset."""
         buffer = self.buffer
         buffer += _ZEROS[-(len(buffer) - _BODY) % 8]
+        offset = len(buffer)
         buffer += _F64(value)
+        return offset
 
     def string(self, text: str) -> None:
         buffer = self.buffer
@@ -236,29 +357,35 @@ class CdrWriter:
             buffer += _ZEROS[-len(buffer) % 4]
             buffer += _string(text)
 
-    def header(self, ns: int, frame_id: str = "") -> None:
+    def header(self, ns: int, frame_id: str = "") -> int:
         """A ``std_msgs/Header`` stamped ``ns`` nanoseconds (its stamp first, as the readers
-        read it).
+        read it); return the stamp's offset.
         """
         buffer = self.buffer
         buffer += _ZEROS[-len(buffer) % 4]
+        offset = len(buffer)
         buffer += _TIME(*divmod(int(ns), 1_000_000_000))
         buffer += _string(frame_id)
+        return offset
 
-    def float64s(self, values) -> None:
+    def float64s(self, values) -> int:
         """A fixed-size run of float64 fields (``Point``, ``Vector3``, ...), or the elements of
-        a sequence of such messages; nothing, not even alignment, for none.
+        a sequence of such messages; nothing, not even alignment, for none. Return the offset
+        of the first value (the end of the buffer for none).
         """
         data = np.asarray(values, dtype="<f8")
+        buffer = self.buffer
         if data.size:
-            buffer = self.buffer
             buffer += _ZEROS[-(len(buffer) - _BODY) % 8]
+            offset = len(buffer)
             buffer += data.tobytes()
+            return offset
+        return len(buffer)
 
-    def sequence(self, values, dtype: str = "<f8") -> None:
+    def sequence(self, values, dtype: str = "<f8") -> int:
         """A sequence of numbers (``float64[]`` by default; ``"<i4"`` int32, ``"u1"`` uint8):
         its count, then its elements aligned to their size (nothing for none, as Fast CDR
-        writes it).
+        writes it). Return the offset of the first element (the end of the buffer for none).
         """
         data = np.asarray(values, dtype=dtype)
         size, buffer = data.size, self.buffer
@@ -266,29 +393,102 @@ class CdrWriter:
         buffer += _U32(size)
         if size:
             buffer += _ZEROS[-(len(buffer) - _BODY) % data.itemsize]
+            offset = len(buffer)
             buffer += data.tobytes()
+            return offset
+        return len(buffer)
 
     def data(self) -> bytes:
         """The serialised message, ready for ``Publisher.publish``."""
         return bytes(self.buffer)
 
 
+class CdrTemplate:
+    """A serialised message to refill in place: the next message of the same layout (the same
+    strings and sequence lengths) differs only in its stamps, ``uint64`` counters and float64
+    runs, which :meth:`refill` writes over the first message's bytes.
+
+    Parameters
+    ----------
+    writer : CdrWriter
+        The first message, written in full; its buffer is kept (and no longer grows).
+    stamps : sequence of int
+        Offsets of the message's stamps (``builtin_interfaces/Time``).
+    runs : sequence of (int, int or tuple of int)
+        (offset, shape) of each float64 run refilled, in :meth:`refill`'s order (a shape
+        (k, 3): k vectors).
+    counters : sequence of int
+        Offsets of the ``uint64`` fields refilled.
+    """
+
+    __slots__ = ("buffer", "counters", "runs", "stamps")
+
+    def __init__(self, writer: CdrWriter, stamps=(), runs=(), counters=()) -> None:
+        self.buffer = writer.buffer
+        self.stamps = tuple(stamps)
+        views = (np.frombuffer(self.buffer, "<f8", math.prod(np.atleast_1d(shape)),
+                               offset).reshape(shape) for offset, shape in runs)
+        self.runs = tuple((index, view) for index, view in enumerate(views) if view.size)
+        """(index in refill's values, writable view) of each run that has numbers."""
+        self.counters = tuple(counters)
+
+    def refill(self, ns: int, values=(), counts=()) -> bytes:
+        """The message stamped ``ns`` with float64 runs ``values`` (each as many numbers as its
+        run) and counters ``counts``, serialised; the same bytes a writer would write.
+        """
+        buffer = self.buffer
+        sec, nanosec = divmod(int(ns), 1_000_000_000)
+        for offset in self.stamps:
+            _TIME_INTO(buffer, offset, sec, nanosec)
+        for offset, count in zip(self.counters, counts):
+            _U64_INTO(buffer, offset, count)
+        for index, run in self.runs:
+            run[:] = values[index]
+        return bytes(buffer)
+
+
+_TIME_INTO, _U64_INTO = (struct.Struct(f).pack_into for f in ("<iI", "<Q"))
+KEPT_LAYOUTS = 256
+"""Templates each thread keeps (all are dropped when it has more, e.g. after many scenes)."""
+_LAYOUTS = threading.local()
+
+
+def refilled(key: tuple, write, ns: int, values=(), counts=()) -> bytes:
+    """A message of layout ``key``: :meth:`CdrTemplate.refill` of the template kept for it (per
+    thread: a refill is not atomic), or, the first time, the bytes of ``write()``, a function
+    that writes the message in full and returns its :class:`CdrTemplate`.
+    """
+    kept = _LAYOUTS.__dict__
+    template = kept.get(key)
+    if template is not None:
+        return template.refill(ns, values, counts)
+    template = write()
+    if len(kept) >= KEPT_LAYOUTS:
+        kept.clear()
+    kept[key] = template
+    return bytes(template.buffer)
+
+
 def pose_stamped_cdr(position, ns: int, frame_id: str) -> bytes:
     """A ``geometry_msgs/PoseStamped`` of a fingertip centre (x, y), m, at z = 0 with the
     identity orientation (:func:`..devices.pose_msg`'s message), serialised.
     """
-    writer = CdrWriter()
-    writer.header(ns, frame_id)
-    writer.float64s((position[0], position[1], 0.0, 0.0, 0.0, 0.0, 1.0))
-    return writer.data()
+    def write() -> CdrTemplate:
+        writer = CdrWriter()
+        stamp = writer.header(ns, frame_id)
+        at = writer.float64s((position[0], position[1], 0.0, 0.0, 0.0, 0.0, 1.0))
+        return CdrTemplate(writer, (stamp,), ((at, 2),))
+    return refilled(("pose", frame_id), write, ns, (position[:2],))
 
 
 def wrench_stamped_cdr(force, torque, ns: int, frame_id: str) -> bytes:
     """A ``geometry_msgs/WrenchStamped`` of a force (3,), N, and torque (3,), N m, serialised."""
-    writer = CdrWriter()
-    writer.header(ns, frame_id)
-    writer.float64s(np.concatenate((force, torque)))
-    return writer.data()
+    def write() -> CdrTemplate:
+        writer = CdrWriter()
+        stamp = writer.header(ns, frame_id)
+        forces = writer.float64s(np.concatenate((force, torque)))
+        return CdrTemplate(writer, (stamp,), ((forces, 3), (forces + 24, 3)))
+    return refilled(("wrench", frame_id), write, ns, (force, torque))
 
 
 def tactile_array_cdr(readings: TactileReadings, ns: int, frame_id: str) -> bytes:
@@ -300,12 +500,16 @@ def tactile_array_cdr(readings: TactileReadings, ns: int, frame_id: str) -> byte
         If the arrays differ in length.
     """
     check_taxels(readings.finger, readings.angles, readings.normal, readings.tangential)
-    writer = CdrWriter()
-    writer.header(ns, frame_id)
-    writer.string(readings.finger)
-    for values in (readings.angles, readings.normal, readings.tangential):
-        writer.sequence(values)
-    return writer.data()
+    arrays = (readings.angles, readings.normal, readings.tangential)
+    count = len(readings.angles)
+
+    def write() -> CdrTemplate:
+        writer = CdrWriter()
+        stamp = writer.header(ns, frame_id)
+        writer.string(readings.finger)
+        return CdrTemplate(writer, (stamp,),
+                           tuple((writer.sequence(values), count) for values in arrays))
+    return refilled(("tactile", frame_id, readings.finger, count), write, ns, arrays)
 
 
 def clock_cdr(ns: int) -> bytes:
@@ -317,25 +521,45 @@ def tick_cdr(index: int, ns: int, readings) -> bytes:
     """The ``squeeze_grasp_interfaces/Tick`` of lockstep tick ``index`` at sim time ``ns``
     (readings as "<device>/<stream>"), serialised.
     """
-    writer = CdrWriter()
-    writer.header(ns)
-    writer.uint64(index)
-    writer.strings(readings)
-    return writer.data()
+    def write() -> CdrTemplate:
+        writer = CdrWriter()
+        stamp = writer.header(ns)
+        at = writer.uint64(index)
+        writer.strings(readings)
+        return CdrTemplate(writer, (stamp,), (), (at,))
+    return refilled(("tick", *readings), write, ns, (), (index,))
 
 
 def write_contact_arrays(writer: CdrWriter, ns: int, frame_id: str, fingers, nodes, angles,
-                         modes, forces_x, forces_y, depth: float, relative_depth: float) -> None:
+                         modes, forces_x, forces_y, depth: float, relative_depth: float
+                         ) -> tuple[int, list[tuple[int, int]]]:
     """A ``squeeze_grasp_interfaces/ContactState`` (parallel per-contact arrays: angles rad,
-    forces N; depth m) into ``writer``.
+    forces N; depth m) into ``writer``. Return its stamp's offset and (offset, count) of its
+    float64 runs: angles, forces x and y, depth, relative depth (:class:`CdrTemplate`).
     """
-    writer.header(ns, frame_id)
+    stamp = writer.header(ns, frame_id)
     writer.strings(fingers)
     writer.sequence(nodes, "<i4")
-    writer.sequence(angles)
+    count = len(nodes)
+    runs = [(writer.sequence(angles), count)]
     writer.sequence(modes, "u1")
-    writer.sequence(forces_x)
-    writer.sequence(forces_y)
-    writer.float64(depth)
-    writer.float64(relative_depth)
+    runs += [(writer.sequence(forces_x), count), (writer.sequence(forces_y), count),
+             (writer.float64(depth), 1), (writer.float64(relative_depth), 1)]
+    return stamp, runs
 
+
+def write_finger_vectors(writer: CdrWriter, ns: int, frame_id: str, fingers, vectors,
+                         per_finger) -> tuple[int, list[tuple[int, tuple[int, int] | int]]]:
+    """The per-finger head of ``MonitorStatus`` and ``SimState`` into ``writer``: a header, the
+    ``string[]`` of ``fingers``, a ``Point[]`` / ``Vector3[]`` of each of ``vectors`` (each one
+    (x, y, z) per finger) and the ``float64[]`` ``per_finger``. Return the stamp's offset and
+    the (offset, shape) of each run (:class:`CdrTemplate`).
+    """
+    stamp = writer.header(ns, frame_id)
+    writer.strings(fingers)
+    runs: list = []
+    for values in vectors:
+        writer.uint32(len(fingers))
+        runs.append((writer.float64s(values), (len(fingers), 3)))
+    runs.append((writer.sequence(per_finger), len(fingers)))
+    return stamp, runs

@@ -51,10 +51,9 @@ def observation_cdr(data: bytes) -> Observation | None:
     read = monitor_status_cdr_reading(data)
     if read is None:
         return None
-    ns, fingers, positions, forces, normals, depth = read
-    return Observation(ns, {f: positions[k, :2].copy() for k, f in enumerate(fingers)},
-                       {f: forces[k, :2].copy() for k, f in enumerate(fingers)},
-                       {f: normals[k, :2].copy() for k, f in enumerate(fingers)}, (), (), depth)
+    ns, fingers, *vectors, depth = read
+    positions, forces, normals = (dict(zip(fingers, v[:, :2].copy())) for v in vectors)
+    return Observation(ns, positions, forces, normals, (), (), depth)
 
 
 def _planar(vectors: Sequence[Vector3]) -> np.ndarray:

@@ -24,7 +24,13 @@ from squeeze_grasp_ros.control.tracker import (
     TrackerOutput,
 )
 from squeeze_grasp_ros.mechanics.vocabulary import EventType, Finger
-from squeeze_grasp_ros.ros.messages.cdr import CdrWriter, write_contact_arrays
+from squeeze_grasp_ros.ros.messages.cdr import (
+    CdrTemplate,
+    CdrWriter,
+    refilled,
+    write_contact_arrays,
+    write_finger_vectors,
+)
 from squeeze_grasp_ros.ros.messages.common import float64_array, header, set_stamp
 from squeeze_grasp_ros.ros.messages.contacts import CONTACT_MODES, fill_contact_arrays
 
@@ -124,14 +130,19 @@ def patches_state_cdr(out: TrackerOutput, frame_id: str) -> bytes:
     """:func:`patches_state_msg`'s message, serialised (:mod:`.cdr`)."""
     patches = out.patches
     trig = [(math.cos(p.angle), math.sin(p.angle)) for p in patches]
-    writer = CdrWriter()
-    write_contact_arrays(writer, out.stamp_ns, frame_id, [p.finger for p in patches],
-                         [-1] * len(patches), [p.angle for p in patches],
-                         [CONTACT_MODES[p.mode] for p in patches],
-                         [p.normal * c - p.tangential * s for p, (c, s) in zip(patches, trig)],
-                         [p.normal * s + p.tangential * c for p, (c, s) in zip(patches, trig)],
-                         out.depth, out.relative_depth)
-    return writer.data()
+    values = ([p.angle for p in patches],
+              [p.normal * c - p.tangential * s for p, (c, s) in zip(patches, trig)],
+              [p.normal * s + p.tangential * c for p, (c, s) in zip(patches, trig)],
+              out.depth, out.relative_depth)
+
+    def write() -> CdrTemplate:
+        writer = CdrWriter()
+        stamp, runs = write_contact_arrays(
+            writer, out.stamp_ns, frame_id, [p.finger for p in patches], [-1] * len(patches),
+            values[0], [CONTACT_MODES[p.mode] for p in patches], *values[1:])
+        return CdrTemplate(writer, (stamp,), runs)
+    return refilled(("patches", frame_id, *((p.finger, p.mode) for p in patches)), write,
+                    out.stamp_ns, values)
 
 
 def monitor_status_cdr(out: TrackerOutput, frame_id: str) -> bytes:
@@ -139,34 +150,35 @@ def monitor_status_cdr(out: TrackerOutput, frame_id: str) -> bytes:
     publishes every tick.
     """
     ns, fingers = out.stamp_ns, out.fingers
-    writer = CdrWriter()
-    writer.header(ns, frame_id)
-    writer.strings(fingers)
     positions = [out.positions.get(f) for f in fingers]
-    for values in ([(0.0, 0.0, 0.0) if xy is None else (xy[0], xy[1], 0.0) for xy in positions],
-                   [(*out.forces[f][:2], 0.0) for f in fingers],
-                   [(*out.normals[f][:2], 0.0) for f in fingers]):
-        writer.uint32(len(fingers))
-        writer.float64s(values)
-    writer.sequence([min(out.ages[f], UNSEEN_AGE) for f in fingers])
-    writer.float64(out.depth)
-    writer.float64(out.relative_depth)
-    writer.uint32(len(out.events))
-    for event in out.events:
-        writer.header(ns)
-        writer.string(str(event.type))
-        writer.int32(-1)
-        writer.string(event.finger)
-        writer.float64(event.depth)
-        writer.float64(event.relative_depth)
-    writer.uint32(len(out.alarms))
-    for alarm in out.alarms:
-        writer.header(ns)
-        writer.string(alarm.type)
-        writer.string(alarm.finger)
-        writer.float64(alarm.value)
-        writer.string(alarm.message)
-    return writer.data()
+    values = ([(0.0, 0.0, 0.0) if xy is None else (xy[0], xy[1], 0.0) for xy in positions],
+              [(*out.forces[f][:2], 0.0) for f in fingers],
+              [(*out.normals[f][:2], 0.0) for f in fingers],
+              [min(out.ages[f], UNSEEN_AGE) for f in fingers], out.depth, out.relative_depth)
+
+    def write() -> CdrTemplate:
+        writer = CdrWriter()
+        stamp, runs = write_finger_vectors(writer, ns, frame_id, fingers, values[:3], values[3])
+        runs += [(writer.float64(out.depth), 1), (writer.float64(out.relative_depth), 1)]
+        writer.uint32(len(out.events))
+        for event in out.events:
+            writer.header(ns)
+            writer.string(str(event.type))
+            writer.int32(-1)
+            writer.string(event.finger)
+            writer.float64(event.depth)
+            writer.float64(event.relative_depth)
+        writer.uint32(len(out.alarms))
+        for alarm in out.alarms:
+            writer.header(ns)
+            writer.string(alarm.type)
+            writer.string(alarm.finger)
+            writer.float64(alarm.value)
+            writer.string(alarm.message)
+        return CdrTemplate(writer, (stamp,), runs)
+    if out.events or out.alarms:
+        return bytes(write().buffer)
+    return refilled(("status", frame_id, *fingers), write, ns, values)
 
 
 def force_residual_cdr(ns: int, frame_id: str, depth: float, fingers: Sequence[str],
@@ -175,14 +187,17 @@ def force_residual_cdr(ns: int, frame_id: str, depth: float, fingers: Sequence[s
     """A ``squeeze_grasp_interfaces/ForceResidual`` (depth m, forces N, per finger in
     ``fingers``' order), serialised (:mod:`.cdr`): the force watch's message of a tick.
     """
-    writer = CdrWriter()
-    writer.header(ns, frame_id)
-    writer.float64(depth)
-    writer.strings(fingers)
-    for values in (measured, predicted, relative_error):
-        writer.sequence(values)
-    writer.float64(tolerance)
-    return writer.data()
+    values = (depth, measured, predicted, relative_error, tolerance)
+
+    def write() -> CdrTemplate:
+        writer = CdrWriter()
+        stamp = writer.header(ns, frame_id)
+        runs = [(writer.float64(depth), 1)]
+        writer.strings(fingers)
+        runs += [(writer.sequence(v), len(fingers)) for v in values[1:4]]
+        runs.append((writer.float64(tolerance), 1))
+        return CdrTemplate(writer, (stamp,), runs)
+    return refilled(("residual", frame_id, *fingers), write, ns, values)
 
 
 def prediction_msg(

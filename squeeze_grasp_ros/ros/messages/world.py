@@ -3,6 +3,7 @@
 """The simulated world's ground truth and its markers."""
 from __future__ import annotations
 
+import functools
 from collections.abc import Sequence
 
 import numpy as np
@@ -17,7 +18,13 @@ from squeeze_grasp_interfaces.msg import (
 )
 from squeeze_grasp_ros.mechanics.squeeze import contact_state
 from squeeze_grasp_ros.mechanics.vocabulary import ContactMode
-from squeeze_grasp_ros.ros.messages.cdr import CdrWriter, write_contact_arrays
+from squeeze_grasp_ros.ros.messages.cdr import (
+    CdrTemplate,
+    CdrWriter,
+    refilled,
+    write_contact_arrays,
+    write_finger_vectors,
+)
 from squeeze_grasp_ros.ros.messages.common import float64_array, header, set_stamp, stamp_ns
 from squeeze_grasp_ros.ros.messages.contacts import (
     CONTACT_MODES,
@@ -77,24 +84,36 @@ def sim_state_cdr(
     publishes every tick, without a Python message in between.
     """
     present = {f.name: f for f in state.fingers}
-    rows = [(c.finger, c.node, c.theta, CONTACT_MODES[c.mode], c.force) for c in state.contacts]
-    names, nodes, angles, modes, forces = zip(*rows) if rows else ((),) * 5
-    forces = np.reshape(forces, (len(rows), 2))
-    totals = [forces[[name == f for name in names]].sum(axis=0) if f in names else (0.0, 0.0)
-              for f in fingers]
-    writer = CdrWriter()
-    writer.header(ns, frame_id)
-    writer.strings(fingers)
-    for values in ([(*present[f].center[:2], 0.0) if f in present else (0.0, 0.0, 0.0)
-                    for f in fingers],
-                   [(x, y, 0.0) for x, y in totals]):
-        writer.uint32(len(fingers))
-        writer.float64s(values)
-    writer.sequence([present[f].work if f in present else 0.0 for f in fingers])
-    write_contact_arrays(writer, ns, frame_id, names, nodes, angles, modes, forces[:, 0],
-                         forces[:, 1], state.depth, state.relative_depth)
-    writer.string(termination or "")
-    return writer.data()
+    contacts = state.contacts
+    layout = tuple((c.finger, c.node, c.mode) for c in contacts)
+    forces = np.array([c.force for c in contacts]).reshape(len(contacts), 2)
+    names = tuple(c.finger for c in contacts)
+    totals = [forces[rows].sum(axis=0) if rows is not None else (0.0, 0.0)
+              for rows in _finger_rows(names, tuple(fingers))]
+    values = ([(*present[f].center[:2], 0.0) if f in present else (0.0, 0.0, 0.0)
+               for f in fingers],
+              [(x, y, 0.0) for x, y in totals],
+              [present[f].work if f in present else 0.0 for f in fingers],
+              [c.theta for c in contacts], forces[:, 0], forces[:, 1],
+              state.depth, state.relative_depth)
+
+    def write() -> CdrTemplate:
+        writer = CdrWriter()
+        stamp, runs = write_finger_vectors(writer, ns, frame_id, fingers, values[:2], values[2])
+        nested = write_contact_arrays(writer, ns, frame_id, names, [c.node for c in contacts],
+                                      values[3], [CONTACT_MODES[c.mode] for c in contacts],
+                                      values[4], values[5], values[6], values[7])
+        writer.string(termination or "")
+        return CdrTemplate(writer, (stamp, nested[0]), runs + nested[1])
+    return refilled(("sim_state", frame_id, tuple(fingers), tuple(present), layout,
+                     termination or ""), write, ns, values)
+
+
+@functools.lru_cache(maxsize=64)
+def _finger_rows(names: tuple[str, ...], fingers: tuple[str, ...]) -> list[np.ndarray | None]:
+    """Each finger's rows among contacts of fingers ``names`` (None: it has none)."""
+    return [np.flatnonzero([name == f for name in names]) if f in names else None
+            for f in fingers]
 
 
 def sim_events_msg(

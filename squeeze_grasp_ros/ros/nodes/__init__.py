@@ -8,10 +8,12 @@ import os
 import signal
 import sys
 import threading
+import time
 from collections.abc import Callable
 from pathlib import Path
 
 import rclpy
+from rclpy.duration import Duration
 from rclpy.executors import Executor, ExternalShutdownException
 from rclpy.experimental import EventsExecutor
 from rclpy.impl.implementation_singleton import rclpy_implementation
@@ -67,6 +69,31 @@ class ParameterError(InvalidInputError):
     """A node parameter is missing or invalid; the message names it."""
 
 
+ACK_TIMEOUT = 5.0
+"""s of wall time a node waits at its end for its readers to acknowledge what it published
+(longer than Fast DDS's default heartbeat period of 3 s, which paces the repair of a lost
+message)."""
+
+
+def wait_acknowledged(node: Node, timeout: float = ACK_TIMEOUT) -> list[str]:
+    """Before a node ends: wait until every reliable reader has acknowledged every message
+    of each of ``node``'s publishers, at most ``timeout`` s of wall time in all.
+
+    A message lost on its way to another process is sent again only after its writer's next
+    heartbeat, and a reliable reader delivers nothing of that writer after the gap until then:
+    a reader stopped before that repair (the recorder at the end of a run) never receives the
+    messages of the run's last seconds. Returns the topics not acknowledged in time (each
+    logged as a warning).
+    """
+    deadline = time.monotonic() + timeout
+    late = [p.topic_name for p in node.publishers
+            if not p.wait_for_all_acked(Duration(seconds=max(deadline - time.monotonic(), 0.0)))]
+    for topic in late:
+        node.get_logger().warning(f"{topic}: not acknowledged by every reader within "
+                                  f"{timeout:g} s")
+    return late
+
+
 def run_node(factory: Callable[[], Node], args: list[str] | None = None,
              executor_type: Callable[[], Executor] = EventsExecutor) -> int:
     """A node's ``main``: init rclpy, spin the node in the main thread until SIGINT, SIGTERM or
@@ -78,7 +105,9 @@ def run_node(factory: Callable[[], Node], args: list[str] | None = None,
     once a node has a timer (measured: no callback runs, no other thread gets the GIL) and does
     not return after shutdown. SIGINT (Ctrl-C, also what ``ros2 launch`` sends first) and
     SIGTERM only set a flag, so no callback is interrupted halfway; the loop then ends, a node
-    with ``drain(executor)`` processes what has already arrived, its ``close()`` is called, and
+    with ``drain(executor)`` processes what has already arrived, the node waits until its readers
+    have acknowledged what it published (:func:`wait_acknowledged`; not a node whose
+    ``acknowledged_at_end`` is False), its ``close()`` is called, and
     the node is destroyed (the planner joins its workers there). A node started by a run ends
     the same way when that process dies (:func:`parent_watch`), and removes the run's
     parameter file.
@@ -131,6 +160,8 @@ def run_node(factory: Callable[[], Node], args: list[str] | None = None,
                 Path(params).unlink(missing_ok=True)
         if (stop.is_set() or orphaned()) and hasattr(node, "drain"):
             node.drain(executor)
+        if getattr(node, "acknowledged_at_end", True):
+            wait_acknowledged(node)
     except ExternalShutdownException:
         pass
     finally:

@@ -19,26 +19,34 @@ message can differ.)
 
 In lockstep it takes part in the start-up handshake and reports on ``recorder/progress`` the
 newest tick it has written, every ``progress_every`` ticks, so ``sim_hardware`` never runs more
-than its ``recorder_window`` ahead (no message is lost to a full history); a wall-clock timer
+than its ``recorder_window`` ahead (what a stalled recorder process has not taken yet stays
+within what the middleware holds for it, docs/pipeline.md); a wall-clock timer
 repeats the newest tick 20 times a second, so the report of the last tick of a run arrives even
 if one copy is lost. On Ctrl-C / SIGINT it first writes what has
 already arrived, then ``close`` writes the MCAP summary and ``metadata.yaml``.
+
+A message the middleware reports lost (``message_lost``: a reliable writer gave up a message
+before this reader received it, its history having moved on, or a message sent before the
+writer matched this reader) is counted per topic, logged as an error at the end and listed in
+``metadata.yaml`` under ``custom_data.messages_lost`` (:data:`..recording.bag.LOST_KEY`), so a
+recording with a gap says so.
 """
 from __future__ import annotations
 
 import sys
 import time
-from collections import deque
+from collections import Counter, deque
 from typing import Any
 
 import yaml
+from rclpy.event_handler import QoSMessageLostInfo, SubscriptionEventCallbacks
 from rclpy.node import Node
 from rclpy.qos import DurabilityPolicy, HistoryPolicy, ReliabilityPolicy
 from std_msgs.msg import Header
 
 from squeeze_grasp_ros.ros import messages
 from squeeze_grasp_ros.ros.nodes import ParameterError, pipeline, run_node
-from squeeze_grasp_ros.ros.recording.bag import BagWriter, qos_dict
+from squeeze_grasp_ros.ros.recording.bag import LOST_KEY, BagWriter, qos_dict
 from squeeze_grasp_ros.ros.recording.schema import starts_with_stamp
 
 PARAMETERS: dict[str, tuple[Any, str]] = {
@@ -59,7 +67,7 @@ PARAMETERS: dict[str, tuple[Any, str]] = {
     "chunk_size": (262144, "uncompressed chunk size written out when full, bytes"),
     "custom_data": ("{}", "YAML mapping of strings stored in metadata.yaml custom_data"),
     "lockstep": (True, "take part in the start-up handshake and report progress"),
-    "progress_every": (10, "ticks between recorder/progress reports"),
+    "progress_every": (5, "ticks between recorder/progress reports"),
     "sensor_qos": ("reliable", "QoS of the readings: reliable (lockstep) or sensor_data"),
     "qos_depth": (1000, "history depth of the subscriptions"),
 }
@@ -79,6 +87,11 @@ POLICY_NAMES = {
 
 class RecorderNode(Node):
     """Raw-subscription recorder writing a rosbag2 MCAP bag."""
+
+    acknowledged_at_end = False
+    """Its one publication, ``recorder/progress``, is flow control nobody needs once it ends:
+    :func:`..nodes.run_node` does not wait for its readers (a wait ends only at the writer's
+    next heartbeat, up to 3 s)."""
 
     def __init__(self, **kwargs: Any) -> None:
         super().__init__("recorder", **kwargs)
@@ -109,6 +122,8 @@ class RecorderNode(Node):
         self.recent = {name: deque(maxlen=DUPLICATE_WINDOW) for name in self.unique}
         self.duplicates = 0
         self.written = 0
+        self.lost: Counter[str] = Counter()
+        """Recorded topic -> messages the middleware reported lost on its way here."""
         self.ticks = 0
         self.newest_tick_ns = -1
         self.reported_ns = -1
@@ -128,8 +143,11 @@ class RecorderNode(Node):
                    else pipeline.sensor_qos(p["sensor_qos"], p["qos_depth"], kept=name in kept)
                    if name in sensors
                    else pipeline.loop_qos(p["qos_depth"], kept=name in kept))
-            self.create_subscription(pipeline.message_type(type_name), self.sources[name],
-                                     lambda data, n=name: self._record(n, data), qos, raw=True)
+            self.create_subscription(
+                pipeline.message_type(type_name), self.sources[name],
+                lambda data, n=name: self._record(n, data), qos, raw=True,
+                event_callbacks=SubscriptionEventCallbacks(
+                    message_lost=lambda info, n=name: self._lost(n, info)))
         self.progress_pub = self.create_publisher(Header, pipeline.RECORDER_PROGRESS,
                                                   pipeline.loop_qos(10))
         if p["lockstep"]:
@@ -176,6 +194,9 @@ class RecorderNode(Node):
             if self.ticks % self.p["progress_every"] == 0:
                 self._report()
 
+    def _lost(self, topic: str, info: QoSMessageLostInfo) -> None:
+        self.lost[topic] += info.total_count_change
+
     def _report(self) -> None:
         """Publish the newest tick written, if not reported yet."""
         if self.newest_tick_ns > self.reported_ns:
@@ -204,8 +225,20 @@ class RecorderNode(Node):
                 return
 
     def close(self) -> None:
-        """Finish the recording (summary and metadata.yaml); safe to call twice."""
+        """Finish the recording (summary and metadata.yaml, with the messages reported lost);
+        safe to call twice.
+        """
+        if self.lost and not self.writer.closed:
+            self.writer.custom_data[LOST_KEY] = lost_text(self.lost)
+            self.get_logger().error(f"{self.p['output']} misses messages the middleware "
+                                    f"reported lost: {lost_text(self.lost)}")
         self.writer.close()
+
+
+def lost_text(lost: Counter[str]) -> str:
+    """``{topic: count, ...}`` (YAML flow mapping, by topic) of the messages lost."""
+    return yaml.safe_dump(dict(sorted(lost.items())), default_flow_style=True,
+                          width=1 << 16).strip()
 
 
 def main(args: list[str] | None = None) -> int:

@@ -29,7 +29,6 @@ import time
 from typing import Any
 
 from geometry_msgs.msg import PoseStamped, WrenchStamped
-from rclpy.duration import Duration
 from rclpy.node import Node
 from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import CameraInfo, Image
@@ -60,7 +59,7 @@ PARAMETERS: dict[str, tuple[Any, str]] = {
     "participants": (["monitor", "executor"], "nodes whose sim/ready starts tick 0"),
     "handshake_period": (0.05, "wall-clock seconds between start-up hellos"),
     "resend_timeout": (1.0, "wall-clock seconds without progress before a tick is re-sent"),
-    "recorder_window": (50, "ticks the recorder may lag behind (if 'recorder' participates)"),
+    "recorder_window": (20, "ticks the recorder may lag behind (if 'recorder' participates)"),
 }
 """Parameter name -> (typed default, description); config/sim_hardware.yaml sets them."""
 
@@ -91,6 +90,10 @@ class SimHardwareNode(Node):
         kept = pipeline.loop_qos(self.p["qos_depth"], kept=True)
         kept_sensors = pipeline.sensor_qos(self.p["sensor_qos"], self.p["qos_depth"], kept=True)
         self.devices = {f: world.devices[f].name for f in world.fingers}
+        self.labels = {f: (f"{d}/pose", f"{d}/wrench", f"{d}/tactile", f"{f}_tip")
+                       for f, d in self.devices.items()}
+        """Finger -> its readings' names in ``sim/tick`` (pose, wrench, tactile) and its
+        sensors' frame."""
         pub = self.create_publisher
         self.clock_pub = pub(Clock, pipeline.CLOCK, loop)
         self.pose_pubs = {f: pub(PoseStamped, pipeline.device_topic(d, "pose"),
@@ -189,19 +192,19 @@ class SimHardwareNode(Node):
         batch = [(self.clock_pub, messages.clock_cdr(ns))]
         readings = []
         for r in out.readings:
-            device, tip = self.devices[r.finger], f"{r.finger}_tip"
+            pose, wrench, tactile, tip = self.labels[r.finger]
             batch.append((self.pose_pubs[r.finger],
                           messages.pose_stamped_cdr(r.position, ns, frame)))
-            readings.append(f"{device}/pose")
+            readings.append(pose)
             if r.force is not None:
                 batch.append((self.wrench_pubs[r.finger],
                               messages.wrench_stamped_cdr(r.force, r.torque, ns, tip)))
-                readings.append(f"{device}/wrench")
+                readings.append(wrench)
             if r.normal is not None:
                 batch.append((self.tactile_pubs[r.finger], messages.tactile_array_cdr(
                     messages.TactileReadings(r.finger, self.world.layouts[r.finger].angles,
                                              r.normal, r.tangential), ns, tip)))
-                readings.append(f"{device}/tactile")
+                readings.append(tactile)
         ending = out.termination is not None and not self.ended
         self.ended = (self.ended or ending) and not out.released
         if out.events or ending or out.released:
@@ -226,22 +229,6 @@ class SimHardwareNode(Node):
         for publisher, msg in batch + [tick]:
             publisher.publish(msg)
 
-    def close(self) -> None:
-        """Before the process ends: wait until every reader has acknowledged the camera frames
-        (at most :data:`CAMERA_ACK_TIMEOUT` s of wall time per topic).
-
-        A large image crosses processes in fragments, and a lost fragment is sent again only
-        after the middleware's next heartbeat (seconds): a frame shortly before the run's end
-        was then never delivered, and the recorder and the shape watch lost the last masks of
-        ``run --processes`` in about a third of the runs. ``run`` stops this node first and
-        the readers after it (:meth:`..run.processes.NodeProcesses.stop_all`), so they still
-        take the frames while this waits.
-        """
-        for topic, publisher in self.camera_pubs.items():
-            if not publisher.wait_for_all_acked(Duration(seconds=CAMERA_ACK_TIMEOUT)):
-                self.get_logger().warning(f"{topic}: the last frames were not acknowledged by "
-                                          f"every reader within {CAMERA_ACK_TIMEOUT:g} s")
-
     def _display_due(self, index: int) -> bool:
         rate = self.p["display_rate"]
         if rate <= 0.0:
@@ -257,11 +244,6 @@ class SimHardwareNode(Node):
             for publisher, msg in self.current:
                 publisher.publish(msg)
 
-
-CAMERA_ACK_TIMEOUT = 5.0
-"""s of wall time the world waits at its end for the readers of its camera frames to
-acknowledge them (longer than the middleware's heartbeat period, which paces the repair of a
-lost fragment)."""
 
 CONTROLLER_NAMES = {ControllerKind.JOINT_TRAJECTORY: "JointTrajectoryController",
                     ControllerKind.GRIPPER_ACTION: "GripperActionController",

@@ -63,6 +63,9 @@ RESERVE_BYTES = 256 * 1024
 RESERVE_NAME = ".space_reserve"
 STOPPED_KEY = "recording_stopped"
 """``custom_data`` key of ``metadata.yaml`` saying why a recording ended early."""
+LOST_KEY = "messages_lost"
+"""``custom_data`` key of ``metadata.yaml`` listing, as a YAML mapping of topic to count, the
+messages its recorder never received that the middleware reported lost (absent: none)."""
 MAX_CHUNK_BYTES = 64 * 2**20
 """Largest chunk a reader decompresses (ours are 256 KiB, rosbag2's 768 KiB); checked on the
 chunk's declared size before decompressing, and on what decompression yields."""

@@ -15,11 +15,13 @@ from __future__ import annotations
 
 from typing import Any, Callable
 
+import numpy as np
 from geometry_msgs.msg import PoseStamped
 from sensor_msgs.msg import CameraInfo, Image
 
 from squeeze_grasp_interfaces.msg import ObjectDescription, PredictedShapes
-from squeeze_grasp_ros.mechanics.vocabulary import ShapeFit
+from squeeze_grasp_ros.control.tracker import mirror_tolerance_for
+from squeeze_grasp_ros.mechanics.vocabulary import Finger, ShapeFit
 from squeeze_grasp_ros.perception.extract import ObjectOutline, extract_outline
 from squeeze_grasp_ros.perception.shape_match import shape_residual
 from squeeze_grasp_ros.perception.shape_watch import predict_shapes
@@ -30,9 +32,10 @@ from squeeze_grasp_ros.ros.messages.images import camera_model, camera_pose, ima
 from squeeze_grasp_ros.ros.messages.objects import description_msg, polygon_msg
 from squeeze_grasp_ros.ros.nodes import pipeline
 from squeeze_grasp_ros.ros.run.options import RunError
-from squeeze_grasp_ros.scene import GraspSetup, Scene, build_outline
+from squeeze_grasp_ros.scene import GraspSetup, Scene, SensorsSpec, build_outline
 
-__all__ = ["first_outline", "predicted_shapes_msg", "seen_description", "seen_report"]
+__all__ = ["first_outline", "predicted_shapes_msg", "seen_description", "seen_mirror_tolerance",
+           "seen_report"]
 
 
 def first_outline(node: Any, spin_until: Callable[..., None], scene: Scene,
@@ -99,13 +102,38 @@ def seen_report(scene: Scene, seen: ObjectOutline) -> dict:
             "pixel_m": seen.pixel_size_m, "tolerance_m": seen.tolerance_m}
 
 
-def predicted_shapes_msg(scene: Scene, depth: float, ns: int,
-                         frame_id: str = pipeline.FRAME) -> PredictedShapes:
-    """The ``PredictedShapes`` of the planner's model (``scene``: the seen object's typed scene
-    on the camera route) squeezed to ``depth`` (m), for the monitor's shape watch: the outer
-    boundary and, depth-major, the holes.
+def seen_mirror_tolerance(model: GraspSetup, scene: Scene, seen: ObjectOutline) -> dict:
+    """The monitor's ``mirror_tolerance`` for a run planned from the camera
+    (:func:`~squeeze_grasp_ros.control.tracker.mirror_tolerance_for`): the planner's model
+    ``model`` (the seen object's typed scene, meshed) gives the boundary spacing h (median over
+    its outer loop), the extraction's stated tolerance the outline error e, ``scene`` the
+    fingertip radius (F1's: the typed route has one) and the taxel pitch.
+
+    Returns
+    -------
+    dict
+        ``value`` (fraction of a mirror pair's separation), and what it came from:
+        ``spacing_m``, ``outline_error_m``, ``tip_radius_m``, ``taxel_pitch_rad``.
     """
-    predicted = predict_shapes(GraspSetup.build(scene).precompute(), depth)
+    mesh = model.solid.mesh
+    loop = mesh.nodes[mesh.boundary]
+    spacing = float(np.median(np.linalg.norm(loop - np.roll(loop, 1, axis=0), axis=1)))
+    sensors = scene.sensors or SensorsSpec()
+    pitch = float(np.radians(sensors.taxel_span_deg) / (sensors.taxels - 1))
+    radius = float(scene.fingers[Finger.F1].tip_radius)
+    return {"value": mirror_tolerance_for(spacing, seen.tolerance_m, tip_radius=radius,
+                                          taxel_pitch=pitch),
+            "spacing_m": spacing, "outline_error_m": float(seen.tolerance_m),
+            "tip_radius_m": radius, "taxel_pitch_rad": pitch}
+
+
+def predicted_shapes_msg(model: GraspSetup, depth: float, ns: int,
+                         frame_id: str = pipeline.FRAME) -> PredictedShapes:
+    """The ``PredictedShapes`` of the planner's model (``model``: the seen object's typed scene
+    on the camera route, built and precomputed) squeezed to ``depth`` (m), for the monitor's
+    shape watch: the outer boundary and, depth-major, the holes.
+    """
+    predicted = predict_shapes(model, depth)
     return PredictedShapes(header=messages.header(ns, frame_id),
                            depths=[float(d) for d in predicted.depths],
                            outlines=[polygon_msg(o) for o in predicted.outlines],

@@ -100,9 +100,15 @@ class RunOptions:
 
 
 def node_parameters(
-    scene: Scene, scene_path: str, options: RunOptions, relative_per_depth: float
+    scene: Scene, scene_path: str, options: RunOptions, relative_per_depth: float, *,
+    mirror_tolerance: float | None = None
 ) -> dict[str, dict[str, Any]]:
-    """Parameters of every node: the config files, then the scene's values, then overrides."""
+    """Parameters of every node: the config files, then the scene's values, then overrides.
+
+    ``mirror_tolerance`` (a fraction, see ``tracker.mirror_tolerance_for``), when given, is the
+    monitor's: derived for an object the planner saw through the camera; None keeps the
+    configured default.
+    """
     params = {name: config_parameters(name) for name in NODES}
     devices = finger_devices(scene)
     mapping = [f"{f}:{d}" for f, d in devices.items()]
@@ -132,6 +138,8 @@ def node_parameters(
                        shape_min_force=max(float(monitor.get("shape_min_force", 0.05)),
                                            20.0 * noise),
                        object_height=float(scene.object.material.thickness))
+    if mirror_tolerance is not None:
+        monitor["mirror_tolerance"] = float(mirror_tolerance)
     controller_scene = str(Path(scene_path).resolve()) if scene.controller else ""
     monitor["controller_scene"] = controller_scene
     params["executor"].update(

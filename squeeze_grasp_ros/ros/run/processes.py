@@ -151,18 +151,20 @@ class NodeProcesses:
         """Stop every node (:data:`STOP_SIGNAL` to all, then wait for each; kill one that does
         not end within :data:`STOP_TIMEOUT`) and remove the parameter file.
 
-        The simulated hardware is stopped first and on its own: at its end it waits for its
-        readers to acknowledge its camera frames (``SimHardwareNode.close``), which they can
-        only do while they still run.
+        The simulated hardware is stopped first and on its own, then the other publishing
+        nodes, and the recorder last: at its end a node waits for its readers to acknowledge
+        every message it published (:func:`..nodes.wait_acknowledged`),
+        which they can only do while they still run.
         """
         if "sim_hardware" in self.running:
             self.stop("sim_hardware")
-        for proc in self.running.values():
-            if proc.poll() is None:
-                proc.send_signal(STOP_SIGNAL)
-        for proc in self.running.values():
-            _wait(proc)
-        self.running.clear()
+        for last in (False, True):
+            group = [self.running.pop(n) for n in list(self.running) if last or n != "recorder"]
+            for proc in group:
+                if proc.poll() is None:
+                    proc.send_signal(STOP_SIGNAL)
+            for proc in group:
+                _wait(proc)
         for params_file in self.params_files:
             params_file.unlink(missing_ok=True)
 

@@ -36,6 +36,7 @@ from pathlib import Path
 from typing import Any
 
 import rclpy
+import yaml
 from rclpy.context import Context
 from rclpy.executors import SingleThreadedExecutor
 from rclpy.experimental import EventsExecutor
@@ -59,6 +60,7 @@ from squeeze_grasp_ros.ros.run.camera_plan import (
     first_outline,
     predicted_shapes_msg,
     seen_description,
+    seen_mirror_tolerance,
     seen_report,
 )
 from squeeze_grasp_ros.ros.run.goal_client import GoalClient
@@ -81,7 +83,7 @@ from squeeze_grasp_ros.ros.run.planning import (
 )
 from squeeze_grasp_ros.ros.run.processes import NodeProcesses, ros_arguments
 from squeeze_grasp_ros.ros.run.summary import run_summary
-from squeeze_grasp_ros.scene import SceneError
+from squeeze_grasp_ros.scene import GraspSetup, SceneError
 
 __all__ = ["EVENTS_PER_CHECK", "STOP_SIGNALS", "PipelineRunner"]
 
@@ -149,6 +151,7 @@ class PipelineRunner:
         self.goal = GoalClient(self.client, self.observer.on_feedback)
         self.plan: Plan | None = None
         self.seen: ObjectOutline | None = None
+        self.mirror: dict | None = None  # the seen object's mirror tolerance, and its sources
         """The outline the camera's first frame showed (camera.plan_from_images)."""
         self.start_ns = 0
 
@@ -218,8 +221,13 @@ class PipelineRunner:
         self.prediction_pub.publish(self.plan.prediction)
         if self.scene.has(Effect.CAMERA):
             self._publish_predicted_shapes()
+        derived = None if self.mirror is None else self.mirror["value"]
         params = node_parameters(self.scene, options.scene_path, options,
-                                 self.plan.goal.relative_per_depth)
+                                 self.plan.goal.relative_per_depth, mirror_tolerance=derived)
+        if self.mirror is not None:  # what the monitor runs with (an override wins; attached:
+            # the running monitor keeps its own)
+            self.mirror["used"] = None if options.attach else float(
+                params["monitor"]["mirror_tolerance"])
         if not options.record:
             del params["recorder"]
         if self.sees_object:
@@ -258,7 +266,10 @@ class PipelineRunner:
         started = time.perf_counter()
         model = self.scene if self.seen is None else typed_scene(typed_object(
             seen_description(self.scene, self.seen))).scene
-        model = dataclasses.replace(model, squeeze=self.scene.squeeze)
+        model = GraspSetup.build(dataclasses.replace(model, squeeze=self.scene.squeeze))
+        model = model.precompute()
+        if self.seen is not None:
+            self.mirror = seen_mirror_tolerance(model, self.scene, self.seen)
         msg = predicted_shapes_msg(model, self.plan.goal.depth, 0)
         self.client.create_publisher(PredictedShapes, pipeline.PREDICTED_SHAPES,
                                      pipeline.LATCHED).publish(msg)
@@ -392,26 +403,38 @@ class PipelineRunner:
             self.executor.shutdown()
             self.context.try_shutdown()
 
-    def recording_stopped(self) -> str | None:
-        """Why the finished run's recording stopped early (a full disk), or None: as the
-        recorder node reports it in this process, or, for a recorder process, as it wrote it
-        into the bag it finished.
+    def recording_defects(self) -> dict:
+        """What is wrong with the finished run's recording: ``recording_stopped``, why it
+        stopped early (a full disk), and ``recording_lost``, the messages per topic the
+        middleware reported lost on their way to the recorder; as the recorder node reports
+        them in this process, or, for a recorder process, as it wrote them into the bag it
+        finished. Empty when the recording is complete (or there is none).
         """
         if not self.options.record:
-            return None
+            return {}
         if self.recorder is not None:
-            return self.recorder.writer.stopped
-        from squeeze_grasp_ros.ros.recording.bag import STOPPED_KEY, BagError, bag_info
+            stopped, lost = self.recorder.writer.stopped, dict(self.recorder.lost)
+        else:
+            from squeeze_grasp_ros.ros.recording.bag import (
+                LOST_KEY,
+                STOPPED_KEY,
+                BagError,
+                bag_info,
+            )
 
-        try:
-            return bag_info(self.options.record).get("custom_data", {}).get(STOPPED_KEY)
-        except BagError as exc:
-            return f"the recording is not readable: {exc}"
+            try:
+                custom = bag_info(self.options.record).get("custom_data", {})
+            except BagError as exc:
+                return {"recording_stopped": f"the recording is not readable: {exc}"}
+            stopped, lost = custom.get(STOPPED_KEY), yaml.safe_load(custom.get(LOST_KEY, "{}"))
+        return {**({"recording_stopped": stopped} if stopped is not None else {}),
+                **({"recording_lost": lost} if lost else {})}
 
     # ----------------------------------------------------------------- the whole run
     def run(self) -> dict:
         """Start, execute the goal, shut down; returns the JSON summary, with
-        ``recording_stopped`` if the recording stopped early.
+        ``recording_stopped`` if the recording stopped early and ``recording_lost`` if it
+        misses messages (:meth:`recording_defects`).
 
         SIGINT (Ctrl-C), SIGTERM and SIGHUP set a flag that the waiting loop turns into
         :class:`Interrupted` between callbacks, so no callback (a recorder write) is cut in half;
@@ -437,10 +460,7 @@ class PipelineRunner:
             finally:
                 for signum, handler in previous.items():
                     signal.signal(signum, handler)
-        stopped = self.recording_stopped()
-        if stopped is not None:
-            summary["recording_stopped"] = stopped
-        return summary
+        return {**summary, **self.recording_defects()}
 
     def summary(self, result: ExecuteGrasp.Result) -> dict:
         """JSON-able summary of a finished goal (:func:`.summary.run_summary`)."""
@@ -449,7 +469,8 @@ class PipelineRunner:
                               observed=self.observer.observed(), result=result,
                               recording=self.options.record, timing=timing),
                 "namespace": self.namespace,
-                **({"seen_outline": seen_report(self.scene, self.seen)} if self.seen else {})}
+                **({"seen_outline": {**seen_report(self.scene, self.seen),
+                                     "mirror_tolerance": self.mirror}} if self.seen else {})}
 
     def _node_timing(self) -> dict:
         """Wall and CPU time of the stepper (``mechanics``) and of whole world ticks (``world``:

@@ -84,28 +84,32 @@ CANDIDATE_TURN_DEG = 10.0
 tip may spread its turn over several vertices."""
 
 
-def _stretch_fits(p: np.ndarray, gaps: np.ndarray, starts: np.ndarray, lengths: np.ndarray,
+def _stretch_fits(p: np.ndarray, gaps: np.ndarray, starts: np.ndarray, span: float,
                   tolerance: float) -> dict[str, np.ndarray]:
-    """The traced stretches beside every corner candidate, and the total-least-squares line and
-    the circle fitted to each, all at once.
+    """The traced stretches beside every corner candidate, and the total-least-squares line
+    fitted to each and the circle fitted to those a line-arc corner reads, all at once.
 
     Stretch (c, i, s, j) holds the traced points whose signed arc length from candidate c's
     vertex, times -1 before it (s = 0) and +1 after it (s = 1), lies in [``starts[i]``,
-    ``starts[i] + lengths[j]``], in the trace's order (``gaps``: (C, n) signed arc lengths).
-    The circle is scikit-image ``CircleModel``'s algebraic fit (:func:`~.primitives.fit_circle`:
-    data centred and scaled to unit spread, least squares on [2x, 2y, 1] -> x^2 + y^2, the
-    radius the RMS distance to the centre), solved here by its 3 x 3 normal equations for all
-    stretches at once.
+    ``starts[i] + STRETCH_SPANS[j] * span``], in the trace's order (``gaps``: (C, n) signed arc
+    lengths). The circle is scikit-image ``CircleModel``'s algebraic fit
+    (:func:`~.primitives.fit_circle`: data centred and scaled to unit spread, least squares on
+    [2x, 2y, 1] -> x^2 + y^2, the radius the RMS distance to the centre), solved here by its
+    3 x 3 normal equations for all stretches at once; it is fitted only where
+    :func:`_arc_side` asks for it (a stretch of :data:`SIDE_SPANS` with at least 3 points, not
+    straight, the other side straight over :data:`LINE_BESIDE_ARC` spans), the others are
+    not circular.
 
     Returns
     -------
     dict
         ``points`` (m, 2): the stretches' points one after the other; per stretch, shaped
         (C, I, 2, J): ``first`` and ``count`` (where it starts in ``points``, how many),
-        ``straight`` (every point within ``tolerance`` of its line), ``circular`` (at least 3
-        points, a circle fitted, every point within ``tolerance`` of it), ``radius``; and
+        ``straight`` (every point within ``tolerance`` of its line), ``circular`` (fitted, at
+        least 3 points, every point within ``tolerance`` of its circle), ``radius``; and
         (C, I, 2, J, 2): ``centre``, ``direction`` (the line's), ``centre_of_circle``.
     """
+    lengths = np.array(STRETCH_SPANS) * span
     side = np.stack([-gaps, gaps], axis=1)[:, None, :, None, :]  # (C, 1, 2, 1, n)
     lo = starts[None, :, None, None, None]
     inside = (side >= lo) & (side <= lo + lengths[None, None, None, :, None])
@@ -122,49 +126,71 @@ def _stretch_fits(p: np.ndarray, gaps: np.ndarray, starts: np.ndarray, lengths: 
     used = count > 0
     at, size = first[used], count[used]
     if len(at):
-        def sums(values: np.ndarray) -> np.ndarray:
-            return np.add.reduceat(values, at, axis=0)
-
-        def each(values: np.ndarray) -> np.ndarray:
-            return np.repeat(values, size, axis=0)
-
-        mean = sums(points) / size[:, None]
-        d = points - each(mean)
-        sxx, syy, sxy = sums(d[:, 0] * d[:, 0]), sums(d[:, 1] * d[:, 1]), sums(d[:, 0] * d[:, 1])
+        mean = np.add.reduceat(points, at, axis=0) / size[:, None]
+        d = points - np.repeat(mean, size, axis=0)
+        sxx, syy, sxy = (np.add.reduceat(d[:, 0] * d[:, 0], at),
+                         np.add.reduceat(d[:, 1] * d[:, 1], at),
+                         np.add.reduceat(d[:, 0] * d[:, 1], at))
         angle = 0.5 * np.arctan2(2.0 * sxy, sxx - syy)  # principal axis of the 2 x 2 scatter
         cos, sin = np.cos(angle), np.sin(angle)
-        off = np.abs(each(cos) * d[:, 1] - each(sin) * d[:, 0])
+        off = np.abs(np.repeat(cos, size) * d[:, 1] - np.repeat(sin, size) * d[:, 0])
         out["centre"][used], out["direction"][used] = mean, np.column_stack([cos, sin])
         out["straight"][used] = np.maximum.reduceat(off, at) <= tolerance
-        # the circles, on the centred points scaled to unit spread (std over both columns)
-        scale = np.sqrt((sxx + syy) / (2 * size))
-        with np.errstate(divide="ignore", invalid="ignore"):
-            u = d / each(scale)[:, None]
-        f = np.sum(u * u, axis=1)
-        suu = sums(u[:, 0] * u[:, 1])
-        normal = np.empty((len(at), 3, 3))
-        normal[:, 0, 0], normal[:, 1, 1] = 4.0 * sums(u[:, 0] ** 2), 4.0 * sums(u[:, 1] ** 2)
-        normal[:, 0, 1] = normal[:, 1, 0] = 4.0 * suu
-        normal[:, :2, 2] = 2.0 * sums(u)
-        normal[:, 2, :2] = normal[:, :2, 2]
-        normal[:, 2, 2] = size
-        rhs = np.column_stack([2.0 * sums(u * f[:, None]), sums(f)])
-        # the design [2x, 2y, 1] has rank 3 (lstsq's test): away from a collinear or tiny set
-        fit = (size >= 3) & (scale >= np.finfo(float).tiny) & np.all(np.isfinite(normal),
-                                                                      axis=(1, 2))
-        fit[fit] &= np.abs(np.linalg.det(normal[fit])) > 1e-10 * size[fit] ** 3
-        solved = np.linalg.solve(np.where(fit[:, None, None], normal, np.eye(3)),
-                                 np.where(fit[:, None], rhs, 0.0)[..., None])[..., 0]
-        c = solved[:, :2]
-        with np.errstate(invalid="ignore"):
-            radius = np.sqrt(sums(np.sum((u - each(c)) ** 2, axis=1)) / size) * scale
-            centre = c * scale[:, None] + mean
-            stray = np.maximum.reduceat(np.abs(each(radius) - np.linalg.norm(
-                points - each(centre), axis=1)), at)
-            circular = fit & np.all(np.isfinite(centre), axis=1) & (stray <= tolerance)
-        out["centre_of_circle"][used], out["radius"][used] = centre, radius
-        out["circular"][used] = circular
+        straight = out["straight"].reshape(shape)
+        beside = straight[:, :, ::-1, STRETCH_SPANS.index(LINE_BESIDE_ARC), None]
+        arc = np.isin(STRETCH_SPANS, SIDE_SPANS) & beside & ~straight
+        wanted = np.flatnonzero((arc.ravel() & (count >= 3))[used])
+        if len(wanted):
+            _circle_fits(out, np.flatnonzero(used)[wanted], points, d, mean[wanted],
+                         sxx[wanted] + syy[wanted], tolerance)
     return {k: v if k == "points" else v.reshape(*shape, *v.shape[1:]) for k, v in out.items()}
+
+
+def _circle_fits(out: dict[str, np.ndarray], which: np.ndarray, points: np.ndarray,
+                 d: np.ndarray, mean: np.ndarray, spread: np.ndarray, tolerance: float) -> None:
+    """Fit the circles of stretches ``which`` (:func:`_stretch_fits`' flat stretch indices;
+    ``d`` their points centred on their ``mean``, ``spread`` the sums of squares of ``d``) and
+    write them into ``out``.
+    """
+    size = out["count"][which]
+    at = np.cumsum(size) - size
+    take = np.repeat(out["first"][which] - at, size) + np.arange(size.sum())
+    points, d = points[take], d[take]
+
+    def sums(values: np.ndarray) -> np.ndarray:
+        return np.add.reduceat(values, at, axis=0)
+
+    def each(values: np.ndarray) -> np.ndarray:
+        return np.repeat(values, size, axis=0)
+
+    # on the centred points scaled to unit spread (std over both columns)
+    scale = np.sqrt(spread / (2 * size))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        u = d / each(scale)[:, None]
+    f = np.sum(u * u, axis=1)
+    suu = sums(u[:, 0] * u[:, 1])
+    normal = np.empty((len(at), 3, 3))
+    normal[:, 0, 0], normal[:, 1, 1] = 4.0 * sums(u[:, 0] ** 2), 4.0 * sums(u[:, 1] ** 2)
+    normal[:, 0, 1] = normal[:, 1, 0] = 4.0 * suu
+    normal[:, :2, 2] = 2.0 * sums(u)
+    normal[:, 2, :2] = normal[:, :2, 2]
+    normal[:, 2, 2] = size
+    rhs = np.column_stack([2.0 * sums(u * f[:, None]), sums(f)])
+    # the design [2x, 2y, 1] has rank 3 (lstsq's test): away from a collinear or tiny set
+    fit = (size >= 3) & (scale >= np.finfo(float).tiny) & np.all(np.isfinite(normal),
+                                                                  axis=(1, 2))
+    fit[fit] &= np.abs(np.linalg.det(normal[fit])) > 1e-10 * size[fit] ** 3
+    solved = np.linalg.solve(np.where(fit[:, None, None], normal, np.eye(3)),
+                             np.where(fit[:, None], rhs, 0.0)[..., None])[..., 0]
+    c = solved[:, :2]
+    with np.errstate(invalid="ignore"):
+        radius = np.sqrt(sums(np.sum((u - each(c)) ** 2, axis=1)) / size) * scale
+        centre = c * scale[:, None] + mean
+        stray = np.maximum.reduceat(np.abs(each(radius) - np.linalg.norm(
+            points - each(centre), axis=1)), at)
+        circular = fit & np.all(np.isfinite(centre), axis=1) & (stray <= tolerance)
+    out["centre_of_circle"][which], out["radius"][which] = centre, radius
+    out["circular"][which] = circular
 
 
 SIDE_SPANS = (4.0, 2.0)
@@ -330,7 +356,7 @@ def sharpen_corners(points: np.ndarray, kept: np.ndarray, *, radius: float, span
     candidates = np.argsort(-turn)[:np.count_nonzero(turn > CANDIDATE_TURN_DEG)]
     skips = np.array([radius, 1.5 * radius, 2.25 * radius])  # acute tips are rounded farther
     gaps = (arc[None, :n] - arc[kept[candidates]][:, None] + 0.5 * total) % total - 0.5 * total
-    fits = _stretch_fits(p, gaps, skips, np.array(STRETCH_SPANS) * span, tolerance)
+    fits = _stretch_fits(p, gaps, skips, span, tolerance)
     for k, c in enumerate(candidates):
         if drop[c]:  # another vertex of the same corner was moved already
             continue

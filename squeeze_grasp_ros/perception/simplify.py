@@ -559,15 +559,15 @@ def smoothed_curve(points: np.ndarray, vertices: np.ndarray, corners: np.ndarray
         distance between samples, the clearance around corners and the trace's noise.
     """
     from scipy.interpolate import splev, splprep
-    from scipy.spatial import cKDTree
 
     p = np.asarray(points, float)
     n = len(p)
     corner_xy = np.asarray(vertices, float)[np.asarray(corners, bool)]
     fitted = np.ones(n, bool)
     if len(corner_xy):
-        fitted = np.linalg.norm(p[:, None] - corner_xy[None], axis=2).min(axis=1) >= clearance
-        at = cKDTree(p).query(corner_xy)[1]
+        distance = np.linalg.norm(p[:, None] - corner_xy[None], axis=2)  # (n, corners)
+        fitted = distance.min(axis=1) >= clearance
+        at = np.argmin(distance, axis=0)  # each corner's nearest traced point
         order = np.argsort(at)  # in the trace's order
         corner_xy, at = corner_xy[order], at[order]
 

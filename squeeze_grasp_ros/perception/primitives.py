@@ -25,6 +25,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from squeeze_grasp_ros.mechanics.vocabulary import ShapeType
+from squeeze_grasp_ros.perception.simplify import vector_lengths
 
 __all__ = ["Primitive", "ellipse_distance_bound", "ellipse_distances", "fit_circle", "fit_loop",
            "fitted_model", "recognise", "sampled", "scene_shape"]
@@ -104,7 +105,7 @@ def fit_loop(points: np.ndarray, tolerance: float) -> Primitive | None:
     p = np.asarray(points, float)
     circle = fit_circle(p)
     if circle is not None and np.all(np.isfinite(circle[0])):
-        worst = float(np.abs(circle[1] - np.linalg.norm(p - circle[0], axis=1)).max())
+        worst = float(np.abs(circle[1] - vector_lengths(p - circle[0])).max())
         if worst <= tolerance:
             return Primitive(ShapeType.DISK, circle[0], {"radius": circle[1]}, worst)
     ellipse = fitted_model(EllipseModel, p)

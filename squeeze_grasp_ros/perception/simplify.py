@@ -123,14 +123,25 @@ def _stretch_fits(p: np.ndarray, gaps: np.ndarray, starts: np.ndarray, span: flo
         (C, I, 2, J, 2): ``centre``, ``direction`` (the line's), ``centre_of_circle``.
     """
     lengths = np.array(STRETCH_SPANS) * span
-    side = np.stack([-gaps, gaps], axis=1)[:, None, :, None, :]  # (C, 1, 2, 1, n)
+    hi = starts[:, None] + lengths[None, :]
+    # the points any stretch of a side may hold (a few dozen of the n), in the trace's order
+    side = np.stack([-gaps, gaps], axis=1).reshape(-1, gaps.shape[1])  # (2 C, n)
+    near_row, near = np.nonzero((side >= starts.min()) & (side <= hi.max()))
+    held = np.bincount(near_row, minlength=len(side))
+    slot = np.arange(len(near)) - np.repeat(np.cumsum(held) - held, held)
+    window = np.zeros((len(side), max(int(held.max(initial=0)), 1)), int)
+    window[near_row, slot] = near
+    seen = np.full(window.shape, np.inf)
+    seen[near_row, slot] = side[near_row, near]
+    seen = seen.reshape(len(gaps), 1, 2, 1, window.shape[1])  # (C, 1, 2, 1, w)
     lo = starts[None, :, None, None, None]
-    inside = (side >= lo) & (side <= lo + lengths[None, None, None, :, None])
+    inside = (seen >= lo) & (seen <= hi[None, :, None, :, None])  # (C, I, 2, J, w)
     shape = inside.shape[:-1]
-    row, col = np.nonzero(inside.reshape(-1, gaps.shape[1]))  # row-major: the trace's order
+    row, at = np.nonzero(inside.reshape(-1, inside.shape[-1]))  # row-major: the trace's order
     count = np.bincount(row, minlength=int(np.prod(shape)))
     first = np.cumsum(count) - count
-    points = p[col]
+    sides = np.arange(len(gaps))[:, None, None, None] * 2 + np.arange(2)[None, None, :, None]
+    points = p[window[np.broadcast_to(sides, shape).ravel()[row], at]]
     out = {"points": points, "first": first, "count": count,
            **{k: np.full((len(count), 2), np.nan)
               for k in ("centre", "direction", "centre_of_circle")},

@@ -16,6 +16,8 @@ import copy
 import numpy as np
 import pytest
 import yaml
+from hypothesis import given, settings
+from hypothesis import strategies as st
 from perception_support import CAMERA, pose, skimage_or_skip, transformed
 from pipeline_support import run_scene
 
@@ -23,7 +25,11 @@ from squeeze_grasp_ros.mechanics.elastic import shapes
 from squeeze_grasp_ros.mechanics.errors import InvalidInputError
 from squeeze_grasp_ros.mechanics.vocabulary import ShapeType
 from squeeze_grasp_ros.perception.extract import PRIMITIVE_TOLERANCE_PX, extract_outline
-from squeeze_grasp_ros.perception.primitives import ellipse_distances, fit_circle
+from squeeze_grasp_ros.perception.primitives import (
+    ellipse_distance_bound,
+    ellipse_distances,
+    fit_circle,
+)
 from squeeze_grasp_ros.perception.render import render_views
 from squeeze_grasp_ros.planning.errors import PlannerError
 from squeeze_grasp_ros.planning.typed_objects import TypedMaterial, TypedObject, typed_scene
@@ -118,6 +124,26 @@ def test_ellipse_distances_match_two_independent_measures():
         mine = ellipse_distances(near_curve, np.asarray(model.center, float),
                                  *map(float, model.axis_lengths), float(model.theta))
         np.testing.assert_allclose(mine, reference, rtol=1e-6, atol=1e-9)  # leastsq xtol
+
+
+@settings(max_examples=300, deadline=None)
+@given(a=st.floats(0.05, 5.0), ratio=st.floats(0.02, 1.0), theta=st.floats(-4.0, 4.0),
+       seed=st.integers(0, 2**32 - 1))
+def test_ellipse_distance_bound_never_exceeds_the_largest_distance(a, ratio, theta, seed):
+    """The ellipse check refuses a curve from the lower bound alone, so it must be one: for
+    points k e (e on the ellipse; k near 1, where the check decides, or anywhere in [0, 3]) the
+    bound lies at or below the exact largest distance (Eberly's, checked above), and it is
+    tight within b / a: k e lies at most |k - 1| |e| <= |k - 1| a from the ellipse, the bound
+    is b |k - 1|.
+    """
+    rng = np.random.default_rng(seed)
+    b = a * ratio
+    k = np.where(rng.random(60) < 0.5, rng.uniform(0.9, 1.1, 60), rng.uniform(0.0, 3.0, 60))
+    points = _on_ellipse(rng.uniform(0.0, 2.0 * np.pi, 60), np.zeros(2), a, b, theta) * k[:, None]
+    bound = ellipse_distance_bound(points, np.zeros(2), a, b, theta)
+    exact = ellipse_distances(points, np.zeros(2), a, b, theta).max()
+    assert bound <= exact * (1.0 + 1e-12) + 1e-15
+    assert bound >= (b / a) * exact * (1.0 - 1e-9)
 
 
 def test_fit_circle_is_scikit_images_circle_estimate():

@@ -33,6 +33,7 @@ from squeeze_grasp_ros.perception.extract import (
     extract_outline,
 )
 from squeeze_grasp_ros.perception.primitives import (
+    ellipse_distance_bound,
     ellipse_distances,
     fit_circle,
     fitted_model,
@@ -304,7 +305,9 @@ def stage_rows(views, camera: CameraModel, pose: CameraPose, thickness: float) -
             pose, loop, thickness)),
         ("primitive check: circle and ellipse fits (recognise)",
          lambda: recognise(traced, [], PRIMITIVE_TOLERANCE_PX * pixel)),
-        ("  the ellipse's residuals: ellipse_distances",
+        ("  the bound that refuses a non-ellipse first: ellipse_distance_bound",
+         lambda: ellipse_distance_bound(traced, centre, a, b, float(ellipse.theta))),
+        ("  the ellipse's residuals (an ellipse passing the bound): ellipse_distances",
          lambda: ellipse_distances(traced, centre, a, b, float(ellipse.theta))),
         ("  the same, old path: skimage, one leastsq per point",
          lambda: _ellipse_residuals_per_point(traced)),

@@ -25,9 +25,10 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from squeeze_grasp_ros.mechanics.vocabulary import ShapeType
+from squeeze_grasp_ros.perception.simplify import vector_lengths
 
-__all__ = ["Primitive", "ellipse_distances", "fit_circle", "fit_loop", "fitted_model",
-           "recognise", "sampled", "scene_shape"]
+__all__ = ["Primitive", "ellipse_distance_bound", "ellipse_distances", "fit_circle", "fit_loop",
+           "fitted_model", "recognise", "sampled", "scene_shape"]
 
 CIRCLE_OVER_ELLIPSE = 1e-3
 """An ellipse whose axes differ by less than this fraction is reported as a circle."""
@@ -104,7 +105,7 @@ def fit_loop(points: np.ndarray, tolerance: float) -> Primitive | None:
     p = np.asarray(points, float)
     circle = fit_circle(p)
     if circle is not None and np.all(np.isfinite(circle[0])):
-        worst = float(np.abs(circle[1] - np.linalg.norm(p - circle[0], axis=1)).max())
+        worst = float(np.abs(circle[1] - vector_lengths(p - circle[0])).max())
         if worst <= tolerance:
             return Primitive(ShapeType.DISK, circle[0], {"radius": circle[1]}, worst)
     ellipse = fitted_model(EllipseModel, p)
@@ -112,6 +113,8 @@ def fit_loop(points: np.ndarray, tolerance: float) -> Primitive | None:
         return None
     a, b = (float(v) for v in ellipse.axis_lengths)
     theta = float(ellipse.theta)
+    if ellipse_distance_bound(p, np.asarray(ellipse.center, float), a, b, theta) > tolerance:
+        return None  # a point lies farther than that: the exact distances are not needed
     worst = float(ellipse_distances(p, np.asarray(ellipse.center, float), a, b, theta).max())
     if not worst <= tolerance:  # NaN (a degenerate fit) is no ellipse either
         return None
@@ -123,6 +126,28 @@ def fit_loop(points: np.ndarray, tolerance: float) -> Primitive | None:
                          {"radius": 0.5 * (a + b)}, worst)
     return Primitive(ShapeType.ELLIPSE, np.asarray(ellipse.center, float),
                      {"a": a, "b": b, "theta": theta}, worst)
+
+
+def ellipse_distance_bound(points: np.ndarray, centre: np.ndarray, a: float, b: float,
+                           theta: float) -> float:
+    """A lower bound on the largest distance of ``points`` (n, 2) from the ellipse of
+    :func:`ellipse_distances` (units of the points), from the ellipse's implicit norm alone.
+
+    The norm f(x) = |(x_a / a, x_b / b)| of a point's ellipse-frame coordinates is 1 on the
+    ellipse and changes by at most 1 / min(a, b) per unit length, so a point where it is f lies
+    at least min(a, b) |f - 1| from the ellipse. A curve that is no ellipse (a square's corners
+    stand 0.2 of its half side outside the fitted one) is refused from this at the cost of one
+    pass over the points, without :func:`ellipse_distances`' bisection.
+
+    >>> p = np.array([[3.0, 0.0], [0.0, 0.25]])  # 1 and 0.75 from the ellipse
+    >>> ellipse_distance_bound(p, np.zeros(2), 2.0, 1.0, 0.0)
+    0.75
+    """
+    c, s = np.cos(theta), np.sin(theta)
+    d = np.asarray(points, float) - centre
+    with np.errstate(divide="ignore", invalid="ignore"):  # a degenerate fit: NaN, no bound
+        norm = np.hypot((c * d[:, 0] + s * d[:, 1]) / a, (-s * d[:, 0] + c * d[:, 1]) / b)
+        return float(min(a, b) * np.abs(norm - 1.0).max(initial=0.0))
 
 
 ROOT_BISECTIONS = 160

@@ -193,7 +193,7 @@ def test_a_recorder_that_matches_late_still_gets_the_first_lockstep_messages(ros
 def test_a_monitor_awaiting_the_prediction_is_ready_only_once_it_arrived(ros_context, awaited):
     """Across processes the monitor could answer the lockstep hello before the run's latched
     prediction had reached it, and its first events were judged against none (3
-    ``prediction_mismatch`` alarms, 1 run of 32). With ``await_prediction`` (``run`` sets it)
+    ``prediction_mismatch`` alarms, 1 run of 40). With ``await_prediction`` (``run`` sets it)
     it is ready only once the prediction is here; without, also while nobody publishes one
     (a launch without a planner), never while a publisher's prediction is on its way.
     """

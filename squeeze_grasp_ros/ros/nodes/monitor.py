@@ -258,7 +258,7 @@ class MonitorNode(Node):
         """Lockstep readiness: the prediction is here, or none is awaited and nobody publishes
         one. Across processes the monitor can be ready before the run's latched prediction
         has reached it; its first events were then judged against no prediction
-        (``prediction_mismatch`` of the first 3 events in 1 of 32 runs, two at once).
+        (``prediction_mismatch`` of the first 3 events in 1 of 40 runs, two at once).
         """
         return self.prediction_seen or (not self.p["await_prediction"]
                                         and self.count_publishers(pipeline.PREDICTION) == 0)

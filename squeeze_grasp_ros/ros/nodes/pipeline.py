@@ -103,7 +103,7 @@ RECORDED_OUTPUTS: tuple[str, ...] = (SIM_EVENTS, MARKERS, EVENTS, ALARMS, FORCE_
 first (the executor's status at the goal's tick 0). In lockstep their publishers keep them
 (:func:`output_qos`) and the lockstep recorder asks for that, so a message published before
 the writer had matched the recorder's reader (discovery across processes under load: the
-executor's first status was missing from 1 of 32 recordings of two runs at once) still
+executor's first status was missing from 2 of 40 recordings of two runs at once) still
 reaches it.
 """
 

@@ -19,8 +19,9 @@ from pathlib import Path
 import numpy as np
 
 from squeeze_grasp_ros import plots
+from squeeze_grasp_ros.bench.evaluation import route, routes
 from squeeze_grasp_ros.bench.table import Table
-from squeeze_grasp_ros.extras import install_hint
+from squeeze_grasp_ros.extras import EXTRAS, install_hint
 from squeeze_grasp_ros.mechanics.elastic.hyperelastic import assemble
 from squeeze_grasp_ros.mechanics.elastic.interior import (
     Fill,
@@ -30,6 +31,7 @@ from squeeze_grasp_ros.mechanics.elastic.interior import (
 )
 from squeeze_grasp_ros.mechanics.elastic.strain_measures import COMMON_STRAIN_MEASURE
 from squeeze_grasp_ros.mechanics.squeeze.contact_model import SolveOptions
+from squeeze_grasp_ros.mechanics.squeeze.fixed_set_kernel import Kernel
 from squeeze_grasp_ros.mechanics.vocabulary import Factorizer, Finger, MaterialModel
 from squeeze_grasp_ros.resources import scene_file
 from squeeze_grasp_ros.scene import GraspSetup, load_scene
@@ -54,6 +56,10 @@ QDLDL_NODES = (8000, 800)
 SCALING_TARGETS = (8000, 10.0, 20000, 60.0)
 """(nodes, at most x linear, nodes, at most seconds): the neo-Hookean targets of the scaling
 table, met in the same run as the linear rows."""
+COMPILED_NODES = ((8000, 20000), (800,))
+"""(full, quick) meshes of the scaling table whose linear and neo-Hookean squeezes also run by
+the compiled route (``SQUEEZE_GRASP_KERNEL=numba``: the neo-Hookean assembly and the linear
+fixed-set solves compiled), when numba is installed."""
 
 
 def _setup(name: str, nodes: int) -> GraspSetup:
@@ -184,13 +190,16 @@ def _exponent(n: list, y: list) -> float:
     return float(np.polyfit(np.log(n), np.log(y), 1)[0])
 
 
-def _neo_row(setup: GraspSetup, linear: tuple, repeats: int) -> tuple[list, float, dict]:
-    """(row from the factoriser on, time, nonlinear diagnostics) of the neo-Hookean squeeze;
-    ``linear`` is (wall, CPU) time of the linear one.
+def _neo_row(setup: GraspSetup, linear: tuple, repeats: int,
+             kernel: Kernel = Kernel.NUMPY) -> tuple[list, float, dict]:
+    """(row from the factoriser on, time, nonlinear diagnostics) of the neo-Hookean squeeze by
+    the ``kernel`` route; ``linear`` is (wall, CPU) time of the linear one by that route.
     """
-    res, t, cpu = _best(setup, MaterialModel.NEO_HOOKEAN, repeats)
+    with route(kernel):
+        res, t, cpu = _best(setup, MaterialModel.NEO_HOOKEAN, repeats)
     nl = res.diagnostics["nonlinear"]
-    return ([nl["factorizer"], linear[0], t, t / linear[0], cpu / linear[1], cpu, len(res.events),
+    return ([nl["factorizer"], kernel.value, linear[0], t, t / linear[0], cpu / linear[1], cpu,
+             len(res.events),
              nl["evaluations"], nl["evaluations"] / max(len(res.events), 1),
              nl["newton_iterations"] / nl["evaluations"], nl["factorizations"], nl["analyses"]],
             t, nl)
@@ -225,13 +234,19 @@ def _scaling(quick: bool, progress) -> tuple[Table, Table]:
             with factorizer(Factorizer.QDLDL):
                 row, t, nl = _neo_row(setup, (t_l, cpu_l), 1)
             rows.append([size, *row, "-", "-", 1e3 * t / nl["evaluations"]])
+        if Kernel.NUMBA in routes() and nodes in COMPILED_NODES[quick]:
+            progress(f"material_models: scaling, {nodes} nodes compiled")
+            with route(Kernel.NUMBA):
+                _, t_lc, cpu_lc = _best(setup, MaterialModel.LINEAR, LINEAR_REPEATS)
+            row, t, nl = _neo_row(setup, (t_lc, cpu_lc), 1, Kernel.NUMBA)
+            rows.append([size, *row, fill.nnz, fill.flops / 1e6, 1e3 * t / nl["evaluations"]])
     load.append(os.getloadavg()[0])
     where = _phase_table(n, profiled, fills, tuple(load))
     growth = ", ".join(f"{name} n^{_exponent(n, y):.2f}" for name, y in (
         ("time per evaluation", per_eval), ("nnz(L)", nnz), ("factor flops", flops),
         ("evaluations", evals), ("neo-Hookean squeeze", t_neo), ("linear squeeze", t_lin)))
     return Table("Growth with the mesh (foam square, neo-Hookean, 12 %)",
-                 ["nodes", "factoriser", "linear [s]", "neo-Hookean [s]", "x linear",
+                 ["nodes", "factoriser", "route", "linear [s]", "neo-Hookean [s]", "x linear",
                   "x linear (CPU)", "neo-Hookean CPU [s]", "events", "evaluations",
                   "evaluations / event",
                   "Newton its / evaluation", "factorisations", "symbolic analyses", "nnz(L)",
@@ -252,30 +267,45 @@ def _scaling(quick: bool, progress) -> tuple[Table, Table]:
                  "pattern). Fitted over the rows of the default factoriser: "
                  f"{growth}. An evaluation costs one assembly of the tangent, one numeric "
                  "factorisation and about three solves and three force assemblies (the Newton "
-                 "iterations, dF/d delta on the finger motion). Load average (1 min) "
+                 "iterations, dF/d delta on the finger motion). Route: numpy, or numba "
+                 "(SQUEEZE_GRASP_KERNEL=numba, the fast extra: the neo-Hookean assembly and the "
+                 "linear fixed-set solves compiled; its linear time is the linear squeeze by "
+                 "that route, measured beside it). Load average (1 min) "
                  f"{load[0]:.1f} before and {load[1]:.1f} after, on {os.cpu_count()} cores. "
                  + _scaling_verdict(rows, quick, method)), where
 
 
 def _scaling_verdict(rows: list, quick: bool, method: Factorizer) -> str:
-    """The target sentences of the scaling table."""
+    """The target sentences of the scaling table, for each route measured."""
     if quick:
         return (f"Quick run: the targets are stated for {SCALING_TARGETS[0]:,} and "
                 f"{SCALING_TARGETS[2]:,} nodes (full run).")
     ratio_nodes, ratio, time_nodes, seconds = SCALING_TARGETS
-    default = [row for row in rows if row[1] == str(method)]
-    at = {nodes: row for nodes, row in zip(SCALING_NODES, default)}
-    got_ratio, got_time = at[ratio_nodes][4], at[time_nodes][3]
-    said = [f"neo-Hookean within {ratio:g}x linear at {at[ratio_nodes][0]:,} nodes: "
-            f"{got_ratio:.1f}x ({'met' if got_ratio <= ratio else 'not met'}; "
-            f"{at[ratio_nodes][5]:.1f}x in CPU time)",
-            f"under {seconds:g} s at {at[time_nodes][0]:,} nodes: {got_time:.1f} s "
-            f"({'met' if got_time <= seconds else 'not met'}; {at[time_nodes][6]:.1f} s of "
-            "CPU time)"]
+    said = []
+    for kernel in routes():
+        at = {_nominal(row[0]): row for row in rows
+              if row[1] == str(method) and row[2] == kernel.value}
+        if ratio_nodes not in at or time_nodes not in at:
+            continue
+        got_ratio, got_time = at[ratio_nodes][5], at[time_nodes][4]
+        said += [f"{kernel.value} route: neo-Hookean within {ratio:g}x linear at "
+                 f"{at[ratio_nodes][0]:,} nodes: {got_ratio:.1f}x "
+                 f"({'met' if got_ratio <= ratio else 'not met'}; "
+                 f"{at[ratio_nodes][6]:.1f}x in CPU time)",
+                 f"under {seconds:g} s at {at[time_nodes][0]:,} nodes: {got_time:.1f} s "
+                 f"({'met' if got_time <= seconds else 'not met'}; {at[time_nodes][7]:.1f} s "
+                 "of CPU time)"]
+    if Kernel.NUMBA not in routes():
+        said.append(f"numba route not measured: {EXTRAS['fast'][1]}")
     if method != Factorizer.CHOLMOD:
         said.append(f"factoriser qdldl: cvxopt is not installed ({install_hint('cvxopt')}) "
                     "and CHOLMOD's supernodal factorisation is what the targets were met with")
     return "Targets: " + "; ".join(said) + "."
+
+
+def _nominal(nodes: int) -> int:
+    """The SCALING_NODES entry a mesh of ``nodes`` nodes was built for (the nearest)."""
+    return min(SCALING_NODES, key=lambda target: abs(target - nodes))
 
 
 def _verdict(cost: list, quick: bool) -> str:

@@ -343,13 +343,38 @@ def assemble(model: MaterialModel | str, nodes: np.ndarray, triangles: np.ndarra
     if not det[worst] > 0:
         raise InvertedElementError(f"element {worst} inverted (det F = {det[worst]:.3g})",
                                    residuals={"det_F": det[worst]})
-    W, P, A = stress_and_tangent(model, F, nu=nu, tangent=tangent)
-    force = geometry.force_operator @ P.reshape(-1)  # f[(a, i)] = sum_e area g_aj P_ij
+    if geometry.compiled and MaterialModel(model) == MaterialModel.NEO_HOOKEAN:
+        energy, force, data = _compiled_neo_hookean(geometry, F, det, nu, tangent)
+    else:
+        W, P, A = stress_and_tangent(model, F, nu=nu, tangent=tangent)
+        energy = float(np.einsum("t,t->", W, geometry.area))
+        force = geometry.force_operator @ P.reshape(-1)  # f[(a, i)] = sum_e area g_aj P_ij
+        data = _stiffness_data(geometry, A) if tangent else None
     K = None
     if tangent:
-        K = sp.csr_matrix((_stiffness_data(geometry, A), geometry.indices, geometry.indptr),
+        K = sp.csr_matrix((data, geometry.indices, geometry.indptr),
                           shape=(geometry.n2, geometry.n2))
-    return Assembly(float(np.einsum("t,t->", W, geometry.area)), force, K, float(det[worst]), F)
+    return Assembly(energy, force, K, float(det[worst]), F)
+
+
+def _compiled_neo_hookean(geometry: MeshGeometry, F: np.ndarray, det: np.ndarray, nu: float,
+                          tangent: bool) -> tuple[float, np.ndarray, np.ndarray | None]:
+    """(energy, forces, the tangent's CSR values or None) of the neo-Hookean law of the
+    deformation gradients ``F`` with determinants ``det`` by the compiled kernel
+    (:mod:`.hyperelastic_numba`), given the thickness stretches as the numpy route has them.
+    """
+    from squeeze_grasp_ros.mechanics.elastic import hyperelastic_numba
+
+    _require_compressible(nu)
+    lam, mu = _lame(nu)
+    l3 = _thickness_stretch(det, lam, mu)
+    force = np.zeros(geometry.n2)
+    data = np.zeros(len(geometry.indices) if tangent else 0)
+    energy = hyperelastic_numba.neo_hookean(F, l3, np.log(det * l3), geometry.shape_gradients,
+                                            geometry.area,
+                                            geometry.dofs, geometry.slots.reshape(len(F), 36),
+                                            lam, mu, force, data)
+    return float(energy), force, (data if tangent else None)
 
 
 def _stiffness_data(geometry: MeshGeometry, A: np.ndarray) -> np.ndarray:
@@ -394,6 +419,13 @@ class MeshGeometry:
         The CSR pattern of the stiffness (column indices, row pointers; sorted).
     transpose : (nnz,) ndarray of int
         CSR position of the transposed entry of each entry.
+    shape_gradients : (t, 3, 2) ndarray
+        Reference shape-function gradients g_aj.
+    dofs : (t, 6) ndarray of int
+        The DOFs of each element, (a, i) order.
+    compiled : bool
+        :func:`assemble` runs the neo-Hookean law by the compiled kernel of
+        :mod:`.hyperelastic_numba` (the ``fast`` extra), the other laws by numpy.
     """
 
     gradient: sp.csr_matrix
@@ -405,18 +437,24 @@ class MeshGeometry:
     indices: np.ndarray
     indptr: np.ndarray
     transpose: np.ndarray
+    shape_gradients: np.ndarray
+    dofs: np.ndarray
+    compiled: bool = False
 
     def deformation(self, u: np.ndarray) -> np.ndarray:
         """Deformation gradients F = I + grad u (t, 2, 2) of the displacement ``u`` (2n,)."""
         return _deformation(self.gradient, u)
 
 
-def mesh_geometry(nodes: np.ndarray, triangles: np.ndarray) -> MeshGeometry:
+def mesh_geometry(nodes: np.ndarray, triangles: np.ndarray, *,
+                  compiled: bool = False) -> MeshGeometry:
     """The displacement-independent part of :func:`assemble` for ``nodes`` (n, 2) and
     ``triangles`` (t, 3); build it once and pass it as ``geometry`` to assemble many states.
 
     The stiffness pattern and the place of every element entry in it are computed here once
-    per mesh, so that an assembly is a product per element and one scatter.
+    per mesh, so that an assembly is a product per element and one scatter. ``compiled``: the
+    neo-Hookean law is assembled by the compiled kernel (:mod:`.hyperelastic_numba`; needs
+    numba, the ``fast`` extra).
     """
     nodes = np.asarray(nodes, float)
     triangles = np.asarray(triangles, int)
@@ -436,4 +474,4 @@ def mesh_geometry(nodes: np.ndarray, triangles: np.ndarray) -> MeshGeometry:
     gradient = gradient_operator(nodes, triangles)
     forces = sp.csr_matrix(gradient.multiply(np.repeat(area, 4)[:, None]).T)
     return MeshGeometry(gradient, area, forces, outer, n2, slots.reshape(-1), col_of, indptr,
-                        transpose)
+                        transpose, grad, dofs.reshape(t, 6), compiled)

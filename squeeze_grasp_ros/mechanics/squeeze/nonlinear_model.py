@@ -11,7 +11,10 @@ whole object with the contact displacements prescribed
 (:class:`~squeeze_grasp_ros.mechanics.elastic.contact_response.ContactResponse`), so contact
 normals, gaps and sliding are those of the current configuration. The strain limit uses the
 model's own measure (:attr:`~squeeze_grasp_ros.mechanics.vocabulary.MaterialModel.strain_measure`:
-Biot for corotational, log for neo-Hookean).
+Biot for corotational, log for neo-Hookean). The route chosen for the linear model's fixed-set
+solve (:mod:`.fixed_set_kernel`: ``SQUEEZE_GRASP_KERNEL=numba``) also assembles the
+neo-Hookean law by its compiled kernel
+(:mod:`~squeeze_grasp_ros.mechanics.elastic.hyperelastic_numba`).
 """
 from __future__ import annotations
 
@@ -37,6 +40,7 @@ from squeeze_grasp_ros.mechanics.squeeze.contact_model import (
     Solution,
     SolveFailure,
 )
+from squeeze_grasp_ros.mechanics.squeeze.fixed_set_kernel import Kernel, selected
 from squeeze_grasp_ros.mechanics.vocabulary import MaterialModel, StrainCriterion
 from squeeze_grasp_ros.threads import one_blas_thread
 
@@ -96,7 +100,9 @@ class NonlinearContactModel(ContactModel):
         if key not in responses:
             mesh = self.obj.mesh
             if "geometry" not in self._cache:
-                self._cache["geometry"] = mesh_geometry(mesh.nodes / self.length, mesh.triangles)
+                self._cache["geometry"] = mesh_geometry(
+                    mesh.nodes / self.length, mesh.triangles,
+                    compiled=selected() == Kernel.NUMBA)
             if "factorization" not in self._cache:
                 self._cache["factorization"] = TangentFactor()
             shared = self._cache["factorization"]

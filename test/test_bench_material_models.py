@@ -1,0 +1,43 @@
+# Copyright 2026 squeeze_grasp_ros developers
+# SPDX-License-Identifier: Apache-2.0
+"""The material-models bench's target sentences: each route's neo-Hookean squeeze against the
+linear squeeze by the same route, at the scaling table's nominal meshes.
+"""
+from __future__ import annotations
+
+from squeeze_grasp_ros.bench import material_models as bench
+from squeeze_grasp_ros.mechanics.squeeze.fixed_set_kernel import Kernel
+from squeeze_grasp_ros.mechanics.vocabulary import Factorizer
+
+
+def _row(nodes, factoriser, route, ratio, cpu_ratio, wall, cpu):
+    """A scaling row as the bench builds it (the columns the verdict reads, the rest blank)."""
+    return [nodes, factoriser, route, 0.1, wall, ratio, cpu_ratio, cpu, *["-"] * 10]
+
+
+ROWS = [_row(534, "cholmod", "numpy", 3.8, 3.6, 0.2, 0.1),
+        _row(8038, "cholmod", "numpy", 12.5, 12.1, 2.5, 2.3),
+        _row(8038, "qdldl", "numpy", 16.0, 16.7, 3.3, 3.2),
+        _row(8038, "cholmod", "numba", 9.6, 9.4, 1.8, 1.6),
+        _row(20054, "cholmod", "numpy", 31.2, 21.6, 58.1, 13.2),
+        _row(20054, "cholmod", "numba", 31.0, 18.8, 61.5, 10.7)]
+
+
+def test_each_route_is_judged_by_its_own_rows(monkeypatch):
+    monkeypatch.setattr(bench, "routes", lambda: [Kernel.NUMPY, Kernel.NUMBA])
+    said = bench._scaling_verdict(ROWS, False, Factorizer.CHOLMOD)
+    assert ("numpy route: neo-Hookean within 10x linear at 8,038 nodes: 12.5x (not met; "
+            "12.1x in CPU time)") in said
+    assert "under 60 s at 20,054 nodes: 58.1 s (met; 13.2 s of CPU time)" in said
+    assert ("numba route: neo-Hookean within 10x linear at 8,038 nodes: 9.6x (met; 9.4x in "
+            "CPU time)") in said
+    assert "under 60 s at 20,054 nodes: 61.5 s (not met; 10.7 s of CPU time)" in said
+    assert "16.0x" not in said  # the QDLDL row is not the default factoriser's
+
+
+def test_without_numba_the_verdict_names_the_extra(monkeypatch):
+    monkeypatch.setattr(bench, "routes", lambda: [Kernel.NUMPY])
+    rows = [row for row in ROWS if row[2] == "numpy"]
+    said = bench._scaling_verdict(rows, False, Factorizer.CHOLMOD)
+    assert "numba route" not in said.replace("numba route not measured", "")
+    assert "numba route not measured: pip install '.[fast]'" in said

@@ -27,7 +27,7 @@ QUICK = scene_data(SMALL_SQUARE, name="quick_square",
 DETERMINISTIC = ("/clock", "/sim/tick", "/sim/state", "/sim/events", "/monitor/status",
                  "/monitor/events", "/monitor/contact_state", "/devices/barrett_f1/setpoint",
                  "/devices/barrett_f3/setpoint", "/devices/barrett_f1/tactile",
-                 "/devices/barrett_f3/wrench")
+                 "/devices/barrett_f3/wrench", "/executor/status")
 """Topics whose messages (content and log time) do not depend on how the nodes ran (the
 action's goal ids are random; markers are logged at the recorder's clock)."""
 
@@ -58,6 +58,24 @@ def test_one_process_and_processes_give_the_same_run_and_recording(tmp_path):
     a, b = contents(tmp_path / "one"), contents(tmp_path / "many")
     for topic in DETERMINISTIC:
         assert a[topic] == b[topic], topic
+    assert [t for t, _ in b["/executor/status"]][0] == 0  # squeezing, from the goal's tick 0
+    offered = offered_durability(tmp_path / "many")
+    for topic in ("/sim/events", "/monitor/events", "/monitor/force_residual",
+                  "/executor/status"):
+        assert offered[topic] == {"transient_local"}, (topic, offered[topic])
+
+
+def offered_durability(bag_path: Path) -> dict[str, set[str]]:
+    """Topic -> the durabilities its publishers offered, as the recording says (rosbag2's
+    ``offered_qos_profiles`` of each MCAP channel).
+    """
+    import yaml
+    from mcap.reader import make_reader
+
+    with open(next(bag_path.glob("*.mcap")), "rb") as stream:
+        channels = make_reader(stream).get_summary().channels.values()
+    return {c.topic: {q["durability"] for q in yaml.safe_load(
+        c.metadata.get("offered_qos_profiles") or "[]")} for c in channels}
 
 
 def run_command(*args: str) -> list[str]:
@@ -169,3 +187,52 @@ def test_a_recorder_that_matches_late_still_gets_the_first_lockstep_messages(ros
     executor.shutdown()
     writer.destroy_node()
     reader.destroy_node()
+
+
+@pytest.mark.parametrize("awaited", [True, False])
+def test_a_monitor_awaiting_the_prediction_is_ready_only_once_it_arrived(ros_context, awaited):
+    """Across processes the monitor could answer the lockstep hello before the run's latched
+    prediction had reached it, and its first events were judged against none (3
+    ``prediction_mismatch`` alarms, 1 run of 40). With ``await_prediction`` (``run`` sets it)
+    it is ready only once the prediction is here; without, also while nobody publishes one
+    (a launch without a planner), never while a publisher's prediction is on its way.
+    """
+    import time
+
+    from rclpy.executors import SingleThreadedExecutor
+    from rclpy.node import Node
+    from rclpy.parameter import Parameter
+
+    from squeeze_grasp_interfaces.msg import ContactEventArray, MonitorStatus, Tick
+    from squeeze_grasp_ros.ros.nodes.monitor import MonitorNode
+
+    monitor = MonitorNode(context=ros_context, parameter_overrides=[
+        Parameter("await_prediction", value=awaited), Parameter("force_watch", value=False)])
+    peer = Node("driver_like", context=ros_context)
+    kept = pipeline.loop_qos(100, kept=True)
+    peer.create_publisher(Tick, pipeline.TICK, kept)
+    peer.create_subscription(MonitorStatus, pipeline.STATUS, lambda _: None, kept)
+    executor = SingleThreadedExecutor(context=ros_context)
+    for node in (monitor, peer):
+        executor.add_node(node)
+
+    def spin_until(done) -> None:
+        deadline = time.monotonic() + 10.0
+        while not done():
+            assert time.monotonic() < deadline
+            executor.spin_once(timeout_sec=0.05)
+
+    try:
+        spin_until(lambda: monitor.count_publishers(pipeline.TICK) > 0
+                   and monitor.status_pub.get_subscription_count() > 0)
+        assert monitor.participant.ready() is not awaited
+        prediction = peer.create_publisher(ContactEventArray, pipeline.PREDICTION,
+                                           pipeline.LATCHED)
+        spin_until(lambda: monitor.count_publishers(pipeline.PREDICTION) > 0)
+        assert not monitor.participant.ready()
+        prediction.publish(ContactEventArray())
+        spin_until(monitor.participant.ready)
+    finally:
+        executor.shutdown()
+        monitor.destroy_node()
+        peer.destroy_node()

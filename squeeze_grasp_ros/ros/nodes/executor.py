@@ -150,7 +150,9 @@ class ExecutorNode(Node):
                                                        pipeline.loop_qos(p["qos_depth"],
                                                                          kept=True))
                               for f, d in self.devices.items() if f not in jaw_fingers}
-        self.status_pub = self.create_publisher(ExecutorStatus, pipeline.EXECUTOR_STATUS, loop)
+        self.status_pub = self.create_publisher(
+            ExecutorStatus, pipeline.EXECUTOR_STATUS,
+            pipeline.output_qos(p["qos_depth"], lockstep=p["lockstep"]))
         pose_pub = self.create_publisher(PoseStamped, pipeline.OBJECT_POSE, pipeline.LATCHED)
         pose_pub.publish(messages.pose_in_base(p["object_pose"], p["base_frame"]))
         self.create_subscription(MonitorStatus, pipeline.STATUS, self._status, loop, raw=True)

@@ -97,6 +97,24 @@ def loop_topics(devices: Iterable[str], *, silent: Iterable[str] = ()) -> list[s
     return names
 
 
+RECORDED_OUTPUTS: tuple[str, ...] = (SIM_EVENTS, MARKERS, EVENTS, ALARMS, FORCE_RESIDUAL,
+                                     EXECUTOR_STATUS)
+"""The loop nodes' other recorded topics (relative): published on some ticks only, from the
+first (the executor's status at the goal's tick 0). In lockstep their publishers keep them
+(:func:`output_qos`) and the lockstep recorder asks for that, so a message published before
+the writer had matched the recorder's reader (discovery across processes under load: the
+executor's first status was missing from 2 of 40 recordings of two runs at once) still
+reaches it.
+"""
+
+
+def output_qos(depth: int, *, lockstep: bool) -> QoSProfile:
+    """QoS of a publisher of :data:`RECORDED_OUTPUTS`: :func:`loop_qos`, kept in lockstep
+    (a late reader on hardware is not sent old events and alarms).
+    """
+    return loop_qos(depth, kept=lockstep)
+
+
 def pipeline_topics(devices: Iterable[str], *, hidden: bool = False,
                     camera: bool = False) -> dict[str, str]:
     """Topic (fully qualified) -> type of every topic of a run with ``devices``.

@@ -134,7 +134,8 @@ class RecorderNode(Node):
                                     pipeline.CAMERA_INFO)}
         sensors = {name for name in topics if name.rsplit("/", 1)[-1] in pipeline.STREAMS}
         extra_loop = [t for t in p["lockstep_topics"] if t.strip()]
-        kept = ({"/" + t.lstrip("/") for t in [*pipeline.loop_topics(p["devices"]), *extra_loop]}
+        kept = ({"/" + t.lstrip("/") for t in [*pipeline.loop_topics(p["devices"]), *extra_loop,
+                                               *pipeline.RECORDED_OUTPUTS]}
                 if p["lockstep"] else set())
         """Lockstep topics whose publishers keep their last messages for a late reader."""
         for name, type_name in topics.items():

@@ -106,8 +106,9 @@ class SimHardwareNode(Node):
                              for f, d in self.devices.items() if f in world.layouts}
         self.tick_pub = pub(Tick, pipeline.TICK, kept)
         self.state_pub = pub(SimState, pipeline.SIM_STATE, kept)
-        self.event_pub = pub(ContactEventArray, pipeline.SIM_EVENTS, loop)
-        self.marker_pub = pub(MarkerArray, pipeline.MARKERS, loop)
+        outputs = pipeline.output_qos(self.p["qos_depth"], lockstep=True)
+        self.event_pub = pub(ContactEventArray, pipeline.SIM_EVENTS, outputs)
+        self.marker_pub = pub(MarkerArray, pipeline.MARKERS, outputs)
         self.camera_pubs: dict[str, Any] = {}
         self.first_frame: list = []
         if world.camera is not None:

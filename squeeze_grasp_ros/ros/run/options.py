@@ -129,6 +129,7 @@ def node_parameters(
         mu=float(scene.mu),
         weight=float(scene.pickup.believed_weight) if scene.has(Effect.PICKUP) else 0.0,
         relative_per_depth=float(relative_per_depth),
+        await_prediction=True,
         load_threshold=max(float(monitor.get("load_threshold", 0.005)), 6.0 * noise),
     )
     if scene.has(Effect.CAMERA):

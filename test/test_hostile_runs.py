@@ -235,10 +235,13 @@ def test_sensor_dropout_1_ends_the_goal_after_the_stale_budget(tmp_path, capfd):
     assert sum(out["alarms"].values()) <= 4  # one per alarm episode and finger, not per tick
 
 
-def run_process(tmp_path: Path, name: str, *extra: str) -> subprocess.Popen:
-    """``squeeze-grasp run`` of the foam square as its own process, recording into NAME."""
+def run_process(tmp_path: Path, name: str, *extra: str,
+                scene: str = str(SCENES / "foam_square.yaml")) -> subprocess.Popen:
+    """``squeeze-grasp run`` of ``scene`` (the foam square) as its own process, recording into
+    NAME.
+    """
     return subprocess.Popen([sys.executable, "-m", "squeeze_grasp_ros.cli", "run",
-                             str(SCENES / "foam_square.yaml"), "--json", "--quiet", "--record",
+                             scene, "--json", "--quiet", "--record",
                              str(tmp_path / name), *extra],
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
 
@@ -289,8 +292,10 @@ def test_foreign_traffic_in_a_runs_namespace_stops_it_as_a_failure(tmp_path, ros
     """A node the run did not start, publishing into its namespace (here a rogue node repeating
     sim/hello), ends the run with exit 4 and the reason, never a success.
 
-    The rogue publishes once its publisher has matched the run's subscribers, so the run
-    receives foreign messages (the run may also see the rogue node in its namespace first and
+    The run squeezes the foam square at a 0.1 ms tick (about 7,000 ticks), so that it lasts long
+    enough for the rogue's discovery even on a loaded machine (at 1 ms ticks a faster loop ended
+    some runs before the rogue matched them three times). The rogue publishes once its publisher
+    has matched the run's subscribers, so the run receives foreign messages (the run may also see the rogue node in its namespace first and
     stop on that); a run that succeeded before discovery matched them, or less than a second
     after (the run's side of the match may not have happened yet), saw nothing foreign for
     certain and is started again (at most three times).
@@ -301,7 +306,8 @@ def test_foreign_traffic_in_a_runs_namespace_stops_it_as_a_failure(tmp_path, ros
     hello = rogue.create_publisher(String, "sim/hello", 10)
     try:
         for attempt in range(3):
-            proc = run_process(tmp_path, f"bag{attempt}", "--namespace", "/lab/intruded")
+            proc = run_process(tmp_path, f"bag{attempt}", "--namespace", "/lab/intruded",
+                               scene=long_scene(tmp_path))
             deadline, matched = time.monotonic() + 120, None
             while proc.poll() is None:
                 assert time.monotonic() < deadline

@@ -295,10 +295,10 @@ def test_foreign_traffic_in_a_runs_namespace_stops_it_as_a_failure(tmp_path, ros
     The run squeezes the foam square at a 0.1 ms tick (about 7,000 ticks), so that it lasts long
     enough for the rogue's discovery even on a loaded machine (at 1 ms ticks a faster loop ended
     some runs before the rogue matched them three times). The rogue publishes once its publisher
-    has matched the run's subscribers, so the run receives foreign messages (the run may also see the rogue node in its namespace first and
-    stop on that); a run that succeeded before discovery matched them, or less than a second
-    after (the run's side of the match may not have happened yet), saw nothing foreign for
-    certain and is started again (at most three times).
+    has matched the run's subscribers, so the run receives foreign messages (the run may also see
+    the rogue node in its namespace first and stop on that); a run that succeeded before discovery
+    matched them, or less than a second after (the run's side of the match may not have happened
+    yet), saw nothing foreign for certain and is started again (at most three times).
     """
     from std_msgs.msg import String
 

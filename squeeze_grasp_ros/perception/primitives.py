@@ -143,11 +143,20 @@ def ellipse_distance_bound(points: np.ndarray, centre: np.ndarray, a: float, b: 
     >>> ellipse_distance_bound(p, np.zeros(2), 2.0, 1.0, 0.0)
     0.75
     """
+    along_a, along_b = _ellipse_frame(points, centre, theta)
+    with np.errstate(divide="ignore", invalid="ignore"):  # a degenerate fit: NaN, no bound
+        norm = np.hypot(along_a / a, along_b / b)
+        return float(min(a, b) * np.abs(norm - 1.0).max(initial=0.0))
+
+
+def _ellipse_frame(points: np.ndarray, centre: np.ndarray, theta: float
+                   ) -> tuple[np.ndarray, np.ndarray]:
+    """Coordinates of ``points`` (n, 2) along the ellipse's ``a`` axis (at ``theta`` rad from
+    x) and its ``b`` axis, from ``centre`` (units of the points).
+    """
     c, s = np.cos(theta), np.sin(theta)
     d = np.asarray(points, float) - centre
-    with np.errstate(divide="ignore", invalid="ignore"):  # a degenerate fit: NaN, no bound
-        norm = np.hypot((c * d[:, 0] + s * d[:, 1]) / a, (-s * d[:, 0] + c * d[:, 1]) / b)
-        return float(min(a, b) * np.abs(norm - 1.0).max(initial=0.0))
+    return c * d[:, 0] + s * d[:, 1], -s * d[:, 0] + c * d[:, 1]
 
 
 ROOT_BISECTIONS = 160
@@ -172,9 +181,7 @@ def ellipse_distances(points: np.ndarray, centre: np.ndarray, a: float, b: float
     ...                   1.0, 0.0).round(12).tolist()
     [1.0, 1.0, 1.5]
     """
-    c, s = np.cos(theta), np.sin(theta)
-    d = np.asarray(points, float) - centre
-    y = np.abs(np.column_stack([c * d[:, 0] + s * d[:, 1], -s * d[:, 0] + c * d[:, 1]]))
+    y = np.abs(np.column_stack(_ellipse_frame(points, centre, theta)))
     if b > a:  # the long axis first
         a, b, y = b, a, y[:, ::-1]
     y0, y1 = y[:, 0], y[:, 1]

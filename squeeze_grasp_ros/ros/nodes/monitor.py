@@ -235,6 +235,9 @@ class MonitorNode(Node):
         self.forces = (ForceWatcher(self, p["force_tolerance"], p["force_min_fraction"], outputs)
                        if p["force_watch"] else None)
         if p["lockstep"]:
+            # the ticks' stamps are the monitor's time and it reads no clock: it does not take
+            # /clock (one delivery a tick), whatever use_sim_time says
+            self._time_source.ros_time_is_active = False
             self.create_subscription(Tick, pipeline.TICK, self._tick, loop, raw=True)
             self.participant = pipeline.Participant(self, "monitor", [pipeline.TICK],
                                                     [self.status_pub],

@@ -132,9 +132,9 @@ class TrackerConfig:
     mirror_tolerance: float = 0.05
 
 
-@dataclass(frozen=True)
-class FingerSample:
-    """The newest readings of one finger at a tick (object frame for positions and forces).
+class FingerSample(NamedTuple):
+    """The newest readings of one finger at a tick (object frame for positions and forces; a
+    named tuple: two are built per tick, a frozen dataclass took 4 us for each).
 
     Attributes
     ----------

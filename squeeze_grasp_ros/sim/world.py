@@ -70,6 +70,7 @@ import time
 from collections import Counter
 from collections.abc import Mapping
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 
@@ -106,9 +107,9 @@ TERMINATE_ON: tuple[str, ...] = (
 """Stepper terminations that end the simulated world (as in Algorithm 1)."""
 
 
-@dataclass(frozen=True)
-class FingerReading:
-    """What one fingertip's devices and sensors report at a tick (SI, fingertip frame).
+class FingerReading(NamedTuple):
+    """What one fingertip's devices and sensors report at a tick (SI, fingertip frame; a named
+    tuple: one is built per finger and tick).
 
     Attributes
     ----------

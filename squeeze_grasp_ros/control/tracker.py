@@ -299,21 +299,32 @@ def patches_of(finger: str, taxels: LoadedTaxels, config: TrackerConfig) -> list
     index = taxels.index
     if not len(index):
         return []
-    breaks = ((index[1:] - index[:-1]) > 1).nonzero()[0] + 1
-    starts = np.concatenate((_FIRST, breaks))
+    starts, firsts, lasts = _runs(index.tobytes())
     sums = np.add.reduceat(np.array((taxels.normal, taxels.tangential,
                                      taxels.normal * taxels.angles)), starts, axis=1)
-    lasts = np.concatenate((index[breaks - 1], index[-1:]))
     mu, edge = config.mu, 1.0 - config.edge_tolerance
     out = []
-    for first, last, normal, tangential, moment in zip(index[starts].tolist(), lasts.tolist(),
-                                                       *sums.tolist()):
+    for first, last, normal, tangential, moment in zip(firsts, lasts, *sums.tolist()):
         sliding = mu == 0.0 or abs(tangential) >= edge * mu * normal
         slip = (-1 if tangential > 0.0 else 1 if tangential < 0.0 else 0) \
             if sliding and mu > 0.0 else 0
         out.append(Patch(finger, moment / normal, normal, tangential,
                          _SLIP if sliding else _STICK, slip, first, last))
     return out
+
+
+@functools.lru_cache(maxsize=256)
+def _runs(index: bytes) -> tuple[np.ndarray, tuple[int, ...], tuple[int, ...]]:
+    """(starts, first taxels, last taxels) of the maximal runs of neighbouring taxels among
+    loaded taxels ``index`` (the bytes of their increasing indices; kept: a finger's loaded
+    taxels stay the same over most ticks).
+    """
+    index = np.frombuffer(index, np.intp)
+    breaks = ((index[1:] - index[:-1]) > 1).nonzero()[0] + 1
+    starts = np.concatenate((_FIRST, breaks))
+    starts.flags.writeable = False
+    lasts = np.concatenate((index[breaks - 1], index[-1:]))
+    return starts, tuple(index[starts].tolist()), tuple(lasts.tolist())
 
 
 _SLIP, _STICK = ContactMode.SLIP, ContactMode.STICK

@@ -25,3 +25,54 @@ def test_each_tick_is_answered_once_and_a_resent_tick_gets_the_same_answer():
     ticks.answer(1_000_000, [(pub, "status 1")])
     assert not ticks.is_new(0) and pub.sent[-1] == "status 1"  # an old tick: nothing new
     assert ticks.stamp_ns == 1_000_000
+
+
+def test_the_lockstep_monitor_takes_no_clock_and_the_hardware_monitor_follows_it(ros_context):
+    """In lockstep the monitor's time is each ``sim/tick``'s stamp: with ``use_sim_time`` it
+    still does not subscribe to ``/clock`` (one delivery a tick less). On hardware
+    (``lockstep: false``) its timer's clock is the one ``use_sim_time`` selects: it follows
+    ``/clock``. Real rclpy nodes in a namespace of their own.
+    """
+    import os
+    import time
+
+    from rclpy.executors import SingleThreadedExecutor
+    from rclpy.node import Node
+    from rclpy.parameter import Parameter
+    from rosgraph_msgs.msg import Clock
+
+    from squeeze_grasp_ros.ros.nodes.monitor import MonitorNode
+    from squeeze_grasp_ros.ros.nodes.pipeline import loop_qos
+    from squeeze_grasp_ros.ros.run.processes import ros_arguments
+
+    namespace = f"/clock_test_{os.getpid()}"
+    monitors = {lockstep: MonitorNode(
+        context=ros_context, cli_args=ros_arguments(f"{namespace}/{lockstep}"),
+        parameter_overrides=[Parameter("use_sim_time", value=True),
+                             Parameter("lockstep", value=lockstep)]) for lockstep in (True, False)}
+    driver = Node("driver", context=ros_context, namespace=namespace)
+    clocks = {lockstep: driver.create_publisher(Clock, f"{namespace}/{lockstep}/clock",
+                                                loop_qos(10)) for lockstep in monitors}
+    executor = SingleThreadedExecutor(context=ros_context)
+    for node in (*monitors.values(), driver):
+        executor.add_node(node)
+    try:
+        subscribed = {lockstep: [s.topic_name for s in node.subscriptions
+                                 if s.topic_name.endswith("/clock")]
+                      for lockstep, node in monitors.items()}
+        assert subscribed == {True: [], False: [f"{namespace}/False/clock"]}
+        message = Clock()
+        message.clock.sec = 5
+        deadline = time.monotonic() + 10.0
+        while monitors[False].get_clock().now().nanoseconds != 5_000_000_000:
+            assert time.monotonic() < deadline, "the hardware monitor never took /clock"
+            for publisher in clocks.values():
+                publisher.publish(message)
+            executor.spin_once(0.05)
+        assert monitors[False].get_clock().ros_time_is_active
+        assert not monitors[True].get_clock().ros_time_is_active
+        assert clocks[True].get_subscription_count() == 0
+    finally:
+        executor.shutdown()
+        for node in (*monitors.values(), driver):
+            node.destroy_node()

@@ -40,6 +40,7 @@ from squeeze_grasp_ros.sim import sensors
 from squeeze_grasp_ros.sim.devices import device_model, follow
 from squeeze_grasp_ros.sim.sensors import (
     SensorRandomness,
+    contact_arrays,
     contact_geometry,
     fingertip_wrench,
     render_tactile,
@@ -357,6 +358,25 @@ def test_pad_sensors_see_the_pad_contacts(pad_run):
     seen = [(k, str(e.type), e.finger) for k, obs in enumerate(pad_run["observed"])
             for e in obs.events]
     assert match_within(net_events(states), seen, EVENT_TOLERANCE_TICKS) == []
+
+
+@pytest.mark.parametrize("run", ["world_run", "pad_run"])
+def test_state_arrays_are_the_nodes_fields(run, request):
+    """A state's :class:`ContactArrays` (gathered once per state for the sensors and the ground
+    truth) hold each node's finger, coordinate, force and normal angle in the state's order,
+    and a finger's rows pick its nodes in that order.
+    """
+    for out in request.getfixturevalue(run)["outputs"]:
+        contacts, arrays = out.state.contacts, out.state.arrays
+        assert arrays is out.state.arrays
+        assert arrays.fingers == tuple(c.finger for c in contacts)
+        for finger in {*arrays.fingers, "F1", "F2"}:
+            mine = [c for c in contacts if c.finger == finger]
+            rows = arrays.rows(finger)
+            thetas, forces = contact_arrays(mine)
+            assert arrays.thetas[rows].tobytes() == thetas.tobytes()
+            assert arrays.forces[rows].tobytes() == forces.tobytes()
+            assert arrays.normal_angles[rows].tolist() == [c.normal_angle for c in mine]
 
 
 @pytest.mark.parametrize("run", ["world_run", "pad_run"])

@@ -83,6 +83,9 @@ DEFAULT_CLEARANCE = 0.002
 """How far a released finger opens past first contact (m), when the goal gives none: 2 mm,
 clear of the object at rest for the shipped pads and circles while a gripper opens in 0.2 s at
 the default ``max_velocity``."""
+_NO_FORCE = np.zeros(2)
+_NO_FORCE.flags.writeable = False
+"""A finger's force while it has no reading (N; one array, not one per tick)."""
 
 
 @dataclass(frozen=True)
@@ -685,8 +688,8 @@ class GraspProgram:
             for f in self.fingers:
                 if f in obs.positions and f in last.positions:
                     force = 0.5 * (
-                        np.asarray(obs.forces.get(f, np.zeros(2)))
-                        + np.asarray(last.forces.get(f, np.zeros(2)))
+                        np.asarray(obs.forces.get(f, _NO_FORCE))
+                        + np.asarray(last.forces.get(f, _NO_FORCE))
                     )
                     self.work[f] += float(
                         force @ (np.asarray(obs.positions[f]) - np.asarray(last.positions[f]))

@@ -132,9 +132,9 @@ class TrackerConfig:
     mirror_tolerance: float = 0.05
 
 
-@dataclass(frozen=True)
-class FingerSample:
-    """The newest readings of one finger at a tick (object frame for positions and forces).
+class FingerSample(NamedTuple):
+    """The newest readings of one finger at a tick (object frame for positions and forces; a
+    named tuple: two are built per tick, a frozen dataclass took 4 us for each).
 
     Attributes
     ----------
@@ -286,6 +286,8 @@ def loaded_taxels(sample: FingerSample, threshold: float,
                         sample.angles[index], cos[index], sin[index])
 
 
+_NO_SAMPLE = FingerSample()
+"""The sample of a finger without readings at a tick."""
 _FIRST = np.zeros(1, dtype=np.intp)
 """The first run's start in :func:`patches_of`."""
 
@@ -297,21 +299,39 @@ def patches_of(finger: str, taxels: LoadedTaxels, config: TrackerConfig) -> list
     index = taxels.index
     if not len(index):
         return []
-    breaks = ((index[1:] - index[:-1]) > 1).nonzero()[0] + 1
-    starts = np.concatenate((_FIRST, breaks))
+    starts, firsts, lasts = _runs(index.tobytes())
     sums = np.add.reduceat(np.array((taxels.normal, taxels.tangential,
                                      taxels.normal * taxels.angles)), starts, axis=1)
-    lasts = np.concatenate((index[breaks - 1], index[-1:]))
     mu, edge = config.mu, 1.0 - config.edge_tolerance
     out = []
-    for first, last, normal, tangential, moment in zip(index[starts].tolist(), lasts.tolist(),
-                                                       *sums.tolist()):
+    for first, last, normal, tangential, moment in zip(firsts, lasts, *sums.tolist()):
         sliding = mu == 0.0 or abs(tangential) >= edge * mu * normal
         slip = (-1 if tangential > 0.0 else 1 if tangential < 0.0 else 0) \
             if sliding and mu > 0.0 else 0
         out.append(Patch(finger, moment / normal, normal, tangential,
-                         ContactMode.SLIP if sliding else ContactMode.STICK, slip, first, last))
+                         _SLIP if sliding else _STICK, slip, first, last))
     return out
+
+
+@functools.lru_cache(maxsize=256)
+def _runs(index: bytes) -> tuple[np.ndarray, tuple[int, ...], tuple[int, ...]]:
+    """(starts, first taxels, last taxels) of the maximal runs of neighbouring taxels among
+    loaded taxels ``index`` (the bytes of their increasing indices; kept: a finger's loaded
+    taxels stay the same over most ticks).
+    """
+    index = np.frombuffer(index, np.intp)
+    breaks = ((index[1:] - index[:-1]) > 1).nonzero()[0] + 1
+    starts = np.concatenate((_FIRST, breaks))
+    starts.flags.writeable = False
+    lasts = np.concatenate((index[breaks - 1], index[-1:]))
+    return starts, tuple(index[starts].tolist()), tuple(lasts.tolist())
+
+
+_SLIP, _STICK = ContactMode.SLIP, ContactMode.STICK
+"""The modes, looked up once (an enum member's attribute access is a Python call)."""
+_MIN, _MAX = np.minimum.reduce, np.maximum.reduce
+"""An array's least and greatest element (``ndarray.min`` and ``max`` without their Python
+wrappers)."""
 
 
 def mirror_tolerance_for(spacing: float, outline_error: float, *, tip_radius: float,
@@ -408,6 +428,22 @@ def _pairs(count: int) -> tuple[np.ndarray, np.ndarray]:
     return pairs
 
 
+def same_spans(previous: Sequence[Patch], current: Sequence[Patch], margin: int) -> bool:
+    """Whether the patches of two ticks cover the same taxel ranges, each patch apart from its
+    neighbours even widened by ``margin``: then :func:`connected_groups` pairs them one to one,
+    in order (the usual tick: the contact nodes stay on their taxels).
+    """
+    if len(previous) != len(current):
+        return False
+    last = None
+    for old, new in zip(previous, current):
+        if old.first != new.first or old.last != new.last or \
+                (last is not None and new.first - last <= 2 * margin):
+            return False
+        last = new.last
+    return True
+
+
 def connected_groups(previous: Sequence[Patch], current: Sequence[Patch],
                      margin: int) -> list[tuple[list[int], list[int]]]:
     """Groups (previous indices, current indices) of patches linked by overlapping taxel ranges.
@@ -486,8 +522,9 @@ class ContactTracker:
         alarms: list[TrackedAlarm] = []
         patches: list[Patch] = []
         loaded: dict[str, LoadedTaxels] = {}
+        positions, forces, normals, ages = {}, {}, {}, {}
         for name in self.fingers:
-            sample = samples.get(name, FingerSample())
+            sample = samples.get(name, _NO_SAMPLE)
             track = self.tracks[name]
             self._note_stamps(track, sample)
             taxels, trig = None, None
@@ -502,7 +539,11 @@ class ContactTracker:
             patches += track.patches
             track.force = self._force(sample, trig, track.force)
             track.normal = self._normal(taxels, track.normal)
-            alarms += self._alarms(name, track, taxels, stamp_ns)
+            ages[name] = age = self._age(track, stamp_ns)
+            alarms += self._alarms(name, track, taxels, age)
+            if track.position is not None:
+                positions[name] = track.position
+            forces[name], normals[name] = track.force.copy(), track.normal.copy()
         if cfg.weight is not None and not self.picked_up and self._can_lift(loaded):
             self.picked_up = True
             events.append(TrackedEvent(Termination.PICKED_UP, "", self.depth, relative, 0.0))
@@ -510,14 +551,10 @@ class ContactTracker:
         return TrackerOutput(
             stamp_ns,
             self.fingers,
-            {
-                f: self.tracks[f].position
-                for f in self.fingers
-                if self.tracks[f].position is not None
-            },
-            {f: self.tracks[f].force.copy() for f in self.fingers},
-            {f: self.tracks[f].normal.copy() for f in self.fingers},
-            {f: self._age(self.tracks[f], stamp_ns) for f in self.fingers},
+            positions,
+            forces,
+            normals,
+            ages,
             tuple(patches),
             tuple(events),
             tuple(alarms),
@@ -574,6 +611,16 @@ class ContactTracker:
     def _events(self, name: str, previous: list[Patch], current: list[Patch],
                 relative: float) -> list[TrackedEvent]:
         found = []
+        if same_spans(previous, current, self.config.match_margin):
+            # one to one: only a patch whose mode changed has an event (C or D)
+            for k, (old, new) in enumerate(zip(previous, current)):
+                if old.mode != new.mode:
+                    kind = EventType.C if old.mode == _STICK else EventType.D
+                    found.append((kind, new.angle, k in self._mirrored(self.tracks[name],
+                                                                       current)))
+            found.sort(key=lambda e: (processing_rank(e[0]), e[1]))
+            return [TrackedEvent(kind, name, self.depth, relative, angle, mirrored)
+                    for kind, angle, mirrored in found]
         for before, after in connected_groups(previous, current, self.config.match_margin):
             if not after:
                 found += [(EventType.B, previous[i].angle, False) for i in before]
@@ -617,10 +664,10 @@ class ContactTracker:
         return v / math.sqrt(v @ v)
 
     def _alarms(self, name: str, track: _FingerTrack, taxels: LoadedTaxels | None,
-                stamp_ns: int) -> list[TrackedAlarm]:
+                age: float) -> list[TrackedAlarm]:
+        """The finger's alarms at a tick (``age``: its stalest stream's, s)."""
         cfg = self.config
         out = []
-        age = self._age(track, stamp_ns)
         if age > cfg.stale_after:
             out.append(TrackedAlarm(AlarmType.STALE_SENSOR, name, age,
                                     f"newest {name} reading is {age * 1e3:.3g} ms old"))
@@ -640,7 +687,7 @@ class ContactTracker:
         if cfg.mu == 0.0 or taxels is None or not len(taxels.index):
             return None
         usage = -taxels.tangential / (cfg.mu * taxels.normal)
-        low, high = float(usage.min()), float(usage.max())
+        low, high = float(_MIN(usage)), float(_MAX(usage))
         if low >= cfg.alarm_ratio or high <= -cfg.alarm_ratio:
             return min(abs(low), abs(high))
         return None

@@ -184,7 +184,14 @@ class FingerSensors:
         contact nodes.
         """
         thetas, forces = contact_arrays(contacts)
-        nu = np.array([c.normal_angle for c in contacts], float)
+        return self.read_arrays(thetas, forces, np.array([c.normal_angle for c in contacts],
+                                                         float))
+
+    def read_arrays(self, thetas: np.ndarray, forces: np.ndarray, nu: np.ndarray
+                    ) -> tuple[np.ndarray, ContactGeometry]:
+        """:meth:`read` of the finger's nodes given as arrays: contact coordinates ``thetas``
+        (k,) rad, forces on the object (k, 2) N and contact normal angles ``nu`` (k,) rad.
+        """
         key = thetas.tobytes() + nu.tobytes()
         if key != self._key:
             self._key, self._geometry = key, contact_geometry(thetas, nu, self.tip, self.layout)

@@ -70,6 +70,7 @@ import time
 from collections import Counter
 from collections.abc import Mapping
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 
@@ -106,9 +107,9 @@ TERMINATE_ON: tuple[str, ...] = (
 """Stepper terminations that end the simulated world (as in Algorithm 1)."""
 
 
-@dataclass(frozen=True)
-class FingerReading:
-    """What one fingertip's devices and sensors report at a tick (SI, fingertip frame).
+class FingerReading(NamedTuple):
+    """What one fingertip's devices and sensors report at a tick (SI, fingertip frame; a named
+    tuple: one is built per finger and tick).
 
     Attributes
     ----------
@@ -417,7 +418,7 @@ class SimWorld:
         return target + offset
 
     def _output(self, events: tuple[Event, ...], *, released: bool = False) -> TickOutput:
-        readings = tuple(self._read(name) for name in self.fingers)
+        readings = tuple(map(self._read, self.fingers))
         return TickOutput(
             self.index, self.index * self.dt_ns, readings, events, self.termination, self.state,
             released,
@@ -425,7 +426,6 @@ class SimWorld:
 
     def _read(self, name: str) -> FingerReading:
         """Sensor readings of finger ``name`` (dropout decided before noise is drawn)."""
-        contacts = [c for c in self.state.contacts if c.finger == name]
         device = self.devices[name].name
         reading = {
             "finger": name,
@@ -436,17 +436,27 @@ class SimWorld:
         sensed = None
         if self.scene.has(Effect.FORCE_SENSING) and not rnd.dropped():
             self._work["wrench_evaluations"] += 1
-            forces, geometry = sensed = sensors.read(contacts)
+            forces, geometry = sensed = self._sense(name)
             force, torque = sensors.wrench(forces, geometry)
             reading["force"] = rnd.perturb(force)
             reading["torque"] = rnd.perturb(torque, self.radii[name])
         if name in self.layouts and not rnd.dropped():
             self._work["tactile_renderings"] += 1
-            forces, geometry = sensed or sensors.read(contacts)
+            forces, geometry = sensed or self._sense(name)
             normal, tangential = sensors.tactile(forces, geometry)
             reading["normal"] = rnd.perturb(normal)
             reading["tangential"] = rnd.perturb(tangential)
         return FingerReading(**reading)
+
+    def _sense(self, name: str) -> tuple:
+        """Finger ``name``'s sensors reading its contact nodes (:meth:`.sensors.FingerSensors.
+        read_arrays` of the state's :attr:`~.contact_state.ContactState.arrays`): (forces on
+        the object (k, 2), N; their geometry).
+        """
+        arrays = self.state.arrays
+        rows = arrays.rows(name)
+        return self.sensors[name].read_arrays(arrays.thetas[rows], arrays.forces[rows],
+                                              arrays.normal_angles[rows])
 
     # ----------------------------------------------------------------- geometry
     def _contact_solution(self) -> tuple:

@@ -10,9 +10,11 @@ see :mod:`.tip_shapes`).
 
 from __future__ import annotations
 
+import functools
 from collections import Counter
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field
+from operator import attrgetter
 
 import numpy as np
 
@@ -114,6 +116,55 @@ class ContactNode:
 
 
 @dataclass(frozen=True)
+class ContactArrays:
+    """A state's contact nodes as arrays, in the state's order (by node index): what the
+    simulated sensors and the ground truth's message read of them at every tick, gathered from
+    the nodes once per state (:attr:`ContactState.arrays`).
+
+    Attributes
+    ----------
+    fingers : tuple of Finger
+        Each node's finger.
+    thetas : (k,) ndarray
+        Contact coordinates, rad.
+    forces : (k, 2) ndarray
+        Forces of the fingers on the nodes, N.
+    normal_angles : (k,) ndarray
+        Contact normal angles nu, rad.
+    """
+
+    fingers: tuple[Finger, ...]
+    thetas: np.ndarray
+    forces: np.ndarray
+    normal_angles: np.ndarray
+
+    @classmethod
+    def of(cls, contacts: Iterable[ContactNode]) -> ContactArrays:
+        """The arrays of ``contacts``."""
+        contacts = tuple(contacts)
+        return cls(tuple(map(_FINGER, contacts)),
+                   np.array(list(map(_THETA, contacts)), float),
+                   np.array(list(map(_FORCE, contacts)), float).reshape(-1, 2),
+                   np.array(list(map(_NORMAL_ANGLE, contacts)), float))
+
+    def rows(self, finger: Finger | str) -> np.ndarray:
+        """Indices of ``finger``'s nodes, in order."""
+        return _finger_rows(self.fingers, finger)
+
+
+_FINGER, _THETA, _FORCE, _NORMAL_ANGLE = map(attrgetter, ("finger", "theta", "force",
+                                                         "normal_angle"))
+
+
+@functools.lru_cache(maxsize=256)
+def _finger_rows(fingers: tuple[Finger, ...], finger: Finger | str) -> np.ndarray:
+    """Indices of ``finger`` in ``fingers`` (kept: the same contact set tick after tick)."""
+    rows = np.array([k for k, f in enumerate(fingers) if f == finger], dtype=np.intp)
+    rows.flags.writeable = False
+    return rows
+
+
+@dataclass(frozen=True)
 class ContactState:
     """Everything the stepper needs to continue a squeeze; immutable.
 
@@ -171,6 +222,11 @@ class ContactState:
     def relative_depth(self) -> float:
         """Depth * relative_per_depth (fraction)."""
         return self.depth * self.relative_per_depth
+
+    @functools.cached_property
+    def arrays(self) -> ContactArrays:
+        """The contact nodes as arrays (computed once: the state is immutable)."""
+        return ContactArrays.of(self.contacts)
 
 
 def initial_state(tips: list[Fingertip], relative_per_depth: float = 0.0) -> ContactState:

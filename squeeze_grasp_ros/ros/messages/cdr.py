@@ -123,18 +123,35 @@ def cdr_stamp_ns(data: bytes) -> int:
 
 def pose_position_cdr(data: bytes) -> tuple[int, np.ndarray]:
     """(stamp ns, planar position (x, y) in m) of a serialised ``geometry_msgs/PoseStamped``."""
-    reader = _Reader(data)
-    stamp = reader.header()
-    reader.skip_string()
-    return stamp, reader.float64s(2)
+    return _after_header(data, 2)
 
 
 def wrench_force_cdr(data: bytes) -> tuple[int, np.ndarray]:
     """(stamp ns, force (3,) in N) of a serialised ``geometry_msgs/WrenchStamped``."""
+    return _after_header(data, 3)
+
+
+def _after_header(data: bytes, count: int) -> tuple[int, np.ndarray]:
+    """(stamp ns, the first ``count`` float64 after the header) of a message that starts with a
+    ``std_msgs/Header``: a little-endian one read at the offset its frame id's length gives, any
+    other walked by :class:`_Reader` (which also refuses what is not classic CDR).
+    """
+    if data[:2] == _CDR_LE and len(data) >= _BODY + 12:
+        at = _BODY + 12 + _U32_LE(data, _BODY + 8)[0]
+        at += -(at - _BODY) % 8
+        if at + 8 * count <= len(data):
+            sec, nanosec = _STAMP_LE(data, _BODY)
+            return (sec * 1_000_000_000 + nanosec,
+                    np.frombuffer(data, "<f8", count, at).astype(np.float64))
     reader = _Reader(data)
     stamp = reader.header()
     reader.skip_string()
-    return stamp, reader.float64s(3)
+    return stamp, reader.float64s(count)
+
+
+_CDR_LE = b"\x00\x01"
+"""The encapsulation of little-endian classic CDR."""
+_U32_LE, _STAMP_LE = struct.Struct("<I").unpack_from, struct.Struct("<iI").unpack_from
 
 
 def tactile_readings_cdr(data: bytes) -> tuple[int, TactileReadings]:
@@ -147,6 +164,10 @@ def tactile_readings_cdr(data: bytes) -> tuple[int, TactileReadings]:
     layout = _TACTILE_LAYOUTS.get(len(data))
     if layout is not None and data[1] == 1 and data[_BODY + 8:layout.start] == layout.prefix \
             and all(data[at:at + 4] == layout.count for at in layout.counts):
+        if layout.stride:  # the three arrays evenly spaced: one strided copy
+            taxels = np.ndarray((3, layout.size), "<f8", data, layout.runs[0],
+                                (layout.stride, 8)).astype(np.float64)
+            return cdr_stamp_ns(data), TactileReadings(layout.finger, *taxels)
         return cdr_stamp_ns(data), TactileReadings(
             layout.finger, *(np.frombuffer(data, "<f8", layout.size, at).copy()
                              for at in layout.runs))
@@ -165,7 +186,9 @@ def tactile_readings_cdr(data: bytes) -> tuple[int, TactileReadings]:
         _TACTILE_LAYOUTS[len(data)] = _Layout(counts[0] + 4, bytes(data[_BODY + 8:counts[0] + 4]),
                                               tuple(counts[1:]),
                                               bytes(data[counts[0]:counts[0] + 4]), finger,
-                                              count, tuple(runs))
+                                              count, tuple(runs),
+                                              runs[1] - runs[0] if runs[2] - runs[1] ==
+                                              runs[1] - runs[0] else 0)
     return stamp, TactileReadings(finger, *arrays)
 
 
@@ -207,6 +230,8 @@ class _Layout(NamedTuple):
     """Numbers per array."""
     runs: tuple[int, ...]
     """Offsets of the arrays."""
+    stride: int = 0
+    """Bytes from one array to the next when they are evenly spaced (else 0)."""
 
 
 _TACTILE_LAYOUTS: dict[int, _Layout] = {}

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import functools
 from collections.abc import Sequence
+from operator import attrgetter
 
 import numpy as np
 from geometry_msgs.msg import Point, Vector3
@@ -84,17 +85,16 @@ def sim_state_cdr(
     publishes every tick, without a Python message in between.
     """
     present = {f.name: f for f in state.fingers}
-    contacts = state.contacts
-    layout = tuple((c.finger, c.node, c.mode) for c in contacts)
-    forces = np.array([c.force for c in contacts]).reshape(len(contacts), 2)
-    names = tuple(c.finger for c in contacts)
-    totals = [forces[rows].sum(axis=0) if rows is not None else (0.0, 0.0)
+    contacts, arrays = state.contacts, state.arrays
+    layout = tuple(map(_LAYOUT, contacts))
+    forces, names = arrays.forces, arrays.fingers
+    totals = [_SUM(forces[rows], axis=0) if rows is not None else (0.0, 0.0)
               for rows in _finger_rows(names, tuple(fingers))]
     values = ([(*present[f].center[:2], 0.0) if f in present else (0.0, 0.0, 0.0)
                for f in fingers],
               [(x, y, 0.0) for x, y in totals],
               [present[f].work if f in present else 0.0 for f in fingers],
-              [c.theta for c in contacts], forces[:, 0], forces[:, 1],
+              arrays.thetas, forces[:, 0], forces[:, 1],
               state.depth, state.relative_depth)
 
     def write() -> CdrTemplate:
@@ -107,6 +107,12 @@ def sim_state_cdr(
         return CdrTemplate(writer, (stamp, nested[0]), runs + nested[1])
     return refilled(("sim_state", frame_id, tuple(fingers), tuple(present), layout,
                      termination or ""), write, ns, values)
+
+
+_LAYOUT = attrgetter("finger", "node", "mode")
+"""A contact node's (finger, node, mode): the ground truth's layout key."""
+_SUM = np.add.reduce
+"""``ndarray.sum`` without its Python wrapper."""
 
 
 @functools.lru_cache(maxsize=64)

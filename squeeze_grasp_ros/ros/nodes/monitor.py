@@ -223,6 +223,7 @@ class MonitorNode(Node):
         kept = pipeline.loop_qos(p["qos_depth"], kept=True)
         self.state_pub = self.create_publisher(ContactState, pipeline.CONTACT_STATE, kept)
         self.status_pub = self.create_publisher(MonitorStatus, pipeline.STATUS, kept)
+        self.lockstep = p["lockstep"]
         self.latest: dict[str, Any] = {}
         self.buffer: dict[int, dict[str, Any]] = {}
         self.expected: dict[int, set[str]] = {}
@@ -235,6 +236,9 @@ class MonitorNode(Node):
         self.forces = (ForceWatcher(self, p["force_tolerance"], p["force_min_fraction"], outputs)
                        if p["force_watch"] else None)
         if p["lockstep"]:
+            # the ticks' stamps are the monitor's time and it reads no clock: it does not take
+            # /clock (one delivery a tick), whatever use_sim_time says
+            self._time_source.ros_time_is_active = False
             self.create_subscription(Tick, pipeline.TICK, self._tick, loop, raw=True)
             self.participant = pipeline.Participant(self, "monitor", [pipeline.TICK],
                                                     [self.status_pub],
@@ -274,13 +278,14 @@ class MonitorNode(Node):
         """A reading stamped ``ns``: the tracker's sample fields of a device stream, or the
         joint state message.
         """
-        if not self.p["lockstep"]:
+        if not self.lockstep:
             self.latest[key] = msg
             return
         if ns <= self.answered.stamp_ns:
             return
         self.buffer.setdefault(ns, {})[key] = msg
-        self._try_close(ns)
+        if ns in self.expected:  # its tick is here: the reading may close it
+            self._try_close(ns)
 
     def _tick(self, data: bytes) -> None:
         """A ``sim/tick``, read from its CDR bytes (:mod:`..messages.cdr`)."""

@@ -71,6 +71,7 @@ def test_the_lockstep_monitor_takes_no_clock_and_the_hardware_monitor_follows_it
             executor.spin_once(0.05)
         assert monitors[False].get_clock().ros_time_is_active
         assert not monitors[True].get_clock().ros_time_is_active
+        assert [m.get_parameter("use_sim_time").value for m in monitors.values()] == [False, True]
         assert clocks[True].get_subscription_count() == 0
     finally:
         executor.shutdown()

@@ -75,6 +75,8 @@ def test_a_kept_client_names_an_outcome_publisher_it_never_hears(ros):
     observer = Observer(client, kept=True)
     for n in (node, client):
         executor.add_node(n)
-    spin(executor, lambda: observer.subscriptions[1].get_publisher_count() > 0, 10.0)
+    spin(executor, observer.incompatible, 10.0)
     assert observer.incompatible() == [f"{namespace}/monitor/events ({namespace}/monitor)"]
+    spin(executor, lambda: False, 0.5)
+    assert not observer.matched()  # never: so run refuses it rather than wait for a match
     assert Observer(client, kept=False).incompatible() == []

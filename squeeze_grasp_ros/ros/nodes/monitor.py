@@ -110,7 +110,9 @@ PARAMETERS: dict[str, tuple[Any, str]] = {
     "relative_per_depth": (0.0, "relative depth per unit depth, 1/m (reports)"),
     "mirror_tolerance": (0.05, "patches mirrored about the finger's force line within this "
                                "fraction of their separation are a tie (no C/D mismatch)"),
-    "lockstep": (True, "close ticks on sim/tick (simulation) or on a wall-clock timer"),
+    "lockstep": (True, "close ticks on sim/tick (simulation: the ticks' stamps are the "
+                 "monitor's time, use_sim_time is set false and /clock not taken) or on a "
+                 "wall-clock timer"),
     "rate": (100.0, "hardware mode: status rate, Hz"),
     "frame_id": (pipeline.FRAME, "object frame"),
     "sensor_qos": ("reliable", "QoS of the readings: reliable (lockstep) or sensor_data"),
@@ -236,9 +238,10 @@ class MonitorNode(Node):
         self.forces = (ForceWatcher(self, p["force_tolerance"], p["force_min_fraction"], outputs)
                        if p["force_watch"] else None)
         if p["lockstep"]:
-            # the ticks' stamps are the monitor's time and it reads no clock: it does not take
-            # /clock (one delivery a tick), whatever use_sim_time says
-            self._time_source.ros_time_is_active = False
+            # the ticks' stamps are the monitor's time and it reads no clock: use_sim_time off,
+            # so it does not take /clock (one delivery a tick); the parameter says so
+            if self.get_parameter("use_sim_time").value:
+                self.set_parameters([Parameter("use_sim_time", value=False)])
             self.create_subscription(Tick, pipeline.TICK, self._tick, loop, raw=True)
             self.participant = pipeline.Participant(self, "monitor", [pipeline.TICK],
                                                     [self.status_pub],

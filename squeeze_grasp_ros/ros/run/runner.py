@@ -240,9 +240,9 @@ class PipelineRunner:
         self.spin_until(lambda: self.goal.action.server_is_ready(), options.timeout,
                         "the executor's action server")
         self.spin_until(lambda: self.observer.sim_state_ns >= 0, options.timeout, "tick 0")
-        self.spin_until(self.observer.matched, options.timeout,
-                        "the publishers of the run's outcome topics")
-        volatile = self.observer.incompatible()
+        self.spin_until(lambda: self.observer.matched() or self.observer.incompatible(),
+                        options.timeout, "the publishers of the run's outcome topics")
+        volatile = self.observer.incompatible()  # they never match: refused, not awaited
         if volatile:
             raise RunError("the run's outcome topics need their lockstep publishers "
                            "(transient-local); volatile, so never received: "

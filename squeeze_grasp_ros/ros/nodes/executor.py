@@ -81,6 +81,9 @@ PARAMETERS: dict[str, tuple[Any, str]] = {
     "qos_depth": (100, "history depth of the reliable topics"),
     "controller_scene": ("", "scene file whose controller: section drives the jaws through "
                              "a stock controller (empty: setpoint topics only)"),
+    "await_prediction": (False, "lockstep, jaws under a stock controller: ready only once "
+                                "planner/predicted_events has arrived (run sets it: it "
+                                "publishes one before the nodes start)"),
 }
 """Parameter name -> (typed default, description); config/executor.yaml sets them."""
 
@@ -138,10 +141,14 @@ class ExecutorNode(Node):
         controller = scene_controller(load_scene(p["controller_scene"]), p["controller_scene"]) \
             if p["controller_scene"] else None
         action = controller is not None and controller.kind.is_action
-        self.jaws = (HandCommands if isinstance(controller, HandController) else JawCommands)(
-            self, controller, p["period"], loop) if controller is not None and not action \
-            else None
-        self.jaw_action = jaw_action(self, controller, loop) if action else None
+        self.jaws = None
+        if isinstance(controller, HandController):
+            self.jaws = HandCommands(self, controller, p["period"], loop)
+        elif controller is not None and not action:
+            self.jaws = JawCommands(self, controller, p["period"], loop,
+                                    awaited=p["await_prediction"])
+        self.jaw_action = jaw_action(self, controller, loop, awaited=p["await_prediction"]) \
+            if action else None
         """The scene's gripper under a JointTrajectoryController (jaws) or a gripper action
         controller (jaw_action), if any."""
         jaw_fingers = controller.jaws if controller is not None else ()
@@ -376,8 +383,9 @@ class ExecutorNode(Node):
             goal.since_feedback = []
 
 
-def jaw_action(node: Node, controller: JawController, qos: Any) -> Any:
-    """The executor's side of a gripper action controller (:class:`.jaw_action.JawAction`).
+def jaw_action(node: Node, controller: JawController, qos: Any, *, awaited: bool) -> Any:
+    """The executor's side of a gripper action controller (:class:`.jaw_action.JawAction`;
+    ``awaited`` as there).
 
     Raises
     ------
@@ -390,7 +398,7 @@ def jaw_action(node: Node, controller: JawController, qos: Any) -> Any:
         raise ParameterError(f"controller.type {controller.kind} needs control_msgs ({exc}): "
                              "build it with squeeze-grasp ros-setup --control-msgs DIR "
                              "(docs/grippers.md)") from None
-    return JawAction(node, controller, qos)
+    return JawAction(node, controller, qos, awaited=awaited)
 
 
 def main(args: list[str] | None = None) -> int:

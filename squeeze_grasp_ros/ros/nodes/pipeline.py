@@ -306,6 +306,19 @@ class TickAnswer:
             publisher.publish(msg)
 
 
+def prediction_ready(node: Node, *, seen: bool, awaited: bool) -> bool:
+    """Lockstep readiness of a node that judges the run by the planner's latched
+    ``planner/predicted_events``: True once it has ``seen`` it, or when it is not ``awaited``
+    and nobody publishes one (a launch without a planner).
+
+    "Nobody publishes one" is a statement about this node's view of the graph, which across
+    processes can lag the writer: a node that had not yet discovered the run's publisher was
+    ready without the prediction and judged the first cycles against none. So a caller that
+    knows a prediction comes (``run`` publishes it before its nodes start) sets ``awaited``.
+    """
+    return seen or (not awaited and node.count_publishers(PREDICTION) == 0)
+
+
 class Participant:
     """A node's side of the lockstep handshake: answer ``sim/hello`` once its peers are there.
 

@@ -163,10 +163,17 @@ class ExecutorNode(Node):
         pose_pub = self.create_publisher(PoseStamped, pipeline.OBJECT_POSE, pipeline.LATCHED)
         pose_pub.publish(messages.pose_in_base(p["object_pose"], p["base_frame"]))
         self.create_subscription(MonitorStatus, pipeline.STATUS, self._status, loop, raw=True)
+        # keep-all request queues (rclpy's default of 10 dropped the 11th and later goals of a
+        # burst unanswered: 10 answers to 30 goals sent at once)
+        queues = {f"{kind}_service_qos_profile": pipeline.request_queue(0)
+                  for kind in ("goal", "cancel", "result")}
         self.server = ActionServer(self, ExecuteGrasp, pipeline.ACTION, self._execute,
                                    goal_callback=self._accept_goal,
-                                   cancel_callback=lambda _: CancelResponse.ACCEPT)
+                                   cancel_callback=lambda _: CancelResponse.ACCEPT, **queues)
         self.goal: _Goal | None = None
+        self.accepted = False
+        """A goal was accepted and has not ended yet (its execution may not have started:
+        rclpy runs it as a later task, after more goal requests may have been taken)."""
         self.latest: bytes | None = None
         """The newest status, serialised (a raw subscription: :meth:`_cycle` reads it)."""
         self.answered = pipeline.TickAnswer()
@@ -193,9 +200,23 @@ class ExecutorNode(Node):
         super().destroy_node()
 
     def _accept_goal(self, _: ExecuteGrasp.Goal) -> GoalResponse:
-        return GoalResponse.REJECT if self.goal is not None else GoalResponse.ACCEPT
+        """One goal at a time: reject while one is accepted, running or not started yet
+        (before, checking only the running goal, a burst of goals at an idle executor on
+        ``EventsExecutor`` had 10 of 10 answered goals accepted; each replaced the previous,
+        whose result never came).
+        """
+        if self.accepted:
+            return GoalResponse.REJECT
+        self.accepted = True
+        return GoalResponse.ACCEPT
 
     async def _execute(self, handle: ServerGoalHandle) -> ExecuteGrasp.Result:
+        try:
+            return await self._run_goal(handle)
+        finally:
+            self.accepted = False
+
+    async def _run_goal(self, handle: ServerGoalHandle) -> ExecuteGrasp.Result:
         goal = messages.grasp_goal(handle.request)
         problem = goal_problem(goal, list(self.devices))
         if problem is None and self.jaws is not None:

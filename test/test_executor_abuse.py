@@ -15,6 +15,7 @@ from geometry_msgs.msg import Point, Vector3
 from rclpy.action import ActionClient
 from rclpy.experimental import EventsExecutor
 from rclpy.node import Node
+from rclpy.parameter import Parameter
 
 from squeeze_grasp_interfaces.action import ExecuteGrasp
 from squeeze_grasp_interfaces.msg import MonitorStatus
@@ -33,9 +34,10 @@ class Rig:
     publisher of ``monitor/status`` that drives the executor's lockstep cycles.
     """
 
-    def __init__(self, context, clients: int) -> None:
+    def __init__(self, context, clients: int, **parameters) -> None:
         self.spinner = EventsExecutor(context=context)
-        self.node = ExecutorNode(context=context)
+        self.node = ExecutorNode(context=context, parameter_overrides=[
+            Parameter(name, value=value) for name, value in parameters.items()])
         self.peer = Node("abuser", context=context)
         self.status = self.peer.create_publisher(MonitorStatus, pipeline.STATUS,
                                                  pipeline.loop_qos(100))
@@ -168,3 +170,41 @@ def test_goals_with_garbage_fields_end_invalid_naming_the_field_and_the_node_ser
     assert rig.until(lambda: rig.node.goal is not None and rig.node.goal.start_ns is not None)
     future.result().cancel_goal_async()
     assert rig.result_of(future.result()).termination == ExecuteGrasp.Result.CANCELED
+
+
+@pytest.mark.parametrize("lockstep", [True, False])
+def test_a_goal_canceled_before_any_status_ends_at_once(ros_context, lockstep):
+    """A goal accepted while no monitor status comes (the loop or the monitor stopped) and
+    then canceled: before, the cancel was accepted and the goal never ended (it waited for a
+    status to run its cycle). Now it ends ``canceled``, having commanded nothing.
+    """
+    rig = Rig(ros_context, clients=1, lockstep=lockstep, stale_budget=60.0)
+    try:
+        future = rig.clients[0].send_goal_async(squeeze())
+        assert rig.until(future.done) and future.result().accepted
+        assert rig.until(lambda: rig.node.goal is not None)
+        result = future.result().get_result_async()
+        cancel = future.result().cancel_goal_async()
+        assert rig.until(lambda: cancel.done() and result.done(), seconds=10.0), \
+            "the canceled goal never ended"
+        assert result.result().result.termination == ExecuteGrasp.Result.CANCELED
+        assert "nothing was commanded" in result.result().result.message
+    finally:
+        rig.close()
+
+
+def test_a_hardware_goal_without_any_monitor_status_ends_after_the_stale_budget(ros_context):
+    """Hardware mode (wall-clock cycles), no monitor at all: before, the goal waited for ever;
+    now it ends ``stale_data`` after ``stale_budget`` s, naming the topic it waited for.
+    """
+    rig = Rig(ros_context, clients=1, lockstep=False, stale_budget=0.2)
+    try:
+        future = rig.clients[0].send_goal_async(squeeze())
+        assert rig.until(future.done) and future.result().accepted
+        result = future.result().get_result_async()
+        assert rig.until(result.done, seconds=10.0), "the goal never ended"
+        ended = result.result().result
+        assert ended.termination == ExecuteGrasp.Result.STALE_DATA
+        assert "no /monitor/status message within stale_budget 0.2 s" in ended.message
+    finally:
+        rig.close()

@@ -38,6 +38,7 @@ from __future__ import annotations
 
 import math
 import sys
+import time
 from typing import Any
 
 from geometry_msgs.msg import PoseStamped
@@ -106,6 +107,9 @@ class _Goal:
         self.since_feedback: list = []
         self.start_ns: int | None = None
         self.waiting_since_ns: int | None = None
+        self.waiting_since: float | None = None
+        """Wall-clock (monotonic) s since which the goal waits for any monitor status
+        (hardware mode)."""
         self.releasing = False
         """The action route's gripper goal is a release's (its result is not the goal's)."""
         self.lifting = False
@@ -169,7 +173,7 @@ class ExecutorNode(Node):
                   for kind in ("goal", "cancel", "result")}
         self.server = ActionServer(self, ExecuteGrasp, pipeline.ACTION, self._execute,
                                    goal_callback=self._accept_goal,
-                                   cancel_callback=lambda _: CancelResponse.ACCEPT, **queues)
+                                   cancel_callback=self._accept_cancel, **queues)
         self.goal: _Goal | None = None
         self.accepted = False
         """A goal was accepted and has not ended yet (its execution may not have started:
@@ -210,6 +214,26 @@ class ExecutorNode(Node):
         self.accepted = True
         return GoalResponse.ACCEPT
 
+    def _accept_cancel(self, handle: ServerGoalHandle) -> CancelResponse:
+        """Accept every cancel. The running goal ends at its next cycle; one that has had no
+        cycle yet (no monitor status since it was accepted) ends now, having commanded nothing
+        (before, it waited for a status that, with the monitor or the loop stopped, never
+        came: the cancel was accepted and the goal never ended).
+        """
+        goal = self.goal
+        if goal is not None and goal.handle is handle and goal.start_ns is None:
+            self._end_unstarted(goal, ExecuteGrasp.Result.CANCELED,
+                                "canceled before its first control cycle; nothing was "
+                                "commanded")
+        return CancelResponse.ACCEPT
+
+    def _end_unstarted(self, goal: _Goal, termination: str, message: str) -> None:
+        """End ``goal``, which has commanded nothing, with ``termination``."""
+        self.goal = None
+        goal.done.set_result(messages.grasp_result(
+            goal.program, Command({}, "holding", termination, message), None, [], 0.0,
+            SUCCESS))
+
     async def _execute(self, handle: ServerGoalHandle) -> ExecuteGrasp.Result:
         try:
             return await self._run_goal(handle)
@@ -247,8 +271,20 @@ class ExecutorNode(Node):
             self._cycle(data)
 
     def _timer(self) -> None:
-        if self.goal is not None and self.latest is not None:
+        goal = self.goal
+        if goal is None:
+            return
+        if self.latest is not None:
             self._cycle(self.latest, self.get_clock().now().nanoseconds)
+            return
+        # no monitor status at all yet: wait stale_budget of wall-clock time, then end
+        now = time.monotonic()
+        goal.waiting_since = now if goal.waiting_since is None else goal.waiting_since
+        if now - goal.waiting_since > self.p["stale_budget"]:
+            self._end_unstarted(goal, ExecuteGrasp.Result.STALE_DATA,
+                                f"no {self.resolve_topic_name(pipeline.STATUS)} message within "
+                                f"stale_budget {self.p['stale_budget']} s of the goal (is the "
+                                "monitor running?); nothing was commanded")
 
     def _cycle(self, data: bytes, now_ns: int | None = None) -> None:
         """One control cycle on the serialised status ``data``; publish the setpoints, finish

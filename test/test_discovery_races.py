@@ -132,3 +132,37 @@ def test_an_executor_under_a_gripper_action_is_ready_only_with_its_action_server
         server.destroy()
     finally:
         spin.close()
+
+
+def test_a_publisher_the_recorder_cannot_take_is_named_in_the_recording(ros_context, tmp_path,
+                                                                      capfd):
+    """In lockstep the recorder reads the loop's topics transient-local; a volatile publisher of
+    one (an attached node of another configuration) is never matched, so nothing of it is
+    recorded. Before, only rclpy's generic warning said so, and the recording did not; now the
+    recorder logs an error naming the topic and the policy and lists it in
+    ``metadata.yaml`` (``custom_data.incompatible_publishers``), which ``run`` reports (exit 4).
+    A compatible publisher is not listed.
+    """
+    from squeeze_grasp_interfaces.msg import Tick
+    from squeeze_grasp_ros.ros.nodes.recorder import RecorderNode
+    from squeeze_grasp_ros.ros.recording.bag import INCOMPATIBLE_KEY, bag_info
+
+    recorder = RecorderNode(context=ros_context, parameter_overrides=[
+        Parameter("output", value=str(tmp_path / "bag"))])
+    peer = Node("attached_like", context=ros_context)
+    peer.create_publisher(MonitorStatus, pipeline.STATUS, pipeline.loop_qos(10))
+    peer.create_publisher(Tick, pipeline.TICK, pipeline.loop_qos(10, kept=True))
+    spin = Spinner(ros_context, recorder, peer)
+    try:
+        spin.until(lambda: "/" + pipeline.STATUS in recorder.incompatible)
+        spin.executor.spin_once(timeout_sec=0.5)
+        assert recorder.incompatible == {"/" + pipeline.STATUS: "durability"}
+        recorder.close()
+    finally:
+        spin.close()
+    custom = bag_info(str(tmp_path / "bag"))["custom_data"]
+    assert custom[INCOMPATIBLE_KEY] == "{/monitor/status: durability}"
+    err = capfd.readouterr().err
+    assert ("/monitor/status: a publisher offers a QoS the recorder cannot take (durability; "
+            "the recorder asks reliable, transient_local): nothing it publishes is recorded"
+            in err)

@@ -62,15 +62,21 @@ def executor_node(context, scene: str, awaited: bool):
         Parameter("await_prediction", value=awaited)])
 
 
-def loop_peer(context, executor) -> Node:
-    """A driver-like peer: publishes the monitor's status, takes every lockstep output."""
+def executor_rig(context, scene: str, awaited: bool):
+    """(executor, driver-like peer, spinner) once the peer's ``monitor/status`` publisher and
+    its reader of the executor's lockstep output (the jaws' trajectory or ``executor/cycle``)
+    have met the executor.
+    """
+    executor = executor_node(context, scene, awaited)
     peer = Node("loop_peer", context=context)
     kept = pipeline.loop_qos(100, kept=True)
     peer.create_publisher(MonitorStatus, pipeline.STATUS, kept)
-    driver = executor.jaws or executor.jaw_action
-    topic = driver.publisher.topic_name
-    peer.create_subscription(driver.publisher.msg_type, topic, lambda _: None, kept)
-    return peer
+    output = (executor.jaws or executor.jaw_action).publisher
+    peer.create_subscription(output.msg_type, output.topic_name, lambda _: None, kept)
+    spin = Spinner(context, executor, peer)
+    spin.until(lambda: executor.count_publishers(pipeline.STATUS) > 0
+               and output.get_subscription_count() > 0)
+    return executor, peer, spin
 
 
 @pytest.mark.parametrize("awaited", [True, False])
@@ -83,12 +89,8 @@ def test_an_executor_awaiting_the_force_curve_is_ready_only_once_it_arrived(ros_
     waits for the curve whatever it has discovered; without, it waits only for a publisher it
     knows of.
     """
-    executor = executor_node(ros_context, "sponge_gripper.yaml", awaited)
-    peer = loop_peer(ros_context, executor)
-    spin = Spinner(ros_context, executor, peer)
+    executor, peer, spin = executor_rig(ros_context, "sponge_gripper.yaml", awaited)
     try:
-        spin.until(lambda: executor.count_publishers(pipeline.STATUS) > 0
-                   and executor.jaws.publisher.get_subscription_count() > 0)
         assert executor.count_publishers(pipeline.PREDICTION) == 0
         assert executor.participant.ready() is not awaited
         prediction = peer.create_publisher(ContactEventArray, pipeline.PREDICTION,
@@ -112,12 +114,8 @@ def test_an_executor_under_a_gripper_action_is_ready_only_with_its_action_server
     from control_msgs.action import ParallelGripperCommand
     from rclpy.action import ActionServer
 
-    executor = executor_node(ros_context, "sponge_gripper_parallel.yaml", False)
-    peer = loop_peer(ros_context, executor)
-    spin = Spinner(ros_context, executor, peer)
+    executor, peer, spin = executor_rig(ros_context, "sponge_gripper_parallel.yaml", False)
     try:
-        spin.until(lambda: executor.count_publishers(pipeline.STATUS) > 0
-                   and executor.jaw_action.publisher.get_subscription_count() > 0)
         spin.executor.spin_once(timeout_sec=0.5)
         assert not executor.participant.ready()
         answered = []

@@ -32,7 +32,10 @@ fingers keep their setpoint topics.
 
 Feedback (every ``feedback_every`` cycles): state, measured depth and forces, events since the
 previous feedback. Cancel: the next cycle holds the measured positions and the goal ends
-``canceled``. Only one goal runs at a time; others are rejected.
+``canceled`` (a goal that has had no cycle yet ends at once, having commanded nothing). Only
+one goal runs at a time; others are rejected, also in a burst (the action's request queues keep
+every request). On hardware, a goal that sees no ``monitor/status`` at all within
+``stale_budget`` s ends ``stale_data``.
 """
 from __future__ import annotations
 

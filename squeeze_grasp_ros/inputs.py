@@ -24,8 +24,24 @@ from typing import Any
 
 import yaml
 
-__all__ = ["InputError", "MAX_FILE_BYTES", "MAX_TEXT_BYTES", "confine", "load_yaml",
-           "read_bytes", "read_text"]
+__all__ = ["InputError", "MAX_FILE_BYTES", "MAX_TEXT_BYTES", "SHOWN_CHARS", "confine",
+           "load_yaml", "read_bytes", "read_text", "shown"]
+
+SHOWN_CHARS = 40
+"""Most characters of a client's string that a message or log line quotes."""
+
+
+def shown(value: str, limit: int = SHOWN_CHARS) -> str:
+    """``repr(value)``, cut after ``limit`` characters with the full length said.
+
+    >>> shown("F" * 50, 4)
+    "'FFFF...' (50 characters)"
+    """
+    if len(value) <= limit:
+        return repr(value)
+    text = repr(value[:limit])
+    return f"{text[:-1]}...{text[-1]} ({len(value)} characters)"
+
 
 MAX_FILE_BYTES = 8 * 1024 * 1024
 """Bytes read at most from a scene, spec or outline file (8 MiB)."""

@@ -210,6 +210,28 @@ def test_oversized_and_huge_text_inputs_are_refused(planner, tmp_path):
     assert_alive(planner)
 
 
+def test_scene_yaml_at_the_size_limit_loads_and_one_byte_more_is_refused(planner):
+    """``scene_yaml`` of exactly MAX_TEXT_BYTES bytes (UTF-8; the padding a comment of
+    two-byte characters) loads; one byte more is refused naming the field and the limit.
+    """
+    from squeeze_grasp_ros.inputs import MAX_TEXT_BYTES
+
+    def padded(size: int) -> str:
+        head = BLOB + "# "
+        room = size - len(head.encode())
+        return head + "\u00e9" * (room // 2) + "x" * (room % 2)
+
+    at, beyond = padded(MAX_TEXT_BYTES), padded(MAX_TEXT_BYTES + 1)
+    assert (len(at.encode()), len(beyond.encode())) == (MAX_TEXT_BYTES, MAX_TEXT_BYTES + 1)
+    response = load(planner, scene_yaml=at, object_id="at_limit")
+    assert response.success, response.message
+    response = load(planner, scene_yaml=beyond, object_id="beyond")
+    assert response.error_code == ErrorCode.INVALID_ARGUMENT
+    assert f"scene_yaml: YAML text is larger than the {MAX_TEXT_BYTES}-byte limit" in \
+        response.message, response.message
+    assert_alive(planner)
+
+
 def scene_variant(tmp_path: Path, name: str, change) -> str:
     data = yaml.safe_load((SCENES / "foam_square.yaml").read_text())
     change(data)

@@ -101,6 +101,99 @@ def test_a_burst_of_200_grasp_map_goals_gets_200_responses_and_results(planner):
     assert len(maps) == 1 and maps.pop() > 0
 
 
+def test_mixed_requests_from_several_clients_at_once_are_all_answered(planner):
+    """Five clients at once, each with its own keep-all queue: YAML and typed loads, squeezes of
+    an object still loading, and requests with one garbage field (empty or broken YAML, a NaN
+    modulus, a 1,000-character id, two sources, NaN, negative and infinite depths, an unknown
+    squeeze type, an unknown id). Every request is answered; loads are OK or BUSY; squeezes of
+    the loading object OK or UNKNOWN_OBJECT; every bad field INVALID_ARGUMENT or
+    UNKNOWN_OBJECT with the field named (a bad load beyond ``max_pending`` may be answered BUSY
+    first: sent again, it is refused naming the field); no INTERNAL_ERROR; afterwards the
+    planner serves on.
+    """
+    import math
+
+    import numpy as np
+
+    from squeeze_grasp_ros.mechanics.elastic.shapes import Outline
+    from squeeze_grasp_ros.ros.messages.objects import object_description
+
+    def typed(modulus: float = 5.0e4):
+        return object_description(
+            Outline(np.array([[-0.05, -0.05], [0.05, -0.05], [0.05, 0.05], [-0.05, 0.05]])),
+            "object", youngs_modulus=modulus, poisson_ratio=0.3, thickness=0.0254,
+            placements=((-0.05, 0.0), (0.05, 0.0)), tip_radius=0.02, mu=0.4, mesh_nodes=300)
+
+    def squeeze(**fields) -> PlanSqueeze.Request:
+        return PlanSqueeze.Request(**{"object_id": "y0", "squeeze_type": "stable",
+                                      "depth": 1e-3, **fields})
+
+    loads = ([LoadObject.Request(scene_yaml=BLOB, object_id=f"y{k}") for k in range(8)]
+             + [LoadObject.Request(object=typed(), object_id=f"t{k}") for k in range(8)])
+    bad_loads = {
+        "scene_yaml": LoadObject.Request(scene_yaml="{"),
+        "exactly one": LoadObject.Request(),
+        "youngs_modulus": LoadObject.Request(object=typed(math.nan)),
+        "object_id": LoadObject.Request(scene_yaml=BLOB, object_id="x" * 1000),
+        "exactly one of": LoadObject.Request(scene_yaml=BLOB, object=typed()),
+    }
+    bad_squeezes = {
+        "depth": squeeze(depth=math.nan),
+        "depth ": squeeze(depth=-1e-3),
+        "depth  ": squeeze(depth=math.inf),
+        "squeeze_type": squeeze(squeeze_type="bogus"),
+        "unknown object_id": squeeze(object_id="nobody"),
+    }
+    clients = {name: planner.node.create_client(srv, f"{planner.planner_name}/{name}",
+                                                qos_profile=KEEP_ALL)
+               for name, srv in (("load_object", LoadObject), ("plan_squeeze", PlanSqueeze))}
+    yaml_loads = planner.node.create_client(LoadObject, f"{planner.planner_name}/load_object",
+                                            qos_profile=KEEP_ALL)
+    bad_client = planner.node.create_client(LoadObject, f"{planner.planner_name}/load_object",
+                                            qos_profile=KEEP_ALL)
+    squeezes = planner.node.create_client(PlanSqueeze, f"{planner.planner_name}/plan_squeeze",
+                                          qos_profile=KEEP_ALL)
+    every = [*clients.values(), yaml_loads, bad_client, squeezes]
+    try:
+        for client in every:
+            assert client.wait_for_service(timeout_sec=30.0)
+        sent = {
+            "loads": [(yaml_loads if k < 8 else clients["load_object"]).call_async(r)
+                      for k, r in enumerate(loads)],
+            "squeezes": [squeezes.call_async(squeeze()) for _ in range(20)],
+            "bad_loads": [bad_client.call_async(r) for r in bad_loads.values()],
+            "bad_squeezes": [clients["plan_squeeze"].call_async(r)
+                             for r in bad_squeezes.values()],
+        }
+        spin_until_done(planner, [f for futures in sent.values() for f in futures])
+    finally:
+        for client in every:
+            planner.node.destroy_client(client)
+    got = {kind: [f.result() for f in futures] for kind, futures in sent.items()}
+    codes = {kind: Counter(ErrorCode(r.error_code) for r in responses)
+             for kind, responses in got.items()}
+    assert set(codes["loads"]) <= {ErrorCode.OK, ErrorCode.BUSY}, codes
+    assert codes["loads"][ErrorCode.OK] >= 1, codes
+    assert set(codes["squeezes"]) <= {ErrorCode.OK, ErrorCode.UNKNOWN_OBJECT}, codes
+    busy = [r for r in got["bad_loads"] if r.error_code == ErrorCode.BUSY]
+    assert all("max_pending" in r.message for r in busy)
+    for field, response in [*((f, r) for f, r in zip(bad_loads, got["bad_loads"])
+                              if r.error_code != ErrorCode.BUSY),
+                            *zip(bad_squeezes, got["bad_squeezes"])]:
+        assert response.error_code in (ErrorCode.INVALID_ARGUMENT, ErrorCode.UNKNOWN_OBJECT), \
+            (field, response.message)
+        assert field.strip().split()[-1] in response.message, (field, response.message)
+        assert len(response.message) < 400, field
+    assert not any(r.error_code == ErrorCode.INTERNAL_ERROR
+                   for responses in got.values() for r in responses)
+    planner.load(BLOB, "after")
+    for field, request in bad_loads.items():  # what was BUSY (loads beyond max_pending)
+        response = planner.call(LoadObject, "load_object", request)
+        assert response.error_code == ErrorCode.INVALID_ARGUMENT, (field, response.message)
+        assert field.split()[-1] in response.message, (field, response.message)
+    assert stiffness(planner, "after").success
+
+
 # --------------------------------------------------------------------------- object ids
 
 DISK = """

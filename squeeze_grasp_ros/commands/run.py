@@ -171,7 +171,8 @@ def _run(args: argparse.Namespace) -> dict | int:
         if show:
             sys.stderr.write("\n")
     stopped, lost = result.get("recording_stopped"), result.get("recording_lost")
-    if stopped is not None or lost:
+    incompatible = result.get("recording_incompatible")
+    if stopped is not None or lost or incompatible:
         print(json.dumps(result) if args.json else summary(result))
         if stopped is not None:
             print(f"squeeze-grasp run: the recording in {args.record} stopped early: "
@@ -180,6 +181,12 @@ def _run(args: argparse.Namespace) -> dict | int:
             print(f"squeeze-grasp run: the recording in {args.record} is incomplete: "
                   f"{sum(lost.values())} messages never reached the recorder ("
                   + ", ".join(f"{topic} {n}" for topic, n in sorted(lost.items()))
+                  + ")", file=sys.stderr)
+        if incompatible:
+            print(f"squeeze-grasp run: the recording in {args.record} is incomplete: nothing "
+                  "was recorded from publishers whose QoS the recorder cannot take ("
+                  + ", ".join(f"{topic}: {policy}" for topic, policy in
+                              sorted(incompatible.items()))
                   + ")", file=sys.stderr)
         return ExitCode.INTERNAL
     if not result["success"]:

@@ -70,6 +70,7 @@ from functools import cached_property
 
 import numpy as np
 
+from squeeze_grasp_ros.inputs import shown
 from squeeze_grasp_ros.mechanics.vocabulary import AlarmType, Finger, SqueezeKind, Termination
 
 RESQUEEZE = "resqueeze"
@@ -179,7 +180,7 @@ def goal_problem(goal: GraspGoal, known: Sequence[str]) -> str | None:
         return "fingers must be non-empty and distinct"
     unknown = sorted(set(goal.fingers) - set(known))
     if unknown:
-        return f"finger {unknown[0]!r} is not mapped to a device (known: {sorted(known)})"
+        return f"finger {shown(unknown[0])} is not mapped to a device (known: {sorted(known)})"
     if goal.directions.shape != (f, 2) or not np.all(np.isfinite(goal.directions)):
         return f"directions must be {f} finite vectors"
     if not np.any(goal.directions):
@@ -187,7 +188,7 @@ def goal_problem(goal: GraspGoal, known: Sequence[str]) -> str | None:
     if not (np.isfinite(goal.depth) and goal.depth >= 0):
         return f"depth must be finite and >= 0, got {goal.depth}"
     if goal.on_slip_alarm not in REACTIONS:
-        return f"on_slip_alarm must be one of {REACTIONS}, got {goal.on_slip_alarm!r}"
+        return f"on_slip_alarm must be one of {REACTIONS}, got {shown(goal.on_slip_alarm)}"
     if goal.on_slip_alarm == SqueezeKind.PURE and (
         goal.pure_directions is None
         or goal.pure_directions.shape != (f, 2)
@@ -213,9 +214,8 @@ def goal_problem(goal: GraspGoal, known: Sequence[str]) -> str | None:
 def _resistance_problem(goal: GraspGoal, known: Sequence[str]) -> str | None:
     f = len(goal.fingers)
     if goal.adversary not in known or goal.adversary in goal.fingers:
-        return (
-            f"adversary {goal.adversary!r} must be a mapped finger other than the squeezing ones"
-        )
+        return (f"adversary {shown(goal.adversary)} must be a mapped finger other than the "
+                "squeezing ones")
     a = goal.adversary_translation
     travel = goal.resist_travel
     k = len(travel)

@@ -14,7 +14,8 @@ The planner's object ids are a namespace shared by every client. The rule:
   the wrong object.
 
 Ids are bounded (:data:`MAX_ID_CHARS` printable characters) and no message echoes more than
-:data:`SHOWN_CHARS` characters of any string a client sent (:func:`shown`).
+:data:`~squeeze_grasp_ros.inputs.SHOWN_CHARS` characters of any string a client sent
+(:func:`~squeeze_grasp_ros.inputs.shown`).
 
 >>> check_object_id("foam_square")
 'foam_square'
@@ -26,22 +27,13 @@ from __future__ import annotations
 
 import re
 
+from squeeze_grasp_ros.inputs import shown
 from squeeze_grasp_ros.planning.errors import ErrorCode, PlannerError, invalid
 
 MAX_ID_CHARS = 256
 """Longest object id (characters)."""
-SHOWN_CHARS = 40
-"""Most characters of a client's string that a message or log line quotes."""
 DIGEST = re.compile(r"[0-9a-f]{64}")
 """An object digest: SHA-256 in lower-case hex."""
-
-
-def shown(value: str, limit: int = SHOWN_CHARS) -> str:
-    """``repr(value)``, cut after ``limit`` characters with the full length said."""
-    if len(value) <= limit:
-        return repr(value)
-    text = repr(value[:limit])
-    return f"{text[:-1]}...{text[-1]} ({len(value)} characters)"
 
 
 def check_object_id(object_id: str, what: str = "object_id") -> str:
@@ -50,8 +42,8 @@ def check_object_id(object_id: str, what: str = "object_id") -> str:
     Raises
     ------
     PlannerError
-        INVALID_ARGUMENT naming ``what`` and the limit (quoting at most :data:`SHOWN_CHARS`
-        characters of the id).
+        INVALID_ARGUMENT naming ``what`` and the limit (quoting at most
+        :data:`~squeeze_grasp_ros.inputs.SHOWN_CHARS` characters of the id).
     """
     if not object_id:
         raise invalid(f"{what} must not be empty")

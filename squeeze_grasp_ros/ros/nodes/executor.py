@@ -32,12 +32,16 @@ fingers keep their setpoint topics.
 
 Feedback (every ``feedback_every`` cycles): state, measured depth and forces, events since the
 previous feedback. Cancel: the next cycle holds the measured positions and the goal ends
-``canceled``. Only one goal runs at a time; others are rejected.
+``canceled`` (a goal that has had no cycle yet ends at once, having commanded nothing). Only
+one goal runs at a time; others are rejected, also in a burst (the action's request queues keep
+every request). On hardware, a goal that sees no ``monitor/status`` at all within
+``stale_budget`` s ends ``stale_data``.
 """
 from __future__ import annotations
 
 import math
 import sys
+import time
 from typing import Any
 
 from geometry_msgs.msg import PoseStamped
@@ -81,6 +85,9 @@ PARAMETERS: dict[str, tuple[Any, str]] = {
     "qos_depth": (100, "history depth of the reliable topics"),
     "controller_scene": ("", "scene file whose controller: section drives the jaws through "
                              "a stock controller (empty: setpoint topics only)"),
+    "await_prediction": (False, "lockstep, jaws under a stock controller: ready only once "
+                                "planner/predicted_events has arrived (run sets it: it "
+                                "publishes one before the nodes start)"),
 }
 """Parameter name -> (typed default, description); config/executor.yaml sets them."""
 
@@ -103,6 +110,9 @@ class _Goal:
         self.since_feedback: list = []
         self.start_ns: int | None = None
         self.waiting_since_ns: int | None = None
+        self.waiting_since: float | None = None
+        """Wall-clock (monotonic) s since which the goal waits for any monitor status
+        (hardware mode)."""
         self.releasing = False
         """The action route's gripper goal is a release's (its result is not the goal's)."""
         self.lifting = False
@@ -138,10 +148,14 @@ class ExecutorNode(Node):
         controller = scene_controller(load_scene(p["controller_scene"]), p["controller_scene"]) \
             if p["controller_scene"] else None
         action = controller is not None and controller.kind.is_action
-        self.jaws = (HandCommands if isinstance(controller, HandController) else JawCommands)(
-            self, controller, p["period"], loop) if controller is not None and not action \
-            else None
-        self.jaw_action = jaw_action(self, controller, loop) if action else None
+        self.jaws = None
+        if isinstance(controller, HandController):
+            self.jaws = HandCommands(self, controller, p["period"], loop)
+        elif controller is not None and not action:
+            self.jaws = JawCommands(self, controller, p["period"], loop,
+                                    awaited=p["await_prediction"])
+        self.jaw_action = jaw_action(self, controller, loop, awaited=p["await_prediction"]) \
+            if action else None
         """The scene's gripper under a JointTrajectoryController (jaws) or a gripper action
         controller (jaw_action), if any."""
         jaw_fingers = controller.jaws if controller is not None else ()
@@ -156,10 +170,17 @@ class ExecutorNode(Node):
         pose_pub = self.create_publisher(PoseStamped, pipeline.OBJECT_POSE, pipeline.LATCHED)
         pose_pub.publish(messages.pose_in_base(p["object_pose"], p["base_frame"]))
         self.create_subscription(MonitorStatus, pipeline.STATUS, self._status, loop, raw=True)
+        # keep-all request queues (rclpy's default of 10 dropped the 11th and later goals of a
+        # burst unanswered: 10 answers to 30 goals sent at once)
+        queues = {f"{kind}_service_qos_profile": pipeline.request_queue(0)
+                  for kind in ("goal", "cancel", "result")}
         self.server = ActionServer(self, ExecuteGrasp, pipeline.ACTION, self._execute,
                                    goal_callback=self._accept_goal,
-                                   cancel_callback=lambda _: CancelResponse.ACCEPT)
+                                   cancel_callback=self._accept_cancel, **queues)
         self.goal: _Goal | None = None
+        self.accepted = False
+        """A goal was accepted and has not ended yet (its execution may not have started:
+        rclpy runs it as a later task, after more goal requests may have been taken)."""
         self.latest: bytes | None = None
         """The newest status, serialised (a raw subscription: :meth:`_cycle` reads it)."""
         self.answered = pipeline.TickAnswer()
@@ -186,9 +207,43 @@ class ExecutorNode(Node):
         super().destroy_node()
 
     def _accept_goal(self, _: ExecuteGrasp.Goal) -> GoalResponse:
-        return GoalResponse.REJECT if self.goal is not None else GoalResponse.ACCEPT
+        """One goal at a time: reject while one is accepted, running or not started yet
+        (before, checking only the running goal, a burst of goals at an idle executor on
+        ``EventsExecutor`` had 10 of 10 answered goals accepted; each replaced the previous,
+        whose result never came).
+        """
+        if self.accepted:
+            return GoalResponse.REJECT
+        self.accepted = True
+        return GoalResponse.ACCEPT
+
+    def _accept_cancel(self, handle: ServerGoalHandle) -> CancelResponse:
+        """Accept every cancel. The running goal ends at its next cycle; one that has had no
+        cycle yet (no monitor status since it was accepted) ends now, having commanded nothing
+        (before, it waited for a status that, with the monitor or the loop stopped, never
+        came: the cancel was accepted and the goal never ended).
+        """
+        goal = self.goal
+        if goal is not None and goal.handle is handle and goal.start_ns is None:
+            self._end_unstarted(goal, ExecuteGrasp.Result.CANCELED,
+                                "canceled before its first control cycle; nothing was "
+                                "commanded")
+        return CancelResponse.ACCEPT
+
+    def _end_unstarted(self, goal: _Goal, termination: str, message: str) -> None:
+        """End ``goal``, which has commanded nothing, with ``termination``."""
+        self.goal = None
+        goal.done.set_result(messages.grasp_result(
+            goal.program, Command({}, "holding", termination, message), None, [], 0.0,
+            SUCCESS))
 
     async def _execute(self, handle: ServerGoalHandle) -> ExecuteGrasp.Result:
+        try:
+            return await self._run_goal(handle)
+        finally:
+            self.accepted = False
+
+    async def _run_goal(self, handle: ServerGoalHandle) -> ExecuteGrasp.Result:
         goal = messages.grasp_goal(handle.request)
         problem = goal_problem(goal, list(self.devices))
         if problem is None and self.jaws is not None:
@@ -219,8 +274,20 @@ class ExecutorNode(Node):
             self._cycle(data)
 
     def _timer(self) -> None:
-        if self.goal is not None and self.latest is not None:
+        goal = self.goal
+        if goal is None:
+            return
+        if self.latest is not None:
             self._cycle(self.latest, self.get_clock().now().nanoseconds)
+            return
+        # no monitor status at all yet: wait stale_budget of wall-clock time, then end
+        now = time.monotonic()
+        goal.waiting_since = now if goal.waiting_since is None else goal.waiting_since
+        if now - goal.waiting_since > self.p["stale_budget"]:
+            self._end_unstarted(goal, ExecuteGrasp.Result.STALE_DATA,
+                                f"no {self.resolve_topic_name(pipeline.STATUS)} message within "
+                                f"stale_budget {self.p['stale_budget']} s of the goal (is the "
+                                "monitor running?); nothing was commanded")
 
     def _cycle(self, data: bytes, now_ns: int | None = None) -> None:
         """One control cycle on the serialised status ``data``; publish the setpoints, finish
@@ -376,8 +443,9 @@ class ExecutorNode(Node):
             goal.since_feedback = []
 
 
-def jaw_action(node: Node, controller: JawController, qos: Any) -> Any:
-    """The executor's side of a gripper action controller (:class:`.jaw_action.JawAction`).
+def jaw_action(node: Node, controller: JawController, qos: Any, *, awaited: bool) -> Any:
+    """The executor's side of a gripper action controller (:class:`.jaw_action.JawAction`;
+    ``awaited`` as there).
 
     Raises
     ------
@@ -390,7 +458,7 @@ def jaw_action(node: Node, controller: JawController, qos: Any) -> Any:
         raise ParameterError(f"controller.type {controller.kind} needs control_msgs ({exc}): "
                              "build it with squeeze-grasp ros-setup --control-msgs DIR "
                              "(docs/grippers.md)") from None
-    return JawAction(node, controller, qos)
+    return JawAction(node, controller, qos, awaited=awaited)
 
 
 def main(args: list[str] | None = None) -> int:

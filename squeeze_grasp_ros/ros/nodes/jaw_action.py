@@ -70,9 +70,12 @@ class JawAction:
     qos : QoSProfile
         Its depth is the cycle publisher's; that publisher is transient-local (a lockstep
         topic a recorder awaits, :func:`.pipeline.loop_qos`).
+    awaited : bool
+        Whether the planner's force curve is sure to come (:class:`.PlannedJawForce`).
     """
 
-    def __init__(self, node: Node, controller: JawController, qos: Any) -> None:
+    def __init__(self, node: Node, controller: JawController, qos: Any, *,
+                 awaited: bool) -> None:
         self.node, self.controller = node, controller
         self.parallel = controller.kind is ControllerKind.PARALLEL_GRIPPER
         self.action = ParallelGripperCommand if self.parallel else GripperCommand
@@ -80,7 +83,7 @@ class JawAction:
         self.client = ActionClient(node, self.action, controller.topic)
         self.publisher = node.create_publisher(Header, pipeline.EXECUTOR_CYCLE,
                                                pipeline.loop_qos(qos.depth, kept=True))
-        self.plan = PlannedJawForce(node, controller)
+        self.plan = PlannedJawForce(node, controller, awaited=awaited)
         self.line: JawLine | None = None
         self.handle: Any = None
         self.outcome: tuple[str, bool, str] | None = None
@@ -93,10 +96,12 @@ class JawAction:
         return self.controller.jaws
 
     def ready(self) -> bool:
-        """True once the planner's force curve is here, or when nobody publishes one (the
-        executor's lockstep readiness: its first goal's effort depends on it).
+        """The executor's lockstep readiness: the controller's action server is ready (the
+        goal request, sent once at the grasp goal's first cycle, would otherwise be lost and
+        the loop wait for its answer for ever), and the planner's force curve is here or not
+        coming (:meth:`.PlannedJawForce.ready`: its first goal's effort depends on it).
         """
-        return self.plan.ready()
+        return self.client.server_is_ready() and self.plan.ready()
 
     def cycle_msg(self, ns: int) -> tuple[Any, Header]:
         """(publisher, message) answering tick ``ns``."""
@@ -142,6 +147,14 @@ class JawAction:
             goal.command.position, goal.command.max_effort = float(position), float(effort)
         self.sent = {"position": float(position), "max_effort": float(effort)}
         self.outcome, self.handle = None, None
+        if not self.client.server_is_ready():
+            self.outcome = (ExecuteGrasp.Result.GRIPPER_REJECTED, False,
+                            f"no action server on {self.topic} answers (is the gripper "
+                            f"controller running and active?): the goal (position "
+                            f"{self.sent['position']:.6g}, max_effort "
+                            f"{self.sent['max_effort']:.6g}) was not sent")
+            on_answer()
+            return
 
         def answered(future: Any) -> None:
             self.handle = future.result()

@@ -51,23 +51,30 @@ class PlannedJawForce:
     ----------
     node : Node
     controller : JawController
+    awaited : bool
+        Whether a force curve is sure to come (the executor's ``await_prediction``): then the
+        curve is awaited even while no publisher of it has been discovered yet.
     """
 
-    def __init__(self, node: Node, controller: JawController) -> None:
+    def __init__(self, node: Node, controller: JawController, *, awaited: bool) -> None:
         self.node, self.controller = node, controller
+        self.awaited = awaited
+        self.seen = False
+        """A prediction arrived (with or without a force curve)."""
         self.forces = None
         node.create_subscription(ContactEventArray, pipeline.PREDICTION, self._prediction,
                                  pipeline.LATCHED)
 
     def _prediction(self, msg: ContactEventArray) -> None:
+        self.seen = True
         self.forces = messages.predicted_forces(msg)
 
     def ready(self) -> bool:
-        """True once the force curve is here, or when nobody publishes one (the executor's
-        lockstep readiness: its first goal is judged on it).
+        """True once the prediction is here (a force curve or none), or when none is awaited
+        and nobody publishes one (the executor's lockstep readiness: its first goal is judged
+        on it; :func:`.pipeline.prediction_ready`).
         """
-        return self.forces is not None or \
-            self.node.count_publishers(pipeline.PREDICTION) == 0
+        return pipeline.prediction_ready(self.node, seen=self.seen, awaited=self.awaited)
 
     def at(self, depth: float) -> float | None:
         """The planned jaw force at squeeze depth ``depth`` (m), N; None without a curve."""
@@ -89,15 +96,18 @@ class JawCommands:
     qos : QoSProfile
         Its depth is the publisher's; the publisher is transient-local (a lockstep topic a
         recorder awaits, :func:`.pipeline.loop_qos`).
+    awaited : bool
+        Whether the planner's force curve is sure to come (:class:`PlannedJawForce`).
     """
 
-    def __init__(self, node: Node, controller: JawController, period: float, qos: Any) -> None:
+    def __init__(self, node: Node, controller: JawController, period: float, qos: Any, *,
+                 awaited: bool) -> None:
         self.controller = controller
         self.topic = node.resolve_topic_name(controller.topic)
         self.publisher = node.create_publisher(JointTrajectory, controller.topic,
                                                pipeline.loop_qos(qos.depth, kept=True))
         self.period_ns = int(round(period * 1e9))
-        self.plan = PlannedJawForce(node, controller)
+        self.plan = PlannedJawForce(node, controller, awaited=awaited)
         self.line: JawLine | None = None
         self.msg = one_point_trajectory(controller.joints, self.period_ns)
 

@@ -267,8 +267,8 @@ class MonitorNode(Node):
         has reached it; its first events were then judged against no prediction
         (``prediction_mismatch`` of the first 3 events in 1 of 40 runs, two at once).
         """
-        return self.prediction_seen or (not self.p["await_prediction"]
-                                        and self.count_publishers(pipeline.PREDICTION) == 0)
+        return pipeline.prediction_ready(self, seen=self.prediction_seen,
+                                         awaited=self.p["await_prediction"])
 
     def _prediction(self, msg: ContactEventArray) -> None:
         self.prediction_seen = True

@@ -243,6 +243,25 @@ def sensor_qos(kind: str, depth: int, *, kept: bool = False) -> QoSProfile:
     raise ValueError(f"sensor_qos must be 'reliable' or 'sensor_data', got {kind!r}")
 
 
+def request_queue(depth: int) -> QoSProfile:
+    """QoS of a server's request queues (the planner's services and actions, the executor's
+    action): reliable, volatile, keep-all for ``depth`` 0 (no request is ever dropped), else
+    keep-last ``depth``.
+
+    rclpy's default for services (keep-last 10) drops the 11th and later requests of a burst
+    inside DDS before rclpy sees them; with keep-all a burst of 2,000 ``plan_squeeze`` requests
+    was answered in full (``bench ros_services``).
+
+    >>> request_queue(0).history.name, request_queue(100).depth
+    ('KEEP_ALL', 100)
+    """
+    if depth < 0:
+        raise ValueError(f"service_queue_depth must be >= 0 (0 = keep all), got {depth}")
+    return QoSProfile(history=HistoryPolicy.KEEP_ALL if depth == 0 else HistoryPolicy.KEEP_LAST,
+                      depth=depth or 1, reliability=ReliabilityPolicy.RELIABLE,
+                      durability=DurabilityPolicy.VOLATILE)
+
+
 LATCHED = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE,
                      history=HistoryPolicy.KEEP_LAST, durability=DurabilityPolicy.TRANSIENT_LOCAL)
 """Transient-local: late subscribers get the last message (prediction, object pose)."""
@@ -304,6 +323,19 @@ class TickAnswer:
         self.stamp_ns, self.messages = ns, list(messages)
         for publisher, msg in self.messages:
             publisher.publish(msg)
+
+
+def prediction_ready(node: Node, *, seen: bool, awaited: bool) -> bool:
+    """Lockstep readiness of a node that judges the run by the planner's latched
+    ``planner/predicted_events``: True once it has ``seen`` it, or when it is not ``awaited``
+    and nobody publishes one (a launch without a planner).
+
+    "Nobody publishes one" is a statement about this node's view of the graph, which across
+    processes can lag the writer: a node that had not yet discovered the run's publisher was
+    ready without the prediction and judged the first cycles against none. So a caller that
+    knows a prediction comes (``run`` publishes it before its nodes start) sets ``awaited``.
+    """
+    return seen or (not awaited and node.count_publishers(PREDICTION) == 0)
 
 
 class Participant:

@@ -44,7 +44,6 @@ from rclpy.action.server import ServerGoalHandle
 from rclpy.callback_groups import ReentrantCallbackGroup
 from rclpy.executors import SingleThreadedExecutor
 from rclpy.node import Node
-from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
 from rclpy.task import Future
 
 from squeeze_grasp_interfaces.action import EventSqueeze as EventSqueezeAction
@@ -63,7 +62,7 @@ from squeeze_grasp_ros.mechanics.vocabulary import ObjectModel
 from squeeze_grasp_ros.planning import Cancelled, ErrorCode, PlannerLimits
 from squeeze_grasp_ros.resources import share_dir
 from squeeze_grasp_ros.ros import messages
-from squeeze_grasp_ros.ros.nodes import run_node
+from squeeze_grasp_ros.ros.nodes import pipeline, run_node
 from squeeze_grasp_ros.ros.nodes.frame_pose_topic import frame_pose_topic
 
 Response = TypeVar("Response")
@@ -104,24 +103,6 @@ PARAMETERS: dict[str, tuple[Any, str]] = {
                             "folder and the node's working directory"),
 }
 """Parameter name -> (typed default, description); config/planner.yaml sets the same names."""
-
-
-def request_queue(depth: int) -> QoSProfile:
-    """QoS of the planner's request queues: reliable, volatile, keep-all for ``depth`` 0 (no
-    request is ever dropped), else keep-last ``depth``.
-
-    rclpy's default for services (keep-last 10) drops the 11th and later requests of a burst
-    inside DDS before rclpy sees them; with keep-all a burst of 2,000 ``plan_squeeze`` requests
-    was answered in full (``bench ros_services``).
-
-    >>> request_queue(0).history.name, request_queue(100).depth
-    ('KEEP_ALL', 100)
-    """
-    if depth < 0:
-        raise ValueError(f"service_queue_depth must be >= 0 (0 = keep all), got {depth}")
-    return QoSProfile(history=HistoryPolicy.KEEP_ALL if depth == 0 else HistoryPolicy.KEEP_LAST,
-                      depth=depth or 1, reliability=ReliabilityPolicy.RELIABLE,
-                      durability=DurabilityPolicy.VOLATILE)
 
 
 def _resume(_: Future) -> None:
@@ -168,7 +149,7 @@ class PlannerNode(Node):
         self._feedback: queue.SimpleQueue[tuple[ServerGoalHandle, Any]] = queue.SimpleQueue()
         self.frame_poses = frame_pose_topic(self, value)
 
-        services = request_queue(value("service_queue_depth"))
+        services = pipeline.request_queue(value("service_queue_depth"))
         self._pending = 0
         self._pending_lock = threading.Lock()
         # Reentrant: a long request awaiting its worker must not hold the node's default

@@ -29,24 +29,44 @@ A message the middleware reports lost (``message_lost``: a reliable writer gave 
 before this reader received it, its history having moved on, or a message sent before the
 writer matched this reader) is counted per topic, logged as an error at the end and listed in
 ``metadata.yaml`` under ``custom_data.messages_lost`` (:data:`..recording.bag.LOST_KEY`), so a
-recording with a gap says so.
+recording with a gap says so. A publisher whose QoS this reader cannot take (a volatile
+publisher of a topic the lockstep recorder reads transient-local, a best-effort one of a
+reliable topic: the middleware never matches them) is logged as an error when discovered and
+listed under ``custom_data.incompatible_publishers`` (:data:`..recording.bag.INCOMPATIBLE_KEY`):
+nothing it publishes is recorded, and the recording says so.
 """
 from __future__ import annotations
 
 import sys
 import time
 from collections import Counter, deque
+from collections.abc import Mapping
 from typing import Any
 
 import yaml
-from rclpy.event_handler import QoSMessageLostInfo, SubscriptionEventCallbacks
+from rclpy.event_handler import (
+    QoSMessageLostInfo,
+    QoSRequestedIncompatibleQoSInfo,
+    SubscriptionEventCallbacks,
+)
 from rclpy.node import Node
-from rclpy.qos import DurabilityPolicy, HistoryPolicy, ReliabilityPolicy
+from rclpy.qos import (
+    DurabilityPolicy,
+    HistoryPolicy,
+    QoSPolicyKind,
+    QoSProfile,
+    ReliabilityPolicy,
+)
 from std_msgs.msg import Header
 
 from squeeze_grasp_ros.ros import messages
 from squeeze_grasp_ros.ros.nodes import ParameterError, pipeline, run_node
-from squeeze_grasp_ros.ros.recording.bag import LOST_KEY, BagWriter, qos_dict
+from squeeze_grasp_ros.ros.recording.bag import (
+    INCOMPATIBLE_KEY,
+    LOST_KEY,
+    BagWriter,
+    qos_dict,
+)
 from squeeze_grasp_ros.ros.recording.schema import starts_with_stamp
 
 PARAMETERS: dict[str, tuple[Any, str]] = {
@@ -124,6 +144,8 @@ class RecorderNode(Node):
         self.written = 0
         self.lost: Counter[str] = Counter()
         """Recorded topic -> messages the middleware reported lost on its way here."""
+        self.incompatible: dict[str, str] = {}
+        """Recorded topic -> the QoS policy of a publisher this reader could not take."""
         self.ticks = 0
         self.newest_tick_ns = -1
         self.reported_ns = -1
@@ -148,7 +170,8 @@ class RecorderNode(Node):
                 pipeline.message_type(type_name), self.sources[name],
                 lambda data, n=name: self._record(n, data), qos, raw=True,
                 event_callbacks=SubscriptionEventCallbacks(
-                    message_lost=lambda info, n=name: self._lost(n, info)))
+                    message_lost=lambda info, n=name: self._lost(n, info),
+                    incompatible_qos=lambda info, n=name, q=qos: self._incompatible(n, q, info)))
         self.progress_pub = self.create_publisher(Header, pipeline.RECORDER_PROGRESS,
                                                   pipeline.loop_qos(10))
         if p["lockstep"]:
@@ -198,6 +221,18 @@ class RecorderNode(Node):
     def _lost(self, topic: str, info: QoSMessageLostInfo) -> None:
         self.lost[topic] += info.total_count_change
 
+    def _incompatible(self, topic: str, qos: QoSProfile,
+                      info: QoSRequestedIncompatibleQoSInfo) -> None:
+        policy = QoSPolicyKind(info.last_policy_kind).name.lower()
+        if topic in self.incompatible:
+            return
+        self.incompatible[topic] = policy
+        asked = ", ".join(POLICY_NAMES[kind].get(value, "unknown") for kind, value in
+                          (("reliability", qos.reliability), ("durability", qos.durability)))
+        self.get_logger().error(
+            f"{topic}: a publisher offers a QoS the recorder cannot take ({policy}; the "
+            f"recorder asks {asked}): nothing it publishes is recorded")
+
     def _report(self) -> None:
         """Publish the newest tick written, if not reported yet."""
         if self.newest_tick_ns > self.reported_ns:
@@ -233,11 +268,15 @@ class RecorderNode(Node):
             self.writer.custom_data[LOST_KEY] = lost_text(self.lost)
             self.get_logger().error(f"{self.p['output']} misses messages the middleware "
                                     f"reported lost: {lost_text(self.lost)}")
+        if self.incompatible and not self.writer.closed:
+            self.writer.custom_data[INCOMPATIBLE_KEY] = lost_text(self.incompatible)
         self.writer.close()
 
 
-def lost_text(lost: Counter[str]) -> str:
-    """``{topic: count, ...}`` (YAML flow mapping, by topic) of the messages lost."""
+def lost_text(lost: Mapping[str, Any]) -> str:
+    """``{topic: value, ...}`` (YAML flow mapping, by topic): the messages lost, or the
+    policies of incompatible publishers.
+    """
     return yaml.safe_dump(dict(sorted(lost.items())), default_flow_style=True,
                           width=1 << 16).strip()
 

@@ -66,6 +66,10 @@ STOPPED_KEY = "recording_stopped"
 LOST_KEY = "messages_lost"
 """``custom_data`` key of ``metadata.yaml`` listing, as a YAML mapping of topic to count, the
 messages its recorder never received that the middleware reported lost (absent: none)."""
+INCOMPATIBLE_KEY = "incompatible_publishers"
+"""``custom_data`` key of ``metadata.yaml`` listing, as a YAML mapping of topic to QoS policy,
+the topics that had a publisher whose QoS the recorder's reader could not take (the middleware
+never matches them: nothing of that publisher was recorded; absent: none)."""
 MAX_CHUNK_BYTES = 64 * 2**20
 """Largest chunk a reader decompresses (ours are 256 KiB, rosbag2's 768 KiB); checked on the
 chunk's declared size before decompressing, and on what decompression yields."""

@@ -145,7 +145,7 @@ def node_parameters(
     monitor["controller_scene"] = controller_scene
     params["executor"].update(
         finger_devices=mapping, period=float(scene.sim.dt), controller_scene=controller_scene,
-        lift_watch=lift_watch(scene))
+        lift_watch=lift_watch(scene), await_prediction=True)
     custom = {"scene": Path(scene_path).read_text(), "scene_path": str(scene_path)}
     params["recorder"].update(
         output=str(options.record or ""),

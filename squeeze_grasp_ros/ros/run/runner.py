@@ -413,8 +413,10 @@ class PipelineRunner:
 
     def recording_defects(self) -> dict:
         """What is wrong with the finished run's recording: ``recording_stopped``, why it
-        stopped early (a full disk), and ``recording_lost``, the messages per topic the
-        middleware reported lost on their way to the recorder; as the recorder node reports
+        stopped early (a full disk), ``recording_lost``, the messages per topic the
+        middleware reported lost on their way to the recorder, and ``recording_incompatible``,
+        the topics with a publisher whose QoS the recorder could not take (the QoS policy, by
+        topic: nothing of that publisher was recorded); as the recorder node reports
         them in this process, or, for a recorder process, as it wrote them into the bag it
         finished. Empty when the recording is complete (or there is none).
         """
@@ -422,8 +424,10 @@ class PipelineRunner:
             return {}
         if self.recorder is not None:
             stopped, lost = self.recorder.writer.stopped, dict(self.recorder.lost)
+            incompatible = dict(self.recorder.incompatible)
         else:
             from squeeze_grasp_ros.ros.recording.bag import (
+                INCOMPATIBLE_KEY,
                 LOST_KEY,
                 STOPPED_KEY,
                 BagError,
@@ -435,8 +439,10 @@ class PipelineRunner:
             except BagError as exc:
                 return {"recording_stopped": f"the recording is not readable: {exc}"}
             stopped, lost = custom.get(STOPPED_KEY), yaml.safe_load(custom.get(LOST_KEY, "{}"))
+            incompatible = yaml.safe_load(custom.get(INCOMPATIBLE_KEY, "{}"))
         return {**({"recording_stopped": stopped} if stopped is not None else {}),
-                **({"recording_lost": lost} if lost else {})}
+                **({"recording_lost": lost} if lost else {}),
+                **({"recording_incompatible": incompatible} if incompatible else {})}
 
     # ----------------------------------------------------------------- the whole run
     def run(self) -> dict:

@@ -1,0 +1,210 @@
+# Copyright 2026 squeeze_grasp_ros developers
+# SPDX-License-Identifier: Apache-2.0
+"""The executor's ``ExecuteGrasp`` action under bursts and abuse, on real rclpy and on the
+``EventsExecutor`` that ``ros2 run`` spins it with: goals sent at once from several clients,
+goals while one runs, cancels, goals with garbage fields. Every request is answered, one goal
+runs at a time, a bad field is named in one short message, and the node serves on.
+"""
+from __future__ import annotations
+
+import math
+import time
+
+import pytest
+from geometry_msgs.msg import Point, Vector3
+from rclpy.action import ActionClient
+from rclpy.experimental import EventsExecutor
+from rclpy.node import Node
+from rclpy.parameter import Parameter
+
+from squeeze_grasp_interfaces.action import ExecuteGrasp
+from squeeze_grasp_interfaces.msg import MonitorStatus
+from squeeze_grasp_ros.ros import messages
+from squeeze_grasp_ros.ros.nodes import pipeline
+from squeeze_grasp_ros.ros.nodes.executor import ExecutorNode
+
+QUEUES = {f"{kind}_service_qos_profile": pipeline.request_queue(0)
+          for kind in ("goal", "cancel", "result")}
+"""A burst client's own queues: keep-all, or its responses are dropped on its side
+(docs/reliability.md, Planner request queues)."""
+
+
+class Rig:
+    """An executor node, a client node with ``clients`` action clients, and a monitor-like
+    publisher of ``monitor/status`` that drives the executor's lockstep cycles.
+    """
+
+    def __init__(self, context, clients: int, **parameters) -> None:
+        self.spinner = EventsExecutor(context=context)
+        self.node = ExecutorNode(context=context, parameter_overrides=[
+            Parameter(name, value=value) for name, value in parameters.items()])
+        self.peer = Node("abuser", context=context)
+        self.status = self.peer.create_publisher(MonitorStatus, pipeline.STATUS,
+                                                 pipeline.loop_qos(100))
+        self.clients = [ActionClient(self.peer, ExecuteGrasp, pipeline.ACTION, **QUEUES)
+                        for _ in range(clients)]
+        for node in (self.node, self.peer):
+            self.spinner.add_node(node)
+        self.tick = 0
+        self.until(lambda: all(c.server_is_ready() for c in self.clients)
+                   and self.node.count_publishers(pipeline.STATUS) > 0)
+
+    def until(self, done, seconds: float = 30.0) -> bool:
+        deadline = time.monotonic() + seconds
+        while not done() and time.monotonic() < deadline:
+            self.spinner.spin_once(timeout_sec=0.05)
+        return done()
+
+    def publish_status(self) -> None:
+        """The status of the next tick: both fingers seen, still, 5 cm either side."""
+        msg = MonitorStatus(fingers=["F1", "F2"],
+                            positions=[Point(x=-0.05), Point(x=0.05)],
+                            forces=[Vector3(), Vector3()], normals=[Vector3(), Vector3()],
+                            sensor_age=[0.0, 0.0])
+        messages.set_stamp(msg.header.stamp, self.tick * 1_000_000)
+        self.tick += 1
+        self.status.publish(msg)
+
+    def result_of(self, handle) -> ExecuteGrasp.Result:
+        """Drive cycles until the goal's result is here."""
+        future = handle.get_result_async()
+
+        def done() -> bool:
+            if not future.done():
+                self.publish_status()
+            return future.done()
+        assert self.until(done), "the goal's result never came"
+        return future.result().result
+
+    def close(self) -> None:
+        for client in self.clients:
+            client.destroy()
+        self.spinner.shutdown()
+        self.node.destroy_node()
+        self.peer.destroy_node()
+
+
+def squeeze(**fields) -> ExecuteGrasp.Goal:
+    """The foam square's squeeze, 1 mm along x, with ``fields`` replaced."""
+    goal = ExecuteGrasp.Goal(fingers=["F1", "F2"], directions=[Vector3(x=1.0), Vector3(x=-1.0)],
+                             depth=1e-3)
+    for name, value in fields.items():
+        setattr(goal, name, value)
+    return goal
+
+
+@pytest.fixture
+def rig(ros_context):
+    rig = Rig(ros_context, clients=3)
+    yield rig
+    rig.close()
+
+
+def test_a_burst_of_goals_from_three_clients_is_answered_in_full_and_one_runs(rig):
+    """60 goals at once (3 clients x 20) at an idle executor: before, 10 were answered (the
+    goal service's queue of 10 dropped the rest, the clients waited for ever) and on
+    ``EventsExecutor`` all 10 answered were accepted, each replacing the previous one as the
+    running goal (their results never came). Now 60 answers, one accepted; cancelled it ends
+    ``canceled``, and the executor takes the next goal.
+    """
+    futures = [client.send_goal_async(squeeze()) for client in rig.clients for _ in range(20)]
+    assert rig.until(lambda: all(f.done() for f in futures)), \
+        f"{sum(not f.done() for f in futures)} of 60 goals never answered"
+    accepted = [f.result() for f in futures if f.result().accepted]
+    assert len(accepted) == 1
+    handle = accepted[0]
+    rig.publish_status()
+    assert rig.until(lambda: rig.node.goal is not None and rig.node.goal.start_ns is not None)
+    busy = [rig.clients[1].send_goal_async(squeeze()) for _ in range(5)]
+    assert rig.until(lambda: all(f.done() for f in busy))
+    assert not any(f.result().accepted for f in busy)
+    cancel = handle.cancel_goal_async()
+    assert rig.until(cancel.done)
+    result = rig.result_of(handle)
+    assert result.termination == ExecuteGrasp.Result.CANCELED
+    again = rig.clients[2].send_goal_async(squeeze())
+    assert rig.until(again.done) and again.result().accepted
+    again.result().cancel_goal_async()
+    assert rig.result_of(again.result()).termination == ExecuteGrasp.Result.CANCELED
+
+
+GARBAGE = [
+    ("depth", {"depth": math.nan}),
+    ("depth", {"depth": math.inf}),
+    ("depth", {"depth": -1e-3}),
+    ("fingers", {"fingers": []}),
+    ("fingers", {"fingers": ["F1", "F1"]}),
+    ("finger", {"fingers": ["F1", "F9"]}),
+    ("finger", {"fingers": ["F1", "x" * 1_000_000]}),
+    ("directions", {"directions": [Vector3(x=math.nan), Vector3(x=-1.0)]}),
+    ("directions", {"directions": [Vector3(x=1.0)]}),
+    ("directions", {"directions": [Vector3(), Vector3()]}),
+    ("on_slip_alarm", {"on_slip_alarm": "explode"}),
+    ("on_slip_alarm", {"on_slip_alarm": "y" * 1_000_000}),
+    ("pure_directions", {"on_slip_alarm": "pure"}),
+    ("resqueeze_margin", {"on_slip_alarm": "resqueeze", "resqueeze_margin": 1.5}),
+    ("release_clearance", {"on_slip_alarm": "resqueeze", "release_clearance": -math.inf}),
+    ("adversary", {"resist": True, "adversary": "F2"}),
+    ("adversary", {"resist": True, "adversary": "z" * 1_000_000}),
+]
+
+
+def test_goals_with_garbage_fields_end_invalid_naming_the_field_and_the_node_serves_on(rig):
+    """Each goal with one bad field (NaN, inf, negative, empty, unknown, repeated, a 1 MB
+    string) is answered: accepted, then aborted ``invalid_goal`` with a message naming the
+    field and quoting at most 40 characters of what was sent; afterwards a good goal runs.
+    """
+    for field, fields in GARBAGE:
+        future = rig.clients[0].send_goal_async(squeeze(**fields))
+        assert rig.until(future.done), f"{field}: the goal was never answered"
+        handle = future.result()
+        assert handle.accepted, field
+        result = rig.result_of(handle)
+        assert (result.termination, result.success) == (ExecuteGrasp.Result.INVALID_GOAL,
+                                                        False), (field, result.message)
+        assert field in result.message, (field, result.message)
+        assert len(result.message) < 200, (field, len(result.message))
+    future = rig.clients[0].send_goal_async(squeeze())
+    assert rig.until(future.done) and future.result().accepted
+    rig.publish_status()
+    assert rig.until(lambda: rig.node.goal is not None and rig.node.goal.start_ns is not None)
+    future.result().cancel_goal_async()
+    assert rig.result_of(future.result()).termination == ExecuteGrasp.Result.CANCELED
+
+
+@pytest.mark.parametrize("lockstep", [True, False])
+def test_a_goal_canceled_before_any_status_ends_at_once(ros_context, lockstep):
+    """A goal accepted while no monitor status comes (the loop or the monitor stopped) and
+    then canceled: before, the cancel was accepted and the goal never ended (it waited for a
+    status to run its cycle). Now it ends ``canceled``, having commanded nothing.
+    """
+    rig = Rig(ros_context, clients=1, lockstep=lockstep, stale_budget=60.0)
+    try:
+        future = rig.clients[0].send_goal_async(squeeze())
+        assert rig.until(future.done) and future.result().accepted
+        assert rig.until(lambda: rig.node.goal is not None)
+        result = future.result().get_result_async()
+        cancel = future.result().cancel_goal_async()
+        assert rig.until(lambda: cancel.done() and result.done(), seconds=10.0), \
+            "the canceled goal never ended"
+        assert result.result().result.termination == ExecuteGrasp.Result.CANCELED
+        assert "nothing was commanded" in result.result().result.message
+    finally:
+        rig.close()
+
+
+def test_a_hardware_goal_without_any_monitor_status_ends_after_the_stale_budget(ros_context):
+    """Hardware mode (wall-clock cycles), no monitor at all: before, the goal waited for ever;
+    now it ends ``stale_data`` after ``stale_budget`` s, naming the topic it waited for.
+    """
+    rig = Rig(ros_context, clients=1, lockstep=False, stale_budget=0.2)
+    try:
+        future = rig.clients[0].send_goal_async(squeeze())
+        assert rig.until(future.done) and future.result().accepted
+        result = future.result().get_result_async()
+        assert rig.until(result.done, seconds=10.0), "the goal never ended"
+        ended = result.result().result
+        assert ended.termination == ExecuteGrasp.Result.STALE_DATA
+        assert "no /monitor/status message within stale_budget 0.2 s" in ended.message
+    finally:
+        rig.close()

@@ -537,9 +537,13 @@ def test_every_camera_frame_crosses_processes_to_the_recorder_and_the_monitor(tm
     a history of one frame the camera topics lost 1-2 of 7 masks per run across processes (to
     the recorder and to the monitor's shape watch alike); with :data:`pipeline.CAMERA` every
     frame arrives: as many masks as depth images and infos, one per camera period of sim time,
-    and each one matched by the monitor.
+    and each one matched by the monitor. Under a load of 9-12 on 2 cores the middleware gave
+    up 1-3 other messages of a camera tick in about 1 of 200 such runs (wrench, pose,
+    sim/state; docs/reliability.md); the run then exits 4 naming them, which this test accepts
+    only for topics it does not count.
     """
     skimage_or_skip()
+    import re
     import subprocess
 
     from executables import script
@@ -551,12 +555,17 @@ def test_every_camera_frame_crosses_processes_to_the_recorder_and_the_monitor(tm
     bag = tmp_path / "bag"
     proc = subprocess.run([script("squeeze-grasp"), "run", str(scene), "--quiet", "--processes",
                            "--record", str(bag)], capture_output=True, text=True, timeout=300)
-    assert proc.returncode == 0, proc.stderr[-2000:]
+    counted = ("/camera/", "/monitor/shape", "/sim/tick")
+    if proc.returncode == 4:  # a reported middleware loss: not of what is counted here
+        lost = re.search(r"never reached the recorder \(([^)]*)\)", proc.stderr)
+        assert lost, proc.stderr[-2000:]
+        assert not any(t.startswith(counted) for t in lost.group(1).split(", ")), lost.group(0)
+    else:
+        assert proc.returncode == 0, proc.stderr[-2000:]
     stamps: dict[str, list[int]] = {}
     ticks = 0
     with AnyReader([bag]) as reader:
-        wanted = [c for c in reader.connections
-                  if c.topic.startswith(("/camera/", "/monitor/shape")) or c.topic == "/sim/tick"]
+        wanted = [c for c in reader.connections if c.topic.startswith(counted)]
         for connection, _, raw in reader.messages(connections=wanted):
             if connection.topic == "/sim/tick":
                 ticks += 1

@@ -94,6 +94,33 @@ def test_event_squeezes_are_identical_with_the_compiled_substeps(name, monkeypat
     assert sum(accepted) >= 0.4 * substeps > 0, (sum(accepted), substeps)
 
 
+@pytest.mark.parametrize("name", ["foam_square", "foam_square_pickup", "sponge_gripper_slip"])
+def test_the_compiled_watched_values_are_the_numpy_codes(name, monkeypatch):
+    """Wherever an event squeeze on the numba route reads its watched functions (a substep's
+    ends, the pending events at a point), the compiled per-contact values and gaps are the
+    floats the numpy code computes at the same solution (a zero's sign aside), and the
+    terminations the same: circles and pads, stick and slip, pickup.
+    """
+    from squeeze_grasp_ros.mechanics.squeeze.stepper.functions import EventFunctions
+
+    watched, compiled = EventFunctions.watched, []
+
+    def checking(self, contacts, sol, s, rows, held, *, terminations=True):
+        got = watched(self, contacts, sol, s, rows, held, terminations=terminations)
+        want = self.entries(contacts, self.values(contacts, sol, s, rows, terminations), rows,
+                            held)
+        assert got.order is want.order
+        np.testing.assert_array_equal(got.values, want.values)
+        assert got.ends == want.ends
+        compiled.append(self._compiled is not None)
+        return got
+
+    monkeypatch.setattr(EventFunctions, "watched", checking)
+    monkeypatch.setenv(KERNEL_VARIABLE, Kernel.NUMBA.value)
+    _setup(name).event_squeeze()
+    assert len(compiled) >= 10 and all(compiled), compiled
+
+
 def test_low_friction_squeeze_keeps_its_physics_on_the_compiled_route(monkeypatch):
     """An independent check of what the kernel produced: sliding contacts on their cone edge,
     sticking ones inside it, and the fingers' work at least the stored energy (friction

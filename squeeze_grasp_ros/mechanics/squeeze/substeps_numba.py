@@ -213,13 +213,13 @@ def _pickup(mu, fn, ft, stick, finger, fingers, weight):
 
 
 @jit
-def _watched(theta, delta, F, dtheta, nu, pick, mu, slip, radius_c, rate, A_rows, R_rows, E,
+def _watched(delta, F, dtheta, nu, pick, mu, slip, radius_c, rate, A_rows, R_rows, E,
              boundary0, centers_f, radius_f, flat_f, t0_f, out):
     """The watched per-contact values (``pick`` into fn, c+, c-, d laid end to end) and the
     free rows' gaps to every finger, in :meth:`~.stepper.functions.EventFunctions.entries`'s
     order, into ``out``; returns (fn, ft).
     """
-    m = theta.shape[0]
+    m = nu.shape[0]
     fn, ft = np.empty(m), np.empty(m)
     table = np.empty(4 * m)
     for k in range(m):
@@ -246,6 +246,20 @@ def _watched(theta, delta, F, dtheta, nu, pick, mu, slip, radius_c, rate, A_rows
                 out[i] = np.sqrt(wx * wx + wy * wy) - radius_f[f]
                 i += 1
     return fn, ft
+
+
+@jit
+def watched_values(delta, F, dtheta, nu, pick, mu, slip, radius_c, rate, A_rows, R_rows, E,
+                   boundary0, centers_f, radius_f, flat_f, t0_f):
+    """The watched per-contact values and the free rows' gaps at one solution, in
+    :meth:`~.stepper.functions.EventFunctions.entries`'s order (:func:`_watched`'s arguments;
+    ``E`` as the contact set holds it, so that ``E.T @ delta`` is numpy's product): the floats
+    the numpy code computes (up to the sign of a zero).
+    """
+    out = np.empty(pick.shape[0] + boundary0.shape[0] * centers_f.shape[0])
+    _watched(delta, F, dtheta, nu, pick, mu, slip, radius_c, rate, A_rows, R_rows,
+             E, boundary0, centers_f, radius_f, flat_f, t0_f, out)
+    return out
 
 
 @jit
@@ -348,7 +362,7 @@ def advance_quiet(a, h, theta, dtheta, F, dF, ft, start_values, start_ends,
         for f in range(nf):
             centers_f[f, 0] = origin[f, 0] + b * D[f, 0]
             centers_f[f, 1] = origin[f, 1] + b * D[f, 1]
-        fn, ft_b = _watched(th, de, Fb, dth, nu, pick, mu, slip, radius_c, rate, A_rows,
+        fn, ft_b = _watched(de, Fb, dth, nu, pick, mu, slip, radius_c, rate, A_rows,
                             R_rows, E, boundary0, centers_f, radius_f, flat_f, t0_f, values)
         det, missing = _area(de, Fb, E, rigid_gradients, bounds, loads, exact_bound)
         if missing:

@@ -116,6 +116,7 @@ class CompiledSubsteps:
         A_rows, R_rows = model._boundary_rows(sd, rows) if len(rows) else (
             np.zeros((0, 2 * len(contacts))), np.zeros((0, 3)))
         _, pick = functions._contact_entries(contacts, held)
+        # E in the set's own layout: the kernel's E.T @ delta is then numpy's product
         tables = (
             (np.ascontiguousarray(sd.C), np.ascontiguousarray(contacts.positions, float),
              np.ascontiguousarray(contacts.stick), np.ascontiguousarray(contacts.slip),
@@ -124,7 +125,7 @@ class CompiledSubsteps:
              np.ascontiguousarray(contacts.finger),
              np.array(sorted(set(contacts.finger.tolist())), int)),
             (np.ascontiguousarray(pick, int), np.ascontiguousarray(A_rows),
-             np.ascontiguousarray(R_rows), np.ascontiguousarray(sd.E),
+             np.ascontiguousarray(R_rows), sd.E,
              np.ascontiguousarray(functions._boundary[rows])),
         )
         self._tables = (sd, key, tables)

@@ -47,6 +47,11 @@ from squeeze_grasp_ros.mechanics.squeeze.event_key import (
     EventKey,
     KeyTable,
 )
+from squeeze_grasp_ros.mechanics.squeeze.fixed_set_kernel import (
+    Kernel,
+    compiled_substeps,
+    selected,
+)
 from squeeze_grasp_ros.mechanics.squeeze.stepper.contact_set import ContactSet
 from squeeze_grasp_ros.mechanics.squeeze.stepper.motion import FingerMotion
 from squeeze_grasp_ros.mechanics.vocabulary import Termination
@@ -274,18 +279,69 @@ class EventFunctions:
         terminations that are checked.
         """
         keys, pick = self._contact_entries(contacts, held)
+        table = np.concatenate((v.fn, v.c_plus, v.c_minus, v.d))
+        values = np.concatenate((table[pick], v.gaps.ravel()))
+        return WatchedValues(self._order(keys, rows), values,
+                             self._ends(v.area, v.strain, v.pickup))
+
+    def watched(self, contacts: ContactSet, sol: Solution, s: float, rows: np.ndarray,
+                held: np.ndarray, *, terminations: bool = True) -> WatchedValues:
+        """:meth:`entries` of :meth:`values` at ``sol`` (free boundary ``rows``, contacts
+        ``held`` left out; the terminations if asked).
+
+        On the numba route, for the fast model's boundary compliance, the per-contact values
+        and the gaps are one compiled call (:func:`..substeps_numba.watched_values`, the
+        numpy code's floats up to the sign of a zero) instead of some thirty numpy calls.
+        """
+        kernel = self._compiled
+        sd = contacts.data
+        if kernel is None or sd.A_bc is None:
+            return self.entries(contacts, self.values(contacts, sol, s, rows, terminations),
+                                rows, held)
+        model, motion = self.model, self.motion
+        keys, pick = self._contact_entries(contacts, held)
+        A, R = model._boundary_rows(sd, rows) if len(rows) else (
+            np.zeros((0, 2 * len(contacts))), np.zeros((0, 3)))
+        tip, rate = motion.tip, motion.rate
+        values = kernel.watched_values(
+            sol.delta, sol.F, sol.dtheta, sol.normal_angle, pick, float(model.mu),
+            contacts.slip, motion.radius[contacts.finger], rate if rate > 0 else 1.0, A, R,
+            sd.E, self._boundary[rows], motion.centers(s), tip.radius, tip.flat,
+            tip._facing_tangent)
+        strain = pickup = area = np.inf
+        if terminations:
+            strain, pickup = self.termination_values(contacts, sol)
+            if rate > 0:
+                area = self.area_value(contacts, sol)
+        return WatchedValues(self._order(keys, rows), values, self._ends(area, strain, pickup))
+
+    @cached_property
+    def _compiled(self):
+        """:mod:`..substeps_numba` when :meth:`watched` computes by it (the numba route and
+        the fast model's boundary displacement), else None.
+        """
+        model = self.model
+        if (selected() != Kernel.NUMBA or model.reference
+                or type(model).boundary_displacement is not ContactModel.boundary_displacement):
+            return None
+        return compiled_substeps()
+
+    def _order(self, keys: list[EventKey], rows: np.ndarray) -> KeyOrder:
+        """The :class:`KeyOrder` of per-contact ``keys`` and the gaps of ``rows`` (kept)."""
         tag = ("watched", id(keys), rows.dtype.str, rows.tobytes())
         order = self._entry_tables.get(tag)
         if order is None:
             order = self._entry_tables[tag] = KeyOrder((*keys, *self._row_gap_keys(rows)))
-        table = np.concatenate((v.fn, v.c_plus, v.c_minus, v.d))
-        values = np.concatenate((table[pick], v.gaps.ravel()))
+        return order
+
+    def _ends(self, area: float, strain: float, pickup: float) -> dict[EventKey, float]:
+        """The termination functions that are checked (finite), by key."""
         ends = {}
-        for function, value in ((EventFunction.AREA, v.area), (EventFunction.STRAIN, v.strain),
-                                (EventFunction.PICKUP, v.pickup)):
+        for function, value in ((EventFunction.AREA, area), (EventFunction.STRAIN, strain),
+                                (EventFunction.PICKUP, pickup)):
             if np.isfinite(value):
                 ends[self.keys.get(function)] = value
-        return WatchedValues(order, values, ends)
+        return ends
 
     @cached_property
     def _entry_tables(self) -> dict[tuple, object]:

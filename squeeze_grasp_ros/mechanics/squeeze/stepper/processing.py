@@ -157,12 +157,12 @@ class EventProcessor:
         """Pending contact events at the current point, in processing order."""
         contacts, functions, depth = self.contacts, self.functions, self.depth
         rows = functions.free_rows(contacts, self.chatter.held_nodes(depth))
-        v = functions.values(contacts, sol, self.s, rows, terminations=False)
+        watched = functions.watched(contacts, sol, self.s, rows,
+                                    self.chatter.held(contacts.nodes, depth), terminations=False)
         gap_nodes = [key.node for key in self.fresh if key.function == EventFunction.GAP]
         slopes = functions.slopes(contacts, sol, self.s, functions.rows_of(gap_nodes))
         out = []
-        for key, value in functions.entries(contacts, v, rows,
-                                            self.chatter.held(contacts.nodes, depth)).items():
+        for key, value in watched.items():
             if key in slopes and key.at_node in self.fresh:
                 if key.function == EventFunction.GAP and value > self.tol:
                     continue  # a freed node is at zero gap only to the finger that released it

@@ -121,6 +121,37 @@ def test_the_compiled_watched_values_are_the_numpy_codes(name, monkeypatch):
     assert len(compiled) >= 10 and all(compiled), compiled
 
 
+def test_the_compiled_area_check_hands_elements_near_inversion_to_the_model(monkeypatch):
+    """The compiled area ratio is the model's bound while no element nears inversion and the
+    model's exact det F once one does (the same floats), up to loads that invert elements.
+    """
+    from squeeze_grasp_ros.mechanics.squeeze.stepper.functions import EventFunctions
+
+    seen = []
+    watched = EventFunctions.watched
+
+    def keeping(self, *args, **kwargs):
+        seen.append((self, args))
+        return watched(self, *args, **kwargs)
+
+    monkeypatch.setattr(EventFunctions, "watched", keeping)
+    monkeypatch.setenv(KERNEL_VARIABLE, Kernel.NUMBA.value)
+    _setup("foam_square").event_squeeze()
+    functions, (contacts, sol, s, rows, held) = seen[-1]
+    monkeypatch.setattr(EventFunctions, "watched", watched)
+    near = []
+    for scale in (1.0, 3.0, 10.0, 30.0, 100.0):
+        scaled = dataclasses.replace(sol, F=sol.F * scale, delta=sol.delta * scale)
+        got = functions.watched(contacts, scaled, s, rows, held)
+        want = functions.entries(contacts, functions.values(contacts, scaled, s, rows), rows,
+                                 held)
+        np.testing.assert_array_equal(got.values, want.values)
+        assert got.ends == want.ends, scale
+        _, element = functions.model.area_ratio(contacts.data, scaled.delta, scaled.F)
+        near.append(element >= 0)
+    assert not near[0] and near[-1], near  # both branches taken
+
+
 def test_low_friction_squeeze_keeps_its_physics_on_the_compiled_route(monkeypatch):
     """An independent check of what the kernel produced: sliding contacts on their cone edge,
     sticking ones inside it, and the fingers' work at least the stored energy (friction

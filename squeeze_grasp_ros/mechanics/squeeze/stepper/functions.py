@@ -37,6 +37,7 @@ from functools import cached_property
 import numpy as np
 
 from squeeze_grasp_ros.mechanics.squeeze.contact_model import (
+    GRADIENT_BOUND_EXACT,
     INVERSION_AREA_RATIO,
     ContactModel,
     Solution,
@@ -60,6 +61,7 @@ __all__ = ["EventFunctions", "EventValues", "KeyOrder", "WatchedValues", "event_
            "pickup_margin"]
 
 _NO_ROWS = np.zeros(0, int)
+_NO_BOUNDS = np.zeros((0, 0))
 
 
 def pickup_margin(
@@ -289,9 +291,11 @@ class EventFunctions:
         """:meth:`entries` of :meth:`values` at ``sol`` (free boundary ``rows``, contacts
         ``held`` left out; the terminations if asked).
 
-        On the numba route, for the fast model's boundary compliance, the per-contact values
-        and the gaps are one compiled call (:func:`..substeps_numba.watched_values`, the
-        numpy code's floats up to the sign of a zero) instead of some thirty numpy calls.
+        On the numba route, for the fast model's boundary compliance, the per-contact values,
+        the gaps, the area ratio while no element nears inversion and the pickup margin are one
+        compiled call (:func:`..substeps_numba.watched_values`, the numpy code's floats, a
+        zero's sign aside) instead of some fifty numpy calls; an element near inversion and a
+        strain limit are computed by the model.
         """
         kernel = self._compiled
         sd = contacts.data
@@ -299,20 +303,27 @@ class EventFunctions:
             return self.entries(contacts, self.values(contacts, sol, s, rows, terminations),
                                 rows, held)
         model, motion = self.model, self.motion
+        lim, rate = model.limits, motion.rate
         keys, pick = self._contact_entries(contacts, held)
         A, R = model._boundary_rows(sd, rows) if len(rows) else (
             np.zeros((0, 2 * len(contacts))), np.zeros((0, 3)))
-        tip, rate = motion.tip, motion.rate
-        values = kernel.watched_values(
+        weight = (lim.weight / model.force_unit if terminations and lim.weight is not None
+                  and Termination.PICKED_UP in self.terminate_on else np.nan)
+        bounds = model.area_tables(sd)[0] if terminations and rate > 0 else _NO_BOUNDS
+        tip = motion.tip
+        values, area, pickup = kernel.watched_values(
             sol.delta, sol.F, sol.dtheta, sol.normal_angle, pick, float(model.mu),
             contacts.slip, motion.radius[contacts.finger], rate if rate > 0 else 1.0, A, R,
             sd.E, self._boundary[rows], motion.centers(s), tip.radius, tip.flat,
-            tip._facing_tangent)
-        strain = pickup = area = np.inf
+            tip._facing_tangent, contacts.stick, contacts.finger, np.unique(contacts.finger),
+            weight, model.obj.rigid_gradients, bounds, GRADIENT_BOUND_EXACT)
+        strain = np.inf
         if terminations:
-            strain, pickup = self.termination_values(contacts, sol)
-            if rate > 0:
-                area = self.area_value(contacts, sol)
+            if np.isnan(area):
+                area = model.area_ratio(sd, sol.delta, sol.F)[0]
+            area -= INVERSION_AREA_RATIO
+            if lim.strain is not None and Termination.STRAIN_LIMIT in self.terminate_on:
+                strain = self.termination_values(contacts, sol)[0]
         return WatchedValues(self._order(keys, rows), values, self._ends(area, strain, pickup))
 
     @cached_property
@@ -322,7 +333,8 @@ class EventFunctions:
         """
         model = self.model
         if (selected() != Kernel.NUMBA or model.reference
-                or type(model).boundary_displacement is not ContactModel.boundary_displacement):
+                or type(model).boundary_displacement is not ContactModel.boundary_displacement
+                or type(model).area_ratio is not ContactModel.area_ratio):
             return None
         return compiled_substeps()
 

@@ -94,28 +94,45 @@ def test_event_squeezes_are_identical_with_the_compiled_substeps(name, monkeypat
     assert sum(accepted) >= 0.4 * substeps > 0, (sum(accepted), substeps)
 
 
-@pytest.mark.parametrize("name", ["foam_square", "foam_square_pickup", "sponge_gripper_slip"])
-def test_the_compiled_watched_values_are_the_numpy_codes(name, monkeypatch):
+@pytest.mark.parametrize("name", ["foam_square", "foam_square_pickup", "sponge_gripper_slip",
+                                  "foam_square_low_friction"])
+def test_the_compiled_watched_values_and_slopes_are_the_numpy_codes(name, monkeypatch):
     """Wherever an event squeeze on the numba route reads its watched functions (a substep's
-    ends, the pending events at a point), the compiled per-contact values and gaps are the
-    floats the numpy code computes at the same solution (a zero's sign aside), and the
-    terminations the same: circles and pads, stick and slip, pickup.
+    ends, the pending events at a point) or their slopes (pending events, location), the
+    compiled per-contact values, gaps, terminations and slopes are the floats the numpy code
+    computes at the same solution (a zero's sign aside): circles and pads, stick and slip,
+    pickup.
     """
     from squeeze_grasp_ros.mechanics.squeeze.stepper.functions import EventFunctions
 
-    watched, compiled = EventFunctions.watched, []
+    watched, slopes, compiled = EventFunctions.watched, EventFunctions.slopes, []
 
-    def checking(self, contacts, sol, s, rows, held, *, terminations=True):
+    def numpy_twin(self) -> EventFunctions:
+        with monkeypatch.context() as m:
+            m.setenv(KERNEL_VARIABLE, Kernel.NUMPY.value)
+            twin = EventFunctions(self.model, self.motion, self.terminate_on)
+            assert twin._compiled is None
+        return twin
+
+    def checking_values(self, contacts, sol, s, rows, held, *, terminations=True):
         got = watched(self, contacts, sol, s, rows, held, terminations=terminations)
-        want = self.entries(contacts, self.values(contacts, sol, s, rows, terminations), rows,
-                            held)
-        assert got.order is want.order
+        want = watched(numpy_twin(self), contacts, sol, s, rows, held,
+                       terminations=terminations)
+        assert got.order.keys == want.order.keys
         np.testing.assert_array_equal(got.values, want.values)
         assert got.ends == want.ends
         compiled.append(self._compiled is not None)
         return got
 
-    monkeypatch.setattr(EventFunctions, "watched", checking)
+    def checking_slopes(self, contacts, sol, s, rows):
+        got = slopes(self, contacts, sol, s, rows)
+        want = slopes(numpy_twin(self), contacts, sol, s, rows)
+        assert list(got) == list(want) and list(got.values()) == list(want.values())
+        compiled.append(self._compiled is not None)
+        return got
+
+    monkeypatch.setattr(EventFunctions, "watched", checking_values)
+    monkeypatch.setattr(EventFunctions, "slopes", checking_slopes)
     monkeypatch.setenv(KERNEL_VARIABLE, Kernel.NUMBA.value)
     _setup(name).event_squeeze()
     assert len(compiled) >= 10 and all(compiled), compiled

@@ -277,7 +277,7 @@ def _watched(delta, F, dtheta, nu, pick, mu, slip, radius_c, rate, A_rows, R_row
 
 @jit
 def watched_values(delta, F, dtheta, nu, pick, mu, slip, radius_c, rate, A_rows, R_rows, E,
-                   boundary0, centers_f, radius_f, flat_f, t0_f, stick, finger, fingers, weight,
+                   boundary0, centers_f, radius_f, flat_f, t0_f, stick, finger, weight,
                    rigid_gradients, bounds, exact_bound):
     """The watched functions at one solution as the numpy code computes them (the same
     floats, a zero's sign aside): :meth:`~.stepper.functions.EventFunctions.watched`.
@@ -288,14 +288,55 @@ def watched_values(delta, F, dtheta, nu, pick, mu, slip, radius_c, rate, A_rows,
     smallest area ratio when no element's gradient bound reaches ``exact_bound`` (the bound
     (1 - max B_e)^2 of :meth:`~.contact_model.ContactModel.area_ratio`; NaN when an element
     does, whose exact det F the model computes; inf without ``bounds`` rows, when the area is
-    not watched), and the pickup margin (:func:`_pickup`'s arguments; inf when ``weight`` is
-    NaN).
+    not watched), and the pickup margin (:func:`_pickup`'s arguments, the fingers those in
+    ``finger``; inf when ``weight`` is NaN).
     """
     out = np.empty(pick.shape[0] + boundary0.shape[0] * centers_f.shape[0])
     fn, ft = _watched(delta, F, dtheta, nu, pick, mu, slip, radius_c, rate, A_rows, R_rows,
                       E, boundary0, centers_f, radius_f, flat_f, t0_f, out)
     return out, _area_floor(delta, F, E, rigid_gradients, bounds, exact_bound), \
-        _pickup(mu, fn, ft, stick, finger, fingers, weight)
+        _pickup(mu, fn, ft, stick, finger, np.unique(finger), weight)
+
+
+@jit
+def slope_values(delta, F, ddelta, dF, dtheta, nu, kappa, mu, A_rows, R_rows, E, boundary0,
+                 centers_f, D, flat_f, t0_f):
+    """The slopes d/ds at one solution as :meth:`~.stepper.functions.EventFunctions.slopes`
+    computes them in numpy (the same floats): the free rows' gaps (rows, fingers) raveled,
+    and each contact's normal force and cone margins (m, 3) raveled.
+
+    ``kappa`` is d nu / d theta per contact, or empty for circular tips (1); ``D`` the
+    fingers' translations over the call (their centres' rates); the rest as in
+    :func:`_watched`.
+    """
+    m = nu.shape[0]
+    rates = np.empty(3 * m)
+    for k in range(m):
+        c, s = np.cos(nu[k]), np.sin(nu[k])
+        turn = dtheta[k] if kappa.shape[0] == 0 else kappa[k] * dtheta[k]
+        fn = F[k, 0] * c + F[k, 1] * s
+        ft = F[k, 0] * -s + F[k, 1] * c
+        fn_r = (dF[k, 0] * c + dF[k, 1] * s) + turn * ft
+        ft_r = (dF[k, 0] * -s + dF[k, 1] * c) - turn * fn
+        rates[3 * k] = fn_r
+        rates[3 * k + 1] = mu * fn_r + ft_r
+        rates[3 * k + 2] = mu * fn_r - ft_r
+    rows, nf = boundary0.shape[0], centers_f.shape[0]
+    gaps = np.empty(rows * nf)
+    if rows:
+        u = np.dot(A_rows, F.ravel()) + np.dot(R_rows, np.dot(E.T, delta.ravel()))
+        v = np.dot(A_rows, dF.ravel()) + np.dot(R_rows, np.dot(E.T, ddelta.ravel()))
+        i = 0
+        for r in range(rows):
+            x, y = boundary0[r, 0] + u[2 * r], boundary0[r, 1] + u[2 * r + 1]
+            for f in range(nf):
+                rx, ry = x - centers_f[f, 0], y - centers_f[f, 1]
+                tau = min(max(rx * t0_f[f, 0] + ry * t0_f[f, 1], -flat_f[f]), flat_f[f])
+                wx, wy = rx - tau * t0_f[f, 0], ry - tau * t0_f[f, 1]
+                vx, vy = v[2 * r] - D[f, 0], v[2 * r + 1] - D[f, 1]
+                gaps[i] = (wx * vx + wy * vy) / np.sqrt(wx * wx + wy * wy)
+                i += 1
+    return gaps, rates
 
 
 @jit

@@ -62,6 +62,7 @@ __all__ = ["EventFunctions", "EventValues", "KeyOrder", "WatchedValues", "event_
 
 _NO_ROWS = np.zeros(0, int)
 _NO_BOUNDS = np.zeros((0, 0))
+_NO_KAPPA = np.zeros(0)
 
 
 def pickup_margin(
@@ -315,8 +316,8 @@ class EventFunctions:
             sol.delta, sol.F, sol.dtheta, sol.normal_angle, pick, float(model.mu),
             contacts.slip, motion.radius[contacts.finger], rate if rate > 0 else 1.0, A, R,
             sd.E, self._boundary[rows], motion.centers(s), tip.radius, tip.flat,
-            tip._facing_tangent, contacts.stick, contacts.finger, np.unique(contacts.finger),
-            weight, model.obj.rigid_gradients, bounds, GRADIENT_BOUND_EXACT)
+            tip._facing_tangent, contacts.stick, contacts.finger, weight,
+            model.obj.rigid_gradients, bounds, GRADIENT_BOUND_EXACT)
         strain = np.inf
         if terminations:
             if np.isnan(area):
@@ -406,6 +407,9 @@ class EventFunctions:
         contact's normal force and cone margins (the functions with
         :attr:`~..event_key.EventFunction.has_slope`).
         """
+        kernel, sd = self._compiled, contacts.data
+        if kernel is not None and sd.A_bc is not None:
+            return self._compiled_slopes(kernel, contacts, sol, s, rows)
         fn_r, ft_r = sol.normal_rate, sol.tangential_rate
         mu = self.model.mu
         out = {}
@@ -419,6 +423,22 @@ class EventFunctions:
         rates[:, 1] = mu * fn_r + ft_r
         rates[:, 2] = mu * fn_r - ft_r
         out.update(zip(self._sloped_keys(contacts), rates.ravel().tolist()))
+        return out
+
+    def _compiled_slopes(self, kernel, contacts: ContactSet, sol: Solution, s: float,
+                         rows: np.ndarray) -> dict[EventKey, float]:
+        """:meth:`slopes` by :func:`..substeps_numba.slope_values` (the same floats)."""
+        model, motion, sd = self.model, self.motion, contacts.data
+        A, R = model._boundary_rows(sd, rows) if len(rows) else (
+            np.zeros((0, 2 * len(contacts))), np.zeros((0, 3)))
+        tip = motion.tip
+        gaps, rates = kernel.slope_values(
+            sol.delta, sol.F, sol.ddelta, sol.dF, sol.dtheta, sol.normal_angle,
+            _NO_KAPPA if sol.kappa is None else sol.kappa, float(model.mu), A, R, sd.E,
+            self._boundary[rows], motion.centers(s), motion.translation, tip.flat,
+            tip._facing_tangent)
+        out = dict(zip(self._row_gap_keys(rows), gaps.tolist())) if len(rows) else {}
+        out.update(zip(self._sloped_keys(contacts), rates.tolist()))
         return out
 
     def _sloped_keys(self, contacts: ContactSet) -> list[EventKey]:

@@ -98,14 +98,15 @@ def test_event_squeezes_are_identical_with_the_compiled_substeps(name, monkeypat
                                   "foam_square_low_friction"])
 def test_the_compiled_watched_values_and_slopes_are_the_numpy_codes(name, monkeypatch):
     """Wherever an event squeeze on the numba route reads its watched functions (a substep's
-    ends, the pending events at a point) or their slopes (pending events, location), the
-    compiled per-contact values, gaps, terminations and slopes are the floats the numpy code
-    computes at the same solution (a zero's sign aside): circles and pads, stick and slip,
-    pickup.
+    ends, the pending events at a point), their slopes (pending events, location) or the
+    terminations at a point, the compiled per-contact values, gaps, terminations and slopes
+    are the floats the numpy code computes at the same solution (a zero's sign aside):
+    circles and pads, stick and slip, pickup.
     """
     from squeeze_grasp_ros.mechanics.squeeze.stepper.functions import EventFunctions
 
     watched, slopes, compiled = EventFunctions.watched, EventFunctions.slopes, []
+    end_values = EventFunctions.end_values
 
     def numpy_twin(self) -> EventFunctions:
         with monkeypatch.context() as m:
@@ -131,8 +132,15 @@ def test_the_compiled_watched_values_and_slopes_are_the_numpy_codes(name, monkey
         compiled.append(self._compiled is not None)
         return got
 
+    def checking_ends(self, contacts, sol):
+        got = end_values(self, contacts, sol)
+        assert got == end_values(numpy_twin(self), contacts, sol)
+        compiled.append(self._compiled is not None)
+        return got
+
     monkeypatch.setattr(EventFunctions, "watched", checking_values)
     monkeypatch.setattr(EventFunctions, "slopes", checking_slopes)
+    monkeypatch.setattr(EventFunctions, "end_values", checking_ends)
     monkeypatch.setenv(KERNEL_VARIABLE, Kernel.NUMBA.value)
     _setup(name).event_squeeze()
     assert len(compiled) >= 10 and all(compiled), compiled

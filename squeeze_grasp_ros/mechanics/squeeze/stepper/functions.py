@@ -248,14 +248,19 @@ class EventFunctions:
     def termination_values(self, contacts: ContactSet, sol: Solution) -> tuple[float, float]:
         """(eps* - max strain, pickup margin); inf for criteria not declared or not enabled."""
         model, lim = self.model, self.model.limits
-        strain = pickup = np.inf
-        if lim.strain is not None and Termination.STRAIN_LIMIT in self.terminate_on:
-            strain = lim.strain - model.max_strain(contacts.data, sol.delta, sol.F)[0]
+        strain, pickup = self._strain_margin(contacts, sol), np.inf
         if lim.weight is not None and Termination.PICKED_UP in self.terminate_on:
             pickup = pickup_margin(model.mu, sol.normal, sol.tangential, contacts.stick,
                                    contacts.finger, sorted(set(contacts.finger.tolist())),
                                    lim.weight / model.force_unit)
         return strain, pickup
+
+    def _strain_margin(self, contacts: ContactSet, sol: Solution) -> float:
+        """eps* - max strain (inf without a strain limit or when it is not enabled)."""
+        lim = self.model.limits
+        if lim.strain is None or Termination.STRAIN_LIMIT not in self.terminate_on:
+            return np.inf
+        return lim.strain - self.model.max_strain(contacts.data, sol.delta, sol.F)[0]
 
     def area_value(self, contacts: ContactSet, sol: Solution) -> float:
         """The smallest area ratio det F less INVERSION_AREA_RATIO (element_inverted at <= 0)."""
@@ -303,29 +308,58 @@ class EventFunctions:
         if kernel is None or sd.A_bc is None:
             return self.entries(contacts, self.values(contacts, sol, s, rows, terminations),
                                 rows, held)
-        model, motion = self.model, self.motion
-        lim, rate = model.limits, motion.rate
         keys, pick = self._contact_entries(contacts, held)
+        values, det, _, strain, pickup = self._kernel_values(kernel, contacts, sol, s, rows,
+                                                             pick, terminations)
+        return WatchedValues(self._order(keys, rows), values,
+                             self._ends(det - INVERSION_AREA_RATIO, strain, pickup))
+
+    def end_values(self, contacts: ContactSet, sol: Solution) -> tuple[float, int, float, float]:
+        """(smallest area ratio det F, its element or -1 when none is near inversion,
+        eps* - max strain, pickup margin) at ``sol``: what the terminations check, in their
+        order (the margins inf for criteria not declared or not enabled, and not measured when
+        the area already ends the motion). On the numba route as :meth:`watched` computes
+        them.
+        """
+        kernel = self._compiled
+        if kernel is None or contacts.data.A_bc is None:
+            det, element = self.model.area_ratio(contacts.data, sol.delta, sol.F)
+            if det <= INVERSION_AREA_RATIO:
+                return det, element, np.inf, np.inf
+            return (det, element, *self.termination_values(contacts, sol))
+        _, det, element, _, pickup = self._kernel_values(kernel, contacts, sol, 0.0, _NO_ROWS,
+                                                         _NO_ROWS, True, strain=False)
+        if det <= INVERSION_AREA_RATIO:
+            return det, element, np.inf, np.inf
+        return det, element, self._strain_margin(contacts, sol), pickup
+
+    def _kernel_values(self, kernel, contacts: ContactSet, sol: Solution, s: float,
+                       rows: np.ndarray, pick: np.ndarray, terminations: bool, *,
+                       strain: bool = True) -> tuple:
+        """(values ``pick`` and the gaps of ``rows``, det F, element, strain margin, pickup
+        margin) by :func:`..substeps_numba.watched_values`, the model's where it does not
+        compute them (an element near inversion, a strain limit: if ``strain``); the
+        terminations inf unless asked (the area also while the fingers do not move).
+        """
+        model, motion, sd = self.model, self.motion, contacts.data
+        lim, rate = model.limits, motion.rate
         A, R = model._boundary_rows(sd, rows) if len(rows) else (
             np.zeros((0, 2 * len(contacts))), np.zeros((0, 3)))
         weight = (lim.weight / model.force_unit if terminations and lim.weight is not None
                   and Termination.PICKED_UP in self.terminate_on else np.nan)
         bounds = model.area_tables(sd)[0] if terminations and rate > 0 else _NO_BOUNDS
         tip = motion.tip
-        values, area, pickup = kernel.watched_values(
+        values, det, pickup = kernel.watched_values(
             sol.delta, sol.F, sol.dtheta, sol.normal_angle, pick, float(model.mu),
             contacts.slip, motion.radius[contacts.finger], rate if rate > 0 else 1.0, A, R,
             sd.E, self._boundary[rows], motion.centers(s), tip.radius, tip.flat,
             tip._facing_tangent, contacts.stick, contacts.finger, weight,
             model.obj.rigid_gradients, bounds, GRADIENT_BOUND_EXACT)
-        strain = np.inf
-        if terminations:
-            if np.isnan(area):
-                area = model.area_ratio(sd, sol.delta, sol.F)[0]
-            area -= INVERSION_AREA_RATIO
-            if lim.strain is not None and Termination.STRAIN_LIMIT in self.terminate_on:
-                strain = self.termination_values(contacts, sol)[0]
-        return WatchedValues(self._order(keys, rows), values, self._ends(area, strain, pickup))
+        element = -1
+        if np.isnan(det):
+            det, element = model.area_ratio(sd, sol.delta, sol.F)
+        margin = self._strain_margin(contacts, sol) if terminations and strain else np.inf
+        return values, det, element, margin, pickup
 
     @cached_property
     def _compiled(self):

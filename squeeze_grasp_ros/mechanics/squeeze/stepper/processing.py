@@ -321,12 +321,11 @@ class EventProcessor:
         """First termination that holds at the current point (order in the module docstring)."""
         if self.motion.rate == 0:
             return None
-        det, element = self.model.area_ratio(self.contacts.data, sol.delta, sol.F)
+        det, element, strain, pickup = self.functions.end_values(self.contacts, sol)
         if det <= INVERSION_AREA_RATIO:
             counters = self.solver.counters
             counters.min_area_ratio, counters.inverted_element = det, element
             return Termination.ELEMENT_INVERTED
-        strain, pickup = self.functions.termination_values(self.contacts, sol)
         if strain <= 0:
             return Termination.STRAIN_LIMIT
         if self.lost is not None:

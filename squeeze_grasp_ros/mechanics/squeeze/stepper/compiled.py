@@ -49,7 +49,8 @@ exceed for a call to be quiet. The start of the next call re-solves the state fr
 values, which moves the functions by round-off (about 1e-16); a function within this margin of
 zero goes through the full stepper, so that round-off can never hide or invent an event. The
 compiled substeps take a substep as quiet on the same margin (their watched values are the
-numpy route's to round-off)."""
+numpy code's floats, but an element near inversion has its det F summed in the kernel's own
+order)."""
 CHUNK = 256
 """Substeps the compiled loop runs before it returns its samples (it is called again)."""
 _NO_LOADS = np.zeros((0, 0, 4, 2))

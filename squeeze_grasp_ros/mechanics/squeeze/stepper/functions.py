@@ -37,7 +37,6 @@ from functools import cached_property
 import numpy as np
 
 from squeeze_grasp_ros.mechanics.squeeze.contact_model import (
-    GRADIENT_BOUND_EXACT,
     INVERSION_AREA_RATIO,
     ContactModel,
     Solution,
@@ -48,11 +47,7 @@ from squeeze_grasp_ros.mechanics.squeeze.event_key import (
     EventKey,
     KeyTable,
 )
-from squeeze_grasp_ros.mechanics.squeeze.fixed_set_kernel import (
-    Kernel,
-    compiled_substeps,
-    selected,
-)
+from squeeze_grasp_ros.mechanics.squeeze.stepper.compiled_functions import CompiledFunctions
 from squeeze_grasp_ros.mechanics.squeeze.stepper.contact_set import ContactSet
 from squeeze_grasp_ros.mechanics.squeeze.stepper.motion import FingerMotion
 from squeeze_grasp_ros.mechanics.vocabulary import Termination
@@ -61,8 +56,6 @@ __all__ = ["EventFunctions", "EventValues", "KeyOrder", "WatchedValues", "event_
            "pickup_margin"]
 
 _NO_ROWS = np.zeros(0, int)
-_NO_BOUNDS = np.zeros((0, 0))
-_NO_KAPPA = np.zeros(0)
 
 
 def pickup_margin(
@@ -248,14 +241,14 @@ class EventFunctions:
     def termination_values(self, contacts: ContactSet, sol: Solution) -> tuple[float, float]:
         """(eps* - max strain, pickup margin); inf for criteria not declared or not enabled."""
         model, lim = self.model, self.model.limits
-        strain, pickup = self._strain_margin(contacts, sol), np.inf
+        strain, pickup = self.strain_margin(contacts, sol), np.inf
         if lim.weight is not None and Termination.PICKED_UP in self.terminate_on:
             pickup = pickup_margin(model.mu, sol.normal, sol.tangential, contacts.stick,
                                    contacts.finger, sorted(set(contacts.finger.tolist())),
                                    lim.weight / model.force_unit)
         return strain, pickup
 
-    def _strain_margin(self, contacts: ContactSet, sol: Solution) -> float:
+    def strain_margin(self, contacts: ContactSet, sol: Solution) -> float:
         """eps* - max strain (inf without a strain limit or when it is not enabled)."""
         lim = self.model.limits
         if lim.strain is None or Termination.STRAIN_LIMIT not in self.terminate_on:
@@ -299,18 +292,17 @@ class EventFunctions:
 
         On the numba route, for the fast model's boundary compliance, the per-contact values,
         the gaps, the area ratio while no element nears inversion and the pickup margin are one
-        compiled call (:func:`..substeps_numba.watched_values`, the numpy code's floats, a
-        zero's sign aside) instead of some fifty numpy calls; an element near inversion and a
-        strain limit are computed by the model.
+        compiled call (:class:`~.compiled_functions.CompiledFunctions`, the numpy code's
+        floats, a zero's sign aside); an element near inversion and a strain limit are
+        computed by the model.
         """
-        kernel = self._compiled
-        sd = contacts.data
-        if kernel is None or sd.A_bc is None:
+        compiled = self._compiled
+        if compiled is None or not compiled.takes(contacts):
             return self.entries(contacts, self.values(contacts, sol, s, rows, terminations),
                                 rows, held)
         keys, pick = self._contact_entries(contacts, held)
-        values, det, _, strain, pickup = self._kernel_values(kernel, contacts, sol, s, rows,
-                                                             pick, terminations)
+        values, det, _, strain, pickup = compiled.values(contacts, sol, s, rows, pick,
+                                                         terminations)
         return WatchedValues(self._order(keys, rows), values,
                              self._ends(det - INVERSION_AREA_RATIO, strain, pickup))
 
@@ -321,57 +313,22 @@ class EventFunctions:
         the area already ends the motion). On the numba route as :meth:`watched` computes
         them.
         """
-        kernel = self._compiled
-        if kernel is None or contacts.data.A_bc is None:
+        compiled = self._compiled
+        if compiled is None or not compiled.takes(contacts):
             det, element = self.model.area_ratio(contacts.data, sol.delta, sol.F)
             if det <= INVERSION_AREA_RATIO:
                 return det, element, np.inf, np.inf
             return (det, element, *self.termination_values(contacts, sol))
-        _, det, element, _, pickup = self._kernel_values(kernel, contacts, sol, 0.0, _NO_ROWS,
-                                                         _NO_ROWS, True, strain=False)
+        _, det, element, _, pickup = compiled.values(contacts, sol, 0.0, _NO_ROWS, _NO_ROWS,
+                                                     True, strain=False)
         if det <= INVERSION_AREA_RATIO:
             return det, element, np.inf, np.inf
-        return det, element, self._strain_margin(contacts, sol), pickup
-
-    def _kernel_values(self, kernel, contacts: ContactSet, sol: Solution, s: float,
-                       rows: np.ndarray, pick: np.ndarray, terminations: bool, *,
-                       strain: bool = True) -> tuple:
-        """(values ``pick`` and the gaps of ``rows``, det F, element, strain margin, pickup
-        margin) by :func:`..substeps_numba.watched_values`, the model's where it does not
-        compute them (an element near inversion, a strain limit: if ``strain``); the
-        terminations inf unless asked (the area also while the fingers do not move).
-        """
-        model, motion, sd = self.model, self.motion, contacts.data
-        lim, rate = model.limits, motion.rate
-        A, R = model._boundary_rows(sd, rows) if len(rows) else (
-            np.zeros((0, 2 * len(contacts))), np.zeros((0, 3)))
-        weight = (lim.weight / model.force_unit if terminations and lim.weight is not None
-                  and Termination.PICKED_UP in self.terminate_on else np.nan)
-        bounds = model.area_tables(sd)[0] if terminations and rate > 0 else _NO_BOUNDS
-        tip = motion.tip
-        values, det, pickup = kernel.watched_values(
-            sol.delta, sol.F, sol.dtheta, sol.normal_angle, pick, float(model.mu),
-            contacts.slip, motion.radius[contacts.finger], rate if rate > 0 else 1.0, A, R,
-            sd.E, self._boundary[rows], motion.centers(s), tip.radius, tip.flat,
-            tip._facing_tangent, contacts.stick, contacts.finger, weight,
-            model.obj.rigid_gradients, bounds, GRADIENT_BOUND_EXACT)
-        element = -1
-        if np.isnan(det):
-            det, element = model.area_ratio(sd, sol.delta, sol.F)
-        margin = self._strain_margin(contacts, sol) if terminations and strain else np.inf
-        return values, det, element, margin, pickup
+        return det, element, self.strain_margin(contacts, sol), pickup
 
     @cached_property
-    def _compiled(self):
-        """:mod:`..substeps_numba` when :meth:`watched` computes by it (the numba route and
-        the fast model's boundary displacement), else None.
-        """
-        model = self.model
-        if (selected() != Kernel.NUMBA or model.reference
-                or type(model).boundary_displacement is not ContactModel.boundary_displacement
-                or type(model).area_ratio is not ContactModel.area_ratio):
-            return None
-        return compiled_substeps()
+    def _compiled(self) -> CompiledFunctions | None:
+        """The compiled reads of this call's functions (numba route), or None."""
+        return CompiledFunctions.of(self)
 
     def _order(self, keys: list[EventKey], rows: np.ndarray) -> KeyOrder:
         """The :class:`KeyOrder` of per-contact ``keys`` and the gaps of ``rows`` (kept)."""
@@ -441,9 +398,12 @@ class EventFunctions:
         contact's normal force and cone margins (the functions with
         :attr:`~..event_key.EventFunction.has_slope`).
         """
-        kernel, sd = self._compiled, contacts.data
-        if kernel is not None and sd.A_bc is not None:
-            return self._compiled_slopes(kernel, contacts, sol, s, rows)
+        compiled = self._compiled
+        if compiled is not None and compiled.takes(contacts):
+            gaps, rates = compiled.slopes(contacts, sol, s, rows)
+            out = dict(zip(self._row_gap_keys(rows), gaps.tolist())) if len(rows) else {}
+            out.update(zip(self._sloped_keys(contacts), rates.tolist()))
+            return out
         fn_r, ft_r = sol.normal_rate, sol.tangential_rate
         mu = self.model.mu
         out = {}
@@ -457,22 +417,6 @@ class EventFunctions:
         rates[:, 1] = mu * fn_r + ft_r
         rates[:, 2] = mu * fn_r - ft_r
         out.update(zip(self._sloped_keys(contacts), rates.ravel().tolist()))
-        return out
-
-    def _compiled_slopes(self, kernel, contacts: ContactSet, sol: Solution, s: float,
-                         rows: np.ndarray) -> dict[EventKey, float]:
-        """:meth:`slopes` by :func:`..substeps_numba.slope_values` (the same floats)."""
-        model, motion, sd = self.model, self.motion, contacts.data
-        A, R = model._boundary_rows(sd, rows) if len(rows) else (
-            np.zeros((0, 2 * len(contacts))), np.zeros((0, 3)))
-        tip = motion.tip
-        gaps, rates = kernel.slope_values(
-            sol.delta, sol.F, sol.ddelta, sol.dF, sol.dtheta, sol.normal_angle,
-            _NO_KAPPA if sol.kappa is None else sol.kappa, float(model.mu), A, R, sd.E,
-            self._boundary[rows], motion.centers(s), motion.translation, tip.flat,
-            tip._facing_tangent)
-        out = dict(zip(self._row_gap_keys(rows), gaps.tolist())) if len(rows) else {}
-        out.update(zip(self._sloped_keys(contacts), rates.tolist()))
         return out
 
     def _sloped_keys(self, contacts: ContactSet) -> list[EventKey]:

@@ -94,6 +94,89 @@ def test_event_squeezes_are_identical_with_the_compiled_substeps(name, monkeypat
     assert sum(accepted) >= 0.4 * substeps > 0, (sum(accepted), substeps)
 
 
+@pytest.mark.parametrize("name", ["foam_square", "foam_square_pickup", "sponge_gripper_slip",
+                                  "foam_square_low_friction"])
+def test_the_compiled_watched_values_and_slopes_are_the_numpy_codes(name, monkeypatch):
+    """Wherever an event squeeze on the numba route reads its watched functions (a substep's
+    ends, the pending events at a point), their slopes (pending events, location) or the
+    terminations at a point, the compiled per-contact values, gaps, terminations and slopes
+    are the floats the numpy code computes at the same solution (a zero's sign aside):
+    circles and pads, stick and slip, pickup.
+    """
+    from squeeze_grasp_ros.mechanics.squeeze.stepper.functions import EventFunctions
+
+    watched, slopes, compiled = EventFunctions.watched, EventFunctions.slopes, []
+    end_values = EventFunctions.end_values
+
+    def numpy_twin(self) -> EventFunctions:
+        with monkeypatch.context() as m:
+            m.setenv(KERNEL_VARIABLE, Kernel.NUMPY.value)
+            twin = EventFunctions(self.model, self.motion, self.terminate_on)
+            assert twin._compiled is None
+        return twin
+
+    def checking_values(self, contacts, sol, s, rows, held, *, terminations=True):
+        got = watched(self, contacts, sol, s, rows, held, terminations=terminations)
+        want = watched(numpy_twin(self), contacts, sol, s, rows, held,
+                       terminations=terminations)
+        assert got.order.keys == want.order.keys
+        np.testing.assert_array_equal(got.values, want.values)
+        assert got.ends == want.ends
+        compiled.append(self._compiled is not None)
+        return got
+
+    def checking_slopes(self, contacts, sol, s, rows):
+        got = slopes(self, contacts, sol, s, rows)
+        want = slopes(numpy_twin(self), contacts, sol, s, rows)
+        assert list(got) == list(want) and list(got.values()) == list(want.values())
+        compiled.append(self._compiled is not None)
+        return got
+
+    def checking_ends(self, contacts, sol):
+        got = end_values(self, contacts, sol)
+        assert got == end_values(numpy_twin(self), contacts, sol)
+        compiled.append(self._compiled is not None)
+        return got
+
+    monkeypatch.setattr(EventFunctions, "watched", checking_values)
+    monkeypatch.setattr(EventFunctions, "slopes", checking_slopes)
+    monkeypatch.setattr(EventFunctions, "end_values", checking_ends)
+    monkeypatch.setenv(KERNEL_VARIABLE, Kernel.NUMBA.value)
+    _setup(name).event_squeeze()
+    assert len(compiled) >= 10 and all(compiled), compiled
+
+
+def test_the_compiled_area_check_hands_elements_near_inversion_to_the_model(monkeypatch):
+    """The compiled area ratio is the model's bound while no element nears inversion and the
+    model's exact det F once one does (the same floats), up to loads that invert elements.
+    """
+    from squeeze_grasp_ros.mechanics.squeeze.stepper.functions import EventFunctions
+
+    seen = []
+    watched = EventFunctions.watched
+
+    def keeping(self, *args, **kwargs):
+        seen.append((self, args))
+        return watched(self, *args, **kwargs)
+
+    monkeypatch.setattr(EventFunctions, "watched", keeping)
+    monkeypatch.setenv(KERNEL_VARIABLE, Kernel.NUMBA.value)
+    _setup("foam_square").event_squeeze()
+    functions, (contacts, sol, s, rows, held) = seen[-1]
+    monkeypatch.setattr(EventFunctions, "watched", watched)
+    near = []
+    for scale in (1.0, 3.0, 10.0, 30.0, 100.0):
+        scaled = dataclasses.replace(sol, F=sol.F * scale, delta=sol.delta * scale)
+        got = functions.watched(contacts, scaled, s, rows, held)
+        want = functions.entries(contacts, functions.values(contacts, scaled, s, rows), rows,
+                                 held)
+        np.testing.assert_array_equal(got.values, want.values)
+        assert got.ends == want.ends, scale
+        _, element = functions.model.area_ratio(contacts.data, scaled.delta, scaled.F)
+        near.append(element >= 0)
+    assert not near[0] and near[-1], near  # both branches taken
+
+
 def test_low_friction_squeeze_keeps_its_physics_on_the_compiled_route(monkeypatch):
     """An independent check of what the kernel produced: sliding contacts on their cone edge,
     sticking ones inside it, and the fingers' work at least the stored energy (friction

@@ -60,9 +60,10 @@ kernel (LAPACK through numpy.linalg's factorising functions or scipy.linalg, Sup
 CHOLMOD). numpy.linalg's helpers and its vector norms (reductions, no LAPACK) are not."""
 COMMAND = "python -m squeeze_grasp_ros.bench.evaluation"
 COMPILED_PATTERN = (r"fixed_set_numba\.py:\d*\(?solve_linear"
-                    r"|substeps_numba\.py:\d*\(?advance_quiet")
-"""The compiled kernels' profile entries: the fixed-set solve, and the substeps between events
-(numba's dispatchers: their self time is the compiled call, BLAS and LAPACK inside included)."""
+                    r"|substeps_numba\.py:\d*\(?(advance_quiet|watched_values|slope_values)")
+"""The compiled kernels' profile entries: the fixed-set solve, the substeps between events, and
+the watched functions' values and slopes at event points (numba's dispatchers: their self time
+is the compiled call, BLAS and LAPACK inside included)."""
 CONTROL_ITERATIONS = 5_000_000
 BASELINE_COMMIT = "9db5097"
 BASELINE_MS_PER_EVALUATION = 12.50
@@ -207,12 +208,13 @@ def table(measured: dict[Kernel, dict], spec: Path, tasks: int | None) -> Table:
          "speed-up over the numpy route (control-normalised)", "profiled evaluations",
          "profiled per evaluation [ms]", "kernels per evaluation (profiled) [ms]",
          "kernel share of the profile [%]", "kernels / unprofiled CPU [%]",
-         "compiled kernels (fixed-set solve, substeps), share of the profile [%]",
+         "compiled kernels (fixed-set solve, substeps, watched values and slopes), share of "
+         "the profile [%]",
          "Python-visible calls per evaluation"],
         rows,
         "Fixed-set route: the linear model's Newton on the sliding contacts in numpy, or "
-        "compiled by numba with the substeps between events (the `fast` extra; the same "
-        "floats); the routes run one after the "
+        "compiled by numba with the substeps between events and the watched functions at "
+        "event points (the `fast` extra; the same floats); the routes run one after the "
         "other, each with its own control loop. CPU per evaluation: all evaluations "
         "unprofiled, groups prepared before, BLAS as "
         f"this process has it; the control loop ({CONTROL_ITERATIONS:,} pure-Python integer "
@@ -224,8 +226,9 @@ def table(measured: dict[Kernel, dict], spec: Path, tasks: int | None) -> Table:
         "their LAPACK gufuncs are invisible to cProfile; `@` products count with their "
         "callers); kernels / unprofiled CPU (the profiled evaluations' own unprofiled time) "
         "estimates the share without the profiler's overhead. The compiled kernels' column is "
-        "their calls' self time (the fixed-set solve's, and the substeps between events' on "
-        "the numba route; their BLAS and LAPACK calls inside, not counted as kernels). "
+        "their calls' self time (the fixed-set solve's, and on the numba route the substeps "
+        "between events' and the watched functions' values and slopes at event points; their "
+        "BLAS and LAPACK calls inside, not counted as kernels). "
         f"Reproduce: `{COMMAND} {spec}{arg}`. Load average (1, 5, 15 min) {load} on "
         f"{os.cpu_count()} cores.",
     )

@@ -158,25 +158,34 @@ def _work(F_a, dF_a, ft_a, dth_a, F_b, dF_b, ft_b, dth_b, a, b, finger, D, radiu
 
 
 @jit
-def _area(delta, F, E, rigid_gradients, bounds, loads, exact_bound):
-    """(smallest det F as :meth:`~.contact_model.ContactModel.area_ratio` bounds or computes
-    it, whether an element needed its load gradients and none were given).
+def _element_bounds(delta, F, E, rigid_gradients, bounds):
+    """(the rigid part's displacement gradients (4t,), every element's gradient bound B_e)
+    as :meth:`~.contact_model.ContactModel.area_ratio` computes them (the same floats).
     """
-    g = np.dot(E.T, delta.ravel())
-    rigid = np.dot(rigid_gradients, g)
-    t = bounds.shape[0]
+    rigid = np.dot(rigid_gradients, np.dot(E.T, delta.ravel()))
     norms = np.empty(F.shape[0])
     for k in range(F.shape[0]):
         norms[k] = np.sqrt(F[k, 0] * F[k, 0] + F[k, 1] * F[k, 1])
     bound = np.dot(bounds, norms)
+    for e in range(bounds.shape[0]):
+        r = rigid[4 * e:4 * e + 4]
+        bound[e] = bound[e] + np.sqrt(r[0] * r[0] + r[1] * r[1] + r[2] * r[2] + r[3] * r[3])
+    return rigid, bound
+
+
+@jit
+def _area(delta, F, E, rigid_gradients, bounds, loads, exact_bound):
+    """(smallest det F as :meth:`~.contact_model.ContactModel.area_ratio` bounds or computes
+    it, whether an element needed its load gradients and none were given).
+    """
+    rigid, bound = _element_bounds(delta, F, E, rigid_gradients, bounds)
+    t = bounds.shape[0]
     floor_bound, near = -1.0, 0
     for e in range(t):
-        r = rigid[4 * e:4 * e + 4]
-        b_e = bound[e] + np.sqrt(r[0] * r[0] + r[1] * r[1] + r[2] * r[2] + r[3] * r[3])
-        if b_e >= exact_bound:
+        if bound[e] >= exact_bound:
             near += 1
-        elif b_e > floor_bound:
-            floor_bound = b_e
+        elif bound[e] > floor_bound:
+            floor_bound = bound[e]
     floor = (1.0 - floor_bound) ** 2 if floor_bound >= 0.0 else np.inf
     if near == 0:
         return floor, False
@@ -184,11 +193,9 @@ def _area(delta, F, E, rigid_gradients, bounds, loads, exact_bound):
         return floor, True
     smallest = floor
     for e in range(t):
-        r = rigid[4 * e:4 * e + 4]
-        b_e = bound[e] + np.sqrt(r[0] * r[0] + r[1] * r[1] + r[2] * r[2] + r[3] * r[3])
-        if b_e < exact_bound:
+        if bound[e] < exact_bound:
             continue
-        H = r.copy()
+        H = rigid[4 * e:4 * e + 4].copy()
         for k in range(F.shape[0]):
             for i in range(4):
                 H[i] += loads[k, e, i, 0] * F[k, 0] + loads[k, e, i, 1] * F[k, 1]
@@ -198,28 +205,48 @@ def _area(delta, F, E, rigid_gradients, bounds, loads, exact_bound):
 
 
 @jit
+def _area_floor(delta, F, E, rigid_gradients, bounds, exact_bound):
+    """:func:`watched_values`'s area ratio: (1 - max B_e)^2 when no B_e reaches
+    ``exact_bound``, NaN when one does, inf without elements (numpy's floats).
+    """
+    if bounds.shape[0] == 0:
+        return np.inf
+    _, bound = _element_bounds(delta, F, E, rigid_gradients, bounds)
+    largest = -np.inf
+    for e in range(bounds.shape[0]):
+        if bound[e] >= exact_bound:
+            return np.nan
+        largest = max(largest, bound[e])
+    return (1.0 - largest) ** 2
+
+
+@jit
 def _pickup(mu, fn, ft, stick, finger, fingers, weight):
-    """:func:`~.stepper.functions.pickup_margin` (inf when ``weight`` is NaN: not checked)."""
+    """:func:`~.stepper.functions.pickup_margin`, each finger's sum in numpy's order
+    (:func:`np_sum` of the finger's entries, sliding nodes' zeros included); inf when
+    ``weight`` is NaN (not checked).
+    """
     if np.isnan(weight):
         return np.inf
+    m = fn.shape[0]
+    c = np.empty(m)
+    for k in range(m):
+        c[k] = np.sqrt(max(mu * mu * fn[k] * fn[k] - ft[k] * ft[k], 0.0)) if stick[k] else 0.0
     least = np.inf
     for f in fingers:
-        total = 0.0
-        for k in range(fn.shape[0]):
-            if finger[k] == f and stick[k]:
-                total += np.sqrt(max(mu * mu * fn[k] * fn[k] - ft[k] * ft[k], 0.0))
-        least = min(least, total)
+        mine = c[finger == f]
+        least = min(least, np_sum(mine))
     return weight / fingers.shape[0] - least
 
 
 @jit
-def _watched(theta, delta, F, dtheta, nu, pick, mu, slip, radius_c, rate, A_rows, R_rows, E,
+def _watched(delta, F, dtheta, nu, pick, mu, slip, radius_c, rate, A_rows, R_rows, E,
              boundary0, centers_f, radius_f, flat_f, t0_f, out):
     """The watched per-contact values (``pick`` into fn, c+, c-, d laid end to end) and the
     free rows' gaps to every finger, in :meth:`~.stepper.functions.EventFunctions.entries`'s
     order, into ``out``; returns (fn, ft).
     """
-    m = theta.shape[0]
+    m = nu.shape[0]
     fn, ft = np.empty(m), np.empty(m)
     table = np.empty(4 * m)
     for k in range(m):
@@ -246,6 +273,70 @@ def _watched(theta, delta, F, dtheta, nu, pick, mu, slip, radius_c, rate, A_rows
                 out[i] = np.sqrt(wx * wx + wy * wy) - radius_f[f]
                 i += 1
     return fn, ft
+
+
+@jit
+def watched_values(delta, F, dtheta, nu, pick, mu, slip, radius_c, rate, A_rows, R_rows, E,
+                   boundary0, centers_f, radius_f, flat_f, t0_f, stick, finger, weight,
+                   rigid_gradients, bounds, exact_bound):
+    """The watched functions at one solution as the numpy code computes them (the same
+    floats, a zero's sign aside): :meth:`~.stepper.functions.EventFunctions.watched`.
+
+    The per-contact values and the free rows' gaps in
+    :meth:`~.stepper.functions.EventFunctions.entries`'s order (:func:`_watched`'s arguments;
+    ``E`` as the contact set holds it, so that ``E.T @ delta`` is numpy's product), then the
+    smallest area ratio when no element's gradient bound reaches ``exact_bound`` (the bound
+    (1 - max B_e)^2 of :meth:`~.contact_model.ContactModel.area_ratio`; NaN when an element
+    does, whose exact det F the model computes; inf without ``bounds`` rows, when the area is
+    not watched), and the pickup margin (:func:`_pickup`'s arguments, the fingers those in
+    ``finger``; inf when ``weight`` is NaN).
+    """
+    out = np.empty(pick.shape[0] + boundary0.shape[0] * centers_f.shape[0])
+    fn, ft = _watched(delta, F, dtheta, nu, pick, mu, slip, radius_c, rate, A_rows, R_rows,
+                      E, boundary0, centers_f, radius_f, flat_f, t0_f, out)
+    return out, _area_floor(delta, F, E, rigid_gradients, bounds, exact_bound), \
+        _pickup(mu, fn, ft, stick, finger, np.unique(finger), weight)
+
+
+@jit
+def slope_values(delta, F, ddelta, dF, dtheta, nu, kappa, mu, A_rows, R_rows, E, boundary0,
+                 centers_f, D, flat_f, t0_f):
+    """The slopes d/ds at one solution as :meth:`~.stepper.functions.EventFunctions.slopes`
+    computes them in numpy (the same floats): the free rows' gaps (rows, fingers) raveled,
+    and each contact's normal force and cone margins (m, 3) raveled.
+
+    ``kappa`` is d nu / d theta per contact, or empty for circular tips (1); ``D`` the
+    fingers' translations over the call (their centres' rates); the rest as in
+    :func:`_watched`.
+    """
+    m = nu.shape[0]
+    rates = np.empty(3 * m)
+    for k in range(m):
+        c, s = np.cos(nu[k]), np.sin(nu[k])
+        turn = dtheta[k] if kappa.shape[0] == 0 else kappa[k] * dtheta[k]
+        fn = F[k, 0] * c + F[k, 1] * s
+        ft = F[k, 0] * -s + F[k, 1] * c
+        fn_r = (dF[k, 0] * c + dF[k, 1] * s) + turn * ft
+        ft_r = (dF[k, 0] * -s + dF[k, 1] * c) - turn * fn
+        rates[3 * k] = fn_r
+        rates[3 * k + 1] = mu * fn_r + ft_r
+        rates[3 * k + 2] = mu * fn_r - ft_r
+    rows, nf = boundary0.shape[0], centers_f.shape[0]
+    gaps = np.empty(rows * nf)
+    if rows:
+        u = np.dot(A_rows, F.ravel()) + np.dot(R_rows, np.dot(E.T, delta.ravel()))
+        v = np.dot(A_rows, dF.ravel()) + np.dot(R_rows, np.dot(E.T, ddelta.ravel()))
+        i = 0
+        for r in range(rows):
+            x, y = boundary0[r, 0] + u[2 * r], boundary0[r, 1] + u[2 * r + 1]
+            for f in range(nf):
+                rx, ry = x - centers_f[f, 0], y - centers_f[f, 1]
+                tau = min(max(rx * t0_f[f, 0] + ry * t0_f[f, 1], -flat_f[f]), flat_f[f])
+                wx, wy = rx - tau * t0_f[f, 0], ry - tau * t0_f[f, 1]
+                vx, vy = v[2 * r] - D[f, 0], v[2 * r + 1] - D[f, 1]
+                gaps[i] = (wx * vx + wy * vy) / np.sqrt(wx * wx + wy * wy)
+                i += 1
+    return gaps, rates
 
 
 @jit
@@ -348,7 +439,7 @@ def advance_quiet(a, h, theta, dtheta, F, dF, ft, start_values, start_ends,
         for f in range(nf):
             centers_f[f, 0] = origin[f, 0] + b * D[f, 0]
             centers_f[f, 1] = origin[f, 1] + b * D[f, 1]
-        fn, ft_b = _watched(th, de, Fb, dth, nu, pick, mu, slip, radius_c, rate, A_rows,
+        fn, ft_b = _watched(de, Fb, dth, nu, pick, mu, slip, radius_c, rate, A_rows,
                             R_rows, E, boundary0, centers_f, radius_f, flat_f, t0_f, values)
         det, missing = _area(de, Fb, E, rigid_gradients, bounds, loads, exact_bound)
         if missing:

@@ -23,6 +23,7 @@ module                      what it holds
 :mod:`.substeps`            substep control (grid or adaptive)
 :mod:`.run`                 :func:`advance`: the substep loop that joins them
 :mod:`.compiled`            the substeps between events in one numba call (numba route)
+:mod:`.compiled_functions`  the event functions at a point in one numba call (numba route)
 :mod:`.quiet`               :class:`QuietSteps`: calls that cross no event, without the loop
 ==========================  ===============================================================
 

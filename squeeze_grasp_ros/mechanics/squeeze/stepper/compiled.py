@@ -49,7 +49,8 @@ exceed for a call to be quiet. The start of the next call re-solves the state fr
 values, which moves the functions by round-off (about 1e-16); a function within this margin of
 zero goes through the full stepper, so that round-off can never hide or invent an event. The
 compiled substeps take a substep as quiet on the same margin (their watched values are the
-numpy route's to round-off)."""
+numpy code's floats, but an element near inversion has its det F summed in the kernel's own
+order)."""
 CHUNK = 256
 """Substeps the compiled loop runs before it returns its samples (it is called again)."""
 _NO_LOADS = np.zeros((0, 0, 4, 2))
@@ -116,6 +117,7 @@ class CompiledSubsteps:
         A_rows, R_rows = model._boundary_rows(sd, rows) if len(rows) else (
             np.zeros((0, 2 * len(contacts))), np.zeros((0, 3)))
         _, pick = functions._contact_entries(contacts, held)
+        # E in the set's own layout: the kernel's E.T @ delta is then numpy's product
         tables = (
             (np.ascontiguousarray(sd.C), np.ascontiguousarray(contacts.positions, float),
              np.ascontiguousarray(contacts.stick), np.ascontiguousarray(contacts.slip),
@@ -124,7 +126,7 @@ class CompiledSubsteps:
              np.ascontiguousarray(contacts.finger),
              np.array(sorted(set(contacts.finger.tolist())), int)),
             (np.ascontiguousarray(pick, int), np.ascontiguousarray(A_rows),
-             np.ascontiguousarray(R_rows), np.ascontiguousarray(sd.E),
+             np.ascontiguousarray(R_rows), sd.E,
              np.ascontiguousarray(functions._boundary[rows])),
         )
         self._tables = (sd, key, tables)

@@ -47,6 +47,7 @@ from squeeze_grasp_ros.mechanics.squeeze.event_key import (
     EventKey,
     KeyTable,
 )
+from squeeze_grasp_ros.mechanics.squeeze.stepper.compiled_functions import CompiledFunctions
 from squeeze_grasp_ros.mechanics.squeeze.stepper.contact_set import ContactSet
 from squeeze_grasp_ros.mechanics.squeeze.stepper.motion import FingerMotion
 from squeeze_grasp_ros.mechanics.vocabulary import Termination
@@ -240,14 +241,19 @@ class EventFunctions:
     def termination_values(self, contacts: ContactSet, sol: Solution) -> tuple[float, float]:
         """(eps* - max strain, pickup margin); inf for criteria not declared or not enabled."""
         model, lim = self.model, self.model.limits
-        strain = pickup = np.inf
-        if lim.strain is not None and Termination.STRAIN_LIMIT in self.terminate_on:
-            strain = lim.strain - model.max_strain(contacts.data, sol.delta, sol.F)[0]
+        strain, pickup = self.strain_margin(contacts, sol), np.inf
         if lim.weight is not None and Termination.PICKED_UP in self.terminate_on:
             pickup = pickup_margin(model.mu, sol.normal, sol.tangential, contacts.stick,
                                    contacts.finger, sorted(set(contacts.finger.tolist())),
                                    lim.weight / model.force_unit)
         return strain, pickup
+
+    def strain_margin(self, contacts: ContactSet, sol: Solution) -> float:
+        """eps* - max strain (inf without a strain limit or when it is not enabled)."""
+        lim = self.model.limits
+        if lim.strain is None or Termination.STRAIN_LIMIT not in self.terminate_on:
+            return np.inf
+        return lim.strain - self.model.max_strain(contacts.data, sol.delta, sol.F)[0]
 
     def area_value(self, contacts: ContactSet, sol: Solution) -> float:
         """The smallest area ratio det F less INVERSION_AREA_RATIO (element_inverted at <= 0)."""
@@ -274,18 +280,72 @@ class EventFunctions:
         terminations that are checked.
         """
         keys, pick = self._contact_entries(contacts, held)
+        table = np.concatenate((v.fn, v.c_plus, v.c_minus, v.d))
+        values = np.concatenate((table[pick], v.gaps.ravel()))
+        return WatchedValues(self._order(keys, rows), values,
+                             self._ends(v.area, v.strain, v.pickup))
+
+    def watched(self, contacts: ContactSet, sol: Solution, s: float, rows: np.ndarray,
+                held: np.ndarray, *, terminations: bool = True) -> WatchedValues:
+        """:meth:`entries` of :meth:`values` at ``sol`` (free boundary ``rows``, contacts
+        ``held`` left out; the terminations if asked).
+
+        On the numba route, for the fast model's boundary compliance, the per-contact values,
+        the gaps, the area ratio while no element nears inversion and the pickup margin are one
+        compiled call (:class:`~.compiled_functions.CompiledFunctions`, the numpy code's
+        floats, a zero's sign aside); an element near inversion and a strain limit are
+        computed by the model.
+        """
+        compiled = self._compiled
+        if compiled is None or not compiled.takes(contacts):
+            return self.entries(contacts, self.values(contacts, sol, s, rows, terminations),
+                                rows, held)
+        keys, pick = self._contact_entries(contacts, held)
+        values, det, _, strain, pickup = compiled.values(contacts, sol, s, rows, pick,
+                                                         terminations)
+        return WatchedValues(self._order(keys, rows), values,
+                             self._ends(det - INVERSION_AREA_RATIO, strain, pickup))
+
+    def end_values(self, contacts: ContactSet, sol: Solution) -> tuple[float, int, float, float]:
+        """(smallest area ratio det F, its element or -1 when none is near inversion,
+        eps* - max strain, pickup margin) at ``sol``: what the terminations check, in their
+        order (the margins inf for criteria not declared or not enabled, and not measured when
+        the area already ends the motion). On the numba route as :meth:`watched` computes
+        them.
+        """
+        compiled = self._compiled
+        if compiled is None or not compiled.takes(contacts):
+            det, element = self.model.area_ratio(contacts.data, sol.delta, sol.F)
+            if det <= INVERSION_AREA_RATIO:
+                return det, element, np.inf, np.inf
+            return (det, element, *self.termination_values(contacts, sol))
+        _, det, element, _, pickup = compiled.values(contacts, sol, 0.0, _NO_ROWS, _NO_ROWS,
+                                                     True, strain=False)
+        if det <= INVERSION_AREA_RATIO:
+            return det, element, np.inf, np.inf
+        return det, element, self.strain_margin(contacts, sol), pickup
+
+    @cached_property
+    def _compiled(self) -> CompiledFunctions | None:
+        """The compiled reads of this call's functions (numba route), or None."""
+        return CompiledFunctions.of(self)
+
+    def _order(self, keys: list[EventKey], rows: np.ndarray) -> KeyOrder:
+        """The :class:`KeyOrder` of per-contact ``keys`` and the gaps of ``rows`` (kept)."""
         tag = ("watched", id(keys), rows.dtype.str, rows.tobytes())
         order = self._entry_tables.get(tag)
         if order is None:
             order = self._entry_tables[tag] = KeyOrder((*keys, *self._row_gap_keys(rows)))
-        table = np.concatenate((v.fn, v.c_plus, v.c_minus, v.d))
-        values = np.concatenate((table[pick], v.gaps.ravel()))
+        return order
+
+    def _ends(self, area: float, strain: float, pickup: float) -> dict[EventKey, float]:
+        """The termination functions that are checked (finite), by key."""
         ends = {}
-        for function, value in ((EventFunction.AREA, v.area), (EventFunction.STRAIN, v.strain),
-                                (EventFunction.PICKUP, v.pickup)):
+        for function, value in ((EventFunction.AREA, area), (EventFunction.STRAIN, strain),
+                                (EventFunction.PICKUP, pickup)):
             if np.isfinite(value):
                 ends[self.keys.get(function)] = value
-        return WatchedValues(order, values, ends)
+        return ends
 
     @cached_property
     def _entry_tables(self) -> dict[tuple, object]:
@@ -338,6 +398,12 @@ class EventFunctions:
         contact's normal force and cone margins (the functions with
         :attr:`~..event_key.EventFunction.has_slope`).
         """
+        compiled = self._compiled
+        if compiled is not None and compiled.takes(contacts):
+            gaps, rates = compiled.slopes(contacts, sol, s, rows)
+            out = dict(zip(self._row_gap_keys(rows), gaps.tolist())) if len(rows) else {}
+            out.update(zip(self._sloped_keys(contacts), rates.tolist()))
+            return out
         fn_r, ft_r = sol.normal_rate, sol.tangential_rate
         mu = self.model.mu
         out = {}

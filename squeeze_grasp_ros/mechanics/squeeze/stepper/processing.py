@@ -157,12 +157,12 @@ class EventProcessor:
         """Pending contact events at the current point, in processing order."""
         contacts, functions, depth = self.contacts, self.functions, self.depth
         rows = functions.free_rows(contacts, self.chatter.held_nodes(depth))
-        v = functions.values(contacts, sol, self.s, rows, terminations=False)
+        watched = functions.watched(contacts, sol, self.s, rows,
+                                    self.chatter.held(contacts.nodes, depth), terminations=False)
         gap_nodes = [key.node for key in self.fresh if key.function == EventFunction.GAP]
         slopes = functions.slopes(contacts, sol, self.s, functions.rows_of(gap_nodes))
         out = []
-        for key, value in functions.entries(contacts, v, rows,
-                                            self.chatter.held(contacts.nodes, depth)).items():
+        for key, value in watched.items():
             if key in slopes and key.at_node in self.fresh:
                 if key.function == EventFunction.GAP and value > self.tol:
                     continue  # a freed node is at zero gap only to the finger that released it
@@ -321,12 +321,11 @@ class EventProcessor:
         """First termination that holds at the current point (order in the module docstring)."""
         if self.motion.rate == 0:
             return None
-        det, element = self.model.area_ratio(self.contacts.data, sol.delta, sol.F)
+        det, element, strain, pickup = self.functions.end_values(self.contacts, sol)
         if det <= INVERSION_AREA_RATIO:
             counters = self.solver.counters
             counters.min_area_ratio, counters.inverted_element = det, element
             return Termination.ELEMENT_INVERTED
-        strain, pickup = self.functions.termination_values(self.contacts, sol)
         if strain <= 0:
             return Termination.STRAIN_LIMIT
         if self.lost is not None:

@@ -160,8 +160,7 @@ class _Call:
                  slopes: bool) -> _Watched:
         """The watched functions at ``sol`` (contacts held at ``depth`` left out)."""
         f, contacts = self.functions, self.events.contacts
-        values = f.entries(contacts, f.values(contacts, sol, s, rows), rows,
-                           self.chatter.held(contacts.nodes, depth))
+        values = f.watched(contacts, sol, s, rows, self.chatter.held(contacts.nodes, depth))
         return _Watched(rows, values, f.slopes(contacts, sol, s, rows) if slopes else None)
 
     def _watched_at(self, sol: Solution, a: float, depth: float, known: _Watched | None,

@@ -1,0 +1,119 @@
+# Copyright 2026 squeeze_grasp_ros developers
+# SPDX-License-Identifier: Apache-2.0
+"""The event functions at a point by the compiled kernel (the numba route of the linear model).
+
+:class:`CompiledFunctions` computes what :class:`~.functions.EventFunctions` reads at a solution
+(the watched values: per-contact functions, the free rows' gaps, the area bound and the pickup
+margin; their slopes d/ds) by one call of :func:`..substeps_numba.watched_values` or
+:func:`..substeps_numba.slope_values`, instead of some fifty numpy calls. They are the numpy
+code's floats, a zero's sign aside: the products are the BLAS calls numpy makes, with the
+arrays in the layouts numpy has them (the set's E as it holds it), the sums in numpy's order.
+What the kernel does not compute stays the model's: an element near inversion (its exact
+det F) and a strain limit. With ``SQUEEZE_GRASP_KERNEL=numpy``, for the reference model and for
+models with their own boundary displacement or area check (the nonlinear ones), none of this
+runs: :class:`~.functions.EventFunctions` computes in numpy, the reference path.
+"""
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from squeeze_grasp_ros.mechanics.squeeze.contact_model import (
+    GRADIENT_BOUND_EXACT,
+    ContactModel,
+    Solution,
+)
+from squeeze_grasp_ros.mechanics.squeeze.fixed_set_kernel import (
+    Kernel,
+    compiled_substeps,
+    selected,
+)
+from squeeze_grasp_ros.mechanics.squeeze.stepper.contact_set import ContactSet
+from squeeze_grasp_ros.mechanics.vocabulary import Termination
+
+if TYPE_CHECKING:
+    from squeeze_grasp_ros.mechanics.squeeze.stepper.functions import EventFunctions
+
+__all__ = ["CompiledFunctions"]
+
+_NO_BOUNDS = np.zeros((0, 0))
+_NO_KAPPA = np.zeros(0)
+
+
+class CompiledFunctions:
+    """The compiled reads of one call's :class:`~.functions.EventFunctions` (see the module).
+
+    Use :meth:`of`, which returns None when the call's functions are computed in numpy, and
+    :meth:`takes` for each contact set (the fast model's boundary compliance).
+    """
+
+    def __init__(self, functions: EventFunctions) -> None:
+        self.functions = functions
+        self.kernel = compiled_substeps()
+
+    @classmethod
+    def of(cls, functions: EventFunctions) -> CompiledFunctions | None:
+        """The compiled reads of ``functions``, or None on the numpy route and for models
+        whose boundary displacement or area check is their own.
+        """
+        model = functions.model
+        if (selected() != Kernel.NUMBA or model.reference
+                or type(model).boundary_displacement is not ContactModel.boundary_displacement
+                or type(model).area_ratio is not ContactModel.area_ratio):
+            return None
+        return cls(functions)
+
+    @staticmethod
+    def takes(contacts: ContactSet) -> bool:
+        """Whether the contact set has the fast model's boundary compliance."""
+        return contacts.data.A_bc is not None
+
+    def _rows(self, contacts: ContactSet, rows: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """The rows of the boundary compliance and of the rigid modes of ``rows``."""
+        if not len(rows):
+            return np.zeros((0, 2 * len(contacts))), np.zeros((0, 3))
+        return self.functions.model._boundary_rows(contacts.data, rows)
+
+    def values(self, contacts: ContactSet, sol: Solution, s: float, rows: np.ndarray,
+               pick: np.ndarray, terminations: bool, *, strain: bool = True) -> tuple:
+        """(the per-contact values ``pick`` and the gaps of ``rows``, det F, its element or
+        -1, eps* - max strain, pickup margin) at ``sol``: the terminations inf unless asked
+        (the area also while the fingers do not move, the strain unless ``strain``), the
+        model's det F once an element nears inversion.
+        """
+        functions = self.functions
+        model, motion, sd = functions.model, functions.motion, contacts.data
+        lim, rate = model.limits, motion.rate
+        A, R = self._rows(contacts, rows)
+        weight = (lim.weight / model.force_unit if terminations and lim.weight is not None
+                  and Termination.PICKED_UP in functions.terminate_on else np.nan)
+        bounds = model.area_tables(sd)[0] if terminations and rate > 0 else _NO_BOUNDS
+        tip = motion.tip
+        values, det, pickup = self.kernel.watched_values(
+            sol.delta, sol.F, sol.dtheta, sol.normal_angle, pick, float(model.mu),
+            contacts.slip, motion.radius[contacts.finger], rate if rate > 0 else 1.0, A, R,
+            sd.E, functions._boundary[rows], motion.centers(s), tip.radius, tip.flat,
+            tip._facing_tangent, contacts.stick, contacts.finger, weight,
+            model.obj.rigid_gradients, bounds, GRADIENT_BOUND_EXACT)
+        element = -1
+        if np.isnan(det):
+            det, element = model.area_ratio(sd, sol.delta, sol.F)
+        margin = (functions.strain_margin(contacts, sol) if terminations and strain
+                  else np.inf)
+        return values, det, element, margin, pickup
+
+    def slopes(self, contacts: ContactSet, sol: Solution, s: float,
+               rows: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(the gap slopes of ``rows`` to every finger, each contact's normal-force and
+        cone-margin slopes), raveled, at ``sol``.
+        """
+        functions = self.functions
+        model, motion, sd = functions.model, functions.motion, contacts.data
+        A, R = self._rows(contacts, rows)
+        tip = motion.tip
+        return self.kernel.slope_values(
+            sol.delta, sol.F, sol.ddelta, sol.dF, sol.dtheta, sol.normal_angle,
+            _NO_KAPPA if sol.kappa is None else sol.kappa, float(model.mu), A, R, sd.E,
+            functions._boundary[rows], motion.centers(s), motion.translation, tip.flat,
+            tip._facing_tangent)

@@ -78,6 +78,19 @@ def pytest_unconfigure(config: pytest.Config) -> None:
         config.stash[DOMAIN_LOCK].close()
 
 
+@pytest.fixture(autouse=True)
+def kernel_route_kept(monkeypatch: pytest.MonkeyPatch) -> None:
+    """Whatever a test does to the kernel route's variable is undone after it: ``sweep``
+    called in-process sets it to numba (as its command does), which made the tests after it
+    run on the compiled route (seen: test_events after test_sweep aborted in the kernel).
+    """
+    value = os.environ.get(KERNEL_VARIABLE)
+    if value is None:
+        monkeypatch.delenv(KERNEL_VARIABLE, raising=False)
+    else:
+        monkeypatch.setenv(KERNEL_VARIABLE, value)
+
+
 @pytest.fixture(params=[k.value for k in Kernel])
 def kernel(request: pytest.FixtureRequest, monkeypatch: pytest.MonkeyPatch) -> Kernel:
     """Each route of the linear model's fixed-set solve in turn (numpy, numba); the numba one

@@ -141,6 +141,13 @@ class CompiledSubsteps:
         ev, model, motion = call.events, call.model, call.motion
         contacts = ev.contacts
         held = call.chatter.held(contacts.nodes, motion.depth_at(a))
+        keys, _ = call.functions._contact_entries(contacts, held)
+        if getattr(start.values, "order", None) is not call.functions._order(keys, start.rows):
+            # ``start`` was taken while another contact was held (a hold expired since, the
+            # free rows unchanged): the kernel compares values by position, so this substep
+            # runs in Python, which compares them by key (before: writes past the kernel's
+            # values array, an abort or a corrupted heap)
+            return Chunk(0, True, a, None)
         problem, watched = self._set_tables(contacts, start.rows, held)
         bounds, loads = model.area_tables(contacts.data)  # loads: kept once an element neared
         area = (np.ascontiguousarray(bounds), _NO_LOADS if loads is None else loads)

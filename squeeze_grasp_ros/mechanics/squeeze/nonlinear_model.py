@@ -22,15 +22,19 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from squeeze_grasp_ros.mechanics.elastic.compliance import node_dofs
+from squeeze_grasp_ros.mechanics.elastic.compliance import ElasticObject, node_dofs
 from squeeze_grasp_ros.mechanics.elastic.contact_response import (
     NEWTON_TOL,
     ContactResponse,
     Evaluation,
     ResponseFailure,
 )
-from squeeze_grasp_ros.mechanics.elastic.hyperelastic import mesh_geometry
-from squeeze_grasp_ros.mechanics.elastic.interior import TangentFactor, default_factorizer
+from squeeze_grasp_ros.mechanics.elastic.hyperelastic import MeshGeometry, mesh_geometry
+from squeeze_grasp_ros.mechanics.elastic.interior import (
+    PatternLayout,
+    TangentFactor,
+    default_factorizer,
+)
 from squeeze_grasp_ros.mechanics.elastic.strain_measures import max_principal_strain
 from squeeze_grasp_ros.mechanics.errors import InvalidInputError
 from squeeze_grasp_ros.mechanics.squeeze.contact_model import (
@@ -44,11 +48,30 @@ from squeeze_grasp_ros.mechanics.squeeze.fixed_set_kernel import Kernel, selecte
 from squeeze_grasp_ros.mechanics.vocabulary import MaterialModel, StrainCriterion
 from squeeze_grasp_ros.threads import one_blas_thread
 
-__all__ = ["NonlinearContactModel", "RESPONSE_ACCURACY", "contact_model"]
+__all__ = ["NonlinearContactModel", "RESPONSE_ACCURACY", "contact_model", "object_geometry"]
 
 RESPONSE_ACCURACY = 100 * NEWTON_TOL
 """Relative accuracy of the contact forces of an interior solve converged to NEWTON_TOL; the
 Newton on the sliding angles cannot resolve the cone better than this."""
+
+
+def object_geometry(obj: ElasticObject, length: float, *, compiled: bool) -> MeshGeometry:
+    """The :func:`~squeeze_grasp_ros.mechanics.elastic.hyperelastic.mesh_geometry` of ``obj``'s
+    mesh with coordinates / ``length``, kept on ``obj`` (its arrays read-only) for all of its
+    contact models: a planner or a sweep squeezes one object many times, and on an 8,000-node
+    mesh the geometry takes about 50 ms to build. ``compiled``: for the compiled neo-Hookean
+    assembly (:mod:`~squeeze_grasp_ros.mechanics.elastic.hyperelastic_numba`).
+    """
+    kept = obj._shared.setdefault("mesh_geometry", {})
+    key = (float(length), bool(compiled))
+    if key not in kept:
+        geometry = mesh_geometry(obj.mesh.nodes / length, obj.mesh.triangles, compiled=compiled)
+        for array in (geometry.area, geometry.weighted_outer, geometry.slots, geometry.indices,
+                      geometry.indptr, geometry.transpose, geometry.shape_gradients,
+                      geometry.dofs, geometry.gradient.data, geometry.force_operator.data):
+            array.flags.writeable = False
+        kept[key] = geometry
+    return kept[key]
 
 
 @dataclass(frozen=True)
@@ -100,11 +123,11 @@ class NonlinearContactModel(ContactModel):
         if key not in responses:
             mesh = self.obj.mesh
             if "geometry" not in self._cache:
-                self._cache["geometry"] = mesh_geometry(
-                    mesh.nodes / self.length, mesh.triangles,
-                    compiled=selected() == Kernel.NUMBA)
+                self._cache["geometry"] = object_geometry(self.obj, self.length,
+                                                          compiled=selected() == Kernel.NUMBA)
             if "factorization" not in self._cache:
-                self._cache["factorization"] = TangentFactor()
+                layout = self.obj._shared.setdefault("pattern_layout", PatternLayout())
+                self._cache["factorization"] = TangentFactor(layout=layout)
             shared = self._cache["factorization"]
             responses[key] = ContactResponse(MaterialModel(self.material_model),
                                              mesh.nodes / self.length, mesh.triangles,

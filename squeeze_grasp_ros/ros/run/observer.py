@@ -11,6 +11,7 @@ from collections.abc import Callable
 from typing import Any
 
 from rclpy.node import Node
+from rclpy.qos import DurabilityPolicy
 from rclpy.serialization import deserialize_message
 from std_msgs.msg import Header
 
@@ -37,10 +38,20 @@ class Observer:
         The run's client node.
     progress : callable, optional
         Called at every feedback of the goal (:data:`Progress`).
+    kept : bool
+        Subscribe transient-local to the outcome topics, as their lockstep publishers offer
+        (:func:`.pipeline.output_qos`): a run's own nodes. Across processes this client can see
+        a publisher before that publisher's writer has matched this client's reader (discovery
+        is not symmetric), and a volatile reader loses what the writer sent before the match
+        (seen under load: a ``--processes`` run's first four monitor events). Not for attached
+        nodes, whose history may hold an earlier run's outcome.
     """
 
-    def __init__(self, node: Node, progress: Progress | None = None) -> None:
+    def __init__(self, node: Node, progress: Progress | None = None, *,
+                 kept: bool = False) -> None:
+        self.node = node
         self.progress = progress
+        self.kept = kept
         self.sim_events: list[ContactEvent] = []
         self.world_end: dict | None = None
         """``{"termination", "depth", "stamp_ns"}`` once the world ended (the last end)."""
@@ -55,7 +66,7 @@ class Observer:
         self.sim_state_ns = -1
         self.recorder_ns = -1
         self.feedback: list[ExecuteGrasp.Feedback] = []
-        loop = pipeline.loop_qos(1000)
+        loop = pipeline.loop_qos(1000, kept=kept)
         self.subscriptions = [
             node.create_subscription(ContactEventArray, pipeline.SIM_EVENTS, self._sim_events,
                                      loop),
@@ -66,7 +77,7 @@ class Observer:
         ]
         """The subscriptions to the outcome topics (they must match before the goal is sent)."""
         node.create_subscription(Header, pipeline.RECORDER_PROGRESS, self._recorder_progress,
-                                 loop)
+                                 pipeline.loop_qos(1000))
 
     # ----------------------------------------------------------------- callbacks
     def _sim_events(self, msg: ContactEventArray) -> None:
@@ -119,6 +130,19 @@ class Observer:
     def matched(self) -> bool:
         """True once every outcome subscription has a publisher."""
         return all(s.get_publisher_count() > 0 for s in self.subscriptions)
+
+    def incompatible(self) -> list[str]:
+        """``topic (node)`` of every outcome publisher that this client, subscribed kept,
+        never receives from: a volatile one (a loop node not in lockstep).
+        """
+        if not self.kept:
+            return []
+        return [
+            f"{sub.topic_name} ({info.node_namespace.rstrip('/')}/{info.node_name})"
+            for sub in self.subscriptions
+            for info in self.node.get_publishers_info_by_topic(sub.topic_name)
+            if info.qos_profile.durability != DurabilityPolicy.TRANSIENT_LOCAL
+        ]
 
     def world_failed(self) -> bool:
         """True once the simulated world has ended with a termination that loses the grasp."""

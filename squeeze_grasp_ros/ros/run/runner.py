@@ -145,7 +145,7 @@ class PipelineRunner:
         """The pipeline nodes built in this process, by name."""
         self.recorder = None
         """The in-process recorder node (with ``record``, without ``processes``)."""
-        self.observer = Observer(self.client, progress)
+        self.observer = Observer(self.client, progress, kept=not options.attach)
         self.prediction_pub = self.client.create_publisher(
             ContactEventArray, pipeline.PREDICTION, pipeline.LATCHED)
         self.goal = GoalClient(self.client, self.observer.on_feedback)
@@ -199,7 +199,10 @@ class PipelineRunner:
         handshake, and simulated time only moves once the goal is sent, so waiting here loses
         nothing; without it a fast loop could publish its first events before discovery
         between this process and the monitor had settled (seen: a run whose 7 monitor events
-        never reached the client).
+        never reached the client). Seeing a publisher is the reader's side of discovery only:
+        the publisher's writer may match this client's reader later, so the subscriptions are
+        transient-local (:class:`.observer.Observer`), and a publisher that is not (a loop node
+        taken out of lockstep) is refused here rather than never heard.
         """
         options = self.options
         started = time.perf_counter()
@@ -239,6 +242,11 @@ class PipelineRunner:
         self.spin_until(lambda: self.observer.sim_state_ns >= 0, options.timeout, "tick 0")
         self.spin_until(self.observer.matched, options.timeout,
                         "the publishers of the run's outcome topics")
+        volatile = self.observer.incompatible()
+        if volatile:
+            raise RunError("the run's outcome topics need their lockstep publishers "
+                           "(transient-local); volatile, so never received: "
+                           + ", ".join(volatile))
         if self.graph is not None:
             self.graph.check()
         self.start_ns = self.observer.sim_state_ns

@@ -30,6 +30,7 @@ from squeeze_grasp_ros.mechanics.vocabulary import Finger, StrainMeasure, Termin
 from squeeze_grasp_ros.scene import GraspSetup
 from squeeze_grasp_ros.scene.setup import check_adversary_node
 from squeeze_grasp_ros.sweep.plan import Task, evaluation_scene, group_setup, rng_for
+from squeeze_grasp_ros.threads import one_blas_thread
 
 CACHE_GROUPS = 4
 """Prepared groups kept per worker process (a 2k-node group holds a few MB, and its object up
@@ -285,14 +286,20 @@ def run_task(task: Task) -> dict:
     """Evaluate a task; returns ``{"rows": [...], "outline": [[x, y], ...], "prepare_s": s,
     "cached": bool, "evaluate_s": s}`` (rows sorted by ``eval_id``; the outline is the mesh's
     outer boundary loop, m, for the report's pictures).
+
+    The task runs with one BLAS thread whatever the process's setting
+    (:func:`~squeeze_grasp_ros.threads.one_blas_thread`), as Dask's nannies start workers:
+    multithreaded OpenBLAS sums some products in another order, and the example sweep run in a
+    plain Python process differed from the workers' rows in the last place of 88 values.
     """
     cached = (task.spec_hash, task.group) in _CACHE
-    group = prepare(task)
-    start = time.perf_counter()
-    rows, resist = [], {}
-    for index in range(task.start, min(task.stop, len(group.placements))):
-        for params in task.params:
-            rows.append(evaluate(task, group, index, params, resist))
+    with one_blas_thread():  # the rows do not depend on the process's BLAS threads
+        group = prepare(task)
+        start = time.perf_counter()
+        rows, resist = [], {}
+        for index in range(task.start, min(task.stop, len(group.placements))):
+            for params in task.params:
+                rows.append(evaluate(task, group, index, params, resist))
     mesh = group.setup.solid.mesh
     return {
         "rows": sorted(rows, key=lambda r: r["eval_id"]),

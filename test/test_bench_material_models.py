@@ -33,6 +33,11 @@ def test_each_route_is_judged_by_its_own_rows(monkeypatch):
             "CPU time)") in said
     assert "under 60 s at 20,054 nodes: 61.5 s (not met; 10.7 s of CPU time)" in said
     assert "16.0x" not in said  # the QDLDL row is not the default factoriser's
+    # unset variable: the 8,038-node neo-Hookean squeeze assembles compiled (the numba row's
+    # 1.8 s, 1.6 s of CPU), its linear squeeze is numpy's (0.1 s, 2.3 / 12.1 s of CPU)
+    assert ("default route (variable unset, numba installed: the neo-Hookean assembly compiled "
+            "from 6,000 nodes, the linear squeeze by numpy) at 8,038 nodes: 18.0x (not met; "
+            "8.4x in CPU time)") in said
 
 
 def test_without_numba_the_verdict_names_the_extra(monkeypatch):
@@ -41,3 +46,4 @@ def test_without_numba_the_verdict_names_the_extra(monkeypatch):
     said = bench._scaling_verdict(rows, False, Factorizer.CHOLMOD)
     assert "numba route" not in said.replace("numba route not measured", "")
     assert "numba route not measured: pip install '.[fast]'" in said
+    assert "default route" not in said

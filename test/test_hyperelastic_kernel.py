@@ -124,3 +124,33 @@ def test_a_neo_hookean_squeeze_by_either_route(monkeypatch):
             assert b.finger_force[finger] == pytest.approx(a.finger_force[finger], rel=1e-9)
         assert b.energy == pytest.approx(a.energy, rel=1e-9)
         calls.clear()
+
+
+def test_large_objects_assemble_compiled_unless_the_route_is_chosen(monkeypatch):
+    """With SQUEEZE_GRASP_KERNEL unset and numba installed, objects of at least
+    COMPILED_ASSEMBLY_NODES nodes assemble the neo-Hookean law compiled (there a squeeze saves
+    more than numba's start-up), smaller ones by numpy; a route set in the variable wins either
+    way; the squeeze's diagnostics name the assembly route, and the kernel runs only when they
+    say numba.
+    """
+    from squeeze_grasp_ros.mechanics.squeeze import nonlinear_model as N
+
+    monkeypatch.delenv(KERNEL_VARIABLE, raising=False)
+    large = N.COMPILED_ASSEMBLY_NODES
+    assert N.compiled_assembly(large) and not N.compiled_assembly(large - 1)
+    monkeypatch.setenv(KERNEL_VARIABLE, "numpy")
+    assert not N.compiled_assembly(10 * large)
+    monkeypatch.setenv(KERNEL_VARIABLE, "numba")
+    assert N.compiled_assembly(1)
+    monkeypatch.delenv(KERNEL_VARIABLE)
+    calls = []
+    kernel = hyperelastic_numba.neo_hookean
+    monkeypatch.setattr(hyperelastic_numba, "neo_hookean",
+                        lambda *a: calls.append(1) or kernel(*a))
+    _, obj, contacts = foam_square(300)
+    for threshold, route in ((large, "numpy"), (obj.mesh.n, "numba")):
+        monkeypatch.setattr(N, "COMPILED_ASSEMBLY_NODES", threshold)
+        res = event_squeeze(obj, contacts, 0.02, 0.4, material_model="neo_hookean",
+                            relative_depth=0.03)
+        assert res.diagnostics["nonlinear"]["assembly"] == route
+        assert bool(calls) == (route == "numba")

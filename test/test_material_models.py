@@ -485,6 +485,40 @@ def test_event_location_skips_only_evaluations_whose_outcome_is_sure(mu, square,
     assert cost[0] < cost[1]
 
 
+def test_an_object_s_squeezes_share_its_set_up_and_keep_their_floats():
+    """A planner or a sweep squeezes one object many times: its contact models share the mesh
+    geometry (read-only) and the factor's pattern layout (ordering, held masks, block gathers)
+    kept on the object. A neo-Hookean squeeze after another squeeze of the same object, at
+    another placement, gives the floats of the same squeeze on a fresh copy of the object, bit
+    for bit (the numeric factorisations stay per squeeze), and builds no geometry of its own.
+    """
+    from squeeze_grasp_ros.mechanics.elastic.interior import PatternLayout
+
+    _, obj, contacts = foam_square(300)
+    fresh = ElasticObject(obj.mesh, obj.material)
+    nodes = obj.mesh.nodes
+    turn = nodes.mean(axis=0) + (nodes[list(contacts)] - nodes.mean(axis=0)) @ rotation(
+        np.pi / 2).T
+    across = tuple(int(np.argmin(np.hypot(*(nodes - p).T))) for p in turn)
+
+    def run(target, pair):
+        res = squeeze(target, pair, "neo_hookean", relative_depth=0.06)
+        return res.to_json() | {"diagnostics": None}
+
+    first = run(obj, across)
+    kept = obj._shared["mesh_geometry"]
+    layout = obj._shared["pattern_layout"]
+    assert len(kept) == 1 and isinstance(layout, PatternLayout)
+    geometry = next(iter(kept.values()))
+    assert not geometry.slots.flags.writeable and not geometry.gradient.data.flags.writeable
+    again = run(obj, contacts)
+    assert obj._shared["mesh_geometry"] == kept and next(iter(kept.values())) is geometry
+    assert obj._shared["pattern_layout"] is layout and len(layout._orders) == 2
+    assert again == run(fresh, contacts)
+    assert first == run(ElasticObject(obj.mesh, obj.material), across)
+    assert again["events"] and first["events"] != again["events"]
+
+
 def test_forces_scale_with_e_for_a_very_soft_object(square):
     _, obj, contacts = square
     soft = ElasticObject(obj.mesh, Material(1e3, 0.3, 0.0254))

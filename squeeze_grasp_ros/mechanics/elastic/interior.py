@@ -43,8 +43,8 @@ from squeeze_grasp_ros.extras import install_hint, installed
 from squeeze_grasp_ros.mechanics.vocabulary import Factorizer
 from squeeze_grasp_ros.threads import one_blas_thread
 
-__all__ = ["ContactStiffness", "Fill", "InteriorBlocks", "MAX_BORDERED_DOFS", "TangentFactor",
-           "default_factorizer", "factorizer", "nested_dissection"]
+__all__ = ["ContactStiffness", "Fill", "InteriorBlocks", "MAX_BORDERED_DOFS", "PatternLayout",
+           "TangentFactor", "default_factorizer", "factorizer", "nested_dissection"]
 
 _FACTORIZER: list[Factorizer | None] = [None]
 
@@ -149,6 +149,68 @@ class Fill:
 
 
 @dataclass
+class PatternLayout:
+    """What the sparsity pattern of an object's tangents fixes for their factorisations, built
+    on first use and then only read: the upper triangle's layout, the held-DOF masks, the
+    nested-dissection order and each contact set's block gathers (:class:`InteriorBlocks`).
+
+    Every contact model of one object shares one (kept on the object), so a planner or a sweep
+    that squeezes the object many times orders the pattern and gathers a set's blocks once;
+    the numeric factorisations stay with each model's :class:`TangentFactor`, so a squeeze's
+    floats do not depend on what was squeezed before. Everything here is a function of the
+    pattern: sharing it changes no result.
+    """
+
+    upper: sp.csc_matrix | None = field(default=None, repr=False)
+    upper_at: np.ndarray | None = field(default=None, repr=False)
+    rows: np.ndarray | None = field(default=None, repr=False)
+    cols: np.ndarray | None = field(default=None, repr=False)
+    _orders: dict = field(default_factory=dict, repr=False)
+    _masks: dict = field(default_factory=dict, repr=False)
+    _blocks: dict = field(default_factory=dict, repr=False)
+
+    def ensure(self, K: sp.csr_matrix) -> None:
+        """Lay out the upper triangle of the pattern of ``K`` (once)."""
+        if self.upper is None:
+            upper, at = _gather(K, np.arange(K.shape[0]), np.arange(K.shape[1]), upper=True)
+            coo = upper.tocoo()
+            self.upper_at, self.rows, self.cols = at, coo.row, coo.col
+            self.upper = upper
+
+    def mask(self, held: tuple) -> tuple[np.ndarray, np.ndarray]:
+        """(entries in a held row or column, held diagonal entries) of the upper pattern."""
+        if held not in self._masks:
+            dofs = np.array(held)
+            off = np.isin(self.rows, dofs) | np.isin(self.cols, dofs)
+            self._masks[held] = (np.flatnonzero(off),
+                                 np.flatnonzero(off & (self.rows == self.cols)))
+        return self._masks[held]
+
+    def order(self, upper: sp.csc_matrix, held: tuple) -> np.ndarray | None:
+        """:func:`nested_dissection` of ``upper``, the pattern with the DOFs ``held`` held
+        (once per held set; None without pymetis).
+        """
+        if held not in self._orders:
+            self._orders[held] = nested_dissection(upper)
+        return self._orders[held]
+
+    def blocks(self, K: sp.csr_matrix, free: np.ndarray, cdofs: np.ndarray) -> tuple:
+        """(K_fc, K_cc) gathers of :func:`_gather` for the contact DOFs ``cdofs``, kept when
+        ``free`` is every other DOF (how contact sets are made).
+        """
+        held = tuple(int(k) for k in cdofs)
+        kept = self._blocks.get(held)
+        if kept is not None:
+            return kept
+        out = (_gather(K, free, cdofs), _gather(K, cdofs, cdofs))
+        others = np.ones(K.shape[0], dtype=bool)
+        others[cdofs] = False
+        if len(free) == int(others.sum()) and bool(others[free].all()):
+            self._blocks[held] = out
+        return out
+
+
+@dataclass
 class TangentFactor:
     """Factorisation of tangents of one mesh with a set of DOFs held: their rows and columns
     replaced by those of the identity, which leaves K_ff of the other DOFs. Every contact set of
@@ -190,42 +252,29 @@ class TangentFactor:
     analyses: int = 0
     generation: int = 0
     bordered: int = 0
+    layout: PatternLayout = field(default_factory=PatternLayout, repr=False)
     _upper: sp.csc_matrix | None = field(default=None, repr=False)
     _ldlt: "object | None" = field(default=None, repr=False)  # a qdldl.Solver
     _cholesky: tuple | None = field(default=None, repr=False)
     _solve: Callable[[np.ndarray], np.ndarray] | None = field(default=None, repr=False)
-    _masks: dict = field(default_factory=dict, repr=False)
 
     def __post_init__(self) -> None:
         self.method = Factorizer(self.method)
 
-    def _layout(self, K: sp.csr_matrix) -> None:
-        self._upper, self._upper_at = _gather(K, np.arange(K.shape[0]), np.arange(K.shape[1]),
-                                              upper=True)
-        coo = self._upper.tocoo()
-        self._rows, self._cols = coo.row, coo.col
-
-    def _mask(self, held: tuple) -> tuple[np.ndarray, np.ndarray]:
-        """(entries in a held row or column, held diagonal entries) of the upper pattern."""
-        if held not in self._masks:
-            dofs = np.array(held)
-            off = np.isin(self._rows, dofs) | np.isin(self._cols, dofs)
-            self._masks[held] = (np.flatnonzero(off),
-                                 np.flatnonzero(off & (self._rows == self._cols)))
-        return self._masks[held]
-
     def _held_upper(self, K: sp.csr_matrix, held: tuple) -> sp.csc_matrix:
         """The upper triangle of ``K`` with the DOFs ``held`` held (the shared pattern)."""
+        layout = self.layout
+        layout.ensure(K)
         if self._upper is None:
-            self._layout(K)
-        data = K.data[self._upper_at]
-        off, diagonal = self._mask(held)
+            self._upper = layout.upper.copy()  # its values are this factoriser's own
+        data = K.data[layout.upper_at]
+        off, diagonal = layout.mask(held)
         data[off] = 0.0
         data[diagonal] = 1.0
         self._upper.data = data
         return self._upper
 
-    def _symbolic(self, upper: sp.csc_matrix) -> tuple:
+    def _symbolic(self, upper: sp.csc_matrix, held: tuple) -> tuple:
         """(cvxopt matrix of the pattern of ``upper``, CHOLMOD's symbolic factorisation of it:
         in the order of :func:`nested_dissection` or CHOLMOD's AMD order, whichever fills less;
         AMD without pymetis).
@@ -233,14 +282,15 @@ class TangentFactor:
         import cvxopt
         from cvxopt import cholmod
 
-        matrix = cvxopt.spmatrix(cvxopt.matrix(upper.data), cvxopt.matrix(self._rows),
-                                 cvxopt.matrix(self._cols), upper.shape)
-        order = nested_dissection(upper)
+        matrix = cvxopt.spmatrix(cvxopt.matrix(upper.data), cvxopt.matrix(self.layout.rows),
+                                 cvxopt.matrix(self.layout.cols), upper.shape)
+        order = self.layout.order(upper, held)
         if order is None:
             return matrix, cholmod.symbolic(matrix, uplo="U")
         return matrix, cholmod.symbolic(matrix, p=cvxopt.matrix(order.tolist(), tc="i"), uplo="U")
 
-    def _cholmod(self, upper: sp.csc_matrix) -> Callable[[np.ndarray], np.ndarray] | None:
+    def _cholmod(self, upper: sp.csc_matrix,
+                 held: tuple) -> Callable[[np.ndarray], np.ndarray] | None:
         """Supernodal LL^T of ``upper`` by CHOLMOD (symbolic analysis once); its solve, or None
         if the matrix is not positive definite.
         """
@@ -248,7 +298,7 @@ class TangentFactor:
         from cvxopt import cholmod
 
         if self._cholesky is None:
-            self._cholesky = self._symbolic(upper)
+            self._cholesky = self._symbolic(upper, held)
             self.analyses += 1
         matrix, factor = self._cholesky
         matrix.V = cvxopt.matrix(upper.data)
@@ -304,7 +354,7 @@ class TangentFactor:
         solve = None
         with one_blas_thread():
             if self.method == Factorizer.CHOLMOD:
-                solve = self._cholmod(upper)
+                solve = self._cholmod(upper, held)
                 if solve is None:
                     self.fallbacks += 1
             self._solve = self._qdldl(upper) if solve is None else solve
@@ -327,7 +377,7 @@ class TangentFactor:
         if self.method == Factorizer.CHOLMOD:
             from cvxopt import cholmod
 
-            matrix, factor = self._symbolic(upper)
+            matrix, factor = self._symbolic(upper, held)
             cholmod.numeric(matrix, factor)
             L = cholmod.getfactor(factor)
             counts = np.bincount(np.asarray(L.J).reshape(-1), minlength=upper.shape[0])
@@ -370,8 +420,7 @@ class InteriorBlocks:
 
     def __post_init__(self) -> None:
         self.held = tuple(int(k) for k in self.cdofs)
-        self._fc = _gather(self.pattern, self.free, self.cdofs)
-        self._cc = _gather(self.pattern, self.cdofs, self.cdofs)
+        self._fc, self._cc = self.shared.layout.blocks(self.pattern, self.free, self.cdofs)
 
     def _bordering(self) -> tuple | None:
         """(D, Z, E_D^T Z) bordering the shared factorisation to this set, () when it holds

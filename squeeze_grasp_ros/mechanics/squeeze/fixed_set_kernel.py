@@ -87,6 +87,14 @@ def compiled_substeps():
     return substeps_numba
 
 
+def chosen() -> Kernel | None:
+    """The route :data:`KERNEL_VARIABLE` names, None when it is unset (:func:`selected` reads
+    that as numpy; the neo-Hookean assembly decides by the mesh:
+    :func:`~.nonlinear_model.compiled_assembly`).
+    """
+    return selected() if os.environ.get(KERNEL_VARIABLE, "") else None
+
+
 def prefer_compiled() -> None:
     """Set :data:`KERNEL_VARIABLE` to numba in this process's environment, which the processes
     it starts (a local Dask cluster's workers) inherit, when numba is installed and the

@@ -11,10 +11,12 @@ whole object with the contact displacements prescribed
 (:class:`~squeeze_grasp_ros.mechanics.elastic.contact_response.ContactResponse`), so contact
 normals, gaps and sliding are those of the current configuration. The strain limit uses the
 model's own measure (:attr:`~squeeze_grasp_ros.mechanics.vocabulary.MaterialModel.strain_measure`:
-Biot for corotational, log for neo-Hookean). The route chosen for the linear model's fixed-set
-solve (:mod:`.fixed_set_kernel`: ``SQUEEZE_GRASP_KERNEL=numba``) also assembles the
-neo-Hookean law by its compiled kernel
-(:mod:`~squeeze_grasp_ros.mechanics.elastic.hyperelastic_numba`).
+Biot for corotational, log for neo-Hookean). The neo-Hookean law is assembled by its compiled
+kernel (:mod:`~squeeze_grasp_ros.mechanics.elastic.hyperelastic_numba`) when
+``SQUEEZE_GRASP_KERNEL=numba`` asks for the compiled route (:mod:`.fixed_set_kernel`), and, with
+the variable unset, on objects of at least :data:`COMPILED_ASSEMBLY_NODES` nodes when numba is
+installed (:func:`compiled_assembly`). What depends on the mesh alone (the assembly geometry,
+the factor's pattern layout) is kept on the object for all of its contact models.
 """
 from __future__ import annotations
 
@@ -22,15 +24,20 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from squeeze_grasp_ros.mechanics.elastic.compliance import node_dofs
+from squeeze_grasp_ros.extras import installed
+from squeeze_grasp_ros.mechanics.elastic.compliance import ElasticObject, node_dofs
 from squeeze_grasp_ros.mechanics.elastic.contact_response import (
     NEWTON_TOL,
     ContactResponse,
     Evaluation,
     ResponseFailure,
 )
-from squeeze_grasp_ros.mechanics.elastic.hyperelastic import mesh_geometry
-from squeeze_grasp_ros.mechanics.elastic.interior import TangentFactor, default_factorizer
+from squeeze_grasp_ros.mechanics.elastic.hyperelastic import MeshGeometry, mesh_geometry
+from squeeze_grasp_ros.mechanics.elastic.interior import (
+    PatternLayout,
+    TangentFactor,
+    default_factorizer,
+)
 from squeeze_grasp_ros.mechanics.elastic.strain_measures import max_principal_strain
 from squeeze_grasp_ros.mechanics.errors import InvalidInputError
 from squeeze_grasp_ros.mechanics.squeeze.contact_model import (
@@ -40,15 +47,61 @@ from squeeze_grasp_ros.mechanics.squeeze.contact_model import (
     Solution,
     SolveFailure,
 )
-from squeeze_grasp_ros.mechanics.squeeze.fixed_set_kernel import Kernel, selected
+from squeeze_grasp_ros.mechanics.squeeze.fixed_set_kernel import Kernel, chosen
 from squeeze_grasp_ros.mechanics.vocabulary import MaterialModel, StrainCriterion
 from squeeze_grasp_ros.threads import one_blas_thread
 
-__all__ = ["NonlinearContactModel", "RESPONSE_ACCURACY", "contact_model"]
+__all__ = ["COMPILED_ASSEMBLY_NODES", "NonlinearContactModel", "RESPONSE_ACCURACY",
+           "compiled_assembly", "contact_model", "object_geometry"]
 
 RESPONSE_ACCURACY = 100 * NEWTON_TOL
 """Relative accuracy of the contact forces of an interior solve converged to NEWTON_TOL; the
 Newton on the sliding angles cannot resolve the cone better than this."""
+
+
+COMPILED_ASSEMBLY_NODES = 6000
+"""Objects of at least this many nodes assemble the neo-Hookean law compiled when numba is
+installed and SQUEEZE_GRASP_KERNEL is unset: there one squeeze saves more CPU than numba's
+import and cached-code load cost the process (0.30 s measured; the compiled assembly saved
+0.06 / 0.15 / 0.46 s of a 12 % foam-square squeeze at 2,054 / 4,045 / 8,038 nodes, load 11)."""
+
+
+def compiled_assembly(nodes: int) -> bool:
+    """Whether the neo-Hookean law of an object of ``nodes`` nodes is assembled by the compiled
+    kernel (:mod:`~squeeze_grasp_ros.mechanics.elastic.hyperelastic_numba`): as
+    SQUEEZE_GRASP_KERNEL says when it is set (``numba``: yes, ``numpy``: no), else when the
+    object has at least :data:`COMPILED_ASSEMBLY_NODES` nodes and numba is installed. The
+    linear model's fixed-set route is :func:`~.fixed_set_kernel.selected`'s either way; the two
+    assembly routes agree to about 1e-15 relative.
+
+    >>> import os; os.environ["SQUEEZE_GRASP_KERNEL"] = "numpy"; compiled_assembly(20000)
+    False
+    >>> del os.environ["SQUEEZE_GRASP_KERNEL"]; compiled_assembly(500)
+    False
+    """
+    route = chosen()
+    if route is not None:
+        return route == Kernel.NUMBA
+    return nodes >= COMPILED_ASSEMBLY_NODES and installed("numba")
+
+
+def object_geometry(obj: ElasticObject, length: float, *, compiled: bool) -> MeshGeometry:
+    """The :func:`~squeeze_grasp_ros.mechanics.elastic.hyperelastic.mesh_geometry` of ``obj``'s
+    mesh with coordinates / ``length``, kept on ``obj`` (its arrays read-only) for all of its
+    contact models: a planner or a sweep squeezes one object many times, and on an 8,000-node
+    mesh the geometry takes about 50 ms to build. ``compiled``: for the compiled neo-Hookean
+    assembly (:mod:`~squeeze_grasp_ros.mechanics.elastic.hyperelastic_numba`).
+    """
+    kept = obj._shared.setdefault("mesh_geometry", {})
+    key = (float(length), bool(compiled))
+    if key not in kept:
+        geometry = mesh_geometry(obj.mesh.nodes / length, obj.mesh.triangles, compiled=compiled)
+        for array in (geometry.area, geometry.weighted_outer, geometry.slots, geometry.indices,
+                      geometry.indptr, geometry.transpose, geometry.shape_gradients,
+                      geometry.dofs, geometry.gradient.data, geometry.force_operator.data):
+            array.flags.writeable = False
+        kept[key] = geometry
+    return kept[key]
 
 
 @dataclass(frozen=True)
@@ -100,11 +153,11 @@ class NonlinearContactModel(ContactModel):
         if key not in responses:
             mesh = self.obj.mesh
             if "geometry" not in self._cache:
-                self._cache["geometry"] = mesh_geometry(
-                    mesh.nodes / self.length, mesh.triangles,
-                    compiled=selected() == Kernel.NUMBA)
+                self._cache["geometry"] = object_geometry(
+                    self.obj, self.length, compiled=compiled_assembly(len(mesh.nodes)))
             if "factorization" not in self._cache:
-                self._cache["factorization"] = TangentFactor()
+                layout = self.obj._shared.setdefault("pattern_layout", PatternLayout())
+                self._cache["factorization"] = TangentFactor(layout=layout)
             shared = self._cache["factorization"]
             responses[key] = ContactResponse(MaterialModel(self.material_model),
                                              mesh.nodes / self.length, mesh.triangles,
@@ -196,7 +249,8 @@ class NonlinearContactModel(ContactModel):
         return self.field_area_ratio(self._field(sd, delta))
 
     def diagnostics(self) -> dict:
-        """Newton evaluations, iterations and factorisations of the interior solves, the
+        """The assembly route (``assembly``: numpy or numba, :func:`compiled_assembly`),
+        Newton evaluations, iterations and factorisations of the interior solves, the
         contact sets that solved with the factorisation of the set they grew from, bordered,
         instead of one of their own (``bordered``), the evaluations answered by a kept state
         (look-ups), the factoriser, its orderings and
@@ -205,7 +259,11 @@ class NonlinearContactModel(ContactModel):
         """
         responses = self._cache.get("responses", {}).values()
         shared = self._cache.get("factorization")
+        geometry = self._cache.get("geometry")
+        compiled = (geometry.compiled if geometry is not None
+                    else compiled_assembly(len(self.obj.mesh.nodes)))
         return {"material_model": str(self.material_model),
+                "assembly": (Kernel.NUMBA if compiled else Kernel.NUMPY).value,
                 "factorizer": str(shared.method if shared else default_factorizer()),
                 "ldlt_fallbacks": shared.fallbacks if shared else 0,
                 "analyses": shared.analyses if shared else 0,

@@ -506,6 +506,13 @@ def bad_requests(fingers: list[int], interior: int) -> list[tuple[str, object, o
             ErrorCode.INVALID_ARGUMENT,
             "depth must be finite",
         ),
+        (  # the request's own fields before the lookup: the same answer loaded or not
+            "plan_squeeze",
+            PlanSqueeze,
+            squeeze(object_id="nope", squeeze_type="stable", depth=float("nan")),
+            ErrorCode.INVALID_ARGUMENT,
+            "depth must be finite",
+        ),
         (
             "plan_squeeze",
             PlanSqueeze,

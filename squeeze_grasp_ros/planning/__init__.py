@@ -68,6 +68,7 @@ from squeeze_grasp_ros.planning.requests import (
     object_grasp_map,
     resistance_plan,
     ring_grasp_test,
+    squeeze_fields,
     squeeze_plan,
 )
 from squeeze_grasp_ros.planning.typed_objects import (
@@ -128,6 +129,7 @@ __all__ = [
     "ring_grasp_test",
     "shown",
     "solver_route",
+    "squeeze_fields",
     "squeeze_plan",
     "typed_scene",
 ]

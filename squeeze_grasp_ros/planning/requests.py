@@ -54,6 +54,16 @@ class SqueezePlan:
     force_closure: bool
 
 
+def squeeze_fields(kind: str, depth: float) -> tuple[SqueezeKind, float]:
+    """A squeeze request's own fields checked: (the kind, the depth scale in m, 1 for 0).
+
+    Checked before the object is looked up, so that a bad field is refused the same way
+    whether or not its object is loaded yet.
+    """
+    return (choice("squeeze_type", kind, SqueezeKind.planned()),
+            check_number("depth", depth, 0.0) or 1.0)
+
+
 def squeeze_plan(
     loaded: LoadedObject, contacts: Sequence[int], kind: str, depth: float
 ) -> SqueezePlan:
@@ -69,9 +79,8 @@ def squeeze_plan(
     depth : float
         rho, m, >= 0; 0 = unit squeeze.
     """
+    kind, scale = squeeze_fields(kind, depth)
     obj = loaded.solid()
-    kind = choice("squeeze_type", kind, SqueezeKind.planned())
-    scale = check_number("depth", depth, 0.0) or 1.0
     nodes = contact_nodes(loaded, contacts, default=loaded.finger_nodes)
     red = reduced_stiffness(obj, nodes)
     sq = plan_squeeze(obj, nodes, kind=kind, red=red)

@@ -207,10 +207,14 @@ class PlannerNode(Node):
 
     def _plan_squeeze(self, request: PlanSqueeze.Request,
                       response: PlanSqueeze.Response) -> PlanSqueeze.Response:
-        """Stable or pure squeeze of a cached object, inline (milliseconds)."""
-        return self._answer(PlanSqueeze.Response, lambda: messages.plan_squeeze_response(
-            planning.squeeze_plan(self._object(request), request.contacts,
-                                  request.squeeze_type, request.depth)))
+        """Stable or pure squeeze of a cached object, inline (milliseconds); the request's own
+        fields are checked before its object is looked up.
+        """
+        def plan() -> PlanSqueeze.Response:
+            planning.squeeze_fields(request.squeeze_type, request.depth)
+            return messages.plan_squeeze_response(planning.squeeze_plan(
+                self._object(request), request.contacts, request.squeeze_type, request.depth))
+        return self._answer(PlanSqueeze.Response, plan)
 
     async def _grasp_map(self, request: GraspMap.Request,
                          response: GraspMap.Response) -> GraspMap.Response:

@@ -18,6 +18,8 @@ from rclpy.parameter import Parameter
 
 from squeeze_grasp_interfaces.msg import ContactEventArray, MonitorStatus
 from squeeze_grasp_ros.ros.nodes import pipeline
+from squeeze_grasp_ros.ros.run.graph import run_namespace
+from squeeze_grasp_ros.ros.run.processes import ros_arguments
 
 SCENES = Path(__file__).resolve().parents[1] / "config" / "scenes"
 NEEDS_CONTROL_MSGS = pytest.mark.skipif(
@@ -53,10 +55,10 @@ def force_curve() -> ContactEventArray:
                              force_f2=[0.0, 4.0])
 
 
-def executor_node(context, scene: str, awaited: bool):
+def executor_node(context, scene: str, awaited: bool, namespace: str):
     from squeeze_grasp_ros.ros.nodes.executor import ExecutorNode
 
-    return ExecutorNode(context=context, parameter_overrides=[
+    return ExecutorNode(context=context, cli_args=ros_arguments(namespace), parameter_overrides=[
         Parameter("controller_scene", value=str(SCENES / scene)),
         Parameter("finger_devices", value=["F1:left_jaw", "F2:right_jaw"]),
         Parameter("await_prediction", value=awaited)])
@@ -65,10 +67,12 @@ def executor_node(context, scene: str, awaited: bool):
 def executor_rig(context, scene: str, awaited: bool):
     """(executor, driver-like peer, spinner) once the peer's ``monitor/status`` publisher and
     its reader of the executor's lockstep output (the jaws' trajectory or ``executor/cycle``)
-    have met the executor.
+    have met the executor; in a namespace of their own (an action server or a prediction
+    publisher of an earlier test still in the graph would make them ready).
     """
-    executor = executor_node(context, scene, awaited)
-    peer = Node("loop_peer", context=context)
+    namespace = run_namespace()
+    executor = executor_node(context, scene, awaited, namespace)
+    peer = Node("loop_peer", context=context, cli_args=ros_arguments(namespace))
     kept = pipeline.loop_qos(100, kept=True)
     peer.create_publisher(MonitorStatus, pipeline.STATUS, kept)
     output = (executor.jaws or executor.jaw_action).publisher
@@ -123,7 +127,8 @@ def test_an_executor_under_a_gripper_action_is_ready_only_with_its_action_server
         assert answered == [True]
         termination, success, message = executor.jaw_action.outcome
         assert (termination, success) == ("gripper_rejected", False)
-        assert "no action server on /gripper_controller/gripper_cmd answers" in message
+        assert (f"no action server on {executor.get_namespace()}/gripper_controller/gripper_cmd"
+                " answers") in message
         server = ActionServer(peer, ParallelGripperCommand, "gripper_controller/gripper_cmd",
                               lambda handle: ParallelGripperCommand.Result())
         spin.until(executor.participant.ready)

@@ -83,7 +83,7 @@ def _fresh(path: Path) -> Path:
 
 def bare_loop(loaded) -> tuple[float, int, float]:
     """(seconds, evaluations, prepare seconds) of the sweep's tasks in this process, one group
-    prepared once (empty cache first); BLAS as this process has it.
+    prepared once (empty cache first); BLAS at one thread, as :func:`run_task` holds it.
     """
     clear_cache()
     start = time.perf_counter()
@@ -152,30 +152,17 @@ SCALING_COLUMNS = [
 
 def scaling_tables(out: Path, nodes: int, count: int, workers: int, progress):
     """Rows of the scaling table, the overhead row and the scaling table's title: a subset
-    (4 objects, ``count`` placements, 12 evaluations per task) as bare loops (this process;
-    a single-threaded-BLAS process), on 1 worker and on ``workers`` workers.
+    (4 objects, ``count`` placements, 12 evaluations per task) as a bare loop (a
+    single-threaded-BLAS process), on 1 worker and on ``workers`` workers.
     """
     sub = _load(out, "subset", {**bench_spec(nodes, count), "objects": OBJECTS[:4], "chunk": 12})
     n_sub = sum(t.evaluations for t in plan_tasks(sub))
-    progress(f"sweep: subset of {n_sub} evaluations: bare loops, 1 worker, {workers} workers")
+    progress(f"sweep: subset of {n_sub} evaluations: bare loop, 1 worker, {workers} workers")
     ceiling = parallel_ceiling(workers)
-    t_bare, n_bare, _ = bare_loop(sub)
     t_one, n_one, prep_one = bare_loop_single_thread(out / "subset.yaml")
     one = run_sweep(sub, _fresh(out / "sub1"), workers=1, progress=False)
     two = run_sweep(sub, _fresh(out / "sub2"), workers=workers, progress=False)
-    cores = os.cpu_count() or 1
     rows = [
-        [
-            "bare loop, multi-threaded BLAS",
-            f"1 process, {cores} cores",
-            n_bare,
-            t_bare,
-            t_bare,
-            t_bare * cores / n_bare,
-            t_bare * cores / t_one,
-            "-",
-            "-",
-        ],
         [
             "bare loop, single-threaded BLAS",
             "1 process, 1 core",
@@ -321,9 +308,10 @@ def _tables(quick: bool, out: Path, progress) -> list[Table]:
             SCALING_COLUMNS,
             scaling,
             "Worker-seconds per evaluation = wall (after cluster start-up for the sweeps) x "
-            "cores used / evaluations, where the multi-threaded-BLAS loop counts all cores; "
-            "the bare loops prepare each group once and run the same evaluations without "
-            "Dask or Parquet. x bare = against the single-threaded loop (what a worker is). "
+            "cores used / evaluations; the bare loop prepares each group once and runs the same "
+            "evaluations without Dask or Parquet, at one BLAS thread as a worker (run_task "
+            "holds it there in any process, so a multi-threaded-BLAS row is no longer "
+            "possible). x bare = against that loop. "
             "The control row is the speed-up the machine gave two independent CPU-bound "
             "processes just before and just after: its ceiling for any 2-worker run while it is "
             "shared. This short run's speed-up counts the serial cluster start-up (about 1 s) "

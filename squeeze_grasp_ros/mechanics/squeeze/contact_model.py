@@ -721,8 +721,9 @@ class ContactModel:
         return u.reshape(-1, 2)
 
     def _boundary_rows(self, sd: SetData, rows: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """The rows of A_bc and of the rigid modes of boundary positions ``rows``, kept for the
-        last contact set (a substep's start and end, its events' look-ups ask for the same rows).
+        """The rows of A_bc and of the rigid modes of boundary positions ``rows`` (integers;
+        none: (0, 2m) and (0, 3) arrays), kept for the last contact set (a substep's start and
+        end, its events' look-ups ask for the same rows).
         """
         kept = self._cache.get("boundary_rows")
         if kept is None or kept[0] is not sd:

@@ -240,6 +240,16 @@ def _pickup(mu, fn, ft, stick, finger, fingers, weight):
 
 
 @jit
+def _from_tip(x, y, centers_f, flat_f, t0_f, f):
+    """The vector from finger ``f``'s tip core (its centre, or the nearest point of its flat
+    segment of half-length ``flat_f[f]`` along ``t0_f[f]``) to the point (x, y).
+    """
+    rx, ry = x - centers_f[f, 0], y - centers_f[f, 1]
+    tau = min(max(rx * t0_f[f, 0] + ry * t0_f[f, 1], -flat_f[f]), flat_f[f])
+    return rx - tau * t0_f[f, 0], ry - tau * t0_f[f, 1]
+
+
+@jit
 def _watched(delta, F, dtheta, nu, pick, mu, slip, radius_c, rate, A_rows, R_rows, E,
              boundary0, centers_f, radius_f, flat_f, t0_f, out):
     """The watched per-contact values (``pick`` into fn, c+, c-, d laid end to end) and the
@@ -267,9 +277,7 @@ def _watched(delta, F, dtheta, nu, pick, mu, slip, radius_c, rate, A_rows, R_row
         for r in range(rows):
             x, y = boundary0[r, 0] + u[2 * r], boundary0[r, 1] + u[2 * r + 1]
             for f in range(centers_f.shape[0]):
-                rx, ry = x - centers_f[f, 0], y - centers_f[f, 1]
-                tau = min(max(rx * t0_f[f, 0] + ry * t0_f[f, 1], -flat_f[f]), flat_f[f])
-                wx, wy = rx - tau * t0_f[f, 0], ry - tau * t0_f[f, 1]
+                wx, wy = _from_tip(x, y, centers_f, flat_f, t0_f, f)
                 out[i] = np.sqrt(wx * wx + wy * wy) - radius_f[f]
                 i += 1
     return fn, ft
@@ -330,9 +338,7 @@ def slope_values(delta, F, ddelta, dF, dtheta, nu, kappa, mu, A_rows, R_rows, E,
         for r in range(rows):
             x, y = boundary0[r, 0] + u[2 * r], boundary0[r, 1] + u[2 * r + 1]
             for f in range(nf):
-                rx, ry = x - centers_f[f, 0], y - centers_f[f, 1]
-                tau = min(max(rx * t0_f[f, 0] + ry * t0_f[f, 1], -flat_f[f]), flat_f[f])
-                wx, wy = rx - tau * t0_f[f, 0], ry - tau * t0_f[f, 1]
+                wx, wy = _from_tip(x, y, centers_f, flat_f, t0_f, f)
                 vx, vy = v[2 * r] - D[f, 0], v[2 * r + 1] - D[f, 1]
                 gaps[i] = (wx * vx + wy * vy) / np.sqrt(wx * wx + wy * wy)
                 i += 1

@@ -114,8 +114,7 @@ class CompiledSubsteps:
         model, functions, motion = self.call.model, self.call.functions, self.call.motion
         sd = contacts.data
         tip = motion.tip.take(contacts.finger)
-        A_rows, R_rows = model._boundary_rows(sd, rows) if len(rows) else (
-            np.zeros((0, 2 * len(contacts))), np.zeros((0, 3)))
+        A_rows, R_rows = model._boundary_rows(sd, rows)
         _, pick = functions._contact_entries(contacts, held)
         # E in the set's own layout: the kernel's E.T @ delta is then numpy's product
         tables = (

@@ -69,12 +69,6 @@ class CompiledFunctions:
         """Whether the contact set has the fast model's boundary compliance."""
         return contacts.data.A_bc is not None
 
-    def _rows(self, contacts: ContactSet, rows: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """The rows of the boundary compliance and of the rigid modes of ``rows``."""
-        if not len(rows):
-            return np.zeros((0, 2 * len(contacts))), np.zeros((0, 3))
-        return self.functions.model._boundary_rows(contacts.data, rows)
-
     def values(self, contacts: ContactSet, sol: Solution, s: float, rows: np.ndarray,
                pick: np.ndarray, terminations: bool, *, strain: bool = True) -> tuple:
         """(the per-contact values ``pick`` and the gaps of ``rows``, det F, its element or
@@ -85,7 +79,7 @@ class CompiledFunctions:
         functions = self.functions
         model, motion, sd = functions.model, functions.motion, contacts.data
         lim, rate = model.limits, motion.rate
-        A, R = self._rows(contacts, rows)
+        A, R = model._boundary_rows(sd, rows)
         weight = (lim.weight / model.force_unit if terminations and lim.weight is not None
                   and Termination.PICKED_UP in functions.terminate_on else np.nan)
         bounds = model.area_tables(sd)[0] if terminations and rate > 0 else _NO_BOUNDS
@@ -110,7 +104,7 @@ class CompiledFunctions:
         """
         functions = self.functions
         model, motion, sd = functions.model, functions.motion, contacts.data
-        A, R = self._rows(contacts, rows)
+        A, R = model._boundary_rows(sd, rows)
         tip = motion.tip
         return self.kernel.slope_values(
             sol.delta, sol.F, sol.ddelta, sol.dF, sol.dtheta, sol.normal_angle,

@@ -40,7 +40,6 @@ from squeeze_grasp_ros.sim import sensors
 from squeeze_grasp_ros.sim.devices import device_model, follow
 from squeeze_grasp_ros.sim.sensors import (
     SensorRandomness,
-    contact_arrays,
     contact_geometry,
     fingertip_wrench,
     render_tactile,
@@ -373,7 +372,8 @@ def test_state_arrays_are_the_nodes_fields(run, request):
         for finger in {*arrays.fingers, "F1", "F2"}:
             mine = [c for c in contacts if c.finger == finger]
             rows = arrays.rows(finger)
-            thetas, forces = contact_arrays(mine)
+            thetas = np.array([c.theta for c in mine], float)
+            forces = np.array([c.force for c in mine], float).reshape(-1, 2)
             assert arrays.thetas[rows].tobytes() == thetas.tobytes()
             assert arrays.forces[rows].tobytes() == forces.tobytes()
             assert arrays.normal_angles[rows].tolist() == [c.normal_angle for c in mine]

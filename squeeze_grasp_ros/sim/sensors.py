@@ -31,7 +31,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from squeeze_grasp_ros.mechanics.squeeze.contact_state import ContactNode
+from squeeze_grasp_ros.mechanics.squeeze.contact_state import ContactArrays, ContactNode
 from squeeze_grasp_ros.mechanics.squeeze.tip_shapes import TipGeometry
 
 
@@ -74,12 +74,6 @@ def taxel_weights(layout: TactileLayout, thetas: np.ndarray) -> np.ndarray:
     return np.maximum(0.0, 1.0 - np.abs(offset) / layout.spacing)
 
 
-def contact_arrays(contacts: Sequence[ContactNode]) -> tuple[np.ndarray, np.ndarray]:
-    """(thetas (k,), rad; forces on the object (k, 2), N) of contact nodes."""
-    return (np.array([c.theta for c in contacts], float),
-            np.array([c.force for c in contacts], float).reshape(-1, 2))
-
-
 @dataclass(frozen=True)
 class ContactGeometry:
     """What a finger's sensors need of its contact nodes' coordinates: the wrench's lever arms
@@ -117,9 +111,9 @@ def contact_components(contacts: Sequence[ContactNode]) -> tuple[np.ndarray, np.
     """(thetas, normal forces, tangential forces) (k,) of contact nodes (rad, N, N): the force
     on the object projected on the contact normal e(nu) and t(nu) (nu = theta on a circle).
     """
-    thetas, forces = contact_arrays(contacts)
-    nu = np.array([c.normal_angle for c in contacts], float)
-    return (thetas, *_components(forces, np.cos(nu), np.sin(nu)))
+    arrays = ContactArrays.of(contacts)
+    nu = arrays.normal_angles
+    return (arrays.thetas, *_components(arrays.forces, np.cos(nu), np.sin(nu)))
 
 
 def _components(forces: np.ndarray, cos: np.ndarray, sin: np.ndarray
@@ -146,8 +140,8 @@ def fingertip_wrench(contacts: Sequence[ContactNode],
     """
     if not contacts:
         return np.zeros(3), np.zeros(3)
-    thetas, on_object = contact_arrays(contacts)
-    return _wrench(on_object, tip.offset(thetas, np.zeros(len(thetas), int)))
+    arrays = ContactArrays.of(contacts)
+    return _wrench(arrays.forces, tip.offset(arrays.thetas, np.zeros(len(contacts), int)))
 
 
 def _wrench(on_object: np.ndarray, arms: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -179,18 +173,12 @@ class FingerSensors:
         self._key: bytes | None = None
         self._geometry: ContactGeometry | None = None
 
-    def read(self, contacts: Sequence[ContactNode]) -> tuple[np.ndarray, ContactGeometry]:
-        """(forces on the object (k, 2), N; their :class:`ContactGeometry`) of the finger's
-        contact nodes.
-        """
-        thetas, forces = contact_arrays(contacts)
-        return self.read_arrays(thetas, forces, np.array([c.normal_angle for c in contacts],
-                                                         float))
-
     def read_arrays(self, thetas: np.ndarray, forces: np.ndarray, nu: np.ndarray
                     ) -> tuple[np.ndarray, ContactGeometry]:
-        """:meth:`read` of the finger's nodes given as arrays: contact coordinates ``thetas``
-        (k,) rad, forces on the object (k, 2) N and contact normal angles ``nu`` (k,) rad.
+        """(forces on the object (k, 2), N; their :class:`ContactGeometry`) of the finger's
+        contact nodes given as arrays (:class:`~.contact_state.ContactArrays`): contact
+        coordinates ``thetas`` (k,) rad, forces on the object (k, 2) N and contact normal
+        angles ``nu`` (k,) rad.
         """
         key = thetas.tobytes() + nu.tobytes()
         if key != self._key:
@@ -199,14 +187,14 @@ class FingerSensors:
 
     def wrench(self, forces: np.ndarray, geometry: ContactGeometry
                ) -> tuple[np.ndarray, np.ndarray]:
-        """:func:`fingertip_wrench` of nodes read by :meth:`read`."""
+        """:func:`fingertip_wrench` of nodes read by :meth:`read_arrays`."""
         if not len(forces):
             return np.zeros(3), np.zeros(3)
         return _wrench(forces, geometry.arms)
 
     def tactile(self, forces: np.ndarray, geometry: ContactGeometry
                 ) -> tuple[np.ndarray, np.ndarray]:
-        """:func:`render_tactile` of nodes read by :meth:`read`."""
+        """:func:`render_tactile` of nodes read by :meth:`read_arrays`."""
         if not len(forces):
             return np.zeros(len(self.layout.angles)), np.zeros(len(self.layout.angles))
         fn, ft = _components(forces, geometry.cos, geometry.sin)

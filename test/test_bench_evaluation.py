@@ -79,6 +79,6 @@ def test_the_example_sweep_evaluations_are_timed_and_profiled_with_their_sparse_
     m = measure(share_dir() / "config" / "sweeps" / "example.yaml", tasks=1)
     names = {f for (_, _, f) in m["stats"].stats}
     assert 0 < m["profiled"] < m["evaluations"]  # one task profiled, all timed
-    assert m["cpu_s"] > 0 and m["control_s"] > 0
+    assert m["cpu_s"] > 0
     assert "<method 'solve' of 'SuperLU' objects>" in names
     assert 0.0 < m["kernel_s"] < m["profiled_s"]

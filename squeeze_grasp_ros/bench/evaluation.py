@@ -2,18 +2,20 @@
 # SPDX-License-Identifier: Apache-2.0
 """One event-driven evaluation: where its time goes, and the share of linear-algebra kernels.
 
-The example sweep's evaluations (``config/sweeps/example.yaml``, 288 of them) are prepared
-(mesh, factorisation, grasp map per group, untimed), timed (CPU time of this process) between
-two runs of a pure-Python control loop, and profiled with :mod:`cProfile` (the quick run
-profiles its first two tasks). The time per evaluation, divided by the control loop's, is
-compared with the same figures recorded at the commit before issue 33 §1
-(:data:`BASELINE_MS_PER_EVALUATION`). The profile's self times are sorted into linear-algebra
-kernels (:data:`KERNEL_PATTERNS`) and everything else; the share is the kernels' self time
-over the profile's total. A reader reproduces it with
+The example sweep's evaluations (``config/sweeps/example.yaml``, 288 of them) are timed on
+each fixed-set route against the code of the commit before issue 33 §1
+(:data:`~.pinned.BASELINE_COMMIT`), taken from this checkout's git history and run in the same
+minutes, interleaved (:mod:`~.pinned`; CPU time of child processes, BLAS at one thread, groups
+prepared untimed), and so is the 2,020-node foam square's squeeze. They are also profiled
+in this process with :mod:`cProfile` (the quick run profiles and times their first two
+tasks). The profile's self times are sorted into linear-algebra kernels
+(:data:`KERNEL_PATTERNS`) and everything else; the share is the kernels' self time over the
+profile's total. A reader reproduces it with
 
     python -m squeeze_grasp_ros.bench.evaluation [SPEC] [--tasks N]
+    python -m squeeze_grasp_ros.bench.evaluation --foam-square
 
-which prints the same table and the profile's largest self times.
+which print the same tables (the first also the profile's largest self times).
 
 What cProfile can see decides what the share counts. numpy.linalg runs LAPACK as gufuncs,
 which cProfile does not list: their time is in the self time of the numpy.linalg function that
@@ -39,6 +41,7 @@ from pathlib import Path
 
 import yaml
 
+from squeeze_grasp_ros.bench.pinned import BASELINE_COMMIT, baseline, interleaved, this_tree
 from squeeze_grasp_ros.bench.table import Table
 from squeeze_grasp_ros.mechanics.squeeze.fixed_set_kernel import KERNEL_VARIABLE, Kernel, compiled
 from squeeze_grasp_ros.mechanics.vocabulary import Factorizer
@@ -64,25 +67,11 @@ COMPILED_PATTERN = (r"fixed_set_numba\.py:\d*\(?solve_linear"
 """The compiled kernels' profile entries: the fixed-set solve, the substeps between events, and
 the watched functions' values and slopes at event points (numba's dispatchers: their self time
 is the compiled call, BLAS and LAPACK inside included)."""
-CONTROL_ITERATIONS = 5_000_000
-BASELINE_COMMIT = "9db5097"
-BASELINE_MS_PER_EVALUATION = 12.50
-BASELINE_CONTROL_S = 0.199
-"""The example sweep's 288 evaluations at commit 9db5097 (before issue 33 §1), single-threaded
-BLAS: CPU ms per evaluation, and :func:`control_seconds`'s loop (best of two) just before in
-another process, on the project's 2-core machine at load 10-13 (interleaved with this
-branch's same runs: 9.83 ms, control 0.203 s). The speed-up column divides both by this run's,
-so a machine slower or busier for pure Python by some factor leaves the ratio alone."""
-
-
-def control_seconds() -> float:
-    """CPU seconds of a fixed pure-Python integer loop (:data:`CONTROL_ITERATIONS`): the
-    machine's speed for interpreter work, beside the evaluations it normalises.
-    """
-    start, x = time.process_time(), 0
-    for i in range(CONTROL_ITERATIONS):
-        x += i * i % 7
-    return time.process_time() - start
+SPEED_UP_PASSES = 2
+"""Rounds of the interleaved comparison with the pinned commit (best of them for each code)."""
+FOAM_SQUARE_NODES, FOAM_SQUARE_REPEATS = 2000, 5
+"""The foam square of issue 33 §1 (about 2,000 nodes: 2,020) and the squeezes timed per child
+(best of them)."""
 
 
 def is_kernel(filename: str, function: str) -> bool:
@@ -136,7 +125,7 @@ def route(kernel: Kernel):
 
 
 def measure_routes(spec: Path, tasks: int | None) -> dict[Kernel, dict]:
-    """:func:`measure` of each fixed-set route (:func:`routes`), one after the other."""
+    """:func:`measure` on each fixed-set route this environment has."""
     out = {}
     for kernel in routes():
         with route(kernel):
@@ -145,10 +134,10 @@ def measure_routes(spec: Path, tasks: int | None) -> dict[Kernel, dict]:
 
 
 def measure(spec: Path, tasks: int | None) -> dict:
-    """Time all of ``spec``'s evaluations (CPU, groups prepared first) between two runs of
-    the control loop, and profile those of its first ``tasks`` tasks (all if None). The first
-    task runs once untimed (numba's compiled code is loaded or compiled on first use); the
-    groups are prepared afresh before the timed pass and before the profiled one.
+    """Time all of ``spec``'s evaluations (CPU, groups prepared first) in this process, and
+    profile those of its first ``tasks`` tasks (all if None). The first task runs once untimed
+    (numba's compiled code is loaded or compiled on first use); the groups are prepared afresh
+    before the timed pass and before the profiled one.
     """
     loaded = parse_sweep_spec(yaml.safe_load(spec.read_text()), spec.parent)
     every = list(plan_tasks(loaded))
@@ -164,12 +153,11 @@ def measure(spec: Path, tasks: int | None) -> dict:
     prepare_all()
     run_task(every[0])
     prepare_all()
-    control, per_task = control_seconds(), []
+    per_task = []
     for task in every:
         start = time.process_time()
         rows = len(run_task(task)["rows"])
         per_task.append((rows, time.process_time() - start))
-    control = min(control, control_seconds())
     n, cpu = (sum(x) for x in zip(*per_task))
     chosen = every[:tasks]
     chosen_cpu = sum(t for _, t in per_task[:len(chosen)])
@@ -180,32 +168,54 @@ def measure(spec: Path, tasks: int | None) -> dict:
     profile.disable()
     stats = pstats.Stats(profile)
     kernel, total, calls = kernel_share(stats)
-    return {"evaluations": n, "cpu_s": cpu, "control_s": control, "profiled": profiled,
+    return {"evaluations": n, "cpu_s": cpu, "profiled": profiled,
             "profiled_cpu_s": chosen_cpu, "kernel_s": kernel, "profiled_s": total,
             "compiled_s": compiled_seconds(stats), "calls": calls, "stats": stats}
 
 
-def table(measured: dict[Kernel, dict], spec: Path, tasks: int | None) -> Table:
+def against_baseline(*workload: str, rounds: int = SPEED_UP_PASSES) -> tuple[dict, str | None]:
+    """``workload`` (:mod:`~.timing_driver`) timed on each fixed-set route of this code and on
+    the pinned commit's code, interleaved; ({label: result}, None) or ({routes only}, why the
+    commit's code could not be run).
+    """
+    mine = [this_tree(k.value, **{KERNEL_VARIABLE: k.value}) for k in routes()]
+    with baseline() as pinned:
+        if isinstance(pinned, str):
+            return interleaved(mine, rounds, *workload), pinned
+        return interleaved([pinned, *mine], rounds, *workload), None
+
+
+def _speed_up(results: dict, label: str) -> float | str:
+    base = results.get(BASELINE_COMMIT)
+    return base["cpu_s"] / results[label]["cpu_s"] if base else "-"
+
+
+def table(measured: dict[Kernel, dict], compared: tuple[dict, str | None], spec: Path,
+          tasks: int | None) -> Table:
     """The measurements as a table (per evaluation), a row per fixed-set route."""
     load = tuple(round(x, 1) for x in os.getloadavg())
     arg = f" --tasks {tasks}" if tasks else ""
-    rows, numpy_ratio = [], None
+    results, missing = compared
+    base = results.get(BASELINE_COMMIT)
+    rows = []
     for kernel, m in measured.items():
         n, k = m["evaluations"], m["profiled"]
-        ms = 1e3 * m["cpu_s"] / n
-        ratio = ms / m["control_s"]
-        numpy_ratio = ratio if numpy_ratio is None else numpy_ratio
-        rows.append([kernel.value, n, ms, m["control_s"],
-                     (BASELINE_MS_PER_EVALUATION / BASELINE_CONTROL_S) / ratio,
-                     numpy_ratio / ratio, k, 1e3 * m["profiled_s"] / k, 1e3 * m["kernel_s"] / k,
-                     100 * m["kernel_s"] / m["profiled_s"],
+        mine = results[kernel.value]
+        rows.append([kernel.value, mine["count"], 1e3 * mine["cpu_s"] / mine["count"],
+                     1e3 * base["cpu_s"] / base["count"] if base else "-",
+                     _speed_up(results, kernel.value),
+                     results[Kernel.NUMPY.value]["cpu_s"] / mine["cpu_s"],
+                     1e3 * m["cpu_s"] / n, k, 1e3 * m["profiled_s"] / k,
+                     1e3 * m["kernel_s"] / k, 100 * m["kernel_s"] / m["profiled_s"],
                      100 * m["kernel_s"] / m["profiled_cpu_s"],
                      100 * m["compiled_s"] / m["profiled_s"], round(m["calls"] / k)])
+    why = f" The pinned commit's code was not run: {missing}." if missing else ""
     return Table(
-        f"{TITLE}: CPU time and the share of linear-algebra kernels ({spec.name})",
-        ["fixed-set route", "evaluations", "CPU per evaluation [ms]", "control loop [s]",
-         f"speed-up over {BASELINE_COMMIT} (control-normalised)",
-         "speed-up over the numpy route (control-normalised)", "profiled evaluations",
+        f"{TITLE}: CPU time against {BASELINE_COMMIT}'s code in the same run, and the share "
+        f"of linear-algebra kernels ({spec.name})",
+        ["fixed-set route", "evaluations timed", "CPU per evaluation [ms]",
+         f"{BASELINE_COMMIT}'s code, same run [ms]", f"speed-up over {BASELINE_COMMIT}",
+         "speed-up over the numpy route", "in this process [ms]", "profiled evaluations",
          "profiled per evaluation [ms]", "kernels per evaluation (profiled) [ms]",
          "kernel share of the profile [%]", "kernels / unprofiled CPU [%]",
          "compiled kernels (fixed-set solve, substeps, watched values and slopes), share of "
@@ -214,15 +224,13 @@ def table(measured: dict[Kernel, dict], spec: Path, tasks: int | None) -> Table:
         rows,
         "Fixed-set route: the linear model's Newton on the sliding contacts in numpy, or "
         "compiled by numba with the substeps between events and the watched functions at "
-        "event points (the `fast` extra; the same floats); the routes run one after the "
-        "other, each with its own control loop. CPU per evaluation: all evaluations "
-        "unprofiled, groups prepared before, BLAS at one thread (run_task holds it, as "
-        "Dask's workers and the recorded figure had it; before, the process's own two threads "
-        f"spun in the CPU time); the control loop ({CONTROL_ITERATIONS:,} pure-Python integer "
-        f"iterations, best of one run before and one after) normalises the speed-up against "
-        f"the figure recorded at {BASELINE_COMMIT} ({BASELINE_MS_PER_EVALUATION:.2f} ms per "
-        f"evaluation, control {BASELINE_CONTROL_S:.3f} s, single-threaded BLAS, this "
-        "machine). Kernels: self time of the cProfile (CPU clock) entries matching "
+        "event points (the `fast` extra; the same floats). CPU per evaluation: the same "
+        f"evaluations timed in child processes for each route and for {BASELINE_COMMIT}'s "
+        "code (git archive of this checkout's history), taking turns, best of "
+        f"{SPEED_UP_PASSES} rounds, groups prepared untimed, BLAS at one thread in every "
+        "child; the speed-ups are ratios of those CPU times." + why + " In this process: "
+        "all evaluations unprofiled, for the kernels' share of the unprofiled CPU. Kernels: "
+        "self time of the cProfile (CPU clock) entries matching "
         f"{' or '.join(KERNEL_PATTERNS)} (numpy.linalg's factorising functions whole, since "
         "their LAPACK gufuncs are invisible to cProfile; `@` products count with their "
         "callers); kernels / unprofiled CPU (the profiled evaluations' own unprofiled time) "
@@ -235,22 +243,63 @@ def table(measured: dict[Kernel, dict], spec: Path, tasks: int | None) -> Table:
     )
 
 
+def foam_square_table(compared: tuple[dict, str | None]) -> Table:
+    """The foam square's squeeze on each route against the pinned commit's code."""
+    load = tuple(round(x, 1) for x in os.getloadavg())
+    results, missing = compared
+    base = results.get(BASELINE_COMMIT)
+    rows = [[label, r["count"], r["events"], 1e3 * r["cpu_s"],
+             1e3 * base["cpu_s"] if base else "-", _speed_up(results, label)]
+            for label, r in results.items() if label != BASELINE_COMMIT]
+    why = f" The pinned commit's code was not run: {missing}." if missing else ""
+    return Table(
+        f"{TITLE}: the foam square, 12 %, mu = 0.4, linear, against {BASELINE_COMMIT}'s code "
+        "in the same run",
+        ["fixed-set route", "nodes", "events", "CPU per squeeze [ms]",
+         f"{BASELINE_COMMIT}'s code, same run [ms]", f"speed-up over {BASELINE_COMMIT}"],
+        rows,
+        "The squeeze of the 2,020-node foam square to 12 % (events to 1e-9 L, precomputed "
+        f"object, one untimed squeeze first), best of {FOAM_SQUARE_REPEATS} squeezes per child "
+        f"process and of {SPEED_UP_PASSES} rounds in which the routes and {BASELINE_COMMIT}'s "
+        "code (git archive of this checkout's history) take turns; BLAS at one thread." + why
+        + f" Reproduce: `{COMMAND} --foam-square`. Load average (1, 5, 15 min) {load} on "
+        f"{os.cpu_count()} cores.",
+    )
+
+
+def speed_ups(spec: Path, tasks: int | None) -> tuple[dict, str | None]:
+    """The example sweep's evaluations against the pinned commit (see :func:`table`)."""
+    return against_baseline("evaluations", str(spec), "1", str(tasks or 0))
+
+
+def foam_square_speed_ups() -> tuple[dict, str | None]:
+    """The foam square against the pinned commit (see :func:`foam_square_table`)."""
+    return against_baseline("foam-square", str(FOAM_SQUARE_NODES), str(FOAM_SQUARE_REPEATS))
+
+
 def run(quick: bool, out_dir: Path, progress) -> list[Table]:
-    """The example sweep's evaluations (profiled: its first two tasks when quick)."""
+    """The example sweep's evaluations (timed and profiled: its first two tasks when quick)
+    and the foam square, against the pinned commit's code.
+    """
     spec = share_dir() / "config" / "sweeps" / "example.yaml"
     tasks = 2 if quick else None
     progress(f"evaluation: timing and profiling the evaluations of {spec.name} "
-             f"({', '.join(k.value for k in routes())})")
-    return [table(measure_routes(spec, tasks), spec, tasks)]
+             f"({', '.join(k.value for k in routes())}, and {BASELINE_COMMIT}'s code)")
+    evaluations = table(measure_routes(spec, tasks), speed_ups(spec, tasks), spec, tasks)
+    progress(f"evaluation: the foam square against {BASELINE_COMMIT}'s code")
+    return [evaluations, foam_square_table(foam_square_speed_ups())]
 
 
 if __name__ == "__main__":
     args = sys.argv[1:]
+    if "--foam-square" in args:
+        print(foam_square_table(foam_square_speed_ups()).markdown())
+        sys.exit()
     n_tasks = int(args[args.index("--tasks") + 1]) if "--tasks" in args else None
     path = Path(args[0]) if args and not args[0].startswith("--") else (
         share_dir() / "config" / "sweeps" / "example.yaml")
     results = measure_routes(path, n_tasks)
-    print(table(results, path, n_tasks).markdown())
+    print(table(results, speed_ups(path, n_tasks), path, n_tasks).markdown())
     for name, result in results.items():
         print(f"\nfixed-set route {name.value}: the largest self times")
         result["stats"].sort_stats("tottime").print_stats(25)

@@ -251,7 +251,10 @@ def test_pad_of_vanishing_flat_is_the_circle():
     r = 0.004
     circle = event_squeeze(obj, ends, r, 0.5, depth=0.004)
     same = event_squeeze(obj, ends, TipShape.pad(width=2 * r, edge_radius=r), 0.5, depth=0.004)
-    assert np.array_equal(finger_force(same), finger_force(circle))
+    # to round-off, not bit for bit: the pad's flat of zero length and the circle reach the
+    # gaps by other operation orders (one host gave 5e-15 relative on the y force)
+    np.testing.assert_allclose(finger_force(same), finger_force(circle), rtol=1e-12,
+                               atol=1e-12 * np.linalg.norm(finger_force(circle)))
     assert same.event_counts == circle.event_counts
     for eps in (1e-6, 1e-7):
         near = event_squeeze(obj, ends, TipShape.pad(width=2 * r + eps, edge_radius=r), 0.5,

@@ -52,8 +52,9 @@ def selected() -> Kernel:
     >>> del os.environ[KERNEL_VARIABLE]
     """
     text = os.environ.get(KERNEL_VARIABLE, "")
-    if not text:
-        return Kernel.NUMPY
+    kernel = _SELECTED.get(text)
+    if kernel is not None:
+        return kernel
     try:
         kernel = Kernel(text)
     except ValueError:
@@ -62,7 +63,13 @@ def selected() -> Kernel:
         ) from None
     if kernel == Kernel.NUMBA and compiled() is None:
         raise InvalidInputError(f"{KERNEL_VARIABLE}=numba needs numba: {EXTRAS['fast'][1]}")
+    _SELECTED[text] = kernel
     return kernel
+
+
+_SELECTED: dict[str, Kernel] = {"": Kernel.NUMPY}
+"""The routes :func:`selected` has read, by the variable's text (it is read at every fixed-set
+solve; a text that raises is not kept)."""
 
 
 @cache

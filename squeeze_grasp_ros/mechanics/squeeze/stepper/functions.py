@@ -197,12 +197,19 @@ class EventFunctions:
         return self.model.mu == 0.0
 
     def free_rows(self, contacts: ContactSet, held: list[int]) -> np.ndarray:
-        """Boundary loop positions watched for Event A: not in contact, not ``held``."""
-        mask = np.ones(len(self.model.boundary_nodes), bool)
-        mask[contacts.rows] = False
-        for node in held:
-            mask[self.model.obj.boundary_positions([node])[0]] = False
-        return np.flatnonzero(mask)
+        """Boundary loop positions watched for Event A: not in contact, not ``held`` (kept
+        for the call's contact sets and holds; read-only).
+        """
+        tag = ("free", contacts.rows.tobytes(), *held)
+        made = self._entry_tables.get(tag)
+        if made is None:
+            mask = np.ones(len(self.model.boundary_nodes), bool)
+            mask[contacts.rows] = False
+            for node in held:
+                mask[self.model.obj.boundary_positions([node])[0]] = False
+            made = self._entry_tables[tag] = np.flatnonzero(mask)
+            made.flags.writeable = False
+        return made
 
     def rows_of(self, nodes) -> np.ndarray:
         """Boundary loop positions of ``nodes``."""

@@ -53,23 +53,21 @@ def selected() -> Kernel:
     """
     text = os.environ.get(KERNEL_VARIABLE, "")
     kernel = _SELECTED.get(text)
-    if kernel is not None:
-        return kernel
-    try:
-        kernel = Kernel(text)
-    except ValueError:
-        raise InvalidInputError(
-            f"{KERNEL_VARIABLE} must be one of {[k.value for k in Kernel]}, got {text!r}"
-        ) from None
+    if kernel is None:
+        try:
+            kernel = _SELECTED[text] = Kernel(text)
+        except ValueError:
+            raise InvalidInputError(
+                f"{KERNEL_VARIABLE} must be one of {[k.value for k in Kernel]}, got {text!r}"
+            ) from None
     if kernel == Kernel.NUMBA and compiled() is None:
         raise InvalidInputError(f"{KERNEL_VARIABLE}=numba needs numba: {EXTRAS['fast'][1]}")
-    _SELECTED[text] = kernel
     return kernel
 
 
 _SELECTED: dict[str, Kernel] = {"": Kernel.NUMPY}
-"""The routes :func:`selected` has read, by the variable's text (it is read at every fixed-set
-solve; a text that raises is not kept)."""
+"""The routes :func:`selected` has parsed, by the variable's text (it is read at every
+fixed-set solve; whether numba is there is checked at every read)."""
 
 
 @cache

@@ -33,7 +33,6 @@ import threading
 from collections import OrderedDict
 from collections.abc import Callable
 from dataclasses import dataclass, field
-from functools import cached_property
 
 import numpy as np
 
@@ -47,6 +46,7 @@ from squeeze_grasp_ros.mechanics.elastic.hyperelastic import area_ratios
 from squeeze_grasp_ros.mechanics.elastic.reduced import reduce_blocks
 from squeeze_grasp_ros.mechanics.errors import InvalidInputError, NumericalError
 from squeeze_grasp_ros.mechanics.squeeze.fixed_set_kernel import Kernel, compiled, selected
+from squeeze_grasp_ros.mechanics.squeeze.kept import kept_property
 from squeeze_grasp_ros.mechanics.squeeze.tip_shapes import TipGeometry, cross, tangent, unit
 from squeeze_grasp_ros.mechanics.vocabulary import MaterialModel, StrainCriterion, StrainMeasure
 
@@ -250,32 +250,32 @@ class Solution:
         """The rates d nu / ds (m,): how fast each contact normal turns (0 on a flat face)."""
         return self.dtheta if self.kappa is None else self.kappa * self.dtheta
 
-    @cached_property
+    @kept_property
     def unit(self) -> np.ndarray:
         """e(nu) (m, 2) of every contact, computed once per solution."""
         return unit(self.normal_angle)
 
-    @cached_property
+    @kept_property
     def tangent(self) -> np.ndarray:
         """t(nu) (m, 2) of every contact, computed once per solution."""
         return tangent(self.normal_angle)
 
-    @cached_property
+    @kept_property
     def normal(self) -> np.ndarray:
         """f_n = F . e(nu) (m,)."""
         return np.einsum("ij,ij->i", self.F, self.unit)
 
-    @cached_property
+    @kept_property
     def tangential(self) -> np.ndarray:
         """f_t = F . t(nu) (m,)."""
         return np.einsum("ij,ij->i", self.F, self.tangent)
 
-    @cached_property
+    @kept_property
     def normal_rate(self) -> np.ndarray:
         """D f_n / ds (m,)."""
         return np.einsum("ij,ij->i", self.dF, self.unit) + self.normal_turn * self.tangential
 
-    @cached_property
+    @kept_property
     def tangential_rate(self) -> np.ndarray:
         """D f_t / ds (m,)."""
         return np.einsum("ij,ij->i", self.dF, self.tangent) - self.normal_turn * self.normal

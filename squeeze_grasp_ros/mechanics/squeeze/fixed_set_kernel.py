@@ -52,17 +52,22 @@ def selected() -> Kernel:
     >>> del os.environ[KERNEL_VARIABLE]
     """
     text = os.environ.get(KERNEL_VARIABLE, "")
-    if not text:
-        return Kernel.NUMPY
-    try:
-        kernel = Kernel(text)
-    except ValueError:
-        raise InvalidInputError(
-            f"{KERNEL_VARIABLE} must be one of {[k.value for k in Kernel]}, got {text!r}"
-        ) from None
+    kernel = _SELECTED.get(text)
+    if kernel is None:
+        try:
+            kernel = _SELECTED[text] = Kernel(text)
+        except ValueError:
+            raise InvalidInputError(
+                f"{KERNEL_VARIABLE} must be one of {[k.value for k in Kernel]}, got {text!r}"
+            ) from None
     if kernel == Kernel.NUMBA and compiled() is None:
         raise InvalidInputError(f"{KERNEL_VARIABLE}=numba needs numba: {EXTRAS['fast'][1]}")
     return kernel
+
+
+_SELECTED: dict[str, Kernel] = {"": Kernel.NUMPY}
+"""The routes :func:`selected` has parsed, by the variable's text (it is read at every
+fixed-set solve; whether numba is there is checked at every read)."""
 
 
 @cache

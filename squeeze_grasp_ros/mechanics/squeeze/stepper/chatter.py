@@ -51,6 +51,8 @@ class ChatterBound:
 
     def held(self, nodes: np.ndarray, depth: float) -> np.ndarray:
         """Boolean mask over ``nodes`` of those frozen at ``depth``."""
+        if not self.holds:
+            return np.zeros(len(nodes), bool)
         return np.array([self.holds.get(int(k), -np.inf) > depth for k in nodes], bool)
 
     def held_nodes(self, depth: float) -> list[int]:

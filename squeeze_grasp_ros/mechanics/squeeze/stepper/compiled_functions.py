@@ -39,6 +39,7 @@ __all__ = ["CompiledFunctions"]
 
 _NO_BOUNDS = np.zeros((0, 0))
 _NO_KAPPA = np.zeros(0)
+_NO_VALUES = np.zeros(0)
 
 
 class CompiledFunctions:
@@ -51,6 +52,7 @@ class CompiledFunctions:
     def __init__(self, functions: EventFunctions) -> None:
         self.functions = functions
         self.kernel = compiled_substeps()
+        self._last: tuple | None = None
 
     @classmethod
     def of(cls, functions: EventFunctions) -> CompiledFunctions | None:
@@ -76,13 +78,36 @@ class CompiledFunctions:
         (the area also while the fingers do not move, the strain unless ``strain``), the
         model's det F once an element nears inversion.
         """
+        values, det, pickup = self._read(contacts, sol, s, rows, pick)
+        if not terminations:
+            return values, np.inf, -1, np.inf, np.inf
+        functions, element = self.functions, -1
+        if np.isnan(det):
+            det, element = functions.model.area_ratio(contacts.data, sol.delta, sol.F)
+        margin = functions.strain_margin(contacts, sol) if strain else np.inf
+        return values, det, element, margin, pickup
+
+    def _read(self, contacts: ContactSet, sol: Solution, s: float, rows: np.ndarray,
+              pick: np.ndarray) -> tuple[np.ndarray, float, float]:
+        """The kernel's (values, area bound, pickup margin) at ``sol``, terminations included.
+
+        The last read is kept: at an event point the pending events, the terminations and the
+        next substep's start read the same solution (the area and the pickup margin of any
+        rows, the values of the same rows, contacts and point), one kernel call for all.
+        """
+        last = self._last
+        if last is not None and last[0] is contacts and last[1] is sol:
+            if not len(rows) and not len(pick):
+                return _NO_VALUES, last[6], last[7]
+            if last[2] == s and np.array_equal(last[3], rows) and np.array_equal(last[4], pick):
+                return last[5], last[6], last[7]
         functions = self.functions
         model, motion, sd = functions.model, functions.motion, contacts.data
         lim, rate = model.limits, motion.rate
         A, R = model._boundary_rows(sd, rows)
-        weight = (lim.weight / model.force_unit if terminations and lim.weight is not None
+        weight = (lim.weight / model.force_unit if lim.weight is not None
                   and Termination.PICKED_UP in functions.terminate_on else np.nan)
-        bounds = model.area_tables(sd)[0] if terminations and rate > 0 else _NO_BOUNDS
+        bounds = model.area_tables(sd)[0] if rate > 0 else _NO_BOUNDS
         tip = motion.tip
         values, det, pickup = self.kernel.watched_values(
             sol.delta, sol.F, sol.dtheta, sol.normal_angle, pick, float(model.mu),
@@ -90,12 +115,8 @@ class CompiledFunctions:
             sd.E, functions._boundary[rows], motion.centers(s), tip.radius, tip.flat,
             tip._facing_tangent, contacts.stick, contacts.finger, weight,
             model.obj.rigid_gradients, bounds, GRADIENT_BOUND_EXACT)
-        element = -1
-        if np.isnan(det):
-            det, element = model.area_ratio(sd, sol.delta, sol.F)
-        margin = (functions.strain_margin(contacts, sol) if terminations and strain
-                  else np.inf)
-        return values, det, element, margin, pickup
+        self._last = (contacts, sol, s, rows, pick, values, det, pickup)
+        return values, det, pickup
 
     def slopes(self, contacts: ContactSet, sol: Solution, s: float,
                rows: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -32,7 +32,6 @@ from __future__ import annotations
 
 from collections.abc import Iterator, Mapping
 from dataclasses import dataclass
-from functools import cached_property
 
 import numpy as np
 
@@ -47,6 +46,7 @@ from squeeze_grasp_ros.mechanics.squeeze.event_key import (
     EventKey,
     KeyTable,
 )
+from squeeze_grasp_ros.mechanics.squeeze.kept import kept_property
 from squeeze_grasp_ros.mechanics.squeeze.stepper.compiled_functions import CompiledFunctions
 from squeeze_grasp_ros.mechanics.squeeze.stepper.contact_set import ContactSet
 from squeeze_grasp_ros.mechanics.squeeze.stepper.motion import FingerMotion
@@ -137,7 +137,7 @@ class KeyOrder:
 
     keys: tuple[EventKey, ...]
 
-    @cached_property
+    @kept_property
     def position(self) -> dict[EventKey, int]:
         """Each key's index in the array."""
         return {key: k for k, key in enumerate(self.keys)}
@@ -197,12 +197,19 @@ class EventFunctions:
         return self.model.mu == 0.0
 
     def free_rows(self, contacts: ContactSet, held: list[int]) -> np.ndarray:
-        """Boundary loop positions watched for Event A: not in contact, not ``held``."""
-        mask = np.ones(len(self.model.boundary_nodes), bool)
-        mask[contacts.rows] = False
-        for node in held:
-            mask[self.model.obj.boundary_positions([node])[0]] = False
-        return np.flatnonzero(mask)
+        """Boundary loop positions watched for Event A: not in contact, not ``held`` (kept
+        for the call's contact sets and holds; read-only).
+        """
+        tag = ("free", contacts.rows.tobytes(), *held)
+        made = self._entry_tables.get(tag)
+        if made is None:
+            mask = np.ones(len(self.model.boundary_nodes), bool)
+            mask[contacts.rows] = False
+            for node in held:
+                mask[self.model.obj.boundary_positions([node])[0]] = False
+            made = self._entry_tables[tag] = np.flatnonzero(mask)
+            made.flags.writeable = False
+        return made
 
     def rows_of(self, nodes) -> np.ndarray:
         """Boundary loop positions of ``nodes``."""
@@ -213,12 +220,12 @@ class EventFunctions:
         """The event keys (one table for the process: keys are values)."""
         return SHARED_KEYS
 
-    @cached_property
+    @kept_property
     def _gap_keys(self) -> list[tuple[EventKey, ...]]:
         """The gap keys of every boundary loop position, one per finger."""
         return self.keys.gaps(self.model.boundary_nodes.tolist(), len(self.motion.names))
 
-    @cached_property
+    @kept_property
     def _boundary(self) -> np.ndarray:
         """Undeformed positions / L (b, 2) of the outer boundary loop."""
         return self.model.positions(self.model.boundary_nodes)
@@ -325,7 +332,7 @@ class EventFunctions:
             return det, element, np.inf, np.inf
         return det, element, self.strain_margin(contacts, sol), pickup
 
-    @cached_property
+    @kept_property
     def _compiled(self) -> CompiledFunctions | None:
         """The compiled reads of this call's functions (numba route), or None."""
         return CompiledFunctions.of(self)
@@ -347,7 +354,7 @@ class EventFunctions:
                 ends[self.keys.get(function)] = value
         return ends
 
-    @cached_property
+    @kept_property
     def _entry_tables(self) -> dict[tuple, object]:
         """Key lists made so far in the call (:meth:`_contact_entries`, :meth:`_row_gap_keys`,
         :meth:`_sloped_keys`), by what they depend on.

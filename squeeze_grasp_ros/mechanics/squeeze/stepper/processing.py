@@ -154,23 +154,49 @@ class EventProcessor:
 
     # ------------------------------------------------------------------ pending events
     def pending(self, sol: Solution) -> list[EventKey]:
-        """Pending contact events at the current point, in processing order."""
+        """Pending contact events at the current point, in processing order.
+
+        A function is pending where its value is <= 0 (one array comparison), except the
+        watched keys zero by construction (:meth:`_by_slope`), which are pending where their
+        slope is negative; their slopes are computed only when there are any.
+        """
         contacts, functions, depth = self.contacts, self.functions, self.depth
         rows = functions.free_rows(contacts, self.chatter.held_nodes(depth))
         watched = functions.watched(contacts, sol, self.s, rows,
                                     self.chatter.held(contacts.nodes, depth), terminations=False)
-        gap_nodes = [key.node for key in self.fresh if key.function == EventFunction.GAP]
-        slopes = functions.slopes(contacts, sol, self.s, functions.rows_of(gap_nodes))
-        out = []
-        for key, value in watched.items():
-            if key in slopes and key.at_node in self.fresh:
-                if key.function == EventFunction.GAP and value > self.tol:
+        keys, values = watched.order.keys, watched.values
+        by_slope = self._by_slope(watched.order.position)
+        hits = [k for k in np.flatnonzero(values <= 0).tolist() if k not in by_slope]
+        if by_slope:
+            gap_nodes = [key.node for key in self.fresh if key.function == EventFunction.GAP]
+            slopes = functions.slopes(contacts, sol, self.s, functions.rows_of(gap_nodes))
+            for k, key in by_slope.items():
+                if key.function == EventFunction.GAP and values[k] > self.tol:
                     continue  # a freed node is at zero gap only to the finger that released it
                 if slopes[key] < 0:
-                    out.append(key)
-            elif value <= 0:
-                out.append(key)
+                    hits.append(k)
+        out = [keys[k] for k in sorted(hits)]
+        out += [key for key, value in watched.ends.items() if value <= 0]
         return sorted(out, key=self.order)
+
+    def _by_slope(self, position: dict[EventKey, int]) -> dict[int, EventKey]:
+        """The watched keys (by their position) whose function is zero by construction and
+        has a slope: a fresh node's gap to every tip, a fresh normal force or cone margin.
+        """
+        out = {}
+        fingers = range(len(self.motion.names))
+        for fresh in self.fresh:
+            if fresh.function == EventFunction.GAP:
+                candidates = [EventKey.gap(fresh.node, f) for f in fingers]
+            elif fresh.function.has_slope:
+                candidates = [fresh]
+            else:
+                continue
+            for key in candidates:
+                k = position.get(key)
+                if k is not None:
+                    out[k] = key
+        return out
 
     def order(self, key: EventKey) -> tuple[int, int, int]:
         """Processing order of simultaneous events: event type, finger, node."""

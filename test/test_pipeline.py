@@ -446,3 +446,51 @@ def test_a_run_parses_its_scene_once_and_meshes_it_once(tmp_path, monkeypatch):
     run = PipelineRunner(RunOptions(path, record=str(tmp_path / "bag"))).run()
     assert run["success"] and run["plan_source"] == "planner"
     assert len(parses) == 1 and len(meshes) == 1, (len(parses), len(meshes))
+
+
+def test_unrecorded_monitor_outputs_are_written_only_while_subscribed(tmp_path, monkeypatch):
+    """Without recording the monitor writes ``monitor/contact_state`` and
+    ``monitor/force_residual`` only while a subscription has matched them (its matched events):
+    none in a run nobody listens to, every tick's to a subscriber that came before the goal,
+    and the same ticks and events either way.
+    """
+    from squeeze_grasp_interfaces.msg import ContactState, ForceResidual
+    from squeeze_grasp_ros.ros import messages
+
+    written = {"state": 0, "residual": 0}
+
+    def counted(name, write):
+        def count(*args, **kwargs):
+            written[name] += 1
+            return write(*args, **kwargs)
+        return count
+    monkeypatch.setattr(messages, "patches_state_cdr",
+                        counted("state", messages.patches_state_cdr))
+    monkeypatch.setattr(messages, "force_residual_cdr",
+                        counted("residual", messages.force_residual_cdr))
+    path = write_scene(tmp_path, scene_data(SMALL_SQUARE, name="unheard", squeeze={
+        "type": "stable", "relative_depth": 0.03}))
+    unheard = PipelineRunner(RunOptions(path)).run()
+    assert unheard["success"] and written == {"state": 0, "residual": 0}
+
+    runner = PipelineRunner(RunOptions(path))
+    received: dict[str, list] = {"state": [], "residual": []}
+    try:
+        runner.start()
+        qos = pipeline.loop_qos(100, kept=True)
+        for name, kind, topic in (("state", ContactState, pipeline.CONTACT_STATE),
+                                  ("residual", ForceResidual, pipeline.FORCE_RESIDUAL)):
+            runner.client.create_subscription(kind, topic, received[name].append, qos,
+                                              raw=True)
+        monitor = runner.nodes["monitor"]
+        runner.wait(lambda: monitor.state_heard.matched and monitor.forces.heard.matched, 10.0)
+        runner.send_goal()
+        heard = runner.summary(runner.wait_result())
+        runner.wait(lambda: len(received["state"]) >= written["state"]
+                    and len(received["residual"]) >= written["residual"], 10.0)
+    finally:
+        runner.shutdown()
+    assert heard["ticks"] == unheard["ticks"] and heard["events"] == unheard["events"]
+    assert written["state"] >= heard["ticks"] and written["residual"] > 0
+    assert len(received["state"]) == written["state"]
+    assert len(received["residual"]) == written["residual"]

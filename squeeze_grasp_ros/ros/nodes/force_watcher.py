@@ -50,11 +50,15 @@ class MotionForces:
 class ForceWatcher:
     """Compares forces for ``node`` (the monitor), which calls :meth:`tick` before its status."""
 
-    def __init__(self, node: Node, tolerance: float, min_fraction: float, qos: Any) -> None:
+    def __init__(self, node: Node, tolerance: float, min_fraction: float, qos: Any, *,
+                 every: bool) -> None:
         self.tolerance, self.min_fraction = tolerance, min_fraction
         self.prediction: PredictedForces | None = None
         self.motion = MotionForces()
-        self.residual_pub = node.create_publisher(ForceResidual, pipeline.FORCE_RESIDUAL, qos)
+        self.heard = pipeline.Heard(every=every)
+        """Whether the residual is written (the monitor's ``every_output``)."""
+        self.residual_pub = node.create_publisher(ForceResidual, pipeline.FORCE_RESIDUAL, qos,
+                                                  event_callbacks=self.heard.callbacks)
 
     def set_prediction(self, msg: ContactEventArray) -> None:
         """Take the force curve of the planner's prediction (none: the watch is idle)."""
@@ -72,6 +76,8 @@ class ForceWatcher:
                              min_fraction=self.min_fraction)
         if check is None:
             return [], ()
+        if not self.heard:
+            return [], check.alarms
         fingers = list(check.measured)
         data = messages.force_residual_cdr(
             out.stamp_ns, frame_id, check.depth, fingers, [check.measured[f] for f in fingers],

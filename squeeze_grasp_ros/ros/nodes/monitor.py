@@ -124,6 +124,9 @@ PARAMETERS: dict[str, tuple[Any, str]] = {
                                          "raises shape_mismatch, m"),
     "shape_min_force": (0.05, "shape watch: smallest pair force matched at equal force, N"),
     "object_height": (0.0, "shape watch: height of the object's top face above the plane, m"),
+    "every_output": (True, "publish monitor/contact_state and monitor/force_residual every "
+                           "tick (a recorder takes them); false: only while a subscription "
+                           "has matched them (run without recording)"),
     "force_watch": (True, "compare finger forces with the prediction's force curve"),
     "force_tolerance": (0.1, "relative force error that raises force_mismatch"),
     "force_min_fraction": (0.01, "force watch: fraction of the predicted depth not judged"),
@@ -223,7 +226,9 @@ class MonitorNode(Node):
         self.event_pub = self.create_publisher(ContactEventArray, pipeline.EVENTS, outputs)
         self.alarm_pub = self.create_publisher(Alarm, pipeline.ALARMS, outputs)
         kept = pipeline.loop_qos(p["qos_depth"], kept=True)
-        self.state_pub = self.create_publisher(ContactState, pipeline.CONTACT_STATE, kept)
+        self.state_heard = pipeline.Heard(every=p["every_output"])
+        self.state_pub = self.create_publisher(ContactState, pipeline.CONTACT_STATE, kept,
+                                               event_callbacks=self.state_heard.callbacks)
         self.status_pub = self.create_publisher(MonitorStatus, pipeline.STATUS, kept)
         self.lockstep = p["lockstep"]
         self.latest: dict[str, Any] = {}
@@ -235,7 +240,8 @@ class MonitorNode(Node):
             self, self.alarm_pub, threshold=p["shape_mismatch_threshold"],
             at_force_threshold=p["shape_at_force_threshold"], object_height=p["object_height"],
             min_force=p["shape_min_force"]) if p["shape_watch"] else None)
-        self.forces = (ForceWatcher(self, p["force_tolerance"], p["force_min_fraction"], outputs)
+        self.forces = (ForceWatcher(self, p["force_tolerance"], p["force_min_fraction"], outputs,
+                                    every=p["every_output"])
                        if p["force_watch"] else None)
         if p["lockstep"]:
             # the ticks' stamps are the monitor's time and it reads no clock: use_sim_time off,
@@ -343,9 +349,9 @@ class MonitorNode(Node):
         batch += [(self.alarm_pub, messages.alarm_msg(a, ns)) for a in out.alarms
                   if (a.type, a.finger) not in self.active_alarms]
         self.active_alarms = active
-        batch.append((self.state_pub, messages.patches_state_cdr(out, frame)))
-        for publisher, msg in batch:
-            publisher.publish(msg)
+        if self.state_heard:
+            batch.append((self.state_pub, messages.patches_state_cdr(out, frame)))
+        pipeline.publish_all(batch)
         self.answered.answer(ns, [(self.status_pub, messages.monitor_status_cdr(out, frame))])
         if self.shapes is not None:
             self.shapes.tick(ns, out, samples)

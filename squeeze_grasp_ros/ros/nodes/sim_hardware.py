@@ -227,8 +227,7 @@ class SimHardwareNode(Node):
             batch.append((self.marker_pub, messages.world_markers(self.world.view(), ns, frame)))
         self.last_progress = time.monotonic()
         self.ticks_published += 1
-        for publisher, msg in batch + [tick]:
-            publisher.publish(msg)
+        pipeline.publish_all(batch + [tick])
 
     def _display_due(self, index: int) -> bool:
         rate = self.p["display_rate"]
@@ -242,8 +241,7 @@ class SimHardwareNode(Node):
         if self.current and time.monotonic() - self.last_progress > self.p["resend_timeout"]:
             self.resends += 1
             self.last_progress = time.monotonic()
-            for publisher, msg in self.current:
-                publisher.publish(msg)
+            pipeline.publish_all(self.current)
 
 
 CONTROLLER_NAMES = {ControllerKind.JOINT_TRAJECTORY: "JointTrajectoryController",

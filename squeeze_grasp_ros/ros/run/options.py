@@ -141,6 +141,8 @@ def node_parameters(
                        object_height=float(scene.object.material.thickness))
     if mirror_tolerance is not None:
         monitor["mirror_tolerance"] = float(mirror_tolerance)
+    if not options.record:  # nobody records: the monitor's outputs only while subscribed
+        monitor["every_output"] = False
     controller_scene = str(Path(scene_path).resolve()) if scene.controller else ""
     monitor["controller_scene"] = controller_scene
     params["executor"].update(

@@ -3,7 +3,7 @@
 """Where one lockstep tick's time goes, by node and by stage, in a one-process run.
 
 :class:`TickProfile` wraps, after :meth:`.runner.PipelineRunner.start`, every subscription
-callback and every publisher's ``publish`` of the run's nodes (the client included) with a
+callback and every publisher's rclpy handle of the run's nodes (the client included) with a
 wall-clock timer. rclpy looks both up at every call, so the nodes run unchanged. By node:
 
 - ``deserialise``: what rclpy's conversion of the received messages costs: the number of
@@ -11,7 +11,9 @@ wall-clock timer. rclpy looks both up at every call, so the nodes run unchanged.
   (timed after the run; raw subscriptions take bytes and cost nothing here);
 - ``logic``: time inside the node's callbacks, minus its publishing, minus (for
   ``sim_hardware``) the mechanics step (reported apart, as ``mechanics``);
-- ``publish``: time inside ``publish`` (serialisation and the hand-over to the middleware);
+- ``publish``: time inside the publisher's rclpy handle (serialisation and the hand-over to
+  the middleware), whether a message came through ``Publisher.publish`` or, serialised,
+  straight to the handle (:func:`..nodes.pipeline.publish_all`);
 - the recorder's logic is the ``record`` stage.
 
 What the loop's wall time holds beyond all of those is the executor itself (waiting, taking
@@ -54,7 +56,7 @@ class TickProfile:
             for sub in node.subscriptions:
                 sub.callback = self._timed_callback(name, sub, sub.callback)
             for pub in node.publishers:
-                pub.publish = self._timed_publish(name, pub.publish)
+                pub._Publisher__publisher = _TimedHandle(pub.handle, self.seconds, name)
 
     def _timed_callback(self, name: str, sub: Any, callback: Callable) -> Callable:
         seconds, received = self.seconds, self.received
@@ -68,17 +70,6 @@ class TickProfile:
                 return callback(msg)
             finally:
                 seconds[name, "callbacks"] += time.perf_counter() - t0
-        return timed
-
-    def _timed_publish(self, name: str, publish: Callable) -> Callable:
-        seconds = self.seconds
-
-        def timed(msg: Any) -> None:
-            t0 = time.perf_counter()
-            try:
-                publish(msg)
-            finally:
-                seconds[name, "publish"] += time.perf_counter() - t0
         return timed
 
     def deserialise_seconds(self) -> dict[str, float]:
@@ -122,3 +113,34 @@ class TickProfile:
         rows["mechanics"] = {"deserialise": 0.0, "logic": mechanics_seconds, "publish": 0.0}
         return {name: {stage: 1e6 * value / ticks for stage, value in row.items()}
                 for name, row in rows.items()}
+
+
+class _TimedHandle:
+    """A publisher's rclpy handle whose ``publish`` and ``publish_raw`` add their wall-clock
+    seconds to ``seconds[node, "publish"]``; everything else is the handle's.
+    """
+
+    def __init__(self, handle: Any, seconds: dict, node: str) -> None:
+        self._handle, self._seconds, self._key = handle, seconds, (node, "publish")
+
+    def __getattr__(self, name: str) -> Any:
+        return getattr(self._handle, name)
+
+    def __enter__(self) -> Any:
+        return self._handle.__enter__()
+
+    def __exit__(self, *exc: Any) -> Any:
+        return self._handle.__exit__(*exc)
+
+    def publish(self, msg: Any) -> None:
+        self._timed(self._handle.publish, msg)
+
+    def publish_raw(self, data: bytes) -> None:
+        self._timed(self._handle.publish_raw, data)
+
+    def _timed(self, publish: Callable, msg: Any) -> None:
+        t0 = time.perf_counter()
+        try:
+            publish(msg)
+        finally:
+            self._seconds[self._key] += time.perf_counter() - t0

@@ -39,6 +39,7 @@ from squeeze_grasp_ros.mechanics.elastic.hyperelastic import (
     assemble,
     determinants,
     mesh_geometry,
+    with_tangent,
 )
 from squeeze_grasp_ros.mechanics.elastic.interior import (
     ContactStiffness,
@@ -338,7 +339,7 @@ class ContactResponse:
             if solve is None:
                 K = asm.tangent if asm.tangent is not None else self._known(u, KNOWN_START)
                 if K is None:
-                    asm = self._assemble(u, tangent=True, deformation=asm.deformation)
+                    asm = with_tangent(self.model, asm, nu=self.nu, geometry=self.geometry)
                     K = asm.tangent
                 solve, fresh = self._factor(K), True
                 if solve is None:
@@ -410,7 +411,7 @@ class ContactResponse:
         self.stats["iterations"] += its
         K = asm.tangent if asm.tangent is not None else self._known(u, KNOWN_STATE)
         if K is None:
-            K = self._assemble(u, tangent=True, deformation=asm.deformation).tangent
+            K = with_tangent(self.model, asm, nu=self.nu, geometry=self.geometry).tangent
         self._known_tangent = None
         C = self._stiffness_of(K)
         if C is None:

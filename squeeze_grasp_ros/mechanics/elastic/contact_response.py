@@ -238,9 +238,9 @@ class ContactResponse:
         return self._current.energy
 
     # ------------------------------------------------------------------ helpers
-    def _assemble(self, u: np.ndarray, *, tangent: bool, deformation: np.ndarray | None = None):
+    def _assemble(self, u: np.ndarray, *, tangent: bool = False, **known):
         return assemble(self.model, self.nodes, self.triangles, u, nu=self.nu,
-                        geometry=self.geometry, tangent=tangent, deformation=deformation)
+                        geometry=self.geometry, tangent=tangent, **known)
 
     def _stiffness(self) -> float:
         """Largest entry of the reference (undeformed) tangent: the scale of NEWTON_TOL."""
@@ -355,7 +355,7 @@ class ContactResponse:
                 F = self._upright(trial)
                 if F is not None:
                     inverted = False
-                    t_asm = self._assemble(trial, tangent=False, deformation=F)
+                    t_asm = self._assemble(trial, deformation=F, stretch=asm.stretch)
                     t_norm = np.linalg.norm(t_asm.force[self.free])
                     if t_norm < norm:
                         break

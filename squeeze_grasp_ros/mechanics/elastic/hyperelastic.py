@@ -217,9 +217,12 @@ def _lame(nu: float) -> tuple[float, float]:
     return nu / ((1.0 + nu) * (1.0 - 2.0 * nu)), 0.5 / (1.0 + nu)
 
 
-def _thickness_stretch(J2: np.ndarray, lam: float, mu: float) -> np.ndarray:
-    """lambda3 with mu (l3^2 - 1) + lam ln(J2 l3) = 0 per element (Newton from l3 = 1)."""
-    l3 = np.ones_like(J2)
+def _thickness_stretch(J2: np.ndarray, lam: float, mu: float,
+                       start: np.ndarray | None = None) -> np.ndarray:
+    """lambda3 with mu (l3^2 - 1) + lam ln(J2 l3) = 0 per element (Newton from l3 = 1, or from
+    ``start``, the stretches of a nearby state: one or two iterations fewer).
+    """
+    l3 = np.ones_like(J2) if start is None else start
     for _ in range(_PLANE_STRESS_ITERATIONS):
         g = mu * (l3 * l3 - 1.0) + lam * np.log(J2 * l3)
         dg = 2.0 * mu * l3 + lam / l3
@@ -236,15 +239,15 @@ def _require_compressible(nu: float) -> None:
                                 f"lambda is infinite at 0.5), got {nu}")
 
 
-def _neo_hookean_terms(F: np.ndarray, J2: np.ndarray, nu: float,
-                       l3: np.ndarray | None = None) -> tuple:
+def _neo_hookean_terms(F: np.ndarray, J2: np.ndarray, nu: float, *,
+                       l3: np.ndarray | None = None, start: np.ndarray | None = None) -> tuple:
     """(lam, mu, l3, ln(J2 l3), G = F^-T, a = lam ln J - mu) of the neo-Hookean law at the
     deformation gradients ``F`` with det F = ``J2``; ``l3``: their thickness stretches when
-    known (solved here otherwise).
+    known, else solved here (from ``start``: :func:`_thickness_stretch`).
     """
     _require_compressible(nu)
     lam, mu = _lame(nu)
-    l3 = _thickness_stretch(J2, lam, mu) if l3 is None else l3
+    l3 = _thickness_stretch(J2, lam, mu, start) if l3 is None else l3
     lnJ = np.log(J2 * l3)
     G = np.empty_like(F)  # F^-T
     G[:, 0, 0], G[:, 1, 1] = F[:, 1, 1], F[:, 0, 0]
@@ -368,7 +371,8 @@ def stress_and_tangent(model: MaterialModel | str, F: np.ndarray, *, nu: float,
 
 def assemble(model: MaterialModel | str, nodes: np.ndarray, triangles: np.ndarray,
              u: np.ndarray, *, nu: float, geometry: MeshGeometry | None = None,
-             tangent: bool = True, deformation: np.ndarray | None = None) -> Assembly:
+             tangent: bool = True, deformation: np.ndarray | None = None,
+             stretch: np.ndarray | None = None) -> Assembly:
     """Energy, internal forces and tangent stiffness of the displacement ``u`` (2n,), m.
 
     Parameters
@@ -392,6 +396,11 @@ def assemble(model: MaterialModel | str, nodes: np.ndarray, triangles: np.ndarra
     deformation : (t, 2, 2) ndarray, optional
         F of ``u`` (:meth:`MeshGeometry.deformation`) when the caller has it already, as after
         testing a state for inverted elements (computed here otherwise).
+    stretch : (t,) ndarray, optional
+        Neo-Hookean: the thickness stretches of a nearby state (``Assembly.stretch``, as of
+        Newton's current iterate for its trial), to start this state's thickness Newton from;
+        it then stops at the same tolerance in fewer iterations, at stretches that may differ
+        from a start at 1 in the last bits.
 
     Raises
     ------
@@ -406,7 +415,7 @@ def assemble(model: MaterialModel | str, nodes: np.ndarray, triangles: np.ndarra
         raise InvertedElementError(f"element {worst} inverted (det F = {det[worst]:.3g})",
                                    residuals={"det_F": det[worst]})
     neo = MaterialModel(model) == MaterialModel.NEO_HOOKEAN
-    terms = _neo_hookean_terms(F, det, nu) if neo else None
+    terms = _neo_hookean_terms(F, det, nu, start=stretch) if neo else None
     if neo and geometry.compiled:
         energy, force, data = _compiled_neo_hookean(geometry, F, terms, tangent)
     else:
@@ -433,7 +442,7 @@ def with_tangent(model: MaterialModel | str, assembly: Assembly, *, nu: float,
         return assembly
     F = assembly.deformation
     if MaterialModel(model) == MaterialModel.NEO_HOOKEAN:
-        terms = _neo_hookean_terms(F, determinants(F), nu, assembly.stretch)
+        terms = _neo_hookean_terms(F, determinants(F), nu, l3=assembly.stretch)
         data = (_compiled_neo_hookean(geometry, F, terms, True)[2] if geometry.compiled
                 else _neo_hookean_stiffness(geometry, terms))
     else:

@@ -86,6 +86,23 @@ def test_a_tangent_added_to_a_forces_only_assembly_is_the_full_one(model, patch)
         assert (full.tangent - full.tangent.T).count_nonzero() == 0
 
 
+def test_a_thickness_newton_from_a_nearby_state_gives_the_same_law(patch):
+    """Neo-Hookean stretches started from a nearby state's (Newton's trial from its iterate):
+    the stretches, energy and forces of a start from 1 to round-off.
+    """
+    rng = np.random.default_rng(6)
+    u = 0.003 * rng.standard_normal(2 * patch.n)
+    near = u + 1e-6 * rng.standard_normal(2 * patch.n)
+    X, tri = patch.nodes, patch.triangles
+    start = H.assemble("neo_hookean", X, tri, near, nu=0.3, tangent=False).stretch
+    cold = H.assemble("neo_hookean", X, tri, u, nu=0.3, tangent=False)
+    warm = H.assemble("neo_hookean", X, tri, u, nu=0.3, tangent=False, stretch=start)
+    assert not np.array_equal(start, cold.stretch)
+    assert np.abs(warm.stretch - cold.stretch).max() <= 4e-16
+    assert warm.energy == pytest.approx(cold.energy, rel=1e-14)
+    assert np.abs(warm.force - cold.force).max() <= 1e-14 * np.abs(cold.force).max()
+
+
 @pytest.mark.parametrize("model", NONLINEAR)
 def test_the_contact_stiffness_against_direct_sparse_solves(model, patch):
     """S = K_cc - K_cf K_ff^-1 K_fc applied through the LDL^T of K_ff, and the interior

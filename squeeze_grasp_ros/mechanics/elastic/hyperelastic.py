@@ -436,7 +436,7 @@ def with_tangent(model: MaterialModel | str, assembly: Assembly, *, nu: float,
     """``assembly`` (of :func:`assemble` with ``geometry``, forces only) with its tangent
     stiffness: the tangent of its deformation gradients (and, neo-Hookean, of the thickness
     stretches it holds: no second solve of them), its energy and forces kept; the floats of
-    ``assemble(..., tangent=True)`` of the same state.
+    ``assemble(..., tangent=True)`` of the same state and ``stretch`` start.
     """
     if assembly.tangent is not None:
         return assembly

@@ -66,6 +66,43 @@ def test_a_forces_only_assembly_is_the_full_one_without_the_tangent(model, patch
     assert lean.energy == full.energy and np.array_equal(lean.force, full.force)
 
 
+@pytest.mark.parametrize("model", MODELS)
+def test_a_tangent_added_to_a_forces_only_assembly_is_the_full_one(model, patch):
+    """``with_tangent`` (Newton's tangent of a state it assembled forces-only, reusing its
+    deformation and thickness stretches): the floats of a full assembly; the neo-Hookean
+    tangent (closed form, upper triangle mirrored) symmetric bit for bit.
+    """
+    u = 0.003 * np.random.default_rng(4).standard_normal(2 * patch.n)
+    geometry = H.mesh_geometry(patch.nodes, patch.triangles)
+    full = H.assemble(model, patch.nodes, patch.triangles, u, nu=0.3, geometry=geometry)
+    lean = H.assemble(model, patch.nodes, patch.triangles, u, nu=0.3, geometry=geometry,
+                      tangent=False)
+    added = H.with_tangent(model, lean, nu=0.3, geometry=geometry)
+    assert lean.tangent is None and added.energy == full.energy
+    assert np.array_equal(added.force, full.force)
+    assert np.array_equal(added.tangent.data, full.tangent.data)
+    assert H.with_tangent(model, full, nu=0.3, geometry=geometry) is full
+    if model == "neo_hookean":
+        assert (full.tangent - full.tangent.T).count_nonzero() == 0
+
+
+def test_a_thickness_newton_from_a_nearby_state_gives_the_same_law(patch):
+    """Neo-Hookean stretches started from a nearby state's (Newton's trial from its iterate):
+    the stretches, energy and forces of a start from 1 to round-off.
+    """
+    rng = np.random.default_rng(6)
+    u = 0.003 * rng.standard_normal(2 * patch.n)
+    near = u + 1e-6 * rng.standard_normal(2 * patch.n)
+    X, tri = patch.nodes, patch.triangles
+    start = H.assemble("neo_hookean", X, tri, near, nu=0.3, tangent=False).stretch
+    cold = H.assemble("neo_hookean", X, tri, u, nu=0.3, tangent=False)
+    warm = H.assemble("neo_hookean", X, tri, u, nu=0.3, tangent=False, stretch=start)
+    assert not np.array_equal(start, cold.stretch)
+    assert np.abs(warm.stretch - cold.stretch).max() <= 4e-16
+    assert warm.energy == pytest.approx(cold.energy, rel=1e-14)
+    assert np.abs(warm.force - cold.force).max() <= 1e-14 * np.abs(cold.force).max()
+
+
 @pytest.mark.parametrize("model", NONLINEAR)
 def test_the_contact_stiffness_against_direct_sparse_solves(model, patch):
     """S = K_cc - K_cf K_ff^-1 K_fc applied through the LDL^T of K_ff, and the interior

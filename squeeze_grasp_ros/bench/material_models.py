@@ -103,7 +103,8 @@ def _fill(setup: GraspSetup) -> Fill:
 
 
 PHASES: tuple[tuple[str, tuple[tuple[str, str, int], ...]], ...] = (
-    ("assembly", (("elastic/hyperelastic.py", "assemble", 1),)),
+    ("assembly", (("elastic/hyperelastic.py", "assemble", 1),
+                  ("elastic/hyperelastic.py", "with_tangent", 1))),
     ("ordering + symbolic", (("elastic/interior.py", "_symbolic", 1),)),
     ("numeric factorisation", (("elastic/interior.py", "_cholmod", 1),
                                ("elastic/interior.py", "_symbolic", -1),
@@ -111,7 +112,8 @@ PHASES: tuple[tuple[str, tuple[tuple[str, str, int], ...]], ...] = (
     ("solves", (("elastic/interior.py", "_solve", 1),)),
 )
 """Phases of a nonlinear squeeze as signed sums of cProfile cumulative times of the functions
-(file suffix, name) that do them: the element assembly (energy, forces, tangent), CHOLMOD's
+(file suffix, name) that do them: the element assembly (energy, forces, tangent; Newton's
+tangents added to its forces-only assemblies), CHOLMOD's
 ordering (METIS or AMD) and symbolic analysis, the numeric factorisations (CHOLMOD's, or
 QDLDL's, whose first also orders and analyses), the interior solves (Newton steps, dF/d delta
 on the finger motion, predictors). The rest is the stepper, the contact model and Newton's
@@ -129,7 +131,7 @@ def _cumulative(stats: pstats.Stats, suffix: str, name: str) -> tuple[float, int
 
 def phases(setup: GraspSetup) -> dict:
     """CPU seconds of one profiled 12 % neo-Hookean squeeze of ``setup`` by :data:`PHASES`
-    (and ``rest``, ``total``), with the calls of each phase's first function and the
+    (and ``rest``, ``total``), with the calls of each phase's functions that add to it, and the
     squeeze's nonlinear diagnostics (``diagnostics``) and events (``events``).
     """
     profile = cProfile.Profile(time.process_time)  # CPU time: the machine is shared
@@ -144,7 +146,7 @@ def phases(setup: GraspSetup) -> dict:
         timed = [(sign, *_cumulative(stats, suffix, function))
                  for suffix, function, sign in parts]
         out[name] = sum(sign * t for sign, t, _ in timed)
-        out["calls"][name] = timed[0][2]
+        out["calls"][name] = sum(calls for sign, _, calls in timed if sign > 0)
     out["rest"] = total - sum(out[name] for name, _ in PHASES)
     return out
 
@@ -179,7 +181,9 @@ def _phase_table(sizes: list, measured: list, fill: list, load: tuple) -> Table:
                  "One more neo-Hookean squeeze per mesh of the growth table, under cProfile "
                  "with the process's CPU clock; a phase is the cumulative time of the "
                  "functions that do it (assembly: hyperelastic.assemble, energy and forces "
-                 "with or without the tangent; ordering + symbolic: the factoriser's analysis, "
+                 "with or without the tangent, and hyperelastic.with_tangent, Newton's tangent "
+                 "of a state it assembled forces-only; ordering + symbolic: the factoriser's "
+                 "analysis, "
                  "once per squeeze, whose METIS order the object keeps from the growth table's "
                  "runs; numeric factorisation: CHOLMOD's numeric LL^T, or QDLDL's "
                  "LDL^T with its first ordering; solves: the interior solves), the rest the "

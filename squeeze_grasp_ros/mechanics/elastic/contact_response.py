@@ -39,6 +39,7 @@ from squeeze_grasp_ros.mechanics.elastic.hyperelastic import (
     assemble,
     determinants,
     mesh_geometry,
+    with_tangent,
 )
 from squeeze_grasp_ros.mechanics.elastic.interior import (
     ContactStiffness,
@@ -237,9 +238,9 @@ class ContactResponse:
         return self._current.energy
 
     # ------------------------------------------------------------------ helpers
-    def _assemble(self, u: np.ndarray, *, tangent: bool, deformation: np.ndarray | None = None):
+    def _assemble(self, u: np.ndarray, *, tangent: bool = False, **known):
         return assemble(self.model, self.nodes, self.triangles, u, nu=self.nu,
-                        geometry=self.geometry, tangent=tangent, deformation=deformation)
+                        geometry=self.geometry, tangent=tangent, **known)
 
     def _stiffness(self) -> float:
         """Largest entry of the reference (undeformed) tangent: the scale of NEWTON_TOL."""
@@ -338,7 +339,7 @@ class ContactResponse:
             if solve is None:
                 K = asm.tangent if asm.tangent is not None else self._known(u, KNOWN_START)
                 if K is None:
-                    asm = self._assemble(u, tangent=True, deformation=asm.deformation)
+                    asm = with_tangent(self.model, asm, nu=self.nu, geometry=self.geometry)
                     K = asm.tangent
                 solve, fresh = self._factor(K), True
                 if solve is None:
@@ -354,7 +355,7 @@ class ContactResponse:
                 F = self._upright(trial)
                 if F is not None:
                     inverted = False
-                    t_asm = self._assemble(trial, tangent=False, deformation=F)
+                    t_asm = self._assemble(trial, deformation=F, stretch=asm.stretch)
                     t_norm = np.linalg.norm(t_asm.force[self.free])
                     if t_norm < norm:
                         break
@@ -410,7 +411,7 @@ class ContactResponse:
         self.stats["iterations"] += its
         K = asm.tangent if asm.tangent is not None else self._known(u, KNOWN_STATE)
         if K is None:
-            K = self._assemble(u, tangent=True, deformation=asm.deformation).tangent
+            K = with_tangent(self.model, asm, nu=self.nu, geometry=self.geometry).tangent
         self._known_tangent = None
         C = self._stiffness_of(K)
         if C is None:

@@ -33,7 +33,7 @@ True
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 import scipy.sparse as sp
@@ -44,7 +44,7 @@ from squeeze_grasp_ros.mechanics.vocabulary import MaterialModel
 
 __all__ = ["Assembly", "InvertedElementError", "MeshGeometry", "area_ratios", "assemble",
            "deformation", "determinants", "gradient_operator", "mesh_geometry",
-           "stress_and_tangent", "thickness_stretch"]
+           "stress_and_tangent", "thickness_stretch", "with_tangent"]
 
 _PLANE_STRESS_ITERATIONS = 30
 _SKEW = np.array([[0.0, -1.0], [1.0, 0.0]])
@@ -57,6 +57,12 @@ _CROSS = (2 * _I + _L, 2 * _K + _J)
 """The same for G_il G_kj."""
 _IDENTITY = ((_I == _K) & (_J == _L)).astype(float)
 """delta_ik delta_jl in that order."""
+_ROW, _COL = np.triu_indices(6)
+_UPPER = (_ROW, _COL, 2 * (_COL // 2) + _ROW % 2, 2 * (_ROW // 2) + _COL % 2,
+          np.flatnonzero(_ROW % 2 == _COL % 2))
+"""The 21 entries (a, i) <= (b, k) of the upper triangle of an element stiffness, rows and
+columns flat (2a + i, 2b + k): the flat positions of v_ai and v_bk, of v_bi and v_ak, and the
+entries with i = k."""
 
 
 class InvertedElementError(NumericalError):
@@ -79,6 +85,9 @@ class Assembly:
         Smallest det F (in-plane) over the elements.
     deformation : (t, 2, 2) ndarray
         The deformation gradients F it was assembled from.
+    stretch : (t,) ndarray or None
+        The neo-Hookean law's thickness stretches lambda3 of F (None for the other laws), kept
+        for :func:`with_tangent`.
     """
 
     energy: float
@@ -86,6 +95,7 @@ class Assembly:
     tangent: sp.csr_matrix | None
     min_det: float
     deformation: np.ndarray
+    stretch: np.ndarray | None = None
 
 
 def _shape_gradients(nodes: np.ndarray, triangles: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -207,9 +217,12 @@ def _lame(nu: float) -> tuple[float, float]:
     return nu / ((1.0 + nu) * (1.0 - 2.0 * nu)), 0.5 / (1.0 + nu)
 
 
-def _thickness_stretch(J2: np.ndarray, lam: float, mu: float) -> np.ndarray:
-    """lambda3 with mu (l3^2 - 1) + lam ln(J2 l3) = 0 per element (Newton from l3 = 1)."""
-    l3 = np.ones_like(J2)
+def _thickness_stretch(J2: np.ndarray, lam: float, mu: float,
+                       start: np.ndarray | None = None) -> np.ndarray:
+    """lambda3 with mu (l3^2 - 1) + lam ln(J2 l3) = 0 per element (Newton from l3 = 1, or from
+    ``start``, the stretches of a nearby state: one or two iterations fewer).
+    """
+    l3 = np.ones_like(J2) if start is None else start
     for _ in range(_PLANE_STRESS_ITERATIONS):
         g = mu * (l3 * l3 - 1.0) + lam * np.log(J2 * l3)
         dg = 2.0 * mu * l3 + lam / l3
@@ -226,34 +239,86 @@ def _require_compressible(nu: float) -> None:
                                 f"lambda is infinite at 0.5), got {nu}")
 
 
-def _neo_hookean(F: np.ndarray, nu: float, tangent: bool):
+def _neo_hookean_terms(F: np.ndarray, J2: np.ndarray, nu: float, *,
+                       l3: np.ndarray | None = None, start: np.ndarray | None = None) -> tuple:
+    """(lam, mu, l3, ln(J2 l3), G = F^-T, a = lam ln J - mu) of the neo-Hookean law at the
+    deformation gradients ``F`` with det F = ``J2``; ``l3``: their thickness stretches when
+    known, else solved here (from ``start``: :func:`_thickness_stretch`).
+    """
     _require_compressible(nu)
     lam, mu = _lame(nu)
-    J2 = determinants(F)
-    l3 = _thickness_stretch(J2, lam, mu)
+    l3 = _thickness_stretch(J2, lam, mu, start) if l3 is None else l3
     lnJ = np.log(J2 * l3)
     G = np.empty_like(F)  # F^-T
     G[:, 0, 0], G[:, 1, 1] = F[:, 1, 1], F[:, 0, 0]
     G[:, 0, 1], G[:, 1, 0] = -F[:, 1, 0], -F[:, 0, 1]
     G /= J2[:, None, None]
+    return lam, mu, l3, lnJ, G, lam * lnJ - mu
+
+
+def _neo_hookean_stress(F: np.ndarray, terms: tuple) -> tuple[np.ndarray, np.ndarray]:
+    """(W (t,), P (t, 2, 2)) of the neo-Hookean law from its :func:`_neo_hookean_terms`."""
+    lam, mu, l3, lnJ, G, a = terms
     I1 = np.einsum("tij,tij->t", F, F) + l3 * l3
     W = 0.5 * mu * (I1 - 3.0) - mu * lnJ + 0.5 * lam * lnJ * lnJ
-    a = lam * lnJ - mu
-    g = G.reshape(-1, 4)
-    P = (mu * F.reshape(-1, 4) + a[:, None] * g).reshape(-1, 2, 2)
+    P = (mu * F.reshape(-1, 4) + a[:, None] * G.reshape(-1, 4)).reshape(-1, 2, 2)
+    return W, P
+
+
+def _condensed(terms: tuple) -> np.ndarray:
+    """The g g^T coefficient c = lam - (lam / l3)^2 / w33 (t,) of the neo-Hookean tangent,
+    with the thickness direction condensed out (w33: its 33 stiffness).
+    """
+    lam, mu, l3, lnJ, _, _ = terms
+    w33 = mu + mu / l3 ** 2 + lam * (1.0 - lnJ) / l3 ** 2
+    return lam - (lam / l3) ** 2 / w33
+
+
+def _neo_hookean(F: np.ndarray, nu: float, tangent: bool):
+    terms = _neo_hookean_terms(F, determinants(F), nu)
+    W, P = _neo_hookean_stress(F, terms)
     if not tangent:
         return W, P, None
-    # A = mu I + (lam - (lam / l3)^2 / w33) g g^T - a X with X[ij, kl] = G_il G_kj, as (t, 16)
-    # rows in (ik, jl) order built in place (the tangent's arrays are the largest of an
-    # assembly); returned as the (i, j, k, l) view of them
+    # A = mu I + c g g^T - a X with X[ij, kl] = G_il G_kj, as (t, 16) rows in (ik, jl) order
+    # built in place (the tangent's arrays are the largest of an assembly); returned as the
+    # (i, j, k, l) view of them
+    mu, g, a = terms[1], terms[4].reshape(-1, 4), terms[5]
     A = np.take(g, _OUTER[0], axis=1) * np.take(g, _OUTER[1], axis=1)
-    w33 = mu + mu / l3 ** 2 + lam * (1.0 - lnJ) / l3 ** 2
-    A *= (lam - (lam / l3) ** 2 / w33)[:, None]
+    A *= _condensed(terms)[:, None]
     A += mu * _IDENTITY
     cross = np.take(g, _CROSS[0], axis=1) * np.take(g, _CROSS[1], axis=1)
     cross *= a[:, None]
     A -= cross
     return W, P, A.reshape(-1, 2, 2, 2, 2).transpose(0, 1, 3, 2, 4)
+
+
+def _neo_hookean_stiffness(geometry: MeshGeometry, terms: tuple) -> np.ndarray:
+    """The CSR values of the neo-Hookean tangent stiffness from the law's
+    :func:`_neo_hookean_terms`, in the closed form of the compiled kernel
+    (:mod:`.hyperelastic_numba`):
+    k[(a, i), (b, k)] = area (mu delta_ik grad N_a . grad N_b + c v_ai v_bk - a v_bi v_ak),
+    v_a = F^-T grad N_a, with the kernel's products in the kernel's order, so that its floats
+    are the kernel's. Such an entry is symmetric bit for bit, so only the 21 of the upper
+    triangle of each element stiffness are formed and summed (in element order) onto the
+    upper triangle of K, which is then mirrored: no symmetrisation pass.
+    """
+    _, mu, _, _, G, a = terms
+    x, y = geometry.shape_gradients[:, :, 0].T, geometry.shape_gradients[:, :, 1].T
+    v = np.empty((3, 2, len(a)))  # v[b, i, e], flat (2b + i, e): element by element in rows
+    v[:, 0] = G[:, 0, 0] * x + G[:, 0, 1] * y
+    v[:, 1] = G[:, 1, 0] * x + G[:, 1, 1] * y
+    v = v.reshape(6, -1)
+    entry = v[_UPPER[0]] * v[_UPPER[1]]  # v_ai v_bk
+    entry *= _condensed(terms)
+    cross = v[_UPPER[2]] * v[_UPPER[3]]  # v_bi v_ak
+    cross *= a
+    entry -= cross
+    entry[_UPPER[4]] += mu * geometry.gram
+    entry *= geometry.area
+    data = np.bincount(geometry.upper_slots, weights=entry.T.reshape(-1),
+                       minlength=len(geometry.indices))
+    data[geometry.lower] = data[geometry.transpose[geometry.lower]]
+    return data
 
 
 def thickness_stretch(model: MaterialModel | str, F: np.ndarray, *, nu: float) -> np.ndarray:
@@ -306,7 +371,8 @@ def stress_and_tangent(model: MaterialModel | str, F: np.ndarray, *, nu: float,
 
 def assemble(model: MaterialModel | str, nodes: np.ndarray, triangles: np.ndarray,
              u: np.ndarray, *, nu: float, geometry: MeshGeometry | None = None,
-             tangent: bool = True, deformation: np.ndarray | None = None) -> Assembly:
+             tangent: bool = True, deformation: np.ndarray | None = None,
+             stretch: np.ndarray | None = None) -> Assembly:
     """Energy, internal forces and tangent stiffness of the displacement ``u`` (2n,), m.
 
     Parameters
@@ -330,6 +396,11 @@ def assemble(model: MaterialModel | str, nodes: np.ndarray, triangles: np.ndarra
     deformation : (t, 2, 2) ndarray, optional
         F of ``u`` (:meth:`MeshGeometry.deformation`) when the caller has it already, as after
         testing a state for inverted elements (computed here otherwise).
+    stretch : (t,) ndarray, optional
+        Neo-Hookean: the thickness stretches of a nearby state (``Assembly.stretch``, as of
+        Newton's current iterate for its trial), to start this state's thickness Newton from;
+        it then stops at the same tolerance in fewer iterations, at stretches that may differ
+        from a start at 1 in the last bits.
 
     Raises
     ------
@@ -343,34 +414,60 @@ def assemble(model: MaterialModel | str, nodes: np.ndarray, triangles: np.ndarra
     if not det[worst] > 0:
         raise InvertedElementError(f"element {worst} inverted (det F = {det[worst]:.3g})",
                                    residuals={"det_F": det[worst]})
-    if geometry.compiled and MaterialModel(model) == MaterialModel.NEO_HOOKEAN:
-        energy, force, data = _compiled_neo_hookean(geometry, F, det, nu, tangent)
+    neo = MaterialModel(model) == MaterialModel.NEO_HOOKEAN
+    terms = _neo_hookean_terms(F, det, nu, start=stretch) if neo else None
+    if neo and geometry.compiled:
+        energy, force, data = _compiled_neo_hookean(geometry, F, terms, tangent)
     else:
-        W, P, A = stress_and_tangent(model, F, nu=nu, tangent=tangent)
+        if neo:
+            W, P = _neo_hookean_stress(F, terms)
+            data = _neo_hookean_stiffness(geometry, terms) if tangent else None
+        else:
+            W, P, A = stress_and_tangent(model, F, nu=nu, tangent=tangent)
+            data = _stiffness_data(geometry, A) if tangent else None
         energy = float(np.einsum("t,t->", W, geometry.area))
         force = geometry.force_operator @ P.reshape(-1)  # f[(a, i)] = sum_e area g_aj P_ij
-        data = _stiffness_data(geometry, A) if tangent else None
-    K = None
-    if tangent:
-        K = sp.csr_matrix((data, geometry.indices, geometry.indptr),
-                          shape=(geometry.n2, geometry.n2))
-    return Assembly(energy, force, K, float(det[worst]), F)
+    K = None if data is None else _csr(geometry, data)
+    return Assembly(energy, force, K, float(det[worst]), F, terms[2] if neo else None)
 
 
-def _compiled_neo_hookean(geometry: MeshGeometry, F: np.ndarray, det: np.ndarray, nu: float,
+def with_tangent(model: MaterialModel | str, assembly: Assembly, *, nu: float,
+                 geometry: MeshGeometry) -> Assembly:
+    """``assembly`` (of :func:`assemble` with ``geometry``, forces only) with its tangent
+    stiffness: the tangent of its deformation gradients (and, neo-Hookean, of the thickness
+    stretches it holds: no second solve of them), its energy and forces kept; the floats of
+    ``assemble(..., tangent=True)`` of the same state and ``stretch`` start.
+    """
+    if assembly.tangent is not None:
+        return assembly
+    F = assembly.deformation
+    if MaterialModel(model) == MaterialModel.NEO_HOOKEAN:
+        terms = _neo_hookean_terms(F, determinants(F), nu, l3=assembly.stretch)
+        data = (_compiled_neo_hookean(geometry, F, terms, True)[2] if geometry.compiled
+                else _neo_hookean_stiffness(geometry, terms))
+    else:
+        data = _stiffness_data(geometry, stress_and_tangent(model, F, nu=nu)[2])
+    return replace(assembly, tangent=_csr(geometry, data))
+
+
+def _csr(geometry: MeshGeometry, data: np.ndarray) -> sp.csr_matrix:
+    """The tangent stiffness of the CSR values ``data`` in the pattern of ``geometry``."""
+    return sp.csr_matrix((data, geometry.indices, geometry.indptr),
+                         shape=(geometry.n2, geometry.n2))
+
+
+def _compiled_neo_hookean(geometry: MeshGeometry, F: np.ndarray, terms: tuple,
                           tangent: bool) -> tuple[float, np.ndarray, np.ndarray | None]:
     """(energy, forces, the tangent's CSR values or None) of the neo-Hookean law of the
-    deformation gradients ``F`` with determinants ``det`` by the compiled kernel
-    (:mod:`.hyperelastic_numba`), given the thickness stretches as the numpy route has them.
+    deformation gradients ``F`` by the compiled kernel (:mod:`.hyperelastic_numba`), given
+    the law's :func:`_neo_hookean_terms` (thickness stretches, logarithms) as numpy has them.
     """
     from squeeze_grasp_ros.mechanics.elastic import hyperelastic_numba
 
-    _require_compressible(nu)
-    lam, mu = _lame(nu)
-    l3 = _thickness_stretch(det, lam, mu)
+    lam, mu, l3, lnJ = terms[:4]
     force = np.zeros(geometry.n2)
     data = np.zeros(len(geometry.indices) if tangent else 0)
-    energy = hyperelastic_numba.neo_hookean(F, l3, np.log(det * l3), geometry.shape_gradients,
+    energy = hyperelastic_numba.neo_hookean(F, l3, lnJ, geometry.shape_gradients,
                                             geometry.area,
                                             geometry.dofs, geometry.slots.reshape(len(F), 36),
                                             lam, mu, force, data)
@@ -423,6 +520,13 @@ class MeshGeometry:
         Reference shape-function gradients g_aj.
     dofs : (t, 6) ndarray of int
         The DOFs of each element, (a, i) order.
+    upper_slots : (21t,) ndarray of int
+        CSR position of the upper-triangle entry (row <= column) of each element entry
+        (a, i) <= (b, k), element by element, in the order of ``np.triu_indices(6)``.
+    lower : ndarray of int
+        CSR positions of the entries below the diagonal.
+    gram : (12, t) ndarray
+        grad N_a . grad N_b of the upper-triangle entries with i = k, in their order.
     compiled : bool
         :func:`assemble` runs the neo-Hookean law by the compiled kernel of
         :mod:`.hyperelastic_numba` (the ``fast`` extra), the other laws by numpy.
@@ -439,6 +543,9 @@ class MeshGeometry:
     transpose: np.ndarray
     shape_gradients: np.ndarray
     dofs: np.ndarray
+    upper_slots: np.ndarray
+    lower: np.ndarray
+    gram: np.ndarray
     compiled: bool = False
 
     def deformation(self, u: np.ndarray) -> np.ndarray:
@@ -473,5 +580,14 @@ def mesh_geometry(nodes: np.ndarray, triangles: np.ndarray, *,
     transpose = np.searchsorted(keys, col_of * n2 + row_of)  # the pattern is symmetric
     gradient = gradient_operator(nodes, triangles)
     forces = sp.csr_matrix(gradient.multiply(np.repeat(area, 4)[:, None]).T)
+    # the upper triangle of each element stiffness, to its place in the upper triangle of K
+    local = np.stack([_ROW // 2, _COL // 2, _ROW % 2, _COL % 2])  # a, b, i, k
+    upper = slots.reshape(t, 3, 3, 2, 2)[:, local[0], local[1], local[2], local[3]]
+    upper = np.where(row_of[upper] <= col_of[upper], upper, transpose[upper])
+    same = _UPPER[4]
+    x, y = grad[:, :, 0], grad[:, :, 1]
+    gram = (x[:, local[0, same]] * x[:, local[1, same]]
+            + y[:, local[0, same]] * y[:, local[1, same]]).T
     return MeshGeometry(gradient, area, forces, outer, n2, slots.reshape(-1), col_of, indptr,
-                        transpose, grad, dofs.reshape(t, 6), compiled)
+                        transpose, grad, dofs.reshape(t, 6), upper.reshape(-1),
+                        np.flatnonzero(row_of > col_of), np.ascontiguousarray(gram), compiled)

@@ -98,7 +98,8 @@ def object_geometry(obj: ElasticObject, length: float, *, compiled: bool) -> Mes
         geometry = mesh_geometry(obj.mesh.nodes / length, obj.mesh.triangles, compiled=compiled)
         for array in (geometry.area, geometry.weighted_outer, geometry.slots, geometry.indices,
                       geometry.indptr, geometry.transpose, geometry.shape_gradients,
-                      geometry.dofs, geometry.gradient.data, geometry.force_operator.data):
+                      geometry.dofs, geometry.upper_slots, geometry.lower, geometry.gram,
+                      geometry.gradient.data, geometry.force_operator.data):
             array.flags.writeable = False
         kept[key] = geometry
     return kept[key]

@@ -28,6 +28,7 @@ from squeeze_grasp_ros.mechanics.squeeze.contact_state import (
 from squeeze_grasp_ros.mechanics.squeeze.event_key import EventFunction, EventKey
 from squeeze_grasp_ros.mechanics.squeeze.stepper.chatter import ChatterBound
 from squeeze_grasp_ros.mechanics.squeeze.stepper.compiled import CompiledSubsteps
+from squeeze_grasp_ros.mechanics.squeeze.stepper.compiled_location import CompiledLocation
 from squeeze_grasp_ros.mechanics.squeeze.stepper.contact_set import ContactSet
 from squeeze_grasp_ros.mechanics.squeeze.stepper.functions import EventFunctions
 from squeeze_grasp_ros.mechanics.squeeze.stepper.location import (
@@ -92,6 +93,7 @@ class _Call:
         self.work = np.array([f.work for f in state.fingers], float) / (fu * L)
         self.dissipation = np.array([f.dissipation for f in state.fingers], float) / (fu * L)
         self.samples: list[Sample] = []
+        self.compiled_location = CompiledLocation.of(self)
 
     # ------------------------------------------------------------------ the loop
     def run(self, stop_on_event: bool, planned: float,
@@ -182,6 +184,12 @@ class _Call:
             rows = f.rows_of(sorted({k.node for k in crossed if k.function == EventFunction.GAP}))
             start_slopes = f.slopes(contacts, sol_a, a, rows)
             end_slopes = f.slopes(contacts, sol_b, b, rows)
+        if self.compiled_location is not None:
+            located = self.compiled_location.locate(crossed, sol_a, sol_b, a, b,
+                                                    (start.values, end.values),
+                                                    (start_slopes, end_slopes))
+            if located is not None:
+                return located[0], located[2]
         points = SolvedPoints(self.solver, contacts, [(a, sol_a), (b, sol_b)])
         s_e, evaluations = earliest_crossing(
             crossed, a, b, self.tol / self.motion.rate, start=start.values, end=end.values,

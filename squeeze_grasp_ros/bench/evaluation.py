@@ -60,10 +60,11 @@ kernel (LAPACK through numpy.linalg's factorising functions or scipy.linalg, Sup
 CHOLMOD). numpy.linalg's helpers and its vector norms (reductions, no LAPACK) are not."""
 COMMAND = "python -m squeeze_grasp_ros.bench.evaluation"
 COMPILED_PATTERN = (r"fixed_set_numba\.py:\d*\(?solve_linear"
-                    r"|substeps_numba\.py:\d*\(?(advance_quiet|watched_values|slope_values)")
-"""The compiled kernels' profile entries: the fixed-set solve, the substeps between events, and
-the watched functions' values and slopes at event points (numba's dispatchers: their self time
-is the compiled call, BLAS and LAPACK inside included)."""
+                    r"|substeps_numba\.py:\d*\(?(advance_quiet|watched_values|slope_values)"
+                    r"|location_numba\.py:\d*\(?earliest_crossing")
+"""The compiled kernels' profile entries: the fixed-set solve, the substeps between events, the
+watched functions' values and slopes at event points, and the event location (numba's
+dispatchers: their self time is the compiled call, BLAS and LAPACK inside included)."""
 CONTROL_ITERATIONS = 5_000_000
 BASELINE_COMMIT = "9db5097"
 BASELINE_MS_PER_EVALUATION = 12.50
@@ -208,8 +209,8 @@ def table(measured: dict[Kernel, dict], spec: Path, tasks: int | None) -> Table:
          "speed-up over the numpy route (control-normalised)", "profiled evaluations",
          "profiled per evaluation [ms]", "kernels per evaluation (profiled) [ms]",
          "kernel share of the profile [%]", "kernels / unprofiled CPU [%]",
-         "compiled kernels (fixed-set solve, substeps, watched values and slopes), share of "
-         "the profile [%]",
+         "compiled kernels (fixed-set solve, substeps, watched values and slopes, location), "
+         "share of the profile [%]",
          "Python-visible calls per evaluation"],
         rows,
         "Fixed-set route: the linear model's Newton on the sliding contacts in numpy, or "
@@ -228,7 +229,8 @@ def table(measured: dict[Kernel, dict], spec: Path, tasks: int | None) -> Table:
         "callers); kernels / unprofiled CPU (the profiled evaluations' own unprofiled time) "
         "estimates the share without the profiler's overhead. The compiled kernels' column is "
         "their calls' self time (the fixed-set solve's, and on the numba route the substeps "
-        "between events' and the watched functions' values and slopes at event points; their "
+        "between events', the watched functions' values and slopes at event points and the "
+        "event location's; their "
         "BLAS and LAPACK calls inside, not counted as kernels). "
         f"Reproduce: `{COMMAND} {spec}{arg}`. Load average (1, 5, 15 min) {load} on "
         f"{os.cpu_count()} cores.",

@@ -41,6 +41,9 @@ from squeeze_grasp_ros.mechanics.squeeze.stepper.solving import (
 
 __all__ = ["CAPACITY", "CompiledLocation"]
 
+_SLOPED = (EventFunction.NORMAL_FORCE, EventFunction.CONE_PLUS, EventFunction.CONE_MINUS)
+"""The per-contact functions with slopes, in the order of a contact's rates."""
+
 CAPACITY = 64
 """Solved points (the substep's two ends included) the kernel has room for; a location that
 needs more runs in Python."""
@@ -86,12 +89,40 @@ class CompiledLocation:
             return None
         return cls(call)
 
-    def locate(self, crossed: list[EventKey], sol_a: Solution, sol_b: Solution, a: float,
-               b: float, values: tuple[Values, Values], slopes: tuple[Values, Values]
-               ) -> tuple[float, int, Solution] | None:
-        """(the event point, the evaluations, the solution there) of the crossings
-        ``crossed`` in [a, b] (``values`` and ``slopes`` at a and b), with the Newton counters
-        of the points solved; None when the location must run in Python.
+    def _slopes(self, crossed: list[EventKey], index: np.ndarray, s: float, sol: Solution,
+                known: Values | None) -> tuple[list[bool], list[float]] | None:
+        """Whether each crossed key has a slope at s, and the slope (0 without): from
+        ``known``, else by :meth:`~.compiled_functions.CompiledFunctions.slopes` at ``sol`` for
+        the crossed gaps' rows, as the Python location asks them (arrays, no mapping by key);
+        None when the functions are not compiled.
+        """
+        if known is not None:
+            return [key in known for key in crossed], [known.get(key, 0.0) for key in crossed]
+        functions, contacts = self.call.functions, self.call.events.contacts
+        compiled = functions._compiled
+        if compiled is None:
+            return None
+        nodes = sorted({key.node for key in crossed if key.function == EventFunction.GAP})
+        gaps, rates = compiled.slopes(contacts, sol, s, functions.rows_of(nodes))
+        fingers = len(self.call.motion.names)
+        has, out = [], []
+        for key, k in zip(crossed, index.tolist()):
+            function = key.function
+            if function == EventFunction.GAP:
+                out.append(float(gaps[nodes.index(key.node) * fingers + k]))
+            elif function in _SLOPED:
+                out.append(float(rates[3 * k + _SLOPED.index(function)]))
+            else:
+                out.append(0.0)
+            has.append(function == EventFunction.GAP or function in _SLOPED)
+        return has, out
+
+    def locate(self, crossed: list[EventKey], start: tuple, end: tuple
+               ) -> tuple[float, Solution] | None:
+        """(the event point, the solution there) of the crossings ``crossed`` in [a, b]
+        (``start`` and ``end``: s, the solution and the watched functions at a and b), with
+        the root evaluations and the Newton counters of the points solved; None when the
+        location must run in Python.
         """
         call = self.call
         contacts, model, motion = call.events.contacts, call.model, call.motion
@@ -99,13 +130,12 @@ class CompiledLocation:
         kinds = [self.kinds.get(key.function) for key in crossed]
         if sd.A_bc is None or None in kinds:
             return None
+        (a, sol_a, watched_a), (b, sol_b, watched_b) = start, end
         k = len(crossed)
-        start, end = values
-        start_slopes, end_slopes = slopes
         index = np.empty(k, int)
         GA, GR, B0 = (np.zeros((k, 2, 2 * len(contacts))), np.zeros((k, 2, sd.E.shape[1])),
                       np.zeros((k, 2)))
-        boundary, fresh = call.functions._boundary, call.events.fresh
+        boundary = call.functions._boundary
         for i, key in enumerate(crossed):
             if key.function == EventFunction.GAP:
                 rows = call.functions.rows_of([key.node])
@@ -114,11 +144,15 @@ class CompiledLocation:
                 index[i] = key.finger
             else:
                 index[i] = contacts.index(key.node)
+        slopes_a = self._slopes(crossed, index, a, sol_a, watched_a.slopes)
+        slopes_b = self._slopes(crossed, index, b, sol_b, watched_b.slopes)
+        if slopes_a is None or slopes_b is None:
+            return None
+        fresh = call.events.fresh
+        columns = np.array([[watched_a.values[key] for key in crossed],
+                            [watched_b.values[key] for key in crossed], *slopes_a, *slopes_b,
+                            [key.at_node in fresh for key in crossed]], float)
         order = np.array([call.events.order(key) for key in crossed], float)
-        rows = [(start[key], end[key], key in start_slopes, start_slopes.get(key, 0.0),
-                 key in end_slopes, end_slopes.get(key, 0.0), key.at_node in fresh)
-                for key in crossed]
-        columns = [np.array(column) for column in zip(*rows)]
         cfg = contacts.configuration(motion.tip)
         origin, D, radius_f, flat_f, t0_f = self.fingers
         m, n = len(contacts), int(np.count_nonzero(~contacts.stick))
@@ -132,20 +166,20 @@ class CompiledLocation:
                                            sol.ddelta, sol.normal_angle,
                                            1.0 if sol.kappa is None else sol.kappa)):
                 array[p] = x
-        fun = (float(model.mu), contacts.slip, np.ascontiguousarray(motion.radius[contacts.finger],
-                                                                    float),
-               float(motion.rate), GA, GR, B0, sd.E, origin, D, radius_f, flat_f, t0_f)
+        fun = (float(model.mu), contacts.slip,
+               np.ascontiguousarray(motion.radius[contacts.finger], float), float(motion.rate),
+               GA, GR, B0, sd.E, origin, D, radius_f, flat_f, t0_f)
         prob = (np.ascontiguousarray(sd.C), np.ascontiguousarray(cfg.p0, float), cfg.stick,
                 cfg.slip, float(model.phi), np.ascontiguousarray(cfg.tip.radius, float),
                 np.ascontiguousarray(cfg.tip.flat, float),
                 np.ascontiguousarray(cfg.tip.facing, float), contacts.finger, origin, D,
                 NEWTON_TOL, NEWTON_MAX_ITERATIONS, NEWTON_BACKTRACKS, CONTINUATION_ITERATIONS,
                 MAX_ANGLE_JUMP)
-        kind = np.array(kinds, int)
         s_e, evaluations, solved = self.kernel.earliest_crossing(
             a, b, call.tol / motion.rate, bool(model.dear_evaluations),
-            (SURE_MARGIN, MAX_ROOT_ITERATIONS), kind, index, *columns[:6], columns[6], order,
-            2, pts, fun, prob)
+            (SURE_MARGIN, MAX_ROOT_ITERATIONS), np.array(kinds, int), index, columns[0],
+            columns[1], columns[2] != 0, columns[3], columns[4] != 0, columns[5],
+            columns[6] != 0, order, 2, pts, fun, prob)
         if evaluations < 0:
             return None
         at, theta, delta, F, dtheta, dF, ddelta, nu, kappa, its, res, Js = pts
@@ -160,8 +194,8 @@ class CompiledLocation:
         counters.root_evaluations += evaluations
         p = int(np.flatnonzero(at[:solved] == s_e)[0])
         if p < 2:
-            return s_e, evaluations, (sol_a, sol_b)[p]
-        return s_e, evaluations, Solution(
+            return s_e, (sol_a, sol_b)[p]
+        return s_e, Solution(
             theta[p].copy(), delta[p].copy(), F[p].copy(), dtheta[p].copy(), dF[p].copy(),
             ddelta[p].copy(), int(its[p]), float(res[p]), float(conditions[p - 2]),
             nu[p].copy(), kappa[p].copy())

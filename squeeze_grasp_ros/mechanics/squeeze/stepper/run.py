@@ -178,18 +178,16 @@ class _Call:
     def locate(self, crossed: list[EventKey], sol_a: Solution, sol_b: Solution, a: float,
                b: float, start: _Watched, end: _Watched) -> tuple[float, Solution]:
         """The earliest event point in [a, b] and the solution there."""
+        if self.compiled_location is not None:
+            located = self.compiled_location.locate(crossed, (a, sol_a, start), (b, sol_b, end))
+            if located is not None:
+                return located
         contacts, f = self.events.contacts, self.functions
         start_slopes, end_slopes = start.slopes, end.slopes
         if start_slopes is None:
             rows = f.rows_of(sorted({k.node for k in crossed if k.function == EventFunction.GAP}))
             start_slopes = f.slopes(contacts, sol_a, a, rows)
             end_slopes = f.slopes(contacts, sol_b, b, rows)
-        if self.compiled_location is not None:
-            located = self.compiled_location.locate(crossed, sol_a, sol_b, a, b,
-                                                    (start.values, end.values),
-                                                    (start_slopes, end_slopes))
-            if located is not None:
-                return located[0], located[2]
         points = SolvedPoints(self.solver, contacts, [(a, sol_a), (b, sol_b)])
         s_e, evaluations = earliest_crossing(
             crossed, a, b, self.tol / self.motion.rate, start=start.values, end=end.values,

@@ -63,10 +63,11 @@ kernel (LAPACK through numpy.linalg's factorising functions or scipy.linalg, Sup
 CHOLMOD). numpy.linalg's helpers and its vector norms (reductions, no LAPACK) are not."""
 COMMAND = "python -m squeeze_grasp_ros.bench.evaluation"
 COMPILED_PATTERN = (r"fixed_set_numba\.py:\d*\(?solve_linear"
-                    r"|substeps_numba\.py:\d*\(?(advance_quiet|watched_values|slope_values)")
-"""The compiled kernels' profile entries: the fixed-set solve, the substeps between events, and
-the watched functions' values and slopes at event points (numba's dispatchers: their self time
-is the compiled call, BLAS and LAPACK inside included)."""
+                    r"|substeps_numba\.py:\d*\(?(advance_quiet|watched_values|slope_values)"
+                    r"|location_numba\.py:\d*\(?earliest_crossing")
+"""The compiled kernels' profile entries: the fixed-set solve, the substeps between events, the
+watched functions' values and slopes at event points, and the event location (numba's
+dispatchers: their self time is the compiled call, BLAS and LAPACK inside included)."""
 SPEED_UP_PASSES = 2
 """Rounds of the interleaved comparison with the pinned commit (best of them for each code)."""
 FOAM_SQUARE_NODES, FOAM_SQUARE_REPEATS = 2000, 5
@@ -218,8 +219,8 @@ def table(measured: dict[Kernel, dict], compared: tuple[dict, str | None], spec:
          "speed-up over the numpy route", "in this process [ms]", "profiled evaluations",
          "profiled per evaluation [ms]", "kernels per evaluation (profiled) [ms]",
          "kernel share of the profile [%]", "kernels / unprofiled CPU [%]",
-         "compiled kernels (fixed-set solve, substeps, watched values and slopes), share of "
-         "the profile [%]",
+         "compiled kernels (fixed-set solve, substeps, watched values and slopes, location), "
+         "share of the profile [%]",
          "Python-visible calls per evaluation"],
         rows,
         "Fixed-set route: the linear model's Newton on the sliding contacts in numpy, or "
@@ -236,7 +237,8 @@ def table(measured: dict[Kernel, dict], compared: tuple[dict, str | None], spec:
         "callers); kernels / unprofiled CPU (the profiled evaluations' own unprofiled time) "
         "estimates the share without the profiler's overhead. The compiled kernels' column is "
         "their calls' self time (the fixed-set solve's, and on the numba route the substeps "
-        "between events' and the watched functions' values and slopes at event points; their "
+        "between events', the watched functions' values and slopes at event points and the "
+        "event location's; their "
         "BLAS and LAPACK calls inside, not counted as kernels). "
         f"Reproduce: `{COMMAND} {spec}{arg}`. Load average (1, 5, 15 min) {load} on "
         f"{os.cpu_count()} cores.",

@@ -28,6 +28,7 @@ from squeeze_grasp_ros.mechanics.squeeze.contact_state import (
 from squeeze_grasp_ros.mechanics.squeeze.event_key import EventFunction, EventKey
 from squeeze_grasp_ros.mechanics.squeeze.stepper.chatter import ChatterBound
 from squeeze_grasp_ros.mechanics.squeeze.stepper.compiled import CompiledSubsteps
+from squeeze_grasp_ros.mechanics.squeeze.stepper.compiled_location import CompiledLocation
 from squeeze_grasp_ros.mechanics.squeeze.stepper.contact_set import ContactSet
 from squeeze_grasp_ros.mechanics.squeeze.stepper.functions import EventFunctions
 from squeeze_grasp_ros.mechanics.squeeze.stepper.location import (
@@ -92,6 +93,7 @@ class _Call:
         self.work = np.array([f.work for f in state.fingers], float) / (fu * L)
         self.dissipation = np.array([f.dissipation for f in state.fingers], float) / (fu * L)
         self.samples: list[Sample] = []
+        self.compiled_location = CompiledLocation.of(self)
 
     # ------------------------------------------------------------------ the loop
     def run(self, stop_on_event: bool, planned: float,
@@ -176,6 +178,10 @@ class _Call:
     def locate(self, crossed: list[EventKey], sol_a: Solution, sol_b: Solution, a: float,
                b: float, start: _Watched, end: _Watched) -> tuple[float, Solution]:
         """The earliest event point in [a, b] and the solution there."""
+        if self.compiled_location is not None:
+            located = self.compiled_location.locate(crossed, (a, sol_a, start), (b, sol_b, end))
+            if located is not None:
+                return located
         contacts, f = self.events.contacts, self.functions
         start_slopes, end_slopes = start.slopes, end.slopes
         if start_slopes is None:

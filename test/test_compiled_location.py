@@ -197,3 +197,25 @@ def test_what_the_kernel_does_not_take_stays_in_python(monkeypatch):
     took.clear()
     _same(_setup("foam_square").event_squeeze(), want)
     assert took and not any(took)  # each location solves at least two points
+
+
+def test_a_numba_without_its_lapack_binding_locates_in_python(monkeypatch):
+    """The kernel calls dgeev through ``numba.np.linalg._LAPACK``, not a public API: a numba
+    without it leaves every location to Python, with the same squeeze.
+    """
+    import sys
+
+    from test_compiled_substeps import _same
+
+    monkeypatch.setenv(KERNEL_VARIABLE, Kernel.NUMBA.value)
+    want = _setup("foam_square").event_squeeze()
+    monkeypatch.delattr(numba.np.linalg, "_LAPACK")
+    monkeypatch.delitem(sys.modules, location_numba.__name__)
+    monkeypatch.delattr(sys.modules["squeeze_grasp_ros.mechanics.squeeze"], "location_numba")
+    located_module._kernel.cache_clear()
+    try:
+        took = _taken(monkeypatch)
+        _same(_setup("foam_square").event_squeeze(), want)
+        assert located_module._kernel() is None and took == []
+    finally:
+        located_module._kernel.cache_clear()

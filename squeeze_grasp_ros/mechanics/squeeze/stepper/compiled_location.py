@@ -51,8 +51,15 @@ needs more runs in Python."""
 
 @cache
 def _kernel():
-    """The compiled module :mod:`..location_numba` (imported on first use: numba)."""
-    from squeeze_grasp_ros.mechanics.squeeze import location_numba
+    """The compiled module :mod:`..location_numba` (imported on first use: numba), or None
+    when this numba lacks the LAPACK binding it calls dgeev through (``numba.np.linalg``'s
+    ``_LAPACK``, not a public API: present in the numba versions tested, 0.68): every event
+    is then located in Python, with the same result.
+    """
+    try:
+        from squeeze_grasp_ros.mechanics.squeeze import location_numba
+    except (ImportError, AttributeError):
+        return None
     return location_numba
 
 
@@ -82,7 +89,7 @@ class CompiledLocation:
     def of(cls, call) -> CompiledLocation | None:
         """The compiled location of ``call``, or None when it locates in Python."""
         model = call.model
-        if (selected() != Kernel.NUMBA or model.reference
+        if (selected() != Kernel.NUMBA or _kernel() is None or model.reference
                 or type(model).response is not ContactModel.response
                 or type(model).boundary_displacement
                 is not ContactModel.boundary_displacement):

@@ -18,7 +18,7 @@ import signal
 import sys
 import threading
 
-from squeeze_grasp_ros.exit_codes import raise_on_signals
+from squeeze_grasp_ros.exit_codes import raise_on_signals, raised_signal
 from squeeze_grasp_ros.stdout import reserve_stdout
 from squeeze_grasp_ros.threads import single_thread_blas
 
@@ -37,9 +37,12 @@ def _run(module: str, name: str):
         return importlib.import_module(module).main()
     except (KeyboardInterrupt, ImportError) as exc:
         stop = _interruption(exc)
-        if stop is None:
+        if stop is not None:
+            signum = getattr(stop, "signum", signal.SIGINT)
+        elif isinstance(exc, ImportError) and raised_signal() is not None:
+            signum = raised_signal()  # the import swallowed the signal's exception
+        else:
             raise
-        signum = getattr(stop, "signum", signal.SIGINT)
         print(f"\n{name}: stopped by {signal.Signals(signum).name}", file=sys.stderr)
         return 128 + int(signum)
 

@@ -15,7 +15,7 @@ from __future__ import annotations
 import signal
 from enum import IntEnum
 
-__all__ = ["ExitCode", "Interrupted", "raise_on_signals"]
+__all__ = ["ExitCode", "Interrupted", "raise_on_signals", "raised_signal"]
 
 
 class ExitCode(IntEnum):
@@ -57,8 +57,24 @@ class Interrupted(KeyboardInterrupt):
         self.signum = int(signum)
 
 
+_RAISED: list[int] = []
+"""The signals the handlers of :func:`raise_on_signals` have raised, in order."""
+
+
+def raised_signal() -> int | None:
+    """The last signal a handler of :func:`raise_on_signals` turned into an exception, or None.
+
+    An interrupt that arrives while a C extension imports a module can be swallowed there and
+    replaced by an ImportError that does not chain it (numpy's "PyCapsule_Import could not
+    import module 'datetime'", seen under load): this says a signal was the cause.
+    """
+    return _RAISED[-1] if _RAISED else None
+
+
 def raise_on_signals() -> dict:
-    """Make SIGTERM and SIGHUP raise :class:`Interrupted`, as Ctrl-C raises KeyboardInterrupt.
+    """Make SIGTERM and SIGHUP raise :class:`Interrupted`, as Ctrl-C raises KeyboardInterrupt
+    (recorded for :func:`raised_signal` too, when Python's own Ctrl-C handler is in place:
+    a process that inherited SIGINT ignored keeps ignoring it).
 
     Installed first thing by the console scripts (and by ``squeeze-grasp run``), so a signal
     that arrives while the program is still importing or starting ends it with one line and
@@ -67,6 +83,10 @@ def raise_on_signals() -> dict:
     its own over these. Returns the handlers it replaced (signal number -> handler).
     """
     def stop(signum: int, _frame: object) -> None:
-        raise Interrupted(signum)
+        _RAISED.append(int(signum))
+        raise KeyboardInterrupt if signum == signal.SIGINT else Interrupted(signum)
 
-    return {signum: signal.signal(signum, stop) for signum in (signal.SIGTERM, signal.SIGHUP)}
+    signums = [signal.SIGTERM, signal.SIGHUP]
+    if signal.getsignal(signal.SIGINT) is signal.default_int_handler:
+        signums.append(signal.SIGINT)
+    return {signum: signal.signal(signum, stop) for signum in signums}

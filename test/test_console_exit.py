@@ -83,3 +83,31 @@ def test_a_recorded_run_through_the_console_script_leaves_a_complete_bag(tmp_pat
     assert ticks == summary["ticks"] + 1  # tick 0, then one per step of the goal
     assert (bag / "metadata.yaml").is_file()
     assert bag_info(bag)["message_count"] == len(contents.messages)
+
+
+SWALLOWED = """
+import os, signal, sys, types
+from squeeze_grasp_ros import entry
+
+def main():
+    try:  # a C extension's import that swallows the interrupt, as numpy's did under load
+        os.kill(os.getpid(), signal.SIGINT)
+        sum(range(10 ** 6))  # the handler runs here
+    except KeyboardInterrupt:
+        pass  # cleared, as C code that sets its own error clears it: nothing chains it
+    raise ImportError("PyCapsule_Import could not import module 'datetime'")
+
+sys.modules["fake_verb"] = types.SimpleNamespace(main=main)
+sys.exit(entry._run("fake_verb", "squeeze-grasp"))
+"""
+
+
+def test_an_import_that_swallows_ctrl_c_still_ends_with_one_line_and_130():
+    """An interrupt swallowed by an import and replaced by an unchained ImportError (numpy's
+    datetime capsule, hit by a Ctrl-C 0.1 s into ``squeeze-grasp sweep`` on a slow machine)
+    is still the interrupt: exit 130 and one line, not the ImportError's traceback.
+    """
+    done = subprocess.run([sys.executable, "-c", SWALLOWED], capture_output=True, text=True,
+                          timeout=60, preexec_fn=lambda: __import__("signal").signal(2, 0))
+    assert done.returncode == 130, done.stderr
+    assert done.stderr.strip() == "squeeze-grasp: stopped by SIGINT"

@@ -67,7 +67,9 @@ def baseline(commit: str = BASELINE_COMMIT) -> Iterator[CodeTree | str]:
     with tempfile.TemporaryDirectory(prefix=f"squeeze-grasp-{commit}-") as folder:
         archive = _git("archive", "--format=tar", commit, "squeeze_grasp_ros", "config")
         with tarfile.open(fileobj=io.BytesIO(archive.stdout)) as tar:
-            tar.extractall(folder, filter="data")
+            # the "data" filter (Python 3.10.12 / 3.11.4 on) refuses paths out of the folder
+            safe = {"filter": "data"} if hasattr(tarfile, "data_filter") else {}
+            tar.extractall(folder, **safe)
         yield CodeTree(commit, Path(folder), {})
 
 

@@ -17,6 +17,7 @@ import numpy as np
 from scipy.interpolate import CubicSpline
 
 from squeeze_grasp_ros.inputs import InputError, read_text
+from squeeze_grasp_ros.mechanics.elastic import portable_math as pm
 from squeeze_grasp_ros.mechanics.errors import InvalidInputError
 from squeeze_grasp_ros.mechanics.vocabulary import ShapeType
 
@@ -143,7 +144,7 @@ def _turning_corners(p: np.ndarray, threshold_deg: float = 20.0) -> np.ndarray:
     e_in = p - np.roll(p, 1, axis=0)
     e_out = np.roll(p, -1, axis=0) - p
     cross = e_in[:, 0] * e_out[:, 1] - e_in[:, 1] * e_out[:, 0]
-    turn = np.abs(np.arctan2(cross, np.einsum("ij,ij->i", e_in, e_out)))
+    turn = np.abs(pm.arctan2(cross, np.einsum("ij,ij->i", e_in, e_out)))
     return np.flatnonzero(turn > np.radians(threshold_deg))
 
 
@@ -282,7 +283,7 @@ def ellipse(a: float, b: float) -> Outline:
     """Ellipse with semi-axes ``a`` (x) and ``b`` (y), m, centred at the origin."""
     _positive(a=a, b=b)
     t = np.linspace(0.0, 2 * np.pi, DENSE, endpoint=False)
-    return _smooth(a * np.cos(t), b * np.sin(t), ShapeType.ELLIPSE)
+    return _smooth(a * pm.cos(t), b * pm.sin(t), ShapeType.ELLIPSE)
 
 
 def disk(radius: float) -> Outline:
@@ -296,9 +297,9 @@ def superellipse(a: float, b: float, exponent: float) -> Outline:
     if not exponent >= 2.0:
         raise InvalidInputError(f"superellipse.exponent must be >= 2, got {exponent}")
     t = np.linspace(0.0, 2 * np.pi, DENSE, endpoint=False)
-    c, s = np.cos(t), np.sin(t)
-    x = a * np.sign(c) * np.abs(c) ** (2.0 / exponent)
-    y = b * np.sign(s) * np.abs(s) ** (2.0 / exponent)
+    c, s = pm.cos(t), pm.sin(t)
+    x = a * np.sign(c) * pm.power(np.abs(c), 2.0 / exponent)
+    y = b * np.sign(s) * pm.power(np.abs(s), 2.0 / exponent)
     return _smooth(x, y, ShapeType.SUPERELLIPSE)
 
 
@@ -311,12 +312,12 @@ def fourier_blob(radius: float, cos: Sequence[float] = (), sin: Sequence[float] 
     t = np.linspace(0.0, 2 * np.pi, DENSE, endpoint=False)
     r = np.ones_like(t)
     for k, ck in enumerate(cos, start=1):
-        r += ck * np.cos(k * t)
+        r += ck * pm.cos(k * t)
     for k, sk in enumerate(sin, start=1):
-        r += sk * np.sin(k * t)
+        r += sk * pm.sin(k * t)
     if np.min(r) <= 0.05:
         raise InvalidInputError("fourier_blob coefficients make the radius vanish; reduce them")
-    return _smooth(radius * r * np.cos(t), radius * r * np.sin(t), ShapeType.FOURIER_BLOB)
+    return _smooth(radius * r * pm.cos(t), radius * r * pm.sin(t), ShapeType.FOURIER_BLOB)
 
 
 def _spline_curve(points: Sequence[Sequence[float]], name: str) -> np.ndarray:

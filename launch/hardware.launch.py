@@ -33,6 +33,11 @@ def generate_launch_description() -> LaunchDescription:
                               description="friction coefficient of the fingertips"),
         DeclareLaunchArgument("record", default_value="",
                               description="rosbag2 folder to record into (empty: no recording)"),
+        DeclareLaunchArgument("sigterm_timeout", default_value="10",
+                              description="s a node has to end after SIGINT before launch "
+                                          "sends SIGTERM (launch's own argument, here longer "
+                                          "than its 5 s: a node waits up to 5 s for its "
+                                          "readers to acknowledge what it published)"),
         Node(package="squeeze_grasp_ros", executable="planner", name="planner",
              parameters=[str(config / "planner.yaml"), {"use_sim_time": False}], output="screen"),
         Node(package="squeeze_grasp_ros", executable="monitor", name="monitor",

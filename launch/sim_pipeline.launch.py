@@ -126,5 +126,10 @@ def generate_launch_description() -> LaunchDescription:
                               description="put every node, topic and /clock under this "
                                           "namespace (empty: the root), so that launches in "
                                           "different namespaces share a ROS domain"),
+        DeclareLaunchArgument("sigterm_timeout", default_value="10",
+                              description="s a node has to end after SIGINT before launch "
+                                          "sends SIGTERM (launch's own argument, here longer "
+                                          "than its 5 s: a node waits up to 5 s for its "
+                                          "readers to acknowledge what it published)"),
         OpaqueFunction(function=nodes),
     ])

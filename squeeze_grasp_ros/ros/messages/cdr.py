@@ -183,12 +183,10 @@ def tactile_readings_cdr(data: bytes) -> tuple[int, TactileReadings]:
     if reader.order == "<" and reader.offset == len(data) and count and \
             all(len(a) == count for a in arrays) and \
             sum(map(len, _TACTILE_LAYOUTS.values())) < 64:
-        _TACTILE_LAYOUTS.setdefault(len(data), []).append(_Layout(counts[0] + 4, bytes(data[_BODY + 8:counts[0] + 4]),
-                                              tuple(counts[1:]),
-                                              bytes(data[counts[0]:counts[0] + 4]), finger,
-                                              count, tuple(runs),
-                                              runs[1] - runs[0] if runs[2] - runs[1] ==
-                                              runs[1] - runs[0] else 0))
+        stride = runs[1] - runs[0] if runs[2] - runs[1] == runs[1] - runs[0] else 0
+        _TACTILE_LAYOUTS.setdefault(len(data), []).append(_Layout(
+            counts[0] + 4, bytes(data[_BODY + 8:counts[0] + 4]), tuple(counts[1:]),
+            bytes(data[counts[0]:counts[0] + 4]), finger, count, tuple(runs), stride))
     return stamp, TactileReadings(finger, *arrays)
 
 

@@ -77,3 +77,59 @@ def test_the_lockstep_monitor_takes_no_clock_and_the_hardware_monitor_follows_it
         executor.shutdown()
         for node in (*monitors.values(), driver):
             node.destroy_node()
+
+
+def test_the_lockstep_executor_takes_its_time_from_the_statuses_not_the_clock(ros_context):
+    """In lockstep with ``use_sim_time`` the executor does not subscribe to ``/clock`` (one
+    delivery a tick less); its clock still reads simulated time, each status's stamp (the
+    action server stamps accepted goals with it), as ``/clock`` of that tick set it before.
+    Without lockstep it follows ``/clock``. Real rclpy nodes in a namespace of their own.
+    """
+    import os
+    import time
+
+    from rclpy.executors import SingleThreadedExecutor
+    from rclpy.node import Node
+    from rclpy.parameter import Parameter
+    from rosgraph_msgs.msg import Clock
+
+    from squeeze_grasp_interfaces.msg import MonitorStatus
+    from squeeze_grasp_ros.ros.nodes.executor import ExecutorNode
+    from squeeze_grasp_ros.ros.nodes.pipeline import STATUS, loop_qos
+    from squeeze_grasp_ros.ros.run.processes import ros_arguments
+
+    namespace = f"/executor_clock_test_{os.getpid()}"
+    executors = {lockstep: ExecutorNode(
+        context=ros_context, cli_args=ros_arguments(f"{namespace}/{lockstep}"),
+        parameter_overrides=[Parameter("use_sim_time", value=True),
+                             Parameter("lockstep", value=lockstep)]) for lockstep in (True, False)}
+    driver = Node("driver", context=ros_context, namespace=namespace)
+    clocks = {lockstep: driver.create_publisher(Clock, f"{namespace}/{lockstep}/clock",
+                                                loop_qos(10)) for lockstep in executors}
+    status = driver.create_publisher(MonitorStatus, f"{namespace}/True/{STATUS}", loop_qos(10))
+    spin = SingleThreadedExecutor(context=ros_context)
+    for node in (*executors.values(), driver):
+        spin.add_node(node)
+    try:
+        assert {lockstep: [s.topic_name for s in node.subscriptions
+                           if s.topic_name.endswith("/clock")]
+                for lockstep, node in executors.items()} == {
+                    True: [], False: [f"{namespace}/False/clock"]}
+        tick, stamped = Clock(), MonitorStatus()
+        tick.clock.sec = stamped.header.stamp.sec = 5
+        stamped.header.stamp.nanosec = 1_000
+        deadline = time.monotonic() + 10.0
+        while {lockstep: node.get_clock().now().nanoseconds
+               for lockstep, node in executors.items()} != {True: 5_000_001_000,
+                                                            False: 5_000_000_000}:
+            assert time.monotonic() < deadline, "an executor's clock never moved"
+            for publisher in clocks.values():
+                publisher.publish(tick)
+            status.publish(stamped)
+            spin.spin_once(0.05)
+        assert all(node.get_clock().ros_time_is_active for node in executors.values())
+        assert clocks[True].get_subscription_count() == 0
+    finally:
+        spin.shutdown()
+        for node in (*executors.values(), driver):
+            node.destroy_node()

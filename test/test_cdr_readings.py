@@ -137,3 +137,24 @@ def test_a_layout_read_before_reads_as_the_full_walk(ns, later, finger, taxels, 
             want = _forgetting(read, message)
             read(kept)
             _same_reading(read(message), want)
+
+
+def test_two_fingers_arrays_of_one_length_keep_a_layout_each(monkeypatch):
+    """The two fingers of a gripper send tactile arrays of the same length, alternately: once
+    each was read, both are read at their kept offsets (the walk over the fields, which each
+    finger's array replaced the other's layout with on every tick before, is not needed), and
+    read the same as by rclpy.
+    """
+    cdr._TACTILE_LAYOUTS.clear()
+    arrays = {finger: messages.TactileReadings(finger, np.linspace(0.0, 1.0, 24),
+                                               np.arange(24.0), -np.arange(24.0))
+              for finger in ("F1", "F2")}
+    data = {finger: messages.tactile_array_cdr(r, 5, f"{finger}_tip")
+            for finger, r in arrays.items()}
+    for message in data.values():
+        messages.tactile_readings_cdr(message)
+    monkeypatch.setattr(cdr, "_Reader", None)  # a walk over the fields now fails
+    for finger, message in data.items():
+        stamp, read = messages.tactile_readings_cdr(message)
+        assert stamp == 5 and read.finger == finger
+        _same_reading(read, arrays[finger])

@@ -94,7 +94,8 @@ def bare_ratio_table(path: Path, repeats: int, progress) -> Table:
         "run config/scenes/foam_square.yaml` in one process without recording, ticks / (loop "
         "wall time - the world's mechanics step). Bare loop (ros/bare_loop.py): three nodes and "
         "a client on the same executor passing the pipeline's 13 messages per tick with 13 "
-        "deliveries (the pipeline's 12 and the monitor's clock, which it no longer takes; "
+        "deliveries (the pipeline's 11 and the clock of the monitor and the executor, which "
+        "they no longer take; "
         "std_msgs/Header, reliable), lockstep, with no work in the callbacks.",
     )
 

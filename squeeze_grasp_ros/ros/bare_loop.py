@@ -15,9 +15,10 @@
 
 Every message is a ``std_msgs/Header`` whose stamp is the tick, on the pipeline's reliable
 loop QoS. The same 13 messages per tick as the pipeline, the same executor, and nothing else:
-no mechanics, no tracker, no program, no message payload. Its 13 deliveries are one more than
-the pipeline's since the monitor stopped taking ``/clock`` in lockstep; the loop keeps the
-clock's delivery to ``monitor``, so that it stays the yardstick issue 33 set.
+no mechanics, no tracker, no program, no message payload. Its 13 deliveries are two more than
+the pipeline's since the monitor and the executor stopped taking ``/clock`` in lockstep; the
+loop keeps the clock's deliveries to ``monitor`` and ``executor``, so that it stays the
+yardstick issue 33 set.
 """
 from __future__ import annotations
 

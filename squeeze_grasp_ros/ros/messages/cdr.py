@@ -161,9 +161,8 @@ def tactile_readings_cdr(data: bytes) -> tuple[int, TactileReadings]:
     An array of the layout of one read before (the same length, frame, finger and taxel count)
     is read at that one's offsets.
     """
-    layout = _TACTILE_LAYOUTS.get(len(data))
-    if layout is not None and data[1] == 1 and data[_BODY + 8:layout.start] == layout.prefix \
-            and all(data[at:at + 4] == layout.count for at in layout.counts):
+    layout = _known_layout(data)
+    if layout is not None:
         if layout.stride:  # the three arrays evenly spaced: one strided copy
             taxels = np.ndarray((3, layout.size), "<f8", data, layout.runs[0],
                                 (layout.stride, 8)).astype(np.float64)
@@ -182,14 +181,24 @@ def tactile_readings_cdr(data: bytes) -> tuple[int, TactileReadings]:
         runs.append(reader.offset - 8 * len(arrays[-1]))
     count = len(arrays[0])
     if reader.order == "<" and reader.offset == len(data) and count and \
-            all(len(a) == count for a in arrays) and len(_TACTILE_LAYOUTS) < 64:
-        _TACTILE_LAYOUTS[len(data)] = _Layout(counts[0] + 4, bytes(data[_BODY + 8:counts[0] + 4]),
-                                              tuple(counts[1:]),
-                                              bytes(data[counts[0]:counts[0] + 4]), finger,
-                                              count, tuple(runs),
-                                              runs[1] - runs[0] if runs[2] - runs[1] ==
-                                              runs[1] - runs[0] else 0)
+            all(len(a) == count for a in arrays) and \
+            sum(map(len, _TACTILE_LAYOUTS.values())) < 64:
+        stride = runs[1] - runs[0] if runs[2] - runs[1] == runs[1] - runs[0] else 0
+        _TACTILE_LAYOUTS.setdefault(len(data), []).append(_Layout(
+            counts[0] + 4, bytes(data[_BODY + 8:counts[0] + 4]), tuple(counts[1:]),
+            bytes(data[counts[0]:counts[0] + 4]), finger, count, tuple(runs), stride))
     return stamp, TactileReadings(finger, *arrays)
+
+
+def _known_layout(data: bytes) -> _Layout | None:
+    """The layout read before that a little-endian tactile array ``data`` has, if any."""
+    if data[1] != 1:
+        return None
+    for layout in _TACTILE_LAYOUTS.get(len(data), ()):
+        if data[_BODY + 8:layout.start] == layout.prefix \
+                and all(data[at:at + 4] == layout.count for at in layout.counts):
+            return layout
+    return None
 
 
 def tick_readings_cdr(data: bytes) -> tuple[int, list[str]]:
@@ -234,8 +243,10 @@ class _Layout(NamedTuple):
     """Bytes from one array to the next when they are evenly spaced (else 0)."""
 
 
-_TACTILE_LAYOUTS: dict[int, _Layout] = {}
-"""Tactile array layouts read before, by message length (little-endian, at most 64)."""
+_TACTILE_LAYOUTS: dict[int, list[_Layout]] = {}
+"""Tactile array layouts read before, by message length (little-endian, at most 64 in all).
+Each finger has its own (its name is in the message): the two fingers of a gripper, whose
+arrays have the same length, keep one each."""
 _TICK_READINGS: dict[bytes, tuple[str, ...]] = {}
 """A tick's readings by the bytes of its ``string[]`` (at most 64 lists)."""
 _NO_FRAME = b"\x01\x00\x00\x00\x00\x00\x00\x00"

@@ -81,7 +81,9 @@ PARAMETERS: dict[str, tuple[Any, str]] = {
                         "goal ends picked_up, s (0: end at picked_up)"),
     "period": (0.001, "control cycle, s (lockstep: the simulated tick)"),
     "feedback_every": (10, "cycles between action feedback messages"),
-    "lockstep": (True, "cycle on each monitor status (simulation) or on a wall-clock timer"),
+    "lockstep": (True, "cycle on each monitor status (simulation: the statuses' stamps are "
+                       "the executor's time, use_sim_time is set false and /clock not taken) "
+                       "or on a wall-clock timer"),
     "qos_depth": (100, "history depth of the reliable topics"),
     "controller_scene": ("", "scene file whose controller: section drives the jaws through "
                              "a stock controller (empty: setpoint topics only)"),
@@ -185,6 +187,8 @@ class ExecutorNode(Node):
         """The newest status, serialised (a raw subscription: :meth:`_cycle` reads it)."""
         self.answered = pipeline.TickAnswer()
         self.state = ExecutorStatus.IDLE
+        self.tick_clock = pipeline.TickClock(self) if p["lockstep"] else None
+        """In lockstep the clock follows the statuses' stamps, not ``/clock``."""
         if p["lockstep"]:
             self.participant = pipeline.Participant(self, "executor", [pipeline.STATUS],
                                                     list(self.setpoint_pubs.values())
@@ -267,8 +271,11 @@ class ExecutorNode(Node):
 
     # ----------------------------------------------------------------- cycles
     def _status(self, data: bytes) -> None:
-        if not self.answered.is_new(messages.cdr_stamp_ns(data)):
+        ns = messages.cdr_stamp_ns(data)
+        if not self.answered.is_new(ns):
             return
+        if self.tick_clock is not None:
+            self.tick_clock.advance(ns)
         self.latest = data
         if self.p["lockstep"] and self.goal is not None:
             self._cycle(data)

@@ -34,6 +34,7 @@ from rclpy.qos import (
     qos_profile_sensor_data,
 )
 from rclpy.serialization import deserialize_message, serialize_message
+from rclpy.time import Time
 from std_msgs.msg import String
 
 FRAME = "object"
@@ -332,6 +333,30 @@ class Heard:
 def wall_timer(node: Node, period: float, callback: Callable[[], None]):
     """A timer on the steady (wall) clock, whatever ``use_sim_time`` says."""
     return node.create_timer(period, callback, clock=Clock(clock_type=ClockType.STEADY_TIME))
+
+
+class TickClock:
+    """A lockstep node's ROS time from the stamps of the ticks it answers, in place of
+    ``/clock``: one delivery and one rclpy ``TimeSource`` callback a tick less.
+
+    With ``use_sim_time`` the node's clock reads simulated time, which rclpy sets from every
+    ``/clock`` message it takes. A node that answers each tick already has the tick's stamp
+    (the clock's value at that tick): the parameter is set false, so rclpy does not subscribe
+    to ``/clock``, and :meth:`advance` sets the clock's ROS time to each new stamp, as the
+    ``/clock`` of that tick did. Without ``use_sim_time`` the clock is left alone.
+    """
+
+    def __init__(self, node: Node) -> None:
+        self.clock = None
+        if node.get_parameter("use_sim_time").value:
+            node.set_parameters([Parameter("use_sim_time", value=False)])
+            self.clock = node.get_clock()
+            self.clock._set_ros_time_is_active(True)  # what rclpy's TimeSource does with /clock
+
+    def advance(self, ns: int) -> None:
+        """Set the ROS time to ``ns`` (a new tick's stamp), if the node runs on sim time."""
+        if self.clock is not None:
+            self.clock.set_ros_time_override(Time(nanoseconds=ns, clock_type=ClockType.ROS_TIME))
 
 
 class TickAnswer:

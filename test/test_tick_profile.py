@@ -16,9 +16,11 @@ from squeeze_grasp_ros.ros.bare_loop import bare_loop_rate
 from squeeze_grasp_ros.ros.run.tick_profile import SPIN, STAGES
 
 
+@pytest.mark.parametrize("clock_deliveries", [True, False])
 @pytest.mark.parametrize("executor", ["events", "single"])
-def test_the_bare_loop_runs_its_ticks_in_lockstep(executor):
-    rate = bare_loop_rate(200, executor=executor, namespace=f"/test_bare_{os.getpid()}")
+def test_the_bare_loop_runs_its_ticks_in_lockstep(executor, clock_deliveries):
+    rate = bare_loop_rate(200, executor=executor, namespace=f"/test_bare_{os.getpid()}",
+                          clock_deliveries=clock_deliveries)
     assert math.isfinite(rate) and rate > 0
 
 

@@ -70,33 +70,39 @@ def profile_table(path: Path, record: Path) -> Table:
 
 def bare_ratio_table(path: Path, repeats: int, progress) -> Table:
     """Pipeline ticks/s (mechanics excluded, no recording) against the bare loop with the same
-    messages per tick (:mod:`..ros.bare_loop`) on the same executor, interleaved, best of
+    messages per tick (:mod:`..ros.bare_loop`) on the same executor, with the pipeline's 11
+    deliveries a tick and with the 13 of the loop issue 33 measured, interleaved, best of
     ``repeats``.
     """
     rows = []
     for executor, label in EXECUTORS:
-        pipeline, bare, ticks = 0.0, 0.0, 0
+        pipeline, bare, ticks = 0.0, {11: 0.0, 13: 0.0}, 0
         for r in range(repeats):
             progress(f"pipeline: loop against the bare loop, {label}, run {r + 1} of {repeats}")
             summary = PipelineRunner(RunOptions(str(path), executor=executor)).run()
             timing, ticks = summary["timing"], summary["ticks"]
             pipeline = max(pipeline, ticks / (timing["loop"] - timing["mechanics"]))
-            bare = max(bare, bare_loop_rate(ticks, executor=executor,
-                                            namespace=f"/bench_bare_{os.getpid()}"))
-        rows.append([label, ticks, pipeline, bare, 100.0 * pipeline / bare,
-                     f">= {100 * TARGET_RATIO:.0f}"])
+            for deliveries in bare:
+                bare[deliveries] = max(bare[deliveries], bare_loop_rate(
+                    ticks, executor=executor, namespace=f"/bench_bare_{os.getpid()}",
+                    clock_deliveries=deliveries == 13))
+        rows.append([label, ticks, pipeline, bare[11], 100.0 * pipeline / bare[11], bare[13],
+                     100.0 * pipeline / bare[13], f">= {100 * TARGET_RATIO:.0f}"])
     return Table(
         "Lockstep loop against rclpy's floor: the bare loop with the same messages per tick",
-        ["executor", "ticks", "pipeline ticks/s excl. mechanics", "bare loop ticks/s",
-         "pipeline / bare [%]", "target [%]"],
+        ["executor", "ticks", "pipeline ticks/s excl. mechanics",
+         "bare loop, 11 deliveries, ticks/s", "pipeline / bare (11) [%]",
+         "bare loop, 13 deliveries, ticks/s", "pipeline / bare (13) [%]", "target [%]"],
         rows,
         f"Best of {repeats} interleaved runs each; load {_load()}. Pipeline: `squeeze-grasp "
         "run config/scenes/foam_square.yaml` in one process without recording, ticks / (loop "
-        "wall time - the world's mechanics step). Bare loop (ros/bare_loop.py): three nodes and "
-        "a client on the same executor passing the pipeline's 13 messages per tick with 13 "
-        "deliveries (the pipeline's 11 and the clock of the monitor and the executor, which "
-        "they no longer take; "
-        "std_msgs/Header, reliable), lockstep, with no work in the callbacks.",
+        "wall time - the world's mechanics step); 13 messages and 11 deliveries a tick (in "
+        "lockstep the monitor and the executor take no /clock). Bare loop (ros/bare_loop.py): "
+        "three nodes and a client on the same executor passing the pipeline's 13 messages per "
+        "tick (std_msgs/Header, reliable), lockstep, with no work in the callbacks; with 11 "
+        "deliveries (the pipeline's: the target is judged on this column) and with 13 (the "
+        "clock also delivered to the monitor and the executor, as in the loop issue 33 "
+        "measured).",
     )
 
 

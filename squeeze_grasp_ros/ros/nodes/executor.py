@@ -127,7 +127,7 @@ class ExecutorNode(Node):
 
     def ready_summary(self) -> str:
         """What the ready line of ``ros2 run`` says: devices, clock and limits."""
-        clock = "lockstep on /clock" if self.p["lockstep"] else "wall-clock timer"
+        clock = "lockstep on the monitor's statuses" if self.p["lockstep"] else "wall-clock timer"
         driver = self.jaws or self.jaw_action
         carried = "hand fingers" if isinstance(driver, HandCommands) else "jaws"
         jaws = f"{carried} {list(driver.fingers)} on {driver.topic}, " if driver else ""

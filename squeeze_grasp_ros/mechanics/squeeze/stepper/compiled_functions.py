@@ -111,7 +111,8 @@ class CompiledFunctions:
         tip = motion.tip
         values, det, pickup = self.kernel.watched_values(
             sol.delta, sol.F, sol.dtheta, sol.normal_angle, pick, float(model.mu),
-            contacts.slip, motion.radius[contacts.finger], rate if rate > 0 else 1.0, A, R,
+            contacts.slip, motion.contact_tips(contacts.finger).tip.radius,
+            rate if rate > 0 else 1.0, A, R,
             sd.E, functions._boundary[rows], motion.centers(s), tip.radius, tip.flat,
             tip._facing_tangent, contacts.stick, contacts.finger, weight,
             model.obj.rigid_gradients, bounds, GRADIENT_BOUND_EXACT)

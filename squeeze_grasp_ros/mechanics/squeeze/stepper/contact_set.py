@@ -12,9 +12,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from squeeze_grasp_ros.mechanics.squeeze.contact_model import Configuration, ContactModel, SetData
+from squeeze_grasp_ros.mechanics.squeeze.contact_model import ContactModel, SetData
 from squeeze_grasp_ros.mechanics.squeeze.contact_state import ContactState
-from squeeze_grasp_ros.mechanics.squeeze.tip_shapes import TipGeometry
 from squeeze_grasp_ros.mechanics.vocabulary import ContactMode
 
 __all__ = ["ContactSet", "SLIP_RATE_ZERO"]
@@ -85,10 +84,6 @@ class ContactSet:
     def finger_of(self, node: int) -> int:
         """Finger index of contact ``node``."""
         return int(self.finger[self.index(node)])
-
-    def configuration(self, tip: TipGeometry) -> Configuration:
-        """The fixed-set problem's data, with the fingers' tips ``tip`` (f)."""
-        return Configuration(self.positions, self.stick, self.slip, tip.take(self.finger))
 
     def _with(self, stick: np.ndarray, slip: np.ndarray, theta: np.ndarray) -> ContactSet:
         """The same nodes in modes ``stick``, ``slip`` at polar angles ``theta`` (built

@@ -130,12 +130,15 @@ class ContactSet:
             return np.sign(rate).astype(int)
         return self.slip
 
-    def sliding_finger(self, signs: np.ndarray) -> int | None:
+    def sliding_finger(self, signs: np.ndarray, masks: tuple[np.ndarray, ...]) -> int | None:
         """Index of a finger whose contacts all slide the same way (finger slip, Sec. 5.1),
-        given each contact's slip direction ``signs``; None if no finger does.
+        given each contact's slip direction ``signs`` and each finger's contacts ``masks``
+        (:attr:`~.motion.ContactTips.masks`); None if no finger does.
         """
-        for f in sorted(set(self.finger.tolist())):
-            mine = self.finger == f
-            if not self.stick[mine].any() and (np.all(signs[mine] > 0) or np.all(signs[mine] < 0)):
+        if self.stick.all():
+            return None
+        for f, mine in enumerate(masks):
+            if (mine.any() and not self.stick[mine].any()
+                    and (np.all(signs[mine] > 0) or np.all(signs[mine] < 0))):
                 return f
         return None

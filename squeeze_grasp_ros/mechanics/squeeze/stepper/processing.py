@@ -340,7 +340,8 @@ class EventProcessor:
         if Termination.FINGER_SLIP not in self.functions.terminate_on:
             return None
         signs = self.contacts.slip_signs(sol.dtheta, self.functions.frictionless)
-        f = self.contacts.sliding_finger(signs)
+        f = self.contacts.sliding_finger(
+            signs, self.motion.contact_tips(self.contacts.finger).masks)
         return None if f is None else self.motion.names[f]
 
     def termination(self, sol: Solution) -> Termination | None:

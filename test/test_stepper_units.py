@@ -152,10 +152,12 @@ def test_a_contact_set_is_sorted_and_changes_by_new_values():
 
 def test_a_finger_slips_when_all_its_contacts_slide_one_way():
     c = synthetic_set([(True, 0), (False, 1), (False, 1), (False, -1)], fingers=[0, 0, 1, 1])
-    assert c.sliding_finger(c.slip) is None
+    masks = tuple(c.finger == f for f in range(3))  # a third finger without contacts
+    assert c.sliding_finger(c.slip, masks) is None
     both = c.with_mode(0, False, 1)
-    assert both.sliding_finger(both.slip) == 0
-    assert c.with_mode(3, False, 1).sliding_finger(np.array([0, 1, 1, 1])) == 1
+    assert both.sliding_finger(both.slip, masks) == 0
+    assert c.with_mode(3, False, 1).sliding_finger(np.array([0, 1, 1, 1]), masks) == 1
+    assert c.with_mode(1, True, 0).sliding_finger(c.slip * 0, masks) is None
     dtheta = np.array([1e-12, 2.0, 3.0, -1.0])
     assert list(c.slip_signs(dtheta, frictionless=True)) == [0, 1, 1, -1]
 

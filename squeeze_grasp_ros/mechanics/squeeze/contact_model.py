@@ -397,6 +397,7 @@ def attempt_fixed_set(
     dirs: np.ndarray,
     theta0: np.ndarray,
     phi: float,
+    *, kernel: Kernel | None = None,
 ) -> Solution | SolveFailure:
     """Solve the sliding constraints (eq. 47) for one contact set at given tip positions.
 
@@ -417,6 +418,9 @@ def attempt_fixed_set(
         initial guess for sliding ones.
     phi : float
         Friction angle atan(mu), rad.
+    kernel : Kernel, optional
+        The route of a linear response (default :func:`~.fixed_set_kernel.selected`: a caller
+        that solves many times reads the environment once).
 
     Returns
     -------
@@ -424,7 +428,8 @@ def attempt_fixed_set(
         The failure when Newton does not converge, its Jacobian is singular or it produces
         non-finite values.
     """
-    if isinstance(response, LinearResponse) and selected() == Kernel.NUMBA:
+    if isinstance(response, LinearResponse) and (
+            selected() if kernel is None else kernel) == Kernel.NUMBA:
         return _attempt_compiled(response.C, cfg, centers, dirs, theta0, phi)
     m = len(theta0)
     theta = np.array(theta0, float)

@@ -411,11 +411,14 @@ def segment_node(c: ContactNode, mu: float) -> SegmentNode:
     )
 
 
-def grasp_health(model: ContactModel, state: ContactState) -> tuple[GraspHealth, np.ndarray]:
+def grasp_health(model: ContactModel, state: ContactState, *,
+                 summaries: Sequence[SegmentNode] | None = None
+                 ) -> tuple[GraspHealth, np.ndarray]:
     """Grasp-health numbers and the full displacement field (n, 2), m, of ``state``.
 
     One sparse solve (K+ F + R g) for the field (the nonlinear models keep theirs); strains in
-    every measure and the model's stress per element.
+    every measure and the model's stress per element. ``summaries``: the :func:`segment_node`
+    of each of the state's contacts, in its order, when the caller has them.
     """
     obj = model.obj
     L, fu = model.length, model.force_unit
@@ -431,9 +434,11 @@ def grasp_health(model: ContactModel, state: ContactState) -> tuple[GraspHealth,
     vm = von_mises(stress)
     u = u_hat.reshape(-1, 2) * L
     norms = np.linalg.norm(u, axis=1)
+    if summaries is None:
+        summaries = [segment_node(c, model.mu) for c in state.contacts]
     margins = {}
     for f in state.fingers:
-        seg = [segment_node(c, model.mu).slip_margin for c in state.contacts if c.finger == f.name]
+        seg = [n.slip_margin for c, n in zip(state.contacts, summaries) if c.finger == f.name]
         if seg:
             margins[f.name] = float(min(seg))
     health = GraspHealth(
@@ -452,6 +457,15 @@ def grasp_health(model: ContactModel, state: ContactState) -> tuple[GraspHealth,
     require_finite("grasp health", [strain, *health.max_principal_strain.values(),
                                     health.max_von_mises, health.max_displacement])
     return health, u
+
+
+def _segment(state: ContactState, summaries: Sequence[SegmentNode],
+             name: str) -> tuple[SegmentNode, ...]:
+    """The :func:`segment_node` ``summaries`` of the state's contacts on finger ``name``, in
+    the order of :meth:`~.contact_state.ContactState.segment`.
+    """
+    mine = [(c, n) for c, n in zip(state.contacts, summaries) if c.finger == name]
+    return tuple(n for _, n in sorted(mine, key=lambda pair: pair[0].theta))
 
 
 def polar_trajectories(samples: tuple[Sample, ...], relative_per_depth: float) -> dict:
@@ -568,7 +582,8 @@ def event_squeeze(
         checkpoint=checkpoint,
     )
     state = run.state
-    health, u_field = grasp_health(model, state)
+    summaries = [segment_node(c, mu) for c in state.contacts]
+    health, u_field = grasp_health(model, state, summaries=summaries)
     L, fu = model.length, model.force_unit
     delta = np.array([c.displacement for c in state.contacts]) / L
     F = np.array([c.force for c in state.contacts]) / fu
@@ -598,7 +613,7 @@ def event_squeeze(
         mu=float(mu),
         tip_radius=radii,
         events=run.events,
-        segments={n: tuple(segment_node(c, mu) for c in state.segment(n)) for n in names},
+        segments={n: _segment(state, summaries, n) for n in names},
         energy=energy,
         work={f.name: f.work for f in state.fingers},
         dissipation={f.name: f.dissipation for f in state.fingers},

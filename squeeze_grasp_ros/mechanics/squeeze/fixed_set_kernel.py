@@ -14,7 +14,8 @@ are the same, and its elementwise arithmetic is written in numpy's order, so the
 the same floats: the example sweep's 288 rows and the golden runs are identical bit for bit
 (docs/design.md, "The evaluation kernel").
 
-The route is chosen at each solve: :data:`KERNEL_VARIABLE` = ``numpy`` or ``numba``
+The route is chosen at each solve (once per stepper call for the stepper's solves):
+:data:`KERNEL_VARIABLE` = ``numpy`` or ``numba``
 (:class:`Kernel`); unset means numpy, because a process pays numba's import and the load of its
 cached code (about 0.2 s of CPU; 12 s to compile on first use after an install) for a few
 milliseconds saved per evaluation. ``squeeze-grasp sweep`` and the large bench sweep, whose

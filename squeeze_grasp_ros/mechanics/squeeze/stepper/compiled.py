@@ -113,7 +113,7 @@ class CompiledSubsteps:
             return kept[2]
         model, functions, motion = self.call.model, self.call.functions, self.call.motion
         sd = contacts.data
-        tip = motion.tip.take(contacts.finger)
+        tip = motion.contact_tips(contacts.finger).tip
         A_rows, R_rows = model._boundary_rows(sd, rows)
         _, pick = functions._contact_entries(contacts, held)
         # E in the set's own layout: the kernel's E.T @ delta is then numpy's product

@@ -40,6 +40,9 @@ __all__ = ["CompiledFunctions"]
 _NO_BOUNDS = np.zeros((0, 0))
 _NO_KAPPA = np.zeros(0)
 _NO_VALUES = np.zeros(0)
+ROW_TABLES_KEPT = 32
+"""Tables of (contact set, boundary rows) the compiled reads of a call keep
+(:meth:`CompiledFunctions._rows_of`)."""
 
 
 class CompiledFunctions:
@@ -53,6 +56,7 @@ class CompiledFunctions:
         self.functions = functions
         self.kernel = compiled_substeps()
         self._last: tuple | None = None
+        self._rows: dict[tuple, tuple] = {}
 
     @classmethod
     def of(cls, functions: EventFunctions) -> CompiledFunctions | None:
@@ -102,18 +106,17 @@ class CompiledFunctions:
             if last[2] == s and np.array_equal(last[3], rows) and np.array_equal(last[4], pick):
                 return last[5], last[6], last[7]
         functions = self.functions
-        model, motion, sd = functions.model, functions.motion, contacts.data
+        model, motion = functions.model, functions.motion
         lim, rate = model.limits, motion.rate
-        A, R = model._boundary_rows(sd, rows)
+        _, A, R, points, bounds = self._rows_of(contacts, rows)
         weight = (lim.weight / model.force_unit if lim.weight is not None
                   and Termination.PICKED_UP in functions.terminate_on else np.nan)
-        bounds = model.area_tables(sd)[0] if rate > 0 else _NO_BOUNDS
         tip = motion.tip
         values, det, pickup = self.kernel.watched_values(
             sol.delta, sol.F, sol.dtheta, sol.normal_angle, pick, float(model.mu),
-            contacts.slip, motion.radius[contacts.finger], rate if rate > 0 else 1.0, A, R,
-            sd.E, functions._boundary[rows], motion.centers(s), tip.radius, tip.flat,
-            tip._facing_tangent, contacts.stick, contacts.finger, weight,
+            contacts.slip, motion.contact_tips(contacts.finger).tip.radius,
+            rate if rate > 0 else 1.0, A, R, contacts.data.E, points, motion.centers(s),
+            tip.radius, tip.flat, tip._facing_tangent, contacts.stick, contacts.finger, weight,
             model.obj.rigid_gradients, bounds, GRADIENT_BOUND_EXACT)
         self._last = (contacts, sol, s, rows, pick, values, det, pickup)
         return values, det, pickup
@@ -123,12 +126,30 @@ class CompiledFunctions:
         """(the gap slopes of ``rows`` to every finger, each contact's normal-force and
         cone-margin slopes), raveled, at ``sol``.
         """
-        functions = self.functions
-        model, motion, sd = functions.model, functions.motion, contacts.data
-        A, R = model._boundary_rows(sd, rows)
+        motion = self.functions.motion
+        _, A, R, points, _ = self._rows_of(contacts, rows)
         tip = motion.tip
         return self.kernel.slope_values(
             sol.delta, sol.F, sol.ddelta, sol.dF, sol.dtheta, sol.normal_angle,
-            _NO_KAPPA if sol.kappa is None else sol.kappa, float(model.mu), A, R, sd.E,
-            functions._boundary[rows], motion.centers(s), motion.translation, tip.flat,
+            _NO_KAPPA if sol.kappa is None else sol.kappa, float(self.functions.model.mu), A, R,
+            contacts.data.E, points, motion.centers(s), motion.translation, tip.flat,
             tip._facing_tangent)
+
+    def _rows_of(self, contacts: ContactSet, rows: np.ndarray) -> tuple:
+        """(the set's data, the rows of its boundary compliance and rigid modes, the rows'
+        undeformed positions, the area bounds or none while the fingers stay) of ``contacts``
+        and boundary ``rows``: kept for the call's last few sets (a point's reads and the
+        substeps of a set ask for the same ones).
+        """
+        sd = contacts.data
+        tag = (id(sd), rows.dtype.str, rows.tobytes())
+        made = self._rows.get(tag)
+        if made is None or made[0] is not sd:
+            if len(self._rows) >= ROW_TABLES_KEPT:
+                self._rows.clear()
+            functions = self.functions
+            model = functions.model
+            made = self._rows[tag] = (
+                sd, *model._boundary_rows(sd, rows), functions._boundary[rows],
+                model.area_tables(sd)[0] if functions.motion.rate > 0 else _NO_BOUNDS)
+        return made

@@ -160,7 +160,7 @@ class CompiledLocation:
                             [watched_b.values[key] for key in crossed], *slopes_a, *slopes_b,
                             [key.at_node in fresh for key in crossed]], float)
         order = np.array([call.events.order(key) for key in crossed], float)
-        cfg = contacts.configuration(motion.tip)
+        tip = motion.contact_tips(contacts.finger).tip
         origin, D, radius_f, flat_f, t0_f = self.fingers
         m, n = len(contacts), int(np.count_nonzero(~contacts.stick))
         pts = (np.empty(CAPACITY), np.empty((CAPACITY, m)), np.empty((CAPACITY, m, 2)),
@@ -174,12 +174,12 @@ class CompiledLocation:
                                            1.0 if sol.kappa is None else sol.kappa)):
                 array[p] = x
         fun = (float(model.mu), contacts.slip,
-               np.ascontiguousarray(motion.radius[contacts.finger], float), float(motion.rate),
+               np.ascontiguousarray(tip.radius, float), float(motion.rate),
                GA, GR, B0, sd.E, origin, D, radius_f, flat_f, t0_f)
-        prob = (np.ascontiguousarray(sd.C), np.ascontiguousarray(cfg.p0, float), cfg.stick,
-                cfg.slip, float(model.phi), np.ascontiguousarray(cfg.tip.radius, float),
-                np.ascontiguousarray(cfg.tip.flat, float),
-                np.ascontiguousarray(cfg.tip.facing, float), contacts.finger, origin, D,
+        prob = (np.ascontiguousarray(sd.C), np.ascontiguousarray(contacts.positions, float),
+                contacts.stick, contacts.slip, float(model.phi),
+                np.ascontiguousarray(tip.radius, float), np.ascontiguousarray(tip.flat, float),
+                np.ascontiguousarray(tip.facing, float), contacts.finger, origin, D,
                 NEWTON_TOL, NEWTON_MAX_ITERATIONS, NEWTON_BACKTRACKS, CONTINUATION_ITERATIONS,
                 MAX_ANGLE_JUMP)
         s_e, evaluations, solved = self.kernel.earliest_crossing(

@@ -12,9 +12,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from squeeze_grasp_ros.mechanics.squeeze.contact_model import Configuration, ContactModel, SetData
+from squeeze_grasp_ros.mechanics.squeeze.contact_model import ContactModel, SetData
 from squeeze_grasp_ros.mechanics.squeeze.contact_state import ContactState
-from squeeze_grasp_ros.mechanics.squeeze.tip_shapes import TipGeometry
 from squeeze_grasp_ros.mechanics.vocabulary import ContactMode
 
 __all__ = ["ContactSet", "SLIP_RATE_ZERO"]
@@ -86,10 +85,6 @@ class ContactSet:
         """Finger index of contact ``node``."""
         return int(self.finger[self.index(node)])
 
-    def configuration(self, tip: TipGeometry) -> Configuration:
-        """The fixed-set problem's data, with the fingers' tips ``tip`` (f)."""
-        return Configuration(self.positions, self.stick, self.slip, tip.take(self.finger))
-
     def _with(self, stick: np.ndarray, slip: np.ndarray, theta: np.ndarray) -> ContactSet:
         """The same nodes in modes ``stick``, ``slip`` at polar angles ``theta`` (built
         directly: :func:`dataclasses.replace` reads the fields' metadata at every call, and a
@@ -135,12 +130,15 @@ class ContactSet:
             return np.sign(rate).astype(int)
         return self.slip
 
-    def sliding_finger(self, signs: np.ndarray) -> int | None:
+    def sliding_finger(self, signs: np.ndarray, masks: tuple[np.ndarray, ...]) -> int | None:
         """Index of a finger whose contacts all slide the same way (finger slip, Sec. 5.1),
-        given each contact's slip direction ``signs``; None if no finger does.
+        given each contact's slip direction ``signs`` and each finger's contacts ``masks``
+        (:attr:`~.motion.ContactTips.masks`); None if no finger does.
         """
-        for f in sorted(set(self.finger.tolist())):
-            mine = self.finger == f
-            if not self.stick[mine].any() and (np.all(signs[mine] > 0) or np.all(signs[mine] < 0)):
+        if self.stick.all():
+            return None
+        for f, mine in enumerate(masks):
+            if (mine.any() and not self.stick[mine].any()
+                    and (np.all(signs[mine] > 0) or np.all(signs[mine] < 0))):
                 return f
         return None

@@ -18,9 +18,36 @@ import numpy as np
 
 from squeeze_grasp_ros.mechanics.errors import InvalidInputError, require_finite
 from squeeze_grasp_ros.mechanics.squeeze.contact_state import ContactState, tip_geometry
+from squeeze_grasp_ros.mechanics.squeeze.kept import kept_property
 from squeeze_grasp_ros.mechanics.squeeze.tip_shapes import TipGeometry
 
-__all__ = ["FingerMotion"]
+__all__ = ["ContactTips", "FingerMotion"]
+
+CONTACT_TIPS_KEPT = 16
+"""Contact sets whose :class:`ContactTips` a motion keeps (a call has a few sets)."""
+
+
+@dataclass(frozen=True)
+class ContactTips:
+    """The motion's per-finger data taken at a contact set's finger indices (m contacts).
+
+    Attributes
+    ----------
+    tip : TipGeometry
+        Each contact's tip (m), lengths / L.
+    start, translation : (m, 2) ndarray
+        Each contact's finger's start and translation, / L.
+    masks : tuple of (m,) ndarray of bool
+        Per finger of the motion, its contacts.
+    present : tuple of bool
+        Per finger, whether it has contacts.
+    """
+
+    tip: TipGeometry
+    start: np.ndarray
+    translation: np.ndarray
+    masks: tuple[np.ndarray, ...]
+    present: tuple[bool, ...]
 
 
 @dataclass(frozen=True)
@@ -65,6 +92,26 @@ class FingerMotion:
         zeros = np.zeros(len(self.radius))
         return TipGeometry(self.radius, zeros if self.flat is None else self.flat,
                            zeros if self.facing is None else self.facing)
+
+    @kept_property
+    def _contact_tips(self) -> dict[int, tuple[np.ndarray, ContactTips]]:
+        return {}
+
+    def contact_tips(self, finger: np.ndarray) -> ContactTips:
+        """The :class:`ContactTips` of the contacts on fingers ``finger`` (a contact set's
+        finger indices), kept while the set's array is (the sets of one node set share it):
+        the fixed-set solves, the work and the samples read them at every point.
+        """
+        kept = self._contact_tips
+        made = kept.get(id(finger))
+        if made is None or made[0] is not finger:
+            if len(kept) >= CONTACT_TIPS_KEPT:
+                kept.clear()
+            masks = tuple(finger == f for f in range(len(self.names)))
+            made = kept[id(finger)] = (finger, ContactTips(
+                self.tip.take(finger), self.start[finger], self.translation[finger], masks,
+                tuple(bool(mine.any()) for mine in masks)))
+        return made[1]
 
     @classmethod
     def of(cls, state: ContactState, translations: Mapping[str, tuple[float, float]],

@@ -339,8 +339,8 @@ class EventProcessor:
         """A finger whose contact nodes all slide the same way (Sec. 5.1), or None."""
         if Termination.FINGER_SLIP not in self.functions.terminate_on:
             return None
-        signs = self.contacts.slip_signs(sol.dtheta, self.functions.frictionless)
-        f = self.contacts.sliding_finger(signs)
+        c, tips = self.contacts, self.motion.contact_tips(self.contacts.finger)
+        f = c.sliding_finger(c.slip_signs(sol.dtheta, self.functions.frictionless), tips.masks)
         return None if f is None else self.motion.names[f]
 
     def termination(self, sol: Solution) -> Termination | None:

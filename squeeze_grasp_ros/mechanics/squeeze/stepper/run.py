@@ -209,16 +209,15 @@ class _Call:
         the slip, 0 while sticking) is what friction dissipates.
         """
         h = b - a
-        finger, D = self.events.contacts.finger, self.motion.translation
+        tips, D = self.motion.contact_tips(self.events.contacts.finger), self.motion.translation
         # no node slides at either end: the dissipation adds zeros (it is never -0.0)
         sliding = sa.dtheta.any() or sb.dtheta.any()
         if sliding:
-            r = self.motion.radius[finger]
+            r = tips.tip.radius
             pa = -sa.tangential * r * sa.dtheta
             pb = -sb.tangential * r * sb.dtheta
-        for f in range(len(self.motion.names)):
-            mine = finger == f
-            if not mine.any():
+        for f, (mine, present) in enumerate(zip(tips.masks, tips.present)):
+            if not present:
                 continue
             ya, yb = sa.F[mine].sum(axis=0) @ D[f], sb.F[mine].sum(axis=0) @ D[f]
             ra, rb = sa.dF[mine].sum(axis=0) @ D[f], sb.dF[mine].sum(axis=0) @ D[f]
@@ -229,10 +228,9 @@ class _Call:
     def record(self, sol: Solution) -> None:
         """Append a trajectory sample at the current point."""
         contacts, fu = self.events.contacts, self.model.force_unit
-        forces = {
-            name: tuple((sol.F[contacts.finger == f].sum(axis=0) * fu).tolist())
-            for f, name in enumerate(self.motion.names)
-        }
+        masks = self.motion.contact_tips(contacts.finger).masks
+        forces = {name: tuple((sol.F[mine].sum(axis=0) * fu).tolist())
+                  for name, mine in zip(self.motion.names, masks)}
         self.samples.append(Sample(self.events.depth, tuple(contacts.nodes.tolist()),
                                    tuple(sol.theta.tolist()), forces))
 

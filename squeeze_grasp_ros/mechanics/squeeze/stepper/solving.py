@@ -9,17 +9,19 @@ solution from one point to another and halves a substep whose continuation fails
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, fields
+from dataclasses import dataclass, field, fields
 
 import numpy as np
 
 from squeeze_grasp_ros.mechanics.errors import NumericalError
 from squeeze_grasp_ros.mechanics.squeeze.contact_model import (
+    Configuration,
     ContactModel,
     Solution,
     SolveFailure,
     attempt_fixed_set,
 )
+from squeeze_grasp_ros.mechanics.squeeze.fixed_set_kernel import Kernel, selected
 from squeeze_grasp_ros.mechanics.squeeze.stepper.contact_set import ContactSet
 from squeeze_grasp_ros.mechanics.squeeze.stepper.motion import FingerMotion
 
@@ -79,23 +81,27 @@ class Counters:
 
 @dataclass(frozen=True)
 class SetSolver:
-    """Fixed-set solves of one call (model, finger motion; counts into ``counters``)."""
+    """Fixed-set solves of one call (model, finger motion; counts into ``counters``; the
+    route of the linear model's solve, ``kernel``, is read once for the call).
+    """
 
     model: ContactModel
     motion: FingerMotion
     counters: Counters
+    kernel: Kernel = field(default_factory=selected)
 
     def attempt(self, contacts: ContactSet, s: float,
                 theta: np.ndarray | None = None) -> Solution | SolveFailure:
         """The solution of ``contacts`` at s (from ``theta``, default the set's), or why none."""
-        motion, f = self.motion, contacts.finger
+        tips = self.motion.contact_tips(contacts.finger)
         sol = attempt_fixed_set(
             self.model.response(contacts.data),
-            contacts.configuration(motion.tip),
-            motion.start[f] + s * motion.translation[f],
-            motion.translation[f],
+            Configuration(contacts.positions, contacts.stick, contacts.slip, tips.tip),
+            tips.start + s * tips.translation,
+            tips.translation,
             contacts.theta if theta is None else theta,
             self.model.phi,
+            kernel=self.kernel,
         )
         if not isinstance(sol, SolveFailure):
             self.counters.note(sol)

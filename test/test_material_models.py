@@ -215,34 +215,6 @@ def test_a_response_returns_to_a_kept_state_without_solving(patch):
     assert abs(oldest.energy - first[0].energy) < 1e-12 * first[0].energy
 
 
-def test_a_delta_one_ulp_from_a_kept_one_takes_its_stiffness_without_factorising(patch):
-    """The stepper recomputes a kept delta one unit in the last place away: that state is
-    solved (its own field, forces and energy) but takes the kept state's dF/d delta, whose
-    field it matches to round-off, instead of a factorisation of its own.
-    """
-    left, right = np.argsort(patch.nodes[:, 0])[:2], np.argsort(-patch.nodes[:, 0])[:2]
-
-    def response():
-        return ContactResponse(MaterialModel.NEO_HOOKEAN, patch.nodes / 0.1, patch.triangles,
-                               np.r_[left, right], 0.3)
-
-    delta, other = np.zeros((4, 2)), np.zeros((4, 2))
-    delta[:2, 0], delta[2:, 0], other[:2, 0], other[2:, 0] = 0.01, -0.01, 0.02, -0.02
-    shared = response()
-    kept = shared.evaluate(delta)
-    shared.evaluate(other)
-    before = dict(shared.stats)
-    near = np.nextafter(delta, 1.0)
-    out = shared.evaluate(near)
-    assert shared.stats["evaluations"] == before["evaluations"] + 1
-    assert shared.stats["factorizations"] == before["factorizations"]
-    assert out.C is kept.C and not np.array_equal(out.u, kept.u)
-    fresh = response().evaluate(near)
-    v = np.random.default_rng(5).standard_normal(8)
-    assert np.abs(out.C @ v - fresh.C @ v).max() < 1e-12 * np.abs(fresh.C @ v).max()
-    assert np.abs(out.F - fresh.F).max() < 1e-12 * np.abs(fresh.F).max()
-
-
 def test_the_linear_law_is_the_cst_stiffness(patch):
     K = stiffness_matrix(patch, 0.3)
     u = np.random.default_rng(3).standard_normal(2 * patch.n) * 1e-3

@@ -72,12 +72,6 @@ continued from takes that state's tangent: as its own (KNOWN_STATE: its dF/d del
 from the exact one by about 1e-9 of its largest entry, within RESPONSE_ACCURACY of the contact
 model) or for Newton's first factorisation (KNOWN_START). A node that touched a tip within the
 event tolerance moves the field by 1e-10 to 3e-8 of it."""
-KEPT_TANGENT = 1e-12
-"""A converged state this close (relative, largest nodal displacement) to a kept state of its
-contact set takes that state's dF/d delta (no tangent, no factorisation): the stepper returns
-to a kept delta recomputed one unit in the last place away, Newton stops at once, and the two
-fields differ by 1e-16 to 1e-13 of their largest displacement, so the two tangents agree to
-round-off."""
 REUSE_CONTRACTION = 0.25
 BACKTRACKS = 30
 
@@ -87,16 +81,6 @@ def _others(n: int, dofs: np.ndarray) -> np.ndarray:
     kept = np.ones(n, dtype=bool)
     kept[dofs] = False
     return np.flatnonzero(kept)
-
-
-def _kept_stiffness(kept: list, u: np.ndarray) -> "ContactStiffness | None":
-    """dF/d delta of the ``kept`` (delta, Evaluation) whose field is ``u`` to KEPT_TANGENT
-    (relative, largest nodal displacement), else None.
-    """
-    for _, out in reversed(kept):
-        if np.abs(u - out.u).max() <= KEPT_TANGENT * max(np.abs(out.u).max(), DISPLACEMENT_FLOOR):
-            return out.C
-    return None
 
 
 @dataclass(frozen=True)
@@ -404,7 +388,9 @@ class ContactResponse:
             if np.abs(nearest[0] - delta).max() < np.abs(self._delta - delta).max():
                 self._recall(nearest[0])
         base_u, base_d = self._u, self._delta
-        target, done, its, fraction, result = delta, 0.0, 0, 1.0, None
+        target, done, its = delta, 0.0, 0
+        fraction = 1.0
+        result = None
         for _ in range(MAX_SUBSTEPS):
             goal = base_d + (done + fraction) * (target - base_d)
             out = self._newton(base_u if result is None else result[0], goal)
@@ -424,11 +410,10 @@ class ContactResponse:
         u, asm, _, residual = result
         self.stats["iterations"] += its
         K = asm.tangent if asm.tangent is not None else self._known(u, KNOWN_STATE)
-        C = _kept_stiffness(self._kept, u) if K is None else None
-        if C is None:
-            C = self._stiffness_of(K if K is not None else with_tangent(
-                self.model, asm, nu=self.nu, geometry=self.geometry).tangent)
+        if K is None:
+            K = with_tangent(self.model, asm, nu=self.nu, geometry=self.geometry).tangent
         self._known_tangent = None
+        C = self._stiffness_of(K)
         if C is None:
             return ResponseFailure("the interior tangent is singular at equilibrium", residual)
         F = asm.force[self.cdofs].reshape(-1, 2)

@@ -240,15 +240,19 @@ def _require_compressible(nu: float) -> None:
 
 
 def _neo_hookean_terms(F: np.ndarray, J2: np.ndarray, nu: float, *,
-                       l3: np.ndarray | None = None, start: np.ndarray | None = None) -> tuple:
+                       l3: np.ndarray | None = None, start: np.ndarray | None = None,
+                       inverse: bool = True) -> tuple:
     """(lam, mu, l3, ln(J2 l3), G = F^-T, a = lam ln J - mu) of the neo-Hookean law at the
     deformation gradients ``F`` with det F = ``J2``; ``l3``: their thickness stretches when
-    known, else solved here (from ``start``: :func:`_thickness_stretch`).
+    known, else solved here (from ``start``: :func:`_thickness_stretch`). ``inverse=False``:
+    G and a are None (the compiled kernel forms them per element).
     """
     _require_compressible(nu)
     lam, mu = _lame(nu)
     l3 = _thickness_stretch(J2, lam, mu, start) if l3 is None else l3
     lnJ = np.log(J2 * l3)
+    if not inverse:
+        return lam, mu, l3, lnJ, None, None
     G = np.empty_like(F)  # F^-T
     G[:, 0, 0], G[:, 1, 1] = F[:, 1, 1], F[:, 0, 0]
     G[:, 0, 1], G[:, 1, 0] = -F[:, 1, 0], -F[:, 0, 1]
@@ -415,7 +419,8 @@ def assemble(model: MaterialModel | str, nodes: np.ndarray, triangles: np.ndarra
         raise InvertedElementError(f"element {worst} inverted (det F = {det[worst]:.3g})",
                                    residuals={"det_F": det[worst]})
     neo = MaterialModel(model) == MaterialModel.NEO_HOOKEAN
-    terms = _neo_hookean_terms(F, det, nu, start=stretch) if neo else None
+    terms = (_neo_hookean_terms(F, det, nu, start=stretch, inverse=not geometry.compiled)
+             if neo else None)
     if neo and geometry.compiled:
         energy, force, data = _compiled_neo_hookean(geometry, F, terms, tangent)
     else:
@@ -442,7 +447,8 @@ def with_tangent(model: MaterialModel | str, assembly: Assembly, *, nu: float,
         return assembly
     F = assembly.deformation
     if MaterialModel(model) == MaterialModel.NEO_HOOKEAN:
-        terms = _neo_hookean_terms(F, determinants(F), nu, l3=assembly.stretch)
+        terms = _neo_hookean_terms(F, determinants(F), nu, l3=assembly.stretch,
+                                   inverse=not geometry.compiled)
         data = (_compiled_neo_hookean(geometry, F, terms, True)[2] if geometry.compiled
                 else _neo_hookean_stiffness(geometry, terms))
     else:

@@ -25,12 +25,13 @@ Within one sticking mode everything but the finger positions stays: the set's st
 offsets, the watched rows and contacts, each contact's node, finger and angles. The first quiet
 call of a mode keeps them (:class:`_Mode`, until the next full call or until a hold of the
 chattering bound expires), and the calls after it compute only what moves: the two solves, the
-work integral, the samples' finger forces, the contacts' displacements and forces. Every watched
-function is then affine in the fingers' translation, with a rate the mode fixes
-(:class:`~.travel.TravelRates`): where the functions are evaluated (the mode's first call, and
-whenever the fingers leave the last reach) they give a travel within which none can reach the
-margin, and a call that ends within it evaluates none. Only the strain limit and the pickup
-margin, when declared, are evaluated at every call.
+work integral, the samples' finger forces, the contacts' displacements and forces. The
+contacts' normal forces and cone margins are linear in the forces (one product with the mode's
+``margins`` per call); the free rows' gaps and the area check change by at most a rate the mode
+fixes times the fingers' translation (:class:`~.travel.TravelRates`): where they are evaluated
+(the mode's first call, and whenever the fingers leave the last reach) they give a travel
+within which neither can reach the margin, and a call that ends within it evaluates neither.
+The strain limit and the pickup margin, when declared, are evaluated at every call.
 """
 from __future__ import annotations
 
@@ -180,15 +181,17 @@ class QuietSteps:
 
     def _within(self, end: np.ndarray, delta: np.ndarray, F: np.ndarray, D: np.ndarray) -> bool:
         """Whether every watched function of the mode is above :data:`QUIET_MARGIN` at the end
-        of the call (tips at ``end``, the set at ``delta``, ``F``): from the reach of their last
-        evaluation when the end lies within it (the terminations declared evaluated), else
-        evaluated there (and the reach renewed).
+        of the call (tips at ``end``, the set at ``delta``, ``F``): the contact functions (affine
+        along the call, so above it all along when above at both ends) and the terminations
+        declared evaluated; the gaps and the area check from the reach of their last evaluation
+        when the end lies within it, else evaluated there (and the reach renewed).
         """
         mode = self._mode
         ref, reach2 = self._reach
         off = (end - ref).ravel()
         if off @ off < reach2:
-            return not self._terminations or self._terminations_clear(mode, delta, F, D)
+            return (_clear(mode.margins, F)
+                    and (not self._terminations or self._terminations_clear(mode, delta, F, D)))
         reach = self._evaluate(mode, end, delta, F, D)
         if reach <= 0.0:
             return False
@@ -213,22 +216,18 @@ class QuietSteps:
         names, fingers, L = motion.names, contacts.finger, model.length
         rows = functions.free_rows(contacts, held)
         thetas = np.array(contacts.theta, float).tolist()
-        watched = None if watched.all() else watched
-        normal = sticking.unit if watched is None else sticking.unit[watched]
-        along = sticking.tangent if watched is None else sticking.tangent[watched]
         radius, flat, facing = (motion.radius * L, (motion.tip.flat * L).tolist(),
                                 motion.tip.facing.tolist())
         return _Mode(
-            sticking, names, frozenset(names), motion.tip, functions, rows, watched, normal,
-            along, expiry,
+            sticking, names, frozenset(names), motion.tip, functions, rows,
+            _margins(sticking, watched, model.mu), expiry,
             tuple((names[f], _rows_of(fingers == f), bool((fingers == f).any()), radius[f],
                    flat[f], facing[f]) for f in range(len(names))),
             tuple(ContactNode(node, names[f], ContactMode.STICK, 0, theta, None, None, nu)
                   for node, f, theta, nu in zip(contacts.nodes.tolist(), fingers.tolist(),
                                                 thetas, sticking.nu.tolist())),
             tuple(contacts.nodes.tolist()), tuple(thetas),
-            TravelRates.of(model, contacts, len(names), rows, watched, normal, along,
-                           self.area),
+            TravelRates.of(model, contacts, len(names), rows, self.area),
             L, model.force_unit, model._cache)
 
     def _motion(self, state: ContactState,
@@ -275,24 +274,20 @@ class QuietSteps:
                   D: np.ndarray) -> float:
         """Evaluate every function a call watches at the configuration ``delta``, ``F`` with
         the tips at ``centers`` (the mode's contacts not held, its free boundary rows, the
-        terminations checked): the travel within which none reaches :data:`QUIET_MARGIN`
-        (:meth:`~.travel.TravelRates.travel`), 0.0 when one is at or below it already.
+        terminations checked): the travel within which neither the gaps nor the area check
+        reaches :data:`QUIET_MARGIN` (:meth:`~.travel.TravelRates.travel`), 0.0 when a function
+        is at or below it already.
         """
         self.evaluations += 1
         if self._terminations and not self._terminations_clear(mode, delta, F, D):
             return 0.0
-        watched = F if mode.watched is None else F[mode.watched]
-        fn = np.einsum("ij,ij->i", watched, mode.unit)
-        ft = np.einsum("ij,ij->i", watched, mode.tangent)
+        if not _clear(mode.margins, F):
+            return 0.0
         sd, rows = mode.sticking.contacts.data, mode.rows
         points = self._boundary[rows] + self.model.boundary_displacement(sd, delta, F, rows)
         gaps = mode.tip.gaps(points, centers)
-        lowest = min(fn.min(initial=np.inf), gaps.min(initial=np.inf))
-        if not lowest > QUIET_MARGIN:
-            return 0.0
         reserve = self.area.reserve(sd, delta, F, INVERSION_AREA_RATIO + QUIET_MARGIN)
-        return mode.rates.travel(fn, self.model.mu * fn - np.abs(ft), gaps, reserve,
-                                 QUIET_MARGIN)
+        return mode.rates.travel(gaps, reserve, QUIET_MARGIN)
 
     def _terminations_clear(self, mode: _Mode, delta: np.ndarray, F: np.ndarray,
                             D: np.ndarray) -> bool:
@@ -347,6 +342,26 @@ class QuietSteps:
         return StepResult(new, (), 1.0, None, samples, (), diagnostics, self.step)
 
 
+def _margins(sticking: _Sticking, watched: np.ndarray, mu: float) -> np.ndarray:
+    """The ``watched`` contacts' (mask) normal forces f_n = u . F_k and cone margins
+    mu f_n -+ f_t (f_t = t . F_k) as rows of one map of the set's forces (m, 2) flattened:
+    (3w, 2m), w the contacts watched.
+    """
+    rows = np.flatnonzero(watched)
+    u, t = sticking.unit[rows], sticking.tangent[rows]
+    k = np.arange(len(rows))
+    margins = np.zeros((3, len(rows), len(watched), 2))
+    margins[0, k, rows], margins[1, k, rows], margins[2, k, rows] = u, mu * u - t, mu * u + t
+    return margins.reshape(3 * len(rows), -1)
+
+
+def _clear(margins: np.ndarray, F: np.ndarray) -> bool:
+    """Whether every contact function of ``margins`` (:func:`_margins`) is above
+    :data:`QUIET_MARGIN` at the forces ``F`` (m, 2).
+    """
+    return bool((margins @ F.reshape(-1)).min(initial=np.inf) > QUIET_MARGIN)
+
+
 def _one_substep(step: float, rate: float) -> bool:
     """Whether a call at ``rate`` is one grid substep (SubstepControl's end(0.0) is 1.0)."""
     return rate > 0.0 and step / rate >= 1.0
@@ -356,12 +371,12 @@ def _one_substep(step: float, rate: float) -> bool:
 class _Mode:
     """What stays fixed while calls stay quiet in one sticking mode: the set's constants, the
     finger names (and as a set), the tips, the functions watched (the free boundary ``rows``;
-    the contacts ``watched``, None for all, their normals' ``unit`` and ``tangent``), the depth
-    (m) at which a hold of the chattering bound ``expiry`` ends, and the parts of a result that
-    do not move: per finger its name, its contact rows (a slice when they are consecutive),
-    whether it has any, its radius, flat and facing; each contact's node, finger, mode, angle
-    and normal angle, as a ContactNode without its displacement and force. ``rates``: how fast
-    the watched functions change with the fingers' translation.
+    the contacts' not held, as the rows of their normal forces and cone margins, ``margins``:
+    :func:`_margins`), the depth (m) at which a hold of the chattering bound ``expiry`` ends,
+    and the parts of a result that do not move: per finger its name, its contact rows (a slice
+    when they are consecutive), whether it has any, its radius, flat and facing; each contact's
+    node, finger, mode, angle and normal angle, as a ContactNode without its displacement and
+    force. ``rates``: how fast the gaps and the area check change with the fingers' translation.
     """
 
     sticking: _Sticking
@@ -370,9 +385,7 @@ class _Mode:
     tip: TipGeometry
     functions: EventFunctions
     rows: np.ndarray
-    watched: np.ndarray | None
-    unit: np.ndarray
-    tangent: np.ndarray
+    margins: np.ndarray
     expiry: float
     fingers: tuple[tuple, ...]
     contacts: tuple[ContactNode, ...]

@@ -186,7 +186,7 @@ def test_travel_rates_bound_the_gaps_change_and_margins_are_the_contact_function
 
     def keep(mode, state, motion, ends):
         out = result(mode, state, motion, ends)
-        seen.append((mode, motion[0] + motion[1], ends[2], ends[3]))
+        seen.append((mode, ends[0][1], ends[1][1], ends[2][1]))
         return out
 
     stepper._result = keep

@@ -69,6 +69,8 @@ from squeeze_grasp_ros.mechanics.vocabulary import ContactMode, MaterialModel, T
 __all__ = ["QUIET_MARGIN", "QuietSteps"]
 
 _STILL = (0.0, 0.0)
+_ENDS = np.array([0.0, 1.0])[:, None, None]
+"""The path parameter s at a quiet call's two ends, to broadcast over the fingers (f, 2)."""
 
 
 class QuietSteps:
@@ -145,15 +147,15 @@ class QuietSteps:
         mode = self._enter(state, motion)
         start, D = motion.start, motion.translation
         ends = mode.sticking.ends(start, D)
-        reach = 0.0 if ends is None else self._evaluate(mode, start, ends[0], ends[1], D)
+        reach = (0.0 if ends is None
+                 else self._evaluate(mode, start, ends[1][0], ends[2][0], D))
         if reach <= 0.0:
             return None
         self._mode, self._reach = mode, (start, reach * reach)
-        end = start + D
-        if not self._within(end, ends[2], ends[3], D):
+        if not self._within(ends[0][1], ends[1][1], ends[2][1], D):
             return None
         t0 = np.array([f.translation for f in state.fingers], float) / self._length
-        return self._result(mode, state, (start, D, motion.rate, t0), ends)
+        return self._result(mode, state, (D, motion.rate, t0), ends)
 
     def _next(self, mode: _Mode, state: ContactState,
               translations: Mapping[str, tuple[float, float]]) -> StepResult | None:
@@ -165,19 +167,17 @@ class QuietSteps:
             return None
         D = np.array([translations.get(n, _STILL) for n in mode.names], float) / L
         d = D.ravel()
-        # the norm as np.linalg.norm computes it (sqrt of the dot product), without its checks;
-        # a translation with a value that is not finite has a rate that is not
-        rate = float(np.sqrt(d.dot(d)))
+        # the norm as np.linalg.norm computes it (sqrt of the dot product: math.sqrt rounds
+        # as np.sqrt), without its checks; a translation with a value that is not finite has a
+        # rate that is not
+        rate = math.sqrt(d.dot(d))
         if not (math.isfinite(rate) and _one_substep(self.step, rate)):
             return None
         centers, moved = self._fingers
-        start = centers / L
-        ends = mode.sticking.ends(start, D)
-        if ends is None:
+        ends = mode.sticking.ends(centers / L, D)
+        if ends is None or not self._within(ends[0][1], ends[1][1], ends[2][1], D):
             return None
-        if not self._within(start + D, ends[2], ends[3], D):
-            return None
-        return self._result(mode, state, (start, D, rate, moved / L), ends)
+        return self._result(mode, state, (D, rate, moved / L), ends)
 
     def _within(self, end: np.ndarray, delta: np.ndarray, F: np.ndarray, D: np.ndarray) -> bool:
         """Whether every watched function of the mode is above :data:`QUIET_MARGIN` at the end
@@ -286,6 +286,8 @@ class QuietSteps:
         sd, rows = mode.sticking.contacts.data, mode.rows
         points = self._boundary[rows] + self.model.boundary_displacement(sd, delta, F, rows)
         gaps = mode.tip.gaps(points, centers)
+        if not np.minimum.reduce(gaps, axis=None, initial=np.inf) > QUIET_MARGIN:
+            return 0.0  # (the area check's reserve is not needed then)
         reserve = self.area.reserve(sd, delta, F, INVERSION_AREA_RATIO + QUIET_MARGIN)
         return mode.rates.travel(gaps, reserve, QUIET_MARGIN)
 
@@ -301,38 +303,38 @@ class QuietSteps:
     def _result(self, mode: _Mode, state: ContactState, motion: tuple,
                 ends: tuple[np.ndarray, ...]) -> StepResult:
         """The :class:`StepResult` :func:`~.run.advance` returns for a call of one substep
-        with no event (``motion``: start (f, 2), translation (f, 2), rate, the fingers'
-        translations so far (f, 2), all / L; ``ends``: delta and F at s = 0 and s = 1): the
-        same operations on the same numbers as its ``integrate_work``, ``record`` and
-        ``to_state``.
+        with no event (``motion``: translation (f, 2), rate, the fingers' translations so far
+        (f, 2), all / L; ``ends``: :meth:`_Sticking.ends`): the same operations on the same
+        numbers as its ``integrate_work``, ``record`` and ``to_state``.
         """
-        start, D, rate, t0 = motion
-        _, F_a, delta_b, F_b = ends
+        D, rate, t0 = motion
+        tips, delta, both = ends
         L, fu, old = mode.length, mode.force_unit, state.fingers
         forces_a, forces_b, fingers = {}, {}, []
-        both = np.array((F_a, F_b))
         # FingerMotion.depth_at(s): depth0 + s * rate * length
         depth = state.depth + 1.0 * rate * L
-        centers, moved = (start + 1.0 * D) * L, (t0 + 1.0 * D) * L
-        for f, ((name, mine, touching, radius, flat, facing), f_old) in enumerate(
-                zip(mode.fingers, old)):
-            # each end's finger force, summed over the same rows in the same order
-            y = both[:, mine].sum(axis=1)
-            forces_a[name], forces_b[name] = map(tuple, (y * fu).tolist())
-            # the work as advance() keeps it (/ (fu L)), in Python floats (the same IEEE
-            # operations as its float64 array's)
+        centers, moved = tips[1] * L, (t0 + 1.0 * D) * L
+        # the finger forces, their products and the work in Python floats: the same IEEE
+        # operations as advance()'s float64 arrays (a 2-vector's dot product in BLAS ddot's
+        # order, as substeps_numba._dot2)
+        for (name, mine, touching, radius, flat, facing), f_old, center, move, (d0, d1) in zip(
+                mode.fingers, old, centers, moved, D.tolist()):
+            # each end's finger force, summed over the same rows in the same order (the
+            # reduction ndarray.sum makes)
+            (a0, a1), (b0, b1) = np.add.reduce(both[:, mine], axis=1).tolist()
+            forces_a[name], forces_b[name] = (a0 * fu, a1 * fu), (b0 * fu, b1 * fu)
+            # the work as advance() keeps it (/ (fu L))
             work = f_old.work / (fu * L)
             if touching:
                 # h = 1; the set and the motion are those of both ends, so dF / ds is the same
                 # there and the Hermite term h^2 / 12 (ra - rb) is 0.0 exactly (ra, rb finite)
-                ya, yb = y
-                work += 0.5 * (float(ya @ D[f]) + float(yb @ D[f])) + 0.0
-            fingers.append(FingerState(name, centers[f], radius, moved[f], float(work * fu * L),
-                                       float(f_old.dissipation / (fu * L) * fu * L), flat,
-                                       facing))
+                work += 0.5 * ((0.0 + ((0.0 + a0 * d0) + a1 * d1))
+                               + (0.0 + ((0.0 + b0 * d0) + b1 * d1))) + 0.0
+            fingers.append(_finger(name, center, radius, move, work * fu * L,
+                                   f_old.dissipation / (fu * L) * fu * L, flat, facing))
         samples = (Sample(state.depth + 0.0 * rate * L, mode.nodes, mode.thetas, forces_a),
                    Sample(depth, mode.nodes, mode.thetas, forces_b))
-        contacts = tuple(map(_moved, mode.contacts, delta_b * L, F_b * fu))
+        contacts = tuple(map(_moved, mode.contacts, delta[1] * L, both[1] * fu))
         holds = tuple(sorted((n, u) for n, u in state.holds if u > depth))
         new = ContactState(tuple(fingers), contacts, depth, state.relative_per_depth, (), (),
                            state.history, holds)
@@ -359,7 +361,7 @@ def _clear(margins: np.ndarray, F: np.ndarray) -> bool:
     """Whether every contact function of ``margins`` (:func:`_margins`) is above
     :data:`QUIET_MARGIN` at the forces ``F`` (m, 2).
     """
-    return bool((margins @ F.reshape(-1)).min(initial=np.inf) > QUIET_MARGIN)
+    return bool(np.minimum.reduce(margins @ F.reshape(-1), initial=np.inf) > QUIET_MARGIN)
 
 
 def _one_substep(step: float, rate: float) -> bool:
@@ -407,6 +409,15 @@ def _rows_of(mask: np.ndarray) -> slice | np.ndarray:
     return mask
 
 
+def _finger(name: str, center: np.ndarray, radius: float, translation: np.ndarray,
+            work: float, dissipation: float, flat: float, facing: float) -> FingerState:
+    """The FingerState of these fields, set at once (as :func:`_moved` does for a contact)."""
+    finger = object.__new__(FingerState)
+    finger.__dict__.update(name=name, center=center, radius=radius, translation=translation,
+                           work=work, dissipation=dissipation, flat=flat, facing=facing)
+    return finger
+
+
 def _moved(contact: ContactNode, displacement: np.ndarray, force: np.ndarray) -> ContactNode:
     """``contact`` with another ``displacement`` and ``force``: the fields ContactNode's
     __init__ would set, set at once (a quiet tick makes one per contact; the frozen dataclass's
@@ -445,21 +456,20 @@ class _Sticking:
     slide: np.ndarray
 
     def ends(self, start: np.ndarray, D: np.ndarray) -> tuple[np.ndarray, ...] | None:
-        """(delta, F) at s = 0 and at s = 1 of the tips moving from ``start`` by ``D`` (f, 2),
-        as :func:`~..contact_model.attempt_fixed_set` computes them with no sliding node
-        (delta = c(s) + offset - X, F = C delta), or None if a force is not finite.
+        """(tips (2, f, 2), delta (2, m, 2), F (2, m, 2)) at s = 0 and at s = 1 of the tips
+        moving from ``start`` by ``D`` (f, 2), as :func:`~..contact_model.attempt_fixed_set`
+        computes them with no sliding node (c(s) = start + s D, delta = c(s) + offset - X,
+        F = C delta), or None if a force is not finite. Both ends at once: the same
+        elementwise operations, and a stacked product that makes the same matrix-vector
+        product per end.
         """
-        f = self.contacts.finger
-        start, dirs = start[f], D[f]
-        m = len(f)
-        delta_a = start + 0.0 * dirs + self.offset - self.positions
-        delta_b = start + 1.0 * dirs + self.offset - self.positions
-        F_a = (self.C @ delta_a.reshape(-1)).reshape(m, 2)
-        F_b = (self.C @ delta_b.reshape(-1)).reshape(m, 2)
+        tips = start + _ENDS * D
+        delta = tips[:, self.contacts.finger] + self.offset - self.positions
+        F = np.matmul(self.C, delta.reshape(2, -1, 1)).reshape(delta.shape)
         # a sum of values is finite only if they all are (or it overflows: then not quiet)
-        if not math.isfinite(F_a.sum() + F_b.sum()):
+        if not math.isfinite(np.add.reduce(F, axis=None)):
             return None
-        return delta_a, F_a, delta_b, F_b
+        return tips, delta, F
 
     def solution(self, delta: np.ndarray, F: np.ndarray, D: np.ndarray) -> Solution:
         """The fixed-set solve's :class:`~..contact_model.Solution` at ``delta``, ``F`` of the

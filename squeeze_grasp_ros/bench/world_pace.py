@@ -95,10 +95,11 @@ def world_pace_table(path: Path, repeats: int, progress) -> Table:
         "Event squeeze: GraspSetup.event_squeeze() of the same scene (Algorithm 1 to the same "
         "depth, its substeps on the step grid), mesh and precomputation excluded for both. A "
         "quiet tick (mechanics/squeeze/stepper/quiet.py) makes the same two fixed-set solves as "
-        "advance(), keeps what its contact mode fixes from the mode's first quiet tick, and "
-        "evaluates the watched functions only when it ends outside the travel within which "
-        "their last evaluation showed none can reach the margin (stepper/travel.py: their "
-        "rates in a sticking mode); ticks that cross an event, slide or use a "
-        "finite-deformation material go through advance(). Both give the same states bit for bit "
-        "(test/test_world_pace.py).",
+        "advance(), keeps what its contact mode fixes from the mode's first quiet tick, "
+        "checks the contacts' normal forces and cone margins at its end (one product with the "
+        "forces), and evaluates the gaps and the area check only when it ends outside the "
+        "travel within which their last evaluation showed neither can reach the margin "
+        "(stepper/travel.py: their rates in a sticking mode); ticks that cross an event, slide "
+        "or use a finite-deformation material go through advance(). Both give the same states "
+        "bit for bit (test/test_world_pace.py).",
     )

@@ -123,8 +123,9 @@ class AreaWatch:
         rigid = (self._rigid_2d @ g).reshape(-1, 4)
         B = bounds @ norms + np.sqrt((rigid * rigid).sum(axis=1))
         if len(B) > AREA_CANDIDATES:
-            kept = np.argpartition(-B, AREA_CANDIDATES)[:AREA_CANDIDATES]
-            budget = reach - np.delete(B, kept).max()
+            # the partition's next element is the largest bound of the rest
+            order = np.argpartition(-B, AREA_CANDIDATES)
+            kept, budget = order[:AREA_CANDIDATES], reach - B[order[AREA_CANDIDATES]]
         else:
             kept, budget = np.arange(len(B)), np.inf
         kept = np.sort(kept)

@@ -25,12 +25,13 @@ Within one sticking mode everything but the finger positions stays: the set's st
 offsets, the watched rows and contacts, each contact's node, finger and angles. The first quiet
 call of a mode keeps them (:class:`_Mode`, until the next full call or until a hold of the
 chattering bound expires), and the calls after it compute only what moves: the two solves, the
-work integral, the samples' finger forces, the contacts' displacements and forces. Every watched
-function is then affine in the fingers' translation, with a rate the mode fixes
-(:class:`~.travel.TravelRates`): where the functions are evaluated (the mode's first call, and
-whenever the fingers leave the last reach) they give a travel within which none can reach the
-margin, and a call that ends within it evaluates none. Only the strain limit and the pickup
-margin, when declared, are evaluated at every call.
+work integral, the samples' finger forces, the contacts' displacements and forces. The
+contacts' normal forces and cone margins are linear in the forces (one product with the mode's
+``margins`` per call); the free rows' gaps and the area check change by at most a rate the mode
+fixes times the fingers' translation (:class:`~.travel.TravelRates`): where they are evaluated
+(the mode's first call, and whenever the fingers leave the last reach) they give a travel
+within which neither can reach the margin, and a call that ends within it evaluates neither.
+The strain limit and the pickup margin, when declared, are evaluated at every call.
 """
 from __future__ import annotations
 
@@ -68,6 +69,8 @@ from squeeze_grasp_ros.mechanics.vocabulary import ContactMode, MaterialModel, T
 __all__ = ["QUIET_MARGIN", "QuietSteps"]
 
 _STILL = (0.0, 0.0)
+_ENDS = np.array([0.0, 1.0])[:, None, None]
+"""The path parameter s at a quiet call's two ends, to broadcast over the fingers (f, 2)."""
 
 
 class QuietSteps:
@@ -144,15 +147,15 @@ class QuietSteps:
         mode = self._enter(state, motion)
         start, D = motion.start, motion.translation
         ends = mode.sticking.ends(start, D)
-        reach = 0.0 if ends is None else self._evaluate(mode, start, ends[0], ends[1], D)
+        reach = (0.0 if ends is None
+                 else self._evaluate(mode, start, ends[1][0], ends[2][0], D))
         if reach <= 0.0:
             return None
         self._mode, self._reach = mode, (start, reach * reach)
-        end = start + D
-        if not self._within(end, ends[2], ends[3], D):
+        if not self._within(ends[0][1], ends[1][1], ends[2][1], D):
             return None
         t0 = np.array([f.translation for f in state.fingers], float) / self._length
-        return self._result(mode, state, (start, D, motion.rate, t0), ends)
+        return self._result(mode, state, (D, motion.rate, t0), ends)
 
     def _next(self, mode: _Mode, state: ContactState,
               translations: Mapping[str, tuple[float, float]]) -> StepResult | None:
@@ -164,31 +167,31 @@ class QuietSteps:
             return None
         D = np.array([translations.get(n, _STILL) for n in mode.names], float) / L
         d = D.ravel()
-        # the norm as np.linalg.norm computes it (sqrt of the dot product), without its checks;
-        # a translation with a value that is not finite has a rate that is not
-        rate = float(np.sqrt(d.dot(d)))
+        # the norm as np.linalg.norm computes it (sqrt of the dot product: math.sqrt rounds
+        # as np.sqrt), without its checks; a translation with a value that is not finite has a
+        # rate that is not
+        rate = math.sqrt(d.dot(d))
         if not (math.isfinite(rate) and _one_substep(self.step, rate)):
             return None
         centers, moved = self._fingers
-        start = centers / L
-        ends = mode.sticking.ends(start, D)
-        if ends is None:
+        ends = mode.sticking.ends(centers / L, D)
+        if ends is None or not self._within(ends[0][1], ends[1][1], ends[2][1], D):
             return None
-        if not self._within(start + D, ends[2], ends[3], D):
-            return None
-        return self._result(mode, state, (start, D, rate, moved / L), ends)
+        return self._result(mode, state, (D, rate, moved / L), ends)
 
     def _within(self, end: np.ndarray, delta: np.ndarray, F: np.ndarray, D: np.ndarray) -> bool:
         """Whether every watched function of the mode is above :data:`QUIET_MARGIN` at the end
-        of the call (tips at ``end``, the set at ``delta``, ``F``): from the reach of their last
-        evaluation when the end lies within it (the terminations declared evaluated), else
-        evaluated there (and the reach renewed).
+        of the call (tips at ``end``, the set at ``delta``, ``F``): the contact functions (affine
+        along the call, so above it all along when above at both ends) and the terminations
+        declared evaluated; the gaps and the area check from the reach of their last evaluation
+        when the end lies within it, else evaluated there (and the reach renewed).
         """
         mode = self._mode
         ref, reach2 = self._reach
         off = (end - ref).ravel()
         if off @ off < reach2:
-            return not self._terminations or self._terminations_clear(mode, delta, F, D)
+            return (_clear(mode.margins, F)
+                    and (not self._terminations or self._terminations_clear(mode, delta, F, D)))
         reach = self._evaluate(mode, end, delta, F, D)
         if reach <= 0.0:
             return False
@@ -213,22 +216,18 @@ class QuietSteps:
         names, fingers, L = motion.names, contacts.finger, model.length
         rows = functions.free_rows(contacts, held)
         thetas = np.array(contacts.theta, float).tolist()
-        watched = None if watched.all() else watched
-        normal = sticking.unit if watched is None else sticking.unit[watched]
-        along = sticking.tangent if watched is None else sticking.tangent[watched]
         radius, flat, facing = (motion.radius * L, (motion.tip.flat * L).tolist(),
                                 motion.tip.facing.tolist())
         return _Mode(
-            sticking, names, frozenset(names), motion.tip, functions, rows, watched, normal,
-            along, expiry,
+            sticking, names, frozenset(names), motion.tip, functions, rows,
+            _margins(sticking, watched, model.mu), expiry,
             tuple((names[f], _rows_of(fingers == f), bool((fingers == f).any()), radius[f],
                    flat[f], facing[f]) for f in range(len(names))),
             tuple(ContactNode(node, names[f], ContactMode.STICK, 0, theta, None, None, nu)
                   for node, f, theta, nu in zip(contacts.nodes.tolist(), fingers.tolist(),
                                                 thetas, sticking.nu.tolist())),
             tuple(contacts.nodes.tolist()), tuple(thetas),
-            TravelRates.of(model, contacts, len(names), rows, watched, normal, along,
-                           self.area),
+            TravelRates.of(model, contacts, len(names), rows, self.area),
             L, model.force_unit, model._cache)
 
     def _motion(self, state: ContactState,
@@ -275,24 +274,22 @@ class QuietSteps:
                   D: np.ndarray) -> float:
         """Evaluate every function a call watches at the configuration ``delta``, ``F`` with
         the tips at ``centers`` (the mode's contacts not held, its free boundary rows, the
-        terminations checked): the travel within which none reaches :data:`QUIET_MARGIN`
-        (:meth:`~.travel.TravelRates.travel`), 0.0 when one is at or below it already.
+        terminations checked): the travel within which neither the gaps nor the area check
+        reaches :data:`QUIET_MARGIN` (:meth:`~.travel.TravelRates.travel`), 0.0 when a function
+        is at or below it already.
         """
         self.evaluations += 1
         if self._terminations and not self._terminations_clear(mode, delta, F, D):
             return 0.0
-        watched = F if mode.watched is None else F[mode.watched]
-        fn = np.einsum("ij,ij->i", watched, mode.unit)
-        ft = np.einsum("ij,ij->i", watched, mode.tangent)
+        if not _clear(mode.margins, F):
+            return 0.0
         sd, rows = mode.sticking.contacts.data, mode.rows
         points = self._boundary[rows] + self.model.boundary_displacement(sd, delta, F, rows)
         gaps = mode.tip.gaps(points, centers)
-        lowest = min(fn.min(initial=np.inf), gaps.min(initial=np.inf))
-        if not lowest > QUIET_MARGIN:
-            return 0.0
+        if not np.minimum.reduce(gaps, axis=None, initial=np.inf) > QUIET_MARGIN:
+            return 0.0  # (the area check's reserve is not needed then)
         reserve = self.area.reserve(sd, delta, F, INVERSION_AREA_RATIO + QUIET_MARGIN)
-        return mode.rates.travel(fn, self.model.mu * fn - np.abs(ft), gaps, reserve,
-                                 QUIET_MARGIN)
+        return mode.rates.travel(gaps, reserve, QUIET_MARGIN)
 
     def _terminations_clear(self, mode: _Mode, delta: np.ndarray, F: np.ndarray,
                             D: np.ndarray) -> bool:
@@ -306,38 +303,38 @@ class QuietSteps:
     def _result(self, mode: _Mode, state: ContactState, motion: tuple,
                 ends: tuple[np.ndarray, ...]) -> StepResult:
         """The :class:`StepResult` :func:`~.run.advance` returns for a call of one substep
-        with no event (``motion``: start (f, 2), translation (f, 2), rate, the fingers'
-        translations so far (f, 2), all / L; ``ends``: delta and F at s = 0 and s = 1): the
-        same operations on the same numbers as its ``integrate_work``, ``record`` and
-        ``to_state``.
+        with no event (``motion``: translation (f, 2), rate, the fingers' translations so far
+        (f, 2), all / L; ``ends``: :meth:`_Sticking.ends`): the same operations on the same
+        numbers as its ``integrate_work``, ``record`` and ``to_state``.
         """
-        start, D, rate, t0 = motion
-        _, F_a, delta_b, F_b = ends
+        D, rate, t0 = motion
+        tips, delta, both = ends
         L, fu, old = mode.length, mode.force_unit, state.fingers
         forces_a, forces_b, fingers = {}, {}, []
-        both = np.array((F_a, F_b))
         # FingerMotion.depth_at(s): depth0 + s * rate * length
         depth = state.depth + 1.0 * rate * L
-        centers, moved = (start + 1.0 * D) * L, (t0 + 1.0 * D) * L
-        for f, ((name, mine, touching, radius, flat, facing), f_old) in enumerate(
-                zip(mode.fingers, old)):
-            # each end's finger force, summed over the same rows in the same order
-            y = both[:, mine].sum(axis=1)
-            forces_a[name], forces_b[name] = map(tuple, (y * fu).tolist())
-            # the work as advance() keeps it (/ (fu L)), in Python floats (the same IEEE
-            # operations as its float64 array's)
+        centers, moved = tips[1] * L, (t0 + 1.0 * D) * L
+        # the finger forces, their products and the work in Python floats: the same IEEE
+        # operations as advance()'s float64 arrays (a 2-vector's dot product in BLAS ddot's
+        # order, as substeps_numba._dot2)
+        for (name, mine, touching, radius, flat, facing), f_old, center, move, (d0, d1) in zip(
+                mode.fingers, old, centers, moved, D.tolist()):
+            # each end's finger force, summed over the same rows in the same order (the
+            # reduction ndarray.sum makes)
+            (a0, a1), (b0, b1) = np.add.reduce(both[:, mine], axis=1).tolist()
+            forces_a[name], forces_b[name] = (a0 * fu, a1 * fu), (b0 * fu, b1 * fu)
+            # the work as advance() keeps it (/ (fu L))
             work = f_old.work / (fu * L)
             if touching:
                 # h = 1; the set and the motion are those of both ends, so dF / ds is the same
                 # there and the Hermite term h^2 / 12 (ra - rb) is 0.0 exactly (ra, rb finite)
-                ya, yb = y
-                work += 0.5 * (float(ya @ D[f]) + float(yb @ D[f])) + 0.0
-            fingers.append(FingerState(name, centers[f], radius, moved[f], float(work * fu * L),
-                                       float(f_old.dissipation / (fu * L) * fu * L), flat,
-                                       facing))
+                work += 0.5 * ((0.0 + ((0.0 + a0 * d0) + a1 * d1))
+                               + (0.0 + ((0.0 + b0 * d0) + b1 * d1))) + 0.0
+            fingers.append(_finger(name, center, radius, move, work * fu * L,
+                                   f_old.dissipation / (fu * L) * fu * L, flat, facing))
         samples = (Sample(state.depth + 0.0 * rate * L, mode.nodes, mode.thetas, forces_a),
                    Sample(depth, mode.nodes, mode.thetas, forces_b))
-        contacts = tuple(map(_moved, mode.contacts, delta_b * L, F_b * fu))
+        contacts = tuple(map(_moved, mode.contacts, delta[1] * L, both[1] * fu))
         holds = tuple(sorted((n, u) for n, u in state.holds if u > depth))
         new = ContactState(tuple(fingers), contacts, depth, state.relative_per_depth, (), (),
                            state.history, holds)
@@ -345,6 +342,26 @@ class QuietSteps:
                        "reduced_max_condition": mode.cache.get("max_condition", 1.0)}
         self._checked, self._fingers = new, (centers, moved)
         return StepResult(new, (), 1.0, None, samples, (), diagnostics, self.step)
+
+
+def _margins(sticking: _Sticking, watched: np.ndarray, mu: float) -> np.ndarray:
+    """The ``watched`` contacts' (mask) normal forces f_n = u . F_k and cone margins
+    mu f_n -+ f_t (f_t = t . F_k) as rows of one map of the set's forces (m, 2) flattened:
+    (3w, 2m), w the contacts watched.
+    """
+    rows = np.flatnonzero(watched)
+    u, t = sticking.unit[rows], sticking.tangent[rows]
+    k = np.arange(len(rows))
+    margins = np.zeros((3, len(rows), len(watched), 2))
+    margins[0, k, rows], margins[1, k, rows], margins[2, k, rows] = u, mu * u - t, mu * u + t
+    return margins.reshape(3 * len(rows), -1)
+
+
+def _clear(margins: np.ndarray, F: np.ndarray) -> bool:
+    """Whether every contact function of ``margins`` (:func:`_margins`) is above
+    :data:`QUIET_MARGIN` at the forces ``F`` (m, 2).
+    """
+    return bool(np.minimum.reduce(margins @ F.reshape(-1), initial=np.inf) > QUIET_MARGIN)
 
 
 def _one_substep(step: float, rate: float) -> bool:
@@ -356,12 +373,12 @@ def _one_substep(step: float, rate: float) -> bool:
 class _Mode:
     """What stays fixed while calls stay quiet in one sticking mode: the set's constants, the
     finger names (and as a set), the tips, the functions watched (the free boundary ``rows``;
-    the contacts ``watched``, None for all, their normals' ``unit`` and ``tangent``), the depth
-    (m) at which a hold of the chattering bound ``expiry`` ends, and the parts of a result that
-    do not move: per finger its name, its contact rows (a slice when they are consecutive),
-    whether it has any, its radius, flat and facing; each contact's node, finger, mode, angle
-    and normal angle, as a ContactNode without its displacement and force. ``rates``: how fast
-    the watched functions change with the fingers' translation.
+    the contacts' not held, as the rows of their normal forces and cone margins, ``margins``:
+    :func:`_margins`), the depth (m) at which a hold of the chattering bound ``expiry`` ends,
+    and the parts of a result that do not move: per finger its name, its contact rows (a slice
+    when they are consecutive), whether it has any, its radius, flat and facing; each contact's
+    node, finger, mode, angle and normal angle, as a ContactNode without its displacement and
+    force. ``rates``: how fast the gaps and the area check change with the fingers' translation.
     """
 
     sticking: _Sticking
@@ -370,9 +387,7 @@ class _Mode:
     tip: TipGeometry
     functions: EventFunctions
     rows: np.ndarray
-    watched: np.ndarray | None
-    unit: np.ndarray
-    tangent: np.ndarray
+    margins: np.ndarray
     expiry: float
     fingers: tuple[tuple, ...]
     contacts: tuple[ContactNode, ...]
@@ -392,6 +407,15 @@ def _rows_of(mask: np.ndarray) -> slice | np.ndarray:
     if len(rows) and rows[-1] - rows[0] + 1 == len(rows):
         return slice(int(rows[0]), int(rows[-1]) + 1)
     return mask
+
+
+def _finger(name: str, center: np.ndarray, radius: float, translation: np.ndarray,
+            work: float, dissipation: float, flat: float, facing: float) -> FingerState:
+    """The FingerState of these fields, set at once (as :func:`_moved` does for a contact)."""
+    finger = object.__new__(FingerState)
+    finger.__dict__.update(name=name, center=center, radius=radius, translation=translation,
+                           work=work, dissipation=dissipation, flat=flat, facing=facing)
+    return finger
 
 
 def _moved(contact: ContactNode, displacement: np.ndarray, force: np.ndarray) -> ContactNode:
@@ -432,21 +456,20 @@ class _Sticking:
     slide: np.ndarray
 
     def ends(self, start: np.ndarray, D: np.ndarray) -> tuple[np.ndarray, ...] | None:
-        """(delta, F) at s = 0 and at s = 1 of the tips moving from ``start`` by ``D`` (f, 2),
-        as :func:`~..contact_model.attempt_fixed_set` computes them with no sliding node
-        (delta = c(s) + offset - X, F = C delta), or None if a force is not finite.
+        """(tips (2, f, 2), delta (2, m, 2), F (2, m, 2)) at s = 0 and at s = 1 of the tips
+        moving from ``start`` by ``D`` (f, 2), as :func:`~..contact_model.attempt_fixed_set`
+        computes them with no sliding node (c(s) = start + s D, delta = c(s) + offset - X,
+        F = C delta), or None if a force is not finite. Both ends at once: the same
+        elementwise operations, and a stacked product that makes the same matrix-vector
+        product per end.
         """
-        f = self.contacts.finger
-        start, dirs = start[f], D[f]
-        m = len(f)
-        delta_a = start + 0.0 * dirs + self.offset - self.positions
-        delta_b = start + 1.0 * dirs + self.offset - self.positions
-        F_a = (self.C @ delta_a.reshape(-1)).reshape(m, 2)
-        F_b = (self.C @ delta_b.reshape(-1)).reshape(m, 2)
+        tips = start + _ENDS * D
+        delta = tips[:, self.contacts.finger] + self.offset - self.positions
+        F = np.matmul(self.C, delta.reshape(2, -1, 1)).reshape(delta.shape)
         # a sum of values is finite only if they all are (or it overflows: then not quiet)
-        if not math.isfinite(F_a.sum() + F_b.sum()):
+        if not math.isfinite(np.add.reduce(F, axis=None)):
             return None
-        return delta_a, F_a, delta_b, F_b
+        return tips, delta, F
 
     def solution(self, delta: np.ndarray, F: np.ndarray, D: np.ndarray) -> Solution:
         """The fixed-set solve's :class:`~..contact_model.Solution` at ``delta``, ``F`` of the

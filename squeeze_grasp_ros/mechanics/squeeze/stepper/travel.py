@@ -1,16 +1,17 @@
 # Copyright 2026 squeeze_grasp_ros developers
 # SPDX-License-Identifier: Apache-2.0
-"""How far the fingers may travel in one sticking mode before a watched function can reach
-the quiet margin (:class:`TravelRates`): what lets a quiet tick skip every check.
+"""How far the fingers may travel in one sticking mode before a watched function that is not
+linear in the forces can reach the quiet margin (:class:`TravelRates`): what lets a quiet tick
+skip the dear checks.
 
 In a sticking mode of a linear contact set every quantity a quiet call watches is affine in the
 fingers' stacked translation T (/ L) from a reference configuration: each contact node rides on
 its finger (d delta_k = dT_f(k)), the forces change by dF = C d delta = K dT (K = C S, S the
 node-to-finger selection), the rigid part by dg = E^T S dT, and a boundary point by
-A_bc dF + R dg = M dT. So every watched function changes by at most a rate times ||dT||:
+A_bc dF + R dg = M dT. The contacts' normal forces and cone margins are linear in the forces
+(one small product per tick, :class:`~.quiet.QuietSteps` checks them at every tick); the others
+change by at most a rate times ||dT||:
 
-* a contact's normal force f_n = u . F_k by ||u^T K_k||, its cone margins mu f_n -+ f_t by
-  mu ||u^T K_k|| + ||t^T K_k|| (u, t the contact's normal and tangent, fixed while it sticks);
 * the gap of a free boundary row i to tip f by ||M_i - I_f||, I_f the motion of tip f's centre
   (a signed distance to a convex tip is 1-Lipschitz in the point less the tip's centre);
 * the area check's bound on every element's gradient change (AreaWatch's ``moved``) by
@@ -18,7 +19,7 @@ A_bc dF + R dg = M dT. So every watched function changes by at most a rate times
 
 Frobenius norms bound the 2-norms. Where every function clears the margin, the smallest
 (value - margin) / rate is a travel within which none can reach it: a quiet call ending within
-that distance of the configuration needs no function evaluated (:meth:`TravelRates.travel`).
+that distance of the configuration needs neither evaluated (:meth:`TravelRates.travel`).
 """
 from __future__ import annotations
 
@@ -40,30 +41,24 @@ TRAVEL_SLACK = 1e-9
 @dataclass(frozen=True)
 class TravelRates:
     """The rates (per unit stacked finger translation, / L) of one sticking mode's watched
-    functions (see the module).
+    functions that are not linear in the forces (see the module).
 
     Attributes
     ----------
-    normal, cone : (c,) ndarray
-        Of each watched contact's normal force and of its cone margins (forces / (E h L)).
     gaps : (r, f) ndarray
         Of each free boundary row's gap to each tip.
     area : float
         Of the area check's gradient bound (:meth:`~.area_watch.AreaWatch.rate`).
     """
 
-    normal: np.ndarray
-    cone: np.ndarray
     gaps: np.ndarray
     area: float
 
     @classmethod
     def of(cls, model: ContactModel, contacts: ContactSet, fingers: int, rows: np.ndarray,
-           watched: np.ndarray | None, unit: np.ndarray, tangent: np.ndarray,
            area: AreaWatch) -> TravelRates:
-        """The rates of the set ``contacts`` (every node sticking) on ``fingers`` tips, its
-        free boundary ``rows``, the contacts ``watched`` (mask; None: all) with their normals'
-        ``unit`` and ``tangent``.
+        """The rates of the set ``contacts`` (every node sticking) on ``fingers`` tips and its
+        free boundary ``rows``.
         """
         sd, m = contacts.data, len(contacts)
         select = np.zeros((2 * m, 2 * fingers))
@@ -72,10 +67,6 @@ class TravelRates:
         K = sd.C @ select                       # dF / dT, (2m, 2f)
         G = sd.E.T @ select                     # dg / dT, (3, 2f)
         blocks = K.reshape(m, 2, 2 * fingers)
-        seen = blocks if watched is None else blocks[watched]
-        normal = np.linalg.norm(np.einsum("ki,kij->kj", unit, seen), axis=1)
-        cone = model.mu * normal + np.linalg.norm(np.einsum("ki,kij->kj", tangent, seen),
-                                                  axis=1)
         A = sd.A_bc[node_dofs(rows)]
         R = model.obj.rigid[node_dofs(model.boundary_nodes[rows])]
         M = (A @ K + R @ G).reshape(len(rows), 2, fingers, 2)
@@ -85,22 +76,17 @@ class TravelRates:
             rel[:, :, f, :] -= np.eye(2)
             gaps[:, f] = np.sqrt((rel * rel).sum(axis=(1, 2, 3)))
         k_norms = np.sqrt((blocks * blocks).sum(axis=(1, 2)))
-        return cls(normal, cone, gaps,
-                   area.rate(sd, k_norms, float(np.sqrt((G * G).sum()))))
+        return cls(gaps, area.rate(sd, k_norms, float(np.sqrt((G * G).sum()))))
 
-    def travel(self, normal: np.ndarray, cone: np.ndarray, gaps: np.ndarray,
-               area_reserve: float, margin: float) -> float:
-        """The travel (stacked, / L) within which no function can reach ``margin`` from the
-        configuration with these values (watched contacts' ``normal`` forces and smallest
-        ``cone`` margins, the rows' ``gaps``) and the area check's ``area_reserve``
-        (:meth:`~.area_watch.AreaWatch.reserve`); 0.0 when a value is at or below the margin.
+    def travel(self, gaps: np.ndarray, area_reserve: float, margin: float) -> float:
+        """The travel (stacked, / L) within which neither the rows' ``gaps`` nor the area check
+        (its ``area_reserve``, :meth:`~.area_watch.AreaWatch.reserve`) can reach ``margin``
+        from the configuration with these values; 0.0 when one is at or below it already.
         """
-        room = [normal - margin, cone - margin, (gaps - margin).ravel()]
-        if min(r.min(initial=np.inf) for r in room) <= 0.0 or not area_reserve > 0.0:
+        room = (gaps - margin).ravel()
+        if room.min(initial=np.inf) <= 0.0 or not area_reserve > 0.0:
             return 0.0
         with np.errstate(divide="ignore"):
-            reach = min((room[0] / self.normal).min(initial=np.inf),
-                        (room[1] / self.cone).min(initial=np.inf),
-                        (room[2] / self.gaps.ravel()).min(initial=np.inf),
+            reach = min((room / self.gaps.ravel()).min(initial=np.inf),
                         area_reserve / self.area if self.area > 0.0 else np.inf)
         return float(reach) * (1.0 - TRAVEL_SLACK)

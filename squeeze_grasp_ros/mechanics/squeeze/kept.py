@@ -11,7 +11,7 @@ from __future__ import annotations
 
 from typing import Any, Callable
 
-__all__ = ["kept_property"]
+__all__ = ["kept_for", "kept_property"]
 
 
 class kept_property:
@@ -41,3 +41,21 @@ class kept_property:
             return self
         value = instance.__dict__[self.name] = self.func(instance)
         return value
+
+
+def kept_for(store: dict, owner: Any, tag: Any, make: Callable[[], Any], limit: int) -> Any:
+    """What ``make()`` returns for ``owner`` (an object, by identity) and ``tag`` (hashable),
+    kept in ``store``: computed once while ``owner`` lives; ``store`` is emptied when it holds
+    ``limit`` entries.
+
+    >>> store, key = {}, object()
+    >>> kept_for(store, key, 1, lambda: print("made") or 2, 8), kept_for(store, key, 1, int, 8)
+    made
+    (2, 2)
+    """
+    made = store.get((id(owner), tag))
+    if made is None or made[0] is not owner:  # a new object may reuse a dead one's id
+        if len(store) >= limit:
+            store.clear()
+        made = store[id(owner), tag] = (owner, make())
+    return made[1]

@@ -22,6 +22,7 @@ import numpy as np
 from squeeze_grasp_ros.mechanics.squeeze.contact_model import (
     GRADIENT_BOUND_EXACT,
     ContactModel,
+    SetData,
     Solution,
 )
 from squeeze_grasp_ros.mechanics.squeeze.fixed_set_kernel import (
@@ -29,6 +30,7 @@ from squeeze_grasp_ros.mechanics.squeeze.fixed_set_kernel import (
     compiled_substeps,
     selected,
 )
+from squeeze_grasp_ros.mechanics.squeeze.kept import kept_for
 from squeeze_grasp_ros.mechanics.squeeze.stepper.contact_set import ContactSet
 from squeeze_grasp_ros.mechanics.vocabulary import Termination
 
@@ -108,7 +110,7 @@ class CompiledFunctions:
         functions = self.functions
         model, motion = functions.model, functions.motion
         lim, rate = model.limits, motion.rate
-        _, A, R, points, bounds = self._rows_of(contacts, rows)
+        A, R, points, bounds = self._rows_of(contacts, rows)
         weight = (lim.weight / model.force_unit if lim.weight is not None
                   and Termination.PICKED_UP in functions.terminate_on else np.nan)
         tip = motion.tip
@@ -127,7 +129,7 @@ class CompiledFunctions:
         cone-margin slopes), raveled, at ``sol``.
         """
         motion = self.functions.motion
-        _, A, R, points, _ = self._rows_of(contacts, rows)
+        A, R, points, _ = self._rows_of(contacts, rows)
         tip = motion.tip
         return self.kernel.slope_values(
             sol.delta, sol.F, sol.ddelta, sol.dF, sol.dtheta, sol.normal_angle,
@@ -136,20 +138,17 @@ class CompiledFunctions:
             tip._facing_tangent)
 
     def _rows_of(self, contacts: ContactSet, rows: np.ndarray) -> tuple:
-        """(the set's data, the rows of its boundary compliance and rigid modes, the rows'
-        undeformed positions, the area bounds or none while the fingers stay) of ``contacts``
-        and boundary ``rows``: kept for the call's last few sets (a point's reads and the
-        substeps of a set ask for the same ones).
+        """(the rows of the set's boundary compliance and rigid modes, the rows' undeformed
+        positions, the area bounds or none while the fingers stay) of ``contacts`` and boundary
+        ``rows``: kept for the call's last few sets (a point's reads and the substeps of a set
+        ask for the same ones).
         """
         sd = contacts.data
-        tag = (id(sd), rows.dtype.str, rows.tobytes())
-        made = self._rows.get(tag)
-        if made is None or made[0] is not sd:
-            if len(self._rows) >= ROW_TABLES_KEPT:
-                self._rows.clear()
-            functions = self.functions
-            model = functions.model
-            made = self._rows[tag] = (
-                sd, *model._boundary_rows(sd, rows), functions._boundary[rows],
+        return kept_for(self._rows, sd, (rows.dtype.str, rows.tobytes()),
+                        lambda: self._tables(sd, rows), ROW_TABLES_KEPT)
+
+    def _tables(self, sd: SetData, rows: np.ndarray) -> tuple:
+        functions = self.functions
+        model = functions.model
+        return (*model._boundary_rows(sd, rows), functions._boundary[rows],
                 model.area_tables(sd)[0] if functions.motion.rate > 0 else _NO_BOUNDS)
-        return made

@@ -18,7 +18,7 @@ import numpy as np
 
 from squeeze_grasp_ros.mechanics.errors import InvalidInputError, require_finite
 from squeeze_grasp_ros.mechanics.squeeze.contact_state import ContactState, tip_geometry
-from squeeze_grasp_ros.mechanics.squeeze.kept import kept_property
+from squeeze_grasp_ros.mechanics.squeeze.kept import kept_for, kept_property
 from squeeze_grasp_ros.mechanics.squeeze.tip_shapes import TipGeometry
 
 __all__ = ["ContactTips", "FingerMotion"]
@@ -94,7 +94,7 @@ class FingerMotion:
                            zeros if self.facing is None else self.facing)
 
     @kept_property
-    def _contact_tips(self) -> dict[int, tuple[np.ndarray, ContactTips]]:
+    def _contact_tips(self) -> dict[tuple, tuple[np.ndarray, ContactTips]]:
         return {}
 
     def contact_tips(self, finger: np.ndarray) -> ContactTips:
@@ -102,16 +102,13 @@ class FingerMotion:
         finger indices), kept while the set's array is (the sets of one node set share it):
         the fixed-set solves, the work and the samples read them at every point.
         """
-        kept = self._contact_tips
-        made = kept.get(id(finger))
-        if made is None or made[0] is not finger:
-            if len(kept) >= CONTACT_TIPS_KEPT:
-                kept.clear()
-            masks = tuple(finger == f for f in range(len(self.names)))
-            made = kept[id(finger)] = (finger, ContactTips(
-                self.tip.take(finger), self.start[finger], self.translation[finger], masks,
-                tuple(bool(mine.any()) for mine in masks)))
-        return made[1]
+        return kept_for(self._contact_tips, finger, None, lambda: self._tips_of(finger),
+                        CONTACT_TIPS_KEPT)
+
+    def _tips_of(self, finger: np.ndarray) -> ContactTips:
+        masks = tuple(finger == f for f in range(len(self.names)))
+        return ContactTips(self.tip.take(finger), self.start[finger], self.translation[finger],
+                           masks, tuple(bool(mine.any()) for mine in masks))
 
     @classmethod
     def of(cls, state: ContactState, translations: Mapping[str, tuple[float, float]],

@@ -35,7 +35,7 @@ _ATAN2 = np.frompyfunc(math.atan2, 2, 1)
 
 
 def _floats(values) -> np.ndarray:
-    return np.asarray(values, dtype=float).astype(float, copy=False)
+    return np.asarray(values, dtype=float)
 
 
 def cos(x) -> np.ndarray:

@@ -22,6 +22,7 @@ import pytest
 import yaml
 
 from squeeze_grasp_ros.cli import main
+from squeeze_grasp_ros.exit_codes import ExitCode
 from squeeze_grasp_ros.sweep.evaluate import COLUMNS, run_task
 from squeeze_grasp_ros.sweep.plan import objects, plan_tasks
 from squeeze_grasp_ros.sweep.spec import SweepError, SweepSpec, parse_sweep_spec, sweep_help
@@ -717,11 +718,20 @@ def test_other_spec_in_the_same_directory_is_refused(tmp_path):
         Store(tmp_path / "o", two, plan(two))
 
 
-def test_without_dask_the_verb_says_how_to_install(tmp_path, monkeypatch, capsys):
+@pytest.mark.parametrize("missing", ["distributed", "pyarrow"])
+def test_without_the_extra_both_verbs_say_how_to_install_and_exit_4(tmp_path, monkeypatch, capsys,
+                                                                     missing):
+    """A missing extra is the environment's failure (status 4, as for ``run`` without ROS and
+    ``outline`` without scikit-image), not invalid input, and nothing is written.
+    """
     spec = write_spec(tmp_path, SMALL)
-    monkeypatch.setitem(sys.modules, "distributed", None)
-    assert main(["sweep", str(spec), "--out", str(tmp_path / "o")]) == 2
-    assert "pip install '.[sweep]'" in capsys.readouterr().err
+    monkeypatch.setitem(sys.modules, missing, None)
+    for argv in (["sweep", str(spec), "--out", str(tmp_path / "o")],
+                 ["sweep-report", str(tmp_path / "o")]):
+        assert main(argv) == ExitCode.INTERNAL == 4
+        assert f"error: needs {missing}, which is not installed: pip install '.[sweep]'" \
+            in capsys.readouterr().err
+    assert not (tmp_path / "o").exists()
 
 
 def test_dry_run_and_report(tmp_path, capsys):

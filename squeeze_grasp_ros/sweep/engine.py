@@ -27,13 +27,11 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Callable, Optional
 
+from squeeze_grasp_ros.extras import install_hint
 from squeeze_grasp_ros.sweep.evaluate import prepare, run_task
 from squeeze_grasp_ros.sweep.plan import Task, plan_tasks
 from squeeze_grasp_ros.sweep.spec import LoadedSpec, SweepError
 
-INSTALL_HINT = ("squeeze-grasp sweep needs the 'sweep' extra (Dask distributed and pyarrow): "
-                "pip install '.[sweep]' in the repository (or pip install 'dask[distributed]' "
-                "pyarrow)")
 BAR_WIDTH = 24
 POLL_S = 0.05
 """Seconds between checks for finished tasks and stop signals."""
@@ -56,12 +54,17 @@ cluster keeps its own configuration."""
 
 
 def require_extra() -> None:
-    """Raise :class:`SweepError` with the install command if Dask or pyarrow is missing."""
-    try:
-        import distributed  # noqa: F401
-        import pyarrow  # noqa: F401
-    except ImportError as exc:
-        raise SweepError(f"{INSTALL_HINT} ({exc})") from None
+    """Raise :class:`ModuleNotFoundError` naming the missing module and the install command if
+    Dask distributed or pyarrow is missing (the CLI prints it and exits with status 4, as for
+    every missing extra).
+    """
+    for module in ("distributed", "pyarrow"):
+        try:
+            importlib.import_module(module)
+        except ImportError as exc:
+            raise ModuleNotFoundError(f"squeeze-grasp sweep needs {module}, which is not "
+                                      f"installed: {install_hint(module)} ({exc})",
+                                      name=module) from None
 
 
 class Progress:

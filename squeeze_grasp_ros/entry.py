@@ -32,8 +32,8 @@ def _run(module: str, name: str):
     exit 128 + the signal number (130, 143, 129), not a traceback or a silent kill.
     """
     single_thread_blas()
-    raise_on_signals()
     try:
+        raise_on_signals()
         return importlib.import_module(module).main()
     except (KeyboardInterrupt, ImportError) as exc:
         stop = _interruption(exc)

@@ -20,6 +20,7 @@ from pathlib import Path
 import pytest
 import rclpy
 import yaml
+from executables import wait_until_caught
 from pipeline_support import SMALL_SQUARE
 
 from squeeze_grasp_ros.cli import main
@@ -179,25 +180,6 @@ def test_stale_parameter_files_are_removed_at_the_next_start(tmp_path):
     finally:
         stale.unlink(missing_ok=True)
         live.unlink(missing_ok=True)
-
-
-def wait_until_caught(pid: int, signum: int, timeout: float = 60.0) -> None:
-    """Return once process ``pid`` catches ``signum`` (its handler is installed: Linux's
-    ``SigCgt`` mask in ``/proc/PID/status``).
-
-    No program can handle a signal before its first statement has installed a handler; under
-    load (11 on the 2-core machine) the interpreter's start-up alone took longer than 0.3 s,
-    and a signal sent 0.3 s after the start took the default action.
-    """
-    deadline = time.monotonic() + timeout
-    while True:
-        status = Path(f"/proc/{pid}/status").read_text()
-        caught = int(next(line.split()[1] for line in status.splitlines()
-                          if line.startswith("SigCgt:")), 16)
-        if caught >> (int(signum) - 1) & 1:
-            return
-        assert time.monotonic() < deadline, f"process {pid} installed no {signum!r} handler"
-        time.sleep(0.005)  # polling another process's state, not a synchronisation of ours
 
 
 @pytest.mark.parametrize("delay", [0.0, 0.3, 0.8, 1.5])

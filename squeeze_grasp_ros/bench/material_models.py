@@ -199,17 +199,32 @@ def _exponent(n: list, y: list) -> float:
     return float(np.polyfit(np.log(n), np.log(y), 1)[0])
 
 
-def _neo_row(setup: GraspSetup, linear: tuple, repeats: int,
+def _interleaved(setup: GraspSetup, model: MaterialModel, repeats: int,
+                 kernels: tuple[Kernel, ...]) -> dict[Kernel, list]:
+    """``repeats`` 12 % squeezes by each route of ``kernels``, interleaved: round i runs one
+    squeeze per route, in reversed order every other round (A B, B A, ...), so that the routes
+    are timed in the same minutes of a machine whose speed drifts; {route: :func:`_run`'s
+    (result, wall, CPU) of each round}.
+    """
+    runs: dict[Kernel, list] = {kernel: [] for kernel in kernels}
+    for i in range(repeats):
+        for kernel in (kernels if i % 2 == 0 else kernels[::-1]):
+            with route(kernel):
+                runs[kernel].append(_run(setup, model, 0.12))
+    return runs
+
+
+def _neo_row(runs: list, linear: list,
              kernel: Kernel = Kernel.NUMPY) -> tuple[list, float, dict, float]:
     """(row from the factoriser on, best time, nonlinear diagnostics, the first run's time) of
-    ``repeats`` neo-Hookean squeezes by the ``kernel`` route; ``linear`` is (wall, CPU) time of
-    the linear one by that route.
+    the neo-Hookean squeezes ``runs`` by the ``kernel`` route (:func:`_run`'s triples);
+    ``linear``: the linear squeezes by that route, whose best wall and CPU times it is compared
+    with.
     """
-    with route(kernel):
-        runs = [_run(setup, MaterialModel.NEO_HOOKEAN, 0.12) for _ in range(repeats)]
     res, t, cpu = runs[0][0], min(r[1] for r in runs), min(r[2] for r in runs)
+    t_lin, cpu_lin = min(r[1] for r in linear), min(r[2] for r in linear)
     nl = res.diagnostics["nonlinear"]
-    return ([nl["factorizer"], kernel.value, linear[0], t, t / linear[0], cpu / linear[1], cpu,
+    return ([nl["factorizer"], kernel.value, t_lin, t, t / t_lin, cpu / cpu_lin, cpu,
              len(res.events),
              nl["evaluations"], nl["evaluations"] / max(len(res.events), 1),
              nl["newton_iterations"] / nl["evaluations"], nl["factorizations"], nl["analyses"]],
@@ -228,29 +243,31 @@ def _scaling(quick: bool, progress) -> tuple[Table, Table]:
     for nodes in sizes:
         progress(f"material_models: scaling, {nodes} nodes")
         setup = _setup("foam_square", nodes)
-        _, t_l, cpu_l = _best(setup, MaterialModel.LINEAR, LINEAR_REPEATS)
-        row, t, nl, first = _neo_row(setup, (t_l, cpu_l), NONLINEAR_REPEATS)
+        kernels = ((Kernel.NUMPY, Kernel.NUMBA)
+                   if Kernel.NUMBA in routes() and nodes in COMPILED_NODES[quick]
+                   else (Kernel.NUMPY,))
+        linear = _interleaved(setup, MaterialModel.LINEAR, LINEAR_REPEATS, kernels)
+        neo = _interleaved(setup, MaterialModel.NEO_HOOKEAN, NONLINEAR_REPEATS, kernels)
+        row, t, nl, first = _neo_row(neo[Kernel.NUMPY], linear[Kernel.NUMPY])
         fill = _fill(setup)
         size = setup.num_nodes
         rows.append([size, *row, fill.nnz, fill.flops / 1e6, 1e3 * t / nl["evaluations"],
                      first, nl["assembly"]])
         n.append(size), per_eval.append(t / nl["evaluations"]), nnz.append(fill.nnz)
         flops.append(fill.flops), evals.append(nl["evaluations"]), t_neo.append(t)
-        t_lin.append(t_l)
+        t_lin.append(row[2])
         progress(f"material_models: scaling, {nodes} nodes profiled")
         profiled.append(phases(setup))
         fills.append(fill)
         if method == Factorizer.CHOLMOD and nodes == QDLDL_NODES[quick]:
             progress(f"material_models: scaling, {nodes} nodes with qdldl")
-            with factorizer(Factorizer.QDLDL):
-                row, t, nl, first = _neo_row(setup, (t_l, cpu_l), 1)
+            with factorizer(Factorizer.QDLDL), route(Kernel.NUMPY):
+                qdldl = [_run(setup, MaterialModel.NEO_HOOKEAN, 0.12)]
+            row, t, nl, first = _neo_row(qdldl, linear[Kernel.NUMPY])
             rows.append([size, *row, "-", "-", 1e3 * t / nl["evaluations"], first,
                          nl["assembly"]])
-        if Kernel.NUMBA in routes() and nodes in COMPILED_NODES[quick]:
-            progress(f"material_models: scaling, {nodes} nodes compiled")
-            with route(Kernel.NUMBA):
-                _, t_lc, cpu_lc = _best(setup, MaterialModel.LINEAR, LINEAR_REPEATS)
-            row, t, nl, first = _neo_row(setup, (t_lc, cpu_lc), NONLINEAR_REPEATS, Kernel.NUMBA)
+        if Kernel.NUMBA in kernels:
+            row, t, nl, first = _neo_row(neo[Kernel.NUMBA], linear[Kernel.NUMBA], Kernel.NUMBA)
             rows.append([size, *row, fill.nnz, fill.flops / 1e6, 1e3 * t / nl["evaluations"],
                          first, nl["assembly"]])
     load.append(os.getloadavg()[0])
@@ -271,7 +288,9 @@ def _scaling(quick: bool, progress) -> tuple[Table, Table]:
                  f"{LINEAR_REPEATS}, after the object's precompute; neo-Hookean: best of "
                  f"{NONLINEAR_REPEATS}, whose later runs use the set-up the first kept on the "
                  "object: its assembly geometry, ordering and block gathers; 'first run' is the "
-                 "first run's wall time, with that set-up); 'x linear' compares wall times, "
+                 "first run's wall time, with that set-up; where both routes are measured, "
+                 "their squeezes alternate, A B then B A, so that both are timed in the same "
+                 "minutes); 'x linear' compares wall times, "
                  "'x linear (CPU)' the "
                  "CPU times of this process, which other processes on the machine inflate less "
                  "(the neo-Hookean squeeze's own CPU seconds beside its wall time). "

@@ -42,8 +42,8 @@ __all__ = ["CompiledFunctions"]
 _NO_BOUNDS = np.zeros((0, 0))
 _NO_KAPPA = np.zeros(0)
 _NO_VALUES = np.zeros(0)
-ROW_TABLES_KEPT = 32
-"""Tables of (contact set, boundary rows) the compiled reads of a call keep
+ROW_TABLES_KEPT = 64
+"""Tables of (contact set, boundary rows) the compiled reads of a model's calls keep
 (:meth:`CompiledFunctions._rows_of`)."""
 
 
@@ -58,7 +58,7 @@ class CompiledFunctions:
         self.functions = functions
         self.kernel = compiled_substeps()
         self._last: tuple | None = None
-        self._rows: dict[tuple, tuple] = {}
+        self._rows: dict[tuple, tuple] = functions.model._cache.setdefault("compiled_rows", {})
 
     @classmethod
     def of(cls, functions: EventFunctions) -> CompiledFunctions | None:
@@ -141,14 +141,16 @@ class CompiledFunctions:
         """(the rows of the set's boundary compliance and rigid modes, the rows' undeformed
         positions, the area bounds or none while the fingers stay) of ``contacts`` and boundary
         ``rows``: kept for the call's last few sets (a point's reads and the substeps of a set
-        ask for the same ones).
+        ask for the same ones), by the model for its calls (an evaluation's calls ask for
+        the same ones too).
         """
         sd = contacts.data
-        return kept_for(self._rows, sd, (rows.dtype.str, rows.tobytes()),
-                        lambda: self._tables(sd, rows), ROW_TABLES_KEPT)
+        moving = self.functions.motion.rate > 0
+        return kept_for(self._rows, sd, (moving, rows.dtype.str, rows.tobytes()),
+                        lambda: self._tables(sd, rows, moving), ROW_TABLES_KEPT)
 
-    def _tables(self, sd: SetData, rows: np.ndarray) -> tuple:
+    def _tables(self, sd: SetData, rows: np.ndarray, moving: bool) -> tuple:
         functions = self.functions
         model = functions.model
         return (*model._boundary_rows(sd, rows), functions._boundary[rows],
-                model.area_tables(sd)[0] if functions.motion.rate > 0 else _NO_BOUNDS)
+                model.area_tables(sd)[0] if moving else _NO_BOUNDS)

@@ -56,6 +56,9 @@ __all__ = ["EventFunctions", "EventValues", "KeyOrder", "WatchedValues", "event_
            "pickup_margin"]
 
 _NO_ROWS = np.zeros(0, int)
+ENTRY_TABLES_KEPT = 2048
+"""Tables of keys and rows a model keeps for its calls' event functions
+(:attr:`EventFunctions._entry_tables`; checked once per call)."""
 
 
 def pickup_margin(
@@ -338,12 +341,15 @@ class EventFunctions:
         return CompiledFunctions.of(self)
 
     def _order(self, keys: list[EventKey], rows: np.ndarray) -> KeyOrder:
-        """The :class:`KeyOrder` of per-contact ``keys`` and the gaps of ``rows`` (kept)."""
+        """The :class:`KeyOrder` of per-contact ``keys`` and the gaps of ``rows`` (kept with
+        ``keys``, by identity: a list the tables no longer hold may share a dead one's id).
+        """
         tag = ("watched", id(keys), rows.dtype.str, rows.tobytes())
-        order = self._entry_tables.get(tag)
-        if order is None:
-            order = self._entry_tables[tag] = KeyOrder((*keys, *self._row_gap_keys(rows)))
-        return order
+        made = self._entry_tables.get(tag)
+        if made is None or made[0] is not keys:
+            made = self._entry_tables[tag] = (
+                keys, KeyOrder((*keys, *self._row_gap_keys(rows))))
+        return made[1]
 
     def _ends(self, area: float, strain: float, pickup: float) -> dict[EventKey, float]:
         """The termination functions that are checked (finite), by key."""
@@ -356,10 +362,16 @@ class EventFunctions:
 
     @kept_property
     def _entry_tables(self) -> dict[tuple, object]:
-        """Key lists made so far in the call (:meth:`_contact_entries`, :meth:`_row_gap_keys`,
-        :meth:`_sloped_keys`), by what they depend on.
+        """Key lists and free rows made so far (:meth:`_contact_entries`, :meth:`_row_gap_keys`,
+        :meth:`_sloped_keys`, :meth:`free_rows`, :meth:`_order`), by what they depend on: kept
+        by the model for its calls with as many fingers (they depend on the model, the finger
+        count and their tag only; an evaluation's calls ask for the same ones), emptied
+        beyond :data:`ENTRY_TABLES_KEPT`.
         """
-        return {}
+        tables = self.model._cache.setdefault(("event_tables", len(self.motion.names)), {})
+        if len(tables) >= ENTRY_TABLES_KEPT:
+            tables.clear()
+        return tables
 
     def _contact_entries(self, contacts: ContactSet,
                          held: np.ndarray) -> tuple[list[EventKey], np.ndarray]:

@@ -535,8 +535,16 @@ def _attempt_compiled(C: np.ndarray, cfg: Configuration, centers: np.ndarray, di
         return SolveFailure(SINGULAR_SLIDING, residual, indeterminate=True)
     if status == kernel.NON_FINITE:
         return SolveFailure(NON_FINITE, residual)
-    cond = float(np.linalg.cond(J)) if J.size else 1.0
-    return Solution(theta, delta, F, dtheta, dF, ddelta, it, residual, cond, nu, kappa)
+    return Solution(theta, delta, F, dtheta, dF, ddelta, it, residual, _condition(J), nu, kappa)
+
+
+def _condition(J: np.ndarray) -> float:
+    """np.linalg.cond(J), 1 for no sliding node; a single sliding node's (1, 1) J with a
+    finite nonzero entry is exactly 1 (its singular value is |J|), without the SVD.
+    """
+    if J.size == 1 and 0.0 < abs(J[0, 0]) < np.inf:
+        return 1.0
+    return float(np.linalg.cond(J)) if J.size else 1.0
 
 
 @dataclass(frozen=True)

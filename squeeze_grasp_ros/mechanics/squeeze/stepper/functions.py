@@ -30,6 +30,7 @@ double roots inside an adaptive substep).
 """
 from __future__ import annotations
 
+import math
 from collections.abc import Iterator, Mapping
 from dataclasses import dataclass
 
@@ -356,7 +357,7 @@ class EventFunctions:
         ends = {}
         for function, value in ((EventFunction.AREA, area), (EventFunction.STRAIN, strain),
                                 (EventFunction.PICKUP, pickup)):
-            if np.isfinite(value):
+            if math.isfinite(value):
                 ends[self.keys.get(function)] = value
         return ends
 

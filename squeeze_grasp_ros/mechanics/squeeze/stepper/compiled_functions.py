@@ -43,7 +43,7 @@ _NO_BOUNDS = np.zeros((0, 0))
 _NO_KAPPA = np.zeros(0)
 _NO_VALUES = np.zeros(0)
 ROW_TABLES_KEPT = 64
-"""Tables of (contact set, boundary rows) the compiled reads of a model's calls keep
+"""Tables of (contact set, boundary rows) the compiled reads of an object's calls keep
 (:meth:`CompiledFunctions._rows_of`)."""
 
 
@@ -58,7 +58,8 @@ class CompiledFunctions:
         self.functions = functions
         self.kernel = compiled_substeps()
         self._last: tuple | None = None
-        self._rows: dict[tuple, tuple] = functions.model._cache.setdefault("compiled_rows", {})
+        self._rows: dict[tuple, tuple] = functions.model.obj._shared.setdefault(
+            "compiled_rows", {})
 
     @classmethod
     def of(cls, functions: EventFunctions) -> CompiledFunctions | None:
@@ -141,8 +142,8 @@ class CompiledFunctions:
         """(the rows of the set's boundary compliance and rigid modes, the rows' undeformed
         positions, the area bounds or none while the fingers stay) of ``contacts`` and boundary
         ``rows``: kept for the call's last few sets (a point's reads and the substeps of a set
-        ask for the same ones), by the model for its calls (an evaluation's calls ask for
-        the same ones too).
+        ask for the same ones), by the object for its models' calls (what they depend on is
+        the object's: a sweep's evaluations of an object ask for the same ones too).
         """
         sd = contacts.data
         moving = self.functions.motion.rate > 0

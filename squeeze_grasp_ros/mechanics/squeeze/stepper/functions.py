@@ -58,7 +58,7 @@ __all__ = ["EventFunctions", "EventValues", "KeyOrder", "WatchedValues", "event_
 
 _NO_ROWS = np.zeros(0, int)
 ENTRY_TABLES_KEPT = 2048
-"""Tables of keys and rows a model keeps for its calls' event functions
+"""Tables of keys and rows an object keeps for its calls' event functions
 (:attr:`EventFunctions._entry_tables`; checked once per call)."""
 
 
@@ -365,11 +365,12 @@ class EventFunctions:
     def _entry_tables(self) -> dict[tuple, object]:
         """Key lists and free rows made so far (:meth:`_contact_entries`, :meth:`_row_gap_keys`,
         :meth:`_sloped_keys`, :meth:`free_rows`, :meth:`_order`), by what they depend on: kept
-        by the model for its calls with as many fingers (they depend on the model, the finger
-        count and their tag only; an evaluation's calls ask for the same ones), emptied
-        beyond :data:`ENTRY_TABLES_KEPT`.
+        by the object for the calls of its models with friction or without and as many
+        fingers (they depend on those and their tag only; a sweep's evaluations of an object
+        ask for the same ones), emptied beyond :data:`ENTRY_TABLES_KEPT`.
         """
-        tables = self.model._cache.setdefault(("event_tables", len(self.motion.names)), {})
+        tables = self.model.obj._shared.setdefault(
+            ("event_tables", self.frictionless, len(self.motion.names)), {})
         if len(tables) >= ENTRY_TABLES_KEPT:
             tables.clear()
         return tables

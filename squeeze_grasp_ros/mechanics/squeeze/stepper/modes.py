@@ -117,10 +117,11 @@ def _violations(sol: Solution, idx: list[int], zero: dict[int, set[EventFunction
 
 def _zero_by_contact(contacts: ContactSet, zero: set[EventKey]) -> dict[int, set[EventFunction]]:
     """The functions of ``zero`` by the position of their contact node in the set."""
+    position = {node: k for k, node in enumerate(contacts.nodes.tolist())}
     out: dict[int, set[EventFunction]] = {}
     for key in zero:
-        k = contacts.index(key.node)
-        if k < len(contacts) and contacts.nodes[k] == key.node:
+        k = position.get(key.node)
+        if k is not None:
             out.setdefault(k, set()).add(key.function)
     return out
 

@@ -47,6 +47,11 @@ ROW_TABLES_KEPT = 64
 (:meth:`CompiledFunctions._rows_of`)."""
 
 
+def _same(a: np.ndarray, b: np.ndarray) -> bool:
+    """Whether two index arrays are equal (the same kept table, most often)."""
+    return a is b or np.array_equal(a, b)
+
+
 class CompiledFunctions:
     """The compiled reads of one call's :class:`~.functions.EventFunctions` (see the module).
 
@@ -106,7 +111,7 @@ class CompiledFunctions:
         if last is not None and last[0] is contacts and last[1] is sol:
             if not len(rows) and not len(pick):
                 return _NO_VALUES, last[6], last[7]
-            if last[2] == s and np.array_equal(last[3], rows) and np.array_equal(last[4], pick):
+            if last[2] == s and _same(last[3], rows) and _same(last[4], pick):
                 return last[5], last[6], last[7]
         functions = self.functions
         model, motion = functions.model, functions.motion

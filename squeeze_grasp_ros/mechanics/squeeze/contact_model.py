@@ -535,8 +535,22 @@ def _attempt_compiled(C: np.ndarray, cfg: Configuration, centers: np.ndarray, di
         return SolveFailure(SINGULAR_SLIDING, residual, indeterminate=True)
     if status == kernel.NON_FINITE:
         return SolveFailure(NON_FINITE, residual)
-    cond = float(np.linalg.cond(J)) if J.size else 1.0
-    return Solution(theta, delta, F, dtheta, dF, ddelta, it, residual, cond, nu, kappa)
+    return Solution(theta, delta, F, dtheta, dF, ddelta, it, residual, jacobian_condition(J), nu,
+                    kappa)
+
+
+def jacobian_condition(J: np.ndarray) -> float:
+    """The largest np.linalg.cond of a sliding Jacobian J (k, k) or a stack of them
+    (c, k, k); 1 without sliding nodes (k = 0). With one sliding node (k = 1) and finite
+    nonzero entries it is exactly 1 (the singular value is |J|), found without the SVD.
+    """
+    if J.size == 0:
+        return 1.0
+    if J.shape[-1] == 1:
+        a = np.abs(J)
+        if np.all((a > 0.0) & (a < np.inf)):
+            return 1.0
+    return float(np.linalg.cond(J).max())
 
 
 @dataclass(frozen=True)

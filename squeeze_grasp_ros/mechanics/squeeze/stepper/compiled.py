@@ -27,6 +27,7 @@ from squeeze_grasp_ros.mechanics.squeeze.contact_model import (
     NEWTON_TOL,
     ContactModel,
     Solution,
+    jacobian_condition,
 )
 from squeeze_grasp_ros.mechanics.squeeze.contact_state import Sample
 from squeeze_grasp_ros.mechanics.squeeze.event_key import SHARED_KEYS, EventFunction
@@ -176,13 +177,12 @@ class CompiledSubsteps:
         counters.newton_max_residual = max(counters.newton_max_residual, most_res)
         if n:
             counters.jacobian_max_condition = max(
-                counters.jacobian_max_condition, float(np.linalg.cond(jacobians[:count]).max()))
+                counters.jacobian_max_condition, jacobian_condition(jacobians[:count]))
         nodes, names = tuple(contacts.nodes.tolist()), motion.names
         for s, th, forces in zip(s_out[:count].tolist(), theta_out[:count].tolist(),
                                  forces_out[:count].tolist()):
             call.samples.append(Sample(motion.depth_at(s), nodes, tuple(th),
                                        {name: tuple(f) for name, f in zip(names, forces)}))
-        cond = float(np.linalg.cond(J)) if J.size else 1.0
         b = float(s_out[count - 1])
-        return Chunk(count, python_next, b,
-                     Solution(theta, delta, F, dtheta, dF, ddelta, it, res, cond, nu, kappa))
+        return Chunk(count, python_next, b, Solution(theta, delta, F, dtheta, dF, ddelta, it, res,
+                                                     jacobian_condition(J), nu, kappa))

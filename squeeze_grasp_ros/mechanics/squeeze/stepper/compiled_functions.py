@@ -42,9 +42,14 @@ __all__ = ["CompiledFunctions"]
 _NO_BOUNDS = np.zeros((0, 0))
 _NO_KAPPA = np.zeros(0)
 _NO_VALUES = np.zeros(0)
-ROW_TABLES_KEPT = 32
-"""Tables of (contact set, boundary rows) the compiled reads of a call keep
+ROW_TABLES_KEPT = 64
+"""Tables of (contact set, boundary rows) the compiled reads of an object's calls keep
 (:meth:`CompiledFunctions._rows_of`)."""
+
+
+def _same(a: np.ndarray, b: np.ndarray) -> bool:
+    """Whether two index arrays are equal (the same kept table, most often)."""
+    return a is b or np.array_equal(a, b)
 
 
 class CompiledFunctions:
@@ -58,7 +63,8 @@ class CompiledFunctions:
         self.functions = functions
         self.kernel = compiled_substeps()
         self._last: tuple | None = None
-        self._rows: dict[tuple, tuple] = {}
+        self._rows: dict[tuple, tuple] = functions.model.obj._shared.setdefault(
+            "compiled_rows", {})
 
     @classmethod
     def of(cls, functions: EventFunctions) -> CompiledFunctions | None:
@@ -105,7 +111,7 @@ class CompiledFunctions:
         if last is not None and last[0] is contacts and last[1] is sol:
             if not len(rows) and not len(pick):
                 return _NO_VALUES, last[6], last[7]
-            if last[2] == s and np.array_equal(last[3], rows) and np.array_equal(last[4], pick):
+            if last[2] == s and _same(last[3], rows) and _same(last[4], pick):
                 return last[5], last[6], last[7]
         functions = self.functions
         model, motion = functions.model, functions.motion
@@ -141,14 +147,16 @@ class CompiledFunctions:
         """(the rows of the set's boundary compliance and rigid modes, the rows' undeformed
         positions, the area bounds or none while the fingers stay) of ``contacts`` and boundary
         ``rows``: kept for the call's last few sets (a point's reads and the substeps of a set
-        ask for the same ones).
+        ask for the same ones), by the object for its models' calls (what they depend on is
+        the object's: a sweep's evaluations of an object ask for the same ones too).
         """
         sd = contacts.data
-        return kept_for(self._rows, sd, (rows.dtype.str, rows.tobytes()),
-                        lambda: self._tables(sd, rows), ROW_TABLES_KEPT)
+        moving = self.functions.motion.rate > 0
+        return kept_for(self._rows, sd, (moving, rows.dtype.str, rows.tobytes()),
+                        lambda: self._tables(sd, rows, moving), ROW_TABLES_KEPT)
 
-    def _tables(self, sd: SetData, rows: np.ndarray) -> tuple:
+    def _tables(self, sd: SetData, rows: np.ndarray, moving: bool) -> tuple:
         functions = self.functions
         model = functions.model
         return (*model._boundary_rows(sd, rows), functions._boundary[rows],
-                model.area_tables(sd)[0] if functions.motion.rate > 0 else _NO_BOUNDS)
+                model.area_tables(sd)[0] if moving else _NO_BOUNDS)

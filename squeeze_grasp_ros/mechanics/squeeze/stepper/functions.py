@@ -30,6 +30,7 @@ double roots inside an adaptive substep).
 """
 from __future__ import annotations
 
+import math
 from collections.abc import Iterator, Mapping
 from dataclasses import dataclass
 
@@ -56,6 +57,9 @@ __all__ = ["EventFunctions", "EventValues", "KeyOrder", "WatchedValues", "event_
            "pickup_margin"]
 
 _NO_ROWS = np.zeros(0, int)
+ENTRY_TABLES_KEPT = 2048
+"""Tables of keys and rows an object keeps for its calls' event functions
+(:attr:`EventFunctions._entry_tables`; checked once per call)."""
 
 
 def pickup_margin(
@@ -338,28 +342,38 @@ class EventFunctions:
         return CompiledFunctions.of(self)
 
     def _order(self, keys: list[EventKey], rows: np.ndarray) -> KeyOrder:
-        """The :class:`KeyOrder` of per-contact ``keys`` and the gaps of ``rows`` (kept)."""
+        """The :class:`KeyOrder` of per-contact ``keys`` and the gaps of ``rows`` (kept with
+        ``keys``, by identity: a list the tables no longer hold may share a dead one's id).
+        """
         tag = ("watched", id(keys), rows.dtype.str, rows.tobytes())
-        order = self._entry_tables.get(tag)
-        if order is None:
-            order = self._entry_tables[tag] = KeyOrder((*keys, *self._row_gap_keys(rows)))
-        return order
+        made = self._entry_tables.get(tag)
+        if made is None or made[0] is not keys:
+            made = self._entry_tables[tag] = (
+                keys, KeyOrder((*keys, *self._row_gap_keys(rows))))
+        return made[1]
 
     def _ends(self, area: float, strain: float, pickup: float) -> dict[EventKey, float]:
         """The termination functions that are checked (finite), by key."""
         ends = {}
         for function, value in ((EventFunction.AREA, area), (EventFunction.STRAIN, strain),
                                 (EventFunction.PICKUP, pickup)):
-            if np.isfinite(value):
+            if math.isfinite(value):
                 ends[self.keys.get(function)] = value
         return ends
 
     @kept_property
     def _entry_tables(self) -> dict[tuple, object]:
-        """Key lists made so far in the call (:meth:`_contact_entries`, :meth:`_row_gap_keys`,
-        :meth:`_sloped_keys`), by what they depend on.
+        """Key lists and free rows made so far (:meth:`_contact_entries`, :meth:`_row_gap_keys`,
+        :meth:`_sloped_keys`, :meth:`free_rows`, :meth:`_order`), by what they depend on: kept
+        by the object for the calls of its models with friction or without and as many
+        fingers (they depend on those and their tag only; a sweep's evaluations of an object
+        ask for the same ones), emptied beyond :data:`ENTRY_TABLES_KEPT`.
         """
-        return {}
+        tables = self.model.obj._shared.setdefault(
+            ("event_tables", self.frictionless, len(self.motion.names)), {})
+        if len(tables) >= ENTRY_TABLES_KEPT:
+            tables.clear()
+        return tables
 
     def _contact_entries(self, contacts: ContactSet,
                          held: np.ndarray) -> tuple[list[EventKey], np.ndarray]:

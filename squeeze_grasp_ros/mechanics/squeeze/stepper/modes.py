@@ -98,16 +98,32 @@ class ModeChoice:
     violations: int
 
 
-def _violations(contacts: ContactSet, sol: Solution, k: int, zero: set[EventKey], mu: float,
-                stick: bool, slip: int, rate_floor: float) -> int:
-    """:func:`mode_violations` of contact k in the hypothesis (stick, slip)."""
-    node = int(contacts.nodes[k])
-    return mode_violations(
-        mu=mu, fn=float(sol.normal[k]), ft=float(sol.tangential[k]),
-        fn_rate=float(sol.normal_rate[k]), ft_rate=float(sol.tangential_rate[k]),
-        dtheta=float(sol.dtheta[k]), stick=bool(stick), slip=int(slip),
-        frictionless=mu == 0.0, zero={key.function for key in zero if key.node == node},
-        rate_floor=rate_floor)
+def _violations(sol: Solution, idx: list[int], zero: dict[int, set[EventFunction]],
+                mu: float, stick: np.ndarray, slip: np.ndarray, rate_floor: float) -> int:
+    """:func:`mode_violations` of contacts ``idx`` summed, in the hypothesis (``stick``,
+    ``slip``); ``zero`` holds each contact's functions zero by construction
+    (:func:`_zero_by_contact`).
+    """
+    fn, ft = sol.normal[idx].tolist(), sol.tangential[idx].tolist()
+    fn_rate, ft_rate = sol.normal_rate[idx].tolist(), sol.tangential_rate[idx].tolist()
+    dtheta = sol.dtheta[idx].tolist()
+    frictionless, none = mu == 0.0, frozenset()
+    return sum(mode_violations(mu=mu, fn=fn[i], ft=ft[i], fn_rate=fn_rate[i],
+                               ft_rate=ft_rate[i], dtheta=dtheta[i], stick=bool(stick[k]),
+                               slip=int(slip[k]), frictionless=frictionless,
+                               zero=zero.get(k, none), rate_floor=rate_floor)
+               for i, k in enumerate(idx))
+
+
+def _zero_by_contact(contacts: ContactSet, zero: set[EventKey]) -> dict[int, set[EventFunction]]:
+    """The functions of ``zero`` by the position of their contact node in the set."""
+    position = {node: k for k, node in enumerate(contacts.nodes.tolist())}
+    out: dict[int, set[EventFunction]] = {}
+    for key in zero:
+        k = position.get(key.node)
+        if k is not None:
+            out.setdefault(k, set()).add(key.function)
+    return out
 
 
 def _options(mu: float) -> list[tuple[bool, int]]:
@@ -115,8 +131,8 @@ def _options(mu: float) -> list[tuple[bool, int]]:
     return [(False, 0)] if mu == 0.0 else [(True, 0), (False, 1), (False, -1)]
 
 
-def _node_by_node(contacts: ContactSet, idx: list[int], zero: set[EventKey], attempt: Attempt,
-                  mu: float, rate_floor: float) -> tuple:
+def _node_by_node(contacts: ContactSet, idx: list[int], zero: dict[int, set[EventFunction]],
+                  attempt: Attempt, mu: float, rate_floor: float) -> tuple:
     """Node-by-node hypothesis-and-test (two passes) for many undecided nodes."""
     options = _options(mu)
     stick, slip = contacts.stick.copy(), contacts.slip.copy()
@@ -128,7 +144,7 @@ def _node_by_node(contacts: ContactSet, idx: list[int], zero: set[EventKey], att
                 sol = attempt(contacts.with_modes(stick, slip))
                 if isinstance(sol, SolveFailure):
                     continue
-                if _violations(contacts, sol, k, zero, mu, st, sl, rate_floor) == 0:
+                if _violations(sol, [k], zero, mu, stick, slip, rate_floor) == 0:
                     choice[k] = (st, sl)
                     break
             stick[k], slip[k] = choice[k]
@@ -173,10 +189,11 @@ def decide_modes(contacts: ContactSet, nodes: list[int], zero: set[EventKey], at
         If no hypothesis can be solved.
     """
     idx = [contacts.index(n) for n in sorted(nodes)]
+    zero_at = _zero_by_contact(contacts, zero)
     if len(idx) <= MAX_JOINT_NODES:
         candidates = itertools.product(_options(mu), repeat=len(idx))
     else:
-        candidates = [_node_by_node(contacts, idx, zero, attempt, mu, rate_floor)]
+        candidates = [_node_by_node(contacts, idx, zero_at, attempt, mu, rate_floor)]
     best, failures = None, []
     for combo in candidates:
         stick, slip = contacts.stick.copy(), contacts.slip.copy()
@@ -186,8 +203,7 @@ def decide_modes(contacts: ContactSet, nodes: list[int], zero: set[EventKey], at
         if isinstance(sol, SolveFailure):
             failures.append(sol)
             continue
-        bad = sum(_violations(contacts, sol, k, zero, mu, stick[k], slip[k], rate_floor)
-                  for k in idx)
+        bad = _violations(sol, idx, zero_at, mu, stick, slip, rate_floor)
         if best is None or bad < best.violations:
             best = ModeChoice(stick, slip, sol.theta, bad)
         if bad == 0:

@@ -22,6 +22,7 @@ from squeeze_grasp_ros.mechanics.squeeze.contact_model import (
     attempt_fixed_set,
 )
 from squeeze_grasp_ros.mechanics.squeeze.fixed_set_kernel import Kernel, selected
+from squeeze_grasp_ros.mechanics.squeeze.kept import kept_property
 from squeeze_grasp_ros.mechanics.squeeze.stepper.contact_set import ContactSet
 from squeeze_grasp_ros.mechanics.squeeze.stepper.motion import FingerMotion
 
@@ -90,6 +91,11 @@ class SetSolver:
     counters: Counters
     kernel: Kernel = field(default_factory=selected)
 
+    @kept_property
+    def phi(self) -> float:
+        """The model's friction angle, rad (read once for the call's solves)."""
+        return self.model.phi
+
     def attempt(self, contacts: ContactSet, s: float,
                 theta: np.ndarray | None = None) -> Solution | SolveFailure:
         """The solution of ``contacts`` at s (from ``theta``, default the set's), or why none."""
@@ -100,7 +106,7 @@ class SetSolver:
             tips.start + s * tips.translation,
             tips.translation,
             contacts.theta if theta is None else theta,
-            self.model.phi,
+            self.phi,
             kernel=self.kernel,
         )
         if not isinstance(sol, SolveFailure):

@@ -22,9 +22,9 @@ from squeeze_grasp_ros.mechanics.vocabulary import ContactMode
 from squeeze_grasp_ros.ros.messages.cdr import (
     CdrTemplate,
     CdrWriter,
+    planar,
     refilled,
     write_contact_arrays,
-    planar,
     write_finger_vectors,
 )
 from squeeze_grasp_ros.ros.messages.common import float64_array, header, set_stamp, stamp_ns

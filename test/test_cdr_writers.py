@@ -9,8 +9,6 @@ along the foam square's squeeze serialises alike tick by tick.
 """
 from __future__ import annotations
 
-import dataclasses
-
 import numpy as np
 import pytest
 from hypothesis import given, settings
@@ -255,8 +253,8 @@ def test_the_monitors_messages_refill_as_written(out, frame, later, scale):
     def shifted(v):
         return v * 0.5 - scale
 
-    nxt = dataclasses.replace(
-        out, stamp_ns=later, positions={f: shifted(v) for f, v in out.positions.items()},
+    nxt = out._replace(
+        stamp_ns=later, positions={f: shifted(v) for f, v in out.positions.items()},
         forces={f: shifted(v) for f, v in out.forces.items()},
         normals={f: -v for f, v in out.normals.items()},
         ages={f: a / 2.0 for f, a in out.ages.items()},

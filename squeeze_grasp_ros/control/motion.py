@@ -67,6 +67,7 @@ from __future__ import annotations
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from functools import cached_property
+from typing import NamedTuple
 
 import numpy as np
 
@@ -233,9 +234,9 @@ def _resistance_problem(goal: GraspGoal, known: Sequence[str]) -> str | None:
     return None
 
 
-@dataclass(frozen=True)
-class Observation:
-    """What the executor knows at a control cycle (the monitor's status; object frame, SI).
+class Observation(NamedTuple):
+    """What the executor knows at a control cycle (the monitor's status; object frame, SI; a
+    named tuple: one is built per cycle).
 
     Attributes
     ----------

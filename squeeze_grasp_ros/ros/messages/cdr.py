@@ -37,7 +37,7 @@ import numpy as np
 from squeeze_grasp_ros.ros.messages.contacts import TactileReadings, check_taxels
 
 __all__ = ["CdrTemplate", "CdrWriter", "cdr_stamp_ns", "clock_cdr", "monitor_status_cdr_reading",
-           "pose_position_cdr", "pose_stamped_cdr", "refilled",
+           "planar", "pose_position_cdr", "pose_stamped_cdr", "refilled",
            "tactile_array_cdr", "tactile_readings_cdr", "tick_cdr", "tick_readings_cdr",
            "wrench_force_cdr", "wrench_stamped_cdr", "write_contact_arrays",
            "write_finger_vectors"]
@@ -450,9 +450,10 @@ class CdrTemplate:
         The first message, written in full; its buffer is kept (and no longer grows).
     stamps : sequence of int
         Offsets of the message's stamps (``builtin_interfaces/Time``).
-    runs : sequence of (int, int or tuple of int)
+    runs : sequence of (int, int or tuple of int) or (int, tuple of int, int)
         (offset, shape) of each float64 run refilled, in :meth:`refill`'s order (a shape
-        (k, 3): k vectors).
+        (k, 3): k vectors); with a third entry, only that many leading columns are refilled
+        (``(offset, (k, 3), 2)``: k planar vectors whose z keeps the first message's value).
     counters : sequence of int
         Offsets of the ``uint64`` fields refilled.
     """
@@ -462,8 +463,7 @@ class CdrTemplate:
     def __init__(self, writer: CdrWriter, stamps=(), runs=(), counters=()) -> None:
         self.buffer = writer.buffer
         self.stamps = tuple(stamps)
-        views = (np.frombuffer(self.buffer, "<f8", math.prod(np.atleast_1d(shape)),
-                               offset).reshape(shape) for offset, shape in runs)
+        views = (_run_view(self.buffer, *run) for run in runs)
         self.runs = tuple((index, view) for index, view in enumerate(views) if view.size)
         """(index in refill's values, writable view) of each run that has numbers."""
         self.counters = tuple(counters)
@@ -481,6 +481,14 @@ class CdrTemplate:
         for index, run in self.runs:
             run[:] = values[index]
         return bytes(buffer)
+
+
+def _run_view(buffer: bytearray, offset: int, shape, columns: int | None = None) -> np.ndarray:
+    """A writable view of the float64 run of ``shape`` at ``offset`` (its first ``columns``
+    columns only, if given).
+    """
+    view = np.frombuffer(buffer, "<f8", math.prod(np.atleast_1d(shape)), offset).reshape(shape)
+    return view if columns is None else view[..., :columns]
 
 
 _TIME_INTO, _U64_INTO = (struct.Struct(f).pack_into for f in ("<iI", "<Q"))
@@ -584,18 +592,30 @@ def write_contact_arrays(writer: CdrWriter, ns: int, frame_id: str, fingers, nod
     return stamp, runs
 
 
+def planar(vectors) -> np.ndarray:
+    """The (k, 2) float64 array of ``vectors``, each (x, y): the values of a planar run of
+    :func:`write_finger_vectors` (a vector of another length is refused by the refill).
+    """
+    return np.array(vectors, dtype=np.float64)
+
+
 def write_finger_vectors(writer: CdrWriter, ns: int, frame_id: str, fingers, vectors,
-                         per_finger) -> tuple[int, list[tuple[int, tuple[int, int] | int]]]:
+                         per_finger) -> tuple[int, list[tuple]]:
     """The per-finger head of ``MonitorStatus`` and ``SimState`` into ``writer``: a header, the
-    ``string[]`` of ``fingers``, a ``Point[]`` / ``Vector3[]`` of each of ``vectors`` (each one
-    (x, y, z) per finger) and the ``float64[]`` ``per_finger``. Return the stamp's offset and
-    the (offset, shape) of each run (:class:`CdrTemplate`).
+    ``string[]`` of ``fingers``, a ``Point[]`` / ``Vector3[]`` of each of ``vectors`` (each a
+    (k, 2) array, one planar (x, y) per finger, written with z = 0) and the ``float64[]``
+    ``per_finger``. Return the stamp's offset and each run's (offset, shape), the vectors'
+    as planar runs (offset, (k, 3), 2) (:class:`CdrTemplate`: a refill writes their x and y
+    from (k, 2) arrays and leaves z zero).
     """
     stamp = writer.header(ns, frame_id)
     writer.strings(fingers)
     runs: list = []
+    count = len(fingers)
     for values in vectors:
-        writer.uint32(len(fingers))
-        runs.append((writer.float64s(values), (len(fingers), 3)))
-    runs.append((writer.sequence(per_finger), len(fingers)))
+        writer.uint32(count)
+        spatial = np.zeros((count, 3))
+        spatial[:, :2] = np.reshape(values, (-1, 2))
+        runs.append((writer.float64s(spatial), (count, 3), 2))
+    runs.append((writer.sequence(per_finger), count))
     return stamp, runs

@@ -27,6 +27,7 @@ from squeeze_grasp_ros.mechanics.vocabulary import EventType, Finger
 from squeeze_grasp_ros.ros.messages.cdr import (
     CdrTemplate,
     CdrWriter,
+    planar,
     refilled,
     write_contact_arrays,
     write_finger_vectors,
@@ -36,6 +37,8 @@ from squeeze_grasp_ros.ros.messages.contacts import CONTACT_MODES, fill_contact_
 
 # --------------------------------------------------------------------------- pipeline: monitor
 
+_ORIGIN = np.zeros(2)
+"""The position a status reports for a finger without one."""
 UNSEEN_AGE = 1e300
 """s: the sensor age a ``MonitorStatus`` gives a finger the monitor has no reading of (the
 tracker's infinite age, kept finite for the message)."""
@@ -150,10 +153,9 @@ def monitor_status_cdr(out: TrackerOutput, frame_id: str) -> bytes:
     publishes every tick.
     """
     ns, fingers = out.stamp_ns, out.fingers
-    positions = [out.positions.get(f) for f in fingers]
-    values = ([(0.0, 0.0, 0.0) if xy is None else (xy[0], xy[1], 0.0) for xy in positions],
-              [(*out.forces[f][:2], 0.0) for f in fingers],
-              [(*out.normals[f][:2], 0.0) for f in fingers],
+    positions, forces, normals = out.positions, out.forces, out.normals
+    values = (planar([positions.get(f, _ORIGIN) for f in fingers]),
+              planar([forces[f] for f in fingers]), planar([normals[f] for f in fingers]),
               [min(out.ages[f], UNSEEN_AGE) for f in fingers], out.depth, out.relative_depth)
 
     def write() -> CdrTemplate:

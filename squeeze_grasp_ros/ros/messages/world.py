@@ -22,6 +22,7 @@ from squeeze_grasp_ros.mechanics.vocabulary import ContactMode
 from squeeze_grasp_ros.ros.messages.cdr import (
     CdrTemplate,
     CdrWriter,
+    planar,
     refilled,
     write_contact_arrays,
     write_finger_vectors,
@@ -88,11 +89,10 @@ def sim_state_cdr(
     contacts, arrays = state.contacts, state.arrays
     layout = tuple(map(_LAYOUT, contacts))
     forces, names = arrays.forces, arrays.fingers
-    totals = [_SUM(forces[rows], axis=0) if rows is not None else (0.0, 0.0)
+    totals = [_SUM(forces[rows], axis=0) if rows is not None else _ORIGIN
               for rows in _finger_rows(names, tuple(fingers))]
-    values = ([(*present[f].center[:2], 0.0) if f in present else (0.0, 0.0, 0.0)
-               for f in fingers],
-              [(x, y, 0.0) for x, y in totals],
+    values = (planar([present[f].center if f in present else _ORIGIN for f in fingers]),
+              planar(totals),
               [present[f].work if f in present else 0.0 for f in fingers],
               arrays.thetas, forces[:, 0], forces[:, 1],
               state.depth, state.relative_depth)
@@ -112,6 +112,8 @@ def sim_state_cdr(
 _LAYOUT = attrgetter("finger", "node", "mode")
 """A contact node's (finger, node, mode): the ground truth's layout key."""
 _SUM = np.add.reduce
+_ORIGIN = np.zeros(2)
+"""A finger's position and total force without contacts (x, y)."""
 """``ndarray.sum`` without its Python wrapper."""
 
 

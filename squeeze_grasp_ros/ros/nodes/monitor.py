@@ -45,7 +45,6 @@ watch on fingers 1 and 2 as on a gripper's jaws.
 """
 from __future__ import annotations
 
-import dataclasses
 import sys
 from typing import Any
 
@@ -334,9 +333,9 @@ class MonitorNode(Node):
         out = self.tracker.update(ns, samples)
         watched = self.jaws or self.hand
         if watched is not None and watched.alarms:
-            out = dataclasses.replace(out, alarms=out.alarms + watched.alarms)
+            out = out._replace(alarms=out.alarms + watched.alarms)
         if self.jaws is not None and self.jaws.take_picked_up():
-            out = dataclasses.replace(out, events=out.events + (TrackedEvent(
+            out = out._replace(events=out.events + (TrackedEvent(
                 Termination.PICKED_UP, "", out.depth, out.relative_depth, 0.0),))
         frame = self.p["frame_id"]
         batch = [(self.event_pub, messages.tracked_events_msg(out))] if out.events else []
@@ -344,7 +343,7 @@ class MonitorNode(Node):
             residual, alarms = self.forces.tick(out, samples, frame)
             batch += residual
             if alarms:
-                out = dataclasses.replace(out, alarms=out.alarms + alarms)
+                out = out._replace(alarms=out.alarms + alarms)
         active = {(a.type, a.finger) for a in out.alarms}
         batch += [(self.alarm_pub, messages.alarm_msg(a, ns)) for a in out.alarms
                   if (a.type, a.finger) not in self.active_alarms]

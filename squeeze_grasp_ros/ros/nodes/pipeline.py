@@ -24,6 +24,7 @@ from typing import Any
 from rcl_interfaces.msg import ParameterDescriptor
 from rclpy.clock import Clock, ClockType
 from rclpy.event_handler import PublisherEventCallbacks
+from rclpy.impl.implementation_singleton import rclpy_implementation
 from rclpy.node import Node
 from rclpy.parameter import Parameter
 from rclpy.qos import (
@@ -34,8 +35,10 @@ from rclpy.qos import (
     qos_profile_sensor_data,
 )
 from rclpy.serialization import deserialize_message, serialize_message
-from rclpy.time import Time
 from std_msgs.msg import String
+
+rcl_time_point = rclpy_implementation.rcl_time_point_t
+"""rclpy's time point type (what ``rclpy.time.Time`` wraps)."""
 
 FRAME = "object"
 """Default object frame: x right, y up, the scene's coordinates (m)."""
@@ -347,16 +350,24 @@ class TickClock:
     """
 
     def __init__(self, node: Node) -> None:
-        self.clock = None
+        self.handle = None
+        """The clock's rcl handle (None: the node is not on sim time)."""
         if node.get_parameter("use_sim_time").value:
             node.set_parameters([Parameter("use_sim_time", value=False)])
-            self.clock = node.get_clock()
-            self.clock._set_ros_time_is_active(True)  # what rclpy's TimeSource does with /clock
+            clock = node.get_clock()
+            clock._set_ros_time_is_active(True)  # what rclpy's TimeSource does with /clock
+            self.handle = clock.handle
 
     def advance(self, ns: int) -> None:
-        """Set the ROS time to ``ns`` (a new tick's stamp), if the node runs on sim time."""
-        if self.clock is not None:
-            self.clock.set_ros_time_override(Time(nanoseconds=ns, clock_type=ClockType.ROS_TIME))
+        """Set the ROS time to ``ns`` (a new tick's stamp), if the node runs on sim time.
+
+        What ``Clock.set_ros_time_override(Time(nanoseconds=ns))`` does, on the clock's rcl
+        handle: without the ``Time`` object and its checks (a tick's stamp is a non-negative
+        int), half the cost (about 6 us a tick).
+        """
+        if self.handle is not None:
+            with self.handle:
+                self.handle.set_ros_time_override(rcl_time_point(ns, ClockType.ROS_TIME))
 
 
 class TickAnswer:

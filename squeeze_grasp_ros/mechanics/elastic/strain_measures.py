@@ -30,8 +30,8 @@ from squeeze_grasp_ros.mechanics.elastic.fem import principal_strains as voigt_p
 from squeeze_grasp_ros.mechanics.errors import InvalidInputError
 from squeeze_grasp_ros.mechanics.vocabulary import StrainMeasure
 
-__all__ = ["COMMON_STRAIN_MEASURE", "max_principal_strain", "max_principal_strains",
-           "principal_strains"]
+__all__ = ["COMMON_STRAIN_MEASURE", "largest_pair_entry", "max_principal_strain",
+           "max_principal_strains", "principal_strains"]
 
 COMMON_STRAIN_MEASURE = StrainMeasure.BIOT
 """The measure in which fields of different material models are compared like for like (the
@@ -107,15 +107,18 @@ def principal_strains(F: np.ndarray, measure: StrainMeasure | str) -> np.ndarray
     return _of_stretch(_green_lagrange(H), measure)
 
 
-def _largest(eps: np.ndarray) -> tuple[float, int]:
-    per_element = np.maximum(np.abs(eps[:, 0]), np.abs(eps[:, 1]))
-    k = int(np.argmax(per_element))
-    return float(per_element[k]), k
+def largest_pair_entry(pair: np.ndarray) -> tuple[float, int]:
+    """(largest |entry| of ``pair`` (t, 2), its row): max(|a|, |b|) of the first row where it
+    is largest (a NaN wins, as in argmax), in one pass over the entries in row order.
+    """
+    magnitude = np.abs(pair).reshape(-1)
+    i = int(magnitude.argmax())
+    return float(magnitude[i]), i // 2
 
 
 def max_principal_strain(F: np.ndarray, measure: StrainMeasure | str) -> tuple[float, int]:
     """(largest max(|eps_1|, |eps_2|) over the elements, its element) in ``measure``."""
-    return _largest(principal_strains(F, measure))
+    return largest_pair_entry(principal_strains(F, measure))
 
 
 def max_principal_strains(F: np.ndarray) -> dict[StrainMeasure, float]:

@@ -21,6 +21,8 @@ from squeeze_grasp_ros.cli import main
 from squeeze_grasp_ros.mechanics.elastic.hyperelastic import deformation
 from squeeze_grasp_ros.mechanics.elastic.material import Material
 from squeeze_grasp_ros.mechanics.elastic.strain_measures import (
+    largest_pair_entry,
+    max_principal_strain,
     max_principal_strains,
     principal_strains,
 )
@@ -123,6 +125,39 @@ def test_the_largest_strains_of_a_field_are_its_elements_eigenvalues():
     largest = max_principal_strains(F)
     for measure, eps in expected.items():
         assert largest[measure] == pytest.approx(float(np.abs(eps).max()), rel=1e-12)
+
+
+@settings(max_examples=200, deadline=None)
+@given(st.lists(st.tuples(*[st.sampled_from([-2.0, -1.0, -0.0, 0.0, 1.0, 2.0, np.nan])] * 3),
+                min_size=1, max_size=12))
+def test_the_largest_entry_is_the_first_element_with_the_largest_strain(rows):
+    """Ties, signed zeros and NaN: (value, element) is max(|eps_1|, |eps_2|) of the first
+    element where that is largest, a NaN winning as in argmax, also of a pair that is two
+    columns of a wider array (the componentwise criterion's normal strains).
+    """
+    eps = np.array(rows, float)
+    for pair in (eps[:, :2], eps[:, 1:]):
+        per_element = [max(abs(a), abs(b)) if a == a and b == b else np.nan for a, b in pair]
+        k = next((i for i, v in enumerate(per_element) if v != v), None)
+        if k is None:
+            k = int(np.argmax(per_element))
+        value, element = largest_pair_entry(pair)
+        assert element == k
+        assert value == per_element[k] or (value != value and per_element[k] != per_element[k])
+
+
+def test_the_field_maxima_are_each_measure_s_largest_element():
+    """:func:`max_principal_strains` is the value :func:`max_principal_strain` finds per
+    measure, to the bit (a field with an element folded to a line: log -inf).
+    """
+    rng = np.random.default_rng(3)
+    F = np.eye(2) + 0.2 * rng.standard_normal((300, 2, 2))
+    F[7] = [[1.0, 0.0], [0.0, 0.0]]
+    largest = max_principal_strains(F)
+    assert list(largest) == list(StrainMeasure)
+    for measure in StrainMeasure:
+        assert largest[measure] == max_principal_strain(F, measure)[0]
+    assert largest[StrainMeasure.LOG] == np.inf
 
 
 def test_an_unknown_measure_names_the_valid_ones():

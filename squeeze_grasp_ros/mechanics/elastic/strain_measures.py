@@ -30,8 +30,8 @@ from squeeze_grasp_ros.mechanics.elastic.fem import principal_strains as voigt_p
 from squeeze_grasp_ros.mechanics.errors import InvalidInputError
 from squeeze_grasp_ros.mechanics.vocabulary import StrainMeasure
 
-__all__ = ["COMMON_STRAIN_MEASURE", "max_principal_strain", "max_principal_strains",
-           "principal_strains"]
+__all__ = ["COMMON_STRAIN_MEASURE", "largest_pair_entry", "max_principal_strain",
+           "max_principal_strains", "principal_strains"]
 
 COMMON_STRAIN_MEASURE = StrainMeasure.BIOT
 """The measure in which fields of different material models are compared like for like (the
@@ -54,15 +54,29 @@ def _green_lagrange(H: np.ndarray) -> np.ndarray:
                                             h01 + h10 + (h00 * h01 + h10 * h11)]))
 
 
+def _stretch_ratio(e: np.ndarray) -> np.ndarray:
+    """2 e = lambda^2 - 1 of the Green-Lagrange strains ``e``, clipped at -1 (lambda^2 >= 0;
+    round-off below it).
+    """
+    return np.maximum(2.0 * e, -1.0)
+
+
+def _biot(two_e: np.ndarray) -> np.ndarray:
+    """Biot strains lambda - 1 of :func:`_stretch_ratio` ``two_e``."""
+    return two_e / (1.0 + np.sqrt(1.0 + two_e))
+
+
+def _log(two_e: np.ndarray) -> np.ndarray:
+    """Log strains ln lambda of :func:`_stretch_ratio` ``two_e``."""
+    with np.errstate(divide="ignore"):
+        return 0.5 * np.log1p(two_e)
+
+
 def _of_stretch(e: np.ndarray, measure: StrainMeasure) -> np.ndarray:
     """Principal strains in a measure of the stretch from the Green-Lagrange ones ``e``."""
     if measure == StrainMeasure.GREEN_LAGRANGE:
         return e
-    two_e = np.maximum(2.0 * e, -1.0)  # lambda^2 = 1 + 2 e >= 0; clip round-off below it
-    if measure == StrainMeasure.BIOT:
-        return two_e / (1.0 + np.sqrt(1.0 + two_e))
-    with np.errstate(divide="ignore"):
-        return 0.5 * np.log1p(two_e)
+    return (_biot if measure == StrainMeasure.BIOT else _log)(_stretch_ratio(e))
 
 
 def principal_strains(F: np.ndarray, measure: StrainMeasure | str) -> np.ndarray:
@@ -93,20 +107,30 @@ def principal_strains(F: np.ndarray, measure: StrainMeasure | str) -> np.ndarray
     return _of_stretch(_green_lagrange(H), measure)
 
 
-def _largest(eps: np.ndarray) -> tuple[float, int]:
-    per_element = np.maximum(np.abs(eps[:, 0]), np.abs(eps[:, 1]))
-    k = int(np.argmax(per_element))
-    return float(per_element[k]), k
+def largest_pair_entry(pair: np.ndarray) -> tuple[float, int]:
+    """(largest |entry| of ``pair`` (t, 2), its row): max(|a|, |b|) of the first row where it
+    is largest (a NaN wins, as in argmax), in one pass over the entries in row order.
+    """
+    magnitude = np.abs(pair).reshape(-1)
+    i = int(magnitude.argmax())
+    return float(magnitude[i]), i // 2
 
 
 def max_principal_strain(F: np.ndarray, measure: StrainMeasure | str) -> tuple[float, int]:
     """(largest max(|eps_1|, |eps_2|) over the elements, its element) in ``measure``."""
-    return _largest(principal_strains(F, measure))
+    return largest_pair_entry(principal_strains(F, measure))
 
 
 def max_principal_strains(F: np.ndarray) -> dict[StrainMeasure, float]:
-    """Largest absolute principal strain of the elements in every measure, by measure."""
+    """Largest absolute principal strain of the elements in every measure, by measure.
+
+    The Green-Lagrange strains and their stretch ratio are computed once for the three
+    measures of the stretch, and each maximum is the largest absolute entry (the value of
+    :func:`max_principal_strain`, without its element).
+    """
     H = np.asarray(F, float) - np.eye(2)
     e = _green_lagrange(H)
-    return {m: _largest(_small(H) if m == StrainMeasure.SMALL else _of_stretch(e, m))[0]
-            for m in StrainMeasure}
+    two_e = _stretch_ratio(e)
+    fields = {StrainMeasure.SMALL: _small(H), StrainMeasure.BIOT: _biot(two_e),
+              StrainMeasure.LOG: _log(two_e), StrainMeasure.GREEN_LAGRANGE: e}
+    return {m: float(np.abs(fields[m]).max()) for m in StrainMeasure}

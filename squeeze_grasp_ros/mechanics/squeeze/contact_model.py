@@ -44,6 +44,7 @@ from squeeze_grasp_ros.mechanics.elastic.fem import (
 )
 from squeeze_grasp_ros.mechanics.elastic.hyperelastic import area_ratios
 from squeeze_grasp_ros.mechanics.elastic.reduced import reduce_blocks
+from squeeze_grasp_ros.mechanics.elastic.strain_measures import largest_pair_entry
 from squeeze_grasp_ros.mechanics.errors import InvalidInputError, NumericalError
 from squeeze_grasp_ros.mechanics.squeeze.fixed_set_kernel import Kernel, compiled, selected
 from squeeze_grasp_ros.mechanics.squeeze.kept import kept_property
@@ -863,7 +864,5 @@ def strain_tables(obj: ElasticObject, length: float) -> tuple[np.ndarray, np.nda
 
 def strain_criterion(eps: np.ndarray, criterion: str) -> tuple[float, int]:
     """(max strain, element) from engineering strains (t, 3) by ``criterion`` (eq. 45)."""
-    pair = eps if criterion == StrainCriterion.COMPONENTWISE else principal_strains(eps)
-    per_element = np.maximum(np.abs(pair[:, 0]), np.abs(pair[:, 1]))
-    k = int(np.argmax(per_element))
-    return float(per_element[k]), k
+    pair = eps[:, :2] if criterion == StrainCriterion.COMPONENTWISE else principal_strains(eps)
+    return largest_pair_entry(pair)

@@ -28,6 +28,7 @@ from squeeze_grasp_ros.mechanics.errors import (
 )
 from squeeze_grasp_ros.mechanics.squeeze.contact_model import (
     ContactModel,
+    SetData,
     SolveOptions,
     TerminationLimits,
 )
@@ -420,42 +421,56 @@ def grasp_health(model: ContactModel, state: ContactState, *,
     every measure and the model's stress per element. ``summaries``: the :func:`segment_node`
     of each of the state's contacts, in its order, when the caller has them.
     """
+    return _health(model, state, _contact_loads(model, state), summaries)
+
+
+def _contact_loads(model: ContactModel, state: ContactState
+                   ) -> tuple[SetData, np.ndarray, np.ndarray]:
+    """The set data of ``state``'s contacts and their displacements and forces (k, 2) / L and
+    / (E h L), as the contact model takes them.
+    """
+    sd = model.set_data(tuple(c.node for c in state.contacts))
+    delta = np.array([c.displacement for c in state.contacts]) / model.length
+    F = np.array([c.force for c in state.contacts]) / model.force_unit
+    return sd, delta, F
+
+
+def _health(model: ContactModel, state: ContactState,
+            loads: tuple[SetData, np.ndarray, np.ndarray],
+            summaries: Sequence[SegmentNode] | None) -> tuple[GraspHealth, np.ndarray]:
+    """:func:`grasp_health` of the :func:`_contact_loads` ``loads`` of ``state``."""
     obj = model.obj
-    L, fu = model.length, model.force_unit
-    nodes = tuple(c.node for c in state.contacts)
-    sd = model.set_data(nodes)
-    delta = np.array([c.displacement for c in state.contacts]) / L
-    F = np.array([c.force for c in state.contacts]) / fu
-    u_hat = model.full_displacement(sd, delta, F)
+    u_hat = model.full_displacement(*loads)
     strain, element = model.field_strain(u_hat)
     deformation = model.field_deformation(u_hat)
     stress, stress_measure = element_stresses(model.constitutive_model, deformation,
                                               E=obj.material.E, nu=obj.material.nu)
     vm = von_mises(stress)
-    u = u_hat.reshape(-1, 2) * L
-    norms = np.linalg.norm(u, axis=1)
+    u = u_hat.reshape(-1, 2) * model.length
+    norms = np.sqrt((u * u).sum(axis=1))  # np.linalg.norm(u, axis=1), without its checks
     if summaries is None:
         summaries = [segment_node(c, model.mu) for c in state.contacts]
-    margins = {}
-    for f in state.fingers:
-        seg = [n.slip_margin for c, n in zip(state.contacts, summaries) if c.finger == f.name]
-        if seg:
-            margins[f.name] = float(min(seg))
+    margins: dict[str, list[float]] = {}
+    for c, n in zip(state.contacts, summaries):
+        margins.setdefault(c.finger, []).append(n.slip_margin)
+    max_principal = max_principal_strains(deformation)
+    k_vm, k_u = int(vm.argmax()), int(norms.argmax())
     health = GraspHealth(
         max_strain=strain,
         max_strain_element=element,
         criterion=StrainCriterion(model.limits.criterion),
         strain_measure=model.strain_measure,
-        max_principal_strain=max_principal_strains(deformation),
-        max_von_mises=float(vm.max()),
-        max_von_mises_element=int(np.argmax(vm)),
+        max_principal_strain=max_principal,
+        max_von_mises=float(vm[k_vm]),
+        max_von_mises_element=k_vm,
         stress_measure=stress_measure,
-        max_displacement=float(norms.max()),
-        max_displacement_node=int(np.argmax(norms)),
-        slip_margin=margins,
+        max_displacement=float(norms[k_u]),
+        max_displacement_node=k_u,
+        slip_margin={f.name: float(min(margins[f.name])) for f in state.fingers
+                     if f.name in margins},
     )
-    require_finite("grasp health", [strain, *health.max_principal_strain.values(),
-                                    health.max_von_mises, health.max_displacement])
+    require_finite("grasp health", [strain, *max_principal.values(), health.max_von_mises,
+                                    health.max_displacement])
     return health, u
 
 
@@ -476,6 +491,23 @@ def polar_trajectories(samples: tuple[Sample, ...], relative_per_depth: float) -
         for node, theta in zip(s.nodes, s.thetas):
             out.setdefault(node, []).append((rel, theta))
     return {k: tuple(v) for k, v in out.items()}
+
+
+def _force_curves(samples: tuple[Sample, ...], dirs: Mapping[str, np.ndarray],
+                  relative_per_depth: float) -> dict[str, tuple[tuple[float, float], ...]]:
+    """Finger -> ((relative depth, force along its motion direction N), ...) at ``samples``.
+
+    One product per finger over the samples: f_x d_x + f_y d_y is what the dot product of two
+    2-vectors computes, term for term.
+    """
+    depths = [s.depth * relative_per_depth for s in samples]
+    curves = {}
+    for name in SQUEEZING_FINGERS:
+        d = dirs[name]
+        f = np.array([s.finger_forces[name] for s in samples], float).reshape(-1, 2)
+        along = (f[:, 0] * d[0] + f[:, 1] * d[1]) / max(float(np.linalg.norm(d)), 1e-300)
+        curves[name] = tuple(zip(depths, along.tolist()))
+    return curves
 
 
 def event_squeeze(
@@ -583,12 +615,9 @@ def event_squeeze(
     )
     state = run.state
     summaries = [segment_node(c, mu) for c in state.contacts]
-    health, u_field = grasp_health(model, state, summaries=summaries)
-    L, fu = model.length, model.force_unit
-    delta = np.array([c.displacement for c in state.contacts]) / L
-    F = np.array([c.force for c in state.contacts]) / fu
-    sd = model.set_data(tuple(c.node for c in state.contacts))
-    energy = model.strain_energy(sd, delta, F) * fu * L
+    loads = _contact_loads(model, state)
+    health, u_field = _health(model, state, loads, summaries)
+    energy = model.strain_energy(*loads) * model.force_unit * model.length
     forces_along = {}
     for name in names:
         d = dirs[name] / max(np.linalg.norm(dirs[name]), 1e-300)
@@ -619,11 +648,7 @@ def event_squeeze(
         dissipation={f.name: f.dissipation for f in state.fingers},
         finger_force=forces_along,
         trajectories=polar_trajectories(run.samples, relative_per_depth),
-        force_curve={n: tuple((s.depth * relative_per_depth,
-                               float(np.asarray(s.finger_forces[n]) @ dirs[n]) / length)
-                              for s in run.samples)
-                     for n, length in ((n, max(float(np.linalg.norm(dirs[n])), 1e-300))
-                                       for n in names)},
+        force_curve=_force_curves(run.samples, dirs, relative_per_depth),
         health=health,
         chatter=run.chatter,
         displacement=u_field,

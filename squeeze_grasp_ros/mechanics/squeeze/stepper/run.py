@@ -216,11 +216,15 @@ class _Call:
             r = tips.tip.radius
             pa = -sa.tangential * r * sa.dtheta
             pb = -sb.tangential * r * sb.dtheta
+        # the four loads side by side (m, 4, 2): one masked sum per finger gives the finger's
+        # F(a), F(b), dF(a), dF(b), each summed over its contacts in order as alone, and the
+        # products with D are the 2-vector dot's terms
+        loads = np.stack([sa.F, sb.F, sa.dF, sb.dF], axis=1)
         for f, (mine, present) in enumerate(zip(tips.masks, tips.present)):
             if not present:
                 continue
-            ya, yb = sa.F[mine].sum(axis=0) @ D[f], sb.F[mine].sum(axis=0) @ D[f]
-            ra, rb = sa.dF[mine].sum(axis=0) @ D[f], sb.dF[mine].sum(axis=0) @ D[f]
+            total = loads[mine].sum(axis=0)
+            ya, yb, ra, rb = (total[:, 0] * D[f, 0] + total[:, 1] * D[f, 1]).tolist()
             self.work[f] += 0.5 * h * (ya + yb) + h * h / 12.0 * (ra - rb)
             if sliding:
                 self.dissipation[f] += 0.5 * h * (pa[mine].sum() + pb[mine].sum())

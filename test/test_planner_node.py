@@ -319,7 +319,10 @@ def await_feedback(planner: Harness, done: Callable[[], bool], timeout: float = 
 
     An action's result (a service response) and its feedback (a topic) travel separately, and
     when both are taken in one wait rclpy 7.1.6's ``ActionClient.execute`` handles the result
-    first: the last feedback can arrive after the result's future is done.
+    first: the last feedback can arrive after the result's future is done. In that same wait
+    the result's done-callback (``_remove_pending_result_request``) deletes the goal's feedback
+    callback before the feedback taken with it is dispatched, so the client never sees that last
+    feedback (seen once in a clean-clone CI, the grasp map's last stage).
     """
     with contextlib.suppress(TimeoutError):
         planner.spin_until(done, timeout=timeout)
@@ -400,13 +403,14 @@ def test_grasp_map_action_loads_with_stages_and_equals_the_service(planner: Harn
     result = outcome.result()
     assert result.status == GoalStatus.STATUS_SUCCEEDED, result.result.message
     await_feedback(planner, lambda: len(stages) >= 5)
-    assert stages == [
+    every = [
         ("mesh", 0, 5),
         ("stiffness", 1, 5),
         ("factorisation", 2, 5),
         ("boundary compliance", 3, 5),
         ("grasp map", 4, 5),
     ]
+    assert stages in (every, every[:-1]), stages  # rclpy may drop the last: see await_feedback
     service = planner.call(
         GraspMap, "grasp_map", GraspMap.Request(object_id="mapped", mu=0.4, full_matrices=True)
     )

@@ -37,7 +37,7 @@ import numpy as np
 from squeeze_grasp_ros.ros.messages.contacts import TactileReadings, check_taxels
 
 __all__ = ["CdrTemplate", "CdrWriter", "cdr_stamp_ns", "clock_cdr", "monitor_status_cdr_reading",
-           "planar", "pose_position_cdr", "pose_stamped_cdr", "refilled",
+           "PLANAR_ORIGIN", "planar", "pose_position_cdr", "pose_stamped_cdr", "refilled",
            "tactile_array_cdr", "tactile_readings_cdr", "tick_cdr", "tick_readings_cdr",
            "wrench_force_cdr", "wrench_stamped_cdr", "write_contact_arrays",
            "write_finger_vectors"]
@@ -590,6 +590,12 @@ def write_contact_arrays(writer: CdrWriter, ns: int, frame_id: str, fingers, nod
     runs += [(writer.sequence(forces_x), count), (writer.sequence(forces_y), count),
              (writer.float64(depth), 1), (writer.float64(relative_depth), 1)]
     return stamp, runs
+
+
+PLANAR_ORIGIN = np.zeros(2)
+PLANAR_ORIGIN.flags.writeable = False
+"""(0, 0): the planar vector a message reports for a finger without one (a position, a total
+force); read-only, shared."""
 
 
 def planar(vectors) -> np.ndarray:

@@ -25,6 +25,7 @@ from squeeze_grasp_ros.control.tracker import (
 )
 from squeeze_grasp_ros.mechanics.vocabulary import EventType, Finger
 from squeeze_grasp_ros.ros.messages.cdr import (
+    PLANAR_ORIGIN,
     CdrTemplate,
     CdrWriter,
     planar,
@@ -37,8 +38,6 @@ from squeeze_grasp_ros.ros.messages.contacts import CONTACT_MODES, fill_contact_
 
 # --------------------------------------------------------------------------- pipeline: monitor
 
-_ORIGIN = np.zeros(2)
-"""The position a status reports for a finger without one."""
 UNSEEN_AGE = 1e300
 """s: the sensor age a ``MonitorStatus`` gives a finger the monitor has no reading of (the
 tracker's infinite age, kept finite for the message)."""
@@ -154,7 +153,7 @@ def monitor_status_cdr(out: TrackerOutput, frame_id: str) -> bytes:
     """
     ns, fingers = out.stamp_ns, out.fingers
     positions, forces, normals = out.positions, out.forces, out.normals
-    values = (planar([positions.get(f, _ORIGIN) for f in fingers]),
+    values = (planar([positions.get(f, PLANAR_ORIGIN) for f in fingers]),
               planar([forces[f] for f in fingers]), planar([normals[f] for f in fingers]),
               [min(out.ages[f], UNSEEN_AGE) for f in fingers], out.depth, out.relative_depth)
 

@@ -20,6 +20,7 @@ from squeeze_grasp_interfaces.msg import (
 from squeeze_grasp_ros.mechanics.squeeze import contact_state
 from squeeze_grasp_ros.mechanics.vocabulary import ContactMode
 from squeeze_grasp_ros.ros.messages.cdr import (
+    PLANAR_ORIGIN,
     CdrTemplate,
     CdrWriter,
     planar,
@@ -89,9 +90,9 @@ def sim_state_cdr(
     contacts, arrays = state.contacts, state.arrays
     layout = tuple(map(_LAYOUT, contacts))
     forces, names = arrays.forces, arrays.fingers
-    totals = [_SUM(forces[rows], axis=0) if rows is not None else _ORIGIN
+    totals = [_SUM(forces[rows], axis=0) if rows is not None else PLANAR_ORIGIN
               for rows in _finger_rows(names, tuple(fingers))]
-    values = (planar([present[f].center if f in present else _ORIGIN for f in fingers]),
+    values = (planar([present[f].center if f in present else PLANAR_ORIGIN for f in fingers]),
               planar(totals),
               [present[f].work if f in present else 0.0 for f in fingers],
               arrays.thetas, forces[:, 0], forces[:, 1],
@@ -112,8 +113,6 @@ def sim_state_cdr(
 _LAYOUT = attrgetter("finger", "node", "mode")
 """A contact node's (finger, node, mode): the ground truth's layout key."""
 _SUM = np.add.reduce
-_ORIGIN = np.zeros(2)
-"""A finger's position and total force without contacts (x, y)."""
 """``ndarray.sum`` without its Python wrapper."""
 
 

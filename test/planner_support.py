@@ -8,6 +8,7 @@ and results arrive through futures and done-callbacks.
 from __future__ import annotations
 
 import threading
+import uuid
 from collections.abc import Callable
 from typing import Any
 
@@ -18,6 +19,7 @@ from rclpy.action import ActionClient
 from rclpy.context import Context
 from rclpy.executors import SingleThreadedExecutor
 from rclpy.task import Future
+from unique_identifier_msgs.msg import UUID
 
 from squeeze_grasp_interfaces.srv import LoadObject
 from squeeze_grasp_ros.mechanics.elastic.compliance import ElasticObject
@@ -104,6 +106,7 @@ class Harness(PlannerClient):
             if node is not None:
                 executor.add_node(node)
         self._actions: dict[str, ActionClient] = {}
+        self._feedback_callbacks: dict[str, dict[bytes, Callable[[Any], None]]] = {}
 
     def action(self, action_type: Any, name: str) -> ActionClient:
         """A (cached) client of action ``<planner>/<name>`` that has found its server."""
@@ -126,9 +129,18 @@ class Harness(PlannerClient):
         """Send a goal; return the futures of its goal handle and of its result response.
 
         The result is requested from a done-callback as soon as the goal is accepted.
+        ``on_feedback`` receives the goal's feedback messages as the server publishes them, from
+        a subscription to the action's feedback topic (matched before the goal is sent) rather
+        than from the action client: when rclpy 7.1.6's ``ActionClient`` takes the result and
+        the last feedback in one wait, it handles the result first, and the result's
+        done-callback deletes the goal's feedback callback before that feedback is dispatched,
+        so a client-side callback can miss the last feedback (seen once in a clean-clone CI).
         """
+        goal_id = UUID(uuid=list(uuid.uuid4().bytes))
+        if on_feedback is not None:
+            self._feedback(action_type, name)[bytes(goal_id.uuid)] = on_feedback
         accepted, outcome = Future(), Future()
-        sent = self.action(action_type, name).send_goal_async(goal, feedback_callback=on_feedback)
+        sent = self.action(action_type, name).send_goal_async(goal, goal_uuid=goal_id)
 
         def on_accepted(future: Future) -> None:
             handle = future.result()
@@ -137,6 +149,24 @@ class Harness(PlannerClient):
                 lambda result: outcome.set_result(result.result()))
         sent.add_done_callback(on_accepted)
         return accepted, outcome
+
+    def _feedback(self, action_type: Any, name: str) -> dict[bytes, Callable[[Any], None]]:
+        """The feedback callbacks by goal id of a (cached) subscription to action ``name``'s
+        feedback topic, once it has matched the server's publisher (at most 30 s).
+        """
+        if name not in self._feedback_callbacks:
+            callbacks: dict[bytes, Callable[[Any], None]] = {}
+
+            def dispatch(message: Any) -> None:
+                callback = callbacks.get(bytes(message.goal_id.uuid))
+                if callback is not None:
+                    callback(message)
+            subscription = self.node.create_subscription(
+                action_type.Impl.FeedbackMessage, f"{self.planner_name}/{name}/_action/feedback",
+                dispatch, 1000)
+            self.spin_until(lambda: subscription.get_publisher_count() > 0, timeout=30.0)
+            self._feedback_callbacks[name] = callbacks
+        return self._feedback_callbacks[name]
 
     def close(self) -> None:
         """Destroy the nodes (the planner joins its workers) and the executor."""

@@ -161,8 +161,9 @@ def squeeze_to_depth(
         samples += result.samples
         chatter += result.chatter
         state = result.state
-        if progress is not None:
-            progress(min(1.0, (state.depth - start) / depth) if depth > 0 else 1.0)
+        if progress is not None:  # exactly 1 once the depth is reached, whatever the rounding
+            reached = result.fraction >= 1.0 or depth <= 0
+            progress(1.0 if reached else min(1.0, (state.depth - start) / depth))
         if result.termination is not None:
             termination = result.termination
             break

@@ -5,11 +5,12 @@ crossing of a substep in one call, with the fixed-set solve at each trial point 
 
 :func:`earliest_crossing` runs :func:`~.stepper.location.earliest_crossing` for crossed
 functions the kernel evaluates (a contact's normal force, cone margins and slip rate, a free
-boundary row's gap, the pickup margin): the crossings in the order of their estimated roots, each located by
-:func:`~.stepper.location.locate_sign_change` (the Hermite steps, Illinois for a slip rate, the
-skips of ``skip_sure``), the trial points solved by continuation from the nearest point solved
-so far (:class:`~.stepper.solving.SolvedPoints`, by :func:`.fixed_set_numba.solve_linear`) and
-the functions valued there as the numpy code values them (:mod:`.substeps_numba`'s arithmetic).
+boundary row's gap, the pickup margin): the crossings in the order of their estimated roots,
+each located by :func:`~.stepper.location.locate_sign_change` (the Hermite steps, Illinois for
+a slip rate, the skips of ``skip_sure``), the trial points solved by continuation from the
+nearest point solved so far (:class:`~.stepper.solving.SolvedPoints`, by
+:func:`.fixed_set_numba.solve_linear`) and the functions valued there as the numpy code values
+them (:mod:`.substeps_numba`'s arithmetic).
 The roots of a Hermite cubic are the eigenvalues of numpy's companion matrix by the LAPACK
 routine numpy's ``eigvals`` calls (dgeev), so every bracket, evaluation count and solution is
 the Python location's. A solve that fails, or a location that does not converge, is reported

@@ -16,6 +16,7 @@ import numpy as np
 import pytest
 
 from squeeze_grasp_ros.mechanics.squeeze.contact_model import ContactModel
+from squeeze_grasp_ros.mechanics.squeeze.event_key import EventFunction
 from squeeze_grasp_ros.mechanics.squeeze.fixed_set_kernel import KERNEL_VARIABLE, Kernel
 from squeeze_grasp_ros.mechanics.squeeze.stepper import compiled_location as located_module
 from squeeze_grasp_ros.mechanics.squeeze.stepper import location, run
@@ -153,11 +154,15 @@ def test_every_located_event_is_the_python_locations(name, monkeypatch):
     took = _taken(monkeypatch)
     counts = _checking(monkeypatch, (lambda call: None, dear, fresh))
     _setup(name).event_squeeze()
-    assert counts and sum(took) >= 0.75 * len(took) > 0, took  # pickup: 12 of 15
+    assert counts and all(took), took
+    if name == "foam_square_pickup":  # the pickup margin's crossings located by the kernel too
+        assert any(key.function == EventFunction.PICKUP for keys in run_crossed
+                   for key in keys)
 
 
-@pytest.mark.parametrize("name", ["foam_square", "sponge_gripper_slip"])
-def test_squeezes_with_the_compiled_location_are_the_numpy_routes(name, monkeypatch):
+@pytest.mark.parametrize("name, located", [("foam_square", 10), ("sponge_gripper_slip", 10),
+                                            ("foam_square_pickup", 5)])
+def test_squeezes_with_the_compiled_location_are_the_numpy_routes(name, located, monkeypatch):
     """Whole event squeezes on the numba route, located by the kernel, are the numpy route's
     field by field (the compiled substeps' test compares more scenes).
     """
@@ -168,14 +173,14 @@ def test_squeezes_with_the_compiled_location_are_the_numpy_routes(name, monkeypa
         monkeypatch.setenv(KERNEL_VARIABLE, route.value)
         took = _taken(monkeypatch)
         results[route] = _setup(name).event_squeeze()
-        assert all(took) and len(took) >= 10 if route == Kernel.NUMBA else not took
+        assert all(took) and len(took) >= located if route == Kernel.NUMBA else not took
     _same(results[Kernel.NUMPY], results[Kernel.NUMBA])
 
 
 def test_what_the_kernel_does_not_take_stays_in_python(monkeypatch):
-    """The numpy route and the nonlinear models have no compiled location; a crossed
-    termination (here the pickup margin) and a location needing more solved points than the
-    kernel has room for run the Python location (the same squeeze).
+    """The numpy route and the nonlinear models have no compiled location; a crossed strain
+    limit and a location needing more solved points than the kernel has room for run the
+    Python location (the same squeeze).
     """
     from test_compiled_substeps import _same
 
@@ -190,8 +195,8 @@ def test_what_the_kernel_does_not_take_stays_in_python(monkeypatch):
     _setup("foam_square").event_squeeze(material_model="neo_hookean", relative_depth=0.02)
     assert calls == []
     took = _taken(monkeypatch)
-    _setup("foam_square_pickup").event_squeeze()
-    assert False in took and len(calls) == sum(took)  # the pickup's location: no kernel call
+    _setup("foam_square_strain_limit").event_squeeze()
+    assert False in took and len(calls) == sum(took)  # the strain limit's: no kernel call
     want = _setup("foam_square").event_squeeze()
     monkeypatch.setattr(located_module, "CAPACITY", 3)
     took.clear()

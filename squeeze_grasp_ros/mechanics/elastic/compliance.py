@@ -108,7 +108,12 @@ class FactorizedSolver:
 
     def solve(self, rhs: np.ndarray) -> np.ndarray:
         """K+ rhs for a (2n,) or (2n, k) right-hand side."""
-        return self.project(self.pinned_solve(self.project(np.asarray(rhs, float))))
+        return self.solve_projected(rhs)[0]
+
+    def solve_projected(self, rhs: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(K+ rhs, P rhs): the solve and the projected right-hand side it solved for."""
+        projected = self.project(np.asarray(rhs, float))
+        return self.project(self.pinned_solve(projected)), projected
 
     def boundary_block(self, boundary_dofs: np.ndarray) -> np.ndarray:
         """K+ restricted to ``boundary_dofs`` (the DOFs ordered last), from the Schur complement.
@@ -287,8 +292,11 @@ class ElasticObject:
 
     def pinv_apply(self, rhs: np.ndarray) -> np.ndarray:
         """Dimensionless K_hat+ applied to ``rhs`` (2n,) or (2n, k); records the residual."""
-        x = self.solver.solve(rhs)
-        P_rhs = rhs - self.rigid @ (self.rigid.T @ rhs)
+        if isinstance(self.solver, FactorizedSolver):  # it projects rhs: P rhs once
+            x, P_rhs = self.solver.solve_projected(rhs)
+        else:
+            x = self.solver.solve(rhs)
+            P_rhs = rhs - self.rigid @ (self.rigid.T @ rhs)
         res = np.linalg.norm(self.stiffness @ x - P_rhs) / max(np.linalg.norm(P_rhs), 1e-300)
         self._diag["last_solve_relative_residual"] = float(res)
         return x

@@ -5,11 +5,12 @@ crossing of a substep in one call, with the fixed-set solve at each trial point 
 
 :func:`earliest_crossing` runs :func:`~.stepper.location.earliest_crossing` for crossed
 functions the kernel evaluates (a contact's normal force, cone margins and slip rate, a free
-boundary row's gap): the crossings in the order of their estimated roots, each located by
-:func:`~.stepper.location.locate_sign_change` (the Hermite steps, Illinois for a slip rate, the
-skips of ``skip_sure``), the trial points solved by continuation from the nearest point solved
-so far (:class:`~.stepper.solving.SolvedPoints`, by :func:`.fixed_set_numba.solve_linear`) and
-the functions valued there as the numpy code values them (:mod:`.substeps_numba`'s arithmetic).
+boundary row's gap, the pickup margin): the crossings in the order of their estimated roots,
+each located by :func:`~.stepper.location.locate_sign_change` (the Hermite steps, Illinois for
+a slip rate, the skips of ``skip_sure``), the trial points solved by continuation from the
+nearest point solved so far (:class:`~.stepper.solving.SolvedPoints`, by
+:func:`.fixed_set_numba.solve_linear`) and the functions valued there as the numpy code values
+them (:mod:`.substeps_numba`'s arithmetic).
 The roots of a Hermite cubic are the eigenvalues of numpy's companion matrix by the LAPACK
 routine numpy's ``eigvals`` calls (dgeev), so every bracket, evaluation count and solution is
 the Python location's. A solve that fails, or a location that does not converge, is reported
@@ -23,9 +24,9 @@ from numba import types
 from numba.np.linalg import _LAPACK
 
 from squeeze_grasp_ros.mechanics.squeeze.fixed_set_numba import SOLVED, solve_linear
-from squeeze_grasp_ros.mechanics.squeeze.substeps_numba import _from_tip
+from squeeze_grasp_ros.mechanics.squeeze.substeps_numba import _from_tip, _pickup
 
-NORMAL_FORCE, CONE_PLUS, CONE_MINUS, SLIP_RATE, GAP = 0, 1, 2, 3, 4
+NORMAL_FORCE, CONE_PLUS, CONE_MINUS, SLIP_RATE, GAP, PICKUP = 0, 1, 2, 3, 4, 5
 """The functions the kernel values (a crossed key's ``kind``)."""
 jit = numba.njit(cache=True, nogil=True)
 _geev = _LAPACK().numba_ez_rgeev(types.float64)
@@ -108,7 +109,16 @@ def _value(kind, k, key, p, s, pts, fun):
     (s), as the numpy code computes it (:meth:`~.stepper.functions.EventFunctions.value`).
     """
     _, _, delta, F, dtheta, _, _, nu, _, _, _, _ = pts
-    mu, slip, radius_c, rate, GA, GR, B0, E, origin, D, radius_f, flat_f, t0_f = fun
+    (mu, slip, radius_c, rate, GA, GR, B0, E, origin, D, radius_f, flat_f, t0_f, stick,
+     finger, fingers, weight) = fun
+    if kind == PICKUP:
+        m = nu.shape[1]
+        fn, ft = np.empty(m), np.empty(m)
+        for j in range(m):
+            c, sn = np.cos(nu[p, j]), np.sin(nu[p, j])
+            fn[j] = F[p, j, 0] * c + F[p, j, 1] * sn
+            ft[j] = F[p, j, 0] * -sn + F[p, j, 1] * c
+        return _pickup(mu, fn, ft, stick, finger, fingers, weight)
     if kind == GAP:
         g = np.dot(E.T, delta[p].ravel())
         u = np.dot(GA[key], F[p].ravel()) + np.dot(GR[key], g)
@@ -128,10 +138,11 @@ def _value(kind, k, key, p, s, pts, fun):
 @jit
 def _slope(kind, k, key, p, s, pts, fun):
     """The slope d/ds of crossed key ``key`` at solved point p (s), as
-    :func:`.substeps_numba.slope_values` computes it.
+    :func:`.substeps_numba.slope_values` computes it (a function with a slope: not the
+    pickup margin).
     """
     _, _, delta, F, dtheta, dF, ddelta, nu, kappa, _, _, _ = pts
-    mu, _, _, _, GA, GR, B0, E, origin, D, _, flat_f, t0_f = fun
+    mu, _, _, _, GA, GR, B0, E, origin, D, _, flat_f, t0_f, _, _, _, _ = fun
     if kind == GAP:
         u = np.dot(GA[key], F[p].ravel()) + np.dot(GR[key], np.dot(E.T, delta[p].ravel()))
         v = np.dot(GA[key], dF[p].ravel()) + np.dot(GR[key], np.dot(E.T, ddelta[p].ravel()))
@@ -278,8 +289,8 @@ def earliest_crossing(a, b, tol, skip_sure, settings, kinds, index, start, end, 
     settings : tuple
         (SURE_MARGIN, MAX_ROOT_ITERATIONS).
     kinds, index : (k,) ndarray of int
-        Each crossed key's function (:data:`NORMAL_FORCE` ... :data:`GAP`) and its contact
-        (the finger for a gap).
+        Each crossed key's function (:data:`NORMAL_FORCE` ... :data:`PICKUP`) and its
+        contact (the finger for a gap, unused for the pickup margin).
     start, end, has_start, start_slopes, has_end, end_slopes : (k,) ndarray
         Their values at a and b, whether they have slopes there and the slopes.
     fresh : (k,) ndarray of bool
@@ -294,7 +305,9 @@ def earliest_crossing(a, b, tol, skip_sure, settings, kinds, index, start, end, 
     fun : tuple
         The functions' tables (mu, slip, each contact's finger radius, rate, each gap key's
         rows of the boundary compliance and of the rigid modes and its undeformed position,
-        the rigid map E, the fingers' origins, translations and tips).
+        the rigid map E, the fingers' origins, translations and tips, then the pickup
+        margin's: each contact's stick flag and finger, the fingers with contacts and the
+        weight, NaN when the pickup is not checked).
     prob : tuple
         The fixed-set problem (:func:`.fixed_set_numba.solve_linear`'s tables, each contact's
         finger, the fingers' origins and translations, Newton's and the continuation's

@@ -5,11 +5,12 @@
 :class:`CompiledLocation` hands :func:`~.location.earliest_crossing` of a substep to
 :func:`..location_numba.earliest_crossing`, one call per event with the fixed-set solve of every
 trial point inside, when the kernel values every crossed function: a contact's normal force,
-cone margins and slip rate, a free boundary row's gap (the fast model's boundary compliance).
+cone margins and slip rate, a free boundary row's gap (the fast model's boundary compliance),
+the pickup margin.
 It gathers the crossed keys' values, slopes and tables, and the two solved ends, and returns
 the event point, the evaluations and the solution there, with the Newton counters of the
 points it solved: the Python location's brackets, counts and floats. The location stays in
-Python for a crossed termination (the area, a strain limit, the pickup margin), on the numpy
+Python for a crossed area or strain limit, on the numpy
 route, for the reference and the nonlinear models, and when the kernel reports a failed solve,
 a location that does not converge or more points than :data:`CAPACITY` (the Python location
 then raises or goes on).
@@ -38,6 +39,7 @@ from squeeze_grasp_ros.mechanics.squeeze.stepper.solving import (
     CONTINUATION_ITERATIONS,
     MAX_ANGLE_JUMP,
 )
+from squeeze_grasp_ros.mechanics.vocabulary import Termination
 
 __all__ = ["CAPACITY", "CompiledLocation"]
 
@@ -76,7 +78,8 @@ class CompiledLocation:
                       EventFunction.CONE_PLUS: self.kernel.CONE_PLUS,
                       EventFunction.CONE_MINUS: self.kernel.CONE_MINUS,
                       EventFunction.SLIP_RATE: self.kernel.SLIP_RATE,
-                      EventFunction.GAP: self.kernel.GAP}
+                      EventFunction.GAP: self.kernel.GAP,
+                      EventFunction.PICKUP: self.kernel.PICKUP}
         motion = call.motion
         tip = motion.tip
         self.fingers = (np.ascontiguousarray(motion.start, float),
@@ -84,6 +87,10 @@ class CompiledLocation:
                         np.ascontiguousarray(tip.radius, float),
                         np.ascontiguousarray(tip.flat, float),
                         np.ascontiguousarray(tip._facing_tangent, float))
+        lim = call.model.limits
+        self.weight = (lim.weight / call.model.force_unit
+                       if lim.weight is not None
+                       and Termination.PICKED_UP in call.functions.terminate_on else np.nan)
 
     @classmethod
     def of(cls, call) -> CompiledLocation | None:
@@ -149,6 +156,8 @@ class CompiledLocation:
                 GA[i], GR[i] = model._boundary_rows(sd, rows)
                 B0[i] = boundary[rows[0]]
                 index[i] = key.finger
+            elif key.function == EventFunction.PICKUP:
+                index[i] = 0
             else:
                 index[i] = contacts.index(key.node)
         slopes_a = self._slopes(crossed, index, a, sol_a, watched_a.slopes)
@@ -175,7 +184,8 @@ class CompiledLocation:
                 array[p] = x
         fun = (float(model.mu), contacts.slip,
                np.ascontiguousarray(tip.radius, float), float(motion.rate),
-               GA, GR, B0, sd.E, origin, D, radius_f, flat_f, t0_f)
+               GA, GR, B0, sd.E, origin, D, radius_f, flat_f, t0_f, contacts.stick,
+               contacts.finger, np.unique(contacts.finger), self.weight)
         prob = (np.ascontiguousarray(sd.C), np.ascontiguousarray(contacts.positions, float),
                 contacts.stick, contacts.slip, float(model.phi),
                 np.ascontiguousarray(tip.radius, float), np.ascontiguousarray(tip.flat, float),

@@ -29,6 +29,7 @@ from squeeze_grasp_ros.mechanics.squeeze.event_key import (
     processing_rank,
 )
 from squeeze_grasp_ros.mechanics.squeeze.fingertips import place_fingertip
+from squeeze_grasp_ros.mechanics.squeeze.fixed_set_kernel import Kernel
 from squeeze_grasp_ros.mechanics.squeeze.stable_pure import plan_squeeze
 from squeeze_grasp_ros.mechanics.squeeze.stepper import advance
 from squeeze_grasp_ros.mechanics.squeeze.stepper.chatter import ChatterBound
@@ -383,6 +384,51 @@ def test_decided_modes_hold_one_step_further_along_the_motion():
                     assert abs(ft[k]) == pytest.approx(model.mu * fn[k], rel=1e-8)
             seen |= {bool(x) for x in decided.stick}
     assert seen == {True, False}
+
+
+def counted(solver: SetSolver, taken: list):
+    """The compiled mode search of ``solver`` at s = 0, noting in ``taken`` whether it chose."""
+    def search(*args, **options):
+        chosen = solver.decide(*args, s=0.0, **options)
+        taken.append(chosen is not None)
+        return chosen
+    return search
+
+
+def test_the_compiled_mode_search_is_the_python_one():
+    """On the numba route the linear model's mode search is one compiled call
+    (:meth:`SetSolver.decide`): for the square's contacts, with friction and without, pushed
+    at an angle, jointly (up to three nodes, every pair of the first four) and node by node
+    (all of them), it chooses the modes, angles and violations the search in Python does
+    from the same solves, and counts those solves the same way.
+    """
+    pytest.importorskip("numba")
+    obj, nodes = square()
+    tips = [place_fingertip(obj.mesh, n, c, 0.02) for n, c in zip(("F1", "F2"), nodes)]
+    cases = [(ContactModel(obj, mu), initial_state(tips)) for mu in (0.0, 0.4)]
+    cases += [squeezed(0.05)[:2], squeezed(0.4)[:2]]
+    by_node, taken = 0, []
+    for model, state in cases:
+        for tilt in (0.0, 0.5, 1.0):
+            d = 1e-3 * np.array([np.cos(tilt), np.sin(tilt)])
+            motion, contacts, _, _ = units(model, state, {"F1": d, "F2": -d})
+            zero = zero_functions(contacts, set(state.fresh))
+            first = range(min(4, len(contacts)))
+            picks = [list(contacts.nodes)] + [
+                list(contacts.nodes[[i, j]]) for i in first for j in first if i < j]
+            for pick in picks:
+                results = []
+                for compiled in (False, True):
+                    solver = SetSolver(model, motion, Counters(), Kernel.NUMBA)
+                    choice = decide_modes(contacts, pick, zero, lambda c: solver.attempt(c, 0.0),
+                                          mu=model.mu, rate_floor=1e-12,
+                                          search=counted(solver, taken) if compiled else None)
+                    results.append((choice.stick.tolist(), choice.slip.tolist(),
+                                    choice.theta.tobytes(), choice.violations,
+                                    solver.counters.as_dict()))
+                assert results[0] == results[1]
+                by_node += len(pick) > 3
+    assert by_node > 0 and all(taken)
 
 
 # ---------------------------------------------------------------------------- root location

@@ -174,3 +174,118 @@ def solve_linear(C, p0, centers, dirs, theta0, stick, slip, phi, radius, flat, f
     finite = np.all(np.isfinite(F)) and np.all(np.isfinite(dF)) and np.all(np.isfinite(theta))
     return SOLVED if finite else NON_FINITE, it, residual, theta, delta, F, dtheta, dF, ddelta, \
         J, nu, kappa
+
+
+@jit
+def _violations(idx, combo, options, F, dF, dtheta, nu, kappa, zero, mu, frictionless,
+                rate_floor):
+    """:func:`~.stepper.modes.mode_violations` of contacts ``idx`` in their options ``combo``
+    summed, from a solution's arrays (the floats of :class:`~.contact_model.Solution`'s force
+    components: e(nu) . F and t(nu) . F as numpy's einsum sums them).
+    """
+    bad = 0
+    for j in range(idx.shape[0]):
+        k, o = idx[j], combo[j]
+        c, s = np.cos(nu[k]), np.sin(nu[k])
+        turn = kappa[k] * dtheta[k]
+        fn = F[k, 0] * c + F[k, 1] * s
+        ft = F[k, 0] * -s + F[k, 1] * c
+        fn_r = (dF[k, 0] * c + dF[k, 1] * s) + turn * ft
+        ft_r = (dF[k, 0] * -s + dF[k, 1] * c) - turn * fn
+        bad += not (fn_r > rate_floor if zero[j, 0] else fn > 0)
+        if options[o, 0]:
+            bad += not (mu * fn_r + ft_r > rate_floor if zero[j, 1] else mu * fn + ft > 0)
+            bad += not (mu * fn_r - ft_r > rate_floor if zero[j, 2] else mu * fn - ft > 0)
+        elif not frictionless:
+            bad += options[o, 1] * dtheta[k] <= 0
+    return bad
+
+
+@jit
+def _attempt(C, p0, centers, dirs, theta0, stick, slip, phi, radius, flat, facing, tol,
+             max_iterations, backtracks, newton_tol, log, Js, a):
+    """:func:`solve_linear` in modes ``stick``, ``slip``, its status, iterations, residual and
+    sliding nodes n written to ``log[a]`` and its Jacobian to ``Js[a, :n, :n]``.
+    """
+    status, it, residual, theta, _, F, dtheta, dF, _, J, nu, kappa = solve_linear(
+        C, p0, centers, dirs, theta0, stick, slip, phi, radius, flat, facing, tol,
+        max_iterations, backtracks, newton_tol)
+    n = J.shape[0]
+    log[a, 0], log[a, 1], log[a, 2], log[a, 3] = status, it, residual, n
+    Js[a, :n, :n] = J
+    return status == SOLVED, theta, F, dtheta, dF, nu, kappa
+
+
+@jit
+def decide_linear(C, p0, centers, dirs, theta0, stick, slip, phi, radius, flat, facing, tol,
+                  max_iterations, backtracks, newton_tol, idx, options, zero, mu, rate_floor,
+                  by_node):
+    """The mode decision of contacts ``idx`` (:func:`~.stepper.modes.decide_modes`) in one
+    call, each hypothesis solved by :func:`solve_linear` and its violations counted: every
+    combination of their ``options`` (rows (stick, slip), in the order tried) in
+    :func:`itertools.product`'s order, the first consistent one winning, else the first with
+    fewest; or, ``by_node``, the node-by-node search's two passes
+    (:func:`~.stepper.modes._node_by_node`) and then its one combination.
+
+    ``zero`` (len(idx), 3) marks each node's normal force and cone margins (+, -) that are
+    zero by construction (they must grow faster than ``rate_floor``); mu = 0 is frictionless.
+    The other arguments are :func:`solve_linear`'s.
+
+    Returns
+    -------
+    tuple
+        (whether a combination was solved, the chosen one's violations, stick, slip and
+        theta (m,) of the whole set; the solves in order: (status, iterations, residual,
+        sliding nodes n) rows and their Jacobians ``Js[a, :n, :n]``).
+    """
+    k, n_options = idx.shape[0], options.shape[0]
+    n_combos = 1 if by_node else n_options ** k
+    n_solves = n_combos + (2 * k * n_options if by_node else 0)
+    free = ~stick
+    for j in range(k):
+        free[idx[j]] = True
+    most = np.count_nonzero(free)  # the most sliding nodes of any hypothesis
+    log, Js = np.zeros((n_solves, 4)), np.zeros((n_solves, most, most))
+    combo = np.zeros(k, np.int64)
+    st, sl = stick.copy(), slip.copy()
+    frictionless, a = mu == 0.0, 0
+    if by_node:
+        for _ in range(2):
+            for j in range(k):
+                for o in range(n_options):
+                    st[idx[j]], sl[idx[j]] = options[o, 0] != 0, options[o, 1]
+                    solved, _, F, dtheta, dF, nu, kappa = _attempt(
+                        C, p0, centers, dirs, theta0, st, sl, phi, radius, flat, facing, tol,
+                        max_iterations, backtracks, newton_tol, log, Js, a)
+                    a += 1
+                    if solved and _violations(
+                            idx[j:j + 1], np.array([o]), options, F, dF, dtheta, nu, kappa,
+                            zero[j:j + 1], mu, frictionless, rate_floor) == 0:
+                        combo[j] = o
+                        break
+                st[idx[j]], sl[idx[j]] = options[combo[j], 0] != 0, options[combo[j], 1]
+    best, best_bad = -1, 0
+    best_stick, best_slip, best_theta = stick.copy(), slip.copy(), theta0.copy()
+    for c in range(n_combos):
+        if not by_node:
+            rest = c
+            for j in range(k - 1, -1, -1):
+                combo[j] = rest % n_options
+                rest //= n_options
+        st, sl = stick.copy(), slip.copy()
+        for j in range(k):
+            st[idx[j]], sl[idx[j]] = options[combo[j], 0] != 0, options[combo[j], 1]
+        solved, theta, F, dtheta, dF, nu, kappa = _attempt(
+            C, p0, centers, dirs, theta0, st, sl, phi, radius, flat, facing, tol,
+            max_iterations, backtracks, newton_tol, log, Js, a)
+        a += 1
+        if not solved:
+            continue
+        bad = _violations(idx, combo, options, F, dF, dtheta, nu, kappa, zero, mu,
+                          frictionless, rate_floor)
+        if best < 0 or bad < best_bad:
+            best, best_bad = c, bad
+            best_stick, best_slip, best_theta = st, sl, theta
+        if bad == 0:
+            break
+    return best >= 0, best_bad, best_stick, best_slip, best_theta, log[:a], Js[:a]

@@ -40,6 +40,11 @@ that scale; a stuck contact's rates in the shipped scenes are 1e-2 to 1 of it.""
 
 Attempt = Callable[[ContactSet], "Solution | SolveFailure"]
 """A solver of a contact set at the current point (the modes it is given, its own angles)."""
+Search = Callable[..., "tuple | None"]
+"""The search of :func:`decide_modes` in one compiled call (:meth:`~.solving.SetSolver.decide`):
+of a contact set, the positions to decide, the options (rows (stick, slip)) and which of their
+functions are zero by construction (:func:`_zero_flags`), given ``mu``, ``rate_floor`` and
+``by_node``, the search's (stick, slip, theta, violations), or None where it does not apply."""
 
 
 def mode_violations(*, mu: float, fn: float, ft: float, fn_rate: float, ft_rate: float,
@@ -126,6 +131,15 @@ def _zero_by_contact(contacts: ContactSet, zero: set[EventKey]) -> dict[int, set
     return out
 
 
+def _zero_flags(idx: list[int], zero: dict[int, set[EventFunction]]) -> np.ndarray:
+    """Whether the normal force and the cone margins (+, -) of each contact ``idx`` are zero
+    by construction, (len(idx), 3) of bool.
+    """
+    functions = (EventFunction.NORMAL_FORCE, EventFunction.CONE_PLUS, EventFunction.CONE_MINUS)
+    return np.array([[f in zero.get(k, ()) for f in functions] for k in idx], bool).reshape(
+        len(idx), 3)
+
+
 def _options(mu: float) -> list[tuple[bool, int]]:
     """Hypotheses per node in the order tried: stick, slip +1, slip -1 (slide if mu = 0)."""
     return [(False, 0)] if mu == 0.0 else [(True, 0), (False, 1), (False, -1)]
@@ -161,7 +175,8 @@ def _no_mode(nodes: list[int], failures: list[SolveFailure]) -> Exception:
 
 
 def decide_modes(contacts: ContactSet, nodes: list[int], zero: set[EventKey], attempt: Attempt,
-                 *, mu: float, rate_floor: float = 0.0) -> ModeChoice:
+                 *, mu: float, rate_floor: float = 0.0,
+                 search: Search | None = None) -> ModeChoice:
     """Joint hypothesis-and-test for the modes of contact ``nodes``.
 
     Options per node in the order stick, slip +1, slip -1; every combination for up to
@@ -182,6 +197,10 @@ def decide_modes(contacts: ContactSet, nodes: list[int], zero: set[EventKey], at
     rate_floor : float
         Rates of functions in ``zero`` at or below it do not count as growing (the stepper
         passes :data:`RATE_NOISE` x its force-rate scale).
+    search : callable, optional
+        The same search in one compiled call (the numba route's linear model), whose choice
+        is taken; where it returns None (another model or route, or no hypothesis solved)
+        the search runs here.
 
     Raises
     ------
@@ -190,7 +209,13 @@ def decide_modes(contacts: ContactSet, nodes: list[int], zero: set[EventKey], at
     """
     idx = [contacts.index(n) for n in sorted(nodes)]
     zero_at = _zero_by_contact(contacts, zero)
-    if len(idx) <= MAX_JOINT_NODES:
+    jointly = len(idx) <= MAX_JOINT_NODES
+    chosen = None if search is None else search(
+        contacts, idx, np.array(_options(mu), np.int64), _zero_flags(idx, zero_at), mu=mu,
+        rate_floor=rate_floor, by_node=not jointly)
+    if chosen is not None:
+        return ModeChoice(*chosen)
+    if jointly:
         candidates = itertools.product(_options(mu), repeat=len(idx))
     else:
         candidates = [_node_by_node(contacts, idx, zero_at, attempt, mu, rate_floor)]

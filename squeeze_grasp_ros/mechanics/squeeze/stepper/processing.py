@@ -24,6 +24,7 @@ contact_lost < finger_slip < picked_up.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from functools import partial
 
 import numpy as np
 
@@ -133,13 +134,13 @@ class EventProcessor:
 
     def decide(self, nodes: list[int]) -> None:
         """Decide the modes of contact ``nodes`` jointly (:func:`~.modes.decide_modes`) and
-        update the fresh keys: a node that sticks keeps its cone margins that were zero, one
-        that slides loses them.
+        update the fresh keys: a sticking node keeps its zero cone margins, a sliding one not.
         """
         zero = zero_functions(self.contacts, self.fresh)
         choice = decide_modes(self.contacts, nodes, zero,
                               lambda contacts: self.solver.attempt(contacts, self.s),
-                              mu=self.model.mu, rate_floor=self.rate_floor)
+                              mu=self.model.mu, rate_floor=self.rate_floor,
+                              search=partial(self.solver.decide, s=self.s))
         if choice.violations > 0:
             self.solver.counters.ambiguous_modes += 1
         self.contacts = self.contacts.with_modes(choice.stick, choice.slip).with_theta(

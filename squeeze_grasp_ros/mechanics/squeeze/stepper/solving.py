@@ -15,13 +15,18 @@ import numpy as np
 
 from squeeze_grasp_ros.mechanics.errors import NumericalError
 from squeeze_grasp_ros.mechanics.squeeze.contact_model import (
+    NEWTON_BACKTRACKS,
+    NEWTON_MAX_ITERATIONS,
+    NEWTON_TOL,
     Configuration,
     ContactModel,
+    LinearResponse,
     Solution,
     SolveFailure,
     attempt_fixed_set,
+    jacobian_condition,
 )
-from squeeze_grasp_ros.mechanics.squeeze.fixed_set_kernel import Kernel, selected
+from squeeze_grasp_ros.mechanics.squeeze.fixed_set_kernel import Kernel, compiled, selected
 from squeeze_grasp_ros.mechanics.squeeze.kept import kept_property
 from squeeze_grasp_ros.mechanics.squeeze.stepper.contact_set import ContactSet
 from squeeze_grasp_ros.mechanics.squeeze.stepper.motion import FingerMotion
@@ -71,9 +76,13 @@ class Counters:
 
     def note(self, sol: Solution) -> None:
         """Take a solution's Newton iterations, residual and Jacobian condition into the maxima."""
-        self.newton_max_iterations = max(self.newton_max_iterations, sol.iterations)
-        self.newton_max_residual = max(self.newton_max_residual, sol.residual)
-        self.jacobian_max_condition = max(self.jacobian_max_condition, sol.jacobian_condition)
+        self.noted(sol.iterations, sol.residual, sol.jacobian_condition)
+
+    def noted(self, iterations: int, residual: float, condition: float) -> None:
+        """Take one solve's Newton iterations, residual and Jacobian condition into the maxima."""
+        self.newton_max_iterations = max(self.newton_max_iterations, iterations)
+        self.newton_max_residual = max(self.newton_max_residual, residual)
+        self.jacobian_max_condition = max(self.jacobian_max_condition, condition)
 
     def as_dict(self) -> dict:
         """The counters that apply (the inversion ones only when it happened)."""
@@ -112,6 +121,35 @@ class SetSolver:
         if not isinstance(sol, SolveFailure):
             self.counters.note(sol)
         return sol
+
+    def decide(self, contacts: ContactSet, idx: list[int], options: np.ndarray,
+               zero: np.ndarray, *, s: float, mu: float, rate_floor: float,
+               by_node: bool) -> tuple | None:
+        """The mode decision's search over the ``options`` of contacts ``idx``, ``zero`` the
+        functions zero by construction (:func:`~.modes.decide_modes`, jointly or ``by_node``),
+        at s in one compiled call (:func:`..fixed_set_numba.decide_linear`), each solve
+        counted as :meth:`attempt` counts it: (stick, slip, theta, violations) of the choice,
+        or None off the numba route, for a model that is not linear, or when no hypothesis
+        could be solved (the search in Python then says why).
+        """
+        response = self.model.response(contacts.data)
+        if self.kernel != Kernel.NUMBA or not isinstance(response, LinearResponse):
+            return None
+        kernel, tips = compiled(), self.motion.contact_tips(contacts.finger)
+        tip = tips.tip
+        solved, bad, stick, slip, theta, log, Js = kernel.decide_linear(
+            response.C, contacts.positions, tips.start + s * tips.translation,
+            tips.translation, np.asarray(contacts.theta, float), contacts.stick, contacts.slip,
+            float(self.phi), tip.radius, tip.flat, tip.facing, NEWTON_TOL,
+            NEWTON_MAX_ITERATIONS, NEWTON_BACKTRACKS, NEWTON_TOL, np.asarray(idx, np.int64),
+            options, zero, float(mu), float(rate_floor), by_node)
+        if not solved:
+            return None
+        for (status, iterations, residual, n), J in zip(log.tolist(), Js):
+            if status == kernel.SOLVED:
+                n = int(n)
+                self.counters.noted(int(iterations), residual, jacobian_condition(J[:n, :n]))
+        return stick, slip, theta, int(bad)
 
     def solve(self, contacts: ContactSet, s: float) -> Solution:
         """:meth:`attempt`, raising the failure's error."""

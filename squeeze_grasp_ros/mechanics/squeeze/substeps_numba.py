@@ -174,50 +174,50 @@ def _element_bounds(delta, F, E, rigid_gradients, bounds):
 
 
 @jit
-def _area(delta, F, E, rigid_gradients, bounds, loads, exact_bound):
-    """(smallest det F as :meth:`~.contact_model.ContactModel.area_ratio` bounds or computes
-    it, whether an element needed its load gradients and none were given).
+def _area_ratio(delta, F, E, rigid_gradients, bounds, loads, exact_bound, numpys_order):
+    """(smallest det F, its element or -1) as :meth:`~.contact_model.ContactModel.area_ratio`
+    bounds or computes it: the bound (1 - max B_e)^2 while no B_e reaches ``exact_bound``
+    (inf without ``bounds`` rows, when the area is not watched), else the near elements' exact
+    det F from the set's ``loads`` (m, t, 4, 2); NaN when one is near and ``loads`` are not
+    given. With ``numpys_order`` its floats are the model's: H_e = rigid_e + ((G_0e f_0 +
+    G_1e f_1) + ...), each G_ke f_k the BLAS product numpy's matmul makes (one call per element
+    and contact: tens of microseconds); else the products are written out (a substep's
+    quiet check, which has QUIET_MARGIN to spare).
     """
-    rigid, bound = _element_bounds(delta, F, E, rigid_gradients, bounds)
     t = bounds.shape[0]
-    floor_bound, near = -1.0, 0
+    if t == 0:
+        return np.inf, -1
+    rigid, bound = _element_bounds(delta, F, E, rigid_gradients, bounds)
+    largest, near = -np.inf, 0
     for e in range(t):
         if bound[e] >= exact_bound:
             near += 1
-        elif bound[e] > floor_bound:
-            floor_bound = bound[e]
-    floor = (1.0 - floor_bound) ** 2 if floor_bound >= 0.0 else np.inf
+        else:
+            largest = max(largest, bound[e])
+    floor = (1.0 - largest) ** 2 if near < t else np.inf
     if near == 0:
-        return floor, False
-    if loads.shape[0] != F.shape[0]:
-        return floor, True
-    smallest = floor
+        return floor, -1
+    m = F.shape[0]
+    if loads.shape[0] != m:
+        return np.nan, -1
+    smallest, element = np.inf, -1
+    H = np.empty(4)
     for e in range(t):
         if bound[e] < exact_bound:
             continue
-        H = rigid[4 * e:4 * e + 4].copy()
-        for k in range(F.shape[0]):
-            for i in range(4):
-                H[i] += loads[k, e, i, 0] * F[k, 0] + loads[k, e, i, 1] * F[k, 1]
+        H[:] = 0.0
+        for k in range(m):
+            if numpys_order:
+                H += np.dot(loads[k, e], F[k])
+            else:
+                for i in range(4):
+                    H[i] += loads[k, e, i, 0] * F[k, 0] + loads[k, e, i, 1] * F[k, 1]
+        for i in range(4):
+            H[i] = rigid[4 * e + i] + H[i]
         det = (1.0 + H[0]) * (1.0 + H[3]) - H[1] * H[2]
-        smallest = min(smallest, det)
-    return smallest, False
-
-
-@jit
-def _area_floor(delta, F, E, rigid_gradients, bounds, exact_bound):
-    """:func:`watched_values`'s area ratio: (1 - max B_e)^2 when no B_e reaches
-    ``exact_bound``, NaN when one does, inf without elements (numpy's floats).
-    """
-    if bounds.shape[0] == 0:
-        return np.inf
-    _, bound = _element_bounds(delta, F, E, rigid_gradients, bounds)
-    largest = -np.inf
-    for e in range(bounds.shape[0]):
-        if bound[e] >= exact_bound:
-            return np.nan
-        largest = max(largest, bound[e])
-    return (1.0 - largest) ** 2
+        if det < smallest:
+            smallest, element = det, e
+    return (smallest, element) if smallest <= floor else (floor, -1)
 
 
 @jit
@@ -286,24 +286,23 @@ def _watched(delta, F, dtheta, nu, pick, mu, slip, radius_c, rate, A_rows, R_row
 @jit
 def watched_values(delta, F, dtheta, nu, pick, mu, slip, radius_c, rate, A_rows, R_rows, E,
                    boundary0, centers_f, radius_f, flat_f, t0_f, stick, finger, weight,
-                   rigid_gradients, bounds, exact_bound):
+                   rigid_gradients, bounds, loads, exact_bound):
     """The watched functions at one solution as the numpy code computes them (the same
     floats, a zero's sign aside): :meth:`~.stepper.functions.EventFunctions.watched`.
 
     The per-contact values and the free rows' gaps in
     :meth:`~.stepper.functions.EventFunctions.entries`'s order (:func:`_watched`'s arguments;
     ``E`` as the contact set holds it, so that ``E.T @ delta`` is numpy's product), then the
-    smallest area ratio when no element's gradient bound reaches ``exact_bound`` (the bound
-    (1 - max B_e)^2 of :meth:`~.contact_model.ContactModel.area_ratio`; NaN when an element
-    does, whose exact det F the model computes; inf without ``bounds`` rows, when the area is
-    not watched), and the pickup margin (:func:`_pickup`'s arguments, the fingers those in
-    ``finger``; inf when ``weight`` is NaN).
+    smallest area ratio and its element (:func:`_area_ratio` in numpy's order: NaN when an
+    element nears inversion and the set's ``loads`` are not kept yet; inf without ``bounds``
+    rows, when the area is not watched), and the pickup margin (:func:`_pickup`'s arguments,
+    the fingers those in ``finger``; inf when ``weight`` is NaN).
     """
     out = np.empty(pick.shape[0] + boundary0.shape[0] * centers_f.shape[0])
     fn, ft = _watched(delta, F, dtheta, nu, pick, mu, slip, radius_c, rate, A_rows, R_rows,
                       E, boundary0, centers_f, radius_f, flat_f, t0_f, out)
-    return out, _area_floor(delta, F, E, rigid_gradients, bounds, exact_bound), \
-        _pickup(mu, fn, ft, stick, finger, np.unique(finger), weight)
+    det, element = _area_ratio(delta, F, E, rigid_gradients, bounds, loads, exact_bound, True)
+    return out, det, element, _pickup(mu, fn, ft, stick, finger, np.unique(finger), weight)
 
 
 @jit
@@ -447,8 +446,8 @@ def advance_quiet(a, h, theta, dtheta, F, dF, ft, start_values, start_ends,
             centers_f[f, 1] = origin[f, 1] + b * D[f, 1]
         fn, ft_b = _watched(de, Fb, dth, nu, pick, mu, slip, radius_c, rate, A_rows,
                             R_rows, E, boundary0, centers_f, radius_f, flat_f, t0_f, values)
-        det, missing = _area(de, Fb, E, rigid_gradients, bounds, loads, exact_bound)
-        if missing:
+        det, _ = _area_ratio(de, Fb, E, rigid_gradients, bounds, loads, exact_bound, False)
+        if np.isnan(det):
             why = LOADS
             break
         ends[0] = det - inversion_ratio

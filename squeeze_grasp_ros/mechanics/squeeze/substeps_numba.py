@@ -180,9 +180,10 @@ def _area_ratio(delta, F, E, rigid_gradients, bounds, loads, exact_bound, numpys
     (inf without ``bounds`` rows, when the area is not watched), else the near elements' exact
     det F from the set's ``loads`` (m, t, 4, 2); NaN when one is near and ``loads`` are not
     given. With ``numpys_order`` its floats are the model's: H_e = rigid_e + ((G_0e f_0 +
-    G_1e f_1) + ...), each G_ke f_k the BLAS product numpy's matmul makes (one call per element
-    and contact: tens of microseconds); else the products are written out (a substep's
-    quiet check, which has QUIET_MARGIN to spare).
+    G_1e f_1) + ...), each contact's G_k[near] f_k one BLAS gemv of the near elements' rows
+    gathered (n * 4, 2), whose rows are those of numpy's matmul of the (n, 4, 2) gather (a
+    gemv per element); else the products are written out (a substep's quiet check, which has
+    QUIET_MARGIN to spare).
     """
     t = bounds.shape[0]
     if t == 0:
@@ -200,21 +201,27 @@ def _area_ratio(delta, F, E, rigid_gradients, bounds, loads, exact_bound, numpys
     m = F.shape[0]
     if loads.shape[0] != m:
         return np.nan, -1
-    smallest, element = np.inf, -1
-    H = np.empty(4)
+    which = np.empty(near, np.int64)
+    j = 0
     for e in range(t):
-        if bound[e] < exact_bound:
-            continue
-        H[:] = 0.0
-        for k in range(m):
-            if numpys_order:
-                H += np.dot(loads[k, e], F[k])
-            else:
+        if bound[e] >= exact_bound:
+            which[j] = e
+            j += 1
+    S = np.zeros(4 * near)  # sum_k G_k[which] f_k, (near, 4) raveled
+    for k in range(m):
+        if numpys_order:
+            S += np.dot(loads[k][which].reshape(4 * near, 2), F[k])
+        else:
+            for j in range(near):
                 for i in range(4):
-                    H[i] += loads[k, e, i, 0] * F[k, 0] + loads[k, e, i, 1] * F[k, 1]
-        for i in range(4):
-            H[i] = rigid[4 * e + i] + H[i]
-        det = (1.0 + H[0]) * (1.0 + H[3]) - H[1] * H[2]
+                    S[4 * j + i] += (loads[k, which[j], i, 0] * F[k, 0]
+                                     + loads[k, which[j], i, 1] * F[k, 1])
+    smallest, element = np.inf, -1
+    for j in range(near):
+        e = which[j]
+        h0, h1 = rigid[4 * e] + S[4 * j], rigid[4 * e + 1] + S[4 * j + 1]
+        h2, h3 = rigid[4 * e + 2] + S[4 * j + 2], rigid[4 * e + 3] + S[4 * j + 3]
+        det = (1.0 + h0) * (1.0 + h3) - h1 * h2
         if det < smallest:
             smallest, element = det, e
     return (smallest, element) if smallest <= floor else (floor, -1)

@@ -37,6 +37,33 @@ def test_sums_are_numpys_to_the_bit():
         assert substeps_numba._finger_sums(F, finger, f) == tuple(F[finger == f].sum(axis=0))
 
 
+def test_the_quiet_area_bound_is_below_the_area_check():
+    """A substep's quiet area bound (watched elements one by one, the rest at once) is at most
+    the area check's value, through loads that bring elements near inversion, and gives way
+    (-inf) when the rest's bound reaches the threshold.
+    """
+    from squeeze_grasp_ros.mechanics.squeeze.contact_model import GRADIENT_BOUND_EXACT
+    from squeeze_grasp_ros.mechanics.squeeze.stepper.compiled import quiet_area_tables
+
+    rng = np.random.default_rng(7)
+    t, m = 300, 6
+    loads = rng.standard_normal((m, t, 4, 2)) * rng.random((1, t, 1, 1)) ** 4
+    bounds = np.sqrt((loads * loads).sum(axis=(2, 3))).T.copy()
+    rigid_gradients = rng.standard_normal((4 * t, 3)) * 1e-2
+    E = np.asfortranarray(rng.standard_normal((2 * m, 3)))
+    tables = quiet_area_tables(bounds, rigid_gradients)
+    assert 0 < len(tables[0]) < t
+    seen = set()
+    for scale in np.geomspace(1e-3, 3.0, 40):
+        F, delta = rng.standard_normal((m, 2)) * scale, rng.standard_normal((m, 2)) * 1e-3
+        det, element = substeps_numba._area_ratio(delta, F, E, rigid_gradients, bounds, loads,
+                                                  GRADIENT_BOUND_EXACT, True)
+        lower = substeps_numba._area_lower(delta, F, E, *tables, loads, GRADIENT_BOUND_EXACT)
+        assert lower <= det + 1e-12, (scale, lower, det)
+        seen.add((element >= 0, lower > -np.inf))
+    assert {(False, True), (True, True), (True, False)} <= seen, seen
+
+
 def _same(a, b, path: str = "") -> None:
     """Assert two results equal field by field, floats bit for bit (NaN equal to NaN)."""
     if dataclasses.is_dataclass(a):

@@ -37,6 +37,33 @@ def test_sums_are_numpys_to_the_bit():
         assert substeps_numba._finger_sums(F, finger, f) == tuple(F[finger == f].sum(axis=0))
 
 
+def test_the_quiet_area_bound_is_below_the_area_check():
+    """A substep's quiet area bound (watched elements one by one, the rest at once) is at most
+    the area check's value, through loads that bring elements near inversion, and gives way
+    (-inf) when the rest's bound reaches the threshold.
+    """
+    from squeeze_grasp_ros.mechanics.squeeze.contact_model import GRADIENT_BOUND_EXACT
+    from squeeze_grasp_ros.mechanics.squeeze.stepper.compiled import quiet_area_tables
+
+    rng = np.random.default_rng(7)
+    t, m = 300, 6
+    loads = rng.standard_normal((m, t, 4, 2)) * rng.random((1, t, 1, 1)) ** 4
+    bounds = np.sqrt((loads * loads).sum(axis=(2, 3))).T.copy()
+    rigid_gradients = rng.standard_normal((4 * t, 3)) * 1e-2
+    E = np.asfortranarray(rng.standard_normal((2 * m, 3)))
+    tables = quiet_area_tables(bounds, rigid_gradients)
+    assert 0 < len(tables[0]) < t
+    seen = set()
+    for scale in np.geomspace(1e-3, 3.0, 40):
+        F, delta = rng.standard_normal((m, 2)) * scale, rng.standard_normal((m, 2)) * 1e-3
+        det, element = substeps_numba._area_ratio(delta, F, E, rigid_gradients, bounds, loads,
+                                                  GRADIENT_BOUND_EXACT, True)
+        lower = substeps_numba._area_lower(delta, F, E, *tables, loads, GRADIENT_BOUND_EXACT)
+        assert lower <= det + 1e-12, (scale, lower, det)
+        seen.add((element >= 0, lower > -np.inf))
+    assert {(False, True), (True, True), (True, False)} <= seen, seen
+
+
 def _same(a, b, path: str = "") -> None:
     """Assert two results equal field by field, floats bit for bit (NaN equal to NaN)."""
     if dataclasses.is_dataclass(a):
@@ -69,7 +96,7 @@ def _setup(name: str) -> GraspSetup:
 def test_event_squeezes_are_identical_with_the_compiled_substeps(name, monkeypatch):
     """Events, samples, forces, work and diagnostics of the numba route are the numpy route's
     to the bit, while the kernel runs most of the substeps (stick and slip, circles and pads,
-    pickup, finger slip).
+    pickup, finger slip), whether the object keeps its sets' load gradients already or not.
     """
     accepted = []
     run = compiled_module.CompiledSubsteps.run
@@ -80,6 +107,11 @@ def test_event_squeezes_are_identical_with_the_compiled_substeps(name, monkeypat
         return chunk
 
     monkeypatch.setattr(compiled_module.CompiledSubsteps, "run", counting)
+    monkeypatch.setenv(KERNEL_VARIABLE, Kernel.NUMBA.value)
+    # an object whose sets' load gradients are not kept yet (the model computes the det F of
+    # an element near inversion until they are), then one that keeps them (the kernel does)
+    first = GraspSetup.build(load_scene(SCENES / f"{name}.yaml")).precompute().event_squeeze()
+    accepted.clear()
     results = {}
     for route in Kernel:
         monkeypatch.setenv(KERNEL_VARIABLE, route.value)
@@ -88,6 +120,7 @@ def test_event_squeezes_are_identical_with_the_compiled_substeps(name, monkeypat
             assert not accepted  # the reference path never calls the kernel
     a, b = results[Kernel.NUMPY], results[Kernel.NUMBA]
     _same(a, b)
+    _same(a, first)
     # the substeps the kernel stops before (a crossing, the first after an event) run in
     # Python: about one in three in these short squeezes of 33-94 substeps
     substeps = b.diagnostics["substeps"]
@@ -146,10 +179,13 @@ def test_the_compiled_watched_values_and_slopes_are_the_numpy_codes(name, monkey
     assert len(compiled) >= 10 and all(compiled), compiled
 
 
-def test_the_compiled_area_check_hands_elements_near_inversion_to_the_model(monkeypatch):
+def test_the_compiled_area_check_computes_elements_near_inversion_as_the_model(monkeypatch):
     """The compiled area ratio is the model's bound while no element nears inversion and the
-    model's exact det F once one does (the same floats), up to loads that invert elements.
+    model's exact det F and element once one does (the same floats), computed in the kernel
+    from the set's load gradients the object keeps (no call of the model's area check), up to
+    loads that invert elements.
     """
+    from squeeze_grasp_ros.mechanics.squeeze.contact_model import ContactModel
     from squeeze_grasp_ros.mechanics.squeeze.stepper.functions import EventFunctions
 
     seen = []
@@ -164,15 +200,24 @@ def test_the_compiled_area_check_hands_elements_near_inversion_to_the_model(monk
     _setup("foam_square").event_squeeze()
     functions, (contacts, sol, s, rows, held) = seen[-1]
     monkeypatch.setattr(EventFunctions, "watched", watched)
+    model = functions.model
+    model.area_tables(contacts.data, loads=True)  # kept after the set's first near element
+    area_ratio, calls = ContactModel.area_ratio, []
+    monkeypatch.setattr(ContactModel, "area_ratio",
+                        lambda self, *args: calls.append(1) or area_ratio(self, *args))
     near = []
     for scale in (1.0, 3.0, 10.0, 30.0, 100.0):
         scaled = dataclasses.replace(sol, F=sol.F * scale, delta=sol.delta * scale)
         got = functions.watched(contacts, scaled, s, rows, held)
+        ends = functions.end_values(contacts, dataclasses.replace(scaled))  # a fresh read
+        assert not calls, scale
+        det, element = area_ratio(model, contacts.data, scaled.delta, scaled.F)
         want = functions.entries(contacts, functions.values(contacts, scaled, s, rows), rows,
                                  held)
         np.testing.assert_array_equal(got.values, want.values)
         assert got.ends == want.ends, scale
-        _, element = functions.model.area_ratio(contacts.data, scaled.delta, scaled.F)
+        assert ends[:2] == (det, element), (scale, ends, det, element)
+        calls.clear()
         near.append(element >= 0)
     assert not near[0] and near[-1], near  # both branches taken
 

@@ -47,7 +47,7 @@ from squeeze_grasp_ros.mechanics.elastic.reduced import reduce_blocks
 from squeeze_grasp_ros.mechanics.elastic.strain_measures import largest_pair_entry
 from squeeze_grasp_ros.mechanics.errors import InvalidInputError, NumericalError
 from squeeze_grasp_ros.mechanics.squeeze.fixed_set_kernel import Kernel, compiled, selected
-from squeeze_grasp_ros.mechanics.squeeze.kept import kept_property
+from squeeze_grasp_ros.mechanics.squeeze.kept import kept_for, kept_property
 from squeeze_grasp_ros.mechanics.squeeze.tip_shapes import TipGeometry, cross, tangent, unit
 from squeeze_grasp_ros.mechanics.vocabulary import MaterialModel, StrainCriterion, StrainMeasure
 
@@ -73,6 +73,9 @@ largest angle update (rad) falls below it."""
 BOUNDARY_ROWS_KEPT = 8
 """Row selections of the boundary compliance the fast model keeps for its last contact set
 (each 2k x 2m floats for k rows and m contacts)."""
+AREA_TABLES_BYTES = 64 * 2**20
+"""Memory an object keeps for its contact sets' area tables (:meth:`ContactModel.area_tables`:
+9 t floats per contact node for t elements)."""
 SHARED_SET_BYTES = 64 * 2**20
 """Memory an object keeps for the reduced data of contact sets its fast contact models share
 (:meth:`ContactModel.set_data`; a set of m contacts holds 2m (2b + 2m + 3) floats, and
@@ -816,36 +819,36 @@ class ContactModel:
         """
         g = sd.E.T @ delta.reshape(-1)
         rigid = (self.obj.rigid_gradients @ g).reshape(-1, 4)
-        kept = self._gradient_bounds(sd)
-        bound = (kept["bounds"] @ np.sqrt((F * F).sum(axis=1))
+        bound = (self.area_tables(sd)[0] @ np.sqrt((F * F).sum(axis=1))
                  + np.sqrt((rigid * rigid).sum(axis=1)))
         exact = bound >= GRADIENT_BOUND_EXACT
         near, rest = np.flatnonzero(exact), bound[~exact]
         floor = (1.0 - rest.max()) ** 2 if rest.size else np.inf
         if near.size == 0:
             return float(floor), -1
-        if "loads" not in kept:
-            kept["loads"] = self.obj.load_gradients(sd.nodes)
-        H = rigid[near] + sum(G[near] @ f for G, f in zip(kept["loads"], F))
+        loads = self.area_tables(sd, loads=True)[1]
+        H = rigid[near] + sum(G[near] @ f for G, f in zip(loads, F))
         det = (1.0 + H[:, 0]) * (1.0 + H[:, 3]) - H[:, 1] * H[:, 2]
         k = int(np.argmin(det))
         return (float(det[k]), int(near[k])) if det[k] <= floor else (float(floor), -1)
 
 
-    def _gradient_bounds(self, sd: SetData) -> dict:
-        """What :meth:`area_ratio` keeps of the last set (bounds; loads once an element neared)."""
-        kept = self._cache.get("gradient_bounds")
-        if kept is None or kept["set"] is not sd:
-            kept = self._cache["gradient_bounds"] = {
-                "set": sd, "bounds": self.obj.gradient_bounds(tuple(sd.nodes.tolist()))}
-        return kept
-
-    def area_tables(self, sd: SetData) -> tuple[np.ndarray, np.ndarray | None]:
-        """:meth:`area_ratio`'s bounds (t, m) and loads stacked (m, t, 4, 2; None until kept)."""
-        kept = self._gradient_bounds(sd)
-        if "loads" in kept and "stacked" not in kept:
-            kept["stacked"] = np.ascontiguousarray(np.stack(kept["loads"]))
-        return kept["bounds"], kept.get("stacked")
+    def area_tables(self, sd: SetData, *, loads: bool = False
+                    ) -> tuple[np.ndarray, np.ndarray | None]:
+        """:meth:`area_ratio`'s bounds (t, m) and the set's load gradients stacked (m, t, 4, 2;
+        None until an element neared, made now if ``loads``), kept by the object for all of its
+        models (they depend on the object and the set's nodes only: repeated squeezes and a
+        sweep's evaluations of an object share them), at most AREA_TABLES_BYTES of them.
+        """
+        obj = self.obj
+        size = 72 * len(obj.mesh.triangles) * max(len(sd.nodes), 1)  # bounds and loads
+        kept = kept_for(obj._shared.setdefault("area_tables", {}), sd, None,
+                        lambda: {"bounds": obj.gradient_bounds(tuple(sd.nodes.tolist()))},
+                        max(AREA_TABLES_BYTES // size, 2))
+        if loads and "loads" not in kept:
+            t = len(obj.mesh.triangles)
+            kept["loads"] = np.array(obj.load_gradients(sd.nodes)).reshape(-1, t, 4, 2)
+        return kept["bounds"], kept.get("loads")
 
 
 def strain_tables(obj: ElasticObject, length: float) -> tuple[np.ndarray, np.ndarray]:

@@ -36,13 +36,14 @@ from squeeze_grasp_ros.mechanics.squeeze.fixed_set_kernel import (
     compiled_substeps,
     selected,
 )
+from squeeze_grasp_ros.mechanics.squeeze.kept import kept_for
 from squeeze_grasp_ros.mechanics.squeeze.stepper.solving import (
     CONTINUATION_ITERATIONS,
     MAX_ANGLE_JUMP,
 )
 from squeeze_grasp_ros.mechanics.vocabulary import Termination
 
-__all__ = ["CHUNK", "QUIET_MARGIN", "Chunk", "CompiledSubsteps"]
+__all__ = ["CHUNK", "QUIET_MARGIN", "Chunk", "CompiledSubsteps", "quiet_area_tables"]
 
 QUIET_MARGIN = 1e-12
 """Dimensionless value (gap / L, force / (E h L), area ratio) every watched function must
@@ -52,11 +53,38 @@ zero goes through the full stepper, so that round-off can never hide or invent a
 compiled substeps take a substep as quiet on the same margin (their watched values are the
 numpy code's floats, but an element near inversion has its det F summed in the kernel's own
 order)."""
+QUIET_AREA_SHARE = 0.1
+"""An element is watched one by one in a substep's quiet area check when its gradient bound per
+unit load at some contact is at least this share of that contact's largest (about an eighth of
+the foam square's elements); the others are bounded together
+(:func:`..substeps_numba._area_lower`)."""
+QUIET_AREA_TABLES_KEPT = 64
+"""Contact sets whose :func:`quiet_area_tables` an object keeps."""
 CHUNK = 256
 """Substeps the compiled loop runs before it returns its samples (it is called again)."""
 _NO_LOADS = np.zeros((0, 0, 4, 2))
 _END_KEYS = (SHARED_KEYS.get(EventFunction.AREA), SHARED_KEYS.get(EventFunction.PICKUP))
 """The terminations the kernel watches, in its order (a strain limit runs in Python)."""
+
+
+def quiet_area_tables(bounds: np.ndarray, rigid_gradients: np.ndarray) -> tuple:
+    """The tables of a contact set's quiet area check (:func:`..substeps_numba._area_lower`)
+    from its gradient bounds (t, m) and the object's rigid gradients (4t, 3): the watched
+    elements (:data:`QUIET_AREA_SHARE`), their bounds (w, m) and rigid gradients (w, 4, 3), the
+    other elements' bounds' column maxima (m,), and the largest Frobenius norm of an element's
+    rigid gradients.
+
+    >>> bounds = np.array([[1.0, 0.0], [0.05, 0.02], [0.0, 2.0]])
+    >>> watched, _, _, rest_top, rigid_top = quiet_area_tables(bounds, np.full((12, 3), 0.5))
+    >>> watched.tolist(), rest_top.tolist(), rigid_top
+    ([0, 2], [0.05, 0.02], 1.7320508075688772)
+    """
+    watched = np.flatnonzero((bounds >= QUIET_AREA_SHARE * bounds.max(axis=0)).any(axis=1))
+    rest = np.delete(bounds, watched, axis=0)
+    rigid = rigid_gradients.reshape(-1, 4, 3)
+    return (watched, np.ascontiguousarray(bounds[watched]), np.ascontiguousarray(rigid[watched]),
+            rest.max(axis=0) if len(rest) else np.zeros(bounds.shape[1]),
+            float(np.sqrt((rigid * rigid).sum(axis=(1, 2))).max()))
 
 
 class Chunk:
@@ -151,6 +179,9 @@ class CompiledSubsteps:
         problem, watched = self._set_tables(contacts, start.rows, held)
         bounds, loads = model.area_tables(contacts.data)  # loads: kept once an element neared
         area = (np.ascontiguousarray(bounds), _NO_LOADS if loads is None else loads)
+        quiet_area = kept_for(model.obj._shared.setdefault("quiet_area", {}), contacts.data,
+                              None, lambda: quiet_area_tables(bounds, self.rigid_gradients),
+                              QUIET_AREA_TABLES_KEPT)
         m, nf = len(contacts), len(motion.names)
         n = int(np.count_nonzero(~contacts.stick))
         ends = start.values.ends
@@ -165,9 +196,10 @@ class CompiledSubsteps:
             self.origin, self.D, NEWTON_TOL, NEWTON_MAX_ITERATIONS, NEWTON_BACKTRACKS,
             CONTINUATION_ITERATIONS, MAX_ANGLE_JUMP, watched[0], float(model.mu),
             float(motion.rate), *watched[1:], *self.tip_tables, self.rigid_gradients, *area,
-            GRADIENT_BOUND_EXACT, INVERSION_AREA_RATIO, self.weight, float(motion.depth0),
-            float(motion.length), expiry, QUIET_MARGIN, float(model.force_unit), call.work,
-            call.dissipation, s_out, theta_out, forces_out, jacobians)
+            GRADIENT_BOUND_EXACT, INVERSION_AREA_RATIO, quiet_area, self.weight,
+            float(motion.depth0), float(motion.length), expiry, QUIET_MARGIN,
+            float(model.force_unit), call.work, call.dissipation, s_out, theta_out, forces_out,
+            jacobians)
         python_next = why != self.kernel.FULL
         if count == 0:
             return Chunk(0, python_next, a, None)

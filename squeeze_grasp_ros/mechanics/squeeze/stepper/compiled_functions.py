@@ -8,8 +8,10 @@ margin; their slopes d/ds) by one call of :func:`..substeps_numba.watched_values
 :func:`..substeps_numba.slope_values`, instead of some fifty numpy calls. They are the numpy
 code's floats, a zero's sign aside: the products are the BLAS calls numpy makes, with the
 arrays in the layouts numpy has them (the set's E as it holds it), the sums in numpy's order.
-What the kernel does not compute stays the model's: an element near inversion (its exact
-det F) and a strain limit. With ``SQUEEZE_GRASP_KERNEL=numpy``, for the reference model and for
+The kernel computes an element near inversion's exact det F too, in the model's order, once
+the set's load gradients are kept (:meth:`~..contact_model.ContactModel.area_tables`: by the
+object, so from a set's second squeeze on); before that, and for a strain limit, the model
+computes. With ``SQUEEZE_GRASP_KERNEL=numpy``, for the reference model and for
 models with their own boundary displacement or area check (the nonlinear ones), none of this
 runs: :class:`~.functions.EventFunctions` computes in numpy, the reference path.
 """
@@ -42,6 +44,7 @@ __all__ = ["CompiledFunctions"]
 _NO_BOUNDS = np.zeros((0, 0))
 _NO_KAPPA = np.zeros(0)
 _NO_VALUES = np.zeros(0)
+_NO_LOADS = np.zeros((0, 0, 4, 2))
 ROW_TABLES_KEPT = 64
 """Tables of (contact set, boundary rows) the compiled reads of an object's calls keep
 (:meth:`CompiledFunctions._rows_of`)."""
@@ -90,18 +93,19 @@ class CompiledFunctions:
         (the area also while the fingers do not move, the strain unless ``strain``), the
         model's det F once an element nears inversion.
         """
-        values, det, pickup = self._read(contacts, sol, s, rows, pick)
+        values, det, element, pickup = self._read(contacts, sol, s, rows, pick)
         if not terminations:
             return values, np.inf, -1, np.inf, np.inf
-        functions, element = self.functions, -1
-        if np.isnan(det):
+        functions = self.functions
+        if np.isnan(det):  # the set's load gradients are not kept yet: the model keeps them
             det, element = functions.model.area_ratio(contacts.data, sol.delta, sol.F)
         margin = functions.strain_margin(contacts, sol) if strain else np.inf
         return values, det, element, margin, pickup
 
     def _read(self, contacts: ContactSet, sol: Solution, s: float, rows: np.ndarray,
-              pick: np.ndarray) -> tuple[np.ndarray, float, float]:
-        """The kernel's (values, area bound, pickup margin) at ``sol``, terminations included.
+              pick: np.ndarray) -> tuple[np.ndarray, float, int, float]:
+        """The kernel's (values, area ratio, its element, pickup margin) at ``sol``,
+        terminations included.
 
         The last read is kept: at an event point the pending events, the terminations and the
         next substep's start read the same solution (the area and the pickup margin of any
@@ -110,9 +114,9 @@ class CompiledFunctions:
         last = self._last
         if last is not None and last[0] is contacts and last[1] is sol:
             if not len(rows) and not len(pick):
-                return _NO_VALUES, last[6], last[7]
+                return (_NO_VALUES, *last[6])
             if last[2] == s and _same(last[3], rows) and _same(last[4], pick):
-                return last[5], last[6], last[7]
+                return (last[5], *last[6])
         functions = self.functions
         model, motion = functions.model, functions.motion
         lim, rate = model.limits, motion.rate
@@ -120,14 +124,16 @@ class CompiledFunctions:
         weight = (lim.weight / model.force_unit if lim.weight is not None
                   and Termination.PICKED_UP in functions.terminate_on else np.nan)
         tip = motion.tip
-        values, det, pickup = self.kernel.watched_values(
+        loads = model.area_tables(contacts.data)[1] if len(bounds) else None
+        values, *ends = self.kernel.watched_values(
             sol.delta, sol.F, sol.dtheta, sol.normal_angle, pick, float(model.mu),
             contacts.slip, motion.contact_tips(contacts.finger).tip.radius,
             rate if rate > 0 else 1.0, A, R, contacts.data.E, points, motion.centers(s),
             tip.radius, tip.flat, tip._facing_tangent, contacts.stick, contacts.finger, weight,
-            model.obj.rigid_gradients, bounds, GRADIENT_BOUND_EXACT)
-        self._last = (contacts, sol, s, rows, pick, values, det, pickup)
-        return values, det, pickup
+            model.obj.rigid_gradients, bounds, _NO_LOADS if loads is None else loads,
+            GRADIENT_BOUND_EXACT)
+        self._last = (contacts, sol, s, rows, pick, values, ends)
+        return (values, *ends)
 
     def slopes(self, contacts: ContactSet, sol: Solution, s: float,
                rows: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

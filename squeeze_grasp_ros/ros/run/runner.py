@@ -87,7 +87,7 @@ from squeeze_grasp_ros.ros.run.processes import NodeProcesses, ros_arguments
 from squeeze_grasp_ros.ros.run.summary import run_summary
 from squeeze_grasp_ros.scene import GraspSetup, SceneError
 
-__all__ = ["EVENTS_PER_CHECK", "STOP_SIGNALS", "PipelineRunner"]
+__all__ = ["EVENTS_PER_CHECK", "STOP_SIGNALS", "WAKE_PERIOD", "PipelineRunner"]
 
 EVENTS_PER_CHECK = 16
 """Queued events :meth:`PipelineRunner.wait` executes between two checks of its condition."""

@@ -184,7 +184,9 @@ class PipelineRunner:
         goal's result or a :data:`WAKE_PERIOD` wall timer completes: the executor dispatches a
         tick's events in C++, where a ``spin_once`` an event cost about 35 us of CPU of its own
         (context check, timeout set-up, the call), and the conditions are checked once a tick.
-        Its timeout is not used: it does not end a spin while events keep coming.
+        The spin's timeout does not end it while events keep coming (hence the timer), but it
+        must be given: without one rclpy 7.1.5's spin runs no timer callback and never returns
+        once a node has a timer.
         """
         deadline = time.monotonic() + timeout
         while not done():
@@ -198,7 +200,7 @@ class PipelineRunner:
                 self.graph.check()
             if per_tick and self.events_per_check:
                 self.wake = Future()
-                self.executor.spin_until_future_complete(self.wake)
+                self.executor.spin_until_future_complete(self.wake, WAKE_PERIOD)
             else:
                 self.executor.spin_once(0.05)
                 for _ in range(self.events_per_check):

@@ -48,8 +48,9 @@ class Observer:
     """
 
     def __init__(self, node: Node, progress: Progress | None = None, *,
-                 kept: bool = False) -> None:
+                 kept: bool = False, on_state: Callable[[], None] = lambda: None) -> None:
         self.node = node
+        self.on_state = on_state
         self.progress = progress
         self.kept = kept
         self.sim_events: list[ContactEvent] = []
@@ -107,6 +108,7 @@ class Observer:
     def _state(self, data: bytes) -> None:
         self.sim_state_data.append(data)
         self.sim_state_ns = cdr_stamp_ns(data)
+        self.on_state()
 
     def _recorder_progress(self, msg: Header) -> None:
         self.recorder_ns = max(self.recorder_ns, messages.stamp_ns(msg.stamp))

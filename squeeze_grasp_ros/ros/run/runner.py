@@ -27,6 +27,7 @@ synchronise.
 from __future__ import annotations
 
 import dataclasses
+import functools
 import importlib.util
 import signal
 import threading
@@ -44,6 +45,7 @@ from rclpy.logging import LoggingSeverity
 from rclpy.node import Node
 from rclpy.parameter import Parameter
 from rclpy.signals import SignalHandlerOptions
+from rclpy.task import Future
 
 from squeeze_grasp_interfaces.action import ExecuteGrasp
 from squeeze_grasp_interfaces.msg import ContactEventArray, PredictedShapes
@@ -85,10 +87,13 @@ from squeeze_grasp_ros.ros.run.processes import NodeProcesses, ros_arguments
 from squeeze_grasp_ros.ros.run.summary import run_summary
 from squeeze_grasp_ros.scene import GraspSetup, SceneError
 
-__all__ = ["EVENTS_PER_CHECK", "STOP_SIGNALS", "PipelineRunner"]
+__all__ = ["EVENTS_PER_CHECK", "STOP_SIGNALS", "WAKE_PERIOD", "PipelineRunner"]
 
 EVENTS_PER_CHECK = 16
 """Queued events :meth:`PipelineRunner.wait` executes between two checks of its condition."""
+WAKE_PERIOD = 0.05
+"""Wall-clock s: the longest a ``per_tick`` :meth:`PipelineRunner.wait` spins without checking
+its condition."""
 STOP_SIGNALS = (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)
 """Signals that stop a run cleanly (the recording is finished, node processes are stopped)."""
 
@@ -145,7 +150,12 @@ class PipelineRunner:
         """The pipeline nodes built in this process, by name."""
         self.recorder = None
         """The in-process recorder node (with ``record``, without ``processes``)."""
-        self.observer = Observer(self.client, progress, kept=not options.attach)
+        self.wake = Future()
+        """Completed to end the current ``per_tick`` spin of :meth:`wait`."""
+        self.observer = Observer(self.client, progress, kept=not options.attach,
+                                 on_state=self._wake)
+        if self.events_per_check:
+            pipeline.wall_timer(self.client, WAKE_PERIOD, self._wake)
         self.prediction_pub = self.client.create_publisher(
             ContactEventArray, pipeline.PREDICTION, pipeline.LATCHED)
         self.goal = GoalClient(self.client, self.observer.on_feedback)
@@ -156,7 +166,7 @@ class PipelineRunner:
         self.start_ns = 0
 
     # ----------------------------------------------------------------- waiting
-    def wait(self, done: Callable[[], bool], timeout: float) -> None:
+    def wait(self, done: Callable[[], bool], timeout: float, *, per_tick: bool = False) -> None:
         """Spin the executor until ``done()``; TimeoutError after ``timeout`` wall-clock s.
 
         Between spins it raises :class:`Interrupted` after a stop signal, :class:`RunError` if
@@ -167,6 +177,16 @@ class PipelineRunner:
         ``SingleThreadedExecutor``: its ``spin_once`` keeps a generator of ready entities per
         timeout argument, and alternating timeouts discard it together with triggers it has
         already taken (a run then waits forever for a lost result).
+
+        With ``per_tick`` (the lockstep loop's wait for the goal's result) on
+        ``EventsExecutor``, each spin is one ``spin_until_future_complete`` on :attr:`wake`,
+        which the tick's ground truth (``sim/state``, the client's one delivery a tick), the
+        goal's result or a :data:`WAKE_PERIOD` wall timer completes: the executor dispatches a
+        tick's events in C++, where a ``spin_once`` an event cost about 35 us of CPU of its own
+        (context check, timeout set-up, the call), and the conditions are checked once a tick.
+        The spin's timeout does not end it while events keep coming (hence the timer), but it
+        must be given: without one rclpy 7.1.5's spin runs no timer callback and never returns
+        once a node has a timer.
         """
         deadline = time.monotonic() + timeout
         while not done():
@@ -178,14 +198,26 @@ class PipelineRunner:
                 self.processes.check()
             if self.graph is not None and self.graph.due():
                 self.graph.check()
-            self.executor.spin_once(0.05)
-            for _ in range(self.events_per_check):
-                self.executor.spin_once(0.0)
+            if per_tick and self.events_per_check:
+                self.wake = Future()
+                self.executor.spin_until_future_complete(self.wake, WAKE_PERIOD)
+            else:
+                self.executor.spin_once(0.05)
+                for _ in range(self.events_per_check):
+                    self.executor.spin_once(0.0)
 
-    def spin_until(self, done: Callable[[], bool], timeout: float, what: str) -> None:
+    def _wake(self) -> None:
+        """End a :meth:`wait` ``per_tick`` spin (a tick's ground truth or the goal's result
+        arrived, or a :data:`WAKE_PERIOD` passed).
+        """
+        if not self.wake.done():
+            self.wake.set_result(None)
+
+    def spin_until(self, done: Callable[[], bool], timeout: float, what: str, *,
+                   per_tick: bool = False) -> None:
         """:meth:`wait`, raising :class:`RunError` naming ``what`` after ``timeout``."""
         try:
-            self.wait(done, timeout)
+            self.wait(done, timeout, per_tick=per_tick)
         except TimeoutError:
             raise RunError(f"timed out after {timeout:.0f} s waiting for {what}") from None
 
@@ -374,7 +406,9 @@ class PipelineRunner:
         reports the goal finished but the result response does not come within a few seconds
         (lost across processes), the result is requested again.
         """
-        result = self.goal.result(self.spin_until, self.options.timeout,
+        self.goal.result_future.add_done_callback(lambda _: self._wake())
+        result = self.goal.result(functools.partial(self.spin_until, per_tick=True),
+                                  self.options.timeout,
                                   (lambda: False) if self.joint_feedback
                                   or self.plan.goal.on_slip_alarm == RESQUEEZE
                                   else self.observer.world_failed)

@@ -19,10 +19,17 @@ no mechanics, no tracker, no program, no message payload. Its 13 deliveries are 
 the pipeline's since the monitor and the executor stopped taking ``/clock`` in lockstep; with
 ``clock_deliveries=False`` the loop drops those two as well (11 deliveries, the pipeline's
 count now), with them it stays the yardstick issue 33 set.
+
+The main thread waits as ``squeeze-grasp run``'s loop does (``PipelineRunner.wait``): on
+``EventsExecutor`` one ``spin_until_future_complete`` a tick, completed by the client's state
+of the tick (or the last tick's setpoints); on ``SingleThreadedExecutor`` one ``spin_once`` an
+event. Spinning once an event on ``EventsExecutor`` costs the bare loop about a quarter of its
+rate, so a yardstick spun that way would flatter a pipeline spun once a tick.
 """
 from __future__ import annotations
 
 import time
+from collections.abc import Callable
 
 import rclpy
 from rclpy.context import Context
@@ -30,9 +37,11 @@ from rclpy.executors import Executor, SingleThreadedExecutor
 from rclpy.experimental import EventsExecutor
 from rclpy.node import Node
 from rclpy.signals import SignalHandlerOptions
+from rclpy.task import Future
 from std_msgs.msg import Header
 
 from squeeze_grasp_ros.ros.nodes.pipeline import loop_qos
+from squeeze_grasp_ros.ros.run.runner import WAKE_PERIOD
 
 __all__ = ["DEVICES", "READINGS", "bare_loop_rate"]
 
@@ -51,9 +60,9 @@ def _tick(msg: Header) -> int:
 
 
 class _Sim:
-    def __init__(self, node: Node, ticks: int) -> None:
+    def __init__(self, node: Node, ticks: int, finished: Callable[[], None]) -> None:
         qos = loop_qos(10)
-        self.ticks, self.tick, self.pending = ticks, 0, set()
+        self.ticks, self.tick, self.pending, self.finished = ticks, 0, set(), finished
         self.pubs = [node.create_publisher(Header, "clock", qos)]
         self.pubs += [node.create_publisher(Header, f"{d}/{r}", qos)
                       for d in DEVICES for r in READINGS]
@@ -77,6 +86,8 @@ class _Sim:
             self.tick += 1
             if self.tick < self.ticks:
                 self.publish()
+            else:
+                self.finished()
 
 
 class _Monitor:
@@ -141,10 +152,15 @@ def bare_loop_rate(ticks: int, *, executor: str = "events", namespace: str = "/b
                       else SingleThreadedExecutor(context=context))
     nodes = [Node(name, namespace=namespace, context=context)
              for name in ("sim", "monitor", "executor", "client")]
+    wake = Future()
+
+    def tick_done(*_: object) -> None:
+        if not wake.done():
+            wake.set_result(None)
     try:
-        sim = _Sim(nodes[0], ticks)
+        sim = _Sim(nodes[0], ticks, tick_done)
         _Monitor(nodes[1], clock_deliveries), _Executor(nodes[2], clock_deliveries)
-        nodes[3].create_subscription(Header, "state", lambda _: None, loop_qos(10))
+        nodes[3].create_subscription(Header, "state", tick_done, loop_qos(10))
         for node in nodes:
             spin.add_node(node)
         subscribed = [(p, (2 if clock_deliveries else 0) if p.topic_name.endswith("/clock")
@@ -157,7 +173,11 @@ def bare_loop_rate(ticks: int, *, executor: str = "events", namespace: str = "/b
         started = time.perf_counter()
         sim.publish()
         while sim.tick < ticks:
-            spin.spin_once(1.0)
+            if executor == "events":
+                wake = Future()
+                spin.spin_until_future_complete(wake, WAKE_PERIOD)
+            else:
+                spin.spin_once(1.0)
         return ticks / (time.perf_counter() - started)
     finally:
         for node in nodes:

@@ -26,6 +26,9 @@ from squeeze_grasp_ros.mechanics.squeeze.graspmap import grasp_map
 from squeeze_grasp_ros.mechanics.squeeze.stable_pure import plan_squeeze
 
 EQUILIBRIUM_TOL = 1e-9
+KIDNEY = [[0.06, 0.0], [0.045, 0.04], [0.0, 0.05], [-0.045, 0.04], [-0.06, 0.0],
+          [-0.04, -0.035], [0.0, -0.012], [0.04, -0.035]]
+"""Control points (m) of a non-convex outline, a kidney whose lower side bulges inward."""
 """Force/torque residual relative to the largest contact force (and object size for torque)."""
 
 
@@ -171,17 +174,7 @@ def test_friction_extremes_in_the_grasp_map(mu):
 
 
 def test_nonconvex_object_and_inward_check():
-    pts = [
-        [0.06, 0.0],
-        [0.045, 0.04],
-        [0.0, 0.05],
-        [-0.045, 0.04],
-        [-0.06, 0.0],
-        [-0.04, -0.035],
-        [0.0, -0.012],
-        [0.04, -0.035],
-    ]
-    outline = shapes.spline(pts)
+    outline = shapes.spline(KIDNEY)
     mesh = generate_mesh(outline, outline.area / 600)
     obj = ElasticObject(mesh, Material(5e4, 0.3, 0.0254))
     b = mesh.boundary
@@ -313,17 +306,7 @@ def test_event_squeeze_from_a_nanometre_depth():
 
 @pytest.mark.usefixtures("kernel")  # both fixed-set routes
 def test_event_squeeze_on_a_nonconvex_object():
-    pts = [
-        [0.06, 0.0],
-        [0.045, 0.04],
-        [0.0, 0.05],
-        [-0.045, 0.04],
-        [-0.06, 0.0],
-        [-0.04, -0.035],
-        [0.0, -0.012],
-        [0.04, -0.035],
-    ]
-    outline = shapes.spline(pts)
+    outline = shapes.spline(KIDNEY)
     obj = ElasticObject(
         generate_mesh(outline, target_max_area(outline, 1200)), Material(5e4, 0.3, 0.0254)
     )

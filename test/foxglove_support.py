@@ -29,15 +29,16 @@ def foxglove_decoder() -> Path:
                     "libraries) cannot run on this machine")
     CACHE.mkdir(parents=True, exist_ok=True)
     manifest = (JS_DIR / "package.json").read_text()
-    installed = CACHE / "package.json"
+    installed = CACHE / ".installed-package.json"  # the manifest of the last good install
     if not installed.is_file() or installed.read_text() != manifest \
             or not (CACHE / "node_modules").is_dir():
+        (CACHE / "package.json").write_text(manifest)
         done = subprocess.run([npm, "install", "--no-audit", "--no-fund", "--loglevel=error"],
                               cwd=CACHE, capture_output=True, text=True, timeout=300)
         if done.returncode != 0:
-            pytest.skip(f"npm install of Foxglove's MCAP libraries into {CACHE} failed (offline? "
-                        f"the npm registry must be reachable once): "
-                        f"{done.stderr.strip().splitlines()[-1:]}")
+            errors = [line for line in done.stderr.splitlines() if "error" in line]
+            pytest.skip(f"npm install of Foxglove's MCAP libraries into {CACHE} failed (the npm "
+                        f"registry must be reachable once): {' | '.join(errors[:3])}")
         installed.write_text(manifest)
     script = CACHE / "decode_mcap.mjs"
     shutil.copyfile(JS_DIR / "decode_mcap.mjs", script)

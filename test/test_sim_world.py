@@ -187,6 +187,22 @@ def test_an_undeclared_effect_costs_nothing():
     assert frictionless.model.mu == 0.0
 
 
+def test_a_tick_asks_the_scene_for_no_effect(monkeypatch):
+    """The world decides its effects when it is built: its ticks look none up in the scene
+    (``Scene.has`` hashes an ``Effect`` in Python; the readings asked it for every finger at
+    every tick).
+    """
+    world = SimWorld(GraspSetup.build(effect_scene({"friction", "force_sensing",
+                                                    "tactile_sensing", "sensor_noise"})))
+    asked = Counter()
+    has = type(world.scene).has
+    monkeypatch.setattr(type(world.scene), "has",
+                        lambda scene, effect: asked.update([effect]) or has(scene, effect))
+    work = drive(world)
+    assert work["wrench_evaluations"] > 0 and work["tactile_renderings"] > 0, work
+    assert not asked, asked
+
+
 def test_sensor_sections_follow_their_effects():
     with pytest.raises(SceneError, match="sensor_noise"):
         scene_with(sensors={"noise_std": 0.01, "seed": 1})

@@ -148,8 +148,8 @@ def _wrench(on_object: np.ndarray, arms: np.ndarray) -> tuple[np.ndarray, np.nda
     """(force (3,), torque (3,)) on the fingertip of forces on the object (k, 2) at ``arms``."""
     forces = -on_object
     torque_z = float(arms[:, 0] @ forces[:, 1] - arms[:, 1] @ forces[:, 0])
-    total = forces.sum(axis=0)
-    return np.array([total[0], total[1], 0.0]), np.array([0.0, 0.0, torque_z])
+    fx, fy = np.add.reduce(forces, axis=0).tolist()  # forces.sum(axis=0) without its wrapper
+    return np.array((fx, fy, 0.0)), np.array((0.0, 0.0, torque_z))
 
 
 class FingerSensors:

@@ -239,6 +239,8 @@ class SimWorld:
                             else tactile_layout(t.facing, taxels, 2 * t.flat / t.radius + np.pi,
                                                 periodic=False)
                             for t in tips}
+        self.force_sensing = scene.has(Effect.FORCE_SENSING)
+        """Whether the fingers have wrench sensors (the scene's force_sensing effect)."""
         self.sensors = {t.name: FingerSensors(self.tips[t.name], self.layouts.get(t.name))
                         for t in tips}
         """Each finger's wrench sensor and tactile array (:class:`.sensors.FingerSensors`)."""
@@ -426,27 +428,21 @@ class SimWorld:
 
     def _read(self, name: str) -> FingerReading:
         """Sensor readings of finger ``name`` (dropout decided before noise is drawn)."""
-        device = self.devices[name].name
-        reading = {
-            "finger": name,
-            "device": device,
-            "position": self.positions[name] - self.offsets[name],
-        }
         rnd, sensors = self.randomness, self.sensors[name]
-        sensed = None
-        if self.scene.has(Effect.FORCE_SENSING) and not rnd.dropped():
+        force = torque = normal = tangential = sensed = None
+        if self.force_sensing and not rnd.dropped():
             self._work["wrench_evaluations"] += 1
             forces, geometry = sensed = self._sense(name)
             force, torque = sensors.wrench(forces, geometry)
-            reading["force"] = rnd.perturb(force)
-            reading["torque"] = rnd.perturb(torque, self.radii[name])
+            force, torque = rnd.perturb(force), rnd.perturb(torque, self.radii[name])
         if name in self.layouts and not rnd.dropped():
             self._work["tactile_renderings"] += 1
             forces, geometry = sensed or self._sense(name)
             normal, tangential = sensors.tactile(forces, geometry)
-            reading["normal"] = rnd.perturb(normal)
-            reading["tangential"] = rnd.perturb(tangential)
-        return FingerReading(**reading)
+            normal, tangential = rnd.perturb(normal), rnd.perturb(tangential)
+        return FingerReading(name, self.devices[name].name,
+                             self.positions[name] - self.offsets[name], force, torque, normal,
+                             tangential)
 
     def _sense(self, name: str) -> tuple:
         """Finger ``name``'s sensors reading its contact nodes (:meth:`.sensors.FingerSensors.

@@ -82,3 +82,6 @@ def test_the_example_sweep_evaluations_are_timed_and_profiled_with_their_sparse_
     assert m["cpu_s"] > 0
     assert "<method 'solve' of 'SuperLU' objects>" in names
     assert 0.0 < m["kernel_s"] < m["profiled_s"]
+    # the groups are prepared outside the profile (before, with more groups than the sweep's
+    # cache holds, the profiled task's group had been evicted and was meshed inside it)
+    assert not names & {"group_setup", "build_mesh", "grasp_map"}

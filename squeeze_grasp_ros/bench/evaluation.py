@@ -43,6 +43,7 @@ import yaml
 
 from squeeze_grasp_ros.bench.pinned import BASELINE_COMMIT, baseline, interleaved, this_tree
 from squeeze_grasp_ros.bench.table import Table
+from squeeze_grasp_ros.bench.timing_driver import prepared_tasks
 from squeeze_grasp_ros.mechanics.squeeze.fixed_set_kernel import KERNEL_VARIABLE, Kernel, compiled
 from squeeze_grasp_ros.mechanics.vocabulary import Factorizer
 from squeeze_grasp_ros.resources import share_dir
@@ -135,38 +136,32 @@ def measure_routes(spec: Path, tasks: int | None) -> dict[Kernel, dict]:
 
 
 def measure(spec: Path, tasks: int | None) -> dict:
-    """Time all of ``spec``'s evaluations (CPU, groups prepared first) in this process, and
-    profile those of its first ``tasks`` tasks (all if None). The first task runs once untimed
-    (numba's compiled code is loaded or compiled on first use); the groups are prepared afresh
-    before the timed pass and before the profiled one.
+    """Time all of ``spec``'s evaluations (CPU) in this process, and profile those of its first
+    ``tasks`` tasks (all if None). The first task runs once untimed (numba's compiled code is
+    loaded or compiled on first use); the timed pass and the profiled one start from fresh
+    groups (what their objects keep from earlier evaluations, reduced contact sets, would
+    shorten the next pass, and a sweep runs each task once), each group prepared outside the
+    timing and the profile just before its first task (:func:`~.timing_driver.prepared_tasks`).
     """
     loaded = parse_sweep_spec(yaml.safe_load(spec.read_text()), spec.parent)
     every = list(plan_tasks(loaded))
-
-    def prepare_all() -> None:
-        """Fresh groups: what their objects keep from earlier evaluations (reduced contact
-        sets) would shorten the next pass, and a sweep runs each task once.
-        """
-        clear_cache()
-        for task in every:
-            prepare(task)
-
-    prepare_all()
     run_task(every[0])
-    prepare_all()
+    clear_cache()
     per_task = []
-    for task in every:
+    for task in prepared_tasks(every, prepare):
         start = time.process_time()
         rows = len(run_task(task)["rows"])
         per_task.append((rows, time.process_time() - start))
     n, cpu = (sum(x) for x in zip(*per_task))
     chosen = every[:tasks]
     chosen_cpu = sum(t for _, t in per_task[:len(chosen)])
-    prepare_all()
+    clear_cache()
     profile = cProfile.Profile(time.process_time)  # CPU time: the machine is shared
-    profile.enable()
-    profiled = sum(len(run_task(task)["rows"]) for task in chosen)
-    profile.disable()
+    profiled = 0
+    for task in prepared_tasks(chosen, prepare):
+        profile.enable()
+        profiled += len(run_task(task)["rows"])
+        profile.disable()
     stats = pstats.Stats(profile)
     kernel, total, calls = kernel_share(stats)
     return {"evaluations": n, "cpu_s": cpu, "profiled": profiled,

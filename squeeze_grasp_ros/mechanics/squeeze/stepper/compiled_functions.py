@@ -71,6 +71,7 @@ class CompiledFunctions:
                        and Termination.PICKED_UP in functions.terminate_on else np.nan)
         self._last: tuple | None = None
         self._last_slopes: tuple | None = None
+        self._last_rows: tuple | None = None
         self._rows: dict[tuple, tuple] = functions.model.obj._shared.setdefault(
             "compiled_rows", {})
 
@@ -191,12 +192,17 @@ class CompiledFunctions:
         positions, the area bounds or none while the fingers stay) of ``contacts`` and boundary
         ``rows``: kept for the call's last few sets (a point's reads and the substeps of a set
         ask for the same ones), by the object for its models' calls (what they depend on is
-        the object's: a sweep's evaluations of an object ask for the same ones too).
+        the object's: a sweep's evaluations of an object ask for the same ones too); the last
+        ones by identity (the free rows are a kept read-only array per set and holds).
         """
-        sd = contacts.data
+        sd, last = contacts.data, self._last_rows
+        if last is not None and last[0] is sd and last[1] is rows:
+            return last[2]
         moving = self.functions.motion.rate > 0
-        return kept_for(self._rows, sd, (moving, rows.dtype.str, rows.tobytes()),
+        made = kept_for(self._rows, sd, (moving, rows.dtype.str, rows.tobytes()),
                         lambda: self._tables(sd, rows, moving), ROW_TABLES_KEPT)
+        self._last_rows = (sd, rows, made)
+        return made
 
     def _tables(self, sd: SetData, rows: np.ndarray, moving: bool) -> tuple:
         functions = self.functions

@@ -136,10 +136,12 @@ def test_the_compiled_watched_values_and_slopes_are_the_numpy_codes(name, monkey
     are the floats the numpy code computes at the same solution (a zero's sign aside):
     circles and pads, stick and slip, pickup.
     """
+    from squeeze_grasp_ros.mechanics.squeeze.stepper import processing
     from squeeze_grasp_ros.mechanics.squeeze.stepper.functions import EventFunctions
 
     watched, slopes, compiled = EventFunctions.watched, EventFunctions.slopes, []
-    end_values = EventFunctions.end_values
+    end_values, pending_values = EventFunctions.end_values, processing.pending_values
+    sloped_reads: list[int] = []
 
     def numpy_twin(self) -> EventFunctions:
         with monkeypatch.context() as m:
@@ -165,6 +167,22 @@ def test_the_compiled_watched_values_and_slopes_are_the_numpy_codes(name, monkey
         compiled.append(self._compiled is not None)
         return got
 
+    def checking_pending(self, contacts, sol, s, rows, held, sloped, gap_nodes):
+        got = pending_values(self, contacts, sol, s, rows, held, sloped, gap_nodes)
+        with monkeypatch.context() as m:  # the twin's own reads are not checked
+            m.setattr(EventFunctions, "watched", watched)
+            m.setattr(EventFunctions, "slopes", slopes)
+            want = pending_values(numpy_twin(self), contacts, sol, s, rows, held, sloped,
+                                  gap_nodes)
+        assert got[0].keys == want[0].keys and got[2] == want[2]
+        np.testing.assert_array_equal(got[1], want[1])
+        # a gap's slope is the free rows' product here, the fresh gaps' rows' in numpy
+        np.testing.assert_allclose(got[3], want[3], rtol=1e-12, atol=1e-15)
+        assert np.array_equal(np.less(got[3], 0), np.less(want[3], 0))
+        sloped_reads.append(len(got[3]))
+        compiled.append(self._compiled is not None)
+        return got
+
     def checking_ends(self, contacts, sol):
         got = end_values(self, contacts, sol)
         assert got == end_values(numpy_twin(self), contacts, sol)
@@ -174,9 +192,11 @@ def test_the_compiled_watched_values_and_slopes_are_the_numpy_codes(name, monkey
     monkeypatch.setattr(EventFunctions, "watched", checking_values)
     monkeypatch.setattr(EventFunctions, "slopes", checking_slopes)
     monkeypatch.setattr(EventFunctions, "end_values", checking_ends)
+    monkeypatch.setattr(processing, "pending_values", checking_pending)
     monkeypatch.setenv(KERNEL_VARIABLE, Kernel.NUMBA.value)
     _setup(name).event_squeeze()
     assert len(compiled) >= 10 and all(compiled), compiled
+    assert any(sloped_reads), sloped_reads
 
 
 def test_the_compiled_area_check_computes_elements_near_inversion_as_the_model(monkeypatch):

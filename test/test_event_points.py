@@ -10,6 +10,7 @@ from pathlib import Path
 import pytest
 
 from squeeze_grasp_ros.mechanics.squeeze.fixed_set_kernel import KERNEL_VARIABLE, Kernel
+from squeeze_grasp_ros.mechanics.squeeze.stepper import processing
 from squeeze_grasp_ros.mechanics.squeeze.stepper.functions import EventFunctions
 from squeeze_grasp_ros.scene import GraspSetup, load_scene
 
@@ -22,22 +23,26 @@ SCENES = Path(__file__).resolve().parents[1] / "config" / "scenes"
 @pytest.mark.parametrize("name", ["foam_square", "foam_square_pickup"])
 def test_the_terminations_at_an_event_point_reuse_the_pending_checks_kernel_call(name,
                                                                                  monkeypatch):
-    """The termination check after the last pending check at a point reads the same contact
-    set and solution: it makes no kernel call, and its (area, element, strain, pickup) are
+    """The termination check after the last pending check at a point (values and slopes in
+    one kernel call, or the values alone) reads the same contact set and solution: it makes
+    no kernel call, and its (area, element, strain, pickup) are
     those of a fresh read.
     """
-    kernel, calls = substeps_numba.watched_values, []
+    calls = []
 
-    def counted(*args):
-        calls.append(1)
-        return kernel(*args)
+    def counted(kernel):
+        def call(*args):
+            calls.append(1)
+            return kernel(*args)
+        return call
 
-    watched, end_values = EventFunctions.watched, EventFunctions.end_values
-    last, shared = {}, []
+    end_values, last, shared = EventFunctions.end_values, {}, []
 
-    def recording(self, contacts, sol, *args, **kwargs):
-        last[id(self)] = (contacts, sol)
-        return watched(self, contacts, sol, *args, **kwargs)
+    def recording(read):
+        def record(self, contacts, sol, *args, **kwargs):
+            last[id(self)] = (contacts, sol)
+            return read(self, contacts, sol, *args, **kwargs)
+        return record
 
     def checked(self, contacts, sol):
         before = len(calls)
@@ -49,8 +54,10 @@ def test_the_terminations_at_an_event_point_reuse_the_pending_checks_kernel_call
                                  contacts, sol)
         return got
 
-    monkeypatch.setattr(substeps_numba, "watched_values", counted)
-    monkeypatch.setattr(EventFunctions, "watched", recording)
+    for kernel in ("watched_values", "point_values"):
+        monkeypatch.setattr(substeps_numba, kernel, counted(getattr(substeps_numba, kernel)))
+    monkeypatch.setattr(EventFunctions, "watched", recording(EventFunctions.watched))
+    monkeypatch.setattr(processing, "pending_values", recording(processing.pending_values))
     monkeypatch.setattr(EventFunctions, "end_values", checked)
     monkeypatch.setenv(KERNEL_VARIABLE, Kernel.NUMBA.value)
     GraspSetup.build(load_scene(SCENES / f"{name}.yaml")).precompute().event_squeeze()

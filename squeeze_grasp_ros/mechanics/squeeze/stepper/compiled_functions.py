@@ -65,7 +65,13 @@ class CompiledFunctions:
     def __init__(self, functions: EventFunctions) -> None:
         self.functions = functions
         self.kernel = compiled_substeps()
+        model, lim = functions.model, functions.model.limits
+        # the object's weight in force units when the pickup is checked, else NaN
+        self.weight = (lim.weight / model.force_unit if lim.weight is not None
+                       and Termination.PICKED_UP in functions.terminate_on else np.nan)
         self._last: tuple | None = None
+        self._last_slopes: tuple | None = None
+        self._last_rows: tuple | None = None
         self._rows: dict[tuple, tuple] = functions.model.obj._shared.setdefault(
             "compiled_rows", {})
 
@@ -117,49 +123,86 @@ class CompiledFunctions:
                 return (_NO_VALUES, *last[6])
             if last[2] == s and _same(last[3], rows) and _same(last[4], pick):
                 return (last[5], *last[6])
-        functions = self.functions
-        model, motion = functions.model, functions.motion
-        lim, rate = model.limits, motion.rate
-        A, R, points, bounds = self._rows_of(contacts, rows)
-        weight = (lim.weight / model.force_unit if lim.weight is not None
-                  and Termination.PICKED_UP in functions.terminate_on else np.nan)
-        tip = motion.tip
-        loads = model.area_tables(contacts.data)[1] if len(bounds) else None
-        values, *ends = self.kernel.watched_values(
-            sol.delta, sol.F, sol.dtheta, sol.normal_angle, pick, float(model.mu),
-            contacts.slip, motion.contact_tips(contacts.finger).tip.radius,
-            rate if rate > 0 else 1.0, A, R, contacts.data.E, points, motion.centers(s),
-            tip.radius, tip.flat, tip._facing_tangent, contacts.stick, contacts.finger, weight,
-            model.obj.rigid_gradients, bounds, _NO_LOADS if loads is None else loads,
-            GRADIENT_BOUND_EXACT)
+        args, ends = self._arguments(contacts, sol, s, rows, pick)
+        values, *ends = self.kernel.watched_values(*args, *ends)
         self._last = (contacts, sol, s, rows, pick, values, ends)
         return (values, *ends)
+
+    def _arguments(self, contacts: ContactSet, sol: Solution, s: float, rows: np.ndarray,
+                   pick: np.ndarray) -> tuple[tuple, tuple]:
+        """:func:`..substeps_numba.watched_values`'s arguments: those of the values
+        (:func:`..substeps_numba._watched`'s), those of the terminations.
+        """
+        functions = self.functions
+        model, motion = functions.model, functions.motion
+        rate = motion.rate
+        A, R, points, bounds = self._rows_of(contacts, rows)
+        tip = motion.tip
+        loads = model.area_tables(contacts.data)[1] if len(bounds) else None
+        return ((sol.delta, sol.F, sol.dtheta, sol.normal_angle, pick, float(model.mu),
+                 contacts.slip, motion.contact_tips(contacts.finger).tip.radius,
+                 rate if rate > 0 else 1.0, A, R, contacts.data.E, points, motion.centers(s),
+                 tip.radius, tip.flat, tip._facing_tangent),
+                (contacts.stick, contacts.finger, self.weight, model.obj.rigid_gradients, bounds,
+                 _NO_LOADS if loads is None else loads, GRADIENT_BOUND_EXACT))
+
+    def point(self, contacts: ContactSet, sol: Solution, s: float, rows: np.ndarray,
+              pick: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(the values :meth:`values` reads, the gap slopes of ``rows`` to every finger, each
+        contact's normal-force and cone-margin slopes) at ``sol`` by one kernel call
+        (:func:`..substeps_numba.point_values`), kept as the last read and the last slopes:
+        the pending events at a point read both, the terminations and the next substep's
+        start read them again.
+        """
+        (delta, F, dtheta, nu, pick, mu, slip, radius_c, rate, A, R, E, points, centers, radius,
+         flat, t0), ends = self._arguments(contacts, sol, s, rows, pick)
+        values, det, element, pickup, gaps, rates = self.kernel.point_values(
+            delta, F, sol.ddelta, sol.dF, dtheta, nu, self._kappa(sol), pick, mu, slip,
+            radius_c, rate, A, R, E, points, centers, radius, flat, t0,
+            self.functions.motion.translation, *ends)
+        self._last = (contacts, sol, s, rows, pick, values, (det, element, pickup))
+        self._last_slopes = (contacts, sol, s, rows, gaps, rates)
+        return values, gaps, rates
 
     def slopes(self, contacts: ContactSet, sol: Solution, s: float,
                rows: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """(the gap slopes of ``rows`` to every finger, each contact's normal-force and
-        cone-margin slopes), raveled, at ``sol``.
+        cone-margin slopes), raveled, at ``sol`` (those :meth:`point` read last if it read
+        them).
         """
+        last = self._last_slopes
+        if (last is not None and last[0] is contacts and last[1] is sol and last[2] == s
+                and _same(last[3], rows)):
+            return last[4], last[5]
         motion = self.functions.motion
         A, R, points, _ = self._rows_of(contacts, rows)
         tip = motion.tip
         return self.kernel.slope_values(
             sol.delta, sol.F, sol.ddelta, sol.dF, sol.dtheta, sol.normal_angle,
-            _NO_KAPPA if sol.kappa is None else sol.kappa, float(self.functions.model.mu), A, R,
-            contacts.data.E, points, motion.centers(s), motion.translation, tip.flat,
-            tip._facing_tangent)
+            self._kappa(sol), float(self.functions.model.mu), A, R, contacts.data.E, points,
+            motion.centers(s), motion.translation, tip.flat, tip._facing_tangent)
+
+    @staticmethod
+    def _kappa(sol: Solution) -> np.ndarray:
+        """The contacts' d nu / d theta, or none for circular tips."""
+        return _NO_KAPPA if sol.kappa is None else sol.kappa
 
     def _rows_of(self, contacts: ContactSet, rows: np.ndarray) -> tuple:
         """(the rows of the set's boundary compliance and rigid modes, the rows' undeformed
         positions, the area bounds or none while the fingers stay) of ``contacts`` and boundary
         ``rows``: kept for the call's last few sets (a point's reads and the substeps of a set
         ask for the same ones), by the object for its models' calls (what they depend on is
-        the object's: a sweep's evaluations of an object ask for the same ones too).
+        the object's: a sweep's evaluations of an object ask for the same ones too); the last
+        ones by identity (the free rows are a kept read-only array per set and holds).
         """
-        sd = contacts.data
+        sd, last = contacts.data, self._last_rows
+        if last is not None and last[0] is sd and last[1] is rows:
+            return last[2]
         moving = self.functions.motion.rate > 0
-        return kept_for(self._rows, sd, (moving, rows.dtype.str, rows.tobytes()),
+        made = kept_for(self._rows, sd, (moving, rows.dtype.str, rows.tobytes()),
                         lambda: self._tables(sd, rows, moving), ROW_TABLES_KEPT)
+        self._last_rows = (sd, rows, made)
+        return made
 
     def _tables(self, sd: SetData, rows: np.ndarray, moving: bool) -> tuple:
         functions = self.functions

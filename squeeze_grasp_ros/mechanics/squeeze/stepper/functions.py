@@ -31,7 +31,7 @@ double roots inside an adaptive substep).
 from __future__ import annotations
 
 import math
-from collections.abc import Iterator, Mapping
+from collections.abc import Callable, Iterator, Mapping
 from dataclasses import dataclass
 
 import numpy as np
@@ -54,9 +54,12 @@ from squeeze_grasp_ros.mechanics.squeeze.stepper.motion import FingerMotion
 from squeeze_grasp_ros.mechanics.vocabulary import Termination
 
 __all__ = ["EventFunctions", "EventValues", "KeyOrder", "WatchedValues", "event_values",
-           "pickup_margin"]
+           "pending_values", "pickup_margin"]
 
 _NO_ROWS = np.zeros(0, int)
+_SLOPED_FUNCTIONS = (EventFunction.NORMAL_FORCE, EventFunction.CONE_PLUS,
+                     EventFunction.CONE_MINUS)
+"""The per-contact functions with a slope, in the order of a contact's slopes."""
 ENTRY_TABLES_KEPT = 2048
 """Tables of keys and rows an object keeps for its calls' event functions
 (:attr:`EventFunctions._entry_tables`; checked once per call)."""
@@ -448,8 +451,7 @@ class EventFunctions:
             key = self.keys.get
             made = self._entry_tables[tag] = [
                 key(function, node) for node in contacts.nodes.tolist()
-                for function in (EventFunction.NORMAL_FORCE, EventFunction.CONE_PLUS,
-                                 EventFunction.CONE_MINUS)]
+                for function in _SLOPED_FUNCTIONS]
         return made
 
     def value(self, key: EventKey, contacts: ContactSet, sol: Solution, s: float) -> float:
@@ -469,3 +471,44 @@ class EventFunctions:
         """The slope d/ds of one function that has one."""
         rows = self.rows_of([key.node]) if key.function == EventFunction.GAP else _NO_ROWS
         return self.slopes(contacts, sol, s, rows)[key]
+
+
+def pending_values(
+    functions: EventFunctions, contacts: ContactSet, sol: Solution, s: float, rows: np.ndarray,
+    held: np.ndarray, sloped: Callable[[dict[EventKey, int]], dict[int, EventKey]],
+    gap_nodes: list[int],
+) -> tuple[KeyOrder, np.ndarray, dict[int, EventKey], list[float]]:
+    """What the pending events at a point read: the watched per-contact values and gaps of
+    :meth:`EventFunctions.watched` (no terminations), their keys, the watched keys whose
+    slopes are needed (``sloped`` of the keys' positions: gaps of ``gap_nodes``, normal
+    forces, cone margins) and those slopes.
+
+    On the numba route one compiled call computes the values and the slopes of every watched
+    function (:meth:`~.compiled_functions.CompiledFunctions.point`; a gap's slope is then the
+    free rows' product, in numpy the rows of ``gap_nodes``': only its sign decides); in numpy,
+    :meth:`EventFunctions.watched`, then :meth:`EventFunctions.slopes` of the rows of
+    ``gap_nodes`` when slopes are needed.
+    """
+    compiled = functions._compiled
+    if compiled is None or not compiled.takes(contacts):
+        watched = functions.watched(contacts, sol, s, rows, held, terminations=False)
+        order = watched.order
+        by_slope = sloped(order.position)
+        if not by_slope:
+            return order, watched.values, by_slope, []
+        slopes = functions.slopes(contacts, sol, s, functions.rows_of(gap_nodes))
+        return order, watched.values, by_slope, [slopes[key] for key in by_slope.values()]
+    keys, pick = functions._contact_entries(contacts, held)
+    order = functions._order(keys, rows)
+    by_slope = sloped(order.position)
+    if not by_slope:
+        values, *_ = compiled.values(contacts, sol, s, rows, pick, False)
+        return order, values, by_slope, []
+    values, gaps, rates = compiled.point(contacts, sol, s, rows, pick)
+    first_gap, sloped_keys = len(pick), by_slope.values()
+    at = np.searchsorted(contacts.nodes, [key.node for key in sloped_keys]).tolist()
+    gaps, rates = gaps.tolist(), rates.tolist()
+    return order, values, by_slope, [
+        gaps[k - first_gap] if key.function == EventFunction.GAP
+        else rates[3 * i + _SLOPED_FUNCTIONS.index(key.function)]
+        for (k, key), i in zip(by_slope.items(), at)]

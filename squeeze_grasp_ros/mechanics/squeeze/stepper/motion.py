@@ -18,13 +18,13 @@ import numpy as np
 
 from squeeze_grasp_ros.mechanics.errors import InvalidInputError, require_finite
 from squeeze_grasp_ros.mechanics.squeeze.contact_state import ContactState, tip_geometry
-from squeeze_grasp_ros.mechanics.squeeze.kept import kept_for, kept_property
+from squeeze_grasp_ros.mechanics.squeeze.kept import kept_property
 from squeeze_grasp_ros.mechanics.squeeze.tip_shapes import TipGeometry
 
 __all__ = ["ContactTips", "FingerMotion"]
 
 CONTACT_TIPS_KEPT = 16
-"""Contact sets whose :class:`ContactTips` a motion keeps (a call has a few sets)."""
+"""Contact sets' finger arrays whose :class:`ContactTips` a motion keeps (a call has a few)."""
 
 
 @dataclass(frozen=True)
@@ -94,16 +94,22 @@ class FingerMotion:
                            zeros if self.facing is None else self.facing)
 
     @kept_property
-    def _contact_tips(self) -> dict[tuple, tuple[np.ndarray, ContactTips]]:
+    def _contact_tips(self) -> dict[bytes, ContactTips]:
         return {}
 
     def contact_tips(self, finger: np.ndarray) -> ContactTips:
         """The :class:`ContactTips` of the contacts on fingers ``finger`` (a contact set's
-        finger indices), kept while the set's array is (the sets of one node set share it):
-        the fixed-set solves, the work and the samples read them at every point.
+        finger indices, int), kept by their values for the call (the sets of the call with
+        as many contacts on each finger share them): the fixed-set solves, the reads of the
+        event functions, the work and the samples read them at every point.
         """
-        return kept_for(self._contact_tips, finger, None, lambda: self._tips_of(finger),
-                        CONTACT_TIPS_KEPT)
+        tag = finger.tobytes()
+        made = self._contact_tips.get(tag)
+        if made is None:
+            if len(self._contact_tips) >= CONTACT_TIPS_KEPT:
+                self._contact_tips.clear()
+            made = self._contact_tips[tag] = self._tips_of(finger)
+        return made
 
     def _tips_of(self, finger: np.ndarray) -> ContactTips:
         masks = tuple(finger == f for f in range(len(self.names)))

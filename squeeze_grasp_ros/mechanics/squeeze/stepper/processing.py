@@ -34,7 +34,7 @@ from squeeze_grasp_ros.mechanics.squeeze.contact_state import ContactState, Even
 from squeeze_grasp_ros.mechanics.squeeze.event_key import WHOLE_OBJECT, EventFunction, EventKey
 from squeeze_grasp_ros.mechanics.squeeze.stepper.chatter import ChatterBound
 from squeeze_grasp_ros.mechanics.squeeze.stepper.contact_set import ContactSet
-from squeeze_grasp_ros.mechanics.squeeze.stepper.functions import EventFunctions
+from squeeze_grasp_ros.mechanics.squeeze.stepper.functions import EventFunctions, pending_values
 from squeeze_grasp_ros.mechanics.squeeze.stepper.modes import (
     RATE_NOISE,
     decide_modes,
@@ -159,26 +159,23 @@ class EventProcessor:
 
         A function is pending where its value is <= 0 (one array comparison), except the
         watched keys zero by construction (:meth:`_by_slope`), which are pending where their
-        slope is negative; their slopes are computed only when there are any.
+        slope is negative (:func:`~.functions.pending_values` reads the values
+        and those slopes together).
         """
         contacts, functions, depth = self.contacts, self.functions, self.depth
         rows = functions.free_rows(contacts, self.chatter.held_nodes(depth))
-        watched = functions.watched(contacts, sol, self.s, rows,
-                                    self.chatter.held(contacts.nodes, depth), terminations=False)
-        keys, values = watched.order.keys, watched.values
-        by_slope = self._by_slope(watched.order.position)
+        gap_nodes = [key.node for key in self.fresh if key.function == EventFunction.GAP]
+        order, values, by_slope, slopes = pending_values(
+            functions, contacts, sol, self.s, rows, self.chatter.held(contacts.nodes, depth),
+            self._by_slope, gap_nodes)
         hits = [k for k in np.flatnonzero(values <= 0).tolist() if k not in by_slope]
-        if by_slope:
-            gap_nodes = [key.node for key in self.fresh if key.function == EventFunction.GAP]
-            slopes = functions.slopes(contacts, sol, self.s, functions.rows_of(gap_nodes))
-            for k, key in by_slope.items():
-                if key.function == EventFunction.GAP and values[k] > self.tol:
-                    continue  # a freed node is at zero gap only to the finger that released it
-                if slopes[key] < 0:
-                    hits.append(k)
-        out = [keys[k] for k in sorted(hits)]
-        out += [key for key, value in watched.ends.items() if value <= 0]
-        return sorted(out, key=self.order)
+        for (k, key), slope in zip(by_slope.items(), slopes):
+            if key.function == EventFunction.GAP and values[k] > self.tol:
+                continue  # a freed node is at zero gap only to the finger that released it
+            if slope < 0:
+                hits.append(k)
+        keys = order.keys
+        return sorted([keys[k] for k in sorted(hits)], key=self.order)
 
     def _by_slope(self, position: dict[EventKey, int]) -> dict[int, EventKey]:
         """The watched keys (by their position) whose function is zero by construction and

@@ -44,14 +44,16 @@ def _small(H: np.ndarray) -> np.ndarray:
 
 
 def _green_lagrange(H: np.ndarray) -> np.ndarray:
-    """Principal Green-Lagrange strains (t, 2) of H: of (H + H^T + H^T H) / 2, in engineering
-    (Voigt) components (xx, yy, 2 xy).
-    """
-    h00, h01, h10, h11 = H[:, 0, 0], H[:, 0, 1], H[:, 1, 0], H[:, 1, 1]
+    """Principal Green-Lagrange strains (t, 2) of H: of (H + H^T + H^T H) / 2."""
+    return voigt_principal(np.column_stack(_green_lagrange_voigt(
+        H[:, 0, 0], H[:, 0, 1], H[:, 1, 0], H[:, 1, 1])))
+
+
+def _green_lagrange_voigt(h00, h01, h10, h11) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The Green-Lagrange strains (xx, yy, 2 xy) (engineering, Voigt) of H by its components."""
     # the three entries of H^T H that enter, summed over k in einsum's order (k = 0, then 1)
-    return voigt_principal(np.column_stack([h00 + 0.5 * (h00 * h00 + h10 * h10),
-                                            h11 + 0.5 * (h01 * h01 + h11 * h11),
-                                            h01 + h10 + (h00 * h01 + h10 * h11)]))
+    return (h00 + 0.5 * (h00 * h00 + h10 * h10), h11 + 0.5 * (h01 * h01 + h11 * h11),
+            h01 + h10 + (h00 * h01 + h10 * h11))
 
 
 def _stretch_ratio(e: np.ndarray) -> np.ndarray:
@@ -121,16 +123,31 @@ def max_principal_strain(F: np.ndarray, measure: StrainMeasure | str) -> tuple[f
     return largest_pair_entry(principal_strains(F, measure))
 
 
+def _pair(exx: np.ndarray, eyy: np.ndarray, gxy: np.ndarray) -> np.ndarray:
+    """Principal strains (2, t), largest first, of engineering strains given by component:
+    :func:`~squeeze_grasp_ros.mechanics.elastic.fem.principal_strains`' arithmetic, rows
+    instead of columns.
+    """
+    mean = 0.5 * (exx + eyy)
+    radius = np.sqrt((0.5 * (exx - eyy)) ** 2 + (0.5 * gxy) ** 2)
+    out = np.empty((2, len(mean)))
+    np.add(mean, radius, out=out[0])
+    np.subtract(mean, radius, out=out[1])
+    return out
+
+
 def max_principal_strains(F: np.ndarray) -> dict[StrainMeasure, float]:
     """Largest absolute principal strain of the elements in every measure, by measure.
 
-    The Green-Lagrange strains and their stretch ratio are computed once for the three
-    measures of the stretch, and each maximum is the largest absolute entry (the value of
+    One pass over the displacement gradients' four components, each a contiguous row: the
+    small and Green-Lagrange principal pairs are :func:`principal_strains`' arithmetic term
+    for term (:func:`_green_lagrange`, :func:`_small`), the three measures of the stretch
+    share one stretch ratio, and each maximum is the largest absolute entry (the value of
     :func:`max_principal_strain`, without its element).
     """
-    H = np.asarray(F, float) - np.eye(2)
-    e = _green_lagrange(H)
+    h00, h01, h10, h11 = (np.asarray(F, float) - np.eye(2)).reshape(-1, 4).T.copy()
+    e = _pair(*_green_lagrange_voigt(h00, h01, h10, h11))
     two_e = _stretch_ratio(e)
-    fields = {StrainMeasure.SMALL: _small(H), StrainMeasure.BIOT: _biot(two_e),
+    fields = {StrainMeasure.SMALL: _pair(h00, h11, h01 + h10), StrainMeasure.BIOT: _biot(two_e),
               StrainMeasure.LOG: _log(two_e), StrainMeasure.GREEN_LAGRANGE: e}
     return {m: float(np.abs(fields[m]).max()) for m in StrainMeasure}

@@ -114,7 +114,7 @@ def force_along_motion(force: np.ndarray, position: np.ndarray, start: np.ndarra
     """
     motion = np.asarray(position, float) - np.asarray(start, float)
     length = math.sqrt(motion.dot(motion))  # np.linalg.norm's own arithmetic, without its wrapper
-    return float(np.asarray(force, float)[:2].dot(motion)) / length if length > 0 else 0.0
+    return float(np.asarray(force, float)[:2] @ motion) / length if length > 0 else 0.0
 
 
 def check_forces(prediction: PredictedForces, depth: float, measured: Mapping[str, float], *,

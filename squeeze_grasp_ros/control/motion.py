@@ -693,6 +693,6 @@ class GraspProgram:
                         + np.asarray(last.forces.get(f, _NO_FORCE))
                     )
                     self.work[f] += float(
-                        force.dot(np.asarray(obs.positions[f]) - np.asarray(last.positions[f]))
+                        force @ (np.asarray(obs.positions[f]) - np.asarray(last.positions[f]))
                     )
         self._last = obs

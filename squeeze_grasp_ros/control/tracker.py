@@ -573,7 +573,7 @@ class ContactTracker:
             position = np.asarray(sample.position, float)
             if track.position is not None:
                 d = position - track.position
-                step += float(d.dot(d))
+                step += float(d @ d)
             track.position = position
         self.depth += float(np.sqrt(step))
 
@@ -648,8 +648,8 @@ class ContactTracker:
             return -np.asarray(sample.force[:2], float)
         if sample.normal is not None:
             c, s = trig
-            return np.array([sample.normal.dot(c) - sample.tangential.dot(s),
-                             sample.normal.dot(s) + sample.tangential.dot(c)])
+            return np.array([sample.normal @ c - sample.tangential @ s,
+                             sample.normal @ s + sample.tangential @ c])
         return previous
 
     @staticmethod
@@ -660,8 +660,8 @@ class ContactTracker:
         if not len(taxels.index):
             return np.zeros(2)
         w = taxels.normal
-        v = np.array((w.dot(taxels.cos), w.dot(taxels.sin)))  # ndarray.dot: matmul's product,
-        return v / math.sqrt(v.dot(v))  # without its ufunc overhead
+        v = np.array([w @ taxels.cos, w @ taxels.sin])
+        return v / math.sqrt(v @ v)
 
     def _alarms(self, name: str, track: _FingerTrack, taxels: LoadedTaxels | None,
                 age: float) -> list[TrackedAlarm]:

@@ -93,8 +93,17 @@ def element_strains(mesh: Mesh, displacement: np.ndarray) -> np.ndarray:
 
 def principal_strains(strains: np.ndarray) -> np.ndarray:
     """Principal strains (t, 2) (largest first) from engineering strains (t, 3)."""
-    exx, eyy, gxy = strains[:, 0], strains[:, 1], strains[:, 2]
+    return np.ascontiguousarray(principal_pair(strains[:, 0], strains[:, 1], strains[:, 2]).T)
+
+
+def principal_pair(exx: np.ndarray, eyy: np.ndarray, gxy: np.ndarray) -> np.ndarray:
+    """Principal strains (2, t), largest first, of engineering strains given by component
+    (eps_xx, eps_yy, gamma_xy), each (t,): the rows of :func:`principal_strains`' columns.
+    """
     mean = 0.5 * (exx + eyy)
     radius = np.sqrt((0.5 * (exx - eyy)) ** 2 + (0.5 * gxy) ** 2)
-    return np.column_stack([mean + radius, mean - radius])
+    out = np.empty((2, len(mean)))
+    np.add(mean, radius, out=out[0])
+    np.subtract(mean, radius, out=out[1])
+    return out
 

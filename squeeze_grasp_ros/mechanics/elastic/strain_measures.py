@@ -26,6 +26,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from squeeze_grasp_ros.mechanics.elastic.fem import principal_pair
 from squeeze_grasp_ros.mechanics.elastic.fem import principal_strains as voigt_principal
 from squeeze_grasp_ros.mechanics.errors import InvalidInputError
 from squeeze_grasp_ros.mechanics.vocabulary import StrainMeasure
@@ -123,19 +124,6 @@ def max_principal_strain(F: np.ndarray, measure: StrainMeasure | str) -> tuple[f
     return largest_pair_entry(principal_strains(F, measure))
 
 
-def _pair(exx: np.ndarray, eyy: np.ndarray, gxy: np.ndarray) -> np.ndarray:
-    """Principal strains (2, t), largest first, of engineering strains given by component:
-    :func:`~squeeze_grasp_ros.mechanics.elastic.fem.principal_strains`' arithmetic, rows
-    instead of columns.
-    """
-    mean = 0.5 * (exx + eyy)
-    radius = np.sqrt((0.5 * (exx - eyy)) ** 2 + (0.5 * gxy) ** 2)
-    out = np.empty((2, len(mean)))
-    np.add(mean, radius, out=out[0])
-    np.subtract(mean, radius, out=out[1])
-    return out
-
-
 def max_principal_strains(F: np.ndarray) -> dict[StrainMeasure, float]:
     """Largest absolute principal strain of the elements in every measure, by measure.
 
@@ -146,8 +134,9 @@ def max_principal_strains(F: np.ndarray) -> dict[StrainMeasure, float]:
     :func:`max_principal_strain`, without its element).
     """
     h00, h01, h10, h11 = (np.asarray(F, float) - np.eye(2)).reshape(-1, 4).T.copy()
-    e = _pair(*_green_lagrange_voigt(h00, h01, h10, h11))
+    e = principal_pair(*_green_lagrange_voigt(h00, h01, h10, h11))
     two_e = _stretch_ratio(e)
-    fields = {StrainMeasure.SMALL: _pair(h00, h11, h01 + h10), StrainMeasure.BIOT: _biot(two_e),
+    fields = {StrainMeasure.SMALL: principal_pair(h00, h11, h01 + h10),
+              StrainMeasure.BIOT: _biot(two_e),
               StrainMeasure.LOG: _log(two_e), StrainMeasure.GREEN_LAGRANGE: e}
     return {m: float(np.abs(fields[m]).max()) for m in StrainMeasure}

@@ -394,15 +394,16 @@ def slope_values(delta, F, ddelta, dF, dtheta, nu, kappa, mu, A_rows, R_rows, E,
     return gaps, rates
 
 
-
 @jit
-def point_values(delta, F, ddelta, dF, dtheta, nu, kappa, pick, mu, slip, radius_c, rate,
-                 A_rows, R_rows, E, boundary0, centers_f, radius_f, flat_f, t0_f, D, stick,
-                 finger, weight, rigid_gradients, bounds, loads, exact_bound):
+def point_values(delta, F, dtheta, nu, pick, mu, slip, radius_c, rate, A_rows, R_rows, E,
+                 boundary0, centers_f, radius_f, flat_f, t0_f, stick, finger, weight,
+                 rigid_gradients, bounds, loads, exact_bound, ddelta, dF, kappa, D):
     """:func:`watched_values` and :func:`slope_values` of the same free rows at one solution
-    in one call (the same floats as the two calls): (values, det, element, pickup, the rows'
-    gap slopes, the contacts' rates). The pending events at a point read the values and the
-    slopes of the functions zero by construction; the next substep's start reads both.
+    in one call (the same floats as the two calls; :func:`watched_values`' arguments, then
+    the solution's rates ``ddelta``, ``dF``, ``kappa`` and the fingers' translation ``D`` that
+    the slopes add): (values, det, element, pickup, the rows' gap slopes, the contacts'
+    rates). The pending events at a point read the values and the slopes of the functions
+    zero by construction; the next substep's start reads both.
     """
     values, det, element, pickup = watched_values(
         delta, F, dtheta, nu, pick, mu, slip, radius_c, rate, A_rows, R_rows, E, boundary0,
@@ -411,6 +412,7 @@ def point_values(delta, F, ddelta, dF, dtheta, nu, kappa, pick, mu, slip, radius
     gaps, rates = slope_values(delta, F, ddelta, dF, dtheta, nu, kappa, mu, A_rows, R_rows, E,
                                boundary0, centers_f, D, flat_f, t0_f)
     return values, det, element, pickup, gaps, rates
+
 
 @jit
 def _sure(start, end, margin):

@@ -154,12 +154,9 @@ class CompiledFunctions:
         the pending events at a point read both, the terminations and the next substep's
         start read them again.
         """
-        (delta, F, dtheta, nu, pick, mu, slip, radius_c, rate, A, R, E, points, centers, radius,
-         flat, t0), ends = self._arguments(contacts, sol, s, rows, pick)
+        args, ends = self._arguments(contacts, sol, s, rows, pick)
         values, det, element, pickup, gaps, rates = self.kernel.point_values(
-            delta, F, sol.ddelta, sol.dF, dtheta, nu, self._kappa(sol), pick, mu, slip,
-            radius_c, rate, A, R, E, points, centers, radius, flat, t0,
-            self.functions.motion.translation, *ends)
+            *args, *ends, sol.ddelta, sol.dF, self._kappa(sol), self.functions.motion.translation)
         self._last = (contacts, sol, s, rows, pick, values, (det, element, pickup))
         self._last_slopes = (contacts, sol, s, rows, gaps, rates)
         return values, gaps, rates

@@ -158,6 +158,27 @@ def test_squeeze_verb_json_keys_and_plot(tmp_path, capsys):
     assert png.stat().st_size > 10_000
 
 
+def test_squeeze_summary_prints_round_off_as_zero(capsys):
+    # the force at depth 0 and a sliding node's slip margin are zero by construction: the JSON
+    # keeps the computed floats (round-off), the summary prints them as 0, other values as they are
+    scene = str(SCENES / "foam_square_low_friction.yaml")
+    out = run_cli(["squeeze", scene, "--json"], capsys)
+    ends = {name: f["end"] for name, f in out["finger_force"].items()}
+    round_off = [out["finger_force"]["F1"]["start"], *out["health"]["slip_margin"].values()]
+    assert all(0 < abs(v) < 1e-12 * ends["F1"] for v in round_off)  # what the summary hides
+    assert cli.main(["squeeze", scene]) == 0
+    text = capsys.readouterr().out
+    for name, end in ends.items():
+        assert f"{name}: 7 nodes" in text and f"force along motion 0 -> {end:.4g} N" in text
+    assert "slip margin F1 0 N, F2 0 N" in text and "e-15" not in text and "e-16" not in text
+    out = run_cli(["squeeze", str(SCENES / "foam_square.yaml"), "--json"], capsys)
+    assert cli.main(["squeeze", str(SCENES / "foam_square.yaml")]) == 0
+    margins = out["health"]["slip_margin"]
+    assert min(margins.values()) > 0.01  # sticking nodes: real margins, printed as computed
+    assert (f"slip margin F1 {margins['F1']:.4g} N, F2 {margins['F2']:.4g} N"
+            in capsys.readouterr().out)
+
+
 def test_squeeze_verb_reference_mode_and_errors(capsys):
     out = run_cli(["squeeze", str(SCENES / "foam_square.yaml"), "--relative-depth", "0.02",
                    "--reference", "--step", "1e-3", "--json"], capsys)

@@ -275,6 +275,23 @@ def compare_summary(result: dict) -> str:
     return "\n".join(lines)
 
 
+ROUND_OFF = 1e-12
+"""Relative size below which a printed value is round-off around an exact zero."""
+
+
+def at_scale(value: float, scale: float) -> float:
+    """``value`` as the summary prints it: 0 if it is round-off against ``scale`` (same unit).
+
+    A squeeze's force along the motion at depth 0, or the slip margin of a sliding node, is zero
+    by construction and comes out of the arithmetic as a few 1e-15 N; printed with 4 digits
+    next to forces of newtons it read as a value. The JSON keeps the computed floats.
+
+    >>> at_scale(-5.214e-15, 4.906), at_scale(0.06069, 4.906), at_scale(-8.8e-16, 0.0)
+    (0.0, 0.06069, -8.8e-16)
+    """
+    return 0.0 if abs(value) <= ROUND_OFF * abs(scale) else value
+
+
 def tip_words(tips: dict) -> str:
     """``tip radius 0.02 m`` for circles alike, else each finger's tip (``F1 pad 0.022 m
     wide, edges 0.002 m``).
@@ -311,7 +328,8 @@ def summary(result: dict) -> str:
         friction = result["dissipation"][name]
         lines.append(
             f"{name}: {len(seg)} nodes [{modes}] (~ = sliding); force along motion "
-            f"{ff['start']:.4g} -> {ff['end']:.4g} N, work {result['work'][name]:.4g} J"
+            f"{at_scale(ff['start'], ff['end']):.4g} -> {ff['end']:.4g} N, work "
+            f"{result['work'][name]:.4g} J"
             + (f" ({friction:.3g} J dissipated by friction)" if friction > 0 else "")
         )
     h = result["health"]
@@ -321,7 +339,8 @@ def summary(result: dict) -> str:
         f"({strain} strain, {h['criterion']}, element {h['max_strain_element']}); max von "
         f"Mises {h['max_von_mises']:.4g} Pa ({StressMeasure(h['stress_measure']).label} "
         f"stress); max displacement {h['max_displacement']:.4g} m; slip margin "
-        + ", ".join(f"{k} {v:.4g} N" for k, v in h["slip_margin"].items())
+        + ", ".join(f"{k} {at_scale(v, result['finger_force'].get(k, {}).get('end', 0.0)):.4g} N"
+                    for k, v in h["slip_margin"].items())
     )
     if result["chatter"]:
         lines.append(f"chattering bound froze {len(result['chatter'])} node mode(s)")

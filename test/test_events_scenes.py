@@ -164,8 +164,9 @@ def test_squeeze_summary_prints_round_off_as_zero(capsys):
     scene = str(SCENES / "foam_square_low_friction.yaml")
     out = run_cli(["squeeze", scene, "--json"], capsys)
     ends = {name: f["end"] for name, f in out["finger_force"].items()}
-    round_off = [out["finger_force"]["F1"]["start"], *out["health"]["slip_margin"].values()]
-    assert all(0 < abs(v) < 1e-12 * ends["F1"] for v in round_off)  # what the summary hides
+    round_off = [(f["start"], ends[name]) for name, f in out["finger_force"].items()]
+    round_off += [(v, ends[name]) for name, v in out["health"]["slip_margin"].items()]
+    assert all(0 < abs(v) < 1e-12 * end for v, end in round_off)  # what the summary hides
     assert cli.main(["squeeze", scene]) == 0
     text = capsys.readouterr().out
     for name, end in ends.items():

@@ -47,8 +47,9 @@ def test_the_quiet_area_bound_is_below_the_area_check():
 
     rng = np.random.default_rng(7)
     t, m = 300, 6
-    loads = rng.standard_normal((m, t, 4, 2)) * rng.random((1, t, 1, 1)) ** 4
-    bounds = np.sqrt((loads * loads).sum(axis=(2, 3))).T.copy()
+    gradients = rng.standard_normal((m, t, 4, 2)) * rng.random((1, t, 1, 1)) ** 4
+    bounds = np.sqrt((gradients * gradients).sum(axis=(2, 3))).T.copy()
+    loads = substeps_numba.load_list(list(gradients))  # as the model keeps them for the kernels
     rigid_gradients = rng.standard_normal((4 * t, 3)) * 1e-2
     E = np.asfortranarray(rng.standard_normal((2 * m, 3)))
     tables = quiet_area_tables(bounds, rigid_gradients)

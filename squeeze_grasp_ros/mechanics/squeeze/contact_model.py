@@ -46,7 +46,12 @@ from squeeze_grasp_ros.mechanics.elastic.hyperelastic import area_ratios
 from squeeze_grasp_ros.mechanics.elastic.reduced import reduce_blocks
 from squeeze_grasp_ros.mechanics.elastic.strain_measures import largest_pair_entry
 from squeeze_grasp_ros.mechanics.errors import InvalidInputError, NumericalError
-from squeeze_grasp_ros.mechanics.squeeze.fixed_set_kernel import Kernel, compiled, selected
+from squeeze_grasp_ros.mechanics.squeeze.fixed_set_kernel import (
+    Kernel,
+    compiled,
+    compiled_substeps,
+    selected,
+)
 from squeeze_grasp_ros.mechanics.squeeze.kept import kept_for, kept_property
 from squeeze_grasp_ros.mechanics.squeeze.tip_shapes import TipGeometry, cross, tangent, unit
 from squeeze_grasp_ros.mechanics.vocabulary import MaterialModel, StrainCriterion, StrainMeasure
@@ -817,9 +822,9 @@ class ContactModel:
         and its element, or, if that is larger, the bound (1 - max B_e)^2 of the rest with
         element -1 (no element near the threshold).
 
-        The numpy route reads each node's gradients where the object keeps them; stacking a
-        set's (m, t, 4, 2), as the numba route's kernels need, copied 107 MB for each of the
-        20,091-node foam square's 21 contact sets that neared inversion (0.72 of its 2.49 s).
+        Each node's gradients are read where the object keeps them: stacking a set's as one
+        (m, t, 4, 2) array copied 107 MB for each of the 20,091-node foam square's 21 contact
+        sets that neared inversion (0.72 of its 2.49 s).
         """
         g = sd.E.T @ delta.reshape(-1)
         rigid = (self.obj.rigid_gradients @ g).reshape(-1, 4)
@@ -830,22 +835,20 @@ class ContactModel:
         floor = (1.0 - rest.max()) ** 2 if rest.size else np.inf
         if near.size == 0:
             return float(floor), -1
-        # the object's per-node gradients; the compiled kernels read the set's stacked copy,
-        # made here for them (the same floats: G_k[near] @ f_k per node, in the same order)
-        loads = (self.area_tables(sd, loads=True)[1] if selected() == Kernel.NUMBA
-                 else self.obj.load_gradients(sd.nodes))
-        H = rigid[near] + sum(G[near] @ f for G, f in zip(loads, F))
+        if selected() == Kernel.NUMBA:
+            self.area_tables(sd, loads=True)  # the kernels' list of them, kept from now
+        H = rigid[near] + sum(G[near] @ f for G, f in zip(self.obj.load_gradients(sd.nodes), F))
         det = (1.0 + H[:, 0]) * (1.0 + H[:, 3]) - H[:, 1] * H[:, 2]
         k = int(np.argmin(det))
         return (float(det[k]), int(near[k])) if det[k] <= floor else (float(floor), -1)
 
 
-    def area_tables(self, sd: SetData, *, loads: bool = False
-                    ) -> tuple[np.ndarray, np.ndarray | None]:
-        """:meth:`area_ratio`'s bounds (t, m) and the set's load gradients stacked (m, t, 4, 2;
-        None until an element neared, made now if ``loads``), kept by the object for all of its
-        models (they depend on the object and the set's nodes only: repeated squeezes and a
-        sweep's evaluations of an object share them), at most AREA_TABLES_BYTES of them.
+    def area_tables(self, sd: SetData, *, loads: bool = False) -> tuple[np.ndarray, object]:
+        """:meth:`area_ratio`'s bounds (t, m) and the set's load gradients as the numba route's
+        kernels take them (:func:`~.substeps_numba.load_list`; None until an element neared,
+        made now if ``loads``), kept by the object for all of its models (they depend on the
+        object and the set's nodes only: repeated squeezes and a sweep's evaluations of an
+        object share them), at most AREA_TABLES_BYTES of them.
         """
         obj = self.obj
         size = 72 * len(obj.mesh.triangles) * max(len(sd.nodes), 1)  # bounds and loads
@@ -853,8 +856,7 @@ class ContactModel:
                         lambda: {"bounds": obj.gradient_bounds(tuple(sd.nodes.tolist()))},
                         max(AREA_TABLES_BYTES // size, 2))
         if loads and "loads" not in kept:
-            t = len(obj.mesh.triangles)
-            kept["loads"] = np.array(obj.load_gradients(sd.nodes)).reshape(-1, t, 4, 2)
+            kept["loads"] = compiled_substeps().load_list(obj.load_gradients(sd.nodes))
         return kept["bounds"], kept.get("loads")
 
 

@@ -31,6 +31,24 @@ END, CROSSING, SOLVE, LOADS, EXPIRY, FULL = 0, 1, 2, 3, 4, 5
 substep, its continuation fails (or would be halved), an element is near inversion without its
 load gradients, a hold expires at the next substep's start, the sample buffers are full."""
 jit = numba.njit(cache=True, nogil=True)
+LOAD_GRADIENTS = numba.types.float64[:, :, ::1]
+"""The type of one node's load gradients (t, 4, 2) in the kernels' lists (:func:`load_list`)."""
+
+
+def load_list(gradients) -> numba.typed.List:
+    """A contact set's load gradients as the kernels take them: a numba typed list of each
+    node's (t, 4, 2) C-contiguous array, in the set's order, not copied (stacking them as one
+    (m, t, 4, 2) array copied about 107 MB for a set of the 20,091-node foam square); empty
+    while the set's are not kept.
+    """
+    out = numba.typed.List.empty_list(LOAD_GRADIENTS)
+    for g in gradients:
+        out.append(g)
+    return out
+
+
+NO_LOADS = load_list(())
+"""The empty list: a set whose load gradients are not kept (never appended to)."""
 
 
 @jit
@@ -178,12 +196,12 @@ def _area_ratio(delta, F, E, rigid_gradients, bounds, loads, exact_bound, numpys
     """(smallest det F, its element or -1) as :meth:`~.contact_model.ContactModel.area_ratio`
     bounds or computes it: the bound (1 - max B_e)^2 while no B_e reaches ``exact_bound``
     (inf without ``bounds`` rows, when the area is not watched), else the near elements' exact
-    det F from the set's ``loads`` (m, t, 4, 2); NaN when one is near and ``loads`` are not
-    given. With ``numpys_order`` its floats are the model's: H_e = rigid_e + ((G_0e f_0 +
-    G_1e f_1) + ...), each contact's G_k[near] f_k one BLAS gemv of the near elements' rows
-    gathered (n * 4, 2), whose rows are those of numpy's matmul of the (n, 4, 2) gather (a
-    gemv per element); else the products are written out (a substep's quiet check, which has
-    QUIET_MARGIN to spare).
+    det F from the set's ``loads`` (:func:`load_list`: m arrays (t, 4, 2)); NaN when one is
+    near and ``loads`` are not given. With ``numpys_order`` its floats are the model's:
+    H_e = rigid_e + ((G_0e f_0 + G_1e f_1) + ...), each contact's G_k[near] f_k one BLAS gemv
+    of the near elements' rows gathered (n * 4, 2), whose rows are those of numpy's matmul of
+    the (n, 4, 2) gather (a gemv per element); else the products are written out (a substep's
+    quiet check, which has QUIET_MARGIN to spare).
     """
     t = bounds.shape[0]
     if t == 0:
@@ -199,7 +217,7 @@ def _area_ratio(delta, F, E, rigid_gradients, bounds, loads, exact_bound, numpys
     if near == 0:
         return floor, -1
     m = F.shape[0]
-    if loads.shape[0] != m:
+    if len(loads) != m:
         return np.nan, -1
     which = np.empty(near, np.int64)
     j = 0
@@ -214,8 +232,8 @@ def _area_ratio(delta, F, E, rigid_gradients, bounds, loads, exact_bound, numpys
         else:
             for j in range(near):
                 for i in range(4):
-                    S[4 * j + i] += (loads[k, which[j], i, 0] * F[k, 0]
-                                     + loads[k, which[j], i, 1] * F[k, 1])
+                    S[4 * j + i] += (loads[k][which[j], i, 0] * F[k, 0]
+                                     + loads[k][which[j], i, 1] * F[k, 1])
     smallest, element = np.inf, -1
     for j in range(near):
         e = which[j]
@@ -260,12 +278,12 @@ def _area_lower(delta, F, E, watched, bounds_w, rigid_w, rest_top, rigid_top, lo
         if b < exact_bound:
             lower = min(lower, (1.0 - b) ** 2)
             continue
-        if loads.shape[0] != m:
+        if len(loads) != m:
             return -np.inf
         e = watched[i]
         for k in range(m):
             for r in range(4):
-                H[r] += loads[k, e, r, 0] * F[k, 0] + loads[k, e, r, 1] * F[k, 1]
+                H[r] += loads[k][e, r, 0] * F[k, 0] + loads[k][e, r, 1] * F[k, 1]
         lower = min(lower, (1.0 + H[0]) * (1.0 + H[3]) - H[1] * H[2])
     return lower
 
@@ -455,8 +473,8 @@ def advance_quiet(a, h, theta, dtheta, F, dF, ft, start_values, start_ends,
         per unit s, the rows of the boundary compliance and of the rigid modes of the free
         rows, the rigid map, the rows' undeformed positions and the fingers' tips.
     rigid_gradients, bounds, loads, exact_bound, inversion_ratio
-        The area check (:meth:`~.contact_model.ContactModel.area_ratio`); ``loads`` (m, t, 4,
-        2) or empty when not kept.
+        The area check (:meth:`~.contact_model.ContactModel.area_ratio`); ``loads``
+        (:func:`load_list`; empty when not kept).
     quiet_area : tuple
         :func:`_area_lower`'s tables of the set (``watched`` to ``rigid_top``): a substep whose
         area bound from them is above ``inversion_ratio + margin`` needs no pass over every

@@ -62,7 +62,6 @@ QUIET_AREA_TABLES_KEPT = 64
 """Contact sets whose :func:`quiet_area_tables` an object keeps."""
 CHUNK = 256
 """Substeps the compiled loop runs before it returns its samples (it is called again)."""
-_NO_LOADS = np.zeros((0, 0, 4, 2))
 _END_KEYS = (SHARED_KEYS.get(EventFunction.AREA), SHARED_KEYS.get(EventFunction.PICKUP))
 """The terminations the kernel watches, in its order (a strain limit runs in Python)."""
 
@@ -178,7 +177,7 @@ class CompiledSubsteps:
             return Chunk(0, True, a, None)
         problem, watched = self._set_tables(contacts, start.rows, held)
         bounds, loads = model.area_tables(contacts.data)  # loads: kept once an element neared
-        area = (np.ascontiguousarray(bounds), _NO_LOADS if loads is None else loads)
+        area = (np.ascontiguousarray(bounds), self.kernel.NO_LOADS if loads is None else loads)
         quiet_area = kept_for(model.obj._shared.setdefault("quiet_area", {}), contacts.data,
                               None, lambda: quiet_area_tables(bounds, self.rigid_gradients),
                               QUIET_AREA_TABLES_KEPT)

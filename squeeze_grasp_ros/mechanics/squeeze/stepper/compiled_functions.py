@@ -44,7 +44,6 @@ __all__ = ["CompiledFunctions"]
 _NO_BOUNDS = np.zeros((0, 0))
 _NO_KAPPA = np.zeros(0)
 _NO_VALUES = np.zeros(0)
-_NO_LOADS = np.zeros((0, 0, 4, 2))
 ROW_TABLES_KEPT = 64
 """Tables of (contact set, boundary rows) the compiled reads of an object's calls keep
 (:meth:`CompiledFunctions._rows_of`)."""
@@ -144,7 +143,7 @@ class CompiledFunctions:
                  rate if rate > 0 else 1.0, A, R, contacts.data.E, points, motion.centers(s),
                  tip.radius, tip.flat, tip._facing_tangent),
                 (contacts.stick, contacts.finger, self.weight, model.obj.rigid_gradients, bounds,
-                 _NO_LOADS if loads is None else loads, GRADIENT_BOUND_EXACT))
+                 self.kernel.NO_LOADS if loads is None else loads, GRADIENT_BOUND_EXACT))
 
     def point(self, contacts: ContactSet, sol: Solution, s: float, rows: np.ndarray,
               pick: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

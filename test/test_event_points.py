@@ -10,7 +10,7 @@ from pathlib import Path
 import pytest
 
 from squeeze_grasp_ros.mechanics.squeeze.fixed_set_kernel import KERNEL_VARIABLE, Kernel
-from squeeze_grasp_ros.mechanics.squeeze.stepper import processing
+from squeeze_grasp_ros.mechanics.squeeze.stepper import compiled_functions, processing
 from squeeze_grasp_ros.mechanics.squeeze.stepper.functions import EventFunctions
 from squeeze_grasp_ros.scene import GraspSetup, load_scene
 
@@ -62,3 +62,47 @@ def test_the_terminations_at_an_event_point_reuse_the_pending_checks_kernel_call
     monkeypatch.setenv(KERNEL_VARIABLE, Kernel.NUMBA.value)
     GraspSetup.build(load_scene(SCENES / f"{name}.yaml")).precompute().event_squeeze()
     assert len(shared) >= 3 and all(shared), shared
+
+
+def _outcome(result) -> tuple:
+    """What a squeeze reports, in full: every event, the displacement, the finger forces and
+    the grasp health.
+    """
+    return ([e.to_json() for e in result.events], result.displacement.tobytes(),
+            repr(result.finger_force), repr(result.health.to_json()))
+
+
+@pytest.mark.parametrize("name", ["foam_square", "foam_square_pickup"])
+def test_a_large_meshs_pending_reads_leave_the_area_check_to_the_terminations(name,
+                                                                           monkeypatch):
+    """From AREA_DEFERRED_FROM elements times contacts (here lowered to every mesh) a read for
+    the pending events alone makes no area check: the terminations after it make one kernel
+    call for it, whose (area, element, strain, pickup) are a fresh read's, and the squeeze
+    is bit for bit the one whose every read computes the area.
+    """
+    monkeypatch.setenv(KERNEL_VARIABLE, Kernel.NUMBA.value)
+    setup = GraspSetup.build(load_scene(SCENES / f"{name}.yaml")).precompute()
+    every_read = _outcome(setup.event_squeeze())
+
+    calls, ends, end_values = [], [], EventFunctions.end_values
+
+    def counted(*args):
+        calls.append(args[21].shape[0])  # the area bounds' rows: none when not checked
+        return watched_values(*args)
+
+    def checked(self, contacts, sol):
+        before = len(calls)
+        got = end_values(self, contacts, sol)
+        ends.append(calls[before:])
+        assert got == end_values(EventFunctions(self.model, self.motion, self.terminate_on),
+                                 contacts, sol)
+        return got
+
+    watched_values = substeps_numba.watched_values
+    monkeypatch.setattr(compiled_functions, "AREA_DEFERRED_FROM", 0)
+    monkeypatch.setattr(substeps_numba, "watched_values", counted)
+    monkeypatch.setattr(EventFunctions, "end_values", checked)
+    assert _outcome(setup.event_squeeze()) == every_read
+    # each termination check made one area call or none (the next substep's read had it)
+    assert len(ends) >= 3 and all(len(made) <= 1 and all(made) for made in ends), ends
+    assert sum(map(len, ends)) >= 3

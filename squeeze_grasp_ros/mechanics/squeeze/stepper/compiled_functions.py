@@ -44,9 +44,18 @@ __all__ = ["CompiledFunctions"]
 _NO_BOUNDS = np.zeros((0, 0))
 _NO_KAPPA = np.zeros(0)
 _NO_VALUES = np.zeros(0)
+_NO_PICK = np.zeros(0, np.int64)
 ROW_TABLES_KEPT = 64
 """Tables of (contact set, boundary rows) the compiled reads of an object's calls keep
 (:meth:`CompiledFunctions._rows_of`)."""
+
+
+AREA_DEFERRED_FROM = 100_000
+"""Elements times contacts from which a read for the pending events alone leaves the area check
+out (:meth:`CompiledFunctions._read`). The check's O(t m) bound costs about 7 us of a kernel
+call at 4,800 (a 400-node foam square, 6 contacts), 40 us at 55,000 (2,000 nodes, 14 contacts)
+and 160 us at 410,000 (8,000 nodes, 26 contacts); computing it in a second call when the
+terminations read it adds a call, about 20 us with its arguments."""
 
 
 def _same(a: np.ndarray, b: np.ndarray) -> bool:
@@ -98,7 +107,8 @@ class CompiledFunctions:
         (the area also while the fingers do not move, the strain unless ``strain``), the
         model's det F once an element nears inversion.
         """
-        values, det, element, pickup = self._read(contacts, sol, s, rows, pick)
+        values, det, element, pickup = self._read(contacts, sol, s, rows, pick,
+                                                  terminations or self._area_kept(contacts))
         if not terminations:
             return values, np.inf, -1, np.inf, np.inf
         functions = self.functions
@@ -108,35 +118,44 @@ class CompiledFunctions:
         return values, det, element, margin, pickup
 
     def _read(self, contacts: ContactSet, sol: Solution, s: float, rows: np.ndarray,
-              pick: np.ndarray) -> tuple[np.ndarray, float, int, float]:
-        """The kernel's (values, area ratio, its element, pickup margin) at ``sol``,
-        terminations included.
+              pick: np.ndarray, area: bool) -> tuple[np.ndarray, float, int, float]:
+        """The kernel's (values, area ratio, its element, pickup margin) at ``sol``; the area
+        ratio inf unless ``area`` (its O(t m) bound over every element is most of a read's
+        time on a large mesh, and a read for the pending events alone does not use it:
+        :meth:`_area_kept`).
 
         The last read is kept: at an event point the pending events, the terminations and the
         next substep's start read the same solution (the area and the pickup margin of any
-        rows, the values of the same rows, contacts and point), one kernel call for all.
+        rows, the values of the same rows, contacts and point), one kernel call for all, and
+        one more for the area when the pending events' read left it out.
         """
         last = self._last
         if last is not None and last[0] is contacts and last[1] is sol:
-            if not len(rows) and not len(pick):
-                return (_NO_VALUES, *last[6])
-            if last[2] == s and _same(last[3], rows) and _same(last[4], pick):
-                return (last[5], *last[6])
-        args, ends = self._arguments(contacts, sol, s, rows, pick)
+            same = last[2] == s and _same(last[3], rows) and _same(last[4], pick)
+            if same or not len(rows) and not len(pick):
+                if area and not last[7]:
+                    args, ends = self._arguments(contacts, sol, s, _NO_PICK, _NO_PICK, True)
+                    last = self._last = (*last[:6], self.kernel.watched_values(*args, *ends)[1:],
+                                         True)
+                return (last[5] if same else _NO_VALUES, *last[6])
+        args, ends = self._arguments(contacts, sol, s, rows, pick, area)
         values, *ends = self.kernel.watched_values(*args, *ends)
-        self._last = (contacts, sol, s, rows, pick, values, ends)
+        self._last = (contacts, sol, s, rows, pick, values, ends, area)
         return (values, *ends)
 
     def _arguments(self, contacts: ContactSet, sol: Solution, s: float, rows: np.ndarray,
-                   pick: np.ndarray) -> tuple[tuple, tuple]:
+                   pick: np.ndarray, area: bool) -> tuple[tuple, tuple]:
         """:func:`..substeps_numba.watched_values`'s arguments: those of the values
-        (:func:`..substeps_numba._watched`'s), those of the terminations.
+        (:func:`..substeps_numba._watched`'s), those of the terminations (no area bounds,
+        so no area check, unless ``area``).
         """
         functions = self.functions
         model, motion = functions.model, functions.motion
         rate = motion.rate
         A, R, points, bounds = self._rows_of(contacts, rows)
         tip = motion.tip
+        if not area:
+            bounds = _NO_BOUNDS
         loads = model.area_tables(contacts.data)[1] if len(bounds) else None
         return ((sol.delta, sol.F, sol.dtheta, sol.normal_angle, pick, float(model.mu),
                  contacts.slip, motion.contact_tips(contacts.finger).tip.radius,
@@ -149,14 +168,15 @@ class CompiledFunctions:
               pick: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """(the values :meth:`values` reads, the gap slopes of ``rows`` to every finger, each
         contact's normal-force and cone-margin slopes) at ``sol`` by one kernel call
-        (:func:`..substeps_numba.point_values`), kept as the last read and the last slopes:
-        the pending events at a point read both, the terminations and the next substep's
-        start read them again.
+        (:func:`..substeps_numba.point_values`; the area check left out on a large mesh, see
+        :meth:`_read`), kept as the last read and the last slopes: the pending events at a
+        point read both, the terminations and the next substep's start read them again.
         """
-        args, ends = self._arguments(contacts, sol, s, rows, pick)
+        area = self._area_kept(contacts)
+        args, ends = self._arguments(contacts, sol, s, rows, pick, area)
         values, det, element, pickup, gaps, rates = self.kernel.point_values(
             *args, *ends, sol.ddelta, sol.dF, self._kappa(sol), self.functions.motion.translation)
-        self._last = (contacts, sol, s, rows, pick, values, (det, element, pickup))
+        self._last = (contacts, sol, s, rows, pick, values, (det, element, pickup), area)
         self._last_slopes = (contacts, sol, s, rows, gaps, rates)
         return values, gaps, rates
 
@@ -177,6 +197,13 @@ class CompiledFunctions:
             sol.delta, sol.F, sol.ddelta, sol.dF, sol.dtheta, sol.normal_angle,
             self._kappa(sol), float(self.functions.model.mu), A, R, contacts.data.E, points,
             motion.centers(s), motion.translation, tip.flat, tip._facing_tangent)
+
+    def _area_kept(self, contacts: ContactSet) -> bool:
+        """Whether a read that does not need the area check computes it all the same: on a
+        mesh whose elements times contacts are under :data:`AREA_DEFERRED_FROM`, where the
+        check costs less than a second call for it when the terminations read it.
+        """
+        return len(self.functions.model.obj.mesh.triangles) * len(contacts) < AREA_DEFERRED_FROM
 
     @staticmethod
     def _kappa(sol: Solution) -> np.ndarray:

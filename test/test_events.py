@@ -21,13 +21,13 @@ from squeeze_grasp_ros.mechanics.elastic.mesh import (
     target_max_area,
 )
 from squeeze_grasp_ros.mechanics.squeeze.contact_model import ContactModel
-from squeeze_grasp_ros.mechanics.squeeze.contact_state import ContactState, initial_state
+from squeeze_grasp_ros.mechanics.squeeze.contact_state import ContactState, Event, initial_state
 from squeeze_grasp_ros.mechanics.squeeze.events import event_squeeze
 from squeeze_grasp_ros.mechanics.squeeze.fingertips import place_fingertip
 from squeeze_grasp_ros.mechanics.squeeze.oneshot import one_shot_solve
 from squeeze_grasp_ros.mechanics.squeeze.stable_pure import plan_squeeze
 from squeeze_grasp_ros.mechanics.squeeze.stepper import advance
-from squeeze_grasp_ros.mechanics.vocabulary import EventType
+from squeeze_grasp_ros.mechanics.vocabulary import EventType, Finger
 
 FOAM = Material(5e4, 0.3, 0.0254)
 RADIUS = 0.02
@@ -304,3 +304,17 @@ def test_a_linear_call_stays_on_the_grid_and_the_first_substep_is_checked():
     for bad in (0.0, -1e-3, float("nan")):
         with pytest.raises(InvalidInputError, match="first_substep must be > 0"):
             advance(model, start(obj, contacts), dirs, first_substep=bad)
+
+
+def test_an_events_fields_have_one_type_whatever_the_route_computed_them_with():
+    """NumPy scalars given to an Event become the Python types its fields declare, so that the
+    numpy and the numba routes' events repr and compare alike (a D event's depth was a
+    numpy.float64 on the numpy route).
+    """
+    given = Event("D", np.int64(7), "F2", np.float64(0.0125), np.float64(0.125), "stick",
+                  np.int64(-1))
+    plain = Event("D", 7, "F2", 0.0125, 0.125, "stick", -1)
+    assert [type(getattr(given, f)) for f in ("node", "depth", "relative_depth", "slip")] == [
+        int, float, float, int]
+    assert repr(given) == repr(plain) and given == plain
+    assert (given.type, given.finger) == (EventType.D, Finger.F2)

@@ -295,6 +295,10 @@ class Event:
     slip: int = 0
 
     def __post_init__(self) -> None:
+        # numpy scalars from either fixed-set route become Python's: one type per field
+        for name, kind in (("node", int), ("depth", float), ("relative_depth", float),
+                           ("slip", int)):
+            object.__setattr__(self, name, kind(getattr(self, name)))
         object.__setattr__(self, "type", EventType(self.type))
         object.__setattr__(self, "finger", Finger(self.finger))
 

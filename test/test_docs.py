@@ -42,6 +42,7 @@ from pathlib import Path
 import doc_ros_session
 import numpy as np
 import pytest
+import yaml
 from doc_transcripts import (
     MASKS,
     PAGES,
@@ -376,3 +377,68 @@ def test_the_executor_goal_example_is_the_foam_squares_plan():
     assert len(printed) == len(actual) == 6
     assert all(number_matches(p, repr(float(a))) for p, a in zip(printed, actual)), \
         (printed, actual)
+
+
+def test_the_scene_error_the_docs_quote_is_the_one_a_scene_gets():
+    """scenes.md and ros.md quote the error of a Poisson's ratio out of range: it is the one
+    loading such a scene raises (the range included).
+    """
+    from squeeze_grasp_ros.scene import SceneError, parse_scene
+
+    doc = yaml.safe_load((REPO / "config" / "scenes" / "foam_square.yaml").read_text())
+    doc["object"]["material"]["nu"] = 0.7
+    with pytest.raises(SceneError) as refused:
+        parse_scene(doc)
+    quoted = f"`{refused.value}`"
+    assert quoted == "`object.material.nu must be in [-0.9, 0.5], got 0.7`"
+    for page in ("scenes.md", "ros.md"):
+        assert quoted in (REPO / "docs" / page).read_text(encoding="utf-8"), page
+
+
+def _package_calls(code: str) -> list[tuple[str, ast.Call, object]]:
+    """The calls in ``code`` of the names it imports from the package: (name, call, object)."""
+    import importlib
+
+    tree, imported = ast.parse(code), {}
+    for node in ast.walk(tree):
+        if isinstance(node, ast.ImportFrom) and (node.module or "").startswith(
+                "squeeze_grasp_ros"):
+            module = importlib.import_module(node.module)
+            for alias in node.names:
+                imported[alias.asname or alias.name] = getattr(module, alias.name)
+    return [(node.func.id, node, imported[node.func.id]) for node in ast.walk(tree)
+            if isinstance(node, ast.Call) and isinstance(node.func, ast.Name)
+            and node.func.id in imported and callable(imported[node.func.id])]
+
+
+def test_the_docs_python_blocks_call_the_package_as_its_signatures_allow():
+    """Every call in a ```python block of the docs to a function the block imports from the
+    package binds to that function's signature: as many positional arguments as it takes,
+    keyword-only ones by name, no name it does not have (the bodies' variables need not
+    exist: only the call's shape is checked).
+    """
+    import inspect
+
+    checked, wrong = 0, []
+    for page in PAGES:
+        for block in blocks(page):
+            if block.language != "python":
+                continue
+            lines = block.lines
+            if any(line.lstrip().startswith(">>>") for line in lines):  # a doctest: its source
+                lines = [line.lstrip()[4:] for line in lines
+                         if line.lstrip().startswith((">>>", "..."))]
+            for name, call, function in _package_calls("\n".join(lines)):
+                if any(isinstance(a, ast.Starred) for a in call.args) or any(
+                        k.arg is None for k in call.keywords):
+                    continue
+                try:
+                    signature = inspect.signature(function)
+                except (TypeError, ValueError):
+                    continue
+                try:
+                    signature.bind(*call.args, **{k.arg: k.value for k in call.keywords})
+                except TypeError as error:
+                    wrong.append(f"{page.name}:{block.line + call.lineno} {name}: {error}")
+                checked += 1
+    assert checked >= 10 and not wrong, wrong

@@ -313,8 +313,8 @@ def sweep_spec(tmp_path):
       "friction": [0.1, 0.2], "objects": [{"family": {
           "type": "superellipse", "count": 10_001, "a": [0.04, 0.06], "b": [0.03, 0.05],
           "exponent": [2.5, 6]}}]}, "10,001 objects"),
-    ({"relative_depth": [0.1, 1.0]}, "relative_depth[1] must be < 1 (at 1 the fingers would "
-                                     "meet), got 1.0"),
+    ({"relative_depth": [0.1, 1.0]}, "relative_depth[1] must be in (0.0, 1.0) (at 1 the "
+                                     "fingers would meet), got 1.0"),
 ])
 def test_a_sweep_that_explodes_is_refused_by_its_counts(sweep_spec, capfd, fields, message):
     line = refused(["sweep", sweep_spec(**fields), "--dry-run"], capfd)

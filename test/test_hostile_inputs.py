@@ -319,7 +319,8 @@ def test_numbers_that_would_be_silently_wrong_are_refused(tmp_path, capfd):
         assert main(argv) == 2, argv
         assert "fingers would meet" in capfd.readouterr().err
     for name, change, message in (
-        ("rel1", lambda d: d["squeeze"].__setitem__("relative_depth", 1.0), "must be < 1"),
+        ("rel1", lambda d: d["squeeze"].__setitem__("relative_depth", 1.0),
+         "squeeze.relative_depth must be in [0.0, 1.0) (at 1 the fingers would meet), got 1.0"),
         ("step", lambda d: d["squeeze"].__setitem__("step", 1e-12), "step must be >= 1e-06"),
     ):
         path = scene_variant(tmp_path, name, change)

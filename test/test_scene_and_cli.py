@@ -213,3 +213,34 @@ def terminal_sigint() -> None:
 def cli_sweep_spec() -> Path:
     """The shipped example sweep spec."""
     return Path(__file__).resolve().parents[1] / "config" / "sweeps" / "example.yaml"
+
+
+def test_every_range_the_help_prints_is_the_range_the_check_keeps():
+    """For every bounded number of a scene and of a sweep spec, the bracket ``scene-help`` and
+    ``sweep-help`` print at each end says what the check does with the bound itself: kept
+    where closed, refused where open (at 1 a relative depth is refused, and the help says
+    so: the help printed a closed bracket there while the check refused it).
+    """
+    import dataclasses
+
+    from squeeze_grasp_ros.scene import schema, specs
+    from squeeze_grasp_ros.sweep import spec as sweep_spec
+
+    bounded = [(cls.__name__, f) for module in (specs, sweep_spec) for cls in vars(module).values()
+               if dataclasses.is_dataclass(cls) and isinstance(cls, type)
+               for f in dataclasses.fields(cls)
+               if f.metadata.get("lo") is not None and f.metadata.get("hi") is not None]
+    for owner, field in bounded:
+        meta = dict(field.metadata)
+        said = schema.describe_range(meta)
+        for bound, open_ in ((meta["lo"], said[3] == "("), (meta["hi"], said[-1] == ")")):
+            try:
+                schema._check_range(bound, meta, field.name, SceneError)
+                kept = True
+            except SceneError:
+                kept = False
+            assert kept is not open_, (owner, field.name, said, bound)
+    names = {(owner, field.name) for owner, field in bounded}
+    assert {("SqueezeSpec", "relative_depth"), ("SweepSpec", "relative_depth")} <= names
+    assert all(field.metadata["hi_open"] for _, field in bounded if field.name == "relative_depth")
+    assert len(bounded) >= 10

@@ -732,6 +732,8 @@ def test_without_the_extra_both_verbs_say_how_to_install_and_exit_4(tmp_path, mo
         assert f"error: needs {missing}, which is not installed: pip install '.[sweep]'" \
             in capsys.readouterr().err
     assert not (tmp_path / "o").exists()
+    from squeeze_grasp_ros.commands.sweep import EPILOG  # what `sweep --help` says of it
+    assert "; 4 the sweep extra missing" in EPILOG and "sweep extra missing;" not in EPILOG
 
 
 def test_dry_run_and_report(tmp_path, capsys):

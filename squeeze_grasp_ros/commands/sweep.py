@@ -20,10 +20,10 @@ EPILOG = ("exit status: 0 every task written (an evaluation that raised is a row
           "(listed with their error in DIR/manifest.json; the other tasks are written, and "
           "re-running the same command retries only the failed ones); 2 invalid spec or option, "
           "a spec over the size limits, unreachable --scheduler, an --out that refuses writes, "
-          "a bad manifest, or the sweep extra missing; 4 the disk filled up (the parts written "
-          "are kept; re-run to resume); 130 stopped by Ctrl-C (SIGINT), "
-          "143 by SIGTERM, at any point from start-up on: finished parts are kept, re-run to "
-          "resume")
+          "or a bad manifest; 4 the sweep extra missing (the install line is printed), or the "
+          "disk filled up (the parts written are kept; re-run to resume); 130 stopped by "
+          "Ctrl-C (SIGINT), 143 by SIGTERM, at any point from start-up on: finished parts are "
+          "kept, re-run to resume")
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:

@@ -191,15 +191,10 @@ def _validate_adversary(scene: Scene) -> None:
 
 
 def _validate_squeeze(scene: Scene) -> None:
-    """At most one of depth and relative_depth; a relative depth below 1."""
+    """At most one of depth and relative_depth (the schema keeps a relative depth below 1)."""
     sq = scene.squeeze
     if sq.depth is not None and sq.relative_depth is not None:
         raise SceneError("squeeze.depth and squeeze.relative_depth are exclusive; give one")
-    if sq.relative_depth is not None and not sq.relative_depth < 1:
-        raise SceneError(
-            f"squeeze.relative_depth must be < 1 (at 1 the fingers would meet), "
-            f"got {sq.relative_depth}"
-        )
 
 
 def _validate_effects(scene: Scene) -> None:

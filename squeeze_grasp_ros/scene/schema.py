@@ -55,6 +55,9 @@ def spec(
     hi: float | None = None,
     lo_open: bool = False,
     choices: tuple = (),
+    *,
+    hi_open: bool = False,
+    why: str = "",
     **kw,
 ) -> Any:
     """A dataclass field with documentation, unit, range and allowed choices for the parser.
@@ -66,15 +69,18 @@ def spec(
     unit : str
         SI unit of a number ("" for none).
     lo, hi : float, optional
-        Range of a number (inclusive unless ``lo_open``).
+        Range of a number (inclusive unless ``lo_open`` / ``hi_open``).
     choices : tuple of str
         Allowed values of a string (an enum-typed field takes its members' values by default).
         A mapping (``dict`` or ``Mapping[K, V]``) is checked to be one and kept as given: its
         document's parser types its keys and values (e.g. a scene's fingers).
+    hi_open, why : bool, str
+        An open upper bound; why the range is what it is, said with a value out of it.
     **kw
         ``default`` or ``default_factory`` of :func:`dataclasses.field`.
     """
-    meta = {"doc": doc, "unit": unit, "lo": lo, "hi": hi, "lo_open": lo_open, "choices": choices}
+    meta = {"doc": doc, "unit": unit, "lo": lo, "hi": hi, "lo_open": lo_open, "hi_open": hi_open,
+            "why": why, "choices": choices}
     return dataclasses.field(metadata=meta, **kw)
 
 
@@ -84,16 +90,19 @@ def _number(x: float) -> str:
 
 
 def describe_range(meta: dict) -> str:
-    """The range of an entry in words ("in (0.0, 1.0]", ">= 0", "a finite number")."""
+    """The range of an entry in words ("in (0.0, 1.0]", "in [0.0, 1.0)", ">= 0", "a finite
+    number").
+    """
     lo, hi = meta.get("lo"), meta.get("hi")
     lo = None if lo is None else _number(lo)
     hi = None if hi is None else _number(hi)
     if lo is not None and hi is not None:
-        return f"in {'(' if meta.get('lo_open') else '['}{lo}, {hi}]"
+        opening, closing = "([" [not meta.get("lo_open")], ")]" [not meta.get("hi_open")]
+        return f"in {opening}{lo}, {hi}{closing}"
     if lo is not None:
         return f"{'>' if meta.get('lo_open') else '>='} {lo}"
     if hi is not None:
-        return f"<= {hi}"
+        return f"{'<' if meta.get('hi_open') else '<='} {hi}"
     return "a finite number"
 
 
@@ -114,10 +123,11 @@ def _check_range(value: float, meta: dict, where: str, error: type[SchemaError])
     if not np.isfinite(float(value)):
         raise error(f"{where} must be a finite number{unit}, got {value!r}")
     bad = (lo is not None and (value < lo or (meta.get("lo_open") and value == lo))) or (
-        hi is not None and value > hi
+        hi is not None and (value > hi or (meta.get("hi_open") and value == hi))
     )
     if bad:
-        raise error(f"{where} must be {describe_range(meta)}{unit}, got {value!r}")
+        why = f" ({meta['why']})" if meta.get("why") else ""
+        raise error(f"{where} must be {describe_range(meta)}{unit}{why}, got {value!r}")
 
 
 def _yaml11_float(text: str, where: str, error: type[SchemaError]) -> float:

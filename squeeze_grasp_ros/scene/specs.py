@@ -211,7 +211,8 @@ class SqueezeSpec:
                              default=SqueezeKind.STABLE)
     depth: Optional[float] = spec("squeeze depth rho", "m", lo=0.0, default=None)
     relative_depth: Optional[float] = spec(
-        "finger approach / initial contact distance", "", lo=0.0, hi=1.0, default=None
+        "finger approach / initial contact distance", "", lo=0.0, hi=1.0, hi_open=True,
+        why="at 1 the fingers would meet", default=None
     )
     step: float = spec(
         "depth step of the event-driven squeeze, relative to the object size (corotational "

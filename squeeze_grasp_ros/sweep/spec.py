@@ -192,11 +192,13 @@ class SweepSpec:
         "squeeze depths rho", "m", lo=0.0, lo_open=True, default=None
     )
     relative_depth: Optional[tuple[float, ...]] = spec(
-        "relative depths (finger approach / initial contact distance; below 1)",
+        "relative depths (finger approach / initial contact distance)",
         "",
         lo=0.0,
         hi=1.0,
         lo_open=True,
+        hi_open=True,
+        why="at 1 the fingers would meet",
         default=None,
     )
     weight: Optional[float] = spec(
@@ -395,10 +397,6 @@ def parse_sweep_spec(data: Any, base_dir: Path) -> LoadedSpec:
         depths = tuple((d, None) for d in _axis(sw.depth, None, "depth"))
     elif sw.relative_depth is not None:
         depths = tuple((None, r) for r in _axis(sw.relative_depth, None, "relative_depth"))
-        for k, r in enumerate(sw.relative_depth):
-            if not r < 1:
-                raise SweepError(f"relative_depth[{k}] must be < 1 (at 1 the fingers would "
-                                 f"meet), got {r}")
     elif base.squeeze.depth is not None or base.squeeze.relative_depth is not None:
         depths = ((base.squeeze.depth, base.squeeze.relative_depth),)
     else:

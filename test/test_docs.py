@@ -442,3 +442,35 @@ def test_the_docs_python_blocks_call_the_package_as_its_signatures_allow():
                     wrong.append(f"{page.name}:{block.line + call.lineno} {name}: {error}")
                 checked += 1
     assert checked >= 10 and not wrong, wrong
+
+
+def test_every_option_of_every_verb_is_described_in_the_docs():
+    """Each ``--option`` that a verb's ``--help`` lists appears in README.md or docs/ (or
+    CONTRIBUTING.md), so that what the help names a user can read more about.
+    """
+    from squeeze_grasp_ros.cli import add_verb_arguments, build_parser
+
+    text = "\n".join(page.read_text(encoding="utf-8") for page in PAGES)
+    parser = build_parser()
+    verbs = next(a for a in parser._actions if a.dest == "verb")._name_parser_map
+    options = [(verb, option) for verb, sub in verbs.items()
+               for action in add_verb_arguments(sub)._actions
+               for option in action.option_strings if option.startswith("--")
+               and option != "--help"]
+    missing = [f"{verb} {option}" for verb, option in options
+               if not re.search(re.escape(option) + r"(?![\w-])", text)]
+    assert len(options) >= 100 and not missing, missing
+
+
+def test_contributing_lists_every_linter_test():
+    """CONTRIBUTING.md's linter table names every test of test/test_lint.py (ruff's three
+    groups by their ids).
+    """
+    source = (REPO / "test" / "test_lint.py").read_text(encoding="utf-8")
+    tests = [node.name for node in ast.parse(source).body
+             if isinstance(node, ast.FunctionDef) and node.name.startswith("test_")]
+    names = [f"test_ruff[{group}]" for group in ("flake8", "pep257", "isort")] + [
+        name for name in tests if name != "test_ruff"]
+    contributing = (REPO / "CONTRIBUTING.md").read_text(encoding="utf-8")
+    assert "test_ruff" in tests and len(names) >= 7
+    assert [name for name in names if f"test_lint.py::{name}`" not in contributing] == []

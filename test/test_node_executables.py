@@ -5,6 +5,7 @@ when a required parameter is missing. Real processes on real rclpy.
 """
 from __future__ import annotations
 
+import re
 import signal
 import subprocess
 import time
@@ -75,3 +76,11 @@ def test_every_node_logs_when_it_is_ready(tmp_path):
     assert "action /executor/execute_grasp" in outputs["executor"]
     assert "camera/mask, camera/pose, frame object" in outputs["outline"]
     assert codes == dict.fromkeys(commands, 0)
+    # the ready lines docs/ros.md shows (recorded with ros2 launch) say what these say
+    shown = (REPO / "docs" / "ros.md").read_text(encoding="utf-8")
+    limits = re.search(r"planner ready: (PlannerLimits\(.*?\));", outputs["planner"]).group(1)
+    documented = re.findall(r"planner ready: (PlannerLimits\(.*?\));", shown)
+    assert documented and set(documented) == {limits}
+    topics = re.search(r"recorder ready: (recording \d+ topics)", outputs["recorder"]).group(1)
+    documented = re.findall(r"recorder ready: (recording \d+ topics)", shown)
+    assert documented and set(documented) == {topics}

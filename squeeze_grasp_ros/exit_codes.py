@@ -90,3 +90,31 @@ def raise_on_signals() -> dict:
     if signal.getsignal(signal.SIGINT) is signal.default_int_handler:
         signums.append(signal.SIGINT)
     return {signum: signal.signal(signum, stop) for signum in signums}
+
+
+class SignalFlag:
+    """A flag that signal handlers set and loops poll, with no lock.
+
+    A handler runs in the main thread between two bytecodes, possibly inside another handler or
+    inside a :class:`threading.Event`'s lock; ``Event.set()`` there waits for a lock its own
+    thread holds. A node whose run was killed got its parent-death signal several times in a
+    row and hung that way, four handlers deep, for good (the slow suite's SIGKILL test). Setting
+    an attribute takes no lock, so any number of nested handlers can set it.
+
+    >>> flag = SignalFlag()
+    >>> flag.is_set(), flag.set(), flag.is_set()
+    (False, None, True)
+    """
+
+    __slots__ = ("_set",)
+
+    def __init__(self) -> None:
+        self._set = False
+
+    def set(self, *_: object) -> None:
+        """Set the flag (with a signal handler's arguments or none)."""
+        self._set = True
+
+    def is_set(self) -> bool:
+        """Whether the flag is set."""
+        return self._set

@@ -462,3 +462,44 @@ def test_a_lagging_recorder_process_records_every_message_or_says_which_are_miss
     else:
         assert proc.returncode == 0, err[-2000:]
     assert run["outcome"] == "grasp held"
+
+
+BURST_CHILD = """
+import os, sys, time
+from squeeze_grasp_ros.exit_codes import SignalFlag
+from squeeze_grasp_ros.ros.nodes import parent_watch
+stop = SignalFlag()
+orphaned = parent_watch(stop)
+print("ready", flush=True)
+while not (stop.is_set() and orphaned() and os.path.exists(sys.argv[1])):
+    time.sleep(1e-4)
+print("stopped", flush=True)
+"""
+
+
+def test_a_burst_of_parent_death_signals_cannot_hang_a_node(tmp_path):
+    """A node whose run was killed got the parent-death signal several times in a row and hung
+    for good: each handler set a threading.Event, and a handler that interrupted another
+    inside the Event's lock waited for that lock (four handlers deep, in the slow suite's
+    SIGKILL test). The handlers of :func:`parent_watch` set lock-free flags now: a process that
+    receives 3,000 of those signals as fast as they can be sent still stops, in every trial
+    (with Events, 6 trials of 10 hung this way).
+    """
+    from squeeze_grasp_ros.ros.nodes import PARENT_DEATH_SIGNAL, PARENT_PID_ENV
+
+    env = {**os.environ, PARENT_PID_ENV: str(os.getpid())}
+    for trial in range(5):
+        go = tmp_path / f"go{trial}"
+        child = subprocess.Popen([sys.executable, "-c", BURST_CHILD, str(go)], env=env,
+                                 stdout=subprocess.PIPE, text=True, stdin=subprocess.DEVNULL)
+        try:
+            assert child.stdout.readline().strip() == "ready"
+            for _ in range(3000):
+                os.kill(child.pid, PARENT_DEATH_SIGNAL)
+            go.touch()
+            assert child.wait(timeout=30) == 0, f"trial {trial}"
+            assert child.stdout.read().strip() == "stopped"
+        finally:
+            if child.poll() is None:
+                child.kill()
+                child.wait()

@@ -7,7 +7,6 @@ import ctypes
 import os
 import signal
 import sys
-import threading
 import time
 from collections.abc import Callable
 from pathlib import Path
@@ -20,7 +19,7 @@ from rclpy.impl.implementation_singleton import rclpy_implementation
 from rclpy.node import Node
 from rclpy.signals import SignalHandlerOptions
 
-from squeeze_grasp_ros.exit_codes import ExitCode
+from squeeze_grasp_ros.exit_codes import ExitCode, SignalFlag
 from squeeze_grasp_ros.mechanics.errors import InvalidInputError
 
 RCLError = rclpy_implementation.RCLError
@@ -38,7 +37,7 @@ PARENT_DEATH_SIGNAL = signal.SIGUSR1
 """The signal a node started by a run asks for when that run dies."""
 
 
-def parent_watch(stop: threading.Event) -> Callable[[], bool]:
+def parent_watch(stop: SignalFlag) -> Callable[[], bool]:
     """'Has the process that started this node died?', for a node started by a run.
 
     With :data:`PARENT_PID_ENV` set, asks Linux for :data:`PARENT_DEATH_SIGNAL` when the parent
@@ -52,7 +51,7 @@ def parent_watch(stop: threading.Event) -> Callable[[], bool]:
     text = os.environ.get(PARENT_PID_ENV, "")
     if not text.isdigit():
         return lambda: False
-    parent, died = int(text), threading.Event()
+    parent, died = int(text), SignalFlag()  # set in a handler: no lock (SignalFlag)
 
     def on_parent_death(*_: object) -> None:
         died.set()
@@ -130,9 +129,9 @@ def run_node(factory: Callable[[], Node], args: list[str] | None = None,
         ``<program>: error: <what>``, not a traceback. Once built, the node logs
         ``<name> ready: <its configuration>``.
     """
-    stop = threading.Event()
+    stop = SignalFlag()
     for signum in (signal.SIGINT, signal.SIGTERM):
-        signal.signal(signum, lambda *_: stop.set())
+        signal.signal(signum, stop.set)
     orphaned = parent_watch(stop)
     try:
         rclpy.init(args=args, signal_handler_options=SignalHandlerOptions.NO)

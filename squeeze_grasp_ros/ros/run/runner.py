@@ -30,7 +30,6 @@ import dataclasses
 import functools
 import importlib.util
 import signal
-import threading
 import time
 from collections.abc import Callable
 from pathlib import Path
@@ -50,7 +49,7 @@ from rclpy.task import Future
 from squeeze_grasp_interfaces.action import ExecuteGrasp
 from squeeze_grasp_interfaces.msg import ContactEventArray, PredictedShapes
 from squeeze_grasp_ros.control.motion import RESQUEEZE
-from squeeze_grasp_ros.exit_codes import Interrupted
+from squeeze_grasp_ros.exit_codes import Interrupted, SignalFlag
 from squeeze_grasp_ros.mechanics.vocabulary import Effect
 from squeeze_grasp_ros.perception.extract import ObjectOutline
 from squeeze_grasp_ros.planning.typed_objects import typed_scene
@@ -127,7 +126,7 @@ class PipelineRunner:
                 )
         self.t0 = time.perf_counter()
         self.timing: dict[str, float] = {}
-        self.interrupted = threading.Event()
+        self.interrupted = SignalFlag()  # set by signal handlers: no lock
         self.signal = signal.SIGINT
         self.context = Context()
         rclpy.init(context=self.context, signal_handler_options=SignalHandlerOptions.NO)

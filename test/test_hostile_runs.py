@@ -503,3 +503,39 @@ def test_a_burst_of_parent_death_signals_cannot_hang_a_node(tmp_path):
             if child.poll() is None:
                 child.kill()
                 child.wait()
+
+
+SWEEP_BURST_CHILD = """
+import os, sys
+from squeeze_grasp_ros.sweep.engine import StopSignals
+with StopSignals() as stop:
+    print("ready", flush=True)
+    while not os.path.exists(sys.argv[1]):
+        stop.wait(1e-4)
+print("stopped by", stop.signal, flush=True)
+"""
+
+
+def test_a_burst_of_ctrl_c_and_sigterm_cannot_hang_a_sweep(tmp_path):
+    """The sweep client's stop handlers had the same defect as the nodes': each set a
+    threading.Event, and a handler interrupting another inside the Event's lock hung the
+    client for good (19 trials of 20). They set attributes only now: a client that receives
+    3,000 SIGINT and SIGTERM, alternating, as fast as they can be sent, still stops, in every
+    trial, and reports a stop signal.
+    """
+    for trial in range(5):
+        go = tmp_path / f"go{trial}"
+        child = subprocess.Popen([sys.executable, "-c", SWEEP_BURST_CHILD, str(go)],
+                                 stdout=subprocess.PIPE, text=True, stdin=subprocess.DEVNULL)
+        try:
+            assert child.stdout.readline().strip() == "ready"
+            for k in range(3000):
+                os.kill(child.pid, (signal.SIGINT, signal.SIGTERM)[k % 2])
+            go.touch()
+            assert child.wait(timeout=30) == 0, f"trial {trial}"
+            assert child.stdout.read().strip() in {f"stopped by {int(signal.SIGINT)}",
+                                                   f"stopped by {int(signal.SIGTERM)}"}
+        finally:
+            if child.poll() is None:
+                child.kill()
+                child.wait()

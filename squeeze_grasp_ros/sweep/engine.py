@@ -264,20 +264,21 @@ class StopSignals:
 
     def __init__(self) -> None:
         self.signal: Optional[int] = None
-        self._event = threading.Event()
         self._old: dict = {}
         self._raise = False
 
     def _handle(self, signum, _frame) -> None:
+        # Attributes only: a handler may interrupt another handler, or code inside a lock,
+        # and must not take one (a threading.Event here deadlocked under a burst of signals).
         self.signal = signum
-        self._event.set()
         if self._raise:
             self._raise = False
             raise Stopped(signum)
 
-    def wait(self, seconds: float) -> None:
-        """Sleep up to ``seconds``, waking at a signal."""
-        self._event.wait(seconds)
+    @staticmethod
+    def wait(seconds: float) -> None:
+        """Sleep ``seconds`` (keep it short: a signal is seen when the sleep ends)."""
+        time.sleep(seconds)
 
     @contextlib.contextmanager
     def at_once(self):

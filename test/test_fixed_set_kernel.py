@@ -21,6 +21,7 @@ from squeeze_grasp_ros.mechanics.squeeze.contact_model import (
 )
 from squeeze_grasp_ros.mechanics.squeeze.events import event_squeeze
 from squeeze_grasp_ros.mechanics.squeeze.fixed_set_kernel import (
+    COMPILED_FROM_EVALUATIONS,
     KERNEL_VARIABLE,
     Kernel,
     prefer_compiled,
@@ -120,10 +121,14 @@ def test_the_route_is_chosen_by_the_environment(monkeypatch):
     monkeypatch.setenv(KERNEL_VARIABLE, "numpy")  # restored (unset or as it was) after the test
     monkeypatch.delenv(KERNEL_VARIABLE)
     assert selected() == Kernel.NUMPY  # a one-off process does not pay numba's start-up
-    prefer_compiled()  # what the sweep does: numba is installed here (the module skips else)
+    # what the sweep does (numba is installed here: the module skips else): a sweep too small
+    # to repay a compilation keeps numpy, a larger one sends its workers by numba
+    assert prefer_compiled(COMPILED_FROM_EVALUATIONS - 1) == Kernel.NUMPY
+    assert KERNEL_VARIABLE not in os.environ
+    assert prefer_compiled(COMPILED_FROM_EVALUATIONS) == Kernel.NUMBA
     assert os.environ[KERNEL_VARIABLE] == "numba" and selected() == Kernel.NUMBA
     monkeypatch.setenv(KERNEL_VARIABLE, "numpy")
-    prefer_compiled()  # a route the user chose stays
+    assert prefer_compiled(10 ** 9) == Kernel.NUMPY  # a route the user chose stays
     assert selected() == Kernel.NUMPY
     monkeypatch.setenv(KERNEL_VARIABLE, "numpy")
     assert selected() == Kernel.NUMPY
@@ -138,7 +143,7 @@ def test_without_numba_the_numpy_route_runs_and_asking_for_numba_names_the_extra
     monkeypatch.setattr(fixed_set_kernel, "installed", lambda module: False)
     monkeypatch.setenv(KERNEL_VARIABLE, "numpy")
     monkeypatch.delenv(KERNEL_VARIABLE)
-    prefer_compiled()
+    assert prefer_compiled(10 ** 9) == Kernel.NUMPY
     assert KERNEL_VARIABLE not in os.environ and selected() == Kernel.NUMPY
     monkeypatch.setenv(KERNEL_VARIABLE, "numba")
     with pytest.raises(InvalidInputError, match=r"needs numba: pip install '\.\[fast\]'"):

@@ -404,6 +404,30 @@ def test_remote_cluster_local_cluster_and_bare_loop_agree_bit_for_bit(tmp_path):
     assert set(manifest["tasks"]) == {t.id for t in plan_tasks(loaded)}
 
 
+def test_the_local_workers_route_is_chosen_by_the_sweeps_size(tmp_path, capsys, monkeypatch):
+    """A sweep too small to repay numba's compilation (about 85 s of CPU per worker after an
+    install) runs its local workers by numpy; one of at least COMPILED_FROM_EVALUATIONS by
+    numba, when it is installed; the rows are the same bit for bit (linear objects).
+    """
+    from squeeze_grasp_ros.mechanics.squeeze import fixed_set_kernel
+    from squeeze_grasp_ros.mechanics.squeeze.fixed_set_kernel import KERNEL_VARIABLE
+
+    monkeypatch.delenv(KERNEL_VARIABLE, raising=False)
+    spec = write_spec(tmp_path, SMALL)
+    loaded = parse_sweep_spec(SMALL, tmp_path)
+    total = sum(t.evaluations for t in plan_tasks(loaded))
+    assert total < fixed_set_kernel.COMPILED_FROM_EVALUATIONS
+    options = ["--json", "--no-progress", "--workers", "1"]
+    assert main(["sweep", str(spec), "--out", str(tmp_path / "small"), *options]) == 0
+    assert json.loads(capsys.readouterr().out)["kernel"] == "numpy"
+    assert KERNEL_VARIABLE not in os.environ
+    pytest.importorskip("numba", reason="the fast extra is not installed: pip install '.[fast]'")
+    monkeypatch.setattr(fixed_set_kernel, "COMPILED_FROM_EVALUATIONS", total)
+    assert main(["sweep", str(spec), "--out", str(tmp_path / "large"), *options]) == 0
+    assert json.loads(capsys.readouterr().out)["kernel"] == "numba"
+    assert table_without_time(tmp_path / "large").equals(table_without_time(tmp_path / "small"))
+
+
 def test_sigkill_of_the_client_loses_nothing_finished_and_resume_completes(tmp_path):
     """A real `squeeze-grasp sweep` process is SIGKILLed once parts exist; the parts it wrote
     stay byte-identical, the re-run writes only the rest, and the table equals a clean run's

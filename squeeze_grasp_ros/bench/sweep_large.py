@@ -63,7 +63,7 @@ def run(evaluations: int, progress) -> list[Table]:
     from squeeze_grasp_ros.sweep.engine import run_sweep  # the [sweep] extra: Dask, Arrow
     from squeeze_grasp_ros.sweep.spec import parse_sweep_spec
 
-    prefer_compiled()  # as squeeze-grasp sweep: the compiled kernel with numba installed
+    prefer_compiled(TARGET_EVALUATIONS)  # the route squeeze-grasp sweep takes for a million
 
     workers = os.cpu_count() or 1
     load0 = os.getloadavg()

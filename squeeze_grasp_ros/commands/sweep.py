@@ -13,6 +13,7 @@ import sys
 from squeeze_grasp_ros.exit_codes import ExitCode
 from squeeze_grasp_ros.mechanics.squeeze.fixed_set_kernel import prefer_compiled
 from squeeze_grasp_ros.sweep.engine import dry_run, run_sweep
+from squeeze_grasp_ros.sweep.plan import plan_tasks
 from squeeze_grasp_ros.sweep.spec import SweepError, load_sweep_spec
 
 EPILOG = ("exit status: 0 every task written (an evaluation that raised is a row with its error "
@@ -59,12 +60,14 @@ def run(args: argparse.Namespace) -> dict | int:
                 **dry_run(loaded, workers=args.workers, scheduler=args.scheduler)}
     if not args.out:
         raise SweepError("--out DIR is required (or use --dry-run)")
-    prefer_compiled()  # the local workers' evaluations by the compiled kernel, with numba
+    # the local workers' route: compiled (numba) for sweeps that repay its compilation
+    kernel = prefer_compiled(sum(task.evaluations for task in plan_tasks(loaded)))
     outcome = run_sweep(loaded, args.out, scheduler=args.scheduler, workers=args.workers,
                         progress=not args.no_progress)
     for line in outcome.repaired:
         print(f"squeeze-grasp sweep: {args.out}/{line}", file=sys.stderr)
-    result = {"dry_run": False, "out": args.out, "spec_hash": loaded.hash, **vars(outcome)}
+    result = {"dry_run": False, "out": args.out, "spec_hash": loaded.hash, **vars(outcome),
+              "kernel": None if args.scheduler else kernel.value}
     if outcome.interrupted is not None:
         name = signal.Signals(outcome.interrupted).name
         print(f"squeeze-grasp sweep: stopped by {name}; {outcome.done} task(s) written this run. "

@@ -94,6 +94,11 @@ def require_finite(name: str, value) -> None:
         raise InvalidInputError(f"{name} must be finite, got {shown(value)}")
 
 
+FINGERS_MEET = "at 1 the fingers would meet"
+"""Why a relative depth (finger approach / initial contact distance) must stay below 1, as
+every error and every schema's range states it."""
+
+
 def require_relative_depth(relative: float, depth: float | None = None) -> None:
     """Refuse a relative depth outside [0, 1): at 1 the fingers would meet. With ``depth``
     (rho, m), the relative depth is the one that depth gives and the message says so. Every
@@ -111,7 +116,7 @@ def require_relative_depth(relative: float, depth: float | None = None) -> None:
         raise InvalidInputError(f"depth must be >= 0 m, got {shown(depth)}")
     if not 0 <= relative < 1:
         if depth is None:
-            raise InvalidInputError(f"relative depth must be in [0, 1) (at 1 the fingers would "
-                                    f"meet), got {shown(relative)}")
+            raise InvalidInputError(f"relative depth must be in [0, 1) ({FINGERS_MEET}), "
+                                    f"got {shown(relative)}")
         raise InvalidInputError(f"depth {depth:.6g} m is a relative depth of {relative:.6g}: it "
-                                "must be in [0, 1) (at 1 the fingers would meet)")
+                                f"must be in [0, 1) ({FINGERS_MEET})")

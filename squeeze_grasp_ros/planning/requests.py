@@ -10,6 +10,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from squeeze_grasp_ros.mechanics.elastic.reduced import boundary_displacement, reduced_stiffness
+from squeeze_grasp_ros.mechanics.errors import FINGERS_MEET
 from squeeze_grasp_ros.mechanics.resistance.frictional import FrictionalResistance
 from squeeze_grasp_ros.mechanics.resistance.optimal import (
     MAX_DIRECTIONS,
@@ -88,7 +89,7 @@ def squeeze_plan(
     if depth and len(nodes) == 2 and not relative < 1.0:
         raise invalid(
             f"depth {depth:.6g} m is a relative depth of {relative:.6g}: it must be "
-            "below 1 (at 1 the fingers would meet)"
+            f"below 1 ({FINGERS_MEET})"
         )
     closure = False
     if len(nodes) == 2:

@@ -16,6 +16,7 @@ from dataclasses import dataclass
 from typing import Any, Optional
 
 from squeeze_grasp_ros.mechanics.elastic.mesh import MAX_MESH_NODES
+from squeeze_grasp_ros.mechanics.errors import FINGERS_MEET
 from squeeze_grasp_ros.mechanics.ring.model import MAX_RING_ELEMENTS
 from squeeze_grasp_ros.mechanics.squeeze.tip_shapes import TipShape
 from squeeze_grasp_ros.mechanics.vocabulary import (
@@ -212,7 +213,7 @@ class SqueezeSpec:
     depth: Optional[float] = spec("squeeze depth rho", "m", lo=0.0, default=None)
     relative_depth: Optional[float] = spec(
         "finger approach / initial contact distance", "", lo=0.0, hi=1.0, hi_open=True,
-        why="at 1 the fingers would meet", default=None
+        why=FINGERS_MEET, default=None
     )
     step: float = spec(
         "depth step of the event-driven squeeze, relative to the object size (corotational "

@@ -20,6 +20,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Optional
 
+from squeeze_grasp_ros.mechanics.errors import FINGERS_MEET
 from squeeze_grasp_ros.mechanics.resistance.optimal import MAX_DIRECTIONS
 from squeeze_grasp_ros.mechanics.vocabulary import (
     ContactKind,
@@ -198,7 +199,7 @@ class SweepSpec:
         hi=1.0,
         lo_open=True,
         hi_open=True,
-        why="at 1 the fingers would meet",
+        why=FINGERS_MEET,
         default=None,
     )
     weight: Optional[float] = spec(

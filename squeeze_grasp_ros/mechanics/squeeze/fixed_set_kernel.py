@@ -17,11 +17,11 @@ the same floats: the example sweep's 288 rows and the golden runs are identical 
 The route is chosen at each solve (once per stepper call for the stepper's solves):
 :data:`KERNEL_VARIABLE` = ``numpy`` or ``numba``
 (:class:`Kernel`); unset means numpy, because a process pays numba's import and the load of its
-cached code (about 0.2 s of CPU; 12 s to compile on first use after an install) for a few
-milliseconds saved per evaluation. ``squeeze-grasp sweep`` and the large bench sweep, whose
-workers run thousands of evaluations, set it to numba when numba is installed
-(:func:`prefer_compiled`). Asking for numba without it installed raises an error that names the
-extra.
+cached code (about 1 s of CPU; about 85 s to compile the kernels on first use after an install
+or an upgrade) for a few milliseconds saved per evaluation. ``squeeze-grasp sweep`` and the
+large bench sweep set it to numba for their local workers when numba is installed and the sweep
+is large enough to pay for a compilation (:func:`prefer_compiled`). Asking for numba without it
+installed raises an error that names the extra.
 """
 from __future__ import annotations
 
@@ -101,10 +101,30 @@ def chosen() -> Kernel | None:
     return selected() if os.environ.get(KERNEL_VARIABLE, "") else None
 
 
-def prefer_compiled() -> None:
-    """Set :data:`KERNEL_VARIABLE` to numba in this process's environment, which the processes
-    it starts (a local Dask cluster's workers) inherit, when numba is installed and the
-    variable is unset: for runs of many evaluations, where numba's start-up is paid once.
+COMPILED_FROM_EVALUATIONS = 25_000
+"""The sweeps whose local workers :func:`prefer_compiled` sends by the compiled route: at least
+this many evaluations. Measured on a 2-core machine (2026-11-28): compiling the kernels after an
+install takes about 85 s of CPU in each worker; compiled, an evaluation of the example sweep's
+kind saves about 6 ms of CPU (2,496 evaluations on 2 workers: 10.2 against 18.2 s), and a
+worker's numba start-up costs about 1 s (288 evaluations: 3.7 s on either route). About
+25,000 evaluations on two workers repay a compilation; the rule reads the spec alone, so every
+run and resume of a sweep takes the same route."""
+
+
+def prefer_compiled(evaluations: int) -> Kernel:
+    """The route of the local workers of a run of ``evaluations`` evaluations.
+
+    With :data:`KERNEL_VARIABLE` unset, numba installed and at least
+    :data:`COMPILED_FROM_EVALUATIONS` evaluations, the variable is set to numba in this
+    process's environment, which the processes it starts (a local Dask cluster's workers)
+    inherit; otherwise it is left as it is (unset: numpy).
+
+    Returns
+    -------
+    Kernel
+        The route the variable now selects.
     """
-    if installed("numba"):
-        os.environ.setdefault(KERNEL_VARIABLE, Kernel.NUMBA.value)
+    if (not os.environ.get(KERNEL_VARIABLE, "") and installed("numba")
+            and evaluations >= COMPILED_FROM_EVALUATIONS):
+        os.environ[KERNEL_VARIABLE] = Kernel.NUMBA.value
+    return selected()

@@ -5,6 +5,7 @@ ids, bounded identifiers and abandoned work (issue 34, items 2, 9, 10, 11, 15).
 """
 from __future__ import annotations
 
+import re
 import time
 from collections import Counter
 
@@ -18,6 +19,7 @@ from test_planner_node import RESIST_FIG10
 from squeeze_grasp_interfaces.action import GraspMap as GraspMapAction
 from squeeze_grasp_interfaces.srv import EventSqueeze, LoadObject, PlanSqueeze
 from squeeze_grasp_ros.planning import ErrorCode
+from squeeze_grasp_ros.ros.refusals import REFUSAL_LOG_INTERVAL_S
 
 BURST = 200
 """Requests or goals sent at once (the issue's burst)."""
@@ -57,6 +59,34 @@ def test_a_burst_of_200_plan_squeeze_requests_is_answered_in_full(planner):
     assert all(r.success for r in responses)
     stiffness = {round(r.stiffness, 9) for r in responses}
     assert len(stiffness) == 1  # one object, one stiffness whatever the depth
+
+
+def test_a_burst_of_200_refused_requests_is_200_reasons_and_a_few_log_lines(planner, capfd):
+    """Every refused request gets its reason; the planner's log gets the first refusal of each
+    kind per second and then the count it left out (before: 200 identical lines).
+    """
+    capfd.readouterr()
+    start = time.monotonic()
+    responses = burst(planner, PlanSqueeze, "plan_squeeze", [
+        PlanSqueeze.Request(object_id=f"ghost{k}", squeeze_type="stable", depth=1e-3)
+        for k in range(BURST)])
+    seconds = time.monotonic() - start
+    assert all(ErrorCode(r.error_code) == ErrorCode.UNKNOWN_OBJECT for r in responses)
+    assert {r.message for r in responses} == {
+        f"unknown object_id 'ghost{k}': load it first with load_object (objects are evicted "
+        "when the cache is full)" for k in range(BURST)}
+    time.sleep(1.1)  # past the refusal log's interval
+    last = burst(planner, PlanSqueeze, "plan_squeeze", [
+        PlanSqueeze.Request(object_id="late", squeeze_type="stable", depth=1e-3)])
+    assert ErrorCode(last[0].error_code) == ErrorCode.UNKNOWN_OBJECT
+    lines = [line for line in capfd.readouterr().err.splitlines()
+             if "refused (UNKNOWN_OBJECT)" in line]
+    assert 2 <= len(lines) <= 2 + seconds / REFUSAL_LOG_INTERVAL_S, (seconds, lines)
+    skipped = [int(line.split("(and ")[1].split()[0]) for line in lines if "(and " in line]
+    assert re.search(r"refused \(UNKNOWN_OBJECT\): unknown object_id 'late': .*\(and \d+ more "
+                     r"UNKNOWN_OBJECT refusals in the \d+\.\d s before, not logged\)$",
+                     lines[-1]), lines[-1]  # the format docs/ros.md quotes
+    assert len(lines) + sum(skipped) == BURST + 1, lines
 
 
 def test_a_burst_of_200_loads_gets_200_answers_ok_or_busy(planner):

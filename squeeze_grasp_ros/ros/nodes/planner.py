@@ -64,6 +64,7 @@ from squeeze_grasp_ros.resources import share_dir
 from squeeze_grasp_ros.ros import messages
 from squeeze_grasp_ros.ros.nodes import pipeline, run_node
 from squeeze_grasp_ros.ros.nodes.frame_pose_topic import frame_pose_topic
+from squeeze_grasp_ros.ros.refusals import RefusalLog
 
 Response = TypeVar("Response")
 WATCH_PERIOD = 0.1
@@ -152,6 +153,7 @@ class PlannerNode(Node):
         services = pipeline.request_queue(value("service_queue_depth"))
         self._pending = 0
         self._pending_lock = threading.Lock()
+        self.refusals = RefusalLog(self.get_logger().info)
         # Reentrant: a long request awaiting its worker must not hold the node's default
         # (mutually exclusive) group, or every other request waits for it (measured: a
         # plan_squeeze waited the whole 7 s of an event_squeeze).
@@ -349,7 +351,7 @@ class PlannerNode(Node):
             if code == ErrorCode.INTERNAL_ERROR:
                 self.get_logger().error(f"{response_type.__name__}: {message}")
             else:
-                self.get_logger().info(f"refused ({code.name}): {message}")
+                self.refusals.refused(code.name, message)
             return messages.failure(response_type, code, message)
 
     async def _in_worker(self, response_type: type[Response],

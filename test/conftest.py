@@ -85,8 +85,9 @@ def kernel_route_kept(monkeypatch: pytest.MonkeyPatch) -> None:
     run on the compiled route (seen: test_events after test_sweep aborted in the kernel).
     """
     value = os.environ.get(KERNEL_VARIABLE)
-    if value is None:
-        monkeypatch.delenv(KERNEL_VARIABLE, raising=False)
+    if value is None:  # setenv records "unset" for the undo; delenv of an unset name does not
+        monkeypatch.setenv(KERNEL_VARIABLE, "")
+        monkeypatch.delenv(KERNEL_VARIABLE)
     else:
         monkeypatch.setenv(KERNEL_VARIABLE, value)
 

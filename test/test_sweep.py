@@ -428,6 +428,21 @@ def test_the_local_workers_route_is_chosen_by_the_sweeps_size(tmp_path, capsys, 
     assert table_without_time(tmp_path / "large").equals(table_without_time(tmp_path / "small"))
 
 
+def test_a_dry_run_says_when_the_workers_take_another_route_than_its_sample(
+        tmp_path, capsys, monkeypatch):
+    pytest.importorskip("numba", reason="the fast extra is not installed: pip install '.[fast]'")
+    from squeeze_grasp_ros.mechanics.squeeze import fixed_set_kernel
+
+    monkeypatch.delenv(fixed_set_kernel.KERNEL_VARIABLE, raising=False)
+    monkeypatch.setattr(fixed_set_kernel, "COMPILED_FROM_EVALUATIONS", 1)
+    spec = write_spec(tmp_path, SMALL)
+    assert main(["sweep", str(spec), "--dry-run"]) == 0
+    assert capsys.readouterr().out.splitlines()[-1] == (
+        "the sample ran by numpy; the local workers will run by numba (the first run after an "
+        "install compiles for about 85 s of CPU per worker, then each evaluation is faster)")
+    assert fixed_set_kernel.KERNEL_VARIABLE not in os.environ  # a dry run starts no worker
+
+
 def test_sigkill_of_the_client_loses_nothing_finished_and_resume_completes(tmp_path):
     """A real `squeeze-grasp sweep` process is SIGKILLed once parts exist; the parts it wrote
     stay byte-identical, the re-run writes only the rest, and the table equals a clean run's
@@ -593,6 +608,7 @@ def test_sweep_help_lists_the_exit_statuses(capsys):
     assert done.value.code == 0
     text = " ".join(capsys.readouterr().out.split())
     assert "exit status: 0 every task written (an evaluation that raised is a row" in text
+    assert "the local workers of a sweep of at least 25,000 evaluations run compiled" in text
     assert "1 some tasks failed as a whole" in text and "retries only the failed ones" in text
     assert "130 stopped by Ctrl-C (SIGINT), 143 by SIGTERM" in text
 
@@ -769,6 +785,7 @@ def test_dry_run_and_report(tmp_path, capsys):
     tasks = plan_tasks(loaded)
     assert dry["tasks"] == len(tasks) and dry["evaluations"] == sum(t.evaluations for t in tasks)
     assert dry["objects"] == 4 and dry["parameters"] == 2 and dry["estimate_s"] > 0
+    assert dry["kernel"] == dry["sample_kernel"] == "numpy"  # a small sweep, variable unset
     from squeeze_grasp_ros.sweep.store import Store
 
     store = Store(tmp_path / "o", loaded, tasks)

@@ -11,7 +11,12 @@ import signal
 import sys
 
 from squeeze_grasp_ros.exit_codes import ExitCode
-from squeeze_grasp_ros.mechanics.squeeze.fixed_set_kernel import prefer_compiled
+from squeeze_grasp_ros.mechanics.squeeze.fixed_set_kernel import (
+    COMPILED_FROM_EVALUATIONS,
+    prefer_compiled,
+    selected,
+    sweep_route,
+)
 from squeeze_grasp_ros.sweep.engine import dry_run, run_sweep
 from squeeze_grasp_ros.sweep.plan import plan_tasks
 from squeeze_grasp_ros.sweep.spec import SweepError, load_sweep_spec
@@ -24,7 +29,11 @@ EPILOG = ("exit status: 0 every task written (an evaluation that raised is a row
           "or a bad manifest; 4 the sweep extra missing (the install line is printed), or the "
           "disk filled up (the parts written are kept; re-run to resume); 130 stopped by "
           "Ctrl-C (SIGINT), 143 by SIGTERM, at any point from start-up on: finished parts are "
-          "kept, re-run to resume")
+          "kept, re-run to resume. Route: with the fast extra (numba), the local workers of a "
+          f"sweep of at least {COMPILED_FROM_EVALUATIONS:,} evaluations run compiled (the "
+          "first run after an install spends about 85 s of CPU per worker compiling), smaller "
+          "sweeps by numpy; SQUEEZE_GRASP_KERNEL=numba or numpy decides instead; --json "
+          "reports it as kernel")
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -56,8 +65,10 @@ def run(args: argparse.Namespace) -> dict | int:
         raise SweepError("--workers sizes the local cluster; it cannot be used with --scheduler")
     loaded = load_sweep_spec(args.spec)
     if args.dry_run:
-        return {"dry_run": True, "spec": args.spec, "spec_hash": loaded.hash,
-                **dry_run(loaded, workers=args.workers, scheduler=args.scheduler)}
+        estimate = dry_run(loaded, workers=args.workers, scheduler=args.scheduler)
+        return {"dry_run": True, "spec": args.spec, "spec_hash": loaded.hash, **estimate,
+                "sample_kernel": selected().value,
+                "kernel": None if args.scheduler else sweep_route(estimate["evaluations"]).value}
     if not args.out:
         raise SweepError("--out DIR is required (or use --dry-run)")
     # the local workers' route: compiled (numba) for sweeps that repay its compilation
@@ -95,6 +106,10 @@ def summary(result: dict) -> str:
         if "estimate_s" in result:
             lines.append(f"estimated time on {result['workers']} worker(s): "
                          f"{result['estimate_s'] / 60:.1f} min")
+        if result["kernel"] not in (None, result["sample_kernel"]):
+            lines.append(f"the sample ran by {result['sample_kernel']}; the local workers will "
+                         f"run by {result['kernel']} (the first run after an install compiles "
+                         "for about 85 s of CPU per worker, then each evaluation is faster)")
         return "\n".join(lines)
     if result["skipped"] == result["tasks"]:
         return (

@@ -111,20 +111,24 @@ worker's numba start-up costs about 1 s (288 evaluations: 3.7 s on either route)
 run and resume of a sweep takes the same route."""
 
 
-def prefer_compiled(evaluations: int) -> Kernel:
-    """The route of the local workers of a run of ``evaluations`` evaluations.
-
-    With :data:`KERNEL_VARIABLE` unset, numba installed and at least
-    :data:`COMPILED_FROM_EVALUATIONS` evaluations, the variable is set to numba in this
-    process's environment, which the processes it starts (a local Dask cluster's workers)
-    inherit; otherwise it is left as it is (unset: numpy).
-
-    Returns
-    -------
-    Kernel
-        The route the variable now selects.
+def sweep_route(evaluations: int) -> Kernel:
+    """The route of the local workers of a sweep of ``evaluations`` evaluations: the one
+    :data:`KERNEL_VARIABLE` names when it is set; else numba when it is installed and the
+    sweep has at least :data:`COMPILED_FROM_EVALUATIONS` evaluations; else numpy.
     """
-    if (not os.environ.get(KERNEL_VARIABLE, "") and installed("numba")
-            and evaluations >= COMPILED_FROM_EVALUATIONS):
-        os.environ[KERNEL_VARIABLE] = Kernel.NUMBA.value
-    return selected()
+    if os.environ.get(KERNEL_VARIABLE, ""):
+        return selected()
+    if installed("numba") and evaluations >= COMPILED_FROM_EVALUATIONS:
+        return Kernel.NUMBA
+    return Kernel.NUMPY
+
+
+def prefer_compiled(evaluations: int) -> Kernel:
+    """Set :data:`KERNEL_VARIABLE` to numba in this process's environment, which the processes
+    it starts (a local Dask cluster's workers) inherit, when :func:`sweep_route` chooses numba
+    for ``evaluations`` evaluations; the route chosen.
+    """
+    kernel = sweep_route(evaluations)
+    if kernel == Kernel.NUMBA:
+        os.environ.setdefault(KERNEL_VARIABLE, kernel.value)
+    return kernel

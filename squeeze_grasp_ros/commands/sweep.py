@@ -12,13 +12,12 @@ import sys
 
 from squeeze_grasp_ros.exit_codes import ExitCode
 from squeeze_grasp_ros.mechanics.squeeze.fixed_set_kernel import (
+    COMPILE_CPU_S,
     COMPILED_FROM_EVALUATIONS,
-    prefer_compiled,
     selected,
     sweep_route,
 )
 from squeeze_grasp_ros.sweep.engine import dry_run, run_sweep
-from squeeze_grasp_ros.sweep.plan import plan_tasks
 from squeeze_grasp_ros.sweep.spec import SweepError, load_sweep_spec
 
 EPILOG = ("exit status: 0 every task written (an evaluation that raised is a row with its error "
@@ -31,7 +30,8 @@ EPILOG = ("exit status: 0 every task written (an evaluation that raised is a row
           "Ctrl-C (SIGINT), 143 by SIGTERM, at any point from start-up on: finished parts are "
           "kept, re-run to resume. Route: with the fast extra (numba), the local workers of a "
           f"sweep of at least {COMPILED_FROM_EVALUATIONS:,} evaluations run compiled (the "
-          "first run after an install spends about 85 s of CPU per worker compiling), smaller "
+          f"first run after an install spends about {COMPILE_CPU_S} s of CPU per worker "
+          "compiling), smaller "
           "sweeps by numpy; SQUEEZE_GRASP_KERNEL=numba or numpy decides instead; --json "
           "reports it as kernel")
 
@@ -71,14 +71,11 @@ def run(args: argparse.Namespace) -> dict | int:
                 "kernel": None if args.scheduler else sweep_route(estimate["evaluations"]).value}
     if not args.out:
         raise SweepError("--out DIR is required (or use --dry-run)")
-    # the local workers' route: compiled (numba) for sweeps that repay its compilation
-    kernel = prefer_compiled(sum(task.evaluations for task in plan_tasks(loaded)))
     outcome = run_sweep(loaded, args.out, scheduler=args.scheduler, workers=args.workers,
                         progress=not args.no_progress)
     for line in outcome.repaired:
         print(f"squeeze-grasp sweep: {args.out}/{line}", file=sys.stderr)
-    result = {"dry_run": False, "out": args.out, "spec_hash": loaded.hash, **vars(outcome),
-              "kernel": None if args.scheduler else kernel.value}
+    result = {"dry_run": False, "out": args.out, "spec_hash": loaded.hash, **vars(outcome)}
     if outcome.interrupted is not None:
         name = signal.Signals(outcome.interrupted).name
         print(f"squeeze-grasp sweep: stopped by {name}; {outcome.done} task(s) written this run. "
@@ -109,7 +106,8 @@ def summary(result: dict) -> str:
         if result["kernel"] not in (None, result["sample_kernel"]):
             lines.append(f"the sample ran by {result['sample_kernel']}; the local workers will "
                          f"run by {result['kernel']} (the first run after an install compiles "
-                         "for about 85 s of CPU per worker, then each evaluation is faster)")
+                         f"for about {COMPILE_CPU_S} s of CPU per worker, then each evaluation "
+                         "is faster)")
         return "\n".join(lines)
     if result["skipped"] == result["tasks"]:
         return (

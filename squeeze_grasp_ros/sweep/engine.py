@@ -28,6 +28,7 @@ from pathlib import Path
 from typing import Callable, Optional
 
 from squeeze_grasp_ros.extras import install_hint
+from squeeze_grasp_ros.mechanics.squeeze.fixed_set_kernel import prefer_compiled
 from squeeze_grasp_ros.sweep.evaluate import prepare, run_task
 from squeeze_grasp_ros.sweep.plan import Task, plan_tasks
 from squeeze_grasp_ros.sweep.spec import LoadedSpec, SweepError
@@ -113,7 +114,9 @@ class Outcome:
     """What a sweep run did: counts of tasks and evaluations; seconds in all, summed over the
     tasks for preparing groups and evaluating, and until the cluster was ready; the signal
     (SIGINT, SIGTERM) that stopped it, or None; one line per bad part found at the start, moved
-    to ``damaged/`` and redone (:attr:`.store.Store.repaired`).
+    to ``damaged/`` and redone (:attr:`.store.Store.repaired`); the local workers' route
+    (:func:`~.fixed_set_kernel.prefer_compiled`: ``numpy`` or ``numba``; None with a
+    scheduler, whose workers read their own environment).
     """
 
     tasks: int
@@ -130,6 +133,7 @@ class Outcome:
     evaluate_s: float
     startup_s: float = 0.0
     repaired: list = field(default_factory=list)
+    kernel: Optional[str] = None
 
 
 @contextlib.contextmanager
@@ -349,8 +353,10 @@ def run_sweep(loaded: LoadedSpec, out: str | Path, *, scheduler: Optional[str] =
         tasks = plan_tasks(loaded)
         store = Store(out, loaded, tasks)
         todo = [t for t in tasks if not store.done(t.id)]
+        # the local workers inherit the route: compiled for sweeps that repay its compilation
+        kernel = None if scheduler else prefer_compiled(sum(t.evaluations for t in tasks)).value
         outcome = Outcome(len(tasks), len(tasks) - len(todo), 0, 0, 0, 0, 0.0, 0, None, None,
-                          0.0, 0.0, repaired=list(store.repaired))
+                          0.0, 0.0, repaired=list(store.repaired), kernel=kernel)
         client = cluster = None
         try:
             if todo and stop.signal is None:

@@ -101,14 +101,17 @@ def chosen() -> Kernel | None:
     return selected() if os.environ.get(KERNEL_VARIABLE, "") else None
 
 
+COMPILE_CPU_S = 85
+"""Seconds of CPU a process spends compiling the kernels on first use after an install or an
+upgrade (measured on a 2-core machine, 2026-11-28: 84.9 s in a 500-node squeeze)."""
 COMPILED_FROM_EVALUATIONS = 25_000
 """The sweeps whose local workers :func:`prefer_compiled` sends by the compiled route: at least
 this many evaluations. Measured on a 2-core machine (2026-11-28): compiling the kernels after an
-install takes about 85 s of CPU in each worker; compiled, an evaluation of the example sweep's
-kind saves about 6 ms of CPU (2,496 evaluations on 2 workers: 10.2 against 18.2 s), and a
-worker's numba start-up costs about 1 s (288 evaluations: 3.7 s on either route). About
-25,000 evaluations on two workers repay a compilation; the rule reads the spec alone, so every
-run and resume of a sweep takes the same route."""
+install takes about :data:`COMPILE_CPU_S` of CPU in each worker; compiled, an evaluation of the
+example sweep's kind saves about 6 ms of CPU (2,496 evaluations on 2 workers: 10.2 against
+18.2 s), and a worker's numba start-up costs about 1 s (288 evaluations: 3.7 s on either
+route). About 25,000 evaluations on two workers repay a compilation; the rule reads the spec
+alone, so every run and resume of a sweep takes the same route."""
 
 
 def sweep_route(evaluations: int) -> Kernel:
@@ -116,8 +119,9 @@ def sweep_route(evaluations: int) -> Kernel:
     :data:`KERNEL_VARIABLE` names when it is set; else numba when it is installed and the
     sweep has at least :data:`COMPILED_FROM_EVALUATIONS` evaluations; else numpy.
     """
-    if os.environ.get(KERNEL_VARIABLE, ""):
-        return selected()
+    kernel = chosen()
+    if kernel is not None:
+        return kernel
     if installed("numba") and evaluations >= COMPILED_FROM_EVALUATIONS:
         return Kernel.NUMBA
     return Kernel.NUMPY

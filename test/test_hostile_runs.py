@@ -464,6 +464,30 @@ def test_a_lagging_recorder_process_records_every_message_or_says_which_are_miss
     assert run["outcome"] == "grasp held"
 
 
+def burst(tmp_path: Path, code: str, signals: tuple, env: dict | None = None) -> list[str]:
+    """In five trials: start ``code`` (it prints "ready", then waits for the file named by its
+    argument), send it 3,000 of ``signals`` in turn as fast as they can be sent, create the
+    file; its exit status must be 0 within 30 s. The lines it printed after "ready", by trial.
+    """
+    printed = []
+    for trial in range(5):
+        go = tmp_path / f"go{trial}"
+        child = subprocess.Popen([sys.executable, "-c", code, str(go)], env=env,
+                                 stdout=subprocess.PIPE, text=True, stdin=subprocess.DEVNULL)
+        try:
+            assert child.stdout.readline().strip() == "ready"
+            for k in range(3000):
+                os.kill(child.pid, signals[k % len(signals)])
+            go.touch()
+            assert child.wait(timeout=30) == 0, f"trial {trial}"
+            printed.append(child.stdout.read().strip())
+        finally:
+            if child.poll() is None:
+                child.kill()
+                child.wait()
+    return printed
+
+
 BURST_CHILD = """
 import os, sys, time
 from squeeze_grasp_ros.exit_codes import SignalFlag
@@ -488,21 +512,7 @@ def test_a_burst_of_parent_death_signals_cannot_hang_a_node(tmp_path):
     from squeeze_grasp_ros.ros.nodes import PARENT_DEATH_SIGNAL, PARENT_PID_ENV
 
     env = {**os.environ, PARENT_PID_ENV: str(os.getpid())}
-    for trial in range(5):
-        go = tmp_path / f"go{trial}"
-        child = subprocess.Popen([sys.executable, "-c", BURST_CHILD, str(go)], env=env,
-                                 stdout=subprocess.PIPE, text=True, stdin=subprocess.DEVNULL)
-        try:
-            assert child.stdout.readline().strip() == "ready"
-            for _ in range(3000):
-                os.kill(child.pid, PARENT_DEATH_SIGNAL)
-            go.touch()
-            assert child.wait(timeout=30) == 0, f"trial {trial}"
-            assert child.stdout.read().strip() == "stopped"
-        finally:
-            if child.poll() is None:
-                child.kill()
-                child.wait()
+    assert burst(tmp_path, BURST_CHILD, (PARENT_DEATH_SIGNAL,), env) == ["stopped"] * 5
 
 
 SWEEP_BURST_CHILD = """
@@ -523,19 +533,6 @@ def test_a_burst_of_ctrl_c_and_sigterm_cannot_hang_a_sweep(tmp_path):
     3,000 SIGINT and SIGTERM, alternating, as fast as they can be sent, still stops, in every
     trial, and reports a stop signal.
     """
-    for trial in range(5):
-        go = tmp_path / f"go{trial}"
-        child = subprocess.Popen([sys.executable, "-c", SWEEP_BURST_CHILD, str(go)],
-                                 stdout=subprocess.PIPE, text=True, stdin=subprocess.DEVNULL)
-        try:
-            assert child.stdout.readline().strip() == "ready"
-            for k in range(3000):
-                os.kill(child.pid, (signal.SIGINT, signal.SIGTERM)[k % 2])
-            go.touch()
-            assert child.wait(timeout=30) == 0, f"trial {trial}"
-            assert child.stdout.read().strip() in {f"stopped by {int(signal.SIGINT)}",
-                                                   f"stopped by {int(signal.SIGTERM)}"}
-        finally:
-            if child.poll() is None:
-                child.kill()
-                child.wait()
+    printed = burst(tmp_path, SWEEP_BURST_CHILD, (signal.SIGINT, signal.SIGTERM))
+    assert set(printed) <= {f"stopped by {int(signal.SIGINT)}",
+                            f"stopped by {int(signal.SIGTERM)}"}

@@ -80,10 +80,12 @@ from squeeze_grasp_ros.mechanics.squeeze.graspmap import GraspMap, grasp_map
 from squeeze_grasp_ros.mechanics.squeeze.stable_pure import Squeeze, plan_squeeze
 from squeeze_grasp_ros.mechanics.vocabulary import (
                                                                    ContactMode,
+                                                                   Effect,
                                                                    EventType,
                                                                    Finger,
                                                                    ImageEncoding,
                                                                    MaterialModel,
+                                                                   RingLimit,
                                                                    ShapeFit,
                                                                    SqueezeKind,
                                                                    StrainCriterion,
@@ -127,7 +129,8 @@ __all__ = [
     "ObjectOutline", "extract_outline", "ShapeMatch", "deformed_outline", "shape_residual",
     # vocabulary
     "Finger", "EventType", "ContactMode", "Termination", "SqueezeKind", "StrainCriterion",
-    "MaterialModel", "StrainMeasure", "StressMeasure", "ImageEncoding", "ShapeFit",
+    "MaterialModel", "StrainMeasure", "StressMeasure", "ImageEncoding", "ShapeFit", "Effect",
+    "RingLimit",
     # errors
     "SqueezeGraspError", "InvalidInputError", "InfeasibleError", "NumericalError",
     "InternalError",

@@ -90,3 +90,19 @@ def test_the_readme_example_runs_and_imports_only_the_front_door(capsys):
     exec(compile(code, "README.md", "exec"), {})
     printed = capsys.readouterr().out.splitlines()
     assert printed and all(line.split()[0] in "ABCD" for line in printed)
+
+
+def test_the_readme_names_only_enums_the_front_door_exports():
+    """The README's Python API section names the domain enums as importable from the API,
+    including the codes (effects, ring limits) that a scene or ``ring_grasp`` hands back.
+    """
+    from pathlib import Path
+
+    readme = (Path(__file__).resolve().parents[1] / "README.md").read_text(encoding="utf-8")
+    section = readme[readme.index("## Python API"):readme.index("## The CLI")]
+    sentence = section[section.index("The domain words are enums"):]
+    named = re.findall(r"`([A-Z][A-Za-z]+)`", sentence[:sentence.index("...")])
+    assert {"Finger", "Effect"} <= set(named)
+    assert [name for name in named if name not in api.__all__] == []
+    from squeeze_grasp_ros.mechanics.vocabulary import Effect, RingLimit
+    assert api.Effect is Effect and api.RingLimit is RingLimit

@@ -96,6 +96,7 @@ def test_pickup_scene_stops_when_friction_carries_the_weight():
     w, mu = loaded.scene.pickup.weight, loaded.scene.mu
     assert res.termination == "picked_up"
     assert res.depth < res.target_depth
+    assert round(100 * res.relative_depth, 3) == 4.154  # docs/events.md, "Scenes"
     supply = {name: sum(np.sqrt(max(mu ** 2 * s.normal_force ** 2 - s.tangential_force ** 2, 0))
                         for s in seg if s.mode == "stick")
               for name, seg in res.segments.items()}
@@ -186,3 +187,18 @@ def test_squeeze_verb_reference_mode_and_errors(capsys):
     assert out["reference"] and out["step"] == 1e-3 and out["event_counts"]["A"] >= 1
     assert cli.main(["squeeze", str(SCENES / "foam_square.yaml"), "--event-tol", "-1"]) == 2
     assert "event_tol" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize(("model", "percent", "measure"), [("linear", 2.720, "small"),
+                                                           ("corotational", 2.748, "biot"),
+                                                           ("neo_hookean", 2.601, "log")])
+def test_strain_limit_scene_stops_where_the_docs_say_on_each_models_own_strain(model, percent,
+                                                                               measure):
+    """docs/events.md, "Scenes": epsilon* = 0.1 stops the foam square at 2.720 % (linear),
+    2.748 % (corotational) and 2.601 % (neo-Hookean), each on its own strain measure.
+    """
+    setup = GraspSetup.build(load_scene(SCENES / "foam_square_strain_limit.yaml")).precompute()
+    res = setup.event_squeeze(material_model=model)
+    assert res.termination == "strain_limit"
+    assert round(100 * res.relative_depth, 3) == percent
+    assert res.to_json()["health"]["strain_measure"] == measure

@@ -360,3 +360,15 @@ def test_bad_tips_name_the_field(finger, message):
 
     with pytest.raises(SceneError, match=message):
         block_scene(**finger)
+
+
+def test_the_squeeze_verb_says_it_takes_flat_pads(capsys):
+    """``squeeze`` runs pad scenes (``sponge_gripper.yaml``); its help must not say rounded
+    fingertips only.
+    """
+    from squeeze_grasp_ros.cli import main
+
+    with pytest.raises(SystemExit):
+        main(["squeeze", "--help"])
+    text = " ".join(capsys.readouterr().out.split())
+    assert "rounded fingertips or flat pads" in text

@@ -13,8 +13,8 @@ VERBS: dict[str, str] = {
     "mesh": "triangulate the scene's object (nodes, triangles, boundary loop, material)",
     "plan": "stable and pure squeezes at the scene's finger placements (point contacts, "
             "Sec. 3-4)",
-    "squeeze": "event-driven squeeze with rounded fingertips under Coulomb friction (Sec. 5, "
-               "Algorithm 1)",
+    "squeeze": "event-driven squeeze with rounded fingertips or flat pads under Coulomb "
+               "friction (Sec. 5, Algorithm 1)",
     "match": "least-squares scale/rotation/translation of measured onto simulated points "
              "(App. C)",
     "calibrate": "Young's modulus, Poisson's ratio from cuboid compressions; mu from the slope "

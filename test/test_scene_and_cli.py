@@ -244,3 +244,46 @@ def test_every_range_the_help_prints_is_the_range_the_check_keeps():
     assert {("SqueezeSpec", "relative_depth"), ("SweepSpec", "relative_depth")} <= names
     assert all(field.metadata["hi_open"] for _, field in bounded if field.name == "relative_depth")
     assert len(bounded) >= 10
+
+
+def test_the_defaults_the_help_prints_are_what_a_scene_without_the_key_gets():
+    """``scene-help`` prints each optional key's default: the foam square's scene, which sets
+    none of the squeeze's numerical keys, with a camera, sensors, pickup, strain limit and
+    adversary given only their required keys, holds exactly the printed values.
+    """
+    import re
+
+    from squeeze_grasp_ros.scene.help import scene_help
+
+    printed = {}
+    for line in scene_help().splitlines():
+        found = re.search(r"default ([^,\]]+)\]$", line)
+        if found:
+            printed[line.split()[0]] = found.group(1)
+    raw = yaml.safe_load(FOAM.read_text())
+    assert not {"step", "event_tol", "max_events_per_depth"} & set(raw["squeeze"])
+    raw.update({"camera": {}, "sensors": {"noise_std": 0.001, "seed": 1},
+                "pickup": {"weight": 1.0}, "strain_limit": {"epsilon": 0.1},
+                "adversary": {"placement": {"angle_deg": 90}, "a": [0.0, -0.01]}})
+    raw["effects"] += ["camera", "sensor_noise", "pickup", "strain_limit", "adversary"]
+    scene = parse_scene(raw, FOAM.parent)
+    compared = set()
+    for path, text in printed.items():
+        value = scene
+        for part in path.replace("F1|F2", "F1").split("."):
+            value = value.get(part) if isinstance(value, dict) else getattr(value, part, None)
+            if value is None:
+                break
+        if value is None or path.endswith("tip_radius") or path == "object.mesh.min_angle":
+            continue  # a section the foam square leaves out, or a key it sets
+        if isinstance(value, (bool, int, float)) and not isinstance(value, str):
+            assert value == (text == "true" if isinstance(value, bool) else float(text)), path
+        else:
+            assert str(value) == text, path
+        compared.add(path)
+    assert {"squeeze.step", "squeeze.event_tol", "squeeze.max_events_per_depth", "squeeze.type",
+            "object.model", "object.material.model", "camera.fx", "camera.frame_id",
+            "camera.plan_from_images", "sensors.taxels", "pickup.lift_after",
+            "strain_limit.criterion", "adversary.contacts"} <= compared, compared
+    assert len(compared) >= 25
+    assert (printed["squeeze.step"], printed["squeeze.event_tol"]) == ("0.001", "1e-09")

@@ -40,8 +40,8 @@ VERBS: dict[str, str] = {
              "x placements) on Dask into a Parquet dataset; re-run to resume",
     "sweep_report": "summarise a sweep directory: success rate by object and material, quality "
                     "distributions, best placements per object; --plot writes pictures",
-    "scene_help": "list every scene key, unit, range, shape type and effect",
-    "sweep_help": "list every sweep-spec key, unit, range and shape family",
+    "scene_help": "list every scene key, unit, range, default, shape type and effect",
+    "sweep_help": "list every sweep-spec key, unit, range, default and shape family",
     "ros_setup": "build the ROS 2 interface package (msg_defs/) into the active virtual "
                  "environment",
 }

@@ -1,6 +1,6 @@
 # Copyright 2026 squeeze_grasp_ros developers
 # SPDX-License-Identifier: Apache-2.0
-"""``squeeze-grasp scene-help``: every scene key with its unit and allowed range."""
+"""``squeeze-grasp scene-help``: every scene key with its unit, allowed range and default."""
 from __future__ import annotations
 
 import argparse

@@ -1,6 +1,6 @@
 # Copyright 2026 squeeze_grasp_ros developers
 # SPDX-License-Identifier: Apache-2.0
-"""``squeeze-grasp scene-help``: every scene key, unit and range, shape type and effect."""
+"""``squeeze-grasp scene-help``: every scene key (unit, range, default), shape type and effect."""
 
 from __future__ import annotations
 

@@ -219,10 +219,28 @@ def parse_section(cls: type, data: Any, where: str, *,
     return cls(**kwargs)
 
 
+def _default(value: Any) -> str:
+    """``default X`` for a field's scalar default as YAML writes it (an enum by its value, a
+    bool as true/false, a number as :func:`_number`), "" for none, None, "" or a section.
+
+    >>> _default(1e-3), _default(4), _default(False), _default(None), _default("")
+    ('default 0.001', 'default 4', 'default false', '', '')
+    """
+    if isinstance(value, Enum):
+        value = value.value
+    if isinstance(value, bool):
+        return f"default {str(value).lower()}"
+    if isinstance(value, (int, float)):
+        return f"default {value if isinstance(value, int) else _number(value)}"
+    if isinstance(value, str) and value:
+        return f"default {value}"
+    return ""
+
+
 def key_reference(
     cls: type, prefix: str = "", width: int = 38, nested: dict[str, tuple[type, str]] | None = None
 ) -> list[str]:
-    """One line per key of dataclass ``cls`` (and its sections): path, doc, unit, range.
+    """One line per key of dataclass ``cls`` (and its sections): path, doc, unit, range, default.
 
     Lists of sections (``tuple[Section, ...]``) are shown as ``key[]``; ``nested`` maps a key
     path to (section class, prefix) for mappings whose values are sections.
@@ -249,7 +267,7 @@ def key_reference(
                 meta.get("unit"),
                 describe_range(dict(meta)) if ranged else "",
                 "one of " + "/".join(choices) if choices else "",
-                "required" if req else "",
+                "required" if req else _default(f.default),
             )
             if x
         ]

@@ -39,7 +39,7 @@ from launch_ros.actions import Node
 from launch_ros.substitutions import ExecutableInPackage
 
 from squeeze_grasp_ros.resources import config_dir, scene_file, viewer_file
-from squeeze_grasp_ros.ros.run.options import RunOptions, node_parameters
+from squeeze_grasp_ros.ros.run.options import RunOptions, node_parameters, without_run
 from squeeze_grasp_ros.scene import GraspSetup, load_scene
 
 TRUE = ("true", "1", "yes", "on")
@@ -66,6 +66,9 @@ def nodes(context, *args, **kwargs):
     setup = GraspSetup.build(load_scene(scene_path))
     options = RunOptions(scene_path, record=record or None, include_hidden_topics=hidden)
     params = node_parameters(setup.scene, scene_path, options, setup.motion.relative_per_depth)
+    run = LaunchConfiguration("run").perform(context).lower() in TRUE
+    if not run:  # no run latches the prediction: a node awaiting it would never start the loop
+        params = without_run(params)
     if not record:
         del params["recorder"]
     roots = [str(Path(scene_path).resolve().parent), str(config_dir().parent), str(Path.cwd())]
@@ -79,7 +82,7 @@ def nodes(context, *args, **kwargs):
     for name, values in params.items():
         actions.append(Node(package="squeeze_grasp_ros", executable=name, name=name,
                             parameters=[values], output="screen", **placed))
-    if LaunchConfiguration("run").perform(context).lower() in TRUE:
+    if run:
         given = {name: LaunchConfiguration(name).perform(context)
                  for name in ("on_slip_alarm", "max_attempts", "resqueeze_margin")}
         reaction = [f"--{name.replace('_', '-')}={value}"

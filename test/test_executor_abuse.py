@@ -132,6 +132,8 @@ GARBAGE = [
     ("depth", {"depth": math.nan}),
     ("depth", {"depth": math.inf}),
     ("depth", {"depth": -1e-3}),
+    ("relative_per_depth", {"relative_per_depth": math.nan}),
+    ("relative_per_depth", {"relative_per_depth": -14.1}),
     ("fingers", {"fingers": []}),
     ("fingers", {"fingers": ["F1", "F1"]}),
     ("finger", {"fingers": ["F1", "F9"]}),

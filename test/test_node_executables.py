@@ -27,6 +27,21 @@ def test_a_missing_required_parameter_is_one_line_and_exit_2(node, parameter):
     assert f"-p {parameter}:=" in lines[0]
 
 
+@pytest.mark.parametrize("value, message", [
+    ("-1.0", "mu must be a finite number >= 0 (0: no friction), got -1.0"),
+    ("abc", "parameter 'mu' must be a number, got 'abc'"),
+])
+def test_a_bad_friction_coefficient_is_one_line_naming_it_and_exit_2(value, message):
+    """``hardware.launch.py mu:=-1`` started a monitor with mu -1.0; ``mu:=abc`` ended it with
+    "could not convert string to float: 'abc'", naming no parameter.
+    """
+    done = subprocess.run([script("monitor"), "--ros-args", "-p", f"mu:={value}"],
+                          capture_output=True, text=True, timeout=120, stdin=subprocess.DEVNULL)
+    assert done.returncode == 2
+    lines = done.stderr.strip().splitlines()
+    assert lines == [f"monitor: error: {message}"], lines
+
+
 def test_ros_args_rcl_cannot_parse_are_one_error_line_and_exit_2():
     # an unquoted YAML list whose items hold a colon, as a user types it after -p
     done = subprocess.run([script("monitor"), "--ros-args", "-p",

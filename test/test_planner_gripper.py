@@ -65,6 +65,8 @@ def test_plan_gripper_grasp_service_equals_the_mechanics(planner: Harness) -> No
     ({"relative_closing": 1.5}, "relative_closing must be in [0.0, 1.0]"),
     ({"mu": float("nan")}, "mu must be finite"),
     ({"evaluate": 9}, "evaluate must be in [0, count=5]"),
+    ({"force_margin": 0.5, "evaluate": 0}, "force_margin must be >= 1 (0: 1.25), got 0.5"),
+    ({"force_margin": 0.5}, "force_margin must be >= 1"),
     ({"object_id": "missing"}, "missing"),
 ])
 def test_bad_gripper_requests_get_the_reason(planner: Harness, fields, message) -> None:
@@ -73,6 +75,14 @@ def test_bad_gripper_requests_get_the_reason(planner: Harness, fields, message) 
     assert not response.success
     assert message in response.message
     assert response.error_code in (ErrorCode.INVALID_ARGUMENT, ErrorCode.UNKNOWN_OBJECT)
+
+
+def test_a_count_out_of_range_is_named_as_the_requests_field(planner: Harness) -> None:
+    """Before, ``count`` was refused as "best_count must be ...", a field this service lacks."""
+    planner.load(SPONGE)
+    response = planner.call(PlanGripperGrasp, "plan_gripper_grasp", request(count=2**31 - 1))
+    assert (response.success, response.error_code) == (False, ErrorCode.INVALID_ARGUMENT)
+    assert response.message == "count must be in [0, 100000], got 2147483647"
 
 
 def test_a_gripper_too_small_is_not_feasible(planner: Harness) -> None:

@@ -188,6 +188,8 @@ def goal_problem(goal: GraspGoal, known: Sequence[str]) -> str | None:
         return "directions are all zero"
     if not (np.isfinite(goal.depth) and goal.depth >= 0):
         return f"depth must be finite and >= 0, got {goal.depth}"
+    if not (np.isfinite(goal.relative_per_depth) and goal.relative_per_depth >= 0):
+        return f"relative_per_depth must be finite and >= 0 (1/m), got {goal.relative_per_depth}"
     if goal.on_slip_alarm not in REACTIONS:
         return f"on_slip_alarm must be one of {REACTIONS}, got {shown(goal.on_slip_alarm)}"
     if goal.on_slip_alarm == SqueezeKind.PURE and (

@@ -36,9 +36,11 @@ def check_step(step: float, limits: PlannerLimits) -> float:
     return step
 
 
-def best_count(requested: int, limits: PlannerLimits) -> int:
-    """Placements a map returns: ``requested`` in [1, MAX_BEST_COUNT], or the default for 0."""
-    return int(check_number("best_count", requested, 0, MAX_BEST_COUNT)) or limits.best_count
+def best_count(requested: int, limits: PlannerLimits, name: str = "best_count") -> int:
+    """Placements a map returns: ``requested`` in [1, MAX_BEST_COUNT], or the default for 0;
+    ``name`` is the request's field in the error.
+    """
+    return int(check_number(name, requested, 0, MAX_BEST_COUNT)) or limits.best_count
 
 
 def choice(name: str, value: str, allowed: Sequence[str], default: str | None = None) -> str:

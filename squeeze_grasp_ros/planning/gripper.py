@@ -53,10 +53,13 @@ def gripper_grasp_plan(loaded: LoadedObject, gripper: GripperSpec, *, mu: float,
     its cached grasp map at ``mu``, the request's zeros meaning "none" / "default" as the
     service documents.
     """
-    count = best_count(count, limits)
+    count = best_count(count, limits, "count")
     if not 0 <= evaluate <= count:
         raise invalid(f"evaluate must be in [0, count={count}], got {evaluate}")
     mu = check_number("mu", mu, 0.0)
+    margin = check_number("force_margin", force_margin, 0.0) or DEFAULT_MARGIN
+    if margin < 1.0:  # checked here, not only when a candidate is evaluated
+        raise invalid(f"force_margin must be >= 1 (0: {DEFAULT_MARGIN:g}), got {force_margin}")
     return plan_gripper_grasp(
         loaded.solid(), gripper, mu, gmap=loaded.grasp_map(mu),
         relative_closing=check_number("relative_closing", relative_closing, 0.0, 1.0),
@@ -64,6 +67,6 @@ def gripper_grasp_plan(loaded: LoadedObject, gripper: GripperSpec, *, mu: float,
         yaw_range=None if yaw_range is None else tuple(
             check_number(name, v) for name, v in zip(("yaw_min", "yaw_max"), yaw_range)),
         weight=check_number("weight", weight, 0.0) or None,
-        margin=check_number("force_margin", force_margin, 0.0) or DEFAULT_MARGIN,
+        margin=margin,
         strain_limit=check_number("strain_limit", strain_limit, 0.0) or None,
         material_model=loaded.scene.object.material.model)

@@ -178,6 +178,9 @@ class MonitorNode(Node):
         super().__init__("monitor", **kwargs)
         self.p = p = pipeline.declare(self, PARAMETERS)
         self.fingers = pipeline.parse_mapping(p["finger_devices"], "finger_devices")
+        if not (np.isfinite(p["mu"]) and p["mu"] >= 0.0):
+            raise ParameterError(f"mu must be a finite number >= 0 (0: no friction), got "
+                                 f"{p['mu']}")
         if not (np.isfinite(p["weight"]) and p["weight"] >= 0.0):
             raise ParameterError(f"weight must be a finite number >= 0 N (0: no pickup test), "
                                  f"got {p['weight']}")

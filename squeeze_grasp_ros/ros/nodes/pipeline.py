@@ -37,6 +37,9 @@ from rclpy.qos import (
 from rclpy.serialization import deserialize_message, serialize_message
 from std_msgs.msg import String
 
+from squeeze_grasp_ros.inputs import shown
+from squeeze_grasp_ros.ros.nodes import ParameterError
+
 rcl_time_point = rclpy_implementation.rcl_time_point_t
 """rclpy's time point type (what ``rclpy.time.Time`` wraps)."""
 
@@ -292,7 +295,14 @@ def declare(node: Node, parameters: Mapping[str, tuple[Any, str]]) -> dict[str, 
             values[name] = node.get_parameter_or(name, Parameter(name, value=None)).value
             continue
         value = node.get_parameter(name).value
-        values[name] = float(value) if isinstance(default, float) else value
+        if isinstance(default, float):
+            # dynamic typing lets any type through: a string must not end in a bare
+            # "could not convert string to float" that names no parameter
+            if isinstance(value, bool) or not isinstance(value, (int, float)):
+                raise ParameterError(f"parameter '{name}' must be a number, got "
+                                     f"{shown(str(value))}")
+            value = float(value)
+        values[name] = value
     return values
 
 

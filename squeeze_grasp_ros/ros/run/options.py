@@ -24,7 +24,7 @@ from squeeze_grasp_ros.scene import Scene, finger_devices
 from squeeze_grasp_ros.scene.specs import ControllerSpec
 
 __all__ = ["EXECUTORS", "NODES", "PLANNER_MODULE", "RunError", "RunOptions", "config_parameters",
-           "node_parameters"]
+           "node_parameters", "without_run"]
 
 NODES: tuple[str, ...] = ("sim_hardware", "monitor", "executor", "recorder")
 EXECUTORS: tuple[str, ...] = ("events", "single")
@@ -164,6 +164,20 @@ def node_parameters(
     custom["monitor_parameters"] = yaml.safe_dump(params["monitor"], sort_keys=True)
     params["recorder"]["custom_data"] = yaml.safe_dump(custom)
     return params
+
+
+def without_run(params: dict[str, dict[str, Any]]) -> dict[str, dict[str, Any]]:
+    """``params`` (of :func:`node_parameters`) for nodes that no run drives
+    (``sim_pipeline.launch.py run:=false``): nobody latches ``planner/predicted_events``, so no
+    node awaits it. A monitor or executor awaiting it is never lockstep-ready, the simulated
+    hardware never starts tick 0, and every goal sent to the executor is accepted and then
+    waits for ever (no feedback, no result).
+    """
+    out = {name: dict(values) for name, values in params.items()}
+    for name in ("monitor", "executor"):
+        if name in out:
+            out[name]["await_prediction"] = False
+    return out
 
 
 LIFT_WATCH = 0.02

@@ -195,6 +195,29 @@ def test_a_goal_canceled_before_any_status_ends_at_once(ros_context, lockstep):
         rig.close()
 
 
+def test_a_goal_canceled_before_its_execution_starts_ends_at_once(ros_context):
+    """The execution of an accepted goal is a later rclpy task, so a cancel can be taken
+    before it starts, when the executor has no goal to end yet. Here the execution is held
+    back until the cancel was accepted (the action server's accepted callback defers it): in
+    lockstep with no monitor status, the goal waited for ever; now it ends ``canceled``.
+    """
+    rig = Rig(ros_context, clients=1, lockstep=True, stale_budget=60.0)
+    held = []
+    rig.node.server.register_handle_accepted_callback(held.append)
+    try:
+        future = rig.clients[0].send_goal_async(squeeze())
+        assert rig.until(lambda: future.done() and held) and future.result().accepted
+        cancel = future.result().cancel_goal_async()
+        assert rig.until(cancel.done) and rig.node.goal is None
+        result = future.result().get_result_async()
+        held[0].execute()
+        assert rig.until(result.done, seconds=10.0), "the canceled goal never ended"
+        assert result.result().result.termination == ExecuteGrasp.Result.CANCELED
+        assert "nothing was commanded" in result.result().result.message
+    finally:
+        rig.close()
+
+
 def test_a_hardware_goal_without_any_monitor_status_ends_after_the_stale_budget(ros_context):
     """Hardware mode (wall-clock cycles), no monitor at all: before, the goal waited for ever;
     now it ends ``stale_data`` after ``stale_budget`` s, naming the topic it waited for.

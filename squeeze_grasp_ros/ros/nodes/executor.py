@@ -229,10 +229,13 @@ class ExecutorNode(Node):
         """
         goal = self.goal
         if goal is not None and goal.handle is handle and goal.start_ns is None:
-            self._end_unstarted(goal, ExecuteGrasp.Result.CANCELED,
-                                "canceled before its first control cycle; nothing was "
-                                "commanded")
+            self._cancel_unstarted(goal)
         return CancelResponse.ACCEPT
+
+    def _cancel_unstarted(self, goal: _Goal) -> None:
+        """End ``goal``, canceled before its first control cycle."""
+        self._end_unstarted(goal, ExecuteGrasp.Result.CANCELED,
+                            "canceled before its first control cycle; nothing was commanded")
 
     def _end_unstarted(self, goal: _Goal, termination: str, message: str) -> None:
         """End ``goal``, which has commanded nothing, with ``termination``."""
@@ -257,7 +260,9 @@ class ExecutorNode(Node):
             return messages.invalid_goal_result(problem)
         self.goal = _Goal(GraspProgram(goal, self.limits, list(self.devices)), handle)
         done = self.goal.done
-        if self.p["lockstep"] and self.latest is not None and \
+        if handle.is_cancel_requested:  # taken before this task ran: _accept_cancel saw no goal
+            self._cancel_unstarted(self.goal)
+        elif self.p["lockstep"] and self.latest is not None and \
                 messages.cdr_stamp_ns(self.latest) > self.answered.stamp_ns:
             self._cycle(self.latest)
         result = await done

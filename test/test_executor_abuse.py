@@ -134,6 +134,8 @@ GARBAGE = [
     ("depth", {"depth": -1e-3}),
     ("relative_per_depth", {"relative_per_depth": math.nan}),
     ("relative_per_depth", {"relative_per_depth": -14.1}),
+    ("depth", {"depth": 1.0, "relative_per_depth": 14.1421}),
+    ("depth", {"depth": 0.0708, "relative_per_depth": 14.1421}),
     ("fingers", {"fingers": []}),
     ("fingers", {"fingers": ["F1", "F1"]}),
     ("finger", {"fingers": ["F1", "F9"]}),

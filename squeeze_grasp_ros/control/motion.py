@@ -72,6 +72,7 @@ from typing import NamedTuple
 import numpy as np
 
 from squeeze_grasp_ros.inputs import shown
+from squeeze_grasp_ros.mechanics.errors import InvalidInputError, require_relative_depth
 from squeeze_grasp_ros.mechanics.vocabulary import AlarmType, Finger, SqueezeKind, Termination
 
 RESQUEEZE = "resqueeze"
@@ -190,6 +191,10 @@ def goal_problem(goal: GraspGoal, known: Sequence[str]) -> str | None:
         return f"depth must be finite and >= 0, got {goal.depth}"
     if not (np.isfinite(goal.relative_per_depth) and goal.relative_per_depth >= 0):
         return f"relative_per_depth must be finite and >= 0 (1/m), got {goal.relative_per_depth}"
+    try:  # the fingers would meet or cross (0: the goal gives no finger distance to check)
+        require_relative_depth(goal.depth * goal.relative_per_depth, goal.depth)
+    except InvalidInputError as exc:
+        return str(exc)
     if goal.on_slip_alarm not in REACTIONS:
         return f"on_slip_alarm must be one of {REACTIONS}, got {shown(goal.on_slip_alarm)}"
     if goal.on_slip_alarm == SqueezeKind.PURE and (

@@ -318,3 +318,30 @@ def test_an_events_fields_have_one_type_whatever_the_route_computed_them_with():
         int, float, float, int]
     assert repr(given) == repr(plain) and given == plain
     assert (given.type, given.finger) == (EventType.D, Finger.F2)
+
+
+@pytest.mark.parametrize("args, overrides, message", [
+    ((0.02, 0.4), {"material_model": "rubber"},
+     r"material_model must be one of linear, corotational, neo_hookean, got 'rubber'"),
+    (({"F1": 0.02}, 0.4), {}, r"tip gives no fingertip for F2"),
+    ((0.02, 0.4), {"relative_depth": -0.1}, r"relative depth must be in \[0, 1\).*got -0.1"),
+], ids=["material_model", "tip_mapping", "relative_depth"])
+def test_bad_arguments_of_event_squeeze_name_the_argument(args, overrides, message):
+    """Each used to escape as ValueError, KeyError, or an error about ``depth`` in metres."""
+    from squeeze_grasp_ros.mechanics.errors import InvalidInputError
+
+    obj, contacts = symmetric_square()
+    kwargs = {"relative_depth": 0.02, **overrides}
+    with pytest.raises(InvalidInputError, match=message):
+        event_squeeze(obj, contacts, *args, **kwargs)
+
+
+@pytest.mark.parametrize("count", [1, 3])
+def test_event_squeeze_takes_exactly_two_contacts(count):
+    """A third node used to be dropped silently (and one node squeezed F1 alone)."""
+    from squeeze_grasp_ros.mechanics.errors import InvalidInputError
+
+    obj, contacts = symmetric_square()
+    nodes = (tuple(contacts) + (int(obj.mesh.boundary[3]),))[:count]
+    with pytest.raises(InvalidInputError, match=f"contacts must be 2 nodes .F1, F2., got {count}"):
+        event_squeeze(obj, nodes, 0.02, 0.4, relative_depth=0.02)

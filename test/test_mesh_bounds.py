@@ -135,6 +135,13 @@ def test_triangle_stops_at_the_node_limit_and_the_mesh_is_refused():
     assert generate_mesh(outline, area).n > 700
 
 
+@pytest.mark.parametrize("max_nodes", [0, 2, -5, 10.5, True])
+def test_a_node_limit_that_is_no_count_is_refused(max_nodes):
+    """A limit of 0 used to divide by zero (ZeroDivisionError) before any check."""
+    with pytest.raises(InvalidInputError, match=r"mesh.max_nodes must be an integer >= 3"):
+        generate_mesh(shapes.rectangle(0.1, 0.05), 1e-4, max_nodes=max_nodes)
+
+
 def test_a_long_boundary_is_refused_by_its_node_count():
     outline = shapes.rectangle(1.0, 0.01)
     area = target_max_area(outline, 200_000)

@@ -590,8 +590,17 @@ def event_squeeze(
     """
     if (depth is None) == (relative_depth is None):
         raise InvalidInputError("give exactly one of depth (m) and relative_depth")
+    if relative_depth is not None:
+        require_relative_depth(relative_depth)
     names = SQUEEZING_FINGERS
+    contacts = tuple(contacts)
+    if len(contacts) != len(names):
+        raise InvalidInputError(f"contacts must be {len(names)} nodes (F1, F2), got "
+                                f"{len(contacts)}")
     shapes = dict(tip) if isinstance(tip, Mapping) else dict.fromkeys(names, tip)
+    missing = [str(n) for n in names if n not in shapes]
+    if missing:
+        raise InvalidInputError(f"tip gives no fingertip for {', '.join(missing)}")
     facing, origins = dict(facing or {}), dict(origins or {})
     tips = [place_fingertip(obj.mesh, n, int(c), shapes[n], facing.get(n), origins.get(n))
             for n, c in zip(names, contacts)]

@@ -113,7 +113,11 @@ def deformed_outline(mesh: Mesh, displacement: np.ndarray) -> Outline:
     >>> print(f"{stretched.area / deformed_outline(mesh, 0 * mesh.nodes).area:.4f}")
     1.0201
     """
-    moved = mesh.nodes + np.asarray(displacement, float).reshape(-1, 2)
+    displacement = np.asarray(displacement, float)
+    if displacement.size != mesh.nodes.size:
+        raise InvalidInputError(f"displacement must be (n, 2) with n = {mesh.n} nodes (or its "
+                                f"{2 * mesh.n} entries flat), got shape {displacement.shape}")
+    moved = mesh.nodes + displacement.reshape(-1, 2)
     require_finite("displacement", moved)
     return Outline(moved[mesh.boundary], tuple(moved[loop] for loop in mesh.inner_boundaries))
 

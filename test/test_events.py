@@ -345,3 +345,18 @@ def test_event_squeeze_takes_exactly_two_contacts(count):
     nodes = (tuple(contacts) + (int(obj.mesh.boundary[3]),))[:count]
     with pytest.raises(InvalidInputError, match=f"contacts must be 2 nodes .F1, F2., got {count}"):
         event_squeeze(obj, nodes, 0.02, 0.4, relative_depth=0.02)
+
+
+def test_a_node_index_that_is_no_whole_number_is_refused():
+    """``j + 0.5`` used to be truncated to node j (another placement, silently); NaN escaped
+    as ValueError.
+    """
+    from squeeze_grasp_ros.mechanics.errors import InvalidInputError
+
+    obj, (i, j) = symmetric_square()
+    for bad in (j + 0.5, float("nan")):
+        with pytest.raises(InvalidInputError, match="contacts must be whole node indices"):
+            plan_squeeze(obj, [i, bad])
+        with pytest.raises(InvalidInputError, match="contacts must be whole node indices"):
+            event_squeeze(obj, (i, bad), 0.02, 0.4, relative_depth=0.02)
+    assert plan_squeeze(obj, [float(i), float(j)]).contacts.tolist() == [i, j]

@@ -47,7 +47,7 @@ from squeeze_grasp_ros.mechanics.elastic.reduced import (
     reduced_stiffness,
     rotation_angle,
 )
-from squeeze_grasp_ros.mechanics.errors import InvalidInputError, require_finite
+from squeeze_grasp_ros.mechanics.errors import InvalidInputError, node_indices, require_finite
 from squeeze_grasp_ros.mechanics.resistance.forms import (
     PureForm,
     StableForm,
@@ -157,7 +157,7 @@ def resistance_grasp(obj: ElasticObject,
         raise InvalidInputError(
             f"segments must have exactly the keys {list(tuple(Finger))}, got {sorted(segments)}"
         )
-    sets = {f: np.asarray(segments[f], dtype=int).reshape(-1) for f in tuple(Finger)}
+    sets = {f: node_indices(f"segments[{f}]", segments[f]) for f in tuple(Finger)}
     empty = [f for f in tuple(Finger) if len(sets[f]) == 0]
     if empty:
         raise InvalidInputError(f"contact set of {empty[0]} is empty")

@@ -23,6 +23,7 @@ from squeeze_grasp_ros.mechanics.elastic.strain_measures import max_principal_st
 from squeeze_grasp_ros.mechanics.elastic.stress_measures import element_stresses, von_mises
 from squeeze_grasp_ros.mechanics.errors import (
     InvalidInputError,
+    node_indices,
     require_finite,
     require_relative_depth,
 )
@@ -593,7 +594,7 @@ def event_squeeze(
     if relative_depth is not None:
         require_relative_depth(relative_depth)
     names = SQUEEZING_FINGERS
-    contacts = tuple(contacts)
+    contacts = tuple(node_indices("contacts", contacts).tolist())
     if len(contacts) != len(names):
         raise InvalidInputError(f"contacts must be {len(names)} nodes (F1, F2), got "
                                 f"{len(contacts)}")

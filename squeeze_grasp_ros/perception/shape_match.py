@@ -197,7 +197,8 @@ def shape_residual(observed: Outline, predicted: Outline, *,
     Raises
     ------
     InvalidInputError
-        For an unknown fit, non-finite curves, or fewer than 3 vertices on a curve.
+        For an unknown fit, non-finite curves, fewer than 3 vertices on a curve, or
+        ``max_iterations`` not an integer >= 1.
     """
     try:
         fit = ShapeFit(fit)

@@ -580,6 +580,23 @@ def event_squeeze(
         Finger -> where a tip given a facing starts its approach (its reference point, m; a
         gripper jaw on its closing line); default on its contact node.
 
+    Returns
+    -------
+    EventSqueeze
+        The termination, the events (depths in m and relative), the final contact segments,
+        forces (N), work and energy (J), grasp health and the displacement field (m).
+
+    Raises
+    ------
+    InvalidInputError
+        For bad arguments (named): contacts not two distinct outer-boundary nodes, a tip
+        missing for a finger, not exactly one of ``depth`` and ``relative_depth``, a relative
+        depth outside [0, 1), an unknown ``kind`` or ``material_model``, ...
+    InfeasibleError
+        If the stable squeeze of ``contacts`` is not unique (a repeated eigenvalue of C).
+    NumericalError
+        If a solve or an event location does not converge.
+
     Examples
     --------
     >>> from squeeze_grasp_ros.api import finger_nodes, load_scene, scene_file, scene_solid

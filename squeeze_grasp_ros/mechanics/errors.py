@@ -83,15 +83,27 @@ def shown(value) -> str:
 
 
 def require_finite(name: str, value) -> None:
-    """Raise :class:`InvalidInputError` if ``value`` (scalar or array) has NaN or inf entries.
+    """Raise :class:`InvalidInputError` if ``value`` (scalar or array) is not numeric or has NaN
+    or inf entries.
 
     >>> require_finite("slope angle", np.float64("nan"))
     Traceback (most recent call last):
     ...
     squeeze_grasp_ros.mechanics.errors.InvalidInputError: slope angle must be finite, got nan
+    >>> require_finite("material.E", "1e5")
+    Traceback (most recent call last):
+    ...
+    squeeze_grasp_ros.mechanics.errors.InvalidInputError: material.E must be a number or an \
+array of numbers, got '1e5'
     """
-    arr = np.asarray(value, dtype=float)
-    if not np.all(np.isfinite(arr)):
+    try:
+        kind = np.asarray(value).dtype.kind
+    except ValueError:  # a ragged sequence
+        kind = "O"
+    if kind not in "fiub":
+        raise InvalidInputError(f"{name} must be a number or an array of numbers, got "
+                                f"{value!r:.80}")
+    if not np.all(np.isfinite(np.asarray(value, dtype=float))):
         raise InvalidInputError(f"{name} must be finite, got {shown(value)}")
 
 

@@ -360,3 +360,17 @@ def test_a_node_index_that_is_no_whole_number_is_refused():
         with pytest.raises(InvalidInputError, match="contacts must be whole node indices"):
             event_squeeze(obj, (i, bad), 0.02, 0.4, relative_depth=0.02)
     assert plan_squeeze(obj, [float(i), float(j)]).contacts.tolist() == [i, j]
+
+
+@pytest.mark.parametrize("directions, message", [
+    ({"F1": (float("nan"), 0.0), "F2": (1.0, 0.0)}, "squeeze directions must be finite"),
+    ({"F1": (1.0, 0.0)}, "squeeze directions give none for F2"),
+    ({"F1": (1.0, 0.0, 0.0), "F2": (-1.0, 0.0, 0.0)}, r"one \[x, y\] per finger, got shape"),
+], ids=["nan", "missing", "three_components"])
+def test_bad_squeeze_directions_are_refused_by_name(directions, message):
+    """NaN was reported as 'must not all be zero', a missing finger escaped as KeyError."""
+    from squeeze_grasp_ros.mechanics.errors import InvalidInputError
+
+    obj, contacts = symmetric_square()
+    with pytest.raises(InvalidInputError, match=message):
+        event_squeeze(obj, contacts, 0.02, 0.4, relative_depth=0.02, directions=directions)

@@ -142,6 +142,16 @@ def test_a_node_limit_that_is_no_count_is_refused(max_nodes):
         generate_mesh(shapes.rectangle(0.1, 0.05), 1e-4, max_nodes=max_nodes)
 
 
+@pytest.mark.parametrize("field, kwargs", [
+    ("mesh.max_area", {"max_area": "a"}),
+    ("mesh.min_angle", {"max_area": 1e-4, "min_angle": "30"}),
+])
+def test_a_mesh_setting_that_is_no_number_is_refused_by_name(field, kwargs):
+    """Both used to escape as TypeError from numpy or from a comparison."""
+    with pytest.raises(InvalidInputError, match=f"{field} must be a number"):
+        generate_mesh(shapes.rectangle(0.1, 0.05), **kwargs)
+
+
 def test_a_long_boundary_is_refused_by_its_node_count():
     outline = shapes.rectangle(1.0, 0.01)
     area = target_max_area(outline, 200_000)

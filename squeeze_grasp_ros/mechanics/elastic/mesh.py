@@ -23,7 +23,7 @@ from squeeze_grasp_ros.mechanics.elastic.mesh_size import (
     estimate_mesh,
 )
 from squeeze_grasp_ros.mechanics.elastic.shapes import Outline, interior_point, signed_area
-from squeeze_grasp_ros.mechanics.errors import InvalidInputError
+from squeeze_grasp_ros.mechanics.errors import InvalidInputError, require_finite
 
 ANGLE_SLACK = 1.0
 """Degrees by which a mesh kept to its resampled boundary may miss ``min_angle`` before it is
@@ -232,7 +232,9 @@ def generate_mesh(
     >>> print(f"{element_areas(mesh.nodes, mesh.triangles).sum():.6f} m^2")
     0.005000 m^2
     """
-    if not (np.isfinite(max_area) and max_area > 0):
+    require_finite("mesh.max_area", max_area)
+    require_finite("mesh.min_angle", min_angle)
+    if not max_area > 0:
         raise InvalidInputError(f"mesh.max_area must be > 0 m^2, got {max_area}")
     if not 0 < min_angle <= 34:
         raise InvalidInputError(f"mesh.min_angle must be in (0, 34] degrees, got {min_angle}")

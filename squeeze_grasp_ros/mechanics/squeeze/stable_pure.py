@@ -266,7 +266,8 @@ def force_closure(p_i, n_i, p_j, n_j, mu: float) -> bool:
 
 def force_closure_pairs(p_i, n_i, p_j, n_j, mu: float) -> np.ndarray:
     """Vectorised :func:`force_closure` over arrays of placements (..., 2) -> bool (...)."""
-    if not (np.isfinite(mu) and mu >= 0):
+    require_finite("friction coefficient mu", mu)
+    if not mu >= 0:
         raise InvalidInputError(f"friction coefficient mu must be >= 0, got {mu}")
     d = p_j - p_i
     dist = np.linalg.norm(d, axis=-1)

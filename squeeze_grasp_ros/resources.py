@@ -75,7 +75,11 @@ def _shipped(folder: str, kind: str, name: str) -> Path:
 
 
 def scene_file(name: str) -> Path:
-    """A shipped scene by name, e.g. ``scene_file("foam_square")``, m/kg/s SI scene YAML."""
+    """A shipped scene by name, e.g. ``scene_file("foam_square")``, m/kg/s SI scene YAML.
+
+    Raises :class:`ResourceError` (a ``FileNotFoundError``, not an ``InvalidInputError``) for a
+    name that is not shipped; its message lists the shipped scenes.
+    """
     return _shipped("scenes", "scene", name)
 
 

@@ -86,3 +86,15 @@ def test_the_cli_route(tmp_path, capfd):
     path.write_text("force,dl\n1.0,0.001\n2.0,0.002\n")
     assert main(args) == 2
     assert "dl must be in" in capfd.readouterr().err
+
+
+def test_an_unknown_model_and_mismatched_arrays_are_refused_by_name():
+    """An unknown model used to escape as ValueError; arrays of two lengths were reported as
+    too few points.
+    """
+    from squeeze_grasp_ros.mechanics.errors import InvalidInputError
+
+    with pytest.raises(InvalidInputError, match="model must be linear or neo_hookean, got 'x'"):
+        fit_compression(curve(np.linspace(0.01, 0.1, 5)), model="x")
+    with pytest.raises(InvalidInputError, match=r"got shapes \(3,\) and \(2,\)"):
+        CompressionCurve(*SIDES, np.ones(3), -0.001 * np.ones(2))

@@ -1,6 +1,6 @@
 # Copyright 2026 squeeze_grasp_ros developers
 # SPDX-License-Identifier: Apache-2.0
-"""Every console transcript in README.md and docs/ is run and its output compared.
+"""Every console transcript in README.md, docs/ and CONTRIBUTING.md is run and its output compared.
 
 How a transcript is compared, and the masks: ``test/doc_transcripts.py`` (and docs/ci.md).
 A command runs as the user would type it, from a scratch folder in which ``config`` is a copy

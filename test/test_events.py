@@ -318,3 +318,59 @@ def test_an_events_fields_have_one_type_whatever_the_route_computed_them_with():
         int, float, float, int]
     assert repr(given) == repr(plain) and given == plain
     assert (given.type, given.finger) == (EventType.D, Finger.F2)
+
+
+@pytest.mark.parametrize("args, overrides, message", [
+    ((0.02, 0.4), {"material_model": "rubber"},
+     r"material_model must be one of linear, corotational, neo_hookean, got 'rubber'"),
+    (({"F1": 0.02}, 0.4), {}, r"tip gives no fingertip for F2"),
+    ((0.02, 0.4), {"relative_depth": -0.1}, r"relative depth must be in \[0, 1\).*got -0.1"),
+], ids=["material_model", "tip_mapping", "relative_depth"])
+def test_bad_arguments_of_event_squeeze_name_the_argument(args, overrides, message):
+    """Each used to escape as ValueError, KeyError, or an error about ``depth`` in metres."""
+    from squeeze_grasp_ros.mechanics.errors import InvalidInputError
+
+    obj, contacts = symmetric_square()
+    kwargs = {"relative_depth": 0.02, **overrides}
+    with pytest.raises(InvalidInputError, match=message):
+        event_squeeze(obj, contacts, *args, **kwargs)
+
+
+@pytest.mark.parametrize("count", [1, 3])
+def test_event_squeeze_takes_exactly_two_contacts(count):
+    """A third node used to be dropped silently (and one node squeezed F1 alone)."""
+    from squeeze_grasp_ros.mechanics.errors import InvalidInputError
+
+    obj, contacts = symmetric_square()
+    nodes = (tuple(contacts) + (int(obj.mesh.boundary[3]),))[:count]
+    with pytest.raises(InvalidInputError, match=f"contacts must be 2 nodes .F1, F2., got {count}"):
+        event_squeeze(obj, nodes, 0.02, 0.4, relative_depth=0.02)
+
+
+def test_a_node_index_that_is_no_whole_number_is_refused():
+    """``j + 0.5`` used to be truncated to node j (another placement, silently); NaN escaped
+    as ValueError.
+    """
+    from squeeze_grasp_ros.mechanics.errors import InvalidInputError
+
+    obj, (i, j) = symmetric_square()
+    for bad in (j + 0.5, float("nan")):
+        with pytest.raises(InvalidInputError, match="contacts must be whole node indices"):
+            plan_squeeze(obj, [i, bad])
+        with pytest.raises(InvalidInputError, match="contacts must be whole node indices"):
+            event_squeeze(obj, (i, bad), 0.02, 0.4, relative_depth=0.02)
+    assert plan_squeeze(obj, [float(i), float(j)]).contacts.tolist() == [i, j]
+
+
+@pytest.mark.parametrize("directions, message", [
+    ({"F1": (float("nan"), 0.0), "F2": (1.0, 0.0)}, "squeeze directions must be finite"),
+    ({"F1": (1.0, 0.0)}, "squeeze directions give none for F2"),
+    ({"F1": (1.0, 0.0, 0.0), "F2": (-1.0, 0.0, 0.0)}, r"one \[x, y\] per finger, got shape"),
+], ids=["nan", "missing", "three_components"])
+def test_bad_squeeze_directions_are_refused_by_name(directions, message):
+    """NaN was reported as 'must not all be zero', a missing finger escaped as KeyError."""
+    from squeeze_grasp_ros.mechanics.errors import InvalidInputError
+
+    obj, contacts = symmetric_square()
+    with pytest.raises(InvalidInputError, match=message):
+        event_squeeze(obj, contacts, 0.02, 0.4, relative_depth=0.02, directions=directions)

@@ -282,3 +282,21 @@ def test_condition_estimate_is_a_reproducible_lower_bound():
     Kp = obj.solver.K[obj.solver.order][:, obj.solver.order].toarray()
     exact = np.linalg.cond(Kp, 1)
     assert exact / 10 <= estimate <= exact * (1 + 1e-9)
+
+
+@pytest.mark.parametrize("bad", ["x", "1e5", None, [1.0, "a"]])
+def test_a_material_constant_that_is_no_number_is_refused_by_name(bad):
+    """``"x"`` used to escape as ValueError, ``"1e5"`` as TypeError from the range check after
+    passing the finiteness check, None as 'must be finite, got None'.
+    """
+    with pytest.raises(InvalidInputError, match="material.E must be a number"):
+        Material(E=bad, nu=0.3, thickness=0.01)
+
+
+def test_a_friction_coefficient_that_is_no_number_is_refused_by_name():
+    """grasp_map(obj, "x") used to escape as TypeError from numpy's isfinite."""
+    from squeeze_grasp_ros.mechanics.squeeze.graspmap import grasp_map
+
+    obj = ElasticObject(generate_mesh(shapes.disk(0.05), 2e-4), Material(1e5, 0.3, 0.01))
+    with pytest.raises(InvalidInputError, match="friction coefficient mu must be a number"):
+        grasp_map(obj, "x")

@@ -135,6 +135,23 @@ def test_triangle_stops_at_the_node_limit_and_the_mesh_is_refused():
     assert generate_mesh(outline, area).n > 700
 
 
+@pytest.mark.parametrize("max_nodes", [0, 2, -5, 10.5, True])
+def test_a_node_limit_that_is_no_count_is_refused(max_nodes):
+    """A limit of 0 used to divide by zero (ZeroDivisionError) before any check."""
+    with pytest.raises(InvalidInputError, match=r"mesh.max_nodes must be an integer >= 3"):
+        generate_mesh(shapes.rectangle(0.1, 0.05), 1e-4, max_nodes=max_nodes)
+
+
+@pytest.mark.parametrize("field, kwargs", [
+    ("mesh.max_area", {"max_area": "a"}),
+    ("mesh.min_angle", {"max_area": 1e-4, "min_angle": "30"}),
+])
+def test_a_mesh_setting_that_is_no_number_is_refused_by_name(field, kwargs):
+    """Both used to escape as TypeError from numpy or from a comparison."""
+    with pytest.raises(InvalidInputError, match=f"{field} must be a number"):
+        generate_mesh(shapes.rectangle(0.1, 0.05), **kwargs)
+
+
 def test_a_long_boundary_is_refused_by_its_node_count():
     outline = shapes.rectangle(1.0, 0.01)
     area = target_max_area(outline, 200_000)

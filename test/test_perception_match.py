@@ -131,3 +131,14 @@ def test_bad_requests_name_the_field():
         shape_residual(Outline(np.zeros((2, 2))), square)
     with pytest.raises(InvalidInputError, match="max_iterations"):
         shape_residual(square, square, max_iterations=0)
+
+
+@pytest.mark.parametrize("size", [5, 2])
+def test_a_displacement_of_another_mesh_is_refused(size):
+    """Five values used to fail in numpy's reshape (ValueError); one row too many in its
+    broadcast.
+    """
+    mesh = build_mesh(parse_scene(yaml.safe_load(scene_file("disk").read_text())))
+    shape = (5,) if size == 5 else (mesh.n + 1, 2)
+    with pytest.raises(InvalidInputError, match=f"displacement must be .n, 2. with n = {mesh.n}"):
+        deformed_outline(mesh, np.zeros(shape))

@@ -393,3 +393,11 @@ def test_cli_resist_point_segment_and_sweep(tmp_path, capsys):
     out = json.loads(capsys.readouterr().out)
     assert out["contact_model"] == "segment" and out["mode"] == "pure"
     assert all(len(out["segments"][f]) >= 2 for f in tuple(Finger))
+
+
+@pytest.mark.parametrize("bad", [10**6, -1])
+def test_a_node_index_outside_the_mesh_is_refused(square, bad):
+    """An index past the mesh's nodes used to escape as IndexError."""
+    b = [int(k) for k in square.mesh.boundary]
+    with pytest.raises(InvalidInputError, match=r"contact nodes must be node indices in \[0, "):
+        resistance_grasp(square, {"F1": [b[0]], "F2": [bad], "A": [b[5]]})

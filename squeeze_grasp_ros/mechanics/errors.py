@@ -26,7 +26,8 @@ from collections.abc import Mapping
 import numpy as np
 
 __all__ = ["ConditioningWarning", "InfeasibleError", "InternalError", "InvalidInputError",
-           "NumericalError", "SqueezeGraspError", "require_finite", "require_relative_depth"]
+           "NumericalError", "SqueezeGraspError", "node_indices", "require_finite",
+           "require_relative_depth"]
 
 
 class SqueezeGraspError(Exception):
@@ -82,16 +83,48 @@ def shown(value) -> str:
 
 
 def require_finite(name: str, value) -> None:
-    """Raise :class:`InvalidInputError` if ``value`` (scalar or array) has NaN or inf entries.
+    """Raise :class:`InvalidInputError` if ``value`` (scalar or array) is not numeric or has NaN
+    or inf entries.
 
     >>> require_finite("slope angle", np.float64("nan"))
     Traceback (most recent call last):
     ...
     squeeze_grasp_ros.mechanics.errors.InvalidInputError: slope angle must be finite, got nan
+    >>> require_finite("material.E", "1e5")
+    Traceback (most recent call last):
+    ...
+    squeeze_grasp_ros.mechanics.errors.InvalidInputError: material.E must be a number or an \
+array of numbers, got '1e5'
     """
-    arr = np.asarray(value, dtype=float)
-    if not np.all(np.isfinite(arr)):
+    try:
+        kind = np.asarray(value).dtype.kind
+    except ValueError:  # a ragged sequence
+        kind = "O"
+    if kind not in "fiub":
+        raise InvalidInputError(f"{name} must be a number or an array of numbers, got "
+                                f"{value!r:.80}")
+    if not np.all(np.isfinite(np.asarray(value, dtype=float))):
         raise InvalidInputError(f"{name} must be finite, got {shown(value)}")
+
+
+def node_indices(name: str, values) -> np.ndarray:
+    """``values`` as a flat int array of node indices; :class:`InvalidInputError` if any is not
+    a whole number (a float index is not truncated to another node).
+
+    >>> node_indices("contacts", [3, 7.0]).tolist()
+    [3, 7]
+    >>> node_indices("contacts", [3, 7.5])
+    Traceback (most recent call last):
+    ...
+    squeeze_grasp_ros.mechanics.errors.InvalidInputError: contacts must be whole node indices, \
+got [3.0, 7.5]
+    """
+    arr = np.asarray(values)
+    if arr.dtype.kind in "iu":
+        return arr.astype(int).reshape(-1)
+    if arr.dtype.kind == "f" and np.all(np.isfinite(arr)) and np.all(arr == np.round(arr)):
+        return arr.astype(int).reshape(-1)
+    raise InvalidInputError(f"{name} must be whole node indices, got {shown(values)}")
 
 
 FINGERS_MEET = "at 1 the fingers would meet"

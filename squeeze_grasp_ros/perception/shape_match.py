@@ -113,7 +113,11 @@ def deformed_outline(mesh: Mesh, displacement: np.ndarray) -> Outline:
     >>> print(f"{stretched.area / deformed_outline(mesh, 0 * mesh.nodes).area:.4f}")
     1.0201
     """
-    moved = mesh.nodes + np.asarray(displacement, float).reshape(-1, 2)
+    displacement = np.asarray(displacement, float)
+    if displacement.size != mesh.nodes.size:
+        raise InvalidInputError(f"displacement must be (n, 2) with n = {mesh.n} nodes (or its "
+                                f"{2 * mesh.n} entries flat), got shape {displacement.shape}")
+    moved = mesh.nodes + displacement.reshape(-1, 2)
     require_finite("displacement", moved)
     return Outline(moved[mesh.boundary], tuple(moved[loop] for loop in mesh.inner_boundaries))
 
@@ -193,7 +197,8 @@ def shape_residual(observed: Outline, predicted: Outline, *,
     Raises
     ------
     InvalidInputError
-        For an unknown fit, non-finite curves, or fewer than 3 vertices on a curve.
+        For an unknown fit, non-finite curves, fewer than 3 vertices on a curve, or
+        ``max_iterations`` not an integer >= 1.
     """
     try:
         fit = ShapeFit(fit)

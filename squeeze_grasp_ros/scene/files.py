@@ -53,7 +53,10 @@ def read_yaml(path: str | Path, what: str = "scene") -> Any:
 
 
 def load_scene(path: str | Path) -> Scene:
-    """Read and validate a YAML scene file (its ``controller:`` section against its device too)."""
+    """Read and validate a YAML scene file (its ``controller:`` section against its device too).
+
+    Raises :class:`SceneError` (an ``InvalidInputError``) naming the file or the entry.
+    """
     from squeeze_grasp_ros.scene.controller import scene_controller  # it reads device files
 
     scene = parse_scene(read_yaml(path), base_dir=Path(path).parent)

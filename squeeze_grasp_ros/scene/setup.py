@@ -354,6 +354,10 @@ class GraspSetup:
         SceneError
             If the object is not a solid, a fingertip radius is 0 (point fingers have no polar
             angle) or no depth is given.
+        InvalidInputError
+            For a bad override (both depths, an unknown kind or model, contacts that are not
+            two outer-boundary nodes), as
+            :func:`~squeeze_grasp_ros.mechanics.squeeze.events.event_squeeze` raises it.
         """
         scene = check_event_squeeze(self.scene)
         sq = scene.squeeze

@@ -68,7 +68,9 @@ class CompressionCurve:
                 raise InvalidInputError(f"{name} must be > 0 m, got {value}")
         force, dl = np.asarray(self.force, float), np.asarray(self.dl, float)
         if force.shape != dl.shape or force.ndim != 1 or len(force) < 2:
-            raise InvalidInputError("a compression curve needs at least 2 (force, dl) points")
+            raise InvalidInputError("a compression curve needs at least 2 (force, dl) points, "
+                                    f"force and dl of one length: got shapes {force.shape} "
+                                    f"and {dl.shape}")
         if not np.all(np.isfinite(force)) or not np.all(force > 0):
             raise InvalidInputError("force must be > 0 N (compression) at every point")
         if not np.all(np.isfinite(dl)) or not np.all((dl < 0) & (dl > -self.length)):
@@ -146,7 +148,15 @@ def fit_compression(curve: CompressionCurve, *, model: MaterialModel | str,
                     nu: float = 0.3) -> MaterialFit:
     """Least-squares fit of ``model`` to ``curve``; nu is fitted when ``curve.dw`` is given,
     else held at ``nu``.
+
+    Raises
+    ------
+    InvalidInputError
+        For a ``model`` other than ``linear`` or ``neo_hookean``, or a ``nu`` the law cannot
+        take.
     """
+    if model not in MaterialModel.values():
+        raise InvalidInputError(f"model must be linear or neo_hookean, got {model!r}")
     model = MaterialModel(model)
     if model == MaterialModel.COROTATIONAL:
         raise InvalidInputError("calibrate fits linear and neo_hookean laws (the corotational "

@@ -23,7 +23,7 @@ from squeeze_grasp_ros.mechanics.elastic.mesh_size import (
     estimate_mesh,
 )
 from squeeze_grasp_ros.mechanics.elastic.shapes import Outline, interior_point, signed_area
-from squeeze_grasp_ros.mechanics.errors import InvalidInputError
+from squeeze_grasp_ros.mechanics.errors import InvalidInputError, require_finite
 
 ANGLE_SLACK = 1.0
 """Degrees by which a mesh kept to its resampled boundary may miss ``min_angle`` before it is
@@ -217,10 +217,11 @@ def generate_mesh(
     Raises
     ------
     InvalidInputError
-        If ``max_area`` is not positive or ``min_angle`` is outside (0, 34] degrees (Triangle's
-        guaranteed-termination range); if the mesh would have more than ``max_nodes`` nodes or
-        more than :data:`~.mesh_size.MAX_BOUNDARY_NODES` boundary nodes, or a thin feature
-        would more than double it (the message names the feature, its width and where it is).
+        If ``max_area`` is not positive, ``min_angle`` is outside (0, 34] degrees (Triangle's
+        guaranteed-termination range) or ``max_nodes`` is not an integer >= 3; if the mesh
+        would have more than ``max_nodes`` nodes or more than
+        :data:`~.mesh_size.MAX_BOUNDARY_NODES` boundary nodes, or a thin feature would more
+        than double it (the message names the feature, its width and where it is).
 
     Examples
     --------
@@ -231,10 +232,15 @@ def generate_mesh(
     >>> print(f"{element_areas(mesh.nodes, mesh.triangles).sum():.6f} m^2")
     0.005000 m^2
     """
-    if not (np.isfinite(max_area) and max_area > 0):
+    require_finite("mesh.max_area", max_area)
+    require_finite("mesh.min_angle", min_angle)
+    if not max_area > 0:
         raise InvalidInputError(f"mesh.max_area must be > 0 m^2, got {max_area}")
     if not 0 < min_angle <= 34:
         raise InvalidInputError(f"mesh.min_angle must be in (0, 34] degrees, got {min_angle}")
+    if isinstance(max_nodes, bool) or not isinstance(max_nodes, (int, np.integer)) \
+            or max_nodes < 3:
+        raise InvalidInputError(f"mesh.max_nodes must be an integer >= 3, got {max_nodes!r}")
     if max_area > outline.area:
         max_area = outline.area / 4.0
     if NODES_PER_AREA * outline.area / max_area > max_nodes:

@@ -24,6 +24,7 @@ from squeeze_grasp_ros.mechanics.elastic.compliance import CONDITION_WARN, Elast
 from squeeze_grasp_ros.mechanics.errors import (
     ConditioningWarning,
     InvalidInputError,
+    node_indices,
     require_finite,
 )
 
@@ -135,7 +136,7 @@ def reduced_stiffness(obj: ElasticObject, contacts) -> ReducedStiffness:
     >>> red.C.shape, bool(np.allclose(red.C, red.C.T, atol=1e-9 * abs(red.C).max()))
     ((4, 4), True)
     """
-    contacts = np.asarray(contacts, dtype=int).reshape(-1)
+    contacts = node_indices("contacts", contacts)
     if len(contacts) < 2:
         raise InvalidInputError(f"contacts needs at least 2 nodes (Lemma 2), got {len(contacts)}")
     if len(np.unique(contacts)) != len(contacts):

@@ -316,7 +316,11 @@ def frictional_resistance(
     Raises
     ------
     InvalidInputError
-        If the state has no finger A, a is zero, the stepper fails or the loop stalls.
+        If ``a`` is not a nonzero finite [x, y] or is longer than
+        :data:`~.optimal.MAX_RELATIVE_PUSH` of the object size, the state's fingers are not
+        F1, F2 and A, or the loop stalls.
+    NumericalError
+        If the stepper fails (a solve or an event location that does not converge).
 
     Examples
     --------

@@ -47,7 +47,7 @@ from squeeze_grasp_ros.mechanics.elastic.reduced import (
     reduced_stiffness,
     rotation_angle,
 )
-from squeeze_grasp_ros.mechanics.errors import InvalidInputError, require_finite
+from squeeze_grasp_ros.mechanics.errors import InvalidInputError, node_indices, require_finite
 from squeeze_grasp_ros.mechanics.resistance.forms import (
     PureForm,
     StableForm,
@@ -157,7 +157,7 @@ def resistance_grasp(obj: ElasticObject,
         raise InvalidInputError(
             f"segments must have exactly the keys {list(tuple(Finger))}, got {sorted(segments)}"
         )
-    sets = {f: np.asarray(segments[f], dtype=int).reshape(-1) for f in tuple(Finger)}
+    sets = {f: node_indices(f"segments[{f}]", segments[f]) for f in tuple(Finger)}
     empty = [f for f in tuple(Finger) if len(sets[f]) == 0]
     if empty:
         raise InvalidInputError(f"contact set of {empty[0]} is empty")
@@ -165,6 +165,9 @@ def resistance_grasp(obj: ElasticObject,
     if len(np.unique(nodes)) != len(nodes):
         listed = {f: sets[f].tolist() for f in tuple(Finger)}
         raise InvalidInputError(f"contact sets of F1, F2 and A must be disjoint, got {listed}")
+    if nodes.min() < 0 or nodes.max() >= obj.mesh.n:
+        raise InvalidInputError(f"contact nodes must be node indices in [0, {obj.mesh.n - 1}], "
+                                f"got {nodes.tolist()}")
     off = nodes[obj.boundary_positions(nodes) < 0]
     if len(off):
         raise InvalidInputError(

@@ -89,7 +89,8 @@ class RingModel:
     material : Material
         E (Pa), nu (must be 0, Sec. 7) and ``thickness`` = the out-of-plane width w (m).
     wall_thickness : float
-        In-plane wall thickness h, m (the bending direction; smaller than the ring).
+        In-plane wall thickness h, m (the bending direction), in (0, L/4) with L the larger
+        side of the middle curve's bounding box (:attr:`scale`).
 
     Notes
     -----

@@ -34,7 +34,7 @@ import numpy as np
 
 from squeeze_grasp_ros.mechanics.elastic.compliance import node_dofs
 from squeeze_grasp_ros.mechanics.elastic.reduced import reduce_blocks
-from squeeze_grasp_ros.mechanics.errors import InvalidInputError, require_finite
+from squeeze_grasp_ros.mechanics.errors import InvalidInputError, node_indices, require_finite
 from squeeze_grasp_ros.mechanics.ring.model import FIBRE_STRAIN_MEASURE, RingModel
 from squeeze_grasp_ros.mechanics.squeeze.stable_pure import two_contact_direction
 from squeeze_grasp_ros.mechanics.vocabulary import SQUEEZING_FINGERS, RingLimit, SqueezeKind
@@ -376,7 +376,7 @@ class RingGrasp:
 
 
 def _check_contacts(ring: RingModel, contacts) -> np.ndarray:
-    c = np.asarray(contacts, dtype=int).reshape(-1)
+    c = node_indices("contacts", contacts)
     if len(c) != 2:
         raise InvalidInputError(f"a ring grasp needs exactly 2 contact nodes, got {len(c)}")
     if c[0] == c[1]:

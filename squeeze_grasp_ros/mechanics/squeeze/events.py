@@ -23,6 +23,7 @@ from squeeze_grasp_ros.mechanics.elastic.strain_measures import max_principal_st
 from squeeze_grasp_ros.mechanics.elastic.stress_measures import element_stresses, von_mises
 from squeeze_grasp_ros.mechanics.errors import (
     InvalidInputError,
+    node_indices,
     require_finite,
     require_relative_depth,
 )
@@ -579,6 +580,23 @@ def event_squeeze(
         Finger -> where a tip given a facing starts its approach (its reference point, m; a
         gripper jaw on its closing line); default on its contact node.
 
+    Returns
+    -------
+    EventSqueeze
+        The termination, the events (depths in m and relative), the final contact segments,
+        forces (N), work and energy (J), grasp health and the displacement field (m).
+
+    Raises
+    ------
+    InvalidInputError
+        For bad arguments (named): contacts not two distinct outer-boundary nodes, a tip
+        missing for a finger, not exactly one of ``depth`` and ``relative_depth``, a relative
+        depth outside [0, 1), an unknown ``kind`` or ``material_model``, ...
+    InfeasibleError
+        If the stable squeeze of ``contacts`` is not unique (a repeated eigenvalue of C).
+    NumericalError
+        If a solve or an event location does not converge.
+
     Examples
     --------
     >>> from squeeze_grasp_ros.api import finger_nodes, load_scene, scene_file, scene_solid
@@ -590,8 +608,17 @@ def event_squeeze(
     """
     if (depth is None) == (relative_depth is None):
         raise InvalidInputError("give exactly one of depth (m) and relative_depth")
+    if relative_depth is not None:
+        require_relative_depth(relative_depth)
     names = SQUEEZING_FINGERS
+    contacts = tuple(node_indices("contacts", contacts).tolist())
+    if len(contacts) != len(names):
+        raise InvalidInputError(f"contacts must be {len(names)} nodes (F1, F2), got "
+                                f"{len(contacts)}")
     shapes = dict(tip) if isinstance(tip, Mapping) else dict.fromkeys(names, tip)
+    missing = [str(n) for n in names if n not in shapes]
+    if missing:
+        raise InvalidInputError(f"tip gives no fingertip for {', '.join(missing)}")
     facing, origins = dict(facing or {}), dict(origins or {})
     tips = [place_fingertip(obj.mesh, n, int(c), shapes[n], facing.get(n), origins.get(n))
             for n, c in zip(names, contacts)]

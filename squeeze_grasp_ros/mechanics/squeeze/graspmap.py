@@ -87,6 +87,9 @@ class GraspMap:
 def grasp_map(obj: ElasticObject, mu: float) -> GraspMap:
     """Stable-squeeze stiffness, inwardness and force closure of all boundary-node pairs.
 
+    ``mu`` is the friction coefficient (>= 0) of the force-closure test; an
+    :class:`InvalidInputError` says so otherwise.
+
     Examples
     --------
     >>> from squeeze_grasp_ros.api import load_scene, scene_file, scene_solid

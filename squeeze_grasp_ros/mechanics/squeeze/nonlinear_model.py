@@ -280,6 +280,10 @@ def contact_model(material_model: MaterialModel | str, *args, **kwargs) -> Conta
     """The contact model of ``material_model``: the linear one (reduced stiffness) or the
     finite-deformation one; arguments as :class:`ContactModel`.
     """
+    if material_model not in MaterialModel.values():
+        choices = ", ".join(MaterialModel.values())
+        raise InvalidInputError(f"material_model must be one of {choices}, got "
+                                f"{material_model!r}")
     model = MaterialModel(material_model)
     if model == MaterialModel.LINEAR:
         return ContactModel(*args, **kwargs)

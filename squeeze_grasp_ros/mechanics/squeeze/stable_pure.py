@@ -21,7 +21,7 @@ from squeeze_grasp_ros.mechanics.elastic.reduced import (
     reduced_stiffness,
     rotation_angle,
 )
-from squeeze_grasp_ros.mechanics.errors import InfeasibleError, InvalidInputError
+from squeeze_grasp_ros.mechanics.errors import InfeasibleError, InvalidInputError, require_finite
 from squeeze_grasp_ros.mechanics.vocabulary import SQUEEZING_FINGERS, Finger, SqueezeKind
 
 
@@ -202,7 +202,8 @@ def finger_motion(obj: ElasticObject, contacts, *, kind: SqueezeKind = SqueezeKi
     Raises
     ------
     InvalidInputError
-        For bad contacts, an unknown kind or all-zero directions.
+        For bad contacts, an unknown kind, or directions that are not one finite [x, y] per
+        finger or are all zero.
 
     Examples
     --------
@@ -219,7 +220,15 @@ def finger_motion(obj: ElasticObject, contacts, *, kind: SqueezeKind = SqueezeKi
         u = plan.displacement.reshape(2, 2)
         return FingerMotion({Finger.F1: u[0].copy(), Finger.F2: u[1].copy()},
                             plan.approach_per_unit_depth / distance, plan.kind)
-    stacked = np.array([directions[n] for n in SQUEEZING_FINGERS], float)
+    missing = [str(n) for n in SQUEEZING_FINGERS if n not in directions]
+    if missing:
+        raise InvalidInputError(f"squeeze directions give none for {', '.join(missing)}")
+    listed = [directions[n] for n in SQUEEZING_FINGERS]
+    require_finite("squeeze directions", listed)
+    stacked = np.asarray(listed, float)
+    if stacked.shape != (len(SQUEEZING_FINGERS), 2):
+        raise InvalidInputError(f"squeeze directions must be one [x, y] per finger, got shape "
+                                f"{stacked.shape}")
     norm = float(np.linalg.norm(stacked))
     if not norm > 0:
         raise InvalidInputError("squeeze directions must not all be zero")
@@ -257,7 +266,8 @@ def force_closure(p_i, n_i, p_j, n_j, mu: float) -> bool:
 
 def force_closure_pairs(p_i, n_i, p_j, n_j, mu: float) -> np.ndarray:
     """Vectorised :func:`force_closure` over arrays of placements (..., 2) -> bool (...)."""
-    if not (np.isfinite(mu) and mu >= 0):
+    require_finite("friction coefficient mu", mu)
+    if not mu >= 0:
         raise InvalidInputError(f"friction coefficient mu must be >= 0, got {mu}")
     d = p_j - p_i
     dist = np.linalg.norm(d, axis=-1)

@@ -107,9 +107,10 @@ array of numbers, got '1e5'
         raise InvalidInputError(f"{name} must be finite, got {shown(value)}")
 
 
-def node_indices(name: str, values) -> np.ndarray:
+def node_indices(name: str, values, n: int | None = None) -> np.ndarray:
     """``values`` as a flat int array of node indices; :class:`InvalidInputError` if any is not
-    a whole number (a float index is not truncated to another node).
+    a whole number (a float index is not truncated to another node) or, with ``n`` (the mesh's
+    node count), outside [0, n - 1].
 
     >>> node_indices("contacts", [3, 7.0]).tolist()
     [3, 7]
@@ -118,13 +119,21 @@ def node_indices(name: str, values) -> np.ndarray:
     ...
     squeeze_grasp_ros.mechanics.errors.InvalidInputError: contacts must be whole node indices, \
 got [3.0, 7.5]
+    >>> node_indices("contacts", [3, 12], 10)
+    Traceback (most recent call last):
+    ...
+    squeeze_grasp_ros.mechanics.errors.InvalidInputError: contacts must be node indices in \
+[0, 9], got [3, 12]
     """
     arr = np.asarray(values)
-    if arr.dtype.kind in "iu":
-        return arr.astype(int).reshape(-1)
-    if arr.dtype.kind == "f" and np.all(np.isfinite(arr)) and np.all(arr == np.round(arr)):
-        return arr.astype(int).reshape(-1)
-    raise InvalidInputError(f"{name} must be whole node indices, got {shown(values)}")
+    if not (arr.dtype.kind in "iu" or arr.dtype.kind == "f" and np.all(np.isfinite(arr))
+            and np.all(arr == np.round(arr))):
+        raise InvalidInputError(f"{name} must be whole node indices, got {shown(values)}")
+    arr = arr.astype(int).reshape(-1)
+    if n is not None and len(arr) and (arr.min() < 0 or arr.max() >= n):
+        raise InvalidInputError(f"{name} must be node indices in [0, {n - 1}], got "
+                                f"{shown(arr.tolist())}")
+    return arr
 
 
 FINGERS_MEET = "at 1 the fingers would meet"

@@ -136,13 +136,11 @@ def reduced_stiffness(obj: ElasticObject, contacts) -> ReducedStiffness:
     >>> red.C.shape, bool(np.allclose(red.C, red.C.T, atol=1e-9 * abs(red.C).max()))
     ((4, 4), True)
     """
-    contacts = node_indices("contacts", contacts)
+    contacts = node_indices("contacts", contacts, obj.mesh.n)
     if len(contacts) < 2:
         raise InvalidInputError(f"contacts needs at least 2 nodes (Lemma 2), got {len(contacts)}")
     if len(np.unique(contacts)) != len(contacts):
         raise InvalidInputError(f"contacts must be distinct nodes, got {contacts.tolist()}")
-    if contacts.min() < 0 or contacts.max() >= obj.mesh.n:
-        raise InvalidInputError(f"contacts must be node indices in [0, {obj.mesh.n - 1}]")
     kept = obj._shared.setdefault("reduced_stiffness", {})
     tag = tuple(contacts.tolist())
     red = kept.get(tag)

@@ -165,9 +165,7 @@ def resistance_grasp(obj: ElasticObject,
     if len(np.unique(nodes)) != len(nodes):
         listed = {f: sets[f].tolist() for f in tuple(Finger)}
         raise InvalidInputError(f"contact sets of F1, F2 and A must be disjoint, got {listed}")
-    if nodes.min() < 0 or nodes.max() >= obj.mesh.n:
-        raise InvalidInputError(f"contact nodes must be node indices in [0, {obj.mesh.n - 1}], "
-                                f"got {nodes.tolist()}")
+    node_indices("contact nodes", nodes, obj.mesh.n)
     off = nodes[obj.boundary_positions(nodes) < 0]
     if len(off):
         raise InvalidInputError(

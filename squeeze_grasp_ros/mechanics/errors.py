@@ -97,13 +97,13 @@ def require_finite(name: str, value) -> None:
 array of numbers, got '1e5'
     """
     try:
-        kind = np.asarray(value).dtype.kind
+        arr = np.asarray(value)
     except ValueError:  # a ragged sequence
-        kind = "O"
-    if kind not in "fiub":
+        arr = None
+    if arr is None or arr.dtype.kind not in "fiub":
         raise InvalidInputError(f"{name} must be a number or an array of numbers, got "
                                 f"{value!r:.80}")
-    if not np.all(np.isfinite(np.asarray(value, dtype=float))):
+    if not np.all(np.isfinite(arr)):
         raise InvalidInputError(f"{name} must be finite, got {shown(value)}")
 
 

@@ -7,6 +7,8 @@ rotated scenes, work = energy, scaling with E, nu near 0.5).
 """
 from __future__ import annotations
 
+import re
+
 import numpy as np
 import pytest
 from foam_support import foam_square
@@ -715,3 +717,60 @@ def test_the_squeeze_force_agrees_on_finer_meshes():
         res = squeeze(obj, contacts, "neo_hookean", relative_depth=0.04)
         forces.append(res.finger_force["F1"][1])
     assert forces[1] == pytest.approx(forces[0], rel=5e-3)
+
+
+def _stated(path: str, pattern: str) -> list[float]:
+    """The numbers ``pattern`` captures in the docs page ``path`` (whitespace normalised,
+    thousands separators dropped).
+    """
+    from doc_transcripts import REPO
+
+    text = " ".join((REPO / path).read_text().split())
+    found = re.search(pattern, text)
+    assert found, f"{path} no longer states {pattern!r}"
+    return [float(x.replace(",", "")) for x in found.groups()]
+
+
+def test_the_docs_neo_hookean_counts_are_the_shipped_square_s():
+    """docs/events.md and docs/materials.md state what the 12 % neo-Hookean squeeze of the
+    shipped foam square costs in evaluations, look-ups, substeps, root evaluations,
+    factorisations and Newton iterations, with CHOLMOD, with QDLDL and on the fixed step
+    grid. Those are the diagnostics of the squeeze itself.
+    """
+    from squeeze_grasp_ros.api import finger_nodes, load_scene, scene_file, scene_solid
+    from squeeze_grasp_ros.mechanics.elastic.interior import factorizer
+    from squeeze_grasp_ros.mechanics.squeeze.contact_model import SolveOptions
+
+    scene = load_scene(scene_file("foam_square"))
+    obj = scene_solid(scene)
+    contacts = finger_nodes(scene, obj.mesh)
+
+    def counts(method, **kw):
+        with factorizer(method):
+            diag = squeeze(obj, contacts, "neo_hookean", relative_depth=0.12, **kw).diagnostics
+        return diag, diag["nonlinear"]
+
+    diag, nl = counts("cholmod")
+    qdiag, qnl = counts("qdldl")
+    gdiag, gnl = counts("cholmod", options=SolveOptions(adaptive_substeps=False))
+    nodes, evaluations, look_ups, substeps, roots, q_evaluations, q_look_ups, g_evaluations, \
+        g_substeps = _stated(
+            "docs/events.md",
+            r"neo-Hookean, ([\d,]+) nodes\) that is (\d+) evaluations and (\d+) look-ups in "
+            r"(\d+) substeps and (\d+) root evaluations with CHOLMOD \((\d+) and (\d+) with "
+            r"QDLDL\); on the fixed grid \(`SolveOptions\(adaptive_substeps=False\)`\) it is "
+            r"(\d+) evaluations in (\d+) substeps")
+    assert obj.mesh.n == nodes
+    assert (nl["evaluations"], nl["look_ups"], diag["substeps"], diag["root_evaluations"]) == (
+        evaluations, look_ups, substeps, roots)
+    assert (qnl["evaluations"], qnl["look_ups"]) == (q_evaluations, q_look_ups)
+    assert (gnl["evaluations"], gdiag["substeps"]) == (g_evaluations, g_substeps)
+    stated = _stated(
+        "docs/materials.md",
+        r"squeeze takes (\d+) substeps, (\d+) root evaluations, (\d+) evaluations \(plus (\d+) "
+        r"look-ups\), ([\d.]+) Newton iterations per evaluation and (\d+) factorisations \((\d+) "
+        r"sets bordered, below; CHOLMOD; with QDLDL (\d+) evaluations and (\d+) look-ups\)")
+    assert stated == [diag["substeps"], diag["root_evaluations"], nl["evaluations"],
+                      nl["look_ups"], round(nl["newton_iterations"] / nl["evaluations"], 1),
+                      nl["factorizations"], nl["bordered"], qnl["evaluations"], qnl["look_ups"]]
+    assert _stated("docs/materials.md", r"then, (\d+) evaluations now") == [gnl["evaluations"]]

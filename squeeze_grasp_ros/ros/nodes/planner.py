@@ -73,6 +73,10 @@ DISCOVERY_GRACE = 5.0
 """Wall-clock seconds a request's client may stay unknown to the planner's graph before its
 absence counts as abandonment (across processes the graph can learn of a client after its
 request arrived)."""
+DRAIN_SECONDS = 4.0
+"""How long a stopping planner (SIGINT, SIGTERM) waits, at most, for the long requests in
+flight to be answered: running ones stop at their next stage, queued ones are refused at once
+(launch sends SIGTERM 5 s after SIGINT by default)."""
 
 PARAMETERS: dict[str, tuple[Any, str]] = {
     "max_nodes": (60_000, "largest solid mesh (nodes) the planner builds; larger scenes are "
@@ -153,6 +157,7 @@ class PlannerNode(Node):
         services = pipeline.request_queue(value("service_queue_depth"))
         self._pending = 0
         self._pending_lock = threading.Lock()
+        self._awaiting = 0  # long requests whose handler awaits its worker (executor thread)
         self.refusals = RefusalLog(self.get_logger().info)
         # Reentrant: a long request awaiting its worker must not hold the node's default
         # (mutually exclusive) group, or every other request waits for it (measured: a
@@ -343,8 +348,12 @@ class PlannerNode(Node):
         return self.cache.get(request.object_id, request.object_digest)
 
     def _answer(self, response_type: type[Response], compute: Callable[[], Response]) -> Response:
-        """``compute()``, or a failure response naming the reason; never raises for a request."""
+        """``compute()``, or a failure response naming the reason (CANCELLED without computing
+        once the node is stopping); never raises for a request.
+        """
         try:
+            if self._stopping.is_set():
+                raise Cancelled("the planner is shutting down")
             return compute()
         except Exception as exc:
             code, message = planning.classify(exc)
@@ -378,14 +387,19 @@ class PlannerNode(Node):
                     self._pending -= 1
         future = Future(executor=self.executor)
         future.add_done_callback(_resume)
+        self._awaiting += 1
         try:
             self._pool.submit(work)
         except RuntimeError:
             with self._pending_lock:
                 self._pending -= 1
+            self._awaiting -= 1
             return messages.failure(response_type, ErrorCode.CANCELLED,
                                     "the planner is shutting down")
-        return await future
+        try:
+            return await future
+        finally:
+            self._awaiting -= 1
 
     def _client_watch(self, service: str) -> Callable[..., None]:
         """A progress callback (and checkpoint) for the worker of a ``~/<service>`` request:
@@ -464,6 +478,22 @@ class PlannerNode(Node):
         else:
             goal_handle.abort()
         return result
+
+    def drain(self, executor: Any, timeout: float = DRAIN_SECONDS) -> None:
+        """Answer the long requests in flight before the node ends (SIGINT, SIGTERM): stop the
+        workers (a running computation stops at its next stage, a queued one is refused
+        CANCELLED, "the planner is shutting down") and spin ``executor`` until every such
+        request's handler has answered, ``timeout`` s at most. Goals end aborted with that
+        message; their results go to the clients that asked for them.
+        """
+        self._stopping.set()
+        if not self._awaiting:
+            return
+        deadline = time.monotonic() + timeout
+        while self._awaiting and time.monotonic() < deadline:
+            executor.spin_once(0.05)
+        for _ in range(4):  # goals: the result requests the finished goals answer
+            executor.spin_once(0.05)  # one timeout throughout: see RecorderNode.drain
 
     def destroy_node(self) -> None:
         """Stop the workers (running computations stop at their next stage), then the node."""

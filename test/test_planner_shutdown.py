@@ -1,0 +1,88 @@
+# Copyright 2026 squeeze_grasp_ros developers
+# SPDX-License-Identifier: Apache-2.0
+"""A planner process stopped by SIGINT or SIGTERM answers the long requests it holds.
+
+Before, the node shut its executor down and then stopped its workers: a load running or queued
+at Ctrl-C was never answered, and its client waited for ever (measured: 0 of 4 answered
+after 40 s).
+"""
+
+from __future__ import annotations
+
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+import rclpy
+from planner_support import BLOB, big_disk
+from rclpy.context import Context
+from rclpy.executors import SingleThreadedExecutor
+
+from squeeze_grasp_interfaces.srv import LoadObject
+from squeeze_grasp_ros.planning import ErrorCode
+from squeeze_grasp_ros.ros.nodes import pipeline
+
+TIMEOUT = 60.0
+
+
+def _spin_until(executor: SingleThreadedExecutor, done, timeout: float = TIMEOUT) -> None:
+    deadline = time.monotonic() + timeout
+    while not done():
+        assert time.monotonic() < deadline, "timed out"
+        executor.spin_once(0.05)
+
+
+@pytest.mark.parametrize("signum", [signal.SIGINT, signal.SIGTERM])
+def test_a_stopped_planner_answers_its_running_and_queued_loads(
+    ros_context: Context, tmp_path: Path, signum: int
+) -> None:
+    """One worker, at most two long requests: a 20,000-node load running, another queued, and
+    a third refused BUSY (which shows the first two are held). Then the signal: the queued
+    load is refused CANCELLED, "the planner is shutting down", the running one is answered
+    too (cancelled at its next stage, or done), and the process exits 0.
+    """
+    log = (tmp_path / "planner.log").open("w")
+    process = subprocess.Popen(
+        [sys.executable, "-m", "squeeze_grasp_ros.ros.nodes.planner", "--ros-args",
+         "-p", "worker_threads:=1", "-p", "max_pending:=2"],
+        stdout=log, stderr=subprocess.STDOUT, env=dict(os.environ))
+    node = rclpy.create_node("shutdown_probe", context=ros_context)
+    executor = SingleThreadedExecutor(context=ros_context)
+    executor.add_node(node)
+    try:
+        client = node.create_client(LoadObject, "/planner/load_object",
+                                    qos_profile=pipeline.request_queue(0))
+        assert client.wait_for_service(timeout_sec=TIMEOUT)
+        # across processes a first request can be lost: a quick refused load first, re-sent
+        while True:
+            probe = client.call_async(LoadObject.Request(scene_yaml="object: [", object_id="p"))
+            deadline = time.monotonic() + 5.0
+            while not probe.done() and time.monotonic() < deadline:
+                executor.spin_once(0.05)
+            if probe.done():
+                break
+        held = [client.call_async(LoadObject.Request(scene_yaml=big_disk(20000 + k),
+                                                     object_id=f"d{k}")) for k in range(2)]
+        busy = client.call_async(LoadObject.Request(scene_yaml=BLOB, object_id="blob"))
+        _spin_until(executor, busy.done)  # after the two held ones: the same client's order
+        assert busy.result().error_code == ErrorCode.BUSY, busy.result().message
+        assert not any(f.done() for f in held), "a 20,000-node load ended before the signal"
+        process.send_signal(signum)
+        _spin_until(executor, lambda: all(f.done() for f in held))
+        running, queued = (f.result() for f in held)
+        assert running.success or running.error_code == ErrorCode.CANCELLED, running.message
+        assert queued.error_code == ErrorCode.CANCELLED, queued.message
+        assert "the planner is shutting down" in queued.message
+        code = process.wait(timeout=TIMEOUT)
+        log.close()
+        assert code == 0, (tmp_path / "planner.log").read_text()
+    finally:
+        if process.poll() is None:
+            process.kill()
+            process.wait()
+        node.destroy_node()
+        executor.shutdown()

@@ -18,10 +18,12 @@ from pathlib import Path
 
 import pytest
 import rclpy
-from planner_support import BLOB, big_disk
+from action_msgs.msg import GoalStatus
+from planner_support import BLOB, Harness, big_disk
 from rclpy.context import Context
 from rclpy.executors import SingleThreadedExecutor
 
+from squeeze_grasp_interfaces.action import GraspMap as GraspMapAction
 from squeeze_grasp_interfaces.srv import LoadObject
 from squeeze_grasp_ros.planning import ErrorCode
 from squeeze_grasp_ros.ros.nodes import pipeline
@@ -86,3 +88,36 @@ def test_a_stopped_planner_answers_its_running_and_queued_loads(
             process.wait()
         node.destroy_node()
         executor.shutdown()
+
+
+def test_a_stopped_planner_ends_its_running_goal(ros_context: Context, tmp_path: Path) -> None:
+    """A grasp-map goal running at SIGINT (signalled on its first feedback) ends ABORTED with
+    CANCELLED, "the planner is shutting down", and its client gets that result.
+    """
+    log = (tmp_path / "planner.log").open("w")
+    process = subprocess.Popen(
+        [sys.executable, "-m", "squeeze_grasp_ros.ros.nodes.planner"],
+        stdout=log, stderr=subprocess.STDOUT, env=dict(os.environ))
+    harness = Harness(ros_context, with_planner=False)
+    try:
+        def on_feedback(_message) -> None:
+            if process.poll() is None and not signalled:
+                signalled.append(True)
+                process.send_signal(signal.SIGINT)
+        signalled: list[bool] = []
+        _, outcome = harness.goal(GraspMapAction, "grasp_map",
+                                  GraspMapAction.Goal(scene_yaml=big_disk(15_000), mu=0.3),
+                                  on_feedback)
+        harness.spin_until(outcome.done, timeout=TIMEOUT)
+        result = outcome.result()
+        assert signalled and result.status == GoalStatus.STATUS_ABORTED
+        assert result.result.error_code == ErrorCode.CANCELLED
+        assert "the planner is shutting down" in result.result.message
+        code = process.wait(timeout=TIMEOUT)
+        log.close()
+        assert code == 0, (tmp_path / "planner.log").read_text()
+    finally:
+        if process.poll() is None:
+            process.kill()
+            process.wait()
+        harness.close()

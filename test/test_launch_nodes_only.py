@@ -14,11 +14,13 @@ from __future__ import annotations
 
 import ast
 import time
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 from pathlib import Path
 
 from geometry_msgs.msg import Vector3
 from rclpy.action import ActionClient
-from rclpy.executors import SingleThreadedExecutor
+from rclpy.executors import Executor, SingleThreadedExecutor
 from rclpy.node import Node
 from rclpy.parameter import Parameter
 
@@ -53,9 +55,11 @@ def test_the_launch_file_gives_nodes_without_a_run_parameters_that_await_no_pred
     assert nodes_only["executor"]["await_prediction"] is False
 
 
-def test_nodes_started_without_a_run_start_the_loop_and_execute_a_typed_goal(ros_context):
-    """The loop nodes of ``run:=false`` on real rclpy: tick 0 starts without a prediction,
-    and the goal docs/pipeline.md has a user type (shallower here) ends ``depth_reached``.
+@contextmanager
+def loop_nodes(ros_context) -> Iterator[tuple[dict, Callable, ActionClient, Executor]]:
+    """The loop nodes of ``run:=false`` and a client node on one executor: (the nodes by name,
+    ``until(done, seconds)`` spinning them, an action client of the executor's goal, the
+    executor).
     """
     from squeeze_grasp_ros.ros.nodes.executor import ExecutorNode
     from squeeze_grasp_ros.ros.nodes.monitor import MonitorNode
@@ -65,16 +69,14 @@ def test_nodes_started_without_a_run_start_the_loop_and_execute_a_typed_goal(ros
     classes = {"sim_hardware": SimHardwareNode, "monitor": MonitorNode,
                "executor": ExecutorNode}
     spinner = SingleThreadedExecutor(context=ros_context)
-    nodes = []
+    nodes = {}
     try:
         for name, values in launch_parameters(run=False).items():
-            nodes.append(classes[name](context=ros_context, cli_args=args, parameter_overrides=[
-                Parameter(k, value=v) for k, v in values.items()]))
-        client_node = Node("typist", namespace=NAMESPACE, context=ros_context)
-        nodes.append(client_node)
-        for node in nodes:
+            nodes[name] = classes[name](context=ros_context, cli_args=args, parameter_overrides=[
+                Parameter(k, value=v) for k, v in values.items()])
+        nodes["typist"] = Node("typist", namespace=NAMESPACE, context=ros_context)
+        for node in nodes.values():
             spinner.add_node(node)
-        sim = nodes[0]
 
         def until(done, seconds=60.0) -> bool:
             deadline = time.monotonic() + seconds
@@ -82,18 +84,53 @@ def test_nodes_started_without_a_run_start_the_loop_and_execute_a_typed_goal(ros
                 spinner.spin_once(timeout_sec=0.05)
             return done()
 
-        assert until(lambda: sim.now_ns >= 0), "sim_hardware never started tick 0"
-        client = ActionClient(client_node, ExecuteGrasp, pipeline.ACTION)
+        yield nodes, until, ActionClient(nodes["typist"], ExecuteGrasp, pipeline.ACTION), spinner
+    finally:
+        for node in nodes.values():
+            spinner.remove_node(node)
+            node.destroy_node()
+        spinner.shutdown()
+
+
+def typed_goal(depth: float) -> ExecuteGrasp.Goal:
+    """The goal docs/pipeline.md has a user type, to ``depth`` m."""
+    return ExecuteGrasp.Goal(fingers=["F1", "F2"],
+                             directions=[Vector3(x=0.70711), Vector3(x=-0.70711)],
+                             depth=depth, relative_per_depth=14.1421, on_slip_alarm="hold")
+
+
+def test_nodes_started_without_a_run_start_the_loop_and_execute_a_typed_goal(ros_context):
+    """The loop nodes of ``run:=false`` on real rclpy: tick 0 starts without a prediction,
+    and the goal docs/pipeline.md has a user type (shallower here) ends ``depth_reached``.
+    """
+    with loop_nodes(ros_context) as (nodes, until, client, _):
+        assert until(lambda: nodes["sim_hardware"].now_ns >= 0), \
+            "sim_hardware never started tick 0"
         assert until(client.server_is_ready)
-        sent = client.send_goal_async(ExecuteGrasp.Goal(
-            fingers=["F1", "F2"], directions=[Vector3(x=0.70711), Vector3(x=-0.70711)],
-            depth=0.002, relative_per_depth=14.1421, on_slip_alarm="hold"))
+        sent = client.send_goal_async(typed_goal(0.002))
         assert until(sent.done) and sent.result().accepted
         result = sent.result().get_result_async()
         assert until(result.done), "the goal never ended"
         assert result.result().result.termination == ExecuteGrasp.Result.DEPTH_REACHED
-    finally:
-        for node in nodes:
-            spinner.remove_node(node)
-            node.destroy_node()
-        spinner.shutdown()
+
+
+def test_an_executor_that_stops_ends_its_goal(ros_context):
+    """SIGINT or SIGTERM makes a node's ``main`` drain it before it ends: the executor ends a
+    running goal ABORTED (termination ``canceled``, "the executor is shutting down"), and its
+    client gets that result. Before, the goal was left running and its client waited for ever.
+    """
+    from action_msgs.msg import GoalStatus
+
+    with loop_nodes(ros_context) as (nodes, until, client, spinner):
+        assert until(client.server_is_ready)
+        feedback = []
+        sent = client.send_goal_async(typed_goal(0.02), feedback_callback=feedback.append)
+        assert until(sent.done) and sent.result().accepted
+        assert until(lambda: feedback), "no feedback: the goal did not start"
+        result = sent.result().get_result_async()
+        nodes["executor"].drain(spinner)
+        assert until(result.done, 5.0), "the goal never ended"
+        assert result.result().status == GoalStatus.STATUS_ABORTED
+        ended = result.result().result
+        assert ended.termination == ExecuteGrasp.Result.CANCELED and not ended.success
+        assert "the executor is shutting down" in ended.message

@@ -210,6 +210,30 @@ class ExecutorNode(Node):
         self.server.destroy()
         super().destroy_node()
 
+    def drain(self, executor: Any, timeout: float = 1.0) -> None:
+        """End the goal in flight when the node stops (SIGINT, SIGTERM): ABORTED, termination
+        ``canceled``, "the executor is shutting down"; spin ``executor`` until its result is
+        sent, ``timeout`` s at most. (Before, the node ended without ending the goal, and its
+        client waited for a result for ever.) The devices keep the last setpoints sent.
+        """
+        goal = self.goal
+        if goal is None or goal.done.done():
+            return
+        self.goal = None
+        latest = messages.cdr_stamp_ns(self.latest) if self.latest is not None else None
+        elapsed = 0.0 if goal.start_ns is None or latest is None else \
+            max(latest - goal.start_ns, 0) * 1e-9
+        goal.done.set_result(messages.grasp_result(
+            goal.program, Command({}, "holding", ExecuteGrasp.Result.CANCELED,
+                                  "the executor is shutting down; the devices keep the last "
+                                  "setpoints sent"),
+            None, goal.events, elapsed, SUCCESS))
+        deadline = time.monotonic() + timeout
+        while self.accepted and time.monotonic() < deadline:
+            executor.spin_once(0.05)
+        for _ in range(4):  # the result request the ended goal answers
+            executor.spin_once(0.05)
+
     def _accept_goal(self, _: ExecuteGrasp.Goal) -> GoalResponse:
         """One goal at a time: reject while one is accepted, running or not started yet
         (before, checking only the running goal, a burst of goals at an idle executor on
@@ -266,7 +290,7 @@ class ExecutorNode(Node):
                 messages.cdr_stamp_ns(self.latest) > self.answered.stamp_ns:
             self._cycle(self.latest)
         result = await done
-        if result.termination == ExecuteGrasp.Result.CANCELED:
+        if result.termination == ExecuteGrasp.Result.CANCELED and handle.is_cancel_requested:
             handle.canceled()
         elif result.success:
             handle.succeed()

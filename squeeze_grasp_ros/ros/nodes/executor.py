@@ -214,7 +214,8 @@ class ExecutorNode(Node):
         """End the goal in flight when the node stops (SIGINT, SIGTERM): ABORTED, termination
         ``canceled``, "the executor is shutting down"; spin ``executor`` until its result is
         sent, ``timeout`` s at most. (Before, the node ended without ending the goal, and its
-        client waited for a result for ever.) The devices keep the last setpoints sent.
+        client waited for a result for ever.) Nothing more is commanded: a joint trajectory's
+        one point ends a period later; a gripper action controller's goal is not canceled.
         """
         goal = self.goal
         if goal is None or goal.done.done():
@@ -225,8 +226,7 @@ class ExecutorNode(Node):
             max(latest - goal.start_ns, 0) * 1e-9
         goal.done.set_result(messages.grasp_result(
             goal.program, Command({}, "holding", ExecuteGrasp.Result.CANCELED,
-                                  "the executor is shutting down; the devices keep the last "
-                                  "setpoints sent"),
+                                  "the executor is shutting down: it sends no more commands"),
             None, goal.events, elapsed, SUCCESS))
         deadline = time.monotonic() + timeout
         while self.accepted and time.monotonic() < deadline:

@@ -14,6 +14,8 @@ import signal
 import subprocess
 import sys
 import time
+from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
 
 import pytest
@@ -38,6 +40,30 @@ def _spin_until(executor: SingleThreadedExecutor, done, timeout: float = TIMEOUT
         executor.spin_once(0.05)
 
 
+@contextmanager
+def planner_process(tmp_path: Path, *ros_args: str) -> Iterator[subprocess.Popen]:
+    """A planner process (``python -m``, ``--ros-args`` ``ros_args``) logging to
+    ``tmp_path/planner.log``; killed if it still runs at the end.
+    """
+    with (tmp_path / "planner.log").open("w") as log:
+        process = subprocess.Popen(
+            [sys.executable, "-m", "squeeze_grasp_ros.ros.nodes.planner",
+             *(("--ros-args", *ros_args) if ros_args else ())],
+            stdout=log, stderr=subprocess.STDOUT, env=dict(os.environ))
+        try:
+            yield process
+        finally:
+            if process.poll() is None:
+                process.kill()
+                process.wait()
+
+
+def assert_exits_cleanly(process: subprocess.Popen, tmp_path: Path) -> None:
+    """The stopped planner process exits 0 (its log in the message otherwise)."""
+    code = process.wait(timeout=TIMEOUT)
+    assert code == 0, (tmp_path / "planner.log").read_text()
+
+
 @pytest.mark.parametrize("signum", [signal.SIGINT, signal.SIGTERM])
 def test_a_stopped_planner_answers_its_running_and_queued_loads(
     ros_context: Context, tmp_path: Path, signum: int
@@ -47,15 +73,10 @@ def test_a_stopped_planner_answers_its_running_and_queued_loads(
     load is refused CANCELLED, "the planner is shutting down", the running one is answered
     too (cancelled at its next stage, or done), and the process exits 0.
     """
-    log = (tmp_path / "planner.log").open("w")
-    process = subprocess.Popen(
-        [sys.executable, "-m", "squeeze_grasp_ros.ros.nodes.planner", "--ros-args",
-         "-p", "worker_threads:=1", "-p", "max_pending:=2"],
-        stdout=log, stderr=subprocess.STDOUT, env=dict(os.environ))
     node = rclpy.create_node("shutdown_probe", context=ros_context)
     executor = SingleThreadedExecutor(context=ros_context)
     executor.add_node(node)
-    try:
+    with planner_process(tmp_path, "-p", "worker_threads:=1", "-p", "max_pending:=2") as process:
         client = node.create_client(LoadObject, "/planner/load_object",
                                     qos_profile=pipeline.request_queue(0))
         assert client.wait_for_service(timeout_sec=TIMEOUT)
@@ -79,27 +100,17 @@ def test_a_stopped_planner_answers_its_running_and_queued_loads(
         assert running.success or running.error_code == ErrorCode.CANCELLED, running.message
         assert queued.error_code == ErrorCode.CANCELLED, queued.message
         assert "the planner is shutting down" in queued.message
-        code = process.wait(timeout=TIMEOUT)
-        log.close()
-        assert code == 0, (tmp_path / "planner.log").read_text()
-    finally:
-        if process.poll() is None:
-            process.kill()
-            process.wait()
-        node.destroy_node()
-        executor.shutdown()
+        assert_exits_cleanly(process, tmp_path)
+    node.destroy_node()
+    executor.shutdown()
 
 
 def test_a_stopped_planner_ends_its_running_goal(ros_context: Context, tmp_path: Path) -> None:
     """A grasp-map goal running at SIGINT (signalled on its first feedback) ends ABORTED with
     CANCELLED, "the planner is shutting down", and its client gets that result.
     """
-    log = (tmp_path / "planner.log").open("w")
-    process = subprocess.Popen(
-        [sys.executable, "-m", "squeeze_grasp_ros.ros.nodes.planner"],
-        stdout=log, stderr=subprocess.STDOUT, env=dict(os.environ))
     harness = Harness(ros_context, with_planner=False)
-    try:
+    with planner_process(tmp_path) as process:
         def on_feedback(_message) -> None:
             if process.poll() is None and not signalled:
                 signalled.append(True)
@@ -113,11 +124,5 @@ def test_a_stopped_planner_ends_its_running_goal(ros_context: Context, tmp_path:
         assert signalled and result.status == GoalStatus.STATUS_ABORTED
         assert result.result.error_code == ErrorCode.CANCELLED
         assert "the planner is shutting down" in result.result.message
-        code = process.wait(timeout=TIMEOUT)
-        log.close()
-        assert code == 0, (tmp_path / "planner.log").read_text()
-    finally:
-        if process.poll() is None:
-            process.kill()
-            process.wait()
-        harness.close()
+        assert_exits_cleanly(process, tmp_path)
+    harness.close()

@@ -266,3 +266,34 @@ def test_a_hostile_action_client_is_rejected(kind, tmp_path, capfd):
         assert goal(0.4, effort=3.0).accepted
     err = capfd.readouterr().err
     assert err.count("rejected the goal on /gripper_controller/gripper_cmd") == len(hostile)
+
+
+def test_a_stopping_executor_cancels_the_gripper_goal(tmp_path):
+    """An executor node stopped mid-squeeze (SIGINT, SIGTERM: its ``drain``) cancels its
+    gripper goal before it ends the grasp goal: the controller holds the measured position, and
+    the goal's result says so. Before, the controller went on to the goal's aperture after the
+    executor had gone.
+    """
+    from squeeze_grasp_ros.ros.run.options import RunOptions
+    from squeeze_grasp_ros.ros.run.runner import PipelineRunner
+
+    path = write_scene(tmp_path, sponge("parallel_gripper", **TIGHT))
+    runner = PipelineRunner(RunOptions(path, planner=False))
+    try:
+        runner.start()
+        runner.send_goal()
+
+        def sim_time() -> float:
+            return (runner.observer.sim_state_ns - runner.start_ns) * 1e-9
+
+        runner.spin_until(lambda: sim_time() > 0.2, 60.0, "0.2 s of the squeeze")
+        controller = runner.nodes["sim_hardware"].controller
+        assert controller.active is not None  # the gripper goal runs
+        runner.nodes["executor"].drain(runner.executor)
+        assert controller.active is None  # canceled: the servo holds the measured position
+        runner.spin_until(runner.goal.result_future.done, 10.0, "the goal's result")
+        result = runner.goal.result_future.result().result
+        assert result.termination == "canceled" and not result.success
+        assert "it canceled the gripper goal" in result.message, result.message
+    finally:
+        runner.shutdown()

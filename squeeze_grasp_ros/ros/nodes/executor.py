@@ -215,18 +215,29 @@ class ExecutorNode(Node):
         ``canceled``, "the executor is shutting down"; spin ``executor`` until its result is
         sent, ``timeout`` s at most. (Before, the node ended without ending the goal, and its
         client waited for a result for ever.) Nothing more is commanded: a joint trajectory's
-        one point ends a period later; a gripper action controller's goal is not canceled.
+        one point ends a period later, and a gripper action controller's goal is canceled first
+        (the stock controllers hold the measured position), waiting ``timeout`` s at most for
+        the controller's answer.
         """
         goal = self.goal
         if goal is None or goal.done.done():
             return
         self.goal = None
+        message = "the executor is shutting down: it sends no more commands"
+        answered: list[bool] = []
+        if self.jaw_action is not None and self.jaw_action.cancel(lambda: answered.append(True)):
+            deadline = time.monotonic() + timeout
+            while not answered and time.monotonic() < deadline:
+                executor.spin_once(0.05)
+            message += ("; it canceled the gripper goal (the controller holds position)"
+                        if answered else
+                        f"; the gripper controller did not answer the cancel of its goal within "
+                        f"{timeout:g} s")
         latest = messages.cdr_stamp_ns(self.latest) if self.latest is not None else None
         elapsed = 0.0 if goal.start_ns is None or latest is None else \
             max(latest - goal.start_ns, 0) * 1e-9
         goal.done.set_result(messages.grasp_result(
-            goal.program, Command({}, "holding", ExecuteGrasp.Result.CANCELED,
-                                  "the executor is shutting down: it sends no more commands"),
+            goal.program, Command({}, "holding", ExecuteGrasp.Result.CANCELED, message),
             None, goal.events, elapsed, SUCCESS))
         deadline = time.monotonic() + timeout
         while self.accepted and time.monotonic() < deadline:

@@ -19,6 +19,7 @@ from squeeze_grasp_ros.api import (
     load_scene,
     scene_file,
 )
+from squeeze_grasp_ros.mechanics.elastic.stress_measures import von_mises
 from squeeze_grasp_ros.mechanics.squeeze import events
 
 
@@ -39,3 +40,25 @@ def test_a_non_finite_health_number_is_named_with_its_measure(foam, monkeypatch,
         event_squeeze(obj, contacts, 0.02, 0.4, relative_depth=0.02, material_model=model)
     assert str(info.value) == (f"grasp health: max von Mises stress ({stress} stress, Pa) must "
                                "be finite, got inf")
+
+
+@pytest.mark.parametrize("scale", [1e200, 1e-200])
+def test_von_mises_of_representable_stresses_neither_overflows_nor_underflows(scale):
+    stress = np.array([[[1.0, 0.3], [0.3, -0.5]], [[0.0, 1.0], [1.0, 0.0]]])
+    with np.errstate(all="raise"):
+        assert von_mises(scale * stress) / scale == pytest.approx(von_mises(stress), rel=1e-15)
+
+
+def test_the_linear_von_mises_stress_scales_with_e_through_the_api(foam):
+    """Linear elasticity: the deformation does not depend on E and the stress is E times it,
+    so max von Mises / E is one number from E = 1e-300 to 1e300 Pa (before: 0.0 Pa at 1e-300,
+    NaN at 1e300 from squares beyond the float range).
+    """
+    mesh, contacts = foam
+    per_e = []
+    for E in (5e4, 1e-300, 1e300):
+        obj = ElasticObject(mesh, Material(E=E, nu=0.3, thickness=0.01))
+        with np.errstate(over="ignore", under="ignore"):
+            health = event_squeeze(obj, contacts, 0.02, 0.4, relative_depth=0.02).health
+        per_e.append(health.max_von_mises / E)
+    assert per_e[1:] == pytest.approx([per_e[0]] * 2, rel=1e-9)

@@ -1,10 +1,14 @@
 # Copyright 2026 squeeze_grasp_ros developers
 # SPDX-License-Identifier: Apache-2.0
 """Reported strains and stresses are finite or refused by name: a grasp-health number that is
-not finite names the quantity and its measure (not an unlabelled list), and the von Mises stress
-neither overflows to NaN nor underflows to 0 when the stresses themselves are representable.
+not finite names the quantity and its measure (not an unlabelled list), the von Mises stress
+neither overflows to NaN nor underflows to 0 when the stresses themselves are representable,
+and a strain a command prints names its measure.
 """
 from __future__ import annotations
+
+import re
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -19,6 +23,7 @@ from squeeze_grasp_ros.api import (
     load_scene,
     scene_file,
 )
+from squeeze_grasp_ros.cli import main
 from squeeze_grasp_ros.mechanics.elastic.stress_measures import von_mises
 from squeeze_grasp_ros.mechanics.squeeze import events
 
@@ -62,3 +67,17 @@ def test_the_linear_von_mises_stress_scales_with_e_through_the_api(foam):
             health = event_squeeze(obj, contacts, 0.02, 0.4, relative_depth=0.02).health
         per_e.append(health.max_von_mises / E)
     assert per_e[1:] == pytest.approx([per_e[0]] * 2, rel=1e-9)
+
+
+def test_every_strain_calibrate_prints_names_its_measure(capsys):
+    """``calibrate --compression``: the fits' strain range is the compressive Biot strain -dl/l
+    (before: 'over 15 points up to strain 0.3', no measure).
+    """
+    examples = Path(__file__).resolve().parents[1] / "config" / "examples"
+    assert main(["calibrate", "--compression", str(examples / "foam_compression.csv"),
+                 "--sample-size", "0.05", "0.05", "0.02"]) == 0
+    lines = capsys.readouterr().out.strip().splitlines()
+    assert len(lines) == 3
+    for line in lines:
+        assert re.search(r"strain [0-9]", line) is None or "Biot strain" in line, line
+    assert all(line.endswith("up to compressive Biot strain 0.3") for line in lines[:2]), lines

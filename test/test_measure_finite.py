@@ -17,6 +17,7 @@ from squeeze_grasp_ros.api import (
     ElasticObject,
     InvalidInputError,
     Material,
+    TerminationLimits,
     build_mesh,
     event_squeeze,
     finger_nodes,
@@ -81,3 +82,13 @@ def test_every_strain_calibrate_prints_names_its_measure(capsys):
     for line in lines:
         assert re.search(r"strain [0-9]", line) is None or "Biot strain" in line, line
     assert all(line.endswith("up to compressive Biot strain 0.3") for line in lines[:2]), lines
+
+
+@pytest.mark.parametrize("value", [float("inf"), float("nan"), 0.0])
+def test_a_non_finite_strain_limit_or_weight_is_refused_as_such(value):
+    """Before: 'strain_limit.epsilon must be > 0, got inf' (inf is > 0: the rule not stated)."""
+    with pytest.raises(InvalidInputError, match=r"^strain_limit.epsilon \(in the material "
+                       r"model's strain measure\) must be finite and > 0, got "):
+        TerminationLimits(strain=value)
+    with pytest.raises(InvalidInputError, match="^pickup.weight must be finite and > 0 N, got "):
+        TerminationLimits(weight=value)

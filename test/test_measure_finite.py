@@ -92,3 +92,16 @@ def test_a_non_finite_strain_limit_or_weight_is_refused_as_such(value):
         TerminationLimits(strain=value)
     with pytest.raises(InvalidInputError, match="^pickup.weight must be finite and > 0 N, got "):
         TerminationLimits(weight=value)
+
+
+def test_the_model_comparison_prints_no_nan_at_depth_zero(tmp_path, capsys):
+    """A squeeze to depth 0 (zero contact forces) has no contact width under linear: its
+    relative difference is undefined and said so (before: 'F1 half-width +nan %').
+    """
+    source = Path(__file__).resolve().parents[1] / "config" / "scenes" / "foam_square.yaml"
+    scene = tmp_path / "depth0.yaml"
+    scene.write_text(source.read_text().replace("relative_depth: 0.12", "relative_depth: 0.0"))
+    assert main(["squeeze", str(scene), "--compare-models"]) == 0
+    out = capsys.readouterr().out
+    assert "nan" not in out.lower() and "inf " not in out, out
+    assert out.count("F1 half-width undefined (linear 0)") == 2, out

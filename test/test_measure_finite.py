@@ -7,7 +7,9 @@ and a strain a command prints names its measure.
 """
 from __future__ import annotations
 
+import dataclasses
 import re
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -105,3 +107,23 @@ def test_the_model_comparison_prints_no_nan_at_depth_zero(tmp_path, capsys):
     out = capsys.readouterr().out
     assert "nan" not in out.lower() and "inf " not in out, out
     assert out.count("F1 half-width undefined (linear 0)") == 2, out
+
+
+def test_a_degenerate_element_is_refused_by_name_not_a_singular_factor(foam):
+    """An interior node moved onto the midpoint of its element's opposite edge (zero area):
+    before, numpy divide-by-zero warnings, NaN strain matrices and scipy's RuntimeError
+    'Factor is exactly singular' from the squeeze.
+    """
+    mesh, contacts = foam
+    interior = np.setdiff1d(np.arange(len(mesh.nodes)), mesh.boundary)[5]
+    k = int(np.flatnonzero(np.any(mesh.triangles == interior, axis=1))[0])
+    a, b = (n for n in mesh.triangles[k] if n != interior)
+    nodes = mesh.nodes.copy()
+    nodes[interior] = 0.5 * (nodes[a] + nodes[b])
+    obj = ElasticObject(dataclasses.replace(mesh, nodes=nodes),
+                        Material(E=5e4, nu=0.3, thickness=0.01))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        with pytest.raises(InvalidInputError, match=rf"^mesh element {k} \(nodes .*\) has area "
+                           r"0 m\^2: elements must be counter-clockwise with a positive area"):
+            event_squeeze(obj, contacts, 0.02, 0.4, relative_depth=0.02)

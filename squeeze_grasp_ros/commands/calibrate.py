@@ -115,13 +115,13 @@ def summary(result: dict) -> str:
                      f"{el['nu_residual']:.2g})")
     cp = result.get("compression")
     if cp:
+        measure = StrainMeasure(cp["strain_measure"]).label
         for name in (MaterialModel.LINEAR, MaterialModel.NEO_HOOKEAN):
             fit = cp[name]
             lines.append(f"{name}: E = {fit['E']:.5g} Pa, nu = {fit['nu']:.4g}"
                          f"{'' if fit['nu_fitted'] else ' (given)'}, relative rms residual "
-                         f"{fit['residual']:.3g} over {cp['points']} points up to strain "
-                         f"{cp['max_strain']:.3g}")
-        measure = StrainMeasure(cp["strain_measure"]).label
+                         f"{fit['residual']:.3g} over {cp['points']} points up to compressive "
+                         f"{measure} strain {cp['max_strain']:.3g}")
         lines.append("linear elasticity (same E, nu) stays within 5 % of the neo-Hookean fit up "
                      f"to {100 * cp['linear_within_5_percent_up_to_strain']:.1f} % compressive "
                      f"{measure} strain (-dl / l): beyond that, use material.model: neo_hookean")

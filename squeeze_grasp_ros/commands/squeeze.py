@@ -237,6 +237,13 @@ def plot_models(obj, results: dict, path: str) -> str:
     return plots.save(fig, path)
 
 
+def _percent(difference: float) -> str:
+    """A relative difference from linear as a signed percentage; one of a quantity that is 0
+    for linear (``rel`` gives NaN: a squeeze to depth 0 has no contact width) says so.
+    """
+    return f"{100 * difference:+.2f} %" if np.isfinite(difference) else "undefined (linear 0)"
+
+
 def compare_summary(result: dict) -> str:
     """The model comparison as a table."""
     rows, diff = result["models"], result["relative_difference"]
@@ -256,16 +263,16 @@ def compare_summary(result: dict) -> str:
                      f"{StressMeasure(r['stress_measure']).label:<13}{counts}  "
                      f"{r['seconds']:.2f}")
     for model, d in diff.items():
-        lines.append(f"{model} vs linear: force {100 * d['force'][Finger.F1]:+.2f} %, energy "
-                     f"{100 * d['energy']:+.2f} %, max {common.label} strain "
-                     f"{100 * d['max_principal_strain'][common]:+.2f} %, F1 half-width "
-                     f"{100 * d['contact_half_width'][Finger.F1]:+.2f} %, time "
+        lines.append(f"{model} vs linear: force {_percent(d['force'][Finger.F1])}, energy "
+                     f"{_percent(d['energy'])}, max {common.label} strain "
+                     f"{_percent(d['max_principal_strain'][common])}, F1 half-width "
+                     f"{_percent(d['contact_half_width'][Finger.F1])}, time "
                      f"x{d['seconds_ratio']:.0f}")
     lines.append("max principal strain vs linear, like for like (the same measure of both "
                  "fields):")
     for model, d in diff.items():
         lines.append(f"  {model}: " + ", ".join(
-            f"{StrainMeasure(k).label} {100 * v:+.2f} %"
+            f"{StrainMeasure(k).label} {_percent(v)}"
             for k, v in d["max_principal_strain"].items()))
     lines.append(f"max strain: in the model's own measure, which its strain limit uses; "
                  f"{common.label} strain: U - I of every field; von Mises of the model's stress "

@@ -13,6 +13,7 @@ import scipy.sparse as sp
 
 from squeeze_grasp_ros.mechanics.elastic.material import unit_elasticity_matrix
 from squeeze_grasp_ros.mechanics.elastic.mesh import Mesh, element_areas
+from squeeze_grasp_ros.mechanics.errors import InvalidInputError
 
 
 def strain_displacement(nodes: np.ndarray, triangles: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -30,6 +31,11 @@ def strain_displacement(nodes: np.ndarray, triangles: np.ndarray) -> tuple[np.nd
     b = np.stack([y[:, 1] - y[:, 2], y[:, 2] - y[:, 0], y[:, 0] - y[:, 1]], axis=1)
     c = np.stack([x[:, 2] - x[:, 1], x[:, 0] - x[:, 2], x[:, 1] - x[:, 0]], axis=1)
     area = element_areas(nodes, triangles)
+    if not np.all(area > 0):  # a zero area divides by zero below: NaN strains, a singular K
+        k = int(np.argmin(np.where(np.isnan(area), -np.inf, area)))
+        raise InvalidInputError(f"mesh element {k} (nodes {triangles[k].tolist()}) has area "
+                                f"{area[k]:.3g} m^2: elements must be counter-clockwise with "
+                                "a positive area (a degenerate or flipped triangle)")
     B = np.zeros((len(triangles), 3, 6))
     B[:, 0, 0::2] = b
     B[:, 1, 1::2] = c

@@ -65,4 +65,8 @@ def von_mises(stress: np.ndarray) -> np.ndarray:
     True
     """
     s11, s22, s12 = stress[:, 0, 0], stress[:, 1, 1], 0.5 * (stress[:, 0, 1] + stress[:, 1, 0])
-    return np.sqrt(s11 * s11 - s11 * s22 + s22 * s22 + 3.0 * s12 * s12)
+    # scaled by each element's largest power of two first (exact), so that the squares neither
+    # overflow to inf - inf = NaN (beyond 1e154 Pa) nor underflow to 0 (below 1e-154 Pa)
+    _, k = np.frexp(np.maximum(np.maximum(np.abs(s11), np.abs(s22)), np.abs(s12)))
+    s11, s22, s12 = np.ldexp(s11, -k), np.ldexp(s22, -k), np.ldexp(s12, -k)
+    return np.ldexp(np.sqrt(s11 * s11 - s11 * s22 + s22 * s22 + 3.0 * s12 * s12), k)

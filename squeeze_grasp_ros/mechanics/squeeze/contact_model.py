@@ -114,9 +114,10 @@ class TerminationLimits:
                 f"got {self.criterion!r}"
             )
         if self.strain is not None and not (np.isfinite(self.strain) and self.strain > 0):
-            raise InvalidInputError(f"strain_limit.epsilon must be > 0, got {self.strain}")
+            raise InvalidInputError(f"strain_limit.epsilon (in the material model's strain "
+                                    f"measure) must be finite and > 0, got {self.strain}")
         if self.weight is not None and not (np.isfinite(self.weight) and self.weight > 0):
-            raise InvalidInputError(f"pickup.weight must be > 0 N, got {self.weight}")
+            raise InvalidInputError(f"pickup.weight must be finite and > 0 N, got {self.weight}")
 
 
 @dataclass(frozen=True)

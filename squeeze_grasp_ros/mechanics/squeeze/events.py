@@ -471,8 +471,12 @@ def _health(model: ContactModel, state: ContactState,
         slip_margin={f.name: float(min(margins[f.name])) for f in state.fingers
                      if f.name in margins},
     )
-    require_finite("grasp health", [strain, *max_principal.values(), health.max_von_mises,
-                                    health.max_displacement])
+    checks = {f"max strain ({health.strain_measure.label} strain)": strain,
+              **{f"max principal {m.label} strain": v for m, v in max_principal.items()},
+              f"max von Mises stress ({stress_measure.label} stress, Pa)": health.max_von_mises,
+              "max displacement (m)": health.max_displacement}
+    for name, value in checks.items():  # the first one that is not finite, by name and measure
+        require_finite(f"grasp health: {name}", value)
     return health, u
 
 

@@ -108,6 +108,21 @@ def test_bad_input_exits_2_with_one_line(tmp_path, capsys, argv, message):
     assert code == 2 and message in err and len(err.strip().splitlines()) == 1
 
 
+@pytest.mark.parametrize("option, message", [
+    (["--seed", "-1"], "seed must be an integer >= 0, got -1"),
+    (["--blur", "1e9"], "blur_px must be at most the image's larger side (640 px)"),
+])
+def test_render_refuses_a_negative_seed_and_a_blur_wider_than_the_image(tmp_path, capsys,
+                                                                        option, message):
+    """Both were tracebacks: numpy's seed ValueError, a 60 GiB kernel's MemoryError."""
+    mask = tmp_path / "mask.png"
+    code = cli.main(["render", str(scene_file("foam_square")), *CAMERA, "--mask", str(mask),
+                     *option])
+    err = capsys.readouterr().err
+    assert code == 2 and message in err and len(err.strip().splitlines()) == 1, err
+    assert not mask.exists()
+
+
 def test_an_empty_mask_and_a_colour_png_are_refused(tmp_path, capsys):
     skimage_or_skip()
     from PIL import Image

@@ -123,6 +123,20 @@ def test_render_refuses_a_negative_seed_and_a_blur_wider_than_the_image(tmp_path
     assert not mask.exists()
 
 
+def test_an_npy_name_on_another_format_is_refused_with_one_line(tmp_path, capsys):
+    """An .npz archive named .npy ended in an AttributeError traceback; a PNG or text file
+    named .npy was called 'pickled (object) data'.
+    """
+    archive, text = tmp_path / "archive.npy", tmp_path / "text.npy"
+    with open(archive, "wb") as fh:
+        np.savez(fh, mask=np.zeros((480, 640), np.uint8))
+    text.write_text("hello\n")
+    for path in (archive, text):
+        assert cli.main(["outline", str(path), *CAMERA]) == 2
+        err = capsys.readouterr().err
+        assert "not an NPY array file" in err and len(err.strip().splitlines()) == 1, err
+
+
 def test_an_empty_mask_and_a_colour_png_are_refused(tmp_path, capsys):
     skimage_or_skip()
     from PIL import Image

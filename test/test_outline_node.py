@@ -139,3 +139,26 @@ def test_a_bad_camera_pose_parameter_is_refused():
         pose_parameter([1.0, 2.0])
     with pytest.raises(ParameterError, match="camera_pose: .*above the support plane"):
         pose_parameter([0.0, 0.0, -0.5, np.pi, 0.0, 0.0])
+
+
+def test_a_camera_whose_undistortion_diverges_is_refused_not_raised(ros_context):
+    """A CameraInfo with distortion too strong to invert (k1 = k2 = k3 = 100) made the image
+    callback raise NumericalError out of the node; now the frame is refused on outline/errors.
+    """
+    skimage_or_skip()
+    from dataclasses import replace
+
+    from rclpy.parameter import Parameter
+
+    from squeeze_grasp_ros.ros.messages.images import image_msg
+    from squeeze_grasp_ros.ros.nodes.outline import OutlineNode
+
+    views = render_views(shapes.rectangle(0.1, 0.1), CAMERA, pose(), top_height=HEIGHT)
+    node = OutlineNode(context=ros_context, parameter_overrides=[
+        Parameter("camera_pose", value=[0.0, 0.0, 0.5, np.pi, 0.0, 0.0])])
+    try:
+        node.camera = replace(CAMERA, distortion=(100.0, 100.0, 0.0, 0.0, 100.0))
+        node._image(image_msg(views.mask, ImageEncoding.MONO8, 1_000, "cam"))
+        assert "undistortion did not converge" in node.last_error
+    finally:
+        node.destroy_node()

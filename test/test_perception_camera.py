@@ -98,6 +98,18 @@ def test_calibration_layouts_agree_and_bad_files_name_the_field():
         CameraModel(6.5, 480, fx=1.0, fy=1.0, cx=0.0, cy=0.0)
 
 
+def test_an_uncalibrated_camera_info_says_so():
+    """A driver without a calibration publishes CameraInfo with k all zero and d empty; the
+    error used to ask for an intrinsics matrix without skew.
+    """
+    info = {"width": 640, "height": 480, "k": [0.0] * 9, "d": [], "distortion_model": ""}
+    with pytest.raises(InvalidInputError, match="camera_info: the camera is uncalibrated"):
+        camera_from_info(info, what="camera_info")
+    with pytest.raises(InvalidInputError, match=r"no skew\), got \[465"):
+        camera_from_info(info | {"k": [465, 3, 320, 0, 465, 240, 0, 0, 1],
+                                 "distortion_model": "plumb_bob"})
+
+
 def test_strong_distortion_that_cannot_be_inverted_raises_with_its_residual():
     wild = CameraModel(640, 480, fx=200.0, fy=200.0, cx=319.5, cy=239.5,
                        distortion=(-0.9, 0.0, 0.0, 0.0, 0.0))

@@ -108,6 +108,35 @@ def test_bad_input_exits_2_with_one_line(tmp_path, capsys, argv, message):
     assert code == 2 and message in err and len(err.strip().splitlines()) == 1
 
 
+@pytest.mark.parametrize("option, message", [
+    (["--seed", "-1"], "seed must be an integer >= 0, got -1"),
+    (["--blur", "1e9"], "blur_px must be at most the image's larger side (640 px)"),
+])
+def test_render_refuses_a_negative_seed_and_a_blur_wider_than_the_image(tmp_path, capsys,
+                                                                        option, message):
+    """Both were tracebacks: numpy's seed ValueError, a 60 GiB kernel's MemoryError."""
+    mask = tmp_path / "mask.png"
+    code = cli.main(["render", str(scene_file("foam_square")), *CAMERA, "--mask", str(mask),
+                     *option])
+    err = capsys.readouterr().err
+    assert code == 2 and message in err and len(err.strip().splitlines()) == 1, err
+    assert not mask.exists()
+
+
+def test_an_npy_name_on_another_format_is_refused_with_one_line(tmp_path, capsys):
+    """An .npz archive named .npy ended in an AttributeError traceback; a PNG or text file
+    named .npy was called 'pickled (object) data'.
+    """
+    archive, text = tmp_path / "archive.npy", tmp_path / "text.npy"
+    with open(archive, "wb") as fh:
+        np.savez(fh, mask=np.zeros((480, 640), np.uint8))
+    text.write_text("hello\n")
+    for path in (archive, text):
+        assert cli.main(["outline", str(path), *CAMERA]) == 2
+        err = capsys.readouterr().err
+        assert "not an NPY array file" in err and len(err.strip().splitlines()) == 1, err
+
+
 def test_an_empty_mask_and_a_colour_png_are_refused(tmp_path, capsys):
     skimage_or_skip()
     from PIL import Image

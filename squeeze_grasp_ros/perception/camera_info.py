@@ -75,9 +75,13 @@ def camera_from_info(data: Any, *, what: str = "camera info") -> CameraModel:
         k = _numbers(data.get("k", data.get("K")), 9, f"{what}: k")
     else:
         raise InvalidInputError(f"{what}: missing camera_matrix (or k), the 3 x 3 intrinsics")
+    if not any(k):  # CameraInfo's convention for a camera without calibration
+        raise InvalidInputError(f"{what}: the camera is uncalibrated (its intrinsics are all "
+                                "zero); calibrate it (camera_calibration) and publish or pass "
+                                "its calibration")
     if abs(k[1]) > 1e-9 or any(abs(v) > 1e-9 for v in k[3:4] + k[6:8]) or abs(k[8] - 1) > 1e-9:
         raise InvalidInputError(f"{what}: the intrinsics must be [fx, 0, cx, 0, fy, cy, 0, 0, 1] "
-                                "(no skew)")
+                                f"(no skew), got {k}")
     model = data.get("distortion_model", DistortionModel.PLUMB_BOB.value)
     if model not in DistortionModel.values():
         raise InvalidInputError(f"{what}: distortion_model must be one of "

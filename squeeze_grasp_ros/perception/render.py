@@ -224,20 +224,21 @@ def render_views(outline: Outline, camera: CameraModel, pose: CameraPose, *,
     top_height : float
         Height of the top face above the plane (the object's thickness), m, >= 0.
     blur_px : float
-        Standard deviation of a Gaussian blur of the coverage (defocus), px, >= 0.
+        Standard deviation of a Gaussian blur of the coverage (defocus), px, in [0, the image's
+        larger side] (a wider blur flattens the whole image; its kernel would not fit memory).
     depth_noise_m : float
         Standard deviation of Gaussian noise added to each depth pixel, m, >= 0.
     mask_noise : float
         Standard deviation of Gaussian noise added to the coverage before it is quantised into
         the mask (fraction of full scale), >= 0.
     seed : int
-        Seed of the noise draws.
+        Seed of the noise draws, an integer >= 0.
 
     Raises
     ------
     InvalidInputError
-        For a negative option, a top face at or above the camera, or a view in which some
-        pixel does not see the plane.
+        For a negative option or seed, a blur wider than the image, a top face at or above the
+        camera, or a view in which some pixel does not see the plane.
     """
     from scipy.ndimage import gaussian_filter
 
@@ -246,6 +247,11 @@ def render_views(outline: Outline, camera: CameraModel, pose: CameraPose, *,
         if not (np.isfinite(value) and value >= 0):
             raise InvalidInputError(f"render_views: {name} must be a finite number >= 0, got "
                                     f"{value!r}")
+    if blur_px > max(camera.shape):
+        raise InvalidInputError(f"render_views: blur_px must be at most the image's larger side "
+                                f"({max(camera.shape)} px), got {blur_px!r}")
+    if isinstance(seed, bool) or not isinstance(seed, int | np.integer) or seed < 0:
+        raise InvalidInputError(f"render_views: seed must be an integer >= 0, got {seed!r}")
     if not top_height < pose.position[2]:
         raise InvalidInputError(f"render_views: top_height {top_height:g} m is not below the "
                                 f"camera (z = {pose.position[2]:g} m)")

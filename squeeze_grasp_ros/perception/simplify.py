@@ -390,8 +390,12 @@ def sharpen_corners(points: np.ndarray, kept: np.ndarray, *, radius: float, span
             corner = _corner(p, gap, skip, _Stretches(fits, k, i), max_cut, min_turn_deg)
             if corner is None:
                 continue
-            if moved.any() and vector_lengths(out[moved] - corner).min() < skip:
-                drop[c] = True  # the same corner, rebuilt from a neighbouring vertex
+            # the same corner, rebuilt from a neighbouring vertex: near it in the plane and
+            # along the curve (across a slit a pixel wide, the next corner is only near)
+            same = ((vector_lengths(out - corner) < skip) & moved
+                    & (np.abs(gap[kept]) < skip + span))
+            if same.any():
+                drop[c] = True
             else:
                 out[c], moved[c] = corner, True
                 drop |= (np.abs(gap[kept]) < skip) & ~moved  # the rounded tip's vertices

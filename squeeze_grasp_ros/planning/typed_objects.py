@@ -195,8 +195,21 @@ class TypedObject:
 
 def _points(points: Sequence[Sequence[float]], pose: tuple[np.ndarray, np.ndarray],
             name: str) -> list[list[float]]:
-    """Points (m) of the outline's frame in the object frame, as a scene holds them."""
-    xy = np.asarray(points, float).reshape(-1, 2) if len(points) else np.zeros((0, 2))
+    """Points (m) of the outline's frame in the object frame, as a scene holds them.
+
+    Raises
+    ------
+    PlannerError
+        INVALID_ARGUMENT naming ``name[k]`` for a point that is not an (x, y) pair of finite
+        numbers (m): a 3-D point would otherwise be re-paired into other points.
+    """
+    for k, point in enumerate(points):
+        if not (isinstance(point, Sequence | np.ndarray) and len(point) == 2):
+            raise invalid(f"{name}[{k}] must be an (x, y) pair (m), got {point!r}")
+    try:
+        xy = np.asarray(points, float).reshape(-1, 2) if len(points) else np.zeros((0, 2))
+    except (TypeError, ValueError):
+        raise invalid(f"{name} must be (x, y) pairs of numbers (m)") from None
     if not np.all(np.isfinite(xy)):
         bad = int(np.flatnonzero(~np.all(np.isfinite(xy), axis=1))[0])
         raise invalid(f"{name}[{bad}] must be finite (m)")

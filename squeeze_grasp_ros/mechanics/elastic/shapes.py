@@ -124,11 +124,17 @@ def validate_polyline(points, name: str = "outline") -> np.ndarray:
         raise InvalidInputError(f"{name} has non-finite coordinates")
     step = np.linalg.norm(np.diff(np.vstack([p, p[:1]]), axis=0), axis=1)
     scale = max(float(np.ptp(p, axis=0).max()), 1e-300)
-    p = p[step > 1e-12 * scale]
-    if len(p) < 3:
-        raise InvalidInputError(f"{name} needs at least 3 distinct vertices, got {len(p)}")
+    distinct = p[step > 1e-12 * scale]
+    if len(distinct) < 3:
+        found = len(distinct) or min(len(p), 1)  # all vertices equal: one distinct vertex
+        raise InvalidInputError(f"{name} needs at least 3 distinct vertices, got {found}")
+    p = distinct
     area = signed_area(p)
     if abs(area) <= 1e-12 * scale * scale:
+        flat = np.linalg.svd(p - p.mean(axis=0), compute_uv=False)[-1] <= 1e-12 * scale
+        if not flat:  # a figure eight: its lobes' signed areas cancel
+            raise InvalidInputError(f"{name} is self-intersecting: two edges cross (its "
+                                    "lobes' signed areas cancel); give a simple closed curve")
         raise InvalidInputError(f"{name} is degenerate (zero enclosed area)")
     if area < 0:
         p = p[::-1].copy()

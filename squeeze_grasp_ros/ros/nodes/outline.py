@@ -33,7 +33,7 @@ from sensor_msgs.msg import CameraInfo, Image
 from std_msgs.msg import String
 
 from squeeze_grasp_interfaces.msg import SeenOutline
-from squeeze_grasp_ros.mechanics.errors import InvalidInputError
+from squeeze_grasp_ros.mechanics.errors import InvalidInputError, NumericalError
 from squeeze_grasp_ros.perception.camera import CameraModel, CameraPose
 from squeeze_grasp_ros.perception.extract import extract_outline
 from squeeze_grasp_ros.ros import messages
@@ -128,7 +128,7 @@ class OutlineNode(Node):
                 plane_tolerance_m=p["plane_tolerance"], max_tilt_deg=p["max_tilt_deg"],
                 min_area_px=p["min_area_px"], ambiguous_ratio=p["ambiguous_ratio"],
                 frame_id=p["frame_id"])
-        except InvalidInputError as error:
+        except (InvalidInputError, NumericalError) as error:  # e.g. undistortion diverged
             self._refuse(msg.header.stamp, str(error))
             return
         self.last_error = ""

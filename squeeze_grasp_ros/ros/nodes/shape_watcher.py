@@ -36,7 +36,7 @@ from sensor_msgs.msg import CameraInfo, Image
 from squeeze_grasp_interfaces.msg import Alarm, ContactEventArray, PredictedShapes, ShapeResidual
 from squeeze_grasp_ros.control.force_watch import PredictedForces
 from squeeze_grasp_ros.control.tracker import FingerSample, TrackerOutput
-from squeeze_grasp_ros.mechanics.errors import InvalidInputError
+from squeeze_grasp_ros.mechanics.errors import InvalidInputError, NumericalError
 from squeeze_grasp_ros.perception.extract import MIN_AREA_PX, extract_outline
 from squeeze_grasp_ros.perception.shape_watch import (
     AtForce,
@@ -179,7 +179,7 @@ class ShapeWatcher:
             pixels, encoding = image_array(msg)
             seen = extract_outline(pixels, encoding, self.camera, self.pose,
                                    object_height_m=self.object_height, frame_id=self.frame_id)
-        except InvalidInputError as error:
+        except (InvalidInputError, NumericalError) as error:  # e.g. undistortion diverged
             self.node.get_logger().warning(f"shape watch: no outline at {ns * 1e-9:.3f} s: "
                                            f"{error}")
             return

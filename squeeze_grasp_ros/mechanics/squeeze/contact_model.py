@@ -94,7 +94,10 @@ class TerminationLimits:
     Attributes
     ----------
     strain : float or None
-        Proportional-limit strain epsilon* (eq. 45); None = not checked (no strain field).
+        Proportional-limit strain epsilon* (eq. 45, dimensionless) in the material model's
+        own measure (:attr:`ContactModel.strain_measure`: small for linear, Biot for
+        corotational, log for neo_hookean; the measure of ``GraspHealth.max_strain``);
+        None = not checked (no strain field).
     criterion : {"principal", "componentwise"}
         "principal": max(|eps_1|, |eps_2|) <= eps* per element (frame invariant, default);
         "componentwise": |eps_x|, |eps_y| <= eps* in the object frame (eq. 45 literally).

@@ -68,6 +68,26 @@ class ParameterError(InvalidInputError):
     """A node parameter is missing or invalid; the message names it."""
 
 
+DRAIN_SPIN = 0.05
+"""s each ``spin_once`` of a draining node waits for work (one value throughout:
+``SingleThreadedExecutor`` discards its ready entities when the timeout changes)."""
+
+
+def spin_until(executor: Executor, done: Callable[[], bool], timeout: float, *,
+               then: int = 0) -> bool:
+    """Spin ``executor`` until ``done()`` or for ``timeout`` s of wall time, then ``then`` more
+    times (work the last callbacks scheduled: the result request of a goal that just ended);
+    whether ``done()`` held. A node's ``drain`` uses it to answer what it holds before it ends.
+    """
+    deadline = time.monotonic() + timeout
+    while not done() and time.monotonic() < deadline:
+        executor.spin_once(DRAIN_SPIN)
+    finished = done()
+    for _ in range(then):
+        executor.spin_once(DRAIN_SPIN)
+    return finished
+
+
 ACK_TIMEOUT = 5.0
 """s of wall time a node waits at its end for its readers to acknowledge what it published
 (longer than Fast DDS's default heartbeat period of 3 s, which paces the repair of a lost

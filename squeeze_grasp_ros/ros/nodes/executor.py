@@ -60,7 +60,7 @@ from squeeze_grasp_ros.control.motion import (
     goal_problem,
 )
 from squeeze_grasp_ros.ros import messages
-from squeeze_grasp_ros.ros.nodes import ParameterError, pipeline, run_node
+from squeeze_grasp_ros.ros.nodes import ParameterError, pipeline, run_node, spin_until
 from squeeze_grasp_ros.ros.nodes.jaw_commands import HandCommands, JawCommands
 from squeeze_grasp_ros.scene import load_scene
 from squeeze_grasp_ros.scene.controller import HandController, JawController, scene_controller
@@ -226,24 +226,16 @@ class ExecutorNode(Node):
         message = "the executor is shutting down: it sends no more commands"
         answered: list[bool] = []
         if self.jaw_action is not None and self.jaw_action.cancel(lambda: answered.append(True)):
-            deadline = time.monotonic() + timeout
-            while not answered and time.monotonic() < deadline:
-                executor.spin_once(0.05)
             message += ("; it canceled the gripper goal (the controller holds position)"
-                        if answered else
+                        if spin_until(executor, lambda: bool(answered), timeout) else
                         f"; the gripper controller did not answer the cancel of its goal within "
                         f"{timeout:g} s")
         latest = messages.cdr_stamp_ns(self.latest) if self.latest is not None else None
-        elapsed = 0.0 if goal.start_ns is None or latest is None else \
-            max(latest - goal.start_ns, 0) * 1e-9
-        goal.done.set_result(messages.grasp_result(
-            goal.program, Command({}, "holding", ExecuteGrasp.Result.CANCELED, message),
-            None, goal.events, elapsed, SUCCESS))
-        deadline = time.monotonic() + timeout
-        while self.accepted and time.monotonic() < deadline:
-            executor.spin_once(0.05)
-        for _ in range(4):  # the result request the ended goal answers
-            executor.spin_once(0.05)
+        self._end_holding(goal, ExecuteGrasp.Result.CANCELED, message,
+                          0.0 if goal.start_ns is None or latest is None else
+                          max(latest - goal.start_ns, 0) * 1e-9)
+        # then the result request the ended goal answers
+        spin_until(executor, lambda: not self.accepted, timeout, then=4)
 
     def _accept_goal(self, _: ExecuteGrasp.Goal) -> GoalResponse:
         """One goal at a time: reject while one is accepted, running or not started yet
@@ -269,15 +261,18 @@ class ExecutorNode(Node):
 
     def _cancel_unstarted(self, goal: _Goal) -> None:
         """End ``goal``, canceled before its first control cycle."""
-        self._end_unstarted(goal, ExecuteGrasp.Result.CANCELED,
-                            "canceled before its first control cycle; nothing was commanded")
+        self._end_holding(goal, ExecuteGrasp.Result.CANCELED,
+                          "canceled before its first control cycle; nothing was commanded")
 
-    def _end_unstarted(self, goal: _Goal, termination: str, message: str) -> None:
-        """End ``goal``, which has commanded nothing, with ``termination``."""
+    def _end_holding(self, goal: _Goal, termination: str, message: str,
+                     elapsed: float = 0.0) -> None:
+        """End ``goal`` outside a control cycle (it has commanded nothing, or the node stops)
+        with ``termination``, holding, after ``elapsed`` s, with the events it has seen.
+        """
         self.goal = None
         goal.done.set_result(messages.grasp_result(
-            goal.program, Command({}, "holding", termination, message), None, [], 0.0,
-            SUCCESS))
+            goal.program, Command({}, "holding", termination, message), None, goal.events,
+            elapsed, SUCCESS))
 
     async def _execute(self, handle: ServerGoalHandle) -> ExecuteGrasp.Result:
         try:
@@ -331,10 +326,10 @@ class ExecutorNode(Node):
         now = time.monotonic()
         goal.waiting_since = now if goal.waiting_since is None else goal.waiting_since
         if now - goal.waiting_since > self.p["stale_budget"]:
-            self._end_unstarted(goal, ExecuteGrasp.Result.STALE_DATA,
-                                f"no {self.resolve_topic_name(pipeline.STATUS)} message within "
-                                f"stale_budget {self.p['stale_budget']} s of the goal (is the "
-                                "monitor running?); nothing was commanded")
+            self._end_holding(goal, ExecuteGrasp.Result.STALE_DATA,
+                              f"no {self.resolve_topic_name(pipeline.STATUS)} message within "
+                              f"stale_budget {self.p['stale_budget']} s of the goal (is the "
+                              "monitor running?); nothing was commanded")
 
     def _cycle(self, data: bytes, now_ns: int | None = None) -> None:
         """One control cycle on the serialised status ``data``; publish the setpoints, finish

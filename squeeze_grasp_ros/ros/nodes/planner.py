@@ -62,7 +62,7 @@ from squeeze_grasp_ros.mechanics.vocabulary import ObjectModel
 from squeeze_grasp_ros.planning import Cancelled, ErrorCode, PlannerLimits
 from squeeze_grasp_ros.resources import share_dir
 from squeeze_grasp_ros.ros import messages
-from squeeze_grasp_ros.ros.nodes import pipeline, run_node
+from squeeze_grasp_ros.ros.nodes import pipeline, run_node, spin_until
 from squeeze_grasp_ros.ros.nodes.frame_pose_topic import frame_pose_topic
 from squeeze_grasp_ros.ros.refusals import RefusalLog
 
@@ -487,13 +487,8 @@ class PlannerNode(Node):
         message; their results go to the clients that asked for them.
         """
         self._stopping.set()
-        if not self._awaiting:
-            return
-        deadline = time.monotonic() + timeout
-        while self._awaiting and time.monotonic() < deadline:
-            executor.spin_once(0.05)
-        for _ in range(4):  # goals: the result requests the finished goals answer
-            executor.spin_once(0.05)  # one timeout throughout: see RecorderNode.drain
+        if self._awaiting:  # then goals' result requests, answered once the goals have ended
+            spin_until(executor, lambda: not self._awaiting, timeout, then=4)
 
     def destroy_node(self) -> None:
         """Stop the workers (running computations stop at their next stage), then the node."""

@@ -39,9 +39,6 @@ ENCODINGS: dict[str, ImageEncoding] = {
 }
 """Array type -> encoding it is read as."""
 
-NPY_MAGIC = b"\x93NUMPY"
-"""The first bytes of every NPY file (``numpy.lib.format.MAGIC_PREFIX``)."""
-
 PNG_MODES: dict[str, str] = {"1": "bool", "L": "uint8", "I;16": "uint16"}
 """Pillow mode of a single-channel PNG -> array type."""
 
@@ -56,7 +53,8 @@ def decode_image(data: bytes, suffix: str) -> tuple[np.ndarray, ImageEncoding]:
     """
     suffix = suffix.lower()
     if suffix == ".npy":
-        if not data.startswith(NPY_MAGIC):  # np.load would open a .npz or call it pickled
+        # without the NPY header np.load would open a .npz or call the file pickled
+        if not data.startswith(np.lib.format.MAGIC_PREFIX):
             raise InvalidInputError("image: not an NPY array file (no NPY header; an .npz archive "
                                     "or another format named .npy?); save it with numpy.save")
         try:

@@ -50,6 +50,21 @@ def test_images_round_trip_through_messages():
         image_array(padded)
 
 
+def test_an_8uc1_mask_reads_as_mono8_and_other_encodings_are_named():
+    """Segmentation nodes publish one-channel 8-bit masks as ``8UC1`` as often as ``mono8``."""
+    from squeeze_grasp_ros.ros.messages.images import image_array, image_msg
+
+    mask = np.zeros((6, 9), np.uint8)
+    mask[2:5, 3:7] = 1
+    msg = image_msg(mask, ImageEncoding.MONO8, 0, "cam")
+    msg.encoding = "8UC1"
+    back, got = image_array(msg)
+    assert got == ImageEncoding.MONO8 and np.array_equal(back, mask)
+    msg.encoding = "bgr8"
+    with pytest.raises(ValueError, match=r"'mono8', '16UC1', '32FC1', '8UC1'\], got 'bgr8'"):
+        image_array(msg)
+
+
 def test_the_outline_node_publishes_the_seen_outline(ros_context):
     skimage_or_skip()
     import rclpy

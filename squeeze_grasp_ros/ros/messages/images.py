@@ -21,6 +21,10 @@ PIXEL_TYPES: dict[ImageEncoding, np.dtype] = {
 }
 """Pixel type of each encoding the outline extraction reads."""
 
+SAME_AS: dict[str, ImageEncoding] = {"8UC1": ImageEncoding.MONO8}
+"""Encodings read as one of :class:`ImageEncoding` because their pixels are the same: a
+one-channel 8-bit image is a mask, whichever name its segmentation node gives it."""
+
 
 def image_array(msg: Image) -> tuple[np.ndarray, ImageEncoding]:
     """The pixels of an ``Image`` (rows of ``step`` bytes, either byte order) and its encoding.
@@ -28,13 +32,15 @@ def image_array(msg: Image) -> tuple[np.ndarray, ImageEncoding]:
     Raises
     ------
     InvalidInputError
-        An encoding other than mono8, 16UC1, 32FC1, or a size that does not match the data.
+        An encoding other than mono8 (or 8UC1, read as mono8), 16UC1, 32FC1, or a size that
+        does not match the data.
     """
     try:
-        encoding = ImageEncoding(msg.encoding)
+        encoding = SAME_AS.get(msg.encoding) or ImageEncoding(msg.encoding)
     except ValueError:
         raise InvalidInputError(f"image encoding must be one of "
-                                f"{list(ImageEncoding.values())}, got {msg.encoding!r}") from None
+                                f"{[*ImageEncoding.values(), *SAME_AS]}, got "
+                                f"{msg.encoding!r}") from None
     dtype = PIXEL_TYPES[encoding].newbyteorder(">" if msg.is_bigendian else "<")
     row = msg.width * dtype.itemsize
     if msg.height < 1 or msg.width < 1 or msg.step < row or len(msg.data) != msg.step * msg.height:

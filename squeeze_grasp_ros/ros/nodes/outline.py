@@ -5,8 +5,8 @@
 Run it with ``ros2 run squeeze_grasp_ros outline --ros-args -p camera_pose:="[0.0, 0.0, 0.5,
 3.14159265, 0.0, 0.0]" -p object_height:=0.0254``. It subscribes to
 
-- ``camera/mask`` (parameter ``image_topic``): ``sensor_msgs/Image``, ``mono8`` mask, or a
-  ``16UC1``/``32FC1`` depth image (the encoding decides);
+- ``camera/mask`` (parameter ``image_topic``): ``sensor_msgs/Image``, ``mono8`` mask (``8UC1``
+  read as ``mono8``), or a ``16UC1``/``32FC1`` depth image (the encoding decides);
 - ``camera/camera_info``: ``sensor_msgs/CameraInfo`` (pinhole, plumb-bob), the newest one is
   used for each image;
 - ``camera/pose`` (latched ``geometry_msgs/PoseStamped``, optional): the camera's optical
@@ -41,7 +41,8 @@ from squeeze_grasp_ros.ros.messages.images import camera_model, camera_pose, ima
 from squeeze_grasp_ros.ros.nodes import ParameterError, pipeline, run_node
 
 PARAMETERS: dict[str, tuple[Any, str]] = {
-    "image_topic": (pipeline.CAMERA_MASK, "image to read: mono8 mask, 16UC1 or 32FC1 depth"),
+    "image_topic": (pipeline.CAMERA_MASK,
+                    "image to read: mono8 (or 8UC1) mask, 16UC1 or 32FC1 depth"),
     "camera_pose": ([0.0] * 6, "camera optical frame in the plane frame: x y z roll pitch yaw "
                                "(m, rad) or x y z qx qy qz qw; all zeros = wait for "
                                "camera/pose"),

@@ -123,6 +123,17 @@ def test_render_refuses_a_negative_seed_and_a_blur_wider_than_the_image(tmp_path
     assert not mask.exists()
 
 
+def test_render_says_when_the_object_is_out_of_view(tmp_path, capsys):
+    """A camera pointed beside the object rendered an empty mask and said only '0.0 px'."""
+    away = ["--camera-info", CAMERA[1], "--camera-pose", "1.5", "0", "0.5", "3.1", "0", "0"]
+    mask = tmp_path / "mask.png"
+    assert cli.main(["render", str(scene_file("foam_square")), *away, "--mask", str(mask)]) == 0
+    out = capsys.readouterr().out
+    assert "covers 0.0 px (the object is out of view: the images show only the plane)" in out
+    assert cli.main(["render", str(scene_file("foam_square")), *CAMERA, "--mask", str(mask)]) == 0
+    assert "out of view" not in capsys.readouterr().out
+
+
 def test_an_npy_name_on_another_format_is_refused_with_one_line(tmp_path, capsys):
     """An .npz archive named .npy ended in an AttributeError traceback; a PNG or text file
     named .npy was called 'pickled (object) data'.

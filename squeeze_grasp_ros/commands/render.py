@@ -80,7 +80,9 @@ def summary(result: dict) -> str:
              f"{', '.join(f'{v:.4g}' for v in result['pose']['position'])} m; top face "
              f"{1e3 * result['top_height']:.4g} mm above the plane covers "
              f"{result['object_pixels']:.1f} px"
-             + (" (it touches the image border)" if result["touches_border"] else "")]
+             + (" (it touches the image border)" if result["touches_border"] else "")
+             + (" (the object is out of view: the images show only the plane)"
+                if result["object_pixels"] == 0 else "")]
     for key in ("mask", "depth"):
         if key in result:
             lines.append(f"{key}: {result[key]}")

@@ -310,6 +310,13 @@ def test_numbers_that_would_be_silently_wrong_are_refused(tmp_path, capfd):
     same = tmp_path / "same.csv"
     same.write_text("x,y\n1,1\n1,1\n1,1\n")
     assert main(["match", str(same), str(same)]) == 2
+    capfd.readouterr()
+    for text, message in (("x,y,z\n0,0,0\n1,0,0\n0,1,0\n", "must be x,y, got x,y,z"),
+                          ("0,0\n1,0,5\n0,1\n", "data row 2 has 3 cells")):
+        cloud = tmp_path / "cloud.csv"
+        cloud.write_text(text)  # a z column was silently dropped
+        assert main(["match", str(cloud), str(cloud)]) == 2
+        assert message in capfd.readouterr().err
     foam = str(SCENES / "foam_square.yaml")
     for argv in (
         ["plan", foam, "--depth", "1e308"],

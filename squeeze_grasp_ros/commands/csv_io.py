@@ -39,15 +39,20 @@ def read_table(path: str | Path) -> tuple[list[str] | None, list[list[str]]]:
 
 
 def read_points(path: str | Path) -> np.ndarray:
-    """Points (n, 2), m, from ``x,y`` rows."""
+    """Points (n, 2), m, from ``x,y`` rows: exactly two columns (a third, such as a z, is
+    refused rather than dropped).
+    """
     header, rows = read_table(path)
+    if header is not None and header != ["x", "y"]:
+        raise InvalidInputError(f"{path}: point columns must be x,y, got {','.join(header)}")
+    for line, row in enumerate(rows, 1 if header is None else 2):
+        if len(row) != 2:
+            raise InvalidInputError(f"{path}: every row must be 'x,y' (metres); data row "
+                                    f"{line} has {len(row)} cells")
     try:
-        pts = np.array([[float(r[0]), float(r[1])] for r in rows])
-    except (ValueError, IndexError):
+        return np.array([[float(x), float(y)] for x, y in rows]).reshape(-1, 2)
+    except ValueError:
         raise InvalidInputError(f"{path}: every row must be 'x,y' (metres)") from None
-    if header is not None and header[:2] != ["x", "y"]:
-        raise InvalidInputError(f"{path}: point columns must be x,y, got {header}")
-    return pts
 
 
 def read_columns(path: str | Path, required: tuple[str, ...],

@@ -13,6 +13,7 @@ import os
 import signal
 import subprocess
 import sys
+import threading
 import time
 from collections.abc import Iterator
 from contextlib import contextmanager
@@ -24,11 +25,13 @@ from action_msgs.msg import GoalStatus
 from planner_support import BLOB, Harness, big_disk
 from rclpy.context import Context
 from rclpy.executors import SingleThreadedExecutor
+from rclpy.parameter import Parameter
 
 from squeeze_grasp_interfaces.action import GraspMap as GraspMapAction
 from squeeze_grasp_interfaces.srv import LoadObject
 from squeeze_grasp_ros.planning import ErrorCode
 from squeeze_grasp_ros.ros.nodes import pipeline
+from squeeze_grasp_ros.ros.nodes import planner as planner_module
 
 TIMEOUT = 60.0
 
@@ -126,3 +129,32 @@ def test_a_stopped_planner_ends_its_running_goal(ros_context: Context, tmp_path:
         assert "the planner is shutting down" in result.result.message
         assert_exits_cleanly(process, tmp_path)
     harness.close()
+
+
+def test_a_computation_that_outlasts_the_drain_is_answered_without_it(
+    ros_context: Context, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A load inside one uninterruptible stage (a call into C, such as meshing a 50,000-node
+    disk) when the planner stops: the drain answers it CANCELLED once its time is up, and the
+    worker's late result is dropped. Before, its client waited for ever.
+    """
+    entered, release = threading.Event(), threading.Event()
+
+    def one_long_stage(*_args, **_kwargs):
+        entered.set()
+        release.wait(TIMEOUT)
+        raise AssertionError("the planner answered from a stage after its drain")
+    monkeypatch.setattr(planner_module.planning, "load_cached", one_long_stage)
+    harness = Harness(ros_context, parameter_overrides=[Parameter("worker_threads", value=1)])
+    try:
+        client = harness.client(LoadObject, "load_object")
+        answer = client.call_async(LoadObject.Request(scene_yaml=BLOB, object_id="blob"))
+        harness.spin_until(entered.is_set, timeout=TIMEOUT)
+        harness.planner.drain(harness.executor, timeout=0.3)
+        assert answer.done(), "the drain ended without answering the request it held"
+        assert answer.result().error_code == ErrorCode.CANCELLED
+        assert "did not reach a stage boundary within 0.3 s" in answer.result().message
+        assert not harness.planner._awaiting
+    finally:
+        release.set()
+        harness.close()

@@ -62,7 +62,7 @@ from squeeze_grasp_ros.mechanics.vocabulary import ObjectModel
 from squeeze_grasp_ros.planning import Cancelled, ErrorCode, PlannerLimits
 from squeeze_grasp_ros.resources import share_dir
 from squeeze_grasp_ros.ros import messages
-from squeeze_grasp_ros.ros.nodes import pipeline, run_node, spin_until
+from squeeze_grasp_ros.ros.nodes import DRAIN_SPIN, pipeline, run_node, spin_until
 from squeeze_grasp_ros.ros.nodes.frame_pose_topic import frame_pose_topic
 from squeeze_grasp_ros.ros.refusals import RefusalLog
 
@@ -158,6 +158,8 @@ class PlannerNode(Node):
         self._pending = 0
         self._pending_lock = threading.Lock()
         self._awaiting = 0  # long requests whose handler awaits its worker (executor thread)
+        self._held: dict[Future, type] = {}  # their futures and response types
+        self._held_lock = threading.Lock()  # a future is answered once: by its worker or drain
         self.refusals = RefusalLog(self.get_logger().info)
         # Reentrant: a long request awaiting its worker must not hold the node's default
         # (mutually exclusive) group, or every other request waits for it (measured: a
@@ -381,19 +383,24 @@ class PlannerNode(Node):
 
         def work() -> None:
             try:
-                future.set_result(self._answer(response_type, compute))
+                answer = self._answer(response_type, compute)
+                with self._held_lock:
+                    if self._held.pop(future, None) is not None:  # else drain has answered
+                        future.set_result(answer)
             finally:
                 with self._pending_lock:
                     self._pending -= 1
         future = Future(executor=self.executor)
         future.add_done_callback(_resume)
         self._awaiting += 1
+        self._held[future] = response_type
         try:
             self._pool.submit(work)
         except RuntimeError:
             with self._pending_lock:
                 self._pending -= 1
             self._awaiting -= 1
+            del self._held[future]
             return messages.failure(response_type, ErrorCode.CANCELLED,
                                     "the planner is shutting down")
         try:
@@ -483,12 +490,25 @@ class PlannerNode(Node):
         """Answer the long requests in flight before the node ends (SIGINT, SIGTERM): stop the
         workers (a running computation stops at its next stage, a queued one is refused
         CANCELLED, "the planner is shutting down") and spin ``executor`` until every such
-        request's handler has answered, ``timeout`` s at most. Goals end aborted with that
-        message; their results go to the clients that asked for them.
+        request's handler has answered, ``timeout`` s at most. A request whose computation is
+        still inside one stage then (a call into C, such as meshing) is refused CANCELLED
+        without waiting for it. Goals end aborted with that message; their results go to the
+        clients that asked for them.
         """
         self._stopping.set()
-        if self._awaiting:  # then goals' result requests, answered once the goals have ended
-            spin_until(executor, lambda: not self._awaiting, timeout, then=4)
+        if not self._awaiting:
+            return
+        # then goals' result requests, answered once the goals have ended
+        if spin_until(executor, lambda: not self._awaiting, timeout, then=4):
+            return
+        with self._held_lock:  # a stage in one call into C (meshing) has not returned: its
+            late, self._held = self._held, {}  # client is answered now, its result dropped
+        message = (f"the planner is shutting down (its computation did not reach a stage "
+                   f"boundary within {timeout:g} s)")
+        for future, response_type in late.items():
+            self.refusals.refused(ErrorCode.CANCELLED.name, message)
+            future.set_result(messages.failure(response_type, ErrorCode.CANCELLED, message))
+        spin_until(executor, lambda: not self._awaiting, DRAIN_SPIN * 20, then=4)
 
     def destroy_node(self) -> None:
         """Stop the workers (running computations stop at their next stage), then the node."""

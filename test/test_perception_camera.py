@@ -113,8 +113,25 @@ def test_an_uncalibrated_camera_info_says_so():
 def test_strong_distortion_that_cannot_be_inverted_raises_with_its_residual():
     wild = CameraModel(640, 480, fx=200.0, fy=200.0, cx=319.5, cy=239.5,
                        distortion=(-0.9, 0.0, 0.0, 0.0, 0.0))
-    with pytest.raises(NumericalError, match="reprojection_px"):
+    with pytest.raises(NumericalError, match="reprojection_px") as info:
         wild.undistort(np.array([[0.0, 0.0]]))
+    assert ", 2 focal lengths from the principal point (distortion too strong" in str(info.value)
+
+
+def test_a_principal_point_outside_the_image_is_named_when_undistortion_fails():
+    """A K with cx and cy swapped or in other units put every pixel far off axis, and the
+    refusal blamed the distortion; a principal point outside the image is legal (cropped
+    images), so it is named only when undistortion fails.
+    """
+    distortion = (-0.2, 0.05, 0.0, 0.0, 0.0)
+    shifted = CameraModel(640, 480, fx=600.0, fy=600.0, cx=-2000.0, cy=239.5,
+                          distortion=distortion)
+    with pytest.raises(NumericalError, match=r"principal point \(-2000, 239.5\) px lies outside "
+                                             r"the 640 x 480 px image: check K"):
+        shifted.undistort(np.array([[639.0, 479.0]]))
+    cropped = CameraModel(640, 480, fx=600.0, fy=600.0, cx=-5.0, cy=239.5,
+                          distortion=distortion)
+    assert cropped.undistort(np.array([[0.0, 0.0], [639.0, 479.0]]))[1] < 1e-3
 
 
 def supersampled(loops_px, shape, k=16):

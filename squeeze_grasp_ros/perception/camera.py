@@ -255,10 +255,18 @@ class CameraModel:
                 if residual <= 0.01 * UNDISTORT_TOLERANCE_PX:
                     break
         if not residual <= UNDISTORT_TOLERANCE_PX:
-            raise NumericalError("undistortion did not converge: the plumb-bob model is not "
-                                 "invertible at some pixels (distortion too strong for the "
-                                 "image size?)", residuals={"reprojection_px": residual})
+            raise NumericalError(
+                f"undistortion did not converge: the plumb-bob model is not invertible at some "
+                f"pixels, {float(np.hypot(ad, bd).max()):.3g} focal lengths from the principal "
+                f"point ({self._why_far()})", residuals={"reprojection_px": residual})
         return normalised, residual
+
+    def _why_far(self) -> str:
+        """The likelier cause of pixels beyond the distortion's invertible radius."""
+        if not (0.0 <= self.cx <= self.width and 0.0 <= self.cy <= self.height):
+            return (f"the principal point ({self.cx:g}, {self.cy:g}) px lies outside the "
+                    f"{self.width} x {self.height} px image: check K")
+        return "distortion too strong for the image size?"
 
     def project(self, pose: CameraPose, points: np.ndarray) -> np.ndarray:
         """Pixels (n, 2) of plane-frame points (n, 3), m; points behind the camera are refused."""

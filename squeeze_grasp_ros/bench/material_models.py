@@ -310,7 +310,8 @@ def _scaling(quick: bool, progress) -> tuple[Table, Table]:
                  f"{COMPILED_ASSEMBLY_NODES:,} nodes assemble compiled when numba is installed). "
                  "Load average (1 min) "
                  f"{load[0]:.1f} before and {load[1]:.1f} after, on {os.cpu_count()} cores. "
-                 + _scaling_verdict(rows, quick, method)), where
+                 + _scaling_verdict(rows, quick, method)
+                 + _floor(rows, dict(zip(map(_nominal, n), profiled)), quick, method)), where
 
 
 def _scaling_verdict(rows: list, quick: bool, method: Factorizer) -> str:
@@ -340,6 +341,23 @@ def _scaling_verdict(rows: list, quick: bool, method: Factorizer) -> str:
         said.append(f"factoriser qdldl: cvxopt is not installed ({install_hint('cvxopt')}) "
                     "and CHOLMOD's supernodal factorisation is what the targets were met with")
     return "Targets: " + "; ".join(said) + "."
+
+
+def _floor(rows: list, profiled: dict, quick: bool, method: Factorizer) -> str:
+    """The sentence on the ratio target's mesh: what the profiled squeeze's numeric
+    factorisations and solves alone (:func:`phases`, by nominal mesh in ``profiled``) cost
+    against each route's linear squeeze, in CPU time; "" on a quick run.
+    """
+    ratio_nodes, ratio = SCALING_TARGETS[:2]
+    if quick or ratio_nodes not in profiled:
+        return ""
+    algebra = profiled[ratio_nodes]["numeric factorisation"] + profiled[ratio_nodes]["solves"]
+    against = [f"{algebra / (row[7] / row[6]):.1f}x the {row[2]} route's"
+               for row in rows if row[1] == str(method) and _nominal(row[0]) == ratio_nodes]
+    return (f" Floor at {ratio_nodes:,} nodes: the profiled squeeze's numeric factorisations "
+            f"and solves alone took {algebra:.2f} s of CPU, {' and '.join(against)} linear "
+            f"squeeze in CPU time (the {ratio:g}x target is below this floor where that figure "
+            f"is above {ratio:g}).")
 
 
 def _default_route(rows: list, method: Factorizer) -> list[str]:

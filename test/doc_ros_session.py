@@ -3,12 +3,13 @@
 """The planner examples of a page (docs/ros.md), run against a real planner process.
 
 A page's ``python`` snippets (each optionally followed by a ``text`` block with what it
-prints) and its ``ros2 service call``, ``ros2 param get`` and ``ros2 action list`` transcripts
-run in document order in one client process, against one planner started as the page says
-(``planner --ros-args --params-file config/planner.yaml``). The ``ros2`` commands run as their
-rclpy equivalents, printing what ros2cli prints: ``ros2 service call`` the request's and the
-response's ``repr`` (ros2service's own format), ``ros2 param get`` ``<Type> value is: <value>``,
-``ros2 action list -t`` ``name [type]``.
+prints) and its ``ros2 service call``, ``ros2 param get``/``set`` and ``ros2 action list``
+transcripts run in document order in one client process, against one planner started as the
+page says (``planner --ros-args --params-file config/planner.yaml``). The ``ros2`` commands
+run as their rclpy equivalents, printing what ros2cli prints: ``ros2 service call`` the
+request's and the response's ``repr`` (ros2service's own format), ``ros2 param get``
+``<Type> value is: <value>``, ``ros2 param set`` ros2param's ``Set parameter successful`` or
+``Setting parameter failed: <reason>``, ``ros2 action list -t`` ``name [type]``.
 """
 from __future__ import annotations
 
@@ -79,6 +80,20 @@ def _param_get(node_name, name):
     print(f"{kind} value is: {shown}")
 
 
+def _param_set(node_name, name, text):
+    from rcl_interfaces.srv import SetParameters
+    from rclpy.parameter import Parameter
+    client = _node.create_client(SetParameters, f"{node_name}/set_parameters")
+    client.wait_for_service(timeout_sec=30.0)
+    value = _yaml.safe_load(text)  # ros2param reads the value as YAML too
+    future = client.call_async(SetParameters.Request(
+        parameters=[Parameter(name, value=value).to_parameter_msg()]))
+    _planner.spin_until(future.done)
+    result = future.result().results[0]
+    said = "Set parameter successful" if result.successful else "Setting parameter failed"
+    print(said + (f": {result.reason}" if result.reason else ""))
+
+
 def _action_list():
     from rclpy.action import get_action_names_and_types
     deadline = _time.monotonic() + 30.0
@@ -111,6 +126,8 @@ def _command_source(text: str) -> str:
         return f"_service_call({words[3]!r}, {words[4]!r}, {words[5]!r})"
     if words[:3] == ["ros2", "param", "get"]:
         return f"_param_get({words[3]!r}, {words[4]!r})"
+    if words[:3] == ["ros2", "param", "set"]:
+        return f"_param_set({words[3]!r}, {words[4]!r}, {words[5]!r})"
     if words[:3] == ["ros2", "action", "list"]:
         return "_action_list()"
     raise AssertionError(f"the planner session cannot run {text!r}")

@@ -18,7 +18,7 @@ driver and handled idempotently by stamp in every node.
 from __future__ import annotations
 
 import importlib
-from collections.abc import Callable, Iterable, Mapping, Sequence
+from collections.abc import Callable, Collection, Iterable, Mapping, Sequence
 from typing import Any
 
 from rcl_interfaces.msg import ParameterDescriptor
@@ -280,16 +280,26 @@ frames on both sides, so that a frame still in flight across processes when the 
 written is not replaced (a history of one lost 1-2 of 7 masks per multi-process run)."""
 
 
-def declare(node: Node, parameters: Mapping[str, tuple[Any, str]]) -> dict[str, Any]:
+READ_AT_START = "read at start-up: restart the node to change it"
+"""The constraint ``ros2 param describe`` shows of a read-only parameter."""
+
+
+def declare(node: Node, parameters: Mapping[str, tuple[Any, str]], *,
+            live: Collection[str] = ()) -> dict[str, Any]:
     """Declare typed parameters (float ones also accept YAML integers); return their values.
 
     A default that is a ``Parameter.Type`` declares a parameter of that type without a default
-    (its value None unless given).
+    (its value None unless given). Parameters not named in ``live`` are read once, here, and
+    declared read-only: ``ros2 param set`` is refused ("Trying to set a read-only parameter")
+    rather than accepted and ignored, with ``ros2 param get`` then showing a value the node
+    does not use.
     """
     values = {}
     for name, (default, description) in parameters.items():
+        read_only = name not in live
         node.declare_parameter(name, default, ParameterDescriptor(
-            description=description, dynamic_typing=isinstance(default, float)))
+            description=description, dynamic_typing=isinstance(default, float),
+            read_only=read_only, additional_constraints=READ_AT_START if read_only else ""))
         if isinstance(default, Parameter.Type):
             # typed without a default: None unless given
             values[name] = node.get_parameter_or(name, Parameter(name, value=None)).value

@@ -1,0 +1,89 @@
+# Copyright 2026 squeeze_grasp_ros developers
+# SPDX-License-Identifier: Apache-2.0
+"""Node parameters as ``ros2 param`` and ``--ros-args -p`` reach them: a value out of its range
+is refused at start-up by name and range; a parameter read only at start-up is read-only on the
+running node (before, ``ros2 param set`` was accepted and ignored, and ``ros2 param get`` showed
+a value the node did not use); the planner's live ``max_pending`` is refused out of range.
+"""
+
+from __future__ import annotations
+
+import math
+
+import pytest
+import rclpy
+from rcl_interfaces.msg import ParameterType
+from rclpy.context import Context
+from rclpy.executors import SingleThreadedExecutor
+from rclpy.parameter import Parameter
+from rclpy.parameter_client import AsyncParameterClient
+
+from squeeze_grasp_ros.ros.nodes import ParameterError
+from squeeze_grasp_ros.ros.nodes.monitor import MonitorNode
+from squeeze_grasp_ros.ros.nodes.pipeline import READ_AT_START
+from squeeze_grasp_ros.ros.nodes.planner import PlannerNode
+
+TIMEOUT = 30.0
+
+
+@pytest.mark.parametrize("name, value, message", [
+    ("max_pending", -1, "parameter 'max_pending' must be an integer >= 1, got -1"),
+    ("worker_threads", 0, "parameter 'worker_threads' must be an integer >= 1, got 0"),
+    ("max_nodes", -5, "parameter 'max_nodes' must be an integer >= 1, got -5"),
+    ("cache_size", 0, "parameter 'cache_size' must be an integer >= 1, got 0"),
+    ("best_count", -3, "parameter 'best_count' must be an integer >= 1, got -3"),
+    ("min_step", math.nan, "parameter 'min_step' must be a finite number > 0"),
+    ("min_step", 0.0, "parameter 'min_step' must be a finite number > 0"),
+])
+def test_a_planner_parameter_out_of_range_is_refused_at_start(ros_context: Context, name,
+                                                              value, message) -> None:
+    """Before, these started a planner that refused every long request (max_pending -1),
+    passed a negative best_count on to grasp maps, or failed in ThreadPoolExecutor's own words.
+    """
+    with pytest.raises(ParameterError, match=message.replace("(", r"\(")):
+        PlannerNode(context=ros_context, parameter_overrides=[Parameter(name, value=value)])
+
+
+def _set(client: AsyncParameterClient, executor, parameter: Parameter):
+    """The SetParametersResult of one ``ros2 param set`` through the node's service."""
+    future = client.set_parameters([parameter])
+    executor.spin_until_future_complete(future, timeout_sec=TIMEOUT)
+    assert future.done(), "no answer from the parameter service"
+    return future.result().results[0]
+
+
+def test_ros2_param_set_on_running_nodes(ros_context: Context) -> None:
+    planner = PlannerNode(context=ros_context)
+    monitor = MonitorNode(context=ros_context)
+    user = rclpy.create_node("param_user", context=ros_context)
+    executor = SingleThreadedExecutor(context=ros_context)
+    for node in (planner, monitor, user):
+        executor.add_node(node)
+    try:
+        to_planner = AsyncParameterClient(user, "planner")
+        to_monitor = AsyncParameterClient(user, "monitor")
+        assert to_planner.wait_for_services(TIMEOUT) and to_monitor.wait_for_services(TIMEOUT)
+        refused = _set(to_planner, executor, Parameter("max_pending", value=-1))
+        assert not refused.successful
+        assert refused.reason == "parameter 'max_pending' must be an integer >= 1, got -1"
+        assert planner.get_parameter("max_pending").value == 16
+        assert _set(to_planner, executor, Parameter("max_pending", value=3)).successful
+        assert planner.get_parameter("max_pending").value == 3
+        for client, node, parameter in (
+                (to_planner, planner, Parameter("min_step", value=1e-3)),
+                (to_planner, planner, Parameter("worker_threads", value=8)),
+                (to_monitor, monitor, Parameter("alarm_ratio", value=0.5))):
+            before = node.get_parameter(parameter.name).value
+            result = _set(client, executor, parameter)
+            assert not result.successful
+            assert "read-only" in result.reason and parameter.name in result.reason
+            assert node.get_parameter(parameter.name).value == before
+        future = to_monitor.describe_parameters(["alarm_ratio"])
+        executor.spin_until_future_complete(future, timeout_sec=TIMEOUT)
+        described = future.result().descriptors[0]
+        assert described.read_only and described.additional_constraints == READ_AT_START
+        assert described.type == ParameterType.PARAMETER_DOUBLE
+    finally:
+        for node in (planner, monitor, user):
+            node.destroy_node()
+        executor.shutdown()

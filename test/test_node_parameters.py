@@ -18,10 +18,21 @@ from rclpy.executors import SingleThreadedExecutor
 from rclpy.parameter import Parameter
 from rclpy.parameter_client import AsyncParameterClient
 
-from squeeze_grasp_ros.ros.nodes import ParameterError
+from squeeze_grasp_ros.ros.nodes import (
+    ParameterError,
+    executor,
+    monitor,
+    outline,
+    recorder,
+    sim_hardware,
+)
+from squeeze_grasp_ros.ros.nodes.executor import ExecutorNode
 from squeeze_grasp_ros.ros.nodes.monitor import MonitorNode
+from squeeze_grasp_ros.ros.nodes.outline import OutlineNode
 from squeeze_grasp_ros.ros.nodes.pipeline import READ_AT_START
 from squeeze_grasp_ros.ros.nodes.planner import PlannerNode
+from squeeze_grasp_ros.ros.nodes.recorder import RecorderNode
+from squeeze_grasp_ros.ros.nodes.sim_hardware import SimHardwareNode
 
 TIMEOUT = 30.0
 
@@ -42,6 +53,33 @@ def test_a_planner_parameter_out_of_range_is_refused_at_start(ros_context: Conte
     """
     with pytest.raises(ParameterError, match=message.replace("(", r"\(")):
         PlannerNode(context=ros_context, parameter_overrides=[Parameter(name, value=value)])
+
+
+MODULES = {"monitor": monitor, "executor": executor, "outline": outline, "recorder": recorder,
+           "sim_hardware": sim_hardware}
+NODES = {"monitor": MonitorNode, "executor": ExecutorNode, "outline": OutlineNode,
+         "recorder": RecorderNode, "sim_hardware": SimHardwareNode}
+BOUNDED = [(label, name) for label, module in MODULES.items() for name in module.BOUNDS]
+
+
+@pytest.mark.parametrize("label, name", BOUNDED)
+def test_every_bounded_pipeline_parameter_refuses_a_value_out_of_range(ros_context: Context,
+                                                                       label, name) -> None:
+    """Before, most of these values started the node: an executor with a NaN or
+    negative max_velocity, a monitor whose stale_after was NaN (no reading ever stale)...
+    """
+    module = MODULES[label]
+    bound, default = module.BOUNDS[name], module.PARAMETERS[name][0]
+    assert bound.why(name, default) is None, "the default is out of its own range"
+    hostile = [bound.low - 1] + ([math.nan, math.inf] if isinstance(default, float) else [])
+    if bound.above:
+        hostile.append(bound.low)
+    if bound.high < math.inf:
+        hostile.append(bound.high + 1)
+    for value in hostile:
+        value = float(value) if isinstance(default, float) else int(value)
+        with pytest.raises(ParameterError, match=f"parameter '{name}' must be "):
+            NODES[label](context=ros_context, parameter_overrides=[Parameter(name, value=value)])
 
 
 def _set(client: AsyncParameterClient, executor, parameter: Parameter):

@@ -39,7 +39,6 @@ every request). On hardware, a goal that sees no ``monitor/status`` at all withi
 """
 from __future__ import annotations
 
-import math
 import sys
 import time
 from typing import Any
@@ -92,6 +91,14 @@ PARAMETERS: dict[str, tuple[Any, str]] = {
                                 "publishes one before the nodes start)"),
 }
 """Parameter name -> (typed default, description); config/executor.yaml sets them."""
+BOUNDS = {"max_velocity": pipeline.Bound(0.0, above=True, unit="m/s"),
+          "max_acceleration": pipeline.Bound(0.0, above=True, unit="m/s^2"),
+          "position_tolerance": pipeline.Bound(0.0, above=True, unit="m"),
+          "redirect_grace": pipeline.Bound(0), "stale_budget": pipeline.Bound(0.0, unit="s"),
+          "lift_watch": pipeline.Bound(0.0, unit="s"),
+          "period": pipeline.Bound(0.0, above=True, unit="s"),
+          "feedback_every": pipeline.Bound(1), "qos_depth": pipeline.Bound(1)}
+"""The range of each numeric parameter."""
 
 SUCCESS = (ExecuteGrasp.Result.DEPTH_REACHED, ExecuteGrasp.Result.RESISTED,
            ExecuteGrasp.Result.PICKED_UP)
@@ -137,14 +144,11 @@ class ExecutorNode(Node):
 
     def __init__(self, **kwargs: Any) -> None:
         super().__init__("executor", **kwargs)
-        self.p = p = pipeline.declare(self, PARAMETERS)
+        self.p = p = pipeline.declare(self, PARAMETERS, bounds=BOUNDS)
         self.devices = pipeline.parse_mapping(p["finger_devices"], "finger_devices")
         self.limits = MotionLimits(p["max_velocity"], p["max_acceleration"],
                                    p["position_tolerance"], p["redirect_grace"],
                                    float(p["stale_budget"]), float(p["lift_watch"]))
-        if not (math.isfinite(self.limits.lift_watch) and self.limits.lift_watch >= 0.0):
-            raise ParameterError(f"lift_watch must be a finite number >= 0 s, got "
-                                 f"{self.limits.lift_watch}")
         self.period_ns = int(round(p["period"] * 1e9))
         loop = pipeline.loop_qos(p["qos_depth"])
         controller = scene_controller(load_scene(p["controller_scene"]), p["controller_scene"]) \

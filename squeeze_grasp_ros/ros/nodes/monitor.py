@@ -144,6 +144,24 @@ PARAMETERS: dict[str, tuple[Any, str]] = {
                      "topic, else the jaws' pose readings)"),
 }
 """Parameter name -> (typed default, description); config/monitor.yaml sets them."""
+BOUNDS = {"load_threshold": pipeline.Bound(0.0, unit="N"),
+          "edge_tolerance": pipeline.Bound(0.0), "alarm_ratio": pipeline.Bound(0.0, above=True),
+          "match_margin": pipeline.Bound(0),
+          "stale_after": pipeline.Bound(0.0, above=True, unit="s"),
+          "prediction_tolerance": pipeline.Bound(0.0, above=True, unit="m"),
+          "relative_per_depth": pipeline.Bound(0.0, unit="1/m"),
+          "mirror_tolerance": pipeline.Bound(0.0),
+          "rate": pipeline.Bound(0.0, above=True, unit="Hz"), "qos_depth": pipeline.Bound(1),
+          "shape_mismatch_threshold": pipeline.Bound(0.0, above=True, unit="m"),
+          "shape_at_force_threshold": pipeline.Bound(0.0, above=True, unit="m"),
+          "shape_min_force": pipeline.Bound(0.0, unit="N"),
+          "object_height": pipeline.Bound(0.0, unit="m"),
+          "force_tolerance": pipeline.Bound(0.0, above=True),
+          "force_min_fraction": pipeline.Bound(0.0, 1.0),
+          "joint_slip_window": pipeline.Bound(0.0, above=True, unit="m"),
+          "joint_slip_ratio": pipeline.Bound(0.0, above=True)}
+"""The range of each numeric parameter (``mu``, ``weight``, ``weight_margin`` and
+``hand_max_condition`` are checked where they are used, by the routes that take them)."""
 POSE_JOINT_TOLERANCE = 1e-5
 """m: the largest gap between the jaws' aperture of their first pose readings and of the first
 joint state that passes without a warning."""
@@ -176,7 +194,7 @@ class MonitorNode(Node):
 
     def __init__(self, **kwargs: Any) -> None:
         super().__init__("monitor", **kwargs)
-        self.p = p = pipeline.declare(self, PARAMETERS)
+        self.p = p = pipeline.declare(self, PARAMETERS, bounds=BOUNDS)
         self.fingers = pipeline.parse_mapping(p["finger_devices"], "finger_devices")
         if not (np.isfinite(p["mu"]) and p["mu"] >= 0.0):
             raise ParameterError(f"mu must be a finite number >= 0 (0: no friction), got "

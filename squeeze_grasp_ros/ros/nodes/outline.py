@@ -58,6 +58,16 @@ PARAMETERS: dict[str, tuple[Any, str]] = {
     "qos_depth": (10, "history depth of the image and outline topics"),
 }
 """Parameter name -> (typed default, description)."""
+BOUNDS = {"object_height": pipeline.Bound(0.0, unit="m"),
+          "tolerance": pipeline.Bound(0.0, unit="m"),
+          "min_height": pipeline.Bound(0.0, above=True, unit="m"),
+          "plane_tolerance": pipeline.Bound(0.0, above=True, unit="m"),
+          "max_tilt_deg": pipeline.Bound(0.0, 90.0, above=True, unit="deg"),
+          "min_area_px": pipeline.Bound(1),
+          "ambiguous_ratio": pipeline.Bound(0.0, 1.0, above=True),
+          "qos_depth": pipeline.Bound(1)}
+"""The range of each numeric parameter (those of :func:`~.extract.extract_outline` as it
+checks them)."""
 
 
 def pose_parameter(values: list[float]) -> CameraPose | None:
@@ -80,7 +90,7 @@ class OutlineNode(Node):
 
     def __init__(self, **kwargs: Any) -> None:
         super().__init__("outline", **kwargs)
-        self.p = p = pipeline.declare(self, PARAMETERS)
+        self.p = p = pipeline.declare(self, PARAMETERS, bounds=BOUNDS)
         self.pose = pose_parameter(list(p["camera_pose"]))
         self.camera: CameraModel | None = None
         self.last_error = ""

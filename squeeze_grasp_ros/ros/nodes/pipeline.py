@@ -18,7 +18,9 @@ driver and handled idempotently by stamp in every node.
 from __future__ import annotations
 
 import importlib
+import math
 from collections.abc import Callable, Collection, Iterable, Mapping, Sequence
+from dataclasses import dataclass
 from typing import Any
 
 from rcl_interfaces.msg import ParameterDescriptor
@@ -280,13 +282,44 @@ frames on both sides, so that a frame still in flight across processes when the 
 written is not replaced (a history of one lost 1-2 of 7 masks per multi-process run)."""
 
 
+@dataclass(frozen=True)
+class Bound:
+    """The range of a numeric parameter: ``low`` <= value (< when ``above``) <= ``high``, and
+    finite.
+
+    >>> Bound(0.0, above=True, unit="m/s").why("max_velocity", -1.0)
+    "parameter 'max_velocity' must be a finite number > 0 m/s, got -1.0"
+    >>> Bound(1).why("feedback_every", 10) is None
+    True
+    """
+
+    low: float
+    high: float = math.inf
+    above: bool = False
+    unit: str = ""
+
+    def why(self, name: str, value: Any) -> str | None:
+        """Why ``value`` is out of this range for parameter ``name``, or None."""
+        if (not isinstance(value, bool) and isinstance(value, int | float)
+                and math.isfinite(value) and (value > self.low if self.above
+                                              else value >= self.low) and value <= self.high):
+            return None
+        kind = "an integer" if isinstance(value, int) else "a finite number"
+        unit = f" {self.unit}" if self.unit else ""
+        upper = f" and <= {self.high:g}{unit}" if self.high < math.inf else ""
+        return (f"parameter '{name}' must be {kind} {'>' if self.above else '>='} "
+                f"{self.low:g}{unit}{upper}, got {value}")
+
+
 READ_AT_START = "read at start-up: restart the node to change it"
 """The constraint ``ros2 param describe`` shows of a read-only parameter."""
 
 
 def declare(node: Node, parameters: Mapping[str, tuple[Any, str]], *,
-            live: Collection[str] = ()) -> dict[str, Any]:
-    """Declare typed parameters (float ones also accept YAML integers); return their values.
+            live: Collection[str] = (), bounds: Mapping[str, Bound] | None = None
+            ) -> dict[str, Any]:
+    """Declare typed parameters (float ones also accept YAML integers); return their values,
+    each within its ``bounds`` entry (a :class:`ParameterError` names the first that is not).
 
     A default that is a ``Parameter.Type`` declares a parameter of that type without a default
     (its value None unless given). Parameters not named in ``live`` are read once, here, and
@@ -312,6 +345,9 @@ def declare(node: Node, parameters: Mapping[str, tuple[Any, str]], *,
                 raise ParameterError(f"parameter '{name}' must be a number, got "
                                      f"{shown(str(value))}")
             value = float(value)
+        reason = bounds[name].why(name, value) if bounds and name in bounds else None
+        if reason:
+            raise ParameterError(reason)
         values[name] = value
     return values
 

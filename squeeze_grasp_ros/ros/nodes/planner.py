@@ -63,7 +63,7 @@ from squeeze_grasp_ros.mechanics.vocabulary import ObjectModel
 from squeeze_grasp_ros.planning import Cancelled, ErrorCode, PlannerLimits
 from squeeze_grasp_ros.resources import share_dir
 from squeeze_grasp_ros.ros import messages
-from squeeze_grasp_ros.ros.nodes import DRAIN_SPIN, ParameterError, pipeline, run_node, spin_until
+from squeeze_grasp_ros.ros.nodes import DRAIN_SPIN, pipeline, run_node, spin_until
 from squeeze_grasp_ros.ros.nodes.frame_pose_topic import frame_pose_topic
 from squeeze_grasp_ros.ros.refusals import RefusalLog
 
@@ -111,36 +111,13 @@ PARAMETERS: dict[str, tuple[Any, str]] = {
 """Parameter name -> (typed default, description); config/planner.yaml sets the same names."""
 LIVE = ("max_pending",)
 """The parameters read at every request, which ``ros2 param set`` changes on a running planner
-(within :data:`MINIMUMS`); the others are read at start-up and read-only."""
-MINIMUMS = {"max_nodes": 1, "max_spectral_nodes": 1, "max_ring_elements": 1, "cache_size": 1,
-            "cache_max_megabytes": 1, "worker_threads": 1, "best_count": 1, "max_pending": 1}
-"""Smallest value of each integer parameter."""
-
-
-def _below(name: str, value: Any) -> str | None:
-    """Why ``value`` is out of range for parameter ``name``, or None."""
-    if name in MINIMUMS and (isinstance(value, bool) or not isinstance(value, int)
-                             or value < MINIMUMS[name]):
-        return f"parameter '{name}' must be an integer >= {MINIMUMS[name]}, got {value}"
-    if name == "min_step" and not 0.0 < value < math.inf:
-        return f"parameter 'min_step' must be a finite number > 0 (relative to the object " \
-               f"size), got {value}"
-    return None
-
-
-def _checked(values: dict[str, Any]) -> dict[str, Any]:
-    """The declared ``values``, each in its range.
-
-    Raises
-    ------
-    ParameterError
-        Naming the first parameter out of range, and the range.
-    """
-    for name, value in values.items():
-        reason = _below(name, value)
-        if reason:
-            raise ParameterError(reason)
-    return values
+(within :data:`BOUNDS`); the others are read at start-up and read-only."""
+BOUNDS = {**{name: pipeline.Bound(1) for name in (
+    "max_nodes", "max_spectral_nodes", "max_ring_elements", "cache_size", "cache_max_megabytes",
+    "worker_threads", "best_count", "max_pending")},
+    "min_step": pipeline.Bound(0.0, above=True)}
+"""The range of each numeric parameter (``service_queue_depth`` and ``frame_pose_max_age``
+are checked where they are used)."""
 
 
 def _set_live(parameters: list[Parameter]) -> SetParametersResult:
@@ -148,7 +125,8 @@ def _set_live(parameters: list[Parameter]) -> SetParametersResult:
     rclpy refuses itself).
     """
     for parameter in parameters:
-        reason = _below(parameter.name, parameter.value) if parameter.name in LIVE else None
+        reason = (BOUNDS[parameter.name].why(parameter.name, parameter.value)
+                  if parameter.name in LIVE else None)
         if reason:
             return SetParametersResult(successful=False, reason=reason)
     return SetParametersResult(successful=True)
@@ -173,7 +151,7 @@ class PlannerNode(Node):
     def __init__(self, *, objects: Sequence[planning.LoadedObject] = (), **kwargs: Any) -> None:
         super().__init__("planner", **kwargs)
         # float parameters also take YAML integers (``min_step: 1`` is an int in YAML)
-        value = _checked(pipeline.declare(self, PARAMETERS, live=LIVE)).__getitem__
+        value = pipeline.declare(self, PARAMETERS, live=LIVE, bounds=BOUNDS).__getitem__
         self.add_on_set_parameters_callback(_set_live)
         self.limits = PlannerLimits(max_nodes=value("max_nodes"),
                              max_spectral_nodes=value("max_spectral_nodes"),

@@ -92,6 +92,9 @@ PARAMETERS: dict[str, tuple[Any, str]] = {
     "qos_depth": (1000, "history depth of the subscriptions"),
 }
 """Parameter name -> (typed default, description); config/recorder.yaml sets them."""
+BOUNDS = {"chunk_size": pipeline.Bound(1, unit="bytes"), "progress_every": pipeline.Bound(1),
+          "qos_depth": pipeline.Bound(1)}
+"""The range of each numeric parameter."""
 
 DUPLICATE_WINDOW = 16
 """Stamps per topic remembered to drop re-sent copies."""
@@ -115,7 +118,7 @@ class RecorderNode(Node):
 
     def __init__(self, **kwargs: Any) -> None:
         super().__init__("recorder", **kwargs)
-        self.p = p = pipeline.declare(self, PARAMETERS)
+        self.p = p = pipeline.declare(self, PARAMETERS, bounds=BOUNDS)
         if not p["output"]:
             raise ParameterError("parameter 'output' (the bag folder) is required: "
                                  "--ros-args -p output:=/path/to/bag")

@@ -62,6 +62,11 @@ PARAMETERS: dict[str, tuple[Any, str]] = {
     "recorder_window": (20, "ticks the recorder may lag behind (if 'recorder' participates)"),
 }
 """Parameter name -> (typed default, description); config/sim_hardware.yaml sets them."""
+BOUNDS = {"qos_depth": pipeline.Bound(1), "display_rate": pipeline.Bound(0.0, unit="Hz"),
+          "handshake_period": pipeline.Bound(0.0, above=True, unit="s"),
+          "resend_timeout": pipeline.Bound(0.0, above=True, unit="s"),
+          "recorder_window": pipeline.Bound(1)}
+"""The range of each numeric parameter."""
 
 
 class SimHardwareNode(Node):
@@ -77,7 +82,7 @@ class SimHardwareNode(Node):
 
     def __init__(self, world: SimWorld | None = None, **kwargs: Any) -> None:
         super().__init__("sim_hardware", **kwargs)
-        self.p = pipeline.declare(self, PARAMETERS)
+        self.p = pipeline.declare(self, PARAMETERS, bounds=BOUNDS)
         if world is None:
             if not self.p["scene"]:
                 raise ParameterError("parameter 'scene' (a scene YAML file) is required: "

@@ -9,9 +9,12 @@ a value the node did not use); the planner's live ``max_pending`` is refused out
 from __future__ import annotations
 
 import math
+import subprocess
+from pathlib import Path
 
 import pytest
 import rclpy
+from executables import script
 from rcl_interfaces.msg import ParameterType
 from rclpy.context import Context
 from rclpy.executors import SingleThreadedExecutor
@@ -125,3 +128,14 @@ def test_ros2_param_set_on_running_nodes(ros_context: Context) -> None:
         for node in (planner, monitor, user):
             node.destroy_node()
         executor.shutdown()
+
+
+def test_a_node_process_given_a_value_out_of_range_exits_2_with_one_line() -> None:
+    """docs/pipeline.md quotes this line; before, the executor started with max_velocity NaN."""
+    out = subprocess.run([script("executor"), "--ros-args", "-p", "max_velocity:=.nan"],
+                         capture_output=True, text=True, timeout=120)
+    assert out.returncode == 2, out.stderr
+    said = "executor: error: parameter 'max_velocity' must be a finite number > 0 m/s, got nan"
+    assert out.stderr.strip().splitlines()[-1] == said
+    page = (Path(__file__).resolve().parents[1] / "docs" / "pipeline.md").read_text()
+    assert f"`{said}`" in " ".join(page.split())

@@ -53,7 +53,8 @@ def test_the_floor_is_the_profiled_linear_algebra_against_each_routes_linear_cpu
     """The 8,038-node rows' linear CPU times are 2.3 / 12.1 (numpy) and 1.6 / 9.4 (numba)."""
     profiled = {8000: {"numeric factorisation": 0.95, "solves": 0.85, "assembly": 0.6}}
     said = bench._floor(ROWS, profiled, False, Factorizer.CHOLMOD)
-    assert ("numeric factorisations and solves alone took 1.80 s of CPU, 9.5x the numpy "
+    assert ("Floor at 8,038 nodes: the profiled squeeze's numeric factorisations and solves "
+            "alone took 1.80 s of CPU, 9.5x the numpy "
             "route's and 10.6x the numba route's linear squeeze in CPU time") in said
     assert bench._floor(ROWS, profiled, True, Factorizer.CHOLMOD) == ""
     assert bench._floor(ROWS, {500: profiled[8000]}, False, Factorizer.CHOLMOD) == ""

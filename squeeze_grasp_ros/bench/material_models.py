@@ -352,9 +352,9 @@ def _floor(rows: list, profiled: dict, quick: bool, method: Factorizer) -> str:
     if quick or ratio_nodes not in profiled:
         return ""
     algebra = profiled[ratio_nodes]["numeric factorisation"] + profiled[ratio_nodes]["solves"]
-    against = [f"{algebra / (row[7] / row[6]):.1f}x the {row[2]} route's"
-               for row in rows if row[1] == str(method) and _nominal(row[0]) == ratio_nodes]
-    return (f" Floor at {ratio_nodes:,} nodes: the profiled squeeze's numeric factorisations "
+    at = [row for row in rows if row[1] == str(method) and _nominal(row[0]) == ratio_nodes]
+    against = [f"{algebra / (row[7] / row[6]):.1f}x the {row[2]} route's" for row in at]
+    return (f" Floor at {at[0][0]:,} nodes: the profiled squeeze's numeric factorisations "
             f"and solves alone took {algebra:.2f} s of CPU, {' and '.join(against)} linear "
             f"squeeze in CPU time (the {ratio:g}x target is below this floor where that figure "
             f"is above {ratio:g}).")

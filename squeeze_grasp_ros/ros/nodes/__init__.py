@@ -88,6 +88,23 @@ def spin_until(executor: Executor, done: Callable[[], bool], timeout: float, *,
     return finished
 
 
+TWIN_CHECKS = (2.0, 10.0, 60.0)
+"""s of wall time after a node is ready at which :func:`run_node` looks for other nodes of its
+name (discovery across processes takes up to a few seconds)."""
+
+
+def twins(node: Node) -> int:
+    """How many other nodes on ``node``'s graph have its fully qualified name.
+
+    ROS 2 lets two nodes share a name: both then serve its services and actions (a request or a
+    goal reaches both, and two executors would both command the fingers) and publish its
+    topics, and nothing refuses either.
+    """
+    name = node.get_fully_qualified_name()
+    return sum(f"{space.rstrip('/')}/{other}" == name
+               for other, space in node.get_node_names_and_namespaces()) - 1
+
+
 ACK_TIMEOUT = 5.0
 """s of wall time a node waits at its end for its readers to acknowledge what it published
 (longer than Fast DDS's default heartbeat period of 3 s, which paces the repair of a lost
@@ -111,6 +128,18 @@ def wait_acknowledged(node: Node, timeout: float = ACK_TIMEOUT) -> list[str]:
         node.get_logger().warning(f"{topic}: not acknowledged by every reader within "
                                   f"{timeout:g} s")
     return late
+
+
+def _warn_twins(node: Node) -> bool:
+    """Log an error if other nodes have ``node``'s name (:func:`twins`); whether any had."""
+    found = twins(node)
+    if found:
+        node.get_logger().error(
+            f"{found} other node(s) named {node.get_fully_qualified_name()} are on this ROS "
+            f"domain: each gets the requests, goals and topics meant for one (two executors "
+            f"would both command the fingers); stop the other or rename this one (--ros-args "
+            f"-r __node:=NAME)")
+    return found > 0
 
 
 def run_node(factory: Callable[[], Node], args: list[str] | None = None,
@@ -147,7 +176,8 @@ def run_node(factory: Callable[[], Node], args: list[str] | None = None,
         ``--ros-args`` or the node refused its parameters (a missing scene, output folder,
         ...). That error is one line on stderr (rcl logs its own ``[ERROR]`` line first),
         ``<program>: error: <what>``, not a traceback. Once built, the node logs
-        ``<name> ready: <its configuration>``.
+        ``<name> ready: <its configuration>``, and an error if other nodes of its name are on
+        the ROS domain (:func:`twins`, looked for at :data:`TWIN_CHECKS`).
     """
     stop = SignalFlag()
     for signum in (signal.SIGINT, signal.SIGTERM):
@@ -168,9 +198,12 @@ def run_node(factory: Callable[[], Node], args: list[str] | None = None,
     node.get_logger().info(f"{node.get_name()} ready" + (f": {summary}" if summary else ""))
     executor = executor_type()
     executor.add_node(node)
+    checks = [time.monotonic() + delay for delay in TWIN_CHECKS]
     try:
         while rclpy.ok() and not stop.is_set() and not orphaned():
             executor.spin_once(0.1)
+            if checks and time.monotonic() >= checks[0]:
+                checks = [] if _warn_twins(node) else checks[1:]
         if orphaned():
             node.get_logger().error(f"the process that started this node "
                                     f"({os.environ[PARENT_PID_ENV]}) has died: shutting down")

@@ -748,6 +748,34 @@ def test_the_local_cluster_samples_its_housekeeping_every_few_seconds():
     assert dask.config.get("distributed.admin.tick.interval") != "1s"
 
 
+def test_a_local_cluster_beside_another_says_nothing_of_dasks_port_8787():
+    """A second sweep on the machine (or any program on Dask's default dashboard port 8787)
+    does not make the local cluster print Dask's four-line "Port 8787 is already in use"
+    warning: the local cluster's HTTP server takes a free port of 127.0.0.1 with or without
+    bokeh.
+    """
+    import socket
+    import warnings
+
+    from squeeze_grasp_ros.sweep.engine import StopSignals, _start
+
+    holder = socket.socket()
+    try:
+        holder.bind(("127.0.0.1", 8787))
+        holder.listen()
+    except OSError:
+        pass  # already held by another program: the same situation
+    try:
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            client, cluster = _start(None, 1, StopSignals())
+            client.close()
+            cluster.close()
+    finally:
+        holder.close()
+    assert [str(w.message) for w in caught if "8787" in str(w.message)] == []
+
+
 def test_other_spec_in_the_same_directory_is_refused(tmp_path):
     from squeeze_grasp_ros.sweep.plan import plan_tasks as plan
     from squeeze_grasp_ros.sweep.store import Store

@@ -211,7 +211,9 @@ def _start(scheduler: Optional[str], workers: Optional[int], stop: "StopSignals"
         except (OSError, TimeoutError) as exc:
             raise SweepError(f"--scheduler {scheduler}: cannot connect ({exc})") from None
     n = workers or os.cpu_count() or 1
-    dashboard = "127.0.0.1:0" if importlib.util.find_spec("bokeh") else None
+    # Dask's HTTP server runs with or without bokeh; given no address it takes port 8787 and,
+    # when that is taken (another sweep, any Dask cluster), warns in four lines on stderr
+    dashboard = "127.0.0.1:0"
     # Dask's own logs stay below CRITICAL: what goes wrong in a task is recorded (manifest,
     # summary, exit status) and a cluster closed right after its start has workers log
     # tracebacks of heartbeats cut short.

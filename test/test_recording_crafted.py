@@ -12,6 +12,7 @@ from __future__ import annotations
 import json
 import os
 import shutil
+import sqlite3
 import subprocess
 import sys
 import time
@@ -170,3 +171,85 @@ def test_many_small_bombs_are_refused_by_the_files_expansion_bound(tmp_path):
     crafted = bomb(tmp_path / "bombs.mcap", 8, size)
     with pytest.raises(BagError, match="64 times the file's size"):
         read_bag(crafted)
+
+
+ROSBAG2_TABLES = (
+    "CREATE TABLE topics(id INTEGER PRIMARY KEY, name TEXT NOT NULL, type TEXT NOT NULL, "
+    "serialization_format TEXT NOT NULL, offered_qos_profiles TEXT NOT NULL)",
+    "CREATE TABLE messages(id INTEGER PRIMARY KEY, topic_id INTEGER, timestamp INTEGER, "
+    "data BLOB)",
+)
+"""rosbag2's SQLite3 tables (its columns are NOT NULL; left open here to craft NULLs)."""
+
+
+def sqlite_bag(target: Path, rows: list[tuple]) -> Path:
+    """A rosbag2 SQLite3 file at ``target``: one topic, ``rows`` of (timestamp, data)."""
+    target.parent.mkdir(parents=True, exist_ok=True)
+    db = sqlite3.connect(target)
+    try:
+        for statement in ROSBAG2_TABLES:
+            db.execute(statement)
+        db.execute("INSERT INTO topics VALUES (1, '/clock', 'rosgraph_msgs/msg/Clock', 'cdr', "
+                   "'')")
+        db.executemany("INSERT INTO messages(topic_id, timestamp, data) VALUES (1, ?, ?)", rows)
+        db.commit()
+    finally:
+        db.close()
+    return target
+
+
+def not_a_database(target: Path) -> Path:
+    target.write_bytes(b"SQLite format 3\n" + bytes(range(256)) * 8)
+    return target
+
+
+def empty_file(target: Path) -> Path:
+    target.write_bytes(b"")
+    return target
+
+
+def other_tables(target: Path) -> Path:
+    db = sqlite3.connect(target)
+    db.execute("CREATE TABLE notes(text TEXT)")
+    db.commit()
+    db.close()
+    return target
+
+
+@pytest.mark.parametrize("craft, reason", [
+    (not_a_database, "file is not a database"),
+    (empty_file, "no such table: messages"),
+    (other_tables, "no such table: messages"),
+    (lambda target: sqlite_bag(target, [(1, None)]), "a message without data"),
+    (lambda target: sqlite_bag(target, [("soon", b"\x00\x01")]), "a message timestamp"),
+])
+def test_a_db3_that_is_not_a_rosbag2_bag_is_refused_in_one_line(tmp_path, craft, reason):
+    """Before: sqlite3.DatabaseError / OperationalError / TypeError tracebacks, exit 1."""
+    crafted = craft(tmp_path / "bag.db3")
+    with pytest.raises(BagError) as raised:
+        read_bag(crafted)
+    message = str(raised.value)
+    assert message.startswith(f"{crafted} is not a readable rosbag2 SQLite3 file (")
+    assert reason in message and "\n" not in message
+
+
+def test_replay_of_a_db3_that_is_not_a_database_exits_2_with_one_line(tmp_path):
+    crafted = not_a_database(tmp_path / "bag.db3")
+    done, _, _ = replay(crafted)
+    assert done.returncode == 2, done.stderr[-2000:]
+    assert "Traceback" not in done.stderr
+    assert json.loads(done.stdout)["error"] == (
+        f"{crafted} is not a readable rosbag2 SQLite3 file (DatabaseError: file is not a "
+        "database)")
+
+
+@pytest.mark.parametrize("folder", ["run#1", "run?mode=rwc", "run%41"])
+def test_a_db3_in_a_folder_named_with_uri_characters_is_read_from_its_own_file(tmp_path,
+                                                                                folder):
+    """The file is opened by its URI: before, '#' and '?' cut the path short ('run#1/bag.db3'
+    opened, and created, the database 'run') and '%41' read as 'A'.
+    """
+    crafted = sqlite_bag(tmp_path / folder / "bag.db3", [(5, b"\x00\x01"), (3, b"\x02")])
+    assert [(m.log_time_ns, m.data) for m in read_bag(crafted).messages] == [
+        (3, b"\x02"), (5, b"\x00\x01")]
+    assert sorted(p.name for p in tmp_path.iterdir()) == [folder]

@@ -253,3 +253,28 @@ def test_a_db3_in_a_folder_named_with_uri_characters_is_read_from_its_own_file(t
     assert [(m.log_time_ns, m.data) for m in read_bag(crafted).messages] == [
         (3, b"\x02"), (5, b"\x00\x01")]
     assert sorted(p.name for p in tmp_path.iterdir()) == [folder]
+
+
+@pytest.mark.parametrize("param, error", [
+    ("mu=[1", "--param mu: invalid YAML at line 1, column 3: expected ',' or ']', but got "
+              "'<stream end>'"),
+    ("mu=*x", "--param mu: YAML aliases (*name) are not accepted (line 1, column 1)"),
+    ("Mu=0.4", "--param Mu: the monitor has no such parameter (its parameters: "
+               "config/monitor.yaml)"),
+    ("finger_devices=F1", "parameter 'finger_devices' must be a list of strings, got 'F1'"),
+    ("finger_devices=[]", "parameter 'finger_devices' must be a list of strings, got '[]'"),
+    ("qos_depth=1.5", "parameter 'qos_depth' must be an integer, got '1.5'"),
+    ("mu={a: 1}", "parameter 'mu' must be true or false, an integer, a number, a string or a "
+                  "list of one of them, got \"{'a': 1}\""),
+    ("streams=[1, a]", "parameter 'streams' must be true or false, an integer, a number, a "
+                       "string or a list of one of them, got \"[1, 'a']\""),
+])
+def test_a_bad_replay_param_is_one_line_naming_it(bag, capfd, param, error):
+    """Before: a YAML, TypeError or rclpy traceback with exit 1, and an unknown name (a typo)
+    was ignored without a word.
+    """
+    from squeeze_grasp_ros.cli import main
+
+    assert main(["replay", str(bag), "--param", param]) == 2
+    out, err = capfd.readouterr()
+    assert (out, err) == ("", f"squeeze-grasp replay: error: {error}\n")

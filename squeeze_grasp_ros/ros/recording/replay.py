@@ -32,11 +32,12 @@ from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import JointState
 
 from squeeze_grasp_interfaces.msg import ContactEventArray, MonitorStatus, TactileArray, Tick
-from squeeze_grasp_ros.inputs import InputError, load_yaml
+from squeeze_grasp_ros.inputs import InputError, load_yaml, shown
 from squeeze_grasp_ros.mechanics.vocabulary import Finger
 from squeeze_grasp_ros.ros import messages
 from squeeze_grasp_ros.ros.messages.cdr import cdr_stamp_ns
-from squeeze_grasp_ros.ros.nodes import pipeline
+from squeeze_grasp_ros.ros.nodes import ParameterError, pipeline
+from squeeze_grasp_ros.ros.nodes.monitor import PARAMETERS as MONITOR_PARAMETERS
 from squeeze_grasp_ros.ros.nodes.monitor import MonitorNode
 from squeeze_grasp_ros.ros.nodes.sim_controllers import JOINT_STATES
 from squeeze_grasp_ros.ros.recording.bag import BagContents, BagError, read_bag
@@ -161,6 +162,62 @@ def monitor_parameters(bag: BagContents) -> dict[str, Any]:
     return params
 
 
+TYPE_WORDS = {
+    Parameter.Type.BOOL: "true or false",
+    Parameter.Type.INTEGER: "an integer",
+    Parameter.Type.STRING: "a string",
+    Parameter.Type.BOOL_ARRAY: "a list of true or false",
+    Parameter.Type.INTEGER_ARRAY: "a list of integers",
+    Parameter.Type.DOUBLE_ARRAY: "a list of numbers",
+    Parameter.Type.STRING_ARRAY: "a list of strings",
+}
+"""What a value of a (non-float) monitor parameter's type is, in an error message."""
+
+
+def monitor_overrides(params: Mapping[str, Any],
+                      given: Mapping[str, Any]) -> list[Parameter]:
+    """The replay monitor's parameters, checked before any node exists.
+
+    Parameters
+    ----------
+    params : mapping
+        Every parameter: the recording's (or the defaults), ``given`` and ``lockstep``.
+    given : mapping
+        The ones given by name (``--param``): each must be one the monitor declares.
+
+    Raises
+    ------
+    ParameterError
+        One line naming the parameter: a given name the monitor does not have, a value no ROS
+        parameter holds, or a value of another type than the monitor's (its float parameters
+        take any number and say so themselves).
+    """
+    for name in given:
+        if name not in MONITOR_PARAMETERS and name != "use_sim_time":
+            raise ParameterError(f"--param {name[:80]}: the monitor has no such parameter (its "
+                                 "parameters: config/monitor.yaml)")
+    out = []
+    for name, value in params.items():
+        try:
+            parameter = Parameter(name, value=value)
+        except TypeError:
+            raise ParameterError(
+                f"parameter '{name[:80]}' must be true or false, an integer, a number, a "
+                f"string or a list of one of them, got {shown(str(value))}") from None
+        default = MONITOR_PARAMETERS.get(name, (None, ""))[0]
+        if isinstance(default, Parameter.Type):
+            expected = None if value is None else default
+        elif default is None or isinstance(default, float):
+            expected = None
+        else:
+            expected = Parameter.Type.from_parameter_value(default)
+        if expected is not None and parameter.type_ != expected:
+            raise ParameterError(f"parameter '{name}' must be {TYPE_WORDS[expected]}, got "
+                                 f"{shown(str(value))}")
+        out.append(parameter)
+    return out
+
+
 class Replayer(Node):
     """Publishes the recorded ticks one at a time, each after the monitor's previous status."""
 
@@ -228,11 +285,11 @@ def replay(path: str, overrides: Mapping[str, Any] | None = None, timeout: float
     if not ticks:
         raise BagError(f"{path} has no devices/<device>/{{pose,wrench,tactile}} readings")
     params = {**monitor_parameters(bag), **dict(overrides or {}), "lockstep": True}
+    parameters = monitor_overrides(params, overrides or {})
     context = Context()
     rclpy.init(context=context, signal_handler_options=SignalHandlerOptions.NO)
     executor = EventsExecutor(context=context)
-    monitor = MonitorNode(context=context,
-                          parameter_overrides=[Parameter(k, value=v) for k, v in params.items()])
+    monitor = MonitorNode(context=context, parameter_overrides=parameters)
     replayer = Replayer(bag, ticks, context=context)
     try:
         for node in (monitor, replayer):

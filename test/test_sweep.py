@@ -776,6 +776,21 @@ def test_a_local_cluster_beside_another_says_nothing_of_dasks_port_8787():
     assert [str(w.message) for w in caught if "8787" in str(w.message)] == []
 
 
+def test_a_resume_keeps_the_manifests_creation_time(tmp_path):
+    """Before: every re-run (even one with nothing to do) wrote its own time as ``created``."""
+    from squeeze_grasp_ros.sweep.plan import plan_tasks as plan
+    from squeeze_grasp_ros.sweep.store import Store, read_manifest
+
+    loaded = parse_sweep_spec(SMALL, tmp_path)
+    Store(tmp_path / "o", loaded, plan(loaded))
+    manifest = tmp_path / "o" / "manifest.json"
+    doc = json.loads(manifest.read_text())
+    doc["created"] = "2001-02-03T04:05:06Z"
+    manifest.write_text(json.dumps(doc))
+    Store(tmp_path / "o", loaded, plan(loaded))
+    assert read_manifest(tmp_path / "o")["created"] == "2001-02-03T04:05:06Z"
+
+
 def test_other_spec_in_the_same_directory_is_refused(tmp_path):
     from squeeze_grasp_ros.sweep.plan import plan_tasks as plan
     from squeeze_grasp_ros.sweep.store import Store

@@ -156,6 +156,23 @@ def test_cli_reports_spec_errors_without_traceback(tmp_path, capsys):
     assert "tip_radius[0] must be > 0.0 m" in capsys.readouterr().err
 
 
+@pytest.mark.parametrize("text, problem", [
+    ("x,y\n0,0\n0.1,0\n", "bad.csv: line 1 is not 'x,y' (two numbers, metres)"),
+    ("0,0\n0.1,0\n0.2,0\n", "bad.csv is degenerate (zero enclosed area)"),
+])
+def test_an_unusable_outline_file_is_named_by_its_objects_entry(tmp_path, capsys, text,
+                                                                 problem):
+    """Before: the scene's key, ``object.shape: outline file ...``, which a sweep spec does not
+    have, for whichever entry it was.
+    """
+    (tmp_path / "bad.csv").write_text(text)
+    spec = write_spec(tmp_path, {**SMALL, "objects": [SMALL["objects"][0],
+                                                      {"outline": "bad.csv"}]})
+    assert main(["sweep", str(spec), "--dry-run"]) == 2
+    assert capsys.readouterr().err == (
+        f"squeeze-grasp sweep: error: objects[1].outline: outline file {problem}\n")
+
+
 def test_sweep_help_lists_every_key():
     text = sweep_help()
     for f in dataclasses.fields(SweepSpec):

@@ -188,8 +188,7 @@ def objects(loaded: LoadedSpec) -> list[ObjectItem]:
     if sw.objects is None:
         name = loaded.base.name or "base"
         shape = loaded.base.object.shape
-        return [ObjectItem(f"00-{name}", shape, loaded.mesh,
-                           build_outline(shape) if shape["type"] == ShapeType.FILE else None)]
+        return [ObjectItem(f"00-{name}", shape, loaded.mesh, _file_outline(shape, "base"))]
     items = []
     for k, entry in enumerate(sw.objects):
         mesh = entry.mesh or loaded.mesh
@@ -205,10 +204,32 @@ def objects(loaded: LoadedSpec) -> list[ObjectItem]:
             pairs = [(entry.name or entry.shape["type"], entry.shape)]
         else:
             pairs = _family_shapes(entry, sw.seed, entry.name or entry.family.type)
-        items += [ObjectItem(f"{k:02d}-{oid}", shape, mesh,
-                             build_outline(shape) if shape["type"] == ShapeType.FILE else None)
+        where = (f"objects[{k}].outline" if entry.outline is not None
+                 else f"objects[{k}].scene {Path(entry.scene).name}" if entry.scene is not None
+                 else f"objects[{k}]")
+        items += [ObjectItem(f"{k:02d}-{oid}", shape, mesh, _file_outline(shape, where))
                   for oid, shape in pairs]
     return items
+
+
+def _file_outline(shape: Mapping[str, Any], where: str) -> Optional[Outline]:
+    """The outline a ``file`` shape reads (None for any other shape).
+
+    Raises
+    ------
+    SweepError
+        The file is no usable outline, named by ``where``, the spec's entry (an outline entry
+        is not a scene's ``object.shape``).
+    """
+    if shape["type"] != ShapeType.FILE:
+        return None
+    try:
+        return build_outline(shape)
+    except SceneError as exc:
+        text = str(exc)
+        if where.endswith(".outline"):
+            text = text.removeprefix("object.shape: ")
+        raise SweepError(f"{where}: {text}") from None
 
 
 def parameter_axes(loaded: LoadedSpec) -> dict[str, int]:

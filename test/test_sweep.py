@@ -8,6 +8,7 @@ the client and of a worker, resume) that must give the same table bit for bit.
 from __future__ import annotations
 
 import dataclasses
+import io
 import json
 import os
 import re
@@ -806,6 +807,43 @@ def test_a_resume_keeps_the_manifests_creation_time(tmp_path):
     manifest.write_text(json.dumps(doc))
     Store(tmp_path / "o", loaded, plan(loaded))
     assert read_manifest(tmp_path / "o")["created"] == "2001-02-03T04:05:06Z"
+
+
+class Terminal(io.StringIO):
+    """A stream that says it is a terminal; :meth:`screen` is what a terminal would show."""
+
+    def isatty(self) -> bool:
+        return True
+
+    def screen(self) -> list[str]:
+        rows, row, column = [], [], 0
+        for char in self.getvalue():
+            if char == "\n":
+                rows.append("".join(row))
+                row, column = [], 0
+            elif char == "\r":
+                column = 0
+            else:
+                row[column:column + 1] = [char]
+                column += 1
+        return [*rows, "".join(row)]
+
+
+def test_the_progress_line_redrawn_shorter_leaves_nothing_of_the_longer_one(monkeypatch):
+    """Before: a line redrawn shorter (the rate falling from 10.00 to 9.99 eval/s) kept the
+    last characters of the previous one on the terminal.
+    """
+    from squeeze_grasp_ros.sweep.engine import Progress
+
+    terminal = Terminal()
+    bar = Progress(2, None, stream=terminal)
+    lines = iter(["sweep 1/2, 10.00 eval/s, ETA 00:00:09", "sweep 2/2, 9.99 eval/s, ETA 00:00:00"])
+    monkeypatch.setattr(bar, "line", lambda: next(lines))
+    bar.update(1)
+    assert terminal.screen() == ["sweep 1/2, 10.00 eval/s, ETA 00:00:09"]
+    bar.update(1, final=True)
+    assert [row.rstrip() for row in terminal.screen()] == [
+        "sweep 2/2, 9.99 eval/s, ETA 00:00:00", ""]
 
 
 def test_other_spec_in_the_same_directory_is_refused(tmp_path):

@@ -82,6 +82,8 @@ class Progress:
         self.enabled, self.interval = enabled, interval
         self.start = time.perf_counter()
         self.last = -float("inf")
+        self.width = 0
+        """Characters of the line last drawn on a terminal (a shorter one is padded over it)."""
 
     def line(self) -> str:
         """The progress text."""
@@ -102,7 +104,9 @@ class Progress:
             return
         now = time.perf_counter()
         if self.tty:
-            self.stream.write("\r" + self.line() + ("\n" if final else ""))
+            text = self.line()
+            self.stream.write("\r" + text.ljust(self.width) + ("\n" if final else ""))
+            self.width = 0 if final else len(text)
         elif final or now - self.last >= self.interval:
             self.stream.write(self.line() + "\n")
             self.last = now

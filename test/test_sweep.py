@@ -174,6 +174,31 @@ def test_an_unusable_outline_file_is_named_by_its_objects_entry(tmp_path, capsys
         f"squeeze-grasp sweep: error: objects[1].outline: outline file {problem}\n")
 
 
+LONG = "a" * 101
+
+
+@pytest.mark.parametrize("patch, message", [
+    ({"objects": [{"name": LONG, "shape": {"type": "disk", "radius": 0.05}}]},
+     "objects[0].name is 101 bytes long; at most 100 (object and material names name the "
+     "sweep's files)"),
+    ({"materials": {LONG: {"E": 5e4, "nu": 0.3, "thickness": 0.01}}},
+     f"materials: name '{LONG}' is 101 bytes long; at most 100 (object and material names "
+     "name the sweep's files)"),
+    ({"objects": [{"outline": f"{LONG}.csv"}]},
+     f"objects[0].outline: the file's name {LONG!r} is 101 bytes long; at most 100 (object "
+     "and material names name the sweep's files): give objects[0].name"),
+])
+def test_a_name_too_long_for_a_file_name_is_refused_before_the_run(tmp_path, capsys, patch,
+                                                                   message):
+    """Before: the sweep started its cluster, ran the task and then failed to write it (a file
+    name is at most 255 bytes: ENAMETOOLONG), saying that a re-run would resume.
+    """
+    (tmp_path / f"{LONG}.csv").write_text("0,0\n0.1,0\n0.1,0.1\n0,0.1\n")
+    spec = write_spec(tmp_path, {**SMALL, **patch})
+    assert main(["sweep", str(spec), "--out", str(tmp_path / "o"), "--dry-run"]) == 2
+    assert capsys.readouterr().err == f"squeeze-grasp sweep: error: {message}\n"
+
+
 def test_sweep_help_lists_every_key():
     text = sweep_help()
     for f in dataclasses.fields(SweepSpec):

@@ -51,7 +51,7 @@ from squeeze_grasp_ros.scene import (
 )
 from squeeze_grasp_ros.scene.checks import validate
 from squeeze_grasp_ros.sweep.limits import check_evaluations, check_objects, check_parameter_sets
-from squeeze_grasp_ros.sweep.spec import LoadedSpec, ObjectEntry, SweepError
+from squeeze_grasp_ros.sweep.spec import LoadedSpec, ObjectEntry, SweepError, name_too_long
 
 
 def id_key(*parts: str | int) -> tuple[int, ...]:
@@ -194,11 +194,11 @@ def objects(loaded: LoadedSpec) -> list[ObjectItem]:
         mesh = entry.mesh or loaded.mesh
         if entry.scene is not None:
             scene = load_scene(entry.scene)
-            name = entry.name or Path(entry.scene).stem
+            name = entry.name or _stem(entry.scene, f"objects[{k}].scene")
             pairs = [(name, scene.object.shape)]
             mesh = entry.mesh or scene.object.mesh
         elif entry.outline is not None:
-            pairs = [(entry.name or Path(entry.outline).stem,
+            pairs = [(entry.name or _stem(entry.outline, f"objects[{k}].outline"),
                       {"type": ShapeType.FILE, "path": entry.outline})]
         elif entry.shape is not None:
             pairs = [(entry.name or entry.shape["type"], entry.shape)]
@@ -210,6 +210,21 @@ def objects(loaded: LoadedSpec) -> list[ObjectItem]:
         items += [ObjectItem(f"{k:02d}-{oid}", shape, mesh, _file_outline(shape, where))
                   for oid, shape in pairs]
     return items
+
+
+def _stem(path: str, where: str) -> str:
+    """The object name a file gives an entry without ``name``: its stem.
+
+    Raises
+    ------
+    SweepError
+        The stem is too long for the sweep's file names (:func:`~.spec.name_too_long`).
+    """
+    stem = Path(path).stem
+    if problem := name_too_long(stem):
+        raise SweepError(f"{where}: the file's name {stem!r} {problem}: give "
+                         f"{where.rsplit('.', 1)[0]}.name")
+    return stem
 
 
 def _file_outline(shape: Mapping[str, Any], where: str) -> Optional[Outline]:

@@ -199,6 +199,28 @@ def test_a_name_too_long_for_a_file_name_is_refused_before_the_run(tmp_path, cap
     assert capsys.readouterr().err == f"squeeze-grasp sweep: error: {message}\n"
 
 
+@pytest.mark.parametrize("name, problem", [
+    ("../../evil", "has a '/' or a NUL, which no file name can hold"),
+    (LONG, "is 101 bytes long; at most 100 (object and material names name the sweep's files)"),
+])
+def test_a_base_scene_whose_name_cannot_name_files_is_refused_before_the_run(tmp_path, capsys,
+                                                                            name, problem):
+    """Without ``objects`` the base scene's name names the object, its part and its outline
+    file (any name a file can have is taken, spaces included). Before: a name with '/' or
+    over 100 bytes ran the cluster and the task and then failed the write (ENOENT,
+    ENAMETOOLONG), saying a re-run would resume.
+    """
+    scene = yaml.safe_load(Path(BASE).read_text())
+    scene["name"] = name
+    (tmp_path / "base.yaml").write_text(yaml.safe_dump(scene))
+    spec = {k: v for k, v in SMALL.items() if k != "objects"}
+    spec = write_spec(tmp_path, {**spec, "base": str(tmp_path / "base.yaml")})
+    assert main(["sweep", str(spec), "--out", str(tmp_path / "o"), "--dry-run"]) == 2
+    assert capsys.readouterr().err == (
+        f"squeeze-grasp sweep: error: base: the scene's name {name!r} {problem}: it names the "
+        "sweep's object; give objects with a name\n")
+
+
 def test_sweep_help_lists_every_key():
     text = sweep_help()
     for f in dataclasses.fields(SweepSpec):

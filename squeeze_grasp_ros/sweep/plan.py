@@ -187,6 +187,11 @@ def objects(loaded: LoadedSpec) -> list[ObjectItem]:
     sw = loaded.spec
     if sw.objects is None:
         name = loaded.base.name or "base"
+        problem = ("has a '/' or a NUL, which no file name can hold"
+                   if "/" in name or "\0" in name else name_too_long(name))
+        if problem:
+            raise SweepError(f"base: the scene's name {name!r} {problem}: it names the sweep's "
+                             "object; give objects with a name")
         shape = loaded.base.object.shape
         return [ObjectItem(f"00-{name}", shape, loaded.mesh, _file_outline(shape, "base"))]
     items = []

@@ -278,3 +278,35 @@ def test_a_bad_replay_param_is_one_line_naming_it(bag, capfd, param, error):
     assert main(["replay", str(bag), "--param", param]) == 2
     out, err = capfd.readouterr()
     assert (out, err) == ("", f"squeeze-grasp replay: error: {error}\n")
+
+
+@pytest.mark.parametrize("topic, type_name", [
+    ("/sim/tick", "squeeze_grasp_interfaces/msg/Tick"),
+    ("/monitor/events", "squeeze_grasp_interfaces/msg/ContactEventArray"),
+    ("/planner/predicted_events", "squeeze_grasp_interfaces/msg/ContactEventArray"),
+])
+def test_a_corrupt_tick_or_event_message_is_refused_in_one_line(bag, tmp_path, topic,
+                                                               type_name):
+    """Replay reads these too (the ticks, the recorded events it compares with, the prediction
+    it hands the monitor). Before: an RMWError traceback, exit 1.
+    """
+    messages = read_bag(bag).messages
+    k = next(i for i, m in enumerate(messages) if m.topic == topic)
+    crafted = rewrite(bag, tmp_path / "corrupt.mcap", data={k: messages[k].data[:6]})
+    done, _, _ = replay(crafted)
+    assert done.returncode == 2, done.stderr[-2000:]
+    assert json.loads(done.stdout)["error"] == (
+        f"the message on {topic} logged at {messages[k].log_time_ns * 1e-9:.6f} s does not "
+        f"decode as {type_name} (RMWError); the recording is corrupt")
+
+
+def test_ticks_of_another_type_are_refused_not_misread(bag, tmp_path):
+    """Before: read as Tick whatever their declared type, and the replay said the events
+    differed (exit 1).
+    """
+    crafted = rewrite(bag, tmp_path / "ticks.mcap", types={"/sim/tick": "std_msgs/msg/String"})
+    done, _, _ = replay(crafted)
+    assert done.returncode == 2, done.stderr[-2000:]
+    assert json.loads(done.stdout)["error"] == (
+        "/sim/tick has type 'std_msgs/msg/String' in the recording; replay reads it as "
+        "squeeze_grasp_interfaces/msg/Tick")

@@ -75,13 +75,44 @@ def event_tuple(e: Any) -> tuple:
             float(e.relative_depth))
 
 
+EVENTS_TYPE = "squeeze_grasp_interfaces/msg/ContactEventArray"
+TICK_TYPE = "squeeze_grasp_interfaces/msg/Tick"
+
+
+def decoded(m: Any, type_name: str, cls: type, verb: str = "reads") -> Any:
+    """The recorded message ``m`` decoded as ``cls``, whose type name is ``type_name``.
+
+    Raises
+    ------
+    BagError
+        The recording declares another type for the topic, or the bytes do not decode: one
+        line naming the topic and the time.
+    """
+    if m.type != type_name:
+        raise BagError(f"{m.topic} has type {m.type[:80]!r} in the recording; replay {verb} it "
+                       f"as {type_name}")
+    try:
+        return deserialize_message(m.data, cls)
+    except Exception as exc:  # noqa: BLE001 (rclpy raises RMWError and others)
+        raise BagError(
+            f"the message on {m.topic} logged at {m.log_time_ns * 1e-9:.6f} s does not "
+            f"decode as {type_name} ({type(exc).__name__}); the recording is corrupt"
+        ) from None
+
+
 def recorded_events(bag: BagContents) -> list[tuple] | None:
-    """The monitor events of a recording (None if it has no ``monitor/events`` topic)."""
+    """The monitor events of a recording (None if it has no ``monitor/events`` topic).
+
+    Raises
+    ------
+    BagError
+        A message of the topic is not a ``ContactEventArray`` (:func:`decoded`).
+    """
     topic = "/" + pipeline.EVENTS
     if topic not in bag.types:
         return None
     return [event_tuple(e) for m in bag.messages if m.topic == topic
-            for e in deserialize_message(m.data, ContactEventArray).events]
+            for e in decoded(m, EVENTS_TYPE, ContactEventArray).events]
 
 
 def checked_readings(bag: BagContents) -> list:
@@ -99,17 +130,7 @@ def checked_readings(bag: BagContents) -> list:
         reading = reading_of(m.topic)
         if reading is None:
             continue
-        type_name, cls = READING_TYPES[reading[1]]
-        if m.type != type_name:
-            raise BagError(f"{m.topic} has type {m.type[:80]!r} in the recording; replay "
-                           f"publishes it as {type_name}")
-        try:
-            deserialize_message(m.data, cls)
-        except Exception as exc:  # noqa: BLE001 (rclpy raises RMWError and others)
-            raise BagError(
-                f"the message on {m.topic} logged at {m.log_time_ns * 1e-9:.6f} s does not "
-                f"decode as {type_name} ({type(exc).__name__}); the recording is corrupt"
-            ) from None
+        decoded(m, *READING_TYPES[reading[1]], verb="publishes")
         readings.append(m)
     return readings
 
@@ -125,7 +146,7 @@ def ticks_of(bag: BagContents) -> list[tuple[int, list]]:
         return sorted(by_stamp.items())
     out = []
     for m in ticks:
-        tick = deserialize_message(m.data, Tick)
+        tick = decoded(m, TICK_TYPE, Tick)
         ns = messages.stamp_ns(tick.header.stamp)
         keys = set(tick.readings)
         out.append((ns, [r for r in by_stamp.get(ns, [])
@@ -218,10 +239,25 @@ def monitor_overrides(params: Mapping[str, Any],
     return out
 
 
+def recorded_prediction(bag: BagContents) -> Any:
+    """The last ``planner/predicted_events`` message of a recording, decoded, or None.
+
+    Raises
+    ------
+    BagError
+        It is not a ``ContactEventArray`` (:func:`decoded`).
+    """
+    prediction = [m for m in bag.messages if m.topic == "/" + pipeline.PREDICTION]
+    return decoded(prediction[-1], EVENTS_TYPE, ContactEventArray) if prediction else None
+
+
 class Replayer(Node):
     """Publishes the recorded ticks one at a time, each after the monitor's previous status."""
 
-    def __init__(self, bag: BagContents, ticks: list[tuple[int, list]], **kwargs: Any) -> None:
+    def __init__(self, prediction: Any, ticks: list[tuple[int, list]], **kwargs: Any) -> None:
+        """``prediction``: the recording's last ``planner/predicted_events``
+        (:func:`recorded_prediction`), latched for the monitor, or None.
+        """
         super().__init__("replayer", **kwargs)
         loop = pipeline.loop_qos(1000)
         self.ticks = ticks
@@ -230,11 +266,10 @@ class Replayer(Node):
         self.pubs = {topic: self.create_publisher(
                          READING_TYPES[reading_of(topic)[1]][1], topic, loop)
                      for topic in {m.topic for _, group in ticks for m in group}}
-        prediction = [m for m in bag.messages if m.topic == "/" + pipeline.PREDICTION]
-        if prediction:
+        if prediction is not None:
             latched = self.create_publisher(ContactEventArray, pipeline.PREDICTION,
                                             pipeline.LATCHED)
-            latched.publish(deserialize_message(prediction[-1].data, ContactEventArray))
+            latched.publish(prediction)
         self.events: list[tuple] = []
         self.alarms: list[tuple] = []
         self.status_ns = -1
@@ -277,7 +312,8 @@ def replay(path: str, overrides: Mapping[str, Any] | None = None, timeout: float
     Raises
     ------
     BagError
-        If the bag has no readings.
+        If the bag has no readings, or a message replay reads is of another type or does not
+        decode (checked before any node starts).
     """
     t0 = time.perf_counter()
     bag = read_bag(path)
@@ -286,11 +322,12 @@ def replay(path: str, overrides: Mapping[str, Any] | None = None, timeout: float
         raise BagError(f"{path} has no devices/<device>/{{pose,wrench,tactile}} readings")
     params = {**monitor_parameters(bag), **dict(overrides or {}), "lockstep": True}
     parameters = monitor_overrides(params, overrides or {})
+    recorded, prediction = recorded_events(bag), recorded_prediction(bag)
     context = Context()
     rclpy.init(context=context, signal_handler_options=SignalHandlerOptions.NO)
     executor = EventsExecutor(context=context)
     monitor = MonitorNode(context=context, parameter_overrides=parameters)
-    replayer = Replayer(bag, ticks, context=context)
+    replayer = Replayer(prediction, ticks, context=context)
     try:
         for node in (monitor, replayer):
             executor.add_node(node)
@@ -310,7 +347,6 @@ def replay(path: str, overrides: Mapping[str, Any] | None = None, timeout: float
             node.destroy_node()
         executor.shutdown()
         context.try_shutdown()
-    recorded = recorded_events(bag)
     keys = ("stamp_ns", "type", "finger", "node", "depth", "relative_depth")
     return {
         "bag": str(path),

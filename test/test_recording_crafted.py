@@ -310,3 +310,38 @@ def test_ticks_of_another_type_are_refused_not_misread(bag, tmp_path):
     assert json.loads(done.stdout)["error"] == (
         "/sim/tick has type 'std_msgs/msg/String' in the recording; replay reads it as "
         "squeeze_grasp_interfaces/msg/Tick")
+
+
+def test_a_re_sent_tick_recorded_twice_replays_once(bag, tmp_path):
+    """A lost tick is re-sent with its stamp, its readings too; a recorder outside the lockstep
+    (``ros2 bag record``) keeps both copies, where ours drops the second. Before: the monitor's
+    answer to the copy carried a stamp already answered, replay waited for it and ended after
+    10 s with "the monitor did not answer tick 101 of 702", exit 4.
+    """
+    messages = list(read_bag(bag).messages)
+    tick = [i for i, m in enumerate(messages) if m.topic == "/sim/tick"][100]
+    stamp = messages[tick].log_time_ns
+    copies = [m for m in messages if m.log_time_ns == stamp and (
+        m.topic == "/sim/tick" or m.topic.endswith(("/pose", "/wrench", "/tactile")))]
+    assert len(copies) > 1
+    folder = tmp_path / "twice"  # the bag's metadata.yaml: the run's monitor parameters
+    shutil.copytree(bag.parent, folder)
+    crafted = folder / bag.name
+    with open(crafted, "wb") as f:
+        writer = Writer(f, compression=CompressionType.ZSTD)
+        writer.start(profile="ros2", library="crafted")
+        schemas: dict[str, int] = {}
+        channels: dict[str, int] = {}
+        for k, m in enumerate(messages + copies):
+            if m.type not in schemas:
+                schemas[m.type] = writer.register_schema(m.type, "ros2msg", b"")
+            if m.topic not in channels:
+                channels[m.topic] = writer.register_channel(m.topic, "cdr", schemas[m.type])
+            writer.add_message(channels[m.topic], m.log_time_ns, m.data, m.log_time_ns,
+                               sequence=k)
+        writer.finish()
+    done, _, _ = replay(folder)
+    assert done.returncode == 0, done.stderr[-2000:]
+    result = json.loads(done.stdout)
+    assert result["reproduced"] is True
+    assert result["ticks"] == sum(m.topic == "/sim/tick" for m in messages)

@@ -136,18 +136,31 @@ def checked_readings(bag: BagContents) -> list:
 
 
 def ticks_of(bag: BagContents) -> list[tuple[int, list]]:
-    """[(stamp ns, [reading messages])] in order: by recorded ticks, else by stamp."""
+    """[(stamp ns, [reading messages])] in order: by recorded ticks, else by stamp.
+
+    A tick and a reading count once per stamp (and topic): a lost tick is re-sent with its
+    stamp and its readings, and a recorder outside the lockstep (``ros2 bag record``) keeps
+    both copies, where the pipeline's recorder drops the second.
+    """
     readings = checked_readings(bag)
     by_stamp: dict[int, list] = {}
+    seen: set[tuple[str, int]] = set()
     for m in readings:
-        by_stamp.setdefault(cdr_stamp_ns(m.data), []).append(m)
+        ns = cdr_stamp_ns(m.data)
+        if (m.topic, ns) not in seen:
+            seen.add((m.topic, ns))
+            by_stamp.setdefault(ns, []).append(m)
     ticks = [m for m in bag.messages if m.topic == "/" + pipeline.TICK]
     if not ticks:
         return sorted(by_stamp.items())
     out = []
+    stamps: set[int] = set()
     for m in ticks:
         tick = decoded(m, TICK_TYPE, Tick)
         ns = messages.stamp_ns(tick.header.stamp)
+        if ns in stamps:
+            continue
+        stamps.add(ns)
         keys = set(tick.readings)
         out.append((ns, [r for r in by_stamp.get(ns, [])
                          if reading_of(r.topic)[2] in keys]))

@@ -8,6 +8,7 @@ the client and of a worker, resume) that must give the same table bit for bit.
 from __future__ import annotations
 
 import dataclasses
+import io
 import json
 import os
 import re
@@ -154,6 +155,70 @@ def test_cli_reports_spec_errors_without_traceback(tmp_path, capsys):
     spec = write_spec(tmp_path, {**SMALL, "tip_radius": [0.0]})
     assert main(["sweep", str(spec), "--out", str(tmp_path / "o")]) == 2
     assert "tip_radius[0] must be > 0.0 m" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("text, problem", [
+    ("x,y\n0,0\n0.1,0\n", "bad.csv: line 1 is not 'x,y' (two numbers, metres)"),
+    ("0,0\n0.1,0\n0.2,0\n", "bad.csv is degenerate (zero enclosed area)"),
+])
+def test_an_unusable_outline_file_is_named_by_its_objects_entry(tmp_path, capsys, text,
+                                                                 problem):
+    """Before: the scene's key, ``object.shape: outline file ...``, which a sweep spec does not
+    have, for whichever entry it was.
+    """
+    (tmp_path / "bad.csv").write_text(text)
+    spec = write_spec(tmp_path, {**SMALL, "objects": [SMALL["objects"][0],
+                                                      {"outline": "bad.csv"}]})
+    assert main(["sweep", str(spec), "--dry-run"]) == 2
+    assert capsys.readouterr().err == (
+        f"squeeze-grasp sweep: error: objects[1].outline: outline file {problem}\n")
+
+
+LONG = "a" * 101
+
+
+@pytest.mark.parametrize("patch, message", [
+    ({"objects": [{"name": LONG, "shape": {"type": "disk", "radius": 0.05}}]},
+     "objects[0].name is 101 bytes long; at most 100 (object and material names name the "
+     "sweep's files)"),
+    ({"materials": {LONG: {"E": 5e4, "nu": 0.3, "thickness": 0.01}}},
+     f"materials: name '{LONG}' is 101 bytes long; at most 100 (object and material names "
+     "name the sweep's files)"),
+    ({"objects": [{"outline": f"{LONG}.csv"}]},
+     f"objects[0].outline: the file's name {LONG!r} is 101 bytes long; at most 100 (object "
+     "and material names name the sweep's files): give objects[0].name"),
+])
+def test_a_name_too_long_for_a_file_name_is_refused_before_the_run(tmp_path, capsys, patch,
+                                                                   message):
+    """Before: the sweep started its cluster, ran the task and then failed to write it (a file
+    name is at most 255 bytes: ENAMETOOLONG), saying that a re-run would resume.
+    """
+    (tmp_path / f"{LONG}.csv").write_text("0,0\n0.1,0\n0.1,0.1\n0,0.1\n")
+    spec = write_spec(tmp_path, {**SMALL, **patch})
+    assert main(["sweep", str(spec), "--out", str(tmp_path / "o"), "--dry-run"]) == 2
+    assert capsys.readouterr().err == f"squeeze-grasp sweep: error: {message}\n"
+
+
+@pytest.mark.parametrize("name, problem", [
+    ("../../evil", "has a '/' or a NUL, which no file name can hold"),
+    (LONG, "is 101 bytes long; at most 100 (object and material names name the sweep's files)"),
+])
+def test_a_base_scene_whose_name_cannot_name_files_is_refused_before_the_run(tmp_path, capsys,
+                                                                            name, problem):
+    """Without ``objects`` the base scene's name names the object, its part and its outline
+    file (any name a file can have is taken, spaces included). Before: a name with '/' or
+    over 100 bytes ran the cluster and the task and then failed the write (ENOENT,
+    ENAMETOOLONG), saying a re-run would resume.
+    """
+    scene = yaml.safe_load(Path(BASE).read_text())
+    scene["name"] = name
+    (tmp_path / "base.yaml").write_text(yaml.safe_dump(scene))
+    spec = {k: v for k, v in SMALL.items() if k != "objects"}
+    spec = write_spec(tmp_path, {**spec, "base": str(tmp_path / "base.yaml")})
+    assert main(["sweep", str(spec), "--out", str(tmp_path / "o"), "--dry-run"]) == 2
+    assert capsys.readouterr().err == (
+        f"squeeze-grasp sweep: error: base: the scene's name {name!r} {problem}: it names the "
+        "sweep's object; give objects with a name\n")
 
 
 def test_sweep_help_lists_every_key():
@@ -746,6 +811,86 @@ def test_the_local_cluster_samples_its_housekeeping_every_few_seconds():
         assert callbacks["monitor"] == 5000
     assert scheduler["tick"] == 1000 and scheduler["monitor"] == 5000
     assert dask.config.get("distributed.admin.tick.interval") != "1s"
+
+
+def test_a_local_cluster_beside_another_says_nothing_of_dasks_port_8787():
+    """A second sweep on the machine (or any program on Dask's default dashboard port 8787)
+    does not make the local cluster print Dask's four-line "Port 8787 is already in use"
+    warning: the local cluster's HTTP server takes a free port of 127.0.0.1 with or without
+    bokeh.
+    """
+    import socket
+    import warnings
+
+    from squeeze_grasp_ros.sweep.engine import StopSignals, _start
+
+    holder = socket.socket()
+    try:
+        holder.bind(("127.0.0.1", 8787))
+        holder.listen()
+    except OSError:
+        pass  # already held by another program: the same situation
+    try:
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            client, cluster = _start(None, 1, StopSignals())
+            client.close()
+            cluster.close()
+    finally:
+        holder.close()
+    assert [str(w.message) for w in caught if "8787" in str(w.message)] == []
+
+
+def test_a_resume_keeps_the_manifests_creation_time(tmp_path):
+    """Before: every re-run (even one with nothing to do) wrote its own time as ``created``."""
+    from squeeze_grasp_ros.sweep.plan import plan_tasks as plan
+    from squeeze_grasp_ros.sweep.store import Store, read_manifest
+
+    loaded = parse_sweep_spec(SMALL, tmp_path)
+    Store(tmp_path / "o", loaded, plan(loaded))
+    manifest = tmp_path / "o" / "manifest.json"
+    doc = json.loads(manifest.read_text())
+    doc["created"] = "2001-02-03T04:05:06Z"
+    manifest.write_text(json.dumps(doc))
+    Store(tmp_path / "o", loaded, plan(loaded))
+    assert read_manifest(tmp_path / "o")["created"] == "2001-02-03T04:05:06Z"
+
+
+class Terminal(io.StringIO):
+    """A stream that says it is a terminal; :meth:`screen` is what a terminal would show."""
+
+    def isatty(self) -> bool:
+        return True
+
+    def screen(self) -> list[str]:
+        rows, row, column = [], [], 0
+        for char in self.getvalue():
+            if char == "\n":
+                rows.append("".join(row))
+                row, column = [], 0
+            elif char == "\r":
+                column = 0
+            else:
+                row[column:column + 1] = [char]
+                column += 1
+        return [*rows, "".join(row)]
+
+
+def test_the_progress_line_redrawn_shorter_leaves_nothing_of_the_longer_one(monkeypatch):
+    """Before: a line redrawn shorter (the rate falling from 10.00 to 9.99 eval/s) kept the
+    last characters of the previous one on the terminal.
+    """
+    from squeeze_grasp_ros.sweep.engine import Progress
+
+    terminal = Terminal()
+    bar = Progress(2, None, stream=terminal)
+    lines = iter(["sweep 1/2, 10.00 eval/s, ETA 00:00:09", "sweep 2/2, 9.99 eval/s, ETA 00:00:00"])
+    monkeypatch.setattr(bar, "line", lambda: next(lines))
+    bar.update(1)
+    assert terminal.screen() == ["sweep 1/2, 10.00 eval/s, ETA 00:00:09"]
+    bar.update(1, final=True)
+    assert [row.rstrip() for row in terminal.screen()] == [
+        "sweep 2/2, 9.99 eval/s, ETA 00:00:00", ""]
 
 
 def test_other_spec_in_the_same_directory_is_refused(tmp_path):

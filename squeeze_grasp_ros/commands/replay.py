@@ -8,10 +8,9 @@ import argparse
 import json
 import sys
 
-import yaml
-
 from squeeze_grasp_ros.commands.common import fail
 from squeeze_grasp_ros.exit_codes import ExitCode
+from squeeze_grasp_ros.inputs import InputError, load_yaml
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -45,7 +44,10 @@ def run(args: argparse.Namespace) -> dict | int:
                 f"squeeze-grasp replay: --param needs NAME=VALUE, got {entry!r}", file=sys.stderr
             )
             return ExitCode.USAGE
-        overrides[name] = yaml.safe_load(value)
+        try:
+            overrides[name] = load_yaml(value, what=f"--param {name}")
+        except InputError as exc:
+            return fail(args, str(exc), ExitCode.USAGE)
     try:
         result = replay(args.bag, overrides)
     except BagError as exc:

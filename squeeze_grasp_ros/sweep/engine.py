@@ -82,6 +82,8 @@ class Progress:
         self.enabled, self.interval = enabled, interval
         self.start = time.perf_counter()
         self.last = -float("inf")
+        self.width = 0
+        """Characters of the line last drawn on a terminal (a shorter one is padded over it)."""
 
     def line(self) -> str:
         """The progress text."""
@@ -102,7 +104,9 @@ class Progress:
             return
         now = time.perf_counter()
         if self.tty:
-            self.stream.write("\r" + self.line() + ("\n" if final else ""))
+            text = self.line()
+            self.stream.write("\r" + text.ljust(self.width) + ("\n" if final else ""))
+            self.width = 0 if final else len(text)
         elif final or now - self.last >= self.interval:
             self.stream.write(self.line() + "\n")
             self.last = now
@@ -211,7 +215,9 @@ def _start(scheduler: Optional[str], workers: Optional[int], stop: "StopSignals"
         except (OSError, TimeoutError) as exc:
             raise SweepError(f"--scheduler {scheduler}: cannot connect ({exc})") from None
     n = workers or os.cpu_count() or 1
-    dashboard = "127.0.0.1:0" if importlib.util.find_spec("bokeh") else None
+    # Dask's HTTP server runs with or without bokeh; given no address it takes port 8787 and,
+    # when that is taken (another sweep, any Dask cluster), warns in four lines on stderr
+    dashboard = "127.0.0.1:0"
     # Dask's own logs stay below CRITICAL: what goes wrong in a task is recorded (manifest,
     # summary, exit status) and a cluster closed right after its start has workers log
     # tracebacks of heartbeats cut short.

@@ -51,7 +51,7 @@ from squeeze_grasp_ros.scene import (
 )
 from squeeze_grasp_ros.scene.checks import validate
 from squeeze_grasp_ros.sweep.limits import check_evaluations, check_objects, check_parameter_sets
-from squeeze_grasp_ros.sweep.spec import LoadedSpec, ObjectEntry, SweepError
+from squeeze_grasp_ros.sweep.spec import LoadedSpec, ObjectEntry, SweepError, name_too_long
 
 
 def id_key(*parts: str | int) -> tuple[int, ...]:
@@ -187,28 +187,69 @@ def objects(loaded: LoadedSpec) -> list[ObjectItem]:
     sw = loaded.spec
     if sw.objects is None:
         name = loaded.base.name or "base"
+        problem = ("has a '/' or a NUL, which no file name can hold"
+                   if "/" in name or "\0" in name else name_too_long(name))
+        if problem:
+            raise SweepError(f"base: the scene's name {name!r} {problem}: it names the sweep's "
+                             "object; give objects with a name")
         shape = loaded.base.object.shape
-        return [ObjectItem(f"00-{name}", shape, loaded.mesh,
-                           build_outline(shape) if shape["type"] == ShapeType.FILE else None)]
+        return [ObjectItem(f"00-{name}", shape, loaded.mesh, _file_outline(shape, "base"))]
     items = []
     for k, entry in enumerate(sw.objects):
         mesh = entry.mesh or loaded.mesh
         if entry.scene is not None:
             scene = load_scene(entry.scene)
-            name = entry.name or Path(entry.scene).stem
+            name = entry.name or _stem(entry.scene, f"objects[{k}].scene")
             pairs = [(name, scene.object.shape)]
             mesh = entry.mesh or scene.object.mesh
         elif entry.outline is not None:
-            pairs = [(entry.name or Path(entry.outline).stem,
+            pairs = [(entry.name or _stem(entry.outline, f"objects[{k}].outline"),
                       {"type": ShapeType.FILE, "path": entry.outline})]
         elif entry.shape is not None:
             pairs = [(entry.name or entry.shape["type"], entry.shape)]
         else:
             pairs = _family_shapes(entry, sw.seed, entry.name or entry.family.type)
-        items += [ObjectItem(f"{k:02d}-{oid}", shape, mesh,
-                             build_outline(shape) if shape["type"] == ShapeType.FILE else None)
+        where = (f"objects[{k}].outline" if entry.outline is not None
+                 else f"objects[{k}].scene {Path(entry.scene).name}" if entry.scene is not None
+                 else f"objects[{k}]")
+        items += [ObjectItem(f"{k:02d}-{oid}", shape, mesh, _file_outline(shape, where))
                   for oid, shape in pairs]
     return items
+
+
+def _stem(path: str, where: str) -> str:
+    """The object name a file gives an entry without ``name``: its stem.
+
+    Raises
+    ------
+    SweepError
+        The stem is too long for the sweep's file names (:func:`~.spec.name_too_long`).
+    """
+    stem = Path(path).stem
+    if problem := name_too_long(stem):
+        raise SweepError(f"{where}: the file's name {stem!r} {problem}: give "
+                         f"{where.rsplit('.', 1)[0]}.name")
+    return stem
+
+
+def _file_outline(shape: Mapping[str, Any], where: str) -> Optional[Outline]:
+    """The outline a ``file`` shape reads (None for any other shape).
+
+    Raises
+    ------
+    SweepError
+        The file is no usable outline, named by ``where``, the spec's entry (an outline entry
+        is not a scene's ``object.shape``).
+    """
+    if shape["type"] != ShapeType.FILE:
+        return None
+    try:
+        return build_outline(shape)
+    except SceneError as exc:
+        text = str(exc)
+        if where.endswith(".outline"):
+            text = text.removeprefix("object.shape: ")
+        raise SweepError(f"{where}: {text}") from None
 
 
 def parameter_axes(loaded: LoadedSpec) -> dict[str, int]:

@@ -104,6 +104,20 @@ class ObjectEntry:
 
 
 PLACEMENT_FILTERS = ("inward", "force_closure")
+MAX_NAME_BYTES = 100
+"""Longest object or material name (UTF-8 bytes): a task id holds both and names a part file,
+``.<task id>.parquet.<pid>.tmp`` while it is written, and a file name is at most 255 bytes."""
+
+
+def name_too_long(name: str) -> str | None:
+    """Why ``name`` cannot name an object or a material (too long for the sweep's file
+    names), or None.
+    """
+    size = len(name.encode("utf-8", "surrogatepass"))
+    if size <= MAX_NAME_BYTES:
+        return None
+    return (f"is {size} bytes long; at most {MAX_NAME_BYTES} (object and material names name "
+            "the sweep's files)")
 
 
 @dataclass(frozen=True)
@@ -275,6 +289,8 @@ def _check_entry(entry: ObjectEntry, where: str) -> None:
         raise SweepError(
             f"{where}.name must use letters, digits, '_', '.', '-', got {entry.name!r}"
         )
+    if entry.name and (problem := name_too_long(entry.name)):
+        raise SweepError(f"{where}.name {problem}")
     fam = entry.family
     if fam is not None:
         for key in FAMILIES[fam.type]:
@@ -378,6 +394,8 @@ def parse_sweep_spec(data: Any, base_dir: Path) -> LoadedSpec:
                 raise SweepError(
                     f"materials: name {name!r} must use letters, digits, '_', '.', '-'"
                 )
+            if problem := name_too_long(name):
+                raise SweepError(f"materials: name {name!r} {problem}")
             materials[name] = parse_section(MaterialSpec, value, f"materials.{name}",
                                             error=SweepError)
             try:

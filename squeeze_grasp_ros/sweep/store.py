@@ -201,6 +201,7 @@ class Store:
         self.tasks = {t.id: t for t in tasks}
         self.errors: dict[str, str] = {}
         self.repaired: list[str] = []
+        self.created = time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime())
         if os.path.lexists(self.out / "manifest.json"):
             old = read_manifest(self.out)
             if old["spec_hash"] != loaded.hash:
@@ -210,6 +211,8 @@ class Store:
                     "a referenced file may have changed): give another --out or "
                     "delete it"
                 )
+            if isinstance(old.get("created"), str):
+                self.created = old["created"][:40]  # the first run's, kept by every resume
         elif self.out.is_dir() and any(self.out.iterdir()):
             raise SweepError(
                 f"--out {self.out} exists, is not empty and has no manifest.json: "
@@ -235,7 +238,6 @@ class Store:
             except BadPart as exc:
                 self.repaired.append(f"parts/{entry.name}: {exc}; moved to "
                                      f"{self._set_aside(entry)} and redone")
-        self.created = time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime())
         self.write_manifest()
 
     def _set_aside(self, entry: os.DirEntry) -> Path:

@@ -552,17 +552,37 @@ def _chunk_records(chunk: Chunk, budget: list[int]) -> list:
 
 
 def _read_sqlite(path: Path) -> Iterator[BagMessage]:
-    db = sqlite3.connect(f"file:{path}?mode=ro", uri=True)
+    """Every message of a rosbag2 SQLite3 file, in time order. The file is opened read-only
+    by its own URI (percent-encoded, so '#', '?' and '%' in its path are its characters).
+
+    Raises
+    ------
+    BagError
+        Not an SQLite3 database, or without rosbag2's tables, or a message row without data
+        or an integer timestamp.
+    """
+    out: list[BagMessage] = []
     try:
-        rows = db.execute(
-            "SELECT topics.name, topics.type, messages.timestamp, messages.data "
-            "FROM messages JOIN topics ON messages.topic_id = topics.id "
-            "ORDER BY messages.timestamp, messages.id"
-        )
-        for name, type_name, timestamp, data in rows:
-            yield BagMessage(name, type_name, int(timestamp), bytes(data))
-    finally:
-        db.close()
+        db = sqlite3.connect(f"{path.resolve().as_uri()}?mode=ro", uri=True)
+        try:
+            rows = db.execute(
+                "SELECT topics.name, topics.type, messages.timestamp, messages.data "
+                "FROM messages JOIN topics ON messages.topic_id = topics.id "
+                "ORDER BY messages.timestamp, messages.id"
+            )
+            for name, type_name, timestamp, data in rows:
+                if not isinstance(data, bytes):
+                    raise TypeError("a message without data")
+                if not isinstance(timestamp, int):
+                    raise TypeError(f"a message timestamp {str(timestamp)[:40]!r} is not an "
+                                    "integer")
+                out.append(BagMessage(str(name), str(type_name), timestamp, data))
+        finally:
+            db.close()
+    except (sqlite3.Error, TypeError) as exc:
+        raise BagError(f"{path} is not a readable rosbag2 SQLite3 file "
+                       f"({type(exc).__name__}: {exc})") from None
+    yield from out
 
 
 def read_bag(path: str | Path, topics: Sequence[str] | None = None) -> BagContents:

@@ -32,11 +32,12 @@ from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import JointState
 
 from squeeze_grasp_interfaces.msg import ContactEventArray, MonitorStatus, TactileArray, Tick
-from squeeze_grasp_ros.inputs import InputError, load_yaml
+from squeeze_grasp_ros.inputs import InputError, load_yaml, shown
 from squeeze_grasp_ros.mechanics.vocabulary import Finger
 from squeeze_grasp_ros.ros import messages
 from squeeze_grasp_ros.ros.messages.cdr import cdr_stamp_ns
-from squeeze_grasp_ros.ros.nodes import pipeline
+from squeeze_grasp_ros.ros.nodes import ParameterError, pipeline
+from squeeze_grasp_ros.ros.nodes.monitor import PARAMETERS as MONITOR_PARAMETERS
 from squeeze_grasp_ros.ros.nodes.monitor import MonitorNode
 from squeeze_grasp_ros.ros.nodes.sim_controllers import JOINT_STATES
 from squeeze_grasp_ros.ros.recording.bag import BagContents, BagError, read_bag
@@ -74,13 +75,44 @@ def event_tuple(e: Any) -> tuple:
             float(e.relative_depth))
 
 
+EVENTS_TYPE = "squeeze_grasp_interfaces/msg/ContactEventArray"
+TICK_TYPE = "squeeze_grasp_interfaces/msg/Tick"
+
+
+def decoded(m: Any, type_name: str, cls: type, verb: str = "reads") -> Any:
+    """The recorded message ``m`` decoded as ``cls``, whose type name is ``type_name``.
+
+    Raises
+    ------
+    BagError
+        The recording declares another type for the topic, or the bytes do not decode: one
+        line naming the topic and the time.
+    """
+    if m.type != type_name:
+        raise BagError(f"{m.topic} has type {m.type[:80]!r} in the recording; replay {verb} it "
+                       f"as {type_name}")
+    try:
+        return deserialize_message(m.data, cls)
+    except Exception as exc:  # noqa: BLE001 (rclpy raises RMWError and others)
+        raise BagError(
+            f"the message on {m.topic} logged at {m.log_time_ns * 1e-9:.6f} s does not "
+            f"decode as {type_name} ({type(exc).__name__}); the recording is corrupt"
+        ) from None
+
+
 def recorded_events(bag: BagContents) -> list[tuple] | None:
-    """The monitor events of a recording (None if it has no ``monitor/events`` topic)."""
+    """The monitor events of a recording (None if it has no ``monitor/events`` topic).
+
+    Raises
+    ------
+    BagError
+        A message of the topic is not a ``ContactEventArray`` (:func:`decoded`).
+    """
     topic = "/" + pipeline.EVENTS
     if topic not in bag.types:
         return None
     return [event_tuple(e) for m in bag.messages if m.topic == topic
-            for e in deserialize_message(m.data, ContactEventArray).events]
+            for e in decoded(m, EVENTS_TYPE, ContactEventArray).events]
 
 
 def checked_readings(bag: BagContents) -> list:
@@ -98,34 +130,37 @@ def checked_readings(bag: BagContents) -> list:
         reading = reading_of(m.topic)
         if reading is None:
             continue
-        type_name, cls = READING_TYPES[reading[1]]
-        if m.type != type_name:
-            raise BagError(f"{m.topic} has type {m.type[:80]!r} in the recording; replay "
-                           f"publishes it as {type_name}")
-        try:
-            deserialize_message(m.data, cls)
-        except Exception as exc:  # noqa: BLE001 (rclpy raises RMWError and others)
-            raise BagError(
-                f"the message on {m.topic} logged at {m.log_time_ns * 1e-9:.6f} s does not "
-                f"decode as {type_name} ({type(exc).__name__}); the recording is corrupt"
-            ) from None
+        decoded(m, *READING_TYPES[reading[1]], verb="publishes")
         readings.append(m)
     return readings
 
 
 def ticks_of(bag: BagContents) -> list[tuple[int, list]]:
-    """[(stamp ns, [reading messages])] in order: by recorded ticks, else by stamp."""
+    """[(stamp ns, [reading messages])] in order: by recorded ticks, else by stamp.
+
+    A tick and a reading count once per stamp (and topic): a lost tick is re-sent with its
+    stamp and its readings, and a recorder outside the lockstep (``ros2 bag record``) keeps
+    both copies, where the pipeline's recorder drops the second.
+    """
     readings = checked_readings(bag)
     by_stamp: dict[int, list] = {}
+    seen: set[tuple[str, int]] = set()
     for m in readings:
-        by_stamp.setdefault(cdr_stamp_ns(m.data), []).append(m)
+        ns = cdr_stamp_ns(m.data)
+        if (m.topic, ns) not in seen:
+            seen.add((m.topic, ns))
+            by_stamp.setdefault(ns, []).append(m)
     ticks = [m for m in bag.messages if m.topic == "/" + pipeline.TICK]
     if not ticks:
         return sorted(by_stamp.items())
     out = []
+    stamps: set[int] = set()
     for m in ticks:
-        tick = deserialize_message(m.data, Tick)
+        tick = decoded(m, TICK_TYPE, Tick)
         ns = messages.stamp_ns(tick.header.stamp)
+        if ns in stamps:
+            continue
+        stamps.add(ns)
         keys = set(tick.readings)
         out.append((ns, [r for r in by_stamp.get(ns, [])
                          if reading_of(r.topic)[2] in keys]))
@@ -161,10 +196,81 @@ def monitor_parameters(bag: BagContents) -> dict[str, Any]:
     return params
 
 
+TYPE_WORDS = {
+    Parameter.Type.BOOL: "true or false",
+    Parameter.Type.INTEGER: "an integer",
+    Parameter.Type.STRING: "a string",
+    Parameter.Type.BOOL_ARRAY: "a list of true or false",
+    Parameter.Type.INTEGER_ARRAY: "a list of integers",
+    Parameter.Type.DOUBLE_ARRAY: "a list of numbers",
+    Parameter.Type.STRING_ARRAY: "a list of strings",
+}
+"""What a value of a (non-float) monitor parameter's type is, in an error message."""
+
+
+def monitor_overrides(params: Mapping[str, Any],
+                      given: Mapping[str, Any]) -> list[Parameter]:
+    """The replay monitor's parameters, checked before any node exists.
+
+    Parameters
+    ----------
+    params : mapping
+        Every parameter: the recording's (or the defaults), ``given`` and ``lockstep``.
+    given : mapping
+        The ones given by name (``--param``): each must be one the monitor declares.
+
+    Raises
+    ------
+    ParameterError
+        One line naming the parameter: a given name the monitor does not have, a value no ROS
+        parameter holds, or a value of another type than the monitor's (its float parameters
+        take any number and say so themselves).
+    """
+    for name in given:
+        if name not in MONITOR_PARAMETERS and name != "use_sim_time":
+            raise ParameterError(f"--param {name[:80]}: the monitor has no such parameter (its "
+                                 "parameters: config/monitor.yaml)")
+    out = []
+    for name, value in params.items():
+        try:
+            parameter = Parameter(name, value=value)
+        except TypeError:
+            raise ParameterError(
+                f"parameter '{name[:80]}' must be true or false, an integer, a number, a "
+                f"string or a list of one of them, got {shown(str(value))}") from None
+        default = MONITOR_PARAMETERS.get(name, (None, ""))[0]
+        if isinstance(default, Parameter.Type):
+            expected = None if value is None else default
+        elif default is None or isinstance(default, float):
+            expected = None
+        else:
+            expected = Parameter.Type.from_parameter_value(default)
+        if expected is not None and parameter.type_ != expected:
+            raise ParameterError(f"parameter '{name}' must be {TYPE_WORDS[expected]}, got "
+                                 f"{shown(str(value))}")
+        out.append(parameter)
+    return out
+
+
+def recorded_prediction(bag: BagContents) -> Any:
+    """The last ``planner/predicted_events`` message of a recording, decoded, or None.
+
+    Raises
+    ------
+    BagError
+        It is not a ``ContactEventArray`` (:func:`decoded`).
+    """
+    prediction = [m for m in bag.messages if m.topic == "/" + pipeline.PREDICTION]
+    return decoded(prediction[-1], EVENTS_TYPE, ContactEventArray) if prediction else None
+
+
 class Replayer(Node):
     """Publishes the recorded ticks one at a time, each after the monitor's previous status."""
 
-    def __init__(self, bag: BagContents, ticks: list[tuple[int, list]], **kwargs: Any) -> None:
+    def __init__(self, prediction: Any, ticks: list[tuple[int, list]], **kwargs: Any) -> None:
+        """``prediction``: the recording's last ``planner/predicted_events``
+        (:func:`recorded_prediction`), latched for the monitor, or None.
+        """
         super().__init__("replayer", **kwargs)
         loop = pipeline.loop_qos(1000)
         self.ticks = ticks
@@ -173,11 +279,10 @@ class Replayer(Node):
         self.pubs = {topic: self.create_publisher(
                          READING_TYPES[reading_of(topic)[1]][1], topic, loop)
                      for topic in {m.topic for _, group in ticks for m in group}}
-        prediction = [m for m in bag.messages if m.topic == "/" + pipeline.PREDICTION]
-        if prediction:
+        if prediction is not None:
             latched = self.create_publisher(ContactEventArray, pipeline.PREDICTION,
                                             pipeline.LATCHED)
-            latched.publish(deserialize_message(prediction[-1].data, ContactEventArray))
+            latched.publish(prediction)
         self.events: list[tuple] = []
         self.alarms: list[tuple] = []
         self.status_ns = -1
@@ -220,7 +325,8 @@ def replay(path: str, overrides: Mapping[str, Any] | None = None, timeout: float
     Raises
     ------
     BagError
-        If the bag has no readings.
+        If the bag has no readings, or a message replay reads is of another type or does not
+        decode (checked before any node starts).
     """
     t0 = time.perf_counter()
     bag = read_bag(path)
@@ -228,12 +334,13 @@ def replay(path: str, overrides: Mapping[str, Any] | None = None, timeout: float
     if not ticks:
         raise BagError(f"{path} has no devices/<device>/{{pose,wrench,tactile}} readings")
     params = {**monitor_parameters(bag), **dict(overrides or {}), "lockstep": True}
+    parameters = monitor_overrides(params, overrides or {})
+    recorded, prediction = recorded_events(bag), recorded_prediction(bag)
     context = Context()
     rclpy.init(context=context, signal_handler_options=SignalHandlerOptions.NO)
     executor = EventsExecutor(context=context)
-    monitor = MonitorNode(context=context,
-                          parameter_overrides=[Parameter(k, value=v) for k, v in params.items()])
-    replayer = Replayer(bag, ticks, context=context)
+    monitor = MonitorNode(context=context, parameter_overrides=parameters)
+    replayer = Replayer(prediction, ticks, context=context)
     try:
         for node in (monitor, replayer):
             executor.add_node(node)
@@ -253,7 +360,6 @@ def replay(path: str, overrides: Mapping[str, Any] | None = None, timeout: float
             node.destroy_node()
         executor.shutdown()
         context.try_shutdown()
-    recorded = recorded_events(bag)
     keys = ("stamp_ns", "type", "finger", "node", "depth", "relative_depth")
     return {
         "bag": str(path),

@@ -14,7 +14,7 @@ gripper (``controller: {type: joint_trajectory, ...}``) and for its joint_state_
   measured jaw force is at the device's ``max_force`` the jaws close no further (the drive's
   effort limit: the stock controller itself limits no effort on a position interface);
 - a refused trajectory (joint names other than the controller's, sizes that do not match,
-  non-finite positions, an aperture beyond the opening range, points all in the past) is
+  non-finite positions, an aperture beyond the opening range, an end in the past) is
   logged as one warning line and not followed: the active trajectory stays (before tick 0 the
   controller is inactive and refuses every trajectory);
 - it publishes ``sensor_msgs/JointState`` on ``joint_states`` every tick, stamped with the

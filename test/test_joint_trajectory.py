@@ -91,6 +91,18 @@ def test_a_point_at_the_time_of_receipt_is_taken_at_once():
     assert f.sample(5 * MS) == f.sample(6 * MS) == pytest.approx(0.03)
 
 
+
+def test_a_new_trajectory_starts_from_the_measured_position():
+    # Jazzy's default (interpolate_from_desired_state false): the segment to a first point ahead
+    # starts at the joint's measured state when the controller takes the message, not at its
+    # last command
+    f = follower()
+    f.accept([(10 * MS, (0.04,))], now_ns=0, to_aperture=lambda p: p)
+    f.accept([(15 * MS, (0.065,))], now_ns=5 * MS, to_aperture=lambda p: p, measured=0.047)
+    assert f.sample(5 * MS) == pytest.approx(0.047)
+    assert f.sample(10 * MS) == pytest.approx(0.056)
+
+
 def test_the_hand_follower_replaces_a_trajectory_as_the_stock_controller_does():
     f = JointFollower([0.5, 0.5], limits=[(0.0, 2.0), (0.0, 2.0)], names=["a", "b"])
     f.accept([(10 * MS, (1.0, 0.0))], now_ns=0)
@@ -293,6 +305,29 @@ def test_a_zero_stamp_point_at_time_zero_is_followed_not_refused():
         # the joint's speed limit lets 0.15 mm of aperture through in the 1 ms tick
         world = sim.world.positions
         assert jtc.line.aperture(world["F1"], world["F2"]) == pytest.approx(0.04985, abs=1e-12)
+    finally:
+        rig.close()
+
+
+
+def test_the_simulated_controller_starts_a_trajectory_from_the_measured_aperture():
+    rig = SimWithClient(SPONGE)
+    sim, pub = rig.sim, rig.pub
+    try:
+        jtc = sim.controller
+        target = list(jtc.controller.gripper.joint_positions(0.04))
+        pub.publish(hostile(["finger_joint"], target))
+        rig.spin_until(lambda: sim.now_ns >= MS)
+        # tick 1: commanded 0.048 m, measured 0.04985 m (the joint's speed limit)
+        measured = jtc.aperture
+        assert jtc.follower.sample(MS) == pytest.approx(0.048)
+        assert measured == pytest.approx(0.04985, abs=1e-12)
+        pub.publish(hostile(["finger_joint"], target))
+        rig.spin_until(lambda: sim.now_ns >= 2 * MS)
+        assert jtc.refusals == []
+        # from the measured 0.04985 m at 1 ms to 0.04 m at 6 ms (the old command 0.048 m
+        # would give 0.0464 m at 2 ms)
+        assert jtc.follower.sample(2 * MS) == pytest.approx(measured + (0.04 - measured) / 5)
     finally:
         rig.close()
 

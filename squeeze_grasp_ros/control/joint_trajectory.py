@@ -13,7 +13,8 @@ ros2_controllers' JointTrajectoryController (position interface, linear interpol
   ``time_from_start`` strictly increasing, each point one finite position per joint; it starts
   at ``header.stamp`` (zero: on receipt);
 - a new trajectory replaces the old one at receipt: when its first point lies ahead the
-  command interpolates linearly from the commanded position at receipt to that point; when it
+  command interpolates linearly from the measured position at receipt (the stock default; the
+  command with ``interpolate_from_desired_state``) to that point; when it
   began in the past the command follows the trajectory's own segments from where it is at
   receipt (Jazzy's ``Trajectory::sample``); then between points, holding the last point; a
   trajectory that ends in the past is refused (a point at the time of receipt, as a zero stamp
@@ -171,9 +172,11 @@ class TrajectoryFollower:
         return float(np.interp(t_ns, times, values))
 
     def accept(self, points: Sequence[tuple[int, Sequence[float]]], *, now_ns: int,
-               to_aperture: Callable[[float], float]) -> None:
+               to_aperture: Callable[[float], float], measured: float | None = None) -> None:
         """Replace the active trajectory by ``points`` (absolute time ns, joint positions),
-        at ``now_ns`` (:func:`replacing_knots`).
+        at ``now_ns`` (:func:`replacing_knots`), starting from ``measured`` (the measured
+        aperture at ``now_ns``, m: the stock controller's start, ``interpolate_from_desired_state``
+        false, its default) or, when None, from the command (that parameter true).
 
         Raises
         ------
@@ -191,7 +194,8 @@ class TrajectoryFollower:
                 raise TrajectoryRefused(f"point {k}'s aperture {apertures[0]:g} m is outside "
                                         f"the opening range [{lo:g}, {hi:g}] m")
             knots.append((t, float(np.mean(apertures))))
-        self.knots = replacing_knots(knots, now_ns, self.sample(now_ns))
+        start = self.sample(now_ns) if measured is None else float(measured)
+        self.knots = replacing_knots(knots, now_ns, start)
 
 
 class JointFollower:

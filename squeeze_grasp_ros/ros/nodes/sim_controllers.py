@@ -207,7 +207,8 @@ class SimJointTrajectoryController(SimJaws, TrajectoryTopic):
 
     def _trajectory(self, msg: JointTrajectory) -> None:
         self._receive(msg, self.controller.joints, lambda points, now: self.follower.accept(
-            points, now_ns=now, to_aperture=self.controller.gripper.aperture))
+            points, now_ns=now, to_aperture=self.controller.gripper.aperture,
+            measured=self.aperture))
 
     def setpoints(self, t_ns: int) -> dict[str, np.ndarray]:
         """The jaws' tip setpoints (m) at sim time ``t_ns``, within the joint limits

@@ -361,12 +361,14 @@ def test_the_executor_cancels_an_outside_gripper_action_on_the_slip_alarm(tmp_pa
         result = rig.squeeze()
         assert result.termination == ExecuteGrasp.Result.SLIP_ALARM, result.message
         assert not result.success
-        # one goal: the planned aperture in joint units; max_effort 0 (no force curve published:
-        # the controller's own limit)
+        # one goal: the planned aperture in joint units; no force curve published, so the
+        # controller's own limit, sent explicitly: the stock GripperActionController takes
+        # max_effort as given, and 0 would clamp an effort interface's output to nothing
+        # (generic_85mm: no max_effort in the scene, the device's 235 N at 1 per N)
         assert len(server.goals) == 1
         position, max_effort = server.goals[0]
         assert position == pytest.approx(joint_of(PLANNED), abs=1e-9)
-        assert max_effort == 0.0
+        assert max_effort == 235.0
         # canceled past the plateau's start, short of the plan, and held there (the grasp goal
         # ends on the alarm's cycle; the cancel reaches the controller right after)
         rig.spin_until(lambda: server.canceled_at is not None, timeout=5.0)

@@ -26,6 +26,7 @@ from trajectory_msgs.msg import JointTrajectory, JointTrajectoryPoint
 
 from squeeze_grasp_ros.control.joint_trajectory import (
     JawLine,
+    JointFollower,
     TrajectoryFollower,
     TrajectoryRefused,
 )
@@ -58,14 +59,59 @@ def test_follower_interpolates_linearly_and_holds_the_last_point():
         assert f.sample(t) == pytest.approx(expected, abs=1e-15)
 
 
-def test_a_new_trajectory_replaces_the_old_from_its_first_future_point():
+def test_a_new_trajectory_replaces_the_old_from_the_command_to_its_first_point():
     f = follower()
     f.accept([(10 * MS, (0.04,))], now_ns=0, to_aperture=lambda p: p)
-    # at 5 ms the command is 0.045; the new trajectory's 2 ms point is past and dropped
-    f.accept([(2 * MS, (0.0,)), (15 * MS, (0.065,))], now_ns=5 * MS, to_aperture=lambda p: p)
+    # at 5 ms the command is 0.045; the new trajectory's first point lies ahead
+    f.accept([(15 * MS, (0.065,))], now_ns=5 * MS, to_aperture=lambda p: p)
     assert f.sample(5 * MS) == pytest.approx(0.045)
     assert f.sample(10 * MS) == pytest.approx(0.055)
     assert f.sample(15 * MS) == pytest.approx(0.065)
+
+
+def test_a_trajectory_begun_in_the_past_is_followed_on_its_own_segments():
+    # Jazzy's JointTrajectoryController (trajectory.cpp, Trajectory::sample) interpolates from
+    # the state before the message only up to a first point still ahead; past it, it samples the
+    # message's own segment: at 5 ms the new command is 3/13 of the way from the 2 ms point
+    # (0.0) to the 15 ms point (0.065), not the old command 0.045
+    f = follower()
+    f.accept([(10 * MS, (0.04,))], now_ns=0, to_aperture=lambda p: p)
+    f.accept([(2 * MS, (0.0,)), (15 * MS, (0.065,))], now_ns=5 * MS, to_aperture=lambda p: p)
+    assert f.sample(5 * MS) == pytest.approx(0.065 * 3 / 13)
+    assert f.sample(10 * MS) == pytest.approx(0.065 * 8 / 13)
+    assert f.sample(15 * MS) == pytest.approx(0.065)
+
+
+def test_a_point_at_the_time_of_receipt_is_taken_at_once():
+    # a zero stamp with time_from_start 0 ("go there now"): the stock controller starts the
+    # trajectory at its first sample and holds the point from then on; it refuses a
+    # trajectory only when it ends before now (validate_trajectory_msg)
+    f = follower()
+    f.accept([(5 * MS, (0.03,))], now_ns=5 * MS, to_aperture=lambda p: p)
+    assert f.sample(5 * MS) == f.sample(6 * MS) == pytest.approx(0.03)
+
+
+
+def test_a_new_trajectory_starts_from_the_measured_position():
+    # Jazzy's default (interpolate_from_desired_state false): the segment to a first point ahead
+    # starts at the joint's measured state when the controller takes the message, not at its
+    # last command
+    f = follower()
+    f.accept([(10 * MS, (0.04,))], now_ns=0, to_aperture=lambda p: p)
+    f.accept([(15 * MS, (0.065,))], now_ns=5 * MS, to_aperture=lambda p: p, measured=0.047)
+    assert f.sample(5 * MS) == pytest.approx(0.047)
+    assert f.sample(10 * MS) == pytest.approx(0.056)
+
+
+def test_the_hand_follower_replaces_a_trajectory_as_the_stock_controller_does():
+    f = JointFollower([0.5, 0.5], limits=[(0.0, 2.0), (0.0, 2.0)], names=["a", "b"])
+    f.accept([(10 * MS, (1.0, 0.0))], now_ns=0)
+    # begun in the past: sampled on its own segment (2 ms -> 15 ms), not from the command
+    f.accept([(2 * MS, (0.0, 1.3)), (15 * MS, (1.3, 0.0))], now_ns=5 * MS)
+    assert f.sample(5 * MS) == pytest.approx([0.3, 1.0])
+    # a point at the time of receipt is taken at once
+    f.accept([(6 * MS, (1.5, 1.5))], now_ns=6 * MS)
+    assert f.sample(6 * MS) == pytest.approx([1.5, 1.5])
 
 
 @pytest.mark.parametrize("points, why", [
@@ -241,6 +287,49 @@ def test_a_hostile_trajectory_is_refused_with_a_log_line_not_followed(capfd):
         rig.close()
     err = capfd.readouterr().err
     assert err.count("refused the trajectory on /gripper_controller/joint_trajectory") == 5
+
+
+def test_a_zero_stamp_point_at_time_zero_is_followed_not_refused():
+    # "go there now" (header.stamp 0, time_from_start 0): Jazzy's controller accepts it (it
+    # refuses only a trajectory with a non-zero stamp that ends in the past) and commands the
+    # point from its first update on
+    rig = SimWithClient(SPONGE)
+    sim, pub = rig.sim, rig.pub
+    try:
+        jtc = sim.controller
+        gripper = jtc.controller.gripper
+        pub.publish(hostile(["finger_joint"], list(gripper.joint_positions(0.04)), ms=0))
+        rig.spin_until(lambda: sim.now_ns >= MS or jtc.refusals)
+        assert jtc.refusals == []
+        assert sim.now_ns == MS and jtc.follower.sample(MS) == pytest.approx(0.04)
+        # the joint's speed limit lets 0.15 mm of aperture through in the 1 ms tick
+        world = sim.world.positions
+        assert jtc.line.aperture(world["F1"], world["F2"]) == pytest.approx(0.04985, abs=1e-12)
+    finally:
+        rig.close()
+
+
+
+def test_the_simulated_controller_starts_a_trajectory_from_the_measured_aperture():
+    rig = SimWithClient(SPONGE)
+    sim, pub = rig.sim, rig.pub
+    try:
+        jtc = sim.controller
+        target = list(jtc.controller.gripper.joint_positions(0.04))
+        pub.publish(hostile(["finger_joint"], target))
+        rig.spin_until(lambda: sim.now_ns >= MS)
+        # tick 1: commanded 0.048 m, measured 0.04985 m (the joint's speed limit)
+        measured = jtc.aperture
+        assert jtc.follower.sample(MS) == pytest.approx(0.048)
+        assert measured == pytest.approx(0.04985, abs=1e-12)
+        pub.publish(hostile(["finger_joint"], target))
+        rig.spin_until(lambda: sim.now_ns >= 2 * MS)
+        assert jtc.refusals == []
+        # from the measured 0.04985 m at 1 ms to 0.04 m at 6 ms (the old command 0.048 m
+        # would give 0.0464 m at 2 ms)
+        assert jtc.follower.sample(2 * MS) == pytest.approx(measured + (0.04 - measured) / 5)
+    finally:
+        rig.close()
 
 
 def test_the_simulated_controller_keeps_the_device_speed_limit(tmp_path):

@@ -12,9 +12,13 @@ ros2_controllers' JointTrajectoryController (position interface, linear interpol
 - a trajectory must name exactly the controller's joints (in any order), its points
   ``time_from_start`` strictly increasing, each point one finite position per joint; it starts
   at ``header.stamp`` (zero: on receipt);
-- a new trajectory replaces the old one from its first point in the future: the command
-  interpolates linearly from the commanded position at receipt to that point, then between
-  points, and holds the last point; a trajectory whose points all lie in the past is refused;
+- a new trajectory replaces the old one at receipt: when its first point lies ahead the
+  command interpolates linearly from the measured position at receipt (the stock default; the
+  command with ``interpolate_from_desired_state``) to that point; when it
+  began in the past the command follows the trajectory's own segments from where it is at
+  receipt (Jazzy's ``Trajectory::sample``); then between points, holding the last point; a
+  trajectory that ends in the past is refused (a point at the time of receipt, as a zero stamp
+  with ``time_from_start`` 0 gives, is taken at once);
 - refusals leave the active trajectory untouched. Beyond the stock controller, this one also
   refuses positions whose aperture lies outside the gripper's opening range or whose joints
   disagree on the aperture (the joints of a parallel gripper move together).
@@ -68,18 +72,23 @@ def checked_points(points: Sequence[tuple[int, Sequence[float]]]
     return out
 
 
-def future_knots(knots: list, now_ns: int) -> list:
-    """The knots (time ns first) after ``now_ns``: where a new trajectory replaces the old.
+def replacing_knots(knots: list, now_ns: int, command) -> list:
+    """The knots (time ns first) a JointTrajectoryController follows once it has taken the new
+    trajectory ``knots`` at ``now_ns``, its command then ``command``, as Jazzy's
+    ``Trajectory::sample`` does: from ``command`` at ``now_ns`` to the first point when that
+    lies ahead; otherwise the message's own points (the command goes to where the trajectory is
+    at ``now_ns``, between its points, and holds the last).
 
     Raises
     ------
     TrajectoryRefused
-        All of them in the past.
+        The trajectory ends before ``now_ns`` (a point at ``now_ns`` is taken).
     """
-    future = [knot for knot in knots if knot[0] > now_ns]
-    if not future:
-        raise TrajectoryRefused("all its points lie in the past")
-    return future
+    if knots[-1][0] < now_ns:
+        raise TrajectoryRefused("it ends in the past (all its points lie in the past)")
+    if knots[0][0] > now_ns:
+        return [(int(now_ns), command)] + knots
+    return knots
 
 
 @dataclass(frozen=True)
@@ -163,9 +172,11 @@ class TrajectoryFollower:
         return float(np.interp(t_ns, times, values))
 
     def accept(self, points: Sequence[tuple[int, Sequence[float]]], *, now_ns: int,
-               to_aperture: Callable[[float], float]) -> None:
+               to_aperture: Callable[[float], float], measured: float | None = None) -> None:
         """Replace the active trajectory by ``points`` (absolute time ns, joint positions),
-        from the first point after ``now_ns``.
+        at ``now_ns`` (:func:`replacing_knots`), starting from ``measured`` (the measured
+        aperture at ``now_ns``, m: the stock controller's start, ``interpolate_from_desired_state``
+        false, its default) or, when None, from the command (that parameter true).
 
         Raises
         ------
@@ -183,16 +194,17 @@ class TrajectoryFollower:
                 raise TrajectoryRefused(f"point {k}'s aperture {apertures[0]:g} m is outside "
                                         f"the opening range [{lo:g}, {hi:g}] m")
             knots.append((t, float(np.mean(apertures))))
-        self.knots = [(int(now_ns), self.sample(now_ns))] + future_knots(knots, now_ns)
+        start = self.sample(now_ns) if measured is None else float(measured)
+        self.knots = replacing_knots(knots, now_ns, start)
 
 
 class JointFollower:
     """A JointTrajectoryController's command for several independent joints (a hand), rad.
 
     The semantics of :class:`TrajectoryFollower` in joint space: linear interpolation of every
-    joint between knots, the last knot held, a new trajectory replacing the old from its first
-    point in the future; refused: unordered times, non-finite positions, a position outside its
-    joint's range, points all in the past.
+    joint between knots, the last knot held, a new trajectory replacing the old at receipt
+    (:func:`replacing_knots`); refused: unordered times, non-finite positions, a position
+    outside its joint's range, a trajectory that ends in the past.
 
     Parameters
     ----------
@@ -220,7 +232,7 @@ class JointFollower:
 
     def accept(self, points: Sequence[tuple[int, Sequence[float]]], *, now_ns: int) -> None:
         """Replace the active trajectory by ``points`` (absolute time ns, joint positions in
-        the order of ``names``) from the first point after ``now_ns``.
+        the order of ``names``) at ``now_ns`` (:func:`replacing_knots`).
 
         Raises
         ------
@@ -236,4 +248,4 @@ class JointFollower:
                 raise TrajectoryRefused(f"point {k} has positions outside the joint limits: "
                                         f"{', '.join(outside)} rad")
             knots.append((t, values))
-        self.knots = [(int(now_ns), self.sample(now_ns))] + future_knots(knots, now_ns)
+        self.knots = replacing_knots(knots, now_ns, self.sample(now_ns))

@@ -15,7 +15,9 @@ line from the jaws' measured tips (as :mod:`.jaw_commands`), and sends
 - **max_effort** (parallel: ``effort[0]``) = the planned jaw force at that depth (the planner's
   force curve, ``planner/predicted_events``, mean of the two jaws) times the controller
   section's ``effort_margin``, through the transmission, capped at the device's limit; without
-  a force curve, 0: the controller's own ``max_effort``. In lockstep the executor is ready only
+  a force curve, the controller's own ``max_effort`` (parallel: no effort sent; ``GripperCommand``,
+  which has no "none": the scene's ``max_effort`` sent explicitly, since the stock
+  GripperActionController takes 0 literally). In lockstep the executor is ready only
   once the force curve is here when somebody publishes one (a run latches it before its nodes
   start).
 
@@ -26,8 +28,8 @@ jaw, a lost contact or a pick-up cancels the gripper goal (the controller holds 
 position) and ends the grasp goal as on the setpoint route.
 
 A re-squeeze (``on_slip_alarm: resqueeze``, docs/grippers.md) is three gripper goals: the
-first squeeze's, canceled at the slip alarm; one to the release aperture (effort 0: the
-controller's own limit) whose result is not the grasp goal's; and, once the jaws are there and
+first squeeze's, canceled at the slip alarm; one to the release aperture (the controller's own
+effort limit, as above) whose result is not the grasp goal's; and, once the jaws are there and
 the monitor reported them free, one to the re-squeeze's aperture and effort, whose result ends
 the grasp goal.
 
@@ -144,6 +146,13 @@ class JawAction:
             goal.command.position = [float(position)]
             goal.command.effort = [float(effort)] if effort > 0.0 else []
         else:
+            if not effort > 0.0:
+                # GripperCommand cannot leave the effort to the controller: the stock
+                # GripperActionController takes max_effort as given, 0 included (an effort
+                # interface clamps its PID output to it: no effort, the jaws stay). Send the
+                # controller's max_effort (the scene's, else the device's limit) explicitly.
+                effort = min(self.controller.parameters().max_effort,
+                             self.controller.effort_limit)
             goal.command.position, goal.command.max_effort = float(position), float(effort)
         self.sent = {"position": float(position), "max_effort": float(effort)}
         self.outcome, self.handle = None, None

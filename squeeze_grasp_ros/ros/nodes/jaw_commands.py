@@ -9,8 +9,9 @@ measured tips at the goal's first cycle) and, through the gripper's transmission
 the joint positions at ``time_from_start`` = one control period after ``header.stamp`` (the
 cycle's tick in lockstep; zero, "on receipt", on hardware). One point because the program is
 reactive: each setpoint depends on the newest status, so the executor commits to the next
-period only, and the controller interpolates from its current command to it; a longer horizon
-would be replaced by the next cycle's message anyway.
+period only, and the controller interpolates to it from the joint's state when it takes the
+message (Jazzy's default; from its last command with ``interpolate_from_desired_state``); a
+longer horizon would be replaced by the next cycle's message anyway.
 
 A position-interface JointTrajectoryController does not limit effort (a trajectory point's
 ``effort`` goes to an effort command interface only, and ros2_control's joint limiters clamp

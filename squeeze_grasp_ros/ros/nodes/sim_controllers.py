@@ -14,7 +14,7 @@ gripper (``controller: {type: joint_trajectory, ...}``) and for its joint_state_
   measured jaw force is at the device's ``max_force`` the jaws close no further (the drive's
   effort limit: the stock controller itself limits no effort on a position interface);
 - a refused trajectory (joint names other than the controller's, sizes that do not match,
-  non-finite positions, an aperture beyond the opening range, points all in the past) is
+  non-finite positions, an aperture beyond the opening range, an end in the past) is
   logged as one warning line and not followed: the active trajectory stays (before tick 0 the
   controller is inactive and refuses every trajectory);
 - it publishes ``sensor_msgs/JointState`` on ``joint_states`` every tick, stamped with the
@@ -207,7 +207,8 @@ class SimJointTrajectoryController(SimJaws, TrajectoryTopic):
 
     def _trajectory(self, msg: JointTrajectory) -> None:
         self._receive(msg, self.controller.joints, lambda points, now: self.follower.accept(
-            points, now_ns=now, to_aperture=self.controller.gripper.aperture))
+            points, now_ns=now, to_aperture=self.controller.gripper.aperture,
+            measured=self.aperture))
 
     def setpoints(self, t_ns: int) -> dict[str, np.ndarray]:
         """The jaws' tip setpoints (m) at sim time ``t_ns``, within the joint limits

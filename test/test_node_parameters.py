@@ -139,3 +139,21 @@ def test_a_node_process_given_a_value_out_of_range_exits_2_with_one_line() -> No
     assert out.stderr.strip().splitlines()[-1] == said
     page = (Path(__file__).resolve().parents[1] / "docs" / "pipeline.md").read_text()
     assert f"`{said}`" in " ".join(page.split())
+
+
+@pytest.mark.parametrize("node, name, value, message", [
+    (PlannerNode, "default_solver_route", "bogus",
+     "parameter 'default_solver_route': solver_route must be one of ['factorized', 'spectral']"),
+    (ExecutorNode, "object_pose", [1.0], "parameter 'object_pose': a pose is 7 finite numbers"),
+    (ExecutorNode, "object_pose", [0.0] * 7, "(a unit quaternion), got [0.0, 0.0, 0.0, 0.0"),
+    (ExecutorNode, "object_pose", [0.0, 0.0, math.nan, 0.0, 0.0, 0.0, 1.0],
+     "a pose is 7 finite numbers"),
+])
+def test_a_parameter_of_the_wrong_shape_is_refused_by_name(ros_context: Context, node, name,
+                                                           value, message) -> None:
+    """Before: a PlannerError traceback (exit 1) and "not enough values to unpack (expected 7,
+    got 1)", which named no parameter; a zero quaternion was published as the object's pose.
+    """
+    with pytest.raises(ParameterError) as refused:
+        node(context=ros_context, parameter_overrides=[Parameter(name, value=value)])
+    assert message in str(refused.value)

@@ -3,6 +3,7 @@
 """Device streams: poses, wrenches and the lockstep tick."""
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 
 import numpy as np
@@ -34,7 +35,18 @@ def pose_position(msg: PoseStamped) -> np.ndarray:
 
 
 def pose_in_base(values: Sequence[float], frame_id: str) -> PoseStamped:
-    """``PoseStamped`` of [x, y, z, qx, qy, qz, qw] (m, unit quaternion) in ``frame_id``."""
+    """``PoseStamped`` of [x, y, z, qx, qy, qz, qw] (m, unit quaternion) in ``frame_id``.
+
+    Raises
+    ------
+    ValueError
+        Not seven finite numbers, or a quaternion whose norm is not 1 (to 1e-3).
+    """
+    values = [float(v) for v in values]
+    if (len(values) != 7 or not all(math.isfinite(v) for v in values)
+            or not abs(math.hypot(*values[3:]) - 1.0) <= 1e-3):
+        raise ValueError(f"a pose is 7 finite numbers, x y z (m) qx qy qz qw (a unit "
+                         f"quaternion), got {values}")
     msg = PoseStamped(header=Header(frame_id=frame_id))
     p, q = msg.pose.position, msg.pose.orientation
     p.x, p.y, p.z, q.x, q.y, q.z, q.w = (float(v) for v in values)

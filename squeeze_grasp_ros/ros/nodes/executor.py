@@ -145,6 +145,10 @@ class ExecutorNode(Node):
     def __init__(self, **kwargs: Any) -> None:
         super().__init__("executor", **kwargs)
         self.p = p = pipeline.declare(self, PARAMETERS, bounds=BOUNDS)
+        try:
+            pose = messages.pose_in_base(p["object_pose"], p["base_frame"])
+        except ValueError as error:
+            raise ParameterError(f"parameter 'object_pose': {error}") from None
         self.devices = pipeline.parse_mapping(p["finger_devices"], "finger_devices")
         self.limits = MotionLimits(p["max_velocity"], p["max_acceleration"],
                                    p["position_tolerance"], p["redirect_grace"],
@@ -174,7 +178,7 @@ class ExecutorNode(Node):
             ExecutorStatus, pipeline.EXECUTOR_STATUS,
             pipeline.output_qos(p["qos_depth"], lockstep=p["lockstep"]))
         pose_pub = self.create_publisher(PoseStamped, pipeline.OBJECT_POSE, pipeline.LATCHED)
-        pose_pub.publish(messages.pose_in_base(p["object_pose"], p["base_frame"]))
+        pose_pub.publish(pose)
         self.create_subscription(MonitorStatus, pipeline.STATUS, self._status, loop, raw=True)
         # keep-all request queues (rclpy's default of 10 dropped the 11th and later goals of a
         # burst unanswered: 10 answers to 30 goals sent at once)

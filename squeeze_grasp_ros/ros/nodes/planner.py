@@ -63,7 +63,7 @@ from squeeze_grasp_ros.mechanics.vocabulary import ObjectModel
 from squeeze_grasp_ros.planning import Cancelled, ErrorCode, PlannerLimits
 from squeeze_grasp_ros.resources import share_dir
 from squeeze_grasp_ros.ros import messages
-from squeeze_grasp_ros.ros.nodes import DRAIN_SPIN, pipeline, run_node, spin_until
+from squeeze_grasp_ros.ros.nodes import DRAIN_SPIN, ParameterError, pipeline, run_node, spin_until
 from squeeze_grasp_ros.ros.nodes.frame_pose_topic import frame_pose_topic
 from squeeze_grasp_ros.ros.refusals import RefusalLog
 
@@ -152,12 +152,15 @@ class PlannerNode(Node):
         super().__init__("planner", **kwargs)
         # float parameters also take YAML integers (``min_step: 1`` is an int in YAML)
         value = pipeline.declare(self, PARAMETERS, live=LIVE, bounds=BOUNDS).__getitem__
+        try:
+            route = planning.solver_route(value("default_solver_route"), PlannerLimits())
+        except planning.PlannerError as error:  # a traceback before: not a ValueError
+            raise ParameterError(f"parameter 'default_solver_route': {error}") from None
         self.add_on_set_parameters_callback(_set_live)
         self.limits = PlannerLimits(max_nodes=value("max_nodes"),
                              max_spectral_nodes=value("max_spectral_nodes"),
                              max_ring_elements=value("max_ring_elements"),
-                             default_route=planning.solver_route(value("default_solver_route"),
-                                                                 PlannerLimits()),
+                             default_route=route,
                              best_count=value("best_count"), min_step=float(value("min_step")),
                              max_bytes=int(value("cache_max_megabytes")) * 2**20)
         roots = [Path(r) for r in value("allowed_roots") if r] or [share_dir(), Path.cwd()]

@@ -7,6 +7,7 @@ by our executables says so in its log; before, nothing did.
 
 from __future__ import annotations
 
+import os
 import time
 
 import rclpy
@@ -38,17 +39,18 @@ def test_twins_counts_the_other_nodes_of_a_name(ros_context: Context) -> None:
 
 
 def test_a_planner_process_logs_the_other_node_of_its_name(ros_context, tmp_path) -> None:
-    twin = rclpy.create_node("planner", context=ros_context)
+    name = f"planner_twin_{os.getpid()}"  # no other test's planner on the domain counts
+    twin = rclpy.create_node(name, context=ros_context)
     log = tmp_path / "planner.log"
     try:
-        with planner_process(tmp_path):
+        with planner_process(tmp_path, "-r", f"__node:={name}"):
             deadline = time.monotonic() + TIMEOUT
-            while "other node(s) named /planner" not in log.read_text():
+            while f"other node(s) named /{name}" not in log.read_text():
                 assert time.monotonic() < deadline, log.read_text()
                 time.sleep(0.2)
         said = next(line for line in log.read_text().splitlines() if "other node(s)" in line)
-        assert ("1 other node(s) named /planner are on this ROS domain: each gets the requests, "
-                "goals and topics meant for one") in said
+        assert (f"1 other node(s) named /{name} are on this ROS domain: each gets the "
+                "requests, goals and topics meant for one") in said
         assert "--ros-args -r __node:=NAME" in said
     finally:
         twin.destroy_node()

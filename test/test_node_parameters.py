@@ -41,7 +41,7 @@ TIMEOUT = 30.0
 
 
 @pytest.mark.parametrize("name, value, message", [
-    ("max_pending", -1, "parameter 'max_pending' must be an integer >= 1, got -1"),
+    ("max_pending", -1, "parameter 'max_pending' must be an integer >= 0, got -1"),
     ("worker_threads", 0, "parameter 'worker_threads' must be an integer >= 1, got 0"),
     ("max_nodes", -5, "parameter 'max_nodes' must be an integer >= 1, got -5"),
     ("cache_size", 0, "parameter 'cache_size' must be an integer >= 1, got 0"),
@@ -106,7 +106,7 @@ def test_ros2_param_set_on_running_nodes(ros_context: Context) -> None:
         assert to_planner.wait_for_services(TIMEOUT) and to_monitor.wait_for_services(TIMEOUT)
         refused = _set(to_planner, executor, Parameter("max_pending", value=-1))
         assert not refused.successful
-        assert refused.reason == "parameter 'max_pending' must be an integer >= 1, got -1"
+        assert refused.reason == "parameter 'max_pending' must be an integer >= 0, got -1"
         assert planner.get_parameter("max_pending").value == 16
         assert _set(to_planner, executor, Parameter("max_pending", value=3)).successful
         assert planner.get_parameter("max_pending").value == 3

@@ -97,7 +97,7 @@ PARAMETERS: dict[str, tuple[Any, str]] = {
                                "limits is held back), N = the last N (older unread requests "
                                "are dropped)"),
     "max_pending": (16, "long requests (loads, maps, event squeezes) queued or running at "
-                        "once; more are answered BUSY at once"),
+                        "once; more are answered BUSY at once (0: every one)"),
     "frame_pose_topic": ("", "geometry_msgs/PoseStamped topic (latched) with the pose of "
                              "frame_pose_frame in the object frame, for typed objects whose "
                              "outline is in that frame and whose frame_pose is unset; '' = none"),
@@ -114,7 +114,8 @@ LIVE = ("max_pending",)
 (within :data:`BOUNDS`); the others are read at start-up and read-only."""
 BOUNDS = {**{name: pipeline.Bound(1) for name in (
     "max_nodes", "max_spectral_nodes", "max_ring_elements", "cache_size", "cache_max_megabytes",
-    "worker_threads", "best_count", "max_pending")},
+    "worker_threads", "best_count")},
+    "max_pending": pipeline.Bound(0),  # 0: every long request is answered BUSY
     "min_step": pipeline.Bound(0.0, above=True)}
 """The range of each numeric parameter (``service_queue_depth`` and ``frame_pose_max_age``
 are checked where they are used)."""

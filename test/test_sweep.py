@@ -904,6 +904,45 @@ def test_other_spec_in_the_same_directory_is_refused(tmp_path):
         Store(tmp_path / "o", two, plan(two))
 
 
+HOLD_STORE = """
+import sys
+from pathlib import Path
+from squeeze_grasp_ros.sweep.plan import plan_tasks
+from squeeze_grasp_ros.sweep.spec import load_sweep_spec
+from squeeze_grasp_ros.sweep.store import Store
+loaded = load_sweep_spec(sys.argv[1])
+with Store(Path(sys.argv[2]), loaded, plan_tasks(loaded)):
+    print("holding", flush=True)
+    sys.stdin.read()
+"""
+
+
+def test_a_second_sweep_into_a_folder_being_written_is_refused_with_the_holders_pid(
+        tmp_path, capsys):
+    """Before: two sweeps into one --out both ran, each removing the other's temporary parts
+    at its start and rewriting the manifest with its own counts. Now the second is refused
+    before it touches the folder, and the folder is free again when the first ends.
+    """
+    spec = write_spec(tmp_path, {**SMALL, "objects": SMALL["objects"][:1]})
+    out = tmp_path / "o"
+    holder = subprocess.Popen([sys.executable, "-c", HOLD_STORE, str(spec), str(out)],
+                              stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True)
+    try:
+        assert holder.stdout.readline() == "holding\n"
+        temporary = out / "parts" / ".t0.parquet.tmp"  # a part the holder is writing
+        temporary.write_text("")
+        assert main(["sweep", str(spec), "--out", str(out)]) == 2
+        err = capsys.readouterr().err
+        assert (f"another sweep is writing {out} (process {holder.pid} holds .sweep.lock): "
+                "wait for it to end or give another --out") in err
+        assert "Traceback" not in err and temporary.exists()
+    finally:
+        holder.communicate("", timeout=60)
+    assert holder.returncode == 0
+    assert main(["sweep", str(spec), "--out", str(out), "--workers", "1"]) == 0
+    assert not temporary.exists()
+
+
 @pytest.mark.parametrize("missing", ["distributed", "pyarrow"])
 def test_without_the_extra_both_verbs_say_how_to_install_and_exit_4(tmp_path, monkeypatch, capsys,
                                                                      missing):

@@ -357,14 +357,15 @@ def run_sweep(loaded: LoadedSpec, out: str | Path, *, scheduler: Optional[str] =
         require_extra()
         from squeeze_grasp_ros.sweep.store import Store
         tasks = plan_tasks(loaded)
-        store = Store(out, loaded, tasks)
-        todo = [t for t in tasks if not store.done(t.id)]
-        # the local workers inherit the route: compiled for sweeps that repay its compilation
-        kernel = None if scheduler else prefer_compiled(sum(t.evaluations for t in tasks)).value
-        outcome = Outcome(len(tasks), len(tasks) - len(todo), 0, 0, 0, 0, 0.0, 0, None, None,
-                          0.0, 0.0, repaired=list(store.repaired), kernel=kernel)
+        store = Store(out, loaded, tasks)  # the folder is locked until store.close()
         client = cluster = None
         try:
+            todo = [t for t in tasks if not store.done(t.id)]
+            # the local workers inherit the route: compiled for sweeps that repay compiling
+            kernel = (None if scheduler
+                      else prefer_compiled(sum(t.evaluations for t in tasks)).value)
+            outcome = Outcome(len(tasks), len(tasks) - len(todo), 0, 0, 0, 0, 0.0, 0, None,
+                              None, 0.0, 0.0, repaired=list(store.repaired), kernel=kernel)
             if todo and stop.signal is None:
                 try:
                     client, cluster = _start(scheduler, workers, stop)
@@ -387,6 +388,7 @@ def run_sweep(loaded: LoadedSpec, out: str | Path, *, scheduler: Optional[str] =
                 client.close()
             if cluster is not None:
                 cluster.close()
+            store.close()
     outcome.interrupted = stop.signal
     outcome.seconds = time.perf_counter() - start
     return outcome

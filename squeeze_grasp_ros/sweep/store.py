@@ -8,6 +8,7 @@ Layout::
     DIR/parts/<task id>.parquet one file per finished task (rows sorted by eval_id)
     DIR/outlines/<object id>.json  the object's meshed outer boundary, m (for pictures)
     DIR/damaged/                parts a resume found bad, moved aside (never deleted)
+    DIR/parts/.sweep.lock       locked by the sweep writing the folder (its process id inside)
 
 Parts are written to a temporary file in ``parts/``, flushed to disk and renamed into place,
 so a part either exists complete or not at all, whatever kills the process; a write that fails
@@ -18,11 +19,18 @@ redoes its task, and the report leaves it out with a line saying why. The manife
 replaced atomically) repeats the status for people and tools and records failed tasks with their
 error; it is read only as a regular file of at most :data:`MAX_MANIFEST_BYTES` and must have the
 manifest's structure. Re-running the same spec into the same directory therefore skips exactly
-the finished, intact tasks.
+the finished, intact tasks. One sweep at a time writes a folder: the store holds a lock on
+``parts/.sweep.lock`` from its opening until :meth:`Store.close` (or its process ends, however),
+and a second sweep into the same folder is refused with the holder's process id, before it
+touches anything (two writers would remove each other's temporary parts and interleave the
+manifest). The lock is a POSIX record lock: it holds between processes of one machine, and
+across machines only on a file system whose locks do (NFS with its lock service, not every
+network file system).
 """
 
 from __future__ import annotations
 
+import fcntl
 import json
 import os
 import time
@@ -45,6 +53,7 @@ MAX_MANIFEST_BYTES = 64 * 1024 * 1024
 MAX_OUTLINE_BYTES = 16 * 1024 * 1024
 """Largest outline file read for pictures."""
 STATUSES = ("done", "failed", "pending")
+LOCK_NAME = ".sweep.lock"
 
 
 def package_version() -> str:
@@ -185,6 +194,30 @@ def read_outlines(out: str | Path) -> dict[str, list]:
     return outlines
 
 
+def _hold_lock(path: Path, out: Path) -> int:
+    """Open ``path`` and lock it for this process (its id written in it); the descriptor.
+
+    Raises
+    ------
+    SweepError
+        If another process holds the lock (a sweep writing ``out`` now), naming its id.
+    """
+    try:
+        fd = os.open(path, os.O_RDWR | os.O_CREAT, 0o644)
+    except OSError as exc:
+        raise output_error(exc, path, "the sweep's lock file") from None
+    try:
+        fcntl.lockf(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+    except OSError:
+        holder = os.pread(fd, 32, 0).decode("ascii", "replace").strip()
+        os.close(fd)
+        raise SweepError(f"another sweep is writing {out} (process {holder or 'unknown'} holds "
+                         f"{path.name}): wait for it to end or give another --out") from None
+    os.ftruncate(fd, 0)
+    os.pwrite(fd, f"{os.getpid()}\n".encode(), 0)
+    return fd
+
+
 class Store:
     """The output directory of one sweep spec.
 
@@ -222,6 +255,20 @@ class Store:
             raise SweepError(f"--out {self.out} is a file; give a new or empty directory")
         try:
             self.parts.mkdir(parents=True, exist_ok=True)
+        except OSError as exc:
+            raise output_error(exc, self.parts, "the sweep's parts folder") from None
+        self._lock = _hold_lock(self.parts / LOCK_NAME, self.out)
+        try:
+            self._open(loaded)
+        except BaseException:
+            self.close()
+            raise
+
+    def _open(self, loaded: LoadedSpec) -> None:
+        """Remove stale temporary parts, check the parts on disk (moving bad ones aside) and
+        write the manifest (under the folder's lock).
+        """
+        try:
             for stale in self.parts.glob(".*.tmp"):
                 stale.unlink()
         except OSError as exc:
@@ -239,6 +286,18 @@ class Store:
                 self.repaired.append(f"parts/{entry.name}: {exc}; moved to "
                                      f"{self._set_aside(entry)} and redone")
         self.write_manifest()
+
+    def close(self) -> None:
+        """Release the folder's lock (another sweep may then write it); idempotent."""
+        if self._lock is not None:
+            os.close(self._lock)  # closing the descriptor releases the record lock
+            self._lock = None
+
+    def __enter__(self) -> "Store":
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.close()
 
     def _set_aside(self, entry: os.DirEntry) -> Path:
         """Move a bad part into ``damaged/`` under a name not taken yet; its new path."""

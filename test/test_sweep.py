@@ -943,6 +943,23 @@ def test_a_second_sweep_into_a_folder_being_written_is_refused_with_the_holders_
     assert not temporary.exists()
 
 
+def test_plots_of_a_folder_with_no_rows_yet_are_refused_in_words(tmp_path, capsys):
+    """Before: ``--plot`` of a sweep folder whose tasks were all pending wrote nothing and said
+    nothing (the summary showed no plot line).
+    """
+    from squeeze_grasp_ros.commands.sweep_report import NO_PLOTS
+    from squeeze_grasp_ros.sweep.store import Store
+
+    loaded = parse_sweep_spec(SMALL, tmp_path)
+    Store(tmp_path / "o", loaded, plan_tasks(loaded)).close()
+    assert main(["sweep-report", str(tmp_path / "o"), "--plot", str(tmp_path / "plots")]) == 0
+    assert capsys.readouterr().out.splitlines()[-1] == f"plots: {NO_PLOTS}"
+    assert list((tmp_path / "plots").iterdir()) == []
+    assert main(["sweep-report", str(tmp_path / "o"), "--json", "--plot",
+                 str(tmp_path / "plots")]) == 0
+    assert json.loads(capsys.readouterr().out)["plots"] == []
+
+
 @pytest.mark.parametrize("missing", ["distributed", "pyarrow"])
 def test_without_the_extra_both_verbs_say_how_to_install_and_exit_4(tmp_path, monkeypatch, capsys,
                                                                      missing):

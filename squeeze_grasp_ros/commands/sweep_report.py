@@ -11,6 +11,8 @@ from squeeze_grasp_ros.sweep.report import plot, summarise, text
 
 MAX_BEST = 10_000
 """Most best placements listed per object."""
+NO_PLOTS = "none written: the folder has no finished rows yet (run or resume the sweep)"
+"""What ``--plot`` says of a folder whose parts hold no rows (every task pending or failed)."""
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -32,8 +34,8 @@ def run(args: argparse.Namespace) -> dict:
     manifest = {k: data.manifest.get(k) for k in ("name", "spec_hash", "package_version")}
     out = {"out": args.out, "manifest": {**manifest, "counts": data.counts},
            "excluded": list(data.excluded), **summarise(rows, args.best)}
-    if args.plot and rows:
-        out["plots"] = plot(rows, args.plot, read_outlines(args.out))
+    if args.plot:
+        out["plots"] = plot(rows, args.plot, read_outlines(args.out)) if rows else []
     return out
 
 
@@ -45,6 +47,6 @@ def summary(result: dict) -> str:
                      "sweep to redo their tasks):")
         lines += [f"  {line}" for line in result["excluded"]]
     lines.append(text(result, result["manifest"]))
-    if result.get("plots"):
-        lines.append("plots: " + ", ".join(result["plots"]))
+    if "plots" in result:
+        lines.append("plots: " + (", ".join(result["plots"]) or NO_PLOTS))
     return "\n".join(lines)

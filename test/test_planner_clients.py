@@ -330,6 +330,9 @@ def test_no_response_or_log_line_echoes_a_huge_field(planner, capfd):
     assert kind.error_code == ErrorCode.INVALID_ARGUMENT and len(kind.message) < 300
     path = planner.call(LoadObject, "load_object", LoadObject.Request(scene_path=huge))
     assert path.error_code == ErrorCode.INVALID_ARGUMENT and len(path.message) < 300
+    missing = "/nonexistent/" + "d" * 200 + "/scene.yaml"  # quoted whole: its end names the file
+    path = planner.call(LoadObject, "load_object", LoadObject.Request(scene_path=missing))
+    assert not path.success and missing in path.message, path.message
     name = planner.call(LoadObject, "load_object", LoadObject.Request(
         scene_yaml=BLOB.replace("name: blob", f"name: {'n' * 300}")))
     assert name.error_code == ErrorCode.INVALID_ARGUMENT

@@ -69,7 +69,8 @@ BOUNDED = [(label, name) for label, module in MODULES.items() for name in module
 def test_every_bounded_pipeline_parameter_refuses_a_value_out_of_range(ros_context: Context,
                                                                        label, name) -> None:
     """Before, most of these values started the node: an executor with a NaN or
-    negative max_velocity, a monitor whose stale_after was NaN (no reading ever stale)...
+    negative max_velocity, a monitor whose stale_after was NaN (no reading ever stale), an
+    executor whose period of 1e-12 s rounded to a tick of 0 ns...
     """
     module = MODULES[label]
     bound, default = module.BOUNDS[name], module.PARAMETERS[name][0]
@@ -77,6 +78,8 @@ def test_every_bounded_pipeline_parameter_refuses_a_value_out_of_range(ros_conte
     hostile = [bound.low - 1] + ([math.nan, math.inf] if isinstance(default, float) else [])
     if bound.above:
         hostile.append(bound.low)
+    if bound.low > 0 and isinstance(default, float):
+        hostile.append(bound.low / 2)  # below a positive floor (a period of 1e-12 s was 0 ns)
     if bound.high < math.inf:
         hostile.append(bound.high + 1)
     for value in hostile:

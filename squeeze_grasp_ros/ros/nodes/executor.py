@@ -96,7 +96,7 @@ BOUNDS = {"max_velocity": pipeline.Bound(0.0, above=True, unit="m/s"),
           "position_tolerance": pipeline.Bound(0.0, above=True, unit="m"),
           "redirect_grace": pipeline.Bound(0), "stale_budget": pipeline.Bound(0.0, unit="s"),
           "lift_watch": pipeline.Bound(0.0, unit="s"),
-          "period": pipeline.Bound(0.0, above=True, unit="s"),
+          "period": pipeline.Bound(1e-6, unit="s"),  # whole nanoseconds within 0.05 %
           "feedback_every": pipeline.Bound(1), "qos_depth": pipeline.Bound(1)}
 """The range of each numeric parameter."""
 

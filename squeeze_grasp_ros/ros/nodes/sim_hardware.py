@@ -63,7 +63,7 @@ PARAMETERS: dict[str, tuple[Any, str]] = {
 }
 """Parameter name -> (typed default, description); config/sim_hardware.yaml sets them."""
 BOUNDS = {"qos_depth": pipeline.Bound(1), "display_rate": pipeline.Bound(0.0, unit="Hz"),
-          "handshake_period": pipeline.Bound(0.0, above=True, unit="s"),
+          "handshake_period": pipeline.Bound(1e-3, unit="s"),  # wall-clock hellos
           "resend_timeout": pipeline.Bound(0.0, above=True, unit="s"),
           "recorder_window": pipeline.Bound(1)}
 """The range of each numeric parameter."""

@@ -157,6 +157,21 @@ def test_cli_reports_spec_errors_without_traceback(tmp_path, capsys):
     assert "tip_radius[0] must be > 0.0 m" in capsys.readouterr().err
 
 
+@pytest.mark.parametrize("workers", [0, 4 * (os.cpu_count() or 1) + 1, 100_000])
+def test_a_local_cluster_size_out_of_range_is_refused_before_anything_starts(tmp_path, capsys,
+                                                                           workers):
+    """Before: --workers had no upper bound, and --workers 100000 began starting 100,000
+    worker processes (over 90 MB each) on this 2-core machine.
+    """
+    spec = write_spec(tmp_path, SMALL)
+    assert main(["sweep", str(spec), "--out", str(tmp_path / "o"), "--workers",
+                 str(workers)]) == 2
+    cores = os.cpu_count() or 1
+    assert (f"--workers must be between 1 and {4 * cores} (4 per core of the {cores} here: "
+            f"each worker is a process), got {workers}") in capsys.readouterr().err
+    assert not (tmp_path / "o").exists()
+
+
 @pytest.mark.parametrize("text, problem", [
     ("x,y\n0,0\n0.1,0\n", "bad.csv: line 1 is not 'x,y' (two numbers, metres)"),
     ("0,0\n0.1,0\n0.2,0\n", "bad.csv is degenerate (zero enclosed area)"),

@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
 import signal
 import sys
 
@@ -20,13 +21,19 @@ from squeeze_grasp_ros.mechanics.squeeze.fixed_set_kernel import (
 from squeeze_grasp_ros.sweep.engine import dry_run, run_sweep
 from squeeze_grasp_ros.sweep.spec import SweepError, load_sweep_spec
 
+WORKERS_PER_CORE = 4
+"""Most local workers per core: each is a process of its own (over 90 MB once it has
+evaluated a task of the example sweep) evaluating on one core, so more only share the cores and
+fill the memory."""
+
 EPILOG = ("exit status: 0 every task written (an evaluation that raised is a row with its error "
           "and leaves the status 0; the summary counts them); 1 some tasks failed as a whole "
           "(listed with their error in DIR/manifest.json; the other tasks are written, and "
           "re-running the same command retries only the failed ones); 2 invalid spec or option, "
-          "a spec over the size limits, unreachable --scheduler, an --out that refuses writes, "
-          "or a bad manifest; 4 the sweep extra missing (the install line is printed), or the "
-          "disk filled up (the parts written are kept; re-run to resume); 130 stopped by "
+          "a spec over the size limits, unreachable --scheduler, an --out that another sweep "
+          "is writing or that refuses writes, or a bad manifest; 4 the sweep extra missing (the "
+          "install line is printed), or the disk filled up (the parts written are kept; re-run "
+          "to resume); 130 stopped by "
           "Ctrl-C (SIGINT), 143 by SIGTERM, at any point from start-up on: finished parts are "
           "kept, re-run to resume. Route: with the fast extra (numba), the local workers of a "
           f"sweep of at least {COMPILED_FROM_EVALUATIONS:,} evaluations run compiled (the "
@@ -48,7 +55,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="address of a running Dask scheduler, e.g. tcp://10.0.0.5:8786 "
                              "(default: a local cluster, one worker process per core)")
     parser.add_argument("--workers", type=int, metavar="N",
-                        help="local cluster size (default: one per core)")
+                        help=f"local cluster size (default: one per core; at most "
+                             f"{WORKERS_PER_CORE} per core)")
     parser.add_argument("--dry-run", action="store_true",
                         help="print task and evaluation counts and an estimated time from a "
                              "small timed sample; run nothing on Dask")
@@ -59,8 +67,11 @@ def run(args: argparse.Namespace) -> dict | int:
     """Run or resume the sweep; returns its counts, or the exit status after printing them
     (1 if tasks failed) or a stop message (130 on SIGINT, 143 on SIGTERM).
     """
-    if args.workers is not None and args.workers < 1:
-        raise SweepError(f"--workers must be >= 1, got {args.workers}")
+    most = WORKERS_PER_CORE * (os.cpu_count() or 1)
+    if args.workers is not None and not 1 <= args.workers <= most:
+        raise SweepError(f"--workers must be between 1 and {most} ({WORKERS_PER_CORE} per core "
+                         f"of the {os.cpu_count() or 1} here: each worker is a process), got "
+                         f"{args.workers}")
     if args.workers is not None and args.scheduler:
         raise SweepError("--workers sizes the local cluster; it cannot be used with --scheduler")
     loaded = load_sweep_spec(args.spec)

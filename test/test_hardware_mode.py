@@ -122,7 +122,8 @@ class Rig:
 
     def __init__(self, scene: Path, joint: Joint, *,
                  reach: float | None = DEVICE["pad"]["edge_radius"],
-                 gripper_pose: list[float] | None = None) -> None:
+                 gripper_pose: list[float] | None = None,
+                 executor: tuple[Parameter, ...] = ()) -> None:
         self.context = Context()
         rclpy.init(context=self.context)
         self.spin = MultiThreadedExecutor(num_threads=3, context=self.context)
@@ -135,7 +136,8 @@ class Rig:
             Parameter("streams", value=[""]), Parameter("rate", value=100.0),
             Parameter("stale_after", value=0.1), Parameter("force_watch", value=False)])
         self.executor = ExecutorNode(context=self.context, parameter_overrides=common + [
-            Parameter("period", value=PERIOD), Parameter("stale_budget", value=1.0)])
+            Parameter("period", value=PERIOD), Parameter("stale_budget", value=1.0),
+            *executor])
         self.kinematics = Node("jaw_kinematics", context=self.context)
         self.client_node = Node("grasp_client", context=self.context)
         self.client = ActionClient(self.client_node, ExecuteGrasp, pipeline.ACTION)
@@ -375,6 +377,62 @@ def test_the_executor_cancels_an_outside_gripper_action_on_the_slip_alarm(tmp_pa
         assert server.canceled_at is not None, "the executor never canceled the gripper goal"
         assert joint_of(0.050) < server.canceled_at < joint_of(PLANNED)
         assert joint.target == server.canceled_at
+    finally:
+        server.server.destroy()
+        rig.close()
+
+
+class InactiveGripperAction:
+    """A GripperCommand server as Jazzy's GripperActionController is while loaded but not
+    active: its goal callback accepts every goal, and the update that would move the joint and
+    end the goal does not run; a cancel is taken.
+    """
+
+    def __init__(self, node: Node) -> None:
+        from control_msgs.action import GripperCommand
+        self.action = GripperCommand
+        self.goals: list[float] = []
+        self.canceled = threading.Event()
+        self.server = ActionServer(node, GripperCommand, "gripper_controller/gripper_cmd",
+                                   self._execute, cancel_callback=lambda _: CancelResponse.ACCEPT,
+                                   callback_group=ReentrantCallbackGroup())
+
+    def _execute(self, handle):
+        self.goals.append(handle.request.command.position)
+        while not handle.is_cancel_requested:
+            time.sleep(0.01)
+        self.canceled.set()
+        handle.canceled()
+        return self.action.Result()
+
+
+@pytest.mark.skipif(NO_CONTROL_MSGS, reason="control_msgs is not built: squeeze-grasp ros-setup "
+                    "--control-msgs DIR (DIR a jazzy checkout of github.com/ros-controls/"
+                    "control_msgs)")
+def test_a_gripper_goal_without_a_result_ends_the_grasp_after_gripper_timeout(tmp_path):
+    """Before: a grasp goal through a GripperActionController loaded but not active waited for
+    ever (the controller accepts the goal and never ends it); the executor said nothing.
+    """
+    scene = yaml.safe_load(SCENE.read_text())
+    scene["controller"]["type"] = "gripper_action"
+    path = tmp_path / "sponge_gripper_action.yaml"
+    path.write_text(yaml.safe_dump(scene))
+    rig = Rig(path, Joint(OPEN), executor=(Parameter("gripper_timeout", value=0.5),))
+    server = InactiveGripperAction(rig.outside)
+    try:
+        result = rig.squeeze()
+        assert result.termination == ExecuteGrasp.Result.GRIPPER_ABORTED, result.message
+        assert not result.success
+        assert f"{joint_of(PLANNED):.6g}" == "0.368397"  # as docs/grippers.md quotes it
+        assert ("no result from gripper_controller/gripper_cmd within gripper_timeout 0.5 s of "
+                f"its goal (position {joint_of(PLANNED):.6g}, max_effort 235): a stock "
+                "GripperActionController that is loaded but not active accepts goals and never "
+                "ends them") in result.message, result.message
+        assert result.message.endswith("the gripper goal was canceled")
+        assert 0.5 <= result.duration < 5.0, result.duration
+        assert server.goals == [pytest.approx(joint_of(PLANNED), abs=1e-9)]
+        rig.spin_until(server.canceled.is_set, timeout=5.0)
+        assert server.canceled.is_set(), "the executor never canceled the gripper goal"
     finally:
         server.server.destroy()
         rig.close()

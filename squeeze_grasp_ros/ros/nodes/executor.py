@@ -89,6 +89,10 @@ PARAMETERS: dict[str, tuple[Any, str]] = {
     "await_prediction": (False, "lockstep, jaws under a stock controller: ready only once "
                                 "planner/predicted_events has arrived (run sets it: it "
                                 "publishes one before the nodes start)"),
+    "gripper_timeout": (30.0, "longest a gripper action goal may run without a result, s; "
+                              "past it the grasp goal ends gripper_aborted and the gripper "
+                              "goal is canceled (an inactive stock GripperActionController "
+                              "accepts goals and never ends them; 0: no limit)"),
 }
 """Parameter name -> (typed default, description); config/executor.yaml sets them."""
 BOUNDS = {"max_velocity": pipeline.Bound(0.0, above=True, unit="m/s"),
@@ -97,7 +101,8 @@ BOUNDS = {"max_velocity": pipeline.Bound(0.0, above=True, unit="m/s"),
           "redirect_grace": pipeline.Bound(0), "stale_budget": pipeline.Bound(0.0, unit="s"),
           "lift_watch": pipeline.Bound(0.0, unit="s"),
           "period": pipeline.Bound(1e-6, unit="s"),  # whole nanoseconds within 0.05 %
-          "feedback_every": pipeline.Bound(1), "qos_depth": pipeline.Bound(1)}
+          "feedback_every": pipeline.Bound(1), "qos_depth": pipeline.Bound(1),
+          "gripper_timeout": pipeline.Bound(0.0, unit="s")}
 """The range of each numeric parameter."""
 
 SUCCESS = (ExecuteGrasp.Result.DEPTH_REACHED, ExecuteGrasp.Result.RESISTED,
@@ -430,7 +435,7 @@ class ExecutorNode(Node):
             waiting = action.cancel(answer)
         elif program.ticks == 1:
             position, effort = action.target(program.goal, obs)
-            action.send(position, effort, answer)
+            action.send(position, effort, answer, at_ns=ns)
             waiting = True
         elif program.phase == "lift" and not goal.lifting:
             goal.lifting = True  # picked up: the controller holds while the arm lifts
@@ -441,7 +446,7 @@ class ExecutorNode(Node):
                                               program.release_positions())))
 
             def release() -> None:
-                action.send(opening, 0.0, answer)
+                action.send(opening, 0.0, answer, at_ns=ns)
 
             if not action.cancel(release):
                 release()
@@ -453,11 +458,15 @@ class ExecutorNode(Node):
                 program.planned_depth)
             if program.under_weight:
                 effort = 0.0  # deeper than the plan's force curve: the controller's own limit
-            action.send(position, effort, answer)
+            action.send(position, effort, answer, at_ns=ns)
             waiting = True
         else:
             end, waiting = (None if goal.releasing or goal.lifting else action.outcome), False
-            if end is not None and program.under_weight and end[1]:
+            overdue = action.overdue(ns, self.p["gripper_timeout"])
+            if end is None and overdue is not None:
+                end = (ExecuteGrasp.Result.GRIPPER_ABORTED, False, overdue)
+                waiting = action.cancel(answer)
+            elif end is not None and program.under_weight and end[1]:
                 # a squeeze deeper under weight reached its depth: hold and watch the lift
                 command, end, goal.lifting = program.lift(obs), None, True
         if not waiting:

@@ -23,9 +23,12 @@ line from the jaws' measured tips (as :mod:`.jaw_commands`), and sends
 
 The grasp goal then ends on the gripper goal's result: ``reached_goal`` -> depth_reached;
 ``stalled`` -> gripper_stalled (success only if the controller allows stalling); a rejection
--> gripper_rejected; another end (preempted) -> gripper_aborted. A cancel, an imminent slip of a
-jaw, a lost contact or a pick-up cancels the gripper goal (the controller holds the measured
-position) and ends the grasp goal as on the setpoint route.
+-> gripper_rejected; another end (preempted) -> gripper_aborted; no result within the
+executor's ``gripper_timeout`` of the executor's time -> gripper_aborted, the gripper goal
+canceled (Jazzy's GripperActionController accepts every goal, active or not, and computes only
+while active: a controller loaded but not activated takes the goal and never ends it). A
+cancel, an imminent slip of a jaw, a lost contact or a pick-up cancels the gripper goal (the
+controller holds the measured position) and ends the grasp goal as on the setpoint route.
 
 A re-squeeze (``on_slip_alarm: resqueeze``, docs/grippers.md) is three gripper goals: the
 first squeeze's, canceled at the slip alarm; one to the release aperture (the controller's own
@@ -91,6 +94,8 @@ class JawAction:
         self.outcome: tuple[str, bool, str] | None = None
         """(termination, success, message) once the gripper goal ended."""
         self.sent: dict[str, float] = {}
+        self.sent_ns: int | None = None
+        """The executor's time (ns) the running gripper goal was sent at; None when none runs."""
 
     @property
     def fingers(self) -> tuple[str, str]:
@@ -138,8 +143,11 @@ class JawAction:
         return float(self.controller.joint_positions(self.line.aperture(tips[first],
                                                                         tips[second]))[0])
 
-    def send(self, position: float, effort: float, on_answer: Callable[[], None]) -> None:
-        """Send the goal; ``on_answer`` once the controller accepted or rejected it."""
+    def send(self, position: float, effort: float, on_answer: Callable[[], None], *,
+             at_ns: int) -> None:
+        """Send the goal at the executor's time ``at_ns``; ``on_answer`` once the controller
+        accepted or rejected it.
+        """
         goal = self.action.Goal()
         if self.parallel:
             goal.command.name = [self.controller.joints[0]]
@@ -155,7 +163,7 @@ class JawAction:
                              self.controller.effort_limit)
             goal.command.position, goal.command.max_effort = float(position), float(effort)
         self.sent = {"position": float(position), "max_effort": float(effort)}
-        self.outcome, self.handle = None, None
+        self.outcome, self.handle, self.sent_ns = None, None, at_ns
         if not self.client.server_is_ready():
             self.outcome = (ExecuteGrasp.Result.GRIPPER_REJECTED, False,
                             f"no action server on {self.topic} answers (is the gripper "
@@ -207,5 +215,21 @@ class JawAction:
         if self.handle is None or not self.handle.accepted or self.outcome is not None:
             return False
         self.handle.cancel_goal_async().add_done_callback(lambda _: on_answer())
-        self.handle = None
+        self.handle, self.sent_ns = None, None
         return True
+
+    def overdue(self, ns: int, timeout: float) -> str | None:
+        """Why the gripper goal sent is overdue at the executor's time ``ns`` (sent more than
+        ``timeout`` s before, not canceled, no result yet), or None (also for ``timeout`` 0).
+        """
+        if (not timeout or self.sent_ns is None or self.outcome is not None
+                or (ns - self.sent_ns) * 1e-9 <= timeout):
+            return None
+        said = (f"no result from {self.controller.topic} within gripper_timeout {timeout:g} s "
+                f"of its goal (position {self.sent['position']:.6g}, max_effort "
+                f"{self.sent['max_effort']:.6g})")
+        if self.handle is None:
+            return f"{said}: the controller never answered the goal request"
+        return (f"{said}: a stock GripperActionController that is loaded but not active "
+                "accepts goals and never ends them (ros2 control list_controllers shows its "
+                "state); the gripper goal was canceled")

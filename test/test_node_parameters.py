@@ -145,7 +145,8 @@ def test_a_node_process_given_a_value_out_of_range_exits_2_with_one_line() -> No
     (PlannerNode, "default_solver_route", "bogus",
      "parameter 'default_solver_route': solver_route must be one of ['factorized', 'spectral']"),
     (ExecutorNode, "object_pose", [1.0], "parameter 'object_pose': a pose is 7 finite numbers"),
-    (ExecutorNode, "object_pose", [0.0] * 7, "(a unit quaternion), got [0.0, 0.0, 0.0, 0.0"),
+    (ExecutorNode, "object_pose", [0.0] * 7, "parameter 'object_pose': its orientation qx qy "
+                                             "qz qw must be a unit quaternion"),
     (ExecutorNode, "object_pose", [0.0, 0.0, math.nan, 0.0, 0.0, 0.0, 1.0],
      "a pose is 7 finite numbers"),
 ])

@@ -286,10 +286,12 @@ written is not replaced (a history of one lost 1-2 of 7 masks per multi-process 
 @dataclass(frozen=True)
 class Bound:
     """The range of a numeric parameter: ``low`` <= value (< when ``above``) <= ``high``, and
-    finite.
+    finite; ``note`` says what a value means (in parentheses after the range).
 
     >>> Bound(0.0, above=True, unit="m/s").why("max_velocity", -1.0)
     "parameter 'max_velocity' must be a finite number > 0 m/s, got -1.0"
+    >>> Bound(0.0, unit="N", note="0: no pickup test").why("weight", float("nan"))
+    "parameter 'weight' must be a finite number >= 0 N (0: no pickup test), got nan"
     >>> Bound(1).why("feedback_every", 10) is None
     True
     """
@@ -298,6 +300,7 @@ class Bound:
     high: float = math.inf
     above: bool = False
     unit: str = ""
+    note: str = ""
 
     def why(self, name: str, value: Any) -> str | None:
         """Why ``value`` is out of this range for parameter ``name``, or None."""
@@ -308,8 +311,9 @@ class Bound:
         kind = "an integer" if isinstance(value, int) else "a finite number"
         unit = f" {self.unit}" if self.unit else ""
         upper = f" and <= {self.high:g}{unit}" if self.high < math.inf else ""
+        note = f" ({self.note})" if self.note else ""
         return (f"parameter '{name}' must be {kind} {'>' if self.above else '>='} "
-                f"{self.low:g}{unit}{upper}, got {value}")
+                f"{self.low:g}{unit}{upper}{note}, got {value}")
 
 
 TYPE_WORDS = {

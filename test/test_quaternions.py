@@ -24,6 +24,7 @@ from rclpy.context import Context
 from rclpy.executors import SingleThreadedExecutor
 from rclpy.parameter import Parameter
 
+from squeeze_grasp_interfaces.msg import Alarm
 from squeeze_grasp_ros import cli
 from squeeze_grasp_ros.mechanics.errors import (
     QUATERNION_TOLERANCE,
@@ -38,6 +39,7 @@ from squeeze_grasp_ros.ros.messages.images import camera_pose
 from squeeze_grasp_ros.ros.nodes import ParameterError, pipeline
 from squeeze_grasp_ros.ros.nodes.executor import ExecutorNode
 from squeeze_grasp_ros.ros.nodes.outline import pose_parameter
+from squeeze_grasp_ros.ros.nodes.shape_watcher import ShapeWatcher
 
 DOWN = (1.0, 0.0, 0.0, 0.0)
 """A camera looking down (roll pi) as a quaternion (x, y, z, w)."""
@@ -187,3 +189,26 @@ def test_a_gripper_pose_takes_what_tf2_takes_and_refuses_a_norm_of_2():
     msg.pose.position.y = math.nan
     with pytest.raises(ValueError, match=r"position \(0.01, nan\) must be finite"):
         messages.gripper_line_pose(msg, "object")
+
+
+def test_the_shape_watch_ignores_a_camera_pose_that_is_no_rotation(ros_context: Context):
+    """The monitor's shape watch on ``camera/pose``: a zero quaternion raised out of the
+    subscription's callback (ending the monitor), and (2, 0, 0, 0) was a rotation.
+    """
+    node = rclpy.create_node("shape_watch_pose", context=ros_context)
+    try:
+        watcher = ShapeWatcher(node, node.create_publisher(Alarm, "alarms", 10), threshold=1e-3,
+                               at_force_threshold=1e-3, object_height=0.0, min_force=0.05)
+        msg = PoseStamped()
+        msg.header.frame_id = "object"
+        msg.pose.position.z = 0.5
+        o = msg.pose.orientation
+        for q in ((0.0, 0.0, 0.0, 0.0), (2.0, 0.0, 0.0, 0.0)):
+            o.x, o.y, o.z, o.w = q
+            watcher._pose(msg)
+            assert watcher.pose is None
+        o.x, o.y, o.z, o.w = scaled(DOWN)
+        watcher._pose(msg)
+        np.testing.assert_allclose(watcher.pose.matrix, np.diag([1.0, -1.0, -1.0]), atol=1e-15)
+    finally:
+        node.destroy_node()

@@ -145,8 +145,8 @@ def test_the_monitor_node_refuses_a_hostile_weight_on_real_rclpy(weight, ros_con
 
     from squeeze_grasp_ros.ros.nodes.monitor import MonitorNode
 
-    with pytest.raises(ParameterError, match=r"weight must be a finite number >= 0 N "
-                                             r"\(0: no pickup test\), got "):
+    with pytest.raises(ParameterError, match=r"parameter 'weight' must be a finite number >= 0 "
+                                             r"N \(0: no pickup test\), got "):
         MonitorNode(context=ros_context, parameter_overrides=[Parameter("weight", value=weight)])
 
 

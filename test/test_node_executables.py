@@ -28,7 +28,7 @@ def test_a_missing_required_parameter_is_one_line_and_exit_2(node, parameter):
 
 
 @pytest.mark.parametrize("value, message", [
-    ("-1.0", "mu must be a finite number >= 0 (0: no friction), got -1.0"),
+    ("-1.0", "parameter 'mu' must be a finite number >= 0 (0: no friction), got -1.0"),
     ("abc", "parameter 'mu' must be a number, got 'abc'"),
 ])
 def test_a_bad_friction_coefficient_is_one_line_naming_it_and_exit_2(value, message):

@@ -148,7 +148,8 @@ def test_a_node_process_given_a_value_out_of_range_exits_2_with_one_line() -> No
     (PlannerNode, "default_solver_route", "bogus",
      "parameter 'default_solver_route': solver_route must be one of ['factorized', 'spectral']"),
     (ExecutorNode, "object_pose", [1.0], "parameter 'object_pose': a pose is 7 finite numbers"),
-    (ExecutorNode, "object_pose", [0.0] * 7, "(a unit quaternion), got [0.0, 0.0, 0.0, 0.0"),
+    (ExecutorNode, "object_pose", [0.0] * 7, "parameter 'object_pose': its orientation qx qy "
+                                             "qz qw must be a unit quaternion"),
     (ExecutorNode, "object_pose", [0.0, 0.0, math.nan, 0.0, 0.0, 0.0, 1.0],
      "a pose is 7 finite numbers"),
 ])
@@ -160,3 +161,42 @@ def test_a_parameter_of_the_wrong_shape_is_refused_by_name(ros_context: Context,
     with pytest.raises(ParameterError) as refused:
         node(context=ros_context, parameter_overrides=[Parameter(name, value=value)])
     assert message in str(refused.value)
+
+
+@pytest.mark.parametrize("program, rule, said", [
+    ("planner", "worker_threads:=1.5", "parameter 'worker_threads' must be an integer, got '1.5'"),
+    ("executor", "qos_depth:=abc", "parameter 'qos_depth' must be an integer, got 'abc'"),
+    ("executor", "object_pose:=[0, 0, 0, 0, 0, 0, 1]",
+     "parameter 'object_pose' must be a list of numbers, got '[0, 0, 0, 0, 0, 0, 1]'"),
+    ("monitor", "finger_devices:=F1", "parameter 'finger_devices' must be a list of strings, "
+                                      "got 'F1'"),
+])
+def test_a_node_process_given_a_value_of_the_wrong_type_exits_2_with_one_line(program, rule,
+                                                                             said) -> None:
+    """Before: rclpy's InvalidParameterTypeException traceback, exit 1."""
+    out = subprocess.run([script(program), "--ros-args", "-p", rule], capture_output=True,
+                         text=True, timeout=120)
+    assert out.returncode == 2, out.stderr
+    assert "Traceback" not in out.stderr
+    assert out.stderr.strip().splitlines()[-1] == f"{program}: error: {said}"
+
+
+@pytest.mark.parametrize("node, name, value, message", [
+    (PlannerNode, "allowed_roots", "/tmp", "parameter 'allowed_roots' must be a list of strings, "
+                                           "got '/tmp'"),
+    (MonitorNode, "gripper_pose", "0 0 0", "parameter 'gripper_pose' must be a list of numbers, "
+                                           "got '0 0 0'"),
+    (MonitorNode, "lockstep", 1, "parameter 'lockstep' must be true or false, got '1'"),
+    (MonitorNode, "frame_id", 3, "parameter 'frame_id' must be a string, got '3'"),
+    (MonitorNode, "qos_depth", None, "parameter 'qos_depth' must be an integer, got 'None'"),
+    (MonitorNode, "mu", "high", "parameter 'mu' must be a number, got 'high'"),
+])
+def test_every_node_refuses_a_value_of_the_wrong_type_by_name(ros_context: Context, node, name,
+                                                              value, message) -> None:
+    """One check in ``pipeline.declare`` for every node: an override of another type than the
+    parameter's (rclpy's InvalidParameterTypeException before, not a ValueError, so no node
+    caught it), and an unset value, which rclpy declares as None without the default.
+    """
+    with pytest.raises(ParameterError) as refused:
+        node(context=ros_context, parameter_overrides=[Parameter(name, value=value)])
+    assert str(refused.value) == message

@@ -264,6 +264,7 @@ def test_a_db3_in_a_folder_named_with_uri_characters_is_read_from_its_own_file(t
     ("finger_devices=F1", "parameter 'finger_devices' must be a list of strings, got 'F1'"),
     ("finger_devices=[]", "parameter 'finger_devices' must be a list of strings, got '[]'"),
     ("qos_depth=1.5", "parameter 'qos_depth' must be an integer, got '1.5'"),
+    ("qos_depth=null", "parameter 'qos_depth' must be an integer, got 'None'"),
     ("mu={a: 1}", "parameter 'mu' must be true or false, an integer, a number, a string or a "
                   "list of one of them, got \"{'a': 1}\""),
     ("streams=[1, a]", "parameter 'streams' must be true or false, an integer, a number, a "

@@ -26,8 +26,8 @@ from collections.abc import Mapping
 import numpy as np
 
 __all__ = ["ConditioningWarning", "InfeasibleError", "InternalError", "InvalidInputError",
-           "NumericalError", "SqueezeGraspError", "node_indices", "require_finite",
-           "require_relative_depth"]
+           "NumericalError", "QUATERNION_TOLERANCE", "SqueezeGraspError", "node_indices",
+           "require_finite", "require_relative_depth", "unit_quaternion"]
 
 
 class SqueezeGraspError(Exception):
@@ -105,6 +105,35 @@ array of numbers, got '1e5'
                                 f"{value!r:.80}")
     if not np.all(np.isfinite(arr)):
         raise InvalidInputError(f"{name} must be finite, got {shown(value)}")
+
+
+QUATERNION_TOLERANCE = 0.01
+"""Largest distance of a quaternion's squared norm from 1 at which it is taken as a rotation
+(and normalised): tf2's own (``QUATERNION_NORMALIZATION_TOLERANCE`` of its ``BufferCore``,
+which ignores a transform beyond it), so what tf2 and ``geometry_msgs`` users send passes."""
+
+
+def unit_quaternion(name: str, values) -> np.ndarray:
+    """The quaternion ``values`` (x, y, z, w) normalised; :class:`InvalidInputError` naming
+    ``name`` and the norm unless it is finite with its squared norm within
+    :data:`QUATERNION_TOLERANCE` of 1 (a zero quaternion is no rotation).
+
+    >>> unit_quaternion("pose.orientation", [0.0, 0.0, 0.7072, 0.7072]).round(6).tolist()
+    [0.0, 0.0, 0.707107, 0.707107]
+    >>> unit_quaternion("pose.orientation", [0.0, 0.0, 0.0, 0.0])
+    Traceback (most recent call last):
+    ...
+    squeeze_grasp_ros.mechanics.errors.InvalidInputError: pose.orientation must be a unit \
+quaternion (x, y, z, w): finite, its squared norm within 0.01 of 1 (as tf2 takes it), got \
+[0.0, 0.0, 0.0, 0.0] of norm 0
+    """
+    q = np.asarray(values, float).reshape(4)
+    norm = float(np.linalg.norm(q))
+    if not abs(norm * norm - 1.0) < QUATERNION_TOLERANCE:  # also NaN
+        raise InvalidInputError(f"{name} must be a unit quaternion (x, y, z, w): finite, its "
+                                f"squared norm within {QUATERNION_TOLERANCE:g} of 1 (as tf2 "
+                                f"takes it), got {shown(values)} of norm {norm:.6g}")
+    return q / norm
 
 
 def node_indices(name: str, values, n: int | None = None) -> np.ndarray:

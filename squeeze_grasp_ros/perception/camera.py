@@ -35,7 +35,11 @@ from functools import cached_property
 
 import numpy as np
 
-from squeeze_grasp_ros.mechanics.errors import InvalidInputError, NumericalError
+from squeeze_grasp_ros.mechanics.errors import (
+    InvalidInputError,
+    NumericalError,
+    unit_quaternion,
+)
 from squeeze_grasp_ros.mechanics.vocabulary import DistortionModel
 
 __all__ = ["BackProjection", "CameraModel", "CameraPose", "UNDISTORT_TOLERANCE_PX"]
@@ -108,14 +112,10 @@ class CameraPose:
     def from_xyz_quaternion(cls, x: float, y: float, z: float, qx: float, qy: float, qz: float,
                             qw: float) -> CameraPose:
         """Pose from a position (m) and a unit quaternion (x, y, z, w), as
-        ``geometry_msgs/Pose`` holds it (normalised here; a zero quaternion is refused).
+        ``geometry_msgs/Pose`` holds it (normalised here, within tf2's tolerance:
+        :func:`~squeeze_grasp_ros.mechanics.errors.unit_quaternion`).
         """
-        q = np.array([qx, qy, qz, qw], float)
-        norm = float(np.linalg.norm(q))
-        if not (np.isfinite(norm) and norm > 1e-9):
-            raise InvalidInputError("camera pose: the quaternion (qx, qy, qz, qw) must be "
-                                    "finite and non-zero")
-        qx, qy, qz, qw = q / norm
+        qx, qy, qz, qw = unit_quaternion("the camera pose's orientation", [qx, qy, qz, qw])
         R = np.array([[1 - 2 * (qy * qy + qz * qz), 2 * (qx * qy - qz * qw),
                        2 * (qx * qz + qy * qw)],
                       [2 * (qx * qy + qz * qw), 1 - 2 * (qx * qx + qz * qz),

@@ -38,6 +38,7 @@ from typing import Any
 import numpy as np
 from scipy.spatial.transform import Rotation
 
+from squeeze_grasp_ros.mechanics.errors import InvalidInputError, unit_quaternion
 from squeeze_grasp_ros.mechanics.vocabulary import Effect, Finger, MaterialModel, ShapeType
 from squeeze_grasp_ros.planning.errors import invalid
 from squeeze_grasp_ros.planning.objects import SceneSource, read_scene
@@ -85,7 +86,8 @@ class FramePose:
     position : (float, float, float)
         m; z is dropped (the object lies in the plane).
     orientation : (float, float, float, float)
-        Quaternion (x, y, z, w), normalised here; a rotation about z only.
+        Quaternion (x, y, z, w), a rotation about z only; normalised here, within tf2's
+        tolerance (:func:`~squeeze_grasp_ros.mechanics.errors.unit_quaternion`).
     """
 
     position: tuple[float, float, float] = (0.0, 0.0, 0.0)
@@ -97,16 +99,19 @@ class FramePose:
         Raises
         ------
         PlannerError
-            INVALID_ARGUMENT for a non-finite pose or a zero quaternion, or a frame whose z
-            axis is tilted from the object's by more than :data:`PLANAR_TOLERANCE`.
+            INVALID_ARGUMENT for a non-finite position, an orientation that is not a unit
+            quaternion, or a frame whose z axis is tilted from the object's by more than
+            :data:`PLANAR_TOLERANCE`.
         """
-        q = np.asarray(self.orientation, float)
         t = np.asarray(self.position, float)
-        if not (np.all(np.isfinite(q)) and np.all(np.isfinite(t))):
-            raise invalid("object.frame_pose must be finite (position m, unit quaternion)")
-        if not np.any(q):
-            q = np.array([0.0, 0.0, 0.0, 1.0])
-        R = Rotation.from_quat(q / np.linalg.norm(q)).as_matrix()
+        if not np.all(np.isfinite(t)):
+            raise invalid(f"object.frame_pose.position must be finite (m), got "
+                          f"{list(self.position)}")
+        try:
+            q = unit_quaternion("object.frame_pose.orientation", self.orientation)
+        except InvalidInputError as error:
+            raise invalid(str(error)) from None
+        R = Rotation.from_quat(q).as_matrix()
         tilt = math.acos(min(1.0, abs(float(R[2, 2])))) if R[2, 2] > 0 else math.pi
         if tilt > PLANAR_TOLERANCE:
             raise invalid(f"object.frame_pose tilts the outline's plane by {tilt:.3g} rad from "

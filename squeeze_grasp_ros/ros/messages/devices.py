@@ -13,6 +13,7 @@ from std_msgs.msg import Header
 from squeeze_grasp_interfaces.msg import (
     Tick,
 )
+from squeeze_grasp_ros.mechanics.errors import unit_quaternion
 from squeeze_grasp_ros.ros.messages.common import header
 
 # --------------------------------------------------------------------------- pipeline: devices
@@ -35,21 +36,24 @@ def pose_position(msg: PoseStamped) -> np.ndarray:
 
 
 def pose_in_base(values: Sequence[float], frame_id: str) -> PoseStamped:
-    """``PoseStamped`` of [x, y, z, qx, qy, qz, qw] (m, unit quaternion) in ``frame_id``.
+    """``PoseStamped`` of [x, y, z, qx, qy, qz, qw] (m, unit quaternion) in ``frame_id``, its
+    quaternion normalised (:func:`~squeeze_grasp_ros.mechanics.errors.unit_quaternion`).
 
     Raises
     ------
     ValueError
-        Not seven finite numbers, or a quaternion whose norm is not 1 (to 1e-3).
+        Not seven finite numbers, or a quaternion that is not a unit one within tf2's tolerance
+        (an :class:`~squeeze_grasp_ros.mechanics.errors.InvalidInputError`).
     """
     values = [float(v) for v in values]
-    if (len(values) != 7 or not all(math.isfinite(v) for v in values)
-            or not abs(math.hypot(*values[3:]) - 1.0) <= 1e-3):
+    if len(values) != 7 or not all(math.isfinite(v) for v in values[:3]):
         raise ValueError(f"a pose is 7 finite numbers, x y z (m) qx qy qz qw (a unit "
                          f"quaternion), got {values}")
     msg = PoseStamped(header=Header(frame_id=frame_id))
     p, q = msg.pose.position, msg.pose.orientation
-    p.x, p.y, p.z, q.x, q.y, q.z, q.w = (float(v) for v in values)
+    p.x, p.y, p.z = values[:3]
+    q.x, q.y, q.z, q.w = (float(v) for v in unit_quaternion("its orientation qx qy qz qw",
+                                                            values[3:]))
     return msg
 
 

@@ -10,6 +10,7 @@ from geometry_msgs.msg import PoseStamped
 
 from squeeze_grasp_interfaces.msg import GripperGrasp
 from squeeze_grasp_interfaces.srv import PlanGripperGrasp
+from squeeze_grasp_ros.mechanics.errors import unit_quaternion
 from squeeze_grasp_ros.mechanics.squeeze.gripper_grasp import GripperCandidate
 from squeeze_grasp_ros.ros.messages.common import float64_array, header, int32_array, success
 from squeeze_grasp_ros.scene.gripper_plan import GripperPlan
@@ -40,25 +41,24 @@ def gripper_line_pose(msg: PoseStamped, frame_id: str) -> tuple[np.ndarray, floa
     Raises
     ------
     ValueError
-        Another frame, values not finite, a quaternion of zero length, or an x axis tilted out
-        of the object plane beyond :data:`PLANAR_TILT`.
+        Another frame, a position not finite, an orientation that is not a unit quaternion
+        within tf2's tolerance (:func:`~squeeze_grasp_ros.mechanics.errors.unit_quaternion`),
+        or an x axis tilted out of the object plane beyond :data:`PLANAR_TILT`.
     """
     if msg.header.frame_id != frame_id:
         raise ValueError(f"the gripper pose is in frame '{msg.header.frame_id}', not the object "
                          f"frame '{frame_id}' (transform it with tf2 first)")
     p, q = msg.pose.position, msg.pose.orientation
-    values = np.array([p.x, p.y, q.x, q.y, q.z, q.w])
-    norm = float(np.linalg.norm(values[2:]))
-    if not (np.all(np.isfinite(values)) and norm > 0.0):
-        raise ValueError(f"the gripper pose's position ({p.x}, {p.y}) and orientation "
-                         f"({q.x}, {q.y}, {q.z}, {q.w}) must be finite, the quaternion nonzero")
-    x, y, z, w = values[2:] / norm
+    centre = np.array([p.x, p.y])
+    if not np.all(np.isfinite(centre)):
+        raise ValueError(f"the gripper pose's position ({p.x}, {p.y}) must be finite")
+    x, y, z, w = unit_quaternion("the gripper pose's orientation", [q.x, q.y, q.z, q.w])
     axis = np.array([1 - 2 * (y * y + z * z), 2 * (x * y + w * z), 2 * (x * z - w * y)])
     if abs(axis[2]) > PLANAR_TILT:
         raise ValueError(f"the gripper pose's closing direction (its x axis) leaves the object "
                          f"plane: its z component is {axis[2]:.4g}, at most {PLANAR_TILT:g} "
                          "allowed")
-    return values[:2].copy(), float(np.arctan2(axis[1], axis[0]))
+    return centre, float(np.arctan2(axis[1], axis[0]))
 
 
 def gripper_grasps(plan: GripperPlan) -> list[GripperGrasp]:

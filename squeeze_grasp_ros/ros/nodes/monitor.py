@@ -144,7 +144,9 @@ PARAMETERS: dict[str, tuple[Any, str]] = {
                      "topic, else the jaws' pose readings)"),
 }
 """Parameter name -> (typed default, description); config/monitor.yaml sets them."""
-BOUNDS = {"load_threshold": pipeline.Bound(0.0, unit="N"),
+BOUNDS = {"mu": pipeline.Bound(0.0, note="0: no friction"),
+          "weight": pipeline.Bound(0.0, unit="N", note="0: no pickup test"),
+          "load_threshold": pipeline.Bound(0.0, unit="N"),
           "edge_tolerance": pipeline.Bound(0.0), "alarm_ratio": pipeline.Bound(0.0, above=True),
           "match_margin": pipeline.Bound(0),
           "stale_after": pipeline.Bound(0.0, above=True, unit="s"),
@@ -160,8 +162,8 @@ BOUNDS = {"load_threshold": pipeline.Bound(0.0, unit="N"),
           "force_min_fraction": pipeline.Bound(0.0, 1.0),
           "joint_slip_window": pipeline.Bound(0.0, above=True, unit="m"),
           "joint_slip_ratio": pipeline.Bound(0.0, above=True)}
-"""The range of each numeric parameter (``mu``, ``weight``, ``weight_margin`` and
-``hand_max_condition`` are checked where they are used, by the routes that take them)."""
+"""The range of each numeric parameter (``weight_margin`` and ``hand_max_condition`` are
+checked where they are used, by the routes that take them)."""
 POSE_JOINT_TOLERANCE = 1e-5
 """m: the largest gap between the jaws' aperture of their first pose readings and of the first
 joint state that passes without a warning."""
@@ -196,12 +198,6 @@ class MonitorNode(Node):
         super().__init__("monitor", **kwargs)
         self.p = p = pipeline.declare(self, PARAMETERS, bounds=BOUNDS)
         self.fingers = pipeline.parse_mapping(p["finger_devices"], "finger_devices")
-        if not (np.isfinite(p["mu"]) and p["mu"] >= 0.0):
-            raise ParameterError(f"mu must be a finite number >= 0 (0: no friction), got "
-                                 f"{p['mu']}")
-        if not (np.isfinite(p["weight"]) and p["weight"] >= 0.0):
-            raise ParameterError(f"weight must be a finite number >= 0 N (0: no pickup test), "
-                                 f"got {p['weight']}")
         streams = [s for s in p["streams"] if s]
         self.jaws = JointFeedback.of(p, streams)
         """The jaws on joint feedback (None: the sensors' route)."""

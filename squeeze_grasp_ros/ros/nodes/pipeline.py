@@ -26,6 +26,7 @@ from typing import Any
 from rcl_interfaces.msg import ParameterDescriptor
 from rclpy.clock import Clock, ClockType
 from rclpy.event_handler import PublisherEventCallbacks
+from rclpy.exceptions import InvalidParameterTypeException
 from rclpy.impl.implementation_singleton import rclpy_implementation
 from rclpy.node import Node
 from rclpy.parameter import Parameter
@@ -285,10 +286,12 @@ written is not replaced (a history of one lost 1-2 of 7 masks per multi-process 
 @dataclass(frozen=True)
 class Bound:
     """The range of a numeric parameter: ``low`` <= value (< when ``above``) <= ``high``, and
-    finite.
+    finite; ``note`` says what a value means (in parentheses after the range).
 
     >>> Bound(0.0, above=True, unit="m/s").why("max_velocity", -1.0)
     "parameter 'max_velocity' must be a finite number > 0 m/s, got -1.0"
+    >>> Bound(0.0, unit="N", note="0: no pickup test").why("weight", float("nan"))
+    "parameter 'weight' must be a finite number >= 0 N (0: no pickup test), got nan"
     >>> Bound(1).why("feedback_every", 10) is None
     True
     """
@@ -297,6 +300,7 @@ class Bound:
     high: float = math.inf
     above: bool = False
     unit: str = ""
+    note: str = ""
 
     def why(self, name: str, value: Any) -> str | None:
         """Why ``value`` is out of this range for parameter ``name``, or None."""
@@ -307,8 +311,33 @@ class Bound:
         kind = "an integer" if isinstance(value, int) else "a finite number"
         unit = f" {self.unit}" if self.unit else ""
         upper = f" and <= {self.high:g}{unit}" if self.high < math.inf else ""
+        note = f" ({self.note})" if self.note else ""
         return (f"parameter '{name}' must be {kind} {'>' if self.above else '>='} "
-                f"{self.low:g}{unit}{upper}, got {value}")
+                f"{self.low:g}{unit}{upper}{note}, got {value}")
+
+
+TYPE_WORDS = {
+    Parameter.Type.BOOL: "true or false",
+    Parameter.Type.INTEGER: "an integer",
+    Parameter.Type.DOUBLE: "a number",
+    Parameter.Type.STRING: "a string",
+    Parameter.Type.BOOL_ARRAY: "a list of true or false",
+    Parameter.Type.INTEGER_ARRAY: "a list of integers",
+    Parameter.Type.DOUBLE_ARRAY: "a list of numbers",
+    Parameter.Type.STRING_ARRAY: "a list of strings",
+}
+"""What a value of a parameter's type is, in an error message (a float parameter is declared
+with dynamic typing and takes any number: :data:`~rclpy.parameter.Parameter.Type.DOUBLE`)."""
+
+
+def wrong_type(name: str, expected: Parameter.Type, value: Any) -> ParameterError:
+    """The error of parameter ``name`` given ``value``, not of the ``expected`` type.
+
+    >>> str(wrong_type("finger_devices", Parameter.Type.STRING_ARRAY, "F1"))
+    "parameter 'finger_devices' must be a list of strings, got 'F1'"
+    """
+    return ParameterError(f"parameter '{name}' must be {TYPE_WORDS[expected]}, got "
+                          f"{shown(str(value))}")
 
 
 READ_AT_START = "read at start-up: restart the node to change it"
@@ -319,7 +348,8 @@ def declare(node: Node, parameters: Mapping[str, tuple[Any, str]], *,
             live: Collection[str] = (), bounds: Mapping[str, Bound] | None = None
             ) -> dict[str, Any]:
     """Declare typed parameters (float ones also accept YAML integers); return their values,
-    each within its ``bounds`` entry (a :class:`ParameterError` names the first that is not).
+    each of its parameter's type and within its ``bounds`` entry (a :class:`ParameterError`
+    names the first that is not, in the words of :data:`TYPE_WORDS` or of :class:`Bound`).
 
     A default that is a ``Parameter.Type`` declares a parameter of that type without a default
     (its value None unless given). Parameters not named in ``live`` are read once, here, and
@@ -330,21 +360,27 @@ def declare(node: Node, parameters: Mapping[str, tuple[Any, str]], *,
     values = {}
     for name, (default, description) in parameters.items():
         read_only = name not in live
-        node.declare_parameter(name, default, ParameterDescriptor(
-            description=description, dynamic_typing=isinstance(default, float),
-            read_only=read_only, additional_constraints=READ_AT_START if read_only else ""))
+        expected = (default if isinstance(default, Parameter.Type)
+                    else Parameter.Type.from_parameter_value(default))
+        try:
+            node.declare_parameter(name, default, ParameterDescriptor(
+                description=description, dynamic_typing=isinstance(default, float),
+                read_only=read_only, additional_constraints=READ_AT_START if read_only else ""))
+        except InvalidParameterTypeException:
+            # rclpy's exception keeps no value: the override it refused is the node's own
+            raise wrong_type(name, expected, node._parameter_overrides[name].value) from None
+        # None: given an unset value (YAML null), rclpy declares it so, without its default
+        value = node.get_parameter_or(name, Parameter(name, value=None)).value
         if isinstance(default, Parameter.Type):
-            # typed without a default: None unless given
-            values[name] = node.get_parameter_or(name, Parameter(name, value=None)).value
+            values[name] = value  # typed without a default: None unless given
             continue
-        value = node.get_parameter(name).value
-        if isinstance(default, float):
+        if isinstance(default, float) and isinstance(value, int | float) \
+                and not isinstance(value, bool):
+            value = float(value)
+        elif value is None or isinstance(default, float):
             # dynamic typing lets any type through: a string must not end in a bare
             # "could not convert string to float" that names no parameter
-            if isinstance(value, bool) or not isinstance(value, (int, float)):
-                raise ParameterError(f"parameter '{name}' must be a number, got "
-                                     f"{shown(str(value))}")
-            value = float(value)
+            raise wrong_type(name, expected, value)
         reason = bounds[name].why(name, value) if bounds and name in bounds else None
         if reason:
             raise ParameterError(reason)

@@ -105,7 +105,12 @@ class ShapeWatcher:
         self._flush()
 
     def _pose(self, msg: PoseStamped) -> None:
-        self.pose, self.frame_id = camera_pose(msg.pose), msg.header.frame_id
+        try:
+            pose = camera_pose(msg.pose)
+        except InvalidInputError as error:  # e.g. not a unit quaternion: the last pose holds
+            self.node.get_logger().error(f"shape watch: camera/pose ignored: {error}")
+            return
+        self.pose, self.frame_id = pose, msg.header.frame_id
         self._flush()
 
     def _prediction(self, msg: PredictedShapes) -> None:

@@ -196,21 +196,11 @@ def monitor_parameters(bag: BagContents) -> dict[str, Any]:
     return params
 
 
-TYPE_WORDS = {
-    Parameter.Type.BOOL: "true or false",
-    Parameter.Type.INTEGER: "an integer",
-    Parameter.Type.STRING: "a string",
-    Parameter.Type.BOOL_ARRAY: "a list of true or false",
-    Parameter.Type.INTEGER_ARRAY: "a list of integers",
-    Parameter.Type.DOUBLE_ARRAY: "a list of numbers",
-    Parameter.Type.STRING_ARRAY: "a list of strings",
-}
-"""What a value of a (non-float) monitor parameter's type is, in an error message."""
-
-
 def monitor_overrides(params: Mapping[str, Any],
                       given: Mapping[str, Any]) -> list[Parameter]:
-    """The replay monitor's parameters, checked before any node exists.
+    """The replay monitor's parameters as ROS parameters, their names and values checked
+    before any node exists (the monitor refuses a value of another type than its parameter's
+    as it declares it, :func:`~..nodes.pipeline.declare`).
 
     Parameters
     ----------
@@ -222,9 +212,8 @@ def monitor_overrides(params: Mapping[str, Any],
     Raises
     ------
     ParameterError
-        One line naming the parameter: a given name the monitor does not have, a value no ROS
-        parameter holds, or a value of another type than the monitor's (its float parameters
-        take any number and say so themselves).
+        One line naming the parameter: a given name the monitor does not have, or a value no
+        ROS parameter holds.
     """
     for name in given:
         if name not in MONITOR_PARAMETERS and name != "use_sim_time":
@@ -238,16 +227,6 @@ def monitor_overrides(params: Mapping[str, Any],
             raise ParameterError(
                 f"parameter '{name[:80]}' must be true or false, an integer, a number, a "
                 f"string or a list of one of them, got {shown(str(value))}") from None
-        default = MONITOR_PARAMETERS.get(name, (None, ""))[0]
-        if isinstance(default, Parameter.Type):
-            expected = None if value is None else default
-        elif default is None or isinstance(default, float):
-            expected = None
-        else:
-            expected = Parameter.Type.from_parameter_value(default)
-        if expected is not None and parameter.type_ != expected:
-            raise ParameterError(f"parameter '{name}' must be {TYPE_WORDS[expected]}, got "
-                                 f"{shown(str(value))}")
         out.append(parameter)
     return out
 
@@ -327,6 +306,9 @@ def replay(path: str, overrides: Mapping[str, Any] | None = None, timeout: float
     BagError
         If the bag has no readings, or a message replay reads is of another type or does not
         decode (checked before any node starts).
+    ParameterError
+        A parameter the monitor does not have or refuses (:func:`monitor_overrides`, then the
+        monitor as it starts).
     """
     t0 = time.perf_counter()
     bag = read_bag(path)
@@ -339,10 +321,12 @@ def replay(path: str, overrides: Mapping[str, Any] | None = None, timeout: float
     context = Context()
     rclpy.init(context=context, signal_handler_options=SignalHandlerOptions.NO)
     executor = EventsExecutor(context=context)
-    monitor = MonitorNode(context=context, parameter_overrides=parameters)
-    replayer = Replayer(prediction, ticks, context=context)
+    nodes: list[Node] = []
     try:
-        for node in (monitor, replayer):
+        nodes.append(MonitorNode(context=context, parameter_overrides=parameters))
+        replayer = Replayer(prediction, ticks, context=context)
+        nodes.append(replayer)
+        for node in nodes:
             executor.add_node(node)
         deadline = time.monotonic() + timeout
         while not replayer.finished:
@@ -355,7 +339,7 @@ def replay(path: str, overrides: Mapping[str, Any] | None = None, timeout: float
                                    f"s) within {TICK_TIMEOUT:.0f} s")
             executor.spin_once(0.05)
     finally:
-        for node in (monitor, replayer):
+        for node in nodes:
             executor.remove_node(node)
             node.destroy_node()
         executor.shutdown()

@@ -9,6 +9,7 @@ a value the node did not use); the planner's live ``max_pending`` is refused out
 from __future__ import annotations
 
 import math
+import re
 import subprocess
 from pathlib import Path
 
@@ -86,6 +87,23 @@ def test_every_bounded_pipeline_parameter_refuses_a_value_out_of_range(ros_conte
         value = float(value) if isinstance(default, float) else int(value)
         with pytest.raises(ParameterError, match=f"parameter '{name}' must be "):
             NODES[label](context=ros_context, parameter_overrides=[Parameter(name, value=value)])
+
+
+@pytest.mark.parametrize("streams, named", [(["wrench", "force"], "'force'"),
+                                             (["pose"], "'pose'"),
+                                             (["tactile", "tactile"], "'tactile'")])
+def test_the_monitor_refuses_a_stream_that_no_finger_has(ros_context: Context, streams,
+                                                         named) -> None:
+    """Before: a name that is no sensor stream ('force') started the monitor, whose staleness
+    test then waited for that stream's readings for ever (its age inf: every finger stale).
+    """
+    message = ("parameter 'streams' must list sensor streams among ('wrench', 'tactile') "
+               f'(or [""] for none), each once, got {named}')
+    with pytest.raises(ParameterError, match=re.escape(message)):
+        MonitorNode(context=ros_context, parameter_overrides=[Parameter("streams",
+                                                                        value=streams)])
+    MonitorNode(context=ros_context, parameter_overrides=[
+        Parameter("streams", value=["tactile", ""])]).destroy_node()
 
 
 def _set(client: AsyncParameterClient, executor, parameter: Parameter):

@@ -76,6 +76,7 @@ from squeeze_grasp_ros.control.tracker import (
     TrackedEvent,
     TrackerConfig,
 )
+from squeeze_grasp_ros.inputs import shown
 from squeeze_grasp_ros.mechanics.vocabulary import Termination
 from squeeze_grasp_ros.ros import messages
 from squeeze_grasp_ros.ros.nodes import ParameterError, pipeline, run_node
@@ -92,7 +93,8 @@ from squeeze_grasp_ros.scene.controller import (
 
 PARAMETERS: dict[str, tuple[Any, str]] = {
     "finger_devices": (["F1:barrett_f1", "F2:barrett_f3"], "finger:device of every fingertip"),
-    "streams": (["wrench", "tactile"], "sensor streams each finger has (staleness test)"),
+    "streams": (["wrench", "tactile"], "sensor streams each finger has, among wrench and "
+                                      "tactile ([\"\"]: none; staleness test)"),
     "mu": (0.4, "friction coefficient of the fingertips"),
     "load_threshold": (0.002, "a taxel (joint feedback: a jaw) is loaded above this normal "
                               "force, N"),
@@ -191,6 +193,31 @@ The device readings are taken raw and read with :mod:`..messages.cdr`, not turne
 message objects (six readings a tick; rclpy's conversion cost 6-17 times as much)."""
 
 
+STREAMS = ("wrench", "tactile")
+"""The sensor streams a finger may have (its ``pose`` is always read)."""
+
+
+def sensor_streams(names: list[str]) -> list[str]:
+    """The ``streams`` parameter's sensor streams (an empty name stands for none).
+
+    >>> sensor_streams(["wrench", ""])
+    ['wrench']
+    >>> sensor_streams(["wrench", "force"])
+    Traceback (most recent call last):
+    ...
+    squeeze_grasp_ros.ros.nodes.ParameterError: parameter 'streams' must list sensor streams \
+among ('wrench', 'tactile') (or [""] for none), each once, got 'force'
+    """
+    streams = [name for name in names if name]
+    for k, name in enumerate(streams):
+        if name not in STREAMS or name in streams[:k]:
+            # a stream nobody publishes was expected for ever: every goal ended stale_data
+            raise ParameterError(f"parameter 'streams' must list sensor streams among "
+                                 f"{STREAMS} (or [\"\"] for none), each once, got "
+                                 f"{shown(name)}")
+    return streams
+
+
 class MonitorNode(Node):
     """Reactive contact-event tracker on fingertip sensors."""
 
@@ -198,7 +225,7 @@ class MonitorNode(Node):
         super().__init__("monitor", **kwargs)
         self.p = p = pipeline.declare(self, PARAMETERS, bounds=BOUNDS)
         self.fingers = pipeline.parse_mapping(p["finger_devices"], "finger_devices")
-        streams = [s for s in p["streams"] if s]
+        streams = sensor_streams(p["streams"])
         self.jaws = JointFeedback.of(p, streams)
         """The jaws on joint feedback (None: the sensors' route)."""
         self.hand = HandFeedback.of(p, streams) if self.jaws is None else None

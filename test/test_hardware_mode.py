@@ -19,6 +19,7 @@ from __future__ import annotations
 import gc
 import importlib.util
 import math
+import re
 import threading
 import time
 from pathlib import Path
@@ -215,6 +216,31 @@ def test_the_executor_drives_an_outside_jtc_in_wall_time(capfd):
     finally:
         rig.close()
     assert "pose readings put the pad faces" not in capfd.readouterr().err
+
+
+def test_an_inactive_jtc_ends_the_grasp_gripper_stalled_after_stall_timeout():
+    """A JointTrajectoryController loaded but not active drops every trajectory: the joint
+    stays open. Before, the grasp goal went on "squeezing" at depth 0 for ever (70 s here
+    before the test gave up); now it ends gripper_stalled once the jaws have stood still short
+    of their setpoints for stall_timeout.
+    """
+    rig = Rig(SCENE, Joint(OPEN, speed=0.0), executor=(Parameter("stall_timeout", value=0.5),))
+    try:
+        result = rig.squeeze()
+        assert result.termination == ExecuteGrasp.Result.GRIPPER_STALLED, result.message
+        assert not result.success and result.depth == pytest.approx(0.0, abs=1e-6)
+        assert result.message.startswith("F1, F2 stood still (within 0.1 mm) for "), \
+            result.message
+        # the setpoints run on along the planned path (7.071 mm each) while the jaws stand
+        gaps = re.search(r"\(stall_timeout 0\.5 s\) short of the setpoints by F1 ([0-9.]+) "
+                         r"mm, F2 ([0-9.]+) mm: a JointTrajectoryController that is loaded but "
+                         r"not active drops every trajectory", result.message)
+        assert gaps is not None, result.message
+        assert all(0.0 < float(gap) <= 7.071 for gap in gaps.groups())
+        assert 0.5 < result.duration < 5.0, result.duration
+        assert rig.outside.joint.q == joint_of(OPEN)
+    finally:
+        rig.close()
 
 
 def pose_topics(rig: Rig) -> dict[str, int]:

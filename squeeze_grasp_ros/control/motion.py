@@ -87,6 +87,9 @@ DEFAULT_CLEARANCE = 0.002
 clear of the object at rest for the shipped pads and circles while a gripper opens in 0.2 s at
 the default ``max_velocity``."""
 _NO_FORCE = np.zeros(2)
+STILL = 1e-4
+"""m: a finger measured within this of where it stood counts as standing still (the stall
+watch; less at a low ``max_velocity``: :meth:`MotionLimits.still_distance`)."""
 _NO_FORCE.flags.writeable = False
 """A finger's force while it has no reading (N; one array, not one per tick)."""
 
@@ -111,6 +114,11 @@ class MotionLimits:
     lift_watch : float
         After ``picked_up``, how long the fingers hold watching for ``weight_slip`` before the
         goal ends ``picked_up``, s (0: it ends at ``picked_up``).
+    stall_timeout : float
+        Longest the moving fingers may stand still short of their setpoints, s of (sim) time;
+        past it the goal ends ``gripper_stalled`` holding the measured positions (0: no limit).
+        Standing still: no moving finger measured more than :func:`still_distance` from where
+        it stood when the watch began.
     """
 
     max_velocity: float = 0.01
@@ -119,6 +127,13 @@ class MotionLimits:
     redirect_grace: int = 20
     stale_budget: float = 0.1
     lift_watch: float = 0.0
+    stall_timeout: float = 0.0
+
+    def still_distance(self) -> float:
+        """How far a finger may move and still stand still for the stall watch, m: 0.1 mm, or
+        a tenth of what ``max_velocity`` covers in ``stall_timeout`` if that is less.
+        """
+        return min(STILL, 0.1 * self.max_velocity * self.stall_timeout)
 
 
 @dataclass(frozen=True)
@@ -368,6 +383,9 @@ class GraspProgram:
         self.grace = 0
         self.hold_ticks = 0
         self.stale_time = 0.0
+        self.still: dict[str, np.ndarray] | None = None
+        """Where the moving fingers stood when the stall watch began (None: not watching)."""
+        self.still_time = 0.0
         self.ticks = 0
         self.cancel_requested = False
         self.work = {f: 0.0 for f in self.fingers}
@@ -471,6 +489,9 @@ class GraspProgram:
                 "stale sensor data: " + ", ".join(sorted(stale & set(self.moving))),
             )
         self.stale_time = 0.0
+        stalled = self._stalled(obs, dt)
+        if stalled is not None:
+            return self._finish(obs, "gripper_stalled", stalled, measured=True)
         if self.s >= self.path.end and self._settled(obs):
             done = self._phase_done(obs)
             if done is not None:
@@ -631,6 +652,31 @@ class GraspProgram:
         if travel >= 0.0:
             self.approaching = False
             self.depth_offset = obs.depth - travel
+
+    def _stalled(self, obs: Observation, dt: float) -> str | None:
+        """Why the moving fingers count as stalled after this cycle of ``dt`` s (standing
+        still short of their setpoints for longer than ``stall_timeout``), or None.
+        """
+        timeout = self.limits.stall_timeout
+        if not timeout:
+            return None
+        where = {f: np.asarray(obs.positions[f], float) for f in self.moving}
+        gaps = {f: float(np.linalg.norm(where[f] - self.commanded[f])) for f in self.moving}
+        short = [f for f in self.moving if gaps[f] > self.limits.position_tolerance]
+        still = self.limits.still_distance()
+        if not short or self.still is None or any(
+                np.linalg.norm(where[f] - self.still[f]) > still for f in self.moving):
+            self.still, self.still_time = (where if short else None), 0.0
+            return None
+        self.still_time += dt
+        if self.still_time <= timeout:
+            return None
+        return (f"{', '.join(short)} stood still (within {still * 1e3:.3g} mm) for "
+                f"{self.still_time:.3f} s (stall_timeout {timeout:g} s) short of the setpoints "
+                f"by {', '.join(f'{f} {gaps[f] * 1e3:.4g} mm' for f in short)}: a "
+                "JointTrajectoryController that is loaded but not active drops every "
+                "trajectory (ros2 control list_controllers shows its state), or the drive "
+                "stalled")
 
     def _settled(self, obs: Observation) -> bool:
         tol = self.limits.position_tolerance

@@ -89,6 +89,10 @@ PARAMETERS: dict[str, tuple[Any, str]] = {
     "await_prediction": (False, "lockstep, jaws under a stock controller: ready only once "
                                 "planner/predicted_events has arrived (run sets it: it "
                                 "publishes one before the nodes start)"),
+    "stall_timeout": (30.0, "longest the moving fingers may stand still short of their "
+                            "setpoints, s; past it the goal ends gripper_stalled holding "
+                            "(an inactive JointTrajectoryController drops every trajectory; "
+                            "0: no limit)"),
     "gripper_timeout": (30.0, "longest a gripper action goal may run without a result, s; "
                               "past it the grasp goal ends gripper_aborted and the gripper "
                               "goal is canceled (an inactive stock GripperActionController "
@@ -102,7 +106,8 @@ BOUNDS = {"max_velocity": pipeline.Bound(0.0, above=True, unit="m/s"),
           "lift_watch": pipeline.Bound(0.0, unit="s"),
           "period": pipeline.Bound(1e-6, unit="s"),  # whole nanoseconds within 0.05 %
           "feedback_every": pipeline.Bound(1), "qos_depth": pipeline.Bound(1),
-          "gripper_timeout": pipeline.Bound(0.0, unit="s")}
+          "gripper_timeout": pipeline.Bound(0.0, unit="s"),
+          "stall_timeout": pipeline.Bound(0.0, unit="s")}
 """The range of each numeric parameter."""
 
 SUCCESS = (ExecuteGrasp.Result.DEPTH_REACHED, ExecuteGrasp.Result.RESISTED,
@@ -157,7 +162,8 @@ class ExecutorNode(Node):
         self.devices = pipeline.parse_mapping(p["finger_devices"], "finger_devices")
         self.limits = MotionLimits(p["max_velocity"], p["max_acceleration"],
                                    p["position_tolerance"], p["redirect_grace"],
-                                   float(p["stale_budget"]), float(p["lift_watch"]))
+                                   float(p["stale_budget"]), float(p["lift_watch"]),
+                                   float(p["stall_timeout"]))
         self.period_ns = int(round(p["period"] * 1e9))
         loop = pipeline.loop_qos(p["qos_depth"])
         controller = scene_controller(load_scene(p["controller_scene"]), p["controller_scene"]) \

@@ -218,3 +218,15 @@ def test_every_node_refuses_a_value_of_the_wrong_type_by_name(ros_context: Conte
     with pytest.raises(ParameterError) as refused:
         node(context=ros_context, parameter_overrides=[Parameter(name, value=value)])
     assert str(refused.value) == message
+
+
+def test_every_parameter_type_has_words_for_its_error() -> None:
+    """``pipeline.wrong_type`` names the type of every parameter a node declares."""
+    from squeeze_grasp_ros.ros.nodes import planner
+    from squeeze_grasp_ros.ros.nodes.pipeline import TYPE_WORDS
+
+    for module in (*MODULES.values(), planner):
+        for name, (default, _) in module.PARAMETERS.items():
+            expected = (default if isinstance(default, Parameter.Type)
+                        else Parameter.Type.from_parameter_value(default))
+            assert expected in TYPE_WORDS, (module.__name__, name, expected)

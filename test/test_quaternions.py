@@ -212,3 +212,29 @@ def test_the_shape_watch_ignores_a_camera_pose_that_is_no_rotation(ros_context: 
         np.testing.assert_allclose(watcher.pose.matrix, np.diag([1.0, -1.0, -1.0]), atol=1e-15)
     finally:
         node.destroy_node()
+
+
+def test_the_shape_watch_ignores_a_camera_info_it_cannot_use(ros_context: Context, capfd):
+    """The shape watch's other camera input, ``camera/camera_info``: an uncalibrated one (k all
+    zero, as a driver without a calibration publishes) raised out of the subscription's
+    callback and ended the monitor, as a bad pose did; now it is logged and the last holds.
+    """
+    from squeeze_grasp_ros.perception.camera import CameraModel
+    from squeeze_grasp_ros.ros.messages.images import camera_info_msg
+
+    node = rclpy.create_node("shape_watch_info", context=ros_context)
+    try:
+        watcher = ShapeWatcher(node, node.create_publisher(Alarm, "alarms", 10), threshold=1e-3,
+                               at_force_threshold=1e-3, object_height=0.0, min_force=0.05)
+        good = camera_info_msg(CameraModel(640, 480, 500.0, 500.0, 320.0, 240.0), 0)
+        watcher._info(good)
+        camera = watcher.camera
+        bad = camera_info_msg(camera, 0)
+        bad.k = [0.0] * 9
+        watcher._info(bad)
+        assert watcher.camera is camera
+        assert "shape watch: camera/camera_info ignored: camera_info: the camera is " \
+            "uncalibrated" in capfd.readouterr().err
+    finally:
+        node.destroy_node()
+

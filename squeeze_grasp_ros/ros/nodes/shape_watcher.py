@@ -101,7 +101,12 @@ class ShapeWatcher:
                                                   pipeline.loop_qos(100))
 
     def _info(self, msg: CameraInfo) -> None:
-        self.camera = camera_model(msg)
+        try:
+            camera = camera_model(msg)
+        except InvalidInputError as error:  # e.g. uncalibrated (k all zero): the last holds
+            self.node.get_logger().error(f"shape watch: {pipeline.CAMERA_INFO} ignored: {error}")
+            return
+        self.camera = camera
         self._flush()
 
     def _pose(self, msg: PoseStamped) -> None:

@@ -304,6 +304,45 @@ def test_a_hostile_hand_trajectory_is_refused_and_a_valid_one_followed(tmp_path,
         "refused the trajectory on /hand_controller/joint_trajectory") == 3
 
 
+def test_the_simulated_hand_controller_starts_a_trajectory_from_the_measured_joints(tmp_path):
+    """As Jazzy's JointTrajectoryController by default (interpolate_from_desired_state false):
+    the segment to a first point ahead starts at the joints' measured state at receipt. Before,
+    the simulated hand's started at its last command (the gripper's was fixed before).
+    """
+    import time
+
+    from builtin_interfaces.msg import Duration
+    from pipeline_support import sim_and_client
+    from trajectory_msgs.msg import JointTrajectoryPoint
+
+    path = write_scene(tmp_path, scene_data())
+    with sim_and_client(path) as (executor, sim, client):
+        publisher = client.create_publisher(JointTrajectory, "hand_controller/joint_trajectory",
+                                            pipeline.loop_qos(10))
+        pipeline.Participant(client, "hostile", [], [publisher])
+        deadline = time.monotonic() + 10.0
+        while sim.now_ns < 0 and time.monotonic() < deadline:
+            executor.spin_once(timeout_sec=0.05)
+        hand = sim.controller
+        command = hand.follower.sample(0)
+        # the joints as measured at receipt, 1 mrad off the command (a lagging hand; the
+        # simulated tips follow their setpoints within a tick)
+        hand.joints = {j: hand.joints[j] + 1e-3 for j in JOINTS}
+        measured = [hand.joints[j] for j in JOINTS]
+        goal = [hand.joints[j] + 5e-3 for j in JOINTS]
+        publisher.publish(JointTrajectory(joint_names=list(JOINTS), points=[JointTrajectoryPoint(
+            positions=goal, time_from_start=Duration(nanosec=5_000_000))]))
+        deadline = time.monotonic() + 10.0
+        while sim.now_ns < 1_000_000 and time.monotonic() < deadline:  # taken, then a step
+            executor.spin_once(timeout_sec=0.05)
+        assert sim.now_ns == 1_000_000 and hand.refusals == []
+        (t0, start), (t1, end) = hand.follower.knots
+        assert (t0, t1) == (0, 5_000_000)
+        np.testing.assert_array_equal(start, measured)
+        np.testing.assert_array_equal(end, goal)
+        assert np.max(np.abs(start - command)) == pytest.approx(1e-3)
+
+
 def test_a_palm_out_of_reach_of_the_placements_is_one_error_line(tmp_path):
     """The palm 0.5 m from the square: the simulated hardware refuses to start, naming the
     palm, the finger, its target and its reach.

@@ -114,6 +114,16 @@ def test_the_hand_follower_replaces_a_trajectory_as_the_stock_controller_does():
     assert f.sample(6 * MS) == pytest.approx([1.5, 1.5])
 
 
+def test_a_new_hand_trajectory_starts_from_the_measured_joints():
+    # as the jaws' follower: the segment to a first point ahead starts at the joints' measured
+    # state when the controller takes the message, not at their last command
+    f = JointFollower([0.5, 0.5], limits=[(0.0, 2.0), (0.0, 2.0)], names=["a", "b"])
+    f.accept([(10 * MS, (1.0, 0.0))], now_ns=0)
+    f.accept([(15 * MS, (1.5, 1.0))], now_ns=5 * MS, measured=(0.6, 0.4))
+    assert f.sample(5 * MS) == pytest.approx([0.6, 0.4])
+    assert f.sample(10 * MS) == pytest.approx([1.05, 0.7])
+
+
 @pytest.mark.parametrize("points, why", [
     ([], "no points"),
     ([(10 * MS, (float("nan"),))], "non-finite"),

@@ -230,9 +230,13 @@ class JointFollower:
         values = np.array([v for _, v in self.knots])
         return np.array([np.interp(t_ns, times, values[:, j]) for j in range(values.shape[1])])
 
-    def accept(self, points: Sequence[tuple[int, Sequence[float]]], *, now_ns: int) -> None:
+    def accept(self, points: Sequence[tuple[int, Sequence[float]]], *, now_ns: int,
+               measured: Sequence[float] | None = None) -> None:
         """Replace the active trajectory by ``points`` (absolute time ns, joint positions in
-        the order of ``names``) at ``now_ns`` (:func:`replacing_knots`).
+        the order of ``names``) at ``now_ns`` (:func:`replacing_knots`), starting from
+        ``measured`` (the measured joint positions at ``now_ns``, rad: the stock controller's
+        start, ``interpolate_from_desired_state`` false, its default) or, when None, from the
+        command (that parameter true).
 
         Raises
         ------
@@ -248,4 +252,5 @@ class JointFollower:
                 raise TrajectoryRefused(f"point {k} has positions outside the joint limits: "
                                         f"{', '.join(outside)} rad")
             knots.append((t, values))
-        self.knots = replacing_knots(knots, now_ns, self.sample(now_ns))
+        start = self.sample(now_ns) if measured is None else np.asarray(measured, float)
+        self.knots = replacing_knots(knots, now_ns, start)

@@ -277,7 +277,8 @@ class SimHandTrajectoryController(TrajectoryTopic):
                 for finger, hand_finger in self.controller.fingers.items()}
 
     def _trajectory(self, msg: JointTrajectory) -> None:
-        self._receive(msg, JOINTS, lambda points, now: self.follower.accept(points, now_ns=now))
+        self._receive(msg, JOINTS, lambda points, now: self.follower.accept(
+            points, now_ns=now, measured=[self.joints[j] for j in JOINTS]))
 
     def setpoints(self, t_ns: int) -> dict[str, np.ndarray]:
         """The carried fingers' tip setpoints (m) at sim time ``t_ns``: the forward kinematics

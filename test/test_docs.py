@@ -31,6 +31,7 @@ import ast
 import contextlib
 import importlib.metadata
 import io
+import json
 import os
 import re
 import shlex
@@ -49,6 +50,8 @@ from doc_transcripts import (
     REPO,
     Command,
     Transcript,
+    abridged_json,
+    abridged_json_matches,
     blocks,
     compare,
     line_matches,
@@ -356,6 +359,31 @@ def test_every_relative_link_and_anchor_exists():
                 if anchor[1:] not in headings:
                     broken.append(f"{page.name}: {target}{anchor}")
     assert broken == []
+
+
+def test_the_abridged_json_example_is_what_the_verb_prints(scratch):
+    """docs/events.md's ``--json`` example (abridged: ``...``) is what ``squeeze --json`` of the
+    scene it names prints: every key shown in the verb's order (all of them where nothing is
+    elided), every value shown at its printed precision.
+    """
+    page = REPO / "docs" / "events.md"
+    block = next(b for b in blocks(page) if b.language == "json")
+    scene = re.search(r"`--json` prints \(abridged; `([\w.]+)`\)", block.before).group(1)
+    command = Command(f"squeeze-grasp squeeze config/scenes/{scene} --json", ())
+    actual = json.loads("\n".join(run_command(command, scratch)))
+    problem = abridged_json_matches(abridged_json("\n".join(block.lines)), actual)
+    assert problem is None, f"{page.name}:{block.line}: {problem}"
+
+
+def test_the_abridged_json_comparison_can_fail():
+    example = abridged_json('{"a": 1.5, "b": [1, 2, ...], "c": {...}, "d": {"x": 1, ...}}')
+    actual = {"a": 1.46, "b": [1, 2, 3], "c": {"y": 0}, "d": {"w": 0, "x": 1, "z": 2}}
+    assert abridged_json_matches(example, actual) is None
+    assert abridged_json_matches(example, {**actual, "a": 1.44}) is not None
+    assert abridged_json_matches(example, {"b": actual["b"], **actual}) is not None  # key order
+    assert abridged_json_matches(example, {**actual, "e": 0}) is not None  # a key not shown
+    assert abridged_json_matches(example, {**actual, "b": [1]}) is not None
+    assert abridged_json_matches(example, {**actual, "d": {"w": 0}}) is not None
 
 
 def test_the_executor_goal_example_is_the_foam_squares_plan():

@@ -251,11 +251,12 @@ ELIDED = "..."
 
 
 def abridged_json(text: str) -> object:
-    """An abridged JSON example as data: ``{...}`` is an elided value (:data:`ELIDED`), and
-    ``, ...`` closing a list or an object an elided rest, kept as a last item ``"..."`` or a
-    last key ``"..."``.
+    """An abridged JSON example as data: ``{...}`` or ``...`` after a key is an elided value
+    (:data:`ELIDED`), and ``, ...`` closing a list or an object an elided rest, kept as a last
+    item ``"..."`` or a last key ``"..."``.
     """
     text = text.replace("{...}", json.dumps(ELIDED))
+    text = re.sub(r":\s*\.\.\.(?=\s*[,}\]])", f": {json.dumps(ELIDED)}", text)
     text = re.sub(r",\s*\.\.\.\s*\]", f", {json.dumps(ELIDED)}]", text)
     text = re.sub(r",\s*\.\.\.\s*\}", f", {json.dumps(ELIDED)}: {json.dumps(ELIDED)}}}", text)
     return json.loads(text)

@@ -423,6 +423,77 @@ def test_the_scene_error_the_docs_quote_is_the_one_a_scene_gets():
         assert quoted in (REPO / "docs" / page).read_text(encoding="utf-8"), page
 
 
+def _refusal(words: list[str], folder: Path) -> str:
+    """The one line ``squeeze-grasp WORDS`` prints when it refuses its input (exit 2)."""
+    from squeeze_grasp_ros import cli
+
+    out = io.StringIO()
+    cwd = os.getcwd()
+    os.chdir(folder)
+    try:
+        with contextlib.redirect_stdout(out), contextlib.redirect_stderr(out):
+            code = cli.main(words)
+    finally:
+        os.chdir(cwd)
+    assert code == ExitCode.USAGE, (words, code, out.getvalue())
+    return out.getvalue().strip()
+
+
+def _quoted_block(page: Path, starts: str) -> str:
+    """The text of the plain fenced block of ``page`` that starts with ``starts``, its
+    wrapped lines joined.
+    """
+    block = next(b for b in blocks(page) if b.language == "" and b.lines
+                 and b.lines[0].startswith(starts))
+    return " ".join(line.strip() for line in block.lines)
+
+
+def test_the_size_refusals_reliability_md_quotes_are_the_ones_printed(scratch):
+    """docs/reliability.md quotes the refusal of a 0.1 m x 1e-7 m rectangle with
+    ``mesh.nodes: 500`` (the case of test/test_mesh_bounds.py) and of a sweep of 3,000
+    frictions, tip radii and depths (test/test_hostile_core.py): each is the line printed.
+    """
+    page = REPO / "docs" / "reliability.md"
+    scene = yaml.safe_load((REPO / "config" / "scenes" / "foam_square.yaml").read_text())
+    scene["object"].update(shape={"type": "rectangle", "width": 0.1, "height": 1e-7},
+                           mesh={"nodes": 500})
+    (scratch / "tmp_user" / "thin.yaml").write_text(yaml.safe_dump(scene))
+    assert _refusal(["mesh", "tmp_user/thin.yaml"], scratch) == _quoted_block(
+        page, "squeeze-grasp mesh: error:")
+    pytest.importorskip("distributed", reason="sweep needs the sweep extra")
+    spec = {"base": str(REPO / "config" / "scenes" / "foam_square.yaml"),
+            "friction": [k * 1e-4 for k in range(3000)],
+            "tip_radius": [0.001 + k * 1e-6 for k in range(3000)],
+            "relative_depth": [0.001 + k * 1e-4 for k in range(3000)]}
+    (scratch / "tmp_user" / "huge.yaml").write_text(yaml.safe_dump(spec))
+    assert _refusal(["sweep", "tmp_user/huge.yaml", "--dry-run"], scratch) == _quoted_block(
+        page, "squeeze-grasp sweep: error:")
+
+
+def test_the_refused_views_perception_md_lists_are_the_messages():
+    """docs/perception.md's table of refused views quotes, for each, the message of its case in
+    test/test_perception_extract.py, whole.
+    """
+    pytest.importorskip("skimage", reason="outline extraction needs the perception extra")
+    import test_perception_extract as cases
+
+    from squeeze_grasp_ros.mechanics.errors import InvalidInputError
+
+    page = (REPO / "docs" / "perception.md").read_text(encoding="utf-8")
+    table = page[page.index("| view | message (excerpt) |"):]
+    table = table[:table.index("\n\n", table.index("|---|"))]
+    quoted = [q for q in re.findall(r"`([^`]+)`", table) if "..." not in q]
+    messages = []
+    for _, image, encoding, options, expected in cases.hostile_views():
+        if expected is None:
+            continue
+        view = options.pop("pose", cases.pose())
+        with pytest.raises(InvalidInputError) as refused:
+            cases.extract_outline(image, encoding, cases.CAMERA, view, **options)
+        messages.append(str(refused.value))
+    assert len(quoted) >= 8 and [q for q in quoted if q not in messages] == [], messages
+
+
 def _package_calls(code: str) -> list[tuple[str, ast.Call, object]]:
     """The calls in ``code`` of the names it imports from the package: (name, call, object)."""
     import importlib

@@ -6,6 +6,7 @@ when a required parameter is missing. Real processes on real rclpy.
 from __future__ import annotations
 
 import re
+import shlex
 import signal
 import subprocess
 import time
@@ -99,3 +100,41 @@ def test_every_node_logs_when_it_is_ready(tmp_path):
     topics = re.search(r"recorder ready: (recording \d+ topics)", outputs["recorder"]).group(1)
     documented = re.findall(r"recorder ready: (recording \d+ topics)", shown)
     assert documented and set(documented) == {topics}
+
+
+def test_the_hardware_mode_commands_of_grippers_md_print_its_ready_lines(tmp_path):
+    """docs/grippers.md's hardware-mode ``ros2 run`` commands of the monitor and the executor
+    (run from a folder holding the repository's config/) log the ready lines the page shows,
+    their stamps shown as ``[...]``.
+    """
+    from doc_transcripts import blocks
+
+    page = REPO / "docs" / "grippers.md"
+    found = [b.lines for b in blocks(page) if b.language == "" and b.lines
+             and b.lines[0].startswith(("ros2 run squeeze_grasp_ros monitor ",
+                                        "[INFO] [...] [monitor]: monitor ready: "))]
+    assert len(found) == 2, found
+    commands, shown = " ".join(found[0]).replace("\\ ", "").split("ros2 run ")[1:], found[1]
+    (tmp_path / "config").symlink_to(REPO / "config")
+    processes = {}
+    for command in commands:
+        words = shlex.split(command)
+        assert words[0] == "squeeze_grasp_ros", words
+        processes[words[1]] = subprocess.Popen(
+            [script(words[1]), *words[2:]], stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
+            text=True, cwd=tmp_path, stdin=subprocess.DEVNULL)
+    logged = []
+    try:
+        for name, process in processes.items():
+            deadline = time.monotonic() + 120
+            while time.monotonic() < deadline:
+                line = process.stdout.readline()
+                if f"[{name}]: {name} ready: " in line or not line:
+                    logged.append(re.sub(r"^(\[\w+\]) \[[\d.]+\]", r"\1 [...]", line.rstrip()))
+                    break
+    finally:
+        for process in processes.values():
+            process.send_signal(signal.SIGINT)
+        codes = {name: p.wait(timeout=60) for name, p in processes.items()}
+    assert list(processes) == ["monitor", "executor"] and logged == list(shown), logged
+    assert codes == dict.fromkeys(processes, 0)

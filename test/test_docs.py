@@ -494,6 +494,21 @@ def test_the_refused_views_perception_md_lists_are_the_messages():
     assert len(quoted) >= 8 and [q for q in quoted if q not in messages] == [], messages
 
 
+def test_the_oversized_refusal_ros_md_quotes_is_the_planners():
+    """docs/ros.md quotes the planner's refusal of the foam square with ``mesh: {max_area:
+    1.0e-9}`` at its default limits, whole (its line breaks aside).
+    """
+    from squeeze_grasp_ros.planning.objects import PlannerLimits, check_requested
+    from squeeze_grasp_ros.scene import parse_scene
+
+    doc = yaml.safe_load((REPO / "config" / "scenes" / "foam_square.yaml").read_text())
+    doc["object"]["mesh"] = {"max_area": 1.0e-9}
+    with pytest.raises(Exception, match="oversized") as refused:
+        check_requested(parse_scene(doc), "factorized", PlannerLimits())
+    page = " ".join((REPO / "docs" / "ros.md").read_text(encoding="utf-8").split())
+    assert "`mesh: {max_area: 1.0e-9}`" in page and f"`{refused.value}`" in page, refused.value
+
+
 def _package_calls(code: str) -> list[tuple[str, ast.Call, object]]:
     """The calls in ``code`` of the names it imports from the package: (name, call, object)."""
     import importlib

@@ -54,6 +54,7 @@ from doc_transcripts import (
     abridged_json_matches,
     blocks,
     compare,
+    json_matches,
     line_matches,
     number_matches,
     transcripts,
@@ -507,6 +508,41 @@ def test_the_oversized_refusal_ros_md_quotes_is_the_planners():
         check_requested(parse_scene(doc), "factorized", PlannerLimits())
     page = " ".join((REPO / "docs" / "ros.md").read_text(encoding="utf-8").split())
     assert "`mesh: {max_area: 1.0e-9}`" in page and f"`{refused.value}`" in page, refused.value
+
+
+def test_the_docs_doctests_run():
+    """Every ``>>>`` example in a ```python block of the docs runs and prints what it shows
+    (docs/perception.md's seen-against-predicted outline needs the perception extra).
+    """
+    import doctest
+
+    pytest.importorskip("skimage", reason="docs/perception.md's example extracts an outline")
+    examples = [(page, block) for page in PAGES for block in blocks(page)
+                if block.language == "python"
+                and any(line.lstrip().startswith(">>>") for line in block.lines)]
+    assert examples
+    runner = doctest.DocTestRunner(optionflags=doctest.ELLIPSIS)
+    for page, block in examples:
+        test = doctest.DocTestParser().get_doctest(
+            "\n".join(block.lines), {}, f"{page.name}:{block.line}", str(page), block.line)
+        runner.run(test)
+    assert runner.summarize(verbose=False).failed == 0
+
+
+def test_the_ring_diameter_example_prints_what_ring_md_shows():
+    """docs/ring.md's ``ring_diameter_changes`` call and the value its comment shows (a full
+    repr: to 1e-8 relative, as in the transcripts).
+    """
+    page = REPO / "docs" / "ring.md"
+    block = next(b for b in blocks(page) if b.language == "python"
+                 and "ring_diameter_changes(" in "\n".join(b.lines))
+    code, comment = block.lines[:-1], block.lines[-1]
+    shown = re.fullmatch(r"# (\(.*?\))\s+.*", comment).group(1)
+    *setup, call = code
+    namespace: dict = {}
+    exec("\n".join(setup), namespace)  # noqa: S102 (the repository's own page)
+    actual = eval(call, namespace)  # noqa: S307
+    assert json_matches(list(ast.literal_eval(shown)), list(actual)) is None, (shown, actual)
 
 
 def _package_calls(code: str) -> list[tuple[str, ast.Call, object]]:

@@ -161,7 +161,10 @@ def _run(text: str, folder: Path) -> str:
     raise AssertionError(f"no way to run {text!r}: mark the transcript <!-- untested: ... -->")
 
 
-def _in_process(words: list[str], folder: Path) -> str:
+def _cli(words: list[str], folder: Path) -> tuple[int, str]:
+    """``squeeze-grasp WORDS`` run in this process from ``folder``: its exit code and its
+    output (stdout and stderr together).
+    """
     from squeeze_grasp_ros import cli
 
     out = io.StringIO()
@@ -172,11 +175,16 @@ def _in_process(words: list[str], folder: Path) -> str:
             code = cli.main(words)
     finally:
         os.chdir(cwd)
-    missing = re.search(r"needs (\S+), which is not installed: (.*)", out.getvalue())
+    return code, out.getvalue()
+
+
+def _in_process(words: list[str], folder: Path) -> str:
+    code, output = _cli(words, folder)
+    missing = re.search(r"needs (\S+), which is not installed: (.*)", output)
     if code == ExitCode.INTERNAL and missing and install_hint(missing.group(1)):
         pytest.skip(f"squeeze-grasp {words[0]} needs {missing.group(1)}: {missing.group(2)}")
-    assert code in (0, 1), f"squeeze-grasp {' '.join(words)} exited {code}:\n{out.getvalue()}"
-    return out.getvalue()
+    assert code in (0, 1), f"squeeze-grasp {' '.join(words)} exited {code}:\n{output}"
+    return output
 
 
 def _process(argv: list[str], folder: Path) -> str:
@@ -426,18 +434,9 @@ def test_the_scene_error_the_docs_quote_is_the_one_a_scene_gets():
 
 def _refusal(words: list[str], folder: Path) -> str:
     """The one line ``squeeze-grasp WORDS`` prints when it refuses its input (exit 2)."""
-    from squeeze_grasp_ros import cli
-
-    out = io.StringIO()
-    cwd = os.getcwd()
-    os.chdir(folder)
-    try:
-        with contextlib.redirect_stdout(out), contextlib.redirect_stderr(out):
-            code = cli.main(words)
-    finally:
-        os.chdir(cwd)
-    assert code == ExitCode.USAGE, (words, code, out.getvalue())
-    return out.getvalue().strip()
+    code, output = _cli(words, folder)
+    assert code == ExitCode.USAGE, (words, code, output)
+    return output.strip()
 
 
 def _quoted_block(page: Path, starts: str) -> str:

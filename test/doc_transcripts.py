@@ -246,6 +246,47 @@ def json_matches(expected: object, actual: object, path: str = "") -> str | None
     return None if expected == actual else f"{path}: {expected!r} != {actual!r}"
 
 
+ELIDED = "..."
+"""An elided value of an abridged JSON example (:func:`abridged_json`)."""
+
+
+def abridged_json(text: str) -> object:
+    """An abridged JSON example as data: ``{...}`` or ``...`` after a key is an elided value
+    (:data:`ELIDED`), and ``, ...`` closing a list or an object an elided rest, kept as a last
+    item ``"..."`` or a last key ``"..."``.
+    """
+    text = text.replace("{...}", json.dumps(ELIDED))
+    text = re.sub(r":\s*\.\.\.(?=\s*[,}\]])", f": {json.dumps(ELIDED)}", text)
+    text = re.sub(r",\s*\.\.\.\s*\]", f", {json.dumps(ELIDED)}]", text)
+    text = re.sub(r",\s*\.\.\.\s*\}", f", {json.dumps(ELIDED)}: {json.dumps(ELIDED)}}}", text)
+    return json.loads(text)
+
+
+def abridged_json_matches(expected: object, actual: object, path: str = "") -> str | None:
+    """None when ``actual`` matches the abridged example ``expected`` (:func:`abridged_json`):
+    an elided value matches anything; an object without an elided rest has exactly the
+    actual keys in their order, one with it some of them in their order; a list with an
+    elided rest is a prefix of the actual one. Everything else as :func:`json_matches`.
+    """
+    if expected == ELIDED:
+        return None
+    if isinstance(expected, dict) and isinstance(actual, dict):
+        keys = [k for k in expected if k != ELIDED]
+        order = [k for k in actual if k in keys]
+        if keys != (order if ELIDED in expected else list(actual)):
+            return f"{path or '(top)'}: keys {keys} != {list(actual)}"
+        return next((d for k in keys
+                     if (d := abridged_json_matches(expected[k], actual[k], f"{path}.{k}"))),
+                    None)
+    if isinstance(expected, list) and isinstance(actual, list):
+        shown = expected[:-1] if expected and expected[-1] == ELIDED else expected
+        if len(shown) > len(actual) or (shown is expected and len(shown) != len(actual)):
+            return f"{path}: {len(expected)} items against {len(actual)}"
+        return next((d for k, (e, a) in enumerate(zip(shown, actual))
+                     if (d := abridged_json_matches(e, a, f"{path}[{k}]"))), None)
+    return json_matches(expected, actual, path)
+
+
 def compare(expected: tuple[str, ...], actual: list[str]) -> str | None:
     """None when ``actual`` matches ``expected``, else what differs (first mismatch)."""
     actual = [line.rstrip() for line in actual]

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from doc_transcripts import REPO, blocks
 from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
@@ -155,6 +156,11 @@ def test_targets_out_of_reach_name_the_finger_the_target_and_the_reach():
                                          r"spread axis .*beyond its reach \[-0.0367585, "
                                          r"0.157157\] m"):
         hand.inverse({F3: np.array([0.0, 0.3])})
+    with pytest.raises(ReachError) as refused:
+        hand.inverse({F3: np.array([0.0, 0.3])})
+    quoted = [b.lines for b in blocks(REPO / "docs" / "grippers.md")
+              if b.language == "text" and "beyond its reach" in "\n".join(b.lines)]
+    assert quoted == [(str(refused.value),)], quoted  # as docs/grippers.md quotes it
     with pytest.raises(ReachError, match=r"barrett_f3: target \(0.01, 0.1\) m is 0.01 m off "
                                          r"its closing line"):
         hand.inverse({F3: np.array([0.01, 0.1])})

@@ -31,6 +31,7 @@ import ast
 import contextlib
 import importlib.metadata
 import io
+import json
 import os
 import re
 import shlex
@@ -49,8 +50,11 @@ from doc_transcripts import (
     REPO,
     Command,
     Transcript,
+    abridged_json,
+    abridged_json_matches,
     blocks,
     compare,
+    json_matches,
     line_matches,
     number_matches,
     transcripts,
@@ -157,7 +161,10 @@ def _run(text: str, folder: Path) -> str:
     raise AssertionError(f"no way to run {text!r}: mark the transcript <!-- untested: ... -->")
 
 
-def _in_process(words: list[str], folder: Path) -> str:
+def _cli(words: list[str], folder: Path) -> tuple[int, str]:
+    """``squeeze-grasp WORDS`` run in this process from ``folder``: its exit code and its
+    output (stdout and stderr together).
+    """
     from squeeze_grasp_ros import cli
 
     out = io.StringIO()
@@ -168,11 +175,16 @@ def _in_process(words: list[str], folder: Path) -> str:
             code = cli.main(words)
     finally:
         os.chdir(cwd)
-    missing = re.search(r"needs (\S+), which is not installed: (.*)", out.getvalue())
+    return code, out.getvalue()
+
+
+def _in_process(words: list[str], folder: Path) -> str:
+    code, output = _cli(words, folder)
+    missing = re.search(r"needs (\S+), which is not installed: (.*)", output)
     if code == ExitCode.INTERNAL and missing and install_hint(missing.group(1)):
         pytest.skip(f"squeeze-grasp {words[0]} needs {missing.group(1)}: {missing.group(2)}")
-    assert code in (0, 1), f"squeeze-grasp {' '.join(words)} exited {code}:\n{out.getvalue()}"
-    return out.getvalue()
+    assert code in (0, 1), f"squeeze-grasp {' '.join(words)} exited {code}:\n{output}"
+    return output
 
 
 def _process(argv: list[str], folder: Path) -> str:
@@ -358,6 +370,31 @@ def test_every_relative_link_and_anchor_exists():
     assert broken == []
 
 
+def test_the_abridged_json_example_is_what_the_verb_prints(scratch):
+    """docs/events.md's ``--json`` example (abridged: ``...``) is what ``squeeze --json`` of the
+    scene it names prints: every key shown in the verb's order (all of them where nothing is
+    elided), every value shown at its printed precision.
+    """
+    page = REPO / "docs" / "events.md"
+    block = next(b for b in blocks(page) if b.language == "json")
+    scene = re.search(r"`--json` prints \(abridged; `([\w.]+)`\)", block.before).group(1)
+    command = Command(f"squeeze-grasp squeeze config/scenes/{scene} --json", ())
+    actual = json.loads("\n".join(run_command(command, scratch)))
+    problem = abridged_json_matches(abridged_json("\n".join(block.lines)), actual)
+    assert problem is None, f"{page.name}:{block.line}: {problem}"
+
+
+def test_the_abridged_json_comparison_can_fail():
+    example = abridged_json('{"a": 1.5, "b": [1, 2, ...], "c": {...}, "d": {"x": 1, ...}}')
+    actual = {"a": 1.46, "b": [1, 2, 3], "c": {"y": 0}, "d": {"w": 0, "x": 1, "z": 2}}
+    assert abridged_json_matches(example, actual) is None
+    assert abridged_json_matches(example, {**actual, "a": 1.44}) is not None
+    assert abridged_json_matches(example, {"b": actual["b"], **actual}) is not None  # key order
+    assert abridged_json_matches(example, {**actual, "e": 0}) is not None  # a key not shown
+    assert abridged_json_matches(example, {**actual, "b": [1]}) is not None
+    assert abridged_json_matches(example, {**actual, "d": {"w": 0}}) is not None
+
+
 def test_the_executor_goal_example_is_the_foam_squares_plan():
     """docs/pipeline.md's ``ros2 action send_goal`` example is the planned goal of the shipped
     foam square, to its printed precision.
@@ -393,6 +430,118 @@ def test_the_scene_error_the_docs_quote_is_the_one_a_scene_gets():
     assert quoted == "`object.material.nu must be in [-0.9, 0.5], got 0.7`"
     for page in ("scenes.md", "ros.md"):
         assert quoted in (REPO / "docs" / page).read_text(encoding="utf-8"), page
+
+
+def _refusal(words: list[str], folder: Path) -> str:
+    """The one line ``squeeze-grasp WORDS`` prints when it refuses its input (exit 2)."""
+    code, output = _cli(words, folder)
+    assert code == ExitCode.USAGE, (words, code, output)
+    return output.strip()
+
+
+def _quoted_block(page: Path, starts: str) -> str:
+    """The text of the plain fenced block of ``page`` that starts with ``starts``, its
+    wrapped lines joined.
+    """
+    block = next(b for b in blocks(page) if b.language == "" and b.lines
+                 and b.lines[0].startswith(starts))
+    return " ".join(line.strip() for line in block.lines)
+
+
+def test_the_size_refusals_reliability_md_quotes_are_the_ones_printed(scratch):
+    """docs/reliability.md quotes the refusal of a 0.1 m x 1e-7 m rectangle with
+    ``mesh.nodes: 500`` (the case of test/test_mesh_bounds.py) and of a sweep of 3,000
+    frictions, tip radii and depths (test/test_hostile_core.py): each is the line printed.
+    """
+    page = REPO / "docs" / "reliability.md"
+    scene = yaml.safe_load((REPO / "config" / "scenes" / "foam_square.yaml").read_text())
+    scene["object"].update(shape={"type": "rectangle", "width": 0.1, "height": 1e-7},
+                           mesh={"nodes": 500})
+    (scratch / "tmp_user" / "thin.yaml").write_text(yaml.safe_dump(scene))
+    assert _refusal(["mesh", "tmp_user/thin.yaml"], scratch) == _quoted_block(
+        page, "squeeze-grasp mesh: error:")
+    pytest.importorskip("distributed", reason="sweep needs the sweep extra")
+    spec = {"base": str(REPO / "config" / "scenes" / "foam_square.yaml"),
+            "friction": [k * 1e-4 for k in range(3000)],
+            "tip_radius": [0.001 + k * 1e-6 for k in range(3000)],
+            "relative_depth": [0.001 + k * 1e-4 for k in range(3000)]}
+    (scratch / "tmp_user" / "huge.yaml").write_text(yaml.safe_dump(spec))
+    assert _refusal(["sweep", "tmp_user/huge.yaml", "--dry-run"], scratch) == _quoted_block(
+        page, "squeeze-grasp sweep: error:")
+
+
+def test_the_refused_views_perception_md_lists_are_the_messages():
+    """docs/perception.md's table of refused views quotes, for each, the message of its case in
+    test/test_perception_extract.py, whole.
+    """
+    pytest.importorskip("skimage", reason="outline extraction needs the perception extra")
+    import test_perception_extract as cases
+
+    from squeeze_grasp_ros.mechanics.errors import InvalidInputError
+
+    page = (REPO / "docs" / "perception.md").read_text(encoding="utf-8")
+    table = page[page.index("| view | message (excerpt) |"):]
+    table = table[:table.index("\n\n", table.index("|---|"))]
+    quoted = [q for q in re.findall(r"`([^`]+)`", table) if "..." not in q]
+    messages = []
+    for _, image, encoding, options, expected in cases.hostile_views():
+        if expected is None:
+            continue
+        view = options.pop("pose", cases.pose())
+        with pytest.raises(InvalidInputError) as refused:
+            cases.extract_outline(image, encoding, cases.CAMERA, view, **options)
+        messages.append(str(refused.value))
+    assert len(quoted) >= 8 and [q for q in quoted if q not in messages] == [], messages
+
+
+def test_the_oversized_refusal_ros_md_quotes_is_the_planners():
+    """docs/ros.md quotes the planner's refusal of the foam square with ``mesh: {max_area:
+    1.0e-9}`` at its default limits, whole (its line breaks aside).
+    """
+    from squeeze_grasp_ros.planning.objects import PlannerLimits, check_requested
+    from squeeze_grasp_ros.scene import parse_scene
+
+    doc = yaml.safe_load((REPO / "config" / "scenes" / "foam_square.yaml").read_text())
+    doc["object"]["mesh"] = {"max_area": 1.0e-9}
+    with pytest.raises(Exception, match="oversized") as refused:
+        check_requested(parse_scene(doc), "factorized", PlannerLimits())
+    page = " ".join((REPO / "docs" / "ros.md").read_text(encoding="utf-8").split())
+    assert "`mesh: {max_area: 1.0e-9}`" in page and f"`{refused.value}`" in page, refused.value
+
+
+def test_the_docs_doctests_run():
+    """Every ``>>>`` example in a ```python block of the docs runs and prints what it shows
+    (docs/perception.md's seen-against-predicted outline needs the perception extra).
+    """
+    import doctest
+
+    pytest.importorskip("skimage", reason="docs/perception.md's example extracts an outline")
+    examples = [(page, block) for page in PAGES for block in blocks(page)
+                if block.language == "python"
+                and any(line.lstrip().startswith(">>>") for line in block.lines)]
+    assert examples
+    runner = doctest.DocTestRunner(optionflags=doctest.ELLIPSIS)
+    for page, block in examples:
+        test = doctest.DocTestParser().get_doctest(
+            "\n".join(block.lines), {}, f"{page.name}:{block.line}", str(page), block.line)
+        runner.run(test)
+    assert runner.summarize(verbose=False).failed == 0
+
+
+def test_the_ring_diameter_example_prints_what_ring_md_shows():
+    """docs/ring.md's ``ring_diameter_changes`` call and the value its comment shows (a full
+    repr: to 1e-8 relative, as in the transcripts).
+    """
+    page = REPO / "docs" / "ring.md"
+    block = next(b for b in blocks(page) if b.language == "python"
+                 and "ring_diameter_changes(" in "\n".join(b.lines))
+    code, comment = block.lines[:-1], block.lines[-1]
+    shown = re.fullmatch(r"# (\(.*?\))\s+.*", comment).group(1)
+    *setup, call = code
+    namespace: dict = {}
+    exec("\n".join(setup), namespace)  # noqa: S102 (the repository's own page)
+    actual = eval(call, namespace)  # noqa: S307
+    assert json_matches(list(ast.literal_eval(shown)), list(actual)) is None, (shown, actual)
 
 
 def _package_calls(code: str) -> list[tuple[str, ast.Call, object]]:

@@ -19,7 +19,8 @@ from squeeze_grasp_ros.extras import install_hint
 
 EXEMPT: dict[str, str] = {
     "extract_outline": "needs the perception extra (scikit-image), which the core suite may "
-                       "lack; docs/perception.md shows it, test_perception_extract.py runs it",
+                       "lack; docs/perception.md's example of it runs in test_docs.py, and "
+                       "test_perception_extract.py runs it",
 }
 """Public functions without their own example, and why."""
 

@@ -10,12 +10,14 @@ from __future__ import annotations
 
 import importlib.util
 import math
+import re
 import time
 from pathlib import Path
 
 import numpy as np
 import pytest
 import yaml
+from doc_transcripts import REPO, blocks
 from mcap.reader import make_reader
 from pipeline_support import run_observed, sim_and_client, write_scene
 
@@ -266,6 +268,13 @@ def test_a_hostile_action_client_is_rejected(kind, tmp_path, capfd):
         assert goal(0.4, effort=3.0).accepted
     err = capfd.readouterr().err
     assert err.count("rejected the goal on /gripper_controller/gripper_cmd") == len(hostile)
+    # the log lines docs/grippers.md quotes (the second a parallel gripper's), stamps as [...]
+    logged = [re.sub(r"^(\[\w+\]) \[[\d.]+\]", r"\1 [...]", line) for line in err.splitlines()]
+    quoted = [b.lines for b in blocks(REPO / "docs" / "grippers.md")
+              if b.language == "text" and "rejected the goal on" in "\n".join(b.lines)]
+    assert len(quoted) == 1 and len(quoted[0]) == 2, quoted
+    shown = quoted[0] if kind == "parallel_gripper" else quoted[0][:1]
+    assert [line for line in shown if line not in logged] == [], err
 
 
 def test_a_stopping_executor_cancels_the_gripper_goal(tmp_path):

@@ -7,6 +7,7 @@ the Cartesian setpoint route on real rclpy, and a hostile trajectory client.
 
 from __future__ import annotations
 
+import re
 import time
 from collections import Counter
 from pathlib import Path
@@ -16,6 +17,7 @@ import pytest
 import rclpy
 import yaml
 from builtin_interfaces.msg import Duration
+from doc_transcripts import REPO, blocks
 from mcap.reader import make_reader
 from pipeline_support import run_observed, write_scene
 from rclpy.context import Context
@@ -297,6 +299,17 @@ def test_a_hostile_trajectory_is_refused_with_a_log_line_not_followed(capfd):
         rig.close()
     err = capfd.readouterr().err
     assert err.count("refused the trajectory on /gripper_controller/joint_trajectory") == 5
+    # docs/grippers.md quotes the first refusal's log line, its stamp as [...]
+    logged = [re.sub(r"^(\[\w+\]) \[[\d.]+\]", r"\1 [...]", line) for line in err.splitlines()]
+    assert grippers_md_text("refused the trajectory") in logged, err
+
+
+def grippers_md_text(containing: str) -> str:
+    """The one-line ``text`` block of docs/grippers.md that contains ``containing``."""
+    found = [b.lines for b in blocks(REPO / "docs" / "grippers.md")
+             if b.language == "text" and containing in "\n".join(b.lines)]
+    assert len(found) == 1 and len(found[0]) == 1, found
+    return found[0][0]
 
 
 def test_a_zero_stamp_point_at_time_zero_is_followed_not_refused():
@@ -464,4 +477,5 @@ def test_the_executor_refuses_a_plan_beyond_the_device_effort(tmp_path):
     print(result.message)
     assert result.termination == "invalid_goal" and not result.success
     assert "max_force 3 N" in result.message and "jaw force of 5.97 N" in result.message
+    assert result.message == grippers_md_text("beyond weak_85mm's max_force")  # as quoted
     assert out["trajectories"] == []

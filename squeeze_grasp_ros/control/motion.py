@@ -64,6 +64,7 @@ squeeze).
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from functools import cached_property
@@ -87,6 +88,13 @@ DEFAULT_CLEARANCE = 0.002
 clear of the object at rest for the shipped pads and circles while a gripper opens in 0.2 s at
 the default ``max_velocity``."""
 _NO_FORCE = np.zeros(2)
+
+
+def _distance(a: Sequence[float], b: Sequence[float]) -> float:
+    """|a - b| of two planar points, m (scalar arithmetic: cheaper than numpy on 2-vectors)."""
+    return math.hypot(float(a[0]) - float(b[0]), float(a[1]) - float(b[1]))
+
+
 STILL = 1e-4
 """m: a finger measured within this of where it stood counts as standing still (the stall
 watch; less at a low ``max_velocity``: :meth:`MotionLimits.still_distance`)."""
@@ -655,27 +663,30 @@ class GraspProgram:
 
     def _stalled(self, obs: Observation, dt: float) -> str | None:
         """Why the moving fingers count as stalled after this cycle of ``dt`` s (standing
-        still short of their setpoints for longer than ``stall_timeout``), or None.
+        still short of their setpoints for longer than ``stall_timeout``), or None (a few
+        scalar distances a cycle: it runs at every control cycle).
         """
         timeout = self.limits.stall_timeout
         if not timeout:
             return None
-        where = {f: np.asarray(obs.positions[f], float) for f in self.moving}
-        gaps = {f: float(np.linalg.norm(where[f] - self.commanded[f])) for f in self.moving}
-        short = [f for f in self.moving if gaps[f] > self.limits.position_tolerance]
+        where, commanded = obs.positions, self.commanded
+        tol = self.limits.position_tolerance
+        short = [f for f in self.moving if _distance(where[f], commanded[f]) > tol]
         still = self.limits.still_distance()
         if not short or self.still is None or any(
-                np.linalg.norm(where[f] - self.still[f]) > still for f in self.moving):
-            self.still, self.still_time = (where if short else None), 0.0
+                _distance(where[f], self.still[f]) > still for f in self.moving):
+            # copies: an observation's arrays may be refilled in place for the next cycle
+            self.still = {f: np.array(where[f], float) for f in self.moving} if short else None
+            self.still_time = 0.0
             return None
         self.still_time += dt
         if self.still_time <= timeout:
             return None
+        gaps = ", ".join(f"{f} {_distance(where[f], commanded[f]) * 1e3:.4g} mm" for f in short)
         return (f"{', '.join(short)} stood still (within {still * 1e3:.3g} mm) for "
                 f"{self.still_time:.3f} s (stall_timeout {timeout:g} s) short of the setpoints "
-                f"by {', '.join(f'{f} {gaps[f] * 1e3:.4g} mm' for f in short)}: a "
-                "JointTrajectoryController that is loaded but not active drops every "
-                "trajectory (ros2 control list_controllers shows its state), or the drive "
+                f"by {gaps}: a JointTrajectoryController that is loaded but not active drops "
+                "every trajectory (ros2 control list_controllers shows its state), or the drive "
                 "stalled")
 
     def _settled(self, obs: Observation) -> bool:

@@ -88,18 +88,16 @@ DEFAULT_CLEARANCE = 0.002
 clear of the object at rest for the shipped pads and circles while a gripper opens in 0.2 s at
 the default ``max_velocity``."""
 _NO_FORCE = np.zeros(2)
+_NO_FORCE.flags.writeable = False
+"""A finger's force while it has no reading (N; one array, not one per tick)."""
+STILL = 1e-4
+"""m: a finger measured within this of where it stood counts as standing still (the stall
+watch; less at a low ``max_velocity``: :meth:`MotionLimits.still_distance`)."""
 
 
 def _distance(a: Sequence[float], b: Sequence[float]) -> float:
     """|a - b| of two planar points, m (scalar arithmetic: cheaper than numpy on 2-vectors)."""
     return math.hypot(float(a[0]) - float(b[0]), float(a[1]) - float(b[1]))
-
-
-STILL = 1e-4
-"""m: a finger measured within this of where it stood counts as standing still (the stall
-watch; less at a low ``max_velocity``: :meth:`MotionLimits.still_distance`)."""
-_NO_FORCE.flags.writeable = False
-"""A finger's force while it has no reading (N; one array, not one per tick)."""
 
 
 @dataclass(frozen=True)

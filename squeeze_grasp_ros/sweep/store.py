@@ -54,6 +54,7 @@ MAX_OUTLINE_BYTES = 16 * 1024 * 1024
 """Largest outline file read for pictures."""
 STATUSES = ("done", "failed", "pending")
 LOCK_NAME = ".sweep.lock"
+"""The file in ``parts/`` a sweep writing the folder holds locked (its process id inside)."""
 
 
 def package_version() -> str:

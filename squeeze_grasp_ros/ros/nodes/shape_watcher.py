@@ -113,7 +113,7 @@ class ShapeWatcher:
         try:
             pose = camera_pose(msg.pose)
         except InvalidInputError as error:  # e.g. not a unit quaternion: the last pose holds
-            self.node.get_logger().error(f"shape watch: camera/pose ignored: {error}")
+            self.node.get_logger().error(f"shape watch: {pipeline.CAMERA_POSE} ignored: {error}")
             return
         self.pose, self.frame_id = pose, msg.header.frame_id
         self._flush()

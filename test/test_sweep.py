@@ -378,8 +378,10 @@ def test_a_sweep_over_material_models_runs_each_and_names_its_measures(tmp_path)
 # ----------------------------------------------------------------- real Dask
 
 
-def start_cluster(tmp_path: Path, workers: int = 2):
-    """A `dask scheduler` and `dask worker` processes on 127.0.0.1 (own session each)."""
+def start_cluster(tmp_path: Path, workers: int = 2, *worker_options: str):
+    """A `dask scheduler` and `dask worker` processes on 127.0.0.1 (own session each), the
+    workers started with ``worker_options`` besides.
+    """
     env = {
         **os.environ,
         "OMP_NUM_THREADS": "1",
@@ -427,6 +429,7 @@ def start_cluster(tmp_path: Path, workers: int = 2):
                     "--host",
                     "127.0.0.1",
                     "--no-dashboard",
+                    *worker_options,
                 ],
                 env=env,
                 stdout=subprocess.DEVNULL,
@@ -606,6 +609,56 @@ def test_ctrl_c_stops_cleanly_and_resumes(tmp_path, signum, code):
 def sweep_command(spec: Path, out: Path, *options: str) -> list[str]:
     """The `squeeze-grasp sweep` console script of this environment."""
     return [str(BIN / "squeeze-grasp"), "sweep", str(spec), "--out", str(out), *options]
+
+
+NO_PACKAGE = """
+import sys
+
+
+class NoPackage:
+    def find_spec(self, name, path=None, target=None):
+        if name.split(".")[0] == "squeeze_grasp_ros":
+            raise ModuleNotFoundError(f"No module named {name!r}", name=name)
+        return None
+
+
+sys.meta_path.insert(0, NoPackage())
+"""
+"""A `dask worker --preload` that makes the worker a machine without this package."""
+OTHER_VERSION = """
+from squeeze_grasp_ros.sweep import store
+
+store.package_version = lambda: "0.0.1"
+"""
+"""A `dask worker --preload` that makes the worker run another version of the package."""
+
+
+@pytest.mark.parametrize("preloaded, says", [
+    (NO_PACKAGE, "cannot run squeeze_grasp_ros (ModuleNotFoundError"),
+    (OTHER_VERSION, "runs squeeze_grasp_ros 0.0.1, this client "),
+], ids=["no package", "other version"])
+def test_a_worker_without_the_package_is_refused_before_any_task(tmp_path, preloaded, says):
+    """A cluster whose worker cannot import the package, or runs another version of it: one
+    line naming the worker, what it lacks and what to install, exit 2, no part written (a
+    worker without the package gave a traceback and exit 1 before).
+    """
+    preload = tmp_path / "preload.py"
+    preload.write_text(preloaded)
+    address, procs = start_cluster(tmp_path, 1, "--preload", str(preload))
+    out = tmp_path / "out"
+    try:
+        done = subprocess.run(sweep_command(write_spec(tmp_path, SMALL), out, "--scheduler",
+                                            address, "--no-progress"),
+                              capture_output=True, text=True, timeout=120)
+    finally:
+        stop(procs)
+    assert done.returncode == ExitCode.USAGE, done.stderr
+    assert "Traceback" not in done.stderr
+    last = done.stderr.strip().splitlines()[-1]
+    assert last.startswith("squeeze-grasp sweep: error: worker tcp://127.0.0.1:")
+    assert says in last
+    assert last.endswith("install the same version, with its sweep extra, on every worker")
+    assert not list(out.glob("parts/*.parquet"))
 
 
 def worker_processes(pgid: int) -> list[str]:

@@ -248,14 +248,25 @@ def _dashboard(client, local: bool) -> Optional[str]:
 
 
 def _check_workers(client) -> int:
+    """The number of the cluster's workers, once each has shown that it runs this client's
+    version of the package.
+
+    Raises
+    ------
+    SweepError
+        If there is no worker, or a worker cannot import the package (its error, e.g. a
+        ModuleNotFoundError, is named) or runs another version.
+    """
     from squeeze_grasp_ros.sweep.store import package_version
-    versions = client.run(package_version)
+    versions = client.run(package_version, on_error="return")
     mine = package_version()
     bad = {w: v for w, v in versions.items() if v != mine}
     if bad:
-        worker, version = sorted(bad.items())[0]
-        raise SweepError(f"worker {worker} runs squeeze_grasp_ros {version}, this client {mine}: "
-                         "install the same version on every worker")
+        worker, version = sorted(bad.items(), key=lambda item: item[0])[0]
+        runs = (f"cannot run squeeze_grasp_ros ({version})" if isinstance(version, BaseException)
+                else f"runs squeeze_grasp_ros {version}")
+        raise SweepError(f"worker {worker} {runs}, this client {mine}: install the same version, "
+                         "with its sweep extra, on every worker")
     if not versions:
         raise SweepError("the Dask cluster has no workers")
     return len(versions)

@@ -45,6 +45,18 @@ The same from its parts: the mesh, the fingers' initial contact nodes, the squee
 >>> squeeze = event_squeeze(obj, (i, j), 0.02, 0.4, kind=SqueezeKind.PURE, relative_depth=0.02)
 >>> print(squeeze.termination, squeeze.events[0].type)
 depth_reached A
+
+An object of your own, with no scene: a polygon (m, either orientation; checked to be simple),
+meshed; anything else is refused by name:
+
+>>> square = polygon([[0, 0], [0.04, 0], [0.04, 0.04], [0, 0.04]])
+>>> print(f"{square.area * 1e4:.1f} cm^2", len(generate_mesh(square, 2e-5).nodes) > 50)
+16.0 cm^2 True
+>>> try:
+...     generate_mesh([[0, 0], [0.04, 0], [0, 0.04]], 2e-5)
+... except InvalidInputError as error:
+...     print(error)
+outline must be an Outline (e.g. polygon(points)), got list
 """
 from __future__ import annotations
 
@@ -58,6 +70,7 @@ from squeeze_grasp_ros.mechanics.elastic.compliance import ElasticObject
 from squeeze_grasp_ros.mechanics.elastic.material import Material
 from squeeze_grasp_ros.mechanics.elastic.mesh import Mesh, generate_mesh
 from squeeze_grasp_ros.mechanics.elastic.reduced import ReducedStiffness, reduced_stiffness
+from squeeze_grasp_ros.mechanics.elastic.shapes import Outline, polygon
 from squeeze_grasp_ros.mechanics.errors import (
                                                                    InfeasibleError,
                                                                    InternalError,
@@ -114,8 +127,8 @@ __all__ = [
     "Scene", "load_scene", "scene_file", "GraspSetup", "build_mesh", "scene_solid",
     "finger_nodes", "event_squeeze_scene",
     # elastic objects
-    "Material", "Mesh", "generate_mesh", "ElasticObject", "ReducedStiffness",
-    "reduced_stiffness",
+    "Outline", "polygon", "Material", "Mesh", "generate_mesh", "ElasticObject",
+    "ReducedStiffness", "reduced_stiffness",
     # squeezes
     "Squeeze", "plan_squeeze", "TerminationLimits", "SolveOptions", "EventSqueeze", "Event",
     "ContactState",

@@ -365,3 +365,31 @@ def test_a_scheduler_address_that_is_not_a_scheduler_times_out():
         closed = sock.getsockname()[1]
     with pytest.raises(SweepError, match="cannot connect"):
         probe_scheduler(f"tcp://127.0.0.1:{closed}", 1.0, 1.0)
+
+
+SQUARE = [[0.0, 0.0], [0.1, 0.0], [0.1, 0.1], [0.0, 0.1]]
+
+
+@pytest.mark.parametrize("outline, says", [
+    (shapes.Outline(np.array([[0, 0], [0.1, 0], [np.nan, 0.1]])),
+     "outline.points has non-finite coordinates"),
+    (shapes.Outline(np.array([[0, 0], [0, 0.1], [0.1, 0]], float)),
+     "outline.points must run counter-clockwise around a positive area, got a signed area of "
+     "-0.005 m^2 (polygon() orients and checks its points)"),
+    (shapes.Outline(np.array([[0, 0], [0.1, 0], [0.2, 0]], float)),
+     "outline.points must run counter-clockwise around a positive area, got a signed area of "
+     "0 m^2 (polygon() orients and checks its points)"),
+    (shapes.Outline(np.array([[0, 0], [0.1, 0]], float)),
+     "outline.points must be an (N, 2) array of N >= 3 vertices (m), got shape (2, 2)"),
+    (shapes.Outline(np.array(SQUARE), (np.array([[0.02, 0.02], [0.05, np.inf], [0.02, 0.05]]),)),
+     "outline.holes[0] has non-finite coordinates"),
+    (SQUARE, "outline must be an Outline (e.g. polygon(points)), got list"),
+], ids=["nan", "clockwise", "flat", "two points", "hole inf", "a list"])
+def test_generate_mesh_refuses_an_outline_built_by_hand_by_name(outline, says):
+    """generate_mesh (public) checks an Outline the shape constructors did not make: before, a
+    NaN gave "spacing nan m is too coarse", a clockwise loop "boundary is not manifold", a flat
+    or two-point one a ZeroDivisionError, a list an AttributeError.
+    """
+    with pytest.raises(InvalidInputError) as refused:
+        generate_mesh(outline, 1e-4)
+    assert str(refused.value) == says

@@ -22,7 +22,12 @@ from squeeze_grasp_ros.mechanics.elastic.mesh_size import (
     check_mesh_size,
     estimate_mesh,
 )
-from squeeze_grasp_ros.mechanics.elastic.shapes import Outline, interior_point, signed_area
+from squeeze_grasp_ros.mechanics.elastic.shapes import (
+    Outline,
+    interior_point,
+    require_outline,
+    signed_area,
+)
 from squeeze_grasp_ros.mechanics.errors import InvalidInputError, require_finite
 
 ANGLE_SLACK = 1.0
@@ -217,7 +222,9 @@ def generate_mesh(
     Raises
     ------
     InvalidInputError
-        If ``max_area`` is not positive, ``min_angle`` is outside (0, 34] degrees (Triangle's
+        If ``outline`` is not an :class:`~.shapes.Outline` of finite loops, the outer one
+        counter-clockwise (:func:`~.shapes.require_outline`); if ``max_area`` is not
+        positive, ``min_angle`` is outside (0, 34] degrees (Triangle's
         guaranteed-termination range) or ``max_nodes`` is not an integer >= 3; if the mesh
         would have more than ``max_nodes`` nodes or more than
         :data:`~.mesh_size.MAX_BOUNDARY_NODES` boundary nodes, or a thin feature would more
@@ -232,6 +239,7 @@ def generate_mesh(
     >>> print(f"{element_areas(mesh.nodes, mesh.triangles).sum():.6f} m^2")
     0.005000 m^2
     """
+    require_outline(outline)
     require_finite("mesh.max_area", max_area)
     require_finite("mesh.min_angle", min_angle)
     if not max_area > 0:

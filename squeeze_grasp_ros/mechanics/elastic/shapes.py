@@ -145,6 +145,36 @@ def validate_polyline(points, name: str = "outline") -> np.ndarray:
     return p
 
 
+def require_outline(outline) -> None:
+    """Refuse anything but an :class:`Outline` with finite loops of at least 3 vertices, the
+    outer one counter-clockwise around a positive area: what :func:`polygon`,
+    :func:`load_outline` and the other constructors here give (an Outline built by hand skips
+    their checks).
+
+    Raises
+    ------
+    InvalidInputError
+        Naming the field (``outline.points``, ``outline.holes[k]``) and what it holds.
+    """
+    if not isinstance(outline, Outline):
+        raise InvalidInputError(
+            f"outline must be an Outline (e.g. polygon(points)), got {type(outline).__name__}")
+    loops = [("outline.points", outline.points),
+             *((f"outline.holes[{k}]", hole) for k, hole in enumerate(outline.holes))]
+    for name, loop in loops:
+        shape = np.shape(loop)
+        if len(shape) != 2 or shape[1] != 2 or shape[0] < 3:
+            raise InvalidInputError(f"{name} must be an (N, 2) array of N >= 3 vertices (m), "
+                                    f"got shape {shape}")
+        if not np.all(np.isfinite(loop)):
+            raise InvalidInputError(f"{name} has non-finite coordinates")
+    area = signed_area(np.asarray(outline.points, float))
+    if not area > 0:
+        raise InvalidInputError(
+            f"outline.points must run counter-clockwise around a positive area, got a signed "
+            f"area of {area:.3g} m^2 (polygon() orients and checks its points)")
+
+
 def _turning_corners(p: np.ndarray, threshold_deg: float = 20.0) -> np.ndarray:
     """Indices of vertices where the polyline turns by more than ``threshold_deg``."""
     e_in = p - np.roll(p, 1, axis=0)

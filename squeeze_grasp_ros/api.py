@@ -47,11 +47,19 @@ The same from its parts: the mesh, the fingers' initial contact nodes, the squee
 depth_reached A
 
 An object of your own, with no scene: a polygon (m, either orientation; checked to be simple),
-meshed; anything else is refused by name:
+meshed, and squeezed at the boundary nodes nearest two points of your choosing; anything but
+an outline is refused by name:
 
+>>> import numpy as np
 >>> square = polygon([[0, 0], [0.04, 0], [0.04, 0.04], [0, 0.04]])
->>> print(f"{square.area * 1e4:.1f} cm^2", len(generate_mesh(square, 2e-5).nodes) > 50)
-16.0 cm^2 True
+>>> mesh = generate_mesh(square, 2e-5)
+>>> def nearest(point):
+...     return int(mesh.boundary[np.argmin(np.hypot(*(mesh.nodes[mesh.boundary] - point).T))])
+>>> obj = ElasticObject(mesh, Material(E=1e5, nu=0.3, thickness=0.01))
+>>> squeeze = event_squeeze(obj, (nearest([0, 0.02]), nearest([0.04, 0.02])), 0.01, 0.4,
+...                         kind=SqueezeKind.PURE, relative_depth=0.05)
+>>> print(f"{square.area * 1e4:.1f} cm^2", squeeze.termination)
+16.0 cm^2 depth_reached
 >>> try:
 ...     generate_mesh([[0, 0], [0.04, 0], [0, 0.04]], 2e-5)
 ... except InvalidInputError as error:

@@ -15,10 +15,17 @@ docs/pipeline.md). Arguments: ``scene`` (default: the shipped foam square), ``re
 folder; empty: no recorder), ``include_hidden_topics`` (record the action's hidden topics too),
 ``rviz`` (start RViz2 with the shipped configuration), ``run``, ``on_slip_alarm``,
 ``max_attempts`` and ``resqueeze_margin`` (the executor's reaction to a slip alarm, as ``run``'s
-options of the same names, checked by it; empty: its defaults), ``namespace`` (empty: the
-nodes' own names at the root, which the RViz2 configuration expects, one such launch per ROS
-domain; ``namespace:=/lab/a``: every node, topic, service and ``/clock`` under ``/lab/a``, so
-launches in different namespaces share a domain without seeing each other).
+options of the same names, checked by run's parser before any node starts; empty: its
+defaults), ``namespace`` (empty: the nodes' own names at the root, which the RViz2 configuration
+expects, one such launch per ROS domain; ``namespace:=/lab/a``: every node, topic, service and
+``/clock`` under ``/lab/a``, so launches in different namespaces share a domain without seeing
+each other).
+
+The launch exits 0 when its run exits 0 (or, with ``run:=false``, when it is stopped). It exits
+1, shutting every node down, when an argument or the scene is refused, when the run exits
+otherwise (the grasp did not hold, ...), or when a pipeline node ends while the pipeline runs
+(a recorder that cannot write its folder: the others would wait for it for ever); launch's
+error line says which and why (:mod:`squeeze_grasp_ros.commands.launch_checks`).
 """
 import shutil
 from pathlib import Path
@@ -38,6 +45,12 @@ from launch.substitutions import LaunchConfiguration
 from launch_ros.actions import Node
 from launch_ros.substitutions import ExecutableInPackage
 
+from squeeze_grasp_ros.commands.launch_checks import (
+    RUN_ARGUMENTS,
+    node_ended,
+    run_arguments,
+    run_ended,
+)
 from squeeze_grasp_ros.resources import config_dir, scene_file, viewer_file
 from squeeze_grasp_ros.ros.run.options import RunOptions, node_parameters, without_run
 from squeeze_grasp_ros.scene import GraspSetup, load_scene
@@ -58,15 +71,47 @@ def rviz(enabled: str) -> list:
                            output="screen")]
 
 
+class PipelineEnded(RuntimeError):
+    """A pipeline node ended while the pipeline ran, or the run did not exit 0: launch logs it
+    and exits 1.
+    """
+
+
+def required(name: str):
+    """``on_exit`` of the node ``name``: ending before the launch shuts down (a recorder that
+    cannot write its folder, a node that crashed) ends the launch with exit status 1; the
+    others would wait for it for ever.
+    """
+    def on_exit(event, context):
+        if not context.is_shutdown:
+            raise PipelineEnded(node_ended(name, event.returncode))
+    return on_exit
+
+
+def run_exited(event, context):
+    """The run's end: shut the pipeline down; exit status 1 unless the run exited 0 (or was
+    stopped by a shutdown already under way, whose cause launch has logged).
+    """
+    if context.is_shutdown:
+        return None
+    failed = run_ended(event.returncode)
+    if failed:
+        raise PipelineEnded(failed)
+    return [LogInfo(msg="the run has ended; shutting the pipeline down"),
+            EmitEvent(event=Shutdown(reason="run finished"))]
+
+
 def nodes(context, *args, **kwargs):
     """One launch_ros Node per pipeline node, parameters as ``squeeze-grasp run`` sets them."""
+    run = LaunchConfiguration("run").perform(context).lower() in TRUE
+    reaction = run_arguments(**{name: LaunchConfiguration(name).perform(context)
+                                for name in RUN_ARGUMENTS}) if run else []
     scene_path = LaunchConfiguration("scene").perform(context) or str(scene_file("foam_square"))
     record = LaunchConfiguration("record").perform(context)
     hidden = LaunchConfiguration("include_hidden_topics").perform(context).lower() in TRUE
     setup = GraspSetup.build(load_scene(scene_path))
     options = RunOptions(scene_path, record=record or None, include_hidden_topics=hidden)
     params = node_parameters(setup.scene, scene_path, options, setup.motion.relative_per_depth)
-    run = LaunchConfiguration("run").perform(context).lower() in TRUE
     if not run:  # no run latches the prediction: a node awaiting it would never start the loop
         params = without_run(params)
     if not record:
@@ -78,23 +123,18 @@ def nodes(context, *args, **kwargs):
     actions = [LogInfo(msg=f"scene {scene_path}"),
                Node(package="squeeze_grasp_ros", executable="planner", name="planner",
                     parameters=[str(config_dir() / "planner.yaml"), {"allowed_roots": roots}],
-                    output="screen", **placed)]
+                    output="screen", on_exit=required("planner"), **placed)]
     for name, values in params.items():
         actions.append(Node(package="squeeze_grasp_ros", executable=name, name=name,
-                            parameters=[values], output="screen", **placed))
+                            parameters=[values], output="screen", on_exit=required(name),
+                            **placed))
     if run:
-        given = {name: LaunchConfiguration(name).perform(context)
-                 for name in ("on_slip_alarm", "max_attempts", "resqueeze_margin")}
-        reaction = [f"--{name.replace('_', '-')}={value}"
-                    for name, value in given.items() if value]
         client = ExecuteProcess(
             cmd=[ExecutableInPackage("squeeze-grasp", "squeeze_grasp_ros"), "run", scene_path,
                  "--attach", *reaction, *(["--namespace", namespace] if namespace else [])],
             output="screen", name="run")
-        actions += [client, RegisterEventHandler(OnProcessExit(
-            target_action=client,
-            on_exit=[LogInfo(msg="the run has ended; shutting the pipeline down"),
-                     EmitEvent(event=Shutdown(reason="run finished"))]))]
+        actions += [client, RegisterEventHandler(OnProcessExit(target_action=client,
+                                                               on_exit=run_exited))]
     return actions + rviz(LaunchConfiguration("rviz").perform(context))
 
 

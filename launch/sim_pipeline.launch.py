@@ -21,9 +21,11 @@ expects, one such launch per ROS domain; ``namespace:=/lab/a``: every node, topi
 ``/clock`` under ``/lab/a``, so launches in different namespaces share a domain without seeing
 each other).
 
-The launch exits 0 when its run exits 0 (or, with ``run:=false``, when it is stopped). It exits
-1, shutting every node down, when an argument or the scene is refused, when the run exits
-otherwise (the grasp did not hold, ...), or when a pipeline node ends while the pipeline runs
+The yes/no arguments (``run``, ``rviz``, ``include_hidden_topics``) take true/false, 1/0, yes/no
+or on/off; any other word is refused. The launch exits 0 when its run exits 0 (or, with
+``run:=false``, when it is stopped). It exits 1, shutting every node down, when an argument or
+the scene is refused, when the run exits otherwise (the grasp did not hold, ...), or when a
+pipeline node ends while the pipeline runs
 (a recorder that cannot write its folder: the others would wait for it for ever); launch's
 error line says which and why (:mod:`squeeze_grasp_ros.commands.launch_checks`).
 """
@@ -47,6 +49,7 @@ from launch_ros.substitutions import ExecutableInPackage
 
 from squeeze_grasp_ros.commands.launch_checks import (
     RUN_ARGUMENTS,
+    flag,
     node_ended,
     run_arguments,
     run_ended,
@@ -55,12 +58,10 @@ from squeeze_grasp_ros.resources import config_dir, scene_file, viewer_file
 from squeeze_grasp_ros.ros.run.options import RunOptions, node_parameters, without_run
 from squeeze_grasp_ros.scene import GraspSetup, load_scene
 
-TRUE = ("true", "1", "yes", "on")
-
 
 def rviz(enabled: str) -> list:
     """RViz2 with the shipped configuration, or a message saying why it does not start."""
-    if enabled.lower() not in TRUE:
+    if not flag("rviz", enabled):
         return []
     config = str(viewer_file("squeeze_grasp.rviz"))
     if shutil.which("rviz2") is None:
@@ -103,12 +104,13 @@ def run_exited(event, context):
 
 def nodes(context, *args, **kwargs):
     """One launch_ros Node per pipeline node, parameters as ``squeeze-grasp run`` sets them."""
-    run = LaunchConfiguration("run").perform(context).lower() in TRUE
+    run = flag("run", LaunchConfiguration("run").perform(context))
     reaction = run_arguments(**{name: LaunchConfiguration(name).perform(context)
                                 for name in RUN_ARGUMENTS}) if run else []
     scene_path = LaunchConfiguration("scene").perform(context) or str(scene_file("foam_square"))
     record = LaunchConfiguration("record").perform(context)
-    hidden = LaunchConfiguration("include_hidden_topics").perform(context).lower() in TRUE
+    hidden = flag("include_hidden_topics",
+                  LaunchConfiguration("include_hidden_topics").perform(context))
     setup = GraspSetup.build(load_scene(scene_path))
     options = RunOptions(scene_path, record=record or None, include_hidden_topics=hidden)
     params = node_parameters(setup.scene, scene_path, options, setup.motion.relative_per_depth)

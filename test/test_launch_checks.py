@@ -19,6 +19,7 @@ import pytest
 from squeeze_grasp_ros.commands import run
 from squeeze_grasp_ros.commands.launch_checks import (
     RUN_ARGUMENTS,
+    flag,
     node_ended,
     run_arguments,
     run_ended,
@@ -101,3 +102,30 @@ def test_the_launch_file_checks_its_run_arguments_and_requires_its_nodes():
     line = {getattr(c.func, "id", ""): c.lineno for c in ast.walk(functions["nodes"])
             if isinstance(c, ast.Call)}
     assert line["run_arguments"] < line["load_scene"]
+
+
+@pytest.mark.parametrize("text, value", [("true", True), ("True", True), ("1", True),
+                                         ("on", True), ("false", False), ("OFF", False),
+                                         ("0", False), ("no", False)])
+def test_a_yes_no_argument_takes_launch_words(text, value):
+    assert flag("run", text) is value
+
+
+@pytest.mark.parametrize("text", ["perhaps", "ture", "", "2", "y"])
+def test_a_yes_no_argument_refuses_other_words(text):
+    """Before, any other word was false: ``run:=ture`` started the nodes without a run, and
+    they waited for a goal nobody sent.
+    """
+    with pytest.raises(ValueError, match=rf"^run:={text}: must be true or false \(or 1, yes, "
+                                         r"on, 0, no, off\)$"):
+        flag("run", text)
+
+
+def test_the_launch_file_reads_every_yes_no_argument_with_flag():
+    tree = ast.parse(LAUNCH.read_text(encoding="utf-8"))
+    flagged = {c.args[0].value for c in ast.walk(tree) if isinstance(c, ast.Call)
+               and getattr(c.func, "id", "") == "flag"}
+    declared = {c.args[0].value for c in ast.walk(tree) if isinstance(c, ast.Call)
+                and getattr(c.func, "id", "") == "DeclareLaunchArgument"
+                and getattr(c.keywords[0].value, "value", None) in ("true", "false")}
+    assert flagged == declared == {"run", "rviz", "include_hidden_topics"}

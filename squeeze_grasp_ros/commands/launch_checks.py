@@ -24,7 +24,11 @@ import argparse
 
 from squeeze_grasp_ros.exit_codes import ExitCode
 
-__all__ = ["RUN_ARGUMENTS", "node_ended", "run_arguments", "run_ended"]
+__all__ = ["FLAG_WORDS", "RUN_ARGUMENTS", "flag", "node_ended", "run_arguments", "run_ended"]
+
+FLAG_WORDS = {"true": True, "1": True, "yes": True, "on": True,
+              "false": False, "0": False, "no": False, "off": False}
+"""The words a yes/no launch argument takes (any case)."""
 
 RUN_ARGUMENTS = ("on_slip_alarm", "max_attempts", "resqueeze_margin")
 """Launch arguments handed to ``squeeze-grasp run`` as the options of the same names."""
@@ -38,6 +42,28 @@ MEANINGS = {
     ExitCode.TERMINATED: "stopped by SIGTERM",
 }
 """What a run's exit status says, as the launch reports it."""
+
+
+def flag(name: str, text: str) -> bool:
+    """The yes/no launch argument ``name`` given as ``text`` (one of :data:`FLAG_WORDS`).
+
+    Raises
+    ------
+    ValueError
+        For any other word, naming the argument (``run:=ture`` would otherwise start the nodes
+        without a run, waiting for a goal nobody sends).
+
+    Examples
+    --------
+    >>> flag("run", "True"), flag("rviz", "off")
+    (True, False)
+    """
+    try:
+        return FLAG_WORDS[text.lower()]
+    except KeyError:
+        raise ValueError(f"{name}:={text[:40]}: must be true or false (or "
+                         f"{', '.join(w for w in FLAG_WORDS if w not in ('true', 'false'))})"
+                         ) from None
 
 
 def run_arguments(**given: str) -> list[str]:

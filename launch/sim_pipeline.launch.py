@@ -49,8 +49,9 @@ from launch_ros.substitutions import ExecutableInPackage
 
 from squeeze_grasp_ros.commands.launch_checks import (
     RUN_ARGUMENTS,
+    LaunchEnded,
     flag,
-    node_ended,
+    required,
     run_arguments,
     run_ended,
 )
@@ -72,23 +73,6 @@ def rviz(enabled: str) -> list:
                            output="screen")]
 
 
-class PipelineEnded(RuntimeError):
-    """A pipeline node ended while the pipeline ran, or the run did not exit 0: launch logs it
-    and exits 1.
-    """
-
-
-def required(name: str):
-    """``on_exit`` of the node ``name``: ending before the launch shuts down (a recorder that
-    cannot write its folder, a node that crashed) ends the launch with exit status 1; the
-    others would wait for it for ever.
-    """
-    def on_exit(event, context):
-        if not context.is_shutdown:
-            raise PipelineEnded(node_ended(name, event.returncode))
-    return on_exit
-
-
 def run_exited(event, context):
     """The run's end: shut the pipeline down; exit status 1 unless the run exited 0 (or was
     stopped by a shutdown already under way, whose cause launch has logged).
@@ -97,7 +81,7 @@ def run_exited(event, context):
         return None
     failed = run_ended(event.returncode)
     if failed:
-        raise PipelineEnded(failed)
+        raise LaunchEnded(failed)
     return [LogInfo(msg="the run has ended; shutting the pipeline down"),
             EmitEvent(event=Shutdown(reason="run finished"))]
 

@@ -13,20 +13,24 @@ from __future__ import annotations
 import argparse
 import ast
 from pathlib import Path
+from types import SimpleNamespace
 
 import pytest
 
 from squeeze_grasp_ros.commands import run
 from squeeze_grasp_ros.commands.launch_checks import (
     RUN_ARGUMENTS,
+    LaunchEnded,
     flag,
     node_ended,
+    required,
     run_arguments,
     run_ended,
 )
 from squeeze_grasp_ros.exit_codes import ExitCode
 
 LAUNCH = Path(__file__).resolve().parents[1] / "launch" / "sim_pipeline.launch.py"
+HARDWARE = LAUNCH.with_name("hardware.launch.py")
 
 
 def refused_by_run(option: str) -> bool:
@@ -129,3 +133,31 @@ def test_the_launch_file_reads_every_yes_no_argument_with_flag():
                 and getattr(c.func, "id", "") == "DeclareLaunchArgument"
                 and getattr(c.keywords[0].value, "value", None) in ("true", "false")}
     assert flagged == declared == {"run", "rviz", "include_hidden_topics"}
+
+
+def test_a_required_node_that_ends_ends_the_launch_unless_it_is_shutting_down():
+    """``required(name)`` is launch's ``on_exit(event, context)`` (ProcessExited has
+    ``returncode``, LaunchContext ``is_shutdown``).
+    """
+    on_exit = required("monitor")
+    with pytest.raises(LaunchEnded, match=r"^the monitor node exited 2 \(USAGE: "):
+        on_exit(SimpleNamespace(returncode=2), SimpleNamespace(is_shutdown=False))
+    with pytest.raises(LaunchEnded, match=r"^the monitor node exited 0 \(OK\) while"):
+        on_exit(SimpleNamespace(returncode=0), SimpleNamespace(is_shutdown=False))
+    assert on_exit(SimpleNamespace(returncode=-2), SimpleNamespace(is_shutdown=True)) is None
+
+
+def test_the_hardware_launch_requires_its_nodes_and_evaluates_no_python():
+    """Before, a monitor that refused ``mu:=abc`` left the executor commanding the fingers
+    without it, and ``record:=/data/bob's run`` failed in launch's PythonExpression
+    ("unterminated string literal").
+    """
+    tree = ast.parse(HARDWARE.read_text(encoding="utf-8"))
+    calls = [n for n in ast.walk(tree) if isinstance(n, ast.Call)]
+    nodes = [c for c in calls if getattr(c.func, "id", "") == "Node"]
+    names = [{k.arg: k.value for k in n.keywords}["name"].value for n in nodes]
+    assert names == ["planner", "monitor", "executor", "recorder"]
+    for node, name in zip(nodes, names):
+        on_exit = {k.arg: k.value for k in node.keywords}["on_exit"]
+        assert ast.unparse(on_exit) == f"required('{name}')"
+    assert "PythonExpression" not in {getattr(c.func, "id", "") for c in calls}

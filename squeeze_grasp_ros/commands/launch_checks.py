@@ -24,7 +24,8 @@ import argparse
 
 from squeeze_grasp_ros.exit_codes import ExitCode
 
-__all__ = ["FLAG_WORDS", "RUN_ARGUMENTS", "flag", "node_ended", "run_arguments", "run_ended"]
+__all__ = ["FLAG_WORDS", "RUN_ARGUMENTS", "LaunchEnded", "flag", "node_ended", "required",
+           "run_arguments", "run_ended"]
 
 FLAG_WORDS = {"true": True, "1": True, "yes": True, "on": True,
               "false": False, "0": False, "no": False, "off": False}
@@ -117,3 +118,25 @@ def node_ended(name: str, returncode: int) -> str:
     runs (its own message is in the log above).
     """
     return f"the {name} node exited {_status(returncode)} while the pipeline ran"
+
+
+class LaunchEnded(RuntimeError):
+    """A process of the launch ended as it should not have: launch logs this and exits 1."""
+
+
+def required(name: str):
+    """The ``on_exit`` of a launch's node ``name``: a node that ends before the launch shuts
+    down (a recorder that cannot write its folder, a monitor refusing its parameters, a crash)
+    ends the launch with exit status 1; the others would wait for it for ever, or go on without
+    it.
+
+    Returns
+    -------
+    callable
+        ``on_exit(event, context)`` of launch's ``ExecuteProcess``: raises :class:`LaunchEnded`
+        (:func:`node_ended`) unless ``context.is_shutdown``.
+    """
+    def on_exit(event, context) -> None:
+        if not context.is_shutdown:
+            raise LaunchEnded(node_ended(name, event.returncode))
+    return on_exit

@@ -3,6 +3,9 @@
 """Launch the planner with its parameter file.
 
 ``ros2 launch squeeze_grasp_ros planner.launch.py [params_file:=/path/to/planner.yaml]``
+
+A planner that ends before the launch is stopped (a parameter it refuses) ends the launch with
+exit status 1, naming it.
 """
 from pathlib import Path
 
@@ -12,6 +15,8 @@ from launch.actions import DeclareLaunchArgument
 from launch.substitutions import LaunchConfiguration
 from launch_ros.actions import Node
 
+from squeeze_grasp_ros.commands.launch_checks import required
+
 
 def generate_launch_description() -> LaunchDescription:
     """The planner node, parameters from ``params_file`` (default: the installed config)."""
@@ -20,5 +25,6 @@ def generate_launch_description() -> LaunchDescription:
         DeclareLaunchArgument("params_file", default_value=str(default),
                               description="parameter file of the planner node"),
         Node(package="squeeze_grasp_ros", executable="planner", name="planner",
-             parameters=[LaunchConfiguration("params_file")], output="screen"),
+             parameters=[LaunchConfiguration("params_file")], output="screen",
+             on_exit=required("planner")),
     ])

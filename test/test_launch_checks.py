@@ -81,7 +81,7 @@ def test_the_statuses_say_which_process_and_why():
     assert run_ended(7) == "the run exited 7"
     assert node_ended("recorder", ExitCode.USAGE) == (
         "the recorder node exited 2 (USAGE: invalid input; its message is above) while the "
-        "pipeline ran")
+        "launch ran")
 
 
 def test_the_launch_file_checks_its_run_arguments_and_requires_its_nodes():
@@ -145,6 +145,14 @@ def test_a_required_node_that_ends_ends_the_launch_unless_it_is_shutting_down():
     with pytest.raises(LaunchEnded, match=r"^the monitor node exited 0 \(OK\) while"):
         on_exit(SimpleNamespace(returncode=0), SimpleNamespace(is_shutdown=False))
     assert on_exit(SimpleNamespace(returncode=-2), SimpleNamespace(is_shutdown=True)) is None
+
+
+def test_the_planner_launch_requires_its_planner():
+    tree = ast.parse(LAUNCH.with_name("planner.launch.py").read_text(encoding="utf-8"))
+    [node] = [c for c in ast.walk(tree) if isinstance(c, ast.Call)
+              and getattr(c.func, "id", "") == "Node"]
+    assert ast.unparse({k.arg: k.value for k in node.keywords}["on_exit"]) == \
+        "required('planner')"
 
 
 def test_the_hardware_launch_requires_its_nodes_and_evaluates_no_python():

@@ -1,13 +1,14 @@
 # Copyright 2026 squeeze_grasp_ros developers
 # SPDX-License-Identifier: Apache-2.0
-"""What ``sim_pipeline.launch.py`` checks before it starts a node, and what it makes of a process
-that ends: plain functions, so that they are tested without ``launch`` installed.
+"""What the launch files check before they start a node, and what they make of a process that
+ends: plain functions, so that they are tested without ``launch`` installed.
 
-A launch argument for the run is checked by ``squeeze-grasp run``'s own parser before any node
-starts (a bad one ends the launch with exit status 1 and the parser's words). Once the nodes
-run, a pipeline node that exits before the launch shuts down, or a run that exits with a
-status other than 0, ends the launch with exit status 1 and a line saying which process and
-why; ``ros2 launch`` exits 0 only when the run did.
+A launch argument of ``sim_pipeline.launch.py`` for the run is checked by ``squeeze-grasp run``'s
+own parser before any node starts, and a yes/no argument by :func:`flag` (a bad one ends the
+launch with exit status 1 and the parser's words). Once the nodes run, a node of any of the
+launch files that exits before the launch shuts down (:func:`required`), or a run that exits
+with a status other than 0, ends the launch with exit status 1 and a line saying which process
+and why; ``ros2 launch`` exits 0 only when the run did.
 
 >>> run_arguments(on_slip_alarm="resqueeze", max_attempts="3", resqueeze_margin="")
 ['--on-slip-alarm=resqueeze', '--max-attempts=3']
@@ -114,10 +115,10 @@ def run_ended(returncode: int) -> str | None:
 
 
 def node_ended(name: str, returncode: int) -> str:
-    """Why the launch fails when the node ``name`` exits with ``returncode`` while the pipeline
+    """Why the launch fails when the node ``name`` exits with ``returncode`` while the launch
     runs (its own message is in the log above).
     """
-    return f"the {name} node exited {_status(returncode)} while the pipeline ran"
+    return f"the {name} node exited {_status(returncode)} while the launch ran"
 
 
 class LaunchEnded(RuntimeError):

@@ -186,6 +186,12 @@ def hostile_views():
         ("NaN in the object", nan_depth, "32FC1", {}, "invalid pixels"),
         ("tilted support", square.depth, "32FC1", {"pose": tilted}, "tilted"),
         ("non-planar support", bump, "32FC1", {}, "not planar"),
+        # the pose 1 cm too high, or 32FC1 depth written in mm: the support is shifted (before:
+        # accepted at z = 30 mm, or refused as "not planar ... holds no object")
+        ("camera height off by 1 cm", square.depth, "32FC1", {"pose": pose(height=0.51)},
+         r"support is \+10\.0 mm off the declared plane"),
+        ("32FC1 depth in mm", square.depth * np.float32(1000), "32FC1", {},
+         r"support is -4\d{5}\.\d mm off the declared plane .* 32FC1 in m"),
         ("depth of the wrong type", square.depth, "16UC1", {}, "must hold uint16"),
         ("far NaNs", far_nan, "32FC1", {}, None),
     ]

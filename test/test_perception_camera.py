@@ -15,6 +15,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from matplotlib.path import Path as MplPath
 
+from squeeze_grasp_ros.inputs import load_yaml
 from squeeze_grasp_ros.mechanics.elastic.shapes import (
     Outline,
     annulus,
@@ -96,6 +97,21 @@ def test_calibration_layouts_agree_and_bad_files_name_the_field():
                                         "d": [0, 0, 0, 0, 0, 0.1, 0, 0]})
     with pytest.raises(InvalidInputError, match="width must be an integer"):
         CameraModel(6.5, 480, fx=1.0, fy=1.0, cx=0.0, cy=0.0)
+
+
+def test_calibration_files_take_exponents_as_scenes_do():
+    """YAML 1.1 (PyYAML) reads ``-4e-2`` or ``1e3`` as text; a scene takes them as numbers, and
+    a calibration file read them as "k must be a list of numbers". A word in the list is named
+    by its index.
+    """
+    text = ("width: 640\nheight: 480\nk: [4.65e2, 0, 319.5, 0, 465, 239.5, 0, 0, 1]\n"
+            "d: [-4e-2, 1.2e-2, 4e-4, -3e-4, 0]\n")
+    camera = camera_from_info(load_yaml(text, what="camera info"))
+    assert camera.fx == 465.0 and camera.distortion == (-0.04, 0.012, 0.0004, -0.0003, 0.0)
+    with pytest.raises(InvalidInputError,
+                       match=r"camera info: distortion coefficients\[1\] must be a number, "
+                             "got 'x'"):
+        camera_from_info(load_yaml(text.replace("1.2e-2", "x"), what="camera info"))
 
 
 def test_an_uncalibrated_camera_info_says_so():

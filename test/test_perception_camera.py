@@ -184,6 +184,27 @@ def test_coverage_matches_exact_areas_and_a_supersampled_count():
         assert np.abs(cov - supersampled(loops, small.shape)).max() < 1.5 / 16
 
 
+def test_objects_reaching_far_out_of_view_render_what_the_camera_sees():
+    """An object far from the view, or a strip reaching 1 km beyond it, met the distortion
+    polynomial far outside its field: the pixels overflowed and ``render`` ended in a
+    MemoryError or "repeats may not contain negative values" (exit 1). Such loops are clipped
+    to the view first: the image is the same.
+    """
+    pose = CameraPose.looking_down(0.5)
+    far = render_views(rectangle(0.1, 0.1), DISTORTED, CameraPose.looking_down(0.5, x=100.0),
+                       top_height=0.02)
+    assert not far.coverage.any() and not far.mask.any()
+    strips = [render_views(Outline(np.array([[-w, -0.01], [w, -0.01], [w, 0.01], [-w, 0.01]])),
+                           camera, pose, top_height=0.0).coverage
+              for camera in (PINHOLE, DISTORTED) for w in (1.0, 1e3)]
+    assert strips[0].sum() == pytest.approx(640 * 20, rel=1e-12)  # 20 rows of the pinhole
+    assert np.array_equal(strips[0], strips[1])
+    assert np.abs(strips[2] - strips[3]).max() < 1e-9
+    with pytest.raises(InvalidInputError, match="behind the camera"):
+        render_views(rectangle(0.1, 0.1), DISTORTED, CameraPose.from_xyz_rpy(0, 0, 0.5, 1.6, 0, 0),
+                     top_height=0.0)
+
+
 def test_depth_mixes_the_two_heights_by_coverage_and_noise_is_seeded():
     pose = CameraPose.from_xyz_rpy(0.0, 0.0, 0.5, np.pi + 0.05, -0.03, 0.2)
     views = render_views(polygon([[-0.05, -0.04], [0.06, -0.05], [0.04, 0.05], [-0.05, 0.03]]),

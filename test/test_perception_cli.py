@@ -130,6 +130,9 @@ def test_render_says_when_the_object_is_out_of_view(tmp_path, capsys):
     assert cli.main(["render", str(scene_file("foam_square")), *away, "--mask", str(mask)]) == 0
     out = capsys.readouterr().out
     assert "covers 0.0 px (the object is out of view: the images show only the plane)" in out
+    far = [*away[:3], "1e9", *away[4:]]  # was a ValueError traceback, exit 1
+    assert cli.main(["render", str(scene_file("foam_square")), *far, "--mask", str(mask)]) == 0
+    assert "the object is out of view" in capsys.readouterr().out
     assert cli.main(["render", str(scene_file("foam_square")), *CAMERA, "--mask", str(mask)]) == 0
     assert "out of view" not in capsys.readouterr().out
 

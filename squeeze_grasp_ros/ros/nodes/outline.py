@@ -19,7 +19,8 @@ publishes ``outline/outline`` (``geometry_msgs/PolygonStamped``: the outer bound
 (``SeenOutline``: the same with the holes, area, tolerance and pixel size; what a client
 passes on to ``load_object``). A view that would give a wrong outline (no object, an object
 cut by the border, two similar blobs, a tilted support, NaNs next to the object, a wrong
-image size) publishes nothing on those topics: its reason goes to ``outline/errors``
+image size, an image whose ``header.frame_id`` is not its camera_info's) publishes nothing on
+those topics: its reason goes to ``outline/errors``
 (``std_msgs/String``, stamped in the text) and to the log (once until the reason changes).
 """
 from __future__ import annotations
@@ -93,6 +94,8 @@ class OutlineNode(Node):
         self.p = p = pipeline.declare(self, PARAMETERS, bounds=BOUNDS)
         self.pose = pose_parameter(list(p["camera_pose"]))
         self.camera: CameraModel | None = None
+        self.camera_frame = ""
+        """``header.frame_id`` of the camera_info in use ("" when it names none)."""
         self.last_error = ""
         depth = p["qos_depth"]
         self.create_subscription(Image, p["image_topic"], self._image, depth)
@@ -110,7 +113,7 @@ class OutlineNode(Node):
 
     def _info(self, msg: CameraInfo) -> None:
         try:
-            self.camera = camera_model(msg)
+            self.camera, self.camera_frame = camera_model(msg), msg.header.frame_id
         except InvalidInputError as error:
             self.camera = None
             self._refuse(msg.header.stamp, str(error))
@@ -129,6 +132,12 @@ class OutlineNode(Node):
         if self.camera is None or self.pose is None:
             self._refuse(msg.header.stamp, "no camera_info yet" if self.camera is None
                          else "no camera pose yet (parameter camera_pose or camera/pose)")
+            return
+        if msg.header.frame_id and self.camera_frame and msg.header.frame_id != self.camera_frame:
+            self._refuse(msg.header.stamp, f"image header.frame_id {msg.header.frame_id!r} is "
+                                           f"not the camera_info's {self.camera_frame!r}: the "
+                                           "image and the calibration come from different "
+                                           "cameras (publish both in the camera's optical frame)")
             return
         p = self.p
         try:

@@ -215,3 +215,33 @@ def test_an_image_from_another_camera_than_its_camera_info_is_refused(ros_contex
         assert len(seen) == 3
     finally:
         node.destroy_node()
+
+
+def test_images_after_a_refused_camera_info_say_why(ros_context):
+    """After a camera_info with fx = 0, each image was refused as 'no camera_info yet', though
+    one had arrived; now the refusal says the newest was refused and why.
+    """
+    skimage_or_skip()
+    from rclpy.parameter import Parameter
+
+    from squeeze_grasp_ros.ros.messages.images import camera_info_msg, image_msg
+    from squeeze_grasp_ros.ros.nodes.outline import OutlineNode
+
+    views = render_views(shapes.rectangle(0.1, 0.1), CAMERA, pose(), top_height=HEIGHT)
+    node = OutlineNode(context=ros_context, parameter_overrides=[
+        Parameter("camera_pose", value=[0.0, 0.0, 0.5, np.pi + 0.04, -0.02, 0.0]),
+        Parameter("object_height", value=HEIGHT)])
+    try:
+        node._image(image_msg(views.mask, ImageEncoding.MONO8, 1_000, CAMERA.frame_id))
+        assert node.last_error == "no camera_info yet"
+        info = camera_info_msg(CAMERA, 2_000)
+        info.k[0] = 0.0
+        node._info(info)
+        node._image(image_msg(views.mask, ImageEncoding.MONO8, 3_000, CAMERA.frame_id))
+        assert node.last_error == ("no usable camera_info: the newest was refused (camera_info: "
+                                   "camera fx must be a positive focal length in px, got 0.0)")
+        node._info(camera_info_msg(CAMERA, 4_000))
+        node._image(image_msg(views.mask, ImageEncoding.MONO8, 5_000, CAMERA.frame_id))
+        assert node.last_error == ""
+    finally:
+        node.destroy_node()

@@ -103,5 +103,8 @@ def camera_from_info(data: Any, *, what: str = "camera info") -> CameraModel:
     frame = frame if isinstance(frame, str) and frame else "camera_optical_frame"
     if not np.all(np.isfinite(k + d)):
         raise InvalidInputError(f"{what}: intrinsics and distortion must be finite")
-    return CameraModel(width, height, fx=k[0], fy=k[4], cx=k[2], cy=k[5], distortion=tuple(d),
-                       frame_id=frame)
+    try:
+        return CameraModel(width, height, fx=k[0], fy=k[4], cx=k[2], cy=k[5],
+                           distortion=tuple(d), frame_id=frame)
+    except InvalidInputError as error:  # e.g. fx <= 0: name the file or topic
+        raise InvalidInputError(f"{what}: {error}") from None

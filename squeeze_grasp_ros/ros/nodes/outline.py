@@ -96,6 +96,8 @@ class OutlineNode(Node):
         self.camera: CameraModel | None = None
         self.camera_frame = ""
         """``header.frame_id`` of the camera_info in use ("" when it names none)."""
+        self.camera_refused = ""
+        """Why the newest camera_info was refused ("" when it was not)."""
         self.last_error = ""
         depth = p["qos_depth"]
         self.create_subscription(Image, p["image_topic"], self._image, depth)
@@ -114,9 +116,10 @@ class OutlineNode(Node):
     def _info(self, msg: CameraInfo) -> None:
         try:
             self.camera, self.camera_frame = camera_model(msg), msg.header.frame_id
+            self.camera_refused = ""
         except InvalidInputError as error:
-            self.camera = None
-            self._refuse(msg.header.stamp, str(error))
+            self.camera, self.camera_refused = None, str(error)
+            self._refuse(msg.header.stamp, self.camera_refused)
 
     def _pose(self, msg: PoseStamped) -> None:
         if msg.header.frame_id != self.p["frame_id"]:
@@ -129,9 +132,14 @@ class OutlineNode(Node):
             self._refuse(msg.header.stamp, f"camera/pose: {error}")
 
     def _image(self, msg: Image) -> None:
-        if self.camera is None or self.pose is None:
-            self._refuse(msg.header.stamp, "no camera_info yet" if self.camera is None
-                         else "no camera pose yet (parameter camera_pose or camera/pose)")
+        if self.camera is None:
+            self._refuse(msg.header.stamp, f"no usable camera_info: the newest was refused "
+                         f"({self.camera_refused})" if self.camera_refused
+                         else "no camera_info yet")
+            return
+        if self.pose is None:
+            self._refuse(msg.header.stamp,
+                         "no camera pose yet (parameter camera_pose or camera/pose)")
             return
         if msg.header.frame_id and self.camera_frame and msg.header.frame_id != self.camera_frame:
             self._refuse(msg.header.stamp, f"image header.frame_id {msg.header.frame_id!r} is "

@@ -172,6 +172,8 @@ def hostile_views():
                        top_height=0.02)
     nan_depth = square.depth.copy()
     nan_depth[240, 320] = np.nan  # inside the object
+    negative = square.depth.copy()
+    negative[240, 320] = -0.48  # was called "(NaN, inf or 0)"
     far_nan = square.depth.copy()
     far_nan[5:20, 5:20] = np.nan  # far from it: tolerated
     tilted = pose(tilt=0.04 + np.radians(4.0))  # the support seen 4 deg off the declared pose
@@ -184,6 +186,8 @@ def hostile_views():
         ("wrong size", square.mask[:-1], "mono8", {}, "shape"),
         ("wrong type", square.mask.astype(np.int32), "mono8", {}, "must hold"),
         ("NaN in the object", nan_depth, "32FC1", {}, "invalid pixels"),
+        ("negative depth in the object", negative, "32FC1", {},
+         r"1 invalid pixels \(NaN, inf, 0 or negative\)"),
         ("tilted support", square.depth, "32FC1", {"pose": tilted}, "tilted"),
         ("non-planar support", bump, "32FC1", {}, "not planar"),
         # the pose 1 cm too high, or 32FC1 depth written in mm: the support is shifted (before:

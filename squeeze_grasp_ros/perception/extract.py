@@ -22,10 +22,10 @@ simplified vertices with corners where it would stray from the traced points
   or / 1 for a 0/1 mask) with the edge at half coverage, so an anti-aliased mask gives edges
   to a small fraction of a pixel and a binary one to about half a pixel. The mask is the
   object's top face at ``object_height_m`` above the plane.
-- **depth** (``16UC1`` mm, 0 invalid; ``32FC1`` m, NaN or 0 invalid): the support plane is
-  fitted and checked (:mod:`.support`); object pixels stand more than ``min_height_m`` above
-  it; the edge is at half the object's median height (a mixed pixel's height is its coverage
-  times the top height) and is met with the plane of the top face.
+- **depth** (``16UC1`` mm, 0 invalid; ``32FC1`` m, NaN, inf, 0 or negative invalid): the
+  support plane is fitted and checked (:mod:`.support`); object pixels stand more than
+  ``min_height_m`` above it; the edge is at half the object's median height (a mixed pixel's
+  height is its coverage times the top height) and is met with the plane of the top face.
 
 Views that would give a wrong outline are refused with :class:`InvalidInputError` naming the
 reason: wrong image size or type, no object, an object touching the border, two blobs of
@@ -484,6 +484,6 @@ def _check_invalid_near(valid: np.ndarray, choice: BlobChoice) -> None:
     if bad.any():
         r, c = np.argwhere(bad)[0]
         raise InvalidInputError(
-            f"depth image: {int(bad.sum())} invalid pixels (NaN, inf or 0) inside or next to "
-            f"the object (first at row {r + window[0].start}, column {c + window[1].start}): "
-            "its outline there is unknown")
+            f"depth image: {int(bad.sum())} invalid pixels (NaN, inf, 0 or negative) inside or "
+            f"next to the object (first at row {r + window[0].start}, column "
+            f"{c + window[1].start}): its outline there is unknown")

@@ -211,3 +211,19 @@ def test_bad_views_are_refused_with_the_reason(case):
         return
     with pytest.raises(InvalidInputError, match=message):
         extract_outline(image, encoding, CAMERA, view, **options)
+
+
+def test_a_depth_image_too_small_for_the_support_fit_says_so():
+    """A 32 x 24 px depth image holds 2 blocks of 16 x 16 px, all valid, and was refused for
+    'too few valid pixels'; now its size is named, with the smallest one that fits.
+    """
+    from squeeze_grasp_ros.perception.camera import CameraModel, CameraPose
+
+    tiny = CameraModel(32, 24, fx=30.0, fy=30.0, cx=15.5, cy=11.5)
+    view = CameraPose.looking_down(0.5)
+    depth = render_views(rectangle(0.1, 0.1), tiny, view, top_height=0.02).depth
+    assert np.all(np.isfinite(depth))
+    with pytest.raises(InvalidInputError, match=r"^depth image: 32 x 24 px is too small to see "
+                       r"the support plane: it holds 2 blocks of 16 x 16 px, the plane fit "
+                       r"needs 6 \(e\.g\. 48 x 32 px\)$"):
+        extract_outline(depth, "32FC1", tiny, view)

@@ -23,6 +23,9 @@ __all__ = ["BLOCK", "SupportPlane", "fit_support", "floor_grids"]
 BLOCK = 16
 """Side of the averaging blocks, px."""
 
+MIN_BLOCKS = 6
+"""Blocks at least half valid the support plane is fitted to, at least."""
+
 RANSAC_TRIALS = 64
 """Random block triples tried by the plane fit (seeded: the fit is deterministic)."""
 
@@ -123,10 +126,15 @@ def fit_support(heights: np.ndarray, valid: np.ndarray, camera: CameraModel, pos
     mean_h, count = _block_means(heights, valid)
     full = count >= BLOCK * BLOCK // 2
     x, y, h = bx[full], by[full], mean_h[full]
-    if len(h) < 6:
+    if full.size < MIN_BLOCKS:
+        raise InvalidInputError(f"depth image: {camera.width} x {camera.height} px is too small "
+                                f"to see the support plane: it holds {full.size} blocks of "
+                                f"{BLOCK} x {BLOCK} px, the plane fit needs {MIN_BLOCKS} (e.g. "
+                                f"{3 * BLOCK} x {2 * BLOCK} px)")
+    if len(h) < MIN_BLOCKS:
         raise InvalidInputError(f"depth image: too few valid pixels to see the support plane "
                                 f"({len(h)} blocks of {BLOCK} x {BLOCK} px at least half valid; "
-                                "need 6)")
+                                f"need {MIN_BLOCKS})")
     rng = np.random.default_rng(0)
     triples = rng.integers(0, len(h), size=(RANSAC_TRIALS, 3))
     A = np.stack([np.ones((RANSAC_TRIALS, 3)), x[triples], y[triples]], axis=2)

@@ -245,3 +245,40 @@ def test_images_after_a_refused_camera_info_say_why(ros_context):
         assert node.last_error == ""
     finally:
         node.destroy_node()
+
+
+def test_images_after_a_refused_camera_pose_are_refused_until_a_usable_one(ros_context):
+    """A camera/pose in another frame (or not a rotation) was refused once, and the images
+    after it were read with the last pose, though the camera may have moved; now they are
+    refused, naming why, until a usable pose arrives.
+    """
+    skimage_or_skip()
+    from geometry_msgs.msg import PoseStamped
+    from rclpy.parameter import Parameter
+
+    from squeeze_grasp_ros.ros import messages
+    from squeeze_grasp_ros.ros.messages.images import camera_info_msg, image_msg, pose_of_camera
+    from squeeze_grasp_ros.ros.nodes.outline import OutlineNode
+
+    view = pose()
+    views = render_views(shapes.rectangle(0.1, 0.1), CAMERA, view, top_height=HEIGHT)
+    node = OutlineNode(context=ros_context, parameter_overrides=[
+        Parameter("object_height", value=HEIGHT)])
+    seen = []
+    node.seen_pub.publish = seen.append
+    try:
+        node._info(camera_info_msg(CAMERA, 1_000))
+        moved = PoseStamped(header=messages.header(2_000, "world"), pose=pose_of_camera(view))
+        node._pose(PoseStamped(header=messages.header(2_000, "object"),
+                               pose=pose_of_camera(view)))
+        node._pose(moved)
+        node._image(image_msg(views.mask, ImageEncoding.MONO8, 3_000, CAMERA.frame_id))
+        assert not seen and node.last_error == (
+            "no usable camera pose: the newest was refused (camera/pose is in frame 'world', "
+            "not the plane frame 'object')")
+        node._pose(PoseStamped(header=messages.header(4_000, "object"),
+                               pose=pose_of_camera(view)))
+        node._image(image_msg(views.mask, ImageEncoding.MONO8, 5_000, CAMERA.frame_id))
+        assert len(seen) == 1 and node.last_error == ""
+    finally:
+        node.destroy_node()

@@ -11,7 +11,8 @@ Run it with ``ros2 run squeeze_grasp_ros outline --ros-args -p camera_pose:="[0.
   used for each image;
 - ``camera/pose`` (latched ``geometry_msgs/PoseStamped``, optional): the camera's optical
   frame in the plane frame; it replaces the ``camera_pose`` parameter once it arrives, and its
-  ``header.frame_id`` must be the node's ``frame_id``.
+  ``header.frame_id`` must be the node's ``frame_id``: after a refused one, images are refused
+  until a usable one arrives (the camera may have moved).
 
 For each image it runs :func:`~squeeze_grasp_ros.perception.extract.extract_outline` and
 publishes ``outline/outline`` (``geometry_msgs/PolygonStamped``: the outer boundary, m, in
@@ -98,6 +99,8 @@ class OutlineNode(Node):
         """``header.frame_id`` of the camera_info in use ("" when it names none)."""
         self.camera_refused = ""
         """Why the newest camera_info was refused ("" when it was not)."""
+        self.pose_refused = ""
+        """Why the newest camera/pose was refused ("" when it was not)."""
         self.last_error = ""
         depth = p["qos_depth"]
         self.create_subscription(Image, p["image_topic"], self._image, depth)
@@ -123,13 +126,15 @@ class OutlineNode(Node):
 
     def _pose(self, msg: PoseStamped) -> None:
         if msg.header.frame_id != self.p["frame_id"]:
-            self._refuse(msg.header.stamp, f"camera/pose is in frame {msg.header.frame_id!r}, "
-                                           f"not the plane frame {self.p['frame_id']!r}")
-            return
-        try:
-            self.pose = camera_pose(msg.pose)
-        except InvalidInputError as error:
-            self._refuse(msg.header.stamp, f"camera/pose: {error}")
+            self.pose_refused = (f"camera/pose is in frame {msg.header.frame_id!r}, not the "
+                                 f"plane frame {self.p['frame_id']!r}")
+        else:
+            try:
+                self.pose, self.pose_refused = camera_pose(msg.pose), ""
+            except InvalidInputError as error:
+                self.pose_refused = f"camera/pose: {error}"
+        if self.pose_refused:  # the camera may have moved: no outline until a usable pose
+            self._refuse(msg.header.stamp, self.pose_refused)
 
     def _image(self, msg: Image) -> None:
         if self.camera is None:
@@ -137,9 +142,10 @@ class OutlineNode(Node):
                          f"({self.camera_refused})" if self.camera_refused
                          else "no camera_info yet")
             return
-        if self.pose is None:
-            self._refuse(msg.header.stamp,
-                         "no camera pose yet (parameter camera_pose or camera/pose)")
+        if self.pose is None or self.pose_refused:
+            self._refuse(msg.header.stamp, f"no usable camera pose: the newest was refused "
+                         f"({self.pose_refused})" if self.pose_refused
+                         else "no camera pose yet (parameter camera_pose or camera/pose)")
             return
         if msg.header.frame_id and self.camera_frame and msg.header.frame_id != self.camera_frame:
             self._refuse(msg.header.stamp, f"image header.frame_id {msg.header.frame_id!r} is "

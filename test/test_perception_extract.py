@@ -227,3 +227,22 @@ def test_a_depth_image_too_small_for_the_support_fit_says_so():
                        r"the support plane: it holds 2 blocks of 16 x 16 px, the plane fit "
                        r"needs 6 \(e\.g\. 48 x 32 px\)$"):
         extract_outline(depth, "32FC1", tiny, view)
+
+
+@pytest.mark.parametrize("side, blur, noise", [(0.01, 2.0, 0.2), (0.1, 20.0, 0.05)])
+def test_a_noisy_trace_whose_every_point_is_near_a_kink_gives_an_outline(side, blur, noise):
+    """Noisy, blurred masks whose trace kinks everywhere left the smoothing spline no traced
+    point to fit (all within 2 px of a corner), and extract_outline ended in numpy's 'zero-size
+    array to reduction operation maximum' ValueError; the fit now gives way to the spline
+    through the simplified vertices.
+    """
+    skimage_or_skip()
+    from squeeze_grasp_ros.perception.camera import CameraModel, CameraPose
+
+    camera = CameraModel(640, 480, fx=465.0, fy=465.0, cx=319.5, cy=239.5,
+                         distortion=(-0.04, 0.012, 0.0004, -0.0003, 0.0))
+    view = CameraPose.looking_down(0.5)
+    mask = render_views(rectangle(side, side), camera, view, top_height=0.02, blur_px=blur,
+                        mask_noise=noise, seed=1).mask
+    found = extract_outline(mask, "mono8", camera, view, object_height_m=0.02)
+    assert found.outline.area == pytest.approx(side * side, rel=0.3)

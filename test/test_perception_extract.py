@@ -176,6 +176,11 @@ def hostile_views():
     negative[240, 320] = -0.48  # was called "(NaN, inf or 0)"
     far_nan = square.depth.copy()
     far_nan[5:20, 5:20] = np.nan  # far from it: tolerated
+    ones = (square.mask >= 128).astype(np.uint8)  # a 0/1 mask
+    speck = ones.copy()
+    speck[5:9, 5:9] = 255  # one 255 speck: it was the object, 16 px
+    labels = ones.copy()
+    labels[400:440, 40:90] = 2  # a label image: it read as empty, "no object in view"
     tilted = pose(tilt=0.04 + np.radians(4.0))  # the support seen 4 deg off the declared pose
     bump = square.depth.copy()
     bump[400:470, 40:200] -= 0.003  # a 3 mm step of the support
@@ -183,6 +188,8 @@ def hostile_views():
         ("empty mask", np.zeros(CAMERA.shape, np.uint8), "mono8", {}, "no object in view"),
         ("cut by the border", cut.mask, "mono8", {}, "touches the image border"),
         ("two equal blobs", np.maximum(twins.mask, other.mask), "mono8", {}, "ambiguous"),
+        ("0/1 mask with 255s", speck, "mono8", {}, "px of value 1 form one region"),
+        ("label image", labels, "mono8", {}, "its largest value is 2"),
         ("wrong size", square.mask[:-1], "mono8", {}, "shape"),
         ("wrong type", square.mask.astype(np.int32), "mono8", {}, "must hold"),
         ("NaN in the object", nan_depth, "32FC1", {}, "invalid pixels"),

@@ -239,6 +239,38 @@ def _mask_level(mask: np.ndarray) -> float:
     return 0.5 if mask.dtype == np.bool_ or mask.max() <= 1 else 127.5
 
 
+def _check_mask_values(mask: np.ndarray, level: float) -> None:
+    """Refuse a mask whose values never reach the edge ``level`` though some are not 0 (a label
+    image such as 0/1/2, or a dim mask): it would read as empty.
+    """
+    top = int(mask.max())
+    if 0 < top < level:
+        raise InvalidInputError(
+            f"mask: its largest value is {top}, below the edge level {level:g} (half of 255): a "
+            "mask holds 0/1 or 0-255 coverage of one object; a label image (0/1/2...), a dim "
+            "mask or an object blurred away reads as empty")
+
+
+def _check_ones(mask: np.ndarray, level: float, object_px: int) -> None:
+    """Refuse a 0-255 mask in which pixels of value 1 form a region at least as large as the
+    object (``object_px`` px at or above ``level``): a 0/1 mask mixed with 255s (a void label
+    around the object, a speck), whose object would be the 255s. An anti-aliased or noisy
+    0-255 mask has value 1 only on thin edge bands or scattered pixels.
+    """
+    from scipy import ndimage
+
+    ones = mask == 1
+    if level <= 1 or np.count_nonzero(ones) < object_px:  # one pass; labels only if needed
+        return
+    labels, count = ndimage.label(ones)
+    largest = int(np.bincount(labels.ravel())[1:].max()) if count else 0
+    if largest >= object_px:
+        raise InvalidInputError(
+            f"mask: {largest} px of value 1 form one region, as large as the object would be "
+            f"({object_px} px of values >= {level:g}): the mask mixes 0/1 with 255 (a void "
+            "label, a speck) and its object would be the 255s; give 0/1 or 0-255 values only")
+
+
 def _depth_metres(depth: np.ndarray, encoding: ImageEncoding) -> np.ndarray:
     if encoding == ImageEncoding.DEPTH_16UC1:
         metres = depth.astype(np.float32) * np.float32(1e-3)
@@ -431,8 +463,10 @@ def extract_outline(image: np.ndarray, encoding: ImageEncoding | str, camera: Ca
     support = None
     if encoding == ImageEncoding.MONO8:
         field, level, plane_height = image, _mask_level(image), object_height_m
+        _check_mask_values(image, level)
         choice = choose_object(field >= level, min_area_px=min_area_px,
                                ambiguous_ratio=ambiguous_ratio, what=what)
+        _check_ones(image, level, choice.blob.area_px)
     else:
         depth = _depth_metres(image, encoding)
         valid = np.isfinite(depth) & (depth > 0)

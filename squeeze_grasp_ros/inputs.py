@@ -25,7 +25,7 @@ from typing import Any
 import yaml
 
 __all__ = ["InputError", "MAX_FILE_BYTES", "MAX_TEXT_BYTES", "SHOWN_CHARS", "confine",
-           "load_yaml", "read_bytes", "read_text", "shown"]
+           "load_yaml", "read_bytes", "read_text", "shown", "yaml11_number"]
 
 SHOWN_CHARS = 40
 """Most characters of a client's string that a message or log line quotes."""
@@ -41,6 +41,24 @@ def shown(value: str, limit: int = SHOWN_CHARS) -> str:
         return repr(value)
     text = repr(value[:limit])
     return f"{text[:-1]}...{text[-1]} ({len(value)} characters)"
+
+
+def yaml11_number(value: Any) -> Any:
+    """``value`` as a float when it is text that reads as a number, else ``value`` unchanged.
+
+    YAML 1.1 (PyYAML) reads a number with an exponent as a float only with both a dot and a
+    signed exponent (``5.0e+4``), so ``5e4``, ``1e-3`` and ``5.0e4`` arrive as strings; a parsed
+    YAML value passes through this before its type is checked.
+
+    >>> yaml11_number("5e4"), yaml11_number(3), yaml11_number("five")
+    (50000.0, 3, 'five')
+    """
+    if isinstance(value, str):
+        try:
+            return float(value)
+        except ValueError:
+            return value
+    return value
 
 
 MAX_FILE_BYTES = 8 * 1024 * 1024

@@ -365,6 +365,25 @@ def test_the_camera_closed_run_matches_the_yaml_route(tmp_path):
         assert decoded[topic]["decoded"] == decoded[topic]["messages"] == len(images[topic])
 
 
+def test_a_camera_closed_scene_whose_camera_sees_no_object_is_invalid_input(tmp_path, capfd):
+    """A scene whose camera looks 2 m beside its object ended run with exit 4, 'not the user's
+    fault'; the view is the scene's, so it is exit 2 naming camera.plan_from_images and what to
+    check.
+    """
+    skimage_or_skip()
+    from squeeze_grasp_ros import cli
+
+    data = yaml.safe_load(CAMERA_SCENE.read_text())
+    data["camera"]["pose"] = [2.0, 0.0, 0.5, 3.14159265, 0.0, 0.0]
+    path = tmp_path / "away.yaml"
+    path.write_text(yaml.safe_dump(data))
+    assert cli.main(["run", str(path)]) == 2
+    err = capfd.readouterr().err
+    assert len(err.strip().splitlines()) == 1, err
+    assert ("camera.plan_from_images: the first frame gives no outline: mask: no object in view"
+            in err and "check the scene's camera (camera.pose" in err)
+
+
 def test_the_camera_closed_run_of_a_stadium_plans_the_worlds_events(tmp_path):
     """A mixed outline on the camera route (issue 32's target): the stadium of
     ``test_perception_mixed.py`` (the true shape a dense spline) squeezed across its straight

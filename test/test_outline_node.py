@@ -105,12 +105,12 @@ def test_the_outline_node_publishes_the_seen_outline(ros_context):
     try:
         spin_until(lambda: images.get_subscription_count() and infos.get_subscription_count(),
                    "the node's subscriptions")
-        images.publish(image_msg(views.mask, ImageEncoding.MONO8, 1_000, "cam"))
+        images.publish(image_msg(views.mask, ImageEncoding.MONO8, 1_000, CAMERA.frame_id))
         spin_until(lambda: got["errors"], "the refusal without camera_info")
         assert "no camera_info yet" in got["errors"][0].data
         infos.publish(camera_info_msg(CAMERA, 2_000))
         spin_until(lambda: node.camera is not None, "the camera info")
-        images.publish(image_msg(views.mask, ImageEncoding.MONO8, 3_000, "cam"))
+        images.publish(image_msg(views.mask, ImageEncoding.MONO8, 3_000, CAMERA.frame_id))
         spin_until(lambda: got["seen"] and got["outline"], "the outline")
         seen = got["seen"][0]
         assert seen.outline.header.frame_id == "object" and seen.encoding == "mono8"
@@ -128,15 +128,16 @@ def test_the_outline_node_publishes_the_seen_outline(ros_context):
 
         depth = render_views(truth, CAMERA, view_pose, top_height=HEIGHT,
                              depth_noise_m=0.0005, seed=2)
-        images.publish(image_msg(depth.depth_mm(), ImageEncoding.DEPTH_16UC1, 4_000, "cam"))
+        images.publish(image_msg(depth.depth_mm(), ImageEncoding.DEPTH_16UC1, 4_000,
+                                 CAMERA.frame_id))
         spin_until(lambda: len(got["seen"]) == 2, "the outline of the depth image")
         empty = np.zeros_like(views.mask)
-        images.publish(image_msg(empty, ImageEncoding.MONO8, 5_000, "cam"))
+        images.publish(image_msg(empty, ImageEncoding.MONO8, 5_000, CAMERA.frame_id))
         spin_until(lambda: len(got["errors"]) == 2, "the empty view's refusal")
         assert "no object" in got["errors"][1].data and len(got["seen"]) == 2
         cut = np.zeros_like(views.mask)
         cut[:, :100] = 255
-        images.publish(image_msg(cut, ImageEncoding.MONO8, 6_000, "cam"))
+        images.publish(image_msg(cut, ImageEncoding.MONO8, 6_000, CAMERA.frame_id))
         spin_until(lambda: len(got["errors"]) == 3, "the border view's refusal")
         assert "border" in got["errors"][2].data
     finally:
@@ -175,5 +176,109 @@ def test_a_camera_whose_undistortion_diverges_is_refused_not_raised(ros_context)
         node.camera = replace(CAMERA, distortion=(100.0, 100.0, 0.0, 0.0, 100.0))
         node._image(image_msg(views.mask, ImageEncoding.MONO8, 1_000, "cam"))
         assert "undistortion did not converge" in node.last_error
+    finally:
+        node.destroy_node()
+
+
+def test_an_image_from_another_camera_than_its_camera_info_is_refused(ros_context):
+    """An image whose ``header.frame_id`` is not its camera_info's was read with that other
+    camera's calibration, and its outline published; now it is refused by both frames. An
+    image or camera_info that names no frame is read as before.
+    """
+    skimage_or_skip()
+    from rclpy.parameter import Parameter
+
+    from squeeze_grasp_ros.ros.messages.images import camera_info_msg, image_msg
+    from squeeze_grasp_ros.ros.nodes.outline import OutlineNode
+
+    views = render_views(shapes.rectangle(0.1, 0.1), CAMERA, pose(), top_height=HEIGHT)
+    node = OutlineNode(context=ros_context, parameter_overrides=[
+        Parameter("camera_pose", value=[0.0, 0.0, 0.5, np.pi + 0.04, -0.02, 0.0]),
+        Parameter("object_height", value=HEIGHT)])
+    seen = []
+    node.seen_pub.publish = seen.append
+    try:
+        info = camera_info_msg(CAMERA, 1_000)
+        info.header.frame_id = "top_optical"
+        node._info(info)
+        node._image(image_msg(views.mask, ImageEncoding.MONO8, 2_000, "side_optical"))
+        assert not seen
+        assert node.last_error == ("image header.frame_id 'side_optical' is not the "
+                                   "camera_info's 'top_optical': the image and the calibration "
+                                   "come from different cameras (publish both in the camera's "
+                                   "optical frame)")
+        for frame in ("top_optical", ""):
+            node._image(image_msg(views.mask, ImageEncoding.MONO8, 3_000, frame))
+        info.header.frame_id = ""
+        node._info(info)
+        node._image(image_msg(views.mask, ImageEncoding.MONO8, 4_000, "side_optical"))
+        assert len(seen) == 3
+    finally:
+        node.destroy_node()
+
+
+def test_images_after_a_refused_camera_info_say_why(ros_context):
+    """After a camera_info with fx = 0, each image was refused as 'no camera_info yet', though
+    one had arrived; now the refusal says the newest was refused and why.
+    """
+    skimage_or_skip()
+    from rclpy.parameter import Parameter
+
+    from squeeze_grasp_ros.ros.messages.images import camera_info_msg, image_msg
+    from squeeze_grasp_ros.ros.nodes.outline import OutlineNode
+
+    views = render_views(shapes.rectangle(0.1, 0.1), CAMERA, pose(), top_height=HEIGHT)
+    node = OutlineNode(context=ros_context, parameter_overrides=[
+        Parameter("camera_pose", value=[0.0, 0.0, 0.5, np.pi + 0.04, -0.02, 0.0]),
+        Parameter("object_height", value=HEIGHT)])
+    try:
+        node._image(image_msg(views.mask, ImageEncoding.MONO8, 1_000, CAMERA.frame_id))
+        assert node.last_error == "no camera_info yet"
+        info = camera_info_msg(CAMERA, 2_000)
+        info.k[0] = 0.0
+        node._info(info)
+        node._image(image_msg(views.mask, ImageEncoding.MONO8, 3_000, CAMERA.frame_id))
+        assert node.last_error == ("no usable camera_info: the newest was refused (camera_info: "
+                                   "camera fx must be a positive focal length in px, got 0.0)")
+        node._info(camera_info_msg(CAMERA, 4_000))
+        node._image(image_msg(views.mask, ImageEncoding.MONO8, 5_000, CAMERA.frame_id))
+        assert node.last_error == ""
+    finally:
+        node.destroy_node()
+
+
+def test_images_after_a_refused_camera_pose_are_refused_until_a_usable_one(ros_context):
+    """A camera/pose in another frame (or not a rotation) was refused once, and the images
+    after it were read with the last pose, though the camera may have moved; now they are
+    refused, naming why, until a usable pose arrives.
+    """
+    skimage_or_skip()
+    from geometry_msgs.msg import PoseStamped
+    from rclpy.parameter import Parameter
+
+    from squeeze_grasp_ros.ros import messages
+    from squeeze_grasp_ros.ros.messages.images import camera_info_msg, image_msg, pose_of_camera
+    from squeeze_grasp_ros.ros.nodes.outline import OutlineNode
+
+    view = pose()
+    views = render_views(shapes.rectangle(0.1, 0.1), CAMERA, view, top_height=HEIGHT)
+    node = OutlineNode(context=ros_context, parameter_overrides=[
+        Parameter("object_height", value=HEIGHT)])
+    seen = []
+    node.seen_pub.publish = seen.append
+    try:
+        node._info(camera_info_msg(CAMERA, 1_000))
+        moved = PoseStamped(header=messages.header(2_000, "world"), pose=pose_of_camera(view))
+        node._pose(PoseStamped(header=messages.header(2_000, "object"),
+                               pose=pose_of_camera(view)))
+        node._pose(moved)
+        node._image(image_msg(views.mask, ImageEncoding.MONO8, 3_000, CAMERA.frame_id))
+        assert not seen and node.last_error == (
+            "no usable camera pose: the newest was refused (camera/pose is in frame 'world', "
+            "not the plane frame 'object')")
+        node._pose(PoseStamped(header=messages.header(4_000, "object"),
+                               pose=pose_of_camera(view)))
+        node._image(image_msg(views.mask, ImageEncoding.MONO8, 5_000, CAMERA.frame_id))
+        assert len(seen) == 1 and node.last_error == ""
     finally:
         node.destroy_node()

@@ -15,6 +15,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from matplotlib.path import Path as MplPath
 
+from squeeze_grasp_ros.inputs import load_yaml
 from squeeze_grasp_ros.mechanics.elastic.shapes import (
     Outline,
     annulus,
@@ -98,6 +99,21 @@ def test_calibration_layouts_agree_and_bad_files_name_the_field():
         CameraModel(6.5, 480, fx=1.0, fy=1.0, cx=0.0, cy=0.0)
 
 
+def test_calibration_files_take_exponents_as_scenes_do():
+    """YAML 1.1 (PyYAML) reads ``-4e-2`` or ``1e3`` as text; a scene takes them as numbers, and
+    a calibration file read them as "k must be a list of numbers". A word in the list is named
+    by its index.
+    """
+    text = ("width: 640\nheight: 480\nk: [4.65e2, 0, 319.5, 0, 465, 239.5, 0, 0, 1]\n"
+            "d: [-4e-2, 1.2e-2, 4e-4, -3e-4, 0]\n")
+    camera = camera_from_info(load_yaml(text, what="camera info"))
+    assert camera.fx == 465.0 and camera.distortion == (-0.04, 0.012, 0.0004, -0.0003, 0.0)
+    with pytest.raises(InvalidInputError,
+                       match=r"camera info: distortion coefficients\[1\] must be a number, "
+                             "got 'x'"):
+        camera_from_info(load_yaml(text.replace("1.2e-2", "x"), what="camera info"))
+
+
 def test_an_uncalibrated_camera_info_says_so():
     """A driver without a calibration publishes CameraInfo with k all zero and d empty; the
     error used to ask for an intrinsics matrix without skew.
@@ -166,6 +182,27 @@ def test_coverage_matches_exact_areas_and_a_supersampled_count():
         area_px = shape.area * (300 / 0.5) ** 2  # the view is a similarity: exact
         assert cov.sum() == pytest.approx(area_px, rel=1e-9)
         assert np.abs(cov - supersampled(loops, small.shape)).max() < 1.5 / 16
+
+
+def test_objects_reaching_far_out_of_view_render_what_the_camera_sees():
+    """An object far from the view, or a strip reaching 1 km beyond it, met the distortion
+    polynomial far outside its field: the pixels overflowed and ``render`` ended in a
+    MemoryError or "repeats may not contain negative values" (exit 1). Such loops are clipped
+    to the view first: the image is the same.
+    """
+    pose = CameraPose.looking_down(0.5)
+    far = render_views(rectangle(0.1, 0.1), DISTORTED, CameraPose.looking_down(0.5, x=100.0),
+                       top_height=0.02)
+    assert not far.coverage.any() and not far.mask.any()
+    strips = [render_views(Outline(np.array([[-w, -0.01], [w, -0.01], [w, 0.01], [-w, 0.01]])),
+                           camera, pose, top_height=0.0).coverage
+              for camera in (PINHOLE, DISTORTED) for w in (1.0, 1e3)]
+    assert strips[0].sum() == pytest.approx(640 * 20, rel=1e-12)  # 20 rows of the pinhole
+    assert np.array_equal(strips[0], strips[1])
+    assert np.abs(strips[2] - strips[3]).max() < 1e-9
+    with pytest.raises(InvalidInputError, match="behind the camera"):
+        render_views(rectangle(0.1, 0.1), DISTORTED, CameraPose.from_xyz_rpy(0, 0, 0.5, 1.6, 0, 0),
+                     top_height=0.0)
 
 
 def test_depth_mixes_the_two_heights_by_coverage_and_noise_is_seeded():

@@ -130,8 +130,24 @@ def test_render_says_when_the_object_is_out_of_view(tmp_path, capsys):
     assert cli.main(["render", str(scene_file("foam_square")), *away, "--mask", str(mask)]) == 0
     out = capsys.readouterr().out
     assert "covers 0.0 px (the object is out of view: the images show only the plane)" in out
+    far = [*away[:3], "1e9", *away[4:]]  # was a ValueError traceback, exit 1
+    assert cli.main(["render", str(scene_file("foam_square")), *far, "--mask", str(mask)]) == 0
+    assert "the object is out of view" in capsys.readouterr().out
     assert cli.main(["render", str(scene_file("foam_square")), *CAMERA, "--mask", str(mask)]) == 0
     assert "out of view" not in capsys.readouterr().out
+
+
+def test_render_refuses_a_png_depth_beyond_16uc1(tmp_path, capsys):
+    """A camera 70 m up wrote a 16UC1 PNG of zeros (every pixel invalid) and exit 0."""
+    high = ["--camera-info", CAMERA[1], "--camera-pose", "0", "0", "70", "3.14159265", "0", "0"]
+    png, npy = tmp_path / "depth.png", tmp_path / "depth.npy"
+    code = cli.main(["render", str(scene_file("foam_square")), *high, "--depth", str(png)])
+    err = capsys.readouterr().err
+    assert code == 2 and len(err.strip().splitlines()) == 1, err
+    assert "the depth reaches 70 m, beyond what 16UC1 holds" in err and "write .npy" in err
+    assert not png.exists()
+    assert cli.main(["render", str(scene_file("foam_square")), *high, "--depth", str(npy)]) == 0
+    assert np.load(npy).max() == pytest.approx(70.0)  # the plane; the object 25.4 mm nearer
 
 
 def test_an_npy_name_on_another_format_is_refused_with_one_line(tmp_path, capsys):

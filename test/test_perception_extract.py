@@ -172,8 +172,15 @@ def hostile_views():
                        top_height=0.02)
     nan_depth = square.depth.copy()
     nan_depth[240, 320] = np.nan  # inside the object
+    negative = square.depth.copy()
+    negative[240, 320] = -0.48  # was called "(NaN, inf or 0)"
     far_nan = square.depth.copy()
     far_nan[5:20, 5:20] = np.nan  # far from it: tolerated
+    ones = (square.mask >= 128).astype(np.uint8)  # a 0/1 mask
+    speck = ones.copy()
+    speck[5:9, 5:9] = 255  # one 255 speck: it was the object, 16 px
+    labels = ones.copy()
+    labels[400:440, 40:90] = 2  # a label image: it read as empty, "no object in view"
     tilted = pose(tilt=0.04 + np.radians(4.0))  # the support seen 4 deg off the declared pose
     bump = square.depth.copy()
     bump[400:470, 40:200] -= 0.003  # a 3 mm step of the support
@@ -181,11 +188,21 @@ def hostile_views():
         ("empty mask", np.zeros(CAMERA.shape, np.uint8), "mono8", {}, "no object in view"),
         ("cut by the border", cut.mask, "mono8", {}, "touches the image border"),
         ("two equal blobs", np.maximum(twins.mask, other.mask), "mono8", {}, "ambiguous"),
+        ("0/1 mask with 255s", speck, "mono8", {}, "px of value 1 form one region"),
+        ("label image", labels, "mono8", {}, "its largest value is 2"),
         ("wrong size", square.mask[:-1], "mono8", {}, "shape"),
         ("wrong type", square.mask.astype(np.int32), "mono8", {}, "must hold"),
         ("NaN in the object", nan_depth, "32FC1", {}, "invalid pixels"),
+        ("negative depth in the object", negative, "32FC1", {},
+         r"1 invalid pixels \(NaN, inf, 0 or negative\)"),
         ("tilted support", square.depth, "32FC1", {"pose": tilted}, "tilted"),
         ("non-planar support", bump, "32FC1", {}, "not planar"),
+        # the pose 1 cm too high, or 32FC1 depth written in mm: the support is shifted (before:
+        # accepted at z = 30 mm, or refused as "not planar ... holds no object")
+        ("camera height off by 1 cm", square.depth, "32FC1", {"pose": pose(height=0.51)},
+         r"support is \+10\.0 mm off the declared plane"),
+        ("32FC1 depth in mm", square.depth * np.float32(1000), "32FC1", {},
+         r"support is -4\d{5}\.\d mm off the declared plane .* 32FC1 in m"),
         ("depth of the wrong type", square.depth, "16UC1", {}, "must hold uint16"),
         ("far NaNs", far_nan, "32FC1", {}, None),
     ]
@@ -201,3 +218,38 @@ def test_bad_views_are_refused_with_the_reason(case):
         return
     with pytest.raises(InvalidInputError, match=message):
         extract_outline(image, encoding, CAMERA, view, **options)
+
+
+def test_a_depth_image_too_small_for_the_support_fit_says_so():
+    """A 32 x 24 px depth image holds 2 blocks of 16 x 16 px, all valid, and was refused for
+    'too few valid pixels'; now its size is named, with the smallest one that fits.
+    """
+    from squeeze_grasp_ros.perception.camera import CameraModel, CameraPose
+
+    tiny = CameraModel(32, 24, fx=30.0, fy=30.0, cx=15.5, cy=11.5)
+    view = CameraPose.looking_down(0.5)
+    depth = render_views(rectangle(0.1, 0.1), tiny, view, top_height=0.02).depth
+    assert np.all(np.isfinite(depth))
+    with pytest.raises(InvalidInputError, match=r"^depth image: 32 x 24 px is too small to see "
+                       r"the support plane: it holds 2 blocks of 16 x 16 px, the plane fit "
+                       r"needs 6 \(e\.g\. 48 x 32 px\)$"):
+        extract_outline(depth, "32FC1", tiny, view)
+
+
+@pytest.mark.parametrize("side, blur, noise", [(0.01, 2.0, 0.2), (0.1, 20.0, 0.05)])
+def test_a_noisy_trace_whose_every_point_is_near_a_kink_gives_an_outline(side, blur, noise):
+    """Noisy, blurred masks whose trace kinks everywhere left the smoothing spline no traced
+    point to fit (all within 2 px of a corner), and extract_outline ended in numpy's 'zero-size
+    array to reduction operation maximum' ValueError; the fit now gives way to the spline
+    through the simplified vertices.
+    """
+    skimage_or_skip()
+    from squeeze_grasp_ros.perception.camera import CameraModel, CameraPose
+
+    camera = CameraModel(640, 480, fx=465.0, fy=465.0, cx=319.5, cy=239.5,
+                         distortion=(-0.04, 0.012, 0.0004, -0.0003, 0.0))
+    view = CameraPose.looking_down(0.5)
+    mask = render_views(rectangle(side, side), camera, view, top_height=0.02, blur_px=blur,
+                        mask_noise=noise, seed=1).mask
+    found = extract_outline(mask, "mono8", camera, view, object_height_m=0.02)
+    assert found.outline.area == pytest.approx(side * side, rel=0.3)

@@ -128,6 +128,13 @@ def test_holes_make_a_ring_like_solid():
     (dict(outline=((0, 0), (0.1,), (0.1, 0.1))), ["object.outline.polygon.points[1]", "pair"]),
     (dict(outline=((0, 0), (0.1, "a"), (0.1, 0.1))), ["object.outline.polygon.points", "numbers"]),
     (dict(placements=((0.0, 0.0, 0.0), (0.1, 0.0, 0.0))), ["object.placements[0]", "pair"]),
+    # coordinates beyond 2**53 m (a float32 Point32 holds up to 3.4e38) were named
+    # 'object.shape_parameters points' / 'holes[0]', with no range
+    (dict(outline=((0, 0), (1e16, 0), (0.1, 0.1))),
+     ["object.outline.polygon.points must be a list of [x, y] number pairs (m, finite, at most "
+      "9.01e+15 in magnitude)"]),
+    (dict(holes=[((0.01, 0.01), (1e16, 0.01), (0.01, 0.02))]),
+     ["object.holes[0] must be a list of [x, y] number pairs"]),
     (dict(holes=[((0.5, 0.5), (0.6, 0.5), (0.6, 0.6))]), ["object.holes", "inside"]),
     (dict(outline=(), shape="disk", shape_parameters={"radius": (-0.05,)}),
      ["object.shape_parameters radius", "m"]),

@@ -13,8 +13,11 @@ from squeeze_grasp_ros.commands.common import add_scene_argument, output_file
 from squeeze_grasp_ros.mechanics.errors import InvalidInputError
 from squeeze_grasp_ros.outputs import write_atomically
 from squeeze_grasp_ros.perception.image_files import encode_png
-from squeeze_grasp_ros.perception.render import render_views, ring_band
+from squeeze_grasp_ros.perception.render import CameraViews, render_views, ring_band
 from squeeze_grasp_ros.scene import build_outline, load_scene
+
+MAX_16UC1_M = 65.5355
+"""Largest depth (m) that rounds to a 16UC1 pixel (65,535 mm)."""
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -50,6 +53,26 @@ def _write(path: str, image: np.ndarray) -> str:
     return path
 
 
+def _depth_image(views: CameraViews, path: str) -> np.ndarray:
+    """The depth as written to ``path``: in m for .npy (``32FC1``), in mm for a PNG
+    (``16UC1``, :meth:`~squeeze_grasp_ros.perception.render.CameraViews.depth_mm`).
+
+    Raises
+    ------
+    InvalidInputError
+        For a PNG when some depth does not fit 16UC1 (65.535 m at most): it would be written as
+        0, invalid.
+    """
+    if Path(path).suffix.lower() == ".npy":
+        return views.depth
+    deepest = float(np.max(views.depth))
+    if not deepest < MAX_16UC1_M:
+        raise InvalidInputError(f"--depth {path}: the depth reaches {deepest:.4g} m, beyond "
+                                f"what 16UC1 holds (mm in uint16, below {MAX_16UC1_M} m); "
+                                "write .npy (32FC1, m) or bring the camera closer")
+    return views.depth_mm()
+
+
 def run(args: argparse.Namespace) -> dict:
     """Render and write the images; report what the camera sees."""
     scene = load_scene(args.scene)
@@ -68,8 +91,7 @@ def run(args: argparse.Namespace) -> dict:
     if args.mask:
         out["mask"] = _write(args.mask, views.mask)
     if args.depth:
-        depth = views.depth if Path(args.depth).suffix.lower() == ".npy" else views.depth_mm()
-        out["depth"] = _write(args.depth, depth)
+        out["depth"] = _write(args.depth, _depth_image(views, args.depth))
     return out
 
 

@@ -28,6 +28,7 @@ from typing import Any
 
 import numpy as np
 
+from squeeze_grasp_ros.inputs import yaml11_number
 from squeeze_grasp_ros.mechanics.errors import InvalidInputError
 from squeeze_grasp_ros.mechanics.vocabulary import DistortionModel
 from squeeze_grasp_ros.perception.camera import CameraModel
@@ -38,9 +39,12 @@ __all__ = ["camera_from_info"]
 def _numbers(value: Any, count: int | None, where: str) -> list[float]:
     if isinstance(value, Mapping):
         value = value.get("data")
-    if not isinstance(value, list) or not all(
-            isinstance(v, (int, float)) and not isinstance(v, bool) for v in value):
+    if not isinstance(value, list):
         raise InvalidInputError(f"{where} must be a list of numbers (or {{data: [...]}})")
+    value = [yaml11_number(v) for v in value]
+    for k, v in enumerate(value):
+        if isinstance(v, bool) or not isinstance(v, (int, float)):
+            raise InvalidInputError(f"{where}[{k}] must be a number, got {v!r}")
     if count is not None and len(value) != count:
         raise InvalidInputError(f"{where} must have {count} numbers, got {len(value)}")
     return [float(v) for v in value]
@@ -99,5 +103,8 @@ def camera_from_info(data: Any, *, what: str = "camera info") -> CameraModel:
     frame = frame if isinstance(frame, str) and frame else "camera_optical_frame"
     if not np.all(np.isfinite(k + d)):
         raise InvalidInputError(f"{what}: intrinsics and distortion must be finite")
-    return CameraModel(width, height, fx=k[0], fy=k[4], cx=k[2], cy=k[5], distortion=tuple(d),
-                       frame_id=frame)
+    try:
+        return CameraModel(width, height, fx=k[0], fy=k[4], cx=k[2], cy=k[5],
+                           distortion=tuple(d), frame_id=frame)
+    except InvalidInputError as error:  # e.g. fx <= 0: name the file or topic
+        raise InvalidInputError(f"{what}: {error}") from None

@@ -22,10 +22,10 @@ simplified vertices with corners where it would stray from the traced points
   or / 1 for a 0/1 mask) with the edge at half coverage, so an anti-aliased mask gives edges
   to a small fraction of a pixel and a binary one to about half a pixel. The mask is the
   object's top face at ``object_height_m`` above the plane.
-- **depth** (``16UC1`` mm, 0 invalid; ``32FC1`` m, NaN or 0 invalid): the support plane is
-  fitted and checked (:mod:`.support`); object pixels stand more than ``min_height_m`` above
-  it; the edge is at half the object's median height (a mixed pixel's height is its coverage
-  times the top height) and is met with the plane of the top face.
+- **depth** (``16UC1`` mm, 0 invalid; ``32FC1`` m, NaN, inf, 0 or negative invalid): the
+  support plane is fitted and checked (:mod:`.support`); object pixels stand more than
+  ``min_height_m`` above it; the edge is at half the object's median height (a mixed pixel's
+  height is its coverage times the top height) and is met with the plane of the top face.
 
 Views that would give a wrong outline are refused with :class:`InvalidInputError` naming the
 reason: wrong image size or type, no object, an object touching the border, two blobs of
@@ -239,6 +239,38 @@ def _mask_level(mask: np.ndarray) -> float:
     return 0.5 if mask.dtype == np.bool_ or mask.max() <= 1 else 127.5
 
 
+def _check_mask_values(mask: np.ndarray, level: float) -> None:
+    """Refuse a mask whose values never reach the edge ``level`` though some are not 0 (a label
+    image such as 0/1/2, or a dim mask): it would read as empty.
+    """
+    top = int(mask.max())
+    if 0 < top < level:
+        raise InvalidInputError(
+            f"mask: its largest value is {top}, below the edge level {level:g} (half of 255): a "
+            "mask holds 0/1 or 0-255 coverage of one object; a label image (0/1/2...), a dim "
+            "mask or an object blurred away reads as empty")
+
+
+def _check_ones(mask: np.ndarray, level: float, object_px: int) -> None:
+    """Refuse a 0-255 mask in which pixels of value 1 form a region at least as large as the
+    object (``object_px`` px at or above ``level``): a 0/1 mask mixed with 255s (a void label
+    around the object, a speck), whose object would be the 255s. An anti-aliased or noisy
+    0-255 mask has value 1 only on thin edge bands or scattered pixels.
+    """
+    from scipy import ndimage
+
+    ones = mask == 1
+    if level <= 1 or np.count_nonzero(ones) < object_px:  # one pass; labels only if needed
+        return
+    labels, count = ndimage.label(ones)
+    largest = int(np.bincount(labels.ravel())[1:].max()) if count else 0
+    if largest >= object_px:
+        raise InvalidInputError(
+            f"mask: {largest} px of value 1 form one region, as large as the object would be "
+            f"({object_px} px of values >= {level:g}): the mask mixes 0/1 with 255 (a void "
+            "label, a speck) and its object would be the 255s; give 0/1 or 0-255 values only")
+
+
 def _depth_metres(depth: np.ndarray, encoding: ImageEncoding) -> np.ndarray:
     if encoding == ImageEncoding.DEPTH_16UC1:
         metres = depth.astype(np.float32) * np.float32(1e-3)
@@ -431,8 +463,10 @@ def extract_outline(image: np.ndarray, encoding: ImageEncoding | str, camera: Ca
     support = None
     if encoding == ImageEncoding.MONO8:
         field, level, plane_height = image, _mask_level(image), object_height_m
+        _check_mask_values(image, level)
         choice = choose_object(field >= level, min_area_px=min_area_px,
                                ambiguous_ratio=ambiguous_ratio, what=what)
+        _check_ones(image, level, choice.blob.area_px)
     else:
         depth = _depth_metres(image, encoding)
         valid = np.isfinite(depth) & (depth > 0)
@@ -484,6 +518,6 @@ def _check_invalid_near(valid: np.ndarray, choice: BlobChoice) -> None:
     if bad.any():
         r, c = np.argwhere(bad)[0]
         raise InvalidInputError(
-            f"depth image: {int(bad.sum())} invalid pixels (NaN, inf or 0) inside or next to "
-            f"the object (first at row {r + window[0].start}, column {c + window[1].start}): "
-            "its outline there is unknown")
+            f"depth image: {int(bad.sum())} invalid pixels (NaN, inf, 0 or negative) inside or "
+            f"next to the object (first at row {r + window[0].start}, column "
+            f"{c + window[1].start}): its outline there is unknown")

@@ -193,21 +193,88 @@ def _untangled(offset: np.ndarray, middle: np.ndarray, wall: float) -> np.ndarra
                                 "(its offset crosses itself)") from None
 
 
+VIEW_MARGIN = 0.05
+"""Margin of the box a loop is clipped to, as a fraction of the image's extent in normalised
+coordinates (plus :data:`MAX_EDGE_PX` pixels): the box holds every pixel's square."""
+
+
+def _view_box(camera: CameraModel) -> tuple[np.ndarray, np.ndarray]:
+    """Lower and upper corners of a box in normalised coordinates (x/z, y/z) that holds the
+    whole image with a margin (:data:`VIEW_MARGIN`).
+    """
+    grid = camera.pixel_grid
+    lo, hi = grid.min(axis=(0, 1)), grid.max(axis=(0, 1))
+    pad = VIEW_MARGIN * (hi - lo) + MAX_EDGE_PX / np.array([camera.fx, camera.fy])
+    return lo - pad, hi + pad
+
+
+def _clipped(loop: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
+    """A closed loop (n, 2) clipped to the box [lo, hi] (Sutherland-Hodgman, one side at a
+    time): the same region inside the box, its part outside replaced by stretches of the box's
+    sides (empty when the loop lies wholly outside).
+    """
+    for axis, bound, sign in ((0, lo[0], 1.0), (0, hi[0], -1.0), (1, lo[1], 1.0),
+                              (1, hi[1], -1.0)):
+        if not len(loop):
+            break
+        side = sign * (loop[:, axis] - bound)  # >= 0 inside
+        after = np.roll(side, -1)
+        inside, cross = side >= 0, (side >= 0) != (after >= 0)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            t = np.where(cross, side / (side - after), 0.0)
+        meet = loop + t[:, None] * (np.roll(loop, -1, axis=0) - loop)
+        loop = np.stack([loop, meet], axis=1)[np.stack([inside, cross], axis=1)]
+    return loop
+
+
 def _densify(points: np.ndarray, camera: CameraModel, pose: CameraPose,
              height: float) -> np.ndarray:
     """Pixels of a closed plane-frame loop at ``height``, its edges split so that none is
-    longer than :data:`MAX_EDGE_PX` in the image when the camera distorts.
+    longer than :data:`MAX_EDGE_PX` in the image when the camera distorts. A loop that reaches
+    beyond the image's box (:func:`_view_box`) is first clipped to it in normalised
+    coordinates, where the plane's straight edges stay straight: the image is the same, and
+    far points never meet the distortion polynomial outside its calibrated field (its values
+    there overflowed, or folded back into the image).
     """
     xyz = np.column_stack([points, np.full(len(points), height)])
+    p = (xyz - pose.position) @ pose.matrix
+    if not np.all(p[:, 2] > 0):
+        raise InvalidInputError("render_views: a point of the object lies behind the camera "
+                                "(the camera pose looks away from it)")
+    lo, hi = _view_box(camera)
+    ab = p[:, :2] / p[:, 2:3]
+    if np.any((ab < lo) | (ab > hi)):
+        ab = _clipped(ab, lo, hi)
+        return _split(ab, camera) if len(ab) else np.zeros((0, 2))
     uv = camera.project(pose, xyz)
     if not any(camera.distortion):
         return uv
-    length = np.linalg.norm(np.roll(uv, -1, axis=0) - uv, axis=1)
-    parts = np.maximum(np.ceil(length / MAX_EDGE_PX).astype(int), 1)
-    edge = np.repeat(np.arange(len(points)), parts)
-    s = (np.arange(parts.sum()) - np.repeat(np.cumsum(parts) - parts, parts)) / parts[edge]
+    edge, s = _subdivision(uv)
     nxt = np.roll(xyz, -1, axis=0)
     return camera.project(pose, xyz[edge] + s[:, None] * (nxt[edge] - xyz[edge]))
+
+
+def _split(ab: np.ndarray, camera: CameraModel) -> np.ndarray:
+    """Pixels of a closed loop of normalised coordinates (n, 2), its edges split so that none
+    is longer than :data:`MAX_EDGE_PX` in the image when the camera distorts.
+    """
+    uv = camera.distort(ab)
+    if not any(camera.distortion):
+        return uv
+    edge, s = _subdivision(uv)
+    nxt = np.roll(ab, -1, axis=0)
+    return camera.distort(ab[edge] + s[:, None] * (nxt[edge] - ab[edge]))
+
+
+def _subdivision(uv: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The edge index and the parameter in [0, 1) along it of the points that split each edge
+    of the closed pixel loop ``uv`` (n, 2) into pieces of at most :data:`MAX_EDGE_PX`.
+    """
+    length = np.linalg.norm(np.roll(uv, -1, axis=0) - uv, axis=1)
+    parts = np.maximum(np.ceil(length / MAX_EDGE_PX).astype(int), 1)
+    edge = np.repeat(np.arange(len(uv)), parts)
+    return edge, (np.arange(parts.sum()) - np.repeat(np.cumsum(parts) - parts, parts)) / parts[
+        edge]
 
 
 def render_views(outline: Outline, camera: CameraModel, pose: CameraPose, *,

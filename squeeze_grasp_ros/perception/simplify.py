@@ -575,7 +575,8 @@ def smoothed_curve(points: np.ndarray, vertices: np.ndarray, corners: np.ndarray
     traced point (quartered until every point is within ``tolerance``). Between two corners the
     curve is an open smoothing spline pinned at both (straight when fewer than 8 traced points
     lie between them); without corners the spline is periodic.
-    Traced points within ``clearance`` of a corner are not fitted (the trace cuts it short).
+    Traced points within ``clearance`` of a corner are not fitted (the trace cuts it short);
+    None when that leaves none (a noisy trace whose kinks are all corners).
 
     Parameters
     ----------
@@ -599,6 +600,8 @@ def smoothed_curve(points: np.ndarray, vertices: np.ndarray, corners: np.ndarray
         at = np.argmin(distance, axis=0)  # each corner's nearest traced point
         order = np.argsort(at)  # in the trace's order
         corner_xy, at = corner_xy[order], at[order]
+        if not fitted.any():  # every traced point near a corner (a noisy trace's kinks)
+            return None
 
     def piece(chain: np.ndarray, ends: tuple | None, smooth: float) -> np.ndarray:
         """Dense samples of one stretch (``ends``: its two corners, or None: periodic)."""

@@ -23,6 +23,9 @@ __all__ = ["BLOCK", "SupportPlane", "fit_support", "floor_grids"]
 BLOCK = 16
 """Side of the averaging blocks, px."""
 
+MIN_BLOCKS = 6
+"""Blocks at least half valid the support plane is fitted to, at least."""
+
 RANSAC_TRIALS = 64
 """Random block triples tried by the plane fit (seeded: the fit is deterministic)."""
 
@@ -113,7 +116,9 @@ def fit_support(heights: np.ndarray, valid: np.ndarray, camera: CameraModel, pos
     Raises
     ------
     InvalidInputError
-        Too little support in view, or a support that is tilted, shifted or not planar.
+        Too little support in view, or a support that is tilted, shifted (more than
+        ``tolerance_m`` off the declared plane at the middle of the support in view) or not
+        planar.
     """
     from scipy import ndimage
 
@@ -121,10 +126,15 @@ def fit_support(heights: np.ndarray, valid: np.ndarray, camera: CameraModel, pos
     mean_h, count = _block_means(heights, valid)
     full = count >= BLOCK * BLOCK // 2
     x, y, h = bx[full], by[full], mean_h[full]
-    if len(h) < 6:
+    if full.size < MIN_BLOCKS:
+        raise InvalidInputError(f"depth image: {camera.width} x {camera.height} px is too small "
+                                f"to see the support plane: it holds {full.size} blocks of "
+                                f"{BLOCK} x {BLOCK} px, the plane fit needs {MIN_BLOCKS} (e.g. "
+                                f"{3 * BLOCK} x {2 * BLOCK} px)")
+    if len(h) < MIN_BLOCKS:
         raise InvalidInputError(f"depth image: too few valid pixels to see the support plane "
                                 f"({len(h)} blocks of {BLOCK} x {BLOCK} px at least half valid; "
-                                "need 6)")
+                                f"need {MIN_BLOCKS})")
     rng = np.random.default_rng(0)
     triples = rng.integers(0, len(h), size=(RANSAC_TRIALS, 3))
     A = np.stack([np.ones((RANSAC_TRIALS, 3)), x[triples], y[triples]], axis=2)
@@ -143,6 +153,7 @@ def fit_support(heights: np.ndarray, valid: np.ndarray, camera: CameraModel, pos
         raise InvalidInputError(f"depth image: the support plane is tilted by {tilt:.2f} deg "
                                 f"against the declared camera pose (max_tilt_deg = "
                                 f"{max_tilt_deg:g}); check the camera pose or level the support")
+    _check_offset(c, x[best], y[best], pose, tolerance_m)
     residual = mean_h - (c[0] + c[1] * bx + c[2] * by)
     objects = ndimage.binary_dilation(_block_any(heights > min_height_m, valid), iterations=1)
     away = full & ~objects
@@ -156,6 +167,22 @@ def fit_support(heights: np.ndarray, valid: np.ndarray, camera: CameraModel, pos
             f"(tolerance {1e3 * tolerance_m:g} mm) and holds no object")
     return SupportPlane((float(c[0]), float(c[1]), float(c[2])), tilt, int(best.sum()),
                         flatness)
+
+
+def _check_offset(c: np.ndarray, x: np.ndarray, y: np.ndarray, pose: CameraPose,
+                  tolerance_m: float) -> None:
+    """Refuse a fitted support plane h = c0 + c1 x + c2 y (m) that lies more than
+    ``tolerance_m`` (m) off the declared plane z = 0 at the middle of the support in view (the
+    mean of the inlier blocks' plane-frame ``x``, ``y``, m): a camera height or depth unit the
+    pose and the image disagree on.
+    """
+    offset = float(c[0] + c[1] * np.mean(x) + c[2] * np.mean(y))
+    if abs(offset) > tolerance_m:
+        raise InvalidInputError(
+            f"depth image: the support is {1e3 * offset:+.1f} mm off the declared plane z = 0 "
+            f"(plane_tolerance {1e3 * tolerance_m:g} mm) with the camera {pose.position[2]:g} m "
+            "above it: check the camera pose's height and the depth's unit (16UC1 in mm, "
+            "32FC1 in m)")
 
 
 def _block_any(flags: np.ndarray, valid: np.ndarray) -> np.ndarray:

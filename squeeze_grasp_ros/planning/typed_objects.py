@@ -65,6 +65,8 @@ FIELDS: dict[str, str] = {
     "object.material.nu": "object.material.poisson_ratio",
     "object.mesh.max_area": "object.mesh_max_area",
     "object.mesh.nodes": "object.mesh_nodes",
+    "object.shape.points": "object.outline.polygon.points",
+    "object.shape.holes": "object.holes",
     "object.shape.": "object.shape_parameters ",
     "object.shape": "object.outline / object.shape",
     "fingers.F1.placement.point": "object.placements[0]",

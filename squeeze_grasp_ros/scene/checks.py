@@ -99,7 +99,8 @@ def _check_shape_value(key: str, value: Any, where: str) -> None:
         if not isinstance(value, list) or not all(
             isinstance(p, (list, tuple)) and len(p) == 2 and all(map(_is_number, p)) for p in value
         ):
-            raise SceneError(f"{where} must be a list of [x, y] number pairs (m)")
+            raise SceneError(f"{where} must be a list of [x, y] number pairs (m, finite, at "
+                             f"most {MAX_INT:.3g} in magnitude)")
     elif key == "holes":
         if not isinstance(value, list):
             raise SceneError(f"{where} must be a list of polygons, each a list of [x, y] number "

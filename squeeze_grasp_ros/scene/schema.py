@@ -33,6 +33,7 @@ from typing import Any
 
 import numpy as np
 
+from squeeze_grasp_ros.inputs import yaml11_number
 from squeeze_grasp_ros.mechanics.errors import InvalidInputError
 
 __all__ = ["MAX_INT", "SchemaError", "describe_range", "key_reference", "parse_section",
@@ -130,14 +131,6 @@ def _check_range(value: float, meta: dict, where: str, error: type[SchemaError])
         raise error(f"{where} must be {describe_range(meta)}{unit}{why}, got {value!r}")
 
 
-def _yaml11_float(text: str, where: str, error: type[SchemaError]) -> float:
-    """Accept exponents such as ``5.0e4`` that YAML 1.1 (PyYAML) leaves as strings."""
-    try:
-        return float(text)
-    except ValueError:
-        raise error(f"{where} must be a number, got {text!r}") from None
-
-
 def _convert(tp: Any, value: Any, meta: dict, where: str, error: type[SchemaError]) -> Any:
     origin = typing.get_origin(tp)
     if origin in (typing.Union, types.UnionType):
@@ -155,8 +148,7 @@ def _convert(tp: Any, value: Any, meta: dict, where: str, error: type[SchemaErro
         return tuple(_convert(inner, v, meta, f"{where}[{k}]", error)
                      for k, v in enumerate(value))
     if tp is float:
-        if isinstance(value, str):
-            value = _yaml11_float(value, where, error)
+        value = yaml11_number(value)
         if isinstance(value, bool) or not isinstance(value, (int, float)):
             raise error(f"{where} must be a number, got {value!r}")
         value = float(value)

@@ -11,7 +11,8 @@ Run it with ``ros2 run squeeze_grasp_ros outline --ros-args -p camera_pose:="[0.
   used for each image;
 - ``camera/pose`` (latched ``geometry_msgs/PoseStamped``, optional): the camera's optical
   frame in the plane frame; it replaces the ``camera_pose`` parameter once it arrives, and its
-  ``header.frame_id`` must be the node's ``frame_id``.
+  ``header.frame_id`` must be the node's ``frame_id``: after a refused one, images are refused
+  until a usable one arrives (the camera may have moved).
 
 For each image it runs :func:`~squeeze_grasp_ros.perception.extract.extract_outline` and
 publishes ``outline/outline`` (``geometry_msgs/PolygonStamped``: the outer boundary, m, in
@@ -19,7 +20,8 @@ publishes ``outline/outline`` (``geometry_msgs/PolygonStamped``: the outer bound
 (``SeenOutline``: the same with the holes, area, tolerance and pixel size; what a client
 passes on to ``load_object``). A view that would give a wrong outline (no object, an object
 cut by the border, two similar blobs, a tilted support, NaNs next to the object, a wrong
-image size) publishes nothing on those topics: its reason goes to ``outline/errors``
+image size, an image whose ``header.frame_id`` is not its camera_info's) publishes nothing on
+those topics: its reason goes to ``outline/errors``
 (``std_msgs/String``, stamped in the text) and to the log (once until the reason changes).
 """
 from __future__ import annotations
@@ -93,6 +95,12 @@ class OutlineNode(Node):
         self.p = p = pipeline.declare(self, PARAMETERS, bounds=BOUNDS)
         self.pose = pose_parameter(list(p["camera_pose"]))
         self.camera: CameraModel | None = None
+        self.camera_frame = ""
+        """``header.frame_id`` of the camera_info in use ("" when it names none)."""
+        self.camera_refused = ""
+        """Why the newest camera_info was refused ("" when it was not)."""
+        self.pose_refused = ""
+        """Why the newest camera/pose was refused ("" when it was not)."""
         self.last_error = ""
         depth = p["qos_depth"]
         self.create_subscription(Image, p["image_topic"], self._image, depth)
@@ -110,25 +118,40 @@ class OutlineNode(Node):
 
     def _info(self, msg: CameraInfo) -> None:
         try:
-            self.camera = camera_model(msg)
+            self.camera, self.camera_frame = camera_model(msg), msg.header.frame_id
+            self.camera_refused = ""
         except InvalidInputError as error:
-            self.camera = None
-            self._refuse(msg.header.stamp, str(error))
+            self.camera, self.camera_refused = None, str(error)
+            self._refuse(msg.header.stamp, self.camera_refused)
 
     def _pose(self, msg: PoseStamped) -> None:
         if msg.header.frame_id != self.p["frame_id"]:
-            self._refuse(msg.header.stamp, f"camera/pose is in frame {msg.header.frame_id!r}, "
-                                           f"not the plane frame {self.p['frame_id']!r}")
-            return
-        try:
-            self.pose = camera_pose(msg.pose)
-        except InvalidInputError as error:
-            self._refuse(msg.header.stamp, f"camera/pose: {error}")
+            self.pose_refused = (f"camera/pose is in frame {msg.header.frame_id!r}, not the "
+                                 f"plane frame {self.p['frame_id']!r}")
+        else:
+            try:
+                self.pose, self.pose_refused = camera_pose(msg.pose), ""
+            except InvalidInputError as error:
+                self.pose_refused = f"camera/pose: {error}"
+        if self.pose_refused:  # the camera may have moved: no outline until a usable pose
+            self._refuse(msg.header.stamp, self.pose_refused)
 
     def _image(self, msg: Image) -> None:
-        if self.camera is None or self.pose is None:
-            self._refuse(msg.header.stamp, "no camera_info yet" if self.camera is None
+        if self.camera is None:
+            self._refuse(msg.header.stamp, f"no usable camera_info: the newest was refused "
+                         f"({self.camera_refused})" if self.camera_refused
+                         else "no camera_info yet")
+            return
+        if self.pose is None or self.pose_refused:
+            self._refuse(msg.header.stamp, f"no usable camera pose: the newest was refused "
+                         f"({self.pose_refused})" if self.pose_refused
                          else "no camera pose yet (parameter camera_pose or camera/pose)")
+            return
+        if msg.header.frame_id and self.camera_frame and msg.header.frame_id != self.camera_frame:
+            self._refuse(msg.header.stamp, f"image header.frame_id {msg.header.frame_id!r} is "
+                                           f"not the camera_info's {self.camera_frame!r}: the "
+                                           "image and the calibration come from different "
+                                           "cameras (publish both in the camera's optical frame)")
             return
         p = self.p
         try:

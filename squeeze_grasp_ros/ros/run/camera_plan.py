@@ -21,6 +21,7 @@ from sensor_msgs.msg import CameraInfo, Image
 
 from squeeze_grasp_interfaces.msg import ObjectDescription, PredictedShapes
 from squeeze_grasp_ros.control.tracker import mirror_tolerance_for
+from squeeze_grasp_ros.mechanics.errors import InvalidInputError
 from squeeze_grasp_ros.mechanics.vocabulary import Finger, ShapeFit
 from squeeze_grasp_ros.perception.extract import ObjectOutline, extract_outline
 from squeeze_grasp_ros.perception.shape_match import shape_residual
@@ -45,8 +46,10 @@ def first_outline(node: Any, spin_until: Callable[..., None], scene: Scene,
     Raises
     ------
     RunError
-        When the frame does not arrive in ``timeout`` s, or the view gives no outline (the
-        reason of :class:`~squeeze_grasp_ros.mechanics.errors.InvalidInputError`).
+        When the frame does not arrive in ``timeout`` s.
+    InvalidInputError
+        When the scene's view gives no outline (its reason: no object in view, cut by the
+        border, ...).
     """
     got: dict[str, Any] = {}
     subscriptions = [
@@ -67,9 +70,10 @@ def first_outline(node: Any, spin_until: Callable[..., None], scene: Scene,
                                camera_pose(pose_msg.pose),
                                object_height_m=scene.object.material.thickness,
                                frame_id=pose_msg.header.frame_id)
-    except ValueError as error:
-        raise RunError(f"camera.plan_from_images: the first frame gives no outline: "
-                       f"{error}") from None
+    except ValueError as error:  # the scene's own view: its camera or its object
+        raise InvalidInputError(f"camera.plan_from_images: the first frame gives no outline: "
+                                f"{error}; check the scene's camera (camera.pose, size, "
+                                "intrinsics) and its object's place") from None
 
 
 def seen_description(scene: Scene, seen: ObjectOutline) -> ObjectDescription:

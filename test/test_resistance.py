@@ -401,3 +401,18 @@ def test_a_node_index_outside_the_mesh_is_refused(square, bad):
     b = [int(k) for k in square.mesh.boundary]
     with pytest.raises(InvalidInputError, match=r"contact nodes must be node indices in \[0, "):
         resistance_grasp(square, {"F1": [b[0]], "F2": [bad], "A": [b[5]]})
+
+
+def test_a_direction_beyond_the_float_range_is_the_same_direction(blob):
+    """``--compare-direction 1e308 1e308`` overflowed the normalisation (with a RuntimeWarning)
+    and compared the resistance along [0, 0]: now it is the resistance along [1, 1], bit for
+    bit, and the ordinary direction's answer is unchanged.
+    """
+    grasp = resistance_grasp(blob, random_placement(blob, np.random.default_rng(8)))
+    a = np.array([0.0024, 0.0044])
+    along = resistance_along(grasp, a, [1.0, 1.0], "stable")
+    with np.errstate(all="raise"):
+        huge = resistance_along(grasp, a, [1e308, 1e308], "stable")
+    assert huge.success and huge.reason == along.reason
+    assert np.array_equal(huge.d1, along.d1) and huge.work == along.work
+

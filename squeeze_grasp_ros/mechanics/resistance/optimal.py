@@ -356,9 +356,26 @@ def _translation(a, name: str = "adversary translation a") -> np.ndarray:
     if a.shape != (2,):
         raise InvalidInputError(f"{name} must be [x, y] in m, got shape {a.shape}")
     require_finite(name, a)
-    if not np.linalg.norm(a) > 0:
+    with np.errstate(over="ignore"):  # a length beyond the float range is nonzero too
+        nonzero = np.linalg.norm(a) > 0
+    if not nonzero:
         raise InvalidInputError(f"{name} must be nonzero")
     return a
+
+
+def _unit(v: np.ndarray) -> np.ndarray:
+    """``v`` (finite, of a nonzero length) divided by its length.
+
+    ``np.linalg.norm`` squares the entries and overflows beyond about 1e154 (a direction of
+    [1e308, 1e308] became [0, 0]): such a ``v`` is first scaled by its largest entry; any
+    other is divided as before, bit for bit.
+    """
+    with np.errstate(over="ignore"):
+        norm = float(np.linalg.norm(v))
+    if not np.isfinite(norm):
+        v = v / np.abs(v).max()
+        norm = float(np.linalg.norm(v))
+    return v / norm
 
 
 def _unresisted(
@@ -611,7 +628,7 @@ def resistance_along(
     if isinstance(form, PureForm) and form.outside(a_hat)[0] > FEASIBILITY_TOL:
         return _cannot_resist(grasp, a)
     x0, Z = form.line(a_hat)
-    e = e / np.linalg.norm(e)
+    e = _unit(e)
     coef = perp(e) @ Z[:2]
     rhs = -float(perp(e) @ x0[0, :2])
     if float(np.linalg.norm(coef)) <= 1e-12:

@@ -34,6 +34,7 @@ forms themselves are in :mod:`.resistance_forms`.
 
 from __future__ import annotations
 
+import itertools
 from dataclasses import dataclass, field, replace
 from functools import cached_property
 from typing import Mapping, Sequence
@@ -197,6 +198,12 @@ def contact_segments(
     -------
     list of (k,) ndarray of int
         One segment per contact, the contact node first, then by arc distance.
+
+    Raises
+    ------
+    InvalidInputError
+        For a ``half_width`` that is negative or not finite, or so wide that two segments
+        share a node (named with the contacts' arc distance, the field's bound).
     """
     loop = mesh.boundary
     edge = np.linalg.norm(np.roll(mesh.nodes[loop], -1, axis=0) - mesh.nodes[loop], axis=1)
@@ -215,7 +222,41 @@ def contact_segments(
             near = np.flatnonzero(dist <= half_width * (1 + 1e-12))
             near = near[np.argsort(dist[near], kind="mergesort")]
         out.append(loop[near])
+    if half_width is not None:
+        _require_apart(out, [s[mesh.boundary_position(int(c))] for c in contacts], perimeter,
+                       half_width)
     return out
+
+
+def _require_apart(segments: list[np.ndarray], arc: list[float], perimeter: float,
+                   half_width: float) -> None:
+    """Refuse segments of F1, F2, A (in that order) that share a node, naming the two
+    contacts, their distance along the boundary and the half width that keeps them apart.
+
+    Parameters
+    ----------
+    segments : list of (k,) ndarray of int
+        Each finger's segment.
+    arc : list of float
+        Arc length, m, of each finger's contact node along the outer boundary.
+    perimeter : float
+        Length of the outer boundary, m.
+    half_width : float
+        The half width that made the segments, m.
+    """
+    names = [str(f) for f in tuple(Finger)]
+    pairs = list(itertools.combinations(range(len(segments)), 2))
+    shared = [(i, j) for i, j in pairs if np.intersect1d(segments[i], segments[j]).size]
+    if not shared:
+        return
+    gaps = {(i, j): min(abs(arc[i] - arc[j]), perimeter - abs(arc[i] - arc[j]))
+            for i, j in pairs}
+    near = min(pairs, key=gaps.get)
+    raise InvalidInputError(
+        f"segment half width {half_width:g} m makes the contact segments of "
+        f"{names[shared[0][0]]} and {names[shared[0][1]]} overlap; the nearest contacts, "
+        f"{names[near[0]]} and {names[near[1]]}, are {gaps[near]:.4g} m apart along the "
+        f"boundary, so the half width must be below {gaps[near] / 2:.4g} m")
 
 
 @dataclass(frozen=True)

@@ -135,6 +135,21 @@ def test_one_relative_depth_rule_for_plan_and_ring(capfd):
         ["ring", RING, "--map", "--best", "-1"], capfd)
 
 
+@pytest.mark.parametrize("options, named", [
+    (["--best", "3"], "--best ranks the placements of --map"),
+    (["--bench", "--plot", "bench.png"], "--bench takes only --elements and --json, got --plot"),
+    (["--bench", "--map", "--depth", "0.001", "--best", "3"],
+     "--bench takes only --elements and --json, got --map, --depth, --best"),
+])
+def test_ring_options_the_task_would_ignore_are_refused(tmp_path, capfd, options, named):
+    """``ring --best 3`` (no ``--map``) and ``ring --bench --plot FILE`` exited 0, the first
+    without the ranking asked for, the second without writing the plot.
+    """
+    options = [str(tmp_path / o) if o.endswith(".png") else o for o in options]
+    assert named in refused(["ring", RING, *options], capfd)
+    assert not (tmp_path / "bench.png").exists()
+
+
 # ----------------------------------------------------------------------------- item 13
 
 

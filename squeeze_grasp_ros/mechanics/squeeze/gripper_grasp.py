@@ -33,7 +33,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from squeeze_grasp_ros.mechanics.elastic.compliance import ElasticObject
-from squeeze_grasp_ros.mechanics.errors import InvalidInputError
+from squeeze_grasp_ros.mechanics.errors import InvalidInputError, shown
 from squeeze_grasp_ros.mechanics.squeeze.contact_model import TerminationLimits
 from squeeze_grasp_ros.mechanics.squeeze.events import EventSqueeze, event_squeeze
 from squeeze_grasp_ros.mechanics.squeeze.fingertips import TOUCH_TOLERANCE
@@ -134,7 +134,8 @@ def _in_yaw_range(yaw: np.ndarray, yaw_range: tuple[float, float] | None) -> np.
         return np.ones(len(yaw), bool)
     lo, hi = yaw_range
     if not (np.isfinite(lo) and np.isfinite(hi) and lo <= hi):
-        raise InvalidInputError(f"yaw range must be finite with min <= max, got {yaw_range}")
+        raise InvalidInputError(f"yaw range must be finite with min <= max, got "
+                                f"{shown(yaw_range)} rad")
     if hi - lo >= np.pi:
         return np.ones(len(yaw), bool)
     return np.mod(yaw - lo, np.pi) <= hi - lo

@@ -623,3 +623,60 @@ def test_contributing_lists_every_linter_test():
     contributing = (REPO / "CONTRIBUTING.md").read_text(encoding="utf-8")
     assert "test_ruff" in tests and len(names) >= 7
     assert [name for name in names if f"test_lint.py::{name}`" not in contributing] == []
+
+
+def _shown_keys(text: str) -> dict:
+    """The keys of a JSON shape written as docs/mechanics.md writes one: ``{"key": value,
+    "bare_key", "nested": {...}}``; a nested object's value is its own dict of keys, ``...``
+    (an elided object) the key ``"..."``, every other value None.
+    """
+    root, stack, last = None, [], None
+    for key, bracket, ellipsis in re.findall(r'"(\w+)"|([{}\[\]])|(\.\.\.)', text):
+        top = stack[-1] if stack else None
+        if bracket == "{":
+            shape: dict = {}
+            if isinstance(top, dict) and last is not None:
+                top[last] = shape
+            root = shape if root is None else root
+            stack.append(shape)
+        elif bracket == "[":
+            stack.append([])
+        elif bracket:
+            stack.pop()
+        elif isinstance(top, dict):
+            top[key or "..."] = None
+        last = key if isinstance(top, dict) and bracket == "" else None
+    return root
+
+
+def _keys_match(shown: dict, actual: dict, path: str = "") -> str | None:
+    """None if ``actual`` has the keys ``shown`` lists, in their order (all of them unless
+    ``...`` elides the rest), and so for every nested object shown; else what differs.
+    """
+    keys = [k for k in shown if k != "..."]
+    listed = [k for k in actual if k in keys] if "..." in shown else list(actual)
+    if listed != keys:
+        return f"{path or 'top level'}: shown {keys}, printed {list(actual)}"
+    for key in keys:
+        if isinstance(shown[key], dict):
+            if not isinstance(actual[key], dict):
+                return f"{path}{key}: shown as an object, printed {type(actual[key]).__name__}"
+            problem = _keys_match(shown[key], actual[key], f"{path}{key}.")
+            if problem:
+                return problem
+    return None
+
+
+def test_the_plan_json_keys_mechanics_md_lists_are_what_plan_prints(scratch):
+    """docs/mechanics.md lists the keys of ``plan --json`` inline: they are the keys the verb
+    prints, in its order, nested objects included (``{...}`` elides one).
+    """
+    page = (REPO / "docs" / "mechanics.md").read_text(encoding="utf-8")
+    text = re.search(r"`plan --json` gives `(\{.*?\})`:", page, re.S).group(1)
+    command = Command("squeeze-grasp plan config/scenes/foam_square.yaml --json", ())
+    actual = json.loads("\n".join(run_command(command, scratch)))
+    shown = _shown_keys(text)
+    assert len(shown) >= 10 and isinstance(shown["stable"], dict)
+    assert _keys_match(shown, actual) is None, _keys_match(shown, actual)
+    assert _keys_match(_shown_keys('{"a": 1, "b": {"x", "y"}}'),
+                       {"a": 1, "b": {"y": 0, "x": 0}}) is not None  # the order counts

@@ -680,3 +680,66 @@ def test_the_plan_json_keys_mechanics_md_lists_are_what_plan_prints(scratch):
     assert _keys_match(shown, actual) is None, _keys_match(shown, actual)
     assert _keys_match(_shown_keys('{"a": 1, "b": {"x", "y"}}'),
                        {"a": 1, "b": {"y": 0, "x": 0}}) is not None  # the order counts
+
+
+SIGNATURE_SPAN = re.compile(r"`((?:[\w.]+\.)?(\w+)\(([^`]*?)\)\s*->\s*(\w+))`", re.S)
+"""An inline signature in the docs: ``name(params) -> Result``, the name dotted from the
+package or bare."""
+BARE_NAMES = {"advance": "mechanics.squeeze.stepper"}
+"""Where a bare name of an inline signature lives, from the package."""
+
+
+def _signature_problem(text: str, name: str, returned: str) -> str | None:
+    """None if ``text`` (``f(a, b=1, ...) -> R``) agrees with the function it names: its
+    positional names are the first parameters, in order; each keyword is a parameter with
+    that default unless shown as ``...``; the return annotation is ``R``; without a ``...``
+    every required parameter is shown.
+    """
+    import importlib
+    import inspect
+
+    call = ast.parse(text.split("->")[0].strip(), mode="eval").body
+    dotted = ast.unparse(call.func)
+    module, _, attribute = (dotted if "." in dotted else
+                            f"{BARE_NAMES[name]}.{name}").rpartition(".")
+    function = getattr(importlib.import_module(f"squeeze_grasp_ros.{module}"), attribute)
+    parameters = inspect.signature(function).parameters
+    names = list(parameters)
+    elided = any(isinstance(a, ast.Constant) and a.value is Ellipsis for a in call.args)
+    shown = [a.id for a in call.args if isinstance(a, ast.Name)]
+    if shown != names[:len(shown)]:
+        return f"{dotted}: positional {shown}, the function's {names[:len(shown)]}"
+    for keyword in call.keywords:
+        if keyword.arg not in parameters:
+            return f"{dotted}: no parameter {keyword.arg!r}"
+        value = ast.literal_eval(keyword.value)
+        if value is not Ellipsis and value != parameters[keyword.arg].default:
+            return (f"{dotted}: {keyword.arg}={value!r}, the function's default "
+                    f"{parameters[keyword.arg].default!r}")
+    required = [n for n in names if parameters[n].default is inspect.Parameter.empty]
+    missing = [n for n in required if n not in shown + [k.arg for k in call.keywords]]
+    if not elided and missing:
+        return f"{dotted}: does not show the required {missing}"
+    annotation = inspect.signature(function).return_annotation
+    if getattr(annotation, "__name__", annotation) != returned:
+        return f"{dotted}: returns {annotation}, shown {returned}"
+    return None
+
+
+def test_the_inline_signatures_are_the_functions():
+    """Every inline ``name(params) -> Result`` of the docs (docs/events.md's ``advance``,
+    docs/design.md's perception calls) names a function of the package with those parameters,
+    defaults and return type.
+    """
+    found, wrong = 0, []
+    for page in PAGES:
+        text = page.read_text(encoding="utf-8")
+        for span in SIGNATURE_SPAN.finditer(text):
+            whole, name, _, returned = span.groups()
+            problem = _signature_problem(" ".join(whole.split()), name, returned)
+            found += 1
+            if problem:
+                wrong.append(f"{page.name}:{text[:span.start()].count(chr(10)) + 1}: {problem}")
+    assert found >= 4 and not wrong, wrong
+    assert _signature_problem("advance(model, state, translations, step=1e-2) -> StepResult",
+                              "advance", "StepResult") is not None  # a default can differ

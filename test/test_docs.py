@@ -418,7 +418,8 @@ def test_the_executor_goal_example_is_the_foam_squares_plan():
 
 def test_the_scene_error_the_docs_quote_is_the_one_a_scene_gets():
     """scenes.md and ros.md quote the error of a Poisson's ratio out of range: it is the one
-    loading such a scene raises (the range included).
+    loading such a scene raises (the range included); scenes.md quotes that of a misspelt key
+    (line breaks aside).
     """
     from squeeze_grasp_ros.scene import SceneError, parse_scene
 
@@ -430,6 +431,11 @@ def test_the_scene_error_the_docs_quote_is_the_one_a_scene_gets():
     assert quoted == "`object.material.nu must be in [-0.9, 0.5], got 0.7`"
     for page in ("scenes.md", "ros.md"):
         assert quoted in (REPO / "docs" / page).read_text(encoding="utf-8"), page
+    doc["object"]["materal"] = doc["object"].pop("material")
+    with pytest.raises(SceneError) as misspelt:
+        parse_scene(doc)
+    scenes = " ".join((REPO / "docs" / "scenes.md").read_text(encoding="utf-8").split())
+    assert f"`{misspelt.value}`" in scenes, misspelt.value
 
 
 def _refusal(words: list[str], folder: Path) -> str:

@@ -60,6 +60,11 @@ def mutate(path: str, value):
     ("strain_limit", {"epsilon": 0.1}, "section strain_limit is given but effect"),
     ("object.material.E", "soft", "object.material.E must be a number"),
     ("object.material", KeyError, "missing required key object.material"),
+    # a misspelt key is named with the key it is closest to, if one is close
+    ("object.materal", {"E": 5e4}, r"unknown key object.materal: did you mean 'material'\? "),
+    ("object.shape.sid", 0.1, r"unknown key object.shape.sid for type square: did you mean "
+                              r"'side'\? (allowed: \['side'\]"),
+    ("xyzzy", 1, r"unknown key xyzzy (allowed: \['actuators'"),
 ])
 def test_scene_errors_name_the_field(path, value, message):
     with pytest.raises(SceneError, match=message.replace("(", r"\(")):

@@ -27,7 +27,7 @@ from squeeze_grasp_ros.mechanics.vocabulary import (
     ObjectModel,
     TipKind,
 )
-from squeeze_grasp_ros.scene.schema import MAX_INT, SchemaError
+from squeeze_grasp_ros.scene.schema import MAX_INT, SchemaError, unknown_key
 from squeeze_grasp_ros.scene.specs import (
     SHAPES,
     MaterialSpec,
@@ -65,10 +65,8 @@ def check_shape(shape: Mapping[str, Any], where: str = "object.shape") -> None:
     allowed = set(SHAPES[kind]) | {"type"}
     unknown = sorted(set(shape) - allowed, key=str)
     if unknown:
-        raise SceneError(
-            f"unknown key {where}.{unknown[0]} for type {kind} "
-            f"(allowed: {sorted(allowed - {'type'})})"
-        )
+        raise SceneError(unknown_key(where, unknown[0], allowed - {"type"},
+                                     context=f" for type {kind}"))
     optional = {"cos", "sin", "holes", "corners"}
     for key in SHAPES[kind]:
         if key not in shape and key not in optional:

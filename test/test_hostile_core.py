@@ -380,3 +380,13 @@ def test_a_scheduler_address_that_is_not_a_scheduler_times_out():
         closed = sock.getsockname()[1]
     with pytest.raises(SweepError, match="cannot connect"):
         probe_scheduler(f"tcp://127.0.0.1:{closed}", 1.0, 1.0)
+
+
+@pytest.mark.parametrize("value", ["inf", "nan", "0"])
+def test_a_run_timeout_that_is_not_a_finite_positive_number_is_refused(value, capfd):
+    """``run --timeout inf`` was refused with "--timeout must be > 0 s, got inf", which inf
+    is: the message now states the range the check applies (before any node starts).
+    """
+    pytest.importorskip("rclpy", reason="run needs ROS 2")
+    assert refused(["run", FOAM, "--timeout", value], capfd) == (
+        f"squeeze-grasp run: error: --timeout must be a finite number > 0 s, got {float(value)}")

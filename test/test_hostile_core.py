@@ -390,3 +390,22 @@ def test_a_run_timeout_that_is_not_a_finite_positive_number_is_refused(value, ca
     pytest.importorskip("rclpy", reason="run needs ROS 2")
     assert refused(["run", FOAM, "--timeout", value], capfd) == (
         f"squeeze-grasp run: error: --timeout must be a finite number > 0 s, got {float(value)}")
+
+
+@pytest.mark.parametrize("argv, message", [
+    (["squeeze", FOAM, "--step", "inf"],
+     "step must be finite and >= 1e-06 (relative to the object size), got inf"),
+    (["squeeze", FOAM, "--event-tol", "inf"],
+     "event_tol must be finite and >= 1e-15 (relative to the object size), got inf"),
+    (["gripper-plan", str(SCENES / "sponge_gripper.yaml"), "--weight", "inf"],
+     "weight must be finite and > 0 N, got inf"),
+    (["gripper-plan", str(SCENES / "sponge_gripper.yaml"), "--margin", "inf"],
+     "force margin must be finite and >= 1, got inf"),
+    (["resist", str(SCENES / "resist_fig9.yaml"), "--contacts", "segment",
+      "--segment-half-width", "inf"], "segment half width must be finite and >= 0 m, got inf"),
+])
+def test_an_infinite_option_is_refused_as_not_finite(argv, message, capfd):
+    """Each refused inf with a range inf is in ("step must be >= 1e-06 ..., got inf", "weight
+    must be > 0 N, got inf"): the messages say finite.
+    """
+    assert refused(argv, capfd).endswith(message)

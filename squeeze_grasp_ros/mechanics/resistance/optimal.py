@@ -210,7 +210,7 @@ def contact_segments(
     s = np.concatenate([[0.0], np.cumsum(edge)[:-1]])
     perimeter = float(edge.sum())
     if half_width is not None and not (np.isfinite(half_width) and half_width >= 0):
-        raise InvalidInputError(f"segment half width must be >= 0 m, got {half_width}")
+        raise InvalidInputError(f"segment half width must be finite and >= 0 m, got {half_width}")
     out = []
     for c in contacts:
         k = mesh.boundary_position(int(c))

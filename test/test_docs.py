@@ -749,3 +749,25 @@ def test_the_inline_signatures_are_the_functions():
     assert found >= 4 and not wrong, wrong
     assert _signature_problem("advance(model, state, translations, step=1e-2) -> StepResult",
                               "advance", "StepResult") is not None  # a default can differ
+
+
+def test_the_readme_verb_table_names_every_verb_and_only_verbs():
+    """README.md's table of the CLI lists each verb of ``squeeze-grasp`` once (the first word
+    of each backticked usage in its first column), and no verb the CLI does not have; every
+    verb has ``--json``, as the sentence above the table says.
+    """
+    from squeeze_grasp_ros.cli import add_verb_arguments, build_parser
+
+    readme = (REPO / "README.md").read_text(encoding="utf-8")
+    table = readme[readme.index("| verb | what it does"):]
+    table = table[:table.index("\n\n")]
+    listed = [usage.split()[0] for row in table.splitlines()[2:]
+              for usage in re.findall(r"`([^`]+)`", row.split(" | ")[0])]
+    parser = build_parser()
+    verbs = next(a for a in parser._actions if a.dest == "verb")._name_parser_map
+    assert sorted(listed) == sorted(verbs) and len(listed) == len(set(listed)), listed
+    assert "Every verb has `--help`, `--json`" in readme
+    without = [v for v, sub in verbs.items()
+               if "--json" not in {o for a in add_verb_arguments(sub)._actions
+                                   for o in a.option_strings}]
+    assert without == []

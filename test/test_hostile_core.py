@@ -409,3 +409,21 @@ def test_an_infinite_option_is_refused_as_not_finite(argv, message, capfd):
     must be > 0 N, got inf"): the messages say finite.
     """
     assert refused(argv, capfd).endswith(message)
+
+
+@pytest.mark.parametrize("radius", [1e6, 1e308])
+def test_a_fingertip_larger_than_a_kilometre_is_refused_by_field(tmp_path, capfd, radius):
+    """A tip radius of 1e308 m ended a squeeze with numpy warnings and "no contact mode ... can
+    be solved" (exit 3); 1e10 m ran, with events that moved with the radius (the circle's gap
+    loses about 1e-16 of the radius to round-off). Tips and pads are bounded at 1 km.
+    """
+    from squeeze_grasp_ros.mechanics.squeeze.tip_shapes import TipShape
+
+    path = variant(tmp_path, FOAM, lambda d: d["fingers"]["F1"].__setitem__("tip_radius",
+                                                                               radius))
+    assert refused(["squeeze", path], capfd).endswith(
+        f"fingers.F1.tip_radius must be in [0.0, 1000.0] m, got {radius!r}")
+    with pytest.raises(InvalidInputError, match=r"tip radius must be finite and in \[0, 1000\]"):
+        TipShape.circle(radius)
+    with pytest.raises(InvalidInputError, match=r"tip.width must be in \[2 tip.edge_radius"):
+        TipShape.pad(width=radius, edge_radius=0.002)

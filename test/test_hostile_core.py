@@ -427,3 +427,12 @@ def test_a_fingertip_larger_than_a_kilometre_is_refused_by_field(tmp_path, capfd
         TipShape.circle(radius)
     with pytest.raises(InvalidInputError, match=r"tip.width must be in \[2 tip.edge_radius"):
         TipShape.pad(width=radius, edge_radius=0.002)
+
+
+def test_a_shape_size_beyond_the_integer_range_names_the_bound(tmp_path, capfd):
+    """``side: 1e308`` was refused as "must be a positive number (m), got 1e+308", which it
+    is: the bound (2**53, the largest integer a float holds exactly) is now in the message.
+    """
+    path = variant(tmp_path, FOAM, lambda d: d["object"]["shape"].__setitem__("side", 1e308))
+    assert refused(["mesh", path], capfd).endswith(
+        "object.shape.side must be a positive number (m) of at most 9.0072e+15, got 1e+308")

@@ -114,7 +114,8 @@ def _check_shape_value(key: str, value: Any, where: str) -> None:
             raise SceneError(f"{where} must be a list of numbers (relative to the radius)")
     elif not _is_number(value) or value <= 0:
         unit = "" if key == "exponent" else " (m)"
-        raise SceneError(f"{where} must be a positive number{unit}, got {value!r}")
+        raise SceneError(f"{where} must be a positive number{unit} of at most {MAX_INT:g}, "
+                         f"got {value!r}")
 
 
 def _validate_fingers(scene: Scene) -> None:

@@ -329,3 +329,22 @@ def test_a_full_disk_during_a_sweep_is_one_line_and_leaves_no_temporary_file(swe
     data = load_dataset(keep)
     assert data.excluded == () and data.counts["done"] >= 1
     assert len(read_dataset(keep)) == 2 * data.counts["done"]
+
+
+def test_the_output_layout_sweep_md_draws_is_the_folder(pristine):
+    """docs/sweep.md's block of a sweep's output folder (``DIR/...`` paths, ``<...>`` for a
+    name) lists what a finished sweep's folder holds: every path drawn exists, and every file
+    there is drawn.
+    """
+    import fnmatch
+
+    page = (ROOT / "docs" / "sweep.md").read_text(encoding="utf-8")
+    block = page[page.index("```\nDIR/manifest.json"):]
+    block = block[4:block.index("```", 4)]
+    drawn = [re.sub(r"<[^>]+>", "*", line).split()[0].removeprefix("DIR/")
+             for line in block.splitlines() if line.strip()]
+    out = pristine / "out"
+    held = sorted(str(p.relative_to(out)) for p in out.rglob("*") if p.is_file())
+    assert len(drawn) >= 4
+    assert [d for d in drawn if not fnmatch.filter(held, d)] == [], (drawn, held)
+    assert [h for h in held if not any(fnmatch.fnmatch(h, d) for d in drawn)] == [], held

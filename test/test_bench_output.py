@@ -36,3 +36,19 @@ def test_the_quick_help_gives_the_measured_duration_range(capsys):
         main(["bench", "--help"])
     text = " ".join(capsys.readouterr().out.split())
     assert "2-6 minutes on two quiet cores" in text and "(about 2 minutes)" not in text
+
+
+def test_large_without_the_sweep_section_is_refused_before_any_section_runs(tmp_path, capfd):
+    """``bench --only solvers --large 5`` ran the solvers section and ignored ``--large`` with
+    exit 0: now one line saying --only leaves the sweep section out, no report written.
+    """
+    from squeeze_grasp_ros.cli import main
+
+    out = tmp_path / "bench"
+    assert main(["bench", "--quick", "--only", "ring", "--large", "5",
+                 "--out", str(out)]) == 2
+    captured = capfd.readouterr()
+    assert captured.err.strip() == (
+        "squeeze-grasp bench: error: --large runs the sweep section, which --only ring "
+        "leaves out: add sweep to --only")
+    assert "[bench]" not in captured.err and not (out / "report.md").exists()

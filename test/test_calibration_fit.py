@@ -98,3 +98,33 @@ def test_an_unknown_model_and_mismatched_arrays_are_refused_by_name():
         fit_compression(curve(np.linspace(0.01, 0.1, 5)), model="x")
     with pytest.raises(InvalidInputError, match=r"got shapes \(3,\) and \(2,\)"):
         CompressionCurve(*SIDES, np.ones(3), -0.001 * np.ones(2))
+
+
+@pytest.mark.parametrize("option, cells, message", [
+    ("--compression", ["--sample-size", "0.05", "0.04", "0.02", "--nu", "nan"],
+     "nu must be finite, got nan"),
+    ("--compression", ["--sample-size", "0.05", "0.04", "0.02", "--nu", "5"],
+     "nu must be in (-1, 0.5], got 5"),
+    ("--compression", ["--sample-size", "1e308", "1e308", "1e308"],
+     "--sample-size L must be in [1e-06, 1000] m, got 1e+308"),
+    ("--compression", ["--sample-size", "0.05", "1e-300", "0.02"],
+     "--sample-size W must be in [1e-06, 1000] m, got 1e-300"),
+    ("--cuboids", [], "cuboid.length must be in [1e-06, 1000] m, got 1e+308"),
+])
+def test_samples_and_ratios_out_of_range_are_refused_by_name(tmp_path, capfd, option, cells,
+                                                              message):
+    """``--nu nan`` and ``--sample-size 1e308 ...`` ended in scipy ValueError tracebacks (exit
+    1), ``--nu 5`` was accepted, and a cuboid of 1e308 m sides reported a NaN Poisson's ratio:
+    each is one line naming the field and its range, exit 2.
+    """
+    data = curve(np.linspace(0.01, 0.25, 8))
+    path = tmp_path / "data.csv"
+    if option == "--compression":
+        path.write_text("force,dl\n" + "".join(f"{float(f)!r},{float(d)!r}\n" for f, d in
+                                                zip(data.force, data.dl)))
+    else:
+        path.write_text("force,length,width,height,dl,dw\n1,1e308,1e308,1e308,-1,0.1\n"
+                        "2,1e308,1e308,1e308,-2,0.2\n")
+    assert main(["calibrate", option, str(path), *cells]) == 2
+    out, err = capfd.readouterr()
+    assert out == "" and err.strip().endswith(message) and len(err.strip().splitlines()) == 1

@@ -418,7 +418,8 @@ def test_the_executor_goal_example_is_the_foam_squares_plan():
 
 def test_the_scene_error_the_docs_quote_is_the_one_a_scene_gets():
     """scenes.md and ros.md quote the error of a Poisson's ratio out of range: it is the one
-    loading such a scene raises (the range included).
+    loading such a scene raises (the range included); scenes.md quotes that of a misspelt key
+    (line breaks aside).
     """
     from squeeze_grasp_ros.scene import SceneError, parse_scene
 
@@ -430,6 +431,11 @@ def test_the_scene_error_the_docs_quote_is_the_one_a_scene_gets():
     assert quoted == "`object.material.nu must be in [-0.9, 0.5], got 0.7`"
     for page in ("scenes.md", "ros.md"):
         assert quoted in (REPO / "docs" / page).read_text(encoding="utf-8"), page
+    doc["object"]["materal"] = doc["object"].pop("material")
+    with pytest.raises(SceneError) as misspelt:
+        parse_scene(doc)
+    scenes = " ".join((REPO / "docs" / "scenes.md").read_text(encoding="utf-8").split())
+    assert f"`{misspelt.value}`" in scenes, misspelt.value
 
 
 def _refusal(words: list[str], folder: Path) -> str:
@@ -623,3 +629,145 @@ def test_contributing_lists_every_linter_test():
     contributing = (REPO / "CONTRIBUTING.md").read_text(encoding="utf-8")
     assert "test_ruff" in tests and len(names) >= 7
     assert [name for name in names if f"test_lint.py::{name}`" not in contributing] == []
+
+
+def _shown_keys(text: str) -> dict:
+    """The keys of a JSON shape written as docs/mechanics.md writes one: ``{"key": value,
+    "bare_key", "nested": {...}}``; a nested object's value is its own dict of keys, ``...``
+    (an elided object) the key ``"..."``, every other value None.
+    """
+    root, stack, last = None, [], None
+    for key, bracket, ellipsis in re.findall(r'"(\w+)"|([{}\[\]])|(\.\.\.)', text):
+        top = stack[-1] if stack else None
+        if bracket == "{":
+            shape: dict = {}
+            if isinstance(top, dict) and last is not None:
+                top[last] = shape
+            root = shape if root is None else root
+            stack.append(shape)
+        elif bracket == "[":
+            stack.append([])
+        elif bracket:
+            stack.pop()
+        elif isinstance(top, dict):
+            top[key or "..."] = None
+        last = key if isinstance(top, dict) and bracket == "" else None
+    return root
+
+
+def _keys_match(shown: dict, actual: dict, path: str = "") -> str | None:
+    """None if ``actual`` has the keys ``shown`` lists, in their order (all of them unless
+    ``...`` elides the rest), and so for every nested object shown; else what differs.
+    """
+    keys = [k for k in shown if k != "..."]
+    listed = [k for k in actual if k in keys] if "..." in shown else list(actual)
+    if listed != keys:
+        return f"{path or 'top level'}: shown {keys}, printed {list(actual)}"
+    for key in keys:
+        if isinstance(shown[key], dict):
+            if not isinstance(actual[key], dict):
+                return f"{path}{key}: shown as an object, printed {type(actual[key]).__name__}"
+            problem = _keys_match(shown[key], actual[key], f"{path}{key}.")
+            if problem:
+                return problem
+    return None
+
+
+def test_the_plan_json_keys_mechanics_md_lists_are_what_plan_prints(scratch):
+    """docs/mechanics.md lists the keys of ``plan --json`` inline: they are the keys the verb
+    prints, in its order, nested objects included (``{...}`` elides one).
+    """
+    page = (REPO / "docs" / "mechanics.md").read_text(encoding="utf-8")
+    text = re.search(r"`plan --json` gives `(\{.*?\})`:", page, re.S).group(1)
+    command = Command("squeeze-grasp plan config/scenes/foam_square.yaml --json", ())
+    actual = json.loads("\n".join(run_command(command, scratch)))
+    shown = _shown_keys(text)
+    assert len(shown) >= 10 and isinstance(shown["stable"], dict)
+    assert _keys_match(shown, actual) is None, _keys_match(shown, actual)
+    assert _keys_match(_shown_keys('{"a": 1, "b": {"x", "y"}}'),
+                       {"a": 1, "b": {"y": 0, "x": 0}}) is not None  # the order counts
+
+
+SIGNATURE_SPAN = re.compile(r"`((?:[\w.]+\.)?(\w+)\(([^`]*?)\)\s*->\s*(\w+))`", re.S)
+"""An inline signature in the docs: ``name(params) -> Result``, the name dotted from the
+package or bare."""
+BARE_NAMES = {"advance": "mechanics.squeeze.stepper"}
+"""Where a bare name of an inline signature lives, from the package."""
+
+
+def _signature_problem(text: str, name: str, returned: str) -> str | None:
+    """None if ``text`` (``f(a, b=1, ...) -> R``) agrees with the function it names: its
+    positional names are the first parameters, in order; each keyword is a parameter with
+    that default unless shown as ``...``; the return annotation is ``R``; without a ``...``
+    every required parameter is shown.
+    """
+    import importlib
+    import inspect
+
+    call = ast.parse(text.split("->")[0].strip(), mode="eval").body
+    dotted = ast.unparse(call.func)
+    module, _, attribute = (dotted if "." in dotted else
+                            f"{BARE_NAMES[name]}.{name}").rpartition(".")
+    function = getattr(importlib.import_module(f"squeeze_grasp_ros.{module}"), attribute)
+    parameters = inspect.signature(function).parameters
+    names = list(parameters)
+    elided = any(isinstance(a, ast.Constant) and a.value is Ellipsis for a in call.args)
+    shown = [a.id for a in call.args if isinstance(a, ast.Name)]
+    if shown != names[:len(shown)]:
+        return f"{dotted}: positional {shown}, the function's {names[:len(shown)]}"
+    for keyword in call.keywords:
+        if keyword.arg not in parameters:
+            return f"{dotted}: no parameter {keyword.arg!r}"
+        value = ast.literal_eval(keyword.value)
+        if value is not Ellipsis and value != parameters[keyword.arg].default:
+            return (f"{dotted}: {keyword.arg}={value!r}, the function's default "
+                    f"{parameters[keyword.arg].default!r}")
+    required = [n for n in names if parameters[n].default is inspect.Parameter.empty]
+    missing = [n for n in required if n not in shown + [k.arg for k in call.keywords]]
+    if not elided and missing:
+        return f"{dotted}: does not show the required {missing}"
+    annotation = inspect.signature(function).return_annotation
+    if getattr(annotation, "__name__", annotation) != returned:
+        return f"{dotted}: returns {annotation}, shown {returned}"
+    return None
+
+
+def test_the_inline_signatures_are_the_functions():
+    """Every inline ``name(params) -> Result`` of the docs (docs/events.md's ``advance``,
+    docs/design.md's perception calls) names a function of the package with those parameters,
+    defaults and return type.
+    """
+    found, wrong = 0, []
+    for page in PAGES:
+        text = page.read_text(encoding="utf-8")
+        for span in SIGNATURE_SPAN.finditer(text):
+            whole, name, _, returned = span.groups()
+            problem = _signature_problem(" ".join(whole.split()), name, returned)
+            found += 1
+            if problem:
+                wrong.append(f"{page.name}:{text[:span.start()].count(chr(10)) + 1}: {problem}")
+    assert found >= 4 and not wrong, wrong
+    assert _signature_problem("advance(model, state, translations, step=1e-2) -> StepResult",
+                              "advance", "StepResult") is not None  # a default can differ
+
+
+def test_the_readme_verb_table_names_every_verb_and_only_verbs():
+    """README.md's table of the CLI lists each verb of ``squeeze-grasp`` once (the first word
+    of each backticked usage in its first column), and no verb the CLI does not have; every
+    verb has ``--json``, as the sentence above the table says.
+    """
+    from squeeze_grasp_ros.cli import add_verb_arguments, build_parser
+
+    readme = (REPO / "README.md").read_text(encoding="utf-8")
+    table = readme[readme.index("| verb | what it does"):]
+    table = table[:table.index("\n\n")]
+    listed = [usage.split()[0] for row in table.splitlines()[2:]
+              for usage in re.findall(r"`([^`]+)`", row.split(" | ")[0])]
+    parser = build_parser()
+    verbs = next(a for a in parser._actions if a.dest == "verb")._name_parser_map
+    assert sorted(listed) == sorted(verbs) and len(listed) == len(set(listed)), listed
+    assert "Every verb has `--help`, `--json`" in readme
+    without = [v for v, sub in verbs.items()
+               if "--json" not in {o for a in add_verb_arguments(sub)._actions
+                                   for o in a.option_strings}]
+    assert without == []

@@ -6,6 +6,7 @@ materials, the special case c3 = c4 = 0, an FEM round trip, and the match/calibr
 from __future__ import annotations
 
 import json
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -155,3 +156,29 @@ def test_match_and_calibrate_verbs(tmp_path, capsys):
     bad.write_text("force,length\n1,2\n")
     assert cli.main(["calibrate", "--cuboids", str(bad)]) == 2
     assert "columns" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("simulated, measured, message", [
+    # coincident simulated points were matched with scale 0 and every error 0 (exit 0)
+    ([[0, 0], [0, 0], [0, 0]], [[0, 0], [1, 0], [0, 1]], "the simulated points coincide"),
+    ([[1e-300, 0], [0, 1e-300], [-1e-300, 0]], [[0, 0], [1, 0], [0, 1]],
+     "the simulated points coincide"),
+    # 1e308 m overflowed the moments: scale inf, a NaN mean error, RuntimeWarnings (exit 0)
+    ([[1e308, 1e308], [-1e308, 1e308], [0, -1e308]], [[0, 0], [1, 0], [0, 1]],
+     "simulated points must lie within 1e+06 m of the origin (coordinates in m), got a "
+     "coordinate of 1e+308"),
+    # here the overflow was reported as "the measured points coincide"
+    ([[0, 0], [1, 0], [0, 1]], [[1e308, 1e308], [-1e308, 1e308], [0, -1e308]],
+     "measured points must lie within 1e+06 m"),
+])
+def test_degenerate_or_overflowing_point_sets_are_refused(tmp_path, capfd, simulated,
+                                                          measured, message):
+    paths = []
+    for name, points in (("sim", simulated), ("meas", measured)):
+        paths.append(tmp_path / f"{name}.csv")
+        paths[-1].write_text("x,y\n" + "".join(f"{x!r},{y!r}\n" for x, y in points))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert cli.main(["match", *map(str, paths)]) == 2
+    out, err = capfd.readouterr()
+    assert out == "" and message in err and len(err.strip().splitlines()) == 1, err

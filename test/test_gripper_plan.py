@@ -225,7 +225,13 @@ def test_gripper_plan_verb_json_and_plot(tmp_path, capsys):
 @pytest.mark.parametrize(("args", "message"), [
     (["--gripper", "no_such_gripper"], "--gripper: no shipped device 'no_such_gripper'"),
     (["--relative-closing", "1.5"], "relative closing must be in (0, 1)"),
-    (["--margin", "0.5"], "force margin must be >= 1"),
+    (["--margin", "0.5"], "force margin must be finite and >= 1"),
+    # a reversed or NaN range was shown in radians as numpy reprs, after the object's meshing:
+    # "got (np.float64(0.17453292519943295), np.float64(-0.17453292519943295))"
+    (["--yaw-range", "10", "-10"],
+     "--yaw-range MIN MAX must be finite, in deg, with MIN <= MAX, got 10 -10"),
+    (["--yaw-range", "nan", "0"],
+     "--yaw-range MIN MAX must be finite, in deg, with MIN <= MAX, got nan 0"),
 ])
 def test_gripper_plan_verb_rejects_bad_input_with_exit_2(args, message, capsys):
     code = main(["gripper-plan", str(scene_file("sponge_gripper")), *args])

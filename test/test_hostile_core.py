@@ -135,6 +135,21 @@ def test_one_relative_depth_rule_for_plan_and_ring(capfd):
         ["ring", RING, "--map", "--best", "-1"], capfd)
 
 
+@pytest.mark.parametrize("options, named", [
+    (["--best", "3"], "--best ranks the placements of --map"),
+    (["--bench", "--plot", "bench.png"], "--bench takes only --elements and --json, got --plot"),
+    (["--bench", "--map", "--depth", "0.001", "--best", "3"],
+     "--bench takes only --elements and --json, got --map, --depth, --best"),
+])
+def test_ring_options_the_task_would_ignore_are_refused(tmp_path, capfd, options, named):
+    """``ring --best 3`` (no ``--map``) and ``ring --bench --plot FILE`` exited 0, the first
+    without the ranking asked for, the second without writing the plot.
+    """
+    options = [str(tmp_path / o) if o.endswith(".png") else o for o in options]
+    assert named in refused(["ring", RING, *options], capfd)
+    assert not (tmp_path / "bench.png").exists()
+
+
 # ----------------------------------------------------------------------------- item 13
 
 
@@ -393,3 +408,58 @@ def test_generate_mesh_refuses_an_outline_built_by_hand_by_name(outline, says):
     with pytest.raises(InvalidInputError) as refused:
         generate_mesh(outline, 1e-4)
     assert str(refused.value) == says
+
+@pytest.mark.parametrize("value", ["inf", "nan", "0"])
+def test_a_run_timeout_that_is_not_a_finite_positive_number_is_refused(value, capfd):
+    """``run --timeout inf`` was refused with "--timeout must be > 0 s, got inf", which inf
+    is: the message now states the range the check applies (before any node starts).
+    """
+    pytest.importorskip("rclpy", reason="run needs ROS 2")
+    assert refused(["run", FOAM, "--timeout", value], capfd) == (
+        f"squeeze-grasp run: error: --timeout must be a finite number > 0 s, got {float(value)}")
+
+
+@pytest.mark.parametrize("argv, message", [
+    (["squeeze", FOAM, "--step", "inf"],
+     "step must be finite and >= 1e-06 (relative to the object size), got inf"),
+    (["squeeze", FOAM, "--event-tol", "inf"],
+     "event_tol must be finite and >= 1e-15 (relative to the object size), got inf"),
+    (["gripper-plan", str(SCENES / "sponge_gripper.yaml"), "--weight", "inf"],
+     "weight must be finite and > 0 N, got inf"),
+    (["gripper-plan", str(SCENES / "sponge_gripper.yaml"), "--margin", "inf"],
+     "force margin must be finite and >= 1, got inf"),
+    (["resist", str(SCENES / "resist_fig9.yaml"), "--contacts", "segment",
+      "--segment-half-width", "inf"], "segment half width must be finite and >= 0 m, got inf"),
+])
+def test_an_infinite_option_is_refused_as_not_finite(argv, message, capfd):
+    """Each refused inf with a range inf is in ("step must be >= 1e-06 ..., got inf", "weight
+    must be > 0 N, got inf"): the messages say finite.
+    """
+    assert refused(argv, capfd).endswith(message)
+
+
+@pytest.mark.parametrize("radius", [1e6, 1e308])
+def test_a_fingertip_larger_than_a_kilometre_is_refused_by_field(tmp_path, capfd, radius):
+    """A tip radius of 1e308 m ended a squeeze with numpy warnings and "no contact mode ... can
+    be solved" (exit 3); 1e10 m ran, with events that moved with the radius (the circle's gap
+    loses about 1e-16 of the radius to round-off). Tips and pads are bounded at 1 km.
+    """
+    from squeeze_grasp_ros.mechanics.squeeze.tip_shapes import TipShape
+
+    path = variant(tmp_path, FOAM, lambda d: d["fingers"]["F1"].__setitem__("tip_radius",
+                                                                               radius))
+    assert refused(["squeeze", path], capfd).endswith(
+        f"fingers.F1.tip_radius must be in [0.0, 1000.0] m, got {radius!r}")
+    with pytest.raises(InvalidInputError, match=r"tip radius must be finite and in \[0, 1000\]"):
+        TipShape.circle(radius)
+    with pytest.raises(InvalidInputError, match=r"tip.width must be in \[2 tip.edge_radius"):
+        TipShape.pad(width=radius, edge_radius=0.002)
+
+
+def test_a_shape_size_beyond_the_integer_range_names_the_bound(tmp_path, capfd):
+    """``side: 1e308`` was refused as "must be a positive number (m), got 1e+308", which it
+    is: the bound (2**53, the largest integer a float holds exactly) is now in the message.
+    """
+    path = variant(tmp_path, FOAM, lambda d: d["object"]["shape"].__setitem__("side", 1e308))
+    assert refused(["mesh", path], capfd).endswith(
+        "object.shape.side must be a positive number (m) of at most 9.0072e+15, got 1e+308")

@@ -328,7 +328,8 @@ def test_numbers_that_would_be_silently_wrong_are_refused(tmp_path, capfd):
     for name, change, message in (
         ("rel1", lambda d: d["squeeze"].__setitem__("relative_depth", 1.0),
          "squeeze.relative_depth must be in [0.0, 1.0) (at 1 the fingers would meet), got 1.0"),
-        ("step", lambda d: d["squeeze"].__setitem__("step", 1e-12), "step must be >= 1e-06"),
+        ("step", lambda d: d["squeeze"].__setitem__("step", 1e-12),
+         "step must be finite and >= 1e-06"),
     ):
         path = scene_variant(tmp_path, name, change)
         assert main(["squeeze", path]) == 2

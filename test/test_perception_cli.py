@@ -111,10 +111,15 @@ def test_bad_input_exits_2_with_one_line(tmp_path, capsys, argv, message):
 @pytest.mark.parametrize("option, message", [
     (["--seed", "-1"], "seed must be an integer >= 0, got -1"),
     (["--blur", "1e9"], "blur_px must be at most the image's larger side (640 px)"),
+    (["--depth-noise", "1e308"], "depth_noise_m must be in [0, 0.1], got 1e+308"),
+    (["--mask-noise", "1e308"], "mask_noise must be in [0, 1], got 1e+308"),
 ])
 def test_render_refuses_a_negative_seed_and_a_blur_wider_than_the_image(tmp_path, capsys,
                                                                         option, message):
-    """Both were tracebacks: numpy's seed ValueError, a 60 GiB kernel's MemoryError."""
+    """Both were tracebacks: numpy's seed ValueError, a 60 GiB kernel's MemoryError. A noise
+    of 1e308 wrote an image of overflowed noise with exit 0 and numpy RuntimeWarnings (a depth
+    of inf at every pixel, 0 in a 16UC1 PNG); its bounds are the scene camera's.
+    """
     mask = tmp_path / "mask.png"
     code = cli.main(["render", str(scene_file("foam_square")), *CAMERA, "--mask", str(mask),
                      *option])

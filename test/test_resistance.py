@@ -401,3 +401,35 @@ def test_a_node_index_outside_the_mesh_is_refused(square, bad):
     b = [int(k) for k in square.mesh.boundary]
     with pytest.raises(InvalidInputError, match=r"contact nodes must be node indices in \[0, "):
         resistance_grasp(square, {"F1": [b[0]], "F2": [bad], "A": [b[5]]})
+
+
+def test_a_direction_beyond_the_float_range_is_the_same_direction(blob):
+    """``--compare-direction 1e308 1e308`` overflowed the normalisation (with a RuntimeWarning)
+    and compared the resistance along [0, 0]: now it is the resistance along [1, 1], bit for
+    bit, and the ordinary direction's answer is unchanged.
+    """
+    grasp = resistance_grasp(blob, random_placement(blob, np.random.default_rng(8)))
+    a = np.array([0.0024, 0.0044])
+    along = resistance_along(grasp, a, [1.0, 1.0], "stable")
+    with np.errstate(all="raise"):
+        huge = resistance_along(grasp, a, [1e308, 1e308], "stable")
+    assert huge.success and huge.reason == along.reason
+    assert np.array_equal(huge.d1, along.d1) and huge.work == along.work
+
+
+def test_overlapping_segments_name_the_half_width_and_its_bound(capsys):
+    """A ``--segment-half-width`` so wide that two fingers' segments meet was refused as
+    "contact sets of F1, F2 and A must be disjoint" with three lists of up to 60 nodes, not
+    naming the option or its bound: now one short line with the nearest contacts' distance
+    along the boundary and the half width below which the segments stay apart.
+    """
+    words = ["resist", f"{SCENES}/resist_fig9.yaml", "--contacts", "segment",
+             "--segment-half-width"]
+    assert main([*words, "1e308"]) == 2
+    message = capsys.readouterr().err.strip()
+    assert message == (
+        "squeeze-grasp resist: error: segment half width 1e+308 m makes the contact segments "
+        "of F1 and F2 overlap; the nearest contacts, F2 and A, are 0.09472 m apart along the "
+        "boundary, so the half width must be below 0.04736 m")
+    assert main([*words, "0.0473", "--json"]) == 0
+    capsys.readouterr()

@@ -50,7 +50,7 @@ def mutate(path: str, value):
     ("object.mesh.min_angle", 40, "object.mesh.min_angle must be in"),
     ("object.shape.type", "hexagon", "object.shape.type must be one of"),
     ("object.shape.radius", 0.1, "unknown key object.shape.radius"),
-    ("fingers.F1.tip_radius", -0.01, "fingers.F1.tip_radius must be >= 0"),
+    ("fingers.F1.tip_radius", -0.01, "fingers.F1.tip_radius must be in \\[0.0, 1000.0\\] m"),
     ("fingers.F1.placement", {"point": [0, 0], "node": 3}, "exactly one of"),
     ("fingers.F3", {"placement": {"node": 1}}, "unknown finger fingers.F3"),
     ("squeeze.depth", 0.01, "exclusive"),
@@ -60,6 +60,11 @@ def mutate(path: str, value):
     ("strain_limit", {"epsilon": 0.1}, "section strain_limit is given but effect"),
     ("object.material.E", "soft", "object.material.E must be a number"),
     ("object.material", KeyError, "missing required key object.material"),
+    # a misspelt key is named with the key it is closest to, if one is close
+    ("object.materal", {"E": 5e4}, r"unknown key object.materal: did you mean 'material'\? "),
+    ("object.shape.sid", 0.1, r"unknown key object.shape.sid for type square: did you mean "
+                              r"'side'\? (allowed: \['side'\]"),
+    ("xyzzy", 1, r"unknown key xyzzy (allowed: \['actuators'"),
 ])
 def test_scene_errors_name_the_field(path, value, message):
     with pytest.raises(SceneError, match=message.replace("(", r"\(")):

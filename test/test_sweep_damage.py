@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import json
 import os
+import re
 import shutil
 import subprocess
 import sys
@@ -187,6 +188,71 @@ def test_a_bad_manifest_is_one_line(sweep, text, problem, capfd):
         assert len(err.strip().splitlines()) == 1
 
 
+def _edit_rows(part: Path) -> None:
+    """Double one row's energy and rewrite the part whole, metadata and all."""
+    import pyarrow.parquet as pq
+
+    table = pq.read_table(part)
+    energy = table.column("energy").to_pylist()
+    energy[0] = 2.0 * energy[0]
+    pq.write_table(table.set_column(table.schema.get_field_index("energy"), "energy",
+                                    pa.array(energy)), part)
+
+
+def _other_sweeps_part(sweep: Path) -> None:
+    other = parse_sweep_spec({**SPEC, "seed": 4}, sweep)
+    task = plan_tasks(other)[0]
+    write_part(sweep / "out" / "parts" / f"{task.id}.parquet",
+               part_table(run_task(task)["rows"], task.id, other.hash))
+
+
+def _folder_for_part(sweep: Path) -> None:
+    victim = parts(sweep)[1]
+    victim.unlink()
+    victim.mkdir()
+
+
+DOC_DAMAGES = {
+    "empty or truncated part": lambda s: parts(s)[1].write_bytes(b""),
+    "a part copied over another's name": lambda s: shutil.copy(parts(s)[0], parts(s)[1]),
+    "a part of another sweep": _other_sweeps_part,
+    "a part edited in place, a flipped byte": lambda s: _edit_rows(parts(s)[1]),
+    "an unknown part (`zz-evil.parquet`)": lambda s: shutil.copy(
+        parts(s)[0], s / "out" / "parts" / "zz-evil.parquet"),
+    "a folder named like a part": _folder_for_part,
+    "a deleted part": lambda s: parts(s)[1].unlink(),
+    "`manifest.json` is `{bad`": lambda s: (s / "out" / "manifest.json").write_text("{bad"),
+    "`manifest.json` is a FIFO": lambda s: ((s / "out" / "manifest.json").unlink(),
+                                            os.mkfifo(s / "out" / "manifest.json")),
+}
+"""The damages of docs/reliability.md's table, by the start of their row."""
+
+
+def test_the_damage_table_quotes_what_sweep_report_says(pristine, tmp_path):
+    """Each message docs/reliability.md's table of damaged sweep folders quotes in its
+    "``sweep-report`` now" column (``X``, ``A``, ``B`` standing for task ids and ``...`` for
+    any text) is in what ``sweep-report`` prints for that damage, in a child process.
+    """
+    page = (ROOT / "docs" / "reliability.md").read_text(encoding="utf-8")
+    rows = [line.split(" | ") for line in page.splitlines()
+            if line.startswith("| ") and line.count(" | ") == 3]
+    checked = 0
+    for k, (start, damage) in enumerate(DOC_DAMAGES.items()):
+        row = next(r for r in rows if r[0].removeprefix("| ").startswith(start))
+        quoted = re.findall(r"`([^`]+)`", row[2])
+        sweep = tmp_path / str(k)
+        shutil.copytree(pristine, sweep)
+        damage(sweep)
+        done = run_cli(["sweep-report", str(sweep / "out")])
+        said = done.stdout + done.stderr
+        for quote in quoted:
+            pattern = re.sub(r"\b[XAB]\b", r"[\\w~.-]+",
+                             re.escape(quote).replace(r"\.\.\.", ".*"))
+            assert re.search(pattern, said), (start, quote, said)
+            checked += 1
+    assert checked >= 8
+
+
 def run_cli(args: list[str], timeout: float = 120) -> subprocess.CompletedProcess:
     return subprocess.run([sys.executable, "-m", "squeeze_grasp_ros.cli", *args],
                           capture_output=True, text=True, timeout=timeout)
@@ -263,3 +329,22 @@ def test_a_full_disk_during_a_sweep_is_one_line_and_leaves_no_temporary_file(swe
     data = load_dataset(keep)
     assert data.excluded == () and data.counts["done"] >= 1
     assert len(read_dataset(keep)) == 2 * data.counts["done"]
+
+
+def test_the_output_layout_sweep_md_draws_is_the_folder(pristine):
+    """docs/sweep.md's block of a sweep's output folder (``DIR/...`` paths, ``<...>`` for a
+    name) lists what a finished sweep's folder holds: every path drawn exists, and every file
+    there is drawn.
+    """
+    import fnmatch
+
+    page = (ROOT / "docs" / "sweep.md").read_text(encoding="utf-8")
+    block = page[page.index("```\nDIR/manifest.json"):]
+    block = block[4:block.index("```", 4)]
+    drawn = [re.sub(r"<[^>]+>", "*", line).split()[0].removeprefix("DIR/")
+             for line in block.splitlines() if line.strip()]
+    out = pristine / "out"
+    held = sorted(str(p.relative_to(out)) for p in out.rglob("*") if p.is_file())
+    assert len(drawn) >= 4
+    assert [d for d in drawn if not fnmatch.filter(held, d)] == [], (drawn, held)
+    assert [h for h in held if not any(fnmatch.fnmatch(h, d) for d in drawn)] == [], held

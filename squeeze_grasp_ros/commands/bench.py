@@ -13,6 +13,7 @@ from squeeze_grasp_ros.bench import SECTIONS, missing
 from squeeze_grasp_ros.bench.sweep_large import DEFAULT_EVALUATIONS, TARGET_EVALUATIONS
 from squeeze_grasp_ros.bench.table import Table
 from squeeze_grasp_ros.commands.common import int_in, output_folder
+from squeeze_grasp_ros.mechanics.errors import InvalidInputError
 from squeeze_grasp_ros.outputs import write_atomically
 
 
@@ -27,7 +28,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         type=int_in(1, 10_000_000), metavar="N",
                         help="the sweep section runs N evaluations (default "
                              f"{DEFAULT_EVALUATIONS:,}) on the local Dask cluster instead of "
-                             f"its tables and extrapolates to {TARGET_EVALUATIONS:,}")
+                             f"its tables and extrapolates to {TARGET_EVALUATIONS:,} (with "
+                             "--only: sweep among its sections)")
     parser.add_argument("--out", default="bench_out", type=output_folder,
                         help="report directory (default: bench_out)")
 
@@ -37,7 +39,16 @@ def _progress(message: str) -> None:
 
 
 def run(args: argparse.Namespace) -> dict:
-    """Run the sections; write OUT/report.md and the plots."""
+    """Run the sections; write OUT/report.md and the plots.
+
+    Raises
+    ------
+    InvalidInputError
+        For ``--large`` with an ``--only`` list without ``sweep``, the one section it changes.
+    """
+    if args.large and args.only and "sweep" not in args.only:
+        raise InvalidInputError(f"--large runs the sweep section, which --only "
+                                f"{' '.join(args.only)} leaves out: add sweep to --only")
     out = Path(args.out)
     tables, skipped = [], []
     for name in args.only or SECTIONS:

@@ -16,10 +16,12 @@ from squeeze_grasp_ros.mechanics.calibration.hyperelastic_fit import (
     linear_validity,
 )
 from squeeze_grasp_ros.mechanics.calibration.material_fit import (
+    SIDE_RANGE,
     Cuboid,
     calibrate_elasticity,
     friction_from_angle,
     friction_from_trials,
+    require_side,
 )
 from squeeze_grasp_ros.mechanics.errors import InvalidInputError
 from squeeze_grasp_ros.mechanics.vocabulary import MaterialModel, StrainMeasure
@@ -37,10 +39,11 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                              "(N, m; dl < 0): fits the linear and the neo-Hookean law and says "
                              "up to which strain linear suffices; needs --sample-size")
     parser.add_argument("--sample-size", type=float, nargs=3, metavar=("L", "W", "H"),
-                        help="the compressed cuboid's sides, m: loaded length, width, height")
+                        help="the compressed cuboid's sides, m: loaded length, width, height "
+                             f"(each in [{SIDE_RANGE[0]:g}, {SIDE_RANGE[1]:g}])")
     parser.add_argument("--nu", type=float, default=0.3,
-                        help="Poisson's ratio used when the curve has no dw column "
-                             "(default 0.3)")
+                        help="Poisson's ratio used when the curve has no dw column, in "
+                             "(-1, 0.5] (default 0.3)")
     slope = parser.add_mutually_exclusive_group()
     slope.add_argument("--slope-angle", type=float, metavar="DEG",
                        help="critical slope angle alpha0, degrees: mu = tan(alpha0)")
@@ -59,6 +62,8 @@ def _compression(args: argparse.Namespace) -> dict:
     """Linear and neo-Hookean fits of one compression curve, and linear's validity range."""
     if not args.sample_size:
         raise InvalidInputError("--compression needs --sample-size L W H (m)")
+    for letter, side in zip("LWH", args.sample_size):
+        require_side(f"--sample-size {letter}", side)
     rows = read_columns(args.compression, ("force", "dl"), ("dw",))
     try:
         force = [float(r["force"]) for r in rows]

@@ -37,7 +37,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--evaluate", type=int_in(0, 100), default=3,
                         help="best candidates squeezed with the pads (default 3)")
     parser.add_argument("--yaw-range", type=float, nargs=2, metavar=("MIN", "MAX"),
-                        help="allowed closing directions in the object frame, deg (mod 180)")
+                        help="allowed closing directions in the object frame, deg (mod 180; "
+                             "finite, MIN <= MAX)")
     parser.add_argument("--weight", type=float, metavar="N",
                         help="the object's weight if it is to be lifted (default: the scene's "
                              "pickup.weight)")
@@ -63,6 +64,11 @@ def gripper_device(text: str) -> GripperSpec:
 def run(args: argparse.Namespace) -> dict:
     """Plan the gripper grasps of the scene's object."""
     gripper = gripper_device(args.gripper)
+    if args.yaw_range is not None:
+        lo, hi = args.yaw_range
+        if not (np.isfinite(lo) and np.isfinite(hi) and lo <= hi):
+            raise InvalidInputError(f"--yaw-range MIN MAX must be finite, in deg, with MIN <= "
+                                    f"MAX, got {lo:g} {hi:g}")
     setup = load_setup(args.scene, args.solver)
     yaw = None if args.yaw_range is None else tuple(np.radians(args.yaw_range))
     options = {"count": args.count, "evaluate": min(args.evaluate, args.count),

@@ -13,7 +13,7 @@ from squeeze_grasp_ros.commands.common import add_scene_argument, output_file
 from squeeze_grasp_ros.mechanics.errors import InvalidInputError
 from squeeze_grasp_ros.outputs import write_atomically
 from squeeze_grasp_ros.perception.image_files import encode_png
-from squeeze_grasp_ros.perception.render import CameraViews, render_views, ring_band
+from squeeze_grasp_ros.perception.render import MAX_NOISE, CameraViews, render_views, ring_band
 from squeeze_grasp_ros.scene import build_outline, load_scene
 
 MAX_16UC1_M = 65.5355
@@ -31,10 +31,12 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--blur", type=float, default=0.0, metavar="PX",
                         help="Gaussian blur of the coverage, std in px (default 0)")
     parser.add_argument("--depth-noise", type=float, default=0.0, metavar="M",
-                        help="Gaussian depth noise, std in m (default 0)")
+                        help="Gaussian depth noise, std in m, at most "
+                             f"{MAX_NOISE['depth_noise_m']:g} (default 0)")
     parser.add_argument("--mask-noise", type=float, default=0.0, metavar="F",
                         help="Gaussian noise on the coverage before quantisation, std as a "
-                             "fraction of full scale (default 0)")
+                             f"fraction of full scale, at most {MAX_NOISE['mask_noise']:g} "
+                             "(default 0)")
     parser.add_argument("--seed", type=int, default=0, help="seed of the noise (default 0)")
 
 

@@ -53,7 +53,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "--segment-half-width",
         type=float,
         metavar="M",
-        help="segment contacts: arc length, m, on each side of a contact node",
+        help="segment contacts: arc length, m, on each side of a contact node (>= 0, below "
+             "half the boundary distance of the nearest two contacts)",
     )
     parser.add_argument(
         "--compare-direction",

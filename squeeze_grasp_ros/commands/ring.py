@@ -18,6 +18,7 @@ import numpy as np
 from squeeze_grasp_ros import plots
 from squeeze_grasp_ros.commands.common import add_plot_argument, add_scene_argument, int_in
 from squeeze_grasp_ros.commands.ring_map import closed, map_summary, plot_map
+from squeeze_grasp_ros.mechanics.errors import InvalidInputError
 from squeeze_grasp_ros.mechanics.ring.grasp_map import bench_ring
 from squeeze_grasp_ros.mechanics.ring.model import MAX_RING_ELEMENTS, RingModel
 from squeeze_grasp_ros.mechanics.ring.squeeze import RingGrasp
@@ -32,6 +33,8 @@ from squeeze_grasp_ros.scene.studies import grasp_map_study, ring_placement
 
 MAX_BEST = 10_000
 """Most placements ``--map --best`` lists."""
+DEFAULT_BEST = 10
+"""Placements ``--map`` lists without ``--best``."""
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -60,14 +63,15 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--best",
         type=int_in(1, MAX_BEST),
-        default=10,
         metavar="K",
-        help=f"--map: list the K placements with the largest maximum depth (1 to {MAX_BEST})",
+        help=f"--map: list the K placements with the largest maximum depth (1 to {MAX_BEST}, "
+             f"default {DEFAULT_BEST})",
     )
     parser.add_argument(
         "--bench",
         action="store_true",
-        help="time the precompute, the all-pairs map and single placements",
+        help="time the precompute, the all-pairs map and single placements (takes --elements "
+             "and --json only)",
     )
     add_plot_argument(parser)
 
@@ -91,6 +95,7 @@ def load_ring(path: str, elements: int | None = None) -> GraspSetup:
 
 def run(args: argparse.Namespace) -> dict:
     """One placement, the map (``--map``) or timings (``--bench``)."""
+    _require_used(args)
     setup = load_ring(args.scene, args.elements)
     scene = setup.scene
     if args.bench:
@@ -106,11 +111,33 @@ def run(args: argparse.Namespace) -> dict:
         study = grasp_map_study(setup, relative_depth=args.relative_depth)
         if args.plot:
             plot_map(setup.ring, study.map, args.plot)
-        return study.to_json(best=args.best)
+        return study.to_json(best=args.best or DEFAULT_BEST)
     placement = ring_placement(setup, depth=args.depth, relative_depth=args.relative_depth)
     if args.plot:
         plot_grasp(setup.ring, placement.grasp, placement.depth, args.plot)
     return placement.to_json()
+
+
+def _require_used(args: argparse.Namespace) -> None:
+    """Refuse an option the chosen task would ignore: ``--bench`` times the scene's ring and
+    draws nothing, and ``--best`` ranks the placements of ``--map`` only.
+
+    Raises
+    ------
+    InvalidInputError
+        Naming the ignored options.
+    """
+    if args.bench:
+        given = [name for name, value in (("--map", args.map), ("--depth", args.depth),
+                                          ("--relative-depth", args.relative_depth),
+                                          ("--best", args.best), ("--plot", args.plot))
+                 if value not in (None, False)]
+        if given:
+            raise InvalidInputError(f"--bench takes only --elements and --json, got "
+                                    f"{', '.join(given)}")
+    elif args.best is not None and not args.map:
+        raise InvalidInputError("--best ranks the placements of --map: give --map, or leave "
+                                "--best out for the scene's placement")
 
 
 def _cone(ax, apex: np.ndarray, normal: np.ndarray, mu: float, length: float, **style) -> None:

@@ -91,8 +91,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                              "never see each other); with --attach: the running nodes' "
                              "namespace (default: /)")
     parser.add_argument("--timeout", type=float, default=300.0, metavar="SECONDS",
-                        help="wall-clock seconds to wait for any step of the run (a node that "
-                             "hangs or dies ends the run with exit 4; default: 300)")
+                        help="wall-clock seconds to wait for any step of the run, finite and "
+                             "> 0 (a node that hangs or dies ends the run with exit 4; default: "
+                             "300)")
 
 
 NAMESPACE = re.compile(r"(/[A-Za-z_][A-Za-z0-9_]*)+")
@@ -138,7 +139,8 @@ def _run(args: argparse.Namespace) -> dict | int:
     from squeeze_grasp_ros.ros.run.runner import PipelineRunner
 
     if not (args.timeout > 0 and args.timeout < float("inf")):
-        return fail(args, f"--timeout must be > 0 s, got {args.timeout}", ExitCode.USAGE)
+        return fail(args, f"--timeout must be a finite number > 0 s, got {args.timeout}",
+                    ExitCode.USAGE)
     if args.record and not args.attach:  # attach records nothing (the runner says so)
         refused = prepare_recording(args.record)
         if refused is not None:

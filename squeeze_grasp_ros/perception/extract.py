@@ -402,7 +402,7 @@ def _outline(loops: list[np.ndarray], camera: CameraModel, pose: CameraPose,
 def _positive(**values: float) -> None:
     for name, value in values.items():
         if not (np.isfinite(value) and value > 0):
-            raise InvalidInputError(f"{name} must be positive, got {value!r}")
+            raise InvalidInputError(f"{name} must be finite and positive, got {value!r}")
 
 
 def extract_outline(image: np.ndarray, encoding: ImageEncoding | str, camera: CameraModel,

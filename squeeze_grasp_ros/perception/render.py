@@ -37,6 +37,10 @@ __all__ = ["CameraViews", "coverage", "render_views", "ring_band"]
 
 MAX_EDGE_PX = 0.5
 """Longest projected edge (px) drawn straight when the camera has distortion."""
+MAX_NOISE = {"depth_noise_m": 0.1, "mask_noise": 1.0}
+"""Largest noise :func:`render_views` draws, as a scene's ``camera`` section allows it: a
+depth noise in m, a mask noise as a fraction of full scale. Beyond, the image is noise alone
+(a depth noise of 1e308 m overflowed to an all-inf depth image, all 0 as a 16UC1 PNG)."""
 
 
 @dataclass(frozen=True)
@@ -294,18 +298,20 @@ def render_views(outline: Outline, camera: CameraModel, pose: CameraPose, *,
         Standard deviation of a Gaussian blur of the coverage (defocus), px, in [0, the image's
         larger side] (a wider blur flattens the whole image; its kernel would not fit memory).
     depth_noise_m : float
-        Standard deviation of Gaussian noise added to each depth pixel, m, >= 0.
+        Standard deviation of Gaussian noise added to each depth pixel, m, in [0, 0.1]
+        (:data:`MAX_NOISE`).
     mask_noise : float
         Standard deviation of Gaussian noise added to the coverage before it is quantised into
-        the mask (fraction of full scale), >= 0.
+        the mask (fraction of full scale), in [0, 1].
     seed : int
         Seed of the noise draws, an integer >= 0.
 
     Raises
     ------
     InvalidInputError
-        For a negative option or seed, a blur wider than the image, a top face at or above the
-        camera, or a view in which some pixel does not see the plane.
+        For a negative option or seed, a noise above :data:`MAX_NOISE`, a blur wider than the
+        image, a top face at or above the camera, or a view in which some pixel does not see the
+        plane.
     """
     from scipy.ndimage import gaussian_filter
 
@@ -314,6 +320,9 @@ def render_views(outline: Outline, camera: CameraModel, pose: CameraPose, *,
         if not (np.isfinite(value) and value >= 0):
             raise InvalidInputError(f"render_views: {name} must be a finite number >= 0, got "
                                     f"{value!r}")
+        if value > MAX_NOISE.get(name, np.inf):
+            raise InvalidInputError(f"render_views: {name} must be in [0, {MAX_NOISE[name]:g}], "
+                                    f"got {value:g}")
     if blur_px > max(camera.shape):
         raise InvalidInputError(f"render_views: blur_px must be at most the image's larger side "
                                 f"({max(camera.shape)} px), got {blur_px!r}")

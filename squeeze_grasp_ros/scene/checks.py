@@ -27,7 +27,7 @@ from squeeze_grasp_ros.mechanics.vocabulary import (
     ObjectModel,
     TipKind,
 )
-from squeeze_grasp_ros.scene.schema import MAX_INT, SchemaError
+from squeeze_grasp_ros.scene.schema import MAX_INT, SchemaError, unknown_key
 from squeeze_grasp_ros.scene.specs import (
     SHAPES,
     MaterialSpec,
@@ -65,10 +65,8 @@ def check_shape(shape: Mapping[str, Any], where: str = "object.shape") -> None:
     allowed = set(SHAPES[kind]) | {"type"}
     unknown = sorted(set(shape) - allowed, key=str)
     if unknown:
-        raise SceneError(
-            f"unknown key {where}.{unknown[0]} for type {kind} "
-            f"(allowed: {sorted(allowed - {'type'})})"
-        )
+        raise SceneError(unknown_key(where, unknown[0], allowed - {"type"},
+                                     context=f" for type {kind}"))
     optional = {"cos", "sin", "holes", "corners"}
     for key in SHAPES[kind]:
         if key not in shape and key not in optional:
@@ -117,7 +115,8 @@ def _check_shape_value(key: str, value: Any, where: str) -> None:
             raise SceneError(f"{where} must be a list of numbers (relative to the radius)")
     elif not _is_number(value) or value <= 0:
         unit = "" if key == "exponent" else " (m)"
-        raise SceneError(f"{where} must be a positive number{unit}, got {value!r}")
+        raise SceneError(f"{where} must be a positive number{unit} of at most {MAX_INT:g}, "
+                         f"got {value!r}")
 
 
 def _validate_fingers(scene: Scene) -> None:

@@ -25,6 +25,7 @@ squeeze_grasp_ros.scene.schema.SchemaError: tip.radius must be >= 0.0 m, got -1.
 from __future__ import annotations
 
 import dataclasses
+import difflib
 import types
 import typing
 from collections.abc import Mapping
@@ -37,7 +38,7 @@ from squeeze_grasp_ros.inputs import yaml11_number
 from squeeze_grasp_ros.mechanics.errors import InvalidInputError
 
 __all__ = ["MAX_INT", "SchemaError", "describe_range", "key_reference", "parse_section",
-           "spec"]
+           "spec", "unknown_key"]
 
 MAX_INT = 2**53
 """Largest integer an entry may hold (exactly representable as a float)."""
@@ -177,6 +178,32 @@ def _convert(tp: Any, value: Any, meta: dict, where: str, error: type[SchemaErro
     raise TypeError(f"unsupported schema field type {tp!r} at {where}")
 
 
+def unknown_key(where: str, key: Any, allowed: typing.Iterable[str], *, context: str = "") -> str:
+    """The message for ``key``, not a key of the mapping at ``where``: its path, the allowed
+    key it is most likely a misspelling of (if one is close) and every allowed key.
+
+    Parameters
+    ----------
+    where : str
+        Key path of the mapping ("" for the top level).
+    key : Any
+        The unknown key (YAML keys need not be strings).
+    allowed : iterable of str
+        The keys the mapping takes.
+    context : str
+        Said after the path (e.g. ``" for type disk"``).
+
+    >>> unknown_key("object", "materal", ["material", "mesh", "shape"])
+    "unknown key object.materal: did you mean 'material'? (allowed: ['material', 'mesh', \
+'shape'])"
+    """
+    allowed = sorted(allowed)
+    path = f"{where}.{key}" if where else str(key)
+    close = difflib.get_close_matches(str(key), allowed, n=1)
+    guess = f": did you mean {close[0]!r}?" if close else ""
+    return f"unknown key {path}{context}{guess} (allowed: {allowed})"
+
+
 def parse_section(cls: type, data: Any, where: str, *,
                   error: type[SchemaError] = SchemaError) -> Any:
     """Parse mapping ``data`` into dataclass ``cls``; errors name ``where.<field>``.
@@ -198,8 +225,7 @@ def parse_section(cls: type, data: Any, where: str, *,
     fields = {f.name: f for f in dataclasses.fields(cls)}
     unknown = sorted(set(data) - set(fields), key=str)
     if unknown:
-        path = f"{where}.{unknown[0]}" if where else unknown[0]
-        raise error(f"unknown key {path} (allowed: {sorted(fields)})")
+        raise error(unknown_key(where, unknown[0], fields))
     kwargs = {}
     for name, f in fields.items():
         path = f"{where}.{name}" if where else name

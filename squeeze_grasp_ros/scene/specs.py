@@ -18,7 +18,7 @@ from typing import Any, Optional
 from squeeze_grasp_ros.mechanics.elastic.mesh import MAX_MESH_NODES
 from squeeze_grasp_ros.mechanics.errors import FINGERS_MEET
 from squeeze_grasp_ros.mechanics.ring.model import MAX_RING_ELEMENTS
-from squeeze_grasp_ros.mechanics.squeeze.tip_shapes import TipShape
+from squeeze_grasp_ros.mechanics.squeeze.tip_shapes import MAX_TIP_SIZE, TipShape
 from squeeze_grasp_ros.mechanics.vocabulary import (
     ContactKind,
     ControllerKind,
@@ -153,13 +153,13 @@ class TipSpec:
 
     shape: TipKind = spec("tip shape", default=TipKind.CIRCLE)
     radius: Optional[float] = spec("circle radius (shape: circle)", "m", lo=0.0, lo_open=True,
-                                   default=None)
+                                   hi=MAX_TIP_SIZE, default=None)
     width: Optional[float] = spec("whole pad width w across the closing direction, at least "
                                   "2 edge_radius (shape: pad)", "m", lo=0.0, lo_open=True,
-                                  default=None)
+                                  hi=MAX_TIP_SIZE, default=None)
     edge_radius: Optional[float] = spec("radius r_e of the pad's two rounded edges; the flat "
                                         "face is w - 2 r_e wide (shape: pad)", "m", lo=0.0,
-                                        lo_open=True, default=None)
+                                        lo_open=True, hi=MAX_TIP_SIZE, default=None)
 
     def shape_of(self) -> TipShape:
         """The mechanics' :class:`~squeeze_grasp_ros.mechanics.squeeze.tip_shapes.TipShape`
@@ -184,7 +184,7 @@ class FingerSpec:
     placement: PlacementSpec = spec("initial contact")
     tip_radius: float = spec("fingertip radius (0 = point finger); with tip given, filled "
                              "with the tip's radius (a pad's edge radius)", "m", lo=0.0,
-                             default=0.0)
+                             hi=MAX_TIP_SIZE, default=0.0)
     tip: Optional[TipSpec] = spec("fingertip shape instead of tip_radius: {shape: circle, "
                                   "radius} or {shape: pad, width, edge_radius}", default=None)
     device: str = spec(
@@ -284,7 +284,8 @@ class AdversarySpec:
 
     placement: PlacementSpec = spec("initial contact of A")
     a: tuple[float, float] = spec("translation of A", "m")
-    tip_radius: float = spec("fingertip radius of A", "m", lo=0.0, default=0.0)
+    tip_radius: float = spec("fingertip radius of A", "m", lo=0.0, hi=MAX_TIP_SIZE,
+                             default=0.0)
     mode: SqueezeKind = spec("resistance type", choices=SqueezeKind.planned(),
                              default=SqueezeKind.STABLE)
     contacts: ContactKind = spec("contact model", default=ContactKind.POINT)

@@ -22,6 +22,7 @@ from typing import Any, Optional
 
 from squeeze_grasp_ros.mechanics.errors import FINGERS_MEET
 from squeeze_grasp_ros.mechanics.resistance.optimal import MAX_DIRECTIONS
+from squeeze_grasp_ros.mechanics.squeeze.tip_shapes import MAX_TIP_SIZE
 from squeeze_grasp_ros.mechanics.vocabulary import (
     ContactKind,
     Effect,
@@ -198,7 +199,8 @@ class SweepSpec:
         "friction coefficients mu", "", lo=0.0, hi=1e3, default=None
     )
     tip_radius: Optional[tuple[float, ...]] = spec(
-        "fingertip radii (both fingers)", "m", lo=0.0, lo_open=True, default=None
+        "fingertip radii (both fingers)", "m", lo=0.0, lo_open=True, hi=MAX_TIP_SIZE,
+        default=None
     )
     squeeze: Optional[tuple[SqueezeKind, ...]] = spec(
         "squeeze types", choices=SqueezeKind.planned(), default=None

@@ -31,7 +31,8 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import least_squares
 
-from squeeze_grasp_ros.mechanics.errors import InvalidInputError, NumericalError
+from squeeze_grasp_ros.mechanics.calibration.material_fit import require_side
+from squeeze_grasp_ros.mechanics.errors import InvalidInputError, NumericalError, require_finite
 from squeeze_grasp_ros.mechanics.vocabulary import MaterialModel
 
 __all__ = ["CompressionCurve", "MaterialFit", "fit_compression", "linear_validity",
@@ -45,7 +46,8 @@ class CompressionCurve:
     Attributes
     ----------
     length, width, height : float
-        Undeformed sides l (loaded), w, h, m (> 0).
+        Undeformed sides l (loaded), w, h, m (in
+        :data:`~squeeze_grasp_ros.mechanics.calibration.material_fit.SIDE_RANGE`).
     force : (k,) ndarray
         Compressive force magnitudes, N (> 0).
     dl : (k,) ndarray
@@ -63,9 +65,7 @@ class CompressionCurve:
 
     def __post_init__(self) -> None:
         for name in ("length", "width", "height"):
-            value = getattr(self, name)
-            if not (np.isfinite(value) and value > 0):
-                raise InvalidInputError(f"{name} must be > 0 m, got {value}")
+            require_side(name, getattr(self, name))
         force, dl = np.asarray(self.force, float), np.asarray(self.dl, float)
         if force.shape != dl.shape or force.ndim != 1 or len(force) < 2:
             raise InvalidInputError("a compression curve needs at least 2 (force, dl) points, "
@@ -149,15 +149,28 @@ def fit_compression(curve: CompressionCurve, *, model: MaterialModel | str,
     """Least-squares fit of ``model`` to ``curve``; nu is fitted when ``curve.dw`` is given,
     else held at ``nu``.
 
+    Parameters
+    ----------
+    curve : CompressionCurve
+        The measured compression.
+    model : MaterialModel or str
+        ``linear`` or ``neo_hookean``.
+    nu : float
+        Poisson's ratio, dimensionless, in (-1, 0.5] (below 0.5 for ``neo_hookean``): held
+        when ``curve.dw`` is None, else the fit's starting value.
+
     Raises
     ------
     InvalidInputError
         For a ``model`` other than ``linear`` or ``neo_hookean``, or a ``nu`` the law cannot
-        take.
+        take (not finite or outside (-1, 0.5]).
     """
     if model not in MaterialModel.values():
         raise InvalidInputError(f"model must be linear or neo_hookean, got {model!r}")
     model = MaterialModel(model)
+    require_finite("nu", nu)
+    if not -1.0 < nu <= 0.5:
+        raise InvalidInputError(f"nu must be in (-1, 0.5], got {nu:g}")
     if model == MaterialModel.COROTATIONAL:
         raise InvalidInputError("calibrate fits linear and neo_hookean laws (the corotational "
                                 "law's uniaxial response is the linear one)")

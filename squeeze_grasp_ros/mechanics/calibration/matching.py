@@ -32,6 +32,34 @@ import numpy as np
 
 from squeeze_grasp_ros.mechanics.errors import InvalidInputError, require_finite
 
+MAX_COORDINATE = 1e6
+"""Largest coordinate magnitude of a matched point, m: the closed form's second moments
+(u^2, x u) overflow beyond about 1e154 m (points at 1e308 m were matched with scale inf and
+a NaN error, exit 0); a kilometre-sized lab is far inside."""
+
+
+def _require_points(name: str, points: np.ndarray) -> None:
+    """Refuse points (n, 2), m, that are not finite, lie beyond :data:`MAX_COORDINATE` or
+    coincide (their spread D = mean(u^2 + v^2) - |mean(q)|^2 is 0 to round-off).
+
+    Parameters
+    ----------
+    name : str
+        ``simulated`` or ``measured``, as the message names them.
+    points : (n, 2) ndarray
+        The points, m.
+    """
+    require_finite(f"{name} points", points)
+    largest = float(np.abs(points).max())
+    if largest > MAX_COORDINATE:
+        raise InvalidInputError(f"{name} points must lie within {MAX_COORDINATE:g} m of the "
+                                f"origin (coordinates in m), got a coordinate of {largest:g}")
+    u, v = points[:, 0], points[:, 1]
+    second = np.mean(u * u) + np.mean(v * v)
+    if not second - (np.mean(u) ** 2 + np.mean(v) ** 2) > 1e-30 * max(second, 1e-300):
+        raise InvalidInputError(f"the {name} points coincide: the similarity transform is "
+                                "undefined")
+
 
 @dataclass(frozen=True)
 class Match:
@@ -95,8 +123,9 @@ def match_similarity(simulated, measured) -> Match:
     Raises
     ------
     InvalidInputError
-        For mismatched shapes, fewer than two points, non-finite input or coincident measured
-        points (D = 0).
+        For mismatched shapes, fewer than two points, non-finite input, a coordinate beyond
+        :data:`MAX_COORDINATE`, or coincident simulated or measured points (D = 0: with
+        coincident simulated points the transform was scale 0 and every error 0).
 
     Examples
     --------
@@ -116,16 +145,13 @@ def match_similarity(simulated, measured) -> Match:
                              f"same n, got {P.shape} and {Q.shape}")
     if len(P) < 2:
         raise InvalidInputError(f"matching needs at least 2 corresponding points, got {len(P)}")
-    require_finite("simulated points", P)
-    require_finite("measured points", Q)
+    _require_points("simulated", P)
+    _require_points("measured", Q)
     x, y = P[:, 0], P[:, 1]
     u, v = Q[:, 0], Q[:, 1]
     c1, c2, c3, c4, c5, c6, c7, c8, c9, c10 = (
         np.mean(a) for a in (x, y, u, v, x * u, x * v, y * u, y * v, u * u, v * v))
     D = c9 + c10 - (c3 * c3 + c4 * c4)
-    if not D > 1e-30 * max(c9 + c10, 1e-300):
-        raise InvalidInputError("the measured points coincide: the similarity transform is "
-                                "undefined")
     tx = (c4 * (c7 - c6) - c3 * (c5 + c8) + c1 * (c9 + c10)) / D
     ty = (c2 * (c9 + c10) - c4 * (c5 + c8) - c3 * (c7 - c6)) / D
     s = np.hypot(c1 * c3 + c2 * c4 - (c5 + c8), c1 * c4 - c2 * c3 + (c7 - c6)) / D

@@ -23,6 +23,33 @@ import numpy as np
 
 from squeeze_grasp_ros.mechanics.errors import InvalidInputError, require_finite
 
+SIDE_RANGE = (1e-6, 1e3)
+"""Sides of a calibration sample, m, inclusive: a micrometre to a kilometre. Beyond, the
+cross-section w h underflows or overflows in double precision (a side of 1e308 m gave a NaN
+Poisson's ratio, and in a compression curve a scipy traceback)."""
+
+
+def require_side(name: str, value: float) -> None:
+    """Refuse a sample side outside :data:`SIDE_RANGE`.
+
+    Parameters
+    ----------
+    name : str
+        The field, as the message names it (``cuboid.length``, ``--sample-size W``).
+    value : float
+        The side, m.
+
+    >>> require_side("cuboid.width", 1e308)
+    Traceback (most recent call last):
+    ...
+    squeeze_grasp_ros.mechanics.errors.InvalidInputError: cuboid.width must be in [1e-06, 1000] \
+m, got 1e+308
+    """
+    require_finite(name, value)
+    lo, hi = SIDE_RANGE
+    if not lo <= value <= hi:
+        raise InvalidInputError(f"{name} must be in [{lo:g}, {hi:g}] m, got {value:g}")
+
 
 @dataclass(frozen=True)
 class Cuboid:
@@ -33,9 +60,9 @@ class Cuboid:
     force : float
         Compressive force magnitude f, N (> 0).
     length, width, height : float
-        Undeformed sides l (loaded), w, h, m (> 0).
+        Undeformed sides l (loaded), w, h, m (in :data:`SIDE_RANGE`).
     dl : float
-        Change of l, m (< 0 in compression).
+        Change of l, m (in (-l, 0): compression).
     dw : float
         Change of w, m.
     dh : float or None
@@ -53,12 +80,14 @@ class Cuboid:
     def __post_init__(self) -> None:
         for name in ("force", "length", "width", "height", "dl", "dw"):
             require_finite(f"cuboid.{name}", getattr(self, name))
-        for name in ("force", "length", "width", "height"):
-            if not getattr(self, name) > 0:
-                raise InvalidInputError(f"cuboid.{name} must be > 0, got {getattr(self, name)}")
-        if not self.dl < 0:
+        if not self.force > 0:
+            raise InvalidInputError(f"cuboid.force must be > 0, got {self.force}")
+        for name in ("length", "width", "height"):
+            require_side(f"cuboid.{name}", getattr(self, name))
+        if not -self.length < self.dl < 0:
             raise InvalidInputError(
-                f"cuboid.dl must be < 0 m (the cuboid shortens), got {self.dl}"
+                f"cuboid.dl must be in (-{self.length:g}, 0) m (the cuboid shortens), "
+                f"got {self.dl}"
             )
         if self.dh is not None:
             require_finite("cuboid.dh", self.dh)

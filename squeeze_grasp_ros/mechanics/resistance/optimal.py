@@ -34,6 +34,7 @@ forms themselves are in :mod:`.resistance_forms`.
 
 from __future__ import annotations
 
+import itertools
 from dataclasses import dataclass, field, replace
 from functools import cached_property
 from typing import Mapping, Sequence
@@ -197,13 +198,19 @@ def contact_segments(
     -------
     list of (k,) ndarray of int
         One segment per contact, the contact node first, then by arc distance.
+
+    Raises
+    ------
+    InvalidInputError
+        For a ``half_width`` that is negative or not finite, or so wide that two segments
+        share a node (named with the contacts' arc distance, the field's bound).
     """
     loop = mesh.boundary
     edge = np.linalg.norm(np.roll(mesh.nodes[loop], -1, axis=0) - mesh.nodes[loop], axis=1)
     s = np.concatenate([[0.0], np.cumsum(edge)[:-1]])
     perimeter = float(edge.sum())
     if half_width is not None and not (np.isfinite(half_width) and half_width >= 0):
-        raise InvalidInputError(f"segment half width must be >= 0 m, got {half_width}")
+        raise InvalidInputError(f"segment half width must be finite and >= 0 m, got {half_width}")
     out = []
     for c in contacts:
         k = mesh.boundary_position(int(c))
@@ -215,7 +222,41 @@ def contact_segments(
             near = np.flatnonzero(dist <= half_width * (1 + 1e-12))
             near = near[np.argsort(dist[near], kind="mergesort")]
         out.append(loop[near])
+    if half_width is not None:
+        _require_apart(out, [s[mesh.boundary_position(int(c))] for c in contacts], perimeter,
+                       half_width)
     return out
+
+
+def _require_apart(segments: list[np.ndarray], arc: list[float], perimeter: float,
+                   half_width: float) -> None:
+    """Refuse segments of F1, F2, A (in that order) that share a node, naming the two
+    contacts, their distance along the boundary and the half width that keeps them apart.
+
+    Parameters
+    ----------
+    segments : list of (k,) ndarray of int
+        Each finger's segment.
+    arc : list of float
+        Arc length, m, of each finger's contact node along the outer boundary.
+    perimeter : float
+        Length of the outer boundary, m.
+    half_width : float
+        The half width that made the segments, m.
+    """
+    names = [str(f) for f in tuple(Finger)]
+    pairs = list(itertools.combinations(range(len(segments)), 2))
+    shared = [(i, j) for i, j in pairs if np.intersect1d(segments[i], segments[j]).size]
+    if not shared:
+        return
+    gaps = {(i, j): min(abs(arc[i] - arc[j]), perimeter - abs(arc[i] - arc[j]))
+            for i, j in pairs}
+    near = min(pairs, key=gaps.get)
+    raise InvalidInputError(
+        f"segment half width {half_width:g} m makes the contact segments of "
+        f"{names[shared[0][0]]} and {names[shared[0][1]]} overlap; the nearest contacts, "
+        f"{names[near[0]]} and {names[near[1]]}, are {gaps[near]:.4g} m apart along the "
+        f"boundary, so the half width must be below {gaps[near] / 2:.4g} m")
 
 
 @dataclass(frozen=True)
@@ -356,9 +397,26 @@ def _translation(a, name: str = "adversary translation a") -> np.ndarray:
     if a.shape != (2,):
         raise InvalidInputError(f"{name} must be [x, y] in m, got shape {a.shape}")
     require_finite(name, a)
-    if not np.linalg.norm(a) > 0:
+    with np.errstate(over="ignore"):  # a length beyond the float range is nonzero too
+        nonzero = np.linalg.norm(a) > 0
+    if not nonzero:
         raise InvalidInputError(f"{name} must be nonzero")
     return a
+
+
+def _unit(v: np.ndarray) -> np.ndarray:
+    """``v`` (finite, of a nonzero length) divided by its length.
+
+    ``np.linalg.norm`` squares the entries and overflows beyond about 1e154 (a direction of
+    [1e308, 1e308] became [0, 0]): such a ``v`` is first scaled by its largest entry; any
+    other is divided as before, bit for bit.
+    """
+    with np.errstate(over="ignore"):
+        norm = float(np.linalg.norm(v))
+    if not np.isfinite(norm):
+        v = v / np.abs(v).max()
+        norm = float(np.linalg.norm(v))
+    return v / norm
 
 
 def _unresisted(
@@ -611,7 +669,7 @@ def resistance_along(
     if isinstance(form, PureForm) and form.outside(a_hat)[0] > FEASIBILITY_TOL:
         return _cannot_resist(grasp, a)
     x0, Z = form.line(a_hat)
-    e = e / np.linalg.norm(e)
+    e = _unit(e)
     coef = perp(e) @ Z[:2]
     rhs = -float(perp(e) @ x0[0, :2])
     if float(np.linalg.norm(coef)) <= 1e-12:

@@ -33,7 +33,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from squeeze_grasp_ros.mechanics.elastic.compliance import ElasticObject
-from squeeze_grasp_ros.mechanics.errors import InvalidInputError
+from squeeze_grasp_ros.mechanics.errors import InvalidInputError, shown
 from squeeze_grasp_ros.mechanics.squeeze.contact_model import TerminationLimits
 from squeeze_grasp_ros.mechanics.squeeze.events import EventSqueeze, event_squeeze
 from squeeze_grasp_ros.mechanics.squeeze.fingertips import TOUCH_TOLERANCE
@@ -68,12 +68,13 @@ class ParallelJaws:
 
     def __post_init__(self) -> None:
         if not (np.isfinite(self.min_aperture) and self.min_aperture >= 0):
-            raise InvalidInputError(f"opening.min must be >= 0 m, got {self.min_aperture}")
+            raise InvalidInputError(f"opening.min must be finite and >= 0 m, got "
+                                    f"{self.min_aperture}")
         if not (np.isfinite(self.max_aperture) and self.max_aperture > self.min_aperture):
             raise InvalidInputError(f"opening.max must be > opening.min ({self.min_aperture} m), "
                                     f"got {self.max_aperture}")
         if not (np.isfinite(self.max_force) and self.max_force > 0):
-            raise InvalidInputError(f"max_force must be > 0 N, got {self.max_force}")
+            raise InvalidInputError(f"max_force must be finite and > 0 N, got {self.max_force}")
         if not self.pad.radius > 0:
             raise InvalidInputError("the jaws' pads need a rounded part: edge_radius > 0 m")
 
@@ -134,7 +135,8 @@ def _in_yaw_range(yaw: np.ndarray, yaw_range: tuple[float, float] | None) -> np.
         return np.ones(len(yaw), bool)
     lo, hi = yaw_range
     if not (np.isfinite(lo) and np.isfinite(hi) and lo <= hi):
-        raise InvalidInputError(f"yaw range must be finite with min <= max, got {yaw_range}")
+        raise InvalidInputError(f"yaw range must be finite with min <= max, got "
+                                f"{shown(yaw_range)} rad")
     if hi - lo >= np.pi:
         return np.ones(len(yaw), bool)
     return np.mod(yaw - lo, np.pi) <= hi - lo
@@ -317,9 +319,9 @@ def evaluate_candidate(obj: ElasticObject, candidate: GripperCandidate, jaws: Pa
         raise InvalidInputError(f"closing must be in (0, {travel:.6g}] m (the jaws' travel "
                                 f"from first contact), got {closing}")
     if not (np.isfinite(margin) and margin >= 1):
-        raise InvalidInputError(f"force margin must be >= 1, got {margin}")
+        raise InvalidInputError(f"force margin must be finite and >= 1, got {margin}")
     if weight is not None and not (np.isfinite(weight) and weight > 0):
-        raise InvalidInputError(f"weight must be > 0 N, got {weight}")
+        raise InvalidInputError(f"weight must be finite and > 0 N, got {weight}")
     search = min(0.5 * candidate.aperture, travel) if limit_search is None else limit_search
     d = candidate.closing_direction
     far = candidate.aperture + 10.0 * obj.scale  # each jaw starts clear, on the closing line

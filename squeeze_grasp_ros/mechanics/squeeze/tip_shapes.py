@@ -51,7 +51,15 @@ import numpy as np
 from squeeze_grasp_ros.mechanics.errors import InvalidInputError
 from squeeze_grasp_ros.mechanics.vocabulary import TipKind
 
-__all__ = ["TipGeometry", "TipShape", "cross", "tangent", "unit"]
+__all__ = ["MAX_TIP_SIZE", "TipGeometry", "TipShape", "cross", "tangent", "unit"]
+
+MAX_TIP_SIZE = 1e3
+"""Largest tip radius and pad width, m. A circle's gap to the object is computed from its
+centre, so its round-off grows with the radius (about 1e-16 of it): at 1e10 m it is a
+micrometre, far above the event tolerance, and the foam square's events changed with the
+radius (A 71 B 33 at 1e6 m, A 67 B 19 at 1e10 m); from about 1e20 m the squeeze ended in
+"grasp health ... must be finite" with numpy warnings. A flat pad is the shape for a large
+flat face."""
 
 
 def unit(theta) -> np.ndarray:
@@ -90,10 +98,11 @@ class TipShape:
     kind : TipKind
         ``circle`` or ``pad``.
     radius : float
-        Circle radius, or the pad's edge radius r_e, m (> 0; a circle of radius 0 is a point
-        finger, which only the stable and pure squeezes take).
+        Circle radius, or the pad's edge radius r_e, m (> 0, at most :data:`MAX_TIP_SIZE`; a
+        circle of radius 0 is a point finger, which only the stable and pure squeezes take).
     width : float
-        The pad's whole width w, m (>= 2 r_e; the flat face is w - 2 r_e wide); 0 for a circle.
+        The pad's whole width w, m (in [2 r_e, :data:`MAX_TIP_SIZE`]; the flat face is
+        w - 2 r_e wide); 0 for a circle.
     """
 
     kind: TipKind
@@ -102,18 +111,19 @@ class TipShape:
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "kind", TipKind(self.kind))
-        if not (np.isfinite(self.radius) and self.radius >= 0):
-            raise InvalidInputError(f"tip radius must be >= 0 m, got {self.radius}")
+        if not (np.isfinite(self.radius) and 0 <= self.radius <= MAX_TIP_SIZE):
+            raise InvalidInputError(f"tip radius must be finite and in [0, {MAX_TIP_SIZE:g}] m, "
+                                    f"got {self.radius}")
         if self.kind == TipKind.CIRCLE:
             if self.width != 0.0:
                 raise InvalidInputError(f"a circular tip has no width, got {self.width} m")
             return
         if not self.radius > 0:
             raise InvalidInputError(f"tip.edge_radius must be > 0 m, got {self.radius}")
-        if not (np.isfinite(self.width) and self.width >= 2.0 * self.radius):
+        if not (np.isfinite(self.width) and 2.0 * self.radius <= self.width <= MAX_TIP_SIZE):
             raise InvalidInputError(
-                f"tip.width must be >= 2 tip.edge_radius ({2.0 * self.radius:g} m), got "
-                f"{self.width} m")
+                f"tip.width must be in [2 tip.edge_radius, {MAX_TIP_SIZE:g}] m "
+                f"([{2.0 * self.radius:g}, {MAX_TIP_SIZE:g}] m), got {self.width} m")
 
     @classmethod
     def circle(cls, radius: float) -> TipShape:

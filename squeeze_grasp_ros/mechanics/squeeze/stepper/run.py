@@ -301,18 +301,19 @@ def _check(step: float, event_tol: float, terminate_on, first_substep: float | N
     """Raise InvalidInputError for an argument of :func:`advance` out of range."""
     if not (np.isfinite(step) and step >= MIN_STEP):
         raise InvalidInputError(
-            f"step must be >= {MIN_STEP} (relative to the object size), got {step}"
+            f"step must be finite and >= {MIN_STEP} (relative to the object size), got {step}"
         )
     if not (np.isfinite(event_tol) and event_tol >= MIN_EVENT_TOL):
         raise InvalidInputError(
-            f"event_tol must be >= {MIN_EVENT_TOL} (relative to the object size), got {event_tol}"
+            f"event_tol must be finite and >= {MIN_EVENT_TOL} (relative to the object size), "
+            f"got {event_tol}"
         )
     bad = sorted(set(terminate_on) - set(TERMINATION_ORDER))
     if bad:
         raise InvalidInputError(f"unknown termination {bad[0]!r} (allowed: {TERMINATION_ORDER})")
     if first_substep is not None and not (np.isfinite(first_substep) and first_substep > 0):
-        raise InvalidInputError(f"first_substep must be > 0 (relative to the object size), got "
-                                f"{first_substep}")
+        raise InvalidInputError(f"first_substep must be finite and > 0 (relative to the object "
+                                f"size), got {first_substep}")
 
 
 def advance(

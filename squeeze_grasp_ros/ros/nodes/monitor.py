@@ -83,6 +83,7 @@ from squeeze_grasp_ros.ros.nodes import ParameterError, pipeline, run_node
 from squeeze_grasp_ros.ros.nodes.force_watcher import ForceWatcher
 from squeeze_grasp_ros.ros.nodes.shape_watcher import ShapeWatcher
 from squeeze_grasp_ros.ros.nodes.sim_controllers import JOINT_STATES
+from squeeze_grasp_ros.ros.refusals import RefusalLog
 from squeeze_grasp_ros.scene import load_scene
 from squeeze_grasp_ros.scene.controller import (
     HandController,
@@ -193,6 +194,51 @@ The device readings are taken raw and read with :mod:`..messages.cdr`, not turne
 message objects (six readings a tick; rclpy's conversion cost 6-17 times as much)."""
 
 
+def reading_problem(fields: dict[str, Any]) -> str | None:
+    """Why the tracker cannot take a device reading's ``FingerSample`` fields, or None.
+
+    A position or force that is not finite, or taxel arrays that are empty, of different
+    lengths or not finite, are refused here: the tracker would raise on them (an empty or
+    ragged ``TactileArray`` ended the monitor process with a ValueError) or carry NaN into
+    every status.
+
+    Parameters
+    ----------
+    fields : dict
+        The fields a :data:`READINGS` reader returned.
+
+    Returns
+    -------
+    str or None
+        The reason in one line, naming the message field; None for a usable reading.
+
+    Examples
+    --------
+    >>> reading_problem({"force": np.array([0.0, np.nan, 0.0]), "force_stamp_ns": 1})
+    'wrench.force is not finite: [0.0, nan, 0.0] N'
+    >>> reading_problem({"angles": np.zeros(3), "normal": np.zeros(2), "tangential": np.zeros(0),
+    ...                  "tactile_stamp_ns": 1})
+    'taxel_angles, normal_forces and tangential_forces must have one value per taxel (at least \
+one), got 3, 2 and 0 values'
+    >>> reading_problem({"position": np.array([0.01, 0.0])}) is None
+    True
+    """
+    for name, label, unit in (("position", "pose.position", "m"), ("force", "wrench.force", "N")):
+        value = fields.get(name)
+        if value is not None and not np.isfinite(value).all():
+            return f"{label} is not finite: {value.tolist()} {unit}"
+    if "normal" not in fields:
+        return None
+    arrays = [fields["angles"], fields["normal"], fields["tangential"]]
+    counts = [len(a) for a in arrays]
+    if not counts[0] or counts.count(counts[0]) < 3:
+        return ("taxel_angles, normal_forces and tangential_forces must have one value per taxel "
+                f"(at least one), got {counts[0]}, {counts[1]} and {counts[2]} values")
+    if not all(np.isfinite(a).all() for a in arrays):
+        return "taxel_angles, normal_forces or tangential_forces are not finite"
+    return None
+
+
 STREAMS = ("wrench", "tactile")
 """The sensor streams a finger may have (its ``pose`` is always read)."""
 
@@ -242,13 +288,16 @@ class MonitorNode(Node):
         sensors = pipeline.sensor_qos(p["sensor_qos"], p["qos_depth"])
         types = {"pose": PoseStamped, "wrench": WrenchStamped, "tactile": TactileArray}
         self.keys: dict[str, tuple[str, str]] = {}
+        self.refusals = RefusalLog(self.get_logger().warning)
+        """The log of refused readings, by device stream."""
         for finger, device in self.fingers.items():
             for stream, msg_type in types.items():
                 key = f"{device}/{stream}"
                 self.keys[key] = (finger, stream)
                 self.create_subscription(
                     msg_type, pipeline.device_topic(device, stream),
-                    lambda data, k=key, read=READINGS[stream]: self._reading(k, *read(data)),
+                    lambda data, k=key, read=READINGS[stream]: self._device_reading(k,
+                                                                                    read(data)),
                     sensors, raw=True)
         if self.jaws is not None:
             self.create_subscription(PoseStamped, pipeline.GRIPPER_POSE,
@@ -325,6 +374,17 @@ class MonitorNode(Node):
             self.tracker.set_prediction(messages.predicted_events(msg))
         if self.forces is not None:
             self.forces.set_prediction(msg)
+
+    def _device_reading(self, key: str, read: tuple[int, dict[str, Any]]) -> None:
+        """A device reading ``read`` (stamp ns, fields) of ``key``: refused with a warning (at
+        most one line per device stream and second, :class:`..refusals.RefusalLog`) when
+        :func:`reading_problem` finds one, so that finger's readings go stale; else taken.
+        """
+        problem = reading_problem(read[1])
+        if problem is None:
+            self._reading(key, *read)
+        else:
+            self.refusals.refused(key, f"the reading of {read[0] * 1e-9:.9f} s: {problem}")
 
     def _reading(self, key: str, ns: int, msg: Any) -> None:
         """A reading stamped ``ns``: the tracker's sample fields of a device stream, or the

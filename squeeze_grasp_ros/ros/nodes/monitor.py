@@ -167,6 +167,11 @@ BOUNDS = {"mu": pipeline.Bound(0.0, note="0: no friction"),
           "joint_slip_ratio": pipeline.Bound(0.0, above=True)}
 """The range of each numeric parameter (``weight_margin`` and ``hand_max_condition`` are
 checked where they are used, by the routes that take them)."""
+PENDING_STAMPS = 64
+"""Lockstep: the most stamps whose readings wait for their tick, and the most ticks that wait
+for their readings. In a loop one stamp waits at a time; readings under stamps no tick ever
+closes (a publisher of its own clock) were kept for ever: 10 kHz of them grew the monitor by
+380 MB in 40 s."""
 POSE_JOINT_TOLERANCE = 1e-5
 """m: the largest gap between the jaws' aperture of their first pose readings and of the first
 joint state that passes without a warning."""
@@ -192,6 +197,34 @@ READINGS = {"pose": _pose, "wrench": _wrench, "tactile": _tactile}
 """Stream -> reader of its raw CDR bytes: (stamp ns, the tracker's ``FingerSample`` fields).
 The device readings are taken raw and read with :mod:`..messages.cdr`, not turned into
 message objects (six readings a tick; rclpy's conversion cost 6-17 times as much)."""
+
+
+def make_room(pending: dict[int, Any], ns: int, limit: int = PENDING_STAMPS) -> bool:
+    """Make room for stamp ``ns`` in ``pending`` (stamp -> what waits under it) of at most
+    ``limit`` stamps, dropping the farthest stamp: the nearest are the next ticks'.
+
+    Returns
+    -------
+    bool
+        False when ``ns`` is itself the farthest and there is no room (do not store it).
+
+    Examples
+    --------
+    >>> pending = {1: "a", 2: "b"}
+    >>> make_room(pending, 3, limit=2), pending
+    (False, {1: 'a', 2: 'b'})
+    >>> make_room(pending, 0, limit=2), pending
+    (True, {1: 'a'})
+    >>> make_room(pending, 1, limit=1)
+    True
+    """
+    if ns in pending or len(pending) < limit:
+        return True
+    farthest = max(pending)
+    if ns > farthest:
+        return False
+    del pending[farthest]
+    return True
 
 
 def reading_problem(fields: dict[str, Any]) -> str | None:
@@ -395,6 +428,10 @@ class MonitorNode(Node):
             return
         if ns <= self.answered.stamp_ns:
             return
+        if not make_room(self.buffer, ns):
+            self.refusals.refused("pending", f"more than {PENDING_STAMPS} stamps wait for their "
+                                             f"tick: dropped {key} of {ns * 1e-9:.9f} s")
+            return
         self.buffer.setdefault(ns, {})[key] = msg
         if ns in self.expected:  # its tick is here: the reading may close it
             self._try_close(ns)
@@ -404,16 +441,26 @@ class MonitorNode(Node):
         ns, readings = messages.tick_readings_cdr(data)
         if not self.answered.is_new(ns):
             return
+        if not make_room(self.expected, ns):
+            self.refusals.refused("pending", f"more than {PENDING_STAMPS} ticks wait for their "
+                                             f"readings: dropped the tick of {ns * 1e-9:.9f} s")
+            return
         self.expected[ns] = set(readings) & self.keys.keys()
         self._try_close(ns)
 
     def _try_close(self, ns: int) -> None:
+        """Answer tick ``ns`` if it and all its readings are here; then drop what waits under
+        older stamps (no tick closes them any more: they were kept for ever).
+        """
         expected = self.expected.get(ns)
         if expected is None or not expected <= self.buffer.get(ns, {}).keys():
             return
         self.latest.update(self.buffer.pop(ns, {}))
         del self.expected[ns]
         self._process(ns)
+        for pending in (self.buffer, self.expected):
+            for old in [k for k in pending if k < ns]:
+                del pending[old]
 
     def _timer(self) -> None:
         self._process(self.get_clock().now().nanoseconds)

@@ -235,3 +235,44 @@ def test_a_hardware_goal_without_any_monitor_status_ends_after_the_stale_budget(
         assert "no /monitor/status message within stale_budget 0.2 s" in ended.message
     finally:
         rig.close()
+
+
+BAD_STATUSES = {
+    "a finger the monitor does not watch": {"fingers": ["Z9", "F2"]},
+    "arrays shorter than its fingers": {"positions": [Point(x=0.05)], "forces": [Vector3()],
+                                        "normals": [Vector3()], "fingers": ["F2", "F1"]},
+    "a NaN position": {"positions": [Point(x=math.nan), Point(x=0.05)]},
+    "an infinite force": {"forces": [Vector3(x=math.inf), Vector3()]},
+}
+
+
+@pytest.mark.parametrize("case", list(BAD_STATUSES))
+def test_a_status_without_a_usable_finger_ends_the_goal_and_the_node_serves_on(rig, case):
+    """A running goal, then a ``monitor/status`` without a finite position and force of one
+    of the executor's fingers (a monitor whose ``finger_devices`` leave one out, or garbage):
+    the goal ends ``stale_data`` naming the finger, and the next goal runs. Before, a missing
+    finger ended the executor process (KeyError in the control step), a short array was read
+    from the bytes after it, and a NaN made the goal's work NaN.
+    """
+    future = rig.clients[0].send_goal_async(squeeze())
+    assert rig.until(future.done) and future.result().accepted
+    rig.publish_status()
+    assert rig.until(lambda: rig.node.goal is not None and rig.node.goal.start_ns is not None)
+    bad = MonitorStatus(fingers=["F1", "F2"], positions=[Point(x=-0.05), Point(x=0.05)],
+                        forces=[Vector3(), Vector3()], normals=[Vector3(), Vector3()],
+                        sensor_age=[0.0, 0.0])
+    for name, value in BAD_STATUSES[case].items():
+        setattr(bad, name, value)
+    messages.set_stamp(bad.header.stamp, rig.tick * 1_000_000)
+    rig.tick += 1
+    rig.status.publish(bad)
+    result = rig.result_of(future.result())
+    assert result.termination == ExecuteGrasp.Result.STALE_DATA, result.message
+    assert "has no finite position and force of F1" in result.message, result.message
+    assert all(math.isfinite(w) for w in result.work)
+    again = rig.clients[0].send_goal_async(squeeze())
+    assert rig.until(again.done) and again.result().accepted
+    rig.publish_status()
+    assert rig.until(lambda: rig.node.goal is not None and rig.node.goal.start_ns is not None)
+    again.result().cancel_goal_async()
+    assert rig.result_of(again.result()).termination == ExecuteGrasp.Result.CANCELED

@@ -39,6 +39,7 @@ every request). On hardware, a goal that sees no ``monitor/status`` at all withi
 """
 from __future__ import annotations
 
+import math
 import sys
 import time
 from typing import Any
@@ -56,8 +57,10 @@ from squeeze_grasp_ros.control.motion import (
     Command,
     GraspProgram,
     MotionLimits,
+    Observation,
     goal_problem,
 )
+from squeeze_grasp_ros.inputs import shown
 from squeeze_grasp_ros.ros import messages
 from squeeze_grasp_ros.ros.nodes import ParameterError, pipeline, run_node, spin_until
 from squeeze_grasp_ros.ros.nodes.jaw_commands import HandCommands, JawCommands
@@ -137,6 +140,17 @@ class _Goal:
         self.lifting = False
         """The action route's jaws hold while the arm lifts (the gripper goal was canceled, or
         reached a squeeze's depth under weight): its result is not the goal's."""
+
+
+_ZERO = (0.0, 0.0)
+"""The force of a finger a status does not list (the control step reads it so)."""
+
+
+def _finite(vector: Any) -> bool:
+    """Whether planar ``vector`` (or None) is there and finite (cheaper than numpy on two
+    numbers: it is checked for every finger at every control cycle).
+    """
+    return vector is not None and math.isfinite(vector[0]) and math.isfinite(vector[1])
 
 
 class ExecutorNode(Node):
@@ -363,6 +377,8 @@ class ExecutorNode(Node):
         msg = None if obs is not None else deserialize_message(data, MonitorStatus)
         obs = obs or messages.observation(msg)
         ns = obs.stamp_ns
+        if self._unwatched(goal, obs):
+            return
         if goal.start_ns is None:
             if not self.p["lockstep"] and self._unseen(
                     goal, msg or deserialize_message(data, MonitorStatus), ns):
@@ -389,6 +405,26 @@ class ExecutorNode(Node):
             self.goal = None
             goal.done.set_result(messages.grasp_result(
                 goal.program, command, obs, goal.events, (ns - goal.start_ns) * 1e-9, SUCCESS))
+
+    def _unwatched(self, goal: _Goal, obs: Observation) -> bool:
+        """True, and ``goal`` ended ``stale_data``, when status ``obs`` has no finite position
+        and force of a finger the executor drives (a monitor whose ``finger_devices`` leave out
+        one of the executor's, a status whose arrays are shorter than its ``fingers``, NaN).
+        Before, a missing finger made the control step raise KeyError, which ended the executor
+        process, and a NaN position made the goal's work NaN.
+        """
+        missing = [f for f in goal.program.fingers
+                   if not _finite(obs.positions.get(f)) or not _finite(obs.forces.get(f, _ZERO))]
+        if not missing:
+            return False
+        elapsed = 0.0 if goal.start_ns is None else (obs.stamp_ns - goal.start_ns) * 1e-9
+        self._end_holding(goal, ExecuteGrasp.Result.STALE_DATA,
+                          f"{self.resolve_topic_name(pipeline.STATUS)} of "
+                          f"{obs.stamp_ns * 1e-9:.9f} s has no finite position and force of "
+                          f"{', '.join(missing)} (it lists {shown(', '.join(obs.positions))}; "
+                          "the monitor must watch every finger of the executor's finger_devices); "
+                          "nothing more was commanded", elapsed)
+        return True
 
     def _setpoints(self, command: Command, stamp: int) -> list:
         """(publisher, serialised PoseStamped) of each commanded finger with a setpoint topic,

@@ -8,6 +8,7 @@ from __future__ import annotations
 import re
 import time
 from collections import Counter
+from pathlib import Path
 
 import yaml
 from action_msgs.msg import GoalStatus
@@ -344,6 +345,19 @@ def test_no_response_or_log_line_echoes_a_huge_field(planner, capfd):
     logged = capfd.readouterr()
     longest = max(len(line) for line in (logged.out + logged.err).splitlines())
     assert longest < 1000, longest
+
+
+def test_an_absurd_mesh_size_is_refused_in_one_short_line(planner):
+    """``mesh: {max_area: 1e-308}`` on the foam square asks for about 8e305 nodes: before, the
+    refusal quoted that count as an integer of 306 digits (a message of 425 characters).
+    """
+    foam = (Path(__file__).resolve().parents[1] / "config" / "scenes" / "foam_square.yaml")
+    text = foam.read_text().replace("nodes: 2000", "max_area: 1.0e-308")
+    tiny = planner.call(LoadObject, "load_object", LoadObject.Request(scene_yaml=text))
+    assert tiny.error_code == ErrorCode.INVALID_ARGUMENT
+    assert tiny.message.startswith("oversized factorized mesh: 8e+305 nodes, more than the "
+                                   "planner's limit of 60000"), tiny.message
+    assert len(tiny.message) < 200, len(tiny.message)
 
 
 # --------------------------------------------------------------------------- abandoned work

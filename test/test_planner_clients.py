@@ -360,6 +360,18 @@ def test_an_absurd_mesh_size_is_refused_in_one_short_line(planner):
     assert len(tiny.message) < 200, len(tiny.message)
 
 
+def test_a_fingertip_beyond_the_float_range_is_refused_naming_the_field(planner):
+    """``tip_radius: 1.0e308``: before, the load succeeded and the event squeeze failed with
+    NUMERICAL_FAILURE ("no contact mode of nodes [49, 114] can be solved"), numpy overflow
+    warnings in the planner's log; now the load is refused with the field and its range.
+    """
+    foam = (Path(__file__).resolve().parents[1] / "config" / "scenes" / "foam_square.yaml")
+    text = foam.read_text().replace("tip_radius: 0.02", "tip_radius: 1.0e308")
+    huge = planner.call(LoadObject, "load_object", LoadObject.Request(scene_yaml=text))
+    assert huge.error_code == ErrorCode.INVALID_ARGUMENT, huge.message
+    assert huge.message == "fingers.F1.tip_radius must be in [0.0, 1000.0] m, got 1e+308"
+
+
 # --------------------------------------------------------------------------- abandoned work
 
 

@@ -38,6 +38,13 @@ class SceneError(SchemaError):
     """A scene entry is unknown, of the wrong type, out of range or contradictory."""
 
 
+MAX_TIP = 1e3
+"""m: the largest fingertip radius, pad width and edge radius (as ``thickness``): a radius of
+1e308 m overflowed the contact geometry, and the event-driven squeeze ended in a numerical
+failure ("no contact mode ... can be solved") with numpy warnings; 1e3 m on a 0.1 m object
+squeezes as a flat plate."""
+
+
 EFFECTS: dict[Effect, str] = {
     Effect.FRICTION: "Coulomb friction at the fingertips (needs friction.mu)",
     Effect.STRAIN_LIMIT: "stop at the proportional limit (needs strain_limit.epsilon)",
@@ -153,13 +160,13 @@ class TipSpec:
 
     shape: TipKind = spec("tip shape", default=TipKind.CIRCLE)
     radius: Optional[float] = spec("circle radius (shape: circle)", "m", lo=0.0, lo_open=True,
-                                   default=None)
+                                   hi=MAX_TIP, default=None)
     width: Optional[float] = spec("whole pad width w across the closing direction, at least "
                                   "2 edge_radius (shape: pad)", "m", lo=0.0, lo_open=True,
-                                  default=None)
+                                  hi=MAX_TIP, default=None)
     edge_radius: Optional[float] = spec("radius r_e of the pad's two rounded edges; the flat "
                                         "face is w - 2 r_e wide (shape: pad)", "m", lo=0.0,
-                                        lo_open=True, default=None)
+                                        lo_open=True, hi=MAX_TIP, default=None)
 
     def shape_of(self) -> TipShape:
         """The mechanics' :class:`~squeeze_grasp_ros.mechanics.squeeze.tip_shapes.TipShape`
@@ -184,7 +191,7 @@ class FingerSpec:
     placement: PlacementSpec = spec("initial contact")
     tip_radius: float = spec("fingertip radius (0 = point finger); with tip given, filled "
                              "with the tip's radius (a pad's edge radius)", "m", lo=0.0,
-                             default=0.0)
+                             hi=MAX_TIP, default=0.0)
     tip: Optional[TipSpec] = spec("fingertip shape instead of tip_radius: {shape: circle, "
                                   "radius} or {shape: pad, width, edge_radius}", default=None)
     device: str = spec(
@@ -284,7 +291,7 @@ class AdversarySpec:
 
     placement: PlacementSpec = spec("initial contact of A")
     a: tuple[float, float] = spec("translation of A", "m")
-    tip_radius: float = spec("fingertip radius of A", "m", lo=0.0, default=0.0)
+    tip_radius: float = spec("fingertip radius of A", "m", lo=0.0, hi=MAX_TIP, default=0.0)
     mode: SqueezeKind = spec("resistance type", choices=SqueezeKind.planned(),
                              default=SqueezeKind.STABLE)
     contacts: ContactKind = spec("contact model", default=ContactKind.POINT)

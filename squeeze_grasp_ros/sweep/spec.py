@@ -41,6 +41,7 @@ from squeeze_grasp_ros.scene import (
 )
 from squeeze_grasp_ros.scene.checks import check_material, check_shape
 from squeeze_grasp_ros.scene.schema import key_reference, parse_section, spec
+from squeeze_grasp_ros.scene.specs import MAX_TIP
 
 
 class SweepError(SceneError):
@@ -198,7 +199,7 @@ class SweepSpec:
         "friction coefficients mu", "", lo=0.0, hi=1e3, default=None
     )
     tip_radius: Optional[tuple[float, ...]] = spec(
-        "fingertip radii (both fingers)", "m", lo=0.0, lo_open=True, default=None
+        "fingertip radii (both fingers)", "m", lo=0.0, lo_open=True, hi=MAX_TIP, default=None
     )
     squeeze: Optional[tuple[SqueezeKind, ...]] = spec(
         "squeeze types", choices=SqueezeKind.planned(), default=None

@@ -99,7 +99,8 @@ def _check_shape_value(key: str, value: Any, where: str) -> None:
         if not isinstance(value, list) or not all(
             isinstance(p, (list, tuple)) and len(p) == 2 and all(map(_is_number, p)) for p in value
         ):
-            raise SceneError(f"{where} must be a list of [x, y] number pairs (m)")
+            raise SceneError(f"{where} must be a list of [x, y] number pairs (m), each number "
+                             f"finite and within +-{MAX_INT:.4g} (2^53)")
     elif key == "holes":
         if not isinstance(value, list):
             raise SceneError(f"{where} must be a list of polygons, each a list of [x, y] number "

@@ -152,3 +152,23 @@ def test_readings_under_stamps_no_tick_closes_are_bounded(rig):
     assert rig.until(lambda: rig.statuses), "the monitor never answered tick 1"
     assert messages.stamp_ns(rig.statuses[-1].header.stamp) == ns
     assert min(rig.monitor.buffer) > ns
+
+
+def test_a_hardware_reading_stamped_ahead_of_the_clock_is_refused(ros_context):
+    """Hardware mode: readings stamped one hour ahead of the monitor's clock, then silence.
+    Before, they counted as fresh until their stamp (``sensor_age`` -3598 s two seconds
+    later, no ``stale_sensor``), so a driver with a clock ahead that stopped kept the executor
+    squeezing; now they are refused and the fingers are stale.
+    """
+    rig = Rig(ros_context, lockstep=False, rate=100.0, stale_after=0.1, use_sim_time=False)
+    try:
+        ahead = rig.peer.get_clock().now().nanoseconds + 3600 * 10**9
+        rig.publish_good(ahead)
+        rig.until(lambda: False, 0.5)
+        assert rig.until(lambda: bool(rig.statuses))
+        status = rig.statuses[-1]
+        assert all(age >= 0.0 for age in status.sensor_age), list(status.sensor_age)
+        assert {(a.type, a.finger) for a in status.alarms} >= {("stale_sensor", "F1"),
+                                                               ("stale_sensor", "F2")}
+    finally:
+        rig.close()

@@ -422,8 +422,19 @@ class MonitorNode(Node):
     def _reading(self, key: str, ns: int, msg: Any) -> None:
         """A reading stamped ``ns``: the tracker's sample fields of a device stream, or the
         joint state message.
+
+        On hardware a reading stamped more than ``stale_after`` ahead of the monitor's clock is
+        refused: it counted as fresh until its stamp (a driver's clock one hour ahead kept its
+        finger fresh for an hour after the driver stopped, the executor squeezing on).
         """
         if not self.lockstep:
+            ahead = (ns - self.get_clock().now().nanoseconds) * 1e-9
+            if ahead > self.p["stale_after"]:
+                self.refusals.refused(key, f"the reading of {ns * 1e-9:.9f} s is stamped "
+                                           f"{ahead:.6g} s ahead of the monitor's clock, more "
+                                           f"than stale_after ({self.p['stale_after']} s): are "
+                                           "the driver's and the monitor's clocks the same?")
+                return
             self.latest[key] = msg
             return
         if ns <= self.answered.stamp_ns:

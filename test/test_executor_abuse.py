@@ -18,7 +18,7 @@ from rclpy.node import Node
 from rclpy.parameter import Parameter
 
 from squeeze_grasp_interfaces.action import ExecuteGrasp
-from squeeze_grasp_interfaces.msg import MonitorStatus
+from squeeze_grasp_interfaces.msg import Alarm, MonitorStatus
 from squeeze_grasp_ros.ros import messages
 from squeeze_grasp_ros.ros.nodes import pipeline
 from squeeze_grasp_ros.ros.nodes.executor import ExecutorNode
@@ -276,3 +276,69 @@ def test_a_status_without_a_usable_finger_ends_the_goal_and_the_node_serves_on(r
     assert rig.until(lambda: rig.node.goal is not None and rig.node.goal.start_ns is not None)
     again.result().cancel_goal_async()
     assert rig.result_of(again.result()).termination == ExecuteGrasp.Result.CANCELED
+
+
+def _hardware_status(rig: Rig, ns: int, alarm: str = "") -> None:
+    """A status stamped ``ns`` (both fingers still, 5 cm either side), with an ``alarm`` of F1."""
+    msg = MonitorStatus(fingers=["F1", "F2"], positions=[Point(x=-0.05), Point(x=0.05)],
+                        forces=[Vector3(), Vector3()], normals=[Vector3(), Vector3()],
+                        sensor_age=[0.0, 0.0])
+    if alarm:
+        msg.alarms = [Alarm(type=alarm, finger="F1")]
+    messages.set_stamp(msg.header.stamp, ns)
+    rig.status.publish(msg)
+
+
+def test_a_hardware_goal_hears_the_monitor_after_its_clock_stepped_back(ros_context):
+    """Hardware mode: statuses at 100 s, then the monitor's clock steps back to 1 s and it
+    reports ``slip_imminent``. Before, every status after the step was dropped as older than
+    the last, and the goal ran on, deaf to the alarm; now it ends ``slip_alarm``.
+    """
+    rig = Rig(ros_context, clients=1, lockstep=False, stale_budget=1.0)
+    try:
+        future = rig.clients[0].send_goal_async(squeeze(depth=0.02))
+        assert rig.until(future.done) and future.result().accepted
+        result = future.result().get_result_async()
+        k = 0
+
+        def started() -> bool:
+            nonlocal k
+            _hardware_status(rig, 100 * 10**9 + k * 1000)
+            k += 1
+            return rig.node.goal is not None and rig.node.goal.start_ns is not None
+        assert rig.until(started)
+        rig.until(lambda: False, 0.1)  # it cycles on the statuses of 100 s
+        k = 0
+
+        def alarmed() -> bool:
+            nonlocal k
+            _hardware_status(rig, 10**9 + k * 1000, "slip_imminent")  # 1 us apart: below 100 s
+            k += 1
+            return result.done()
+        assert rig.until(alarmed, 5.0), "the goal never heard the alarm"
+        assert result.result().result.termination == ExecuteGrasp.Result.SLIP_ALARM
+    finally:
+        rig.close()
+
+
+def test_a_hardware_goal_whose_monitor_stops_ends_after_the_stale_budget(ros_context):
+    """Hardware mode: statuses for 0.2 s, then none (the monitor stopped). Before, the goal ran
+    on its last status, commanding the squeeze without feedback; now it ends ``stale_data``
+    once no status came for ``stale_budget`` s.
+    """
+    rig = Rig(ros_context, clients=1, lockstep=False, stale_budget=0.3)
+    try:
+        future = rig.clients[0].send_goal_async(squeeze(depth=0.02))
+        assert rig.until(future.done) and future.result().accepted
+        result = future.result().get_result_async()
+        for k in range(20):
+            _hardware_status(rig, 100 * 10**9 + k * 10**7)
+            rig.until(lambda: False, 0.01)
+        assert not result.done()
+        assert rig.until(result.done, 5.0), "the goal ran on without a monitor"
+        ended = result.result().result
+        assert ended.termination == ExecuteGrasp.Result.STALE_DATA
+        assert "no /monitor/status message for" in ended.message
+        assert "more than stale_budget 0.3 s" in ended.message
+    finally:
+        rig.close()

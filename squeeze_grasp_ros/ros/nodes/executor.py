@@ -218,6 +218,8 @@ class ExecutorNode(Node):
         rclpy runs it as a later task, after more goal requests may have been taken)."""
         self.latest: bytes | None = None
         """The newest status, serialised (a raw subscription: :meth:`_cycle` reads it)."""
+        self.latest_at = 0.0
+        """Hardware mode: when it arrived (``time.monotonic``, s)."""
         self.answered = pipeline.TickAnswer()
         self.state = ExecutorStatus.IDLE
         self.tick_clock = pipeline.TickClock(self) if p["lockstep"] else None
@@ -340,23 +342,50 @@ class ExecutorNode(Node):
     # ----------------------------------------------------------------- cycles
     def _status(self, data: bytes) -> None:
         ns = messages.cdr_stamp_ns(data)
+        if not self.p["lockstep"]:
+            self._hardware_status(ns, data)
+            return
         if not self.answered.is_new(ns):
             return
-        if self.tick_clock is not None:
-            self.tick_clock.advance(ns)
+        self.tick_clock.advance(ns)
         self.latest = data
-        if self.p["lockstep"] and self.goal is not None:
+        if self.goal is not None:
             self._cycle(data)
+
+    def _hardware_status(self, ns: int, data: bytes) -> None:
+        """Hardware mode: the newest status by arrival is the one the timer's cycles read,
+        whatever its stamp, and its arrival time says whether the monitor still speaks.
+
+        Before, a status stamped before the last one was dropped as an old tick: after the
+        monitor's clock stepped back (a restart on sim time, an NTP step) every later status
+        was, and the goal ran on the last one, deaf to its alarms (a ``slip_imminent`` went
+        unheard for as long as the test waited, 5 s).
+        """
+        if self.latest is not None and ns < messages.cdr_stamp_ns(self.latest):
+            self.get_logger().warning(
+                f"{self.resolve_topic_name(pipeline.STATUS)} went back from "
+                f"{messages.cdr_stamp_ns(self.latest) * 1e-9:.9f} s to {ns * 1e-9:.9f} s (the "
+                "monitor's clock stepped back, or it restarted): taking it as the newest",
+                throttle_duration_sec=1.0)
+        self.latest, self.latest_at = data, time.monotonic()
 
     def _timer(self) -> None:
         goal = self.goal
         if goal is None:
             return
+        now = time.monotonic()
         if self.latest is not None:
-            self._cycle(self.latest, self.get_clock().now().nanoseconds)
+            silent = now - self.latest_at
+            if silent <= self.p["stale_budget"]:
+                self._cycle(self.latest, self.get_clock().now().nanoseconds)
+            else:  # before, the goal ran on the last status after the monitor had stopped
+                self._end_holding(goal, ExecuteGrasp.Result.STALE_DATA,
+                                  f"no {self.resolve_topic_name(pipeline.STATUS)} message for "
+                                  f"{silent:.3f} s, more than stale_budget "
+                                  f"{self.p['stale_budget']} s (is the monitor running?); "
+                                  "holding")
             return
         # no monitor status at all yet: wait stale_budget of wall-clock time, then end
-        now = time.monotonic()
         goal.waiting_since = now if goal.waiting_since is None else goal.waiting_since
         if now - goal.waiting_since > self.p["stale_budget"]:
             self._end_holding(goal, ExecuteGrasp.Result.STALE_DATA,

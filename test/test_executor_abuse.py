@@ -10,6 +10,7 @@ from __future__ import annotations
 import math
 import time
 
+import numpy as np
 import pytest
 from geometry_msgs.msg import Point, Vector3
 from rclpy.action import ActionClient
@@ -19,6 +20,7 @@ from rclpy.parameter import Parameter
 
 from squeeze_grasp_interfaces.action import ExecuteGrasp
 from squeeze_grasp_interfaces.msg import Alarm, MonitorStatus
+from squeeze_grasp_ros.control.motion import MAX_TRAVEL, GraspGoal, goal_problem
 from squeeze_grasp_ros.ros import messages
 from squeeze_grasp_ros.ros.nodes import pipeline
 from squeeze_grasp_ros.ros.nodes.executor import ExecutorNode
@@ -150,6 +152,13 @@ GARBAGE = [
     ("release_clearance", {"on_slip_alarm": "resqueeze", "release_clearance": -math.inf}),
     ("adversary", {"resist": True, "adversary": "F2"}),
     ("adversary", {"resist": True, "adversary": "z" * 1_000_000}),
+    # finite but beyond MAX_TRAVEL: before, 1e308 was accepted and its first cycle raised
+    # OverflowError in the motion profile, ending the executor process
+    ("depth", {"depth": 1e308}),
+    ("depth", {"depth": 11.0}),
+    ("pure_directions", {"on_slip_alarm": "pure",
+                         "pure_directions": [Vector3(x=1e300), Vector3(x=-1.0)]}),
+    ("release_clearance", {"on_slip_alarm": "resqueeze", "release_clearance": 1e308}),
 ]
 
 
@@ -342,3 +351,20 @@ def test_a_hardware_goal_whose_monitor_stops_ends_after_the_stale_budget(ros_con
         assert "more than stale_budget 0.3 s" in ended.message
     finally:
         rig.close()
+
+
+def test_a_resistance_beyond_the_longest_travel_is_refused():
+    """The adversary's translation and the resistance waypoints, finite but beyond
+    ``MAX_TRAVEL`` (10 m): before, accepted (their profile overflowed as the depth's did).
+    """
+    base = dict(fingers=("F1", "F2"), directions=np.array([[1.0, 0.0], [-1.0, 0.0]]),
+                depth=1e-3, adversary="A", resist_travel=np.array([1e300]),
+                adversary_translation=np.array([1e300, 0.0]),
+                resist_waypoints=np.zeros((1, 2, 2)))
+    far = goal_problem(GraspGoal(**base), ["F1", "F2", "A"])
+    assert far == f"adversary_translation must be a nonzero vector of at most {MAX_TRAVEL:g} m"
+    waypoints = np.full((1, 2, 2), 1e300)
+    far = goal_problem(GraspGoal(**{**base, "adversary_translation": np.array([0.01, 0.0]),
+                                    "resist_travel": np.array([0.01]),
+                                    "resist_waypoints": waypoints}), ["F1", "F2", "A"])
+    assert far == f"resist_waypoints must hold 1 x 2 vectors of at most {MAX_TRAVEL:g} m"

@@ -10,6 +10,7 @@ from __future__ import annotations
 import math
 import time
 
+import numpy as np
 import pytest
 from geometry_msgs.msg import Point, Vector3
 from rclpy.action import ActionClient
@@ -18,7 +19,8 @@ from rclpy.node import Node
 from rclpy.parameter import Parameter
 
 from squeeze_grasp_interfaces.action import ExecuteGrasp
-from squeeze_grasp_interfaces.msg import MonitorStatus
+from squeeze_grasp_interfaces.msg import Alarm, MonitorStatus
+from squeeze_grasp_ros.control.motion import MAX_TRAVEL, GraspGoal, goal_problem
 from squeeze_grasp_ros.ros import messages
 from squeeze_grasp_ros.ros.nodes import pipeline
 from squeeze_grasp_ros.ros.nodes.executor import ExecutorNode
@@ -150,6 +152,13 @@ GARBAGE = [
     ("release_clearance", {"on_slip_alarm": "resqueeze", "release_clearance": -math.inf}),
     ("adversary", {"resist": True, "adversary": "F2"}),
     ("adversary", {"resist": True, "adversary": "z" * 1_000_000}),
+    # finite but beyond MAX_TRAVEL: before, 1e308 was accepted and its first cycle raised
+    # OverflowError in the motion profile, ending the executor process
+    ("depth", {"depth": 1e308}),
+    ("depth", {"depth": 11.0}),
+    ("pure_directions", {"on_slip_alarm": "pure",
+                         "pure_directions": [Vector3(x=1e300), Vector3(x=-1.0)]}),
+    ("release_clearance", {"on_slip_alarm": "resqueeze", "release_clearance": 1e308}),
 ]
 
 
@@ -235,3 +244,127 @@ def test_a_hardware_goal_without_any_monitor_status_ends_after_the_stale_budget(
         assert "no /monitor/status message within stale_budget 0.2 s" in ended.message
     finally:
         rig.close()
+
+
+BAD_STATUSES = {
+    "a finger the monitor does not watch": {"fingers": ["Z9", "F2"]},
+    "arrays shorter than its fingers": {"positions": [Point(x=0.05)], "forces": [Vector3()],
+                                        "normals": [Vector3()], "fingers": ["F2", "F1"]},
+    "a NaN position": {"positions": [Point(x=math.nan), Point(x=0.05)]},
+    "an infinite force": {"forces": [Vector3(x=math.inf), Vector3()]},
+}
+
+
+@pytest.mark.parametrize("case", list(BAD_STATUSES))
+def test_a_status_without_a_usable_finger_ends_the_goal_and_the_node_serves_on(rig, case):
+    """A running goal, then a ``monitor/status`` without a finite position and force of one
+    of the executor's fingers (a monitor whose ``finger_devices`` leave one out, or garbage):
+    the goal ends ``stale_data`` naming the finger, and the next goal runs. Before, a missing
+    finger ended the executor process (KeyError in the control step), a short array was read
+    from the bytes after it, and a NaN made the goal's work NaN.
+    """
+    future = rig.clients[0].send_goal_async(squeeze())
+    assert rig.until(future.done) and future.result().accepted
+    rig.publish_status()
+    assert rig.until(lambda: rig.node.goal is not None and rig.node.goal.start_ns is not None)
+    bad = MonitorStatus(fingers=["F1", "F2"], positions=[Point(x=-0.05), Point(x=0.05)],
+                        forces=[Vector3(), Vector3()], normals=[Vector3(), Vector3()],
+                        sensor_age=[0.0, 0.0])
+    for name, value in BAD_STATUSES[case].items():
+        setattr(bad, name, value)
+    messages.set_stamp(bad.header.stamp, rig.tick * 1_000_000)
+    rig.tick += 1
+    rig.status.publish(bad)
+    result = rig.result_of(future.result())
+    assert result.termination == ExecuteGrasp.Result.STALE_DATA, result.message
+    assert "has no finite position and force of F1" in result.message, result.message
+    assert all(math.isfinite(w) for w in result.work)
+    again = rig.clients[0].send_goal_async(squeeze())
+    assert rig.until(again.done) and again.result().accepted
+    rig.publish_status()
+    assert rig.until(lambda: rig.node.goal is not None and rig.node.goal.start_ns is not None)
+    again.result().cancel_goal_async()
+    assert rig.result_of(again.result()).termination == ExecuteGrasp.Result.CANCELED
+
+
+def _hardware_status(rig: Rig, ns: int, alarm: str = "") -> None:
+    """A status stamped ``ns`` (both fingers still, 5 cm either side), with an ``alarm`` of F1."""
+    msg = MonitorStatus(fingers=["F1", "F2"], positions=[Point(x=-0.05), Point(x=0.05)],
+                        forces=[Vector3(), Vector3()], normals=[Vector3(), Vector3()],
+                        sensor_age=[0.0, 0.0])
+    if alarm:
+        msg.alarms = [Alarm(type=alarm, finger="F1")]
+    messages.set_stamp(msg.header.stamp, ns)
+    rig.status.publish(msg)
+
+
+def test_a_hardware_goal_hears_the_monitor_after_its_clock_stepped_back(ros_context):
+    """Hardware mode: statuses at 100 s, then the monitor's clock steps back to 1 s and it
+    reports ``slip_imminent``. Before, every status after the step was dropped as older than
+    the last, and the goal ran on, deaf to the alarm; now it ends ``slip_alarm``.
+    """
+    rig = Rig(ros_context, clients=1, lockstep=False, stale_budget=1.0)
+    try:
+        future = rig.clients[0].send_goal_async(squeeze(depth=0.02))
+        assert rig.until(future.done) and future.result().accepted
+        result = future.result().get_result_async()
+        k = 0
+
+        def started() -> bool:
+            nonlocal k
+            _hardware_status(rig, 100 * 10**9 + k * 1000)
+            k += 1
+            return rig.node.goal is not None and rig.node.goal.start_ns is not None
+        assert rig.until(started)
+        rig.until(lambda: False, 0.1)  # it cycles on the statuses of 100 s
+        k = 0
+
+        def alarmed() -> bool:
+            nonlocal k
+            _hardware_status(rig, 10**9 + k * 1000, "slip_imminent")  # 1 us apart: below 100 s
+            k += 1
+            return result.done()
+        assert rig.until(alarmed, 5.0), "the goal never heard the alarm"
+        assert result.result().result.termination == ExecuteGrasp.Result.SLIP_ALARM
+    finally:
+        rig.close()
+
+
+def test_a_hardware_goal_whose_monitor_stops_ends_after_the_stale_budget(ros_context):
+    """Hardware mode: statuses for 0.2 s, then none (the monitor stopped). Before, the goal ran
+    on its last status, commanding the squeeze without feedback; now it ends ``stale_data``
+    once no status came for ``stale_budget`` s.
+    """
+    rig = Rig(ros_context, clients=1, lockstep=False, stale_budget=0.3)
+    try:
+        future = rig.clients[0].send_goal_async(squeeze(depth=0.02))
+        assert rig.until(future.done) and future.result().accepted
+        result = future.result().get_result_async()
+        for k in range(20):
+            _hardware_status(rig, 100 * 10**9 + k * 10**7)
+            rig.until(lambda: False, 0.01)
+        assert not result.done()
+        assert rig.until(result.done, 5.0), "the goal ran on without a monitor"
+        ended = result.result().result
+        assert ended.termination == ExecuteGrasp.Result.STALE_DATA
+        assert "no /monitor/status message for" in ended.message
+        assert "more than stale_budget 0.3 s" in ended.message
+    finally:
+        rig.close()
+
+
+def test_a_resistance_beyond_the_longest_travel_is_refused():
+    """The adversary's translation and the resistance waypoints, finite but beyond
+    ``MAX_TRAVEL`` (10 m): before, accepted (their profile overflowed as the depth's did).
+    """
+    base = dict(fingers=("F1", "F2"), directions=np.array([[1.0, 0.0], [-1.0, 0.0]]),
+                depth=1e-3, adversary="A", resist_travel=np.array([1e300]),
+                adversary_translation=np.array([1e300, 0.0]),
+                resist_waypoints=np.zeros((1, 2, 2)))
+    far = goal_problem(GraspGoal(**base), ["F1", "F2", "A"])
+    assert far == f"adversary_translation must be a nonzero vector of at most {MAX_TRAVEL:g} m"
+    waypoints = np.full((1, 2, 2), 1e300)
+    far = goal_problem(GraspGoal(**{**base, "adversary_translation": np.array([0.01, 0.0]),
+                                    "resist_travel": np.array([0.01]),
+                                    "resist_waypoints": waypoints}), ["F1", "F2", "A"])
+    assert far == f"resist_waypoints must hold 1 x 2 vectors of at most {MAX_TRAVEL:g} m"

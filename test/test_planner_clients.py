@@ -8,15 +8,18 @@ from __future__ import annotations
 import re
 import time
 from collections import Counter
+from pathlib import Path
 
 import yaml
 from action_msgs.msg import GoalStatus
+from geometry_msgs.msg import Point32
 from planner_support import BLOB, Harness
 from rclpy.action import ActionClient
 from rclpy.qos import HistoryPolicy, QoSProfile, ReliabilityPolicy
 from test_planner_node import RESIST_FIG10
 
 from squeeze_grasp_interfaces.action import GraspMap as GraspMapAction
+from squeeze_grasp_interfaces.msg import Material, ObjectDescription
 from squeeze_grasp_interfaces.srv import EventSqueeze, LoadObject, PlanSqueeze
 from squeeze_grasp_ros.planning import ErrorCode
 from squeeze_grasp_ros.ros.refusals import REFUSAL_LOG_INTERVAL_S
@@ -344,6 +347,48 @@ def test_no_response_or_log_line_echoes_a_huge_field(planner, capfd):
     logged = capfd.readouterr()
     longest = max(len(line) for line in (logged.out + logged.err).splitlines())
     assert longest < 1000, longest
+
+
+def test_an_absurd_mesh_size_is_refused_in_one_short_line(planner):
+    """``mesh: {max_area: 1e-308}`` on the foam square asks for about 8e305 nodes: before, the
+    refusal quoted that count as an integer of 306 digits (a message of 425 characters).
+    """
+    foam = (Path(__file__).resolve().parents[1] / "config" / "scenes" / "foam_square.yaml")
+    text = foam.read_text().replace("nodes: 2000", "max_area: 1.0e-308")
+    tiny = planner.call(LoadObject, "load_object", LoadObject.Request(scene_yaml=text))
+    assert tiny.error_code == ErrorCode.INVALID_ARGUMENT
+    assert tiny.message.startswith("oversized factorized mesh: 8e+305 nodes, more than the "
+                                   "planner's limit of 60000"), tiny.message
+    assert len(tiny.message) < 200, len(tiny.message)
+
+
+def test_a_fingertip_beyond_the_float_range_is_refused_naming_the_field(planner):
+    """``tip_radius: 1.0e308``: before, the load succeeded and the event squeeze failed with
+    NUMERICAL_FAILURE ("no contact mode of nodes [49, 114] can be solved"), numpy overflow
+    warnings in the planner's log; now the load is refused with the field and its range.
+    """
+    foam = (Path(__file__).resolve().parents[1] / "config" / "scenes" / "foam_square.yaml")
+    text = foam.read_text().replace("tip_radius: 0.02", "tip_radius: 1.0e308")
+    huge = planner.call(LoadObject, "load_object", LoadObject.Request(scene_yaml=text))
+    assert huge.error_code == ErrorCode.INVALID_ARGUMENT, huge.message
+    assert huge.message == "fingers.F1.tip_radius must be in [0.0, 1000.0] m, got 1e+308"
+
+
+def test_an_outline_placed_beyond_the_scenes_range_names_the_frame_pose(planner):
+    """A typed square in frame ``camera`` whose ``frame_pose`` sits at x = 1e300 m: before, the
+    refusal named ``object.shape_parameters points``, a field the request did not give.
+    """
+    desc = ObjectDescription(material=Material(youngs_modulus=5e4, poisson_ratio=0.3,
+                                               thickness=0.0254), mesh_nodes=500)
+    desc.outline.header.frame_id = "camera"
+    desc.outline.polygon.points = [Point32(x=x, y=y) for x, y in (
+        (-0.05, -0.05), (0.05, -0.05), (0.05, 0.05), (-0.05, 0.05))]
+    desc.frame_pose.position.x, desc.frame_pose.orientation.w = 1e300, 1.0
+    far = planner.call(LoadObject, "load_object", LoadObject.Request(object=desc))
+    assert far.error_code == ErrorCode.INVALID_ARGUMENT
+    assert far.message.startswith("object.outline.polygon.points[0] lies at [1e+300, "), \
+        far.message
+    assert "object.frame_pose" in far.message and len(far.message) < 200
 
 
 # --------------------------------------------------------------------------- abandoned work

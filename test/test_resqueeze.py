@@ -223,8 +223,9 @@ def test_a_second_slip_ends_the_goal_and_one_attempt_is_hold(setup):
     ("max_attempts", 0, "max_attempts must be >= 1"),
     ("resqueeze_margin", 1.0, r"resqueeze_margin must be in \(0, 1\)"),
     ("resqueeze_margin", float("nan"), r"resqueeze_margin must be in \(0, 1\)"),
-    ("release_clearance", -1e-3, "release_clearance must be finite and > 0 m"),
-    ("release_clearance", float("inf"), "release_clearance must be finite and > 0 m"),
+    ("release_clearance", -1e-3, r"release_clearance must be in \(0, 10\] m"),
+    ("release_clearance", float("inf"), r"release_clearance must be in \(0, 10\] m"),
+    ("release_clearance", 1e308, r"release_clearance must be in \(0, 10\] m, got 1e\+308"),
 ])
 def test_invalid_resqueeze_fields_are_named(field, value, why):
     goal = GraspGoal(("F1", "F2"), np.array([[0.0, 1.0], [0.0, -1.0]]) / np.sqrt(2), 1e-3,

@@ -50,7 +50,10 @@ def mutate(path: str, value):
     ("object.mesh.min_angle", 40, "object.mesh.min_angle must be in"),
     ("object.shape.type", "hexagon", "object.shape.type must be one of"),
     ("object.shape.radius", 0.1, "unknown key object.shape.radius"),
-    ("fingers.F1.tip_radius", -0.01, "fingers.F1.tip_radius must be in \\[0.0, 1000.0\\] m"),
+    ("fingers.F1.tip_radius", -0.01, r"fingers.F1.tip_radius must be in \[0.0, 1000.0\] m"),
+    # before, 1e308 was taken and overflowed the contact geometry (a numerical failure)
+    ("fingers.F1.tip_radius", 1e308, r"fingers.F1.tip_radius must be in \[0.0, 1000.0\] m, "
+                                     r"got 1e\+308"),
     ("fingers.F1.placement", {"point": [0, 0], "node": 3}, "exactly one of"),
     ("fingers.F3", {"placement": {"node": 1}}, "unknown finger fingers.F3"),
     ("squeeze.depth", 0.01, "exclusive"),

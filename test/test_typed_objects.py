@@ -149,6 +149,12 @@ def test_holes_make_a_ring_like_solid():
     (dict(mu=-0.2), ["object.mu"]),
     (dict(frame_id="tilted", frame_pose=FramePose((0, 0, 0), (0.1, 0.0, 0.0, 0.995))),
      ["object.frame_pose", "rad", "z axis"]),
+    # placed beyond the scenes' range by the pose: before, "object.shape_parameters points must
+    # be a list of [x, y] number pairs (m)", naming a field the request did not give
+    (dict(frame_id="camera", frame_pose=FramePose((1e308, 0, 0), (0, 0, 0, 1))),
+     ["object.placements[0] lies at [1e+308, 0.0] m", "object.frame_pose", "2^53"]),
+    (dict(frame_id="camera", placements=(), frame_pose=FramePose((1e300, 0, 0), (0, 0, 0, 1))),
+     ["object.outline.polygon.points[0] lies at", "object.frame_pose", "2^53"]),
 ])
 def test_bad_typed_objects_name_the_message_field(fields, words):
     with pytest.raises(PlannerError) as caught:

@@ -87,6 +87,12 @@ DEFAULT_CLEARANCE = 0.002
 """How far a released finger opens past first contact (m), when the goal gives none: 2 mm,
 clear of the object at rest for the shipped pads and circles while a gripper opens in 0.2 s at
 the default ``max_velocity``."""
+MAX_TRAVEL = 10.0
+"""m: the longest fingertip travel a goal may ask for (its depth times its longest direction or
+pure direction, the adversary's translation, a resistance waypoint, the release clearance).
+Before, a depth of 1e308 m was accepted and its first control cycle overflowed the motion
+profile ("OverflowError: cannot convert float infinity to integer"), which ended the executor
+process."""
 _NO_FORCE = np.zeros(2)
 _NO_FORCE.flags.writeable = False
 """A finger's force while it has no reading (N; one array, not one per tick)."""
@@ -196,6 +202,11 @@ class GraspGoal:
         return bool(self.adversary)
 
 
+def _longest_travel(depth: float, directions: np.ndarray) -> float:
+    """The longest fingertip travel (m) of ``depth`` along ``directions`` (m/m)."""
+    return float(depth * np.max(np.hypot(directions[:, 0], directions[:, 1])))
+
+
 def goal_problem(goal: GraspGoal, known: Sequence[str]) -> str | None:
     """Why ``goal`` cannot be executed with fingers ``known``, or None if it can."""
     f = len(goal.fingers)
@@ -210,6 +221,10 @@ def goal_problem(goal: GraspGoal, known: Sequence[str]) -> str | None:
         return "directions are all zero"
     if not (np.isfinite(goal.depth) and goal.depth >= 0):
         return f"depth must be finite and >= 0, got {goal.depth}"
+    travel = _longest_travel(goal.depth, goal.directions)
+    if not travel <= MAX_TRAVEL:
+        return (f"depth times the longest direction must be at most {MAX_TRAVEL:g} m of "
+                f"fingertip travel, got {travel:.6g} m (depth {goal.depth:.6g} m)")
     if not (np.isfinite(goal.relative_per_depth) and goal.relative_per_depth >= 0):
         return f"relative_per_depth must be finite and >= 0 (1/m), got {goal.relative_per_depth}"
     try:  # the fingers would meet or cross (0: the goal gives no finger distance to check)
@@ -223,15 +238,18 @@ def goal_problem(goal: GraspGoal, known: Sequence[str]) -> str | None:
         or goal.pure_directions.shape != (f, 2)
         or not np.all(np.isfinite(goal.pure_directions))
         or not np.any(goal.pure_directions)
+        or not _longest_travel(goal.depth, goal.pure_directions) <= MAX_TRAVEL
     ):
-        return f"on_slip_alarm 'pure' needs {f} finite, not all zero pure_directions"
+        return (f"on_slip_alarm 'pure' needs {f} finite, not all zero pure_directions, at most "
+                f"{MAX_TRAVEL:g} m of fingertip travel at the goal's depth")
     if goal.on_slip_alarm == RESQUEEZE:
         if not goal.max_attempts >= 1:
             return f"max_attempts must be >= 1, got {goal.max_attempts}"
         if not 0.0 < goal.resqueeze_margin < 1.0:
             return f"resqueeze_margin must be in (0, 1), got {goal.resqueeze_margin}"
-        if not (np.isfinite(goal.release_clearance) and goal.release_clearance > 0.0):
-            return f"release_clearance must be finite and > 0 m, got {goal.release_clearance}"
+        if not 0.0 < goal.release_clearance <= MAX_TRAVEL:
+            return (f"release_clearance must be in (0, {MAX_TRAVEL:g}] m, got "
+                    f"{goal.release_clearance}")
         if goal.resist:
             return ("on_slip_alarm 'resqueeze' cannot be combined with a resistance: its "
                     "waypoints are planned for the goal's depth, not a re-squeeze's")
@@ -248,8 +266,8 @@ def _resistance_problem(goal: GraspGoal, known: Sequence[str]) -> str | None:
     a = goal.adversary_translation
     travel = goal.resist_travel
     k = len(travel)
-    if a.shape != (2,) or not np.all(np.isfinite(a)) or not np.hypot(*a) > 0:
-        return "adversary_translation must be a finite nonzero vector"
+    if a.shape != (2,) or not 0 < np.hypot(*a) <= MAX_TRAVEL:
+        return f"adversary_translation must be a nonzero vector of at most {MAX_TRAVEL:g} m"
     if (
         k == 0
         or np.any(np.diff(travel) <= 0)
@@ -257,8 +275,9 @@ def _resistance_problem(goal: GraspGoal, known: Sequence[str]) -> str | None:
         or not np.isclose(travel[-1], np.hypot(*a), rtol=1e-9, atol=0.0)
     ):
         return "resist_travel must increase from > 0 to |adversary_translation|"
-    if goal.resist_waypoints.shape != (k, f, 2) or not np.all(np.isfinite(goal.resist_waypoints)):
-        return f"resist_waypoints must hold {k} x {f} finite vectors"
+    if goal.resist_waypoints.shape != (k, f, 2) or not np.all(
+            np.abs(goal.resist_waypoints) <= MAX_TRAVEL):
+        return f"resist_waypoints must hold {k} x {f} vectors of at most {MAX_TRAVEL:g} m"
     return None
 
 

@@ -257,10 +257,21 @@ def read_scene(
 
 
 def check_size(count: int | None, limit: int, what: str) -> None:
-    """Refuse a model with more than ``limit`` nodes (INVALID_ARGUMENT, oversized)."""
+    """Refuse a model with more than ``limit`` nodes (INVALID_ARGUMENT, oversized).
+
+    A count of 16 digits or more is given to 3 significant digits: ``mesh.max_area: 1e-308``
+    asks for an integer of 306 digits, which the message quoted whole.
+
+    >>> check_size(10**306 * 8, 60000, "factorized mesh")
+    Traceback (most recent call last):
+    ...
+    squeeze_grasp_ros.planning.errors.PlannerError: oversized factorized mesh: 8e+306 nodes, \
+more than the planner's limit of 60000 (parameter); coarsen object.mesh or object.ring
+    """
     if count is not None and count > limit:
+        shown_count = f"{count:.3g}" if count >= 10**15 else f"{count}"
         raise invalid(
-            f"oversized {what}: {count} nodes, more than the planner's limit of "
+            f"oversized {what}: {shown_count} nodes, more than the planner's limit of "
             f"{limit} (parameter); coarsen object.mesh or object.ring"
         )
 

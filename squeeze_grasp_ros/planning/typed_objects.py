@@ -43,6 +43,7 @@ from squeeze_grasp_ros.mechanics.vocabulary import Effect, Finger, MaterialModel
 from squeeze_grasp_ros.planning.errors import invalid
 from squeeze_grasp_ros.planning.objects import SceneSource, read_scene
 from squeeze_grasp_ros.scene import SHAPES, Scene, SceneError, build_outline, parse_scene
+from squeeze_grasp_ros.scene.schema import MAX_INT
 
 __all__ = ["OBJECT_FRAME", "PLANAR_TOLERANCE", "TYPED_SHAPES", "FramePose", "TypedMaterial",
            "TypedObject", "object_source", "scene_data", "seen_object", "typed_scene"]
@@ -208,7 +209,8 @@ def _points(points: Sequence[Sequence[float]], pose: tuple[np.ndarray, np.ndarra
     ------
     PlannerError
         INVALID_ARGUMENT naming ``name[k]`` for a point that is not an (x, y) pair of finite
-        numbers (m): a 3-D point would otherwise be re-paired into other points.
+        numbers (m): a 3-D point would otherwise be re-paired into other points; or that
+        ``frame_pose`` places beyond the scenes' coordinate range (``MAX_INT`` m).
     """
     for k, point in enumerate(points):
         if not (isinstance(point, Sequence | np.ndarray) and len(point) == 2):
@@ -221,7 +223,13 @@ def _points(points: Sequence[Sequence[float]], pose: tuple[np.ndarray, np.ndarra
         bad = int(np.flatnonzero(~np.all(np.isfinite(xy), axis=1))[0])
         raise invalid(f"{name}[{bad}] must be finite (m)")
     R, t = pose
-    return (xy @ R.T + t).tolist()
+    placed = xy @ R.T + t
+    beyond = np.flatnonzero(~np.all(np.abs(placed) <= MAX_INT, axis=1))
+    if len(beyond):  # a scene refused it naming object.shape_parameters, not this field
+        k = int(beyond[0])
+        raise invalid(f"{name}[{k}] lies at {placed[k].tolist()} m in the object frame (after "
+                      f"object.frame_pose), beyond the scenes' range of +-{MAX_INT:.4g} m (2^53)")
+    return placed.tolist()
 
 
 def _shape(obj: TypedObject, pose: tuple[np.ndarray, np.ndarray]) -> dict:

@@ -256,7 +256,9 @@ _NO_FRAME = b"\x01\x00\x00\x00\x00\x00\x00\x00"
 def monitor_status_cdr_reading(data: bytes) -> tuple | None:
     """(stamp ns, fingers, positions (k, 3) m, forces (k, 3) N, normals (k, 3), depth m) of a
     serialised ``squeeze_grasp_interfaces/MonitorStatus`` that carries no event and no alarm
-    (most ticks); None when it carries any (deserialise it whole then).
+    (most ticks); None when it carries any, or when its positions, forces or normals are not
+    one per finger (deserialise it whole then; before, the vectors were read from the bytes
+    after a short array).
 
     The arrays are read-only views of ``data``. A status of the layout of one read before (the
     same length, frame, fingers and counts, no event and no alarm) is read at that one's offsets
@@ -278,6 +280,8 @@ def monitor_status_cdr_reading(data: bytes) -> tuple | None:
     for _ in range(3):
         counts.append(reader.offset + -(reader.offset - _BODY) % 4)
         count = reader.uint32()
+        if count != len(fingers):  # not one vector per finger: deserialise it whole
+            return None
         if count:
             reader._align(8)
         runs.append(reader.offset)

@@ -39,6 +39,7 @@ every request). On hardware, a goal that sees no ``monitor/status`` at all withi
 """
 from __future__ import annotations
 
+import math
 import sys
 import time
 from typing import Any
@@ -56,8 +57,10 @@ from squeeze_grasp_ros.control.motion import (
     Command,
     GraspProgram,
     MotionLimits,
+    Observation,
     goal_problem,
 )
+from squeeze_grasp_ros.inputs import shown
 from squeeze_grasp_ros.ros import messages
 from squeeze_grasp_ros.ros.nodes import ParameterError, pipeline, run_node, spin_until
 from squeeze_grasp_ros.ros.nodes.jaw_commands import HandCommands, JawCommands
@@ -139,6 +142,17 @@ class _Goal:
         reached a squeeze's depth under weight): its result is not the goal's."""
 
 
+_ZERO = (0.0, 0.0)
+"""The force of a finger a status does not list (the control step reads it so)."""
+
+
+def _finite(vector: Any) -> bool:
+    """Whether planar ``vector`` (or None) is there and finite (cheaper than numpy on two
+    numbers: it is checked for every finger at every control cycle).
+    """
+    return vector is not None and math.isfinite(vector[0]) and math.isfinite(vector[1])
+
+
 class ExecutorNode(Node):
     """Grasp executor action server."""
 
@@ -204,6 +218,8 @@ class ExecutorNode(Node):
         rclpy runs it as a later task, after more goal requests may have been taken)."""
         self.latest: bytes | None = None
         """The newest status, serialised (a raw subscription: :meth:`_cycle` reads it)."""
+        self.latest_at = 0.0
+        """Hardware mode: when it arrived (``time.monotonic``, s)."""
         self.answered = pipeline.TickAnswer()
         self.state = ExecutorStatus.IDLE
         self.tick_clock = pipeline.TickClock(self) if p["lockstep"] else None
@@ -326,23 +342,50 @@ class ExecutorNode(Node):
     # ----------------------------------------------------------------- cycles
     def _status(self, data: bytes) -> None:
         ns = messages.cdr_stamp_ns(data)
+        if not self.p["lockstep"]:
+            self._hardware_status(ns, data)
+            return
         if not self.answered.is_new(ns):
             return
-        if self.tick_clock is not None:
-            self.tick_clock.advance(ns)
+        self.tick_clock.advance(ns)
         self.latest = data
-        if self.p["lockstep"] and self.goal is not None:
+        if self.goal is not None:
             self._cycle(data)
+
+    def _hardware_status(self, ns: int, data: bytes) -> None:
+        """Hardware mode: the newest status by arrival is the one the timer's cycles read,
+        whatever its stamp, and its arrival time says whether the monitor still speaks.
+
+        Before, a status stamped before the last one was dropped as an old tick: after the
+        monitor's clock stepped back (a restart on sim time, an NTP step) every later status
+        was, and the goal ran on the last one, deaf to its alarms (a ``slip_imminent`` went
+        unheard for as long as the test waited, 5 s).
+        """
+        if self.latest is not None and ns < messages.cdr_stamp_ns(self.latest):
+            self.get_logger().warning(
+                f"{self.resolve_topic_name(pipeline.STATUS)} went back from "
+                f"{messages.cdr_stamp_ns(self.latest) * 1e-9:.9f} s to {ns * 1e-9:.9f} s (the "
+                "monitor's clock stepped back, or it restarted): taking it as the newest",
+                throttle_duration_sec=1.0)
+        self.latest, self.latest_at = data, time.monotonic()
 
     def _timer(self) -> None:
         goal = self.goal
         if goal is None:
             return
+        now = time.monotonic()
         if self.latest is not None:
-            self._cycle(self.latest, self.get_clock().now().nanoseconds)
+            silent = now - self.latest_at
+            if silent <= self.p["stale_budget"]:
+                self._cycle(self.latest, self.get_clock().now().nanoseconds)
+            else:  # before, the goal ran on the last status after the monitor had stopped
+                self._end_holding(goal, ExecuteGrasp.Result.STALE_DATA,
+                                  f"no {self.resolve_topic_name(pipeline.STATUS)} message for "
+                                  f"{silent:.3f} s, more than stale_budget "
+                                  f"{self.p['stale_budget']} s (is the monitor running?); "
+                                  "holding")
             return
         # no monitor status at all yet: wait stale_budget of wall-clock time, then end
-        now = time.monotonic()
         goal.waiting_since = now if goal.waiting_since is None else goal.waiting_since
         if now - goal.waiting_since > self.p["stale_budget"]:
             self._end_holding(goal, ExecuteGrasp.Result.STALE_DATA,
@@ -363,6 +406,8 @@ class ExecutorNode(Node):
         msg = None if obs is not None else deserialize_message(data, MonitorStatus)
         obs = obs or messages.observation(msg)
         ns = obs.stamp_ns
+        if self._unwatched(goal, obs):
+            return
         if goal.start_ns is None:
             if not self.p["lockstep"] and self._unseen(
                     goal, msg or deserialize_message(data, MonitorStatus), ns):
@@ -389,6 +434,26 @@ class ExecutorNode(Node):
             self.goal = None
             goal.done.set_result(messages.grasp_result(
                 goal.program, command, obs, goal.events, (ns - goal.start_ns) * 1e-9, SUCCESS))
+
+    def _unwatched(self, goal: _Goal, obs: Observation) -> bool:
+        """True, and ``goal`` ended ``stale_data``, when status ``obs`` has no finite position
+        and force of a finger the executor drives (a monitor whose ``finger_devices`` leave out
+        one of the executor's, a status whose arrays are shorter than its ``fingers``, NaN).
+        Before, a missing finger made the control step raise KeyError, which ended the executor
+        process, and a NaN position made the goal's work NaN.
+        """
+        missing = [f for f in goal.program.fingers
+                   if not _finite(obs.positions.get(f)) or not _finite(obs.forces.get(f, _ZERO))]
+        if not missing:
+            return False
+        elapsed = 0.0 if goal.start_ns is None else (obs.stamp_ns - goal.start_ns) * 1e-9
+        self._end_holding(goal, ExecuteGrasp.Result.STALE_DATA,
+                          f"{self.resolve_topic_name(pipeline.STATUS)} of "
+                          f"{obs.stamp_ns * 1e-9:.9f} s has no finite position and force of "
+                          f"{', '.join(missing)} (it lists {shown(', '.join(obs.positions))}; "
+                          "the monitor must watch every finger of the executor's finger_devices); "
+                          "nothing more was commanded", elapsed)
+        return True
 
     def _setpoints(self, command: Command, stamp: int) -> list:
         """(publisher, serialised PoseStamped) of each commanded finger with a setpoint topic,

@@ -45,6 +45,7 @@ watch on fingers 1 and 2 as on a gripper's jaws.
 """
 from __future__ import annotations
 
+import math
 import sys
 from typing import Any
 
@@ -83,6 +84,7 @@ from squeeze_grasp_ros.ros.nodes import ParameterError, pipeline, run_node
 from squeeze_grasp_ros.ros.nodes.force_watcher import ForceWatcher
 from squeeze_grasp_ros.ros.nodes.shape_watcher import ShapeWatcher
 from squeeze_grasp_ros.ros.nodes.sim_controllers import JOINT_STATES
+from squeeze_grasp_ros.ros.refusals import RefusalLog
 from squeeze_grasp_ros.scene import load_scene
 from squeeze_grasp_ros.scene.controller import (
     HandController,
@@ -166,6 +168,11 @@ BOUNDS = {"mu": pipeline.Bound(0.0, note="0: no friction"),
           "joint_slip_ratio": pipeline.Bound(0.0, above=True)}
 """The range of each numeric parameter (``weight_margin`` and ``hand_max_condition`` are
 checked where they are used, by the routes that take them)."""
+PENDING_STAMPS = 64
+"""Lockstep: the most stamps whose readings wait for their tick, and the most ticks that wait
+for their readings. In a loop one stamp waits at a time; readings under stamps no tick ever
+closes (a publisher of its own clock) were kept for ever: 10 kHz of them grew the monitor by
+380 MB in 40 s."""
 POSE_JOINT_TOLERANCE = 1e-5
 """m: the largest gap between the jaws' aperture of their first pose readings and of the first
 joint state that passes without a warning."""
@@ -191,6 +198,81 @@ READINGS = {"pose": _pose, "wrench": _wrench, "tactile": _tactile}
 """Stream -> reader of its raw CDR bytes: (stamp ns, the tracker's ``FingerSample`` fields).
 The device readings are taken raw and read with :mod:`..messages.cdr`, not turned into
 message objects (six readings a tick; rclpy's conversion cost 6-17 times as much)."""
+
+
+def make_room(pending: dict[int, Any], ns: int, limit: int = PENDING_STAMPS) -> bool:
+    """Make room for stamp ``ns`` in ``pending`` (stamp -> what waits under it) of at most
+    ``limit`` stamps, dropping the farthest stamp: the nearest are the next ticks'.
+
+    Returns
+    -------
+    bool
+        False when ``ns`` is itself the farthest and there is no room (do not store it).
+
+    Examples
+    --------
+    >>> pending = {1: "a", 2: "b"}
+    >>> make_room(pending, 3, limit=2), pending
+    (False, {1: 'a', 2: 'b'})
+    >>> make_room(pending, 0, limit=2), pending
+    (True, {1: 'a'})
+    >>> make_room(pending, 1, limit=1)
+    True
+    """
+    if ns in pending or len(pending) < limit:
+        return True
+    farthest = max(pending)
+    if ns > farthest:
+        return False
+    del pending[farthest]
+    return True
+
+
+def reading_problem(fields: dict[str, Any]) -> str | None:
+    """Why the tracker cannot take a device reading's ``FingerSample`` fields, or None.
+
+    A position or force that is not finite, or taxel arrays that are empty, of different
+    lengths or not finite, are refused here: the tracker would raise on them (an empty or
+    ragged ``TactileArray`` ended the monitor process with a ValueError) or carry NaN into
+    every status.
+
+    Parameters
+    ----------
+    fields : dict
+        The fields a :data:`READINGS` reader returned.
+
+    Returns
+    -------
+    str or None
+        The reason in one line, naming the message field; None for a usable reading.
+
+    Examples
+    --------
+    >>> reading_problem({"force": np.array([0.0, np.nan, 0.0]), "force_stamp_ns": 1})
+    'wrench.force is not finite: [0.0, nan, 0.0] N'
+    >>> reading_problem({"angles": np.zeros(3), "normal": np.zeros(2), "tangential": np.zeros(0),
+    ...                  "tactile_stamp_ns": 1})
+    'taxel_angles, normal_forces and tangential_forces must have one value per taxel (at least \
+one), got 3, 2 and 0 values'
+    >>> reading_problem({"position": np.array([0.01, 0.0])}) is None
+    True
+    """
+    # math.isfinite over the values' list: a fifth of np.isfinite's cost on these short
+    # arrays (six readings a tick)
+    for name, label, unit in (("position", "pose.position", "m"), ("force", "wrench.force", "N")):
+        value = fields.get(name)
+        if value is not None and not all(map(math.isfinite, value.tolist())):
+            return f"{label} is not finite: {value.tolist()} {unit}"
+    if "normal" not in fields:
+        return None
+    arrays = [fields["angles"], fields["normal"], fields["tangential"]]
+    counts = [len(a) for a in arrays]
+    if not counts[0] or counts.count(counts[0]) < 3:
+        return ("taxel_angles, normal_forces and tangential_forces must have one value per taxel "
+                f"(at least one), got {counts[0]}, {counts[1]} and {counts[2]} values")
+    if not all(all(map(math.isfinite, a.tolist())) for a in arrays):
+        return "taxel_angles, normal_forces or tangential_forces are not finite"
+    return None
 
 
 STREAMS = ("wrench", "tactile")
@@ -242,13 +324,16 @@ class MonitorNode(Node):
         sensors = pipeline.sensor_qos(p["sensor_qos"], p["qos_depth"])
         types = {"pose": PoseStamped, "wrench": WrenchStamped, "tactile": TactileArray}
         self.keys: dict[str, tuple[str, str]] = {}
+        self.refusals = RefusalLog(self.get_logger().warning)
+        """The log of refused readings, by device stream."""
         for finger, device in self.fingers.items():
             for stream, msg_type in types.items():
                 key = f"{device}/{stream}"
                 self.keys[key] = (finger, stream)
                 self.create_subscription(
                     msg_type, pipeline.device_topic(device, stream),
-                    lambda data, k=key, read=READINGS[stream]: self._reading(k, *read(data)),
+                    lambda data, k=key, read=READINGS[stream]: self._device_reading(k,
+                                                                                    read(data)),
                     sensors, raw=True)
         if self.jaws is not None:
             self.create_subscription(PoseStamped, pipeline.GRIPPER_POSE,
@@ -326,14 +411,40 @@ class MonitorNode(Node):
         if self.forces is not None:
             self.forces.set_prediction(msg)
 
+    def _device_reading(self, key: str, read: tuple[int, dict[str, Any]]) -> None:
+        """A device reading ``read`` (stamp ns, fields) of ``key``: refused with a warning (at
+        most one line per device stream and second, :class:`..refusals.RefusalLog`) when
+        :func:`reading_problem` finds one, so that finger's readings go stale; else taken.
+        """
+        problem = reading_problem(read[1])
+        if problem is None:
+            self._reading(key, *read)
+        else:
+            self.refusals.refused(key, f"the reading of {read[0] * 1e-9:.9f} s: {problem}")
+
     def _reading(self, key: str, ns: int, msg: Any) -> None:
         """A reading stamped ``ns``: the tracker's sample fields of a device stream, or the
         joint state message.
+
+        On hardware a reading stamped more than ``stale_after`` ahead of the monitor's clock is
+        refused: it counted as fresh until its stamp (a driver's clock one hour ahead kept its
+        finger fresh for an hour after the driver stopped, the executor squeezing on).
         """
         if not self.lockstep:
+            ahead = (ns - self.get_clock().now().nanoseconds) * 1e-9
+            if ahead > self.p["stale_after"]:
+                self.refusals.refused(key, f"the reading of {ns * 1e-9:.9f} s is stamped "
+                                           f"{ahead:.6g} s ahead of the monitor's clock, more "
+                                           f"than stale_after ({self.p['stale_after']} s): are "
+                                           "the driver's and the monitor's clocks the same?")
+                return
             self.latest[key] = msg
             return
         if ns <= self.answered.stamp_ns:
+            return
+        if not make_room(self.buffer, ns):
+            self.refusals.refused("pending", f"more than {PENDING_STAMPS} stamps wait for their "
+                                             f"tick: dropped {key} of {ns * 1e-9:.9f} s")
             return
         self.buffer.setdefault(ns, {})[key] = msg
         if ns in self.expected:  # its tick is here: the reading may close it
@@ -344,16 +455,26 @@ class MonitorNode(Node):
         ns, readings = messages.tick_readings_cdr(data)
         if not self.answered.is_new(ns):
             return
+        if not make_room(self.expected, ns):
+            self.refusals.refused("pending", f"more than {PENDING_STAMPS} ticks wait for their "
+                                             f"readings: dropped the tick of {ns * 1e-9:.9f} s")
+            return
         self.expected[ns] = set(readings) & self.keys.keys()
         self._try_close(ns)
 
     def _try_close(self, ns: int) -> None:
+        """Answer tick ``ns`` if it and all its readings are here; then drop what waits under
+        older stamps (no tick closes them any more: they were kept for ever).
+        """
         expected = self.expected.get(ns)
         if expected is None or not expected <= self.buffer.get(ns, {}).keys():
             return
         self.latest.update(self.buffer.pop(ns, {}))
         del self.expected[ns]
         self._process(ns)
+        for pending in (self.buffer, self.expected):
+            for old in [k for k in pending if k < ns]:
+                del pending[old]
 
     def _timer(self) -> None:
         self._process(self.get_clock().now().nanoseconds)

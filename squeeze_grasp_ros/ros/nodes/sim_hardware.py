@@ -24,6 +24,7 @@ every re-sent topic carries one message per stamp, which is how the recorder dro
 """
 from __future__ import annotations
 
+import math
 import sys
 import time
 from typing import Any
@@ -45,6 +46,7 @@ from squeeze_grasp_ros.ros.nodes.sim_controllers import (
     SimHandTrajectoryController,
     SimJointTrajectoryController,
 )
+from squeeze_grasp_ros.ros.refusals import RefusalLog
 from squeeze_grasp_ros.scene import GraspSetup, load_scene
 from squeeze_grasp_ros.scene.controller import HandController, JawController, scene_controller
 from squeeze_grasp_ros.sim.camera import CameraFrame
@@ -135,6 +137,8 @@ class SimHardwareNode(Node):
         self.recorder_ns = -1
         self.create_subscription(Header, pipeline.RECORDER_PROGRESS, self._progress, loop)
         self.pending: dict = {}
+        self.refusals = RefusalLog(self.get_logger().warning)
+        """The log of refused setpoints, by finger."""
         self.current: list = []
         self.now_ns = -1
         self.ended = False
@@ -164,9 +168,16 @@ class SimHardwareNode(Node):
         self._publish(self.world.start())
 
     def _setpoint(self, finger: str, data: bytes) -> None:
-        """A setpoint, read from its CDR bytes (:mod:`..messages.cdr`)."""
+        """A setpoint, read from its CDR bytes (:mod:`..messages.cdr`). One that is not finite
+        is refused with a warning line (at most one per finger and second): the world waits
+        for a finite one. Before, the world's step raised on it and the process ended.
+        """
         ns, position = messages.pose_position_cdr(data)
         if self.now_ns < 0 or ns <= self.now_ns:
+            return
+        if not (math.isfinite(position[0]) and math.isfinite(position[1])):
+            self.refusals.refused(f"{finger} setpoint", f"the setpoint of {ns * 1e-9:.9f} s is "
+                                                        f"not finite: {position.tolist()} m")
             return
         self.pending[finger] = position
         self._try_step()

@@ -177,12 +177,7 @@ def test_goals_with_garbage_fields_end_invalid_naming_the_field_and_the_node_ser
                                                         False), (field, result.message)
         assert field in result.message, (field, result.message)
         assert len(result.message) < 200, (field, len(result.message))
-    future = rig.clients[0].send_goal_async(squeeze())
-    assert rig.until(future.done) and future.result().accepted
-    rig.publish_status()
-    assert rig.until(lambda: rig.node.goal is not None and rig.node.goal.start_ns is not None)
-    future.result().cancel_goal_async()
-    assert rig.result_of(future.result()).termination == ExecuteGrasp.Result.CANCELED
+    assert_the_next_goal_runs(rig)
 
 
 @pytest.mark.parametrize("lockstep", [True, False])
@@ -279,12 +274,17 @@ def test_a_status_without_a_usable_finger_ends_the_goal_and_the_node_serves_on(r
     assert result.termination == ExecuteGrasp.Result.STALE_DATA, result.message
     assert "has no finite position and force of F1" in result.message, result.message
     assert all(math.isfinite(w) for w in result.work)
-    again = rig.clients[0].send_goal_async(squeeze())
-    assert rig.until(again.done) and again.result().accepted
+    assert_the_next_goal_runs(rig)
+
+
+def assert_the_next_goal_runs(rig: Rig) -> None:
+    """A plain goal after an abuse is accepted, starts on the next status and cancels."""
+    future = rig.clients[0].send_goal_async(squeeze())
+    assert rig.until(future.done) and future.result().accepted
     rig.publish_status()
     assert rig.until(lambda: rig.node.goal is not None and rig.node.goal.start_ns is not None)
-    again.result().cancel_goal_async()
-    assert rig.result_of(again.result()).termination == ExecuteGrasp.Result.CANCELED
+    future.result().cancel_goal_async()
+    assert rig.result_of(future.result()).termination == ExecuteGrasp.Result.CANCELED
 
 
 def _hardware_status(rig: Rig, ns: int, alarm: str = "") -> None:

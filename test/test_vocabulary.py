@@ -149,6 +149,7 @@ NOT_DOMAIN: dict[tuple[str, str], str] = {
     ("scene/checks.py", "camera"): "a scene section name (SECTION_EFFECT's keys)",
     ("planning/typed_objects.py", "point"): "the placement key of a scene finger",
     ("planning/typed_objects.py", "friction"): "a scene section name",
+    ("api.py", "polygon"): "the name of the polygon() constructor in __all__",
 }
 """Literals that spell a vocabulary word but mean something else, with what they mean."""
 NOT_COUNTED = {RingLimit.NONE.value: "the English word (messages, matplotlib colours, a world "

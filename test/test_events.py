@@ -302,7 +302,7 @@ def test_a_linear_call_stays_on_the_grid_and_the_first_substep_is_checked():
     result = advance(model, start(obj, contacts), dirs, step=2e-3)
     assert result.next_substep == 2e-3 and result.diagnostics["substep_rejections"] == 0
     for bad in (0.0, -1e-3, float("nan")):
-        with pytest.raises(InvalidInputError, match="first_substep must be > 0"):
+        with pytest.raises(InvalidInputError, match="first_substep must be finite and > 0"):
             advance(model, start(obj, contacts), dirs, first_substep=bad)
 
 

@@ -25,9 +25,9 @@ The yes/no arguments (``run``, ``rviz``, ``include_hidden_topics``) take true/fa
 or on/off; any other word is refused. The launch exits 0 when its run exits 0 (or, with
 ``run:=false``, when it is stopped). It exits 1, shutting every node down, when an argument or
 the scene is refused, when the run exits otherwise (the grasp did not hold, ...), or when a
-pipeline node ends while the pipeline runs
-(a recorder that cannot write its folder: the others would wait for it for ever); launch's
-error line says which and why (:mod:`squeeze_grasp_ros.commands.launch_checks`).
+pipeline node ends while the pipeline runs (a recorder that cannot write its folder: the others
+would wait for it for ever); launch's error line says which and why
+(:mod:`squeeze_grasp_ros.commands.launch_checks`).
 """
 import shutil
 from pathlib import Path

@@ -61,6 +61,7 @@ from doc_transcripts import (
 )
 from executables import script
 
+from squeeze_grasp_ros.commands.launch_checks import RUN_ARGUMENTS, run_arguments
 from squeeze_grasp_ros.exit_codes import ExitCode
 from squeeze_grasp_ros.extras import install_hint
 
@@ -238,9 +239,7 @@ def launched_run(arguments: dict[str, str], folder: Path) -> str:
     argv = [script("squeeze-grasp"), "run", scene]
     if arguments.get("record"):
         argv += ["--record", arguments["record"]]
-    reaction = ("on_slip_alarm", "max_attempts", "resqueeze_margin")
-    argv += [f"--{name.replace('_', '-')}={arguments[name]}"
-             for name in reaction if arguments.get(name)]
+    argv += run_arguments(**{name: arguments.get(name, "") for name in RUN_ARGUMENTS})
     return _process(argv, folder)
 
 

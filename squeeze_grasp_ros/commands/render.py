@@ -13,11 +13,14 @@ from squeeze_grasp_ros.commands.common import add_scene_argument, output_file
 from squeeze_grasp_ros.mechanics.errors import InvalidInputError
 from squeeze_grasp_ros.outputs import write_atomically
 from squeeze_grasp_ros.perception.image_files import encode_png
-from squeeze_grasp_ros.perception.render import MAX_NOISE, CameraViews, render_views, ring_band
+from squeeze_grasp_ros.perception.render import (
+    MAX_16UC1_M,
+    MAX_NOISE,
+    CameraViews,
+    render_views,
+    ring_band,
+)
 from squeeze_grasp_ros.scene import build_outline, load_scene
-
-MAX_16UC1_M = 65.5355
-"""Largest depth (m) that rounds to a 16UC1 pixel (65,535 mm)."""
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:

@@ -37,6 +37,9 @@ __all__ = ["CameraViews", "coverage", "render_views", "ring_band"]
 
 MAX_EDGE_PX = 0.5
 """Longest projected edge (px) drawn straight when the camera has distortion."""
+MAX_16UC1_M = 65.5355
+"""Largest depth (m) that rounds to a 16UC1 pixel (65,535 mm): :meth:`CameraViews.depth_mm`
+writes 0, invalid, from here on."""
 MAX_NOISE = {"depth_noise_m": 0.1, "mask_noise": 1.0}
 """Largest noise :func:`render_views` draws, as a scene's ``camera`` section allows it: a
 depth noise in m, a mask noise as a fraction of full scale. Beyond, the image is noise alone
@@ -66,7 +69,9 @@ class CameraViews:
     pose: CameraPose
 
     def depth_mm(self) -> np.ndarray:
-        """The depth as ``16UC1`` (uint16, mm, rounded; 0 where it would not fit)."""
+        """The depth as ``16UC1`` (uint16, mm, rounded; 0 where it would not fit: at
+        :data:`MAX_16UC1_M` and beyond).
+        """
         mm = np.rint(self.depth * 1000.0)
         return np.where((mm > 0) & (mm < 65536), mm, 0).astype(np.uint16)
 
@@ -277,8 +282,8 @@ def _subdivision(uv: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     length = np.linalg.norm(np.roll(uv, -1, axis=0) - uv, axis=1)
     parts = np.maximum(np.ceil(length / MAX_EDGE_PX).astype(int), 1)
     edge = np.repeat(np.arange(len(uv)), parts)
-    return edge, (np.arange(parts.sum()) - np.repeat(np.cumsum(parts) - parts, parts)) / parts[
-        edge]
+    start = np.repeat(np.cumsum(parts) - parts, parts)
+    return edge, (np.arange(parts.sum()) - start) / parts[edge]
 
 
 def render_views(outline: Outline, camera: CameraModel, pose: CameraPose, *,

@@ -38,7 +38,6 @@ class SceneError(SchemaError):
     """A scene entry is unknown, of the wrong type, out of range or contradictory."""
 
 
-
 EFFECTS: dict[Effect, str] = {
     Effect.FRICTION: "Coulomb friction at the fingertips (needs friction.mu)",
     Effect.STRAIN_LIMIT: "stop at the proportional limit (needs strain_limit.epsilon)",

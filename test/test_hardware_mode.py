@@ -337,6 +337,36 @@ def test_jaw_poses_that_disagree_with_joint_states_are_named_once(capfd):
                      "60.0000 mm") == 1
 
 
+def test_a_driver_repeating_an_unusable_joint_state_gets_one_warning_line_a_second(capfd):
+    # a second driver on joint_states with a joint the device file does not know, at 200 Hz:
+    # before, the monitor wrote a warning for every new one its 100 Hz ticks read (19 lines in
+    # 2.5 s here); now one line a second, the next naming how many it did not write
+    rig = Rig(SCENE, Joint(OPEN))
+    try:
+        rogue = Node("rogue_driver", context=rig.context)
+        rig.nodes.append(rogue)
+        rig.spin.add_node(rogue)
+        states = rogue.create_publisher(JointState, "joint_states", 10)
+
+        def publish():
+            msg = JointState(name=["wrong_joint"], position=[0.1], effort=[0.0])
+            msg.header.stamp = rogue.get_clock().now().to_msg()
+            states.publish(msg)
+
+        rogue.create_timer(0.005, publish)
+        start = time.monotonic()
+        rig.spin_until(lambda: time.monotonic() - start > 2.5, timeout=10.0)
+        elapsed = time.monotonic() - start
+    finally:
+        rig.close()
+    lines = [line for line in capfd.readouterr().err.splitlines()
+             if "ignored the joint state" in line]
+    assert lines and all("wrong_joint" in line or "finger_joint" in line for line in lines)
+    assert len(lines) <= elapsed / 1.0 + 1, lines
+    assert re.search(r"\(and \d+ more joint_states refusals in the \d\.\d s before, not "
+                     r"logged\)", lines[-1]), lines
+
+
 class OutsideGripperAction:
     """A plain rclpy GripperCommand server on ``gripper_controller/gripper_cmd``: moves the joint
     to the goal's position, succeeds with ``reached_goal`` there, holds on a cancel.

@@ -13,6 +13,8 @@ from __future__ import annotations
 import threading
 import time
 from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Any
 
 REFUSAL_LOG_INTERVAL_S = 1.0
 """Seconds after a logged refusal during which refusals of the same error code are counted,
@@ -59,6 +61,22 @@ class RefusalLog:
 
     def refused(self, code: str, message: str) -> None:
         """Log the refusal of a request with error ``code`` for ``message``, or count it."""
+        self.line(code, f"refused ({code}): {message}")
+
+    def line(self, code: str, text: str) -> None:
+        """Write ``text``, or count it if a line of ``code`` was written within the interval.
+
+        >>> now = [0.0]
+        >>> log = RefusalLog(print, clock=lambda: now[0])
+        >>> for k in range(3):
+        ...     now[0] = 0.01 * k
+        ...     log.line("joint_states", f"ignored the joint state of {now[0]:.2f} s: a NaN")
+        ignored the joint state of 0.00 s: a NaN
+        >>> now[0] = 1.0
+        >>> log.line("joint_states", "ignored the joint state of 1.00 s: a NaN")
+        ignored the joint state of 1.00 s: a NaN (and 2 more joint_states refusals in the 1.0 s \
+before, not logged)
+        """
         with self._lock:
             now = self._clock()
             logged, unlogged = self._last.get(code, (-float("inf"), 0))
@@ -68,4 +86,26 @@ class RefusalLog:
             self._last[code] = (now, 0)
         note = (f" (and {unlogged} more {code} refusals in the {now - logged:.1f} s before, "
                 "not logged)" if unlogged else "")
-        self._write(f"refused ({code}): {message}{note}")
+        self._write(f"{text}{note}")
+
+
+@dataclass(frozen=True)
+class LimitedWarnings:
+    """A node logger whose warnings go through a :class:`RefusalLog` under one code (at most
+    one line per interval, the rest counted); its info lines are written as they come.
+
+    For readings that a driver may repeat at its full rate: a joint state the monitor cannot
+    use, republished at 1 kHz, wrote a warning line per state.
+    """
+
+    logger: Any
+    refusals: RefusalLog
+    code: str
+
+    def warning(self, text: str) -> None:
+        """Write ``text`` as a warning, or count it."""
+        self.refusals.line(self.code, text)
+
+    def info(self, text: str) -> None:
+        """Write ``text`` at INFO."""
+        self.logger.info(text)

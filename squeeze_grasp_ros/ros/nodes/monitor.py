@@ -84,7 +84,7 @@ from squeeze_grasp_ros.ros.nodes import ParameterError, pipeline, run_node
 from squeeze_grasp_ros.ros.nodes.force_watcher import ForceWatcher
 from squeeze_grasp_ros.ros.nodes.shape_watcher import ShapeWatcher
 from squeeze_grasp_ros.ros.nodes.sim_controllers import JOINT_STATES
-from squeeze_grasp_ros.ros.refusals import RefusalLog
+from squeeze_grasp_ros.ros.refusals import LimitedWarnings, RefusalLog
 from squeeze_grasp_ros.scene import load_scene
 from squeeze_grasp_ros.scene.controller import (
     HandController,
@@ -326,6 +326,8 @@ class MonitorNode(Node):
         self.keys: dict[str, tuple[str, str]] = {}
         self.refusals = RefusalLog(self.get_logger().warning)
         """The log of refused readings, by device stream."""
+        self.joint_log = LimitedWarnings(self.get_logger(), self.refusals, JOINT_STATES)
+        """The joint-state feedback's logger: its warnings at most one line a second."""
         for finger, device in self.fingers.items():
             for stream, msg_type in types.items():
                 key = f"{device}/{stream}"
@@ -488,9 +490,9 @@ class MonitorNode(Node):
             if stream != JOINT_STATES:
                 fields[finger].update(reading)
         if self.jaws is not None:
-            self.jaws.replace(fields, self.latest.get(JOINT_STATES), self.get_logger())
+            self.jaws.replace(fields, self.latest.get(JOINT_STATES), self.joint_log)
         if self.hand is not None:
-            self.hand.replace(fields, self.latest.get(JOINT_STATES), self.get_logger())
+            self.hand.replace(fields, self.latest.get(JOINT_STATES), self.joint_log)
         return {f: FingerSample(**v) for f, v in fields.items()}
 
     def _process(self, ns: int) -> None:

@@ -248,3 +248,21 @@ def test_replay_of_a_bare_mcap_and_odd_metadata_reproduces(default_bag, tmp_path
     data[len(data) // 3] ^= 0x10
     corrupt.write_bytes(bytes(data))
     assert main(["replay", str(corrupt)]) == 2
+
+
+def test_an_empty_or_cut_short_mcap_is_refused_naming_its_end(default_bag, tmp_path, capsys):
+    """A recorder killed before it wrote, or a copy cut short: before, "is corrupt (EndOfFile:
+    )" with nothing after the colon.
+    """
+    from squeeze_grasp_ros.cli import main
+
+    data = default_bag.read_bytes()
+    for name, size in (("empty", 0), ("cut", len(data) // 2)):
+        path = tmp_path / f"{name}.mcap"
+        path.write_bytes(data[:size])
+        assert main(["replay", str(path)]) == 2
+        err = capsys.readouterr().err
+        end = ("the file is empty" if size == 0 else
+               f"the file ends inside a record, at byte {size}")
+        assert f"{path} is corrupt (EndOfFile: {end}); it cannot be trusted" in err, err
+

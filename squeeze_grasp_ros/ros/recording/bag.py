@@ -509,12 +509,27 @@ def _read_mcap(path: Path) -> Iterator[BagMessage]:
     except BagError:
         raise
     except Exception as exc:  # noqa: BLE001 (any failure to parse these bytes means corruption)
-        raise BagError(
-            f"{path} is corrupt ({type(exc).__name__}: {exc}); it cannot be "
-            "trusted, not even in part"
-        ) from None
+        raise BagError(f"{path} is corrupt ({_damage(exc, path.stat().st_size)}); it cannot be "
+                       "trusted, not even in part") from None
     out.sort(key=lambda m: m.log_time_ns)
     yield from out
+
+
+def _damage(exc: Exception, size: int) -> str:
+    """What the MCAP reader's ``exc`` says of a file of ``size`` bytes; the reader's EndOfFile
+    says nothing, so the file's end is named (a recorder killed before it closed the file, or a
+    copy cut short).
+
+    >>> _damage(EOFError(), 0)
+    'EOFError: the file is empty'
+    >>> _damage(EOFError(), 1234)
+    'EOFError: the file ends inside a record, at byte 1234'
+    >>> _damage(ValueError("bad opcode"), 10)
+    'ValueError: bad opcode'
+    """
+    detail = str(exc) or ("the file is empty" if size == 0 else
+                          f"the file ends inside a record, at byte {size}")
+    return f"{type(exc).__name__}: {detail}"
 
 
 def _chunk_records(chunk: Chunk, budget: list[int]) -> list:

@@ -515,8 +515,8 @@ def test_a_frame_before_the_prediction_waits_for_it(ros_context):
 
         for pub, msg in camera_messages(pubs, world.camera_frame(0, 0)):
             pub.publish(msg)
-        spin_until(lambda: watcher.waiting and watcher.camera is not None
-                   and watcher.pose is not None)
+        spin_until(lambda: watcher.waiting and watcher.inputs.camera is not None
+                   and watcher.inputs.pose is not None)
         watcher.close(0, 0.0, 0.0)  # tick 0 closes: the predictions are not there yet
         for _ in range(10):
             executor.spin_once(timeout_sec=0.02)
@@ -549,6 +549,86 @@ def test_a_frame_before_the_prediction_waits_for_it(ros_context):
         executor.shutdown()
         for node in (monitor, camera):
             node.destroy_node()
+
+
+def test_the_shape_watch_matches_no_frame_with_camera_inputs_it_cannot_trust(ros_context,
+                                                                            capfd):
+    """Before, the shape watch took a ``camera/pose`` in any frame (and put its residuals in
+    that frame), matched frames with the last usable pose after a refused one (the camera may
+    have moved: a false ``shape_mismatch``), and read images of another camera than its
+    ``camera_info``. Now those frames are not matched, with one log line naming why, as the
+    outline node refuses them; usable inputs match again.
+    """
+    skimage_or_skip()
+    import rclpy
+    from geometry_msgs.msg import PoseStamped
+
+    from squeeze_grasp_interfaces.msg import Alarm
+    from squeeze_grasp_ros.ros import messages
+    from squeeze_grasp_ros.ros.messages.images import pose_of_camera
+    from squeeze_grasp_ros.ros.nodes import pipeline
+    from squeeze_grasp_ros.ros.nodes.shape_watcher import ShapeWatcher
+    from squeeze_grasp_ros.ros.nodes.sim_hardware import camera_messages
+    from squeeze_grasp_ros.ros.run.camera_plan import predicted_shapes_msg
+
+    scene = parse_scene(with_camera(yaml.safe_load(YAML_SCENE.read_text())))
+    world = SimWorld(GraspSetup.build(scene))
+    node = rclpy.create_node("watch_inputs_monitor", context=ros_context)
+    try:
+        watcher = ShapeWatcher(node, node.create_publisher(Alarm, "alarms", 10),
+                               threshold=scene.camera.shape_mismatch_threshold,
+                               at_force_threshold=scene.camera.shape_at_force_threshold,
+                               object_height=0.0254, min_force=0.05)
+        residuals: list = []
+        watcher.residual_pub.publish = residuals.append
+        watcher._prediction(predicted_shapes_msg(GraspSetup.build(scene).precompute(), 0.005, 0))
+        curve = squeeze_forces(GraspSetup.build(scene).precompute().event_squeeze(depth=0.005))
+        watcher._events(messages.prediction_msg([], "none", 0.005, curve))
+
+        def pose(frame, rotation=True):
+            msg = PoseStamped(header=messages.header(0, frame),
+                              pose=pose_of_camera(world.camera.pose))
+            if not rotation:  # a zero quaternion
+                o = msg.pose.orientation
+                o.x = o.y = o.z = o.w = 0.0
+            return msg
+
+        def frame(k, image_frame=None):
+            """The camera's k-th frame (tick 100 k): its info and mask, its tick closed; the
+            residuals it gave.
+            """
+            sent, tick = len(residuals), 100 * k
+            topics = (pipeline.CAMERA_MASK, pipeline.CAMERA_DEPTH, pipeline.CAMERA_INFO)
+            shot = dict(camera_messages({t: t for t in topics},
+                                        world.camera_frame(tick, tick * 1_000_000)))
+            watcher._info(shot[pipeline.CAMERA_INFO])
+            mask = shot[pipeline.CAMERA_MASK]
+            mask.header.frame_id = image_frame or mask.header.frame_id
+            watcher._image(mask)
+            watcher.close(tick * 1_000_000, 0.0, None)
+            return residuals[sent:]
+
+        watcher._pose(pose("world"))
+        assert frame(0) == []
+        watcher._pose(pose("object"))
+        matched = frame(1)
+        assert len(matched) == 1 and matched[0].header.frame_id == "object"
+        assert matched[0].rms < 0.25 * scene.camera.shape_mismatch_threshold
+        watcher._pose(pose("object", rotation=False))   # the camera may have moved
+        assert frame(2) == [] and frame(3) == []
+        watcher._pose(pose("object"))
+        assert len(frame(4)) == 1
+        assert frame(5, image_frame="side_camera_optical") == []
+        assert len(frame(6)) == 1
+        err = capfd.readouterr().err
+        for reason in ("camera/pose is in frame 'world', not the plane frame 'object'",
+                       "camera/pose: ", "image header.frame_id 'side_camera_optical' is not "
+                                        "the camera_info's"):
+            lines = [line for line in err.splitlines()
+                     if f"shape watch: frames are not matched: {reason}" in line]
+            assert len(lines) == 1, (reason, err)
+    finally:
+        node.destroy_node()
 
 
 def test_every_camera_frame_crosses_processes_to_the_recorder_and_the_monitor(tmp_path):

@@ -109,7 +109,7 @@ def test_the_outline_node_publishes_the_seen_outline(ros_context):
         spin_until(lambda: got["errors"], "the refusal without camera_info")
         assert "no camera_info yet" in got["errors"][0].data
         infos.publish(camera_info_msg(CAMERA, 2_000))
-        spin_until(lambda: node.camera is not None, "the camera info")
+        spin_until(lambda: node.inputs.camera is not None, "the camera info")
         images.publish(image_msg(views.mask, ImageEncoding.MONO8, 3_000, CAMERA.frame_id))
         spin_until(lambda: got["seen"] and got["outline"], "the outline")
         seen = got["seen"][0]
@@ -173,7 +173,7 @@ def test_a_camera_whose_undistortion_diverges_is_refused_not_raised(ros_context)
     node = OutlineNode(context=ros_context, parameter_overrides=[
         Parameter("camera_pose", value=[0.0, 0.0, 0.5, np.pi, 0.0, 0.0])])
     try:
-        node.camera = replace(CAMERA, distortion=(100.0, 100.0, 0.0, 0.0, 100.0))
+        node.inputs.camera = replace(CAMERA, distortion=(100.0, 100.0, 0.0, 0.0, 100.0))
         node._image(image_msg(views.mask, ImageEncoding.MONO8, 1_000, "cam"))
         assert "undistortion did not converge" in node.last_error
     finally:

@@ -206,10 +206,12 @@ def test_the_shape_watch_ignores_a_camera_pose_that_is_no_rotation(ros_context: 
         for q in ((0.0, 0.0, 0.0, 0.0), (2.0, 0.0, 0.0, 0.0)):
             o.x, o.y, o.z, o.w = q
             watcher._pose(msg)
-            assert watcher.pose is None
+            assert watcher.inputs.pose is None and watcher.inputs.pose_refused
         o.x, o.y, o.z, o.w = scaled(DOWN)
         watcher._pose(msg)
-        np.testing.assert_allclose(watcher.pose.matrix, np.diag([1.0, -1.0, -1.0]), atol=1e-15)
+        assert watcher.inputs.pose_refused == ""
+        np.testing.assert_allclose(watcher.inputs.pose.matrix, np.diag([1.0, -1.0, -1.0]),
+                                   atol=1e-15)
     finally:
         node.destroy_node()
 
@@ -217,7 +219,8 @@ def test_the_shape_watch_ignores_a_camera_pose_that_is_no_rotation(ros_context: 
 def test_the_shape_watch_ignores_a_camera_info_it_cannot_use(ros_context: Context, capfd):
     """The shape watch's other camera input, ``camera/camera_info``: an uncalibrated one (k all
     zero, as a driver without a calibration publishes) raised out of the subscription's
-    callback and ended the monitor, as a bad pose did; now it is logged and the last holds.
+    callback and ended the monitor, as a bad pose did; now it is logged once, and frames are
+    not matched until a usable one arrives (as the outline node refuses them).
     """
     from squeeze_grasp_ros.perception.camera import CameraModel
     from squeeze_grasp_ros.ros.messages.images import camera_info_msg
@@ -228,13 +231,16 @@ def test_the_shape_watch_ignores_a_camera_info_it_cannot_use(ros_context: Contex
                                at_force_threshold=1e-3, object_height=0.0, min_force=0.05)
         good = camera_info_msg(CameraModel(640, 480, 500.0, 500.0, 320.0, 240.0), 0)
         watcher._info(good)
-        camera = watcher.camera
+        camera = watcher.inputs.camera
         bad = camera_info_msg(camera, 0)
         bad.k = [0.0] * 9
-        watcher._info(bad)
-        assert watcher.camera is camera
-        assert "shape watch: camera/camera_info ignored: camera_info: the camera is " \
-            "uncalibrated" in capfd.readouterr().err
+        for _ in range(3):
+            watcher._info(bad)
+        assert watcher.inputs.camera is None
+        assert capfd.readouterr().err.count("shape watch: frames are not matched: camera_info: "
+                                            "the camera is uncalibrated") == 1
+        watcher._info(good)
+        assert watcher.inputs.camera == camera and watcher.inputs.camera_refused == ""
     finally:
         node.destroy_node()
 

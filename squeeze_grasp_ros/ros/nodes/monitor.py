@@ -369,7 +369,8 @@ class MonitorNode(Node):
         self.shapes = (ShapeWatcher(
             self, self.alarm_pub, threshold=p["shape_mismatch_threshold"],
             at_force_threshold=p["shape_at_force_threshold"], object_height=p["object_height"],
-            min_force=p["shape_min_force"]) if p["shape_watch"] else None)
+            min_force=p["shape_min_force"], frame_id=p["frame_id"]) if p["shape_watch"]
+            else None)
         self.forces = (ForceWatcher(self, p["force_tolerance"], p["force_min_fraction"], outputs,
                                     every=p["every_output"])
                        if p["force_watch"] else None)

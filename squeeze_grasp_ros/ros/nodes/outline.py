@@ -36,11 +36,12 @@ from std_msgs.msg import String
 
 from squeeze_grasp_interfaces.msg import SeenOutline
 from squeeze_grasp_ros.mechanics.errors import InvalidInputError, NumericalError
-from squeeze_grasp_ros.perception.camera import CameraModel, CameraPose
+from squeeze_grasp_ros.perception.camera import CameraPose
 from squeeze_grasp_ros.perception.extract import extract_outline
 from squeeze_grasp_ros.ros import messages
-from squeeze_grasp_ros.ros.messages.images import camera_model, camera_pose, image_array
+from squeeze_grasp_ros.ros.messages.images import image_array
 from squeeze_grasp_ros.ros.nodes import ParameterError, pipeline, run_node
+from squeeze_grasp_ros.ros.nodes.camera_inputs import CameraInputs
 
 PARAMETERS: dict[str, tuple[Any, str]] = {
     "image_topic": (pipeline.CAMERA_MASK,
@@ -93,14 +94,8 @@ class OutlineNode(Node):
     def __init__(self, **kwargs: Any) -> None:
         super().__init__("outline", **kwargs)
         self.p = p = pipeline.declare(self, PARAMETERS, bounds=BOUNDS)
-        self.pose = pose_parameter(list(p["camera_pose"]))
-        self.camera: CameraModel | None = None
-        self.camera_frame = ""
-        """``header.frame_id`` of the camera_info in use ("" when it names none)."""
-        self.camera_refused = ""
-        """Why the newest camera_info was refused ("" when it was not)."""
-        self.pose_refused = ""
-        """Why the newest camera/pose was refused ("" when it was not)."""
+        self.inputs = CameraInputs(p["frame_id"], pose_parameter(list(p["camera_pose"])),
+                                   "parameter camera_pose or camera/pose")
         self.last_error = ""
         depth = p["qos_depth"]
         self.create_subscription(Image, p["image_topic"], self._image, depth)
@@ -112,53 +107,30 @@ class OutlineNode(Node):
 
     def ready_summary(self) -> str:
         """What the ready line says: the image topic, the pose source and the frame."""
-        pose = ("camera/pose" if self.pose is None
-                else f"camera at {', '.join(f'{v:g}' for v in self.pose.position)} m")
+        known = self.inputs.pose
+        pose = ("camera/pose" if known is None
+                else f"camera at {', '.join(f'{v:g}' for v in known.position)} m")
         return f"{self.p['image_topic']}, {pose}, frame {self.p['frame_id']}"
 
     def _info(self, msg: CameraInfo) -> None:
-        try:
-            self.camera, self.camera_frame = camera_model(msg), msg.header.frame_id
-            self.camera_refused = ""
-        except InvalidInputError as error:
-            self.camera, self.camera_refused = None, str(error)
-            self._refuse(msg.header.stamp, self.camera_refused)
+        if reason := self.inputs.take_info(msg):
+            self._refuse(msg.header.stamp, reason)
 
     def _pose(self, msg: PoseStamped) -> None:
-        if msg.header.frame_id != self.p["frame_id"]:
-            self.pose_refused = (f"camera/pose is in frame {msg.header.frame_id!r}, not the "
-                                 f"plane frame {self.p['frame_id']!r}")
-        else:
-            try:
-                self.pose, self.pose_refused = camera_pose(msg.pose), ""
-            except InvalidInputError as error:
-                self.pose_refused = f"camera/pose: {error}"
-        if self.pose_refused:  # the camera may have moved: no outline until a usable pose
-            self._refuse(msg.header.stamp, self.pose_refused)
+        if reason := self.inputs.take_pose(msg):  # the camera may have moved: no outline
+            self._refuse(msg.header.stamp, reason)  # until a usable pose
 
     def _image(self, msg: Image) -> None:
-        if self.camera is None:
-            self._refuse(msg.header.stamp, f"no usable camera_info: the newest was refused "
-                         f"({self.camera_refused})" if self.camera_refused
-                         else "no camera_info yet")
-            return
-        if self.pose is None or self.pose_refused:
-            self._refuse(msg.header.stamp, f"no usable camera pose: the newest was refused "
-                         f"({self.pose_refused})" if self.pose_refused
-                         else "no camera pose yet (parameter camera_pose or camera/pose)")
-            return
-        if msg.header.frame_id and self.camera_frame and msg.header.frame_id != self.camera_frame:
-            self._refuse(msg.header.stamp, f"image header.frame_id {msg.header.frame_id!r} is "
-                                           f"not the camera_info's {self.camera_frame!r}: the "
-                                           "image and the calibration come from different "
-                                           "cameras (publish both in the camera's optical frame)")
+        if reason := self.inputs.image_problem(msg):
+            self._refuse(msg.header.stamp, reason)
             return
         p = self.p
         try:
             pixels, encoding = image_array(msg)
             seen = extract_outline(
-                pixels, encoding, self.camera, self.pose, tolerance_m=p["tolerance"] or None,
-                object_height_m=p["object_height"], min_height_m=p["min_height"],
+                pixels, encoding, self.inputs.camera, self.inputs.pose,
+                tolerance_m=p["tolerance"] or None, object_height_m=p["object_height"],
+                min_height_m=p["min_height"],
                 plane_tolerance_m=p["plane_tolerance"], max_tilt_deg=p["max_tilt_deg"],
                 min_area_px=p["min_area_px"], ambiguous_ratio=p["ambiguous_ratio"],
                 frame_id=p["frame_id"])

@@ -47,9 +47,10 @@ from squeeze_grasp_ros.perception.shape_watch import (
 )
 from squeeze_grasp_ros.perception.shape_watch import PredictedShapes as Prediction
 from squeeze_grasp_ros.ros import messages
-from squeeze_grasp_ros.ros.messages.images import camera_model, camera_pose, image_array
+from squeeze_grasp_ros.ros.messages.images import image_array
 from squeeze_grasp_ros.ros.messages.objects import polygon_points
 from squeeze_grasp_ros.ros.nodes import pipeline
+from squeeze_grasp_ros.ros.nodes.camera_inputs import CameraInputs
 from squeeze_grasp_ros.ros.nodes.force_watcher import MotionForces
 
 DEPTH_HISTORY = 4096
@@ -71,10 +72,13 @@ class ShapeWatcher:
         m, the object's top face above the support plane.
     min_force : float
         N, the smallest pair force matched at equal force.
+    frame_id : str, optional
+        The plane frame: the prediction's, and the one ``camera/pose`` must be in.
     """
 
     def __init__(self, node: Node, alarm_pub: Any, *, threshold: float,
-                 at_force_threshold: float, object_height: float, min_force: float) -> None:
+                 at_force_threshold: float, object_height: float, min_force: float,
+                 frame_id: str = pipeline.FRAME) -> None:
         self.node, self.alarm_pub = node, alarm_pub
         self.threshold, self.object_height = threshold, object_height
         self.at_force_threshold, self.min_force = at_force_threshold, min_force
@@ -83,8 +87,9 @@ class ShapeWatcher:
         self.has_events = False
         """The planner's ``predicted_events`` (with or without a force curve) has arrived."""
         self.motion = MotionForces()
-        self.camera = self.pose = None
-        self.frame_id = pipeline.FRAME
+        self.inputs = CameraInputs(frame_id)
+        self.refused = ""
+        """The last reason logged for a refused camera input or skipped frame."""
         self.waiting: dict[int, Image] = {}
         self.depths: OrderedDict[int, tuple[float, float | None]] = OrderedDict()
         """Closed tick -> (depth m, pair force N or None)."""
@@ -101,22 +106,20 @@ class ShapeWatcher:
                                                   pipeline.loop_qos(100))
 
     def _info(self, msg: CameraInfo) -> None:
-        try:
-            camera = camera_model(msg)
-        except InvalidInputError as error:  # e.g. uncalibrated (k all zero): the last holds
-            self.node.get_logger().error(f"shape watch: {pipeline.CAMERA_INFO} ignored: {error}")
-            return
-        self.camera = camera
+        self._log(self.inputs.take_info(msg))  # e.g. uncalibrated (k all zero)
         self._flush()
 
     def _pose(self, msg: PoseStamped) -> None:
-        try:
-            pose = camera_pose(msg.pose)
-        except InvalidInputError as error:  # e.g. not a unit quaternion: the last pose holds
-            self.node.get_logger().error(f"shape watch: {pipeline.CAMERA_POSE} ignored: {error}")
-            return
-        self.pose, self.frame_id = pose, msg.header.frame_id
+        self._log(self.inputs.take_pose(msg))  # e.g. another frame, not a unit quaternion
         self._flush()
+
+    def _log(self, reason: str) -> None:
+        """Log why frames are not matched (a refused camera input, an image of another camera),
+        once until the reason changes.
+        """
+        if reason and reason != self.refused:
+            self.node.get_logger().error(f"shape watch: frames are not matched: {reason}")
+        self.refused = reason
 
     def _prediction(self, msg: PredictedShapes) -> None:
         outlines = [np.asarray(polygon_points(p), float) for p in msg.outlines]
@@ -168,8 +171,10 @@ class ShapeWatcher:
         """Match the waiting frames whose tick has closed, once the predictions, the camera
         info and the pose are known.
         """
-        if self.prediction is None or not self.has_events or self.camera is None \
-                or self.pose is None or not self.depths:
+        inputs = self.inputs
+        if self.prediction is None or not self.has_events or not self.depths \
+                or (inputs.camera is None and not inputs.camera_refused) \
+                or (inputs.pose is None and not inputs.pose_refused):
             return
         closed = next(reversed(self.depths))
         for stamp in sorted(s for s in self.waiting if s <= closed):
@@ -185,10 +190,16 @@ class ShapeWatcher:
         return depth_at_force(self.forces, force, min_force=self.min_force)
 
     def _match(self, msg: Image, ns: int, depth: float, force: float | None) -> None:
+        inputs = self.inputs
+        if reason := inputs.image_problem(msg):
+            if not (inputs.camera_refused or inputs.pose_refused):  # those are logged on arrival
+                self._log(reason)
+            return
+        self.refused = ""
         try:
             pixels, encoding = image_array(msg)
-            seen = extract_outline(pixels, encoding, self.camera, self.pose,
-                                   object_height_m=self.object_height, frame_id=self.frame_id)
+            seen = extract_outline(pixels, encoding, inputs.camera, inputs.pose,
+                                   object_height_m=self.object_height, frame_id=inputs.frame_id)
         except (InvalidInputError, NumericalError) as error:  # e.g. undistortion diverged
             self.node.get_logger().warning(f"shape watch: no outline at {ns * 1e-9:.3f} s: "
                                            f"{error}")
@@ -207,7 +218,7 @@ class ShapeWatcher:
                 f"{inverted.reason(self.min_force)}")
         self.skipped = None if inverted.matched else inverted.status
         self.residual_pub.publish(ShapeResidual(
-            header=messages.header(ns, self.frame_id), depth=float(depth), rms=match.rms_m,
+            header=messages.header(ns, inputs.frame_id), depth=float(depth), rms=match.rms_m,
             max=match.max_m, scale=float(check.scale), rotation=float(match.rotation),
             threshold=float(self.threshold), holes_predicted=check.holes_predicted,
             holes_seen=check.holes_seen, force=float(inverted.force),

@@ -240,9 +240,9 @@ def test_world_is_a_loop_over_the_stepper(world_run):
         moves = {f: tuple(after[f] - before[f]) for f in ("F1", "F2")
                  if np.any(after[f] != before[f])}
         if moves:
-            step = advance(world.model, state, moves, scene.squeeze.step,
-                           scene.squeeze.event_tol, terminate_on=("strain_limit", "finger_slip",
-                                                                  "picked_up"))
+            step = advance(world.model, state, moves, step=scene.squeeze.step,
+                           event_tol=scene.squeeze.event_tol,
+                           terminate_on=("strain_limit", "finger_slip", "picked_up"))
             state = step.state
             assert step.events == out.events
     assert state.depth == outputs[-1].state.depth

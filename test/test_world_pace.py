@@ -232,8 +232,8 @@ def test_quiet_results_are_advance_results_field_by_field():
     squeeze_world(world, 300)
     assert len(calls) > 250
     for state, translations, ours in calls[::10]:
-        theirs = advance(world.model, state, translations, stepper.step, stepper.event_tol,
-                         terminate_on=stepper.terminate_on)
+        theirs = advance(world.model, state, translations, step=stepper.step,
+                         event_tol=stepper.event_tol, terminate_on=stepper.terminate_on)
         assert (ours.events, ours.fraction, ours.termination, ours.chatter,
                 ours.next_substep) == (theirs.events, theirs.fraction, theirs.termination,
                                        theirs.chatter, theirs.next_substep)

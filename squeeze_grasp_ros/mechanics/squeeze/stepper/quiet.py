@@ -126,8 +126,8 @@ class QuietSteps:
         if result is None:
             self.calls["full"] += 1
             self._mode = None
-            return advance(self.model, state, translations, self.step, self.event_tol,
-                           terminate_on=self.terminate_on)
+            return advance(self.model, state, translations, step=self.step,
+                           event_tol=self.event_tol, terminate_on=self.terminate_on)
         self.calls["quiet"] += 1
         return result
 

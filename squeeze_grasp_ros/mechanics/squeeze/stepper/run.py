@@ -320,6 +320,7 @@ def advance(
     model: ContactModel,
     state: ContactState,
     translations: Mapping[str, tuple[float, float]],
+    *,
     step: float = 1e-3,
     event_tol: float = 1e-9,
     stop_on_event: bool = False,

@@ -202,6 +202,23 @@ def test_bad_output_paths_are_refused_before_any_work(tmp_path, capfd):
         ["bench", "--only", "solvers", "--out", str(existing)], capfd)
 
 
+def test_an_output_folder_is_made_when_the_command_runs_not_while_it_is_parsed(tmp_path,
+                                                                              capfd):
+    """Before, ``bench --out NEW`` and ``sweep-report --plot NEW`` made NEW while the command
+    line was parsed: a mistake in a later argument left an empty folder behind."""
+    new = tmp_path / "a" / "b"
+    assert "invalid choice: 'bogus'" in usage_error(
+        ["bench", "--out", str(new), "--only", "bogus"], capfd)
+    assert "is not a sweep directory" in refused(
+        ["sweep-report", str(tmp_path / "nowhere"), "--plot", str(new)], capfd)
+    assert not (tmp_path / "a").exists()
+    assert "cannot create files in /proc" in usage_error(
+        ["bench", "--only", "solvers", "--out", "/proc/new/bench"], capfd)
+    (tmp_path / "file").write_text("")
+    assert "is not a folder" in usage_error(
+        ["bench", "--only", "solvers", "--out", str(tmp_path / "file" / "x")], capfd)
+
+
 def test_non_finite_calibration_input_is_shown_plainly(capfd):
     line = refused(["calibrate", "--slope-angle", "nan"], capfd)
     assert line.endswith("slope angle must be finite, got nan")

@@ -12,7 +12,7 @@ from pathlib import Path
 from squeeze_grasp_ros.bench import SECTIONS, missing
 from squeeze_grasp_ros.bench.sweep_large import DEFAULT_EVALUATIONS, TARGET_EVALUATIONS
 from squeeze_grasp_ros.bench.table import Table
-from squeeze_grasp_ros.commands.common import int_in, output_folder
+from squeeze_grasp_ros.commands.common import int_in, make_output_folder, output_folder
 from squeeze_grasp_ros.mechanics.errors import InvalidInputError
 from squeeze_grasp_ros.outputs import write_atomically
 
@@ -49,7 +49,7 @@ def run(args: argparse.Namespace) -> dict:
     if args.large and args.only and "sweep" not in args.only:
         raise InvalidInputError(f"--large runs the sweep section, which --only "
                                 f"{' '.join(args.only)} leaves out: add sweep to --only")
-    out = Path(args.out)
+    out = make_output_folder(args.out)
     tables, skipped = [], []
     for name in args.only or SECTIONS:
         absent, how = missing(name)

@@ -78,22 +78,40 @@ def output_file(text: str) -> str:
 
 
 def output_folder(text: str) -> str:
-    """Argparse type of an output folder (a report, plots): created if missing (with its
-    parents) and probed for new files before any computation; not a file.
+    """Argparse type of an output folder (a report, plots): a folder, or one that can be made
+    (its nearest existing parent a folder in which files can be created: probed, before any
+    computation); not a file. It is made by :func:`make_output_folder` when the command runs,
+    not while the command line is parsed (an error in a later argument left it behind).
     """
     path = Path(text)
     if not text.strip():
         raise argparse.ArgumentTypeError("needs a folder name")
     if path.exists() and not path.is_dir():
         raise argparse.ArgumentTypeError(f"{text} exists and is not a folder; give a folder")
+    parent = next(p for p in (path, *path.absolute().parents) if p.exists())
+    if not parent.is_dir():
+        raise argparse.ArgumentTypeError(f"{text}: {parent} is not a folder")
     try:
-        path.mkdir(parents=True, exist_ok=True)
-        probe_folder(path, text)
-    except OSError as exc:
-        raise argparse.ArgumentTypeError(str(output_error(exc, text, "the folder"))) from None
+        probe_folder(parent, text)
     except SqueezeGraspError as exc:
         raise argparse.ArgumentTypeError(str(exc)) from None
     return text
+
+
+def make_output_folder(text: str) -> Path:
+    """Make the output folder ``text`` of :func:`output_folder` (with its parents).
+
+    Raises
+    ------
+    InvalidInputError, InternalError
+        If it cannot be made (:func:`~squeeze_grasp_ros.outputs.output_error`).
+    """
+    path = Path(text)
+    try:
+        path.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise output_error(exc, text, "the folder") from None
+    return path
 
 
 def new_folder(text: str) -> str:

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import argparse
 
-from squeeze_grasp_ros.commands.common import int_in, output_folder
+from squeeze_grasp_ros.commands.common import int_in, make_output_folder, output_folder
 from squeeze_grasp_ros.sweep.engine import require_extra
 from squeeze_grasp_ros.sweep.report import plot, summarise, text
 
@@ -35,6 +35,7 @@ def run(args: argparse.Namespace) -> dict:
     out = {"out": args.out, "manifest": {**manifest, "counts": data.counts},
            "excluded": list(data.excluded), **summarise(rows, args.best)}
     if args.plot:
+        make_output_folder(args.plot)
         out["plots"] = plot(rows, args.plot, read_outlines(args.out)) if rows else []
     return out
 

@@ -8,6 +8,7 @@ import importlib
 import json
 import math
 import os
+import re
 import sys
 from typing import Any
 
@@ -18,6 +19,29 @@ EPILOG = ("exit status: 0 done; 1 negative outcome (grasp failed in the world, r
           "2 invalid input; 3 a solver failed (the message carries its residuals); 4 pipeline or "
           "environment failure (e.g. ROS not installed); 130 interrupted (Ctrl-C); 143 "
           "terminated (SIGTERM)")
+
+
+class _Parser(argparse.ArgumentParser):
+    """An argument parser whose usage errors, with ``--json`` on the command line, are also one
+    JSON object on stdout, as the errors of a running verb are (:func:`.commands.common.fail`):
+    a script reading stdout got nothing for ``plan --json --depth abc``.
+    """
+
+    def __init__(self, *args: Any, json_errors: bool = False, **kwargs: Any) -> None:
+        super().__init__(*args, **kwargs)
+        self.json_errors = json_errors
+
+    def error(self, message: str):
+        if self.json_errors:
+            named = ARGUMENT.match(message)
+            sys.stdout.write(json.dumps({
+                "error": message, "field": named.group(1).lstrip("-") if named else None,
+                "code": int(ExitCode.USAGE), "code_name": ExitCode.USAGE.name}) + "\n")
+        super().error(message)
+
+
+ARGUMENT = re.compile(r"^argument ([\w-]+)")
+"""The option or positional an argparse error names ("argument --depth: invalid float ...")."""
 
 
 class _Verbs(argparse._SubParsersAction):
@@ -45,18 +69,21 @@ def add_verb_arguments(parser: argparse.ArgumentParser) -> argparse.ArgumentPars
     return parser
 
 
-def build_parser() -> argparse.ArgumentParser:
+def build_parser(*, json_errors: bool = False) -> argparse.ArgumentParser:
     """The argument parser with one sub-command per verb (:data:`.commands.VERBS`); a verb's
-    arguments are added when it is chosen (:func:`add_verb_arguments`).
+    arguments are added when it is chosen (:func:`add_verb_arguments`). ``json_errors``: usage
+    errors are also printed as a JSON object on stdout (``--json`` was given).
     """
-    parser = argparse.ArgumentParser(
+    parser = _Parser(
+        json_errors=json_errors,
         prog="squeeze-grasp",
         description="Squeeze grasps of deformable planar objects (Jia, Guo, Lin, IJRR 2014). "
                     "SI units throughout. Scene format: `squeeze-grasp scene-help`.",
         epilog=EPILOG)
     sub = parser.add_subparsers(action=_Verbs, dest="verb", metavar="VERB", required=True)
     for name, help_ in VERBS.items():
-        verb = sub.add_parser(name.replace("_", "-"), help=help_, description=help_)
+        verb = sub.add_parser(name.replace("_", "-"), help=help_, description=help_,
+                              json_errors=json_errors)
         verb.set_defaults(_verb=name, _module=None)
     return parser
 
@@ -95,9 +122,10 @@ def main(argv: list[str] | None = None) -> int:
 
     With ``--json`` a result is printed as one JSON object (non-finite numbers become null and
     are listed under ``non_finite``), and an error as ``{"error", "field", "code",
-    "code_name"}``.
+    "code_name"}``, a usage error too.
     """
-    args = build_parser().parse_args(argv)
+    argv = sys.argv[1:] if argv is None else argv
+    args = build_parser(json_errors="--json" in argv).parse_args(argv)
     from squeeze_grasp_ros import plots
     from squeeze_grasp_ros.commands.common import fail
     from squeeze_grasp_ros.extras import install_hint

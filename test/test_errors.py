@@ -119,3 +119,30 @@ def test_help_lists_every_exit_code():
     epilog = build_parser().epilog
     listed = {int(n) for n in re.findall(r"(?:^|; |: )(\d+) ", epilog)}
     assert listed == {int(code) for code in ExitCode}
+
+
+def _exit(argv: list[str]) -> int:
+    """The CLI's exit status for ``argv``: argparse's refusals exit, the verbs' return."""
+    try:
+        return main(argv)
+    except SystemExit as done:
+        return done.code
+
+
+def test_a_usage_error_under_json_is_a_json_object_too(capfd):
+    """Before, a run-time refusal under ``--json`` printed a JSON object on stdout and a mistyped
+    option printed nothing there; the README quotes the object of the second.
+    """
+    scene = str(REPO / "config" / "scenes" / "foam_square.yaml")
+    for depth in ("abc", "-1"):
+        assert _exit(["plan", scene, "--json", "--depth", depth]) == 2
+        out = capfd.readouterr().out
+        error = json.loads(out)
+        assert (error["field"], error["code"], error["code_name"]) == ("depth", 2, "USAGE")
+    quoted = " ".join((REPO / "README.md").read_text().split())
+    _exit(["plan", scene, "--json", "--depth", "abc"])
+    assert f"`plan SCENE --json --depth abc` prints `{capfd.readouterr().out.strip()}`" in quoted
+    assert _exit(["plan", "--json"]) == 2
+    assert json.loads(capfd.readouterr().out)["field"] is None
+    assert _exit(["plan", scene, "--depth", "abc"]) == 2   # without --json stdout stays empty
+    assert capfd.readouterr().out == ""

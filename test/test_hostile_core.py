@@ -205,7 +205,8 @@ def test_bad_output_paths_are_refused_before_any_work(tmp_path, capfd):
 def test_an_output_folder_is_made_when_the_command_runs_not_while_it_is_parsed(tmp_path,
                                                                               capfd):
     """Before, ``bench --out NEW`` and ``sweep-report --plot NEW`` made NEW while the command
-    line was parsed: a mistake in a later argument left an empty folder behind."""
+    line was parsed: a mistake in a later argument left an empty folder behind.
+    """
     new = tmp_path / "a" / "b"
     assert "invalid choice: 'bogus'" in usage_error(
         ["bench", "--out", str(new), "--only", "bogus"], capfd)

@@ -463,6 +463,19 @@ def test_a_ring_hole_is_watched_on_ros_and_a_missing_one_raises_shape_mismatch(t
     assert "1 of 1 predicted holes not seen" in first["message"]
 
 
+def scene_watcher(node, scene):
+    """A shape watch on ``node`` with ``scene``'s camera thresholds (the foam square's 1 in
+    top face).
+    """
+    from squeeze_grasp_interfaces.msg import Alarm
+    from squeeze_grasp_ros.ros.nodes.shape_watcher import ShapeWatcher
+
+    return ShapeWatcher(node, node.create_publisher(Alarm, "alarms", 10),
+                        threshold=scene.camera.shape_mismatch_threshold,
+                        at_force_threshold=scene.camera.shape_at_force_threshold,
+                        object_height=0.0254, min_force=0.05)
+
+
 def test_a_frame_before_the_prediction_waits_for_it(ros_context):
     """The monitor's shape watch on real rclpy, in the order a launched world gives: the
     tick-0 frame (latched) arrives and tick 0 closes before the prediction does. Nothing is
@@ -475,12 +488,11 @@ def test_a_frame_before_the_prediction_waits_for_it(ros_context):
     from rclpy.executors import SingleThreadedExecutor
     from sensor_msgs.msg import CameraInfo, Image
 
-    from squeeze_grasp_interfaces.msg import Alarm, ContactEventArray, ShapeResidual
+    from squeeze_grasp_interfaces.msg import ContactEventArray, ShapeResidual
     from squeeze_grasp_interfaces.msg import PredictedShapes as PredictedShapesMsg
     from squeeze_grasp_ros.ros import messages
     from squeeze_grasp_ros.ros.messages.images import pose_of_camera
     from squeeze_grasp_ros.ros.nodes import pipeline
-    from squeeze_grasp_ros.ros.nodes.shape_watcher import ShapeWatcher
     from squeeze_grasp_ros.ros.nodes.sim_hardware import camera_messages
     from squeeze_grasp_ros.ros.run.camera_plan import predicted_shapes_msg
 
@@ -492,10 +504,7 @@ def test_a_frame_before_the_prediction_waits_for_it(ros_context):
     for node in (monitor, camera):
         executor.add_node(node)
     try:
-        watcher = ShapeWatcher(monitor, monitor.create_publisher(Alarm, "alarms", 10),
-                               threshold=scene.camera.shape_mismatch_threshold,
-                               at_force_threshold=scene.camera.shape_at_force_threshold,
-                               object_height=0.0254, min_force=0.05)
+        watcher = scene_watcher(monitor, scene)
         residuals: list = []
         camera.create_subscription(ShapeResidual, pipeline.SHAPE_RESIDUAL, residuals.append,
                                    pipeline.loop_qos(100))
@@ -563,11 +572,9 @@ def test_the_shape_watch_matches_no_frame_with_camera_inputs_it_cannot_trust(ros
     import rclpy
     from geometry_msgs.msg import PoseStamped
 
-    from squeeze_grasp_interfaces.msg import Alarm
     from squeeze_grasp_ros.ros import messages
     from squeeze_grasp_ros.ros.messages.images import pose_of_camera
     from squeeze_grasp_ros.ros.nodes import pipeline
-    from squeeze_grasp_ros.ros.nodes.shape_watcher import ShapeWatcher
     from squeeze_grasp_ros.ros.nodes.sim_hardware import camera_messages
     from squeeze_grasp_ros.ros.run.camera_plan import predicted_shapes_msg
 
@@ -575,10 +582,7 @@ def test_the_shape_watch_matches_no_frame_with_camera_inputs_it_cannot_trust(ros
     world = SimWorld(GraspSetup.build(scene))
     node = rclpy.create_node("watch_inputs_monitor", context=ros_context)
     try:
-        watcher = ShapeWatcher(node, node.create_publisher(Alarm, "alarms", 10),
-                               threshold=scene.camera.shape_mismatch_threshold,
-                               at_force_threshold=scene.camera.shape_at_force_threshold,
-                               object_height=0.0254, min_force=0.05)
+        watcher = scene_watcher(node, scene)
         residuals: list = []
         watcher.residual_pub.publish = residuals.append
         watcher._prediction(predicted_shapes_msg(GraspSetup.build(scene).precompute(), 0.005, 0))

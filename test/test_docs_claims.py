@@ -1,0 +1,233 @@
+# Copyright 2026 squeeze_grasp_ros developers
+# SPDX-License-Identifier: Apache-2.0
+"""What README.md and docs/ state in prose and in blocks that are not console transcripts
+(those are run by test_docs.py): shipped files they reproduce, the options they give a verb,
+the columns and values they list, the constants they quote.
+
+Each check reads the page, so a page edited away from the product fails here; each compares
+with the product's own objects (files, parsers, constants), so a product changed away from the
+page fails here too.
+"""
+from __future__ import annotations
+
+import re
+
+import pytest
+import yaml
+from doc_transcripts import PAGES, REPO, blocks
+
+from squeeze_grasp_ros.cli import add_verb_arguments, build_parser
+
+
+def page_text(name: str) -> str:
+    """A page of the docs (``README.md`` or ``docs/NAME``), whitespace normalised."""
+    path = REPO / name if name == "README.md" else REPO / "docs" / name
+    return " ".join(path.read_text(encoding="utf-8").split())
+
+
+def yaml_block(name: str, first: str) -> dict:
+    """The ```yaml block of ``docs/NAME`` whose first line starts with ``first``, parsed."""
+    found = [b for b in blocks(REPO / "docs" / name)
+             if b.language == "yaml" and b.lines and b.lines[0].startswith(first)]
+    assert len(found) == 1, f"docs/{name}: {len(found)} yaml blocks start with {first!r}"
+    return yaml.safe_load("\n".join(found[0].lines))
+
+
+def shipped(path: str) -> dict:
+    """A shipped YAML file under config/, parsed."""
+    return yaml.safe_load((REPO / "config" / path).read_text(encoding="utf-8"))
+
+
+SHIPPED_COPIES = [
+    # (page, the block's first line, the file it reproduces, its keys the block leaves out)
+    ("scenes.md", "name: foam_square", "scenes/foam_square.yaml", {"description"}),
+    ("sweep.md", "base: ../scenes/foam_square.yaml", "sweeps/example.yaml",
+     {"name", "description"}),
+    ("grippers.md", "name: generic_85mm", "devices/generic_85mm.yaml", {"description"}),
+    ("grippers.md", "controller: {type: joint_trajectory, name: gripper_controller",
+     "scenes/sponge_gripper.yaml", None),
+    ("grippers.md", "controller: {type: parallel_gripper", "scenes/sponge_gripper_parallel.yaml",
+     None),
+    ("grippers.md", "controller: {type: joint_trajectory, name: hand_controller",
+     "scenes/foam_square_barrett_jtc.yaml", None),
+]
+"""Blocks that show a shipped file (whole but for the keys named) or one of its sections
+(None: the block's top-level keys only)."""
+
+
+@pytest.mark.parametrize("page, first, path, left_out", SHIPPED_COPIES,
+                         ids=[f"{c[0]}:{c[2]}" for c in SHIPPED_COPIES])
+def test_a_yaml_block_that_shows_a_shipped_file_is_that_file(page, first, path, left_out):
+    block, file = yaml_block(page, first), shipped(path)
+    if left_out is None:
+        assert block == {key: file[key] for key in block}
+    else:
+        assert block == {key: value for key, value in file.items() if key not in left_out}
+
+
+def test_the_scene_example_names_every_shape_type():
+    """docs/scenes.md's example comments the shape types: every one the parser takes."""
+    from squeeze_grasp_ros.scene.specs import SHAPES
+
+    block = next(b for b in blocks(REPO / "docs" / "scenes.md") if b.language == "yaml")
+    comment = " ".join(line.partition("#")[2] for line in block.lines[2:5])
+    assert re.findall(r"\w+", comment) == [t.value for t in SHAPES], comment
+
+
+def test_the_camera_section_perception_md_shows_is_valid_and_at_its_defaults():
+    """docs/perception.md's ``camera:`` section parses as a scene's camera, and its values are
+    the defaults ``scene-help`` lists, but for the distortion and the pose of the shipped
+    camera scene (which its comments describe as examples).
+    """
+    import dataclasses
+
+    from squeeze_grasp_ros.scene import parse_scene
+    from squeeze_grasp_ros.scene.specs import CameraSpec
+
+    section = yaml_block("perception.md", "camera:")["camera"]
+    scene = shipped("scenes/foam_square.yaml")
+    scene.update(camera=section, effects=[*scene["effects"], "camera"])
+    camera = parse_scene(scene).camera
+    defaults = {f.name: f.default for f in dataclasses.fields(CameraSpec)}
+    camera_scene = shipped("scenes/foam_square_camera.yaml")["camera"]
+    for key, value in section.items():
+        expected = camera_scene[key] if key in ("distortion", "pose") else defaults[key]
+        assert getattr(camera, key) == pytest.approx(expected), key
+
+
+def verb_options() -> dict[str, set[str]]:
+    """Every verb of ``squeeze-grasp`` and its option strings."""
+    parser = build_parser()
+    verbs = next(a for a in parser._actions if a.dest == "verb")._name_parser_map
+    return {verb: {o for action in add_verb_arguments(sub)._actions
+                   for o in action.option_strings} for verb, sub in verbs.items()}
+
+
+VERB_SPAN = re.compile(r"`(?:squeeze-grasp )?([a-z][\w-]*) ([^`]*?--[^`]*)`")
+"""An inline code span that starts with a verb (``squeeze-grasp`` optional) and gives it
+options."""
+
+
+def misgiven_options(text: str, options: dict[str, set[str]]) -> list[str]:
+    """The ``verb --option`` pairs of ``text``'s inline spans whose verb has no such option."""
+    wrong = []
+    for span in VERB_SPAN.finditer(text):
+        verb, rest = span.groups()
+        if verb in options:
+            wrong += [f"{verb} {o}" for o in re.findall(r"(?<![\w-])--[a-z][\w-]*", rest)
+                      if o not in options[verb]]
+    return wrong
+
+
+def test_an_inline_verb_with_options_has_those_options():
+    """An inline span such as `` `ring --map --best 3` `` or `` `squeeze --compare-models` ``
+    names options its verb has (test_docs.py checks the converse, and the transcripts).
+    """
+    options = verb_options()
+    wrong, checked = [], 0
+    for page in PAGES:
+        text = page.read_text(encoding="utf-8")
+        checked += len(VERB_SPAN.findall(text))
+        wrong += [f"{page.name}: {w}" for w in misgiven_options(text, options)]
+    assert checked >= 50 and wrong == [], wrong
+    assert misgiven_options("`sweep --large`", options) == ["sweep --large"]
+
+
+def test_the_records_table_of_sweep_md_is_the_parquet_schema():
+    """docs/sweep.md's table of a sweep's columns lists the Parquet schema's columns, in its
+    order (``a`` … ``b`` standing for the columns between), and the values it gives for
+    ``termination``, ``strain_measure`` and ``stress_measure`` are the ones a row can hold.
+    """
+    from squeeze_grasp_ros.mechanics.vocabulary import StrainMeasure, StressMeasure, Termination
+    from squeeze_grasp_ros.sweep.parts import SCHEMA
+
+    page = (REPO / "docs" / "sweep.md").read_text(encoding="utf-8")
+    table = page[page.index("| columns | what |"):]
+    rows = {}
+    for row in table[:table.index("\n\n")].splitlines()[2:]:
+        first, what = row.strip("|").split(" | ", 1)
+        rows[first.strip()] = what
+    names = list(SCHEMA.names)
+    listed: list[str] = []
+    for first in rows:
+        for k, piece in enumerate(first.split(" … ")):
+            shown = re.findall(r"`(\w+)`", piece)
+            if k:  # a range: every schema column up to the first one shown after the ellipsis
+                start = names.index(listed[-1]) + 1
+                listed += names[start:names.index(shown[0])]
+            listed += shown
+    assert listed == names
+
+    def values(column: str) -> list[str]:
+        what = next(w for first, w in rows.items() if f"`{column}`" in first)
+        return re.findall(r"`(\w+)`", what)
+    # a sweep squeezes with no controller: weight_slip is the simulated lift's only
+    assert sorted(values("termination")) == sorted(t.value for t in Termination
+                                                   if t != Termination.WEIGHT_SLIP)
+    measures = [m.value for m in StrainMeasure if m != StrainMeasure.GREEN_LAGRANGE]
+    assert [v for v in values("strain_measure") if v in measures] == measures
+    assert [m.value for m in StressMeasure] == [v for v in values("max_von_mises")
+                                                if v in {m.value for m in StressMeasure}]
+
+
+def stated(name: str, pattern: str) -> list[float]:
+    """The numbers ``pattern`` captures on a page (thousands separators dropped)."""
+    found = re.search(pattern, page_text(name))
+    assert found, f"{name} no longer states {pattern!r}"
+    return [float(x.replace(",", "")) for x in found.groups()]
+
+
+def _constant(dotted: str) -> float:
+    import importlib
+
+    module, _, name = dotted.rpartition(".")
+    return getattr(importlib.import_module(f"squeeze_grasp_ros.{module}"), name)
+
+
+CONSTANTS = [
+    ("sweep.md", r"at most ([\d,]+) evaluations, ([\d,]+) parameter sets per placement, "
+     r"([\d,]+) tasks and ([\d,]+) objects",
+     ["sweep.limits.MAX_EVALUATIONS", "sweep.limits.MAX_TASK_EVALUATIONS",
+      "sweep.limits.MAX_TASKS", "sweep.limits.MAX_OBJECTS"], 1),
+    ("sweep.md", r"Each worker process keeps the last (\d+) prepared groups",
+     ["sweep.evaluate.CACHE_GROUPS"], 1),
+    ("sweep.md", r"at most (\d+) per core", ["commands.sweep.WORKERS_PER_CORE"], 1),
+    ("sweep.md", r"read only as regular files, bounded \((\d+) MiB and (\d+) MiB\)",
+     ["sweep.store.MAX_MANIFEST_BYTES", "sweep.parts.MAX_PART_BYTES"], 2 ** 20),
+    ("sweep.md", r"a sweep of at least ([\d,]+) evaluations \(`COMPILED_FROM_EVALUATIONS`\)",
+     ["mechanics.squeeze.fixed_set_kernel.COMPILED_FROM_EVALUATIONS"], 1),
+    ("README.md", r"fixed-set Newton for a `sweep` of ([\d,]+) evaluations or more",
+     ["mechanics.squeeze.fixed_set_kernel.COMPILED_FROM_EVALUATIONS"], 1),
+    ("README.md", r"for objects of ([\d,]+) nodes or more",
+     ["mechanics.squeeze.nonlinear_model.COMPILED_ASSEMBLY_NODES"], 1),
+    ("materials.md", r"default for objects under ([\d,]+) nodes",
+     ["mechanics.squeeze.nonlinear_model.COMPILED_ASSEMBLY_NODES"], 1),
+    ("README.md", r"an ellipse or a ring fits within ([\d.]+) pixel",
+     ["perception.extract.PRIMITIVE_TOLERANCE_PX"], 1),
+    ("perception.md", r"within \*\*([\d.]+) pixel footprints\*\* \(`PRIMITIVE_TOLERANCE_PX`\)",
+     ["perception.extract.PRIMITIVE_TOLERANCE_PX"], 1),
+]
+"""(page, pattern, the constants its numbers are, the unit of the page's numbers)."""
+
+
+@pytest.mark.parametrize("page, pattern, constants, unit", CONSTANTS,
+                         ids=[f"{c[0]}:{c[2][0].rpartition('.')[2]}" for c in CONSTANTS])
+def test_a_stated_constant_is_the_code_s(page, pattern, constants, unit):
+    assert stated(page, pattern) == [_constant(c) / unit for c in constants]
+
+
+def test_the_readme_s_extras_are_the_package_s():
+    """Every ``pip install -e '.[extra,...]'`` of README.md and docs/ names extras of
+    setup.py.
+    """
+    import ast
+
+    tree = ast.parse((REPO / "setup.py").read_text(encoding="utf-8"))
+    call = next(n for n in ast.walk(tree) if isinstance(n, ast.keyword)
+                and n.arg == "extras_require")
+    extras = {ast.literal_eval(k) for k in call.value.keys}
+    named = {e for page in PAGES for group in re.findall(
+        r"pip install (?:-e )?'\.\[([\w,]+)\]'", page.read_text(encoding="utf-8"))
+        for e in group.split(",")}
+    assert {"ros", "test", "sweep", "cholmod", "fast", "perception"} <= named
+    assert named - extras == set()

@@ -231,3 +231,132 @@ def test_the_readme_s_extras_are_the_package_s():
         for e in group.split(",")}
     assert {"ros", "test", "sweep", "cholmod", "fast", "perception"} <= named
     assert named - extras == set()
+
+
+def cli_json(words: list[str], folder) -> dict:
+    """``squeeze-grasp WORDS --json`` run in this process from ``folder``, its JSON."""
+    import contextlib
+    import io
+    import json
+    import os
+
+    from squeeze_grasp_ros import cli
+
+    out, cwd = io.StringIO(), os.getcwd()
+    os.chdir(folder)
+    try:
+        with contextlib.redirect_stdout(out):
+            code = cli.main([*words, "--json"])
+    finally:
+        os.chdir(cwd)
+    assert code == 0, (words, out.getvalue())
+    return json.loads(out.getvalue())
+
+
+FOAM_SQUARE = str(REPO / "config" / "scenes" / "foam_square.yaml")
+
+
+def test_the_diagnostics_mechanics_md_names_are_plan_s(tmp_path):
+    """docs/mechanics.md names the diagnostics ``plan --json`` gives and says it has no solve
+    residual; its ConditioningWarning threshold is the code's.
+    """
+    from squeeze_grasp_ros.mechanics.elastic.compliance import CONDITION_WARN
+
+    text = page_text("mechanics.md")
+    bullet = text[text.index("**Diagnostics**"):text.index("**Point contacts")]
+    named = re.findall(r"`(\w+)`", bullet)
+    diagnostics = cli_json(["plan", FOAM_SQUARE], tmp_path)["diagnostics"]
+    assert {"condition_estimate", "rigid_mode_residual", "reduced_condition"} <= set(named)
+    assert [k for k in named if k not in ("diagnostics", "plan", "ConditioningWarning")
+            and k not in diagnostics] == []
+    assert "so its JSON has no residual" in bullet
+    assert [k for k in diagnostics if "residual" in k] == ["rigid_mode_residual"]
+    assert stated("mechanics.md", r"a `ConditioningWarning` is issued past (1e\d+)") == [
+        CONDITION_WARN]
+
+
+def test_the_yaml_route_the_readme_compares_the_camera_with():
+    """README.md: "The YAML route gives 4.9061 N and the same 12 events" (the shipped foam
+    square's event squeeze).
+    """
+    from squeeze_grasp_ros.api import event_squeeze_scene, load_scene, scene_file, scene_solid
+
+    force, events = stated("README.md", r"The YAML route gives ([\d.]+) N and the same (\d+) "
+                                        r"events")
+    scene = load_scene(scene_file("foam_square"))
+    result = event_squeeze_scene(scene, scene_solid(scene))
+    assert (round(float(result.finger_force["F1"][1]), 4), len(result.events)) == (force, events)
+
+
+def test_the_mask_outline_as_a_file_and_as_a_polygon_squeezes_as_perception_md_says(tmp_path):
+    """docs/perception.md, "Files": the foam square's mask outline (the example's render), as
+    an outline file and as a polygon, meshed and squeezed: boundary nodes, events, the first
+    event's relative depth and the final finger force it states, beside the scene's own.
+    """
+    pytest.importorskip("skimage", reason="outline extraction needs the perception extra")
+    camera = ["--camera-info", str(REPO / "config" / "examples" / "camera_top.yaml"),
+              "--camera-pose", "0.01", "-0.02", "0.5", "3.1", "0.05", "0.3"]
+    cli_json(["render", FOAM_SQUARE, *camera, "--mask", "mask.png"], tmp_path)
+    polygon = cli_json(["outline", "mask.png", *camera, "--object-height", "0.0254",
+                        "--output", "shape.yaml"], tmp_path)
+    cli_json(["outline", "mask.png", *camera, "--object-height", "0.0254",
+              "--output", "outline.json"], tmp_path)
+    base = shipped("scenes/foam_square.yaml")
+    shapes = {"file": {"type": "file", "path": str(tmp_path / "outline.json")},
+              "polygon": yaml.safe_load((tmp_path / "shape.yaml").read_text())["shape"]}
+    runs = {"scene": cli_json(["squeeze", FOAM_SQUARE], tmp_path)}
+    for name, shape in shapes.items():
+        (tmp_path / f"{name}.yaml").write_text(yaml.safe_dump(
+            {**base, "object": {**base["object"], "shape": shape}}))
+        runs[name] = cli_json(["squeeze", f"{name}.yaml"], tmp_path)
+
+    def seen(run: dict) -> tuple:
+        return (run["mesh"]["boundary"], len(run["events"]),
+                round(100 * run["events"][0]["relative_depth"], 1),
+                round(run["finger_force"]["F1"]["end"], 3))
+    text = page_text("perception.md")
+    as_file = stated("perception.md", r"as an outline file it meshes like the scene's own square "
+                     r"\((\d+) boundary nodes, the same (\d+) new-contact events, final finger "
+                     r"force ([\d.]+) N against ([\d.]+) N: (-?[\d.]+) %\)")
+    as_polygon = stated("perception.md", r"as a polygon its (\d+) vertices give (\d+) boundary "
+                        r"nodes, (\d+) events, the first ones at ([\d.]+) % instead of ([\d.]+) % "
+                        r"relative depth .{0,80}?, and ([\d.]+) N")
+    assert "through the mask, then `squeeze`" in text
+    assert seen(runs["file"])[:2] == seen(runs["scene"])[:2] == tuple(as_file[:2])
+    assert [seen(runs["file"])[3], seen(runs["scene"])[3]] == as_file[2:4]
+    assert round(100 * (as_file[2] / as_file[3] - 1), 1) == as_file[4]
+    assert polygon["vertices"] == len(shapes["polygon"]["points"]) == as_polygon[0]
+    boundary, events, first, force = seen(runs["polygon"])
+    assert [boundary, events, first, seen(runs["scene"])[2], force] == as_polygon[1:]
+
+
+CLI_DEFAULTS = [
+    # (page, pattern capturing the stated default, verb, option, the page's unit in SI)
+    ("perception.md", r"higher than `--min-height`, default (\d+) mm", "outline", "--min-height",
+     1e-3),
+    ("perception.md", r"`--frame-id` names the plane frame \(default `(\w+)`\)", "outline",
+     "--frame-id", None),
+    ("perception.md", r"seeded by `--seed` \(default (\d+)\)", "render", "--seed", 1),
+    ("grippers.md", r"the jaw force times `--margin` \(default ([\d.]+)", "gripper-plan",
+     "--margin", 1),
+    ("pipeline.md", r"`--max-attempts N` \| with `resqueeze`: squeezes in all, the first "
+     r"included \(default (\d+)\)", "run", "--max-attempts", 1),
+    ("README.md", r"squeezes again to ([\d.]+) of the alarm's depth", "run",
+     "--resqueeze-margin", None),
+]
+
+
+@pytest.mark.parametrize("page, pattern, verb, option, unit", CLI_DEFAULTS,
+                         ids=[f"{c[0]}:{c[2]} {c[3]}" for c in CLI_DEFAULTS])
+def test_a_default_the_docs_state_is_the_option_s(page, pattern, verb, option, unit):
+    parser = build_parser()
+    sub = next(a for a in parser._actions if a.dest == "verb")._name_parser_map[verb]
+    action = next(a for a in add_verb_arguments(sub)._actions if option in a.option_strings)
+    found = re.search(pattern, page_text(page))
+    assert found, f"{page} no longer states {pattern!r}"
+    if option == "--resqueeze-margin":  # the README states the depth it leaves: 1 - margin
+        assert float(found.group(1)) == pytest.approx(1 - action.default)
+    elif unit is None:
+        assert found.group(1) == action.default
+    else:
+        assert float(found.group(1)) * unit == pytest.approx(action.default)

@@ -360,3 +360,28 @@ def test_a_default_the_docs_state_is_the_option_s(page, pattern, verb, option, u
         assert found.group(1) == action.default
     else:
         assert float(found.group(1)) * unit == pytest.approx(action.default)
+
+
+@pytest.mark.slow
+def test_where_an_element_inverts_is_where_materials_md_says(tmp_path):
+    """docs/materials.md: ``squeeze --relative-depth 0.95`` of the foam square ends
+    ``element_inverted`` at the relative depths it states (the shipped mesh, linear; a
+    300-node mesh, linear and corotational), and the neo-Hookean one reaches 95 %.
+    """
+    text = page_text("materials.md")
+    assert "`squeeze --relative-depth 0.95`" in text
+    shipped_linear, linear, corotational, reached = stated(
+        "materials.md", r"the shipped linear foam square, 2,054 nodes, at ([\d.]+) % relative "
+        r"depth; on a 300-node mesh of it the linear one at ([\d.]+) %, the corotational one "
+        r"at ([\d.]+) %, and the neo-Hookean one reaches (\d+) % with no element inverted")
+    coarse = shipped("scenes/foam_square.yaml")
+    coarse["object"]["mesh"] = {"nodes": 300, "min_angle": 30}
+    (tmp_path / "coarse.yaml").write_text(yaml.safe_dump(coarse))
+    runs = [(FOAM_SQUARE, "linear"), ("coarse.yaml", "linear"),
+            ("coarse.yaml", "corotational"), ("coarse.yaml", "neo_hookean")]
+    ends = [cli_json(["squeeze", scene, "--model", model, "--relative-depth", "0.95"], tmp_path)
+            for scene, model in runs]
+    assert ends[0]["mesh"]["nodes"] == 2054
+    assert [e["termination"] for e in ends] == ["element_inverted"] * 3 + ["depth_reached"]
+    assert [round(100 * e["relative_depth"], 1) for e in ends] == [
+        shipped_linear, linear, corotational, reached]

@@ -385,3 +385,29 @@ def test_where_an_element_inverts_is_where_materials_md_says(tmp_path):
     assert [e["termination"] for e in ends] == ["element_inverted"] * 3 + ["depth_reached"]
     assert [round(100 * e["relative_depth"], 1) for e in ends] == [
         shipped_linear, linear, corotational, reached]
+
+
+def test_the_quick_bench_s_force_differences_materials_md_quotes():
+    """docs/materials.md: in ``bench --only material_models --quick`` (400-node meshes) the
+    neo-Hookean foam square's F1 force is +0.25/+1.4/+3.6 % above linear at 2/8/16 % and the
+    corotational one -2.0/-3.9/-8.4 % below: the bench's own set-up and squeezes.
+    """
+    from squeeze_grasp_ros.bench.material_models import _run, _setup
+    from squeeze_grasp_ros.mechanics.vocabulary import Finger, MaterialModel
+
+    found = stated("materials.md", r"in its quick mode \((\d+)-node meshes\) the neo-Hookean "
+                   r"force is \+([\d.]+)/\+([\d.]+)/\+([\d.]+) % above linear on the foam square "
+                   r"at (\d+)/(\d+)/(\d+) % and the corotational one "
+                   r"−([\d.]+)/−([\d.]+)/−([\d.]+) % below")
+    nodes, neo, depths, corotational = int(found[0]), found[1:4], found[4:7], found[7:]
+    setup = _setup("foam_square", nodes)
+
+    def force(model: MaterialModel, depth: float) -> float:
+        return _run(setup, model, depth / 100)[0].finger_force[Finger.F1][1]
+    for k, depth in enumerate(depths):
+        linear = force(MaterialModel.LINEAR, depth)
+        for model, shown, sign in ((MaterialModel.NEO_HOOKEAN, neo[k], 1),
+                                   (MaterialModel.COROTATIONAL, corotational[k], -1)):
+            change = 100 * (force(model, depth) / linear - 1)
+            decimals = len(f"{shown}".partition(".")[2])
+            assert round(sign * change, decimals) == shown, (model, depth, change)

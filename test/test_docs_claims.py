@@ -411,3 +411,38 @@ def test_the_quick_bench_s_force_differences_materials_md_quotes():
             change = 100 * (force(model, depth) / linear - 1)
             decimals = len(f"{shown}".partition(".")[2])
             assert round(sign * change, decimals) == shown, (model, depth, change)
+
+
+@pytest.mark.slow
+def test_the_suite_sizes_the_docs_state_are_the_collected_ones():
+    """README.md and docs/ci.md give the default suite's size (about N tests) and docs/ci.md
+    the slow suite's: within 5 % of what pytest collects now (one collection, 10-20 s).
+    """
+    import subprocess
+    import sys
+
+    done = subprocess.run([sys.executable, "-m", "pytest", "--collect-only", "-q",
+                           "-p", "no:cacheprovider"], cwd=REPO, capture_output=True, text=True,
+                          timeout=600)
+    found = re.search(r"(\d+)/(\d+) tests collected \((\d+) deselected\)", done.stdout)
+    assert found, done.stdout[-2000:]
+    default, slow = int(found.group(1)), int(found.group(3))
+    stated_default = (stated("README.md", r"the default test suite \(about ([\d,]+) tests;")
+                      + stated("ci.md", r"The default suite grew from 562 tests .*? to about "
+                                        r"([\d,]+)"))
+    stated_slow = stated("ci.md", r"The slow suite \(`python -m pytest -m slow`, about "
+                                  r"([\d,]+) tests")
+    assert all(abs(n / default - 1) < 0.05 for n in stated_default), (stated_default, default)
+    assert all(abs(n / slow - 1) < 0.05 for n in stated_slow), (stated_slow, slow)
+
+
+def test_the_ros_setup_tests_ci_md_says_skip_on_the_colcon_route():
+    """docs/ci.md: "On the colcon route the N `ros-setup` tests ... skip": the tests of
+    test/test_ros_setup.py marked ``pip_route_only``.
+    """
+    import ast
+
+    tree = ast.parse((REPO / "test" / "test_ros_setup.py").read_text(encoding="utf-8"))
+    marked = [f.name for f in tree.body if isinstance(f, ast.FunctionDef) and any(
+        isinstance(d, ast.Name) and d.id == "pip_route_only" for d in f.decorator_list)]
+    assert stated("ci.md", r"On the colcon route the (\d+) `ros-setup` tests") == [len(marked)]

@@ -446,3 +446,47 @@ def test_the_ros_setup_tests_ci_md_says_skip_on_the_colcon_route():
     marked = [f.name for f in tree.body if isinstance(f, ast.FunctionDef) and any(
         isinstance(d, ast.Name) and d.id == "pip_route_only" for d in f.decorator_list)]
     assert stated("ci.md", r"On the colcon route the (\d+) `ros-setup` tests") == [len(marked)]
+
+
+def _foam_square_names() -> dict:
+    """What docs/events.md's stepper example leaves free: the shipped foam square's object and
+    its finger nodes.
+    """
+    from squeeze_grasp_ros.api import load_scene, scene_file
+    from squeeze_grasp_ros.scene import GraspSetup
+
+    setup = GraspSetup.build(load_scene(scene_file("foam_square"))).precompute()
+    i, j = setup.contacts
+    return {"obj": setup.solid, "i": int(i), "j": int(j)}
+
+
+def _resist_fig10_names() -> dict:
+    """What docs/resistance.md's API example leaves free, from the Fig. 10 scene: the object,
+    F1's, F2's and A's nodes, the squeeze, its contact model, A's tip radius and push.
+    """
+    from squeeze_grasp_ros.api import load_scene, scene_file
+    from squeeze_grasp_ros.scene import GraspSetup
+
+    setup = GraspSetup.build(load_scene(scene_file("resist_fig10"))).precompute()
+    i, j = setup.contacts
+    return {"obj": setup.solid, "i": int(i), "j": int(j), "k": setup.adversary_node,
+            "squeeze": setup.event_squeeze(), "model": setup.contact_model(terminations=False),
+            "radius": setup.scene.adversary.tip_radius, "a": setup.scene.adversary.a}
+
+
+@pytest.mark.parametrize("page, marker, names", [
+    ("events.md", "advance(", _foam_square_names),
+    ("resistance.md", "optimal_resistance(", _resist_fig10_names)])
+def test_a_python_example_with_free_names_runs_and_returns_what_its_comments_name(
+        page, marker, names):
+    """The API examples of docs/events.md and docs/resistance.md leave the object and its
+    nodes free: bound to a shipped scene's, each runs, and a result whose comment names a
+    class (``res = ...  # Resistance``) is of that class.
+    """
+    block = next(b for b in blocks(REPO / "docs" / page)
+                 if b.language == "python" and marker in "\n".join(b.lines))
+    namespace = names()
+    exec("\n".join(block.lines), namespace)  # noqa: S102 (the repository's own page)
+    typed = re.findall(r"^(\w+) = .*#\s+([A-Z]\w+)\b", "\n".join(block.lines), re.M)
+    assert [(n, type(namespace[n]).__name__) for n, _ in typed] == typed
+    assert len(typed) >= (3 if page == "resistance.md" else 0)

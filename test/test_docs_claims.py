@@ -120,13 +120,16 @@ def misgiven_options(text: str, options: dict[str, set[str]]) -> list[str]:
 
 
 def test_an_inline_verb_with_options_has_those_options():
-    """An inline span such as `` `ring --map --best 3` `` or `` `squeeze --compare-models` ``
-    names options its verb has (test_docs.py checks the converse, and the transcripts).
+    """An inline span such as `` `ring --map --best 3` `` or `` `squeeze --compare-models` ``,
+    or a usage line of a block, names options its verb has (test_docs.py checks the converse,
+    and the transcripts).
     """
     options = verb_options()
     wrong, checked = [], 0
     for page in PAGES:
-        text = page.read_text(encoding="utf-8")
+        text = page.read_text(encoding="utf-8") + "".join(  # and the usage lines of blocks
+            f"`{line.split('#')[0].strip()}`" for b in blocks(page) if b.language != "console"
+            for line in b.lines if line.startswith("squeeze-grasp "))
         checked += len(VERB_SPAN.findall(text))
         wrong += [f"{page.name}: {w}" for w in misgiven_options(text, options)]
     assert checked >= 50 and wrong == [], wrong

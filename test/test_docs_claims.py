@@ -493,3 +493,62 @@ def test_a_python_example_with_free_names_runs_and_returns_what_its_comments_nam
     typed = re.findall(r"^(\w+) = .*#\s+([A-Z]\w+)\b", "\n".join(block.lines), re.M)
     assert [(n, type(namespace[n]).__name__) for n, _ in typed] == typed
     assert len(typed) >= (3 if page == "resistance.md" else 0)
+
+
+def test_the_planner_parameter_table_of_ros_md_is_the_node_s():
+    """docs/ros.md's table of the planner's parameters lists every parameter the node declares,
+    each with its default (as config/planner.yaml sets it too).
+    """
+    from squeeze_grasp_ros.ros.nodes.planner import PARAMETERS
+
+    page = (REPO / "docs" / "ros.md").read_text(encoding="utf-8")
+    table = page[page.index("| name | default | meaning |"):]
+    rows = [row.split(" | ")[:2] for row in table[:table.index("\n\n")].splitlines()[2:]]
+
+    def value(text: str):
+        parsed = yaml.safe_load(text.strip("`"))  # YAML 1.1 reads 1e-5 as text
+        return float(parsed) if re.fullmatch(r"[-+]?\d+(\.\d*)?e[-+]?\d+", str(parsed)) else parsed
+    shown = {name.strip("|` "): value(default) for name, default in rows}
+    assert shown == {name: default for name, (default, _) in PARAMETERS.items()}
+    assert shipped("planner.yaml")["/**"]["ros__parameters"] == shown
+
+
+NODE_DEFAULTS = [
+    # (page, pattern capturing the stated default, node module, parameter, the page's unit)
+    ("reliability.md", r"at most `max_pending` of them \(default (\d+)\)", "planner",
+     "max_pending", 1),
+    ("reliability.md", r"`stale_budget` seconds \(executor parameter, default ([\d.]+) s",
+     "executor", "stale_budget", 1),
+    ("perception.md", r"`min_area_px` \(default (\d+):", "outline", "min_area_px", 1),
+    ("perception.md", r"`ambiguous_ratio` \(default ([\d.]+):", "outline", "ambiguous_ratio", 1),
+    ("perception.md", r"and `qos_depth` \(default (\d+)\), the history depth of the image",
+     "outline", "qos_depth", 1),
+    ("perception.md", r"whose frame must be the node's `frame_id`, default `(\w+)`", "outline",
+     "frame_id", None),
+    ("grippers.md", r"`weight_margin` w \(default ([\d.]+),", "monitor", "weight_margin", 1),
+    ("grippers.md", r"over the last `joint_slip_window` \(([\d.]+) mm\)", "monitor",
+     "joint_slip_window", 1e-3),
+    ("grippers.md", r"less than `joint_slip_ratio` \(([\d.]+)\)", "monitor", "joint_slip_ratio",
+     1),
+    ("grippers.md", r"its grace of (\d+) cycles later", "executor", "redirect_grace", 1),
+    ("grippers.md", r"\| `stall_timeout`, `gripper_timeout` \| (\d+) s each by default",
+     "executor", "stall_timeout", 1),
+    ("grippers.md", r"\| `stall_timeout`, `gripper_timeout` \| (\d+) s each by default",
+     "executor", "gripper_timeout", 1),
+]
+
+
+@pytest.mark.parametrize("page, pattern, node, parameter, unit", NODE_DEFAULTS,
+                         ids=[f"{c[0]}:{c[2]}.{c[3]}" for c in NODE_DEFAULTS])
+def test_a_node_parameter_default_the_docs_state_is_the_node_s(page, pattern, node, parameter,
+                                                               unit):
+    import importlib
+
+    default = importlib.import_module(
+        f"squeeze_grasp_ros.ros.nodes.{node}").PARAMETERS[parameter][0]
+    found = re.search(pattern, page_text(page))
+    assert found, f"{page} no longer states {pattern!r}"
+    if unit is None:
+        assert found.group(1) == default
+    else:
+        assert float(found.group(1)) * unit == pytest.approx(default)

@@ -577,3 +577,22 @@ def test_a_node_parameter_default_the_docs_state_is_the_node_s(page, pattern, no
         assert found.group(1) == default
     else:
         assert float(found.group(1)) * unit == pytest.approx(default)
+
+
+def test_the_run_json_keys_pipeline_md_lists_are_the_summary_s():
+    """docs/pipeline.md's ``--json`` row names keys of ``run``'s JSON summary, in its order (the
+    keys of the dict ``run_summary`` returns, read from its source: a run takes seconds).
+    """
+    import ast
+    import inspect
+
+    from squeeze_grasp_ros.ros.run import summary
+
+    tree = ast.parse(inspect.getsource(summary.run_summary))
+    returned = next(n.value for n in ast.walk(tree) if isinstance(n, ast.Return)
+                    and isinstance(n.value, ast.Dict))
+    keys = [ast.literal_eval(k) for k in returned.keys]
+    page = (REPO / "docs" / "pipeline.md").read_text(encoding="utf-8")
+    row = next(line for line in page.splitlines() if line.startswith("| `--json` | the summary"))
+    listed = re.findall(r"`(\w+)`", row.split(" | ")[1])
+    assert len(listed) >= 10 and [k for k in keys if k in listed] == listed, (listed, keys)

@@ -596,3 +596,35 @@ def test_the_run_json_keys_pipeline_md_lists_are_the_summary_s():
     row = next(line for line in page.splitlines() if line.startswith("| `--json` | the summary"))
     listed = re.findall(r"`(\w+)`", row.split(" | ")[1])
     assert len(listed) >= 10 and [k for k in keys if k in listed] == listed, (listed, keys)
+
+
+def test_the_table_5_scenes_succeed_as_ring_md_says(tmp_path):
+    """docs/ring.md's Table 5: each shipped ring scene's ``--map`` at its requested depth, the
+    placements succeeding of all; and the steel heart's own placement (where the strain limit
+    stops it, its fibre strain at 15 %; without the limit, how many placements reach 15 % and
+    how deep this one goes).
+    """
+    page = (REPO / "docs" / "ring.md").read_text(encoding="utf-8")
+    table = page[page.index("| scene | shape | E |"):]
+    rows = [row.strip("|").split(" | ") for row in table[:table.index("\n\n")].splitlines()[2:]]
+    assert len(rows) == 5
+    for row in rows:
+        scene = REPO / "config" / "scenes" / f"{row[0].strip()}.yaml"
+        found = cli_json(["ring", str(scene), "--map"], tmp_path)
+        assert f"{found['feasible_pairs']} of {found['pairs']}" == row[-1].strip(), row[0]
+    heart = REPO / "config" / "scenes" / "ring_heart.yaml"
+    reached, strain, unlimited, deepest = stated(
+        "ring.md", r"the scene's placement reaches `ε\* = 0.005` at ([\d.]+) % relative depth "
+        r"and a ([\d.]+) % fibre strain, small strain, at 15 %\)\. Without the strain limit, "
+        r"friction alone lets (\d+) placements reach 15 %, this one to (\d+) %")
+    single = cli_json(["ring", str(heart)], tmp_path)
+    assert (single["limit"], single["strain_measure"]) == ("strain", "small")
+    assert [round(100 * single["max_relative_depth"], 1),
+            round(100 * single["max_strain"], 1)] == [reached, strain]
+    free = shipped("scenes/ring_heart.yaml")
+    del free["strain_limit"]
+    free["effects"] = ["friction"]
+    (tmp_path / "heart.yaml").write_text(yaml.safe_dump(free))
+    single = cli_json(["ring", "heart.yaml"], tmp_path)
+    assert round(100 * single["max_relative_depth"]) == deepest
+    assert cli_json(["ring", "heart.yaml", "--map"], tmp_path)["feasible_pairs"] == unlimited

@@ -223,6 +223,10 @@ CONSTANTS = [
     ("materials.md", r"an element squashed to (\d+) % of its area \(det F = ([\d.]+),",
      ["mechanics.squeeze.contact_model.INVERSION_AREA_RATIO",
       "mechanics.squeeze.contact_model.INVERSION_AREA_RATIO"], [0.01, 1]),
+    ("README.md", r"the first run after an install spends about (\d+) s of CPU compiling",
+     ["mechanics.squeeze.fixed_set_kernel.COMPILE_CPU_S"], 1),
+    ("sweep.md", r"each worker spends about (\d+) s of CPU compiling the kernels",
+     ["mechanics.squeeze.fixed_set_kernel.COMPILE_CPU_S"], 1),
     ("README.md", r"an ellipse or a ring fits within ([\d.]+) pixel",
      ["perception.extract.PRIMITIVE_TOLERANCE_PX"], 1),
     ("perception.md", r"within \*\*([\d.]+) pixel footprints\*\* \(`PRIMITIVE_TOLERANCE_PX`\)",
@@ -628,3 +632,26 @@ def test_the_table_5_scenes_succeed_as_ring_md_says(tmp_path):
     single = cli_json(["ring", "heart.yaml"], tmp_path)
     assert round(100 * single["max_relative_depth"]) == deepest
     assert cli_json(["ring", "heart.yaml", "--map"], tmp_path)["feasible_pairs"] == unlimited
+
+
+def test_the_exit_statuses_the_readme_and_the_help_list_are_the_codes():
+    """README.md's "Exit status of every verb" and ``squeeze-grasp --help``'s epilog give every
+    exit code and no other; docs/sweep.md's status table and ``sweep --help``'s epilog give the
+    same codes as each other.
+    """
+    from squeeze_grasp_ros.cli import EPILOG
+    from squeeze_grasp_ros.commands.sweep import EPILOG as SWEEP_EPILOG
+    from squeeze_grasp_ros.exit_codes import ExitCode
+
+    def codes(text: str) -> list[int]:
+        return sorted({int(c) for c in re.findall(r"(?:^|[:;,] )(\d+) ", text)})
+    readme = page_text("README.md")
+    sentence = readme[readme.index("Exit status of every verb:"):]
+    sentence = sentence[:sentence.index("SIGTERM") + 8]
+    assert codes(sentence) == codes(EPILOG) == sorted(int(c) for c in ExitCode), sentence
+    page = (REPO / "docs" / "sweep.md").read_text(encoding="utf-8")
+    table = page[page.index("| status | when |"):]
+    rows = [row.split(" | ")[0].strip("| ") for row in
+            table[:table.index("\n\n")].splitlines()[2:]]
+    listed = sorted(int(c) for row in rows for c in row.split(", "))
+    assert listed == codes(SWEEP_EPILOG) == [0, 1, 2, 4, 130, 143], (listed, SWEEP_EPILOG)

@@ -655,3 +655,15 @@ def test_the_exit_statuses_the_readme_and_the_help_list_are_the_codes():
             table[:table.index("\n\n")].splitlines()[2:]]
     listed = sorted(int(c) for row in rows for c in row.split(", "))
     assert listed == codes(SWEEP_EPILOG) == [0, 1, 2, 4, 130, 143], (listed, SWEEP_EPILOG)
+
+
+def test_perception_md_names_every_parameter_of_the_outline_node():
+    """docs/perception.md's section on the ``outline`` node names each parameter the node
+    declares.
+    """
+    from squeeze_grasp_ros.ros.nodes.outline import PARAMETERS
+
+    page = (REPO / "docs" / "perception.md").read_text(encoding="utf-8")
+    section = page[page.index("## The `outline` node"):]
+    section = section[:section.index("\n## ", 4)]
+    assert [name for name in PARAMETERS if f"`{name}`" not in section] == []

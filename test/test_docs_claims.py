@@ -667,3 +667,28 @@ def test_perception_md_names_every_parameter_of_the_outline_node():
     section = page[page.index("## The `outline` node"):]
     section = section[:section.index("\n## ", 4)]
     assert [name for name in PARAMETERS if not re.search(rf"\b{name}\b", section)] == []
+
+
+def launch_arguments(name: str) -> dict:
+    """The arguments ``launch/NAME.launch.py`` declares and their default values (source)."""
+    import ast
+
+    tree = ast.parse((REPO / "launch" / f"{name}.launch.py").read_text(encoding="utf-8"))
+    return {ast.literal_eval(call.args[0]): next(
+        (ast.unparse(k.value) for k in call.keywords if k.arg == "default_value"), None)
+        for call in ast.walk(tree) if isinstance(call, ast.Call)
+        and getattr(call.func, "id", "") == "DeclareLaunchArgument"}
+
+
+def test_ros_md_gives_every_argument_of_the_launch_files():
+    """docs/ros.md's paragraph on the launch files gives each argument they declare, as
+    ``name:=``, and sim_pipeline's ``sigterm_timeout`` default as the file's.
+    """
+    text = page_text("ros.md")
+    paragraph = text[text.index("`sim_pipeline.launch.py` with no arguments"):]
+    paragraph = paragraph[:paragraph.index("Data and configuration files")]
+    for name in ("sim_pipeline", "hardware", "planner"):
+        declared = launch_arguments(name)
+        assert declared and [a for a in declared if f"{a}:=" not in paragraph] == [], name
+    timeout = launch_arguments("sim_pipeline")["sigterm_timeout"].strip("'\"")
+    assert f"`sigterm_timeout:={timeout}`" in paragraph

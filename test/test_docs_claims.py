@@ -692,3 +692,17 @@ def test_ros_md_gives_every_argument_of_the_launch_files():
         assert declared and [a for a in declared if f"{a}:=" not in paragraph] == [], name
     timeout = launch_arguments("sim_pipeline")["sigterm_timeout"].strip("'\"")
     assert f"`sigterm_timeout:={timeout}`" in paragraph
+
+
+def test_every_constant_the_docs_name_is_the_package_s():
+    """Each ``UPPER_CASE`` name in backticks in the docs (``MAX_BORDERED_DOFS``,
+    ``SQUEEZE_GRASP_KERNEL``, ...) occurs in the package's source, but for the environment
+    variables of ROS 2 and Fast DDS the docs name.
+    """
+    source = "\n".join(p.read_text(encoding="utf-8")
+                       for p in (REPO / "squeeze_grasp_ros").rglob("*.py"))
+    outside = {"ROS_DOMAIN_ID", "FASTRTPS_DEFAULT_PROFILES_FILE"}
+    named = {name for page in PAGES for name in re.findall(
+        r"`([A-Z][A-Z0-9]*_[A-Z0-9_]+)`", page.read_text(encoding="utf-8"))}
+    assert len(named) >= 20
+    assert [n for n in sorted(named - outside) if not re.search(rf"\b{n}\b", source)] == []

@@ -706,3 +706,26 @@ def test_every_constant_the_docs_name_is_the_package_s():
         r"`([A-Z][A-Z0-9]*_[A-Z0-9_]+)`", page.read_text(encoding="utf-8"))}
     assert len(named) >= 20
     assert [n for n in sorted(named - outside) if not re.search(rf"\b{n}\b", source)] == []
+
+
+def test_the_slip_scene_is_what_grippers_md_says():
+    """docs/grippers.md: the shipped slip scene grips the sponge N mm off its short axis, where
+    the surface leans M degrees from the pads, with its mu; the mechanics API's squeeze ends
+    with a jaw slipping at the depth it states.
+    """
+    import math
+
+    from squeeze_grasp_ros.api import event_squeeze_scene, load_scene, scene_file, scene_solid
+
+    off, lean, mu, depth = stated(
+        "grippers.md", r"The shipped slip scene grips the sponge (\d+) mm off its short axis, "
+        r"where the surface leans (\d+) degrees from the pads, with mu = ([\d.]+): the mechanics "
+        r"API's squeeze ends with a jaw slipping at ([\d.]+) mm of depth")
+    scene = load_scene(scene_file("sponge_gripper_slip"))
+    shape = scene.object.shape
+    x, y = scene.fingers["F2"].placement.point
+    assert (round(1e3 * x), scene.friction.mu) == (off, mu)
+    normal = math.degrees(math.atan2(shape["b"] ** 2 * x, shape["a"] ** 2 * y))
+    assert round(normal) == lean  # the outward normal's tilt from the pads' closing line (y)
+    result = event_squeeze_scene(scene, scene_solid(scene))
+    assert (result.termination, round(1e3 * result.depth, 2)) == ("finger_slip", depth)

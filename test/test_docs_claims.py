@@ -729,3 +729,19 @@ def test_the_slip_scene_is_what_grippers_md_says():
     assert round(normal) == lean  # the outward normal's tilt from the pads' closing line (y)
     result = event_squeeze_scene(scene, scene_solid(scene))
     assert (result.termination, round(1e3 * result.depth, 2)) == ("finger_slip", depth)
+
+
+def test_the_npm_packages_and_caches_the_readme_names_are_the_tests():
+    """README.md: the tests fetch four npm packages into ~/.cache/squeeze_grasp_ros/foxglove-js
+    and cache the colcon test's interface build in .../colcon-interfaces.
+    """
+    import json
+
+    words = {"two": 2, "three": 3, "four": 4, "five": 5}
+    count = re.search(r"The tests fetch (\w+) npm packages", page_text("README.md")).group(1)
+    dependencies = json.loads((REPO / "test" / "js" / "package.json").read_text())["dependencies"]
+    assert words[count] == len(dependencies)
+    for cache, module in (("foxglove-js", "foxglove_support.py"),
+                          ("colcon-interfaces", "test_colcon_route.py")):
+        assert f"`~/.cache/squeeze_grasp_ros/{cache}`" in page_text("README.md")
+        assert f'"{cache}"' in (REPO / "test" / module).read_text(encoding="utf-8")

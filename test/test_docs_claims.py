@@ -745,3 +745,21 @@ def test_the_npm_packages_and_caches_the_readme_names_are_the_tests():
                           ("colcon-interfaces", "test_colcon_route.py")):
         assert f"`~/.cache/squeeze_grasp_ros/{cache}`" in page_text("README.md")
         assert f'"{cache}"' in (REPO / "test" / module).read_text(encoding="utf-8")
+
+
+def test_the_error_kinds_the_readme_names_are_the_package_s():
+    """README.md: "Errors come in four kinds (...) under `SqueezeGraspError`": the direct
+    subclasses of SqueezeGraspError in the package's error module, all of them.
+    """
+    import inspect
+
+    from squeeze_grasp_ros.mechanics import errors
+
+    text = page_text("README.md")
+    sentence = re.search(r"Errors come in (\w+) kinds \((.*?)\) under `SqueezeGraspError`",
+                         text)
+    named = re.findall(r"`(\w+)`", sentence.group(2))
+    kinds = [name for name, cls in inspect.getmembers(errors, inspect.isclass)
+             if errors.SqueezeGraspError in cls.__bases__]
+    assert sorted(named) == sorted(kinds)
+    assert {"two": 2, "three": 3, "four": 4, "five": 5}[sentence.group(1)] == len(kinds)

@@ -227,6 +227,8 @@ CONSTANTS = [
      ["mechanics.squeeze.fixed_set_kernel.COMPILE_CPU_S"], 1),
     ("sweep.md", r"each worker spends about (\d+) s of CPU compiling the kernels",
      ["mechanics.squeeze.fixed_set_kernel.COMPILE_CPU_S"], 1),
+    ("design.md", r"beyond `SHARED_SET_BYTES`, (\d+) MiB\)",
+     ["mechanics.squeeze.contact_model.SHARED_SET_BYTES"], 2 ** 20),
     ("README.md", r"an ellipse or a ring fits within ([\d.]+) pixel",
      ["perception.extract.PRIMITIVE_TOLERANCE_PX"], 1),
     ("perception.md", r"within \*\*([\d.]+) pixel footprints\*\* \(`PRIMITIVE_TOLERANCE_PX`\)",
@@ -560,6 +562,10 @@ NODE_DEFAULTS = [
     ("grippers.md", r"less than `joint_slip_ratio` \(([\d.]+)\)", "monitor", "joint_slip_ratio",
      1),
     ("grippers.md", r"its grace of (\d+) cycles later", "executor", "redirect_grace", 1),
+    ("design.md", r"The world runs at most (\d+) ticks \(a report every \d+\) ahead of the "
+     r"recorder", "sim_hardware", "recorder_window", 1),
+    ("design.md", r"The world runs at most \d+ ticks \(a report every (\d+)\) ahead of the "
+     r"recorder", "recorder", "progress_every", 1),
     ("grippers.md", r"\| `stall_timeout`, `gripper_timeout` \| (\d+) s each by default",
      "executor", "stall_timeout", 1),
     ("grippers.md", r"\| `stall_timeout`, `gripper_timeout` \| (\d+) s each by default",

@@ -229,6 +229,14 @@ CONSTANTS = [
      ["mechanics.squeeze.fixed_set_kernel.COMPILE_CPU_S"], 1),
     ("design.md", r"beyond `SHARED_SET_BYTES`, (\d+) MiB\)",
      ["mechanics.squeeze.contact_model.SHARED_SET_BYTES"], 2 ** 20),
+    ("reliability.md", r"\| nodes \(interior, boundary and thin features\) \| ([\d,]+) "
+     r"\(`MAX_MESH_NODES`\)", ["mechanics.elastic.mesh_size.MAX_MESH_NODES"], 1),
+    ("reliability.md", r"\| boundary nodes \(outer and holes\) \| ([\d,]+) "
+     r"\(`MAX_BOUNDARY_NODES`\)", ["mechanics.elastic.mesh_size.MAX_BOUNDARY_NODES"], 1),
+    ("reliability.md", r"at most max\(the nodes asked for, ([\d,]+)\) nodes \(`THIN_ALLOWANCE`\)",
+     ["mechanics.elastic.mesh_size.THIN_ALLOWANCE"], 1),
+    ("reliability.md", r"`ring --elements` in \[8, ([\d,]+)\]",
+     ["mechanics.ring.model.MAX_RING_ELEMENTS"], 1),
     ("README.md", r"an ellipse or a ring fits within ([\d.]+) pixel",
      ["perception.extract.PRIMITIVE_TOLERANCE_PX"], 1),
     ("perception.md", r"within \*\*([\d.]+) pixel footprints\*\* \(`PRIMITIVE_TOLERANCE_PX`\)",

@@ -237,6 +237,12 @@ CONSTANTS = [
      ["mechanics.elastic.mesh_size.THIN_ALLOWANCE"], 1),
     ("reliability.md", r"`ring --elements` in \[8, ([\d,]+)\]",
      ["mechanics.ring.model.MAX_RING_ELEMENTS"], 1),
+    ("events.md", r"`RATE_NOISE` \(([\de.-]+)\)", ["mechanics.squeeze.stepper.modes.RATE_NOISE"],
+     1),
+    ("events.md", r"one solve with two right-hand sides, at most (\d+) MiB per object\)",
+     ["mechanics.elastic.compliance.GRADIENT_BOUND_BYTES"], 2 ** 20),
+    ("events.md", r"clears every element whose bound is below ([\d.]+)",
+     ["mechanics.squeeze.contact_model.GRADIENT_BOUND_EXACT"], 1),
     ("README.md", r"an ellipse or a ring fits within ([\d.]+) pixel",
      ["perception.extract.PRIMITIVE_TOLERANCE_PX"], 1),
     ("perception.md", r"within \*\*([\d.]+) pixel footprints\*\* \(`PRIMITIVE_TOLERANCE_PX`\)",
@@ -777,3 +783,17 @@ def test_the_error_kinds_the_readme_names_are_the_package_s():
              if errors.SqueezeGraspError in cls.__bases__]
     assert sorted(named) == sorted(kinds)
     assert {"two": 2, "three": 3, "four": 4, "five": 5}[sentence.group(1)] == len(kinds)
+
+
+def test_the_measure_table_of_events_md_is_the_models():
+    """docs/events.md's table of each material model's strain and stress measure is what
+    ``MaterialModel.strain_measure`` and ``stress_measure`` give.
+    """
+    from squeeze_grasp_ros.mechanics.vocabulary import MaterialModel
+
+    page = (REPO / "docs" / "events.md").read_text(encoding="utf-8")
+    table = page[page.index("| model | strain (`strain_measure`"):]
+    rows = [re.findall(r"`(\w+)`", row) for row in
+            table[:table.index("\n\n")].splitlines()[2:]]
+    assert [(m.value, str(m.strain_measure), str(m.stress_measure)) for m in MaterialModel] == [
+        tuple(row) for row in rows]

@@ -797,3 +797,35 @@ def test_the_measure_table_of_events_md_is_the_models():
             table[:table.index("\n\n")].splitlines()[2:]]
     assert [(m.value, str(m.strain_measure), str(m.stress_measure)) for m in MaterialModel] == [
         tuple(row) for row in rows]
+
+
+def test_the_controller_manager_examples_of_grippers_md_fit_the_shipped_scenes():
+    """docs/grippers.md's ``controller_manager`` examples (not run: the simulated hardware
+    stands in for them) name the shipped scenes' controller, the device's joints (the Barrett
+    hand's eight), and for the parallel gripper the scene's goal tolerance, stall timeout,
+    speed limit and the device's largest effort.
+    """
+    from squeeze_grasp_ros.control.barrett import JOINTS
+
+    found = [yaml.safe_load("\n".join(b.lines)) for b in blocks(REPO / "docs" / "grippers.md")
+             if b.language == "yaml" and b.lines[0] == "controller_manager:"]
+    assert len(found) == 4
+    device = shipped("devices/generic_85mm.yaml")
+    parallel = shipped("scenes/sponge_gripper_parallel.yaml")["controller"]
+    for example in found:
+        (name,) = [k for k in example if k not in ("controller_manager",
+                                                   "joint_state_broadcaster")]
+        parameters = example[name]["ros__parameters"]
+        joints = parameters.get("joints", [parameters.get("joint")])
+        if name == "hand_controller":
+            assert shipped("scenes/foam_square_barrett_jtc.yaml")["controller"]["name"] == name
+            assert joints == list(JOINTS)
+            continue
+        assert shipped("scenes/sponge_gripper.yaml")["controller"]["name"] == name
+        assert joints == device["transmission"]["joints"]
+        if "goal_tolerance" in parameters:
+            assert {k: parameters[k] for k in ("goal_tolerance", "stall_timeout",
+                                               "max_velocity")} == {
+                k: parallel[k] for k in ("goal_tolerance", "stall_timeout", "max_velocity")}
+            assert parameters["max_effort"] == (device["max_force"]
+                                                * device["transmission"]["effort_per_force"])

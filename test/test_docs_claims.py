@@ -829,3 +829,26 @@ def test_the_controller_manager_examples_of_grippers_md_fit_the_shipped_scenes()
                 k: parallel[k] for k in ("goal_tolerance", "stall_timeout", "max_velocity")}
             assert parameters["max_effort"] == (device["max_force"]
                                                 * device["transmission"]["effort_per_force"])
+
+
+def test_an_outline_file_in_either_orientation_loads_as_scenes_md_says(tmp_path):
+    """docs/scenes.md: an outline file's points may run clockwise; they are taken in reverse.
+    A clockwise and a counter-clockwise CSV of one square give one counter-clockwise outline.
+    """
+    from squeeze_grasp_ros.api import load_scene
+    from squeeze_grasp_ros.mechanics.elastic.shapes import signed_area
+    from squeeze_grasp_ros.scene.build import build_outline
+
+    assert "clockwise points are taken in reverse, as counter-clockwise" in page_text("scenes.md")
+    square = [(0.0, 0.0), (0.05, 0.0), (0.05, 0.05), (0.0, 0.05)]
+    outlines = []
+    for name, points in (("ccw", square), ("cw", square[::-1])):
+        (tmp_path / f"{name}.csv").write_text("".join(f"{x},{y}\n" for x, y in points))
+        scene = shipped("scenes/foam_square.yaml")
+        scene["object"]["shape"] = {"type": "file", "path": f"{name}.csv"}
+        for finger, x in (("F1", 0.0), ("F2", 0.05)):
+            scene["fingers"][finger]["placement"] = {"point": [x, 0.025]}
+        (tmp_path / f"{name}.yaml").write_text(yaml.safe_dump(scene))
+        outlines.append(build_outline(load_scene(tmp_path / f"{name}.yaml").object.shape).points)
+    assert all(signed_area(p) == pytest.approx(0.0025) for p in outlines)
+    assert sorted(map(tuple, outlines[0])) == sorted(map(tuple, outlines[1]))

@@ -243,6 +243,12 @@ CONSTANTS = [
      ["mechanics.elastic.compliance.GRADIENT_BOUND_BYTES"], 2 ** 20),
     ("events.md", r"clears every element whose bound is below ([\d.]+)",
      ["mechanics.squeeze.contact_model.GRADIENT_BOUND_EXACT"], 1),
+    ("perception.md", r"Douglas-Peucker to `--tolerance` \(default ([\d.]+) of the pixel "
+     r"footprint",
+     ["perception.extract.DEFAULT_TOLERANCE_PX"], 1),
+    ("perception.md", r"heights above the declared plane are averaged over (\d+) x (\d+) px "
+     r"blocks", ["perception.support.BLOCK", "perception.support.BLOCK"], 1),
+    ("perception.md", r"within (\d+) px \(`STRAIGHT_PX`", ["perception.extract.STRAIGHT_PX"], 1),
     ("README.md", r"an ellipse or a ring fits within ([\d.]+) pixel",
      ["perception.extract.PRIMITIVE_TOLERANCE_PX"], 1),
     ("perception.md", r"within \*\*([\d.]+) pixel footprints\*\* \(`PRIMITIVE_TOLERANCE_PX`\)",

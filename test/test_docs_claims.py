@@ -858,3 +858,19 @@ def test_an_outline_file_in_either_orientation_loads_as_scenes_md_says(tmp_path)
         outlines.append(build_outline(load_scene(tmp_path / f"{name}.yaml").object.shape).points)
     assert all(signed_area(p) == pytest.approx(0.0025) for p in outlines)
     assert sorted(map(tuple, outlines[0])) == sorted(map(tuple, outlines[1]))
+
+
+def test_the_api_help_shows_what_the_readme_says():
+    """README.md: ``help(squeeze_grasp_ros.api)`` shows ``polygon(points)``,
+    ``generate_mesh(polygon(points), max_area)`` and a squeeze at nodes of your choosing, as
+    examples (test_doctests.py runs them).
+    """
+    import doctest
+
+    from squeeze_grasp_ros import api
+
+    assert "`help(squeeze_grasp_ros.api)` shows this, and a squeeze at nodes of your choosing" \
+        in page_text("README.md")
+    source = "".join(e.source for e in doctest.DocTestParser().get_examples(api.__doc__))
+    for call in (r"\bpolygon\(", r"\bgenerate_mesh\(", r"\bevent_squeeze\(obj, \("):
+        assert re.search(call, source), call

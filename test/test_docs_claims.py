@@ -874,3 +874,20 @@ def test_the_api_help_shows_what_the_readme_says():
     source = "".join(e.source for e in doctest.DocTestParser().get_examples(api.__doc__))
     for call in (r"\bpolygon\(", r"\bgenerate_mesh\(", r"\bevent_squeeze\(obj, \("):
         assert re.search(call, source), call
+
+
+def test_the_planner_interface_table_of_ros_md_is_the_node_s():
+    """docs/ros.md's table of the planner's services and actions lists each one the node
+    creates, with its type, and no other.
+    """
+    source = (REPO / "squeeze_grasp_ros" / "ros" / "nodes" / "planner.py").read_text(
+        encoding="utf-8")
+    created = {("srv", kind, name) for kind, name in
+               re.findall(r"\((\w+), \"(\w+)\", self\._\w+\)", source)}
+    created |= {("action", kind.removesuffix("Action"), name) for kind, name in
+                re.findall(r"ActionServer\(self, (\w+), \"~/(\w+)\"", source)}
+    page = (REPO / "docs" / "ros.md").read_text(encoding="utf-8")
+    table = page[page.index("| name | type | computes | where |"):]
+    listed = {(kind, typ, name) for name, kind, typ in re.findall(
+        r"^\| `~/(\w+)` \| (srv|action) `(\w+)` \|", table[:table.index("\n\n")], re.M)}
+    assert len(created) == 9 and listed == created, (listed ^ created)

@@ -891,3 +891,22 @@ def test_the_planner_interface_table_of_ros_md_is_the_node_s():
     listed = {(kind, typ, name) for name, kind, typ in re.findall(
         r"^\| `~/(\w+)` \| (srv|action) `(\w+)` \|", table[:table.index("\n\n")], re.M)}
     assert len(created) == 9 and listed == created, (listed ^ created)
+
+
+def test_the_node_table_of_pipeline_md_is_the_console_scripts():
+    """docs/pipeline.md's table of the nodes names every node console script of setup.py (all
+    but ``squeeze-grasp``), and each parameter file it names is shipped.
+    """
+    import ast
+
+    tree = ast.parse((REPO / "setup.py").read_text(encoding="utf-8"))
+    scripts = next(ast.literal_eval(k.value)["console_scripts"] for k in ast.walk(tree)
+                   if isinstance(k, ast.keyword) and k.arg == "entry_points")
+    nodes = sorted(s.split("=")[0].strip() for s in scripts)
+    nodes.remove("squeeze-grasp")
+    page = (REPO / "docs" / "pipeline.md").read_text(encoding="utf-8")
+    table = page[page.index("| node (console script) |"):]
+    rows = table[:table.index("\n\n")].splitlines()[2:]
+    assert sorted(re.match(r"\| `(\w+)` \|", row).group(1) for row in rows) == nodes
+    files = re.findall(r"`(config/\w+\.yaml)`", "\n".join(rows))
+    assert len(files) >= 5 and all((REPO / f).exists() for f in files), files

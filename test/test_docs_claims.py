@@ -910,3 +910,21 @@ def test_the_node_table_of_pipeline_md_is_the_console_scripts():
     assert sorted(re.match(r"\| `(\w+)` \|", row).group(1) for row in rows) == nodes
     files = re.findall(r"`(config/\w+\.yaml)`", "\n".join(rows))
     assert len(files) >= 5 and all((REPO / f).exists() for f in files), files
+
+
+def test_every_topic_of_the_pipeline_is_documented_and_the_table_names_real_ones():
+    """Each topic name of ``ros/nodes/pipeline.py`` appears in the docs (in backticks), and each
+    fixed name in docs/pipeline.md's topic table is one of them.
+    """
+    source = (REPO / "squeeze_grasp_ros" / "ros" / "nodes" / "pipeline.py").read_text(
+        encoding="utf-8")
+    topics = set(re.findall(r'^[A-Z_]+ = "(/?[a-z_]+(?:/[a-z_]+)*)"$', source, re.M))
+    topics -= {"object"}  # FRAME: the object frame's name, not a topic
+    text = "\n".join(page.read_text(encoding="utf-8") for page in PAGES)
+    assert len(topics) >= 25
+    assert [t for t in sorted(topics) if f"`{t}`" not in text] == []
+    page = (REPO / "docs" / "pipeline.md").read_text(encoding="utf-8")
+    table = page[page.index("| topic | type | direction |"):]
+    rows = table[:table.index("\n\n")].splitlines()[2:]
+    named = [t for row in rows for t in re.findall(r"`([^`<>]+)`", row.split(" | ")[0])]
+    assert len(named) >= 15 and [t for t in named if t not in topics] == []

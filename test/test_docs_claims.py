@@ -2,11 +2,12 @@
 # SPDX-License-Identifier: Apache-2.0
 """What README.md and docs/ state in prose and in blocks that are not console transcripts
 (those are run by test_docs.py): shipped files they reproduce, the options they give a verb,
-the columns and values they list, the constants they quote.
+the columns, parameters, topics and values they list, the constants and defaults they quote.
 
 Each check reads the page, so a page edited away from the product fails here; each compares
-with the product's own objects (files, parsers, constants), so a product changed away from the
-page fails here too.
+with the product's own objects (files, parsers, declarations, constants), so a product changed
+away from the page fails here too. Results the pages state (forces, events, depths) are
+compared with runs in test_docs_results.py.
 """
 from __future__ import annotations
 
@@ -14,29 +15,10 @@ import re
 
 import pytest
 import yaml
+from doc_claims import page_text, shipped, stated, yaml_block
 from doc_transcripts import PAGES, REPO, blocks
 
 from squeeze_grasp_ros.cli import add_verb_arguments, build_parser
-
-
-def page_text(name: str) -> str:
-    """A page of the docs (``README.md`` or ``docs/NAME``), whitespace normalised."""
-    path = REPO / name if name == "README.md" else REPO / "docs" / name
-    return " ".join(path.read_text(encoding="utf-8").split())
-
-
-def yaml_block(name: str, first: str) -> dict:
-    """The ```yaml block of ``docs/NAME`` whose first line starts with ``first``, parsed."""
-    found = [b for b in blocks(REPO / "docs" / name)
-             if b.language == "yaml" and b.lines and b.lines[0].startswith(first)]
-    assert len(found) == 1, f"docs/{name}: {len(found)} yaml blocks start with {first!r}"
-    return yaml.safe_load("\n".join(found[0].lines))
-
-
-def shipped(path: str) -> dict:
-    """A shipped YAML file under config/, parsed."""
-    return yaml.safe_load((REPO / "config" / path).read_text(encoding="utf-8"))
-
 
 SHIPPED_COPIES = [
     # (page, the block's first line, the file it reproduces, its keys the block leaves out)
@@ -51,8 +33,6 @@ SHIPPED_COPIES = [
     ("grippers.md", "controller: {type: joint_trajectory, name: hand_controller",
      "scenes/foam_square_barrett_jtc.yaml", None),
 ]
-"""Blocks that show a shipped file (whole but for the keys named) or one of its sections
-(None: the block's top-level keys only)."""
 
 
 @pytest.mark.parametrize("page, first, path, left_out", SHIPPED_COPIES,
@@ -104,8 +84,6 @@ def verb_options() -> dict[str, set[str]]:
 
 
 VERB_SPAN = re.compile(r"`(?:squeeze-grasp )?([a-z][\w-]*) ([^`]*?--[^`]*)`")
-"""An inline code span that starts with a verb (``squeeze-grasp`` optional) and gives it
-options."""
 
 
 def misgiven_options(text: str, options: dict[str, set[str]]) -> list[str]:
@@ -171,13 +149,6 @@ def test_the_records_table_of_sweep_md_is_the_parquet_schema():
     assert [v for v in values("strain_measure") if v in measures] == measures
     assert [m.value for m in StressMeasure] == [v for v in values("max_von_mises")
                                                 if v in {m.value for m in StressMeasure}]
-
-
-def stated(name: str, pattern: str) -> list[float]:
-    """The numbers ``pattern`` captures on a page (thousands separators dropped)."""
-    found = re.search(pattern, page_text(name))
-    assert found, f"{name} no longer states {pattern!r}"
-    return [float(x.replace(",", "")) for x in found.groups()]
 
 
 def _constant(dotted: str) -> float:
@@ -254,8 +225,6 @@ CONSTANTS = [
     ("perception.md", r"within \*\*([\d.]+) pixel footprints\*\* \(`PRIMITIVE_TOLERANCE_PX`\)",
      ["perception.extract.PRIMITIVE_TOLERANCE_PX"], 1),
 ]
-"""(page, pattern, the constants its numbers are, the unit of the page's numbers: one, or one
-per constant; a number may be written as a word)."""
 
 
 @pytest.mark.parametrize("page, pattern, constants, unit", CONSTANTS,
@@ -285,103 +254,6 @@ def test_the_readme_s_extras_are_the_package_s():
         for e in group.split(",")}
     assert {"ros", "test", "sweep", "cholmod", "fast", "perception"} <= named
     assert named - extras == set()
-
-
-def cli_json(words: list[str], folder) -> dict:
-    """``squeeze-grasp WORDS --json`` run in this process from ``folder``, its JSON."""
-    import contextlib
-    import io
-    import json
-    import os
-
-    from squeeze_grasp_ros import cli
-
-    out, cwd = io.StringIO(), os.getcwd()
-    os.chdir(folder)
-    try:
-        with contextlib.redirect_stdout(out):
-            code = cli.main([*words, "--json"])
-    finally:
-        os.chdir(cwd)
-    assert code == 0, (words, out.getvalue())
-    return json.loads(out.getvalue())
-
-
-FOAM_SQUARE = str(REPO / "config" / "scenes" / "foam_square.yaml")
-
-
-def test_the_diagnostics_mechanics_md_names_are_plan_s(tmp_path):
-    """docs/mechanics.md names the diagnostics ``plan --json`` gives and says it has no solve
-    residual; its ConditioningWarning threshold is the code's.
-    """
-    from squeeze_grasp_ros.mechanics.elastic.compliance import CONDITION_WARN
-
-    text = page_text("mechanics.md")
-    bullet = text[text.index("**Diagnostics**"):text.index("**Point contacts")]
-    named = re.findall(r"`(\w+)`", bullet)
-    diagnostics = cli_json(["plan", FOAM_SQUARE], tmp_path)["diagnostics"]
-    assert {"condition_estimate", "rigid_mode_residual", "reduced_condition"} <= set(named)
-    assert [k for k in named if k not in ("diagnostics", "plan", "ConditioningWarning")
-            and k not in diagnostics] == []
-    assert "so its JSON has no residual" in bullet
-    assert [k for k in diagnostics if "residual" in k] == ["rigid_mode_residual"]
-    assert stated("mechanics.md", r"a `ConditioningWarning` is issued past (1e\d+)") == [
-        CONDITION_WARN]
-
-
-def test_the_yaml_route_the_readme_compares_the_camera_with():
-    """README.md: "The YAML route gives 4.9061 N and the same 12 events" (the shipped foam
-    square's event squeeze).
-    """
-    from squeeze_grasp_ros.api import event_squeeze_scene, load_scene, scene_file, scene_solid
-
-    force, events = stated("README.md", r"The YAML route gives ([\d.]+) N and the same (\d+) "
-                                        r"events")
-    scene = load_scene(scene_file("foam_square"))
-    result = event_squeeze_scene(scene, scene_solid(scene))
-    assert (round(float(result.finger_force["F1"][1]), 4), len(result.events)) == (force, events)
-
-
-def test_the_mask_outline_as_a_file_and_as_a_polygon_squeezes_as_perception_md_says(tmp_path):
-    """docs/perception.md, "Files": the foam square's mask outline (the example's render), as
-    an outline file and as a polygon, meshed and squeezed: boundary nodes, events, the first
-    event's relative depth and the final finger force it states, beside the scene's own.
-    """
-    pytest.importorskip("skimage", reason="outline extraction needs the perception extra")
-    camera = ["--camera-info", str(REPO / "config" / "examples" / "camera_top.yaml"),
-              "--camera-pose", "0.01", "-0.02", "0.5", "3.1", "0.05", "0.3"]
-    cli_json(["render", FOAM_SQUARE, *camera, "--mask", "mask.png"], tmp_path)
-    polygon = cli_json(["outline", "mask.png", *camera, "--object-height", "0.0254",
-                        "--output", "shape.yaml"], tmp_path)
-    cli_json(["outline", "mask.png", *camera, "--object-height", "0.0254",
-              "--output", "outline.json"], tmp_path)
-    base = shipped("scenes/foam_square.yaml")
-    shapes = {"file": {"type": "file", "path": str(tmp_path / "outline.json")},
-              "polygon": yaml.safe_load((tmp_path / "shape.yaml").read_text())["shape"]}
-    runs = {"scene": cli_json(["squeeze", FOAM_SQUARE], tmp_path)}
-    for name, shape in shapes.items():
-        (tmp_path / f"{name}.yaml").write_text(yaml.safe_dump(
-            {**base, "object": {**base["object"], "shape": shape}}))
-        runs[name] = cli_json(["squeeze", f"{name}.yaml"], tmp_path)
-
-    def seen(run: dict) -> tuple:
-        return (run["mesh"]["boundary"], len(run["events"]),
-                round(100 * run["events"][0]["relative_depth"], 1),
-                round(run["finger_force"]["F1"]["end"], 3))
-    text = page_text("perception.md")
-    as_file = stated("perception.md", r"as an outline file it meshes like the scene's own square "
-                     r"\((\d+) boundary nodes, the same (\d+) new-contact events, final finger "
-                     r"force ([\d.]+) N against ([\d.]+) N: (-?[\d.]+) %\)")
-    as_polygon = stated("perception.md", r"as a polygon its (\d+) vertices give (\d+) boundary "
-                        r"nodes, (\d+) events, the first ones at ([\d.]+) % instead of ([\d.]+) % "
-                        r"relative depth .{0,80}?, and ([\d.]+) N")
-    assert "through the mask, then `squeeze`" in text
-    assert seen(runs["file"])[:2] == seen(runs["scene"])[:2] == tuple(as_file[:2])
-    assert [seen(runs["file"])[3], seen(runs["scene"])[3]] == as_file[2:4]
-    assert round(100 * (as_file[2] / as_file[3] - 1), 1) == as_file[4]
-    assert polygon["vertices"] == len(shapes["polygon"]["points"]) == as_polygon[0]
-    boundary, events, first, force = seen(runs["polygon"])
-    assert [boundary, events, first, seen(runs["scene"])[2], force] == as_polygon[1:]
 
 
 CLI_DEFAULTS = [
@@ -416,80 +288,6 @@ def test_a_default_the_docs_state_is_the_option_s(page, pattern, verb, option, u
         assert float(found.group(1)) * unit == pytest.approx(action.default)
 
 
-@pytest.mark.slow
-def test_where_an_element_inverts_is_where_materials_md_says(tmp_path):
-    """docs/materials.md: ``squeeze --relative-depth 0.95`` of the foam square ends
-    ``element_inverted`` at the relative depths it states (the shipped mesh, linear; a
-    300-node mesh, linear and corotational), and the neo-Hookean one reaches 95 %.
-    """
-    text = page_text("materials.md")
-    assert "`squeeze --relative-depth 0.95`" in text
-    shipped_linear, linear, corotational, reached = stated(
-        "materials.md", r"the shipped linear foam square, 2,054 nodes, at ([\d.]+) % relative "
-        r"depth; on a 300-node mesh of it the linear one at ([\d.]+) %, the corotational one "
-        r"at ([\d.]+) %, and the neo-Hookean one reaches (\d+) % with no element inverted")
-    coarse = shipped("scenes/foam_square.yaml")
-    coarse["object"]["mesh"] = {"nodes": 300, "min_angle": 30}
-    (tmp_path / "coarse.yaml").write_text(yaml.safe_dump(coarse))
-    runs = [(FOAM_SQUARE, "linear"), ("coarse.yaml", "linear"),
-            ("coarse.yaml", "corotational"), ("coarse.yaml", "neo_hookean")]
-    ends = [cli_json(["squeeze", scene, "--model", model, "--relative-depth", "0.95"], tmp_path)
-            for scene, model in runs]
-    assert ends[0]["mesh"]["nodes"] == 2054
-    assert [e["termination"] for e in ends] == ["element_inverted"] * 3 + ["depth_reached"]
-    assert [round(100 * e["relative_depth"], 1) for e in ends] == [
-        shipped_linear, linear, corotational, reached]
-
-
-def test_the_quick_bench_s_force_differences_materials_md_quotes():
-    """docs/materials.md: in ``bench --only material_models --quick`` (400-node meshes) the
-    neo-Hookean foam square's F1 force is +0.25/+1.4/+3.6 % above linear at 2/8/16 % and the
-    corotational one -2.0/-3.9/-8.4 % below: the bench's own set-up and squeezes.
-    """
-    from squeeze_grasp_ros.bench.material_models import _run, _setup
-    from squeeze_grasp_ros.mechanics.vocabulary import Finger, MaterialModel
-
-    found = stated("materials.md", r"in its quick mode \((\d+)-node meshes\) the neo-Hookean "
-                   r"force is \+([\d.]+)/\+([\d.]+)/\+([\d.]+) % above linear on the foam square "
-                   r"at (\d+)/(\d+)/(\d+) % and the corotational one "
-                   r"−([\d.]+)/−([\d.]+)/−([\d.]+) % below")
-    nodes, neo, depths, corotational = int(found[0]), found[1:4], found[4:7], found[7:]
-    setup = _setup("foam_square", nodes)
-
-    def force(model: MaterialModel, depth: float) -> float:
-        return _run(setup, model, depth / 100)[0].finger_force[Finger.F1][1]
-    for k, depth in enumerate(depths):
-        linear = force(MaterialModel.LINEAR, depth)
-        for model, shown, sign in ((MaterialModel.NEO_HOOKEAN, neo[k], 1),
-                                   (MaterialModel.COROTATIONAL, corotational[k], -1)):
-            change = 100 * (force(model, depth) / linear - 1)
-            decimals = len(f"{shown}".partition(".")[2])
-            assert round(sign * change, decimals) == shown, (model, depth, change)
-
-
-@pytest.mark.slow
-def test_the_suite_sizes_the_docs_state_are_the_collected_ones():
-    """README.md and docs/ci.md give the default suite's size (about N tests) and docs/ci.md
-    the slow suite's: within 5 % of what pytest collects now (one collection, 10-20 s).
-    """
-    import subprocess
-    import sys
-
-    done = subprocess.run([sys.executable, "-m", "pytest", "--collect-only", "-q",
-                           "-p", "no:cacheprovider"], cwd=REPO, capture_output=True, text=True,
-                          timeout=600)
-    found = re.search(r"(\d+)/(\d+) tests collected \((\d+) deselected\)", done.stdout)
-    assert found, done.stdout[-2000:]
-    default, slow = int(found.group(1)), int(found.group(3))
-    stated_default = (stated("README.md", r"the default test suite \(about ([\d,]+) tests;")
-                      + stated("ci.md", r"The default suite grew from 562 tests .*? to about "
-                                        r"([\d,]+)"))
-    stated_slow = stated("ci.md", r"The slow suite \(`python -m pytest -m slow`, about "
-                                  r"([\d,]+) tests")
-    assert all(abs(n / default - 1) < 0.05 for n in stated_default), (stated_default, default)
-    assert all(abs(n / slow - 1) < 0.05 for n in stated_slow), (stated_slow, slow)
-
-
 def test_the_ros_setup_tests_ci_md_says_skip_on_the_colcon_route():
     """docs/ci.md: "On the colcon route the N `ros-setup` tests ... skip": the tests of
     test/test_ros_setup.py marked ``pip_route_only``.
@@ -500,50 +298,6 @@ def test_the_ros_setup_tests_ci_md_says_skip_on_the_colcon_route():
     marked = [f.name for f in tree.body if isinstance(f, ast.FunctionDef) and any(
         isinstance(d, ast.Name) and d.id == "pip_route_only" for d in f.decorator_list)]
     assert stated("ci.md", r"On the colcon route the (\d+) `ros-setup` tests") == [len(marked)]
-
-
-def _foam_square_names() -> dict:
-    """What docs/events.md's stepper example leaves free: the shipped foam square's object and
-    its finger nodes.
-    """
-    from squeeze_grasp_ros.api import load_scene, scene_file
-    from squeeze_grasp_ros.scene import GraspSetup
-
-    setup = GraspSetup.build(load_scene(scene_file("foam_square"))).precompute()
-    i, j = setup.contacts
-    return {"obj": setup.solid, "i": int(i), "j": int(j)}
-
-
-def _resist_fig10_names() -> dict:
-    """What docs/resistance.md's API example leaves free, from the Fig. 10 scene: the object,
-    F1's, F2's and A's nodes, the squeeze, its contact model, A's tip radius and push.
-    """
-    from squeeze_grasp_ros.api import load_scene, scene_file
-    from squeeze_grasp_ros.scene import GraspSetup
-
-    setup = GraspSetup.build(load_scene(scene_file("resist_fig10"))).precompute()
-    i, j = setup.contacts
-    return {"obj": setup.solid, "i": int(i), "j": int(j), "k": setup.adversary_node,
-            "squeeze": setup.event_squeeze(), "model": setup.contact_model(terminations=False),
-            "radius": setup.scene.adversary.tip_radius, "a": setup.scene.adversary.a}
-
-
-@pytest.mark.parametrize("page, marker, names", [
-    ("events.md", "advance(", _foam_square_names),
-    ("resistance.md", "optimal_resistance(", _resist_fig10_names)])
-def test_a_python_example_with_free_names_runs_and_returns_what_its_comments_name(
-        page, marker, names):
-    """The API examples of docs/events.md and docs/resistance.md leave the object and its
-    nodes free: bound to a shipped scene's, each runs, and a result whose comment names a
-    class (``res = ...  # Resistance``) is of that class.
-    """
-    block = next(b for b in blocks(REPO / "docs" / page)
-                 if b.language == "python" and marker in "\n".join(b.lines))
-    namespace = names()
-    exec("\n".join(block.lines), namespace)  # noqa: S102 (the repository's own page)
-    typed = re.findall(r"^(\w+) = .*#\s+([A-Z]\w+)\b", "\n".join(block.lines), re.M)
-    assert [(n, type(namespace[n]).__name__) for n, _ in typed] == typed
-    assert len(typed) >= (3 if page == "resistance.md" else 0)
 
 
 def test_the_planner_parameter_table_of_ros_md_is_the_node_s():
@@ -628,38 +382,6 @@ def test_the_run_json_keys_pipeline_md_lists_are_the_summary_s():
     assert len(listed) >= 10 and [k for k in keys if k in listed] == listed, (listed, keys)
 
 
-def test_the_table_5_scenes_succeed_as_ring_md_says(tmp_path):
-    """docs/ring.md's Table 5: each shipped ring scene's ``--map`` at its requested depth, the
-    placements succeeding of all; and the steel heart's own placement (where the strain limit
-    stops it, its fibre strain at 15 %; without the limit, how many placements reach 15 % and
-    how deep this one goes).
-    """
-    page = (REPO / "docs" / "ring.md").read_text(encoding="utf-8")
-    table = page[page.index("| scene | shape | E |"):]
-    rows = [row.strip("|").split(" | ") for row in table[:table.index("\n\n")].splitlines()[2:]]
-    assert len(rows) == 5
-    for row in rows:
-        scene = REPO / "config" / "scenes" / f"{row[0].strip()}.yaml"
-        found = cli_json(["ring", str(scene), "--map"], tmp_path)
-        assert f"{found['feasible_pairs']} of {found['pairs']}" == row[-1].strip(), row[0]
-    heart = REPO / "config" / "scenes" / "ring_heart.yaml"
-    reached, strain, unlimited, deepest = stated(
-        "ring.md", r"the scene's placement reaches `ε\* = 0.005` at ([\d.]+) % relative depth "
-        r"and a ([\d.]+) % fibre strain, small strain, at 15 %\)\. Without the strain limit, "
-        r"friction alone lets (\d+) placements reach 15 %, this one to (\d+) %")
-    single = cli_json(["ring", str(heart)], tmp_path)
-    assert (single["limit"], single["strain_measure"]) == ("strain", "small")
-    assert [round(100 * single["max_relative_depth"], 1),
-            round(100 * single["max_strain"], 1)] == [reached, strain]
-    free = shipped("scenes/ring_heart.yaml")
-    del free["strain_limit"]
-    free["effects"] = ["friction"]
-    (tmp_path / "heart.yaml").write_text(yaml.safe_dump(free))
-    single = cli_json(["ring", "heart.yaml"], tmp_path)
-    assert round(100 * single["max_relative_depth"]) == deepest
-    assert cli_json(["ring", "heart.yaml", "--map"], tmp_path)["feasible_pairs"] == unlimited
-
-
 def test_the_exit_statuses_the_readme_and_the_help_list_are_the_codes():
     """README.md's "Exit status of every verb" and ``squeeze-grasp --help``'s epilog give every
     exit code and no other; docs/sweep.md's status table and ``sweep --help``'s epilog give the
@@ -732,29 +454,6 @@ def test_every_constant_the_docs_name_is_the_package_s():
         r"`([A-Z][A-Z0-9]*_[A-Z0-9_]+)`", page.read_text(encoding="utf-8"))}
     assert len(named) >= 20
     assert [n for n in sorted(named - outside) if not re.search(rf"\b{n}\b", source)] == []
-
-
-def test_the_slip_scene_is_what_grippers_md_says():
-    """docs/grippers.md: the shipped slip scene grips the sponge N mm off its short axis, where
-    the surface leans M degrees from the pads, with its mu; the mechanics API's squeeze ends
-    with a jaw slipping at the depth it states.
-    """
-    import math
-
-    from squeeze_grasp_ros.api import event_squeeze_scene, load_scene, scene_file, scene_solid
-
-    off, lean, mu, depth = stated(
-        "grippers.md", r"The shipped slip scene grips the sponge (\d+) mm off its short axis, "
-        r"where the surface leans (\d+) degrees from the pads, with mu = ([\d.]+): the mechanics "
-        r"API's squeeze ends with a jaw slipping at ([\d.]+) mm of depth")
-    scene = load_scene(scene_file("sponge_gripper_slip"))
-    shape = scene.object.shape
-    x, y = scene.fingers["F2"].placement.point
-    assert (round(1e3 * x), scene.friction.mu) == (off, mu)
-    normal = math.degrees(math.atan2(shape["b"] ** 2 * x, shape["a"] ** 2 * y))
-    assert round(normal) == lean  # the outward normal's tilt from the pads' closing line (y)
-    result = event_squeeze_scene(scene, scene_solid(scene))
-    assert (result.termination, round(1e3 * result.depth, 2)) == ("finger_slip", depth)
 
 
 def test_the_npm_packages_and_caches_the_readme_names_are_the_tests():
@@ -835,29 +534,6 @@ def test_the_controller_manager_examples_of_grippers_md_fit_the_shipped_scenes()
                 k: parallel[k] for k in ("goal_tolerance", "stall_timeout", "max_velocity")}
             assert parameters["max_effort"] == (device["max_force"]
                                                 * device["transmission"]["effort_per_force"])
-
-
-def test_an_outline_file_in_either_orientation_loads_as_scenes_md_says(tmp_path):
-    """docs/scenes.md: an outline file's points may run clockwise; they are taken in reverse.
-    A clockwise and a counter-clockwise CSV of one square give one counter-clockwise outline.
-    """
-    from squeeze_grasp_ros.api import load_scene
-    from squeeze_grasp_ros.mechanics.elastic.shapes import signed_area
-    from squeeze_grasp_ros.scene.build import build_outline
-
-    assert "clockwise points are taken in reverse, as counter-clockwise" in page_text("scenes.md")
-    square = [(0.0, 0.0), (0.05, 0.0), (0.05, 0.05), (0.0, 0.05)]
-    outlines = []
-    for name, points in (("ccw", square), ("cw", square[::-1])):
-        (tmp_path / f"{name}.csv").write_text("".join(f"{x},{y}\n" for x, y in points))
-        scene = shipped("scenes/foam_square.yaml")
-        scene["object"]["shape"] = {"type": "file", "path": f"{name}.csv"}
-        for finger, x in (("F1", 0.0), ("F2", 0.05)):
-            scene["fingers"][finger]["placement"] = {"point": [x, 0.025]}
-        (tmp_path / f"{name}.yaml").write_text(yaml.safe_dump(scene))
-        outlines.append(build_outline(load_scene(tmp_path / f"{name}.yaml").object.shape).points)
-    assert all(signed_area(p) == pytest.approx(0.0025) for p in outlines)
-    assert sorted(map(tuple, outlines[0])) == sorted(map(tuple, outlines[1]))
 
 
 def test_the_api_help_shows_what_the_readme_says():

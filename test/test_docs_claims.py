@@ -604,3 +604,20 @@ def test_every_topic_of_the_pipeline_is_documented_and_the_table_names_real_ones
     rows = table[:table.index("\n\n")].splitlines()[2:]
     named = [t for row in rows for t in re.findall(r"`([^`<>]+)`", row.split(" | ")[0])]
     assert len(named) >= 15 and [t for t in named if t not in topics] == []
+
+
+def test_the_readme_s_ci_line_is_what_ci_runs():
+    """README.md's second quick-start line is "exactly what CI runs, `.ci/run`": its commands
+    are the script's, in order (and CONTRIBUTING.md's set-up line is the same without the
+    tests; docs/ci.md names the same extras).
+    """
+    script = [line for line in (REPO / ".ci" / "run").read_text(encoding="utf-8").splitlines()
+              if line and not line.startswith(("#", "set ", "cd "))]
+    readme = next(b for b in blocks(REPO / "README.md") if b.language == "bash"
+                  and "pytest" in "\n".join(b.lines))
+    assert "exactly what CI runs, `.ci/run`" in readme.before
+    assert [c.strip() for c in " ".join(readme.lines).split("&&")] == script
+    contributing = next(b for b in blocks(REPO / "CONTRIBUTING.md") if b.language == "bash")
+    assert [c.strip() for c in " ".join(contributing.lines).split("&&")] == script[:-1]
+    extras = re.search(r"pip install -e '\.\[([\w,]+)\]'", script[2]).group(1)
+    assert f"`pip install -e '.[{extras}]'`" in page_text("ci.md")

@@ -19,8 +19,8 @@ from doc_transcripts import REPO, blocks
 
 
 def page_text(name: str) -> str:
-    """A page of the docs (``README.md`` or ``docs/NAME``), whitespace normalised."""
-    path = REPO / name if name == "README.md" else REPO / "docs" / name
+    """A page (``README.md``, ``CONTRIBUTING.md`` or ``docs/NAME``), whitespace normalised."""
+    path = REPO / name if name in ("README.md", "CONTRIBUTING.md") else REPO / "docs" / name
     return " ".join(path.read_text(encoding="utf-8").split())
 
 

@@ -621,3 +621,20 @@ def test_the_readme_s_ci_line_is_what_ci_runs():
     assert [c.strip() for c in " ".join(contributing.lines).split("&&")] == script[:-1]
     extras = re.search(r"pip install -e '\.\[([\w,]+)\]'", script[2]).group(1)
     assert f"`pip install -e '.[{extras}]'`" in page_text("ci.md")
+
+
+def test_the_readme_s_pictures_are_schematics_captioned_as_such():
+    """CONTRIBUTING.md: the README's pictures in docs/img/ are hand-drawn schematics, captioned
+    as such beside the command that draws the computed picture: each embedded picture says so
+    in its own description and in the caption under it, which names a ``squeeze-grasp``
+    command or the commands of its section.
+    """
+    readme = (REPO / "README.md").read_text(encoding="utf-8")
+    embedded = re.findall(r"!\[[^\]]*\]\((docs/img/[\w.]+)\)\n\n(\*[^\n]*(?:\n[^\n]+)*)", readme)
+    assert sorted(path for path, _ in embedded) == sorted(
+        f"docs/img/{p.name}" for p in (REPO / "docs" / "img").iterdir())
+    for path, caption in embedded:
+        assert "(hand-drawn, not a result)" in (REPO / path).read_text(encoding="utf-8"), path
+        assert "drawn by hand" in caption and ("squeeze-grasp " in caption
+                                               or "commands below" in caption), caption
+    assert "are hand-drawn schematics, captioned as such" in page_text("CONTRIBUTING.md")

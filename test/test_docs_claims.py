@@ -638,3 +638,23 @@ def test_the_readme_s_pictures_are_schematics_captioned_as_such():
         assert "drawn by hand" in caption and ("squeeze-grasp " in caption
                                                or "commands below" in caption), caption
     assert "are hand-drawn schematics, captioned as such" in page_text("CONTRIBUTING.md")
+
+
+def test_every_named_section_a_page_points_to_exists():
+    """A reference such as ``docs/grippers.md, "The lift"`` or ``docs/design.md §4`` names a
+    heading (or a bold paragraph title) of that page.
+    """
+    checked, missing = 0, []
+    for page in PAGES:
+        flat = " ".join(page.read_text(encoding="utf-8").split())
+        for name, section, number in re.findall(
+                r'(?:docs/)?(\w+)\.md(?:, "([^"]+)"| §(\d+))', flat):
+            target = REPO / "docs" / f"{name}.md"
+            text = target.read_text(encoding="utf-8") if target.exists() else ""
+            found = (re.search(rf"^## {number}\. ", text, re.M) if number else
+                     re.search(rf"^#+ {re.escape(section)}", text, re.M)
+                     or f"**{section}" in " ".join(text.split()))
+            checked += 1
+            if not found:
+                missing.append(f"{page.name}: {name}.md {section or '§' + number}")
+    assert checked >= 25 and missing == [], missing

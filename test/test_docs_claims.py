@@ -658,3 +658,13 @@ def test_every_named_section_a_page_points_to_exists():
             if not found:
                 missing.append(f"{page.name}: {name}.md {section or '§' + number}")
     assert checked >= 25 and missing == [], missing
+
+
+def test_every_bench_section_the_docs_name_is_one():
+    """Each ``bench [--quick] --only SECTION ...`` of the docs names sections of the bench."""
+    from squeeze_grasp_ros.bench import SECTIONS
+
+    named = [s for page in PAGES for run in re.findall(
+        r"bench (?:--quick )?--only ((?:[a-z_]+ ?)+)", page.read_text(encoding="utf-8"))
+        for s in run.split()]
+    assert len(named) >= 50 and sorted(set(named) - set(SECTIONS)) == []

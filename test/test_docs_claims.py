@@ -336,6 +336,9 @@ NODE_DEFAULTS = [
     ("grippers.md", r"less than `joint_slip_ratio` \(([\d.]+)\)", "monitor", "joint_slip_ratio",
      1),
     ("grippers.md", r"its grace of (\d+) cycles later", "executor", "redirect_grace", 1),
+    ("pipeline.md", r"Ticks before `force_min_fraction` \((\d+) %\)", "monitor",
+     "force_min_fraction", 0.01),
+    ("pipeline.md", r"beyond `force_tolerance` \((\d+) %\)", "monitor", "force_tolerance", 0.01),
     ("design.md", r"The world runs at most (\d+) ticks \(a report every \d+\) ahead of the "
      r"recorder", "sim_hardware", "recorder_window", 1),
     ("design.md", r"The world runs at most \d+ ticks \(a report every (\d+)\) ahead of the "

@@ -282,3 +282,17 @@ def test_an_outline_file_in_either_orientation_loads_as_scenes_md_says(tmp_path)
         outlines.append(build_outline(load_scene(tmp_path / f"{name}.yaml").object.shape).points)
     assert all(signed_area(p) == pytest.approx(0.0025) for p in outlines)
     assert sorted(map(tuple, outlines[0])) == sorted(map(tuple, outlines[1]))
+
+
+def test_the_force_curve_pipeline_md_counts_is_the_foam_square_s():
+    """docs/pipeline.md: the planner's event squeeze returns its force curve, "each finger's
+    force along its motion at every accepted point, N on the foam square".
+    """
+    from squeeze_grasp_ros.api import event_squeeze_scene, load_scene, scene_file, scene_solid
+    from squeeze_grasp_ros.control.force_watch import squeeze_forces
+
+    (points,) = stated("pipeline.md", r"each finger's force along its motion at every accepted "
+                                      r"point, (\d+) on the foam square")
+    scene = load_scene(scene_file("foam_square"))
+    curve = squeeze_forces(event_squeeze_scene(scene, scene_solid(scene)))
+    assert len(curve.depths) == points

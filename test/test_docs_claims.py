@@ -671,3 +671,16 @@ def test_every_bench_section_the_docs_name_is_one():
         r"bench (?:--quick )?--only ((?:[a-z_]+ ?)+)", page.read_text(encoding="utf-8"))
         for s in run.split()]
     assert len(named) >= 50 and sorted(set(named) - set(SECTIONS)) == []
+
+
+def test_the_default_taxels_pipeline_md_states_are_the_scene_s():
+    """docs/pipeline.md: "the default 96 taxels over 150°" are ``sensors.taxels`` and
+    ``sensors.taxel_span_deg``'s defaults.
+    """
+    import dataclasses
+
+    from squeeze_grasp_ros.scene.specs import SensorsSpec
+
+    taxels, span = stated("pipeline.md", r"with the default (\d+) taxels over (\d+)°")
+    defaults = {f.name: f.default for f in dataclasses.fields(SensorsSpec)}
+    assert (defaults["taxels"], defaults["taxel_span_deg"]) == (taxels, span)

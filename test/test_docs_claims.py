@@ -684,3 +684,16 @@ def test_the_default_taxels_pipeline_md_states_are_the_scene_s():
     taxels, span = stated("pipeline.md", r"with the default (\d+) taxels over (\d+)°")
     defaults = {f.name: f.default for f in dataclasses.fields(SensorsSpec)}
     assert (defaults["taxels"], defaults["taxel_span_deg"]) == (taxels, span)
+
+
+def test_the_corner_turn_perception_md_states_is_the_outline_file_s():
+    """docs/perception.md: an outline file's vertices are samples of the curve and only turns of
+    more than 20 degrees are kept (as mesh corners): ``shapes._turning_corners``' default.
+    """
+    import inspect
+
+    from squeeze_grasp_ros.mechanics.elastic import shapes
+
+    (turn,) = stated("perception.md", r"only turns of more than (\d+) degrees are kept")
+    default = inspect.signature(shapes._turning_corners).parameters["threshold_deg"].default
+    assert turn == default

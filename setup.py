@@ -65,7 +65,7 @@ setup(
         # squeeze-grasp sweep: Dask distributed runs the tasks, pyarrow writes the Parquet dataset
         "sweep": ["dask[distributed]>=2024.1", "pyarrow>=14"],
         # supernodal Cholesky of the interior tangent (SuiteSparse CHOLMOD through cvxopt,
-        # GPL-3.0): about 5x faster factorisations of large nonlinear objects than QDLDL, in
+        # GPL-3.0): about 4x faster factorisations of large nonlinear objects than QDLDL, in
         # METIS's nested-dissection order (pymetis, MIT)
         "cholmod": ["cvxopt>=1.3", "pymetis>=2023.1"],
         # the linear model's fixed-set Newton compiled (numba: BSD, LLVM-based, wheels for

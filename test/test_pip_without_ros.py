@@ -10,11 +10,14 @@ then runs the CLI verbs in turn; the ROS-only verbs must say what to install.
 from __future__ import annotations
 
 import json
+import re
 import subprocess
 import sys
 from pathlib import Path
 
 SCENES = Path(__file__).resolve().parents[1] / "config" / "scenes"
+EXAMPLES = SCENES.parent / "examples"
+SWEEP = SCENES.parent / "sweeps" / "example.yaml"
 ABSENT = (
     "rclpy",
     "rosidl",
@@ -87,20 +90,38 @@ def test_mechanics_verbs_and_bench_work_without_ros(tmp_path):
         ["graspmap", disk, "--json"],
         ["resist", str(SCENES / "resist_fig9.yaml"), "--json"],
         ["ring", str(SCENES / "ring_ring.yaml"), "--json"],
+        ["gripper-plan", str(SCENES / "sponge_gripper.yaml"), "--count", "2", "--evaluate", "1",
+         "--json"],
+        ["render", foam, "--camera-info", str(EXAMPLES / "camera_top.yaml"), "--camera-pose",
+         "0", "0", "0.5", "3.14159265", "0", "0", "--mask", str(tmp_path / "mask.png"), "--json"],
         ["scene-help"],
+        ["sweep-help"],
+        ["sweep", str(SWEEP), "--dry-run", "--json"],
+        ["sweep", str(SWEEP), "--out", str(tmp_path / "sweep")],
         ["bench", "--quick", "--only", "convergence", "ros_services", "pipeline", "sweep",
          "--out", str(tmp_path / "bench")],
         ["run", foam],
     ]
     report = run_without_ros(runs, tmp_path)
     assert report["leaked"] == []
-    by_verb = {r["argv"][0]: r for r in report["results"]}
-    for verb in ("mesh", "plan", "squeeze", "match", "calibrate", "graspmap", "resist", "ring"):
+    by_verb = {" ".join(r["argv"][:1] + [a for a in r["argv"] if a == "--dry-run"]): r
+               for r in report["results"]}
+    for verb in ("mesh", "plan", "squeeze", "match", "calibrate", "graspmap", "resist", "ring",
+                 "gripper-plan", "render", "sweep --dry-run"):
         result = by_verb[verb]
         assert result["code"] == 0, (verb, result["stderr"])
         assert isinstance(json.loads(result["stdout"]), dict)
     assert json.loads(by_verb["match"]["stdout"])["rms_error"] < 1e-12
     assert by_verb["scene-help"]["code"] == 0 and "object" in by_verb["scene-help"]["stdout"]
+    assert by_verb["sweep-help"]["code"] == 0 and "objects" in by_verb["sweep-help"]["stdout"]
+    sweep = by_verb["sweep"]
+    assert sweep["code"] == 4 and "pip install '.[sweep]'" in sweep["stderr"], sweep["stderr"]
+    # what README.md's pip route says a plain install gives: exactly what ran here
+    readme = " ".join((SCENES.parents[1] / "README.md").read_text(encoding="utf-8").split())
+    listed = readme[readme.index("`pip install .` gives every mechanics verb ("):]
+    listed = re.findall(r"`([\w -]+)`", listed[:listed.index(") and `bench`")])
+    assert sorted(listed) == sorted(
+        v for v in by_verb if v not in ("bench", "run", "sweep")), listed
 
     bench = by_verb["bench"]
     assert bench["code"] == 0, bench["stderr"]

@@ -20,8 +20,9 @@ from squeeze_grasp_ros.outputs import write_atomically
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     """--quick, --only, --large, --out."""
     parser.add_argument("--quick", action="store_true",
-                        help="smaller sizes (every section: 2-6 minutes on two quiet cores, "
-                             "3 times that under load; docs/ci.md)")
+                        help="smaller sizes (every section: about 6 minutes on two quiet "
+                             "cores, 7 right after an install while numba compiles, 3 times "
+                             "that under load; docs/ci.md)")
     parser.add_argument("--only", nargs="+", choices=SECTIONS, metavar="SECTION",
                         help=f"run only these sections ({', '.join(SECTIONS)})")
     parser.add_argument("--large", nargs="?", const=DEFAULT_EVALUATIONS, default=None,

@@ -8,7 +8,8 @@ Run it with ``ros2 run squeeze_grasp_ros outline --ros-args -p camera_pose:="[0.
 - ``camera/mask`` (parameter ``image_topic``): ``sensor_msgs/Image``, ``mono8`` mask (``8UC1``
   read as ``mono8``), or a ``16UC1``/``32FC1`` depth image (the encoding decides);
 - ``camera/camera_info``: ``sensor_msgs/CameraInfo`` (pinhole, plumb-bob), the newest one is
-  used for each image;
+  used for each image (both reliable; ``sensor_qos:=sensor_data`` reads a camera driver that
+  publishes them best effort, which a reliable subscription never matches);
 - ``camera/pose`` (latched ``geometry_msgs/PoseStamped``, optional): the camera's optical
   frame in the plane frame; it replaces the ``camera_pose`` parameter once it arrives, and its
   ``header.frame_id`` must be the node's ``frame_id``: after a refused one, images are refused
@@ -58,6 +59,9 @@ PARAMETERS: dict[str, tuple[Any, str]] = {
     "ambiguous_ratio": (0.8, "refuse a view whose second blob has this fraction of the "
                              "object's area"),
     "qos_depth": (10, "history depth of the image and outline topics"),
+    "sensor_qos": ("reliable", "QoS of the image and camera_info subscriptions: reliable, or "
+                               "sensor_data (best effort, depth 5) for a camera driver that "
+                               "publishes them best effort"),
 }
 """Parameter name -> (typed default, description)."""
 BOUNDS = {"object_height": pipeline.Bound(0.0, unit="m"),
@@ -103,8 +107,11 @@ class OutlineNode(Node):
         """Why the newest camera/pose was refused ("" when it was not)."""
         self.last_error = ""
         depth = p["qos_depth"]
-        self.create_subscription(Image, p["image_topic"], self._image, depth)
-        self.create_subscription(CameraInfo, pipeline.CAMERA_INFO, self._info, depth)
+        # a reliable reader never matches a best-effort writer (a camera driver on sensor-data
+        # QoS): before this parameter, such a camera's images never reached the node
+        camera = pipeline.sensor_qos(p["sensor_qos"], depth)
+        self.create_subscription(Image, p["image_topic"], self._image, camera)
+        self.create_subscription(CameraInfo, pipeline.CAMERA_INFO, self._info, camera)
         self.create_subscription(PoseStamped, pipeline.CAMERA_POSE, self._pose, pipeline.LATCHED)
         self.outline_pub = self.create_publisher(PolygonStamped, pipeline.OUTLINE, depth)
         self.seen_pub = self.create_publisher(SeenOutline, pipeline.SEEN_OUTLINE, depth)

@@ -164,7 +164,7 @@ class ExecutorNode(Node):
         jaws = f"{carried} {list(driver.fingers)} on {driver.topic}, " if driver else ""
         return (f"fingers {self.devices}, {jaws}{clock}, "
                 f"period {self.p['period']} s, max velocity {self.p['max_velocity']} m/s; "
-                f"action {self.resolve_topic_name(pipeline.ACTION)}")
+                f"action {self.action}")
 
     def __init__(self, **kwargs: Any) -> None:
         super().__init__("executor", **kwargs)
@@ -209,7 +209,9 @@ class ExecutorNode(Node):
         # burst unanswered: 10 answers to 30 goals sent at once)
         queues = {f"{kind}_service_qos_profile": pipeline.request_queue(0)
                   for kind in ("goal", "cancel", "result")}
-        self.server = ActionServer(self, ExecuteGrasp, pipeline.ACTION, self._execute,
+        self.action = pipeline.action_name(self, pipeline.ACTION)
+        """The action's fully qualified name (:func:`.pipeline.action_name`)."""
+        self.server = ActionServer(self, ExecuteGrasp, self.action, self._execute,
                                    goal_callback=self._accept_goal,
                                    cancel_callback=self._accept_cancel, **queues)
         self.goal: _Goal | None = None

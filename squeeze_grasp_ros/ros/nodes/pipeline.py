@@ -86,6 +86,22 @@ FORCE_RESIDUAL = "monitor/force_residual"
 PREDICTED_SHAPES = "planner/predicted_shapes"
 
 
+def action_name(node: Node, name: str) -> str:
+    """The fully qualified name an rclpy action server or client of ``node`` takes for
+    ``name``: expanded into the node's namespace, never remapped (rclpy 7.1, Jazzy, applies no
+    remap rule to action names). A rule that would rename it is logged as a warning, naming
+    the name the action keeps; before, the executor's ready line named the remapped name, where
+    no action was.
+    """
+    expanded = node.resolve_topic_name(name, only_expand=True)
+    remapped = node.resolve_topic_name(name)
+    if remapped != expanded:
+        node.get_logger().warning(
+            f"the remap of action {name} to {remapped} is not applied (rclpy remaps no action "
+            f"names): the action is {expanded}; move it with the namespace (__ns) instead")
+    return expanded
+
+
 def device_topic(device: str, stream: str) -> str:
     """``devices/<device>/<stream>`` (stream: setpoint, pose, wrench, tactile)."""
     return f"devices/{device}/{stream}"

@@ -203,10 +203,11 @@ class PlannerNode(Node):
         # 200 goals sent at once got 20 responses (issue 34).
         queues = {f"{kind}_service_qos_profile": services for kind in ("goal", "cancel", "result")}
         self._actions = [
-            ActionServer(self, GraspMapAction, "~/grasp_map", self._execute_grasp_map,
-                         cancel_callback=self._accept_cancel, callback_group=self._group,
-                         **queues),
-            ActionServer(self, EventSqueezeAction, "~/event_squeeze",
+            ActionServer(self, GraspMapAction, pipeline.action_name(self, "~/grasp_map"),
+                         self._execute_grasp_map, cancel_callback=self._accept_cancel,
+                         callback_group=self._group, **queues),
+            ActionServer(self, EventSqueezeAction,
+                         pipeline.action_name(self, "~/event_squeeze"),
                          self._execute_event_squeeze, cancel_callback=self._accept_cancel,
                          callback_group=self._group, **queues),
         ]

@@ -318,18 +318,28 @@ class Bound:
     unit: str = ""
     note: str = ""
 
+    def words(self, value: Any) -> str:
+        """What a value of this range is, for a value of ``value``'s type: the words of
+        :meth:`why` and of ``ros2 param describe`` (its additional constraints).
+
+        >>> Bound(0.0, 90.0, above=True, unit="deg").words(2.0)
+        'a finite number > 0 deg and <= 90 deg'
+        >>> Bound(1).words(10)
+        'an integer >= 1'
+        """
+        kind = "an integer" if isinstance(value, int) else "a finite number"
+        unit = f" {self.unit}" if self.unit else ""
+        upper = f" and <= {self.high:g}{unit}" if self.high < math.inf else ""
+        note = f" ({self.note})" if self.note else ""
+        return f"{kind} {'>' if self.above else '>='} {self.low:g}{unit}{upper}{note}"
+
     def why(self, name: str, value: Any) -> str | None:
         """Why ``value`` is out of this range for parameter ``name``, or None."""
         if (not isinstance(value, bool) and isinstance(value, int | float)
                 and math.isfinite(value) and (value > self.low if self.above
                                               else value >= self.low) and value <= self.high):
             return None
-        kind = "an integer" if isinstance(value, int) else "a finite number"
-        unit = f" {self.unit}" if self.unit else ""
-        upper = f" and <= {self.high:g}{unit}" if self.high < math.inf else ""
-        note = f" ({self.note})" if self.note else ""
-        return (f"parameter '{name}' must be {kind} {'>' if self.above else '>='} "
-                f"{self.low:g}{unit}{upper}{note}, got {value}")
+        return f"parameter '{name}' must be {self.words(value)}, got {value}"
 
 
 TYPE_WORDS = {
@@ -360,6 +370,21 @@ READ_AT_START = "read at start-up: restart the node to change it"
 """The constraint ``ros2 param describe`` shows of a read-only parameter."""
 
 
+def constraints(default: Any, bound: Bound | None, *, read_only: bool) -> str:
+    """The additional constraints ``ros2 param describe`` shows of a parameter: its range
+    (``bound``, in the words of its errors, for a value of ``default``'s type) and
+    :data:`READ_AT_START` when ``read_only``; "" when neither. Before, the ranges the nodes
+    enforce were shown nowhere.
+
+    >>> constraints(0.01, Bound(0.0, above=True, unit="m/s"), read_only=True)
+    'a finite number > 0 m/s; read at start-up: restart the node to change it'
+    >>> constraints(16, Bound(0), read_only=False)
+    'an integer >= 0'
+    """
+    words = [bound.words(default)] if bound else []
+    return "; ".join(words + ([READ_AT_START] if read_only else []))
+
+
 def declare(node: Node, parameters: Mapping[str, tuple[Any, str]], *,
             live: Collection[str] = (), bounds: Mapping[str, Bound] | None = None
             ) -> dict[str, Any]:
@@ -381,7 +406,8 @@ def declare(node: Node, parameters: Mapping[str, tuple[Any, str]], *,
         try:
             node.declare_parameter(name, default, ParameterDescriptor(
                 description=description, dynamic_typing=isinstance(default, float),
-                read_only=read_only, additional_constraints=READ_AT_START if read_only else ""))
+                read_only=read_only, additional_constraints=constraints(
+                    default, (bounds or {}).get(name), read_only=read_only)))
         except InvalidParameterTypeException:
             # rclpy's exception keeps no value: the override it refused is the node's own
             raise wrong_type(name, expected, node._parameter_overrides[name].value) from None

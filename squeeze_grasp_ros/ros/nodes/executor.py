@@ -201,7 +201,10 @@ class ExecutorNode(Node):
                               for f, d in self.devices.items() if f not in jaw_fingers}
         self.status_pub = self.create_publisher(
             ExecutorStatus, pipeline.EXECUTOR_STATUS,
-            pipeline.output_qos(p["qos_depth"], lockstep=p["lockstep"]))
+            pipeline.status_qos(p["qos_depth"], lockstep=p["lockstep"]))
+        if not p["lockstep"]:  # the state a late reader gets before the first goal
+            self.status_pub.publish(messages.executor_status_msg(
+                ExecutorStatus.IDLE, 0.0, "", self.get_clock().now().nanoseconds))
         pose_pub = self.create_publisher(PoseStamped, pipeline.OBJECT_POSE, pipeline.LATCHED)
         pose_pub.publish(pose)
         self.create_subscription(MonitorStatus, pipeline.STATUS, self._status, loop, raw=True)

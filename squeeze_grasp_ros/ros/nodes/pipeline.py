@@ -142,6 +142,16 @@ def output_qos(depth: int, *, lockstep: bool) -> QoSProfile:
     return loop_qos(depth, kept=lockstep)
 
 
+def status_qos(depth: int, *, lockstep: bool) -> QoSProfile:
+    """QoS of the executor's status (its state, published on change): :func:`output_qos` in
+    lockstep; on hardware :data:`LATCHED`, the current state only, which a reader that starts
+    later (``ros2 topic echo``, a dashboard) gets at once. Before, it was volatile on hardware:
+    a late reader got nothing until the state next changed (through a whole hold), and one
+    asking for transient-local durability matched no publisher at all.
+    """
+    return output_qos(depth, lockstep=True) if lockstep else LATCHED
+
+
 def pipeline_topics(devices: Iterable[str], *, hidden: bool = False,
                     camera: bool = False) -> dict[str, str]:
     """Topic (fully qualified) -> type of every topic of a run with ``devices``.

@@ -74,3 +74,54 @@ def test_ros2_param_describe_shows_the_range_each_node_enforces(ros_context: Con
         spin.shutdown()
         for node in (*nodes, user):
             node.destroy_node()
+
+
+def test_the_hardware_recorder_subscribes_no_simulation_topic(ros_context: Context, tmp_path):
+    """``ros2 topic list`` during ``ros2 launch squeeze_grasp_ros hardware.launch.py
+    record:=DIR`` showed ``/clock``, ``/sim/tick``, ``/sim/state``, ``/sim/events``,
+    ``/sim/markers`` and ``/recorder/progress``: the hardware launch's recorder subscribed to the
+    simulated hardware's topics (and recorded them, had a simulation run in the domain) and
+    advertised the lockstep's flow control. Now the launch gives it ``simulation: false``,
+    which leaves those topics out, and a recorder outside lockstep advertises no progress.
+    """
+    import ast
+    import re
+    from pathlib import Path
+
+    from rclpy.parameter import Parameter
+
+    from squeeze_grasp_ros.ros.nodes import pipeline
+    from squeeze_grasp_ros.ros.nodes.recorder import RecorderNode
+
+    repo = Path(__file__).resolve().parents[1]
+    launch = ast.parse((repo / "launch" / "hardware.launch.py").read_text(encoding="utf-8"))
+    [recorder_call] = [c for c in ast.walk(launch) if isinstance(c, ast.Call)
+                       and getattr(c.func, "id", "") == "Node"
+                       and any(k.arg == "name" and getattr(k.value, "value", "") == "recorder"
+                               for k in c.keywords)]
+    parameters = ast.unparse({k.arg: k.value for k in recorder_call.keywords}["parameters"])
+    assert "'simulation': False" in parameters and "HARDWARE" in parameters
+
+    namespace = run_namespace()
+    node = RecorderNode(context=ros_context, cli_args=["--ros-args", "-r", f"__ns:={namespace}"],
+                        parameter_overrides=[
+                            Parameter("output", value=str(tmp_path / "bag")),
+                            Parameter("lockstep", value=False),
+                            Parameter("sensor_qos", value="sensor_data"),
+                            Parameter("simulation", value=False)])
+    try:
+        subscribed = {name for name, _ in node.get_subscriber_names_and_types_by_node(
+            "recorder", namespace)}
+        published = {name for name, _ in node.get_publisher_names_and_types_by_node(
+            "recorder", namespace)}
+        simulated = {f"{namespace}/{name.lstrip('/')}" for name in pipeline.SIMULATION_TOPICS}
+        assert f"{namespace}/{pipeline.STATUS}" in subscribed
+        assert not subscribed & simulated
+        assert f"{namespace}/{pipeline.RECORDER_PROGRESS}" not in published
+        # the hardware launch's ready line docs/ros.md shows says the same count
+        shown = (repo / "docs" / "ros.md").read_text(encoding="utf-8")
+        [count] = re.findall(r"recorder ready: recording (\d+) topics into \S+hw_bag", shown)
+        assert node.ready_summary().startswith(f"recording {count} topics into")
+        node.close()
+    finally:
+        node.destroy_node()

@@ -152,13 +152,18 @@ def status_qos(depth: int, *, lockstep: bool) -> QoSProfile:
     return output_qos(depth, lockstep=True) if lockstep else LATCHED
 
 
+SIMULATION_TOPICS = (CLOCK, TICK, SIM_STATE, SIM_EVENTS, MARKERS)
+"""The recorded topics only the simulated hardware publishes."""
+
+
 def pipeline_topics(devices: Iterable[str], *, hidden: bool = False,
-                    camera: bool = False) -> dict[str, str]:
+                    camera: bool = False, simulation: bool = True) -> dict[str, str]:
     """Topic (fully qualified) -> type of every topic of a run with ``devices``.
 
     ``hidden`` adds the executor action's hidden topics (``.../_action/feedback`` and
     ``.../_action/status``), which rosbag2 too records only when asked; ``camera`` the camera's
-    images, its info and pose, and the monitor's shape residual (scenes with a camera).
+    images, its info and pose, and the monitor's shape residual (scenes with a camera);
+    ``simulation`` False leaves out :data:`SIMULATION_TOPICS` (real hardware).
     """
     types = {
         CLOCK: "rosgraph_msgs/msg/Clock",
@@ -175,6 +180,9 @@ def pipeline_topics(devices: Iterable[str], *, hidden: bool = False,
         EXECUTOR_STATUS: "squeeze_grasp_interfaces/msg/ExecutorStatus",
         OBJECT_POSE: "geometry_msgs/msg/PoseStamped",
     }
+    if not simulation:
+        for name in SIMULATION_TOPICS:
+            del types[name]
     if hidden:
         types[f"{ACTION}/_action/feedback"] = \
             "squeeze_grasp_interfaces/action/ExecuteGrasp_FeedbackMessage"

@@ -125,3 +125,22 @@ def test_the_hardware_recorder_subscribes_no_simulation_topic(ros_context: Conte
         node.close()
     finally:
         node.destroy_node()
+
+
+def test_every_number_and_vector_field_of_the_interfaces_says_its_unit():
+    """``ros2 interface show`` prints a field's trailing comment: a float or vector field
+    without one (``relative_depth`` of MonitorStatus, ContactEvent and ExecuteGrasp's result and
+    feedback, ``poisson_ratio`` of ObjectModel) left its unit, or that it has none, unsaid.
+    """
+    import re
+    from pathlib import Path
+
+    field = re.compile(r"^(float32|float64|geometry_msgs/(?:Vector3|Point|Pose)\w*)(\[\])? "
+                       r"(\w+)\s*(#.*)?$")
+    bare = []
+    for path in sorted((Path(__file__).resolve().parents[1] / "msg_defs").glob("*/*.*")):
+        for number, line in enumerate(path.read_text(encoding="utf-8").splitlines(), 1):
+            match = field.match(line)
+            if match and not (match.group(4) or "").strip("# "):
+                bare.append(f"{path.name}:{number} {match.group(3)}")
+    assert bare == []

@@ -6,6 +6,7 @@ of its names under namespaces and remaps (``ros2 run ... --ros-args -r``), and w
 """
 from __future__ import annotations
 
+import pytest
 from rclpy.action import get_action_names_and_types
 from rclpy.context import Context
 
@@ -144,3 +145,65 @@ def test_every_number_and_vector_field_of_the_interfaces_says_its_unit():
             if match and not (match.group(4) or "").strip("# "):
                 bare.append(f"{path.name}:{number} {match.group(3)}")
     assert bare == []
+
+
+TOPIC_PARAMETERS = [
+    ("outline", "OutlineNode", {"image_topic": "cam-mask"},
+     "parameter 'image_topic': 'cam-mask' is a topic name ROS refuses: topic name must not "
+     "contain characters other than alphanumerics, '_', '~', '{', or '}'"),
+    ("executor", "ExecutorNode", {"finger_devices": ["F1:left-jaw", "F2:right_jaw"]},
+     "parameter 'finger_devices': device 'left-jaw' gives the topic name "
+     "'devices/left-jaw/setpoint', which ROS refuses: topic name must not contain characters"),
+    ("monitor", "MonitorNode", {"finger_devices": ["F1:left jaw", "F2:right_jaw"]},
+     "parameter 'finger_devices': device 'left jaw' gives the topic name "
+     "'devices/left jaw/setpoint', which ROS refuses"),
+    ("recorder", "RecorderNode", {"devices": ["2jaw"]},
+     "parameter 'devices': device '2jaw' gives the topic name 'devices/2jaw/setpoint', which ROS "
+     "refuses: topic name token must not start with a number"),
+    ("recorder", "RecorderNode", {"extra_topics": ["joint-states sensor_msgs/msg/JointState"]},
+     "parameter 'extra_topics': 'joint-states' is a topic name ROS refuses"),
+    ("planner", "PlannerNode", {"frame_pose_topic": "table-pose", "frame_pose_frame": "table"},
+     "parameter 'frame_pose_topic': 'table-pose' is a topic name ROS refuses"),
+]
+"""(module, node class, parameters, the refusal) of a topic name ROS refuses in a parameter."""
+
+
+@pytest.mark.parametrize("module, node, values, said", TOPIC_PARAMETERS)
+def test_a_topic_name_ros_refuses_is_refused_by_parameter(ros_context: Context, tmp_path,
+                                                          module, node, values, said):
+    """``image_topic:=cam-mask``, a device ``left-jaw`` and the like ended the node with
+    rclpy's InvalidTopicNameException traceback (exit 1), naming no parameter, when it created
+    the publisher or subscription; now the parameter is refused by name with rcl's reason.
+    """
+    import importlib
+
+    from rclpy.parameter import Parameter
+
+    from squeeze_grasp_ros.ros.nodes import ParameterError
+
+    factory = getattr(importlib.import_module(f"squeeze_grasp_ros.ros.nodes.{module}"), node)
+    overrides = [Parameter(name, value=value) for name, value in values.items()]
+    if module == "recorder":
+        overrides.append(Parameter("output", value=str(tmp_path / "bag")))
+    with pytest.raises(ParameterError) as refused:
+        factory(context=ros_context, parameter_overrides=overrides)
+    assert said in str(refused.value)
+
+
+def test_a_node_process_given_a_device_ros_cannot_name_exits_2_with_one_line():
+    """``ros2 run squeeze_grasp_ros executor --ros-args -p "finger_devices:=['F1:left-jaw',
+    'F2:b']"`` printed a traceback and ``[ros2run]: Process exited with failure 1``.
+    """
+    import subprocess
+
+    from executables import script
+
+    out = subprocess.run([script("executor"), "--ros-args", "-p",
+                          "finger_devices:=['F1:left-jaw', 'F2:b']"], capture_output=True,
+                         text=True, timeout=120, stdin=subprocess.DEVNULL)
+    assert out.returncode == 2, out.stderr
+    assert "Traceback" not in out.stderr
+    assert out.stderr.strip().splitlines() == [
+        "executor: error: parameter 'finger_devices': device 'left-jaw' gives the topic name "
+        "'devices/left-jaw/setpoint', which ROS refuses: topic name must not contain characters "
+        "other than alphanumerics, '_', '~', '{', or '}'"]

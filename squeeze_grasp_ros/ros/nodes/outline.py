@@ -110,7 +110,8 @@ class OutlineNode(Node):
         # a reliable reader never matches a best-effort writer (a camera driver on sensor-data
         # QoS): before this parameter, such a camera's images never reached the node
         camera = pipeline.sensor_qos(p["sensor_qos"], depth)
-        self.create_subscription(Image, p["image_topic"], self._image, camera)
+        self.create_subscription(Image, pipeline.check_topic("image_topic", p["image_topic"]),
+                                 self._image, camera)
         self.create_subscription(CameraInfo, pipeline.CAMERA_INFO, self._info, camera)
         self.create_subscription(PoseStamped, pipeline.CAMERA_POSE, self._pose, pipeline.LATCHED)
         self.outline_pub = self.create_publisher(PolygonStamped, pipeline.OUTLINE, depth)

@@ -244,13 +244,55 @@ def round_trip(messages: Sequence[tuple[str, bytes]]) -> Callable[[], None]:
     return convert
 
 
+def check_topic(parameter: str, topic: str, *, device: str | None = None) -> str:
+    """``topic``, a topic name taken from parameter ``parameter`` (made from its ``device``,
+    if given), if ROS takes it as a name.
+
+    Before, a name ROS refuses (``image_topic:=cam-mask``, a device ``left-jaw``) ended the
+    node with rclpy's traceback and exit status 1 when the node created its publisher or
+    subscription.
+
+    Raises
+    ------
+    ParameterError
+        Naming the parameter, its value and rcl's reason.
+
+    >>> check_topic("image_topic", "camera/mask")
+    'camera/mask'
+    >>> check_topic("image_topic", "cam-mask")
+    Traceback (most recent call last):
+    ...
+    squeeze_grasp_ros.ros.nodes.ParameterError: parameter 'image_topic': 'cam-mask' is a ...
+    """
+    error = rclpy_implementation.rclpy_get_validation_error_for_topic_name(topic)
+    if error is None:
+        return topic
+    what = (f"device {device!r} gives the topic name {topic!r}, which ROS refuses"
+            if device is not None else f"{topic!r} is a topic name ROS refuses")
+    raise ParameterError(f"parameter '{parameter}': {what}: {error[0]}")
+
+
+def check_devices(parameter: str, devices: Iterable[str]) -> None:
+    """Refuse (:func:`check_topic`) a device of parameter ``parameter`` whose topics
+    (:func:`device_topic`) ROS refuses as names.
+
+    >>> check_devices("devices", ["barrett_f1", "2jaw"])
+    Traceback (most recent call last):
+    ...
+    squeeze_grasp_ros.ros.nodes.ParameterError: parameter 'devices': device '2jaw' gives ...
+    """
+    for device in devices:
+        check_topic(parameter, device_topic(device, "setpoint"), device=device)
+
+
 def parse_mapping(entries: Sequence[str], what: str) -> dict[str, str]:
     """``["F1:barrett_f1", ...]`` -> {"F1": "barrett_f1", ...}.
 
     Raises
     ------
     ValueError
-        For an entry without exactly one ':' or a repeated key.
+        For an entry without exactly one ':' or a repeated key, or a device that gives no
+        valid topic name (:func:`check_devices`).
     """
     out: dict[str, str] = {}
     for entry in entries:
@@ -258,6 +300,7 @@ def parse_mapping(entries: Sequence[str], what: str) -> dict[str, str]:
         if not sep or not key or not value or ":" in value or key in out:
             raise ValueError(f"{what}: expected distinct 'finger:device' entries, got {entry!r}")
         out[key] = value
+    check_devices(what, out.values())
     return out
 
 

@@ -129,6 +129,8 @@ class RecorderNode(Node):
         custom = yaml.safe_load(p["custom_data"]) or {}
         self.writer = BagWriter(p["output"], p["compression"], p["chunk_size"],
                                 {str(k): str(v) for k, v in custom.items()})
+        pipeline.check_devices("devices", p["devices"])
+        pipeline.check_devices("silent_setpoints", [d for d in p["silent_setpoints"] if d])
         topics = pipeline.pipeline_topics(p["devices"], hidden=p["include_hidden_topics"],
                                           camera=p["camera"], simulation=p["simulation"])
         self.sources = {name: name.lstrip("/") for name in topics}
@@ -139,6 +141,7 @@ class RecorderNode(Node):
         for entry in p["extra_topics"]:
             if entry.strip():
                 name, type_name = entry.split()
+                pipeline.check_topic("extra_topics", name)
                 recorded = name if name.startswith("/") else "/" + name
                 topics[recorded] = type_name
                 self.sources[recorded] = name
@@ -162,7 +165,8 @@ class RecorderNode(Node):
         camera = {"/" + t for t in (pipeline.CAMERA_MASK, pipeline.CAMERA_DEPTH,
                                     pipeline.CAMERA_INFO)}
         sensors = {name for name in topics if name.rsplit("/", 1)[-1] in pipeline.STREAMS}
-        extra_loop = [t for t in p["lockstep_topics"] if t.strip()]
+        extra_loop = [pipeline.check_topic("lockstep_topics", t) for t in p["lockstep_topics"]
+                      if t.strip()]
         kept = ({"/" + t.lstrip("/") for t in [*pipeline.loop_topics(p["devices"]), *extra_loop,
                                                *pipeline.RECORDED_OUTPUTS]}
                 if p["lockstep"] else set())

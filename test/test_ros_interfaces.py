@@ -207,3 +207,44 @@ def test_a_node_process_given_a_device_ros_cannot_name_exits_2_with_one_line():
         "executor: error: parameter 'finger_devices': device 'left-jaw' gives the topic name "
         "'devices/left-jaw/setpoint', which ROS refuses: topic name must not contain characters "
         "other than alphanumerics, '_', '~', '{', or '}'"]
+
+
+def test_a_hardware_monitor_without_readings_says_so(ros_context: Context):
+    """``ros2 topic echo /monitor/status`` of a hardware monitor that has had no reading showed
+    the alarm message ``newest F1 reading is inf ms old``; now ``no F1 reading yet`` (the value
+    stays inf, the status's sensor age 1e300, as the interface comments now say).
+    """
+    import time
+
+    import rclpy
+    from rclpy.executors import SingleThreadedExecutor
+    from rclpy.parameter import Parameter
+
+    from squeeze_grasp_interfaces.msg import MonitorStatus
+    from squeeze_grasp_ros.ros.messages import UNSEEN_AGE
+    from squeeze_grasp_ros.ros.nodes import pipeline
+    from squeeze_grasp_ros.ros.nodes.monitor import MonitorNode
+
+    args = ["--ros-args", "-r", f"__ns:={run_namespace()}"]
+    node = MonitorNode(context=ros_context, cli_args=args, parameter_overrides=[
+        Parameter("lockstep", value=False), Parameter("sensor_qos", value="sensor_data")])
+    reader = rclpy.create_node("status_reader", context=ros_context, cli_args=args)
+    got: list[MonitorStatus] = []
+    reader.create_subscription(MonitorStatus, pipeline.STATUS, got.append, 10)
+    spin = SingleThreadedExecutor(context=ros_context)
+    for n in (node, reader):
+        spin.add_node(n)
+    try:
+        deadline = time.monotonic() + 30
+        while not got:
+            assert time.monotonic() < deadline, "no monitor status within 30 s"
+            spin.spin_once(0.05)
+        status = got[0]
+        assert list(status.sensor_age) == [UNSEEN_AGE, UNSEEN_AGE]
+        assert [(a.type, a.finger, a.message) for a in status.alarms] == [
+            ("stale_sensor", "F1", "no F1 reading yet"),
+            ("stale_sensor", "F2", "no F2 reading yet")]
+    finally:
+        spin.shutdown()
+        for n in (node, reader):
+            n.destroy_node()

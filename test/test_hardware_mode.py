@@ -247,8 +247,10 @@ def test_a_reader_that_starts_late_gets_the_executors_current_state():
         assert [(s.state, s.message) for s in late_reader()] == [(ExecutorStatus.IDLE, "")]
         result = rig.squeeze()
         assert result.termination == ExecuteGrasp.Result.DEPTH_REACHED, result.message
-        assert [(s.state, s.message) for s in late_reader()] == [
-            (ExecutorStatus.IDLE, result.message)]
+        late = late_reader()
+        assert [(s.state, s.message) for s in late] == [(ExecutorStatus.IDLE, result.message)]
+        # the status's depth is the measured one (ExecutorStatus.msg said "commanded")
+        assert late[0].depth == result.depth
     finally:
         for node in readers:
             rig.spin.remove_node(node)

@@ -176,5 +176,5 @@ def invalid_goal_result(message: str) -> ExecuteGrasp.Result:
 
 
 def executor_status_msg(state: str, depth: float, message: str, ns: int) -> ExecutorStatus:
-    """``ExecutorStatus`` of the executor (depth: commanded or measured, m)."""
+    """``ExecutorStatus`` of the executor (depth: the squeeze's measured depth, m)."""
     return ExecutorStatus(header=header(ns), state=state, depth=float(depth), message=message)

@@ -322,7 +322,8 @@ class ExecutorNode(Node):
 
     async def _run_goal(self, handle: ServerGoalHandle) -> ExecuteGrasp.Result:
         goal = messages.grasp_goal(handle.request)
-        problem = goal_problem(goal, list(self.devices))
+        problem = (messages.goal_msg_problem(handle.request)
+                   or goal_problem(goal, list(self.devices)))
         if problem is None and self.jaws is not None:
             problem = self.jaws.effort_problem(goal)
         if problem is not None:

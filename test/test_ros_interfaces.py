@@ -248,3 +248,43 @@ def test_a_hardware_monitor_without_readings_says_so(ros_context: Context):
         spin.shutdown()
         for n in (node, reader):
             n.destroy_node()
+
+
+def test_a_remapped_lockstep_input_still_makes_the_node_ready(ros_context: Context):
+    """``ros2 run squeeze_grasp_ros executor --ros-args -r monitor/status:=...`` (and the
+    monitor so remapped) never answered the simulated hardware's hello, so the lockstep never
+    started: its readiness counted the publishers of ``monitor/status`` by the name before the
+    remap (rclpy's ``count_publishers`` applies no remap rule). Now the executor is ready once
+    its remapped input has a publisher.
+    """
+    import time
+
+    import rclpy
+    from geometry_msgs.msg import PoseStamped
+    from rclpy.executors import SingleThreadedExecutor
+
+    from squeeze_grasp_interfaces.msg import MonitorStatus
+    from squeeze_grasp_ros.ros.nodes import pipeline
+    from squeeze_grasp_ros.ros.nodes.executor import ExecutorNode
+
+    namespace = run_namespace()
+    status = f"{namespace}/remapped_status"
+    node = ExecutorNode(context=ros_context, cli_args=[
+        "--ros-args", "-r", f"__ns:={namespace}", "-r", f"{pipeline.STATUS}:={status}"])
+    peer = rclpy.create_node("monitor_like", context=ros_context, namespace=namespace)
+    peer.create_publisher(MonitorStatus, status, pipeline.loop_qos(10))
+    for device in ("barrett_f1", "barrett_f3"):  # the driver side of the executor's outputs
+        peer.create_subscription(PoseStamped, pipeline.device_topic(device, "setpoint"),
+                                 lambda _: None, pipeline.loop_qos(10))
+    spin = SingleThreadedExecutor(context=ros_context)
+    for n in (node, peer):
+        spin.add_node(n)
+    try:
+        deadline = time.monotonic() + 20
+        while not node.participant.ready():
+            assert time.monotonic() < deadline, "the executor never became ready"
+            spin.spin_once(0.05)
+    finally:
+        spin.shutdown()
+        for n in (node, peer):
+            n.destroy_node()

@@ -602,7 +602,8 @@ def prediction_ready(node: Node, *, seen: bool, awaited: bool) -> bool:
     ready without the prediction and judged the first cycles against none. So a caller that
     knows a prediction comes (``run`` publishes it before its nodes start) sets ``awaited``.
     """
-    return seen or (not awaited and node.count_publishers(PREDICTION) == 0)
+    return seen or (not awaited
+                    and node.count_publishers(node.resolve_topic_name(PREDICTION)) == 0)
 
 
 class Participant:
@@ -625,7 +626,10 @@ class Participant:
                  condition: Callable[[], bool] | None = None) -> None:
         self.node = node
         self.name = name
-        self.inputs = list(inputs)
+        # resolved with the node's remap rules: rclpy's count_publishers applies none, so a
+        # remapped input (-r monitor/status:=...) was looked for under its old name and the
+        # node never became ready (the lockstep never started)
+        self.inputs = [node.resolve_topic_name(t) for t in inputs]
         self.outputs = list(outputs)
         self.condition = condition
         self._ready = node.create_publisher(String, READY, loop_qos(10))

@@ -206,7 +206,8 @@ class RecorderNode(Node):
         return [qos_dict(name("history", q.history), q.depth, name("reliability", q.reliability),
                          name("durability", q.durability))
                 for q in (i.qos_profile
-                          for i in self.get_publishers_info_by_topic(self.sources[topic]))]
+                          for i in self.get_publishers_info_by_topic(
+                              self.resolve_topic_name(self.sources[topic])))]
 
     def _record(self, topic: str, data: bytes) -> None:
         ns = (messages.cdr_stamp_ns(data) if self.stamped[topic]

@@ -332,6 +332,12 @@ class PlannerNode(Node):
                     self.cache, source, goal.object_id, goal.solver_route, self.limits,
                     lambda stage, index, count, nodes: report(stage, index, stages, nodes),
                     goal.replace)
+            elif not goal.object_id:  # before: "unknown object_id '': load it first with
+                # load_object", though this action loads a scene itself
+                raise planning.PlannerError(
+                    ErrorCode.INVALID_ARGUMENT,
+                    "give scene_yaml or scene_path (the action loads it), or the object_id of "
+                    "a loaded object")
             else:
                 loaded = self._object(goal)
             report("grasp map", stages - 1, stages, loaded.num_nodes)

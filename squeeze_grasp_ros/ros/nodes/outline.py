@@ -106,6 +106,11 @@ class OutlineNode(Node):
         self.pose_refused = ""
         """Why the newest camera/pose was refused ("" when it was not)."""
         self.last_error = ""
+        self.logged: dict[str, str] = {}
+        """Stream (``camera_info``, ``camera/pose``, ``image``) -> the reason last logged for
+        it: each stream's refusals are logged once until they change. With one "last reason"
+        for all, a refused camera_info and the images it left unusable alternated, and every
+        message logged a line."""
         depth = p["qos_depth"]
         # a reliable reader never matches a best-effort writer (a camera driver on sensor-data
         # QoS): before this parameter, such a camera's images never reached the node
@@ -128,9 +133,10 @@ class OutlineNode(Node):
         try:
             self.camera, self.camera_frame = camera_model(msg), msg.header.frame_id
             self.camera_refused = ""
+            self.logged.pop("camera_info", None)
         except InvalidInputError as error:
             self.camera, self.camera_refused = None, str(error)
-            self._refuse(msg.header.stamp, self.camera_refused)
+            self._refuse(msg.header.stamp, self.camera_refused, stream="camera_info")
 
     def _pose(self, msg: PoseStamped) -> None:
         if msg.header.frame_id != self.p["frame_id"]:
@@ -142,7 +148,9 @@ class OutlineNode(Node):
             except InvalidInputError as error:
                 self.pose_refused = f"camera/pose: {error}"
         if self.pose_refused:  # the camera may have moved: no outline until a usable pose
-            self._refuse(msg.header.stamp, self.pose_refused)
+            self._refuse(msg.header.stamp, self.pose_refused, stream="camera/pose")
+        else:
+            self.logged.pop("camera/pose", None)
 
     def _image(self, msg: Image) -> None:
         if self.camera is None:
@@ -174,6 +182,7 @@ class OutlineNode(Node):
             self._refuse(msg.header.stamp, str(error))
             return
         self.last_error = ""
+        self.logged.pop("image", None)
         out = messages.seen_outline_msg(
             seen.outline, frame_id=seen.frame_id, ns=messages.stamp_ns(msg.header.stamp),
             encoding=seen.encoding, plane_height=seen.plane_height,
@@ -183,13 +192,16 @@ class OutlineNode(Node):
         self.outline_pub.publish(out.outline)
         self.seen_pub.publish(out)
 
-    def _refuse(self, stamp: Any, reason: str) -> None:
-        """Publish ``reason`` on outline/errors; log it when it differs from the last one."""
+    def _refuse(self, stamp: Any, reason: str, *, stream: str = "image") -> None:
+        """Publish ``reason`` on outline/errors; log it when it differs from the last one
+        logged for ``stream`` (:attr:`logged`).
+        """
         ns = messages.stamp_ns(stamp)
         self.error_pub.publish(String(data=f"{ns * 1e-9:.6f} s: {reason}"))
-        if reason != self.last_error:
+        self.last_error = reason
+        if self.logged.get(stream) != reason:
             self.get_logger().warning(f"no outline: {reason}")
-            self.last_error = reason
+            self.logged[stream] = reason
 
 
 def main(args: list[str] | None = None) -> int:

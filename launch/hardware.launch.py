@@ -55,7 +55,8 @@ def generate_launch_description() -> LaunchDescription:
                          {"use_sim_time": False, "lockstep": False}], output="screen",
              on_exit=required("executor")),
         Node(package="squeeze_grasp_ros", executable="recorder", name="recorder",
-             parameters=[str(config / "recorder.yaml"), HARDWARE, {"output": record}],
+             parameters=[str(config / "recorder.yaml"), HARDWARE,
+                         {"output": record, "simulation": False}],
              condition=IfCondition(NotEqualsSubstitution(record, "")), output="screen",
              on_exit=required("recorder")),
     ])

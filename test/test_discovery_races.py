@@ -123,7 +123,7 @@ def test_an_executor_under_a_gripper_action_is_ready_only_with_its_action_server
         spin.executor.spin_once(timeout_sec=0.5)
         assert not executor.participant.ready()
         answered = []
-        executor.jaw_action.send(0.4, 3.0, lambda: answered.append(True))
+        executor.jaw_action.send(0.4, 3.0, lambda: answered.append(True), at_ns=0)
         assert answered == [True]
         termination, success, message = executor.jaw_action.outcome
         assert (termination, success) == ("gripper_rejected", False)

@@ -150,6 +150,8 @@ GARBAGE = [
     ("pure_directions", {"on_slip_alarm": "pure"}),
     ("resqueeze_margin", {"on_slip_alarm": "resqueeze", "resqueeze_margin": 1.5}),
     ("release_clearance", {"on_slip_alarm": "resqueeze", "release_clearance": -math.inf}),
+    # resist without an adversary: before, the squeeze ran alone and ended depth_reached
+    ("adversary", {"resist": True}),
     ("adversary", {"resist": True, "adversary": "F2"}),
     ("adversary", {"resist": True, "adversary": "z" * 1_000_000}),
     # finite but beyond MAX_TRAVEL: before, 1e308 was accepted and its first cycle raised

@@ -218,6 +218,46 @@ def test_the_executor_drives_an_outside_jtc_in_wall_time(capfd):
     assert "pose readings put the pad faces" not in capfd.readouterr().err
 
 
+def test_a_reader_that_starts_late_gets_the_executors_current_state():
+    """``ros2 topic echo --once /executor/status`` started after a goal (or before the first)
+    never printed on hardware: the status was volatile, and only published on a change (with
+    ``--qos-durability transient_local`` it matched no publisher). Now the executor publishes
+    its state at start and keeps the current one for late readers.
+    """
+    from rclpy.qos import DurabilityPolicy, QoSProfile
+
+    from squeeze_grasp_interfaces.msg import ExecutorStatus
+
+    rig = Rig(SCENE, Joint(OPEN))
+    readers: list[Node] = []
+
+    def late_reader() -> list[ExecutorStatus]:
+        got: list[ExecutorStatus] = []
+        node = Node(f"late_reader_{len(readers)}", context=rig.context)
+        node.create_subscription(ExecutorStatus, pipeline.EXECUTOR_STATUS, got.append,
+                                 QoSProfile(depth=10,
+                                            durability=DurabilityPolicy.TRANSIENT_LOCAL))
+        readers.append(node)
+        rig.spin.add_node(node)
+        rig.spin_until(lambda: got)
+        rig.spin_until(lambda: False, timeout=0.3)  # anything else kept would arrive meanwhile
+        return got
+
+    try:
+        assert [(s.state, s.message) for s in late_reader()] == [(ExecutorStatus.IDLE, "")]
+        result = rig.squeeze()
+        assert result.termination == ExecuteGrasp.Result.DEPTH_REACHED, result.message
+        late = late_reader()
+        assert [(s.state, s.message) for s in late] == [(ExecutorStatus.IDLE, result.message)]
+        # the status's depth is the measured one (ExecutorStatus.msg said "commanded")
+        assert late[0].depth == result.depth
+    finally:
+        for node in readers:
+            rig.spin.remove_node(node)
+            node.destroy_node()
+        rig.close()
+
+
 def test_an_inactive_jtc_ends_the_grasp_gripper_stalled_after_stall_timeout():
     """A JointTrajectoryController loaded but not active drops every trajectory: the joint
     stays open. Before, the grasp goal went on "squeezing" at depth 0 for ever (70 s here

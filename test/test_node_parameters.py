@@ -143,7 +143,8 @@ def test_ros2_param_set_on_running_nodes(ros_context: Context) -> None:
         future = to_monitor.describe_parameters(["alarm_ratio"])
         executor.spin_until_future_complete(future, timeout_sec=TIMEOUT)
         described = future.result().descriptors[0]
-        assert described.read_only and described.additional_constraints == READ_AT_START
+        assert described.read_only
+        assert described.additional_constraints == f"a finite number > 0; {READ_AT_START}"
         assert described.type == ParameterType.PARAMETER_DOUBLE
     finally:
         for node in (planner, monitor, user):

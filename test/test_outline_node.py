@@ -247,6 +247,37 @@ def test_images_after_a_refused_camera_info_say_why(ros_context):
         node.destroy_node()
 
 
+def test_a_refused_camera_info_and_the_images_it_leaves_unusable_log_once(ros_context, capfd):
+    """Seen with ``ros2 topic pub -r 2`` of a camera_info the node refuses and of a mask: each
+    camera_info logged its refusal and each image "no usable camera_info: ...", alternating
+    for ever (one "last reason" for all streams); now each stream logs once until its reason
+    changes, while every refusal still goes to ``outline/errors``.
+    """
+    from rclpy.parameter import Parameter
+
+    from squeeze_grasp_ros.ros.messages.images import camera_info_msg, image_msg
+    from squeeze_grasp_ros.ros.nodes.outline import OutlineNode
+
+    node = OutlineNode(context=ros_context, parameter_overrides=[
+        Parameter("camera_pose", value=[0.0, 0.0, 0.5, np.pi, 0.0, 0.0])])
+    errors = []
+    node.error_pub.publish = errors.append
+    empty = np.zeros((CAMERA.height, CAMERA.width), np.uint8)
+    try:
+        capfd.readouterr()
+        for k in range(3):
+            info = camera_info_msg(CAMERA, 2 * k)
+            info.k[0] = 0.0
+            node._info(info)
+            node._image(image_msg(empty, ImageEncoding.MONO8, 2 * k + 1, CAMERA.frame_id))
+        logged = [line for line in capfd.readouterr().err.splitlines() if "no outline:" in line]
+        assert len(errors) == 6 and len(logged) == 2, logged
+        assert "camera fx must be a positive focal length" in logged[0]
+        assert "no usable camera_info: the newest was refused" in logged[1]
+    finally:
+        node.destroy_node()
+
+
 def test_images_after_a_refused_camera_pose_are_refused_until_a_usable_one(ros_context):
     """A camera/pose in another frame (or not a rotation) was refused once, and the images
     after it were read with the last pose, though the camera may have moved; now they are
@@ -281,4 +312,49 @@ def test_images_after_a_refused_camera_pose_are_refused_until_a_usable_one(ros_c
         node._image(image_msg(views.mask, ImageEncoding.MONO8, 5_000, CAMERA.frame_id))
         assert len(seen) == 1 and node.last_error == ""
     finally:
+        node.destroy_node()
+
+
+def test_sensor_qos_reads_a_camera_that_publishes_best_effort(ros_context):
+    """A camera driver on sensor-data QoS (best effort) never reached the node: its subscriptions
+    were reliable, which no best-effort publisher matches (rclpy warned "offering incompatible
+    QoS", and nothing came). With ``sensor_qos:=sensor_data`` its camera_info and images arrive.
+    """
+    skimage_or_skip()
+    import rclpy
+    from rclpy.executors import SingleThreadedExecutor
+    from rclpy.parameter import Parameter
+    from rclpy.qos import ReliabilityPolicy, qos_profile_sensor_data
+    from sensor_msgs.msg import CameraInfo, Image
+    from std_msgs.msg import String
+
+    from squeeze_grasp_ros.ros.messages.images import camera_info_msg, image_msg
+    from squeeze_grasp_ros.ros.nodes.outline import OutlineNode
+
+    node = OutlineNode(context=ros_context, parameter_overrides=[
+        Parameter("camera_pose", value=[0.0, 0.0, 0.5, np.pi, 0.0, 0.0]),
+        Parameter("sensor_qos", value="sensor_data")])
+    client = rclpy.create_node("best_effort_camera", context=ros_context)
+    executor = SingleThreadedExecutor(context=ros_context)
+    for n in (node, client):
+        executor.add_node(n)
+    errors: list = []
+    client.create_subscription(String, "outline/errors", errors.append, 10)
+    images = client.create_publisher(Image, "camera/mask", qos_profile_sensor_data)
+    infos = client.create_publisher(CameraInfo, "camera/camera_info", qos_profile_sensor_data)
+    try:
+        for topic in ("camera/mask", "camera/camera_info"):
+            (info,) = node.get_subscriptions_info_by_topic(topic)
+            assert info.qos_profile.reliability == ReliabilityPolicy.BEST_EFFORT
+        deadline = time.monotonic() + 30
+        empty = np.zeros((CAMERA.height, CAMERA.width), np.uint8)
+        while not any("no object" in e.data for e in errors):  # read with a camera_info
+            assert time.monotonic() < deadline, "the best-effort camera never reached the node"
+            infos.publish(camera_info_msg(CAMERA, 1_000))
+            images.publish(image_msg(empty, ImageEncoding.MONO8, 2_000, CAMERA.frame_id))
+            executor.spin_once(0.05)
+        assert node.camera is not None
+    finally:
+        executor.shutdown()
+        client.destroy_node()
         node.destroy_node()

@@ -666,6 +666,20 @@ def test_a_failed_goal_is_aborted_with_the_reason(planner: Harness) -> None:
     assert result.result.error_code == ErrorCode.UNKNOWN_OBJECT and "nope" in result.result.message
 
 
+def test_an_empty_grasp_map_goal_names_what_to_give(planner: Harness) -> None:
+    """``ros2 action send_goal /planner/grasp_map ... "{}"`` ended "unknown object_id '': load
+    it first with load_object", though the action loads a scene itself; now it says what a goal
+    gives.
+    """
+    _, outcome = planner.goal(GraspMapAction, "grasp_map", GraspMapAction.Goal())
+    planner.spin_until(outcome.done)
+    result = outcome.result()
+    assert result.status == GoalStatus.STATUS_ABORTED
+    assert (result.result.error_code, result.result.message) == (
+        ErrorCode.INVALID_ARGUMENT, "give scene_yaml or scene_path (the action loads it), or the "
+                                    "object_id of a loaded object")
+
+
 # --------------------------------------------------------------------------- concurrency
 
 

@@ -669,8 +669,10 @@ class ContactTracker:
         cfg = self.config
         out = []
         if age > cfg.stale_after:
+            # never any reading: the age is infinite ("inf ms old" before)
             out.append(TrackedAlarm(AlarmType.STALE_SENSOR, name, age,
-                                    f"newest {name} reading is {age * 1e3:.3g} ms old"))
+                                    f"no {name} reading yet" if math.isinf(age)
+                                    else f"newest {name} reading is {age * 1e3:.3g} ms old"))
         if track.had_contact and not track.patches:
             out.append(TrackedAlarm(Termination.CONTACT_LOST, name, 0.0, f"{name} has no loaded "
                                                                          "taxel"))

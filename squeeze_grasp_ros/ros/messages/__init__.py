@@ -56,6 +56,7 @@ from squeeze_grasp_ros.ros.messages.devices import (
 )
 from squeeze_grasp_ros.ros.messages.executor import (
     executor_status_msg,
+    goal_msg_problem,
     grasp_feedback,
     grasp_goal,
     grasp_goal_msg,
@@ -146,6 +147,7 @@ __all__ = [
     "fill_sim_state",
     "float64_array",
     "frictional_resistance_response",
+    "goal_msg_problem",
     "grasp_candidates",
     "grasp_feedback",
     "grasp_goal",

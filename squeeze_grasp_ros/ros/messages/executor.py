@@ -89,6 +89,18 @@ def grasp_goal(msg: ExecuteGrasp.Goal) -> GraspGoal:
     )
 
 
+def goal_msg_problem(msg: ExecuteGrasp.Goal) -> str | None:
+    """Why goal ``msg`` asks for what :func:`grasp_goal` cannot carry, or None: ``resist``
+    without an ``adversary`` (a :class:`GraspGoal` resists exactly when it names one). Before,
+    such a goal, e.g. ``ros2 action send_goal ... "{..., resist: true}"``, ran the squeeze alone
+    and ended ``depth_reached``, SUCCEEDED, without a word of the resistance.
+    """
+    if msg.resist and not msg.adversary:
+        return ("resist is true but adversary is empty: name the adversary finger, with "
+                "adversary_translation, resist_travel and resist_waypoints")
+    return None
+
+
 def grasp_goal_msg(goal: GraspGoal) -> ExecuteGrasp.Goal:
     """The ``ExecuteGrasp`` goal of a :class:`GraspGoal`."""
     msg = ExecuteGrasp.Goal(
@@ -176,5 +188,5 @@ def invalid_goal_result(message: str) -> ExecuteGrasp.Result:
 
 
 def executor_status_msg(state: str, depth: float, message: str, ns: int) -> ExecutorStatus:
-    """``ExecutorStatus`` of the executor (depth: commanded or measured, m)."""
+    """``ExecutorStatus`` of the executor (depth: the squeeze's measured depth, m)."""
     return ExecutorStatus(header=header(ns), state=state, depth=float(depth), message=message)

@@ -164,7 +164,7 @@ class ExecutorNode(Node):
         jaws = f"{carried} {list(driver.fingers)} on {driver.topic}, " if driver else ""
         return (f"fingers {self.devices}, {jaws}{clock}, "
                 f"period {self.p['period']} s, max velocity {self.p['max_velocity']} m/s; "
-                f"action {self.resolve_topic_name(pipeline.ACTION)}")
+                f"action {self.action}")
 
     def __init__(self, **kwargs: Any) -> None:
         super().__init__("executor", **kwargs)
@@ -201,7 +201,10 @@ class ExecutorNode(Node):
                               for f, d in self.devices.items() if f not in jaw_fingers}
         self.status_pub = self.create_publisher(
             ExecutorStatus, pipeline.EXECUTOR_STATUS,
-            pipeline.output_qos(p["qos_depth"], lockstep=p["lockstep"]))
+            pipeline.status_qos(p["qos_depth"], lockstep=p["lockstep"]))
+        if not p["lockstep"]:  # the state a late reader gets before the first goal
+            self.status_pub.publish(messages.executor_status_msg(
+                ExecutorStatus.IDLE, 0.0, "", self.get_clock().now().nanoseconds))
         pose_pub = self.create_publisher(PoseStamped, pipeline.OBJECT_POSE, pipeline.LATCHED)
         pose_pub.publish(pose)
         self.create_subscription(MonitorStatus, pipeline.STATUS, self._status, loop, raw=True)
@@ -209,7 +212,9 @@ class ExecutorNode(Node):
         # burst unanswered: 10 answers to 30 goals sent at once)
         queues = {f"{kind}_service_qos_profile": pipeline.request_queue(0)
                   for kind in ("goal", "cancel", "result")}
-        self.server = ActionServer(self, ExecuteGrasp, pipeline.ACTION, self._execute,
+        self.action = pipeline.action_name(self, pipeline.ACTION)
+        """The action's fully qualified name (:func:`.pipeline.action_name`)."""
+        self.server = ActionServer(self, ExecuteGrasp, self.action, self._execute,
                                    goal_callback=self._accept_goal,
                                    cancel_callback=self._accept_cancel, **queues)
         self.goal: _Goal | None = None
@@ -317,7 +322,8 @@ class ExecutorNode(Node):
 
     async def _run_goal(self, handle: ServerGoalHandle) -> ExecuteGrasp.Result:
         goal = messages.grasp_goal(handle.request)
-        problem = goal_problem(goal, list(self.devices))
+        problem = (messages.goal_msg_problem(handle.request)
+                   or goal_problem(goal, list(self.devices)))
         if problem is None and self.jaws is not None:
             problem = self.jaws.effort_problem(goal)
         if problem is not None:

@@ -64,6 +64,7 @@ class FramePoseTopic:
         if not max_age >= 0:
             raise ParameterError(f"parameter frame_pose_max_age must be >= 0 s (0 = any age), "
                                  f"got {max_age!r}")
+        pipeline.check_topic("frame_pose_topic", topic)
         self.node, self.topic, self.frame, self.max_age = node, topic, frame, float(max_age)
         self.latest: PoseStamped | None = None
         node.create_subscription(PoseStamped, topic, self._pose, pipeline.LATCHED)

@@ -84,7 +84,7 @@ class JawAction:
         self.node, self.controller = node, controller
         self.parallel = controller.kind is ControllerKind.PARALLEL_GRIPPER
         self.action = ParallelGripperCommand if self.parallel else GripperCommand
-        self.topic = node.resolve_topic_name(controller.topic)
+        self.topic = pipeline.action_name(node, controller.topic)
         self.client = ActionClient(node, self.action, controller.topic)
         self.publisher = node.create_publisher(Header, pipeline.EXECUTOR_CYCLE,
                                                pipeline.loop_qos(qos.depth, kept=True))

@@ -8,7 +8,8 @@ Run it with ``ros2 run squeeze_grasp_ros outline --ros-args -p camera_pose:="[0.
 - ``camera/mask`` (parameter ``image_topic``): ``sensor_msgs/Image``, ``mono8`` mask (``8UC1``
   read as ``mono8``), or a ``16UC1``/``32FC1`` depth image (the encoding decides);
 - ``camera/camera_info``: ``sensor_msgs/CameraInfo`` (pinhole, plumb-bob), the newest one is
-  used for each image;
+  used for each image (both reliable; ``sensor_qos:=sensor_data`` reads a camera driver that
+  publishes them best effort, which a reliable subscription never matches);
 - ``camera/pose`` (latched ``geometry_msgs/PoseStamped``, optional): the camera's optical
   frame in the plane frame; it replaces the ``camera_pose`` parameter once it arrives, and its
   ``header.frame_id`` must be the node's ``frame_id``: after a refused one, images are refused
@@ -59,6 +60,9 @@ PARAMETERS: dict[str, tuple[Any, str]] = {
     "ambiguous_ratio": (0.8, "refuse a view whose second blob has this fraction of the "
                              "object's area"),
     "qos_depth": (10, "history depth of the image and outline topics"),
+    "sensor_qos": ("reliable", "QoS of the image and camera_info subscriptions: reliable, or "
+                               "sensor_data (best effort, depth 5) for a camera driver that "
+                               "publishes them best effort"),
 }
 """Parameter name -> (typed default, description)."""
 BOUNDS = {"object_height": pipeline.Bound(0.0, unit="m"),
@@ -97,9 +101,18 @@ class OutlineNode(Node):
         self.inputs = CameraInputs(p["frame_id"], pose_parameter(list(p["camera_pose"])),
                                    "parameter camera_pose or camera/pose")
         self.last_error = ""
+        self.logged: dict[str, str] = {}
+        """Stream (``camera_info``, ``camera/pose``, ``image``) -> the reason last logged for
+        it: each stream's refusals are logged once until they change. With one "last reason"
+        for all, a refused camera_info and the images it left unusable alternated, and every
+        message logged a line."""
         depth = p["qos_depth"]
-        self.create_subscription(Image, p["image_topic"], self._image, depth)
-        self.create_subscription(CameraInfo, pipeline.CAMERA_INFO, self._info, depth)
+        # a reliable reader never matches a best-effort writer (a camera driver on sensor-data
+        # QoS): before this parameter, such a camera's images never reached the node
+        camera = pipeline.sensor_qos(p["sensor_qos"], depth)
+        self.create_subscription(Image, pipeline.check_topic("image_topic", p["image_topic"]),
+                                 self._image, camera)
+        self.create_subscription(CameraInfo, pipeline.CAMERA_INFO, self._info, camera)
         self.create_subscription(PoseStamped, pipeline.CAMERA_POSE, self._pose, pipeline.LATCHED)
         self.outline_pub = self.create_publisher(PolygonStamped, pipeline.OUTLINE, depth)
         self.seen_pub = self.create_publisher(SeenOutline, pipeline.SEEN_OUTLINE, depth)
@@ -114,11 +127,15 @@ class OutlineNode(Node):
 
     def _info(self, msg: CameraInfo) -> None:
         if reason := self.inputs.take_info(msg):
-            self._refuse(msg.header.stamp, reason)
+            self._refuse(msg.header.stamp, reason, stream="camera_info")
+        else:
+            self.logged.pop("camera_info", None)
 
     def _pose(self, msg: PoseStamped) -> None:
         if reason := self.inputs.take_pose(msg):  # the camera may have moved: no outline
-            self._refuse(msg.header.stamp, reason)  # until a usable pose
+            self._refuse(msg.header.stamp, reason, stream="camera/pose")  # until a usable pose
+        else:
+            self.logged.pop("camera/pose", None)
 
     def _image(self, msg: Image) -> None:
         if reason := self.inputs.image_problem(msg):
@@ -138,6 +155,7 @@ class OutlineNode(Node):
             self._refuse(msg.header.stamp, str(error))
             return
         self.last_error = ""
+        self.logged.pop("image", None)
         out = messages.seen_outline_msg(
             seen.outline, frame_id=seen.frame_id, ns=messages.stamp_ns(msg.header.stamp),
             encoding=seen.encoding, plane_height=seen.plane_height,
@@ -147,13 +165,16 @@ class OutlineNode(Node):
         self.outline_pub.publish(out.outline)
         self.seen_pub.publish(out)
 
-    def _refuse(self, stamp: Any, reason: str) -> None:
-        """Publish ``reason`` on outline/errors; log it when it differs from the last one."""
+    def _refuse(self, stamp: Any, reason: str, *, stream: str = "image") -> None:
+        """Publish ``reason`` on outline/errors; log it when it differs from the last one
+        logged for ``stream`` (:attr:`logged`).
+        """
         ns = messages.stamp_ns(stamp)
         self.error_pub.publish(String(data=f"{ns * 1e-9:.6f} s: {reason}"))
-        if reason != self.last_error:
+        self.last_error = reason
+        if self.logged.get(stream) != reason:
             self.get_logger().warning(f"no outline: {reason}")
-            self.last_error = reason
+            self.logged[stream] = reason
 
 
 def main(args: list[str] | None = None) -> int:

@@ -86,6 +86,22 @@ FORCE_RESIDUAL = "monitor/force_residual"
 PREDICTED_SHAPES = "planner/predicted_shapes"
 
 
+def action_name(node: Node, name: str) -> str:
+    """The fully qualified name an rclpy action server or client of ``node`` takes for
+    ``name``: expanded into the node's namespace, never remapped (rclpy 7.1, Jazzy, applies no
+    remap rule to action names). A rule that would rename it is logged as a warning, naming
+    the name the action keeps; before, the executor's ready line named the remapped name, where
+    no action was.
+    """
+    expanded = node.resolve_topic_name(name, only_expand=True)
+    remapped = node.resolve_topic_name(name)
+    if remapped != expanded:
+        node.get_logger().warning(
+            f"the remap of action {name} to {remapped} is not applied (rclpy remaps no action "
+            f"names): the action is {expanded}; move it with the namespace (__ns) instead")
+    return expanded
+
+
 def device_topic(device: str, stream: str) -> str:
     """``devices/<device>/<stream>`` (stream: setpoint, pose, wrench, tactile)."""
     return f"devices/{device}/{stream}"
@@ -126,13 +142,28 @@ def output_qos(depth: int, *, lockstep: bool) -> QoSProfile:
     return loop_qos(depth, kept=lockstep)
 
 
+def status_qos(depth: int, *, lockstep: bool) -> QoSProfile:
+    """QoS of the executor's status (its state, published on change): :func:`output_qos` in
+    lockstep; on hardware :data:`LATCHED`, the current state only, which a reader that starts
+    later (``ros2 topic echo``, a dashboard) gets at once. Before, it was volatile on hardware:
+    a late reader got nothing until the state next changed (through a whole hold), and one
+    asking for transient-local durability matched no publisher at all.
+    """
+    return output_qos(depth, lockstep=True) if lockstep else LATCHED
+
+
+SIMULATION_TOPICS = (CLOCK, TICK, SIM_STATE, SIM_EVENTS, MARKERS)
+"""The recorded topics only the simulated hardware publishes."""
+
+
 def pipeline_topics(devices: Iterable[str], *, hidden: bool = False,
-                    camera: bool = False) -> dict[str, str]:
+                    camera: bool = False, simulation: bool = True) -> dict[str, str]:
     """Topic (fully qualified) -> type of every topic of a run with ``devices``.
 
     ``hidden`` adds the executor action's hidden topics (``.../_action/feedback`` and
     ``.../_action/status``), which rosbag2 too records only when asked; ``camera`` the camera's
-    images, its info and pose, and the monitor's shape residual (scenes with a camera).
+    images, its info and pose, and the monitor's shape residual (scenes with a camera);
+    ``simulation`` False leaves out :data:`SIMULATION_TOPICS` (real hardware).
     """
     types = {
         CLOCK: "rosgraph_msgs/msg/Clock",
@@ -149,6 +180,9 @@ def pipeline_topics(devices: Iterable[str], *, hidden: bool = False,
         EXECUTOR_STATUS: "squeeze_grasp_interfaces/msg/ExecutorStatus",
         OBJECT_POSE: "geometry_msgs/msg/PoseStamped",
     }
+    if not simulation:
+        for name in SIMULATION_TOPICS:
+            del types[name]
     if hidden:
         types[f"{ACTION}/_action/feedback"] = \
             "squeeze_grasp_interfaces/action/ExecuteGrasp_FeedbackMessage"
@@ -210,13 +244,55 @@ def round_trip(messages: Sequence[tuple[str, bytes]]) -> Callable[[], None]:
     return convert
 
 
+def check_topic(parameter: str, topic: str, *, device: str | None = None) -> str:
+    """``topic``, a topic name taken from parameter ``parameter`` (made from its ``device``,
+    if given), if ROS takes it as a name.
+
+    Before, a name ROS refuses (``image_topic:=cam-mask``, a device ``left-jaw``) ended the
+    node with rclpy's traceback and exit status 1 when the node created its publisher or
+    subscription.
+
+    Raises
+    ------
+    ParameterError
+        Naming the parameter, its value and rcl's reason.
+
+    >>> check_topic("image_topic", "camera/mask")
+    'camera/mask'
+    >>> check_topic("image_topic", "cam-mask")
+    Traceback (most recent call last):
+    ...
+    squeeze_grasp_ros.ros.nodes.ParameterError: parameter 'image_topic': 'cam-mask' is a ...
+    """
+    error = rclpy_implementation.rclpy_get_validation_error_for_topic_name(topic)
+    if error is None:
+        return topic
+    what = (f"device {device!r} gives the topic name {topic!r}, which ROS refuses"
+            if device is not None else f"{topic!r} is a topic name ROS refuses")
+    raise ParameterError(f"parameter '{parameter}': {what}: {error[0]}")
+
+
+def check_devices(parameter: str, devices: Iterable[str]) -> None:
+    """Refuse (:func:`check_topic`) a device of parameter ``parameter`` whose topics
+    (:func:`device_topic`) ROS refuses as names.
+
+    >>> check_devices("devices", ["barrett_f1", "2jaw"])
+    Traceback (most recent call last):
+    ...
+    squeeze_grasp_ros.ros.nodes.ParameterError: parameter 'devices': device '2jaw' gives ...
+    """
+    for device in devices:
+        check_topic(parameter, device_topic(device, "setpoint"), device=device)
+
+
 def parse_mapping(entries: Sequence[str], what: str) -> dict[str, str]:
     """``["F1:barrett_f1", ...]`` -> {"F1": "barrett_f1", ...}.
 
     Raises
     ------
     ValueError
-        For an entry without exactly one ':' or a repeated key.
+        For an entry without exactly one ':' or a repeated key, or a device that gives no
+        valid topic name (:func:`check_devices`).
     """
     out: dict[str, str] = {}
     for entry in entries:
@@ -224,6 +300,7 @@ def parse_mapping(entries: Sequence[str], what: str) -> dict[str, str]:
         if not sep or not key or not value or ":" in value or key in out:
             raise ValueError(f"{what}: expected distinct 'finger:device' entries, got {entry!r}")
         out[key] = value
+    check_devices(what, out.values())
     return out
 
 
@@ -302,18 +379,28 @@ class Bound:
     unit: str = ""
     note: str = ""
 
+    def words(self, value: Any) -> str:
+        """What a value of this range is, for a value of ``value``'s type: the words of
+        :meth:`why` and of ``ros2 param describe`` (its additional constraints).
+
+        >>> Bound(0.0, 90.0, above=True, unit="deg").words(2.0)
+        'a finite number > 0 deg and <= 90 deg'
+        >>> Bound(1).words(10)
+        'an integer >= 1'
+        """
+        kind = "an integer" if isinstance(value, int) else "a finite number"
+        unit = f" {self.unit}" if self.unit else ""
+        upper = f" and <= {self.high:g}{unit}" if self.high < math.inf else ""
+        note = f" ({self.note})" if self.note else ""
+        return f"{kind} {'>' if self.above else '>='} {self.low:g}{unit}{upper}{note}"
+
     def why(self, name: str, value: Any) -> str | None:
         """Why ``value`` is out of this range for parameter ``name``, or None."""
         if (not isinstance(value, bool) and isinstance(value, int | float)
                 and math.isfinite(value) and (value > self.low if self.above
                                               else value >= self.low) and value <= self.high):
             return None
-        kind = "an integer" if isinstance(value, int) else "a finite number"
-        unit = f" {self.unit}" if self.unit else ""
-        upper = f" and <= {self.high:g}{unit}" if self.high < math.inf else ""
-        note = f" ({self.note})" if self.note else ""
-        return (f"parameter '{name}' must be {kind} {'>' if self.above else '>='} "
-                f"{self.low:g}{unit}{upper}{note}, got {value}")
+        return f"parameter '{name}' must be {self.words(value)}, got {value}"
 
 
 TYPE_WORDS = {
@@ -344,6 +431,21 @@ READ_AT_START = "read at start-up: restart the node to change it"
 """The constraint ``ros2 param describe`` shows of a read-only parameter."""
 
 
+def constraints(default: Any, bound: Bound | None, *, read_only: bool) -> str:
+    """The additional constraints ``ros2 param describe`` shows of a parameter: its range
+    (``bound``, in the words of its errors, for a value of ``default``'s type) and
+    :data:`READ_AT_START` when ``read_only``; "" when neither. Before, the ranges the nodes
+    enforce were shown nowhere.
+
+    >>> constraints(0.01, Bound(0.0, above=True, unit="m/s"), read_only=True)
+    'a finite number > 0 m/s; read at start-up: restart the node to change it'
+    >>> constraints(16, Bound(0), read_only=False)
+    'an integer >= 0'
+    """
+    words = [bound.words(default)] if bound else []
+    return "; ".join(words + ([READ_AT_START] if read_only else []))
+
+
 def declare(node: Node, parameters: Mapping[str, tuple[Any, str]], *,
             live: Collection[str] = (), bounds: Mapping[str, Bound] | None = None
             ) -> dict[str, Any]:
@@ -365,7 +467,8 @@ def declare(node: Node, parameters: Mapping[str, tuple[Any, str]], *,
         try:
             node.declare_parameter(name, default, ParameterDescriptor(
                 description=description, dynamic_typing=isinstance(default, float),
-                read_only=read_only, additional_constraints=READ_AT_START if read_only else ""))
+                read_only=read_only, additional_constraints=constraints(
+                    default, (bounds or {}).get(name), read_only=read_only)))
         except InvalidParameterTypeException:
             # rclpy's exception keeps no value: the override it refused is the node's own
             raise wrong_type(name, expected, node._parameter_overrides[name].value) from None
@@ -499,7 +602,8 @@ def prediction_ready(node: Node, *, seen: bool, awaited: bool) -> bool:
     ready without the prediction and judged the first cycles against none. So a caller that
     knows a prediction comes (``run`` publishes it before its nodes start) sets ``awaited``.
     """
-    return seen or (not awaited and node.count_publishers(PREDICTION) == 0)
+    return seen or (not awaited
+                    and node.count_publishers(node.resolve_topic_name(PREDICTION)) == 0)
 
 
 class Participant:
@@ -522,7 +626,10 @@ class Participant:
                  condition: Callable[[], bool] | None = None) -> None:
         self.node = node
         self.name = name
-        self.inputs = list(inputs)
+        # resolved with the node's remap rules: rclpy's count_publishers applies none, so a
+        # remapped input (-r monitor/status:=...) was looked for under its old name and the
+        # node never became ready (the lockstep never started)
+        self.inputs = [node.resolve_topic_name(t) for t in inputs]
         self.outputs = list(outputs)
         self.condition = condition
         self._ready = node.create_publisher(String, READY, loop_qos(10))

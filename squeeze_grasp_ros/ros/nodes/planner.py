@@ -203,10 +203,11 @@ class PlannerNode(Node):
         # 200 goals sent at once got 20 responses (issue 34).
         queues = {f"{kind}_service_qos_profile": services for kind in ("goal", "cancel", "result")}
         self._actions = [
-            ActionServer(self, GraspMapAction, "~/grasp_map", self._execute_grasp_map,
-                         cancel_callback=self._accept_cancel, callback_group=self._group,
-                         **queues),
-            ActionServer(self, EventSqueezeAction, "~/event_squeeze",
+            ActionServer(self, GraspMapAction, pipeline.action_name(self, "~/grasp_map"),
+                         self._execute_grasp_map, cancel_callback=self._accept_cancel,
+                         callback_group=self._group, **queues),
+            ActionServer(self, EventSqueezeAction,
+                         pipeline.action_name(self, "~/event_squeeze"),
                          self._execute_event_squeeze, cancel_callback=self._accept_cancel,
                          callback_group=self._group, **queues),
         ]
@@ -331,6 +332,12 @@ class PlannerNode(Node):
                     self.cache, source, goal.object_id, goal.solver_route, self.limits,
                     lambda stage, index, count, nodes: report(stage, index, stages, nodes),
                     goal.replace)
+            elif not goal.object_id:  # before: "unknown object_id '': load it first with
+                # load_object", though this action loads a scene itself
+                raise planning.PlannerError(
+                    ErrorCode.INVALID_ARGUMENT,
+                    "give scene_yaml or scene_path (the action loads it), or the object_id of "
+                    "a loaded object")
             else:
                 loaded = self._object(goal)
             report("grasp map", stages - 1, stages, loaded.num_nodes)

@@ -86,7 +86,11 @@ PARAMETERS: dict[str, tuple[Any, str]] = {
     "compression": ("zstd", "chunk compression: zstd, lz4 or none"),
     "chunk_size": (262144, "uncompressed chunk size written out when full, bytes"),
     "custom_data": ("{}", "YAML mapping of strings stored in metadata.yaml custom_data"),
-    "lockstep": (True, "take part in the start-up handshake and report progress"),
+    "lockstep": (True, "take part in the start-up handshake and report progress on "
+                       "recorder/progress"),
+    "simulation": (True, "also record the simulated hardware's topics (/clock, sim/tick, "
+                         "sim/state, sim/events, sim/markers); false on real hardware, where "
+                         "nothing publishes them"),
     "progress_every": (5, "ticks between recorder/progress reports"),
     "sensor_qos": ("reliable", "QoS of the readings: reliable (lockstep) or sensor_data"),
     "qos_depth": (1000, "history depth of the subscriptions"),
@@ -125,8 +129,10 @@ class RecorderNode(Node):
         custom = yaml.safe_load(p["custom_data"]) or {}
         self.writer = BagWriter(p["output"], p["compression"], p["chunk_size"],
                                 {str(k): str(v) for k, v in custom.items()})
+        pipeline.check_devices("devices", p["devices"])
+        pipeline.check_devices("silent_setpoints", [d for d in p["silent_setpoints"] if d])
         topics = pipeline.pipeline_topics(p["devices"], hidden=p["include_hidden_topics"],
-                                          camera=p["camera"])
+                                          camera=p["camera"], simulation=p["simulation"])
         self.sources = {name: name.lstrip("/") for name in topics}
         """Recorded name -> the name subscribed to: the pipeline's topics relative to the
         node's namespace (a run in a namespace records '/sim/tick' from '<ns>/sim/tick'),
@@ -135,6 +141,7 @@ class RecorderNode(Node):
         for entry in p["extra_topics"]:
             if entry.strip():
                 name, type_name = entry.split()
+                pipeline.check_topic("extra_topics", name)
                 recorded = name if name.startswith("/") else "/" + name
                 topics[recorded] = type_name
                 self.sources[recorded] = name
@@ -158,7 +165,8 @@ class RecorderNode(Node):
         camera = {"/" + t for t in (pipeline.CAMERA_MASK, pipeline.CAMERA_DEPTH,
                                     pipeline.CAMERA_INFO)}
         sensors = {name for name in topics if name.rsplit("/", 1)[-1] in pipeline.STREAMS}
-        extra_loop = [t for t in p["lockstep_topics"] if t.strip()]
+        extra_loop = [pipeline.check_topic("lockstep_topics", t) for t in p["lockstep_topics"]
+                      if t.strip()]
         kept = ({"/" + t.lstrip("/") for t in [*pipeline.loop_topics(p["devices"]), *extra_loop,
                                                *pipeline.RECORDED_OUTPUTS]}
                 if p["lockstep"] else set())
@@ -176,7 +184,9 @@ class RecorderNode(Node):
                     message_lost=lambda info, n=name: self._lost(n, info),
                     incompatible_qos=lambda info, n=name, q=qos: self._incompatible(n, q, info)))
         self.progress_pub = self.create_publisher(Header, pipeline.RECORDER_PROGRESS,
-                                                  pipeline.loop_qos(10))
+                                                  pipeline.loop_qos(10)) \
+            if p["lockstep"] else None
+        """The lockstep handshake's flow control (no publisher without the handshake)."""
         if p["lockstep"]:
             awaited = pipeline.loop_topics(p["devices"],
                                            silent=[d for d in p["silent_setpoints"] if d])
@@ -196,7 +206,8 @@ class RecorderNode(Node):
         return [qos_dict(name("history", q.history), q.depth, name("reliability", q.reliability),
                          name("durability", q.durability))
                 for q in (i.qos_profile
-                          for i in self.get_publishers_info_by_topic(self.sources[topic]))]
+                          for i in self.get_publishers_info_by_topic(
+                              self.resolve_topic_name(self.sources[topic])))]
 
     def _record(self, topic: str, data: bytes) -> None:
         ns = (messages.cdr_stamp_ns(data) if self.stamped[topic]
@@ -243,7 +254,7 @@ class RecorderNode(Node):
 
     def _repeat_report(self) -> None:
         """Publish the newest tick written (again: a lost report is repeated by the timer)."""
-        if self.newest_tick_ns >= 0:
+        if self.newest_tick_ns >= 0 and self.progress_pub is not None:
             self.reported_ns = self.newest_tick_ns
             self.progress_pub.publish(messages.header(self.newest_tick_ns))
 

@@ -326,7 +326,7 @@ NODE_DEFAULTS = [
      "executor", "stale_budget", 1),
     ("perception.md", r"`min_area_px` \(default (\d+):", "outline", "min_area_px", 1),
     ("perception.md", r"`ambiguous_ratio` \(default ([\d.]+):", "outline", "ambiguous_ratio", 1),
-    ("perception.md", r"and `qos_depth` \(default (\d+)\), the history depth of the image",
+    ("perception.md", r"`qos_depth` \(default (\d+)\), the history depth of the image",
      "outline", "qos_depth", 1),
     ("perception.md", r"whose frame must be the node's `frame_id`, default `(\w+)`", "outline",
      "frame_id", None),
@@ -564,7 +564,8 @@ def test_the_planner_interface_table_of_ros_md_is_the_node_s():
     created = {("srv", kind, name) for kind, name in
                re.findall(r"\((\w+), \"(\w+)\", self\._\w+\)", source)}
     created |= {("action", kind.removesuffix("Action"), name) for kind, name in
-                re.findall(r"ActionServer\(self, (\w+), \"~/(\w+)\"", source)}
+                re.findall(r"ActionServer\(self, (\w+),\s+pipeline\.action_name\(self, "
+                           r"\"~/(\w+)\"\)", source)}
     page = (REPO / "docs" / "ros.md").read_text(encoding="utf-8")
     table = page[page.index("| name | type | computes | where |"):]
     listed = {(kind, typ, name) for name, kind, typ in re.findall(

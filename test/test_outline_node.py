@@ -353,7 +353,7 @@ def test_sensor_qos_reads_a_camera_that_publishes_best_effort(ros_context):
             infos.publish(camera_info_msg(CAMERA, 1_000))
             images.publish(image_msg(empty, ImageEncoding.MONO8, 2_000, CAMERA.frame_id))
             executor.spin_once(0.05)
-        assert node.camera is not None
+        assert node.inputs.camera is not None
     finally:
         executor.shutdown()
         client.destroy_node()

@@ -72,6 +72,21 @@ def test_poisson_ratio_outside_range_is_a_clear_error():
         Material(1e5, 0.5000001, 0.01)
 
 
+@pytest.mark.parametrize("field, value, named", [
+    ("E", 1e-320, r"material.E must be in \[0.001, 1e\+13\] Pa, got 1e-320"),
+    ("E", 1e16, r"material.E must be in \[0.001, 1e\+13\] Pa, got 1e\+16"),
+    ("thickness", 1e-320, r"material.thickness must be in \[1e-09, 1000\] m, got 1e-320"),
+    ("thickness", 1e-12, r"material.thickness must be in \[1e-09, 1000\] m, got 1e-12"),
+])
+def test_material_magnitudes_beyond_the_scene_ranges_are_refused_by_field(field, value, named):
+    """A Material takes the scene's ranges. Before, E = 1e-320 Pa (or E h = 1e-322 N/m) made
+    an event-driven squeeze return NaN work and dissipation with no error, and E h = 1e310 N/m
+    ended in "reduced stiffness must be finite" naming no material field.
+    """
+    with pytest.raises(InvalidInputError, match=named):
+        Material(**{"E": 1e5, "nu": 0.3, "thickness": 0.01, field: value})
+
+
 def test_E_from_foam_to_steel_scales_exactly():
     mesh = blob()
     c = [mesh.boundary[5], mesh.boundary[30]]

@@ -327,7 +327,7 @@ def test_a_wall_too_thin_for_its_element_count_is_refused_by_field():
     assert ring.n == 32
 
 
-@settings(max_examples=12)
+@settings(max_examples=12, deadline=None)
 @given(quarter=st.integers(4, 150), log_margin=st.floats(0.0, 2.0))
 def test_a_thin_wall_within_the_bound_keeps_its_accuracy(quarter, log_margin):
     """Within MAX_THINNESS the ring agrees with the closed form to its discretisation error

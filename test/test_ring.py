@@ -4,7 +4,9 @@
 
 from __future__ import annotations
 
+import re
 from functools import cache
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -325,6 +327,15 @@ def test_a_wall_too_thin_for_its_element_count_is_refused_by_field():
         circle_diametral_response(256, 0.04, E, W, 1.2e-8, 1.0)
     ring = ring_from_outline(outline("disk"), Material(E, 0.0, W), 6.83e-7 / 8, 32)
     assert ring.n == 32
+
+
+def test_the_thin_wall_refusal_ring_md_quotes_is_the_one_raised():
+    page = (Path(__file__).resolve().parents[1] / "docs" / "ring.md").read_text(encoding="utf-8")
+    quoted = re.search(r"\(`(ring\.wall_thickness must be >=[^`]*?) \.\.\.`\)", page).group(1)
+    quoted = " ".join(quoted.split())  # the page wraps it
+    with pytest.raises(InvalidInputError) as refused:
+        ring_from_outline(outline("disk"), Material(E, 0.0, W), 1e-7, 200)
+    assert str(refused.value).startswith(quoted)
 
 
 @settings(max_examples=12, deadline=None)

@@ -91,6 +91,28 @@ def test_a_point_near_the_object_still_snaps_to_the_boundary(tmp_path):
     assert np.allclose(mesh.nodes[i], [-0.05, 0.0])
 
 
+@pytest.mark.parametrize("offset", [2e-10, 1e-9, 1e-8])
+def test_a_placement_a_hair_from_a_corner_is_refused_naming_the_placement(tmp_path, capfd,
+                                                                          offset):
+    """A point 2e-10 to 1e-8 m from the foam square's corner (beyond the 1e-10 m within which
+    it is the corner) made elements the mesh refuses: "object.mesh: mesh has degenerate
+    (zero-area) elements" named neither the placement nor the distance. 3e-8 m meshes.
+    """
+    path = variant(tmp_path, FOAM, lambda d: d["fingers"]["F1"].__setitem__(
+        "placement", {"point": [-0.05, -0.05 + offset]}))
+    line = refused(["squeeze", path], capfd)
+    assert (f"error: fingers.F1.placement.point: the outline has vertices {offset:.3g} m apart "
+            "at (-0.05, -0.05) m") in line
+
+
+def test_an_outline_with_vertices_a_hair_apart_is_refused_naming_them():
+    with pytest.raises(InvalidInputError, match=r"the outline has vertices 1e-08 m apart at "
+                                                r"\(0, 1e-08\) m \(1e-07 of its size 0.1 m\)"):
+        generate_mesh(shapes.polygon([[0, 0], [0.1, 0], [0.1, 0.1], [0, 0.1], [0, 1e-8]]), 3e-5)
+    assert generate_mesh(shapes.polygon([[0, 0], [0.1, 0], [0.1, 0.1], [0, 0.1], [0, 3e-8]]),
+                         3e-5).n > 300
+
+
 # ----------------------------------------------------------------------------- item 5
 
 

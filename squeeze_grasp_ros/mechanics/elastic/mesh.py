@@ -280,12 +280,39 @@ def generate_mesh(
                 f"the mesher reached the limit of {max_nodes:,} nodes before it met the "
                 f"element size {estimate.spacing:.3g} m and angle {min_angle:g} deg: use "
                 "larger elements (mesh.nodes or mesh.max_area) or a simpler outline")
-        return mesh_from_triangles(nodes, tris)
+        try:
+            return mesh_from_triangles(nodes, tris)
+        except InvalidInputError as exc:
+            raise _close_vertices_error(loops) or exc from None
 
     mesh = triangulated(split_boundary)
     if not split_boundary and mesh.min_angle_deg() < min_angle - ANGLE_SLACK:
         mesh = triangulated(True)
     return mesh
+
+
+CLOSE_VERTICES = 1e-6
+"""Vertices of an outline closer than this fraction of its size are named when its mesh fails
+with elements of (almost) zero area: Triangle grades its elements down to their distance, and
+:func:`mesh_from_triangles` refuses elements below 1e-14 of the size squared. A square of side
+0.1 m with a vertex 1e-8 m from a corner failed so (1e-10 m is one vertex, 3e-8 m meshed)."""
+
+
+def _close_vertices_error(loops: list[np.ndarray]) -> InvalidInputError | None:
+    """The error naming the closest consecutive vertices of ``loops`` (m) when they are closer
+    than :data:`CLOSE_VERTICES` of the outline's size, else None.
+    """
+    points = np.concatenate(loops)
+    size = float(np.ptp(points, axis=0).max())
+    gaps = [(float(np.linalg.norm(np.roll(loop, -1, axis=0)[k] - loop[k])), loop[k])
+            for loop in loops for k in range(len(loop))]
+    gap, where = min(gaps, key=lambda g: g[0])
+    if not gap < CLOSE_VERTICES * size:
+        return None
+    return InvalidInputError(
+        f"the outline has vertices {gap:.3g} m apart at ({where[0]:.6g}, {where[1]:.6g}) m "
+        f"({gap / size:.2g} of its size {size:.4g} m): the mesh there has elements of almost "
+        "zero area; make them one vertex or move them apart")
 
 
 def mesh_from_triangles(nodes: np.ndarray, triangles: np.ndarray) -> Mesh:

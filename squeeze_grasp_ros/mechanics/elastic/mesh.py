@@ -280,10 +280,11 @@ def generate_mesh(
                 f"the mesher reached the limit of {max_nodes:,} nodes before it met the "
                 f"element size {estimate.spacing:.3g} m and angle {min_angle:g} deg: use "
                 "larger elements (mesh.nodes or mesh.max_area) or a simpler outline")
-        try:
-            return mesh_from_triangles(nodes, tris)
-        except InvalidInputError as exc:
-            raise _close_vertices_error(loops) or exc from None
+        if _has_degenerate_elements(nodes, tris):
+            close = _close_vertices_error(loops)
+            if close is not None:
+                raise close
+        return mesh_from_triangles(nodes, tris)
 
     mesh = triangulated(split_boundary)
     if not split_boundary and mesh.min_angle_deg() < min_angle - ANGLE_SLACK:
@@ -294,8 +295,22 @@ def generate_mesh(
 CLOSE_VERTICES = 1e-6
 """Vertices of an outline closer than this fraction of its size are named when its mesh fails
 with elements of (almost) zero area: Triangle grades its elements down to their distance, and
-:func:`mesh_from_triangles` refuses elements below 1e-14 of the size squared. A square of side
-0.1 m with a vertex 1e-8 m from a corner failed so (1e-10 m is one vertex, 3e-8 m meshed)."""
+:func:`mesh_from_triangles` refuses elements below :data:`DEGENERATE_AREA` of the size
+squared. A square of side 0.1 m with a vertex 1e-8 m from a corner failed so (1e-10 m is one
+vertex, 3e-8 m meshed)."""
+
+
+DEGENERATE_AREA = 1e-14
+"""Elements of an area at most this fraction of the square of the mesh's extent are refused as
+degenerate (:func:`mesh_from_triangles`)."""
+
+
+def _has_degenerate_elements(nodes: np.ndarray, triangles: np.ndarray) -> bool:
+    """Whether :func:`mesh_from_triangles` would refuse an element of ``triangles`` as
+    degenerate.
+    """
+    scale = float(np.ptp(nodes, axis=0).max()) ** 2
+    return bool(np.any(np.abs(element_areas(nodes, triangles)) <= DEGENERATE_AREA * scale))
 
 
 def _close_vertices_error(loops: list[np.ndarray]) -> InvalidInputError | None:
@@ -304,9 +319,10 @@ def _close_vertices_error(loops: list[np.ndarray]) -> InvalidInputError | None:
     """
     points = np.concatenate(loops)
     size = float(np.ptp(points, axis=0).max())
-    gaps = [(float(np.linalg.norm(np.roll(loop, -1, axis=0)[k] - loop[k])), loop[k])
-            for loop in loops for k in range(len(loop))]
-    gap, where = min(gaps, key=lambda g: g[0])
+    gaps = np.concatenate([np.linalg.norm(np.roll(loop, -1, axis=0) - loop, axis=1)
+                           for loop in loops])
+    k = int(np.argmin(gaps))
+    gap, where = float(gaps[k]), points[k]
     if not gap < CLOSE_VERTICES * size:
         return None
     return InvalidInputError(
@@ -329,10 +345,9 @@ def mesh_from_triangles(nodes: np.ndarray, triangles: np.ndarray) -> Mesh:
     remap = -np.ones(len(nodes), dtype=int)
     remap[used] = np.arange(len(used))
     nodes, triangles = nodes[used], remap[triangles]
-    area = element_areas(nodes, triangles)
-    scale = float(np.ptp(nodes, axis=0).max()) ** 2
-    if np.any(np.abs(area) <= 1e-14 * scale):
+    if _has_degenerate_elements(nodes, triangles):
         raise InvalidInputError("mesh has degenerate (zero-area) elements")
+    area = element_areas(nodes, triangles)
     flip = area < 0
     triangles[flip] = triangles[flip][:, [0, 2, 1]]
     loops = boundary_loops(triangles)

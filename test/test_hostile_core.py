@@ -268,6 +268,16 @@ def test_poisson_ratios_a_model_cannot_represent_are_refused_up_front(tmp_path, 
     assert f"object.material.nu must be in [{lo:g}, {hi:g}]" in line
 
 
+def test_a_model_given_on_the_command_line_is_held_to_its_poisson_range(tmp_path, capfd):
+    """The scene checks its own model's range; `--model` chose another after that check: a
+    linear scene at nu = -0.5 squeezed with `--model neo_hookean` ran past a minute with a
+    leaked RuntimeWarning. Every squeeze's contact model now checks the range it runs.
+    """
+    path = variant(tmp_path, FOAM, lambda d: d["object"]["material"].update(nu=-0.5))
+    line = refused(["squeeze", path, "--model", "neo_hookean"], capfd)
+    assert "material.nu must be in [-0.3, 0.4999] for the neo_hookean model, got -0.5" in line
+
+
 def test_the_auxetic_side_against_the_analytic_disk():
     """Timoshenko's disk under diametral loads: the perpendicular diameter grows by about
     P / (E h) (4 / pi - 1 + nu), so below nu = 1 - 4 / pi it shrinks (an auxetic disk pulls in

@@ -105,6 +105,17 @@ def test_a_placement_a_hair_from_a_corner_is_refused_naming_the_placement(tmp_pa
             "at (-0.05, -0.05) m") in line
 
 
+def test_a_mesh_error_of_another_cause_is_not_blamed_on_a_placement_near_a_corner(tmp_path,
+                                                                                  capfd):
+    """3e-8 m from the corner meshes; asked for too many nodes, the refusal is the mesh's."""
+    def change(d):
+        d["fingers"]["F1"]["placement"] = {"point": [-0.05, -0.05 + 3e-8]}
+        d["object"]["mesh"] = {"max_area": 1e-12}
+
+    line = refused(["squeeze", variant(tmp_path, FOAM, change)], capfd)
+    assert "error: object.mesh: mesh.max_area 1e-12 m^2 would give about" in line
+
+
 def test_an_outline_with_vertices_a_hair_apart_is_refused_naming_them():
     with pytest.raises(InvalidInputError, match=r"the outline has vertices 1e-08 m apart at "
                                                 r"\(0, 1e-08\) m \(1e-07 of its size 0.1 m\)"):

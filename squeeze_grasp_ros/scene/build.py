@@ -20,6 +20,7 @@ from squeeze_grasp_ros.mechanics.elastic.compliance import ElasticObject
 from squeeze_grasp_ros.mechanics.elastic.material import Material
 from squeeze_grasp_ros.mechanics.elastic.mesh import (
     CLOSE_VERTICES,
+    CLOSE_VERTICES_ERROR,
     MAX_MESH_NODES,
     Mesh,
     generate_mesh,
@@ -109,7 +110,8 @@ def build_mesh(scene: Scene, *, outline: shapes.Outline | None = None,
                              split_boundary=ShapeType(scene.object.shape["type"])
                              != ShapeType.SPLINE)
     except InvalidInputError as exc:
-        raise SceneError(f"{_crowded_placement(scene, outline) or 'object.mesh'}: {exc}") from None
+        crowded = str(exc).startswith(CLOSE_VERTICES_ERROR) and _crowded_placement(scene, outline)
+        raise SceneError(f"{crowded or 'object.mesh'}: {exc}") from None
 
 
 def _crowded_placement(scene: Scene, outline: shapes.Outline) -> str | None:

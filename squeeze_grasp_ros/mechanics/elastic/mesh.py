@@ -300,6 +300,9 @@ squared. A square of side 0.1 m with a vertex 1e-8 m from a corner failed so (1e
 vertex, 3e-8 m meshed)."""
 
 
+CLOSE_VERTICES_ERROR = "the outline has vertices"
+"""How the error of :data:`CLOSE_VERTICES` begins (a scene names the placement behind it)."""
+
 DEGENERATE_AREA = 1e-14
 """Elements of an area at most this fraction of the square of the mesh's extent are refused as
 degenerate (:func:`mesh_from_triangles`)."""
@@ -326,7 +329,7 @@ def _close_vertices_error(loops: list[np.ndarray]) -> InvalidInputError | None:
     if not gap < CLOSE_VERTICES * size:
         return None
     return InvalidInputError(
-        f"the outline has vertices {gap:.3g} m apart at ({where[0]:.6g}, {where[1]:.6g}) m "
+        f"{CLOSE_VERTICES_ERROR} {gap:.3g} m apart at ({where[0]:.6g}, {where[1]:.6g}) m "
         f"({gap / size:.2g} of its size {size:.4g} m): the mesh there has elements of almost "
         "zero area; make them one vertex or move them apart")
 

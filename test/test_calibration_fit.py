@@ -17,6 +17,7 @@ from squeeze_grasp_ros.mechanics.calibration.hyperelastic_fit import (
     uniaxial_response,
 )
 from squeeze_grasp_ros.mechanics.elastic import hyperelastic
+from squeeze_grasp_ros.mechanics.errors import InvalidInputError
 from squeeze_grasp_ros.mechanics.vocabulary import MaterialModel
 
 SIDES = (0.05, 0.04, 0.02)
@@ -92,8 +93,6 @@ def test_an_unknown_model_and_mismatched_arrays_are_refused_by_name():
     """An unknown model used to escape as ValueError; arrays of two lengths were reported as
     too few points.
     """
-    from squeeze_grasp_ros.mechanics.errors import InvalidInputError
-
     with pytest.raises(InvalidInputError, match="model must be linear or neo_hookean, got 'x'"):
         fit_compression(curve(np.linspace(0.01, 0.1, 5)), model="x")
     with pytest.raises(InvalidInputError, match=r"got shapes \(3,\) and \(2,\)"):
@@ -128,3 +127,26 @@ def test_samples_and_ratios_out_of_range_are_refused_by_name(tmp_path, capfd, op
     assert main(["calibrate", option, str(path), *cells]) == 2
     out, err = capfd.readouterr()
     assert out == "" and err.strip().endswith(message) and len(err.strip().splitlines()) == 1
+
+
+@pytest.mark.parametrize("model", ["linear", "neo_hookean"])
+def test_a_compression_below_a_nanostrain_is_refused_by_name(model):
+    """-dl / l = 1e-200: the linear curve fit raised scipy's "Residuals are not finite in the
+    initial point" (a ValueError), the neo-Hookean one a NumericalError with a NaN residual, and
+    a cuboid "fitted Poisson's ratio nan ... check the signs".
+    """
+    from squeeze_grasp_ros.mechanics.calibration.material_fit import Cuboid
+
+    force = np.linspace(0.1, 1.0, 8)
+    with pytest.raises(InvalidInputError, match=r"dl must be in \(-0.05, -5e-11\] m at every "
+                                                 r"point \(the cuboid shortens, by at least "
+                                                 r"1e-09 of its length\)"):
+        fit_compression(CompressionCurve(0.05, 0.05, 0.02, force, -1e-202 * np.arange(1, 9)),
+                        model=model, nu=0.3)
+    with pytest.raises(InvalidInputError, match=r"cuboid.dl must be in \(-0.05, -5e-11\] m .* "
+                                                r"got -1e-202"):
+        Cuboid(1.0, 0.05, 0.05, 0.02, -1e-202, 0.0)
+    # a nanostrain is measured and fitted
+    fit = fit_compression(CompressionCurve(0.05, 0.05, 0.02, force, -5e-11 * np.arange(1, 9)),
+                          model=model, nu=0.3)
+    assert np.isfinite(fit.E) and fit.E > 0

@@ -72,6 +72,38 @@ def test_poisson_ratio_outside_range_is_a_clear_error():
         Material(1e5, 0.5000001, 0.01)
 
 
+@pytest.mark.parametrize("field, value, named", [
+    ("E", 1e-320, r"material.E must be in \[0.001, 1e\+13\] Pa, got 1e-320"),
+    ("E", 1e16, r"material.E must be in \[0.001, 1e\+13\] Pa, got 1e\+16"),
+    ("thickness", 1e-320, r"material.thickness must be in \[1e-09, 1000\] m, got 1e-320"),
+    ("thickness", 1e-12, r"material.thickness must be in \[1e-09, 1000\] m, got 1e-12"),
+])
+def test_material_magnitudes_beyond_the_scene_ranges_are_refused_by_field(field, value, named):
+    """A Material takes the scene's ranges. Before, E = 1e-320 Pa (or E h = 1e-322 N/m) made
+    an event-driven squeeze return NaN work and dissipation with no error, and E h = 1e310 N/m
+    ended in "reduced stiffness must be finite" naming no material field.
+    """
+    with pytest.raises(InvalidInputError, match=named):
+        Material(**{"E": 1e5, "nu": 0.3, "thickness": 0.01, field: value})
+
+
+@pytest.mark.parametrize("model, nu", [("linear", -0.95), ("corotational", -0.95),
+                                       ("neo_hookean", 0.49995), ("neo_hookean", -0.5)])
+def test_an_event_squeeze_refuses_a_poisson_ratio_its_model_cannot_represent(model, nu):
+    """The API applies POISSON_RANGES as a scene does. Before, event_squeeze took any nu in
+    (-1, 0.5): the neo-Hookean model at nu = -0.9 ran 24 s and ended contact_lost with a finger
+    force of -0.007 N, and -0.5 did not finish in 300 s.
+    """
+    from squeeze_grasp_ros.mechanics.squeeze.events import event_squeeze
+
+    mesh = blob(300)
+    obj = ElasticObject(mesh, Material(1e5, nu, 0.01))
+    contacts = (int(mesh.boundary[2]), int(mesh.boundary[len(mesh.boundary) // 2]))
+    with pytest.raises(InvalidInputError, match=rf"material.nu must be in \[.*\] for the "
+                                                rf"{model} model, got {nu:g}"):
+        event_squeeze(obj, contacts, 0.01, 0.4, relative_depth=0.05, material_model=model)
+
+
 def test_E_from_foam_to_steel_scales_exactly():
     mesh = blob()
     c = [mesh.boundary[5], mesh.boundary[30]]

@@ -91,6 +91,39 @@ def test_a_point_near_the_object_still_snaps_to_the_boundary(tmp_path):
     assert np.allclose(mesh.nodes[i], [-0.05, 0.0])
 
 
+@pytest.mark.parametrize("offset", [2e-10, 1e-9, 1e-8])
+def test_a_placement_a_hair_from_a_corner_is_refused_naming_the_placement(tmp_path, capfd,
+                                                                          offset):
+    """A point 2e-10 to 1e-8 m from the foam square's corner (beyond the 1e-10 m within which
+    it is the corner) made elements the mesh refuses: "object.mesh: mesh has degenerate
+    (zero-area) elements" named neither the placement nor the distance. 3e-8 m meshes.
+    """
+    path = variant(tmp_path, FOAM, lambda d: d["fingers"]["F1"].__setitem__(
+        "placement", {"point": [-0.05, -0.05 + offset]}))
+    line = refused(["squeeze", path], capfd)
+    assert (f"error: fingers.F1.placement.point: the outline has vertices {offset:.3g} m apart "
+            "at (-0.05, -0.05) m") in line
+
+
+def test_a_mesh_error_of_another_cause_is_not_blamed_on_a_placement_near_a_corner(tmp_path,
+                                                                                  capfd):
+    """3e-8 m from the corner meshes; asked for too many nodes, the refusal is the mesh's."""
+    def change(d):
+        d["fingers"]["F1"]["placement"] = {"point": [-0.05, -0.05 + 3e-8]}
+        d["object"]["mesh"] = {"max_area": 1e-12}
+
+    line = refused(["squeeze", variant(tmp_path, FOAM, change)], capfd)
+    assert "error: object.mesh: mesh.max_area 1e-12 m^2 would give about" in line
+
+
+def test_an_outline_with_vertices_a_hair_apart_is_refused_naming_them():
+    with pytest.raises(InvalidInputError, match=r"the outline has vertices 1e-08 m apart at "
+                                                r"\(0, 1e-08\) m \(1e-07 of its size 0.1 m\)"):
+        generate_mesh(shapes.polygon([[0, 0], [0.1, 0], [0.1, 0.1], [0, 0.1], [0, 1e-8]]), 3e-5)
+    assert generate_mesh(shapes.polygon([[0, 0], [0.1, 0], [0.1, 0.1], [0, 0.1], [0, 3e-8]]),
+                         3e-5).n > 300
+
+
 # ----------------------------------------------------------------------------- item 5
 
 
@@ -262,6 +295,19 @@ def test_poisson_ratios_a_model_cannot_represent_are_refused_up_front(tmp_path, 
     lo, hi = POISSON_RANGES[model]
     line = refused(["squeeze", path], capfd)
     assert f"object.material.nu must be in [{lo:g}, {hi:g}]" in line
+
+
+def test_a_model_given_on_the_command_line_is_held_to_its_poisson_range(tmp_path, capfd):
+    """The scene checks its own model's range; `--model` chose another after that check: a
+    linear scene at nu = -0.5 squeezed with `--model neo_hookean` ran past a minute with a
+    leaked RuntimeWarning. Every squeeze's contact model now checks the range it runs, a
+    scene's naming the scene's field.
+    """
+    path = variant(tmp_path, FOAM, lambda d: d["object"]["material"].update(nu=-0.5))
+    line = refused(["squeeze", path, "--model", "neo_hookean"], capfd)
+    assert line.endswith("error: object.material.nu must be in [-0.3, 0.4999] for the "
+                         "neo_hookean model, got -0.5: beyond, its solves fail or lose digits "
+                         "(docs/reliability.md)")
 
 
 def test_the_auxetic_side_against_the_analytic_disk():

@@ -4,10 +4,14 @@
 
 from __future__ import annotations
 
+import re
 from functools import cache
+from pathlib import Path
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from squeeze_grasp_ros.mechanics.elastic import shapes
 from squeeze_grasp_ros.mechanics.elastic.compliance import node_dofs
@@ -16,6 +20,7 @@ from squeeze_grasp_ros.mechanics.elastic.reduced import reduce_blocks
 from squeeze_grasp_ros.mechanics.errors import InvalidInputError
 from squeeze_grasp_ros.mechanics.ring.grasp_map import ring_grasp_map
 from squeeze_grasp_ros.mechanics.ring.model import (
+    MAX_THINNESS,
     RingModel,
     circle_diametral_response,
     ring_diameter_changes,
@@ -310,6 +315,42 @@ def test_bad_inputs_raise():
         ring_from_outline(outline("disk"), Material(E, 0.0, W), 0.05, 40)
     with pytest.raises(InvalidInputError):
         ring.solve_loads(np.ones((ring.n, 2)))
+
+
+def test_a_wall_too_thin_for_its_element_count_is_refused_by_field():
+    """A wall of 1.2e-8 m on a 0.08 m circle of 256 elements (n L / h = 1.7e9) returned diameter
+    changes off by a factor of 10 with no warning; now the wall is refused, naming the bound,
+    which fewer elements lower.
+    """
+    with pytest.raises(InvalidInputError, match=r"ring.wall_thickness must be >= 6.83e-07 m "
+                                                r"with 256 elements .* got 1.2e-08"):
+        circle_diametral_response(256, 0.04, E, W, 1.2e-8, 1.0)
+    ring = ring_from_outline(outline("disk"), Material(E, 0.0, W), 6.83e-7 / 8, 32)
+    assert ring.n == 32
+
+
+def test_the_thin_wall_refusal_ring_md_quotes_is_the_one_raised():
+    page = (Path(__file__).resolve().parents[1] / "docs" / "ring.md").read_text(encoding="utf-8")
+    quoted = re.search(r"\(`(ring\.wall_thickness must be >=[^`]*?) \.\.\.`\)", page).group(1)
+    quoted = " ".join(quoted.split())  # the page wraps it
+    with pytest.raises(InvalidInputError) as refused:
+        ring_from_outline(outline("disk"), Material(E, 0.0, W), 1e-7, 200)
+    assert str(refused.value).startswith(quoted)
+
+
+@settings(max_examples=12, deadline=None)
+@given(quarter=st.integers(4, 150), log_margin=st.floats(0.0, 2.0))
+def test_a_thin_wall_within_the_bound_keeps_its_accuracy(quarter, log_margin):
+    """Within MAX_THINNESS the ring agrees with the closed form to its discretisation error
+    (about 8 / n^2, second order) plus 1e-3 of round-off, from the thinnest wall allowed to 100
+    times it (n a multiple of 4, so that nodes sit under both loads and across).
+    """
+    R, elements = 0.04, 4 * quarter
+    h = elements * 2 * R / MAX_THINNESS * 10 ** log_margin
+    P = 1e-4 * R / abs(ring_diameter_changes(R, E, W, h, 1.0)[0])  # a small displacement
+    exact = np.array(ring_diameter_changes(R, E, W, h, P))
+    fe = np.array(circle_diametral_response(elements, R, E, W, h, P)[:2])
+    assert np.abs(fe / exact - 1).max() <= 10 / elements**2 + 1e-3
 
 
 def _write_scene(tmp_path, relative_depth=0.05, effects="[friction, strain_limit]"):

@@ -19,6 +19,8 @@ from squeeze_grasp_ros.mechanics.elastic import shapes
 from squeeze_grasp_ros.mechanics.elastic.compliance import ElasticObject
 from squeeze_grasp_ros.mechanics.elastic.material import Material
 from squeeze_grasp_ros.mechanics.elastic.mesh import (
+    CLOSE_VERTICES,
+    CLOSE_VERTICES_ERROR,
     MAX_MESH_NODES,
     Mesh,
     generate_mesh,
@@ -108,7 +110,23 @@ def build_mesh(scene: Scene, *, outline: shapes.Outline | None = None,
                              split_boundary=ShapeType(scene.object.shape["type"])
                              != ShapeType.SPLINE)
     except InvalidInputError as exc:
-        raise SceneError(f"object.mesh: {exc}") from None
+        crowded = str(exc).startswith(CLOSE_VERTICES_ERROR) and _crowded_placement(scene, outline)
+        raise SceneError(f"{crowded or 'object.mesh'}: {exc}") from None
+
+
+def _crowded_placement(scene: Scene, outline: shapes.Outline) -> str | None:
+    """The field of the first placement point whose vertex on ``outline`` (the outline with the
+    placements inserted) lies within :data:`CLOSE_VERTICES` of the size of a neighbour, or None.
+    """
+    p = outline.points
+    for where, placement in named_placements(scene):
+        if placement.point is None:
+            continue
+        k = int(np.argmin(np.linalg.norm(p - np.asarray(placement.point), axis=1)))
+        gaps = np.linalg.norm(p[[k - 1, (k + 1) % len(p)]] - p[k], axis=1)
+        if gaps.min() < CLOSE_VERTICES * outline.size:
+            return f"{where}.placement.point"
+    return None
 
 
 def scene_solid(scene: Scene) -> ElasticObject:

@@ -21,7 +21,7 @@ depth_reached 0.12
 from __future__ import annotations
 
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from functools import cached_property
 
 import numpy as np
@@ -67,6 +67,7 @@ from squeeze_grasp_ros.scene.build import (
     placement_node,
     scene_material,
 )
+from squeeze_grasp_ros.scene.checks import check_material
 from squeeze_grasp_ros.scene.specs import Scene, SceneError
 
 __all__ = ["RING_STAGES", "SOLID_STAGES", "GraspSetup", "Progress", "check_adversary_node",
@@ -293,6 +294,18 @@ class GraspSetup:
         return finger_motion(self.solid, self.contacts, kind=self.scene.squeeze.type,
                              directions=self.given_directions)
 
+    def _material_model(self, material_model: MaterialModel | str | None) -> MaterialModel | str:
+        """``material_model``, default the scene's; another known model than the scene's is
+        held to its Poisson's ratio range with the scene's field named (an unknown one is
+        refused by name where it is used).
+        """
+        if material_model is None:
+            return self.scene.object.material.model
+        if material_model in MaterialModel.values():
+            check_material(replace(self.scene.object.material,
+                                   model=MaterialModel(material_model)))
+        return material_model
+
     def contact_model(self, *, terminations: bool = True,
                       material_model: MaterialModel | str | None = None) -> ContactModel:
         """The contact model of the object, the scene's friction and material model.
@@ -304,10 +317,9 @@ class GraspSetup:
         material_model : MaterialModel or str, optional
             Default the scene's ``object.material.model``.
         """
-        material = self.scene.object.material.model if material_model is None else material_model
         limits = self.limits if terminations else TerminationLimits()
-        return contact_model(material, self.solid, self.scene.mu, limits,
-                             max_events_per_depth=self.scene.squeeze.max_events_per_depth)
+        return contact_model(self._material_model(material_model), self.solid, self.scene.mu,
+                             limits, max_events_per_depth=self.scene.squeeze.max_events_per_depth)
 
     def event_squeeze(
         self,
@@ -383,8 +395,7 @@ class GraspSetup:
             max_events_per_depth=sq.max_events_per_depth,
             directions=self.given_directions,
             progress=progress,
-            material_model=scene.object.material.model if material_model is None
-            else material_model,
+            material_model=self._material_model(material_model),
             checkpoint=checkpoint,
             options=options,
         )

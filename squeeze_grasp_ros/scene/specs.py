@@ -15,6 +15,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any, Optional
 
+from squeeze_grasp_ros.mechanics.elastic.material import E_RANGE, THICKNESS_RANGE
 from squeeze_grasp_ros.mechanics.elastic.mesh import MAX_MESH_NODES
 from squeeze_grasp_ros.mechanics.errors import FINGERS_MEET
 from squeeze_grasp_ros.mechanics.ring.model import MAX_RING_ELEMENTS
@@ -103,10 +104,10 @@ class MeshSpec:
 class MaterialSpec:
     """Material of the object (plane stress)."""
 
-    E: float = spec("Young's modulus (gels to diamond)", "Pa", lo=1e-3, hi=1e13)
+    E: float = spec("Young's modulus (gels to diamond)", "Pa", lo=E_RANGE[0], hi=E_RANGE[1])
     nu: float = spec("Poisson's ratio (neo_hookean: -0.3 to 0.4999)", "", lo=-0.9, hi=0.5)
-    thickness: float = spec("out-of-plane thickness h (ring: width w)", "m", lo=0.0, hi=1e3,
-                            lo_open=True)
+    thickness: float = spec("out-of-plane thickness h (ring: width w)", "m",
+                            lo=THICKNESS_RANGE[0], hi=THICKNESS_RANGE[1])
     model: MaterialModel = spec("constitutive model of a solid (event-driven squeeze): linear "
                                 "(the paper's), corotational or neo_hookean (finite "
                                 "deformation)", default=MaterialModel.LINEAR)

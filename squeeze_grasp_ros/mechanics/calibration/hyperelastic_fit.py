@@ -31,7 +31,11 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import least_squares
 
-from squeeze_grasp_ros.mechanics.calibration.material_fit import require_side
+from squeeze_grasp_ros.mechanics.calibration.material_fit import (
+    MIN_STRAIN,
+    require_side,
+    shortened_by,
+)
 from squeeze_grasp_ros.mechanics.errors import InvalidInputError, NumericalError, require_finite
 from squeeze_grasp_ros.mechanics.vocabulary import MaterialModel
 
@@ -73,9 +77,10 @@ class CompressionCurve:
                                     f"and {dl.shape}")
         if not np.all(np.isfinite(force)) or not np.all(force > 0):
             raise InvalidInputError("force must be > 0 N (compression) at every point")
-        if not np.all(np.isfinite(dl)) or not np.all((dl < 0) & (dl > -self.length)):
-            raise InvalidInputError(f"dl must be in (-{self.length:g}, 0) m at every point "
-                                    "(the cuboid shortens)")
+        if not shortened_by(dl, self.length):
+            raise InvalidInputError(f"dl must be in (-{self.length:g}, "
+                                    f"{-MIN_STRAIN * self.length:.3g}] m at every point (the "
+                                    f"cuboid shortens, by at least {MIN_STRAIN:g} of its length)")
         if self.dw is not None and (np.shape(self.dw) != dl.shape
                                     or not np.all(np.isfinite(self.dw))):
             raise InvalidInputError("dw must have one finite value per point")

@@ -29,6 +29,21 @@ cross-section w h underflows or overflows in double precision (a side of 1e308 m
 Poisson's ratio, and in a compression curve a scipy traceback)."""
 
 
+MIN_STRAIN = 1e-9
+"""Smallest compressive strain -dl / l a measurement may give (a nanostrain; no compression test
+resolves less). At -dl / l = 1e-200 the cuboid fit gave a Poisson's ratio of NaN ("check the
+signs"), the linear curve fit scipy's "Residuals are not finite in the initial point" and the
+neo-Hookean one a NaN residual."""
+
+
+def shortened_by(dl: float | np.ndarray, length: float) -> bool:
+    """Whether every change ``dl`` (m) shortens a side ``length`` (m) by a strain in
+    [:data:`MIN_STRAIN`, 1).
+    """
+    strain = -np.asarray(dl, float) / length
+    return bool(np.all(np.isfinite(strain) & (strain >= MIN_STRAIN) & (strain < 1.0)))
+
+
 def require_side(name: str, value: float) -> None:
     """Refuse a sample side outside :data:`SIDE_RANGE`.
 
@@ -84,10 +99,10 @@ class Cuboid:
             raise InvalidInputError(f"cuboid.force must be > 0, got {self.force}")
         for name in ("length", "width", "height"):
             require_side(f"cuboid.{name}", getattr(self, name))
-        if not -self.length < self.dl < 0:
+        if not shortened_by(self.dl, self.length):
             raise InvalidInputError(
-                f"cuboid.dl must be in (-{self.length:g}, 0) m (the cuboid shortens), "
-                f"got {self.dl}"
+                f"cuboid.dl must be in (-{self.length:g}, {-MIN_STRAIN * self.length:.3g}] m "
+                f"(the cuboid shortens, by at least {MIN_STRAIN:g} of its length), got {self.dl}"
             )
         if self.dh is not None:
             require_finite("cuboid.dh", self.dh)

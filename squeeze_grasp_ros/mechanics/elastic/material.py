@@ -10,6 +10,17 @@ import numpy as np
 from squeeze_grasp_ros.mechanics.errors import InvalidInputError, require_finite
 from squeeze_grasp_ros.mechanics.vocabulary import MaterialModel
 
+E_RANGE = (1e-3, 1e13)
+"""Young's moduli a :class:`Material` takes, Pa, inclusive: gels to diamond (the scene's range
+too). Far beyond, E h leaves the floats' normal range: E = 1e-320 Pa (subnormal) gave
+compliances of inf and NaN work and dissipation in an event-driven squeeze's result, and
+E h = 1e310 N/m "reduced stiffness must be finite"."""
+
+THICKNESS_RANGE = (1e-9, 1e3)
+"""Out-of-plane thicknesses a :class:`Material` takes, m, inclusive: a nanometre (no plane-stress
+continuum is thinner) to a kilometre. With E in :data:`E_RANGE`, E h stays in [1e-12, 1e16] N/m;
+a thickness of 1e-320 m gave compliances of inf (with numpy overflow warnings)."""
+
 
 @dataclass(frozen=True)
 class Material:
@@ -18,11 +29,12 @@ class Material:
     Parameters
     ----------
     E : float
-        Young's modulus, Pa (> 0).
+        Young's modulus, Pa, in :data:`E_RANGE` ([1e-3, 1e13]).
     nu : float
         Poisson's ratio, dimensionless, in (-1, 0.5].
     thickness : float
-        Out-of-plane thickness h, m (> 0). Forces, energies and stiffnesses scale with E*h.
+        Out-of-plane thickness h, m, in :data:`THICKNESS_RANGE` ([1e-9, 1e3]). Forces, energies
+        and stiffnesses scale with E*h.
 
     Examples
     --------
@@ -42,12 +54,15 @@ class Material:
     def __post_init__(self) -> None:
         for name in ("E", "nu", "thickness"):
             require_finite(f"material.{name}", getattr(self, name))
-        if not self.E > 0:
-            raise InvalidInputError(f"material.E must be > 0 Pa, got {self.E}")
+        if not E_RANGE[0] <= self.E <= E_RANGE[1]:
+            raise InvalidInputError(f"material.E must be in [{E_RANGE[0]:g}, {E_RANGE[1]:g}] Pa, "
+                                    f"got {self.E}")
         if not -1.0 < self.nu <= 0.5:
             raise InvalidInputError(f"material.nu must be in (-1, 0.5], got {self.nu}")
-        if not self.thickness > 0:
-            raise InvalidInputError(f"material.thickness must be > 0 m, got {self.thickness}")
+        lo, hi = THICKNESS_RANGE
+        if not lo <= self.thickness <= hi:
+            raise InvalidInputError(f"material.thickness must be in [{lo:g}, {hi:g}] m, got "
+                                    f"{self.thickness}")
 
     @property
     def force_scale(self) -> float:

@@ -280,12 +280,58 @@ def generate_mesh(
                 f"the mesher reached the limit of {max_nodes:,} nodes before it met the "
                 f"element size {estimate.spacing:.3g} m and angle {min_angle:g} deg: use "
                 "larger elements (mesh.nodes or mesh.max_area) or a simpler outline")
+        if _has_degenerate_elements(nodes, tris):
+            close = _close_vertices_error(loops)
+            if close is not None:
+                raise close
         return mesh_from_triangles(nodes, tris)
 
     mesh = triangulated(split_boundary)
     if not split_boundary and mesh.min_angle_deg() < min_angle - ANGLE_SLACK:
         mesh = triangulated(True)
     return mesh
+
+
+CLOSE_VERTICES = 1e-6
+"""Vertices of an outline closer than this fraction of its size are named when its mesh fails
+with elements of (almost) zero area: Triangle grades its elements down to their distance, and
+:func:`mesh_from_triangles` refuses elements below :data:`DEGENERATE_AREA` of the size
+squared. A square of side 0.1 m with a vertex 1e-8 m from a corner failed so (1e-10 m is one
+vertex, 3e-8 m meshed)."""
+
+
+CLOSE_VERTICES_ERROR = "the outline has vertices"
+"""How the error of :data:`CLOSE_VERTICES` begins (a scene names the placement behind it)."""
+
+DEGENERATE_AREA = 1e-14
+"""Elements of an area at most this fraction of the square of the mesh's extent are refused as
+degenerate (:func:`mesh_from_triangles`)."""
+
+
+def _has_degenerate_elements(nodes: np.ndarray, triangles: np.ndarray) -> bool:
+    """Whether :func:`mesh_from_triangles` would refuse an element of ``triangles`` as
+    degenerate.
+    """
+    scale = float(np.ptp(nodes, axis=0).max()) ** 2
+    return bool(np.any(np.abs(element_areas(nodes, triangles)) <= DEGENERATE_AREA * scale))
+
+
+def _close_vertices_error(loops: list[np.ndarray]) -> InvalidInputError | None:
+    """The error naming the closest consecutive vertices of ``loops`` (m) when they are closer
+    than :data:`CLOSE_VERTICES` of the outline's size, else None.
+    """
+    points = np.concatenate(loops)
+    size = float(np.ptp(points, axis=0).max())
+    gaps = np.concatenate([np.linalg.norm(np.roll(loop, -1, axis=0) - loop, axis=1)
+                           for loop in loops])
+    k = int(np.argmin(gaps))
+    gap, where = float(gaps[k]), points[k]
+    if not gap < CLOSE_VERTICES * size:
+        return None
+    return InvalidInputError(
+        f"{CLOSE_VERTICES_ERROR} {gap:.3g} m apart at ({where[0]:.6g}, {where[1]:.6g}) m "
+        f"({gap / size:.2g} of its size {size:.4g} m): the mesh there has elements of almost "
+        "zero area; make them one vertex or move them apart")
 
 
 def mesh_from_triangles(nodes: np.ndarray, triangles: np.ndarray) -> Mesh:
@@ -302,10 +348,9 @@ def mesh_from_triangles(nodes: np.ndarray, triangles: np.ndarray) -> Mesh:
     remap = -np.ones(len(nodes), dtype=int)
     remap[used] = np.arange(len(used))
     nodes, triangles = nodes[used], remap[triangles]
-    area = element_areas(nodes, triangles)
-    scale = float(np.ptp(nodes, axis=0).max()) ** 2
-    if np.any(np.abs(area) <= 1e-14 * scale):
+    if _has_degenerate_elements(nodes, triangles):
         raise InvalidInputError("mesh has degenerate (zero-area) elements")
+    area = element_areas(nodes, triangles)
     flip = area < 0
     triangles[flip] = triangles[flip][:, [0, 2, 1]]
     loops = boundary_loops(triangles)

@@ -78,6 +78,15 @@ BANDWIDTH = 5
 """Upper bandwidth of the clamped stiffness (two nodes of three DOFs per element)."""
 
 
+MAX_THINNESS = 3e7
+"""Largest n L / h of a ring (n elements, size L, wall thickness h): the bending stiffness
+(h^3) is round-off against the extension (h) beyond. Measured on a circle under diametral loads
+against :func:`ring_diameter_changes` (16 to 2,000 elements): the round-off part of the error
+stayed below 7e-4 up to 3e7; at 1.7e8 it was 6e-3 (256 elements), at 4e8 1.1e-2 (2,000), at
+2.7e8 1,000 % (256 elements, h / L = 1.5e-7, returned without a warning), and thinner walls
+ended in "clamped ring stiffness is not positive definite"."""
+
+
 @dataclass(frozen=True)
 class RingModel:
     """A ring-like object: middle curve, material and wall thickness, with cached mechanics.
@@ -90,7 +99,8 @@ class RingModel:
         E (Pa), nu (must be 0, Sec. 7) and ``thickness`` = the out-of-plane width w (m).
     wall_thickness : float
         In-plane wall thickness h, m (the bending direction), in (0, L/4) with L the larger
-        side of the middle curve's bounding box (:attr:`scale`).
+        side of the middle curve's bounding box (:attr:`scale`), and at least n L /
+        :data:`MAX_THINNESS`.
 
     Notes
     -----
@@ -120,6 +130,12 @@ class RingModel:
                 "m "
                 f"(a quarter of the ring size), got {self.wall_thickness}"
             )
+        if len(p) * self.scale > MAX_THINNESS * self.wall_thickness:
+            raise InvalidInputError(
+                f"ring.wall_thickness must be >= {len(p) * self.scale / MAX_THINNESS:.3g} m with "
+                f"{len(p)} elements on a ring of size {self.scale:.4g} m, got "
+                f"{self.wall_thickness} (n L / h <= {MAX_THINNESS:g}: a thinner wall loses "
+                "digits to round-off; fewer ring.elements allow a thinner wall)")
         if np.min(self.element_lengths) <= 1e-9 * self.scale:
             raise InvalidInputError("ring.points has coincident consecutive nodes")
         object.__setattr__(self, "points", p)

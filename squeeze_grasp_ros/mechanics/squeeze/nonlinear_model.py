@@ -38,6 +38,7 @@ from squeeze_grasp_ros.mechanics.elastic.interior import (
     TangentFactor,
     default_factorizer,
 )
+from squeeze_grasp_ros.mechanics.elastic.material import require_poisson_ratio
 from squeeze_grasp_ros.mechanics.elastic.strain_measures import max_principal_strain
 from squeeze_grasp_ros.mechanics.errors import InvalidInputError
 from squeeze_grasp_ros.mechanics.squeeze.contact_model import (
@@ -276,15 +277,24 @@ class NonlinearContactModel(ContactModel):
                 "load_substeps": sum(r.stats["substeps"] for r in responses)}
 
 
-def contact_model(material_model: MaterialModel | str, *args, **kwargs) -> ContactModel:
-    """The contact model of ``material_model``: the linear one (reduced stiffness) or the
-    finite-deformation one; arguments as :class:`ContactModel`.
+def contact_model(material_model: MaterialModel | str, obj: ElasticObject, *args,
+                  **kwargs) -> ContactModel:
+    """The contact model of ``material_model`` for ``obj``: the linear one (reduced stiffness)
+    or the finite-deformation one; arguments as :class:`ContactModel`.
+
+    Raises
+    ------
+    InvalidInputError
+        For an unknown model, or a Poisson's ratio of ``obj`` outside the model's
+        :data:`~squeeze_grasp_ros.mechanics.elastic.material.POISSON_RANGES` (a scene is
+        checked when it loads; this is the check of every other caller).
     """
     if material_model not in MaterialModel.values():
         choices = ", ".join(MaterialModel.values())
         raise InvalidInputError(f"material_model must be one of {choices}, got "
                                 f"{material_model!r}")
     model = MaterialModel(material_model)
+    require_poisson_ratio(obj.material.nu, model)
     if model == MaterialModel.LINEAR:
-        return ContactModel(*args, **kwargs)
-    return NonlinearContactModel(*args, material_model=model, **kwargs)
+        return ContactModel(obj, *args, **kwargs)
+    return NonlinearContactModel(obj, *args, material_model=model, **kwargs)

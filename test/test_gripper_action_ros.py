@@ -125,6 +125,34 @@ def test_an_effort_below_the_planned_force_stalls(tmp_path):
     assert limit <= force <= 1.05 * limit
 
 
+def test_a_joint_in_metres_gets_its_goal_in_metres_and_a_wide_tolerance_is_refused(tmp_path):
+    """A lab's own device, a joint at half the aperture in m (as a Franka Hand's finger): the
+    gripper goal's position is half the planned aperture, 0.5 x (50 - 7.5) mm. With the stock
+    goal_tolerance 0.01 (20 mm of aperture, beyond the 7.5 mm closing) the run said "grasp
+    held" at a depth of 0.04 mm, the controller having reported the goal reached at once; now
+    the executor refuses the goal (invalid_goal), naming the field, and sends none.
+    """
+    device = yaml.safe_load((REPO / "config" / "devices" / "generic_85mm.yaml").read_text())
+    device.update(name="half_85mm", transmission={
+        "joints": ["finger_joint"], "position_per_aperture": 0.5, "position_limits": [0, 0.0425]})
+    (tmp_path / "half_85mm.yaml").write_text(yaml.safe_dump(device))
+    tight = run(write_scene(tmp_path, sponge("gripper_action", device="half_85mm.yaml",
+                                             **TIGHT)))["result"]
+    print(tight.message)
+    assert tight.termination == "depth_reached" and tight.success
+    sent = re.search(r"goal: position ([-\d.e]+), max_effort ([-\d.e]+)", tight.message)
+    assert float(sent[1]) == pytest.approx(0.5 * (0.05 - 0.0075), abs=1e-6)
+    assert float(sent[2]) == pytest.approx(1.25 * 5.9703, rel=1e-3)   # 1 N per N
+    wide = run(write_scene(tmp_path, sponge("gripper_action", device="half_85mm.yaml")))
+    result = wide["result"]
+    print(result.message)
+    assert result.termination == "invalid_goal" and not result.success
+    assert result.message.startswith("controller.goal_tolerance 0.01 (joint units) is 20 mm of "
+                                     "aperture on half_85mm")
+    assert "closing of 7.5 mm" in result.message and result.ticks == 0
+    assert wide["depth"] == 0.0
+
+
 def test_a_canceled_grasp_cancels_the_gripper_goal(tmp_path):
     """A cancel of the grasp goal mid-squeeze cancels the gripper goal: the controller holds the
     measured position and the goal ends canceled, short of the planned depth.

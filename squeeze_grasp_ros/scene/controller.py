@@ -118,6 +118,23 @@ class JawController:
             max_velocity=(s.max_velocity if self.kind is ControllerKind.PARALLEL_GRIPPER
                           else float("inf")))
 
+    def tolerance_problem(self, closing: float) -> str | None:
+        """Why a gripper action controller would take a squeeze closing the aperture by
+        ``closing`` (m) as reached before it squeezes, or None: its ``goal_tolerance`` (joint
+        units) is, through the transmission, at least that closing (the stock controllers end a
+        goal once the joint is within the tolerance of its position).
+        """
+        tolerance = self.spec.goal_tolerance
+        gain = abs(self.gripper.transmission.position_per_aperture)
+        if tolerance / gain < closing:
+            return None
+        return (f"controller.goal_tolerance {tolerance:g} (joint units) is "
+                f"{tolerance / gain * 1e3:.4g} mm of aperture on {self.gripper.name} "
+                f"(/ |transmission.position_per_aperture| {gain:g}), not below the squeeze's "
+                f"closing of {closing * 1e3:.4g} mm: the {self.spec.type} controller would "
+                f"report the goal reached before the jaws squeeze; set controller.goal_tolerance "
+                f"below {closing * gain:.4g}")
+
     def joint_positions(self, aperture: float) -> tuple[float, ...]:
         """Each controller joint's position at ``aperture`` (m), through the transmission."""
         return self.gripper.joint_positions(aperture)[:1] * len(self.joints)

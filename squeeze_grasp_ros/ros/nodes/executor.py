@@ -320,6 +320,8 @@ class ExecutorNode(Node):
         problem = goal_problem(goal, list(self.devices))
         if problem is None and self.jaws is not None:
             problem = self.jaws.effort_problem(goal)
+        if problem is None and self.jaw_action is not None:
+            problem = self.jaw_action.tolerance_problem(goal)
         if problem is not None:
             handle.abort()
             return messages.invalid_goal_result(problem)

@@ -115,6 +115,15 @@ class JawAction:
         return self.publisher, messages.header(ns)
 
     # ----------------------------------------------------------------- the goal
+    def tolerance_problem(self, goal: GraspGoal) -> str | None:
+        """Why grasp goal ``goal`` would be reached where it starts, or None
+        (:meth:`.JawController.tolerance_problem` of its largest closing: its depth times the
+        jaws' speeds per unit depth, both along the jaw line).
+        """
+        speed = sum(float(np.linalg.norm(d)) for f, d in zip(goal.fingers, goal.directions)
+                    if f in self.fingers)
+        return self.controller.tolerance_problem(goal.depth * speed)
+
     def target(self, goal: GraspGoal, obs: Observation) -> tuple[float, float]:
         """(joint position, joint effort limit) of grasp goal ``goal`` from its first
         observation (fixes the jaw line).

@@ -118,6 +118,19 @@ class JawController:
             max_velocity=(s.max_velocity if self.kind is ControllerKind.PARALLEL_GRIPPER
                           else float("inf")))
 
+    def opening_problem(self, start: float, end: float) -> str | None:
+        """Why a squeeze of the jaws from aperture ``start`` to ``end`` (m) cannot be
+        commanded, or None: ``end`` outside the device's opening range (a controller refuses
+        or clamps such a command, and the jaws stand short of it until the stall watch).
+        """
+        lo, hi = self.gripper.opening.min, self.gripper.opening.max
+        if lo - 1e-12 <= end <= hi + 1e-12:
+            return None
+        return (f"the goal's squeeze takes the aperture from {start * 1e3:.4g} mm to "
+                f"{end * 1e3:.4g} mm, outside {self.gripper.name}'s opening [{lo * 1e3:.4g}, "
+                f"{hi * 1e3:.4g}] mm (its device file's opening): the controller cannot take the "
+                "jaws there; plan a shallower squeeze or another gripper")
+
     def tolerance_problem(self, closing: float) -> str | None:
         """Why a gripper action controller would take a squeeze closing the aperture by
         ``closing`` (m) as reached before it squeezes, or None: its ``goal_tolerance`` (joint

@@ -415,8 +415,11 @@ class ExecutorNode(Node):
                     goal, msg or deserialize_message(data, MonitorStatus), ns):
                 return
             goal.start_ns = ns
-            if self.jaws is not None:
-                self.jaws.start(obs)
+            problem = None if self.jaws is None else self.jaws.start(obs, goal.program.goal)
+            if problem is not None:
+                self._end_holding(goal, ExecuteGrasp.Result.INVALID_GOAL,
+                                  f"{problem}; nothing was commanded")
+                return
         if msg is not None:
             goal.events += msg.events
             goal.since_feedback += msg.events

@@ -135,9 +135,19 @@ class JawCommands:
                 f"JointTrajectoryController does not limit effort: the drive would stall short "
                 f"of the planned aperture); plan a shallower squeeze or a stronger gripper")
 
-    def start(self, obs: Observation) -> None:
-        """Fix the jaw line from the jaws' measured tips (a goal's first cycle)."""
+    def start(self, obs: Observation, goal: GraspGoal) -> str | None:
+        """Fix the jaw line from the jaws' measured tips (a goal's first cycle); why ``goal``'s
+        squeeze leaves the device's opening range, or None
+        (:meth:`.JawController.opening_problem`).
+        """
         self.line = self.controller.jaw_line(obs.positions)
+        first, second = self.fingers
+        end = {f: np.asarray(obs.positions[f], float) + goal.depth * np.asarray(d, float)
+               for f, d in zip(goal.fingers, goal.directions)}
+        return self.controller.opening_problem(
+            self.line.aperture(obs.positions[first], obs.positions[second]),
+            self.line.aperture(end.get(first, obs.positions[first]),
+                               end.get(second, obs.positions[second])))
 
     def trajectory(self, setpoints: Mapping[str, np.ndarray], start_ns: int
                    ) -> tuple[Any, JointTrajectory]:
@@ -208,8 +218,10 @@ class HandCommands:
         return {hand_finger: tips[finger]
                 for finger, hand_finger in self.controller.fingers.items()}
 
-    def start(self, obs: Observation) -> None:
-        """The joints of the measured tips (a goal's first cycle)."""
+    def start(self, obs: Observation, goal: GraspGoal | None = None) -> None:
+        """The joints of the measured tips (a goal's first cycle; a setpoint out of the hand's
+        reach is warned about per cycle, not refused: None).
+        """
         self.solution = self.controller.hand.inverse(self._targets(obs.positions),
                                                      tolerance=np.inf)
         self.warned = False

@@ -87,7 +87,8 @@ class GripperSpec:
     name: str = spec("device name")
     opening: OpeningSpec = spec("aperture range")
     max_force: float = spec("largest grip force of one jaw", "N", lo=0.0, lo_open=True)
-    pad: TipSpec = spec("each jaw's pad: {shape: pad, width, edge_radius} (or a circle)")
+    pad: TipSpec = spec("each jaw's pad: {shape: pad, width, edge_radius} (or a circle), each "
+                        "length at most 1 m")
     transmission: TransmissionSpec = spec("jaw position and force to joint position and "
                                           "effort")
     max_speed: float = spec("largest closing speed of the aperture", "m/s", lo=0.0,

@@ -153,6 +153,27 @@ def test_a_joint_in_metres_gets_its_goal_in_metres_and_a_wide_tolerance_is_refus
     assert wide["depth"] == 0.0
 
 
+@pytest.mark.parametrize("kind", ["parallel_gripper", "gripper_action"])
+def test_a_squeeze_below_the_device_opening_is_refused_before_any_goal(kind, tmp_path, capfd):
+    """A device closing no further than 45 mm, the sponge planned from 50 to 42.5 mm: before,
+    the gripper goal went out and the grasp goal ended "gripper_rejected (... rejected the goal
+    (position ..., max_effort ...): its log says why)"; now it ends invalid_goal at its first
+    cycle, naming the range, as on the JointTrajectory route, and no gripper goal is sent.
+    """
+    device = yaml.safe_load((REPO / "config" / "devices" / "generic_85mm.yaml").read_text())
+    device["name"], device["opening"]["min"] = "narrow_85mm", 0.045
+    device["transmission"]["position_limits"] = [0.0, 0.8 - 0.045 * 0.8 / 0.085]
+    (tmp_path / "narrow_85mm.yaml").write_text(yaml.safe_dump(device))
+    out = run_observed(write_scene(tmp_path, sponge(kind, device="narrow_85mm.yaml", **TIGHT)))
+    result = out["result"]
+    print(result.message)
+    assert result.termination == "invalid_goal" and not result.success
+    assert result.message.startswith("the goal's squeeze takes the aperture from 50 mm to "
+                                     "42.5 mm, outside narrow_85mm's opening [45, 85] mm")
+    # the simulated server logs each goal it rejects (this one would be, outside its range)
+    assert out["depth"] == 0.0 and "rejected the goal on" not in capfd.readouterr().err
+
+
 def test_a_canceled_grasp_cancels_the_gripper_goal(tmp_path):
     """A cancel of the grasp goal mid-squeeze cancels the gripper goal: the controller holds the
     measured position and the goal ends canceled, short of the planned depth.

@@ -118,16 +118,21 @@ class JawController:
             max_velocity=(s.max_velocity if self.kind is ControllerKind.PARALLEL_GRIPPER
                           else float("inf")))
 
-    def opening_problem(self, start: float, end: float) -> str | None:
-        """Why a squeeze of the jaws from aperture ``start`` to ``end`` (m) cannot be
-        commanded, or None: ``end`` outside the device's opening range (a controller refuses
-        or clamps such a command, and the jaws stand short of it until the stall watch).
+    def opening_problem(self, line: JawLine, start: Mapping[str, np.ndarray],
+                        end: Mapping[str, np.ndarray]) -> str | None:
+        """Why a squeeze of the jaws from tips ``start`` to ``end`` (m; a jaw missing from
+        ``end`` stays) on ``line`` cannot be commanded, or None: its end aperture outside the
+        device's opening range (a controller refuses or clamps such a command, and the jaws
+        stand short of it until the stall watch).
         """
+        first, second = self.jaws
+        before = line.aperture(start[first], start[second])
+        after = line.aperture(end.get(first, start[first]), end.get(second, start[second]))
         lo, hi = self.gripper.opening.min, self.gripper.opening.max
-        if lo - 1e-12 <= end <= hi + 1e-12:
+        if lo - 1e-12 <= after <= hi + 1e-12:
             return None
-        return (f"the goal's squeeze takes the aperture from {start * 1e3:.4g} mm to "
-                f"{end * 1e3:.4g} mm, outside {self.gripper.name}'s opening [{lo * 1e3:.4g}, "
+        return (f"the goal's squeeze takes the aperture from {before * 1e3:.4g} mm to "
+                f"{after * 1e3:.4g} mm, outside {self.gripper.name}'s opening [{lo * 1e3:.4g}, "
                 f"{hi * 1e3:.4g}] mm (its device file's opening): the controller cannot take the "
                 "jaws there; plan a shallower squeeze or another gripper")
 

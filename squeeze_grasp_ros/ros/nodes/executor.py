@@ -415,7 +415,8 @@ class ExecutorNode(Node):
                     goal, msg or deserialize_message(data, MonitorStatus), ns):
                 return
             goal.start_ns = ns
-            problem = None if self.jaws is None else self.jaws.start(obs, goal.program.goal)
+            driver = self.jaws or self.jaw_action
+            problem = None if driver is None else driver.start(obs, goal.program.goal)
             if problem is not None:
                 self._end_holding(goal, ExecuteGrasp.Result.INVALID_GOAL,
                                   f"{problem}; nothing was commanded")

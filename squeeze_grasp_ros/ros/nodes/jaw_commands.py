@@ -141,13 +141,8 @@ class JawCommands:
         (:meth:`.JawController.opening_problem`).
         """
         self.line = self.controller.jaw_line(obs.positions)
-        first, second = self.fingers
-        end = {f: np.asarray(obs.positions[f], float) + goal.depth * np.asarray(d, float)
-               for f, d in zip(goal.fingers, goal.directions)}
-        return self.controller.opening_problem(
-            self.line.aperture(obs.positions[first], obs.positions[second]),
-            self.line.aperture(end.get(first, obs.positions[first]),
-                               end.get(second, obs.positions[second])))
+        return self.controller.opening_problem(self.line, obs.positions,
+                                               squeeze_end(goal, obs.positions, goal.depth))
 
     def trajectory(self, setpoints: Mapping[str, np.ndarray], start_ns: int
                    ) -> tuple[Any, JointTrajectory]:
@@ -160,6 +155,15 @@ class JawCommands:
         messages.set_stamp(msg.header.stamp, start_ns)
         msg.points[0].positions = [float(p) for p in self.controller.joint_positions(aperture)]
         return self.publisher, msg
+
+
+def squeeze_end(goal: GraspGoal, start: Mapping[str, np.ndarray], depth: float
+                ) -> dict[str, np.ndarray]:
+    """The tips of ``goal``'s fingers (m) after a squeeze from ``start`` to ``depth`` (m)
+    along its directions.
+    """
+    return {f: np.asarray(start[f], float) + depth * np.asarray(d, float)
+            for f, d in zip(goal.fingers, goal.directions)}
 
 
 def one_point_trajectory(joints: Sequence[str], period_ns: int) -> JointTrajectory:

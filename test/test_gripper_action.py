@@ -242,3 +242,4 @@ def test_a_goal_tolerance_the_squeeze_ends_within_at_once_is_named(gain, closing
             assert problem.startswith(f"controller.goal_tolerance {tolerance:g} (joint units) "
                                       f"is {tolerance / abs(gain) * 1e3:.4g} mm of aperture")
             assert f"below {closing * abs(gain):.4g}" in problem
+        assert jaws.tolerance_problem(0.0) is None   # a depth-0 goal is reached where it starts

@@ -140,11 +140,12 @@ class JawController:
         """Why a gripper action controller would take a squeeze closing the aperture by
         ``closing`` (m) as reached before it squeezes, or None: its ``goal_tolerance`` (joint
         units) is, through the transmission, at least that closing (the stock controllers end a
-        goal once the joint is within the tolerance of its position).
+        goal once the joint is within the tolerance of its position). A goal that does not close
+        (depth 0) is rightly reached where it starts: None.
         """
         tolerance = self.spec.goal_tolerance
         gain = abs(self.gripper.transmission.position_per_aperture)
-        if tolerance / gain < closing:
+        if not closing > 0 or tolerance / gain < closing:
             return None
         return (f"controller.goal_tolerance {tolerance:g} (joint units) is "
                 f"{tolerance / gain * 1e3:.4g} mm of aperture on {self.gripper.name} "

@@ -210,3 +210,36 @@ def test_the_force_stop_outlasts_the_goal():
     assert servo.goal is None
     assert servo.command(0.05, 5.0, dt=DT) == 0.05
     assert servo.command(0.05, 4.0, dt=DT) == pytest.approx(0.05 - 0.02 * DT)
+
+
+@pytest.mark.parametrize("gain", [-0.8 / 0.085, 0.5, 1.0])
+@pytest.mark.parametrize("closing", [0.0024, 0.0075])
+def test_a_goal_tolerance_the_squeeze_ends_within_at_once_is_named(gain, closing, tmp_path):
+    """The controller section's goal_tolerance is in joint units: on a joint at half the
+    aperture in m (a Franka-like finger) the stock 0.01 is 20 mm of aperture. The stock rule
+    (|goal - position| < goal_tolerance) ends a squeeze of ``closing`` where it starts exactly
+    when JawController.tolerance_problem names it.
+    """
+    from squeeze_grasp_ros.scene import parse_scene
+    from squeeze_grasp_ros.scene.controller import scene_controller
+
+    device = yaml.safe_load((REPO / "config" / "devices" / "generic_85mm.yaml").read_text())
+    device["transmission"] = {"joints": ["finger_joint"], "position_per_aperture": gain,
+                              "position_offset": 0.8 if gain < 0 else 0.0}
+    (tmp_path / "device.yaml").write_text(yaml.safe_dump(device))
+    for tolerance in (0.99 * closing * abs(gain), 1.01 * closing * abs(gain), 0.01):
+        data = yaml.safe_load(SPONGE.read_text())
+        data["controller"] = {"type": "parallel_gripper", "name": "gripper_controller",
+                              "device": "device.yaml", "goal_tolerance": tolerance}
+        jaws = scene_controller(parse_scene(data), tmp_path / "scene.yaml")
+        start = jaws.joint_positions(0.05)[0]
+        servo = GripperServo(jaws.parameters(), position=start)
+        servo.accept(GripperGoal(jaws.joint_positions(0.05 - closing)[0], 5.0, 0.1), now=0.0)
+        at_once = servo.update(now=0.001, position=start, velocity=0.0) is not None
+        problem = jaws.tolerance_problem(closing)
+        assert at_once == (problem is not None), (tolerance, problem)
+        if problem is not None:
+            assert problem.startswith(f"controller.goal_tolerance {tolerance:g} (joint units) "
+                                      f"is {tolerance / abs(gain) * 1e3:.4g} mm of aperture")
+            assert f"below {closing * abs(gain):.4g}" in problem
+        assert jaws.tolerance_problem(0.0) is None   # a depth-0 goal is reached where it starts

@@ -125,6 +125,55 @@ def test_an_effort_below_the_planned_force_stalls(tmp_path):
     assert limit <= force <= 1.05 * limit
 
 
+def test_a_joint_in_metres_gets_its_goal_in_metres_and_a_wide_tolerance_is_refused(tmp_path):
+    """A lab's own device, a joint at half the aperture in m (as a Franka Hand's finger): the
+    gripper goal's position is half the planned aperture, 0.5 x (50 - 7.5) mm. With the stock
+    goal_tolerance 0.01 (20 mm of aperture, beyond the 7.5 mm closing) the run said "grasp
+    held" at a depth of 0.04 mm, the controller having reported the goal reached at once; now
+    the executor refuses the goal (invalid_goal), naming the field, and sends none.
+    """
+    device = yaml.safe_load((REPO / "config" / "devices" / "generic_85mm.yaml").read_text())
+    device.update(name="half_85mm", transmission={
+        "joints": ["finger_joint"], "position_per_aperture": 0.5, "position_limits": [0, 0.0425]})
+    (tmp_path / "half_85mm.yaml").write_text(yaml.safe_dump(device))
+    tight = run(write_scene(tmp_path, sponge("gripper_action", device="half_85mm.yaml",
+                                             **TIGHT)))["result"]
+    print(tight.message)
+    assert tight.termination == "depth_reached" and tight.success
+    sent = re.search(r"goal: position ([-\d.e]+), max_effort ([-\d.e]+)", tight.message)
+    assert float(sent[1]) == pytest.approx(0.5 * (0.05 - 0.0075), abs=1e-6)
+    assert float(sent[2]) == pytest.approx(1.25 * 5.9703, rel=1e-3)   # 1 N per N
+    wide = run(write_scene(tmp_path, sponge("gripper_action", device="half_85mm.yaml")))
+    result = wide["result"]
+    print(result.message)
+    assert result.termination == "invalid_goal" and not result.success
+    assert result.message.startswith("controller.goal_tolerance 0.01 (joint units) is 20 mm of "
+                                     "aperture on half_85mm")
+    assert "closing of 7.5 mm" in result.message and result.ticks == 0
+    assert wide["depth"] == 0.0
+
+
+@pytest.mark.parametrize("kind", ["parallel_gripper", "gripper_action"])
+def test_a_squeeze_below_the_device_opening_is_refused_before_any_goal(kind, tmp_path, capfd):
+    """A device closing no further than 45 mm, the sponge planned from 50 to 42.5 mm: before,
+    the gripper goal went out and the grasp goal ended "gripper_rejected (... rejected the goal
+    (position ..., max_effort ...): its log says why)"; now it ends invalid_goal at its first
+    cycle, naming the range, as on the JointTrajectory route, and no gripper goal is sent.
+    """
+    device = yaml.safe_load((REPO / "config" / "devices" / "generic_85mm.yaml").read_text())
+    device["name"], device["opening"]["min"] = "narrow_85mm", 0.045
+    device["transmission"]["position_limits"] = [0.0, 0.8 - 0.045 * 0.8 / 0.085]
+    (tmp_path / "narrow_85mm.yaml").write_text(yaml.safe_dump(device))
+    out = run_observed(write_scene(tmp_path, sponge(kind, device="narrow_85mm.yaml", **TIGHT)))
+    result = out["result"]
+    print(result.message)
+    assert result.termination == "invalid_goal" and not result.success
+    assert result.message.startswith("the goal's squeeze takes the aperture from 50 mm to "
+                                     "42.5 mm, outside narrow_85mm's opening [45, 85] mm")
+    # the simulated server logs each goal it rejects (this one would be, outside its range)
+    assert out["depth"] == 0.0 and "rejected the goal on" not in capfd.readouterr().err
+
+
 def test_a_canceled_grasp_cancels_the_gripper_goal(tmp_path):
     """A cancel of the grasp goal mid-squeeze cancels the gripper goal: the controller holds the
     measured position and the goal ends canceled, short of the planned depth.

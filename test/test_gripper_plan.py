@@ -8,9 +8,12 @@ from __future__ import annotations
 
 import functools
 import json
+import re
 
 import numpy as np
 import pytest
+import yaml
+from doc_transcripts import REPO, blocks
 
 from squeeze_grasp_ros.cli import main
 from squeeze_grasp_ros.mechanics.elastic import shapes
@@ -26,7 +29,7 @@ from squeeze_grasp_ros.mechanics.squeeze.gripper_grasp import (
 )
 from squeeze_grasp_ros.mechanics.vocabulary import Finger
 from squeeze_grasp_ros.resources import device_file, scene_file
-from squeeze_grasp_ros.scene import GraspSetup, load_scene
+from squeeze_grasp_ros.scene import GraspSetup, SceneError, load_scene
 from squeeze_grasp_ros.scene.gripper import GripperError, load_gripper, parse_gripper
 from squeeze_grasp_ros.scene.gripper_plan import plan_gripper_grasp
 
@@ -78,7 +81,7 @@ def test_shipped_device_transmission_round_trips():
 
 
 @pytest.mark.parametrize(("changes", "message"), [
-    ({"opening.max": 0.0}, r"gripper\.opening\.max must be > 0"),
+    ({"opening.max": 0.0}, r"gripper\.opening\.max must be in \(0\.0, 1\.0\] m"),
     ({"opening.min": 0.09}, r"gripper\.opening\.max must be > gripper\.opening\.min"),
     ({"max_force": -1.0}, r"gripper\.max_force"),
     ({"pad.width": 0.003}, r"gripper\.pad\.width must be >= 2 gripper\.pad\.edge_radius"),
@@ -87,10 +90,91 @@ def test_shipped_device_transmission_round_trips():
     ({"transmission.joints": []}, r"gripper\.transmission\.joints must name"),
     ({"transmission.joints": ["a", "a"]}, r"gripper\.transmission\.joints repeats"),
     ({"colour": "red"}, r"colour"),
+    # a user's unit mistakes, which planned silently (mm: "no placement fits [0, 85] m" after
+    # the meshing; an 8 m pad, a speed in mm/s, a joint in degrees: planned and commanded)
+    ({"opening.max": 85.0}, r"gripper\.opening\.max must be in \(0\.0, 1\.0\] m \(a gripper's "
+                            r"stroke is below 1 m: a length in mm\?\), got 85\.0"),
+    ({"opening.min": 2.0, "opening.max": 0.085},
+     r"gripper\.opening\.min must be in \[0\.0, 1\.0\]"),
+    ({"pad.width": 22.0, "pad.edge_radius": 2.0},
+     r"gripper\.pad\.width must be <= 1 m .*got 22 m"),
+    ({"max_speed": 150.0}, r"gripper\.max_speed must be in \(0\.0, 10\.0\] m/s, got 150\.0"),
+    ({"max_speed": 0.0}, r"gripper\.max_speed must be in \(0\.0, 10\.0\] m/s, got 0\.0"),
+    ({"transmission.position_per_aperture": -45.84 / 0.085, "transmission.position_offset": 45.84},
+     r"gripper\.transmission\.position_offset \+ position_per_aperture \* aperture puts the "
+     r"joints at 45\.84 closed and 0 open \(opening \[0, 0\.085\] m\), beyond \+-6\.283: joint "
+     r"positions are in rad or m, not degrees or mm"),
+    # the sign closing the wrong way: 0.8 rad open, 1.6 rad closed, outside the joint's limits
+    ({"transmission.position_per_aperture": 0.8 / 0.085, "transmission.position_limits": [0, 0.8]},
+     r"puts the joints at 0\.8 closed and 1\.6 open \(opening \[0, 0\.085\] m\), outside "
+     r"gripper\.transmission\.position_limits \[0, 0\.8\]: position_per_aperture's sign"),
+    ({"transmission.position_limits": [0.8, 0.0]},
+     r"gripper\.transmission\.position_limits must be \[lower, upper\] with lower < upper"),
+    ({"transmission.position_limits": [0.0, float("nan")]},
+     r"gripper\.transmission\.position_limits\[1\] must be a finite number"),
+    ({"transmission.position_limits": [0.0]},
+     r"gripper\.transmission\.position_limits must have 2 entries"),
 ])
 def test_bad_device_files_name_the_field(changes, message):
     with pytest.raises(GripperError, match=message):
         parse_gripper(device(**changes))
+
+
+@pytest.mark.parametrize("changes", [
+    # a Franka Hand-like: two prismatic finger joints at half the aperture each, in m
+    {"opening.max": 0.08, "transmission.joints": ["finger_joint1", "finger_joint2"],
+     "transmission.position_per_aperture": 0.5, "transmission.position_offset": 0.0,
+     "transmission.position_limits": [0.0, 0.04]},
+    # a Robotiq 2F-140-like: one revolute joint, 0.7 rad closed, 0 rad open
+    {"opening.max": 0.14, "transmission.position_per_aperture": -5.0,
+     "transmission.position_offset": 0.7, "transmission.position_limits": [0.0, 0.7],
+     "pad.width": 0.03, "pad.edge_radius": 0.003},
+    # a small servo gripper of 20 mm stroke in m, its pads wider than its stroke
+    {"opening.min": 0.002, "opening.max": 0.022, "max_speed": 0.02, "pad.width": 0.03,
+     "pad.edge_radius": 0.0005, "transmission.position_per_aperture": 0.5,
+     "transmission.position_offset": -0.001, "transmission.position_limits": [0.0, 0.01]},
+    # a joint of a full turn (rad) is still a joint
+    {"transmission.position_per_aperture": -6.2 / 0.085, "transmission.position_offset": 6.2},
+])
+def test_a_labs_own_devices_are_accepted(changes):
+    g = parse_gripper(device(**changes))
+    lo, hi = g.transmission.position_limits or (-np.inf, np.inf)
+    for aperture in (g.opening.min, g.opening.max):
+        assert all(lo - 1e-12 <= p <= hi + 1e-12 for p in g.joint_positions(aperture))
+        assert g.aperture(g.joint_positions(aperture)[0]) == pytest.approx(aperture, abs=1e-15)
+
+
+def test_a_device_file_error_names_the_file_before_any_work(tmp_path, monkeypatch, capsys):
+    """docs/grippers.md's error line: a device file in mm is refused, exit 2, naming the file
+    (before: "no inward, force-closing placement of the object fits franka_mm's opening
+    [0, 80] m", exit 1, after meshing the object and computing its grasp map).
+    """
+    (tmp_path / "lab").mkdir()
+    (tmp_path / "lab" / "franka_mm.yaml").write_text(
+        "name: franka_mm\nopening: {min: 0, max: 80}\nmax_force: 70\n"
+        "pad: {shape: pad, width: 18, edge_radius: 1}\n"
+        "transmission: {joints: [j1, j2], position_per_aperture: 0.5}\n")
+    monkeypatch.chdir(tmp_path)
+    code = main(["gripper-plan", str(scene_file("sponge_gripper")), "--gripper",
+                 "lab/franka_mm.yaml"])
+    err = capsys.readouterr().err
+    assert code == 2
+    (shown,) = [b.lines for b in blocks(REPO / "docs" / "grippers.md")
+                if b.language == "text" and b.lines[0].startswith("gripper device ")]
+    assert err == f"squeeze-grasp gripper-plan: error: {shown[0]}\n"
+
+
+def test_a_scenes_device_file_error_names_the_scene_field_and_the_file(tmp_path):
+    data = yaml.safe_load(scene_file("sponge_gripper").read_text())
+    data["controller"]["device"] = "franka_deg.yaml"
+    bad = device(**{"transmission.position_per_aperture": -45.84 / 0.085,
+                    "transmission.position_offset": 45.84})
+    (tmp_path / "franka_deg.yaml").write_text(yaml.safe_dump(bad))
+    (tmp_path / "scene.yaml").write_text(yaml.safe_dump(data))
+    with pytest.raises(SceneError, match=re.escape(
+            f"controller.device: gripper device {tmp_path / 'franka_deg.yaml'}: "
+            "gripper.transmission.position_offset + position_per_aperture")):
+        load_scene(tmp_path / "scene.yaml")
 
 
 # --- candidates against the grasp map and geometry -------------------------------------------

@@ -479,3 +479,26 @@ def test_the_executor_refuses_a_plan_beyond_the_device_effort(tmp_path):
     assert "max_force 3 N" in result.message and "jaw force of 5.97 N" in result.message
     assert result.message == grippers_md_text("beyond weak_85mm's max_force")  # as quoted
     assert out["trajectories"] == []
+
+
+def test_the_executor_refuses_a_squeeze_below_the_device_opening(tmp_path):
+    """A lab's device closing no further than 45 mm: the sponge's plan takes the jaws from 50
+    to 42.5 mm. Before, the executor sent the trajectories, the controller refused each one
+    ("point 0's aperture ... is outside the opening range") and the goal waited for the stall
+    watch (30 s of sim time); now it ends invalid_goal at its first cycle, naming the range,
+    and sends no trajectory.
+    """
+    device = yaml.safe_load((SPONGE.parents[1] / "devices" / "generic_85mm.yaml").read_text())
+    device["name"], device["opening"]["min"] = "narrow_85mm", 0.045
+    device["transmission"]["position_limits"] = [0.0, 0.8 - 0.045 * 0.8 / 0.085]
+    (tmp_path / "narrow_85mm.yaml").write_text(yaml.safe_dump(device))
+    data = sponge_data()
+    data["controller"]["device"] = "narrow_85mm.yaml"
+    out = run_observed(write_scene(tmp_path, data), [
+        ("trajectories", "gripper_controller/joint_trajectory", JointTrajectory)])
+    result = out["result"]
+    print(result.message)
+    assert result.termination == "invalid_goal" and not result.success
+    assert result.message == grippers_md_text("outside narrow_85mm's opening")  # as quoted
+    assert "from 50 mm to 42.5 mm" in result.message
+    assert out["trajectories"] == [] and out["depth"] == 0.0

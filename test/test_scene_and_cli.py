@@ -231,10 +231,11 @@ def test_every_range_the_help_prints_is_the_range_the_check_keeps():
     """
     import dataclasses
 
-    from squeeze_grasp_ros.scene import schema, specs
+    from squeeze_grasp_ros.scene import gripper, schema, specs
     from squeeze_grasp_ros.sweep import spec as sweep_spec
 
-    bounded = [(cls.__name__, f) for module in (specs, sweep_spec) for cls in vars(module).values()
+    bounded = [(cls.__name__, f) for module in (specs, sweep_spec, gripper)
+               for cls in vars(module).values()
                if dataclasses.is_dataclass(cls) and isinstance(cls, type)
                for f in dataclasses.fields(cls)
                if f.metadata.get("lo") is not None and f.metadata.get("hi") is not None]
@@ -249,9 +250,40 @@ def test_every_range_the_help_prints_is_the_range_the_check_keeps():
                 kept = False
             assert kept is not open_, (owner, field.name, said, bound)
     names = {(owner, field.name) for owner, field in bounded}
-    assert {("SqueezeSpec", "relative_depth"), ("SweepSpec", "relative_depth")} <= names
+    assert {("SqueezeSpec", "relative_depth"), ("SweepSpec", "relative_depth"),
+            ("OpeningSpec", "max"), ("GripperSpec", "max_speed")} <= names
     assert all(field.metadata["hi_open"] for _, field in bounded if field.name == "relative_depth")
     assert len(bounded) >= 10
+
+
+def test_the_help_lists_the_device_files_keys_with_their_defaults():
+    """``scene-help`` lists every key of a gripper device file (before, only docs/grippers.md's
+    example showed them, without which are optional), and a device file without its optional
+    keys gets the printed defaults.
+    """
+    import re
+
+    from squeeze_grasp_ros.scene.gripper import parse_gripper
+    from squeeze_grasp_ros.scene.help import scene_help
+
+    printed = {line.split()[0]: line for line in scene_help().splitlines()
+               if line.startswith("gripper.")}
+    minimal = {"name": "g", "opening": {"max": 0.05}, "max_force": 10.0,
+               "pad": {"shape": "pad", "width": 0.01, "edge_radius": 0.001},
+               "transmission": {"joints": ["j"], "position_per_aperture": 1.0}}
+    for key in ("opening.max", "max_force", "pad", "transmission.joints",
+                "transmission.position_per_aperture"):
+        assert printed[f"gripper.{key}"].endswith("required]"), key
+    g = parse_gripper(minimal)
+    for key in ("opening.min", "max_speed", "transmission.position_offset",
+                "transmission.effort_per_force"):
+        value = g
+        for part in key.split("."):
+            value = getattr(value, part)
+        default = re.search(r"default ([^,\]]+)\]$", printed[f"gripper.{key}"]).group(1)
+        assert value == float(default), key
+    assert g.transmission.position_limits is None
+    assert "gripper.transmission.position_limits" in printed
 
 
 def test_the_defaults_the_help_prints_are_what_a_scene_without_the_key_gets():

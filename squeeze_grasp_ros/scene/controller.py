@@ -118,6 +118,42 @@ class JawController:
             max_velocity=(s.max_velocity if self.kind is ControllerKind.PARALLEL_GRIPPER
                           else float("inf")))
 
+    def opening_problem(self, line: JawLine, start: Mapping[str, np.ndarray],
+                        end: Mapping[str, np.ndarray]) -> str | None:
+        """Why a squeeze of the jaws from tips ``start`` to ``end`` (m; a jaw missing from
+        ``end`` stays) on ``line`` cannot be commanded, or None: its end aperture outside the
+        device's opening range (a controller refuses or clamps such a command, and the jaws
+        stand short of it until the stall watch).
+        """
+        first, second = self.jaws
+        before = line.aperture(start[first], start[second])
+        after = line.aperture(end.get(first, start[first]), end.get(second, start[second]))
+        lo, hi = self.gripper.opening.min, self.gripper.opening.max
+        if lo - 1e-12 <= after <= hi + 1e-12:
+            return None
+        return (f"the goal's squeeze takes the aperture from {before * 1e3:.4g} mm to "
+                f"{after * 1e3:.4g} mm, outside {self.gripper.name}'s opening [{lo * 1e3:.4g}, "
+                f"{hi * 1e3:.4g}] mm (its device file's opening): the controller cannot take the "
+                "jaws there; plan a shallower squeeze or another gripper")
+
+    def tolerance_problem(self, closing: float) -> str | None:
+        """Why a gripper action controller would take a squeeze closing the aperture by
+        ``closing`` (m) as reached before it squeezes, or None: its ``goal_tolerance`` (joint
+        units) is, through the transmission, at least that closing (the stock controllers end a
+        goal once the joint is within the tolerance of its position). A goal that does not close
+        (depth 0) is rightly reached where it starts: None.
+        """
+        tolerance = self.spec.goal_tolerance
+        gain = abs(self.gripper.transmission.position_per_aperture)
+        if not closing > 0 or tolerance / gain < closing:
+            return None
+        return (f"controller.goal_tolerance {tolerance:g} (joint units) is "
+                f"{tolerance / gain * 1e3:.4g} mm of aperture on {self.gripper.name} "
+                f"(/ |transmission.position_per_aperture| {gain:g}), not below the squeeze's "
+                f"closing of {closing * 1e3:.4g} mm: the {self.spec.type} controller would "
+                f"report the goal reached before the jaws squeeze; set controller.goal_tolerance "
+                f"below {closing * gain:.4g}")
+
     def joint_positions(self, aperture: float) -> tuple[float, ...]:
         """Each controller joint's position at ``aperture`` (m), through the transmission."""
         return self.gripper.joint_positions(aperture)[:1] * len(self.joints)

@@ -24,6 +24,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Optional
 
 import numpy as np
 
@@ -33,8 +34,16 @@ from squeeze_grasp_ros.scene.files import read_yaml
 from squeeze_grasp_ros.scene.schema import SchemaError, parse_section, spec
 from squeeze_grasp_ros.scene.specs import TipSpec
 
-__all__ = ["GripperError", "GripperSpec", "OpeningSpec", "TransmissionSpec", "load_gripper",
-           "parse_gripper"]
+__all__ = ["MAX_JOINT_POSITION", "MAX_LENGTH", "GripperError", "GripperSpec", "OpeningSpec",
+           "TransmissionSpec", "load_gripper", "parse_gripper"]
+
+MAX_LENGTH = 1.0
+"""Largest opening and pad size of a device, m: a parallel gripper's stroke and pads are below
+a metre, so a larger value is a length in mm."""
+MAX_JOINT_POSITION = 2.0 * np.pi
+"""Largest joint position over the opening range, rad or m: a gripper's revolute joint turns
+less than a turn, its prismatic joint moves less than a metre; degrees or mm give more."""
+_UNITS = "a gripper's stroke is below 1 m: a length in mm?"
 
 
 class GripperError(SchemaError):
@@ -47,8 +56,10 @@ class GripperError(SchemaError):
 class OpeningSpec:
     """The range of the distance between the two pad faces."""
 
-    max: float = spec("largest aperture (fully open)", "m", lo=0.0, lo_open=True)
-    min: float = spec("smallest aperture (fully closed)", "m", lo=0.0, default=0.0)
+    max: float = spec("largest aperture (fully open)", "m", lo=0.0, lo_open=True,
+                      hi=MAX_LENGTH, why=_UNITS)
+    min: float = spec("smallest aperture (fully closed)", "m", lo=0.0, hi=MAX_LENGTH,
+                      why=_UNITS, default=0.0)
 
 
 @dataclass(frozen=True)
@@ -63,6 +74,10 @@ class TransmissionSpec:
     position_offset: float = spec("joint position at aperture 0", "", default=0.0)
     effort_per_force: float = spec("joint effort per N of jaw force (N/N or N m/N)", "",
                                    lo=0.0, lo_open=True, default=1.0)
+    position_limits: Optional[tuple[float, float]] = spec(
+        "the joint's [lower, upper] position limits (the URDF's, rad or m); the joints' "
+        "positions over the opening range must lie within (a transmission closing the wrong "
+        "way does not)", default=None)
 
 
 @dataclass(frozen=True)
@@ -72,11 +87,12 @@ class GripperSpec:
     name: str = spec("device name")
     opening: OpeningSpec = spec("aperture range")
     max_force: float = spec("largest grip force of one jaw", "N", lo=0.0, lo_open=True)
-    pad: TipSpec = spec("each jaw's pad: {shape: pad, width, edge_radius} (or a circle)")
+    pad: TipSpec = spec("each jaw's pad: {shape: pad, width, edge_radius} (or a circle), each "
+                        "length at most 1 m")
     transmission: TransmissionSpec = spec("jaw position and force to joint position and "
                                           "effort")
     max_speed: float = spec("largest closing speed of the aperture", "m/s", lo=0.0,
-                            lo_open=True, default=0.1)
+                            lo_open=True, hi=10.0, default=0.1)
     description: str = spec("free text", default="")
 
     def jaws(self) -> ParallelJaws:
@@ -127,9 +143,45 @@ def parse_gripper(data, where: str = "gripper") -> GripperSpec:
     if not (np.isfinite(t.position_per_aperture) and t.position_per_aperture != 0):
         raise GripperError(f"{where}.transmission.position_per_aperture must be a nonzero "
                            f"number, got {t.position_per_aperture}")
+    _check_joint_range(g, where)
     return g
 
 
+def _check_joint_range(g: GripperSpec, where: str) -> None:
+    """The pad below :data:`MAX_LENGTH`; the joint positions over the opening range within
+    :data:`MAX_JOINT_POSITION` and ``transmission.position_limits``.
+    """
+    pad = g.pad
+    for key in ("radius", "width", "edge_radius"):
+        value = getattr(pad, key)
+        if value is not None and value > MAX_LENGTH:
+            raise GripperError(f"{where}.pad.{key} must be <= {MAX_LENGTH:g} m ({_UNITS}), "
+                               f"got {value:g} m")
+    t = g.transmission
+    ends = (g.joint_positions(g.opening.min)[0], g.joint_positions(g.opening.max)[0])
+    span = (f"{where}.transmission.position_offset + position_per_aperture * aperture puts the "
+            f"joints at {ends[0]:g} closed and {ends[1]:g} open (opening [{g.opening.min:g}, "
+            f"{g.opening.max:g}] m)")
+    if max(abs(e) for e in ends) > MAX_JOINT_POSITION:
+        raise GripperError(f"{span}, beyond +-{MAX_JOINT_POSITION:.4g}: joint positions are in "
+                           "rad or m, not degrees or mm")
+    if t.position_limits is not None:
+        lower, upper = t.position_limits
+        if not lower < upper:
+            raise GripperError(f"{where}.transmission.position_limits must be [lower, upper] "
+                               f"with lower < upper, got {[lower, upper]}")
+        if not all(lower - 1e-9 * (upper - lower) <= e <= upper + 1e-9 * (upper - lower)
+                   for e in ends):
+            raise GripperError(f"{span}, outside {where}.transmission.position_limits "
+                               f"[{lower:g}, {upper:g}]: position_per_aperture's sign (negative "
+                               "when the joint closes with a larger position) or the offset is "
+                               "wrong")
+
+
 def load_gripper(path: str | Path) -> GripperSpec:
-    """Read and validate a gripper device file."""
-    return parse_gripper(read_yaml(path, what="gripper device"))
+    """Read and validate a gripper device file; errors name the file and the field."""
+    data = read_yaml(path, what="gripper device")
+    try:
+        return parse_gripper(data)
+    except GripperError as exc:
+        raise GripperError(f"gripper device {path}: {exc}") from None

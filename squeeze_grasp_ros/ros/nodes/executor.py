@@ -326,6 +326,8 @@ class ExecutorNode(Node):
                    or goal_problem(goal, list(self.devices)))
         if problem is None and self.jaws is not None:
             problem = self.jaws.effort_problem(goal)
+        if problem is None and self.jaw_action is not None:
+            problem = self.jaw_action.tolerance_problem(goal)
         if problem is not None:
             handle.abort()
             return messages.invalid_goal_result(problem)
@@ -419,8 +421,12 @@ class ExecutorNode(Node):
                     goal, msg or deserialize_message(data, MonitorStatus), ns):
                 return
             goal.start_ns = ns
-            if self.jaws is not None:
-                self.jaws.start(obs)
+            driver = self.jaws or self.jaw_action
+            problem = None if driver is None else driver.start(obs, goal.program.goal)
+            if problem is not None:
+                self._end_holding(goal, ExecuteGrasp.Result.INVALID_GOAL,
+                                  f"{problem}; nothing was commanded")
+                return
         if msg is not None:
             goal.events += msg.events
             goal.since_feedback += msg.events

@@ -56,7 +56,7 @@ from squeeze_grasp_ros.control.motion import GraspGoal, Observation
 from squeeze_grasp_ros.mechanics.vocabulary import ControllerKind
 from squeeze_grasp_ros.ros import messages
 from squeeze_grasp_ros.ros.nodes import pipeline
-from squeeze_grasp_ros.ros.nodes.jaw_commands import PlannedJawForce
+from squeeze_grasp_ros.ros.nodes.jaw_commands import PlannedJawForce, squeeze_end
 from squeeze_grasp_ros.scene.controller import JawController
 
 __all__ = ["JawAction"]
@@ -115,11 +115,28 @@ class JawAction:
         return self.publisher, messages.header(ns)
 
     # ----------------------------------------------------------------- the goal
-    def target(self, goal: GraspGoal, obs: Observation) -> tuple[float, float]:
-        """(joint position, joint effort limit) of grasp goal ``goal`` from its first
-        observation (fixes the jaw line).
+    def tolerance_problem(self, goal: GraspGoal) -> str | None:
+        """Why grasp goal ``goal`` would be reached where it starts, or None
+        (:meth:`.JawController.tolerance_problem` of its largest closing: its depth times the
+        jaws' speeds per unit depth, both along the jaw line).
+        """
+        speed = sum(float(np.linalg.norm(d)) for f, d in zip(goal.fingers, goal.directions)
+                    if f in self.fingers)
+        return self.controller.tolerance_problem(goal.depth * speed)
+
+    def start(self, obs: Observation, goal: GraspGoal) -> str | None:
+        """Fix the jaw line from grasp goal ``goal``'s first observation ``obs`` (as
+        :meth:`.JawCommands.start`); why its squeeze
+        leaves the device's opening range, or None (:meth:`.JawController.opening_problem`).
         """
         self.line = self.controller.jaw_line(obs.positions)
+        return self.controller.opening_problem(self.line, obs.positions,
+                                               squeeze_end(goal, obs.positions, goal.depth))
+
+    def target(self, goal: GraspGoal, obs: Observation) -> tuple[float, float]:
+        """(joint position, joint effort limit) of grasp goal ``goal`` from its first
+        observation (after :meth:`start`).
+        """
         return self.squeeze(goal, obs.positions, goal.depth)
 
     def squeeze(self, goal: GraspGoal, start: Mapping[str, np.ndarray],
@@ -127,8 +144,7 @@ class JawAction:
         """(joint position, joint effort limit) of a squeeze of ``goal``'s fingers from
         ``start`` (m) to ``depth`` (m) along its directions, on the fixed jaw line.
         """
-        end = {f: np.asarray(start[f], float) + depth * np.asarray(d, float)
-               for f, d in zip(goal.fingers, goal.directions)}
+        end = squeeze_end(goal, start, depth)
         position = self.opening({f: end.get(f, start[f]) for f in self.fingers})
         effort = 0.0
         force = self.plan.at(depth)

@@ -135,9 +135,14 @@ class JawCommands:
                 f"JointTrajectoryController does not limit effort: the drive would stall short "
                 f"of the planned aperture); plan a shallower squeeze or a stronger gripper")
 
-    def start(self, obs: Observation) -> None:
-        """Fix the jaw line from the jaws' measured tips (a goal's first cycle)."""
+    def start(self, obs: Observation, goal: GraspGoal) -> str | None:
+        """Fix the jaw line from the jaws' measured tips (a goal's first cycle); why ``goal``'s
+        squeeze leaves the device's opening range, or None
+        (:meth:`.JawController.opening_problem`).
+        """
         self.line = self.controller.jaw_line(obs.positions)
+        return self.controller.opening_problem(self.line, obs.positions,
+                                               squeeze_end(goal, obs.positions, goal.depth))
 
     def trajectory(self, setpoints: Mapping[str, np.ndarray], start_ns: int
                    ) -> tuple[Any, JointTrajectory]:
@@ -150,6 +155,15 @@ class JawCommands:
         messages.set_stamp(msg.header.stamp, start_ns)
         msg.points[0].positions = [float(p) for p in self.controller.joint_positions(aperture)]
         return self.publisher, msg
+
+
+def squeeze_end(goal: GraspGoal, start: Mapping[str, np.ndarray], depth: float
+                ) -> dict[str, np.ndarray]:
+    """The tips of ``goal``'s fingers (m) after a squeeze from ``start`` to ``depth`` (m)
+    along its directions.
+    """
+    return {f: np.asarray(start[f], float) + depth * np.asarray(d, float)
+            for f, d in zip(goal.fingers, goal.directions)}
 
 
 def one_point_trajectory(joints: Sequence[str], period_ns: int) -> JointTrajectory:
@@ -208,8 +222,10 @@ class HandCommands:
         return {hand_finger: tips[finger]
                 for finger, hand_finger in self.controller.fingers.items()}
 
-    def start(self, obs: Observation) -> None:
-        """The joints of the measured tips (a goal's first cycle)."""
+    def start(self, obs: Observation, goal: GraspGoal | None = None) -> None:
+        """The joints of the measured tips (a goal's first cycle; a setpoint out of the hand's
+        reach is warned about per cycle, not refused: None).
+        """
         self.solution = self.controller.hand.inverse(self._targets(obs.positions),
                                                      tolerance=np.inf)
         self.warned = False

@@ -293,12 +293,16 @@ def compare(expected: tuple[str, ...], actual: list[str]) -> str | None:
     while actual and not actual[-1]:
         actual.pop()
     if expected and expected[0].startswith("{") and actual and actual[0].startswith("{"):
+        text = "\n".join(expected)
         try:
-            wanted = json.loads("\n".join(expected))
-        except json.JSONDecodeError:
-            pass  # an abridged example (with ...): compared line by line
-        else:
-            found = json_matches(wanted, json.loads("\n".join(actual)))
+            wanted, matches = json.loads(text), json_matches
+        except json.JSONDecodeError:  # an abridged example (a value elided as ...)
+            try:
+                wanted, matches = abridged_json(text), abridged_json_matches
+            except json.JSONDecodeError:
+                wanted = None  # not JSON even so: compared line by line
+        if wanted is not None:
+            found = matches(wanted, json.loads("\n".join(actual)))
             return None if found is None else f"JSON differs at {found}"
 
     def match(i: int, j: int) -> int | None:

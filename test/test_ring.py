@@ -178,6 +178,22 @@ def test_stable_squeeze_forces_follow_theorem_10():
     assert pure.stiffness < g.stiffness * (1 + 1e-12)
 
 
+def test_a_ring_grasp_reports_its_equilibrium_residual_and_it_sees_a_wrong_solve(monkeypatch):
+    """``diagnostics.equilibrium_residual``: ||K x - f|| / ||f|| of the ring's field under the
+    contact forces. Small for the banded solve (the shipped rings: 1e-10 to 3e-9, docs/ring.md);
+    a solve 1 % off shows as about 1e-2. Before, a ring grasp reported no solve residual.
+    """
+    ring = make_ring(elements=60)
+    g = ring_grasp(ring, (7, 33), 0.5)
+    assert 0.0 < g.residual < 1e-8
+    assert g.to_json(0.0)["diagnostics"] == {"reduced_condition": g.condition,
+                                             "equilibrium_residual": g.residual}
+    exact = RingModel.clamped_solve
+    monkeypatch.setattr(RingModel, "clamped_solve", lambda self, rhs: 1.01 * exact(self, rhs))
+    off = ring_grasp(make_ring(elements=60), (7, 33), 0.5)
+    assert off.residual == pytest.approx(0.01, rel=1e-3)
+
+
 def test_normal_polynomial_matches_direct_evaluation():
     rng = np.random.default_rng(3)
     base, rate = rng.normal(size=(5, 3, 2)), rng.normal(size=(5, 3, 2))

@@ -254,6 +254,9 @@ class RingGrasp:
         What bounds it.
     condition : float
         Condition number of the reduced compliance (Z^T A Z).
+    residual : float
+        Relative equilibrium residual ||K x - f|| / ||f|| of the ring's field under the
+        contact forces (:meth:`~.model.RingModel.equilibrium_residual`).
     """
 
     contacts: np.ndarray
@@ -273,6 +276,7 @@ class RingGrasp:
     max_depth: float
     limit: RingLimit
     condition: float
+    residual: float
 
     @property
     def stiffness(self) -> float:
@@ -372,6 +376,8 @@ class RingGrasp:
             "cone_half_angle_deg": float(np.degrees(np.arctan(self.mu))),
             "force_angle_deg": {f: [float(at0[k]), float(at_depth[k])]
                                 for k, f in enumerate(SQUEEZING_FINGERS)},
+            "diagnostics": {"reduced_condition": self.condition,
+                            "equilibrium_residual": self.residual},
         }
 
 
@@ -468,6 +474,8 @@ def ring_grasp(
     )
     depth, code = resolve_limits(cones, np.array([strain_hat]), np.array([cap_hat]))
     require_finite("ring grasp forces", F_hat)
+    loads = np.zeros((ring.n, 2))
+    loads[c] = F_hat.reshape(2, 2)
     return RingGrasp(
         contacts=c,
         kind=kind,
@@ -486,4 +494,5 @@ def ring_grasp(
         max_depth=float(depth[0] * L),
         limit=LIMITS[int(code[0])],
         condition=condition,
+        residual=ring.equilibrium_residual(loads),
     )

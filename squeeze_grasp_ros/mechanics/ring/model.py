@@ -337,21 +337,6 @@ class RingModel:
         F[self.translation_dofs] = np.asarray(forces_hat, float).reshape(-1)
         return self.remove_rigid(self.clamped_solve(F))
 
-    def equilibrium_residual(self, forces_hat: np.ndarray) -> float:
-        """Relative residual ||K_hat x - f|| / ||f|| of the field x (:meth:`field_from_forces`)
-        of equilibrated dimensionless nodal forces ``forces_hat`` (n, 2): how well the banded
-        solve and the loads' balance hold (the node clamped in the solve carries what the
-        others do not balance); 1e-10 to 3e-9 on the shipped rings (round-off times the clamped
-        stiffness's conditioning), 0 for no load.
-        """
-        F = np.zeros(3 * self.n)
-        F[self.translation_dofs] = np.asarray(forces_hat, float).reshape(-1)
-        scale = float(np.linalg.norm(F))
-        if scale == 0.0:
-            return 0.0
-        return float(np.linalg.norm(self.stiffness @ self.field_from_forces(forces_hat) - F)
-                     / scale)
-
     def solve_loads(self, forces: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Deformation under equilibrated nodal point loads.
 

@@ -13,7 +13,7 @@ import sys
 from typing import Any
 
 from squeeze_grasp_ros.commands import VERBS
-from squeeze_grasp_ros.exit_codes import ExitCode
+from squeeze_grasp_ros.exit_codes import ExitCode, error_json
 
 EPILOG = ("exit status: 0 done; 1 negative outcome (grasp failed in the world, replay differs); "
           "2 invalid input; 3 a solver failed (the message carries its residuals); 4 pipeline or "
@@ -23,8 +23,9 @@ EPILOG = ("exit status: 0 done; 1 negative outcome (grasp failed in the world, r
 
 class _Parser(argparse.ArgumentParser):
     """An argument parser whose usage errors, with ``--json`` on the command line, are also one
-    JSON object on stdout, as the errors of a running verb are (:func:`.commands.common.fail`):
-    a script reading stdout got nothing for ``plan --json --depth abc``.
+    JSON object on stdout (:func:`.exit_codes.error_json`), as the errors of a running verb are
+    (:func:`.commands.common.fail`): a script reading stdout got nothing for ``plan --json
+    --depth abc``.
     """
 
     def __init__(self, *args: Any, json_errors: bool = False, **kwargs: Any) -> None:
@@ -34,9 +35,8 @@ class _Parser(argparse.ArgumentParser):
     def error(self, message: str):
         if self.json_errors:
             named = ARGUMENT.match(message)
-            sys.stdout.write(json.dumps({
-                "error": message, "field": named.group(1).lstrip("-") if named else None,
-                "code": int(ExitCode.USAGE), "code_name": ExitCode.USAGE.name}) + "\n")
+            print(error_json(message, named.group(1).lstrip("-") if named else None,
+                             ExitCode.USAGE))
         super().error(message)
 
 

@@ -12,10 +12,11 @@ The codes say who has to act: the user (``USAGE``), nobody because physics said 
 """
 from __future__ import annotations
 
+import json
 import signal
 from enum import IntEnum
 
-__all__ = ["ExitCode", "Interrupted", "raise_on_signals", "raised_signal"]
+__all__ = ["ExitCode", "Interrupted", "error_json", "raise_on_signals", "raised_signal"]
 
 
 class ExitCode(IntEnum):
@@ -47,6 +48,17 @@ class ExitCode(IntEnum):
     INTERNAL = 4
     INTERRUPTED = 130
     TERMINATED = 143
+
+
+def error_json(message: str, field: str | None, code: ExitCode) -> str:
+    """The one JSON object a command prints on stdout under ``--json`` for an error: its
+    message, the field it names (None when it names none) and the exit code.
+
+    >>> error_json("depth must be >= 0 m, got -1", "depth", ExitCode.USAGE)
+    '{"error": "depth must be >= 0 m, got -1", "field": "depth", "code": 2, "code_name": "USAGE"}'
+    """
+    return json.dumps({"error": message, "field": field, "code": int(code),
+                       "code_name": code.name})
 
 
 class Interrupted(KeyboardInterrupt):

@@ -4,12 +4,11 @@
 from __future__ import annotations
 
 import argparse
-import json
 import re
 import sys
 from pathlib import Path
 
-from squeeze_grasp_ros.exit_codes import ExitCode
+from squeeze_grasp_ros.exit_codes import ExitCode, error_json
 from squeeze_grasp_ros.mechanics.elastic.compliance import ROUTES
 from squeeze_grasp_ros.mechanics.errors import SqueezeGraspError
 from squeeze_grasp_ros.outputs import output_error, probe_folder
@@ -24,8 +23,7 @@ def fail(args: argparse.Namespace, message: str, code: ExitCode) -> int:
     print(f"squeeze-grasp {args.verb}: error: {message}", file=sys.stderr)
     if getattr(args, "json", False):
         match = FIELD.match(message)
-        print(json.dumps({"error": message, "field": match.group(1) if match else None,
-                          "code": int(code), "code_name": code.name}))
+        print(error_json(message, match.group(1) if match else None, code))
     return code
 
 

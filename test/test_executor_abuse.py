@@ -22,7 +22,7 @@ from squeeze_grasp_interfaces.action import ExecuteGrasp
 from squeeze_grasp_interfaces.msg import Alarm, MonitorStatus
 from squeeze_grasp_ros.control.motion import MAX_TRAVEL, GraspGoal, goal_problem
 from squeeze_grasp_ros.ros import messages
-from squeeze_grasp_ros.ros.nodes import pipeline
+from squeeze_grasp_ros.ros.nodes import SPIN_PERIOD, Spinner, pipeline
 from squeeze_grasp_ros.ros.nodes.executor import ExecutorNode
 
 QUEUES = {f"{kind}_service_qos_profile": pipeline.request_queue(0)
@@ -370,3 +370,35 @@ def test_a_resistance_beyond_the_longest_travel_is_refused():
                                     "resist_travel": np.array([0.01]),
                                     "resist_waypoints": waypoints}), ["F1", "F2", "A"])
     assert far == f"resist_waypoints must hold 1 x 2 vectors of at most {MAX_TRAVEL:g} m"
+
+
+def test_a_waiting_hardware_goal_does_not_make_the_nodes_spin_poll(ros_context):
+    """A hardware-mode goal with no monitor status (stale_budget 60 s) waits: the executor's
+    execute coroutine is suspended. Spun as ``run_node`` spins it (:class:`Spinner`), the
+    ``EventsExecutor`` returns about once a ``SPIN_PERIOD`` while the node's control timer runs
+    on and the cancel is served. Before, ``run_node``'s ``spin_once`` loop returned about
+    90,000 times a second for as long as a goal ran: each call first resumed the suspended
+    coroutine (the executor node's thread at 76 % CPU during a hardware goal).
+    """
+    rig = Rig(ros_context, clients=1, lockstep=False, stale_budget=60.0)
+    try:
+        sent = rig.clients[0].send_goal_async(squeeze())
+        assert rig.until(sent.done) and sent.result().accepted
+        assert rig.until(lambda: rig.node.goal is not None and rig.node.timer_at is not None)
+        spin = Spinner(rig.spinner, rig.node)
+        spins, start, timer_at = 0, time.monotonic(), rig.node.timer_at
+        while time.monotonic() - start < 1.0:
+            spin()
+            spins += 1
+        assert spins <= 1.0 / SPIN_PERIOD + 3, f"{spins} spins in 1 s: the spin polls"
+        assert rig.node.goal is not None, "the goal ended: it should still wait"
+        assert rig.node.timer_at - timer_at > 0.5, "the control timer stopped running"
+        sent.result().cancel_goal_async()
+        result = sent.result().get_result_async()
+        deadline = time.monotonic() + 10.0
+        while not result.done() and time.monotonic() < deadline:
+            spin()
+        assert result.done(), "the cancel was not served"
+        assert result.result().result.termination == ExecuteGrasp.Result.CANCELED
+    finally:
+        rig.close()

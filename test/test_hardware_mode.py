@@ -20,6 +20,7 @@ import gc
 import importlib.util
 import math
 import re
+import sys
 import threading
 import time
 from pathlib import Path
@@ -33,6 +34,7 @@ from rclpy.action import ActionClient, ActionServer, CancelResponse
 from rclpy.callback_groups import ReentrantCallbackGroup
 from rclpy.context import Context
 from rclpy.executors import MultiThreadedExecutor
+from rclpy.experimental import EventsExecutor
 from rclpy.node import Node
 from rclpy.parameter import Parameter
 from sensor_msgs.msg import JointState
@@ -40,7 +42,7 @@ from trajectory_msgs.msg import JointTrajectory
 
 from squeeze_grasp_interfaces.action import ExecuteGrasp
 from squeeze_grasp_ros.control.motion import GraspGoal
-from squeeze_grasp_ros.ros import messages
+from squeeze_grasp_ros.ros import messages, nodes
 from squeeze_grasp_ros.ros.nodes import pipeline
 from squeeze_grasp_ros.ros.nodes.executor import ExecutorNode
 from squeeze_grasp_ros.ros.nodes.monitor import MonitorNode
@@ -116,9 +118,36 @@ class OutsideHardware(Node):
         self.states.publish(msg)
 
 
+class LabThread:
+    """An executor spun in a thread of its own by ``spin_once``."""
+
+    def __init__(self, executor, *spun: Node) -> None:
+        self.executor, self.running = executor, True
+        for node in spun:
+            executor.add_node(node)
+        self.thread = threading.Thread(target=self._spin, daemon=True)
+        self.thread.start()
+
+    def _spin(self) -> None:
+        while self.running:
+            self.executor.spin_once(timeout_sec=0.02)
+
+    def stop(self) -> None:
+        self.running = False
+        self.thread.join(timeout=5.0)
+        self.executor.shutdown()
+
+
 class Rig:
     """The outside hardware, our monitor and executor in hardware mode, the jaws' kinematics
-    stand-in and a grasp client, in one context spun by a multi-threaded executor.
+    stand-in and a grasp client, in one context, on one ``EventsExecutor`` spun in the test's
+    thread as ``run_node`` spins a node (:class:`~squeeze_grasp_ros.ros.nodes.Spinner`); a
+    lab's gripper action server (:meth:`lab_node`), which blocks in its goals, on a
+    multi-threaded executor in a thread of its own. Before, all of them shared one
+    multi-threaded executor spun by ``spin_once`` in the test's thread: each call first re-ran
+    the goal's suspended execute coroutine, the process ran at 100 % CPU, and the executor's
+    100 Hz control timer ran 15 to 38 times a second, stretching every wall-clock budget (a
+    0.5 s stall_timeout ended after 6.5 s).
     """
 
     def __init__(self, scene: Path, joint: Joint, *,
@@ -127,7 +156,6 @@ class Rig:
                  executor: tuple[Parameter, ...] = ()) -> None:
         self.context = Context()
         rclpy.init(context=self.context)
-        self.spin = MultiThreadedExecutor(num_threads=3, context=self.context)
         self.outside = OutsideHardware(self.context, joint)
         common = [Parameter("lockstep", value=False),
                   Parameter("finger_devices", value=["F1:jaw_f1", "F2:jaw_f2"]),
@@ -144,8 +172,11 @@ class Rig:
         self.client = ActionClient(self.client_node, ExecuteGrasp, pipeline.ACTION)
         self.nodes = [self.outside, self.monitor, self.executor, self.kinematics,
                       self.client_node]
+        self.spin = EventsExecutor(context=self.context)
         for node in self.nodes:
             self.spin.add_node(node)
+        self.slice = nodes.Spinner(self.spin, self.client_node, 0.02)
+        self.lab: LabThread | None = None
         if reach is None:       # no pose topics
             return
         # the tips' centres: half the aperture between the pad faces plus the pad's edge radius
@@ -159,7 +190,7 @@ class Rig:
     def spin_until(self, condition, timeout: float = 30.0) -> None:
         deadline = time.monotonic() + timeout
         while not condition() and time.monotonic() < deadline:
-            self.spin.spin_once(timeout_sec=0.02)
+            self.slice()
 
     def squeeze(self, *, seen: bool = True) -> ExecuteGrasp.Result:
         """Send the squeeze of DEPTH and return its result (``seen``: once the monitor has
@@ -178,16 +209,28 @@ class Rig:
         assert done.done(), "the grasp goal did not end within 60 s"
         return done.result().result
 
+    def lab_node(self) -> Node:
+        """A node for the lab's gripper action server, spun in a thread of its own (the server
+        blocks in its goals).
+        """
+        node = Node("outside_gripper_action", context=self.context)
+        self.nodes.append(node)
+        self.lab = LabThread(MultiThreadedExecutor(num_threads=3, context=self.context), node)
+        return node
+
     def close(self) -> None:
         self.client.destroy()
+        if self.lab is not None:
+            self.lab.stop()
         self.spin.shutdown()
         for node in self.nodes:
             node.destroy_node()
         rclpy.shutdown(context=self.context)
         # rclpy prints "The following exception was never retrieved" when a task of the stopped
-        # executor is collected: drop the executor and its nodes and collect here, not in a
+        # executor is collected: drop the executors and their nodes and collect here, not in a
         # later test that reads stderr
-        self.spin = self.nodes = self.outside = self.monitor = self.executor = None
+        self.spin = self.lab = self.slice = self.nodes = self.outside = self.monitor = None
+        self.executor = None
         gc.collect()
 
 
@@ -216,6 +259,47 @@ def test_the_executor_drives_an_outside_jtc_in_wall_time(capfd):
     finally:
         rig.close()
     assert "pose readings put the pad faces" not in capfd.readouterr().err
+
+
+def hold_the_gil(seconds: float) -> None:
+    """Stall the whole process for ``seconds`` as a long garbage collection would: this thread
+    keeps the GIL (no forced switch) while it spins.
+    """
+    interval = sys.getswitchinterval()
+    sys.setswitchinterval(10.0 * seconds)
+    try:
+        end = time.monotonic() + seconds
+        while time.monotonic() < end:
+            pass
+    finally:
+        sys.setswitchinterval(interval)
+
+
+def test_a_stall_of_the_whole_process_is_not_the_monitors_silence():
+    """The process that runs the monitor and the executor stands still for 1.3 s mid-squeeze,
+    more than the executor's stale_budget (1 s): nobody could publish or hear. The goal goes on
+    to its depth. Before, it ended ``stale_data`` ("no /monitor/status message for 1.305 s ...
+    (is the monitor running?)"): a loaded CI machine failed the test above so.
+    """
+    rig = Rig(SCENE, Joint(OPEN))
+    stalled = threading.Event()
+
+    def stall() -> None:
+        while rig.executor.goal is None or rig.executor.goal.start_ns is None:
+            time.sleep(0.005)
+        hold_the_gil(1.3)
+        stalled.set()
+
+    thread = threading.Thread(target=stall, daemon=True)
+    thread.start()
+    try:
+        result = rig.squeeze()
+        thread.join(timeout=10.0)
+        assert stalled.is_set(), "the stall never came: the goal ended before it started"
+        assert result.termination == ExecuteGrasp.Result.DEPTH_REACHED, result.message
+        assert result.depth == pytest.approx(DEPTH, rel=0.05)
+    finally:
+        rig.close()
 
 
 def test_a_reader_that_starts_late_gets_the_executors_current_state():
@@ -457,7 +541,7 @@ def test_the_executor_cancels_an_outside_gripper_action_on_the_slip_alarm(tmp_pa
     # 10 ms ticks of the monitor and the executor)
     joint = Joint(OPEN, touch=0.055, stiffness=2000.0, plateau=10.0, speed=0.02)
     rig = Rig(path, joint)
-    server = OutsideGripperAction(rig.outside, joint)
+    server = OutsideGripperAction(rig.lab_node(), joint)
     try:
         result = rig.squeeze()
         assert result.termination == ExecuteGrasp.Result.SLIP_ALARM, result.message
@@ -517,7 +601,7 @@ def test_a_gripper_goal_without_a_result_ends_the_grasp_after_gripper_timeout(tm
     path = tmp_path / "sponge_gripper_action.yaml"
     path.write_text(yaml.safe_dump(scene))
     rig = Rig(path, Joint(OPEN), executor=(Parameter("gripper_timeout", value=0.5),))
-    server = InactiveGripperAction(rig.outside)
+    server = InactiveGripperAction(rig.lab_node())
     try:
         result = rig.squeeze()
         assert result.termination == ExecuteGrasp.Result.GRIPPER_ABORTED, result.message

@@ -18,6 +18,7 @@ from rclpy.experimental import EventsExecutor
 from rclpy.impl.implementation_singleton import rclpy_implementation
 from rclpy.node import Node
 from rclpy.signals import SignalHandlerOptions
+from rclpy.task import Future
 
 from squeeze_grasp_ros.exit_codes import ExitCode, SignalFlag
 from squeeze_grasp_ros.mechanics.errors import InvalidInputError
@@ -71,6 +72,47 @@ class ParameterError(InvalidInputError):
 DRAIN_SPIN = 0.05
 """s each ``spin_once`` of a draining node waits for work (one value throughout:
 ``SingleThreadedExecutor`` discards its ready entities when the timeout changes)."""
+
+
+SPIN_PERIOD = 0.1
+"""Wall-clock s: the longest one :class:`Spinner` spin lasts (a node started by
+:func:`run_node` checks for its stop between spins)."""
+
+
+class Spinner:
+    """Spins ``executor`` (``node`` on it) in slices of at most ``period`` wall-clock s; call it
+    for one slice.
+
+    On ``rclpy.experimental.EventsExecutor`` a slice is one ``spin_until_future_complete`` on a
+    future that a ``period`` wall timer on ``node`` completes: events are dispatched in C++ and
+    a suspended coroutine (a goal's execute callback awaiting its end) is resumed after each
+    event. Not ``spin_once`` in a loop: in rclpy 7.1.6 each ``spin_once`` first resumes every
+    suspended coroutine, which counts as its one callback, so the loop returned about 90,000
+    times a second for as long as a goal ran (the executor node's thread at 76 % CPU during
+    a hardware-mode goal, against 7 % now; ``test_nodes_spin``). The timeout alone does not end
+    a spin while events keep coming, hence the timer. On rclpy's ``Executor`` classes (they do
+    not resume a suspended coroutine without an event, and their
+    ``spin_until_future_complete`` keeps a done callback per call) a slice is ``spin_once``.
+    """
+
+    def __init__(self, executor: Executor, node: Node, period: float = SPIN_PERIOD) -> None:
+        from squeeze_grasp_ros.ros.nodes.pipeline import wall_timer  # it imports this module
+        self.executor, self.period = executor, period
+        self.events = not isinstance(executor, Executor)
+        self.wake = Future()
+        if self.events:
+            wall_timer(node, period, self._wake)
+
+    def _wake(self) -> None:
+        if not self.wake.done():
+            self.wake.set_result(None)
+
+    def __call__(self) -> None:
+        if not self.events:
+            self.executor.spin_once(self.period)
+            return
+        self.wake = Future()
+        self.executor.spin_until_future_complete(self.wake, self.period)
 
 
 def spin_until(executor: Executor, done: Callable[[], bool], timeout: float, *,
@@ -148,10 +190,11 @@ def run_node(factory: Callable[[], Node], args: list[str] | None = None,
     shutdown, then clean up.
 
     The executor (default ``rclpy.experimental.EventsExecutor``; the planner, whose worker
-    threads hand results back through futures, uses ``SingleThreadedExecutor``) is spun with
-    ``spin_once`` in a loop: in rclpy 7.1.6 ``EventsExecutor.spin()`` holds the GIL at 100 % CPU
-    once a node has a timer (measured: no callback runs, no other thread gets the GIL) and does
-    not return after shutdown. SIGINT (Ctrl-C, also what ``ros2 launch`` sends first) and
+    threads hand results back through futures, uses ``SingleThreadedExecutor``) is spun in
+    slices of at most :data:`SPIN_PERIOD` by a :class:`Spinner`: in rclpy 7.1.6
+    ``EventsExecutor.spin()`` without a timeout holds the GIL at 100 % CPU once a node has a
+    timer (measured: no callback runs, no other thread gets the GIL) and does not return after
+    shutdown. SIGINT (Ctrl-C, also what ``ros2 launch`` sends first) and
     SIGTERM only set a flag, so no callback is interrupted halfway; the loop then ends, a node
     with ``drain(executor)`` processes what has already arrived, the node waits until its readers
     have acknowledged what it published (:func:`wait_acknowledged`; not a node whose
@@ -198,10 +241,11 @@ def run_node(factory: Callable[[], Node], args: list[str] | None = None,
     node.get_logger().info(f"{node.get_name()} ready" + (f": {summary}" if summary else ""))
     executor = executor_type()
     executor.add_node(node)
+    spin = Spinner(executor, node)
     checks = [time.monotonic() + delay for delay in TWIN_CHECKS]
     try:
         while rclpy.ok() and not stop.is_set() and not orphaned():
-            executor.spin_once(0.1)
+            spin()
             if checks and time.monotonic() >= checks[0]:
                 checks = [] if _warn_twins(node) else checks[1:]
         if orphaned():

@@ -78,7 +78,8 @@ PARAMETERS: dict[str, tuple[Any, str]] = {
     "position_tolerance": (1e-7, "a phase ends when every moving tip is this close, m"),
     "redirect_grace": (20, "cycles the slip alarm is ignored after a redirection"),
     "stale_budget": (0.1, "longest hold for stale sensor data, s; past it the goal ends "
-                          "stale_data"),
+                          "stale_data (hardware mode: also the longest monitor silence, not "
+                          "counting the executor's own stalls)"),
     "lift_watch": (0.0, "after picked_up, hold this long watching for weight_slip before the "
                         "goal ends picked_up, s (0: end at picked_up)"),
     "period": (0.001, "control cycle, s (lockstep: the simulated tick)"),
@@ -224,7 +225,10 @@ class ExecutorNode(Node):
         self.latest: bytes | None = None
         """The newest status, serialised (a raw subscription: :meth:`_cycle` reads it)."""
         self.latest_at = 0.0
-        """Hardware mode: when it arrived (``time.monotonic``, s)."""
+        """Hardware mode: when it arrived (``time.monotonic``, s), moved on by the executor's
+        own stalls (:meth:`_own_stall`)."""
+        self.timer_at: float | None = None
+        """Hardware mode: when the control timer last ran (``time.monotonic``, s)."""
         self.answered = pipeline.TickAnswer()
         self.state = ExecutorStatus.IDLE
         self.tick_clock = pipeline.TickClock(self) if p["lockstep"] else None
@@ -378,10 +382,15 @@ class ExecutorNode(Node):
         self.latest, self.latest_at = data, time.monotonic()
 
     def _timer(self) -> None:
+        now = time.monotonic()
+        lost = self._own_stall(now)
         goal = self.goal
         if goal is None:
             return
-        now = time.monotonic()
+        if lost:    # the silence clocks do not run while the executor itself could not run
+            self.latest_at = min(self.latest_at + lost, now)
+            if goal.waiting_since is not None:
+                goal.waiting_since = min(goal.waiting_since + lost, now)
         if self.latest is not None:
             silent = now - self.latest_at
             if silent <= self.p["stale_budget"]:
@@ -400,6 +409,19 @@ class ExecutorNode(Node):
                               f"no {self.resolve_topic_name(pipeline.STATUS)} message within "
                               f"stale_budget {self.p['stale_budget']} s of the goal (is the "
                               "monitor running?); nothing was commanded")
+
+    def _own_stall(self, now: float) -> float:
+        """How long the executor itself stood still before this timer callback (``now``,
+        monotonic s): the part of the gap since the last callback beyond two periods (the
+        silence clocks run at most two periods a control cycle).
+
+        A process stalled by the garbage collector, the GIL or a starved CPU hears nothing, and
+        its monitor (in the same process, or queued behind the stall) could not speak: that
+        silence says nothing of the monitor. Before, a 1.3 s stall of the process ended a
+        hardware goal ``stale_data`` at stale_budget 1 s, blaming the monitor.
+        """
+        last, self.timer_at = self.timer_at, now
+        return 0.0 if last is None else max(now - last - 2.0 * self.p["period"], 0.0)
 
     def _cycle(self, data: bytes, now_ns: int | None = None) -> None:
         """One control cycle on the serialised status ``data``; publish the setpoints, finish

@@ -275,7 +275,7 @@ def hold_the_gil(seconds: float) -> None:
         sys.setswitchinterval(interval)
 
 
-def test_a_stall_of_the_whole_process_is_not_the_monitors_silence():
+def test_a_stall_of_the_whole_process_is_not_the_monitors_silence(capfd):
     """The process that runs the monitor and the executor stands still for 1.3 s mid-squeeze,
     more than the executor's stale_budget (1 s): nobody could publish or hear. The goal goes on
     to its depth. Before, it ended ``stale_data`` ("no /monitor/status message for 1.305 s ...
@@ -300,6 +300,35 @@ def test_a_stall_of_the_whole_process_is_not_the_monitors_silence():
         assert result.depth == pytest.approx(DEPTH, rel=0.05)
     finally:
         rig.close()
+    stall = re.search(r"the control timer did not run for ([0-9.]+) s \(period 0\.01 s\): this "
+                      r"process stood still \(garbage collection, a starved CPU\); no setpoint "
+                      r"went out meanwhile", capfd.readouterr().err)
+    assert stall is not None and 1.3 <= float(stall.group(1)) < 3.0
+
+
+def test_a_control_period_the_timer_cannot_keep_is_named(capfd):
+    """Period 0.1 ms asks for 10,000 control cycles a second, more than an rclpy timer beside
+    the rig's other nodes runs: the squeeze still ends at its depth (each cycle advances one
+    period), and the executor says how slow its cycles ran against the asked rate.
+    """
+    rig = Rig(SCENE, Joint(OPEN), executor=(Parameter("period", value=1e-4),))
+    try:
+        result = rig.squeeze()
+        assert result.termination == ExecuteGrasp.Result.DEPTH_REACHED, result.message
+    finally:
+        rig.close()
+    rate = result.ticks / result.duration
+    assert rate < 7500.0, f"{rate:.0f} cycles a second: this machine keeps 75 % of 10 kHz"
+    warned = re.search(r"the goal ran (\d+) control cycles in ([0-9.]+) s(?: \(and [0-9.]+ s of "
+                       r"stalls\))?: ([0-9.e+]+) a second "
+                       r"against the 1e\+04 that period 0\.0001 s asks; the motion ran and its "
+                       r"time budgets counted at (\d+) % of wall time: give a period this "
+                       r"machine keeps", capfd.readouterr().err)
+    assert warned is not None
+    assert int(warned.group(1)) == result.ticks
+    running = float(warned.group(2))   # the duration outside the executor's own stalls
+    assert running <= result.duration + 1e-3
+    assert float(warned.group(3)) == pytest.approx(result.ticks / running, rel=2e-3)
 
 
 def test_a_reader_that_starts_late_gets_the_executors_current_state():

@@ -114,6 +114,17 @@ BOUNDS = {"max_velocity": pipeline.Bound(0.0, above=True, unit="m/s"),
           "stall_timeout": pipeline.Bound(0.0, unit="s")}
 """The range of each numeric parameter."""
 
+STALL_FLOOR = 0.05
+"""s: hardware mode, a gap between two runs of the control timer shorter than this (or than two
+periods) is lateness, not a stall of the executor's own process."""
+STALL_WARNING = 0.1
+"""s: hardware mode, a stall of the executor's own control timer longer than this is logged."""
+RATE_WINDOW = 0.5
+"""s: hardware mode, a goal at least this long whose control cycles ran below
+:data:`SLOW_RATE` of the rate ``period`` asks is logged."""
+SLOW_RATE = 0.75
+"""The fraction of the asked control rate below which a hardware goal's cycles are logged."""
+
 SUCCESS = (ExecuteGrasp.Result.DEPTH_REACHED, ExecuteGrasp.Result.RESISTED,
            ExecuteGrasp.Result.PICKED_UP)
 """Terminations that count as success."""
@@ -133,6 +144,9 @@ class _Goal:
         self.since_feedback: list = []
         self.start_ns: int | None = None
         self.waiting_since_ns: int | None = None
+        self.stalled = 0.0
+        """Hardware mode: s the executor's own control timer stood still during the goal
+        (:meth:`ExecutorNode._own_stall`)."""
         self.waiting_since: float | None = None
         """Wall-clock (monotonic) s since which the goal waits for any monitor status
         (hardware mode)."""
@@ -229,6 +243,9 @@ class ExecutorNode(Node):
         own stalls (:meth:`_own_stall`)."""
         self.timer_at: float | None = None
         """Hardware mode: when the control timer last ran (``time.monotonic``, s)."""
+        self.allowance = max(2.0 * p["period"], STALL_FLOOR)
+        """Hardware mode: s between two runs of the control timer beyond which the executor
+        itself stood still (a late timer that runs on is not a stall)."""
         self.answered = pipeline.TickAnswer()
         self.state = ExecutorStatus.IDLE
         self.tick_clock = pipeline.TickClock(self) if p["lockstep"] else None
@@ -335,7 +352,7 @@ class ExecutorNode(Node):
         if problem is not None:
             handle.abort()
             return messages.invalid_goal_result(problem)
-        self.goal = _Goal(GraspProgram(goal, self.limits, list(self.devices)), handle)
+        self.goal = running = _Goal(GraspProgram(goal, self.limits, list(self.devices)), handle)
         done = self.goal.done
         if handle.is_cancel_requested:  # taken before this task ran: _accept_cancel saw no goal
             self._cancel_unstarted(self.goal)
@@ -343,6 +360,7 @@ class ExecutorNode(Node):
                 messages.cdr_stamp_ns(self.latest) > self.answered.stamp_ns:
             self._cycle(self.latest)
         result = await done
+        self._check_rate(result, running)
         if result.termination == ExecuteGrasp.Result.CANCELED and handle.is_cancel_requested:
             handle.canceled()
         elif result.success:
@@ -391,6 +409,13 @@ class ExecutorNode(Node):
             self.latest_at = min(self.latest_at + lost, now)
             if goal.waiting_since is not None:
                 goal.waiting_since = min(goal.waiting_since + lost, now)
+            goal.stalled += lost
+            if lost > STALL_WARNING:
+                self.get_logger().warning(
+                    f"the control timer did not run for {lost + self.allowance:.3f} s "
+                    f"(period {self.p['period']} s): this process stood still (garbage "
+                    "collection, a starved CPU); no setpoint went out meanwhile, and the stall "
+                    "does not count as monitor silence", throttle_duration_sec=1.0)
         if self.latest is not None:
             silent = now - self.latest_at
             if silent <= self.p["stale_budget"]:
@@ -410,10 +435,29 @@ class ExecutorNode(Node):
                               f"stale_budget {self.p['stale_budget']} s of the goal (is the "
                               "monitor running?); nothing was commanded")
 
+    def _check_rate(self, result: ExecuteGrasp.Result, goal: _Goal) -> None:
+        """Hardware mode: warn when ``goal``'s control cycles ran below :data:`SLOW_RATE` of
+        the rate ``period`` asks, over at least :data:`RATE_WINDOW` s of its ``result``'s
+        duration outside the executor's own stalls (logged apart). A cycle advances the motion
+        and the time budgets by one period, so a timer that cannot keep up slows the squeeze
+        and stretches stale_budget and stall_timeout in wall time.
+        """
+        running = result.duration - goal.stalled
+        if self.p["lockstep"] or running < RATE_WINDOW or not result.ticks:
+            return
+        rate, asked = result.ticks / running, 1.0 / self.p["period"]
+        if rate < SLOW_RATE * asked:
+            self.get_logger().warning(
+                f"the goal ran {result.ticks} control cycles in {running:.3f} s"
+                + (f" (and {goal.stalled:.3f} s of stalls)" if goal.stalled else "") + ": "
+                f"{rate:.4g} a second against the {asked:.4g} that period {self.p['period']} s "
+                f"asks; the motion ran and its time budgets counted at {100 * rate / asked:.0f} "
+                "% of wall time: give a period this machine keeps")
+
     def _own_stall(self, now: float) -> float:
         """How long the executor itself stood still before this timer callback (``now``,
-        monotonic s): the part of the gap since the last callback beyond two periods (the
-        silence clocks run at most two periods a control cycle).
+        monotonic s): the part of the gap since the last callback beyond :attr:`allowance` (the
+        silence clocks run at most that much between two callbacks).
 
         A process stalled by the garbage collector, the GIL or a starved CPU hears nothing, and
         its monitor (in the same process, or queued behind the stall) could not speak: that
@@ -421,7 +465,7 @@ class ExecutorNode(Node):
         hardware goal ``stale_data`` at stale_budget 1 s, blaming the monitor.
         """
         last, self.timer_at = self.timer_at, now
-        return 0.0 if last is None else max(now - last - 2.0 * self.p["period"], 0.0)
+        return 0.0 if last is None else max(now - last - self.allowance, 0.0)
 
     def _cycle(self, data: bytes, now_ns: int | None = None) -> None:
         """One control cycle on the serialised status ``data``; publish the setpoints, finish

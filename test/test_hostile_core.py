@@ -28,6 +28,7 @@ from squeeze_grasp_ros.mechanics.elastic.mesh import generate_mesh
 from squeeze_grasp_ros.mechanics.errors import InvalidInputError
 from squeeze_grasp_ros.mechanics.resistance.optimal import (
     MAX_RELATIVE_PUSH,
+    MIN_RELATIVE_PUSH,
     optimal_resistance,
     resistance_grasp,
     sweep_directions,
@@ -151,6 +152,34 @@ def test_the_bound_is_the_push_not_the_rate_per_unit_push():
     assert np.allclose(at_bound.d1, unit.d1 * np.hypot(*edge), rtol=1e-9)
     with pytest.raises(InvalidInputError, match="adversary.a is"):
         optimal_resistance(grasp, 1.001 * edge)
+
+
+def test_a_push_too_short_for_the_float_range_is_refused_naming_the_floor(tmp_path, capfd):
+    """The work is quadratic in a: at |a| = 1e-160 m it came out subnormal (1.4e-318 J, 6
+    digits), and a = [1e-200, 0] was refused as "must be nonzero" (the norm underflowed). A
+    push below MIN_RELATIVE_PUSH of the size is refused naming the floor, in both modes and
+    for friction contacts; at the floor the answer is the unit-push one scaled, to 1e-9.
+    """
+    obj = scene_solid(load_scene(scene_file("disk")))
+    b = [int(k) for k in obj.mesh.boundary]
+    grasp = resistance_grasp(obj, {"F1": [b[0]], "F2": [b[len(b) // 2]], "A": [b[len(b) // 4]]})
+    floor = rf"the resistance model takes \|a\| >= {MIN_RELATIVE_PUSH:g} of the size"
+    for tiny in ([-1e-160, 0.0], [-1e-200, 0.0], [-5e-324, 0.0]):
+        for per_unit_push in (False, True):
+            with pytest.raises(InvalidInputError, match=floor):
+                optimal_resistance(grasp, tiny, per_unit_push=per_unit_push)
+    with pytest.raises(InvalidInputError, match="must be nonzero"):
+        optimal_resistance(grasp, [0.0, -0.0])
+    edge = np.array([-MIN_RELATIVE_PUSH * obj.scale, 0.0])
+    at_floor = optimal_resistance(grasp, edge)
+    unit = optimal_resistance(grasp, [-1.0, 0.0], per_unit_push=True)
+    assert np.allclose(at_floor.d1, unit.d1 * np.hypot(*edge), rtol=1e-9)
+    assert at_floor.work["total"] == pytest.approx(unit.work["total"] * edge @ edge, rel=1e-9)
+    assert at_floor.work["total"] > np.finfo(float).tiny   # a normal float, full precision
+    friction = variant(tmp_path, str(SCENES / "resist_fig10.yaml"),
+                       lambda d: d["adversary"].__setitem__("a", [1e-200, 0.0]), "fig10.yaml")
+    line = refused(["resist", friction], capfd)
+    assert "adversary.a is 1e-200 m long" in line and f"|a| >= {MIN_RELATIVE_PUSH:g}" in line
 
 
 # ----------------------------------------------------------------------------- item 6

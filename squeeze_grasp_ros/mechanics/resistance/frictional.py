@@ -37,7 +37,7 @@ from squeeze_grasp_ros.mechanics.elastic.mesh import vertex_normals
 from squeeze_grasp_ros.mechanics.errors import InvalidInputError, require_finite
 from squeeze_grasp_ros.mechanics.resistance.optimal import (
     optimal_resistance,
-    require_small_push,
+    require_push_range,
     resistance_grasp,
 )
 from squeeze_grasp_ros.mechanics.squeeze.contact_model import ContactModel
@@ -316,8 +316,8 @@ def frictional_resistance(
     Raises
     ------
     InvalidInputError
-        If ``a`` is not a nonzero finite [x, y] or is longer than
-        :data:`~.optimal.MAX_RELATIVE_PUSH` of the object size, the state's fingers are not
+        If ``a`` is not a finite [x, y] from :data:`~.optimal.MIN_RELATIVE_PUSH` to
+        :data:`~.optimal.MAX_RELATIVE_PUSH` of the object size long, the state's fingers are not
         F1, F2 and A, or the loop stalls.
     NumericalError
         If the stepper fails (a solve or an event location that does not converge).
@@ -340,12 +340,12 @@ def frictional_resistance(
     """
     a = np.asarray(a, float).reshape(-1)
     require_finite("adversary translation a", a)
-    length = float(np.linalg.norm(a))
-    if a.shape != (2,) or not length > 0:
+    if a.shape != (2,) or not np.any(a):
         raise InvalidInputError(
             f"adversary translation a must be a nonzero [x, y] in m, got {a.tolist()}"
         )
-    require_small_push(a, model.obj.scale)
+    require_push_range(a, model.obj.scale)
+    length = float(np.hypot(*a))
     if [f.name for f in state.fingers] != list(tuple(Finger)):
         raise InvalidInputError(
             f"the state needs fingers {list(tuple(Finger))}, has {[f.name for f in state.fingers]}"

@@ -380,12 +380,27 @@ MAX_DIRECTIONS = 100_000
 """Most push directions of :func:`sweep_directions` (0.0036 degrees apart; a few MB)."""
 
 
-def require_small_push(a: np.ndarray, size: float) -> None:
-    """Refuse an adversary translation ``a`` (m) longer than :data:`MAX_RELATIVE_PUSH` of the
-    object size ``size`` (m).
+MIN_RELATIVE_PUSH = 1e-100
+"""Shortest adversary translation |a| a resistance accepts, relative to the object size L, also
+as a per-unit-push direction. The work is quadratic in a: at |a| = 1e-160 L the Fig. 9 blob's
+work came out as 1.4e-318 J, a subnormal float with 6 significant digits, and below about
+1e-154 L of a 0.1 m object |a|^2 left the float range, so a = [1e-200, 0] m was refused as
+"must be nonzero"."""
+
+
+def require_push_range(a: np.ndarray, size: float, *, per_unit_push: bool = False) -> None:
+    """Refuse an adversary translation ``a`` (m) shorter than :data:`MIN_RELATIVE_PUSH` or,
+    unless ``per_unit_push`` (``a`` is then a direction of any length), longer than
+    :data:`MAX_RELATIVE_PUSH` of the object size ``size`` (m).
     """
     length = float(np.hypot(*a))
-    if length > MAX_RELATIVE_PUSH * size:
+    if length < MIN_RELATIVE_PUSH * size:
+        raise InvalidInputError(
+            f"adversary.a is {length:.4g} m long, {length / size:.3g} of the object size "
+            f"{size:.4g} m; the resistance model takes |a| >= {MIN_RELATIVE_PUSH:g} of the "
+            f"size, {MIN_RELATIVE_PUSH * size:.4g} m (its work, quadratic in a, would leave "
+            "the floating-point range)")
+    if not per_unit_push and length > MAX_RELATIVE_PUSH * size:
         raise InvalidInputError(
             f"adversary.a is {length:.4g} m long, {length / size:.3g} times the object size "
             f"{size:.4g} m; the resistance model (small deformations) takes |a| <= "
@@ -397,9 +412,7 @@ def _translation(a, name: str = "adversary translation a") -> np.ndarray:
     if a.shape != (2,):
         raise InvalidInputError(f"{name} must be [x, y] in m, got shape {a.shape}")
     require_finite(name, a)
-    with np.errstate(over="ignore"):  # a length beyond the float range is nonzero too
-        nonzero = np.linalg.norm(a) > 0
-    if not nonzero:
+    if not np.any(a):
         raise InvalidInputError(f"{name} must be nonzero")
     return a
 
@@ -497,7 +510,8 @@ def evaluate_resistance(
     """Forces, work and constraint residuals of a given resistance (d1, d2) to a, all in m.
 
     ``a`` is at most :data:`MAX_RELATIVE_PUSH` of the object size, unless ``per_unit_push``:
-    then (d1, d2, a) are rates per metre of A's travel, of any length (the model is linear).
+    then (d1, d2, a) are rates per metre of A's travel, of any length (the model is linear);
+    at least :data:`MIN_RELATIVE_PUSH` of it either way.
 
     ``success`` is False (the residual is in ``reason``) when (d1, d2, a) violates the mode's
     constraints by more than :data:`FEASIBILITY_TOL`: eqs. (54)-(55) (segments: their Sec. 6.2
@@ -514,8 +528,7 @@ def evaluate_resistance(
     """
     form = grasp.form(mode)
     a = _translation(a)
-    if not per_unit_push:
-        require_small_push(a, grasp.scale)
+    require_push_range(a, grasp.scale, per_unit_push=per_unit_push)
     x = np.concatenate([np.asarray(d1, float).reshape(2), np.asarray(d2, float).reshape(2), a])
     require_finite("d1, d2", x)
     red, obj = grasp.red, grasp.obj
@@ -591,8 +604,8 @@ def optimal_resistance(
     grasp : ResistanceGrasp
         Fixed contact sets of F1, F2, A (:func:`resistance_grasp`).
     a : (2,) array_like
-        Adversary translation, m, object frame (nonzero), at most :data:`MAX_RELATIVE_PUSH`
-        of the object size.
+        Adversary translation, m, object frame, from :data:`MIN_RELATIVE_PUSH` to
+        :data:`MAX_RELATIVE_PUSH` of the object size.
     mode : {"stable", "pure"}
         Stable: Delta in col(C) (eqs. 54-61, 66); pure: Delta in col(AC) (eqs. 62-63, 91, 94).
     per_unit_push : bool
@@ -620,8 +633,7 @@ def optimal_resistance(
     stable True True
     """
     a = _translation(a)
-    if not per_unit_push:
-        require_small_push(a, grasp.scale)
+    require_push_range(a, grasp.scale, per_unit_push=per_unit_push)
     form = grasp.form(mode)
     L = grasp.scale
     a_hat = a[None] / L
@@ -661,7 +673,7 @@ def resistance_along(
         ``success`` False when no resistance of this mode moves F1 along that line.
     """
     a = _translation(a)
-    require_small_push(a, grasp.scale)
+    require_push_range(a, grasp.scale)
     e = _translation(direction, "d1 direction")
     form = grasp.form(mode)
     L = grasp.scale

@@ -56,7 +56,7 @@ from squeeze_grasp_ros.control.motion import GraspGoal, Observation
 from squeeze_grasp_ros.mechanics.vocabulary import ControllerKind
 from squeeze_grasp_ros.ros import messages
 from squeeze_grasp_ros.ros.nodes import pipeline
-from squeeze_grasp_ros.ros.nodes.jaw_commands import PlannedJawForce, squeeze_end
+from squeeze_grasp_ros.ros.nodes.jaw_commands import PlannedJawForce, squeeze_end, start_line
 from squeeze_grasp_ros.scene.controller import JawController
 
 __all__ = ["JawAction"]
@@ -129,9 +129,8 @@ class JawAction:
         :meth:`.JawCommands.start`); why its squeeze
         leaves the device's opening range, or None (:meth:`.JawController.opening_problem`).
         """
-        self.line = self.controller.jaw_line(obs.positions)
-        return self.controller.opening_problem(self.line, obs.positions,
-                                               squeeze_end(goal, obs.positions, goal.depth))
+        self.line, problem = start_line(self.controller, obs, goal)
+        return problem
 
     def target(self, goal: GraspGoal, obs: Observation) -> tuple[float, float]:
         """(joint position, joint effort limit) of grasp goal ``goal`` from its first

@@ -140,9 +140,8 @@ class JawCommands:
         squeeze leaves the device's opening range, or None
         (:meth:`.JawController.opening_problem`).
         """
-        self.line = self.controller.jaw_line(obs.positions)
-        return self.controller.opening_problem(self.line, obs.positions,
-                                               squeeze_end(goal, obs.positions, goal.depth))
+        self.line, problem = start_line(self.controller, obs, goal)
+        return problem
 
     def trajectory(self, setpoints: Mapping[str, np.ndarray], start_ns: int
                    ) -> tuple[Any, JointTrajectory]:
@@ -155,6 +154,17 @@ class JawCommands:
         messages.set_stamp(msg.header.stamp, start_ns)
         msg.points[0].positions = [float(p) for p in self.controller.joint_positions(aperture)]
         return self.publisher, msg
+
+
+def start_line(controller: JawController, obs: Observation, goal: GraspGoal
+               ) -> tuple[JawLine, str | None]:
+    """The jaw line fixed from the jaws' measured tips in a goal's first observation ``obs``,
+    and why ``goal``'s squeeze leaves the device's opening range, or None
+    (:meth:`.JawController.opening_problem`).
+    """
+    line = controller.jaw_line(obs.positions)
+    return line, controller.opening_problem(line, obs.positions,
+                                            squeeze_end(goal, obs.positions, goal.depth))
 
 
 def squeeze_end(goal: GraspGoal, start: Mapping[str, np.ndarray], depth: float

@@ -650,6 +650,39 @@ def test_a_gripper_goal_without_a_result_ends_the_grasp_after_gripper_timeout(tm
         rig.close()
 
 
+def test_a_device_without_position_limits_is_named_on_hardware(tmp_path, capfd):
+    """A transmission closing the wrong way maps the joint both ways consistently, so the
+    executor's own view stays right while the jaws open: only the joint's limits catch it at
+    load. A hardware executor whose device gives none says so at start; with them (the shipped
+    device), or in simulation, it says nothing.
+    """
+    device = {k: v for k, v in DEVICE.items()}
+    device["transmission"] = {k: v for k, v in DEVICE["transmission"].items()
+                              if k != "position_limits"}
+    (tmp_path / "unlimited.yaml").write_text(yaml.safe_dump({**device, "name": "unlimited"}))
+    scene = yaml.safe_load(SCENE.read_text())
+    scene["controller"]["device"] = "unlimited.yaml"
+    path = tmp_path / "sponge_unlimited.yaml"
+    path.write_text(yaml.safe_dump(scene))
+    warning = ("the device unlimited gives no transmission.position_limits: a transmission "
+               "that closes the wrong way (position_per_aperture's sign, or the offset) cannot "
+               "be caught before the jaws move; give the joint's limits (the URDF's) in its "
+               "device file")
+    for scene_path, lockstep, said in ((path, False, True), (path, True, False),
+                                       (SCENE, False, False)):
+        context = Context()
+        rclpy.init(context=context)
+        try:
+            node = ExecutorNode(context=context, parameter_overrides=[
+                Parameter("lockstep", value=lockstep),
+                Parameter("finger_devices", value=["F1:jaw_f1", "F2:jaw_f2"]),
+                Parameter("controller_scene", value=str(scene_path))])
+            node.destroy_node()
+        finally:
+            rclpy.shutdown(context=context)
+        assert (warning in capfd.readouterr().err) is said, (scene_path, lockstep)
+
+
 def test_a_goal_before_the_monitor_saw_the_jaws_waits_then_ends_stale_data():
     # nobody publishes the jaws' poses: the monitor reports them unseen (at the origin)
     rig = Rig(SCENE, Joint(OPEN), reach=None)

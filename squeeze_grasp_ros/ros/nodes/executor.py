@@ -198,6 +198,13 @@ class ExecutorNode(Node):
         controller = scene_controller(load_scene(p["controller_scene"]), p["controller_scene"]) \
             if p["controller_scene"] else None
         action = controller is not None and controller.kind.is_action
+        if isinstance(controller, JawController) and not p["lockstep"] \
+                and controller.gripper.transmission.position_limits is None:
+            self.get_logger().warning(
+                f"the device {controller.gripper.name} gives no transmission.position_limits: "
+                "a transmission that closes the wrong way (position_per_aperture's sign, or the "
+                "offset) cannot be caught before the jaws move; give the joint's limits (the "
+                "URDF's) in its device file")
         self.jaws = None
         if isinstance(controller, HandController):
             self.jaws = HandCommands(self, controller, p["period"], loop)

@@ -1033,11 +1033,12 @@ def test_without_the_extra_both_verbs_say_how_to_install_and_exit_4(tmp_path, mo
                                                                      missing):
     """A missing extra is the environment's failure (status 4, as for ``run`` without ROS and
     ``outline`` without scikit-image), not invalid input, and nothing is written.
+    ``sweep-report`` needs pyarrow only (:func:`test_sweep_report_needs_pyarrow_only`).
     """
     spec = write_spec(tmp_path, SMALL)
     monkeypatch.setitem(sys.modules, missing, None)
     for argv in (["sweep", str(spec), "--out", str(tmp_path / "o")],
-                 ["sweep-report", str(tmp_path / "o")]):
+                 *([["sweep-report", str(tmp_path / "o")]] if missing == "pyarrow" else [])):
         assert main(argv) == ExitCode.INTERNAL == 4
         assert f"error: needs {missing}, which is not installed: pip install '.[sweep]'" \
             in capsys.readouterr().err
@@ -1209,3 +1210,23 @@ def test_a_tasks_rows_do_not_depend_on_the_processs_blas_threads():
             rows[threads] = [{k: v for k, v in r.items() if k != "time_s"}
                              for task in plan_tasks(loaded) for r in run_task(task)["rows"]]
     assert len(rows[1]) == 288 and rows[2] == rows[1]
+
+
+def test_sweep_report_needs_pyarrow_only(tmp_path, capsys, monkeypatch):
+    """``sweep-report`` reads Parquet: without Dask distributed it reports (before, it refused:
+    "squeeze-grasp sweep-report: error: needs distributed"); ``sweep`` still needs both.
+    """
+    from squeeze_grasp_ros.sweep.store import Store
+
+    loaded = parse_sweep_spec(SMALL, tmp_path)
+    Store(tmp_path / "o", loaded, plan_tasks(loaded)).close()
+    monkeypatch.setitem(sys.modules, "distributed", None)   # import distributed fails
+    assert main(["sweep-report", str(tmp_path / "o")]) == 0
+    capsys.readouterr()
+    assert main(["sweep", str(write_spec(tmp_path, SMALL)), "--out", str(tmp_path / "p")]) == 4
+    assert "squeeze-grasp sweep: error: needs distributed, which is not installed" in \
+        capsys.readouterr().err
+    monkeypatch.setitem(sys.modules, "pyarrow", None)
+    assert main(["sweep-report", str(tmp_path / "o")]) == 4
+    assert "squeeze-grasp sweep-report: error: needs pyarrow, which is not installed" in \
+        capsys.readouterr().err

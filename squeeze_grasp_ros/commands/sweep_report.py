@@ -27,7 +27,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 def run(args: argparse.Namespace) -> dict:
     """Read the verified parts and summarise them; parts left out are listed."""
-    require_extra()
+    require_extra("sweep-report", ("pyarrow",))
     from squeeze_grasp_ros.sweep.store import load_dataset, read_outlines
     data = load_dataset(args.out)
     rows = data.table.to_pylist()

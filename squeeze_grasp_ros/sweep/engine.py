@@ -54,16 +54,18 @@ and the rest sample every few seconds: the memory limit is still enforced, withi
 cluster keeps its own configuration."""
 
 
-def require_extra() -> None:
-    """Raise :class:`ModuleNotFoundError` naming the missing module and the install command if
-    Dask distributed or pyarrow is missing (the CLI prints it and exits with status 4, as for
-    every missing extra).
+def require_extra(verb: str = "sweep", modules: tuple[str, ...] = ("distributed", "pyarrow")
+                  ) -> None:
+    """Raise :class:`ModuleNotFoundError` naming ``verb``, the missing module and the install
+    command if one of ``modules`` (for ``sweep``: Dask distributed and pyarrow; ``sweep-report``
+    reads Parquet only) is missing (the CLI prints it and exits with status 4, as for every
+    missing extra).
     """
-    for module in ("distributed", "pyarrow"):
+    for module in modules:
         try:
             importlib.import_module(module)
         except ImportError as exc:
-            raise ModuleNotFoundError(f"squeeze-grasp sweep needs {module}, which is not "
+            raise ModuleNotFoundError(f"squeeze-grasp {verb} needs {module}, which is not "
                                       f"installed: {install_hint(module)} ({exc})",
                                       name=module) from None
 

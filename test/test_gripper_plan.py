@@ -340,3 +340,29 @@ def test_the_evaluated_jaws_sit_where_the_candidate_put_them():
         assert (start - c.center) @ t == pytest.approx(0.0, abs=1e-12)  # on the line
         face = (start - c.center) @ d - sign * jaws.pad.radius  # F1's face is r ahead of it
         assert face == pytest.approx(sign * 0.5 * c.aperture, abs=1e-12)
+
+
+def test_a_closing_capped_by_the_jaws_travel_is_named_on_its_line(tmp_path, capsys):
+    """The header's closing (15 % of the aperture at first contact) is what was asked; a
+    gripper whose opening.min leaves less travel closes only that far. Before, the candidate's
+    line said nothing of it: the header read "closing 15.0 %" over a 2.4 % squeeze.
+    """
+    device = yaml.safe_load(device_file("generic_85mm").read_text())
+    device["opening"]["min"], device["name"] = 0.044, "narrow_travel"
+    path = tmp_path / "narrow_travel.yaml"
+    path.write_text(yaml.safe_dump(device))
+    argv = ["gripper-plan", str(scene_file("sponge_gripper")), "--count", "1", "--evaluate",
+            "1", "--yaw-range", "80", "100"]
+    assert main([*argv, "--gripper", str(path), "--json"]) == 0
+    c = json.loads(capsys.readouterr().out)["candidates"][0]
+    travel = c["aperture_at_contact"] - 0.044
+    assert c["closing"] == pytest.approx(travel, rel=1e-9) and c["termination"] == "depth_reached"
+    assert main([*argv, "--gripper", str(path)]) == 0
+    out = capsys.readouterr().out
+    assert "closing 15.0 % beyond first contact" in out
+    assert (f"(depth_reached), closing {1e3 * travel:.2f} mm "
+            f"({100 * travel / c['aperture_at_contact']:.1f} %) of the "
+            f"{150 * c['aperture_at_contact']:.2f} mm asked, capped by the jaws' travel to "
+            "opening.min; limit closing") in out
+    assert main(argv) == 0   # the shipped device's travel holds the 15 %: nothing added
+    assert "mm asked" not in capsys.readouterr().out

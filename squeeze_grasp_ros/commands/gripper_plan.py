@@ -121,6 +121,20 @@ def plot(mesh, plan: GripperPlan, path: str) -> None:
     plots.save(fig, path)
 
 
+def _short(result: dict, c: dict) -> str:
+    """What the planned line adds when candidate ``c``'s closing fell short of the header's
+    (the jaws' travel to ``opening.min`` caps it, or the squeeze ended first), else nothing.
+    """
+    asked = result["relative_closing"] * c["aperture_at_contact"]
+    if c["closing"] >= asked * (1.0 - 1e-9):
+        return ""
+    why = ", capped by the jaws' travel to opening.min" if c["termination"] == "depth_reached" \
+        else ""
+    return (f", closing {1e3 * c['closing']:.2f} mm "
+            f"({100 * c['closing'] / c['aperture_at_contact']:.1f} %) of the {1e3 * asked:.2f} mm "
+            f"asked{why}")
+
+
 def summary(result: dict) -> str:
     """One line per candidate; the evaluated ones with their force, limit and command."""
     lines = [f"{result['scene']}: {result['gripper']}, mu = {result['mu']:g}, closing "
@@ -137,8 +151,8 @@ def summary(result: dict) -> str:
             stop = ("none up to " + f"{1e3 * c['limit_searched_to']:.2f} mm" if limit is None
                     else f"{limit['termination']} at {1e3 * limit['closing']:.2f} mm")
             lines.append(f"        planned: aperture {1e3 * c['aperture_planned']:.2f} mm, jaw "
-                         f"force {c['jaw_force']:.4g} N ({c['termination']}); limit closing "
-                         f"{stop}")
+                         f"force {c['jaw_force']:.4g} N ({c['termination']}){_short(result, c)}; "
+                         f"limit closing {stop}")
             joints = ", ".join(f"{j} {p:.4g}" for j, p in zip(cmd["joints"], cmd["positions"]))
             lines.append(f"        command: {joints}, effort {cmd['efforts'][0]:.4g} "
                          f"(jaw force {cmd['jaw_force']:.4g} N = {c['force_margin']:g} x "

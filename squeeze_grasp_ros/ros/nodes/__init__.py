@@ -80,18 +80,20 @@ SPIN_PERIOD = 0.1
 
 
 class Spinner:
-    """Spins ``executor`` (``node`` on it) in slices of at most ``period`` wall-clock s; call it
+    """Spins ``executor`` (``node`` on it) in slices of about ``period`` wall-clock s; call it
     for one slice.
 
     On ``rclpy.experimental.EventsExecutor`` a slice is one ``spin_until_future_complete`` on a
     future that a ``period`` wall timer on ``node`` completes: events are dispatched in C++ and
     a suspended coroutine (a goal's execute callback awaiting its end) is resumed after each
-    event. Not ``spin_once`` in a loop: in rclpy 7.1.6 each ``spin_once`` first resumes every
-    suspended coroutine, which counts as its one callback, so the loop returned about 90,000
-    times a second for as long as a goal ran (the executor node's thread at 76 % CPU during
-    a hardware-mode goal, against 7 % now; ``test_nodes_spin``). The timeout alone does not end
-    a spin while events keep coming, hence the timer. On rclpy's ``Executor`` classes (they do
-    not resume a suspended coroutine without an event, and their
+    event. The timeout alone does not end a spin while events keep coming, hence the timer; the
+    timeout, two periods, is a guard (at one period it raced the timer, and a slice could end
+    twice a period). Not ``spin_once`` in a loop: in rclpy 7.1.6 each ``spin_once`` first
+    resumes every suspended coroutine, which counts as its one callback, so the loop returned
+    about 90,000 times a second for as long as a goal ran (the executor node's process at
+    100.8 % CPU while a hardware-mode goal waited, against 2.3 % now;
+    ``test_a_waiting_hardware_goal_does_not_make_the_nodes_spin_poll``). On rclpy's
+    ``Executor`` classes (they do not resume a suspended coroutine without an event, and their
     ``spin_until_future_complete`` keeps a done callback per call) a slice is ``spin_once``.
     """
 
@@ -112,7 +114,7 @@ class Spinner:
             self.executor.spin_once(self.period)
             return
         self.wake = Future()
-        self.executor.spin_until_future_complete(self.wake, self.period)
+        self.executor.spin_until_future_complete(self.wake, 2.0 * self.period)
 
 
 def spin_until(executor: Executor, done: Callable[[], bool], timeout: float, *,

@@ -19,6 +19,7 @@ from squeeze_grasp_ros.commands.common import (
     load_setup,
 )
 from squeeze_grasp_ros.mechanics.errors import InvalidInputError
+from squeeze_grasp_ros.mechanics.vocabulary import Termination
 from squeeze_grasp_ros.resources import ResourceError, device_file
 from squeeze_grasp_ros.scene.gripper import GripperSpec, load_gripper
 from squeeze_grasp_ros.scene.gripper_plan import DEFAULT_MARGIN, GripperPlan, scene_gripper_plan
@@ -128,8 +129,8 @@ def _short(result: dict, c: dict) -> str:
     asked = result["relative_closing"] * c["aperture_at_contact"]
     if c["closing"] >= asked * (1.0 - 1e-9):
         return ""
-    why = ", capped by the jaws' travel to opening.min" if c["termination"] == "depth_reached" \
-        else ""
+    why = ", capped by the jaws' travel to opening.min" \
+        if c["termination"] == Termination.DEPTH_REACHED else ""
     return (f", closing {1e3 * c['closing']:.2f} mm "
             f"({100 * c['closing'] / c['aperture_at_contact']:.1f} %) of the {1e3 * asked:.2f} mm "
             f"asked{why}")

@@ -525,11 +525,11 @@ def test_the_loop_spins_once_a_tick_not_once_an_event(tmp_path):
         runner.start()
         runner.send_goal()
         started = time.monotonic()
-        runner.executor = Counted()
+        runner.executor = runner.spinner.executor = Counted()
         run = runner.summary(runner.wait_result())
         wakes = 2 * (time.monotonic() - started) / WAKE_PERIOD + 2
     finally:
-        runner.executor = executor
+        runner.executor = runner.spinner.executor = executor
         runner.shutdown()
     assert run["success"] and run["ticks"] > 50
     assert set(spins) == {"spin_until_future_complete"}

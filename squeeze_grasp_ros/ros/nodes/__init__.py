@@ -75,8 +75,8 @@ DRAIN_SPIN = 0.05
 
 
 SPIN_PERIOD = 0.1
-"""Wall-clock s: the longest one :class:`Spinner` spin lasts (a node started by
-:func:`run_node` checks for its stop between spins)."""
+"""Wall-clock s: the period of a :class:`Spinner`'s wall timer, about how long one of its spins
+lasts (a node started by :func:`run_node` checks for its stop between spins)."""
 
 
 class Spinner:
@@ -84,7 +84,8 @@ class Spinner:
     for one slice.
 
     On ``rclpy.experimental.EventsExecutor`` a slice is one ``spin_until_future_complete`` on a
-    future that a ``period`` wall timer on ``node`` completes: events are dispatched in C++ and
+    future that a ``period`` wall timer on ``node``, or any callback calling :meth:`wake`,
+    completes: events are dispatched in C++ and
     a suspended coroutine (a goal's execute callback awaiting its end) is resumed after each
     event. The timeout alone does not end a spin while events keep coming, hence the timer; the
     timeout, two periods, is a guard (at one period it raced the timer, and a slice could end
@@ -101,20 +102,24 @@ class Spinner:
         from squeeze_grasp_ros.ros.nodes.pipeline import wall_timer  # it imports this module
         self.executor, self.period = executor, period
         self.events = not isinstance(executor, Executor)
-        self.wake = Future()
+        self.slice_end = Future()
+        """Completed to end the current slice."""
         if self.events:
-            wall_timer(node, period, self._wake)
+            wall_timer(node, period, self.wake)
 
-    def _wake(self) -> None:
-        if not self.wake.done():
-            self.wake.set_result(None)
+    def wake(self) -> None:
+        """End the current slice (``EventsExecutor``; a callback that wants its spinner to
+        look at its conditions now).
+        """
+        if not self.slice_end.done():
+            self.slice_end.set_result(None)
 
     def __call__(self) -> None:
         if not self.events:
             self.executor.spin_once(self.period)
             return
-        self.wake = Future()
-        self.executor.spin_until_future_complete(self.wake, 2.0 * self.period)
+        self.slice_end = Future()
+        self.executor.spin_until_future_complete(self.slice_end, 2.0 * self.period)
 
 
 def spin_until(executor: Executor, done: Callable[[], bool], timeout: float, *,
@@ -193,7 +198,7 @@ def run_node(factory: Callable[[], Node], args: list[str] | None = None,
 
     The executor (default ``rclpy.experimental.EventsExecutor``; the planner, whose worker
     threads hand results back through futures, uses ``SingleThreadedExecutor``) is spun in
-    slices of at most :data:`SPIN_PERIOD` by a :class:`Spinner`: in rclpy 7.1.6
+    slices of about :data:`SPIN_PERIOD` by a :class:`Spinner`: in rclpy 7.1.6
     ``EventsExecutor.spin()`` without a timeout holds the GIL at 100 % CPU once a node has a
     timer (measured: no callback runs, no other thread gets the GIL) and does not return after
     shutdown. SIGINT (Ctrl-C, also what ``ros2 launch`` sends first) and

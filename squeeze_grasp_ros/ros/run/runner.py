@@ -44,7 +44,6 @@ from rclpy.logging import LoggingSeverity
 from rclpy.node import Node
 from rclpy.parameter import Parameter
 from rclpy.signals import SignalHandlerOptions
-from rclpy.task import Future
 
 from squeeze_grasp_interfaces.action import ExecuteGrasp
 from squeeze_grasp_interfaces.msg import ContactEventArray, PredictedShapes
@@ -55,7 +54,7 @@ from squeeze_grasp_ros.perception.extract import ObjectOutline
 from squeeze_grasp_ros.planning.typed_objects import typed_scene
 from squeeze_grasp_ros.ros import messages
 from squeeze_grasp_ros.ros.messages.objects import typed_object
-from squeeze_grasp_ros.ros.nodes import pipeline
+from squeeze_grasp_ros.ros.nodes import Spinner, pipeline
 from squeeze_grasp_ros.ros.nodes.planner_client import PlannerClient
 from squeeze_grasp_ros.ros.run.camera_plan import (
     first_outline,
@@ -91,8 +90,8 @@ __all__ = ["EVENTS_PER_CHECK", "STOP_SIGNALS", "WAKE_PERIOD", "PipelineRunner"]
 EVENTS_PER_CHECK = 16
 """Queued events :meth:`PipelineRunner.wait` executes between two checks of its condition."""
 WAKE_PERIOD = 0.05
-"""Wall-clock s: the longest a ``per_tick`` :meth:`PipelineRunner.wait` spins without checking
-its condition."""
+"""Wall-clock s: the period of the wall timer that ends a ``per_tick`` spin of
+:meth:`PipelineRunner.wait`, about the longest it spins without checking its condition."""
 STOP_SIGNALS = (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)
 """Signals that stop a run cleanly (the recording is finished, node processes are stopped)."""
 
@@ -149,12 +148,11 @@ class PipelineRunner:
         """The pipeline nodes built in this process, by name."""
         self.recorder = None
         """The in-process recorder node (with ``record``, without ``processes``)."""
-        self.wake = Future()
-        """Completed to end the current ``per_tick`` spin of :meth:`wait`."""
+        self.spinner = Spinner(self.executor, self.client, WAKE_PERIOD)
+        """The ``per_tick`` spins of :meth:`wait`, each ended by a tick's ground truth, the
+        goal's result or the spinner's :data:`WAKE_PERIOD` wall timer."""
         self.observer = Observer(self.client, progress, kept=not options.attach,
-                                 on_state=self._wake)
-        if self.events_per_check:
-            pipeline.wall_timer(self.client, WAKE_PERIOD, self._wake)
+                                 on_state=self.spinner.wake)
         self.prediction_pub = self.client.create_publisher(
             ContactEventArray, pipeline.PREDICTION, pipeline.LATCHED)
         self.goal = GoalClient(self.client, self.observer.on_feedback)
@@ -178,14 +176,12 @@ class PipelineRunner:
         already taken (a run then waits forever for a lost result).
 
         With ``per_tick`` (the lockstep loop's wait for the goal's result) on
-        ``EventsExecutor``, each spin is one ``spin_until_future_complete`` on :attr:`wake`,
-        which the tick's ground truth (``sim/state``, the client's one delivery a tick), the
-        goal's result or a :data:`WAKE_PERIOD` wall timer completes: the executor dispatches a
-        tick's events in C++, where a ``spin_once`` an event cost about 35 us of CPU of its own
-        (context check, timeout set-up, the call), and the conditions are checked once a tick.
-        The spin's timeout does not end it while events keep coming (hence the timer), but it
-        must be given: without one rclpy 7.1.5's spin runs no timer callback and never returns
-        once a node has a timer.
+        ``EventsExecutor``, each spin is one slice of :attr:`spinner`
+        (:class:`~squeeze_grasp_ros.ros.nodes.Spinner`), which the tick's ground truth
+        (``sim/state``, the client's one delivery a tick), the goal's result or its
+        :data:`WAKE_PERIOD` wall timer ends: the executor dispatches a tick's events in C++,
+        where a ``spin_once`` an event cost about 35 us of CPU of its own (context check,
+        timeout set-up, the call), and the conditions are checked once a tick.
         """
         deadline = time.monotonic() + timeout
         while not done():
@@ -198,19 +194,11 @@ class PipelineRunner:
             if self.graph is not None and self.graph.due():
                 self.graph.check()
             if per_tick and self.events_per_check:
-                self.wake = Future()
-                self.executor.spin_until_future_complete(self.wake, WAKE_PERIOD)
+                self.spinner()
             else:
                 self.executor.spin_once(0.05)
                 for _ in range(self.events_per_check):
                     self.executor.spin_once(0.0)
-
-    def _wake(self) -> None:
-        """End a :meth:`wait` ``per_tick`` spin (a tick's ground truth or the goal's result
-        arrived, or a :data:`WAKE_PERIOD` passed).
-        """
-        if not self.wake.done():
-            self.wake.set_result(None)
 
     def spin_until(self, done: Callable[[], bool], timeout: float, what: str, *,
                    per_tick: bool = False) -> None:
@@ -405,7 +393,7 @@ class PipelineRunner:
         reports the goal finished but the result response does not come within a few seconds
         (lost across processes), the result is requested again.
         """
-        self.goal.result_future.add_done_callback(lambda _: self._wake())
+        self.goal.result_future.add_done_callback(lambda _: self.spinner.wake())
         result = self.goal.result(functools.partial(self.spin_until, per_tick=True),
                                   self.options.timeout,
                                   (lambda: False) if self.joint_feedback

@@ -84,12 +84,16 @@ def place_fingertip(mesh: Mesh, name: str, node: int, radius: float | TipShape,
     ``node``.
 
     A circle without ``facing`` sits on the outward normal at ``node`` (the paper's
-    placement). A pad (or a tip given ``facing``, the angle in rad of the direction it faces,
-    into the object) faces the inward normal at ``node`` (or ``facing``) and approaches the
-    object along that direction until its face first touches the outer boundary, at ``node``
-    when the boundary allows (a pad set square on a convex side), else at the node it meets
-    first, which becomes the initial contact; every other node then touching is in
-    :attr:`Fingertip.touching`. With ``origin`` (x, y), m, the tip's reference point starts
+    placement) where it overlaps no other boundary node. A pad (or a tip given ``facing``, the
+    angle in rad of the direction it faces, into the object), and a circle whose paper
+    placement would overlap the object (a concave stretch of the boundary more tightly curved
+    than the tip: the tip cannot reach ``node`` along its normal), faces the inward normal at
+    ``node`` (or ``facing``) and approaches the object along that direction until its face
+    first touches the outer boundary, at ``node`` when the boundary allows (a pad set square on
+    a convex side), else at the node it meets first, which becomes the initial contact; every
+    other node then touching is in :attr:`Fingertip.touching`. Either way no boundary node
+    starts inside the tip (by more than TOUCH_TOLERANCE of the object size), so the squeeze
+    starts from zero force. With ``origin`` (x, y), m, the tip's reference point starts
     there (a gripper jaw on its closing line, clear of the object) instead of on ``node``.
 
     Raises
@@ -110,8 +114,18 @@ def place_fingertip(mesh: Mesh, name: str, node: int, radius: float | TipShape,
     p = mesh.nodes[int(node)]
     theta0 = float(np.arctan2(-n[1], -n[0])) if facing is None else float(facing)
     if shape.kind == TipKind.CIRCLE and facing is None:
-        return Fingertip(name, int(node), p + r * n, float(r), theta0, facing=theta0)
+        if not _overlaps(mesh, shape, theta0, p + r * n):
+            return Fingertip(name, int(node), p + r * n, float(r), theta0, facing=theta0)
+        origin = None
     return _approach(mesh, name, int(node), shape, theta0, origin)
+
+
+def _overlaps(mesh: Mesh, shape: TipShape, theta0: float, center: np.ndarray) -> bool:
+    """Whether a boundary node lies inside the tip at ``center`` by more than TOUCH_TOLERANCE
+    of the object size.
+    """
+    gaps = TipGeometry.of([shape], [theta0]).gaps(mesh.nodes[mesh.boundary], center[None])
+    return bool(gaps.min() < -TOUCH_TOLERANCE * float(np.ptp(mesh.nodes, axis=0).max()))
 
 
 def _approach(mesh: Mesh, name: str, node: int, shape: TipShape, theta0: float,

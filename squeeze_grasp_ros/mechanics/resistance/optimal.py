@@ -379,6 +379,12 @@ unbounded work. Fig. 9 pushes 0.09 L, Fig. 10 0.05 L."""
 MAX_DIRECTIONS = 100_000
 """Most push directions of :func:`sweep_directions` (0.0036 degrees apart; a few MB)."""
 
+EXTREME_TIE = 1e-12
+"""Relative difference in W*_F under which two push directions tie for the easiest or the
+hardest (:meth:`ResistanceSweep.extremes` takes the first, the smallest angle): W*_F of fixed
+contacts is even in a, so each extreme is reached at a direction and its opposite, equal to
+round-off (1.5e-15 relative on Fig. 9's grasp), and the arithmetic of the machine picked one."""
+
 
 MIN_RELATIVE_PUSH = 1e-100
 """Shortest adversary translation |a| a resistance accepts, relative to the object size L, also
@@ -738,11 +744,15 @@ class ResistanceSweep:
     feasible: np.ndarray
 
     def extremes(self) -> dict:
-        """Easiest and hardest feasible push directions with their W*_F (J/m^2), and the mean."""
+        """Easiest and hardest feasible push directions with their W*_F (J/m^2), and the mean;
+        of directions within :data:`EXTREME_TIE` of an extreme, the first.
+        """
         if not np.any(self.feasible):
             return {"min": None, "max": None, "mean": None}
         w = np.where(self.feasible, self.unit_work, np.nan)
-        lo, hi = int(np.nanargmin(w)), int(np.nanargmax(w))
+        least, most = np.nanmin(w), np.nanmax(w)
+        lo = int(np.flatnonzero(w <= least + EXTREME_TIE * abs(least))[0])
+        hi = int(np.flatnonzero(w >= most - EXTREME_TIE * abs(most))[0])
         return {
             "min": {"angle_deg": float(np.degrees(self.angles[lo])), "unit_work": float(w[lo])},
             "max": {"angle_deg": float(np.degrees(self.angles[hi])), "unit_work": float(w[hi])},

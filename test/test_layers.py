@@ -37,8 +37,8 @@ LAYERS: tuple[tuple[str, ...], ...] = (
     ("ros",),
     ("commands", "bench", "cli", "entry"),
 )
-MECHANICS_ORDER: dict[str, int] = {"vocabulary": 0, "errors": 0, "elastic": 1, "squeeze": 2,
-                                   "resistance": 3, "ring": 3, "calibration": 1}
+MECHANICS_ORDER: dict[str, int] = {"vocabulary": 0, "errors": 0, "ties": 0, "elastic": 1,
+                                   "squeeze": 2, "resistance": 3, "ring": 3, "calibration": 1}
 """Rank of each part of ``mechanics``: a part imports only parts of lower rank (and itself);
 calibration imports nothing but the base parts."""
 

@@ -334,3 +334,20 @@ def test_squeeze_reports_name_their_measures(tmp_path, capfd):
     assert main(["squeeze", str(path), "--relative-depth", "0.02", "--compare-models"]) == 0
     text = capfd.readouterr().out
     assert "like for like" in text and "max Biot strain" in text
+
+
+def test_a_symmetric_squeeze_names_the_first_of_its_mirror_twins():
+    """The foam square squeezed symmetrically displaces two mirror nodes equally to round-off
+    (1e-16 relative), which np.argmax would choose between by the machine's arithmetic: the
+    grasp health names the first of them, and the largest strain's element is the first within
+    the tie of the largest.
+    """
+    scene = load_scene(scene_file("foam_square"))
+    result = event_squeeze_scene(scene, scene_solid(scene))
+    norms = np.hypot(*result.displacement.T)
+    twins = np.flatnonzero(norms >= norms.max() * (1 - 1e-12))
+    assert len(twins) == 2 and np.ptp(norms[twins]) <= 1e-15 * norms.max()
+    assert result.health.max_displacement_node == twins[0]
+    assert result.health.max_displacement == pytest.approx(norms.max(), rel=1e-15)
+    pair = np.array([[3.0, -1.0], [2.0, 3.0 * (1 + 1e-15)], [3.0, 0.0]])
+    assert largest_pair_entry(pair) == (3.0 * (1 + 1e-15), 0)

@@ -29,6 +29,7 @@ import numpy as np
 from squeeze_grasp_ros.mechanics.elastic.fem import principal_pair
 from squeeze_grasp_ros.mechanics.elastic.fem import principal_strains as voigt_principal
 from squeeze_grasp_ros.mechanics.errors import InvalidInputError
+from squeeze_grasp_ros.mechanics.ties import first_max
 from squeeze_grasp_ros.mechanics.vocabulary import StrainMeasure
 
 __all__ = ["COMMON_STRAIN_MEASURE", "largest_pair_entry", "max_principal_strain",
@@ -111,12 +112,13 @@ def principal_strains(F: np.ndarray, measure: StrainMeasure | str) -> np.ndarray
 
 
 def largest_pair_entry(pair: np.ndarray) -> tuple[float, int]:
-    """(largest |entry| of ``pair`` (t, 2), its row): max(|a|, |b|) of the first row where it
-    is largest (a NaN wins, as in argmax), in one pass over the entries in row order.
+    """(largest |entry| of ``pair`` (t, 2), its row): the largest max(|a|, |b|) (a NaN wins,
+    as in argmax) and the first row where it is reached to
+    :data:`~squeeze_grasp_ros.mechanics.ties.TIE` (of two mirror twins, the same on every
+    machine).
     """
     magnitude = np.abs(pair).reshape(-1)
-    i = int(magnitude.argmax())
-    return float(magnitude[i]), i // 2
+    return float(magnitude[magnitude.argmax()]), first_max(magnitude) // 2
 
 
 def max_principal_strain(F: np.ndarray, measure: StrainMeasure | str) -> tuple[float, int]:

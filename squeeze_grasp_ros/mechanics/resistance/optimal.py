@@ -59,6 +59,7 @@ from squeeze_grasp_ros.mechanics.resistance.forms import (
     stable_form,
 )
 from squeeze_grasp_ros.mechanics.squeeze.contact_state import event_counts
+from squeeze_grasp_ros.mechanics.ties import first_max, first_min
 from squeeze_grasp_ros.mechanics.vocabulary import ContactKind, ContactMode, Finger, SqueezeKind
 
 FEASIBILITY_TOL = 1e-7
@@ -378,12 +379,6 @@ unbounded work. Fig. 9 pushes 0.09 L, Fig. 10 0.05 L."""
 
 MAX_DIRECTIONS = 100_000
 """Most push directions of :func:`sweep_directions` (0.0036 degrees apart; a few MB)."""
-
-EXTREME_TIE = 1e-12
-"""Relative difference in W*_F under which two push directions tie for the easiest or the
-hardest (:meth:`ResistanceSweep.extremes` takes the first, the smallest angle): W*_F of fixed
-contacts is even in a, so each extreme is reached at a direction and its opposite, equal to
-round-off (1.5e-15 relative on Fig. 9's grasp), and the arithmetic of the machine picked one."""
 
 
 MIN_RELATIVE_PUSH = 1e-100
@@ -744,15 +739,17 @@ class ResistanceSweep:
     feasible: np.ndarray
 
     def extremes(self) -> dict:
-        """Easiest and hardest feasible push directions with their W*_F (J/m^2), and the mean;
-        of directions within :data:`EXTREME_TIE` of an extreme, the first.
+        """Easiest and hardest feasible push directions with their W*_F (J/m^2), and the mean.
+
+        W*_F of fixed contacts is even in a: each extreme is reached at a direction and its
+        opposite, equal to round-off, and the first of them (the smaller angle) is named
+        (:mod:`~squeeze_grasp_ros.mechanics.ties`).
         """
         if not np.any(self.feasible):
             return {"min": None, "max": None, "mean": None}
         w = np.where(self.feasible, self.unit_work, np.nan)
-        least, most = np.nanmin(w), np.nanmax(w)
-        lo = int(np.flatnonzero(w <= least + EXTREME_TIE * abs(least))[0])
-        hi = int(np.flatnonzero(w >= most - EXTREME_TIE * abs(most))[0])
+        lo = first_min(np.where(self.feasible, self.unit_work, np.inf))
+        hi = first_max(np.where(self.feasible, self.unit_work, -np.inf))
         return {
             "min": {"angle_deg": float(np.degrees(self.angles[lo])), "unit_work": float(w[lo])},
             "max": {"angle_deg": float(np.degrees(self.angles[hi])), "unit_work": float(w[hi])},

@@ -37,6 +37,7 @@ from squeeze_grasp_ros.mechanics.elastic.reduced import reduce_blocks
 from squeeze_grasp_ros.mechanics.errors import InvalidInputError, node_indices, require_finite
 from squeeze_grasp_ros.mechanics.ring.model import FIBRE_STRAIN_MEASURE, RingModel
 from squeeze_grasp_ros.mechanics.squeeze.stable_pure import two_contact_direction
+from squeeze_grasp_ros.mechanics.ties import first_max
 from squeeze_grasp_ros.mechanics.vocabulary import SQUEEZING_FINGERS, RingLimit, SqueezeKind
 
 LIMITS: tuple[RingLimit, ...] = tuple(RingLimit)
@@ -372,7 +373,7 @@ class RingGrasp:
             "forces": {f: forces[k].tolist() for k, f in enumerate(SQUEEZING_FINGERS)},
             "stiffness": self.stiffness,
             "max_strain": self.max_strain_at(depth),
-            "max_strain_element": int(np.argmax(self.strains)),
+            "max_strain_element": first_max(self.strains),
             "cone_half_angle_deg": float(np.degrees(np.arctan(self.mu))),
             "force_angle_deg": {f: [float(at0[k]), float(at_depth[k])]
                                 for k, f in enumerate(SQUEEZING_FINGERS)},

@@ -51,6 +51,7 @@ from squeeze_grasp_ros.mechanics.squeeze.nonlinear_model import (
 from squeeze_grasp_ros.mechanics.squeeze.stable_pure import finger_motion
 from squeeze_grasp_ros.mechanics.squeeze.stepper import TERMINATION_ORDER, advance
 from squeeze_grasp_ros.mechanics.squeeze.tip_shapes import TipShape
+from squeeze_grasp_ros.mechanics.ties import first_max
 from squeeze_grasp_ros.mechanics.vocabulary import (
     SQUEEZING_FINGERS,
     ContactMode,
@@ -457,7 +458,7 @@ def _health(model: ContactModel, state: ContactState,
     for c, n in zip(state.contacts, summaries):
         margins.setdefault(c.finger, []).append(n.slip_margin)
     max_principal = max_principal_strains(deformation)
-    k_vm, k_u = int(vm.argmax()), int(norms.argmax())
+    k_vm, k_u = first_max(vm), first_max(norms)  # a mirror twin: the first, on any machine
     health = GraspHealth(
         max_strain=strain,
         max_strain_element=element,

@@ -7,6 +7,7 @@ integrated work and final forces must equal the fixed-segment linear model with 
 forces as preload: W_F = d1 . F1_0 + d2 . F2_0 + 1/2 (d1, d2, 0) . G (d1, d2, a).
 """
 
+import dataclasses
 import json
 
 import numpy as np
@@ -19,6 +20,7 @@ from squeeze_grasp_ros.mechanics.elastic.material import Material
 from squeeze_grasp_ros.mechanics.elastic.mesh import generate_mesh
 from squeeze_grasp_ros.mechanics.errors import InvalidInputError
 from squeeze_grasp_ros.mechanics.resistance.frictional import (
+    _outcome,
     add_adversary,
     frictional_resistance,
     slipping_fingers,
@@ -26,7 +28,7 @@ from squeeze_grasp_ros.mechanics.resistance.frictional import (
 from squeeze_grasp_ros.mechanics.resistance.optimal import evaluate_resistance, resistance_grasp
 from squeeze_grasp_ros.mechanics.squeeze.contact_model import ContactModel
 from squeeze_grasp_ros.mechanics.squeeze.events import event_squeeze
-from squeeze_grasp_ros.mechanics.vocabulary import Finger
+from squeeze_grasp_ros.mechanics.vocabulary import Finger, Termination
 
 
 @pytest.fixture(scope="module")
@@ -94,6 +96,26 @@ def test_large_push_makes_a_grasping_finger_slip(squeezed_disk):
     json.dumps(out, allow_nan=False)
     assert out["contacts"] == list(contacts)
     assert [e["travel"] for e in out["events"]] == sorted(e["travel"] for e in out["events"])
+
+
+def test_both_grasping_fingers_slipping_are_both_named(squeezed_disk):
+    """A finger_slip where F1 and F2 both slide (every contact of each the same way) names
+    both; one finger sliding names that one (before, the reason always named the first).
+    """
+    model, state, contacts = squeezed_disk
+    res = frictional_resistance(model, state, (0.0, 0.004), mode="stable", contacts=contacts)
+
+    def sliding(fingers):
+        """res.state with the contacts of ``fingers`` sliding (+1), F1's and F2's others stuck."""
+        return dataclasses.replace(res.state, contacts=tuple(
+            dataclasses.replace(c, mode="slip", slip=1) if c.finger in fingers
+            else dataclasses.replace(c, mode="stick", slip=0) if c.finger in ("F1", "F2")
+            else c for c in res.state.contacts))
+
+    both = sliding({"F1", "F2"})
+    assert slipping_fingers(both) == ["F1", "F2"]
+    assert _outcome(Termination.FINGER_SLIP, both) == (False, "F1 and F2 slip")
+    assert _outcome(Termination.FINGER_SLIP, sliding({"F2"})) == (False, "F2 slips")
 
 
 def test_oblique_push_outside_the_adversary_cone_slips_at_once(squeezed_disk):

@@ -103,7 +103,8 @@ class FrictionalResistance:
     success : bool
         A completed a, or A slipped, while F1 and F2 held.
     reason : str
-        "adversary completed a", "adversary slips", "F1 slips", "F2 slips", or a lost contact.
+        "adversary completed a", "adversary slips", "F1 slips", "F2 slips", "F1 and F2 slip"
+        (both at once), or a lost contact.
     mode : SqueezeKind
         How each stage's directions were chosen (stable or pure).
     contacts : list of int
@@ -271,6 +272,8 @@ def _outcome(termination: str | None, state: ContactState) -> tuple[bool, str] |
         slipping = slipping_fingers(state)
         if Finger.A in slipping:
             return True, "adversary slips"
+        if len(slipping) > 1:
+            return False, f"{' and '.join(slipping)} slip"
         return False, f"{slipping[0] if slipping else 'a grasping finger'} slips"
     if termination == Termination.CONTACT_LOST:
         finger = _lost_finger(state)

@@ -16,11 +16,22 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["TIE", "first_max", "first_min"]
+__all__ = ["TIE", "first_max", "first_min", "first_tied"]
 
 TIE = 1e-12
 """Relative difference under which two values tie for an extreme: far above round-off (twins
 differ by 1e-16-1e-15), far below any difference the mechanics resolves."""
+
+
+def first_tied(values: np.ndarray, k: int) -> int:
+    """Index of the first entry within :data:`TIE` (relative) below ``values[k]``, the largest
+    entry of the flat array ``values`` (its ``np.argmax``, which a caller that needs the value
+    has already found); ``k`` itself when that entry is a NaN or infinite.
+    """
+    top = values[k]
+    if not np.isfinite(top):
+        return int(k)
+    return int(np.argmax(values >= top - TIE * abs(top)))  # the first True
 
 
 def first_max(values) -> int:
@@ -28,11 +39,7 @@ def first_max(values) -> int:
     infinite largest entry is returned as ``np.argmax`` returns it (the first NaN wins).
     """
     v = np.asarray(values, float).reshape(-1)
-    k = int(np.argmax(v))
-    top = v[k]
-    if not np.isfinite(top):
-        return k
-    return int(np.argmax(v >= top - TIE * abs(top)))  # the first True
+    return first_tied(v, int(np.argmax(v)))
 
 
 def first_min(values) -> int:

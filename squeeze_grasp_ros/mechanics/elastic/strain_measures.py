@@ -29,7 +29,7 @@ import numpy as np
 from squeeze_grasp_ros.mechanics.elastic.fem import principal_pair
 from squeeze_grasp_ros.mechanics.elastic.fem import principal_strains as voigt_principal
 from squeeze_grasp_ros.mechanics.errors import InvalidInputError
-from squeeze_grasp_ros.mechanics.ties import first_max
+from squeeze_grasp_ros.mechanics.ties import first_tied
 from squeeze_grasp_ros.mechanics.vocabulary import StrainMeasure
 
 __all__ = ["COMMON_STRAIN_MEASURE", "largest_pair_entry", "max_principal_strain",
@@ -118,7 +118,8 @@ def largest_pair_entry(pair: np.ndarray) -> tuple[float, int]:
     machine).
     """
     magnitude = np.abs(pair).reshape(-1)
-    return float(magnitude[magnitude.argmax()]), first_max(magnitude) // 2
+    k = int(magnitude.argmax())
+    return float(magnitude[k]), first_tied(magnitude, k) // 2
 
 
 def max_principal_strain(F: np.ndarray, measure: StrainMeasure | str) -> tuple[float, int]:

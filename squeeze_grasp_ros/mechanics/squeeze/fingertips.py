@@ -147,8 +147,7 @@ def _approach(mesh: Mesh, name: str, node: int, shape: TipShape, theta0: float,
     center = center + advance * e0
     tips = TipGeometry.of([shape], [theta0])
     gaps = tips.gaps(mesh.nodes[boundary], center[None])[:, 0]
-    size = float(np.ptp(mesh.nodes, axis=0).max())
-    touching = boundary[gaps <= TOUCH_TOLERANCE * size].tolist()
+    touching = boundary[gaps <= TOUCH_TOLERANCE * mesh.size].tolist()
     start = node if node in touching else int(boundary[first])
 
     def coordinate(k: int) -> float:

@@ -62,6 +62,10 @@ MIN_AREA_RATIO = 1e-8
 accepted state keeps a margin above det F = 0, where assembly refuses the state."""
 MAX_ITERATIONS = 25
 MAX_SUBSTEPS = 64
+"""Newton solves an evaluation may make, the load sub-stepping's included. A failed solve
+halves the increment, which never grows again: once the solves left cannot add up to the rest
+of the contact displacement, the evaluation fails with that solve's failure at once (more
+halvings would spend Newton solves on a sure failure)."""
 KEPT_STATES = 4
 """Evaluated states a response keeps (with their tangents): the stepper returns to
 points it solved while locating an event, and an evaluation at a kept delta is a look-up."""
@@ -74,6 +78,15 @@ model) or for Newton's first factorisation (KNOWN_START). A node that touched a 
 event tolerance moves the field by 1e-10 to 3e-8 of it."""
 REUSE_CONTRACTION = 0.25
 BACKTRACKS = 30
+FRESH_BACKTRACKS = 16
+"""Halvings of a step from a tangent factorised in this solve before the line search gives up
+(BACKTRACKS for the step of a factorisation held from another state). A Newton step of the
+state's own tangent whose residual falls only below 2^-16 of its length is stalling at a
+minimum of the residual norm that is no equilibrium: its failure then costs 16 force assemblies
+instead of 30, and the iterations that would creep on toward it are not spent. No converged
+solve of 1,598 random hard squeezes (corotational and neo-Hookean: five shapes, friction to 1.5,
+tips of 0.5 % to 30 % of the object, pads, depths to 25 %) took more than 12 halvings of such
+a step."""
 
 
 def _others(n: int, dofs: np.ndarray) -> np.ndarray:
@@ -349,7 +362,7 @@ class ContactResponse:
                 return ResponseFailure("the interior tangent is singular", norm / scale)
             its += 1
             inverted = True
-            for _ in range(BACKTRACKS):
+            for _ in range(FRESH_BACKTRACKS if fresh else BACKTRACKS):
                 trial = u.copy()
                 trial[self.free] += step
                 F = self._upright(trial)
@@ -391,13 +404,13 @@ class ContactResponse:
         target, done, its = delta, 0.0, 0
         fraction = 1.0
         result = None
-        for _ in range(MAX_SUBSTEPS):
+        for k in range(MAX_SUBSTEPS):
             goal = base_d + (done + fraction) * (target - base_d)
             out = self._newton(base_u if result is None else result[0], goal)
             if isinstance(out, ResponseFailure):
                 fraction *= 0.5
                 self.stats["substeps"] += 1
-                if fraction < 1e-6:
+                if fraction < 1e-6 or done + (MAX_SUBSTEPS - 1 - k) * fraction < 1.0 - 1e-12:
                     return out
                 continue
             result = out

@@ -419,7 +419,10 @@ def attempt_fixed_set(
     response : callable
         The set's elastic response: contact displacements delta (m, 2) -> (forces F (m, 2),
         tangent dF/d delta (2m, 2m)), or a :class:`SolveFailure` (:meth:`ContactModel.response`).
-        An attribute ``tolerance`` (relative accuracy of F) loosens the cone tolerance to it.
+        An attribute ``tolerance`` (relative accuracy of F) loosens the cone tolerance to it;
+        an attribute ``stall_halvings`` (a response whose every evaluation is an equilibrium
+        solve) ends the solve once a Newton step has been halved that many times: the failure
+        of the last trial, or a stall when the trials were solved but none lowered the residual.
     cfg : Configuration
         Modes and geometry.
     centers : (m, 2) ndarray
@@ -463,6 +466,7 @@ def attempt_fixed_set(
         return F
     force_scale = max(stiffness_scale(C) * float(r.max()), 1e-300)
     tol = max(NEWTON_TOL, getattr(response, "tolerance", 0.0))
+    stall = getattr(response, "stall_halvings", NEWTON_BACKTRACKS)
     it, residual, cond = 0, 0.0, 1.0
     J = np.zeros((0, 0))
     R = cone_residual(theta, F)
@@ -486,18 +490,21 @@ def attempt_fixed_set(
         except np.linalg.LinAlgError:
             return SolveFailure(SINGULAR_SLIDING, residual, indeterminate=True)
         it += 1
-        for _ in range(NEWTON_BACKTRACKS):
+        for halvings in range(NEWTON_BACKTRACKS):
             trial = theta.copy()
             trial[P] -= step
             t_delta, t_F, t_C = forces(trial)
             if isinstance(t_F, SolveFailure):
-                if np.abs(step).max() < NEWTON_TOL:
+                if np.abs(step).max() < NEWTON_TOL or halvings >= stall:
                     return t_F
                 step = 0.5 * step
                 continue
             t_R = cone_residual(trial, t_F)
             if np.abs(t_R).max() < residual or np.abs(step).max() < NEWTON_TOL:
                 break
+            if halvings >= stall:
+                return SolveFailure(f"Newton on the sliding angles stalled: {stall} halvings of "
+                                    f"its step did not lower the cone residual", residual)
             step = 0.5 * step
         if isinstance(t_F, SolveFailure):
             return t_F

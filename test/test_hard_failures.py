@@ -1,0 +1,212 @@
+# Copyright 2026 squeeze_grasp_ros developers
+# SPDX-License-Identifier: Apache-2.0
+"""Solves that cannot succeed end in bounded work: the nonlinear response's load sub-stepping,
+its line search on a tangent of its own, and the Newton on the sliding angles over an
+equilibrium solve each stop once going on cannot help, and a hard squeeze that has no
+equilibrium ahead fails with its depth after a bounded number of force assemblies.
+"""
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+import pytest
+
+from squeeze_grasp_ros.api import load_scene, scene_file, scene_solid
+from squeeze_grasp_ros.mechanics.elastic import contact_response as cr
+from squeeze_grasp_ros.mechanics.elastic import shapes
+from squeeze_grasp_ros.mechanics.elastic.mesh import generate_mesh
+from squeeze_grasp_ros.mechanics.errors import NumericalError
+from squeeze_grasp_ros.mechanics.squeeze.contact_model import (
+    NEWTON_BACKTRACKS,
+    Configuration,
+    LinearResponse,
+    SolveFailure,
+    attempt_fixed_set,
+)
+from squeeze_grasp_ros.mechanics.squeeze.events import event_squeeze
+from squeeze_grasp_ros.mechanics.squeeze.nonlinear_model import STALL_HALVINGS
+from squeeze_grasp_ros.mechanics.squeeze.tip_shapes import TipGeometry
+from squeeze_grasp_ros.mechanics.vocabulary import MaterialModel
+
+
+@pytest.fixture(scope="module")
+def response_and_target():
+    """A neo-Hookean response of a 0.1 x 0.06 m rectangle held at two nodes each side, and a
+    2 % squeeze of it (contact displacements / L).
+    """
+    mesh = generate_mesh(shapes.rectangle(0.1, 0.06), 4e-4, min_angle=25.0)
+    left, right = np.argsort(mesh.nodes[:, 0])[:2], np.argsort(-mesh.nodes[:, 0])[:2]
+    target = np.zeros((4, 2))
+    target[:2, 0], target[2:, 0] = 0.01, -0.01
+
+    def fresh():
+        return cr.ContactResponse(MaterialModel.NEO_HOOKEAN, mesh.nodes / 0.1, mesh.triangles,
+                                  np.r_[left, right], 0.3)
+    return fresh, target
+
+
+def _reach_limited(response, limit: float) -> list[bool]:
+    """Make ``response``'s Newton fail whenever its goal is more than ``limit`` of the whole
+    load beyond the last contact displacement it reached; the outcome of every call, in order.
+    """
+    real, outcomes = response._newton, []
+    reached = [response._delta.copy()]
+
+    def newton(u, delta):
+        whole = np.abs(TARGET - BASE).max()
+        if np.abs(delta - reached[-1]).max() > limit * whole * (1 + 1e-12):
+            outcomes.append(False)
+            return cr.ResponseFailure("beyond the test's reach", 1.0)
+        out = real(u, delta)
+        outcomes.append(not isinstance(out, cr.ResponseFailure))
+        reached.append(delta.copy())
+        return out
+    response._newton = newton
+    return outcomes
+
+
+TARGET = BASE = None
+
+
+@pytest.mark.parametrize("limit, halvings, succeeds", [
+    (1.0, 0, True), (0.3, 2, True), (0.04, 5, True),
+    # 1/64 of the load a substep would need 64 substeps after 6 failures: more than MAX_SUBSTEPS
+    (1 / 60, 6, False), (1e-9, 6, False)])
+def test_load_sub_stepping_stops_once_the_rest_of_the_load_is_out_of_reach(
+        response_and_target, limit, halvings, succeeds):
+    """The increment halves at each failed Newton and never grows again, and a call has at most
+    MAX_SUBSTEPS Newton solves: once those left cannot add up to the rest of the load, the
+    evaluation fails with its last Newton failure. Before, it halved on to 1e-6 of the load (20
+    failures) or marched 1/128 of the load until the solves ran out (64 solves), each failure a
+    Newton that had used its iterations.
+    """
+    global TARGET, BASE
+    fresh, target = response_and_target
+    response = fresh()
+    TARGET, BASE = target, response._delta.copy()
+    outcomes = _reach_limited(response, limit)
+    out = response.evaluate(target)
+    assert outcomes.count(False) == halvings == response.stats["substeps"]
+    assert len(outcomes) <= cr.MAX_SUBSTEPS
+    if succeeds:
+        assert isinstance(out, cr.Evaluation)
+        assert outcomes.count(True) == 2 ** halvings
+        whole = fresh().evaluate(target)  # the same equilibrium as one step
+        assert np.abs(out.F - whole.F).max() <= 1e-8 * np.abs(whole.F).max()
+    else:
+        assert isinstance(out, cr.ResponseFailure) and out.reason == "beyond the test's reach"
+        assert not any(outcomes)
+
+
+def _sliding_problem():
+    """A two-node contact set, one node sliding, whose sliding angle is off its solution: the
+    Newton on the sliding angles must take a step (response, configuration, centres,
+    directions, initial angles, friction angle).
+    """
+    C = np.array([[3.0, 0.2, -1.0, 0.0], [0.2, 2.0, 0.0, -0.5],
+                  [-1.0, 0.0, 3.0, 0.1], [0.0, -0.5, 0.1, 2.5]])
+    tip = TipGeometry(np.array([0.1, 0.1]), np.zeros(2), np.array([0.0, np.pi]))
+    centers = np.array([[-0.2, 0.0], [0.2, 0.0]])
+    theta = np.array([0.0, np.pi])
+    p0 = centers + tip.offset(theta) + np.array([[-0.01, 0.003], [0.012, -0.002]])
+    cfg = Configuration(p0, np.array([True, False]), np.array([0, 1]), tip)
+    return LinearResponse(C), cfg, centers, np.array([[1.0, 0.0], [-1.0, 0.0]]), \
+        theta + np.array([0.0, 0.3]), float(np.arctan(0.5))
+
+
+class _Counted:
+    """A response that answers at the initial angles and, elsewhere, ``elsewhere(F, C)``;
+    ``stall_halvings`` as a nonlinear model's response declares it (None: not declared).
+    """
+
+    def __init__(self, linear, start_delta, elsewhere, stall_halvings):
+        self.linear, self.start, self.elsewhere, self.calls = linear, start_delta, elsewhere, 0
+        if stall_halvings is not None:
+            self.stall_halvings = stall_halvings
+
+    def __call__(self, delta):
+        self.calls += 1
+        F, C = self.linear(delta)
+        return (F, C) if np.array_equal(delta, self.start) else self.elsewhere(F, C)
+
+
+@pytest.mark.parametrize("declared", [STALL_HALVINGS, None])
+@pytest.mark.parametrize("trial", ["fails", "no_lower"])
+def test_the_sliding_newton_over_equilibrium_solves_stops_after_its_stall_halvings(
+        declared, trial):
+    """Every trial step of the Newton on the sliding angles costs one response evaluation,
+    for the nonlinear models an equilibrium solve of the whole object. A response that declares
+    ``stall_halvings`` ends the solve after that many halvings of a step: with the failure of
+    the last trial when every trial failed, or as a stall when the trials were solved but none
+    lowered the cone residual. Without it (the linear model: a trial is a matrix product) the
+    line search keeps its 30 halvings.
+    """
+    linear, cfg, centers, dirs, theta0, phi = _sliding_problem()
+    start = centers + cfg.tip.offset(theta0) - cfg.p0
+    failure = SolveFailure("the test's equilibrium cannot be found", 1.0)
+    # off the start, a force across the sliding node's cone edge, 1,000 times the start's: no
+    # trial angle near the start lowers the cone residual
+    edge = cfg.tip.normal_angle(theta0)[1] - cfg.slip[1] * phi
+    across = 1e3 * np.abs(linear(start)[0]).max() * np.array([-np.sin(edge), np.cos(edge)])
+    elsewhere = {"fails": lambda F, C: failure,
+                 "no_lower": lambda F, C: (np.array([F[0], across]), C)}[trial]
+    response = _Counted(linear, start, elsewhere, declared)
+    out = attempt_fixed_set(response, cfg, centers, dirs, theta0, phi)
+    if declared is None:  # the linear model's line search: to 30 halvings or a 1e-14 rad step
+        assert response.calls > 1 + 1 + STALL_HALVINGS
+        assert response.calls >= 1 + NEWTON_BACKTRACKS or trial == "fails"
+        return
+    assert isinstance(out, SolveFailure)
+    assert response.calls == 1 + 1 + declared  # the start, then trials at 2^0 ... 2^-declared
+    if trial == "fails":
+        assert out is failure
+    else:
+        assert out.reason.startswith(f"Newton on the sliding angles stalled: {declared} halvings")
+
+
+@pytest.mark.slow
+def test_a_squeeze_with_no_equilibrium_ahead_fails_in_bounded_work(monkeypatch):
+    """The corotational blob squeezed from node 57 against node 4 at mu = 1.5 with 12 mm tips
+    (found by a random campaign of hard squeezes): beyond 17 % of the depth its contact set has
+    no equilibrium the solver can reach. The squeeze fails with its depth and reason, in 20,980
+    force assemblies (2026-11-29); before these bounds it spent 145,221 (about two minutes).
+    """
+    assemblies = [0]
+    real = cr.ContactResponse._assemble
+
+    def counted(self, *args, **kwargs):
+        assemblies[0] += 1
+        return real(self, *args, **kwargs)
+    monkeypatch.setattr(cr.ContactResponse, "_assemble", counted)
+    obj = scene_solid(load_scene(scene_file("nonconvex_blob")))
+    with pytest.raises(NumericalError, match=r"failed near depth 0\.0207\d* m"):
+        event_squeeze(obj, (57, 4), 0.012047076053241505, 1.5, kind="stable",
+                      relative_depth=0.25, material_model="corotational")
+    assert assemblies[0] < 30_000
+
+
+def test_a_line_search_on_the_state_s_own_tangent_gives_up_after_its_halvings(
+        response_and_target, monkeypatch):
+    """A Newton step of a tangent factorised in this solve that lowers the residual only below
+    2^-FRESH_BACKTRACKS of itself is stalling at a minimum of the residual norm that is no
+    equilibrium: the solve fails after FRESH_BACKTRACKS trial assemblies (before: BACKTRACKS,
+    30), and a step of a factorisation held from another state keeps all BACKTRACKS before the
+    tangent is refactored.
+    """
+    fresh, target = response_and_target
+    response = fresh()
+    trials = []
+    real = cr.ContactResponse._assemble
+
+    def no_descent(self, u, **known):  # every trial's residual 1,000 times the start's
+        asm = real(self, u, **known)
+        if "stretch" not in known:
+            return asm
+        trials.append(asm)
+        return dataclasses.replace(asm, force=1e3 * asm.force)
+    monkeypatch.setattr(cr.ContactResponse, "_assemble", no_descent)
+    out = response._newton(response.state_u(), 0.25 * target)
+    assert isinstance(out, cr.ResponseFailure)
+    assert out.reason == "interior line search found no descent"
+    assert len(trials) == cr.FRESH_BACKTRACKS < cr.BACKTRACKS

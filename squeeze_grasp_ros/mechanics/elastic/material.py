@@ -98,7 +98,9 @@ loads (the perpendicular diameter change, a far-field quantity) was off by 4.8 %
 0.6 % at 600, 1,500 and 4,800 nodes at nu = -0.9; by 37 %, 19 % and 5.8 % at -0.99, and by
 60 % at -0.999 with 1,500 nodes; at -1 + 1e-8 the stiffness's condition passed 1e12.
 Neo-Hookean (Lame lambda / mu = 2 nu / (1 - 2 nu)), measured on the foam square (E = 5e4 Pa,
-mu = 0.4, 400 and 2,000 nodes): 0.4999 (lambda / mu = 5,000) and 0.49995 squeezed to 12 % in
+mu = 0.4, 400 and 2,000 nodes; 2026-11-26, before the solver's loops got the bounds of
+docs/reliability.md, "Squeezes with no equilibrium ahead", so the times of the failures are
+upper bounds): 0.4999 (lambda / mu = 5,000) and 0.49995 squeezed to 12 % in
 seconds, 0.49998 and 0.49999 failed after 42-48 s of substep halvings; below 0 lambda is
 negative, the plane-stress thickness equation mu (l3^2 - 1) + lambda ln(J2 l3) = 0 loses
 monotonicity at l3^2 = -nu / (1 - 2 nu), and the law stiffens at ever smaller strains (its

@@ -372,3 +372,20 @@ def test_the_squeeze_verb_says_it_takes_flat_pads(capsys):
         main(["squeeze", "--help"])
     text = " ".join(capsys.readouterr().out.split())
     assert "rounded fingertips or flat pads" in text
+
+
+def test_two_pads_touching_the_same_nodes_are_refused_by_name():
+    """Two 60 mm pads placed 28 mm apart on one side of the foam square both touch that side's
+    nodes 109-114: one node cannot be held by two fingers. Before, the squeeze failed deep in
+    the stable squeeze's plan with "Z^T A Z is not positive definite: contact nodes coincide
+    or the compliance is corrupt" (a random campaign of squeezes met it three times).
+    """
+    from squeeze_grasp_ros.api import load_scene, scene_file, scene_solid
+
+    obj = scene_solid(load_scene(scene_file("foam_square")))
+    pad = TipShape.pad(width=0.06, edge_radius=0.0075)
+    with pytest.raises(InvalidInputError, match=r"fingers F1 and F2 both touch boundary "
+                                                r"node\(s\) \[109, 110, 111, 112, 113, 114\]"):
+        event_squeeze(obj, (116, 107), pad, 0.2, kind="stable", relative_depth=0.05)
+    narrow = TipShape.pad(width=0.01, edge_radius=0.001)  # apart: squeezed (it slips at once)
+    assert event_squeeze(obj, (116, 107), narrow, 0.2, kind="pure", relative_depth=0.05)

@@ -18,6 +18,7 @@ from operator import attrgetter
 
 import numpy as np
 
+from squeeze_grasp_ros.mechanics.errors import InvalidInputError
 from squeeze_grasp_ros.mechanics.squeeze.event_key import EventFunction, EventKey
 from squeeze_grasp_ros.mechanics.squeeze.fingertips import Fingertip
 from squeeze_grasp_ros.mechanics.squeeze.tip_shapes import TipGeometry, tangent, unit
@@ -235,9 +236,26 @@ def initial_state(tips: list[Fingertip], relative_per_depth: float = 0.0) -> Con
 
     Initial modes are undetermined: the stepper decides them by hypothesis-and-test along the
     first motion (Algorithm 1, line 2).
+
+    Raises
+    ------
+    InvalidInputError
+        If two fingertips touch the same boundary node where they are placed (two pads on one
+        side of the object, wider than the gap between their nodes): one node cannot be held by
+        two fingers (its two contacts made the set's reduced compliance singular).
     """
     order = {name: k for k, name in enumerate(Finger.values())}
     tips = sorted(tips, key=lambda t: order[t.name])
+    held: dict[int, str] = {}
+    for t in tips:
+        mine = (t.node, *(n for n, _ in t.touching))
+        shared = sorted(n for n in mine if n in held)
+        if shared:
+            raise InvalidInputError(
+                f"fingers {held[shared[0]]} and {t.name} both touch boundary node(s) {shared} "
+                "where they are placed: one node cannot be held by two fingers; place them "
+                "farther apart or use narrower tips")
+        held.update(dict.fromkeys(mine, t.name))
     fingers = tuple(
         FingerState(t.name, np.asarray(t.center, float), t.radius, np.zeros(2), flat=t.flat,
                     facing=t.facing)

@@ -265,3 +265,21 @@ def test_random_hard_squeezes_end_in_a_checked_state_or_a_named_error(shipped_so
     loaded = max((np.abs(c.force).max() for c in res.state.contacts), default=0.0)
     if model == "linear" and loaded > 1e-9:
         check_state(ContactModel(obj, mu), res.state)
+
+
+def test_a_failed_equilibrium_names_its_residual_interior_not_cone(shipped_solids):
+    """A nonlinear response that finds no equilibrium reports the residual of that equilibrium
+    (the interior forces, relative to the contact forces), and says so: "residuals: interior".
+    Before, every fixed-set failure labelled its residual "cone", the sliding Newton's.
+    """
+    from squeeze_grasp_ros.mechanics.squeeze.nonlinear_model import contact_model
+
+    obj = shipped_solids["foam_square"]
+    b = obj.mesh.boundary
+    model = contact_model("neo_hookean", obj, 0.5)
+    response = model.response(model.set_data((int(b[0]), int(b[len(b) // 2]))))
+    squashed = np.array([[0.6, 0.0], [-0.6, 0.0]])  # each node pushed through the other
+    out = response(squashed)
+    assert isinstance(out, SolveFailure) and out.inverted and out.measure == "interior"
+    assert "(residuals: interior " in str(out.error())
+    assert SolveFailure("a cone that cannot close", 0.5).error().residuals == {"cone": 0.5}

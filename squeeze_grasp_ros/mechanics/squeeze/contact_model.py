@@ -329,26 +329,31 @@ class SolveFailure:
     reason : str
         What failed.
     residual : float
-        Largest cone residual |f_k x e(alpha_k)| at the last iterate (dimensionless force;
-        inf when none was computed).
+        The residual ``measure`` names at the last iterate (inf when none was computed).
     indeterminate : bool
         The problem itself has no unique solution (the sliding contacts do not fix the
         object), which the input must change, rather than a solver failure.
     inverted : bool
         No state without an inverted element exists at these finger positions (nonlinear
         models): the squeeze ends ``element_inverted`` rather than failing.
+    measure : str
+        What ``residual`` is: ``cone``, the largest cone residual |f_k x e(alpha_k)| of the
+        Newton on the sliding angles (dimensionless force), or ``interior``, the interior
+        force residual of a nonlinear response's equilibrium relative to its contact forces
+        (when that equilibrium is what failed).
     """
 
     reason: str
     residual: float = float("inf")
     indeterminate: bool = False
     inverted: bool = False
+    measure: str = "cone"
 
     def error(self) -> InvalidInputError | NumericalError:
         """The failure as an exception, for callers that cannot go on without a solution."""
         if self.indeterminate:
             return InvalidInputError(self.reason)
-        return NumericalError(self.reason, residuals={"cone": self.residual})
+        return NumericalError(self.reason, residuals={self.measure: self.residual})
 
 
 @dataclass(frozen=True, eq=False)

@@ -209,7 +209,8 @@ class NonlinearContactModel(ContactModel):
         def nonlinear(delta: np.ndarray):
             out = self._evaluate(sd, delta)
             if isinstance(out, ResponseFailure):
-                return SolveFailure(out.reason, out.residual, inverted=out.inverted)
+                return SolveFailure(out.reason, out.residual, inverted=out.inverted,
+                                    measure="interior")
             return out.F, out.C
         nonlinear.tolerance = RESPONSE_ACCURACY
         nonlinear.stall_halvings = STALL_HALVINGS
@@ -220,7 +221,7 @@ class NonlinearContactModel(ContactModel):
         if not response.at(delta):
             out = self._evaluate(sd, delta)
             if isinstance(out, ResponseFailure):
-                raise SolveFailure(out.reason, out.residual).error()
+                raise SolveFailure(out.reason, out.residual, measure="interior").error()
         return response.state_u()
 
     # ------------------------------------------------------------------ fields

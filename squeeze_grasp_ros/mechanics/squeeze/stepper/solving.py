@@ -196,7 +196,7 @@ class SetSolver:
         raise NumericalError(
             f"the fixed-set solve failed near depth {self.motion.depth_at(a):.6g} m "
             f"after {MAX_SUBSTEP_HALVINGS} substep halvings: {sol.reason}",
-            residuals={"cone": sol.residual},
+            residuals={sol.measure: sol.residual},
         )
 
 

@@ -50,16 +50,17 @@ def response_and_target():
     return fresh, target
 
 
-def _reach_limited(response, limit: float) -> list[bool]:
+def _reach_limited(response, target: np.ndarray, limit: float) -> list[bool]:
     """Make ``response``'s Newton fail whenever its goal is more than ``limit`` of the whole
-    load beyond the last contact displacement it reached; the outcome of every call, in order.
+    load (from its state to ``target``) beyond the last contact displacement it reached; the
+    outcome of every call, in order.
     """
     real, outcomes = response._newton, []
     reached = [response._delta.copy()]
+    reach = limit * np.abs(target - reached[0]).max() * (1 + 1e-12)
 
     def newton(u, delta):
-        whole = np.abs(TARGET - BASE).max()
-        if np.abs(delta - reached[-1]).max() > limit * whole * (1 + 1e-12):
+        if np.abs(delta - reached[-1]).max() > reach:
             outcomes.append(False)
             return cr.ResponseFailure("beyond the test's reach", 1.0)
         out = real(u, delta)
@@ -68,9 +69,6 @@ def _reach_limited(response, limit: float) -> list[bool]:
         return out
     response._newton = newton
     return outcomes
-
-
-TARGET = BASE = None
 
 
 @pytest.mark.parametrize("limit, halvings, succeeds", [
@@ -85,11 +83,9 @@ def test_load_sub_stepping_stops_once_the_rest_of_the_load_is_out_of_reach(
     failures) or marched 1/128 of the load until the solves ran out (64 solves), each failure a
     Newton that had used its iterations.
     """
-    global TARGET, BASE
     fresh, target = response_and_target
     response = fresh()
-    TARGET, BASE = target, response._delta.copy()
-    outcomes = _reach_limited(response, limit)
+    outcomes = _reach_limited(response, target, limit)
     out = response.evaluate(target)
     assert outcomes.count(False) == halvings == response.stats["substeps"]
     assert len(outcomes) <= cr.MAX_SUBSTEPS

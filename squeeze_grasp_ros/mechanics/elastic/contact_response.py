@@ -84,7 +84,7 @@ FRESH_BACKTRACKS = 16
 state's own tangent whose residual falls only below 2^-16 of its length is stalling at a
 minimum of the residual norm that is no equilibrium: its failure then costs 16 force assemblies
 instead of 30, and the iterations that would creep on toward it are not spent. No converged
-solve of 1,598 random hard squeezes (corotational and neo-Hookean: five shapes, friction to 1.5,
+solve of 1,598 random hard squeezes (corotational and neo-Hookean: six shapes, friction to 1.5,
 tips of 0.5 % to 30 % of the object, pads, depths to 25 %) took more than 12 halvings of such
 a step."""
 

@@ -246,16 +246,6 @@ def initial_state(tips: list[Fingertip], relative_per_depth: float = 0.0) -> Con
     """
     order = {name: k for k, name in enumerate(Finger.values())}
     tips = sorted(tips, key=lambda t: order[t.name])
-    held: dict[int, str] = {}
-    for t in tips:
-        mine = (t.node, *(n for n, _ in t.touching))
-        shared = sorted(n for n in mine if n in held)
-        if shared:
-            raise InvalidInputError(
-                f"fingers {held[shared[0]]} and {t.name} both touch boundary node(s) {shared} "
-                "where they are placed: one node cannot be held by two fingers; place them "
-                "farther apart or use narrower tips")
-        held.update(dict.fromkeys(mine, t.name))
     fingers = tuple(
         FingerState(t.name, np.asarray(t.center, float), t.radius, np.zeros(2), flat=t.flat,
                     facing=t.facing)
@@ -264,6 +254,13 @@ def initial_state(tips: list[Fingertip], relative_per_depth: float = 0.0) -> Con
     geometry = tip_geometry(fingers)
     touching = [(k, t.name, node, q) for k, t in enumerate(tips)
                 for node, q in ((t.node, t.theta), *t.touching)]
+    shared = sorted(n for n, count in Counter(c[2] for c in touching).items() if count > 1)
+    if shared:  # a tip lists each node it touches once
+        names = dict.fromkeys(name for _, name, node, _ in touching if node in shared)
+        raise InvalidInputError(
+            f"fingers {' and '.join(names)} both touch boundary node(s) {shared} where they "
+            "are placed: one node cannot be held by two fingers; place them farther apart or "
+            "use narrower tips")
     contacts = tuple(
         sorted(
             (

@@ -183,6 +183,8 @@ CONSTANTS = [
       "mechanics.squeeze.stepper.substeps.ADAPTIVE_SLOPE_CHANGE"], [1, 1, 0.01]),
     ("events.md", r"all combinations for up to (\w+) nodes",
      ["mechanics.squeeze.stepper.modes.MAX_JOINT_NODES"], 1),
+    ("events.md", r"all combinations\s+again for up to (\w+) nodes",
+     ["mechanics.squeeze.stepper.modes.MAX_SEARCHED_NODES"], 1),
     ("events.md", r"the response keeps the last (\d+) evaluated states",
      ["mechanics.elastic.contact_response.KEPT_STATES"], 1),
     ("materials.md", r"a contact set's response keeps its last (\d+) evaluated states",
@@ -232,7 +234,7 @@ CONSTANTS = [
 def test_a_stated_constant_is_the_code_s(page, pattern, constants, unit):
     units = unit if isinstance(unit, list) else [unit] * len(constants)
     numbers = [_constant(c) / u for c, u in zip(constants, units)]
-    words = {"two": 2, "three": 3, "four": 4}
+    words = {"two": 2, "three": 3, "four": 4, "five": 5}
     found = re.search(pattern, page_text(page))
     assert found, f"{page} no longer states {pattern!r}"
     shown = [float(words.get(x, x.replace(",", ""))) for x in found.groups()]

@@ -289,7 +289,9 @@ class EventFunctions:
     def entries(self, contacts: ContactSet, v: EventValues, rows: np.ndarray,
                 held: np.ndarray) -> WatchedValues:
         """The watched functions by key, in a fixed order: per contact not ``held`` (mask) its
-        normal force and its cone margins or slip rate, then every free boundary row's gaps
+        normal force and its cone margins or slip rate, per held sticking contact its cone
+        margins (a frozen node may still start to slide, never stick outside its cone), then
+        every free boundary row's gaps
         (one array, its keys a table kept for the contact set, mask and rows), then the
         terminations that are checked.
         """
@@ -389,11 +391,10 @@ class EventFunctions:
         if made is None:
             m, keys, pick, key = len(contacts), [], [], self.keys.get
             for k, node in enumerate(contacts.nodes.tolist()):
-                if held[k]:
-                    continue
-                keys.append(key(EventFunction.NORMAL_FORCE, node))
-                pick.append(k)
-                if self.frictionless:
+                if not held[k]:
+                    keys.append(key(EventFunction.NORMAL_FORCE, node))
+                    pick.append(k)
+                if self.frictionless or (held[k] and not contacts.stick[k]):
                     continue
                 if contacts.stick[k]:
                     keys += [key(EventFunction.CONE_PLUS, node),

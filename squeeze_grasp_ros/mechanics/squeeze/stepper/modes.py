@@ -19,6 +19,7 @@ from __future__ import annotations
 import itertools
 from collections.abc import Callable
 from dataclasses import dataclass
+from functools import partial
 
 import numpy as np
 
@@ -27,11 +28,14 @@ from squeeze_grasp_ros.mechanics.squeeze.contact_model import Solution, SolveFai
 from squeeze_grasp_ros.mechanics.squeeze.event_key import EventFunction, EventKey
 from squeeze_grasp_ros.mechanics.squeeze.stepper.contact_set import ContactSet
 
-__all__ = ["MAX_JOINT_NODES", "RATE_NOISE", "ModeChoice", "decide_modes", "mode_violations",
-           "zero_functions"]
+__all__ = ["MAX_JOINT_NODES", "MAX_SEARCHED_NODES", "RATE_NOISE", "ModeChoice", "decide_modes",
+           "mode_violations", "zero_functions"]
 
 MAX_JOINT_NODES = 3
 """Up to this many undecided nodes every combination of modes is tried; beyond, node by node."""
+MAX_SEARCHED_NODES = 5
+"""Up to this many undecided nodes whose node-by-node choice is inconsistent, every combination
+is tried after it (at most 3^5 = 243 solves; a consistent choice node by node is kept)."""
 RATE_NOISE = 1e-10
 """Noise floor of the rate of a function zero by construction, relative to the force rate a
 stuck contact would see (the fingers' motion per unit s, forces / (E h L)): a rate at or below
@@ -181,7 +185,11 @@ def decide_modes(contacts: ContactSet, nodes: list[int], zero: set[EventKey], at
 
     Options per node in the order stick, slip +1, slip -1; every combination for up to
     MAX_JOINT_NODES nodes (the first consistent one wins, else the one with fewest
-    violations), node by node in two passes for more. The other contacts keep their modes.
+    violations), node by node in two passes for more, and then, when that choice is
+    inconsistent and there are at most MAX_SEARCHED_NODES nodes, every combination (the node
+    by node choice goes the same way on its own one node at a time; nodes that must change
+    together, such as a finger's contacts that all start to slide one way, need the joint
+    search). The other contacts keep their modes.
 
     Parameters
     ----------
@@ -209,7 +217,22 @@ def decide_modes(contacts: ContactSet, nodes: list[int], zero: set[EventKey], at
     """
     idx = [contacts.index(n) for n in sorted(nodes)]
     zero_at = _zero_by_contact(contacts, zero)
+    decide = partial(_decide, contacts, nodes, idx, zero_at, attempt, mu, rate_floor, search)
     jointly = len(idx) <= MAX_JOINT_NODES
+    choice = decide(jointly=jointly)
+    if choice.violations and not jointly and len(idx) <= MAX_SEARCHED_NODES:
+        joint = decide(jointly=True)
+        if joint.violations < choice.violations:
+            return joint
+    return choice
+
+
+def _decide(contacts: ContactSet, nodes: list[int], idx: list[int],
+            zero_at: dict[int, set[EventFunction]], attempt: Attempt, mu: float,
+            rate_floor: float, search: Search | None, *, jointly: bool) -> ModeChoice:
+    """The search of :func:`decide_modes` over every combination (``jointly``) or node by
+    node, compiled where ``search`` takes it.
+    """
     chosen = None if search is None else search(
         contacts, idx, np.array(_options(mu), np.int64), _zero_flags(idx, zero_at), mu=mu,
         rate_floor=rate_floor, by_node=not jointly)

@@ -16,7 +16,9 @@ by finger (F1, F2, A) and node index, re-solving after each:
 * finger slip is checked after every event and stops the processing; a break that would leave
   a finger without contact is not applied and ends the call as ``contact_lost``;
 * a node that would exceed the chattering bound (:class:`~.chatter.ChatterBound`), flips again
-  after a joint decision, or has a second A/B event at one point, is frozen instead.
+  after a joint decision, or has a second A/B event at one point, is frozen instead; a frozen
+  node that sticks still slides when its force reaches its friction cone (event C, not
+  counted: it then stays sliding until the hold ends), so no node sticks outside its cone.
 
 Then the terminations are checked in the order element_inverted < strain_limit <
 contact_lost < finger_slip < picked_up.
@@ -230,12 +232,12 @@ class EventProcessor:
         for node in sorted(added):
             self._log_contact(EventType.A, self.contacts.index(node))
 
-    def apply(self, key: EventKey, sol: Solution) -> None:
-        """Process one B, C or D event (modes, the contact set and the fresh keys)."""
+    def apply(self, key: EventKey, sol: Solution, *, admit: bool = True) -> None:
+        """One B, C or D event (modes, set, fresh keys); ``admit``: count it (may freeze)."""
         node, function = key.node, key.function
         k = self.contacts.index(node)
         f = int(self.contacts.finger[k])
-        if not self._admit(node, f):
+        if admit and not self._admit(node, f):
             return
         self.contacts = self.contacts.with_theta(sol.theta.copy())
         if function == EventFunction.NORMAL_FORCE:
@@ -303,16 +305,17 @@ class EventProcessor:
             if not todo:
                 return sol
             self._process(todo, sol, point)
-        raise NumericalError(
-            "event processing at one point did not settle (chattering bound "
-            "exceeded); lower squeeze.max_events_per_depth"
-        )
+        raise NumericalError("event processing at one point did not settle (chattering bound "
+                             "exceeded); lower squeeze.max_events_per_depth")
 
     def _process(self, todo: list[EventKey], sol: Solution, point: _Point) -> None:
         """Process the first pending event ``todo[0]`` (with every pending A if it is one)."""
         key = todo[0]
         node, function = key.node, key.function
-        if node in point.settled or (function in _CONTACT_CHANGES
+        if function in _CONES and node in self.chatter.held_nodes(self.depth):
+            point.mode_events.discard(node)  # frozen and sticking: it slides, not counted
+            self.apply(key, sol, admit=False)
+        elif node in point.settled or (function in _CONTACT_CHANGES
                                      and node in point.contact_events):
             finger = key.finger if function == EventFunction.GAP else self.contacts.finger_of(node)
             self.chatter.hold(node, self.motion.names[finger], self.depth)

@@ -345,16 +345,18 @@ class QuietSteps:
 
 
 def _margins(sticking: _Sticking, watched: np.ndarray, mu: float) -> np.ndarray:
-    """The ``watched`` contacts' (mask) normal forces f_n = u . F_k and cone margins
-    mu f_n -+ f_t (f_t = t . F_k) as rows of one map of the set's forces (m, 2) flattened:
-    (3w, 2m), w the contacts watched.
+    """The ``watched`` contacts' (mask: not held) normal forces f_n = u . F_k and every
+    contact's cone margins mu f_n -+ f_t (f_t = t . F_k; a held node that sticks still watches
+    its cone) as rows of one map of the set's forces (m, 2) flattened: (w + 2m, 2m), w the
+    contacts watched, normal forces first.
     """
-    rows = np.flatnonzero(watched)
-    u, t = sticking.unit[rows], sticking.tangent[rows]
-    k = np.arange(len(rows))
-    margins = np.zeros((3, len(rows), len(watched), 2))
-    margins[0, k, rows], margins[1, k, rows], margins[2, k, rows] = u, mu * u - t, mu * u + t
-    return margins.reshape(3 * len(rows), -1)
+    rows, every = np.flatnonzero(watched), np.arange(len(watched))
+    u, t = sticking.unit, sticking.tangent
+    normal = np.zeros((len(rows), len(watched), 2))
+    normal[np.arange(len(rows)), rows] = u[rows]
+    cones = np.zeros((2, len(watched), len(watched), 2))
+    cones[0, every, every], cones[1, every, every] = mu * u - t, mu * u + t
+    return np.concatenate((normal.reshape(len(rows), -1), cones.reshape(2 * len(watched), -1)))
 
 
 def _clear(margins: np.ndarray, F: np.ndarray) -> bool:
@@ -373,7 +375,7 @@ def _one_substep(step: float, rate: float) -> bool:
 class _Mode:
     """What stays fixed while calls stay quiet in one sticking mode: the set's constants, the
     finger names (and as a set), the tips, the functions watched (the free boundary ``rows``;
-    the contacts' not held, as the rows of their normal forces and cone margins, ``margins``:
+    the contacts' normal forces, of those not held, and cone margins, ``margins``:
     :func:`_margins`), the depth (m) at which a hold of the chattering bound ``expiry`` ends,
     and the parts of a result that do not move: per finger its name, its contact rows (a slice
     when they are consecutive), whether it has any, its radius, flat and facing; each contact's

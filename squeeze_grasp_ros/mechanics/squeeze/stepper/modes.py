@@ -186,10 +186,10 @@ def decide_modes(contacts: ContactSet, nodes: list[int], zero: set[EventKey], at
     Options per node in the order stick, slip +1, slip -1; every combination for up to
     MAX_JOINT_NODES nodes (the first consistent one wins, else the one with fewest
     violations), node by node in two passes for more, and then, when that choice is
-    inconsistent and there are at most MAX_SEARCHED_NODES nodes, every combination (the node
-    by node choice goes the same way on its own one node at a time; nodes that must change
-    together, such as a finger's contacts that all start to slide one way, need the joint
-    search). The other contacts keep their modes.
+    inconsistent and there are at most MAX_SEARCHED_NODES nodes, every combination: the
+    node-by-node search changes one node at a time, so it misses nodes that can only change
+    together (a finger's contacts that all start to slide one way). The other contacts keep
+    their modes.
 
     Parameters
     ----------

@@ -291,9 +291,8 @@ class EventFunctions:
         """The watched functions by key, in a fixed order: per contact not ``held`` (mask) its
         normal force and its cone margins or slip rate, per held sticking contact its cone
         margins (a frozen node may still start to slide, never stick outside its cone), then
-        every free boundary row's gaps
-        (one array, its keys a table kept for the contact set, mask and rows), then the
-        terminations that are checked.
+        every free boundary row's gaps (one array, its keys a table kept for the contact set,
+        mask and rows), then the terminations that are checked.
         """
         keys, pick = self._contact_entries(contacts, held)
         table = np.concatenate((v.fn, v.c_plus, v.c_minus, v.d))

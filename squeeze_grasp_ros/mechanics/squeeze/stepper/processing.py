@@ -233,7 +233,9 @@ class EventProcessor:
             self._log_contact(EventType.A, self.contacts.index(node))
 
     def apply(self, key: EventKey, sol: Solution, *, admit: bool = True) -> None:
-        """One B, C or D event (modes, set, fresh keys); ``admit``: count it (may freeze)."""
+        """Process one B, C or D event (modes, the contact set and the fresh keys); ``admit``:
+        count it against the chattering bound, which may freeze the node instead.
+        """
         node, function = key.node, key.function
         k = self.contacts.index(node)
         f = int(self.contacts.finger[k])

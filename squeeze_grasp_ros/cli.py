@@ -117,12 +117,33 @@ def exit_code(error: Exception) -> ExitCode:
     return next((code for kind, code in codes if isinstance(error, kind)), ExitCode.INTERNAL)
 
 
+def error_details(error: Exception) -> dict[str, Any]:
+    """What an error's JSON object adds to its message: for a solver failure
+    (:class:`~.mechanics.errors.NumericalError`) its ``residuals`` by name, and ``depth`` (m)
+    and ``relative_depth`` of a squeeze's failure (None where it was not a squeeze's); numbers
+    that are not finite become None (a residual never computed is inf).
+
+    >>> from squeeze_grasp_ros.mechanics.errors import NumericalError
+    >>> error_details(NumericalError("stalled", residuals={"cone": 2e-6}).located(0.0177, 0.24))
+    {'residuals': {'cone': 2e-06}, 'depth': 0.0177, 'relative_depth': 0.24}
+    """
+    from squeeze_grasp_ros.mechanics.errors import NumericalError
+
+    if not isinstance(error, NumericalError):
+        return {}
+
+    def finite(value: float | None) -> float | None:
+        return value if value is not None and math.isfinite(value) else None
+    return {"residuals": {k: finite(v) for k, v in error.residuals.items()},
+            "depth": finite(error.depth), "relative_depth": finite(error.relative_depth)}
+
+
 def main(argv: list[str] | None = None) -> int:
     """Entry point; returns the process exit code (:class:`~.exit_codes.ExitCode`).
 
     With ``--json`` a result is printed as one JSON object (non-finite numbers become null and
     are listed under ``non_finite``), and an error as ``{"error", "field", "code",
-    "code_name"}``, a usage error too.
+    "code_name"}``, a usage error too, a solver failure with its :func:`error_details`.
     """
     argv = sys.argv[1:] if argv is None else argv
     args = build_parser(json_errors="--json" in argv).parse_args(argv)
@@ -135,7 +156,7 @@ def main(argv: list[str] | None = None) -> int:
     try:
         result = args._module.run(args)
     except SqueezeGraspError as exc:
-        return fail(args, str(exc), exit_code(exc))
+        return fail(args, str(exc), exit_code(exc), details=error_details(exc))
     except ModuleNotFoundError as exc:
         hint = install_hint(exc.name or "")
         if hint is None:

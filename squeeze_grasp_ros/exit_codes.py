@@ -14,7 +14,9 @@ from __future__ import annotations
 
 import json
 import signal
+from collections.abc import Mapping
 from enum import IntEnum
+from typing import Any
 
 __all__ = ["ExitCode", "Interrupted", "error_json", "raise_on_signals", "raised_signal"]
 
@@ -50,15 +52,18 @@ class ExitCode(IntEnum):
     TERMINATED = 143
 
 
-def error_json(message: str, field: str | None, code: ExitCode) -> str:
+def error_json(message: str, field: str | None, code: ExitCode,
+               details: Mapping[str, Any] | None = None) -> str:
     """The one JSON object a command prints on stdout under ``--json`` for an error: its
-    message, the field it names (None when it names none) and the exit code.
+    message, the field it names (None when it names none), the exit code and the error's
+    ``details`` (a solver failure's residuals and where a squeeze failed:
+    :func:`~.cli.error_details`).
 
     >>> error_json("depth must be >= 0 m, got -1", "depth", ExitCode.USAGE)
     '{"error": "depth must be >= 0 m, got -1", "field": "depth", "code": 2, "code_name": "USAGE"}'
     """
     return json.dumps({"error": message, "field": field, "code": int(code),
-                       "code_name": code.name})
+                       "code_name": code.name, **(details or {})}, allow_nan=False)
 
 
 class Interrupted(KeyboardInterrupt):

@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import ast
 import json
+import re
 from pathlib import Path
 
 import pytest
@@ -16,14 +17,19 @@ from squeeze_grasp_ros.exit_codes import ExitCode
 from squeeze_grasp_ros.mechanics import errors
 from squeeze_grasp_ros.mechanics.elastic.compliance import ElasticObject
 from squeeze_grasp_ros.mechanics.squeeze import contact_model
+from squeeze_grasp_ros.mechanics.vocabulary import ContactMode
 from squeeze_grasp_ros.planning import ErrorCode, PlannerError, classify
 from squeeze_grasp_ros.scene import (
+    GraspSetup,
     build_mesh,
     event_squeeze_scene,
     finger_nodes,
     load_scene,
     scene_material,
 )
+from squeeze_grasp_ros.sweep.evaluate import run_task
+from squeeze_grasp_ros.sweep.plan import plan_tasks
+from squeeze_grasp_ros.sweep.spec import parse_sweep_spec
 
 REPO = Path(__file__).resolve().parents[1]
 MECHANICS = REPO / "squeeze_grasp_ros" / "mechanics"
@@ -41,6 +47,55 @@ def test_a_solver_failure_reaches_the_cli_as_numerical(newton_without_iterations
     error = json.loads(capfd.readouterr().out)
     assert error["code"] == 3 and error["code_name"] == "NUMERICAL"
     assert "did not converge" in error["error"] and "residuals: cone" in error["error"]
+    assert error["error"].startswith(f"at depth {error['depth']:.6g} m (relative depth "
+                                     f"{error['relative_depth']:.6g}): Newton on the sliding")
+    assert error["depth"] > 0 and error["residuals"]["cone"] >= 0
+
+
+def _first_sliding_point() -> tuple[float, float]:
+    """(depth m, relative depth) of the low-friction foam square's first event with a sliding
+    contact, from its squeeze with Newton: where the squeeze without Newton iterations fails.
+    """
+    squeeze = GraspSetup.build(load_scene(SLIPPING)).event_squeeze()
+    first = next(e for e in squeeze.events if e.mode == ContactMode.SLIP)
+    return first.depth, first.relative_depth
+
+
+def test_a_squeeze_failure_says_where_it_failed(monkeypatch):
+    """The error of a squeeze that fails starts with the depth and relative depth of the last
+    point it solved (here the event whose sliding contact Newton cannot solve), keeps its
+    reason and residuals, and chains the stepper's error (which knows the depth in metres only).
+    """
+    depth, relative = _first_sliding_point()
+    monkeypatch.setattr(contact_model, "NEWTON_MAX_ITERATIONS", 0)
+    with pytest.raises(errors.NumericalError) as info:
+        GraspSetup.build(load_scene(SLIPPING)).event_squeeze()
+    error = info.value
+    assert (error.depth, error.relative_depth) == (depth, relative) and depth > 0
+    assert str(error) == (f"at depth {depth:.6g} m (relative depth {relative:.6g}): Newton on the "
+                          f"sliding angles did not converge in 0 iterations (residuals: cone "
+                          f"{error.residuals['cone']:.3g})")
+    assert error.reason == "Newton on the sliding angles did not converge in 0 iterations"
+    cause = error.__cause__
+    assert isinstance(cause, errors.NumericalError) and cause.depth == depth
+    assert cause.relative_depth is None and str(cause).startswith(f"at depth {depth:.6g} m: ")
+
+
+def test_a_failed_evaluation_s_row_says_where(monkeypatch, tmp_path):
+    """The dataset route: the row of a squeeze that fails carries its error as the API raises
+    it, with the depth and the relative depth of the point where the squeeze failed.
+    """
+    spec = {"name": "where", "base": SLIPPING, "objects": [{"scene": SLIPPING}],
+            "placements": {"mode": "graspmap", "count": 2}}
+    tasks = list(plan_tasks(parse_sweep_spec(spec, tmp_path)))
+    monkeypatch.setattr(contact_model, "NEWTON_MAX_ITERATIONS", 0)
+    rows = [row for task in tasks for row in run_task(task)["rows"]]
+    assert len(rows) == 2
+    for row in rows:
+        where = re.match(r"NumericalError: at depth (\S+) m \(relative depth (\S+)\): Newton "
+                         r"on the sliding angles did not converge", row["error"])
+        depth, relative = float(where[1]), float(where[2])
+        assert depth > 0 and 0 < relative < row["target_relative_depth"]
 
 
 def test_the_same_scene_succeeds_with_newton(capfd):
@@ -88,8 +143,16 @@ def test_every_error_kind_has_its_exit_code(kind, exit_code, monkeypatch, capfd)
     assert "what failed" in capfd.readouterr().err
 
 
+def _reraises(handler: ast.ExceptHandler) -> bool:
+    """Whether the clause only adds context and raises again: assignments, then a raise."""
+    *before, last = handler.body
+    return isinstance(last, ast.Raise) and all(isinstance(s, ast.Assign) for s in before)
+
+
 def caught_package_errors(path: Path) -> list[str]:
-    """``except`` clauses in ``path`` that catch one of the package's own error kinds."""
+    """``except`` clauses in ``path`` that catch one of the package's own error kinds and do
+    more than raise it again with context (:func:`_reraises`).
+    """
     names = {"SqueezeGraspError", "InvalidInputError", "InfeasibleError", "NumericalError",
              "InternalError", "SceneError"}
     found = []
@@ -97,13 +160,15 @@ def caught_package_errors(path: Path) -> list[str]:
         if isinstance(node, ast.ExceptHandler) and node.type is not None:
             caught = {n.id for n in ast.walk(node.type) if isinstance(n, ast.Name)}
             caught |= {n.attr for n in ast.walk(node.type) if isinstance(n, ast.Attribute)}
-            if caught & names:
+            if caught & names and not _reraises(node):
                 found.append(f"{path.relative_to(REPO)}:{node.lineno}")
     return found
 
 
 def test_the_mechanics_use_no_exception_for_control_flow():
-    """A failed mode hypothesis or substep is a value (SolveFailure), not a caught error."""
+    """A failed mode hypothesis or substep is a value (SolveFailure), not a caught error (a
+    squeeze's failure is caught only to be raised again with where it failed).
+    """
     offenders = [hit for p in MECHANICS.rglob("*.py") for hit in caught_package_errors(p)]
     assert offenders == []
     assert caught_package_errors(REPO / "squeeze_grasp_ros" / "cli.py")  # the check can fail

@@ -6,7 +6,9 @@ from __future__ import annotations
 import argparse
 import re
 import sys
+from collections.abc import Mapping
 from pathlib import Path
+from typing import Any
 
 from squeeze_grasp_ros.exit_codes import ExitCode, error_json
 from squeeze_grasp_ros.mechanics.elastic.compliance import ROUTES
@@ -18,12 +20,15 @@ FIELD = re.compile(r"^([A-Za-z_][\w.\[\]]*) (?:must|is|needs|has)\b")
 """A message that starts with the name of the offending field ("object.shape.side must ...")."""
 
 
-def fail(args: argparse.Namespace, message: str, code: ExitCode) -> int:
-    """Report an error: one line on stderr, and with ``--json`` a JSON object on stdout."""
+def fail(args: argparse.Namespace, message: str, code: ExitCode, *,
+         details: Mapping[str, Any] | None = None) -> int:
+    """Report an error: one line on stderr, and with ``--json`` a JSON object on stdout (with
+    ``details``, :func:`~squeeze_grasp_ros.exit_codes.error_json`).
+    """
     print(f"squeeze-grasp {args.verb}: error: {message}", file=sys.stderr)
     if getattr(args, "json", False):
         match = FIELD.match(message)
-        print(error_json(message, match.group(1) if match else None, code))
+        print(error_json(message, match.group(1) if match else None, code, details))
     return code
 
 

@@ -48,18 +48,49 @@ class NumericalError(SqueezeGraspError, ArithmeticError):
     Parameters
     ----------
     message : str
-        What failed and where.
+        What failed.
     residuals : mapping of str to float, optional
         The solver's last residuals by name (dimensionless unless the name says otherwise);
         they are appended to the message.
+    depth : float, optional
+        Where a squeeze failed: its depth, m (the last point it had solved); the message then
+        starts with it.
+    relative_depth : float, optional
+        The same depth over the initial contact distance, shown beside it.
+
+    Attributes
+    ----------
+    reason : str
+        ``message`` alone (without the depth and the residuals).
+
+    >>> err = NumericalError("Newton did not converge", residuals={"cone": 2.5e-3})
+    >>> str(err.located(0.0079, 0.079))
+    'at depth 0.0079 m (relative depth 0.079): Newton did not converge (residuals: cone 0.0025)'
     """
 
-    def __init__(self, message: str, *, residuals: Mapping[str, float] | None = None) -> None:
+    def __init__(self, message: str, *, residuals: Mapping[str, float] | None = None,
+                 depth: float | None = None, relative_depth: float | None = None) -> None:
+        self.reason = message
         self.residuals: dict[str, float] = {k: float(v) for k, v in (residuals or {}).items()}
+        self.depth = None if depth is None else float(depth)
+        self.relative_depth = None if relative_depth is None else float(relative_depth)
         if self.residuals:
             listed = ", ".join(f"{k} {v:.3g}" for k, v in self.residuals.items())
             message = f"{message} (residuals: {listed})"
+        if self.depth is not None:
+            relative = ("" if self.relative_depth is None
+                        else f" (relative depth {self.relative_depth:.6g})")
+            message = f"at depth {self.depth:.6g} m{relative}: {message}"
         super().__init__(message)
+
+    def located(self, depth: float | None,
+                relative_depth: float | None = None) -> NumericalError:
+        """This error (its type, reason and residuals) at a squeeze's ``depth``, m, and
+        ``relative_depth``: a new error whose message starts with them (a copy of this one
+        where ``depth`` is None).
+        """
+        return type(self)(self.reason, residuals=self.residuals, depth=depth,
+                          relative_depth=relative_depth)
 
 
 class InternalError(SqueezeGraspError, RuntimeError):

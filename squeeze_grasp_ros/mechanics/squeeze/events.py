@@ -24,6 +24,7 @@ from squeeze_grasp_ros.mechanics.elastic.strain_measures import max_principal_st
 from squeeze_grasp_ros.mechanics.elastic.stress_measures import element_stresses, von_mises
 from squeeze_grasp_ros.mechanics.errors import (
     InvalidInputError,
+    NumericalError,
     node_indices,
     require_finite,
     require_relative_depth,
@@ -602,7 +603,9 @@ def event_squeeze(
     InfeasibleError
         If the stable squeeze of ``contacts`` is not unique (a repeated eigenvalue of C).
     NumericalError
-        If a solve or an event location does not converge.
+        If a solve or an event location does not converge; the message starts with the
+        depth, m, and relative depth of the last point solved (``depth`` and
+        ``relative_depth`` of the error).
 
     Examples
     --------
@@ -644,10 +647,12 @@ def event_squeeze(
     require_relative_depth(depth * relative_per_depth, depth)
     model = contact_model(material_model, obj, mu, limits or TerminationLimits(), reference,
                           max_events_per_depth, options or SolveOptions())
-    run = squeeze_to_depth(
-        model, initial_state(tips, relative_per_depth), dirs, depth, step, event_tol, progress,
-        checkpoint=checkpoint,
-    )
+    try:
+        run = squeeze_to_depth(model, initial_state(tips, relative_per_depth), dirs, depth, step,
+                               event_tol, progress, checkpoint=checkpoint)
+    except NumericalError as error:  # where, also as a relative depth
+        relative = None if error.depth is None else error.depth * relative_per_depth
+        raise error.located(error.depth, relative) from error
     state = run.state
     summaries = [segment_node(c, mu) for c in state.contacts]
     loads = _contact_loads(model, state)

@@ -16,7 +16,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from squeeze_grasp_ros.mechanics.errors import InvalidInputError
+from squeeze_grasp_ros.mechanics.errors import InvalidInputError, NumericalError
 from squeeze_grasp_ros.mechanics.squeeze.contact_model import ContactModel, Solution, SolveFailure
 from squeeze_grasp_ros.mechanics.squeeze.contact_state import (
     ContactNode,
@@ -366,9 +366,15 @@ def advance(
     ------
     InvalidInputError
         For bad arguments, a lost grasp (fewer than 2 contacts) or a solve that fails.
+    NumericalError
+        If a solve or an event location does not converge; its ``depth`` (and message) says
+        where: the depth of the last point the motion had solved, m.
     """
     _check(step, event_tol, terminate_on, first_substep)
     call = _Call(model, state, translations, step, min(event_tol, step), tuple(terminate_on))
-    sol, termination, next_substep = call.run(
-        stop_on_event, step if first_substep is None else first_substep, checkpoint)
+    try:
+        sol, termination, next_substep = call.run(
+            stop_on_event, step if first_substep is None else first_substep, checkpoint)
+    except NumericalError as error:  # where: the last point solved
+        raise error.located(call.events.depth) from error
     return call.result(sol, termination, next_substep)

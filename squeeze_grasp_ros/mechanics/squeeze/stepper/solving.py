@@ -193,11 +193,8 @@ class SetSolver:
             b = a + 0.5 * (b - a)
         if sol.inverted:
             return a, sol
-        raise NumericalError(
-            f"the fixed-set solve failed near depth {self.motion.depth_at(a):.6g} m "
-            f"after {MAX_SUBSTEP_HALVINGS} substep halvings: {sol.reason}",
-            residuals={sol.measure: sol.residual},
-        )
+        raise NumericalError(f"the fixed-set solve failed after {MAX_SUBSTEP_HALVINGS} substep "
+                             f"halvings: {sol.reason}", residuals={sol.measure: sol.residual})
 
 
 class SolvedPoints:

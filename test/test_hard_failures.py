@@ -30,8 +30,10 @@ from squeeze_grasp_ros.mechanics.squeeze.contact_model import (
 )
 from squeeze_grasp_ros.mechanics.squeeze.events import event_squeeze
 from squeeze_grasp_ros.mechanics.squeeze.nonlinear_model import STALL_HALVINGS
+from squeeze_grasp_ros.mechanics.squeeze.stepper import solving
 from squeeze_grasp_ros.mechanics.squeeze.tip_shapes import TipGeometry, TipShape
 from squeeze_grasp_ros.mechanics.vocabulary import MaterialModel
+from squeeze_grasp_ros.scene import GraspSetup
 
 
 @pytest.fixture(scope="module")
@@ -280,3 +282,43 @@ def test_a_failed_equilibrium_names_its_residual_interior_not_cone(shipped_solid
     assert isinstance(out, SolveFailure) and out.inverted and out.measure == "interior"
     assert "(residuals: interior " in str(out.error())
     assert SolveFailure("a cone that cannot close", 0.5).error().residuals == {"cone": 0.5}
+
+
+class _Stop(Exception):
+    """The cancellation of the checkpoint test."""
+
+
+@pytest.mark.parametrize("model", [MaterialModel.LINEAR, MaterialModel.COROTATIONAL])
+def test_a_cancellation_stops_a_squeeze_within_one_fixed_set_solve(model, monkeypatch):
+    """The checkpoint (the planner's cancellation) runs before every fixed-set solve and every
+    equilibrium solve of a nonlinear one, not only before every substep: a substep's halvings
+    can take many solves (the blob squeeze above spent up to 5.9 s of CPU between two
+    substeps, the neo-Hookean foam square of docs/reliability.md 12 s; 0.8 s at most now).
+    Every solve follows a checkpoint call, and none follows the call that raises.
+    """
+    log: list[str] = []
+    real, evaluate = solving.attempt_fixed_set, cr.ContactResponse.evaluate
+
+    def solve(*args, **kwargs):
+        log.append("solve")
+        return real(*args, **kwargs)
+
+    def equilibrium(self, delta):
+        log.append("equilibrium")
+        return evaluate(self, delta)
+    monkeypatch.setattr(solving, "attempt_fixed_set", solve)
+    monkeypatch.setattr(cr.ContactResponse, "evaluate", equilibrium)
+
+    def checkpoint():
+        log.append("check")
+        if log.count("solve") >= 25:
+            raise _Stop
+    setup = GraspSetup.build(load_scene(scene_file("foam_square_low_friction")))
+    with pytest.raises(_Stop):
+        setup.event_squeeze(material_model=model, checkpoint=checkpoint)
+    assert log.count("solve") == 25 and log[-1] == "check"
+    assert all(log[k - 1] == "check" for k, entry in enumerate(log) if entry == "solve")
+    # a nonlinear solve's equilibrium solves (the trials of its Newton) each follow one too
+    equilibria = [k for k, entry in enumerate(log) if entry == "equilibrium"]
+    assert (len(equilibria) > 25) == (model != MaterialModel.LINEAR)
+    assert all(log[k - 1] == "check" for k in equilibria)

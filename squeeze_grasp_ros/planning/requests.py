@@ -158,7 +158,8 @@ def resistance_plan(
     limits : PlannerLimits
         Friction: the scene's squeeze step must be >= ``limits.min_step``.
     checkpoint : callable, optional
-        Friction: called before every stepper substep; may raise :class:`Cancelled`.
+        Friction: called before every stepper substep and fixed-set solve; may raise
+        :class:`Cancelled`.
     """
     loaded.solid()  # INVALID_ARGUMENT for a ring
     mode = choice("mode", mode, SqueezeKind.planned())
@@ -191,7 +192,7 @@ def friction_resistance(
     checkpoint: Callable[[], None] | None = None,
 ) -> FrictionalResistance:
     """Algorithm 2 after the scene's event-driven squeeze at F1, F2 (Sec. 6.3); ``checkpoint``
-    is called before every stepper substep of both.
+    is called before every stepper substep and fixed-set solve of both.
     """
     scene = loaded.scene
     radius = check_number("adversary_tip_radius", tip_radius, 0.0)
@@ -305,7 +306,8 @@ def event_squeeze_run(
     progress : callable, optional
         Called with the completed fraction; may raise :class:`Cancelled`.
     checkpoint : callable, optional
-        Called before every stepper substep; may raise :class:`Cancelled`.
+        Called before every stepper substep and fixed-set solve; may raise
+        :class:`Cancelled`.
     """
     loaded.solid()  # INVALID_ARGUMENT for a ring
     scene = loaded.scene

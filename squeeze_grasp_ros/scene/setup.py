@@ -356,7 +356,8 @@ class GraspSetup:
         material_model : MaterialModel or str, optional
             Constitutive model; default the scene's ``object.material.model``.
         checkpoint : callable, optional
-            Called before every substep; may raise to abandon the squeeze (a cancellation).
+            Called before every substep and every fixed-set solve; may raise to abandon the
+            squeeze (a cancellation).
         options : SolveOptions, optional
             Switches of the large-deformation savings (see
             :func:`~squeeze_grasp_ros.mechanics.squeeze.events.event_squeeze`).
@@ -475,7 +476,8 @@ class GraspSetup:
         adversary_node : int, optional
             A's contact node; default :attr:`adversary_node`.
         checkpoint : callable, optional
-            Called before every substep; may raise to abandon the resistance.
+            Called before every substep and every fixed-set solve; may raise to abandon the
+            resistance.
         """
         if None in (mode, a, tip_radius, adversary_node):
             adv = self.scene.adversary

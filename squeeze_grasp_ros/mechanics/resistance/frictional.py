@@ -314,7 +314,8 @@ def frictional_resistance(
     progress : callable, optional
         Called after every stage with the fraction of a travelled by A.
     checkpoint : callable, optional
-        Called before every stepper substep; may raise to abandon the computation.
+        Called before every stepper substep and fixed-set solve; may raise to abandon the
+        computation.
 
     Raises
     ------

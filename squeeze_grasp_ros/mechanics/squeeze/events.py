@@ -134,7 +134,8 @@ def squeeze_to_depth(
     terminate_on : tuple of str
         Terminations that end the squeeze besides the depth.
     checkpoint : callable, optional
-        Called before every substep; may raise to abandon the squeeze (see :func:`advance`).
+        Called before every substep and every fixed-set solve; may raise to abandon the
+        squeeze (see :func:`advance`).
     """
     if not (np.isfinite(depth) and depth >= 0):
         raise InvalidInputError(f"squeeze depth must be >= 0 m, got {depth}")
@@ -574,7 +575,8 @@ def event_squeeze(
         ``linear`` (the paper's small-strain model, default), ``corotational`` or
         ``neo_hookean`` (finite deformation: :mod:`.nonlinear_model`).
     checkpoint : callable, optional
-        Called before every substep; may raise to abandon the squeeze (a cancellation).
+        Called before every substep and every fixed-set solve; may raise to abandon the
+        squeeze (a cancellation).
     options : SolveOptions, optional
         Switches of the large-deformation savings (adaptive substeps, factorisation reuse),
         for measuring them; default both on.

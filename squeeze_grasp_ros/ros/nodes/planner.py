@@ -363,7 +363,8 @@ class PlannerNode(Node):
                               progress: Callable[[float], None],
                               checkpoint: Callable[[], None]) -> Response:
         """The event squeeze of a service request or action goal as ``response_type``; the
-        callbacks may raise :class:`Cancelled` (after every event, before every substep).
+        callbacks may raise :class:`Cancelled` (after every event, before every substep and
+        fixed-set solve).
         """
         loaded = self._object(request)
         result = planning.event_squeeze_run(
@@ -446,11 +447,12 @@ class PlannerNode(Node):
 
         ROS 2 services have no cancel; a client that gives up and destroys its client (or
         whose process ends) leaves the graph, and its work stops at the next progress report
-        or checkpoint (the long loops call it before every stepper substep). The graph is
-        asked at most every :data:`WATCH_PERIOD` s; a progress report always asks. Clients
-        count as gone only once the graph has shown one during this request, or after
-        :data:`DISCOVERY_GRACE` s: across processes the graph can learn of a client after its
-        request arrived (a run's first ``load_object`` was refused as abandoned).
+        or checkpoint (the long loops call it before every stepper substep and fixed-set
+        solve). The graph is asked at most every :data:`WATCH_PERIOD` s; a progress report
+        always asks. Clients count as gone only once the graph has shown one during this
+        request, or after :data:`DISCOVERY_GRACE` s: across processes the graph can learn of a
+        client after its request arrived (a run's first ``load_object`` was refused as
+        abandoned).
         """
         name = f"{self.get_fully_qualified_name()}/{service}"
         asked, reported = [-math.inf], [()]

@@ -75,15 +75,18 @@ class _Call:
     def __init__(self, model: ContactModel, state: ContactState,
                  translations: Mapping[str, tuple[float, float]], step: float,
                  event_tol: float, terminate_on: tuple[str, ...], *,
-                 motion: FingerMotion | None = None, contacts: ContactSet | None = None) -> None:
+                 motion: FingerMotion | None = None, contacts: ContactSet | None = None,
+                 checkpoint: Callable[[], None] | None = None) -> None:
         """``motion`` and ``contacts``, when given, are those of ``state`` and
-        ``translations`` (a caller that keeps them across calls).
+        ``translations`` (a caller that keeps them across calls); ``checkpoint``: see
+        :func:`advance`.
         """
         L, fu = model.length, model.force_unit
         self.model, self.step, self.tol = model, step, event_tol
         self.motion = FingerMotion.of(state, translations, L) if motion is None else motion
         self.counters = Counters()
-        self.solver = SetSolver(model, self.motion, self.counters)
+        self.checkpoint = checkpoint
+        self.solver = SetSolver(model, self.motion, self.counters, checkpoint=checkpoint)
         self.functions = EventFunctions(model, self.motion, terminate_on)
         self.chatter = ChatterBound(state, step * L, model.max_events_per_depth)
         self.events = EventProcessor(state, ContactSet.of_state(model, state) if contacts is None
@@ -96,15 +99,14 @@ class _Call:
         self.compiled_location = CompiledLocation.of(self)
 
     # ------------------------------------------------------------------ the loop
-    def run(self, stop_on_event: bool, planned: float,
-            checkpoint: Callable[[], None] | None = None) -> tuple[Solution, str | None, float]:
+    def run(self, stop_on_event: bool, planned: float) -> tuple[Solution, str | None, float]:
         """Advance s from 0 to 1 (or to a termination / the first event point).
 
         Returns the last solution, the termination (or None) and the next planned substep
-        (relative to L). ``checkpoint`` is called before every substep (it may raise to
-        abandon the motion).
+        (relative to L). The call's checkpoint is called before every substep and every
+        fixed-set solve (it may raise to abandon the motion).
         """
-        ev, rate = self.events, self.motion.rate
+        ev, rate, checkpoint = self.events, self.motion.rate, self.checkpoint
         sol = ev.resolve()
         self.record(sol)
         term = ev.termination(sol)
@@ -353,8 +355,11 @@ def advance(
         First substep of a model that adapts its substeps, relative to L (default ``step``):
         a previous call's ``StepResult.next_substep``, to go on where its adaptation ended.
     checkpoint : callable, optional
-        Called with no arguments before every substep; it may raise (e.g. a cancellation) to
-        abandon the motion, and the exception propagates.
+        Called with no arguments before every substep and every fixed-set solve (of a
+        substep, an event location or a mode hypothesis): it may raise (e.g. a cancellation)
+        to abandon the motion, which then stops within one solve, and the exception
+        propagates. Given, the substeps run in Python (the numba route's compiled substeps
+        would not call it).
 
     Returns
     -------
@@ -371,10 +376,11 @@ def advance(
         where: the depth of the last point the motion had solved, m.
     """
     _check(step, event_tol, terminate_on, first_substep)
-    call = _Call(model, state, translations, step, min(event_tol, step), tuple(terminate_on))
+    call = _Call(model, state, translations, step, min(event_tol, step), tuple(terminate_on),
+                 checkpoint=checkpoint)
     try:
         sol, termination, next_substep = call.run(
-            stop_on_event, step if first_substep is None else first_substep, checkpoint)
+            stop_on_event, step if first_substep is None else first_substep)
     except NumericalError as error:  # where: the last point solved
         raise error.located(call.events.depth) from error
     return call.result(sol, termination, next_substep)

@@ -9,6 +9,8 @@ solution from one point to another and halves a substep whose continuation fails
 """
 from __future__ import annotations
 
+import functools
+from collections.abc import Callable
 from dataclasses import dataclass, field, fields
 
 import numpy as np
@@ -89,16 +91,31 @@ class Counters:
         return {f.name: v for f in fields(self) if (v := getattr(self, f.name)) is not None}
 
 
+def _checked(response: Callable, checkpoint: Callable[[], None]) -> Callable:
+    """``response`` (a nonlinear model's, with its attributes) calling ``checkpoint`` before
+    each of its evaluations.
+    """
+    @functools.wraps(response)  # its __dict__ too: tolerance, stall_halvings
+    def checked(delta: np.ndarray):
+        checkpoint()
+        return response(delta)
+    return checked
+
+
 @dataclass(frozen=True)
 class SetSolver:
     """Fixed-set solves of one call (model, finger motion; counts into ``counters``; the
-    route of the linear model's solve, ``kernel``, is read once for the call).
+    route of the linear model's solve, ``kernel``, is read once for the call; ``checkpoint``,
+    the call's, runs before every solve and, for a nonlinear model, before every equilibrium
+    solve of its Newton: a cancellation waits for one of them, not for a substep's halvings,
+    which on hard nonlinear squeezes took up to 12 s of CPU).
     """
 
     model: ContactModel
     motion: FingerMotion
     counters: Counters
     kernel: Kernel = field(default_factory=selected)
+    checkpoint: Callable[[], None] | None = None
 
     @kept_property
     def phi(self) -> float:
@@ -108,9 +125,14 @@ class SetSolver:
     def attempt(self, contacts: ContactSet, s: float,
                 theta: np.ndarray | None = None) -> Solution | SolveFailure:
         """The solution of ``contacts`` at s (from ``theta``, default the set's), or why none."""
+        response = self.model.response(contacts.data)
+        if self.checkpoint is not None:
+            self.checkpoint()
+            if not isinstance(response, LinearResponse):
+                response = _checked(response, self.checkpoint)
         tips = self.motion.contact_tips(contacts.finger)
         sol = attempt_fixed_set(
-            self.model.response(contacts.data),
+            response,
             Configuration(contacts.positions, contacts.stick, contacts.slip, tips.tip),
             tips.start + s * tips.translation,
             tips.translation,

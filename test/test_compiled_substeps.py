@@ -258,18 +258,39 @@ def test_low_friction_squeeze_keeps_its_physics_on_the_compiled_route(monkeypatc
 
 
 def test_what_the_kernel_does_not_take_stays_in_python(monkeypatch):
-    """Nonlinear materials, strain limits and checkpoints run the Python loop on the numba
-    route (their results are those of the numpy route, which the golden tests check).
+    """Nonlinear materials and strain limits run the Python loop on the numba route (their
+    results are those of the numpy route, which the golden tests check).
     """
     calls = []
     monkeypatch.setattr(compiled_module.CompiledSubsteps, "run",
                         lambda self, *args: calls.append(args))
     monkeypatch.setenv(KERNEL_VARIABLE, Kernel.NUMBA.value)
     _setup("foam_square_strain_limit").event_squeeze()
-    setup = _setup("foam_square")
-    setup.event_squeeze(checkpoint=lambda: None)
-    setup.event_squeeze(material_model="neo_hookean", relative_depth=0.02)
+    _setup("foam_square").event_squeeze(material_model="neo_hookean", relative_depth=0.02)
     assert calls == []
+
+
+@pytest.mark.parametrize("name", ["foam_square", "foam_square_low_friction"])
+def test_a_checkpointed_squeeze_runs_the_kernel_and_checks_between_its_calls(name, monkeypatch):
+    """A checkpoint (the planner's cancellation) no longer sends the numba route back to the
+    Python loop: the kernel runs the quiet substeps, the checkpoint runs before each of its
+    calls (at most CHUNK substeps each) as before every Python substep and solve, and the
+    result is the squeeze's without a checkpoint to the bit.
+    """
+    log: list[str] = []
+    run = compiled_module.CompiledSubsteps.run
+
+    def logged(self, *args):
+        log.append("kernel")
+        return run(self, *args)
+    monkeypatch.setattr(compiled_module.CompiledSubsteps, "run", logged)
+    monkeypatch.setenv(KERNEL_VARIABLE, Kernel.NUMBA.value)
+    plain = _setup(name).event_squeeze()
+    log.clear()
+    checked = _setup(name).event_squeeze(checkpoint=lambda: log.append("check"))
+    _same(plain, checked)
+    kernel = [k for k, entry in enumerate(log) if entry == "kernel"]
+    assert kernel and all(log[k - 1] == "check" for k in kernel)
 
 
 def _example_rows(route: Kernel, tasks: int | None, monkeypatch) -> list[dict]:

@@ -5,8 +5,9 @@
 :class:`CompiledSubsteps` hands the substep loop of a :func:`~.run.advance` call to
 :func:`..substeps_numba.advance_quiet` while nothing needs Python: the model's response is the
 linear F = C delta with the fast model's boundary compliance, the substeps keep the grid, no
-function is zero by construction at the start (``fresh``), no strain limit is checked and no
-``checkpoint`` is given. It gathers the contact set's tables (the fixed-set problem, the rows of
+function is zero by construction at the start (``fresh``) and no strain limit is checked (a
+``checkpoint`` of the call runs between the kernel's calls, each at most :data:`CHUNK`
+substeps). It gathers the contact set's tables (the fixed-set problem, the rows of
 the boundary operator for the free rows, the area bounds, where each watched value is), calls
 the kernel, and applies what it returns to the call: the accepted substeps' samples, work,
 dissipation and counters, the solution at the last point and the watched values there
@@ -120,11 +121,11 @@ class CompiledSubsteps:
         self._tables: tuple | None = None
 
     @classmethod
-    def of(cls, call, checkpoint) -> CompiledSubsteps | None:
+    def of(cls, call) -> CompiledSubsteps | None:
         """The compiled substeps of ``call``, or None when it must run in Python."""
         model = call.model
         lim = model.limits
-        if (checkpoint is not None or selected() != Kernel.NUMBA or model.reference
+        if (selected() != Kernel.NUMBA or model.reference
                 or model.adaptive_steps or type(model).response is not ContactModel.response
                 or call.motion.rate == 0
                 or (lim.strain is not None

@@ -114,7 +114,7 @@ class _Call:
             return sol, term, planned
         adaptive = self.model.adaptive_steps and not self.model.reference
         control = SubstepControl(self.step / rate, adaptive, planned / rate)
-        start, compiled = None, CompiledSubsteps.of(self, checkpoint)
+        start, compiled = None, CompiledSubsteps.of(self)
         python_next = False
         while ev.s < 1.0:
             if checkpoint is not None:
@@ -358,8 +358,8 @@ def advance(
         Called with no arguments before every substep and every fixed-set solve (of a
         substep, an event location or a mode hypothesis): it may raise (e.g. a cancellation)
         to abandon the motion, which then stops within one solve, and the exception
-        propagates. Given, the substeps run in Python (the numba route's compiled substeps
-        would not call it).
+        propagates. The numba route's compiled substeps call it between the kernel's calls
+        (each at most 256 substeps, :data:`~.compiled.CHUNK`).
 
     Returns
     -------

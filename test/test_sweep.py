@@ -86,6 +86,27 @@ def bare_rows(loaded) -> list[dict]:
     return sorted(rows, key=lambda r: r["eval_id"])
 
 
+def test_a_time_limit_cuts_only_the_squeezes_that_exceed_it(tmp_path):
+    """``time_limit``: a limit no squeeze reaches leaves every row as without one, bit for bit;
+    one every squeeze passes makes each row the squeeze's error, stopped at its first check
+    (before its first solve, at depth 0). The limit is part of the spec's hash, so rows cut by
+    one limit are not resumed under another.
+    """
+    data = {**SMALL, "objects": SMALL["objects"][:1], "friction": [0.3],
+            "placements": {"mode": "graspmap", "count": 1}}
+    loaded = {limit: parse_sweep_spec({**data, **({} if limit is None else
+                                                  {"time_limit": limit})}, tmp_path)
+              for limit in (None, 1000.0, 1e-9)}
+    plain = bare_rows(loaded[None])
+    assert plain and all(row["error"] is None for row in plain)
+    assert bare_rows(loaded[1000.0]) == plain
+    cut = bare_rows(loaded[1e-9])
+    assert [row["eval_id"] for row in cut] == [row["eval_id"] for row in plain]
+    assert all(row["error"] == "TimeLimitError: at depth 0 m (relative depth 0): the squeeze "
+               "used more than 1e-09 s of CPU (the sweep's time_limit)" for row in cut)
+    assert len({spec.hash for spec in loaded.values()}) == 3
+
+
 # ----------------------------------------------------------------- spec
 
 
@@ -99,6 +120,7 @@ def bare_rows(loaded) -> list[dict]:
          "relative_depth[0] must be in (0.0, 1.0) (at 1 the fingers would meet), got 1.5"),
         ({"depth": [0.01]}, "depth and relative_depth are exclusive"),
         ({"chunk": 0}, "chunk must be >= 1"),
+        ({"time_limit": -1}, "time_limit must be > 0.0 s, got -1.0"),
         ({"placements": {"mode": "random"}}, "placements.mode must be one of"),
         ({"repeat": 2}, "only sampled placements are random"),
         (

@@ -19,11 +19,13 @@ from __future__ import annotations
 
 import time
 from collections import OrderedDict
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
 
 from squeeze_grasp_ros.mechanics.elastic.mesh import Mesh
+from squeeze_grasp_ros.mechanics.errors import NumericalError
 from squeeze_grasp_ros.mechanics.resistance.optimal import sweep_directions
 from squeeze_grasp_ros.mechanics.squeeze.graspmap import GraspMap, grasp_map
 from squeeze_grasp_ros.mechanics.vocabulary import Finger, StrainMeasure, Termination
@@ -99,7 +101,8 @@ COLUMNS: dict[str, str] = {
     "error": "string",
 }
 """Dataset columns and their Arrow types (SI units; see docs/sweep.md). Every column but
-``time_s`` is identical, bit for bit, however the sweep is distributed."""
+``time_s`` is identical, bit for bit, however the sweep is distributed (but for the rows a
+``time_limit`` cut: where the limit falls depends on the machine)."""
 
 
 @dataclass(frozen=True)
@@ -230,7 +233,7 @@ def evaluate(task: Task, group: Group, index: int, params, resist: dict) -> dict
     )
     start = time.perf_counter()
     try:
-        res = setup.event_squeeze()
+        res = setup.event_squeeze(checkpoint=_time_limit(task.time_limit))
         if task.adversary is not None:
             key = (i, j)
             if key not in resist:
@@ -280,6 +283,26 @@ def evaluate(task: Task, group: Group, index: int, params, resist: dict) -> dict
     row["max_von_mises_x"], row["max_von_mises_y"] = _centroid(mesh, h.max_von_mises_element)
     row["time_s"] = time.perf_counter() - start
     return row
+
+
+class TimeLimitError(NumericalError):
+    """An evaluation's squeeze used more CPU time than the sweep's ``time_limit``."""
+
+
+def _time_limit(seconds: float | None) -> Callable[[], None] | None:
+    """The squeeze's checkpoint of a ``time_limit``: raises :class:`TimeLimitError` once this
+    thread has used more than ``seconds`` of CPU since the call (the stepper calls it before
+    every substep and every solve, so the squeeze stops within one solve); None without one.
+    """
+    if seconds is None:
+        return None
+    start = time.thread_time()
+
+    def check() -> None:
+        if time.thread_time() - start > seconds:
+            raise TimeLimitError(f"the squeeze used more than {seconds:g} s of CPU (the "
+                                 "sweep's time_limit)")
+    return check
 
 
 def run_task(task: Task) -> dict:

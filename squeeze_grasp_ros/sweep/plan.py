@@ -128,6 +128,8 @@ class Task:
     params : tuple of Params
     adversary : tuple or None
         (position, mode, contacts, directions).
+    time_limit : float or None
+        CPU seconds an evaluation's squeeze may use (the spec's ``time_limit``).
     """
 
     id: str
@@ -146,6 +148,7 @@ class Task:
     stop: int
     params: tuple
     adversary: Optional[tuple]
+    time_limit: Optional[float] = None
 
     @property
     def evaluations(self) -> int:
@@ -357,5 +360,5 @@ def plan_tasks(loaded: LoadedSpec) -> list[Task]:
                 tasks.append(Task(
                     f"{group}~c{c:04d}", group, loaded.hash, item, mat_name, scene, pl.mode,
                     pl.count, tuple(pl.require), float(mu_filter), sw.seed, sw.repeat, start,
-                    min(start + per_task, total), params, adversary))
+                    min(start + per_task, total), params, adversary, sw.time_limit))
     return sorted(tasks, key=lambda t: t.id)

@@ -236,6 +236,14 @@ class SweepSpec:
         lo=1,
         default=64,
     )
+    time_limit: Optional[float] = spec(
+        "CPU time one evaluation's squeeze may use; beyond it the squeeze stops within one "
+        "solve and the row carries the error (default: none; such rows depend on the machine)",
+        "s",
+        lo=0.0,
+        lo_open=True,
+        default=None,
+    )
 
 
 @dataclass(frozen=True)

@@ -85,7 +85,6 @@ class _Call:
         self.model, self.step, self.tol = model, step, event_tol
         self.motion = FingerMotion.of(state, translations, L) if motion is None else motion
         self.counters = Counters()
-        self.checkpoint = checkpoint
         self.solver = SetSolver(model, self.motion, self.counters, checkpoint=checkpoint)
         self.functions = EventFunctions(model, self.motion, terminate_on)
         self.chatter = ChatterBound(state, step * L, model.max_events_per_depth)
@@ -106,7 +105,7 @@ class _Call:
         (relative to L). The call's checkpoint is called before every substep and every
         fixed-set solve (it may raise to abandon the motion).
         """
-        ev, rate, checkpoint = self.events, self.motion.rate, self.checkpoint
+        ev, rate, checkpoint = self.events, self.motion.rate, self.solver.checkpoint
         sol = ev.resolve()
         self.record(sol)
         term = ev.termination(sol)

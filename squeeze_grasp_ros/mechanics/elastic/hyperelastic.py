@@ -44,7 +44,7 @@ from squeeze_grasp_ros.mechanics.vocabulary import MaterialModel
 
 __all__ = ["Assembly", "InvertedElementError", "MeshGeometry", "area_ratios", "assemble",
            "deformation", "determinants", "gradient_operator", "mesh_geometry",
-           "stress_and_tangent", "thickness_stretch", "with_tangent"]
+           "plane_stress_tensor", "stress_and_tangent", "thickness_stretch", "with_tangent"]
 
 _PLANE_STRESS_ITERATIONS = 30
 _SKEW = np.array([[0.0, -1.0], [1.0, 0.0]])
@@ -163,7 +163,7 @@ def determinants(F: np.ndarray) -> np.ndarray:
     return F[:, 0, 0] * F[:, 1, 1] - F[:, 0, 1] * F[:, 1, 0]
 
 
-def _plane_stress_tensor(nu: float) -> np.ndarray:
+def plane_stress_tensor(nu: float) -> np.ndarray:
     """C / E as a (2, 2, 2, 2) tensor for plane stress."""
     lam, mu2 = nu / (1.0 - nu * nu), 1.0 / (1.0 + nu)
     eye = np.eye(2)
@@ -173,7 +173,7 @@ def _plane_stress_tensor(nu: float) -> np.ndarray:
 
 
 def _linear(F: np.ndarray, nu: float, tangent: bool):
-    C = _plane_stress_tensor(nu)
+    C = plane_stress_tensor(nu)
     eps = 0.5 * (F + np.swapaxes(F, 1, 2)) - np.eye(2)
     P = np.einsum("ijkl,tkl->tij", C, eps)
     W = 0.5 * np.einsum("tij,tij->t", P, eps)
@@ -193,7 +193,7 @@ def _rotation(F: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
 
 def _corotational(F: np.ndarray, nu: float, tangent: bool):
     t = len(F)
-    C = _plane_stress_tensor(nu).reshape(4, 4)
+    C = plane_stress_tensor(nu).reshape(4, 4)
     R, dtheta, _ = _rotation(F)
     U = np.swapaxes(R, 1, 2) @ F
     E = 0.5 * (U + np.swapaxes(U, 1, 2)) - np.eye(2)

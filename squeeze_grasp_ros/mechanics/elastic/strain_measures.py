@@ -32,7 +32,7 @@ from squeeze_grasp_ros.mechanics.errors import InvalidInputError
 from squeeze_grasp_ros.mechanics.ties import first_tied
 from squeeze_grasp_ros.mechanics.vocabulary import StrainMeasure
 
-__all__ = ["COMMON_STRAIN_MEASURE", "largest_pair_entry", "max_principal_strain",
+__all__ = ["COMMON_STRAIN_MEASURE", "largest_pair_entry", "log_strain", "max_principal_strain",
            "max_principal_strains", "principal_strains"]
 
 COMMON_STRAIN_MEASURE = StrainMeasure.BIOT
@@ -70,7 +70,7 @@ def _biot(two_e: np.ndarray) -> np.ndarray:
     return two_e / (1.0 + np.sqrt(1.0 + two_e))
 
 
-def _log(two_e: np.ndarray) -> np.ndarray:
+def log_strain(two_e: np.ndarray) -> np.ndarray:
     """Log strains ln lambda of :func:`_stretch_ratio` ``two_e``."""
     with np.errstate(divide="ignore"):
         return 0.5 * np.log1p(two_e)
@@ -80,7 +80,7 @@ def _of_stretch(e: np.ndarray, measure: StrainMeasure) -> np.ndarray:
     """Principal strains in a measure of the stretch from the Green-Lagrange ones ``e``."""
     if measure == StrainMeasure.GREEN_LAGRANGE:
         return e
-    return (_biot if measure == StrainMeasure.BIOT else _log)(_stretch_ratio(e))
+    return (_biot if measure == StrainMeasure.BIOT else log_strain)(_stretch_ratio(e))
 
 
 def principal_strains(F: np.ndarray, measure: StrainMeasure | str) -> np.ndarray:
@@ -141,5 +141,5 @@ def max_principal_strains(F: np.ndarray) -> dict[StrainMeasure, float]:
     two_e = _stretch_ratio(e)
     fields = {StrainMeasure.SMALL: principal_pair(h00, h11, h01 + h10),
               StrainMeasure.BIOT: _biot(two_e),
-              StrainMeasure.LOG: _log(two_e), StrainMeasure.GREEN_LAGRANGE: e}
+              StrainMeasure.LOG: log_strain(two_e), StrainMeasure.GREEN_LAGRANGE: e}
     return {m: float(np.abs(fields[m]).max()) for m in StrainMeasure}

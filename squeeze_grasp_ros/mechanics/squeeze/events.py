@@ -13,6 +13,7 @@ SI units at the interface, object frame.
 
 from __future__ import annotations
 
+import functools
 import math
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
@@ -20,7 +21,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from squeeze_grasp_ros.mechanics.elastic.compliance import ElasticObject
-from squeeze_grasp_ros.mechanics.elastic.strain_measures import max_principal_strains
+from squeeze_grasp_ros.mechanics.elastic.hyperelastic import plane_stress_tensor
+from squeeze_grasp_ros.mechanics.elastic.strain_measures import log_strain, max_principal_strains
 from squeeze_grasp_ros.mechanics.elastic.stress_measures import element_stresses, von_mises
 from squeeze_grasp_ros.mechanics.errors import (
     InvalidInputError,
@@ -34,6 +36,7 @@ from squeeze_grasp_ros.mechanics.squeeze.contact_model import (
     SetData,
     SolveOptions,
     TerminationLimits,
+    strain_tables,
 )
 from squeeze_grasp_ros.mechanics.squeeze.contact_state import (
     Chatter,
@@ -45,6 +48,7 @@ from squeeze_grasp_ros.mechanics.squeeze.contact_state import (
     initial_state,
 )
 from squeeze_grasp_ros.mechanics.squeeze.fingertips import place_fingertip
+from squeeze_grasp_ros.mechanics.squeeze.fixed_set_kernel import Kernel, compiled_health, selected
 from squeeze_grasp_ros.mechanics.squeeze.nonlinear_model import (
     NonlinearContactModel,
     contact_model,
@@ -52,7 +56,7 @@ from squeeze_grasp_ros.mechanics.squeeze.nonlinear_model import (
 from squeeze_grasp_ros.mechanics.squeeze.stable_pure import finger_motion
 from squeeze_grasp_ros.mechanics.squeeze.stepper import TERMINATION_ORDER, advance
 from squeeze_grasp_ros.mechanics.squeeze.tip_shapes import TipShape
-from squeeze_grasp_ros.mechanics.ties import first_max
+from squeeze_grasp_ros.mechanics.ties import TIE, first_max
 from squeeze_grasp_ros.mechanics.vocabulary import (
     SQUEEZING_FINGERS,
     ContactMode,
@@ -447,11 +451,18 @@ def _health(model: ContactModel, state: ContactState,
     """:func:`grasp_health` of the :func:`_contact_loads` ``loads`` of ``state``."""
     obj = model.obj
     u_hat = model.full_displacement(*loads)
-    strain, element = model.field_strain(u_hat)
-    deformation = model.field_deformation(u_hat)
-    stress, stress_measure = element_stresses(model.constitutive_model, deformation,
-                                              E=obj.material.E, nu=obj.material.nu)
-    vm = von_mises(stress)
+    fields = _compiled_fields(model, u_hat)
+    if fields is None:
+        strain, element = model.field_strain(u_hat)
+        deformation = model.field_deformation(u_hat)
+        stress, stress_measure = element_stresses(model.constitutive_model, deformation,
+                                                  E=obj.material.E, nu=obj.material.nu)
+        vm = von_mises(stress)
+        k_vm = first_max(vm)
+        max_vm, max_principal = float(vm[k_vm]), max_principal_strains(deformation)
+    else:
+        strain, element, max_vm, k_vm, max_principal = fields
+        stress_measure = model.constitutive_model.stress_measure
     u = u_hat.reshape(-1, 2) * model.length
     norms = np.sqrt((u * u).sum(axis=1))  # np.linalg.norm(u, axis=1), without its checks
     if summaries is None:
@@ -459,15 +470,14 @@ def _health(model: ContactModel, state: ContactState,
     margins: dict[str, list[float]] = {}
     for c, n in zip(state.contacts, summaries):
         margins.setdefault(c.finger, []).append(n.slip_margin)
-    max_principal = max_principal_strains(deformation)
-    k_vm, k_u = first_max(vm), first_max(norms)  # a mirror twin: the first, on any machine
+    k_u = first_max(norms)  # a mirror twin: the first, on any machine
     health = GraspHealth(
         max_strain=strain,
         max_strain_element=element,
         criterion=StrainCriterion(model.limits.criterion),
         strain_measure=model.strain_measure,
         max_principal_strain=max_principal,
-        max_von_mises=float(vm[k_vm]),
+        max_von_mises=max_vm,
         max_von_mises_element=k_vm,
         stress_measure=stress_measure,
         max_displacement=float(norms[k_u]),
@@ -483,6 +493,39 @@ def _health(model: ContactModel, state: ContactState,
         if not math.isfinite(value):  # (the check once per squeeze, without an array each)
             require_finite(f"grasp health: {name}", value)
     return health, u
+
+
+@functools.lru_cache(maxsize=16)
+def _plane_stress(nu: float) -> np.ndarray:
+    """:func:`~..elastic.hyperelastic.plane_stress_tensor` of ``nu``, kept (read-only)."""
+    C = plane_stress_tensor(nu)
+    C.flags.writeable = False
+    return C
+
+
+def _compiled_fields(model: ContactModel, u_hat: np.ndarray) -> tuple | None:
+    """The linear model's health fields of the displacement ``u_hat`` (2n,) / L by the
+    compiled pass (:mod:`.health_numba`; the same floats as the numpy route): (strain, its
+    element, von Mises stress Pa, its element, the largest principal strain by measure); None
+    on the numpy route or for a nonlinear model.
+    """
+    if model.constitutive_model != MaterialModel.LINEAR or selected() != Kernel.NUMBA:
+        return None
+    obj = model.obj
+    B, dofs = strain_tables(obj, model.length)
+    G = obj.gradient
+    t = len(dofs)
+    two_e = np.empty((2, t))
+    strain, element, vm, k_vm, small, biot, green = compiled_health().linear_fields(
+        u_hat, G.data, G.indices, G.indptr, B, dofs,
+        model.limits.criterion == StrainCriterion.COMPONENTWISE,
+        _plane_stress(float(obj.material.nu)), float(obj.material.E), TIE,
+        np.empty((t, 2, 2)), two_e, np.empty(2 * t))
+    by_measure = {StrainMeasure.SMALL: small, StrainMeasure.BIOT: biot,
+                  StrainMeasure.LOG: float(np.abs(log_strain(two_e)).max()),
+                  StrainMeasure.GREEN_LAGRANGE: green}
+    return (float(strain), int(element), float(vm), int(k_vm),
+            {m: float(by_measure[m]) for m in StrainMeasure})
 
 
 def _segment(state: ContactState, summaries: Sequence[SegmentNode],

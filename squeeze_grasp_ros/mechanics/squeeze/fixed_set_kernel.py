@@ -93,6 +93,18 @@ def compiled_substeps():
     return substeps_numba
 
 
+@cache
+def compiled_health():
+    """The compiled module :mod:`.health_numba` (the linear model's grasp-health field pass),
+    or None without numba.
+    """
+    try:
+        from squeeze_grasp_ros.mechanics.squeeze import health_numba
+    except ImportError:
+        return None
+    return health_numba
+
+
 def chosen() -> Kernel | None:
     """The route :data:`KERNEL_VARIABLE` names, None when it is unset (:func:`selected` reads
     that as numpy; the neo-Hookean assembly decides by the mesh:

@@ -47,13 +47,14 @@ from squeeze_grasp_ros.mechanics.squeeze.contact_state import (
     event_counts,
     initial_state,
 )
-from squeeze_grasp_ros.mechanics.squeeze.fingertips import place_fingertip
+from squeeze_grasp_ros.mechanics.squeeze.fingertips import Fingertip, place_fingertip
 from squeeze_grasp_ros.mechanics.squeeze.fixed_set_kernel import Kernel, compiled_health, selected
+from squeeze_grasp_ros.mechanics.squeeze.kept import kept_for
 from squeeze_grasp_ros.mechanics.squeeze.nonlinear_model import (
     NonlinearContactModel,
     contact_model,
 )
-from squeeze_grasp_ros.mechanics.squeeze.stable_pure import finger_motion
+from squeeze_grasp_ros.mechanics.squeeze.stable_pure import FingerMotion, finger_motion
 from squeeze_grasp_ros.mechanics.squeeze.stepper import TERMINATION_ORDER, advance
 from squeeze_grasp_ros.mechanics.squeeze.tip_shapes import TipShape
 from squeeze_grasp_ros.mechanics.ties import TIE, first_max
@@ -503,6 +504,51 @@ def _plane_stress(nu: float) -> np.ndarray:
     return C
 
 
+KEPT_STARTS = 256
+"""Squeeze starts (tips, motion, initial state) an object keeps (:func:`_start`)."""
+
+
+def _start(obj: ElasticObject, placements: Mapping[str, tuple], kind: str,
+           directions: Mapping[str, tuple[float, float]] | None
+           ) -> tuple[list[Fingertip], FingerMotion, ContactState]:
+    """The placed tips, the finger motion and the initial state of a squeeze of ``obj`` from
+    ``placements`` (finger -> (node, tip, facing, origin) as :func:`event_squeeze` takes
+    them). A start of planned directions is kept on the object, its arrays read-only (the state
+    is immutable): a sweep squeezes each placement and tip at several frictions and depths,
+    from the same start. Inputs that cannot be a key (an origin given as an array) are not kept.
+    """
+    def make() -> tuple[list[Fingertip], FingerMotion, ContactState]:
+        tips = [place_fingertip(obj.mesh, n, *placement) for n, placement in placements.items()]
+        motion = finger_motion(obj, tuple(t.node for t in tips), kind=kind,
+                               directions=directions)
+        return tips, motion, initial_state(tips, motion.relative_per_depth)
+
+    tag = (str(kind), tuple((str(n), node, tip, facing, None if origin is None else tuple(
+        float(x) for x in np.asarray(origin, float).reshape(-1)))
+        for n, (node, tip, facing, origin) in placements.items()))
+    try:
+        hash(tag)
+    except TypeError:
+        return make()
+    if directions is not None:
+        return make()
+    kept = obj._shared.setdefault("squeeze_starts", {})
+    return kept_for(kept, obj, tag, lambda: _frozen(make()), KEPT_STARTS)
+
+
+def _frozen(start: tuple[list[Fingertip], FingerMotion, ContactState]) -> tuple:
+    """``start`` with every array it holds made read-only (it is shared by the squeezes that
+    start there).
+    """
+    tips, motion, state = start
+    arrays = [t.center for t in tips] + list(motion.directions.values())
+    arrays += [a for f in state.fingers for a in (f.center, f.translation)]
+    arrays += [a for c in state.contacts for a in (c.displacement, c.force)]
+    for a in arrays:
+        a.flags.writeable = False
+    return start
+
+
 def _compiled_fields(model: ContactModel, u_hat: np.ndarray) -> tuple | None:
     """The linear model's health fields of the displacement ``u_hat`` (2n,) / L by the
     compiled pass (:mod:`.health_numba`; the same floats as the numpy route): (strain, its
@@ -675,13 +721,12 @@ def event_squeeze(
     if missing:
         raise InvalidInputError(f"tip gives no fingertip for {', '.join(missing)}")
     facing, origins = dict(facing or {}), dict(origins or {})
-    tips = [place_fingertip(obj.mesh, n, int(c), shapes[n], facing.get(n), origins.get(n))
-            for n, c in zip(names, contacts)]
+    tips, motion, start = _start(obj, {n: (int(c), shapes[n], facing.get(n), origins.get(n))
+                                       for n, c in zip(names, contacts)}, kind, directions)
     contacts = tuple(t.node for t in tips)
     radii = {t.name: t.radius for t in tips}
     shapes = {n: s if isinstance(s, TipShape) else TipShape.circle(radii[n])
               for n, s in shapes.items() if n in names}
-    motion = finger_motion(obj, contacts, kind=kind, directions=directions)
     dirs, relative_per_depth, kind = motion.directions, motion.relative_per_depth, motion.kind
     if depth is None:
         if not relative_per_depth > 0:
@@ -693,8 +738,8 @@ def event_squeeze(
     model = contact_model(material_model, obj, mu, limits or TerminationLimits(), reference,
                           max_events_per_depth, options or SolveOptions())
     try:
-        run = squeeze_to_depth(model, initial_state(tips, relative_per_depth), dirs, depth, step,
-                               event_tol, progress, checkpoint=checkpoint)
+        run = squeeze_to_depth(model, start, dirs, depth, step, event_tol, progress,
+                               checkpoint=checkpoint)
     except NumericalError as error:  # where, also as a relative depth
         relative = None if error.depth is None else error.depth * relative_per_depth
         raise error.located(error.depth, relative) from error
@@ -723,7 +768,7 @@ def event_squeeze(
         target_depth=float(depth),
         kind=kind,
         contacts=tuple(int(c) for c in contacts),
-        directions=dirs,
+        directions={k: v.copy() for k, v in dirs.items()},
         mu=float(mu),
         tip_radius=radii,
         events=run.events,

@@ -69,8 +69,10 @@ COMPILED_PATTERN = (r"fixed_set_numba\.py:\d*\(?solve_linear"
 """The compiled kernels' profile entries: the fixed-set solve, the substeps between events, the
 watched functions' values and slopes at event points, and the event location (numba's
 dispatchers: their self time is the compiled call, BLAS and LAPACK inside included)."""
-SPEED_UP_PASSES = 2
-"""Rounds of the interleaved comparison with the pinned commit (best of them for each code)."""
+SPEED_UP_PASSES = 4
+"""Rounds of the interleaved comparison with the pinned commit (best of them for each code).
+Two were too few on this shared machine: runs of the same code minutes apart printed 3.79x
+and 4.27x (2026-11-30), a neighbour's load having slowed both rounds of one code."""
 FOAM_SQUARE_NODES, FOAM_SQUARE_REPEATS = 2000, 5
 """The foam square of issue 33 §1 (about 2,000 nodes: 2,020) and the squeezes timed per child
 (best of them)."""

@@ -14,6 +14,7 @@ import pytest
 from squeeze_grasp_ros.api import load_scene, scene_file
 from squeeze_grasp_ros.mechanics.errors import InvalidInputError
 from squeeze_grasp_ros.mechanics.squeeze import events
+from squeeze_grasp_ros.mechanics.squeeze.fingertips import place_fingertip
 from squeeze_grasp_ros.mechanics.squeeze.tip_shapes import TipShape
 from squeeze_grasp_ros.scene import GraspSetup
 
@@ -84,4 +85,22 @@ def test_a_start_that_fails_is_not_kept_and_fails_again():
     for _ in range(2):  # two wide pads on neighbouring nodes touch the same node
         with pytest.raises(InvalidInputError, match="both touch boundary node"):
             events.event_squeeze(obj, (int(b[0]), int(b[1])), pad, 0.4, relative_depth=0.02)
+    assert not obj._shared.get("squeeze_starts")
+
+
+def test_an_origin_that_is_no_key_fails_as_the_tip_placement_does():
+    """The key is not built before the placement checks its inputs: a bad tip is named first,
+    as the placement names it, and an origin that is not numbers fails as it fails there.
+    """
+    setup = foam()
+    obj, nodes = setup.solid, setup.contacts
+    with pytest.raises(InvalidInputError, match="tip_radius must be > 0"):
+        events.event_squeeze(obj, nodes, -0.02, 0.4, relative_depth=0.02, facing={"F1": 0.0},
+                             origins={"F1": "not a point"})
+    with pytest.raises(ValueError) as direct:
+        place_fingertip(obj.mesh, "F1", nodes[0], 0.02, 0.0, "not a point")
+    with pytest.raises(ValueError) as squeezed:
+        events.event_squeeze(obj, nodes, 0.02, 0.4, relative_depth=0.02, facing={"F1": 0.0},
+                             origins={"F1": "not a point"})
+    assert str(squeezed.value) == str(direct.value)
     assert not obj._shared.get("squeeze_starts")

@@ -515,7 +515,7 @@ def _start(obj: ElasticObject, placements: Mapping[str, tuple], kind: str,
     ``placements`` (finger -> (node, tip, facing, origin) as :func:`event_squeeze` takes
     them). A start of planned directions is kept on the object, its arrays read-only (the state
     is immutable): a sweep squeezes each placement and tip at several frictions and depths,
-    from the same start. Inputs that cannot be a key (an origin given as an array) are not kept.
+    from the same start. Inputs that cannot be a key are not kept (they fail as they did).
     """
     def make() -> tuple[list[Fingertip], FingerMotion, ContactState]:
         tips = [place_fingertip(obj.mesh, n, *placement) for n, placement in placements.items()]
@@ -523,14 +523,14 @@ def _start(obj: ElasticObject, placements: Mapping[str, tuple], kind: str,
                                directions=directions)
         return tips, motion, initial_state(tips, motion.relative_per_depth)
 
-    tag = (str(kind), tuple((str(n), node, tip, facing, None if origin is None else tuple(
-        float(x) for x in np.asarray(origin, float).reshape(-1)))
-        for n, (node, tip, facing, origin) in placements.items()))
-    try:
-        hash(tag)
-    except TypeError:
-        return make()
     if directions is not None:
+        return make()
+    try:
+        tag = (str(kind), tuple((str(n), node, tip, facing, None if origin is None else tuple(
+            float(x) for x in np.asarray(origin, float).reshape(-1)))
+            for n, (node, tip, facing, origin) in placements.items()))
+        hash(tag)
+    except (TypeError, ValueError):  # no key (an origin that is not numbers): make() says why
         return make()
     kept = obj._shared.setdefault("squeeze_starts", {})
     return kept_for(kept, obj, tag, lambda: _frozen(make()), KEPT_STARTS)

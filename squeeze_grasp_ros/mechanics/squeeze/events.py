@@ -560,18 +560,14 @@ def _compiled_fields(model: ContactModel, u_hat: np.ndarray) -> tuple | None:
     obj = model.obj
     B, dofs = strain_tables(obj, model.length)
     G = obj.gradient
-    t = len(dofs)
-    two_e = np.empty((2, t))
-    strain, element, vm, k_vm, small, biot, green = compiled_health().linear_fields(
+    strain, element, vm, k_vm, small, biot, green, two_e = compiled_health().linear_fields(
         u_hat, G.data, G.indices, G.indptr, B, dofs,
         model.limits.criterion == StrainCriterion.COMPONENTWISE,
-        _plane_stress(float(obj.material.nu)), float(obj.material.E), TIE,
-        np.empty((t, 2, 2)), two_e, np.empty(2 * t))
-    by_measure = {StrainMeasure.SMALL: small, StrainMeasure.BIOT: biot,
-                  StrainMeasure.LOG: float(np.abs(log_strain(two_e)).max()),
-                  StrainMeasure.GREEN_LAGRANGE: green}
-    return (float(strain), int(element), float(vm), int(k_vm),
-            {m: float(by_measure[m]) for m in StrainMeasure})
+        _plane_stress(float(obj.material.nu)), float(obj.material.E), TIE)
+    return strain, element, vm, k_vm, {
+        StrainMeasure.SMALL: small, StrainMeasure.BIOT: biot,
+        StrainMeasure.LOG: float(np.abs(log_strain(two_e)).max()),
+        StrainMeasure.GREEN_LAGRANGE: green}  # StrainMeasure's order, as the numpy route's
 
 
 def _segment(state: ContactState, summaries: Sequence[SegmentNode],

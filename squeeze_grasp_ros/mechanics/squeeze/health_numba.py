@@ -95,8 +95,7 @@ def _abs_max(current, value):
 
 
 @jit
-def linear_fields(u, g_data, g_indices, g_indptr, B, dofs, componentwise, C, E, tie,
-                  F, two_e, work):
+def linear_fields(u, g_data, g_indices, g_indptr, B, dofs, componentwise, C, E, tie):
     """The linear model's health fields of the dimensionless displacement ``u`` (2n,).
 
     Parameters
@@ -113,28 +112,18 @@ def linear_fields(u, g_data, g_indices, g_indptr, B, dofs, componentwise, C, E, 
         Plane-stress C / E; ``E`` Young's modulus, Pa.
     tie : float
         :data:`~..ties.TIE`.
-    F, two_e, work : ndarray
-        Outputs and scratch: the deformation gradients (t, 2, 2), the stretch ratios 2 e of
-        the principal Green-Lagrange strains (2, t) (for the log strain), scratch (2t,).
 
     Returns
     -------
     tuple
         (strain, its element, von Mises stress Pa, its element, the largest absolute principal
-        small, Biot and Green-Lagrange strains).
+        small, Biot and Green-Lagrange strains, the stretch ratios 2 e of the principal
+        Green-Lagrange strains (2, t) for the log strain).
     """
-    t = F.shape[0]
-    for e in range(t):  # the CSR product, row by row as scipy sums it
-        for r in range(4):
-            row = 4 * e + r
-            s = 0.0
-            for jj in range(g_indptr[row], g_indptr[row + 1]):
-                s += g_data[jj] * u[g_indices[jj]]
-            F[e, r // 2, r % 2] = s
-        F[e, 0, 0] += 1.0
-        F[e, 1, 1] += 1.0
-    eps = np.empty(3)
+    t = dofs.shape[0]
+    work = np.empty(2 * t)
     for e in range(t):  # the strain limit's strain: B d_e as einsum sums it
+        eps = np.empty(3)
         for i in range(3):
             even = (B[e, i, 0] * u[dofs[e, 0]] + B[e, i, 2] * u[dofs[e, 2]]) \
                 + B[e, i, 4] * u[dofs[e, 4]]
@@ -148,10 +137,19 @@ def linear_fields(u, g_data, g_indices, g_indptr, B, dofs, componentwise, C, E, 
         work[2 * e], work[2 * e + 1] = abs(a), abs(b)
     strain, k = _first_max(work, tie)
     small = biot = green = 0.0
+    two_e = np.empty((2, t))
+    F = np.empty((2, 2))
     sym = np.empty((2, 2))
-    for e in range(t):  # principal strains in every measure, the stress
-        h00, h01 = F[e, 0, 0] - 1.0, F[e, 0, 1] - 0.0
-        h10, h11 = F[e, 1, 0] - 0.0, F[e, 1, 1] - 1.0
+    for e in range(t):  # F, the principal strains in every measure, the stress
+        for r in range(4):  # the CSR product, row by row as scipy sums it
+            row = 4 * e + r
+            s = 0.0
+            for jj in range(g_indptr[row], g_indptr[row + 1]):
+                s += g_data[jj] * u[g_indices[jj]]
+            F[r // 2, r % 2] = s
+        F[0, 0] += 1.0
+        F[1, 1] += 1.0
+        h00, h01, h10, h11 = F[0, 0] - 1.0, F[0, 1] - 0.0, F[1, 0] - 0.0, F[1, 1] - 1.0
         s1, s2 = _pair(h00, h11, h01 + h10)
         small = _abs_max(_abs_max(small, s1), s2)
         g1, g2 = _pair(h00 + 0.5 * (h00 * h00 + h10 * h10), h11 + 0.5 * (h01 * h01 + h11 * h11),
@@ -161,11 +159,11 @@ def linear_fields(u, g_data, g_indices, g_indptr, B, dofs, componentwise, C, E, 
         biot = _abs_max(_abs_max(biot, _biot(two_e[0, e])), _biot(two_e[1, e]))
         for i in range(2):
             for j in range(2):
-                sym[i, j] = 0.5 * (F[e, i, j] + F[e, j, i]) - (1.0 if i == j else 0.0)
+                sym[i, j] = 0.5 * (F[i, j] + F[j, i]) - (1.0 if i == j else 0.0)
         work[e] = _von_mises(E * _contract(C, 0, 0, sym), E * _contract(C, 1, 1, sym),
                              0.5 * (E * _contract(C, 0, 1, sym) + E * _contract(C, 1, 0, sym)))
     vm, k_vm = _first_max(work[:t], tie)
-    return strain, k // 2, vm, k_vm, small, biot, green
+    return strain, k // 2, vm, k_vm, small, biot, green, two_e
 
 
 @jit
@@ -173,9 +171,8 @@ def _von_mises(s11, s22, s12):
     """Plane-stress von Mises stress of (s11, s22, s12), scaled by the largest power of two
     as :func:`~..elastic.stress_measures.von_mises`.
     """
-    top = max(max(abs(s11), abs(s22)), abs(s12))
     if np.isnan(s11) or np.isnan(s22) or np.isnan(s12):
         return np.nan
-    _, k = math.frexp(top)
+    _, k = math.frexp(max(max(abs(s11), abs(s22)), abs(s12)))
     s11, s22, s12 = math.ldexp(s11, -k), math.ldexp(s22, -k), math.ldexp(s12, -k)
     return math.ldexp(math.sqrt(s11 * s11 - s11 * s22 + s22 * s22 + 3.0 * s12 * s12), k)

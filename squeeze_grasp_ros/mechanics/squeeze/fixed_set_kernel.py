@@ -28,6 +28,7 @@ from __future__ import annotations
 import os
 from enum import Enum
 from functools import cache
+from importlib import import_module
 
 from squeeze_grasp_ros.extras import EXTRAS, installed
 from squeeze_grasp_ros.mechanics.errors import InvalidInputError
@@ -72,37 +73,31 @@ fixed-set solve; whether numba is there is checked at every read)."""
 
 
 @cache
-def compiled():
-    """The compiled module :mod:`.fixed_set_numba`, or None without numba."""
+def _kernel_module(name: str):
+    """The compiled module ``name`` of this package's squeeze, or None without numba."""
     try:
-        from squeeze_grasp_ros.mechanics.squeeze import fixed_set_numba
+        return import_module(f"squeeze_grasp_ros.mechanics.squeeze.{name}")
     except ImportError:
         return None
-    return fixed_set_numba
 
 
-@cache
+def compiled():
+    """The compiled module :mod:`.fixed_set_numba`, or None without numba."""
+    return _kernel_module("fixed_set_numba")
+
+
 def compiled_substeps():
     """The compiled module :mod:`.substeps_numba` (the substeps between events), or None
     without numba.
     """
-    try:
-        from squeeze_grasp_ros.mechanics.squeeze import substeps_numba
-    except ImportError:
-        return None
-    return substeps_numba
+    return _kernel_module("substeps_numba")
 
 
-@cache
 def compiled_health():
     """The compiled module :mod:`.health_numba` (the linear model's grasp-health field pass),
     or None without numba.
     """
-    try:
-        from squeeze_grasp_ros.mechanics.squeeze import health_numba
-    except ImportError:
-        return None
-    return health_numba
+    return _kernel_module("health_numba")
 
 
 def chosen() -> Kernel | None:
